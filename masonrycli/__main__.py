@@ -1,0 +1,3 @@
+from masonrycli.cli import main
+
+main()

@@ -1,0 +1,59 @@
+"""One recorded frame: everything the history file and the recording receive every ``record_every`` steps.
+
+Plain arrays (struct of arrays). Index conventions: blocks 0..N-1 in scenario order, supports 0..S-1,
+contacts 0..C-1 (C varies per frame). Body indices in ``contact_body`` run over blocks first, then
+supports (body N + s is support s).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+CONTACT_OPEN, CONTACT_STICK, CONTACT_SLIP = 0, 1, 2
+
+
+@dataclass(frozen=True, eq=False)
+class Frame:
+    step: int
+    """Time-step index (0 = initial state)."""
+    time: float
+    """Simulated time, s."""
+    block_q: np.ndarray
+    """(N, 3) centroid x, y (m) and rotation from the initial orientation (rad, counter-clockwise)."""
+    block_v: np.ndarray
+    """(N, 3) centroid velocity vx, vy (m/s) and angular velocity (rad/s)."""
+    support_q: np.ndarray
+    """(S, 3) support displacement-carrying pose: reference point x, y (m) and rotation (rad)."""
+    support_v: np.ndarray
+    """(S, 2) imposed support velocity, m/s."""
+    support_force: np.ndarray
+    """(S, 2) total contact force the blocks exert on each support, N (per block thickness)."""
+    contact_body: np.ndarray
+    """(C, 2) int: bodies a, b of each contact (normal points from a to b)."""
+    contact_point: np.ndarray
+    """(C, 2) contact point in world coordinates, m."""
+    contact_normal: np.ndarray
+    """(C, 2) unit normal from body a to body b."""
+    contact_force: np.ndarray
+    """(C, 2) contact force on body b in world coordinates, N (impulse / dt); body a gets the opposite."""
+    contact_gap: np.ndarray
+    """(C,) gap at detection, m (negative = penetration)."""
+    contact_status: np.ndarray
+    """(C,) int8: 0 open, 1 stick, 2 slip."""
+    contact_mobilised: np.ndarray
+    """(C,) |r_t| / (mu r_n), 0 for open contacts."""
+    tensors: dict
+    """Per-block tensor fields, name -> array (see masonrycli.tensors.TENSOR_FIELDS)."""
+    energy_kinetic: float
+    """J (per block thickness)."""
+    energy_potential: float
+    """J, relative to y = 0 along gravity."""
+    energy_dissipated: float
+    """J, cumulated since t = 0 (>= 0)."""
+    support_work: float
+    """J, cumulated work done by the supports on the blocks since t = 0."""
+    nlgs_iterations: int
+    nlgs_residual: float
+    contact_count: int
