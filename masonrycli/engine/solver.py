@@ -1,0 +1,145 @@
+"""One Moreau–Jean time step: launchers only, every loop lives in a kernel.
+
+    1. q_m = q_n + (1 − θ) dt v_n                          integrate.intermediate_q
+    2. contacts at q_m (broad + narrow phase)              collision.detect_contacts
+    3. warm start: r_α ← r of the previous step with the same key
+    4. v_free = v_n + dt g ; supports get v(t_n+1)         integrate.free_velocity
+    5. lever arms, W_αα, Signorini bias                    nlgs.prepare_contacts
+    6. NLGS → r, v_n+1                                     nlgs.solve
+    7. contact forces, dissipation, support work           nlgs.contact_power
+    8. q_n+1 = q_n + dt (θ v_n+1 + (1 − θ) v_n)            integrate.update_q
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from masonrycli.engine import integrate, nlgs
+from masonrycli.engine.collision import ContactBuffers, detect_contacts
+
+
+@dataclass(frozen=True)
+class StepStats:
+    contact_count: int
+    iterations: int
+    residual: float
+    dissipated: float
+    """Energy dissipated at the contacts during the step, J."""
+    support_work: float
+    """Work of the supports on the blocks during the step, J."""
+    max_penetration: float
+    """Largest penetration among the step's contacts at detection, m (0 if none)."""
+
+
+class Solver:
+    """Owns the per-step work buffers of one model. ``step(state)`` advances ``state`` in place.
+
+    After a step, the ``contact_*`` properties hold the step's contacts (views of length C).
+    """
+
+    def __init__(self, model):
+        self.model = model
+        b = model.body_count
+        self.buffers = ContactBuffers(max(64, 8 * b))
+        self.body_q_m = np.empty((b, 3))
+        """(B, 3) configuration at which the last step detected its contacts."""
+        self._v_old = np.empty((b, 3))
+        self._prev_key = np.empty(0, dtype=np.int64)
+        self._prev_r = np.empty((0, 2))
+        self._count = 0
+        self._alloc(self.buffers.capacity)
+
+    def _alloc(self, capacity: int) -> None:
+        self._ra = np.zeros((capacity, 2))
+        self._rb = np.zeros((capacity, 2))
+        self._w = np.zeros((capacity, 3))
+        self._bias = np.zeros(capacity)
+        self._r = np.zeros((capacity, 2))
+        self._status = np.zeros(capacity, dtype=np.int8)
+        self._force = np.zeros((capacity, 2))
+        self.support_force = np.zeros((self.model.support_count, 2))
+        """(S, 2) N: total force the blocks exert on each support during the last step."""
+
+    # Views of the last step's contacts -------------------------------------------------------
+    @property
+    def contact_body(self) -> np.ndarray:
+        return self.buffers.body[: self._count]
+
+    @property
+    def contact_point(self) -> np.ndarray:
+        return self.buffers.point[: self._count]
+
+    @property
+    def contact_normal(self) -> np.ndarray:
+        return self.buffers.normal[: self._count]
+
+    @property
+    def contact_gap(self) -> np.ndarray:
+        return self.buffers.gap[: self._count]
+
+    @property
+    def contact_r(self) -> np.ndarray:
+        """(C, 2) local impulses (r_t, r_n), N·s, on body b."""
+        return self._r[: self._count]
+
+    @property
+    def contact_force(self) -> np.ndarray:
+        """(C, 2) world force on body b, N."""
+        return self._force[: self._count]
+
+    @property
+    def contact_status(self) -> np.ndarray:
+        """(C,) int8: 0 open, 1 stick, 2 slip."""
+        return self._status[: self._count]
+
+    def detect(self, body_q: np.ndarray) -> int:
+        """Contacts of configuration ``body_q`` into the buffers (no solve); returns the count."""
+        m = self.model
+        count = detect_contacts(body_q, m.body_vert_start, m.vert_local, m.body_dynamic, m.alert_distance,
+                                self.buffers)
+        if self.buffers.capacity > self._r.shape[0]:
+            self._alloc(self.buffers.capacity)
+        self._count = count
+        return count
+
+    def _warm_start(self, count: int) -> None:
+        # Impulses of contacts that existed last step (same key) start from their last value.
+        key = self.buffers.key[:count]
+        r = self._r[:count]
+        r[:] = 0.0
+        if self._prev_key.size and count:
+            pos = np.searchsorted(self._prev_key, key)
+            pos = np.minimum(pos, self._prev_key.size - 1)
+            hit = self._prev_key[pos] == key
+            r[hit] = self._prev_r[pos[hit]]
+
+    def _remember(self, count: int) -> None:
+        key = self.buffers.key[:count]
+        order = np.argsort(key, kind="stable")
+        self._prev_key = key[order]
+        self._prev_r = self._r[:count][order]
+
+    def step(self, state) -> StepStats:
+        m = self.model
+        k = state.step
+        integrate.intermediate_q(state.body_q, state.body_v, m.dt, m.theta, self.body_q_m)
+        count = self.detect(self.body_q_m)
+        self._warm_start(count)
+        self._v_old[:] = state.body_v
+        integrate.free_velocity(m, self._v_old, m.support_velocity[k + 1], state.body_v)
+        body, normal = self.buffers.body, self.buffers.normal
+        nlgs.prepare_contacts(body, self.buffers.point, normal, self.buffers.gap, count, self.body_q_m, m,
+                              self._ra, self._rb, self._w, self._bias)
+        iterations, residual = nlgs.solve(body, normal, self._ra, self._rb, self._w, self._bias, count, m,
+                                          state.body_v, self._r, self._status)
+        dissipated, work = nlgs.contact_power(body, normal, self._ra, self._rb, self._r, count, self._v_old,
+                                              state.body_v, m, self._force, self.support_force)
+        integrate.update_q(state.body_q, self._v_old, state.body_v, m.dt, m.theta)
+        state.step = k + 1
+        state.time = state.step * m.dt
+        self._remember(count)
+        gap = self.buffers.gap[:count]
+        penetration = float(max(0.0, -gap.min())) if count else 0.0
+        return StepStats(count, int(iterations), float(residual), float(dissipated), float(work), penetration)

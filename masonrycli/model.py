@@ -1,0 +1,149 @@
+"""Model (what does not change during a run) and State (what does), as flat arrays.
+
+``build_model`` turns a :class:`~masonrycli.scenario.Scenario` into a :class:`Model` once; the time loop
+then only touches arrays. Bodies are the blocks (0..N-1, scenario order) followed by the supports
+(N..N+S-1). Supports have zero inverse mass: they move with their imposed velocity and ignore impulses.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from geometry_library.mass import mass_properties
+from masonrycli.motion import support_velocity
+
+
+@dataclass(frozen=True, eq=False)
+class Model:
+    """Immutable description of a run. Arrays are float64 unless stated."""
+
+    block_count: int
+    """N, number of dynamic blocks."""
+    support_count: int
+    """S, number of supports."""
+    body_mass: np.ndarray
+    """(B,) kg (per the block thickness); supports: inf."""
+    body_inertia: np.ndarray
+    """(B,) kg·m², polar, about the centroid; supports: inf."""
+    body_inv_mass: np.ndarray
+    """(B,) 1/kg; 0 for supports."""
+    body_inv_inertia: np.ndarray
+    """(B,) 1/(kg·m²); 0 for supports."""
+    body_dynamic: np.ndarray
+    """(B,) bool; True for blocks."""
+    body_vert_start: np.ndarray
+    """(B+1,) int64; vertices of body b are vert_local[start[b]:start[b+1]]."""
+    vert_local: np.ndarray
+    """(V, 2) m; CCW polygon vertices relative to the body's initial centroid, at θ = 0."""
+    body_q0: np.ndarray
+    """(B, 3) initial pose: centroid x, y (m), θ = 0 (rad)."""
+    body_v0: np.ndarray
+    """(B, 3) initial velocity vx, vy (m/s), ω (rad/s); supports take their imposed velocity at t = 0."""
+    block_volume: np.ndarray
+    """(N,) m³: area × thickness."""
+    gravity: np.ndarray
+    """(2,) m/s²."""
+    friction: float
+    """Coulomb coefficient μ of every contact."""
+    dt: float
+    """Time step, s."""
+    theta: float
+    """Moreau–Jean θ ∈ [0.5, 1]."""
+    tolerance: float
+    """NLGS stopping tolerance on the relative quadratic norm of the impulse change."""
+    max_iterations: int
+    """NLGS sweep cap."""
+    alert_distance: float
+    """Contacts whose gap is below this are kept, m."""
+    n_steps: int
+    """Number of time steps of the run."""
+    support_velocity: np.ndarray
+    """(n_steps + 1, S, 2) m/s: imposed support velocity at t_k = k·dt."""
+    block_name: tuple
+    support_name: tuple
+
+    @property
+    def body_count(self) -> int:
+        return self.block_count + self.support_count
+
+
+@dataclass(eq=False)
+class State:
+    """What the time loop advances. Mutated in place by the solver."""
+
+    body_q: np.ndarray
+    """(B, 3) centroid x, y (m), rotation θ from the initial orientation (rad, CCW)."""
+    body_v: np.ndarray
+    """(B, 3) vx, vy (m/s), ω (rad/s)."""
+    step: int = 0
+    time: float = 0.0
+
+    def copy(self) -> "State":
+        return State(self.body_q.copy(), self.body_v.copy(), self.step, self.time)
+
+
+def build_model(scenario) -> Model:
+    """Flatten a scenario into a :class:`Model` (mass properties, CSR vertices, support motion table)."""
+    run, assembly = scenario.run, scenario.assembly
+    blocks, supports = assembly.blocks, assembly.supports
+    n, s = len(blocks), len(supports)
+    mass = np.empty(n + s)
+    inertia = np.empty(n + s)
+    volume = np.empty(n)
+    q0 = np.zeros((n + s, 3))
+    v0 = np.zeros((n + s, 3))
+    starts = [0]
+    local = []
+    for i, block in enumerate(blocks):
+        xy = block.vertices
+        props = mass_properties(xy, block.density, block.thickness)
+        mass[i], inertia[i], volume[i] = props.mass, props.inertia, props.area * block.thickness
+        q0[i, :2] = props.centroid
+        v0[i] = block.velocity
+        local.append(xy - props.centroid)
+        starts.append(starts[-1] + len(xy))
+    for j, support in enumerate(supports):
+        xy = support.vertices
+        props = mass_properties(xy, 1.0, 1.0)
+        q0[n + j, :2] = props.centroid
+        local.append(xy - props.centroid)
+        starts.append(starts[-1] + len(xy))
+    mass[n:] = np.inf
+    inertia[n:] = np.inf
+    n_steps = run.n_steps
+    times = np.arange(n_steps + 1, dtype=np.float64) * run.dt
+    table = support_velocity(scenario.motions, times) if s else np.zeros((n_steps + 1, 0, 2))
+    v0[n:, :2] = table[0]
+    dynamic = np.zeros(n + s, dtype=np.bool_)
+    dynamic[:n] = True
+    return Model(
+        block_count=n,
+        support_count=s,
+        body_mass=mass,
+        body_inertia=inertia,
+        body_inv_mass=np.where(dynamic, 1.0 / mass, 0.0),
+        body_inv_inertia=np.where(dynamic, 1.0 / inertia, 0.0),
+        body_dynamic=dynamic,
+        body_vert_start=np.asarray(starts, dtype=np.int64),
+        vert_local=np.ascontiguousarray(np.concatenate(local), dtype=np.float64),
+        body_q0=q0,
+        body_v0=v0,
+        block_volume=volume,
+        gravity=np.asarray(run.gravity, dtype=np.float64),
+        friction=float(scenario.material.friction),
+        dt=float(run.dt),
+        theta=float(run.theta),
+        tolerance=float(run.tolerance),
+        max_iterations=int(run.max_iterations),
+        alert_distance=float(run.alert_distance),
+        n_steps=n_steps,
+        support_velocity=np.ascontiguousarray(table, dtype=np.float64),
+        block_name=tuple(b.name for b in blocks),
+        support_name=tuple(sp.name for sp in supports),
+    )
+
+
+def initial_state(model: Model) -> State:
+    return State(model.body_q0.copy(), model.body_v0.copy(), 0, 0.0)

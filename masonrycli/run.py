@@ -1,0 +1,192 @@
+"""The one time loop: motion → detect → solve → tensors → record → progress.
+
+``simulate`` owns no I/O format: it hands each recorded :class:`~masonrycli.frame.Frame` to the sinks it
+is given (a :class:`~masonrycli.history.History`, a recorder) and always closes them — after a normal end,
+a divergence, an exception or Ctrl-C — so what was computed is never lost.
+"""
+
+from __future__ import annotations
+
+import time as _time
+from dataclasses import dataclass, field
+from typing import Callable
+
+import numpy as np
+
+from masonrycli.engine import integrate
+from masonrycli.engine.solver import Solver, StepStats
+from masonrycli.frame import CONTACT_OPEN, Frame
+from masonrycli.model import Model, State, build_model, initial_state
+from masonrycli.tensors import TensorComputer, build_triangles
+
+DIVERGENCE_SPEED = 1e3
+"""m/s: a block faster than this (or a non-finite state) stops the run as diverged."""
+
+
+@dataclass
+class RunResult:
+    """What happened, for the summary table."""
+
+    status: str
+    """"completed", "interrupted", "diverged" or "error"."""
+    message: str
+    steps: int
+    time: float
+    wall_time: float
+    iterations: np.ndarray
+    """(steps,) NLGS sweeps per step."""
+    residual: np.ndarray
+    contact_count: np.ndarray
+    max_penetration: float
+    energy_initial: float
+    energy_final: float
+    energy_dissipated: float
+    support_work: float
+    frames: int
+    extra: dict = field(default_factory=dict)
+
+
+class Simulation:
+    """Model, state, solver and tensor computer of one scenario, advanced step by step."""
+
+    def __init__(self, scenario, model: Model | None = None):
+        self.scenario = scenario
+        self.model = model if model is not None else build_model(scenario)
+        self.state: State = initial_state(self.model)
+        self.solver = Solver(self.model)
+        m = self.model
+        n = m.block_count
+        # Cells and triangles come from the blocks touching in the initial configuration.
+        count = self.solver.detect(self.state.body_q)
+        body = self.solver.contact_body[:count]
+        blocks_only = body[(body[:, 0] < n) & (body[:, 1] < n)]
+        self.triangles = build_triangles(m.body_q0[:n, :2], blocks_only)
+        self.tensors = TensorComputer(n, m.block_volume, self.triangles)
+        self.energy_dissipated = 0.0
+        self.support_work = 0.0
+        self.last: StepStats | None = None
+
+    def step(self) -> StepStats:
+        stats = self.solver.step(self.state)
+        n = self.model.block_count
+        s = self.solver
+        self.tensors.step(s.body_q_m[:n], self.state.body_v[:n], s.contact_body, s.contact_point,
+                          s.contact_force, s.contact_gap, s.contact_status, self.model.dt)
+        self.energy_dissipated += stats.dissipated
+        self.support_work += stats.support_work
+        self.last = stats
+        return stats
+
+    def energies(self) -> tuple[float, float]:
+        return integrate.energies(self.model, self.state.body_q, self.state.body_v)
+
+    def frame(self) -> Frame:
+        """Snapshot of the current state and the last step's contacts and tensors."""
+        m, st, s = self.model, self.state, self.solver
+        n = m.block_count
+        kinetic, potential = self.energies()
+        if self.last is None:  # initial frame: contacts known, no impulses yet
+            c = 0
+            body = np.zeros((0, 2), dtype=np.int32)
+            point = normal = force = np.zeros((0, 2))
+            gap = np.zeros(0)
+            status = np.zeros(0, dtype=np.int8)
+            mobilised = np.zeros(0)
+            support_force = np.zeros((m.support_count, 2))
+            iterations, residual = 0, 0.0
+        else:
+            c = self.last.contact_count
+            body, point, normal = s.contact_body, s.contact_point, s.contact_normal
+            force, gap, status = s.contact_force, s.contact_gap, s.contact_status
+            r = s.contact_r
+            closed = status != CONTACT_OPEN
+            mobilised = np.zeros(c)
+            denom = m.friction * r[closed, 1]
+            mobilised[closed] = np.divide(np.abs(r[closed, 0]), denom, out=np.zeros(denom.size),
+                                          where=denom > 0)
+            support_force = s.support_force
+            iterations, residual = self.last.iterations, self.last.residual
+        support_q = st.body_q[n:].copy()
+        return Frame(
+            step=st.step, time=st.time,
+            block_q=st.body_q[:n].copy(), block_v=st.body_v[:n].copy(),
+            support_q=support_q, support_v=st.body_v[n:, :2].copy(),
+            support_force=np.array(support_force, copy=True),
+            contact_body=np.array(body, copy=True), contact_point=np.array(point, copy=True),
+            contact_normal=np.array(normal, copy=True), contact_force=np.array(force, copy=True),
+            contact_gap=np.array(gap, copy=True), contact_status=np.array(status, copy=True),
+            contact_mobilised=mobilised, tensors=self.tensors.fields(),
+            energy_kinetic=float(kinetic), energy_potential=float(potential),
+            energy_dissipated=self.energy_dissipated, support_work=self.support_work,
+            nlgs_iterations=int(iterations), nlgs_residual=float(residual), contact_count=int(c),
+        )
+
+    def diverged(self) -> str:
+        """Empty string, or why the state is no longer physical."""
+        n = self.model.block_count
+        q, v = self.state.body_q[:n], self.state.body_v[:n]
+        if not (np.isfinite(q).all() and np.isfinite(v).all()):
+            return "non-finite block position or velocity"
+        speed = float(np.sqrt((v[:, :2] ** 2).sum(axis=1)).max()) if n else 0.0
+        if speed > DIVERGENCE_SPEED:
+            return f"a block reached {speed:.3g} m/s (> {DIVERGENCE_SPEED:g} m/s)"
+        return ""
+
+
+def simulate(scenario, sinks=(), on_progress: Callable | None = None, progress_every: int = 10,
+             steps: int | None = None) -> RunResult:
+    """Run ``scenario`` to its end (or ``steps`` steps). Each sink gets ``append(frame)``/``log_frame(frame)``
+    for every recorded frame; sinks are *not* closed here (the caller owns them) but every frame computed
+    before an interruption has been handed over when this returns.
+
+    ``on_progress(sim, step_stats)`` is called every ``progress_every`` steps.
+    """
+    t0 = _time.perf_counter()
+    sim = Simulation(scenario)
+    m = sim.model
+    n_steps = m.n_steps if steps is None else min(steps, m.n_steps)
+    every = scenario.run.record_every
+    iterations = np.zeros(n_steps, dtype=np.int64)
+    residual = np.zeros(n_steps)
+    contacts = np.zeros(n_steps, dtype=np.int64)
+    max_pen = 0.0
+    e0 = sum(sim.energies())
+    frames = 0
+
+    def emit():
+        nonlocal frames
+        frame = sim.frame()
+        for sink in sinks:
+            (sink.append if hasattr(sink, "append") else sink.log_frame)(frame)
+        frames += 1
+
+    status, message = "completed", ""
+    done = 0
+    try:
+        emit()
+        for k in range(n_steps):
+            stats = sim.step()
+            iterations[k], residual[k], contacts[k] = stats.iterations, stats.residual, stats.contact_count
+            max_pen = max(max_pen, stats.max_penetration)
+            done = k + 1
+            why = sim.diverged()
+            if why:
+                status, message = "diverged", f"diverged at t = {sim.state.time:.4f} s (step {done}): {why}"
+                emit()
+                break
+            if done % every == 0 or done == n_steps:
+                emit()
+            if on_progress is not None and (done % progress_every == 0 or done == n_steps):
+                on_progress(sim, stats)
+    except KeyboardInterrupt:
+        status = "interrupted"
+        # The interrupted step may be half done: keep the frames recorded so far, add none.
+        message = f"interrupted at t = {sim.state.time:.4f} s (step {done} of {n_steps})"
+    return RunResult(
+        status=status, message=message, steps=done, time=sim.state.time,
+        wall_time=_time.perf_counter() - t0, iterations=iterations[:done], residual=residual[:done],
+        contact_count=contacts[:done], max_penetration=max_pen, energy_initial=e0,
+        energy_final=float(sum(sim.energies())), energy_dissipated=sim.energy_dissipated,
+        support_work=sim.support_work, frames=frames,
+        extra={"model": m},
+    )
