@@ -1,0 +1,253 @@
+"""Support motions: closed-form velocities of every kind, record files, validation messages."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+from scipy.integrate import cumulative_trapezoid, quad
+
+from masonrycli.errors import InputError
+from masonrycli.motion import Motion, load_record_csv, record_motion, support_velocity
+
+DATA = Path(__file__).parent / "data"
+T = np.linspace(-0.5, 3.0, 1401)
+
+
+def one_line(exc_info) -> str:
+    msg = str(exc_info.value)
+    assert "\n" not in msg and msg.strip() == msg and msg
+    return msg
+
+
+# ---------------------------------------------------------------------------------------------- kinds
+
+
+def test_fixed_is_zero():
+    v = support_velocity([Motion()], T)
+    assert v.shape == (T.size, 1, 2)
+    assert np.all(v == 0.0)
+    assert Motion().role == "fixed"
+
+
+def test_constant_velocity_settlement():
+    m = Motion(kind="constant", velocity=[0.0, -0.01])
+    v = support_velocity([m], T)
+    assert np.all(v[:, 0, 0] == 0.0) and np.all(v[:, 0, 1] == -0.01)
+    assert m.role == "driven"
+    assert m.velocity == (0.0, -0.01)  # normalised to a tuple of floats
+
+
+def test_sine_closed_form_along_normalised_direction():
+    m = Motion(kind="sine", direction=(3.0, 4.0), amplitude=1.5, frequency=2.0, phase=0.3)
+    v = support_velocity([m], T)[:, 0, :]
+    s = 1.5 * np.sin(2 * np.pi * 2.0 * T + 0.3)
+    np.testing.assert_allclose(v[:, 0], 0.6 * s, rtol=0, atol=1e-15)
+    np.testing.assert_allclose(v[:, 1], 0.8 * s, rtol=0, atol=1e-15)
+    assert m.direction == (3.0, 4.0)  # stored as given, normalised on use
+
+
+def test_sine_paper_ground():
+    m = Motion(kind="sine", amplitude=1.0, frequency=2.0)  # default direction: horizontal
+    t = np.array([0.0, 0.125, 0.25, 0.375])
+    np.testing.assert_allclose(m.velocity_at(t)[:, 0], [0.0, 1.0, 0.0, -1.0], atol=1e-15)
+    assert np.all(m.velocity_at(t)[:, 1] == 0.0)
+
+
+def test_ramp_pulse_and_unbounded_ramp():
+    pulse = Motion(kind="ramp", acceleration=(2.0, -1.0), until=0.5)
+    ramp = Motion(kind="ramp", acceleration=(0.0, 3.0))
+    v = support_velocity([pulse, ramp], T)
+    tc = np.clip(T, 0.0, 0.5)
+    np.testing.assert_allclose(v[:, 0, 0], 2.0 * tc, atol=1e-15)
+    np.testing.assert_allclose(v[:, 0, 1], -1.0 * tc, atol=1e-15)
+    np.testing.assert_allclose(v[:, 1, 1], 3.0 * np.clip(T, 0.0, None), atol=1e-15)
+    assert np.all(v[:, 1, 0] == 0.0)
+
+
+def test_support_velocity_shapes():
+    assert support_velocity([], T).shape == (T.size, 0, 2)
+    assert support_velocity([Motion(kind="constant", velocity=(1, 2))], 0.25).shape == (1, 1, 2)
+    with pytest.raises(ValueError):
+        support_velocity([Motion()], np.zeros((2, 2)))
+
+
+def test_support_velocity_order_follows_supports():
+    ms = [Motion(kind="constant", velocity=(float(i), -float(i))) for i in range(4)]
+    v = support_velocity(ms, np.array([0.0, 1.0]))
+    assert v.shape == (2, 4, 2)
+    for i in range(4):
+        assert np.all(v[:, i, 0] == i) and np.all(v[:, i, 1] == -i)
+
+
+def test_support_velocity_is_vectorised_over_time():
+    # a long record evaluated at a million instants must not loop over them in Python
+    import time
+
+    rng = np.random.default_rng(0)
+    t_rec = np.cumsum(rng.uniform(0.005, 0.015, 2000))
+    m = Motion(kind="record", record_time=tuple(t_rec), record_value=tuple(rng.normal(size=2000)),
+               quantity="acceleration")
+    t = np.linspace(0, t_rec[-1] + 1, 1_000_000)
+    start = time.perf_counter()
+    v = support_velocity([m, Motion(kind="sine", amplitude=1, frequency=2), Motion()], t)
+    assert time.perf_counter() - start < 5.0  # a Python loop over 1e6 samples would take far longer
+    assert v.shape == (t.size, 3, 2) and np.all(np.isfinite(v))
+
+
+# -------------------------------------------------------------------------------------------- records
+
+
+def test_velocity_record_interpolates_and_holds_end_values():
+    m = Motion(kind="record", record_time=(0.1, 0.2, 0.4), record_value=(1.0, 3.0, -1.0),
+               direction=(0.0, 2.0), scale=0.5)
+    t = np.array([0.0, 0.1, 0.15, 0.2, 0.3, 0.4, 5.0])
+    expected = 0.5 * np.array([1.0, 1.0, 2.0, 3.0, 1.0, -1.0, -1.0])
+    v = m.velocity_at(t)
+    np.testing.assert_allclose(v[:, 1], expected, atol=1e-15)
+    assert np.all(v[:, 0] == 0.0)
+
+
+def test_vector_record_three_columns():
+    m = record_motion(DATA / "ground_xy.csv")
+    assert m.record_is_vector and m.quantity == "velocity"
+    v = m.velocity_at([0.0, 0.25, 0.5, 0.75, 1.0, 2.0])
+    np.testing.assert_allclose(v[:, 0], [0.0, 0.05, 0.1, 0.05, 0.0, 0.0], atol=1e-15)
+    np.testing.assert_allclose(v[:, 1], [0.0, -0.01, -0.02, -0.01, 0.0, 0.0], atol=1e-15)
+
+
+def test_constant_acceleration_record_integrates_to_a_t():
+    m = record_motion(DATA / "accel_constant.csv", quantity="acceleration", direction=(0.0, 1.0))
+    t = np.linspace(-0.2, 1.5, 171)
+    v = m.velocity_at(t)
+    np.testing.assert_allclose(v[:, 1], 0.5 * np.clip(t, 0.0, 1.0), rtol=0, atol=1e-14)
+    assert np.all(v[:, 0] == 0.0)
+
+
+def test_linear_acceleration_record_integrates_exactly_between_samples():
+    # a(t) = c t sampled every 0.25 s: v(t) = c t^2 / 2 everywhere, not only at the samples
+    c = 1.7
+    times = np.arange(0.0, 2.0001, 0.25)
+    m = Motion(kind="record", record_time=tuple(times), record_value=tuple(c * times), quantity="acceleration")
+    t = np.linspace(0.0, 2.0, 801)
+    np.testing.assert_allclose(m.velocity_at(t)[:, 0], c * t**2 / 2, rtol=0, atol=1e-13)
+    # after the record the acceleration is zero: the velocity holds its final value
+    np.testing.assert_allclose(m.velocity_at([3.0])[0, 0], c * 2.0**2 / 2, rtol=1e-14)
+
+
+def test_random_acceleration_record_matches_independent_integration():
+    rng = np.random.default_rng(1)
+    times = np.concatenate([[0.0], np.cumsum(rng.uniform(0.01, 0.05, 60))])
+    acc = rng.normal(size=(times.size, 2))
+    m = Motion(kind="record", record_time=tuple(times), record_value=tuple(map(tuple, acc)),
+               quantity="acceleration", scale=-2.0)
+    # at the samples: the cumulative trapezoid rule (scipy's, independent of ours)
+    nodal = -2.0 * cumulative_trapezoid(acc, times, axis=0, initial=0.0)
+    np.testing.assert_allclose(m.velocity_at(times), nodal, rtol=0, atol=1e-12)
+    # between samples: the integral of the linearly interpolated acceleration (adaptive quadrature)
+    for tq in rng.uniform(times[0], times[-1], 5):
+        for k in range(2):
+            ref, _ = quad(lambda s: -2.0 * np.interp(s, times, acc[:, k]), 0.0, tq,
+                          points=times[times < tq], limit=200, epsabs=1e-13)
+            assert m.velocity_at([tq])[0, k] == pytest.approx(ref, abs=1e-10)
+    # before the first sample: at rest
+    assert np.all(m.velocity_at([-1.0]) == 0.0)
+
+
+def test_acceleration_record_starting_late_is_at_rest_before():
+    m = Motion(kind="record", record_time=(1.0, 2.0), record_value=(2.0, 2.0), quantity="acceleration")
+    np.testing.assert_allclose(m.velocity_at([0.0, 1.0, 1.5, 2.0, 9.0])[:, 0], [0, 0, 1.0, 2.0, 2.0], atol=1e-15)
+
+
+def test_load_record_csv_formats(tmp_path):
+    t, v = load_record_csv(DATA / "quake_velocity.csv")
+    np.testing.assert_array_equal(t, [0.0, 0.1, 0.2, 0.3, 0.4])
+    np.testing.assert_array_equal(v, [0.0, 0.2, -0.1, 0.05, 0.0])
+    f = tmp_path / "semi.csv"
+    f.write_text("\ufefftime;vx;vy\n\n# comment\n0;1;2\n  1 ;  3 ; 4  \n2\t5\t6\n")
+    t, v = load_record_csv(f)
+    np.testing.assert_array_equal(t, [0, 1, 2])
+    np.testing.assert_array_equal(v, [[1, 2], [3, 4], [5, 6]])
+
+
+def test_record_motion_source_is_absolute():
+    m = record_motion(DATA / "quake_velocity.csv", scale=2.0)
+    assert Path(m.source).is_absolute() and Path(m.source).name == "quake_velocity.csv"
+    assert m.describe().startswith("record of velocity (quake_velocity.csv, 5 samples")
+    assert m.velocity_at([0.1])[0, 0] == pytest.approx(0.4)
+
+
+@pytest.mark.parametrize(
+    "text, expected",
+    [
+        ("0,1\n0.1,abc\n", "bad.csv:2: not a number: \"abc\""),
+        ("# c\n0,1,2,3\n", "bad.csv:2: expected 2 columns (time, value) or 3 (time, x, y), got 4"),
+        ("0,1\n1,2,3\n", "bad.csv:2: expected 2 columns like the first sample, got 3"),
+        ("0,1\n0.5,2\n0.5,3\n", "bad.csv:3: time 0.5 is not after the previous sample's 0.5"),
+        ("0,1\n1,nan\n", "bad.csv:2: values must be finite"),
+        ("time,value\n0,1\n", "bad.csv: a record needs at least 2 samples, found 1"),
+        ("", "bad.csv: a record needs at least 2 samples, found 0"),
+        ("t,v\nx,y\n0,1\n", "bad.csv:2: not a number: \"x\""),
+    ],
+)
+def test_load_record_csv_errors_name_file_and_line(tmp_path, text, expected):
+    f = tmp_path / "bad.csv"
+    f.write_text(text)
+    with pytest.raises(InputError) as exc:
+        load_record_csv(f, display="bad.csv")
+    assert expected in one_line(exc)
+
+
+def test_load_record_csv_unreadable(tmp_path):
+    with pytest.raises(InputError) as exc:
+        load_record_csv(tmp_path / "missing.csv")
+    assert "missing.csv: cannot read record" in one_line(exc)
+    with pytest.raises(InputError) as exc:
+        load_record_csv(tmp_path)
+    assert "is a directory" in one_line(exc)
+    f = tmp_path / "latin1.csv"
+    f.write_bytes(b"0,1\n1,\xe9\n")
+    with pytest.raises(InputError) as exc:
+        load_record_csv(f)
+    assert "latin1.csv: not a UTF-8 text file" in one_line(exc)
+
+
+# ------------------------------------------------------------------------------------------ validation
+
+
+@pytest.mark.parametrize(
+    "kwargs, expected",
+    [
+        (dict(kind="shake"), 'kind = "shake": unknown motion kind'),
+        (dict(kind="sine", direction=(0, 0), amplitude=1), "direction = [0.0, 0.0]: must not be the zero vector"),
+        (dict(kind="sine", direction=(1,)), "direction = [1]: must be 2 numbers"),
+        (dict(kind="sine", amplitude=math.nan), "amplitude = nan: must be a finite number"),
+        (dict(kind="sine", frequency=-1.0), "frequency = -1.0: must be >= 0"),
+        (dict(kind="sine", phase=math.inf), "phase = inf: must be a finite number"),
+        (dict(kind="constant", velocity=(1.0, math.inf)), "velocity = [1.0, inf]: must be finite numbers"),
+        (dict(kind="ramp", acceleration=(1, 0), until=0.0), "until = 0.0: must be > 0"),
+        (dict(kind="record", record_time=(0.0,), record_value=(1.0,)), "a record needs at least 2 samples"),
+        (dict(kind="record", record_time=(0.0, 1.0), record_value=(1.0,)), "record_value = [1.0]: has 1 samples"),
+        (dict(kind="record", record_time=(0.0, 0.0), record_value=(1.0, 2.0)), "record_time[1] = 0.0: must be >"),
+        (dict(kind="record", record_time=(0, 1), record_value=(1, 2), quantity="displacement"),
+         'quantity = "displacement": must be "velocity" or "acceleration"'),
+        (dict(kind="record", record_time=(0, 1), record_value=(1, 2), scale="2"), 'scale = "2": must be a number'),
+        (dict(kind="sine", amplitude=True), "amplitude = true: must be a number"),
+    ],
+)
+def test_motion_validation(kwargs, expected):
+    with pytest.raises(InputError) as exc:
+        Motion(**kwargs)
+    assert expected in one_line(exc)
+
+
+def test_motion_equality_hash_and_describe():
+    a = Motion(kind="sine", direction=[1, 0], amplitude=1, frequency=2)
+    b = Motion(kind="sine", direction=(1.0, 0.0), amplitude=1.0, frequency=2.0)
+    assert a == b and hash(a) == hash(b)
+    assert a.describe() == "sine 1 m/s · sin(2π·2 Hz·t) along (1, 0)"
+    assert Motion(kind="ramp", acceleration=(0, -1), until=0.2).describe() == \
+        "ramp acceleration (0, -1) m/s² until 0.2 s"
+    assert Motion(kind="constant", velocity=(0, -0.01)).describe() == "constant velocity (0, -0.01) m/s"
