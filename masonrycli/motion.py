@@ -133,13 +133,13 @@ def check_real(key: str, value, *, gt=None, ge=None, le=None, lt=None, allow_inf
     if math.isinf(x) and not (allow_inf and x > 0):
         raise field_error(key, value, "must be a finite number")
     if gt is not None and not x > gt:
-        raise field_error(key, value, f"must be > {format_value(gt)}")
+        raise field_error(key, value, f"must be > {gt:g}")
     if ge is not None and not x >= ge:
-        raise field_error(key, value, f"must be >= {format_value(ge)}")
+        raise field_error(key, value, f"must be >= {ge:g}")
     if lt is not None and not x < lt:
-        raise field_error(key, value, f"must be < {format_value(lt)}")
+        raise field_error(key, value, f"must be < {lt:g}")
     if le is not None and not x <= le:
-        raise field_error(key, value, f"must be <= {format_value(le)}")
+        raise field_error(key, value, f"must be <= {le:g}")
     return x
 
 

@@ -406,10 +406,23 @@ def _check_polygon(value) -> list[tuple[float, float]]:
     return coords
 
 
-def _polygon(coords, index: int, name: str):
-    from geometry_library.checks import polygon_from_coords
+def _polygon(coords, index: int, name: str, kind: str, ctx: _Ctx, loc: str):
+    """geometry_library's normalised convex polygon; its GeometryError becomes an InputError at ``loc``.
 
-    return polygon_from_coords(coords, index, name)
+    ``index`` is 0-based (geometry_library's convention); the body label geometry_library puts in front
+    of its message is replaced by our ``[[block]] #i ("name"):`` locator.
+    """
+    from geometry_library import checks
+
+    try:
+        return checks.polygon_from_coords(coords, index, name, kind)
+    except GeometryError as exc:
+        msg = str(exc)
+        label_fn = getattr(checks, "body_label", None)
+        label = f"{label_fn(index, name, kind)}: " if label_fn else ""
+        if label and msg.startswith(label):
+            msg = msg[len(label):]
+        raise ctx.error(loc, msg) from None
 
 
 def _check_unique(name: str, loc: str, names: dict, ctx: _Ctx):
@@ -435,10 +448,7 @@ def _parse_block(i: int, table: dict, material: Material, ctx: _Ctx, names: dict
     except InputError as exc:
         raise ctx.error(loc, str(exc)) from None
     _check_unique(name, loc, names, ctx)
-    try:
-        polygon = _polygon(coords, i - 1, name)
-    except GeometryError as exc:
-        raise ctx.error(loc, str(exc)) from None
+    polygon = _polygon(coords, i - 1, name, "block", ctx, loc)
     return Block(polygon=polygon, name=name, density=density, thickness=thickness, velocity=velocity)
 
 
@@ -456,11 +466,8 @@ def _parse_support(i: int, table: dict, ctx: _Ctx, names: dict) -> tuple[Support
     except InputError as exc:
         raise ctx.error(loc, str(exc)) from None
     _check_unique(name, loc, names, ctx)
+    polygon = _polygon(coords, i - 1, name, "support", ctx, loc)
     motion = _parse_motion(table.get("motion"), ctx, loc)
-    try:
-        polygon = _polygon(coords, i - 1, name)
-    except GeometryError as exc:
-        raise ctx.error(loc, str(exc)) from None
     return Support(polygon=polygon, name=name, role=motion.role), motion
 
 
