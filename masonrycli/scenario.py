@@ -269,7 +269,7 @@ def load_scenario(path) -> Scenario:
     except OSError as exc:
         raise InputError(_one_line(f"{fname}: cannot read scenario: {exc.strerror or exc}")) from None
     try:
-        text = raw.decode("utf-8")
+        text = raw.decode("utf-8-sig")  # tolerate the byte-order mark some Windows editors add
     except UnicodeDecodeError as exc:
         raise InputError(f"{fname}: not a UTF-8 text file (byte {exc.start})") from None
     base_dir = os.path.dirname(os.path.abspath(fname))
@@ -329,8 +329,9 @@ def _parse_document(doc: dict, ctx: _Ctx, default_name: str) -> Scenario:
     if "structure" in doc:
         structure = _table(doc, "structure", ctx)
         if block_tables:
-            raise ctx.error("[[block]] #1", "not allowed together with a [structure] builder "
-                            "(use either explicit blocks or a builder)")
+            raise ctx.error(_locator("block", 1, block_tables[0], "block-1"),
+                            "not allowed together with a [structure] builder (use either explicit blocks "
+                            "or a builder)")
         if "builder" not in structure:
             raise ctx.error("[structure]", "builder: missing (e.g. builder = \"wall\")")
         builder = structure["builder"]

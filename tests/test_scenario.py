@@ -542,6 +542,8 @@ def test_unreadable_files(tmp_path):
         load_scenario(tmp_path / "missing.toml")
     msg = str(exc.value)
     assert "\n" not in msg and msg == f"{tmp_path / 'missing.toml'}: cannot read scenario: No such file or directory"
+    (tmp_path / "bom.toml").write_bytes("\ufeff".encode() + BLOCK.encode())
+    assert load_scenario(tmp_path / "bom.toml").assembly.block_count == 1
     with pytest.raises(InputError, match="is a directory"):
         load_scenario(tmp_path)
     (tmp_path / "latin.toml").write_bytes(b'name = "caf\xe9"\n')
@@ -636,7 +638,7 @@ def test_builder_option_errors(tmp_path, fake_builders, line, expected):
         ("[structure]\nblocks = 51\n", '[structure] builder: missing (e.g. builder = "wall")'),
         ("[structure]\nbuilder = 3\n", "[structure] builder = 3: must be a string"),
         ('[structure]\nbuilder = "fake"\n' + BLOCK,
-         "[[block]] #1 not allowed together with a [structure] builder"),
+         '[[block]] #1 ("b1"): not allowed together with a [structure] builder'),
         ('[structure]\nbuilder = "fake"\n[[support]]\nname = "moat"\n',
          '[[support]] #1 ("moat"): name = "moat": no such support in builder "fake" (supports: ground, pad)'),
         ('[structure]\nbuilder = "fake"\n[[support]]\nmotion = { kind = "fixed" }\n',
