@@ -598,6 +598,8 @@ def _expected_type(param: inspect.Parameter) -> str:
 def _check_option_type(key: str, value, param: inspect.Parameter):
     """Light type check of a builder option (the builder validates ranges itself)."""
     expected = _expected_type(param)
+    if value is None and (param.default is None or "None" in str(param.annotation)):
+        return value  # programmatic callers may pass None where the builder accepts it
     if expected == "number":
         if not is_real(value):
             raise field_error(key, value, "must be a number")
@@ -630,12 +632,8 @@ def _call_builder(builder: str, options: dict, material: Material) -> Assembly:
             kwargs[key] = getattr(material, key)
     try:
         assembly = fn(**kwargs)
-    except InputError as exc:
+    except ValueError as exc:  # GeometryError, InputError, bad values; a TypeError is a bug: not hidden
         raise InputError(f"builder \"{builder}\": {_one_line(exc)}") from None
-    except GeometryError as exc:
-        raise InputError(f"builder \"{builder}\": {_one_line(exc)}") from None
-    except (ValueError, TypeError) as exc:
-        raise InputError(f"builder \"{builder}\" failed: {type(exc).__name__}: {_one_line(exc)}") from None
     if not isinstance(assembly, Assembly):
         raise InputError(f"builder \"{builder}\" returned {type(assembly).__name__}, not an Assembly")
     return assembly

@@ -712,3 +712,23 @@ def test_real_wall_builder_from_file(tmp_path):
     s = load_scenario(write(tmp_path, '[structure]\nbuilder = "wall"\n'))
     assert s.structure == {"builder": "wall"} and s.assembly.block_count > 0
     assert os.path.basename(s.source) == "wall.toml"
+
+
+@pytest.mark.parametrize(
+    "file, builder, blocks, motions",
+    [
+        ("wall_shaken.toml", "wall", 248, {"ground": Motion(kind="sine", amplitude=1.0, frequency=2.0)}),
+        ("arch_settlement.toml", "arch", 98, {"right-foundation": Motion(kind="constant", velocity=(0.0, -0.01))}),
+    ],
+)
+def test_paper_builder_scenarios(file, builder, blocks, motions):
+    if builder not in _real_builders():
+        pytest.skip(f"geometry_library builder {builder!r} not available yet")
+    s = load_scenario(DATA / file)
+    assert s.structure["builder"] == builder and s.assembly.block_count == blocks
+    for support, motion in zip(s.assembly.supports, s.motions):
+        assert motion == motions.get(support.name, Motion())
+        assert support.role == ("driven" if support.name in motions else "fixed")
+    options = {k: v for k, v in s.structure.items() if k != "builder"}
+    same = scenario_from_builder(builder, options, s.run, s.material, motions)
+    assert_same_scenario(dataclasses.replace(same, name=s.name), s)
