@@ -732,3 +732,18 @@ def test_paper_builder_scenarios(file, builder, blocks, motions):
     options = {k: v for k, v in s.structure.items() if k != "builder"}
     same = scenario_from_builder(builder, options, s.run, s.material, motions)
     assert_same_scenario(dataclasses.replace(same, name=s.name), s)
+
+
+def test_builder_bug_is_not_disguised_as_input_error(fake_builders):
+    def broken(*, bays: int = 1):
+        raise TypeError("'float' object is not iterable")
+
+    fake_builders["broken"] = broken
+    with pytest.raises(TypeError):
+        scenario_from_builder("broken", {}, RunConfig(), Material(), {})
+    # None passes where the builder's annotation allows it
+    def nullable(*, bays: int | None = 2):
+        return fake_builder(bays=bays or 1)
+
+    fake_builders["nullable"] = nullable
+    assert scenario_from_builder("nullable", {"bays": None}, RunConfig(), Material(), {}).block_count == 1
