@@ -42,14 +42,14 @@ class Solver:
     def __init__(self, model):
         self.model = model
         b = model.body_count
-        self.buffers = ContactBuffers(max(64, 8 * b))
+        self.buffers = ContactBuffers(model.body_vert_start)
         self.body_q_m = np.empty((b, 3))
         """(B, 3) configuration at which the last step detected its contacts."""
         self._v_old = np.empty((b, 3))
         self._prev_key = np.empty(0, dtype=np.int64)
         self._prev_r = np.empty((0, 2))
         self._count = 0
-        self._alloc(self.buffers.capacity)
+        self._alloc(self.buffers.contact_capacity)
 
     def _alloc(self, capacity: int) -> None:
         self._ra = np.zeros((capacity, 2))
@@ -65,19 +65,19 @@ class Solver:
     # Views of the last step's contacts -------------------------------------------------------
     @property
     def contact_body(self) -> np.ndarray:
-        return self.buffers.body[: self._count]
+        return self.buffers.contact_body[: self._count]
 
     @property
     def contact_point(self) -> np.ndarray:
-        return self.buffers.point[: self._count]
+        return self.buffers.contact_point[: self._count]
 
     @property
     def contact_normal(self) -> np.ndarray:
-        return self.buffers.normal[: self._count]
+        return self.buffers.contact_normal[: self._count]
 
     @property
     def contact_gap(self) -> np.ndarray:
-        return self.buffers.gap[: self._count]
+        return self.buffers.contact_gap[: self._count]
 
     @property
     def contact_r(self) -> np.ndarray:
@@ -99,14 +99,14 @@ class Solver:
         m = self.model
         count = detect_contacts(body_q, m.body_vert_start, m.vert_local, m.body_dynamic, m.alert_distance,
                                 self.buffers)
-        if self.buffers.capacity > self._r.shape[0]:
-            self._alloc(self.buffers.capacity)
+        if self.buffers.contact_capacity > self._r.shape[0]:
+            self._alloc(self.buffers.contact_capacity)
         self._count = count
         return count
 
     def _warm_start(self, count: int) -> None:
         # Impulses of contacts that existed last step (same key) start from their last value.
-        key = self.buffers.key[:count]
+        key = self.buffers.contact_key[:count]
         r = self._r[:count]
         r[:] = 0.0
         if self._prev_key.size and count:
@@ -116,7 +116,7 @@ class Solver:
             r[hit] = self._prev_r[pos[hit]]
 
     def _remember(self, count: int) -> None:
-        key = self.buffers.key[:count]
+        key = self.buffers.contact_key[:count]
         order = np.argsort(key, kind="stable")
         self._prev_key = key[order]
         self._prev_r = self._r[:count][order]
@@ -129,8 +129,9 @@ class Solver:
         self._warm_start(count)
         self._v_old[:] = state.body_v
         integrate.free_velocity(m, self._v_old, m.support_velocity[k + 1], state.body_v)
-        body, normal = self.buffers.body, self.buffers.normal
-        nlgs.prepare_contacts(body, self.buffers.point, normal, self.buffers.gap, count, self.body_q_m, m,
+        bf = self.buffers
+        body, normal = bf.contact_body, bf.contact_normal
+        nlgs.prepare_contacts(body, bf.contact_point, normal, bf.contact_gap, count, self.body_q_m, m,
                               self._ra, self._rb, self._w, self._bias)
         iterations, residual = nlgs.solve(body, normal, self._ra, self._rb, self._w, self._bias, count, m,
                                           state.body_v, self._r, self._status)
@@ -140,6 +141,6 @@ class Solver:
         state.step = k + 1
         state.time = state.step * m.dt
         self._remember(count)
-        gap = self.buffers.gap[:count]
+        gap = self.buffers.contact_gap[:count]
         penetration = float(max(0.0, -gap.min())) if count else 0.0
         return StepStats(count, int(iterations), float(residual), float(dissipated), float(work), penetration)

@@ -1,0 +1,28 @@
+"""Small helpers shared by the engine tests: load a validation scenario, run it, return the history."""
+
+from __future__ import annotations
+
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+
+from masonrycli.history import History
+from masonrycli.run import simulate
+from masonrycli.scenario import load_scenario
+
+DATA = Path(__file__).parent / "data"
+
+
+def scenario(name: str, **run_overrides):
+    sc = load_scenario(DATA / "validation" / name)
+    if run_overrides:
+        sc = replace(sc, run=replace(sc.run, **run_overrides))
+    return sc
+
+
+def run_history(sc) -> tuple[dict, object]:
+    hist = History([b.name for b in sc.assembly.blocks], [s.name for s in sc.assembly.supports])
+    result = simulate(sc, sinks=[hist])
+    assert result.status == "completed", result.message
+    return {k: np.asarray(v) for k, v in hist.arrays().items()}, result
