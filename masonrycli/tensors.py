@@ -58,7 +58,9 @@ TENSOR_FIELDS: dict[str, tuple[tuple[int, ...], str, str]] = {
     "cell_spherical_stress": ((), "Pa", "2-D spherical stress p = (σ1 + σ2) / 2"),
     "cell_deviatoric_stress": ((), "Pa", "deviatoric stress q = (σ1 − σ2) / 2 ≥ 0"),
     "cell_principal_strain_rate": ((2,), "1/s", "principal strain rates ε̇1 ≥ ε̇2"),
-    "cell_principal_strain_rate_angle": ((), "rad", "direction of ε̇1 from x, counter-clockwise, in (−π/2, π/2]"),
+    "cell_principal_strain_rate_angle": (
+        (), "rad", "direction of ε̇1 from x, counter-clockwise, in (−π/2, π/2]"
+    ),
     "cell_volumetric_strain_rate": ((), "1/s", "volumetric strain rate ε̇1 + ε̇2 (trace)"),
     "cell_deviatoric_strain_rate": ((), "1/s", "deviatoric strain rate (ε̇1 − ε̇2) / 2 ≥ 0"),
     "cell_principal_strain": ((2,), "1", "principal cumulated strains ε1 ≥ ε2"),
@@ -66,7 +68,9 @@ TENSOR_FIELDS: dict[str, tuple[tuple[int, ...], str, str]] = {
     "cell_volumetric_strain": ((), "1", "volumetric cumulated strain ε1 + ε2 (trace)"),
     "cell_deviatoric_strain": ((), "1", "deviatoric cumulated strain (ε1 − ε2) / 2 ≥ 0"),
     "block_sliding_ratio": ((), "1", "slipping contacts / closed contacts of the block (0 if none closed)"),
-    "block_max_opening": ((), "m", "largest gap among the block's contacts, ≥ 0 (saturates at the alert distance)"),
+    "block_max_opening": (
+        (), "m", "largest gap among the block's contacts, ≥ 0 (saturates at the alert distance)"
+    ),
 }
 """Every per-block field of ``TensorComputer.fields()``, in order: name → (shape after the leading
 block axis N, unit, description)."""
@@ -169,7 +173,9 @@ def build_triangles(centroids0: np.ndarray, touching_pairs: np.ndarray) -> np.nd
 # ---------------------------------------------------------------------------------------------------
 
 
-def block_stress(block_count, block_q, block_volume, contact_body, contact_point, contact_force) -> np.ndarray:
+def block_stress(
+    block_count, block_q, block_volume, contact_body, contact_point, contact_force
+) -> np.ndarray:
     """Block stress σ_b = (1/V_b) Σ GI ⊗ F (eq. 8).
 
     Args:

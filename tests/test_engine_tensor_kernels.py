@@ -26,7 +26,9 @@ def ref_block_stress(n, q, volume, body, point, force):
 def ref_cell_average(n, tensor, volume, body):
     out = np.empty((n, 2, 2))
     for i in range(n):
-        cell = {i} | {int(b) for a, b in body if a == i and b < n} | {int(a) for a, b in body if b == i and a < n}
+        cell = {i}
+        cell |= {int(b) for a, b in body if a == i and b < n}
+        cell |= {int(a) for a, b in body if b == i and a < n}
         cell = sorted(cell)
         out[i] = sum(volume[j] * tensor[j] for j in cell) / sum(volume[j] for j in cell)
     return out
@@ -248,3 +250,17 @@ def test_principal_uses_symmetric_part_and_factors():
     assert iso[0] == 0.0 and dev[0] == pytest.approx(math.sqrt(5.0), rel=1e-15)
     K._principal(t + np.eye(2), values, angle, iso, dev, 1.0)
     assert iso[0] == pytest.approx(2.0, rel=1e-15)
+
+
+def test_cell_strain_rate_flat_or_inverted_star_is_nan():
+    # one triangle (0, 1, 2), CCW at set-up; flattened now (area 0) → NaN; inverted (area < 0) → NaN
+    v = np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 2.0, 0.0]])
+    tri = np.array([[0, 1, 2]])
+    out = np.empty((3, 2, 2))
+    flat = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [2.0, 0.0, 0.0]]
+    inverted = [[0.0, 0.0, 0.0], [0.0, 1.0, 0.0], [1.0, 0.0, 0.0]]
+    for q in (flat, inverted):
+        K._cell_strain_rate(3, np.array(q), v, tri, out)
+        assert np.all(np.isnan(out))
+    K._cell_strain_rate(3, np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]), v, tri, out)
+    np.testing.assert_allclose(out, np.broadcast_to([[1.0, 0.0], [0.0, 2.0]], (3, 2, 2)), rtol=1e-15)

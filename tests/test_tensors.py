@@ -320,7 +320,8 @@ def test_build_triangles_drops_non_touching_and_degenerate():
     both = np.concatenate([sides, [[0, 2], [1, 3]]])
     assert T.build_triangles(c, both).shape == (2, 3)
     # collinear, fewer than 3, no pairs
-    assert T.build_triangles(np.array([[0.0, 0.0], [1.0, 0.0], [2.0, 0.0]]), [[0, 1], [1, 2], [0, 2]]).shape == (0, 3)
+    line = np.array([[0.0, 0.0], [1.0, 0.0], [2.0, 0.0]])
+    assert T.build_triangles(line, [[0, 1], [1, 2], [0, 2]]).shape == (0, 3)
     assert T.build_triangles(c[:2], [[0, 1]]).shape == (0, 3)
     assert T.build_triangles(c, np.zeros((0, 2))).shape == (0, 3)
     # a nearly flat triangle (area ~1e-14 · scale²) is dropped
@@ -356,9 +357,11 @@ def wall_contacts(centroids, pairs, rng):
     """Two contact points per touching pair, random forces, gaps and statuses, plus ground contacts."""
     n = len(centroids)
     bottom = np.nonzero(centroids[:, 1] < 0.15)[0]
-    body = np.concatenate([np.repeat(pairs, 2, axis=0), np.stack([np.repeat(bottom, 2), np.full(2 * len(bottom), n)], 1)])
+    ground = np.stack([np.repeat(bottom, 2), np.full(2 * len(bottom), n)], 1)
+    body = np.concatenate([np.repeat(pairs, 2, axis=0), ground])
     c = len(body)
-    point = 0.5 * (centroids[body[:, 0]] + centroids[np.minimum(body[:, 1], n - 1)]) + rng.normal(scale=0.05, size=(c, 2))
+    point = 0.5 * (centroids[body[:, 0]] + centroids[np.minimum(body[:, 1], n - 1)])
+    point += rng.normal(scale=0.05, size=(c, 2))
     return (body.astype(np.int32), point, rng.normal(size=(c, 2)) * 1e3, rng.normal(size=c) * 1e-4,
             rng.integers(0, 3, c).astype(np.int8))
 
@@ -418,10 +421,10 @@ def test_fields_are_consistent_with_independent_references(wall):
     np.testing.assert_allclose(f["cell_stress_skew"], 0.5 * np.abs(cs[:, 0, 1] - cs[:, 1, 0]), rtol=1e-15)
     for rate in ("_rate", ""):
         e = f["cell_principal_strain" + rate][tc.has_triangle]
-        np.testing.assert_allclose(f["cell_volumetric_strain" + rate][tc.has_triangle], e[:, 0] + e[:, 1],
-                                   rtol=1e-12, atol=1e-15)
-        np.testing.assert_allclose(f["cell_deviatoric_strain" + rate][tc.has_triangle], 0.5 * (e[:, 0] - e[:, 1]),
-                                   rtol=1e-12, atol=1e-15)
+        volumetric = f["cell_volumetric_strain" + rate][tc.has_triangle]
+        deviatoric = f["cell_deviatoric_strain" + rate][tc.has_triangle]
+        np.testing.assert_allclose(volumetric, e[:, 0] + e[:, 1], rtol=1e-12, atol=1e-15)
+        np.testing.assert_allclose(deviatoric, 0.5 * (e[:, 0] - e[:, 1]), rtol=1e-12, atol=1e-15)
 
 
 def test_cumulated_strain_integrates_the_rate(wall):
@@ -440,8 +443,8 @@ def test_cumulated_strain_integrates_the_rate(wall):
         tc.step(q, v, *args, dt)
     f = tc.fields()
     expected = steps * dt * 0.5 * (l0 + l0.T)
-    np.testing.assert_allclose(f["cell_strain"][tc.has_triangle], np.broadcast_to(expected, (tc.has_triangle.sum(), 2, 2)),
-                               rtol=1e-10, atol=1e-15)
+    got = f["cell_strain"][tc.has_triangle]
+    np.testing.assert_allclose(got, np.broadcast_to(expected, got.shape), rtol=1e-10, atol=1e-15)
     assert f["cell_volumetric_strain"][tc.has_triangle] == pytest.approx(steps * dt * 0.2, rel=1e-10)
     tc.reset_strain()
     assert np.all(tc.fields()["cell_strain"][tc.has_triangle] == 0.0)
