@@ -1,0 +1,103 @@
+"""256-entry colour lookup tables and scalar → packed RGBA mapping (numpy only).
+
+Rerun has no colormap for geometry, so block fills are coloured here. Colours are packed ``uint32``
+``0xRRGGBBAA`` (what Rerun's ``Rgba32`` takes without conversion).
+
+- ``VIRIDIS`` (sequential) for fields that are >= 0 (deviatoric parts);
+- ``COOLWARM`` (diverging, blue < 0 < red, light grey at 0) for signed fields (compression is
+  negative, so compression is blue);
+- ``NAN_RGBA`` (mid grey) for a value that is NaN (a block with no triangle, no contact...).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Final
+
+import numpy as np
+
+LUT_SIZE: Final = 256
+
+# Control points (position in [0, 1], R, G, B), interpolated linearly in RGB.
+_VIRIDIS_STOPS: Final = (
+    (0.000, 68, 1, 84),
+    (0.125, 71, 44, 122),
+    (0.250, 59, 82, 139),
+    (0.375, 44, 114, 142),
+    (0.500, 33, 145, 140),
+    (0.625, 40, 174, 128),
+    (0.750, 94, 201, 98),
+    (0.875, 170, 220, 50),
+    (1.000, 253, 231, 37),
+)
+_COOLWARM_STOPS: Final = (
+    (0.000, 59, 76, 192),
+    (0.250, 124, 159, 249),
+    (0.500, 221, 221, 221),
+    (0.750, 244, 154, 123),
+    (1.000, 180, 4, 38),
+)
+
+
+def pack_rgba(rgb: np.ndarray, alpha: int = 255) -> np.ndarray:
+    """(..., 3) uint8-range RGB -> (...,) uint32 packed 0xRRGGBBAA."""
+    c = np.asarray(rgb, dtype=np.uint32)
+    return (c[..., 0] << 24) | (c[..., 1] << 16) | (c[..., 2] << 8) | np.uint32(alpha)
+
+
+def unpack_rgba(packed: np.ndarray) -> np.ndarray:
+    """(...,) uint32 0xRRGGBBAA -> (..., 4) uint8 RGBA."""
+    p = np.asarray(packed, dtype=np.uint32)
+    return np.stack([(p >> s) & 0xFF for s in (24, 16, 8, 0)], axis=-1).astype(np.uint8)
+
+
+def make_lut(stops: tuple[tuple[float, int, int, int], ...], size: int = LUT_SIZE) -> np.ndarray:
+    """(size, 3) uint8 table interpolated linearly between the control points."""
+    pos = np.array([s[0] for s in stops])
+    rgb = np.array([s[1:] for s in stops], dtype=np.float64)
+    x = np.linspace(0.0, 1.0, size)
+    return np.round(np.stack([np.interp(x, pos, rgb[:, k]) for k in range(3)], axis=1)).astype(np.uint8)
+
+
+VIRIDIS: Final = pack_rgba(make_lut(_VIRIDIS_STOPS))
+"""(256,) uint32: sequential, dark purple (low) to yellow (high)."""
+COOLWARM: Final = pack_rgba(make_lut(_COOLWARM_STOPS))
+"""(256,) uint32: diverging, blue (low) - light grey (middle) - red (high)."""
+NAN_RGBA: Final = int(pack_rgba(np.array([128, 128, 128])))
+
+
+def map_scalars(values: np.ndarray, lo: float, hi: float, lut: np.ndarray, nan_rgba: int = NAN_RGBA) -> np.ndarray:
+    """Colours of ``values`` (any shape) on ``[lo, hi]`` (clipped): same shape, uint32 packed.
+
+    ``lo`` maps to ``lut[0]``, ``hi`` to ``lut[-1]``; NaN maps to ``nan_rgba``.
+    """
+    v = np.asarray(values, dtype=np.float64)
+    span = hi - lo if hi > lo else 1.0
+    t = (v - lo) * ((len(lut) - 1) / span)
+    finite = np.isfinite(t)
+    idx = np.clip(np.where(finite, t, 0.0), 0, len(lut) - 1)
+    out = lut[np.rint(idx).astype(np.intp)]
+    if not finite.all():
+        out = np.where(finite, out, np.uint32(nan_rgba))
+    return out
+
+
+def robust_max_abs(values: np.ndarray, percentile: float = 99.0) -> float:
+    """``percentile`` of |values| over the finite entries (0.0 when there are none)."""
+    a = np.abs(np.asarray(values, dtype=np.float64).ravel())
+    a = a[np.isfinite(a)]
+    if a.size == 0:
+        return 0.0
+    return float(np.percentile(a, percentile))
+
+
+def nice_ceil(x: float) -> float:
+    """Smallest of 1, 2, 2.5, 5 × 10^k that is >= x (x > 0); 0.0 for x <= 0 or not finite."""
+    if not (x > 0.0 and math.isfinite(x)):
+        return 0.0
+    e = math.floor(math.log10(x))
+    for m in (1.0, 2.0, 2.5, 5.0, 10.0):
+        v = m * 10.0**e
+        if v >= x * (1.0 - 1e-12):
+            return v
+    return 10.0 ** (e + 1)
