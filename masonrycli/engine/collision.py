@@ -1,0 +1,184 @@
+"""Contact detection for one configuration: world vertices → boxes → candidate pairs → contacts.
+
+Python orchestration only; the work is done by the numba kernels of :mod:`.broadphase` and
+:mod:`.narrowphase`. One :class:`ContactBuffers` per model is reused every step, so that a step
+allocates nothing unless a capacity is exceeded (capacities then double).
+
+Typical use in the time loop::
+
+    buffers = ContactBuffers(model.body_vert_start)
+    ...
+    n = detect_contacts(body_q_m, model.body_vert_start, model.vert_local, model.body_dynamic,
+                        alert, buffers)
+    c = buffers.view()          # c.contact_body, c.contact_point, ... — views of the first n rows
+"""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import numpy as np
+
+from .broadphase import PairBuffers, _body_aabbs, _world_vertices, candidate_pairs, world_vertices
+from .narrowphase import _narrowphase, check_topology, decode_contact_key
+
+__all__ = ["ContactBuffers", "Contacts", "decode_contact_key", "detect_contacts", "world_vertices"]
+
+
+class Contacts(NamedTuple):
+    """Views of the contacts found by the last :func:`detect_contacts` call (C = contact count)."""
+
+    contact_body: np.ndarray
+    """(C, 2) int32: bodies a < b; the normal points from a to b."""
+    contact_point: np.ndarray
+    """(C, 2) float64: contact point, world coordinates [m]."""
+    contact_normal: np.ndarray
+    """(C, 2) float64: unit normal from a to b; the tangent is t = (−n_y, n_x)."""
+    contact_gap: np.ndarray
+    """(C,) float64: gap [m] at detection, < 0 = penetration."""
+    contact_key: np.ndarray
+    """(C,) int64: stable key (pair + vertex/edge features), see :mod:`.narrowphase`."""
+
+
+class ContactBuffers:
+    """Work and output arrays of :func:`detect_contacts`, reused from one step to the next.
+
+    Parameters
+    ----------
+    body_vert_start : (B+1,) int64
+        CSR vertex offsets of the model (3..256 vertices per body, B < 2**23; checked here).
+    pair_capacity, contact_capacity : int, optional
+        Initial capacities (default 8·B pairs and 2 × pair capacity contacts); both double whenever
+        a step needs more.
+
+    Attributes
+    ----------
+    vert_world : (V, 2) float64
+        World vertices [m] of the last configuration.
+    body_aabb : (B, 4) float64
+        ``xmin, ymin, xmax, ymax`` [m] of each body, inflated by alert / 2.
+    pairs : PairBuffers
+        Broad-phase state: ``pairs.pair_body[:pair_count]`` are the candidate pairs (a < b, sorted).
+    contact_body, contact_point, contact_normal, contact_gap, contact_key
+        Output arrays of capacity ``contact_capacity`` (shapes and units as in :class:`Contacts`);
+        rows ``[:contact_count]`` are valid.
+    contact_count : int
+        Number of contacts found by the last call.
+
+    Arrays can be replaced by larger ones during a call: take them from the instance (or from
+    :meth:`view`) after each call, never keep references across calls.
+    """
+
+    def __init__(self, body_vert_start, pair_capacity: int | None = None, contact_capacity: int | None = None):
+        body_vert_start = np.asarray(body_vert_start)
+        check_topology(body_vert_start)
+        self._checked_vert_start = body_vert_start
+        self.body_count = body_vert_start.shape[0] - 1
+        self.vertex_count = int(body_vert_start[-1])
+        self.vert_world = np.zeros((self.vertex_count, 2), dtype=np.float64)
+        self.body_aabb = np.zeros((self.body_count, 4), dtype=np.float64)
+        self.pairs = PairBuffers(self.body_count, pair_capacity)
+        if contact_capacity is None:
+            contact_capacity = 2 * self.pairs.pair_capacity
+        self._allocate_contacts(max(int(contact_capacity), 2))
+        self.contact_count = 0
+
+    def _allocate_contacts(self, capacity: int) -> None:
+        self.contact_body = np.zeros((capacity, 2), dtype=np.int32)
+        self.contact_point = np.zeros((capacity, 2), dtype=np.float64)
+        self.contact_normal = np.zeros((capacity, 2), dtype=np.float64)
+        self.contact_gap = np.zeros(capacity, dtype=np.float64)
+        self.contact_key = np.zeros(capacity, dtype=np.int64)
+
+    @property
+    def contact_capacity(self) -> int:
+        return self.contact_gap.shape[0]
+
+    @property
+    def pair_count(self) -> int:
+        return self.pairs.pair_count
+
+    @property
+    def pair_body(self) -> np.ndarray:
+        """(P, 2) int32 view of the candidate pairs of the last call."""
+        return self.pairs.pair_body[: self.pairs.pair_count]
+
+    def grow_contacts(self, needed: int) -> None:
+        """Make room for at least ``needed`` contacts (capacity doubles until it fits)."""
+        capacity = self.contact_capacity
+        while capacity < needed:
+            capacity *= 2
+        if capacity != self.contact_capacity:
+            self._allocate_contacts(capacity)
+
+    def view(self) -> Contacts:
+        """The contacts of the last call, as views of the first ``contact_count`` rows."""
+        n = self.contact_count
+        return Contacts(
+            self.contact_body[:n],
+            self.contact_point[:n],
+            self.contact_normal[:n],
+            self.contact_gap[:n],
+            self.contact_key[:n],
+        )
+
+
+def detect_contacts(body_q, body_vert_start, vert_local, body_dynamic, alert, buffers: ContactBuffers) -> int:
+    """Find every contact with gap ≤ ``alert`` in the configuration ``body_q``.
+
+    Parameters
+    ----------
+    body_q : (B, 3) float64
+        Centroid x, y [m] and rotation θ [rad, CCW] from the initial orientation (for the
+        Moreau–Jean scheme: the intermediate configuration q_m).
+    body_vert_start : (B+1,) int64
+        CSR vertex offsets (the one ``buffers`` was made for, or one with the same layout).
+    vert_local : (V, 2) float64
+        Convex CCW polygons relative to the body centroid at θ = 0 [m].
+    body_dynamic : (B,) bool
+        True for blocks, False for supports (support–support pairs are never tested).
+    alert : float
+        Alert distance [m] (≥ 0).
+    buffers : ContactBuffers
+        Reused work and output arrays.
+
+    Returns
+    -------
+    contact_count : int
+        The contacts are ``buffers.view()`` (rows ``[:contact_count]`` of ``buffers.contact_*``):
+        sorted by pair (a, b), at most two per pair, ordered along the reference edge within a pair.
+        The result depends on the inputs only (not on earlier calls).
+    """
+    if body_vert_start is not buffers._checked_vert_start:
+        check_topology(body_vert_start)
+        buffers._checked_vert_start = body_vert_start
+    if (
+        body_q.shape != (buffers.body_count, 3)
+        or body_vert_start.shape != (buffers.body_count + 1,)
+        or vert_local.shape != (buffers.vertex_count, 2)
+        or body_dynamic.shape != (buffers.body_count,)
+    ):
+        raise ValueError(
+            f"detect_contacts: shapes body_q {body_q.shape}, body_vert_start {body_vert_start.shape}, "
+            f"vert_local {vert_local.shape}, body_dynamic {body_dynamic.shape} do not match buffers made "
+            f"for {buffers.body_count} bodies and {buffers.vertex_count} vertices"
+        )
+    if not np.isfinite(body_q).all():
+        bad = int(np.flatnonzero(~np.isfinite(body_q).all(axis=1))[0])
+        raise FloatingPointError(f"detect_contacts: body {bad} has a non-finite pose {body_q[bad]}")
+    alert = float(alert)
+    if not alert >= 0.0:
+        raise ValueError(f"detect_contacts: alert distance must be >= 0, got {alert}")
+
+    _world_vertices(body_q, body_vert_start, vert_local, buffers.vert_world)
+    _body_aabbs(buffers.vert_world, body_vert_start, 0.5 * alert, buffers.body_aabb)
+    pair_count = candidate_pairs(buffers.body_aabb, body_dynamic, buffers.pairs)
+    if buffers.contact_capacity < 2 * pair_count:  # ≤ 2 contacts per pair: the kernel never overflows
+        buffers.grow_contacts(2 * pair_count)
+    n = _narrowphase(
+        buffers.vert_world, body_vert_start, buffers.pairs.pair_body, pair_count, alert,
+        buffers.contact_body, buffers.contact_point, buffers.contact_normal, buffers.contact_gap,
+        buffers.contact_key,
+    )  # fmt: skip
+    buffers.contact_count = n
+    return n

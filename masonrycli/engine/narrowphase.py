@@ -1,0 +1,469 @@
+"""Narrow phase: contact points between two convex polygons (separating axes + edge clipping).
+
+For a candidate pair (a, b) of convex counter-clockwise polygons:
+
+1. **Separating axes.** For each edge i of a, with outward unit normal n_i and start vertex v_i, the
+   separation of b along n_i is ``min_{w ∈ b} n_i · (w − v_i)``; ``sep_a`` is the largest over a's
+   edges (first edge on ties), ``sep_b`` likewise with the roles swapped. If either exceeds the alert
+   distance, the polygons are farther apart than ``alert``: no contact.
+2. **Reference face.** The face of larger separation, preferring a's face unless
+   ``sep_b > sep_a + tol`` with ``tol = 1e-9 m + 1e-6 · size`` (size = the smaller of the two
+   polygons' bounding-box extents). Coincident faces (a joint) then always pick a's face, whatever
+   the rounding of the world vertices.
+3. **Incident edge.** The edge of the other polygon whose outward normal is most anti-parallel to the
+   reference normal n (first edge on ties).
+4. **Clipping.** The incident segment is clipped against the two side planes of the reference edge
+   (the lines through its end vertices, along n). An end within ``tol`` outside a side plane is kept
+   as it is (not clipped): perfectly aligned corners (a column of blocks) then give the same points
+   whatever the rounding.
+5. **Points.** Each clipped end p with separation ``g = n · (p − v_ref) ≤ alert`` gives a contact:
+   point ``p − ½ g n`` (midway between p and its projection on the reference face), normal n
+   oriented from a to b, gap g (< 0 = penetration). At most two per pair, ordered along the reference
+   edge (from its start vertex to its end vertex). Two ends closer than ``tol`` (corner against
+   corner) are one contact: the one at an incident vertex is kept.
+
+Two blocks sharing a joint give exactly the two ends of the overlapping segment with gap 0; a block
+on a wide ground gives its two bottom corners; a corner on a face gives one point.
+
+**Contact key** (int64, the same from one step to the next for the same physical contact, used to warm
+start the solver). A contact always sits at a *vertex* of one body against an *edge* of the other: an
+incident end that survived clipping is the incident polygon's vertex against the reference edge; an end
+clipped at a side plane is the reference polygon's vertex (that end of the reference edge) against the
+incident edge. The key encodes that pair of features rather than "which face was the reference", so it
+does not change when the reference face flips between two nearly coincident faces (a joint starting to
+open, a block starting to rock). Where two corners nearly coincide (the incident vertex within
+``snap = max(alert, tol)`` of the side plane: a column, the vertical joints of a course), which of the
+two is "inside" flips with rounding and tiny motions, so the end is then always labelled with the
+corner of body a, against the edge of body b::
+
+    key = a << 40 | b << 17 | owner_is_b << 16 | vertex << 8 | edge
+
+    bits 40..62  a           first body (a < b), < 2**23
+    bits 17..39  b           second body, < 2**23
+    bit  16      owner_is_b  1 if the vertex belongs to b (the edge then belongs to a), 0 otherwise
+    bits  8..15  vertex      local index of the vertex in its polygon, < 256
+    bits  0..7   edge        local index of the edge in the other polygon (edge k joins vertices
+                             k and k+1), < 256
+
+Limits: fewer than 2**23 = 8 388 608 bodies and at most 256 vertices per polygon (checked by the
+launchers). Keys are non-negative and unique within a step. :func:`decode_contact_key` unpacks them.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ._jit import njit
+
+__all__ = [
+    "KEY_LIMIT_BODIES",
+    "KEY_LIMIT_VERTICES",
+    "REF_TOL_ABS",
+    "REF_TOL_REL",
+    "check_topology",
+    "collide_polygons",
+    "decode_contact_key",
+    "narrowphase",
+]
+
+REF_TOL_ABS = 1e-9
+"""Absolute part of the face-choice / clipping / merging tolerance, m."""
+REF_TOL_REL = 1e-6
+"""Relative part of the tolerance, times the smaller polygon extent of the pair."""
+KEY_LIMIT_BODIES = 1 << 23
+"""Body indices must be below this for the contact key to be unique."""
+KEY_LIMIT_VERTICES = 256
+"""Vertex count per polygon must be at most this for the contact key to be unique."""
+
+
+@njit
+def _max_face_separation(vert, s1, n1, s2, n2, alert):
+    # Largest separation of polygon 2 along the outward edge normals of polygon 1:
+    #     for each edge i of 1:  sep_i = min_{w ∈ 2} n_i · (w − v_i)
+    #     return (max_i sep_i, argmax_i)          (strict '>' : the first edge wins ties)
+    # Stops as soon as an edge separates by more than alert: the pair is then dropped anyway.
+    # Returns edge -1 if no separation is a number (NaN coordinates): the caller skips the pair.
+    best = -math.inf
+    best_edge = -1
+    for i in range(n1):
+        j = i + 1 if i + 1 < n1 else 0
+        x1 = vert[s1 + i, 0]
+        y1 = vert[s1 + i, 1]
+        dx = vert[s1 + j, 0] - x1
+        dy = vert[s1 + j, 1] - y1
+        length = math.sqrt(dx * dx + dy * dy)
+        if not (length > 0.0):
+            continue  # degenerate edge: no normal (input checks should have refused it)
+        nx = dy / length
+        ny = -dx / length
+        sep = math.inf
+        for k in range(n2):
+            d = nx * (vert[s2 + k, 0] - x1) + ny * (vert[s2 + k, 1] - y1)
+            if d < sep:
+                sep = d
+        if sep > best:
+            best = sep
+            best_edge = i
+            if best > alert:
+                break
+    return best, best_edge
+
+
+@njit
+def _extent(vert, s, n):
+    # Largest side of the polygon's bounding box (sets the scale of the tolerances).
+    xmin = vert[s, 0]
+    xmax = xmin
+    ymin = vert[s, 1]
+    ymax = ymin
+    for k in range(s + 1, s + n):
+        x = vert[k, 0]
+        y = vert[k, 1]
+        xmin = min(xmin, x)
+        xmax = max(xmax, x)
+        ymin = min(ymin, y)
+        ymax = max(ymax, y)
+    return max(xmax - xmin, ymax - ymin)
+
+
+@njit
+def _make_key(a, b, owner_is_b, vertex, edge):
+    return (
+        (np.int64(a) << 40)
+        | (np.int64(b) << 17)
+        | (np.int64(owner_is_b) << 16)
+        | (np.int64(vertex) << 8)
+        | np.int64(edge)
+    )
+
+
+@njit
+def _end_label(side, t0, ivtx, e, e2, k, length, snap, ref_is_b):
+    # Feature label (owner_is_b, vertex, edge) of one end of the clipped incident segment.
+    #   raw:  clipped at side s → R's vertex (e or e2) against I's incident edge k
+    #         not clipped       → I's vertex ivtx against R's reference edge e
+    #   aligned corners: if the incident vertex lies within `snap` of the side plane (|t0 − 0| or
+    #   |t0 − L| ≤ snap), the end is at two nearly coincident corners, one of R and one of I; which one
+    #   is "inside" flips with rounding and tiny motions (a column, the vertical joints of a course),
+    #   so the label is always the corner of body a, against the edge of body b.
+    # snap < 0 gives the raw label.
+    if side >= 0:
+        rv = e if side == 0 else e2
+        aligned = (t0 >= -snap) if side == 0 else (t0 <= length + snap)
+    else:
+        if t0 <= length - t0:
+            rv = e
+            aligned = t0 <= snap
+        else:
+            rv = e2
+            aligned = t0 >= length - snap
+    if aligned:
+        if ref_is_b:
+            return 0, ivtx, e  # a is the incident body: its vertex, against b's reference edge
+        return 0, rv, k  # a is the reference body: its vertex, against b's incident edge
+    if side >= 0:
+        return (1 if ref_is_b else 0), rv, k
+    return (0 if ref_is_b else 1), ivtx, e
+
+
+@njit
+def _collide_pair(
+    vert, sa, na, sb, nb, a, b, alert, c,
+    contact_body, contact_point, contact_normal, contact_gap, contact_key,
+):  # fmt: skip
+    # Contacts of the pair (a, b) written from row c on; returns the next free row.
+    #   sep_a, e_a = max face separation of b along a's normals   (> alert → none)
+    #   sep_b, e_b = same with the roles swapped                   (> alert → none)
+    #   reference R = b if sep_b > sep_a + tol else a ; incident I = the other polygon
+    #   n = outward normal of R's edge e (v1 → v2), u = (v2 − v1)/|v2 − v1|
+    #   incident edge k = argmin over I's edges of n · n_k; segment w1 = I[k] → w2 = I[k+1]
+    #   in the frame (t, g) = (u·(p − v1), n·(p − v1)): clip [w1, w2] to t ∈ [0, L]
+    #   (ends within tol outside are kept), interpolating g
+    #   each end with g ≤ alert → contact (p − g n / 2, ±n, g, key)
+    sep_a, e_a = _max_face_separation(vert, sa, na, sb, nb, alert)
+    if not (sep_a <= alert) or e_a < 0:
+        return c
+    sep_b, e_b = _max_face_separation(vert, sb, nb, sa, na, alert)
+    if not (sep_b <= alert) or e_b < 0:
+        return c
+    tol = REF_TOL_ABS + REF_TOL_REL * min(_extent(vert, sa, na), _extent(vert, sb, nb))
+
+    # Reference face: a's unless b's separates clearly more (deterministic on coincident faces).
+    ref_is_b = sep_b > sep_a + tol
+    if ref_is_b:
+        rs, rn, e, is_, in_ = sb, nb, e_b, sa, na
+    else:
+        rs, rn, e, is_, in_ = sa, na, e_a, sb, nb
+    e2 = e + 1 if e + 1 < rn else 0
+    v1x = vert[rs + e, 0]
+    v1y = vert[rs + e, 1]
+    v2x = vert[rs + e2, 0]
+    v2y = vert[rs + e2, 1]
+    ux = v2x - v1x
+    uy = v2y - v1y
+    length = math.sqrt(ux * ux + uy * uy)
+    ux /= length
+    uy /= length
+    nx = uy  # outward normal of a CCW polygon's edge: the edge direction turned by -90°
+    ny = 0.0 - ux  # (0.0 - x rather than -x: no negative zeros in the outputs)
+
+    # Incident edge: outward normal most anti-parallel to n, i.e. smallest n · n_k.
+    k = 0
+    best = math.inf
+    for i in range(in_):
+        j = i + 1 if i + 1 < in_ else 0
+        dx = vert[is_ + j, 0] - vert[is_ + i, 0]
+        dy = vert[is_ + j, 1] - vert[is_ + i, 1]
+        li = math.sqrt(dx * dx + dy * dy)
+        if not (li > 0.0):
+            continue
+        d = (nx * dy - ny * dx) / li
+        if d < best:
+            best = d
+            k = i
+    k2 = k + 1 if k + 1 < in_ else 0
+
+    # Ends of the incident segment in the reference frame: t along the edge (from v1), g along n.
+    # Per end: the incident vertex it started as (at t0) and the side plane it was clipped at (-1:
+    # none). A clipped end is placed at v_side + g·n rather than interpolated in x, y: on a joint
+    # (g = 0) it is then exactly the reference vertex.
+    w1x = vert[is_ + k, 0]
+    w1y = vert[is_ + k, 1]
+    w2x = vert[is_ + k2, 0]
+    w2y = vert[is_ + k2, 1]
+    t1 = ux * (w1x - v1x) + uy * (w1y - v1y)
+    t2 = ux * (w2x - v1x) + uy * (w2y - v1y)
+    g1 = nx * (w1x - v1x) + ny * (w1y - v1y)
+    g2 = nx * (w2x - v1x) + ny * (w2y - v1y)
+    t01 = t1
+    t02 = t2
+    side1 = -1
+    side2 = -1
+
+    # Side plane through v1 (t ≥ 0).
+    if t1 < -tol and t2 < -tol:
+        return c
+    if t1 < -tol:
+        lam = min(t1 / (t1 - t2), 1.0)  # ≤ 1: never beyond the other end (kept within tol)
+        g1 = g1 + lam * (g2 - g1)
+        t1 = 0.0
+        side1 = 0
+    elif t2 < -tol:
+        lam = max(t1 / (t1 - t2), 0.0)
+        g2 = g1 + lam * (g2 - g1)
+        t2 = 0.0
+        side2 = 0
+    # Side plane through v2 (t ≤ L).
+    d1 = length - t1
+    d2 = length - t2
+    if d1 < -tol and d2 < -tol:
+        return c
+    if d1 < -tol:
+        lam = min(d1 / (d1 - d2), 1.0)
+        g1 = g1 + lam * (g2 - g1)
+        t1 = length
+        side1 = 1
+    elif d2 < -tol:
+        lam = max(d1 / (d1 - d2), 0.0)
+        g2 = g1 + lam * (g2 - g1)
+        t2 = length
+        side2 = 1
+
+    if side1 < 0:
+        p1x, p1y = w1x, w1y
+    else:
+        p1x = (v1x if side1 == 0 else v2x) + g1 * nx
+        p1y = (v1y if side1 == 0 else v2y) + g1 * ny
+    if side2 < 0:
+        p2x, p2y = w2x, w2y
+    else:
+        p2x = (v1x if side2 == 0 else v2x) + g2 * nx
+        p2y = (v1y if side2 == 0 else v2y) + g2 * ny
+
+    keep1 = g1 <= alert
+    keep2 = g2 <= alert
+    if keep1 and keep2:
+        ddx = p2x - p1x
+        ddy = p2y - p1y
+        if ddx * ddx + ddy * ddy <= tol * tol:
+            # One physical contact (corner against corner): keep the end at an incident vertex.
+            if side1 >= 0 and side2 < 0:
+                keep1 = False
+            else:
+                keep2 = False
+
+    # Features → keys. snap: corners closer than this along the edge count as aligned.
+    snap = max(alert, tol)
+    own1, vtx1, edg1 = _end_label(side1, t01, k, e, e2, k, length, snap, ref_is_b)
+    own2, vtx2, edg2 = _end_label(side2, t02, k2, e, e2, k, length, snap, ref_is_b)
+    if keep1 and keep2 and own1 == own2 and vtx1 == vtx2 and edg1 == edg2:
+        # Both ends near the same aligned corner (a very short overlap): the raw labels differ.
+        own1, vtx1, edg1 = _end_label(side1, t01, k, e, e2, k, length, -1.0, ref_is_b)
+        own2, vtx2, edg2 = _end_label(side2, t02, k2, e, e2, k, length, -1.0, ref_is_b)
+
+    # Order along the reference edge (t increasing), so the order does not depend on the direction
+    # in which the incident edge runs.
+    swap = t2 < t1
+    out_normal_x = 0.0 - nx if ref_is_b else nx  # from a to b
+    out_normal_y = 0.0 - ny if ref_is_b else ny
+    capacity = contact_gap.shape[0]
+    for m in range(2):
+        first = (m == 0) != swap
+        if first:
+            if not keep1:
+                continue
+            px, py, g, own, vtx, edg = p1x, p1y, g1, own1, vtx1, edg1
+        else:
+            if not keep2:
+                continue
+            px, py, g, own, vtx, edg = p2x, p2y, g2, own2, vtx2, edg2
+        if c < capacity:
+            contact_body[c, 0] = a
+            contact_body[c, 1] = b
+            contact_point[c, 0] = px - 0.5 * g * nx
+            contact_point[c, 1] = py - 0.5 * g * ny
+            contact_normal[c, 0] = out_normal_x
+            contact_normal[c, 1] = out_normal_y
+            contact_gap[c] = g
+            contact_key[c] = _make_key(a, b, own, vtx, edg)
+        c += 1
+    return c
+
+
+@njit
+def _narrowphase(
+    vert_world, body_vert_start, pair_body, pair_count, alert,
+    contact_body, contact_point, contact_normal, contact_gap, contact_key,
+):  # fmt: skip
+    # for each candidate pair p (in the given order): append its 0..2 contacts (see _collide_pair).
+    # Contacts beyond the capacity are counted, not written. Returns the number of contacts.
+    c = 0
+    for p in range(pair_count):
+        a = pair_body[p, 0]
+        b = pair_body[p, 1]
+        sa = body_vert_start[a]
+        sb = body_vert_start[b]
+        c = _collide_pair(
+            vert_world, sa, body_vert_start[a + 1] - sa, sb, body_vert_start[b + 1] - sb,
+            a, b, alert, c,
+            contact_body, contact_point, contact_normal, contact_gap, contact_key,
+        )  # fmt: skip
+    return c
+
+
+def check_topology(body_vert_start) -> None:
+    """Raise ValueError unless the CSR vertex offsets fit the kernels and the contact key.
+
+    ``body_vert_start (B+1,)`` int64: starts at 0, every polygon has 3..256 vertices, B < 2**23.
+    """
+    body_vert_start = np.asarray(body_vert_start)
+    if body_vert_start.ndim != 1 or body_vert_start.shape[0] < 1 or body_vert_start.dtype != np.int64:
+        raise ValueError("body_vert_start must be a 1-D int64 array of B+1 offsets")
+    if body_vert_start[0] != 0:
+        raise ValueError("body_vert_start[0] must be 0")
+    body_count = body_vert_start.shape[0] - 1
+    if body_count >= KEY_LIMIT_BODIES:
+        raise ValueError(f"{body_count} bodies: the contact key allows fewer than {KEY_LIMIT_BODIES}")
+    counts = np.diff(body_vert_start)
+    bad = np.flatnonzero((counts < 3) | (counts > KEY_LIMIT_VERTICES))
+    if bad.size:
+        raise ValueError(
+            f"body {bad[0]} has {counts[bad[0]]} vertices: polygons need 3..{KEY_LIMIT_VERTICES}"
+        )
+
+
+def narrowphase(
+    vert_world, body_vert_start, pair_body, pair_count, alert,
+    contact_body, contact_point, contact_normal, contact_gap, contact_key,
+) -> int:  # fmt: skip
+    """Contact points of the candidate pairs, written into preallocated arrays.
+
+    Parameters
+    ----------
+    vert_world : (V, 2) float64
+        World vertices [m], CCW per body (``broadphase.world_vertices``).
+    body_vert_start : (B+1,) int64
+        CSR offsets of the vertices (3..256 per body, see :func:`check_topology`).
+    pair_body : (P_cap, 2) int32
+        Candidate pairs (a, b), a < b; rows ``[:pair_count]`` are used, in that order.
+    pair_count : int
+        Number of pairs.
+    alert : float
+        Alert distance [m]: contacts with gap ≤ alert are kept.
+    contact_body : (C_cap, 2) int32
+        Out: bodies a, b of each contact (normal from a to b).
+    contact_point : (C_cap, 2) float64
+        Out: contact point, world [m].
+    contact_normal : (C_cap, 2) float64
+        Out: unit normal from a to b (tangent t = (−n_y, n_x)).
+    contact_gap : (C_cap,) float64
+        Out: gap [m], < 0 = penetration.
+    contact_key : (C_cap,) int64
+        Out: stable contact key (layout in the module docstring).
+
+    Returns
+    -------
+    contact_count : int
+        Rows ``[:contact_count]`` of the outputs are written; contacts of one pair are consecutive,
+        pairs in input order. At most 2 per pair: the capacity C_cap must be ≥ 2·pair_count.
+    """
+    capacity = contact_gap.shape[0]
+    if capacity < 2 * pair_count:
+        raise ValueError(f"narrowphase: capacity {capacity} < 2 x {pair_count} pairs")
+    return _narrowphase(
+        vert_world, body_vert_start, pair_body, int(pair_count), float(alert),
+        contact_body, contact_point, contact_normal, contact_gap, contact_key,
+    )  # fmt: skip
+
+
+def collide_polygons(verts_a, verts_b, alert, a: int = 0, b: int = 1):
+    """Contacts between two convex CCW polygons given by their world vertices (tests, tools).
+
+    Allocates; the time loop uses :func:`masonrycli.engine.collision.detect_contacts` instead.
+
+    Parameters
+    ----------
+    verts_a, verts_b : (n, 2) float64
+        World vertices of body a and body b [m], CCW, without repeating the first vertex.
+    alert : float
+        Alert distance [m].
+    a, b : int
+        Body indices written into the keys and ``contact_body``.
+
+    Returns
+    -------
+    (contact_point (c, 2), contact_normal (c, 2), contact_gap (c,), contact_key (c,)) with c ≤ 2.
+    """
+    verts_a = np.ascontiguousarray(verts_a, dtype=np.float64)
+    verts_b = np.ascontiguousarray(verts_b, dtype=np.float64)
+    vert = np.concatenate([verts_a, verts_b])
+    body_vert_start = np.array([0, len(verts_a), len(vert)], dtype=np.int64)
+    check_topology(body_vert_start)
+    contact_body = np.zeros((2, 2), dtype=np.int32)
+    contact_point = np.zeros((2, 2))
+    contact_normal = np.zeros((2, 2))
+    contact_gap = np.zeros(2)
+    contact_key = np.zeros(2, dtype=np.int64)
+    c = _collide_pair(
+        vert, 0, len(verts_a), len(verts_a), len(verts_b), a, b, float(alert), 0,
+        contact_body, contact_point, contact_normal, contact_gap, contact_key,
+    )  # fmt: skip
+    return contact_point[:c].copy(), contact_normal[:c].copy(), contact_gap[:c].copy(), contact_key[:c].copy()
+
+
+def decode_contact_key(key):
+    """Unpack contact keys (scalar or array) into ``(a, b, owner_is_b, vertex, edge)``.
+
+    ``vertex`` is a local vertex index of body b if ``owner_is_b`` else of body a; ``edge`` is a local
+    edge index of the other body.
+    """
+    key = np.asarray(key, dtype=np.int64)
+    return (
+        key >> 40,
+        (key >> 17) & (KEY_LIMIT_BODIES - 1),
+        (key >> 16) & 1,
+        (key >> 8) & 0xFF,
+        key & 0xFF,
+    )
