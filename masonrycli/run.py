@@ -134,15 +134,16 @@ class Simulation:
 
 
 def simulate(scenario, sinks=(), on_progress: Callable | None = None, progress_every: int = 10,
-             steps: int | None = None) -> RunResult:
+             steps: int | None = None, sim: Simulation | None = None) -> RunResult:
     """Run ``scenario`` to its end (or ``steps`` steps). Each sink gets ``append(frame)``/``log_frame(frame)``
     for every recorded frame; sinks are *not* closed here (the caller owns them) but every frame computed
     before an interruption has been handed over when this returns.
 
-    ``on_progress(sim, step_stats)`` is called every ``progress_every`` steps.
+    ``on_progress(sim, step_stats)`` is called every ``progress_every`` steps. Pass ``sim`` to run an
+    already built :class:`Simulation` (the caller needed its model or triangles first).
     """
     t0 = _time.perf_counter()
-    sim = Simulation(scenario)
+    sim = Simulation(scenario) if sim is None else sim
     m = sim.model
     n_steps = m.n_steps if steps is None else min(steps, m.n_steps)
     every = scenario.run.record_every

@@ -54,8 +54,7 @@ class Solver:
     def _alloc(self, capacity: int) -> None:
         self._ra = np.zeros((capacity, 2))
         self._rb = np.zeros((capacity, 2))
-        self._w = np.zeros((capacity, 3))
-        self._bias = np.zeros(capacity)
+        self._pack = np.zeros((capacity, nlgs.PACK_WIDTH))
         self._r = np.zeros((capacity, 2))
         self._status = np.zeros(capacity, dtype=np.int8)
         self._force = np.zeros((capacity, 2))
@@ -132,9 +131,8 @@ class Solver:
         bf = self.buffers
         body, normal = bf.contact_body, bf.contact_normal
         nlgs.prepare_contacts(body, bf.contact_point, normal, bf.contact_gap, count, self.body_q_m, m,
-                              self._ra, self._rb, self._w, self._bias)
-        iterations, residual = nlgs.solve(body, normal, self._ra, self._rb, self._w, self._bias, count, m,
-                                          state.body_v, self._r, self._status)
+                              self._ra, self._rb, self._pack)
+        iterations, residual = nlgs.solve(body, self._pack, count, m, state.body_v, self._r, self._status)
         dissipated, work = nlgs.contact_power(body, normal, self._ra, self._rb, self._r, count, self._v_old,
                                               state.body_v, m, self._force, self.support_force)
         integrate.update_q(state.body_q, self._v_old, state.body_v, m.dt, m.theta)

@@ -1,0 +1,437 @@
+"""The ``masonry`` command line. Thin: options → Scenario → execute; errors → one line, exit code 2."""
+
+from __future__ import annotations
+
+import dataclasses
+import functools
+import sys
+from pathlib import Path
+from typing import Annotated, Optional
+
+import typer
+from rich.console import Console
+from rich.table import Table
+
+from geometry_library.blocks import GeometryError
+from masonrycli import __version__
+from masonrycli.errors import InputError
+
+app = typer.Typer(rich_markup_mode="rich", no_args_is_help=True, add_completion=False,
+                  help="Dynamic analysis of dry-stone masonry: rigid blocks, Coulomb friction, NSCD, "
+                       "the cell stress and strain tensors of Chetouane et al. (2003), Rerun recordings.")
+simulate_app = typer.Typer(no_args_is_help=True, help="Build a structure, load it and record the run.")
+build_app = typer.Typer(no_args_is_help=True, help="Build a structure and write it as GeoJSON.")
+app.add_typer(simulate_app, name="simulate")
+app.add_typer(build_app, name="build")
+
+console = Console()
+err_console = Console(stderr=True)
+
+EXIT_BAD_INPUT = 2
+EXIT_INTERRUPTED = 130
+EXIT_DIVERGED = 3
+
+
+def _fail(message: str) -> None:
+    err_console.print(f"[bold red]error:[/bold red] {message}", highlight=False, soft_wrap=True)
+    raise typer.Exit(EXIT_BAD_INPUT)
+
+
+def user_errors(func):
+    """Turn bad input into one line on stderr and exit code 2 — never a traceback."""
+
+    @functools.wraps(func)
+    def wrapper(*args, **kwargs):
+        try:
+            return func(*args, **kwargs)
+        except (InputError, GeometryError) as exc:
+            _fail(str(exc).splitlines()[0] if str(exc) else type(exc).__name__)
+        except OSError as exc:
+            _fail(f"{exc.filename or ''}: {exc.strerror or exc}".lstrip(": "))
+
+    return wrapper
+
+
+def _version(value: bool) -> None:
+    if value:
+        console.print(f"masonry {__version__}")
+        raise typer.Exit()
+
+
+@app.callback()
+def main_callback(
+    version: Annotated[bool, typer.Option("--version", callback=_version, is_eager=True,
+                                          help="Print the version and exit.")] = False,
+) -> None:
+    """masonry: rigid-block dynamics of dry-stone masonry."""
+
+
+# -- shared options -------------------------------------------------------------------------------
+
+Duration = Annotated[Optional[float], typer.Option(help="Simulated time, s.", rich_help_panel="Run")]
+Dt = Annotated[Optional[float], typer.Option("--dt", help="Time step, s (default 1e-3).", rich_help_panel="Run")]
+Theta = Annotated[Optional[float], typer.Option(help="Moreau–Jean θ in [0.5, 1] (default 0.5).",
+                                                rich_help_panel="Run")]
+Friction = Annotated[Optional[float], typer.Option(help="Coulomb coefficient of every contact (default 0.6).",
+                                                   rich_help_panel="Material")]
+Density = Annotated[Optional[float], typer.Option(help="Block density, kg/m³ (default 2500).",
+                                                  rich_help_panel="Material")]
+Thickness = Annotated[Optional[float], typer.Option(help="Out-of-plane thickness, m (default 1).",
+                                                    rich_help_panel="Material")]
+RecordEvery = Annotated[Optional[int], typer.Option(help="Steps between recorded frames (default 10).",
+                                                    rich_help_panel="Run")]
+Tolerance = Annotated[Optional[float], typer.Option(help="NLGS tolerance, relative quadratic norm (default 1.666e-4).",
+                                                    rich_help_panel="Run")]
+MaxIterations = Annotated[Optional[int], typer.Option(help="NLGS sweep cap per step (default 1000).",
+                                                      rich_help_panel="Run")]
+Out = Annotated[Optional[Path], typer.Option("--out", "-o", help="Recording (.rrd). Default: "
+                                             "recordings/<scenario>-<timestamp>.rrd.", rich_help_panel="Output")]
+NoRecording = Annotated[bool, typer.Option("--no-recording", help="Write no .rrd recording.",
+                                           rich_help_panel="Output")]
+HistoryOpt = Annotated[Optional[Path], typer.Option("--history", help="History file (.npz), one row per "
+                                                    "recorded frame.", rich_help_panel="Output")]
+Freq = Annotated[Optional[float], typer.Option("--freq", help="Ground velocity frequency, Hz.", rich_help_panel="Loading")]
+Amp = Annotated[Optional[float], typer.Option("--amp", help="Horizontal ground velocity amplitude, m/s.",
+                                              rich_help_panel="Loading")]
+Settlement = Annotated[Optional[float], typer.Option(help="Downward velocity of the right foundation, m/s.",
+                                                     rich_help_panel="Loading")]
+
+
+def _run_overrides(**values) -> dict:
+    return {k: v for k, v in values.items() if v is not None}
+
+
+def _replace(obj, where: str, **changes):
+    """dataclasses.replace with the option name in the error message."""
+    try:
+        return dataclasses.replace(obj, **changes)
+    except InputError as exc:
+        raise InputError(f"{where}: {exc}") from None
+
+
+def _apply_options(scenario, *, duration, dt, theta, friction, record_every, tolerance, max_iterations):
+    from masonrycli.scenario import RunConfig  # noqa: F401  (validation lives in the dataclass)
+
+    run_changes = _run_overrides(duration=duration, dt=dt, theta=theta, record_every=record_every,
+                                 tolerance=tolerance, max_iterations=max_iterations)
+    for key, value in run_changes.items():
+        _replace(scenario.run, f"--{key.replace('_', '-')}", **{key: value})
+    run = _replace(scenario.run, "options", **run_changes) if run_changes else scenario.run
+    material = scenario.material
+    if friction is not None:
+        material = _replace(material, "--friction", friction=friction)
+    return dataclasses.replace(scenario, run=run, material=material)
+
+
+def _outputs(name: str, out: Optional[Path], no_recording: bool) -> Optional[Path]:
+    from masonrycli.execute import default_recording_path
+
+    if no_recording:
+        return None
+    if out is None:
+        return default_recording_path(name)
+    if out.suffix != ".rrd":
+        raise InputError(f"--out {out}: a recording file must end in .rrd")
+    return out
+
+
+def _execute(scenario, out: Optional[Path], history: Optional[Path]) -> None:
+    from masonrycli.execute import execute, print_summary
+
+    for warning in scenario.warnings:
+        err_console.print(f"[yellow]warning:[/yellow] {warning}", highlight=False)
+    try:
+        result = execute(scenario, out=out, history=history, console=console)
+    except KeyboardInterrupt:
+        err_console.print("interrupted: the recording and history hold every frame computed so far"
+                          + (f" ({out})" if out else ""))
+        raise typer.Exit(EXIT_INTERRUPTED)
+    print_summary(console, result, scenario, out, history)
+    if result.status == "diverged":
+        raise typer.Exit(EXIT_DIVERGED)
+    if result.status == "interrupted":
+        raise typer.Exit(EXIT_INTERRUPTED)
+
+
+# -- builder options ------------------------------------------------------------------------------
+
+def _wall_options(blocks, courses, length, block_length, block_height) -> dict:
+    opts = {"blocks": blocks, "courses": courses, "length": length, "block_length": block_length,
+            "block_height": block_height}
+    if courses is not None or length is not None:
+        opts["blocks"] = blocks  # None unless given: the builder solves for the rest
+    return {k: v for k, v in opts.items() if v is not None}
+
+
+def _arch_options(voussoirs, pier_courses, span, ring_thickness, pier_width) -> dict:
+    opts = {"voussoirs": voussoirs, "pier_courses": pier_courses, "span": span,
+            "ring_thickness": ring_thickness, "pier_width": pier_width}
+    return {k: v for k, v in opts.items() if v is not None}
+
+
+Blocks = Annotated[Optional[int], typer.Option(help="Number of blocks (default 51; 248 for the paper's "
+                                               "large wall).", rich_help_panel="Structure")]
+Courses = Annotated[Optional[int], typer.Option(help="Number of courses.", rich_help_panel="Structure")]
+Length = Annotated[Optional[float], typer.Option(help="Wall length, m.", rich_help_panel="Structure")]
+BlockLength = Annotated[Optional[float], typer.Option(help="Block length, m (default 0.30).",
+                                                      rich_help_panel="Structure")]
+BlockHeight = Annotated[Optional[float], typer.Option(help="Block height, m (default 0.20).",
+                                                      rich_help_panel="Structure")]
+Voussoirs = Annotated[Optional[int], typer.Option(help="Voussoirs in the arch (default 30).",
+                                                  rich_help_panel="Structure")]
+PierCourses = Annotated[Optional[int], typer.Option(help="Courses per pier, 2 blocks each (default 17).",
+                                                    rich_help_panel="Structure")]
+Span = Annotated[Optional[float], typer.Option(help="Clear span of the arch, m (default 3.0).",
+                                               rich_help_panel="Structure")]
+RingThickness = Annotated[Optional[float], typer.Option(help="Arch ring thickness, m (default 0.35).",
+                                                        rich_help_panel="Structure")]
+PierWidth = Annotated[Optional[float], typer.Option(help="Pier width, m (default 0.90).",
+                                                    rich_help_panel="Structure")]
+WallCourses = Annotated[Optional[int], typer.Option(help="Courses of the spandrel walls (default 19).",
+                                                    rich_help_panel="Structure")]
+
+DEFAULT_DURATION = {"wall": 1.0, "arch": 5.0, "aqueduct": 5.0}
+
+
+def _simulate(builder: str, options: dict, *, freq, amp, settlement, duration, dt, theta, friction, density,
+              thickness, record_every, tolerance, max_iterations, out, no_recording, history) -> None:
+    from masonrycli.motion import Motion
+    from masonrycli.scenario import Material, RunConfig, scenario_from_builder
+
+    material = Material(**_run_overrides(density=density, thickness=thickness, friction=friction))
+    run = RunConfig(duration=DEFAULT_DURATION[builder])
+    if builder == "wall":
+        if settlement:
+            raise InputError("--settlement: the wall stands on one ground; settlement applies to arch and aqueduct")
+        amp = 1.0 if amp is None else amp
+        freq = 2.0 if freq is None else freq
+        motions = {"ground": _sine(amp, freq)} if amp else {}
+    else:
+        settlement = 0.01 if settlement is None else settlement
+        amp = 0.0 if amp is None else amp
+        freq = 2.0 if freq is None else freq
+        if settlement < 0:
+            raise InputError(f"--settlement {settlement}: must be >= 0 (a downward velocity, m/s)")
+        motions = {}
+        if amp:
+            motions = {"left-foundation": _sine(amp, freq), "right-foundation": _sine(amp, freq)}
+        if settlement:
+            if amp:
+                raise InputError("--settlement with --amp: choose one loading (settle or shake)")
+            motions["right-foundation"] = Motion(kind="constant", velocity=(0.0, -settlement))
+    scenario = scenario_from_builder(builder, options, run, material, motions)
+    scenario = _apply_options(scenario, duration=duration, dt=dt, theta=theta, friction=None,
+                              record_every=record_every, tolerance=tolerance, max_iterations=max_iterations)
+    _execute(scenario, _outputs(builder, out, no_recording), history)
+
+
+def _sine(amp: float, freq: float):
+    from masonrycli.motion import Motion
+
+    try:
+        return Motion(kind="sine", direction=(1.0, 0.0), amplitude=amp, frequency=freq)
+    except InputError as exc:
+        raise InputError(f"--amp/--freq: {exc}") from None
+
+
+@simulate_app.command("wall")
+@user_errors
+def simulate_wall(
+    blocks: Blocks = None, courses: Courses = None, length: Length = None, block_length: BlockLength = None,
+    block_height: BlockHeight = None, freq: Freq = None, amp: Amp = None, settlement: Settlement = None,
+    duration: Duration = None, dt: Dt = None, theta: Theta = None, friction: Friction = None,
+    density: Density = None, thickness: Thickness = None, record_every: RecordEvery = None,
+    tolerance: Tolerance = None, max_iterations: MaxIterations = None, out: Out = None,
+    no_recording: NoRecording = False, history: HistoryOpt = None,
+) -> None:
+    """The paper's running-bond wall on a shaken ground (default 51 blocks, 1 m/s at 2 Hz for 1 s)."""
+    if blocks is None and courses is None and length is None:
+        blocks = 51
+    _simulate("wall", _wall_options(blocks, courses, length, block_length, block_height), freq=freq, amp=amp,
+              settlement=settlement, duration=duration, dt=dt, theta=theta, friction=friction, density=density,
+              thickness=thickness, record_every=record_every, tolerance=tolerance,
+              max_iterations=max_iterations, out=out, no_recording=no_recording, history=history)
+
+
+@simulate_app.command("arch")
+@user_errors
+def simulate_arch(
+    voussoirs: Voussoirs = None, pier_courses: PierCourses = None, span: Span = None,
+    ring_thickness: RingThickness = None, pier_width: PierWidth = None, freq: Freq = None, amp: Amp = None,
+    settlement: Settlement = None, duration: Duration = None, dt: Dt = None, theta: Theta = None,
+    friction: Friction = None, density: Density = None, thickness: Thickness = None,
+    record_every: RecordEvery = None, tolerance: Tolerance = None, max_iterations: MaxIterations = None,
+    out: Out = None, no_recording: NoRecording = False, history: HistoryOpt = None,
+) -> None:
+    """The paper's 98-block arch on two piers; default: right foundation settles at 1 cm/s for 5 s."""
+    _simulate("arch", _arch_options(voussoirs, pier_courses, span, ring_thickness, pier_width), freq=freq,
+              amp=amp, settlement=settlement, duration=duration, dt=dt, theta=theta, friction=friction,
+              density=density, thickness=thickness, record_every=record_every, tolerance=tolerance,
+              max_iterations=max_iterations, out=out, no_recording=no_recording, history=history)
+
+
+@simulate_app.command("aqueduct")
+@user_errors
+def simulate_aqueduct(
+    voussoirs: Voussoirs = None, pier_courses: PierCourses = None, span: Span = None,
+    ring_thickness: RingThickness = None, pier_width: PierWidth = None, wall_courses: WallCourses = None,
+    freq: Freq = None, amp: Amp = None, settlement: Settlement = None, duration: Duration = None,
+    dt: Dt = None, theta: Theta = None, friction: Friction = None, density: Density = None,
+    thickness: Thickness = None, record_every: RecordEvery = None, tolerance: Tolerance = None,
+    max_iterations: MaxIterations = None, out: Out = None, no_recording: NoRecording = False,
+    history: HistoryOpt = None,
+) -> None:
+    """A segment of the Arles aqueduct (98 arch + 248 wall blocks); default: settlement 1 cm/s for 5 s.
+
+    Shake it instead with [bold]--settlement 0 --amp 1 --freq 2[/bold].
+    """
+    options = _arch_options(voussoirs, pier_courses, span, ring_thickness, pier_width)
+    if wall_courses is not None:
+        options["wall_courses"] = wall_courses
+    _simulate("aqueduct", options, freq=freq, amp=amp, settlement=settlement, duration=duration, dt=dt,
+              theta=theta, friction=friction, density=density, thickness=thickness, record_every=record_every,
+              tolerance=tolerance, max_iterations=max_iterations, out=out, no_recording=no_recording,
+              history=history)
+
+
+@app.command("run")
+@user_errors
+def run_command(
+    scenario_file: Annotated[Path, typer.Argument(help="Scenario file (TOML).", metavar="SCENARIO.toml")],
+    duration: Duration = None, dt: Dt = None, theta: Theta = None, friction: Friction = None,
+    record_every: RecordEvery = None, tolerance: Tolerance = None, max_iterations: MaxIterations = None,
+    out: Out = None, no_recording: NoRecording = False, history: HistoryOpt = None,
+) -> None:
+    """Run any scenario file; options given here override the file's values."""
+    from masonrycli.scenario import load_scenario
+
+    scenario = load_scenario(scenario_file)
+    scenario = _apply_options(scenario, duration=duration, dt=dt, theta=theta, friction=friction,
+                              record_every=record_every, tolerance=tolerance, max_iterations=max_iterations)
+    _execute(scenario, _outputs(scenario.name, out, no_recording), history)
+
+
+@app.command("check")
+@user_errors
+def check_command(
+    scenario_file: Annotated[Path, typer.Argument(help="Scenario file (TOML).", metavar="SCENARIO.toml")],
+) -> None:
+    """Validate a scenario file and print a summary (blocks, supports, mass, bounding box)."""
+    from masonrycli.scenario import load_scenario, scenario_summary
+
+    scenario = load_scenario(scenario_file)
+    info = scenario_summary(scenario)
+    table = Table(title=f"{scenario_file} — valid", show_header=False, title_justify="left")
+    table.add_column("", style="bold")
+    table.add_column("")
+    xmin, ymin, xmax, ymax = info["bounding_box"]
+    table.add_row("scenario", str(info["name"]))
+    table.add_row("blocks", str(info["blocks"]))
+    table.add_row("supports", ", ".join(f"{k} ({v})" for k, v in info["support_motions"].items())
+                  if isinstance(info.get("support_motions"), dict) else str(info["supports"]))
+    table.add_row("total mass", f"{info['total_mass']:.6g} kg")
+    table.add_row("bounding box", f"x {xmin:.4g} … {xmax:.4g} m, y {ymin:.4g} … {ymax:.4g} m")
+    table.add_row("friction", f"{info['friction']:g}")
+    table.add_row("time", f"{info['duration']:g} s in {info['n_steps']} steps of {info['dt']:g} s, θ = {info['theta']:g}")
+    console.print(table)
+    for warning in scenario.warnings:
+        err_console.print(f"[yellow]warning:[/yellow] {warning}", highlight=False)
+
+
+def _write_assembly(builder: str, options: dict, density, thickness, out: Path) -> None:
+    from geometry_library.builders import BUILDERS
+    from geometry_library.checks import validate_assembly
+    from geometry_library.io import write_geojson
+
+    if density is not None:
+        options["density"] = density
+    if thickness is not None:
+        options["thickness"] = thickness
+    try:
+        assembly = BUILDERS[builder](**options)
+    except (ValueError, GeometryError) as exc:
+        raise InputError(f"{builder}: {exc}") from None
+    for warning in validate_assembly(assembly):
+        err_console.print(f"[yellow]warning:[/yellow] {warning}", highlight=False)
+    write_geojson(assembly, out)
+    console.print(f"{builder}: {assembly.block_count} blocks and {assembly.support_count} "
+                  f"support{'s' if assembly.support_count != 1 else ''} → {out}")
+
+
+GeoOut = Annotated[Path, typer.Option("--out", "-o", help="GeoJSON file to write.")]
+
+
+@build_app.command("wall")
+@user_errors
+def build_wall_command(
+    out: GeoOut, blocks: Blocks = None, courses: Courses = None, length: Length = None,
+    block_length: BlockLength = None, block_height: BlockHeight = None, density: Density = None,
+    thickness: Thickness = None,
+) -> None:
+    """A running-bond wall on its ground."""
+    if blocks is None and courses is None and length is None:
+        blocks = 51
+    _write_assembly("wall", _wall_options(blocks, courses, length, block_length, block_height), density,
+                    thickness, out)
+
+
+@build_app.command("arch")
+@user_errors
+def build_arch_command(
+    out: GeoOut, voussoirs: Voussoirs = None, pier_courses: PierCourses = None, span: Span = None,
+    ring_thickness: RingThickness = None, pier_width: PierWidth = None, density: Density = None,
+    thickness: Thickness = None,
+) -> None:
+    """A semicircular arch on two piers, each on its foundation."""
+    _write_assembly("arch", _arch_options(voussoirs, pier_courses, span, ring_thickness, pier_width), density,
+                    thickness, out)
+
+
+@build_app.command("aqueduct")
+@user_errors
+def build_aqueduct_command(
+    out: GeoOut, voussoirs: Voussoirs = None, pier_courses: PierCourses = None, span: Span = None,
+    ring_thickness: RingThickness = None, pier_width: PierWidth = None, wall_courses: WallCourses = None,
+    density: Density = None, thickness: Thickness = None,
+) -> None:
+    """The arch plus spandrel walls in running bond up to a level top."""
+    options = _arch_options(voussoirs, pier_courses, span, ring_thickness, pier_width)
+    if wall_courses is not None:
+        options["wall_courses"] = wall_courses
+    _write_assembly("aqueduct", options, density, thickness, out)
+
+
+@app.command("inspect")
+@user_errors
+def inspect_command(
+    recording: Annotated[Path, typer.Argument(help="Recording (.rrd).", metavar="REC.rrd")],
+) -> None:
+    """Summarise a recording: scenario, frames, time span, entities."""
+    from masonrycli.recording import inspect_recording
+
+    if not recording.is_file():
+        raise InputError(f"{recording}: no such recording")
+    try:
+        info = inspect_recording(recording)
+    except Exception as exc:  # a corrupt or foreign file: say so in one line
+        raise InputError(f"{recording}: not a readable Rerun recording ({type(exc).__name__}: {exc})") from None
+    table = Table(title=str(recording), show_header=False, title_justify="left")
+    table.add_column("", style="bold")
+    table.add_column("")
+    for key, value in info.items():
+        if key == "metadata":
+            continue
+        if isinstance(value, (list, tuple)):
+            value = "\n".join(map(str, value))
+        table.add_row(key, str(value))
+    console.print(table)
+    if info.get("metadata"):
+        console.print(info["metadata"])
+
+
+def main() -> None:
+    app()
+
+
+if __name__ == "__main__":
+    sys.exit(main())
