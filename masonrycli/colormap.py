@@ -92,11 +92,11 @@ def robust_max_abs(values: np.ndarray, percentile: float = 99.0) -> float:
 
 
 def nice_ceil(x: float) -> float:
-    """Smallest of 1, 2, 2.5, 5 × 10^k that is >= x (x > 0); 0.0 for x <= 0 or not finite."""
+    """Smallest of 1, 1.5, 2, 2.5, 3, 4, 5, 6, 8 × 10^k that is >= x (x > 0); 0.0 for x <= 0 or not finite."""
     if not (x > 0.0 and math.isfinite(x)):
         return 0.0
     e = math.floor(math.log10(x))
-    for m in (1.0, 2.0, 2.5, 5.0, 10.0):
+    for m in (1.0, 1.5, 2.0, 2.5, 3.0, 4.0, 5.0, 6.0, 8.0, 10.0):
         v = m * 10.0**e
         if v >= x * (1.0 - 1e-12):
             return v

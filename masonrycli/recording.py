@@ -15,11 +15,11 @@ colour legend), so the 2-D views open fitted to the structure. The camera must b
 drawn at a fixed depth and a closer 3-D mesh would hide it.
 
 Colour ranges (documented in the run document): each field's range is fixed once for the whole run, at
-the first flushed batch in which the field is not identically zero: ``nice_ceil`` of the 99th percentile
+the first flushed batch in which the field is not identically zero: ``nice_ceil`` of the 98th percentile
 of |value| over that batch, symmetric for signed fields and [0, M] for >= 0 fields; values beyond are
 clipped to the end colours. The same rule fixes the force-arrow scale (a force of that robust maximum is
-drawn one median block height long) and the principal-axis glyph scales. A ``field_ranges`` argument
-overrides the colour ranges.
+drawn one median block height long; arrows are capped at two) and the principal-axis glyph scales.
+A ``field_ranges`` argument overrides the colour ranges.
 
 Entity paths: ``ENTITY_PATHS`` below.
 """
@@ -55,7 +55,12 @@ APPLICATION_ID: Final = "masonry"
 _RECORDING_NAMESPACE: Final = uuid.UUID("6f1c4f5e-9b0e-4c51-a0a6-3f0d6c1e2a77")
 _CAMERA_HEIGHT: Final = 1.0e4
 """m. Distance of the drawing-plane camera (see the module docstring)."""
-_ROBUST_PERCENTILE: Final = 99.0
+_ROBUST_PERCENTILE: Final = 98.0
+"""Colour ranges, force and glyph scales come from this percentile of |value| (see the module docstring)."""
+_ARROW_CAP: Final = 2.0
+"""Longest force arrow, in median block heights (hover an arrow for its force)."""
+_SUPPORT_MARGIN: Final = 0.15
+"""The initial view shows supports up to this fraction of the structure's size beyond the blocks."""
 _GLYPH_HALF_LENGTH: Final = 0.45
 """Largest principal-axis half-length, as a fraction of the median block's smaller side."""
 
@@ -73,14 +78,16 @@ class FieldSpec(NamedTuple):
 
 FIELDS: Final = (
     FieldSpec("cell_volumetric_strain_rate", "volumetric_strain_rate", "Volumetric strain rate", "1/s", True),
-    FieldSpec("cell_deviatoric_strain", "deviatoric_strain", "Deviatoric cumulated strain", "-", False),
+    FieldSpec("cell_deviatoric_strain", "deviatoric_strain", "Deviatoric cumulated strain", "", False),
     FieldSpec("cell_spherical_stress", "spherical_stress", "Spherical stress p", "Pa", True),
     FieldSpec("cell_deviatoric_stress", "deviatoric_stress", "Deviatoric stress q", "Pa", False),
 )
 _FIELD_BY_KEY: Final = {f.key: f for f in FIELDS}
 _HOVER_VALUES: Final = (("p", "cell_spherical_stress"), ("q", "cell_deviatoric_stress"),
                         ("volumetric_strain_rate", "cell_volumetric_strain_rate"),
-                        ("deviatoric_strain", "cell_deviatoric_strain"))
+                        ("deviatoric_strain", "cell_deviatoric_strain"),
+                        ("sliding_ratio", "block_sliding_ratio"), ("max_opening", "block_max_opening"))
+"""Per-block values shown when hovering a block outline: name -> Frame.tensors key."""
 _AXES: Final = {  # glyph set -> (principal values key, principal angle key)
     "stress_axes": ("cell_principal_stress", "cell_principal_angle"),
     "strain_rate_axes": ("cell_principal_strain_rate", "cell_principal_strain_rate_angle"),
@@ -232,6 +239,7 @@ class _Batch:
         self.contact_point: list[np.ndarray] = []
         self.contact_force: list[np.ndarray] = []
         self.contact_status: list[np.ndarray] = []
+        self.contact_mobilised: list[np.ndarray] = []
         self.tensors: dict[str, list[np.ndarray]] = {}
 
     def __len__(self) -> int:
@@ -240,7 +248,8 @@ class _Batch:
 
 _SCALAR_ORDER: Final = ("energy_kinetic", "energy_potential", "energy_dissipated", "support_work",
                         "nlgs_iterations", "nlgs_residual", "contact_count")
-_TENSOR_KEYS: Final = tuple(f.key for f in FIELDS) + tuple(k for pair in _AXES.values() for k in pair)
+_TENSOR_KEYS: Final = tuple(dict.fromkeys([*(f.key for f in FIELDS), *(k for pair in _AXES.values() for k in pair),
+                                           *(key for _, key in _HOVER_VALUES)]))
 
 
 # ---------------------------------------------------------------------------------------------- recorder
@@ -338,6 +347,7 @@ class Recorder:
         b.contact_point.append(np.array(np.asarray(frame.contact_point).reshape(-1, 2)[shown], dtype=np.float64))
         b.contact_force.append(force[shown])
         b.contact_status.append(np.array(status[shown]))
+        b.contact_mobilised.append(np.array(np.asarray(frame.contact_mobilised, dtype=np.float64).reshape(-1)[shown]))
         for key in _TENSOR_KEYS:
             b.tensors.setdefault(key, []).append(_tensor(frame.tensors, key, self._n))
         self._last = (int(frame.step), float(frame.time))
@@ -401,15 +411,20 @@ class Recorder:
 
     def _log_plane(self, block_q: np.ndarray, support_q: np.ndarray) -> None:
         """Pinhole and y-up transform, sized to the structure at the first frame; remembers the legend box."""
-        pts = np.concatenate([self._blocks.world(block_q[None])[0], self._supports.world(support_q[None])[0]])
-        blk = self._blocks.world(block_q[None])[0] if self._n else pts
-        lo, hi = pts.min(axis=0), pts.max(axis=0)
+        sup = self._supports.world(support_q[None])[0]
+        blk = self._blocks.world(block_q[None])[0] if self._n else sup
+        lo, hi = blk.min(axis=0), blk.max(axis=0)
         size = float(max(hi - lo)) or 1.0
+        if len(sup):  # show the supports, but a wide ground only a little beyond the blocks
+            lo = np.minimum(lo, np.maximum(sup.min(axis=0), lo - _SUPPORT_MARGIN * size))
+            hi = np.maximum(hi, np.minimum(sup.max(axis=0), hi + _SUPPORT_MARGIN * size))
         pad = 0.05 * size
         bar_w = 0.025 * size
-        self._legend_box = (hi[0] + 2 * pad, blk[:, 1].min(), hi[0] + 2 * pad + bar_w, blk[:, 1].max())
+        ya, yb = blk[:, 1].min(), blk[:, 1].max()
+        shrink = 0.08 * (yb - ya)  # room for the labels above and below the bar
+        self._legend_box = (hi[0] + 2 * pad, ya + shrink, hi[0] + 2 * pad + bar_w, yb - shrink)
         x0, y0 = lo[0] - pad, hi[1] + pad
-        width = (hi[0] + pad - x0) + 2 * pad + bar_w + 0.18 * size
+        width = (hi[0] + pad - x0) + 2 * pad + bar_w + 0.12 * size
         height = y0 - (lo[1] - pad)
         self.rec.log(PLANE, rr.Pinhole(focal_length=_CAMERA_HEIGHT, principal_point=[0.0, 0.0],
                                        resolution=[width, height]),
@@ -432,10 +447,10 @@ class Recorder:
         tri = np.concatenate([np.stack([j, j + 1, j + 3], 1), np.stack([j, j + 3, j + 2], 1)]).astype(np.uint32)
         self.rec.log(legend_bar_path(f), rr.Mesh3D(vertex_positions=verts, triangle_indices=tri,
                                                    vertex_colors=cols), static=True)
-        values = [lo, 0.5 * (lo + hi), hi]
-        labels = [f"{v:+.3g} {f.unit}" if f.signed else f"{v:.3g} {f.unit}" for v in values]
+        labels = [_fmt_quantity(v, f.unit, max(abs(lo), abs(hi)), f.signed) for v in (lo, 0.5 * (lo + hi), hi)]
         labels[-1] = f"{f.title}\n{labels[-1]}"
-        pos = np.array([[xb, ya], [xb, 0.5 * (ya + yb)], [xb, yb]])
+        xm, gap = 0.5 * (xa + xb), 0.5 * (yb - ya) * 0.08
+        pos = np.array([[xm, ya - gap], [xb + (xb - xa), 0.5 * (ya + yb)], [xm, yb + 2 * gap]])
         self.rec.log(legend_label_path(f), rr.Points2D(pos, labels=labels, radii=-0.5, colors=_LEGEND_TEXT_RGBA,
                                                        show_labels=True), static=True)
 
@@ -503,7 +518,8 @@ class Recorder:
         pts = verts[:, poly.outline_index].reshape(-1, 2)
         offsets = _frame_offsets(poly.outline_offsets, n_frames, len(poly.outline_index))
         lengths = np.full(n_frames, self._n)
-        values = {name: tensors[key].reshape(-1) for name, key in _HOVER_VALUES}
+        # pyarrow arrays: AnyValues.columns turns a 1-D numpy array into a Python list of lists (slow).
+        values = {name: pa.array(tensors[key].reshape(-1)) for name, key in _HOVER_VALUES}
         self.rec.send_columns(BLOCKS, indexes=idx, columns=[
             *rr.LineStrips2D.columns(strips=_strips(pts, offsets)).partition(lengths),
             *rr.AnyValues.columns(**values).partition(lengths),
@@ -554,13 +570,22 @@ class Recorder:
         points = np.concatenate(b.contact_point) if lengths.sum() else np.zeros((0, 2))
         forces = np.concatenate(b.contact_force) if lengths.sum() else np.zeros((0, 2))
         status = np.concatenate(b.contact_status) if lengths.sum() else np.zeros(0, dtype=np.int8)
+        mobilised = np.concatenate(b.contact_mobilised) if lengths.sum() else np.zeros(0)
         colors = np.full(len(status), np.uint32(OPEN_RGBA))
         colors[status == CONTACT_STICK] = STICK_RGBA
         colors[status == CONTACT_SLIP] = SLIP_RGBA
+        magnitude = np.hypot(forces[:, 0], forces[:, 1])
         scale = self.force_scale or 0.0
-        self.rec.send_columns(FORCES, indexes=idx, columns=rr.Arrows2D.columns(
-            origins=points.astype(np.float32), vectors=(forces * scale).astype(np.float32),
-            colors=colors).partition(lengths))
+        cap = _ARROW_CAP * self.block_height
+        with np.errstate(divide="ignore", invalid="ignore"):
+            shrink = np.where(magnitude * scale > cap, cap / (magnitude * scale), 1.0)
+        vectors = forces * (scale * shrink)[:, None]
+        self.rec.send_columns(FORCES, indexes=idx, columns=[
+            *rr.Arrows2D.columns(origins=points.astype(np.float32), vectors=vectors.astype(np.float32),
+                                 colors=colors).partition(lengths),
+            *rr.AnyValues.columns(force=pa.array(magnitude), mobilised_friction=pa.array(mobilised)
+                                  ).partition(lengths),
+        ])
 
     def _send_series(self, idx: list, b: _Batch, q: np.ndarray) -> None:
         n_frames = len(q)
@@ -596,12 +621,11 @@ class Recorder:
         md = self.metadata
         scenario = md.get("scenario", "run")
         status_line = status
-        if status not in ("completed", "running") and self._last is not None:
-            status_line = f"{status} at t = {self._last[1]:.3f} s (step {self._last[0]})"
-        elif self._last is not None:
-            status_line = f"{status}, last frame t = {self._last[1]:.3f} s (step {self._last[0]})"
-        if note:
-            status_line += f" — {note}"
+        if self._last is not None:
+            at = f"t = {self._last[1]:.3f} s (step {self._last[0]})"
+            status_line = f"{status}, last frame {at}" if status in ("completed", "running") else f"{status} at {at}"
+        if note:  # the caller's note usually says it all ("interrupted at t = ..."): do not repeat the status
+            status_line = note if note.startswith(status) else f"{status_line}: {note}"
         lines = [f"# masonry — {scenario}", "", f"**Status:** {status_line}", "",
                  f"**Wall time:** {time.perf_counter() - self._t0:.2f} s · **frames:** {self._frames} · "
                  f"**dt:** {self.static.dt:g} s · **friction:** {self.static.friction:g} · "
@@ -609,17 +633,21 @@ class Recorder:
                  "| parameter | value |", "|---|---|"]
         lines += [f"| {k} | {v} |" for k, v in _flatten(md)]
         lines += ["", "## How to read the views", "",
-                  f"- Forces: arrow = contact force on body b at the contact point; green = stick, orange = slip. "
-                  f"Scale: {_fmt_scale(self.force_scale, 'm per N')} (a force of the first batch's 99th-percentile "
-                  f"magnitude is one median block height, {self.block_height:.3g} m, long).",
-                  "- Principal axes: two segments per cell along the eigenvectors, half-length proportional to |λ| "
-                  f"(full length {self._glyph_length:.3g} m at the field's robust max, clipped); "
-                  "black = compression / contraction, magenta = tension / extension."]
-        for name, (key, _) in _AXES.items():
-            lines.append(f"  - {name}: full length at |λ| = {_fmt_scale(self.axis_scale.get(name), '')}")
-        lines += ["- Fields: colour range fixed for the whole run from the first batch where the field is not "
-                  "zero (99th percentile of |value|, rounded up); grey = undefined (NaN).", "",
-                  "| field | colour map | range |", "|---|---|---|"]
+                  "- **Forces**: arrow = contact force on body b at the contact point; green = stick, orange = "
+                  f"slip. Scale {_fmt_scale(self.force_scale, 'm per N')}: a force of the first batch's "
+                  f"{_ROBUST_PERCENTILE:g}th-percentile magnitude is one median block height "
+                  f"({self.block_height:.3g} m) long; arrows are capped at {_ARROW_CAP:g} block heights "
+                  "(hover an arrow for its force in N).",
+                  "- **Principal axes**: two segments per cell along the eigenvectors, half-length proportional "
+                  f"to |λ|, {self._glyph_length:.3g} m at the scale below (longer ones clipped); black = "
+                  "compression / contraction, magenta = tension / extension. Stress axes in the main view, "
+                  "strain-rate axes (and the centroid triangulation) in the volumetric strain rate view."]
+        lines += [f"  - {name.replace('_', ' ')}: full length at |λ| = {_fmt_scale(self.axis_scale.get(name), '')}"
+                  for name in _AXES]
+        lines += ["- **Fields**: each colour range is fixed for the whole run, at the first batch where the "
+                  f"field is not zero ({_ROBUST_PERCENTILE:g}th percentile of |value|, rounded up); values "
+                  "beyond take the end colours; grey = undefined (NaN). Hover a block outline for its values.",
+                  "", "| field | colour map | range |", "|---|---|---|"]
         for f in FIELDS:
             r = self.field_ranges.get(f.key)
             rng = "not fixed yet (field zero so far)" if r is None else f"{r[0]:.4g} … {r[1]:.4g} {f.unit}"
@@ -665,6 +693,16 @@ def _flatten(d: dict, prefix: str = "") -> list[tuple[str, str]]:
         else:
             out.append((f"{prefix}{k}", str(v).replace("|", "\\|").replace("\n", " ")))
     return out
+
+
+def _fmt_quantity(v: float, unit: str, span: float, signed: bool) -> str:
+    """Legend value: Pa with a prefix chosen from the range, 3 significant digits, sign if signed."""
+    scale, prefix = 1.0, ""
+    if unit == "Pa":
+        scale, prefix = next(((s, p) for s, p in ((1e9, "G"), (1e6, "M"), (1e3, "k")) if span >= s), (1.0, ""))
+    x = v / scale
+    text = f"{x:+.3g}" if signed and x != 0 else f"{x:.3g}"
+    return f"{text} {prefix}{unit}".strip()
 
 
 def _fmt_scale(x: float | None, unit: str) -> str:
@@ -724,8 +762,10 @@ def inspect_recording(path: str | os.PathLike) -> dict:
     time_span (first, last sim_time in s) or None, entity_paths (sorted, with leading "/"),
     has_blueprint, complete (footer present), metadata (the run document's Markdown, or None).
     """
-    reader = rr.chunk.RrdReader(os.fspath(path))
-    recordings = reader.recordings()
+    with warnings.catch_warnings():  # a file without footer is reported as complete=False below
+        warnings.simplefilter("ignore")
+        reader = rr.chunk.RrdReader(os.fspath(path))
+        recordings = reader.recordings()
     if not recordings:
         raise ValueError(f"{path}: no recording in this file")
     entry = recordings[0]
@@ -760,7 +800,7 @@ def inspect_recording(path: str | os.PathLike) -> dict:
         "recording_id": entry.recording_id,
         "frames": len(steps),
         "steps": (min(steps), max(steps)) if steps else None,
-        "time_span": (float(t_lo), float(t_hi)) if steps and np.isfinite(t_lo) else None,
+        "time_span": (round(float(t_lo), 9), round(float(t_hi), 9)) if steps and np.isfinite(t_lo) else None,
         "entity_paths": sorted(paths),
         "has_blueprint": bool(reader.blueprints()),
         "complete": complete,

@@ -1,0 +1,375 @@
+"""The Rerun recording, read back with rr.chunk.RrdReader (no viewer needed)."""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+import textwrap
+
+import numpy as np
+import pytest
+import rerun as rr
+
+import recording_fixtures as fx
+from masonrycli import colormap as cm
+from masonrycli import recording as rec_mod
+from masonrycli.frame import CONTACT_OPEN
+from masonrycli.recording import ENTITY_PATHS, FIELDS, Recorder, inspect_recording
+
+N_FRAMES, BATCH = 25, 10  # three flushes, the last one partial
+
+
+@pytest.fixture(autouse=True)
+def strict_rerun():
+    """Any logging error raises instead of becoming a warning."""
+    before = rr.strict_mode()
+    rr.set_strict_mode(True)
+    yield
+    rr.set_strict_mode(before)
+
+
+@pytest.fixture(scope="module")
+def wall():
+    return fx.wall()
+
+
+@pytest.fixture(scope="module")
+def written(wall, tmp_path_factory):
+    static, q0 = wall
+    frames = fx.frames(static, q0, N_FRAMES)
+    path = tmp_path_factory.mktemp("rec") / "run.rrd"
+    before = rr.strict_mode()
+    rr.set_strict_mode(True)
+    with Recorder(path, static, fx.METADATA, batch_frames=BATCH) as rec:
+        for f in frames:
+            rec.log_frame(f)
+    rr.set_strict_mode(before)
+    return path, static, frames, rec
+
+
+def temporal_rows(path, entity: str, column: str) -> dict[int, list]:
+    """step -> the row's value (Python list) of `column` on `entity` (temporal chunks only)."""
+    out: dict[int, list] = {}
+    for chunk in rr.chunk.RrdReader(path).stream():
+        if chunk.entity_path != entity or chunk.is_static:
+            continue
+        batch = chunk.to_record_batch()
+        if column not in batch.schema.names:
+            continue
+        for step, value in zip(batch.column("step").to_pylist(), batch.column(column).to_pylist()):
+            out[step] = value
+    return out
+
+
+def static_value(path, entity: str, column: str):
+    value = None
+    for chunk in rr.chunk.RrdReader(path).stream():
+        if chunk.entity_path == entity and chunk.is_static:
+            batch = chunk.to_record_batch()
+            if column in batch.schema.names:
+                value = batch.column(column).to_pylist()[-1]
+    return value
+
+
+def world_outline(static, q: np.ndarray, b: int) -> np.ndarray:
+    """Block b's polygon in world coordinates, computed independently of the recorder."""
+    s, e = static.block_vert_start[b], static.block_vert_start[b + 1]
+    c, sn = np.cos(q[b, 2]), np.sin(q[b, 2])
+    rot = np.array([[c, -sn], [sn, c]])
+    return q[b, :2] + static.block_vert_local[s:e] @ rot.T
+
+
+# ------------------------------------------------------------------------------------------- the file
+def test_application_id_blueprint_and_entity_paths(written):
+    path, *_ = written
+    reader = rr.chunk.RrdReader(path)
+    (recording,) = reader.recordings()
+    assert recording.application_id == "masonry"
+    assert len(reader.blueprints()) == 1
+    paths = {chunk.entity_path for chunk in reader.stream()}
+    assert {f"/{p}" for p in ENTITY_PATHS} <= paths
+
+
+def test_embedded_blueprint_has_the_views(written):
+    path, *_ = written
+    reader = rr.chunk.RrdReader(path)
+    views = {}
+    for chunk in reader.stream(store=reader.blueprints()[0]):
+        batch = chunk.to_record_batch()
+        if "ViewBlueprint:display_name" in batch.schema.names:
+            name = batch.column("ViewBlueprint:display_name").to_pylist()[0][0]
+            views[name] = (batch.column("ViewBlueprint:class_identifier").to_pylist()[0][0],
+                           batch.column("ViewBlueprint:space_origin").to_pylist()[0][0])
+    spatial = {n for n, (kind, origin) in views.items() if kind == "2D" and origin == "/structure/plane"}
+    assert {f.title for f in FIELDS} < spatial and any(n.startswith("Structure") for n in spatial)
+    assert sum(kind == "TimeSeries" for kind, _ in views.values()) == 7
+    assert views["Run"] == ("TextDocument", "/run/metadata")
+
+
+def test_recording_id_is_deterministic(wall, tmp_path):
+    static, _ = wall
+    ids = []
+    for name in ("a.rrd", "b.rrd", "c.rrd"):
+        meta = fx.METADATA if name != "c.rrd" else {**fx.METADATA, "seed": 1}
+        with Recorder(tmp_path / name, static, meta) as rec:
+            ids.append(rec.recording_id)
+        assert rr.chunk.RrdReader(tmp_path / name).recordings()[0].recording_id == rec.recording_id
+    assert ids[0] == ids[1] != ids[2]
+
+
+def test_frames_on_the_step_and_sim_time_timelines(written):
+    path, static, frames, _ = written
+    info = inspect_recording(path)
+    assert info["frames"] == N_FRAMES
+    assert info["steps"] == (frames[0].step, frames[-1].step)
+    assert info["time_span"] == pytest.approx((frames[0].time, frames[-1].time))
+    assert info["has_blueprint"] and info["complete"]
+    assert info["application_id"] == "masonry"
+    assert "/structure/plane/xy/blocks" in info["entity_paths"]
+    rows = temporal_rows(path, "/structure/plane/xy/blocks", "LineStrips2D:strips")
+    assert sorted(rows) == [f.step for f in frames]
+
+
+# --------------------------------------------------------------------------------------- per frame
+def test_block_outlines_are_closed_world_polygons(written):
+    path, static, frames, _ = written
+    rows = temporal_rows(path, "/structure/plane/xy/blocks", "LineStrips2D:strips")
+    n = len(static.block_name)
+    for f in frames[::7]:
+        strips = rows[f.step]
+        assert len(strips) == n
+        for b in (0, n - 1):  # the last block is the pentagon
+            pts = np.array(strips[b])
+            expected = world_outline(static, f.block_q, b)
+            assert len(pts) == len(expected) + 1
+            np.testing.assert_allclose(pts[:-1], expected, atol=1e-5)
+            np.testing.assert_allclose(pts[-1], pts[0])
+
+
+def test_array_shapes_per_frame(written):
+    path, static, frames, _ = written
+    n = len(static.block_name)
+    n_vert = len(static.block_vert_local)
+    by_step = {f.step: f for f in frames}
+    arrows = temporal_rows(path, "/structure/plane/xy/forces", "Arrows2D:vectors")
+    force_values = temporal_rows(path, "/structure/plane/xy/forces", "force")
+    axes = {k: temporal_rows(path, f"/structure/plane/xy/{k}", "LineStrips2D:strips")
+            for k in ("stress_axes", "strain_rate_axes")}
+    tri = temporal_rows(path, "/structure/plane/xy/triangulation", "LineStrips2D:strips")
+    hover_p = temporal_rows(path, "/structure/plane/xy/blocks", "p")
+    for f in FIELDS:
+        verts = temporal_rows(path, f"/structure/fields/{f.short}", "Mesh3D:vertex_positions")
+        colors = temporal_rows(path, f"/structure/fields/{f.short}", "Mesh3D:vertex_colors")
+        assert {len(v) for v in verts.values()} == {n_vert} and {len(c) for c in colors.values()} == {n_vert}
+        assert len(verts) == N_FRAMES
+    for step, frame in by_step.items():
+        shown = int((frame.contact_status != CONTACT_OPEN).sum())
+        assert len(arrows[step]) == shown == len(force_values[step])
+        assert len(axes["stress_axes"][step]) == len(axes["strain_rate_axes"][step]) == 2 * n
+        assert len(tri[step]) == len(static.triangles)
+        assert len(hover_p[step]) == n
+        np.testing.assert_allclose(hover_p[step], frame.tensors["cell_spherical_stress"])
+    assert static_value(path, "/structure/plane/xy/blocks", "name") == list(static.block_name)
+
+
+def test_force_arrows_start_at_contact_points_along_the_force(written):
+    path, static, frames, rec = written
+    origins = temporal_rows(path, "/structure/plane/xy/forces", "Arrows2D:origins")
+    vectors = temporal_rows(path, "/structure/plane/xy/forces", "Arrows2D:vectors")
+    f = frames[3]
+    shown = f.contact_status != CONTACT_OPEN
+    np.testing.assert_allclose(np.array(origins[f.step]), f.contact_point[shown], atol=1e-5)
+    v, force = np.array(vectors[f.step]), f.contact_force[shown]
+    cos = (v * force).sum(1) / np.linalg.norm(v, axis=1) / np.linalg.norm(force, axis=1)
+    np.testing.assert_allclose(cos, 1.0, atol=1e-5)
+    length = np.linalg.norm(v, axis=1)
+    assert length.max() <= 2.0 * rec.block_height * (1 + 1e-5)
+    uncapped = np.linalg.norm(force, axis=1) * rec.force_scale < 2.0 * rec.block_height
+    np.testing.assert_allclose(length[uncapped], np.linalg.norm(force, axis=1)[uncapped] * rec.force_scale,
+                               rtol=1e-5)
+
+
+def test_principal_axes_follow_eigenvectors_and_sign(written):
+    path, static, frames, rec = written
+    f = frames[-1]
+    strips = np.array(temporal_rows(path, "/structure/plane/xy/stress_axes", "LineStrips2D:strips")[f.step])
+    colors = np.array(temporal_rows(path, "/structure/plane/xy/stress_axes", "LineStrips2D:colors")[f.step])
+    lam = f.tensors["cell_principal_stress"]
+    ang = f.tensors["cell_principal_angle"]
+    for b in (0, 5):
+        major, minor = strips[2 * b], strips[2 * b + 1]
+        np.testing.assert_allclose(major.mean(axis=0), f.block_q[b, :2], atol=1e-5)
+        d = major[1] - major[0]
+        assert abs(d[0] * np.sin(ang[b]) - d[1] * np.cos(ang[b])) < 1e-5  # parallel to (cos θ, sin θ)
+        assert abs((minor[1] - minor[0]) @ d) < 1e-6  # orthogonal
+        ratio = np.linalg.norm(d) / np.linalg.norm(minor[1] - minor[0])
+        assert ratio == pytest.approx(min(abs(lam[b, 0]), rec.axis_scale["stress_axes"])
+                                      / min(abs(lam[b, 1]), rec.axis_scale["stress_axes"]), rel=1e-4)
+        for k in range(2):
+            assert colors[2 * b + k] == (rec_mod.COMPRESSION_RGBA if lam[b, k] < 0 else rec_mod.TENSION_RGBA)
+
+
+# ------------------------------------------------------------------------------------------- colours
+def ramp_frames(static, q0, count: int) -> list:
+    """Frames whose fields are ramps over the blocks, growing with time, with one outlier per end."""
+    rng = np.random.default_rng(3)
+    out = []
+    for k in range(count):
+        f = fx.frame(static, q0, 10 * k, rng)
+        n = len(q0)
+        ramp = np.linspace(-1.0, 1.0, n) * 1e3 * (1 + 0.1 * k)
+        ramp[0], ramp[-1] = -1e6, 1e6  # far beyond any robust range
+        f.tensors["cell_spherical_stress"] = ramp
+        dev = np.linspace(0.0, 1.0, n) * 50.0 * (1 + 0.1 * k)
+        dev[-1] = 1e6
+        f.tensors["cell_deviatoric_stress"] = dev
+        out.append(f)
+    return out
+
+
+def test_fill_colours_follow_the_field_with_a_fixed_range(wall, tmp_path):
+    static, q0 = wall
+    frames = ramp_frames(static, q0, 12)
+    path = tmp_path / "ramp.rrd"
+    with Recorder(path, static, fx.METADATA, batch_frames=5) as rec:
+        for f in frames:
+            rec.log_frame(f)
+    owner = np.repeat(np.arange(len(q0)), np.diff(static.block_vert_start))
+    first_vertex = np.r_[0, np.cumsum(np.diff(static.block_vert_start))[:-1]]
+    for key, short, lut in (("cell_spherical_stress", "spherical_stress", cm.COOLWARM),
+                            ("cell_deviatoric_stress", "deviatoric_stress", cm.VIRIDIS)):
+        # The range comes from the first batch only (5 frames): the 98th percentile, rounded up.
+        first = np.concatenate([f.tensors[key] for f in frames[:5]])
+        m = cm.nice_ceil(np.percentile(np.abs(first), 98))
+        expected_range = (-m, m) if lut is cm.COOLWARM else (0.0, m)
+        assert rec.field_ranges[key] == pytest.approx(expected_range)
+        rows = temporal_rows(path, f"/structure/fields/{short}", "Mesh3D:vertex_colors")
+        for f in (frames[0], frames[-1]):
+            colors = np.array(rows[f.step], dtype=np.uint32)
+            values = f.tensors[key]
+            assert np.all(colors == colors[first_vertex][owner])  # one colour per block
+            block_colors = colors[first_vertex]
+            assert block_colors[np.argmax(values)] == lut[-1]  # the highest value gets the top colour
+            assert block_colors[np.argmin(values)] == lut[0]
+            np.testing.assert_array_equal(block_colors, cm.map_scalars(values, *expected_range, lut))
+            index = {int(c): i for i, c in enumerate(lut)}
+            order = np.argsort(values)
+            assert np.all(np.diff([index[int(c)] for c in block_colors[order]]) >= 0)  # monotone
+
+
+def test_nan_field_values_are_grey(written):
+    path, static, frames, _ = written
+    rows = temporal_rows(path, "/structure/fields/volumetric_strain_rate", "Mesh3D:vertex_colors")
+    s, e = static.block_vert_start[1], static.block_vert_start[2]  # block 1 has no triangle (NaN)
+    for f in frames[::5]:
+        assert np.isnan(f.tensors["cell_volumetric_strain_rate"][1])
+        assert set(rows[f.step][s:e]) == {cm.NAN_RGBA}
+
+
+def test_legend_and_run_document(written):
+    path, static, frames, rec = written
+    info = inspect_recording(path)
+    doc = info["metadata"]
+    assert doc.startswith("# masonry — synthetic wall")
+    assert "completed, last frame t = 0.240 s (step 240)" in doc
+    for needle in ("parameters.freq | 2.0", "Wall time", "| masonry |", "| rerun-sdk | 0.41", "| numpy |",
+                   "| numba |", "| python |", "m per N"):
+        assert needle in doc, needle
+    for f in FIELDS:
+        lo, hi = rec.field_ranges[f.key]
+        assert f"{lo:.4g} … {hi:.4g}" in doc
+        labels = static_value(path, f"/structure/plane/xy/legend/{f.short}", "Points2D:labels")
+        assert len(labels) == 3 and f.title in labels[-1]
+
+
+# ------------------------------------------------------------------------------- closing and errors
+@pytest.mark.parametrize("exc, status", [(RuntimeError("boom"), "failed"), (KeyboardInterrupt(), "interrupted")])
+def test_recording_is_complete_after_an_exception(wall, tmp_path, exc, status):
+    static, q0 = wall
+    frames = fx.frames(static, q0, 15)
+    path = tmp_path / "crash.rrd"
+    with pytest.raises(type(exc)):
+        with Recorder(path, static, fx.METADATA, batch_frames=BATCH) as rec:
+            for f in frames:
+                rec.log_frame(f)
+            raise exc
+    info = inspect_recording(path)
+    assert info["complete"] and info["frames"] == 15  # the partial batch was flushed
+    assert f"{status} at t = 0.140 s (step 140)" in info["metadata"]
+    if status == "failed":
+        assert "RuntimeError: boom" in info["metadata"]
+    verify = subprocess.run([os.path.join(os.path.dirname(sys.executable), "rerun"), "rrd", "verify", str(path)],
+                            capture_output=True, text=True, timeout=120,
+                            env={**os.environ, "RERUN_ANALYTICS": "0"})
+    assert verify.returncode == 0, verify.stderr
+
+
+def test_close_note_and_idempotence(wall, tmp_path):
+    static, q0 = wall
+    rec = Recorder(tmp_path / "x.rrd", static, fx.METADATA)
+    rec.log_frame(fx.frames(static, q0, 1)[0])
+    rec.close("interrupted", "interrupted at t = 0.0000 s (step 0 of 1000)")
+    rec.close()  # no-op
+    with pytest.raises(RuntimeError):
+        rec.log_frame(fx.frames(static, q0, 1)[0])
+    doc = inspect_recording(tmp_path / "x.rrd")["metadata"]
+    assert "**Status:** interrupted at t = 0.0000 s (step 0 of 1000)" in doc
+
+
+def test_inspect_a_file_without_footer(wall, tmp_path):
+    """A killed writer leaves no footer: inspect still reads what was flushed and says it is incomplete."""
+    path = tmp_path / "killed.rrd"
+    script = textwrap.dedent(f"""
+        import os, signal, sys
+        sys.path[:0] = {[os.path.dirname(__file__), os.path.dirname(os.path.dirname(__file__))]!r}
+        import recording_fixtures as fx
+        from masonrycli.recording import Recorder
+        static, q0 = fx.wall()
+        rec = Recorder({str(path)!r}, static, fx.METADATA, batch_frames=4)
+        for f in fx.frames(static, q0, 8):
+            rec.log_frame(f)
+        rec.rec.flush()
+        os.kill(os.getpid(), signal.SIGKILL)
+    """)
+    subprocess.run([sys.executable, "-c", script], timeout=120, env={**os.environ, "RERUN_ANALYTICS": "0"})
+    info = inspect_recording(path)
+    assert not info["complete"]
+    assert info["frames"] == 8 and info["application_id"] == "masonry"
+
+
+def test_frames_without_tensor_fields_or_contacts(wall, tmp_path):
+    static, q0 = wall
+    f = fx.frames(static, q0, 1)[0]
+    empty = type(f)(**{**f.__dict__, "tensors": {}, "contact_body": np.zeros((0, 2), np.int32),
+                       "contact_point": np.zeros((0, 2)), "contact_normal": np.zeros((0, 2)),
+                       "contact_force": np.zeros((0, 2)), "contact_gap": np.zeros(0),
+                       "contact_status": np.zeros(0, np.int8), "contact_mobilised": np.zeros(0)})
+    path = tmp_path / "empty.rrd"
+    with Recorder(path, static, fx.METADATA) as rec:
+        rec.log_frame(empty)
+    rows = temporal_rows(path, "/structure/fields/spherical_stress", "Mesh3D:vertex_colors")
+    assert set(rows[0]) == {cm.NAN_RGBA}
+    assert temporal_rows(path, "/structure/plane/xy/forces", "Arrows2D:vectors")[0] == []
+    assert "not fixed yet" in inspect_recording(path)["metadata"]
+
+
+def test_viewer_safe_text():
+    assert rec_mod.viewer_safe_text("σ ≤ 5 kPa, é — ∝ 漢") == "σ ≤ 5 kPa, é — ? ?"
+
+
+# ------------------------------------------------------------------------------------------ colormap
+def test_colormap_lookup():
+    lut = cm.VIRIDIS
+    assert len(lut) == 256 and lut.dtype == np.uint32
+    colors = cm.map_scalars(np.array([-1.0, 0.0, 0.5, 1.0, 2.0, np.nan]), 0.0, 1.0, lut)
+    assert list(colors[[0, 1, 3, 4]]) == [lut[0], lut[0], lut[-1], lut[-1]]
+    assert colors[2] in (lut[127], lut[128]) and colors[5] == cm.NAN_RGBA
+    np.testing.assert_array_equal(cm.unpack_rgba(cm.COOLWARM[[0, -1]])[:, :3], [[59, 76, 192], [180, 4, 38]])
+    assert cm.unpack_rgba(cm.COOLWARM[128])[0] == pytest.approx(221, abs=2)  # light grey at zero
+
+
+def test_nice_ceil_and_robust_max():
+    assert [cm.nice_ceil(x) for x in (0.0, 0.9, 1.0, 1.2, 2.7, 7.0, 1.1e5)] == [0.0, 1.0, 1.0, 1.5, 3.0, 8.0, 1.5e5]
+    assert cm.robust_max_abs(np.array([np.nan, -3.0, 1.0]), 100) == 3.0
+    assert cm.robust_max_abs(np.array([np.nan])) == 0.0

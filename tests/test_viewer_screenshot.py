@@ -1,0 +1,71 @@
+"""Open a recording in the headless Rerun viewer, as a user would, and look at it.
+
+Needs a Vulkan driver (Debian: mesa-vulkan-drivers libvulkan1); skipped without one. About 10 s.
+"""
+
+from __future__ import annotations
+
+import ctypes.util
+
+import numpy as np
+import pytest
+
+import recording_fixtures as fx
+from masonrycli.colormap import COOLWARM, unpack_rgba
+from masonrycli.recording import _SUPPORT_FILL_RGBA, Recorder, _viewer_executable, screenshot_recording
+
+pytestmark = pytest.mark.skipif(
+    ctypes.util.find_library("vulkan") is None or _viewer_executable() is None,
+    reason="headless viewer needs libvulkan1 + mesa-vulkan-drivers and the rerun executable",
+)
+
+
+def png_size(path) -> tuple[int, int]:
+    with open(path, "rb") as fh:
+        head = fh.read(24)
+    assert head[:8] == b"\x89PNG\r\n\x1a\n"
+    return int.from_bytes(head[16:20], "big"), int.from_bytes(head[20:24], "big")
+
+
+def near(image: np.ndarray, colors: np.ndarray, tol: float = 8.0) -> np.ndarray:
+    """(H, W) mask of pixels within `tol` (RGB distance) of any of `colors` (K, 3)."""
+    rgb = image[..., :3].astype(np.int32)
+    mask = np.zeros(rgb.shape[:2], dtype=bool)
+    for c in np.asarray(colors, dtype=np.int32)[::4]:  # every 4th LUT entry is dense enough
+        mask |= np.abs(rgb - c).sum(axis=-1) < tol
+    return mask
+
+
+@pytest.fixture(scope="module")
+def screenshot(tmp_path_factory):
+    tmp = tmp_path_factory.mktemp("viewer")
+    static, q0 = fx.wall(5, 6)
+    frames = fx.frames(static, q0, 20)
+    rrd = tmp / "wall.rrd"
+    # Characters the viewer's font lacks would kill the viewer: the recorder must replace them.
+    with Recorder(rrd, static, {**fx.METADATA, "scenario": "aqueduct 水道 ∝"}, batch_frames=8) as rec:
+        for f in frames:
+            rec.log_frame(f)
+    png = tmp / "viewer.png"
+    reports = screenshot_recording(rrd, png, time_step=frames[-1].step, timeout=120, tabs_dir=tmp / "tabs")
+    return png, reports, tmp
+
+
+def test_no_view_reports_visualizer_errors(screenshot):
+    png, reports, tmp = screenshot
+    assert reports == []
+    assert png_size(png) == (1920, 1080)
+    assert len(list((tmp / "tabs").glob("tab*.png"))) == 4  # every tab was shown and checked
+
+
+def test_blocks_are_drawn_y_up_with_field_colours(screenshot):
+    image_module = pytest.importorskip("PIL.Image")
+    png, _, _ = screenshot
+    image = np.asarray(image_module.open(png).convert("RGB"))
+    main = image[60:1000, :1100]  # the structure view (left of the plots, above the time panel)
+    blocks = near(main, unpack_rgba(COOLWARM)[:, :3])
+    ground = near(main, unpack_rgba(np.array([_SUPPORT_FILL_RGBA]))[:, :3].repeat(4, axis=0), tol=12)
+    assert blocks.mean() > 0.05 and ground.mean() > 0.01  # filled blocks and the ground are visible
+    block_rows, ground_rows = np.nonzero(blocks)[0], np.nonzero(ground)[0]
+    # y up: the ground is below the wall on screen (larger row index); the legend bar is above it too.
+    assert np.median(ground_rows) > np.percentile(block_rows, 97)
