@@ -7,7 +7,7 @@ supports (body N + s is support s).
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -57,3 +57,9 @@ class Frame:
     nlgs_iterations: int
     nlgs_residual: float
     contact_count: int
+    joint_body: np.ndarray = field(default_factory=lambda: np.zeros((0, 2), dtype=np.int64))
+    """(J, 2) bodies of each joint (pairs touching along a face initially; see masonrycli.mechanism)."""
+    joint_hinged: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=bool))
+    """(J,) True where the joint is hinged: one end carries all the normal force, the other is open."""
+    hinge_point: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)))
+    """(H, 2) m: the loaded contact point of each hinged joint (the hinge), world coordinates."""

@@ -7,6 +7,7 @@ Arrays (T frames, N blocks, S supports), block order = scenario order:
     contact_count (T,) · nlgs_iterations (T,) · nlgs_residual (T,)
     energy_kinetic (T,) J · energy_potential (T,) J · energy_dissipated (T,) J (cumulated)
     support_work (T,) J (cumulated) · every per-block tensor field of masonrycli.tensors.TENSOR_FIELDS
+    joint_body (J,2) · joint_hinged (T,J) bool · hinge_count (T,)  (see masonrycli.mechanism)
     block_name (N,) · support_name (S,) · status () str
 """
 
@@ -43,11 +44,16 @@ class History:
             rows.setdefault(name, []).append(np.array(getattr(frame, name), copy=True))
         for name, value in frame.tensors.items():
             rows.setdefault(name, []).append(np.array(value, copy=True))
+        rows.setdefault("joint_hinged", []).append(np.array(frame.joint_hinged, copy=True))
+        rows.setdefault("hinge_count", []).append(int(frame.joint_hinged.sum()))
+        self.joint_body = frame.joint_body
 
     def arrays(self) -> dict[str, np.ndarray]:
         out = {name: np.asarray(values) for name, values in self._rows.items()}
         out["block_name"] = self.block_name
         out["support_name"] = self.support_name
+        if self._rows:
+            out["joint_body"] = np.asarray(self.joint_body)
         return out
 
     def write(self, path: str | os.PathLike, status: str = "completed") -> Path:

@@ -16,6 +16,7 @@ import numpy as np
 from masonrycli.engine import integrate
 from masonrycli.engine.solver import Solver, StepStats
 from masonrycli.frame import CONTACT_OPEN, Frame
+from masonrycli.mechanism import find_joints, hinged_joints
 from masonrycli.model import Model, State, build_model, initial_state
 from masonrycli.tensors import TensorComputer, build_triangles
 
@@ -61,6 +62,8 @@ class Simulation:
         body = self.solver.contact_body[:count]
         blocks_only = body[(body[:, 0] < n) & (body[:, 1] < n)]
         self.triangles = build_triangles(m.body_q0[:n, :2], blocks_only)
+        weight = float(np.mean(m.body_mass[:n]) * np.hypot(*m.gravity)) if n else 0.0
+        self.joints = find_joints(body, m.body_count, weight)
         self.tensors = TensorComputer(n, m.block_volume, self.triangles)
         self.energy_dissipated = 0.0
         self.support_work = 0.0
@@ -106,6 +109,9 @@ class Simulation:
                                           where=denom > 0)
             support_force = s.support_force
             iterations, residual = self.last.iterations, self.last.residual
+        hinged, hinge_point = self.hinges()
+        if self.last is None:
+            hinged, hinge_point = np.zeros(self.joints.key.size, dtype=bool), np.zeros((0, 2))
         support_q = st.body_q[n:].copy()
         return Frame(
             step=st.step, time=st.time,
@@ -119,7 +125,17 @@ class Simulation:
             energy_kinetic=float(kinetic), energy_potential=float(potential),
             energy_dissipated=self.energy_dissipated, support_work=self.support_work,
             nlgs_iterations=int(iterations), nlgs_residual=float(residual), contact_count=int(c),
+            joint_body=self.joints.joint_body, joint_hinged=hinged, hinge_point=hinge_point,
         )
+
+    def hinges(self) -> tuple[np.ndarray, np.ndarray]:
+        """(J,) hinged flags of the joints after the last step, and (H, 2) the hinge points."""
+        s = self.solver
+        hinged = hinged_joints(self.joints, s.contact_body, s.contact_r[:, 1], s.contact_gap, self.model.dt)
+        # The hinge is the loaded contact point of a hinged joint.
+        key = s.contact_body[:, 0].astype(np.int64) * self.model.body_count + s.contact_body[:, 1]
+        loaded = (s.contact_r[:, 1] > 0) & np.isin(key, self.joints.key[hinged])
+        return hinged, s.contact_point[loaded].copy()
 
     def diverged(self) -> str:
         """Empty string, or why the state is no longer physical."""
@@ -183,11 +199,17 @@ def simulate(scenario, sinks=(), on_progress: Callable | None = None, progress_e
         status = "interrupted"
         # The interrupted step may be half done: keep the frames recorded so far, add none.
         message = f"interrupted at t = {sim.state.time:.4f} s (step {done} of {n_steps})"
+    extra = {"model": m}
+    if sim.last is not None and sim.joints.key.size:
+        hinged, _ = sim.hinges()
+        names = list(m.block_name) + list(m.support_name)
+        pairs = [f"{names[a]}|{names[b]}" for a, b in sim.joints.joint_body[hinged]]
+        shown = ", ".join(pairs[:8]) + (" …" if len(pairs) > 8 else "")
+        extra["hinged joints (end)"] = f"{len(pairs)}" + (f": {shown}" if pairs else "")
     return RunResult(
         status=status, message=message, steps=done, time=sim.state.time,
         wall_time=_time.perf_counter() - t0, iterations=iterations[:done], residual=residual[:done],
         contact_count=contacts[:done], max_penetration=max_pen, energy_initial=e0,
         energy_final=float(sum(sim.energies())), energy_dissipated=sim.energy_dissipated,
-        support_work=sim.support_work, frames=frames,
-        extra={"model": m},
+        support_work=sim.support_work, frames=frames, extra=extra,
     )
