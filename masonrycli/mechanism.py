@@ -19,7 +19,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-OPENING = 1e-5
+OPENING = 1e-4
 """m: gap above which the unloaded end of a joint counts as open."""
 LOAD_FRACTION = 1e-3
 """Joints carrying less than this fraction of the mean block weight are never hinges."""
