@@ -13,6 +13,7 @@ from masonrycli.engine.narrowphase import (
     check_topology,
     collide_polygons,
     decode_contact_key,
+    edge_normals,
     narrowphase,
 )
 
@@ -37,7 +38,9 @@ def run_batch(pairs, alert):
     normal = np.full((cap, 2), np.nan)
     gap = np.full(cap, np.nan)
     key = np.full(cap, -1, dtype=np.int64)
-    n = narrowphase(vert_world, body_vert_start, pair_body, len(pairs), alert, body, point, normal, gap, key)
+    edge_normal, body_size = edge_normals(vert_world, body_vert_start)
+    n = narrowphase(vert_world, edge_normal, body_size, body_vert_start, pair_body, len(pairs), alert,
+                    body, point, normal, gap, key)
     assert np.all(body[:n, 0] % 2 == 0) and np.all(body[:n, 1] == body[:n, 0] + 1)
     assert np.all(np.diff(body[:n, 0]) >= 0), "contacts grouped by pair, pairs in input order"
     out = []
@@ -470,6 +473,7 @@ def test_narrowphase_refuses_too_small_output():
     vert = np.concatenate([nv.rect(0, 0, 1, 1), nv.rect(1, 0, 2, 1)])
     start = np.array([0, 4, 8], dtype=np.int64)
     pairs = np.array([[0, 1]], dtype=np.int32)
-    small = (np.zeros((1, 2), np.int32), np.zeros((1, 2)), np.zeros((1, 2)), np.zeros(1), np.zeros(1, np.int64))
+    small = (np.zeros((1, 2), np.int32), np.zeros((1, 2)), np.zeros((1, 2)), np.zeros(1),
+             np.zeros(1, np.int64))
     with pytest.raises(ValueError, match="capacity"):
-        narrowphase(vert, start, pairs, 1, 1e-3, *small)
+        narrowphase(vert, *edge_normals(vert, start), start, pairs, 1, 1e-3, *small)

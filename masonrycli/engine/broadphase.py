@@ -285,6 +285,8 @@ def candidate_pairs(body_aabb, body_dynamic, buffers: PairBuffers) -> int:
             f"candidate_pairs: {body_count} boxes, {body_dynamic.shape} body_dynamic, "
             f"buffers for {buffers.body_count} bodies"
         )
+    if body_dynamic.dtype != np.bool_:
+        raise ValueError(f"candidate_pairs: body_dynamic must be bool, got {body_dynamic.dtype}")
     if buffers.axis < 0:
         # First call: sweep along the axis of largest spread of the box centres (fewest boxes
         # overlapping along the sweep axis), and start from a stable numpy sort so that the

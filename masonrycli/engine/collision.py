@@ -1,5 +1,9 @@
 """Contact detection for one configuration: world vertices → boxes → candidate pairs → contacts.
 
+Stages (each a numba kernel): world vertices, bounding boxes and sweep-and-prune
+(:mod:`.broadphase`); edge normals and the separating-axis / clipping narrow phase
+(:mod:`.narrowphase`).
+
 Python orchestration only; the work is done by the numba kernels of :mod:`.broadphase` and
 :mod:`.narrowphase`. One :class:`ContactBuffers` per model is reused every step, so that a step
 allocates nothing unless a capacity is exceeded (capacities then double).
@@ -20,7 +24,7 @@ from typing import NamedTuple
 import numpy as np
 
 from .broadphase import PairBuffers, _body_aabbs, _world_vertices, candidate_pairs, world_vertices
-from .narrowphase import _narrowphase, check_topology, decode_contact_key
+from .narrowphase import _edge_normals, _narrowphase, check_topology, decode_contact_key
 
 __all__ = ["ContactBuffers", "Contacts", "decode_contact_key", "detect_contacts", "world_vertices"]
 
@@ -55,6 +59,10 @@ class ContactBuffers:
     ----------
     vert_world : (V, 2) float64
         World vertices [m] of the last configuration.
+    edge_normal : (V, 2) float64
+        Outward unit normal of the edge from each vertex to the next [-].
+    body_size : (B,) float64
+        Largest bounding-box side of each body [m] (scale of the narrow phase's tolerances).
     body_aabb : (B, 4) float64
         ``xmin, ymin, xmax, ymax`` [m] of each body, inflated by alert / 2.
     pairs : PairBuffers
@@ -69,13 +77,17 @@ class ContactBuffers:
     :meth:`view`) after each call, never keep references across calls.
     """
 
-    def __init__(self, body_vert_start, pair_capacity: int | None = None, contact_capacity: int | None = None):
+    def __init__(
+        self, body_vert_start, pair_capacity: int | None = None, contact_capacity: int | None = None
+    ):
         body_vert_start = np.asarray(body_vert_start)
         check_topology(body_vert_start)
         self._checked_vert_start = body_vert_start
         self.body_count = body_vert_start.shape[0] - 1
         self.vertex_count = int(body_vert_start[-1])
         self.vert_world = np.zeros((self.vertex_count, 2), dtype=np.float64)
+        self.edge_normal = np.zeros((self.vertex_count, 2), dtype=np.float64)
+        self.body_size = np.zeros(self.body_count, dtype=np.float64)
         self.body_aabb = np.zeros((self.body_count, 4), dtype=np.float64)
         self.pairs = PairBuffers(self.body_count, pair_capacity)
         if contact_capacity is None:
@@ -175,8 +187,10 @@ def detect_contacts(body_q, body_vert_start, vert_local, body_dynamic, alert, bu
     pair_count = candidate_pairs(buffers.body_aabb, body_dynamic, buffers.pairs)
     if buffers.contact_capacity < 2 * pair_count:  # ≤ 2 contacts per pair: the kernel never overflows
         buffers.grow_contacts(2 * pair_count)
+    _edge_normals(buffers.vert_world, body_vert_start, buffers.edge_normal, buffers.body_size)
     n = _narrowphase(
-        buffers.vert_world, body_vert_start, buffers.pairs.pair_body, pair_count, alert,
+        buffers.vert_world, buffers.edge_normal, buffers.body_size, body_vert_start,
+        buffers.pairs.pair_body, pair_count, alert,
         buffers.contact_body, buffers.contact_point, buffers.contact_normal, buffers.contact_gap,
         buffers.contact_key,
     )  # fmt: skip

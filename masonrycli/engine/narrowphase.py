@@ -65,6 +65,7 @@ __all__ = [
     "check_topology",
     "collide_polygons",
     "decode_contact_key",
+    "edge_normals",
     "narrowphase",
 ]
 
@@ -79,7 +80,69 @@ KEY_LIMIT_VERTICES = 256
 
 
 @njit
-def _max_face_separation(vert, s1, n1, s2, n2, alert):
+def _edge_normals(vert_world, body_vert_start, edge_normal, body_size):
+    # for each body b, each edge k (vertex k → vertex k+1, wrapping around):
+    #     edge_normal[k] = (dy, −dx) / |(dx, dy)|      outward unit normal of a CCW polygon's edge
+    #                      (0, 0) for a zero-length edge: the narrow phase ignores it
+    #     body_size[b]   = largest side of the bounding box of b's vertices (scale of tolerances)
+    # Done once per body and step rather than once per pair: the square roots and divisions were
+    # most of the narrow phase's cost.
+    for b in range(body_vert_start.shape[0] - 1):
+        s = body_vert_start[b]
+        n = body_vert_start[b + 1] - s
+        xmin = vert_world[s, 0]
+        xmax = xmin
+        ymin = vert_world[s, 1]
+        ymax = ymin
+        for i in range(n):
+            j = i + 1 if i + 1 < n else 0
+            x = vert_world[s + i, 0]
+            y = vert_world[s + i, 1]
+            dx = vert_world[s + j, 0] - x
+            dy = vert_world[s + j, 1] - y
+            length = math.sqrt(dx * dx + dy * dy)
+            if length > 0.0:
+                edge_normal[s + i, 0] = dy / length
+                edge_normal[s + i, 1] = 0.0 - dx / length
+            else:
+                edge_normal[s + i, 0] = 0.0
+                edge_normal[s + i, 1] = 0.0
+            xmin = min(xmin, x)
+            xmax = max(xmax, x)
+            ymin = min(ymin, y)
+            ymax = max(ymax, y)
+        body_size[b] = max(xmax - xmin, ymax - ymin)
+
+
+def edge_normals(vert_world, body_vert_start, edge_normal=None, body_size=None):
+    """Outward unit normal of every polygon edge, and the size of every body.
+
+    Parameters
+    ----------
+    vert_world : (V, 2) float64
+        World vertices [m], CCW per body.
+    body_vert_start : (B+1,) int64
+        CSR offsets of the vertices.
+    edge_normal : (V, 2) float64, optional
+        Out: row k is the unit outward normal of the edge from vertex k to the next vertex of the same
+        body ((0, 0) for a zero-length edge). Allocated if None.
+    body_size : (B,) float64, optional
+        Out: largest side of each body's bounding box [m]. Allocated if None.
+
+    Returns
+    -------
+    (edge_normal, body_size)
+    """
+    if edge_normal is None:
+        edge_normal = np.empty((vert_world.shape[0], 2), dtype=np.float64)
+    if body_size is None:
+        body_size = np.empty(body_vert_start.shape[0] - 1, dtype=np.float64)
+    _edge_normals(vert_world, body_vert_start, edge_normal, body_size)
+    return edge_normal, body_size
+
+
+@njit
+def _max_face_separation(vert, normal, s1, n1, s2, n2, alert):
     # Largest separation of polygon 2 along the outward edge normals of polygon 1:
     #     for each edge i of 1:  sep_i = min_{w ∈ 2} n_i · (w − v_i)
     #     return (max_i sep_i, argmax_i)          (strict '>' : the first edge wins ties)
@@ -88,44 +151,21 @@ def _max_face_separation(vert, s1, n1, s2, n2, alert):
     best = -math.inf
     best_edge = -1
     for i in range(n1):
-        j = i + 1 if i + 1 < n1 else 0
+        nx = normal[s1 + i, 0]
+        ny = normal[s1 + i, 1]
+        if nx == 0.0 and ny == 0.0:
+            continue  # degenerate edge: no normal (input checks should have refused it)
         x1 = vert[s1 + i, 0]
         y1 = vert[s1 + i, 1]
-        dx = vert[s1 + j, 0] - x1
-        dy = vert[s1 + j, 1] - y1
-        length = math.sqrt(dx * dx + dy * dy)
-        if not (length > 0.0):
-            continue  # degenerate edge: no normal (input checks should have refused it)
-        nx = dy / length
-        ny = -dx / length
         sep = math.inf
         for k in range(n2):
-            d = nx * (vert[s2 + k, 0] - x1) + ny * (vert[s2 + k, 1] - y1)
-            if d < sep:
-                sep = d
+            sep = min(sep, nx * (vert[s2 + k, 0] - x1) + ny * (vert[s2 + k, 1] - y1))  # branch-free
         if sep > best:
             best = sep
             best_edge = i
             if best > alert:
                 break
     return best, best_edge
-
-
-@njit
-def _extent(vert, s, n):
-    # Largest side of the polygon's bounding box (sets the scale of the tolerances).
-    xmin = vert[s, 0]
-    xmax = xmin
-    ymin = vert[s, 1]
-    ymax = ymin
-    for k in range(s + 1, s + n):
-        x = vert[k, 0]
-        y = vert[k, 1]
-        xmin = min(xmin, x)
-        xmax = max(xmax, x)
-        ymin = min(ymin, y)
-        ymax = max(ymax, y)
-    return max(xmax - xmin, ymax - ymin)
 
 
 @njit
@@ -170,7 +210,7 @@ def _end_label(side, t0, ivtx, e, e2, k, length, snap, ref_is_b):
 
 @njit
 def _collide_pair(
-    vert, sa, na, sb, nb, a, b, alert, c,
+    vert, normal, size_a, size_b, sa, na, sb, nb, a, b, alert, c,
     contact_body, contact_point, contact_normal, contact_gap, contact_key,
 ):  # fmt: skip
     # Contacts of the pair (a, b) written from row c on; returns the next free row.
@@ -182,13 +222,13 @@ def _collide_pair(
     #   in the frame (t, g) = (u·(p − v1), n·(p − v1)): clip [w1, w2] to t ∈ [0, L]
     #   (ends within tol outside are kept), interpolating g
     #   each end with g ≤ alert → contact (p − g n / 2, ±n, g, key)
-    sep_a, e_a = _max_face_separation(vert, sa, na, sb, nb, alert)
+    sep_a, e_a = _max_face_separation(vert, normal, sa, na, sb, nb, alert)
     if not (sep_a <= alert) or e_a < 0:
         return c
-    sep_b, e_b = _max_face_separation(vert, sb, nb, sa, na, alert)
+    sep_b, e_b = _max_face_separation(vert, normal, sb, nb, sa, na, alert)
     if not (sep_b <= alert) or e_b < 0:
         return c
-    tol = REF_TOL_ABS + REF_TOL_REL * min(_extent(vert, sa, na), _extent(vert, sb, nb))
+    tol = REF_TOL_ABS + REF_TOL_REL * min(size_a, size_b)
 
     # Reference face: a's unless b's separates clearly more (deterministic on coincident faces).
     ref_is_b = sep_b > sep_a + tol
@@ -201,25 +241,21 @@ def _collide_pair(
     v1y = vert[rs + e, 1]
     v2x = vert[rs + e2, 0]
     v2y = vert[rs + e2, 1]
-    ux = v2x - v1x
-    uy = v2y - v1y
-    length = math.sqrt(ux * ux + uy * uy)
-    ux /= length
-    uy /= length
-    nx = uy  # outward normal of a CCW polygon's edge: the edge direction turned by -90°
-    ny = 0.0 - ux  # (0.0 - x rather than -x: no negative zeros in the outputs)
+    nx = normal[rs + e, 0]
+    ny = normal[rs + e, 1]
+    ux = 0.0 - ny  # along the edge, from v1 to v2 (n is u turned by -90°)
+    uy = nx
+    length = ux * (v2x - v1x) + uy * (v2y - v1y)
 
     # Incident edge: outward normal most anti-parallel to n, i.e. smallest n · n_k.
     k = 0
     best = math.inf
     for i in range(in_):
-        j = i + 1 if i + 1 < in_ else 0
-        dx = vert[is_ + j, 0] - vert[is_ + i, 0]
-        dy = vert[is_ + j, 1] - vert[is_ + i, 1]
-        li = math.sqrt(dx * dx + dy * dy)
-        if not (li > 0.0):
+        mx = normal[is_ + i, 0]
+        my = normal[is_ + i, 1]
+        if mx == 0.0 and my == 0.0:
             continue
-        d = (nx * dy - ny * dx) / li
+        d = nx * mx + ny * my
         if d < best:
             best = d
             k = i
@@ -334,7 +370,7 @@ def _collide_pair(
 
 @njit
 def _narrowphase(
-    vert_world, body_vert_start, pair_body, pair_count, alert,
+    vert_world, edge_normal, body_size, body_vert_start, pair_body, pair_count, alert,
     contact_body, contact_point, contact_normal, contact_gap, contact_key,
 ):  # fmt: skip
     # for each candidate pair p (in the given order): append its 0..2 contacts (see _collide_pair).
@@ -346,7 +382,8 @@ def _narrowphase(
         sa = body_vert_start[a]
         sb = body_vert_start[b]
         c = _collide_pair(
-            vert_world, sa, body_vert_start[a + 1] - sa, sb, body_vert_start[b + 1] - sb,
+            vert_world, edge_normal, body_size[a], body_size[b],
+            sa, body_vert_start[a + 1] - sa, sb, body_vert_start[b + 1] - sb,
             a, b, alert, c,
             contact_body, contact_point, contact_normal, contact_gap, contact_key,
         )  # fmt: skip
@@ -375,7 +412,7 @@ def check_topology(body_vert_start) -> None:
 
 
 def narrowphase(
-    vert_world, body_vert_start, pair_body, pair_count, alert,
+    vert_world, edge_normal, body_size, body_vert_start, pair_body, pair_count, alert,
     contact_body, contact_point, contact_normal, contact_gap, contact_key,
 ) -> int:  # fmt: skip
     """Contact points of the candidate pairs, written into preallocated arrays.
@@ -384,6 +421,10 @@ def narrowphase(
     ----------
     vert_world : (V, 2) float64
         World vertices [m], CCW per body (``broadphase.world_vertices``).
+    edge_normal : (V, 2) float64
+        Outward unit edge normals (:func:`edge_normals`).
+    body_size : (B,) float64
+        Largest bounding-box side of each body [m] (:func:`edge_normals`).
     body_vert_start : (B+1,) int64
         CSR offsets of the vertices (3..256 per body, see :func:`check_topology`).
     pair_body : (P_cap, 2) int32
@@ -413,7 +454,7 @@ def narrowphase(
     if capacity < 2 * pair_count:
         raise ValueError(f"narrowphase: capacity {capacity} < 2 x {pair_count} pairs")
     return _narrowphase(
-        vert_world, body_vert_start, pair_body, int(pair_count), float(alert),
+        vert_world, edge_normal, body_size, body_vert_start, pair_body, int(pair_count), float(alert),
         contact_body, contact_point, contact_normal, contact_gap, contact_key,
     )  # fmt: skip
 
@@ -441,13 +482,14 @@ def collide_polygons(verts_a, verts_b, alert, a: int = 0, b: int = 1):
     vert = np.concatenate([verts_a, verts_b])
     body_vert_start = np.array([0, len(verts_a), len(vert)], dtype=np.int64)
     check_topology(body_vert_start)
+    normal, size = edge_normals(vert, body_vert_start)
     contact_body = np.zeros((2, 2), dtype=np.int32)
     contact_point = np.zeros((2, 2))
     contact_normal = np.zeros((2, 2))
     contact_gap = np.zeros(2)
     contact_key = np.zeros(2, dtype=np.int64)
     c = _collide_pair(
-        vert, 0, len(verts_a), len(verts_a), len(verts_b), a, b, float(alert), 0,
+        vert, normal, size[0], size[1], 0, len(verts_a), len(verts_a), len(verts_b), a, b, float(alert), 0,
         contact_body, contact_point, contact_normal, contact_gap, contact_key,
     )  # fmt: skip
     return contact_point[:c].copy(), contact_normal[:c].copy(), contact_gap[:c].copy(), contact_key[:c].copy()
