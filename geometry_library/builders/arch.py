@@ -1,0 +1,210 @@
+"""Semicircular voussoir arch on two running-bond piers (the paper's 98-block arch).
+
+Geometry (defaults)
+-------------------
+- Intrados radius R_i = span / 2 = 1.50 m, ring thickness t = 0.35 m, extrados R_e = 1.85 m
+  (t / R_mid = 0.21, about twice the minimum thickness of a semicircular arch under self-weight).
+- 30 voussoirs, each spanning 6°: exact convex quadrilaterals whose intrados and extrados are the
+  straight chords between the circle points and whose joints are radial (they pass through the
+  arch centre). With an even count there is a joint at the crown.
+- Two piers, each 0.90 m wide and 17 courses of 0.20 m (3.40 m high), 2 blocks per course in
+  running bond: a full block 0.60 m and a half block 0.30 m, swapping sides every course (vertical
+  joints of consecutive courses offset by half a full block). The top course has its full block on
+  the arch side, so each springing voussoir (0.35 m wide) rests on one 0.60 m block. The piers'
+  inner faces are flush with the intrados (x = ±R_i), their outer faces at x = ±(R_i + pier width).
+- Each pier stands on its own foundation support ("left-foundation", "right-foundation"): the pier
+  footprint widened by 0.30 m on each side, 0.50 m deep, top at y = 0.
+- Springing line at y = 17 × 0.20 = 3.40 m, crown extrados at 5.25 m; centre of the arch at x = 0.
+
+Block count: 2 × 17 × 2 + 30 = 98. Order: left pier (bottom up, left to right), voussoirs (left to
+right, ``v01`` … ``v30``), right pier. Names: ``left-pier-c01-b1`` …, ``v01`` …, ``right-pier-c17-b2``.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from shapely.geometry import box
+
+from ..blocks import SUPPORT_ROLES, Assembly, Block, GeometryError, Support
+from ._common import check_count, check_positive, make_block, make_support, name_width
+
+
+@dataclass(frozen=True, eq=False)
+class ArchGeometry:
+    """Where the arch is, for builders that add to it (the aqueduct's spandrel walls).
+
+    Attributes
+    ----------
+    centre : ndarray (2,), m — arch centre, on the springing line.
+    intrados_radius, extrados_radius : float, m.
+    springing : float, m — y of the springing line (top of the piers).
+    half_width : float, m — x of the piers' outer faces is ±half_width.
+    extrados : ndarray (N+1, 2), m — the extrados chain (voussoir outer chord ends), left to right.
+    """
+
+    centre: np.ndarray
+    intrados_radius: float
+    extrados_radius: float
+    springing: float
+    half_width: float
+    extrados: np.ndarray
+
+
+def _unit_half_circle(n: int) -> np.ndarray:
+    """(n+1, 2) points (cos φ_k, sin φ_k), φ_k = π − πk/n, exactly mirror-symmetric about x = 0."""
+    out = np.empty((n + 1, 2))
+    for k in range(n + 1):
+        j = min(k, n - k)  # mirror partner with angle ≥ π/2 measured from the left
+        if 2 * j == n:
+            c, s = 0.0, 1.0
+        elif j == 0:
+            c, s = 1.0, 0.0
+        else:
+            phi = math.pi * j / n
+            c, s = math.cos(phi), math.sin(phi)
+        out[k] = (-c, s) if k == j else (c, s)
+    return out
+
+
+def arch_parts(
+    voussoirs: int = 30,
+    pier_courses: int = 17,
+    span: float = 3.0,
+    ring_thickness: float = 0.35,
+    pier_width: float = 0.90,
+    pier_course_height: float = 0.20,
+    density: float = 2500.0,
+    thickness: float = 1.0,
+    foundation_margin: float = 0.30,
+    foundation_depth: float = 0.50,
+    left_role: str = "fixed",
+    right_role: str = "fixed",
+) -> tuple[list[Block], list[Support], ArchGeometry]:
+    """The blocks, supports and geometry of :func:`build_arch` (same parameters)."""
+    check_count("arch", 2, voussoirs=voussoirs)
+    check_count("arch", 1, pier_courses=pier_courses)
+    check_positive(
+        "arch",
+        span=span,
+        ring_thickness=ring_thickness,
+        pier_width=pier_width,
+        pier_course_height=pier_course_height,
+        density=density,
+        thickness=thickness,
+        foundation_depth=foundation_depth,
+    )
+    if ring_thickness > pier_width:
+        raise GeometryError(
+            f"arch: ring_thickness {ring_thickness:g} m is wider than the pier ({pier_width:g} m): "
+            "the pier top must carry the whole springing voussoir"
+        )
+    if foundation_margin < 0:
+        raise GeometryError(f"arch: foundation_margin must be ≥ 0, got {foundation_margin!r}")
+    for key, role in (("left_role", left_role), ("right_role", right_role)):
+        if role not in SUPPORT_ROLES:
+            raise GeometryError(f"arch: {key} must be one of {SUPPORT_ROLES}, got {role!r}")
+
+    r_in = 0.5 * span
+    r_out = r_in + ring_thickness
+    outer = r_in + pier_width
+    y_spring = pier_courses * pier_course_height
+    unit = _unit_half_circle(voussoirs)
+    intrados = unit * r_in + (0.0, y_spring)
+    extrados = unit * r_out + (0.0, y_spring)
+    intrados[:, 1][[0, -1]] = y_spring
+    extrados[:, 1][[0, -1]] = y_spring
+
+    def pier(side: str, x_in: float, x_out: float) -> list[Block]:
+        sign = 1.0 if x_out > x_in else -1.0
+        full, part = 2.0 * pier_width / 3.0, pier_width / 3.0
+        blocks = []
+        cw = name_width(pier_courses)
+        for c in range(1, pier_courses + 1):
+            y0, y1 = (c - 1) * pier_course_height, c * pier_course_height
+            from_top = pier_courses - c
+            inner_len = full if from_top % 2 == 0 else part
+            x_joint = x_in + sign * inner_len
+            pieces = sorted([(x_in, x_joint), (x_joint, x_out)], key=lambda ab: min(ab))
+            for k, (xa, xb) in enumerate(pieces, start=1):
+                lo, hi = min(xa, xb), max(xa, xb)
+                blocks.append(
+                    make_block(box(lo, y0, hi, y1), f"{side}-pier-c{c:0{cw}d}-b{k}", density, thickness)
+                )
+        return blocks
+
+    vw = name_width(voussoirs)
+    ring = [
+        make_block(
+            np.array([intrados[k], intrados[k + 1], extrados[k + 1], extrados[k]]),
+            f"v{k + 1:0{vw}d}",
+            density,
+            thickness,
+        )
+        for k in range(voussoirs)
+    ]
+    blocks = pier("left", -r_in, -outer) + ring + pier("right", r_in, outer)
+
+    inner_margin = min(foundation_margin, 0.25 * span)
+    supports = [
+        make_support(
+            box(-outer - foundation_margin, -foundation_depth, -r_in + inner_margin, 0.0),
+            "left-foundation",
+            left_role,
+        ),
+        make_support(
+            box(r_in - inner_margin, -foundation_depth, outer + foundation_margin, 0.0),
+            "right-foundation",
+            right_role,
+        ),
+    ]
+    geometry = ArchGeometry(
+        centre=np.array([0.0, y_spring]),
+        intrados_radius=r_in,
+        extrados_radius=r_out,
+        springing=y_spring,
+        half_width=outer,
+        extrados=extrados,
+    )
+    return blocks, supports, geometry
+
+
+def build_arch(
+    voussoirs: int = 30,
+    pier_courses: int = 17,
+    span: float = 3.0,
+    ring_thickness: float = 0.35,
+    pier_width: float = 0.90,
+    pier_course_height: float = 0.20,
+    density: float = 2500.0,
+    thickness: float = 1.0,
+    foundation_margin: float = 0.30,
+    foundation_depth: float = 0.50,
+    left_role: str = "fixed",
+    right_role: str = "fixed",
+) -> Assembly:
+    """A semicircular arch of ``voussoirs`` radial-jointed voussoirs on two running-bond piers.
+
+    Parameters
+    ----------
+    voussoirs : int ≥ 2 — number of voussoirs (default 30, 6° each).
+    pier_courses : int — courses per pier, 2 blocks each (default 17 → 34 blocks per pier).
+    span : float, m — clear span between the piers = intrados diameter (default 3.0).
+    ring_thickness : float, m — extrados radius − intrados radius (default 0.35), ≤ pier_width.
+    pier_width : float, m (default 0.90; blocks 0.60 + 0.30). pier_course_height : m (0.20).
+    density : kg/m³. thickness : m, out of plane.
+    foundation_margin, foundation_depth : m — foundation pads under each pier.
+    left_role, right_role : support roles of "left-foundation" / "right-foundation".
+
+    Returns
+    -------
+    Assembly with 2·2·pier_courses + voussoirs blocks (98 by default) and two supports. See the
+    module docstring for the layout, names and order.
+    """
+    blocks, supports, _ = arch_parts(
+        voussoirs, pier_courses, span, ring_thickness, pier_width, pier_course_height, density,
+        thickness, foundation_margin, foundation_depth, left_role, right_role,
+    )
+    return Assembly(tuple(blocks), tuple(supports))

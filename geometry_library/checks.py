@@ -1,0 +1,276 @@
+"""Validation and normalisation of block polygons, and whole-assembly checks.
+
+Every error is a :class:`GeometryError` whose message is one line naming the body, for example::
+
+    block 7 ("c03-b02"): polygon is not convex (reflex vertex at (0.45, 0.6))
+    blocks 3 ("c01-b04") and 4 ("c01-b05") overlap by 2.5e-03 m² (tolerance 1e-09 m²)
+
+Normalised polygons are counter-clockwise, without the closing repeat, without duplicate or
+collinear consecutive vertices (collinear points are allowed on input and silently removed).
+
+Tolerances
+----------
+- two consecutive vertices closer than ``1e-12 ×`` the polygon's size are one vertex;
+- a vertex is collinear when the cross product of its two edges is below ``1e-9 × |e1| |e2|``
+  (``COLLINEAR_RTOL``) and the edges point the same way; this absorbs the float noise of clipped
+  polygons, so a convexity test never trips on a 1e-17 "reflex" angle;
+- areas below ``MIN_AREA`` (1e-10 m²) are zero, above ``MAX_AREA`` (1e6 m²) absurd (wrong units).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+
+import numpy as np
+import shapely
+from shapely.geometry import Polygon
+from shapely.strtree import STRtree
+
+from .blocks import SUPPORT_ROLES, Assembly, GeometryError
+
+COLLINEAR_RTOL = 1e-9
+MIN_AREA = 1e-10
+MAX_AREA = 1e6
+CONTACT_DISTANCE = 1e-3
+
+
+def body_label(index: int, name: str, kind: str = "block") -> str:
+    """``block 7 ("c03-b02")`` — how every message names a body."""
+    return f'{kind} {index} ("{name}")'
+
+
+def _fmt(p: Sequence[float]) -> str:
+    return f"({p[0]:.6g}, {p[1]:.6g})"
+
+
+def _next(xy: np.ndarray) -> np.ndarray:
+    """Vertices shifted by one: xy[i + 1] (cyclic). Cheaper than np.roll on small arrays."""
+    return np.concatenate((xy[1:], xy[:1]))
+
+
+def _prev(xy: np.ndarray) -> np.ndarray:
+    """xy[i − 1] (cyclic)."""
+    return np.concatenate((xy[-1:], xy[:-1]))
+
+
+def _turn_cross(xy: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Cross products e_{i-1} × e_i at every vertex and their collinearity scale |e_{i-1}| |e_i|."""
+    e_in = xy - _prev(xy)
+    e_out = _next(xy) - xy
+    cross = e_in[:, 0] * e_out[:, 1] - e_in[:, 1] * e_out[:, 0]
+    scale = np.hypot(e_in[:, 0], e_in[:, 1]) * np.hypot(e_out[:, 0], e_out[:, 1])
+    return cross, scale
+
+
+def _remove_collinear(xy: np.ndarray) -> np.ndarray:
+    """Drop vertices lying on the straight line through their neighbours (CCW ring, no repeat)."""
+    while len(xy) > 3:
+        cross, scale = _turn_cross(xy)
+        e_in = xy - _prev(xy)
+        e_out = _next(xy) - xy
+        dot = np.einsum("ij,ij->i", e_in, e_out)
+        straight = np.flatnonzero((np.abs(cross) <= COLLINEAR_RTOL * scale) & (dot > 0.0))
+        if straight.size == 0:
+            break
+        xy = np.delete(xy, straight[0], axis=0)
+    return xy
+
+
+def signed_area(xy: np.ndarray) -> float:
+    """Shoelace signed area of a ring (k, 2) without closing repeat; > 0 for counter-clockwise."""
+    p = xy - xy.mean(axis=0)
+    q = _next(p)
+    return 0.5 * float(np.sum(p[:, 0] * q[:, 1] - q[:, 0] * p[:, 1]))
+
+
+def is_convex(xy: np.ndarray) -> bool:
+    """True if the CCW ring ``xy`` (k, 2), collinear vertices allowed, is convex within tolerance."""
+    xy = _remove_collinear(np.asarray(xy, dtype=np.float64))
+    cross, scale = _turn_cross(xy)
+    return bool(len(xy) >= 3 and np.all(cross > COLLINEAR_RTOL * scale))
+
+
+def normalise_coords(coords, label: str) -> np.ndarray:
+    """Check a ring of vertices and return it normalised (CCW, no repeats, no collinear vertices).
+
+    Parameters
+    ----------
+    coords : array_like (k, 2), m — exterior ring, either orientation, closing repeat optional.
+    label : str — how to name the body in an error, e.g. ``block 7 ("c03-b02")``.
+
+    Returns
+    -------
+    ndarray (m, 2) float64, m ≤ k.
+
+    Raises
+    ------
+    GeometryError — NaN/inf, fewer than 3 distinct vertices, zero or absurd area, self-intersection,
+    non-convex.
+    """
+    try:
+        xy = np.array(coords, dtype=np.float64)
+    except (TypeError, ValueError) as exc:
+        raise GeometryError(f"{label}: coordinates are not numbers ({exc})") from None
+    if xy.ndim != 2 or xy.shape[1] != 2 or xy.shape[0] == 0:
+        raise GeometryError(f"{label}: expected (k, 2) vertex coordinates, got shape {xy.shape}")
+    if not np.all(np.isfinite(xy)):
+        bad = int(np.flatnonzero(~np.all(np.isfinite(xy), axis=1))[0])
+        raise GeometryError(f"{label}: vertex {bad} has a NaN or infinite coordinate")
+    size = float(np.hypot(*(xy.max(axis=0) - xy.min(axis=0))))
+    dup_tol = 1e-12 * max(size, 1e-300)
+    # Drop the closing repeat and consecutive duplicates.
+    keep = [0]
+    for i in range(1, len(xy)):
+        if np.hypot(*(xy[i] - xy[keep[-1]])) > dup_tol:
+            keep.append(i)
+    xy = xy[keep]
+    if len(xy) > 1 and np.hypot(*(xy[-1] - xy[0])) <= dup_tol:
+        xy = xy[:-1]
+    distinct = len(np.unique(np.round(xy / max(dup_tol, 1e-300)), axis=0)) if size > 0 else 1
+    if distinct < 3:
+        raise GeometryError(f"{label}: polygon has fewer than 3 distinct vertices ({distinct})")
+    # All vertices on one line: no area at all (checked before validity, which would call it a
+    # self-intersection).
+    centred = xy - xy.mean(axis=0)
+    if np.linalg.svd(centred, compute_uv=False)[-1] <= 1e-12 * size:
+        raise GeometryError(f"{label}: polygon has zero area (all vertices collinear)")
+    poly = Polygon(xy)
+    if not poly.is_valid:
+        reason = shapely.is_valid_reason(poly)
+        raise GeometryError(f"{label}: polygon self-intersects ({reason})")
+    area = signed_area(xy)
+    if abs(area) < MIN_AREA:
+        raise GeometryError(f"{label}: polygon area {abs(area):.3g} m² is zero or too small")
+    if abs(area) > MAX_AREA:
+        raise GeometryError(
+            f"{label}: polygon area {abs(area):.3g} m² is absurd (coordinates must be metres)"
+        )
+    if area < 0.0:
+        xy = xy[::-1]
+    xy = _remove_collinear(xy)
+    cross, scale = _turn_cross(xy)
+    reflex = np.flatnonzero(cross <= COLLINEAR_RTOL * scale)
+    if reflex.size:
+        raise GeometryError(f"{label}: polygon is not convex (reflex vertex at {_fmt(xy[reflex[0]])})")
+    return np.ascontiguousarray(xy)
+
+
+def polygon_from_coords(coords, index: int, name: str, kind: str = "block") -> Polygon:
+    """Build a normalised convex shapely Polygon from vertex coordinates, or raise a one-line error.
+
+    Parameters
+    ----------
+    coords : array_like (k, 2), m — either orientation; a closing repeat and collinear vertices are
+        allowed (removed).
+    index, name : the body's index and name, used in the error message.
+    kind : ``"block"`` or ``"support"``.
+
+    Raises
+    ------
+    GeometryError, e.g. ``block 7 ("c3-b2"): polygon is not convex (reflex vertex at (1, 2))``.
+    """
+    return Polygon(normalise_coords(coords, body_label(index, name, kind)))
+
+
+def normalise_polygon(geometry, index: int, name: str, kind: str = "block") -> Polygon:
+    """Like :func:`polygon_from_coords` for a shapely geometry: also rejects holes and other types."""
+    label = body_label(index, name, kind)
+    if not isinstance(geometry, Polygon):
+        kind_name = getattr(geometry, "geom_type", type(geometry).__name__)
+        raise GeometryError(f"{label}: expected a Polygon, got {kind_name}")
+    if geometry.is_empty:
+        raise GeometryError(f"{label}: polygon is empty")
+    if len(geometry.interiors) > 0:
+        raise GeometryError(f"{label}: polygon has {len(geometry.interiors)} hole(s); blocks are solid")
+    return Polygon(normalise_coords(np.asarray(geometry.exterior.coords)[:, :2], label))
+
+
+def _check_positive(value, what: str, label: str) -> None:
+    try:
+        ok = math.isfinite(float(value)) and float(value) > 0.0
+    except (TypeError, ValueError):
+        ok = False
+    if not ok:
+        raise GeometryError(f"{label}: {what} must be a positive number, got {value!r}")
+
+
+def validate_assembly(
+    assembly: Assembly,
+    overlap_tolerance: float = 1e-9,
+    contact_distance: float = CONTACT_DISTANCE,
+) -> list[str]:
+    """Check every body of ``assembly`` and their overlaps; return warnings, raise on errors.
+
+    Errors (GeometryError, one line naming the body): not a polygon / holes / NaN / fewer than 3
+    vertices / self-intersection / zero or absurd area / non-convex; non-positive density or
+    thickness; unknown support role; duplicate names; no blocks; a block overlapping another block
+    or a support by more than ``overlap_tolerance`` m².
+
+    Warnings: a block farther than ``contact_distance`` m from every other body (it touches nothing);
+    two supports overlapping (supports never interact, so this is harmless but suspicious).
+
+    Overlaps are found with a shapely STRtree, so a few hundred blocks take milliseconds.
+    """
+    if assembly.block_count == 0:
+        raise GeometryError("assembly has no blocks")
+    labels: list[str] = []
+    polys: list[Polygon] = []
+    seen: dict[str, str] = {}
+    for i, block in enumerate(assembly.blocks):
+        label = body_label(i, block.name)
+        polys.append(normalise_polygon(block.polygon, i, block.name))
+        _check_positive(block.density, "density", label)
+        _check_positive(block.thickness, "thickness", label)
+        labels.append(label)
+    for j, support in enumerate(assembly.supports):
+        label = body_label(j, support.name, "support")
+        polys.append(normalise_polygon(support.polygon, j, support.name, "support"))
+        if support.role not in SUPPORT_ROLES:
+            raise GeometryError(f"{label}: role must be one of {SUPPORT_ROLES}, got {support.role!r}")
+        labels.append(label)
+    names = [b.name for b in assembly.blocks] + [s.name for s in assembly.supports]
+    for label, name in zip(labels, names):
+        if name in seen:
+            raise GeometryError(f"{label}: duplicate name, also used by {seen[name]}")
+        seen[name] = label
+
+    n_blocks = assembly.block_count
+    geoms = np.array(polys, dtype=object)
+    tree = STRtree(geoms)
+    warnings: list[str] = []
+
+    left, right = tree.query(geoms, predicate="intersects")
+    pair = left < right
+    left, right = left[pair], right[pair]
+    areas = shapely.area(shapely.intersection(geoms[left], geoms[right])) if left.size else np.zeros(0)
+    bad = []
+    for a, b, area in zip(left.tolist(), right.tolist(), areas.tolist()):
+        if area <= overlap_tolerance:
+            continue
+        if a >= n_blocks:  # support / support
+            warnings.append(f"{labels[a]} and {labels[b]} overlap by {area:.3g} m² (supports only)")
+            continue
+        bad.append((a, b, area))
+    if bad:
+        a, b, area = bad[0]
+        more = f" (and {len(bad) - 1} more overlapping pair(s))" if len(bad) > 1 else ""
+        if b < n_blocks:
+            what = f"blocks {a} (\"{names[a]}\") and {b} (\"{names[b]}\")"
+        else:
+            what = f"{labels[a]} and {labels[b]}"
+        raise GeometryError(
+            f"{what} overlap by {area:.3g} m² (tolerance {overlap_tolerance:.3g} m²){more}"
+        )
+
+    near_a, near_b = tree.query(geoms[:n_blocks], predicate="dwithin", distance=contact_distance)
+    touched = np.zeros(n_blocks, dtype=bool)
+    touched[near_a[near_a != near_b]] = True
+    for i in np.flatnonzero(~touched).tolist():
+        others = np.delete(geoms, i)
+        gap = float(shapely.distance(geoms[i], others).min()) if others.size else math.inf
+        warnings.append(
+            f"{labels[i]} touches nothing (nearest body {gap:.3g} m away, more than "
+            f"{contact_distance:g} m): it will fall freely"
+        )
+    return warnings
