@@ -1,4 +1,4 @@
-"""256-entry colour lookup tables and scalar → packed RGBA mapping (numpy only).
+"""Colour scales (numpy only): 256-entry lookup tables, scalar → packed RGBA, range rounding, labels.
 
 Rerun has no colormap for geometry, so block fills are coloured here. Colours are packed ``uint32``
 ``0xRRGGBBAA`` (what Rerun's ``Rgba32`` takes without conversion).
@@ -66,7 +66,8 @@ COOLWARM: Final = pack_rgba(make_lut(_COOLWARM_STOPS))
 NAN_RGBA: Final = int(pack_rgba(np.array([128, 128, 128])))
 
 
-def map_scalars(values: np.ndarray, lo: float, hi: float, lut: np.ndarray, nan_rgba: int = NAN_RGBA) -> np.ndarray:
+def map_scalars(values: np.ndarray, lo: float, hi: float, lut: np.ndarray,
+                nan_rgba: int = NAN_RGBA) -> np.ndarray:
     """Colours of ``values`` (any shape) on ``[lo, hi]`` (clipped): same shape, uint32 packed.
 
     ``lo`` maps to ``lut[0]``, ``hi`` to ``lut[-1]``; NaN maps to ``nan_rgba``.
@@ -92,7 +93,7 @@ def robust_max_abs(values: np.ndarray, percentile: float = 99.0) -> float:
 
 
 def nice_ceil(x: float) -> float:
-    """Smallest of 1, 1.5, 2, 2.5, 3, 4, 5, 6, 8 × 10^k that is >= x (x > 0); 0.0 for x <= 0 or not finite."""
+    """Smallest of (1, 1.5, 2, 2.5, 3, 4, 5, 6, 8) × 10^k that is >= x > 0; 0.0 for x <= 0 or not finite."""
     if not (x > 0.0 and math.isfinite(x)):
         return 0.0
     e = math.floor(math.log10(x))
@@ -101,3 +102,29 @@ def nice_ceil(x: float) -> float:
         if v >= x * (1.0 - 1e-12):
             return v
     return 10.0 ** (e + 1)
+
+
+def tick_label(value: float, unit: str, span: float, signed: bool) -> str:
+    """Legend label: 3 significant digits, explicit sign on a signed scale, Pa with a prefix from ``span``."""
+    scale, prefix = 1.0, ""
+    if unit == "Pa":
+        prefixes = ((1e9, "G"), (1e6, "M"), (1e3, "k"))
+        scale, prefix = next(((s, p) for s, p in prefixes if span >= s), (1.0, ""))
+    x = value / scale
+    text = f"{x:+.3g}" if signed and x != 0 else f"{x:.3g}"
+    return f"{text} {prefix}{unit}".strip()
+
+
+def colorbar_mesh(box: tuple[float, float, float, float], lut: np.ndarray, segments: int = 32):
+    """A vertical colour bar filling ``box`` = (x0, y0, x1, y1), ``lut[0]`` at the bottom.
+
+    Returns vertices (2 (segments+1), 2), triangles (2 segments, 3) uint32 and per-vertex colours.
+    """
+    x0, y0, x1, y1 = box
+    verts = np.zeros((segments + 1, 2, 2))
+    verts[:, :, 0] = x0, x1
+    verts[:, :, 1] = np.linspace(y0, y1, segments + 1)[:, None]
+    colors = np.repeat(lut[np.rint(np.linspace(0, len(lut) - 1, segments + 1)).astype(int)], 2)
+    j = 2 * np.arange(segments)
+    tri = np.concatenate([np.stack([j, j + 1, j + 3], 1), np.stack([j, j + 3, j + 2], 1)]).astype(np.uint32)
+    return verts.reshape(-1, 2), tri, colors

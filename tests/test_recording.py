@@ -159,8 +159,8 @@ def test_array_shapes_per_frame(written):
     tri = temporal_rows(path, "/structure/plane/xy/triangulation", "LineStrips2D:strips")
     hover_p = temporal_rows(path, "/structure/plane/xy/blocks", "p")
     for f in FIELDS:
-        verts = temporal_rows(path, f"/structure/fields/{f.short}", "Mesh3D:vertex_positions")
-        colors = temporal_rows(path, f"/structure/fields/{f.short}", "Mesh3D:vertex_colors")
+        verts = temporal_rows(path, f"/{f.fill}", "Mesh3D:vertex_positions")
+        colors = temporal_rows(path, f"/{f.fill}", "Mesh3D:vertex_colors")
         assert {len(v) for v in verts.values()} == {n_vert} and {len(c) for c in colors.values()} == {n_vert}
         assert len(verts) == N_FRAMES
     for step, frame in by_step.items():
@@ -279,12 +279,13 @@ def test_legend_and_run_document(written):
     for f in FIELDS:
         lo, hi = rec.field_ranges[f.key]
         assert f"{lo:.4g} … {hi:.4g}" in doc
-        labels = static_value(path, f"/structure/plane/xy/legend/{f.short}", "Points2D:labels")
+        labels = static_value(path, f"/{f.labels}", "Points2D:labels")
         assert len(labels) == 3 and f.title in labels[-1]
 
 
 # ------------------------------------------------------------------------------- closing and errors
-@pytest.mark.parametrize("exc, status", [(RuntimeError("boom"), "failed"), (KeyboardInterrupt(), "interrupted")])
+@pytest.mark.parametrize("exc, status", [(RuntimeError("boom"), "failed"),
+                                         (KeyboardInterrupt(), "interrupted")])
 def test_recording_is_complete_after_an_exception(wall, tmp_path, exc, status):
     static, q0 = wall
     frames = fx.frames(static, q0, 15)
@@ -299,9 +300,9 @@ def test_recording_is_complete_after_an_exception(wall, tmp_path, exc, status):
     assert f"{status} at t = 0.140 s (step 140)" in info["metadata"]
     if status == "failed":
         assert "RuntimeError: boom" in info["metadata"]
-    verify = subprocess.run([os.path.join(os.path.dirname(sys.executable), "rerun"), "rrd", "verify", str(path)],
-                            capture_output=True, text=True, timeout=120,
-                            env={**os.environ, "RERUN_ANALYTICS": "0"})
+    rerun_cli = os.path.join(os.path.dirname(sys.executable), "rerun")
+    verify = subprocess.run([rerun_cli, "rrd", "verify", str(path)], capture_output=True, text=True,
+                            timeout=120, env={**os.environ, "RERUN_ANALYTICS": "0"})
     assert verify.returncode == 0, verify.stderr
 
 
@@ -370,6 +371,8 @@ def test_colormap_lookup():
 
 
 def test_nice_ceil_and_robust_max():
-    assert [cm.nice_ceil(x) for x in (0.0, 0.9, 1.0, 1.2, 2.7, 7.0, 1.1e5)] == [0.0, 1.0, 1.0, 1.5, 3.0, 8.0, 1.5e5]
+    values = (0.0, 0.9, 1.0, 1.2, 2.7, 7.0, 1.1e5)
+    assert [cm.nice_ceil(x) for x in values] == [0.0, 1.0, 1.0, 1.5, 3.0, 8.0, 1.5e5]
     assert cm.robust_max_abs(np.array([np.nan, -3.0, 1.0]), 100) == 3.0
     assert cm.robust_max_abs(np.array([np.nan])) == 0.0
+
