@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import dataclasses
 import functools
+import os
 import sys
 from pathlib import Path
 from typing import Annotated, Optional
@@ -30,6 +31,7 @@ err_console = Console(stderr=True)
 EXIT_BAD_INPUT = 2
 EXIT_INTERRUPTED = 130
 EXIT_DIVERGED = 3
+EXIT_INTERNAL = 1
 
 
 def _fail(message: str) -> None:
@@ -146,6 +148,15 @@ def _execute(scenario, out: Optional[Path], history: Optional[Path]) -> None:
         err_console.print("interrupted: the recording and history hold every frame computed so far"
                           + (f" ({out})" if out else ""))
         raise typer.Exit(EXIT_INTERRUPTED)
+    except (InputError, GeometryError):
+        raise
+    except Exception as exc:  # an engine bug: say so in one line, keep what was computed
+        if os.environ.get("MASONRY_DEBUG"):
+            raise
+        err_console.print(f"[bold red]internal error:[/bold red] {type(exc).__name__}: {exc} — the recording"
+                          " and history hold every frame computed before it (MASONRY_DEBUG=1 shows the"
+                          " traceback)", highlight=False, soft_wrap=True)
+        raise typer.Exit(EXIT_INTERNAL)
     print_summary(console, result, scenario, out, history)
     if result.status == "diverged":
         raise typer.Exit(EXIT_DIVERGED)

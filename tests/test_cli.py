@@ -132,3 +132,52 @@ def test_sigint_leaves_a_readable_recording(tmp_path):
     reader = rr.chunk.RrdReader(str(rrd))
     assert reader.recordings()[0].application_id == "masonry"
     reader.store().schema().column_names()  # needs the footer
+
+
+def _frames_in(rrd: Path) -> int:
+    import rerun as rr
+
+    reader = rr.chunk.RrdReader(str(rrd))
+    assert reader.recordings()[0].application_id == "masonry"
+    steps = set()
+    for chunk in reader.stream():
+        if chunk.is_static:
+            continue
+        batch = chunk.to_record_batch()
+        if "step" in batch.schema.names:
+            steps.update(batch.column("step").to_pylist())
+    return len(steps)
+
+
+def test_divergence_leaves_complete_outputs(tmp_path, monkeypatch):
+    import masonrycli.run as run_module
+
+    monkeypatch.setattr(run_module, "DIVERGENCE_SPEED", 0.05)  # the shaken wall exceeds it quickly
+    rrd, npz = tmp_path / "div.rrd", tmp_path / "div.npz"
+    result = invoke("simulate", "wall", "--duration", 0.5, "--out", rrd, "--history", npz)
+    assert result.exit_code == 3, result.output
+    assert "diverged" in result.output
+    h = np.load(npz)
+    assert str(h["status"]) == "diverged"
+    assert _frames_in(rrd) == len(h["time"])
+
+
+def test_engine_error_mid_run_keeps_frames(tmp_path, monkeypatch):
+    from masonrycli.run import Simulation
+
+    original = Simulation.step
+
+    def failing(self):
+        if self.state.step == 25:
+            raise FloatingPointError("synthetic failure")
+        return original(self)
+
+    monkeypatch.setattr(Simulation, "step", failing)
+    rrd, npz = tmp_path / "err.rrd", tmp_path / "err.npz"
+    result = invoke("simulate", "wall", "--duration", 0.1, "--out", rrd, "--history", npz)
+    assert result.exit_code == 1, result.output
+    assert "Traceback" not in result.output and "synthetic failure" in result.output
+    h = np.load(npz)
+    assert str(h["status"]) == "error"
+    assert list(h["step"]) == [0, 10, 20]
+    assert _frames_in(rrd) == 3
