@@ -204,9 +204,7 @@ def _uniform_strips(points: np.ndarray) -> pa.Array:
 
 def _z0(verts: np.ndarray) -> np.ndarray:
     """(..., 2) -> (n, 3) float32 with z = 0."""
-    out = np.zeros((*verts.shape[:-1], 3), dtype=np.float32)
-    out[..., :2] = verts
-    return out.reshape(-1, 3)
+    return np.pad(np.asarray(verts, dtype=np.float32).reshape(-1, 2), ((0, 0), (0, 1)))
 
 
 _per_frame = np.full  # (n_frames, instances per frame) -> partition lengths
@@ -262,8 +260,7 @@ class Recorder:
         self.axis_scale: dict[str, float] = {}
         self._legends: set[str] = set()
         self._legend_box = (0.0, 0.0, 0.0, 0.0)
-        self._frames = 0
-        self._last: tuple[int, float] | None = None
+        self._frames, self._last = 0, None  # frames logged; (step, time) of the last one
         self._ref: tuple[np.ndarray, np.ndarray, float] | None = None  # first block_q, support_q, E_pot
         self._batch = _Batch()
         meta_json = json.dumps(self.metadata, sort_keys=True, default=str)
@@ -646,8 +643,11 @@ def build_blueprint(main_field: str = "cell_spherical_stress") -> rrb.Blueprint:
         active_tab=0,
     )
 
+    whole_run = rrb.TimeAxis(view_range=rrb.TimeRange(rrb.TimeRangeBoundary.infinite(),
+                                                      rrb.TimeRangeBoundary.infinite()))
+
     def plot(key: str, name: str) -> rrb.TimeSeriesView:
-        return rrb.TimeSeriesView(origin=f"/{SERIES[key]}", name=name)
+        return rrb.TimeSeriesView(origin=f"/{SERIES[key]}", name=name, axis_x=whole_run)
 
     right = rrb.Vertical(
         rrb.Tabs(plot("energy", "Energy (J)"), plot("max_displacement", "Max block displacement (m)"),
