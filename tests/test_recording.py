@@ -376,3 +376,25 @@ def test_nice_ceil_and_robust_max():
     assert cm.robust_max_abs(np.array([np.nan, -3.0, 1.0]), 100) == 3.0
     assert cm.robust_max_abs(np.array([np.nan])) == 0.0
 
+
+
+def test_interrupt_in_the_middle_of_a_flush_still_leaves_a_complete_file(wall, tmp_path):
+    static, q0 = wall
+    path = tmp_path / "mid_flush.rrd"
+    with pytest.raises(KeyboardInterrupt):
+        with Recorder(path, static, fx.METADATA, batch_frames=5) as rec:
+            send, calls = rec.rec.send_columns, []
+
+            def flaky_send(*args, **kwargs):
+                if rec._frames == 10:  # flushing the second batch
+                    calls.append(args[0])
+                    if len(calls) == 9:  # part-way through its entities
+                        raise KeyboardInterrupt
+                return send(*args, **kwargs)
+
+            rec.rec.send_columns = flaky_send
+            for f in fx.frames(static, q0, 12):
+                rec.log_frame(f)
+    info = inspect_recording(path)
+    assert info["complete"] and "interrupted at t = 0.090 s (step 90)" in info["metadata"]
+    assert info["frames"] == 10  # the first batch, then as much of the second as was sent: no duplicates
