@@ -1,0 +1,290 @@
+"""Reading and writing assemblies: GeoJSON and WKT.
+
+GeoJSON
+-------
+A ``FeatureCollection`` with one ``Polygon`` feature per body (coordinates in metres, exterior ring
+only). Feature properties:
+
+=================  =========================================================================
+``role``           ``"block"`` (default) or ``"support"``
+``name``           unique label (default ``block-<i>`` / ``support-<j>``)
+``density``        kg/m³, blocks only (default: the reader's ``density`` argument)
+``thickness``      m, blocks only (default: the reader's ``thickness`` argument)
+``velocity``       [vx, vy, ω] initial velocity, blocks only (default [0, 0, 0])
+``support_role``   ``"fixed"`` (default) or ``"driven"``, supports only
+=================  =========================================================================
+
+Blocks keep the order of their features, supports too. :func:`write_geojson` writes the same
+format with full float precision, so ``read_geojson(write_geojson(a))`` gives back ``a``.
+
+WKT
+---
+One body per line; blank lines and lines starting with ``#`` are ignored. A line is a WKT
+geometry, optionally preceded by a label and a colon::
+
+    POLYGON ((0 0, 0.3 0, 0.3 0.2, 0 0.2, 0 0))            # block "block-<i>"
+    c01-b01: POLYGON ((...))                                # block "c01-b01"
+    block c01-b02: POLYGON ((...))
+    support ground fixed: POLYGON ((...))                   # support, role fixed or driven
+
+A ``MULTIPOLYGON`` or ``GEOMETRYCOLLECTION`` of polygons gives one block per member (named
+``<label>-<k>`` when labelled); the whole file may also be one such geometry spread over lines.
+WKT carries no density or thickness: the reader's arguments apply to every block.
+
+Errors are one-line :class:`GeometryError` messages naming the file and the feature / line.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import re
+from pathlib import Path
+
+import numpy as np
+import shapely
+import shapely.wkt
+from shapely.geometry import GeometryCollection, MultiPolygon, Polygon
+
+from .blocks import SUPPORT_ROLES, Assembly, Block, GeometryError, Support
+from .checks import polygon_from_coords
+
+_LABEL = re.compile(
+    r"^\s*(?:(?P<role>block|support)\s+)?(?P<name>[^\s:]+)(?:\s+(?P<srole>fixed|driven))?\s*:\s*(?P<wkt>.+)$",
+    re.IGNORECASE,
+)
+
+
+def _read_text(path: Path) -> str:
+    try:
+        return path.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as exc:
+        raise GeometryError(f"{path}: cannot read file ({exc.__class__.__name__}: {exc})") from None
+
+
+def _number(value, what: str, where: str) -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) or value <= 0:
+        raise GeometryError(f"{where}: {what} must be a positive number, got {value!r}")
+    return float(value)
+
+
+def _velocity(value, where: str) -> tuple[float, float, float]:
+    try:
+        v = tuple(float(x) for x in value)
+    except (TypeError, ValueError):
+        v = ()
+    if len(v) != 3 or not all(math.isfinite(x) for x in v):
+        raise GeometryError(f"{where}: velocity must be [vx, vy, omega], got {value!r}")
+    return v
+
+
+def read_geojson(path, density: float = 2500.0, thickness: float = 1.0) -> Assembly:
+    """Read an assembly from a GeoJSON FeatureCollection (format in the module docstring).
+
+    Parameters
+    ----------
+    path : str or Path.
+    density : kg/m³, thickness : m — defaults for blocks without those properties.
+
+    Raises
+    ------
+    GeometryError — unreadable file, bad JSON, not a FeatureCollection, a feature that is not a
+    Polygon, has holes, bad properties, or a polygon failing the checks of
+    :func:`~geometry_library.checks.polygon_from_coords` (named by file, feature, body).
+    """
+    path = Path(path)
+    text = _read_text(path)
+    try:
+        data = json.loads(text)
+    except json.JSONDecodeError as exc:
+        raise GeometryError(f"{path}: invalid JSON ({exc.msg} at line {exc.lineno}, column {exc.colno})") from None
+    if not isinstance(data, dict) or data.get("type") != "FeatureCollection":
+        got = data.get("type") if isinstance(data, dict) else type(data).__name__
+        raise GeometryError(f"{path}: expected a GeoJSON FeatureCollection, got {got!r}")
+    features = data.get("features")
+    if not isinstance(features, list):
+        raise GeometryError(f"{path}: FeatureCollection has no 'features' list")
+    blocks: list[Block] = []
+    supports: list[Support] = []
+    for k, feature in enumerate(features):
+        where = f"{path}: feature {k}"
+        if not isinstance(feature, dict) or feature.get("type") != "Feature":
+            raise GeometryError(f"{where}: not a GeoJSON Feature")
+        props = feature.get("properties") or {}
+        if not isinstance(props, dict):
+            raise GeometryError(f"{where}: 'properties' must be an object")
+        role = props.get("role", "block")
+        if role not in ("block", "support"):
+            raise GeometryError(f"{where}: role must be 'block' or 'support', got {role!r}")
+        index = len(blocks) if role == "block" else len(supports)
+        name = str(props.get("name", f"{role}-{index}"))
+        where = f'{where} ({role} {index} "{name}")'
+        geometry = feature.get("geometry")
+        gtype = geometry.get("type") if isinstance(geometry, dict) else None
+        if gtype != "Polygon":
+            raise GeometryError(f"{where}: geometry must be a Polygon, got {gtype!r}")
+        rings = geometry.get("coordinates")
+        if not isinstance(rings, list) or not rings:
+            raise GeometryError(f"{where}: Polygon has no coordinates")
+        if len(rings) > 1:
+            raise GeometryError(f"{where}: polygon has {len(rings) - 1} hole(s); blocks are solid")
+        try:
+            coords = np.array([[float(c) for c in xy[:2]] for xy in rings[0]], dtype=np.float64)
+        except (TypeError, ValueError, IndexError):
+            raise GeometryError(f"{where}: coordinates must be [x, y] number pairs") from None
+        try:
+            polygon = polygon_from_coords(coords, index, name, role)
+        except GeometryError as exc:
+            raise GeometryError(f"{path}: feature {k}: {exc}") from None
+        if role == "block":
+            blocks.append(
+                Block(
+                    polygon,
+                    name,
+                    _number(props.get("density", density), "density", where),
+                    _number(props.get("thickness", thickness), "thickness", where),
+                    _velocity(props.get("velocity", (0.0, 0.0, 0.0)), where),
+                )
+            )
+        else:
+            srole = props.get("support_role", "fixed")
+            if srole not in SUPPORT_ROLES:
+                raise GeometryError(f"{where}: support_role must be one of {SUPPORT_ROLES}, got {srole!r}")
+            supports.append(Support(polygon, name, srole))
+    return Assembly(tuple(blocks), tuple(supports))
+
+
+def _ring_coords(polygon: Polygon) -> list[list[float]]:
+    """Closed CCW exterior ring as [[x, y], ...] (RFC 7946 orientation)."""
+    xy = shapely.geometry.polygon.orient(polygon, sign=1.0).exterior.coords
+    return [[float(x), float(y)] for x, y in np.asarray(xy)[:, :2]]
+
+
+def write_geojson(assembly: Assembly, path) -> Path:
+    """Write ``assembly`` as a GeoJSON FeatureCollection (full precision); returns the path."""
+    path = Path(path)
+    features = []
+    for block in assembly.blocks:
+        props = {"role": "block", "name": block.name, "density": block.density, "thickness": block.thickness}
+        if any(v != 0.0 for v in block.velocity):
+            props["velocity"] = [float(v) for v in block.velocity]
+        features.append(_feature(block.polygon, props))
+    for support in assembly.supports:
+        props = {"role": "support", "name": support.name, "support_role": support.role}
+        features.append(_feature(support.polygon, props))
+    data = {"type": "FeatureCollection", "features": features}
+    try:
+        path.write_text(json.dumps(data, indent=1) + "\n", encoding="utf-8")
+    except OSError as exc:
+        raise GeometryError(f"{path}: cannot write file ({exc})") from None
+    return path
+
+
+def _feature(polygon: Polygon, props: dict) -> dict:
+    return {
+        "type": "Feature",
+        "properties": props,
+        "geometry": {"type": "Polygon", "coordinates": [_ring_coords(polygon)]},
+    }
+
+
+def _polygons_of(geom, where: str) -> list[Polygon]:
+    if isinstance(geom, Polygon):
+        return [geom]
+    if isinstance(geom, (MultiPolygon, GeometryCollection)):
+        out = []
+        for member in geom.geoms:
+            if not isinstance(member, Polygon):
+                raise GeometryError(f"{where}: collection member must be a POLYGON, got {member.geom_type}")
+            out.append(member)
+        return out
+    raise GeometryError(f"{where}: geometry must be a POLYGON, MULTIPOLYGON or GEOMETRYCOLLECTION, got {geom.geom_type}")
+
+
+def _parse_wkt(text: str, where: str):
+    try:
+        return shapely.wkt.loads(text)
+    except Exception as exc:  # shapely raises GEOSException / ValueError variants
+        msg = str(exc).splitlines()[0] if str(exc) else exc.__class__.__name__
+        raise GeometryError(f"{where}: cannot parse WKT ({msg})") from None
+
+
+def read_wkt(path, density: float = 2500.0, thickness: float = 1.0) -> Assembly:
+    """Read an assembly from a WKT file (format in the module docstring).
+
+    Raises
+    ------
+    GeometryError — unreadable file, unparsable WKT, wrong geometry type, holes, or a polygon failing
+    the checks of :func:`~geometry_library.checks.polygon_from_coords` (named by file, line, body).
+    """
+    path = Path(path)
+    _number(density, "density", str(path))
+    _number(thickness, "thickness", str(path))
+    lines = [
+        (n, line.strip())
+        for n, line in enumerate(_read_text(path).splitlines(), start=1)
+        if line.strip() and not line.lstrip().startswith("#")
+    ]
+    if not lines:
+        raise GeometryError(f"{path}: no geometry in file")
+    entries: list[tuple[str, str | None, str | None, str | None, str]] = []  # where, role, name, srole, wkt
+    first = lines[0][1].upper()
+    if first.startswith(("GEOMETRYCOLLECTION", "MULTIPOLYGON")) and len(lines) > 1 and not _complete(lines[0][1]):
+        entries.append((f"{path}: line {lines[0][0]}", None, None, None, " ".join(t for _, t in lines)))
+    else:
+        for n, line in lines:
+            m = _LABEL.match(line)
+            if m and not line.upper().startswith(("POLYGON", "MULTIPOLYGON", "GEOMETRYCOLLECTION")):
+                entries.append((f"{path}: line {n}", m["role"], m["name"], m["srole"], m["wkt"]))
+            else:
+                entries.append((f"{path}: line {n}", None, None, None, line))
+    blocks: list[Block] = []
+    supports: list[Support] = []
+    for where, role, name, srole, text in entries:
+        role = (role or ("support" if srole else "block")).lower()
+        polys = _polygons_of(_parse_wkt(text, where), where)
+        if role == "support" and len(polys) != 1:
+            raise GeometryError(f"{where}: a support must be a single POLYGON")
+        for k, poly in enumerate(polys):
+            index = len(blocks) if role == "block" else len(supports)
+            label = name if len(polys) == 1 or name is None else f"{name}-{k + 1}"
+            label = label or f"{role}-{index}"
+            if poly.is_empty:
+                raise GeometryError(f'{where}: {role} {index} ("{label}"): polygon is empty')
+            if poly.interiors:
+                raise GeometryError(f'{where}: {role} {index} ("{label}"): polygon has holes; blocks are solid')
+            try:
+                polygon = polygon_from_coords(np.asarray(poly.exterior.coords)[:, :2], index, label, role)
+            except GeometryError as exc:
+                raise GeometryError(f"{where}: {exc}") from None
+            if role == "block":
+                blocks.append(Block(polygon, label, float(density), float(thickness)))
+            else:
+                supports.append(Support(polygon, label, (srole or "fixed").lower()))
+    return Assembly(tuple(blocks), tuple(supports))
+
+
+def _complete(text: str) -> bool:
+    """True if the parentheses of a WKT text are balanced (one complete geometry on the line)."""
+    return text.count("(") == text.count(")") and "(" in text
+
+
+def _wkt_polygon(polygon: Polygon) -> str:
+    ring = ", ".join(f"{x!r} {y!r}" for x, y in _ring_coords(polygon))
+    return f"POLYGON (({ring}))"
+
+
+def write_wkt(assembly: Assembly, path) -> Path:
+    """Write ``assembly`` as labelled WKT lines (full precision; density/thickness are not kept)."""
+    path = Path(path)
+    for body in (*assembly.blocks, *assembly.supports):
+        if not body.name or re.search(r"[\s:]", body.name):
+            raise GeometryError(f'{path}: name "{body.name}" cannot be written to WKT (spaces or colons)')
+    lines = ["# masonry assembly: one body per line, '<role> <name> [support role]: <WKT>'"]
+    lines += [f"block {b.name}: {_wkt_polygon(b.polygon)}" for b in assembly.blocks]
+    lines += [f"support {s.name} {s.role}: {_wkt_polygon(s.polygon)}" for s in assembly.supports]
+    try:
+        path.write_text("\n".join(lines) + "\n", encoding="utf-8")
+    except OSError as exc:
+        raise GeometryError(f"{path}: cannot write file ({exc})") from None
+    return path

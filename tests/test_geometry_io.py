@@ -1,0 +1,162 @@
+"""GeoJSON / WKT reading and writing: round trips and one-line errors naming file and feature."""
+
+import json
+
+import numpy as np
+import pytest
+from shapely.geometry import box
+
+from geometry_library import (
+    Assembly,
+    Block,
+    GeometryError,
+    Support,
+    build_arch,
+    read_geojson,
+    read_wkt,
+    write_geojson,
+    write_wkt,
+)
+
+
+def same_assembly(a: Assembly, b: Assembly, *, materials: bool = True) -> None:
+    assert [x.name for x in a.blocks] == [x.name for x in b.blocks]
+    assert [(s.name, s.role) for s in a.supports] == [(s.name, s.role) for s in b.supports]
+    for x, y in zip(a.blocks + a.supports, b.blocks + b.supports):
+        np.testing.assert_array_equal(x.vertices, y.vertices)
+    if materials:
+        for x, y in zip(a.blocks, b.blocks):
+            assert (x.density, x.thickness, x.velocity) == (y.density, y.thickness, y.velocity)
+
+
+def test_geojson_round_trip_is_exact(tmp_path):
+    arch = build_arch()
+    blocks = list(arch.blocks)
+    blocks[3] = Block(blocks[3].polygon, blocks[3].name, 2100.0, 0.6, (0.1, -0.2, 0.3))
+    original = Assembly(tuple(blocks), (arch.supports[0], Support(arch.supports[1].polygon, "right-foundation", "driven")))
+    path = write_geojson(original, tmp_path / "arch.geojson")
+    data = json.loads(path.read_text())
+    assert data["type"] == "FeatureCollection" and len(data["features"]) == 100
+    assert data["features"][-1]["properties"] == {
+        "role": "support",
+        "name": "right-foundation",
+        "support_role": "driven",
+    }
+    same_assembly(original, read_geojson(path))
+
+
+def feature(coords, **props):
+    return {"type": "Feature", "properties": props, "geometry": {"type": "Polygon", "coordinates": [coords]}}
+
+
+def write(tmp_path, features, name="in.geojson"):
+    path = tmp_path / name
+    path.write_text(json.dumps({"type": "FeatureCollection", "features": features}))
+    return path
+
+
+SQ = [[0, 0], [1, 0], [1, 1], [0, 1], [0, 0]]
+
+
+def test_geojson_defaults_and_properties(tmp_path):
+    path = write(
+        tmp_path,
+        [
+            feature([[0, 0], [4, 0], [4, -1], [0, -1], [0, 0]], role="support", name="pad"),
+            feature(SQ),
+            feature([[0, 1], [1, 1], [1, 2], [0, 2], [0, 1]], name="top", density=2000, thickness=0.5),
+        ],
+    )
+    a = read_geojson(path, density=1800.0, thickness=0.8)
+    assert [(b.name, b.density, b.thickness) for b in a.blocks] == [("block-0", 1800.0, 0.8), ("top", 2000.0, 0.5)]
+    assert [(s.name, s.role) for s in a.supports] == [("pad", "fixed")]
+    assert a.supports[0].polygon.exterior.is_ccw
+
+
+def one_line_error(fn, *args):
+    with pytest.raises(GeometryError) as info:
+        fn(*args)
+    text = str(info.value)
+    assert "\n" not in text
+    return text
+
+
+def test_geojson_errors_name_file_and_feature(tmp_path):
+    missing = one_line_error(read_geojson, tmp_path / "nope.geojson")
+    assert "nope.geojson: cannot read file" in missing
+
+    bad_json = tmp_path / "bad.geojson"
+    bad_json.write_text("{ not json")
+    assert "bad.geojson: invalid JSON" in one_line_error(read_geojson, bad_json)
+
+    not_fc = tmp_path / "fc.geojson"
+    not_fc.write_text(json.dumps({"type": "Feature"}))
+    assert "expected a GeoJSON FeatureCollection" in one_line_error(read_geojson, not_fc)
+
+    point = {"type": "Feature", "properties": {"name": "p"}, "geometry": {"type": "Point", "coordinates": [0, 0]}}
+    text = one_line_error(read_geojson, write(tmp_path, [feature(SQ), point], "pt.geojson"))
+    assert "pt.geojson: feature 1" in text and "must be a Polygon, got 'Point'" in text
+
+    concave = [[0, 0], [2, 0], [2, 2], [1, 0.5], [0, 2], [0, 0]]
+    text = one_line_error(read_geojson, write(tmp_path, [feature(SQ), feature(concave, name="c3-b2")], "cc.geojson"))
+    assert text.startswith(str(tmp_path / "cc.geojson") + ': feature 1: block 1 ("c3-b2"): polygon is not convex')
+
+    holed = {"type": "Feature", "properties": {"name": "h"}, "geometry": {"type": "Polygon", "coordinates": [SQ, SQ]}}
+    assert "hole" in one_line_error(read_geojson, write(tmp_path, [holed], "h.geojson"))
+
+    text = one_line_error(read_geojson, write(tmp_path, [feature(SQ, role="support", support_role="wobbly")], "r.geojson"))
+    assert "feature 0" in text and "support_role" in text
+
+    text = one_line_error(read_geojson, write(tmp_path, [feature(SQ, density="heavy")], "d.geojson"))
+    assert "feature 0" in text and "density" in text
+
+
+def test_wkt_lines_labels_and_supports(tmp_path):
+    path = tmp_path / "blocks.wkt"
+    path.write_text(
+        "# two blocks and a ground\n"
+        "POLYGON ((0 0, 1 0, 1 1, 0 1, 0 0))\n"
+        "\n"
+        "top: POLYGON ((0 1, 1 1, 1 2, 0 2, 0 1))\n"
+        "support ground driven: POLYGON ((-2 -1, 3 -1, 3 0, -2 0, -2 -1))\n"
+    )
+    a = read_wkt(path, density=2000.0)
+    assert [b.name for b in a.blocks] == ["block-0", "top"]
+    assert a.blocks[0].density == 2000.0
+    assert [(s.name, s.role) for s in a.supports] == [("ground", "driven")]
+
+
+def test_wkt_collection_file_and_multipolygon(tmp_path):
+    path = tmp_path / "multi.wkt"
+    path.write_text("MULTIPOLYGON (((0 0, 1 0, 1 1, 0 1, 0 0)),\n ((1 0, 2 0, 2 1, 1 1, 1 0)))\n")
+    assert read_wkt(path).block_count == 2
+    path.write_text(
+        "GEOMETRYCOLLECTION (POLYGON ((0 0, 1 0, 1 1, 0 1, 0 0)), POLYGON ((1 0, 2 0, 2 1, 1 1, 1 0)),"
+        " POLYGON ((0 1, 1 1, 1 2, 0 2, 0 1)))"
+    )
+    assert [b.name for b in read_wkt(path).blocks] == ["block-0", "block-1", "block-2"]
+
+
+def test_wkt_round_trip(tmp_path):
+    arch = build_arch()
+    back = read_wkt(write_wkt(arch, tmp_path / "arch.wkt"))
+    same_assembly(arch, back)
+
+
+def test_wkt_errors_name_file_and_line(tmp_path):
+    path = tmp_path / "bad.wkt"
+    path.write_text("POLYGON ((0 0, 1 0, 1 1, 0 1, 0 0))\nPOLYGON ((0 0, 1 0\n")
+    text = one_line_error(read_wkt, path)
+    assert "bad.wkt: line 2: cannot parse WKT" in text
+    path.write_text("POLYGON ((0 0, 1 0, 1 1, 0 1, 0 0))\nLINESTRING (0 0, 1 1)\n")
+    assert "line 2" in one_line_error(read_wkt, path)
+    path.write_text("a: POLYGON ((0 0, 1 0, 1 1, 0 1, 0 0))\nc3-b2: POLYGON ((0 0, 2 0, 2 2, 1 0.5, 0 2, 0 0))\n")
+    assert 'line 2: block 1 ("c3-b2"): polygon is not convex' in one_line_error(read_wkt, path)
+    with pytest.raises(GeometryError, match="cannot read file"):
+        read_wkt(tmp_path / "missing.wkt")
+
+
+def test_write_wkt_rejects_names_it_cannot_label(tmp_path):
+    a = Assembly((Block(box(0, 0, 1, 1), "has space"),))
+    with pytest.raises(GeometryError, match="cannot be written to WKT"):
+        write_wkt(a, tmp_path / "x.wkt")
