@@ -682,21 +682,8 @@ def test_scenario_from_builder(fake_builders):
         scenario_from_builder("fake", {"height": math.nan}, RunConfig(), Material(), {})
 
 
-def _real_builders():
-    registry = getattr(builders_pkg, "BUILDERS", None)
-    if not registry:
-        try:
-            from geometry_library.builders import BUILDERS as registry
-        except ImportError:
-            registry = None
-    return registry or {}
-
-
 @pytest.mark.parametrize("name", ["wall", "arch", "aqueduct"])
 def test_real_builders_round_trip(name):
-    registry = _real_builders()
-    if name not in registry:
-        pytest.skip(f"geometry_library builder {name!r} not available yet")
     s = scenario_from_builder(name, {}, RunConfig(), Material(), {})
     assert s.assembly.block_count > 0 and len(s.motions) == s.assembly.support_count
     text = dump_scenario(s)
@@ -706,9 +693,6 @@ def test_real_builders_round_trip(name):
 
 
 def test_real_wall_builder_from_file(tmp_path):
-    registry = _real_builders()
-    if "wall" not in registry:
-        pytest.skip("geometry_library wall builder not available yet")
     s = load_scenario(write(tmp_path, '[structure]\nbuilder = "wall"\n'))
     assert s.structure == {"builder": "wall"} and s.assembly.block_count > 0
     assert os.path.basename(s.source) == "wall.toml"
@@ -722,8 +706,6 @@ def test_real_wall_builder_from_file(tmp_path):
     ],
 )
 def test_paper_builder_scenarios(file, builder, blocks, motions):
-    if builder not in _real_builders():
-        pytest.skip(f"geometry_library builder {builder!r} not available yet")
     s = load_scenario(DATA / file)
     assert s.structure["builder"] == builder and s.assembly.block_count == blocks
     for support, motion in zip(s.assembly.supports, s.motions):
