@@ -29,7 +29,6 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 os.environ.setdefault("RERUN_ANALYTICS", "0")
 
-import numpy as np  # noqa: E402
 
 from masonrycli.engine import nlgs  # noqa: E402
 from masonrycli.engine import solver as solver_module  # noqa: E402
@@ -187,8 +186,8 @@ def main() -> None:
         results["ratio_ns_per_contact_sweep_248_over_51"] = (
             rows["wall-248"]["ns_per_contact_sweep"] / rows["wall-51"]["ns_per_contact_sweep"])
 
-    print(f"| case | wall-clock per simulated s | sweeps/step | contacts/step | ns per contact·sweep | "
-          f"tensors share | recording share | peak RSS |")
+    print("| case | wall-clock per simulated s | sweeps/step | contacts/step | ns per contact·sweep | "
+          "tensors share | recording share | peak RSS |")
     print("|---|---|---|---|---|---|---|---|")
     for case, r in rows.items():
         print(f"| {case} | {r['wall_per_sim_s']:.2f} s (runs {r['runs']}) | {r['sweeps_per_step']:.1f} | "

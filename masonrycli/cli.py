@@ -7,7 +7,7 @@ import functools
 import os
 import sys
 from pathlib import Path
-from typing import Annotated, Optional
+from typing import Annotated
 
 import typer
 from rich.console import Console
@@ -70,32 +70,32 @@ def main_callback(
 
 # -- shared options -------------------------------------------------------------------------------
 
-Duration = Annotated[Optional[float], typer.Option(help="Simulated time, s.", rich_help_panel="Run")]
-Dt = Annotated[Optional[float], typer.Option("--dt", help="Time step, s (default 1e-3).", rich_help_panel="Run")]
-Theta = Annotated[Optional[float], typer.Option(help="Moreau–Jean θ in [0.5, 1] (default 0.5).",
+Duration = Annotated[float | None, typer.Option(help="Simulated time, s.", rich_help_panel="Run")]
+Dt = Annotated[float | None, typer.Option("--dt", help="Time step, s (default 1e-3).", rich_help_panel="Run")]
+Theta = Annotated[float | None, typer.Option(help="Moreau–Jean θ in [0.5, 1] (default 0.5).",
                                                 rich_help_panel="Run")]
-Friction = Annotated[Optional[float], typer.Option(help="Coulomb coefficient of every contact (default 0.6).",
+Friction = Annotated[float | None, typer.Option(help="Coulomb coefficient of every contact (default 0.6).",
                                                    rich_help_panel="Material")]
-Density = Annotated[Optional[float], typer.Option(help="Block density, kg/m³ (default 2500).",
+Density = Annotated[float | None, typer.Option(help="Block density, kg/m³ (default 2500).",
                                                   rich_help_panel="Material")]
-Thickness = Annotated[Optional[float], typer.Option(help="Out-of-plane thickness, m (default 1).",
+Thickness = Annotated[float | None, typer.Option(help="Out-of-plane thickness, m (default 1).",
                                                     rich_help_panel="Material")]
-RecordEvery = Annotated[Optional[int], typer.Option(help="Steps between recorded frames (default 10).",
+RecordEvery = Annotated[int | None, typer.Option(help="Steps between recorded frames (default 10).",
                                                     rich_help_panel="Run")]
-Tolerance = Annotated[Optional[float], typer.Option(help="NLGS tolerance, relative quadratic norm (default 1.666e-4).",
+Tolerance = Annotated[float | None, typer.Option(help="NLGS tolerance, relative quadratic norm (default 1.666e-4).",
                                                     rich_help_panel="Run")]
-MaxIterations = Annotated[Optional[int], typer.Option(help="NLGS sweep cap per step (default 1000).",
+MaxIterations = Annotated[int | None, typer.Option(help="NLGS sweep cap per step (default 1000).",
                                                       rich_help_panel="Run")]
-Out = Annotated[Optional[Path], typer.Option("--out", "-o", help="Recording (.rrd). Default: "
+Out = Annotated[Path | None, typer.Option("--out", "-o", help="Recording (.rrd). Default: "
                                              "recordings/<scenario>-<timestamp>.rrd.", rich_help_panel="Output")]
 NoRecording = Annotated[bool, typer.Option("--no-recording", help="Write no .rrd recording.",
                                            rich_help_panel="Output")]
-HistoryOpt = Annotated[Optional[Path], typer.Option("--history", help="History file (.npz), one row per "
+HistoryOpt = Annotated[Path | None, typer.Option("--history", help="History file (.npz), one row per "
                                                     "recorded frame.", rich_help_panel="Output")]
-Freq = Annotated[Optional[float], typer.Option("--freq", help="Ground velocity frequency, Hz.", rich_help_panel="Loading")]
-Amp = Annotated[Optional[float], typer.Option("--amp", help="Horizontal ground velocity amplitude, m/s.",
+Freq = Annotated[float | None, typer.Option("--freq", help="Ground velocity frequency, Hz.", rich_help_panel="Loading")]
+Amp = Annotated[float | None, typer.Option("--amp", help="Horizontal ground velocity amplitude, m/s.",
                                               rich_help_panel="Loading")]
-Settlement = Annotated[Optional[float], typer.Option(help="Downward velocity of the right foundation, m/s.",
+Settlement = Annotated[float | None, typer.Option(help="Downward velocity of the right foundation, m/s.",
                                                      rich_help_panel="Loading")]
 
 
@@ -125,7 +125,7 @@ def _apply_options(scenario, *, duration, dt, theta, friction, record_every, tol
     return dataclasses.replace(scenario, run=run, material=material)
 
 
-def _outputs(name: str, out: Optional[Path], no_recording: bool) -> Optional[Path]:
+def _outputs(name: str, out: Path | None, no_recording: bool) -> Path | None:
     from masonrycli.execute import default_recording_path
 
     if no_recording:
@@ -137,7 +137,7 @@ def _outputs(name: str, out: Optional[Path], no_recording: bool) -> Optional[Pat
     return out
 
 
-def _execute(scenario, out: Optional[Path], history: Optional[Path]) -> None:
+def _execute(scenario, out: Path | None, history: Path | None) -> None:
     from masonrycli.execute import execute, print_summary
 
     for warning in scenario.warnings:
@@ -147,7 +147,7 @@ def _execute(scenario, out: Optional[Path], history: Optional[Path]) -> None:
     except KeyboardInterrupt:
         err_console.print("interrupted: the recording and history hold every frame computed so far"
                           + (f" ({out})" if out else ""))
-        raise typer.Exit(EXIT_INTERRUPTED)
+        raise typer.Exit(EXIT_INTERRUPTED) from None
     except (InputError, GeometryError):
         raise
     except Exception as exc:  # an engine bug: say so in one line, keep what was computed
@@ -156,12 +156,12 @@ def _execute(scenario, out: Optional[Path], history: Optional[Path]) -> None:
         err_console.print(f"[bold red]internal error:[/bold red] {type(exc).__name__}: {exc} — the recording"
                           " and history hold every frame computed before it (MASONRY_DEBUG=1 shows the"
                           " traceback)", highlight=False, soft_wrap=True)
-        raise typer.Exit(EXIT_INTERNAL)
+        raise typer.Exit(EXIT_INTERNAL) from None
     print_summary(console, result, scenario, out, history)
     if result.status == "diverged":
         raise typer.Exit(EXIT_DIVERGED)
     if result.status == "interrupted":
-        raise typer.Exit(EXIT_INTERRUPTED)
+        raise typer.Exit(EXIT_INTERRUPTED) from None
 
 
 # -- builder options ------------------------------------------------------------------------------
@@ -180,25 +180,25 @@ def _arch_options(voussoirs, pier_courses, span, ring_thickness, pier_width) -> 
     return {k: v for k, v in opts.items() if v is not None}
 
 
-Blocks = Annotated[Optional[int], typer.Option(help="Number of blocks (default 51; 248 for the paper's "
+Blocks = Annotated[int | None, typer.Option(help="Number of blocks (default 51; 248 for the paper's "
                                                "large wall).", rich_help_panel="Structure")]
-Courses = Annotated[Optional[int], typer.Option(help="Number of courses.", rich_help_panel="Structure")]
-Length = Annotated[Optional[float], typer.Option(help="Wall length, m.", rich_help_panel="Structure")]
-BlockLength = Annotated[Optional[float], typer.Option(help="Block length, m (default 0.30).",
+Courses = Annotated[int | None, typer.Option(help="Number of courses.", rich_help_panel="Structure")]
+Length = Annotated[float | None, typer.Option(help="Wall length, m.", rich_help_panel="Structure")]
+BlockLength = Annotated[float | None, typer.Option(help="Block length, m (default 0.30).",
                                                       rich_help_panel="Structure")]
-BlockHeight = Annotated[Optional[float], typer.Option(help="Block height, m (default 0.20).",
+BlockHeight = Annotated[float | None, typer.Option(help="Block height, m (default 0.20).",
                                                       rich_help_panel="Structure")]
-Voussoirs = Annotated[Optional[int], typer.Option(help="Voussoirs in the arch (default 30).",
+Voussoirs = Annotated[int | None, typer.Option(help="Voussoirs in the arch (default 30).",
                                                   rich_help_panel="Structure")]
-PierCourses = Annotated[Optional[int], typer.Option(help="Courses per pier, 2 blocks each (default 17).",
+PierCourses = Annotated[int | None, typer.Option(help="Courses per pier, 2 blocks each (default 17).",
                                                     rich_help_panel="Structure")]
-Span = Annotated[Optional[float], typer.Option(help="Clear span of the arch, m (default 3.0).",
+Span = Annotated[float | None, typer.Option(help="Clear span of the arch, m (default 3.0).",
                                                rich_help_panel="Structure")]
-RingThickness = Annotated[Optional[float], typer.Option(help="Arch ring thickness, m (default 0.35).",
+RingThickness = Annotated[float | None, typer.Option(help="Arch ring thickness, m (default 0.35).",
                                                         rich_help_panel="Structure")]
-PierWidth = Annotated[Optional[float], typer.Option(help="Pier width, m (default 0.90).",
+PierWidth = Annotated[float | None, typer.Option(help="Pier width, m (default 0.90).",
                                                     rich_help_panel="Structure")]
-WallCourses = Annotated[Optional[int], typer.Option(help="Courses of the spandrel walls (default 19).",
+WallCourses = Annotated[int | None, typer.Option(help="Courses of the spandrel walls (default 19).",
                                                     rich_help_panel="Structure")]
 
 DEFAULT_DURATION = {"wall": 1.0, "arch": 5.0, "aqueduct": 5.0}

@@ -80,7 +80,7 @@ class State:
     step: int = 0
     time: float = 0.0
 
-    def copy(self) -> "State":
+    def copy(self) -> State:
         return State(self.body_q.copy(), self.body_v.copy(), self.step, self.time)
 
 

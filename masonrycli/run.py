@@ -8,8 +8,8 @@ a divergence, an exception or Ctrl-C — so what was computed is never lost.
 from __future__ import annotations
 
 import time as _time
+from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Callable
 
 import numpy as np
 

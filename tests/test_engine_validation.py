@@ -115,8 +115,9 @@ def test_free_flight_energy(theta, tmp_path):
     path.write_text(toml.replace("[[support]]\nname = \"ground\"\npolygon = [[-1.0, -0.5], [1.4, -0.5], [1.4, 0.0], [-1.0, 0.0]]",
                                  "[[support]]\nname = \"ground\"\npolygon = [[-1.0, -2.5], [1.4, -2.5], [1.4, -2.0], [-1.0, -2.0]]")
                     .replace("duration = 1.0", "duration = 0.3").replace("record_every = 100", "record_every = 1"))
-    from masonrycli.scenario import load_scenario
     from dataclasses import replace
+
+    from masonrycli.scenario import load_scenario
 
     sc = load_scenario(path)
     sc = replace(sc, run=replace(sc.run, theta=theta))

@@ -8,11 +8,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from engine_helpers import run_history, scenario
 from masonrycli.history import History
-from masonrycli.motion import Motion
 from masonrycli.run import simulate
 from masonrycli.scenario import Material, RunConfig, scenario_from_builder
+
+from engine_helpers import run_history, scenario
 
 G = 9.81
 
