@@ -70,69 +70,68 @@ def _prepare(contact_body, contact_point, contact_normal, contact_gap, count, bo
         wtn = iia * ta * na + iib * tb * nb
         wnn = ima + imb + iia * na * na + iib * nb * nb
         det = wtt * wnn - wtn * wtn
-        p = out_pack[c]
-        p[P_NX] = nx
-        p[P_NY] = ny
-        p[P_TA] = ta
-        p[P_NA] = na
-        p[P_TB] = tb
-        p[P_NB] = nb
-        p[P_WTT] = wtt
-        p[P_WTN] = wtn
-        p[P_WNN] = wnn
+        out_pack[c, P_NX] = nx
+        out_pack[c, P_NY] = ny
+        out_pack[c, P_TA] = ta
+        out_pack[c, P_NA] = na
+        out_pack[c, P_TB] = tb
+        out_pack[c, P_NB] = nb
+        out_pack[c, P_WTT] = wtt
+        out_pack[c, P_WTN] = wtn
+        out_pack[c, P_WNN] = wnn
         g = contact_gap[c]
-        p[P_BIAS] = g / dt if g > 0.0 else 0.0
+        out_pack[c, P_BIAS] = g / dt if g > 0.0 else 0.0
         if det > 0.0:
-            p[P_ITT] = wnn / det
-            p[P_ITN] = -wtn / det
-            p[P_INN] = wtt / det
+            out_pack[c, P_ITT] = wnn / det
+            out_pack[c, P_ITN] = -wtn / det
+            out_pack[c, P_INN] = wtt / det
         else:  # degenerate (never for finite masses): the stick branch is skipped
-            p[P_ITT] = 0.0
-            p[P_ITN] = 0.0
-            p[P_INN] = 0.0
+            out_pack[c, P_ITT] = 0.0
+            out_pack[c, P_ITN] = 0.0
+            out_pack[c, P_INN] = 0.0
         dp = wnn - mu * wtn
         dm = wnn + mu * wtn
-        p[P_ISP] = 1.0 / dp if dp > 0.0 else 0.0
-        p[P_ISM] = 1.0 / dm if dm > 0.0 else 0.0
-        p[P_IMA] = ima
-        p[P_IIA] = iia
-        p[P_IMB] = imb
-        p[P_IIB] = iib
+        out_pack[c, P_ISP] = 1.0 / dp if dp > 0.0 else 0.0
+        out_pack[c, P_ISM] = 1.0 / dm if dm > 0.0 else 0.0
+        out_pack[c, P_IMA] = ima
+        out_pack[c, P_IIA] = iia
+        out_pack[c, P_IMB] = imb
+        out_pack[c, P_IIB] = iib
 
 
 @njit
-def _local_solve(ut, un, p, mu):
-    # Exact solution of the 2×2 Signorini–Coulomb problem u = u_free + W r (p: the packed row),
-    # enumerating the cases:
+def _local_solve(ut, un, pack, c, mu):
+    # Exact solution of the 2×2 Signorini–Coulomb problem u = u_free + W r,
+    # enumerating the cases (pack[c]: the contact's packed row):
     #   open:   r = 0 if u_free_n + bias ≥ 0
     #   stick:  u = (0, −bias) → r = W⁻¹(−u_t, −bias − u_n), valid if r_n ≥ 0 and |r_t| ≤ μ r_n
     #   slide:  r_t = −s μ r_n (s = ±1, the sliding direction), u_n = −bias fixes r_n,
     #           valid if s·u_t ≥ 0 afterwards
     # Returns (r_t, r_n, status).
-    bias = p[P_BIAS]
+    bias = pack[c, P_BIAS]
     if un + bias >= 0.0:
         return 0.0, 0.0, STATUS_OPEN
     target = -bias - un  # > 0: the normal velocity change needed
-    if p[P_INN] > 0.0:
-        rt = -p[P_ITT] * ut + p[P_ITN] * target
-        rn = -p[P_ITN] * ut + p[P_INN] * target
+    if pack[c, P_INN] > 0.0:
+        rt = -pack[c, P_ITT] * ut + pack[c, P_ITN] * target
+        rn = -pack[c, P_ITN] * ut + pack[c, P_INN] * target
         if rn >= 0.0 and abs(rt) <= mu * rn:
             return rt, rn, STATUS_STICK
     # Try the free sliding direction first; the t–n coupling W_tn can reverse it, so then the other.
     s0 = 1.0 if ut >= 0.0 else -1.0
     for k in range(2):
         s = s0 if k == 0 else -s0
-        inv = p[P_ISP] if s > 0.0 else p[P_ISM]
+        inv = pack[c, P_ISP] if s > 0.0 else pack[c, P_ISM]
         if inv <= 0.0:
             continue
         rn = target * inv
         rt = -s * mu * rn
-        slip = ut + p[P_WTT] * rt + p[P_WTN] * rn
+        slip = ut + pack[c, P_WTT] * rt + pack[c, P_WTN] * rn
         if s * slip >= 0.0:
             return rt, rn, STATUS_SLIP
     # Unreachable for μ ≥ 0 and a positive definite W; keep the normal solve and project friction.
-    rn = target / p[P_WNN]
-    rt = -ut / p[P_WTT]
+    rn = target / pack[c, P_WNN]
+    rt = -ut / pack[c, P_WTT]
     lim = mu * rn
     if rt > lim:
         rt = lim
@@ -150,22 +149,22 @@ def _point_velocity(v, body, rx, ry, tx, ty, nx, ny):
 
 
 @njit
-def _push(v, a, b, p, drt, drn):
+def _push(v, a, b, pack, c, drt, drn):
     # v_b += M_b⁻¹ H_b Δr, v_a −= M_a⁻¹ H_a Δr  (impulse Δr_t t + Δr_n n at the contact point)
-    nx = p[P_NX]
-    ny = p[P_NY]
+    nx = pack[c, P_NX]
+    ny = pack[c, P_NY]
     px = drt * ny + drn * nx
     py = -drt * nx + drn * ny
-    ima = p[P_IMA]
+    ima = pack[c, P_IMA]
     if ima != 0.0:
         v[a, 0] -= ima * px
         v[a, 1] -= ima * py
-        v[a, 2] -= p[P_IIA] * (p[P_TA] * drt + p[P_NA] * drn)
-    imb = p[P_IMB]
+        v[a, 2] -= pack[c, P_IIA] * (pack[c, P_TA] * drt + pack[c, P_NA] * drn)
+    imb = pack[c, P_IMB]
     if imb != 0.0:
         v[b, 0] += imb * px
         v[b, 1] += imb * py
-        v[b, 2] += p[P_IIB] * (p[P_TB] * drt + p[P_NB] * drn)
+        v[b, 2] += pack[c, P_IIB] * (pack[c, P_TB] * drt + pack[c, P_NB] * drn)
 
 
 @njit
@@ -176,7 +175,7 @@ def _nlgs(contact_body, pack, count, mu, tolerance, max_iterations, v, r, status
     #                           v += M⁻¹ H_α (r_α' − r_α)
     #           until sqrt(Σ|Δr|² / Σ|r|²) < tolerance (LMGC90's quadratic norm) or the cap.
     for c in range(count):
-        _push(v, contact_body[c, 0], contact_body[c, 1], pack[c], r[c, 0], r[c, 1])
+        _push(v, contact_body[c, 0], contact_body[c, 1], pack, c, r[c, 0], r[c, 1])
     iterations = 0
     residual = 0.0
     for it in range(max_iterations):
@@ -186,24 +185,23 @@ def _nlgs(contact_body, pack, count, mu, tolerance, max_iterations, v, r, status
         for c in range(count):
             a = contact_body[c, 0]
             b = contact_body[c, 1]
-            p = pack[c]
-            nx = p[P_NX]
-            ny = p[P_NY]
+            nx = pack[c, P_NX]
+            ny = pack[c, P_NY]
             # u = v_b·t + ω_b (r_b×t) − v_a·t − ω_a (r_a×t), same with n; t = (n_y, −n_x)
             dvx = v[b, 0] - v[a, 0]
             dvy = v[b, 1] - v[a, 1]
-            ut = dvx * ny - dvy * nx + v[b, 2] * p[P_TB] - v[a, 2] * p[P_TA]
-            un = dvx * nx + dvy * ny + v[b, 2] * p[P_NB] - v[a, 2] * p[P_NA]
+            ut = dvx * ny - dvy * nx + v[b, 2] * pack[c, P_TB] - v[a, 2] * pack[c, P_TA]
+            un = dvx * nx + dvy * ny + v[b, 2] * pack[c, P_NB] - v[a, 2] * pack[c, P_NA]
             rt0 = r[c, 0]
             rn0 = r[c, 1]
-            ut -= p[P_WTT] * rt0 + p[P_WTN] * rn0
-            un -= p[P_WTN] * rt0 + p[P_WNN] * rn0
-            rt, rn, st = _local_solve(ut, un, p, mu)
+            ut -= pack[c, P_WTT] * rt0 + pack[c, P_WTN] * rn0
+            un -= pack[c, P_WTN] * rt0 + pack[c, P_WNN] * rn0
+            rt, rn, st = _local_solve(ut, un, pack, c, mu)
             status[c] = st
             drt = rt - rt0
             drn = rn - rn0
             if drt != 0.0 or drn != 0.0:
-                _push(v, a, b, p, drt, drn)
+                _push(v, a, b, pack, c, drt, drn)
                 r[c, 0] = rt
                 r[c, 1] = rn
             sum_dr2 += drt * drt + drn * drn
