@@ -12,7 +12,7 @@ RNG = np.random.default_rng(20261121)
 
 
 def _packed_row(w, bias, mu):
-    """A packed row built by the engine's own _prepare from an equivalent one-contact geometry would
+    """A packed row (as a one-row pack) built by the engine's own _prepare from an equivalent one-contact geometry would
     hide bugs shared by both; build it here from W directly, as the definition says."""
     p = np.zeros(nlgs.PACK_WIDTH)
     wtt, wtn, wnn = w
@@ -23,7 +23,7 @@ def _packed_row(w, bias, mu):
     p[nlgs.P_ISP] = 1 / dp if dp > 0 else 0.0
     p[nlgs.P_ISM] = 1 / dm if dm > 0 else 0.0
     p[nlgs.P_BIAS] = bias
-    return p
+    return p.reshape(1, -1)
 
 
 def _random_w():
@@ -39,7 +39,7 @@ def test_local_solve_satisfies_signorini_coulomb(trial):
     mu = RNG.uniform(0.0, 1.2)
     bias = RNG.choice([0.0, RNG.uniform(0, 0.5)])
     u_free = RNG.normal(size=2)
-    rt, rn, status = nlgs._local_solve(u_free[0], u_free[1], _packed_row(w, bias, mu), mu)
+    rt, rn, status = nlgs._local_solve(u_free[0], u_free[1], _packed_row(w, bias, mu), 0, mu)
     W = np.array([[w[0], w[1]], [w[1], w[2]]])
     ut, un = u_free + W @ np.array([rt, rn])
     scale = 1.0 + np.abs(u_free).max()
@@ -62,11 +62,11 @@ def test_local_solve_is_unique_case():
     """A contact pressed down with a small tangential velocity sticks; a large one slides."""
     mu = 0.5
     p = _packed_row((2.0, 0.0, 2.0), 0.0, mu)
-    rt, rn, st = nlgs._local_solve(0.1, -1.0, p, mu)
+    rt, rn, st = nlgs._local_solve(0.1, -1.0, p, 0, mu)
     assert st == nlgs.STATUS_STICK and rn == pytest.approx(0.5) and rt == pytest.approx(-0.05)
-    rt, rn, st = nlgs._local_solve(3.0, -1.0, p, mu)
+    rt, rn, st = nlgs._local_solve(3.0, -1.0, p, 0, mu)
     assert st == nlgs.STATUS_SLIP and rn == pytest.approx(0.5) and rt == pytest.approx(-0.25)
-    rt, rn, st = nlgs._local_solve(3.0, 0.2, p, mu)
+    rt, rn, st = nlgs._local_solve(3.0, 0.2, p, 0, mu)
     assert st == nlgs.STATUS_OPEN and rt == 0.0 and rn == 0.0
 
 
@@ -74,7 +74,7 @@ def test_open_contact_inside_alert_may_close_but_not_cross():
     """Gap g > 0: the normal velocity may reach −g/dt (closing exactly) but no further."""
     mu, dt, gap = 0.6, 1e-3, 2e-4
     p = _packed_row((1.0, 0.0, 1.0), gap / dt, mu)
-    rt, rn, st = nlgs._local_solve(0.0, -0.1, p, mu)  # slower than g/dt = 0.2 m/s: stays open
+    rt, rn, st = nlgs._local_solve(0.0, -0.1, p, 0, mu)  # slower than g/dt = 0.2 m/s: stays open
     assert st == nlgs.STATUS_OPEN
-    rt, rn, st = nlgs._local_solve(0.0, -0.5, p, mu)  # faster: stopped at −g/dt
+    rt, rn, st = nlgs._local_solve(0.0, -0.5, p, 0, mu)  # faster: stopped at −g/dt
     assert rn == pytest.approx(0.3) and st == nlgs.STATUS_STICK
