@@ -7,6 +7,8 @@ recording always has its footer and the history holds every frame computed.
 from __future__ import annotations
 
 import platform
+import shutil
+import sys
 import time
 from datetime import datetime
 from pathlib import Path
@@ -113,4 +115,12 @@ def print_summary(console: Console, result: RunResult, scenario, out: Path | Non
     console.print(summary_table(result, scenario.run.max_iterations, str(out) if out else None,
                                 str(history) if history else None))
     if out is not None:
-        console.print(f"Open the recording:  [bold]rerun {out}[/bold]")
+        console.print(f"Open the recording:  [bold]{rerun_command()} {out}[/bold]")
+
+
+def rerun_command() -> str:
+    """How to start the viewer from here: ``rerun`` if it is on PATH, else the one beside this Python."""
+    if shutil.which("rerun"):
+        return "rerun"
+    beside = Path(sys.executable).parent / "rerun"
+    return str(beside) if beside.exists() else "rerun"
