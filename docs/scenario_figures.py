@@ -279,6 +279,9 @@ def wall(path: str, static: str | None) -> None:
           f"< 0 in {(ev_mean < 0).mean() * 100:.0f} %; range {ev_mean.min():+.3f} … {ev_mean.max():+.3f} 1/s. "
           "Mean cumulated volumetric strain at t = 0.1/0.25/0.5/0.75/1 s: " + ", ".join(
               f"{evc[run.at(t)]:+.4f}" for t in (0.1, 0.25, 0.5, 0.75, 1.0)))
+    print(f"Dilatant cells vs open joints at t = {t1:.2f} s: of the {band.sum()} cells with ε̇v > 0.05 1/s, "
+          f"{(band & (gop > 1e-4)).sum()} have a joint open > 0.1 mm; of the {(gop > 1e-3).sum()} blocks with a "
+          f"joint open > 1 mm, {((gop > 1e-3) & band).sum()} have ε̇v > 0.05 1/s.")
     print(f"Deviatoric cumulated strain at t = {t1:.2f} s: mean {ed[band].mean():.4f} in the {band.sum()} cells of the "
           f"dilatant band (ε̇v > 0.05 1/s), {ed[~band].mean():.4f} elsewhere; max {ed.max():.4f} "
           f"({h['block_name'][np.argmax(ed)]})\n")
@@ -459,6 +462,41 @@ def arch(path: str, kind: str) -> None:
               "hinged at the end.\n")
         table(["region", "y m", "joints", "open>1mm", "hinged", "max open mm"], rows,
               [None, None, None, None, None, "{:.1f}"])
+        dd = h["block_q"][ie] - h["block_q"][0]
+        sp = grp[:n] == "spandrel"
+        rows = []
+        for label, m in (("x < −0.5 m", xs < -0.5), ("|x| ≤ 0.5 m", np.abs(xs) <= 0.5), ("x > 0.5 m", xs > 0.5)):
+            m = m & sp
+            rows.append([label, m.sum(), 1e3 * dd[m, 0].mean(), 1e3 * dd[m, 1].mean(), np.degrees(dd[m, 2]).mean(),
+                         np.degrees(dd[m, 2]).min()])
+        print("Spandrel blocks by initial x: mean displacement (mm) and rotation (deg) at the end.\n")
+        table(["spandrel blocks", "count", "mean dx", "mean dy", "mean rot", "min rot"], rows,
+              [None, None, "{:+.1f}", "{:+.1f}", "{:+.2f}", "{:+.2f}"])
+        # voids: holes of the union of the moved blocks (each grown by 0.1 mm to close the contact gaps)
+        from shapely import affinity
+        from shapely.geometry import Polygon
+        from shapely.ops import unary_union
+        moved = []
+        for b in range(n):
+            c0 = h["block_q"][0, b, :2]
+            pb = affinity.rotate(run.polys[b], h["block_q"][ie, b, 2], origin=tuple(c0), use_radians=True)
+            moved.append(affinity.translate(pb, *(h["block_q"][ie, b, :2] - c0)).buffer(1e-4))
+        u = unary_union(moved)
+        holes = [Polygon(ring) for g in getattr(u, "geoms", [u]) for ring in g.interiors]
+        rows = []
+        for label, test in (("x < −0.5 m", lambda x: x < -0.5), ("|x| ≤ 0.5 m", lambda x: abs(x) <= 0.5),
+                            ("x > 0.5 m", lambda x: x > 0.5)):
+            sel = [hh for hh in holes if test(hh.centroid.x)]
+            big = max(sel, key=lambda hh: hh.area) if sel else None
+            rows.append([label, len(sel), 1e4 * sum(hh.area for hh in sel), 1e4 * big.area if big else 0.0,
+                         f"({big.centroid.x:+.2f}, {big.centroid.y:.2f})" if big else "-"])
+        print("Voids at the end (holes in the union of the moved blocks), by x of their centroid:\n")
+        table(["region", "voids", "total cm²", "largest cm²", "largest at (x, y) m"], rows,
+              [None, None, "{:.1f}", "{:.1f}", None])
+        rs = np.array([j for j in range(len(jb)) if {grp[jb[j, 0]], grp[jb[j, 1]]} == {"ring", "spandrel"}])
+        top = rs[np.argsort(-np.abs(slip[ie, rs]))][:6]
+        print("Largest slips along the extrados (ring / spandrel joints) at the end: " + ", ".join(
+            f"{joint_label(run, j)} {1e3 * slip[ie, j]:+.1f} mm" for j in top) + "\n")
 
     # real sliding: relative tangential displacement of the joint faces, by the bodies they join
     key = np.array([" / ".join(sorted({grp[a], grp[b]})) for a, b in jb])
@@ -559,6 +597,7 @@ def main(argv=None) -> None:
     ap.add_argument("--arch", action="append", default=[], help="history of an arch run")
     ap.add_argument("--aqueduct", action="append", default=[], help="history of an aqueduct run")
     args = ap.parse_args(argv)
+    np.seterr(invalid="ignore", divide="ignore")  # NaN strains (blocks in no triangle) are expected
     np.set_printoptions(linewidth=160)
     for i, w in enumerate(args.wall):
         wall(w, args.static[i] if i < len(args.static) else None)
