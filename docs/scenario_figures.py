@@ -238,11 +238,18 @@ def wall(path: str, static: str | None) -> None:
         print("```\n")
 
     show_map(i1)
-    show_map(len(h["time"]) - 1)
     # where the dilatant band sits: x of the cells with ε̇v > 0.05 per course
-    band = [(c, x0[(course == c) & (evr > 0.05)]) for c in range(1, C + 1)]
-    print("Cells with ε̇v > 0.05 1/s, x range of their initial centroids per course (m): " + ", ".join(
-        f"c{c:02d} [{b.min():+.2f}, {b.max():+.2f}]" for c, b in band if b.size) + "\n")
+    band_x = [(c, x0[(course == c) & (evr > 0.05)]) for c in range(1, C + 1)]
+    print(f"Cells with ε̇v > 0.05 1/s at t = {t1:.2f} s, x range of their initial centroids per course (m): " + ", ".join(
+        f"c{c:02d} [{b.min():+.2f}, {b.max():+.2f}]" for c, b in band_x if b.size) + "\n")
+    vy = h["block_v"][i1, :, 1]
+    for c in (C, (C + 1) // 2):
+        idx = np.where(course == c)[0]
+        idx = idx[np.argsort(x0[idx])]
+        print(f"Vertical velocity at t = {t1:.2f} s, course {c}, left → right (mm/s): "
+              + " ".join(f"{1e3 * v:.0f}" for v in vy[idx]))
+    print()
+    show_map(len(h["time"]) - 1)
 
     # bed joints vs head joints, ground joint
     a_c = np.where(jb[:, 0] < n, course[np.minimum(jb[:, 0], n - 1)], 0)
@@ -263,7 +270,7 @@ def wall(path: str, static: str | None) -> None:
           [None, None, None, None, "{:.1f}", None, "{:.1f}", None, None])
 
     print(f"Hinge detector vs geometry at t = {t1:.2f} s: " + detector_vs_geometry(run, op, i1))
-    print(f"… and at the end: " + detector_vs_geometry(run, op, len(h["time"]) - 1) + "\n")
+    print("… and at the end: " + detector_vs_geometry(run, op, len(h["time"]) - 1) + "\n")
     wide = gop > 1e-3
     print(f"block_max_opening of the {wide.sum()} blocks with a joint open > 1 mm at t = {t1:.2f} s: max "
           f"{1e3 * bmo[wide].max():.3f} mm, mean {1e3 * bmo[wide].mean():.3f} mm (a joint opened beyond the 1 mm "
@@ -300,6 +307,15 @@ def wall(path: str, static: str | None) -> None:
     table(["t s", "ground mm", "bottom mm", "base slip mm", "top mm", "drift mm", "max |rot| deg", "hinges",
            "contacts"], rows,
           ["{:.2f}", "{:+.1f}", "{:+.1f}", "{:+.1f}", "{:+.1f}", "{:+.1f}", "{:.2f}", None, None])
+    weight = RHO * G * sum(p.area for p in run.polys[:n])
+    f1 = h["support_force"][1, 0]
+    print(f"Ground reaction at t = {h['time'][1]:.2f} s: horizontal {-f1[0] / weight:+.3f} × weight, vertical "
+          f"{-f1[1] / weight:.4f} × weight (μ × vertical = {0.6 * -f1[1] / weight:.3f}); mean block vy "
+          f"{1e3 * h['block_v'][1, :, 1].mean():+.1f} mm/s at t = {h['time'][1]:.2f} s, "
+          f"{1e3 * h['block_v'][run.at(0.05), :, 1].mean():+.1f} mm/s at t = 0.05 s")
+    ar = np.abs(rot)
+    print(f"Largest block rotation over the run: {ar.max():.2f}° ({h['block_name'][ar.max(0).argmax()]}, "
+          f"t = {h['time'][ar.max(1).argmax()]:.2f} s)")
     vb = h["block_v"][:, bottom, 0].mean(axis=1)
     vg = h["support_v"][:, 0, 0]
     print(f"Bottom course velocity vs ground: max |v_ground − v_bottom| = {np.abs(vg - vb).max():.3f} m/s; "
@@ -410,6 +426,12 @@ def arch(path: str, kind: str) -> None:
     marks = [t for t in (0.1, 0.25, 0.5, 1, 2, 3, 4, 5) if t <= T[-1] + 1e-9]
     print(f"Hinged joints: {len(ever)} joints hinged at some frame; count at t = " + "/".join(f"{t:g}" for t in marks)
           + " s: " + ", ".join(str(hc[run.at(t)]) for t in marks) + f"; max {hc.max()} at t = {T[hc.argmax()]:.2f} s\n")
+    many = np.where(hc > 3)[0]
+    if many.size and len(ever) <= 30:
+        from collections import Counter
+        sets = Counter(" + ".join(joint_label(run, j) for j in np.where(hinged[i])[0]) for i in many)
+        print(f"Frames with more than 3 hinged joints: {many.size} ({100 * many.size / len(T):.0f} %), "
+              f"t = {T[many[0]]:.2f} … {T[many[-1]]:.2f} s; sets: " + "; ".join(f"{k} ({v})" for k, v in sets.most_common()) + "\n")
     rows = []
     ring_like = [j for j in ever if "ring" in (grp[jb[j, 0]], grp[jb[j, 1]])]
     show = ever if len(ever) <= 30 else np.array(ring_like + [j for j in ever if j not in ring_like])[:30]
@@ -442,7 +464,7 @@ def arch(path: str, kind: str) -> None:
         print("Joints open more than 1 mm at the end (geometric, widest end), by the bodies they join:\n")
         table(["bodies", "open>1mm", "hinged", "max mm", "widest three"], rows, [None, None, None, "{:.1f}", None])
         # spandrel cracks by region
-        xs, ys = run.h["block_q"][0, :, 0], run.h["block_q"][0, :, 1]
+        xs = run.h["block_q"][0, :, 0]
         rows = []
         wj = [j for j in range(len(jb)) if grp[jb[j, 0]] == "spandrel" or grp[jb[j, 1]] == "spandrel"]
         wj = np.array(wj)
@@ -525,6 +547,14 @@ def arch(path: str, kind: str) -> None:
                          rot[m].min(), rot[m].max()])
     table(["group", "blocks", "mean dx mm", "mean dy mm", "max |d| mm", "min rot", "max rot"], rows,
           [None, None, "{:+.2f}", "{:+.2f}", "{:.2f}", "{:+.3f}", "{:+.3f}"])
+    pier = [i for i in range(n) if grp[i].endswith("pier")]
+    pier_course = {i: int(names[i].split("-c")[1][:2]) for i in pier}
+    top_course = max(pier_course.values())
+    rows = [[names[i], h["block_q"][0, i, 0], 1e3 * d[i, 0], 1e3 * d[i, 1], rot[i],
+             h["cell_spherical_stress"][ie, i] / 1e3]
+            for i in pier if pier_course[i] <= 3 or pier_course[i] == top_course]
+    print("Pier blocks, bottom three courses and top course, at the end:\n")
+    table(["block", "x0 m", "dx mm", "dy mm", "rot deg", "p kPa"], rows, [None, "{:+.2f}", "{:+.2f}", "{:+.2f}", "{:+.3f}", "{:.0f}"])
     rows = []
     for i in ring:
         rows.append([names[i], 1e3 * d[i, 0], 1e3 * d[i, 1], rot[i], h["cell_spherical_stress"][ie, i] / 1e3,
@@ -586,7 +616,8 @@ def arch(path: str, kind: str) -> None:
     s = h["energy_dissipated"][-1], h["support_work"][-1]
     dE = (h["energy_kinetic"][-1] + h["energy_potential"][-1]) - (h["energy_kinetic"][0] + h["energy_potential"][0])
     print(f"Energy: support work {s[1]:.0f} J, dissipated {s[0]:.1f} J, Δ(kinetic+potential) {dE:.0f} J "
-          f"(balance error {dE - (s[1] - s[0]):.1f} J); max kinetic energy {h['energy_kinetic'].max():.2f} J\n")
+          f"(balance error {dE - (s[1] - s[0]):.1f} J); kinetic energy max {h['energy_kinetic'].max():.2f} J "
+          f"(t = {T[h['energy_kinetic'].argmax()]:.2f} s), at the end {h['energy_kinetic'][-1]:.2f} J\n")
 
 
 def main(argv=None) -> None:
