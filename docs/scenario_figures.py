@@ -610,6 +610,9 @@ def arch(path: str, kind: str) -> None:
     k = np.argsort(-np.nan_to_num(np.abs(evol), nan=-1))[:5]
     print("Five largest |volumetric cumulated strain|: " + ", ".join(
         f"{names[i]} ({evol[i]:+.1e})" for i in k if defined[i]))
+    edev = h["cell_deviatoric_strain"][ie]
+    print(f"Deviatoric cumulated strain at the end: {np.isfinite(edev).sum()} cells defined, max {np.nanmax(edev):.4f}, "
+          f"{(edev > 0.004).sum()} above 0.004 (the top of the recording's colour range for the settling aqueduct)")
     k = np.argsort(-np.nan_to_num(np.abs(evr[ie]), nan=-1))[:5]
     print("Five largest |volumetric strain rate| at the end: " + ", ".join(
         f"{names[i]} ({evr[ie, i]:+.1e} 1/s)" for i in k if defined[i]) + "\n")
