@@ -9,7 +9,6 @@ from __future__ import annotations
 import platform
 import shutil
 import sys
-import time
 from datetime import datetime
 from pathlib import Path
 
@@ -79,7 +78,6 @@ def recording_static(sim: Simulation):
 
 def execute(scenario, *, out: Path | None, history: Path | None, console: Console) -> RunResult:
     """Run ``scenario``, writing the recording ``out`` and the history ``history`` (either may be None)."""
-    t0 = time.perf_counter()
     sim = Simulation(scenario)
     sinks = []
     hist = None
@@ -105,7 +103,7 @@ def execute(scenario, *, out: Path | None, history: Path | None, console: Consol
         raise
     finally:
         if recorder is not None:
-            recorder.close(status=status, note=f"{note} — wall time {time.perf_counter() - t0:.1f} s".lstrip(" —"))
+            recorder.close(status=status, note=note)
         if hist is not None:
             hist.write(history, status=status)
     return result

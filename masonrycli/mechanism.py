@@ -1,69 +1,130 @@
-"""Mechanism detector: which joints are hinged at a frame.
+"""Joint states: how far each joint has opened, how much of a block's load slides, which joints hinge.
 
-A *joint* is a pair of bodies (block–block or block–support) that touch along a face in the initial
-configuration (two contact points). A joint is *hinged* when one end carries all of its normal force and
-the other end is open:
+*Joint ends* are the contact points of the initial configuration (blocks against blocks or supports).
+Each end is followed with the two bodies: its material point on a and on b and the normal, which turns
+with body a. The **opening** of an end is the normal separation of its two material points,
 
-* exactly one of its contact points has r_n > 0, and
-* the other point is either no longer detected (opened beyond the alert distance) or open (r_n = 0)
-  with a gap larger than ``OPENING`` (so a joint merely unloaded at zero gap is not a hinge), and
-* the joint carries a normal force of at least ``LOAD_FRACTION`` × the mean block weight, so nearly
-  unloaded joints (vertical joints of a pier, say) are not reported.
+    opening = (X_b − X_a) · n(θ_a) + g₀        (m; > 0 open, 0 closed as built, < 0 penetrating)
 
-Vectorised over contacts with numpy (no Python loop over joints or contacts).
+so it keeps growing when the joint opens beyond the alert distance (where contact detection stops
+seeing it). A *joint* is a body pair with two initial ends (the two ends of a face-to-face contact).
+
+Per block (the paper's "load level" indicators):
+
+* ``block_max_opening`` — the largest opening, ≥ 0, over the ends of the block's joints (m);
+* ``block_sliding_ratio`` — the share of the block's normal contact load carried by sliding contacts:
+  Σ_slip r_n / Σ_closed r_n over its current contacts (0 with none). Weighting by r_n keeps lightly
+  loaded contacts (vertical joints) that sit at the friction limit from dominating the ratio.
+
+A joint is **hinged** when exactly one of its current contact points carries normal force (r_n > 0),
+its other end has opened by more than ``OPENING``, and it carries at least ``LOAD_FRACTION`` × the
+mean block weight (nearly unloaded joints are not reported).
+
+All vectorised with numpy (no Python loop over joints, ends or contacts).
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 
+from masonrycli.frame import CONTACT_OPEN, CONTACT_SLIP
+
 OPENING = 1e-4
-"""m: gap above which the unloaded end of a joint counts as open."""
+"""m: opening above which the unloaded end of a joint counts as open (0.1 mm)."""
 LOAD_FRACTION = 1e-3
 """Joints carrying less than this fraction of the mean block weight are never hinges."""
+JOINT_FIELDS = {
+    "block_sliding_ratio": ((), "1", "share of the block's normal contact load carried by sliding contacts"),
+    "block_max_opening": ((), "m", "largest opening of the block's joints (followed kinematically), ≥ 0"),
+}
+"""Per-block fields of :meth:`JointTracker.block_fields`: name → (shape after N, unit, description)."""
 
 
-@dataclass(frozen=True, eq=False)
-class Joints:
-    """The joints of a structure, from its initial contacts."""
-
-    joint_body: np.ndarray
-    """(J, 2) int: bodies a < b of each joint."""
-    key: np.ndarray
-    """(J,) int64: a·B + b, sorted (for lookup)."""
-    body_count: int
-    min_force: float
-    """N: the load below which a joint is not reported as a hinge."""
+def _rotate(theta: np.ndarray, xy: np.ndarray) -> np.ndarray:
+    c, s = np.cos(theta), np.sin(theta)
+    return np.stack([c * xy[:, 0] - s * xy[:, 1], s * xy[:, 0] + c * xy[:, 1]], axis=1)
 
 
-def find_joints(contact_body: np.ndarray, body_count: int, mean_block_weight: float) -> Joints:
-    """Joints = body pairs with two contact points in the initial configuration."""
-    key = contact_body[:, 0].astype(np.int64) * body_count + contact_body[:, 1]
-    unique, counts = np.unique(key, return_counts=True)
-    joint_key = unique[counts >= 2]
-    body = np.stack([joint_key // body_count, joint_key % body_count], axis=1)
-    return Joints(body, joint_key, body_count, LOAD_FRACTION * mean_block_weight)
+class JointTracker:
+    """Joint ends of the initial configuration, followed with the bodies.
 
+    Args:
+        contact_body, contact_point, contact_normal, contact_gap: the initial contacts (C0 rows).
+        body_q0: (B, 3) initial poses. block_count: N. mean_block_weight: N (per thickness).
+    """
 
-def hinged_joints(joints: Joints, contact_body: np.ndarray, contact_r_n: np.ndarray, contact_gap: np.ndarray,
-                  dt: float) -> np.ndarray:
-    """(J,) bool: which joints are hinged, given a frame's contacts and normal impulses r_n (N·s)."""
-    j = joints.key.size
-    if j == 0 or contact_body.shape[0] == 0:
-        return np.zeros(j, dtype=bool)
-    key = contact_body[:, 0].astype(np.int64) * joints.body_count + contact_body[:, 1]
-    pos = np.minimum(np.searchsorted(joints.key, key), j - 1)
-    member = joints.key[pos] == key
-    idx = pos[member]
-    force = contact_r_n[member] / dt
-    loaded = force > 0.0
-    open_end = (~loaded) & (contact_gap[member] > OPENING)
-    n_points = np.bincount(idx, minlength=j)
-    n_loaded = np.bincount(idx, weights=loaded, minlength=j)
-    n_open = np.bincount(idx, weights=open_end, minlength=j)
-    total = np.bincount(idx, weights=np.where(loaded, force, 0.0), minlength=j)
-    one_loaded = n_loaded == 1
-    other_open = (n_points == 1) | ((n_points == 2) & (n_open == 1))
-    return one_loaded & other_open & (total >= joints.min_force)
+    def __init__(self, contact_body, contact_point, contact_normal, contact_gap, body_q0, block_count: int,
+                 mean_block_weight: float):
+        body = np.asarray(contact_body, dtype=np.int64).reshape(-1, 2)
+        self.block_count = int(block_count)
+        self.body_count = int(body_q0.shape[0])
+        self.end_body = body
+        """(E, 2) bodies a, b of each joint end."""
+        q0 = np.asarray(body_q0)
+        # Material points and normal in the bodies' frames (θ = 0 initially, so only a translation).
+        self._local_a = np.asarray(contact_point) - q0[body[:, 0], :2]
+        self._local_b = np.asarray(contact_point) - q0[body[:, 1], :2]
+        self._normal0 = np.asarray(contact_normal, dtype=np.float64).copy()
+        self._gap0 = np.asarray(contact_gap, dtype=np.float64).copy()
+        key = body[:, 0] * self.body_count + body[:, 1]
+        unique, inverse, counts = np.unique(key, return_inverse=True, return_counts=True)
+        is_joint = counts >= 2
+        self.key = unique[is_joint]
+        """(J,) int64 a·B + b of each joint, sorted."""
+        self.joint_body = np.stack([self.key // self.body_count, self.key % self.body_count], axis=1)
+        """(J, 2) bodies a < b of each joint."""
+        joint_of_pair = np.cumsum(is_joint) - 1
+        self._end_joint = np.where(is_joint[inverse], joint_of_pair[inverse], -1)
+        self.min_force = LOAD_FRACTION * mean_block_weight
+
+    def opening(self, body_q: np.ndarray) -> np.ndarray:
+        """(E,) m: opening of every joint end in configuration ``body_q`` (B, 3)."""
+        a, b = self.end_body[:, 0], self.end_body[:, 1]
+        xa = body_q[a, :2] + _rotate(body_q[a, 2], self._local_a)
+        xb = body_q[b, :2] + _rotate(body_q[b, 2], self._local_b)
+        n = _rotate(body_q[a, 2], self._normal0)
+        return np.einsum("ij,ij->i", xb - xa, n) + self._gap0
+
+    def block_fields(self, body_q, contact_body, contact_r, contact_status) -> dict[str, np.ndarray]:
+        """``JOINT_FIELDS`` for configuration ``body_q`` and the current contacts (impulses r = (r_t, r_n))."""
+        n = self.block_count
+        opening = np.maximum(self.opening(body_q), 0.0)
+        max_opening = np.zeros(n)
+        for side in range(2):
+            owner = self.end_body[:, side]
+            blocks = owner < n
+            np.maximum.at(max_opening, owner[blocks], opening[blocks])
+        rn = np.asarray(contact_r)[:, 1]
+        closed = np.where(contact_status != CONTACT_OPEN, rn, 0.0)
+        sliding = np.where(contact_status == CONTACT_SLIP, rn, 0.0)
+        load = np.zeros(n)
+        slide = np.zeros(n)
+        for side in range(2):
+            owner = np.asarray(contact_body)[:, side]
+            blocks = owner < n
+            load += np.bincount(owner[blocks], weights=closed[blocks], minlength=n)
+            slide += np.bincount(owner[blocks], weights=sliding[blocks], minlength=n)
+        ratio = np.divide(slide, load, out=np.zeros(n), where=load > 0)
+        return {"block_sliding_ratio": ratio, "block_max_opening": max_opening}
+
+    def hinged(self, body_q, contact_body, contact_rn, dt: float) -> np.ndarray:
+        """(J,) bool: which joints are hinged (one end carries all the normal force, the other is open)."""
+        j = self.key.size
+        if j == 0:
+            return np.zeros(0, dtype=bool)
+        # The joint's widest opening over its ends.
+        opening = self.opening(body_q)
+        joint_end = self._end_joint >= 0
+        widest = np.full(j, -np.inf)
+        np.maximum.at(widest, self._end_joint[joint_end], opening[joint_end])
+        # Loaded current contact points per joint, and the joint's normal force.
+        body = np.asarray(contact_body, dtype=np.int64)
+        key = body[:, 0] * self.body_count + body[:, 1]
+        pos = np.minimum(np.searchsorted(self.key, key), j - 1)
+        member = self.key[pos] == key
+        idx = pos[member]
+        force = np.asarray(contact_rn)[member] / dt
+        loaded = force > 0.0
+        n_loaded = np.bincount(idx, weights=loaded, minlength=j)
+        total = np.bincount(idx, weights=np.where(loaded, force, 0.0), minlength=j)
+        return (n_loaded == 1) & (widest > OPENING) & (total >= self.min_force)

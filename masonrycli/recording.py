@@ -735,6 +735,7 @@ def screenshot_recording(rrd_path: str | os.PathLike, png_path: str | os.PathLik
     """
     from rerun.experimental import ViewerClient
 
+    os.makedirs(os.path.dirname(os.path.abspath(png_path)), exist_ok=True)
     deadline = time.monotonic() + timeout
     viewer = ViewerClient.spawn(headless=True, port=_free_port(), hide_welcome_screen=True,
                                 executable_path=_viewer_executable())

@@ -16,7 +16,7 @@ import numpy as np
 from masonrycli.engine import integrate
 from masonrycli.engine.solver import Solver, StepStats
 from masonrycli.frame import CONTACT_OPEN, Frame
-from masonrycli.mechanism import find_joints, hinged_joints
+from masonrycli.mechanism import JointTracker
 from masonrycli.model import Model, State, build_model, initial_state
 from masonrycli.tensors import TensorComputer, build_triangles
 
@@ -63,7 +63,8 @@ class Simulation:
         blocks_only = body[(body[:, 0] < n) & (body[:, 1] < n)]
         self.triangles = build_triangles(m.body_q0[:n, :2], blocks_only)
         weight = float(np.mean(m.body_mass[:n]) * np.hypot(*m.gravity)) if n else 0.0
-        self.joints = find_joints(body, m.body_count, weight)
+        s = self.solver
+        self.joints = JointTracker(body, s.contact_point, s.contact_normal, s.contact_gap, m.body_q0, n, weight)
         self.tensors = TensorComputer(n, m.block_volume, self.triangles)
         self.energy_dissipated = 0.0
         self.support_work = 0.0
@@ -74,7 +75,7 @@ class Simulation:
         n = self.model.block_count
         s = self.solver
         self.tensors.step(s.body_q_m[:n], self.state.body_v[:n], s.contact_body, s.contact_point,
-                          s.contact_force, s.contact_gap, s.contact_status, self.model.dt)
+                          s.contact_force, self.model.dt)
         self.energy_dissipated += stats.dissipated
         self.support_work += stats.support_work
         self.last = stats
@@ -95,8 +96,10 @@ class Simulation:
             gap = np.zeros(0)
             status = np.zeros(0, dtype=np.int8)
             mobilised = np.zeros(0)
+            r = np.zeros((0, 2))
             support_force = np.zeros((m.support_count, 2))
             iterations, residual = 0, 0.0
+            hinged, hinge_point = np.zeros(self.joints.key.size, dtype=bool), np.zeros((0, 2))
         else:
             c = self.last.contact_count
             body, point, normal = s.contact_body, s.contact_point, s.contact_normal
@@ -109,9 +112,8 @@ class Simulation:
                                           where=denom > 0)
             support_force = s.support_force
             iterations, residual = self.last.iterations, self.last.residual
-        hinged, hinge_point = self.hinges()
-        if self.last is None:
-            hinged, hinge_point = np.zeros(self.joints.key.size, dtype=bool), np.zeros((0, 2))
+            hinged, hinge_point = self.hinges()
+        joint_fields = self.joints.block_fields(st.body_q, body, r, status)
         support_q = st.body_q[n:].copy()
         return Frame(
             step=st.step, time=st.time,
@@ -121,7 +123,7 @@ class Simulation:
             contact_body=np.array(body, copy=True), contact_point=np.array(point, copy=True),
             contact_normal=np.array(normal, copy=True), contact_force=np.array(force, copy=True),
             contact_gap=np.array(gap, copy=True), contact_status=np.array(status, copy=True),
-            contact_mobilised=mobilised, tensors=self.tensors.fields(),
+            contact_mobilised=mobilised, tensors=self.tensors.fields() | joint_fields,
             energy_kinetic=float(kinetic), energy_potential=float(potential),
             energy_dissipated=self.energy_dissipated, support_work=self.support_work,
             nlgs_iterations=int(iterations), nlgs_residual=float(residual), contact_count=int(c),
@@ -131,7 +133,7 @@ class Simulation:
     def hinges(self) -> tuple[np.ndarray, np.ndarray]:
         """(J,) hinged flags of the joints after the last step, and (H, 2) the hinge points."""
         s = self.solver
-        hinged = hinged_joints(self.joints, s.contact_body, s.contact_r[:, 1], s.contact_gap, self.model.dt)
+        hinged = self.joints.hinged(self.state.body_q, s.contact_body, s.contact_r[:, 1], self.model.dt)
         # The hinge is the loaded contact point of a hinged joint.
         key = s.contact_body[:, 0].astype(np.int64) * self.model.body_count + s.contact_body[:, 1]
         loaded = (s.contact_r[:, 1] > 0) & np.isin(key, self.joints.key[hinged])

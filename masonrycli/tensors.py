@@ -1,4 +1,4 @@
-"""Cell stress and strain tensors of Chetouane et al. (2003), their invariants and the joint state.
+"""Cell stress and strain tensors of Chetouane et al. (2003) and their invariants.
 
 Python front of ``masonrycli.engine.tensor_kernels``: triangulation (once, at set-up), launchers, and
 ``TensorComputer``, which the time loop calls once per step.
@@ -31,10 +31,7 @@ Definitions (DESIGN §3; paper eqs. 1–12)
   tensor (r ≤ 1e-14 (|c| + r)) gets φ = 0. Stress: spherical p = (σ1+σ2)/2, deviatoric
   q = (σ1−σ2)/2, skew |σ_xy − σ_yx|/2. Strain (rate): volumetric = trace = ε1+ε2, deviatoric
   (ε1−ε2)/2. Compression and contraction are negative.
-* **Joint state** of block i over its contacts in the list (with blocks and supports): sliding ratio
-  = number of slipping contacts / number of closed (stick or slip) contacts, 0 with no closed
-  contact; largest opening = max(0, max gap) — the gap at detection, so it saturates at the alert
-  distance (a joint opened wider has left the contact list).
+* The joint states (sliding ratio, joint opening, hinges) are in ``masonrycli.mechanism``.
 
 Units: SI. Forces in N acting on the block's whole thickness (as the solver's, m = ρ·A·e); with the
 default e = 1 m these are N/m and σ is in Pa either way.
@@ -67,10 +64,6 @@ TENSOR_FIELDS: dict[str, tuple[tuple[int, ...], str, str]] = {
     "cell_principal_strain_angle": ((), "rad", "direction of ε1 from x, counter-clockwise, in (−π/2, π/2]"),
     "cell_volumetric_strain": ((), "1", "volumetric cumulated strain ε1 + ε2 (trace)"),
     "cell_deviatoric_strain": ((), "1", "deviatoric cumulated strain (ε1 − ε2) / 2 ≥ 0"),
-    "block_sliding_ratio": ((), "1", "slipping contacts / closed contacts of the block (0 if none closed)"),
-    "block_max_opening": (
-        (), "m", "largest gap among the block's contacts, ≥ 0 (saturates at the alert distance)"
-    ),
 }
 """Every per-block field of ``TensorComputer.fields()``, in order: name → (shape after the leading
 block axis N, unit, description)."""
@@ -94,8 +87,6 @@ _LAYOUT: dict[str, tuple[str, int]] = {
     "cell_principal_strain_angle": ("scalar", _k.S_STRAIN_ANGLE),
     "cell_volumetric_strain": ("scalar", _k.S_STRAIN_VOLUMETRIC),
     "cell_deviatoric_strain": ("scalar", _k.S_STRAIN_DEVIATORIC),
-    "block_sliding_ratio": ("scalar", _k.S_SLIDING_RATIO),
-    "block_max_opening": ("scalar", _k.S_MAX_OPENING),
 }
 assert list(_LAYOUT) == list(TENSOR_FIELDS)
 
@@ -113,7 +104,10 @@ def build_triangles(centroids0: np.ndarray, touching_pairs: np.ndarray) -> np.nd
     """Triangles of block centroids for the strain rate, fixed for the whole run.
 
     Delaunay triangulation of the initial centroids, keeping only the triangles whose three edges join
-    blocks that touch, then dropping degenerate ones (area < ``DEGENERATE_AREA`` · scale²).
+    blocks that touch; where that leaves a hole because Delaunay chose an edge between blocks that do
+    not touch, the hole is filled with triangles of mutually touching blocks that overlap no kept
+    triangle (``_complete_with_cliques``); degenerate ones (area < ``DEGENERATE_AREA`` · scale²) are
+    dropped.
 
     Args:
         centroids0: (N, 2) initial block centroids, m.
@@ -153,7 +147,7 @@ def build_triangles(centroids0: np.ndarray, touching_pairs: np.ndarray) -> np.nd
     e_lo = np.minimum(tri, np.roll(tri, -1, axis=1))
     e_hi = np.maximum(tri, np.roll(tri, -1, axis=1))
     keep = np.isin(e_lo * n + e_hi, touch_keys).all(axis=1)
-    tri = tri[keep]
+    tri = _complete_with_cliques(points, tri[keep], touch_keys, n, DEGENERATE_AREA * scale * scale)
 
     p0, p1, p2 = points[tri[:, 0]], points[tri[:, 1]], points[tri[:, 2]]
     area2 = (p1[:, 0] - p0[:, 0]) * (p2[:, 1] - p0[:, 1]) - (p1[:, 1] - p0[:, 1]) * (p2[:, 0] - p0[:, 0])
@@ -166,6 +160,64 @@ def build_triangles(centroids0: np.ndarray, touching_pairs: np.ndarray) -> np.nd
     tri = tri[np.arange(tri.shape[0])[:, None], (first[:, None] + np.arange(3)) % 3]
     order = np.lexsort((tri[:, 2], tri[:, 1], tri[:, 0]))
     return np.ascontiguousarray(tri[order])
+
+
+def _complete_with_cliques(points, tri, touch_keys, n, min_area) -> np.ndarray:
+    """Fill the holes Delaunay leaves where its edge joins two blocks that do not touch.
+
+    Where four blocks touch each other (two courses of a two-block pier, say), Delaunay may pick the
+    diagonal between the two that do not touch, and the filter then drops both triangles. Every triple
+    of mutually touching blocks is a candidate; candidates are added, smallest first, when they overlap
+    no triangle kept so far. Set-up only (once per run); the result stays deterministic.
+    """
+    lo, hi = touch_keys // n, touch_keys % n
+    neighbours = [set() for _ in range(n)]
+    for i, j in zip(lo.tolist(), hi.tolist()):
+        neighbours[i].add(j)
+        neighbours[j].add(i)
+    cliques = [(i, j, k) for i, j in zip(lo.tolist(), hi.tolist())
+               for k in sorted(neighbours[i] & neighbours[j]) if k > j]
+    if not cliques:
+        return tri
+    cand = np.array(cliques, dtype=np.int64)
+    have = {tuple(sorted(t)) for t in tri.tolist()}
+    cand = cand[[tuple(c) not in have for c in cand.tolist()]]
+    p = points[cand]
+    area = 0.5 * np.abs((p[:, 1, 0] - p[:, 0, 0]) * (p[:, 2, 1] - p[:, 0, 1])
+                        - (p[:, 1, 1] - p[:, 0, 1]) * (p[:, 2, 0] - p[:, 0, 0]))
+    cand = cand[area >= min_area]
+    area = area[area >= min_area]
+    order = np.lexsort((cand[:, 2], cand[:, 1], cand[:, 0], area))
+    kept = [t for t in tri]
+    kept_pts = [points[t] for t in tri]
+    for c in cand[order]:
+        pc = points[c]
+        if kept_pts and _overlaps_any(pc, np.array(kept_pts), min_area):
+            continue
+        kept.append(c)
+        kept_pts.append(pc)
+    return np.array(kept, dtype=np.int64).reshape(-1, 3)
+
+
+def _overlaps_any(tri_pts: np.ndarray, others: np.ndarray, min_area: float) -> bool:
+    """Does triangle ``tri_pts`` (3, 2) overlap any of ``others`` (M, 3, 2) with positive area?
+
+    Separating axes of two triangles: the six edge normals. They overlap when every axis shows an
+    overlap of the projections longer than a tolerance (triangles sharing an edge or a vertex touch
+    but do not overlap).
+    """
+    tol = np.sqrt(min_area)
+    both = [np.broadcast_to(tri_pts, others.shape), others]
+    separated = np.zeros(others.shape[0], dtype=bool)
+    for shape in both:
+        edges = np.roll(shape, -1, axis=1) - shape               # (M, 3, 2)
+        normals = np.stack([-edges[..., 1], edges[..., 0]], -1)  # (M, 3, 2)
+        normals /= np.linalg.norm(normals, axis=-1, keepdims=True)
+        pa = np.einsum("mkd,mvd->mkv", normals, both[0])          # (M, 3 axes, 3 vertices)
+        pb = np.einsum("mkd,mvd->mkv", normals, both[1])
+        overlap = np.minimum(pa.max(-1), pb.max(-1)) - np.maximum(pa.min(-1), pb.min(-1))
+        separated |= (overlap <= tol).any(axis=1)
+    return not separated.all()
 
 
 # ---------------------------------------------------------------------------------------------------
@@ -223,16 +275,6 @@ def cell_strain_rate(block_count, block_q, block_v, triangles) -> np.ndarray:
     return out
 
 
-def joint_states(block_count, contact_body, contact_gap, contact_status) -> tuple[np.ndarray, np.ndarray]:
-    """Per-block joint state: (sliding ratio (N,) — slipping / closed contacts, 0 if none closed;
-    largest opening (N,) m — max(0, max gap over the block's contacts))."""
-    ratio = np.empty(block_count)
-    opening = np.empty(block_count)
-    _k._joint_states(block_count, np.asarray(contact_body), _f64(contact_gap), np.asarray(contact_status),
-                     ratio, opening)
-    return ratio, opening
-
-
 def principal(tensor) -> tuple[np.ndarray, np.ndarray]:
     """Principal values and major direction of the symmetric part of (..., 2, 2) tensors.
 
@@ -262,7 +304,7 @@ class TensorComputer:
 
     Owns the cumulated-strain state. One numba dispatch per ``step``; no Python loop over blocks,
     contacts or triangles.
-    ``step`` stores the tensors, the joint states and the cumulated strain; ``fields`` derives the
+    ``step`` stores the tensors and the cumulated strain; ``fields`` derives the
     invariants from them on demand.
 
     Args:
@@ -309,8 +351,6 @@ class TensorComputer:
         contact_body: np.ndarray,
         contact_point: np.ndarray,
         contact_force: np.ndarray,
-        contact_gap: np.ndarray,
-        contact_status: np.ndarray,
         dt: float,
     ) -> None:
         """Compute every field for the state passed in and add dt · (its strain rate) to the strain.
@@ -321,8 +361,6 @@ class TensorComputer:
             contact_body: (C, 2) int bodies (a, b); indices ≥ N are supports.
             contact_point: (C, 2) float64 world contact points, m.
             contact_force: (C, 2) float64 force on body b in world coordinates, N (impulse / dt).
-            contact_gap: (C,) float64 gap, m (< 0 penetration).
-            contact_status: (C,) int8 0 open, 1 stick, 2 slip.
             dt: time step, s (0 computes the fields without integrating, e.g. for the initial frame).
 
         Before the first call every field except ``cell_strain`` and its invariants is NaN.
@@ -334,14 +372,11 @@ class TensorComputer:
             or block_v.shape[0] < n
             or contact_point.shape[0] != c
             or contact_force.shape[0] != c
-            or contact_gap.shape[0] != c
-            or contact_status.shape[0] != c
         ):
             raise ValueError(
                 f"inconsistent shapes: N={n}, block_q {block_q.shape}, block_v {block_v.shape}, "
                 f"contact_body {contact_body.shape}, contact_point {contact_point.shape}, "
-                f"contact_force {contact_force.shape}, contact_gap {contact_gap.shape}, "
-                f"contact_status {contact_status.shape}"
+                f"contact_force {contact_force.shape}"
             )
         _k._tensor_step(
             n,
@@ -352,11 +387,8 @@ class TensorComputer:
             contact_body,
             contact_point,
             contact_force,
-            contact_gap,
-            contact_status,
             float(dt),
             self._tensor,
-            self._scalar,
         )
         self._invariants_stale = True
 

@@ -159,27 +159,6 @@ def test_integrate_strain_keeps_nan_and_skips_nan_rate():
     np.testing.assert_array_equal(strain[2], [[1.0, 0.0], [0.0, 1.0]])
 
 
-def test_joint_states_hand_counted():
-    # blocks 0, 1, 2; support 3
-    body = np.array([[0, 1], [0, 1], [0, 3], [0, 3], [1, 2], [2, 3]], np.int32)
-    status = np.array([1, 2, 2, 0, 0, 0], np.int8)
-    gap = np.array([0.0, -1e-5, 2e-4, 7e-4, 3e-4, -2e-4])
-    ratio, opening = np.empty(3), np.empty(3)
-    K._joint_states(3, body, gap, status, ratio, opening)
-    # block 0: closed = stick, slip, slip (3), slipping 2; gaps 0, -1e-5, 2e-4, 7e-4 → 7e-4
-    # block 1: closed = stick, slip (2), slipping 1; gaps 0, -1e-5, 3e-4 → 3e-4
-    # block 2: no closed contact → 0; gaps 3e-4, -2e-4 → 3e-4
-    np.testing.assert_array_equal(ratio, [2 / 3, 0.5, 0.0])
-    np.testing.assert_array_equal(opening, [7e-4, 3e-4, 3e-4])
-
-
-def test_joint_states_no_contact_and_negative_gaps():
-    ratio, opening = np.empty(2), np.empty(2)
-    K._joint_states(2, np.array([[0, 1]]), np.array([-1e-3]), np.array([1], np.int8), ratio, opening)
-    np.testing.assert_array_equal(ratio, [0.0, 0.0])
-    np.testing.assert_array_equal(opening, [0.0, 0.0])
-
-
 # ---------------------------------------------------------------------------------------------------
 # Closed-form 2×2 eigen vs numpy.linalg.eigh
 # ---------------------------------------------------------------------------------------------------

@@ -111,7 +111,7 @@ def test_case4_through_tensor_computer():
     tc = T.TensorComputer(1, np.array([0.08]), np.zeros((0, 3), np.int64))
     q = np.zeros((2, 3))
     body = np.tile([0, 1], (8, 1)).astype(np.int32)
-    tc.step(q, q.copy(), body, CASE4_POINTS, -CASE4_FORCES, np.zeros(8), np.ones(8, np.int8), 1e-3)
+    tc.step(q, q.copy(), body, CASE4_POINTS, -CASE4_FORCES, 1e-3)
     f = tc.fields()
     np.testing.assert_allclose(f["block_stress"][0], CASE4_SIGMA, rtol=1e-10)
     np.testing.assert_allclose(f["cell_stress"][0], CASE4_SIGMA, rtol=1e-10)  # cell = the block alone
@@ -128,7 +128,7 @@ def test_rotation_makes_stress_non_symmetric_and_skew_is_reported():
     points = np.array([[0.0, 0.1], [0.0, -0.1]])
     forces = np.array([[10.0, 0.0], [-10.0, 0.0]])  # on the block: −forces
     tc = T.TensorComputer(1, np.array([0.08]), np.zeros((0, 3)))
-    tc.step(np.zeros((2, 3)), np.zeros((2, 3)), body, points, forces, np.zeros(2), np.ones(2, np.int8), 0.0)
+    tc.step(np.zeros((2, 3)), np.zeros((2, 3)), body, points, forces, 0.0)
     f = tc.fields()
     # σ_yx = (0.1 · (−10) + (−0.1) · 10) / 0.08 = −25, σ_xy = 0
     np.testing.assert_allclose(f["cell_stress"][0], [[0.0, 0.0], [-25.0, 0.0]], atol=1e-12)
@@ -167,7 +167,7 @@ def test_case3_column_block_and_cell_stress():
     tc = T.TensorComputer(n, volume, triangles)
     q, v = state_arrays(centroids)
     c = len(body)
-    tc.step(q, v, body, point, force, np.zeros(c), np.ones(c, np.int8), 1e-3)
+    tc.step(q, v, body, point, force, 1e-3)
     f = tc.fields()
     expected_from_top = np.array([-1962.0, -5886.0, -9810.0, -13734.0, -17658.0])
     k_from_top = np.arange(1, 6)
@@ -340,7 +340,7 @@ def test_isolated_block_gets_nan_strain(wall):
     q, v = state_arrays(far)
     v[: n + 1, 0] = 0.1 * far[:, 1]  # simple shear
     no = np.zeros((0, 2))
-    tc.step(q, v, np.zeros((0, 2), np.int32), no, no, np.zeros(0), np.zeros(0, np.int8), 1e-3)
+    tc.step(q, v, np.zeros((0, 2), np.int32), no, no, 1e-3)
     f = tc.fields()
     for name in ("cell_strain_rate", "cell_strain", "cell_principal_strain_rate", "cell_principal_strain",
                  "cell_volumetric_strain", "cell_deviatoric_strain_rate", "cell_principal_strain_angle"):
@@ -354,7 +354,7 @@ def test_isolated_block_gets_nan_strain(wall):
 
 
 def wall_contacts(centroids, pairs, rng):
-    """Two contact points per touching pair, random forces, gaps and statuses, plus ground contacts."""
+    """Two contact points per touching pair and random forces, plus ground contacts."""
     n = len(centroids)
     bottom = np.nonzero(centroids[:, 1] < 0.15)[0]
     ground = np.stack([np.repeat(bottom, 2), np.full(2 * len(bottom), n)], 1)
@@ -362,8 +362,7 @@ def wall_contacts(centroids, pairs, rng):
     c = len(body)
     point = 0.5 * (centroids[body[:, 0]] + centroids[np.minimum(body[:, 1], n - 1)])
     point += rng.normal(scale=0.05, size=(c, 2))
-    return (body.astype(np.int32), point, rng.normal(size=(c, 2)) * 1e3, rng.normal(size=c) * 1e-4,
-            rng.integers(0, 3, c).astype(np.int8))
+    return body.astype(np.int32), point, rng.normal(size=(c, 2)) * 1e3
 
 
 def test_fields_names_shapes_units(wall):
@@ -394,12 +393,9 @@ def test_fields_are_consistent_with_independent_references(wall):
     contacts = wall_contacts(x, pairs, rng)
     tc.step(q, v, *contacts, 1e-3)
     f = tc.fields()
-    body, point, force, gap, status = contacts
+    body, point, force = contacts
     np.testing.assert_allclose(f["block_stress"], T.block_stress(n, q, areas, body, point, force), rtol=1e-14)
     np.testing.assert_allclose(f["cell_strain_rate"], T.cell_strain_rate(n, q, v, triangles), rtol=1e-14)
-    ratio, opening = T.joint_states(n, body, gap, status)
-    np.testing.assert_array_equal(f["block_sliding_ratio"], ratio)
-    np.testing.assert_array_equal(f["block_max_opening"], opening)
     for tensor, values, angle in (
         ("cell_stress", "cell_principal_stress", "cell_principal_angle"),
         ("cell_strain_rate", "cell_principal_strain_rate", "cell_principal_strain_rate_angle"),
@@ -435,7 +431,7 @@ def test_cumulated_strain_integrates_the_rate(wall):
     q, v = state_arrays(centroids)
     v[:n, :2] = centroids @ l0.T
     no = np.zeros((0, 2))
-    args = (np.zeros((0, 2), np.int32), no, no, np.zeros(0), np.zeros(0, np.int8))
+    args = (np.zeros((0, 2), np.int32), no, no)
     tc.step(q, v, *args, 0.0)  # initial frame: no integration
     assert np.all(tc.fields()["cell_strain"][tc.has_triangle] == 0.0)
     dt, steps = 1e-3, 40
@@ -454,12 +450,12 @@ def test_step_accepts_block_or_body_arrays_and_int64_bodies(wall):
     centroids, areas, pairs, triangles = wall
     n = len(centroids)
     rng = np.random.default_rng(4)
-    body, point, force, gap, status = wall_contacts(centroids, pairs, rng)
+    body, point, force = wall_contacts(centroids, pairs, rng)
     q, v = state_arrays(centroids, n_supports=3)
     v[:n] = rng.normal(size=(n, 3))
     a, b = T.TensorComputer(n, areas, triangles), T.TensorComputer(n, areas, triangles)
-    a.step(q, v, body, point, force, gap, status, 1e-3)
-    b.step(q[:n].copy(), v[:n].copy(), body.astype(np.int64), point, force, gap, status, 1e-3)
+    a.step(q, v, body, point, force, 1e-3)
+    b.step(q[:n].copy(), v[:n].copy(), body.astype(np.int64), point, force, 1e-3)
     for name, value in a.fields().items():
         np.testing.assert_array_equal(value, b.fields()[name])
 
@@ -474,10 +470,10 @@ def test_constructor_and_step_validation():
     tc = T.TensorComputer(2, np.ones(2), np.zeros((0, 3)))
     with pytest.raises(ValueError):
         tc.step(np.zeros((1, 3)), np.zeros((2, 3)), np.zeros((0, 2), np.int32), np.zeros((0, 2)),
-                np.zeros((0, 2)), np.zeros(0), np.zeros(0, np.int8), 1e-3)
+                np.zeros((0, 2)), 1e-3)
     with pytest.raises(ValueError):
         tc.step(np.zeros((2, 3)), np.zeros((2, 3)), np.zeros((1, 2), np.int32), np.zeros((1, 2)),
-                np.zeros((2, 2)), np.zeros(1), np.zeros(1, np.int8), 1e-3)
+                np.zeros((2, 2)), 1e-3)
 
 
 def test_principal_launcher_batches():

@@ -56,3 +56,33 @@ def test_wall_at_rest_course_stress():
         mean = (volume[sel] * sigma[sel, 1, 1]).sum() / volume[sel].sum()
         expected = -density * G * height * (k - 0.5)
         assert mean == pytest.approx(expected, rel=5e-3), (k, mean, expected)
+
+
+@pytest.mark.parametrize("builder", ["arch", "aqueduct"])
+def test_triangulation_covers_piers_and_spandrels_without_overlap(builder):
+    """Delaunay alone loses the two-block piers (its diagonals join blocks that do not touch); the
+    completed triangulation gives every block that has two touching neighbours that touch each other
+    a triangle, and its triangles never overlap (checked with shapely, independently)."""
+    from shapely.geometry import Polygon
+    from shapely.strtree import STRtree
+
+    from masonrycli.run import Simulation
+
+    sc = scenario_from_builder(builder, {}, RunConfig(duration=0.01), Material(), {})
+    sim = Simulation(sc)
+    n = sim.model.block_count
+    tri = sim.triangles
+    xy = sim.model.body_q0[:n, :2]
+    polys = [Polygon(xy[t]) for t in tri]
+    tree = STRtree(polys)
+    for i, p in enumerate(polys):
+        for j in tree.query(p):
+            if j != i:
+                assert p.intersection(polys[j]).area < 1e-9, (tri[i], tri[j])
+    has = np.zeros(n, bool)
+    has[tri.ravel()] = True
+    names = [b.name for b in sc.assembly.blocks]
+    piers = [k for k, name in enumerate(names) if "pier" in name]
+    assert has[piers].all()
+    if builder == "aqueduct":
+        assert has.all()

@@ -38,10 +38,8 @@ PAIR_ROWS = 3
     S_STRAIN_ANGLE,
     S_STRAIN_VOLUMETRIC,
     S_STRAIN_DEVIATORIC,
-    S_SLIDING_RATIO,
-    S_MAX_OPENING,
-) = range(12)
-SCALAR_ROWS = 12
+) = range(10)
+SCALAR_ROWS = 10
 
 
 # ---------------------------------------------------------------------------------------------------
@@ -218,30 +216,6 @@ def _integrate_strain(rate, dt, strain):
 # for each contact, for each of its bodies that is a block:
 #     closed += status ≠ open ; slipping += status = slip ; opening = max(opening, gap)
 # sliding ratio = slipping / closed (0 if no closed contact); opening starts at 0 (so ≥ 0)
-@njit
-def _joint_states(block_count, contact_body, contact_gap, contact_status, out_ratio, out_opening):
-    # Inputs: contact_body (C,2), contact_gap (C,) m, contact_status (C,) int8
-    # Outputs: out_ratio (N,) 1, out_opening (N,) m
-    closed = np.zeros(block_count, np.int64)
-    slipping = np.zeros(block_count, np.int64)
-    out_opening[:] = 0.0
-    for c in range(contact_body.shape[0]):
-        status = contact_status[c]
-        gap = contact_gap[c]
-        for side in range(2):
-            body = contact_body[c, side]
-            if body < 0 or body >= block_count:
-                continue
-            if status != 0:
-                closed[body] += 1
-                if status == 2:
-                    slipping[body] += 1
-            if gap > out_opening[body]:
-                out_opening[body] = gap
-    for i in range(block_count):
-        out_ratio[i] = slipping[i] / closed[i] if closed[i] > 0 else 0.0
-
-
 # ---------------------------------------------------------------------------------------------------
 # Closed-form 2×2 symmetric eigen-decomposition and invariants
 # ---------------------------------------------------------------------------------------------------
@@ -287,7 +261,7 @@ def _principal(tensor, out_values, out_angle, out_isotropic, out_deviatoric, tra
 # ---------------------------------------------------------------------------------------------------
 
 
-# block stress → cell neighbours → cell stress → strain rate → strain += dt·rate → joint states.
+# block stress → cell neighbours → cell stress → strain rate → strain += dt·rate.
 # The invariants are derived separately (``_tensor_invariants``), only when the fields are read.
 @njit
 def _tensor_step(
@@ -299,15 +273,11 @@ def _tensor_step(
     contact_body,
     contact_point,
     contact_force,
-    contact_gap,
-    contact_status,
     dt,
     tensor_out,
-    scalar_out,
 ):
     # Inputs: as the kernels above
-    # Outputs: tensor_out (4,N,2,2) rows T_* (tensor_out[T_CELL_STRAIN] in/out: the cumulated strain),
-    #          scalar_out (12,N) rows S_SLIDING_RATIO, S_MAX_OPENING
+    # Outputs: tensor_out (4,N,2,2) rows T_* (tensor_out[T_CELL_STRAIN] in/out: the cumulated strain)
     n = block_count
     block_stress = tensor_out[T_BLOCK_STRESS]
     _block_stress(n, block_q, block_volume, contact_body, contact_point, contact_force, block_stress)
@@ -317,16 +287,13 @@ def _tensor_step(
     _cell_strain_rate(n, block_q, block_v, triangles, rate)
     if dt != 0.0:
         _integrate_strain(rate, dt, tensor_out[T_CELL_STRAIN])
-    _joint_states(n, contact_body, contact_gap, contact_status,
-                  scalar_out[S_SLIDING_RATIO], scalar_out[S_MAX_OPENING])
 
 
 # cell stress: skew |t_xy − t_yx|/2, principal values/angle, p = (σ1+σ2)/2, q = (σ1−σ2)/2
 # strain rate, strain: principal values/angle, volumetric = trace, deviatoric = (ε1−ε2)/2
 @njit
 def _tensor_invariants(tensor_out, pair_out, scalar_out):
-    # Inputs: tensor_out (4,N,2,2) ; Outputs: pair_out (3,N,2) rows P_*, scalar_out (12,N) rows S_*
-    # except S_SLIDING_RATIO and S_MAX_OPENING
+    # Inputs: tensor_out (4,N,2,2) ; Outputs: pair_out (3,N,2) rows P_*, scalar_out (10,N) rows S_*
     cell_stress = tensor_out[T_CELL_STRESS]
     for i in range(cell_stress.shape[0]):
         scalar_out[S_STRESS_SKEW, i] = 0.5 * abs(cell_stress[i, 0, 1] - cell_stress[i, 1, 0])
