@@ -1,0 +1,86 @@
+"""Joint openings, sliding ratio and hinges against hand computations."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from masonrycli.frame import CONTACT_OPEN, CONTACT_SLIP, CONTACT_STICK
+from masonrycli.mechanism import OPENING, JointTracker
+
+# Block 0: unit square on [0,1]x[0,1]; block 1: unit square on [0,1]x[1,2]; body 2: a support below.
+Q0 = np.array([[0.5, 0.5, 0.0], [0.5, 1.5, 0.0], [0.5, -0.5, 0.0]])
+BODY = np.array([[0, 1], [0, 1], [0, 2], [0, 2]])
+POINT = np.array([[0.0, 1.0], [1.0, 1.0], [0.0, 0.0], [1.0, 0.0]])
+NORMAL = np.array([[0.0, 1.0], [0.0, 1.0], [0.0, -1.0], [0.0, -1.0]])
+GAP = np.zeros(4)
+
+
+def tracker():
+    return JointTracker(BODY, POINT, NORMAL, GAP, Q0, block_count=2, mean_block_weight=10.0)
+
+
+def test_joints_are_face_contacts():
+    jt = tracker()
+    np.testing.assert_array_equal(jt.joint_body, [[0, 1], [0, 2]])
+
+
+def test_opening_of_a_lifted_and_rocked_block():
+    jt = tracker()
+    q = Q0.copy()
+    q[1, 1] += 0.002  # lift the upper block 2 mm
+    np.testing.assert_allclose(jt.opening(q), [0.002, 0.002, 0.0, 0.0], atol=1e-15)
+    # Rock the upper block clockwise (φ < 0) about its bottom-right corner (1, 1): its bottom-left
+    # corner rises by sin|φ| (lever 1 m), the right corner stays.
+    phi = -0.01
+    q = Q0.copy()
+    c, s = np.cos(phi), np.sin(phi)
+    centroid_rel = np.array([-0.5, 0.5])
+    q[1, :2] = np.array([1.0, 1.0]) + np.array([c * centroid_rel[0] - s * centroid_rel[1],
+                                                s * centroid_rel[0] + c * centroid_rel[1]])
+    q[1, 2] = phi
+    np.testing.assert_allclose(jt.opening(q), [-np.sin(phi), 0.0, 0.0, 0.0], atol=1e-14)
+    fields = jt.block_fields(q, np.zeros((0, 2), int), np.zeros((0, 2)), np.zeros(0, np.int8))
+    np.testing.assert_allclose(fields["block_max_opening"], [-np.sin(phi), -np.sin(phi)], atol=1e-14)
+
+
+def test_opening_is_relative_to_the_initial_gap_and_follows_rotation_of_a():
+    jt = JointTracker(BODY[:2], POINT[:2], NORMAL[:2], np.array([1e-4, 1e-4]), Q0, 2, 10.0)
+    q = Q0.copy()
+    q[:2, 0] += 0.3  # both blocks translate together: nothing opens
+    np.testing.assert_allclose(jt.opening(q), [1e-4, 1e-4], atol=1e-15)
+
+
+def test_sliding_ratio_is_load_weighted():
+    jt = tracker()
+    body = np.array([[0, 1], [0, 1], [0, 2], [0, 2]])
+    r = np.array([[0.0, 3.0], [0.0, 1.0], [0.0, 4.0], [0.0, 0.0]])
+    status = np.array([CONTACT_SLIP, CONTACT_STICK, CONTACT_SLIP, CONTACT_OPEN], np.int8)
+    f = jt.block_fields(Q0, body, r, status)
+    # block 0: slipping load 3 + 4 of closed load 3 + 1 + 4; block 1: 3 of 3 + 1.
+    np.testing.assert_allclose(f["block_sliding_ratio"], [7 / 8, 3 / 4])
+
+
+def test_hinge_needs_one_loaded_end_and_an_opened_other_end():
+    jt = tracker()
+    dt = 1e-3
+    body = np.array([[0, 1], [0, 2], [0, 2]])
+    q = Q0.copy()
+    # Rocked upper block: only its right corner (one contact) is loaded.
+    phi = -10 * OPENING  # clockwise about the right corner: the left end opens by ~10 × OPENING
+    q[1, :2] = [1.0 - 0.5 * np.cos(phi) - 0.5 * np.sin(phi), 1.0 - 0.5 * np.sin(phi) + 0.5 * np.cos(phi)]
+    q[1, 2] = phi
+    rn = np.array([1.0, 0.5, 0.5]) * dt * 10.0
+    hinged = jt.hinged(q, body, rn, dt)
+    np.testing.assert_array_equal(hinged, [True, False])
+    # Not opened (flat): both ends detected, only one loaded -> still no hinge.
+    body2 = np.array([[0, 1], [0, 1]])
+    assert not jt.hinged(Q0, body2, np.array([1.0, 0.0]) * dt * 10.0, dt)[0]
+    # Too little load: not reported.
+    assert not jt.hinged(q, body, np.array([1e-6, 0.5, 0.5]) * dt, dt)[0]
+
+
+@pytest.mark.parametrize("n_blocks", [0])
+def test_no_joints(n_blocks):
+    jt = JointTracker(np.zeros((0, 2), int), np.zeros((0, 2)), np.zeros((0, 2)), np.zeros(0), Q0, 2, 1.0)
+    assert jt.hinged(Q0, np.zeros((0, 2), int), np.zeros(0), 1e-3).shape == (0,)
