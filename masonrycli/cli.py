@@ -308,15 +308,20 @@ def simulate_aqueduct(
 @app.command("run")
 @user_errors
 def run_command(
-    scenario_file: Annotated[Path, typer.Argument(help="Scenario file (TOML).", metavar="SCENARIO.toml")],
+    scenario_file: Annotated[Path, typer.Argument(help="Scenario file (TOML), or a GeoJSON / WKT geometry.",
+                                                  metavar="SCENARIO.toml")],
     duration: Duration = None, dt: Dt = None, theta: Theta = None, friction: Friction = None,
     record_every: RecordEvery = None, tolerance: Tolerance = None, max_iterations: MaxIterations = None,
     out: Out = None, no_recording: NoRecording = False, history: HistoryOpt = None,
 ) -> None:
-    """Run any scenario file; options given here override the file's values."""
-    from masonrycli.scenario import load_scenario
+    """Run any scenario file (or a GeoJSON / WKT geometry file, supports fixed); options given here
+    override the file's values."""
+    from masonrycli.scenario import GEOMETRY_SUFFIXES, load_scenario, scenario_from_geometry_file
 
-    scenario = load_scenario(scenario_file)
+    if scenario_file.suffix.lower() in GEOMETRY_SUFFIXES:
+        scenario = scenario_from_geometry_file(scenario_file)
+    else:
+        scenario = load_scenario(scenario_file)
     scenario = _apply_options(scenario, duration=duration, dt=dt, theta=theta, friction=friction,
                               record_every=record_every, tolerance=tolerance, max_iterations=max_iterations)
     _execute(scenario, _outputs(scenario.name, out, no_recording), history)

@@ -330,23 +330,39 @@ def _parse_document(doc: dict, ctx: _Ctx, default_name: str) -> Scenario:
         structure = _table(doc, "structure", ctx)
         if block_tables:
             raise ctx.error(_locator("block", 1, block_tables[0], "block-1"),
-                            "not allowed together with a [structure] builder (use either explicit blocks "
-                            "or a builder)")
-        if "builder" not in structure:
-            raise ctx.error("[structure]", "builder: missing (e.g. builder = \"wall\")")
-        builder = structure["builder"]
-        if not isinstance(builder, str):
-            raise ctx.error("[structure]", f"builder = {format_value(builder)[:40]}: must be a string")
-        options = {k: v for k, v in structure.items() if k != "builder"}
-        for key, value in options.items():
+                            "not allowed together with a [structure] builder or file (use either explicit "
+                            "blocks or a [structure])")
+        if "file" in structure:
+            extra = [k for k in structure if k != "file"]
+            if extra:
+                raise ctx.error("[structure]", f"{extra[0]}: not allowed with file = ... (a geometry file "
+                                "brings its own blocks and supports)")
+            file = structure["file"]
+            if not isinstance(file, str):
+                raise ctx.error("[structure]", f"file = {format_value(file)[:40]}: must be a string")
+            path = os.path.abspath(os.path.join(ctx.base_dir, file))
+            assembly = _read_geometry(path, material, ctx)
+            what = f"file {quote_string(file)}"
+            structure_info = {"file": path}
+        else:
+            if "builder" not in structure:
+                raise ctx.error("[structure]", "builder: missing (e.g. builder = \"wall\", or file = "
+                                "\"my-wall.geojson\")")
+            builder = structure["builder"]
+            if not isinstance(builder, str):
+                raise ctx.error("[structure]", f"builder = {format_value(builder)[:40]}: must be a string")
+            options = {k: v for k, v in structure.items() if k != "builder"}
+            for key, value in options.items():
+                try:
+                    _check_finite_tree(key, value)
+                except InputError as exc:
+                    raise ctx.error("[structure]", str(exc)) from None
             try:
-                _check_finite_tree(key, value)
+                assembly = _call_builder(builder, options, material)
             except InputError as exc:
                 raise ctx.error("[structure]", str(exc)) from None
-        try:
-            assembly = _call_builder(builder, options, material)
-        except InputError as exc:
-            raise ctx.error("[structure]", str(exc)) from None
+            structure_info = {"builder": builder, **options}
+            what = f"builder \"{builder}\""
         motions_by_support = {}
         known = [s.name for s in assembly.supports]
         for i, table in enumerate(support_tables, start=1):
@@ -354,20 +370,19 @@ def _parse_document(doc: dict, ctx: _Ctx, default_name: str) -> Scenario:
             for key in table:
                 if key not in BUILDER_SUPPORT_KEYS:
                     if key in SUPPORT_KEYS:
-                        raise ctx.error(loc, f"{key}: not allowed with a [structure] builder "
-                                        "(the builder makes its supports; give only name and motion)")
+                        raise ctx.error(loc, f"{key}: not allowed with a [structure] "
+                                        f"({what} makes the supports; give only name and motion)")
                     raise ctx.error(loc, _unknown_key(key, BUILDER_SUPPORT_KEYS))
             if "name" not in table:
-                raise ctx.error(loc, f"name: missing (builder \"{builder}\" supports: {', '.join(known)})")
+                raise ctx.error(loc, f"name: missing ({what} supports: {', '.join(known)})")
             sname = table["name"]
             if sname not in known:
-                raise ctx.error(loc, f"name = {format_value(sname)[:40]}: no such support in builder "
-                                f"\"{builder}\" (supports: {', '.join(known) or 'none'})")
+                raise ctx.error(loc, f"name = {format_value(sname)[:40]}: no such support in {what} "
+                                f"(supports: {', '.join(known) or 'none'})")
             if sname in motions_by_support:
                 raise ctx.error(loc, f"name = {quote_string(sname)}: support given twice")
             motions_by_support[sname] = _parse_motion(table.get("motion"), ctx, loc)
         motions = tuple(motions_by_support.get(s.name, Motion()) for s in assembly.supports)
-        structure_info = {"builder": builder, **options}
     else:
         blocks = []
         names: dict[str, str] = {}
@@ -389,6 +404,43 @@ def _parse_document(doc: dict, ctx: _Ctx, default_name: str) -> Scenario:
         name=name, run=run, material=material, assembly=assembly, motions=motions,
         source=ctx.fname, structure=structure_info, warnings=warnings,
     )
+
+
+GEOMETRY_SUFFIXES = (".geojson", ".json", ".wkt")
+
+
+def _read_geometry(path: str, material: Material, ctx: _Ctx) -> Assembly:
+    """Blocks and supports of a GeoJSON or WKT file (``geometry_library.io``), with the material's
+    density and thickness as defaults."""
+    from geometry_library import io as geo_io
+
+    suffix = Path(path).suffix.lower()
+    if suffix not in GEOMETRY_SUFFIXES:
+        raise ctx.error("[structure]", f"file = {quote_string(path)}: unknown geometry format "
+                        f"(expected {', '.join(GEOMETRY_SUFFIXES)})")
+    if not os.path.isfile(path):
+        raise ctx.error("[structure]", f"file = {quote_string(path)}: no such file")
+    reader = geo_io.read_wkt if suffix == ".wkt" else geo_io.read_geojson
+    try:
+        return reader(path, density=material.density, thickness=material.thickness)
+    except (GeometryError, ValueError) as exc:
+        raise ctx.error("[structure]", _one_line(exc)) from None
+
+
+def scenario_from_geometry_file(path) -> Scenario:
+    """A scenario with default run and material settings for a GeoJSON / WKT file: every support fixed.
+
+    ``masonry run my-wall.geojson`` uses it; for motions or other settings, write a scenario file with
+    ``[structure] file = "my-wall.geojson"``.
+    """
+    path = os.fspath(path)
+    ctx = _Ctx(path, os.path.dirname(os.path.abspath(path)))
+    material = Material()
+    assembly = _read_geometry(os.path.abspath(path), material, ctx)
+    warnings = _validate(assembly, ctx)
+    return Scenario(name=Path(path).stem, run=RunConfig(), material=material, assembly=assembly,
+                    motions=tuple(Motion() for _ in assembly.supports), source=path,
+                    structure={"file": os.path.abspath(path)}, warnings=warnings)
 
 
 def _locator(section: str, index: int, table: dict, default_name: str | None) -> str:

@@ -635,7 +635,7 @@ def test_builder_option_errors(tmp_path, fake_builders, line, expected):
     "text, expected",
     [
         ('[structure]\nbuilder = "tower"\n', '[structure] builder = "tower": unknown builder (expected one of '),
-        ("[structure]\nblocks = 51\n", '[structure] builder: missing (e.g. builder = "wall")'),
+        ("[structure]\nblocks = 51\n", '[structure] builder: missing (e.g. builder = "wall", or file = "my-wall.geojson")'),
         ("[structure]\nbuilder = 3\n", "[structure] builder = 3: must be a string"),
         ('[structure]\nbuilder = "fake"\n' + BLOCK,
          '[[block]] #1 ("b1"): not allowed together with a [structure] builder'),
@@ -644,7 +644,7 @@ def test_builder_option_errors(tmp_path, fake_builders, line, expected):
         ('[structure]\nbuilder = "fake"\n[[support]]\nmotion = { kind = "fixed" }\n',
          '[[support]] #1: name: missing (builder "fake" supports: ground, pad)'),
         ('[structure]\nbuilder = "fake"\n' + GROUND,
-         '[[support]] #1 ("ground"): polygon: not allowed with a [structure] builder'),
+         '[[support]] #1 ("ground"): polygon: not allowed with a [structure] (builder "fake" makes the supports'),
         ('[structure]\nbuilder = "fake"\n[[support]]\nname = "pad"\n[[support]]\nname = "pad"\n',
          '[[support]] #2 ("pad"): name = "pad": support given twice'),
         ('[structure]\nbuilder = "fake"\n[[support]]\nname = "pad"\nmotion = { kind = "sine" }\n',
