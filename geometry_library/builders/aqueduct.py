@@ -2,21 +2,28 @@
 
 Geometry (defaults)
 -------------------
-The arch is :func:`build_arch` with its defaults (98 blocks: span 3.0 m, ring 0.35 m, 30
-voussoirs, piers 0.90 × 3.40 m in 17 courses). On top of the piers and around the arch ring, the
-spandrel wall is laid in courses of 0.30 × 0.20 m blocks in running bond, from the springing line
-(y = 3.40 m) up to a level top, across the full width between the piers' outer faces
-(x = ±2.40 m, 16 blocks). Blocks meeting the extrados are cut along it and split so every block
-is convex (see :mod:`.spandrel` for the cut / merge / split rules; minimum piece 5 % of a block).
+The arch is :func:`~.arch.build_arch` with its defaults (98 blocks: span 3.60 m, ring 0.35 m,
+30 voussoirs, piers 0.90 × 3.40 m in 17 courses of 2 blocks). On the piers and around the ring,
+the spandrel wall is laid in 18 courses of 0.30 × 0.20 m blocks in running bond, from the
+springing line (y = 3.40 m) to a level top at y = 7.00 m (1.45 m above the crown extrados),
+across the full width between the piers' outer faces (x = ±2.70 m, 18 full blocks; alternate
+courses closed by half blocks). Blocks meeting the extrados are cut along its chords and split so
+every block is convex (rules in :mod:`.spandrel`); slivers are merged away.
 
-TODO-tuned defaults: see ``build_aqueduct``.
+Result: 248 wall blocks (176 full, 18 half, 54 cut along the arch; the smallest is 8.5 % of a
+full block and 3.2 cm thick, as 2·area/perimeter) + 98 arch blocks = 346. These defaults (span,
+ring, pier width, course count, sliver limits) were chosen among the combinations giving exactly
+the paper's 248 wall blocks for the best smallest block. Other parameters give other counts.
+
+Block order: the arch's 98 blocks, then the wall bottom course first, left to right, named
+``wall-cCC-bBB`` (course from the springing line, block from the left).
 """
 
 from __future__ import annotations
 
 from shapely.geometry import Polygon
 
-from ..blocks import Assembly
+from ..blocks import Assembly, GeometryError
 from ._common import check_count, check_positive, make_block, name_width
 from .arch import arch_parts
 from .spandrel import spandrel_blocks
@@ -25,16 +32,16 @@ from .spandrel import spandrel_blocks
 def build_aqueduct(
     voussoirs: int = 30,
     pier_courses: int = 17,
-    span: float = 3.0,
+    span: float = 3.6,
     ring_thickness: float = 0.35,
     pier_width: float = 0.90,
     pier_course_height: float = 0.20,
-    wall_courses: int = 19,
+    wall_courses: int = 18,
     block_length: float = 0.30,
     block_height: float = 0.20,
     first_course_offset: bool = False,
     min_fraction: float = 0.05,
-    min_thickness: float = 0.1,
+    min_thickness: float = 0.15,
     density: float = 2500.0,
     thickness: float = 1.0,
     foundation_margin: float = 0.30,
@@ -42,13 +49,43 @@ def build_aqueduct(
     left_role: str = "fixed",
     right_role: str = "fixed",
 ) -> Assembly:
-    """Arch on two piers plus spandrel walls in running bond up to a level top."""
+    """Arch on two piers plus spandrel walls in running bond up to a level top (346 blocks).
+
+    Parameters
+    ----------
+    voussoirs, pier_courses, span, ring_thickness, pier_width, pier_course_height,
+    foundation_margin, foundation_depth, left_role, right_role : the arch, as in
+        :func:`~.arch.build_arch`.
+    wall_courses : int — spandrel courses above the springing line (default 18); the level top is
+        at springing + wall_courses · block_height and should clear the crown.
+    block_length, block_height : float, m — full wall block (0.30 × 0.20).
+    first_course_offset : bool — start the bond with half blocks at the ends of the first course.
+    min_fraction, min_thickness : sliver limits — a wall block smaller than ``min_fraction`` of a
+        full block, or thinner (2·area/perimeter) than ``min_thickness`` × block_height, is merged
+        or re-cut with a neighbour (see :mod:`.spandrel`).
+    density : kg/m³. thickness : m, out of plane.
+
+    Returns
+    -------
+    Assembly: the arch's blocks, then the wall's; supports "left-foundation", "right-foundation".
+
+    Raises
+    ------
+    GeometryError (one line) for invalid parameters, or a wall top below the crown.
+    """
     check_count("aqueduct", 1, wall_courses=wall_courses)
     check_positive("aqueduct", block_length=block_length, block_height=block_height)
     blocks, supports, geom = arch_parts(
         voussoirs, pier_courses, span, ring_thickness, pier_width, pier_course_height, density,
         thickness, foundation_margin, foundation_depth, left_role, right_role,
     )
+    top = geom.springing + wall_courses * block_height
+    crown = geom.springing + geom.extrados_radius
+    if top < crown:
+        raise GeometryError(
+            f"aqueduct: the wall top ({top:g} m) is below the crown of the extrados ({crown:g} m); "
+            "add wall_courses"
+        )
     region = Polygon(geom.extrados)
     pieces = spandrel_blocks(
         region,

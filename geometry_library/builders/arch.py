@@ -2,8 +2,9 @@
 
 Geometry (defaults)
 -------------------
-- Intrados radius R_i = span / 2 = 1.50 m, ring thickness t = 0.35 m, extrados R_e = 1.85 m
-  (t / R_mid = 0.21, about twice the minimum thickness of a semicircular arch under self-weight).
+- Intrados radius R_i = span / 2 = 1.80 m, ring thickness t = 0.35 m, extrados R_e = 2.15 m
+  (t / R_mid = 0.18, well above the ≈ 0.11 minimum thickness of a semicircular arch under its
+  own weight).
 - 30 voussoirs, each spanning 6°: exact convex quadrilaterals whose intrados and extrados are the
   straight chords between the circle points and whose joints are radial (they pass through the
   arch centre). With an even count there is a joint at the crown.
@@ -11,10 +12,11 @@ Geometry (defaults)
   running bond: a full block 0.60 m and a half block 0.30 m, swapping sides every course (vertical
   joints of consecutive courses offset by half a full block). The top course has its full block on
   the arch side, so each springing voussoir (0.35 m wide) rests on one 0.60 m block. The piers'
-  inner faces are flush with the intrados (x = ±R_i), their outer faces at x = ±(R_i + pier width).
+  inner faces are flush with the intrados (x = ±1.80 m), their outer faces at x = ±2.70 m.
 - Each pier stands on its own foundation support ("left-foundation", "right-foundation"): the pier
   footprint widened by 0.30 m on each side, 0.50 m deep, top at y = 0.
-- Springing line at y = 17 × 0.20 = 3.40 m, crown extrados at 5.25 m; centre of the arch at x = 0.
+- Springing line at y = 3.40 m, crown intrados at 5.20 m and extrados at 5.55 m; arch centre at
+  x = 0. Overall 5.40 m wide (piers' outer faces).
 
 Block count: 2 × 17 × 2 + 30 = 98. Order: left pier (bottom up, left to right), voussoirs (left to
 right, ``v01`` … ``v30``), right pier. Names: ``left-pier-c01-b1`` …, ``v01`` …, ``right-pier-c17-b2``.
@@ -72,7 +74,7 @@ def _unit_half_circle(n: int) -> np.ndarray:
 def arch_parts(
     voussoirs: int = 30,
     pier_courses: int = 17,
-    span: float = 3.0,
+    span: float = 3.6,
     ring_thickness: float = 0.35,
     pier_width: float = 0.90,
     pier_course_height: float = 0.20,
@@ -174,7 +176,7 @@ def arch_parts(
 def build_arch(
     voussoirs: int = 30,
     pier_courses: int = 17,
-    span: float = 3.0,
+    span: float = 3.6,
     ring_thickness: float = 0.35,
     pier_width: float = 0.90,
     pier_course_height: float = 0.20,
@@ -191,7 +193,7 @@ def build_arch(
     ----------
     voussoirs : int ≥ 2 — number of voussoirs (default 30, 6° each).
     pier_courses : int — courses per pier, 2 blocks each (default 17 → 34 blocks per pier).
-    span : float, m — clear span between the piers = intrados diameter (default 3.0).
+    span : float, m — clear span between the piers = intrados diameter (default 3.6).
     ring_thickness : float, m — extrados radius − intrados radius (default 0.35), ≤ pier_width.
     pier_width : float, m (default 0.90; blocks 0.60 + 0.30). pier_course_height : m (0.20).
     density : kg/m³. thickness : m, out of plane.

@@ -5,25 +5,32 @@ Algorithm
 The extrados region E is the convex polygon bounded by the extrados chain (the voussoirs' outer
 chords) and the springing line. Courses are horizontal bands of height h from the springing line up
 to a level top, spanning the width between the piers' outer faces; their vertical joints follow the
-running bond (every l, shifted by l/2 on alternate courses).
+running bond (every l, shifted by l/2 on alternate courses, mirror-symmetric about the arch axis).
 
-1. **Cut.** Every slab (band ∩ between two joints) minus E gives the raw pieces. Their boundary
-   follows the chain exactly (same vertex coordinates as the voussoirs), so walls and arch neither
-   overlap nor leave a gap.
-2. **Merge across joints.** While a raw piece is smaller than ``min_fraction`` of a full block
-   (default 5 %), the vertical joint between it and its neighbour in the course (the one it shares
-   the longer edge with) is removed — the piece becomes part of a longer block, as a mason would cut
-   one stone instead of two. Removing a joint keeps the union a "band ∩ slab − E" piece.
-3. **Split into convex blocks.** A piece is not convex where a chain vertex lies strictly inside
-   its band (the extrados bulges into it). Each such reflex vertex is resolved by a straight cut
-   from it to another vertex of the piece, or along a vertical, horizontal or radial ray; among the
-   cuts that make that vertex convex, the one whose smaller side is largest is taken, recursively.
-4. **Last slivers.** A block still below ``min_fraction`` is merged with a touching wall block if
-   their union is convex. If none is, it is kept when thicker than ``hair`` (1 mm, measured as
-   2·area/perimeter) and dropped otherwise (the gap it leaves is thinner than a hair).
+A block is a *sliver* when its area is below ``min_fraction`` of a full block (default 5 %) or its
+thickness 2·area/perimeter is below ``min_thickness`` × h (default 0.15 × 0.20 = 3 cm); its
+quality is min(area / limit, thickness / limit), < 1 for a sliver.
 
-The result depends only on the parameters (no randomness), is mirror-symmetric about the arch axis
-when the bond is, and every block is a convex polygon.
+1. **Cut.** Every slab (band ∩ between two vertical joints) minus E gives the raw pieces. Their
+   boundary follows the chain exactly (the voussoirs' own vertex coordinates), so the wall and the
+   arch neither overlap nor leave a gap.
+2. **Split into convex blocks.** A piece is not convex where a chain vertex lies strictly inside its
+   band (the extrados bulges into it). Each such reflex vertex is resolved by a straight cut from
+   it to another vertex of the piece, or along a ray (vertical, horizontal, radial — continuing the
+   voussoir joint —, extending an edge, or bisecting the vertex); the decomposition whose worst
+   block has the best quality is kept (exhaustive search up to 2 reflex vertices, greedy beyond).
+3. **Merge across joints.** While a course has a sliver, the vertical joint it touches most is
+   removed (the two slabs become one longer stone, as a mason would cut one stone instead of two)
+   and the slab is cut and split again.
+4. **Re-cut the last slivers.** A remaining sliver is united with each touching wall block in turn
+   and the union split again (or kept whole if convex); the best result replaces both if its worst
+   block beats the sliver. Otherwise the sliver is dropped if thinner than ``hair`` (1 mm — the
+   gap it leaves is a hair) and kept as it is if not.
+
+Limits: a convex block can follow only one chord of the extrados, so an arch whose chords are much
+shorter than a wall block (many voussoirs on a small ring, e.g. 100 voussoirs on 2.15 m) leaves
+small blocks along the extrados. The result depends only on the parameters, is mirror-symmetric
+about the arch axis, and every block is a convex polygon.
 """
 
 from __future__ import annotations
@@ -36,9 +43,11 @@ import shapely
 from shapely.geometry import LineString, Polygon, box
 
 from ..blocks import GeometryError
-from ..checks import COLLINEAR_RTOL, _next, _remove_collinear, _turn_cross, is_convex, signed_area
+from ..checks import COLLINEAR_RTOL, _next, _turn_cross, is_convex, signed_area
 
 DUST = 1e-10  # m², pieces below this are clipping noise
+EXHAUSTIVE = 2  # pieces with at most this many reflex vertices get an exhaustive split search
+_MEMO: dict[bytes, tuple] = {}  # convex_split results of the current spandrel_blocks call
 
 
 def _components(geom) -> list[Polygon]:
@@ -50,11 +59,11 @@ def _components(geom) -> list[Polygon]:
 
 
 def _ring(poly: Polygon) -> np.ndarray:
-    """CCW exterior without repeat or collinear vertices."""
+    """CCW exterior without repeat, collinear vertices or spikes."""
     xy = np.asarray(poly.exterior.coords)[:-1, :2]
     if signed_area(xy) < 0:
         xy = xy[::-1]
-    return _remove_collinear(xy)
+    return _clean(xy)
 
 
 @dataclass(frozen=True)
@@ -117,103 +126,184 @@ def _course_blocks(
 
 def _split_ring(xy: np.ndarray, i: int, j: int) -> tuple[np.ndarray, np.ndarray]:
     """Cut the ring along the diagonal i–j: (i … j) and (j … i), both inclusive."""
-    n = len(xy)
     if j < i:
         i, j = j, i
     return xy[i : j + 1], np.concatenate([xy[j:], xy[: i + 1]])
 
 
+def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    return a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
+
+
 def _ray_hit(xy: np.ndarray, i: int, d: np.ndarray) -> tuple[int, np.ndarray] | None:
-    """First edge (index e: xy[e]→xy[e+1]) hit by the ray from vertex i along d, and the point."""
+    """First edge e (xy[e]→xy[e+1]) hit strictly inside by the ray from vertex i along d, and the
+    hit point; None if the ray first meets a vertex (vertex targets cover that case)."""
     n = len(xy)
-    p = xy[i]
-    best = None
-    for e in range(n):
-        if e == i or (e + 1) % n == i:
-            continue
-        a, b = xy[e], xy[(e + 1) % n]
-        s = b - a
-        den = d[0] * s[1] - d[1] * s[0]
-        if abs(den) < 1e-15:
-            continue
-        w = a - p
-        t = (w[0] * s[1] - w[1] * s[0]) / den
-        u = (w[0] * d[1] - w[1] * d[0]) / den
-        if t > 1e-12 and -1e-12 <= u <= 1 + 1e-12 and (best is None or t < best[0]):
-            best = (t, e, p + t * d)
-    return None if best is None else (best[1], best[2])
+    a = xy
+    s = _next(xy) - xy
+    w = a - xy[i]
+    den = _cross(np.broadcast_to(d, s.shape), s)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        t = _cross(w, s) / den
+        u = _cross(w, np.broadcast_to(d, s.shape)) / den
+    ok = (np.abs(den) > 1e-15) & (t > 1e-12) & (u > -1e-12) & (u < 1 + 1e-12)
+    ok[[i, (i - 1) % n]] = False
+    if not ok.any():
+        return None
+    e = int(np.flatnonzero(ok)[np.argmin(t[ok])])
+    if u[e] < 1e-9 or u[e] > 1 - 1e-9:
+        return None
+    return e, xy[i] + t[e] * d
 
 
-def _valid_cut(a: np.ndarray, b: np.ndarray, total: float) -> bool:
-    area_a, area_b = signed_area(a), signed_area(b)
-    if area_a <= DUST or area_b <= DUST or abs(area_a + area_b - total) > 1e-9 * total:
-        # (a cut leaving the ring makes one side clockwise or self-intersecting)
-        return False
-    return Polygon(a).is_valid and Polygon(b).is_valid
+def _clear(xy: np.ndarray, i: int, w: np.ndarray, skip: tuple[int, ...]) -> bool:
+    """True if the open segment xy[i]→w touches no edge of the ring except the edges in ``skip``."""
+    a, b = xy, _next(xy)
+    v = xy[i]
+    d = w - v
+    tol = 1e-12 * float(np.abs(xy).max() + 1.0) ** 2
+    o1, o2 = _cross(d, a - v), _cross(d, b - v)
+    o3, o4 = _cross(b - a, v - a), _cross(b - a, w - a)
+    hit = (o1 * o2 <= tol * tol) & (o3 * o4 <= tol * tol)
+    # Colinear edges far along the same line give o1 = o2 = 0: only a real overlap counts.
+    hit[list(skip)] = False
+    return not hit.any()
 
 
 def _reflex(xy: np.ndarray) -> np.ndarray:
+    """Indices of the reflex vertices of a CCW ring (cleaned by :func:`_clean`)."""
     cross, scale = _turn_cross(xy)
     return np.flatnonzero(cross < -COLLINEAR_RTOL * scale)
 
 
+def _clean(xy: np.ndarray) -> np.ndarray:
+    """Drop straight-angle vertices and zero-width spikes (both |cross| ≤ tol) from a CCW ring."""
+    while len(xy) > 3:
+        cross, scale = _turn_cross(xy)
+        flat = np.flatnonzero(np.abs(cross) <= COLLINEAR_RTOL * scale)
+        if flat.size == 0:
+            break
+        xy = np.delete(xy, flat[0], axis=0)
+    return xy
+
+
 def _cuts(xy: np.ndarray, i: int, centre: np.ndarray):
-    """Every admissible cut from reflex vertex i: pairs of sub-rings leaving vertex i convex."""
+    """Every admissible cut from reflex vertex i, as pairs of sub-rings.
+
+    A cut along d from v = xy[i] leaves v convex on both sides iff d lies left of the incoming and
+    of the outgoing edge (cross(e_in, d) ≥ 0 and cross(e_out, d) ≥ 0: the "resolving cone"); it is
+    admissible if it also reaches its end — another vertex, or the first edge hit by a ray along
+    a fixed direction — without touching the ring. The cone's bisector always qualifies.
+    """
     n = len(xy)
-    total = signed_area(xy)
-    candidates = [(xy, i, j) for j in range(n) if j not in (i, (i - 1) % n, (i + 1) % n)]
-    radial = xy[i] - centre
-    for d in ((0.0, 1.0), (0.0, -1.0), (1.0, 0.0), (-1.0, 0.0), tuple(radial / np.hypot(*radial))):
-        hit = _ray_hit(xy, i, np.asarray(d))
+    v = xy[i]
+    e_in, e_out = v - xy[i - 1], xy[(i + 1) % n] - v
+
+    def resolves(d: np.ndarray) -> bool:
+        # Strictly left of both edges, or exactly along the extension of one of them (that side
+        # then gets a straight angle at v, which normalisation removes).
+        ok = True
+        for e, forward in ((e_in, 1.0), (e_out, -1.0)):
+            tol = COLLINEAR_RTOL * np.hypot(*d) * np.hypot(*e)
+            c = _cross(e, d)
+            ok &= bool(c > tol or (abs(c) <= tol and forward * float(np.dot(e, d)) > 0))
+        return ok
+
+    candidates = []
+    for j in range(n):
+        if j in (i, (i - 1) % n, (i + 1) % n) or not resolves(xy[j] - v):
+            continue
+        skip = {i, (i - 1) % n, j, (j - 1) % n}
+        if _clear(xy, i, xy[j], tuple(skip)):
+            candidates.append((xy, i, j))
+    radial = v - centre
+    left_in = np.array([-e_in[1], e_in[0]]) / np.hypot(*e_in)
+    left_out = np.array([-e_out[1], e_out[0]]) / np.hypot(*e_out)
+    directions = [
+        (0.0, 1.0), (0.0, -1.0), (1.0, 0.0), (-1.0, 0.0),
+        radial / np.hypot(*radial),      # continues the voussoir joint
+        e_in, -e_out,                    # extends an edge of the piece
+        left_in + left_out,              # bisects the cone: always admissible
+    ]
+    for d in directions:
+        d = np.asarray(d, dtype=np.float64)
+        d = d / np.hypot(*d)
+        if not resolves(d):
+            continue
+        hit = _ray_hit(xy, i, d)
         if hit is None:
             continue
         e, point = hit
         ext = np.insert(xy, e + 1, point, axis=0)
         candidates.append((ext, i + 1 if i > e else i, e + 1))
     for ring, ii, jj in candidates:
+        if not _off_cut(ring, ii, jj):
+            continue
         a, b = _split_ring(ring, ii, jj)
-        if not _valid_cut(a, b, total):
-            continue
-        # The cut vertex is the first/last vertex of the sub-rings; it must be convex in both.
-        at_a, at_b = (0, len(b) - 1) if ii < jj else (len(a) - 1, 0)
-        if at_a in _reflex(a).tolist() or at_b in _reflex(b).tolist():
-            continue
-        yield a, b
+        if signed_area(a) > DUST and signed_area(b) > DUST:
+            yield a, b
 
 
-def convex_split(
-    xy: np.ndarray, centre: np.ndarray, limits: Limits, depth: int = 0
-) -> tuple[float, list[np.ndarray]]:
+def _off_cut(ring: np.ndarray, i: int, j: int) -> bool:
+    """True if no vertex other than the ends lies on the segment ring[i]–ring[j] (a cut grazing a
+    vertex would make a self-touching side)."""
+    p, q = ring[i], ring[j]
+    d = q - p
+    length2 = float(d @ d)
+    others = np.delete(ring, [i, j], axis=0) - p
+    t = np.clip(others @ d / length2, 0.0, 1.0)
+    gap = np.hypot(*(others - t[:, None] * d).T)
+    return bool(np.all(gap > 1e-9 * np.sqrt(length2)))
+
+
+def _split_key(parts: list[np.ndarray], limits: Limits) -> tuple:
+    """Ranking of a decomposition: worst quality first, then fewer parts, then the other qualities
+    (leximin). Qualities are rounded so mirror-image pieces rank their mirror-image cuts alike."""
+    q = sorted(round(limits.quality(p), 9) for p in parts)
+    return (q[0], -len(parts), tuple(q))
+
+
+def convex_split(xy: np.ndarray, centre: np.ndarray, limits: Limits) -> tuple[tuple, list[np.ndarray]]:
     """Step 3: split a CCW ring into convex rings by straight cuts from its reflex vertices.
 
-    Returns (worst part quality, parts), choosing the cuts that maximise the worst quality
-    (:meth:`Limits.quality`: area and thickness relative to the limits).
+    Returns (ranking key, parts) for the best decomposition found: the one whose worst part has
+    the highest :meth:`Limits.quality` (ties: fewer parts, then the next-worst part, ...).
 
     Pseudo-code::
 
-        if no reflex vertex: return area, [ring]
-        v = first reflex vertex (every decomposition must cut at v)
-        for each cut from v (to another vertex, or along a ray up / down / left / right / away
-        from ``centre``) that stays inside the ring and leaves v convex on both sides:
-            split both sides recursively; score = worst part quality
-        return the best score (ties: fewer parts)
+        if no reflex vertex: return [ring]
+        for each reflex vertex v, for each cut from v (to another vertex, or along a ray up / down /
+        left / right / away from ``centre``) that stays inside the ring and leaves v convex on
+        both sides:
+            decompose both sides recursively
+        return the best-ranked decomposition
     """
-    xy = _remove_collinear(xy)
+    xy = _clean(xy)
+    memo_key = xy.tobytes()
+    if memo_key in _MEMO:
+        return _MEMO[memo_key]
     reflex = _reflex(xy)
     if reflex.size == 0:
-        return limits.quality(xy), [xy]
-    if depth > 8:
+        return _split_key([xy], limits), [xy]
+    # Every reflex vertex is tried as the first cut, so mirror-image pieces get mirror-image splits.
+    cuts = [ab for v in reflex.tolist() for ab in _cuts(xy, v, centre)]
+    if not cuts:
         raise GeometryError("spandrel: could not split a wall piece into convex blocks (builder bug)")
-    best = None
-    for a, b in _cuts(xy, int(reflex[0]), centre):
-        sa, pa = convex_split(a, centre, limits, depth + 1)
-        sb, pb = convex_split(b, centre, limits, depth + 1)
-        key = (min(sa, sb), -(len(pa) + len(pb)))
-        if best is None or key > best[0]:
-            best = (key, pa + pb)
-    if best is None:
-        raise GeometryError("spandrel: could not split a wall piece into convex blocks (builder bug)")
-    return best[0][0], best[1]
+    if reflex.size > EXHAUSTIVE:
+        # Many reflex vertices (a fine extrados along a long piece): greedy, to bound the search —
+        # take the cut whose two sides rank best as they are, then split those.
+        a, b = max(cuts, key=lambda ab: _split_key(list(ab), limits))
+        parts = convex_split(a, centre, limits)[1] + convex_split(b, centre, limits)[1]
+        best = (_split_key(parts, limits), parts)
+    else:
+        best = None
+        for a, b in cuts:
+            parts = convex_split(a, centre, limits)[1] + convex_split(b, centre, limits)[1]
+            key = _split_key(parts, limits)
+            if best is None or key > best[0]:
+                best = (key, parts)
+    _MEMO[memo_key] = best
+    return best
 
 
 def spandrel_blocks(
@@ -227,7 +317,7 @@ def spandrel_blocks(
     block_height: float,
     first_offset: bool = False,
     min_fraction: float = 0.05,
-    min_thickness: float = 0.1,
+    min_thickness: float = 0.15,
     hair: float = 1e-3,
 ) -> list[tuple[int, Polygon]]:
     """Convex spandrel blocks as (course index from 0, polygon), bottom course first, left to right.
@@ -246,6 +336,7 @@ def spandrel_blocks(
     hair : m — a sliver that cannot be merged is dropped only if thinner than this.
     """
     limits = Limits(min_fraction * block_length * block_height, min_thickness * block_height)
+    _MEMO.clear()
     half = 0.5 * block_length
     mid = 0.5 * (x_min + x_max)
     pieces: list[tuple[int, Polygon]] = []
@@ -262,40 +353,57 @@ def spandrel_blocks(
         ]
         for poly in _course_blocks([x_min, *inner, x_max], y0, y1, region, centre, limits):
             pieces.append((c, poly))
-    pieces = _merge_slivers(pieces, limits, hair)
+    _MEMO.clear()
+    pieces = _merge_slivers(pieces, centre, limits, hair)
     pieces.sort(key=lambda cp: (cp[0], cp[1].centroid.x))
     return pieces
 
 
-def _merge_slivers(pieces: list[tuple[int, Polygon]], limits: Limits, hair: float):
-    """Step 4: merge remaining slivers into a touching block when the union is convex."""
+def _merge_slivers(pieces: list[tuple[int, Polygon]], centre: np.ndarray, limits: Limits, hair: float):
+    """Step 4: re-cut each remaining sliver together with a touching block.
+
+    Pseudo-code::
+
+        while some block p has quality < 1 (and was not given up on):
+            for each block q sharing an edge with p:
+                u = p ∪ q; parts = [u] if u is convex else convex_split(u)
+            take the best-ranked parts; if their worst quality beats min(quality p, quality q),
+            replace p and q by them (a merge when parts == [u]); otherwise drop p if it is thinner
+            than a hair, else keep it as it is.
+    """
     pieces = list(pieces)
     kept: set[int] = set()  # ids of slivers we gave up on
-    while True:
+    for _ in range(10 * len(pieces) + 10):
         small = [
             (q, k)
             for k, (c, p) in enumerate(pieces)
             if (q := limits.quality(_ring(p))) < 1.0 and id(p) not in kept
         ]
         if not small:
-            return pieces
-        _, k = min(small)
+            break
+        q_p, k = min(small)
         c, p = pieces[k]
-        options = []
+        best = None
         for m, (cm, q) in enumerate(pieces):
-            if m == k or not p.intersects(q):
-                continue
-            shared = _shared_length(p, q)
-            if shared <= 1e-9:
+            if m == k or not p.intersects(q) or _shared_length(p, q) <= 1e-9:
                 continue
             union = shapely.union(p, q)
-            if isinstance(union, Polygon) and not union.interiors and is_convex(_ring(union)):
-                options.append((-shared, m, cm, union))
-        if options:
-            _, m, cm, union = min(options, key=lambda t: (t[0], t[1]))
-            pieces[m] = (cm, Polygon(_ring(union)))
-            del pieces[k]
+            if not isinstance(union, Polygon) or union.interiors:
+                continue
+            ring = _ring(union)
+            try:
+                parts = [ring] if is_convex(ring) else convex_split(ring, centre, limits)[1]
+            except GeometryError:  # a degenerate union (pieces touching at a vertex)
+                continue
+            key = _split_key(parts, limits)
+            if key[0] > round(min(q_p, limits.quality(_ring(q))), 9) and (best is None or key > best[0]):
+                best = (key, m, min(c, cm), parts)
+        if best is not None:
+            _, m, course, parts = best
+            pieces = [cp for n, cp in enumerate(pieces) if n not in (k, m)]
+            pieces += [(course, Polygon(r)) for r in parts]
         elif 2.0 * p.area / p.length < hair:
             del pieces[k]
         else:
             kept.add(id(p))
+    return pieces

@@ -32,7 +32,7 @@ from dataclasses import dataclass
 
 from shapely.geometry import box
 
-from ..blocks import Assembly, Block, GeometryError, Support
+from ..blocks import Assembly, Block, GeometryError
 from ._common import check_positive, make_block, make_support, name_width
 
 
