@@ -192,13 +192,13 @@ Voussoirs = Annotated[int | None, typer.Option(help="Voussoirs in the arch (defa
                                                   rich_help_panel="Structure")]
 PierCourses = Annotated[int | None, typer.Option(help="Courses per pier, 2 blocks each (default 17).",
                                                     rich_help_panel="Structure")]
-Span = Annotated[float | None, typer.Option(help="Clear span of the arch, m (default 3.0).",
+Span = Annotated[float | None, typer.Option(help="Clear span of the arch, m (default 3.6).",
                                                rich_help_panel="Structure")]
 RingThickness = Annotated[float | None, typer.Option(help="Arch ring thickness, m (default 0.35).",
                                                         rich_help_panel="Structure")]
 PierWidth = Annotated[float | None, typer.Option(help="Pier width, m (default 0.90).",
                                                     rich_help_panel="Structure")]
-WallCourses = Annotated[int | None, typer.Option(help="Courses of the spandrel walls (default 19).",
+WallCourses = Annotated[int | None, typer.Option(help="Courses of the spandrel walls (default 18).",
                                                     rich_help_panel="Structure")]
 
 DEFAULT_DURATION = {"wall": 1.0, "arch": 5.0, "aqueduct": 5.0}
