@@ -437,7 +437,9 @@ def inspect_command(
     for key, value in info.items():
         if key == "metadata":
             continue
-        if isinstance(value, (list, tuple)):
+        if key in ("steps", "time_span") and isinstance(value, (list, tuple)) and len(value) == 2:
+            value = f"{value[0]} … {value[1]}" + (" s" if key == "time_span" else "")
+        elif isinstance(value, (list, tuple)):
             value = "\n".join(map(str, value))
         table.add_row(key, str(value))
     console.print(table)

@@ -113,7 +113,7 @@ def print_summary(console: Console, result: RunResult, scenario, out: Path | Non
     console.print(summary_table(result, scenario.run.max_iterations, str(out) if out else None,
                                 str(history) if history else None))
     if out is not None:
-        console.print(f"Open the recording:  [bold]{rerun_command()} {out}[/bold]")
+        console.print(f"Open the recording:  [bold]{rerun_command()} {out}[/bold]", soft_wrap=True)
 
 
 def rerun_command() -> str:
