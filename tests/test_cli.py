@@ -228,3 +228,15 @@ def test_geometry_file_errors_are_one_line(tmp_path):
     scen = tmp_path / "s.toml"
     scen.write_text('[structure]\nfile = "missing.geojson"\n')
     assert_one_line_error(invoke("check", scen), "missing.geojson", "no such file")
+
+
+def test_inspect_summarises_a_recording(tmp_path):
+    rrd = tmp_path / "w.rrd"
+    assert invoke("simulate", "wall", "--duration", 0.03, "--out", rrd).exit_code == 0
+    result = invoke("inspect", rrd)
+    assert result.exit_code == 0, result.output
+    assert "masonry" in result.output and "0 … 30" in result.output and "/structure/plane/xy/blocks" in result.output
+    bad = tmp_path / "bad.rrd"
+    bad.write_bytes(b"not a recording")
+    assert_one_line_error(invoke("inspect", bad), "bad.rrd")
+    assert_one_line_error(invoke("inspect", tmp_path / "missing.rrd"), "missing.rrd")
