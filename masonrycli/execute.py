@@ -94,7 +94,7 @@ def execute(scenario, *, out: Path | None, history: Path | None, console: Consol
     result = None
     status, note = "error", "the run stopped on an unexpected error"
     try:
-        with progress_bar(console, sim.model.n_steps, sim.model.dt) as on_progress:
+        with progress_bar(console, sim.model.n_steps) as on_progress:
             result = simulate(scenario, sinks, on_progress=on_progress, sim=sim)
         status, note = result.status, result.message
     except KeyboardInterrupt:

@@ -5,14 +5,13 @@ from __future__ import annotations
 import time
 from contextlib import contextmanager
 
-import numpy as np
 from rich.console import Console
 from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
 from rich.table import Table
 
 
 @contextmanager
-def progress_bar(console: Console, n_steps: int, dt: float):
+def progress_bar(console: Console, n_steps: int):
     """Yield an ``on_progress(sim, stats)`` callback drawing steps/s, simulated time and NLGS sweeps."""
     progress = Progress(
         TextColumn("[bold]simulating"),
@@ -58,8 +57,7 @@ def summary_table(result, max_iterations: int, recording: str | None, history: s
     table.add_row("dissipated at contacts", f"{result.energy_dissipated:.4g} J")
     table.add_row("work of the supports", f"{result.support_work:.4g} J")
     for key, value in result.extra.items():
-        if isinstance(value, str):
-            table.add_row(key, value)
+        table.add_row(key, value)
     if result.message:
         table.add_row("note", result.message)
     if history:
@@ -67,7 +65,3 @@ def summary_table(result, max_iterations: int, recording: str | None, history: s
     if recording:
         table.add_row("recording", recording)
     return table
-
-
-def iterations_summary(iterations: np.ndarray) -> str:
-    return f"{iterations.mean():.1f}" if iterations.size else "-"

@@ -45,6 +45,7 @@ class RunResult:
     support_work: float
     frames: int
     extra: dict = field(default_factory=dict)
+    """Further summary rows, label → text (e.g. the hinged joints at the end)."""
 
 
 class Simulation:
@@ -201,7 +202,7 @@ def simulate(scenario, sinks=(), on_progress: Callable | None = None, progress_e
         status = "interrupted"
         # The interrupted step may be half done: keep the frames recorded so far, add none.
         message = f"interrupted at t = {sim.state.time:.4f} s (step {done} of {n_steps})"
-    extra = {"model": m}
+    extra: dict[str, str] = {}
     if sim.last is not None and sim.joints.key.size:
         hinged, _ = sim.hinges()
         names = list(m.block_name) + list(m.support_name)
