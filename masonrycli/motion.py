@@ -45,119 +45,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from masonrycli.errors import InputError
+from masonrycli.values import check_real, check_vector, field_error, format_value, is_real, shorten
 
 MOTION_KINDS = ("fixed", "constant", "sine", "ramp", "record")
 RECORD_QUANTITIES = ("velocity", "acceleration")
-
-
-# --------------------------------------------------------------------------------------------------
-# small formatting / checking helpers (shared with masonrycli.scenario)
-
-
-def format_value(value) -> str:
-    """A value as it would be written in TOML (for error messages and the emitter)."""
-    if isinstance(value, bool):
-        return "true" if value else "false"
-    if isinstance(value, int):
-        return str(value)
-    if isinstance(value, float):
-        if math.isnan(value):
-            return "nan"
-        if math.isinf(value):
-            return "inf" if value > 0 else "-inf"
-        return repr(value)
-    if isinstance(value, str):
-        return quote_string(value)
-    if isinstance(value, (list, tuple)):
-        return "[" + ", ".join(format_value(v) for v in value) + "]"
-    if isinstance(value, dict):
-        return "{ " + ", ".join(f"{quote_key(k)} = {format_value(v)}" for k, v in value.items()) + " }"
-    if isinstance(value, np.generic):
-        return format_value(value.item())
-    if isinstance(value, np.ndarray):
-        return format_value(value.tolist())
-    return repr(value)
-
-
-def quote_string(text: str) -> str:
-    """A TOML basic string (double quotes, escapes for quote, backslash and control characters)."""
-    out = ['"']
-    for ch in text:
-        code = ord(ch)
-        if ch == '"':
-            out.append('\\"')
-        elif ch == "\\":
-            out.append("\\\\")
-        elif ch == "\n":
-            out.append("\\n")
-        elif ch == "\t":
-            out.append("\\t")
-        elif ch == "\r":
-            out.append("\\r")
-        elif code < 0x20 or code == 0x7F:
-            out.append(f"\\u{code:04x}")
-        else:
-            out.append(ch)
-    out.append('"')
-    return "".join(out)
-
-
-_BARE_KEY = re.compile(r"^[A-Za-z0-9_-]+$")
-
-
-def quote_key(key: str) -> str:
-    return key if _BARE_KEY.match(key) else quote_string(key)
-
-
-def _short(value, limit: int = 60) -> str:
-    text = format_value(value)
-    return text if len(text) <= limit else text[: limit - 3] + "..."
-
-
-def field_error(key: str, value, reason: str) -> InputError:
-    """``InputError('key = value: reason')`` with the value shortened to keep the message one line."""
-    return InputError(f"{key} = {_short(value)}: {reason}")
-
-
-def is_real(value) -> bool:
-    return isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(value, (bool, np.bool_))
-
-
-def check_real(key: str, value, *, gt=None, ge=None, le=None, lt=None, allow_inf: bool = False) -> float:
-    """Return ``value`` as a float or raise ``InputError`` naming ``key``."""
-    if not is_real(value):
-        raise field_error(key, value, "must be a number")
-    x = float(value)
-    if math.isnan(x):
-        raise field_error(key, value, "must be a finite number")
-    if math.isinf(x) and not (allow_inf and x > 0):
-        raise field_error(key, value, "must be a finite number")
-    if gt is not None and not x > gt:
-        raise field_error(key, value, f"must be > {gt:g}")
-    if ge is not None and not x >= ge:
-        raise field_error(key, value, f"must be >= {ge:g}")
-    if lt is not None and not x < lt:
-        raise field_error(key, value, f"must be < {lt:g}")
-    if le is not None and not x <= le:
-        raise field_error(key, value, f"must be <= {le:g}")
-    return x
-
-
-def check_vector(key: str, value, size: int = 2) -> tuple[float, ...]:
-    """Return ``value`` as a tuple of ``size`` finite floats or raise ``InputError`` naming ``key``."""
-    if isinstance(value, np.ndarray):
-        value = value.tolist()
-    if not isinstance(value, (list, tuple)) or len(value) != size or not all(is_real(v) for v in value):
-        names = {2: "[x, y]", 3: "[vx, vy, omega]"}.get(size, f"{size} numbers")
-        raise field_error(key, value, f"must be {size} numbers {names}")
-    out = tuple(float(v) for v in value)
-    if not all(math.isfinite(v) for v in out):
-        raise field_error(key, value, "must be finite numbers")
-    return out
-
-
-# --------------------------------------------------------------------------------------------------
-# Motion
 
 
 @dataclass(frozen=True)
@@ -410,7 +301,7 @@ def load_record_csv(path, display: str | None = None) -> tuple[np.ndarray, np.nd
                 header_seen = True
                 continue
             bad = next(f for f in fields if not _is_float(f))
-            raise InputError(f"{name}:{lineno}: not a number: {_short(bad, 40)}") from None
+            raise InputError(f"{name}:{lineno}: not a number: {shorten(bad, 40)}") from None
         if ncol == 0:
             if len(nums) not in (2, 3):
                 raise InputError(
@@ -420,7 +311,7 @@ def load_record_csv(path, display: str | None = None) -> tuple[np.ndarray, np.nd
         elif len(nums) != ncol:
             raise InputError(f"{name}:{lineno}: expected {ncol} columns like the first sample, got {len(nums)}")
         if not all(math.isfinite(x) for x in nums):
-            raise InputError(f"{name}:{lineno}: values must be finite, got {_short(stripped, 40)}")
+            raise InputError(f"{name}:{lineno}: values must be finite, got {shorten(stripped, 40)}")
         if times and not nums[0] > times[-1]:
             raise InputError(
                 f"{name}:{lineno}: time {format_value(nums[0])} is not after the previous sample's "

@@ -7,9 +7,10 @@ import math
 import numpy as np
 import pytest
 
-import naive_collision as nv
 from masonrycli.engine.broadphase import PairBuffers, body_aabbs, candidate_pairs, world_vertices
 from masonrycli.engine.collision import ContactBuffers, detect_contacts
+
+import naive_collision as nv
 
 
 def random_scene(rng, n, supports=3, spread=4.0, quantum=None):

@@ -7,7 +7,6 @@ import math
 import numpy as np
 import pytest
 
-import naive_collision as nv
 from masonrycli.engine.narrowphase import (
     KEY_LIMIT_VERTICES,
     check_topology,
@@ -16,6 +15,8 @@ from masonrycli.engine.narrowphase import (
     edge_normals,
     narrowphase,
 )
+
+import naive_collision as nv
 
 ALERT = 0.02  # random polygons are ~1 m across: a generous alert distance gives many near contacts
 

@@ -149,7 +149,7 @@ def test_random_acceleration_record_matches_independent_integration():
     # between samples: the integral of the linearly interpolated acceleration (adaptive quadrature)
     for tq in rng.uniform(times[0], times[-1], 5):
         for k in range(2):
-            ref, _ = quad(lambda s: -2.0 * np.interp(s, times, acc[:, k]), 0.0, tq,
+            ref, _ = quad(lambda s, k=k: -2.0 * np.interp(s, times, acc[:, k]), 0.0, tq,
                           points=times[times < tq], limit=200, epsabs=1e-13)
             assert m.velocity_at([tq])[0, k] == pytest.approx(ref, abs=1e-10)
     # before the first sample: at rest

@@ -11,11 +11,12 @@ import numpy as np
 import pytest
 import rerun as rr
 
-import recording_fixtures as fx
 from masonrycli import colormap as cm
 from masonrycli import recording as rec_mod
 from masonrycli.frame import CONTACT_OPEN
 from masonrycli.recording import ENTITY_PATHS, FIELDS, Recorder, inspect_recording
+
+import recording_fixtures as fx
 
 N_FRAMES, BATCH = 25, 10  # three flushes, the last one partial
 

@@ -18,12 +18,12 @@ from masonrycli.scenario import (
     Material,
     RunConfig,
     Scenario,
-    dump_scenario,
     load_scenario,
     loads_scenario,
     scenario_from_builder,
     scenario_summary,
 )
+from masonrycli.scenario_toml import dump_scenario
 
 DATA = Path(__file__).parent / "data"
 

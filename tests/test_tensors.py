@@ -166,7 +166,6 @@ def test_case3_column_block_and_cell_stress():
     assert triangles.shape == (0, 3)
     tc = T.TensorComputer(n, volume, triangles)
     q, v = state_arrays(centroids)
-    c = len(body)
     tc.step(q, v, body, point, force, 1e-3)
     f = tc.fields()
     expected_from_top = np.array([-1962.0, -5886.0, -9810.0, -13734.0, -17658.0])

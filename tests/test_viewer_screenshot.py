@@ -10,10 +10,10 @@ import ctypes.util
 import numpy as np
 import pytest
 
-import recording_fixtures as fx
 from masonrycli.colormap import COOLWARM, unpack_rgba
 from masonrycli.recording import _SUPPORT_FILL_RGBA, Recorder, _viewer_executable, screenshot_recording
 
+import recording_fixtures as fx
 
 
 def test_viewer_prerequisites_are_installed():

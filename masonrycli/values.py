@@ -1,0 +1,121 @@
+"""Checked input values and their TOML spelling, shared by the scenario reader, writer and motions.
+
+``check_real`` / ``check_vector`` / ``field_error`` turn a bad value into a one-line
+:class:`~masonrycli.errors.InputError` naming the key; ``format_value`` / ``quote_string`` / ``quote_key``
+write Python values as TOML text that ``tomllib`` reads back bit for bit.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+
+import numpy as np
+
+from masonrycli.errors import InputError
+
+
+def format_value(value) -> str:
+    """A value as it would be written in TOML (for error messages and the emitter)."""
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, int):
+        return str(value)
+    if isinstance(value, float):
+        if math.isnan(value):
+            return "nan"
+        if math.isinf(value):
+            return "inf" if value > 0 else "-inf"
+        return repr(value)
+    if isinstance(value, str):
+        return quote_string(value)
+    if isinstance(value, (list, tuple)):
+        return "[" + ", ".join(format_value(v) for v in value) + "]"
+    if isinstance(value, dict):
+        return "{ " + ", ".join(f"{quote_key(k)} = {format_value(v)}" for k, v in value.items()) + " }"
+    if isinstance(value, np.generic):
+        return format_value(value.item())
+    if isinstance(value, np.ndarray):
+        return format_value(value.tolist())
+    return repr(value)
+
+
+def quote_string(text: str) -> str:
+    """A TOML basic string (double quotes, escapes for quote, backslash and control characters)."""
+    out = ['"']
+    for ch in text:
+        code = ord(ch)
+        if ch == '"':
+            out.append('\\"')
+        elif ch == "\\":
+            out.append("\\\\")
+        elif ch == "\n":
+            out.append("\\n")
+        elif ch == "\t":
+            out.append("\\t")
+        elif ch == "\r":
+            out.append("\\r")
+        elif code < 0x20 or code == 0x7F:
+            out.append(f"\\u{code:04x}")
+        else:
+            out.append(ch)
+    out.append('"')
+    return "".join(out)
+
+
+_BARE_KEY = re.compile(r"^[A-Za-z0-9_-]+$")
+
+
+def quote_key(key: str) -> str:
+    return key if _BARE_KEY.match(key) else quote_string(key)
+
+
+def shorten(value, limit: int = 60) -> str:
+    text = format_value(value)
+    return text if len(text) <= limit else text[: limit - 3] + "..."
+
+
+def field_error(key: str, value, reason: str) -> InputError:
+    """``InputError('key = value: reason')`` with the value shortened to keep the message one line."""
+    return InputError(f"{key} = {shorten(value)}: {reason}")
+
+
+def is_real(value) -> bool:
+    return isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(value, (bool, np.bool_))
+
+
+def check_real(key: str, value, *, gt=None, ge=None, le=None, lt=None, allow_inf: bool = False) -> float:
+    """Return ``value`` as a float or raise ``InputError`` naming ``key``."""
+    if not is_real(value):
+        raise field_error(key, value, "must be a number")
+    x = float(value)
+    if math.isnan(x):
+        raise field_error(key, value, "must be a finite number")
+    if math.isinf(x) and not (allow_inf and x > 0):
+        raise field_error(key, value, "must be a finite number")
+    if gt is not None and not x > gt:
+        raise field_error(key, value, f"must be > {gt:g}")
+    if ge is not None and not x >= ge:
+        raise field_error(key, value, f"must be >= {ge:g}")
+    if lt is not None and not x < lt:
+        raise field_error(key, value, f"must be < {lt:g}")
+    if le is not None and not x <= le:
+        raise field_error(key, value, f"must be <= {le:g}")
+    return x
+
+
+def check_vector(key: str, value, size: int = 2) -> tuple[float, ...]:
+    """Return ``value`` as a tuple of ``size`` finite floats or raise ``InputError`` naming ``key``."""
+    if isinstance(value, np.ndarray):
+        value = value.tolist()
+    if not isinstance(value, (list, tuple)) or len(value) != size or not all(is_real(v) for v in value):
+        names = {2: "[x, y]", 3: "[vx, vy, omega]"}.get(size, f"{size} numbers")
+        raise field_error(key, value, f"must be {size} numbers {names}")
+    out = tuple(float(v) for v in value)
+    if not all(math.isfinite(v) for v in out):
+        raise field_error(key, value, "must be finite numbers")
+    return out
+
+
+# --------------------------------------------------------------------------------------------------
+# Motion
