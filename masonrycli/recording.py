@@ -42,8 +42,16 @@ import rerun as rr
 import rerun.blueprint as rrb
 
 from masonrycli import __version__ as MASONRY_VERSION
-from masonrycli.colormap import (COOLWARM, NAN_RGBA, VIRIDIS, colorbar_mesh, map_scalars, nice_ceil,
-                                 robust_max_abs, tick_label)
+from masonrycli.colormap import (
+    COOLWARM,
+    NAN_RGBA,
+    VIRIDIS,
+    colorbar_mesh,
+    map_scalars,
+    nice_ceil,
+    robust_max_abs,
+    tick_label,
+)
 from masonrycli.frame import CONTACT_OPEN, CONTACT_SLIP, CONTACT_STICK, Frame
 
 APPLICATION_ID: Final = "masonry"
