@@ -137,7 +137,11 @@ def _outputs(name: str, out: Path | None, no_recording: bool) -> Path | None:
     return out
 
 
-def _execute(scenario, out: Path | None, history: Path | None) -> None:
+PAPER_INSTANT = {"wall": ("III.2–III.5", 0.1), "arch": ("III.7–III.10", 5.0)}
+"""The instant of the paper's figures for each built-in structure."""
+
+
+def _execute(scenario, out: Path | None, history: Path | None, hint: str = "") -> None:
     from masonrycli.execute import execute, print_summary
 
     for warning in scenario.warnings:
@@ -158,6 +162,8 @@ def _execute(scenario, out: Path | None, history: Path | None) -> None:
                           " traceback)", highlight=False, soft_wrap=True)
         raise typer.Exit(EXIT_INTERNAL) from None
     print_summary(console, result, scenario, out, history)
+    if hint and out is not None:
+        console.print(hint, soft_wrap=True)
     if result.status == "diverged":
         raise typer.Exit(EXIT_DIVERGED)
     if result.status == "interrupted":
@@ -233,7 +239,13 @@ def _simulate(builder: str, options: dict, *, freq, amp, settlement, duration, d
     scenario = scenario_from_builder(builder, options, run, material, motions)
     scenario = _apply_options(scenario, duration=duration, dt=dt, theta=theta, friction=None,
                               record_every=record_every, tolerance=tolerance, max_iterations=max_iterations)
-    _execute(scenario, _outputs(builder, out, no_recording), history)
+    hint = ""
+    if builder in PAPER_INSTANT:
+        figs, t = PAPER_INSTANT[builder]
+        step = round(t / scenario.run.dt)
+        if step <= scenario.run.n_steps:
+            hint = f"The paper's Figs. {figs} are at t = {t:g} s: step {step} on the viewer's timeline."
+    _execute(scenario, _outputs(builder, out, no_recording), history, hint)
 
 
 def _sine(amp: float, freq: float):
