@@ -1,6 +1,6 @@
 """Recompute the figures quoted in docs/scenarios.md from the runs' history files.
 
-Run the four scenarios of docs/scenarios.md with ``--history X.npz``, then, from the repository root::
+Run the five scenarios of docs/scenarios.md with ``--history X.npz``, then, from the repository root::
 
     python docs/scenario_figures.py --wall wall51.npz --wall wall248.npz --arch arch.npz \\
         --aqueduct aqueduct.npz --aqueduct aqueduct-shaken.npz \\
@@ -10,12 +10,19 @@ Any subset of the options works; each prints its tables (plain text, numbers as 
 ``--static`` takes the history of the same wall with the ground at rest (``masonry simulate wall
 --amp 0 --duration 0.01 --record-every 1 --history ...``) for the exact check of σ_yy per course.
 
-Joint openings are measured geometrically, not read from ``block_max_opening`` (which saturates at the
-1 mm alert distance and drops to 0 once a joint has opened beyond it): the structure is rebuilt with the
-project's builder (defaults, ``blocks`` = N for a wall; checked against the recorded initial centroids),
-the two end points of every joint face of ``joint_body`` are attached to both bodies, and each end's
-opening is the normal separation of the two copies, (p_b − p_a)·n_a, with the rigid motions of
-``block_q`` / ``support_q``. Positive = open, negative = interpenetration.
+Joint states are read from the history: ``block_max_opening`` (the widest opening of the block's initial
+joints, followed kinematically by ``masonrycli.mechanism``), ``block_sliding_ratio`` (share of the block's
+normal contact load carried by sliding contacts) and ``joint_hinged``. Two things the history does not hold
+per joint — which end of a joint is open (intrados / extrados) and how far its faces have slid — are
+measured geometrically, which also gives an independent cross-check of the openings and hinges: the
+structure is rebuilt with the project's builder (defaults, ``blocks`` = N for a wall; checked against the
+recorded initial centroids), the two end points of every joint face of ``joint_body`` are attached to both
+bodies, and each end's opening is the normal separation of the two copies, (p_b − p_a)·n_a, with the rigid
+motions of ``block_q`` / ``support_q``. Positive = open, negative = interpenetration. The script prints how
+far the widest geometric opening of each block is from ``block_max_opening``.
+
+The colour ranges of the recording are reproduced from the history the way the recorder fixes them (first
+batch of 100 frames whose field is not all zero, 98th percentile of |value|, rounded up).
 """
 
 from __future__ import annotations
@@ -149,6 +156,71 @@ def table(header, rows, fmt=None):
     print()
 
 
+def per_block_max(run: Run, values: np.ndarray) -> np.ndarray:
+    """(..., J) values per joint -> (..., N) the largest over each block's joints (0 with none)."""
+    jb, n = run.h["joint_body"], run.n
+    out = np.zeros(values.shape[:-1] + (n,))
+    for k in range(2):
+        m = jb[:, k] < n
+        for j in np.where(m)[0]:
+            b = jb[j, k]
+            out[..., b] = np.maximum(out[..., b], values[..., j])
+    return out
+
+
+def opening_crosscheck(run: Run, op, slip) -> str:
+    """Widest geometric opening per block vs the recorded ``block_max_opening``, over every frame; at the last
+    frame, the blocks where they differ by more than 0.1 mm, with the largest slip of their joints."""
+    geo = per_block_max(run, np.maximum(op.max(axis=2), 0.0))
+    bmo = run.h["block_max_opening"]
+    d = np.abs(geo - bmo)
+    t, b = np.unravel_index(np.argmax(d), d.shape)
+    flips = [int(((geo > thr) != (bmo > thr)).sum()) for thr in (1e-4, 1e-3)]
+    out = (f"widest geometric opening per block vs block_max_opening, all {d.shape[0]} frames × {d.shape[1]} "
+           f"blocks: max |difference| {1e3 * d.max():.4f} mm ({run.names[b]}, t = {run.h['time'][t]:.2f} s: "
+           f"geometric {1e3 * geo[t, b]:.3f} mm, recorded {1e3 * bmo[t, b]:.3f} mm); (block, frame) pairs on "
+           f"different sides of 0.1 mm / 1 mm: {flips[0]} / {flips[1]}; largest block_max_opening over the run "
+           f"{1e3 * bmo.max():.1f} mm")
+    off = np.where(d[-1] > 1e-4)[0]
+    if off.size:
+        gslip = per_block_max(run, np.abs(slip[-1]))
+        off = off[np.argsort(-d[-1, off])]
+        out += (f". At the end {off.size} blocks differ by more than 0.1 mm (recorded / geometric opening / largest "
+                "|slip| of the block's joints, mm): " + ", ".join(
+                    f"{run.names[i]} {1e3 * bmo[-1, i]:.1f} / {1e3 * geo[-1, i]:.1f} / {1e3 * gslip[i]:.1f}"
+                    for i in off[:16]) + (" …" if off.size > 16 else ""))
+    return out
+
+
+RECORDED_FIELDS = (("cell_volumetric_strain_rate", True), ("cell_deviatoric_strain", False),
+                   ("cell_spherical_stress", True), ("cell_deviatoric_stress", False))
+
+
+def recorded_range(h: dict, key: str, batch: int = 100) -> float:
+    """M of the recording's colour range of ``key``, as ``masonrycli.recording`` fixes it: first batch of
+    ``batch`` frames with a non-zero 98th percentile of |value|, rounded up with ``nice_ceil``."""
+    from masonrycli.colormap import nice_ceil, robust_max_abs
+    v = h[key]
+    for i in range(0, v.shape[0], batch):
+        m = nice_ceil(robust_max_abs(v[i:i + batch], 98.0))
+        if m > 0.0:
+            return m
+    return 0.0
+
+
+def colour_ranges(run: Run, i: int) -> str:
+    h = run.h
+    parts = []
+    for key, signed in RECORDED_FIELDS:
+        m = recorded_range(h, key)
+        v = h[key][i]
+        over = int((np.abs(v) > m).sum()) if signed else int((v > m).sum())
+        parts.append(f"{key.removeprefix('cell_')} {'±' if signed else '0 … '}{m:g} "
+                     f"({over} of {int(np.isfinite(v).sum())} defined cells beyond at t = {h['time'][i]:.2f} s, "
+                     f"max |value| {np.nanmax(np.abs(v)):.3g})")
+    return "Recording colour ranges (reproduced from the history): " + "; ".join(parts)
+
+
 def detector_vs_geometry(run: Run, op, i: int) -> str:
     """Compare the hinge detector (joint_hinged) with the geometric openings at frame i."""
     o = op[i]
@@ -186,46 +258,51 @@ def wall(path: str, static: str | None) -> None:
     ground = n  # the single support
     opmax = op.max(axis=2)  # (T, J) widest end of each joint
 
-    # per-block largest geometric opening over its joints
-    def block_max(values):  # (J,) -> (n,)
-        out = np.zeros(n)
-        for k in range(2):
-            b = jb[:, k]
-            m = b < n
-            np.maximum.at(out, b[m], values[m])
-        return out
-
-    gop = block_max(opmax[i1])
     evr = h["cell_volumetric_strain_rate"][i1]
-    bmo = h["block_max_opening"][i1]
+    bmo_all = h["block_max_opening"]  # (T, N) recorded, followed kinematically
+    bmo = bmo_all[i1]
     sr = h["block_sliding_ratio"]
     dx = h["block_q"][:, :, 0] - h["block_q"][0, :, 0]
     ug = h["support_q"][:, 0, 0] - h["support_q"][0, 0, 0]
     rot = np.degrees(h["block_q"][:, :, 2])
+    # bed joints under each course (course 1: the ground joints), for the slip by course
+    a_c = np.where(jb[:, 0] < n, course[np.minimum(jb[:, 0], n - 1)], 0)
+    b_c = np.where(jb[:, 1] < n, course[np.minimum(jb[:, 1], n - 1)], 0)
+    under = np.where(a_c != b_c, np.maximum(a_c, b_c), -1)  # course above the bed joint, -1 for head joints
+    aslip = np.abs(slip)
+    T = h["time"]
+    rate = np.abs(slip[i1 + 1] - slip[i1 - 1]) / (T[i1 + 1] - T[i1 - 1])  # (J,) m/s, central difference at t
 
     rows = []
     for c in range(C, 0, -1):
         m = course == c
-        rows.append([c, m.sum(), (gop[m] > 1e-4).sum(), (gop[m] > 1e-3).sum(), 1e3 * gop[m].max(),
-                     (bmo[m] > 1e-4).sum(), (evr[m] > 0).sum(), evr[m].mean(), sr[i1, m].mean(),
-                     sr[1:, m].mean(), 1e3 * dx[i1, m].mean(), rot[i1, m].mean()])
-    print(f"Per course at t = {t1:.2f} s (course 1 = bottom). open>0.1/open>1: blocks with a joint opened more "
-          "than 0.1 / 1 mm (geometric); bmo>0.1: block_max_opening > 0.1 mm (saturates at 1 mm); "
-          "ev>0: cells with volumetric strain rate > 0; slide: mean block_sliding_ratio at t and over the "
-          "whole run; dx: mean horizontal displacement; rot: mean rotation.\n")
-    table(["course", "blocks", "open>0.1", "open>1", "max open mm", "bmo>0.1", "ev>0", "mean ev 1/s",
-           "slide(t)", "slide(run)", "dx mm", "rot deg"], rows,
-          [None, None, None, None, "{:.1f}", None, None, "{:+.3f}", "{:.2f}", "{:.2f}", "{:.1f}", "{:+.2f}"])
+        bj = under == c
+        rows.append([c, m.sum(), (bmo[m] > 1e-4).sum(), (bmo[m] > 1e-3).sum(), 1e3 * bmo[m].max(),
+                     (evr[m] > 0).sum(), evr[m].mean(), sr[i1, m].mean(), sr[1:, m].mean(),
+                     1e3 * rate[bj].mean(), 1e3 * aslip[i1, bj].mean(), 1e3 * aslip[i1, bj].max(),
+                     1e3 * aslip[-1, bj].max(),
+                     1e3 * dx[i1, m].mean(), rot[i1, m].mean()])
+    print(f"Per course at t = {t1:.2f} s (course 1 = bottom). open>0.1/open>1/max open: from block_max_opening; "
+          "ev>0: cells with volumetric strain rate > 0; slide: mean block_sliding_ratio (share of the normal "
+          "load on sliding contacts) at t and over the whole run; bed slip: relative tangential displacement "
+          "of the faces of the bed joints under the course (geometric; course 1: the ground joints): mean rate "
+          "at t (central difference over ±1 frame), mean and max at t, max at the end; dx: mean horizontal displacement; rot: mean rotation.\n")
+    table(["course", "blocks", "open>0.1", "open>1", "max open mm", "ev>0", "mean ev 1/s", "slide(t)",
+           "slide(run)", "bed slip rate mm/s", "bed slip mean mm", "bed slip max mm", "bed slip max end",
+           "dx mm", "rot deg"], rows,
+          [None, None, None, None, "{:.1f}", None, "{:+.3f}", "{:.2f}", "{:.2f}", "{:.0f}", "{:.1f}", "{:.1f}",
+           "{:.1f}", "{:.1f}", "{:+.2f}"])
+    print("Cross-check: " + opening_crosscheck(run, op, slip) + "\n")
 
     # maps: one character per block, left to right
     x0 = h["block_q"][0, :, 0]
     widest = max((course == k).sum() for k in range(1, C + 1))
 
     def show_map(i):
-        g = block_max(opmax[i])
+        g = bmo_all[i]
         e = h["cell_volumetric_strain_rate"][i]
         print(f"Map at t = {h['time'][i]:.2f} s, top course first, one character per block (left → right).")
-        print("Joint opening (geometric, widest joint of the block): '#' > 5 mm, 'o' 1–5 mm, '+' 0.1–1 mm, "
+        print("Joint opening (block_max_opening): '#' > 5 mm, 'o' 1–5 mm, '+' 0.1–1 mm, "
               "'.' closed. Volumetric strain rate ε̇v: 'O' > 0.3 1/s, '+' 0.05–0.3, '.' |ε̇v| ≤ 0.05, '-' < −0.05.\n")
         print("```")
         for c in range(C, 0, -1):
@@ -251,9 +328,7 @@ def wall(path: str, static: str | None) -> None:
     print()
     show_map(len(h["time"]) - 1)
 
-    # bed joints vs head joints, ground joint
-    a_c = np.where(jb[:, 0] < n, course[np.minimum(jb[:, 0], n - 1)], 0)
-    b_c = np.where(jb[:, 1] < n, course[np.minimum(jb[:, 1], n - 1)], 0)
+    # bed joints vs head joints, ground joint (geometric openings per joint)
     is_ground = jb[:, 1] == ground
     is_bed = (a_c != b_c) & ~is_ground
     is_head = (a_c == b_c) & ~is_ground
@@ -263,20 +338,14 @@ def wall(path: str, static: str | None) -> None:
         rows.append([label, m.sum(), (opmax[i1, m] > 1e-4).sum(), (opmax[i1, m] > 1e-3).sum(),
                      1e3 * opmax[i1, m].max(), hinged[i1, m].sum(), 1e3 * np.abs(slip[i1, m]).max(),
                      (opmax[-1, m] > 1e-3).sum(), hinged[-1, m].sum()])
-    print(f"Joints by type: open / hinged at t = {t1:.2f} s and at the end (t = {h['time'][-1]:.2f} s); "
-          "slip = largest relative tangential displacement of the two faces.\n")
+    print(f"Joints by type (geometric openings of the joint ends): open / hinged at t = {t1:.2f} s and at the "
+          f"end (t = {h['time'][-1]:.2f} s); slip = largest relative tangential displacement of the two faces.\n")
     table(["joints", "count", "open>0.1mm", "open>1mm", "max open mm", "hinged", "max slip mm",
            "open>1mm end", "hinged end"], rows,
           [None, None, None, None, "{:.1f}", None, "{:.1f}", None, None])
 
     print(f"Hinge detector vs geometry at t = {t1:.2f} s: " + detector_vs_geometry(run, op, i1))
     print("… and at the end: " + detector_vs_geometry(run, op, len(h["time"]) - 1) + "\n")
-    wide = gop > 1e-3
-    print(f"block_max_opening of the {wide.sum()} blocks with a joint open > 1 mm at t = {t1:.2f} s: max "
-          f"{1e3 * bmo[wide].max():.3f} mm, mean {1e3 * bmo[wide].mean():.3f} mm (a joint opened beyond the 1 mm "
-          f"alert distance leaves the contact list, so the field reports the other, closed contacts); largest "
-          f"block_max_opening anywhere over the run: {1e3 * np.nanmax(h['block_max_opening']):.3f} mm\n")
-
     # opening and closing: the volumetric strain rate of the whole wall changes sign
     ev_mean = np.nanmean(h["cell_volumetric_strain_rate"][1:], axis=1)
     evc = np.nanmean(h["cell_volumetric_strain"], axis=1)
@@ -287,8 +356,8 @@ def wall(path: str, static: str | None) -> None:
           "Mean cumulated volumetric strain at t = 0.1/0.25/0.5/0.75/1 s: " + ", ".join(
               f"{evc[run.at(t)]:+.4f}" for t in (0.1, 0.25, 0.5, 0.75, 1.0)))
     print(f"Dilatant cells vs open joints at t = {t1:.2f} s: of the {band.sum()} cells with ε̇v > 0.05 1/s, "
-          f"{(band & (gop > 1e-4)).sum()} have a joint open > 0.1 mm; of the {(gop > 1e-3).sum()} blocks with a "
-          f"joint open > 1 mm, {((gop > 1e-3) & band).sum()} have ε̇v > 0.05 1/s.")
+          f"{(band & (bmo > 1e-4)).sum()} have a joint open > 0.1 mm; of the {(bmo > 1e-3).sum()} blocks with a "
+          f"joint open > 1 mm, {((bmo > 1e-3) & band).sum()} have ε̇v > 0.05 1/s (block_max_opening).")
     print(f"Deviatoric cumulated strain at t = {t1:.2f} s: mean {ed[band].mean():.4f} in the {band.sum()} cells of the "
           f"dilatant band (ε̇v > 0.05 1/s), {ed[~band].mean():.4f} elsewhere; max {ed.max():.4f} "
           f"({h['block_name'][np.argmax(ed)]})\n")
@@ -337,7 +406,8 @@ def wall(path: str, static: str | None) -> None:
     print("Bottom course mean p by third of the length (left, middle, right): " + ", ".join(
         f"{p[bottom & (thirds == k)].mean() / 1e3:.0f} kPa" for k in range(3)))
     print(f"Tension (p > 0) cells: {(p > 0).sum()}; largest p = {p.max() / 1e3:.1f} kPa; "
-          f"max skew |σxy−σyx|/2 = {np.nanmax(h['cell_stress_skew'][i1]):.0f} Pa (over the run {np.nanmax(h['cell_stress_skew']):.0f} Pa)\n")
+          f"max skew |σxy−σyx|/2 = {np.nanmax(h['cell_stress_skew'][i1]):.0f} Pa (over the run {np.nanmax(h['cell_stress_skew']):.0f} Pa)")
+    print(colour_ranges(run, i1) + "\n")
 
     # σ_yy per course vs statics
     def syy_rows(hh, i):
@@ -449,8 +519,19 @@ def arch(path: str, kind: str) -> None:
     if len(ever) > len(show):
         print(f"({len(ever) - len(show)} more hinged joints not listed)\n")
 
+    ring_end = [j for j in np.where(hinged[ie])[0] if "ring" in (grp[jb[j, 0]], grp[jb[j, 1]])]
+    if 0 < len(ring_end) <= 6:
+        together = hinged[:, ring_end].all(1)
+        if together.any():
+            i0 = int(np.argmax(together))
+            print(f"The {len(ring_end)} ring joints hinged at the end ({', '.join(joint_label(run, j) for j in ring_end)}) "
+                  f"are first all flagged together at t = {T[i0]:.2f} s, then in {100 * together[i0:].mean():.0f} % of "
+                  "the frames. Geometric opening of their open end (mm) at t = " + "/".join(f"{t:g}" for t in marks)
+                  + " s: " + "; ".join(joint_label(run, j) + " " + ", ".join(
+                      f"{1e3 * op[run.at(t), j].max():.2f}" for t in marks) for j in ring_end) + "\n")
     o = op[ie]
-    print("Hinge detector vs geometry at the end: " + detector_vs_geometry(run, op, ie) + "\n")
+    print("Hinge detector vs geometry at the end: " + detector_vs_geometry(run, op, ie))
+    print("Cross-check: " + opening_crosscheck(run, op, slip) + "\n")
     if kind == "aqueduct":
         rows = []
         pairs = {}
@@ -610,12 +691,49 @@ def arch(path: str, kind: str) -> None:
     k = np.argsort(-np.nan_to_num(np.abs(evol), nan=-1))[:5]
     print("Five largest |volumetric cumulated strain|: " + ", ".join(
         f"{names[i]} ({evol[i]:+.1e})" for i in k if defined[i]))
-    edev = h["cell_deviatoric_strain"][ie]
-    print(f"Deviatoric cumulated strain at the end: {np.isfinite(edev).sum()} cells defined, max {np.nanmax(edev):.4f}, "
-          f"{(edev > 0.004).sum()} above 0.004 (the top of the recording's colour range for the settling aqueduct)")
+    print(f"Cells with a defined strain (in a centroid triangle): {defined.sum()} of {n}; without: "
+          + (", ".join(names[:n][~defined]) if (~defined).sum() <= 40 else f"{(~defined).sum()} blocks"))
+    print(colour_ranges(run, ie))
     k = np.argsort(-np.nan_to_num(np.abs(evr[ie]), nan=-1))[:5]
     print("Five largest |volumetric strain rate| at the end: " + ", ".join(
         f"{names[i]} ({evr[ie, i]:+.1e} 1/s)" for i in k if defined[i]) + "\n")
+    # the piers' volumetric strain, course by course (the paper: "a great part of the left pile is under the
+    # highest level of a volume strain")
+    pc = np.array([pier_course.get(i, 0) for i in range(n)])
+    ev_all = h["cell_volumetric_strain"]
+    rows = []
+    for c in range(top_course, 0, -1):
+        row = [c]
+        for g in ("left pier", "right pier"):
+            for b in ("b1", "b2"):
+                i = next(i for i in pier if grp[i] == g and pc[i] == c and names[i].endswith(b))
+                row += [1e5 * evol[i]]
+        for g in ("left pier", "right pier"):
+            m = (grp[:n] == g) & (pc == c)
+            row += [1e5 * evr[ie, m].mean()]
+        rows.append(row)
+    print("Pier cells at the end, course by course (c01 = bottom; b1 = the block at the pier's left): cumulated "
+          "volumetric strain εv (×1e-5) and the course's mean volumetric strain rate (×1e-5 1/s).\n")
+    table(["course", "left b1 εv", "left b2 εv", "right b1 εv", "right b2 εv", "left ε̇v", "right ε̇v"], rows,
+          [None] + ["{:+.1f}"] * 6)
+    rows = []
+    for g in ("left pier", "right pier"):
+        m = grp[:n] == g
+        js = np.array([j for j in range(len(jb)) if grp[jb[j, 0]] == g and grp[jb[j, 1]] == g])
+        pos = evr[1:, m] > 0
+        rows.append([g, *(1e5 * np.nanmean(ev_all[run.at(t), m]) for t in marks), 1e5 * np.nanmax(np.abs(evol[m])),
+                     100 * pos.mean(), 1e3 * op[ie, js].max(), 1e3 * op[ie, js].min()])
+    print("Piers: mean εv (×1e-5) over time, largest |εv| at the end (×1e-5), share of (block, frame) with "
+          "ε̇v > 0, and the widest opening / deepest interpenetration of the joints inside the pier at the end "
+          "(geometric, mm) — the scale of the relative motions behind these strains.\n")
+    table(["pier", *(f"εv {t:g} s" for t in marks), "max |εv|", "% ε̇v>0", "open mm", "penetr. mm"], rows,
+          [None] + ["{:+.1f}"] * len(marks) + ["{:.1f}", "{:.0f}", "{:.3f}", "{:+.3f}"])
+    ranks = np.argsort(-np.nan_to_num(np.abs(evol), nan=-1))
+    for k in (10, 20):
+        top = ranks[:k]
+        print(f"Of the {k} largest |εv| at the end: " + ", ".join(
+            f"{(grp[top] == g).sum()} {g}" for g in ("ring", "left pier", "right pier", "spandrel") if (grp[top] == g).any()))
+    print()
     s = h["energy_dissipated"][-1], h["support_work"][-1]
     dE = (h["energy_kinetic"][-1] + h["energy_potential"][-1]) - (h["energy_kinetic"][0] + h["energy_potential"][0])
     print(f"Energy: support work {s[1]:.0f} J, dissipated {s[0]:.1f} J, Δ(kinetic+potential) {dE:.0f} J "
