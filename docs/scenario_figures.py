@@ -192,6 +192,31 @@ def opening_crosscheck(run: Run, op, slip) -> str:
     return out
 
 
+def single_point_contacts(run: Run, kind: str) -> str:
+    """The initial contacts that are not one of two ends of a joint, as the run's JointTracker sees them
+    (``masonrycli.run.Simulation`` set-up, no time step), classified by where the contact point lies on
+    each body (a corner or inside a face); ``block_max_opening`` follows them too."""
+    from masonrycli.run import Simulation
+    from masonrycli.scenario import Material, RunConfig, scenario_from_builder
+    options = {"blocks": run.n} if kind == "wall" else {}
+    tracker = Simulation(scenario_from_builder(kind, options, RunConfig(duration=0.001), Material(), {})).joints
+    single = np.where(tracker._end_joint < 0)[0]
+    counts: dict[str, int] = {}
+    for e in single:
+        a, b = tracker.end_body[e]
+        pt = tracker._local_a[e] + run.h["block_q"][0, a, :2] if a < run.n else None
+        if pt is None:
+            continue
+        where = []
+        for body in (a, b):
+            d = np.hypot(*(np.array(run.polys[body].exterior.coords) - pt).T).min()
+            where.append("corner" if d < 1e-6 else "face")
+        key = "–".join(where)
+        counts[key] = counts.get(key, 0) + 1
+    return (f"initial contact points: {tracker.end_body.shape[0]}, of which {single.size} are not one of two ends "
+            "of a joint (" + ", ".join(f"{v} {k}" for k, v in sorted(counts.items())) + ")")
+
+
 RECORDED_FIELDS = (("cell_volumetric_strain_rate", True), ("cell_deviatoric_strain", False),
                    ("cell_spherical_stress", True), ("cell_deviatoric_stress", False))
 
@@ -292,7 +317,8 @@ def wall(path: str, static: str | None) -> None:
            "dx mm", "rot deg"], rows,
           [None, None, None, None, "{:.1f}", None, "{:+.3f}", "{:.2f}", "{:.2f}", "{:.0f}", "{:.1f}", "{:.1f}",
            "{:.1f}", "{:.1f}", "{:+.2f}"])
-    print("Cross-check: " + opening_crosscheck(run, op, slip) + "\n")
+    print("Cross-check: " + opening_crosscheck(run, op, slip))
+    print("Set-up: " + single_point_contacts(run, "wall") + "\n")
 
     # maps: one character per block, left to right
     x0 = h["block_q"][0, :, 0]
@@ -531,7 +557,8 @@ def arch(path: str, kind: str) -> None:
                       f"{1e3 * op[run.at(t), j].max():.2f}" for t in marks) for j in ring_end) + "\n")
     o = op[ie]
     print("Hinge detector vs geometry at the end: " + detector_vs_geometry(run, op, ie))
-    print("Cross-check: " + opening_crosscheck(run, op, slip) + "\n")
+    print("Cross-check: " + opening_crosscheck(run, op, slip))
+    print("Set-up: " + single_point_contacts(run, kind) + "\n")
     if kind == "aqueduct":
         rows = []
         pairs = {}
