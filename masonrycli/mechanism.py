@@ -11,10 +11,12 @@ seeing it). A *joint* is a body pair with two initial ends (the two ends of a fa
 
 Per block (the paper's "load level" indicators):
 
-* ``block_max_opening`` — the largest opening, ≥ 0, over the ends of the block's joints (m);
+* ``block_max_opening`` — the largest opening, ≥ 0, over the ends of the block's joints (m; single
+  corner-to-corner contacts are not joints);
 * ``block_sliding_ratio`` — the share of the block's normal contact load carried by sliding contacts:
-  Σ_slip r_n / Σ_closed r_n over its current contacts (0 with none). Weighting by r_n keeps lightly
-  loaded contacts (vertical joints) that sit at the friction limit from dominating the ratio.
+  Σ_slip r_n / Σ_closed r_n over its current contacts (0 with none), "slip" meaning at the friction
+  limit *and* sliding faster than ``SLIP_SPEED`` (``reported_status``). Weighting by r_n keeps lightly
+  loaded contacts (vertical joints) from dominating the ratio.
 
 A joint is **hinged** when exactly one of its current contact points carries normal force (r_n > 0),
 its other end has opened by more than ``OPENING``, and it carries at least ``LOAD_FRACTION`` × the
@@ -27,8 +29,12 @@ from __future__ import annotations
 
 import numpy as np
 
-from masonrycli.frame import CONTACT_OPEN, CONTACT_SLIP
+from masonrycli.frame import CONTACT_OPEN, CONTACT_SLIP, CONTACT_STICK
 
+SLIP_SPEED = 1e-3
+"""m/s: a contact at the friction limit is reported as slipping only when its faces slide faster than
+this; slower, it is reported as sticking (the solver's "slide" branch also covers contacts that are
+merely at the limit, creeping by a few µm per step)."""
 OPENING = 1e-4
 """m: opening above which the unloaded end of a joint counts as open (0.1 mm)."""
 LOAD_FRACTION = 1e-3
@@ -38,6 +44,13 @@ JOINT_FIELDS = {
     "block_max_opening": ((), "m", "largest opening of the block's joints (followed kinematically), ≥ 0"),
 }
 """Per-block fields of :meth:`JointTracker.block_fields`: name → (shape after N, unit, description)."""
+
+
+def reported_status(status: np.ndarray, tangential_velocity: np.ndarray) -> np.ndarray:
+    """(C,) int8: the solver's contact status with slip kept only where |u_t| > ``SLIP_SPEED``."""
+    out = np.array(status, dtype=np.int8, copy=True)
+    out[(out == CONTACT_SLIP) & (np.abs(tangential_velocity) <= SLIP_SPEED)] = CONTACT_STICK
+    return out
 
 
 def _rotate(theta: np.ndarray, xy: np.ndarray) -> np.ndarray:
@@ -88,11 +101,14 @@ class JointTracker:
     def block_fields(self, body_q, contact_body, contact_r, contact_status) -> dict[str, np.ndarray]:
         """``JOINT_FIELDS`` for configuration ``body_q`` and the current contacts (impulses r = (r_t, r_n))."""
         n = self.block_count
+        # Only the ends of joints: a corner-to-corner contact has no face whose opening could be read,
+        # and its normal may lie along a face that slides (the slip would be counted as opening).
         opening = np.maximum(self.opening(body_q), 0.0)
         max_opening = np.zeros(n)
+        in_joint = self._end_joint >= 0
         for side in range(2):
             owner = self.end_body[:, side]
-            blocks = owner < n
+            blocks = (owner < n) & in_joint
             np.maximum.at(max_opening, owner[blocks], opening[blocks])
         rn = np.asarray(contact_r)[:, 1]
         closed = np.where(contact_status != CONTACT_OPEN, rn, 0.0)

@@ -16,7 +16,7 @@ import numpy as np
 from masonrycli.engine import integrate
 from masonrycli.engine.solver import Solver, StepStats
 from masonrycli.frame import CONTACT_OPEN, Frame
-from masonrycli.mechanism import JointTracker
+from masonrycli.mechanism import JointTracker, reported_status
 from masonrycli.model import Model, State, build_model, initial_state
 from masonrycli.tensors import TensorComputer, build_triangles
 
@@ -104,7 +104,8 @@ class Simulation:
         else:
             c = self.last.contact_count
             body, point, normal = s.contact_body, s.contact_point, s.contact_normal
-            force, gap, status = s.contact_force, s.contact_gap, s.contact_status
+            force, gap = s.contact_force, s.contact_gap
+            status = reported_status(s.contact_status, s.contact_tangential_velocity(st.body_v))
             r = s.contact_r
             closed = status != CONTACT_OPEN
             mobilised = np.zeros(c)

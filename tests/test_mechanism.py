@@ -84,3 +84,23 @@ def test_hinge_needs_one_loaded_end_and_an_opened_other_end():
 def test_no_joints(n_blocks):
     jt = JointTracker(np.zeros((0, 2), int), np.zeros((0, 2)), np.zeros((0, 2)), np.zeros(0), Q0, 2, 1.0)
     assert jt.hinged(Q0, np.zeros((0, 2), int), np.zeros(0), 1e-3).shape == (0,)
+
+
+def test_reported_status_keeps_slip_only_when_sliding():
+    from masonrycli.mechanism import SLIP_SPEED, reported_status
+
+    status = np.array([CONTACT_SLIP, CONTACT_SLIP, CONTACT_STICK, CONTACT_OPEN], np.int8)
+    ut = np.array([0.5 * SLIP_SPEED, -2 * SLIP_SPEED, 5.0, 5.0])
+    np.testing.assert_array_equal(reported_status(status, ut),
+                                  [CONTACT_STICK, CONTACT_SLIP, CONTACT_STICK, CONTACT_OPEN])
+
+
+def test_corner_contacts_do_not_count_as_openings():
+    # Block 1 touches block 0 only at a corner (one initial contact): sliding there is not an opening.
+    body = np.array([[0, 1]])
+    jt = JointTracker(body, np.array([[1.0, 1.0]]), np.array([[0.6, 0.8]]), np.zeros(1), Q0, 2, 10.0)
+    q = Q0.copy()
+    q[1, 0] += 0.01
+    assert jt.opening(q)[0] > 0  # the end itself separates along its normal
+    f = jt.block_fields(q, np.zeros((0, 2), int), np.zeros((0, 2)), np.zeros(0, np.int8))
+    np.testing.assert_array_equal(f["block_max_opening"], [0.0, 0.0])

@@ -93,6 +93,19 @@ class Solver:
         """(C,) int8: 0 open, 1 stick, 2 slip."""
         return self._status[: self._count]
 
+    def contact_tangential_velocity(self, body_v: np.ndarray) -> np.ndarray:
+        """(C,) m/s: u_t = (v_b(I) − v_a(I))·t of the last step's contacts for velocities ``body_v``
+        (B, 3), with the step's lever arms (numpy; called for recorded frames only)."""
+        c = self._count
+        body = self.buffers.contact_body[:c]
+        n = self.buffers.contact_normal[:c]
+        ra, rb = self._ra[:c], self._rb[:c]
+        va, vb = body_v[body[:, 0]], body_v[body[:, 1]]
+        # point velocity v + ω ẑ × r = (vx − ω r_y, vy + ω r_x), projected on t = (n_y, −n_x)
+        dx = (vb[:, 0] - vb[:, 2] * rb[:, 1]) - (va[:, 0] - va[:, 2] * ra[:, 1])
+        dy = (vb[:, 1] + vb[:, 2] * rb[:, 0]) - (va[:, 1] + va[:, 2] * ra[:, 0])
+        return dx * n[:, 1] - dy * n[:, 0]
+
     def detect(self, body_q: np.ndarray) -> int:
         """Contacts of configuration ``body_q`` into the buffers (no solve); returns the count."""
         m = self.model
