@@ -11,8 +11,10 @@ Any subset of the options works; each prints its tables (plain text, numbers as 
 --amp 0 --duration 0.01 --record-every 1 --history ...``) for the exact check of σ_yy per course.
 
 Joint states are read from the history: ``block_max_opening`` (the widest opening of the block's initial
-joints, followed kinematically by ``masonrycli.mechanism``), ``block_sliding_ratio`` (share of the block's
-normal contact load carried by sliding contacts) and ``joint_hinged``. Two things the history does not hold
+face joints — body pairs with two initial contact points — followed kinematically by
+``masonrycli.mechanism``; single corner contacts are left out), ``block_sliding_ratio`` (share of the block's
+normal contact load carried by sliding contacts: at the friction limit *and* sliding faster than
+``masonrycli.mechanism.SLIP_SPEED``, 1 mm/s) and ``joint_hinged``. Two things the history does not hold
 per joint — which end of a joint is open (intrados / extrados) and how far its faces have slid — are
 measured geometrically, which also gives an independent cross-check of the openings and hinges: the
 structure is rebuilt with the project's builder (defaults, ``blocks`` = N for a wall; checked against the
@@ -195,7 +197,7 @@ def opening_crosscheck(run: Run, op, slip) -> str:
 def single_point_contacts(run: Run, kind: str) -> str:
     """The initial contacts that are not one of two ends of a joint, as the run's JointTracker sees them
     (``masonrycli.run.Simulation`` set-up, no time step), classified by where the contact point lies on
-    each body (a corner or inside a face); ``block_max_opening`` follows them too."""
+    each body (a corner or inside a face); ``block_max_opening`` leaves them out (joints only)."""
     from masonrycli.run import Simulation
     from masonrycli.scenario import Material, RunConfig, scenario_from_builder
     options = {"blocks": run.n} if kind == "wall" else {}
