@@ -215,7 +215,9 @@ def _simulate(builder: str, options: dict, *, freq, amp, settlement, duration, d
     from masonrycli.motion import Motion
     from masonrycli.scenario import Material, RunConfig, scenario_from_builder
 
-    material = Material(**_run_overrides(density=density, thickness=thickness, friction=friction))
+    material = Material()
+    for key, value in _run_overrides(density=density, thickness=thickness, friction=friction).items():
+        material = _replace(material, f"--{key}", **{key: value})
     run = RunConfig(duration=DEFAULT_DURATION[builder])
     if builder == "wall":
         if settlement:
