@@ -43,6 +43,8 @@ class Model:
     """(B, 3) initial velocity vx, vy (m/s), ω (rad/s); supports take their imposed velocity at t = 0."""
     block_volume: np.ndarray
     """(N,) m³: area × thickness."""
+    body_radius: np.ndarray
+    """(B,) m: largest distance from the centroid to a vertex (bounds the speed of any point)."""
     gravity: np.ndarray
     """(2,) m/s²."""
     friction: float
@@ -131,6 +133,7 @@ def build_model(scenario) -> Model:
         body_q0=q0,
         body_v0=v0,
         block_volume=volume,
+        body_radius=_radii(np.asarray(starts, dtype=np.int64), np.concatenate(local)),
         gravity=np.asarray(run.gravity, dtype=np.float64),
         friction=float(scenario.material.friction),
         dt=float(run.dt),
@@ -143,6 +146,12 @@ def build_model(scenario) -> Model:
         block_name=tuple(b.name for b in blocks),
         support_name=tuple(sp.name for sp in supports),
     )
+
+
+def _radii(start: np.ndarray, local: np.ndarray) -> np.ndarray:
+    """(B,) largest |vertex − centroid| of each body (vectorised over the CSR vertices)."""
+    dist = np.hypot(local[:, 0], local[:, 1])
+    return np.maximum.reduceat(dist, start[:-1])
 
 
 def initial_state(model: Model) -> State:

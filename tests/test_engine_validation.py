@@ -140,3 +140,29 @@ def test_block_on_ground_does_not_creep_or_sink(tmp_path):
     assert np.abs(dq[:, 0]).max() < 1e-9
     assert -dq[:, 1].min() < 1e-5
     assert result.max_penetration < 1e-5
+
+
+@pytest.mark.parametrize("height", [2.0, 10.0])
+def test_fast_impact_does_not_penetrate(height, tmp_path):
+    """A block dropped from 10 m hits the ground at 14 m/s, 14 mm per step: contacts must be found
+    before the faces cross (a penetration is never pushed out), so it rests at y = 0.1 m."""
+    path = tmp_path / "drop.toml"
+    top = height + 0.2
+    path.write_text(f"""[run]
+duration = {np.sqrt(2 * height / G) + 0.3:.3f}
+record_every = 1
+[[block]]
+name = "b"
+polygon = [[0.0, {height}], [0.4, {height}], [0.4, {top}], [0.0, {top}]]
+[[support]]
+name = "ground"
+polygon = [[-2.0, -0.5], [2.0, -0.5], [2.0, 0.0], [-2.0, 0.0]]
+""")
+    from masonrycli.scenario import load_scenario
+
+    h, result = run_history(load_scenario(path))
+    y = h["block_q"][:, 0, 1]
+    assert np.abs(h["block_v"][:, 0, 1]).max() > 0.9 * np.sqrt(2 * G * height)  # it did fall that fast
+    assert result.max_penetration < 1e-5
+    assert y.min() > 0.1 - 1e-5
+    assert y[-1] == pytest.approx(0.1, abs=1e-5)
