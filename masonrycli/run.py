@@ -66,7 +66,7 @@ class Simulation:
         weight = float(np.mean(m.body_mass[:n]) * np.hypot(*m.gravity)) if n else 0.0
         s = self.solver
         self.joints = JointTracker(body, s.contact_point, s.contact_normal, s.contact_gap, m.body_q0, n, weight)
-        self.tensors = TensorComputer(n, m.block_volume, self.triangles)
+        self.tensors = TensorComputer(n, m.block_volume, self.triangles, centroids0=m.body_q0[:n, :2])
         self.energy_dissipated = 0.0
         self.support_work = 0.0
         self.last: StepStats | None = None

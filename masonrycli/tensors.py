@@ -90,6 +90,11 @@ _LAYOUT: dict[str, tuple[str, int]] = {
 }
 assert list(_LAYOUT) == list(TENSOR_FIELDS)
 
+FOLDED_FRACTION = 0.25
+"""A cell whose star of triangles has shrunk to this fraction of its initial area (the structure is
+falling apart there) gets NaN strain rate and keeps its cumulated strain: the gradient of a nearly flat
+triangle is not a strain of the masonry (a collapsing aqueduct gave −342 1/s without this guard)."""
+
 DEGENERATE_AREA = 1e-12
 """``build_triangles`` drops triangles whose area is below this times scale², scale being the diagonal
 of the bounding box of the initial centroids."""
@@ -259,19 +264,22 @@ def cell_average(block_count, block_tensor, block_volume, contact_body) -> np.nd
     return out
 
 
-def cell_strain_rate(block_count, block_q, block_v, triangles) -> np.ndarray:
+def cell_strain_rate(block_count, block_q, block_v, triangles, min_area=None) -> np.ndarray:
     """Cell strain rate (eqs. 1–5): area-weighted mean of sym(grad v) over the triangles of each block.
 
     Args:
         block_count: N.
         block_q: (B ≥ N, 3) current centroid x, y (m), θ; block_v: (B ≥ N, 3) vx, vy (m/s), ω.
         triangles: (T, 3) int block indices from ``build_triangles``.
+        min_area: (N,) m², optional: a star whose area is not above it gives NaN (default 0).
 
     Returns:
         (N, 2, 2) symmetric, 1/s; NaN rows for blocks in no triangle.
     """
     out = np.empty((block_count, 2, 2))
-    _k._cell_strain_rate(block_count, _f64(block_q), _f64(block_v), _triangles(triangles, block_count), out)
+    floor = np.zeros(block_count) if min_area is None else _f64(min_area)
+    _k._cell_strain_rate(block_count, _f64(block_q), _f64(block_v), _triangles(triangles, block_count), floor,
+                         out)
     return out
 
 
@@ -313,7 +321,8 @@ class TensorComputer:
         triangles: (T, 3) int block indices, from ``build_triangles`` on the initial configuration.
     """
 
-    def __init__(self, block_count: int, block_volume: np.ndarray, triangles: np.ndarray):
+    def __init__(self, block_count: int, block_volume: np.ndarray, triangles: np.ndarray,
+                 centroids0: np.ndarray | None = None):
         n = int(block_count)
         if n < 0:
             raise ValueError("block_count must be >= 0")
@@ -330,6 +339,17 @@ class TensorComputer:
         self.has_triangle = np.zeros(n, bool)
         """(N,) True for the blocks with at least one triangle (finite strain rate and strain)."""
         self.has_triangle[self.triangles.ravel()] = True
+        self.min_star_area = np.zeros(n)
+        """(N,) m²: a cell whose star of triangles is not larger than this has no strain rate that step
+        (``FOLDED_FRACTION`` of its initial area when ``centroids0`` is given, else 0)."""
+        if centroids0 is not None and self.triangles.size:
+            p = np.asarray(centroids0, dtype=np.float64)[self.triangles]
+            area = 0.5 * ((p[:, 1, 0] - p[:, 0, 0]) * (p[:, 2, 1] - p[:, 0, 1])
+                          - (p[:, 1, 1] - p[:, 0, 1]) * (p[:, 2, 0] - p[:, 0, 0]))
+            star = np.zeros(n)
+            for m in range(3):
+                np.add.at(star, self.triangles[:, m], area)
+            self.min_star_area = FOLDED_FRACTION * star
         self._tensor = np.full((_k.TENSOR_ROWS, n, 2, 2), np.nan)
         self._pair = np.full((_k.PAIR_ROWS, n, 2), np.nan)
         self._scalar = np.full((_k.SCALAR_ROWS, n), np.nan)
@@ -384,6 +404,7 @@ class TensorComputer:
             block_v,
             self.block_volume,
             self.triangles,
+            self.min_star_area,
             contact_body,
             contact_point,
             contact_force,

@@ -144,7 +144,7 @@ def test_cell_strain_rate_matches_reference(seed):
     tris = np.array(tris, np.int64)
     v = rng.normal(size=(n + 1, 3))
     out = np.empty((n, 2, 2))
-    K._cell_strain_rate(n, q, v, tris, out)
+    K._cell_strain_rate(n, q, v, tris, np.zeros(n), out)
     ref = ref_strain_rate(n, q, v, tris)
     assert np.all(np.isnan(out[nx * ny]))
     np.testing.assert_allclose(out, ref, rtol=1e-10, atol=1e-12)
@@ -239,7 +239,20 @@ def test_cell_strain_rate_flat_or_inverted_star_is_nan():
     flat = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [2.0, 0.0, 0.0]]
     inverted = [[0.0, 0.0, 0.0], [0.0, 1.0, 0.0], [1.0, 0.0, 0.0]]
     for q in (flat, inverted):
-        K._cell_strain_rate(3, np.array(q), v, tri, out)
+        K._cell_strain_rate(3, np.array(q), v, tri, np.zeros(3), out)
         assert np.all(np.isnan(out))
-    K._cell_strain_rate(3, np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]), v, tri, out)
+    K._cell_strain_rate(3, np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]), v, tri, np.zeros(3), out)
     np.testing.assert_allclose(out, np.broadcast_to([[1.0, 0.0], [0.0, 2.0]], (3, 2, 2)), rtol=1e-15)
+
+
+def test_cell_strain_rate_collapsed_star_below_floor_is_nan():
+    # The same triangle squashed to 10 % of its area: finite without a floor, NaN with a floor of 25 %
+    # of the initial area (0.5 m²), as TensorComputer sets it from the initial centroids.
+    v = np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 2.0, 0.0]])
+    tri = np.array([[0, 1, 2]])
+    q = np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.1, 0.0]])
+    out = np.empty((3, 2, 2))
+    K._cell_strain_rate(3, q, v, tri, np.zeros(3), out)
+    assert np.all(np.isfinite(out))
+    K._cell_strain_rate(3, q, v, tri, np.full(3, 0.25 * 0.5), out)
+    assert np.all(np.isnan(out))

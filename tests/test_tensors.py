@@ -482,3 +482,18 @@ def test_principal_launcher_batches():
     assert values.shape == (4, 5, 2) and angle.shape == (4, 5)
     w = np.linalg.eigvalsh(0.5 * (t + np.swapaxes(t, -1, -2)))
     np.testing.assert_allclose(values, w[..., ::-1], atol=1e-13)
+
+
+def test_tensor_computer_floors_the_star_area_from_the_initial_centroids():
+    centroids0 = np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]])
+    tc = T.TensorComputer(3, np.ones(3), np.array([[0, 1, 2]]), centroids0=centroids0)
+    np.testing.assert_allclose(tc.min_star_area, T.FOLDED_FRACTION * 0.5)
+    q = np.zeros((3, 3))
+    q[:, :2] = [[0.0, 0.0], [1.0, 0.0], [0.0, 0.05]]  # squashed to 5 % of its area
+    v = np.zeros((3, 3))
+    v[2, 1] = -1.0
+    no = np.zeros((0, 2))
+    tc.step(q, v, np.zeros((0, 2), np.int32), no, no, 1e-3)
+    f = tc.fields()
+    assert np.all(np.isnan(f["cell_strain_rate"]))
+    assert np.all(f["cell_strain"] == 0.0)  # the cumulated strain keeps its value

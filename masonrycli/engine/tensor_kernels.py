@@ -151,12 +151,13 @@ def _cell_average(block_count, start, neighbour, block_volume, block_tensor, out
 #     E = [x_j − x_i, x_k − x_i]    W = [v_j − v_i, v_k − v_i]      (columns)
 #     L_T = W E⁻¹,  A_T = det(E)/2  ⇒  A_T L_T = ½ W adj(E)          (no division: finite even when flat)
 #     add A_T L_T and A_T to each of i, j, k
-# cell i: D_i = sym(Σ A_T L_T) / Σ A_T ; NaN if i has no triangle or Σ A_T ≤ 0 (star folded over)
+# cell i: D_i = sym(Σ A_T L_T) / Σ A_T ; NaN if i has no triangle or Σ A_T ≤ min_area_i (the star has
+# folded over or collapsed: the gradient of a nearly flat triangle says nothing about the masonry)
 # A_T is signed (positive unless the triangle has inverted), which keeps Σ_T A_T ∇N_i = 0 around an
 # interior vertex exactly, whatever the current shape.
 @njit
-def _cell_strain_rate(block_count, block_q, block_v, triangles, out):
-    # Inputs: block_q, block_v (>=N,3), triangles (T,3) ; Outputs: out (N,2,2) 1/s
+def _cell_strain_rate(block_count, block_q, block_v, triangles, min_area, out):
+    # Inputs: block_q, block_v (>=N,3), triangles (T,3), min_area (N,) m² ; Outputs: out (N,2,2) 1/s
     area = np.zeros(block_count)
     out[:] = 0.0
     for t in range(triangles.shape[0]):
@@ -185,7 +186,7 @@ def _cell_strain_rate(block_count, block_q, block_v, triangles, out):
             out[v, 1, 0] += sym
             out[v, 1, 1] += l11
     for i in range(block_count):
-        if area[i] > 0.0:
+        if area[i] > 0.0 and area[i] > min_area[i]:
             inv = 1.0 / area[i]
             out[i, 0, 0] *= inv
             out[i, 0, 1] *= inv
@@ -270,6 +271,7 @@ def _tensor_step(
     block_v,
     block_volume,
     triangles,
+    min_area,
     contact_body,
     contact_point,
     contact_force,
@@ -284,7 +286,7 @@ def _tensor_step(
     start, neighbour = _cell_neighbours(n, contact_body)
     _cell_average(n, start, neighbour, block_volume, block_stress, tensor_out[T_CELL_STRESS])
     rate = tensor_out[T_CELL_STRAIN_RATE]
-    _cell_strain_rate(n, block_q, block_v, triangles, rate)
+    _cell_strain_rate(n, block_q, block_v, triangles, min_area, rate)
     if dt != 0.0:
         _integrate_strain(rate, dt, tensor_out[T_CELL_STRAIN])
 
