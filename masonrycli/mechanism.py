@@ -134,8 +134,7 @@ class JointTracker:
         widest = np.full(j, -np.inf)
         np.maximum.at(widest, self._end_joint[joint_end], opening[joint_end])
         # Loaded current contact points per joint, and the joint's normal force.
-        body = np.asarray(contact_body, dtype=np.int64)
-        key = body[:, 0] * self.body_count + body[:, 1]
+        key = self._pair_key(contact_body)
         pos = np.minimum(np.searchsorted(self.key, key), j - 1)
         member = self.key[pos] == key
         idx = pos[member]
@@ -144,3 +143,12 @@ class JointTracker:
         n_loaded = np.bincount(idx, weights=loaded, minlength=j)
         total = np.bincount(idx, weights=np.where(loaded, force, 0.0), minlength=j)
         return (n_loaded == 1) & (widest > OPENING) & (total >= self.min_force)
+
+    def hinge_points(self, contact_body, contact_point, contact_rn, hinged) -> np.ndarray:
+        """(H, 2) m: the loaded contact points of the hinged joints (the hinges themselves)."""
+        loaded = (np.asarray(contact_rn) > 0) & np.isin(self._pair_key(contact_body), self.key[hinged])
+        return np.asarray(contact_point)[loaded].copy()
+
+    def _pair_key(self, contact_body) -> np.ndarray:
+        body = np.asarray(contact_body, dtype=np.int64).reshape(-1, 2)
+        return body[:, 0] * self.body_count + body[:, 1]

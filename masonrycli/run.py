@@ -136,10 +136,7 @@ class Simulation:
         """(J,) hinged flags of the joints after the last step, and (H, 2) the hinge points."""
         s = self.solver
         hinged = self.joints.hinged(self.state.body_q, s.contact_body, s.contact_r[:, 1], self.model.dt)
-        # The hinge is the loaded contact point of a hinged joint.
-        key = s.contact_body[:, 0].astype(np.int64) * self.model.body_count + s.contact_body[:, 1]
-        loaded = (s.contact_r[:, 1] > 0) & np.isin(key, self.joints.key[hinged])
-        return hinged, s.contact_point[loaded].copy()
+        return hinged, self.joints.hinge_points(s.contact_body, s.contact_point, s.contact_r[:, 1], hinged)
 
     def diverged(self) -> str:
         """Empty string, or why the state is no longer physical."""
