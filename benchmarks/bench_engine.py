@@ -134,8 +134,7 @@ def subprocess_start(cache_dir: str, case: str = "wall-51") -> dict:
         "print(time.perf_counter() - t0, resource.getrusage(resource.RUSAGE_SELF).ru_maxrss)"
     )
     env = dict(os.environ, NUMBA_CACHE_DIR=cache_dir)
-    out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, check=True,
-                         cwd=ROOT)
+    out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, check=True, cwd=ROOT)
     seconds, rss = out.stdout.split()
     return {"start_s": float(seconds), "peak_rss_mb": int(rss) / 1024}
 
@@ -160,8 +159,13 @@ def main() -> None:
     parser.add_argument("--no-startup", action="store_true", help="skip the compile / cached-start runs")
     args = parser.parse_args()
 
-    results: dict = {"machine": {"python": platform.python_version(), "cpu_count": os.cpu_count(),
-                                 "processor": platform.processor() or platform.machine()}}
+    results: dict = {
+        "machine": {
+            "python": platform.python_version(),
+            "cpu_count": os.cpu_count(),
+            "processor": platform.processor() or platform.machine(),
+        }
+    }
     if not args.no_startup:
         with tempfile.TemporaryDirectory() as cache:
             first = subprocess_start(cache)
@@ -184,19 +188,26 @@ def main() -> None:
     results["cases"] = rows
     if "wall-51" in rows and "wall-248" in rows:
         results["ratio_ns_per_contact_sweep_248_over_51"] = (
-            rows["wall-248"]["ns_per_contact_sweep"] / rows["wall-51"]["ns_per_contact_sweep"])
+            rows["wall-248"]["ns_per_contact_sweep"] / rows["wall-51"]["ns_per_contact_sweep"]
+        )
 
-    print("| case | wall-clock per simulated s | sweeps/step | contacts/step | ns per contact·sweep | "
-          "tensors share | recording share | peak RSS |")
+    print(
+        "| case | wall-clock per simulated s | sweeps/step | contacts/step | ns per contact·sweep | "
+        "tensors share | recording share | peak RSS |"
+    )
     print("|---|---|---|---|---|---|---|---|")
     for case, r in rows.items():
-        print(f"| {case} | {r['wall_per_sim_s']:.2f} s (runs {r['runs']}) | {r['sweeps_per_step']:.1f} | "
-              f"{r['contacts_per_step']:.0f} | {r['ns_per_contact_sweep']:.1f} | {100 * r['tensor_share']:.1f} % | "
-              f"{100 * r['recording_share']:.1f} % | {r['peak_rss_mb']:.0f} MB |")
+        print(
+            f"| {case} | {r['wall_per_sim_s']:.2f} s (runs {r['runs']}) | {r['sweeps_per_step']:.1f} | "
+            f"{r['contacts_per_step']:.0f} | {r['ns_per_contact_sweep']:.1f} | {100 * r['tensor_share']:.1f} % | "
+            f"{100 * r['recording_share']:.1f} % | {r['peak_rss_mb']:.0f} MB |"
+        )
     if "startup" in results:
         s = results["startup"]
-        print(f"\nstart to 10 steps of wall-51: first run (empty numba cache) {s['first_run_compile_s']:.1f} s, "
-              f"cached {s['cached_start_s']:.1f} s")
+        print(
+            f"\nstart to 10 steps of wall-51: first run (empty numba cache) {s['first_run_compile_s']:.1f} s, "
+            f"cached {s['cached_start_s']:.1f} s"
+        )
     if "ratio_ns_per_contact_sweep_248_over_51" in results:
         print(f"ns per contact·sweep, 248 / 51 blocks: {results['ratio_ns_per_contact_sweep_248_over_51']:.2f}")
     (ROOT / "benchmarks" / "results.json").write_text(json.dumps(results, indent=2))

@@ -140,13 +140,27 @@ class Body3D(ctypes.Structure):
 
 class Inter3D(ctypes.Structure):  # lmgc90_inter_meca_3D of the binding (bind(c) Fortran type)
     _fields_ = [
-        ("cdan", ctypes.c_char * 5), ("icdan", ctypes.c_int), ("cdbdy", ctypes.c_char * 5),
-        ("icdbdy", ctypes.c_int), ("anbdy", ctypes.c_char * 5), ("ianbdy", ctypes.c_int),
-        ("cdtac", ctypes.c_char * 5), ("icdtac", ctypes.c_int), ("antac", ctypes.c_char * 5),
-        ("iantac", ctypes.c_int), ("icdsci", ctypes.c_int), ("iansci", ctypes.c_int),
-        ("behav", ctypes.c_char * 5), ("status", ctypes.c_char * 5), ("coor", ctypes.c_double * 3),
-        ("uc", ctypes.c_double * 9), ("rloc", ctypes.c_double * 3), ("vloc", ctypes.c_double * 3),
-        ("gap", ctypes.c_double), ("nb_int", ctypes.c_int), ("internals", ctypes.c_double * 19),
+        ("cdan", ctypes.c_char * 5),
+        ("icdan", ctypes.c_int),
+        ("cdbdy", ctypes.c_char * 5),
+        ("icdbdy", ctypes.c_int),
+        ("anbdy", ctypes.c_char * 5),
+        ("ianbdy", ctypes.c_int),
+        ("cdtac", ctypes.c_char * 5),
+        ("icdtac", ctypes.c_int),
+        ("antac", ctypes.c_char * 5),
+        ("iantac", ctypes.c_int),
+        ("icdsci", ctypes.c_int),
+        ("iansci", ctypes.c_int),
+        ("behav", ctypes.c_char * 5),
+        ("status", ctypes.c_char * 5),
+        ("coor", ctypes.c_double * 3),
+        ("uc", ctypes.c_double * 9),
+        ("rloc", ctypes.c_double * 3),
+        ("vloc", ctypes.c_double * 3),
+        ("gap", ctypes.c_double),
+        ("nb_int", ctypes.c_int),
+        ("internals", ctypes.c_double * 19),
     ]
 
 
@@ -211,8 +225,9 @@ class Lmgc:
     def nlgs_loop(self):
         it, nc = ctypes.c_int(), ctypes.c_int()
         e1, e2, e3 = ctypes.c_double(), ctypes.c_double(), ctypes.c_double()
-        getattr(self.lib, ANCHOR[0])(ctypes.byref(it), ctypes.byref(e1), ctypes.byref(e2), ctypes.byref(e3),
-                                     ctypes.byref(nc))
+        getattr(self.lib, ANCHOR[0])(
+            ctypes.byref(it), ctypes.byref(e1), ctypes.byref(e2), ctypes.byref(e3), ctypes.byref(nc)
+        )
         return it.value, nc.value
 
 
@@ -307,8 +322,10 @@ def bench_lmgc(configs, repeat, duration):
         runs = []
         for r in range(repeat):
             res = run_lmgc(lmgc, prisms, courses, CONFIGS[name], duration)
-            log(f"lmgc90 {name} run {r + 1}/{repeat}: {res['wall_s']:.2f} s, "
-                f"{res['iterations'].mean():.1f} it/step, {res['contacts'].mean():.1f} contacts")
+            log(
+                f"lmgc90 {name} run {r + 1}/{repeat}: {res['wall_s']:.2f} s, "
+                f"{res['iterations'].mean():.1f} it/step, {res['contacts'].mean():.1f} contacts"
+            )
             runs.append(res)
         first = runs[0]
         deterministic = all(np.array_equal(r["iterations"], first["iterations"]) for r in runs)
@@ -418,8 +435,20 @@ print(json.dumps({
 
 
 def bench_ours(python: str, repeat: int, duration: float) -> dict:
-    consts = dict(ROOT=str(ROOT), AMPLITUDE=AMPLITUDE, FREQUENCY=FREQUENCY, DURATION=duration, DT=DT,
-                  THETA=THETA, ALERT=ALERT, RHO=RHO, DEPTH=DEPTH, MU=MU, BLOCKS=BLOCKS, REPEAT=repeat)
+    consts = dict(
+        ROOT=str(ROOT),
+        AMPLITUDE=AMPLITUDE,
+        FREQUENCY=FREQUENCY,
+        DURATION=duration,
+        DT=DT,
+        THETA=THETA,
+        ALERT=ALERT,
+        RHO=RHO,
+        DEPTH=DEPTH,
+        MU=MU,
+        BLOCKS=BLOCKS,
+        REPEAT=repeat,
+    )
     code = "".join(f"{k} = {v!r}\n" for k, v in consts.items()) + OURS
     env = dict(os.environ, RERUN_ANALYTICS="0")
     proc = subprocess.run([python, "-c", code], capture_output=True, text=True, cwd=ROOT, env=env)
@@ -461,27 +490,41 @@ def main(argv=None):
                 continue
             ratios[name] = {
                 "lmgc90_over_ours_wall": r["wall_per_sim_s"] / ours["wall_per_sim_s"],
-                "lmgc90_over_ours_per_contact_iteration":
-                    r["us_per_contact_iteration"] / ours["us_per_contact_iteration"],
-                "lmgc90_over_ours_ns_per_contact_sweep_fit":
-                    r["fit_ns_per_contact_sweep"] / ours["fit_ns_per_contact_sweep"],
-                "lmgc90_over_ours_us_per_step_outside_nlgs_fit":
-                    r["fit_us_per_step_outside_nlgs"] / ours["fit_us_per_step_outside_nlgs"],
+                "lmgc90_over_ours_per_contact_iteration": r["us_per_contact_iteration"]
+                / ours["us_per_contact_iteration"],
+                "lmgc90_over_ours_ns_per_contact_sweep_fit": r["fit_ns_per_contact_sweep"]
+                / ours["fit_ns_per_contact_sweep"],
+                "lmgc90_over_ours_us_per_step_outside_nlgs_fit": r["fit_us_per_step_outside_nlgs"]
+                / ours["fit_us_per_step_outside_nlgs"],
                 "lmgc90_over_ours_contacts": r["contacts_per_step"] / ours["contacts_per_step"],
                 "lmgc90_over_ours_iterations": r["iterations_per_step"] / ours["iterations_per_step"],
             }
     doc = {
         "scenario": {
             "structure": f"running-bond wall, {BLOCKS} blocks 0.30 x 0.20 m (build_wall(blocks={BLOCKS}))",
-            "ground": f"v_x = {AMPLITUDE} sin(2 pi {FREQUENCY} t) m/s", "friction": MU, "density": RHO,
-            "dt": DT, "theta": THETA, "duration_s": args.duration, "alert_m": ALERT, "repeat": args.repeat,
+            "ground": f"v_x = {AMPLITUDE} sin(2 pi {FREQUENCY} t) m/s",
+            "friction": MU,
+            "density": RHO,
+            "dt": DT,
+            "theta": THETA,
+            "duration_s": args.duration,
+            "alert_m": ALERT,
+            "repeat": args.repeat,
             "dimension": "LMGC90 3-D (RBDY3/POLYR prisms, depth 1.0 m) vs ours 2-D (thickness 1.0 m)",
         },
-        "machine": {"python": platform.python_version(), "cpu_count": os.cpu_count(),
-                    "processor": platform.machine(), "loadavg_at_end": list(os.getloadavg())},
-        "versions": {"compas_lmgc90": compas_lmgc90.__version__, "numpy": numpy.__version__,
-                     "lmgc90_so_sha256": lib.sha256, "settings_patchable": lib.patchable,
-                     "why_not_patchable": lib.why_not},
+        "machine": {
+            "python": platform.python_version(),
+            "cpu_count": os.cpu_count(),
+            "processor": platform.machine(),
+            "loadavg_at_end": list(os.getloadavg()),
+        },
+        "versions": {
+            "compas_lmgc90": compas_lmgc90.__version__,
+            "numpy": numpy.__version__,
+            "lmgc90_so_sha256": lib.sha256,
+            "settings_patchable": lib.patchable,
+            "why_not_patchable": lib.why_not,
+        },
         "ours": ours,
         "lmgc90": lmgc,
         "ratios": ratios,

@@ -143,9 +143,7 @@ def normalise_coords(coords, label: str) -> np.ndarray:
     if abs(area) < MIN_AREA:
         raise GeometryError(f"{label}: polygon area {abs(area):.3g} m² is zero or too small")
     if abs(area) > MAX_AREA:
-        raise GeometryError(
-            f"{label}: polygon area {abs(area):.3g} m² is absurd (coordinates must be metres)"
-        )
+        raise GeometryError(f"{label}: polygon area {abs(area):.3g} m² is absurd (coordinates must be metres)")
     if area < 0.0:
         xy = xy[::-1]
     xy = _remove_collinear(xy)
@@ -256,12 +254,10 @@ def validate_assembly(
         a, b, area = bad[0]
         more = f" (and {len(bad) - 1} more overlapping pair(s))" if len(bad) > 1 else ""
         if b < n_blocks:
-            what = f"blocks {a} (\"{names[a]}\") and {b} (\"{names[b]}\")"
+            what = f'blocks {a} ("{names[a]}") and {b} ("{names[b]}")'
         else:
             what = f"{labels[a]} and {labels[b]}"
-        raise GeometryError(
-            f"{what} overlap by {area:.3g} m² (tolerance {overlap_tolerance:.3g} m²){more}"
-        )
+        raise GeometryError(f"{what} overlap by {area:.3g} m² (tolerance {overlap_tolerance:.3g} m²){more}")
 
     near_a, near_b = tree.query(geoms[:n_blocks], predicate="dwithin", distance=contact_distance)
     touched = np.zeros(n_blocks, dtype=bool)

@@ -198,7 +198,9 @@ def _polygons_of(geom, where: str) -> list[Polygon]:
                 raise GeometryError(f"{where}: collection member must be a POLYGON, got {member.geom_type}")
             out.append(member)
         return out
-    raise GeometryError(f"{where}: geometry must be a POLYGON, MULTIPOLYGON or GEOMETRYCOLLECTION, got {geom.geom_type}")
+    raise GeometryError(
+        f"{where}: geometry must be a POLYGON, MULTIPOLYGON or GEOMETRYCOLLECTION, got {geom.geom_type}"
+    )
 
 
 def _parse_wkt(text: str, where: str):

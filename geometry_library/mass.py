@@ -75,15 +75,15 @@ def mass_properties(vertices, density: float = 2500.0, thickness: float = 1.0) -
         raise GeometryError("mass_properties: polygon has zero area")
     cx = float(np.sum((p[:, 0] + q[:, 0]) * cross)) / (3.0 * twice_area)
     cy = float(np.sum((p[:, 1] + q[:, 1]) * cross)) / (3.0 * twice_area)
-    j_origin = float(
-        np.sum(
-            cross
-            * (
-                p[:, 0] ** 2 + p[:, 0] * q[:, 0] + q[:, 0] ** 2
-                + p[:, 1] ** 2 + p[:, 1] * q[:, 1] + q[:, 1] ** 2
+    j_origin = (
+        float(
+            np.sum(
+                cross
+                * (p[:, 0] ** 2 + p[:, 0] * q[:, 0] + q[:, 0] ** 2 + p[:, 1] ** 2 + p[:, 1] * q[:, 1] + q[:, 1] ** 2)
             )
         )
-    ) / 12.0
+        / 12.0
+    )
     area = 0.5 * abs(twice_area)
     j_origin = math.copysign(1.0, twice_area) * j_origin
     j_centroid = j_origin - area * (cx * cx + cy * cy)

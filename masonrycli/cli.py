@@ -17,9 +17,13 @@ from geometry_library.blocks import GeometryError
 from masonrycli import __version__
 from masonrycli.errors import InputError
 
-app = typer.Typer(rich_markup_mode="rich", no_args_is_help=True, add_completion=False,
-                  help="Dynamic analysis of dry-stone masonry: rigid blocks, Coulomb friction, NSCD, "
-                       "the cell stress and strain tensors of Chetouane et al. (2003), Rerun recordings.")
+app = typer.Typer(
+    rich_markup_mode="rich",
+    no_args_is_help=True,
+    add_completion=False,
+    help="Dynamic analysis of dry-stone masonry: rigid blocks, Coulomb friction, NSCD, "
+    "the cell stress and strain tensors of Chetouane et al. (2003), Rerun recordings.",
+)
 simulate_app = typer.Typer(no_args_is_help=True, help="Build a structure, load it and record the run.")
 build_app = typer.Typer(no_args_is_help=True, help="Build a structure and write it as GeoJSON.")
 app.add_typer(simulate_app, name="simulate")
@@ -62,8 +66,9 @@ def _version(value: bool) -> None:
 
 @app.callback()
 def main_callback(
-    version: Annotated[bool, typer.Option("--version", callback=_version, is_eager=True,
-                                          help="Print the version and exit.")] = False,
+    version: Annotated[
+        bool, typer.Option("--version", callback=_version, is_eager=True, help="Print the version and exit.")
+    ] = False,
 ) -> None:
     """masonry: rigid-block dynamics of dry-stone masonry."""
 
@@ -72,31 +77,45 @@ def main_callback(
 
 Duration = Annotated[float | None, typer.Option(help="Simulated time, s.", rich_help_panel="Run")]
 Dt = Annotated[float | None, typer.Option("--dt", help="Time step, s (default 1e-3).", rich_help_panel="Run")]
-Theta = Annotated[float | None, typer.Option(help="Moreau–Jean θ in [0.5, 1] (default 0.5).",
-                                                rich_help_panel="Run")]
-Friction = Annotated[float | None, typer.Option(help="Coulomb coefficient of every contact (default 0.6).",
-                                                   rich_help_panel="Material")]
-Density = Annotated[float | None, typer.Option(help="Block density, kg/m³ (default 2500).",
-                                                  rich_help_panel="Material")]
-Thickness = Annotated[float | None, typer.Option(help="Out-of-plane thickness, m (default 1).",
-                                                    rich_help_panel="Material")]
-RecordEvery = Annotated[int | None, typer.Option(help="Steps between recorded frames (default 10).",
-                                                    rich_help_panel="Run")]
-Tolerance = Annotated[float | None, typer.Option(help="NLGS tolerance, relative quadratic norm (default 1.666e-4).",
-                                                    rich_help_panel="Run")]
-MaxIterations = Annotated[int | None, typer.Option(help="NLGS sweep cap per step (default 1000).",
-                                                      rich_help_panel="Run")]
-Out = Annotated[Path | None, typer.Option("--out", "-o", help="Recording (.rrd). Default: "
-                                             "recordings/<scenario>-<timestamp>.rrd.", rich_help_panel="Output")]
-NoRecording = Annotated[bool, typer.Option("--no-recording", help="Write no .rrd recording.",
-                                           rich_help_panel="Output")]
-HistoryOpt = Annotated[Path | None, typer.Option("--history", help="History file (.npz), one row per "
-                                                    "recorded frame.", rich_help_panel="Output")]
+Theta = Annotated[float | None, typer.Option(help="Moreau–Jean θ in [0.5, 1] (default 0.5).", rich_help_panel="Run")]
+Friction = Annotated[
+    float | None, typer.Option(help="Coulomb coefficient of every contact (default 0.6).", rich_help_panel="Material")
+]
+Density = Annotated[float | None, typer.Option(help="Block density, kg/m³ (default 2500).", rich_help_panel="Material")]
+Thickness = Annotated[
+    float | None, typer.Option(help="Out-of-plane thickness, m (default 1).", rich_help_panel="Material")
+]
+RecordEvery = Annotated[
+    int | None, typer.Option(help="Steps between recorded frames (default 10).", rich_help_panel="Run")
+]
+Tolerance = Annotated[
+    float | None,
+    typer.Option(help="NLGS tolerance, relative quadratic norm (default 1.666e-4).", rich_help_panel="Run"),
+]
+MaxIterations = Annotated[
+    int | None, typer.Option(help="NLGS sweep cap per step (default 1000).", rich_help_panel="Run")
+]
+Out = Annotated[
+    Path | None,
+    typer.Option(
+        "--out",
+        "-o",
+        help="Recording (.rrd). Default: recordings/<scenario>-<timestamp>.rrd.",
+        rich_help_panel="Output",
+    ),
+]
+NoRecording = Annotated[bool, typer.Option("--no-recording", help="Write no .rrd recording.", rich_help_panel="Output")]
+HistoryOpt = Annotated[
+    Path | None,
+    typer.Option("--history", help="History file (.npz), one row per recorded frame.", rich_help_panel="Output"),
+]
 Freq = Annotated[float | None, typer.Option("--freq", help="Ground velocity frequency, Hz.", rich_help_panel="Loading")]
-Amp = Annotated[float | None, typer.Option("--amp", help="Horizontal ground velocity amplitude, m/s.",
-                                              rich_help_panel="Loading")]
-Settlement = Annotated[float | None, typer.Option(help="Downward velocity of the right foundation, m/s.",
-                                                     rich_help_panel="Loading")]
+Amp = Annotated[
+    float | None, typer.Option("--amp", help="Horizontal ground velocity amplitude, m/s.", rich_help_panel="Loading")
+]
+Settlement = Annotated[
+    float | None, typer.Option(help="Downward velocity of the right foundation, m/s.", rich_help_panel="Loading")
+]
 
 
 def _run_overrides(**values) -> dict:
@@ -114,8 +133,14 @@ def _replace(obj, where: str, **changes):
 def _apply_options(scenario, *, duration, dt, theta, friction, record_every, tolerance, max_iterations):
     from masonrycli.scenario import RunConfig  # noqa: F401  (validation lives in the dataclass)
 
-    run_changes = _run_overrides(duration=duration, dt=dt, theta=theta, record_every=record_every,
-                                 tolerance=tolerance, max_iterations=max_iterations)
+    run_changes = _run_overrides(
+        duration=duration,
+        dt=dt,
+        theta=theta,
+        record_every=record_every,
+        tolerance=tolerance,
+        max_iterations=max_iterations,
+    )
     for key, value in run_changes.items():
         _replace(scenario.run, f"--{key.replace('_', '-')}", **{key: value})
     run = _replace(scenario.run, "options", **run_changes) if run_changes else scenario.run
@@ -149,17 +174,22 @@ def _execute(scenario, out: Path | None, history: Path | None, hint: str = "") -
     try:
         result = execute(scenario, out=out, history=history, console=console)
     except KeyboardInterrupt:
-        err_console.print("interrupted: the recording and history hold every frame computed so far"
-                          + (f" ({out})" if out else ""))
+        err_console.print(
+            "interrupted: the recording and history hold every frame computed so far" + (f" ({out})" if out else "")
+        )
         raise typer.Exit(EXIT_INTERRUPTED) from None
     except (InputError, GeometryError):
         raise
     except Exception as exc:  # an engine bug: say so in one line, keep what was computed
         if os.environ.get("MASONRY_DEBUG"):
             raise
-        err_console.print(f"[bold red]internal error:[/bold red] {type(exc).__name__}: {exc} — the recording"
-                          " and history hold every frame computed before it (MASONRY_DEBUG=1 shows the"
-                          " traceback)", highlight=False, soft_wrap=True)
+        err_console.print(
+            f"[bold red]internal error:[/bold red] {type(exc).__name__}: {exc} — the recording"
+            " and history hold every frame computed before it (MASONRY_DEBUG=1 shows the"
+            " traceback)",
+            highlight=False,
+            soft_wrap=True,
+        )
         raise typer.Exit(EXIT_INTERNAL) from None
     print_summary(console, result, scenario, out, history)
     if hint and out is not None:
@@ -172,46 +202,77 @@ def _execute(scenario, out: Path | None, history: Path | None, hint: str = "") -
 
 # -- builder options ------------------------------------------------------------------------------
 
+
 def _wall_options(blocks, courses, length, block_length, block_height) -> dict:
-    opts = {"blocks": blocks, "courses": courses, "length": length, "block_length": block_length,
-            "block_height": block_height}
+    opts = {
+        "blocks": blocks,
+        "courses": courses,
+        "length": length,
+        "block_length": block_length,
+        "block_height": block_height,
+    }
     if courses is not None or length is not None:
         opts["blocks"] = blocks  # None unless given: the builder solves for the rest
     return {k: v for k, v in opts.items() if v is not None}
 
 
 def _arch_options(voussoirs, pier_courses, span, ring_thickness, pier_width) -> dict:
-    opts = {"voussoirs": voussoirs, "pier_courses": pier_courses, "span": span,
-            "ring_thickness": ring_thickness, "pier_width": pier_width}
+    opts = {
+        "voussoirs": voussoirs,
+        "pier_courses": pier_courses,
+        "span": span,
+        "ring_thickness": ring_thickness,
+        "pier_width": pier_width,
+    }
     return {k: v for k, v in opts.items() if v is not None}
 
 
-Blocks = Annotated[int | None, typer.Option(help="Number of blocks (default 51; 248 for the paper's "
-                                               "large wall).", rich_help_panel="Structure")]
+Blocks = Annotated[
+    int | None,
+    typer.Option(help="Number of blocks (default 51; 248 for the paper's large wall).", rich_help_panel="Structure"),
+]
 Courses = Annotated[int | None, typer.Option(help="Number of courses.", rich_help_panel="Structure")]
 Length = Annotated[float | None, typer.Option(help="Wall length, m.", rich_help_panel="Structure")]
-BlockLength = Annotated[float | None, typer.Option(help="Block length, m (default 0.30).",
-                                                      rich_help_panel="Structure")]
-BlockHeight = Annotated[float | None, typer.Option(help="Block height, m (default 0.20).",
-                                                      rich_help_panel="Structure")]
-Voussoirs = Annotated[int | None, typer.Option(help="Voussoirs in the arch (default 30).",
-                                                  rich_help_panel="Structure")]
-PierCourses = Annotated[int | None, typer.Option(help="Courses per pier, 2 blocks each (default 17).",
-                                                    rich_help_panel="Structure")]
-Span = Annotated[float | None, typer.Option(help="Clear span of the arch, m (default 3.6).",
-                                               rich_help_panel="Structure")]
-RingThickness = Annotated[float | None, typer.Option(help="Arch ring thickness, m (default 0.35).",
-                                                        rich_help_panel="Structure")]
-PierWidth = Annotated[float | None, typer.Option(help="Pier width, m (default 0.90).",
-                                                    rich_help_panel="Structure")]
-WallCourses = Annotated[int | None, typer.Option(help="Courses of the spandrel walls (default 18).",
-                                                    rich_help_panel="Structure")]
+BlockLength = Annotated[float | None, typer.Option(help="Block length, m (default 0.30).", rich_help_panel="Structure")]
+BlockHeight = Annotated[float | None, typer.Option(help="Block height, m (default 0.20).", rich_help_panel="Structure")]
+Voussoirs = Annotated[int | None, typer.Option(help="Voussoirs in the arch (default 30).", rich_help_panel="Structure")]
+PierCourses = Annotated[
+    int | None, typer.Option(help="Courses per pier, 2 blocks each (default 17).", rich_help_panel="Structure")
+]
+Span = Annotated[
+    float | None, typer.Option(help="Clear span of the arch, m (default 3.6).", rich_help_panel="Structure")
+]
+RingThickness = Annotated[
+    float | None, typer.Option(help="Arch ring thickness, m (default 0.35).", rich_help_panel="Structure")
+]
+PierWidth = Annotated[float | None, typer.Option(help="Pier width, m (default 0.90).", rich_help_panel="Structure")]
+WallCourses = Annotated[
+    int | None, typer.Option(help="Courses of the spandrel walls (default 18).", rich_help_panel="Structure")
+]
 
 DEFAULT_DURATION = {"wall": 1.0, "arch": 5.0, "aqueduct": 5.0}
 
 
-def _simulate(builder: str, options: dict, *, freq, amp, settlement, duration, dt, theta, friction, density,
-              thickness, record_every, tolerance, max_iterations, out, no_recording, history) -> None:
+def _simulate(
+    builder: str,
+    options: dict,
+    *,
+    freq,
+    amp,
+    settlement,
+    duration,
+    dt,
+    theta,
+    friction,
+    density,
+    thickness,
+    record_every,
+    tolerance,
+    max_iterations,
+    out,
+    no_recording,
+    history,
+) -> None:
     from masonrycli.motion import Motion
     from masonrycli.scenario import Material, RunConfig, scenario_from_builder
 
@@ -239,8 +300,16 @@ def _simulate(builder: str, options: dict, *, freq, amp, settlement, duration, d
                 raise InputError("--settlement with --amp: choose one loading (settle or shake)")
             motions["right-foundation"] = Motion(kind="constant", velocity=(0.0, -settlement))
     scenario = scenario_from_builder(builder, options, run, material, motions)
-    scenario = _apply_options(scenario, duration=duration, dt=dt, theta=theta, friction=None,
-                              record_every=record_every, tolerance=tolerance, max_iterations=max_iterations)
+    scenario = _apply_options(
+        scenario,
+        duration=duration,
+        dt=dt,
+        theta=theta,
+        friction=None,
+        record_every=record_every,
+        tolerance=tolerance,
+        max_iterations=max_iterations,
+    )
     hint = ""
     if builder in PAPER_INSTANT:
         figs, t = PAPER_INSTANT[builder]
@@ -262,48 +331,120 @@ def _sine(amp: float, freq: float):
 @simulate_app.command("wall")
 @user_errors
 def simulate_wall(
-    blocks: Blocks = None, courses: Courses = None, length: Length = None, block_length: BlockLength = None,
-    block_height: BlockHeight = None, freq: Freq = None, amp: Amp = None, settlement: Settlement = None,
-    duration: Duration = None, dt: Dt = None, theta: Theta = None, friction: Friction = None,
-    density: Density = None, thickness: Thickness = None, record_every: RecordEvery = None,
-    tolerance: Tolerance = None, max_iterations: MaxIterations = None, out: Out = None,
-    no_recording: NoRecording = False, history: HistoryOpt = None,
+    blocks: Blocks = None,
+    courses: Courses = None,
+    length: Length = None,
+    block_length: BlockLength = None,
+    block_height: BlockHeight = None,
+    freq: Freq = None,
+    amp: Amp = None,
+    settlement: Settlement = None,
+    duration: Duration = None,
+    dt: Dt = None,
+    theta: Theta = None,
+    friction: Friction = None,
+    density: Density = None,
+    thickness: Thickness = None,
+    record_every: RecordEvery = None,
+    tolerance: Tolerance = None,
+    max_iterations: MaxIterations = None,
+    out: Out = None,
+    no_recording: NoRecording = False,
+    history: HistoryOpt = None,
 ) -> None:
     """The paper's running-bond wall on a shaken ground (default 51 blocks, 1 m/s at 2 Hz for 1 s)."""
     if blocks is None and courses is None and length is None:
         blocks = 51
-    _simulate("wall", _wall_options(blocks, courses, length, block_length, block_height), freq=freq, amp=amp,
-              settlement=settlement, duration=duration, dt=dt, theta=theta, friction=friction, density=density,
-              thickness=thickness, record_every=record_every, tolerance=tolerance,
-              max_iterations=max_iterations, out=out, no_recording=no_recording, history=history)
+    _simulate(
+        "wall",
+        _wall_options(blocks, courses, length, block_length, block_height),
+        freq=freq,
+        amp=amp,
+        settlement=settlement,
+        duration=duration,
+        dt=dt,
+        theta=theta,
+        friction=friction,
+        density=density,
+        thickness=thickness,
+        record_every=record_every,
+        tolerance=tolerance,
+        max_iterations=max_iterations,
+        out=out,
+        no_recording=no_recording,
+        history=history,
+    )
 
 
 @simulate_app.command("arch")
 @user_errors
 def simulate_arch(
-    voussoirs: Voussoirs = None, pier_courses: PierCourses = None, span: Span = None,
-    ring_thickness: RingThickness = None, pier_width: PierWidth = None, freq: Freq = None, amp: Amp = None,
-    settlement: Settlement = None, duration: Duration = None, dt: Dt = None, theta: Theta = None,
-    friction: Friction = None, density: Density = None, thickness: Thickness = None,
-    record_every: RecordEvery = None, tolerance: Tolerance = None, max_iterations: MaxIterations = None,
-    out: Out = None, no_recording: NoRecording = False, history: HistoryOpt = None,
+    voussoirs: Voussoirs = None,
+    pier_courses: PierCourses = None,
+    span: Span = None,
+    ring_thickness: RingThickness = None,
+    pier_width: PierWidth = None,
+    freq: Freq = None,
+    amp: Amp = None,
+    settlement: Settlement = None,
+    duration: Duration = None,
+    dt: Dt = None,
+    theta: Theta = None,
+    friction: Friction = None,
+    density: Density = None,
+    thickness: Thickness = None,
+    record_every: RecordEvery = None,
+    tolerance: Tolerance = None,
+    max_iterations: MaxIterations = None,
+    out: Out = None,
+    no_recording: NoRecording = False,
+    history: HistoryOpt = None,
 ) -> None:
     """The paper's 98-block arch on two piers; default: right foundation settles at 1 cm/s for 5 s."""
-    _simulate("arch", _arch_options(voussoirs, pier_courses, span, ring_thickness, pier_width), freq=freq,
-              amp=amp, settlement=settlement, duration=duration, dt=dt, theta=theta, friction=friction,
-              density=density, thickness=thickness, record_every=record_every, tolerance=tolerance,
-              max_iterations=max_iterations, out=out, no_recording=no_recording, history=history)
+    _simulate(
+        "arch",
+        _arch_options(voussoirs, pier_courses, span, ring_thickness, pier_width),
+        freq=freq,
+        amp=amp,
+        settlement=settlement,
+        duration=duration,
+        dt=dt,
+        theta=theta,
+        friction=friction,
+        density=density,
+        thickness=thickness,
+        record_every=record_every,
+        tolerance=tolerance,
+        max_iterations=max_iterations,
+        out=out,
+        no_recording=no_recording,
+        history=history,
+    )
 
 
 @simulate_app.command("aqueduct")
 @user_errors
 def simulate_aqueduct(
-    voussoirs: Voussoirs = None, pier_courses: PierCourses = None, span: Span = None,
-    ring_thickness: RingThickness = None, pier_width: PierWidth = None, wall_courses: WallCourses = None,
-    freq: Freq = None, amp: Amp = None, settlement: Settlement = None, duration: Duration = None,
-    dt: Dt = None, theta: Theta = None, friction: Friction = None, density: Density = None,
-    thickness: Thickness = None, record_every: RecordEvery = None, tolerance: Tolerance = None,
-    max_iterations: MaxIterations = None, out: Out = None, no_recording: NoRecording = False,
+    voussoirs: Voussoirs = None,
+    pier_courses: PierCourses = None,
+    span: Span = None,
+    ring_thickness: RingThickness = None,
+    pier_width: PierWidth = None,
+    wall_courses: WallCourses = None,
+    freq: Freq = None,
+    amp: Amp = None,
+    settlement: Settlement = None,
+    duration: Duration = None,
+    dt: Dt = None,
+    theta: Theta = None,
+    friction: Friction = None,
+    density: Density = None,
+    thickness: Thickness = None,
+    record_every: RecordEvery = None,
+    tolerance: Tolerance = None,
+    max_iterations: MaxIterations = None,
+    out: Out = None,
+    no_recording: NoRecording = False,
     history: HistoryOpt = None,
 ) -> None:
     """A segment of the Arles aqueduct (98 arch + 248 wall blocks); default: settlement 1 cm/s for 5 s.
@@ -313,20 +454,43 @@ def simulate_aqueduct(
     options = _arch_options(voussoirs, pier_courses, span, ring_thickness, pier_width)
     if wall_courses is not None:
         options["wall_courses"] = wall_courses
-    _simulate("aqueduct", options, freq=freq, amp=amp, settlement=settlement, duration=duration, dt=dt,
-              theta=theta, friction=friction, density=density, thickness=thickness, record_every=record_every,
-              tolerance=tolerance, max_iterations=max_iterations, out=out, no_recording=no_recording,
-              history=history)
+    _simulate(
+        "aqueduct",
+        options,
+        freq=freq,
+        amp=amp,
+        settlement=settlement,
+        duration=duration,
+        dt=dt,
+        theta=theta,
+        friction=friction,
+        density=density,
+        thickness=thickness,
+        record_every=record_every,
+        tolerance=tolerance,
+        max_iterations=max_iterations,
+        out=out,
+        no_recording=no_recording,
+        history=history,
+    )
 
 
 @app.command("run")
 @user_errors
 def run_command(
-    scenario_file: Annotated[Path, typer.Argument(help="Scenario file (TOML), or a GeoJSON / WKT geometry.",
-                                                  metavar="SCENARIO.toml")],
-    duration: Duration = None, dt: Dt = None, theta: Theta = None, friction: Friction = None,
-    record_every: RecordEvery = None, tolerance: Tolerance = None, max_iterations: MaxIterations = None,
-    out: Out = None, no_recording: NoRecording = False, history: HistoryOpt = None,
+    scenario_file: Annotated[
+        Path, typer.Argument(help="Scenario file (TOML), or a GeoJSON / WKT geometry.", metavar="SCENARIO.toml")
+    ],
+    duration: Duration = None,
+    dt: Dt = None,
+    theta: Theta = None,
+    friction: Friction = None,
+    record_every: RecordEvery = None,
+    tolerance: Tolerance = None,
+    max_iterations: MaxIterations = None,
+    out: Out = None,
+    no_recording: NoRecording = False,
+    history: HistoryOpt = None,
 ) -> None:
     """Run any scenario file (or a GeoJSON / WKT geometry file, supports fixed); options given here
     override the file's values."""
@@ -336,8 +500,16 @@ def run_command(
         scenario = scenario_from_geometry_file(scenario_file)
     else:
         scenario = load_scenario(scenario_file)
-    scenario = _apply_options(scenario, duration=duration, dt=dt, theta=theta, friction=friction,
-                              record_every=record_every, tolerance=tolerance, max_iterations=max_iterations)
+    scenario = _apply_options(
+        scenario,
+        duration=duration,
+        dt=dt,
+        theta=theta,
+        friction=friction,
+        record_every=record_every,
+        tolerance=tolerance,
+        max_iterations=max_iterations,
+    )
     _execute(scenario, _outputs(scenario.name, out, no_recording), history)
 
 
@@ -357,12 +529,18 @@ def check_command(
     xmin, ymin, xmax, ymax = info["bounding_box"]
     table.add_row("scenario", str(info["name"]))
     table.add_row("blocks", str(info["blocks"]))
-    table.add_row("supports", ", ".join(f"{k} ({v})" for k, v in info["support_motions"].items())
-                  if isinstance(info.get("support_motions"), dict) else str(info["supports"]))
+    table.add_row(
+        "supports",
+        ", ".join(f"{k} ({v})" for k, v in info["support_motions"].items())
+        if isinstance(info.get("support_motions"), dict)
+        else str(info["supports"]),
+    )
     table.add_row("total mass", f"{info['total_mass']:.6g} kg")
     table.add_row("bounding box", f"x {xmin:.4g} … {xmax:.4g} m, y {ymin:.4g} … {ymax:.4g} m")
     table.add_row("friction", f"{info['friction']:g}")
-    table.add_row("time", f"{info['duration']:g} s in {info['n_steps']} steps of {info['dt']:g} s, θ = {info['theta']:g}")
+    table.add_row(
+        "time", f"{info['duration']:g} s in {info['n_steps']} steps of {info['dt']:g} s, θ = {info['theta']:g}"
+    )
     console.print(table)
     for warning in scenario.warnings:
         err_console.print(f"[yellow]warning:[/yellow] {warning}", highlight=False)
@@ -384,8 +562,10 @@ def _write_assembly(builder: str, options: dict, density, thickness, out: Path) 
     for warning in validate_assembly(assembly):
         err_console.print(f"[yellow]warning:[/yellow] {warning}", highlight=False)
     write_geojson(assembly, out)
-    console.print(f"{builder}: {assembly.block_count} blocks and {assembly.support_count} "
-                  f"support{'s' if assembly.support_count != 1 else ''} → {out}")
+    console.print(
+        f"{builder}: {assembly.block_count} blocks and {assembly.support_count} "
+        f"support{'s' if assembly.support_count != 1 else ''} → {out}"
+    )
 
 
 GeoOut = Annotated[Path, typer.Option("--out", "-o", help="GeoJSON file to write.")]
@@ -394,35 +574,51 @@ GeoOut = Annotated[Path, typer.Option("--out", "-o", help="GeoJSON file to write
 @build_app.command("wall")
 @user_errors
 def build_wall_command(
-    out: GeoOut, blocks: Blocks = None, courses: Courses = None, length: Length = None,
-    block_length: BlockLength = None, block_height: BlockHeight = None, density: Density = None,
+    out: GeoOut,
+    blocks: Blocks = None,
+    courses: Courses = None,
+    length: Length = None,
+    block_length: BlockLength = None,
+    block_height: BlockHeight = None,
+    density: Density = None,
     thickness: Thickness = None,
 ) -> None:
     """A running-bond wall on its ground."""
     if blocks is None and courses is None and length is None:
         blocks = 51
-    _write_assembly("wall", _wall_options(blocks, courses, length, block_length, block_height), density,
-                    thickness, out)
+    _write_assembly("wall", _wall_options(blocks, courses, length, block_length, block_height), density, thickness, out)
 
 
 @build_app.command("arch")
 @user_errors
 def build_arch_command(
-    out: GeoOut, voussoirs: Voussoirs = None, pier_courses: PierCourses = None, span: Span = None,
-    ring_thickness: RingThickness = None, pier_width: PierWidth = None, density: Density = None,
+    out: GeoOut,
+    voussoirs: Voussoirs = None,
+    pier_courses: PierCourses = None,
+    span: Span = None,
+    ring_thickness: RingThickness = None,
+    pier_width: PierWidth = None,
+    density: Density = None,
     thickness: Thickness = None,
 ) -> None:
     """A semicircular arch on two piers, each on its foundation."""
-    _write_assembly("arch", _arch_options(voussoirs, pier_courses, span, ring_thickness, pier_width), density,
-                    thickness, out)
+    _write_assembly(
+        "arch", _arch_options(voussoirs, pier_courses, span, ring_thickness, pier_width), density, thickness, out
+    )
 
 
 @build_app.command("aqueduct")
 @user_errors
 def build_aqueduct_command(
-    out: GeoOut, voussoirs: Voussoirs = None, pier_courses: PierCourses = None, span: Span = None,
-    ring_thickness: RingThickness = None, pier_width: PierWidth = None, wall_courses: WallCourses = None,
-    density: Density = None, thickness: Thickness = None,
+    out: GeoOut,
+    voussoirs: Voussoirs = None,
+    pier_courses: PierCourses = None,
+    span: Span = None,
+    ring_thickness: RingThickness = None,
+    pier_width: PierWidth = None,
+    wall_courses: WallCourses = None,
+    density: Density = None,
+    thickness: Thickness = None,
 ) -> None:
     """The arch plus spandrel walls in running bond up to a level top."""
     options = _arch_options(voussoirs, pier_courses, span, ring_thickness, pier_width)

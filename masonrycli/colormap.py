@@ -66,8 +66,7 @@ COOLWARM: Final = pack_rgba(make_lut(_COOLWARM_STOPS))
 NAN_RGBA: Final = int(pack_rgba(np.array([128, 128, 128])))
 
 
-def map_scalars(values: np.ndarray, lo: float, hi: float, lut: np.ndarray,
-                nan_rgba: int = NAN_RGBA) -> np.ndarray:
+def map_scalars(values: np.ndarray, lo: float, hi: float, lut: np.ndarray, nan_rgba: int = NAN_RGBA) -> np.ndarray:
     """Colours of ``values`` (any shape) on ``[lo, hi]`` (clipped): same shape, uint32 packed.
 
     ``lo`` maps to ``lut[0]``, ``hi`` to ``lut[-1]``; NaN maps to ``nan_rgba``.

@@ -69,7 +69,7 @@ def recording_static(sim: Simulation):
         block_vert_local=m.vert_local[: start[n]].copy(),
         support_name=np.asarray(m.support_name, dtype=str),
         support_vert_start=start[n:] - start[n],
-        support_vert_local=m.vert_local[start[n]:].copy(),
+        support_vert_local=m.vert_local[start[n] :].copy(),
         triangles=sim.triangles,
         friction=m.friction,
         dt=m.dt,
@@ -110,8 +110,9 @@ def execute(scenario, *, out: Path | None, history: Path | None, console: Consol
 
 
 def print_summary(console: Console, result: RunResult, scenario, out: Path | None, history: Path | None) -> None:
-    console.print(summary_table(result, scenario.run.max_iterations, str(out) if out else None,
-                                str(history) if history else None))
+    console.print(
+        summary_table(result, scenario.run.max_iterations, str(out) if out else None, str(history) if history else None)
+    )
     if out is not None:
         console.print(f"Open the recording:  [bold]{rerun_command()} {out}[/bold]", soft_wrap=True)
 

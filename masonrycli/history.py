@@ -20,8 +20,17 @@ import numpy as np
 
 from masonrycli.frame import Frame
 
-_SCALARS = ("time", "step", "contact_count", "nlgs_iterations", "nlgs_residual", "energy_kinetic",
-            "energy_potential", "energy_dissipated", "support_work")
+_SCALARS = (
+    "time",
+    "step",
+    "contact_count",
+    "nlgs_iterations",
+    "nlgs_residual",
+    "energy_kinetic",
+    "energy_potential",
+    "energy_dissipated",
+    "support_work",
+)
 _ARRAYS = ("block_q", "block_v", "support_q", "support_v", "support_force")
 
 

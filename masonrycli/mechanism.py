@@ -66,8 +66,16 @@ class JointTracker:
         body_q0: (B, 3) initial poses. block_count: N. mean_block_weight: N (per thickness).
     """
 
-    def __init__(self, contact_body, contact_point, contact_normal, contact_gap, body_q0, block_count: int,
-                 mean_block_weight: float):
+    def __init__(
+        self,
+        contact_body,
+        contact_point,
+        contact_normal,
+        contact_gap,
+        body_q0,
+        block_count: int,
+        mean_block_weight: float,
+    ):
         body = np.asarray(contact_body, dtype=np.int64).reshape(-1, 2)
         self.block_count = int(block_count)
         self.body_count = int(body_q0.shape[0])

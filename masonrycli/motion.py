@@ -125,9 +125,7 @@ class Motion:
         if len(time) < 2:
             raise field_error("record_time", time, f"a record needs at least 2 samples, got {len(time)}")
         if len(value) != len(time):
-            raise field_error(
-                "record_value", value, f"has {len(value)} samples but record_time has {len(time)}"
-            )
+            raise field_error("record_value", value, f"has {len(value)} samples but record_time has {len(time)}")
         t = tuple(check_real(f"record_time[{i}]", x) for i, x in enumerate(time))
         for i in range(1, len(t)):
             if not t[i] > t[i - 1]:
@@ -220,16 +218,17 @@ class Motion:
             return f"constant velocity {vec(self.velocity)} m/s"
         if self.kind == "sine":
             ph = f" + {g(self.phase)}" if self.phase else ""
-            return (f"sine {g(self.amplitude)} m/s · sin(2π·{g(self.frequency)} Hz·t{ph}) "
-                    f"along {vec(self.direction)}")
+            return f"sine {g(self.amplitude)} m/s · sin(2π·{g(self.frequency)} Hz·t{ph}) along {vec(self.direction)}"
         if self.kind == "ramp":
             until = "" if math.isinf(self.until) else f" until {g(self.until)} s"
             return f"ramp acceleration {vec(self.acceleration)} m/s²{until}"
         src = os.path.basename(self.source) if self.source else "inline"
         axis = "" if self.record_is_vector else f" along {vec(self.direction)}"
         scale = "" if self.scale == 1.0 else f" × {g(self.scale)}"
-        return (f"record of {self.quantity} ({src}, {len(self.record_time)} samples, "
-                f"{g(self.record_time[0])}–{g(self.record_time[-1])} s){scale}{axis}")
+        return (
+            f"record of {self.quantity} ({src}, {len(self.record_time)} samples, "
+            f"{g(self.record_time[0])}–{g(self.record_time[-1])} s){scale}{axis}"
+        )
 
 
 def support_velocity(motions: Sequence[Motion], t) -> np.ndarray:
@@ -332,8 +331,9 @@ def _is_float(text: str) -> bool:
     return True
 
 
-def record_motion(path, *, quantity: str = "velocity", scale: float = 1.0,
-                  direction=(1.0, 0.0), display: str | None = None) -> Motion:
+def record_motion(
+    path, *, quantity: str = "velocity", scale: float = 1.0, direction=(1.0, 0.0), display: str | None = None
+) -> Motion:
     """A ``record`` :class:`Motion` from a CSV file (see :func:`load_record_csv`).
 
     ``source`` is the absolute path of the file. ``direction`` applies to 2-column records only.

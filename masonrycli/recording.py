@@ -75,8 +75,15 @@ class FieldSpec(NamedTuple):
 
 def _field(key: str, title: str, unit: str, signed: bool) -> FieldSpec:
     short = key.removeprefix("cell_")
-    return FieldSpec(key, title, unit, signed, f"structure/fields/{short}", f"structure/legend/{short}",
-                     f"structure/plane/xy/legend/{short}")
+    return FieldSpec(
+        key,
+        title,
+        unit,
+        signed,
+        f"structure/fields/{short}",
+        f"structure/legend/{short}",
+        f"structure/plane/xy/legend/{short}",
+    )
 
 
 FIELDS: Final = (
@@ -87,18 +94,29 @@ FIELDS: Final = (
 )
 _FIELD_BY_KEY: Final = {f.key: f for f in FIELDS}
 _HOVER_VALUES: Final = {  # per-block value shown when hovering a block outline -> Frame.tensors key
-    "p": "cell_spherical_stress", "q": "cell_deviatoric_stress",
-    "volumetric_strain_rate": "cell_volumetric_strain_rate", "deviatoric_strain": "cell_deviatoric_strain",
-    "sliding_ratio": "block_sliding_ratio", "max_opening": "block_max_opening",
+    "p": "cell_spherical_stress",
+    "q": "cell_deviatoric_stress",
+    "volumetric_strain_rate": "cell_volumetric_strain_rate",
+    "deviatoric_strain": "cell_deviatoric_strain",
+    "sliding_ratio": "block_sliding_ratio",
+    "max_opening": "block_max_opening",
 }
 _AXES: Final = {  # glyph set -> (principal values (N, 2) key, angle of the major one (N,) key)
     "stress_axes": ("cell_principal_stress", "cell_principal_angle"),
     "strain_rate_axes": ("cell_principal_strain_rate", "cell_principal_strain_rate_angle"),
 }
-_TENSOR_KEYS: Final = tuple(dict.fromkeys(
-    [*(f.key for f in FIELDS), *(k for pair in _AXES.values() for k in pair), *_HOVER_VALUES.values()]))
-_SCALARS: Final = ("energy_kinetic", "energy_potential", "energy_dissipated", "support_work",
-                   "nlgs_iterations", "nlgs_residual", "contact_count")
+_TENSOR_KEYS: Final = tuple(
+    dict.fromkeys([*(f.key for f in FIELDS), *(k for pair in _AXES.values() for k in pair), *_HOVER_VALUES.values()])
+)
+_SCALARS: Final = (
+    "energy_kinetic",
+    "energy_potential",
+    "energy_dissipated",
+    "support_work",
+    "nlgs_iterations",
+    "nlgs_residual",
+    "contact_count",
+)
 
 PLANE: Final = "structure/plane"
 XY: Final = "structure/plane/xy"
@@ -112,16 +130,30 @@ STRAIN_RATE_AXES: Final = f"{XY}/strain_rate_axes"
 SUPPORT_FILL: Final = "structure/supports"
 METADATA: Final = "run/metadata"
 SERIES: Final = {
-    "energy": "series/energy", "max_displacement": "series/blocks/max_displacement",
-    "support_velocity": "series/supports/velocity", "support_displacement": "series/supports/displacement",
-    "iterations": "series/solver/iterations", "residual": "series/solver/residual",
+    "energy": "series/energy",
+    "max_displacement": "series/blocks/max_displacement",
+    "support_velocity": "series/supports/velocity",
+    "support_displacement": "series/supports/displacement",
+    "iterations": "series/solver/iterations",
+    "residual": "series/solver/residual",
     "contacts": "series/contacts/count",
 }
 
 
 ENTITY_PATHS: Final = (
-    PLANE, XY, BLOCKS, SUPPORT_OUTLINES, TRIANGULATION, FORCES, HINGES, STRESS_AXES, STRAIN_RATE_AXES,
-    SUPPORT_FILL, *(p for f in FIELDS for p in (f.fill, f.bar, f.labels)), *SERIES.values(), METADATA,
+    PLANE,
+    XY,
+    BLOCKS,
+    SUPPORT_OUTLINES,
+    TRIANGULATION,
+    FORCES,
+    HINGES,
+    STRESS_AXES,
+    STRAIN_RATE_AXES,
+    SUPPORT_FILL,
+    *(p for f in FIELDS for p in (f.fill, f.bar, f.labels)),
+    *SERIES.values(),
+    METADATA,
 )
 """Every entity of a recording (without the leading "/")."""
 
@@ -175,12 +207,15 @@ class _Polygons:
         n_vert = np.diff(start)
         self.owner = np.repeat(np.arange(self.count), n_vert)
         # Fan of each convex polygon: (s, s+k, s+k+1), k = 1 .. n-2.
-        fans = [np.stack([np.full(n - 2, s), s + np.arange(1, n - 1), s + np.arange(2, n)], axis=1)
-                for s, n in zip(start[:-1], n_vert)]
+        fans = [
+            np.stack([np.full(n - 2, s), s + np.arange(1, n - 1), s + np.arange(2, n)], axis=1)
+            for s, n in zip(start[:-1], n_vert)
+        ]
         self.fan = np.concatenate(fans or [np.zeros((0, 3))]).astype(np.uint32)
         # Closed outline: the polygon's vertices, then its first vertex again.
         self.outline_index = np.concatenate(
-            [np.r_[s:s + n, s] for s, n in zip(start[:-1], n_vert)] or [np.zeros(0)]).astype(np.intp)
+            [np.r_[s : s + n, s] for s, n in zip(start[:-1], n_vert)] or [np.zeros(0)]
+        ).astype(np.intp)
         self.outline_offsets = np.r_[0, np.cumsum(n_vert + 1)].astype(np.int32)
 
     def world(self, q: np.ndarray) -> np.ndarray:
@@ -244,10 +279,17 @@ class Recorder:
     (KeyboardInterrupt: "interrupted") and the time of the last frame; the file is complete either way.
     """
 
-    def __init__(self, path: str | os.PathLike, static: RecordingStatic, metadata: dict,
-                 application_id: str = APPLICATION_ID, batch_frames: int = 100, *,
-                 main_field: str = "cell_spherical_stress",
-                 field_ranges: dict[str, tuple[float, float]] | None = None) -> None:
+    def __init__(
+        self,
+        path: str | os.PathLike,
+        static: RecordingStatic,
+        metadata: dict,
+        application_id: str = APPLICATION_ID,
+        batch_frames: int = 100,
+        *,
+        main_field: str = "cell_spherical_stress",
+        field_ranges: dict[str, tuple[float, float]] | None = None,
+    ) -> None:
         if main_field not in _FIELD_BY_KEY:
             raise ValueError(f"main_field must be one of {sorted(_FIELD_BY_KEY)}, not {main_field!r}")
         self.path, self.static, self.metadata = os.fspath(path), static, dict(metadata)
@@ -294,8 +336,11 @@ class Recorder:
             raise RuntimeError("Recorder is closed")
         f64 = np.float64
         if self._ref is None:
-            self._ref = (np.array(frame.block_q, f64), np.array(frame.support_q, f64).reshape(-1, 3),
-                         float(frame.energy_potential))
+            self._ref = (
+                np.array(frame.block_q, f64),
+                np.array(frame.support_q, f64).reshape(-1, 3),
+                float(frame.energy_potential),
+            )
             self._log_plane(*self._ref[:2])
         b = self._batch
         b.add("step", int(frame.step))
@@ -354,15 +399,29 @@ class Recorder:
         rec, st = self.rec, self.static
         for f in FIELDS:
             rec.log(f.fill, rr.Mesh3D.from_fields(triangle_indices=self._blocks.fan), static=True)
-        rec.log(SUPPORT_FILL, rr.Mesh3D.from_fields(triangle_indices=self._supports.fan,
-                                                   albedo_factor=_SUPPORT_FILL_RGBA), static=True)
-        rec.log(BLOCKS, rr.LineStrips2D.from_fields(colors=_OUTLINE_RGBA, radii=-0.75, draw_order=30.0),
-                rr.AnyValues(name=[viewer_safe_text(str(n)) for n in st.block_name]), static=True)
+        rec.log(
+            SUPPORT_FILL,
+            rr.Mesh3D.from_fields(triangle_indices=self._supports.fan, albedo_factor=_SUPPORT_FILL_RGBA),
+            static=True,
+        )
+        rec.log(
+            BLOCKS,
+            rr.LineStrips2D.from_fields(colors=_OUTLINE_RGBA, radii=-0.75, draw_order=30.0),
+            rr.AnyValues(name=[viewer_safe_text(str(n)) for n in st.block_name]),
+            static=True,
+        )
         names = [viewer_safe_text(str(n)) for n in st.support_name]
-        rec.log(SUPPORT_OUTLINES, rr.LineStrips2D.from_fields(colors=_SUPPORT_LINE_RGBA, radii=-0.75),
-                rr.AnyValues(name=names), static=True)
-        rec.log(TRIANGULATION, rr.LineStrips2D.from_fields(colors=_TRIANGULATION_RGBA, radii=-0.5,
-                                                          draw_order=31.0), static=True)
+        rec.log(
+            SUPPORT_OUTLINES,
+            rr.LineStrips2D.from_fields(colors=_SUPPORT_LINE_RGBA, radii=-0.75),
+            rr.AnyValues(name=names),
+            static=True,
+        )
+        rec.log(
+            TRIANGULATION,
+            rr.LineStrips2D.from_fields(colors=_TRIANGULATION_RGBA, radii=-0.5, draw_order=31.0),
+            static=True,
+        )
         for path in (STRESS_AXES, STRAIN_RATE_AXES):
             rec.log(path, rr.LineStrips2D.from_fields(radii=-1.25, draw_order=40.0), static=True)
         rec.log(FORCES, rr.Arrows2D.from_fields(radii=-1.25, draw_order=50.0), static=True)
@@ -372,7 +431,9 @@ class Recorder:
             "max_displacement": ["max block displacement"],
             "support_velocity": [f"{n} v{c}" for n in names for c in "xy"],
             "support_displacement": [f"{n} u{c}" for n in names for c in "xy"],
-            "iterations": ["NLGS iterations"], "residual": ["NLGS residual"], "contacts": ["contacts"],
+            "iterations": ["NLGS iterations"],
+            "residual": ["NLGS residual"],
+            "contacts": ["contacts"],
         }
         for key, path in SERIES.items():
             rec.log(path, rr.SeriesLines(names=series_names[key]), static=True)
@@ -392,10 +453,12 @@ class Recorder:
         self._legend_box = (hi[0] + 2 * pad, ya + room, hi[0] + 2 * pad + bar, yb - room)
         x0, y0 = lo[0] - pad, hi[1] + pad
         resolution = [hi[0] + 3 * pad + bar + 0.12 * size - x0, y0 - lo[1] + pad]
-        self.rec.log(PLANE, rr.Pinhole(focal_length=_CAMERA_HEIGHT, principal_point=[0.0, 0.0],
-                                       resolution=resolution),
-                     rr.Transform3D(translation=[x0, y0, _CAMERA_HEIGHT], mat3x3=np.diag([1.0, -1.0, -1.0])),
-                     static=True)
+        self.rec.log(
+            PLANE,
+            rr.Pinhole(focal_length=_CAMERA_HEIGHT, principal_point=[0.0, 0.0], resolution=resolution),
+            rr.Transform3D(translation=[x0, y0, _CAMERA_HEIGHT], mat3x3=np.diag([1.0, -1.0, -1.0])),
+            static=True,
+        )
         self.rec.log(XY, rr.Transform3D(translation=[-x0, y0, 0.0], scale=[1.0, -1.0, 1.0]), static=True)
 
     def _log_legend(self, f: FieldSpec) -> None:
@@ -408,13 +471,18 @@ class Recorder:
         labels[-1] = f"{f.title}\n{labels[-1]}"
         xm, gap = 0.5 * (xa + xb), 0.04 * (yb - ya)
         pos = [[xm, ya - gap], [2 * xb - xa, 0.5 * (ya + yb)], [xm, yb + 2 * gap]]
-        self.rec.log(f.labels, rr.Points2D(pos, labels=labels, radii=-0.5, show_labels=True,
-                                           colors=_LEGEND_TEXT_RGBA), static=True)
+        self.rec.log(
+            f.labels,
+            rr.Points2D(pos, labels=labels, radii=-0.5, show_labels=True, colors=_LEGEND_TEXT_RGBA),
+            static=True,
+        )
 
     # ---- per-batch content
     def _send_batch(self, b: _Batch) -> None:
-        idx = [rr.TimeColumn("step", sequence=np.asarray(b["step"], dtype=np.int64)),
-               rr.TimeColumn("sim_time", duration=np.asarray(b["time"], dtype=np.float64))]
+        idx = [
+            rr.TimeColumn("step", sequence=np.asarray(b["step"], dtype=np.int64)),
+            rr.TimeColumn("sim_time", duration=np.asarray(b["time"], dtype=np.float64)),
+        ]
         q = b.stack("block_q")  # (F, N, 3)
         tensors = {key: b.stack(key) for key in _TENSOR_KEYS}
         if self._fix_scales(tensors, b):
@@ -457,32 +525,52 @@ class Recorder:
         for f in FIELDS:
             lo, hi = self.field_ranges.get(f.key, (-1.0, 1.0))
             colors = map_scalars(tensors[f.key], lo, hi, COOLWARM if f.signed else VIRIDIS, NAN_RGBA)
-            self.rec.send_columns(f.fill, indexes=idx, columns=rr.Mesh3D.columns(
-                vertex_positions=pos, vertex_colors=colors[:, self._blocks.owner].reshape(-1),
-            ).partition(_per_frame(n_frames, n_vert)))
+            self.rec.send_columns(
+                f.fill,
+                indexes=idx,
+                columns=rr.Mesh3D.columns(
+                    vertex_positions=pos,
+                    vertex_colors=colors[:, self._blocks.owner].reshape(-1),
+                ).partition(_per_frame(n_frames, n_vert)),
+            )
         # pyarrow arrays: AnyValues.columns turns 1-D numpy arrays into Python lists of lists (slow).
         values = {name: pa.array(tensors[key].reshape(-1)) for name, key in _HOVER_VALUES.items()}
         per_frame = _per_frame(n_frames, self._n)
-        self.rec.send_columns(BLOCKS, indexes=idx, columns=[
-            *rr.LineStrips2D.columns(strips=self._blocks.outlines(verts)).partition(per_frame),
-            *rr.AnyValues.columns(**values).partition(per_frame),
-        ])
+        self.rec.send_columns(
+            BLOCKS,
+            indexes=idx,
+            columns=[
+                *rr.LineStrips2D.columns(strips=self._blocks.outlines(verts)).partition(per_frame),
+                *rr.AnyValues.columns(**values).partition(per_frame),
+            ],
+        )
 
     def _send_supports(self, idx: list, support_q: np.ndarray) -> None:
         poly, n_frames = self._supports, len(support_q)
         if poly.count:
             verts = poly.world(support_q)
-            self.rec.send_columns(SUPPORT_FILL, indexes=idx, columns=rr.Mesh3D.columns(
-                vertex_positions=_z0(verts)).partition(_per_frame(n_frames, verts.shape[1])))
-            self.rec.send_columns(SUPPORT_OUTLINES, indexes=idx, columns=rr.LineStrips2D.columns(
-                strips=poly.outlines(verts)).partition(_per_frame(n_frames, poly.count)))
+            self.rec.send_columns(
+                SUPPORT_FILL,
+                indexes=idx,
+                columns=rr.Mesh3D.columns(vertex_positions=_z0(verts)).partition(_per_frame(n_frames, verts.shape[1])),
+            )
+            self.rec.send_columns(
+                SUPPORT_OUTLINES,
+                indexes=idx,
+                columns=rr.LineStrips2D.columns(strips=poly.outlines(verts)).partition(
+                    _per_frame(n_frames, poly.count)
+                ),
+            )
 
     def _send_triangulation(self, idx: list, q: np.ndarray) -> None:
         if len(self._triangles):
             closed = q[:, self._triangles[:, [0, 1, 2, 0]], :2]  # (F, T, 4, 2)
             strips = _uniform_strips(closed.reshape(-1, 4, 2))
-            self.rec.send_columns(TRIANGULATION, indexes=idx, columns=rr.LineStrips2D.columns(
-                strips=strips).partition(_per_frame(len(q), len(self._triangles))))
+            self.rec.send_columns(
+                TRIANGULATION,
+                indexes=idx,
+                columns=rr.LineStrips2D.columns(strips=strips).partition(_per_frame(len(q), len(self._triangles))),
+            )
 
     def _send_axes(self, idx: list, q: np.ndarray, tensors: dict[str, np.ndarray]) -> None:
         """Two segments per cell along the principal directions, half-length ∝ |λ|, coloured by sign."""
@@ -496,9 +584,14 @@ class Recorder:
             d, centre = axes * half[..., None], q[:, :, None, :2]
             ends = np.stack([centre - d, centre + d], axis=3)  # (F, N, axis, end, xy)
             colors = np.where(lam < 0.0, np.uint32(COMPRESSION_RGBA), np.uint32(TENSION_RGBA)).reshape(-1)
-            self.rec.send_columns(f"{XY}/{name}", indexes=idx, columns=rr.LineStrips2D.columns(
-                strips=_uniform_strips(ends.reshape(-1, 2, 2)), colors=colors,
-            ).partition(_per_frame(len(q), 2 * self._n)))
+            self.rec.send_columns(
+                f"{XY}/{name}",
+                indexes=idx,
+                columns=rr.LineStrips2D.columns(
+                    strips=_uniform_strips(ends.reshape(-1, 2, 2)),
+                    colors=colors,
+                ).partition(_per_frame(len(q), 2 * self._n)),
+            )
 
     def _send_contacts(self, idx: list, b: _Batch) -> None:
         """Force on body b at each closed contact, coloured stick / slip, capped; hinges as points."""
@@ -513,15 +606,24 @@ class Recorder:
         length = magnitude * (self.force_scale or 0.0)
         cap = _ARROW_CAP * self.block_height
         factor = (self.force_scale or 0.0) * np.minimum(1.0, cap / np.maximum(length, 1e-300))
-        self.rec.send_columns(FORCES, indexes=idx, columns=[
-            *rr.Arrows2D.columns(origins=points.astype(np.float32), colors=colors,
-                                 vectors=(forces * factor[:, None]).astype(np.float32)).partition(lengths),
-            *rr.AnyValues.columns(force=pa.array(magnitude), mobilised_friction=pa.array(mobilised)
-                                  ).partition(lengths),
-        ])
+        self.rec.send_columns(
+            FORCES,
+            indexes=idx,
+            columns=[
+                *rr.Arrows2D.columns(
+                    origins=points.astype(np.float32),
+                    colors=colors,
+                    vectors=(forces * factor[:, None]).astype(np.float32),
+                ).partition(lengths),
+                *rr.AnyValues.columns(force=pa.array(magnitude), mobilised_friction=pa.array(mobilised)).partition(
+                    lengths
+                ),
+            ],
+        )
         hinges, per_frame = b.concat("hinge_point", (0, 2))
-        self.rec.send_columns(HINGES, indexes=idx, columns=rr.Points2D.columns(
-            positions=hinges.astype(np.float32)).partition(per_frame))
+        self.rec.send_columns(
+            HINGES, indexes=idx, columns=rr.Points2D.columns(positions=hinges.astype(np.float32)).partition(per_frame)
+        )
 
     def _send_series(self, idx: list, b: _Batch, q: np.ndarray) -> None:
         n_frames = len(q)
@@ -532,14 +634,22 @@ class Recorder:
         series = {
             "energy": np.stack([sc[:, 0], sc[:, 1] - ref_pot, sc[:, 2], sc[:, 3]], axis=1),
             "max_displacement": np.sqrt((moved**2).sum(-1)).max(axis=1) if self._n else np.zeros(n_frames),
-            "support_velocity": sv, "support_displacement": sq[..., :2] - ref_sq[None, :, :2],
-            "iterations": sc[:, 4], "residual": sc[:, 5], "contacts": sc[:, 6],
+            "support_velocity": sv,
+            "support_displacement": sq[..., :2] - ref_sq[None, :, :2],
+            "iterations": sc[:, 4],
+            "residual": sc[:, 5],
+            "contacts": sc[:, 6],
         }
         for key, values in series.items():
             values = np.asarray(values, dtype=np.float64).reshape(n_frames, -1)
             if values.shape[1]:
-                self.rec.send_columns(SERIES[key], indexes=idx, columns=rr.Scalars.columns(
-                    scalars=values.reshape(-1)).partition(_per_frame(n_frames, values.shape[1])))
+                self.rec.send_columns(
+                    SERIES[key],
+                    indexes=idx,
+                    columns=rr.Scalars.columns(scalars=values.reshape(-1)).partition(
+                        _per_frame(n_frames, values.shape[1])
+                    ),
+                )
 
     # ---- run document
     def _log_metadata(self, status: str, note: str) -> None:
@@ -555,13 +665,22 @@ class Recorder:
             line = note if note.startswith(status) else f"{line}: {note}"
         pct = f"{_ROBUST_PERCENTILE:g}th percentile"
         lines = [
-            f"# masonry — {self.metadata.get('scenario', 'run')}", "", f"**Status:** {line}", "",
+            f"# masonry — {self.metadata.get('scenario', 'run')}",
+            "",
+            f"**Status:** {line}",
+            "",
             f"**Wall time:** {time.perf_counter() - self._t0:.2f} s · **frames:** {self._frames} · "
             f"**dt:** {self.static.dt:g} s · **friction:** {self.static.friction:g} · "
-            f"**blocks:** {self._n} · **supports:** {self._supports.count}", "",
-            "## Parameters", "", "| parameter | value |", "|---|---|",
-            *(f"| {k} | {v} |" for k, v in _flatten(self.metadata)), "",
-            "## How to read the views", "",
+            f"**blocks:** {self._n} · **supports:** {self._supports.count}",
+            "",
+            "## Parameters",
+            "",
+            "| parameter | value |",
+            "|---|---|",
+            *(f"| {k} | {v} |" for k, v in _flatten(self.metadata)),
+            "",
+            "## How to read the views",
+            "",
             "- **Forces**: arrow = contact force on body b at the contact point; green = stick, orange = "
             f"slip. Scale {_fmt_scale(self.force_scale, 'm per N')}: a force of the first batch's {pct} is "
             f"one median block height ({self.block_height:.3g} m) long; arrows are capped at {_ARROW_CAP:g} "
@@ -570,19 +689,29 @@ class Recorder:
             f"to |λ|, {self._glyph_length:.3g} m at the value below (longer ones clipped); black = "
             "compression / contraction, magenta = tension / extension. Stress axes in the main view; "
             "strain-rate axes and the centroid triangulation in the volumetric strain rate view.",
-            *(f"  - {n.replace('_', ' ')}: full length at |λ| = {_fmt_scale(self.axis_scale.get(n), '')}"
-              for n in _AXES),
+            *(
+                f"  - {n.replace('_', ' ')}: full length at |λ| = {_fmt_scale(self.axis_scale.get(n), '')}"
+                for n in _AXES
+            ),
             "- **Fields**: each colour range is fixed for the whole run, at the first batch where the field "
             f"is not zero ({pct} of |value|, rounded up); values beyond take the end colours; grey = "
-            "undefined (NaN). Hover a block outline for its values.", "",
-            "| field | colour map | range |", "|---|---|---|",
+            "undefined (NaN). Hover a block outline for its values.",
+            "",
+            "| field | colour map | range |",
+            "|---|---|---|",
         ]
         for f in FIELDS:
             r = self.field_ranges.get(f.key)
             rng = "not fixed yet (zero so far)" if r is None else f"{r[0]:.4g} … {r[1]:.4g} {f.unit}"
             lines.append(f"| {f.title} | {'blue–grey–red' if f.signed else 'viridis'} | {rng} |")
-        lines += ["", "## Versions", "", "| package | version |", "|---|---|",
-                  *(f"| {k} | {v} |" for k, v in _versions().items())]
+        lines += [
+            "",
+            "## Versions",
+            "",
+            "| package | version |",
+            "|---|---|",
+            *(f"| {k} | {v} |" for k, v in _versions().items()),
+        ]
         return "\n".join(lines) + "\n"
 
 
@@ -596,6 +725,7 @@ def viewer_safe_text(text: str) -> str:
     e.g. "∝" or CJK, in a document, label or hover text. Kept: ASCII, Latin-1, Latin Extended-A, Greek,
     basic Cyrillic and a few punctuation and math signs checked in the headless viewer.
     """
+
     def ok(c: str) -> bool:
         o = ord(c)
         return c in "\n\t" or 0x20 <= o < 0x7F or 0xA0 <= o < 0x180 or 0x370 <= o < 0x460 or c in _SAFE_EXTRA
@@ -612,9 +742,15 @@ def _tensor(tensors: dict, key: str, n: int) -> np.ndarray:
 
 def _flatten(d: dict, prefix: str = "") -> list[tuple[str, str]]:
     """Nested metadata -> (dotted key, table-safe value) rows."""
-    return [row for k, v in d.items() for row in (
-        _flatten(v, f"{prefix}{k}.") if isinstance(v, dict)
-        else [(f"{prefix}{k}", str(v).replace("|", "\\|").replace("\n", " "))])]
+    return [
+        row
+        for k, v in d.items()
+        for row in (
+            _flatten(v, f"{prefix}{k}.")
+            if isinstance(v, dict)
+            else [(f"{prefix}{k}", str(v).replace("|", "\\|").replace("\n", " "))]
+        )
+    ]
 
 
 def _fmt_scale(x: float | None, unit: str) -> str:
@@ -628,14 +764,18 @@ def _versions() -> dict[str, str]:
         except importlib.metadata.PackageNotFoundError:
             return "not installed"
 
-    return {"masonry": MASONRY_VERSION, "rerun-sdk": rr.__version__, "numpy": np.__version__,
-            "numba": dist("numba"), "python": platform.python_version()}
+    return {
+        "masonry": MASONRY_VERSION,
+        "rerun-sdk": rr.__version__,
+        "numpy": np.__version__,
+        "numba": dist("numba"),
+        "python": platform.python_version(),
+    }
 
 
 # ---------------------------------------------------------------------------------------------- blueprint
 def _structure_view(name: str, field: FieldSpec, extra: tuple[str, ...] = ()) -> rrb.Spatial2DView:
-    paths = (SUPPORT_FILL, field.fill, field.bar, BLOCKS, SUPPORT_OUTLINES,
-             field.labels, *extra)
+    paths = (SUPPORT_FILL, field.fill, field.bar, BLOCKS, SUPPORT_OUTLINES, field.labels, *extra)
     return rrb.Spatial2DView(origin=f"/{PLANE}", contents=[f"+ /{p}" for p in paths], name=name)
 
 
@@ -644,31 +784,37 @@ def build_blueprint(main_field: str = "cell_spherical_stress") -> rrb.Blueprint:
     main = _FIELD_BY_KEY[main_field]
     strain_rate_extra = (TRIANGULATION, STRAIN_RATE_AXES)
     structure = rrb.Tabs(
-        _structure_view(f"Structure: forces, principal stress, {main.title}", main,
-                        (FORCES, STRESS_AXES, HINGES)),
-        *(_structure_view(f.title, f, strain_rate_extra if f is FIELDS[0] else ())
-          for f in FIELDS),
+        _structure_view(f"Structure: forces, principal stress, {main.title}", main, (FORCES, STRESS_AXES, HINGES)),
+        *(_structure_view(f.title, f, strain_rate_extra if f is FIELDS[0] else ()) for f in FIELDS),
         active_tab=0,
     )
 
-    whole_run = rrb.TimeAxis(view_range=rrb.TimeRange(rrb.TimeRangeBoundary.infinite(),
-                                                      rrb.TimeRangeBoundary.infinite()))
+    whole_run = rrb.TimeAxis(
+        view_range=rrb.TimeRange(rrb.TimeRangeBoundary.infinite(), rrb.TimeRangeBoundary.infinite())
+    )
 
     def plot(key: str, name: str) -> rrb.TimeSeriesView:
         return rrb.TimeSeriesView(origin=f"/{SERIES[key]}", name=name, axis_x=whole_run)
 
     right = rrb.Vertical(
-        rrb.Tabs(plot("energy", "Energy (J)"), plot("max_displacement", "Max block displacement (m)"),
-                 plot("support_velocity", "Support velocity (m/s)"),
-                 plot("support_displacement", "Support displacement (m)")),
-        rrb.Tabs(plot("iterations", "NLGS iterations"), plot("residual", "NLGS residual"),
-                 plot("contacts", "Contacts")),
+        rrb.Tabs(
+            plot("energy", "Energy (J)"),
+            plot("max_displacement", "Max block displacement (m)"),
+            plot("support_velocity", "Support velocity (m/s)"),
+            plot("support_displacement", "Support displacement (m)"),
+        ),
+        rrb.Tabs(
+            plot("iterations", "NLGS iterations"), plot("residual", "NLGS residual"), plot("contacts", "Contacts")
+        ),
         rrb.TextDocumentView(origin=f"/{METADATA}", name="Run"),
         row_shares=[2, 2, 3],
     )
-    return rrb.Blueprint(rrb.Horizontal(structure, right, column_shares=[3, 2]),
-                         rrb.BlueprintPanel(state="collapsed"), rrb.SelectionPanel(state="collapsed"),
-                         rrb.TimePanel(state="collapsed"))
+    return rrb.Blueprint(
+        rrb.Horizontal(structure, right, column_shares=[3, 2]),
+        rrb.BlueprintPanel(state="collapsed"),
+        rrb.SelectionPanel(state="collapsed"),
+        rrb.TimePanel(state="collapsed"),
+    )
 
 
 # ---------------------------------------------------------------------------------------------- read back
@@ -710,10 +856,14 @@ def inspect_recording(path: str | os.PathLike) -> dict:
     except Exception:  # no footer / manifest: the writer did not finish
         complete = False
     return {
-        "application_id": entry.application_id, "recording_id": entry.recording_id, "frames": len(steps),
+        "application_id": entry.application_id,
+        "recording_id": entry.recording_id,
+        "frames": len(steps),
         "steps": (min(steps), max(steps)) if steps else None,
         "time_span": (round(float(t_lo), 9), round(float(t_hi), 9)) if np.isfinite(t_lo) else None,
-        "entity_paths": sorted(paths), "has_blueprint": bool(reader.blueprints()), "complete": complete,
+        "entity_paths": sorted(paths),
+        "has_blueprint": bool(reader.blueprints()),
+        "complete": complete,
         "metadata": metadata,
     }
 
@@ -731,9 +881,14 @@ def _viewer_executable() -> str | None:
     return here if os.access(here, os.X_OK) else shutil.which("rerun")
 
 
-def screenshot_recording(rrd_path: str | os.PathLike, png_path: str | os.PathLike,
-                         time_step: int | None = None, timeout: float = 60, *,
-                         tabs_dir: str | os.PathLike | None = None) -> list[str]:
+def screenshot_recording(
+    rrd_path: str | os.PathLike,
+    png_path: str | os.PathLike,
+    time_step: int | None = None,
+    timeout: float = 60,
+    *,
+    tabs_dir: str | os.PathLike | None = None,
+) -> list[str]:
     """Open a recording in a headless viewer, save a PNG of the window, return the views' error reports.
 
     ``time_step``: the `step` shown (None: the last one). The PNG shows the default layout. A hidden tab
@@ -745,8 +900,9 @@ def screenshot_recording(rrd_path: str | os.PathLike, png_path: str | os.PathLik
 
     os.makedirs(os.path.dirname(os.path.abspath(png_path)), exist_ok=True)
     deadline = time.monotonic() + timeout
-    viewer = ViewerClient.spawn(headless=True, port=_free_port(), hide_welcome_screen=True,
-                                executable_path=_viewer_executable())
+    viewer = ViewerClient.spawn(
+        headless=True, port=_free_port(), hide_welcome_screen=True, executable_path=_viewer_executable()
+    )
     pid = viewer._pid
     try:
         while True:  # until the viewer answers
@@ -774,8 +930,11 @@ def screenshot_recording(rrd_path: str | os.PathLike, png_path: str | os.PathLik
         viewer.save_screenshot(os.path.abspath(png_path))
         reports = {v.view_id: (v.name, v.reports) for v in viewer.get_state().views}
         blueprint = viewer.get_blueprint(of="recording").blueprint
-        tabs = [c["ContainerBlueprint"] for c in blueprint.values()
-                if c.get("ContainerBlueprint", {}).get("container_kind") == "Tabs"]
+        tabs = [
+            c["ContainerBlueprint"]
+            for c in blueprint.values()
+            if c.get("ContainerBlueprint", {}).get("container_kind") == "Tabs"
+        ]
         for i in range(1, max((len(t.get("contents", [])) for t in tabs), default=0)):
             if time.monotonic() > deadline:
                 raise TimeoutError(f"viewer did not show every tab of {rrd_path} within {timeout} s")
@@ -791,8 +950,11 @@ def screenshot_recording(rrd_path: str | os.PathLike, png_path: str | os.PathLik
             for v in viewer.get_state().views:
                 if v.reports or v.view_id not in reports:
                     reports[v.view_id] = (v.name, v.reports)
-        return [f"{name}: {r.severity}: {r.summary}" + (f" ({r.details})" if r.details else "")
-                for name, rs in reports.values() for r in rs]
+        return [
+            f"{name}: {r.severity}: {r.summary}" + (f" ({r.details})" if r.details else "")
+            for name, rs in reports.values()
+            for r in rs
+        ]
     finally:
         with contextlib.suppress(Exception):
             viewer.quit(timeout=5.0)
@@ -806,4 +968,3 @@ def _settle(viewer, paints: int = 2, pause: float = 0.2) -> None:
     for _ in range(paints):
         viewer.take_screenshot(max_size=64)
         time.sleep(pause)
-

@@ -30,8 +30,13 @@ def progress_bar(console: Console, n_steps: int):
 
     def on_progress(sim, stats):
         elapsed = time.perf_counter() - start
-        progress.update(task, completed=sim.state.step, t=sim.state.time,
-                        rate=sim.state.step / elapsed if elapsed > 0 else 0.0, iters=stats.iterations)
+        progress.update(
+            task,
+            completed=sim.state.step,
+            t=sim.state.time,
+            rate=sim.state.step / elapsed if elapsed > 0 else 0.0,
+            iters=stats.iterations,
+        )
 
     with progress:
         yield on_progress
@@ -52,8 +57,7 @@ def summary_table(result, max_iterations: int, recording: str | None, history: s
         table.add_row("steps at the sweep cap", f"{capped} ({100.0 * capped / its.size:.1f} %)")
         table.add_row("last residual", f"{result.residual[-1]:.2e}")
     table.add_row("max penetration", f"{result.max_penetration:.3e} m")
-    table.add_row("energy (kinetic + potential)",
-                  f"{result.energy_initial:.4g} J → {result.energy_final:.4g} J")
+    table.add_row("energy (kinetic + potential)", f"{result.energy_initial:.4g} J → {result.energy_final:.4g} J")
     table.add_row("dissipated at contacts", f"{result.energy_dissipated:.4g} J")
     table.add_row("work of the supports", f"{result.support_work:.4g} J")
     for key, value in result.extra.items():

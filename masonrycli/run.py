@@ -75,8 +75,9 @@ class Simulation:
         stats = self.solver.step(self.state)
         n = self.model.block_count
         s = self.solver
-        self.tensors.step(s.body_q_m[:n], self.state.body_v[:n], s.contact_body, s.contact_point,
-                          s.contact_force, self.model.dt)
+        self.tensors.step(
+            s.body_q_m[:n], self.state.body_v[:n], s.contact_body, s.contact_point, s.contact_force, self.model.dt
+        )
         self.energy_dissipated += stats.dissipated
         self.support_work += stats.support_work
         self.last = stats
@@ -110,26 +111,38 @@ class Simulation:
             closed = status != CONTACT_OPEN
             mobilised = np.zeros(c)
             denom = m.friction * r[closed, 1]
-            mobilised[closed] = np.divide(np.abs(r[closed, 0]), denom, out=np.zeros(denom.size),
-                                          where=denom > 0)
+            mobilised[closed] = np.divide(np.abs(r[closed, 0]), denom, out=np.zeros(denom.size), where=denom > 0)
             support_force = s.support_force
             iterations, residual = self.last.iterations, self.last.residual
             hinged, hinge_point = self.hinges()
         joint_fields = self.joints.block_fields(st.body_q, body, r, status)
         support_q = st.body_q[n:].copy()
         return Frame(
-            step=st.step, time=st.time,
-            block_q=st.body_q[:n].copy(), block_v=st.body_v[:n].copy(),
-            support_q=support_q, support_v=st.body_v[n:, :2].copy(),
+            step=st.step,
+            time=st.time,
+            block_q=st.body_q[:n].copy(),
+            block_v=st.body_v[:n].copy(),
+            support_q=support_q,
+            support_v=st.body_v[n:, :2].copy(),
             support_force=np.array(support_force, copy=True),
-            contact_body=np.array(body, copy=True), contact_point=np.array(point, copy=True),
-            contact_normal=np.array(normal, copy=True), contact_force=np.array(force, copy=True),
-            contact_gap=np.array(gap, copy=True), contact_status=np.array(status, copy=True),
-            contact_mobilised=mobilised, tensors=self.tensors.fields() | joint_fields,
-            energy_kinetic=float(kinetic), energy_potential=float(potential),
-            energy_dissipated=self.energy_dissipated, support_work=self.support_work,
-            nlgs_iterations=int(iterations), nlgs_residual=float(residual), contact_count=int(c),
-            joint_body=self.joints.joint_body, joint_hinged=hinged, hinge_point=hinge_point,
+            contact_body=np.array(body, copy=True),
+            contact_point=np.array(point, copy=True),
+            contact_normal=np.array(normal, copy=True),
+            contact_force=np.array(force, copy=True),
+            contact_gap=np.array(gap, copy=True),
+            contact_status=np.array(status, copy=True),
+            contact_mobilised=mobilised,
+            tensors=self.tensors.fields() | joint_fields,
+            energy_kinetic=float(kinetic),
+            energy_potential=float(potential),
+            energy_dissipated=self.energy_dissipated,
+            support_work=self.support_work,
+            nlgs_iterations=int(iterations),
+            nlgs_residual=float(residual),
+            contact_count=int(c),
+            joint_body=self.joints.joint_body,
+            joint_hinged=hinged,
+            hinge_point=hinge_point,
         )
 
     def hinges(self) -> tuple[np.ndarray, np.ndarray]:
@@ -150,8 +163,14 @@ class Simulation:
         return ""
 
 
-def simulate(scenario, sinks=(), on_progress: Callable | None = None, progress_every: int = 10,
-             steps: int | None = None, sim: Simulation | None = None) -> RunResult:
+def simulate(
+    scenario,
+    sinks=(),
+    on_progress: Callable | None = None,
+    progress_every: int = 10,
+    steps: int | None = None,
+    sim: Simulation | None = None,
+) -> RunResult:
     """Run ``scenario`` to its end (or ``steps`` steps). Each sink gets ``append(frame)``/``log_frame(frame)``
     for every recorded frame; sinks are *not* closed here (the caller owns them) but every frame computed
     before an interruption has been handed over when this returns.
@@ -208,9 +227,19 @@ def simulate(scenario, sinks=(), on_progress: Callable | None = None, progress_e
         shown = ", ".join(pairs[:8]) + (" …" if len(pairs) > 8 else "")
         extra["hinged joints (end)"] = f"{len(pairs)}" + (f": {shown}" if pairs else "")
     return RunResult(
-        status=status, message=message, steps=done, time=sim.state.time,
-        wall_time=_time.perf_counter() - t0, iterations=iterations[:done], residual=residual[:done],
-        contact_count=contacts[:done], max_penetration=max_pen, energy_initial=e0,
-        energy_final=float(sum(sim.energies())), energy_dissipated=sim.energy_dissipated,
-        support_work=sim.support_work, frames=frames, extra=extra,
+        status=status,
+        message=message,
+        steps=done,
+        time=sim.state.time,
+        wall_time=_time.perf_counter() - t0,
+        iterations=iterations[:done],
+        residual=residual[:done],
+        contact_count=contacts[:done],
+        max_penetration=max_pen,
+        energy_initial=e0,
+        energy_final=float(sum(sim.energies())),
+        energy_dissipated=sim.energy_dissipated,
+        support_work=sim.support_work,
+        frames=frames,
+        extra=extra,
     )

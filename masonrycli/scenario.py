@@ -100,8 +100,10 @@ class RunConfig:
             raise field_error("dt", self.dt, f"must be <= duration ({format_value(self.duration)})")
         if self.duration / self.dt > MAX_STEPS:
             raise field_error(
-                "dt", self.dt, f"gives {self.duration / self.dt:.3g} steps for duration "
-                f"{format_value(self.duration)} (at most {MAX_STEPS:.0e})"
+                "dt",
+                self.dt,
+                f"gives {self.duration / self.dt:.3g} steps for duration "
+                f"{format_value(self.duration)} (at most {MAX_STEPS:.0e})",
             )
         put("theta", check_real("theta", self.theta, ge=0.5, le=1.0))
         put("gravity", check_vector("gravity", self.gravity))
@@ -266,8 +268,9 @@ def load_scenario(path) -> Scenario:
     return loads_scenario(text, source=fname, base_dir=base_dir, default_name=Path(fname).stem)
 
 
-def loads_scenario(text: str, source: str = "<string>", base_dir: str | os.PathLike = ".",
-                   default_name: str = "scenario") -> Scenario:
+def loads_scenario(
+    text: str, source: str = "<string>", base_dir: str | os.PathLike = ".", default_name: str = "scenario"
+) -> Scenario:
     """Parse scenario TOML ``text``. ``source`` names it in error messages; ``base_dir`` resolves
     relative record files."""
     ctx = _Ctx(os.fspath(source), os.path.abspath(os.fspath(base_dir)))
@@ -319,14 +322,17 @@ def _parse_document(doc: dict, ctx: _Ctx, default_name: str) -> Scenario:
     if "structure" in doc:
         structure = _table(doc, "structure", ctx)
         if block_tables:
-            raise ctx.error(_locator("block", 1, block_tables[0], "block-1"),
-                            "not allowed together with a [structure] builder or file (use either explicit "
-                            "blocks or a [structure])")
+            raise ctx.error(
+                _locator("block", 1, block_tables[0], "block-1"),
+                "not allowed together with a [structure] builder or file (use either explicit blocks or a [structure])",
+            )
         if "file" in structure:
             extra = [k for k in structure if k != "file"]
             if extra:
-                raise ctx.error("[structure]", f"{extra[0]}: not allowed with file = ... (a geometry file "
-                                "brings its own blocks and supports)")
+                raise ctx.error(
+                    "[structure]",
+                    f"{extra[0]}: not allowed with file = ... (a geometry file brings its own blocks and supports)",
+                )
             file = structure["file"]
             if not isinstance(file, str):
                 raise ctx.error("[structure]", f"file = {format_value(file)[:40]}: must be a string")
@@ -336,8 +342,7 @@ def _parse_document(doc: dict, ctx: _Ctx, default_name: str) -> Scenario:
             structure_info = {"file": path}
         else:
             if "builder" not in structure:
-                raise ctx.error("[structure]", "builder: missing (e.g. builder = \"wall\", or file = "
-                                "\"my-wall.geojson\")")
+                raise ctx.error("[structure]", 'builder: missing (e.g. builder = "wall", or file = "my-wall.geojson")')
             builder = structure["builder"]
             if not isinstance(builder, str):
                 raise ctx.error("[structure]", f"builder = {format_value(builder)[:40]}: must be a string")
@@ -352,7 +357,7 @@ def _parse_document(doc: dict, ctx: _Ctx, default_name: str) -> Scenario:
             except InputError as exc:
                 raise ctx.error("[structure]", str(exc)) from None
             structure_info = {"builder": builder, **options}
-            what = f"builder \"{builder}\""
+            what = f'builder "{builder}"'
         motions_by_support = {}
         known = [s.name for s in assembly.supports]
         for i, table in enumerate(support_tables, start=1):
@@ -360,15 +365,21 @@ def _parse_document(doc: dict, ctx: _Ctx, default_name: str) -> Scenario:
             for key in table:
                 if key not in BUILDER_SUPPORT_KEYS:
                     if key in SUPPORT_KEYS:
-                        raise ctx.error(loc, f"{key}: not allowed with a [structure] "
-                                        f"({what} makes the supports; give only name and motion)")
+                        raise ctx.error(
+                            loc,
+                            f"{key}: not allowed with a [structure] "
+                            f"({what} makes the supports; give only name and motion)",
+                        )
                     raise ctx.error(loc, _unknown_key(key, BUILDER_SUPPORT_KEYS))
             if "name" not in table:
                 raise ctx.error(loc, f"name: missing ({what} supports: {', '.join(known)})")
             sname = table["name"]
             if sname not in known:
-                raise ctx.error(loc, f"name = {format_value(sname)[:40]}: no such support in {what} "
-                                f"(supports: {', '.join(known) or 'none'})")
+                raise ctx.error(
+                    loc,
+                    f"name = {format_value(sname)[:40]}: no such support in {what} "
+                    f"(supports: {', '.join(known) or 'none'})",
+                )
             if sname in motions_by_support:
                 raise ctx.error(loc, f"name = {quote_string(sname)}: support given twice")
             motions_by_support[sname] = _parse_motion(table.get("motion"), ctx, loc)
@@ -391,8 +402,14 @@ def _parse_document(doc: dict, ctx: _Ctx, default_name: str) -> Scenario:
 
     warnings = _validate(assembly, ctx)
     return Scenario(
-        name=name, run=run, material=material, assembly=assembly, motions=motions,
-        source=ctx.fname, structure=structure_info, warnings=warnings,
+        name=name,
+        run=run,
+        material=material,
+        assembly=assembly,
+        motions=motions,
+        source=ctx.fname,
+        structure=structure_info,
+        warnings=warnings,
     )
 
 
@@ -406,8 +423,10 @@ def _read_geometry(path: str, material: Material, ctx: _Ctx) -> Assembly:
 
     suffix = Path(path).suffix.lower()
     if suffix not in GEOMETRY_SUFFIXES:
-        raise ctx.error("[structure]", f"file = {quote_string(path)}: unknown geometry format "
-                        f"(expected {', '.join(GEOMETRY_SUFFIXES)})")
+        raise ctx.error(
+            "[structure]",
+            f"file = {quote_string(path)}: unknown geometry format (expected {', '.join(GEOMETRY_SUFFIXES)})",
+        )
     if not os.path.isfile(path):
         raise ctx.error("[structure]", f"file = {quote_string(path)}: no such file")
     reader = geo_io.read_wkt if suffix == ".wkt" else geo_io.read_geojson
@@ -428,9 +447,16 @@ def scenario_from_geometry_file(path) -> Scenario:
     material = Material()
     assembly = _read_geometry(os.path.abspath(path), material, ctx)
     warnings = _validate(assembly, ctx)
-    return Scenario(name=Path(path).stem, run=RunConfig(), material=material, assembly=assembly,
-                    motions=tuple(Motion() for _ in assembly.supports), source=path,
-                    structure={"file": os.path.abspath(path)}, warnings=warnings)
+    return Scenario(
+        name=Path(path).stem,
+        run=RunConfig(),
+        material=material,
+        assembly=assembly,
+        motions=tuple(Motion() for _ in assembly.supports),
+        source=path,
+        structure={"file": os.path.abspath(path)},
+        warnings=warnings,
+    )
 
 
 def _locator(section: str, index: int, table: dict, default_name: str | None) -> str:
@@ -464,7 +490,7 @@ def _polygon(coords, index: int, name: str, kind: str, ctx: _Ctx, loc: str):
         label_fn = getattr(checks, "body_label", None)
         label = f"{label_fn(index, name, kind)}: " if label_fn else ""
         if label and msg.startswith(label):
-            msg = msg[len(label):]
+            msg = msg[len(label) :]
         raise ctx.error(loc, msg) from None
 
 
@@ -519,8 +545,11 @@ def _parse_motion(table, ctx: _Ctx, loc: str) -> Motion:
     if table is None:
         return Motion()
     if not isinstance(table, dict):
-        raise ctx.error(loc, f"motion = {format_value(table)[:40]}: must be a table, e.g. "
-                        "motion = { kind = \"sine\", amplitude = 1.0, frequency = 2.0 }")
+        raise ctx.error(
+            loc,
+            f"motion = {format_value(table)[:40]}: must be a table, e.g. "
+            'motion = { kind = "sine", amplitude = 1.0, frequency = 2.0 }',
+        )
     for key in table:
         if key not in ALL_MOTION_KEYS:
             raise ctx.error(loc, "motion: " + _unknown_key(key, ALL_MOTION_KEYS))
@@ -528,15 +557,17 @@ def _parse_motion(table, ctx: _Ctx, loc: str) -> Motion:
         raise ctx.error(loc, f"motion.kind: missing (one of {', '.join(MOTION_KINDS)})")
     kind = table["kind"]
     if not isinstance(kind, str) or kind not in MOTION_KINDS:
-        raise ctx.error(loc, f"motion.kind = {format_value(kind)[:40]}: unknown motion kind "
-                        f"(expected one of {', '.join(MOTION_KINDS)})")
+        raise ctx.error(
+            loc,
+            f"motion.kind = {format_value(kind)[:40]}: unknown motion kind (expected one of {', '.join(MOTION_KINDS)})",
+        )
     allowed = MOTION_KEYS[kind]
     for key in table:
         if key not in allowed:
-            raise ctx.error(loc, f"motion.{key}: not used by kind \"{kind}\" (its keys: {', '.join(allowed)})")
+            raise ctx.error(loc, f'motion.{key}: not used by kind "{kind}" (its keys: {", ".join(allowed)})')
     for key in MOTION_REQUIRED[kind]:
         if key not in table:
-            raise ctx.error(loc, f"motion.{key}: missing (required for kind \"{kind}\")")
+            raise ctx.error(loc, f'motion.{key}: missing (required for kind "{kind}")')
 
     args = {k: v for k, v in table.items() if k not in ("file", "time", "value")}
     if kind == "record":
@@ -547,7 +578,7 @@ def _parse_motion(table, ctx: _Ctx, loc: str) -> Motion:
         msg = str(exc)
         for old, new in (("record_time", "time"), ("record_value", "value")):
             if msg.startswith(old):
-                msg = new + msg[len(old):]
+                msg = new + msg[len(old) :]
         raise ctx.error(loc, f"motion.{msg}") from None
 
 
@@ -576,7 +607,7 @@ def _record_data(table: dict, ctx: _Ctx, loc: str) -> dict:
         }
     for key in ("time", "value"):
         if key not in table:
-            raise ctx.error(loc, f"motion.{key}: missing (kind \"record\" needs file, or time and value)")
+            raise ctx.error(loc, f'motion.{key}: missing (kind "record" needs file, or time and value)')
         if not isinstance(table[key], list):
             raise ctx.error(loc, f"motion.{key} = {format_value(table[key])[:40]}: must be an array")
     value = table["value"]
@@ -609,20 +640,32 @@ def _builders() -> dict:
 
 def _builder_parameters(fn) -> dict[str, inspect.Parameter]:
     params = inspect.signature(fn).parameters
-    return {n: p for n, p in params.items()
-            if p.kind in (inspect.Parameter.POSITIONAL_OR_KEYWORD, inspect.Parameter.KEYWORD_ONLY)}
+    return {
+        n: p
+        for n, p in params.items()
+        if p.kind in (inspect.Parameter.POSITIONAL_OR_KEYWORD, inspect.Parameter.KEYWORD_ONLY)
+    }
 
 
 def _expected_type(param: inspect.Parameter) -> str:
-    """"number" | "int" | "bool" | "str" | "" (unknown) from a builder parameter's annotation or default."""
+    """ "number" | "int" | "bool" | "str" | "" (unknown) from a builder parameter's annotation or default."""
     ann = param.annotation
     if ann is inspect.Parameter.empty:
         ann = ""
     elif not isinstance(ann, str):
         ann = getattr(ann, "__name__", str(ann))
     ann = ann.replace(" ", "")
-    table = {"float": "number", "float|None": "number", "int|float": "number", "float|int": "number",
-             "int": "int", "int|None": "int", "bool": "bool", "str": "str", "str|None": "str"}
+    table = {
+        "float": "number",
+        "float|None": "number",
+        "int|float": "number",
+        "float|int": "number",
+        "int": "int",
+        "int|None": "int",
+        "bool": "bool",
+        "str": "str",
+        "str|None": "str",
+    }
     if ann:
         return table.get(ann, "")
     default = param.default
@@ -667,7 +710,7 @@ def _call_builder(builder: str, options: dict, material: Material) -> Assembly:
         if key not in params:
             close = difflib.get_close_matches(key, list(params), n=1)
             hint = f'did you mean "{close[0]}"?' if close else f"options: {', '.join(params) or 'none'}"
-            raise InputError(f"unknown option {quote_string(key)} of builder \"{builder}\" ({hint})")
+            raise InputError(f'unknown option {quote_string(key)} of builder "{builder}" ({hint})')
         kwargs[key] = _check_option_type(key, _freeze(value), params[key])
     for key in ("density", "thickness"):
         if key in params and key not in kwargs:
@@ -675,21 +718,22 @@ def _call_builder(builder: str, options: dict, material: Material) -> Assembly:
     try:
         assembly = fn(**kwargs)
     except ValueError as exc:  # GeometryError, InputError, bad values; a TypeError is a bug: not hidden
-        raise InputError(f"builder \"{builder}\": {_one_line(exc)}") from None
+        raise InputError(f'builder "{builder}": {_one_line(exc)}') from None
     if not isinstance(assembly, Assembly):
-        raise InputError(f"builder \"{builder}\" returned {type(assembly).__name__}, not an Assembly")
+        raise InputError(f'builder "{builder}" returned {type(assembly).__name__}, not an Assembly')
     return assembly
 
 
-def scenario_from_builder(builder: str, options: dict, run: RunConfig, material: Material,
-                          motions_by_support: dict[str, Motion]) -> Scenario:
+def scenario_from_builder(
+    builder: str, options: dict, run: RunConfig, material: Material, motions_by_support: dict[str, Motion]
+) -> Scenario:
     """A scenario from ``geometry_library.builders.BUILDERS[builder](**options)``.
 
     ``material.density`` / ``material.thickness`` are passed to the builder unless ``options`` sets
     them. ``motions_by_support`` maps support names to motions; supports not named are fixed; a name the
     builder does not make is an error. Raises :class:`InputError` (``builder "wall": ...``).
     """
-    where = f"builder \"{builder}\":"
+    where = f'builder "{builder}":'
     options = dict(options)
     for key, value in options.items():
         try:
@@ -700,19 +744,26 @@ def scenario_from_builder(builder: str, options: dict, run: RunConfig, material:
         assembly = _call_builder(builder, options, material)
     except InputError as exc:
         msg = str(exc)
-        raise InputError(msg if msg.startswith(f"builder \"{builder}\"") else f"{where} {msg}") from None
+        raise InputError(msg if msg.startswith(f'builder "{builder}"') else f"{where} {msg}") from None
     known = [s.name for s in assembly.supports]
     for name, motion in motions_by_support.items():
         if name not in known:
-            raise InputError(f"{where} no support named {quote_string(str(name))} "
-                             f"(supports: {', '.join(known) or 'none'})")
+            raise InputError(
+                f"{where} no support named {quote_string(str(name))} (supports: {', '.join(known) or 'none'})"
+            )
         if not isinstance(motion, Motion):
             raise InputError(f"{where} motion of support {quote_string(name)} must be a Motion")
     motions = tuple(motions_by_support.get(s.name, Motion()) for s in assembly.supports)
-    warnings = _validate(assembly, _Ctx(f"builder \"{builder}\"", "."))
+    warnings = _validate(assembly, _Ctx(f'builder "{builder}"', "."))
     return Scenario(
-        name=builder, run=run, material=material, assembly=assembly, motions=motions,
-        source=f"builder:{builder}", structure={"builder": builder, **options}, warnings=warnings,
+        name=builder,
+        run=run,
+        material=material,
+        assembly=assembly,
+        motions=motions,
+        source=f"builder:{builder}",
+        structure={"builder": builder, **options},
+        warnings=warnings,
     )
 
 
@@ -739,8 +790,7 @@ def scenario_summary(scenario: Scenario) -> dict:
         "blocks": asm.block_count,
         "supports": asm.support_count,
         "support_motions": [
-            {"name": s.name, "role": s.role, "motion": m.describe()}
-            for s, m in zip(asm.supports, scenario.motions)
+            {"name": s.name, "role": s.role, "motion": m.describe()} for s, m in zip(asm.supports, scenario.motions)
         ],
         "total_mass": float(sum(masses)),
         "total_area": float(sum(float(b.polygon.area) for b in asm.blocks)),

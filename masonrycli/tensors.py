@@ -55,9 +55,7 @@ TENSOR_FIELDS: dict[str, tuple[tuple[int, ...], str, str]] = {
     "cell_spherical_stress": ((), "Pa", "2-D spherical stress p = (σ1 + σ2) / 2"),
     "cell_deviatoric_stress": ((), "Pa", "deviatoric stress q = (σ1 − σ2) / 2 ≥ 0"),
     "cell_principal_strain_rate": ((2,), "1/s", "principal strain rates ε̇1 ≥ ε̇2"),
-    "cell_principal_strain_rate_angle": (
-        (), "rad", "direction of ε̇1 from x, counter-clockwise, in (−π/2, π/2]"
-    ),
+    "cell_principal_strain_rate_angle": ((), "rad", "direction of ε̇1 from x, counter-clockwise, in (−π/2, π/2]"),
     "cell_volumetric_strain_rate": ((), "1/s", "volumetric strain rate ε̇1 + ε̇2 (trace)"),
     "cell_deviatoric_strain_rate": ((), "1/s", "deviatoric strain rate (ε̇1 − ε̇2) / 2 ≥ 0"),
     "cell_principal_strain": ((2,), "1", "principal cumulated strains ε1 ≥ ε2"),
@@ -180,16 +178,18 @@ def _complete_with_cliques(points, tri, touch_keys, n, min_area) -> np.ndarray:
     for i, j in zip(lo.tolist(), hi.tolist()):
         neighbours[i].add(j)
         neighbours[j].add(i)
-    cliques = [(i, j, k) for i, j in zip(lo.tolist(), hi.tolist())
-               for k in sorted(neighbours[i] & neighbours[j]) if k > j]
+    cliques = [
+        (i, j, k) for i, j in zip(lo.tolist(), hi.tolist()) for k in sorted(neighbours[i] & neighbours[j]) if k > j
+    ]
     if not cliques:
         return tri
     cand = np.array(cliques, dtype=np.int64)
     have = {tuple(sorted(t)) for t in tri.tolist()}
     cand = cand[[tuple(c) not in have for c in cand.tolist()]]
     p = points[cand]
-    area = 0.5 * np.abs((p[:, 1, 0] - p[:, 0, 0]) * (p[:, 2, 1] - p[:, 0, 1])
-                        - (p[:, 1, 1] - p[:, 0, 1]) * (p[:, 2, 0] - p[:, 0, 0]))
+    area = 0.5 * np.abs(
+        (p[:, 1, 0] - p[:, 0, 0]) * (p[:, 2, 1] - p[:, 0, 1]) - (p[:, 1, 1] - p[:, 0, 1]) * (p[:, 2, 0] - p[:, 0, 0])
+    )
     cand = cand[area >= min_area]
     area = area[area >= min_area]
     order = np.lexsort((cand[:, 2], cand[:, 1], cand[:, 0], area))
@@ -215,10 +215,10 @@ def _overlaps_any(tri_pts: np.ndarray, others: np.ndarray, min_area: float) -> b
     both = [np.broadcast_to(tri_pts, others.shape), others]
     separated = np.zeros(others.shape[0], dtype=bool)
     for shape in both:
-        edges = np.roll(shape, -1, axis=1) - shape               # (M, 3, 2)
+        edges = np.roll(shape, -1, axis=1) - shape  # (M, 3, 2)
         normals = np.stack([-edges[..., 1], edges[..., 0]], -1)  # (M, 3, 2)
         normals /= np.linalg.norm(normals, axis=-1, keepdims=True)
-        pa = np.einsum("mkd,mvd->mkv", normals, both[0])          # (M, 3 axes, 3 vertices)
+        pa = np.einsum("mkd,mvd->mkv", normals, both[0])  # (M, 3 axes, 3 vertices)
         pb = np.einsum("mkd,mvd->mkv", normals, both[1])
         overlap = np.minimum(pa.max(-1), pb.max(-1)) - np.maximum(pa.min(-1), pb.min(-1))
         separated |= (overlap <= tol).any(axis=1)
@@ -230,9 +230,7 @@ def _overlaps_any(tri_pts: np.ndarray, others: np.ndarray, min_area: float) -> b
 # ---------------------------------------------------------------------------------------------------
 
 
-def block_stress(
-    block_count, block_q, block_volume, contact_body, contact_point, contact_force
-) -> np.ndarray:
+def block_stress(block_count, block_q, block_volume, contact_body, contact_point, contact_force) -> np.ndarray:
     """Block stress σ_b = (1/V_b) Σ GI ⊗ F (eq. 8).
 
     Args:
@@ -247,8 +245,15 @@ def block_stress(
         (N, 2, 2) Pa, ``[i, j] = Σ GI_i F_j / V``.
     """
     out = np.empty((block_count, 2, 2))
-    _k._block_stress(block_count, _f64(block_q), _f64(block_volume), np.asarray(contact_body),
-                     _f64(contact_point), _f64(contact_force), out)
+    _k._block_stress(
+        block_count,
+        _f64(block_q),
+        _f64(block_volume),
+        np.asarray(contact_body),
+        _f64(contact_point),
+        _f64(contact_force),
+        out,
+    )
     return out
 
 
@@ -278,8 +283,7 @@ def cell_strain_rate(block_count, block_q, block_v, triangles, min_area=None) ->
     """
     out = np.empty((block_count, 2, 2))
     floor = np.zeros(block_count) if min_area is None else _f64(min_area)
-    _k._cell_strain_rate(block_count, _f64(block_q), _f64(block_v), _triangles(triangles, block_count), floor,
-                         out)
+    _k._cell_strain_rate(block_count, _f64(block_q), _f64(block_v), _triangles(triangles, block_count), floor, out)
     return out
 
 
@@ -321,8 +325,9 @@ class TensorComputer:
         triangles: (T, 3) int block indices, from ``build_triangles`` on the initial configuration.
     """
 
-    def __init__(self, block_count: int, block_volume: np.ndarray, triangles: np.ndarray,
-                 centroids0: np.ndarray | None = None):
+    def __init__(
+        self, block_count: int, block_volume: np.ndarray, triangles: np.ndarray, centroids0: np.ndarray | None = None
+    ):
         n = int(block_count)
         if n < 0:
             raise ValueError("block_count must be >= 0")
@@ -344,8 +349,10 @@ class TensorComputer:
         (``FOLDED_FRACTION`` of its initial area when ``centroids0`` is given, else 0)."""
         if centroids0 is not None and self.triangles.size:
             p = np.asarray(centroids0, dtype=np.float64)[self.triangles]
-            area = 0.5 * ((p[:, 1, 0] - p[:, 0, 0]) * (p[:, 2, 1] - p[:, 0, 1])
-                          - (p[:, 1, 1] - p[:, 0, 1]) * (p[:, 2, 0] - p[:, 0, 0]))
+            area = 0.5 * (
+                (p[:, 1, 0] - p[:, 0, 0]) * (p[:, 2, 1] - p[:, 0, 1])
+                - (p[:, 1, 1] - p[:, 0, 1]) * (p[:, 2, 0] - p[:, 0, 0])
+            )
             star = np.zeros(n)
             for m in range(3):
                 np.add.at(star, self.triangles[:, m], area)
@@ -387,12 +394,7 @@ class TensorComputer:
         """
         n = self.block_count
         c = contact_body.shape[0]
-        if (
-            block_q.shape[0] < n
-            or block_v.shape[0] < n
-            or contact_point.shape[0] != c
-            or contact_force.shape[0] != c
-        ):
+        if block_q.shape[0] < n or block_v.shape[0] < n or contact_point.shape[0] != c or contact_force.shape[0] != c:
             raise ValueError(
                 f"inconsistent shapes: N={n}, block_q {block_q.shape}, block_v {block_v.shape}, "
                 f"contact_body {contact_body.shape}, contact_point {contact_point.shape}, "

@@ -156,9 +156,22 @@ def reference_manifold(A, B, alert, a=0, b=1):
     """
     A, B = as_list(A), as_list(B)
     ref_is_b, e, sep_a, sep_b, tol, ambiguous = reference_choice(A, B)
-    out = dict(points=[], gaps=[], keys=[], normal=None, ref_is_b=ref_is_b, ref_edge=e,
-               incident_edge=None, sep=max(sep_a, sep_b), ambiguous=ambiguous, slab_margin=math.inf,
-               sep_a=sep_a, sep_b=sep_b, tol=tol, at_threshold=abs(sep_b - sep_a - tol) <= 1e-12)
+    out = dict(
+        points=[],
+        gaps=[],
+        keys=[],
+        normal=None,
+        ref_is_b=ref_is_b,
+        ref_edge=e,
+        incident_edge=None,
+        sep=max(sep_a, sep_b),
+        ambiguous=ambiguous,
+        slab_margin=math.inf,
+        sep_a=sep_a,
+        sep_b=sep_b,
+        tol=tol,
+        at_threshold=abs(sep_b - sep_a - tol) <= 1e-12,
+    )
     if sep_a > alert or sep_b > alert:
         return out
     R, I = (B, A) if ref_is_b else (A, B)
@@ -178,12 +191,14 @@ def reference_manifold(A, B, alert, a=0, b=1):
     out["slab_margin"] = min(min(abs(t_of(w)), abs(L - t_of(w))) for w in (w1, w2))
 
     big = 10.0 * (extent(A) + extent(B) + abs(out["sep"]) + alert)
-    slab = Polygon([
-        (v1[0] - big * n[0], v1[1] - big * n[1]),
-        (v2[0] - big * n[0], v2[1] - big * n[1]),
-        (v2[0] + big * n[0], v2[1] + big * n[1]),
-        (v1[0] + big * n[0], v1[1] + big * n[1]),
-    ])
+    slab = Polygon(
+        [
+            (v1[0] - big * n[0], v1[1] - big * n[1]),
+            (v2[0] - big * n[0], v2[1] - big * n[1]),
+            (v2[0] + big * n[0], v2[1] + big * n[1]),
+            (v1[0] + big * n[0], v1[1] + big * n[1]),
+        ]
+    )
     clipped = LineString([w1, w2]).intersection(slab)
     if clipped.is_empty:
         return out
@@ -283,8 +298,9 @@ def aabbs_numpy(vert_world, body_vert_start, alert):
     boxes = []
     for b in range(len(body_vert_start) - 1):
         v = vert_world[body_vert_start[b] : body_vert_start[b + 1]]
-        boxes.append([v[:, 0].min() - alert / 2, v[:, 1].min() - alert / 2,
-                      v[:, 0].max() + alert / 2, v[:, 1].max() + alert / 2])
+        boxes.append(
+            [v[:, 0].min() - alert / 2, v[:, 1].min() - alert / 2, v[:, 0].max() + alert / 2, v[:, 1].max() + alert / 2]
+        )
     return np.array(boxes).reshape(-1, 4)
 
 
@@ -295,8 +311,12 @@ def aabb_pairs_bruteforce(boxes, body_dynamic):
         for j in range(i + 1, len(boxes)):
             if not (body_dynamic[i] or body_dynamic[j]):
                 continue
-            if (boxes[i][0] <= boxes[j][2] and boxes[j][0] <= boxes[i][2]
-                    and boxes[i][1] <= boxes[j][3] and boxes[j][1] <= boxes[i][3]):
+            if (
+                boxes[i][0] <= boxes[j][2]
+                and boxes[j][0] <= boxes[i][2]
+                and boxes[i][1] <= boxes[j][3]
+                and boxes[j][1] <= boxes[i][3]
+            ):
                 pairs.append((i, j))
     return pairs
 

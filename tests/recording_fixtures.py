@@ -90,8 +90,7 @@ def tensor_fields(n: int, rng: np.random.Generator, t: float) -> dict[str, np.nd
     }
 
 
-def frame(static: RecordingStatic, q0: np.ndarray, step: int, rng: np.random.Generator,
-          n_contacts: int = 40) -> Frame:
+def frame(static: RecordingStatic, q0: np.ndarray, step: int, rng: np.random.Generator, n_contacts: int = 40) -> Frame:
     """One synthetic frame at `step` (t = step·dt): the wall sways, contacts are random."""
     n = len(q0)
     t = step * static.dt
@@ -106,20 +105,34 @@ def frame(static: RecordingStatic, q0: np.ndarray, step: int, rng: np.random.Gen
     force[status == CONTACT_OPEN] = 0.0
     normal = np.tile([0.0, 1.0], (n_contacts, 1))
     return Frame(
-        step=step, time=t, block_q=q, block_v=np.zeros((n, 3)), support_q=ground_q,
+        step=step,
+        time=t,
+        block_q=q,
+        block_v=np.zeros((n, 3)),
+        support_q=ground_q,
         support_v=np.array([[2 * np.pi * 2 * 0.01 * np.cos(2 * np.pi * 2 * t), 0.0]]),
-        support_force=np.array([[0.0, 1e4]]), contact_body=body,
+        support_force=np.array([[0.0, 1e4]]),
+        contact_body=body,
         contact_point=q[rng.integers(0, n, n_contacts), :2] + rng.normal(0, 0.05, (n_contacts, 2)),
-        contact_normal=normal, contact_force=force, contact_gap=np.zeros(n_contacts), contact_status=status,
+        contact_normal=normal,
+        contact_force=force,
+        contact_gap=np.zeros(n_contacts),
+        contact_status=status,
         contact_mobilised=rng.uniform(0, 1, n_contacts) * (status != CONTACT_OPEN),
-        tensors=tensor_fields(n, rng, t), energy_kinetic=0.5 * t, energy_potential=1e4 - t,
-        energy_dissipated=0.1 * t, support_work=0.6 * t, nlgs_iterations=int(rng.integers(5, 50)),
-        nlgs_residual=float(rng.uniform(1e-6, 1e-4)), contact_count=int((status != CONTACT_OPEN).sum()),
+        tensors=tensor_fields(n, rng, t),
+        energy_kinetic=0.5 * t,
+        energy_potential=1e4 - t,
+        energy_dissipated=0.1 * t,
+        support_work=0.6 * t,
+        nlgs_iterations=int(rng.integers(5, 50)),
+        nlgs_residual=float(rng.uniform(1e-6, 1e-4)),
+        contact_count=int((status != CONTACT_OPEN).sum()),
     )
 
 
-def frames(static: RecordingStatic, q0: np.ndarray, count: int, every: int = 10, seed: int = 0,
-           n_contacts: int = 40) -> list[Frame]:
+def frames(
+    static: RecordingStatic, q0: np.ndarray, count: int, every: int = 10, seed: int = 0, n_contacts: int = 40
+) -> list[Frame]:
     rng = np.random.default_rng(seed)
     return [frame(static, q0, k * every, rng, n_contacts) for k in range(count)]
 

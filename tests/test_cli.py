@@ -47,8 +47,7 @@ def test_help_and_version():
 
 def test_simulate_wall_short_run_writes_recording_and_history(tmp_path):
     rrd, npz = tmp_path / "wall.rrd", tmp_path / "wall.npz"
-    result = invoke("simulate", "wall", "--freq", 2, "--amp", 1, "--duration", 0.05, "--out", rrd,
-                    "--history", npz)
+    result = invoke("simulate", "wall", "--freq", 2, "--amp", 1, "--duration", 0.05, "--out", rrd, "--history", npz)
     assert result.exit_code == 0, result.output
     assert rrd.stat().st_size > 0
     h = np.load(npz)
@@ -60,8 +59,7 @@ def test_simulate_wall_short_run_writes_recording_and_history(tmp_path):
 
 def test_run_scenario_file(tmp_path):
     npz = tmp_path / "h.npz"
-    result = invoke("run", DATA / "validation" / "column5.toml", "--duration", 0.02, "--no-recording",
-                    "--history", npz)
+    result = invoke("run", DATA / "validation" / "column5.toml", "--duration", 0.02, "--no-recording", "--history", npz)
     assert result.exit_code == 0, result.output
     h = np.load(npz)
     assert list(h["block_name"]) == ["k5", "k4", "k3", "k2", "k1"]
@@ -101,8 +99,10 @@ def test_non_convex_block_is_named(tmp_path):
 
 def test_overlapping_blocks_are_named(tmp_path):
     path = tmp_path / "overlap.toml"
-    path.write_text('[[block]]\nname = "a"\npolygon = [[0, 0], [1, 0], [1, 1], [0, 1]]\n'
-                    '[[block]]\nname = "b"\npolygon = [[0.5, 0], [1.5, 0], [1.5, 1], [0.5, 1]]\n')
+    path.write_text(
+        '[[block]]\nname = "a"\npolygon = [[0, 0], [1, 0], [1, 1], [0, 1]]\n'
+        '[[block]]\nname = "b"\npolygon = [[0.5, 0], [1.5, 0], [1.5, 1], [0.5, 1]]\n'
+    )
     assert_one_line_error(invoke("check", path), '"a"', '"b"', "overlap")
 
 
@@ -111,9 +111,25 @@ def test_sigint_leaves_a_readable_recording(tmp_path):
     rrd, npz = tmp_path / "int.rrd", tmp_path / "int.npz"
     env = dict(os.environ, RERUN_ANALYTICS="0")
     proc = subprocess.Popen(
-        [sys.executable, "-m", "masonrycli", "simulate", "wall", "--blocks", "248", "--duration", "20",
-         "--out", str(rrd), "--history", str(npz)],
-        env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+        [
+            sys.executable,
+            "-m",
+            "masonrycli",
+            "simulate",
+            "wall",
+            "--blocks",
+            "248",
+            "--duration",
+            "20",
+            "--out",
+            str(rrd),
+            "--history",
+            str(npz),
+        ],
+        env=env,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.STDOUT,
+        text=True,
     )
     # Wait until frames are flowing (history is only written at the end; watch the recording grow).
     deadline = time.time() + 120
@@ -183,11 +199,14 @@ def test_engine_error_mid_run_keeps_frames(tmp_path, monkeypatch):
     assert _frames_in(rrd) == 3
 
 
-@pytest.mark.parametrize("builder, args, blocks, supports", [
-    ("wall", ["--blocks", "51"], 51, 1),
-    ("wall", ["--blocks", "248"], 248, 1),
-    ("arch", [], 98, 2),
-])
+@pytest.mark.parametrize(
+    "builder, args, blocks, supports",
+    [
+        ("wall", ["--blocks", "51"], 51, 1),
+        ("wall", ["--blocks", "248"], 248, 1),
+        ("arch", [], 98, 2),
+    ],
+)
 def test_build_writes_geojson_that_runs(builder, args, blocks, supports, tmp_path):
     """`masonry build` output: the right counts, convex, non-overlapping (checked with shapely), and the
     same format runs directly and from a scenario file that gives its support a motion."""
@@ -214,8 +233,10 @@ def test_build_writes_geojson_that_runs(builder, args, blocks, supports, tmp_pat
         assert result.exit_code == 0, result.output
         assert np.load(npz)["block_q"].shape[1] == 51
         scen = tmp_path / "shaken.toml"
-        scen.write_text(f'[run]\nduration = 0.02\n[structure]\nfile = "{out.name}"\n[[support]]\nname = "ground"\n'
-                        'motion = { kind = "sine", amplitude = 1.0, frequency = 2.0 }\n')
+        scen.write_text(
+            f'[run]\nduration = 0.02\n[structure]\nfile = "{out.name}"\n[[support]]\nname = "ground"\n'
+            'motion = { kind = "sine", amplitude = 1.0, frequency = 2.0 }\n'
+        )
         result = invoke("run", scen, "--no-recording", "--history", npz)
         assert result.exit_code == 0, result.output
         assert np.load(npz)["support_v"][-1, 0, 0] == pytest.approx(np.sin(2 * np.pi * 2 * 0.02))

@@ -15,21 +15,22 @@ import naive_collision as nv
 
 def random_scene(rng, n, supports=3, spread=4.0, quantum=None):
     """n random convex polygons (the last `supports` are supports), random poses."""
-    polys = [nv.random_convex_polygon(rng, radius=rng.uniform(0.05, 0.4), aspect=rng.uniform(0.3, 3))
-             for _ in range(n)]
-    body_q = np.column_stack([rng.uniform(0, spread, n), rng.uniform(0, spread / 2, n),
-                              rng.uniform(-math.pi, math.pi, n)])
+    polys = [nv.random_convex_polygon(rng, radius=rng.uniform(0.05, 0.4), aspect=rng.uniform(0.3, 3)) for _ in range(n)]
+    body_q = np.column_stack(
+        [rng.uniform(0, spread, n), rng.uniform(0, spread / 2, n), rng.uniform(-math.pi, math.pi, n)]
+    )
     if quantum:  # many equal box bounds: ties in the sort, touching boxes
         body_q[:, :2] = np.round(body_q[:, :2] / quantum) * quantum
         polys = [np.round(p / quantum) * quantum for p in polys]
-        polys = [p if len(np.unique(p, axis=0)) == len(p) else nv.rect(-quantum, -quantum, quantum, quantum)
-                 for p in polys]
+        polys = [
+            p if len(np.unique(p, axis=0)) == len(p) else nv.rect(-quantum, -quantum, quantum, quantum) for p in polys
+        ]
         body_q[:, 2] = 0.0
     start = np.zeros(n + 1, dtype=np.int64)
     start[1:] = np.cumsum([len(p) for p in polys])
     vert_local = np.concatenate(polys)
     dynamic = np.ones(n, dtype=bool)
-    dynamic[n - supports:] = False
+    dynamic[n - supports :] = False
     return body_q, start, vert_local, dynamic
 
 
@@ -148,8 +149,10 @@ def test_column_sweeps_along_y():
 def naive_contacts(polys_world, dynamic, alert):
     """Every pair's reference manifold (brute force over all pairs)."""
     out = {}
-    boxes = [[p[:, 0].min() - alert, p[:, 1].min() - alert, p[:, 0].max() + alert, p[:, 1].max() + alert]
-             for p in polys_world]
+    boxes = [
+        [p[:, 0].min() - alert, p[:, 1].min() - alert, p[:, 0].max() + alert, p[:, 1].max() + alert]
+        for p in polys_world
+    ]
     for a, b in nv.aabb_pairs_bruteforce(boxes, dynamic):  # (prefilter only: saves shapely calls)
         if nv.distance(polys_world[a], polys_world[b]) > alert + 1e-9:
             continue
@@ -193,7 +196,7 @@ def test_wall_contacts_match_reference(perturb):
         assert np.all(np.abs(c.contact_gap) <= 1e-15)
         # 232 joints within the courses, 15 × 30 between courses, 15 on the ground
         assert len(ref) == 232 + 450 + 15 and n == 2 * len(ref)
-        for (a, b) in ref:  # the two ends of the shared segment of the two rectangles
+        for a, b in ref:  # the two ends of the shared segment of the two rectangles
             lo = np.maximum(polys[a].min(axis=0), polys[b].min(axis=0))
             hi = np.minimum(polys[a].max(axis=0), polys[b].max(axis=0))
             m = (c.contact_body[:, 0] == a) & (c.contact_body[:, 1] == b)

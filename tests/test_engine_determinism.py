@@ -12,8 +12,13 @@ from masonrycli.scenario import Material, RunConfig, scenario_from_builder
 
 
 def _wall_history(duration: float) -> np.ndarray:
-    sc = scenario_from_builder("wall", {"blocks": 248}, RunConfig(duration=duration, record_every=25),
-                               Material(), {"ground": Motion(kind="sine", amplitude=1.0, frequency=2.0)})
+    sc = scenario_from_builder(
+        "wall",
+        {"blocks": 248},
+        RunConfig(duration=duration, record_every=25),
+        Material(),
+        {"ground": Motion(kind="sine", amplitude=1.0, frequency=2.0)},
+    )
     hist = History([b.name for b in sc.assembly.blocks], [s.name for s in sc.assembly.supports])
     result = simulate(sc, sinks=[hist])
     assert result.status == "completed"

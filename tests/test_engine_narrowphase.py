@@ -40,8 +40,9 @@ def run_batch(pairs, alert):
     gap = np.full(cap, np.nan)
     key = np.full(cap, -1, dtype=np.int64)
     edge_normal, body_size = edge_normals(vert_world, body_vert_start)
-    n = narrowphase(vert_world, edge_normal, body_size, body_vert_start, pair_body, len(pairs), alert,
-                    body, point, normal, gap, key)
+    n = narrowphase(
+        vert_world, edge_normal, body_size, body_vert_start, pair_body, len(pairs), alert, body, point, normal, gap, key
+    )
     assert np.all(body[:n, 0] % 2 == 0) and np.all(body[:n, 1] == body[:n, 0] + 1)
     assert np.all(np.diff(body[:n, 0]) >= 0), "contacts grouped by pair, pairs in input order"
     out = []
@@ -190,8 +191,9 @@ def test_nearly_parallel_faces(delta, swap):
     # lower block's face is the reference, and the lower block's face spans the upper one entirely
     ref = nv.reference_manifold(a_poly, b_poly, 1e-3)
     if ref["ref_is_b"] == swap:  # reference = lower block's top face
-        np.testing.assert_allclose(sorted(gap), [-0.1 * math.sin(abs(delta)), 0.1 * math.sin(abs(delta))],
-                                   rtol=1e-9, atol=1e-16)
+        np.testing.assert_allclose(
+            sorted(gap), [-0.1 * math.sin(abs(delta)), 0.1 * math.sin(abs(delta))], rtol=1e-9, atol=1e-16
+        )
     np.testing.assert_allclose(point, ref["points"], atol=1e-15)
     np.testing.assert_allclose(gap, ref["gaps"], atol=1e-15)
     np.testing.assert_allclose(normal, [ref["normal"]] * 2, atol=1e-15)
@@ -358,9 +360,7 @@ def test_swapping_bodies_flips_the_normal_only(random_cases):
     kinds, pairs, results, refs = random_cases
     swapped = run_batch([(B, A) for A, B in pairs], ALERT)
     checked = 0
-    for i, ((point, normal, gap, key), (point2, normal2, gap2, key2), ref) in enumerate(
-        zip(results, swapped, refs)
-    ):
+    for i, ((point, normal, gap, key), (point2, normal2, gap2, key2), ref) in enumerate(zip(results, swapped, refs)):
         if abs(ref["sep_a"] - ref["sep_b"]) <= ref["tol"] + 1e-9:
             continue  # the specification prefers body a's face: the choice changes with the order
         checked += len(point)
@@ -440,13 +440,13 @@ def test_keys_stable_for_aligned_corners():
 
 
 def test_key_layout_and_uniqueness():
-    point, normal, gap, key = collide_polygons(nv.rect(0, 0, 0.3, 0.2), nv.rect(0.15, 0.2, 0.45, 0.4), 1e-3,
-                                               a=123456, b=8_000_000)
+    point, normal, gap, key = collide_polygons(
+        nv.rect(0, 0, 0.3, 0.2), nv.rect(0.15, 0.2, 0.45, 0.4), 1e-3, a=123456, b=8_000_000
+    )
     a, b, own, vtx, edg = decode_contact_key(key)
     assert list(a) == [123456] * 2 and list(b) == [8_000_000] * 2
     assert len(set(key.tolist())) == 2 and np.all(key > 0)
-    expected = {(123456 << 40) | (8_000_000 << 17) | (o << 16) | (v << 8) | e
-                for o, v, e in zip(own, vtx, edg)}
+    expected = {(123456 << 40) | (8_000_000 << 17) | (o << 16) | (v << 8) | e for o, v, e in zip(own, vtx, edg)}
     assert expected == set(key.tolist())
 
 
@@ -474,7 +474,6 @@ def test_narrowphase_refuses_too_small_output():
     vert = np.concatenate([nv.rect(0, 0, 1, 1), nv.rect(1, 0, 2, 1)])
     start = np.array([0, 4, 8], dtype=np.int64)
     pairs = np.array([[0, 1]], dtype=np.int32)
-    small = (np.zeros((1, 2), np.int32), np.zeros((1, 2)), np.zeros((1, 2)), np.zeros(1),
-             np.zeros(1, np.int64))
+    small = (np.zeros((1, 2), np.int32), np.zeros((1, 2)), np.zeros((1, 2)), np.zeros(1), np.zeros(1, np.int64))
     with pytest.raises(ValueError, match="capacity"):
         narrowphase(vert, *edge_normals(vert, start), start, pairs, 1, 1e-3, *small)

@@ -84,8 +84,9 @@ def test_block_stress_matches_reference(seed):
 
 def test_block_stress_no_contact_is_zero():
     out = np.full((3, 2, 2), 7.0)
-    K._block_stress(3, np.zeros((3, 3)), np.ones(3), np.zeros((0, 2), np.int64), np.zeros((0, 2)),
-                    np.zeros((0, 2)), out)
+    K._block_stress(
+        3, np.zeros((3, 3)), np.ones(3), np.zeros((0, 2), np.int64), np.zeros((0, 2)), np.zeros((0, 2)), out
+    )
     assert np.all(out == 0.0)
 
 
@@ -119,9 +120,9 @@ def test_cell_neighbours_ignore_supports_and_keep_repeats():
     body = np.array([[0, 1], [0, 1], [1, 3], [0, 2]], np.int32)  # body 3 is a support for n = 3
     start, neighbour = K._cell_neighbours(3, body)
     assert start.tolist() == [0, 3, 5, 6]
-    assert sorted(neighbour[start[0]:start[1]].tolist()) == [1, 1, 2]
-    assert neighbour[start[1]:start[2]].tolist() == [0, 0]
-    assert neighbour[start[2]:start[3]].tolist() == [0]
+    assert sorted(neighbour[start[0] : start[1]].tolist()) == [1, 1, 2]
+    assert neighbour[start[1] : start[2]].tolist() == [0, 0]
+    assert neighbour[start[2] : start[3]].tolist() == [0]
 
 
 @pytest.mark.parametrize("seed", [0, 1, 2])

@@ -112,9 +112,14 @@ def test_free_flight_energy(theta, tmp_path):
     toml = (DATA / "validation" / "column5.toml").read_text()
     # Lift the column 2 m: it falls freely for the whole (short) run.
     path = tmp_path / "flight.toml"
-    path.write_text(toml.replace("[[support]]\nname = \"ground\"\npolygon = [[-1.0, -0.5], [1.4, -0.5], [1.4, 0.0], [-1.0, 0.0]]",
-                                 "[[support]]\nname = \"ground\"\npolygon = [[-1.0, -2.5], [1.4, -2.5], [1.4, -2.0], [-1.0, -2.0]]")
-                    .replace("duration = 1.0", "duration = 0.3").replace("record_every = 100", "record_every = 1"))
+    path.write_text(
+        toml.replace(
+            '[[support]]\nname = "ground"\npolygon = [[-1.0, -0.5], [1.4, -0.5], [1.4, 0.0], [-1.0, 0.0]]',
+            '[[support]]\nname = "ground"\npolygon = [[-1.0, -2.5], [1.4, -2.5], [1.4, -2.0], [-1.0, -2.0]]',
+        )
+        .replace("duration = 1.0", "duration = 0.3")
+        .replace("record_every = 100", "record_every = 1")
+    )
     from dataclasses import replace
 
     from masonrycli.scenario import load_scenario
@@ -131,8 +136,11 @@ def test_free_flight_energy(theta, tmp_path):
 def test_block_on_ground_does_not_creep_or_sink(tmp_path):
     toml = (DATA / "validation" / "harmonic_ground.toml").read_text()
     path = tmp_path / "rest.toml"
-    path.write_text(toml.replace('motion = { kind = "sine", direction = [1.0, 0.0], amplitude = 1.0, frequency = 2.0 }', "")
-                    .replace("duration = 1.0", "duration = 10.0").replace("record_every = 1", "record_every = 100"))
+    path.write_text(
+        toml.replace('motion = { kind = "sine", direction = [1.0, 0.0], amplitude = 1.0, frequency = 2.0 }', "")
+        .replace("duration = 1.0", "duration = 10.0")
+        .replace("record_every = 1", "record_every = 100")
+    )
     from masonrycli.scenario import load_scenario
 
     h, result = run_history(load_scenario(path))

@@ -45,9 +45,12 @@ def max_pairwise_overlap(assembly) -> float:
 
 @pytest.mark.parametrize(
     "key, blocks, supports",
-    [("wall51", 51, ["ground"]), ("wall248", 248, ["ground"]),
-     ("arch", 98, ["left-foundation", "right-foundation"]),
-     ("aqueduct", 346, ["left-foundation", "right-foundation"])],
+    [
+        ("wall51", 51, ["ground"]),
+        ("wall248", 248, ["ground"]),
+        ("arch", 98, ["left-foundation", "right-foundation"]),
+        ("aqueduct", 346, ["left-foundation", "right-foundation"]),
+    ],
 )
 def test_counts_overlaps_convexity_and_validation(built, key, blocks, supports):
     a = built[key]

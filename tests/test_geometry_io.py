@@ -33,7 +33,9 @@ def test_geojson_round_trip_is_exact(tmp_path):
     arch = build_arch()
     blocks = list(arch.blocks)
     blocks[3] = Block(blocks[3].polygon, blocks[3].name, 2100.0, 0.6, (0.1, -0.2, 0.3))
-    original = Assembly(tuple(blocks), (arch.supports[0], Support(arch.supports[1].polygon, "right-foundation", "driven")))
+    original = Assembly(
+        tuple(blocks), (arch.supports[0], Support(arch.supports[1].polygon, "right-foundation", "driven"))
+    )
     path = write_geojson(original, tmp_path / "arch.geojson")
     data = json.loads(path.read_text())
     assert data["type"] == "FeatureCollection" and len(data["features"]) == 100
@@ -104,7 +106,9 @@ def test_geojson_errors_name_file_and_feature(tmp_path):
     holed = {"type": "Feature", "properties": {"name": "h"}, "geometry": {"type": "Polygon", "coordinates": [SQ, SQ]}}
     assert "hole" in one_line_error(read_geojson, write(tmp_path, [holed], "h.geojson"))
 
-    text = one_line_error(read_geojson, write(tmp_path, [feature(SQ, role="support", support_role="wobbly")], "r.geojson"))
+    text = one_line_error(
+        read_geojson, write(tmp_path, [feature(SQ, role="support", support_role="wobbly")], "r.geojson")
+    )
     assert "feature 0" in text and "support_role" in text
 
     text = one_line_error(read_geojson, write(tmp_path, [feature(SQ, density="heavy")], "d.geojson"))

@@ -36,8 +36,9 @@ def test_opening_of_a_lifted_and_rocked_block():
     q = Q0.copy()
     c, s = np.cos(phi), np.sin(phi)
     centroid_rel = np.array([-0.5, 0.5])
-    q[1, :2] = np.array([1.0, 1.0]) + np.array([c * centroid_rel[0] - s * centroid_rel[1],
-                                                s * centroid_rel[0] + c * centroid_rel[1]])
+    q[1, :2] = np.array([1.0, 1.0]) + np.array(
+        [c * centroid_rel[0] - s * centroid_rel[1], s * centroid_rel[0] + c * centroid_rel[1]]
+    )
     q[1, 2] = phi
     np.testing.assert_allclose(jt.opening(q), [-np.sin(phi), 0.0, 0.0, 0.0], atol=1e-14)
     fields = jt.block_fields(q, np.zeros((0, 2), int), np.zeros((0, 2)), np.zeros(0, np.int8))
@@ -91,8 +92,9 @@ def test_reported_status_keeps_slip_only_when_sliding():
 
     status = np.array([CONTACT_SLIP, CONTACT_SLIP, CONTACT_STICK, CONTACT_OPEN], np.int8)
     ut = np.array([0.5 * SLIP_SPEED, -2 * SLIP_SPEED, 5.0, 5.0])
-    np.testing.assert_array_equal(reported_status(status, ut),
-                                  [CONTACT_STICK, CONTACT_SLIP, CONTACT_STICK, CONTACT_OPEN])
+    np.testing.assert_array_equal(
+        reported_status(status, ut), [CONTACT_STICK, CONTACT_SLIP, CONTACT_STICK, CONTACT_OPEN]
+    )
 
 
 def test_corner_contacts_do_not_count_as_openings():

@@ -88,8 +88,9 @@ def test_support_velocity_is_vectorised_over_time():
 
     rng = np.random.default_rng(0)
     t_rec = np.cumsum(rng.uniform(0.005, 0.015, 2000))
-    m = Motion(kind="record", record_time=tuple(t_rec), record_value=tuple(rng.normal(size=2000)),
-               quantity="acceleration")
+    m = Motion(
+        kind="record", record_time=tuple(t_rec), record_value=tuple(rng.normal(size=2000)), quantity="acceleration"
+    )
     t = np.linspace(0, t_rec[-1] + 1, 1_000_000)
     start = time.perf_counter()
     v = support_velocity([m, Motion(kind="sine", amplitude=1, frequency=2), Motion()], t)
@@ -101,8 +102,9 @@ def test_support_velocity_is_vectorised_over_time():
 
 
 def test_velocity_record_interpolates_and_holds_end_values():
-    m = Motion(kind="record", record_time=(0.1, 0.2, 0.4), record_value=(1.0, 3.0, -1.0),
-               direction=(0.0, 2.0), scale=0.5)
+    m = Motion(
+        kind="record", record_time=(0.1, 0.2, 0.4), record_value=(1.0, 3.0, -1.0), direction=(0.0, 2.0), scale=0.5
+    )
     t = np.array([0.0, 0.1, 0.15, 0.2, 0.3, 0.4, 5.0])
     expected = 0.5 * np.array([1.0, 1.0, 2.0, 3.0, 1.0, -1.0, -1.0])
     v = m.velocity_at(t)
@@ -141,16 +143,27 @@ def test_random_acceleration_record_matches_independent_integration():
     rng = np.random.default_rng(1)
     times = np.concatenate([[0.0], np.cumsum(rng.uniform(0.01, 0.05, 60))])
     acc = rng.normal(size=(times.size, 2))
-    m = Motion(kind="record", record_time=tuple(times), record_value=tuple(map(tuple, acc)),
-               quantity="acceleration", scale=-2.0)
+    m = Motion(
+        kind="record",
+        record_time=tuple(times),
+        record_value=tuple(map(tuple, acc)),
+        quantity="acceleration",
+        scale=-2.0,
+    )
     # at the samples: the cumulative trapezoid rule (scipy's, independent of ours)
     nodal = -2.0 * cumulative_trapezoid(acc, times, axis=0, initial=0.0)
     np.testing.assert_allclose(m.velocity_at(times), nodal, rtol=0, atol=1e-12)
     # between samples: the integral of the linearly interpolated acceleration (adaptive quadrature)
     for tq in rng.uniform(times[0], times[-1], 5):
         for k in range(2):
-            ref, _ = quad(lambda s, k=k: -2.0 * np.interp(s, times, acc[:, k]), 0.0, tq,
-                          points=times[times < tq], limit=200, epsabs=1e-13)
+            ref, _ = quad(
+                lambda s, k=k: -2.0 * np.interp(s, times, acc[:, k]),
+                0.0,
+                tq,
+                points=times[times < tq],
+                limit=200,
+                epsabs=1e-13,
+            )
             assert m.velocity_at([tq])[0, k] == pytest.approx(ref, abs=1e-10)
     # before the first sample: at rest
     assert np.all(m.velocity_at([-1.0]) == 0.0)
@@ -182,14 +195,14 @@ def test_record_motion_source_is_absolute():
 @pytest.mark.parametrize(
     "text, expected",
     [
-        ("0,1\n0.1,abc\n", "bad.csv:2: not a number: \"abc\""),
+        ("0,1\n0.1,abc\n", 'bad.csv:2: not a number: "abc"'),
         ("# c\n0,1,2,3\n", "bad.csv:2: expected 2 columns (time, value) or 3 (time, x, y), got 4"),
         ("0,1\n1,2,3\n", "bad.csv:2: expected 2 columns like the first sample, got 3"),
         ("0,1\n0.5,2\n0.5,3\n", "bad.csv:3: time 0.5 is not after the previous sample's 0.5"),
         ("0,1\n1,nan\n", "bad.csv:2: values must be finite"),
         ("time,value\n0,1\n", "bad.csv: a record needs at least 2 samples, found 1"),
         ("", "bad.csv: a record needs at least 2 samples, found 0"),
-        ("t,v\nx,y\n0,1\n", "bad.csv:2: not a number: \"x\""),
+        ("t,v\nx,y\n0,1\n", 'bad.csv:2: not a number: "x"'),
     ],
 )
 def test_load_record_csv_errors_name_file_and_line(tmp_path, text, expected):
@@ -231,8 +244,10 @@ def test_load_record_csv_unreadable(tmp_path):
         (dict(kind="record", record_time=(0.0,), record_value=(1.0,)), "a record needs at least 2 samples"),
         (dict(kind="record", record_time=(0.0, 1.0), record_value=(1.0,)), "record_value = [1.0]: has 1 samples"),
         (dict(kind="record", record_time=(0.0, 0.0), record_value=(1.0, 2.0)), "record_time[1] = 0.0: must be >"),
-        (dict(kind="record", record_time=(0, 1), record_value=(1, 2), quantity="displacement"),
-         'quantity = "displacement": must be "velocity" or "acceleration"'),
+        (
+            dict(kind="record", record_time=(0, 1), record_value=(1, 2), quantity="displacement"),
+            'quantity = "displacement": must be "velocity" or "acceleration"',
+        ),
         (dict(kind="record", record_time=(0, 1), record_value=(1, 2), scale="2"), 'scale = "2": must be a number'),
         (dict(kind="sine", amplitude=True), "amplitude = true: must be a number"),
     ],
@@ -248,6 +263,7 @@ def test_motion_equality_hash_and_describe():
     b = Motion(kind="sine", direction=(1.0, 0.0), amplitude=1.0, frequency=2.0)
     assert a == b and hash(a) == hash(b)
     assert a.describe() == "sine 1 m/s · sin(2π·2 Hz·t) along (1, 0)"
-    assert Motion(kind="ramp", acceleration=(0, -1), until=0.2).describe() == \
-        "ramp acceleration (0, -1) m/s² until 0.2 s"
+    assert (
+        Motion(kind="ramp", acceleration=(0, -1), until=0.2).describe() == "ramp acceleration (0, -1) m/s² until 0.2 s"
+    )
     assert Motion(kind="constant", velocity=(0, -0.01)).describe() == "constant velocity (0, -0.01) m/s"

@@ -20,8 +20,9 @@ pytestmark = pytest.mark.slow
 
 
 def _run(builder, options, duration, motions, record_every=10):
-    sc = scenario_from_builder(builder, options, RunConfig(duration=duration, record_every=record_every),
-                               Material(), motions)
+    sc = scenario_from_builder(
+        builder, options, RunConfig(duration=duration, record_every=record_every), Material(), motions
+    )
     hist = History([b.name for b in sc.assembly.blocks], [s.name for s in sc.assembly.supports])
     result = simulate(sc, sinks=[hist])
     assert result.status == "completed", result.message

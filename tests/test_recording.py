@@ -100,8 +100,10 @@ def test_embedded_blueprint_has_the_views(written):
         batch = chunk.to_record_batch()
         if "ViewBlueprint:display_name" in batch.schema.names:
             name = batch.column("ViewBlueprint:display_name").to_pylist()[0][0]
-            views[name] = (batch.column("ViewBlueprint:class_identifier").to_pylist()[0][0],
-                           batch.column("ViewBlueprint:space_origin").to_pylist()[0][0])
+            views[name] = (
+                batch.column("ViewBlueprint:class_identifier").to_pylist()[0][0],
+                batch.column("ViewBlueprint:space_origin").to_pylist()[0][0],
+            )
     spatial = {n for n, (kind, origin) in views.items() if kind == "2D" and origin == "/structure/plane"}
     assert {f.title for f in FIELDS} < spatial and any(n.startswith("Structure") for n in spatial)
     assert sum(kind == "TimeSeries" for kind, _ in views.values()) == 7
@@ -155,8 +157,10 @@ def test_array_shapes_per_frame(written):
     by_step = {f.step: f for f in frames}
     arrows = temporal_rows(path, "/structure/plane/xy/forces", "Arrows2D:vectors")
     force_values = temporal_rows(path, "/structure/plane/xy/forces", "force")
-    axes = {k: temporal_rows(path, f"/structure/plane/xy/{k}", "LineStrips2D:strips")
-            for k in ("stress_axes", "strain_rate_axes")}
+    axes = {
+        k: temporal_rows(path, f"/structure/plane/xy/{k}", "LineStrips2D:strips")
+        for k in ("stress_axes", "strain_rate_axes")
+    }
     tri = temporal_rows(path, "/structure/plane/xy/triangulation", "LineStrips2D:strips")
     hover_p = temporal_rows(path, "/structure/plane/xy/blocks", "p")
     for f in FIELDS:
@@ -187,8 +191,7 @@ def test_force_arrows_start_at_contact_points_along_the_force(written):
     length = np.linalg.norm(v, axis=1)
     assert length.max() <= 2.0 * rec.block_height * (1 + 1e-5)
     uncapped = np.linalg.norm(force, axis=1) * rec.force_scale < 2.0 * rec.block_height
-    np.testing.assert_allclose(length[uncapped], np.linalg.norm(force, axis=1)[uncapped] * rec.force_scale,
-                               rtol=1e-5)
+    np.testing.assert_allclose(length[uncapped], np.linalg.norm(force, axis=1)[uncapped] * rec.force_scale, rtol=1e-5)
 
 
 def test_principal_axes_follow_eigenvectors_and_sign(written):
@@ -205,8 +208,10 @@ def test_principal_axes_follow_eigenvectors_and_sign(written):
         assert abs(d[0] * np.sin(ang[b]) - d[1] * np.cos(ang[b])) < 1e-5  # parallel to (cos θ, sin θ)
         assert abs((minor[1] - minor[0]) @ d) < 1e-6  # orthogonal
         ratio = np.linalg.norm(d) / np.linalg.norm(minor[1] - minor[0])
-        assert ratio == pytest.approx(min(abs(lam[b, 0]), rec.axis_scale["stress_axes"])
-                                      / min(abs(lam[b, 1]), rec.axis_scale["stress_axes"]), rel=1e-4)
+        assert ratio == pytest.approx(
+            min(abs(lam[b, 0]), rec.axis_scale["stress_axes"]) / min(abs(lam[b, 1]), rec.axis_scale["stress_axes"]),
+            rel=1e-4,
+        )
         for k in range(2):
             assert colors[2 * b + k] == (rec_mod.COMPRESSION_RGBA if lam[b, k] < 0 else rec_mod.TENSION_RGBA)
 
@@ -238,8 +243,10 @@ def test_fill_colours_follow_the_field_with_a_fixed_range(wall, tmp_path):
             rec.log_frame(f)
     owner = np.repeat(np.arange(len(q0)), np.diff(static.block_vert_start))
     first_vertex = np.r_[0, np.cumsum(np.diff(static.block_vert_start))[:-1]]
-    for key, short, lut in (("cell_spherical_stress", "spherical_stress", cm.COOLWARM),
-                            ("cell_deviatoric_stress", "deviatoric_stress", cm.VIRIDIS)):
+    for key, short, lut in (
+        ("cell_spherical_stress", "spherical_stress", cm.COOLWARM),
+        ("cell_deviatoric_stress", "deviatoric_stress", cm.VIRIDIS),
+    ):
         # The range comes from the first batch only (5 frames): the 98th percentile, rounded up.
         first = np.concatenate([f.tensors[key] for f in frames[:5]])
         m = cm.nice_ceil(np.percentile(np.abs(first), 98))
@@ -274,8 +281,16 @@ def test_legend_and_run_document(written):
     doc = info["metadata"]
     assert doc.startswith("# masonry — synthetic wall")
     assert "completed, last frame t = 0.240 s (step 240)" in doc
-    for needle in ("parameters.freq | 2.0", "Wall time", "| masonry |", "| rerun-sdk | 0.41", "| numpy |",
-                   "| numba |", "| python |", "m per N"):
+    for needle in (
+        "parameters.freq | 2.0",
+        "Wall time",
+        "| masonry |",
+        "| rerun-sdk | 0.41",
+        "| numpy |",
+        "| numba |",
+        "| python |",
+        "m per N",
+    ):
         assert needle in doc, needle
     for f in FIELDS:
         lo, hi = rec.field_ranges[f.key]
@@ -285,8 +300,7 @@ def test_legend_and_run_document(written):
 
 
 # ------------------------------------------------------------------------------- closing and errors
-@pytest.mark.parametrize("exc, status", [(RuntimeError("boom"), "failed"),
-                                         (KeyboardInterrupt(), "interrupted")])
+@pytest.mark.parametrize("exc, status", [(RuntimeError("boom"), "failed"), (KeyboardInterrupt(), "interrupted")])
 def test_recording_is_complete_after_an_exception(wall, tmp_path, exc, status):
     static, q0 = wall
     frames = fx.frames(static, q0, 15)
@@ -302,8 +316,13 @@ def test_recording_is_complete_after_an_exception(wall, tmp_path, exc, status):
     if status == "failed":
         assert "RuntimeError: boom" in info["metadata"]
     rerun_cli = os.path.join(os.path.dirname(sys.executable), "rerun")
-    verify = subprocess.run([rerun_cli, "rrd", "verify", str(path)], capture_output=True, text=True,
-                            timeout=120, env={**os.environ, "RERUN_ANALYTICS": "0"})
+    verify = subprocess.run(
+        [rerun_cli, "rrd", "verify", str(path)],
+        capture_output=True,
+        text=True,
+        timeout=120,
+        env={**os.environ, "RERUN_ANALYTICS": "0"},
+    )
     assert verify.returncode == 0, verify.stderr
 
 
@@ -343,10 +362,19 @@ def test_inspect_a_file_without_footer(wall, tmp_path):
 def test_frames_without_tensor_fields_or_contacts(wall, tmp_path):
     static, q0 = wall
     f = fx.frames(static, q0, 1)[0]
-    empty = type(f)(**{**f.__dict__, "tensors": {}, "contact_body": np.zeros((0, 2), np.int32),
-                       "contact_point": np.zeros((0, 2)), "contact_normal": np.zeros((0, 2)),
-                       "contact_force": np.zeros((0, 2)), "contact_gap": np.zeros(0),
-                       "contact_status": np.zeros(0, np.int8), "contact_mobilised": np.zeros(0)})
+    empty = type(f)(
+        **{
+            **f.__dict__,
+            "tensors": {},
+            "contact_body": np.zeros((0, 2), np.int32),
+            "contact_point": np.zeros((0, 2)),
+            "contact_normal": np.zeros((0, 2)),
+            "contact_force": np.zeros((0, 2)),
+            "contact_gap": np.zeros(0),
+            "contact_status": np.zeros(0, np.int8),
+            "contact_mobilised": np.zeros(0),
+        }
+    )
     path = tmp_path / "empty.rrd"
     with Recorder(path, static, fx.METADATA) as rec:
         rec.log_frame(empty)
@@ -376,7 +404,6 @@ def test_nice_ceil_and_robust_max():
     assert [cm.nice_ceil(x) for x in values] == [0.0, 1.0, 1.0, 1.5, 3.0, 8.0, 1.5e5]
     assert cm.robust_max_abs(np.array([np.nan, -3.0, 1.0]), 100) == 3.0
     assert cm.robust_max_abs(np.array([np.nan])) == 0.0
-
 
 
 def test_interrupt_in_the_middle_of_a_flush_still_leaves_a_complete_file(wall, tmp_path):

@@ -45,7 +45,7 @@ def load_error(tmp_path: Path, text: str, name: str = "wall.toml") -> str:
     msg = str(exc.value)
     assert "\n" not in msg and msg == msg.strip()
     assert msg.startswith(f"{path}: "), msg
-    return msg[len(str(path)) + 2:]  # the part after "<file>: "
+    return msg[len(str(path)) + 2 :]  # the part after "<file>: "
 
 
 def assert_same_scenario(a: Scenario, b: Scenario):
@@ -101,9 +101,13 @@ def test_column_example_and_summary():
 
 
 def test_defaults_and_default_names(tmp_path):
-    path = write(tmp_path, "[[block]]\npolygon = [[0, 0], [1, 0], [1, 1], [0, 1]]\n"
-                           "[[block]]\npolygon = [[0, 1], [1, 1], [1, 2], [0, 2]]\ndensity = 1000\n"
-                           "[[support]]\npolygon = [[-1, -1], [2, -1], [2, 0], [-1, 0]]\n", "my_wall.toml")
+    path = write(
+        tmp_path,
+        "[[block]]\npolygon = [[0, 0], [1, 0], [1, 1], [0, 1]]\n"
+        "[[block]]\npolygon = [[0, 1], [1, 1], [1, 2], [0, 2]]\ndensity = 1000\n"
+        "[[support]]\npolygon = [[-1, -1], [2, -1], [2, 0], [-1, 0]]\n",
+        "my_wall.toml",
+    )
     s = load_scenario(path)
     assert s.name == "my_wall"
     assert s.run == RunConfig(1.0, 1e-3, 0.5, (0.0, -9.81), 1.666e-4, 1000, 10, 1e-3)
@@ -116,8 +120,11 @@ def test_defaults_and_default_names(tmp_path):
 
 
 def test_ints_accepted_for_floats_and_vertices_oriented_ccw(tmp_path):
-    path = write(tmp_path, "[run]\nduration = 2\ndt = 1\ngravity = [0, -10]\n"
-                           "[[block]]\npolygon = [[0, 0], [0, 1], [1, 1], [1, 0]]\nvelocity = [1, 2, 3]\n")
+    path = write(
+        tmp_path,
+        "[run]\nduration = 2\ndt = 1\ngravity = [0, -10]\n"
+        "[[block]]\npolygon = [[0, 0], [0, 1], [1, 1], [1, 0]]\nvelocity = [1, 2, 3]\n",
+    )
     s = load_scenario(path)
     assert s.run.duration == 2.0 and isinstance(s.run.duration, float) and s.run.gravity == (0.0, -10.0)
     assert s.run.n_steps == 2
@@ -138,7 +145,7 @@ def test_run_config_n_steps():
 RECORD_CSV = "t,v\n0.0,0.1\n0.05,0.3333333333333333\n0.2,-0.7\n"
 XY_CSV = "0 0 0\n0.5 1e-3 -2e-3\n1.5 0.25 0.125\n"
 
-ROUND_TRIP = '''
+ROUND_TRIP = """
 name = "odd \\"name\\" é \\\\ 1"
 
 [run]
@@ -219,7 +226,7 @@ motion = { kind = "record", time = [0.0, 0.1, 0.3], value = [0.0, 1.0, 0.5], qua
 name = "inline-xy"
 polygon = [[7.5, -0.5], [8.5, -0.5], [8.5, 0.0], [7.5, 0.0]]
 motion = { kind = "record", time = [0.0, 1.0], value = [[0.1, 0.2], [0.3, 0.4]] }
-'''
+"""
 
 
 @pytest.fixture
@@ -233,8 +240,17 @@ def round_trip_file(tmp_path):
 def test_round_trip_explicit(round_trip_file, tmp_path, monkeypatch):
     s = load_scenario(round_trip_file)
     assert s.name == 'odd "name" é \\ 1'
-    assert [m.kind for m in s.motions] == ["fixed", "constant", "sine", "ramp", "ramp",
-                                          "record", "record", "record", "record"]
+    assert [m.kind for m in s.motions] == [
+        "fixed",
+        "constant",
+        "sine",
+        "ramp",
+        "ramp",
+        "record",
+        "record",
+        "record",
+        "record",
+    ]
     assert [x.role for x in s.assembly.supports] == ["fixed"] + ["driven"] * 8
     assert s.assembly.blocks[2].name == "block-3"
     assert s.motions[5].source == str(tmp_path / "records" / "quake.csv")
@@ -272,8 +288,13 @@ def test_dump_is_toml_with_expected_sections():
     s = load_scenario(DATA / "block_on_ground.toml")
     doc = tomllib.loads(dump_scenario(s))
     assert set(doc) == {"name", "run", "material", "block", "support"}
-    assert doc["support"][0]["motion"] == {"kind": "sine", "direction": [1.0, 0.0], "amplitude": 1.0,
-                                           "frequency": 2.0, "phase": 0.0}
+    assert doc["support"][0]["motion"] == {
+        "kind": "sine",
+        "direction": [1.0, 0.0],
+        "amplitude": 1.0,
+        "frequency": 2.0,
+        "phase": 0.0,
+    }
     assert "density" not in doc["block"][0]  # equal to the material default: not repeated
 
 
@@ -282,8 +303,7 @@ def test_programmatic_scenario_round_trip_and_role_fix():
     fixed_ground = Support(polygon=base.assembly.supports[0].polygon, name="ground", role="fixed")
     asm = Assembly(blocks=base.assembly.blocks, supports=(fixed_ground,))
     rec = record_motion(DATA / "accel_constant.csv", quantity="acceleration", scale=-1.0)
-    s = Scenario(name="prog", run=RunConfig(duration=0.5), material=Material(friction=0.3),
-                 assembly=asm, motions=[rec])
+    s = Scenario(name="prog", run=RunConfig(duration=0.5), material=Material(friction=0.3), assembly=asm, motions=[rec])
     assert s.assembly.supports[0].role == "driven"  # made consistent with the motion
     assert isinstance(s.motions, tuple)
     assert_same_scenario(s, loads_scenario(dump_scenario(s)))
@@ -298,8 +318,11 @@ def test_relative_record_path_resolves_against_scenario_folder(tmp_path, monkeyp
     sub = tmp_path / "project" / "scenarios"
     (sub / "records").mkdir(parents=True)
     (sub / "records" / "q.csv").write_text("0,0\n1,2\n")
-    write(sub, BLOCK + GROUND.replace(
-        "polygon", 'motion = { kind = "record", file = "records/q.csv" }\npolygon'), "scen.toml")
+    write(
+        sub,
+        BLOCK + GROUND.replace("polygon", 'motion = { kind = "record", file = "records/q.csv" }\npolygon'),
+        "scen.toml",
+    )
     monkeypatch.chdir(tmp_path)
     for path in (Path("project/scenarios/scen.toml"), sub / "scen.toml"):
         s = load_scenario(path)
@@ -310,8 +333,9 @@ def test_relative_record_path_resolves_against_scenario_folder(tmp_path, monkeyp
     assert s.motions[0].source == str(DATA / "quake_velocity.csv")
     assert s.motions[0].velocity_at([0.1])[0, 0] == pytest.approx(0.4)  # scale 2
     # an absolute file path is used as is
-    text = BLOCK + GROUND.replace("polygon", f'motion = {{ kind = "record", file = "{DATA / "ground_xy.csv"}" }}'
-                                  "\npolygon")
+    text = BLOCK + GROUND.replace(
+        "polygon", f'motion = {{ kind = "record", file = "{DATA / "ground_xy.csv"}" }}\npolygon'
+    )
     s = load_scenario(write(tmp_path, text, "abs.toml"))
     assert s.motions[0].record_is_vector
 
@@ -319,8 +343,9 @@ def test_relative_record_path_resolves_against_scenario_folder(tmp_path, monkeyp
 def test_missing_record_file_names_resolved_path(tmp_path):
     text = BLOCK + GROUND.replace("polygon", 'motion = { kind = "record", file = "nope.csv" }\npolygon')
     msg = load_error(tmp_path, text)
-    assert msg == (f'[[support]] #1 ("ground"): motion.file = "nope.csv": no such file '
-                   f'(looked for {tmp_path / "nope.csv"})')
+    assert msg == (
+        f'[[support]] #1 ("ground"): motion.file = "nope.csv": no such file (looked for {tmp_path / "nope.csv"})'
+    )
 
 
 def test_bad_record_row_names_scenario_csv_and_line(tmp_path):
@@ -332,9 +357,9 @@ def test_bad_record_row_names_scenario_csv_and_line(tmp_path):
 # ------------------------------------------------------------------------------------------- errors
 
 RUN_ERRORS = [
-    ("dt = -0.001", '[run] dt = -0.001: must be > 0'),
-    ("dt = 0", '[run] dt = 0: must be > 0'),
-    ("dt = 2.0", '[run] dt = 2.0: must be <= duration (1.0)'),
+    ("dt = -0.001", "[run] dt = -0.001: must be > 0"),
+    ("dt = 0", "[run] dt = 0: must be > 0"),
+    ("dt = 2.0", "[run] dt = 2.0: must be <= duration (1.0)"),
     ("dt = 1e-12", "[run] dt = 1e-12: gives 1e+12 steps"),
     ("duration = 0.0", "[run] duration = 0.0: must be > 0"),
     ("duration = -1", "[run] duration = -1: must be > 0"),
@@ -401,17 +426,27 @@ def test_block_errors(tmp_path, line, expected):
 @pytest.mark.parametrize(
     "block, expected",
     [
-        ('[[block]]\nname = "b3"\n', '[[block]] #1 ("b3"): polygon: missing (e.g. polygon = [[0.0, 0.0], '
-         '[0.4, 0.0], [0.4, 0.2], [0.0, 0.2]])'),
-        ('[[block]]\nname = "b3"\npolygon = [[0, 0], [1, 0]]\n',
-         '[[block]] #1 ("b3"): polygon = [[0, 0], [1, 0]]: needs at least 3 vertices, got 2'),
-        ('[[block]]\nname = "b3"\npolygon = [[0, 0], [1], [1, 1]]\n',
-         '[[block]] #1 ("b3"): polygon[1] = [1]: must be 2 numbers [x, y]'),
-        ('[[block]]\nname = "b3"\npolygon = [[0, 0], [1, nan], [1, 1]]\n',
-         '[[block]] #1 ("b3"): polygon[1] = [1, nan]: must be finite numbers'),
-        ('[[block]]\nname = "b3"\npolygon = "POLYGON ((0 0, 1 0, 1 1))"\n',
-         '[[block]] #1 ("b3"): polygon = "POLYGON ((0 0, 1 0, 1 1))": must be a list of [x, y] vertices'),
-        ('[[block]]\nname = 3\npolygon = [[0, 0], [1, 0], [1, 1]]\n', "[[block]] #1: name = 3: must be a string"),
+        (
+            '[[block]]\nname = "b3"\n',
+            '[[block]] #1 ("b3"): polygon: missing (e.g. polygon = [[0.0, 0.0], [0.4, 0.0], [0.4, 0.2], [0.0, 0.2]])',
+        ),
+        (
+            '[[block]]\nname = "b3"\npolygon = [[0, 0], [1, 0]]\n',
+            '[[block]] #1 ("b3"): polygon = [[0, 0], [1, 0]]: needs at least 3 vertices, got 2',
+        ),
+        (
+            '[[block]]\nname = "b3"\npolygon = [[0, 0], [1], [1, 1]]\n',
+            '[[block]] #1 ("b3"): polygon[1] = [1]: must be 2 numbers [x, y]',
+        ),
+        (
+            '[[block]]\nname = "b3"\npolygon = [[0, 0], [1, nan], [1, 1]]\n',
+            '[[block]] #1 ("b3"): polygon[1] = [1, nan]: must be finite numbers',
+        ),
+        (
+            '[[block]]\nname = "b3"\npolygon = "POLYGON ((0 0, 1 0, 1 1))"\n',
+            '[[block]] #1 ("b3"): polygon = "POLYGON ((0 0, 1 0, 1 1))": must be a list of [x, y] vertices',
+        ),
+        ("[[block]]\nname = 3\npolygon = [[0, 0], [1, 0], [1, 1]]\n", "[[block]] #1: name = 3: must be a string"),
         ('[[block]]\nname = ""\npolygon = [[0, 0], [1, 0], [1, 1]]\n', '[[block]] #1: name = "": must not be empty'),
     ],
 )
@@ -461,21 +496,32 @@ def test_validate_assembly_errors_and_warnings(tmp_path, monkeypatch):
 
 
 MOTION_ERRORS = [
-    ('{ kind = "shake" }',
-     'motion.kind = "shake": unknown motion kind (expected one of fixed, constant, sine, ramp, record)'),
+    (
+        '{ kind = "shake" }',
+        'motion.kind = "shake": unknown motion kind (expected one of fixed, constant, sine, ramp, record)',
+    ),
     ("{ amplitude = 1.0 }", "motion.kind: missing (one of fixed, constant, sine, ramp, record)"),
     ('{ kind = "sine", frequency = 2.0 }', 'motion.amplitude: missing (required for kind "sine")'),
     ('{ kind = "sine", amplitude = 1.0 }', 'motion.frequency: missing (required for kind "sine")'),
-    ('{ kind = "sine", amplitude = 1.0, frequency = 2.0, direction = [0.0, 0.0] }',
-     "motion.direction = [0.0, 0.0]: must not be the zero vector"),
+    (
+        '{ kind = "sine", amplitude = 1.0, frequency = 2.0, direction = [0.0, 0.0] }',
+        "motion.direction = [0.0, 0.0]: must not be the zero vector",
+    ),
     ('{ kind = "sine", amplitude = 1.0, frequency = -2.0 }', "motion.frequency = -2.0: must be >= 0"),
     ('{ kind = "sine", amplitude = nan, frequency = 2.0 }', "motion.amplitude = nan: must be a finite number"),
-    ('{ kind = "sine", amplitude = 1.0, frequency = 2.0, velocity = [1.0, 0.0] }',
-     'motion.velocity: not used by kind "sine" (its keys: kind, direction, amplitude, frequency, phase)'),
-    ('{ kind = "sine", amplitude = 1.0, frequncy = 2.0 }', 'motion: unknown key "frequncy" (did you mean "frequency"?)'),
+    (
+        '{ kind = "sine", amplitude = 1.0, frequency = 2.0, velocity = [1.0, 0.0] }',
+        'motion.velocity: not used by kind "sine" (its keys: kind, direction, amplitude, frequency, phase)',
+    ),
+    (
+        '{ kind = "sine", amplitude = 1.0, frequncy = 2.0 }',
+        'motion: unknown key "frequncy" (did you mean "frequency"?)',
+    ),
     ('{ kind = "constant" }', 'motion.velocity: missing (required for kind "constant")'),
-    ('{ kind = "constant", velocity = [0.0, -0.01, 0.0] }',
-     "motion.velocity = [0.0, -0.01, 0.0]: must be 2 numbers [x, y]"),
+    (
+        '{ kind = "constant", velocity = [0.0, -0.01, 0.0] }',
+        "motion.velocity = [0.0, -0.01, 0.0]: must be 2 numbers [x, y]",
+    ),
     ('{ kind = "ramp" }', 'motion.acceleration: missing (required for kind "ramp")'),
     ('{ kind = "ramp", acceleration = [1.0, 0.0], until = -1.0 }', "motion.until = -1.0: must be > 0"),
     ('{ kind = "ramp", acceleration = [1.0, 0.0], until = nan }', "motion.until = nan: must be a finite number"),
@@ -484,14 +530,22 @@ MOTION_ERRORS = [
     ('{ kind = "record", time = [0.0, 1.0] }', 'motion.value: missing (kind "record" needs file, or time and value)'),
     ('{ kind = "record", time = [0.0, 1.0], value = [1.0] }', "motion.value = [1.0]: has 1 samples but"),
     ('{ kind = "record", time = [1.0, 0.0], value = [1.0, 2.0] }', "motion.time[1] = 0.0: must be > the previous"),
-    ('{ kind = "record", time = [0.0, 1.0], value = [1.0, 2.0], quantity = "displacement" }',
-     'motion.quantity = "displacement": must be "velocity" or "acceleration"'),
-    ('{ kind = "record", time = [0.0, 1.0], value = [1.0, 2.0], scale = inf }',
-     "motion.scale = inf: must be a finite number"),
-    ('{ kind = "record", time = [0.0, 1.0], value = [[1.0, 2.0], [3.0, 4.0]], direction = [0.0, 1.0] }',
-     "motion.direction: not used by a vector record"),
-    ('{ kind = "record", file = "q.csv", time = [0.0, 1.0], value = [1.0, 2.0] }',
-     "motion.file: give either file or inline time and value, not both"),
+    (
+        '{ kind = "record", time = [0.0, 1.0], value = [1.0, 2.0], quantity = "displacement" }',
+        'motion.quantity = "displacement": must be "velocity" or "acceleration"',
+    ),
+    (
+        '{ kind = "record", time = [0.0, 1.0], value = [1.0, 2.0], scale = inf }',
+        "motion.scale = inf: must be a finite number",
+    ),
+    (
+        '{ kind = "record", time = [0.0, 1.0], value = [[1.0, 2.0], [3.0, 4.0]], direction = [0.0, 1.0] }',
+        "motion.direction: not used by a vector record",
+    ),
+    (
+        '{ kind = "record", file = "q.csv", time = [0.0, 1.0], value = [1.0, 2.0] }',
+        "motion.file: give either file or inline time and value, not both",
+    ),
     ('{ kind = "record", file = 3 }', "motion.file = 3: must be a file name"),
     ('"sine"', 'motion = "sine": must be a table'),
 ]
@@ -508,8 +562,10 @@ def test_motion_errors(tmp_path, motion, expected):
 def test_three_column_record_file_rejects_direction(tmp_path):
     (tmp_path / "xy.csv").write_text(XY_CSV)
     text = BLOCK + GROUND + 'motion = { kind = "record", file = "xy.csv", direction = [1.0, 0.0] }\n'
-    assert load_error(tmp_path, text) == \
-        '[[support]] #1 ("ground"): motion.direction: not used by a 3-column record (xy.csv gives x and y)'
+    assert (
+        load_error(tmp_path, text)
+        == '[[support]] #1 ("ground"): motion.direction: not used by a 3-column record (xy.csv gives x and y)'
+    )
 
 
 @pytest.mark.parametrize(
@@ -517,7 +573,7 @@ def test_three_column_record_file_rejects_direction(tmp_path):
     [
         ("[runn]\ndt = 0.1\n" + BLOCK, 'unknown key "runn" (did you mean "run"?)'),
         ("run = 3\n" + BLOCK, "run = 3: must be a table [run]"),
-        ('[block]\npolygon = [[0, 0], [1, 0], [1, 1]]\n', "block: must be an array of tables [[block]]"),
+        ("[block]\npolygon = [[0, 0], [1, 0], [1, 1]]\n", "block: must be an array of tables [[block]]"),
         ("support = [1, 2]\n" + BLOCK, "support: must be an array of tables [[support]]"),
         ("name = 3\n" + BLOCK, "name = 3: must be a string"),
         ("[run]\ndt = 0.01\n", "no blocks: add [[block]] tables or a [structure] builder"),
@@ -567,16 +623,21 @@ def _rect(x0, y0, x1, y1):
     return [[x0, y0], [x1, y0], [x1, y1], [x0, y1]]
 
 
-def fake_builder(*, bays: int = 2, height: float = 0.2, density: float = 2500.0, thickness: float = 1.0,
-                 label: str = "b"):
+def fake_builder(
+    *, bays: int = 2, height: float = 0.2, density: float = 2500.0, thickness: float = 1.0, label: str = "b"
+):
     """A tiny builder with the geometry_library builder conventions (keyword options, Assembly out)."""
     from geometry_library.checks import polygon_from_coords
 
     if bays < 1:
         raise GeometryError(f"bays = {bays}: must be >= 1")
     blocks = tuple(
-        Block(polygon_from_coords(_rect(0.4 * i, 0.0, 0.4 * i + 0.4, height), i, f"{label}{i}"),
-              f"{label}{i}", density, thickness)
+        Block(
+            polygon_from_coords(_rect(0.4 * i, 0.0, 0.4 * i + 0.4, height), i, f"{label}{i}"),
+            f"{label}{i}",
+            density,
+            thickness,
+        )
         for i in range(bays)
     )
     supports = (
@@ -595,8 +656,10 @@ def fake_builders(monkeypatch):
 
 
 def test_builder_scenario_file(tmp_path, fake_builders):
-    text = ('[material]\ndensity = 2000.0\nthickness = 0.5\n[structure]\nbuilder = "fake"\nbays = 3\n'
-            '[[support]]\nname = "pad"\nmotion = { kind = "constant", velocity = [0.0, -0.01] }\n')
+    text = (
+        '[material]\ndensity = 2000.0\nthickness = 0.5\n[structure]\nbuilder = "fake"\nbays = 3\n'
+        '[[support]]\nname = "pad"\nmotion = { kind = "constant", velocity = [0.0, -0.01] }\n'
+    )
     s = load_scenario(write(tmp_path, text))
     assert s.structure == {"builder": "fake", "bays": 3}
     assert [b.name for b in s.assembly.blocks] == ["b0", "b1", "b2"]
@@ -635,20 +698,35 @@ def test_builder_option_errors(tmp_path, fake_builders, line, expected):
     "text, expected",
     [
         ('[structure]\nbuilder = "tower"\n', '[structure] builder = "tower": unknown builder (expected one of '),
-        ("[structure]\nblocks = 51\n", '[structure] builder: missing (e.g. builder = "wall", or file = "my-wall.geojson")'),
+        (
+            "[structure]\nblocks = 51\n",
+            '[structure] builder: missing (e.g. builder = "wall", or file = "my-wall.geojson")',
+        ),
         ("[structure]\nbuilder = 3\n", "[structure] builder = 3: must be a string"),
-        ('[structure]\nbuilder = "fake"\n' + BLOCK,
-         '[[block]] #1 ("b1"): not allowed together with a [structure] builder'),
-        ('[structure]\nbuilder = "fake"\n[[support]]\nname = "moat"\n',
-         '[[support]] #1 ("moat"): name = "moat": no such support in builder "fake" (supports: ground, pad)'),
-        ('[structure]\nbuilder = "fake"\n[[support]]\nmotion = { kind = "fixed" }\n',
-         '[[support]] #1: name: missing (builder "fake" supports: ground, pad)'),
-        ('[structure]\nbuilder = "fake"\n' + GROUND,
-         '[[support]] #1 ("ground"): polygon: not allowed with a [structure] (builder "fake" makes the supports'),
-        ('[structure]\nbuilder = "fake"\n[[support]]\nname = "pad"\n[[support]]\nname = "pad"\n',
-         '[[support]] #2 ("pad"): name = "pad": support given twice'),
-        ('[structure]\nbuilder = "fake"\n[[support]]\nname = "pad"\nmotion = { kind = "sine" }\n',
-         '[[support]] #1 ("pad"): motion.amplitude: missing (required for kind "sine")'),
+        (
+            '[structure]\nbuilder = "fake"\n' + BLOCK,
+            '[[block]] #1 ("b1"): not allowed together with a [structure] builder',
+        ),
+        (
+            '[structure]\nbuilder = "fake"\n[[support]]\nname = "moat"\n',
+            '[[support]] #1 ("moat"): name = "moat": no such support in builder "fake" (supports: ground, pad)',
+        ),
+        (
+            '[structure]\nbuilder = "fake"\n[[support]]\nmotion = { kind = "fixed" }\n',
+            '[[support]] #1: name: missing (builder "fake" supports: ground, pad)',
+        ),
+        (
+            '[structure]\nbuilder = "fake"\n' + GROUND,
+            '[[support]] #1 ("ground"): polygon: not allowed with a [structure] (builder "fake" makes the supports',
+        ),
+        (
+            '[structure]\nbuilder = "fake"\n[[support]]\nname = "pad"\n[[support]]\nname = "pad"\n',
+            '[[support]] #2 ("pad"): name = "pad": support given twice',
+        ),
+        (
+            '[structure]\nbuilder = "fake"\n[[support]]\nname = "pad"\nmotion = { kind = "sine" }\n',
+            '[[support]] #1 ("pad"): motion.amplitude: missing (required for kind "sine")',
+        ),
     ],
 )
 def test_builder_structure_errors(tmp_path, fake_builders, text, expected):
@@ -657,8 +735,7 @@ def test_builder_structure_errors(tmp_path, fake_builders, text, expected):
 
 def test_scenario_from_builder(fake_builders):
     shake = Motion(kind="sine", amplitude=1.0, frequency=2.0)
-    s = scenario_from_builder("fake", {"bays": 4}, RunConfig(duration=0.5), Material(density=2200.0),
-                              {"ground": shake})
+    s = scenario_from_builder("fake", {"bays": 4}, RunConfig(duration=0.5), Material(density=2200.0), {"ground": shake})
     assert s.name == "fake" and s.source == "builder:fake" and s.structure == {"builder": "fake", "bays": 4}
     assert s.assembly.block_count == 4 and all(b.density == 2200.0 for b in s.assembly.blocks)
     assert s.motions == (shake, Motion())
@@ -666,8 +743,11 @@ def test_scenario_from_builder(fake_builders):
     assert s.run.n_steps == 500
     summary = scenario_summary(s)
     assert summary["total_mass"] == pytest.approx(4 * 0.4 * 0.2 * 2200.0)
-    assert summary["support_motions"][0] == {"name": "ground", "role": "driven",
-                                             "motion": "sine 1 m/s · sin(2π·2 Hz·t) along (1, 0)"}
+    assert summary["support_motions"][0] == {
+        "name": "ground",
+        "role": "driven",
+        "motion": "sine 1 m/s · sin(2π·2 Hz·t) along (1, 0)",
+    }
 
     with pytest.raises(InputError) as exc:
         scenario_from_builder("fake", {}, RunConfig(), Material(), {"moat": shake})
@@ -723,6 +803,7 @@ def test_builder_bug_is_not_disguised_as_input_error(fake_builders):
     fake_builders["broken"] = broken
     with pytest.raises(TypeError):
         scenario_from_builder("broken", {}, RunConfig(), Material(), {})
+
     # None passes where the builder's annotation allows it
     def nullable(*, bays: int | None = 2):
         return fake_builder(bays=bays or 1)

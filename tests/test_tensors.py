@@ -71,9 +71,7 @@ def state_arrays(centroids, n_supports=1):
 CASE4_POINTS = np.array(
     [[0.2, 0.1], [-0.2, 0.1], [0.2, -0.1], [-0.2, -0.1], [0.2, 0.1], [0.2, -0.1], [-0.2, 0.1], [-0.2, -0.1]]
 )
-CASE4_FORCES = np.array(
-    [[-150.0, -500.0]] * 2 + [[150.0, 500.0]] * 2 + [[-150.0, -75.0]] * 2 + [[150.0, 75.0]] * 2
-)
+CASE4_FORCES = np.array([[-150.0, -500.0]] * 2 + [[150.0, 500.0]] * 2 + [[-150.0, -75.0]] * 2 + [[150.0, 75.0]] * 2)
 CASE4_SIGMA = np.array([[-1500.0, -750.0], [-750.0, -2500.0]])
 CASE4_S1 = -2000.0 + math.sqrt(500.0**2 + 750.0**2)  # c ± hypot((a − d)/2, b)
 CASE4_S2 = -2000.0 - math.sqrt(500.0**2 + 750.0**2)
@@ -223,8 +221,9 @@ def test_case5_affine_velocity_recovers_sym_l0(wall, seed):
     rate = T.cell_strain_rate(n, q, v, triangles)
     has = np.isin(np.arange(n), triangles)
     assert has.sum() > n // 2
-    np.testing.assert_allclose(rate[has], np.broadcast_to(0.5 * (l0 + l0.T), (has.sum(), 2, 2)),
-                               rtol=0, atol=1e-12 * np.abs(l0).max())
+    np.testing.assert_allclose(
+        rate[has], np.broadcast_to(0.5 * (l0 + l0.T), (has.sum(), 2, 2)), rtol=0, atol=1e-12 * np.abs(l0).max()
+    )
 
 
 def test_case5_rigid_rotation_gives_zero(wall):
@@ -341,8 +340,15 @@ def test_isolated_block_gets_nan_strain(wall):
     no = np.zeros((0, 2))
     tc.step(q, v, np.zeros((0, 2), np.int32), no, no, 1e-3)
     f = tc.fields()
-    for name in ("cell_strain_rate", "cell_strain", "cell_principal_strain_rate", "cell_principal_strain",
-                 "cell_volumetric_strain", "cell_deviatoric_strain_rate", "cell_principal_strain_angle"):
+    for name in (
+        "cell_strain_rate",
+        "cell_strain",
+        "cell_principal_strain_rate",
+        "cell_principal_strain",
+        "cell_volumetric_strain",
+        "cell_deviatoric_strain_rate",
+        "cell_principal_strain_angle",
+    ):
         assert np.all(np.isnan(f[name][n])), name
         assert np.all(np.isfinite(f[name][tc.has_triangle])), name
 
@@ -468,11 +474,13 @@ def test_constructor_and_step_validation():
         T.TensorComputer(3, np.ones(3), np.array([[0, 1, 3]]))
     tc = T.TensorComputer(2, np.ones(2), np.zeros((0, 3)))
     with pytest.raises(ValueError):
-        tc.step(np.zeros((1, 3)), np.zeros((2, 3)), np.zeros((0, 2), np.int32), np.zeros((0, 2)),
-                np.zeros((0, 2)), 1e-3)
+        tc.step(
+            np.zeros((1, 3)), np.zeros((2, 3)), np.zeros((0, 2), np.int32), np.zeros((0, 2)), np.zeros((0, 2)), 1e-3
+        )
     with pytest.raises(ValueError):
-        tc.step(np.zeros((2, 3)), np.zeros((2, 3)), np.zeros((1, 2), np.int32), np.zeros((1, 2)),
-                np.zeros((2, 2)), 1e-3)
+        tc.step(
+            np.zeros((2, 3)), np.zeros((2, 3)), np.zeros((1, 2), np.int32), np.zeros((1, 2)), np.zeros((2, 2)), 1e-3
+        )
 
 
 def test_principal_launcher_batches():

@@ -37,8 +37,9 @@ def test_column_block_stress_from_simulation():
 
 def test_wall_at_rest_course_stress():
     density = 2500.0
-    sc = scenario_from_builder("wall", {"blocks": 51}, RunConfig(duration=0.1, record_every=100),
-                               Material(density=density), {})
+    sc = scenario_from_builder(
+        "wall", {"blocks": 51}, RunConfig(duration=0.1, record_every=100), Material(density=density), {}
+    )
     hist = History([b.name for b in sc.assembly.blocks], [s.name for s in sc.assembly.supports])
     result = simulate(sc, sinks=[hist])
     assert result.status == "completed"

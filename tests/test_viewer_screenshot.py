@@ -62,6 +62,7 @@ def test_no_view_reports_visualizer_errors(screenshot):
 
 def test_blocks_are_drawn_y_up_with_field_colours(screenshot):
     import PIL.Image as image_module  # pillow comes with rerun-sdk
+
     png, _, _ = screenshot
     image = np.asarray(image_module.open(png).convert("RGB"))
     main = image[60:1000, :1100]  # the structure view (left of the plots, above the time panel)

@@ -76,15 +76,24 @@ def build_aqueduct(
     check_count("aqueduct", 1, wall_courses=wall_courses)
     check_positive("aqueduct", block_length=block_length, block_height=block_height)
     blocks, supports, geom = arch_parts(
-        voussoirs, pier_courses, span, ring_thickness, pier_width, pier_course_height, density,
-        thickness, foundation_margin, foundation_depth, left_role, right_role,
+        voussoirs,
+        pier_courses,
+        span,
+        ring_thickness,
+        pier_width,
+        pier_course_height,
+        density,
+        thickness,
+        foundation_margin,
+        foundation_depth,
+        left_role,
+        right_role,
     )
     top = geom.springing + wall_courses * block_height
     crown = geom.springing + geom.extrados_radius
     if top < crown:
         raise GeometryError(
-            f"aqueduct: the wall top ({top:g} m) is below the crown of the extrados ({crown:g} m); "
-            "add wall_courses"
+            f"aqueduct: the wall top ({top:g} m) is below the crown of the extrados ({crown:g} m); add wall_courses"
         )
     region = Polygon(geom.extrados)
     pieces = spandrel_blocks(

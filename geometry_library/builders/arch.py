@@ -132,9 +132,7 @@ def arch_parts(
             pieces = sorted([(x_in, x_joint), (x_joint, x_out)], key=lambda ab: min(ab))
             for k, (xa, xb) in enumerate(pieces, start=1):
                 lo, hi = min(xa, xb), max(xa, xb)
-                blocks.append(
-                    make_block(box(lo, y0, hi, y1), f"{side}-pier-c{c:0{cw}d}-b{k}", density, thickness)
-                )
+                blocks.append(make_block(box(lo, y0, hi, y1), f"{side}-pier-c{c:0{cw}d}-b{k}", density, thickness))
         return blocks
 
     vw = name_width(voussoirs)
@@ -206,7 +204,17 @@ def build_arch(
     module docstring for the layout, names and order.
     """
     blocks, supports, _ = arch_parts(
-        voussoirs, pier_courses, span, ring_thickness, pier_width, pier_course_height, density,
-        thickness, foundation_margin, foundation_depth, left_role, right_role,
+        voussoirs,
+        pier_courses,
+        span,
+        ring_thickness,
+        pier_width,
+        pier_course_height,
+        density,
+        thickness,
+        foundation_margin,
+        foundation_depth,
+        left_role,
+        right_role,
     )
     return Assembly(tuple(blocks), tuple(supports))

@@ -220,10 +220,14 @@ def _cuts(xy: np.ndarray, i: int, centre: np.ndarray):
     left_in = np.array([-e_in[1], e_in[0]]) / np.hypot(*e_in)
     left_out = np.array([-e_out[1], e_out[0]]) / np.hypot(*e_out)
     directions = [
-        (0.0, 1.0), (0.0, -1.0), (1.0, 0.0), (-1.0, 0.0),
-        radial / np.hypot(*radial),      # continues the voussoir joint
-        e_in, -e_out,                    # extends an edge of the piece
-        left_in + left_out,              # bisects the cone: always admissible
+        (0.0, 1.0),
+        (0.0, -1.0),
+        (1.0, 0.0),
+        (-1.0, 0.0),
+        radial / np.hypot(*radial),  # continues the voussoir joint
+        e_in,
+        -e_out,  # extends an edge of the piece
+        left_in + left_out,  # bisects the cone: always admissible
     ]
     for d in directions:
         d = np.asarray(d, dtype=np.float64)
@@ -375,9 +379,7 @@ def _merge_slivers(pieces: list[tuple[int, Polygon]], centre: np.ndarray, limits
     kept: set[int] = set()  # ids of slivers we gave up on
     for _ in range(10 * len(pieces) + 10):
         small = [
-            (q, k)
-            for k, (c, p) in enumerate(pieces)
-            if (q := limits.quality(_ring(p))) < 1.0 and id(p) not in kept
+            (q, k) for k, (c, p) in enumerate(pieces) if (q := limits.quality(_ring(p))) < 1.0 and id(p) not in kept
         ]
         if not small:
             break

@@ -122,9 +122,7 @@ def wall_layout(
         n_float = length / block_length
         n_pinned = round(n_float)
         if n_pinned < 1 or abs(n_float - n_pinned) > 1e-9 * max(1.0, n_float):
-            raise GeometryError(
-                f"wall: length {length:g} m is not a whole number of {block_length:g} m blocks"
-            )
+            raise GeometryError(f"wall: length {length:g} m is not a whole number of {block_length:g} m blocks")
     if courses is not None and (not isinstance(courses, int) or courses < 1):
         raise GeometryError(f"wall: courses must be a positive integer, got {courses!r}")
     if blocks is None:
@@ -209,9 +207,7 @@ def build_wall(
         m = 0
         for k, u in enumerate(units, start=1):
             xa, xb = x0 + m * 0.5 * block_length, x0 + (m + u) * 0.5 * block_length
-            out.append(
-                make_block(box(xa, y0, xb, y0 + block_height), f"c{c:0{cw}d}-b{k:0{bw}d}", density, thickness)
-            )
+            out.append(make_block(box(xa, y0, xb, y0 + block_height), f"c{c:0{cw}d}-b{k:0{bw}d}", density, thickness))
             m += u
     half = 0.5 * layout.length + ground_margin
     ground = make_support(box(-half, -ground_depth, half, 0.0), "ground", ground_role)

@@ -77,9 +77,7 @@ class ContactBuffers:
     :meth:`view`) after each call, never keep references across calls.
     """
 
-    def __init__(
-        self, body_vert_start, pair_capacity: int | None = None, contact_capacity: int | None = None
-    ):
+    def __init__(self, body_vert_start, pair_capacity: int | None = None, contact_capacity: int | None = None):
         body_vert_start = np.asarray(body_vert_start)
         check_topology(body_vert_start)
         self._checked_vert_start = body_vert_start

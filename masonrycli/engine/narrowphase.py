@@ -406,9 +406,7 @@ def check_topology(body_vert_start) -> None:
     counts = np.diff(body_vert_start)
     bad = np.flatnonzero((counts < 3) | (counts > KEY_LIMIT_VERTICES))
     if bad.size:
-        raise ValueError(
-            f"body {bad[0]} has {counts[bad[0]]} vertices: polygons need 3..{KEY_LIMIT_VERTICES}"
-        )
+        raise ValueError(f"body {bad[0]} has {counts[bad[0]]} vertices: polygons need 3..{KEY_LIMIT_VERTICES}")
 
 
 def narrowphase(

@@ -25,20 +25,33 @@ STATUS_OPEN, STATUS_STICK, STATUS_SLIP = 0, 1, 2
 # Columns of the packed per-contact array built by _prepare and read by every NLGS sweep. Packing the
 # contact's constants in one row (instead of a dozen arrays) and precomputing inverses keeps the sweep
 # free of divisions and of lever-arm rotations: ~3x faster than recomputing them per sweep.
-P_NX, P_NY = 0, 1            # unit normal a → b (t = (n_y, −n_x))
-P_TA, P_NA = 2, 3            # r_a × t, r_a × n   (m): moment arms of a unit t / n impulse on body a
-P_TB, P_NB = 4, 5            # r_b × t, r_b × n
+P_NX, P_NY = 0, 1  # unit normal a → b (t = (n_y, −n_x))
+P_TA, P_NA = 2, 3  # r_a × t, r_a × n   (m): moment arms of a unit t / n impulse on body a
+P_TB, P_NB = 4, 5  # r_b × t, r_b × n
 P_WTT, P_WTN, P_WNN = 6, 7, 8  # Delassus block W_αα (1/kg)
-P_BIAS = 9                   # max(g_m, 0)/dt (m/s)
+P_BIAS = 9  # max(g_m, 0)/dt (m/s)
 P_ITT, P_ITN, P_INN = 10, 11, 12  # W_αα⁻¹
-P_ISP, P_ISM = 13, 14        # 1/(W_nn − μ W_tn), 1/(W_nn + μ W_tn): sliding with s = +1 / −1 (0 if ≤ 0)
+P_ISP, P_ISM = 13, 14  # 1/(W_nn − μ W_tn), 1/(W_nn + μ W_tn): sliding with s = +1 / −1 (0 if ≤ 0)
 P_IMA, P_IIA, P_IMB, P_IIB = 15, 16, 17, 18  # inverse masses and inertias of a and b
 PACK_WIDTH = 19
 
 
 @njit
-def _prepare(contact_body, contact_point, contact_normal, contact_gap, count, body_q, inv_mass, inv_inertia,
-             mu, dt, out_ra, out_rb, out_pack):
+def _prepare(
+    contact_body,
+    contact_point,
+    contact_normal,
+    contact_gap,
+    count,
+    body_q,
+    inv_mass,
+    inv_inertia,
+    mu,
+    dt,
+    out_ra,
+    out_rb,
+    out_pack,
+):
     # For each contact: lever arms from the centroids (at the detection configuration q_m) to the
     # contact point; their moments about t and n; the Delassus diagonal block
     #   W_ij = Σ_{a,b} (m⁻¹ dᵢ·dⱼ + I⁻¹ (r×dᵢ)(r×dⱼ)),  d = (t, n)
@@ -216,8 +229,21 @@ def _nlgs(contact_body, pack, count, mu, tolerance, max_iterations, v, r, status
 
 
 @njit
-def _contact_power(contact_body, contact_normal, ra, rb, r, count, v_old, v_new, body_dynamic, block_count,
-                   dt, out_force, out_support_force):
+def _contact_power(
+    contact_body,
+    contact_normal,
+    ra,
+    rb,
+    r,
+    count,
+    v_old,
+    v_new,
+    body_dynamic,
+    block_count,
+    dt,
+    out_force,
+    out_support_force,
+):
     # Per contact: world force on body b (r/dt) and, over the step, the energy dissipated
     # D = −Σ r·ū (ū: relative velocity at the mean velocity (v_n + v_n+1)/2) and the work of the supports
     # W_s = Σ (force of the support on the block)·(support velocity)·dt. At θ = ½ these close the
@@ -259,12 +285,26 @@ def _contact_power(contact_body, contact_normal, ra, rb, r, count, v_old, v_new,
     return dissipated, support_work
 
 
-def prepare_contacts(contact_body, contact_point, contact_normal, contact_gap, count, body_q, model,
-                     out_ra, out_rb, out_pack) -> None:
+def prepare_contacts(
+    contact_body, contact_point, contact_normal, contact_gap, count, body_q, model, out_ra, out_rb, out_pack
+) -> None:
     """Lever arms ``out_ra``/``out_rb`` (C,2) m and the packed per-contact constants ``out_pack``
     (C, PACK_WIDTH): frame, moment arms, W_αα (1/kg) and its inverse, Signorini bias (m/s)."""
-    _prepare(contact_body, contact_point, contact_normal, contact_gap, count, body_q, model.body_inv_mass,
-             model.body_inv_inertia, model.friction, model.dt, out_ra, out_rb, out_pack)
+    _prepare(
+        contact_body,
+        contact_point,
+        contact_normal,
+        contact_gap,
+        count,
+        body_q,
+        model.body_inv_mass,
+        model.body_inv_inertia,
+        model.friction,
+        model.dt,
+        out_ra,
+        out_rb,
+        out_pack,
+    )
 
 
 def solve(contact_body, pack, count, model, v, r, status) -> tuple[int, float]:
@@ -276,8 +316,22 @@ def solve(contact_body, pack, count, model, v, r, status) -> tuple[int, float]:
     return _nlgs(contact_body, pack, count, model.friction, model.tolerance, model.max_iterations, v, r, status)
 
 
-def contact_power(contact_body, contact_normal, ra, rb, r, count, v_old, v_new, model, out_force,
-                  out_support_force) -> tuple[float, float]:
+def contact_power(
+    contact_body, contact_normal, ra, rb, r, count, v_old, v_new, model, out_force, out_support_force
+) -> tuple[float, float]:
     """World contact forces on body b (C,2) N, support forces (S,2) N; returns (dissipated, support work) J."""
-    return _contact_power(contact_body, contact_normal, ra, rb, r, count, v_old, v_new, model.body_dynamic,
-                          model.block_count, model.dt, out_force, out_support_force)
+    return _contact_power(
+        contact_body,
+        contact_normal,
+        ra,
+        rb,
+        r,
+        count,
+        v_old,
+        v_new,
+        model.body_dynamic,
+        model.block_count,
+        model.dt,
+        out_force,
+        out_support_force,
+    )

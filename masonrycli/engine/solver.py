@@ -1,13 +1,13 @@
 """One Moreau–Jean time step: launchers only, every loop lives in a kernel.
 
-    1. q_m = q_n + (1 − θ) dt v_n                          integrate.intermediate_q
-    2. contacts at q_m within alert + 2·dt·(top speed)     collision.detect_contacts
-    3. warm start: r_α ← r of the previous step with the same key
-    4. v_free = v_n + dt g ; supports get v(t_n+1)         integrate.free_velocity
-    5. lever arms, W_αα, Signorini bias                    nlgs.prepare_contacts
-    6. NLGS → r, v_n+1                                     nlgs.solve
-    7. contact forces, dissipation, support work           nlgs.contact_power
-    8. q_n+1 = q_n + dt (θ v_n+1 + (1 − θ) v_n)            integrate.update_q
+1. q_m = q_n + (1 − θ) dt v_n                          integrate.intermediate_q
+2. contacts at q_m within alert + 2·dt·(top speed)     collision.detect_contacts
+3. warm start: r_α ← r of the previous step with the same key
+4. v_free = v_n + dt g ; supports get v(t_n+1)         integrate.free_velocity
+5. lever arms, W_αα, Signorini bias                    nlgs.prepare_contacts
+6. NLGS → r, v_n+1                                     nlgs.solve
+7. contact forces, dissipation, support work           nlgs.contact_power
+8. q_n+1 = q_n + dt (θ v_n+1 + (1 − θ) v_n)            integrate.update_q
 """
 
 from __future__ import annotations
@@ -155,11 +155,23 @@ class Solver:
         integrate.free_velocity(m, self._v_old, m.support_velocity[k + 1], state.body_v)
         bf = self.buffers
         body, normal = bf.contact_body, bf.contact_normal
-        nlgs.prepare_contacts(body, bf.contact_point, normal, bf.contact_gap, count, self.body_q_m, m,
-                              self._ra, self._rb, self._pack)
+        nlgs.prepare_contacts(
+            body, bf.contact_point, normal, bf.contact_gap, count, self.body_q_m, m, self._ra, self._rb, self._pack
+        )
         iterations, residual = nlgs.solve(body, self._pack, count, m, state.body_v, self._r, self._status)
-        dissipated, work = nlgs.contact_power(body, normal, self._ra, self._rb, self._r, count, self._v_old,
-                                              state.body_v, m, self._force, self.support_force)
+        dissipated, work = nlgs.contact_power(
+            body,
+            normal,
+            self._ra,
+            self._rb,
+            self._r,
+            count,
+            self._v_old,
+            state.body_v,
+            m,
+            self._force,
+            self.support_force,
+        )
         integrate.update_q(state.body_q, self._v_old, state.body_v, m.dt, m.theta)
         state.step = k + 1
         state.time = state.step * m.dt

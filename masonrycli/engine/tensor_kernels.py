@@ -299,9 +299,27 @@ def _tensor_invariants(tensor_out, pair_out, scalar_out):
     cell_stress = tensor_out[T_CELL_STRESS]
     for i in range(cell_stress.shape[0]):
         scalar_out[S_STRESS_SKEW, i] = 0.5 * abs(cell_stress[i, 0, 1] - cell_stress[i, 1, 0])
-    _principal(cell_stress, pair_out[P_STRESS], scalar_out[S_STRESS_ANGLE],
-               scalar_out[S_STRESS_SPHERICAL], scalar_out[S_STRESS_DEVIATORIC], 0.5)
-    _principal(tensor_out[T_CELL_STRAIN_RATE], pair_out[P_STRAIN_RATE], scalar_out[S_STRAIN_RATE_ANGLE],
-               scalar_out[S_STRAIN_RATE_VOLUMETRIC], scalar_out[S_STRAIN_RATE_DEVIATORIC], 1.0)
-    _principal(tensor_out[T_CELL_STRAIN], pair_out[P_STRAIN], scalar_out[S_STRAIN_ANGLE],
-               scalar_out[S_STRAIN_VOLUMETRIC], scalar_out[S_STRAIN_DEVIATORIC], 1.0)
+    _principal(
+        cell_stress,
+        pair_out[P_STRESS],
+        scalar_out[S_STRESS_ANGLE],
+        scalar_out[S_STRESS_SPHERICAL],
+        scalar_out[S_STRESS_DEVIATORIC],
+        0.5,
+    )
+    _principal(
+        tensor_out[T_CELL_STRAIN_RATE],
+        pair_out[P_STRAIN_RATE],
+        scalar_out[S_STRAIN_RATE_ANGLE],
+        scalar_out[S_STRAIN_RATE_VOLUMETRIC],
+        scalar_out[S_STRAIN_RATE_DEVIATORIC],
+        1.0,
+    )
+    _principal(
+        tensor_out[T_CELL_STRAIN],
+        pair_out[P_STRAIN],
+        scalar_out[S_STRAIN_ANGLE],
+        scalar_out[S_STRAIN_VOLUMETRIC],
+        scalar_out[S_STRAIN_DEVIATORIC],
+        1.0,
+    )
