@@ -11,7 +11,9 @@ import numpy as np
 import pytest
 
 from masonrycli.colormap import COOLWARM, unpack_rgba
-from masonrycli.recording import _SUPPORT_FILL_RGBA, Recorder, _viewer_executable, screenshot_recording
+from masonrycli.recording import Recorder, screenshot_recording
+from masonrycli.recording.layout import SUPPORT_FILL_RGBA
+from masonrycli.recording.readback import _viewer_executable
 
 import recording_fixtures as fx
 
@@ -67,7 +69,7 @@ def test_blocks_are_drawn_y_up_with_field_colours(screenshot):
     image = np.asarray(image_module.open(png).convert("RGB"))
     main = image[60:1000, :1100]  # the structure view (left of the plots, above the time panel)
     blocks = near(main, unpack_rgba(COOLWARM)[:, :3])
-    ground = near(main, unpack_rgba(np.array([_SUPPORT_FILL_RGBA]))[:, :3].repeat(4, axis=0), tol=12)
+    ground = near(main, unpack_rgba(np.array([SUPPORT_FILL_RGBA]))[:, :3].repeat(4, axis=0), tol=12)
     assert blocks.mean() > 0.05 and ground.mean() > 0.01  # filled blocks and the ground are visible
     block_rows, ground_rows = np.nonzero(blocks)[0], np.nonzero(ground)[0]
     # y up: the ground is below the wall on screen (larger row index); the legend bar is above it too.

@@ -1,0 +1,46 @@
+"""Rerun recording of a run: the only package that imports rerun.
+
+- ``recorder``: ``Recorder`` writes one run's ``.rrd`` from its frames; ``RecordingStatic`` is its input.
+- ``layout``: entity paths, field specs, colours, scale constants, the default blueprint.
+- ``document``: the run document (status, parameters, scales, versions) shown beside the views.
+- ``static_content``: ``RecordingStatic`` and what is logged once (styles, drawing plane, colour bars).
+- ``arrays``: posed polygons, Arrow line strips and the frame buffer behind ``send_columns``.
+- ``readback``: ``inspect_recording`` (summary of a file) and ``screenshot_recording`` (headless viewer).
+- ``_rerun_private``: the only use of rerun's private API, kept small and explained there.
+"""
+
+from masonrycli.recording.document import viewer_safe_text
+from masonrycli.recording.layout import (
+    COMPRESSION_RGBA,
+    ENTITY_PATHS,
+    FIELDS,
+    HINGE_RGBA,
+    OPEN_RGBA,
+    SLIP_RGBA,
+    STICK_RGBA,
+    TENSION_RGBA,
+    FieldSpec,
+    build_blueprint,
+)
+from masonrycli.recording.readback import inspect_recording, screenshot_recording
+from masonrycli.recording.recorder import APPLICATION_ID, Recorder
+from masonrycli.recording.static_content import RecordingStatic
+
+__all__ = [
+    "APPLICATION_ID",
+    "COMPRESSION_RGBA",
+    "ENTITY_PATHS",
+    "FIELDS",
+    "HINGE_RGBA",
+    "OPEN_RGBA",
+    "SLIP_RGBA",
+    "STICK_RGBA",
+    "TENSION_RGBA",
+    "FieldSpec",
+    "Recorder",
+    "RecordingStatic",
+    "build_blueprint",
+    "inspect_recording",
+    "screenshot_recording",
+    "viewer_safe_text",
+]

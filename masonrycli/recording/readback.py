@@ -1,0 +1,171 @@
+"""Reading recordings back: a summary of an ``.rrd`` (``inspect``) and screenshots from a headless viewer."""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import shutil
+import signal
+import socket
+import sys
+import time
+import warnings
+
+import numpy as np
+import pyarrow as pa
+import rerun as rr
+
+from masonrycli.recording._rerun_private import viewer_pid
+from masonrycli.recording.layout import METADATA
+
+
+def inspect_recording(path: str | os.PathLike) -> dict:
+    """Summary of a recording file; works without a footer too (a killed writer's file).
+
+    Keys: application_id, recording_id, frames (distinct `step` values), steps (first, last) or None,
+    time_span (first, last sim_time, s) or None, entity_paths (sorted, with the leading "/"),
+    has_blueprint, complete (footer present), metadata (the run document's Markdown, or None).
+    """
+    with warnings.catch_warnings():  # a file without footer is reported as complete=False below
+        warnings.simplefilter("ignore")
+        reader = rr.chunk.RrdReader(os.fspath(path))
+        recordings = reader.recordings()
+    if not recordings:
+        raise ValueError(f"{path}: no recording in this file")
+    entry = recordings[0]
+    paths: set[str] = set()
+    steps: set[int] = set()
+    t_lo, t_hi = np.inf, -np.inf
+    metadata: str | None = None
+    for chunk in reader.stream(store=entry):
+        paths.add(chunk.entity_path)
+        batch = chunk.to_record_batch()
+        names = batch.schema.names
+        if chunk.is_static:
+            if chunk.entity_path == f"/{METADATA}" and "TextDocument:text" in names:
+                texts = [t for t in batch.column("TextDocument:text").to_pylist() if t]
+                metadata = texts[-1][0] if texts else metadata  # the last one logged wins
+            continue
+        if "step" in names:
+            steps.update(batch.column("step").to_numpy().tolist())
+        if "sim_time" in names and batch.num_rows:
+            t = batch.column("sim_time").cast(pa.int64()).to_numpy() * 1e-9
+            t_lo, t_hi = min(t_lo, t.min()), max(t_hi, t.max())
+    try:
+        reader.store(store=entry)
+        complete = True
+    except Exception:  # no footer / manifest: the writer did not finish
+        complete = False
+    return {
+        "application_id": entry.application_id,
+        "recording_id": entry.recording_id,
+        "frames": len(steps),
+        "steps": (min(steps), max(steps)) if steps else None,
+        "time_span": (round(float(t_lo), 9), round(float(t_hi), 9)) if np.isfinite(t_lo) else None,
+        "entity_paths": sorted(paths),
+        "has_blueprint": bool(reader.blueprints()),
+        "complete": complete,
+        "metadata": metadata,
+    }
+
+
+# ---------------------------------------------------------------------------------------- headless viewer
+def _free_port() -> int:
+    with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as s:
+        s.bind(("127.0.0.1", 0))
+        return int(s.getsockname()[1])
+
+
+def _viewer_executable() -> str | None:
+    """The `rerun` next to this interpreter (same version as the SDK), else the one on PATH."""
+    here = os.path.join(os.path.dirname(sys.executable), "rerun")
+    return here if os.access(here, os.X_OK) else shutil.which("rerun")
+
+
+def screenshot_recording(
+    rrd_path: str | os.PathLike,
+    png_path: str | os.PathLike,
+    time_step: int | None = None,
+    timeout: float = 60,
+    *,
+    tabs_dir: str | os.PathLike | None = None,
+) -> list[str]:
+    """Open a recording in a headless viewer, save a PNG of the window, return the views' error reports.
+
+    ``time_step``: the `step` shown (None: the last one). The PNG shows the default layout. A hidden tab
+    is not drawn and cannot report, so every tab is then brought to the front in turn (saved as
+    ``tabs_dir/tab<i>.png`` if given). Returns "view: severity: summary" for every report of every view;
+    empty means healthy. Needs a Vulkan driver (Debian: mesa-vulkan-drivers libvulkan1).
+    """
+    from rerun.experimental import ViewerClient
+
+    os.makedirs(os.path.dirname(os.path.abspath(png_path)), exist_ok=True)
+    deadline = time.monotonic() + timeout
+    viewer = ViewerClient.spawn(
+        headless=True, port=_free_port(), hide_welcome_screen=True, executable_path=_viewer_executable()
+    )
+    pid = viewer_pid(viewer)
+    try:
+        while True:  # until the viewer answers
+            try:
+                viewer.get_state()
+                break
+            except Exception:
+                if time.monotonic() > deadline:
+                    raise
+                time.sleep(0.2)
+        viewer.open(os.path.abspath(rrd_path))
+        while True:  # until the file is loaded and its timelines are known
+            state = viewer.get_state()
+            recs = [r for r in state.recordings if r.timelines]
+            if not state.loading and recs and state.views:
+                break
+            if time.monotonic() > deadline:
+                raise TimeoutError(f"viewer did not load {rrd_path} within {timeout} s")
+            time.sleep(0.2)
+        if time_step is None:
+            line = next((t for r in recs for t in r.timelines if t.name == "step"), None)
+            time_step = line.end if line is not None and line.end is not None else 0
+        viewer.set_time("step", sequence=int(time_step), play_state="paused")
+        _settle(viewer)
+        viewer.save_screenshot(os.path.abspath(png_path))
+        reports = {v.view_id: (v.name, v.reports) for v in viewer.get_state().views}
+        blueprint = viewer.get_blueprint(of="recording").blueprint
+        tabs = [
+            c["ContainerBlueprint"]
+            for c in blueprint.values()
+            if c.get("ContainerBlueprint", {}).get("container_kind") == "Tabs"
+        ]
+        for i in range(1, max((len(t.get("contents", [])) for t in tabs), default=0)):
+            if time.monotonic() > deadline:
+                raise TimeoutError(f"viewer did not show every tab of {rrd_path} within {timeout} s")
+            for t in tabs:
+                t["active_tab"] = t["contents"][min(i, len(t["contents"]) - 1)]
+            viewer.set_blueprint(blueprint, of="recording")
+            _settle(viewer)
+            png = viewer.take_screenshot()
+            if tabs_dir is not None:
+                os.makedirs(tabs_dir, exist_ok=True)
+                with open(os.path.join(tabs_dir, f"tab{i}.png"), "wb") as fh:
+                    fh.write(png)
+            for v in viewer.get_state().views:
+                if v.reports or v.view_id not in reports:
+                    reports[v.view_id] = (v.name, v.reports)
+        return [
+            f"{name}: {r.severity}: {r.summary}" + (f" ({r.details})" if r.details else "")
+            for name, rs in reports.values()
+            for r in rs
+        ]
+    finally:
+        with contextlib.suppress(Exception):
+            viewer.quit(timeout=5.0)
+        if viewer_pid(viewer) is not None and pid is not None:  # quit failed: end the shim's process group
+            with contextlib.suppress(ProcessLookupError, PermissionError):
+                os.killpg(pid, signal.SIGKILL)
+
+
+def _settle(viewer, paints: int = 2, pause: float = 0.2) -> None:
+    """Let the viewer paint a few frames: newly shown views fetch their chunks on demand."""
+    for _ in range(paints):
+        viewer.take_screenshot(max_size=64)
+        time.sleep(pause)
