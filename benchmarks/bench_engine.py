@@ -32,15 +32,15 @@ os.environ.setdefault("RERUN_ANALYTICS", "0")
 
 from masonrycli.engine import nlgs  # noqa: E402
 from masonrycli.engine import solver as solver_module  # noqa: E402
-from masonrycli.motion import Motion  # noqa: E402
+from masonrycli.motion import Constant, Sine  # noqa: E402
 from masonrycli.run import Simulation, simulate  # noqa: E402
 from masonrycli.scenario import Material, RunConfig, scenario_from_builder  # noqa: E402
 
-SINE = Motion(kind="sine", direction=(1.0, 0.0), amplitude=1.0, frequency=2.0)
+SINE = Sine(direction=(1.0, 0.0), amplitude=1.0, frequency=2.0)
 CASES = {
     "wall-51": ("wall", {"blocks": 51}, 1.0, {"ground": SINE}),
     "wall-248": ("wall", {"blocks": 248}, 1.0, {"ground": SINE}),
-    "arch-98": ("arch", {}, 5.0, {"right-foundation": Motion(kind="constant", velocity=(0.0, -0.01))}),
+    "arch-98": ("arch", {}, 5.0, {"right-foundation": Constant(velocity=(0.0, -0.01))}),
 }
 
 

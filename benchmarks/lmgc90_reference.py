@@ -364,12 +364,12 @@ OURS = r"""
 import json, statistics, sys, time
 sys.path.insert(0, ROOT)
 import numpy as np
-from masonrycli.motion import Motion
+from masonrycli.motion import Sine
 from masonrycli.run import Simulation, simulate
 from masonrycli.scenario import Material, RunConfig, scenario_from_builder
 
 def scenario():
-    motion = Motion(kind="sine", direction=(1.0, 0.0), amplitude=AMPLITUDE, frequency=FREQUENCY)
+    motion = Sine(direction=(1.0, 0.0), amplitude=AMPLITUDE, frequency=FREQUENCY)
     run = RunConfig(duration=DURATION, dt=DT, theta=THETA, tolerance=1.666e-4, max_iterations=1000,
                     alert_distance=ALERT)
     material = Material(density=RHO, thickness=DEPTH, friction=MU)

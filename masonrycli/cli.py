@@ -273,7 +273,7 @@ def _simulate(
     no_recording,
     history,
 ) -> None:
-    from masonrycli.motion import Motion
+    from masonrycli.motion import Constant
     from masonrycli.scenario import Material, RunConfig, scenario_from_builder
 
     material = Material()
@@ -298,7 +298,7 @@ def _simulate(
         if settlement:
             if amp:
                 raise InputError("--settlement with --amp: choose one loading (settle or shake)")
-            motions["right-foundation"] = Motion(kind="constant", velocity=(0.0, -settlement))
+            motions["right-foundation"] = Constant(velocity=(0.0, -settlement))
     scenario = scenario_from_builder(builder, options, run, material, motions)
     scenario = _apply_options(
         scenario,
@@ -320,10 +320,10 @@ def _simulate(
 
 
 def _sine(amp: float, freq: float):
-    from masonrycli.motion import Motion
+    from masonrycli.motion import Sine
 
     try:
-        return Motion(kind="sine", direction=(1.0, 0.0), amplitude=amp, frequency=freq)
+        return Sine(direction=(1.0, 0.0), amplitude=amp, frequency=freq)
     except InputError as exc:
         raise InputError(f"--amp/--freq: {exc}") from None
 

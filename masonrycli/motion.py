@@ -1,24 +1,25 @@
-"""Imposed support motions and their velocities.
+"""Imposed support motions: one small frozen dataclass per kind, and their velocities.
 
-A support (ground, foundation pad) translates with an imposed velocity. :class:`Motion` describes one
-support's velocity history; :func:`support_velocity` evaluates the velocities of all supports at many
-instants at once, vectorised over time.
+A support (ground, foundation pad) translates with an imposed velocity. Each motion kind below knows
+its velocity history (:meth:`velocity_at`, vectorised over time), a one-line description
+(:meth:`describe`) and its TOML spelling (``TOML_KEYS``, ``TOML_REQUIRED``, :meth:`toml_fields`);
+:func:`support_velocity` evaluates all supports of a scenario at many instants at once. Record files
+(CSV) are read in :mod:`masonrycli.records`.
 
 Kinds
 -----
-``fixed``
+:class:`Fixed` (``fixed``)
     v(t) = 0.
-``constant``
+:class:`Constant` (``constant``)
     v(t) = ``velocity`` (settlement: a foundation moving down at 1 cm/s is ``velocity = (0, -0.01)``).
-``sine``
+:class:`Sine` (``sine``)
     v(t) = ``amplitude`` · sin(2π · ``frequency`` · t + ``phase``) · d̂, with d̂ = ``direction`` / |direction|.
-``ramp``
+:class:`Ramp` (``ramp``)
     v(t) = ``acceleration`` · clip(t, 0, ``until``): constant acceleration from rest, then constant
     velocity after ``until`` (an acceleration pulse; ``until = inf`` by default).
-``record``
-    A tabulated velocity or acceleration history (earthquake record), see :func:`load_record_csv`.
-    ``record_time`` (n,) s; ``record_value`` either n numbers applied along d̂ (``direction``) or n
-    (x, y) pairs. Values are multiplied by ``scale``.
+:class:`Record` (``record``)
+    A tabulated velocity or acceleration history (earthquake record). ``time`` (n,) s; ``value`` either
+    n numbers applied along d̂ (``direction``) or n (x, y) pairs. Values are multiplied by ``scale``.
 
     * ``quantity = "velocity"``: the velocity is interpolated linearly between samples; before the first
       sample it holds the first value, after the last sample it holds the last value.
@@ -38,128 +39,266 @@ from __future__ import annotations
 import functools
 import math
 import os
-import re
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import ClassVar
 
 import numpy as np
 
-from masonrycli.errors import InputError
-from masonrycli.values import check_real, check_vector, field_error, format_value, is_real, shorten
+from masonrycli.values import check_real, check_vector, field_error, format_value, is_real
 
-MOTION_KINDS = ("fixed", "constant", "sine", "ramp", "record")
 RECORD_QUANTITIES = ("velocity", "acceleration")
 
 
-@dataclass(frozen=True)
-class Motion:
-    """Imposed velocity history of one support (see the module docstring for the kinds).
+def _g(x: float) -> str:
+    return f"{x:g}"
 
-    Attributes
-    ----------
-    kind : "fixed" | "constant" | "sine" | "ramp" | "record".
-    direction : (dx, dy) — axis of ``sine`` and of 2-column ``record`` motions; normalised on use.
-    amplitude : m/s — ``sine`` velocity amplitude.
-    frequency : Hz — ``sine``.
-    phase : rad — ``sine``.
-    velocity : (vx, vy) m/s — ``constant``.
-    acceleration : (ax, ay) m/s² — ``ramp``.
-    until : s — ``ramp`` stops accelerating at this time (inf: never).
-    record_time : (n,) s, strictly increasing — ``record``.
-    record_value : n floats (along ``direction``) or n (x, y) pairs — ``record``, m/s or m/s².
-    quantity : "velocity" | "acceleration" — what ``record_value`` holds.
-    scale : multiplies ``record_value``.
-    source : where the record came from (absolute CSV path, or "" for inline data).
+
+def _vec(v) -> str:
+    return "(" + ", ".join(_g(x) for x in v) + ")"
+
+
+def _put(obj, name: str, value) -> None:
+    # frozen dataclasses normalise their fields (lists -> tuples, ints -> floats) in __post_init__
+    object.__setattr__(obj, name, value)
+
+
+def _direction(obj) -> None:
+    _put(obj, "direction", check_vector("direction", obj.direction))
+    if obj.direction == (0.0, 0.0):
+        raise field_error("direction", obj.direction, "must not be the zero vector")
+
+
+def _time_column(t) -> np.ndarray:
+    t = np.atleast_1d(np.asarray(t, dtype=np.float64))
+    if t.ndim != 1:
+        raise ValueError(f"t must be a 1-D array of times, got shape {t.shape}")
+    return t
+
+
+class Motion:
+    """Base of the motion kinds: the interface every support motion offers.
+
+    ``kind`` is the TOML name; ``TOML_KEYS`` the keys a ``motion = {...}`` table of this kind may hold,
+    ``TOML_REQUIRED`` those it must hold. Subclasses are frozen dataclasses whose ``__post_init__``
+    validates and normalises the fields; error messages start with the field name
+    (``amplitude = nan: must be a finite number``) so callers can prefix a location.
     """
 
-    kind: str = "fixed"
-    direction: tuple[float, float] = (1.0, 0.0)
+    kind: ClassVar[str]
+    TOML_KEYS: ClassVar[tuple[str, ...]]
+    TOML_REQUIRED: ClassVar[tuple[str, ...]] = ()
+
+    @property
+    def role(self) -> str:
+        """``"fixed"`` for a fixed support, ``"driven"`` otherwise (the ``Support.role`` value)."""
+        return "driven"
+
+    def velocity_at(self, t) -> np.ndarray:
+        """Support velocity at times ``t`` (T,) s, shape (T, 2), m/s. Vectorised over time."""
+        raise NotImplementedError
+
+    def describe(self) -> str:
+        """One human-readable line, e.g. ``sine 1 m/s · sin(2π·2 Hz·t) along (1, 0)``."""
+        raise NotImplementedError
+
+    def toml_fields(self, inline_records: bool = False) -> dict:
+        """The ``motion = {...}`` table of this motion, ``kind`` first (what the scenario writer emits)."""
+        raise NotImplementedError
+
+
+@dataclass(frozen=True)
+class Fixed(Motion):
+    """A support that does not move."""
+
+    kind: ClassVar[str] = "fixed"
+    TOML_KEYS: ClassVar[tuple[str, ...]] = ("kind",)
+
+    @property
+    def role(self) -> str:
+        return "fixed"
+
+    def velocity_at(self, t) -> np.ndarray:
+        return np.zeros((_time_column(t).shape[0], 2), dtype=np.float64)
+
+    def describe(self) -> str:
+        return "fixed"
+
+    def toml_fields(self, inline_records: bool = False) -> dict:
+        return {"kind": self.kind}
+
+
+@dataclass(frozen=True)
+class Constant(Motion):
+    """Constant velocity ``velocity`` (vx, vy) m/s (a settling foundation)."""
+
+    velocity: tuple[float, float] = (0.0, 0.0)
+
+    kind: ClassVar[str] = "constant"
+    TOML_KEYS: ClassVar[tuple[str, ...]] = ("kind", "velocity")
+    TOML_REQUIRED: ClassVar[tuple[str, ...]] = ("velocity",)
+
+    def __post_init__(self):
+        _put(self, "velocity", check_vector("velocity", self.velocity))
+
+    def velocity_at(self, t) -> np.ndarray:
+        out = np.zeros((_time_column(t).shape[0], 2), dtype=np.float64)
+        out[:] = self.velocity
+        return out
+
+    def describe(self) -> str:
+        return f"constant velocity {_vec(self.velocity)} m/s"
+
+    def toml_fields(self, inline_records: bool = False) -> dict:
+        return {"kind": self.kind, "velocity": list(self.velocity)}
+
+
+@dataclass(frozen=True, kw_only=True)
+class Sine(Motion):
+    """``amplitude`` (m/s) · sin(2π ``frequency`` (Hz) · t + ``phase`` (rad)) along ``direction``
+    (normalised on use)."""
+
     amplitude: float = 0.0
     frequency: float = 0.0
+    direction: tuple[float, float] = (1.0, 0.0)
     phase: float = 0.0
-    velocity: tuple[float, float] = (0.0, 0.0)
+
+    kind: ClassVar[str] = "sine"
+    TOML_KEYS: ClassVar[tuple[str, ...]] = ("kind", "direction", "amplitude", "frequency", "phase")
+    TOML_REQUIRED: ClassVar[tuple[str, ...]] = ("amplitude", "frequency")
+
+    def __post_init__(self):
+        _direction(self)
+        _put(self, "amplitude", check_real("amplitude", self.amplitude))
+        _put(self, "frequency", check_real("frequency", self.frequency, ge=0.0))
+        _put(self, "phase", check_real("phase", self.phase))
+
+    @property
+    def unit_direction(self) -> np.ndarray:
+        """``direction`` normalised, shape (2,)."""
+        return np.asarray(self.direction, dtype=np.float64) / math.hypot(*self.direction)
+
+    def velocity_at(self, t) -> np.ndarray:
+        t = _time_column(t)
+        out = np.zeros((t.shape[0], 2), dtype=np.float64)
+        s = self.amplitude * np.sin(2.0 * np.pi * self.frequency * t + self.phase)
+        out[:] = s[:, None] * self.unit_direction[None, :]
+        return out
+
+    def describe(self) -> str:
+        ph = f" + {_g(self.phase)}" if self.phase else ""
+        return f"sine {_g(self.amplitude)} m/s · sin(2π·{_g(self.frequency)} Hz·t{ph}) along {_vec(self.direction)}"
+
+    def toml_fields(self, inline_records: bool = False) -> dict:
+        return {
+            "kind": self.kind,
+            "direction": list(self.direction),
+            "amplitude": self.amplitude,
+            "frequency": self.frequency,
+            "phase": self.phase,
+        }
+
+
+@dataclass(frozen=True, kw_only=True)
+class Ramp(Motion):
+    """Constant ``acceleration`` (ax, ay) m/s² from rest until ``until`` s (inf: never), then constant
+    velocity."""
+
     acceleration: tuple[float, float] = (0.0, 0.0)
     until: float = math.inf
-    record_time: tuple[float, ...] = ()
-    record_value: tuple = ()
+
+    kind: ClassVar[str] = "ramp"
+    TOML_KEYS: ClassVar[tuple[str, ...]] = ("kind", "acceleration", "until")
+    TOML_REQUIRED: ClassVar[tuple[str, ...]] = ("acceleration",)
+
+    def __post_init__(self):
+        _put(self, "acceleration", check_vector("acceleration", self.acceleration))
+        _put(self, "until", check_real("until", self.until, gt=0.0, allow_inf=True))
+
+    def velocity_at(self, t) -> np.ndarray:
+        t = _time_column(t)
+        out = np.zeros((t.shape[0], 2), dtype=np.float64)
+        tc = np.clip(t, 0.0, self.until)
+        out[:] = tc[:, None] * np.asarray(self.acceleration)[None, :]
+        return out
+
+    def describe(self) -> str:
+        until = "" if math.isinf(self.until) else f" until {_g(self.until)} s"
+        return f"ramp acceleration {_vec(self.acceleration)} m/s²{until}"
+
+    def toml_fields(self, inline_records: bool = False) -> dict:
+        kv = {"kind": self.kind, "acceleration": list(self.acceleration)}
+        if math.isfinite(self.until):
+            kv["until"] = self.until
+        return kv
+
+
+@dataclass(frozen=True, kw_only=True)
+class Record(Motion):
+    """A tabulated velocity or acceleration history (see the module docstring).
+
+    time : (n,) s, strictly increasing, n >= 2.
+    value : n floats (along ``direction``) or n (x, y) pairs, m/s or m/s² (before ``scale``).
+    direction : (dx, dy) axis of a 1-component record; normalised on use.
+    quantity : "velocity" | "acceleration" — what ``value`` holds.
+    scale : multiplies ``value``.
+    source : where the record came from (absolute file path, or "" for inline data).
+    """
+
+    time: tuple[float, ...] = ()
+    value: tuple = ()
+    direction: tuple[float, float] = (1.0, 0.0)
     quantity: str = "velocity"
     scale: float = 1.0
     source: str = ""
 
-    def __post_init__(self):
-        # Normalise types (lists -> tuples, ints -> floats) and validate. Error messages start with the
-        # field name ("amplitude = nan: must be a finite number") so callers can prefix a location.
-        def put(name, value):
-            object.__setattr__(self, name, value)
+    kind: ClassVar[str] = "record"
+    TOML_KEYS: ClassVar[tuple[str, ...]] = ("kind", "file", "time", "value", "quantity", "scale", "direction")
 
-        if self.kind not in MOTION_KINDS:
-            raise field_error("kind", self.kind, f"unknown motion kind (expected one of {', '.join(MOTION_KINDS)})")
-        put("direction", check_vector("direction", self.direction))
-        if self.direction == (0.0, 0.0):
-            raise field_error("direction", self.direction, "must not be the zero vector")
-        put("amplitude", check_real("amplitude", self.amplitude))
-        put("frequency", check_real("frequency", self.frequency, ge=0.0))
-        put("phase", check_real("phase", self.phase))
-        put("velocity", check_vector("velocity", self.velocity))
-        put("acceleration", check_vector("acceleration", self.acceleration))
-        put("until", check_real("until", self.until, gt=0.0, allow_inf=True))
+    def __post_init__(self):
+        _direction(self)
         if self.quantity not in RECORD_QUANTITIES:
             raise field_error("quantity", self.quantity, 'must be "velocity" or "acceleration"')
-        put("scale", check_real("scale", self.scale))
+        _put(self, "scale", check_real("scale", self.scale))
         if not isinstance(self.source, str):
             raise field_error("source", self.source, "must be a string")
-        self._check_record()
-
-    def _check_record(self):
-        time, value = self.record_time, self.record_value
+        time, value = self.time, self.value
         if isinstance(time, np.ndarray):
             time = time.tolist()
         if isinstance(value, np.ndarray):
             value = value.tolist()
         if not isinstance(time, (list, tuple)) or not isinstance(value, (list, tuple)):
-            raise field_error("record_time", time, "record_time and record_value must be sequences")
-        if self.kind != "record" and not time and not value:
-            object.__setattr__(self, "record_time", ())
-            object.__setattr__(self, "record_value", ())
-            return
+            raise field_error("time", time, "time and value must be sequences")
         if len(time) < 2:
-            raise field_error("record_time", time, f"a record needs at least 2 samples, got {len(time)}")
+            raise field_error("time", time, f"a record needs at least 2 samples, got {len(time)}")
         if len(value) != len(time):
-            raise field_error("record_value", value, f"has {len(value)} samples but record_time has {len(time)}")
-        t = tuple(check_real(f"record_time[{i}]", x) for i, x in enumerate(time))
+            raise field_error("value", value, f"has {len(value)} samples but time has {len(time)}")
+        t = tuple(check_real(f"time[{i}]", x) for i, x in enumerate(time))
         for i in range(1, len(t)):
             if not t[i] > t[i - 1]:
-                raise field_error(f"record_time[{i}]", t[i], f"must be > the previous time {format_value(t[i - 1])}")
+                raise field_error(f"time[{i}]", t[i], f"must be > the previous time {format_value(t[i - 1])}")
         if all(is_real(v) for v in value):
-            v = tuple(check_real(f"record_value[{i}]", x) for i, x in enumerate(value))
+            v = tuple(check_real(f"value[{i}]", x) for i, x in enumerate(value))
         else:
-            v = tuple(check_vector(f"record_value[{i}]", x) for i, x in enumerate(value))
-        object.__setattr__(self, "record_time", t)
-        object.__setattr__(self, "record_value", v)
-
-    # ---------------------------------------------------------------------------------------------
-
-    @property
-    def role(self) -> str:
-        """``"fixed"`` for a fixed support, ``"driven"`` otherwise (the ``Support.role`` value)."""
-        return "fixed" if self.kind == "fixed" else "driven"
+            v = tuple(check_vector(f"value[{i}]", x) for i, x in enumerate(value))
+        _put(self, "time", t)
+        _put(self, "value", v)
 
     @property
     def unit_direction(self) -> np.ndarray:
         """``direction`` normalised, shape (2,)."""
-        d = np.asarray(self.direction, dtype=np.float64)
-        return d / math.hypot(*self.direction)
+        return np.asarray(self.direction, dtype=np.float64) / math.hypot(*self.direction)
 
     @property
-    def record_is_vector(self) -> bool:
-        """True for 3-column (time, x, y) records, False for 2-column (time, value along ``direction``)."""
-        return bool(self.record_value) and isinstance(self.record_value[0], tuple)
+    def is_vector(self) -> bool:
+        """True for (x, y) records, False for 1-component records applied along ``direction``."""
+        return bool(self.value) and isinstance(self.value[0], tuple)
 
     @functools.cached_property
-    def _record_arrays(self):
-        """Precomputed (time (n,), value (n,2) scaled, nodal velocity (n,2)) for ``record`` motions."""
-        time = np.asarray(self.record_time, dtype=np.float64)
-        value = np.asarray(self.record_value, dtype=np.float64)
+    def _arrays(self):
+        """Precomputed (time (n,), value (n,2) scaled, nodal velocity (n,2))."""
+        time = np.asarray(self.time, dtype=np.float64)
+        value = np.asarray(self.value, dtype=np.float64)
         if value.ndim == 1:
             value = value[:, None] * self.unit_direction[None, :]
         value = value * self.scale
@@ -175,60 +314,48 @@ class Motion:
         return time, value, nodal_v
 
     def velocity_at(self, t) -> np.ndarray:
-        """Support velocity at times ``t`` (T,) s, shape (T, 2), m/s. Vectorised over time."""
-        t = np.atleast_1d(np.asarray(t, dtype=np.float64))
-        if t.ndim != 1:
-            raise ValueError(f"t must be a 1-D array of times, got shape {t.shape}")
+        t = _time_column(t)
         out = np.zeros((t.shape[0], 2), dtype=np.float64)
-        kind = self.kind
-        if kind == "fixed":
-            pass
-        elif kind == "constant":
-            out[:] = self.velocity
-        elif kind == "sine":
-            s = self.amplitude * np.sin(2.0 * np.pi * self.frequency * t + self.phase)
-            out[:] = s[:, None] * self.unit_direction[None, :]
-        elif kind == "ramp":
-            tc = np.clip(t, 0.0, self.until)
-            out[:] = tc[:, None] * np.asarray(self.acceleration)[None, :]
-        elif kind == "record":
-            time, value, nodal_v = self._record_arrays
-            if self.quantity == "velocity":
-                out[:, 0] = np.interp(t, time, value[:, 0])
-                out[:, 1] = np.interp(t, time, value[:, 1])
-            else:
-                # exact integral of the piecewise-linear acceleration:
-                #   i = interval holding t (clamped), tau = clip(t - t_i, 0, h_i)
-                #   v = v_i + a_i tau + (a_{i+1} - a_i) tau^2 / (2 h_i)
-                # tau clamps to 0 before the record (v = v_0 = 0) and to h_i after it (v = v_n).
-                i = np.clip(np.searchsorted(time, t, side="right") - 1, 0, time.shape[0] - 2)
-                h = (time[i + 1] - time[i])[:, None]
-                tau = np.clip(t - time[i], 0.0, h[:, 0])[:, None]
-                a0, a1 = value[i], value[i + 1]
-                out[:] = nodal_v[i] + a0 * tau + (a1 - a0) * (tau * tau) / (2.0 * h)
+        time, value, nodal_v = self._arrays
+        if self.quantity == "velocity":
+            out[:, 0] = np.interp(t, time, value[:, 0])
+            out[:, 1] = np.interp(t, time, value[:, 1])
+        else:
+            # exact integral of the piecewise-linear acceleration:
+            #   i = interval holding t (clamped), tau = clip(t - t_i, 0, h_i)
+            #   v = v_i + a_i tau + (a_{i+1} - a_i) tau^2 / (2 h_i)
+            # tau clamps to 0 before the record (v = v_0 = 0) and to h_i after it (v = v_n).
+            i = np.clip(np.searchsorted(time, t, side="right") - 1, 0, time.shape[0] - 2)
+            h = (time[i + 1] - time[i])[:, None]
+            tau = np.clip(t - time[i], 0.0, h[:, 0])[:, None]
+            a0, a1 = value[i], value[i + 1]
+            out[:] = nodal_v[i] + a0 * tau + (a1 - a0) * (tau * tau) / (2.0 * h)
         return out
 
     def describe(self) -> str:
-        """One human-readable line, e.g. ``sine 1 m/s · sin(2π·2 Hz·t) along (1, 0)``."""
-        g = lambda x: f"{x:g}"  # noqa: E731
-        vec = lambda v: "(" + ", ".join(g(x) for x in v) + ")"  # noqa: E731
-        if self.kind == "fixed":
-            return "fixed"
-        if self.kind == "constant":
-            return f"constant velocity {vec(self.velocity)} m/s"
-        if self.kind == "sine":
-            ph = f" + {g(self.phase)}" if self.phase else ""
-            return f"sine {g(self.amplitude)} m/s · sin(2π·{g(self.frequency)} Hz·t{ph}) along {vec(self.direction)}"
-        if self.kind == "ramp":
-            until = "" if math.isinf(self.until) else f" until {g(self.until)} s"
-            return f"ramp acceleration {vec(self.acceleration)} m/s²{until}"
         src = os.path.basename(self.source) if self.source else "inline"
-        axis = "" if self.record_is_vector else f" along {vec(self.direction)}"
-        scale = "" if self.scale == 1.0 else f" × {g(self.scale)}"
+        axis = "" if self.is_vector else f" along {_vec(self.direction)}"
+        scale = "" if self.scale == 1.0 else f" × {_g(self.scale)}"
         return (
-            f"record of {self.quantity} ({src}, {len(self.record_time)} samples, "
-            f"{g(self.record_time[0])}–{g(self.record_time[-1])} s){scale}{axis}"
+            f"record of {self.quantity} ({src}, {len(self.time)} samples, "
+            f"{_g(self.time[0])}–{_g(self.time[-1])} s){scale}{axis}"
         )
+
+    def toml_fields(self, inline_records: bool = False) -> dict:
+        kv: dict = {"kind": self.kind}
+        if self.source and not inline_records:
+            kv["file"] = self.source
+        else:
+            kv["time"] = list(self.time)
+            kv["value"] = [list(v) if isinstance(v, tuple) else v for v in self.value]
+        kv.update(quantity=self.quantity, scale=self.scale)
+        if not self.is_vector:
+            kv["direction"] = list(self.direction)
+        return kv
+
+
+MOTION_KINDS: dict[str, type[Motion]] = {cls.kind: cls for cls in (Fixed, Constant, Sine, Ramp, Record)}
+"""TOML ``kind`` -> motion class."""
 
 
 def support_velocity(motions: Sequence[Motion], t) -> np.ndarray:
@@ -243,108 +370,8 @@ def support_velocity(motions: Sequence[Motion], t) -> np.ndarray:
     -------
     (T, S, 2) float64 support velocities, m/s. Vectorised over time (a Python loop runs over supports only).
     """
-    t = np.atleast_1d(np.asarray(t, dtype=np.float64))
-    if t.ndim != 1:
-        raise ValueError(f"t must be a 1-D array of times, got shape {t.shape}")
+    t = _time_column(t)
     out = np.zeros((t.shape[0], len(motions), 2), dtype=np.float64)
     for s, motion in enumerate(motions):
         out[:, s, :] = motion.velocity_at(t)
     return out
-
-
-# --------------------------------------------------------------------------------------------------
-# records
-
-
-_SPLIT = re.compile(r"\s*[,;]\s*|\s+")
-
-
-def load_record_csv(path, display: str | None = None) -> tuple[np.ndarray, np.ndarray]:
-    """Read a tabulated motion record.
-
-    Format: one sample per line, ``time,value`` (2 columns: a value along the motion's direction) or
-    ``time,x,y`` (3 columns: a vector). Separators: comma, semicolon or white space. Blank lines and
-    lines starting with ``#`` are skipped; a single non-numeric header line before the first sample is
-    allowed. Times in s, strictly increasing, at least 2 samples; all values finite.
-
-    Returns ``(time (n,), value (n,) or (n, 2))`` float64 arrays.
-    Raises :class:`InputError` with a one-line message ``<file>:<line>: <problem>``.
-    ``display`` is the file name used in messages (default: ``path`` as given).
-    """
-    name = display if display is not None else str(path)
-    try:
-        with open(path, "rb") as fh:
-            raw = fh.read()
-    except IsADirectoryError:
-        raise InputError(f"{name}: cannot read record: is a directory") from None
-    except OSError as exc:
-        raise InputError(f"{name}: cannot read record: {exc.strerror or exc}") from None
-    try:
-        text = raw.decode("utf-8-sig")
-    except UnicodeDecodeError as exc:
-        raise InputError(f"{name}: not a UTF-8 text file (byte {exc.start})") from None
-
-    times: list[float] = []
-    values: list = []
-    ncol = 0
-    header_seen = False
-    for lineno, line in enumerate(text.splitlines(), start=1):
-        stripped = line.strip()
-        if not stripped or stripped.startswith("#"):
-            continue
-        fields = [f for f in _SPLIT.split(stripped) if f != ""]
-        try:
-            nums = [float(f) for f in fields]
-        except ValueError:
-            if not times and not header_seen:
-                header_seen = True
-                continue
-            bad = next(f for f in fields if not _is_float(f))
-            raise InputError(f"{name}:{lineno}: not a number: {shorten(bad, 40)}") from None
-        if ncol == 0:
-            if len(nums) not in (2, 3):
-                raise InputError(
-                    f"{name}:{lineno}: expected 2 columns (time, value) or 3 (time, x, y), got {len(nums)}"
-                )
-            ncol = len(nums)
-        elif len(nums) != ncol:
-            raise InputError(f"{name}:{lineno}: expected {ncol} columns like the first sample, got {len(nums)}")
-        if not all(math.isfinite(x) for x in nums):
-            raise InputError(f"{name}:{lineno}: values must be finite, got {shorten(stripped, 40)}")
-        if times and not nums[0] > times[-1]:
-            raise InputError(
-                f"{name}:{lineno}: time {format_value(nums[0])} is not after the previous sample's "
-                f"{format_value(times[-1])} (times must be strictly increasing)"
-            )
-        times.append(nums[0])
-        values.append(nums[1] if ncol == 2 else (nums[1], nums[2]))
-    if len(times) < 2:
-        raise InputError(f"{name}: a record needs at least 2 samples, found {len(times)}")
-    return np.asarray(times, dtype=np.float64), np.asarray(values, dtype=np.float64)
-
-
-def _is_float(text: str) -> bool:
-    try:
-        float(text)
-    except ValueError:
-        return False
-    return True
-
-
-def record_motion(
-    path, *, quantity: str = "velocity", scale: float = 1.0, direction=(1.0, 0.0), display: str | None = None
-) -> Motion:
-    """A ``record`` :class:`Motion` from a CSV file (see :func:`load_record_csv`).
-
-    ``source`` is the absolute path of the file. ``direction`` applies to 2-column records only.
-    """
-    time, value = load_record_csv(path, display=display)
-    return Motion(
-        kind="record",
-        direction=tuple(direction),
-        record_time=tuple(time.tolist()),
-        record_value=tuple(value.tolist()) if value.ndim == 1 else tuple(map(tuple, value.tolist())),
-        quantity=quantity,
-        scale=scale,
-        source=os.path.abspath(os.fspath(path)),
-    )

@@ -24,7 +24,8 @@ import numpy as np
 
 from geometry_library.blocks import Assembly, Block, GeometryError, Support
 from masonrycli.errors import InputError
-from masonrycli.motion import MOTION_KINDS, Motion, load_record_csv
+from masonrycli.motion import MOTION_KINDS, Fixed, Motion
+from masonrycli.records import load_record_csv
 from masonrycli.values import check_real, check_vector, field_error, format_value, is_real, quote_string
 
 MAX_DURATION = 1e5
@@ -37,21 +38,7 @@ BLOCK_KEYS = ("name", "polygon", "density", "thickness", "velocity")
 SUPPORT_KEYS = ("name", "polygon", "motion")
 BUILDER_SUPPORT_KEYS = ("name", "motion")
 
-MOTION_KEYS = {
-    "fixed": ("kind",),
-    "constant": ("kind", "velocity"),
-    "sine": ("kind", "direction", "amplitude", "frequency", "phase"),
-    "ramp": ("kind", "acceleration", "until"),
-    "record": ("kind", "file", "time", "value", "quantity", "scale", "direction"),
-}
-MOTION_REQUIRED = {
-    "fixed": (),
-    "constant": ("velocity",),
-    "sine": ("amplitude", "frequency"),
-    "ramp": ("acceleration",),
-    "record": (),  # file, or time and value: checked separately
-}
-ALL_MOTION_KEYS = tuple(dict.fromkeys(k for keys in MOTION_KEYS.values() for k in keys))
+ALL_MOTION_KEYS = tuple(dict.fromkeys(k for cls in MOTION_KINDS.values() for k in cls.TOML_KEYS))
 
 
 # --------------------------------------------------------------------------------------------------
@@ -383,7 +370,7 @@ def _parse_document(doc: dict, ctx: _Ctx, default_name: str) -> Scenario:
             if sname in motions_by_support:
                 raise ctx.error(loc, f"name = {quote_string(sname)}: support given twice")
             motions_by_support[sname] = _parse_motion(table.get("motion"), ctx, loc)
-        motions = tuple(motions_by_support.get(s.name, Motion()) for s in assembly.supports)
+        motions = tuple(motions_by_support.get(s.name, Fixed()) for s in assembly.supports)
     else:
         blocks = []
         names: dict[str, str] = {}
@@ -452,7 +439,7 @@ def scenario_from_geometry_file(path) -> Scenario:
         run=RunConfig(),
         material=material,
         assembly=assembly,
-        motions=tuple(Motion() for _ in assembly.supports),
+        motions=tuple(Fixed() for _ in assembly.supports),
         source=path,
         structure={"file": os.path.abspath(path)},
         warnings=warnings,
@@ -543,7 +530,7 @@ def _parse_support(i: int, table: dict, ctx: _Ctx, names: dict) -> tuple[Support
 def _parse_motion(table, ctx: _Ctx, loc: str) -> Motion:
     """A ``motion = {...}`` table -> Motion (None -> fixed)."""
     if table is None:
-        return Motion()
+        return Fixed()
     if not isinstance(table, dict):
         raise ctx.error(
             loc,
@@ -561,25 +548,22 @@ def _parse_motion(table, ctx: _Ctx, loc: str) -> Motion:
             loc,
             f"motion.kind = {format_value(kind)[:40]}: unknown motion kind (expected one of {', '.join(MOTION_KINDS)})",
         )
-    allowed = MOTION_KEYS[kind]
+    cls = MOTION_KINDS[kind]
+    allowed = cls.TOML_KEYS
     for key in table:
         if key not in allowed:
             raise ctx.error(loc, f'motion.{key}: not used by kind "{kind}" (its keys: {", ".join(allowed)})')
-    for key in MOTION_REQUIRED[kind]:
+    for key in cls.TOML_REQUIRED:
         if key not in table:
             raise ctx.error(loc, f'motion.{key}: missing (required for kind "{kind}")')
 
-    args = {k: v for k, v in table.items() if k not in ("file", "time", "value")}
+    args = {k: v for k, v in table.items() if k not in ("kind", "file", "time", "value")}
     if kind == "record":
         args.update(_record_data(table, ctx, loc))
     try:
-        return Motion(**args)
+        return cls(**args)
     except InputError as exc:
-        msg = str(exc)
-        for old, new in (("record_time", "time"), ("record_value", "value")):
-            if msg.startswith(old):
-                msg = new + msg[len(old) :]
-        raise ctx.error(loc, f"motion.{msg}") from None
+        raise ctx.error(loc, f"motion.{exc}") from None
 
 
 def _record_data(table: dict, ctx: _Ctx, loc: str) -> dict:
@@ -601,8 +585,8 @@ def _record_data(table: dict, ctx: _Ctx, loc: str) -> dict:
         if value.ndim == 2 and "direction" in table:
             raise ctx.error(loc, f"motion.direction: not used by a 3-column record ({file} gives x and y)")
         return {
-            "record_time": tuple(time.tolist()),
-            "record_value": tuple(value.tolist()) if value.ndim == 1 else tuple(map(tuple, value.tolist())),
+            "time": tuple(time.tolist()),
+            "value": tuple(value.tolist()) if value.ndim == 1 else tuple(map(tuple, value.tolist())),
             "source": resolved,
         }
     for key in ("time", "value"):
@@ -613,7 +597,7 @@ def _record_data(table: dict, ctx: _Ctx, loc: str) -> dict:
     value = table["value"]
     if value and all(isinstance(v, list) for v in value) and "direction" in table:
         raise ctx.error(loc, "motion.direction: not used by a vector record (value holds [x, y] pairs)")
-    return {"record_time": table["time"], "record_value": value}
+    return {"time": table["time"], "value": value}
 
 
 def _validate(assembly: Assembly, ctx: _Ctx) -> tuple[str, ...]:
@@ -753,7 +737,7 @@ def scenario_from_builder(
             )
         if not isinstance(motion, Motion):
             raise InputError(f"{where} motion of support {quote_string(name)} must be a Motion")
-    motions = tuple(motions_by_support.get(s.name, Motion()) for s in assembly.supports)
+    motions = tuple(motions_by_support.get(s.name, Fixed()) for s in assembly.supports)
     warnings = _validate(assembly, _Ctx(f'builder "{builder}"', "."))
     return Scenario(
         name=builder,

@@ -7,7 +7,6 @@ spelled by ``repr`` so that a reload gives bit-identical vertices.
 from __future__ import annotations
 
 import dataclasses
-import math
 
 import numpy as np
 
@@ -21,27 +20,7 @@ def _vertices(polygon_owner) -> list[list[float]]:
 
 
 def _motion_lines(motion: Motion, inline_records: bool) -> list[str]:
-    kv: dict = {"kind": motion.kind}
-    if motion.kind == "constant":
-        kv["velocity"] = list(motion.velocity)
-    elif motion.kind == "sine":
-        kv.update(
-            direction=list(motion.direction), amplitude=motion.amplitude, frequency=motion.frequency, phase=motion.phase
-        )
-    elif motion.kind == "ramp":
-        kv["acceleration"] = list(motion.acceleration)
-        if math.isfinite(motion.until):
-            kv["until"] = motion.until
-    elif motion.kind == "record":
-        if motion.source and not inline_records:
-            kv["file"] = motion.source
-        else:
-            kv["time"] = list(motion.record_time)
-            kv["value"] = [list(v) if isinstance(v, tuple) else v for v in motion.record_value]
-        kv.update(quantity=motion.quantity, scale=motion.scale)
-        if not motion.record_is_vector:
-            kv["direction"] = list(motion.direction)
-    return [f"{quote_key(k)} = {format_value(v)}" for k, v in kv.items()]
+    return [f"{quote_key(k)} = {format_value(v)}" for k, v in motion.toml_fields(inline_records).items()]
 
 
 def dump_scenario(scenario: Scenario, *, inline_records: bool = False) -> str:

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from masonrycli.history import History
-from masonrycli.motion import Motion
+from masonrycli.motion import Sine
 from masonrycli.run import simulate
 from masonrycli.scenario import Material, RunConfig, scenario_from_builder
 
@@ -17,7 +17,7 @@ def _wall_history(duration: float) -> np.ndarray:
         {"blocks": 248},
         RunConfig(duration=duration, record_every=25),
         Material(),
-        {"ground": Motion(kind="sine", amplitude=1.0, frequency=2.0)},
+        {"ground": Sine(amplitude=1.0, frequency=2.0)},
     )
     hist = History([b.name for b in sc.assembly.blocks], [s.name for s in sc.assembly.supports])
     result = simulate(sc, sinks=[hist])

@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from masonrycli.history import History
-from masonrycli.motion import Motion
+from masonrycli.motion import Constant, Sine
 from masonrycli.run import simulate
 from masonrycli.scenario import Material, RunConfig, scenario_from_builder
 
@@ -31,12 +31,12 @@ def _run(builder, options, duration, motions, record_every=10):
 
 @pytest.fixture(scope="module")
 def arch_settlement():
-    return _run("arch", {}, 5.0, {"right-foundation": Motion(kind="constant", velocity=(0.0, -0.01))})
+    return _run("arch", {}, 5.0, {"right-foundation": Constant(velocity=(0.0, -0.01))})
 
 
 @pytest.fixture(scope="module")
 def wall_248():
-    return _run("wall", {"blocks": 248}, 0.5, {"ground": Motion(kind="sine", amplitude=1.0, frequency=2.0)})
+    return _run("wall", {"blocks": 248}, 0.5, {"ground": Sine(amplitude=1.0, frequency=2.0)})
 
 
 def test_arch_forms_hinges_and_stands(arch_settlement):

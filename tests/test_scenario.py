@@ -13,7 +13,8 @@ import pytest
 import geometry_library.builders as builders_pkg
 from geometry_library.blocks import Assembly, Block, GeometryError, Support
 from masonrycli.errors import InputError
-from masonrycli.motion import Motion, record_motion
+from masonrycli.motion import Constant, Fixed, Sine
+from masonrycli.records import record_motion
 from masonrycli.scenario import (
     Material,
     RunConfig,
@@ -83,7 +84,7 @@ def test_block_on_ground_example():
     assert block.polygon.area == pytest.approx(0.08)
     (ground,) = s.assembly.supports
     assert ground.name == "ground" and ground.role == "driven"
-    assert s.motions == (Motion(kind="sine", direction=(1.0, 0.0), amplitude=1.0, frequency=2.0),)
+    assert s.motions == (Sine(direction=(1.0, 0.0), amplitude=1.0, frequency=2.0),)
     assert s.structure == {}
 
 
@@ -91,7 +92,7 @@ def test_column_example_and_summary():
     s = load_scenario(DATA / "column_5.toml")
     assert [b.name for b in s.assembly.blocks] == ["k5", "k4", "k3", "k2", "k1"]
     assert s.run.duration == 0.2 and s.run.n_steps == 200 and s.run.theta == 0.5
-    assert s.motions == (Motion(),) and s.assembly.supports[0].role == "fixed"
+    assert s.motions == (Fixed(),) and s.assembly.supports[0].role == "fixed"
     summary = scenario_summary(s)
     assert summary["blocks"] == 5 and summary["supports"] == 1
     assert summary["total_mass"] == pytest.approx(5 * 0.4 * 0.2 * 2000.0, rel=1e-12)
@@ -116,7 +117,7 @@ def test_defaults_and_default_names(tmp_path):
     assert [b.density for b in s.assembly.blocks] == [2500.0, 1000.0]
     assert isinstance(s.assembly.blocks[1].density, float)
     assert [x.name for x in s.assembly.supports] == ["support-1"]
-    assert s.motions == (Motion(),) and s.warnings == ()
+    assert s.motions == (Fixed(),) and s.warnings == ()
 
 
 def test_ints_accepted_for_floats_and_vertices_oriented_ccw(tmp_path):
@@ -254,8 +255,8 @@ def test_round_trip_explicit(round_trip_file, tmp_path, monkeypatch):
     assert [x.role for x in s.assembly.supports] == ["fixed"] + ["driven"] * 8
     assert s.assembly.blocks[2].name == "block-3"
     assert s.motions[5].source == str(tmp_path / "records" / "quake.csv")
-    assert s.motions[5].record_value == (0.1, 0.3333333333333333, -0.7)
-    assert s.motions[6].record_value == ((0.0, 0.0), (1e-3, -2e-3), (0.25, 0.125))
+    assert s.motions[5].value == (0.1, 0.3333333333333333, -0.7)
+    assert s.motions[6].value == ((0.0, 0.0), (1e-3, -2e-3), (0.25, 0.125))
 
     text = dump_scenario(s)
     # load from elsewhere: record files are written as absolute paths
@@ -272,7 +273,7 @@ def test_round_trip_explicit(round_trip_file, tmp_path, monkeypatch):
     assert "file =" not in inline
     again = loads_scenario(inline, base_dir=other)
     assert [m.source for m in again.motions[5:7]] == ["", ""]
-    strip = [dataclasses.replace(m, source="") for m in s.motions]
+    strip = [dataclasses.replace(m, source="") if m.kind == "record" else m for m in s.motions]
     assert again.motions == tuple(strip)
 
 
@@ -308,7 +309,7 @@ def test_programmatic_scenario_round_trip_and_role_fix():
     assert isinstance(s.motions, tuple)
     assert_same_scenario(s, loads_scenario(dump_scenario(s)))
     with pytest.raises(InputError, match="2 motions for 1 supports"):
-        Scenario(name="bad", run=RunConfig(), material=Material(), assembly=asm, motions=(Motion(), Motion()))
+        Scenario(name="bad", run=RunConfig(), material=Material(), assembly=asm, motions=(Fixed(), Fixed()))
 
 
 # ------------------------------------------------------------------------------------- record files
@@ -337,7 +338,7 @@ def test_relative_record_path_resolves_against_scenario_folder(tmp_path, monkeyp
         "polygon", f'motion = {{ kind = "record", file = "{DATA / "ground_xy.csv"}" }}\npolygon'
     )
     s = load_scenario(write(tmp_path, text, "abs.toml"))
-    assert s.motions[0].record_is_vector
+    assert s.motions[0].is_vector
 
 
 def test_missing_record_file_names_resolved_path(tmp_path):
@@ -666,7 +667,7 @@ def test_builder_scenario_file(tmp_path, fake_builders):
     assert all(b.density == 2000.0 and b.thickness == 0.5 for b in s.assembly.blocks)  # from [material]
     assert [x.name for x in s.assembly.supports] == ["ground", "pad"]
     assert [x.role for x in s.assembly.supports] == ["fixed", "driven"]
-    assert s.motions == (Motion(), Motion(kind="constant", velocity=(0.0, -0.01)))
+    assert s.motions == (Fixed(), Constant(velocity=(0.0, -0.01)))
 
     # builder options override the material defaults; dumped as explicit blocks
     s2 = load_scenario(write(tmp_path, '[structure]\nbuilder = "fake"\ndensity = 1800\nheight = 1\n', "b.toml"))
@@ -734,11 +735,11 @@ def test_builder_structure_errors(tmp_path, fake_builders, text, expected):
 
 
 def test_scenario_from_builder(fake_builders):
-    shake = Motion(kind="sine", amplitude=1.0, frequency=2.0)
+    shake = Sine(amplitude=1.0, frequency=2.0)
     s = scenario_from_builder("fake", {"bays": 4}, RunConfig(duration=0.5), Material(density=2200.0), {"ground": shake})
     assert s.name == "fake" and s.source == "builder:fake" and s.structure == {"builder": "fake", "bays": 4}
     assert s.assembly.block_count == 4 and all(b.density == 2200.0 for b in s.assembly.blocks)
-    assert s.motions == (shake, Motion())
+    assert s.motions == (shake, Fixed())
     assert [x.role for x in s.assembly.supports] == ["driven", "fixed"]
     assert s.run.n_steps == 500
     summary = scenario_summary(s)
@@ -781,15 +782,15 @@ def test_real_wall_builder_from_file(tmp_path):
 @pytest.mark.parametrize(
     "file, builder, blocks, motions",
     [
-        ("wall_shaken.toml", "wall", 248, {"ground": Motion(kind="sine", amplitude=1.0, frequency=2.0)}),
-        ("arch_settlement.toml", "arch", 98, {"right-foundation": Motion(kind="constant", velocity=(0.0, -0.01))}),
+        ("wall_shaken.toml", "wall", 248, {"ground": Sine(amplitude=1.0, frequency=2.0)}),
+        ("arch_settlement.toml", "arch", 98, {"right-foundation": Constant(velocity=(0.0, -0.01))}),
     ],
 )
 def test_paper_builder_scenarios(file, builder, blocks, motions):
     s = load_scenario(DATA / file)
     assert s.structure["builder"] == builder and s.assembly.block_count == blocks
     for support, motion in zip(s.assembly.supports, s.motions):
-        assert motion == motions.get(support.name, Motion())
+        assert motion == motions.get(support.name, Fixed())
         assert support.role == ("driven" if support.name in motions else "fixed")
     options = {k: v for k, v in s.structure.items() if k != "builder"}
     same = scenario_from_builder(builder, options, s.run, s.material, motions)
