@@ -30,14 +30,14 @@ import numpy as np
 import pytest
 
 from masonrycli.history import History
-from masonrycli.motion import Motion
+from masonrycli.motion import Constant, Sine
 from masonrycli.run import simulate
 from masonrycli.scenario import Material, RunConfig, scenario_from_builder
 
 GOLDEN = Path(__file__).parent / "data" / "golden_histories.json"
 
-_SHAKE = Motion(kind="sine", amplitude=1.0, frequency=2.0)  # ground velocity 1 m/s at 2 Hz
-_SETTLE = Motion(kind="constant", velocity=(0.0, -0.01))  # right foundation down at 1 cm/s
+_SHAKE = Sine(amplitude=1.0, frequency=2.0)  # ground velocity 1 m/s at 2 Hz
+_SETTLE = Constant(velocity=(0.0, -0.01))  # right foundation down at 1 cm/s
 
 # name -> (builder, builder options, motions by support, simulated seconds). Short runs: the whole file
 # stays within ~30 s of CPU, yet each run has contacts opening and closing under the loading.
