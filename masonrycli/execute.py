@@ -70,7 +70,7 @@ def recording_static(sim: Simulation):
         support_name=np.asarray(m.support_name, dtype=str),
         support_vert_start=start[n:] - start[n],
         support_vert_local=m.vert_local[start[n] :].copy(),
-        triangles=sim.triangles,
+        triangles=np.unique(np.sort(sim.triangles, axis=1), axis=0),  # each drawn once (fans share them)
         friction=m.friction,
         dt=m.dt,
     )

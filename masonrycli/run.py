@@ -18,7 +18,7 @@ from masonrycli.engine.solver import Solver, StepStats
 from masonrycli.frame import CONTACT_OPEN, Frame
 from masonrycli.mechanism import JointTracker, reported_status
 from masonrycli.model import Model, State, build_model, initial_state
-from masonrycli.tensors import TensorComputer, build_triangles
+from masonrycli.tensors import TensorComputer, build_triangles, chain_neighbours
 
 DIVERGENCE_SPEED = 1e3
 """m/s: a block faster than this (or a non-finite state) stops the run as diverged."""
@@ -66,7 +66,9 @@ class Simulation:
         weight = float(np.mean(m.body_mass[:n]) * np.hypot(*m.gravity)) if n else 0.0
         s = self.solver
         self.joints = JointTracker(body, s.contact_point, s.contact_normal, s.contact_gap, m.body_q0, n, weight)
-        self.tensors = TensorComputer(n, m.block_volume, self.triangles, centroids0=m.body_q0[:n, :2])
+        self.tensors = TensorComputer(
+            n, m.block_volume, self.triangles, centroids0=m.body_q0[:n, :2], chain=chain_neighbours(n, body)
+        )
         self.energy_dissipated = 0.0
         self.support_work = 0.0
         self.last: StepStats | None = None

@@ -14,14 +14,19 @@ Definitions (DESIGN §3; paper eqs. 1–12)
 * **Cell** of block i: block i plus the distinct *blocks* (not supports) having at least one contact
   with i in the current contact list — every listed contact counts, open ones (inside the alert
   distance) included. Cell stress (eq. 12): Σ V_b σ_b / Σ V_b over the cell.
-* **Strain rate** (eqs. 1–5): triangles of centroids fixed at set-up (``build_triangles``); in each,
-  the centroid velocities are interpolated linearly over the *current* centroid positions, giving a
-  constant gradient L_T (L_ij = ∂v_i/∂x_j) and D_T = sym(L_T). Cell strain rate of i =
-  Σ_{T∋i} A_T D_T / Σ_{T∋i} A_T with A_T the current area (signed with respect to the initial
-  counter-clockwise orientation, so equal to the area until a triangle inverts). NaN for a block in
-  no triangle, and for a step in which the star of i has folded (Σ A_T ≤ 0).
-  For a vertex i whose star of triangles is closed (an interior vertex), Σ_{T∋i} A_T ∇N_i^T = 0, so
-  i's own cell strain rate does not depend on v_i — only on its ring of neighbours.
+* **Strain rate** (eqs. 1–5): the cell of block i is the fan of triangles with apex G_i and opposite
+  edge G_j G_k over i's neighbours (Fig. I.1), fixed at set-up (``build_triangles``); in each, the
+  centroid velocities are interpolated linearly over the *current* centroid positions, giving a constant
+  gradient L_T (L_ij = ∂v_i/∂x_j) and D_T = sym(L_T). Cell strain rate of i = Σ_{T of i} A_T D_T /
+  Σ_{T of i} A_T with A_T the current area (signed with respect to the initial counter-clockwise
+  orientation, so equal to the area until a triangle inverts). NaN for a block without a triangle, and
+  for a step in which its fan has folded (Σ A_T ≤ ``FOLDED_FRACTION`` of its initial area).
+  For a closed fan (an interior block), Σ_T A_T ∇N_i^T = 0, so i's own cell strain rate does not
+  depend on v_i — only on its ring of neighbours.
+* **Chain strain rate**: a block with exactly two neighbouring blocks and no support (a voussoir of a
+  bare ring) has a fan of at most one triangle, a sliver across the ring that ``build_triangles``
+  drops; its 1-D strain rate along the chain, d(l_ij + l_ik)/dt / (l_ij + l_ik) over its two links to
+  the neighbours' centroids, carries the hinge-opening signal instead (NaN for other blocks).
 * **Cumulated strain**: ε ← ε + dt · D each ``step`` (explicit, with the rate at the state passed
   in). Starts at 0 (NaN for blocks in no triangle, which stay NaN); a step whose rate is NaN leaves
   the strain unchanged.
@@ -39,8 +44,9 @@ default e = 1 m these are N/m and σ is in Pa either way.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
-from scipy.spatial import Delaunay
 
 from masonrycli.engine import tensor_kernels as _k
 
@@ -62,6 +68,7 @@ TENSOR_FIELDS: dict[str, tuple[tuple[int, ...], str, str]] = {
     "cell_principal_strain_angle": ((), "rad", "direction of ε1 from x, counter-clockwise, in (−π/2, π/2]"),
     "cell_volumetric_strain": ((), "1", "volumetric cumulated strain ε1 + ε2 (trace)"),
     "cell_deviatoric_strain": ((), "1", "deviatoric cumulated strain (ε1 − ε2) / 2 ≥ 0"),
+    "chain_strain_rate": ((), "1/s", "1-D strain rate along a one-block chain, d(l_ij + l_ik)/dt / (l_ij + l_ik)"),
 }
 """Every per-block field of ``TensorComputer.fields()``, in order: name → (shape after the leading
 block axis N, unit, description)."""
@@ -85,17 +92,19 @@ _LAYOUT: dict[str, tuple[str, int]] = {
     "cell_principal_strain_angle": ("scalar", _k.S_STRAIN_ANGLE),
     "cell_volumetric_strain": ("scalar", _k.S_STRAIN_VOLUMETRIC),
     "cell_deviatoric_strain": ("scalar", _k.S_STRAIN_DEVIATORIC),
+    "chain_strain_rate": ("chain", 0),
 }
 assert list(_LAYOUT) == list(TENSOR_FIELDS)
 
 FOLDED_FRACTION = 0.25
-"""A cell whose star of triangles has shrunk to this fraction of its initial area (the structure is
+"""A cell whose fan of triangles has shrunk to this fraction of its initial area (the structure is
 falling apart there) gets NaN strain rate and keeps its cumulated strain: the gradient of a nearly flat
 triangle is not a strain of the masonry (a collapsing aqueduct gave −342 1/s without this guard)."""
 
-DEGENERATE_AREA = 1e-12
-"""``build_triangles`` drops triangles whose area is below this times scale², scale being the diagonal
-of the bounding box of the initial centroids."""
+MIN_ANGLE = math.radians(10.0)
+"""``build_triangles`` drops fan triangles whose smallest angle is below this: across a ring of voussoirs
+the fan of a block is a sliver (11 mm high on a 414 mm base in the arch) whose gradient across the ring
+is noise."""
 
 
 # ---------------------------------------------------------------------------------------------------
@@ -104,13 +113,12 @@ of the bounding box of the initial centroids."""
 
 
 def build_triangles(centroids0: np.ndarray, touching_pairs: np.ndarray) -> np.ndarray:
-    """Triangles of block centroids for the strain rate, fixed for the whole run.
+    """The cells' triangles (the paper's Fig. I.1), fixed for the whole run.
 
-    Delaunay triangulation of the initial centroids, keeping only the triangles whose three edges join
-    blocks that touch; where that leaves a hole because Delaunay chose an edge between blocks that do
-    not touch, the hole is filled with triangles of mutually touching blocks that overlap no kept
-    triangle (``_complete_with_cliques``); degenerate ones (area < ``DEGENERATE_AREA`` · scale²) are
-    dropped.
+    For each block i, its neighbours (blocks touching it initially; supports are not grains) sorted by
+    the direction of G_j − G_i; each two angularly consecutive neighbours j, k less than 180° apart
+    give the triangle (i, j, k) — j and k need not touch. Triangles whose smallest angle is below
+    ``MIN_ANGLE`` are dropped (slivers across a ring). A gap of 180° or more is the cell's free edge.
 
     Args:
         centroids0: (N, 2) initial block centroids, m.
@@ -119,110 +127,81 @@ def build_triangles(centroids0: np.ndarray, touching_pairs: np.ndarray) -> np.nd
             pairs involving supports (index ≥ N) are allowed; the latter are ignored.
 
     Returns:
-        (T, 3) int64 block indices, each row counter-clockwise in the initial configuration and
-        starting with its smallest index, rows sorted lexicographically (deterministic). (0, 3) when
-        fewer than three blocks or all centroids collinear (e.g. a column).
+        (T, 3) int64 rows (apex i, j, k), counter-clockwise in the initial configuration, sorted
+        lexicographically (deterministic); the cell of i is the rows whose first entry is i. (0, 3)
+        when no block has a well-shaped triangle (e.g. a column).
     """
     points = np.asarray(centroids0, dtype=np.float64)
     if points.ndim != 2 or points.shape[1] != 2:
         raise ValueError(f"centroids0 must have shape (N, 2), got {points.shape}")
     n = points.shape[0]
-    empty = np.zeros((0, 3), np.int64)
+    apex, first, second = _fan_pairs(n, _block_pairs(touching_pairs, n), points)
+    p0, p1, p2 = points[apex], points[first], points[second]
+    # smallest angle: the one opposite the shortest side, from the area and the two sides around it
+    sides = np.stack([np.hypot(*(p2 - p1).T), np.hypot(*(p0 - p2).T), np.hypot(*(p1 - p0).T)], axis=1)
+    area2 = (p1[:, 0] - p0[:, 0]) * (p2[:, 1] - p0[:, 1]) - (p1[:, 1] - p0[:, 1]) * (p2[:, 0] - p0[:, 0])
+    s = np.sort(sides, axis=1)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        sin_min = area2 / (s[:, 1] * s[:, 2])
+    keep = (area2 > 0) & (np.arcsin(np.clip(sin_min, 0.0, 1.0)) >= MIN_ANGLE)
+    tri = np.stack([apex, first, second], axis=1)[keep].astype(np.int64)
+    order = np.lexsort((tri[:, 2], tri[:, 1], tri[:, 0]))
+    return np.ascontiguousarray(tri[order]).reshape(-1, 3)
+
+
+def chain_neighbours(block_count: int, touching_pairs: np.ndarray) -> np.ndarray:
+    """(N, 2) int64: the two neighbouring blocks of each block in a one-block chain, (−1, −1) otherwise.
+
+    A block is in a one-block chain when it touches exactly two blocks and no support initially (a
+    voussoir of a bare ring, the springing voussoirs included). ``touching_pairs`` as for
+    ``build_triangles``, supports included.
+    """
+    n = int(block_count)
     pairs = np.asarray(touching_pairs, dtype=np.int64).reshape(-1, 2)
-    if n < 3 or pairs.shape[0] == 0:
-        return empty
-    scale = float(np.hypot(*np.ptp(points, axis=0)))
-    if scale == 0.0:
-        return empty
-    # All collinear (Qhull would refuse): distance of every point to the line through p0 and the
-    # point farthest from it.
-    rel = points - points[0]
-    far = rel[np.argmax(np.einsum("ij,ij->i", rel, rel))]
-    off_line = np.abs(rel[:, 0] * far[1] - rel[:, 1] * far[0]) / np.hypot(far[0], far[1])
-    if off_line.max() <= DEGENERATE_AREA * scale:
-        return empty
+    pairs = pairs[pairs[:, 0] != pairs[:, 1]]
+    on_support = np.zeros(n, bool)
+    for side in range(2):
+        mine, other = pairs[:, side], pairs[:, 1 - side]
+        on_support[mine[(mine < n) & (other >= n)]] = True
+    blocks = _block_pairs(pairs, n)
+    both = np.concatenate([blocks, blocks[:, ::-1]])
+    both = both[np.lexsort((both[:, 1], both[:, 0]))]
+    count = np.bincount(both[:, 0], minlength=n)
+    out = np.full((n, 2), -1, np.int64)
+    chain = (count == 2) & ~on_support
+    start = np.r_[0, np.cumsum(count)[:-1]]
+    out[chain, 0] = both[start[chain], 1]
+    out[chain, 1] = both[start[chain] + 1, 1]
+    return out
 
-    tri = Delaunay(points).simplices.astype(np.int64)
 
+def _block_pairs(touching_pairs, n: int) -> np.ndarray:
+    """(P, 2) distinct block pairs (lo < hi) of ``touching_pairs``, supports and self-pairs left out."""
+    pairs = np.asarray(touching_pairs, dtype=np.int64).reshape(-1, 2)
     lo, hi = np.minimum(pairs[:, 0], pairs[:, 1]), np.maximum(pairs[:, 0], pairs[:, 1])
     valid = (lo >= 0) & (hi < n) & (lo != hi)
-    touch_keys = np.unique(lo[valid] * n + hi[valid])
-    e_lo = np.minimum(tri, np.roll(tri, -1, axis=1))
-    e_hi = np.maximum(tri, np.roll(tri, -1, axis=1))
-    keep = np.isin(e_lo * n + e_hi, touch_keys).all(axis=1)
-    tri = _complete_with_cliques(points, tri[keep], touch_keys, n, DEGENERATE_AREA * scale * scale)
-
-    p0, p1, p2 = points[tri[:, 0]], points[tri[:, 1]], points[tri[:, 2]]
-    area2 = (p1[:, 0] - p0[:, 0]) * (p2[:, 1] - p0[:, 1]) - (p1[:, 1] - p0[:, 1]) * (p2[:, 0] - p0[:, 0])
-    tri[area2 < 0] = tri[area2 < 0][:, [0, 2, 1]]
-    tri = tri[0.5 * np.abs(area2) >= DEGENERATE_AREA * scale * scale]
-    if tri.shape[0] == 0:
-        return empty
-
-    first = np.argmin(tri, axis=1)
-    tri = tri[np.arange(tri.shape[0])[:, None], (first[:, None] + np.arange(3)) % 3]
-    order = np.lexsort((tri[:, 2], tri[:, 1], tri[:, 0]))
-    return np.ascontiguousarray(tri[order])
+    keys = np.unique(lo[valid] * n + hi[valid])
+    return np.stack([keys // max(n, 1), keys % max(n, 1)], axis=1)
 
 
-def _complete_with_cliques(points, tri, touch_keys, n, min_area) -> np.ndarray:
-    """Fill the holes Delaunay leaves where its edge joins two blocks that do not touch.
-
-    Where four blocks touch each other (two courses of a two-block pier, say), Delaunay may pick the
-    diagonal between the two that do not touch, and the filter then drops both triangles. Every triple
-    of mutually touching blocks is a candidate; candidates are added, smallest first, when they overlap
-    no triangle kept so far. Set-up only (once per run); the result stays deterministic.
-    """
-    lo, hi = touch_keys // n, touch_keys % n
-    neighbours = [set() for _ in range(n)]
-    for i, j in zip(lo.tolist(), hi.tolist()):
-        neighbours[i].add(j)
-        neighbours[j].add(i)
-    cliques = [
-        (i, j, k) for i, j in zip(lo.tolist(), hi.tolist()) for k in sorted(neighbours[i] & neighbours[j]) if k > j
-    ]
-    if not cliques:
-        return tri
-    cand = np.array(cliques, dtype=np.int64)
-    have = {tuple(sorted(t)) for t in tri.tolist()}
-    cand = cand[[tuple(c) not in have for c in cand.tolist()]]
-    p = points[cand]
-    area = 0.5 * np.abs(
-        (p[:, 1, 0] - p[:, 0, 0]) * (p[:, 2, 1] - p[:, 0, 1]) - (p[:, 1, 1] - p[:, 0, 1]) * (p[:, 2, 0] - p[:, 0, 0])
-    )
-    cand = cand[area >= min_area]
-    area = area[area >= min_area]
-    order = np.lexsort((cand[:, 2], cand[:, 1], cand[:, 0], area))
-    kept = [t for t in tri]
-    kept_pts = [points[t] for t in tri]
-    for c in cand[order]:
-        pc = points[c]
-        if kept_pts and _overlaps_any(pc, np.array(kept_pts), min_area):
-            continue
-        kept.append(c)
-        kept_pts.append(pc)
-    return np.array(kept, dtype=np.int64).reshape(-1, 3)
-
-
-def _overlaps_any(tri_pts: np.ndarray, others: np.ndarray, min_area: float) -> bool:
-    """Does triangle ``tri_pts`` (3, 2) overlap any of ``others`` (M, 3, 2) with positive area?
-
-    Separating axes of two triangles: the six edge normals. They overlap when every axis shows an
-    overlap of the projections longer than a tolerance (triangles sharing an edge or a vertex touch
-    but do not overlap).
-    """
-    tol = np.sqrt(min_area)
-    both = [np.broadcast_to(tri_pts, others.shape), others]
-    separated = np.zeros(others.shape[0], dtype=bool)
-    for shape in both:
-        edges = np.roll(shape, -1, axis=1) - shape  # (M, 3, 2)
-        normals = np.stack([-edges[..., 1], edges[..., 0]], -1)  # (M, 3, 2)
-        normals /= np.linalg.norm(normals, axis=-1, keepdims=True)
-        pa = np.einsum("mkd,mvd->mkv", normals, both[0])  # (M, 3 axes, 3 vertices)
-        pb = np.einsum("mkd,mvd->mkv", normals, both[1])
-        overlap = np.minimum(pa.max(-1), pb.max(-1)) - np.maximum(pa.min(-1), pb.min(-1))
-        separated |= (overlap <= tol).any(axis=1)
-    return not separated.all()
+def _fan_pairs(n: int, pairs: np.ndarray, points: np.ndarray):
+    """Candidate fan triangles (apex, j, k): angularly consecutive neighbours less than π apart."""
+    apex = np.concatenate([pairs[:, 0], pairs[:, 1]])
+    other = np.concatenate([pairs[:, 1], pairs[:, 0]])
+    d = points[other] - points[apex]
+    angle = np.arctan2(d[:, 1], d[:, 0])
+    order = np.lexsort((other, angle, apex))
+    apex, other, angle = apex[order], other[order], angle[order]
+    count = np.bincount(apex, minlength=n)
+    start = np.r_[0, np.cumsum(count)[:-1]]
+    # next neighbour counter-clockwise, cyclic within each apex's run
+    pos = np.arange(apex.size)
+    nxt = pos + 1
+    last = pos == start[apex] + count[apex] - 1
+    nxt[last] = start[apex[last]]
+    gap = np.mod(angle[nxt] - angle, 2.0 * np.pi)
+    ok = (count[apex] >= 2) & (gap > 0.0) & (gap < np.pi)
+    return apex[ok], other[ok], other[nxt][ok]
 
 
 # ---------------------------------------------------------------------------------------------------
@@ -270,13 +249,13 @@ def cell_average(block_count, block_tensor, block_volume, contact_body) -> np.nd
 
 
 def cell_strain_rate(block_count, block_q, block_v, triangles, min_area=None) -> np.ndarray:
-    """Cell strain rate (eqs. 1–5): area-weighted mean of sym(grad v) over the triangles of each block.
+    """Cell strain rate (eqs. 1–5): area-weighted mean of sym(grad v) over the fan of each block.
 
     Args:
         block_count: N.
         block_q: (B ≥ N, 3) current centroid x, y (m), θ; block_v: (B ≥ N, 3) vx, vy (m/s), ω.
-        triangles: (T, 3) int block indices from ``build_triangles``.
-        min_area: (N,) m², optional: a star whose area is not above it gives NaN (default 0).
+        triangles: (T, 3) int block indices (apex first) from ``build_triangles``.
+        min_area: (N,) m², optional: a fan whose area is not above it gives NaN (default 0).
 
     Returns:
         (N, 2, 2) symmetric, 1/s; NaN rows for blocks in no triangle.
@@ -284,6 +263,16 @@ def cell_strain_rate(block_count, block_q, block_v, triangles, min_area=None) ->
     out = np.empty((block_count, 2, 2))
     floor = np.zeros(block_count) if min_area is None else _f64(min_area)
     _k._cell_strain_rate(block_count, _f64(block_q), _f64(block_v), _triangles(triangles, block_count), floor, out)
+    return out
+
+
+def chain_strain_rate(block_count, block_q, block_v, chain) -> np.ndarray:
+    """(N,) 1/s: the 1-D strain rate of each block's two links in a one-block chain (NaN off chains).
+
+    ``chain``: (N, 2) int from ``chain_neighbours``; block_q, block_v as for ``cell_strain_rate``.
+    """
+    out = np.empty(block_count)
+    _k._chain_strain_rate(block_count, _f64(block_q), _f64(block_v), _chain(chain, block_count), out)
     return out
 
 
@@ -322,11 +311,19 @@ class TensorComputer:
     Args:
         block_count: N.
         block_volume: (N,) block area · thickness, m³ (> 0).
-        triangles: (T, 3) int block indices, from ``build_triangles`` on the initial configuration.
+        triangles: (T, 3) int block indices (apex first), from ``build_triangles`` on the initial
+            configuration.
+        centroids0: (N, 2) m, optional: the initial centroids, for the folded-fan floor.
+        chain: (N, 2) int, optional: ``chain_neighbours`` (default: no block in a chain).
     """
 
     def __init__(
-        self, block_count: int, block_volume: np.ndarray, triangles: np.ndarray, centroids0: np.ndarray | None = None
+        self,
+        block_count: int,
+        block_volume: np.ndarray,
+        triangles: np.ndarray,
+        centroids0: np.ndarray | None = None,
+        chain: np.ndarray | None = None,
     ):
         n = int(block_count)
         if n < 0:
@@ -343,9 +340,11 @@ class TensorComputer:
         """(T, 3) int64 block indices."""
         self.has_triangle = np.zeros(n, bool)
         """(N,) True for the blocks with at least one triangle (finite strain rate and strain)."""
-        self.has_triangle[self.triangles.ravel()] = True
+        self.has_triangle[self.triangles[:, 0]] = True
+        self.chain = _chain(np.full((n, 2), -1) if chain is None else chain, n)
+        """(N, 2) int64 neighbours of the blocks in a one-block chain, −1 elsewhere."""
         self.min_star_area = np.zeros(n)
-        """(N,) m²: a cell whose star of triangles is not larger than this has no strain rate that step
+        """(N,) m²: a cell whose fan of triangles is not larger than this has no strain rate that step
         (``FOLDED_FRACTION`` of its initial area when ``centroids0`` is given, else 0)."""
         if centroids0 is not None and self.triangles.size:
             p = np.asarray(centroids0, dtype=np.float64)[self.triangles]
@@ -353,14 +352,12 @@ class TensorComputer:
                 (p[:, 1, 0] - p[:, 0, 0]) * (p[:, 2, 1] - p[:, 0, 1])
                 - (p[:, 1, 1] - p[:, 0, 1]) * (p[:, 2, 0] - p[:, 0, 0])
             )
-            star = np.zeros(n)
-            for m in range(3):
-                np.add.at(star, self.triangles[:, m], area)
-            self.min_star_area = FOLDED_FRACTION * star
+            self.min_star_area = FOLDED_FRACTION * np.bincount(self.triangles[:, 0], weights=area, minlength=n)
         self._tensor = np.full((_k.TENSOR_ROWS, n, 2, 2), np.nan)
         self._pair = np.full((_k.PAIR_ROWS, n, 2), np.nan)
         self._scalar = np.full((_k.SCALAR_ROWS, n), np.nan)
-        self._buffers = {"tensor": self._tensor, "pair": self._pair, "scalar": self._scalar}
+        self._chain_rate = np.full((1, n), np.nan)
+        self._buffers = {"tensor": self._tensor, "pair": self._pair, "scalar": self._scalar, "chain": self._chain_rate}
         self._invariants_stale = False
         self.reset_strain()
 
@@ -407,11 +404,13 @@ class TensorComputer:
             self.block_volume,
             self.triangles,
             self.min_star_area,
+            self.chain,
             contact_body,
             contact_point,
             contact_force,
             float(dt),
             self._tensor,
+            self._chain_rate[0],
         )
         self._invariants_stale = True
 
@@ -430,6 +429,13 @@ class TensorComputer:
 
 def _f64(a) -> np.ndarray:
     return np.asarray(a, dtype=np.float64)
+
+
+def _chain(chain, block_count: int) -> np.ndarray:
+    out = np.ascontiguousarray(np.asarray(chain, dtype=np.int64).reshape(-1, 2))
+    if out.shape[0] != block_count or out.max(initial=-1) >= block_count:
+        raise ValueError(f"chain must have shape ({block_count}, 2) with indices < {block_count}")
+    return out
 
 
 def _triangles(triangles, block_count: int) -> np.ndarray:

@@ -45,9 +45,8 @@ def ref_strain_rate(n, q, v, triangles):
         sol = np.linalg.solve(a, vel)
         grad = sol[:2].T  # L_ij = dv_i/dx_j
         area = 0.5 * np.linalg.det(np.array([x[1] - x[0], x[2] - x[0]]).T)
-        for i in tri:
-            num[i] += area * 0.5 * (grad + grad.T)
-            den[i] += area
+        num[tri[0]] += area * 0.5 * (grad + grad.T)  # the triangle belongs to the cell of its apex
+        den[tri[0]] += area
     out = np.full((n, 2, 2), np.nan)
     has = den > 0
     out[has] = num[has] / den[has, None, None]
@@ -141,7 +140,8 @@ def test_cell_strain_rate_matches_reference(seed):
     for j in range(ny - 1):
         for i in range(nx - 1):
             p = j * nx + i
-            tris += [[p, p + 1, p + nx + 1], [p, p + nx + 1, p + nx]]
+            for a, b, c in ((p, p + 1, p + nx + 1), (p, p + nx + 1, p + nx)):  # each in its 3 cells
+                tris += [[a, b, c], [b, c, a], [c, a, b]]
     tris = np.array(tris, np.int64)
     v = rng.normal(size=(n + 1, 3))
     out = np.empty((n, 2, 2))
@@ -233,9 +233,10 @@ def test_principal_uses_symmetric_part_and_factors():
 
 
 def test_cell_strain_rate_flat_or_inverted_star_is_nan():
-    # one triangle (0, 1, 2), CCW at set-up; flattened now (area 0) → NaN; inverted (area < 0) → NaN
+    # one triangle (0, 1, 2), CCW at set-up, in the fan of each of its blocks; flattened now (area 0)
+    # → NaN; inverted (area < 0) → NaN
     v = np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 2.0, 0.0]])
-    tri = np.array([[0, 1, 2]])
+    tri = np.array([[0, 1, 2], [1, 2, 0], [2, 0, 1]])
     out = np.empty((3, 2, 2))
     flat = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [2.0, 0.0, 0.0]]
     inverted = [[0.0, 0.0, 0.0], [0.0, 1.0, 0.0], [1.0, 0.0, 0.0]]
@@ -250,7 +251,7 @@ def test_cell_strain_rate_collapsed_star_below_floor_is_nan():
     # The same triangle squashed to 10 % of its area: finite without a floor, NaN with a floor of 25 %
     # of the initial area (0.5 m²), as TensorComputer sets it from the initial centroids.
     v = np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 2.0, 0.0]])
-    tri = np.array([[0, 1, 2]])
+    tri = np.array([[0, 1, 2], [1, 2, 0], [2, 0, 1]])
     q = np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.1, 0.0]])
     out = np.empty((3, 2, 2))
     K._cell_strain_rate(3, q, v, tri, np.zeros(3), out)

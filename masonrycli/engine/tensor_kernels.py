@@ -147,14 +147,15 @@ def _cell_average(block_count, start, neighbour, block_volume, block_tensor, out
 # ---------------------------------------------------------------------------------------------------
 
 
-# per triangle T = (i, j, k) (CCW in the initial configuration), current centroids x, velocities v:
+# per triangle T = (i, j, k) of the fan of cell i (apex i first, CCW in the initial configuration),
+# current centroids x, velocities v:
 #     E = [x_j − x_i, x_k − x_i]    W = [v_j − v_i, v_k − v_i]      (columns)
 #     L_T = W E⁻¹,  A_T = det(E)/2  ⇒  A_T L_T = ½ W adj(E)          (no division: finite even when flat)
-#     add A_T L_T and A_T to each of i, j, k
-# cell i: D_i = sym(Σ A_T L_T) / Σ A_T ; NaN if i has no triangle or Σ A_T ≤ min_area_i (the star has
+#     add A_T L_T and A_T to cell i only (the paper's cell: the triangles with apex G_i)
+# cell i: D_i = sym(Σ A_T L_T) / Σ A_T ; NaN if i has no triangle or Σ A_T ≤ min_area_i (the fan has
 # folded over or collapsed: the gradient of a nearly flat triangle says nothing about the masonry)
-# A_T is signed (positive unless the triangle has inverted), which keeps Σ_T A_T ∇N_i = 0 around an
-# interior vertex exactly, whatever the current shape.
+# A_T is signed (positive unless the triangle has inverted), which keeps Σ_T A_T ∇N_i = 0 around a
+# closed fan exactly, whatever the current shape.
 @njit
 def _cell_strain_rate(block_count, block_q, block_v, triangles, min_area, out):
     # Inputs: block_q, block_v (>=N,3), triangles (T,3), min_area (N,) m² ; Outputs: out (N,2,2) 1/s
@@ -178,13 +179,11 @@ def _cell_strain_rate(block_count, block_q, block_v, triangles, min_area, out):
         l10 = 0.5 * (w1y * e2y - w2y * e1y)
         l11 = 0.5 * (w2y * e1x - w1y * e2x)
         sym = 0.5 * (l01 + l10)
-        for m in range(3):
-            v = triangles[t, m]
-            area[v] += a_t
-            out[v, 0, 0] += l00
-            out[v, 0, 1] += sym
-            out[v, 1, 0] += sym
-            out[v, 1, 1] += l11
+        area[i] += a_t
+        out[i, 0, 0] += l00
+        out[i, 0, 1] += sym
+        out[i, 1, 0] += sym
+        out[i, 1, 1] += l11
     for i in range(block_count):
         if area[i] > 0.0 and area[i] > min_area[i]:
             inv = 1.0 / area[i]
@@ -194,6 +193,30 @@ def _cell_strain_rate(block_count, block_q, block_v, triangles, min_area, out):
             out[i, 1, 1] *= inv
         else:
             out[i, :, :] = np.nan
+
+
+# block i in a one-block chain between blocks j and k (chain[i] = (j, k), −1 otherwise):
+#     ε̇_i = d(l_ij + l_ik)/dt / (l_ij + l_ik),  dl_ij/dt = u_ij · (v_j − v_i),  u_ij = (x_j − x_i)/l_ij
+# (the 1-D strain rate of the chain's two links: > 0 when the joints open, as at a hinge)
+@njit
+def _chain_strain_rate(block_count, block_q, block_v, chain, out):
+    # Inputs: block_q, block_v (>=N,3), chain (N,2) int64 ; Outputs: out (N,) 1/s, NaN off chains
+    for i in range(block_count):
+        out[i] = np.nan
+        if chain[i, 0] < 0:
+            continue
+        rate = 0.0
+        length = 0.0
+        for side in range(2):
+            j = chain[i, side]
+            dx = block_q[j, 0] - block_q[i, 0]
+            dy = block_q[j, 1] - block_q[i, 1]
+            lij = math.hypot(dx, dy)
+            if lij > 0.0:
+                rate += (dx * (block_v[j, 0] - block_v[i, 0]) + dy * (block_v[j, 1] - block_v[i, 1])) / lij
+            length += lij
+        if length > 0.0:
+            out[i] = rate / length
 
 
 # strain_i += dt · rate_i where rate_i is finite (a block without triangle has NaN strain from the
@@ -209,14 +232,6 @@ def _integrate_strain(rate, dt, strain):
             strain[i, 1, 1] += dt * rate[i, 1, 1]
 
 
-# ---------------------------------------------------------------------------------------------------
-# Joint state per block
-# ---------------------------------------------------------------------------------------------------
-
-
-# for each contact, for each of its bodies that is a block:
-#     closed += status ≠ open ; slipping += status = slip ; opening = max(opening, gap)
-# sliding ratio = slipping / closed (0 if no closed contact); opening starts at 0 (so ≥ 0)
 # ---------------------------------------------------------------------------------------------------
 # Closed-form 2×2 symmetric eigen-decomposition and invariants
 # ---------------------------------------------------------------------------------------------------
@@ -262,7 +277,7 @@ def _principal(tensor, out_values, out_angle, out_isotropic, out_deviatoric, tra
 # ---------------------------------------------------------------------------------------------------
 
 
-# block stress → cell neighbours → cell stress → strain rate → strain += dt·rate.
+# block stress → cell neighbours → cell stress → strain rate, chain strain rate → strain += dt·rate.
 # The invariants are derived separately (``_tensor_invariants``), only when the fields are read.
 @njit
 def _tensor_step(
@@ -272,14 +287,17 @@ def _tensor_step(
     block_volume,
     triangles,
     min_area,
+    chain,
     contact_body,
     contact_point,
     contact_force,
     dt,
     tensor_out,
+    chain_out,
 ):
     # Inputs: as the kernels above
-    # Outputs: tensor_out (4,N,2,2) rows T_* (tensor_out[T_CELL_STRAIN] in/out: the cumulated strain)
+    # Outputs: tensor_out (4,N,2,2) rows T_* (tensor_out[T_CELL_STRAIN] in/out: the cumulated strain),
+    #          chain_out (N,) chain strain rate
     n = block_count
     block_stress = tensor_out[T_BLOCK_STRESS]
     _block_stress(n, block_q, block_volume, contact_body, contact_point, contact_force, block_stress)
@@ -287,6 +305,7 @@ def _tensor_step(
     _cell_average(n, start, neighbour, block_volume, block_stress, tensor_out[T_CELL_STRESS])
     rate = tensor_out[T_CELL_STRAIN_RATE]
     _cell_strain_rate(n, block_q, block_v, triangles, min_area, rate)
+    _chain_strain_rate(n, block_q, block_v, chain, chain_out)
     if dt != 0.0:
         _integrate_strain(rate, dt, tensor_out[T_CELL_STRAIN])
 
