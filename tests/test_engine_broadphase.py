@@ -57,6 +57,21 @@ def test_world_vertices_match_numpy():
     np.testing.assert_array_equal(out, body_q[body_of_vertex, :2] + vert_local)
 
 
+def test_broadphase_launchers_refuse_mismatched_arrays():
+    body_q, start, vert_local, _ = random_scene(np.random.default_rng(3), 5)
+    with pytest.raises(ValueError, match="world_vertices: body_q has shape \\(4, 3\\)"):
+        world_vertices(body_q[:-1], start, vert_local)
+    with pytest.raises(ValueError, match="world_vertices: body_vert_start .* int32"):
+        world_vertices(body_q, start.astype(np.int32), vert_local)
+    with pytest.raises(ValueError, match="world_vertices: out"):
+        world_vertices(body_q, start, vert_local, np.empty((len(vert_local), 3)))
+    vw = world_vertices(body_q, start, vert_local)
+    with pytest.raises(ValueError, match="body_aabbs: vert_world"):
+        body_aabbs(vw[1:], start, 1e-3)
+    with pytest.raises(ValueError, match="body_aabbs: out"):
+        body_aabbs(vw, start, 1e-3, np.empty((4, 4)))
+
+
 def test_boxes_match_numpy():
     rng = np.random.default_rng(2)
     body_q, start, vert_local, _ = random_scene(rng, 100)
@@ -227,8 +242,10 @@ def test_detect_contacts_is_deterministic_and_grows_buffers():
 def test_detect_contacts_checks_its_inputs():
     body_q, start, vert_local, dynamic, polys = nv.running_bond_wall(rows=2, full_per_row=3)
     buffers = ContactBuffers(start)
-    with pytest.raises(ValueError, match="shapes"):
+    with pytest.raises(ValueError, match="world_vertices: body_q has shape"):
         detect_contacts(body_q[:-1], start, vert_local, dynamic, 1e-3, buffers)
+    with pytest.raises(ValueError, match="candidate_pairs"):
+        detect_contacts(body_q, start, vert_local, dynamic[:-1], 1e-3, buffers)
     q = body_q.copy()
     q[2, 1] = np.nan
     with pytest.raises(FloatingPointError, match="body 2"):

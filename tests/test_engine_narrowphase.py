@@ -7,14 +7,8 @@ import math
 import numpy as np
 import pytest
 
-from masonrycli.engine.narrowphase import (
-    KEY_LIMIT_VERTICES,
-    check_topology,
-    collide_polygons,
-    decode_contact_key,
-    edge_normals,
-    narrowphase,
-)
+from masonrycli.engine.contact_key import KEY_LIMIT_VERTICES, check_topology, decode_contact_key
+from masonrycli.engine.narrowphase import collide_polygons, edge_normals, narrowphase
 
 import naive_collision as nv
 
@@ -477,3 +471,21 @@ def test_narrowphase_refuses_too_small_output():
     small = (np.zeros((1, 2), np.int32), np.zeros((1, 2)), np.zeros((1, 2)), np.zeros(1), np.zeros(1, np.int64))
     with pytest.raises(ValueError, match="capacity"):
         narrowphase(vert, *edge_normals(vert, start), start, pairs, 1, 1e-3, *small)
+
+
+def test_launchers_refuse_mismatched_arrays():
+    vert = np.concatenate([nv.rect(0, 0, 1, 1), nv.rect(1, 0, 2, 1)])
+    start = np.array([0, 4, 8], dtype=np.int64)
+    with pytest.raises(ValueError, match="edge_normals: vert_world has shape \\(7, 2\\)"):
+        edge_normals(vert[:-1], start)
+    with pytest.raises(ValueError, match="edge_normals: body_size"):
+        edge_normals(vert, start, body_size=np.zeros(3))
+    pairs = np.array([[0, 1]], dtype=np.int32)
+    out = (np.zeros((2, 2), np.int32), np.zeros((2, 2)), np.zeros((2, 2)), np.zeros(2), np.zeros(2, np.int64))
+    with pytest.raises(ValueError, match="pair_count 2"):
+        narrowphase(vert, *edge_normals(vert, start), start, pairs, 2, 1e-3, *out)
+    with pytest.raises(ValueError, match="pair_body has shape \\(1, 2\\) int64"):
+        narrowphase(vert, *edge_normals(vert, start), start, pairs.astype(np.int64), 1, 1e-3, *out)
+    with pytest.raises(ValueError, match="contact_key"):
+        narrowphase(vert, *edge_normals(vert, start), start, pairs, 1, 1e-3, *out[:4], np.zeros(2))
+    assert narrowphase(vert, *edge_normals(vert, start), start, pairs, 1, 1e-3, *out) == 2

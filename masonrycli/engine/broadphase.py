@@ -15,6 +15,7 @@ import math
 
 import numpy as np
 
+from ._arrays import check_array, check_vertices
 from ._jit import njit
 
 __all__ = ["PairBuffers", "body_aabbs", "candidate_pairs", "world_vertices"]
@@ -60,8 +61,12 @@ def world_vertices(body_q, body_vert_start, vert_local, out=None):
     vert_world : (V, 2) float64
         ``x_b + R(θ_b) · vert_local`` [m] (``out`` if it was given).
     """
+    where = "world_vertices"
+    vertex_count, body_count = check_vertices(where, "vert_local", vert_local, body_vert_start)
+    check_array(where, "body_q", body_q, (body_count, 3), np.float64)
     if out is None:
-        out = np.empty((vert_local.shape[0], 2), dtype=np.float64)
+        out = np.empty((vertex_count, 2), dtype=np.float64)
+    check_array(where, "out", out, (vertex_count, 2), np.float64)
     _world_vertices(body_q, body_vert_start, vert_local, out)
     return out
 
@@ -118,8 +123,11 @@ def body_aabbs(vert_world, body_vert_start, alert, out=None):
     body_aabb : (B, 4) float64
         ``xmin, ymin, xmax, ymax`` [m] of each body, inflated.
     """
+    where = "body_aabbs"
+    _, body_count = check_vertices(where, "vert_world", vert_world, body_vert_start)
     if out is None:
-        out = np.empty((body_vert_start.shape[0] - 1, 4), dtype=np.float64)
+        out = np.empty((body_count, 4), dtype=np.float64)
+    check_array(where, "out", out, (body_count, 4), np.float64)
     _body_aabbs(vert_world, body_vert_start, 0.5 * float(alert), out)
     return out
 

@@ -4,9 +4,9 @@ Stages (each a numba kernel): world vertices, bounding boxes and sweep-and-prune
 (:mod:`.broadphase`); edge normals and the separating-axis / clipping narrow phase
 (:mod:`.narrowphase`).
 
-Python orchestration only; the work is done by the numba kernels of :mod:`.broadphase` and
-:mod:`.narrowphase`. One :class:`ContactBuffers` per model is reused every step, so that a step
-allocates nothing unless a capacity is exceeded (capacities then double).
+Python orchestration only, through the checking launchers of :mod:`.broadphase` and :mod:`.narrowphase`
+(they check shapes and dtypes; their numba kernels do the work). One :class:`ContactBuffers` per model is
+reused every step, so that a step allocates nothing unless a capacity is exceeded (capacities then double).
 
 Typical use in the time loop::
 
@@ -23,8 +23,9 @@ from typing import NamedTuple
 
 import numpy as np
 
-from .broadphase import PairBuffers, _body_aabbs, _world_vertices, candidate_pairs, world_vertices
-from .narrowphase import _edge_normals, _narrowphase, check_topology, decode_contact_key
+from .broadphase import PairBuffers, body_aabbs, candidate_pairs, world_vertices
+from .contact_key import check_topology, decode_contact_key
+from .narrowphase import edge_normals, narrowphase
 
 __all__ = ["ContactBuffers", "Contacts", "decode_contact_key", "detect_contacts", "world_vertices"]
 
@@ -37,7 +38,7 @@ class Contacts(NamedTuple):
     contact_point: np.ndarray
     """(C, 2) float64: contact point, world coordinates [m]."""
     contact_normal: np.ndarray
-    """(C, 2) float64: unit normal from a to b; the tangent is t = (−n_y, n_x)."""
+    """(C, 2) float64: unit normal from a to b; the tangent is t = (n_y, −n_x)."""
     contact_gap: np.ndarray
     """(C,) float64: gap [m] at detection, < 0 = penetration."""
     contact_key: np.ndarray
@@ -162,17 +163,7 @@ def detect_contacts(body_q, body_vert_start, vert_local, body_dynamic, alert, bu
     if body_vert_start is not buffers._checked_vert_start:
         check_topology(body_vert_start)
         buffers._checked_vert_start = body_vert_start
-    if (
-        body_q.shape != (buffers.body_count, 3)
-        or body_vert_start.shape != (buffers.body_count + 1,)
-        or vert_local.shape != (buffers.vertex_count, 2)
-        or body_dynamic.shape != (buffers.body_count,)
-    ):
-        raise ValueError(
-            f"detect_contacts: shapes body_q {body_q.shape}, body_vert_start {body_vert_start.shape}, "
-            f"vert_local {vert_local.shape}, body_dynamic {body_dynamic.shape} do not match buffers made "
-            f"for {buffers.body_count} bodies and {buffers.vertex_count} vertices"
-        )
+    # Shapes and dtypes are checked by the launchers, against the buffers' arrays.
     if not np.isfinite(body_q).all():
         bad = int(np.flatnonzero(~np.isfinite(body_q).all(axis=1))[0])
         raise FloatingPointError(f"detect_contacts: body {bad} has a non-finite pose {body_q[bad]}")
@@ -180,13 +171,13 @@ def detect_contacts(body_q, body_vert_start, vert_local, body_dynamic, alert, bu
     if not alert >= 0.0:
         raise ValueError(f"detect_contacts: alert distance must be >= 0, got {alert}")
 
-    _world_vertices(body_q, body_vert_start, vert_local, buffers.vert_world)
-    _body_aabbs(buffers.vert_world, body_vert_start, 0.5 * alert, buffers.body_aabb)
+    world_vertices(body_q, body_vert_start, vert_local, buffers.vert_world)
+    body_aabbs(buffers.vert_world, body_vert_start, alert, buffers.body_aabb)
     pair_count = candidate_pairs(buffers.body_aabb, body_dynamic, buffers.pairs)
     if buffers.contact_capacity < 2 * pair_count:  # ≤ 2 contacts per pair: the kernel never overflows
         buffers.grow_contacts(2 * pair_count)
-    _edge_normals(buffers.vert_world, body_vert_start, buffers.edge_normal, buffers.body_size)
-    n = _narrowphase(
+    edge_normals(buffers.vert_world, body_vert_start, buffers.edge_normal, buffers.body_size)
+    n = narrowphase(
         buffers.vert_world, buffers.edge_normal, buffers.body_size, body_vert_start,
         buffers.pairs.pair_body, pair_count, alert,
         buffers.contact_body, buffers.contact_point, buffers.contact_normal, buffers.contact_gap,

@@ -25,28 +25,11 @@ For a candidate pair (a, b) of convex counter-clockwise polygons:
 Two blocks sharing a joint give exactly the two ends of the overlapping segment with gap 0; a block
 on a wide ground gives its two bottom corners; a corner on a face gives one point.
 
-**Contact key** (int64, the same from one step to the next for the same physical contact, used to warm
-start the solver). A contact always sits at a *vertex* of one body against an *edge* of the other: an
-incident end that survived clipping is the incident polygon's vertex against the reference edge; an end
-clipped at a side plane is the reference polygon's vertex (that end of the reference edge) against the
-incident edge. The key encodes that pair of features rather than "which face was the reference", so it
-does not change when the reference face flips between two nearly coincident faces (a joint starting to
-open, a block starting to rock). Where two corners nearly coincide (the incident vertex within
-``snap = max(alert, tol)`` of the side plane: a column, the vertical joints of a course), which of the
-two is "inside" flips with rounding and tiny motions, so the end is then always labelled with the
-corner of body a, against the edge of body b::
+Each contact carries a key naming the touching features (vertex of one body against edge of the other),
+the same from one step to the next: see :mod:`.contact_key`.
 
-    key = a << 40 | b << 17 | owner_is_b << 16 | vertex << 8 | edge
-
-    bits 40..62  a           first body (a < b), < 2**23
-    bits 17..39  b           second body, < 2**23
-    bit  16      owner_is_b  1 if the vertex belongs to b (the edge then belongs to a), 0 otherwise
-    bits  8..15  vertex      local index of the vertex in its polygon, < 256
-    bits  0..7   edge        local index of the edge in the other polygon (edge k joins vertices
-                             k and k+1), < 256
-
-Limits: fewer than 2**23 = 8 388 608 bodies and at most 256 vertices per polygon (checked by the
-launchers). Keys are non-negative and unique within a step. :func:`decode_contact_key` unpacks them.
+The work is split in three kernels per pair, called by :func:`_collide_pair`: :func:`_choose_faces`
+(steps 1–3), :func:`_clip_incident` (step 4) and :func:`_write_pair_contacts` (step 5).
 """
 
 from __future__ import annotations
@@ -55,28 +38,16 @@ import math
 
 import numpy as np
 
+from ._arrays import check_array, check_vertices
 from ._jit import njit
+from .contact_key import _end_label, _make_key, check_topology
 
-__all__ = [
-    "KEY_LIMIT_BODIES",
-    "KEY_LIMIT_VERTICES",
-    "REF_TOL_ABS",
-    "REF_TOL_REL",
-    "check_topology",
-    "collide_polygons",
-    "decode_contact_key",
-    "edge_normals",
-    "narrowphase",
-]
+__all__ = ["REF_TOL_ABS", "REF_TOL_REL", "collide_polygons", "edge_normals", "narrowphase"]
 
 REF_TOL_ABS = 1e-9
 """Absolute part of the face-choice / clipping / merging tolerance, m."""
 REF_TOL_REL = 1e-6
 """Relative part of the tolerance, times the smaller polygon extent of the pair."""
-KEY_LIMIT_BODIES = 1 << 23
-"""Body indices must be below this for the contact key to be unique."""
-KEY_LIMIT_VERTICES = 256
-"""Vertex count per polygon must be at most this for the contact key to be unique."""
 
 
 @njit
@@ -133,10 +104,13 @@ def edge_normals(vert_world, body_vert_start, edge_normal=None, body_size=None):
     -------
     (edge_normal, body_size)
     """
+    vertex_count, body_count = check_vertices("edge_normals", "vert_world", vert_world, body_vert_start)
     if edge_normal is None:
-        edge_normal = np.empty((vert_world.shape[0], 2), dtype=np.float64)
+        edge_normal = np.empty((vertex_count, 2), dtype=np.float64)
     if body_size is None:
-        body_size = np.empty(body_vert_start.shape[0] - 1, dtype=np.float64)
+        body_size = np.empty(body_count, dtype=np.float64)
+    check_array("edge_normals", "edge_normal", edge_normal, (vertex_count, 2), np.float64)
+    check_array("edge_normals", "body_size", body_size, (body_count,), np.float64)
     _edge_normals(vert_world, body_vert_start, edge_normal, body_size)
     return edge_normal, body_size
 
@@ -169,65 +143,21 @@ def _max_face_separation(vert, normal, s1, n1, s2, n2, alert):
 
 
 @njit
-def _make_key(a, b, owner_is_b, vertex, edge):
-    return (
-        (np.int64(a) << 40)
-        | (np.int64(b) << 17)
-        | (np.int64(owner_is_b) << 16)
-        | (np.int64(vertex) << 8)
-        | np.int64(edge)
-    )
-
-
-@njit
-def _end_label(side, t0, ivtx, e, e2, k, length, snap, ref_is_b):
-    # Feature label (owner_is_b, vertex, edge) of one end of the clipped incident segment.
-    #   raw:  clipped at side s → R's vertex (e or e2) against I's incident edge k
-    #         not clipped       → I's vertex ivtx against R's reference edge e
-    #   aligned corners: if the incident vertex lies within `snap` of the side plane (|t0 − 0| or
-    #   |t0 − L| ≤ snap), the end is at two nearly coincident corners, one of R and one of I; which one
-    #   is "inside" flips with rounding and tiny motions (a column, the vertical joints of a course),
-    #   so the label is always the corner of body a, against the edge of body b.
-    # snap < 0 gives the raw label.
-    if side >= 0:
-        rv = e if side == 0 else e2
-        aligned = (t0 >= -snap) if side == 0 else (t0 <= length + snap)
-    else:
-        if t0 <= length - t0:
-            rv = e
-            aligned = t0 <= snap
-        else:
-            rv = e2
-            aligned = t0 >= length - snap
-    if aligned:
-        if ref_is_b:
-            return 0, ivtx, e  # a is the incident body: its vertex, against b's reference edge
-        return 0, rv, k  # a is the reference body: its vertex, against b's incident edge
-    if side >= 0:
-        return (1 if ref_is_b else 0), rv, k
-    return (0 if ref_is_b else 1), ivtx, e
-
-
-@njit
-def _collide_pair(
-    vert, normal, size_a, size_b, sa, na, sb, nb, a, b, alert, c,
-    contact_body, contact_point, contact_normal, contact_gap, contact_key,
-):  # fmt: skip
-    # Contacts of the pair (a, b) written from row c on; returns the next free row.
-    #   sep_a, e_a = max face separation of b along a's normals   (> alert → none)
-    #   sep_b, e_b = same with the roles swapped                   (> alert → none)
+def _choose_faces(vert, normal, size_a, size_b, sa, na, sb, nb, alert):
+    # Steps 1–3: separating axes, reference face, incident edge.
+    #   sep_a, e_a = max face separation of b along a's normals   (> alert → no contact)
+    #   sep_b, e_b = same with the roles swapped                   (> alert → no contact)
     #   reference R = b if sep_b > sep_a + tol else a ; incident I = the other polygon
-    #   n = outward normal of R's edge e (v1 → v2), u = (v2 − v1)/|v2 − v1|
-    #   incident edge k = argmin over I's edges of n · n_k; segment w1 = I[k] → w2 = I[k+1]
-    #   in the frame (t, g) = (u·(p − v1), n·(p − v1)): clip [w1, w2] to t ∈ [0, L]
-    #   (ends within tol outside are kept), interpolating g
-    #   each end with g ≤ alert → contact (p − g n / 2, ±n, g, key)
+    #   reference edge e (vertex e → e2) with outward normal n
+    #   incident edge k (vertex k → k2) = argmin over I's edges of n · n_k
+    # Returns (e, e2, k, k2, ref_is_b, rs, is_, tol) with rs / is_ the first vertex rows of R / I;
+    # e = -1 when the pair has no contact.
     sep_a, e_a = _max_face_separation(vert, normal, sa, na, sb, nb, alert)
     if not (sep_a <= alert) or e_a < 0:
-        return c
+        return -1, -1, -1, -1, False, sa, sb, 0.0
     sep_b, e_b = _max_face_separation(vert, normal, sb, nb, sa, na, alert)
     if not (sep_b <= alert) or e_b < 0:
-        return c
+        return -1, -1, -1, -1, False, sa, sb, 0.0
     tol = REF_TOL_ABS + REF_TOL_REL * min(size_a, size_b)
 
     # Reference face: a's unless b's separates clearly more (deterministic on coincident faces).
@@ -237,17 +167,10 @@ def _collide_pair(
     else:
         rs, rn, e, is_, in_ = sa, na, e_a, sb, nb
     e2 = e + 1 if e + 1 < rn else 0
-    v1x = vert[rs + e, 0]
-    v1y = vert[rs + e, 1]
-    v2x = vert[rs + e2, 0]
-    v2y = vert[rs + e2, 1]
     nx = normal[rs + e, 0]
     ny = normal[rs + e, 1]
-    ux = 0.0 - ny  # along the edge, from v1 to v2 (n is u turned by -90°)
-    uy = nx
-    length = ux * (v2x - v1x) + uy * (v2y - v1y)
 
-    # Incident edge: outward normal most anti-parallel to n, i.e. smallest n · n_k.
+    # Incident edge: outward normal most anti-parallel to n, i.e. smallest n · n_k (first on ties).
     k = 0
     best = math.inf
     for i in range(in_):
@@ -260,11 +183,29 @@ def _collide_pair(
             best = d
             k = i
     k2 = k + 1 if k + 1 < in_ else 0
+    return e, e2, k, k2, ref_is_b, rs, is_, tol
 
-    # Ends of the incident segment in the reference frame: t along the edge (from v1), g along n.
-    # Per end: the incident vertex it started as (at t0) and the side plane it was clipped at (-1:
-    # none). A clipped end is placed at v_side + g·n rather than interpolated in x, y: on a joint
-    # (g = 0) it is then exactly the reference vertex.
+
+@njit
+def _clip_incident(vert, rs, e, e2, is_, k, k2, nx, ny, tol):
+    # Step 4: clip the incident segment w1 = I[k] → w2 = I[k2] to the side planes of R's edge e.
+    #   frame of the edge v1 = R[e] → v2 = R[e2]: u = (−n_y, n_x) (n is u turned by −90°), L = u·(v2 − v1)
+    #   (t, g) = (u·(p − v1), n·(p − v1)) for each end p
+    #   both ends beyond one side plane (by more than tol) → no contact
+    #   an end beyond t = 0 or t = L (by more than tol) moves onto that plane, g interpolated;
+    #   it is placed at v_side + g n rather than interpolated in x, y: on a joint (g = 0) it is then
+    #   exactly the reference vertex. Ends within tol outside are kept as they are.
+    # Returns (inside, L, end1, end2) with end = (p_x, p_y, g, t, t0, side): t0 is the incident
+    # vertex's t before clipping, side the plane it was clipped at (0: through v1, 1: through v2,
+    # -1: not clipped).
+    v1x = vert[rs + e, 0]
+    v1y = vert[rs + e, 1]
+    v2x = vert[rs + e2, 0]
+    v2y = vert[rs + e2, 1]
+    ux = 0.0 - ny
+    uy = nx
+    length = ux * (v2x - v1x) + uy * (v2y - v1y)
+
     w1x = vert[is_ + k, 0]
     w1y = vert[is_ + k, 1]
     w2x = vert[is_ + k2, 0]
@@ -277,10 +218,11 @@ def _collide_pair(
     t02 = t2
     side1 = -1
     side2 = -1
+    outside = (0.0, 0.0, 0.0, 0.0, 0.0, -1)
 
     # Side plane through v1 (t ≥ 0).
     if t1 < -tol and t2 < -tol:
-        return c
+        return False, length, outside, outside
     if t1 < -tol:
         lam = min(t1 / (t1 - t2), 1.0)  # ≤ 1: never beyond the other end (kept within tol)
         g1 = g1 + lam * (g2 - g1)
@@ -295,7 +237,7 @@ def _collide_pair(
     d1 = length - t1
     d2 = length - t2
     if d1 < -tol and d2 < -tol:
-        return c
+        return False, length, outside, outside
     if d1 < -tol:
         lam = min(d1 / (d1 - d2), 1.0)
         g1 = g1 + lam * (g2 - g1)
@@ -317,7 +259,22 @@ def _collide_pair(
     else:
         p2x = (v1x if side2 == 0 else v2x) + g2 * nx
         p2y = (v1y if side2 == 0 else v2y) + g2 * ny
+    return True, length, (p1x, p1y, g1, t1, t01, side1), (p2x, p2y, g2, t2, t02, side2)
 
+
+@njit
+def _write_pair_contacts(
+    a, b, ref_is_b, e, e2, k, k2, nx, ny, length, tol, alert, end1, end2, c,
+    contact_body, contact_point, contact_normal, contact_gap, contact_key,
+):  # fmt: skip
+    # Step 5: the clipped ends (see _clip_incident) → contacts of the pair, written from row c on.
+    #   each end with g ≤ alert is a contact; two kept ends closer than tol are one (keep the end at an
+    #   incident vertex)
+    #   features → key (contact_key._end_label; snap = max(alert, tol) for aligned corners)
+    #   rows ordered by t along the reference edge; point p − g n / 2, normal ±n from a to b, gap g
+    # Rows beyond the capacity are counted, not written. Returns the next free row.
+    p1x, p1y, g1, t1, t01, side1 = end1
+    p2x, p2y, g2, t2, t02, side2 = end2
     keep1 = g1 <= alert
     keep2 = g2 <= alert
     if keep1 and keep2:
@@ -369,6 +326,29 @@ def _collide_pair(
 
 
 @njit
+def _collide_pair(
+    vert, normal, size_a, size_b, sa, na, sb, nb, a, b, alert, c,
+    contact_body, contact_point, contact_normal, contact_gap, contact_key,
+):  # fmt: skip
+    # Contacts of the pair (a, b) written from row c on; returns the next free row.
+    #   faces    = _choose_faces(...)          reference edge e of R, incident edge k of I (or none)
+    #   clipped  = _clip_incident(...)         the incident segment within the reference side planes
+    #   c        = _write_pair_contacts(...)   0..2 contacts with their keys
+    e, e2, k, k2, ref_is_b, rs, is_, tol = _choose_faces(vert, normal, size_a, size_b, sa, na, sb, nb, alert)
+    if e < 0:
+        return c
+    nx = normal[rs + e, 0]
+    ny = normal[rs + e, 1]
+    inside, length, end1, end2 = _clip_incident(vert, rs, e, e2, is_, k, k2, nx, ny, tol)
+    if not inside:
+        return c
+    return _write_pair_contacts(
+        a, b, ref_is_b, e, e2, k, k2, nx, ny, length, tol, alert, end1, end2, c,
+        contact_body, contact_point, contact_normal, contact_gap, contact_key,
+    )  # fmt: skip
+
+
+@njit
 def _narrowphase(
     vert_world, edge_normal, body_size, body_vert_start, pair_body, pair_count, alert,
     contact_body, contact_point, contact_normal, contact_gap, contact_key,
@@ -388,25 +368,6 @@ def _narrowphase(
             contact_body, contact_point, contact_normal, contact_gap, contact_key,
         )  # fmt: skip
     return c
-
-
-def check_topology(body_vert_start) -> None:
-    """Raise ValueError unless the CSR vertex offsets fit the kernels and the contact key.
-
-    ``body_vert_start (B+1,)`` int64: starts at 0, every polygon has 3..256 vertices, B < 2**23.
-    """
-    body_vert_start = np.asarray(body_vert_start)
-    if body_vert_start.ndim != 1 or body_vert_start.shape[0] < 1 or body_vert_start.dtype != np.int64:
-        raise ValueError("body_vert_start must be a 1-D int64 array of B+1 offsets")
-    if body_vert_start[0] != 0:
-        raise ValueError("body_vert_start[0] must be 0")
-    body_count = body_vert_start.shape[0] - 1
-    if body_count >= KEY_LIMIT_BODIES:
-        raise ValueError(f"{body_count} bodies: the contact key allows fewer than {KEY_LIMIT_BODIES}")
-    counts = np.diff(body_vert_start)
-    bad = np.flatnonzero((counts < 3) | (counts > KEY_LIMIT_VERTICES))
-    if bad.size:
-        raise ValueError(f"body {bad[0]} has {counts[bad[0]]} vertices: polygons need 3..{KEY_LIMIT_VERTICES}")
 
 
 def narrowphase(
@@ -436,7 +397,7 @@ def narrowphase(
     contact_point : (C_cap, 2) float64
         Out: contact point, world [m].
     contact_normal : (C_cap, 2) float64
-        Out: unit normal from a to b (tangent t = (−n_y, n_x)).
+        Out: unit normal from a to b (tangent t = (n_y, −n_x), see docs/architecture.md).
     contact_gap : (C_cap,) float64
         Out: gap [m], < 0 = penetration.
     contact_key : (C_cap,) int64
@@ -448,9 +409,24 @@ def narrowphase(
         Rows ``[:contact_count]`` of the outputs are written; contacts of one pair are consecutive,
         pairs in input order. At most 2 per pair: the capacity C_cap must be ≥ 2·pair_count.
     """
+    where = "narrowphase"
+    vertex_count, body_count = check_vertices(where, "vert_world", vert_world, body_vert_start)
+    check_array(where, "edge_normal", edge_normal, (vertex_count, 2), np.float64)
+    check_array(where, "body_size", body_size, (body_count,), np.float64)
+    check_array(where, "pair_body", pair_body, (None, 2), np.int32)
+    if not 0 <= pair_count <= pair_body.shape[0]:
+        raise ValueError(f"{where}: pair_count {pair_count} outside 0..{pair_body.shape[0]} (rows of pair_body)")
     capacity = contact_gap.shape[0]
+    for name, array, shape, dtype in (
+        ("contact_body", contact_body, (capacity, 2), np.int32),
+        ("contact_point", contact_point, (capacity, 2), np.float64),
+        ("contact_normal", contact_normal, (capacity, 2), np.float64),
+        ("contact_gap", contact_gap, (capacity,), np.float64),
+        ("contact_key", contact_key, (capacity,), np.int64),
+    ):
+        check_array(where, name, array, shape, dtype)
     if capacity < 2 * pair_count:
-        raise ValueError(f"narrowphase: capacity {capacity} < 2 x {pair_count} pairs")
+        raise ValueError(f"{where}: capacity {capacity} < 2 x {pair_count} pairs")
     return _narrowphase(
         vert_world, edge_normal, body_size, body_vert_start, pair_body, int(pair_count), float(alert),
         contact_body, contact_point, contact_normal, contact_gap, contact_key,
@@ -491,19 +467,3 @@ def collide_polygons(verts_a, verts_b, alert, a: int = 0, b: int = 1):
         contact_body, contact_point, contact_normal, contact_gap, contact_key,
     )  # fmt: skip
     return contact_point[:c].copy(), contact_normal[:c].copy(), contact_gap[:c].copy(), contact_key[:c].copy()
-
-
-def decode_contact_key(key):
-    """Unpack contact keys (scalar or array) into ``(a, b, owner_is_b, vertex, edge)``.
-
-    ``vertex`` is a local vertex index of body b if ``owner_is_b`` else of body a; ``edge`` is a local
-    edge index of the other body.
-    """
-    key = np.asarray(key, dtype=np.int64)
-    return (
-        key >> 40,
-        (key >> 17) & (KEY_LIMIT_BODIES - 1),
-        (key >> 16) & 1,
-        (key >> 8) & 0xFF,
-        key & 0xFF,
-    )
