@@ -13,8 +13,11 @@ The only package of masonry that imports shapely. It knows nothing about dynamic
 from .blocks import SUPPORT_ROLES, Assembly, Block, GeometryError, Support, ccw_vertices
 from .builders import (
     BUILDERS,
+    AqueductSpec,
     ArchGeometry,
+    ArchSpec,
     WallLayout,
+    WallSpec,
     build_aqueduct,
     build_arch,
     build_wall,
@@ -28,13 +31,16 @@ from .mass import MassProperties, mass_properties
 __all__ = [
     "BUILDERS",
     "SUPPORT_ROLES",
+    "AqueductSpec",
     "ArchGeometry",
+    "ArchSpec",
     "Assembly",
     "Block",
     "GeometryError",
     "MassProperties",
     "Support",
     "WallLayout",
+    "WallSpec",
     "body_label",
     "build_aqueduct",
     "build_arch",

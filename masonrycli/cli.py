@@ -556,7 +556,7 @@ def _write_assembly(builder: str, options: dict, density, thickness, out: Path) 
     if thickness is not None:
         options["thickness"] = thickness
     try:
-        assembly = BUILDERS[builder](**options)
+        assembly = BUILDERS[builder](**options).build()
     except (ValueError, GeometryError) as exc:
         raise InputError(f"{builder}: {exc}") from None
     for warning in validate_assembly(assembly):

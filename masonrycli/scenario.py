@@ -13,7 +13,6 @@ from __future__ import annotations
 
 import dataclasses
 import difflib
-import inspect
 import math
 import os
 import tomllib
@@ -473,11 +472,7 @@ def _polygon(coords, index: int, name: str, kind: str, ctx: _Ctx, loc: str):
     try:
         return checks.polygon_from_coords(coords, index, name, kind)
     except GeometryError as exc:
-        msg = str(exc)
-        label_fn = getattr(checks, "body_label", None)
-        label = f"{label_fn(index, name, kind)}: " if label_fn else ""
-        if label and msg.startswith(label):
-            msg = msg[len(label) :]
+        msg = str(exc).removeprefix(f"{checks.body_label(index, name, kind)}: ")
         raise ctx.error(loc, msg) from None
 
 
@@ -614,61 +609,23 @@ def _validate(assembly: Assembly, ctx: _Ctx) -> tuple[str, ...]:
 # builders
 
 
-def _builders() -> dict:
-    try:
-        from geometry_library.builders import BUILDERS
-    except ImportError as exc:  # pragma: no cover - only while geometry_library is incomplete
-        raise InputError(f"structure builders are not available ({exc})") from None
-    return BUILDERS
+_OPTION_TYPES = {  # spec field annotation (spaces removed) -> what a TOML / CLI value must be
+    "float": "number",
+    "float|None": "number",
+    "int": "int",
+    "int|None": "int",
+    "bool": "bool",
+    "str": "str",
+}
 
 
-def _builder_parameters(fn) -> dict[str, inspect.Parameter]:
-    params = inspect.signature(fn).parameters
-    return {
-        n: p
-        for n, p in params.items()
-        if p.kind in (inspect.Parameter.POSITIONAL_OR_KEYWORD, inspect.Parameter.KEYWORD_ONLY)
-    }
-
-
-def _expected_type(param: inspect.Parameter) -> str:
-    """ "number" | "int" | "bool" | "str" | "" (unknown) from a builder parameter's annotation or default."""
-    ann = param.annotation
-    if ann is inspect.Parameter.empty:
-        ann = ""
-    elif not isinstance(ann, str):
-        ann = getattr(ann, "__name__", str(ann))
+def _check_option_type(key: str, value, spec_field: dataclasses.Field):
+    """Light type check of a builder option against its spec field (the builder validates ranges itself)."""
+    ann = spec_field.type if isinstance(spec_field.type, str) else spec_field.type.__name__
     ann = ann.replace(" ", "")
-    table = {
-        "float": "number",
-        "float|None": "number",
-        "int|float": "number",
-        "float|int": "number",
-        "int": "int",
-        "int|None": "int",
-        "bool": "bool",
-        "str": "str",
-        "str|None": "str",
-    }
-    if ann:
-        return table.get(ann, "")
-    default = param.default
-    if isinstance(default, bool):
-        return "bool"
-    if isinstance(default, int):
-        return "int"
-    if isinstance(default, float):
-        return "number"
-    if isinstance(default, str):
-        return "str"
-    return ""
-
-
-def _check_option_type(key: str, value, param: inspect.Parameter):
-    """Light type check of a builder option (the builder validates ranges itself)."""
-    expected = _expected_type(param)
-    if value is None and (param.default is None or "None" in str(param.annotation)):
+    if value is None and (spec_field.default is None or "None" in ann):
         return value  # programmatic callers may pass None where the builder accepts it
+    expected = _OPTION_TYPES[ann]
     if expected == "number":
         if not is_real(value):
             raise field_error(key, value, "must be a number")
@@ -683,12 +640,13 @@ def _check_option_type(key: str, value, param: inspect.Parameter):
 
 
 def _call_builder(builder: str, options: dict, material: Material) -> Assembly:
-    """Run ``BUILDERS[builder](**options)``; errors become InputError ``key = value: problem``."""
-    builders = _builders()
-    if builder not in builders:
-        raise field_error("builder", builder, f"unknown builder (expected one of {', '.join(sorted(builders))})")
-    fn = builders[builder]
-    params = _builder_parameters(fn)
+    """``BUILDERS[builder](**options).build()``; errors become InputError ``key = value: problem``."""
+    from geometry_library.builders import BUILDERS
+
+    if builder not in BUILDERS:
+        raise field_error("builder", builder, f"unknown builder (expected one of {', '.join(sorted(BUILDERS))})")
+    spec_cls = BUILDERS[builder]
+    params = {f.name: f for f in dataclasses.fields(spec_cls)}
     kwargs = {}
     for key, value in options.items():
         if key not in params:
@@ -700,7 +658,7 @@ def _call_builder(builder: str, options: dict, material: Material) -> Assembly:
         if key in params and key not in kwargs:
             kwargs[key] = getattr(material, key)
     try:
-        assembly = fn(**kwargs)
+        assembly = spec_cls(**kwargs).build()
     except ValueError as exc:  # GeometryError, InputError, bad values; a TypeError is a bug: not hidden
         raise InputError(f'builder "{builder}": {_one_line(exc)}') from None
     if not isinstance(assembly, Assembly):
@@ -711,7 +669,7 @@ def _call_builder(builder: str, options: dict, material: Material) -> Assembly:
 def scenario_from_builder(
     builder: str, options: dict, run: RunConfig, material: Material, motions_by_support: dict[str, Motion]
 ) -> Scenario:
-    """A scenario from ``geometry_library.builders.BUILDERS[builder](**options)``.
+    """A scenario from ``geometry_library.builders.BUILDERS[builder](**options).build()``.
 
     ``material.density`` / ``material.thickness`` are passed to the builder unless ``options`` sets
     them. ``motions_by_support`` maps support names to motions; supports not named are fixed; a name the
@@ -756,10 +714,8 @@ def scenario_from_builder(
 
 
 def _block_mass(block: Block) -> float:
-    try:
-        from geometry_library.mass import mass_properties
-    except ImportError:  # pragma: no cover - only while geometry_library is incomplete
-        return float(block.polygon.area) * block.density * block.thickness
+    from geometry_library.mass import mass_properties
+
     return float(mass_properties(block.vertices, block.density, block.thickness).mass)
 
 

@@ -1,5 +1,6 @@
 """Builders: exact counts, no overlaps (STRtree), convexity, bond pattern, radial joints, level top."""
 
+import dataclasses
 import math
 
 import numpy as np
@@ -9,7 +10,10 @@ from shapely.strtree import STRtree
 
 from geometry_library import (
     BUILDERS,
+    AqueductSpec,
+    ArchSpec,
     GeometryError,
+    WallSpec,
     build_aqueduct,
     build_arch,
     build_wall,
@@ -63,7 +67,22 @@ def test_counts_overlaps_convexity_and_validation(built, key, blocks, supports):
 
 
 def test_builders_registry():
-    assert BUILDERS == {"wall": build_wall, "arch": build_arch, "aqueduct": build_aqueduct}
+    assert BUILDERS == {"wall": WallSpec, "arch": ArchSpec, "aqueduct": AqueductSpec}
+    # The aqueduct's parameters are the arch's plus its wall's, declared once.
+    arch_fields = [f.name for f in dataclasses.fields(ArchSpec)]
+    assert [f.name for f in dataclasses.fields(AqueductSpec)][: len(arch_fields)] == arch_fields
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        WallSpec().blocks = 3
+
+
+def test_spec_build_is_the_builder(built):
+    wall = WallSpec(blocks=248).build()
+    assert [b.name for b in wall.blocks] == [b.name for b in built["wall248"].blocks]
+    assert all(np.array_equal(a.vertices, b.vertices) for a, b in zip(wall.blocks, built["wall248"].blocks))
+    arch = ArchSpec(voussoirs=21, pier_courses=10).build()
+    assert arch.block_count == 21 + 40 and arch.block_count == build_arch(voussoirs=21, pier_courses=10).block_count
+    with pytest.raises(TypeError):
+        build_wall(voussoirs=3)
 
 
 # --- wall ------------------------------------------------------------------------------------

@@ -624,35 +624,42 @@ def _rect(x0, y0, x1, y1):
     return [[x0, y0], [x1, y0], [x1, y1], [x0, y1]]
 
 
-def fake_builder(
-    *, bays: int = 2, height: float = 0.2, density: float = 2500.0, thickness: float = 1.0, label: str = "b"
-):
-    """A tiny builder with the geometry_library builder conventions (keyword options, Assembly out)."""
-    from geometry_library.checks import polygon_from_coords
+@dataclasses.dataclass(frozen=True)
+class FakeSpec:
+    """A tiny builder spec with the geometry_library conventions (frozen dataclass, ``build()`` -> Assembly)."""
 
-    if bays < 1:
-        raise GeometryError(f"bays = {bays}: must be >= 1")
-    blocks = tuple(
-        Block(
-            polygon_from_coords(_rect(0.4 * i, 0.0, 0.4 * i + 0.4, height), i, f"{label}{i}"),
-            f"{label}{i}",
-            density,
-            thickness,
+    bays: int = 2
+    height: float = 0.2
+    density: float = 2500.0
+    thickness: float = 1.0
+    label: str = "b"
+
+    def build(self) -> Assembly:
+        from geometry_library.checks import polygon_from_coords
+
+        bays, label = self.bays, self.label
+        if bays < 1:
+            raise GeometryError(f"bays = {bays}: must be >= 1")
+        blocks = tuple(
+            Block(
+                polygon_from_coords(_rect(0.4 * i, 0.0, 0.4 * i + 0.4, self.height), i, f"{label}{i}"),
+                f"{label}{i}",
+                self.density,
+                self.thickness,
+            )
+            for i in range(bays)
         )
-        for i in range(bays)
-    )
-    supports = (
-        Support(polygon_from_coords(_rect(-1.0, -0.5, 0.4, 0.0), 0, "ground"), "ground"),
-        Support(polygon_from_coords(_rect(0.4, -0.5, 0.4 * bays + 1.0, 0.0), 1, "pad"), "pad"),
-    )
-    return Assembly(blocks=blocks, supports=supports)
+        supports = (
+            Support(polygon_from_coords(_rect(-1.0, -0.5, 0.4, 0.0), 0, "ground"), "ground"),
+            Support(polygon_from_coords(_rect(0.4, -0.5, 0.4 * bays + 1.0, 0.0), 1, "pad"), "pad"),
+        )
+        return Assembly(blocks=blocks, supports=supports)
 
 
 @pytest.fixture
 def fake_builders(monkeypatch):
-    registry = dict(getattr(builders_pkg, "BUILDERS", {}))
-    registry["fake"] = fake_builder
-    monkeypatch.setattr(builders_pkg, "BUILDERS", registry, raising=False)
+    registry = {**builders_pkg.BUILDERS, "fake": FakeSpec}
+    monkeypatch.setattr(builders_pkg, "BUILDERS", registry)
     return registry
 
 
@@ -797,17 +804,34 @@ def test_paper_builder_scenarios(file, builder, blocks, motions):
     assert_same_scenario(dataclasses.replace(same, name=s.name), s)
 
 
-def test_builder_bug_is_not_disguised_as_input_error(fake_builders):
-    def broken(*, bays: int = 1):
+@dataclasses.dataclass(frozen=True)
+class BrokenSpec:
+    bays: int = 1
+
+    def build(self) -> Assembly:
         raise TypeError("'float' object is not iterable")
 
-    fake_builders["broken"] = broken
+
+@dataclasses.dataclass(frozen=True)
+class NullableSpec:
+    bays: int | None = 2
+
+    def build(self) -> Assembly:
+        return FakeSpec(bays=self.bays or 1).build()
+
+
+def test_builder_bug_is_not_disguised_as_input_error(fake_builders):
+    fake_builders["broken"] = BrokenSpec
     with pytest.raises(TypeError):
         scenario_from_builder("broken", {}, RunConfig(), Material(), {})
 
-    # None passes where the builder's annotation allows it
-    def nullable(*, bays: int | None = 2):
-        return fake_builder(bays=bays or 1)
-
-    fake_builders["nullable"] = nullable
+    # None passes where the spec's annotation allows it
+    fake_builders["nullable"] = NullableSpec
     assert scenario_from_builder("nullable", {"bays": None}, RunConfig(), Material(), {}).block_count == 1
+
+
+def test_every_builder_option_has_a_checked_type():
+    for name, spec_cls in builders_pkg.BUILDERS.items():
+        for f in dataclasses.fields(spec_cls):
+            with pytest.raises(InputError, match=rf'^builder "{name}": {f.name} = \[\]: must be '):
+                scenario_from_builder(name, {f.name: []}, RunConfig(), Material(), {})

@@ -21,41 +21,22 @@ Block order: the arch's 98 blocks, then the wall bottom course first, left to ri
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 from shapely.geometry import Polygon
 
 from ..blocks import Assembly, GeometryError
 from ._common import check_count, check_positive, make_block, name_width
-from .arch import arch_parts
+from .arch import ArchSpec, arch_parts
 from .spandrel import spandrel_blocks
 
 
-def build_aqueduct(
-    voussoirs: int = 30,
-    pier_courses: int = 17,
-    span: float = 3.6,
-    ring_thickness: float = 0.35,
-    pier_width: float = 0.90,
-    pier_course_height: float = 0.20,
-    wall_courses: int = 18,
-    block_length: float = 0.30,
-    block_height: float = 0.20,
-    first_course_offset: bool = False,
-    min_fraction: float = 0.05,
-    min_thickness: float = 0.15,
-    density: float = 2500.0,
-    thickness: float = 1.0,
-    foundation_margin: float = 0.30,
-    foundation_depth: float = 0.50,
-    left_role: str = "fixed",
-    right_role: str = "fixed",
-) -> Assembly:
-    """Arch on two piers plus spandrel walls in running bond up to a level top (346 blocks).
+@dataclass(frozen=True)
+class AqueductSpec(ArchSpec):
+    """Parameters of the aqueduct: those of the arch (:class:`~.arch.ArchSpec`) and of its spandrel walls.
 
-    Parameters
-    ----------
-    voussoirs, pier_courses, span, ring_thickness, pier_width, pier_course_height,
-    foundation_margin, foundation_depth, left_role, right_role : the arch, as in
-        :func:`~.arch.build_arch`.
+    Attributes (beyond the arch's)
+    ------------------------------
     wall_courses : int — spandrel courses above the springing line (default 18); the level top is
         at springing + wall_courses · block_height and should clear the crown.
     block_length, block_height : float, m — full wall block (0.30 × 0.20).
@@ -63,59 +44,55 @@ def build_aqueduct(
     min_fraction, min_thickness : sliver limits — a wall block smaller than ``min_fraction`` of a
         full block, or thinner (2·area/perimeter) than ``min_thickness`` × block_height, is merged
         or re-cut with a neighbour (see :mod:`.spandrel`).
-    density : kg/m³. thickness : m, out of plane.
-
-    Returns
-    -------
-    Assembly: the arch's blocks, then the wall's; supports "left-foundation", "right-foundation".
-
-    Raises
-    ------
-    GeometryError (one line) for invalid parameters, or a wall top below the crown.
     """
-    check_count("aqueduct", 1, wall_courses=wall_courses)
-    check_positive("aqueduct", block_length=block_length, block_height=block_height)
-    blocks, supports, geom = arch_parts(
-        voussoirs,
-        pier_courses,
-        span,
-        ring_thickness,
-        pier_width,
-        pier_course_height,
-        density,
-        thickness,
-        foundation_margin,
-        foundation_depth,
-        left_role,
-        right_role,
-    )
-    top = geom.springing + wall_courses * block_height
-    crown = geom.springing + geom.extrados_radius
-    if top < crown:
-        raise GeometryError(
-            f"aqueduct: the wall top ({top:g} m) is below the crown of the extrados ({crown:g} m); add wall_courses"
+
+    wall_courses: int = 18
+    block_length: float = 0.30
+    block_height: float = 0.20
+    first_course_offset: bool = False
+    min_fraction: float = 0.05
+    min_thickness: float = 0.15
+
+    def build(self) -> Assembly:
+        """The arch's blocks, then the wall's; supports "left-foundation", "right-foundation".
+
+        Raises GeometryError (one line) for invalid parameters, or a wall top below the crown.
+        """
+        check_count("aqueduct", 1, wall_courses=self.wall_courses)
+        check_positive("aqueduct", block_length=self.block_length, block_height=self.block_height)
+        blocks, supports, geom = arch_parts(self)
+        top = geom.springing + self.wall_courses * self.block_height
+        crown = geom.springing + geom.extrados_radius
+        if top < crown:
+            raise GeometryError(
+                f"aqueduct: the wall top ({top:g} m) is below the crown of the extrados ({crown:g} m); add wall_courses"
+            )
+        region = Polygon(geom.extrados)
+        pieces = spandrel_blocks(
+            region,
+            geom.centre,
+            -geom.half_width,
+            geom.half_width,
+            geom.springing,
+            self.wall_courses,
+            self.block_length,
+            self.block_height,
+            first_offset=self.first_course_offset,
+            min_fraction=self.min_fraction,
+            min_thickness=self.min_thickness,
         )
-    region = Polygon(geom.extrados)
-    pieces = spandrel_blocks(
-        region,
-        geom.centre,
-        -geom.half_width,
-        geom.half_width,
-        geom.springing,
-        wall_courses,
-        block_length,
-        block_height,
-        first_offset=first_course_offset,
-        min_fraction=min_fraction,
-        min_thickness=min_thickness,
-    )
-    cw = name_width(wall_courses)
-    counts: dict[int, int] = {}
-    for c, _ in pieces:
-        counts[c] = counts.get(c, 0) + 1
-    bw = name_width(max(counts.values()))
-    seen: dict[int, int] = {}
-    for c, poly in pieces:
-        seen[c] = seen.get(c, 0) + 1
-        blocks.append(make_block(poly, f"wall-c{c + 1:0{cw}d}-b{seen[c]:0{bw}d}", density, thickness))
-    return Assembly(tuple(blocks), tuple(supports))
+        cw = name_width(self.wall_courses)
+        counts: dict[int, int] = {}
+        for c, _ in pieces:
+            counts[c] = counts.get(c, 0) + 1
+        bw = name_width(max(counts.values()))
+        seen: dict[int, int] = {}
+        for c, poly in pieces:
+            seen[c] = seen.get(c, 0) + 1
+            blocks.append(make_block(poly, f"wall-c{c + 1:0{cw}d}-b{seen[c]:0{bw}d}", self.density, self.thickness))
+        return Assembly(tuple(blocks), tuple(supports))
+
+
+def build_aqueduct(**options) -> Assembly:
+    """Arch on two piers plus spandrel walls in running bond up to a level top: ``AqueductSpec(**options).build()``."""
+    return AqueductSpec(**options).build()

@@ -71,21 +71,50 @@ def _unit_half_circle(n: int) -> np.ndarray:
     return out
 
 
-def arch_parts(
-    voussoirs: int = 30,
-    pier_courses: int = 17,
-    span: float = 3.6,
-    ring_thickness: float = 0.35,
-    pier_width: float = 0.90,
-    pier_course_height: float = 0.20,
-    density: float = 2500.0,
-    thickness: float = 1.0,
-    foundation_margin: float = 0.30,
-    foundation_depth: float = 0.50,
-    left_role: str = "fixed",
-    right_role: str = "fixed",
-) -> tuple[list[Block], list[Support], ArchGeometry]:
-    """The blocks, supports and geometry of :func:`build_arch` (same parameters)."""
+@dataclass(frozen=True)
+class ArchSpec:
+    """Parameters of a semicircular arch on two running-bond piers (the TOML ``[structure]`` options).
+
+    Attributes
+    ----------
+    voussoirs : int ≥ 2 — number of voussoirs (default 30, 6° each).
+    pier_courses : int — courses per pier, 2 blocks each (default 17 → 34 blocks per pier).
+    span : float, m — clear span between the piers = intrados diameter (default 3.6).
+    ring_thickness : float, m — extrados radius − intrados radius (default 0.35), ≤ pier_width.
+    pier_width : float, m (default 0.90; blocks 0.60 + 0.30). pier_course_height : m (0.20).
+    density : kg/m³. thickness : m, out of plane.
+    foundation_margin, foundation_depth : m — foundation pads under each pier.
+    left_role, right_role : support roles of "left-foundation" / "right-foundation".
+    """
+
+    voussoirs: int = 30
+    pier_courses: int = 17
+    span: float = 3.6
+    ring_thickness: float = 0.35
+    pier_width: float = 0.90
+    pier_course_height: float = 0.20
+    density: float = 2500.0
+    thickness: float = 1.0
+    foundation_margin: float = 0.30
+    foundation_depth: float = 0.50
+    left_role: str = "fixed"
+    right_role: str = "fixed"
+
+    def build(self) -> Assembly:
+        """The arch: 2·2·pier_courses + voussoirs blocks (98 by default) and two supports. See the
+        module docstring for the layout, names and order."""
+        blocks, supports, _ = arch_parts(self)
+        return Assembly(tuple(blocks), tuple(supports))
+
+
+def arch_parts(spec: ArchSpec) -> tuple[list[Block], list[Support], ArchGeometry]:
+    """The blocks, supports and geometry of the arch of ``spec`` (an :class:`ArchSpec`, or a spec
+    extending it such as the aqueduct's)."""
+    voussoirs, pier_courses, span = spec.voussoirs, spec.pier_courses, spec.span
+    ring_thickness, pier_width, pier_course_height = spec.ring_thickness, spec.pier_width, spec.pier_course_height
+    density, thickness = spec.density, spec.thickness
+    foundation_margin, foundation_depth = spec.foundation_margin, spec.foundation_depth
+    left_role, right_role = spec.left_role, spec.right_role
     check_count("arch", 2, voussoirs=voussoirs)
     check_count("arch", 1, pier_courses=pier_courses)
     check_positive(
@@ -171,50 +200,6 @@ def arch_parts(
     return blocks, supports, geometry
 
 
-def build_arch(
-    voussoirs: int = 30,
-    pier_courses: int = 17,
-    span: float = 3.6,
-    ring_thickness: float = 0.35,
-    pier_width: float = 0.90,
-    pier_course_height: float = 0.20,
-    density: float = 2500.0,
-    thickness: float = 1.0,
-    foundation_margin: float = 0.30,
-    foundation_depth: float = 0.50,
-    left_role: str = "fixed",
-    right_role: str = "fixed",
-) -> Assembly:
-    """A semicircular arch of ``voussoirs`` radial-jointed voussoirs on two running-bond piers.
-
-    Parameters
-    ----------
-    voussoirs : int ≥ 2 — number of voussoirs (default 30, 6° each).
-    pier_courses : int — courses per pier, 2 blocks each (default 17 → 34 blocks per pier).
-    span : float, m — clear span between the piers = intrados diameter (default 3.6).
-    ring_thickness : float, m — extrados radius − intrados radius (default 0.35), ≤ pier_width.
-    pier_width : float, m (default 0.90; blocks 0.60 + 0.30). pier_course_height : m (0.20).
-    density : kg/m³. thickness : m, out of plane.
-    foundation_margin, foundation_depth : m — foundation pads under each pier.
-    left_role, right_role : support roles of "left-foundation" / "right-foundation".
-
-    Returns
-    -------
-    Assembly with 2·2·pier_courses + voussoirs blocks (98 by default) and two supports. See the
-    module docstring for the layout, names and order.
-    """
-    blocks, supports, _ = arch_parts(
-        voussoirs,
-        pier_courses,
-        span,
-        ring_thickness,
-        pier_width,
-        pier_course_height,
-        density,
-        thickness,
-        foundation_margin,
-        foundation_depth,
-        left_role,
-        right_role,
-    )
-    return Assembly(tuple(blocks), tuple(supports))
+def build_arch(**options) -> Assembly:
+    """A semicircular arch of radial-jointed voussoirs on two running-bond piers: ``ArchSpec(**options).build()``."""
+    return ArchSpec(**options).build()

@@ -161,21 +161,11 @@ def wall_layout(
     return WallLayout(blocks, c, n, block_length, block_height)
 
 
-def build_wall(
-    blocks: int | None = 51,
-    courses: int | None = None,
-    length: float | None = None,
-    block_length: float = 0.30,
-    block_height: float = 0.20,
-    density: float = 2500.0,
-    thickness: float = 1.0,
-    ground_margin: float = 2.0,
-    ground_depth: float = 0.5,
-    ground_role: str = "fixed",
-) -> Assembly:
-    """A running-bond wall standing on a ground support.
+@dataclass(frozen=True)
+class WallSpec:
+    """Parameters of a running-bond wall standing on a ground support (the TOML ``[structure]`` options).
 
-    Parameters
+    Attributes
     ----------
     blocks : int — block count (default 51: 6 courses × 8, 2.40 × 1.20 m; 248: 16 courses × 15,
         4.50 × 3.20 m). None when ``courses`` and ``length`` are both given.
@@ -184,31 +174,48 @@ def build_wall(
     density : kg/m³. thickness : m.
     ground_margin : m the ground extends beyond each end of the wall. ground_depth : m.
     ground_role : role of the "ground" support; the loading decides how it moves.
-
-    Returns
-    -------
-    Assembly — blocks named ``cCC-bBB`` (course from the bottom, block from the left, both from 1),
-    ordered course by course, left to right; one support ``"ground"``.
     """
-    layout = wall_layout(blocks, courses, length, block_length, block_height)
-    check_positive("wall", density=density, thickness=thickness, ground_depth=ground_depth)
-    if ground_margin < 0:
-        raise GeometryError(f"wall: ground_margin must be ≥ 0, got {ground_margin!r}")
-    x0 = -0.5 * layout.length
-    cw = name_width(layout.courses)
-    bw = name_width(layout.full_per_course + 1)
-    out: list[Block] = []
-    for c, full, halves, _ in layout.rows():
-        y0 = (c - 1) * block_height
-        # Joints on the integer grid of half blocks: no round-off drift along long courses.
-        units = [2] * full
-        if halves:
-            units = [1] + units + [1]
-        m = 0
-        for k, u in enumerate(units, start=1):
-            xa, xb = x0 + m * 0.5 * block_length, x0 + (m + u) * 0.5 * block_length
-            out.append(make_block(box(xa, y0, xb, y0 + block_height), f"c{c:0{cw}d}-b{k:0{bw}d}", density, thickness))
-            m += u
-    half = 0.5 * layout.length + ground_margin
-    ground = make_support(box(-half, -ground_depth, half, 0.0), "ground", ground_role)
-    return Assembly(tuple(out), (ground,))
+
+    blocks: int | None = 51
+    courses: int | None = None
+    length: float | None = None
+    block_length: float = 0.30
+    block_height: float = 0.20
+    density: float = 2500.0
+    thickness: float = 1.0
+    ground_margin: float = 2.0
+    ground_depth: float = 0.5
+    ground_role: str = "fixed"
+
+    def build(self) -> Assembly:
+        """The wall: blocks named ``cCC-bBB`` (course from the bottom, block from the left, both from 1),
+        ordered course by course, left to right; one support ``"ground"``."""
+        block_height, density, thickness = self.block_height, self.density, self.thickness
+        layout = wall_layout(self.blocks, self.courses, self.length, self.block_length, block_height)
+        check_positive("wall", density=density, thickness=thickness, ground_depth=self.ground_depth)
+        if self.ground_margin < 0:
+            raise GeometryError(f"wall: ground_margin must be ≥ 0, got {self.ground_margin!r}")
+        x0 = -0.5 * layout.length
+        cw = name_width(layout.courses)
+        bw = name_width(layout.full_per_course + 1)
+        out: list[Block] = []
+        for c, full, halves, _ in layout.rows():
+            y0 = (c - 1) * block_height
+            # Joints on the integer grid of half blocks: no round-off drift along long courses.
+            units = [2] * full
+            if halves:
+                units = [1] + units + [1]
+            m = 0
+            for k, u in enumerate(units, start=1):
+                xa, xb = x0 + m * 0.5 * self.block_length, x0 + (m + u) * 0.5 * self.block_length
+                name = f"c{c:0{cw}d}-b{k:0{bw}d}"
+                out.append(make_block(box(xa, y0, xb, y0 + block_height), name, density, thickness))
+                m += u
+        half = 0.5 * layout.length + self.ground_margin
+        ground = make_support(box(-half, -self.ground_depth, half, 0.0), "ground", self.ground_role)
+        return Assembly(tuple(out), (ground,))
+
+
+def build_wall(**options) -> Assembly:
+    """A running-bond wall standing on a ground support: ``WallSpec(**options).build()``."""
+    return WallSpec(**options).build()
