@@ -494,7 +494,9 @@ def run_command(
 ) -> None:
     """Run any scenario file (or a GeoJSON / WKT geometry file, supports fixed); options given here
     override the file's values."""
-    from masonrycli.scenario import GEOMETRY_SUFFIXES, load_scenario, scenario_from_geometry_file
+    from masonrycli.scenario import scenario_from_geometry_file
+    from masonrycli.scenario_toml import load_scenario
+    from masonrycli.structure import GEOMETRY_SUFFIXES
 
     if scenario_file.suffix.lower() in GEOMETRY_SUFFIXES:
         scenario = scenario_from_geometry_file(scenario_file)
@@ -519,7 +521,8 @@ def check_command(
     scenario_file: Annotated[Path, typer.Argument(help="Scenario file (TOML).", metavar="SCENARIO.toml")],
 ) -> None:
     """Validate a scenario file and print a summary (blocks, supports, mass, bounding box)."""
-    from masonrycli.scenario import load_scenario, scenario_summary
+    from masonrycli.scenario import scenario_summary
+    from masonrycli.scenario_toml import load_scenario
 
     scenario = load_scenario(scenario_file)
     info = scenario_summary(scenario)

@@ -1,18 +1,377 @@
-"""Writing a scenario back as TOML (``masonry`` reads it with :func:`masonrycli.scenario.load_scenario`).
+"""Scenario files in TOML: the reader (format: ``docs/scenario-format.md``) and the writer.
 
-tomllib only reads TOML; this small writer emits exactly the subset the scenario format uses, with floats
-spelled by ``repr`` so that a reload gives bit-identical vertices.
+``load_scenario`` / ``loads_scenario`` read a scenario file; every problem with it raises
+:class:`masonrycli.errors.InputError` with a one-line message naming the file and the key, e.g.
+``wall.toml: [run] dt = -0.001: must be > 0``.
+
+``dump_scenario`` writes one back. tomllib only reads TOML; this small writer emits exactly the subset the
+scenario format uses, with floats spelled by ``repr`` so that a reload gives bit-identical vertices.
 """
 
 from __future__ import annotations
 
 import dataclasses
+import difflib
+import os
+import tomllib
+from pathlib import Path
 
 import numpy as np
 
-from masonrycli.motion import Motion
+from geometry_library.blocks import Assembly, Block, GeometryError, Support
+from masonrycli.errors import InputContext, InputError, one_line
+from masonrycli.motion import MOTION_KINDS, Fixed, Motion
+from masonrycli.records import load_record_csv
 from masonrycli.scenario import Material, RunConfig, Scenario
-from masonrycli.values import format_value, quote_key, quote_string
+from masonrycli.structure import build_structure, check_finite_tree, read_geometry, structure_warnings
+from masonrycli.values import check_real, check_vector, field_error, format_value, quote_key, quote_string
+
+TOP_LEVEL_KEYS = ("name", "run", "material", "structure", "block", "support")
+BLOCK_KEYS = ("name", "polygon", "density", "thickness", "velocity")
+SUPPORT_KEYS = ("name", "polygon", "motion")
+BUILDER_SUPPORT_KEYS = ("name", "motion")
+
+ALL_MOTION_KEYS = tuple(dict.fromkeys(k for cls in MOTION_KINDS.values() for k in cls.TOML_KEYS))
+
+
+# --------------------------------------------------------------------------------------------------
+# reading
+
+
+def _unknown_key(key, known) -> str:
+    close = difflib.get_close_matches(str(key), list(known), n=1)
+    hint = f' (did you mean "{close[0]}"?)' if close else f" (expected one of: {', '.join(known)})"
+    return f"unknown key {quote_string(str(key))}{hint}"
+
+
+def _check_name(key: str, value) -> str:
+    if not isinstance(value, str):
+        raise field_error(key, value, "must be a string")
+    if not value.strip():
+        raise field_error(key, value, "must not be empty")
+    if any(ord(c) < 0x20 or ord(c) == 0x7F for c in value):
+        raise field_error(key, value, "must not contain control characters")
+    return value
+
+
+def load_scenario(path) -> Scenario:
+    """Read a TOML scenario file (format: ``docs/scenario-format.md``).
+
+    Relative record ``file`` paths are resolved against the scenario file's folder.
+    Raises :class:`InputError` (one line naming the file and the key) on any problem.
+    """
+    fname = os.fspath(path)
+    try:
+        raw = Path(fname).read_bytes()
+    except IsADirectoryError:
+        raise InputError(f"{fname}: cannot read scenario: is a directory") from None
+    except OSError as exc:
+        raise InputError(one_line(f"{fname}: cannot read scenario: {exc.strerror or exc}")) from None
+    try:
+        text = raw.decode("utf-8-sig")  # tolerate the byte-order mark some Windows editors add
+    except UnicodeDecodeError as exc:
+        raise InputError(f"{fname}: not a UTF-8 text file (byte {exc.start})") from None
+    base_dir = os.path.dirname(os.path.abspath(fname))
+    return loads_scenario(text, source=fname, base_dir=base_dir, default_name=Path(fname).stem)
+
+
+def loads_scenario(
+    text: str, source: str = "<string>", base_dir: str | os.PathLike = ".", default_name: str = "scenario"
+) -> Scenario:
+    """Parse scenario TOML ``text``. ``source`` names it in error messages; ``base_dir`` resolves
+    relative record files."""
+    ctx = InputContext(os.fspath(source), os.path.abspath(os.fspath(base_dir)))
+    try:
+        doc = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise ctx.error("", f"TOML syntax error: {exc}") from None
+    return _parse_document(doc, ctx, default_name)
+
+
+def _table(doc: dict, key: str, ctx: InputContext) -> dict:
+    value = doc.get(key, {})
+    if not isinstance(value, dict):
+        raise ctx.error("", f"{key} = {format_value(value)[:40]}: must be a table [{key}]")
+    return value
+
+
+def _array_of_tables(doc: dict, key: str, ctx: InputContext) -> list:
+    value = doc.get(key, [])
+    if not isinstance(value, list) or not all(isinstance(v, dict) for v in value):
+        raise ctx.error("", f"{key}: must be an array of tables [[{key}]]")
+    return value
+
+
+def _config(cls, table: dict, ctx: InputContext, section: str):
+    names = [f.name for f in dataclasses.fields(cls)]
+    for key in table:
+        if key not in names:
+            raise ctx.error(f"[{section}]", _unknown_key(key, names))
+    try:
+        return cls(**table)
+    except InputError as exc:
+        raise ctx.error(f"[{section}]", str(exc)) from None
+
+
+def _parse_document(doc: dict, ctx: InputContext, default_name: str) -> Scenario:
+    for key in doc:
+        if key not in TOP_LEVEL_KEYS:
+            raise ctx.error("", _unknown_key(key, TOP_LEVEL_KEYS))
+    try:
+        name = _check_name("name", doc["name"]) if "name" in doc else default_name
+    except InputError as exc:
+        raise ctx.error("", str(exc)) from None
+    run = _config(RunConfig, _table(doc, "run", ctx), ctx, "run")
+    material = _config(Material, _table(doc, "material", ctx), ctx, "material")
+    block_tables = _array_of_tables(doc, "block", ctx)
+    support_tables = _array_of_tables(doc, "support", ctx)
+
+    if "structure" in doc:
+        structure = _table(doc, "structure", ctx)
+        if block_tables:
+            raise ctx.error(
+                _locator("block", 1, block_tables[0], "block-1"),
+                "not allowed together with a [structure] builder or file (use either explicit blocks or a [structure])",
+            )
+        if "file" in structure:
+            extra = [k for k in structure if k != "file"]
+            if extra:
+                raise ctx.error(
+                    "[structure]",
+                    f"{extra[0]}: not allowed with file = ... (a geometry file brings its own blocks and supports)",
+                )
+            file = structure["file"]
+            if not isinstance(file, str):
+                raise ctx.error("[structure]", f"file = {format_value(file)[:40]}: must be a string")
+            path = os.path.abspath(os.path.join(ctx.base_dir, file))
+            assembly = read_geometry(path, material.density, material.thickness, ctx)
+            what = f"file {quote_string(file)}"
+            structure_info = {"file": path}
+        else:
+            if "builder" not in structure:
+                raise ctx.error("[structure]", 'builder: missing (e.g. builder = "wall", or file = "my-wall.geojson")')
+            builder = structure["builder"]
+            if not isinstance(builder, str):
+                raise ctx.error("[structure]", f"builder = {format_value(builder)[:40]}: must be a string")
+            options = {k: v for k, v in structure.items() if k != "builder"}
+            for key, value in options.items():
+                try:
+                    check_finite_tree(key, value)
+                except InputError as exc:
+                    raise ctx.error("[structure]", str(exc)) from None
+            try:
+                assembly = build_structure(builder, options, material.density, material.thickness)
+            except InputError as exc:
+                raise ctx.error("[structure]", str(exc)) from None
+            structure_info = {"builder": builder, **options}
+            what = f'builder "{builder}"'
+        motions_by_support = {}
+        known = [s.name for s in assembly.supports]
+        for i, table in enumerate(support_tables, start=1):
+            loc = _locator("support", i, table, None)
+            for key in table:
+                if key not in BUILDER_SUPPORT_KEYS:
+                    if key in SUPPORT_KEYS:
+                        raise ctx.error(
+                            loc,
+                            f"{key}: not allowed with a [structure] "
+                            f"({what} makes the supports; give only name and motion)",
+                        )
+                    raise ctx.error(loc, _unknown_key(key, BUILDER_SUPPORT_KEYS))
+            if "name" not in table:
+                raise ctx.error(loc, f"name: missing ({what} supports: {', '.join(known)})")
+            sname = table["name"]
+            if sname not in known:
+                raise ctx.error(
+                    loc,
+                    f"name = {format_value(sname)[:40]}: no such support in {what} "
+                    f"(supports: {', '.join(known) or 'none'})",
+                )
+            if sname in motions_by_support:
+                raise ctx.error(loc, f"name = {quote_string(sname)}: support given twice")
+            motions_by_support[sname] = _parse_motion(table.get("motion"), ctx, loc)
+        motions = tuple(motions_by_support.get(s.name, Fixed()) for s in assembly.supports)
+    else:
+        blocks = []
+        names: dict[str, str] = {}
+        for i, table in enumerate(block_tables, start=1):
+            blocks.append(_parse_block(i, table, material, ctx, names))
+        if not blocks:
+            raise ctx.error("", "no blocks: add [[block]] tables or a [structure] builder")
+        supports, motions_list = [], []
+        for i, table in enumerate(support_tables, start=1):
+            support, motion = _parse_support(i, table, ctx, names)
+            supports.append(support)
+            motions_list.append(motion)
+        assembly = Assembly(blocks=tuple(blocks), supports=tuple(supports))
+        motions = tuple(motions_list)
+        structure_info = {}
+
+    warnings = structure_warnings(assembly, ctx)
+    return Scenario(
+        name=name,
+        run=run,
+        material=material,
+        assembly=assembly,
+        motions=motions,
+        source=ctx.fname,
+        structure=structure_info,
+        warnings=warnings,
+    )
+
+
+def _locator(section: str, index: int, table: dict, default_name: str | None) -> str:
+    name = table.get("name", default_name)
+    if isinstance(name, str) and name and not any(ord(c) < 0x20 for c in name):
+        return f"[[{section}]] #{index} ({quote_string(name)}):"
+    return f"[[{section}]] #{index}:"
+
+
+def _check_polygon(value) -> list[tuple[float, float]]:
+    if not isinstance(value, list) or not all(isinstance(v, list) for v in value):
+        raise field_error("polygon", value, "must be a list of [x, y] vertices")
+    coords = [check_vector(f"polygon[{j}]", v) for j, v in enumerate(value)]
+    if len(coords) < 3:
+        raise field_error("polygon", value, f"needs at least 3 vertices, got {len(coords)}")
+    return coords
+
+
+def _polygon(coords, index: int, name: str, kind: str, ctx: InputContext, loc: str):
+    """geometry_library's normalised convex polygon; its GeometryError becomes an InputError at ``loc``.
+
+    ``index`` is 0-based (geometry_library's convention); the body label geometry_library puts in front
+    of its message is replaced by our ``[[block]] #i ("name"):`` locator.
+    """
+    from geometry_library import checks
+
+    try:
+        return checks.polygon_from_coords(coords, index, name, kind)
+    except GeometryError as exc:
+        msg = str(exc).removeprefix(f"{checks.body_label(index, name, kind)}: ")
+        raise ctx.error(loc, msg) from None
+
+
+def _check_unique(name: str, loc: str, names: dict, ctx: InputContext):
+    if name in names:
+        raise ctx.error(loc, f"name = {quote_string(name)}: already used by {names[name]} (names must be unique)")
+    names[name] = loc.rstrip(":")
+
+
+def _parse_block(i: int, table: dict, material: Material, ctx: InputContext, names: dict) -> Block:
+    default_name = f"block-{i}"
+    loc = _locator("block", i, table, default_name)
+    for key in table:
+        if key not in BLOCK_KEYS:
+            raise ctx.error(loc, _unknown_key(key, BLOCK_KEYS))
+    try:
+        name = _check_name("name", table.get("name", default_name))
+        if "polygon" not in table:
+            raise InputError("polygon: missing (e.g. polygon = [[0.0, 0.0], [0.4, 0.0], [0.4, 0.2], [0.0, 0.2]])")
+        coords = _check_polygon(table["polygon"])
+        density = check_real("density", table.get("density", material.density), gt=0.0)
+        thickness = check_real("thickness", table.get("thickness", material.thickness), gt=0.0)
+        velocity = check_vector("velocity", table.get("velocity", (0.0, 0.0, 0.0)), size=3)
+    except InputError as exc:
+        raise ctx.error(loc, str(exc)) from None
+    _check_unique(name, loc, names, ctx)
+    polygon = _polygon(coords, i - 1, name, "block", ctx, loc)
+    return Block(polygon=polygon, name=name, density=density, thickness=thickness, velocity=velocity)
+
+
+def _parse_support(i: int, table: dict, ctx: InputContext, names: dict) -> tuple[Support, Motion]:
+    default_name = f"support-{i}"
+    loc = _locator("support", i, table, default_name)
+    for key in table:
+        if key not in SUPPORT_KEYS:
+            raise ctx.error(loc, _unknown_key(key, SUPPORT_KEYS))
+    try:
+        name = _check_name("name", table.get("name", default_name))
+        if "polygon" not in table:
+            raise InputError("polygon: missing (e.g. polygon = [[-5.0, -0.5], [5.0, -0.5], [5.0, 0.0], [-5.0, 0.0]])")
+        coords = _check_polygon(table["polygon"])
+    except InputError as exc:
+        raise ctx.error(loc, str(exc)) from None
+    _check_unique(name, loc, names, ctx)
+    polygon = _polygon(coords, i - 1, name, "support", ctx, loc)
+    motion = _parse_motion(table.get("motion"), ctx, loc)
+    return Support(polygon=polygon, name=name, role=motion.role), motion
+
+
+def _parse_motion(table, ctx: InputContext, loc: str) -> Motion:
+    """A ``motion = {...}`` table -> Motion (None -> fixed)."""
+    if table is None:
+        return Fixed()
+    if not isinstance(table, dict):
+        raise ctx.error(
+            loc,
+            f"motion = {format_value(table)[:40]}: must be a table, e.g. "
+            'motion = { kind = "sine", amplitude = 1.0, frequency = 2.0 }',
+        )
+    for key in table:
+        if key not in ALL_MOTION_KEYS:
+            raise ctx.error(loc, "motion: " + _unknown_key(key, ALL_MOTION_KEYS))
+    if "kind" not in table:
+        raise ctx.error(loc, f"motion.kind: missing (one of {', '.join(MOTION_KINDS)})")
+    kind = table["kind"]
+    if not isinstance(kind, str) or kind not in MOTION_KINDS:
+        raise ctx.error(
+            loc,
+            f"motion.kind = {format_value(kind)[:40]}: unknown motion kind (expected one of {', '.join(MOTION_KINDS)})",
+        )
+    cls = MOTION_KINDS[kind]
+    allowed = cls.TOML_KEYS
+    for key in table:
+        if key not in allowed:
+            raise ctx.error(loc, f'motion.{key}: not used by kind "{kind}" (its keys: {", ".join(allowed)})')
+    for key in cls.TOML_REQUIRED:
+        if key not in table:
+            raise ctx.error(loc, f'motion.{key}: missing (required for kind "{kind}")')
+
+    args = {k: v for k, v in table.items() if k not in ("kind", "file", "time", "value")}
+    if kind == "record":
+        args.update(_record_data(table, ctx, loc))
+    try:
+        return cls(**args)
+    except InputError as exc:
+        raise ctx.error(loc, f"motion.{exc}") from None
+
+
+def _record_data(table: dict, ctx: InputContext, loc: str) -> dict:
+    has_file = "file" in table
+    has_inline = "time" in table or "value" in table
+    if has_file and has_inline:
+        raise ctx.error(loc, "motion.file: give either file or inline time and value, not both")
+    if has_file:
+        file = table["file"]
+        if not isinstance(file, str) or not file:
+            raise ctx.error(loc, f"motion.file = {format_value(file)[:40]}: must be a file name")
+        resolved = os.path.abspath(os.path.join(ctx.base_dir, file))
+        if not os.path.isfile(resolved):
+            raise ctx.error(loc, f"motion.file = {quote_string(file)}: no such file (looked for {resolved})")
+        try:
+            time, value = load_record_csv(resolved, display=file)
+        except InputError as exc:
+            raise ctx.error(loc, f"motion.file: {exc}") from None
+        if value.ndim == 2 and "direction" in table:
+            raise ctx.error(loc, f"motion.direction: not used by a 3-column record ({file} gives x and y)")
+        return {
+            "time": tuple(time.tolist()),
+            "value": tuple(value.tolist()) if value.ndim == 1 else tuple(map(tuple, value.tolist())),
+            "source": resolved,
+        }
+    for key in ("time", "value"):
+        if key not in table:
+            raise ctx.error(loc, f'motion.{key}: missing (kind "record" needs file, or time and value)')
+        if not isinstance(table[key], list):
+            raise ctx.error(loc, f"motion.{key} = {format_value(table[key])[:40]}: must be an array")
+    value = table["value"]
+    if value and all(isinstance(v, list) for v in value) and "direction" in table:
+        raise ctx.error(loc, "motion.direction: not used by a vector record (value holds [x, y] pairs)")
+    return {"time": table["time"], "value": value}
+
+
+# --------------------------------------------------------------------------------------------------
+# writing
 
 
 def _vertices(polygon_owner) -> list[list[float]]:

@@ -122,7 +122,7 @@ def test_free_flight_energy(theta, tmp_path):
     )
     from dataclasses import replace
 
-    from masonrycli.scenario import load_scenario
+    from masonrycli.scenario_toml import load_scenario
 
     sc = load_scenario(path)
     sc = replace(sc, run=replace(sc.run, theta=theta))
@@ -141,7 +141,7 @@ def test_block_on_ground_does_not_creep_or_sink(tmp_path):
         .replace("duration = 1.0", "duration = 10.0")
         .replace("record_every = 1", "record_every = 100")
     )
-    from masonrycli.scenario import load_scenario
+    from masonrycli.scenario_toml import load_scenario
 
     h, result = run_history(load_scenario(path))
     dq = h["block_q"][:, 0, :2] - h["block_q"][0, 0, :2]
@@ -166,7 +166,7 @@ polygon = [[0.0, {height}], [0.4, {height}], [0.4, {top}], [0.0, {top}]]
 name = "ground"
 polygon = [[-2.0, -0.5], [2.0, -0.5], [2.0, 0.0], [-2.0, 0.0]]
 """)
-    from masonrycli.scenario import load_scenario
+    from masonrycli.scenario_toml import load_scenario
 
     h, result = run_history(load_scenario(path))
     y = h["block_q"][:, 0, 1]

@@ -19,12 +19,10 @@ from masonrycli.scenario import (
     Material,
     RunConfig,
     Scenario,
-    load_scenario,
-    loads_scenario,
     scenario_from_builder,
     scenario_summary,
 )
-from masonrycli.scenario_toml import dump_scenario
+from masonrycli.scenario_toml import dump_scenario, load_scenario, loads_scenario
 
 DATA = Path(__file__).parent / "data"
 

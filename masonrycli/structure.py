@@ -1,0 +1,133 @@
+"""The structure of a scenario: blocks and supports from a builder spec or a geometry file, checked.
+
+``build_structure`` checks TOML / command-line options against the builder's spec dataclass
+(``geometry_library.builders.BUILDERS``) and builds it; ``read_geometry`` reads a GeoJSON or WKT file;
+``structure_warnings`` runs ``geometry_library.checks.validate_assembly``. Problems raise a one-line
+:class:`~masonrycli.errors.InputError`.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import difflib
+import math
+import os
+from pathlib import Path
+
+from geometry_library.blocks import Assembly, GeometryError
+from masonrycli.errors import InputContext, InputError, one_line
+from masonrycli.values import field_error, is_real, quote_string
+
+GEOMETRY_SUFFIXES = (".geojson", ".json", ".wkt")
+
+
+def read_geometry(path: str, density: float, thickness: float, ctx: InputContext) -> Assembly:
+    """Blocks and supports of a GeoJSON or WKT file (``geometry_library.io``), with ``density`` and
+    ``thickness`` (the material's) as defaults."""
+    from geometry_library import io as geo_io
+
+    suffix = Path(path).suffix.lower()
+    if suffix not in GEOMETRY_SUFFIXES:
+        raise ctx.error(
+            "[structure]",
+            f"file = {quote_string(path)}: unknown geometry format (expected {', '.join(GEOMETRY_SUFFIXES)})",
+        )
+    if not os.path.isfile(path):
+        raise ctx.error("[structure]", f"file = {quote_string(path)}: no such file")
+    reader = geo_io.read_wkt if suffix == ".wkt" else geo_io.read_geojson
+    try:
+        return reader(path, density=density, thickness=thickness)
+    except (GeometryError, ValueError) as exc:
+        raise ctx.error("[structure]", one_line(exc)) from None
+
+
+def structure_warnings(assembly: Assembly, ctx: InputContext) -> tuple[str, ...]:
+    """``validate_assembly``: its errors raised at ``ctx``, its warnings on one line each."""
+    from geometry_library.checks import validate_assembly
+
+    try:
+        warnings = validate_assembly(assembly)
+    except GeometryError as exc:
+        raise ctx.error("", str(exc)) from None
+    return tuple(one_line(w) for w in (warnings or ()))
+
+
+def check_finite_tree(key: str, value):
+    """Reject NaN/inf anywhere inside a TOML value (builder options)."""
+    if isinstance(value, float) and not math.isfinite(value):
+        raise field_error(key, value, "must be a finite number")
+    if isinstance(value, list):
+        for i, v in enumerate(value):
+            check_finite_tree(f"{key}[{i}]", v)
+    if isinstance(value, dict):
+        for k, v in value.items():
+            check_finite_tree(f"{key}.{k}", v)
+
+
+def _freeze(value):
+    """TOML lists -> tuples (recursively), for builder options."""
+    if isinstance(value, list):
+        return tuple(_freeze(v) for v in value)
+    if isinstance(value, dict):
+        return {k: _freeze(v) for k, v in value.items()}
+    return value
+
+
+_OPTION_TYPES = {  # spec field annotation (spaces removed) -> what a TOML / CLI value must be
+    "float": "number",
+    "float|None": "number",
+    "int": "int",
+    "int|None": "int",
+    "bool": "bool",
+    "str": "str",
+}
+
+
+def _check_option_type(key: str, value, spec_field: dataclasses.Field):
+    """Light type check of a builder option against its spec field (the builder validates ranges itself)."""
+    ann = spec_field.type if isinstance(spec_field.type, str) else spec_field.type.__name__
+    ann = ann.replace(" ", "")
+    if value is None and (spec_field.default is None or "None" in ann):
+        return value  # programmatic callers may pass None where the builder accepts it
+    expected = _OPTION_TYPES[ann]
+    if expected == "number":
+        if not is_real(value):
+            raise field_error(key, value, "must be a number")
+        return float(value)
+    if expected == "int" and (isinstance(value, bool) or not isinstance(value, int)):
+        raise field_error(key, value, "must be an integer")
+    if expected == "bool" and not isinstance(value, bool):
+        raise field_error(key, value, "must be true or false")
+    if expected == "str" and not isinstance(value, str):
+        raise field_error(key, value, "must be a string")
+    return value
+
+
+def build_structure(builder: str, options: dict, density: float, thickness: float) -> Assembly:
+    """``BUILDERS[builder](**options).build()``; errors become InputError ``key = value: problem``.
+
+    ``density`` and ``thickness`` (the material's) are passed to the builder unless ``options`` sets them.
+    """
+    from geometry_library.builders import BUILDERS
+
+    if builder not in BUILDERS:
+        raise field_error("builder", builder, f"unknown builder (expected one of {', '.join(sorted(BUILDERS))})")
+    spec_cls = BUILDERS[builder]
+    params = {f.name: f for f in dataclasses.fields(spec_cls)}
+    kwargs = {}
+    for key, value in options.items():
+        if key not in params:
+            close = difflib.get_close_matches(key, list(params), n=1)
+            hint = f'did you mean "{close[0]}"?' if close else f"options: {', '.join(params) or 'none'}"
+            raise InputError(f'unknown option {quote_string(key)} of builder "{builder}" ({hint})')
+        kwargs[key] = _check_option_type(key, _freeze(value), params[key])
+    for key, value in (("density", density), ("thickness", thickness)):
+        if key in params and key not in kwargs:
+            kwargs[key] = value
+    try:
+        assembly = spec_cls(**kwargs).build()
+    except ValueError as exc:  # GeometryError, InputError, bad values; a TypeError is a bug: not hidden
+        raise InputError(f'builder "{builder}": {one_line(exc)}') from None
+    if not isinstance(assembly, Assembly):
+        raise InputError(f'builder "{builder}" returned {type(assembly).__name__}, not an Assembly')
+    return assembly
