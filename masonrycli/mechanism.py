@@ -18,6 +18,9 @@ Per block (the paper's "load level" indicators):
   limit *and* sliding faster than ``SLIP_SPEED`` (``reported_status``). Weighting by r_n keeps lightly
   loaded contacts (vertical joints) from dominating the ratio.
 
+Per contact, ``mobilised_friction`` is the share of the available friction in use, |r_t| / (μ r_n): 1 at
+the friction limit, 0 on open contacts (and where μ r_n ≤ 0, where no friction is available).
+
 A joint is **hinged** when exactly one of its current contact points carries normal force (r_n > 0),
 its other end has opened by more than ``OPENING``, and it carries at least ``LOAD_FRACTION`` × the
 mean block weight (nearly unloaded joints are not reported).
@@ -50,6 +53,18 @@ def reported_status(status: np.ndarray, tangential_velocity: np.ndarray) -> np.n
     """(C,) int8: the solver's contact status with slip kept only where |u_t| > ``SLIP_SPEED``."""
     out = np.array(status, dtype=np.int8, copy=True)
     out[(out == CONTACT_SLIP) & (np.abs(tangential_velocity) <= SLIP_SPEED)] = CONTACT_STICK
+    return out
+
+
+def mobilised_friction(contact_r: np.ndarray, status: np.ndarray, friction: float) -> np.ndarray:
+    """(C,) |r_t| / (μ r_n) of the closed contacts (status not open), 0 for open ones or where μ r_n ≤ 0.
+
+    ``contact_r`` (C, 2) holds the local impulses (r_t, r_n); ``friction`` is the Coulomb coefficient μ.
+    """
+    closed = status != CONTACT_OPEN
+    out = np.zeros(status.shape[0])
+    denom = friction * contact_r[closed, 1]
+    out[closed] = np.divide(np.abs(contact_r[closed, 0]), denom, out=np.zeros(denom.size), where=denom > 0)
     return out
 
 

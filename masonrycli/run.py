@@ -15,8 +15,8 @@ import numpy as np
 
 from masonrycli.engine import integrate
 from masonrycli.engine.solver import Solver, StepStats
-from masonrycli.frame import CONTACT_OPEN, Frame
-from masonrycli.mechanism import JointTracker, reported_status
+from masonrycli.frame import Frame
+from masonrycli.mechanism import JointTracker, mobilised_friction, reported_status
 from masonrycli.model import Model, State, build_model, initial_state
 from masonrycli.tensors import TensorComputer, build_triangles, chain_neighbours
 
@@ -110,10 +110,7 @@ class Simulation:
             force, gap = s.contact_force, s.contact_gap
             status = reported_status(s.contact_status, s.contact_tangential_velocity(st.body_v))
             r = s.contact_r
-            closed = status != CONTACT_OPEN
-            mobilised = np.zeros(c)
-            denom = m.friction * r[closed, 1]
-            mobilised[closed] = np.divide(np.abs(r[closed, 0]), denom, out=np.zeros(denom.size), where=denom > 0)
+            mobilised = mobilised_friction(r, status, m.friction)
             support_force = s.support_force
             iterations, residual = self.last.iterations, self.last.residual
             hinged, hinge_point = self.hinges()

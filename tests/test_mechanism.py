@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from masonrycli.frame import CONTACT_OPEN, CONTACT_SLIP, CONTACT_STICK
-from masonrycli.mechanism import OPENING, JointTracker
+from masonrycli.mechanism import OPENING, JointTracker, mobilised_friction
 
 # Block 0: unit square on [0,1]x[0,1]; block 1: unit square on [0,1]x[1,2]; body 2: a support below.
 Q0 = np.array([[0.5, 0.5, 0.0], [0.5, 1.5, 0.0], [0.5, -0.5, 0.0]])
@@ -106,3 +106,13 @@ def test_corner_contacts_do_not_count_as_openings():
     assert jt.opening(q)[0] > 0  # the end itself separates along its normal
     f = jt.block_fields(q, np.zeros((0, 2), int), np.zeros((0, 2)), np.zeros(0, np.int8))
     np.testing.assert_array_equal(f["block_max_opening"], [0.0, 0.0])
+
+
+def test_mobilised_friction_is_the_used_share_of_coulomb_friction():
+    # μ = 0.6. Stick at half the limit, slip at the limit (either sign of r_t), an open contact carrying
+    # a stale impulse, and a closed contact without normal impulse (no friction available).
+    r = np.array([[0.3, 1.0], [-1.2, 2.0], [1.2, 2.0], [0.5, 1.0], [0.1, 0.0]])
+    status = np.array([CONTACT_STICK, CONTACT_SLIP, CONTACT_SLIP, CONTACT_OPEN, CONTACT_STICK], dtype=np.int8)
+    got = mobilised_friction(r, status, 0.6)
+    np.testing.assert_allclose(got, [0.5, 1.0, 1.0, 0.0, 0.0], rtol=1e-15)
+    assert mobilised_friction(np.zeros((0, 2)), np.zeros(0, dtype=np.int8), 0.6).shape == (0,)
