@@ -79,10 +79,22 @@ CASE4_S2 = -2000.0 - math.sqrt(500.0**2 + 750.0**2)
 CASE4_ANGLE = 0.5 * math.atan2(-1500.0, 1000.0)
 
 
-def test_case4_reference_values_are_the_design_numbers():
-    assert CASE4_S1 == pytest.approx(-1098.612, abs=5e-4)
-    assert CASE4_S2 == pytest.approx(-2901.388, abs=5e-4)
-    assert math.degrees(CASE4_ANGLE) == pytest.approx(-28.155, abs=5e-4)
+def test_case4_principal_stresses_are_the_design_numbers():
+    # The code on DESIGN.md §6 case 4, against the numbers printed there (3 decimals) and, to 1e-10,
+    # against numpy: σ = Σ x ⊗ F / A and the eigen-decomposition of σ (symmetric here).
+    body = np.tile([0, 1], (8, 1)).astype(np.int32)
+    sigma = T.block_stress(1, np.zeros((2, 3)), np.array([0.08]), body, CASE4_POINTS, -CASE4_FORCES)[0]
+    values, angle = T.principal(sigma)
+    np.testing.assert_allclose(values, [-1098.612, -2901.388], rtol=0, atol=5e-4)
+    assert math.degrees(angle) == pytest.approx(-28.155, abs=5e-4)
+    reference = np.einsum("ki,kj->ij", CASE4_POINTS, CASE4_FORCES) / 0.08
+    np.testing.assert_allclose(sigma, reference, rtol=1e-12)
+    w, v = np.linalg.eigh(reference)
+    np.testing.assert_allclose(values, w[::-1], rtol=1e-10)
+    assert math.tan(angle) == pytest.approx(v[1, 1] / v[0, 1], rel=1e-10)
+    # The module's constants, used by the tests below, are these numbers.
+    np.testing.assert_allclose([CASE4_S1, CASE4_S2, CASE4_ANGLE], [*values, angle], rtol=1e-10)
+    np.testing.assert_allclose(CASE4_SIGMA, reference, rtol=1e-12)
 
 
 def test_case4_block_against_support():
