@@ -1,0 +1,137 @@
+"""One limit analysis, end to end: scenario → model → joints → LP → mechanism, hinges, line of thrust.
+
+:func:`analyse` is what ``masonry limit`` runs; :class:`LimitResult` holds everything it reports, and
+:meth:`LimitResult.summary` is the JSON object of ``--json``.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from masonrycli.limit.joints import Joints, find_joints, joint_names
+from masonrycli.limit.kinematics import JointMotion, joint_motion
+from masonrycli.limit.problem import LiveLoad, LPSolution, load_vectors, solve_limit
+from masonrycli.limit.thrust import ThrustLine, thrust_line
+from masonrycli.model import Model, build_model
+
+
+@dataclass(frozen=True, eq=False)
+class LimitResult:
+    """A limit analysis: the program's answer and its reading."""
+
+    scenario_name: str
+    load: LiveLoad
+    model: Model
+    joints: Joints
+    solution: LPSolution
+    motion: JointMotion
+    thrust: ThrustLine
+    reference_force: float
+    """N: the live load at λ = 1 (total weight, or the loaded block's weight)."""
+    analysis_time: float
+    """s: joints + assembly + solve + reading (model building excluded)."""
+
+    @property
+    def load_factor(self) -> float:
+        return self.solution.load_factor
+
+    @property
+    def names(self) -> list[str]:
+        return joint_names(self.model, self.joints)
+
+    @property
+    def hinges(self) -> list[str]:
+        return [n for n, h in zip(self.names, self.motion.joint_hinged) if h]
+
+    @property
+    def sliding_joints(self) -> list[str]:
+        return [n for n, s in zip(self.names, self.motion.joint_sliding) if s]
+
+    @property
+    def moving_blocks(self) -> list[str]:
+        return [n for n, m in zip(self.model.block_name, self.motion.block_moving) if m]
+
+    def tilt_angle(self) -> float | None:
+        """Degrees: the tilting table's critical angle atan(λ) (body-force loads only)."""
+        return None if self.load.kind == "point" else math.degrees(math.atan(self.load_factor))
+
+    def summary(self) -> dict:
+        """Everything ``--json`` prints: plain numbers, strings and lists."""
+        m, j, th = self.model, self.joints, self.thrust
+        names = self.names
+        hinge_idx = np.flatnonzero(self.motion.joint_hinged)
+        line = [
+            {
+                "joint": names[k],
+                "point": _finite(th.joint_point[k]),
+                "normal_force": float(th.joint_normal_force[k]),
+                "shear_force": float(th.joint_shear_force[k]),
+                "eccentricity": _finite(th.joint_eccentricity[k]),
+            }
+            for k in range(j.joint_count)
+        ]
+        return {
+            "scenario": self.scenario_name,
+            "load": {"kind": self.load.kind, "direction": self.load.direction, "block": self.load.block},
+            "load_factor": self.load_factor,
+            "tilt_angle_deg": self.tilt_angle(),
+            "collapse_load_N": self.load_factor * self.reference_force,
+            "reference_load_N": self.reference_force,
+            "friction": m.friction,
+            "blocks": m.block_count,
+            "supports": m.support_count,
+            "joints": j.joint_count,
+            "contact_points": j.contact_count,
+            "hinges": self.hinges,
+            "hinge_points": [[float(x), float(y)] for x, y in self.motion.hinge_point],
+            "sliding_joints": self.sliding_joints,
+            "moving_blocks": self.moving_blocks,
+            "mechanism": {
+                name: [float(v) for v in vel]
+                for name, vel, moving in zip(m.block_name, self.solution.block_velocity, self.motion.block_moving)
+                if moving
+            },
+            "line_of_thrust": line,
+            "hinge_joint_index": hinge_idx.tolist(),
+            "solve_time_s": self.solution.solve_time,
+            "analysis_time_s": self.analysis_time,
+            "lp_iterations": self.solution.iterations,
+        }
+
+
+def _finite(value):
+    arr = np.atleast_1d(np.asarray(value, dtype=float))
+    if not np.isfinite(arr).all():
+        return None
+    return [float(v) for v in arr] if np.ndim(value) else float(arr[0])
+
+
+def analyse_model(model: Model, load: LiveLoad, scenario_name: str = "") -> LimitResult:
+    """Limit analysis of a built model (supports are rigid and fixed whatever their motion in a run)."""
+    t0 = time.perf_counter()
+    joints = find_joints(model)
+    dead, live, reference = load_vectors(model, load)
+    solution = solve_limit(model, joints, dead, live)
+    motion = joint_motion(model, joints, solution.block_velocity)
+    weight = float(np.mean(model.body_mass[: model.block_count]) * np.hypot(*model.gravity))
+    thrust = thrust_line(joints, solution.contact_force, loaded=1e-9 * weight)
+    return LimitResult(
+        scenario_name=scenario_name,
+        load=load,
+        model=model,
+        joints=joints,
+        solution=solution,
+        motion=motion,
+        thrust=thrust,
+        reference_force=reference,
+        analysis_time=time.perf_counter() - t0,
+    )
+
+
+def analyse(scenario, load: LiveLoad) -> LimitResult:
+    """Limit analysis of ``scenario`` (its blocks, supports, material and gravity) under ``load``."""
+    return analyse_model(build_model(scenario), load, scenario.name)

@@ -1,0 +1,87 @@
+"""Joints of an assembly for limit analysis: the engine's contacts, grouped per pair of bodies.
+
+The contact points come from :func:`masonrycli.engine.collision.detect_contacts` — the very detection the
+time loop runs — in the initial configuration, with the model's alert distance. So every assembly the
+engine can run can also be analysed, and a joint here is a joint there.
+
+A *joint* is one pair of bodies (a < b; supports come after the blocks) with its contact points: two
+for a face-to-face joint (the ends of the shared segment), one for a corner touching a face. All the
+points of a joint share one normal n (from a to b) and tangent t = (−n_y, n_x).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from masonrycli.engine.collision import ContactBuffers, detect_contacts
+from masonrycli.model import Model
+
+
+@dataclass(frozen=True, eq=False)
+class Joints:
+    """Contacts of the initial configuration, sorted by pair (C contacts, J joints)."""
+
+    contact_body: np.ndarray
+    """(C, 2) int64: bodies a < b (blocks 0..N-1, then supports)."""
+    contact_point: np.ndarray
+    """(C, 2) m: contact point, world coordinates."""
+    contact_normal: np.ndarray
+    """(C, 2): unit normal from a to b."""
+    contact_joint: np.ndarray
+    """(C,) int64: joint of each contact."""
+    joint_body: np.ndarray
+    """(J, 2) int64: the two bodies of each joint."""
+    joint_start: np.ndarray
+    """(J+1,) int64: contacts of joint j are rows joint_start[j]:joint_start[j+1]."""
+
+    @property
+    def contact_count(self) -> int:
+        return int(self.contact_body.shape[0])
+
+    @property
+    def joint_count(self) -> int:
+        return int(self.joint_body.shape[0])
+
+    @property
+    def contact_tangent(self) -> np.ndarray:
+        """(C, 2): t = (−n_y, n_x)."""
+        n = self.contact_normal
+        return np.stack([-n[:, 1], n[:, 0]], axis=1)
+
+    @property
+    def joint_points(self) -> np.ndarray:
+        """(J,) int64: number of contact points of each joint (2 for faces, 1 for corners)."""
+        return np.diff(self.joint_start)
+
+
+def find_joints(model: Model) -> Joints:
+    """The joints of ``model`` in its initial configuration (engine contact detection, model alert distance)."""
+    buffers = ContactBuffers(model.body_vert_start)
+    count = detect_contacts(
+        model.body_q0, model.body_vert_start, model.vert_local, model.body_dynamic, model.alert_distance, buffers
+    )
+    c = buffers.view()
+    body = np.asarray(c.contact_body[:count], dtype=np.int64)
+    # detect_contacts sorts by pair already; a stable sort keeps that promise explicit and cheap.
+    key = body[:, 0] * model.body_count + body[:, 1]
+    order = np.argsort(key, kind="stable")
+    key, body = key[order], body[order]
+    first = np.ones(key.size, dtype=bool)
+    first[1:] = key[1:] != key[:-1]
+    starts = np.flatnonzero(first)
+    return Joints(
+        contact_body=body,
+        contact_point=np.array(c.contact_point[:count][order], dtype=np.float64),
+        contact_normal=np.array(c.contact_normal[:count][order], dtype=np.float64),
+        contact_joint=np.cumsum(first) - 1,
+        joint_body=body[starts].copy(),
+        joint_start=np.append(starts, key.size).astype(np.int64),
+    )
+
+
+def joint_names(model: Model, joints: Joints) -> list[str]:
+    """``"a|b"`` for each joint, the two body names as the dynamic run's hinge report spells them."""
+    names = list(model.block_name) + list(model.support_name)
+    return [f"{names[a]}|{names[b]}" for a, b in joints.joint_body]

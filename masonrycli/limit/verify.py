@@ -1,0 +1,133 @@
+"""Static and dynamic side by side: run the NSCD engine near the LP's collapse load.
+
+The LP assumes associative friction (a sliding joint dilates by μ × its slip); real joints do not, so
+where sliding matters the LP's λ is an upper bound. This module checks λ with the engine itself: the
+structure starts at rest under gravity tilted to atan(f·λ) — the tilting table, which is the horizontal
+body-force load λ·weight up to a factor on all loads that no rigid no-tension structure feels — for
+f = 0.95 and 1.05, with every support fixed. It should stand at 0.95 λ and collapse at 1.05 λ.
+
+"Collapse" means some block moved more than ``COLLAPSE_SHARE`` × the median block radius; the run stops
+there, and its displacement field is compared with the LP's mechanism:
+
+    similarity = Σ_i d_i · u_i / (|d| |u|),   d_i = (Δx_i, Δy_i, Δθ_i r_i),  u_i = (vx_i, vy_i, ω_i r_i)
+
+(r_i: block radius, so rotations weigh like the motion they give a block's corners), together with the
+hinged joints of the dynamic run (``masonrycli.mechanism``) found at that instant.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from masonrycli.errors import InputError
+from masonrycli.limit.analysis import LimitResult
+from masonrycli.motion import Motion
+from masonrycli.run import Simulation
+
+FACTORS = (0.95, 1.05)
+"""Multiples of λ the engine is run at."""
+DURATION = 2.0
+"""s of simulated time per run (a run that collapses stops earlier)."""
+COLLAPSE_SHARE = 0.1
+"""A block displaced by more than this × the median block radius means the structure is collapsing."""
+
+
+@dataclass(frozen=True)
+class DynamicCheck:
+    """One engine run at f·λ."""
+
+    factor: float
+    tilt_deg: float
+    collapsed: bool
+    time: float
+    """s: when the collapse threshold was crossed, or the end of the run."""
+    max_displacement: float
+    """m: largest block displacement at that time."""
+    threshold: float
+    """m: the collapse threshold."""
+    similarity: float | None
+    """Cosine between the dynamic displacement field and the LP mechanism (collapsing runs only)."""
+    hinges: tuple[str, ...]
+    """Joints hinged in the dynamic run at that time."""
+    shared_hinges: tuple[str, ...]
+    """Of those, the ones the LP's mechanism hinges too."""
+    wall_time: float
+
+    @property
+    def as_predicted(self) -> bool:
+        return self.collapsed == (self.factor > 1.0)
+
+    def summary(self) -> dict:
+        return dataclasses.asdict(self) | {"as_predicted": self.as_predicted}
+
+
+def tilted_scenario(scenario, result: LimitResult, factor: float, duration: float):
+    """``scenario`` with gravity tilted to atan(factor·λ) towards the live load, fixed supports, ``duration``."""
+    if result.load.kind == "point":
+        raise InputError("--verify: the engine has no point loads; verify a horizontal or tilt load")
+    g = float(np.hypot(*scenario.run.gravity))
+    side = 1.0 if result.load.direction == "+x" else -1.0
+    psi = math.atan(factor * result.load_factor)
+    gravity = (side * g * math.sin(psi), -g * math.cos(psi))
+    run = dataclasses.replace(scenario.run, gravity=gravity, duration=duration, record_every=10**6)
+    return dataclasses.replace(scenario, run=run, motions=tuple(Motion() for _ in scenario.motions))
+
+
+def _similarity(displacement: np.ndarray, velocity: np.ndarray, radius: np.ndarray) -> float:
+    d = displacement * np.array([1.0, 1.0, 0.0]) + np.outer(displacement[:, 2] * radius, [0.0, 0.0, 1.0])
+    u = velocity * np.array([1.0, 1.0, 0.0]) + np.outer(velocity[:, 2] * radius, [0.0, 0.0, 1.0])
+    norm = float(np.linalg.norm(d) * np.linalg.norm(u))
+    return float((d * u).sum() / norm) if norm > 0 else 0.0
+
+
+def run_check(scenario, result: LimitResult, factor: float, duration: float = DURATION) -> DynamicCheck:
+    """Run the engine at ``factor`` × λ until it collapses or ``duration`` ends."""
+    t0 = time.perf_counter()
+    sim = Simulation(tilted_scenario(scenario, result, factor, duration))
+    m = sim.model
+    n = m.block_count
+    threshold = COLLAPSE_SHARE * float(np.median(m.body_radius[:n]))
+    q0 = m.body_q0[:n].copy()
+    radius = m.body_radius[:n]
+
+    def displacement() -> np.ndarray:
+        d = sim.state.body_q[:n] - q0
+        return np.hypot(d[:, 0], d[:, 1]) + np.abs(d[:, 2]) * radius
+
+    collapsed = False
+    for _ in range(m.n_steps):
+        sim.step()
+        if sim.diverged() or displacement().max() > threshold:
+            collapsed = True
+            break
+    largest = float(displacement().max())
+    hinged, _ = sim.hinges() if sim.last is not None else (np.zeros(0, dtype=bool), None)
+    names = list(m.block_name) + list(m.support_name)
+    hinges = tuple(f"{names[a]}|{names[b]}" for a, b in sim.joints.joint_body[hinged])
+    similarity = None
+    if collapsed:
+        moved = sim.state.body_q[:n] - q0
+        similarity = _similarity(moved, result.solution.block_velocity, radius)
+    lp_hinges = set(result.hinges)
+    return DynamicCheck(
+        factor=factor,
+        tilt_deg=math.degrees(math.atan(factor * result.load_factor)),
+        collapsed=collapsed,
+        time=sim.state.time,
+        max_displacement=largest,
+        threshold=threshold,
+        similarity=similarity,
+        hinges=hinges,
+        shared_hinges=tuple(h for h in hinges if h in lp_hinges),
+        wall_time=time.perf_counter() - t0,
+    )
+
+
+def verify(scenario, result: LimitResult, factors=FACTORS, duration: float = DURATION) -> list[DynamicCheck]:
+    """One :func:`run_check` per factor (default 0.95 and 1.05)."""
+    return [run_check(scenario, result, f, duration) for f in factors]
