@@ -515,6 +515,47 @@ def run_command(
     _execute(scenario, _outputs(scenario.name, out, no_recording), history)
 
 
+@app.command("limit")
+@user_errors
+def limit_command(
+    structure: Annotated[
+        str,
+        typer.Argument(
+            help="wall, arch or aqueduct (built-in defaults), a scenario file (TOML) or a GeoJSON / WKT geometry.",
+            metavar="SCENARIO|wall|arch|aqueduct",
+        ),
+    ],
+    load: Annotated[
+        str, typer.Option(help="horizontal (λ × weight), tilt (tilting table, tan ψ = λ) or point (on --block).")
+    ] = "horizontal",
+    block: Annotated[str | None, typer.Option(help="Block carrying the point load (λ × its weight).")] = None,
+    direction: Annotated[str, typer.Option(help="+x or -x (a point load also +y or -y).")] = "+x",
+    friction: Friction = None,
+    as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object on stdout, nothing else.")] = False,
+    verify: Annotated[
+        bool, typer.Option("--verify", help="Run the NSCD engine at 0.95 λ and 1.05 λ (tilted gravity) and compare.")
+    ] = False,
+    out: Annotated[
+        Path | None, typer.Option("--out", "-o", help="Write the mechanism recording (.rrd).", metavar="REC.rrd")
+    ] = None,
+) -> None:
+    """The collapse load factor λ and mechanism of a block assembly (rigid-block limit analysis, one LP)."""
+    from masonrycli.limit.command import run_limit
+
+    run_limit(
+        structure,
+        load=load,
+        direction=direction,
+        block=block,
+        friction=friction,
+        as_json=as_json,
+        verify=verify,
+        out=out,
+        console=console,
+        err_console=err_console,
+    )
+
+
 @app.command("check")
 @user_errors
 def check_command(

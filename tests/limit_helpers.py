@@ -6,7 +6,7 @@ import numpy as np
 from shapely.geometry import Polygon, box
 
 from geometry_library.blocks import Assembly, Block, Support
-from masonrycli.motion import Motion
+from masonrycli.motion import Fixed
 from masonrycli.scenario import Material, RunConfig, Scenario
 
 DENSITY = 2000.0
@@ -23,7 +23,7 @@ def scenario(blocks, supports, friction: float, name: str = "test", **run) -> Sc
         run=RunConfig(**run),
         material=Material(density=DENSITY, friction=friction),
         assembly=assembly,
-        motions=tuple(Motion() for _ in supports),
+        motions=tuple(Fixed() for _ in supports),
     )
 
 

@@ -65,7 +65,9 @@ class LiveLoad:
             raise InputError(f"--load {self.kind}: expected one of {', '.join(LOAD_KINDS)}")
         allowed = tuple(DIRECTIONS) if self.kind == "point" else ("+x", "-x")
         if self.direction not in allowed:
-            raise InputError(f"--direction {self.direction}: expected one of {', '.join(allowed)} for a {self.kind} load")
+            raise InputError(
+                f"--direction {self.direction}: expected one of {', '.join(allowed)} for a {self.kind} load"
+            )
         if self.kind == "point" and not self.block:
             raise InputError("--load point: name the loaded block with --block NAME")
         if self.kind != "point" and self.block:
@@ -132,9 +134,7 @@ def equilibrium_matrix(model: Model, joints: Joints) -> sp.csc_matrix:
         rows += [3 * b, 3 * b + 1, 3 * b + 2]
         cols += [col, col, col]
         vals += [f[:, 0], f[:, 1], moment]
-    return sp.csc_matrix(
-        (np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))), shape=(3 * n, 2 * c)
-    )
+    return sp.csc_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))), shape=(3 * n, 2 * c))
 
 
 @dataclass(frozen=True, eq=False)

@@ -26,7 +26,7 @@ import numpy as np
 
 from masonrycli.errors import InputError
 from masonrycli.limit.analysis import LimitResult
-from masonrycli.motion import Motion
+from masonrycli.motion import Fixed
 from masonrycli.run import Simulation
 
 FACTORS = (0.95, 1.05)
@@ -75,7 +75,7 @@ def tilted_scenario(scenario, result: LimitResult, factor: float, duration: floa
     psi = math.atan(factor * result.load_factor)
     gravity = (side * g * math.sin(psi), -g * math.cos(psi))
     run = dataclasses.replace(scenario.run, gravity=gravity, duration=duration, record_every=10**6)
-    return dataclasses.replace(scenario, run=run, motions=tuple(Motion() for _ in scenario.motions))
+    return dataclasses.replace(scenario, run=run, motions=tuple(Fixed() for _ in scenario.motions))
 
 
 def _similarity(displacement: np.ndarray, velocity: np.ndarray, radius: np.ndarray) -> float:

@@ -1,0 +1,200 @@
+"""What ``masonry limit`` does behind its Typer command: resolve the structure, analyse, verify, report.
+
+The structure is a built-in name (``wall``, ``arch``, ``aqueduct``: the builders' defaults), a scenario
+file (TOML) or a geometry file (GeoJSON / WKT), resolved as ``masonry run`` resolves them. ``--json``
+prints exactly one JSON object on stdout and nothing else (warnings go to stderr).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+from pathlib import Path
+
+import numpy as np
+from rich.console import Console
+from rich.table import Table
+
+from masonrycli.errors import InputError
+from masonrycli.limit.analysis import LimitResult, analyse
+from masonrycli.limit.problem import LiveLoad
+
+BUILT_INS = ("wall", "arch", "aqueduct")
+SHOWN = 8
+"""Joint names listed in the terminal table (all of them are in --json)."""
+THRUST_SHOWN = 0.02
+"""The recording's line of thrust shows joints carrying at least this share of the largest joint force."""
+
+
+def resolve_structure(structure: str, friction: float | None):
+    """A scenario from a built-in name, a scenario file or a geometry file; ``friction`` overrides μ."""
+    from masonrycli.scenario import (
+        GEOMETRY_SUFFIXES,
+        Material,
+        RunConfig,
+        load_scenario,
+        scenario_from_builder,
+        scenario_from_geometry_file,
+    )
+
+    path = Path(structure)
+    if structure in BUILT_INS and not path.exists():
+        scenario = scenario_from_builder(structure, {}, RunConfig(), Material(), {})
+    elif not path.is_file():
+        raise InputError(f"{structure}: no such scenario or geometry file (built-ins: {', '.join(BUILT_INS)})")
+    elif path.suffix.lower() in GEOMETRY_SUFFIXES:
+        scenario = scenario_from_geometry_file(path)
+    else:
+        scenario = load_scenario(path)
+    if friction is not None:
+        try:
+            material = dataclasses.replace(scenario.material, friction=friction)
+        except InputError as exc:
+            raise InputError(f"--friction: {exc}") from None
+        scenario = dataclasses.replace(scenario, material=material)
+    return scenario
+
+
+def _names(names: list[str]) -> str:
+    shown = ", ".join(names[:SHOWN]) + (" …" if len(names) > SHOWN else "")
+    return f"{len(names)}" + (f": {shown}" if names else "")
+
+
+def result_table(result: LimitResult, out: Path | None) -> Table:
+    s = result.summary()
+    table = Table(title=f"masonry limit — {result.scenario_name}", show_header=False, title_justify="left")
+    table.add_column("quantity", style="bold")
+    table.add_column("value")
+    table.add_row("structure", f"{s['blocks']} blocks, {s['supports']} supports, friction μ = {s['friction']:g}")
+    table.add_row("joints", f"{s['joints']} ({s['contact_points']} contact points, from the engine's detection)")
+    table.add_row("live load", result.load.describe())
+    lam = f"[bold]{result.load_factor:.4f}[/bold]"
+    if result.tilt_angle() is not None:
+        lam += f"  (tilt ψ = {result.tilt_angle():.2f}°)"
+    table.add_row("load factor λ", lam)
+    table.add_row("collapse load", f"{s['collapse_load_N']:.4g} N (λ × {s['reference_load_N']:.4g} N)")
+    table.add_row("hinges", _names(result.hinges))
+    table.add_row("sliding joints", _names(result.sliding_joints))
+    table.add_row("blocks in the mechanism", f"{len(result.moving_blocks)} of {s['blocks']}")
+    table.add_row(
+        "solve time", f"{s['solve_time_s'] * 1e3:.0f} ms HiGHS, {s['analysis_time_s'] * 1e3:.0f} ms analysis in all"
+    )
+    if out is not None:
+        table.add_row("recording", str(out))
+    return table
+
+
+def verify_table(checks) -> Table:
+    table = Table(title="--verify: the NSCD engine under gravity tilted to atan(f·λ)", title_justify="left")
+    for col in ("f", "tilt", "engine", "predicted", "max displacement", "mechanism similarity", "hinges shared"):
+        table.add_column(col)
+    for c in checks:
+        table.add_row(
+            f"{c.factor:g}",
+            f"{c.tilt_deg:.2f}°",
+            f"collapses at t = {c.time:.3f} s" if c.collapsed else f"stands for {c.time:.2f} s",
+            ("yes" if c.as_predicted else "[bold red]no[/bold red]"),
+            f"{c.max_displacement * 1e3:.2f} mm (threshold {c.threshold * 1e3:.1f})",
+            "" if c.similarity is None else f"{c.similarity:.3f}",
+            f"{len(c.shared_hinges)} of {len(c.hinges)}",
+        )
+    return table
+
+
+def mechanism_document(result: LimitResult) -> str:
+    """Markdown for the recording's side panel."""
+    tilt = result.tilt_angle()
+    lines = [
+        f"# masonry limit: {result.scenario_name}",
+        f"**load factor λ = {result.load_factor:.4f}**" + (f" (tilt {tilt:.2f}°)" if tilt is not None else ""),
+        "",
+        f"live load: {result.load.describe()}; friction {result.model.friction:g}",
+        "",
+        "Left: the structure as built; red dots: the line of thrust (centre of pressure of each loaded joint).",
+        "Right: the collapse mechanism, magnified, blocks coloured by their speed in it (grey: still);",
+        "yellow: hinges; orange: sliding joints. Play the timeline to grow the mechanism.",
+        "",
+        f"hinges ({len(result.hinges)}): " + ", ".join(result.hinges[:40]),
+        "",
+        f"sliding joints ({len(result.sliding_joints)}): " + ", ".join(result.sliding_joints[:40]),
+    ]
+    return "\n".join(lines)
+
+
+def write_recording(result: LimitResult, out: Path) -> None:
+    """The mechanism recording (``masonrycli.recording.limit``) of ``result``."""
+    from masonrycli.recording.limit import MechanismDrawing, write_limit_recording
+
+    m, j, mo = result.model, result.joints, result.motion
+    n = m.block_count
+    start = m.body_vert_start
+    first, last = j.joint_start[:-1], j.joint_start[1:] - 1
+    # The block that carries a joint marker into the mechanism copy: b unless b is a support.
+    carrier = np.where(j.joint_body[:, 1] < n, j.joint_body[:, 1], j.joint_body[:, 0])
+    middle = 0.5 * (j.contact_point[first] + j.contact_point[last])
+    # Centres of pressure of the joints that carry load (lightly loaded head joints only clutter the line).
+    normal = result.thrust.joint_normal_force
+    thrust = result.thrust.joint_point[normal >= THRUST_SHOWN * normal.max(initial=0.0)]
+    drawing = MechanismDrawing(
+        block_vert_start=start[: n + 1].copy(),
+        block_vert_local=m.vert_local[: start[n]].copy(),
+        block_q0=m.body_q0[:n].copy(),
+        block_velocity=result.solution.block_velocity,
+        block_moving=mo.block_moving,
+        support_vert_start=start[n:] - start[n],
+        support_vert_local=m.vert_local[start[n] :].copy(),
+        support_q0=m.body_q0[n:].copy(),
+        hinge_point=mo.hinge_point,
+        hinge_block=carrier[mo.joint_hinged],
+        sliding_point=middle[mo.joint_sliding],
+        sliding_block=carrier[mo.joint_sliding],
+        thrust_point=thrust[np.isfinite(thrust).all(axis=1)],
+        document=mechanism_document(result),
+    )
+    out.parent.mkdir(parents=True, exist_ok=True)
+    write_limit_recording(out, drawing)
+
+
+def run_limit(
+    structure: str,
+    *,
+    load: str,
+    direction: str,
+    block: str | None,
+    friction: float | None,
+    as_json: bool,
+    verify: bool,
+    out: Path | None,
+    console: Console,
+    err_console: Console,
+) -> None:
+    """``masonry limit``: analyse, optionally record and verify, then print a table or one JSON object."""
+    if out is not None and out.suffix != ".rrd":
+        raise InputError(f"--out {out}: a recording file must end in .rrd")
+    live = LiveLoad(load, direction, block)
+    scenario = resolve_structure(structure, friction)
+    if verify and live.kind == "point":
+        raise InputError("--verify: the engine has no point loads; verify a horizontal or tilt load")
+    for warning in scenario.warnings:
+        err_console.print(f"[yellow]warning:[/yellow] {warning}", highlight=False)
+    result = analyse(scenario, live)
+    if out is not None:
+        write_recording(result, out)
+    checks = []
+    if verify:
+        from masonrycli.limit.verify import verify as run_verify
+
+        if not as_json:
+            console.print(result_table(result, out))
+            console.print("running the engine at 0.95 λ and 1.05 λ …", style="dim")
+        checks = run_verify(scenario, result)
+    if as_json:
+        summary = result.summary() | {"recording": str(out) if out else None}
+        if verify:
+            summary["verify"] = [c.summary() for c in checks]
+        print(json.dumps(summary, allow_nan=False))
+        return
+    if not verify:
+        console.print(result_table(result, out))
+    else:
+        console.print(verify_table(checks))

@@ -1,0 +1,94 @@
+"""``masonry limit`` as a user drives it: table, one JSON object, recording, bad input in one line."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+from typer.testing import CliRunner
+
+from masonrycli.cli import app
+from masonrycli.scenario_toml import dump_scenario
+
+from limit_helpers import column
+
+runner = CliRunner()
+
+
+def invoke(*args):
+    return runner.invoke(app, [str(a) for a in args])
+
+
+def assert_one_line_error(result, *fragments):
+    assert result.exit_code == 2, result.output
+    assert "Traceback" not in result.output
+    lines = [ln for ln in result.output.strip().splitlines() if ln.strip()]
+    assert len(lines) == 1, result.output
+    for fragment in fragments:
+        assert fragment in lines[0], lines[0]
+
+
+@pytest.fixture(scope="module")
+def column_file(tmp_path_factory) -> Path:
+    path = tmp_path_factory.mktemp("limit") / "column.toml"
+    path.write_text(dump_scenario(column(3, 0.4, 0.2, 0.9)))
+    return path
+
+
+def test_json_is_one_object_with_the_load_factor_hinges_and_sliding_joints(column_file):
+    result = runner.invoke(app, ["limit", str(column_file), "--json"])
+    assert result.exit_code == 0, result.output
+    data = json.loads(result.stdout)  # the whole of stdout is one JSON object
+    assert data["load_factor"] == pytest.approx(0.4 / (3 * 0.2), rel=5e-3)
+    assert data["hinges"] == ["b0|ground"] and data["sliding_joints"] == []
+    assert data["solve_time_s"] > 0 and data["tilt_angle_deg"] > 0
+    assert {"line_of_thrust", "mechanism", "collapse_load_N", "hinge_points"} <= set(data)
+
+
+def test_table_names_lambda_and_mechanism(column_file, tmp_path):
+    out = tmp_path / "col.rrd"
+    result = invoke("limit", column_file, "--load", "tilt", "--direction", "-x", "--out", out)
+    assert result.exit_code == 0, result.output
+    assert "0.6667" in result.output and "b0|ground" in result.output
+    assert out.stat().st_size > 0
+
+
+def test_point_load_on_a_named_block(column_file):
+    result = runner.invoke(app, ["limit", str(column_file), "--load", "point", "--block", "b2", "--json"])
+    data = json.loads(result.stdout)
+    # Top block of 3: overturning of the whole column 3B/(5H) = 1.2 > μ = 0.9, so the top block slides.
+    assert data["load_factor"] == pytest.approx(0.9, rel=5e-3)
+    assert data["sliding_joints"] == ["b1|b2"] and data["load"]["block"] == "b2"
+
+
+def test_built_in_arch_by_name():
+    result = runner.invoke(app, ["limit", "arch", "--json"])
+    data = json.loads(result.stdout)
+    assert data["blocks"] == 98 and 0 < data["load_factor"] < 1 and data["hinges"]
+
+
+@pytest.mark.parametrize(
+    ("args", "fragments"),
+    [
+        (["nowhere.toml"], ["nowhere.toml", "no such scenario"]),
+        (["arch", "--load", "wind"], ["--load wind"]),
+        (["arch", "--load", "point"], ["--block NAME"]),
+        (["arch", "--load", "point", "--block", "v99"], ["--block v99", "no such block"]),
+        (["arch", "--direction", "up"], ["--direction up"]),
+        (["arch", "--friction", "-1"], ["--friction"]),
+        (["arch", "--out", "x.png"], ["--out x.png", ".rrd"]),
+        (["arch", "--load", "point", "--block", "v01", "--verify"], ["--verify", "point"]),
+    ],
+)
+def test_bad_input_is_one_line(args, fragments):
+    assert_one_line_error(invoke("limit", *args), *fragments)
+
+
+def test_infeasible_structure_is_one_line_exit_2(tmp_path):
+    path = tmp_path / "thin.toml"
+    path.write_text(
+        '[material]\nfriction = 2.0\n[[block]]\nname = "leaning"\npolygon = [[0, 0], [1, 0], [1, 1], [0, 1]]\n'
+        '[[support]]\nname = "ground"\npolygon = [[-1, -1], [0.3, -1], [0.3, 0], [-1, 0]]\n'
+    )
+    assert_one_line_error(invoke("limit", path), "no equilibrium")

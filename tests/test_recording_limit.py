@@ -1,0 +1,73 @@
+"""The mechanism recording of a limit analysis: complete file, both copies, the mechanism moved rigidly."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import rerun as rr
+
+from masonrycli.limit import LiveLoad, analyse
+from masonrycli.limit.command import write_recording
+from masonrycli.recording import inspect_recording
+from masonrycli.recording.limit import FILL, HINGES, LIMIT_PATHS, MAGNIFIED_SHARE, OUTLINES, STEPS, THRUST
+
+from limit_helpers import column
+
+
+@pytest.fixture(scope="module")
+def written(tmp_path_factory):
+    result = analyse(column(2, 0.4, 0.8, 0.9), LiveLoad("horizontal"))  # both blocks tip as one about (0.4, 0)
+    path = tmp_path_factory.mktemp("limit") / "mechanism.rrd"
+    write_recording(result, path)
+    return path, result
+
+
+def rows(path, entity: str, column_name: str) -> dict[int, list]:
+    out = {}
+    for chunk in rr.chunk.RrdReader(path).stream():
+        if chunk.entity_path == f"/{entity}" and not chunk.is_static:
+            batch = chunk.to_record_batch()
+            if column_name in batch.schema.names:
+                for step, value in zip(batch.column("step").to_pylist(), batch.column(column_name).to_pylist()):
+                    out[step] = value
+    return out
+
+
+def test_file_is_complete_with_a_blueprint_and_every_entity(written):
+    path, _ = written
+    info = inspect_recording(path)
+    assert info["complete"] and info["has_blueprint"] and info["application_id"] == "masonry"
+    assert info["steps"] == (0, STEPS)
+    assert {f"/{p}" for p in LIMIT_PATHS} <= set(info["entity_paths"])
+
+
+def test_undeformed_copy_stays_and_the_mechanism_copy_rotates_about_the_hinge(written):
+    path, result = written
+    strips = rows(path, OUTLINES, "LineStrips2D:strips")
+    first, last = (np.array(strips[k], dtype=float) for k in (0, STEPS))
+    # Four closed outlines: the two blocks as built, then the two blocks of the mechanism copy.
+    assert len(first) == 4
+    np.testing.assert_allclose(first[:2], last[:2], atol=1e-6)  # the undeformed copy never moves
+    shift = first[2][0] - first[0][0]
+    assert shift[0] > 0.4 and abs(shift[1]) < 1e-6  # beside it, on the right
+    # Full amplitude: the fastest point (the top corner r = √(0.4² + 1.6²) from the toe) turned by
+    # θ = MAGNIFIED_SHARE × size / r about the toe, so it moved 2 r sin(θ/2).
+    r = np.hypot(0.4, 1.6)
+    theta = MAGNIFIED_SHARE * 1.6 / r
+    moved = np.hypot(*(last[2:] - first[2:]).reshape(-1, 2).T).max()
+    assert moved == pytest.approx(2 * r * np.sin(theta / 2), rel=1e-5)
+    # Rigid rotation about the hinge (0.4, 0) (shifted): the toe corner does not move.
+    toe = np.array([0.4, 0.0]) + shift
+    d0 = np.linalg.norm(first[2] - toe, axis=1)
+    d1 = np.linalg.norm(last[2] - toe, axis=1)
+    np.testing.assert_allclose(d0, d1, atol=1e-5)
+
+
+def test_hinge_drawn_on_both_copies_and_thrust_points_static(written):
+    path, result = written
+    hinges = rows(path, HINGES, "Points2D:positions")
+    assert len(hinges[STEPS]) == 2 * len(result.hinges) == 2
+    np.testing.assert_allclose(hinges[STEPS][0], [0.4, 0.0], atol=1e-6)
+    assert FILL in {c.entity_path.lstrip("/") for c in rr.chunk.RrdReader(path).stream()}
+    thrust = [c for c in rr.chunk.RrdReader(path).stream() if c.entity_path == f"/{THRUST}" and c.is_static]
+    assert thrust
