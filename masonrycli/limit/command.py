@@ -28,14 +28,9 @@ THRUST_SHOWN = 0.02
 
 def resolve_structure(structure: str, friction: float | None):
     """A scenario from a built-in name, a scenario file or a geometry file; ``friction`` overrides μ."""
-    from masonrycli.scenario import (
-        GEOMETRY_SUFFIXES,
-        Material,
-        RunConfig,
-        load_scenario,
-        scenario_from_builder,
-        scenario_from_geometry_file,
-    )
+    from masonrycli.scenario import Material, RunConfig, scenario_from_builder, scenario_from_geometry_file
+    from masonrycli.scenario_toml import load_scenario
+    from masonrycli.structure import GEOMETRY_SUFFIXES
 
     path = Path(structure)
     if structure in BUILT_INS and not path.exists():
