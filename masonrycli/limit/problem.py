@@ -185,8 +185,13 @@ def _status_error(status: int, message: str, what: str) -> LimitError:
     return LimitError(f"the linear program failed: {' '.join(message.split())}")
 
 
-def solve_limit(model: Model, joints: Joints, dead: np.ndarray, live: np.ndarray) -> LPSolution:
-    """Maximise λ (see the module docstring). Raises :class:`LimitError` if infeasible or unbounded."""
+def solve_limit(
+    model: Model, joints: Joints, dead: np.ndarray, live: np.ndarray, method: str = METHOD, options: dict | None = None
+) -> LPSolution:
+    """Maximise λ (see the module docstring). Raises :class:`LimitError` if infeasible or unbounded.
+
+    ``method`` and ``options`` go to :func:`scipy.optimize.linprog` (the benchmark compares a tight solve).
+    """
     _check_supported(model, joints)
     weight, _ = _scales(model)
     scale = _row_scale(model)
@@ -196,7 +201,7 @@ def solve_limit(model: Model, joints: Joints, dead: np.ndarray, live: np.ndarray
     cost = np.zeros(a_eq.shape[1])
     cost[-1] = -1.0
     t0 = time.perf_counter()
-    res = linprog(cost, A_eq=a_eq, b_eq=b_eq, bounds=(0, None), method=METHOD)
+    res = linprog(cost, A_eq=a_eq, b_eq=b_eq, bounds=(0, None), method=method, options=options or {})
     elapsed = time.perf_counter() - t0
     if res.status != 0:
         raise _status_error(res.status, res.message, "the blocks cannot carry their own weight")
