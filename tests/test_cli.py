@@ -117,6 +117,7 @@ def test_overlapping_blocks_are_named(tmp_path):
     assert_one_line_error(invoke("check", path), '"a"', '"b"', "overlap")
 
 
+@pytest.mark.slow
 def test_sigint_leaves_a_readable_recording(tmp_path):
     """Ctrl-C in the middle of a real run: exit 130, recording with footer, history written."""
     rrd, npz = tmp_path / "int.rrd", tmp_path / "int.npz"

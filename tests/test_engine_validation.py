@@ -133,6 +133,7 @@ def test_free_flight_energy(theta, tmp_path):
     assert np.allclose(np.diff(e), -per_step, rtol=1e-6, atol=1e-9)
 
 
+@pytest.mark.slow
 def test_block_on_ground_does_not_creep_or_sink(tmp_path):
     toml = (DATA / "validation" / "harmonic_ground.toml").read_text()
     path = tmp_path / "rest.toml"

@@ -17,6 +17,8 @@ from masonrycli.recording.readback import _viewer_executable
 
 import recording_fixtures as fx
 
+pytestmark = pytest.mark.slow  # starts the viewer: ~20 s on the CI machine
+
 
 def test_viewer_prerequisites_are_installed():
     """Not a skip: without them the screenshot tests below would prove nothing (.ci/run installs them)."""
