@@ -18,15 +18,18 @@ def check_array(where: str, name: str, array, shape: tuple, dtype) -> None:
     ``shape`` may hold None for a free dimension. The message names the launcher (``where``) and the
     argument, e.g. ``world_vertices: out has shape (3, 2), expected (4, 2) float64``.
     """
+    # The message is built only on failure: formatting it every call cost more than the checks.
+    if (
+        isinstance(array, np.ndarray)
+        and array.dtype == dtype
+        and array.ndim == len(shape)
+        and all(s is None or s == d for s, d in zip(shape, array.shape))
+    ):
+        return
     expected = f"expected {tuple('any' if s is None else s for s in shape)} {np.dtype(dtype)}"
     if not isinstance(array, np.ndarray):
         raise ValueError(f"{where}: {name} is a {type(array).__name__}, {expected}")
-    if (
-        array.dtype != dtype
-        or array.ndim != len(shape)
-        or any(s is not None and s != d for s, d in zip(shape, array.shape))
-    ):
-        raise ValueError(f"{where}: {name} has shape {array.shape} {array.dtype}, {expected}")
+    raise ValueError(f"{where}: {name} has shape {array.shape} {array.dtype}, {expected}")
 
 
 def check_vertices(where: str, name: str, vertices, body_vert_start) -> tuple[int, int]:
