@@ -1,0 +1,37 @@
+"""Solver lab: ``python -m benchmarks.solver_lab capture|table`` (see benchmarks/README.md, "Solver lab")."""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
+os.environ.setdefault("RERUN_ANALYTICS", "0")
+
+
+def main() -> None:
+    from benchmarks.solver_lab.capture import CASES
+
+    ap = argparse.ArgumentParser(prog="python -m benchmarks.solver_lab", description=__doc__)
+    sub = ap.add_subparsers(dest="command", required=True)
+    cap = sub.add_parser("capture", help="run the cases, keep cold/typical/hard steps with their reference")
+    cap.add_argument("--cases", nargs="+", default=list(CASES), choices=list(CASES))
+    tab = sub.add_parser("table", help="run the methods on the captured problems; Markdown table + JSON")
+    tab.add_argument("--methods", nargs="+", default=None)
+    tab.add_argument("--problems", nargs="+", default=None)
+    tab.add_argument("--repeat", type=int, default=3, help="interleaved repeats; CPU-time minimum is kept")
+    args = ap.parse_args()
+    if args.command == "capture":
+        from benchmarks.solver_lab.capture import capture
+
+        capture(args.cases)
+    else:
+        from benchmarks.solver_lab.harness import run_table
+
+        run_table(args.methods, args.problems, args.repeat)
+
+
+if __name__ == "__main__":
+    main()

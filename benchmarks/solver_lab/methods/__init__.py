@@ -1,0 +1,1 @@
+"""The lab's methods. Each is ``solve(ctx, target) -> Outcome`` (see ``harness.Context`` / ``Outcome``)."""

@@ -1,0 +1,79 @@
+"""What a method hands back to the harness, and the context it gets (problem + prebuilt operators)."""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from benchmarks.solver_lab import law
+from masonrycli.engine import nlgs
+
+
+@dataclass
+class Outcome:
+    v: np.ndarray
+    """(B, 3) end-of-step velocities."""
+    r: np.ndarray
+    """(C, 2) impulses; the harness re-derives v from them to check consistency."""
+    iterations: int
+    """The method's own iteration count (sweeps for Gauss–Seidel variants)."""
+    sweeps: float
+    """Work in Gauss–Seidel sweeps: sweeps run, plus any other work converted at the problem's
+    measured time per sweep (see ``Context.sweep_s``)."""
+    phases: dict = field(default_factory=dict)
+    """phase name → CPU seconds."""
+    converged: bool = True
+
+
+class Clock:
+    """Accumulates CPU seconds per phase: ``with clock("sweeps"): ...``."""
+
+    def __init__(self):
+        self.phases: dict[str, float] = {}
+        self._name = ""
+
+    def __call__(self, name: str) -> Clock:
+        self._name = name
+        return self
+
+    def __enter__(self):
+        self._t = time.process_time()
+
+    def __exit__(self, *exc):
+        self.phases[self._name] = self.phases.get(self._name, 0.0) + time.process_time() - self._t
+
+
+class Context:
+    """One problem with what every method needs prebuilt (not timed: the engine builds ``pack`` anyway;
+    methods that need H or M⁻¹ must count building them in their own phases if the engine would have to)."""
+
+    def __init__(self, problem):
+        self.p = problem
+        self.pack, self.ra, self.rb = problem.pack()
+        self.H = law.h_matrix(problem, self.pack)
+        self.minv = law.inv_mass_diag(problem)
+        self.sweep_s = np.nan
+        """CPU seconds of one engine NLGS sweep on this problem (measured by the harness)."""
+
+    def sweep(self, r: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
+        """``n`` engine NLGS sweeps from impulses ``r`` (updated in place); returns (v, status)."""
+        p = self.p
+        v = p.v_free.copy()
+        status = np.zeros(p.count, dtype=np.int8)
+        nlgs.solve(p.body, self.pack, p.count, p.shim(0.0, n), v, r, status)
+        return v, status
+
+    def residual(self, v: np.ndarray, r: np.ndarray) -> float:
+        """m/s: the largest contact-law residual (law.law_residual)."""
+        return float(law.law_residual(self.p, self.pack, self.H, v, r).max(initial=0.0))
+
+
+def project_cone(r: np.ndarray, mu: float) -> np.ndarray:
+    """r with r_n ≥ 0 and |r_t| ≤ μ r_n (componentwise clip; a valid start for Gauss–Seidel)."""
+    out = r.copy()
+    out[:, 1] = np.maximum(out[:, 1], 0.0)
+    lim = mu * out[:, 1]
+    out[:, 0] = np.clip(out[:, 0], -lim, lim)
+    return out

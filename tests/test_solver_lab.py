@@ -1,0 +1,71 @@
+"""The solver lab's capture and measures (benchmarks/solver_lab), on a tiny wall.
+
+The lab's numpy H and local solve are written independently of the engine's kernels: a reference solved
+by the engine's NLGS must satisfy the lab's contact law and reproduce v = v_free + M⁻¹ H r.
+"""
+
+import numpy as np
+
+from benchmarks.solver_lab import law
+from benchmarks.solver_lab.capture import SINE, capture_run, reference
+from benchmarks.solver_lab.methods import gauss_seidel
+from benchmarks.solver_lab.outcome import Context
+from benchmarks.solver_lab.problems import REF_RESIDUAL, Problem
+from masonrycli.engine import nlgs as N
+from masonrycli.run import Simulation
+from masonrycli.scenario import Material, RunConfig, scenario_from_builder
+
+
+def _captured(tmp_path):
+    sc = scenario_from_builder(
+        "wall", {"blocks": 7, "courses": 2}, RunConfig(duration=0.03), Material(), {"ground": SINE}
+    )
+    kept = capture_run(Simulation(sc), typical_step=20)
+    assert sorted(kept) == ["cold", "hard", "typical"]
+    p = kept["typical"]
+    p.name = "tiny"
+    reference(p)
+    p.save(tmp_path / "tiny.npz")
+    return Problem.load(tmp_path / "tiny.npz")
+
+
+def test_reference_satisfies_the_lab_law_and_momentum(tmp_path):
+    p = _captured(tmp_path)
+    assert p.step == 20 and p.count > 0 and (p.r_warm[:, 1] > 0).any()
+    ctx = Context(p)
+    assert p.ref_residual <= REF_RESIDUAL
+    assert ctx.residual(p.v_ref, p.r_ref) <= REF_RESIDUAL
+    np.testing.assert_allclose(law.velocity_from_impulse(p, ctx.H, p.r_ref), p.v_ref, atol=1e-12)
+    # the warm start alone is not a solution: the residual measures something
+    v_warm = law.velocity_from_impulse(p, ctx.H, p.r_warm)
+    assert ctx.residual(v_warm, p.r_warm) > 1e3 * REF_RESIDUAL
+
+
+def test_local_solve_open_stick_slide():
+    # one contact with W = I (unit mass, no lever arm), μ = 0.5, no gap
+    pack = np.zeros((1, N.PACK_WIDTH))
+    pack[0, [N.P_NX, N.P_NY]] = 0.0, 1.0
+    pack[0, [N.P_WTT, N.P_WTN, N.P_WNN]] = 1.0, 0.0, 1.0
+    pack[0, [N.P_ITT, N.P_ITN, N.P_INN]] = 1.0, 0.0, 1.0
+    mu = 0.5
+    pack[0, [N.P_ISP, N.P_ISM]] = 1.0, 1.0
+    # approaching at 2 m/s with 0.5 m/s tangential: stick, r = (−0.5, 2) (|r_t| ≤ μ r_n = 1)
+    rt, rn = law.local_solve(np.array([0.5]), np.array([-2.0]), pack, mu)
+    assert np.allclose([rt[0], rn[0]], [-0.5, 2.0])
+    # with 3 m/s tangential it slides: r_n = 2, r_t = −μ r_n = −1
+    rt, rn = law.local_solve(np.array([3.0]), np.array([-2.0]), pack, mu)
+    assert np.allclose([rt[0], rn[0]], [-1.0, 2.0])
+    # separating: open
+    rt, rn = law.local_solve(np.array([3.0]), np.array([0.5]), pack, mu)
+    assert (rt[0], rn[0]) == (0.0, 0.0)
+
+
+def test_gauss_seidel_methods_reach_the_target(tmp_path):
+    p = _captured(tmp_path)
+    ctx = Context(p)
+    for name in ("nlgs-law", "nlgs-predict", "nlgs-cold"):
+        out = gauss_seidel.METHODS[name](ctx, 1e-6)
+        assert out.converged
+        v = law.velocity_from_impulse(p, ctx.H, out.r)
+        assert ctx.residual(v, out.r) <= 1e-6
+        assert law.velocity_error(p, v) < 1e-3
