@@ -35,8 +35,8 @@ from masonrycli.engine import nlgs as N
 
 KAPPA = 1000.0
 SWEEPS_BETWEEN = 5
-OUTER_CAP = 50
-INNER_CAP = 30
+OUTER_CAP = 30
+INNER_CAP = 10
 
 
 def _impulse(x_t, x_n, s):

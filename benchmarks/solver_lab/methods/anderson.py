@@ -20,6 +20,8 @@ from benchmarks.solver_lab.outcome import Clock, Outcome, project_cone
 
 DEPTH = 5
 CAP = 5_000
+CHECK_EVERY = 10
+"""The lab checks the (numpy) residual every this many iterations; counts are ≤ 9 high."""
 
 
 def anderson(ctx, target, depth: int = DEPTH) -> Outcome:
@@ -39,7 +41,7 @@ def anderson(ctx, target, depth: int = DEPTH) -> Outcome:
         with clock("sweeps"):
             vp, _ = ctx.sweep(rp, 1)
         with clock("check"):
-            if ctx.residual(vp, rp) <= target:
+            if iterations % CHECK_EVERY == 0 and ctx.residual(vp, rp) <= target:
                 r, v, ok = rp, vp, True
                 break
         with clock("mix"):
