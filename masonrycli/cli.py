@@ -116,6 +116,16 @@ Amp = Annotated[
 Settlement = Annotated[
     float | None, typer.Option(help="Downward velocity of the right foundation, m/s.", rich_help_panel="Loading")
 ]
+RecordFile = Annotated[
+    Path | None,
+    typer.Option(
+        "--record",
+        help="Ground motion record shaking the ground/foundations instead of the sine: PEER .AT2 (g) or CSV "
+        "(time, velocity). Baseline-corrected; window and vertical component in a scenario file.",
+        rich_help_panel="Loading",
+    ),
+]
+Scale = Annotated[float | None, typer.Option("--scale", help="Multiplies the --record.", rich_help_panel="Loading")]
 
 
 def _run_overrides(**values) -> dict:
@@ -260,6 +270,8 @@ def _simulate(
     freq,
     amp,
     settlement,
+    record,
+    scale,
     duration,
     dt,
     theta,
@@ -280,7 +292,16 @@ def _simulate(
     for key, value in _run_overrides(density=density, thickness=thickness, friction=friction).items():
         material = _replace(material, f"--{key}", **{key: value})
     run = RunConfig(duration=DEFAULT_DURATION[builder])
-    if builder == "wall":
+    if record is not None:
+        if amp is not None or freq is not None or settlement:
+            given = "--amp" if amp is not None else "--freq" if freq is not None else "--settlement"
+            raise InputError(f"--record with {given}: choose one loading (the record replaces the sine)")
+        shaken = ("ground",) if builder == "wall" else ("left-foundation", "right-foundation")
+        motion = _record(record, scale)
+        motions = {name: motion for name in shaken}
+    elif scale is not None:
+        raise InputError("--scale: goes with --record (it multiplies the record)")
+    elif builder == "wall":
         if settlement:
             raise InputError("--settlement: the wall stands on one ground; settlement applies to arch and aqueduct")
         amp = 1.0 if amp is None else amp
@@ -319,6 +340,30 @@ def _simulate(
     _execute(scenario, _outputs(builder, out, no_recording), history, hint)
 
 
+def _record(path: Path, scale: float | None):
+    from masonrycli.records import record_motion
+
+    try:
+        return record_motion(path, scale=1.0 if scale is None else scale, display=str(path))
+    except InputError as exc:
+        msg = str(exc)
+        raise InputError(msg if msg.startswith(str(path)) else f"--record {path}: {msg}") from None
+
+
+def _with_record(scenario, record: Path | None, scale: float | None):
+    """``scenario`` with every shaking support (sine or record motion) driven by the ``--record`` file."""
+    if record is None:
+        if scale is not None:
+            raise InputError("--scale: goes with --record (it multiplies the record)")
+        return scenario
+    shaking = [m.kind in ("sine", "record") for m in scenario.motions]
+    if not any(shaking):
+        raise InputError(f"--record: {scenario.name} has no shaking support (give one a sine or record motion)")
+    motion = _record(record, scale)
+    motions = tuple(motion if shake else m for shake, m in zip(shaking, scenario.motions))
+    return dataclasses.replace(scenario, motions=motions)
+
+
 def _sine(amp: float, freq: float):
     from masonrycli.motion import Sine
 
@@ -339,6 +384,8 @@ def simulate_wall(
     freq: Freq = None,
     amp: Amp = None,
     settlement: Settlement = None,
+    record: RecordFile = None,
+    scale: Scale = None,
     duration: Duration = None,
     dt: Dt = None,
     theta: Theta = None,
@@ -361,6 +408,8 @@ def simulate_wall(
         freq=freq,
         amp=amp,
         settlement=settlement,
+        record=record,
+        scale=scale,
         duration=duration,
         dt=dt,
         theta=theta,
@@ -387,6 +436,8 @@ def simulate_arch(
     freq: Freq = None,
     amp: Amp = None,
     settlement: Settlement = None,
+    record: RecordFile = None,
+    scale: Scale = None,
     duration: Duration = None,
     dt: Dt = None,
     theta: Theta = None,
@@ -407,6 +458,8 @@ def simulate_arch(
         freq=freq,
         amp=amp,
         settlement=settlement,
+        record=record,
+        scale=scale,
         duration=duration,
         dt=dt,
         theta=theta,
@@ -434,6 +487,8 @@ def simulate_aqueduct(
     freq: Freq = None,
     amp: Amp = None,
     settlement: Settlement = None,
+    record: RecordFile = None,
+    scale: Scale = None,
     duration: Duration = None,
     dt: Dt = None,
     theta: Theta = None,
@@ -460,6 +515,8 @@ def simulate_aqueduct(
         freq=freq,
         amp=amp,
         settlement=settlement,
+        record=record,
+        scale=scale,
         duration=duration,
         dt=dt,
         theta=theta,
@@ -491,6 +548,8 @@ def run_command(
     out: Out = None,
     no_recording: NoRecording = False,
     history: HistoryOpt = None,
+    record: RecordFile = None,
+    scale: Scale = None,
 ) -> None:
     """Run any scenario file (or a GeoJSON / WKT geometry file, supports fixed); options given here
     override the file's values."""
@@ -502,6 +561,7 @@ def run_command(
         scenario = scenario_from_geometry_file(scenario_file)
     else:
         scenario = load_scenario(scenario_file)
+    scenario = _with_record(scenario, record, scale)
     scenario = _apply_options(
         scenario,
         duration=duration,

@@ -38,6 +38,11 @@ def run_metadata(scenario, sim: Simulation) -> dict:
         "structure": dict(scenario.structure),
         "blocks": sim.model.block_count,
         "supports": {s.name: m.describe() for s, m in zip(scenario.assembly.supports, scenario.motions)},
+        "baseline_corrections": {
+            s.name: m.baseline_correction
+            for s, m in zip(scenario.assembly.supports, scenario.motions)
+            if m.kind == "record"
+        },
         "duration_s": run.duration,
         "dt_s": run.dt,
         "theta": run.theta,
@@ -96,6 +101,8 @@ def execute(scenario, *, out: Path | None, history: Path | None, console: Consol
     try:
         with progress_bar(console, sim.model.n_steps) as on_progress:
             result = simulate(scenario, sinks, on_progress=on_progress, sim=sim)
+        if hist is not None:
+            hist.run_values |= {f"intensity_{k}": v for k, v in result.intensity.items()}
         status, note = result.status, result.message
     except KeyboardInterrupt:
         status = "interrupted"

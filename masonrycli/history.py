@@ -9,6 +9,8 @@ Arrays (T frames, N blocks, S supports), block order = scenario order:
     support_work (T,) J (cumulated) · every per-block tensor field of masonrycli.tensors.TENSOR_FIELDS
     joint_body (J,2) · joint_hinged (T,J) bool · hinge_count (T,)  (see masonrycli.mechanism)
     block_name (N,) · support_name (S,) · status () str
+    intensity_pga, intensity_pgv, intensity_arias, intensity_d5_95, intensity_sa () — the ground motion as
+    applied (masonrycli.intensity), when a support shakes
 """
 
 from __future__ import annotations
@@ -41,6 +43,8 @@ class History:
         self.block_name = np.asarray(block_name, dtype=str)
         self.support_name = np.asarray(support_name, dtype=str)
         self._rows: dict[str, list] = {}
+        self.run_values: dict[str, float] = {}
+        """One value per run (e.g. ``intensity_pga``), written as 0-d arrays."""
 
     def __len__(self) -> int:
         return len(self._rows.get("time", ()))
@@ -61,6 +65,7 @@ class History:
         out = {name: np.asarray(values) for name, values in self._rows.items()}
         out["block_name"] = self.block_name
         out["support_name"] = self.support_name
+        out |= {name: np.asarray(value) for name, value in self.run_values.items()}
         if self._rows:
             out["joint_body"] = np.asarray(self.joint_body)
         return out

@@ -28,8 +28,18 @@ Kinds
       trapezoid rule; between samples the velocity follows the exact (quadratic) integral of the linear
       acceleration rather than a chord, so that the velocity is the integral of the interpolated
       acceleration everywhere. Before the first sample v = 0 (the ground is at rest); after the last
-      sample the acceleration is taken as zero, so the velocity holds its final integrated value
-      (a record that does not end at rest keeps the ground drifting, as a real baseline error would).
+      sample the acceleration is taken as zero, so the velocity holds its final integrated value.
+    * ``baseline = "quadratic"`` (the default for acceleration records): integrated records drift (noise
+      and rounding in the samples add up), so the integrated velocity v is corrected by the smallest
+      polynomial that brings the ground back to rest where it started. With s = (t − t₀)/T over the
+      record (length T), v_c(t) = v(t) − (c₁ s + c₂ s²) where c₁ + c₂ = v(T) (ends at rest) and
+      T (c₁/2 + c₂/3) = ∫v dt (ends where it started): c₂ = 3 v(T) − 6 D/T, c₁ = 6 D/T − 2 v(T),
+      D = ∫₀ᵀ v dt computed exactly for the piecewise-quadratic v. The acceleration changes by the
+      straight line (c₁ + 2 c₂ s)/T. For a record that already ends at rest where it started (a
+      processed PEER record) c₁ and c₂ are tiny and the correction is invisible. ``baseline = "none"``
+      integrates as is. The coefficients are in :attr:`Record.baseline_correction`.
+    * ``window = [a, b]``: only the samples with a <= t <= b are used, moved so that the first of them
+      is at t = 0.
 
 Units: m/s, m/s², s, Hz, rad.
 """
@@ -48,6 +58,7 @@ import numpy as np
 from masonrycli.values import check_real, check_vector, field_error, format_value, is_real
 
 RECORD_QUANTITIES = ("velocity", "acceleration")
+BASELINES = ("quadratic", "none")
 
 
 def _g(x: float) -> str:
@@ -242,7 +253,10 @@ class Record(Motion):
     direction : (dx, dy) axis of a 1-component record; normalised on use.
     quantity : "velocity" | "acceleration" — what ``value`` holds.
     scale : multiplies ``value``.
+    window : (a, b) s, or None — the part of the record used, moved to start at t = 0.
+    baseline : "quadratic" | "none" — drift correction of acceleration records (module docstring).
     source : where the record came from (absolute file path, or "" for inline data).
+    vertical_source : file of the vertical component (then ``value`` holds (x, y) pairs), or "".
     """
 
     time: tuple[float, ...] = ()
@@ -250,18 +264,35 @@ class Record(Motion):
     direction: tuple[float, float] = (1.0, 0.0)
     quantity: str = "velocity"
     scale: float = 1.0
+    window: tuple[float, float] | None = None
+    baseline: str = "quadratic"
     source: str = ""
+    vertical_source: str = ""
 
     kind: ClassVar[str] = "record"
-    TOML_KEYS: ClassVar[tuple[str, ...]] = ("kind", "file", "time", "value", "quantity", "scale", "direction")
+    TOML_KEYS: ClassVar[tuple[str, ...]] = (
+        "kind",
+        "file",
+        "vertical",
+        "time",
+        "value",
+        "quantity",
+        "scale",
+        "direction",
+        "window",
+        "baseline",
+    )
 
     def __post_init__(self):
         _direction(self)
         if self.quantity not in RECORD_QUANTITIES:
             raise field_error("quantity", self.quantity, 'must be "velocity" or "acceleration"')
         _put(self, "scale", check_real("scale", self.scale))
-        if not isinstance(self.source, str):
-            raise field_error("source", self.source, "must be a string")
+        if self.baseline not in BASELINES:
+            raise field_error("baseline", self.baseline, 'must be "quadratic" or "none"')
+        for key in ("source", "vertical_source"):
+            if not isinstance(getattr(self, key), str):
+                raise field_error(key, getattr(self, key), "must be a string")
         time, value = self.time, self.value
         if isinstance(time, np.ndarray):
             time = time.tolist()
@@ -283,6 +314,14 @@ class Record(Motion):
             v = tuple(check_vector(f"value[{i}]", x) for i, x in enumerate(value))
         _put(self, "time", t)
         _put(self, "value", v)
+        if self.window is not None:
+            w = check_vector("window", self.window)
+            if not w[1] > w[0]:
+                raise field_error("window", w, "must be [start, end] with end > start")
+            inside = sum(1 for x in t if w[0] <= x <= w[1])
+            if inside < 2:
+                raise field_error("window", w, f"holds {inside} samples of the record (at least 2 needed)")
+            _put(self, "window", w)
 
     @property
     def unit_direction(self) -> np.ndarray:
@@ -294,29 +333,64 @@ class Record(Motion):
         """True for (x, y) records, False for 1-component records applied along ``direction``."""
         return bool(self.value) and isinstance(self.value[0], tuple)
 
+    @property
+    def corrected(self) -> bool:
+        """True when the baseline correction applies (an acceleration record with baseline "quadratic")."""
+        return self.quantity == "acceleration" and self.baseline == "quadratic"
+
     @functools.cached_property
     def _arrays(self):
-        """Precomputed (time (n,), value (n,2) scaled, nodal velocity (n,2))."""
+        """Precomputed (time (n,), value (n,2) scaled, nodal velocity (n,2) uncorrected, baseline (2, 2)).
+
+        ``baseline`` rows are c₁ and c₂ (m/s, one column per axis), zero when not corrected.
+        """
         time = np.asarray(self.time, dtype=np.float64)
         value = np.asarray(self.value, dtype=np.float64)
         if value.ndim == 1:
             value = value[:, None] * self.unit_direction[None, :]
         value = value * self.scale
+        if self.window is not None:
+            keep = (time >= self.window[0]) & (time <= self.window[1])
+            time, value = time[keep] - time[keep][0], value[keep]
+        baseline = np.zeros((2, 2))
         if self.quantity == "acceleration":
             # cumulative trapezoid from v = 0 at the first sample
             h = np.diff(time)[:, None]
             nodal_v = np.zeros_like(value)
             nodal_v[1:] = np.cumsum(0.5 * h * (value[:-1] + value[1:]), axis=0)
+            if self.baseline == "quadratic":
+                # D = exact integral of the piecewise-quadratic velocity, interval by interval:
+                #   ∫₀ʰ (v_i + a_i τ + (a_{i+1} − a_i) τ²/(2h)) dτ = h v_i + h² a_i / 2 + h² (a_{i+1} − a_i) / 6
+                d = (h * nodal_v[:-1] + h * h * value[:-1] / 2.0 + h * h * (value[1:] - value[:-1]) / 6.0).sum(axis=0)
+                length, v_end = time[-1] - time[0], nodal_v[-1]
+                baseline[1] = 3.0 * v_end - 6.0 * d / length
+                baseline[0] = 6.0 * d / length - 2.0 * v_end
         else:
             nodal_v = value
-        for a in (time, value, nodal_v):
+        for a in (time, value, nodal_v, baseline):
             a.setflags(write=False)
-        return time, value, nodal_v
+        return time, value, nodal_v, baseline
+
+    @property
+    def baseline_correction(self) -> dict:
+        """What the baseline correction subtracted, for the run document: ``{"baseline": "quadratic",
+        "c1": [x, y], "c2": [x, y], "length": T}`` (m/s, s; see the module docstring), or
+        ``{"baseline": "none"}``."""
+        if not self.corrected:
+            return {"baseline": "none"}
+        time, _, _, baseline = self._arrays
+        return {
+            "baseline": "quadratic",
+            "formula": "v_c(t) = v(t) - (c1 s + c2 s^2), s = t/T",
+            "c1": baseline[0].tolist(),
+            "c2": baseline[1].tolist(),
+            "length": float(time[-1] - time[0]),
+        }
 
     def velocity_at(self, t) -> np.ndarray:
         t = _time_column(t)
         out = np.zeros((t.shape[0], 2), dtype=np.float64)
-        time, value, nodal_v = self._arrays
+        time, value, nodal_v, baseline = self._arrays
         if self.quantity == "velocity":
             out[:, 0] = np.interp(t, time, value[:, 0])
             out[:, 1] = np.interp(t, time, value[:, 1])
@@ -330,27 +404,40 @@ class Record(Motion):
             tau = np.clip(t - time[i], 0.0, h[:, 0])[:, None]
             a0, a1 = value[i], value[i + 1]
             out[:] = nodal_v[i] + a0 * tau + (a1 - a0) * (tau * tau) / (2.0 * h)
+            if self.corrected:
+                s = (np.clip(t, time[0], time[-1]) - time[0])[:, None] / (time[-1] - time[0])
+                out -= baseline[0] * s + baseline[1] * (s * s)
         return out
 
     def describe(self) -> str:
         src = os.path.basename(self.source) if self.source else "inline"
         axis = "" if self.is_vector else f" along {_vec(self.direction)}"
+        if self.vertical_source:
+            src += f" + vertical {os.path.basename(self.vertical_source)}"
         scale = "" if self.scale == 1.0 else f" × {_g(self.scale)}"
+        window = "" if self.window is None else f", window {_g(self.window[0])}–{_g(self.window[1])} s"
+        corrected = ", baseline-corrected" if self.corrected else ""
         return (
             f"record of {self.quantity} ({src}, {len(self.time)} samples, "
-            f"{_g(self.time[0])}–{_g(self.time[-1])} s){scale}{axis}"
+            f"{_g(self.time[0])}–{_g(self.time[-1])} s{window}{corrected}){scale}{axis}"
         )
 
     def toml_fields(self, inline_records: bool = False) -> dict:
         kv: dict = {"kind": self.kind}
         if self.source and not inline_records:
             kv["file"] = self.source
+            if self.vertical_source:
+                kv["vertical"] = self.vertical_source
         else:
             kv["time"] = list(self.time)
             kv["value"] = [list(v) if isinstance(v, tuple) else v for v in self.value]
         kv.update(quantity=self.quantity, scale=self.scale)
         if not self.is_vector:
             kv["direction"] = list(self.direction)
+        if self.window is not None:
+            kv["window"] = list(self.window)
+        if self.quantity == "acceleration":
+            kv["baseline"] = self.baseline
         return kv
 
 

@@ -1,6 +1,13 @@
 """Reading ground-motion records from files into :class:`~masonrycli.motion.Record` motions.
 
-CSV: one sample per line, ``time,value`` or ``time,x,y`` (see :func:`load_record_csv`).
+Two formats, chosen by the file's extension:
+
+* ``.AT2`` (PEER NGA): acceleration in g, one component per file, a 4-line header whose last line
+  gives ``NPTS`` and ``DT`` (see :func:`load_at2`); samples at t = 0, DT, 2 DT, ...
+* anything else is CSV: one sample per line, ``time,value`` or ``time,x,y`` (see :func:`load_record_csv`).
+
+:func:`record_motion` makes the motion (scale, window, optional vertical component, baseline
+correction); :func:`record_fields` does the same for a scenario's ``motion = { kind = "record", ... }``.
 """
 
 from __future__ import annotations
@@ -13,7 +20,7 @@ import numpy as np
 
 from masonrycli.errors import InputError
 from masonrycli.motion import Record
-from masonrycli.values import format_value, shorten
+from masonrycli.values import format_value, quote_string, shorten
 
 _SPLIT = re.compile(r"\s*[,;]\s*|\s+")
 
@@ -31,18 +38,7 @@ def load_record_csv(path, display: str | None = None) -> tuple[np.ndarray, np.nd
     ``display`` is the file name used in messages (default: ``path`` as given).
     """
     name = display if display is not None else str(path)
-    try:
-        with open(path, "rb") as fh:
-            raw = fh.read()
-    except IsADirectoryError:
-        raise InputError(f"{name}: cannot read record: is a directory") from None
-    except OSError as exc:
-        raise InputError(f"{name}: cannot read record: {exc.strerror or exc}") from None
-    try:
-        text = raw.decode("utf-8-sig")
-    except UnicodeDecodeError as exc:
-        raise InputError(f"{name}: not a UTF-8 text file (byte {exc.start})") from None
-
+    text = _read_text(path, name)
     times: list[float] = []
     values: list = []
     ncol = 0
@@ -82,6 +78,62 @@ def load_record_csv(path, display: str | None = None) -> tuple[np.ndarray, np.nd
     return np.asarray(times, dtype=np.float64), np.asarray(values, dtype=np.float64)
 
 
+def _read_text(path, name: str) -> str:
+    try:
+        with open(path, "rb") as fh:
+            raw = fh.read()
+    except IsADirectoryError:
+        raise InputError(f"{name}: cannot read record: is a directory") from None
+    except OSError as exc:
+        raise InputError(f"{name}: cannot read record: {exc.strerror or exc}") from None
+    try:
+        return raw.decode("utf-8-sig")
+    except UnicodeDecodeError as exc:
+        raise InputError(f"{name}: not a UTF-8 text file (byte {exc.start})") from None
+
+
+# "NPTS=  3930, DT=   .0100 SEC" (NGA-West2) or "3930   0.0100   NPTS, DT" (older NGA files)
+_AT2_NEW = re.compile(r"NPTS\s*=\s*(\d+)\s*,?\s*DT\s*=\s*([-+0-9.eE]+)", re.IGNORECASE)
+_AT2_OLD = re.compile(r"^\s*(\d+)\s+([-+0-9.eE]+)\s+NPTS", re.IGNORECASE)
+
+
+def load_at2(path, display: str | None = None) -> tuple[float, np.ndarray]:
+    """Read a PEER NGA ``.AT2`` file: ``(dt s, acceleration (NPTS,) in g)``.
+
+    Layout: 3 free text lines, a 4th line with the number of points and the time step, then the NPTS
+    samples, several per line. Raises :class:`InputError` (``<file>:<line>: <problem>``).
+    """
+    name = display if display is not None else str(path)
+    lines = _read_text(path, name).splitlines()
+    if len(lines) < 5:
+        raise InputError(f"{name}: not a PEER .AT2 file (expected 4 header lines, then the samples)")
+    match = _AT2_NEW.search(lines[3]) or _AT2_OLD.search(lines[3])
+    if not match:
+        raise InputError(
+            f"{name}:4: expected NPTS and DT (e.g. NPTS=  3930, DT=   .0100 SEC), got {shorten(lines[3].strip(), 40)}"
+        )
+    npts, dt = int(match.group(1)), _number(match.group(2), f"{name}:4")
+    if not (math.isfinite(dt) and dt > 0.0) or npts < 2:
+        raise InputError(f"{name}:4: DT must be > 0 and NPTS >= 2, got DT = {format_value(dt)}, NPTS = {npts}")
+    values: list[float] = []
+    for lineno, line in enumerate(lines[4:], start=5):
+        for field in line.split():
+            x = _number(field, f"{name}:{lineno}")
+            if not math.isfinite(x):
+                raise InputError(f"{name}:{lineno}: values must be finite, got {shorten(field, 40)}")
+            values.append(x)
+    if len(values) < npts:
+        raise InputError(f"{name}: header says NPTS = {npts} but the file holds {len(values)} samples")
+    return dt, np.asarray(values[:npts], dtype=np.float64)
+
+
+def _number(text: str, where: str) -> float:
+    try:
+        return float(text)
+    except ValueError:
+        raise InputError(f"{where}: not a number: {shorten(text, 40)}") from None
+
+
 def _is_float(text: str) -> bool:
     try:
         float(text)
@@ -90,19 +142,134 @@ def _is_float(text: str) -> bool:
     return True
 
 
-def record_motion(
-    path, *, quantity: str = "velocity", scale: float = 1.0, direction=(1.0, 0.0), display: str | None = None
-) -> Record:
-    """A :class:`~masonrycli.motion.Record` from a CSV file (see :func:`load_record_csv`).
+G_STANDARD = 9.80665
+"""m/s² per g: .AT2 accelerations are in units of standard gravity."""
 
-    ``source`` is the absolute path of the file. ``direction`` applies to 2-column records only.
+
+def is_at2(path) -> bool:
+    return os.fspath(path).lower().endswith(".at2")
+
+
+def read_record(path, display: str | None = None) -> tuple[np.ndarray, np.ndarray, str | None]:
+    """``(time (n,) s, value (n,) or (n, 2), quantity)`` of a record file: an .AT2 file gives its
+    acceleration in m/s² and quantity ``"acceleration"``; a CSV file gives its columns as they are and
+    quantity None (the caller says what the values are)."""
+    if is_at2(path):
+        dt, acc = load_at2(path, display)
+        return np.arange(acc.size) * dt, acc * G_STANDARD, "acceleration"
+    time, value = load_record_csv(path, display)
+    return time, value, None
+
+
+def _pairs(value: np.ndarray) -> tuple:
+    return tuple(value.tolist()) if value.ndim == 1 else tuple(map(tuple, value.tolist()))
+
+
+def combine_vertical(time, value, vtime, vvalue, name: str, vname: str) -> tuple[np.ndarray, np.ndarray]:
+    """(time, (x, y) pairs) from a horizontal and a vertical component sampled alike (the shorter
+    sets the length). Raises :class:`InputError` when the two are sampled differently."""
+    if value.ndim != 1 or vvalue.ndim != 1:
+        raise InputError(f"{vname}: a vertical component goes with 1-component records (time, value)")
+    n = min(time.size, vtime.size)
+    if not np.allclose(time[:n], vtime[:n], rtol=1e-9, atol=1e-12):
+        raise InputError(f"{vname}: not sampled like {name} (the two components need the same times)")
+    return time[:n], np.stack([value[:n], vvalue[:n]], axis=1)
+
+
+def record_motion(
+    path,
+    *,
+    quantity: str | None = None,
+    scale: float = 1.0,
+    direction=(1.0, 0.0),
+    vertical=None,
+    window=None,
+    baseline: str = "quadratic",
+    display: str | None = None,
+) -> Record:
+    """A :class:`~masonrycli.motion.Record` from a record file (.AT2 or CSV, see :func:`read_record`).
+
+    ``quantity`` defaults to "acceleration" for .AT2 files (the only one they hold) and "velocity" for
+    CSV. ``vertical`` is the file of the vertical component (the record then acts along x and y and
+    ``direction`` is not used). ``source`` is the absolute path of the file.
     """
-    time, value = load_record_csv(path, display=display)
+    time, value, native = read_record(path, display)
+    if native is not None and quantity not in (None, native):
+        raise InputError(f"{display or path}: an .AT2 file holds acceleration, not {quantity}")
+    quantity = quantity or native or "velocity"
+    vertical_source = ""
+    if vertical is not None:
+        vtime, vvalue, vnative = read_record(vertical)
+        if vnative != native:
+            raise InputError(f"{vertical}: the vertical component must be in the same format as {path}")
+        time, value = combine_vertical(time, value, vtime, vvalue, str(path), str(vertical))
+        vertical_source = os.path.abspath(os.fspath(vertical))
     return Record(
         direction=tuple(direction),
         time=tuple(time.tolist()),
-        value=tuple(value.tolist()) if value.ndim == 1 else tuple(map(tuple, value.tolist())),
+        value=_pairs(value),
         quantity=quantity,
         scale=scale,
+        window=window,
+        baseline=baseline,
         source=os.path.abspath(os.fspath(path)),
+        vertical_source=vertical_source,
     )
+
+
+def record_fields(table: dict, base_dir: str) -> dict:
+    """The :class:`~masonrycli.motion.Record` arguments for the data of a scenario's record table:
+    ``file`` (and ``vertical``) read relative to ``base_dir``, or inline ``time`` and ``value``.
+
+    Raises :class:`InputError` with a message naming the key (``motion.file = "q.csv": no such file ...``).
+    """
+    has_file = "file" in table
+    has_inline = "time" in table or "value" in table
+    if has_file and has_inline:
+        raise InputError("motion.file: give either file or inline time and value, not both")
+    if "vertical" in table and not has_file:
+        raise InputError("motion.vertical: goes with file (the horizontal component's file)")
+    if has_file:
+        time, value, native, source = _table_file(table, "file", base_dir)
+        out = {"source": source}
+        if "vertical" in table:
+            vtime, vvalue, vnative, vsource = _table_file(table, "vertical", base_dir)
+            if vnative != native:
+                raise InputError(f"motion.vertical: must be in the same format as {table['file']}")
+            try:
+                time, value = combine_vertical(time, value, vtime, vvalue, table["file"], table["vertical"])
+            except InputError as exc:
+                raise InputError(f"motion.vertical: {exc}") from None
+            out["vertical_source"] = vsource
+        if value.ndim == 2 and "direction" in table:
+            if "vertical" in table:
+                raise InputError("motion.direction: not used with a vertical component (the record acts along x, y)")
+            raise InputError(f"motion.direction: not used by a 3-column record ({table['file']} gives x and y)")
+        if native is not None:
+            if table.get("quantity", native) != native:
+                raise InputError(f"motion.quantity: {table['file']} holds {native}")
+            out["quantity"] = native
+        return out | {"time": tuple(time.tolist()), "value": _pairs(value)}
+    for key in ("time", "value"):
+        if key not in table:
+            raise InputError(f'motion.{key}: missing (kind "record" needs file, or time and value)')
+        if not isinstance(table[key], list):
+            raise InputError(f"motion.{key} = {format_value(table[key])[:40]}: must be an array")
+    value = table["value"]
+    if value and all(isinstance(v, list) for v in value) and "direction" in table:
+        raise InputError("motion.direction: not used by a vector record (value holds [x, y] pairs)")
+    return {"time": table["time"], "value": value}
+
+
+def _table_file(table: dict, key: str, base_dir: str):
+    file = table[key]
+    if not isinstance(file, str) or not file:
+        raise InputError(f"motion.{key} = {format_value(file)[:40]}: must be a file name")
+    resolved = os.path.abspath(os.path.join(base_dir, file))
+    if not os.path.isfile(resolved):
+        raise InputError(f"motion.{key} = {quote_string(file)}: no such file (looked for {resolved})")
+    try:
+        time, value, native = read_record(resolved, display=file)
+    except InputError as exc:
+        raise InputError(f"motion.{key}: {exc}") from None
+    return time, value, native, resolved

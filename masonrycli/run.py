@@ -13,9 +13,12 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from masonrycli.collapse import CollapseMonitor, rule_for
 from masonrycli.engine import integrate
 from masonrycli.engine.solver import Solver, StepStats
 from masonrycli.frame import Frame
+from masonrycli.intensity import describe as describe_intensity
+from masonrycli.intensity import intensity_measures, shaking_support
 from masonrycli.mechanism import JointTracker, mobilised_friction, reported_status
 from masonrycli.model import Model, State, build_model, initial_state
 from masonrycli.tensors import TensorComputer, build_triangles, chain_neighbours
@@ -46,6 +49,10 @@ class RunResult:
     frames: int
     extra: dict = field(default_factory=dict)
     """Further summary rows, label → text (e.g. the hinged joints at the end)."""
+    intensity: dict = field(default_factory=dict)
+    """Intensity measures of the shaking support's motion as applied (:mod:`masonrycli.intensity`), or {}."""
+    outcome: dict = field(default_factory=dict)
+    """What happened to the structure (:func:`run_outcome`): state, collapse time, drifts, hinges, ..."""
 
 
 class Simulation:
@@ -72,6 +79,8 @@ class Simulation:
         self.energy_dissipated = 0.0
         self.support_work = 0.0
         self.last: StepStats | None = None
+        vertices = [b.vertices for b in scenario.assembly.blocks]
+        self.monitor = CollapseMonitor(m, vertices, shaking_support(scenario.motions), rule_for(scenario))
 
     def step(self) -> StepStats:
         stats = self.solver.step(self.state)
@@ -83,6 +92,7 @@ class Simulation:
         self.energy_dissipated += stats.dissipated
         self.support_work += stats.support_work
         self.last = stats
+        self.monitor.update(self.state.time, s, self.state.body_q, self.state.body_v)
         return stats
 
     def energies(self) -> tuple[float, float]:
@@ -169,6 +179,7 @@ def simulate(
     progress_every: int = 10,
     steps: int | None = None,
     sim: Simulation | None = None,
+    stop_at_collapse: bool = False,
 ) -> RunResult:
     """Run ``scenario`` to its end (or ``steps`` steps). Each sink gets ``append(frame)``/``log_frame(frame)``
     for every recorded frame; sinks are *not* closed here (the caller owns them) but every frame computed
@@ -176,6 +187,8 @@ def simulate(
 
     ``on_progress(sim, step_stats)`` is called every ``progress_every`` steps. Pass ``sim`` to run an
     already built :class:`Simulation` (the caller needed its model or triangles first).
+    ``stop_at_collapse`` ends the run at the first step where the structure has collapsed
+    (:mod:`masonrycli.collapse`); the status stays "completed" and the message says so.
     """
     t0 = _time.perf_counter()
     sim = Simulation(scenario) if sim is None else sim
@@ -214,17 +227,29 @@ def simulate(
                 emit()
             if on_progress is not None and (done % progress_every == 0 or done == n_steps):
                 on_progress(sim, stats)
+            if stop_at_collapse and sim.monitor.collapse_time is not None:
+                message = f"stopped at collapse, t = {sim.state.time:.4f} s (step {done} of {n_steps})"
+                if done % every:
+                    emit()
+                break
     except KeyboardInterrupt:
         status = "interrupted"
         # The interrupted step may be half done: keep the frames recorded so far, add none.
         message = f"interrupted at t = {sim.state.time:.4f} s (step {done} of {n_steps})"
     extra: dict[str, str] = {}
+    hinge_count = 0
     if sim.last is not None and sim.joints.key.size:
         hinged, _ = sim.hinges()
+        hinge_count = int(hinged.sum())
         names = list(m.block_name) + list(m.support_name)
         pairs = [f"{names[a]}|{names[b]}" for a, b in sim.joints.joint_body[hinged]]
         shown = ", ".join(pairs[:8]) + (" …" if len(pairs) > 8 else "")
         extra["hinged joints (end)"] = f"{len(pairs)}" + (f": {shown}" if pairs else "")
+    ims = applied_intensity(scenario, m, done)
+    if ims:
+        extra[f"ground motion ({m.support_name[shaking_support(scenario.motions)]})"] = describe_intensity(ims)
+    outcome = run_outcome(sim, hinge_count)
+    extra["state"] = describe_outcome(outcome)
     return RunResult(
         status=status,
         message=message,
@@ -241,4 +266,50 @@ def simulate(
         support_work=sim.support_work,
         frames=frames,
         extra=extra,
+        intensity=ims,
+        outcome=outcome,
     )
+
+
+def run_outcome(sim: Simulation, hinges: int) -> dict:
+    """The structure's state and the indicators behind it (:mod:`masonrycli.collapse`): ``state``,
+    ``collapse_time`` (s, NaN if none), ``collapse_reason``, ``residual_drift`` and ``peak_drift``
+    (× height), ``max_opening`` (m), ``hinges``, ``slide_time`` / ``rock_time`` (s, NaN if none),
+    ``max_slide_speed`` (m/s), ``max_rock_speed`` (rad/s)."""
+    mon, q = sim.monitor, sim.state.body_q
+    opening = sim.joints.opening(q) if sim.joints.key.size else np.zeros(0)
+    max_opening = float(np.maximum(opening, 0.0).max()) if opening.size else 0.0
+    nan = float("nan")
+    return {
+        "state": mon.state(q, hinges, max_opening),
+        "collapse_time": nan if mon.collapse_time is None else mon.collapse_time,
+        "collapse_reason": mon.collapse_reason,
+        "residual_drift": mon.drift(q) / mon.height,
+        "peak_drift": mon.peak_drift,
+        "max_opening": max_opening,
+        "hinges": hinges,
+        "slide_time": nan if mon.slide_time is None else mon.slide_time,
+        "rock_time": nan if mon.rock_time is None else mon.rock_time,
+        "max_slide_speed": mon.max_slide_speed,
+        "max_rock_speed": mon.max_rock_speed,
+    }
+
+
+def describe_outcome(outcome: dict) -> str:
+    """``collapsed at t = 0.53 s (a block fell ...)``, ``damaged (residual drift 0.31 %, 2 hinges, ...)``."""
+    tail = (
+        f"residual drift {100 * outcome['residual_drift']:.3g} % of the height, {outcome['hinges']} hinges, "
+        f"largest opening {1000 * outcome['max_opening']:.3g} mm"
+    )
+    if outcome["state"] == "collapsed":
+        return f"collapsed at t = {outcome['collapse_time']:.3f} s ({outcome['collapse_reason']})"
+    return f"{outcome['state']} ({tail})"
+
+
+def applied_intensity(scenario, model: Model, steps: int) -> dict[str, float]:
+    """Intensity measures of the shaking support's horizontal velocity over the first ``steps`` steps
+    (what the structure felt), or {} when no support shakes or fewer than 2 steps ran."""
+    j = shaking_support(scenario.motions)
+    if j is None or steps < 2:
+        return {}
+    return intensity_measures(model.support_velocity[: steps + 1, j, 0], model.dt)

@@ -21,7 +21,7 @@ import numpy as np
 from geometry_library.blocks import Assembly, Block, GeometryError, Support
 from masonrycli.errors import InputContext, InputError, one_line
 from masonrycli.motion import MOTION_KINDS, Fixed, Motion
-from masonrycli.records import load_record_csv
+from masonrycli.records import record_fields
 from masonrycli.scenario import Material, RunConfig, Scenario
 from masonrycli.structure import build_structure, check_finite_tree, read_geometry, structure_warnings
 from masonrycli.values import check_real, check_vector, field_error, format_value, quote_key, quote_string
@@ -327,47 +327,16 @@ def _parse_motion(table, ctx: InputContext, loc: str) -> Motion:
         if key not in table:
             raise ctx.error(loc, f'motion.{key}: missing (required for kind "{kind}")')
 
-    args = {k: v for k, v in table.items() if k not in ("kind", "file", "time", "value")}
+    args = {k: v for k, v in table.items() if k not in ("kind", "file", "vertical", "time", "value")}
     if kind == "record":
-        args.update(_record_data(table, ctx, loc))
+        try:
+            args.update(record_fields(table, ctx.base_dir))
+        except InputError as exc:
+            raise ctx.error(loc, str(exc)) from None
     try:
         return cls(**args)
     except InputError as exc:
         raise ctx.error(loc, f"motion.{exc}") from None
-
-
-def _record_data(table: dict, ctx: InputContext, loc: str) -> dict:
-    has_file = "file" in table
-    has_inline = "time" in table or "value" in table
-    if has_file and has_inline:
-        raise ctx.error(loc, "motion.file: give either file or inline time and value, not both")
-    if has_file:
-        file = table["file"]
-        if not isinstance(file, str) or not file:
-            raise ctx.error(loc, f"motion.file = {format_value(file)[:40]}: must be a file name")
-        resolved = os.path.abspath(os.path.join(ctx.base_dir, file))
-        if not os.path.isfile(resolved):
-            raise ctx.error(loc, f"motion.file = {quote_string(file)}: no such file (looked for {resolved})")
-        try:
-            time, value = load_record_csv(resolved, display=file)
-        except InputError as exc:
-            raise ctx.error(loc, f"motion.file: {exc}") from None
-        if value.ndim == 2 and "direction" in table:
-            raise ctx.error(loc, f"motion.direction: not used by a 3-column record ({file} gives x and y)")
-        return {
-            "time": tuple(time.tolist()),
-            "value": tuple(value.tolist()) if value.ndim == 1 else tuple(map(tuple, value.tolist())),
-            "source": resolved,
-        }
-    for key in ("time", "value"):
-        if key not in table:
-            raise ctx.error(loc, f'motion.{key}: missing (kind "record" needs file, or time and value)')
-        if not isinstance(table[key], list):
-            raise ctx.error(loc, f"motion.{key} = {format_value(table[key])[:40]}: must be an array")
-    value = table["value"]
-    if value and all(isinstance(v, list) for v in value) and "direction" in table:
-        raise ctx.error(loc, "motion.direction: not used by a vector record (value holds [x, y] pairs)")
-    return {"time": table["time"], "value": value}
 
 
 # --------------------------------------------------------------------------------------------------

@@ -118,7 +118,7 @@ def test_vector_record_three_columns():
 
 
 def test_constant_acceleration_record_integrates_to_a_t():
-    m = record_motion(DATA / "accel_constant.csv", quantity="acceleration", direction=(0.0, 1.0))
+    m = record_motion(DATA / "accel_constant.csv", quantity="acceleration", direction=(0.0, 1.0), baseline="none")
     t = np.linspace(-0.2, 1.5, 171)
     v = m.velocity_at(t)
     np.testing.assert_allclose(v[:, 1], 0.5 * np.clip(t, 0.0, 1.0), rtol=0, atol=1e-14)
@@ -129,7 +129,7 @@ def test_linear_acceleration_record_integrates_exactly_between_samples():
     # a(t) = c t sampled every 0.25 s: v(t) = c t^2 / 2 everywhere, not only at the samples
     c = 1.7
     times = np.arange(0.0, 2.0001, 0.25)
-    m = Record(time=tuple(times), value=tuple(c * times), quantity="acceleration")
+    m = Record(time=tuple(times), value=tuple(c * times), quantity="acceleration", baseline="none")
     t = np.linspace(0.0, 2.0, 801)
     np.testing.assert_allclose(m.velocity_at(t)[:, 0], c * t**2 / 2, rtol=0, atol=1e-13)
     # after the record the acceleration is zero: the velocity holds its final value
@@ -144,6 +144,7 @@ def test_random_acceleration_record_matches_independent_integration():
         time=tuple(times),
         value=tuple(map(tuple, acc)),
         quantity="acceleration",
+        baseline="none",
         scale=-2.0,
     )
     # at the samples: the cumulative trapezoid rule (scipy's, independent of ours)
@@ -166,7 +167,7 @@ def test_random_acceleration_record_matches_independent_integration():
 
 
 def test_acceleration_record_starting_late_is_at_rest_before():
-    m = Record(time=(1.0, 2.0), value=(2.0, 2.0), quantity="acceleration")
+    m = Record(time=(1.0, 2.0), value=(2.0, 2.0), quantity="acceleration", baseline="none")
     np.testing.assert_allclose(m.velocity_at([0.0, 1.0, 1.5, 2.0, 9.0])[:, 0], [0, 0, 1.0, 2.0, 2.0], atol=1e-15)
 
 
@@ -208,3 +209,35 @@ def test_motion_equality_hash_and_describe():
     assert a.describe() == "sine 1 m/s · sin(2π·2 Hz·t) along (1, 0)"
     assert Ramp(acceleration=(0, -1), until=0.2).describe() == "ramp acceleration (0, -1) m/s² until 0.2 s"
     assert Constant(velocity=(0, -0.01)).describe() == "constant velocity (0, -0.01) m/s"
+
+
+def test_baseline_correction_is_the_smallest_quadratic_that_returns_the_ground():
+    # a random acceleration record drifts; corrected, it ends at rest where it started, and the
+    # correction is a polynomial c1 s + c2 s^2 (s = t/T) in the velocity, checked by an independent fit
+    rng = np.random.default_rng(4)
+    times = np.concatenate([[0.0], np.cumsum(rng.uniform(0.01, 0.03, 80))])
+    acc = rng.normal(size=times.size) + 0.3
+    raw = Record(time=tuple(times), value=tuple(acc), quantity="acceleration", baseline="none")
+    cor = Record(time=tuple(times), value=tuple(acc), quantity="acceleration")
+    t = np.linspace(0.0, times[-1], 20_001)
+    diff = raw.velocity_at(t)[:, 0] - cor.velocity_at(t)[:, 0]
+    s = t / times[-1]
+    coef, *_ = np.linalg.lstsq(np.stack([s, s * s], axis=1), diff, rcond=None)
+    np.testing.assert_allclose(diff, coef[0] * s + coef[1] * s * s, atol=1e-12)
+    c = cor.baseline_correction
+    np.testing.assert_allclose(coef, [c["c1"][0], c["c2"][0]], rtol=1e-9)
+    assert abs(cor.velocity_at([times[-1], times[-1] + 5.0])[:, 0]).max() < 1e-12  # at rest after
+    displacement, _ = quad(lambda x: cor.velocity_at([x])[0, 0], 0.0, times[-1], points=times[1:-1], limit=500)
+    assert abs(displacement) < 1e-10
+    assert abs(quad(lambda x: raw.velocity_at([x])[0, 0], 0.0, times[-1], points=times[1:-1], limit=500)[0]) > 0.1
+    assert "baseline-corrected" in cor.describe() and "baseline" not in raw.describe()
+    assert Record(time=(0, 1), value=(1, 2)).baseline_correction == {"baseline": "none"}  # velocity records
+
+
+def test_record_window_and_baseline_validation():
+    with pytest.raises(InputError, match="window = \\[0.5, 0.6\\]: holds 0 samples"):
+        Record(time=(0, 1), value=(1, 2), window=(0.5, 0.6))
+    with pytest.raises(InputError, match="window = \\[1.0, 0.0\\]: must be \\[start, end\\]"):
+        Record(time=(0, 1), value=(1, 2), window=(1, 0))
+    with pytest.raises(InputError, match='baseline = "linear": must be "quadratic" or "none"'):
+        Record(time=(0, 1), value=(1, 2), baseline="linear")

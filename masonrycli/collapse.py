@@ -1,0 +1,167 @@
+"""Collapse, defined: what happened to the structure, watched step by step.
+
+A run ends in one of three **states**:
+
+``collapsed``
+    at some step (the *time of collapse*) one of the following held:
+
+    * a block has fallen by more than ``drop`` × its own height (the height of its bounding box as
+      built) — stones on the ground, a voussoir through the arch;
+    * a block has turned by more than ``turn`` (45° by default) — overturned (a slender block past its
+      tipping angle only goes on falling);
+    * the top of the structure has drifted, relative to the shaking ground, by more than ``drift`` ×
+      its height (the structure leans beyond recovery).
+``damaged``
+    not collapsed, but at the end the residual drift of the top exceeds ``damage_drift`` × the height,
+    or at least ``damage_hinges`` joints are hinged, or a block has slid or opened a joint by more than
+    ``damage_opening``.
+``intact``
+    neither.
+
+The parameters are per structure (:data:`RULES`, keyed by the builder name; scenario files use
+``"default"``) and documented in ``docs/collapse.md``. The *top* is the blocks whose centroid lies
+within half a median block height of the highest centroid; the height is the blocks' vertical extent.
+
+For threshold studies the monitor also records the first **sliding** (a closed contact whose faces
+slide faster than ``SLIDE_SPEED``) and the first **rocking** (a block turning faster than
+``ROCK_SPEED``), and the peak drift ratio. The per-step maxima come from one engine kernel
+(:func:`masonrycli.engine.watch.watch_step`).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from masonrycli.engine.watch import watch_step
+
+SLIDE_SPEED = 1e-4
+"""m/s: a closed contact sliding faster than this is sliding (a stuck block stays below 1e-7 m/s)."""
+ROCK_SPEED = 1e-4
+"""rad/s: a block turning faster than this is rocking (a block at rest stays below 1e-7 rad/s)."""
+STATES = ("intact", "damaged", "collapsed")
+
+
+@dataclass(frozen=True)
+class CollapseRule:
+    """Thresholds of the collapse and damage definitions (module docstring)."""
+
+    drop: float = 1.0
+    """× block height: a block falling further has collapsed."""
+    turn: float = math.pi / 4
+    """rad: a block turning further has collapsed."""
+    drift: float = 0.25
+    """× structure height: a top drift beyond this is collapse."""
+    damage_drift: float = 0.002
+    """× structure height: residual top drift beyond this is damage."""
+    damage_hinges: int = 1
+    """hinged joints at the end from which the structure is damaged."""
+    damage_opening: float = 0.005
+    """m: a joint opened or a block displaced relative to the ground by more than this at the end is damage."""
+
+
+RULES = {
+    "wall": CollapseRule(),
+    # The arch and the aqueduct carry their load by thrust: three hinges are how they stand on moved
+    # supports, so only a fourth hinge (a mechanism) counts as damage; a leaning pier is damage early.
+    "arch": CollapseRule(drift=0.1, damage_hinges=4),
+    "aqueduct": CollapseRule(drift=0.1, damage_hinges=4),
+    "default": CollapseRule(),
+}
+
+
+def rule_for(scenario) -> CollapseRule:
+    return RULES.get(str(scenario.structure.get("builder", "default")), RULES["default"])
+
+
+class CollapseMonitor:
+    """Running maxima of the collapse indicators of one run, updated after every step.
+
+    model : the run's :class:`~masonrycli.model.Model`; ground : index of the shaking support or None.
+    """
+
+    def __init__(self, model, vertices_by_block: list[np.ndarray], ground: int | None, rule: CollapseRule):
+        n = model.block_count
+        self.rule = rule
+        self.n = n
+        self.ground = None if ground is None else n + ground
+        q0 = model.body_q0
+        self.q0 = q0.copy()
+        heights = np.array([np.ptp(v[:, 1]) for v in vertices_by_block]) if n else np.zeros(0)
+        self.block_height = heights
+        ys = np.concatenate([v[:, 1] for v in vertices_by_block]) if n else np.zeros(1)
+        self.height = float(np.ptp(ys)) or 1.0
+        top_y = q0[:n, 1].max() if n else 0.0
+        self.top = np.flatnonzero(q0[:n, 1] >= top_y - 0.5 * float(np.median(heights) if n else 0.0)).astype(np.int64)
+        self.collapse_time: float | None = None
+        self.collapse_reason = ""
+        self.slide_time: float | None = None
+        self.rock_time: float | None = None
+        self.peak_drift = 0.0
+        self.max_slide_speed = 0.0
+        self.max_rock_speed = 0.0
+
+    def drift(self, body_q: np.ndarray) -> float:
+        """m: mean horizontal displacement of the top blocks relative to the shaking ground."""
+        if not self.top.size:
+            return 0.0
+        return float(np.mean(body_q[self.top, 0] - self.q0[self.top, 0])) - self._ground_dx(body_q)
+
+    def update(self, time: float, solver, body_q: np.ndarray, body_v: np.ndarray) -> None:
+        """One step: ``body_q``/``body_v`` (B, 3) after ``solver``'s step."""
+        if not self.n:
+            return
+        rock, slide, fall, turn, top_dx = watch_step(solver, body_q, body_v, self.q0, self.block_height, self.top)
+        self.observe(time, rock, slide, fall, turn, top_dx - self._ground_dx(body_q))
+
+    def observe(self, time: float, rock: float, slide: float, fall: float, turn: float, drift: float) -> None:
+        """Fold one step's indicators in: max |ω| (rad/s), max closed-contact |u_t| (m/s), max fall ×
+        block height, max |θ| (rad), top drift relative to the ground (m)."""
+        rule = self.rule
+        self.max_rock_speed = max(self.max_rock_speed, rock)
+        self.max_slide_speed = max(self.max_slide_speed, slide)
+        if self.rock_time is None and rock > ROCK_SPEED:
+            self.rock_time = time
+        if self.slide_time is None and slide > SLIDE_SPEED:
+            self.slide_time = time
+        ratio = abs(drift) / self.height
+        self.peak_drift = max(self.peak_drift, ratio)
+        if self.collapse_time is not None:
+            return
+        reason = ""
+        if fall > rule.drop:
+            reason = f"a block fell by more than {rule.drop:g} × its height"
+        elif turn > rule.turn:
+            reason = f"a block turned by more than {math.degrees(rule.turn):g}°"
+        elif ratio > rule.drift:
+            reason = f"the top drifted by more than {rule.drift:g} × the height"
+        if reason:
+            self.collapse_time, self.collapse_reason = time, reason
+
+    def _ground_dx(self, body_q: np.ndarray) -> float:
+        return 0.0 if self.ground is None else float(body_q[self.ground, 0] - self.q0[self.ground, 0])
+
+    def state(self, body_q: np.ndarray, hinges: int, max_opening: float) -> str:
+        """``collapsed``, ``damaged`` or ``intact`` at the end of the run (module docstring)."""
+        if self.collapse_time is not None:
+            return "collapsed"
+        rule = self.rule
+        displaced = self.max_block_displacement(body_q)
+        if (
+            abs(self.drift(body_q)) / self.height > rule.damage_drift
+            or hinges >= rule.damage_hinges
+            or max(max_opening, displaced) > rule.damage_opening
+        ):
+            return "damaged"
+        return "intact"
+
+    def max_block_displacement(self, body_q: np.ndarray) -> float:
+        """m: largest distance a block has moved relative to the shaking ground."""
+        if not self.n:
+            return 0.0
+        d = body_q[: self.n, :2] - self.q0[: self.n, :2]
+        if self.ground is not None:
+            d = d - (body_q[self.ground, :2] - self.q0[self.ground, :2])
+        return float(np.hypot(d[:, 0], d[:, 1]).max())

@@ -1,0 +1,78 @@
+"""``--record`` on the command line: the ground moves as the record says, intensity in summary and history."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+from masonrycli.cli import app
+from masonrycli.records import G_STANDARD, record_motion
+
+from synthetic_records import band_limited, write_at2
+
+DATA = Path(__file__).parent / "data"
+runner = CliRunner()
+
+
+def invoke(*args):
+    return runner.invoke(app, [str(a) for a in args], terminal_width=200)
+
+
+@pytest.fixture
+def at2(tmp_path):
+    t, u, v, a = band_limited(2.0, 0.01, [1.5, 3.0], [0.01, 0.004], seed=3)
+    write_at2(tmp_path / "quake.AT2", a / G_STANDARD, 0.01)
+    return tmp_path / "quake.AT2"
+
+
+def test_simulate_wall_with_record_and_scale(at2, tmp_path):
+    npz = tmp_path / "h.npz"
+    result = invoke(
+        "simulate", "wall", "--blocks", 12, "--record", at2, "--scale", 0.5, "--duration", 0.2, "--dt", 1e-3,
+        "--record-every", 1, "--no-recording", "--history", npz,
+    )  # fmt: skip
+    assert result.exit_code == 0, result.output
+    assert "ground motion (ground)" in result.output and "PGA" in result.output
+    h = np.load(npz)
+    motion = record_motion(at2, scale=0.5)
+    np.testing.assert_array_equal(h["support_v"][:, 0, :], motion.velocity_at(h["time"]))
+    acc = np.diff(motion.velocity_at(np.arange(201) * 1e-3)[:, 0]) / 1e-3
+    assert float(h["intensity_pga"]) == pytest.approx(np.abs(acc).max(), rel=1e-12)
+    assert float(h["intensity_pgv"]) == pytest.approx(np.abs(h["support_v"][:, 0, 0]).max(), rel=1e-12)
+
+
+def test_arch_record_shakes_both_foundations_and_run_overrides_scenario_motion(at2, tmp_path):
+    npz = tmp_path / "a.npz"
+    result = invoke("simulate", "arch", "--record", at2, "--duration", 0.02, "--no-recording", "--history", npz)
+    assert result.exit_code == 0, result.output
+    h = np.load(npz)
+    np.testing.assert_array_equal(h["support_v"][:, 0], h["support_v"][:, 1])
+    assert np.abs(h["support_v"][:, 0, 0]).max() > 0
+    npz = tmp_path / "r.npz"
+    result = invoke(
+        "run", DATA / "quake_record.toml", "--record", at2, "--scale", 2, "--no-recording", "--history", npz
+    )
+    assert result.exit_code == 0, result.output
+    h = np.load(npz)
+    np.testing.assert_array_equal(h["support_v"][:, 0, :], record_motion(at2, scale=2).velocity_at(h["time"]))
+
+
+@pytest.mark.parametrize(
+    "args, fragment",
+    [
+        (["simulate", "wall", "--record", "RECORD", "--amp", 1], "--record with --amp: choose one loading"),
+        (["simulate", "arch", "--record", "RECORD", "--settlement", 0.01], "--record with --settlement"),
+        (["simulate", "wall", "--scale", 2], "--scale: goes with --record"),
+        (["simulate", "wall", "--record", "nope.AT2"], "nope.AT2: cannot read record"),
+        (["run", DATA / "block_on_ground.toml", "--scale", 2], "--scale: goes with --record"),
+        (["run", DATA / "column_5.toml", "--record", "RECORD"], "has no shaking support"),
+    ],
+)
+def test_record_option_errors_are_one_line(at2, args, fragment):
+    result = invoke(*[at2 if a == "RECORD" else a for a in args])
+    assert result.exit_code == 2, result.output
+    lines = [ln for ln in result.output.strip().splitlines() if ln.strip()]
+    assert len(lines) == 1 and fragment in lines[0], result.output
