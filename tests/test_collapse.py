@@ -11,7 +11,7 @@ import pytest
 
 from masonrycli.collapse import RULES, CollapseMonitor, CollapseRule
 from masonrycli.run import Simulation, simulate
-from masonrycli.scenario import loads_scenario
+from masonrycli.scenario_toml import loads_scenario
 
 G = 9.81
 F = 2.0

@@ -172,8 +172,7 @@ motion = MOTION
 
 
 def test_scenario_record_with_at2_vertical_window_and_round_trip(tmp_path):
-    from masonrycli.scenario import loads_scenario
-    from masonrycli.scenario_toml import dump_scenario
+    from masonrycli.scenario_toml import dump_scenario, loads_scenario
 
     write_at2(tmp_path / "h.AT2", [0.0, 0.1, 0.2, 0.3, 0.4, 0.5], 0.01)
     write_at2(tmp_path / "v.AT2", [0.0, -0.1, -0.2, -0.3, -0.4, -0.5], 0.01)
@@ -205,7 +204,7 @@ def test_scenario_record_with_at2_vertical_window_and_round_trip(tmp_path):
     ],
 )
 def test_scenario_record_errors(tmp_path, motion, expected):
-    from masonrycli.scenario import loads_scenario
+    from masonrycli.scenario_toml import loads_scenario
 
     write_at2(tmp_path / "h.AT2", [0.0, 0.1, 0.2], 0.01)
     (tmp_path / "q.csv").write_text("0,0\n1,1\n")
