@@ -2,10 +2,11 @@
 
 from __future__ import annotations
 
-import dataclasses
 import functools
+import inspect
 import os
 import sys
+import typing
 from pathlib import Path
 from typing import Annotated
 
@@ -74,90 +75,100 @@ def main_callback(
 
 
 # -- shared options -------------------------------------------------------------------------------
+# Each group maps a parameter name to its option; ``with_options`` adds groups to a command, so the
+# commands that share them declare each option once.
 
-Duration = Annotated[float | None, typer.Option(help="Simulated time, s.", rich_help_panel="Run")]
-Dt = Annotated[float | None, typer.Option("--dt", help="Time step, s (default 1e-3).", rich_help_panel="Run")]
-Theta = Annotated[float | None, typer.Option(help="Moreau–Jean θ in [0.5, 1] (default 0.5).", rich_help_panel="Run")]
-Friction = Annotated[
-    float | None, typer.Option(help="Coulomb coefficient of every contact (default 0.6).", rich_help_panel="Material")
-]
-Density = Annotated[float | None, typer.Option(help="Block density, kg/m³ (default 2500).", rich_help_panel="Material")]
-Thickness = Annotated[
-    float | None, typer.Option(help="Out-of-plane thickness, m (default 1).", rich_help_panel="Material")
-]
-RecordEvery = Annotated[
-    int | None, typer.Option(help="Steps between recorded frames (default 10).", rich_help_panel="Run")
-]
-Tolerance = Annotated[
-    float | None,
-    typer.Option(help="NLGS tolerance, relative quadratic norm (default 1.666e-4).", rich_help_panel="Run"),
-]
-MaxIterations = Annotated[
-    int | None, typer.Option(help="NLGS sweep cap per step (default 1000).", rich_help_panel="Run")
-]
-Out = Annotated[
-    Path | None,
-    typer.Option(
-        "--out",
-        "-o",
-        help="Recording (.rrd). Default: recordings/<scenario>-<timestamp>.rrd.",
-        rich_help_panel="Output",
-    ),
-]
-NoRecording = Annotated[bool, typer.Option("--no-recording", help="Write no .rrd recording.", rich_help_panel="Output")]
-HistoryOpt = Annotated[
-    Path | None,
-    typer.Option("--history", help="History file (.npz), one row per recorded frame.", rich_help_panel="Output"),
-]
-Freq = Annotated[float | None, typer.Option("--freq", help="Ground velocity frequency, Hz.", rich_help_panel="Loading")]
-Amp = Annotated[
-    float | None, typer.Option("--amp", help="Horizontal ground velocity amplitude, m/s.", rich_help_panel="Loading")
-]
-Settlement = Annotated[
-    float | None, typer.Option(help="Downward velocity of the right foundation, m/s.", rich_help_panel="Loading")
-]
-RecordFile = Annotated[
-    Path | None,
-    typer.Option(
-        "--record",
-        help="Ground motion record shaking the ground/foundations instead of the sine: PEER .AT2 (g) or CSV "
+
+def _opt(kind: type, panel: str, help: str, *decls: str):
+    """An optional ``kind`` value (None when not given), listed under ``panel`` in --help."""
+    return Annotated[kind | None, typer.Option(*decls, help=help, rich_help_panel=panel)]
+
+
+WALL = {
+    "blocks": _opt(int, "Structure", "Number of blocks (default 51; 248 for the paper's large wall)."),
+    "courses": _opt(int, "Structure", "Number of courses."),
+    "length": _opt(float, "Structure", "Wall length, m."),
+    "block_length": _opt(float, "Structure", "Block length, m (default 0.30)."),
+    "block_height": _opt(float, "Structure", "Block height, m (default 0.20)."),
+}
+ARCH = {
+    "voussoirs": _opt(int, "Structure", "Voussoirs in the arch (default 30)."),
+    "pier_courses": _opt(int, "Structure", "Courses per pier, 2 blocks each (default 17)."),
+    "span": _opt(float, "Structure", "Clear span of the arch, m (default 3.6)."),
+    "ring_thickness": _opt(float, "Structure", "Arch ring thickness, m (default 0.35)."),
+    "pier_width": _opt(float, "Structure", "Pier width, m (default 0.90)."),
+}
+AQUEDUCT = {**ARCH, "wall_courses": _opt(int, "Structure", "Courses of the spandrel walls (default 18).")}
+LOADING = {
+    "freq": _opt(float, "Loading", "Ground velocity frequency, Hz.", "--freq"),
+    "amp": _opt(float, "Loading", "Horizontal ground velocity amplitude, m/s.", "--amp"),
+    "settlement": _opt(float, "Loading", "Downward velocity of the right foundation, m/s."),
+}
+RECORD = {
+    "record": _opt(
+        Path,
+        "Loading",
+        "Ground motion record shaking the ground/foundations instead of the sine: PEER .AT2 (g) or CSV "
         "(time, velocity). Baseline-corrected; window and vertical component in a scenario file.",
-        rich_help_panel="Loading",
+        "--record",
     ),
-]
-Scale = Annotated[float | None, typer.Option("--scale", help="Multiplies the --record.", rich_help_panel="Loading")]
+    "scale": _opt(float, "Loading", "Multiplies the --record.", "--scale"),
+}
+RUN = {
+    "duration": _opt(float, "Run", "Simulated time, s."),
+    "dt": _opt(float, "Run", "Time step, s (default 1e-3).", "--dt"),
+    "theta": _opt(float, "Run", "Moreau–Jean θ in [0.5, 1] (default 0.5)."),
+    "record_every": _opt(int, "Run", "Steps between recorded frames (default 10)."),
+    "tolerance": _opt(float, "Run", "NLGS tolerance, relative quadratic norm (default 1.666e-4)."),
+    "max_iterations": _opt(int, "Run", "NLGS sweep cap per step (default 1000)."),
+}
+Friction = _opt(float, "Material", "Coulomb coefficient of every contact (default 0.6).")
+FRICTION = {"friction": Friction}
+BLOCK_MATERIAL = {
+    "density": _opt(float, "Material", "Block density, kg/m³ (default 2500)."),
+    "thickness": _opt(float, "Material", "Out-of-plane thickness, m (default 1)."),
+}
+OUTPUT = {
+    "out": _opt(Path, "Output", "Recording (.rrd). Default: recordings/<scenario>-<timestamp>.rrd.", "--out", "-o"),
+    "no_recording": Annotated[
+        bool, typer.Option("--no-recording", help="Write no .rrd recording.", rich_help_panel="Output")
+    ],
+    "history": _opt(Path, "Output", "History file (.npz), one row per recorded frame.", "--history"),
+}
+GEO_OUT = {"out": Annotated[Path, typer.Option("--out", "-o", help="GeoJSON file to write.")]}
 
 
-def _run_overrides(**values) -> dict:
-    return {k: v for k, v in values.items() if v is not None}
+def with_options(*groups: dict):
+    """Add the options of ``groups`` (after the command's own parameters) to a Typer command.
+
+    The command takes them as keyword arguments (``**opts``). Options default to None (flags to False,
+    an option without a default stays required).
+    """
+
+    def decorate(func):
+        own = [p for p in inspect.signature(func, eval_str=True).parameters.values() if p.kind != p.VAR_KEYWORD]
+        added = [
+            inspect.Parameter(name, inspect.Parameter.KEYWORD_ONLY, annotation=ann, default=_default(ann))
+            for group in groups
+            for name, ann in group.items()
+        ]
+
+        @functools.wraps(func)
+        def command(**kwargs):
+            return func(**kwargs)
+
+        command.__signature__ = inspect.Signature([*own, *added])
+        return command
+
+    return decorate
 
 
-def _replace(obj, where: str, **changes):
-    """dataclasses.replace with the option name in the error message."""
-    try:
-        return dataclasses.replace(obj, **changes)
-    except InputError as exc:
-        raise InputError(f"{where}: {exc}") from None
-
-
-def _apply_options(scenario, *, duration, dt, theta, friction, record_every, tolerance, max_iterations):
-    from masonrycli.scenario import RunConfig  # noqa: F401  (validation lives in the dataclass)
-
-    run_changes = _run_overrides(
-        duration=duration,
-        dt=dt,
-        theta=theta,
-        record_every=record_every,
-        tolerance=tolerance,
-        max_iterations=max_iterations,
-    )
-    for key, value in run_changes.items():
-        _replace(scenario.run, f"--{key.replace('_', '-')}", **{key: value})
-    run = _replace(scenario.run, "options", **run_changes) if run_changes else scenario.run
-    material = scenario.material
-    if friction is not None:
-        material = _replace(material, "--friction", friction=friction)
-    return dataclasses.replace(scenario, run=run, material=material)
+def _default(annotation):
+    """None for an optional value, False for a flag, required (no default) otherwise."""
+    kind = typing.get_args(annotation)[0]
+    if kind is bool:
+        return False
+    return None if type(None) in typing.get_args(kind) else inspect.Parameter.empty
 
 
 def _outputs(name: str, out: Path | None, no_recording: bool) -> Path | None:
@@ -170,10 +181,6 @@ def _outputs(name: str, out: Path | None, no_recording: bool) -> Path | None:
     if out.suffix != ".rrd":
         raise InputError(f"--out {out}: a recording file must end in .rrd")
     return out
-
-
-PAPER_INSTANT = {"wall": ("III.2–III.5", 0.1), "arch": ("III.7–III.10", 5.0)}
-"""The instant of the paper's figures for each built-in structure."""
 
 
 def _execute(scenario, out: Path | None, history: Path | None, hint: str = "") -> None:
@@ -210,368 +217,68 @@ def _execute(scenario, out: Path | None, history: Path | None, hint: str = "") -
         raise typer.Exit(EXIT_INTERRUPTED) from None
 
 
-# -- builder options ------------------------------------------------------------------------------
+# -- commands -------------------------------------------------------------------------------------
 
 
-def _wall_options(blocks, courses, length, block_length, block_height) -> dict:
-    opts = {
-        "blocks": blocks,
-        "courses": courses,
-        "length": length,
-        "block_length": block_length,
-        "block_height": block_height,
-    }
-    if courses is not None or length is not None:
-        opts["blocks"] = blocks  # None unless given: the builder solves for the rest
-    return {k: v for k, v in opts.items() if v is not None}
+def _simulate(name: str, opts: dict) -> None:
+    from masonrycli.builtin import builtin, paper_instant_hint
 
-
-def _arch_options(voussoirs, pier_courses, span, ring_thickness, pier_width) -> dict:
-    opts = {
-        "voussoirs": voussoirs,
-        "pier_courses": pier_courses,
-        "span": span,
-        "ring_thickness": ring_thickness,
-        "pier_width": pier_width,
-    }
-    return {k: v for k, v in opts.items() if v is not None}
-
-
-Blocks = Annotated[
-    int | None,
-    typer.Option(help="Number of blocks (default 51; 248 for the paper's large wall).", rich_help_panel="Structure"),
-]
-Courses = Annotated[int | None, typer.Option(help="Number of courses.", rich_help_panel="Structure")]
-Length = Annotated[float | None, typer.Option(help="Wall length, m.", rich_help_panel="Structure")]
-BlockLength = Annotated[float | None, typer.Option(help="Block length, m (default 0.30).", rich_help_panel="Structure")]
-BlockHeight = Annotated[float | None, typer.Option(help="Block height, m (default 0.20).", rich_help_panel="Structure")]
-Voussoirs = Annotated[int | None, typer.Option(help="Voussoirs in the arch (default 30).", rich_help_panel="Structure")]
-PierCourses = Annotated[
-    int | None, typer.Option(help="Courses per pier, 2 blocks each (default 17).", rich_help_panel="Structure")
-]
-Span = Annotated[
-    float | None, typer.Option(help="Clear span of the arch, m (default 3.6).", rich_help_panel="Structure")
-]
-RingThickness = Annotated[
-    float | None, typer.Option(help="Arch ring thickness, m (default 0.35).", rich_help_panel="Structure")
-]
-PierWidth = Annotated[float | None, typer.Option(help="Pier width, m (default 0.90).", rich_help_panel="Structure")]
-WallCourses = Annotated[
-    int | None, typer.Option(help="Courses of the spandrel walls (default 18).", rich_help_panel="Structure")
-]
-
-DEFAULT_DURATION = {"wall": 1.0, "arch": 5.0, "aqueduct": 5.0}
-
-
-def _simulate(
-    builder: str,
-    options: dict,
-    *,
-    freq,
-    amp,
-    settlement,
-    record,
-    scale,
-    duration,
-    dt,
-    theta,
-    friction,
-    density,
-    thickness,
-    record_every,
-    tolerance,
-    max_iterations,
-    out,
-    no_recording,
-    history,
-) -> None:
-    from masonrycli.motion import Constant
-    from masonrycli.scenario import Material, RunConfig, scenario_from_builder
-
-    material = Material()
-    for key, value in _run_overrides(density=density, thickness=thickness, friction=friction).items():
-        material = _replace(material, f"--{key}", **{key: value})
-    run = RunConfig(duration=DEFAULT_DURATION[builder])
-    if record is not None:
-        if amp is not None or freq is not None or settlement:
-            given = "--amp" if amp is not None else "--freq" if freq is not None else "--settlement"
-            raise InputError(f"--record with {given}: choose one loading (the record replaces the sine)")
-        shaken = ("ground",) if builder == "wall" else ("left-foundation", "right-foundation")
-        motion = _record(record, scale)
-        motions = {name: motion for name in shaken}
-    elif scale is not None:
-        raise InputError("--scale: goes with --record (it multiplies the record)")
-    elif builder == "wall":
-        if settlement:
-            raise InputError("--settlement: the wall stands on one ground; settlement applies to arch and aqueduct")
-        amp = 1.0 if amp is None else amp
-        freq = 2.0 if freq is None else freq
-        motions = {"ground": _sine(amp, freq)} if amp else {}
-    else:
-        settlement = 0.01 if settlement is None else settlement
-        amp = 0.0 if amp is None else amp
-        freq = 2.0 if freq is None else freq
-        if settlement < 0:
-            raise InputError(f"--settlement {settlement}: must be >= 0 (a downward velocity, m/s)")
-        motions = {}
-        if amp:
-            motions = {"left-foundation": _sine(amp, freq), "right-foundation": _sine(amp, freq)}
-        if settlement:
-            if amp:
-                raise InputError("--settlement with --amp: choose one loading (settle or shake)")
-            motions["right-foundation"] = Constant(velocity=(0.0, -settlement))
-    scenario = scenario_from_builder(builder, options, run, material, motions)
-    scenario = _apply_options(
-        scenario,
-        duration=duration,
-        dt=dt,
-        theta=theta,
-        friction=None,
-        record_every=record_every,
-        tolerance=tolerance,
-        max_iterations=max_iterations,
-    )
-    hint = ""
-    if builder in PAPER_INSTANT:
-        figs, t = PAPER_INSTANT[builder]
-        step = round(t / scenario.run.dt)
-        if step <= scenario.run.n_steps:
-            hint = f"The paper's Figs. {figs} are at t = {t:g} s: step {step} on the viewer's timeline."
-    _execute(scenario, _outputs(builder, out, no_recording), history, hint)
-
-
-def _record(path: Path, scale: float | None):
-    from masonrycli.records import record_motion
-
-    try:
-        return record_motion(path, scale=1.0 if scale is None else scale, display=str(path))
-    except InputError as exc:
-        msg = str(exc)
-        raise InputError(msg if msg.startswith(str(path)) else f"--record {path}: {msg}") from None
-
-
-def _with_record(scenario, record: Path | None, scale: float | None):
-    """``scenario`` with every shaking support (sine or record motion) driven by the ``--record`` file."""
-    if record is None:
-        if scale is not None:
-            raise InputError("--scale: goes with --record (it multiplies the record)")
-        return scenario
-    shaking = [m.kind in ("sine", "record") for m in scenario.motions]
-    if not any(shaking):
-        raise InputError(f"--record: {scenario.name} has no shaking support (give one a sine or record motion)")
-    motion = _record(record, scale)
-    motions = tuple(motion if shake else m for shake, m in zip(shaking, scenario.motions))
-    return dataclasses.replace(scenario, motions=motions)
-
-
-def _sine(amp: float, freq: float):
-    from masonrycli.motion import Sine
-
-    try:
-        return Sine(direction=(1.0, 0.0), amplitude=amp, frequency=freq)
-    except InputError as exc:
-        raise InputError(f"--amp/--freq: {exc}") from None
+    out, no_recording, history = (opts.pop(k) for k in OUTPUT)
+    scenario = builtin(name, **opts)
+    hint = paper_instant_hint(name, scenario.run)
+    _execute(scenario, _outputs(name, out, no_recording), history, hint)
 
 
 @simulate_app.command("wall")
 @user_errors
-def simulate_wall(
-    blocks: Blocks = None,
-    courses: Courses = None,
-    length: Length = None,
-    block_length: BlockLength = None,
-    block_height: BlockHeight = None,
-    freq: Freq = None,
-    amp: Amp = None,
-    settlement: Settlement = None,
-    record: RecordFile = None,
-    scale: Scale = None,
-    duration: Duration = None,
-    dt: Dt = None,
-    theta: Theta = None,
-    friction: Friction = None,
-    density: Density = None,
-    thickness: Thickness = None,
-    record_every: RecordEvery = None,
-    tolerance: Tolerance = None,
-    max_iterations: MaxIterations = None,
-    out: Out = None,
-    no_recording: NoRecording = False,
-    history: HistoryOpt = None,
-) -> None:
+@with_options(WALL, LOADING, RECORD, RUN, FRICTION, BLOCK_MATERIAL, OUTPUT)
+def simulate_wall(**opts) -> None:
     """The paper's running-bond wall on a shaken ground (default 51 blocks, 1 m/s at 2 Hz for 1 s)."""
-    if blocks is None and courses is None and length is None:
-        blocks = 51
-    _simulate(
-        "wall",
-        _wall_options(blocks, courses, length, block_length, block_height),
-        freq=freq,
-        amp=amp,
-        settlement=settlement,
-        record=record,
-        scale=scale,
-        duration=duration,
-        dt=dt,
-        theta=theta,
-        friction=friction,
-        density=density,
-        thickness=thickness,
-        record_every=record_every,
-        tolerance=tolerance,
-        max_iterations=max_iterations,
-        out=out,
-        no_recording=no_recording,
-        history=history,
-    )
+    _simulate("wall", opts)
 
 
 @simulate_app.command("arch")
 @user_errors
-def simulate_arch(
-    voussoirs: Voussoirs = None,
-    pier_courses: PierCourses = None,
-    span: Span = None,
-    ring_thickness: RingThickness = None,
-    pier_width: PierWidth = None,
-    freq: Freq = None,
-    amp: Amp = None,
-    settlement: Settlement = None,
-    record: RecordFile = None,
-    scale: Scale = None,
-    duration: Duration = None,
-    dt: Dt = None,
-    theta: Theta = None,
-    friction: Friction = None,
-    density: Density = None,
-    thickness: Thickness = None,
-    record_every: RecordEvery = None,
-    tolerance: Tolerance = None,
-    max_iterations: MaxIterations = None,
-    out: Out = None,
-    no_recording: NoRecording = False,
-    history: HistoryOpt = None,
-) -> None:
+@with_options(ARCH, LOADING, RECORD, RUN, FRICTION, BLOCK_MATERIAL, OUTPUT)
+def simulate_arch(**opts) -> None:
     """The paper's 98-block arch on two piers; default: right foundation settles at 1 cm/s for 5 s."""
-    _simulate(
-        "arch",
-        _arch_options(voussoirs, pier_courses, span, ring_thickness, pier_width),
-        freq=freq,
-        amp=amp,
-        settlement=settlement,
-        record=record,
-        scale=scale,
-        duration=duration,
-        dt=dt,
-        theta=theta,
-        friction=friction,
-        density=density,
-        thickness=thickness,
-        record_every=record_every,
-        tolerance=tolerance,
-        max_iterations=max_iterations,
-        out=out,
-        no_recording=no_recording,
-        history=history,
-    )
+    _simulate("arch", opts)
 
 
 @simulate_app.command("aqueduct")
 @user_errors
-def simulate_aqueduct(
-    voussoirs: Voussoirs = None,
-    pier_courses: PierCourses = None,
-    span: Span = None,
-    ring_thickness: RingThickness = None,
-    pier_width: PierWidth = None,
-    wall_courses: WallCourses = None,
-    freq: Freq = None,
-    amp: Amp = None,
-    settlement: Settlement = None,
-    record: RecordFile = None,
-    scale: Scale = None,
-    duration: Duration = None,
-    dt: Dt = None,
-    theta: Theta = None,
-    friction: Friction = None,
-    density: Density = None,
-    thickness: Thickness = None,
-    record_every: RecordEvery = None,
-    tolerance: Tolerance = None,
-    max_iterations: MaxIterations = None,
-    out: Out = None,
-    no_recording: NoRecording = False,
-    history: HistoryOpt = None,
-) -> None:
+@with_options(AQUEDUCT, LOADING, RECORD, RUN, FRICTION, BLOCK_MATERIAL, OUTPUT)
+def simulate_aqueduct(**opts) -> None:
     """A segment of the Arles aqueduct (98 arch + 248 wall blocks); default: settlement 1 cm/s for 5 s.
 
     Shake it instead with [bold]--settlement 0 --amp 1 --freq 2[/bold].
     """
-    options = _arch_options(voussoirs, pier_courses, span, ring_thickness, pier_width)
-    if wall_courses is not None:
-        options["wall_courses"] = wall_courses
-    _simulate(
-        "aqueduct",
-        options,
-        freq=freq,
-        amp=amp,
-        settlement=settlement,
-        record=record,
-        scale=scale,
-        duration=duration,
-        dt=dt,
-        theta=theta,
-        friction=friction,
-        density=density,
-        thickness=thickness,
-        record_every=record_every,
-        tolerance=tolerance,
-        max_iterations=max_iterations,
-        out=out,
-        no_recording=no_recording,
-        history=history,
-    )
+    _simulate("aqueduct", opts)
 
 
 @app.command("run")
 @user_errors
+@with_options(RUN, FRICTION, OUTPUT, RECORD)
 def run_command(
     scenario_file: Annotated[
         Path, typer.Argument(help="Scenario file (TOML), or a GeoJSON / WKT geometry.", metavar="SCENARIO.toml")
     ],
-    duration: Duration = None,
-    dt: Dt = None,
-    theta: Theta = None,
-    friction: Friction = None,
-    record_every: RecordEvery = None,
-    tolerance: Tolerance = None,
-    max_iterations: MaxIterations = None,
-    out: Out = None,
-    no_recording: NoRecording = False,
-    history: HistoryOpt = None,
-    record: RecordFile = None,
-    scale: Scale = None,
+    **opts,
 ) -> None:
     """Run any scenario file (or a GeoJSON / WKT geometry file, supports fixed); options given here
     override the file's values."""
+    from masonrycli.builtin import override_run, with_record
     from masonrycli.scenario import scenario_from_geometry_file
     from masonrycli.scenario_toml import load_scenario
     from masonrycli.structure import GEOMETRY_SUFFIXES
 
+    out, no_recording, history = (opts.pop(k) for k in OUTPUT)
+    record, scale = (opts.pop(k) for k in RECORD)
     if scenario_file.suffix.lower() in GEOMETRY_SUFFIXES:
         scenario = scenario_from_geometry_file(scenario_file)
     else:
         scenario = load_scenario(scenario_file)
-    scenario = _with_record(scenario, record, scale)
-    scenario = _apply_options(
-        scenario,
-        duration=duration,
-        dt=dt,
-        theta=theta,
-        friction=friction,
-        record_every=record_every,
-        tolerance=tolerance,
-        max_iterations=max_iterations,
-    )
+    scenario = override_run(with_record(scenario, record, scale), **opts)
     _execute(scenario, _outputs(scenario.name, out, no_recording), history)
 
 
@@ -633,12 +340,7 @@ def check_command(
     xmin, ymin, xmax, ymax = info["bounding_box"]
     table.add_row("scenario", str(info["name"]))
     table.add_row("blocks", str(info["blocks"]))
-    table.add_row(
-        "supports",
-        ", ".join(f"{k} ({v})" for k, v in info["support_motions"].items())
-        if isinstance(info.get("support_motions"), dict)
-        else str(info["supports"]),
-    )
+    table.add_row("supports", str(info["supports"]))
     table.add_row("total mass", f"{info['total_mass']:.6g} kg")
     table.add_row("bounding box", f"x {xmin:.4g} … {xmax:.4g} m, y {ymin:.4g} … {ymax:.4g} m")
     table.add_row("friction", f"{info['friction']:g}")
@@ -650,15 +352,13 @@ def check_command(
         err_console.print(f"[yellow]warning:[/yellow] {warning}", highlight=False)
 
 
-def _write_assembly(builder: str, options: dict, density, thickness, out: Path) -> None:
+def _write_assembly(builder: str, opts: dict) -> None:
     from geometry_library.builders import BUILDERS
     from geometry_library.checks import validate_assembly
     from geometry_library.io import write_geojson
 
-    if density is not None:
-        options["density"] = density
-    if thickness is not None:
-        options["thickness"] = thickness
+    out = opts.pop("out")
+    options = {k: v for k, v in opts.items() if v is not None}
     try:
         assembly = BUILDERS[builder](**options).build()
     except (ValueError, GeometryError) as exc:
@@ -672,63 +372,28 @@ def _write_assembly(builder: str, options: dict, density, thickness, out: Path) 
     )
 
 
-GeoOut = Annotated[Path, typer.Option("--out", "-o", help="GeoJSON file to write.")]
-
-
 @build_app.command("wall")
 @user_errors
-def build_wall_command(
-    out: GeoOut,
-    blocks: Blocks = None,
-    courses: Courses = None,
-    length: Length = None,
-    block_length: BlockLength = None,
-    block_height: BlockHeight = None,
-    density: Density = None,
-    thickness: Thickness = None,
-) -> None:
+@with_options(GEO_OUT, WALL, BLOCK_MATERIAL)
+def build_wall_command(**opts) -> None:
     """A running-bond wall on its ground."""
-    if blocks is None and courses is None and length is None:
-        blocks = 51
-    _write_assembly("wall", _wall_options(blocks, courses, length, block_length, block_height), density, thickness, out)
+    _write_assembly("wall", opts)
 
 
 @build_app.command("arch")
 @user_errors
-def build_arch_command(
-    out: GeoOut,
-    voussoirs: Voussoirs = None,
-    pier_courses: PierCourses = None,
-    span: Span = None,
-    ring_thickness: RingThickness = None,
-    pier_width: PierWidth = None,
-    density: Density = None,
-    thickness: Thickness = None,
-) -> None:
+@with_options(GEO_OUT, ARCH, BLOCK_MATERIAL)
+def build_arch_command(**opts) -> None:
     """A semicircular arch on two piers, each on its foundation."""
-    _write_assembly(
-        "arch", _arch_options(voussoirs, pier_courses, span, ring_thickness, pier_width), density, thickness, out
-    )
+    _write_assembly("arch", opts)
 
 
 @build_app.command("aqueduct")
 @user_errors
-def build_aqueduct_command(
-    out: GeoOut,
-    voussoirs: Voussoirs = None,
-    pier_courses: PierCourses = None,
-    span: Span = None,
-    ring_thickness: RingThickness = None,
-    pier_width: PierWidth = None,
-    wall_courses: WallCourses = None,
-    density: Density = None,
-    thickness: Thickness = None,
-) -> None:
+@with_options(GEO_OUT, AQUEDUCT, BLOCK_MATERIAL)
+def build_aqueduct_command(**opts) -> None:
     """The arch plus spandrel walls in running bond up to a level top."""
-    options = _arch_options(voussoirs, pier_courses, span, ring_thickness, pier_width)
-    if wall_courses is not None:
-        options["wall_courses"] = wall_courses
-    _write_assembly("aqueduct", options, density, thickness, out)
+    _write_assembly("aqueduct", opts)
 
 
 @app.command("inspect")

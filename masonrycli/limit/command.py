@@ -7,7 +7,6 @@ prints exactly one JSON object on stdout and nothing else (warnings go to stderr
 
 from __future__ import annotations
 
-import dataclasses
 import json
 from pathlib import Path
 
@@ -28,6 +27,7 @@ THRUST_SHOWN = 0.02
 
 def resolve_structure(structure: str, friction: float | None):
     """A scenario from a built-in name, a scenario file or a geometry file; ``friction`` overrides μ."""
+    from masonrycli.builtin import override_run
     from masonrycli.scenario import Material, RunConfig, scenario_from_builder, scenario_from_geometry_file
     from masonrycli.scenario_toml import load_scenario
     from masonrycli.structure import GEOMETRY_SUFFIXES
@@ -41,13 +41,7 @@ def resolve_structure(structure: str, friction: float | None):
         scenario = scenario_from_geometry_file(path)
     else:
         scenario = load_scenario(path)
-    if friction is not None:
-        try:
-            material = dataclasses.replace(scenario.material, friction=friction)
-        except InputError as exc:
-            raise InputError(f"--friction: {exc}") from None
-        scenario = dataclasses.replace(scenario, material=material)
-    return scenario
+    return override_run(scenario, friction=friction)
 
 
 def _names(names: list[str]) -> str:

@@ -1,0 +1,164 @@
+"""Built-in scenarios: the paper's structures with their loadings, and run settings given as overrides.
+
+``builtin(name, **overrides)`` is what ``masonry simulate wall|arch|aqueduct`` runs:
+
+============  ==============  =====================================================  ===============
+name          structure       loading (default)                                      duration
+============  ==============  =====================================================  ===============
+wall          51-block wall   ground shaken horizontally, v = 1 m/s · sin(2π · 2 t)  1 s
+arch          98-block arch   right foundation settles at 1 cm/s                     5 s
+aqueduct      346 blocks      right foundation settles at 1 cm/s                     5 s
+============  ==============  =====================================================  ===============
+
+The overrides are the command line's options, under their Python names (None = not given): the
+builder's own options (``blocks``, ``voussoirs``...), the loading (``amp`` m/s, ``freq`` Hz,
+``settlement`` m/s, or a ground motion ``record`` file times ``scale``), the material (``density``, ``thickness``, ``friction``) and the run settings
+(``duration``, ``dt``, ``theta``, ``record_every``, ``tolerance``, ``max_iterations``). Errors name them
+as the command line spells them (``--settlement -1: must be >= 0 ...``).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from pathlib import Path
+
+from masonrycli.errors import InputError
+from masonrycli.motion import Constant, Record, Sine
+from masonrycli.records import record_motion
+from masonrycli.scenario import Material, RunConfig, Scenario, scenario_from_builder
+
+DEFAULT_DURATION = {"wall": 1.0, "arch": 5.0, "aqueduct": 5.0}
+"""s, simulated time of each built-in scenario."""
+SHAKE_AMPLITUDE, SHAKE_FREQUENCY = 1.0, 2.0
+"""m/s and Hz: the wall's ground velocity (the paper's shaking)."""
+SETTLEMENT = 0.01
+"""m/s: downward velocity of the right foundation of the arch and the aqueduct (the paper's settlement)."""
+PAPER_INSTANT = {"wall": ("III.2–III.5", 0.1), "arch": ("III.7–III.10", 5.0)}
+"""The instant of the paper's figures for each built-in structure: (figures, t in s)."""
+
+RUN_OVERRIDES = ("duration", "dt", "theta", "record_every", "tolerance", "max_iterations")
+MATERIAL_OVERRIDES = ("density", "thickness", "friction")
+LOADING_OVERRIDES = ("freq", "amp", "settlement", "record", "scale")
+
+
+def _given(values: dict, keys) -> dict:
+    return {k: values[k] for k in keys if values.get(k) is not None}
+
+
+def _replace(obj, where: str, **changes):
+    """dataclasses.replace with the option name in the error message."""
+    try:
+        return dataclasses.replace(obj, **changes)
+    except InputError as exc:
+        raise InputError(f"{where}: {exc}") from None
+
+
+def override_run(scenario: Scenario, *, friction: float | None = None, **run_values) -> Scenario:
+    """``scenario`` with the run settings (RunConfig fields) and the friction that are not None replaced.
+
+    Each value is checked alone first, so the message names its option (``--dt: dt = -1.0: must be > 0``);
+    then together (``options: ...``, e.g. a dt longer than the new duration).
+    """
+    run_changes = _given(run_values, RUN_OVERRIDES)
+    for key, value in run_changes.items():
+        _replace(scenario.run, f"--{key.replace('_', '-')}", **{key: value})
+    run = _replace(scenario.run, "options", **run_changes) if run_changes else scenario.run
+    material = scenario.material
+    if friction is not None:
+        material = _replace(material, "--friction", friction=friction)
+    return dataclasses.replace(scenario, run=run, material=material)
+
+
+def _sine(amp: float, freq: float) -> Sine:
+    try:
+        return Sine(direction=(1.0, 0.0), amplitude=amp, frequency=freq)
+    except InputError as exc:
+        raise InputError(f"--amp/--freq: {exc}") from None
+
+
+def record_motion_option(path: Path, scale: float | None) -> Record:
+    """The ground motion of a ``--record`` file (.AT2 or CSV), multiplied by ``scale``."""
+    try:
+        return record_motion(path, scale=1.0 if scale is None else scale, display=str(path))
+    except InputError as exc:
+        msg = str(exc)
+        raise InputError(msg if msg.startswith(str(path)) else f"--record {path}: {msg}") from None
+
+
+def with_record(scenario: Scenario, record: Path | None, scale: float | None) -> Scenario:
+    """``scenario`` with every shaking support (sine or record motion) driven by the ``record`` file."""
+    if record is None:
+        if scale is not None:
+            raise InputError("--scale: goes with --record (it multiplies the record)")
+        return scenario
+    shaking = [m.kind in ("sine", "record") for m in scenario.motions]
+    if not any(shaking):
+        raise InputError(f"--record: {scenario.name} has no shaking support (give one a sine or record motion)")
+    motion = record_motion_option(record, scale)
+    motions = tuple(motion if shake else m for shake, m in zip(shaking, scenario.motions))
+    return dataclasses.replace(scenario, motions=motions)
+
+
+def _loading(name: str, amp, freq, settlement, record, scale) -> dict:
+    """Support name -> motion of the built-in loading, with the loading overrides applied."""
+    if record is not None:
+        if amp is not None or freq is not None or settlement:
+            given = "--amp" if amp is not None else "--freq" if freq is not None else "--settlement"
+            raise InputError(f"--record with {given}: choose one loading (the record replaces the sine)")
+        shaken = ("ground",) if name == "wall" else ("left-foundation", "right-foundation")
+        motion = record_motion_option(record, scale)
+        return {support: motion for support in shaken}
+    if scale is not None:
+        raise InputError("--scale: goes with --record (it multiplies the record)")
+    freq = SHAKE_FREQUENCY if freq is None else freq
+    if name == "wall":
+        if settlement:
+            raise InputError("--settlement: the wall stands on one ground; settlement applies to arch and aqueduct")
+        amp = SHAKE_AMPLITUDE if amp is None else amp
+        return {"ground": _sine(amp, freq)} if amp else {}
+    settlement = SETTLEMENT if settlement is None else settlement
+    amp = 0.0 if amp is None else amp
+    if settlement < 0:
+        raise InputError(f"--settlement {settlement}: must be >= 0 (a downward velocity, m/s)")
+    motions = {}
+    if amp:
+        motions = {"left-foundation": _sine(amp, freq), "right-foundation": _sine(amp, freq)}
+    if settlement:
+        if amp:
+            raise InputError("--settlement with --amp: choose one loading (settle or shake)")
+        motions["right-foundation"] = Constant(velocity=(0.0, -settlement))
+    return motions
+
+
+def builtin(name: str, **overrides) -> Scenario:
+    """The built-in scenario ``name`` ("wall", "arch" or "aqueduct"), with ``overrides`` (see the module doc).
+
+    Raises :class:`InputError` (one line) for a bad override.
+    """
+    if name not in DEFAULT_DURATION:
+        raise InputError(f"unknown built-in scenario {name!r} (expected one of {', '.join(DEFAULT_DURATION)})")
+    material = Material()
+    for key, value in _given(overrides, MATERIAL_OVERRIDES).items():
+        material = _replace(material, f"--{key}", **{key: value})
+    loading = {k: overrides.get(k) for k in LOADING_OVERRIDES}
+    motions = _loading(name, **loading)
+    reserved = (*RUN_OVERRIDES, *MATERIAL_OVERRIDES, *LOADING_OVERRIDES)
+    options = {k: v for k, v in overrides.items() if k not in reserved and v is not None}
+    if name == "wall" and not options.keys() & {"blocks", "courses", "length"}:
+        options = {"blocks": 51, **options}  # the paper's small wall
+    run = RunConfig(duration=DEFAULT_DURATION[name])
+    scenario = scenario_from_builder(name, options, run, material, motions)
+    return override_run(scenario, **_given(overrides, RUN_OVERRIDES))
+
+
+def paper_instant_hint(name: str, run: RunConfig) -> str:
+    """Where the paper's figures of ``name`` are on the viewer's timeline, or "" (none, or after the run)."""
+    if name not in PAPER_INSTANT:
+        return ""
+    figs, t = PAPER_INSTANT[name]
+    step = round(t / run.dt)
+    return (
+        f"The paper's Figs. {figs} are at t = {t:g} s: step {step} on the viewer's timeline."
+        if step <= run.n_steps
+        else ""
+    )

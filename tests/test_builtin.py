@@ -1,0 +1,98 @@
+"""Built-in scenarios: the paper's loadings (1 m/s at 2 Hz, 1 cm/s settlement), overrides, their errors."""
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from masonrycli.builtin import builtin, override_run, paper_instant_hint
+from masonrycli.errors import InputError
+from masonrycli.motion import Constant, Fixed, Sine
+from masonrycli.records import record_motion
+from masonrycli.scenario import RunConfig
+
+RECORD = Path(__file__).parent / "data" / "quake_velocity.csv"
+
+
+def motions_by_name(scenario):
+    return {s.name: m for s, m in zip(scenario.assembly.supports, scenario.motions)}
+
+
+def test_wall_is_shaken_at_one_metre_per_second_and_two_hertz():
+    s = builtin("wall")
+    assert s.block_count == 51 and s.run.duration == 1.0 and s.structure == {"builder": "wall", "blocks": 51}
+    ground = motions_by_name(s)["ground"]
+    assert ground == Sine(direction=(1.0, 0.0), amplitude=1.0, frequency=2.0)
+    t = np.array([0.125, 0.3])  # a quarter period: the peak; then 1·sin(2π·2·0.3)
+    v = ground.velocity_at(t)
+    assert v[0] == pytest.approx([1.0, 0.0], abs=1e-15)
+    assert v[1] == pytest.approx([math.sin(2 * math.pi * 2 * 0.3), 0.0], abs=1e-15)
+
+
+def test_arch_right_foundation_settles_one_centimetre_per_second():
+    s = builtin("arch")
+    assert s.block_count == 98 and s.run.duration == 5.0
+    assert motions_by_name(s) == {"left-foundation": Fixed(), "right-foundation": Constant(velocity=(0.0, -0.01))}
+
+
+def test_overrides_reach_structure_loading_material_and_run():
+    s = builtin("wall", courses=2, amp=0.5, freq=3.0, friction=0.4, density=2000.0, dt=2e-3, record_every=5)
+    assert s.structure == {"builder": "wall", "courses": 2} and s.block_count == 51  # 2 courses × 25 + 1
+    assert motions_by_name(s)["ground"] == Sine(direction=(1.0, 0.0), amplitude=0.5, frequency=3.0)
+    assert (s.material.friction, s.material.density) == (0.4, 2000.0)
+    assert all(b.density == 2000.0 for b in s.assembly.blocks)
+    assert (s.run.dt, s.run.record_every, s.run.duration) == (2e-3, 5, 1.0)
+    shaken = builtin("arch", settlement=0.0, amp=1.0, voussoirs=20, duration=None)
+    assert shaken.block_count == 20 + 68
+    assert set(map(type, shaken.motions)) == {Sine}
+    assert motions_by_name(builtin("wall", amp=0.0))["ground"] == Fixed()
+
+
+@pytest.mark.parametrize(
+    "name, overrides, message",
+    [
+        ("wall", {"settlement": 0.01}, "--settlement: the wall stands on one ground; settlement applies to arch"),
+        ("arch", {"settlement": -1.0}, "--settlement -1.0: must be >= 0 (a downward velocity, m/s)"),
+        ("arch", {"settlement": 0.01, "amp": 1.0}, "--settlement with --amp: choose one loading (settle or shake)"),
+        ("wall", {"freq": -2.0}, "--amp/--freq: frequency = -2.0: must be >= 0"),
+        ("wall", {"density": 0.0, "friction": -1.0}, "--density: density = 0.0: must be > 0"),
+        ("wall", {"dt": 2.0}, "--dt: dt = 2.0: must be <= duration (1.0)"),
+        ("wall", {"duration": 0.01, "dt": 0.02}, "options: dt = 0.02: must be <= duration (0.01)"),
+        ("wall", {"blockz": 3}, 'builder "wall": unknown option "blockz" of builder "wall" (did you mean "blocks"?)'),
+        ("tower", {}, "unknown built-in scenario 'tower' (expected one of wall, arch, aqueduct)"),
+        ("wall", {"scale": 2.0}, "--scale: goes with --record (it multiplies the record)"),
+        ("arch", {"record": RECORD, "settlement": 0.01}, "--record with --settlement: choose one loading"),
+    ],
+)
+def test_bad_override_is_one_line_naming_the_option(name, overrides, message):
+    with pytest.raises(InputError) as info:
+        builtin(name, **overrides)
+    assert str(info.value).startswith(message) and "\n" not in str(info.value)
+
+
+def test_record_replaces_the_sine_on_every_shaken_support():
+    shaken = motions_by_name(builtin("arch", record=RECORD, scale=2.0))
+    expected = record_motion(RECORD, scale=2.0)
+    assert shaken == {"left-foundation": expected, "right-foundation": expected}
+
+
+def test_override_run_leaves_unset_values():
+    s = builtin("wall", blocks=7, courses=1)
+    same = override_run(s, duration=None, dt=None, friction=None)
+    assert same.run == s.run and same.material == s.material
+    changed = override_run(s, theta=0.75, friction=0.3)
+    assert (changed.run.theta, changed.material.friction, changed.run.dt) == (0.75, 0.3, s.run.dt)
+    with pytest.raises(InputError, match=r"^--friction: friction = -1\.0: must be >= 0$"):
+        override_run(s, friction=-1.0)
+
+
+def test_paper_instant_hint_only_within_the_run():
+    assert paper_instant_hint("wall", RunConfig(duration=1.0)) == (
+        "The paper's Figs. III.2–III.5 are at t = 0.1 s: step 100 on the viewer's timeline."
+    )
+    assert paper_instant_hint("arch", RunConfig(duration=5.0, dt=0.5)).endswith(
+        "t = 5 s: step 10 on the viewer's timeline."
+    )
+    assert paper_instant_hint("arch", RunConfig(duration=1.0)) == ""
+    assert paper_instant_hint("aqueduct", RunConfig(duration=5.0)) == ""
