@@ -28,6 +28,7 @@ from shapely.geometry import Polygon
 from shapely.strtree import STRtree
 
 from .blocks import SUPPORT_ROLES, Assembly, GeometryError
+from .values import check_positive
 
 COLLINEAR_RTOL = 1e-9
 MIN_AREA = 1e-10
@@ -184,15 +185,6 @@ def normalise_polygon(geometry, index: int, name: str, kind: str = "block") -> P
     return Polygon(normalise_coords(np.asarray(geometry.exterior.coords)[:, :2], label))
 
 
-def _check_positive(value, what: str, label: str) -> None:
-    try:
-        ok = math.isfinite(float(value)) and float(value) > 0.0
-    except (TypeError, ValueError):
-        ok = False
-    if not ok:
-        raise GeometryError(f"{label}: {what} must be a positive number, got {value!r}")
-
-
 def validate_assembly(
     assembly: Assembly,
     overlap_tolerance: float = 1e-9,
@@ -218,8 +210,7 @@ def validate_assembly(
     for i, block in enumerate(assembly.blocks):
         label = body_label(i, block.name)
         polys.append(normalise_polygon(block.polygon, i, block.name))
-        _check_positive(block.density, "density", label)
-        _check_positive(block.thickness, "thickness", label)
+        check_positive(label, density=block.density, thickness=block.thickness)
         labels.append(label)
     for j, support in enumerate(assembly.supports):
         label = body_label(j, support.name, "support")

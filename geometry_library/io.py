@@ -48,6 +48,7 @@ from shapely.geometry import GeometryCollection, MultiPolygon, Polygon
 
 from .blocks import SUPPORT_ROLES, Assembly, Block, GeometryError, Support
 from .checks import polygon_from_coords
+from .values import check_positive
 
 _LABEL = re.compile(
     r"^\s*(?:(?P<role>block|support)\s+)?(?P<name>[^\s:]+)(?:\s+(?P<srole>fixed|driven))?\s*:\s*(?P<wkt>.+)$",
@@ -63,8 +64,7 @@ def _read_text(path: Path) -> str:
 
 
 def _number(value, what: str, where: str) -> float:
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) or value <= 0:
-        raise GeometryError(f"{where}: {what} must be a positive number, got {value!r}")
+    check_positive(where, **{what: value})
     return float(value)
 
 

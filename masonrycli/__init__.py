@@ -1,4 +1,3 @@
 """masonry: dynamic analysis of dry-stone masonry with Non-Smooth Contact Dynamics."""
 
 __version__ = "0.1.0"
-APPLICATION_ID = "masonry"

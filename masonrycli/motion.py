@@ -55,7 +55,8 @@ from typing import ClassVar
 
 import numpy as np
 
-from masonrycli.values import check_real, check_vector, field_error, format_value, is_real
+from geometry_library.values import is_real
+from masonrycli.values import check_real, check_vector, field_error, format_value
 
 RECORD_QUANTITIES = ("velocity", "acceleration")
 BASELINES = ("quadratic", "none")

@@ -18,13 +18,11 @@ import os
 from dataclasses import dataclass, field
 from pathlib import Path
 
-import numpy as np
-
 from geometry_library.blocks import Assembly, Block
 from masonrycli.errors import InputContext, InputError
 from masonrycli.motion import Fixed, Motion
 from masonrycli.structure import build_structure, check_finite_tree, read_geometry, structure_warnings
-from masonrycli.values import check_real, check_vector, field_error, format_value, quote_string
+from masonrycli.values import check_int, check_real, check_vector, field_error, format_value, quote_string
 
 MAX_DURATION = 1e5
 """s — longer runs are refused as a likely typo."""
@@ -33,17 +31,6 @@ MAX_COUNT = 10**9
 
 # --------------------------------------------------------------------------------------------------
 # configuration dataclasses
-
-
-def _check_int(key: str, value, *, ge: int, le: int = MAX_COUNT) -> int:
-    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer)):
-        raise field_error(key, value, "must be an integer")
-    v = int(value)
-    if v < ge:
-        raise field_error(key, value, f"must be >= {ge}")
-    if v > le:
-        raise field_error(key, value, f"must be <= {le}")
-    return v
 
 
 @dataclass(frozen=True)
@@ -85,8 +72,8 @@ class RunConfig:
         put("theta", check_real("theta", self.theta, ge=0.5, le=1.0))
         put("gravity", check_vector("gravity", self.gravity))
         put("tolerance", check_real("tolerance", self.tolerance, gt=0.0, lt=1.0))
-        put("max_iterations", _check_int("max_iterations", self.max_iterations, ge=1))
-        put("record_every", _check_int("record_every", self.record_every, ge=1))
+        put("max_iterations", check_int("max_iterations", self.max_iterations, ge=1, le=MAX_COUNT))
+        put("record_every", check_int("record_every", self.record_every, ge=1, le=MAX_COUNT))
         put("alert_distance", check_real("alert_distance", self.alert_distance, gt=0.0))
 
     @property

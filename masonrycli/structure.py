@@ -15,8 +15,9 @@ import os
 from pathlib import Path
 
 from geometry_library.blocks import Assembly, GeometryError
+from geometry_library.values import is_integer, is_real
 from masonrycli.errors import InputContext, InputError, one_line
-from masonrycli.values import field_error, is_real, quote_string
+from masonrycli.values import field_error, quote_string
 
 GEOMETRY_SUFFIXES = (".geojson", ".json", ".wkt")
 
@@ -94,7 +95,7 @@ def _check_option_type(key: str, value, spec_field: dataclasses.Field):
         if not is_real(value):
             raise field_error(key, value, "must be a number")
         return float(value)
-    if expected == "int" and (isinstance(value, bool) or not isinstance(value, int)):
+    if expected == "int" and not is_integer(value):
         raise field_error(key, value, "must be an integer")
     if expected == "bool" and not isinstance(value, bool):
         raise field_error(key, value, "must be true or false")

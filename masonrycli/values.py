@@ -1,7 +1,8 @@
 """Checked input values and their TOML spelling, shared by the scenario reader, writer and motions.
 
-``check_real`` / ``check_vector`` / ``field_error`` turn a bad value into a one-line
-:class:`~masonrycli.errors.InputError` naming the key; ``format_value`` / ``quote_string`` / ``quote_key``
+``check_real`` / ``check_int`` / ``check_vector`` / ``field_error`` turn a bad value into a one-line
+:class:`~masonrycli.errors.InputError` naming the key (what a valid number is, :func:`is_real` included,
+is defined once in :mod:`geometry_library.values`); ``format_value`` / ``quote_string`` / ``quote_key``
 write Python values as TOML text that ``tomllib`` reads back bit for bit.
 """
 
@@ -12,6 +13,7 @@ import re
 
 import numpy as np
 
+from geometry_library.values import is_real, number_problem
 from masonrycli.errors import InputError
 
 
@@ -80,28 +82,20 @@ def field_error(key: str, value, reason: str) -> InputError:
     return InputError(f"{key} = {shorten(value)}: {reason}")
 
 
-def is_real(value) -> bool:
-    return isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(value, (bool, np.bool_))
-
-
 def check_real(key: str, value, *, gt=None, ge=None, le=None, lt=None, allow_inf: bool = False) -> float:
     """Return ``value`` as a float or raise ``InputError`` naming ``key``."""
-    if not is_real(value):
-        raise field_error(key, value, "must be a number")
-    x = float(value)
-    if math.isnan(x):
-        raise field_error(key, value, "must be a finite number")
-    if math.isinf(x) and not (allow_inf and x > 0):
-        raise field_error(key, value, "must be a finite number")
-    if gt is not None and not x > gt:
-        raise field_error(key, value, f"must be > {gt:g}")
-    if ge is not None and not x >= ge:
-        raise field_error(key, value, f"must be >= {ge:g}")
-    if lt is not None and not x < lt:
-        raise field_error(key, value, f"must be < {lt:g}")
-    if le is not None and not x <= le:
-        raise field_error(key, value, f"must be <= {le:g}")
-    return x
+    problem = number_problem(value, gt=gt, ge=ge, lt=lt, le=le, allow_inf=allow_inf)
+    if problem is not None:
+        raise field_error(key, value, problem)
+    return float(value)
+
+
+def check_int(key: str, value, *, ge: int, le: int) -> int:
+    """Return ``value`` as an int or raise ``InputError`` naming ``key``."""
+    problem = number_problem(value, integer=True, ge=ge, le=le)
+    if problem is not None:
+        raise field_error(key, value, problem)
+    return int(value)
 
 
 def check_vector(key: str, value, size: int = 2) -> tuple[float, ...]:

@@ -1,32 +1,12 @@
-"""Small helpers shared by the builders."""
+"""Small helpers shared by the builders (their value checks are in :mod:`geometry_library.values`)."""
 
 from __future__ import annotations
-
-import math
 
 import numpy as np
 from shapely.geometry import Polygon
 
-from ..blocks import Block, GeometryError, Support
+from ..blocks import Block, Support
 from ..checks import normalise_coords
-
-
-def check_positive(builder: str, **values: float) -> None:
-    """Raise a one-line GeometryError unless every value is a finite positive number."""
-    for key, value in values.items():
-        try:
-            ok = math.isfinite(float(value)) and float(value) > 0.0
-        except (TypeError, ValueError):
-            ok = False
-        if not ok:
-            raise GeometryError(f"{builder}: {key} must be a positive number, got {value!r}")
-
-
-def check_count(builder: str, minimum: int = 1, **values: int) -> None:
-    """Raise a one-line GeometryError unless every value is an integer ≥ ``minimum``."""
-    for key, value in values.items():
-        if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < minimum:
-            raise GeometryError(f"{builder}: {key} must be an integer ≥ {minimum}, got {value!r}")
 
 
 def name_width(count: int) -> int:

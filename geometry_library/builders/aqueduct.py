@@ -26,7 +26,8 @@ from dataclasses import dataclass
 from shapely.geometry import Polygon
 
 from ..blocks import Assembly, GeometryError
-from ._common import check_count, check_positive, make_block, name_width
+from ..values import check_count, check_positive
+from ._common import make_block, name_width
 from .arch import ArchSpec, arch_parts
 from .spandrel import spandrel_blocks
 

@@ -31,7 +31,8 @@ import numpy as np
 from shapely.geometry import box
 
 from ..blocks import SUPPORT_ROLES, Assembly, Block, GeometryError, Support
-from ._common import check_count, check_positive, make_block, make_support, name_width
+from ..values import check_count, check_positive
+from ._common import make_block, make_support, name_width
 
 
 @dataclass(frozen=True, eq=False)

@@ -33,7 +33,8 @@ from dataclasses import dataclass
 from shapely.geometry import box
 
 from ..blocks import Assembly, Block, GeometryError
-from ._common import check_positive, make_block, make_support, name_width
+from ..values import check_positive, number_problem
+from ._common import make_block, make_support, name_width
 
 
 @dataclass(frozen=True)
@@ -86,7 +87,7 @@ class WallLayout:
 
 def wall_layouts(blocks: int) -> list[tuple[int, int]]:
     """Every (courses, full_per_course) with courses·n + ⌊courses/2⌋ == blocks, fewest courses first."""
-    if not isinstance(blocks, int) or blocks < 1:
+    if number_problem(blocks, integer=True, ge=1) is not None:
         raise GeometryError(f"wall: block count must be a positive integer, got {blocks!r}")
     out = []
     for c in range(1, blocks + 1):
@@ -123,7 +124,7 @@ def wall_layout(
         n_pinned = round(n_float)
         if n_pinned < 1 or abs(n_float - n_pinned) > 1e-9 * max(1.0, n_float):
             raise GeometryError(f"wall: length {length:g} m is not a whole number of {block_length:g} m blocks")
-    if courses is not None and (not isinstance(courses, int) or courses < 1):
+    if courses is not None and number_problem(courses, integer=True, ge=1) is not None:
         raise GeometryError(f"wall: courses must be a positive integer, got {courses!r}")
     if blocks is None:
         if courses is None or n_pinned is None:

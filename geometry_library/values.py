@@ -1,0 +1,73 @@
+"""Checked numbers: the one definition of a valid real, integer or positive value, for both packages.
+
+:func:`number_problem` says what is wrong with a value, as the end of a sentence ("must be a number",
+"must be a finite number", "must be an integer", "must be > 0", "must be >= 1"), or None. Each caller
+words its message in its own style around it:
+
+- geometry_library (builders, checks, geometry files): :func:`check_positive` and :func:`check_count`
+  raise ``GeometryError("<label>: <key> must be a positive number, got <value>")``;
+- masonrycli (scenario files, options, motions): ``masonrycli.values.check_real`` / ``check_int`` raise
+  ``InputError("<key> = <value>: <reason>")``.
+
+A bool is not a number here (``True`` is an int to Python, never a density or a count to a user).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from .blocks import GeometryError
+
+
+def is_real(value) -> bool:
+    """An int or a float (numpy's too), not a bool."""
+    return isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(value, (bool, np.bool_))
+
+
+def is_integer(value) -> bool:
+    """An int (numpy's too), not a bool."""
+    return isinstance(value, (int, np.integer)) and not isinstance(value, (bool, np.bool_))
+
+
+def _bound(b) -> str:
+    """An integer bound as written (10**9 stays 1000000000), a float one in %g."""
+    return str(b) if is_integer(b) else f"{b:g}"
+
+
+def number_problem(value, *, integer=False, gt=None, ge=None, lt=None, le=None, allow_inf=False) -> str | None:
+    """What is wrong with ``value`` as a (finite) number within the given bounds, or None.
+
+    ``integer``: it must be an int. ``allow_inf``: +inf passes (before the bounds are checked).
+    """
+    if integer and not is_integer(value):
+        return "must be an integer"
+    if not is_real(value):
+        return "must be a number"
+    x = value if integer else float(value)
+    if not integer and (math.isnan(x) or (math.isinf(x) and not (allow_inf and x > 0))):
+        return "must be a finite number"
+    if gt is not None and not x > gt:
+        return f"must be > {_bound(gt)}"
+    if ge is not None and not x >= ge:
+        return f"must be >= {_bound(ge)}"
+    if lt is not None and not x < lt:
+        return f"must be < {_bound(lt)}"
+    if le is not None and not x <= le:
+        return f"must be <= {_bound(le)}"
+    return None
+
+
+def check_positive(label: str, **values) -> None:
+    """Raise a one-line GeometryError unless every value is a finite number > 0."""
+    for key, value in values.items():
+        if number_problem(value, gt=0.0) is not None:
+            raise GeometryError(f"{label}: {key} must be a positive number, got {value!r}")
+
+
+def check_count(label: str, minimum: int = 1, **values) -> None:
+    """Raise a one-line GeometryError unless every value is an integer ≥ ``minimum``."""
+    for key, value in values.items():
+        if number_problem(value, integer=True, ge=minimum) is not None:
+            raise GeometryError(f"{label}: {key} must be an integer ≥ {minimum}, got {value!r}")

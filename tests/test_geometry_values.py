@@ -1,0 +1,65 @@
+"""The one definition of a valid number: reasons, bounds, bools, and the two message styles built on it."""
+
+import math
+
+import numpy as np
+import pytest
+
+from geometry_library.blocks import GeometryError
+from geometry_library.values import check_count, check_positive, is_integer, is_real, number_problem
+from masonrycli.errors import InputError
+from masonrycli.values import check_int, check_real
+
+
+@pytest.mark.parametrize(
+    "value, kwargs, reason",
+    [
+        (1.5, {}, None),
+        (np.float32(2.0), {"gt": 0.0}, None),
+        (True, {}, "must be a number"),
+        ("2", {}, "must be a number"),
+        (None, {}, "must be a number"),
+        (math.nan, {}, "must be a finite number"),
+        (math.inf, {}, "must be a finite number"),
+        (math.inf, {"allow_inf": True, "le": 1.0}, "must be <= 1"),
+        (-math.inf, {"allow_inf": True}, "must be a finite number"),
+        (0.0, {"gt": 0.0}, "must be > 0"),
+        (0.4, {"ge": 0.5}, "must be >= 0.5"),
+        (1.0, {"lt": 1.0}, "must be < 1"),
+        (2e5, {"le": 1e5}, "must be <= 100000"),
+        (3, {"integer": True, "ge": 1}, None),
+        (np.int64(0), {"integer": True, "ge": 1}, "must be >= 1"),
+        (2.0, {"integer": True}, "must be an integer"),
+        (np.bool_(True), {"integer": True}, "must be an integer"),
+        (10**9 + 1, {"integer": True, "le": 10**9}, "must be <= 1000000000"),  # an integer bound as written
+    ],
+)
+def test_number_problem(value, kwargs, reason):
+    assert number_problem(value, **kwargs) == reason
+
+
+def test_is_real_and_is_integer_reject_bools():
+    assert is_real(3) and is_real(np.float64(0.1)) and not is_real(False) and not is_real(np.bool_(False))
+    assert is_integer(np.int32(4)) and not is_integer(4.0) and not is_integer(True)
+
+
+def test_geometry_style_messages():
+    check_positive("wall", a=0.1, b=np.float64(2.0))
+    with pytest.raises(GeometryError, match=r"^wall: b must be a positive number, got -1\.0$"):
+        check_positive("wall", a=0.1, b=-1.0)
+    with pytest.raises(GeometryError, match=r"^block 3: density must be a positive number, got True$"):
+        check_positive("block 3", density=True)
+    check_count("arch", 2, voussoirs=np.int64(2))
+    with pytest.raises(GeometryError, match=r"^arch: voussoirs must be an integer ≥ 2, got 1$"):
+        check_count("arch", 2, voussoirs=1)
+
+
+def test_input_style_messages():
+    assert check_real("dt", 1) == 1.0 and isinstance(check_real("dt", 1), float)
+    with pytest.raises(InputError, match=r"^dt = -0\.001: must be > 0$"):
+        check_real("dt", -0.001, gt=0.0)
+    assert check_int("n", np.int64(5), ge=1, le=10) == 5
+    with pytest.raises(InputError, match=r"^record_every = 0: must be >= 1$"):
+        check_int("record_every", 0, ge=1, le=10**9)
+    with pytest.raises(InputError, match=r"^record_every = 2\.5: must be an integer$"):
+        check_int("record_every", 2.5, ge=1, le=10**9)
