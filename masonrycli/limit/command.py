@@ -81,7 +81,9 @@ def verify_table(checks) -> Table:
         table.add_row(
             f"{c.factor:g}",
             f"{c.tilt_deg:.2f}°",
-            f"collapses at t = {c.time:.3f} s" if c.collapsed else f"stands for {c.time:.2f} s",
+            f"collapses at t = {c.time:.3f} s"
+            if c.collapsed
+            else f"stands for {c.time:.2f} s (end speed {c.max_speed * 1e3:.2g} mm/s)",
             ("yes" if c.as_predicted else "[bold red]no[/bold red]"),
             f"{c.max_displacement * 1e3:.2f} mm (threshold {c.threshold * 1e3:.1f})",
             "" if c.similarity is None else f"{c.similarity:.3f}",
