@@ -282,6 +282,17 @@ def run_command(
     _execute(scenario, _outputs(scenario.name, out, no_recording), history)
 
 
+def _register_sweep() -> None:
+    # the sweep command lives in its own module (it is as long as a small CLI); registered here so
+    # that `masonry --help` lists it with the others
+    from masonrycli.cli_sweep import sweep_command
+
+    app.command("sweep")(user_errors(sweep_command))
+
+
+_register_sweep()
+
+
 @app.command("limit")
 @user_errors
 def limit_command(

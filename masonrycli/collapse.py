@@ -37,8 +37,9 @@ import numpy as np
 
 from masonrycli.engine.watch import watch_step
 
-SLIDE_SPEED = 1e-4
-"""m/s: a closed contact sliding faster than this is sliding (a stuck block stays below 1e-7 m/s)."""
+SLIDE_SPEED = 1e-5
+"""m/s: a closed contact sliding faster than this is sliding (a stuck block stays below 1e-12 m/s; a
+block 0.5 % past its sliding threshold reaches ~1e-4 m/s)."""
 ROCK_SPEED = 1e-4
 """rad/s: a block turning faster than this is rocking (a block at rest stays below 1e-7 rad/s)."""
 STATES = ("intact", "damaged", "collapsed")

@@ -1,7 +1,8 @@
 """Intensity measures of the ground motion as applied to a run.
 
 The measures are taken from the imposed velocity of the shaking support sampled at the run's time
-steps (the motion *as applied*: scaled, windowed, baseline-corrected, cut at the run's duration), along
+steps (the motion *as applied*: scaled, windowed, baseline-corrected, cut at the run's duration — the
+whole duration even when the run stops early at collapse, so the measure belongs to the loading), along
 x (horizontal). The acceleration is the step-to-step difference of that velocity, which for a record is
 the record's own (linearly interpolated) acceleration averaged over each step. The field's library
 `eqsig` computes the Arias intensity, the significant duration and the spectral acceleration.

@@ -245,7 +245,7 @@ def simulate(
         pairs = [f"{names[a]}|{names[b]}" for a, b in sim.joints.joint_body[hinged]]
         shown = ", ".join(pairs[:8]) + (" …" if len(pairs) > 8 else "")
         extra["hinged joints (end)"] = f"{len(pairs)}" + (f": {shown}" if pairs else "")
-    ims = applied_intensity(scenario, m, done)
+    ims = applied_intensity(scenario, m)
     if ims:
         extra[f"ground motion ({m.support_name[shaking_support(scenario.motions)]})"] = describe_intensity(ims)
     outcome = run_outcome(sim, hinge_count)
@@ -306,10 +306,12 @@ def describe_outcome(outcome: dict) -> str:
     return f"{outcome['state']} ({tail})"
 
 
-def applied_intensity(scenario, model: Model, steps: int) -> dict[str, float]:
-    """Intensity measures of the shaking support's horizontal velocity over the first ``steps`` steps
-    (what the structure felt), or {} when no support shakes or fewer than 2 steps ran."""
+def applied_intensity(scenario, model: Model) -> dict[str, float]:
+    """Intensity measures of the shaking support's horizontal velocity over the run's duration (the
+    loading as applied: scaled, windowed, corrected, cut at the duration — whether or not the run
+    stopped early, so the measure belongs to the loading, not to the response), or {} when no
+    support shakes."""
     j = shaking_support(scenario.motions)
-    if j is None or steps < 2:
+    if j is None or model.n_steps < 2:
         return {}
-    return intensity_measures(model.support_velocity[: steps + 1, j, 0], model.dt)
+    return intensity_measures(model.support_velocity[:, j, 0], model.dt)

@@ -1,0 +1,224 @@
+"""``masonry sweep``: a study of one structure over a grid of parameters or a set of records, on Dask.
+
+Thin: options -> base scenario and :class:`~masonrycli.study.study.StudyRequest` -> run_study ->
+table, PNG, Rerun recording. Registered on the app by :mod:`masonrycli.cli`.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import Annotated
+
+import typer
+from rich.table import Table
+
+from masonrycli.errors import InputError
+
+BUILT_IN = ("wall", "arch", "aqueduct")
+SWEEP_DURATION = {"wall": 1.0, "arch": 2.0, "aqueduct": 2.0}
+"""s: default simulated time of a built-in structure in a study."""
+
+
+def sweep_command(
+    target: Annotated[str, typer.Argument(help="wall, arch, aqueduct, or a scenario file (TOML).", metavar="TARGET")],
+    param: Annotated[
+        list[str] | None,
+        typer.Option(
+            "--param",
+            "-p",
+            help="An axis: NAME=LO:HI:N, NAME=a,b,c or NAME=value. Names: amp, freq, phase (the sine of the "
+            "moving supports; ground.amp for one), scale (records), friction, duration, dt, builder options.",
+        ),
+    ] = None,
+    records: Annotated[
+        Path | None, typer.Option("--records", help="Folder of records (.AT2 or CSV): one axis 'record' over them.")
+    ] = None,
+    scale: Annotated[
+        str | None, typer.Option("--scale", help="Record scale axis, e.g. 0.25:2:8 (= --param scale=...).")
+    ] = None,
+    find: Annotated[
+        str | None, typer.Option("--find", help="Bisect this parameter for the smallest value giving --outcome.")
+    ] = None,
+    outcome: Annotated[
+        str, typer.Option("--outcome", help="What --find looks for: collapse, sliding, rocking or drift:X.")
+    ] = "collapse",
+    rtol: Annotated[float, typer.Option("--rtol", help="Relative width at which --find stops bisecting.")] = 0.005,
+    out: Annotated[
+        Path | None, typer.Option("--out", "-o", help="Results, .parquet or .csv (one row per run).")
+    ] = None,
+    scheduler: Annotated[
+        str | None, typer.Option("--scheduler", help="Address of an existing Dask scheduler, tcp://HOST:8786.")
+    ] = None,
+    workers: Annotated[
+        int | None,
+        typer.Option("--workers", help="Worker processes of the local cluster (default: one per core; 0: no cluster)."),
+    ] = None,
+    full_runs: Annotated[bool, typer.Option("--full-runs", help="Do not stop a run when it collapses.")] = False,
+    duration: Annotated[float | None, typer.Option(help="Simulated time of every run, s.")] = None,
+    dt: Annotated[float | None, typer.Option("--dt", help="Time step, s.")] = None,
+    im: Annotated[
+        str, typer.Option("--im", help="Intensity measure of the fragility curve: pga, pgv, arias, sa.")
+    ] = "pga",
+    plot: Annotated[Path | None, typer.Option("--plot", help="PNG of the state map / fragility / thresholds.")] = None,
+    recording: Annotated[Path | None, typer.Option("--recording", help="Rerun recording of the study (.rrd).")] = None,
+) -> None:
+    """Run a structure over a grid of parameters or a set of records on Dask; one row per run.
+
+    [bold]masonry sweep wall --param amp=0.1:1.0:10 --param freq=0.5:4:8 --out study.parquet[/bold]
+    """
+    from masonrycli.cli import console, err_console
+    from masonrycli.intensity import INTENSITY_MEASURES
+    from masonrycli.study import store
+    from masonrycli.study.axes import StudyBase, parse_axis
+    from masonrycli.study.study import StudyRequest, run_study
+    from masonrycli.study.task import check_outcome
+
+    base = StudyBase(_base_scenario(target, duration, dt), {})
+    axes = [parse_axis(p) for p in param or []]
+    if records is not None:
+        from masonrycli.study.axes import Axis
+
+        motions = _records(records)
+        base = StudyBase(base.scenario, motions)
+        axes.insert(0, Axis("record", tuple(motions)))
+    if scale is not None:
+        axes.append(parse_axis(f"scale={scale}"))
+    if not axes:
+        raise InputError("nothing to sweep: give --param NAME=..., or --records DIR")
+    if im not in INTENSITY_MEASURES or im == "d5_95":
+        raise InputError(f"--im {im}: expected one of pga, pgv, arias, sa")
+    if workers is not None and workers < 0:
+        raise InputError(f"--workers {workers}: must be >= 0")
+    if workers is not None and scheduler:
+        raise InputError("--workers with --scheduler: the existing cluster has its own workers")
+    if not (0 < rtol < 1):
+        raise InputError(f"--rtol {rtol}: must be in (0, 1)")
+    name = base.scenario.name
+    out = store.check_out(out or Path(f"study-{name}.parquet"))
+    request = StudyRequest(
+        axes=axes,
+        out=out,
+        find=find,
+        outcome=check_outcome(outcome),
+        rtol=rtol,
+        scheduler=scheduler,
+        workers=workers,
+        stop_at_collapse=not full_runs,
+    )
+    try:
+        result = run_study(base, request, console)
+    except KeyboardInterrupt:
+        err_console.print(f"interrupted: every finished row is in {out}; run the same command again to resume")
+        raise typer.Exit(130) from None
+    _report(console, result, request, name, im, plot or out.with_suffix(".png"), recording)
+
+
+def _base_scenario(target: str, duration, dt):
+    import dataclasses
+
+    from masonrycli.motion import Sine
+    from masonrycli.scenario import Material, RunConfig, scenario_from_builder
+
+    if target in BUILT_IN:
+        # a shaken structure: 1 m/s at 2 Hz on the ground (wall) or both foundations (arch, aqueduct)
+        shaken = ("ground",) if target == "wall" else ("left-foundation", "right-foundation")
+        motions = {s: Sine(amplitude=1.0, frequency=2.0) for s in shaken}
+        options = {"blocks": 51} if target == "wall" else {}
+        scenario = scenario_from_builder(
+            target, options, RunConfig(duration=SWEEP_DURATION[target]), Material(), motions
+        )
+    else:
+        from masonrycli.scenario_toml import load_scenario
+
+        path = Path(target)
+        if not path.exists():
+            raise InputError(f"{target}: no such scenario file (or built-in structure: {', '.join(BUILT_IN)})")
+        scenario = load_scenario(path)
+    changes = {k: v for k, v in (("duration", duration), ("dt", dt)) if v is not None}
+    if changes:
+        try:
+            scenario = dataclasses.replace(scenario, run=dataclasses.replace(scenario.run, **changes))
+        except InputError as exc:
+            raise InputError(f"--{next(iter(changes))}: {exc}") from None
+    return scenario
+
+
+def _records(folder: Path) -> dict:
+    from masonrycli.records import record_motion
+
+    if not folder.is_dir():
+        raise InputError(f"--records {folder}: not a folder")
+    files = sorted(p for p in folder.iterdir() if p.suffix.lower() in (".at2", ".csv"))
+    if not files:
+        raise InputError(f"--records {folder}: no .AT2 or .csv record in it")
+    return {p.name: record_motion(p, display=str(p)) for p in files}
+
+
+def _report(console, result, request, name: str, im: str, plot: Path, recording: Path | None) -> None:
+    from masonrycli.intensity import UNITS
+    from masonrycli.study.fragility import fit_lognormal
+    from masonrycli.study.plots import fragility_curve, state_map, threshold_curve
+
+    rows, axes = result.rows, request.axes
+    console.print(_table(rows, result.columns, request))
+    console.print(
+        f"{len(rows)} rows in {request.out} ({result.ran} runs now, {result.skipped} rows already there, "
+        f"{result.failed} failed) in {result.wall_time:.1f} s"
+    )
+    names = [a.name for a in axes if a.name != request.find and len(a.values) > 1]
+    fit = None
+    if request.find:
+        plot = threshold_curve(
+            rows, request.find, names[0] if names else None, plot, f"{name}: {request.outcome} threshold"
+        )
+    elif "record" in [a.name for a in axes]:
+        good = [r for r in rows if r.get("status") != "error"]
+        fit = fit_lognormal([r[im] for r in good], [r["state"] == "collapsed" for r in good], im)
+        plot = fragility_curve(good, im, fit, plot, f"{name}: fragility ({len(good)} runs)", UNITS[im])
+        if fit is None:
+            console.print("fragility: no fit (every run collapsed, or none did)")
+        else:
+            console.print(
+                f"fragility ({im}): median θ = {fit.median:.4g} {UNITS[im]}, dispersion β = {fit.dispersion:.3f} "
+                f"({fit.collapsed} of {fit.runs} runs collapsed)"
+            )
+    else:
+        plot = state_map(rows, names[0] if names else axes[0].name, names[1] if len(names) > 1 else None, plot, name)
+    console.print(f"plot: {plot}")
+    if recording is not None:
+        from masonrycli.recording.study import record_study
+
+        record_study(recording, name, rows, request, fit, im, plot)
+        console.print(f"recording: {recording}")
+
+
+def _table(rows: list[dict], columns: list[str], request) -> Table:
+    names = [a.name for a in request.axes if a.name != request.find]
+    if request.find:
+        shown = names + [f"{request.find}_threshold", "evaluations", "note", "error"]
+    else:
+        shown = names + [
+            "state",
+            "collapse_time",
+            "pga",
+            "residual_drift",
+            "max_opening",
+            "hinges",
+            "wall_time",
+            "error",
+        ]
+    table = Table(title=f"study ({len(rows)} rows)", title_justify="left")
+    for c in shown:
+        table.add_column(c, overflow="fold")
+    for r in rows[:40]:
+        table.add_row(*(_cell(r.get(c)) for c in shown))
+    if len(rows) > 40:
+        table.add_row(*(["…"] * len(shown)))
+    return table
+
+
+def _cell(value) -> str:
+    if isinstance(value, float):
+        return "" if math.isnan(value) else f"{value:.4g}"
+    return "" if value is None else str(value)

@@ -1,0 +1,182 @@
+"""The axes of a study and how a point of the grid changes the base scenario.
+
+An axis is written ``name=LO:HI:N`` (N values evenly spaced from LO to HI), ``name=a,b,c`` (a list) or
+``name=v`` (one value). The names a study understands:
+
+=================================== ===========================================================
+``amp``, ``freq``, ``phase``        the sine motion (m/s, Hz, rad) of every sine-driven support;
+                                    ``ground.amp`` addresses one support by name
+``scale``                           the scale of every record motion (``ground.scale`` for one)
+``record``                          the record file (``--records DIR`` makes this axis): every
+                                    shaking support (sine or record) is driven by it
+``friction``                        the Coulomb coefficient of every contact
+``duration``, ``dt``, ``theta``,    the run settings of :class:`~masonrycli.scenario.RunConfig`
+``tolerance``, ``max_iterations``
+a builder option (``blocks``, ...)  the structure is rebuilt (builder scenarios only)
+=================================== ===========================================================
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import itertools
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from masonrycli.errors import InputError
+
+MOTION_PARAMS = {"amp": ("sine", "amplitude"), "freq": ("sine", "frequency"), "phase": ("sine", "phase")}
+MOTION_PARAMS["scale"] = ("record", "scale")
+RUN_PARAMS = ("duration", "dt", "theta", "tolerance", "max_iterations")
+INT_PARAMS = ("max_iterations",)
+
+
+@dataclass(frozen=True)
+class Axis:
+    """One swept parameter: its name and its values (floats, or file names for ``record``)."""
+
+    name: str
+    values: tuple
+
+    @property
+    def bracket(self) -> tuple[float, float]:
+        """(LO, HI): the range ``--find`` bisects in."""
+        return float(min(self.values)), float(max(self.values))
+
+
+def parse_axis(text: str) -> Axis:
+    """``amp=0.1:1.0:10`` / ``amp=0.2,0.8`` / ``blocks=51`` -> :class:`Axis`. Raises :class:`InputError`."""
+    where = f"--param {text}"
+    name, sep, spec = text.partition("=")
+    name = name.strip()
+    if not sep or not name or not spec.strip():
+        raise InputError(f"{where}: expected NAME=LO:HI:N, NAME=a,b,c or NAME=value")
+    if ":" in spec:
+        parts = spec.split(":")
+        if len(parts) != 3:
+            raise InputError(f"{where}: a range is LO:HI:N (e.g. amp=0.1:1.0:10)")
+        lo, hi = (_number(p, where) for p in parts[:2])
+        try:
+            n = int(parts[2])
+        except ValueError:
+            raise InputError(f"{where}: N = {parts[2]!r} must be a whole number of values") from None
+        if n < 1 or (n == 1 and lo != hi):
+            raise InputError(f"{where}: N must be >= 2 for a range (or give one value)")
+        if not hi >= lo:
+            raise InputError(f"{where}: HI must be >= LO")
+        values = tuple(float(v) for v in np.linspace(lo, hi, n))
+    else:
+        values = tuple(_number(p, where) for p in spec.split(","))
+    if name.split(".")[-1] in INT_PARAMS or _is_builder_int(name):
+        if not all(float(v).is_integer() for v in values):
+            raise InputError(f"{where}: {name} takes whole numbers")
+        values = tuple(int(v) for v in values)
+    return Axis(name, values)
+
+
+def _number(text: str, where: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise InputError(f"{where}: {text.strip()!r} is not a number") from None
+    if not math.isfinite(value):
+        raise InputError(f"{where}: values must be finite")
+    return value
+
+
+def _is_builder_int(name: str) -> bool:
+    from geometry_library.builders import BUILDERS
+
+    for spec in BUILDERS.values():
+        for f in dataclasses.fields(spec):
+            if f.name == name and f.type in (int, "int", "int | None"):
+                return True
+    return False
+
+
+def grid(axes: list[Axis]) -> list[dict]:
+    """Every combination of the axes' values, first axis slowest: ``[{name: value, ...}, ...]``."""
+    names = [a.name for a in axes]
+    return [dict(zip(names, combo)) for combo in itertools.product(*(a.values for a in axes))]
+
+
+def check_axes(axes: list[Axis]) -> None:
+    names = [a.name for a in axes]
+    dup = {n for n in names if names.count(n) > 1}
+    if dup:
+        raise InputError(f"--param {sorted(dup)[0]}: given twice")
+
+
+def apply_point(base, params: dict):
+    """The scenario of one grid point: ``base`` (a :class:`StudyBase`) changed by ``params``.
+
+    Order: builder options (rebuild), run and material settings, the record, then motion parameters
+    (so ``scale`` applies to the record chosen on the same point). Raises :class:`InputError`.
+    """
+    from masonrycli.scenario import scenario_from_builder
+
+    scenario = base.scenario
+    builder = scenario.structure.get("builder")
+    options = {k: v for k, v in params.items() if k not in RUN_PARAMS and _builder_option(builder, k)}
+    if options:
+        names = [s.name for s in scenario.assembly.supports]
+        structure = {k: v for k, v in scenario.structure.items() if k != "builder"}
+        scenario = scenario_from_builder(
+            builder, structure | options, scenario.run, scenario.material, dict(zip(names, scenario.motions))
+        )
+    run_changes = {k: v for k, v in params.items() if k in RUN_PARAMS}
+    if run_changes:
+        scenario = dataclasses.replace(scenario, run=_replace(scenario.run, run_changes))
+    if "friction" in params:
+        scenario = dataclasses.replace(scenario, material=_replace(scenario.material, {"friction": params["friction"]}))
+    motions = list(scenario.motions)
+    if "record" in params:
+        record = base.records[params["record"]]
+        shaking = [j for j, m in enumerate(motions) if m.kind in ("sine", "record")]
+        if not shaking:
+            raise InputError(f"record: {scenario.name} has no shaking support (give one a sine or record motion)")
+        for j in shaking:
+            motions[j] = record
+    names = [s.name for s in scenario.assembly.supports]
+    for key, value in params.items():
+        support, _, short = key.rpartition(".")
+        if short not in MOTION_PARAMS:
+            if key not in RUN_PARAMS and key not in ("friction", "record") and key not in options:
+                raise InputError(f"--param {key}: unknown parameter (see masonry sweep --help)")
+            continue
+        kind, attr = MOTION_PARAMS[short]
+        targets = [j for j, m in enumerate(motions) if m.kind == kind and (not support or names[j] == support)]
+        if support and support not in names:
+            raise InputError(f"--param {key}: no support named {support!r} (supports: {', '.join(names)})")
+        if not targets:
+            raise InputError(
+                f"--param {key}: {scenario.name} has no {kind} motion{' on ' + support if support else ''}"
+            )
+        for j in targets:
+            motions[j] = _replace(motions[j], {attr: value}, where=f"--param {key}")
+    return dataclasses.replace(scenario, motions=tuple(motions))
+
+
+def _builder_option(builder, name: str) -> bool:
+    if not builder:
+        return False
+    from geometry_library.builders import BUILDERS
+
+    return name in {f.name for f in dataclasses.fields(BUILDERS[builder])}
+
+
+def _replace(obj, changes: dict, where: str = ""):
+    try:
+        return dataclasses.replace(obj, **changes)
+    except InputError as exc:
+        raise InputError(f"{where or '--param'}: {exc}") from None
+
+
+@dataclass(frozen=True)
+class StudyBase:
+    """What every task of a study starts from: the base scenario and the records it may use (by name)."""
+
+    scenario: object
+    records: dict = dataclasses.field(default_factory=dict)

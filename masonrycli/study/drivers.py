@@ -1,0 +1,137 @@
+"""What a study asks the cluster to run next: a grid (every point once) or threshold searches.
+
+A driver hands out points (``start``), takes each finished row back (``feed``, which may hand out more
+points) and finally gives the study's rows (``rows``). The runner (:mod:`masonrycli.study.runner`) does
+the Dask side and knows nothing of grids or bisection; the drivers know nothing of Dask.
+
+Threshold search (``--find amp``): for every point of the other axes, the values of the ``amp`` axis
+(``amp=LO:HI:N``) are run first, all at once; the smallest value producing the outcome and the value
+below it bracket the threshold, which is then bisected until the bracket is narrower than ``rtol`` ×
+its upper end. The threshold reported is the middle of the final bracket (so it is within rtol / 2 of
+every value in the bracket). A point whose LO already produces the outcome, or whose HI does not, has
+no threshold in the range: NaN, and the note says which end.
+"""
+
+from __future__ import annotations
+
+import math
+
+from masonrycli.study.axes import Axis, grid
+from masonrycli.study.store import row_key
+from masonrycli.study.task import reached
+
+
+class GridDriver:
+    """Every point of the grid once; ``done`` rows (resume) are not run again."""
+
+    def __init__(self, axes: list[Axis], done: dict):
+        self.names = [a.name for a in axes]
+        self.points = grid(axes)
+        self._rows = {
+            row_key(p, self.names): done[row_key(p, self.names)] for p in self.points if row_key(p, self.names) in done
+        }
+        self.skipped = len(self._rows)
+        self.total = len(self.points)
+        self.finished: list[dict] = []
+        """Rows finished since the caller last emptied this list (to journal them at once)."""
+
+    def start(self) -> list[dict]:
+        return [p for p in self.points if row_key(p, self.names) not in self._rows]
+
+    def feed(self, params: dict, row: dict) -> list[dict]:
+        self._rows[row_key(params, self.names)] = row
+        self.finished.append(row)
+        return []
+
+    def rows(self) -> list[dict]:
+        """Finished rows in grid order (first axis slowest)."""
+        return [self._rows[k] for k in (row_key(p, self.names) for p in self.points) if k in self._rows]
+
+
+class _Search:
+    """The bracket of one threshold search."""
+
+    def __init__(self, values: tuple):
+        self.values = tuple(sorted(values))
+        self.results: dict[float, bool] = {}
+        self.lo = self.hi = math.nan
+        self.evaluations = 0
+        self.wall_time = 0.0
+        self.error = ""
+        self.note = ""
+
+
+class FindDriver:
+    """Bisect ``find`` for the smallest value producing ``outcome`` at every point of the other axes."""
+
+    def __init__(self, axes: list[Axis], find: str, outcome: str, rtol: float, done: dict):
+        self.find, self.outcome, self.rtol = find, outcome, rtol
+        found = [a for a in axes if a.name == find]
+        self.values = found[0].values
+        self.others = [a for a in axes if a.name != find]
+        self.names = [a.name for a in self.others]
+        self.points = grid(self.others)
+        self.searches = {row_key(p, self.names): _Search(self.values) for p in self.points}
+        self._rows = {k: done[k] for k in self.searches if k in done}
+        self.skipped = len(self._rows)
+        self.total = len(self.points)
+        self.finished: list[dict] = []
+
+    def start(self) -> list[dict]:
+        return [
+            p | {self.find: v} for p in self.points if row_key(p, self.names) not in self._rows for v in self.values
+        ]
+
+    def feed(self, params: dict, row: dict) -> list[dict]:
+        key = row_key(params, self.names)
+        search = self.searches[key]
+        search.evaluations += 1
+        search.wall_time += row.get("wall_time", 0.0) or 0.0
+        if row["status"] == "error":
+            search.error = search.error or row["error"]
+        else:
+            search.results[params[self.find]] = reached(row, self.outcome)
+        if math.isnan(search.hi) and search.evaluations < len(search.values):  # initial values pending
+            return []
+        point = {n: params[n] for n in self.names}
+        if search.error:
+            return self._finish(key, point, search)
+        if math.isnan(search.hi):  # the initial values are all in: bracket the threshold
+            yes = [v for v in search.values if search.results[v]]
+            if not yes:
+                search.note = f"no {self.outcome} up to {self.find} = {search.values[-1]:g}"
+                return self._finish(key, point, search)
+            first = yes[0]
+            below = [v for v in search.values if v < first]
+            if not below:
+                search.note = f"{self.outcome} already at {self.find} = {first:g}"
+                return self._finish(key, point, search)
+            search.lo, search.hi = below[-1], first
+        else:
+            value = params[self.find]
+            if search.results[value]:
+                search.hi = value
+            else:
+                search.lo = value
+        if search.hi - search.lo <= self.rtol * search.hi:
+            return self._finish(key, point, search)
+        return [point | {self.find: 0.5 * (search.lo + search.hi)}]
+
+    def _finish(self, key, point: dict, search: _Search) -> list[dict]:
+        threshold = 0.5 * (search.lo + search.hi)
+        self._rows[key] = point | {
+            f"{self.find}_threshold": threshold,
+            f"{self.find}_lo": search.lo,
+            f"{self.find}_hi": search.hi,
+            "outcome": self.outcome,
+            "evaluations": search.evaluations,
+            "status": "error" if search.error else "completed",
+            "wall_time": search.wall_time,
+            "note": search.note,
+            "error": search.error,
+        }
+        self.finished.append(self._rows[key])
+        return []
+
+    def rows(self) -> list[dict]:
+        return [self._rows[k] for k in (row_key(p, self.names) for p in self.points) if k in self._rows]

@@ -1,0 +1,83 @@
+"""Running a study's tasks on Dask distributed.
+
+By default a ``LocalCluster`` with one single-threaded worker *process* per core (the engine is
+serial numba code holding the GIL, so threads would not help); ``--scheduler tcp://host:8786`` uses an
+existing cluster instead, whose workers need only ``pip install masonry``. The base scenario is one
+task whose result the other tasks share, so each task ships only its parameters and returns one row.
+
+Rows come back in completion order; the driver (:mod:`masonrycli.study.drivers`) decides what runs
+next. A task that fails inside the run returns an error row (:func:`~masonrycli.study.task.run_task`);
+a task lost with its worker is retried elsewhere by the scheduler, and if it keeps killing workers
+(``KilledWorker``) or the cluster fails it otherwise, its row says so.
+"""
+
+from __future__ import annotations
+
+import logging
+import os
+from collections.abc import Callable
+
+from masonrycli.errors import InputError
+from masonrycli.study.task import empty_result, run_task
+
+
+def open_cluster(scheduler: str | None, workers: int | None):
+    """``(client, cluster)``: a client of ``scheduler``, or of a new LocalCluster (then also returned,
+    to be closed by the caller) with ``workers`` processes (default: one per core)."""
+    from distributed import Client, LocalCluster
+
+    if scheduler:
+        try:
+            return Client(scheduler, timeout="20s"), None
+        except (OSError, TimeoutError) as exc:
+            raise InputError(f"--scheduler {scheduler}: cannot connect ({type(exc).__name__}: {exc})") from None
+    n = workers or os.cpu_count() or 1
+    cluster = LocalCluster(
+        n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None, silence_logs=logging.ERROR
+    )
+    return Client(cluster), cluster
+
+
+def run_on_cluster(client, base, driver, on_row: Callable[[dict, dict], None], stop_at_collapse: bool) -> None:
+    """Run ``driver``'s points on ``client`` until it hands out no more; ``on_row(params, row)`` for each."""
+    from distributed import as_completed
+
+    # The base is a task, not scattered data: the scheduler keeps its spec and recomputes it on another
+    # worker if the worker holding it dies (scattered data would be lost with its worker, and every task
+    # depending on it cancelled).
+    base_future = client.submit(_identity, base, pure=False)
+    pending = {}
+    completed = as_completed()
+
+    def submit(points):
+        for params in points:
+            future = client.submit(run_task, base_future, params, stop_at_collapse, pure=False)
+            pending[future.key] = params
+            completed.add(future)
+
+    submit(driver.start())
+    for future in completed:
+        params = pending.pop(future.key)
+        try:
+            row = future.result()
+        except Exception as exc:  # the task never returned (KilledWorker, a cluster failure)
+            row = params | empty_result(f"{type(exc).__name__}: {exc}", 0.0)
+        future.release()
+        more = driver.feed(params, row)
+        on_row(params, row)
+        submit(more)
+
+
+def _identity(value):
+    return value
+
+
+def run_serially(base, driver, on_row: Callable[[dict, dict], None], stop_at_collapse: bool) -> None:
+    """The same as :func:`run_on_cluster` in this process, one task after the other (``--workers 0``)."""
+    queue = list(driver.start())
+    while queue:
+        params = queue.pop(0)
+        row = run_task(base, params, stop_at_collapse)
+        more = driver.feed(params, row)
+        on_row(params, row)
+        queue += more

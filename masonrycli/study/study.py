@@ -1,0 +1,137 @@
+"""A study from start to finish: resume, run on the cluster, keep every row, fit, summarise.
+
+:func:`run_study` is what ``masonry sweep`` does after parsing its options; the outputs around it
+(terminal table, PNGs, Rerun recording) are in :func:`study_outputs`.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from rich.console import Console
+from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
+
+from masonrycli.errors import InputError
+from masonrycli.study import store
+from masonrycli.study.axes import Axis, StudyBase, apply_point, check_axes, grid
+from masonrycli.study.drivers import FindDriver, GridDriver
+from masonrycli.study.task import RESULT_COLUMNS
+
+
+@dataclass(frozen=True)
+class StudyRequest:
+    """What to run: the axes, an optional threshold search, where the rows go and on what cluster."""
+
+    axes: list[Axis]
+    out: Path
+    find: str | None = None
+    outcome: str = "collapse"
+    rtol: float = 0.005
+    scheduler: str | None = None
+    workers: int | None = None
+    stop_at_collapse: bool = True
+
+
+@dataclass
+class StudyResult:
+    rows: list[dict]
+    columns: list[str]
+    skipped: int
+    ran: int
+    wall_time: float
+    failed: int = 0
+    states: dict = field(default_factory=dict)
+
+
+def prepare(base: StudyBase, request: StudyRequest) -> str:
+    """Check the request against the base (a bad axis fails here, before any cluster starts) and
+    return the study's fingerprint."""
+    from masonrycli.scenario_toml import dump_scenario
+
+    check_axes(request.axes)
+    if request.find is not None:
+        names = [a.name for a in request.axes]
+        if request.find not in names:
+            raise InputError(f"--find {request.find}: give its range too, e.g. --param {request.find}=0.1:1.0:4")
+        axis = request.axes[names.index(request.find)]
+        if isinstance(axis.values[0], str) or len(axis.values) < 2:
+            raise InputError(f"--find {request.find}: needs a numeric range LO:HI:N with N >= 2")
+    for point in grid(request.axes)[:1] + grid(request.axes)[-1:]:
+        apply_point(base, point)  # raises InputError for an unknown or impossible parameter
+    records = {name: (r.source, r.scale, len(r.time)) for name, r in base.records.items()}
+    settings = (request.find, request.outcome if request.find else None, request.rtol if request.find else None)
+    return store.fingerprint(
+        dump_scenario(base.scenario, inline_records=True), records, settings, request.stop_at_collapse
+    )
+
+
+def run_study(base: StudyBase, request: StudyRequest, console: Console) -> StudyResult:
+    """Run every row of the study not already in ``request.out``; write the table (also on Ctrl-C)."""
+    from masonrycli.study.runner import open_cluster, run_on_cluster, run_serially
+
+    study_id = prepare(base, request)
+    previous = [r for r in store.read_rows(request.out) if r.get("study") == study_id and r.get("status") != "error"]
+    if request.find:
+        names = [a.name for a in request.axes if a.name != request.find]
+        done = {store.row_key(r, names): r for r in previous}
+        driver = FindDriver(request.axes, request.find, request.outcome, request.rtol, done)
+        columns = names + [f"{request.find}_{s}" for s in ("threshold", "lo", "hi")]
+        columns += ["outcome", "evaluations", "status", "wall_time", "note", "error", "study"]
+    else:
+        names = [a.name for a in request.axes]
+        done = {store.row_key(r, names): r for r in previous}
+        driver = GridDriver(request.axes, done)
+        columns = names + list(RESULT_COLUMNS) + ["study"]
+    start = time.perf_counter()
+    journal = store.Journal(request.out)
+    progress = Progress(
+        TextColumn("[bold]sweep"),
+        BarColumn(),
+        MofNCompleteColumn(),
+        TextColumn("{task.fields[states]}"),
+        TimeElapsedColumn(),
+        console=console,
+        disable=not console.is_terminal,
+    )
+    bar = progress.add_task("rows", total=driver.total, completed=driver.skipped, states="")
+    counts: dict[str, int] = {}
+    ran = 0
+
+    def on_row(params: dict, row: dict) -> None:
+        # every finished row of the study goes to the journal at once (a threshold row when its bisection ends)
+        nonlocal ran
+        ran += 1
+        label = row.get("state") or "failed"
+        counts[label] = counts.get(label, 0) + 1
+        for finished in driver.finished:
+            finished["study"] = study_id
+            journal.append(finished)
+            progress.advance(bar)
+        driver.finished.clear()
+        progress.update(bar, states=f"{ran} runs: " + ", ".join(f"{k} {v}" for k, v in sorted(counts.items())))
+
+    cluster = client = None
+    try:
+        with progress:
+            if request.workers == 0:
+                run_serially(base, driver, on_row, request.stop_at_collapse)
+            else:
+                client, cluster = open_cluster(request.scheduler, request.workers)
+                run_on_cluster(client, base, driver, on_row, request.stop_at_collapse)
+    finally:
+        journal.close()
+        rows = driver.rows()
+        for r in rows:
+            r.setdefault("study", study_id)
+        store.write_rows(request.out, rows, columns)
+        if client is not None:
+            client.close()
+        if cluster is not None:
+            cluster.close()
+    failed = sum(1 for r in rows if r.get("status") == "error")
+    states = {}
+    for r in rows:
+        states[r.get("state", "")] = states.get(r.get("state", ""), 0) + 1
+    return StudyResult(rows, columns, driver.skipped, ran, time.perf_counter() - start, failed, states)

@@ -1,0 +1,116 @@
+"""One task of a study: build the point's scenario, run it, return a small row.
+
+:func:`run_task` is what a Dask worker executes; it never raises for a failed run (the row says
+``status = "error"`` and why), so one bad point does not stop a study.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+
+import numpy as np
+
+from masonrycli.intensity import INTENSITY_MEASURES
+
+OUTCOMES = ("collapse", "sliding", "rocking")
+"""Outcomes ``--find`` can bisect for, besides ``drift:X`` (peak top drift beyond X × the height)."""
+RESULT_COLUMNS = (
+    "state",
+    "collapse_time",
+    "energy_dissipated",
+    *INTENSITY_MEASURES,
+    "residual_drift",
+    "peak_drift",
+    "max_opening",
+    "hinges",
+    "slide_time",
+    "rock_time",
+    "status",
+    "steps",
+    "time",
+    "wall_time",
+    "sweeps_mean",
+    "capped_steps",
+    "last_residual",
+    "max_penetration",
+    "error",
+)
+"""The columns every row has after its parameters (units in ``docs/sweep.md``)."""
+
+
+def run_task(base, params: dict, stop_at_collapse: bool = True) -> dict:
+    """Run the grid point ``params`` of ``base`` (:class:`~masonrycli.study.axes.StudyBase`): its row."""
+    from masonrycli.run import simulate
+    from masonrycli.study.axes import apply_point
+
+    start = time.perf_counter()
+    row = dict(params)
+    try:
+        scenario = apply_point(base, params)
+        result = simulate(scenario, stop_at_collapse=stop_at_collapse)
+    except Exception as exc:  # a failed task is reported in its row; the study goes on
+        return row | empty_result(f"{type(exc).__name__}: {exc}", time.perf_counter() - start)
+    out = result.outcome
+    its = result.iterations
+    row |= {
+        "state": out["state"],
+        "collapse_time": out["collapse_time"],
+        "energy_dissipated": result.energy_dissipated,
+    }
+    row |= {name: result.intensity.get(name, math.nan) for name in INTENSITY_MEASURES}
+    row |= {k: out[k] for k in ("residual_drift", "peak_drift", "max_opening", "hinges", "slide_time", "rock_time")}
+    row |= {
+        "status": result.status,
+        "steps": result.steps,
+        "time": result.time,
+        "wall_time": time.perf_counter() - start,
+        "sweeps_mean": float(its.mean()) if its.size else 0.0,
+        "capped_steps": int((its >= scenario.run.max_iterations).sum()),
+        "last_residual": float(result.residual[-1]) if result.residual.size else 0.0,
+        "max_penetration": result.max_penetration,
+        "error": result.message if result.status == "diverged" else "",
+    }
+    return row
+
+
+def empty_result(error: str, wall_time: float) -> dict:
+    """The result columns of a task that failed before or during its run."""
+    row = {name: math.nan for name in RESULT_COLUMNS}
+    row |= {"state": "", "status": "error", "steps": 0, "hinges": 0, "capped_steps": 0, "wall_time": wall_time}
+    return row | {"error": " ".join(error.split())[:300]}
+
+
+def reached(row: dict, outcome: str) -> bool:
+    """Did the run of ``row`` produce ``outcome`` (collapse, sliding, rocking, or drift:X)?"""
+    if outcome == "collapse":
+        return row["state"] == "collapsed"
+    if outcome == "sliding":
+        return not np.isnan(row["slide_time"])
+    if outcome == "rocking":
+        return not np.isnan(row["rock_time"])
+    return row["peak_drift"] > drift_limit(outcome)
+
+
+def drift_limit(outcome: str) -> float:
+    """X of ``drift:X``; raises ValueError otherwise."""
+    name, _, value = outcome.partition(":")
+    if name != "drift":
+        raise ValueError(outcome)
+    return float(value)
+
+
+def check_outcome(outcome: str) -> str:
+    from masonrycli.errors import InputError
+
+    if outcome in OUTCOMES:
+        return outcome
+    try:
+        limit = drift_limit(outcome)
+    except ValueError:
+        raise InputError(
+            f"--outcome {outcome}: expected collapse, sliding, rocking or drift:X (X a drift ratio, e.g. drift:0.01)"
+        ) from None
+    if not (math.isfinite(limit) and limit > 0):
+        raise InputError(f"--outcome {outcome}: the drift ratio must be > 0")
+    return outcome

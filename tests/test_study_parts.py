@@ -1,0 +1,165 @@
+"""The parts of a study without a cluster: axes, grid points, threshold bisection, rows on disk, fragility."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from scipy.stats import norm
+
+from masonrycli.errors import InputError
+from masonrycli.motion import Constant, Sine
+from masonrycli.records import record_motion
+from masonrycli.scenario import Material, RunConfig, scenario_from_builder
+from masonrycli.study import store
+from masonrycli.study.axes import Axis, StudyBase, apply_point, grid, parse_axis
+from masonrycli.study.drivers import FindDriver, GridDriver
+from masonrycli.study.fragility import fit_lognormal
+from masonrycli.study.task import check_outcome, empty_result, reached, run_task
+
+
+def test_parse_axis_forms_and_errors():
+    assert parse_axis("amp=0.1:1.0:4").values == pytest.approx((0.1, 0.4, 0.7, 1.0))
+    assert parse_axis("ground.amp=0.2,0.8").values == (0.2, 0.8)
+    assert parse_axis("blocks=12,51").values == (12, 51) and isinstance(parse_axis("blocks=12").values[0], int)
+    assert parse_axis("friction=0.6").values == (0.6,)
+    for text, fragment in [
+        ("amp", "expected NAME=LO:HI:N"),
+        ("amp=1:2", "a range is LO:HI:N"),
+        ("amp=1:2:x", "must be a whole number"),
+        ("amp=2:1:3", "HI must be >= LO"),
+        ("amp=1:2:1", "N must be >= 2"),
+        ("amp=a,b", "'a' is not a number"),
+        ("amp=nan", "values must be finite"),
+        ("blocks=12.5", "blocks takes whole numbers"),
+    ]:
+        with pytest.raises(InputError, match=fragment):
+            parse_axis(text)
+    assert grid([Axis("a", (1, 2)), Axis("b", (3, 4))]) == [
+        {"a": 1, "b": 3},
+        {"a": 1, "b": 4},
+        {"a": 2, "b": 3},
+        {"a": 2, "b": 4},
+    ]
+
+
+@pytest.fixture(scope="module")
+def arch_base():
+    motions = {"left-foundation": Sine(amplitude=1.0, frequency=2.0), "right-foundation": Constant(velocity=(0, -0.01))}
+    return StudyBase(scenario_from_builder("arch", {}, RunConfig(duration=0.1), Material(), motions))
+
+
+def test_apply_point_changes_what_it_names(arch_base, tmp_path):
+    s = apply_point(arch_base, {"amp": 0.5, "freq": 3.0, "friction": 0.7, "duration": 0.2})
+    assert s.motions[0] == Sine(amplitude=0.5, frequency=3.0) and s.motions[1] == Constant(velocity=(0, -0.01))
+    assert s.material.friction == 0.7 and s.run.duration == 0.2
+    s = apply_point(arch_base, {"left-foundation.phase": 1.0})
+    assert s.motions[0].phase == 1.0
+    s = apply_point(arch_base, {"voussoirs": 20})
+    assert s.block_count == arch_base.scenario.block_count - 10 and s.motions == arch_base.scenario.motions
+    for params, fragment in [
+        ({"bogus": 1.0}, "--param bogus: unknown parameter"),
+        ({"scale": 2.0}, "has no record motion"),
+        ({"pad.amp": 1.0}, "no support named 'pad'"),
+        ({"right-foundation.amp": 1.0}, "has no sine motion on right-foundation"),
+        ({"freq": -1.0}, "--param freq: frequency = -1.0: must be >= 0"),
+        ({"dt": 1.0}, "must be <= duration"),
+    ]:
+        with pytest.raises(InputError, match=fragment):
+            apply_point(arch_base, params)
+    rec = record_motion(_csv(tmp_path), quantity="acceleration")
+    base = StudyBase(arch_base.scenario, {"q.csv": rec})
+    s = apply_point(base, {"record": "q.csv", "scale": 2.0})
+    assert s.motions[0].scale == 2.0 and s.motions[0].time == rec.time and s.motions[1].kind == "constant"
+
+
+def _csv(tmp_path):
+    (tmp_path / "q.csv").write_text("0,0\n0.05,1\n0.1,0\n")
+    return tmp_path / "q.csv"
+
+
+def _row(amp, threshold):
+    # a fake run: the outcome happens from `threshold` on
+    row = empty_result("", 0.1) | {"status": "completed", "state": "collapsed" if amp >= threshold else "intact"}
+    return row | {"slide_time": 0.01 if amp >= threshold else math.nan}
+
+
+def test_find_driver_bisects_to_rtol_and_reports_the_ends():
+    axes = [Axis("amp", (0.1, 0.4, 0.7, 1.0)), Axis("freq", (1.0, 2.0, 3.0))]
+    thresholds = {1.0: 0.55, 2.0: 0.05, 3.0: 5.0}
+    driver = FindDriver(axes, "amp", "collapse", 0.005, done={})
+    queue = driver.start()
+    assert len(queue) == 12
+    runs = 0
+    while queue:
+        p = queue.pop()
+        runs += 1
+        queue += driver.feed(p, _row(p["amp"], thresholds[p["freq"]]))
+    rows = {r["freq"]: r for r in driver.rows()}
+    r = rows[1.0]
+    assert r["amp_lo"] < 0.55 <= r["amp_hi"] and (r["amp_hi"] - r["amp_lo"]) <= 0.005 * r["amp_hi"]
+    assert abs(r["amp_threshold"] - 0.55) <= 0.0025 * 0.55 and r["evaluations"] == 4 + 7
+    assert math.isnan(rows[2.0]["amp_threshold"]) and "collapse already at amp = 0.1" in rows[2.0]["note"]
+    assert math.isnan(rows[3.0]["amp_threshold"]) and "no collapse up to amp = 1" in rows[3.0]["note"]
+    assert runs == 12 + 7 and len(driver.finished) == 3
+    # resume: a finished point is not searched again
+    again = FindDriver(axes, "amp", "collapse", 0.005, done={store.row_key(rows[1.0], ["freq"]): rows[1.0]})
+    assert {p["freq"] for p in again.start()} == {2.0, 3.0} and again.skipped == 1
+
+
+def test_outcomes():
+    row = _row(1.0, 0.5) | {"peak_drift": 0.02, "rock_time": math.nan}
+    assert reached(row, "collapse") and reached(row, "sliding") and not reached(row, "rocking")
+    assert reached(row, "drift:0.01") and not reached(row, "drift:0.03")
+    assert check_outcome("drift:0.01") == "drift:0.01"
+    for bad in ("fall", "drift:x", "drift:-1"):
+        with pytest.raises(InputError):
+            check_outcome(bad)
+
+
+@pytest.mark.parametrize("suffix", [".csv", ".parquet"])
+def test_rows_round_trip_and_journal(tmp_path, suffix):
+    out = tmp_path / f"study{suffix}"
+    rows = [
+        {"amp": 0.1 + 0.2, "record": "a.AT2", "state": "intact", "error": "", "x": math.nan, "study": "1234e567"},
+        {"amp": 1.0, "record": "b.AT2", "state": "", "error": "boom, it failed", "x": 2.5, "study": "1234e567"},
+    ]
+    journal = store.Journal(out)
+    journal.append(rows[0])
+    journal.close()
+    assert store.read_rows(out) == [rows[0] | {"x": store.read_rows(out)[0]["x"]}]  # journal alone
+    store.write_rows(out, rows, list(rows[0]))
+    assert not store.journal_path(out).exists()
+    back = store.read_rows(out)
+    assert back[0]["amp"] == 0.1 + 0.2 and back[0]["study"] == "1234e567" and math.isnan(back[0]["x"])
+    assert back[1]["error"] == "boom, it failed" and back[1]["record"] == "b.AT2"
+    assert store.row_key(back[0], ["amp", "record"]) == store.row_key(rows[0], ["amp", "record"])
+    with pytest.raises(InputError, match="a study is written as .parquet or .csv"):
+        store.check_out(tmp_path / "study.txt")
+
+
+def test_grid_driver_skips_done_rows():
+    axes = [Axis("amp", (0.1, 0.2, 0.3))]
+    done = {store.row_key({"amp": 0.2}, ["amp"]): {"amp": 0.2, "state": "intact"}}
+    driver = GridDriver(axes, done)
+    assert driver.start() == [{"amp": 0.1}, {"amp": 0.3}] and driver.skipped == 1 and driver.total == 3
+    driver.feed({"amp": 0.3}, {"amp": 0.3, "state": "collapsed"})
+    assert [r["amp"] for r in driver.rows()] == [0.2, 0.3]
+
+
+def test_failed_task_is_a_row(arch_base):
+    row = run_task(arch_base, {"amp": 0.5, "dt": 1.0})
+    assert row["status"] == "error" and "must be <= duration" in row["error"] and row["amp"] == 0.5
+    assert math.isnan(row["pga"]) and row["state"] == ""
+
+
+def test_lognormal_fit_recovers_known_median_and_dispersion():
+    rng = np.random.default_rng(7)
+    theta, beta = 0.8, 0.4
+    im = np.exp(rng.uniform(np.log(0.2), np.log(3.0), 4000))
+    collapsed = rng.uniform(size=im.size) < norm.cdf(np.log(im / theta) / beta)
+    fit = fit_lognormal(im, collapsed, "sa")
+    assert fit.median == pytest.approx(theta, rel=0.05) and fit.dispersion == pytest.approx(beta, rel=0.1)
+    assert fit.probability([theta])[0] == pytest.approx(0.5, abs=0.03)
+    assert fit_lognormal([1, 2], [True, True]) is None and fit_lognormal([1], [True]) is None
