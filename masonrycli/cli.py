@@ -135,6 +135,16 @@ OUTPUT = {
     ],
     "history": _opt(Path, "Output", "History file (.npz), one row per recorded frame.", "--history"),
 }
+STOP = {
+    "stop_at_collapse": Annotated[
+        bool,
+        typer.Option(
+            "--stop-at-collapse",
+            help="End the run once the structure has collapsed (docs/collapse.md).",
+            rich_help_panel="Run",
+        ),
+    ]
+}
 GEO_OUT = {"out": Annotated[Path, typer.Option("--out", "-o", help="GeoJSON file to write.")]}
 
 
@@ -183,13 +193,13 @@ def _outputs(name: str, out: Path | None, no_recording: bool) -> Path | None:
     return out
 
 
-def _execute(scenario, out: Path | None, history: Path | None, hint: str = "") -> None:
+def _execute(scenario, out: Path | None, history: Path | None, hint: str = "", stop: bool = False) -> None:
     from masonrycli.execute import execute, print_summary
 
     for warning in scenario.warnings:
         err_console.print(f"[yellow]warning:[/yellow] {warning}", highlight=False)
     try:
-        result = execute(scenario, out=out, history=history, console=console)
+        result = execute(scenario, out=out, history=history, console=console, stop_at_collapse=stop)
     except KeyboardInterrupt:
         err_console.print(
             "interrupted: the recording and history hold every frame computed so far" + (f" ({out})" if out else "")
@@ -224,14 +234,15 @@ def _simulate(name: str, opts: dict) -> None:
     from masonrycli.builtin import builtin, paper_instant_hint
 
     out, no_recording, history = (opts.pop(k) for k in OUTPUT)
+    stop = opts.pop("stop_at_collapse")
     scenario = builtin(name, **opts)
     hint = paper_instant_hint(name, scenario.run)
-    _execute(scenario, _outputs(name, out, no_recording), history, hint)
+    _execute(scenario, _outputs(name, out, no_recording), history, hint, stop)
 
 
 @simulate_app.command("wall")
 @user_errors
-@with_options(WALL, LOADING, RECORD, RUN, FRICTION, BLOCK_MATERIAL, OUTPUT)
+@with_options(WALL, LOADING, RECORD, RUN, STOP, FRICTION, BLOCK_MATERIAL, OUTPUT)
 def simulate_wall(**opts) -> None:
     """The paper's running-bond wall on a shaken ground (default 51 blocks, 1 m/s at 2 Hz for 1 s)."""
     _simulate("wall", opts)
@@ -239,7 +250,7 @@ def simulate_wall(**opts) -> None:
 
 @simulate_app.command("arch")
 @user_errors
-@with_options(ARCH, LOADING, RECORD, RUN, FRICTION, BLOCK_MATERIAL, OUTPUT)
+@with_options(ARCH, LOADING, RECORD, RUN, STOP, FRICTION, BLOCK_MATERIAL, OUTPUT)
 def simulate_arch(**opts) -> None:
     """The paper's 98-block arch on two piers; default: right foundation settles at 1 cm/s for 5 s."""
     _simulate("arch", opts)
@@ -247,7 +258,7 @@ def simulate_arch(**opts) -> None:
 
 @simulate_app.command("aqueduct")
 @user_errors
-@with_options(AQUEDUCT, LOADING, RECORD, RUN, FRICTION, BLOCK_MATERIAL, OUTPUT)
+@with_options(AQUEDUCT, LOADING, RECORD, RUN, STOP, FRICTION, BLOCK_MATERIAL, OUTPUT)
 def simulate_aqueduct(**opts) -> None:
     """A segment of the Arles aqueduct (98 arch + 248 wall blocks); default: settlement 1 cm/s for 5 s.
 
@@ -258,7 +269,7 @@ def simulate_aqueduct(**opts) -> None:
 
 @app.command("run")
 @user_errors
-@with_options(RUN, FRICTION, OUTPUT, RECORD)
+@with_options(RUN, STOP, FRICTION, OUTPUT, RECORD)
 def run_command(
     scenario_file: Annotated[
         Path, typer.Argument(help="Scenario file (TOML), or a GeoJSON / WKT geometry.", metavar="SCENARIO.toml")
@@ -274,12 +285,13 @@ def run_command(
 
     out, no_recording, history = (opts.pop(k) for k in OUTPUT)
     record, scale = (opts.pop(k) for k in RECORD)
+    stop = opts.pop("stop_at_collapse")
     if scenario_file.suffix.lower() in GEOMETRY_SUFFIXES:
         scenario = scenario_from_geometry_file(scenario_file)
     else:
         scenario = load_scenario(scenario_file)
     scenario = override_run(with_record(scenario, record, scale), **opts)
-    _execute(scenario, _outputs(scenario.name, out, no_recording), history)
+    _execute(scenario, _outputs(scenario.name, out, no_recording), history, stop=stop)
 
 
 def _register_sweep() -> None:

@@ -81,8 +81,11 @@ def recording_static(sim: Simulation):
     )
 
 
-def execute(scenario, *, out: Path | None, history: Path | None, console: Console) -> RunResult:
-    """Run ``scenario``, writing the recording ``out`` and the history ``history`` (either may be None)."""
+def execute(
+    scenario, *, out: Path | None, history: Path | None, console: Console, stop_at_collapse: bool = False
+) -> RunResult:
+    """Run ``scenario``, writing the recording ``out`` and the history ``history`` (either may be None);
+    ``stop_at_collapse`` ends the run when the structure collapses (:mod:`masonrycli.collapse`)."""
     sim = Simulation(scenario)
     sinks = []
     hist = None
@@ -100,7 +103,7 @@ def execute(scenario, *, out: Path | None, history: Path | None, console: Consol
     status, note = "error", "the run stopped on an unexpected error"
     try:
         with progress_bar(console, sim.model.n_steps) as on_progress:
-            result = simulate(scenario, sinks, on_progress=on_progress, sim=sim)
+            result = simulate(scenario, sinks, on_progress=on_progress, sim=sim, stop_at_collapse=stop_at_collapse)
         if hist is not None:
             hist.run_values |= {f"intensity_{k}": v for k, v in result.intensity.items()}
         status, note = result.status, result.message

@@ -76,3 +76,27 @@ def test_record_option_errors_are_one_line(at2, args, fragment):
     assert result.exit_code == 2, result.output
     lines = [ln for ln in result.output.strip().splitlines() if ln.strip()]
     assert len(lines) == 1 and fragment in lines[0], result.output
+
+
+def test_stop_at_collapse_ends_the_run_when_the_block_overturns(tmp_path):
+    (tmp_path / "slender.toml").write_text(
+        """
+[run]
+duration = 2.5
+[material]
+friction = 0.8
+[[block]]
+polygon = [[-0.125, 0.0], [0.125, 0.0], [0.125, 1.0], [-0.125, 1.0]]
+[[support]]
+name = "ground"
+polygon = [[-5.0, -0.5], [5.0, -0.5], [5.0, 0.0], [-5.0, 0.0]]
+motion = { kind = "sine", amplitude = 0.5, frequency = 2.0 }
+"""
+    )
+    npz = tmp_path / "h.npz"
+    result = invoke("run", tmp_path / "slender.toml", "--stop-at-collapse", "--no-recording", "--history", npz)
+    assert result.exit_code == 0, result.output
+    said = " ".join(result.output.split())
+    assert "stopped at collapse" in said and "collapsed at t =" in said
+    t_end = float(np.load(npz)["time"][-1])
+    assert 0.5 < t_end < 2.5

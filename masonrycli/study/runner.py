@@ -32,8 +32,10 @@ def open_cluster(scheduler: str | None, workers: int | None):
         except (OSError, TimeoutError) as exc:
             raise InputError(f"--scheduler {scheduler}: cannot connect ({type(exc).__name__}: {exc})") from None
     n = workers or os.cpu_count() or 1
+    # ":0": the scheduler's HTTP endpoints (it serves them even without a dashboard) on a free port, so
+    # two studies at once do not fight over 8787
     cluster = LocalCluster(
-        n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None, silence_logs=logging.ERROR
+        n_workers=n, threads_per_worker=1, processes=True, dashboard_address=":0", silence_logs=logging.ERROR
     )
     return Client(cluster), cluster
 
