@@ -47,6 +47,17 @@ def test_point_load_on_a_named_block(column_file):
     assert data["sliding_joints"] == ["b1|b2"] and data["load"]["block"] == "b2"
 
 
+def test_verify_with_json_is_still_one_object(tmp_path):
+    path = tmp_path / "block.toml"
+    path.write_text(dump_scenario(column(1, 0.4, 0.8, 0.9)))
+    result = runner.invoke(app, ["limit", str(path), "--load", "tilt", "--verify", "--json"])
+    assert result.exit_code == 0, result.output
+    data = json.loads(result.stdout)
+    assert [c["factor"] for c in data["verify"]] == [0.95, 1.05]
+    assert [c["collapsed"] for c in data["verify"]] == [False, True]
+    assert all(c["as_predicted"] for c in data["verify"])
+
+
 def test_built_in_arch_by_name():
     result = runner.invoke(app, ["limit", "arch", "--json"])
     data = json.loads(result.stdout)

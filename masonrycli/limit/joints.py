@@ -6,7 +6,8 @@ engine can run can also be analysed, and a joint here is a joint there.
 
 A *joint* is one pair of bodies (a < b; supports come after the blocks) with its contact points: two
 for a face-to-face joint (the ends of the shared segment), one for a corner touching a face. All the
-points of a joint share one normal n (from a to b) and tangent t = (−n_y, n_x).
+points of a joint share one normal n (from a to b) and tangent t = (n_y, −n_x) (the engine's convention,
+docs/architecture.md).
 """
 
 from __future__ import annotations
@@ -46,9 +47,9 @@ class Joints:
 
     @property
     def contact_tangent(self) -> np.ndarray:
-        """(C, 2): t = (−n_y, n_x)."""
+        """(C, 2): t = (n_y, −n_x), so that (t, n) is right-handed as in the engine."""
         n = self.contact_normal
-        return np.stack([-n[:, 1], n[:, 0]], axis=1)
+        return np.stack([n[:, 1], -n[:, 0]], axis=1)
 
     @property
     def joint_points(self) -> np.ndarray:
