@@ -114,3 +114,13 @@ def test_arch_mechanism_under_a_horizontal_load_has_four_hinges():
     # Hinges lie on the intrados or the extrados (R = 1 ± t/2), where the thrust line touches the ring.
     radius = np.hypot(*r.motion.hinge_point.T)
     assert np.all(np.isclose(radius, 0.925, atol=1e-9) | np.isclose(radius, 1.075, atol=1e-9))
+
+
+def test_a_symmetric_arch_fails_the_same_way_in_both_directions():
+    """Mirror symmetry: the same λ for ±x, and the hinges of one mechanism are the mirror images of the other's."""
+    sc = semicircular_arch(0.15, 40, friction=2.0)
+    right, left = (analyse(sc, LiveLoad("horizontal", d)) for d in ("+x", "-x"))
+    assert right.load_factor == pytest.approx(left.load_factor, rel=1e-6)
+    mirrored = right.motion.hinge_point * [-1.0, 1.0]
+    key = lambda p: np.round(p, 9).tolist()  # noqa: E731
+    assert sorted(map(key, mirrored)) == sorted(map(key, left.motion.hinge_point))
