@@ -39,6 +39,7 @@ from __future__ import annotations
 import json
 import math
 import re
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -205,7 +206,9 @@ def _polygons_of(geom, where: str) -> list[Polygon]:
 
 def _parse_wkt(text: str, where: str):
     try:
-        return shapely.wkt.loads(text)
+        with warnings.catch_warnings():  # GEOS warns on NaN coordinates; the vertex check reports them
+            warnings.simplefilter("ignore", RuntimeWarning)
+            return shapely.wkt.loads(text)
     except Exception as exc:  # shapely raises GEOSException / ValueError variants
         msg = str(exc).splitlines()[0] if str(exc) else exc.__class__.__name__
         raise GeometryError(f"{where}: cannot parse WKT ({msg})") from None

@@ -56,13 +56,17 @@ def _replace(obj, where: str, **changes):
 def override_run(scenario: Scenario, *, friction: float | None = None, **run_values) -> Scenario:
     """``scenario`` with the run settings (RunConfig fields) and the friction that are not None replaced.
 
-    Each value is checked alone first, so the message names its option (``--dt: dt = -1.0: must be > 0``);
-    then together (``options: ...``, e.g. a dt longer than the new duration).
+    The values are applied together (``--duration 0.3 --dt 0.3`` is fine whatever the file's duration);
+    if that fails, the message names the option wrong on its own (``--dt: dt = -1.0: must be > 0``), else
+    the options together (``--duration and --dt: ...``).
     """
     run_changes = _given(run_values, RUN_OVERRIDES)
-    for key, value in run_changes.items():
-        _replace(scenario.run, f"--{key.replace('_', '-')}", **{key: value})
-    run = _replace(scenario.run, "options", **run_changes) if run_changes else scenario.run
+    try:
+        run = dataclasses.replace(scenario.run, **run_changes)
+    except InputError:
+        for key, value in run_changes.items():
+            _replace(scenario.run, f"--{key.replace('_', '-')}", **{key: value})
+        run = _replace(scenario.run, " and ".join(f"--{k.replace('_', '-')}" for k in run_changes), **run_changes)
     material = scenario.material
     if friction is not None:
         material = _replace(material, "--friction", friction=friction)
@@ -130,6 +134,17 @@ def _loading(name: str, amp, freq, settlement, record, scale) -> dict:
     return motions
 
 
+def builder_options(name: str, options: dict) -> dict:
+    """The builder options of ``simulate``/``build``: the wall without --blocks is the paper's 51 blocks
+    (laid in --courses courses, or --length long, if one is given); with both --courses and --length the
+    builder solves for the count instead."""
+    if name != "wall" or "blocks" in options:
+        return options
+    if {"courses", "length"} <= options.keys():
+        return {**options, "blocks": None}
+    return options if options.keys() & {"courses", "length"} else {"blocks": 51, **options}  # spec default: 51
+
+
 def builtin(name: str, **overrides) -> Scenario:
     """The built-in scenario ``name`` ("wall", "arch" or "aqueduct"), with ``overrides`` (see the module doc).
 
@@ -144,8 +159,7 @@ def builtin(name: str, **overrides) -> Scenario:
     motions = _loading(name, **loading)
     reserved = (*RUN_OVERRIDES, *MATERIAL_OVERRIDES, *LOADING_OVERRIDES)
     options = {k: v for k, v in overrides.items() if k not in reserved and v is not None}
-    if name == "wall" and not options.keys() & {"blocks", "courses", "length"}:
-        options = {"blocks": 51, **options}  # the paper's small wall
+    options = builder_options(name, options)
     run = RunConfig(duration=DEFAULT_DURATION[name])
     scenario = scenario_from_builder(name, options, run, material, motions)
     return override_run(scenario, **_given(overrides, RUN_OVERRIDES))

@@ -11,14 +11,41 @@ from pathlib import Path
 from typing import Annotated
 
 import typer
+import typer.core
 from rich.console import Console
 from rich.table import Table
+from rich.text import Text
+from typer._click import exceptions as click_errors  # typer 0.29 vendors click; no public name
 
 from geometry_library.blocks import GeometryError
 from masonrycli import __version__
-from masonrycli.errors import InputError
+from masonrycli.errors import EXIT_BAD_INPUT, EXIT_DIVERGED, EXIT_INTERNAL, EXIT_OUTPUT_FAILED, InputError
+
+
+class _OneLineUsageErrors(typer.core.TyperGroup):
+    """Click's usage errors (``--dt abc``, an unknown option) as one line and exit code 2, like every
+    other bad input, instead of a framed panel."""
+
+    def main(self, args=None, prog_name=None, complete_var=None, standalone_mode=True, **extra):
+        if not standalone_mode:
+            return super().main(args, prog_name, complete_var, standalone_mode=False, **extra)
+        try:
+            code = super().main(args, prog_name, complete_var, standalone_mode=False, **extra)
+        except click_errors.NoArgsIsHelpError as exc:
+            console.print(exc.ctx.get_help(), markup=True)
+            sys.exit(0)
+        except click_errors.UsageError as exc:
+            command = exc.ctx.command_path if exc.ctx is not None else "masonry"
+            _say("error", "bold red", f"{exc.format_message()} ({command} --help lists the options)")
+            sys.exit(exc.exit_code)
+        except click_errors.ClickException as exc:
+            _say("error", "bold red", exc.format_message())
+            sys.exit(exc.exit_code)
+        sys.exit(code if isinstance(code, int) else 0)
+
 
 app = typer.Typer(
+    cls=_OneLineUsageErrors,
     rich_markup_mode="rich",
     no_args_is_help=True,
     add_completion=False,
@@ -30,18 +57,23 @@ build_app = typer.Typer(no_args_is_help=True, help="Build a structure and write 
 app.add_typer(simulate_app, name="simulate")
 app.add_typer(build_app, name="build")
 
-console = Console()
-err_console = Console(stderr=True)
-
-EXIT_BAD_INPUT = 2
-EXIT_INTERRUPTED = 130
-EXIT_DIVERGED = 3
-EXIT_INTERNAL = 1
+# No markup and no highlighting: file names, TOML tables ("[run]") and values ("[inf, 0, 0]") print as given.
+console = Console(markup=False, highlight=False)
+err_console = Console(stderr=True, markup=False, highlight=False)
 
 
-def _fail(message: str) -> None:
-    err_console.print(f"[bold red]error:[/bold red] {message}", highlight=False, soft_wrap=True)
-    raise typer.Exit(EXIT_BAD_INPUT)
+def _say(label: str, style: str, message: str) -> None:
+    """The one place messages go to stderr: ``label: message`` on one line, the message never parsed."""
+    err_console.print(Text.assemble((f"{label}:", style), " ", message), soft_wrap=True)
+
+
+def _warn(message: str) -> None:
+    _say("warning", "yellow", message)
+
+
+def _fail(message: str, code: int = EXIT_BAD_INPUT) -> None:
+    _say("error", "bold red", message)
+    raise typer.Exit(code)
 
 
 def user_errors(func):
@@ -86,8 +118,8 @@ def _opt(kind: type, panel: str, help: str, *decls: str):
 
 WALL = {
     "blocks": _opt(int, "Structure", "Number of blocks (default 51; 248 for the paper's large wall)."),
-    "courses": _opt(int, "Structure", "Number of courses."),
-    "length": _opt(float, "Structure", "Wall length, m."),
+    "courses": _opt(int, "Structure", "Number of courses (with --length and no --blocks: the count follows)."),
+    "length": _opt(float, "Structure", "Wall length, m, a whole number of blocks."),
     "block_length": _opt(float, "Structure", "Block length, m (default 0.30)."),
     "block_height": _opt(float, "Structure", "Block height, m (default 0.20)."),
 }
@@ -145,7 +177,15 @@ STOP = {
         ),
     ]
 }
-GEO_OUT = {"out": Annotated[Path, typer.Option("--out", "-o", help="GeoJSON file to write.")]}
+FORCE = {
+    "force": Annotated[
+        bool,
+        typer.Option(
+            "--force", help="Replace output files that exist (default: refuse, exit 2).", rich_help_panel="Output"
+        ),
+    ]
+}
+GEO_OUT = {"out": Annotated[Path, typer.Option("--out", "-o", help="GeoJSON file to write (.geojson).")]}
 
 
 def with_options(*groups: dict):
@@ -181,50 +221,49 @@ def _default(annotation):
     return None if type(None) in typing.get_args(kind) else inspect.Parameter.empty
 
 
-def _outputs(name: str, out: Path | None, no_recording: bool) -> Path | None:
-    from masonrycli.execute import default_recording_path
+def _execute(scenario, opts: dict, hint: str = "") -> None:
+    """Check the outputs (``opts``: the OUTPUT, FORCE and STOP options), run, print the summary; exit with
+    the code of how the run ended."""
+    from masonrycli.execute import execute, plan_outputs, print_summary
+    from masonrycli.interrupt import StopRun, exit_code, signal_name
+    from masonrycli.sinks import DIVERGED, FAILED
 
-    if no_recording:
-        return None
-    if out is None:
-        return default_recording_path(name)
-    if out.suffix != ".rrd":
-        raise InputError(f"--out {out}: a recording file must end in .rrd")
-    return out
-
-
-def _execute(scenario, out: Path | None, history: Path | None, hint: str = "", stop: bool = False) -> None:
-    from masonrycli.execute import execute, print_summary
-
+    outputs = plan_outputs(
+        scenario, opts["out"], opts["history"], no_recording=opts["no_recording"], force=opts["force"]
+    )
     for warning in scenario.warnings:
-        err_console.print(f"[yellow]warning:[/yellow] {warning}", highlight=False)
+        _warn(warning)
     try:
-        result = execute(scenario, out=out, history=history, console=console, stop_at_collapse=stop)
-    except KeyboardInterrupt:
-        err_console.print(
-            "interrupted: the recording and history hold every frame computed so far" + (f" ({out})" if out else "")
-        )
-        raise typer.Exit(EXIT_INTERRUPTED) from None
+        outcome = execute(scenario, outputs, console=console, stop_at_collapse=opts["stop_at_collapse"])
+    except StopRun as stop:
+        _fail(f"{signal_name(stop.signum)} before the first step: nothing was written", exit_code(stop.signum))
     except (InputError, GeometryError):
         raise
     except Exception as exc:  # an engine bug: say so in one line, keep what was computed
         if os.environ.get("MASONRY_DEBUG"):
             raise
-        err_console.print(
-            f"[bold red]internal error:[/bold red] {type(exc).__name__}: {exc} — the recording"
-            " and history hold every frame computed before it (MASONRY_DEBUG=1 shows the"
-            " traceback)",
-            highlight=False,
-            soft_wrap=True,
+        _say(
+            "internal error",
+            "bold red",
+            f"{type(exc).__name__}: {exc} — the recording and history hold every frame computed before it"
+            " (MASONRY_DEBUG=1 shows the traceback)",
         )
         raise typer.Exit(EXIT_INTERNAL) from None
-    print_summary(console, result, scenario, out, history)
-    if hint and out is not None:
-        console.print(hint, soft_wrap=True)
-    if result.status == "diverged":
+    result = outcome.result
+    print_summary(console, outcome, scenario, hint)
+    for error in outcome.errors:
+        _say("error", "bold red", f"cannot write {error}")
+    if outcome.errors or result.status == FAILED:
+        raise typer.Exit(EXIT_OUTPUT_FAILED)
+    if outcome.signum is not None:
+        raise typer.Exit(exit_code(outcome.signum))
+    if result.status == DIVERGED:
         raise typer.Exit(EXIT_DIVERGED)
-    if result.status == "interrupted":
-        raise typer.Exit(EXIT_INTERRUPTED) from None
+
+
+def _pop(opts: dict, *groups: dict) -> dict:
+    """The options of ``groups`` taken out of ``opts``."""
+    return {k: opts.pop(k) for group in groups for k in group}
 
 
 # -- commands -------------------------------------------------------------------------------------
@@ -233,16 +272,14 @@ def _execute(scenario, out: Path | None, history: Path | None, hint: str = "", s
 def _simulate(name: str, opts: dict) -> None:
     from masonrycli.builtin import builtin, paper_instant_hint
 
-    out, no_recording, history = (opts.pop(k) for k in OUTPUT)
-    stop = opts.pop("stop_at_collapse")
+    outputs = _pop(opts, OUTPUT, FORCE, STOP)
     scenario = builtin(name, **opts)
-    hint = paper_instant_hint(name, scenario.run)
-    _execute(scenario, _outputs(name, out, no_recording), history, hint, stop)
+    _execute(scenario, outputs, paper_instant_hint(name, scenario.run))
 
 
 @simulate_app.command("wall")
 @user_errors
-@with_options(WALL, LOADING, RECORD, RUN, STOP, FRICTION, BLOCK_MATERIAL, OUTPUT)
+@with_options(WALL, LOADING, RECORD, RUN, STOP, FRICTION, BLOCK_MATERIAL, OUTPUT, FORCE)
 def simulate_wall(**opts) -> None:
     """The paper's running-bond wall on a shaken ground (default 51 blocks, 1 m/s at 2 Hz for 1 s)."""
     _simulate("wall", opts)
@@ -250,7 +287,7 @@ def simulate_wall(**opts) -> None:
 
 @simulate_app.command("arch")
 @user_errors
-@with_options(ARCH, LOADING, RECORD, RUN, STOP, FRICTION, BLOCK_MATERIAL, OUTPUT)
+@with_options(ARCH, LOADING, RECORD, RUN, STOP, FRICTION, BLOCK_MATERIAL, OUTPUT, FORCE)
 def simulate_arch(**opts) -> None:
     """The paper's 98-block arch on two piers; default: right foundation settles at 1 cm/s for 5 s."""
     _simulate("arch", opts)
@@ -258,7 +295,7 @@ def simulate_arch(**opts) -> None:
 
 @simulate_app.command("aqueduct")
 @user_errors
-@with_options(AQUEDUCT, LOADING, RECORD, RUN, STOP, FRICTION, BLOCK_MATERIAL, OUTPUT)
+@with_options(AQUEDUCT, LOADING, RECORD, RUN, STOP, FRICTION, BLOCK_MATERIAL, OUTPUT, FORCE)
 def simulate_aqueduct(**opts) -> None:
     """A segment of the Arles aqueduct (98 arch + 248 wall blocks); default: settlement 1 cm/s for 5 s.
 
@@ -267,31 +304,35 @@ def simulate_aqueduct(**opts) -> None:
     _simulate("aqueduct", opts)
 
 
-@app.command("run")
-@user_errors
-@with_options(RUN, STOP, FRICTION, OUTPUT, RECORD)
-def run_command(
-    scenario_file: Annotated[
-        Path, typer.Argument(help="Scenario file (TOML), or a GeoJSON / WKT geometry.", metavar="SCENARIO.toml")
-    ],
-    **opts,
-) -> None:
-    """Run any scenario file (or a GeoJSON / WKT geometry file, supports fixed); options given here
-    override the file's values."""
+ScenarioFile = Annotated[
+    Path, typer.Argument(help="Scenario file (TOML), or a GeoJSON / WKT geometry.", metavar="SCENARIO.toml")
+]
+
+
+def _load(scenario_file: Path, opts: dict):
+    """The scenario of a TOML, GeoJSON or WKT file with the command line's record and run options
+    (taken out of ``opts``) applied."""
     from masonrycli.builtin import override_run, with_record
     from masonrycli.scenario import scenario_from_geometry_file
     from masonrycli.scenario_toml import load_scenario
     from masonrycli.structure import GEOMETRY_SUFFIXES
 
-    out, no_recording, history = (opts.pop(k) for k in OUTPUT)
-    record, scale = (opts.pop(k) for k in RECORD)
-    stop = opts.pop("stop_at_collapse")
+    record, scale = _pop(opts, RECORD).values()
     if scenario_file.suffix.lower() in GEOMETRY_SUFFIXES:
         scenario = scenario_from_geometry_file(scenario_file)
     else:
         scenario = load_scenario(scenario_file)
-    scenario = override_run(with_record(scenario, record, scale), **opts)
-    _execute(scenario, _outputs(scenario.name, out, no_recording), history, stop=stop)
+    return override_run(with_record(scenario, record, scale), **_pop(opts, RUN, FRICTION))
+
+
+@app.command("run")
+@user_errors
+@with_options(RUN, STOP, FRICTION, OUTPUT, FORCE, RECORD)
+def run_command(scenario_file: ScenarioFile, **opts) -> None:
+    """Run any scenario file (or a GeoJSON / WKT geometry file, supports fixed); options given here
+    override the file's values."""
+    scenario = _load(scenario_file, opts)
+    _execute(scenario, opts)
 
 
 def _register_sweep() -> None:
@@ -348,14 +389,17 @@ def limit_command(
 
 @app.command("check")
 @user_errors
-def check_command(
-    scenario_file: Annotated[Path, typer.Argument(help="Scenario file (TOML).", metavar="SCENARIO.toml")],
-) -> None:
-    """Validate a scenario file and print a summary (blocks, supports, mass, bounding box)."""
+@with_options(RUN, STOP, FRICTION, OUTPUT, FORCE, RECORD)
+def check_command(scenario_file: ScenarioFile, **opts) -> None:
+    """Validate what `masonry run` would run, with the same arguments, and print a summary (blocks,
+    supports, mass, bounding box, steps, outputs); nothing is computed or written."""
+    from masonrycli.execute import plan_outputs
     from masonrycli.scenario import scenario_summary
-    from masonrycli.scenario_toml import load_scenario
 
-    scenario = load_scenario(scenario_file)
+    scenario = _load(scenario_file, opts)
+    outputs = plan_outputs(
+        scenario, opts["out"], opts["history"], no_recording=opts["no_recording"], force=opts["force"]
+    )
     info = scenario_summary(scenario)
     table = Table(title=f"{scenario_file} — valid", show_header=False, title_justify="left")
     table.add_column("", style="bold")
@@ -370,25 +414,36 @@ def check_command(
     table.add_row(
         "time", f"{info['duration']:g} s in {info['n_steps']} steps of {info['dt']:g} s, θ = {info['theta']:g}"
     )
+    for out_file in outputs.files():
+        table.add_row("recording" if out_file.option == "--out" else "history", str(out_file.path))
     console.print(table)
     for warning in scenario.warnings:
-        err_console.print(f"[yellow]warning:[/yellow] {warning}", highlight=False)
+        _warn(warning)
 
 
 def _write_assembly(builder: str, opts: dict) -> None:
+    """Build, check and write the GeoJSON under a temporary name, renamed onto ``--out`` when complete."""
     from geometry_library.builders import BUILDERS
     from geometry_library.checks import validate_assembly
     from geometry_library.io import write_geojson
+    from masonrycli.builtin import builder_options
+    from masonrycli.outputs import check_output, open_part
 
-    out = opts.pop("out")
-    options = {k: v for k, v in opts.items() if v is not None}
+    target = check_output(opts.pop("out"), "--out", ".geojson", opts.pop("force"))
+    options = builder_options(builder, {k: v for k, v in opts.items() if v is not None})
     try:
         assembly = BUILDERS[builder](**options).build()
     except (ValueError, GeometryError) as exc:
         raise InputError(f"{builder}: {exc}") from None
     for warning in validate_assembly(assembly):
-        err_console.print(f"[yellow]warning:[/yellow] {warning}", highlight=False)
-    write_geojson(assembly, out)
+        _warn(warning)
+    open_part(target)
+    try:
+        write_geojson(assembly, target.part)
+        out = target.commit()
+    except BaseException:
+        target.discard()
+        raise
     console.print(
         f"{builder}: {assembly.block_count} blocks and {assembly.support_count} "
         f"support{'s' if assembly.support_count != 1 else ''} → {out}"
@@ -397,7 +452,7 @@ def _write_assembly(builder: str, opts: dict) -> None:
 
 @build_app.command("wall")
 @user_errors
-@with_options(GEO_OUT, WALL, BLOCK_MATERIAL)
+@with_options(GEO_OUT, WALL, BLOCK_MATERIAL, FORCE)
 def build_wall_command(**opts) -> None:
     """A running-bond wall on its ground."""
     _write_assembly("wall", opts)
@@ -405,7 +460,7 @@ def build_wall_command(**opts) -> None:
 
 @build_app.command("arch")
 @user_errors
-@with_options(GEO_OUT, ARCH, BLOCK_MATERIAL)
+@with_options(GEO_OUT, ARCH, BLOCK_MATERIAL, FORCE)
 def build_arch_command(**opts) -> None:
     """A semicircular arch on two piers, each on its foundation."""
     _write_assembly("arch", opts)
@@ -413,7 +468,7 @@ def build_arch_command(**opts) -> None:
 
 @build_app.command("aqueduct")
 @user_errors
-@with_options(GEO_OUT, AQUEDUCT, BLOCK_MATERIAL)
+@with_options(GEO_OUT, AQUEDUCT, BLOCK_MATERIAL, FORCE)
 def build_aqueduct_command(**opts) -> None:
     """The arch plus spandrel walls in running bond up to a level top."""
     _write_assembly("aqueduct", opts)
@@ -447,6 +502,11 @@ def inspect_command(
     console.print(table)
     if info.get("metadata"):
         console.print(info["metadata"])
+    if info.get("truncated") or not info.get("complete", True):
+        _warn(
+            f"{recording}: truncated (its writer did not finish: killed, or the disk was full) — "
+            f"{info['frames']} frames up to its last complete chunk"
+        )
 
 
 def main() -> None:

@@ -1,4 +1,17 @@
-"""The one error type the command line turns into a one-line message and exit code 2, and where it happened."""
+"""The one error type the command line turns into a one-line message and exit code 2, where it happened,
+and the exit codes.
+
+Exit codes (README, "Troubleshooting"): 0 the run completed (or the command succeeded) · 1 internal error
+(an engine bug; ``MASONRY_DEBUG=1`` shows the traceback) · 2 bad input, including an output path that
+cannot be written, checked before step 1 · 3 the run diverged · 4 an output could not be written during
+the run (disk full, folder removed) · 128 + signal number when stopped by a signal (130 Ctrl-C, 143 SIGTERM).
+"""
+
+EXIT_OK = 0
+EXIT_INTERNAL = 1
+EXIT_BAD_INPUT = 2
+EXIT_DIVERGED = 3
+EXIT_OUTPUT_FAILED = 4
 
 
 class InputError(ValueError):

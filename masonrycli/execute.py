@@ -1,7 +1,9 @@
-"""Run a scenario with its outputs: history file, Rerun recording, progress bar and summary.
+"""Run a scenario with its outputs: output checks, history file, Rerun recording, progress bar, summary.
 
-The outputs are closed whatever happens — normal end, divergence, an exception or Ctrl-C — so the
-recording always has its footer and the history holds every frame computed.
+Before step 1 every output path is checked and its temporary file created (:mod:`masonrycli.outputs`),
+and a run whose outputs would not fit on the disk is refused. The outputs are then closed whatever
+happens — normal end, divergence, a signal, an engine error, a failed write — and each one that closed
+is renamed into place, so what was computed is kept and a path never holds half a file.
 """
 
 from __future__ import annotations
@@ -9,24 +11,68 @@ from __future__ import annotations
 import platform
 import shutil
 import sys
+import warnings
+from dataclasses import dataclass, field
 from datetime import datetime
 from pathlib import Path
 
 import numpy as np
 from rich.console import Console
+from rich.text import Text
 
 from masonrycli import __version__
-from masonrycli.history import History
+from masonrycli.errors import InputError
+from masonrycli.history import HistoryFile
+from masonrycli.interrupt import StopSignals
+from masonrycli.outputs import OutputFile, check_distinct, check_output, check_space, default_recording_path, open_part
 from masonrycli.report import progress_bar, summary_table
 from masonrycli.run import RunResult, Simulation, simulate
+from masonrycli.sinks import COMPLETED, FAILED
 
-RECORDINGS_DIR = Path("recordings")
+HISTORY_BYTES_PER_BLOCK = 400
+"""Upper estimate of one block's share of a history row (measured: 326 B for the walls)."""
+RECORDING_BYTES_PER_BLOCK = 500
+"""Upper estimate of one block's share of a recorded frame (measured: 405 B for the walls)."""
+FRAME_OVERHEAD_BYTES = 2000
 
 
-def default_recording_path(name: str) -> Path:
-    """``recordings/<scenario>-<timestamp>.rrd`` relative to the working directory."""
-    stamp = datetime.now().strftime("%Y%m%d-%H%M%S")
-    return RECORDINGS_DIR / f"{name}-{stamp}.rrd"
+@dataclass
+class Outputs:
+    """The run's output files, checked (see :func:`plan_outputs`); None where not written."""
+
+    recording: OutputFile | None = None
+    history: OutputFile | None = None
+
+    def files(self) -> list[OutputFile]:
+        return [o for o in (self.recording, self.history) if o is not None]
+
+
+def plan_outputs(scenario, out: Path | None, history: Path | None, *, no_recording: bool, force: bool) -> Outputs:
+    """Check the output paths and the free space before anything is computed (raises InputError)."""
+    rec = None
+    if not no_recording:
+        if out is None:
+            rec = OutputFile(default_recording_path(scenario.name), "--out", default_name=True)
+        else:
+            rec = check_output(out, "--out", ".rrd", force)
+    hist = check_output(history, "--history", ".npz", force) if history is not None else None
+    check_distinct(rec, hist)
+    frames = scenario.run.n_steps // scenario.run.record_every + 2
+    n = scenario.assembly.block_count
+    sizes = [(rec, RECORDING_BYTES_PER_BLOCK), (hist, HISTORY_BYTES_PER_BLOCK)]
+    check_space([(o, frames * (per_block * n + FRAME_OVERHEAD_BYTES)) for o, per_block in sizes if o is not None])
+    return Outputs(rec, hist)
+
+
+@dataclass
+class Outcome:
+    """What :func:`execute` did: the run's result, the signal that stopped it, the outputs' fates."""
+
+    result: RunResult
+    signum: int | None = None
+    written: list[OutputFile] = field(default_factory=list)
+    errors: list[str] = field(default_factory=list)
+    """One line per output that could not be written: "--history h.npz: No space left on device"."""
 
 
 def run_metadata(scenario, sim: Simulation) -> dict:
@@ -81,50 +127,104 @@ def recording_static(sim: Simulation):
     )
 
 
-def execute(
-    scenario, *, out: Path | None, history: Path | None, console: Console, stop_at_collapse: bool = False
-) -> RunResult:
-    """Run ``scenario``, writing the recording ``out`` and the history ``history`` (either may be None);
-    ``stop_at_collapse`` ends the run when the structure collapses (:mod:`masonrycli.collapse`)."""
-    sim = Simulation(scenario)
-    sinks = []
-    hist = None
-    recorder = None
-    if history is not None:
-        hist = History(sim.model.block_name, sim.model.support_name)
-        sinks.append(hist)
-    if out is not None:
-        from masonrycli.recording import Recorder
+def execute(scenario, outputs: Outputs, *, console: Console, stop_at_collapse: bool = False) -> Outcome:
+    """Run ``scenario`` writing ``outputs``; ``stop_at_collapse`` ends the run when the structure
+    collapses (:mod:`masonrycli.collapse`). Signals: :mod:`masonrycli.interrupt` (a stop before step 1
+    raises its ``StopRun`` after removing the temporary files); an engine error is re-raised after the
+    outputs are closed with status "failed" and renamed into place."""
+    with StopSignals() as signals:
+        sinks: dict[OutputFile, object] = {}
+        try:
+            for out in outputs.files():
+                open_part(out)
+            sim = Simulation(scenario)
+            for out in outputs.files():
+                try:
+                    sinks[out] = _open_sink(out, outputs, scenario, sim)
+                except OSError as exc:
+                    raise InputError(f"{out.option} {out.path}: cannot write: {exc.strerror or exc}") from None
+        except BaseException:
+            for sink in sinks.values():
+                _quietly_close(sink)
+            for out in outputs.files():
+                out.discard()
+            raise
+        status, note = FAILED, "the run stopped on an unexpected error"
+        result = None
+        try:
+            signals.stepping()
+            with progress_bar(console, sim.model.n_steps) as on_progress:
+                result = simulate(
+                    scenario,
+                    list(sinks.values()),
+                    on_progress=on_progress,
+                    sim=sim,
+                    stop=signals.requested,
+                    stop_at_collapse=stop_at_collapse,
+                )
+            status, note = result.status, result.message
+            if outputs.history is not None:
+                sinks[outputs.history].run_values |= {f"intensity_{k}": v for k, v in result.intensity.items()}
+        finally:
+            signals.closing()
+            written, errors = _close_all(sinks, status, note, result)
+    return Outcome(result, signals.signum, written, errors)
 
-        out.parent.mkdir(parents=True, exist_ok=True)
-        recorder = Recorder(out, recording_static(sim), run_metadata(scenario, sim))
-        sinks.append(recorder)
-    result = None
-    status, note = "error", "the run stopped on an unexpected error"
-    try:
-        with progress_bar(console, sim.model.n_steps) as on_progress:
-            result = simulate(scenario, sinks, on_progress=on_progress, sim=sim, stop_at_collapse=stop_at_collapse)
-        if hist is not None:
-            hist.run_values |= {f"intensity_{k}": v for k, v in result.intensity.items()}
-        status, note = result.status, result.message
-    except KeyboardInterrupt:
-        status = "interrupted"
-        note = f"interrupted at t = {sim.state.time:.4f} s (step {sim.state.step})"
-        raise
-    finally:
-        if recorder is not None:
-            recorder.close(status=status, note=note)
-        if hist is not None:
-            hist.write(history, status=status)
-    return result
+
+def _open_sink(out: OutputFile, outputs: Outputs, scenario, sim: Simulation):
+    """The history or the recorder writing ``out``'s temporary file."""
+    if out is outputs.history:
+        return HistoryFile(out.part, sim.model.block_name, sim.model.support_name)
+    from masonrycli.recording import Recorder
+
+    return Recorder(out.part, recording_static(sim), run_metadata(scenario, sim))
 
 
-def print_summary(console: Console, result: RunResult, scenario, out: Path | None, history: Path | None) -> None:
-    console.print(
-        summary_table(result, scenario.run.max_iterations, str(out) if out else None, str(history) if history else None)
-    )
-    if out is not None:
-        console.print(f"Open the recording:  [bold]{rerun_command()} {out}[/bold]", soft_wrap=True)
+def _quietly_close(sink) -> None:
+    """Close a sink whose file is abandoned anyway: no error, no warning."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        try:
+            sink.close(FAILED, "")
+        except Exception:  # the caller removes the temporary file anyway
+            pass
+
+
+def _close_all(sinks: dict, status: str, note: str, result) -> tuple[list[OutputFile], list[str]]:
+    """Close every sink (the recording first), rename each complete file into place; a file that cannot
+    be finished is removed. Once one output failed, the run is "failed", not "completed", in the others
+    and in ``result``."""
+    written, errors = [], []
+    for out, sink in sinks.items():
+        if errors and status == COMPLETED:
+            status, note = FAILED, f"output failed: {errors[0]}"
+        try:
+            if result is not None and sink is result.failed_sink:
+                raise OSError(result.message)
+            sink.close(status, note)
+            out.commit()
+            written.append(out)
+        except Exception as exc:  # OSError: disk full, folder removed; anything else: said as it is
+            cause = exc.strerror or str(exc) if isinstance(exc, OSError) else f"{type(exc).__name__}: {exc}"
+            errors.append(f"{out.option} {out.path}: {cause}")
+            _quietly_close(sink)
+            out.discard()
+    if errors and result is not None and result.status == COMPLETED:
+        result.status, result.message = FAILED, f"output failed: {errors[0]}"
+    return written, errors
+
+
+def print_summary(console: Console, outcome: Outcome, scenario, hint: str = "") -> None:
+    """The summary table, the optional ``hint``, and last the command that opens the recording."""
+    result = outcome.result
+    paths = {o.option: str(o.path) for o in outcome.written}
+    console.print(summary_table(result, scenario.run.max_iterations, paths.get("--out"), paths.get("--history")))
+    if hint and "--out" in paths:
+        console.print(hint, soft_wrap=True)
+    if "--out" in paths:
+        console.print(
+            Text.assemble("Open the recording:  ", (f"{rerun_command()} {paths['--out']}", "bold")), soft_wrap=True
+        )
 
 
 def rerun_command() -> str:

@@ -1,4 +1,4 @@
-"""The history file: one row per recorded frame, written as an uncompressed ``.npz``.
+"""The history file: one row per recorded frame, an uncompressed ``.npz``.
 
 Arrays (T frames, N blocks, S supports), block order = scenario order:
 
@@ -8,19 +8,25 @@ Arrays (T frames, N blocks, S supports), block order = scenario order:
     energy_kinetic (T,) J · energy_potential (T,) J · energy_dissipated (T,) J (cumulated)
     support_work (T,) J (cumulated) · every per-block tensor field of masonrycli.tensors.TENSOR_FIELDS
     joint_body (J,2) · joint_hinged (T,J) bool · hinge_count (T,)  (see masonrycli.mechanism)
-    block_name (N,) · support_name (S,) · status () str
+    block_name (N,) · support_name (S,) · status () str (masonrycli.sinks.STATUSES) · note () str
     intensity_pga, intensity_pgv, intensity_arias, intensity_d5_95, intensity_sa () — the ground motion as
     applied (masonrycli.intensity), when a support shakes
+
+:class:`HistoryFile` (the command line's sink) streams every row to disk as it comes, so memory stays
+flat however long the run; :class:`History` keeps the rows in memory for tests and scripts.
 """
 
 from __future__ import annotations
 
 import os
+import shutil
+import zipfile
 from pathlib import Path
 
 import numpy as np
 
 from masonrycli.frame import Frame
+from masonrycli.sinks import COMPLETED
 
 _SCALARS = (
     "time",
@@ -36,30 +42,39 @@ _SCALARS = (
 _ARRAYS = ("block_q", "block_v", "support_q", "support_v", "support_force")
 
 
+def frame_rows(frame: Frame) -> dict[str, np.ndarray]:
+    """One history row per array name (copies: the engine reuses its buffers)."""
+    rows = {name: np.asarray(getattr(frame, name)) for name in _SCALARS}
+    rows.update({name: np.array(getattr(frame, name), copy=True) for name in _ARRAYS})
+    rows.update({name: np.array(value, copy=True) for name, value in frame.tensors.items()})
+    rows["joint_hinged"] = np.array(frame.joint_hinged, dtype=bool, copy=True)
+    rows["hinge_count"] = np.asarray(int(frame.joint_hinged.sum()))
+    return rows
+
+
 class History:
-    """Collects frames in memory and writes them as one ``.npz``."""
+    """Collects frames in memory (tests, scripts); :meth:`arrays` gives the history's arrays."""
 
     def __init__(self, block_name, support_name):
         self.block_name = np.asarray(block_name, dtype=str)
         self.support_name = np.asarray(support_name, dtype=str)
         self._rows: dict[str, list] = {}
+        self.joint_body = np.zeros((0, 2), dtype=np.int64)
         self.run_values: dict[str, float] = {}
         """One value per run (e.g. ``intensity_pga``), written as 0-d arrays."""
 
     def __len__(self) -> int:
         return len(self._rows.get("time", ()))
 
-    def append(self, frame: Frame) -> None:
-        rows = self._rows
-        for name in _SCALARS:
-            rows.setdefault(name, []).append(getattr(frame, name))
-        for name in _ARRAYS:
-            rows.setdefault(name, []).append(np.array(getattr(frame, name), copy=True))
-        for name, value in frame.tensors.items():
-            rows.setdefault(name, []).append(np.array(value, copy=True))
-        rows.setdefault("joint_hinged", []).append(np.array(frame.joint_hinged, copy=True))
-        rows.setdefault("hinge_count", []).append(int(frame.joint_hinged.sum()))
+    def on_frame(self, frame: Frame) -> None:
+        for name, value in frame_rows(frame).items():
+            self._rows.setdefault(name, []).append(value)
         self.joint_body = frame.joint_body
+
+    append = on_frame
+
+    def close(self, status: str = COMPLETED, note: str = "") -> None:
+        """Nothing to finish: the rows stay in memory."""
 
     def arrays(self) -> dict[str, np.ndarray]:
         out = {name: np.asarray(values) for name, values in self._rows.items()}
@@ -70,11 +85,80 @@ class History:
             out["joint_body"] = np.asarray(self.joint_body)
         return out
 
-    def write(self, path: str | os.PathLike, status: str = "completed") -> Path:
-        """Write atomically (temporary file then rename) so an interrupted write never leaves half a file."""
-        path = Path(path)
-        path.parent.mkdir(parents=True, exist_ok=True)
-        tmp = path.with_name(path.name + ".tmp.npz")
-        np.savez(tmp, status=np.asarray(status), **self.arrays())
-        os.replace(tmp, path)
-        return path
+
+class HistoryFile:
+    """A :class:`~masonrycli.sinks.FrameSink` writing the history ``.npz`` at ``path`` without holding it.
+
+    Each frame's rows are appended to one raw file per array in the scratch folder ``<path>.rows``;
+    :meth:`close` writes the ``.npz`` from them (a stored zip of ``.npy`` members, read by ``np.load``)
+    and removes the folder. A write error (disk full, folder removed) raises ``OSError`` from
+    :meth:`on_frame` or :meth:`close`; the scratch folder is removed either way.
+    """
+
+    def __init__(self, path: str | os.PathLike, block_name, support_name):
+        self.path = Path(path)
+        self.block_name = np.asarray(block_name, dtype=str)
+        self.support_name = np.asarray(support_name, dtype=str)
+        self.scratch = self.path.with_name(self.path.name + ".rows")
+        self.scratch.mkdir()
+        self.frames = 0
+        self.joint_body = np.zeros((0, 2), dtype=np.int64)
+        self.run_values: dict[str, float] = {}
+        """One value per run (e.g. ``intensity_pga``), written as 0-d arrays; set before :meth:`close`."""
+        self._files: dict[str, tuple] = {}  # name -> (open raw file, dtype, row shape)
+        self._closed = False
+
+    def on_frame(self, frame: Frame) -> None:
+        for name, row in frame_rows(frame).items():
+            row = np.asarray(row, order="C")  # not ascontiguousarray: it makes scalars 1-d
+            entry = self._files.get(name)
+            if entry is None:
+                entry = self._files[name] = (open(self.scratch / f"{name}.raw", "wb"), row.dtype, row.shape)
+            fh, dtype, shape = entry
+            if row.dtype != dtype or row.shape != shape:
+                raise ValueError(f"history: {name} changed from {dtype}{shape} to {row.dtype}{row.shape}")
+            fh.write(row.tobytes())
+        self.joint_body = np.array(frame.joint_body, copy=True)
+        self.frames += 1
+
+    def close(self, status: str = COMPLETED, note: str = "") -> None:
+        """Write the ``.npz`` (every frame handed over so far) and remove the scratch folder. Idempotent."""
+        if self._closed:
+            return
+        self._closed = True
+        try:
+            for fh, _, _ in self._files.values():
+                fh.close()
+            constants = {
+                "block_name": self.block_name,
+                "support_name": self.support_name,
+                "joint_body": self.joint_body,
+                "status": np.asarray(status),
+                "note": np.asarray(note),
+            } | {name: np.asarray(value) for name, value in self.run_values.items()}
+            with zipfile.ZipFile(self.path, "w", zipfile.ZIP_STORED, allowZip64=True) as zf:
+                for name, (_, dtype, shape) in self._files.items():
+                    with zf.open(f"{name}.npy", "w", force_zip64=True) as member:
+                        header = {"descr": np.lib.format.dtype_to_descr(dtype), "fortran_order": False}
+                        np.lib.format.write_array_header_2_0(member, header | {"shape": (self.frames, *shape)})
+                        _copy_rows(
+                            self.scratch / f"{name}.raw", member, self.frames * dtype.itemsize * int(np.prod(shape))
+                        )
+                for name, value in constants.items():
+                    with zf.open(f"{name}.npy", "w") as member:
+                        np.lib.format.write_array(member, value, allow_pickle=False)
+        finally:
+            for fh, _, _ in self._files.values():
+                fh.close()
+            shutil.rmtree(self.scratch, ignore_errors=True)
+
+
+def _copy_rows(raw_path: Path, member, size: int) -> None:
+    """Copy the first ``size`` bytes (the whole rows: a failed write may have left part of one after them)."""
+    with open(raw_path, "rb") as raw:
+        while size > 0:
+            chunk = raw.read(min(size, 1 << 20))
+            if not chunk:
+                raise OSError(f"history: {raw_path.name} is {size} bytes short")
+            member.write(chunk)
+            size -= len(chunk)

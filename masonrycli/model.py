@@ -61,8 +61,8 @@ class Model:
     """Contacts whose gap is below this are kept, m."""
     n_steps: int
     """Number of time steps of the run."""
-    support_velocity: np.ndarray
-    """(n_steps + 1, S, 2) m/s: imposed support velocity at t_k = k·dt."""
+    support_velocity: SupportVelocity
+    """``support_velocity[k]`` (S, 2) m/s: imposed support velocity at t_k = k·dt, k = 0 … n_steps."""
     block_name: tuple
     support_name: tuple
 
@@ -115,8 +115,7 @@ def build_model(scenario) -> Model:
     mass[n:] = np.inf
     inertia[n:] = np.inf
     n_steps = run.n_steps
-    times = np.arange(n_steps + 1, dtype=np.float64) * run.dt
-    table = support_velocity(scenario.motions, times) if s else np.zeros((n_steps + 1, 0, 2))
+    table = SupportVelocity(tuple(scenario.motions), float(run.dt), n_steps)
     v0[n:, :2] = table[0]
     dynamic = np.zeros(n + s, dtype=np.bool_)
     dynamic[:n] = True
@@ -142,10 +141,41 @@ def build_model(scenario) -> Model:
         max_iterations=int(run.max_iterations),
         alert_distance=float(run.alert_distance),
         n_steps=n_steps,
-        support_velocity=np.ascontiguousarray(table, dtype=np.float64),
+        support_velocity=table,
         block_name=tuple(b.name for b in blocks),
         support_name=tuple(sp.name for sp in supports),
     )
+
+
+class SupportVelocity:
+    """The supports' imposed velocities at t_k = k·dt, evaluated ``CHUNK`` steps at a time when first asked.
+
+    Nothing is held in proportion to the run's length (a table of every step of a 10⁸-step run would
+    take gigabytes before step 1). ``table[k]`` is bit-identical to row k of
+    ``support_velocity(motions, arange(n_steps + 1) * dt)``: the motions are evaluated elementwise in t.
+    """
+
+    CHUNK = 4096
+
+    def __init__(self, motions: tuple, dt: float, n_steps: int):
+        self.motions, self.dt, self.n_steps = motions, dt, n_steps
+        self._start, self._rows = 0, np.zeros((0, len(motions), 2))
+
+    def __len__(self) -> int:
+        return self.n_steps + 1
+
+    def __getitem__(self, k: int) -> np.ndarray:
+        if not 0 <= k <= self.n_steps:
+            raise IndexError(f"step {k} outside 0 … {self.n_steps}")
+        if not self._start <= k < self._start + len(self._rows):
+            self._start = k
+            stop = min(k + self.CHUNK, self.n_steps + 1)
+            self._rows = support_velocity(self.motions, np.arange(k, stop, dtype=np.float64) * self.dt)
+        return self._rows[k - self._start]
+
+    def between(self, start: int, stop: int) -> np.ndarray:
+        """(stop − start, S, 2) the rows of steps start … stop − 1, evaluated now (not kept)."""
+        return support_velocity(self.motions, np.arange(start, stop, dtype=np.float64) * self.dt)
 
 
 def _radii(start: np.ndarray, local: np.ndarray) -> np.ndarray:

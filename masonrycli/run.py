@@ -1,8 +1,9 @@
 """The one time loop: motion → detect → solve → tensors → record → progress.
 
 ``simulate`` owns no I/O format: it hands each recorded :class:`~masonrycli.frame.Frame` to the sinks it
-is given (a :class:`~masonrycli.history.History`, a recorder) and always closes them — after a normal end,
-a divergence, an exception or Ctrl-C — so what was computed is never lost.
+is given (:class:`~masonrycli.sinks.FrameSink`: a history, a recorder); the caller closes them. It stops
+early when ``stop()`` says so (a signal, see :mod:`masonrycli.interrupt`), when the state diverges, or
+when a sink cannot write (``OSError``: the result says which sink and why).
 """
 
 from __future__ import annotations
@@ -21,6 +22,7 @@ from masonrycli.intensity import describe as describe_intensity
 from masonrycli.intensity import intensity_measures, shaking_support
 from masonrycli.mechanism import JointTracker, mobilised_friction, reported_status
 from masonrycli.model import Model, State, build_model, initial_state
+from masonrycli.sinks import COMPLETED, DIVERGED, FAILED, INTERRUPTED
 from masonrycli.tensors import TensorComputer, build_triangles, chain_neighbours
 
 DIVERGENCE_SPEED = 1e3
@@ -53,6 +55,8 @@ class RunResult:
     """Intensity measures of the shaking support's motion as applied (:mod:`masonrycli.intensity`), or {}."""
     outcome: dict = field(default_factory=dict)
     """What happened to the structure (:func:`run_outcome`): state, collapse time, drifts, hinges, ..."""
+    failed_sink: object = None
+    """The sink whose ``on_frame`` raised ``OSError`` (status "failed"), else None."""
 
 
 class Simulation:
@@ -180,13 +184,14 @@ def simulate(
     steps: int | None = None,
     sim: Simulation | None = None,
     stop_at_collapse: bool = False,
+    stop: Callable[[], bool] | None = None,
 ) -> RunResult:
-    """Run ``scenario`` to its end (or ``steps`` steps). Each sink gets ``append(frame)``/``log_frame(frame)``
-    for every recorded frame; sinks are *not* closed here (the caller owns them) but every frame computed
-    before an interruption has been handed over when this returns.
+    """Run ``scenario`` to its end (or ``steps`` steps), handing every recorded frame to each sink's
+    ``on_frame``. Sinks are *not* closed here (the caller owns them).
 
-    ``on_progress(sim, step_stats)`` is called every ``progress_every`` steps. Pass ``sim`` to run an
-    already built :class:`Simulation` (the caller needed its model or triangles first).
+    ``on_progress(sim, step_stats)`` is called every ``progress_every`` steps. ``stop()`` is polled after
+    every step; when it is true the run ends "interrupted" after recording the state it reached. Pass
+    ``sim`` to run an already built :class:`Simulation` (the caller needed its model or triangles first).
     ``stop_at_collapse`` ends the run at the first step where the structure has collapsed
     (:mod:`masonrycli.collapse`); the status stays "completed" and the message says so.
     """
@@ -202,40 +207,51 @@ def simulate(
     e0 = sum(sim.energies())
     frames = 0
 
-    def emit():
-        nonlocal frames
+    failed_sink = None
+
+    def emit() -> bool:
+        """Hand the current frame to every sink; False (and ``failed_sink`` set) if one cannot write."""
+        nonlocal frames, failed_sink
         frame = sim.frame()
         for sink in sinks:
-            (sink.append if hasattr(sink, "append") else sink.log_frame)(frame)
+            try:
+                sink.on_frame(frame)
+            except OSError as exc:
+                failed_sink = (sink, exc)
+                return False
         frames += 1
+        return True
 
-    status, message = "completed", ""
+    status, message = COMPLETED, ""
     done = 0
-    try:
-        emit()
-        for k in range(n_steps):
-            stats = sim.step()
-            iterations[k], residual[k], contacts[k] = stats.iterations, stats.residual, stats.contact_count
-            max_pen = max(max_pen, stats.max_penetration)
-            done = k + 1
-            why = sim.diverged()
-            if why:
-                status, message = "diverged", f"diverged at t = {sim.state.time:.4f} s (step {done}): {why}"
-                emit()
-                break
-            if done % every == 0 or done == n_steps:
-                emit()
-            if on_progress is not None and (done % progress_every == 0 or done == n_steps):
-                on_progress(sim, stats)
-            if stop_at_collapse and sim.monitor.collapse_time is not None:
-                message = f"stopped at collapse, t = {sim.state.time:.4f} s (step {done} of {n_steps})"
-                if done % every:
-                    emit()
-                break
-    except KeyboardInterrupt:
-        status = "interrupted"
-        # The interrupted step may be half done: keep the frames recorded so far, add none.
-        message = f"interrupted at t = {sim.state.time:.4f} s (step {done} of {n_steps})"
+    ok = emit()
+    for k in range(n_steps if ok else 0):
+        stats = sim.step()
+        iterations[k], residual[k], contacts[k] = stats.iterations, stats.residual, stats.contact_count
+        max_pen = max(max_pen, stats.max_penetration)
+        done = k + 1
+        why = sim.diverged()
+        recorded = done % every == 0 or done == n_steps
+        if why:
+            status, message = DIVERGED, f"diverged at t = {sim.state.time:.4f} s (step {done}): {why}"
+            ok = emit()
+            break
+        if recorded and not emit():
+            ok = False
+            break
+        if on_progress is not None and (done % progress_every == 0 or done == n_steps):
+            on_progress(sim, stats)
+        if stop_at_collapse and sim.monitor.collapse_time is not None:
+            message = f"stopped at collapse, t = {sim.state.time:.4f} s (step {done} of {n_steps})"
+            ok = recorded or emit()
+            break
+        if stop is not None and stop() and done < n_steps:
+            status, message = INTERRUPTED, f"interrupted at t = {sim.state.time:.4f} s (step {done} of {n_steps})"
+            ok = recorded or emit()
+            break
+    if not ok:
+        sink, exc = failed_sink
+        status, message = FAILED, f"stopped at t = {sim.state.time:.4f} s (step {done}): {exc.strerror or exc}"
     extra: dict[str, str] = {}
     hinge_count = 0
     if sim.last is not None and sim.joints.key.size:
@@ -268,6 +284,7 @@ def simulate(
         extra=extra,
         intensity=ims,
         outcome=outcome,
+        failed_sink=failed_sink[0] if failed_sink else None,
     )
 
 
@@ -314,4 +331,4 @@ def applied_intensity(scenario, model: Model) -> dict[str, float]:
     j = shaking_support(scenario.motions)
     if j is None or model.n_steps < 2:
         return {}
-    return intensity_measures(model.support_velocity[:, j, 0], model.dt)
+    return intensity_measures(model.support_velocity.between(0, model.n_steps + 1)[:, j, 0], model.dt)

@@ -26,7 +26,8 @@ from masonrycli.values import check_int, check_real, check_vector, field_error, 
 
 MAX_DURATION = 1e5
 """s — longer runs are refused as a likely typo."""
-MAX_STEPS = 10**9
+MAX_STEPS = 10**8
+"""Steps per run: more is refused up front as a likely typo (10⁸ steps of the 51-block wall take ~1 day)."""
 MAX_COUNT = 10**9
 
 # --------------------------------------------------------------------------------------------------
@@ -38,7 +39,8 @@ class RunConfig:
     """Time stepping and solver settings.
 
     duration : s, simulated time (0 < duration <= 1e5).
-    dt : s, time step (0 < dt <= duration).
+    dt : s, time step (0 < dt <= duration); duration must be a whole number of steps (within 1e-6 of
+        one), else the run would silently stop short of it. At most ``MAX_STEPS`` steps.
     theta : Moreau–Jean θ, in [0.5, 1].
     gravity : (gx, gy) m/s², a vector (tilt it for tilting tests).
     tolerance : NLGS convergence tolerance (relative quadratic norm of the impulse change), in (0, 1).
@@ -68,6 +70,15 @@ class RunConfig:
                 self.dt,
                 f"gives {self.duration / self.dt:.3g} steps for duration "
                 f"{format_value(self.duration)} (at most {MAX_STEPS:.0e})",
+            )
+        steps = self.duration / self.dt
+        if abs(steps - round(steps)) > 1e-6 * max(1.0, steps):
+            n = max(1, round(steps))
+            raise field_error(
+                "dt",
+                self.dt,
+                f"does not divide duration = {format_value(self.duration)} ({steps:.6g} steps); "
+                f"use dt = {self.duration / n:.6g} ({n} steps) or change the duration",
             )
         put("theta", check_real("theta", self.theta, ge=0.5, le=1.0))
         put("gravity", check_vector("gravity", self.gravity))
@@ -210,7 +221,7 @@ def scenario_from_geometry_file(path) -> Scenario:
     path = os.fspath(path)
     ctx = InputContext(path, os.path.dirname(os.path.abspath(path)))
     material = Material()
-    assembly = read_geometry(os.path.abspath(path), material.density, material.thickness, ctx)
+    assembly = read_geometry(path, material.density, material.thickness, ctx, where="")
     warnings = structure_warnings(assembly, ctx)
     return Scenario(
         name=Path(path).stem,

@@ -22,24 +22,30 @@ from masonrycli.values import field_error, quote_string
 GEOMETRY_SUFFIXES = (".geojson", ".json", ".wkt")
 
 
-def read_geometry(path: str, density: float, thickness: float, ctx: InputContext) -> Assembly:
+def read_geometry(
+    path: str, density: float, thickness: float, ctx: InputContext, where: str = "[structure]"
+) -> Assembly:
     """Blocks and supports of a GeoJSON or WKT file (``geometry_library.io``), with ``density`` and
-    ``thickness`` (the material's) as defaults."""
+    ``thickness`` (the material's) as defaults. ``where`` is the table naming the file ("" when the file
+    is the scenario itself: ``masonry run wall.geojson``)."""
     from geometry_library import io as geo_io
 
     suffix = Path(path).suffix.lower()
     if suffix not in GEOMETRY_SUFFIXES:
         raise ctx.error(
-            "[structure]",
+            where,
             f"file = {quote_string(path)}: unknown geometry format (expected {', '.join(GEOMETRY_SUFFIXES)})",
         )
     if not os.path.isfile(path):
-        raise ctx.error("[structure]", f"file = {quote_string(path)}: no such file")
+        raise ctx.error(where, f"file = {quote_string(path)}: no such file" if where else "no such file")
     reader = geo_io.read_wkt if suffix == ".wkt" else geo_io.read_geojson
     try:
         return reader(path, density=density, thickness=thickness)
     except (GeometryError, ValueError) as exc:
-        raise ctx.error("[structure]", one_line(exc)) from None
+        msg = one_line(exc)
+        if not where and msg.startswith(f"{path}:"):  # the reader named the file already
+            raise InputError(msg) from None
+        raise ctx.error(where, msg) from None
 
 
 def structure_warnings(assembly: Assembly, ctx: InputContext) -> tuple[str, ...]:

@@ -58,7 +58,7 @@ def test_overrides_reach_structure_loading_material_and_run():
         ("wall", {"freq": -2.0}, "--amp/--freq: frequency = -2.0: must be >= 0"),
         ("wall", {"density": 0.0, "friction": -1.0}, "--density: density = 0.0: must be > 0"),
         ("wall", {"dt": 2.0}, "--dt: dt = 2.0: must be <= duration (1.0)"),
-        ("wall", {"duration": 0.01, "dt": 0.02}, "options: dt = 0.02: must be <= duration (0.01)"),
+        ("wall", {"duration": 0.01, "dt": 0.02}, "--duration and --dt: dt = 0.02: must be <= duration (0.01)"),
         ("wall", {"blockz": 3}, 'builder "wall": unknown option "blockz" of builder "wall" (did you mean "blocks"?)'),
         ("tower", {}, "unknown built-in scenario 'tower' (expected one of wall, arch, aqueduct)"),
         ("wall", {"scale": 2.0}, "--scale: goes with --record (it multiplies the record)"),

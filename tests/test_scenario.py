@@ -148,7 +148,7 @@ ROUND_TRIP = """
 name = "odd \\"name\\" é \\\\ 1"
 
 [run]
-duration = 2.5
+duration = 2.4
 dt = 3.0000000000000004e-4
 theta = 0.7
 gravity = [1.2345678901234567, -9.81]

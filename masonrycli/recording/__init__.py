@@ -9,7 +9,14 @@
 - ``_rerun_private``: the only use of rerun's private API, kept small and explained there.
 """
 
-from masonrycli.recording.document import viewer_safe_text
+import os
+
+# Rerun's Rust side logs write failures as raw coloured lines on stderr; the recorder turns them into
+# OSError and the command line into one line of its own. Set before rerun is first imported; a user's
+# RUST_LOG wins.
+os.environ.setdefault("RUST_LOG", "off")
+
+from masonrycli.recording.document import viewer_safe_text  # noqa: E402
 from masonrycli.recording.layout import (
     COMPRESSION_RGBA,
     ENTITY_PATHS,

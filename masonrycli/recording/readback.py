@@ -3,11 +3,14 @@
 from __future__ import annotations
 
 import contextlib
+import errno
 import os
+import re
 import shutil
 import signal
 import socket
 import sys
+import tempfile
 import time
 import warnings
 
@@ -18,17 +21,64 @@ import rerun as rr
 from masonrycli.recording._rerun_private import viewer_pid
 from masonrycli.recording.layout import METADATA
 
+_TRUNCATED = re.compile(r"Message payload \(start (\d+), length \d+\) exceeds file size")
+_MESSAGE_HEADER_BYTES = 16  # an RRD message: kind (u64) and length (u64), then the payload
+
+
+def check_complete(path: str | os.PathLike) -> None:
+    """Raise ``OSError`` unless ``path`` is a whole recording with its footer (cheap: the footer says
+    where everything is). Rerun writes from its own thread and reports no error, so this is how a full
+    disk is noticed."""
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            reader = rr.chunk.RrdReader(os.fspath(path))
+            reader.store(store=reader.recordings()[0])
+    except Exception as exc:
+        folder = os.path.dirname(os.path.abspath(path))
+        cause = "the disk is full" if shutil.disk_usage(folder).free < 1 << 20 else str(exc).splitlines()[0]
+        raise OSError(errno.EIO, f"the recording is incomplete on disk ({cause})") from None
+
+
+def _open_reader(path: str, scratch: str) -> tuple[rr.chunk.RrdReader, bool]:
+    """A reader of ``path``; a file cut in the middle of a message (a killed writer, a full disk) is read
+    up to its last complete message, from a shortened copy in ``scratch``. Returns (reader, truncated)."""
+    source, truncated = path, False
+    for _ in range(8):
+        try:
+            with warnings.catch_warnings():  # a file without footer is reported as complete=False
+                warnings.simplefilter("ignore")
+                reader = rr.chunk.RrdReader(source)
+                reader.recordings()  # reads the file: a cut message raises here
+                return reader, truncated
+        except RuntimeError as exc:
+            cut = _TRUNCATED.search(str(exc))
+            if cut is None:
+                raise
+            end = max(0, int(cut.group(1)) - _MESSAGE_HEADER_BYTES)
+            shorter = os.path.join(scratch, f"prefix-{end}.rrd")
+            with open(source, "rb") as src, open(shorter, "wb") as dst:
+                dst.write(src.read(end))
+            source, truncated = shorter, True
+    raise ValueError(f"{path}: no complete message found")
+
 
 def inspect_recording(path: str | os.PathLike) -> dict:
-    """Summary of a recording file; works without a footer too (a killed writer's file).
+    """Summary of a recording file; works without a footer too (a killed writer's file) and on a file cut
+    in the middle of a message (read up to its last complete message).
 
     Keys: application_id, recording_id, frames (distinct `step` values), steps (first, last) or None,
     time_span (first, last sim_time, s) or None, entity_paths (sorted, with the leading "/"),
-    has_blueprint, complete (footer present), metadata (the run document's Markdown, or None).
+    has_blueprint, complete (footer present), truncated (cut in a message), metadata (the run document's
+    Markdown, or None).
     """
-    with warnings.catch_warnings():  # a file without footer is reported as complete=False below
+    with tempfile.TemporaryDirectory(prefix="masonry-inspect-") as scratch:
+        return _summarise(*_open_reader(os.fspath(path), scratch), path)
+
+
+def _summarise(reader: rr.chunk.RrdReader, truncated: bool, path) -> dict:
+    with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        reader = rr.chunk.RrdReader(os.fspath(path))
         recordings = reader.recordings()
     if not recordings:
         raise ValueError(f"{path}: no recording in this file")
@@ -65,6 +115,7 @@ def inspect_recording(path: str | os.PathLike) -> dict:
         "entity_paths": sorted(paths),
         "has_blueprint": bool(reader.blueprints()),
         "complete": complete,
+        "truncated": truncated,
         "metadata": metadata,
     }
 

@@ -15,8 +15,12 @@ median block height long; arrows are capped at two) and the principal-axis scale
 
 from __future__ import annotations
 
+import contextlib
+import errno
 import json
 import os
+import re
+import shutil
 import time
 import uuid
 import warnings
@@ -63,10 +67,29 @@ from masonrycli.recording.layout import (
     XY,
     build_blueprint,
 )
+from masonrycli.recording.readback import check_complete
 from masonrycli.recording.static_content import RecordingStatic, log_legend, log_plane, log_static
+from masonrycli.sinks import COMPLETED, FAILED, INTERRUPTED, RUNNING
 
 APPLICATION_ID: Final = "masonry"
 _RECORDING_NAMESPACE: Final = uuid.UUID("6f1c4f5e-9b0e-4c51-a0a6-3f0d6c1e2a77")
+FLUSH_SECONDS: Final = 1.0  # s of wall-clock time between writes to the file, once the scales are fixed
+
+
+@contextlib.contextmanager
+def _io_errors(path: str):
+    """Rerun reports a failed write (disk full) as ``RuntimeError('… (os error 28)')``: make it the
+    ``OSError`` it is, so the run stops as an output failure rather than an engine error."""
+    try:
+        yield
+    except RuntimeError as exc:  # only rerun's writes run in these blocks
+        code = re.search(r"\(os error (\d+)\)", str(exc))
+        if code is not None:
+            raise OSError(int(code.group(1)), os.strerror(int(code.group(1)))) from None
+        folder = os.path.dirname(os.path.abspath(path))
+        if shutil.disk_usage(folder).free < 1 << 20:  # the cause rerun's message lost
+            raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC)) from None
+        raise OSError(errno.EIO, f"rerun could not write the recording ({str(exc).splitlines()[0]})") from None
 
 
 class Recorder:
@@ -96,6 +119,7 @@ class Recorder:
         self.path, self.static, self.metadata = os.fspath(path), static, dict(metadata)
         self.batch_frames = max(1, int(batch_frames))
         self._t0, self._closed = time.perf_counter(), False
+        self._flushed = self._t0
         self._blocks = Polygons(static.block_vert_start, static.block_vert_local)
         self._supports = Polygons(static.support_vert_start, static.support_vert_local)
         self._triangles = np.asarray(static.triangles, dtype=np.intp).reshape(-1, 3)
@@ -118,21 +142,24 @@ class Recorder:
         self.recording_id = str(uuid.uuid5(_RECORDING_NAMESPACE, meta_json))
         self.rec = rr.RecordingStream(application_id, recording_id=self.recording_id)
         os.makedirs(os.path.dirname(os.path.abspath(self.path)), exist_ok=True)
-        self.rec.save(self.path, default_blueprint=build_blueprint(main_field))
-        log_static(self.rec, static, self._blocks, self._supports)
-        self._log_metadata("running", "")
+        with _io_errors(self.path):
+            self.rec.save(self.path, default_blueprint=build_blueprint(main_field))
+            log_static(self.rec, static, self._blocks, self._supports)
+            self._log_metadata(RUNNING, "")
 
     def __enter__(self) -> Recorder:
         return self
 
     def __exit__(self, exc_type, exc, tb) -> None:
         if exc_type is None or issubclass(exc_type, KeyboardInterrupt):
-            self.close("completed" if exc_type is None else "interrupted")
+            self.close(COMPLETED if exc_type is None else INTERRUPTED)
         else:
-            self.close("failed", f"{exc_type.__name__}: {exc}")
+            self.close(FAILED, f"{exc_type.__name__}: {exc}")
 
-    def log_frame(self, frame: Frame) -> None:
-        """Buffer one frame; sends the buffer when it holds ``batch_frames`` frames."""
+    def on_frame(self, frame: Frame) -> None:
+        """Buffer one frame (the :class:`~masonrycli.sinks.FrameSink` method); sends the buffer when it holds
+        ``batch_frames`` frames, or when ``FLUSH_SECONDS`` have passed and every scale is fixed (the scales
+        come from whole batches, so the recording's content does not depend on the machine's speed)."""
         if self._closed:
             raise RuntimeError("Recorder is closed")
         f64 = np.float64
@@ -162,8 +189,19 @@ class Recorder:
             b.add(key, _tensor(frame.tensors, key, self._n))
         self._last = (int(frame.step), float(frame.time))
         self._frames += 1
-        if len(b["step"]) >= self.batch_frames:
-            self.flush()
+        due = time.perf_counter() - self._flushed >= FLUSH_SECONDS and self._scales_fixed()
+        if len(b["step"]) >= self.batch_frames or due:
+            with _io_errors(self.path):
+                self.flush()
+                self.rec.flush()  # to the file: a killed run loses at most about FLUSH_SECONDS of frames
+            self._flushed = time.perf_counter()
+
+    log_frame = on_frame
+
+    def _scales_fixed(self) -> bool:
+        return (
+            len(self.field_ranges) == len(FIELDS) and self.force_scale is not None and len(self.axis_scale) == len(AXES)
+        )
 
     def flush(self) -> None:
         """Send the buffered frames now."""
@@ -171,27 +209,33 @@ class Recorder:
         if batch:
             self._send_batch(batch)
 
-    def close(self, status: str = "completed", note: str = "") -> None:
-        """Flush, write the final run document and disconnect (which writes the file's footer).
+    def close(self, status: str = COMPLETED, note: str = "") -> None:
+        """Flush, write the final run document and disconnect (which writes the file's footer), then read
+        the file's footer back: rerun's writer thread reports no I/O error, so a full disk shows only as a
+        file without one — raised as ``OSError``.
 
-        ``status``: "completed", "interrupted", "failed", "diverged"...; ``note``: one line, e.g.
+        ``status``: one of :data:`masonrycli.sinks.STATUSES`; ``note``: one line, e.g.
         "interrupted at t = 0.412 s (step 412)" (without a note, the last frame's time is given).
         """
         if self._closed:
             return
         self._closed = True
         error: Exception | None = None
-        try:
+        with _io_errors(self.path):
             try:
-                self.flush()
-            except Exception as err:  # keep going: the file must be complete
-                error = err
-                note = f"{note} (recording flush failed: {err!r})".strip()
-            self._log_metadata(status, note)
-        finally:
-            self.rec.disconnect()
+                try:
+                    self.flush()
+                except OSError:
+                    raise
+                except Exception as err:  # keep going: the file must be complete
+                    error = err
+                    note = f"{note} (recording flush failed: {err!r})".strip()
+                self._log_metadata(status, note)
+            finally:
+                self.rec.disconnect()
+        check_complete(self.path)
         if error is not None:
-            if status == "completed":
+            if status == COMPLETED:
                 raise error
             warnings.warn(f"recording flush failed while closing: {error!r}", RuntimeWarning, stacklevel=2)
 
@@ -204,7 +248,7 @@ class Recorder:
         q = b.stack("block_q")  # (F, N, 3)
         tensors = {key: b.stack(key) for key in TENSOR_KEYS}
         if self._fix_scales(tensors, b):
-            self._log_metadata("running", "")
+            self._log_metadata(RUNNING, "")
         verts = self._blocks.world(q)  # (F, V, 2)
         self._send_blocks(idx, verts, tensors)
         self._send_supports(idx, b.stack("support_q"))

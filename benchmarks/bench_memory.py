@@ -1,0 +1,64 @@
+"""Peak resident memory (RSS) of a whole `masonry` run against its length.
+
+The 51-block wall shaken at 1 m/s, 2 Hz, every step recorded (``--record-every 1``), with the recording
+and the history, for 1 s and for 20 s of simulated time (1 001 and 20 001 frames). Each run is its own
+process; its peak RSS comes from ``os.wait4`` (``ru_maxrss``, kB on Linux). The outputs are written to a
+temporary folder and removed. Accuracy is not at stake here (the same run, only longer): the history's
+last frame is checked to be at the requested time.
+
+    .venv/bin/python benchmarks/bench_memory.py [--durations 1 20]
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+
+def peak_rss(duration: float, folder: Path) -> tuple[float, float, int, float]:
+    """(peak RSS MB, wall time s, frames, output MB) of one run."""
+    rrd, npz = folder / f"w{duration:g}.rrd", folder / f"w{duration:g}.npz"
+    argv = [sys.executable, "-m", "masonrycli", "simulate", "wall", "--duration", f"{duration:g}"]
+    argv += ["--record-every", "1", "--out", str(rrd), "--history", str(npz)]
+    t0 = time.perf_counter()
+    proc = subprocess.Popen(argv, env=dict(os.environ, RERUN_ANALYTICS="0"), stdout=subprocess.DEVNULL)
+    _, status, usage = os.wait4(proc.pid, 0)
+    wall = time.perf_counter() - t0
+    if os.waitstatus_to_exitcode(status) != 0:
+        raise SystemExit(f"run of {duration:g} s failed")
+    h = np.load(npz)
+    assert abs(float(h["time"][-1]) - duration) < 1e-9, h["time"][-1]
+    size = (rrd.stat().st_size + npz.stat().st_size) / 1e6
+    frames = len(h["time"])
+    rrd.unlink()
+    npz.unlink()
+    return usage.ru_maxrss / 1024, wall, frames, size
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--durations", type=float, nargs="+", default=[1.0, 20.0])
+    args = parser.parse_args()
+    rows = []
+    with tempfile.TemporaryDirectory(prefix="masonry-bench-memory-") as tmp:
+        peak_rss(0.01, Path(tmp))  # numba cache warm, not measured
+        for duration in args.durations:
+            rows.append((duration, *peak_rss(duration, Path(tmp))))
+    print(f"load average {os.getloadavg()[0]:.1f}; 51-block wall, --record-every 1, recording + history")
+    print("| simulated | frames | outputs | wall time | peak RSS |")
+    print("|---|---|---|---|---|")
+    for duration, rss, wall, frames, size in rows:
+        print(f"| {duration:g} s | {frames} | {size:.0f} MB | {wall:.0f} s | {rss:.0f} MB |")
+    if len(rows) >= 2:
+        print(f"peak RSS ratio {rows[-1][0]:g} s / {rows[0][0]:g} s: {rows[-1][1] / rows[0][1]:.2f}")
+
+
+if __name__ == "__main__":
+    main()

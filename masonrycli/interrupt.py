@@ -1,0 +1,80 @@
+"""Ctrl-C (SIGINT) and SIGTERM, handled in one place for the whole run.
+
+Three phases, because what a signal may safely do depends on what is under way:
+
+- **setup** (model, first numba compile, output files opened): nothing is computed yet, so the signal
+  raises :class:`StopRun` at once — the caller removes its temporary files and exits;
+- **stepping**: the signal only sets :attr:`StopSignals.signum`; the time loop polls :meth:`requested`
+  after each step, so the step in progress finishes and every frame handed to the sinks is whole;
+- **closing** (files being finished and renamed): further signals are counted and acknowledged on stderr,
+  never raised, so a second Ctrl-C or a ``kill`` during shutdown cannot lose a file.
+
+Outside the main thread (where Python cannot install handlers) the context does nothing.
+"""
+
+from __future__ import annotations
+
+import os
+import signal
+import threading
+
+SIGNALS = (signal.SIGINT, signal.SIGTERM)
+
+
+class StopRun(BaseException):
+    """A stop signal arrived before the first step (not an ``Exception``: nothing should swallow it)."""
+
+    def __init__(self, signum: int):
+        super().__init__(signal.Signals(signum).name)
+        self.signum = signum
+
+
+def exit_code(signum: int) -> int:
+    """The shell convention for a process stopped by a signal: 128 + its number (130 SIGINT, 143 SIGTERM)."""
+    return 128 + int(signum)
+
+
+def signal_name(signum: int) -> str:
+    return "Ctrl-C" if signum == signal.SIGINT else signal.Signals(signum).name
+
+
+class StopSignals:
+    """Context manager installing the handlers; starts in the setup phase."""
+
+    def __init__(self) -> None:
+        self.signum: int | None = None
+        self.phase = "setup"
+        self.repeats = 0
+        self._previous: dict[int, object] = {}
+
+    def __enter__(self) -> StopSignals:
+        if threading.current_thread() is threading.main_thread():
+            for sig in SIGNALS:
+                self._previous[sig] = signal.signal(sig, self._handle)
+        return self
+
+    def __exit__(self, *exc) -> None:
+        for sig, handler in self._previous.items():
+            signal.signal(sig, handler)
+        self._previous.clear()
+
+    def stepping(self) -> None:
+        """From now on a signal asks the time loop to stop after its current step."""
+        self.phase = "stepping"
+
+    def closing(self) -> None:
+        """From now on signals are acknowledged and otherwise ignored until the files are closed."""
+        self.phase = "closing"
+
+    def requested(self) -> bool:
+        return self.signum is not None
+
+    def _handle(self, signum, _frame) -> None:
+        if self.signum is None:
+            self.signum = signum
+            if self.phase == "setup":
+                raise StopRun(signum)
+            return
+        self.repeats += 1
+        # os.write: no buffered I/O inside a signal handler (it may interrupt a print).
+        os.write(2, f"{signal_name(signum)}: already stopping — finishing the output files\n".encode())

@@ -1,0 +1,180 @@
+"""Output files: checked before step 1, written under a temporary name, renamed into place when complete.
+
+The policy (README, "Outputs and overwriting"):
+
+- An explicit path (``--out``, ``--history``, ``build --out``) that already exists is refused, exit 2,
+  unless ``--force`` is given. Two outputs naming the same file are refused.
+- Default recording names ``recordings/<name>-<YYYYmmdd-HHMMSS>.rrd`` never collide: a name already on
+  disk, or being written by another run, takes ``-2``, ``-3``… Scenario names are reduced to
+  ``[A-Za-z0-9._-]`` so they cannot leave ``recordings/``.
+- Every file is written as a hidden ``.<name>.<pid>.part`` beside its target and renamed onto it when
+  complete, so the path holds either the previous file or a complete new one, whatever happens to the
+  process. Without ``--force`` the rename cannot replace a file that appeared during the run either (a hard
+  link fails if the target exists): the new file then takes the next free ``-k`` name.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import re
+import shutil
+from dataclasses import dataclass
+from datetime import datetime
+from pathlib import Path
+
+from masonrycli.errors import InputError
+
+RECORDINGS_DIR = Path("recordings")
+
+_UNSAFE = re.compile(r"[^A-Za-z0-9._-]+")
+
+
+def safe_name(name: str) -> str:
+    """A scenario name as a file-name stem that stays in its folder: ``../../x`` → ``x``, ``a b`` → ``a-b``."""
+    stem = _UNSAFE.sub("-", str(name)).strip(".-")
+    return re.sub(r"\.{2,}", ".", stem)[:80] or "run"
+
+
+def part_path(path: Path) -> Path:
+    """The temporary name ``path`` is written under by this process."""
+    return path.with_name(f".{path.name}.{os.getpid()}.part")
+
+
+def _being_written(path: Path) -> bool:
+    return any(path.parent.glob(f".{glob_escape(path.name)}.*.part")) if path.parent.is_dir() else False
+
+
+def glob_escape(text: str) -> str:
+    return re.sub(r"([*?\[])", r"[\1]", text)
+
+
+def _numbered(path: Path, k: int) -> Path:
+    return path if k == 1 else path.with_name(f"{path.stem}-{k}{path.suffix}")
+
+
+def free_name(path: Path) -> Path:
+    """``path``, or the first ``stem-k.suffix`` (k = 2, 3…) that neither exists nor is being written."""
+    k = 1
+    while _numbered(path, k).exists() or _being_written(_numbered(path, k)):
+        k += 1
+    return _numbered(path, k)
+
+
+def default_recording_path(name: str, folder: Path = RECORDINGS_DIR) -> Path:
+    """``recordings/<safe name>-<timestamp>.rrd``, numbered if a run of the same second has it."""
+    stamp = datetime.now().strftime("%Y%m%d-%H%M%S")
+    return free_name(folder / f"{safe_name(name)}-{stamp}.rrd")
+
+
+@dataclass(eq=False)
+class OutputFile:
+    """One output: its final ``path``, the ``part`` file being written and whether it may replace a file."""
+
+    path: Path
+    option: str
+    """The option that named it ("--out", "--history"), for messages."""
+    force: bool = False
+    default_name: bool = False
+
+    @property
+    def part(self) -> Path:
+        return part_path(self.path)
+
+    def commit(self) -> Path:
+        """Rename the complete ``part`` file onto ``path`` (see the module docstring); returns where it went."""
+        if self.force:
+            os.replace(self.part, self.path)
+            return self.path
+        target = self.path
+        while True:
+            try:
+                os.link(self.part, target)
+            except FileExistsError:
+                target = free_name(target)
+                continue
+            except OSError:  # no hard links on this file system: check, then rename
+                if target.exists():
+                    target = free_name(target)
+                    continue
+                os.replace(self.part, target)
+                break
+            os.unlink(self.part)
+            break
+        self.path = target
+        return target
+
+    def discard(self) -> None:
+        """Remove the temporary file (and a history's temporary folder), if any."""
+        with contextlib.suppress(FileNotFoundError):
+            os.unlink(self.part)
+        shutil.rmtree(self.part.with_name(self.part.name + ".rows"), ignore_errors=True)  # a history's rows
+
+
+def check_output(path: Path, option: str, suffix: str, force: bool, *, default_name: bool = False) -> OutputFile:
+    """Check ``path`` before anything is computed: suffix, not a folder, not existing (unless ``force``),
+    its folder creatable and writable. Raises :class:`InputError` naming the option and the path."""
+    where = f"{option} {path}"
+    if path.suffix.lower() != suffix:
+        raise InputError(f"{where}: the file name must end in {suffix}")
+    if path.is_dir():
+        raise InputError(f"{where}: is a folder")
+    if path.exists() and not force:
+        raise InputError(f"{where}: the file exists (add --force to replace it)")
+    if path.exists() and not os.access(path, os.W_OK):
+        raise InputError(f"{where}: the file exists and is read-only")
+    folder = path.parent
+    existing = next((p for p in (folder, *folder.parents) if p.exists()), Path("."))
+    if not existing.is_dir():
+        raise InputError(f"{where}: {existing} is not a folder")
+    if not os.access(existing, os.W_OK | os.X_OK):
+        raise InputError(f"{where}: cannot write in {existing} (permission denied)")
+    return OutputFile(path, option, force=force, default_name=default_name)
+
+
+def check_distinct(*outputs: OutputFile | None) -> None:
+    """Two outputs naming the same file is an error (one would replace the other)."""
+    seen: dict[str, OutputFile] = {}
+    for out in outputs:
+        if out is None:
+            continue
+        key = os.path.realpath(out.path)
+        if key in seen:
+            raise InputError(f"{seen[key].option} and {out.option} name the same file {out.path}")
+        seen[key] = out
+
+
+def open_part(out: OutputFile) -> None:
+    """Create the output's folder and its empty ``part`` file (O_EXCL): proves the folder is writable
+    before step 1. Raises :class:`InputError` naming the option, the path and the cause."""
+    try:
+        out.path.parent.mkdir(parents=True, exist_ok=True)
+        fd = os.open(out.part, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o644)
+        os.close(fd)
+    except OSError as exc:
+        raise InputError(f"{out.option} {out.path}: cannot write: {exc.strerror or exc}") from None
+
+
+def check_space(outputs: list[tuple[OutputFile, int]]) -> None:
+    """Refuse a run whose outputs (estimated bytes each) would not fit in the free space of their disk."""
+    need: dict[int, tuple[int, list[str], str]] = {}
+    for out, size in outputs:
+        folder = next(p for p in (out.path.parent, *out.path.parent.parents) if p.exists())
+        dev = os.stat(folder).st_dev
+        total, names, _ = need.get(dev, (0, [], str(folder)))
+        need[dev] = (total + size, [*names, f"{out.option} {out.path}"], str(folder))
+    for total, names, folder in need.values():
+        free = shutil.disk_usage(folder).free
+        if total > free:
+            raise InputError(
+                f"{' and '.join(names)}: the run would write about {human_bytes(total)} but {folder} has "
+                f"{human_bytes(free)} free (shorten --duration or raise --record-every)"
+            )
+
+
+def human_bytes(n: float) -> str:
+    for unit in ("B", "kB", "MB", "GB", "TB"):
+        if abs(n) < 1000 or unit == "TB":
+            return f"{n:.0f} {unit}" if unit == "B" else f"{n:.1f} {unit}"
+        n /= 1000
+    return f"{n:.1f} TB"  # pragma: no cover

@@ -1,0 +1,106 @@
+"""Signals on a real process running the 248-block wall: Ctrl-C, SIGTERM and a double Ctrl-C leave a history
+and a recording that load and agree on the frame count; SIGKILL leaves the previous file at the path."""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from masonrycli.interrupt import StopRun, StopSignals, exit_code
+
+
+def start(tmp_path: Path, *extra: str) -> tuple[subprocess.Popen, Path, Path]:
+    rrd, npz = tmp_path / "w.rrd", tmp_path / "w.npz"
+    argv = ["simulate", "wall", "--blocks", "248", "--duration", "20", "--out", str(rrd), "--history", str(npz)]
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "masonrycli", *argv, *extra],
+        env=dict(os.environ, RERUN_ANALYTICS="0"),
+        stdout=subprocess.PIPE,
+        stderr=subprocess.STDOUT,
+        text=True,
+    )
+    return proc, rrd, npz
+
+
+def wait_for_frames(proc: subprocess.Popen, folder: Path, frames: int = 3, timeout: float = 60) -> None:
+    """Until the history's scratch rows hold ``frames`` frames of ``block_q`` (248 × 3 float64 each)."""
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        rows = list(folder.glob(".w.npz.*.part.rows/block_q.raw"))
+        if rows and rows[0].stat().st_size >= 248 * 3 * 8 * frames:
+            return
+        assert proc.poll() is None, proc.stdout.read()
+        time.sleep(0.1)
+    raise AssertionError("no frames within the timeout")
+
+
+def frames_in_recording(rrd: Path) -> int:
+    from masonrycli.recording import inspect_recording
+
+    info = inspect_recording(rrd)
+    assert info["complete"] and info["application_id"] == "masonry"
+    return info["frames"]
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize(
+    "signals, code",
+    [((signal.SIGINT,), 130), ((signal.SIGTERM,), 143), ((signal.SIGINT, signal.SIGINT), 130)],
+    ids=["sigint", "sigterm", "double-sigint"],
+)
+def test_signal_leaves_history_and_recording(signals, code, tmp_path):
+    """Finding 5: SIGTERM wrote no history and printed nothing; two Ctrl-C 50 ms apart lost the history."""
+    proc, rrd, npz = start(tmp_path)
+    wait_for_frames(proc, tmp_path)
+    for sig in signals:
+        proc.send_signal(sig)
+        time.sleep(0.05)
+    out, _ = proc.communicate(timeout=120)
+    assert proc.returncode == code, out
+    assert "Traceback" not in out and "completed" not in out
+    assert "interrupted at t = " in out
+    h = np.load(npz)
+    assert str(h["status"]) == "interrupted"
+    assert 0 < h["time"][-1] < 20
+    assert frames_in_recording(rrd) == len(h["time"]) >= 3
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["w.npz", "w.rrd"]  # no temporary file left
+
+
+@pytest.mark.slow
+def test_sigkill_keeps_the_previous_file(tmp_path):
+    """Finding 5: SIGKILL destroyed the previous recording at the same path (it was written in place)."""
+    rrd = tmp_path / "w.rrd"
+    rrd.write_bytes(b"the previous recording")
+    proc, rrd, npz = start(tmp_path, "--force")
+    wait_for_frames(proc, tmp_path)
+    proc.kill()
+    proc.communicate(timeout=60)
+    assert rrd.read_bytes() == b"the previous recording"
+    assert not npz.exists()
+
+
+def test_stop_signals_phases():
+    """Setup: a signal raises StopRun; stepping: it is only noted; closing: repeats are counted, never raised."""
+    with StopSignals() as stop:
+        with pytest.raises(StopRun) as info:
+            os.kill(os.getpid(), signal.SIGTERM)
+            time.sleep(0.1)  # the handler runs between bytecodes
+        assert exit_code(info.value.signum) == 143
+    with StopSignals() as stop:
+        stop.stepping()
+        os.kill(os.getpid(), signal.SIGINT)
+        time.sleep(0.1)
+        assert stop.requested() and stop.signum == signal.SIGINT
+        stop.closing()
+        os.kill(os.getpid(), signal.SIGINT)
+        os.kill(os.getpid(), signal.SIGTERM)
+        time.sleep(0.1)
+        assert stop.repeats == 2 and stop.signum == signal.SIGINT
+    assert signal.getsignal(signal.SIGINT) is signal.default_int_handler

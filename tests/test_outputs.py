@@ -1,0 +1,239 @@
+"""Output files: nothing overwritten without --force, default names that never collide, paths checked
+before step 1, temporary files renamed into place, and the findings of issue 11 about them."""
+
+from __future__ import annotations
+
+import errno
+import json
+import os
+from pathlib import Path
+
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+from masonrycli.cli import app
+from masonrycli.outputs import OutputFile, default_recording_path, free_name, open_part, part_path, safe_name
+
+DATA = Path(__file__).parent / "data"
+COLUMN = DATA / "validation" / "column5.toml"
+
+
+def invoke(*args):
+    return CliRunner().invoke(app, [str(a) for a in args])
+
+
+def leftovers(folder: Path) -> list[str]:
+    return sorted(p.name for p in folder.rglob("*") if ".part" in p.name)
+
+
+@pytest.mark.parametrize(
+    "name, stem", [("../../x", "x"), ("a b/c", "a-b-c"), ("..", "run"), ("wall", "wall"), ("/etc/passwd", "etc-passwd")]
+)
+def test_safe_name_stays_in_its_folder(name, stem):
+    assert safe_name(name) == stem
+    assert Path("recordings", safe_name(name)).resolve().parent == Path("recordings").resolve()
+
+
+def test_scenario_name_cannot_leave_recordings(tmp_path, monkeypatch):
+    """Finding 2: name = "../../x" wrote outside recordings/."""
+    work = tmp_path / "a" / "b"
+    work.mkdir(parents=True)
+    monkeypatch.chdir(work)
+    (work / "s.toml").write_text('name = "../../x"\n' + COLUMN.read_text())
+    result = invoke("run", "s.toml", "--duration", 0.01)
+    assert result.exit_code == 0, result.output
+    written = [p for p in tmp_path.rglob("*.rrd")]
+    assert len(written) == 1 and written[0].parent == work / "recordings", written
+    assert written[0].name.startswith("x-")
+
+
+def test_default_names_of_the_same_second_differ(tmp_path):
+    """Finding 2: two runs started in the same second took the same default name; one recording was lost."""
+    first = OutputFile(default_recording_path("wall", tmp_path), "--out", default_name=True)
+    open_part(first)  # the first run is writing
+    second = OutputFile(default_recording_path("wall", tmp_path), "--out", default_name=True)
+    assert second.path != first.path and second.path.name.endswith("-2.rrd")
+    # Even if two runs took the same name, the second rename does not replace the first file.
+    for text in (b"one", b"two"):
+        out = OutputFile(first.path, "--out", default_name=True)
+        out.part.write_bytes(text)
+        out.commit()
+    assert first.path.read_bytes() == b"one"
+    assert first.path.with_name(first.path.stem + "-2.rrd").read_bytes() == b"two"
+
+
+def test_two_runs_in_the_same_second_keep_both_recordings(tmp_path, monkeypatch):
+    import masonrycli.outputs as outputs
+
+    class Frozen:
+        @staticmethod
+        def now():
+            from datetime import datetime
+
+            return datetime(2026, 1, 2, 3, 4, 5)
+
+    monkeypatch.setattr(outputs, "datetime", Frozen)
+    monkeypatch.chdir(tmp_path)
+    for _ in range(2):
+        assert invoke("run", COLUMN, "--duration", 0.01).exit_code == 0
+    names = sorted(p.name for p in (tmp_path / "recordings").iterdir())
+    assert names == ["column5-20260102-030405-2.rrd", "column5-20260102-030405.rrd"], names
+
+
+def test_existing_outputs_are_kept_unless_force(tmp_path):
+    """Finding 2: an existing --out, --history or build --out file was overwritten without a word."""
+    rrd, npz, geo = tmp_path / "r.rrd", tmp_path / "h.npz", tmp_path / "w.geojson"
+    for path in (rrd, npz, geo):
+        path.write_bytes(b"previous")
+    assert invoke("run", COLUMN, "--duration", 0.01, "--out", rrd).exit_code == 2
+    assert invoke("run", COLUMN, "--duration", 0.01, "--no-recording", "--history", npz).exit_code == 2
+    assert invoke("build", "wall", "--out", geo).exit_code == 2
+    assert all(p.read_bytes() == b"previous" for p in (rrd, npz, geo))
+    result = invoke("run", COLUMN, "--duration", 0.01, "--out", rrd, "--history", npz, "--force")
+    assert result.exit_code == 0, result.output
+    assert np.load(npz)["block_q"].shape[0] == 2 and rrd.read_bytes()[:4] != b"prev"
+    assert invoke("build", "wall", "--out", geo, "--force").exit_code == 0
+    assert len(json.loads(geo.read_text())["features"]) == 52
+    assert leftovers(tmp_path) == []
+
+
+def test_out_and_history_naming_one_file_is_refused(tmp_path):
+    """Finding 2: --out X.rrd --history X.rrd replaced the recording with the history and exited 0."""
+    x = tmp_path / "x.rrd"
+    result = invoke("run", COLUMN, "--duration", 0.01, "--out", x, "--history", x)
+    assert result.exit_code == 2 and not x.exists()
+
+
+def test_unwritable_history_is_found_before_any_computing(tmp_path, monkeypatch):
+    """Finding 4: an unwritable --history was found only after the whole run (exit 1, frames lost)."""
+    import masonrycli.run as run_module
+
+    def no_run(*args, **kwargs):
+        raise AssertionError("the run started")
+
+    monkeypatch.setattr(run_module.Simulation, "__init__", no_run)
+    blocker = tmp_path / "file"
+    blocker.write_text("")
+    for args in (("--no-recording", "--history", blocker / "h.npz"), ("--out", blocker / "r.rrd")):
+        result = invoke("run", COLUMN, "--duration", 0.01, *args)
+        assert result.exit_code == 2, result.output
+        assert "is not a folder" in result.output and len(result.output.strip().splitlines()) == 1
+
+
+def test_unwritable_folder_found_when_the_temporary_file_is_created(tmp_path, monkeypatch):
+    """Permissions are checked by creating the temporary file (root passes os.access checks)."""
+    import masonrycli.outputs as outputs
+
+    def denied(*args, **kwargs):
+        raise PermissionError(errno.EACCES, "Permission denied")
+
+    monkeypatch.setattr(outputs.os, "open", denied)
+    result = invoke("run", COLUMN, "--duration", 0.01, "--no-recording", "--history", tmp_path / "h.npz")
+    assert result.exit_code == 2, result.output
+    assert f"--history {tmp_path / 'h.npz'}: cannot write: Permission denied" in result.output
+    assert leftovers(tmp_path) == []
+
+
+def test_commit_replaces_only_with_force(tmp_path):
+    target = tmp_path / "a.npz"
+    target.write_bytes(b"old")
+    out = OutputFile(target, "--history", force=True)
+    open_part(out)
+    out.part.write_bytes(b"new")
+    assert out.commit() == target and target.read_bytes() == b"new"
+    assert not part_path(target).exists()
+    assert free_name(target) == tmp_path / "a-2.npz"
+
+
+def test_last_line_opens_the_recording(tmp_path):
+    """Finding 12: the README says the last line of a run is the command that opens the recording."""
+    rrd = tmp_path / "w.rrd"
+    result = invoke("simulate", "wall", "--duration", 0.11, "--out", rrd)
+    assert result.exit_code == 0, result.output
+    last = result.output.strip().splitlines()[-1]
+    assert last.startswith("Open the recording:") and last.endswith(f"rerun {rrd}"), last
+
+
+def test_courses_and_length_choose_the_wall(tmp_path):
+    """Finding 8: --courses/--length without --blocks always failed ("51 blocks cannot be laid…")."""
+    npz = tmp_path / "h.npz"
+    result = invoke(
+        "simulate", "wall", "--courses", 8, "--length", 3, "--duration", 0.01, "--no-recording", "--history", npz
+    )
+    assert result.exit_code == 0, result.output
+    assert np.load(npz)["block_q"].shape[1] == 8 * 10 + 4  # 8 courses of 10 blocks, half blocks on 4 of them
+    geo = tmp_path / "w.geojson"
+    assert invoke("build", "wall", "--courses", 4, "--length", 1.2, "--out", geo).exit_code == 0
+    roles = [f["properties"]["role"] for f in json.loads(geo.read_text())["features"]]
+    assert roles.count("block") == 4 * 4 + 2
+
+
+def test_check_reads_geometry_files_like_run(tmp_path, monkeypatch):
+    """Finding 7: `masonry check a.geojson` answered "TOML syntax error"."""
+    monkeypatch.chdir(tmp_path)
+    assert invoke("build", "wall", "--out", "a.geojson").exit_code == 0
+    result = invoke("check", "a.geojson", "--duration", 0.5, "--history", "h.npz")
+    assert result.exit_code == 0, result.output
+    assert "51" in result.output and "500 steps" in result.output and "h.npz" in result.output
+    assert not (tmp_path / "h.npz").exists()
+
+
+def test_wkt_nan_prints_no_warning(tmp_path):
+    """Finding 10: WKT with a NaN printed shapely's RuntimeWarning and a source line before the error."""
+    import warnings
+
+    from geometry_library.blocks import GeometryError
+    from geometry_library.io import read_wkt
+
+    path = tmp_path / "n.wkt"
+    path.write_text("POLYGON ((0 0, nan 0, 1 1, 0 1, 0 0))\n")
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        with pytest.raises(GeometryError, match="NaN"):
+            read_wkt(path)
+    assert [str(w.message) for w in caught] == []
+
+
+def test_dt_not_dividing_the_duration_is_reported():
+    """Finding 11: --dt 0.3 --duration 1 silently ran 3 steps and stopped at t = 0.9 s."""
+    result = invoke("run", COLUMN, "--duration", 1, "--dt", 0.3, "--no-recording")
+    assert result.exit_code == 2
+    assert "dt = 0.3: does not divide duration = 1.0" in result.output and "0.333333 (3 steps)" in result.output
+    assert invoke("run", COLUMN, "--duration", 0.9, "--dt", 0.3, "--no-recording").exit_code == 0
+
+
+def test_outputs_that_would_not_fit_are_refused(tmp_path, monkeypatch):
+    """Finding 6: a run whose outputs cannot fit on the disk is refused before it starts, with the estimate."""
+    import shutil
+
+    import masonrycli.outputs as outputs
+
+    monkeypatch.setattr(outputs.shutil, "disk_usage", lambda p: shutil._ntuple_diskusage(10**9, 10**9 - 10**6, 10**6))
+    result = invoke("simulate", "wall", "--duration", 20, "--record-every", 1, "--history", tmp_path / "h.npz")
+    assert result.exit_code == 2, result.output
+    assert "the run would write about" in result.output and "1.0 MB free" in result.output
+    assert leftovers(tmp_path) == [] and not (tmp_path / "recordings").exists()
+
+
+def test_history_write_failure_stops_the_run(tmp_path, monkeypatch):
+    """Finding 3 (history side): disk full on the history exited 1 and left h.npz.tmp.npz behind. Now: exit
+    4, one line naming the file and the cause, never "completed", no temporary file, the recording kept."""
+    from masonrycli.history import HistoryFile
+
+    original = HistoryFile.on_frame
+
+    def full_disk(self, frame):
+        if self.frames == 3:
+            raise OSError(errno.ENOSPC, "No space left on device")
+        original(self, frame)
+
+    monkeypatch.setattr(HistoryFile, "on_frame", full_disk)
+    rrd, npz = tmp_path / "r.rrd", tmp_path / "h.npz"
+    result = invoke("simulate", "wall", "--duration", 0.1, "--out", rrd, "--history", npz)
+    assert result.exit_code == 4, result.output
+    assert "completed" not in result.output
+    assert f"cannot write --history {npz}: stopped at t = 0.0300 s (step 30): No space left on device" in result.output
+    assert not npz.exists() and leftovers(tmp_path) == []
+    assert rrd.exists()  # what was computed is kept where possible
+    assert os.listdir(tmp_path) == ["r.rrd"]

@@ -1,0 +1,78 @@
+"""The recording as an output: a failed write stops the run (exit 4, never "completed"), a file without its
+footer is noticed at close, and ``inspect`` reads a truncated file up to its last complete chunk."""
+
+from __future__ import annotations
+
+import errno
+import shutil
+
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+from masonrycli.cli import app
+from masonrycli.recording.readback import check_complete, inspect_recording
+
+
+def invoke(*args):
+    return CliRunner().invoke(app, [str(a) for a in args])
+
+
+@pytest.fixture(scope="module")
+def recording(tmp_path_factory):
+    rrd = tmp_path_factory.mktemp("rec") / "w.rrd"
+    result = invoke("simulate", "wall", "--duration", 0.3, "--record-every", 1, "--out", rrd)
+    assert result.exit_code == 0, result.output
+    return rrd
+
+
+def test_full_disk_at_the_recorder_stops_the_run(tmp_path, monkeypatch):
+    """Finding 3: disk full while recording exited 0 with "completed" and an unreadable .rrd. Rerun's writer
+    reports ENOSPC as a RuntimeError from its flush: injected there, the run stops with exit 4, one line
+    naming the file and the cause, the history kept (status "failed"), no temporary file."""
+    from masonrycli.recording.recorder import Recorder
+
+    original = Recorder.flush
+
+    def full_disk(self):
+        if self._frames > 150:
+            raise RuntimeError("Failed to encode LogMsg: Failed to write: No space left on device (os error 28)")
+        original(self)
+
+    monkeypatch.setattr(Recorder, "flush", full_disk)
+    rrd, npz = tmp_path / "w.rrd", tmp_path / "h.npz"
+    result = invoke("simulate", "wall", "--duration", 0.3, "--record-every", 1, "--out", rrd, "--history", npz)
+    assert result.exit_code == 4, result.output
+    assert "completed" not in result.output
+    line = next(ln for ln in result.output.splitlines() if ln.startswith("error:"))
+    assert line.startswith(f"error: cannot write --out {rrd}: ") and line.endswith("No space left on device"), line
+    assert not rrd.exists() and sorted(p.name for p in tmp_path.iterdir()) == ["h.npz"]
+    h = np.load(npz)
+    assert str(h["status"]) == "failed" and 150 <= h["step"][-1] <= 300
+
+
+def test_a_recording_without_footer_is_noticed(recording, tmp_path):
+    check_complete(recording)  # a whole file passes
+    cut = tmp_path / "cut.rrd"
+    cut.write_bytes(recording.read_bytes()[: recording.stat().st_size * 2 // 3])
+    with pytest.raises(OSError) as info:
+        check_complete(cut)
+    assert info.value.errno == errno.EIO and "incomplete on disk" in str(info.value)
+
+
+def test_inspect_reads_a_truncated_recording(recording, tmp_path):
+    """Finding 9: `masonry inspect` could not read a truncated recording — the file a kill or a full disk leaves."""
+    whole = inspect_recording(recording)
+    assert whole["frames"] == 301 and whole["complete"] and not whole["truncated"]
+    cut = tmp_path / "cut.rrd"
+    with open(recording, "rb") as src, open(cut, "wb") as dst:
+        dst.write(src.read(recording.stat().st_size * 2 // 3))
+    info = inspect_recording(cut)
+    assert info["truncated"] and not info["complete"] and 0 < info["frames"] < whole["frames"]
+    assert info["steps"] == (0, info["frames"] - 1)
+    result = invoke("inspect", cut)
+    assert result.exit_code == 0, result.output
+    assert f"truncated (its writer did not finish: killed, or the disk was full) — {info['frames']} frames" in (
+        " ".join(result.output.split())
+    )
+    shutil.rmtree(tmp_path)
