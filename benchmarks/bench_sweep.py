@@ -1,7 +1,7 @@
 """Sweep benchmark: speed-up of a study on a LocalCluster over the same runs one by one, and the
 per-task overhead of going through Dask. Run with ``.venv/bin/python benchmarks/bench_sweep.py``.
 
-* **speed-up** — ``--tasks`` runs of the 12-block wall (amp swept, ``--duration`` s each) made serially
+* **speed-up** — ``--tasks`` runs of the 51-block wall (amp swept, ``--duration`` s each) made serially
   in this process vs on a LocalCluster of ``--workers`` single-threaded worker processes (cluster
   start excluded: it is reported apart; the numba cache is warm in both). Repeats are interleaved
   (serial, cluster, serial, cluster, ...) and the minimum wall time of each is kept.
@@ -38,7 +38,7 @@ COMPARED += ("steps", "sweeps_mean")
 
 def study_base(duration: float) -> StudyBase:
     motions = {"ground": Sine(amplitude=1.0, frequency=2.0)}
-    return StudyBase(scenario_from_builder("wall", {"blocks": 12}, RunConfig(duration=duration), Material(), motions))
+    return StudyBase(scenario_from_builder("wall", {"blocks": 51}, RunConfig(duration=duration), Material(), motions))
 
 
 def timed(run, base, axes) -> tuple[float, list[dict]]:
@@ -77,6 +77,10 @@ def main() -> None:
         t, cluster_rows = timed(on_cluster, base, axes)
         cluster_times.append(t)
     identical = all(all(a[k] == b[k] for k in COMPARED) for a, b in zip(serial_rows, cluster_rows))
+    # a task's own wall time: the same in both modes on idle cores; longer on the workers when the
+    # machine's other processes take the cores (then no speed-up can show)
+    task_serial = sum(r["wall_time"] for r in serial_rows) / len(serial_rows)
+    task_cluster = sum(r["wall_time"] for r in cluster_rows) / len(cluster_rows)
 
     tiny = study_base(1e-3)
     tiny_axes = [parse_axis(f"amp=0.1:1.0:{args.tiny}")]
@@ -95,6 +99,8 @@ def main() -> None:
         "cluster_s": min(cluster_times),
         "speedup": min(serial_times) / min(cluster_times),
         "rows_identical": identical,
+        "task_wall_serial_s": task_serial,
+        "task_wall_on_worker_s": task_cluster,
         "cluster_start_s": cluster_start,
         "worker_warm_up_s": warm_up,
         "tiny_tasks": len(grid(tiny_axes)),
@@ -102,9 +108,10 @@ def main() -> None:
         "tiny_serial_ms_per_task": 1e3 * tiny_serial / len(grid(tiny_axes)),
         "tiny_cluster_ms_per_task": 1e3 * tiny_cluster / len(grid(tiny_axes)),
     }
-    print(f"{args.tasks} runs of the 12-block wall, {args.duration:g} s each, {args.workers} workers")
+    print(f"{args.tasks} runs of the 51-block wall, {args.duration:g} s each, {args.workers} workers")
     print(f"  serial {res['serial_s']:.2f} s, cluster {res['cluster_s']:.2f} s: speed-up {res['speedup']:.2f}x")
     print(f"  rows identical to the serial runs: {identical}")
+    print(f"  one task's own wall time: {task_serial:.2f} s in process, {task_cluster:.2f} s on a worker")
     print(f"  cluster start {cluster_start:.1f} s, workers' first task (numba cache load) {warm_up:.1f} s")
     print(
         f"  per-task overhead: {res['overhead_ms_per_task']:.1f} ms ({res['tiny_tasks']} one-step tasks: "

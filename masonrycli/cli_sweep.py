@@ -62,6 +62,9 @@ def sweep_command(
     ] = "pga",
     plot: Annotated[Path | None, typer.Option("--plot", help="PNG of the state map / fragility / thresholds.")] = None,
     recording: Annotated[Path | None, typer.Option("--recording", help="Rerun recording of the study (.rrd).")] = None,
+    histories: Annotated[
+        Path | None, typer.Option("--histories", help="Folder for one history (.npz) per run, e.g. amp=0.5_freq=2.npz.")
+    ] = None,
 ) -> None:
     """Run a structure over a grid of parameters or a set of records on Dask; one row per run.
 
@@ -105,6 +108,7 @@ def sweep_command(
         scheduler=scheduler,
         workers=workers,
         stop_at_collapse=not full_runs,
+        histories=histories,
     )
     try:
         result = run_study(base, request, console)

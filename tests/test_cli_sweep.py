@@ -73,16 +73,18 @@ def test_records_sweep_fits_a_fragility_curve_and_records_the_study(block, tmp_p
     assert again.exit_code == 0 and "(0 runs now, 12 rows already there" in " ".join(again.output.split())
 
 
-def test_grid_sweep_state_map(block, tmp_path):
+def test_grid_sweep_state_map_and_histories(block, tmp_path):
     out = tmp_path / "grid.parquet"
-    result = invoke(
-        "sweep", block, "-p", "amp=0.05,0.6", "-p", "friction=0.3,0.8", "--duration", 0.3, "--workers", 0, "-o", out
-    )
+    args = ["-p", "amp=0.05,0.6", "-p", "friction=0.3,0.8", "--duration", 0.3, "--workers", 0, "-o", out]
+    result = invoke("sweep", block, *args, "--histories", tmp_path / "h")
     assert result.exit_code == 0, result.output
     rows = read_rows(out)
     assert [(r["amp"], r["friction"]) for r in rows] == [(0.05, 0.3), (0.05, 0.8), (0.6, 0.3), (0.6, 0.8)]
     assert rows[0]["state"] == "intact" and rows[0]["time"] == pytest.approx(0.3)
     assert (tmp_path / "grid.png").stat().st_size > 0
+    h = np.load(tmp_path / "h" / "amp=0.6_friction=0.3.npz")
+    assert float(h["intensity_pga"]) == rows[2]["pga"] and h["time"][-1] == pytest.approx(rows[2]["time"])
+    assert len(list((tmp_path / "h").glob("*.npz"))) == 4
 
 
 @pytest.mark.parametrize(

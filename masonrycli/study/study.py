@@ -32,6 +32,8 @@ class StudyRequest:
     scheduler: str | None = None
     workers: int | None = None
     stop_at_collapse: bool = True
+    histories: Path | None = None
+    """Folder for one history file per run (written by the workers), or None."""
 
 
 @dataclass
@@ -112,14 +114,18 @@ def run_study(base: StudyBase, request: StudyRequest, console: Console) -> Study
         driver.finished.clear()
         progress.update(bar, states=f"{ran} runs: " + ", ".join(f"{k} {v}" for k, v in sorted(counts.items())))
 
+    histories = None
+    if request.histories is not None:
+        request.histories.mkdir(parents=True, exist_ok=True)
+        histories = str(request.histories.resolve())
     cluster = client = None
     try:
         with progress:
             if request.workers == 0:
-                run_serially(base, driver, on_row, request.stop_at_collapse)
+                run_serially(base, driver, on_row, request.stop_at_collapse, histories)
             else:
                 client, cluster = open_cluster(request.scheduler, request.workers)
-                run_on_cluster(client, base, driver, on_row, request.stop_at_collapse)
+                run_on_cluster(client, base, driver, on_row, request.stop_at_collapse, histories)
     finally:
         journal.close()
         rows = driver.rows()

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import math
 import time
+from pathlib import Path
 
 import numpy as np
 
@@ -39,16 +40,26 @@ RESULT_COLUMNS = (
 """The columns every row has after its parameters (units in ``docs/sweep.md``)."""
 
 
-def run_task(base, params: dict, stop_at_collapse: bool = True) -> dict:
-    """Run the grid point ``params`` of ``base`` (:class:`~masonrycli.study.axes.StudyBase`): its row."""
-    from masonrycli.run import simulate
+def run_task(base, params: dict, stop_at_collapse: bool = True, history_dir: str | None = None) -> dict:
+    """Run the grid point ``params`` of ``base`` (:class:`~masonrycli.study.axes.StudyBase`): its row.
+
+    With ``history_dir`` the run's history (:mod:`masonrycli.history`) is written there as
+    :func:`history_name` of the point (on the worker's file system).
+    """
+    from masonrycli.history import History
+    from masonrycli.run import Simulation, simulate
     from masonrycli.study.axes import apply_point
 
     start = time.perf_counter()
     row = dict(params)
     try:
         scenario = apply_point(base, params)
-        result = simulate(scenario, stop_at_collapse=stop_at_collapse)
+        sim = Simulation(scenario)
+        sinks = [History(sim.model.block_name, sim.model.support_name)] if history_dir else []
+        result = simulate(scenario, sinks, sim=sim, stop_at_collapse=stop_at_collapse)
+        if history_dir:
+            sinks[0].run_values |= {f"intensity_{k}": v for k, v in result.intensity.items()}
+            sinks[0].write(Path(history_dir) / history_name(params), status=result.status)
     except Exception as exc:  # a failed task is reported in its row; the study goes on
         return row | empty_result(f"{type(exc).__name__}: {exc}", time.perf_counter() - start)
     out = result.outcome
@@ -72,6 +83,12 @@ def run_task(base, params: dict, stop_at_collapse: bool = True) -> dict:
         "error": result.message if result.status == "diverged" else "",
     }
     return row
+
+
+def history_name(params: dict) -> str:
+    """``amp=0.5_freq=2.npz``: the file name of a point's history (characters unsafe in names -> "-")."""
+    text = "_".join(f"{k}={v:g}" if isinstance(v, float) else f"{k}={v}" for k, v in params.items())
+    return "".join(c if c.isalnum() or c in "=._-" else "-" for c in text) + ".npz"
 
 
 def empty_result(error: str, wall_time: float) -> dict:
