@@ -7,6 +7,8 @@
 from __future__ import annotations
 
 import math
+import os
+import shutil
 import time
 from pathlib import Path
 
@@ -46,7 +48,7 @@ def run_task(base, params: dict, stop_at_collapse: bool = True, history_dir: str
     With ``history_dir`` the run's history (:mod:`masonrycli.history`) is written there as
     :func:`history_name` of the point (on the worker's file system).
     """
-    from masonrycli.history import History
+    from masonrycli.history import HistoryFile
     from masonrycli.run import Simulation, simulate
     from masonrycli.study.axes import apply_point
 
@@ -55,11 +57,19 @@ def run_task(base, params: dict, stop_at_collapse: bool = True, history_dir: str
     try:
         scenario = apply_point(base, params)
         sim = Simulation(scenario)
-        sinks = [History(sim.model.block_name, sim.model.support_name)] if history_dir else []
-        result = simulate(scenario, sinks, sim=sim, stop_at_collapse=stop_at_collapse)
+        sinks = []
         if history_dir:
+            # written beside its final name, then renamed: a reader never sees half a history; a
+            # scratch folder left by a worker killed mid-run is cleared first
+            final = Path(history_dir) / history_name(params)
+            part = final.with_name(final.name + ".part.npz")
+            shutil.rmtree(part.with_name(part.name + ".rows"), ignore_errors=True)
+            sinks.append(HistoryFile(part, sim.model.block_name, sim.model.support_name))
+        result = simulate(scenario, sinks, sim=sim, stop_at_collapse=stop_at_collapse)
+        if sinks:
             sinks[0].run_values |= {f"intensity_{k}": v for k, v in result.intensity.items()}
-            sinks[0].write(Path(history_dir) / history_name(params), status=result.status)
+            sinks[0].close(status=result.status, note=result.message)
+            os.replace(part, final)
     except Exception as exc:  # a failed task is reported in its row; the study goes on
         return row | empty_result(f"{type(exc).__name__}: {exc}", time.perf_counter() - start)
     out = result.outcome
