@@ -11,41 +11,15 @@ from pathlib import Path
 from typing import Annotated
 
 import typer
-import typer.core
-from rich.console import Console
 from rich.table import Table
-from rich.text import Text
-from typer._click import exceptions as click_errors  # typer 0.29 vendors click; no public name
 
 from geometry_library.blocks import GeometryError
 from masonrycli import __version__
-from masonrycli.errors import EXIT_BAD_INPUT, EXIT_DIVERGED, EXIT_INTERNAL, EXIT_OUTPUT_FAILED, InputError
-
-
-class _OneLineUsageErrors(typer.core.TyperGroup):
-    """Click's usage errors (``--dt abc``, an unknown option) as one line and exit code 2, like every
-    other bad input, instead of a framed panel."""
-
-    def main(self, args=None, prog_name=None, complete_var=None, standalone_mode=True, **extra):
-        if not standalone_mode:
-            return super().main(args, prog_name, complete_var, standalone_mode=False, **extra)
-        try:
-            code = super().main(args, prog_name, complete_var, standalone_mode=False, **extra)
-        except click_errors.NoArgsIsHelpError as exc:
-            console.print(exc.ctx.get_help(), markup=True)
-            sys.exit(0)
-        except click_errors.UsageError as exc:
-            command = exc.ctx.command_path if exc.ctx is not None else "masonry"
-            _say("error", "bold red", f"{exc.format_message()} ({command} --help lists the options)")
-            sys.exit(exc.exit_code)
-        except click_errors.ClickException as exc:
-            _say("error", "bold red", exc.format_message())
-            sys.exit(exc.exit_code)
-        sys.exit(code if isinstance(code, int) else 0)
-
+from masonrycli.cli_messages import OneLineUsageErrors, console, err_console, fail, say, user_errors, warn
+from masonrycli.errors import EXIT_DIVERGED, EXIT_INTERNAL, EXIT_OUTPUT_FAILED, InputError
 
 app = typer.Typer(
-    cls=_OneLineUsageErrors,
+    cls=OneLineUsageErrors,
     rich_markup_mode="rich",
     no_args_is_help=True,
     add_completion=False,
@@ -56,39 +30,6 @@ simulate_app = typer.Typer(no_args_is_help=True, help="Build a structure, load i
 build_app = typer.Typer(no_args_is_help=True, help="Build a structure and write it as GeoJSON.")
 app.add_typer(simulate_app, name="simulate")
 app.add_typer(build_app, name="build")
-
-# No markup and no highlighting: file names, TOML tables ("[run]") and values ("[inf, 0, 0]") print as given.
-console = Console(markup=False, highlight=False)
-err_console = Console(stderr=True, markup=False, highlight=False)
-
-
-def _say(label: str, style: str, message: str) -> None:
-    """The one place messages go to stderr: ``label: message`` on one line, the message never parsed."""
-    err_console.print(Text.assemble((f"{label}:", style), " ", message), soft_wrap=True)
-
-
-def _warn(message: str) -> None:
-    _say("warning", "yellow", message)
-
-
-def _fail(message: str, code: int = EXIT_BAD_INPUT) -> None:
-    _say("error", "bold red", message)
-    raise typer.Exit(code)
-
-
-def user_errors(func):
-    """Turn bad input into one line on stderr and exit code 2 — never a traceback."""
-
-    @functools.wraps(func)
-    def wrapper(*args, **kwargs):
-        try:
-            return func(*args, **kwargs)
-        except (InputError, GeometryError) as exc:
-            _fail(str(exc).splitlines()[0] if str(exc) else type(exc).__name__)
-        except OSError as exc:
-            _fail(f"{exc.filename or ''}: {exc.strerror or exc}".lstrip(": "))
-
-    return wrapper
 
 
 def _version(value: bool) -> None:
@@ -232,17 +173,17 @@ def _execute(scenario, opts: dict, hint: str = "") -> None:
         scenario, opts["out"], opts["history"], no_recording=opts["no_recording"], force=opts["force"]
     )
     for warning in scenario.warnings:
-        _warn(warning)
+        warn(warning)
     try:
         outcome = execute(scenario, outputs, console=console, stop_at_collapse=opts["stop_at_collapse"])
     except StopRun as stop:
-        _fail(f"{signal_name(stop.signum)} before the first step: nothing was written", exit_code(stop.signum))
+        fail(f"{signal_name(stop.signum)} before the first step: nothing was written", exit_code(stop.signum))
     except (InputError, GeometryError):
         raise
     except Exception as exc:  # an engine bug: say so in one line, keep what was computed
         if os.environ.get("MASONRY_DEBUG"):
             raise
-        _say(
+        say(
             "internal error",
             "bold red",
             f"{type(exc).__name__}: {exc} — the recording and history hold every frame computed before it"
@@ -252,7 +193,7 @@ def _execute(scenario, opts: dict, hint: str = "") -> None:
     result = outcome.result
     print_summary(console, outcome, scenario, hint)
     for error in outcome.errors:
-        _say("error", "bold red", f"cannot write {error}")
+        say("error", "bold red", f"cannot write {error}")
     if outcome.errors or result.status == FAILED:
         raise typer.Exit(EXIT_OUTPUT_FAILED)
     if outcome.signum is not None:
@@ -369,6 +310,7 @@ def limit_command(
     out: Annotated[
         Path | None, typer.Option("--out", "-o", help="Write the mechanism recording (.rrd).", metavar="REC.rrd")
     ] = None,
+    force: Annotated[bool, typer.Option("--force", help="Replace the --out file if it exists.")] = False,
 ) -> None:
     """The collapse load factor λ and mechanism of a block assembly (rigid-block limit analysis, one LP)."""
     from masonrycli.limit.command import run_limit
@@ -384,6 +326,7 @@ def limit_command(
         out=out,
         console=console,
         err_console=err_console,
+        force=force,
     )
 
 
@@ -418,7 +361,7 @@ def check_command(scenario_file: ScenarioFile, **opts) -> None:
         table.add_row("recording" if out_file.option == "--out" else "history", str(out_file.path))
     console.print(table)
     for warning in scenario.warnings:
-        _warn(warning)
+        warn(warning)
 
 
 def _write_assembly(builder: str, opts: dict) -> None:
@@ -436,7 +379,7 @@ def _write_assembly(builder: str, opts: dict) -> None:
     except (ValueError, GeometryError) as exc:
         raise InputError(f"{builder}: {exc}") from None
     for warning in validate_assembly(assembly):
-        _warn(warning)
+        warn(warning)
     open_part(target)
     try:
         write_geojson(assembly, target.part)
@@ -503,7 +446,7 @@ def inspect_command(
     if info.get("metadata"):
         console.print(info["metadata"])
     if info.get("truncated") or not info.get("complete", True):
-        _warn(
+        warn(
             f"{recording}: truncated (its writer did not finish: killed, or the disk was full) — "
             f"{info['frames']} frames up to its last complete chunk"
         )

@@ -460,6 +460,13 @@ CATALOGUE = [
         "--out w.geojson: the file exists (add --force",
     ),
     ("build-out-suffix", {}, ("build", "arch", "--out", "w.txt"), 2, "--out w.txt: the file name must end in .geojson"),
+    (
+        "limit-out-exists",
+        {"r.rrd": "old"},
+        ("limit", "arch", "--out", "r.rrd"),
+        2,
+        "--out r.rrd: the file exists (add --force to replace it)",
+    ),
     # -- inspect
     ("inspect-missing", {}, ("inspect", "missing.rrd"), 2, "missing.rrd: no such recording"),
     (

@@ -13,10 +13,12 @@ from pathlib import Path
 import numpy as np
 from rich.console import Console
 from rich.table import Table
+from rich.text import Text
 
 from masonrycli.errors import InputError
 from masonrycli.limit.analysis import LimitResult, analyse
 from masonrycli.limit.problem import LiveLoad
+from masonrycli.outputs import check_output, open_part
 
 BUILT_INS = ("wall", "arch", "aqueduct")
 SHOWN = 8
@@ -57,9 +59,9 @@ def result_table(result: LimitResult, out: Path | None) -> Table:
     table.add_row("structure", f"{s['blocks']} blocks, {s['supports']} supports, friction μ = {s['friction']:g}")
     table.add_row("joints", f"{s['joints']} ({s['contact_points']} contact points, from the engine's detection)")
     table.add_row("live load", result.load.describe())
-    lam = f"[bold]{result.load_factor:.4f}[/bold]"
+    lam = Text(f"{result.load_factor:.4f}", style="bold")  # Text: the consoles parse no markup
     if result.tilt_angle() is not None:
-        lam += f"  (tilt ψ = {result.tilt_angle():.2f}°)"
+        lam.append(f"  (tilt ψ = {result.tilt_angle():.2f}°)")
     table.add_row("load factor λ", lam)
     table.add_row("collapse load", f"{s['collapse_load_N']:.4g} N (λ × {s['reference_load_N']:.4g} N)")
     table.add_row("hinges", _names(result.hinges))
@@ -84,7 +86,7 @@ def verify_table(checks) -> Table:
             f"collapses at t = {c.time:.3f} s"
             if c.collapsed
             else f"stands for {c.time:.2f} s (end speed {c.max_speed * 1e3:.2g} mm/s)",
-            ("yes" if c.as_predicted else "[bold red]no[/bold red]"),
+            Text("yes") if c.as_predicted else Text("no", style="bold red"),
             f"{c.max_displacement * 1e3:.2f} mm (threshold {c.threshold * 1e3:.1f})",
             "" if c.similarity is None else f"{c.similarity:.3f}",
             f"{len(c.shared_hinges)} of {len(c.hinges)}",
@@ -158,19 +160,25 @@ def run_limit(
     out: Path | None,
     console: Console,
     err_console: Console,
+    force: bool = False,
 ) -> None:
     """``masonry limit``: analyse, optionally record and verify, then print a table or one JSON object."""
-    if out is not None and out.suffix != ".rrd":
-        raise InputError(f"--out {out}: a recording file must end in .rrd")
+    target = None if out is None else check_output(out, "--out", ".rrd", force)
     live = LiveLoad(load, direction, block)
     scenario = resolve_structure(structure, friction)
     if verify and live.kind == "point":
         raise InputError("--verify: the engine has no point loads; verify a horizontal or tilt load")
     for warning in scenario.warnings:
-        err_console.print(f"[yellow]warning:[/yellow] {warning}", highlight=False)
+        err_console.print(Text.assemble(("warning:", "yellow"), f" {warning}"))
     result = analyse(scenario, live)
-    if out is not None:
-        write_recording(result, out)
+    if target is not None:  # under a temporary name, renamed when complete (masonrycli.outputs)
+        open_part(target)
+        try:
+            write_recording(result, target.part)
+            out = target.commit()
+        except BaseException:
+            target.discard()
+            raise
     checks = []
     if verify:
         from masonrycli.limit.verify import verify as run_verify

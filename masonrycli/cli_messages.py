@@ -1,0 +1,71 @@
+"""How the command line talks: two consoles that never parse markup, one-line errors and warnings, the
+decorator that turns bad input into exit code 2, and click's usage errors as one line."""
+
+from __future__ import annotations
+
+import functools
+import sys
+
+import typer
+import typer.core
+from rich.console import Console
+from rich.text import Text
+from typer._click import exceptions as click_errors  # typer 0.29 vendors click; no public name
+
+from geometry_library.blocks import GeometryError
+from masonrycli.errors import EXIT_BAD_INPUT, InputError
+
+# No markup and no highlighting: file names, TOML tables ("[run]") and values ("[inf, 0, 0]") print as given.
+console = Console(markup=False, highlight=False)
+err_console = Console(stderr=True, markup=False, highlight=False)
+
+
+def say(label: str, style: str, message: str) -> None:
+    """The one place messages go to stderr: ``label: message`` on one line, the message never parsed."""
+    err_console.print(Text.assemble((f"{label}:", style), " ", message), soft_wrap=True)
+
+
+def warn(message: str) -> None:
+    say("warning", "yellow", message)
+
+
+def fail(message: str, code: int = EXIT_BAD_INPUT) -> None:
+    say("error", "bold red", message)
+    raise typer.Exit(code)
+
+
+def user_errors(func):
+    """Turn bad input into one line on stderr and exit code 2 — never a traceback."""
+
+    @functools.wraps(func)
+    def wrapper(*args, **kwargs):
+        try:
+            return func(*args, **kwargs)
+        except (InputError, GeometryError) as exc:
+            fail(str(exc).splitlines()[0] if str(exc) else type(exc).__name__)
+        except OSError as exc:
+            fail(f"{exc.filename or ''}: {exc.strerror or exc}".lstrip(": "))
+
+    return wrapper
+
+
+class OneLineUsageErrors(typer.core.TyperGroup):
+    """Click's usage errors (``--dt abc``, an unknown option) as one line and exit code 2, like every
+    other bad input, instead of a framed panel."""
+
+    def main(self, args=None, prog_name=None, complete_var=None, standalone_mode=True, **extra):
+        if not standalone_mode:
+            return super().main(args, prog_name, complete_var, standalone_mode=False, **extra)
+        try:
+            code = super().main(args, prog_name, complete_var, standalone_mode=False, **extra)
+        except click_errors.NoArgsIsHelpError as exc:
+            console.print(exc.ctx.get_help(), markup=True)
+            sys.exit(0)
+        except click_errors.UsageError as exc:
+            command = exc.ctx.command_path if exc.ctx is not None else "masonry"
+            say("error", "bold red", f"{exc.format_message()} ({command} --help lists the options)")
+            sys.exit(exc.exit_code)
+        except click_errors.ClickException as exc:
+            say("error", "bold red", exc.format_message())
+            sys.exit(exc.exit_code)
+        sys.exit(code if isinstance(code, int) else 0)
