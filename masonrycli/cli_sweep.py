@@ -32,7 +32,10 @@ def sweep_command(
         ),
     ] = None,
     records: Annotated[
-        Path | None, typer.Option("--records", help="Folder of records (.AT2 or CSV): one axis 'record' over them.")
+        list[Path] | None,
+        typer.Option(
+            "--records", help="Record files (.AT2 or CSV) or folders of them, repeatable: one axis 'record' over them."
+        ),
     ] = None,
     scale: Annotated[
         str | None, typer.Option("--scale", help="Record scale axis, e.g. 0.25:2:8 (= --param scale=...).")
@@ -79,7 +82,7 @@ def sweep_command(
 
     base = StudyBase(_base_scenario(target, duration, dt), {})
     axes = [parse_axis(p) for p in param or []]
-    if records is not None:
+    if records:
         from masonrycli.study.axes import Axis
 
         motions = _records(records)
@@ -148,14 +151,25 @@ def _base_scenario(target: str, duration, dt):
     return scenario
 
 
-def _records(folder: Path) -> dict:
+def _records(entries: list[Path]) -> dict:
+    """Record motions by file name, from files and the .AT2 / .csv files of folders."""
     from masonrycli.records import record_motion
 
-    if not folder.is_dir():
-        raise InputError(f"--records {folder}: not a folder")
-    files = sorted(p for p in folder.iterdir() if p.suffix.lower() in (".at2", ".csv"))
-    if not files:
-        raise InputError(f"--records {folder}: no .AT2 or .csv record in it")
+    files = []
+    for entry in entries:
+        if entry.is_dir():
+            found = sorted(p for p in entry.iterdir() if p.suffix.lower() in (".at2", ".csv"))
+            if not found:
+                raise InputError(f"--records {entry}: no .AT2 or .csv record in it")
+            files += found
+        elif entry.is_file():
+            files.append(entry)
+        else:
+            raise InputError(f"--records {entry}: no such file or folder")
+    names = [p.name for p in files]
+    twice = sorted({n for n in names if names.count(n) > 1})
+    if twice:
+        raise InputError(f"--records: two records named {twice[0]} (rows are keyed by the file name)")
     return {p.name: record_motion(p, display=str(p)) for p in files}
 
 

@@ -71,12 +71,18 @@ def test_records_sweep_fits_a_fragility_curve_and_records_the_study(block, tmp_p
     assert {"/study/fragility/runs", "/study/plot", "/study/rows"} <= paths
     again = invoke("sweep", block, "--records", folder, "--scale", "0.5:8:4", "--workers", 0, "--out", out)
     assert again.exit_code == 0 and "(0 runs now, 12 rows already there" in " ".join(again.output.split())
+    # records given as files (repeatable) make the same study as their folder
+    files = [a for f in sorted(folder.iterdir()) for a in ("--records", f)]
+    again = invoke("sweep", block, *files, "--scale", "0.5:8:4", "--workers", 0, "--out", out)
+    assert again.exit_code == 0 and "(0 runs now, 12 rows already there" in " ".join(again.output.split())
+    twice = invoke("sweep", block, "--records", folder, "--records", folder / "syn0.AT2", "--out", out)
+    assert twice.exit_code == 2 and "two records named syn0.AT2" in twice.output
 
 
 def test_grid_sweep_state_map_and_histories(block, tmp_path):
     out = tmp_path / "grid.parquet"
     args = ["-p", "amp=0.05,0.6", "-p", "friction=0.3,0.8", "--duration", 0.3, "--workers", 0, "-o", out]
-    result = invoke("sweep", block, *args, "--histories", tmp_path / "h")
+    result = invoke("sweep", block, *args, "--histories", tmp_path / "h", "--recording", tmp_path / "grid.rrd")
     assert result.exit_code == 0, result.output
     rows = read_rows(out)
     assert [(r["amp"], r["friction"]) for r in rows] == [(0.05, 0.3), (0.05, 0.8), (0.6, 0.3), (0.6, 0.8)]
@@ -85,6 +91,11 @@ def test_grid_sweep_state_map_and_histories(block, tmp_path):
     h = np.load(tmp_path / "h" / "amp=0.6_friction=0.3.npz")
     assert float(h["intensity_pga"]) == rows[2]["pga"] and h["time"][-1] == pytest.approx(rows[2]["time"])
     assert len(list((tmp_path / "h").glob("*.npz"))) == 4
+
+    import rerun as rr
+
+    paths = {ch.entity_path for ch in rr.chunk.RrdReader(str(tmp_path / "grid.rrd")).stream()}
+    assert {"/study/state_map", "/study/plot", "/study/rows"} <= paths
 
 
 @pytest.mark.parametrize(
@@ -97,7 +108,7 @@ def test_grid_sweep_state_map_and_histories(block, tmp_path):
         (["-p", "amp=0.1,0.2", "--outcome", "fall"], "--outcome fall: expected collapse, sliding"),
         (["-p", "amp=0.1,0.2", "--out", "x.txt"], "a study is written as .parquet or .csv"),
         (["-p", "scale=1,2"], "has no record motion"),
-        (["-p", "amp=0.1", "--records", "nowhere"], "--records nowhere: not a folder"),
+        (["-p", "amp=0.1", "--records", "nowhere"], "--records nowhere: no such file or folder"),
         (["-p", "amp=0.1", "--workers", "2", "--scheduler", "tcp://x:1"], "--workers with --scheduler"),
     ],
 )
