@@ -58,7 +58,7 @@ def _align(key, prev_key, prev_r):
 
 def reference(problem: Problem) -> None:
     """Engine NLGS continued in growing chunks until the contact-law residual ≤ REF_RESIDUAL m/s."""
-    pack, _, _ = problem.pack()
+    pack = problem.pack()
     H = law.h_matrix(problem, pack)
     c = problem.count
     r = problem.r_warm.copy()

@@ -8,7 +8,9 @@ Contact-law residual, m/s. For each contact take the velocity it would have with
 u_free = u − W_αα r_α, solve the 2×2 local problem exactly (open / stick / slide ±, as the engine does),
 and measure how far the velocity would move: |W_αα (r*_α − r_α)|. It is zero exactly when every contact
 satisfies Signorini + Coulomb with the given velocities — no regularisation, no dilatancy — and it is
-what one more Gauss–Seidel visit of that contact would change. The largest over the contacts is reported.
+what one more Gauss–Seidel visit of that contact would change. The harness reports its root mean square
+over the contacts (the quantity of the engine's stopping test, there taken during the sweep) and its
+largest value.
 """
 
 from __future__ import annotations
