@@ -7,7 +7,7 @@
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 
 from rich.console import Console
@@ -36,15 +36,16 @@ class StudyRequest:
     """Folder for one history file per run (written by the workers), or None."""
 
 
-@dataclass
+@dataclass(frozen=True)
 class StudyResult:
+    """The study's rows (grid order) and columns; rows found done, runs made now, failed rows, seconds."""
+
     rows: list[dict]
     columns: list[str]
     skipped: int
     ran: int
     wall_time: float
     failed: int = 0
-    states: dict = field(default_factory=dict)
 
 
 def prepare(base: StudyBase, request: StudyRequest) -> str:
@@ -137,7 +138,4 @@ def run_study(base: StudyBase, request: StudyRequest, console: Console) -> Study
         if cluster is not None:
             cluster.close()
     failed = sum(1 for r in rows if r.get("status") == "error")
-    states = {}
-    for r in rows:
-        states[r.get("state", "")] = states.get(r.get("state", ""), 0) + 1
-    return StudyResult(rows, columns, driver.skipped, ran, time.perf_counter() - start, failed, states)
+    return StudyResult(rows, columns, driver.skipped, ran, time.perf_counter() - start, failed)
