@@ -10,6 +10,7 @@ as they are; the PNG is the annotated picture.
 from __future__ import annotations
 
 import math
+import os
 import uuid
 from pathlib import Path
 
@@ -48,8 +49,10 @@ def record_study(path: Path, name: str, rows: list[dict], request, fit, im: str,
         _log_state_map(rec, rows, names)
         views.insert(0, rrb.Spatial2DView(origin="study/state_map", name="state map"))
     rec.log("study/rows", rr.TextDocument(_markdown(name, rows), media_type=rr.MediaType.MARKDOWN), static=True)
-    rec.save(path, default_blueprint=rrb.Blueprint(rrb.Grid(*views)))
+    tmp = path.with_name(path.name + ".part.rrd")  # renamed once complete: never half a file at ``path``
+    rec.save(tmp, default_blueprint=rrb.Blueprint(rrb.Grid(*views)))
     rec.disconnect()
+    os.replace(tmp, path)
     return path
 
 
