@@ -100,3 +100,18 @@ motion = { kind = "sine", amplitude = 0.5, frequency = 2.0 }
     assert "stopped at collapse" in said and "collapsed at t =" in said
     t_end = float(np.load(npz)["time"][-1])
     assert 0.5 < t_end < 2.5
+
+
+def test_run_document_holds_the_baseline_correction(at2):
+    from masonrycli.execute import run_metadata
+    from masonrycli.motion import Sine
+    from masonrycli.run import Simulation
+    from masonrycli.scenario import Material, RunConfig, scenario_from_builder
+
+    motion = record_motion(at2, scale=0.5)
+    motions = {"left-foundation": motion, "right-foundation": Sine(amplitude=0.1, frequency=2.0)}
+    scenario = scenario_from_builder("arch", {}, RunConfig(duration=0.01), Material(), motions)
+    meta = run_metadata(scenario, Simulation(scenario))
+    corr = meta["baseline_corrections"]
+    assert set(corr) == {"left-foundation"} and corr["left-foundation"] == motion.baseline_correction
+    assert corr["left-foundation"]["baseline"] == "quadratic" and len(corr["left-foundation"]["c1"]) == 2
