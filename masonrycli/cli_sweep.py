@@ -64,7 +64,12 @@ def sweep_command(
         str, typer.Option("--im", help="Intensity measure of the fragility curve: pga, pgv, arias, sa.")
     ] = "pga",
     plot: Annotated[Path | None, typer.Option("--plot", help="PNG of the state map / fragility / thresholds.")] = None,
-    recording: Annotated[Path | None, typer.Option("--recording", help="Rerun recording of the study (.rrd).")] = None,
+    recording: Annotated[
+        Path | None, typer.Option("--recording", help="Rerun recording of the study (default: beside --out, .rrd).")
+    ] = None,
+    no_recording: Annotated[
+        bool, typer.Option("--no-recording", help="Write no Rerun recording of the study.")
+    ] = False,
     histories: Annotated[
         Path | None, typer.Option("--histories", help="Folder for one history (.npz) per run, e.g. amp=0.5_freq=2.npz.")
     ] = None,
@@ -102,6 +107,9 @@ def sweep_command(
         raise InputError(f"--rtol {rtol}: must be in (0, 1)")
     name = base.scenario.name
     out = store.check_out(out or Path(f"study-{name}.parquet"))
+    if recording is not None and recording.suffix != ".rrd":
+        raise InputError(f"--recording {recording}: a recording file must end in .rrd")
+    recording = None if no_recording else recording or out.with_suffix(".rrd")
     request = StudyRequest(
         axes=axes,
         out=out,

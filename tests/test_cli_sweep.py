@@ -110,6 +110,7 @@ def test_grid_sweep_state_map_and_histories(block, tmp_path):
         (["-p", "scale=1,2"], "has no record motion"),
         (["-p", "amp=0.1", "--records", "nowhere"], "--records nowhere: no such file or folder"),
         (["-p", "amp=0.1", "--workers", "2", "--scheduler", "tcp://x:1"], "--workers with --scheduler"),
+        (["-p", "amp=0.1", "--recording", "x.png"], "--recording x.png: a recording file must end in .rrd"),
     ],
 )
 def test_sweep_errors_are_one_line(block, args, fragment):

@@ -62,3 +62,4 @@ def test_find_reproduces_the_closed_form_threshold(tmp_path, width, height, mu, 
     assert closed_form <= rows[0]["amp_hi"] and rows[0]["amp_lo"] < 1.005 * closed_form
     assert (rows[0]["amp_hi"] - rows[0]["amp_lo"]) <= 0.005 * rows[0]["amp_hi"]
     assert "amp_threshold" in result.output and (tmp_path / "find.png").stat().st_size > 0
+    assert (tmp_path / "find.rrd").stat().st_size > 0  # the study recording, beside --out by default
