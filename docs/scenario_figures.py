@@ -23,8 +23,8 @@ bodies, and each end's opening is the normal separation of the two copies, (p_b 
 motions of ``block_q`` / ``support_q``. Positive = open, negative = interpenetration. The script prints how
 far the widest geometric opening of each block is from ``block_max_opening``.
 
-The colour ranges of the recording are reproduced from the history the way the recorder fixes them (first
-batch of 100 frames whose field is not all zero, 98th percentile of |value|, rounded up).
+The colour ranges of the recording are replayed from the history the way the recorder follows the data
+(``masonrycli.colour_range.RangeTracker`` over every frame after the initial one).
 """
 
 from __future__ import annotations
@@ -242,32 +242,35 @@ RECORDED_FIELDS = (
 )
 
 
-def recorded_range(h: dict, key: str, batch: int = 100) -> float:
-    """M of the recording's colour range of ``key``, as ``masonrycli.recording`` fixes it: first batch of
-    ``batch`` frames with a non-zero 98th percentile of |value|, rounded up with ``nice_ceil``."""
-    from masonrycli.colormap import nice_ceil, robust_max_abs
+def recorded_ranges(h: dict, key: str) -> list:
+    """The colour range of ``key`` at every frame, as ``masonrycli.recording`` logs it: a
+    ``masonrycli.colour_range.RangeTracker`` fed the frames from the first computed one on (the initial
+    state is not shown); the volumetric strain rate falls back on the chain strain rate. Entry 0: None."""
+    from masonrycli.colour_range import RangeTracker
+    from masonrycli.recording.layout import CHAIN_KEY, FIELD_BY_KEY
 
+    spec = FIELD_BY_KEY[key]
     v = h[key]
-    for i in range(0, v.shape[0], batch):
-        m = nice_ceil(robust_max_abs(v[i : i + batch], 98.0))
-        if m > 0.0:
-            return m
-    return 0.0
+    if key == "cell_volumetric_strain_rate" and CHAIN_KEY in h:
+        v = np.where(np.isnan(v), h[CHAIN_KEY], v)
+    tracker = RangeTracker(spec.kind, spec.floor)
+    return [None] + [tracker.update(v[i]) for i in range(1, v.shape[0])]
 
 
 def colour_ranges(run: Run, i: int) -> str:
     h = run.h
     parts = []
-    for key, signed in RECORDED_FIELDS:
-        m = recorded_range(h, key)
+    for key, _ in RECORDED_FIELDS:
+        r = recorded_ranges(h, key)[i]
         v = h[key][i]
-        over = int((np.abs(v) > m).sum()) if signed else int((v > m).sum())
+        d = v[np.isfinite(v)]
+        over = int(((d < r.lo) | (d > r.hi)).sum())
+        span = (min(d.max(), r.hi) - max(d.min(), r.lo)) / (r.hi - r.lo)
         parts.append(
-            f"{key.removeprefix('cell_')} {'±' if signed else '0 … '}{m:g} "
-            f"({over} of {int(np.isfinite(v).sum())} defined cells beyond at t = {h['time'][i]:.2f} s, "
-            f"max |value| {np.nanmax(np.abs(v)):.3g})"
+            f"{key.removeprefix('cell_')} {r.lo:.3g} … {r.hi:.3g} ({over} of {d.size} defined cells beyond, "
+            f"cells span {100 * span:.0f} % of it at t = {h['time'][i]:.2f} s)"
         )
-    return "Recording colour ranges (reproduced from the history): " + "; ".join(parts)
+    return "Recording colour ranges at that frame (replayed from the history): " + "; ".join(parts)
 
 
 def detector_vs_geometry(run: Run, op, i: int) -> str:

@@ -166,13 +166,14 @@ def builtin(name: str, **overrides) -> Scenario:
 
 
 def paper_instant_hint(name: str, run: RunConfig) -> str:
-    """Where the paper's figures of ``name`` are on the viewer's timeline, or "" (none, or after the run)."""
+    """Where the paper's figures of ``name`` are in the run (the recording's tabs pinned there), or "" (none,
+    or after the run)."""
     if name not in PAPER_INSTANT:
         return ""
     figs, t = PAPER_INSTANT[name]
     step = round(t / run.dt)
     return (
-        f"The paper's Figs. {figs} are at t = {t:g} s: step {step} on the viewer's timeline."
+        f"The paper's Figs. {figs} are at t = {t:g} s (step {step}): the recording opens on them, pinned there."
         if step <= run.n_steps
         else ""
     )

@@ -107,6 +107,13 @@ OUTPUT = {
         bool, typer.Option("--no-recording", help="Write no .rrd recording.", rich_help_panel="Output")
     ],
     "history": _opt(Path, "Output", "History file (.npz), one row per recorded frame.", "--history"),
+    "magnify": _opt(
+        float,
+        "Output",
+        "Displacement factor of the recording's magnified deformed shape (default: the largest displacement "
+        "drawn as 5 % of the structure's size).",
+        "--magnify",
+    ),
 }
 STOP = {
     "stop_at_collapse": Annotated[
@@ -169,13 +176,17 @@ def _execute(scenario, opts: dict, hint: str = "") -> None:
     from masonrycli.interrupt import StopRun, exit_code, signal_name
     from masonrycli.sinks import DIVERGED, FAILED
 
+    if opts["magnify"] is not None and not opts["magnify"] >= 1.0:
+        raise InputError(f"--magnify {opts['magnify']}: must be >= 1")
     outputs = plan_outputs(
         scenario, opts["out"], opts["history"], no_recording=opts["no_recording"], force=opts["force"]
     )
     for warning in scenario.warnings:
         warn(warning)
     try:
-        outcome = execute(scenario, outputs, console=console, stop_at_collapse=opts["stop_at_collapse"])
+        outcome = execute(
+            scenario, outputs, console=console, stop_at_collapse=opts["stop_at_collapse"], magnify=opts["magnify"]
+        )
     except StopRun as stop:
         fail(f"{signal_name(stop.signum)} before the first step: nothing was written", exit_code(stop.signum))
     except (InputError, GeometryError):
@@ -340,6 +351,8 @@ def check_command(scenario_file: ScenarioFile, **opts) -> None:
     from masonrycli.scenario import scenario_summary
 
     scenario = _load(scenario_file, opts)
+    if opts["magnify"] is not None and not opts["magnify"] >= 1.0:
+        raise InputError(f"--magnify {opts['magnify']}: must be >= 1")
     outputs = plan_outputs(
         scenario, opts["out"], opts["history"], no_recording=opts["no_recording"], force=opts["force"]
     )

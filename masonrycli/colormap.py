@@ -6,7 +6,11 @@ Rerun has no colormap for geometry, so block fills are coloured here. Colours ar
 - ``VIRIDIS`` (sequential) for fields that are >= 0 (deviatoric parts);
 - ``COOLWARM`` (diverging, blue < 0 < red, light grey at 0) for signed fields (compression is
   negative, so compression is blue);
-- ``NAN_RGBA`` (mid grey) for a value that is NaN (a block with no triangle, no contact...).
+- ``BLUES`` (sequential, dark blue at the most negative end, near white at 0) for fields that are
+  <= 0 (the spherical stress p: compression is blue, as on the diverging map);
+- ``NAN_RGBA`` (mid grey) for a value that is NaN (a block with no triangle, no contact...);
+- ``UNDER_RGBA`` (black) and ``OVER_RGBA`` (white) for values beyond the range's low / high end — a
+  colour no map uses, so an over-range cell never passes for an end-of-range one.
 """
 
 from __future__ import annotations
@@ -39,6 +43,15 @@ _COOLWARM_STOPS: Final = (
 )
 
 
+_BLUES_STOPS: Final = (  # ColorBrewer "Blues", dark end first
+    (0.000, 8, 48, 107),
+    (0.250, 33, 113, 181),
+    (0.500, 107, 174, 214),
+    (0.750, 198, 219, 239),
+    (1.000, 247, 251, 255),
+)
+
+
 def pack_rgba(rgb: np.ndarray, alpha: int = 255) -> np.ndarray:
     """(..., 3) uint8-range RGB -> (...,) uint32 packed 0xRRGGBBAA."""
     c = np.asarray(rgb, dtype=np.uint32)
@@ -63,7 +76,11 @@ VIRIDIS: Final = pack_rgba(make_lut(_VIRIDIS_STOPS))
 """(256,) uint32: sequential, dark purple (low) to yellow (high)."""
 COOLWARM: Final = pack_rgba(make_lut(_COOLWARM_STOPS))
 """(256,) uint32: diverging, blue (low) - light grey (middle) - red (high)."""
+BLUES: Final = pack_rgba(make_lut(_BLUES_STOPS))
+"""(256,) uint32: sequential, dark blue (low, most negative) to near white (high, zero)."""
 NAN_RGBA: Final = int(pack_rgba(np.array([128, 128, 128])))
+UNDER_RGBA: Final = int(pack_rgba(np.array([0, 0, 0])))
+OVER_RGBA: Final = int(pack_rgba(np.array([255, 255, 255])))
 
 
 def map_scalars(values: np.ndarray, lo: float, hi: float, lut: np.ndarray, nan_rgba: int = NAN_RGBA) -> np.ndarray:
@@ -80,6 +97,18 @@ def map_scalars(values: np.ndarray, lo: float, hi: float, lut: np.ndarray, nan_r
     if not finite.all():
         out = np.where(finite, out, np.uint32(nan_rgba))
     return out
+
+
+def map_positions(position: np.ndarray, lut: np.ndarray) -> np.ndarray:
+    """Colours of colour-map positions (0 = ``lut[0]`` … 1 = ``lut[-1]``, e.g. ``ColourRange.position``):
+    ``UNDER_RGBA`` below 0, ``OVER_RGBA`` above 1, ``NAN_RGBA`` for NaN; same shape, uint32 packed."""
+    t = np.asarray(position, dtype=np.float64)
+    finite = np.isfinite(t)
+    idx = np.rint(np.clip(np.where(finite, t, 0.0), 0.0, 1.0) * (len(lut) - 1)).astype(np.intp)
+    out = lut[idx]
+    out = np.where(finite & (t < 0.0), np.uint32(UNDER_RGBA), out)
+    out = np.where(finite & (t > 1.0), np.uint32(OVER_RGBA), out)
+    return np.where(finite, out, np.uint32(NAN_RGBA))
 
 
 def robust_max_abs(values: np.ndarray, percentile: float = 99.0) -> float:

@@ -127,9 +127,12 @@ def recording_static(sim: Simulation):
     )
 
 
-def execute(scenario, outputs: Outputs, *, console: Console, stop_at_collapse: bool = False) -> Outcome:
+def execute(
+    scenario, outputs: Outputs, *, console: Console, stop_at_collapse: bool = False, magnify: float | None = None
+) -> Outcome:
     """Run ``scenario`` writing ``outputs``; ``stop_at_collapse`` ends the run when the structure
-    collapses (:mod:`masonrycli.collapse`). Signals: :mod:`masonrycli.interrupt` (a stop before step 1
+    collapses (:mod:`masonrycli.collapse`); ``magnify``: the recording's magnified-shape factor (None:
+    chosen from the run). Signals: :mod:`masonrycli.interrupt` (a stop before step 1
     raises its ``StopRun`` after removing the temporary files); an engine error is re-raised after the
     outputs are closed with status "failed" and renamed into place."""
     with StopSignals() as signals:
@@ -140,7 +143,7 @@ def execute(scenario, outputs: Outputs, *, console: Console, stop_at_collapse: b
             sim = Simulation(scenario)
             for out in outputs.files():
                 try:
-                    sinks[out] = _open_sink(out, outputs, scenario, sim)
+                    sinks[out] = _open_sink(out, outputs, scenario, sim, magnify)
                 except OSError as exc:
                     raise InputError(f"{out.option} {out.path}: cannot write: {exc.strerror or exc}") from None
         except BaseException:
@@ -171,13 +174,13 @@ def execute(scenario, outputs: Outputs, *, console: Console, stop_at_collapse: b
     return Outcome(result, signals.signum, written, errors)
 
 
-def _open_sink(out: OutputFile, outputs: Outputs, scenario, sim: Simulation):
+def _open_sink(out: OutputFile, outputs: Outputs, scenario, sim: Simulation, magnify: float | None = None):
     """The history or the recorder writing ``out``'s temporary file."""
     if out is outputs.history:
         return HistoryFile(out.part, sim.model.block_name, sim.model.support_name)
     from masonrycli.recording import Recorder
 
-    return Recorder(out.part, recording_static(sim), run_metadata(scenario, sim))
+    return Recorder(out.part, recording_static(sim), run_metadata(scenario, sim), magnify=magnify)
 
 
 def _quietly_close(sink) -> None:

@@ -187,7 +187,8 @@ def simulate(
     stop: Callable[[], bool] | None = None,
 ) -> RunResult:
     """Run ``scenario`` to its end (or ``steps`` steps), handing every recorded frame to each sink's
-    ``on_frame``. Sinks are *not* closed here (the caller owns them).
+    ``on_frame``, and a sink with ``log_step`` gets ``log_step(step, time, stats)`` after every step (solver
+    health is cheap to keep for each step). Sinks are *not* closed here (the caller owns them).
 
     ``on_progress(sim, step_stats)`` is called every ``progress_every`` steps. ``stop()`` is polled after
     every step; when it is true the run ends "interrupted" after recording the state it reached. Pass
@@ -222,6 +223,7 @@ def simulate(
         frames += 1
         return True
 
+    per_step = [sink.log_step for sink in sinks if hasattr(sink, "log_step")]
     status, message = COMPLETED, ""
     done = 0
     ok = emit()
@@ -230,6 +232,8 @@ def simulate(
         iterations[k], residual[k], contacts[k] = stats.iterations, stats.residual, stats.contact_count
         max_pen = max(max_pen, stats.max_penetration)
         done = k + 1
+        for log_step in per_step:
+            log_step(done, sim.state.time, stats)
         why = sim.diverged()
         recorded = done % every == 0 or done == n_steps
         if why:

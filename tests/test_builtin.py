@@ -89,10 +89,10 @@ def test_override_run_leaves_unset_values():
 
 def test_paper_instant_hint_only_within_the_run():
     assert paper_instant_hint("wall", RunConfig(duration=1.0)) == (
-        "The paper's Figs. III.2–III.5 are at t = 0.1 s: step 100 on the viewer's timeline."
+        "The paper's Figs. III.2–III.5 are at t = 0.1 s (step 100): the recording opens on them, pinned there."
     )
     assert paper_instant_hint("arch", RunConfig(duration=5.0, dt=0.5)).endswith(
-        "t = 5 s: step 10 on the viewer's timeline."
+        "t = 5 s (step 10): the recording opens on them, pinned there."
     )
     assert paper_instant_hint("arch", RunConfig(duration=1.0)) == ""
     assert paper_instant_hint("aqueduct", RunConfig(duration=5.0)) == ""

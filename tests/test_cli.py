@@ -114,18 +114,12 @@ def test_overlapping_blocks_are_named(tmp_path):
 
 
 def _frames_in(rrd: Path) -> int:
-    import rerun as rr
+    """Frames shown in the recording (the initial state, before any force, is in the history only)."""
+    from masonrycli.recording import inspect_recording
 
-    reader = rr.chunk.RrdReader(str(rrd))
-    assert reader.recordings()[0].application_id == "masonry"
-    steps = set()
-    for chunk in reader.stream():
-        if chunk.is_static:
-            continue
-        batch = chunk.to_record_batch()
-        if "step" in batch.schema.names:
-            steps.update(batch.column("step").to_pylist())
-    return len(steps)
+    info = inspect_recording(rrd)
+    assert info["application_id"] == "masonry"
+    return info["frames"]
 
 
 def test_divergence_leaves_complete_outputs(tmp_path, monkeypatch):
@@ -138,7 +132,7 @@ def test_divergence_leaves_complete_outputs(tmp_path, monkeypatch):
     assert "diverged" in result.output
     h = np.load(npz)
     assert str(h["status"]) == "diverged"
-    assert _frames_in(rrd) == len(h["time"])
+    assert _frames_in(rrd) == len(h["time"]) - 1
 
 
 def test_engine_error_mid_run_keeps_frames(tmp_path, monkeypatch):
@@ -159,7 +153,7 @@ def test_engine_error_mid_run_keeps_frames(tmp_path, monkeypatch):
     h = np.load(npz)
     assert str(h["status"]) == "failed"
     assert list(h["step"]) == [0, 10, 20]
-    assert _frames_in(rrd) == 3
+    assert _frames_in(rrd) == 2
 
 
 @pytest.mark.parametrize(
@@ -219,7 +213,7 @@ def test_inspect_summarises_a_recording(tmp_path):
     assert invoke("simulate", "wall", "--duration", 0.03, "--out", rrd).exit_code == 0
     result = invoke("inspect", rrd)
     assert result.exit_code == 0, result.output
-    assert "masonry" in result.output and "0 … 30" in result.output and "/structure/plane/xy/blocks" in result.output
+    assert "masonry" in result.output and "10 … 30" in result.output and "/structure/plane/xy/blocks" in result.output
     bad = tmp_path / "bad.rrd"
     bad.write_bytes(b"not a recording")
     assert_one_line_error(invoke("inspect", bad), "bad.rrd")

@@ -13,8 +13,11 @@ import rerun as rr
 
 from masonrycli import colormap as cm
 from masonrycli import recording as rec_mod
-from masonrycli.frame import CONTACT_OPEN
+from masonrycli.colour_range import MIN_SPAN, OUTSIDE_SHARE
+from masonrycli.joint_forces import joint_resultants
 from masonrycli.recording import ENTITY_PATHS, FIELDS, Recorder, inspect_recording
+from masonrycli.recording.layout import FILL, INSET, PAPER_FIELDS
+from masonrycli.recording.readback import blueprint_views, field_frames
 
 import recording_fixtures as fx
 
@@ -92,22 +95,26 @@ def test_application_id_blueprint_and_entity_paths(written):
     assert {f"/{p}" for p in ENTITY_PATHS} <= paths
 
 
-def test_embedded_blueprint_has_the_views(written):
+def test_embedded_blueprint_has_the_views(written, wall, tmp_path):
     path, *_ = written
-    reader = rr.chunk.RrdReader(path)
-    views = {}
-    for chunk in reader.stream(store=reader.blueprints()[0]):
-        batch = chunk.to_record_batch()
-        if "ViewBlueprint:display_name" in batch.schema.names:
-            name = batch.column("ViewBlueprint:display_name").to_pylist()[0][0]
-            views[name] = (
-                batch.column("ViewBlueprint:class_identifier").to_pylist()[0][0],
-                batch.column("ViewBlueprint:space_origin").to_pylist()[0][0],
-            )
-    spatial = {n for n, (kind, origin) in views.items() if kind == "2D" and origin == "/structure/plane"}
-    assert {f.title for f in FIELDS} < spatial and any(n.startswith("Structure") for n in spatial)
-    assert sum(kind == "TimeSeries" for kind, _ in views.values()) == 7
-    assert views["Run"] == ("TextDocument", "/run/metadata")
+    views = blueprint_views(path)
+    spatial = {n for n, v in views.items() if v["kind"] == "2D" and v["origin"] == "/structure/plane"}
+    assert {f"Live: {f.title}" for f in PAPER_FIELDS} < spatial
+    assert {"Magnified deformed shape", "Joint states: sliding ratio", "Joint states: largest opening"} < spatial
+    assert any(n.startswith("Live: joint forces") for n in spatial)
+    assert sum(v["kind"] == "TimeSeries" for v in views.values()) == 9
+    assert views["Run"]["origin"] == "/run/metadata" and views["Legend"]["origin"] == "/run/legend"
+    assert not any(v["pinned"] for v in views.values())  # no paper instant for a synthetic run
+    # A wall long enough for the paper's instant gets the four figures, pinned to t = 0.1 s on sim_time.
+    static, q0 = wall
+    with Recorder(tmp_path / "w.rrd", static, {**fx.METADATA, "scenario": "wall", "duration_s": 1.0}) as rec:
+        rec.log_frame(fx.frames(static, q0, 1)[0])
+    views = blueprint_views(tmp_path / "w.rrd")
+    pinned = {n: v["pinned"] for n, v in views.items() if v["pinned"]}
+    assert sorted(pinned) == sorted(
+        f"Fig. {fig}: {f.title} at t = 0.1 s" for fig, f in zip(("III.2", "III.3", "III.4", "III.5"), PAPER_FIELDS)
+    )
+    assert set(pinned.values()) == {("sim_time", 0.1, 0.1)}
 
 
 def test_recording_id_is_deterministic(wall, tmp_path):
@@ -130,24 +137,28 @@ def test_frames_on_the_step_and_sim_time_timelines(written):
     assert info["has_blueprint"] and info["complete"]
     assert info["application_id"] == "masonry"
     assert "/structure/plane/xy/blocks" in info["entity_paths"]
-    rows = temporal_rows(path, "/structure/plane/xy/blocks", "LineStrips2D:strips")
+    rows = temporal_rows(path, "/structure/plane/xy/blocks", "Points2D:positions")
     assert sorted(rows) == [f.step for f in frames]
 
 
 # --------------------------------------------------------------------------------------- per frame
-def test_block_outlines_are_closed_world_polygons(written):
-    path, static, frames, _ = written
-    rows = temporal_rows(path, "/structure/plane/xy/blocks", "LineStrips2D:strips")
-    n = len(static.block_name)
+def test_block_fills_are_the_world_polygons_inset(written):
+    """Fill vertices: the block's world polygon moved inwards by INSET × the structure's size (checked
+    with the distance of each vertex to the polygon's two edges at that corner)."""
+    path, static, frames, rec = written
+    rows = temporal_rows(path, f"/{FILL}", "Mesh3D:vertex_positions")
+    d = INSET * rec._size
     for f in frames[::7]:
-        strips = rows[f.step]
-        assert len(strips) == n
-        for b in (0, n - 1):  # the last block is the pentagon
-            pts = np.array(strips[b])
-            expected = world_outline(static, f.block_q, b)
-            assert len(pts) == len(expected) + 1
-            np.testing.assert_allclose(pts[:-1], expected, atol=1e-5)
-            np.testing.assert_allclose(pts[-1], pts[0])
+        verts = np.array(rows[f.step])
+        for b in (0, len(static.block_name) - 1):  # the last block is the pentagon
+            s, e = static.block_vert_start[b], static.block_vert_start[b + 1]
+            poly, fill = world_outline(static, f.block_q, b), verts[s:e, :2]
+            assert np.all(verts[s:e, 2] == 0.0)
+            for k in range(len(poly)):
+                for a_, b_ in ((poly[k - 1], poly[k]), (poly[k], poly[(k + 1) % len(poly)])):
+                    edge = b_ - a_
+                    inward = np.array([-edge[1], edge[0]]) / np.linalg.norm(edge)
+                    assert (fill[k] - a_) @ inward == pytest.approx(d, abs=1e-5)
 
 
 def test_array_shapes_per_frame(written):
@@ -156,42 +167,52 @@ def test_array_shapes_per_frame(written):
     n_vert = len(static.block_vert_local)
     by_step = {f.step: f for f in frames}
     arrows = temporal_rows(path, "/structure/plane/xy/forces", "Arrows2D:vectors")
-    force_values = temporal_rows(path, "/structure/plane/xy/forces", "force")
-    axes = {
-        k: temporal_rows(path, f"/structure/plane/xy/{k}", "LineStrips2D:strips")
-        for k in ("stress_axes", "strain_rate_axes")
-    }
-    tri = temporal_rows(path, "/structure/plane/xy/triangulation", "LineStrips2D:strips")
+    force_values = temporal_rows(path, "/structure/plane/xy/forces", "force_kN")
+    axes = temporal_rows(path, "/structure/plane/xy/stress_axes", "LineStrips2D:strips")
     hover_p = temporal_rows(path, "/structure/plane/xy/blocks", "p")
+    hover_pos = temporal_rows(path, "/structure/plane/xy/blocks", "Points2D:positions")
+    verts = temporal_rows(path, f"/{FILL}", "Mesh3D:vertex_positions")
+    assert {len(v) for v in verts.values()} == {n_vert} and len(verts) == N_FRAMES
     for f in FIELDS:
-        verts = temporal_rows(path, f"/{f.fill}", "Mesh3D:vertex_positions")
-        colors = temporal_rows(path, f"/{f.fill}", "Mesh3D:vertex_colors")
-        assert {len(v) for v in verts.values()} == {n_vert} and {len(c) for c in colors.values()} == {n_vert}
-        assert len(verts) == N_FRAMES
+        colors = temporal_rows(path, f"/{FILL}", f.colors)
+        assert {len(c) for c in colors.values()} == {n_vert} and len(colors) == N_FRAMES
     for step, frame in by_step.items():
-        shown = int((frame.contact_status != CONTACT_OPEN).sum())
-        assert len(arrows[step]) == shown == len(force_values[step])
-        assert len(axes["stress_axes"][step]) == len(axes["strain_rate_axes"][step]) == 2 * n
-        assert len(tri[step]) == len(static.triangles)
+        j = joint_resultants(
+            frame.contact_body, frame.contact_point, frame.contact_normal, frame.contact_force, frame.contact_status
+        )
+        assert len(arrows[step]) == len(j.force) == len(force_values[step])
+        assert len(axes[step]) == 2 * n
         assert len(hover_p[step]) == n
-        np.testing.assert_allclose(hover_p[step], frame.tensors["cell_spherical_stress"])
+        np.testing.assert_allclose(hover_p[step], frame.tensors["cell_spherical_stress"], rtol=1e-6)
+        np.testing.assert_allclose(hover_pos[step], frame.block_q[:, :2], atol=1e-6)
     assert static_value(path, "/structure/plane/xy/blocks", "name") == list(static.block_name)
 
 
-def test_force_arrows_start_at_contact_points_along_the_force(written):
+def test_joint_arrows_are_resultants_at_their_point_of_application(written):
+    """Independent check: per pair, the sum of the forces and the normal-force-weighted mean point; the
+    arrow is centred there, along the force on the body above, its length force_scale · |R|."""
     path, static, frames, rec = written
     origins = temporal_rows(path, "/structure/plane/xy/forces", "Arrows2D:origins")
     vectors = temporal_rows(path, "/structure/plane/xy/forces", "Arrows2D:vectors")
     f = frames[3]
-    shown = f.contact_status != CONTACT_OPEN
-    np.testing.assert_allclose(np.array(origins[f.step]), f.contact_point[shown], atol=1e-5)
-    v, force = np.array(vectors[f.step]), f.contact_force[shown]
-    cos = (v * force).sum(1) / np.linalg.norm(v, axis=1) / np.linalg.norm(force, axis=1)
-    np.testing.assert_allclose(cos, 1.0, atol=1e-5)
-    length = np.linalg.norm(v, axis=1)
-    assert length.max() <= 2.0 * rec.block_height * (1 + 1e-5)
-    uncapped = np.linalg.norm(force, axis=1) * rec.force_scale < 2.0 * rec.block_height
-    np.testing.assert_allclose(length[uncapped], np.linalg.norm(force, axis=1)[uncapped] * rec.force_scale, rtol=1e-5)
+    n = len(static.block_name)
+    y = np.r_[f.block_q[:, 1], f.support_q[:, 1]]
+    expected = {}
+    for (a, b), p, nrm, force in zip(f.contact_body, f.contact_point, f.contact_normal, f.contact_force):
+        if a == b:
+            continue  # not a joint
+        key = (min(a, b), max(a, b))
+        on_high = force if b > a else -force
+        fn = max(force @ nrm, 0.0)
+        tot, wp, w = expected.get(key, (np.zeros(2), np.zeros(2), 0.0))
+        expected[key] = (tot + on_high, wp + fn * p, w + fn)
+    rows = sorted((k, v) for k, v in expected.items() if v[2] > 0)
+    got_o, got_v = np.array(origins[f.step]), np.array(vectors[f.step])
+    assert len(got_o) == len(rows) and n > 0
+    for (key, (tot, wp, w)), o, v in zip(rows, got_o, got_v):
+        up = tot if y[key[1]] >= y[key[0]] else -tot
+        np.testing.assert_allclose(o + 0.5 * v, wp / w, atol=1e-5)
+        np.testing.assert_allclose(v, up * rec.force_scale, rtol=1e-5, atol=1e-6)
 
 
 def test_principal_axes_follow_eigenvectors_and_sign(written):
@@ -218,85 +239,122 @@ def test_principal_axes_follow_eigenvectors_and_sign(written):
 
 # ------------------------------------------------------------------------------------------- colours
 def ramp_frames(static, q0, count: int) -> list:
-    """Frames whose fields are ramps over the blocks, growing with time, with one outlier per end."""
+    """Frames whose fields are ramps over the blocks growing 20× over the run, with one outlier per end."""
     rng = np.random.default_rng(3)
     out = []
     for k in range(count):
         f = fx.frame(static, q0, 10 * k, rng)
         n = len(q0)
-        ramp = np.linspace(-1.0, 1.0, n) * 1e3 * (1 + 0.1 * k)
-        ramp[0], ramp[-1] = -1e6, 1e6  # far beyond any robust range
+        grow = 1.2**k
+        ramp = -np.linspace(0.0, 1.0, n) * 1e3 * grow
+        ramp[0] = -1e6  # far beyond any robust range
         f.tensors["cell_spherical_stress"] = ramp
-        dev = np.linspace(0.0, 1.0, n) * 50.0 * (1 + 0.1 * k)
+        dev = np.linspace(0.0, 1.0, n) * 50.0 * grow
         dev[-1] = 1e6
         f.tensors["cell_deviatoric_stress"] = dev
         out.append(f)
     return out
 
 
-def test_fill_colours_follow_the_field_with_a_fixed_range(wall, tmp_path):
-    static, q0 = wall
-    frames = ramp_frames(static, q0, 12)
+def test_fill_colours_follow_the_field_with_ranges_that_follow_the_data(tmp_path):
+    static, q0 = fx.wall(8, 8)  # 60 blocks: one cell (under 2 %) may lie outside the range
+    frames = ramp_frames(static, q0, 18)
     path = tmp_path / "ramp.rrd"
     with Recorder(path, static, fx.METADATA, batch_frames=5) as rec:
         for f in frames:
             rec.log_frame(f)
     owner = np.repeat(np.arange(len(q0)), np.diff(static.block_vert_start))
     first_vertex = np.r_[0, np.cumsum(np.diff(static.block_vert_start))[:-1]]
-    for key, short, lut in (
-        ("cell_spherical_stress", "spherical_stress", cm.COOLWARM),
-        ("cell_deviatoric_stress", "deviatoric_stress", cm.VIRIDIS),
-    ):
-        # The range comes from the first batch only (5 frames): the 98th percentile, rounded up.
-        first = np.concatenate([f.tensors[key] for f in frames[:5]])
-        m = cm.nice_ceil(np.percentile(np.abs(first), 98))
-        expected_range = (-m, m) if lut is cm.COOLWARM else (0.0, m)
-        assert rec.field_ranges[key] == pytest.approx(expected_range)
-        rows = temporal_rows(path, f"/structure/fields/{short}", "Mesh3D:vertex_colors")
-        for f in (frames[0], frames[-1]):
-            colors = np.array(rows[f.step], dtype=np.uint32)
+    read = field_frames(path)
+    for key, lut in (("cell_spherical_stress", cm.BLUES), ("cell_deviatoric_stress", cm.VIRIDIS)):
+        spec = rec_mod.layout.FIELD_BY_KEY[key]
+        rows = temporal_rows(path, f"/{FILL}", spec.colors)
+        ranges = []
+        for f in frames:
+            lo, hi = read[f.step]["ranges"][key]
+            ranges.append((lo, hi))
             values = f.tensors[key]
+            if key == "cell_spherical_stress":
+                assert hi == 0.0 and lo < 0.0  # p: one-sided, ends at zero
+            outside = (values < lo) | (values > hi)
+            assert outside.mean() <= OUTSIDE_SHARE + 1e-12
+            inside = values[~outside]
+            assert (inside.max() - inside.min()) / (hi - lo) >= MIN_SPAN
+            colors = np.array(rows[f.step], dtype=np.uint32)
             assert np.all(colors == colors[first_vertex][owner])  # one colour per block
             block_colors = colors[first_vertex]
-            assert block_colors[np.argmax(values)] == lut[-1]  # the highest value gets the top colour
-            assert block_colors[np.argmin(values)] == lut[0]
-            np.testing.assert_array_equal(block_colors, cm.map_scalars(values, *expected_range, lut))
-            index = {int(c): i for i, c in enumerate(lut)}
-            order = np.argsort(values)
-            assert np.all(np.diff([index[int(c)] for c in block_colors[order]]) >= 0)  # monotone
+            t = (values - lo) / (hi - lo)  # an independent linear map (both are one-sided here)
+            expected = np.where(
+                t < 0, cm.UNDER_RGBA, np.where(t > 1, cm.OVER_RGBA, lut[np.rint(np.clip(t, 0, 1) * 255).astype(int)])
+            )
+            np.testing.assert_array_equal(block_colors, expected)
+        assert len(set(ranges)) >= 2  # the data grew 20×: the range followed
 
 
 def test_nan_field_values_are_grey(written):
     path, static, frames, _ = written
-    rows = temporal_rows(path, "/structure/fields/volumetric_strain_rate", "Mesh3D:vertex_colors")
+    spec = rec_mod.layout.FIELD_BY_KEY["cell_volumetric_strain_rate"]
+    rows = temporal_rows(path, f"/{FILL}", spec.colors)
     s, e = static.block_vert_start[1], static.block_vert_start[2]  # block 1 has no triangle (NaN)
     for f in frames[::5]:
         assert np.isnan(f.tensors["cell_volumetric_strain_rate"][1])
         assert set(rows[f.step][s:e]) == {cm.NAN_RGBA}
 
 
-def test_legend_and_run_document(written):
+def test_legend_labels_per_frame_and_run_document(written):
     path, static, frames, rec = written
     info = inspect_recording(path)
     doc = info["metadata"]
     assert doc.startswith("# masonry — synthetic wall")
     assert "completed, last frame t = 0.240 s (step 240)" in doc
-    for needle in (
-        "parameters.freq | 2.0",
-        "Wall time",
-        "| masonry |",
-        "| rerun-sdk | 0.41",
-        "| numpy |",
-        "| numba |",
-        "| python |",
-        "m per N",
-    ):
+    for needle in ("parameters.freq | 2.0", "Wall time", "| masonry |", "| rerun-sdk | 0.41", "| numba |", "kN"):
         assert needle in doc, needle
+    read = field_frames(path)
     for f in FIELDS:
         lo, hi = rec.field_ranges[f.key]
         assert f"{lo:.4g} … {hi:.4g}" in doc
-        labels = static_value(path, f"/{f.labels}", "Points2D:labels")
-        assert len(labels) == 3 and f.title in labels[-1]
+        labels = temporal_rows(path, f"/{f.labels}", "Points2D:labels")
+        last = labels[frames[-1].step]
+        assert len(last) == 8 and last[5] == f.title  # five ticks, the title, below / above counts
+        assert read[frames[-1].step]["ranges"][f.key] == (lo, hi)
+    legend = static_value(path, "/run/legend", "TextDocument:text")
+    assert "Joint forces" in legend[0] and "Magnified" in legend[0]
+
+
+def test_solver_health_once_per_step_and_no_empty_first_frame(wall, tmp_path):
+    """log_step values are logged at every step; the initial frame without forces is not shown."""
+    static, q0 = wall
+    frames = fx.frames(static, q0, 4)
+    empty = type(frames[0])(**{**frames[0].__dict__, "contact_force": np.zeros_like(frames[0].contact_force)})
+    path = tmp_path / "steps.rrd"
+
+    class Stats:
+        def __init__(self, k):
+            self.iterations, self.residual, self.contact_count = 10 + k, 10.0 ** (-3 - k % 3), 40
+
+    with Recorder(path, static, {**fx.METADATA, "nlgs_tolerance": 1e-4}, batch_frames=2) as rec:
+        rec.log_frame(empty)
+        for k in range(1, 31):
+            rec.log_step(k, k * static.dt, Stats(k))
+            if k % 10 == 0:
+                rec.log_frame(frames[k // 10])
+    iterations = temporal_rows(path, "/series/solver/iterations", "Scalars:scalars")
+    residual = temporal_rows(path, "/series/solver/log10_residual", "Scalars:scalars")
+    assert sorted(iterations) == list(range(1, 31)) == sorted(residual)
+    assert iterations[7] == [17.0]
+    np.testing.assert_allclose(residual[7], [-4.0, -4.0])  # log10 residual, log10 tolerance
+    assert inspect_recording(path)["steps"] == (10, 30) and inspect_recording(path)["frames"] == 3
+
+
+def test_magnified_shape(written):
+    path, static, frames, rec = written
+    rows = temporal_rows(path, "/structure/plane/xy/magnified", "LineStrips2D:strips")
+    m = rec.magnify
+    assert m >= 1.0
+    f = frames[-1]
+    q = frames[0].block_q + m * (f.block_q - frames[0].block_q)
+    np.testing.assert_allclose(np.array(rows[f.step][0])[:-1], world_outline(static, q, 0), atol=1e-4)
+    assert len(rows[f.step]) == len(static.block_name) + 1  # blocks and the ground
 
 
 # ------------------------------------------------------------------------------- closing and errors
@@ -361,7 +419,7 @@ def test_inspect_a_file_without_footer(wall, tmp_path):
 
 def test_frames_without_tensor_fields_or_contacts(wall, tmp_path):
     static, q0 = wall
-    f = fx.frames(static, q0, 1)[0]
+    f = fx.frames(static, q0, 2)[1]  # step 10 (an initial frame without forces is not shown)
     empty = type(f)(
         **{
             **f.__dict__,
@@ -378,10 +436,10 @@ def test_frames_without_tensor_fields_or_contacts(wall, tmp_path):
     path = tmp_path / "empty.rrd"
     with Recorder(path, static, fx.METADATA) as rec:
         rec.log_frame(empty)
-    rows = temporal_rows(path, "/structure/fields/spherical_stress", "Mesh3D:vertex_colors")
-    assert set(rows[0]) == {cm.NAN_RGBA}
-    assert temporal_rows(path, "/structure/plane/xy/forces", "Arrows2D:vectors")[0] == []
-    assert "not fixed yet" in inspect_recording(path)["metadata"]
+    rows = temporal_rows(path, f"/{FILL}", rec_mod.layout.FIELD_BY_KEY["cell_spherical_stress"].colors)
+    assert set(rows[10]) == {cm.NAN_RGBA}
+    assert temporal_rows(path, "/structure/plane/xy/forces", "Arrows2D:vectors")[10] == []
+    assert "scale not fixed yet" in inspect_recording(path)["metadata"]
 
 
 def test_viewer_safe_text():

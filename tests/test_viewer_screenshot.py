@@ -10,7 +10,7 @@ import ctypes.util
 import numpy as np
 import pytest
 
-from masonrycli.colormap import COOLWARM, unpack_rgba
+from masonrycli.colormap import BLUES, unpack_rgba
 from masonrycli.recording import Recorder, screenshot_recording
 from masonrycli.recording.layout import SUPPORT_FILL_RGBA
 from masonrycli.recording.readback import _viewer_executable
@@ -53,7 +53,7 @@ def screenshot(tmp_path_factory):
         for f in frames:
             rec.log_frame(f)
     png = tmp / "viewer.png"
-    reports = screenshot_recording(rrd, png, time_step=frames[-1].step, timeout=120, tabs_dir=tmp / "tabs")
+    reports = screenshot_recording(rrd, png, time_s=frames[-1].time, timeout=120, tabs_dir=tmp / "tabs")
     return png, reports, tmp
 
 
@@ -61,7 +61,7 @@ def test_no_view_reports_visualizer_errors(screenshot):
     png, reports, tmp = screenshot
     assert reports == []
     assert png_size(png) == (1920, 1080)
-    assert len(list((tmp / "tabs").glob("tab*.png"))) == 4  # every tab was shown and checked
+    assert len(list((tmp / "tabs").glob("tab*.png"))) == 7  # every tab was shown and checked
 
 
 def test_blocks_are_drawn_y_up_with_field_colours(screenshot):
@@ -70,7 +70,7 @@ def test_blocks_are_drawn_y_up_with_field_colours(screenshot):
     png, _, _ = screenshot
     image = np.asarray(image_module.open(png).convert("RGB"))
     main = image[60:1000, :1100]  # the structure view (left of the plots, above the time panel)
-    blocks = near(main, unpack_rgba(COOLWARM)[:, :3])
+    blocks = near(main, unpack_rgba(BLUES)[:, :3])
     ground = near(main, unpack_rgba(np.array([SUPPORT_FILL_RGBA]))[:, :3].repeat(4, axis=0), tol=12)
     assert blocks.mean() > 0.05 and ground.mean() > 0.01  # filled blocks and the ground are visible
     block_rows, ground_rows = np.nonzero(blocks)[0], np.nonzero(ground)[0]

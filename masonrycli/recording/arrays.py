@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import numpy as np
 import pyarrow as pa
+import rerun as rr
 
 from masonrycli.recording._rerun_private import STRIP_TYPE, VEC2_TYPE
 
@@ -80,3 +81,11 @@ class FrameBatch(dict):
         """Ragged per-frame arrays -> (all rows, rows per frame)."""
         lengths = np.array([len(p) for p in self[name]], dtype=np.int64)
         return (np.concatenate(self[name]) if lengths.sum() else np.zeros(empty_shape)), lengths
+
+
+def time_indexes(b: FrameBatch) -> list:
+    """The ``step`` and ``sim_time`` columns of a batch (its "step" and "time" lists)."""
+    return [
+        rr.TimeColumn("step", sequence=np.asarray(b["step"], dtype=np.int64)),
+        rr.TimeColumn("sim_time", duration=np.asarray(b["time"], dtype=np.float64)),
+    ]

@@ -1,4 +1,4 @@
-"""The run document: the Markdown page shown beside the views (status, parameters, scales, versions).
+"""The run document (status, parameters, scales, versions) and the legend shown under the structure views.
 
 Rewritten whenever a scale is fixed and when the recorder closes; the last one logged wins. Every text
 that reaches the viewer goes through ``viewer_safe_text``.
@@ -14,7 +14,8 @@ import numpy as np
 import rerun as rr
 
 from masonrycli import __version__ as MASONRY_VERSION
-from masonrycli.recording.layout import ARROW_CAP, AXES, FIELDS, ROBUST_PERCENTILE
+from masonrycli.colour_range import MIN_SPAN, OUTSIDE_SHARE
+from masonrycli.recording.layout import AXES, FIELDS, ROBUST_PERCENTILE
 
 
 def run_document(
@@ -34,12 +35,15 @@ def run_document(
     glyph_length: float,
     axis_scale: dict[str, float],
     field_ranges: dict[str, tuple[float, float]],
+    range_changes: dict[str, int] | None = None,
+    magnify: float | None = None,
 ) -> str:
     """Markdown of the run document.
 
     ``last``: (step, time) of the last frame logged, None before the first; ``wall_time``: s since the
-    recording was opened; ``force_scale`` (m per N), ``axis_scale`` (glyph set -> |λ| at full length) and
-    ``field_ranges`` as fixed so far by the recorder.
+    recording was opened; ``force_scale`` (m per N), ``axis_scale`` (glyph set -> |λ| at full length),
+    ``field_ranges`` (the last range of each field), ``range_changes`` (how often each was refitted) and
+    ``magnify`` (the magnified view's factor) as the recorder has them so far.
     """
     line = status
     if last is not None:
@@ -48,6 +52,7 @@ def run_document(
     if note:  # the caller's note usually says it all ("interrupted at t = ..."): do not repeat it
         line = note if note.startswith(status) else f"{line}: {note}"
     pct = f"{ROBUST_PERCENTILE:g}th percentile"
+    changes = range_changes or {}
     lines = [
         f"# masonry — {metadata.get('scenario', 'run')}",
         "",
@@ -65,26 +70,26 @@ def run_document(
         "",
         "## How to read the views",
         "",
-        "- **Forces**: arrow = contact force on body b at the contact point; green = stick, orange = "
-        f"slip. Scale {_fmt_scale(force_scale, 'm per N')}: a force of the first batch's {pct} is "
-        f"one median block height ({block_height:.3g} m) long; arrows are capped at {ARROW_CAP:g} "
-        "block heights (hover an arrow for its force in N). Yellow dots: hinges.",
+        legend_markdown(force_scale, block_height, magnify),
         "- **Principal axes**: two segments per cell along the eigenvectors, half-length proportional "
-        f"to |λ|, {glyph_length:.3g} m at the value below (longer ones clipped); black = "
-        "compression / contraction, magenta = tension / extension. Stress axes in the main view; "
-        "strain-rate axes and the centroid triangulation in the volumetric strain rate view.",
+        f"to |λ|, {glyph_length:.3g} m at the value below (longer ones clipped; the {pct} of the first "
+        "batch); black = compression / contraction, magenta = tension / extension. Stress axes in the "
+        "main view and the spherical-stress tabs; the triangles of the cells (as built) in the volumetric "
+        "strain rate tabs.",
         *(f"  - {n.replace('_', ' ')}: full length at |λ| = {_fmt_scale(axis_scale.get(n), '')}" for n in AXES),
-        "- **Fields**: each colour range is fixed for the whole run, at the first batch where the field "
-        f"is not zero ({pct} of |value|, rounded up); values beyond take the end colours; grey = "
-        "undefined (NaN). Hover a block outline for its values.",
+        "- **Colour ranges follow the data**: each field's range is checked against every recorded frame "
+        f"and refitted from that frame on only when more than {100 * OUTSIDE_SHARE:g} % of the cells fall "
+        f"outside it or the cells use less than {100 * MIN_SPAN:g} % of it; the colour bar always shows "
+        "the range in force (five ticks) and how many cells are beyond it.",
         "",
-        "| field | colour map | range |",
-        "|---|---|---|",
+        "| field | colour map | last range | refits |",
+        "|---|---|---|---|",
     ]
+    maps = {"signed": "blue–grey–red, zero grey", "negative": "blues, zero white", "positive": "viridis"}
     for f in FIELDS:
         r = field_ranges.get(f.key)
-        rng = "not fixed yet (zero so far)" if r is None else f"{r[0]:.4g} … {r[1]:.4g} {f.unit}"
-        lines.append(f"| {f.title} | {'blue–grey–red' if f.signed else 'viridis'} | {rng} |")
+        rng = "none yet" if r is None else f"{r[0]:.4g} … {r[1]:.4g} {f.unit}"
+        lines.append(f"| {f.title} | {maps[f.kind]} | {rng} | {changes.get(f.key, 0)} |")
     lines += [
         "",
         "## Versions",
@@ -94,6 +99,24 @@ def run_document(
         *(f"| {k} | {v} |" for k, v in _versions().items()),
     ]
     return "\n".join(lines) + "\n"
+
+
+def legend_markdown(force_scale: float | None, block_height: float, magnify: float | None) -> str:
+    """The legend shown under the structure views (and in the run document)."""
+    scale = (
+        "scale not fixed yet"
+        if not force_scale
+        else f"{block_height:.3g} m (a median block height) = {block_height / force_scale / 1e3:.4g} kN"
+    )
+    factor = "set when the run closes" if magnify is None else f"× {magnify:g}"
+    return (
+        "- **Joint forces**: one arrow per joint, the resultant of its contact forces on the body above it, "
+        f"centred on its point of application (line of thrust); length proportional to the force, {scale}. Green = sticking, "
+        "orange = sliding, red = open at one end (turning about the other). Yellow dots: hinges.\n"
+        "- **Fills**: colour bar beside the structure; grey = undefined (NaN), black = below the range, "
+        "white = above it. Hover a block for its name and values.\n"
+        f"- **Magnified deformed shape**: displacements and rotations {factor}; grey = as built."
+    )
 
 
 _SAFE_EXTRA: Final = frozenset("–—‘’“”…·•×−≤≥≈°±²³µ√∞→✓∑ΔΣ")

@@ -8,104 +8,128 @@ from __future__ import annotations
 
 from typing import Final, NamedTuple
 
+import rerun as rr
 import rerun.blueprint as rrb
+from rerun.blueprint.encodings import ComponentSourceKind, VisualizerComponentMapping
 
-ROBUST_PERCENTILE: Final = 98.0  # scales and colour ranges come from this percentile of |value|
-ARROW_CAP: Final = 2.0  # longest force arrow, in median block heights (hover an arrow for its force)
+from masonrycli.colour_range import ScaleKind
+
+ROBUST_PERCENTILE: Final = 98.0  # the glyph scales come from this percentile of |value|
 GLYPH_HALF_LENGTH: Final = 0.45  # longest principal-axis half-length / median block's smaller side
+RESULTANT_LENGTH: Final = 1.5  # joint resultant of the first loaded frame's 95th percentile, in block heights
+RESULTANT_PERCENTILE: Final = 95.0
+INSET: Final = 0.002  # block fills are inset by this × the structure's size: the joints show as dark lines
 
 
 class FieldSpec(NamedTuple):
     key: str  # name in Frame.tensors
     title: str
     unit: str
-    signed: bool  # diverging colour map on [−M, M] if True, sequential on [0, M] otherwise
-    fill: str  # entity paths: the blocks filled with the field's colours, the colour bar, its labels
-    bar: str
+    kind: ScaleKind  # "signed" (diverging about 0), "negative" or "positive" (one-sided)
+    floor: float  # the colour range never shrinks below this (field unit): smaller values are noise
+    colors: str  # the fill mesh's colour component for this field ("<Name>:colors")
+    bar: str  # entity paths: the colour bar and its labels
     labels: str
 
 
-def _field(key: str, title: str, unit: str, signed: bool) -> FieldSpec:
-    short = key.removeprefix("cell_")
+def _field(key: str, title: str, unit: str, kind: ScaleKind, floor: float) -> FieldSpec:
+    short = key.removeprefix("cell_").removeprefix("block_")
+    archetype = "".join(w.capitalize() for w in short.split("_"))
     return FieldSpec(
         key,
         title,
         unit,
-        signed,
-        f"structure/fields/{short}",
+        kind,
+        floor,
+        f"{archetype}:colors",
         f"structure/legend/{short}",
         f"structure/plane/xy/legend/{short}",
     )
 
 
 FIELDS: Final = (
-    _field("cell_volumetric_strain_rate", "Volumetric strain rate", "1/s", True),
-    _field("cell_deviatoric_strain", "Deviatoric cumulated strain", "", False),
-    _field("cell_spherical_stress", "Spherical stress p", "Pa", True),
-    _field("cell_deviatoric_stress", "Deviatoric stress q", "Pa", False),
+    _field("cell_volumetric_strain_rate", "Volumetric strain rate", "1/s", "signed", 1e-4),
+    _field("cell_deviatoric_strain", "Deviatoric cumulated strain", "", "positive", 1e-5),
+    _field("cell_spherical_stress", "Spherical stress p", "Pa", "negative", 100.0),
+    _field("cell_deviatoric_stress", "Deviatoric stress q", "Pa", "positive", 100.0),
+    _field("block_sliding_ratio", "Sliding ratio", "", "positive", 1.0),
+    _field("block_max_opening", "Largest joint opening", "m", "positive", 1e-4),
 )
+"""Colour-mapped per-block fields: the paper's four (Figs. III.2–III.5 / III.7–III.10), then the joint
+states. The volumetric strain rate of a block without a cell strain but in a one-block chain (a voussoir
+of a bare ring) is its ``chain_strain_rate``: the strain rate along the ring."""
+PAPER_FIELDS: Final = FIELDS[:4]
 FIELD_BY_KEY: Final = {f.key: f for f in FIELDS}
-HOVER_VALUES: Final = {  # per-block value shown when hovering a block outline -> Frame.tensors key
+CHAIN_KEY: Final = "chain_strain_rate"
+HOVER_VALUES: Final = {  # per-block value shown when hovering a block -> Frame.tensors key
     "p": "cell_spherical_stress",
     "q": "cell_deviatoric_stress",
     "volumetric_strain_rate": "cell_volumetric_strain_rate",
+    "chain_strain_rate": CHAIN_KEY,
     "deviatoric_strain": "cell_deviatoric_strain",
     "sliding_ratio": "block_sliding_ratio",
     "max_opening": "block_max_opening",
 }
 AXES: Final = {  # glyph set -> (principal values (N, 2) key, angle of the major one (N,) key)
+    # (stress only: strain-rate glyphs doubled the file of a large structure; the volumetric strain rate
+    # and the cells' triangles show where the masonry opens)
     "stress_axes": ("cell_principal_stress", "cell_principal_angle"),
-    "strain_rate_axes": ("cell_principal_strain_rate", "cell_principal_strain_rate_angle"),
 }
 TENSOR_KEYS: Final = tuple(
     dict.fromkeys([*(f.key for f in FIELDS), *(k for pair in AXES.values() for k in pair), *HOVER_VALUES.values()])
 )
-SCALARS: Final = (
-    "energy_kinetic",
-    "energy_potential",
-    "energy_dissipated",
-    "support_work",
-    "nlgs_iterations",
-    "nlgs_residual",
-    "contact_count",
-)
+SCALARS: Final = ("energy_kinetic", "energy_potential", "energy_dissipated", "support_work")
+PAPER_FIGURES: Final = {  # scenario -> (the paper's instant, s; figure numbers of the four fields)
+    "wall": (0.1, ("III.2", "III.3", "III.4", "III.5")),
+    "arch": (5.0, ("III.7", "III.8", "III.9", "III.10")),
+    "aqueduct": (5.0, ("III.7", "III.8", "III.9", "III.10")),
+}
 
 PLANE: Final = "structure/plane"
 XY: Final = "structure/plane/xy"
-BLOCKS: Final = f"{XY}/blocks"
+FILL: Final = "structure/fill"  # the blocks, filled: one mesh, one colour component per field
+BLOCKS: Final = f"{XY}/blocks"  # a point per block under its fill: names and values on hover
 SUPPORT_OUTLINES: Final = f"{XY}/supports"
 TRIANGULATION: Final = f"{XY}/triangulation"
 FORCES: Final = f"{XY}/forces"
 HINGES: Final = f"{XY}/hinges"
 STRESS_AXES: Final = f"{XY}/stress_axes"
-STRAIN_RATE_AXES: Final = f"{XY}/strain_rate_axes"
+MAGNIFIED: Final = f"{XY}/magnified"
+UNDEFORMED: Final = f"{XY}/undeformed"
 SUPPORT_FILL: Final = "structure/supports"
 METADATA: Final = "run/metadata"
+LEGEND: Final = "run/legend"
 SERIES: Final = {
-    "energy": "series/energy",
+    "energy_small": "series/energy/kinetic_dissipated",
+    "energy_large": "series/energy/potential_work",
+    "energy_balance": "series/energy/balance_error",
     "max_displacement": "series/blocks/max_displacement",
     "support_velocity": "series/supports/velocity",
     "support_displacement": "series/supports/displacement",
     "iterations": "series/solver/iterations",
-    "residual": "series/solver/residual",
+    "residual": "series/solver/log10_residual",
     "contacts": "series/contacts/count",
 }
+PER_STEP_SERIES: Final = ("iterations", "residual", "contacts")  # logged after every step, not per frame
 
 
 ENTITY_PATHS: Final = (
     PLANE,
     XY,
+    FILL,
     BLOCKS,
     SUPPORT_OUTLINES,
     TRIANGULATION,
     FORCES,
     HINGES,
     STRESS_AXES,
-    STRAIN_RATE_AXES,
+    MAGNIFIED,
+    UNDEFORMED,
     SUPPORT_FILL,
-    *(p for f in FIELDS for p in (f.fill, f.bar, f.labels)),
+    *(p for f in FIELDS for p in (f.bar, f.labels)),
     *SERIES.values(),
     METADATA,
+    LEGEND,
 )
 """Every entity of a recording (without the leading "/")."""
 
@@ -117,27 +141,85 @@ TRIANGULATION_RGBA: Final = 0x5A5A5AFF
 LEGEND_TEXT_RGBA: Final = 0xDCDCDCFF
 STICK_RGBA: Final = 0x00963CFF  # force arrow of a sticking contact (green)
 SLIP_RGBA: Final = 0xFF8C00FF  # force arrow of a sliding contact (orange)
-OPEN_RGBA: Final = 0x9A9A9AFF  # an open contact with a force (should not happen)
+OPEN_RGBA: Final = 0xE03C31FF  # joint open at one end, turning about the other (red)
+MAGNIFIED_RGBA: Final = 0xE8E8E8FF
+UNDEFORMED_RGBA: Final = 0x6E6E6EFF
 HINGE_RGBA: Final = 0xFFD700FF
 COMPRESSION_RGBA: Final = 0x141414FF  # principal axis with a negative value (near black)
 TENSION_RGBA: Final = 0xDC00DCFF  # principal axis with a positive value (magenta)
 
 
-def _structure_view(name: str, field: FieldSpec, extra: tuple[str, ...] = ()) -> rrb.Spatial2DView:
-    paths = (SUPPORT_FILL, field.fill, field.bar, BLOCKS, SUPPORT_OUTLINES, field.labels, *extra)
-    return rrb.Spatial2DView(origin=f"/{PLANE}", contents=[f"+ /{p}" for p in paths], name=name)
+def _fill_colours(f: FieldSpec) -> dict:
+    """Blueprint overrides: the fill mesh takes its vertex colours from field ``f``'s component, and the
+    hover points (one per block, under the pointer wherever it is on the block) the same block colours,
+    so they do not show."""
+
+    def source(target: str, component: str) -> VisualizerComponentMapping:
+        return VisualizerComponentMapping(
+            target=target, source_kind=ComponentSourceKind.SourceComponent, source_component=component
+        )
+
+    return {
+        f"/{FILL}": [rr.Mesh3D.from_fields().visualizer(mappings=[source("Mesh3D:vertex_colors", f.colors)])],
+        f"/{BLOCKS}": [rr.Points2D.from_fields().visualizer(mappings=[source("Points2D:colors", f.colors)])],
+    }
 
 
-def build_blueprint(main_field: str = "cell_spherical_stress") -> rrb.Blueprint:
-    """Structure views in tabs (left); time series and the run document (right)."""
-    main = FIELD_BY_KEY[main_field]
-    strain_rate_extra = (TRIANGULATION, STRAIN_RATE_AXES)
-    structure = rrb.Tabs(
-        _structure_view(f"Structure: forces, principal stress, {main.title}", main, (FORCES, STRESS_AXES, HINGES)),
-        *(_structure_view(f.title, f, strain_rate_extra if f is FIELDS[0] else ()) for f in FIELDS),
-        active_tab=0,
+def _structure_view(name: str, f: FieldSpec, extra: tuple[str, ...] = (), at: float | None = None) -> rrb.Spatial2DView:
+    """A tab of the structure coloured by field ``f``; ``at``: pinned to that sim_time (s), else live.
+    Hover points (block values) in the tabs of the paper's fields."""
+    hover = (BLOCKS,) if f in PAPER_FIELDS else ()
+    paths = (SUPPORT_FILL, FILL, f.bar, *hover, SUPPORT_OUTLINES, f.labels, *extra)
+    pinned = None
+    if at is not None:
+        moment = rrb.TimeRangeBoundary.absolute(seconds=at)
+        pinned = rrb.VisibleTimeRanges(timeline="sim_time", start=moment, end=moment)
+    return rrb.Spatial2DView(
+        origin=f"/{PLANE}",
+        contents=[f"+ /{p}" for p in paths],
+        name=name,
+        overrides=_fill_colours(f),
+        time_ranges=pinned,
     )
 
+
+def build_blueprint(
+    main_field: str = "cell_spherical_stress", paper: tuple[float, tuple[str, ...]] | None = None
+) -> rrb.Blueprint:
+    """Structure tabs and the on-screen legend (left); time series and the run document (right).
+
+    Tabs: the live main view (forces, principal stress, ``main_field``), with ``paper`` = (t, figure
+    numbers) the paper's four figures pinned to t, the four fields live, the magnified deformed shape,
+    the joint states. Opens paused on ``sim_time``.
+    """
+    main = FIELD_BY_KEY[main_field]
+    by_key = {f.key: f for f in FIELDS}
+    vsr, dev, p, q, sliding, opening = (by_key[k] for k in FIELD_BY_KEY)
+    strain_rate_extra = (TRIANGULATION,)
+    extras = {vsr.key: strain_rate_extra, p.key: (STRESS_AXES,)}
+    joints = (FORCES, HINGES)
+    tabs = [_structure_view(f"Live: joint forces, principal stress, {main.title}", main, (FORCES, STRESS_AXES, HINGES))]
+    if paper is not None:
+        t, figures = paper
+        tabs += [
+            _structure_view(f"Fig. {fig}: {f.title} at t = {t:g} s", f, extras.get(f.key, ()), at=t)
+            for fig, f in zip(figures, PAPER_FIELDS)
+        ]
+    tabs += [_structure_view(f"Live: {f.title}", f, extras.get(f.key, ())) for f in PAPER_FIELDS]
+    tabs += [
+        rrb.Spatial2DView(
+            origin=f"/{PLANE}",
+            contents=[f"+ /{x}" for x in (UNDEFORMED, MAGNIFIED)],
+            name="Magnified deformed shape",
+        ),
+        _structure_view("Joint states: sliding ratio", sliding, joints),
+        _structure_view("Joint states: largest opening", opening, joints),
+    ]
+    structure = rrb.Vertical(
+        rrb.Tabs(*tabs, active_tab=1 if paper is not None else 0),
+        rrb.TextDocumentView(origin=f"/{LEGEND}", name="Legend"),
+        row_shares=[5, 1],
+    )
     whole_run = rrb.TimeAxis(
         view_range=rrb.TimeRange(rrb.TimeRangeBoundary.infinite(), rrb.TimeRangeBoundary.infinite())
     )
@@ -147,13 +229,17 @@ def build_blueprint(main_field: str = "cell_spherical_stress") -> rrb.Blueprint:
 
     right = rrb.Vertical(
         rrb.Tabs(
-            plot("energy", "Energy (J)"),
+            plot("energy_small", "Kinetic and dissipated energy (J)"),
+            plot("energy_balance", "Energy balance error (J)"),
+            plot("energy_large", "Potential change and support work (J)"),
             plot("max_displacement", "Max block displacement (m)"),
             plot("support_velocity", "Support velocity (m/s)"),
             plot("support_displacement", "Support displacement (m)"),
         ),
         rrb.Tabs(
-            plot("iterations", "NLGS iterations"), plot("residual", "NLGS residual"), plot("contacts", "Contacts")
+            plot("residual", "NLGS residual (log10) and tolerance"),
+            plot("iterations", "NLGS sweeps per step"),
+            plot("contacts", "Contacts"),
         ),
         rrb.TextDocumentView(origin=f"/{METADATA}", name="Run"),
         row_shares=[2, 2, 3],
@@ -162,5 +248,5 @@ def build_blueprint(main_field: str = "cell_spherical_stress") -> rrb.Blueprint:
         rrb.Horizontal(structure, right, column_shares=[3, 2]),
         rrb.BlueprintPanel(state="collapsed"),
         rrb.SelectionPanel(state="collapsed"),
-        rrb.TimePanel(state="collapsed"),
+        rrb.TimePanel(state="collapsed", timeline="sim_time", play_state="paused"),
     )

@@ -1,4 +1,5 @@
-"""Reading recordings back: a summary of an ``.rrd`` (``inspect``) and screenshots from a headless viewer."""
+"""Reading recordings back: a summary of an ``.rrd`` (``inspect``), its views and per-frame field values and
+colour ranges (for tests and docs), and screenshots from a headless viewer."""
 
 from __future__ import annotations
 
@@ -19,7 +20,7 @@ import pyarrow as pa
 import rerun as rr
 
 from masonrycli.recording._rerun_private import viewer_pid
-from masonrycli.recording.layout import METADATA
+from masonrycli.recording.layout import BLOCKS, CHAIN_KEY, FIELDS, HOVER_VALUES, METADATA
 
 _TRUNCATED = re.compile(r"Message payload \(start (\d+), length \d+\) exceeds file size")
 _MESSAGE_HEADER_BYTES = 16  # an RRD message: kind (u64) and length (u64), then the payload
@@ -67,10 +68,10 @@ def inspect_recording(path: str | os.PathLike) -> dict:
     """Summary of a recording file; works without a footer too (a killed writer's file) and on a file cut
     in the middle of a message (read up to its last complete message).
 
-    Keys: application_id, recording_id, frames (distinct `step` values), steps (first, last) or None,
-    time_span (first, last sim_time, s) or None, entity_paths (sorted, with the leading "/"),
-    has_blueprint, complete (footer present), truncated (cut in a message), metadata (the run document's
-    Markdown, or None).
+    Keys: application_id, recording_id, frames (distinct `step` values of the recorded frames; solver
+    health is logged for every step besides), steps (first, last frame) or None, time_span (first, last
+    frame's sim_time, s) or None, entity_paths (sorted, with the leading "/"), has_blueprint, complete
+    (footer present), truncated (cut in a message), metadata (the run document's Markdown, or None).
     """
     with tempfile.TemporaryDirectory(prefix="masonry-inspect-") as scratch:
         return _summarise(*_open_reader(os.fspath(path), scratch), path)
@@ -96,6 +97,8 @@ def _summarise(reader: rr.chunk.RrdReader, truncated: bool, path) -> dict:
                 texts = [t for t in batch.column("TextDocument:text").to_pylist() if t]
                 metadata = texts[-1][0] if texts else metadata  # the last one logged wins
             continue
+        if chunk.entity_path != f"/{BLOCKS}":
+            continue
         if "step" in names:
             steps.update(batch.column("step").to_numpy().tolist())
         if "sim_time" in names and batch.num_rows:
@@ -120,6 +123,63 @@ def _summarise(reader: rr.chunk.RrdReader, truncated: bool, path) -> dict:
     }
 
 
+def blueprint_views(path: str | os.PathLike) -> dict[str, dict]:
+    """The embedded blueprint's views: name -> {"kind", "origin", "pinned"}; ``pinned`` is (timeline,
+    start s, end s) for a view whose visible time range is fixed, else None."""
+    reader = rr.chunk.RrdReader(os.fspath(path))
+    by_id: dict[str, dict] = {}
+    for chunk in reader.stream(store=reader.blueprints()[0]):
+        batch = chunk.to_record_batch()
+        parts = chunk.entity_path.strip("/").split("/")
+        if parts[0] != "view" or len(parts) < 2:
+            continue
+        view = by_id.setdefault(parts[1], {"pinned": None})
+        names = batch.schema.names
+        if "ViewBlueprint:display_name" in names:
+            view["name"] = batch.column("ViewBlueprint:display_name").to_pylist()[-1][0]
+            view["kind"] = batch.column("ViewBlueprint:class_identifier").to_pylist()[-1][0]
+            view["origin"] = batch.column("ViewBlueprint:space_origin").to_pylist()[-1][0]
+        if "VisibleTimeRanges:ranges" in names:
+            (r,) = batch.column("VisibleTimeRanges:ranges").to_pylist()[-1]
+            view["pinned"] = (r["timeline"], 1e-9 * r["range"]["start"], 1e-9 * r["range"]["end"])
+    return {v["name"]: v for v in by_id.values() if "name" in v}
+
+
+def field_frames(path: str | os.PathLike) -> dict[int, dict]:
+    """Per recorded step: {"time": s, "values": hover values by field key (N,), "ranges": field key ->
+    the colour range logged for that frame}. The volumetric strain rate is the one the fill shows (the
+    chain strain rate where the cell has none)."""
+    out: dict[int, dict] = {}
+    hover = {name: key for name, key in HOVER_VALUES.items()}
+    labels = {f"/{f.labels}": f.key for f in FIELDS}
+    for chunk in rr.chunk.RrdReader(os.fspath(path)).stream():
+        if chunk.is_static:
+            continue
+        batch = chunk.to_record_batch()
+        names = batch.schema.names
+        if "step" not in names:
+            continue
+        steps = batch.column("step").to_pylist()
+        if chunk.entity_path == f"/{BLOCKS}":
+            times = batch.column("sim_time").cast(pa.int64()).to_numpy() * 1e-9
+            for name, key in hover.items():
+                if name in names:
+                    for step, t, v in zip(steps, times, batch.column(name).to_pylist()):
+                        row = out.setdefault(step, {"values": {}, "ranges": {}})
+                        row["time"] = float(t)
+                        row["values"][key] = np.array(v, dtype=np.float64)
+        elif chunk.entity_path in labels and "range_lo" in names:
+            key = labels[chunk.entity_path]
+            for step, lo, hi in zip(steps, batch.column("range_lo").to_pylist(), batch.column("range_hi").to_pylist()):
+                out.setdefault(step, {"values": {}, "ranges": {}})["ranges"][key] = (lo[0], hi[0])
+    for row in out.values():
+        v = row["values"]
+        if "cell_volumetric_strain_rate" in v and CHAIN_KEY in v:
+            cell = v["cell_volumetric_strain_rate"]
+            v["cell_volumetric_strain_rate"] = np.where(np.isnan(cell), v[CHAIN_KEY], cell)
+    return out
+
+
 # ---------------------------------------------------------------------------------------- headless viewer
 def _free_port() -> int:
     with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as s:
@@ -136,14 +196,15 @@ def _viewer_executable() -> str | None:
 def screenshot_recording(
     rrd_path: str | os.PathLike,
     png_path: str | os.PathLike,
-    time_step: int | None = None,
+    time_s: float | None = None,
     timeout: float = 60,
     *,
     tabs_dir: str | os.PathLike | None = None,
 ) -> list[str]:
     """Open a recording in a headless viewer, save a PNG of the window, return the views' error reports.
 
-    ``time_step``: the `step` shown (None: the last one). The PNG shows the default layout. A hidden tab
+    ``time_s``: the ``sim_time`` shown, s (None: the last frame's). The cursor is set on ``sim_time`` (the
+    timeline the blueprint opens on and the paper-figure tabs are pinned on). The PNG shows the default layout. A hidden tab
     is not drawn and cannot report, so every tab is then brought to the front in turn (saved as
     ``tabs_dir/tab<i>.png`` if given). Returns "view: severity: summary" for every report of every view;
     empty means healthy. Needs a Vulkan driver (Debian: mesa-vulkan-drivers libvulkan1).
@@ -174,10 +235,10 @@ def screenshot_recording(
             if time.monotonic() > deadline:
                 raise TimeoutError(f"viewer did not load {rrd_path} within {timeout} s")
             time.sleep(0.2)
-        if time_step is None:
-            line = next((t for r in recs for t in r.timelines if t.name == "step"), None)
-            time_step = line.end if line is not None and line.end is not None else 0
-        viewer.set_time("step", sequence=int(time_step), play_state="paused")
+        if time_s is None:
+            line = next((t for r in recs for t in r.timelines if t.name == "sim_time"), None)
+            time_s = 1e-9 * line.end if line is not None and line.end is not None else 0.0
+        viewer.set_time("sim_time", duration=float(time_s), play_state="paused")
         _settle(viewer)
         viewer.save_screenshot(os.path.abspath(png_path))
         reports = {v.view_id: (v.name, v.reports) for v in viewer.get_state().views}

@@ -1,16 +1,22 @@
-"""The recorder: writes one run's ``.rrd`` from its frames.
+"""The recorder: writes one run's ``.rrd`` from its frames (and its steps' solver health).
 
 One ``.rrd`` per run from an explicit ``rr.RecordingStream``, with an embedded default blueprint.
 Constants are logged static; frames are buffered and sent with ``send_columns`` every ``batch_frames``
 frames, one array per entity kind. Timelines ``step`` (sequence) and ``sim_time`` (duration). Entity
-paths: ``layout.ENTITY_PATHS``.
+paths: ``layout.ENTITY_PATHS``. The initial frame, before any contact force, only sets the references
+(drawing plane, as-built shape): the recording starts at the first computed frame.
 
-The drawing plane and everything logged once: ``static_content``.
+What is logged per frame, once each: the block fill mesh's vertex positions (float32, inset so the
+joints show) with one colour component per field (each view maps its own, ``layout.FIELDS``); a hover
+point per block with its values (float32); the principal-axis glyphs; one resultant arrow per joint
+(``masonrycli.joint_forces``); hinges; each field's colour range and legend labels. Solver health
+(sweeps, residual, contacts) is logged for every step (``log_step``). The magnified deformed shape is
+logged when the recorder closes, when the largest displacement of the run is known.
 
-Scales (written in the run document) are fixed once per run, at the first flushed batch where the data
-is not all zero, from the 98th percentile of |value| rounded up (``nice_ceil``): the colour range of each
-field ([−M, M] if signed, else [0, M]; ``field_ranges`` overrides it), the force scale (that force is one
-median block height long; arrows are capped at two) and the principal-axis scales.
+Scales: colour ranges follow the data (``masonrycli.colour_range.RangeTracker``, checked every frame);
+the joint-resultant scale (``RESULTANT_LENGTH`` block heights for the 95th percentile resultant of the
+first loaded frame) and the glyph scales (98th percentile of the first batch) are fixed once per run so
+lengths compare across time.
 """
 
 from __future__ import annotations
@@ -30,30 +36,32 @@ import numpy as np
 import pyarrow as pa
 import rerun as rr
 
-from masonrycli.colormap import (
-    COOLWARM,
-    NAN_RGBA,
-    VIRIDIS,
-    map_scalars,
-    nice_ceil,
-    robust_max_abs,
-)
-from masonrycli.frame import CONTACT_OPEN, CONTACT_SLIP, CONTACT_STICK, Frame
-from masonrycli.recording.arrays import FrameBatch, Polygons, partition_lengths, uniform_strips, z0
-from masonrycli.recording.document import run_document, viewer_safe_text
+from masonrycli.colormap import map_positions, nice_ceil, robust_max_abs, tick_label
+from masonrycli.colour_range import RangeTracker
+from masonrycli.frame import Frame
+from masonrycli.joint_forces import JOINT_OPEN, JOINT_SLIP, JOINT_STICK, joint_resultants
+from masonrycli.recording.arrays import FrameBatch, Polygons, partition_lengths, time_indexes, uniform_strips, z0
+from masonrycli.recording.document import legend_markdown, run_document, viewer_safe_text
 from masonrycli.recording.layout import (
-    ARROW_CAP,
     AXES,
     BLOCKS,
+    CHAIN_KEY,
     COMPRESSION_RGBA,
     FIELD_BY_KEY,
     FIELDS,
+    FILL,
     FORCES,
     GLYPH_HALF_LENGTH,
     HINGES,
     HOVER_VALUES,
+    INSET,
+    LEGEND,
     METADATA,
     OPEN_RGBA,
+    PAPER_FIELDS,
+    PAPER_FIGURES,
+    RESULTANT_LENGTH,
+    RESULTANT_PERCENTILE,
     ROBUST_PERCENTILE,
     SCALARS,
     SERIES,
@@ -63,12 +71,23 @@ from masonrycli.recording.layout import (
     SUPPORT_OUTLINES,
     TENSION_RGBA,
     TENSOR_KEYS,
-    TRIANGULATION,
     XY,
+    FieldSpec,
     build_blueprint,
 )
+from masonrycli.recording.magnified import send_magnified
 from masonrycli.recording.readback import check_complete
-from masonrycli.recording.static_content import RecordingStatic, log_legend, log_plane, log_static
+from masonrycli.recording.static_content import (
+    LUTS,
+    TICKS,
+    RecordingStatic,
+    inset_local,
+    legend_positions,
+    log_initial_shape,
+    log_legend,
+    log_plane,
+    log_static,
+)
 from masonrycli.sinks import COMPLETED, FAILED, INTERRUPTED, RUNNING
 
 APPLICATION_ID: Final = "masonry"
@@ -92,6 +111,9 @@ def _io_errors(path: str):
         raise OSError(errno.EIO, f"rerun could not write the recording ({str(exc).splitlines()[0]})") from None
 
 
+_STATE_RGBA: Final = {JOINT_STICK: STICK_RGBA, JOINT_SLIP: SLIP_RGBA, JOINT_OPEN: OPEN_RGBA}
+
+
 class Recorder:
     """Writes one run's ``.rrd``. A context manager; ``close`` is idempotent.
 
@@ -101,6 +123,9 @@ class Recorder:
 
     Leaving the ``with`` block by an exception closes the recording with status "failed"
     (KeyboardInterrupt: "interrupted") and the time of the last frame; the file is complete either way.
+    ``magnify``: the magnified view's factor (None: the largest displacement of the run drawn as 5 % of
+    the structure's size, ``masonrycli.joint_forces.magnification``). The paper-figure tabs are added
+    for the scenarios of ``layout.PAPER_FIGURES`` whose ``duration_s`` reaches the paper's instant.
     """
 
     def __init__(
@@ -112,7 +137,7 @@ class Recorder:
         batch_frames: int = 100,
         *,
         main_field: str = "cell_spherical_stress",
-        field_ranges: dict[str, tuple[float, float]] | None = None,
+        magnify: float | None = None,
     ) -> None:
         if main_field not in FIELD_BY_KEY:
             raise ValueError(f"main_field must be one of {sorted(FIELD_BY_KEY)}, not {main_field!r}")
@@ -122,29 +147,39 @@ class Recorder:
         self._flushed = self._t0
         self._blocks = Polygons(static.block_vert_start, static.block_vert_local)
         self._supports = Polygons(static.support_vert_start, static.support_vert_local)
-        self._triangles = np.asarray(static.triangles, dtype=np.intp).reshape(-1, 3)
+        self._fill: Polygons | None = None  # inset blocks, once the structure's size is known
         self._n = n = self._blocks.count
         first = np.asarray(static.block_vert_start[:-1], dtype=np.intp)
         loc = self._blocks.local
         size = (np.maximum.reduceat(loc, first) - np.minimum.reduceat(loc, first)) if n else np.ones((1, 2))
         self.block_height = float(np.median(size[:, 1]))  # m, median block height: the force-arrow unit
         self._glyph_length = GLYPH_HALF_LENGTH * float(np.median(size.min(axis=1)))
-        # Scales, once fixed: field key -> colour range (lo, hi); m per N; glyph set -> |λ| at full length.
-        self.field_ranges: dict[str, tuple[float, float]] = dict(field_ranges or {})
+        self._trackers = {f.key: RangeTracker(f.kind, f.floor) for f in FIELDS}
+        self.field_ranges: dict[str, tuple[float, float]] = {}
+        """The range each field has at the last frame sent."""
         self.force_scale: float | None = None
+        """m per N of the joint resultants, fixed at the first batch with a loaded joint."""
         self.axis_scale: dict[str, float] = {}
-        self._legends: set[str] = set()
+        self.magnify = magnify
         self._legend_box = (0.0, 0.0, 0.0, 0.0)
+        self._label_anchors = np.zeros((0, 2), np.float32)
+        self._size = 1.0
         self._frames, self._last = 0, None  # frames logged; (step, time) of the last one
         self._ref: tuple[np.ndarray, np.ndarray, float] | None = None  # first block_q, support_q, E_pot
-        self._batch = FrameBatch()
+        self._batch, self._steps = FrameBatch(), FrameBatch()
+        self._poses: list[tuple[int, float, np.ndarray, np.ndarray]] = []  # for the magnified view
+        paper = PAPER_FIGURES.get(str(self.metadata.get("scenario")))
+        duration = self.metadata.get("duration_s")
+        self.paper = paper if paper is not None and duration is not None and float(duration) >= paper[0] else None
         meta_json = json.dumps(self.metadata, sort_keys=True, default=str)
         self.recording_id = str(uuid.uuid5(_RECORDING_NAMESPACE, meta_json))
         self.rec = rr.RecordingStream(application_id, recording_id=self.recording_id)
         os.makedirs(os.path.dirname(os.path.abspath(self.path)), exist_ok=True)
         with _io_errors(self.path):
-            self.rec.save(self.path, default_blueprint=build_blueprint(main_field))
+            self.rec.save(self.path, default_blueprint=build_blueprint(main_field, self.paper))
             log_static(self.rec, static, self._blocks, self._supports)
+            tolerance = self.metadata.get("nlgs_tolerance")
+            self._log10_tolerance = float(np.log10(tolerance)) if tolerance else np.nan
             self._log_metadata(RUNNING, "")
 
     def __enter__(self) -> Recorder:
@@ -156,6 +191,15 @@ class Recorder:
         else:
             self.close(FAILED, f"{exc_type.__name__}: {exc}")
 
+    def log_step(self, step: int, time_s: float, stats) -> None:
+        """Solver health of one step (``stats``: iterations, residual, contact_count), logged every step."""
+        if self._closed:
+            raise RuntimeError("Recorder is closed")
+        s = self._steps
+        s.add("step", int(step))
+        s.add("time", float(time_s))
+        s.add("values", (float(stats.iterations), float(stats.residual), float(stats.contact_count)))
+
     def on_frame(self, frame: Frame) -> None:
         """Buffer one frame (the :class:`~masonrycli.sinks.FrameSink` method); sends the buffer when it holds
         ``batch_frames`` frames, or when ``FLUSH_SECONDS`` have passed and every scale is fixed (the scales
@@ -163,30 +207,42 @@ class Recorder:
         if self._closed:
             raise RuntimeError("Recorder is closed")
         f64 = np.float64
+        q = np.array(frame.block_q, f64)
+        sq = np.array(frame.support_q, f64).reshape(-1, 3)
         if self._ref is None:
-            self._ref = (
-                np.array(frame.block_q, f64),
-                np.array(frame.support_q, f64).reshape(-1, 3),
-                float(frame.energy_potential),
+            self._ref = (q, sq, float(frame.energy_potential))
+            self._legend_box, self._size = log_plane(self.rec, self._blocks, self._supports, q, sq)
+            self._fill = Polygons(
+                self.static.block_vert_start,
+                inset_local(self.static.block_vert_start, self.static.block_vert_local, INSET * self._size),
             )
-            self._legend_box = log_plane(self.rec, self._blocks, self._supports, *self._ref[:2])
+            log_initial_shape(self.rec, self._blocks, self.static.triangles, q, sq, self._supports)
+            for f in FIELDS:
+                log_legend(self.rec, f, self._legend_box)
+            self._label_anchors = legend_positions(self._legend_box).astype(np.float32)
+            force = np.asarray(frame.contact_force, f64)
+            if int(frame.step) == 0 and not np.any(force != 0.0):
+                return  # the state before the first step: no forces, no stress, nothing to show
         b = self._batch
         b.add("step", int(frame.step))
         b.add("time", float(frame.time))
         b.add("scalars", [float(getattr(frame, name)) for name in SCALARS])
-        b.add("block_q", np.array(frame.block_q, f64))
-        b.add("support_q", np.array(frame.support_q, f64).reshape(-1, 3))
+        b.add("block_q", q)
+        b.add("support_q", sq)
         b.add("support_v", np.array(frame.support_v, f64).reshape(-1, 2))
-        force = np.asarray(frame.contact_force, f64).reshape(-1, 2)
-        status = np.asarray(frame.contact_status).reshape(-1)
-        shown = (status != CONTACT_OPEN) | np.any(force != 0.0, axis=1)  # open contacts carry no force
-        b.add("contact_point", np.asarray(frame.contact_point, f64).reshape(-1, 2)[shown])
-        b.add("contact_force", force[shown])
-        b.add("contact_status", status[shown])
-        b.add("contact_mobilised", np.asarray(frame.contact_mobilised, f64).reshape(-1)[shown])
+        j = joint_resultants(
+            frame.contact_body, frame.contact_point, frame.contact_normal, frame.contact_force, frame.contact_status
+        )
+        # Draw the force on the body above the joint (up the structure, whatever the index order).
+        body_y = np.concatenate([q[:, 1], sq[:, 1]])
+        sign = np.where(body_y[j.body[:, 1]] >= body_y[j.body[:, 0]], 1.0, -1.0)[:, None]
+        b.add("joint_point", j.point)
+        b.add("joint_force", j.force * sign)
+        b.add("joint_state", j.state)
         b.add("hinge_point", np.array(getattr(frame, "hinge_point", np.zeros((0, 2))), f64).reshape(-1, 2))
         for key in TENSOR_KEYS:
             b.add(key, _tensor(frame.tensors, key, self._n))
+        self._poses.append((int(frame.step), float(frame.time), q.astype(np.float32), sq.astype(np.float32)))
         self._last = (int(frame.step), float(frame.time))
         self._frames += 1
         due = time.perf_counter() - self._flushed >= FLUSH_SECONDS and self._scales_fixed()
@@ -199,20 +255,22 @@ class Recorder:
     log_frame = on_frame
 
     def _scales_fixed(self) -> bool:
-        return (
-            len(self.field_ranges) == len(FIELDS) and self.force_scale is not None and len(self.axis_scale) == len(AXES)
-        )
+        """The force and glyph scales come from the first batch with data; the colour ranges follow each frame."""
+        return self.force_scale is not None and len(self.axis_scale) == len(AXES)
 
     def flush(self) -> None:
-        """Send the buffered frames now."""
+        """Send the buffered frames and steps now."""
         batch, self._batch = self._batch, FrameBatch()  # an interrupted send loses a batch, never duplicates
+        steps, self._steps = self._steps, FrameBatch()
         if batch:
             self._send_batch(batch)
+        if steps:
+            self._send_steps(steps)
 
     def close(self, status: str = COMPLETED, note: str = "") -> None:
-        """Flush, write the final run document and disconnect (which writes the file's footer), then read
-        the file's footer back: rerun's writer thread reports no I/O error, so a full disk shows only as a
-        file without one — raised as ``OSError``.
+        """Flush, log the magnified shape, write the final run document and disconnect (which writes the
+        file's footer), then read the file's footer back: rerun's writer thread reports no I/O error, so a
+        full disk shows only as a file without one — raised as ``OSError``.
 
         ``status``: one of :data:`masonrycli.sinks.STATUSES`; ``note``: one line, e.g.
         "interrupted at t = 0.412 s (step 412)" (without a note, the last frame's time is given).
@@ -225,6 +283,7 @@ class Recorder:
             try:
                 try:
                     self.flush()
+                    self._send_magnified()
                 except OSError:
                     raise
                 except Exception as err:  # keep going: the file must be complete
@@ -241,71 +300,95 @@ class Recorder:
 
     # ---- per-batch content
     def _send_batch(self, b: FrameBatch) -> None:
-        idx = [
-            rr.TimeColumn("step", sequence=np.asarray(b["step"], dtype=np.int64)),
-            rr.TimeColumn("sim_time", duration=np.asarray(b["time"], dtype=np.float64)),
-        ]
+        idx = time_indexes(b)
         q = b.stack("block_q")  # (F, N, 3)
         tensors = {key: b.stack(key) for key in TENSOR_KEYS}
+        # A voussoir of a bare ring has no cell strain rate; its strain rate along the ring stands in.
+        vsr = tensors["cell_volumetric_strain_rate"]
+        tensors["cell_volumetric_strain_rate"] = np.where(np.isnan(vsr), tensors[CHAIN_KEY], vsr)
         if self._fix_scales(tensors, b):
             self._log_metadata(RUNNING, "")
-        verts = self._blocks.world(q)  # (F, V, 2)
-        self._send_blocks(idx, verts, tensors)
+        self._send_blocks(idx, q, tensors)
         self._send_supports(idx, b.stack("support_q"))
-        self._send_triangulation(idx, q)
         self._send_axes(idx, q, tensors)
-        self._send_contacts(idx, b)
+        self._send_joints(idx, b)
         self._send_series(idx, b, q)
 
     def _fix_scales(self, tensors: dict[str, np.ndarray], b: FrameBatch) -> bool:
-        """Fix the scales not fixed yet from this batch if it has non-zero data; True if any was fixed."""
+        """Fix the force and glyph scales not fixed yet from this batch if it has data; True if any was."""
         fixed = False
-        for f in FIELDS:
-            if f.key not in self.field_ranges:
-                m = nice_ceil(robust_max_abs(tensors[f.key], ROBUST_PERCENTILE))
-                if m > 0.0:  # all zero or NaN so far: any range draws it the same, decide later
-                    self.field_ranges[f.key] = (-m, m) if f.signed else (0.0, m)
-            if f.key in self.field_ranges and f.key not in self._legends:
-                log_legend(self.rec, f, self.field_ranges[f.key], self._legend_box)
-                self._legends.add(f.key)
-                fixed = True
         if self.force_scale is None:
-            forces, _ = b.concat("contact_force", (0, 2))
-            m = nice_ceil(robust_max_abs(np.hypot(forces[:, 0], forces[:, 1]), ROBUST_PERCENTILE))
-            if m > 0.0:
-                self.force_scale, fixed = self.block_height / m, True
+            forces, lengths = b.concat("joint_force", (0, 2))
+            loaded = np.nonzero(lengths)[0]
+            if loaded.size:  # the first frame with a loaded joint
+                start = int(lengths[: loaded[0]].sum())
+                first = forces[start : start + lengths[loaded[0]]]
+                m = nice_ceil(float(np.percentile(np.hypot(first[:, 0], first[:, 1]), RESULTANT_PERCENTILE)))
+                if m > 0.0:
+                    self.force_scale, fixed = RESULTANT_LENGTH * self.block_height / m, True
         for name, (values_key, _) in AXES.items():
             m = nice_ceil(robust_max_abs(tensors[values_key], ROBUST_PERCENTILE))
             if name not in self.axis_scale and m > 0.0:
                 self.axis_scale[name], fixed = m, True
         return fixed
 
-    def _send_blocks(self, idx: list, verts: np.ndarray, tensors: dict[str, np.ndarray]) -> None:
-        """One fill per field (same vertices, colours from the field), the outlines and hover values."""
-        n_frames, n_vert = verts.shape[:2]
-        pos = z0(verts)
+    def _send_blocks(self, idx: list, q: np.ndarray, tensors: dict[str, np.ndarray]) -> None:
+        """The fill (positions once, a colour component per field), legends, hover points and values."""
+        n_frames = len(q)
+        verts = self._fill.world(q)  # (F, V, 2)
+        n_vert = verts.shape[1]
+        per_vertex, per_block = partition_lengths(n_frames, n_vert), partition_lengths(n_frames, self._n)
+        columns = [*rr.Mesh3D.columns(vertex_positions=z0(verts)).partition(per_vertex)]
+        hover = [*rr.Points2D.columns(positions=q[..., :2].reshape(-1, 2).astype(np.float32)).partition(per_block)]
         for f in FIELDS:
-            lo, hi = self.field_ranges.get(f.key, (-1.0, 1.0))
-            colors = map_scalars(tensors[f.key], lo, hi, COOLWARM if f.signed else VIRIDIS, NAN_RGBA)
+            colors, labels, lo, hi = self._colour_field(f, tensors[f.key])
+            archetype = f.colors.removesuffix(":colors")
+            columns += rr.DynamicArchetype.columns(
+                archetype, components={"colors": rr.components.ColorBatch(colors[:, self._blocks.owner].reshape(-1))}
+            ).partition(per_vertex)
+            if f in PAPER_FIELDS:  # the joint-state tabs have no hover points
+                hover += rr.DynamicArchetype.columns(
+                    archetype, components={"colors": rr.components.ColorBatch(colors.reshape(-1))}
+                ).partition(per_block)
             self.rec.send_columns(
-                f.fill,
+                f.labels,
                 indexes=idx,
-                columns=rr.Mesh3D.columns(
-                    vertex_positions=pos,
-                    vertex_colors=colors[:, self._blocks.owner].reshape(-1),
-                ).partition(partition_lengths(n_frames, n_vert)),
+                columns=[
+                    # positions with the labels at every frame: a view pinned to an instant reads a time
+                    # range, which joins no static positions to temporal labels
+                    *rr.Points2D.columns(
+                        positions=np.tile(self._label_anchors, (n_frames, 1)), labels=labels
+                    ).partition(partition_lengths(n_frames, TICKS + 3)),
+                    *rr.AnyValues.columns(range_lo=pa.array(lo), range_hi=pa.array(hi)),
+                ],
             )
+        self.rec.send_columns(FILL, indexes=idx, columns=columns)
         # pyarrow arrays: AnyValues.columns turns 1-D numpy arrays into Python lists of lists (slow).
-        values = {name: pa.array(tensors[key].reshape(-1)) for name, key in HOVER_VALUES.items()}
-        per_frame = partition_lengths(n_frames, self._n)
+        values = {
+            name: pa.array(tensors[key].reshape(-1).astype(np.float32), type=pa.float32())
+            for name, key in HOVER_VALUES.items()
+        }
         self.rec.send_columns(
-            BLOCKS,
-            indexes=idx,
-            columns=[
-                *rr.LineStrips2D.columns(strips=self._blocks.outlines(verts)).partition(per_frame),
-                *rr.AnyValues.columns(**values).partition(per_frame),
-            ],
+            BLOCKS, indexes=idx, columns=[*hover, *rr.AnyValues.columns(**values).partition(per_block)]
         )
+
+    def _colour_field(self, f: FieldSpec, values: np.ndarray):
+        """Per frame: the range (tracked), block colours (F, N), legend labels, range ends (F,) each."""
+        n_frames = len(values)
+        colors = np.empty(values.shape, dtype=np.uint32)
+        labels: list[str] = []
+        lo, hi = np.empty(n_frames), np.empty(n_frames)
+        tracker = self._trackers[f.key]
+        for k in range(n_frames):  # a few numpy calls per frame; ranges depend on the frames before
+            r = tracker.update(values[k])
+            colors[k] = map_positions(r.position(values[k]), LUTS[f.kind])
+            below, above, _ = r.outside(values[k])
+            span = max(-r.lo, r.hi)
+            labels += [tick_label(v, f.unit, span, f.kind == "signed") for v in r.ticks(TICKS)]
+            labels += [viewer_safe_text(f.title), f"{below} below" if below else "", f"{above} above" if above else ""]
+            lo[k], hi[k] = r.lo, r.hi
+        self.field_ranges[f.key] = (float(lo[-1]), float(hi[-1]))
+        return colors, labels, lo, hi
 
     def _send_supports(self, idx: list, support_q: np.ndarray) -> None:
         poly, n_frames = self._supports, len(support_q)
@@ -323,18 +406,6 @@ class Recorder:
                 indexes=idx,
                 columns=rr.LineStrips2D.columns(strips=poly.outlines(verts)).partition(
                     partition_lengths(n_frames, poly.count)
-                ),
-            )
-
-    def _send_triangulation(self, idx: list, q: np.ndarray) -> None:
-        if len(self._triangles):
-            closed = q[:, self._triangles[:, [0, 1, 2, 0]], :2]  # (F, T, 4, 2)
-            strips = uniform_strips(closed.reshape(-1, 4, 2))
-            self.rec.send_columns(
-                TRIANGULATION,
-                indexes=idx,
-                columns=rr.LineStrips2D.columns(strips=strips).partition(
-                    partition_lengths(len(q), len(self._triangles))
                 ),
             )
 
@@ -359,31 +430,27 @@ class Recorder:
                 ).partition(partition_lengths(len(q), 2 * self._n)),
             )
 
-    def _send_contacts(self, idx: list, b: FrameBatch) -> None:
-        """Force on body b at each closed contact, coloured stick / slip, capped; hinges as points."""
-        points, lengths = b.concat("contact_point", (0, 2))
-        forces, _ = b.concat("contact_force", (0, 2))
-        status, _ = b.concat("contact_status", (0,))
-        mobilised, _ = b.concat("contact_mobilised", (0,))
-        colors = np.full(len(status), np.uint32(OPEN_RGBA))
-        colors[status == CONTACT_STICK] = STICK_RGBA
-        colors[status == CONTACT_SLIP] = SLIP_RGBA
-        magnitude = np.hypot(forces[:, 0], forces[:, 1])
-        length = magnitude * (self.force_scale or 0.0)
-        cap = ARROW_CAP * self.block_height
-        factor = (self.force_scale or 0.0) * np.minimum(1.0, cap / np.maximum(length, 1e-300))
+    def _send_joints(self, idx: list, b: FrameBatch) -> None:
+        """One arrow per loaded joint, centred on its point of application, coloured by state; hinges."""
+        points, lengths = b.concat("joint_point", (0, 2))
+        forces, _ = b.concat("joint_force", (0, 2))
+        state, _ = b.concat("joint_state", (0,))
+        colors = np.full(len(state), np.uint32(STICK_RGBA))
+        for value, rgba in _STATE_RGBA.items():
+            colors[state == value] = rgba
+        vectors = forces * (self.force_scale or 0.0)
         self.rec.send_columns(
             FORCES,
             indexes=idx,
             columns=[
                 *rr.Arrows2D.columns(
-                    origins=points.astype(np.float32),
+                    origins=(points - 0.5 * vectors).astype(np.float32),
                     colors=colors,
-                    vectors=(forces * factor[:, None]).astype(np.float32),
+                    vectors=vectors.astype(np.float32),
                 ).partition(lengths),
-                *rr.AnyValues.columns(force=pa.array(magnitude), mobilised_friction=pa.array(mobilised)).partition(
-                    lengths
-                ),
+                *rr.AnyValues.columns(
+                    force_kN=pa.array(1e-3 * np.hypot(forces[:, 0], forces[:, 1]).astype(np.float32), type=pa.float32())
+                ).partition(lengths),
             ],
         )
         hinges, per_frame = b.concat("hinge_point", (0, 2))
@@ -394,28 +461,54 @@ class Recorder:
     def _send_series(self, idx: list, b: FrameBatch, q: np.ndarray) -> None:
         n_frames = len(q)
         ref_q, ref_sq, ref_pot = self._ref
-        sc = np.array(b["scalars"])  # (F, 7) in SCALARS order
+        kinetic, potential, dissipated, work = np.array(b["scalars"]).T  # SCALARS order
         moved = q[..., :2] - ref_q[None, :, :2]
         sq, sv = b.stack("support_q"), b.stack("support_v")
         series = {
-            "energy": np.stack([sc[:, 0], sc[:, 1] - ref_pot, sc[:, 2], sc[:, 3]], axis=1),
+            "energy_small": np.stack([kinetic, dissipated], axis=1),
+            "energy_large": np.stack([potential - ref_pot, work], axis=1),
+            "energy_balance": kinetic + (potential - ref_pot) + dissipated - work,
             "max_displacement": np.sqrt((moved**2).sum(-1)).max(axis=1) if self._n else np.zeros(n_frames),
             "support_velocity": sv,
             "support_displacement": sq[..., :2] - ref_sq[None, :, :2],
-            "iterations": sc[:, 4],
-            "residual": sc[:, 5],
-            "contacts": sc[:, 6],
         }
+        self._send_scalars(idx, series)
+
+    def _send_steps(self, s: FrameBatch) -> None:
+        iterations, residual, contacts = np.array(s["values"]).T
+        with np.errstate(divide="ignore"):
+            log_residual = np.log10(residual)
+        tolerance = np.full(len(residual), self._log10_tolerance)
+        self._send_scalars(
+            time_indexes(s),
+            {"iterations": iterations, "residual": np.stack([log_residual, tolerance], 1), "contacts": contacts},
+        )
+
+    def _send_scalars(self, idx: list, series: dict[str, np.ndarray]) -> None:
         for key, values in series.items():
-            values = np.asarray(values, dtype=np.float64).reshape(n_frames, -1)
+            n_rows = len(values)
+            values = np.asarray(values, dtype=np.float64).reshape(n_rows, -1)
             if values.shape[1]:
                 self.rec.send_columns(
                     SERIES[key],
                     indexes=idx,
                     columns=rr.Scalars.columns(scalars=values.reshape(-1)).partition(
-                        partition_lengths(n_frames, values.shape[1])
+                        partition_lengths(n_rows, values.shape[1])
                     ),
                 )
+
+    def _send_magnified(self) -> None:
+        if self._poses and self._ref is not None:
+            self.magnify = send_magnified(
+                self.rec,
+                self._blocks,
+                self._supports,
+                self._poses,
+                self._ref[:2],
+                self.magnify,
+                self._size,
+                self.batch_frames,
+            )
 
     # ---- run document
     def _log_metadata(self, status: str, note: str) -> None:
@@ -435,8 +528,12 @@ class Recorder:
             glyph_length=self._glyph_length,
             axis_scale=self.axis_scale,
             field_ranges=self.field_ranges,
+            range_changes={k: t.changes for k, t in self._trackers.items()},
+            magnify=self.magnify,
         )
         self.rec.log(METADATA, rr.TextDocument(viewer_safe_text(text), media_type="text/markdown"), static=True)
+        legend = legend_markdown(self.force_scale, self.block_height, self.magnify)
+        self.rec.log(LEGEND, rr.TextDocument(viewer_safe_text(legend), media_type="text/markdown"), static=True)
 
 
 def _tensor(tensors: dict, key: str, n: int) -> np.ndarray:

@@ -15,22 +15,23 @@ from dataclasses import dataclass
 from typing import Final
 
 import numpy as np
+import pyarrow as pa
 import rerun as rr
 
-from masonrycli.colormap import COOLWARM, VIRIDIS, colorbar_mesh, tick_label
-from masonrycli.recording.arrays import Polygons, z0
+from masonrycli.colormap import BLUES, COOLWARM, OVER_RGBA, UNDER_RGBA, VIRIDIS, colorbar_mesh
+from masonrycli.recording.arrays import Polygons, uniform_strips, z0
 from masonrycli.recording.document import viewer_safe_text
 from masonrycli.recording.layout import (
     BLOCKS,
-    FIELDS,
+    FILL,
     FORCES,
     HINGE_RGBA,
     HINGES,
     LEGEND_TEXT_RGBA,
-    OUTLINE_RGBA,
+    MAGNIFIED,
+    MAGNIFIED_RGBA,
     PLANE,
     SERIES,
-    STRAIN_RATE_AXES,
     STRESS_AXES,
     SUPPORT_FILL,
     SUPPORT_FILL_RGBA,
@@ -38,6 +39,8 @@ from masonrycli.recording.layout import (
     SUPPORT_OUTLINES,
     TRIANGULATION,
     TRIANGULATION_RGBA,
+    UNDEFORMED,
+    UNDEFORMED_RGBA,
     XY,
     FieldSpec,
 )
@@ -63,24 +66,27 @@ class RecordingStatic:
     support_vert_local: np.ndarray
     """(Vs, 2) m, relative to the support's initial centroid (its position in Frame.support_q)."""
     triangles: np.ndarray
-    """(T, 3) int64 block indices of the centroid triangulation."""
+    """(T, 3) int64 block indices of the cells' triangles (each drawn once)."""
     friction: float
     dt: float
     """s."""
 
 
 def log_static(rec: rr.RecordingStream, st: RecordingStatic, blocks: Polygons, supports: Polygons) -> None:
-    """Everything constant over the run: fill meshes' triangles, line styles, names, series names."""
-    for f in FIELDS:
-        rec.log(f.fill, rr.Mesh3D.from_fields(triangle_indices=blocks.fan), static=True)
+    """Everything constant over the run: the fill mesh's triangles, line styles, names, series names."""
+    rec.log(FILL, rr.Mesh3D.from_fields(triangle_indices=blocks.fan), static=True)
     rec.log(
         SUPPORT_FILL,
         rr.Mesh3D.from_fields(triangle_indices=supports.fan, albedo_factor=SUPPORT_FILL_RGBA),
         static=True,
     )
+    # Hover targets: a dot at each block's centroid, in the block's colour (each view maps its field).
+    first = np.asarray(st.block_vert_start[:-1], dtype=np.intp)
+    loc = blocks.local
+    size = (np.maximum.reduceat(loc, first) - np.minimum.reduceat(loc, first)) if blocks.count else np.ones((0, 2))
     rec.log(
         BLOCKS,
-        rr.LineStrips2D.from_fields(colors=OUTLINE_RGBA, radii=-0.75, draw_order=30.0),
+        rr.Points2D.from_fields(radii=0.15 * size.min(axis=1), draw_order=5.0),
         rr.AnyValues(name=[viewer_safe_text(str(n)) for n in st.block_name]),
         static=True,
     )
@@ -91,32 +97,84 @@ def log_static(rec: rr.RecordingStream, st: RecordingStatic, blocks: Polygons, s
         rr.AnyValues(name=names),
         static=True,
     )
-    rec.log(
-        TRIANGULATION,
-        rr.LineStrips2D.from_fields(colors=TRIANGULATION_RGBA, radii=-0.5, draw_order=31.0),
-        static=True,
-    )
-    for path in (STRESS_AXES, STRAIN_RATE_AXES):
-        rec.log(path, rr.LineStrips2D.from_fields(radii=-1.25, draw_order=40.0), static=True)
-    rec.log(FORCES, rr.Arrows2D.from_fields(radii=-1.25, draw_order=50.0), static=True)
+    rec.log(STRESS_AXES, rr.LineStrips2D.from_fields(radii=-1.25, draw_order=40.0), static=True)
+    rec.log(FORCES, rr.Arrows2D.from_fields(radii=-1.5, draw_order=50.0), static=True)
     rec.log(HINGES, rr.Points2D.from_fields(radii=-4.0, colors=HINGE_RGBA, draw_order=60.0), static=True)
+    rec.log(MAGNIFIED, rr.LineStrips2D.from_fields(colors=MAGNIFIED_RGBA, radii=-1.0, draw_order=30.0), static=True)
     series_names = {
-        "energy": ["kinetic", "potential change", "dissipated", "support work"],
+        "energy_small": ["kinetic", "dissipated (cumulated)"],
+        "energy_large": ["potential change", "support work"],
+        "energy_balance": ["kinetic + potential change + dissipated − support work"],
         "max_displacement": ["max block displacement"],
         "support_velocity": [f"{n} v{c}" for n in names for c in "xy"],
         "support_displacement": [f"{n} u{c}" for n in names for c in "xy"],
-        "iterations": ["NLGS iterations"],
-        "residual": ["NLGS residual"],
+        "iterations": ["NLGS sweeps"],
+        "residual": ["log10 NLGS residual", "log10 tolerance"],
         "contacts": ["contacts"],
     }
     for key, path in SERIES.items():
-        rec.log(path, rr.SeriesLines(names=series_names[key]), static=True)
+        rec.log(path, rr.SeriesLines(names=[viewer_safe_text(n) for n in series_names[key]]), static=True)
+
+
+def log_initial_shape(
+    rec: rr.RecordingStream,
+    blocks: Polygons,
+    triangles: np.ndarray,
+    block_q: np.ndarray,
+    support_q: np.ndarray,
+    supports: Polygons,
+) -> None:
+    """The as-built outlines (the magnified view's ghost) and the cells' triangles as built."""
+    verts = blocks.world(block_q[None])
+    ghost = [blocks.outlines(verts)]
+    if supports.count:
+        ghost.append(supports.outlines(supports.world(support_q[None])))
+    rec.log(
+        UNDEFORMED,
+        rr.LineStrips2D(pa.concat_arrays(ghost), colors=UNDEFORMED_RGBA, radii=-0.75, draw_order=20.0),
+        static=True,
+    )
+    closed = block_q[np.asarray(triangles, dtype=np.intp).reshape(-1, 3)[:, [0, 1, 2, 0]], :2]
+    rec.log(
+        TRIANGULATION,
+        rr.LineStrips2D(uniform_strips(closed), colors=TRIANGULATION_RGBA, radii=-0.5, draw_order=31.0),
+        static=True,
+    )
+
+
+def inset_local(start: np.ndarray, local: np.ndarray, distance: float) -> np.ndarray:
+    """(V, 2) the convex polygons' local vertices moved inwards by ``distance`` (at most a quarter of each
+    polygon's smaller side): adjacent fills then leave a dark line along every joint, so no outline has
+    to be logged per frame. Each vertex moves along its corner's bisector by distance / sin(half angle).
+    """
+    start = np.asarray(start, dtype=np.int64)
+    local = np.asarray(local, dtype=np.float64).reshape(-1, 2)
+    if local.size == 0:
+        return local.copy()
+    n_vert = np.diff(start)
+    owner = np.repeat(np.arange(len(n_vert)), n_vert)
+    pos = np.arange(len(local)) - start[owner]
+    nxt = start[owner] + (pos + 1) % n_vert[owner]
+    prv = start[owner] + (pos - 1) % n_vert[owner]
+    first = start[:-1]
+    size = np.maximum.reduceat(local, first) - np.minimum.reduceat(local, first)
+    d = np.minimum(distance, 0.25 * size.min(axis=1))[owner]
+
+    def inward(a, b):  # unit normal of edge a → b pointing into a counter-clockwise polygon
+        e = b - a
+        n = np.stack([-e[:, 1], e[:, 0]], axis=1)
+        return n / np.linalg.norm(n, axis=1, keepdims=True)
+
+    n1, n2 = inward(local[prv], local), inward(local, local[nxt])
+    bis = n1 + n2
+    return local + bis * (d / (1.0 + np.einsum("ij,ij->i", n1, n2)))[:, None]
 
 
 def log_plane(
     rec: rr.RecordingStream, blocks: Polygons, supports: Polygons, block_q: np.ndarray, support_q: np.ndarray
-) -> tuple[float, float, float, float]:
-    """Pinhole and y-up transform sized to the structure at the first frame; returns the legend box."""
+) -> tuple[tuple[float, float, float, float], float]:
+    """Pinhole and y-up transform sized to the structure at the first frame; returns the legend box and
+    the structure's size (m)."""
     sup = supports.world(support_q[None])[0]
     blk = blocks.world(block_q[None])[0] if blocks.count else sup
     lo, hi = blk.min(axis=0), blk.max(axis=0)
@@ -126,10 +184,10 @@ def log_plane(
         hi = np.maximum(hi, np.minimum(sup.max(axis=0), hi + _SUPPORT_MARGIN * size))
     pad, bar = 0.05 * size, 0.025 * size
     ya, yb = blk[:, 1].min(), blk[:, 1].max()
-    room = 0.08 * (yb - ya)  # for the labels above and below the bar
+    room = 0.12 * (yb - ya)  # for the title above the bar and the over / under labels
     legend_box = (hi[0] + 2 * pad, ya + room, hi[0] + 2 * pad + bar, yb - room)
     x0, y0 = lo[0] - pad, hi[1] + pad
-    resolution = [hi[0] + 3 * pad + bar + 0.12 * size - x0, y0 - lo[1] + pad]
+    resolution = [hi[0] + 3 * pad + bar + 0.2 * size - x0, y0 - lo[1] + pad]
     rec.log(
         PLANE,
         rr.Pinhole(focal_length=_CAMERA_HEIGHT, principal_point=[0.0, 0.0], resolution=resolution),
@@ -137,26 +195,46 @@ def log_plane(
         static=True,
     )
     rec.log(XY, rr.Transform3D(translation=[-x0, y0, 0.0], scale=[1.0, -1.0, 1.0]), static=True)
-    return legend_box
+    return legend_box, size
 
 
-def log_legend(
-    rec: rr.RecordingStream,
-    f: FieldSpec,
-    field_range: tuple[float, float],
-    legend_box: tuple[float, float, float, float],
-) -> None:
-    """Colour bar (a Mesh3D gradient beside the structure) and its labels, once the range is fixed."""
-    (lo, hi), (xa, ya, xb, yb) = field_range, legend_box
-    verts, tri, colors = colorbar_mesh(legend_box, COOLWARM if f.signed else VIRIDIS)
-    bar = rr.Mesh3D(vertex_positions=z0(verts), triangle_indices=tri, vertex_colors=colors)
-    rec.log(f.bar, bar, static=True)
-    labels = [tick_label(v, f.unit, max(-lo, hi), f.signed) for v in (lo, 0.5 * (lo + hi), hi)]
-    labels[-1] = f"{f.title}\n{labels[-1]}"
-    xm, gap = 0.5 * (xa + xb), 0.04 * (yb - ya)
-    pos = [[xm, ya - gap], [2 * xb - xa, 0.5 * (ya + yb)], [xm, yb + 2 * gap]]
-    rec.log(
-        f.labels,
-        rr.Points2D(pos, labels=labels, radii=-0.5, show_labels=True, colors=LEGEND_TEXT_RGBA),
-        static=True,
+LUTS: Final = {"signed": COOLWARM, "negative": BLUES, "positive": VIRIDIS}
+TICKS: Final = 5
+
+
+def legend_positions(legend_box: tuple[float, float, float, float]) -> np.ndarray:
+    """(TICKS + 3, 2) label anchors: the ticks right of the bar (bottom up), the title above it, the
+    below / above counts beside the end caps."""
+    xa, ya, xb, yb = legend_box
+    h, w = yb - ya, xb - xa
+    ticks = np.stack([np.full(TICKS, xb + 0.6 * w), np.linspace(ya, yb, TICKS)], axis=1)
+    title = [[xa, yb + 0.14 * h]]
+    caps = [[xb + 0.6 * w, ya - 0.05 * h], [xb + 0.6 * w, yb + 0.05 * h]]
+    return np.concatenate([ticks, title, caps])
+
+
+def log_legend(rec: rr.RecordingStream, f: FieldSpec, legend_box: tuple[float, float, float, float]) -> None:
+    """Colour bar (a Mesh3D gradient beside the structure) with end caps in the below / above colours,
+    and the static style of its labels (the labels themselves change with the range, per frame)."""
+    xa, ya, xb, yb = legend_box
+    verts, tri, colors = colorbar_mesh(legend_box, LUTS[f.kind])
+    cap = 0.04 * (yb - ya)
+    xm = 0.5 * (xa + xb)
+    cap_verts = np.array(
+        [
+            [xa, ya - 0.01 * cap],
+            [xb, ya - 0.01 * cap],
+            [xm, ya - cap],
+            [xa, yb + 0.01 * cap],
+            [xb, yb + 0.01 * cap],
+            [xm, yb + cap],
+        ]
     )
+    k = len(verts)
+    bar = rr.Mesh3D(
+        vertex_positions=z0(np.concatenate([verts, cap_verts])),
+        triangle_indices=np.concatenate([tri, np.array([[k, k + 2, k + 1], [k + 3, k + 4, k + 5]], np.uint32)]),
+        vertex_colors=np.concatenate([colors, np.repeat(np.array([UNDER_RGBA, OVER_RGBA], np.uint32), 3)]),
+    )
+    rec.log(f.bar, bar, static=True)
+    rec.log(f.labels, rr.Points2D.from_fields(radii=-0.5, show_labels=True, colors=LEGEND_TEXT_RGBA), static=True)

@@ -1,0 +1,145 @@
+"""Colour ranges that follow the data while a run is recorded (numpy only).
+
+A recording is written while the run progresses, so a field's colour range cannot wait for the last
+frame. ``RangeTracker`` keeps one range per field and checks it against every recorded frame; it is
+refitted to that frame (and the new range logged from that frame on) only when the frame breaks one
+of two rules:
+
+* **coverage** — at most ``OUTSIDE_SHARE`` (2 %) of the frame's defined cells lie outside the range;
+* **use** — the frame's cells span at least ``MIN_SPAN`` of the range (a range fitted to a violent
+  moment must not flatten the quiet frames after it, nor a quiet start the growth that follows).
+
+A refit covers all but ``OUTSIDE_SHARE`` / 2 of the cells (rounded down, so a 51-cell wall keeps every
+cell inside) and rounds the ends outwards to 1, 1.5, 2, 2.5, 3, 4, 5, 6, 8 × 10^k, which leaves some
+headroom, so a range typically holds for many frames. A range never shrinks below the field's
+``floor`` (a physical magnitude below which the values are noise: a still structure is not coloured
+by its round-off). Every frame therefore satisfies both rules, except where the floor applies.
+
+Three kinds of scale (``ScaleKind``):
+
+* ``"negative"`` — values ≤ 0 (the spherical stress p, compression negative): one-sided, [lo, 0];
+* ``"positive"`` — values ≥ 0 (deviatoric parts): one-sided, [0, hi];
+* ``"signed"`` — both signs (volumetric strain rate): diverging about 0 with independent ends lo < 0 < hi,
+  each half of the colour map stretched over its own side (zero stays the middle colour).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Final, Literal
+
+import numpy as np
+
+from masonrycli.colormap import nice_ceil
+
+ScaleKind = Literal["negative", "positive", "signed"]
+
+OUTSIDE_SHARE: Final = 0.02
+"""Largest share of a frame's defined cells allowed outside the logged range."""
+MIN_SPAN: Final = 0.45
+"""Smallest share of the range the frame's cells must span (min to max, clipped to the range)."""
+SIGNED_MIN_SIDE: Final = 0.1
+"""On a signed scale, neither side is shorter than this fraction of the other (zero stays readable)."""
+
+
+@dataclass(frozen=True)
+class ColourRange:
+    """One field's colour range: [lo, hi], lo ≤ 0 ≤ hi for every kind."""
+
+    kind: ScaleKind
+    lo: float
+    hi: float
+
+    def position(self, values: np.ndarray) -> np.ndarray:
+        """Where each value sits on the colour map, 0 (lo) … 1 (hi); < 0 or > 1 outside; NaN stays NaN.
+
+        Signed: [lo, 0] → [0, ½] and [0, hi] → [½, 1] (zero is the middle colour).
+        """
+        v = np.asarray(values, dtype=np.float64)
+        if self.kind == "signed":
+            with np.errstate(invalid="ignore"):
+                return np.where(v < 0.0, 0.5 - 0.5 * v / self.lo, 0.5 + 0.5 * v / self.hi)
+        return (v - self.lo) / (self.hi - self.lo)
+
+    def ticks(self, count: int = 5) -> np.ndarray:
+        """``count`` (odd) tick values at evenly spaced colour positions, lo first; zero is one of them."""
+        t = np.linspace(0.0, 1.0, count)
+        if self.kind == "signed":
+            return np.where(t < 0.5, self.lo * (1.0 - 2.0 * t), self.hi * (2.0 * t - 1.0))
+        return self.lo + t * (self.hi - self.lo)
+
+    def outside(self, values: np.ndarray) -> tuple[int, int, int]:
+        """(cells below lo, cells above hi, defined cells) of one frame."""
+        v = np.asarray(values, dtype=np.float64).ravel()
+        v = v[np.isfinite(v)]
+        return int((v < self.lo).sum()), int((v > self.hi).sum()), int(v.size)
+
+    def span(self, values: np.ndarray) -> float:
+        """Share of the range covered by the frame's cells, min to max clipped to [lo, hi] (0 if none)."""
+        v = np.asarray(values, dtype=np.float64).ravel()
+        v = v[np.isfinite(v)]
+        if v.size == 0:
+            return 0.0
+        return float((min(v.max(), self.hi) - max(v.min(), self.lo)) / (self.hi - self.lo))
+
+
+def nice_floor_negative(x: float) -> float:
+    """−nice_ceil(−x) for x < 0: the nice number at or below x."""
+    return -nice_ceil(-x)
+
+
+def fit_range(values: np.ndarray, kind: ScaleKind, floor: float) -> ColourRange:
+    """The range a refit gives for one frame (see the module docstring); ``floor`` > 0 in the field's unit."""
+    v = np.sort(np.asarray(values, dtype=np.float64).ravel())
+    v = v[np.isfinite(v)]
+    budget = int(math.floor(OUTSIDE_SHARE * v.size))
+    if kind == "positive":
+        wrong_side = int((v < 0.0).sum())  # counted outside whatever the range
+        keep = max(budget - wrong_side, 0)
+        top = v[v.size - 1 - keep] if v.size else 0.0
+        return ColourRange(kind, 0.0, nice_ceil(max(top, floor)))
+    if kind == "negative":
+        wrong_side = int((v > 0.0).sum())
+        keep = max(budget - wrong_side, 0)
+        bottom = v[keep] if v.size else 0.0
+        return ColourRange(kind, -nice_ceil(max(-bottom, floor)), 0.0)
+    low_budget = budget // 2
+    bottom = v[low_budget] if v.size else 0.0
+    top = v[v.size - 1 - (budget - low_budget)] if v.size else 0.0
+    lo_mag, hi_mag = max(-bottom, floor), max(top, floor)
+    lo_mag, hi_mag = max(lo_mag, SIGNED_MIN_SIDE * hi_mag), max(hi_mag, SIGNED_MIN_SIDE * lo_mag)
+    return ColourRange(kind, -nice_ceil(lo_mag), nice_ceil(hi_mag))
+
+
+class RangeTracker:
+    """The colour range of one field over a run, checked against every frame (module docstring).
+
+    >>> tracker = RangeTracker("positive", floor=1e-6)
+    >>> r = tracker.update(np.array([0.0, 0.3, 0.9]))   # first frame: fitted, [0, 1]
+    >>> tracker.update(np.array([0.0, 0.5, 0.8])) is r  # still covers and is used: kept
+    True
+    """
+
+    def __init__(self, kind: ScaleKind, floor: float) -> None:
+        if not floor > 0.0:
+            raise ValueError(f"floor must be > 0, got {floor!r}")
+        self.kind, self.floor = kind, float(floor)
+        self.current: ColourRange | None = None
+        self.changes = 0
+        """How many times the range was (re)fitted."""
+
+    def update(self, values: np.ndarray) -> ColourRange:
+        """The range for this frame: the current one if the frame keeps both rules, else a refit."""
+        r = self.current
+        if r is None or not self._holds(r, values):
+            fitted = fit_range(values, self.kind, self.floor)
+            if fitted != r:
+                self.current, self.changes = fitted, self.changes + 1
+        return self.current
+
+    def _holds(self, r: ColourRange, values: np.ndarray) -> bool:
+        below, above, defined = r.outside(values)
+        if below + above > math.floor(OUTSIDE_SHARE * defined):
+            return False
+        return defined == 0 or r.span(values) >= MIN_SPAN

@@ -1,0 +1,102 @@
+"""One resultant per joint: what an engineer reads as a force chain or a line of thrust (numpy only).
+
+A *joint* here is a pair of bodies in contact in the current frame (two blocks, or a block and a
+support). Its contact points carry forces F_c (on body b of the pair (a, b), normal n_c from a to b);
+the joint passes their sum
+
+    R = Σ_c F_c
+
+through its **point of application** (centre of pressure): the normal-force-weighted mean of the
+contact points,
+
+    x_R = Σ_c f_c p_c / Σ_c f_c,    f_c = F_c · n_c ≥ 0 (compression),
+
+which lies on the joint face between its loaded ends — at the face's middle under a centred load, at an
+end when the joint has opened into a hinge — so the eccentricity and the line of thrust show. The
+moment of R about x_R equals that of the contact forces about x_R up to the friction components' lever
+arm along the face, which is zero for a straight face. Joints without compression (Σ f_c ≤ 0) have no
+resultant.
+
+**State** of a joint (colour of its resultant): ``JOINT_SLIP`` if one of its closed contacts slides,
+else ``JOINT_OPEN`` if one of its contact points is open (the joint has opened at that end and turns
+about the other), else ``JOINT_STICK``.
+"""
+
+from __future__ import annotations
+
+from typing import Final, NamedTuple
+
+import numpy as np
+
+from masonrycli.frame import CONTACT_OPEN, CONTACT_SLIP
+
+JOINT_STICK: Final = 0
+JOINT_SLIP: Final = 1
+JOINT_OPEN: Final = 2
+
+
+class JointResultants(NamedTuple):
+    body: np.ndarray
+    """(J, 2) int64 bodies (a, b), a < b (indices ≥ N are supports)."""
+    point: np.ndarray
+    """(J, 2) m: point of application (centre of pressure)."""
+    force: np.ndarray
+    """(J, 2) N: resultant force on body b (body a gets −force)."""
+    state: np.ndarray
+    """(J,) int8: JOINT_STICK, JOINT_SLIP or JOINT_OPEN."""
+
+
+def joint_resultants(contact_body, contact_point, contact_normal, contact_force, contact_status) -> JointResultants:
+    """Resultant of each joint at its point of application (module docstring); rows sorted by (a, b).
+
+    Args:
+        contact_body: (C, 2) int bodies (a, b) of each contact; contact_point (C, 2) m; contact_normal
+            (C, 2) unit, from a to b; contact_force (C, 2) N on body b; contact_status (C,) int
+            (``masonrycli.frame`` CONTACT_*).
+    """
+    body = np.asarray(contact_body, dtype=np.int64).reshape(-1, 2)
+    point = np.asarray(contact_point, dtype=np.float64).reshape(-1, 2)
+    normal = np.asarray(contact_normal, dtype=np.float64).reshape(-1, 2)
+    force = np.asarray(contact_force, dtype=np.float64).reshape(-1, 2)
+    status = np.asarray(contact_status).reshape(-1)
+    keep = body[:, 0] != body[:, 1]  # a body against itself is no joint
+    body, point, normal, force, status = body[keep], point[keep], normal[keep], force[keep], status[keep]
+    # Orient every contact as (low, high) body: the force on the higher index flips with the order.
+    flip = body[:, 0] > body[:, 1]
+    sign = np.where(flip, -1.0, 1.0)[:, None]
+    lo, hi = np.minimum(body[:, 0], body[:, 1]), np.maximum(body[:, 0], body[:, 1])
+    force, normal = force * sign, normal * sign
+    pairs, joint = np.unique(np.stack([lo, hi], axis=1), axis=0, return_inverse=True)
+    joint = joint.reshape(-1)
+    j = len(pairs)
+    fn = np.maximum(np.einsum("ij,ij->i", force, normal), 0.0)
+    weight = np.bincount(joint, weights=fn, minlength=j)
+    resultant = np.stack([np.bincount(joint, weights=force[:, k], minlength=j) for k in range(2)], axis=1)
+    centre = np.stack([np.bincount(joint, weights=fn * point[:, k], minlength=j) for k in range(2)], axis=1)
+    slipping = np.bincount(joint, weights=(status == CONTACT_SLIP), minlength=j) > 0
+    opened = np.bincount(joint, weights=(status == CONTACT_OPEN), minlength=j) > 0
+    state = np.where(slipping, JOINT_SLIP, np.where(opened, JOINT_OPEN, JOINT_STICK)).astype(np.int8)
+    loaded = weight > 0.0
+    return JointResultants(
+        body=pairs[loaded],
+        point=centre[loaded] / weight[loaded, None],
+        force=resultant[loaded],
+        state=state[loaded],
+    )
+
+
+def magnification(displacement: np.ndarray, structure_size: float, share: float = 0.05) -> float:
+    """Default displacement magnification: the largest |displacement| drawn as ``share`` of the structure.
+
+    Rounded down to 1, 1.5, 2, 2.5, 3, 4, 5, 6, 8 × 10^k so the factor reads well; never below 1 (a
+    structure that moved more than ``share`` of its size is drawn as it is). ``displacement`` (..., 2) m.
+    """
+    d = np.asarray(displacement, dtype=np.float64).reshape(-1, 2)
+    largest = float(np.sqrt((d**2).sum(axis=1)).max()) if d.size else 0.0
+    if not largest > 0.0:
+        return 1.0
+    target = share * structure_size / largest
+    if target <= 1.0:
+        return 1.0
+    e = 10.0 ** np.floor(np.log10(target))
+    return float(max(m * e for m in (1.0, 1.5, 2.0, 2.5, 3.0, 4.0, 5.0, 6.0, 8.0) if m * e <= target * (1 + 1e-12)))

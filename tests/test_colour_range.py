@@ -1,0 +1,79 @@
+"""masonrycli.colour_range: the two rules (coverage, use) on every frame, the three kinds, the floor."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from masonrycli import colormap as cm
+from masonrycli.colour_range import MIN_SPAN, OUTSIDE_SHARE, ColourRange, RangeTracker, fit_range
+
+
+def outside_share(r: ColourRange, v: np.ndarray) -> float:
+    v = v[np.isfinite(v)]
+    return float(((v < r.lo) | (v > r.hi)).mean())
+
+
+def span_share(r: ColourRange, v: np.ndarray) -> float:
+    v = v[np.isfinite(v)]
+    return (min(v.max(), r.hi) - max(v.min(), r.lo)) / (r.hi - r.lo)
+
+
+@pytest.mark.parametrize("kind", ["signed", "negative", "positive"])
+def test_every_frame_keeps_both_rules_on_a_growing_then_calming_field(kind):
+    """A field that grows 50× then calms down 50× (as a cumulated strain, a shaking): every frame has
+    at most 2 % of its cells outside the range in force and spans at least MIN_SPAN of it."""
+    rng = np.random.default_rng(1)
+    tracker = RangeTracker(kind, floor=1e-9)
+    amplitude = np.r_[np.geomspace(1.0, 50.0, 60), np.geomspace(50.0, 1.0, 60)]
+    for a in amplitude:
+        v = a * rng.standard_normal(300)
+        v[rng.integers(0, 300, 3)] *= 30.0  # a few outliers (1 %)
+        v = {"signed": v, "negative": -np.abs(v), "positive": np.abs(v)}[kind]
+        v[5] = np.nan  # undefined cells do not count
+        r = tracker.update(v)
+        assert outside_share(r, v) <= OUTSIDE_SHARE
+        assert span_share(r, v) >= MIN_SPAN
+        assert r.lo <= 0.0 <= r.hi
+        if kind == "negative":
+            assert r.hi == 0.0  # one-sided: the map ends at zero
+        if kind == "positive":
+            assert r.lo == 0.0
+    assert 2 <= tracker.changes < len(amplitude) // 2  # refitted when needed, not every frame
+
+
+def test_a_range_is_kept_while_it_holds_and_ends_are_nice_numbers():
+    tracker = RangeTracker("positive", floor=1e-6)
+    r = tracker.update(np.linspace(0.0, 0.9, 51))
+    assert (r.lo, r.hi) == (0.0, 1.0)
+    assert tracker.update(np.linspace(0.1, 0.7, 51)) is r
+    assert tracker.update(np.linspace(0.0, 0.3, 51)) is not r  # spans 30 %: refitted
+    assert tracker.current.hi == pytest.approx(0.3)
+
+
+def test_small_frames_keep_every_cell_inside_and_the_floor_holds_noise_down():
+    v = np.linspace(-1.0, 3.0, 40)  # 2 % of 40 cells rounds down to 0: nothing may be left out
+    r = fit_range(v, "signed", 1e-9)
+    assert r.lo <= -1.0 and r.hi >= 3.0
+    noise = 1e-12 * np.random.default_rng(0).standard_normal(100)
+    r = fit_range(noise, "signed", 1e-4)
+    assert (r.lo, r.hi) == (-1e-4, 1e-4)
+
+
+def test_signed_position_is_two_sided_and_ticks_include_zero():
+    r = ColourRange("signed", -2.0, 8.0)
+    np.testing.assert_allclose(r.position(np.array([-2.0, -1.0, 0.0, 4.0, 8.0, 16.0])), [0, 0.25, 0.5, 0.75, 1, 1.5])
+    np.testing.assert_allclose(r.ticks(5), [-2.0, -1.0, 0.0, 4.0, 8.0])
+    one_sided = ColourRange("negative", -40e3, 0.0)
+    np.testing.assert_allclose(one_sided.ticks(5), [-40e3, -30e3, -20e3, -10e3, 0.0])
+    assert one_sided.outside(np.array([-50e3, -1.0, 5.0, np.nan])) == (1, 1, 3)
+
+
+def test_map_positions_marks_below_and_above():
+    lut = cm.BLUES
+    colors = cm.map_positions(np.array([-0.1, 0.0, 1.0, 1.2, np.nan]), lut)
+    assert list(colors) == [cm.UNDER_RGBA, lut[0], lut[-1], cm.OVER_RGBA, cm.NAN_RGBA]
+    assert cm.UNDER_RGBA not in lut and cm.OVER_RGBA not in lut and cm.NAN_RGBA not in lut
+    assert math.isclose(cm.unpack_rgba(lut[-1])[:3].mean(), 251, abs_tol=5)  # zero is near white
