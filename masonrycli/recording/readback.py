@@ -20,7 +20,9 @@ import pyarrow as pa
 import rerun as rr
 
 from masonrycli.recording._rerun_private import viewer_pid
-from masonrycli.recording.layout import BLOCKS, CHAIN_KEY, FIELDS, HOVER_VALUES, METADATA
+from masonrycli.recording.layout import BLOCKS, CHAIN_KEY, FIELDS, HOVER_VALUES, METADATA, PER_STEP_SERIES, SERIES
+
+_PER_STEP = frozenset(f"/{SERIES[k]}" for k in PER_STEP_SERIES)
 
 _TRUNCATED = re.compile(r"Message payload \(start (\d+), length \d+\) exceeds file size")
 _MESSAGE_HEADER_BYTES = 16  # an RRD message: kind (u64) and length (u64), then the payload
@@ -97,7 +99,7 @@ def _summarise(reader: rr.chunk.RrdReader, truncated: bool, path) -> dict:
                 texts = [t for t in batch.column("TextDocument:text").to_pylist() if t]
                 metadata = texts[-1][0] if texts else metadata  # the last one logged wins
             continue
-        if chunk.entity_path != f"/{BLOCKS}":
+        if chunk.entity_path in _PER_STEP:  # solver health, logged at every step: not frames
             continue
         if "step" in names:
             steps.update(batch.column("step").to_numpy().tolist())
