@@ -63,13 +63,15 @@ def test_a_recording_without_footer_is_noticed(recording, tmp_path):
 def test_inspect_reads_a_truncated_recording(recording, tmp_path):
     """Finding 9: `masonry inspect` could not read a truncated recording — the file a kill or a full disk leaves."""
     whole = inspect_recording(recording)
-    assert whole["frames"] == 301 and whole["complete"] and not whole["truncated"]
+    # 300 frames: steps 1 … 300 (the initial state, before any force, is in the history only)
+    assert whole["frames"] == 300 and whole["complete"] and not whole["truncated"]
     cut = tmp_path / "cut.rrd"
     with open(recording, "rb") as src, open(cut, "wb") as dst:
-        dst.write(src.read(recording.stat().st_size * 2 // 3))
+        # a third: the last third holds the magnified shape, written when the recorder closes
+        dst.write(src.read(recording.stat().st_size // 3))
     info = inspect_recording(cut)
     assert info["truncated"] and not info["complete"] and 0 < info["frames"] < whole["frames"]
-    assert info["steps"] == (0, info["frames"] - 1)
+    assert info["steps"] == (1, info["frames"])
     result = invoke("inspect", cut)
     assert result.exit_code == 0, result.output
     assert f"truncated (its writer did not finish: killed, or the disk was full) — {info['frames']} frames" in (
