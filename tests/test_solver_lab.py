@@ -85,3 +85,23 @@ def test_every_lab_method_solves_a_tiny_wall_step(tmp_path):
         assert row["v_error"] < 1e-4, name
         if name not in ("nlgs", "nlgs-oracle"):  # stopped by the engine's own test / the oracle
             assert row["law_residual"] <= 1e-6, name
+
+
+def test_rigid_share_of_a_free_cluster(tmp_path):
+    from benchmarks.solver_lab.clusters import rigid_share
+
+    p = _captured(tmp_path)
+    dyn = p.inv_mass > 0
+    a, b = p.body[:, 0], p.body[:, 1]
+    st = np.where(dyn[a] & dyn[b], 1, 0).astype(np.int8)  # blocks stuck together, free of the ground
+    x = p.q_m[:, :2]
+    rigid = np.zeros_like(p.v_ref)
+    rigid[:, 0], rigid[:, 1], rigid[:, 2] = 0.1 - 0.05 * x[:, 1], 0.05 * x[:, 0], 0.05  # V + ω ẑ × x
+    share, free = rigid_share(p, st, p.v_ref + np.where(dyn[:, None], rigid, 0.0))
+    assert free == 1 and abs(share - 1.0) < 1e-12
+    wobble = np.zeros_like(p.v_ref)
+    wobble[np.flatnonzero(dyn)[0], 0] = 1e-3  # one block alone: mostly not a motion of the whole cluster
+    share, _ = rigid_share(p, st, p.v_ref + wobble)
+    assert share < 0.5
+    # stuck to the ground: nothing is free to move rigidly
+    assert rigid_share(p, np.ones_like(st), p.v_ref + wobble) == (0.0, 0)

@@ -1,4 +1,4 @@
-"""Solver lab: ``python -m benchmarks.solver_lab capture|table`` (see benchmarks/README.md, "Solver lab")."""
+"""Solver lab: ``python -m benchmarks.solver_lab capture|table|clusters`` (see benchmarks/README.md, "Solver lab")."""
 
 from __future__ import annotations
 
@@ -22,11 +22,17 @@ def main() -> None:
     tab.add_argument("--methods", nargs="+", default=None)
     tab.add_argument("--problems", nargs="+", default=None)
     tab.add_argument("--repeat", type=int, default=3, help="interleaved repeats; CPU-time minimum is kept")
+    clu = sub.add_parser("clusters", help="share of an NLGS iterate's velocity error in rigid motion of stick clusters")
+    clu.add_argument("specs", nargs="+", metavar="PROBLEM:SWEEPS")
     args = ap.parse_args()
     if args.command == "capture":
         from benchmarks.solver_lab.capture import capture
 
         capture(args.cases)
+    elif args.command == "clusters":
+        from benchmarks.solver_lab.clusters import report
+
+        report(args.specs)
     else:
         from benchmarks.solver_lab.harness import run_table
 
