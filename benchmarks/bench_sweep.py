@@ -9,6 +9,9 @@ per-task overhead of going through Dask. Run with ``.venv/bin/python benchmarks/
   (energy dissipated, state, drifts, IMs, NLGS sweeps): the speed-up is only claimed for identical
   results.
 * **per-task overhead** — ``--tiny`` one-step runs through the cluster vs in process, per task.
+* **CPU time per task** in process and on a worker (``time.process_time`` inside the task): on a machine
+  whose other processes take the cores, the wall-time speed-up says more about them than about the
+  sweep; workers × (CPU time in process / CPU time on a worker) is the speed-up with a free core each.
 
 Figures are printed and written to ``benchmarks/results_sweep.json``.
 """
@@ -81,6 +84,8 @@ def main() -> None:
     # machine's other processes take the cores (then no speed-up can show)
     task_serial = sum(r["wall_time"] for r in serial_rows) / len(serial_rows)
     task_cluster = sum(r["wall_time"] for r in cluster_rows) / len(cluster_rows)
+    cpu_serial = sum(r["cpu_time"] for r in serial_rows) / len(serial_rows)
+    cpu_cluster = sum(r["cpu_time"] for r in cluster_rows) / len(cluster_rows)
 
     tiny = study_base(1e-3)
     tiny_axes = [parse_axis(f"amp=0.1:1.0:{args.tiny}")]
@@ -101,6 +106,9 @@ def main() -> None:
         "rows_identical": identical,
         "task_wall_serial_s": task_serial,
         "task_wall_on_worker_s": task_cluster,
+        "task_cpu_serial_s": cpu_serial,
+        "task_cpu_on_worker_s": cpu_cluster,
+        "speedup_from_cpu_time": args.workers * cpu_serial / cpu_cluster,
         "cluster_start_s": cluster_start,
         "worker_warm_up_s": warm_up,
         "tiny_tasks": len(grid(tiny_axes)),
@@ -112,6 +120,11 @@ def main() -> None:
     print(f"  serial {res['serial_s']:.2f} s, cluster {res['cluster_s']:.2f} s: speed-up {res['speedup']:.2f}x")
     print(f"  rows identical to the serial runs: {identical}")
     print(f"  one task's own wall time: {task_serial:.2f} s in process, {task_cluster:.2f} s on a worker")
+    print(f"  one task's CPU time: {cpu_serial:.2f} s in process, {cpu_cluster:.2f} s on a worker")
+    print(
+        f"  speed-up the CPU times give with a free core per worker: {res['speedup_from_cpu_time']:.2f}x "
+        "(workers × CPU time in process / CPU time on a worker)"
+    )
     print(f"  cluster start {cluster_start:.1f} s, workers' first task (numba cache load) {warm_up:.1f} s")
     print(
         f"  per-task overhead: {res['overhead_ms_per_task']:.1f} ms ({res['tiny_tasks']} one-step tasks: "

@@ -33,6 +33,7 @@ RESULT_COLUMNS = (
     "steps",
     "time",
     "wall_time",
+    "cpu_time",
     "sweeps_mean",
     "capped_steps",
     "last_residual",
@@ -52,7 +53,7 @@ def run_task(base, params: dict, stop_at_collapse: bool = True, history_dir: str
     from masonrycli.run import Simulation, simulate
     from masonrycli.study.axes import apply_point
 
-    start = time.perf_counter()
+    start, cpu_start = time.perf_counter(), time.process_time()
     row = dict(params)
     try:
         scenario = apply_point(base, params)
@@ -86,6 +87,7 @@ def run_task(base, params: dict, stop_at_collapse: bool = True, history_dir: str
         "steps": result.steps,
         "time": result.time,
         "wall_time": time.perf_counter() - start,
+        "cpu_time": time.process_time() - cpu_start,
         "sweeps_mean": float(its.mean()) if its.size else 0.0,
         "capped_steps": int((its >= scenario.run.max_iterations).sum()),
         "last_residual": float(result.residual[-1]) if result.residual.size else 0.0,
