@@ -92,8 +92,10 @@ RUN = {
     "dt": _opt(float, "Run", "Time step, s (default 1e-3).", "--dt"),
     "theta": _opt(float, "Run", "Moreau–Jean θ in [0.5, 1] (default 0.5)."),
     "record_every": _opt(int, "Run", "Steps between recorded frames (default 10)."),
-    "tolerance": _opt(float, "Run", "NLGS tolerance, relative quadratic norm (default 1.666e-4)."),
-    "max_iterations": _opt(int, "Run", "NLGS sweep cap per step (default 1000)."),
+    "tolerance": _opt(
+        float, "Run", "NLGS stopping test: RMS contact-law violation of a sweep, m/s (default 1e-5; 1e-8 is tight)."
+    ),
+    "max_iterations": _opt(int, "Run", "NLGS sweep cap per step (default 50000)."),
 }
 Friction = _opt(float, "Material", "Coulomb coefficient of every contact (default 0.6).")
 FRICTION = {"friction": Friction}

@@ -222,6 +222,14 @@ def print_summary(console: Console, outcome: Outcome, scenario, hint: str = "") 
     result = outcome.result
     paths = {o.option: str(o.path) for o in outcome.written}
     console.print(summary_table(result, scenario.run.max_iterations, paths.get("--out"), paths.get("--history")))
+    if result is not None and result.unconverged:
+        run = scenario.run
+        console.print(
+            f"[bold red]warning:[/] {result.unconverged} of {result.steps} steps ended unconverged (contact-law "
+            f"residual above --tolerance {run.tolerance:g} m/s at the {run.max_iterations}-sweep cap); their "
+            "impulses and motion are approximate. Raise --max-iterations, or check the history's nlgs_residual.",
+            soft_wrap=True,
+        )
     if hint and "--out" in paths:
         console.print(hint, soft_wrap=True)
     if "--out" in paths:

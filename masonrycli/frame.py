@@ -11,7 +11,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-CONTACT_OPEN, CONTACT_STICK, CONTACT_SLIP = 0, 1, 2
+from masonrycli.engine.contact import ContactStatus
+
+CONTACT_OPEN, CONTACT_STICK, CONTACT_SLIP = ContactStatus.OPEN, ContactStatus.STICK, ContactStatus.SLIP
 
 
 @dataclass(frozen=True, eq=False)
@@ -41,7 +43,7 @@ class Frame:
     contact_gap: np.ndarray
     """(C,) gap at detection, m (negative = penetration)."""
     contact_status: np.ndarray
-    """(C,) int8: 0 open, 1 stick, 2 slip."""
+    """(C,) int8 :class:`~masonrycli.engine.contact.ContactStatus`: 0 open, 1 stick, 2 slip."""
     contact_mobilised: np.ndarray
     """(C,) |r_t| / (mu r_n), 0 for open contacts."""
     tensors: dict
@@ -55,7 +57,9 @@ class Frame:
     support_work: float
     """J, cumulated work done by the supports on the blocks since t = 0."""
     nlgs_iterations: int
+    """Sweeps of the step that ended at this frame (masonrycli.engine.nlgs.solve)."""
     nlgs_residual: float
+    """m/s: RMS contact-law violation of that step's last sweep, the quantity compared with the tolerance."""
     contact_count: int
     joint_body: np.ndarray = field(default_factory=lambda: np.zeros((0, 2), dtype=np.int64))
     """(J, 2) bodies of each joint (pairs touching along a face initially; see masonrycli.mechanism)."""
@@ -63,3 +67,5 @@ class Frame:
     """(J,) True where the joint is hinged: one end carries all the normal force, the other is open."""
     hinge_point: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)))
     """(H, 2) m: the loaded contact point of each hinged joint (the hinge), world coordinates."""
+    nlgs_unconverged: int = 0
+    """Steps since t = 0 (up to this frame) whose solve did not meet its tolerance before the sweep cap."""

@@ -4,7 +4,8 @@ Arrays (T frames, N blocks, S supports), block order = scenario order:
 
     time (T,) s · step (T,) · block_q (T,N,3) [x, y m, rotation from the initial orientation rad CCW]
     block_v (T,N,3) [m/s, m/s, rad/s] · support_q (T,S,3) · support_v (T,S,2) · support_force (T,S,2) N
-    contact_count (T,) · nlgs_iterations (T,) · nlgs_residual (T,)
+    contact_count (T,) · nlgs_iterations (T,) sweeps · nlgs_residual (T,) m/s (of the step ending at the frame)
+    nlgs_unconverged (T,) steps since t = 0 that ended unconverged (residual > tolerance or at the cap)
     energy_kinetic (T,) J · energy_potential (T,) J · energy_dissipated (T,) J (cumulated)
     support_work (T,) J (cumulated) · every per-block tensor field of masonrycli.tensors.TENSOR_FIELDS
     joint_body (J,2) · joint_hinged (T,J) bool · hinge_count (T,)  (see masonrycli.mechanism)
@@ -34,6 +35,7 @@ _SCALARS = (
     "contact_count",
     "nlgs_iterations",
     "nlgs_residual",
+    "nlgs_unconverged",
     "energy_kinetic",
     "energy_potential",
     "energy_dissipated",

@@ -54,7 +54,7 @@ class Model:
     theta: float
     """Moreau–Jean θ ∈ [0.5, 1]."""
     tolerance: float
-    """NLGS stopping tolerance on the relative quadratic norm of the impulse change."""
+    """NLGS stopping tolerance, m/s: RMS contact-law violation of a sweep (masonrycli.engine.nlgs)."""
     max_iterations: int
     """NLGS sweep cap."""
     alert_distance: float

@@ -43,7 +43,7 @@ class RunConfig:
         one), else the run would silently stop short of it. At most ``MAX_STEPS`` steps.
     theta : Moreau–Jean θ, in [0.5, 1].
     gravity : (gx, gy) m/s², a vector (tilt it for tilting tests).
-    tolerance : NLGS convergence tolerance (relative quadratic norm of the impulse change), in (0, 1).
+    tolerance : m/s, NLGS stopping test: RMS contact-law violation of a sweep (engine.nlgs), in (0, 1).
     max_iterations : NLGS sweep cap per step, >= 1.
     record_every : record one frame every this many steps, >= 1.
     alert_distance : m, contacts with a gap below this are kept, > 0.
@@ -53,8 +53,8 @@ class RunConfig:
     dt: float = 1e-3
     theta: float = 0.5
     gravity: tuple[float, float] = (0.0, -9.81)
-    tolerance: float = 1.666e-4
-    max_iterations: int = 1000
+    tolerance: float = 1e-5
+    max_iterations: int = 50000
     record_every: int = 10
     alert_distance: float = 1e-3
 

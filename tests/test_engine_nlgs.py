@@ -78,3 +78,148 @@ def test_open_contact_inside_alert_may_close_but_not_cross():
     assert st == nlgs.STATUS_OPEN
     rt, rn, st = nlgs._local_solve(0.0, -0.5, p, 0, mu)  # faster: stopped at −g/dt
     assert rn == pytest.approx(0.3) and st == nlgs.STATUS_STICK
+
+
+# --- The Delassus assembly and the contact power, against dense matrices built here in numpy ----------
+
+
+def _random_contacts(n_contacts=7, seed=3):
+    """Three blocks and one support (inverse mass 0), contacts between random pairs a < b."""
+    rng = np.random.default_rng(seed)
+    q = rng.normal(size=(4, 3))
+    inv_mass = np.array([1 / 2.0, 1 / 3.5, 1 / 1.2, 0.0])
+    inv_inertia = np.array([1 / 0.4, 1 / 0.9, 1 / 0.15, 0.0])
+    pairs = [(0, 1), (0, 3), (1, 2), (2, 3), (0, 2)]
+    body = np.array([pairs[i % len(pairs)] for i in range(n_contacts)], dtype=np.int32)
+    point = q[body[:, 0], :2] + rng.normal(scale=0.3, size=(n_contacts, 2))
+    angle = rng.uniform(0, 2 * np.pi, n_contacts)
+    normal = np.column_stack([np.cos(angle), np.sin(angle)])
+    gap = rng.normal(scale=1e-3, size=n_contacts)
+    return q, inv_mass, inv_inertia, body, point, normal, gap
+
+
+def _dense_h(q, body, point, normal):
+    """H (3B × 2C): column 2c is the unit tangential impulse t of contact c, column 2c+1 the normal one,
+    acting on b (+) and a (−) at the contact point; t = (n_y, −n_x) (masonrycli.engine.contact)."""
+    h = np.zeros((3 * q.shape[0], 2 * body.shape[0]))
+    for c, (a, b) in enumerate(body):
+        n = normal[c]
+        t = np.array([n[1], -n[0]])
+        for col, d in ((2 * c, t), (2 * c + 1, n)):
+            for k, sign in ((b, 1.0), (a, -1.0)):
+                arm = point[c] - q[k, :2]
+                h[3 * k : 3 * k + 2, col] += sign * d
+                h[3 * k + 2, col] += sign * (arm[0] * d[1] - arm[1] * d[0])
+    return h
+
+
+def test_prepare_matches_dense_delassus():
+    q, inv_mass, inv_inertia, body, point, normal, gap = _random_contacts()
+    mu, dt = 0.6, 1e-3
+    count = body.shape[0]
+    pack = np.zeros((count, nlgs.PACK_WIDTH))
+    nlgs._prepare(body, point, normal, gap, count, q, inv_mass, inv_inertia, mu, dt, pack)
+    h = _dense_h(q, body, point, normal)
+    m_inv = np.diag(np.column_stack([inv_mass, inv_mass, inv_inertia]).ravel())
+    w = h.T @ m_inv @ h
+    for c in range(count):
+        block = w[2 * c : 2 * c + 2, 2 * c : 2 * c + 2]
+        got = np.array([[pack[c, nlgs.P_WTT], pack[c, nlgs.P_WTN]], [pack[c, nlgs.P_WTN], pack[c, nlgs.P_WNN]]])
+        np.testing.assert_allclose(got, block, rtol=1e-12, atol=1e-14)
+        inv = np.array([[pack[c, nlgs.P_ITT], pack[c, nlgs.P_ITN]], [pack[c, nlgs.P_ITN], pack[c, nlgs.P_INN]]])
+        np.testing.assert_allclose(inv @ block, np.eye(2), atol=1e-10)
+        wtn, wnn = block[0, 1], block[1, 1]
+        assert pack[c, nlgs.P_ISP] == pytest.approx(1 / (wnn - mu * wtn) if wnn - mu * wtn > 0 else 0.0)
+        assert pack[c, nlgs.P_ISM] == pytest.approx(1 / (wnn + mu * wtn) if wnn + mu * wtn > 0 else 0.0)
+        assert pack[c, nlgs.P_BIAS] == pytest.approx(max(gap[c], 0.0) / dt)
+    # The sweep's relative velocity is Hᵀ v and its push is M⁻¹ H Δr.
+    rng = np.random.default_rng(5)
+    v = rng.normal(size=(4, 3))
+    u = h.T @ v.ravel()
+    for c in range(count):
+        ut, un = nlgs._relative_velocity(v, body[c, 0], body[c, 1], pack, c)
+        np.testing.assert_allclose([ut, un], u[2 * c : 2 * c + 2], rtol=1e-12, atol=1e-12)
+    dr = rng.normal(size=2)
+    pushed = v.copy()
+    nlgs._push(pushed, body[2, 0], body[2, 1], pack, 2, dr[0], dr[1])
+    expected = v.ravel() + m_inv @ h[:, 4:6] @ dr
+    np.testing.assert_allclose(pushed.ravel(), expected, rtol=1e-12, atol=1e-12)
+    assert np.all(pushed[3] == v[3])  # the support's imposed velocity is untouched (+0)
+
+
+def test_contact_power_matches_dense_definitions():
+    q, inv_mass, inv_inertia, body, point, normal, gap = _random_contacts(seed=11)
+    dt, count = 1e-3, body.shape[0]
+    pack = np.zeros((count, nlgs.PACK_WIDTH))
+    nlgs._prepare(body, point, normal, gap, count, q, inv_mass, inv_inertia, 0.6, dt, pack)
+    rng = np.random.default_rng(13)
+    r = rng.normal(size=(count, 2))
+    v_old, v_new = rng.normal(size=(4, 3)), rng.normal(size=(4, 3))
+    v_old[3, 2] = v_new[3, 2] = 0.0
+    dynamic = np.array([True, True, True, False])
+    force = np.zeros((count, 2))
+    support_force = np.zeros((1, 2))
+    dissipated, work = nlgs._contact_power(body, pack, r, count, v_old, v_new, dynamic, 3, dt, force, support_force)
+    h = _dense_h(q, body, point, normal)
+    u_mean = h.T @ (0.5 * (v_old + v_new)).ravel()
+    assert dissipated == pytest.approx(-(r.ravel() @ u_mean), rel=1e-12)
+    t = np.column_stack([normal[:, 1], -normal[:, 0]])
+    impulse = r[:, :1] * t + r[:, 1:] * normal  # on b; a gets the opposite
+    np.testing.assert_allclose(force, impulse / dt, rtol=1e-12)
+    # The support (body 3) receives +P where it is b and −P where it is a; it does work on the blocks
+    # with the opposite force, at its mean velocity.
+    on_support = np.where(body[:, 1:] == 3, 1.0, 0.0) * impulse - np.where(body[:, :1] == 3, 1.0, 0.0) * impulse
+    np.testing.assert_allclose(support_force[0], on_support.sum(axis=0) / dt, rtol=1e-12)
+    v_support = 0.5 * (v_old[3, :2] + v_new[3, :2])
+    assert work == pytest.approx(-(on_support.sum(axis=0) @ v_support), rel=1e-12)
+
+
+def _slow_sweeps(body, w_blocks, h, m_inv, v, r, mu, bias, sweeps):
+    """Gauss–Seidel written out with the dense H and M⁻¹ (numpy, one contact at a time); returns the last
+    sweep's RMS of |W_αα Δr_α| (m/s), the stopping quantity of nlgs.solve."""
+    v = v.ravel().copy()
+    v += m_inv @ h @ r.ravel()
+    for _ in range(sweeps):
+        e2 = 0.0
+        for c in range(body.shape[0]):
+            w = w_blocks[c]
+            u_free = h[:, 2 * c : 2 * c + 2].T @ v - w @ r[c]
+            row = _packed_row((w[0, 0], w[0, 1], w[1, 1]), bias[c], mu)
+            rt, rn, _ = nlgs._local_solve(u_free[0], u_free[1], row, 0, mu)
+            dr = np.array([rt, rn]) - r[c]
+            v += m_inv @ h[:, 2 * c : 2 * c + 2] @ dr
+            r[c] = (rt, rn)
+            e2 += float((w @ dr) @ (w @ dr))
+        residual = np.sqrt(e2 / body.shape[0])
+    return v.reshape(-1, 3), r, residual
+
+
+@pytest.mark.parametrize("sweeps", [1, 3, 12])
+def test_residual_is_rms_contact_law_violation_of_the_last_sweep(sweeps):
+    q, inv_mass, inv_inertia, body, point, normal, gap = _random_contacts(seed=17)
+    mu, dt, count = 0.5, 1e-3, body.shape[0]
+    pack = np.zeros((count, nlgs.PACK_WIDTH))
+    nlgs._prepare(body, point, normal, gap, count, q, inv_mass, inv_inertia, mu, dt, pack)
+    h = _dense_h(q, body, point, normal)
+    m_inv = np.diag(np.column_stack([inv_mass, inv_mass, inv_inertia]).ravel())
+    w_full = h.T @ m_inv @ h
+    w_blocks = [w_full[2 * c : 2 * c + 2, 2 * c : 2 * c + 2] for c in range(count)]
+    rng = np.random.default_rng(19)
+    v0 = rng.normal(scale=0.1, size=(4, 3))
+    v0[3] = 0.0
+    r0 = np.abs(rng.normal(scale=0.01, size=(count, 2)))
+    bias = np.maximum(gap, 0.0) / dt
+    v_ref, r_ref, res_ref = _slow_sweeps(body, w_blocks, h, m_inv, v0, r0.copy(), mu, bias, sweeps)
+    v, r, status = v0.copy(), r0.copy(), np.zeros(count, dtype=np.int8)
+    its, res = nlgs._nlgs(body, pack, count, mu, 0.0, sweeps, v, r, status)
+    assert its == sweeps
+    assert res == pytest.approx(res_ref, rel=1e-9, abs=1e-15)
+    np.testing.assert_allclose(r, r_ref, rtol=1e-9, atol=1e-14)
+    np.testing.assert_allclose(v, v_ref, rtol=1e-9, atol=1e-12)
+    # With a tolerance, the solve stops at the first sweep whose residual meets it.
+    v, r = v0.copy(), r0.copy()
+    its, res = nlgs._nlgs(body, pack, count, mu, 1e-9, 100000, v, r, status)
+    assert res <= 1e-9
+    v, r = v0.copy(), r0.copy()
+    _, before = nlgs._nlgs(body, pack, count, mu, 0.0, its - 1, v, r, status) if its > 1 else (0, np.inf)
+    assert before > 1e-9

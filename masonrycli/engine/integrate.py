@@ -15,12 +15,20 @@ from masonrycli.engine._jit import njit
 
 
 @njit
-def _intermediate_q(body_q, body_v, dt, theta, out_q):
-    # q_m = q_n + (1 − θ)·dt·v_n, all bodies (supports translate with their imposed velocity).
+def _begin_step(body_q, body_v, body_radius, dt, theta, out_q, out_v_old):
+    # One pass over the bodies at the start of a step:
+    #   q_m = q_n + (1 − θ)·dt·v_n  (supports translate with their imposed velocity), v_old = v_n,
+    #   top point speed max_k |v_k| + |ω_k|·radius_k  (for the detection distance).
     h = (1.0 - theta) * dt
+    top = 0.0
     for b in range(body_q.shape[0]):
         for k in range(3):
             out_q[b, k] = body_q[b, k] + h * body_v[b, k]
+            out_v_old[b, k] = body_v[b, k]
+        speed = np.sqrt(body_v[b, 0] ** 2 + body_v[b, 1] ** 2) + abs(body_v[b, 2]) * body_radius[b]
+        if speed > top:
+            top = speed
+    return top
 
 
 @njit
@@ -39,11 +47,21 @@ def _free_velocity(body_v, body_dynamic, gravity, dt, support_v_next, block_coun
 
 
 @njit
-def _update_q(body_q, body_v_old, body_v_new, dt, theta):
-    # q_n+1 = q_n + dt·(θ v_n+1 + (1 − θ) v_n), in place.
+def _update_q(body_q, body_v_old, body_v_new, dt, theta, block_count):
+    # q_n+1 = q_n + dt·(θ v_n+1 + (1 − θ) v_n), in place; in the same pass, for the divergence check,
+    # whether every block's q and v are finite and the top block speed |v| (NaN if not finite).
+    finite = True
+    top = 0.0
     for b in range(body_q.shape[0]):
         for k in range(3):
             body_q[b, k] += dt * (theta * body_v_new[b, k] + (1.0 - theta) * body_v_old[b, k])
+            if b < block_count and not (np.isfinite(body_q[b, k]) and np.isfinite(body_v_new[b, k])):
+                finite = False
+        if b < block_count:
+            speed = np.sqrt(body_v_new[b, 0] ** 2 + body_v_new[b, 1] ** 2)
+            if speed > top:
+                top = speed
+    return top if finite else np.nan
 
 
 @njit
@@ -58,9 +76,10 @@ def _energies(body_q, body_v, body_mass, body_inertia, gravity, block_count):
     return kinetic, potential
 
 
-def intermediate_q(body_q: np.ndarray, body_v: np.ndarray, dt: float, theta: float, out: np.ndarray) -> None:
-    """Write q_m = q_n + (1 − θ)·dt·v_n into ``out`` (B, 3)."""
-    _intermediate_q(body_q, body_v, dt, theta, out)
+def begin_step(model, body_q: np.ndarray, body_v: np.ndarray, out_q: np.ndarray, out_v_old: np.ndarray) -> float:
+    """Write q_m = q_n + (1 − θ)·dt·v_n into ``out_q`` and v_n into ``out_v_old`` (B, 3); return the top
+    speed of any body point, m/s (|v| + |ω|·radius)."""
+    return _begin_step(body_q, body_v, model.body_radius, model.dt, model.theta, out_q, out_v_old)
 
 
 def free_velocity(model, body_v: np.ndarray, support_v_next: np.ndarray, out: np.ndarray) -> None:
@@ -68,9 +87,10 @@ def free_velocity(model, body_v: np.ndarray, support_v_next: np.ndarray, out: np
     _free_velocity(body_v, model.body_dynamic, model.gravity, model.dt, support_v_next, model.block_count, out)
 
 
-def update_q(body_q: np.ndarray, v_old: np.ndarray, v_new: np.ndarray, dt: float, theta: float) -> None:
-    """Advance ``body_q`` (B, 3) in place with the θ-rule."""
-    _update_q(body_q, v_old, v_new, dt, theta)
+def update_q(model, body_q: np.ndarray, v_old: np.ndarray, v_new: np.ndarray) -> float:
+    """Advance ``body_q`` (B, 3) in place with the θ-rule; return the top block speed |v| (m/s), NaN
+    when a block's position or velocity is not finite."""
+    return _update_q(body_q, v_old, v_new, model.dt, model.theta, model.block_count)
 
 
 def energies(model, body_q: np.ndarray, body_v: np.ndarray) -> tuple[float, float]:

@@ -1,13 +1,15 @@
 """One Moreau–Jean time step: launchers only, every loop lives in a kernel.
 
-1. q_m = q_n + (1 − θ) dt v_n                          integrate.intermediate_q
+1. q_m = q_n + (1 − θ) dt v_n, top speed               integrate.begin_step
 2. contacts at q_m within alert + 2·dt·(top speed)     collision.detect_contacts
-3. warm start: r_α ← r of the previous step with the same key
+3. r_α ← r of the previous step with the same key      warmstart.WarmStart.start
 4. v_free = v_n + dt g ; supports get v(t_n+1)         integrate.free_velocity
 5. lever arms, W_αα, Signorini bias                    nlgs.prepare_contacts
+   no contact warm-started (first step): static guess  warmstart.static_guess
 6. NLGS → r, v_n+1                                     nlgs.solve
 7. contact forces, dissipation, support work           nlgs.contact_power
 8. q_n+1 = q_n + dt (θ v_n+1 + (1 − θ) v_n)            integrate.update_q
+9. keep the keys and impulses for step 3 next time    warmstart.WarmStart.remember
 """
 
 from __future__ import annotations
@@ -16,7 +18,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from masonrycli.engine import integrate, nlgs
+from masonrycli.engine import integrate, nlgs, warmstart
 from masonrycli.engine.collision import ContactBuffers, detect_contacts
 
 
@@ -31,6 +33,10 @@ class StepStats:
     """Work of the supports on the blocks during the step, J."""
     max_penetration: float
     """Largest penetration among the step's contacts at detection, m (0 if none)."""
+    max_block_speed: float
+    """Top block speed |v| at the end of the step, m/s; NaN if a block's q or v is not finite."""
+    converged: bool
+    """The solver met its stopping test: residual ≤ tolerance before the sweep cap (nlgs.solve)."""
 
 
 class Solver:
@@ -46,14 +52,11 @@ class Solver:
         self.body_q_m = np.empty((b, 3))
         """(B, 3) configuration at which the last step detected its contacts."""
         self._v_old = np.empty((b, 3))
-        self._prev_key = np.empty(0, dtype=np.int64)
-        self._prev_r = np.empty((0, 2))
+        self._warm = warmstart.WarmStart(self.buffers.contact_capacity)
         self._count = 0
         self._alloc(self.buffers.contact_capacity)
 
     def _alloc(self, capacity: int) -> None:
-        self._ra = np.zeros((capacity, 2))
-        self._rb = np.zeros((capacity, 2))
         self._pack = np.zeros((capacity, nlgs.PACK_WIDTH))
         self._r = np.zeros((capacity, 2))
         self._status = np.zeros(capacity, dtype=np.int8)
@@ -94,17 +97,9 @@ class Solver:
         return self._status[: self._count]
 
     def contact_tangential_velocity(self, body_v: np.ndarray) -> np.ndarray:
-        """(C,) m/s: u_t = (v_b(I) − v_a(I))·t of the last step's contacts for velocities ``body_v``
-        (B, 3), with the step's lever arms (numpy; called for recorded frames only)."""
-        c = self._count
-        body = self.buffers.contact_body[:c]
-        n = self.buffers.contact_normal[:c]
-        ra, rb = self._ra[:c], self._rb[:c]
-        va, vb = body_v[body[:, 0]], body_v[body[:, 1]]
-        # point velocity v + ω ẑ × r = (vx − ω r_y, vy + ω r_x), projected on t = (n_y, −n_x)
-        dx = (vb[:, 0] - vb[:, 2] * rb[:, 1]) - (va[:, 0] - va[:, 2] * ra[:, 1])
-        dy = (vb[:, 1] + vb[:, 2] * rb[:, 0]) - (va[:, 1] + va[:, 2] * ra[:, 0])
-        return dx * n[:, 1] - dy * n[:, 0]
+        """(C,) m/s: u_t of the last step's contacts for velocities ``body_v`` (B, 3), with the step's
+        lever arms (called for recorded frames only)."""
+        return nlgs.tangential_velocity(self.buffers.contact_body, self._pack, self._count, body_v)
 
     def detect(self, body_q: np.ndarray, alert: float | None = None) -> int:
         """Contacts of configuration ``body_q`` within ``alert`` (default: the model's alert distance)
@@ -117,65 +112,47 @@ class Solver:
         self._count = count
         return count
 
-    def detection_distance(self, body_v: np.ndarray) -> float:
+    def detection_distance(self, top_speed: float) -> float:
         """m: the alert distance plus how far two bodies can approach each other within a step.
 
         A pair farther apart than the alert distance but closing fast (a falling block, a collapsing
         arch) would otherwise be found only once it has penetrated, and a penetration is never pushed
         out. Found in time, its Signorini condition u_n + g/dt ≥ 0 stops it at contact instead.
-        Points move at most |v| + |ω|·radius; two bodies approach at most twice the fastest.
+        Points move at most ``top_speed`` = max |v| + |ω|·radius; two bodies approach at most twice that.
         """
-        speed = np.hypot(body_v[:, 0], body_v[:, 1]) + np.abs(body_v[:, 2]) * self.model.body_radius
-        return self.model.alert_distance + 2.0 * self.model.dt * float(speed.max(initial=0.0))
-
-    def _warm_start(self, count: int) -> None:
-        # Impulses of contacts that existed last step (same key) start from their last value.
-        key = self.buffers.contact_key[:count]
-        r = self._r[:count]
-        r[:] = 0.0
-        if self._prev_key.size and count:
-            pos = np.searchsorted(self._prev_key, key)
-            pos = np.minimum(pos, self._prev_key.size - 1)
-            hit = self._prev_key[pos] == key
-            r[hit] = self._prev_r[pos[hit]]
-
-    def _remember(self, count: int) -> None:
-        key = self.buffers.contact_key[:count]
-        order = np.argsort(key, kind="stable")
-        self._prev_key = key[order]
-        self._prev_r = self._r[:count][order]
+        return self.model.alert_distance + 2.0 * self.model.dt * top_speed
 
     def step(self, state) -> StepStats:
         m = self.model
         k = state.step
-        integrate.intermediate_q(state.body_q, state.body_v, m.dt, m.theta, self.body_q_m)
-        count = self.detect(self.body_q_m, self.detection_distance(state.body_v))
-        self._warm_start(count)
-        self._v_old[:] = state.body_v
-        integrate.free_velocity(m, self._v_old, m.support_velocity[k + 1], state.body_v)
+        top_speed = integrate.begin_step(m, state.body_q, state.body_v, self.body_q_m, self._v_old)
+        count = self.detect(self.body_q_m, self.detection_distance(top_speed))
         bf = self.buffers
-        body, normal = bf.contact_body, bf.contact_normal
+        body = bf.contact_body
+        warm = self._warm.start(bf.contact_key, count, self._r)
+        integrate.free_velocity(m, self._v_old, m.support_velocity[k + 1], state.body_v)
         nlgs.prepare_contacts(
-            body, bf.contact_point, normal, bf.contact_gap, count, self.body_q_m, m, self._ra, self._rb, self._pack
+            body, bf.contact_point, bf.contact_normal, bf.contact_gap, count, self.body_q_m, m, self._pack
         )
+        if warm == 0:  # nothing to warm-start from (first step): start from the static load path
+            warmstart.static_guess(body, self._pack, count, self.body_q_m, m, self._r)
         iterations, residual = nlgs.solve(body, self._pack, count, m, state.body_v, self._r, self._status)
         dissipated, work = nlgs.contact_power(
-            body,
-            normal,
-            self._ra,
-            self._rb,
-            self._r,
-            count,
-            self._v_old,
-            state.body_v,
-            m,
-            self._force,
-            self.support_force,
+            body, self._pack, self._r, count, self._v_old, state.body_v, m, self._force, self.support_force
         )
-        integrate.update_q(state.body_q, self._v_old, state.body_v, m.dt, m.theta)
+        block_speed = integrate.update_q(m, state.body_q, self._v_old, state.body_v)
         state.step = k + 1
         state.time = state.step * m.dt
-        self._remember(count)
-        gap = self.buffers.contact_gap[:count]
-        penetration = float(max(0.0, -gap.min())) if count else 0.0
-        return StepStats(count, int(iterations), float(residual), float(dissipated), float(work), penetration)
+        self._warm.remember(bf.contact_key, self._r, count)
+        penetration = float(max(0.0, -bf.contact_gap[:count].min())) if count else 0.0
+        converged = residual <= m.tolerance and iterations < m.max_iterations
+        return StepStats(
+            count,
+            int(iterations),
+            float(residual),
+            float(dissipated),
+            float(work),
+            penetration,
+            float(block_speed),
+            bool(converged),
+        )

@@ -11,12 +11,13 @@ from __future__ import annotations
 import numpy as np
 
 from masonrycli.engine._jit import njit
+from masonrycli.engine.nlgs import _relative_velocity
 
 
 @njit
-def _watch(body_q, body_v, q0, height, n, top, contact_body, contact_normal, ra, rb, status, count):
+def _watch(body_q, body_v, q0, height, n, top, contact_body, pack, status, count):
     # for each block i < n:   rock = max |ω_i|,  fall = max (y0_i − y_i) / h_i,  turn = max |θ_i|
-    # for each closed contact: u_t = (v_b(I) − v_a(I)) · t,  t = (n_y, −n_x);  slide = max |u_t|
+    # for each closed contact: u_t = (v_b(I) − v_a(I)) · t (nlgs._relative_velocity);  slide = max |u_t|
     # top_dx = mean over the top blocks of x_i − x0_i
     rock = 0.0
     fall = -np.inf
@@ -29,10 +30,8 @@ def _watch(body_q, body_v, q0, height, n, top, contact_body, contact_normal, ra,
     for c in range(count):
         if status[c] == 0:  # open
             continue
-        a, b = contact_body[c, 0], contact_body[c, 1]
-        dx = (body_v[b, 0] - body_v[b, 2] * rb[c, 1]) - (body_v[a, 0] - body_v[a, 2] * ra[c, 1])
-        dy = (body_v[b, 1] + body_v[b, 2] * rb[c, 0]) - (body_v[a, 1] + body_v[a, 2] * ra[c, 0])
-        slide = max(slide, abs(dx * contact_normal[c, 1] - dy * contact_normal[c, 0]))
+        ut, _ = _relative_velocity(body_v, contact_body[c, 0], contact_body[c, 1], pack, c)
+        slide = max(slide, abs(ut))
     top_dx = 0.0
     for k in range(top.shape[0]):
         top_dx += body_q[top[k], 0] - q0[top[k], 0]
@@ -59,9 +58,7 @@ def watch_step(solver, body_q, body_v, q0, height, top) -> tuple[float, float, f
         height.shape[0],
         top,
         bf.contact_body,
-        bf.contact_normal,
-        solver._ra,
-        solver._rb,
+        solver._pack,
         solver._status,
         c,
     )

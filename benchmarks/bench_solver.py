@@ -1,0 +1,306 @@
+"""The solver benchmark of issue 9: speed *and* accuracy of masonry's NLGS, beside pymunk and LMGC90.
+
+One command (from the repository root, in the project venv; ``pip install -e ".[bench]"`` adds pymunk)::
+
+    .venv/bin/python -m benchmarks.bench_solver [--suite paper height length] [--cases ...]
+        [--repeat 3] [--duration S] [--lmgc-python PATH] [--json benchmarks/results_solver.json]
+
+Cases: benchmarks/solver_cases.py (the paper's 51- and 248-block walls, an 8 × 6 wall, the arch and the
+aqueduct; walls of 8, 16, 32, 64 courses × 15 blocks; 8-course walls of ~500 to ~4000 blocks). For each:
+
+* CPU seconds per simulated second (``time.process_time``, the minimum over ``--repeat`` repeats run
+  interleaved: case A, case B, …, then again), in process, with a Rerun recording every 10 steps
+  written to a temporary file (start-up apart: measured once, below);
+* NLGS sweeps per step (mean, max), unconverged steps (residual > tolerance or at the cap), contacts per
+  step, ns per contact per sweep (CPU time inside ``nlgs.solve`` / Σ contacts × sweeps), peak memory
+  (tracemalloc peak of a 0.1 s run: numpy buffers, history, frames);
+* accuracy: slip of the top course and mean slip at 0.1 and 0.2 s (solver_cases.slips) against a tight
+  solve of the same case in the same run (tolerance 1e-7 m/s, cap 20000 sweeps), in % (for the arch and
+  the aqueduct, the mean block displacement |Δx, Δy| and that of the highest block, in %);
+* pymunk (walls; 100 solver passes, when installed): CPU s per simulated s, ratio to masonry, and its
+  slips against masonry's tight solve;
+* LMGC90 (``compas_lmgc90``, 3-D prisms; only with ``--lmgc-python``, the interpreter of a separate
+  venv where it is installed, see LMGC90.md): the 51-block wall through benchmarks/lmgc90_reference.py.
+
+Start-up: wall-clock of ``masonry --help`` and of a fresh process that imports the engine, builds the
+51-block wall and runs its first step (numba cache warm), minimum of 3. The table goes to the terminal
+(rich), everything to ``--json``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import platform
+import subprocess
+import sys
+import tempfile
+import time
+import tracemalloc
+from datetime import UTC, datetime
+from pathlib import Path
+
+import numpy as np
+
+os.environ.setdefault("RERUN_ANALYTICS", "0")
+ROOT = Path(__file__).resolve().parent.parent
+
+from benchmarks import pymunk_engine  # noqa: E402
+from benchmarks.solver_cases import CASES, course_of, is_wall, make_scenario, slips  # noqa: E402
+from masonrycli.engine import nlgs  # noqa: E402
+from masonrycli.run import Simulation, simulate  # noqa: E402
+
+SUITES = {
+    "paper": ["wall-51", "wall-52", "wall-248", "arch", "aqueduct"],
+    "height": ["h8", "h16", "h32", "h64"],
+    "length": ["l500", "l1000", "l2000", "l4000"],
+}
+TIGHT = {"tolerance": 1e-7, "max_iterations": 20000}
+SAMPLES = (100, 200)
+"""Steps (dt = 1e-3) at which the accuracy is read: 0.1 and 0.2 s."""
+
+
+class _Sampler:
+    """A sink keeping the displacement measures at the sample steps."""
+
+    def __init__(self, sim: Simulation, case: str):
+        m = sim.model
+        self.n = m.block_count
+        self.q0 = m.body_q0[: self.n].copy()
+        self.ground0 = m.body_q0[self.n :].copy()
+        self.course = course_of(m.block_name) if is_wall(case) else None
+        self.values: dict[int, tuple[float, float]] = {}
+
+    def append(self, frame) -> None:
+        if frame.step not in SAMPLES:
+            return
+        if self.course is not None:
+            ground_dx = frame.support_q[0, 0] - self.ground0[0, 0]
+            self.values[frame.step] = slips(self.q0[:, 0], frame.block_q[:, 0], ground_dx, self.course)
+        else:
+            d = np.hypot(*(frame.block_q[:, :2] - self.q0[:, :2]).T)
+            self.values[frame.step] = (float(d[np.argmax(self.q0[:, 1])]), float(d.mean()))
+
+
+class _SolveTimer:
+    """Wraps nlgs.solve (as the solver module calls it) to sum CPU time and contact·sweeps."""
+
+    def __init__(self):
+        self.cpu = 0.0
+        self.contact_sweeps = 0
+        self._solve = nlgs.solve
+
+    def __enter__(self):
+        def timed(contact_body, pack, count, model, v, r, status):
+            t = time.process_time()
+            its, res = self._solve(contact_body, pack, count, model, v, r, status)
+            self.cpu += time.process_time() - t
+            self.contact_sweeps += its * count
+            return its, res
+
+        nlgs.solve = timed
+        return self
+
+    def __exit__(self, *exc):
+        nlgs.solve = self._solve
+
+
+def run_masonry(case: str, duration: float | None, record: bool, **run_options) -> dict:
+    """One run of ``case``; CPU time of ``simulate`` only (scenario and model built before)."""
+    sc = make_scenario(case, duration, **run_options)
+    sim = Simulation(sc)
+    sampler = _Sampler(sim, case)
+    sinks: list = [sampler]
+    recorder = tmp = None
+    if record:
+        from masonrycli.execute import recording_static, run_metadata
+        from masonrycli.recording import Recorder
+
+        tmp = tempfile.TemporaryDirectory()
+        recorder = Recorder(Path(tmp.name) / "bench.rrd", recording_static(sim), run_metadata(sc, sim))
+        sinks.append(recorder)
+    with _SolveTimer() as timer:
+        t_wall, t_cpu = time.perf_counter(), time.process_time()
+        result = simulate(sc, sinks, sim=sim)
+        if recorder is not None:
+            recorder.close()
+        cpu, wall = time.process_time() - t_cpu, time.perf_counter() - t_wall
+    if tmp is not None:
+        tmp.cleanup()
+    its = result.iterations
+    return {
+        "cpu_s": cpu,
+        "wall_s": wall,
+        "sim_s": result.time,
+        "sweeps_mean": float(its.mean()),
+        "sweeps_max": int(its.max()),
+        "unconverged": int(result.unconverged),
+        "contacts_mean": float(result.contact_count.mean()),
+        "ns_per_contact_sweep": 1e9 * timer.cpu / max(timer.contact_sweeps, 1),
+        "nlgs_share": timer.cpu / cpu if cpu > 0 else 0.0,
+        "samples": {str(k): v for k, v in sampler.values.items()},
+        "blocks": sim.model.block_count,
+        "status": result.status,
+    }
+
+
+def peak_memory_mb(case: str) -> float:
+    tracemalloc.start()
+    run_masonry(case, 0.1, record=False)
+    _, peak = tracemalloc.get_traced_memory()
+    tracemalloc.stop()
+    return peak / 2**20
+
+
+def errors_pct(samples: dict, reference: dict) -> dict:
+    """Relative error (%) of each (top, mean) sample against the reference's."""
+    out = {}
+    for step, (top, mean) in samples.items():
+        if step in reference:
+            rt, rm = reference[step]
+            out[step] = (100.0 * (top - rt) / abs(rt), 100.0 * (mean - rm) / abs(rm))
+    return out
+
+
+def startup() -> dict:
+    """`masonry --help`, and a fresh process to the end of the first step (numba cache warm): minimum of 3
+    of the wall-clock and of the CPU time (user + system) of the child process. On a shared machine the
+    CPU time is the figure to read: the wall-clock adds the time spent waiting for a core."""
+    import resource
+
+    masonry = str(Path(sys.executable).parent / "masonry")
+    first_step = (
+        f"import sys; sys.path.insert(0, {str(ROOT)!r});"
+        "from benchmarks.solver_cases import make_scenario; from masonrycli.run import simulate;"
+        "simulate(make_scenario('wall-51'), steps=1)"
+    )
+    out = {}
+    for name, cmd in (("help", [masonry, "--help"]), ("first_step", [sys.executable, "-c", first_step])):
+        wall = cpu = np.inf
+        for _ in range(3):
+            before = resource.getrusage(resource.RUSAGE_CHILDREN)
+            t = time.perf_counter()
+            subprocess.run(cmd, check=True, capture_output=True, cwd=ROOT)
+            wall = min(wall, time.perf_counter() - t)
+            after = resource.getrusage(resource.RUSAGE_CHILDREN)
+            cpu = min(cpu, after.ru_utime - before.ru_utime + after.ru_stime - before.ru_stime)
+        out[f"{name}_wall_s"], out[f"{name}_cpu_s"] = wall, cpu
+    return out
+
+
+def lmgc90(python: str | None) -> dict:
+    if not python:
+        return {"available": False, "why": "no --lmgc-python (compas_lmgc90 lives in a separate venv: LMGC90.md)"}
+    script = ROOT / "benchmarks" / "lmgc90_reference.py"
+    cmd = [python, str(script), "--configs", "matched", "--repeat", "1", "--skip-ours"]
+    done = subprocess.run(cmd, capture_output=True, text=True, cwd=ROOT)
+    if done.returncode != 0:
+        return {"available": False, "why": done.stderr.strip().splitlines()[-1] if done.stderr else "failed"}
+    return {"available": True, "wall-51": json.loads(done.stdout)}
+
+
+def main(argv=None) -> dict:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--suite", nargs="*", default=["paper"], choices=sorted(SUITES))
+    parser.add_argument("--cases", nargs="*", help="cases instead of suites (solver_cases.CASES)")
+    parser.add_argument("--repeat", type=int, default=3)
+    parser.add_argument("--duration", type=float, help="simulated s per run (default: each case's own)")
+    parser.add_argument("--no-pymunk", action="store_true")
+    parser.add_argument("--lmgc-python", help="interpreter of a venv with compas_lmgc90 installed")
+    parser.add_argument("--json", type=Path, default=ROOT / "benchmarks" / "results_solver.json")
+    args = parser.parse_args(argv)
+    cases = args.cases or [c for s in args.suite for c in SUITES[s]]
+    unknown = [c for c in cases if c not in CASES]
+    if unknown:
+        parser.error(f"unknown case(s): {', '.join(unknown)}")
+    use_pymunk = pymunk_engine.available() and not args.no_pymunk
+
+    commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True, cwd=ROOT)
+    report = {
+        "date": datetime.now(UTC).strftime("%Y-%m-%d %H:%M UTC"),
+        "commit": commit.stdout.strip(),
+        "machine": {"python": platform.python_version(), "cpu_count": os.cpu_count(), "load": os.getloadavg()},
+        "startup": startup(),
+        "cases": {},
+    }
+    run_masonry("wall-51", 0.02, record=True)  # compile / load every kernel and the recorder first
+    rows = {c: {"runs": [], "pymunk": []} for c in cases}
+    for _ in range(args.repeat):  # interleaved: every case once, then again
+        for case in cases:
+            rows[case]["runs"].append(run_masonry(case, args.duration, record=True))
+            if use_pymunk and is_wall(case):
+                rows[case]["pymunk"].append(pymunk_engine.run_wall(case, args.duration or CASES[case][2]))
+    for case in cases:
+        best = min(rows[case]["runs"], key=lambda r: r["cpu_s"])
+        tight = run_masonry(case, 0.2, record=False, **TIGHT)
+        row = dict(best)
+        row["cpu_per_sim_s"] = best["cpu_s"] / best["sim_s"]
+        row["cpu_runs"] = [round(r["cpu_s"], 3) for r in rows[case]["runs"]]
+        row["error_pct"] = errors_pct(best["samples"], tight["samples"])
+        row["tight"] = {k: tight[k] for k in ("sweeps_mean", "unconverged", "samples")}
+        row["peak_memory_mb"] = peak_memory_mb(case)
+        if rows[case]["pymunk"]:
+            pm = min(rows[case]["pymunk"], key=lambda r: r["cpu_s"])
+            row["pymunk"] = {
+                "cpu_per_sim_s": pm["cpu_s"] / pm["sim_s"],
+                "ratio_masonry_over_pymunk": row["cpu_per_sim_s"] / (pm["cpu_s"] / pm["sim_s"]),
+                "error_pct": errors_pct({str(k): v for k, v in pm["slips"].items()}, tight["samples"]),
+            }
+        report["cases"][case] = row
+    report["lmgc90"] = lmgc90(args.lmgc_python)
+    args.json.write_text(json.dumps(report, indent=2))
+    print_table(report)
+    return report
+
+
+def _err(e: dict) -> str:
+    return " ".join(f"{e[s][0]:+.2f}/{e[s][1]:+.2f}" if s in e else "–" for s in ("100", "200"))
+
+
+def print_table(report: dict) -> None:
+    from rich.console import Console
+    from rich.table import Table
+
+    table = Table(title=f"masonry solver benchmark — {report['date']}, commit {report['commit']}")
+    for col in (
+        "case",
+        "blocks",
+        "CPU s / sim s",
+        "sweeps/step (max)",
+        "unconv.",
+        "contacts",
+        "ns/contact·sweep",
+        "error % top/mean 0.1 s 0.2 s",
+        "peak MB",
+        "pymunk s / sim s (×)",
+        "pymunk error %",
+    ):
+        table.add_column(col, justify="right")
+    for case, r in report["cases"].items():
+        pm = r.get("pymunk")
+        table.add_row(
+            case,
+            str(r["blocks"]),
+            f"{r['cpu_per_sim_s']:.3f}",
+            f"{r['sweeps_mean']:.0f} ({r['sweeps_max']})",
+            str(r["unconverged"]),
+            f"{r['contacts_mean']:.0f}",
+            f"{r['ns_per_contact_sweep']:.1f}",
+            _err(r["error_pct"]),
+            f"{r['peak_memory_mb']:.1f}",
+            f"{pm['cpu_per_sim_s']:.3f} ({pm['ratio_masonry_over_pymunk']:.2f})" if pm else "–",
+            _err(pm["error_pct"]) if pm else "–",
+        )
+    console = Console(width=200)
+    console.print(table)
+    s = report["startup"]
+    console.print(
+        f"start-up: masonry --help {s['help_s']:.2f} s, fresh process to the first step {s['first_step_s']:.2f} s"
+    )
+    lm = report["lmgc90"]
+    console.print("LMGC90: " + (json.dumps(lm["wall-51"])[:300] if lm["available"] else f"not run ({lm['why']})"))
+
+
+if __name__ == "__main__":
+    main()
