@@ -237,6 +237,34 @@ def test_principal_axes_follow_eigenvectors_and_sign(written):
             assert colors[2 * b + k] == (rec_mod.COMPRESSION_RGBA if lam[b, k] < 0 else rec_mod.TENSION_RGBA)
 
 
+def test_a_glyph_stays_inside_a_thin_block(wall, tmp_path):
+    """Block 0 squashed to a quarter of its height (as the aqueduct's thin cut spandrel blocks): its stress
+    glyphs are at most 0.45 × its smaller side long, while the others keep the common length."""
+    import dataclasses
+
+    static, q0 = wall
+    local = static.block_vert_local.copy()
+    s0, e0 = static.block_vert_start[0], static.block_vert_start[1]
+    local[s0:e0, 1] *= 0.25
+    thin = dataclasses.replace(static, block_vert_local=local)
+    frames = fx.frames(thin, q0, 12)
+    for f in frames:
+        f.tensors["cell_principal_stress"][0] = f.tensors["cell_principal_stress"][1:].min() * 10  # long glyphs
+    path = tmp_path / "thin.rrd"
+    with Recorder(path, thin, fx.METADATA, batch_frames=5) as rec:
+        for f in frames:
+            rec.log_frame(f)
+    strips = temporal_rows(path, "/structure/plane/xy/stress_axes", "LineStrips2D:strips")[frames[-1].step]
+    half = [0.5 * np.linalg.norm(np.subtract(*strips[k])) for k in range(len(strips))]
+    lam, scale = frames[-1].tensors["cell_principal_stress"], rec.axis_scale["stress_axes"]
+    smaller = 0.25 * fx.BLOCK_H
+    assert rec._glyph_length > 0.45 * smaller  # the common length would stick out of block 0
+    for b, full in ((0, 0.45 * smaller), (3, rec._glyph_length), (7, rec._glyph_length)):
+        for k in range(2):
+            expected = min(abs(lam[b, k]) / scale, 1.0) * full
+            assert half[2 * b + k] == pytest.approx(expected, rel=1e-4, abs=1e-7)
+
+
 # ------------------------------------------------------------------------------------------- colours
 def ramp_frames(static, q0, count: int) -> list:
     """Frames whose fields are ramps over the blocks growing 20× over the run, with one outlier per end."""

@@ -72,7 +72,8 @@ def run_document(
         "",
         legend_markdown(force_scale, block_height, magnify),
         "- **Principal axes**: two segments per cell along the eigenvectors, half-length proportional "
-        f"to |λ|, {glyph_length:.3g} m at the value below (longer ones clipped; the {pct} of the first "
+        f"to |λ|, {glyph_length:.3g} m (at most 0.45 × the block's smaller side) at the value below (longer "
+        f"ones clipped; the {pct} of the first "
         "batch); black = compression / contraction, magenta = tension / extension. Stress axes in the "
         "main view and the spherical-stress tabs; the triangles of the cells (as built) in the volumetric "
         "strain rate tabs.",

@@ -39,25 +39,21 @@ import rerun as rr
 from masonrycli.colormap import map_positions, nice_ceil, robust_max_abs, tick_label
 from masonrycli.colour_range import RangeTracker
 from masonrycli.frame import Frame
-from masonrycli.joint_forces import JOINT_OPEN, JOINT_SLIP, JOINT_STICK, joint_resultants
-from masonrycli.recording.arrays import FrameBatch, Polygons, partition_lengths, time_indexes, uniform_strips, z0
+from masonrycli.joint_forces import joint_resultants
+from masonrycli.recording.arrays import FrameBatch, Polygons, partition_lengths, time_indexes, z0
 from masonrycli.recording.document import legend_markdown, run_document, viewer_safe_text
 from masonrycli.recording.layout import (
     AXES,
     BLOCKS,
     CHAIN_KEY,
-    COMPRESSION_RGBA,
     FIELD_BY_KEY,
     FIELDS,
     FILL,
-    FORCES,
     GLYPH_HALF_LENGTH,
-    HINGES,
     HOVER_VALUES,
     INSET,
     LEGEND,
     METADATA,
-    OPEN_RGBA,
     PAPER_FIELDS,
     PAPER_FIGURES,
     RESULTANT_LENGTH,
@@ -65,17 +61,15 @@ from masonrycli.recording.layout import (
     ROBUST_PERCENTILE,
     SCALARS,
     SERIES,
-    SLIP_RGBA,
-    STICK_RGBA,
     SUPPORT_FILL,
     SUPPORT_OUTLINES,
-    TENSION_RGBA,
     TENSOR_KEYS,
     XY,
     FieldSpec,
     build_blueprint,
 )
 from masonrycli.recording.magnified import send_magnified
+from masonrycli.recording.overlays import send_axes, send_joints
 from masonrycli.recording.readback import check_complete
 from masonrycli.recording.static_content import (
     LUTS,
@@ -109,9 +103,6 @@ def _io_errors(path: str):
         if shutil.disk_usage(folder).free < 1 << 20:  # the cause rerun's message lost
             raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC)) from None
         raise OSError(errno.EIO, f"rerun could not write the recording ({str(exc).splitlines()[0]})") from None
-
-
-_STATE_RGBA: Final = {JOINT_STICK: STICK_RGBA, JOINT_SLIP: SLIP_RGBA, JOINT_OPEN: OPEN_RGBA}
 
 
 class Recorder:
@@ -154,6 +145,8 @@ class Recorder:
         size = (np.maximum.reduceat(loc, first) - np.minimum.reduceat(loc, first)) if n else np.ones((1, 2))
         self.block_height = float(np.median(size[:, 1]))  # m, median block height: the force-arrow unit
         self._glyph_length = GLYPH_HALF_LENGTH * float(np.median(size.min(axis=1)))
+        # (N,) m: a glyph never reaches out of its own block (thin cut spandrel blocks of the aqueduct)
+        self._glyph_cap = np.minimum(self._glyph_length, GLYPH_HALF_LENGTH * size.min(axis=1))[: self._n]
         self._trackers = {f.key: RangeTracker(f.kind, f.floor) for f in FIELDS}
         self.field_ranges: dict[str, tuple[float, float]] = {}
         """The range each field has at the last frame sent."""
@@ -410,53 +403,12 @@ class Recorder:
             )
 
     def _send_axes(self, idx: list, q: np.ndarray, tensors: dict[str, np.ndarray]) -> None:
-        """Two segments per cell along the principal directions, half-length ∝ |λ|, coloured by sign."""
-        for name, (values_key, angle_key) in AXES.items():
-            lam = np.nan_to_num(tensors[values_key], nan=0.0)  # (F, N, 2): major, minor
-            ang = np.nan_to_num(tensors[angle_key], nan=0.0)  # (F, N): direction of the major one
-            scale = self.axis_scale.get(name)
-            half = np.minimum(np.abs(lam) / scale, 1.0) * self._glyph_length if scale else 0.0 * lam
-            c, s = np.cos(ang), np.sin(ang)
-            axes = np.stack([np.stack([c, s], -1), np.stack([-s, c], -1)], axis=2)  # (F, N, 2, 2)
-            d, centre = axes * half[..., None], q[:, :, None, :2]
-            ends = np.stack([centre - d, centre + d], axis=3)  # (F, N, axis, end, xy)
-            colors = np.where(lam < 0.0, np.uint32(COMPRESSION_RGBA), np.uint32(TENSION_RGBA)).reshape(-1)
-            self.rec.send_columns(
-                f"{XY}/{name}",
-                indexes=idx,
-                columns=rr.LineStrips2D.columns(
-                    strips=uniform_strips(ends.reshape(-1, 2, 2)),
-                    colors=colors,
-                ).partition(partition_lengths(len(q), 2 * self._n)),
-            )
+        for name, (lam, angle) in AXES.items():
+            args = (q, tensors[lam], tensors[angle], self.axis_scale.get(name), self._glyph_cap)
+            send_axes(self.rec, f"{XY}/{name}", idx, *args)
 
     def _send_joints(self, idx: list, b: FrameBatch) -> None:
-        """One arrow per loaded joint, centred on its point of application, coloured by state; hinges."""
-        points, lengths = b.concat("joint_point", (0, 2))
-        forces, _ = b.concat("joint_force", (0, 2))
-        state, _ = b.concat("joint_state", (0,))
-        colors = np.full(len(state), np.uint32(STICK_RGBA))
-        for value, rgba in _STATE_RGBA.items():
-            colors[state == value] = rgba
-        vectors = forces * (self.force_scale or 0.0)
-        self.rec.send_columns(
-            FORCES,
-            indexes=idx,
-            columns=[
-                *rr.Arrows2D.columns(
-                    origins=(points - 0.5 * vectors).astype(np.float32),
-                    colors=colors,
-                    vectors=vectors.astype(np.float32),
-                ).partition(lengths),
-                *rr.AnyValues.columns(
-                    force_kN=pa.array(1e-3 * np.hypot(forces[:, 0], forces[:, 1]).astype(np.float32), type=pa.float32())
-                ).partition(lengths),
-            ],
-        )
-        hinges, per_frame = b.concat("hinge_point", (0, 2))
-        self.rec.send_columns(
-            HINGES, indexes=idx, columns=rr.Points2D.columns(positions=hinges.astype(np.float32)).partition(per_frame)
-        )
+        send_joints(self.rec, idx, b, self.force_scale)
 
     def _send_series(self, idx: list, b: FrameBatch, q: np.ndarray) -> None:
         n_frames = len(q)

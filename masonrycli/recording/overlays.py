@@ -1,0 +1,82 @@
+"""What is drawn over the block fills per frame: principal-stress glyphs, joint resultants, hinges."""
+
+from __future__ import annotations
+
+from typing import Final
+
+import numpy as np
+import pyarrow as pa
+import rerun as rr
+
+from masonrycli.joint_forces import JOINT_OPEN, JOINT_SLIP, JOINT_STICK
+from masonrycli.recording.arrays import FrameBatch, partition_lengths, uniform_strips
+from masonrycli.recording.layout import (
+    COMPRESSION_RGBA,
+    FORCES,
+    HINGES,
+    OPEN_RGBA,
+    SLIP_RGBA,
+    STICK_RGBA,
+    TENSION_RGBA,
+)
+
+_STATE_RGBA: Final = {JOINT_STICK: STICK_RGBA, JOINT_SLIP: SLIP_RGBA, JOINT_OPEN: OPEN_RGBA}
+
+
+def send_axes(
+    rec: rr.RecordingStream,
+    path: str,
+    idx: list,
+    q: np.ndarray,
+    values: np.ndarray,
+    angle: np.ndarray,
+    scale: float | None,
+    full_length: np.ndarray,
+) -> None:
+    """Two segments per cell along the principal directions, half-length min(|λ| / ``scale``, 1) ×
+    ``full_length`` (N,) m, black for a negative value, magenta for a positive one.
+
+    ``q`` (F, N, 3) poses; ``values`` (F, N, 2) major, minor; ``angle`` (F, N) of the major one.
+    """
+    lam = np.nan_to_num(values, nan=0.0)
+    ang = np.nan_to_num(angle, nan=0.0)
+    half = np.minimum(np.abs(lam) / scale, 1.0) * full_length[None, :, None] if scale else 0.0 * lam
+    c, s = np.cos(ang), np.sin(ang)
+    axes = np.stack([np.stack([c, s], -1), np.stack([-s, c], -1)], axis=2)  # (F, N, 2, 2)
+    d, centre = axes * half[..., None], q[:, :, None, :2]
+    ends = np.stack([centre - d, centre + d], axis=3)  # (F, N, axis, end, xy)
+    colors = np.where(lam < 0.0, np.uint32(COMPRESSION_RGBA), np.uint32(TENSION_RGBA)).reshape(-1)
+    rec.send_columns(
+        path,
+        indexes=idx,
+        columns=rr.LineStrips2D.columns(strips=uniform_strips(ends.reshape(-1, 2, 2)), colors=colors).partition(
+            partition_lengths(len(q), 2 * q.shape[1])
+        ),
+    )
+
+
+def send_joints(rec: rr.RecordingStream, idx: list, b: FrameBatch, force_scale: float | None) -> None:
+    """One arrow per loaded joint (the batch's "joint_point", "joint_force", "joint_state"), centred on its
+    point of application, ``force_scale`` m per N, coloured by state; the hinges ("hinge_point")."""
+    points, lengths = b.concat("joint_point", (0, 2))
+    forces, _ = b.concat("joint_force", (0, 2))
+    state, _ = b.concat("joint_state", (0,))
+    colors = np.full(len(state), np.uint32(STICK_RGBA))
+    for value, rgba in _STATE_RGBA.items():
+        colors[state == value] = rgba
+    vectors = forces * (force_scale or 0.0)
+    magnitude = 1e-3 * np.hypot(forces[:, 0], forces[:, 1]).astype(np.float32)
+    rec.send_columns(
+        FORCES,
+        indexes=idx,
+        columns=[
+            *rr.Arrows2D.columns(
+                origins=(points - 0.5 * vectors).astype(np.float32), colors=colors, vectors=vectors.astype(np.float32)
+            ).partition(lengths),
+            *rr.AnyValues.columns(force_kN=pa.array(magnitude, type=pa.float32())).partition(lengths),
+        ],
+    )
+    hinges, per_frame = b.concat("hinge_point", (0, 2))
+    rec.send_columns(
+        HINGES, indexes=idx, columns=rr.Points2D.columns(positions=hinges.astype(np.float32)).partition(per_frame)
+    )
