@@ -274,7 +274,9 @@ def simulate(
         pairs = [f"{names[a]}|{names[b]}" for a, b in sim.joints.joint_body[hinged]]
         shown = ", ".join(pairs[:8]) + (" …" if len(pairs) > 8 else "")
         extra["hinged joints (end)"] = f"{len(pairs)}" + (f": {shown}" if pairs else "")
-    ims = applied_intensity(scenario, m)
+    # Stopped by the user: measure what was applied (the whole run's loading can be 10⁸ samples, minutes
+    # of work after a Ctrl-C that should end the run at once).
+    ims = applied_intensity(scenario, m, done if status == INTERRUPTED else None)
     if ims:
         extra[f"ground motion ({m.support_name[shaking_support(scenario.motions)]})"] = describe_intensity(ims)
     outcome = run_outcome(sim, hinge_count)
@@ -337,12 +339,13 @@ def describe_outcome(outcome: dict) -> str:
     return f"{outcome['state']} ({tail})"
 
 
-def applied_intensity(scenario, model: Model) -> dict[str, float]:
+def applied_intensity(scenario, model: Model, steps: int | None = None) -> dict[str, float]:
     """Intensity measures of the shaking support's horizontal velocity over the run's duration (the
     loading as applied: scaled, windowed, corrected, cut at the duration — whether or not the run
     stopped early, so the measure belongs to the loading, not to the response), or {} when no
-    support shakes."""
+    support shakes. ``steps``: over the first ``steps`` steps only (a run interrupted by the user)."""
     j = shaking_support(scenario.motions)
-    if j is None or model.n_steps < 2:
+    steps = model.n_steps if steps is None else steps
+    if j is None or steps < 2:
         return {}
-    return intensity_measures(model.support_velocity.between(0, model.n_steps + 1)[:, j, 0], model.dt)
+    return intensity_measures(model.support_velocity.between(0, steps + 1)[:, j, 0], model.dt)
