@@ -38,7 +38,7 @@ class Contacts(NamedTuple):
     contact_point: np.ndarray
     """(C, 2) float64: contact point, world coordinates [m]."""
     contact_normal: np.ndarray
-    """(C, 2) float64: unit normal from a to b; the tangent is t = (n_y, −n_x)."""
+    """(C, 2) float64: unit normal from a to b; the tangent is t = (n_y, −n_x) (:mod:`.contact`)."""
     contact_gap: np.ndarray
     """(C,) float64: gap [m] at detection, < 0 = penetration."""
     contact_key: np.ndarray

@@ -189,7 +189,8 @@ def _choose_faces(vert, normal, size_a, size_b, sa, na, sb, nb, alert):
 @njit
 def _clip_incident(vert, rs, e, e2, is_, k, k2, nx, ny, tol):
     # Step 4: clip the incident segment w1 = I[k] → w2 = I[k2] to the side planes of R's edge e.
-    #   frame of the edge v1 = R[e] → v2 = R[e2]: u = (−n_y, n_x) (n is u turned by −90°), L = u·(v2 − v1)
+    #   frame of the edge v1 = R[e] → v2 = R[e2]: u = (−n_y, n_x) (n is u turned by −90°), L = u·(v2 − v1);
+    #   u is the CCW edge direction, the opposite of the contact tangent t = (n_y, −n_x) of .contact
     #   (t, g) = (u·(p − v1), n·(p − v1)) for each end p
     #   both ends beyond one side plane (by more than tol) → no contact
     #   an end beyond t = 0 or t = L (by more than tol) moves onto that plane, g interpolated;
@@ -397,7 +398,7 @@ def narrowphase(
     contact_point : (C_cap, 2) float64
         Out: contact point, world [m].
     contact_normal : (C_cap, 2) float64
-        Out: unit normal from a to b (tangent t = (n_y, −n_x), see docs/architecture.md).
+        Out: unit normal from a to b (tangent t = (n_y, −n_x), see :mod:`.contact`).
     contact_gap : (C_cap,) float64
         Out: gap [m], < 0 = penetration.
     contact_key : (C_cap,) int64
