@@ -78,3 +78,31 @@ def test_inspect_reads_a_truncated_recording(recording, tmp_path):
         " ".join(result.output.split())
     )
     shutil.rmtree(tmp_path)
+
+
+def test_recorder_writes_to_the_file_every_second(tmp_path, monkeypatch):
+    """Finding 5: frames reached the file only every 100 frames (0 frames for the first 1000 steps). Once the
+    first batch has fixed the scales, a frame is written as soon as FLUSH_SECONDS have passed."""
+    import masonrycli.recording.recorder as recorder
+
+    import recording_fixtures as fx
+
+    static, q0 = fx.wall()
+    frames = fx.frames(static, q0, 103)
+    path = tmp_path / "r.rrd"
+    rec = recorder.Recorder(path, static, fx.METADATA, batch_frames=100)
+    for frame in frames[:100]:  # the first batch: written, and fixes every scale
+        rec.on_frame(frame)
+    assert rec._scales_fixed()
+    size = path.stat().st_size
+    rec.on_frame(frames[100])  # less than FLUSH_SECONDS later: buffered
+    assert path.stat().st_size == size
+    monkeypatch.setattr(recorder, "FLUSH_SECONDS", 0.0)
+    rec.on_frame(frames[101])  # FLUSH_SECONDS have passed: on disk now, with the frame before
+    assert path.stat().st_size > size
+    copy = tmp_path / "copy.rrd"  # what a SIGKILL now would leave: no footer, 102 frames
+    shutil.copyfile(path, copy)
+    assert inspect_recording(copy)["frames"] == 102
+    rec.on_frame(frames[102])
+    rec.close()
+    assert inspect_recording(path)["frames"] == 103
