@@ -60,7 +60,7 @@ class OneLineUsageErrors(typer.core.TyperGroup):
             code = super().main(args, prog_name, complete_var, standalone_mode=False, **extra)
         except click_errors.NoArgsIsHelpError as exc:
             console.print(exc.ctx.get_help(), markup=True)
-            sys.exit(0)
+            sys.exit(exc.exit_code)  # as click and typer do
         except click_errors.UsageError as exc:
             command = exc.ctx.command_path if exc.ctx is not None else "masonry"
             say("error", "bold red", f"{exc.format_message()} ({command} --help lists the options)")
