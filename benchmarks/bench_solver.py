@@ -72,7 +72,10 @@ class _Sampler:
         self.course = course_of(m.block_name) if is_wall(case) else None
         self.values: dict[int, tuple[float, float]] = {}
 
-    def append(self, frame) -> None:
+    def close(self, status: str = "completed", note: str = "") -> None:
+        """Nothing to write (the sink protocol of masonrycli.run.simulate)."""
+
+    def on_frame(self, frame) -> None:
         if frame.step not in SAMPLES:
             return
         if self.course is not None:
@@ -296,7 +299,8 @@ def print_table(report: dict) -> None:
     console.print(table)
     s = report["startup"]
     console.print(
-        f"start-up: masonry --help {s['help_s']:.2f} s, fresh process to the first step {s['first_step_s']:.2f} s"
+        f"start-up (CPU / wall-clock): masonry --help {s['help_cpu_s']:.2f} / {s['help_wall_s']:.2f} s, fresh "
+        f"process to the end of the first step {s['first_step_cpu_s']:.2f} / {s['first_step_wall_s']:.2f} s"
     )
     lm = report["lmgc90"]
     console.print("LMGC90: " + (json.dumps(lm["wall-51"])[:300] if lm["available"] else f"not run ({lm['why']})"))

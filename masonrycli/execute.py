@@ -225,9 +225,12 @@ def print_summary(console: Console, outcome: Outcome, scenario, hint: str = "") 
     if result is not None and result.unconverged:
         run = scenario.run
         console.print(
-            f"[bold red]warning:[/] {result.unconverged} of {result.steps} steps ended unconverged (contact-law "
-            f"residual above --tolerance {run.tolerance:g} m/s at the {run.max_iterations}-sweep cap); their "
-            "impulses and motion are approximate. Raise --max-iterations, or check the history's nlgs_residual.",
+            Text.assemble(
+                ("warning: ", "bold red"),
+                f"{result.unconverged} of {result.steps} steps ended unconverged (contact-law residual above "
+                f"--tolerance {run.tolerance:g} m/s at the {run.max_iterations}-sweep cap); their impulses and "
+                "motion are approximate. Raise --max-iterations, or check the history's nlgs_residual.",
+            ),
             soft_wrap=True,
         )
     if hint and "--out" in paths:

@@ -8,6 +8,7 @@ from contextlib import contextmanager
 from rich.console import Console
 from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
 from rich.table import Table
+from rich.text import Text
 
 
 @contextmanager
@@ -56,8 +57,9 @@ def summary_table(result, max_iterations: int, recording: str | None, history: s
         capped = int((its >= max_iterations).sum())
         table.add_row("steps at the sweep cap", f"{capped} ({100.0 * capped / its.size:.1f} %)")
         bad = result.unconverged
-        style = "bold red" if bad else ""
-        table.add_row("unconverged steps", f"[{style}]{bad} ({100.0 * bad / its.size:.1f} %)[/]" if bad else "0")
+        table.add_row(
+            "unconverged steps", Text(f"{bad} ({100.0 * bad / its.size:.1f} %)", style="bold red" if bad else "")
+        )
         table.add_row("NLGS residual (m/s)", f"max {result.residual.max():.2e}, last {result.residual[-1]:.2e}")
     table.add_row("max penetration", f"{result.max_penetration:.3e} m")
     table.add_row("energy (kinetic + potential)", f"{result.energy_initial:.4g} J → {result.energy_final:.4g} J")

@@ -218,3 +218,19 @@ def test_inspect_summarises_a_recording(tmp_path):
     bad.write_bytes(b"not a recording")
     assert_one_line_error(invoke("inspect", bad), "bad.rrd")
     assert_one_line_error(invoke("inspect", tmp_path / "missing.rrd"), "missing.rrd")
+
+
+def test_unconverged_steps_are_counted_and_warned(tmp_path):
+    """A sweep cap too low for the tolerance: the summary, the history and a warning say how many steps."""
+    npz = tmp_path / "h.npz"
+    r = invoke("simulate", "wall", "--duration", "0.02", "--max-iterations", "2", "--no-recording", "--history", npz)
+    assert r.exit_code == 0, r.output
+    assert "warning: 20 of 20 steps ended unconverged" in " ".join(r.output.split())
+    h = np.load(npz)
+    assert h["nlgs_unconverged"][-1] == 20
+    assert np.all(h["nlgs_iterations"][1:] == 2) and np.all(h["nlgs_residual"][1:] > 1e-5)
+    npz = tmp_path / "h_default.npz"
+    r = invoke("simulate", "wall", "--duration", "0.02", "--no-recording", "--history", npz)
+    assert r.exit_code == 0 and "unconverged" in r.output and "warning" not in r.output, r.output
+    h = np.load(npz)
+    assert h["nlgs_unconverged"][-1] == 0 and np.all(h["nlgs_residual"] <= 1e-5)
