@@ -60,13 +60,21 @@ def _kill(proc, sig=signal.SIGKILL):
     proc.wait(timeout=60)
 
 
-def _wait(predicate, timeout: float, what: str):
+def _wait(predicate, timeout: float, what: str, logs: dict):
+    """Poll ``predicate``; fail at once, with every log, if a process in ``logs`` (proc -> log) exits."""
     end = time.monotonic() + timeout
     while time.monotonic() < end:
         if predicate():
             return
+        for proc, log in logs.items():
+            if proc.poll() is not None:
+                raise AssertionError(f"{log.name} exited ({proc.returncode}) while waiting for {what}\n" + _tails(logs))
         time.sleep(0.2)
-    raise AssertionError(f"timed out waiting for {what}")
+    raise AssertionError(f"timed out waiting for {what}\n" + _tails(logs))
+
+
+def _tails(logs: dict) -> str:
+    return "\n".join(f"--- {log.name}\n" + "\n".join(log.read_text().splitlines()[-15:]) for log in logs.values())
 
 
 def _journal_rows(out: Path) -> list[dict]:
@@ -83,29 +91,36 @@ def test_scheduler_and_worker_processes_kill_the_worker_and_resume(tmp_path):
         [BIN / "dask", "scheduler", "--port", "0", "--no-dashboard", "--scheduler-file", sched_file], tmp_path / "s.log"
     )
     workers, sweeps = [], []
+    logs = {scheduler: tmp_path / "s.log"}
     try:
-        _wait(sched_file.exists, 60, "the scheduler file")
+        _wait(sched_file.exists, 60, "the scheduler file", logs)
         address = json.loads(sched_file.read_text())["address"]
         worker_args = [BIN / "dask", "worker", address, "--nworkers", "1", "--nthreads", "1", "--no-dashboard"]
         workers.append(_spawn(worker_args, tmp_path / "w1.log"))
-        sweep = [sys.executable, "-m", "masonrycli", "sweep", "wall", "--param", "blocks=12", "--duration", "0.3"]
-        sweep += ["--param", "amp=0.2:1.2:6", "--scheduler", address, "--out", out]
+        # Four runs of 5 s that stay intact (~0.5 s of CPU each). Once two rows are in, the two runs left
+        # take a second of the worker's CPU: far more than the test needs to see the rows and kill it, however
+        # loaded the machine (six runs of 0.3 s took 20-130 ms each: the study could end, and its journal go,
+        # between two looks, and the wait for two rows then timed out).
+        sweep = [sys.executable, "-m", "masonrycli", "sweep", "wall", "--param", "blocks=12", "--duration", "5"]
+        sweep += ["--param", "amp=0.1:0.25:4", "--scheduler", address, "--out", out]
         sweeps.append(_spawn(sweep, tmp_path / "sweep1.log"))
-        _wait(lambda: len(_journal_rows(out)) >= 2, 240, "two finished rows")
+        logs |= {workers[0]: tmp_path / "w1.log", sweeps[0]: tmp_path / "sweep1.log"}
+        _wait(lambda: len(_journal_rows(out)) >= 2, 240, "two finished rows", logs)
         _kill(workers[0])  # mid-study: the remaining tasks have no worker now
         finished = _journal_rows(out)
         time.sleep(1.0)
         _kill(sweeps[0], signal.SIGINT)  # the user gives up waiting: the finished rows are written
         rows = _read_csv(out)
-        assert len(rows) >= len(finished) >= 2 and len(rows) < 6
+        assert len(rows) >= len(finished) >= 2 and len(rows) < 4, _tails(logs)
         assert all(r["status"] == "completed" for r in rows)
         kept = {r["amp"]: r["wall_time"] for r in rows}
         workers.append(_spawn(worker_args, tmp_path / "w2.log"))
         sweeps.append(_spawn(sweep, tmp_path / "sweep2.log"))
-        assert sweeps[1].wait(timeout=300) == 0, (tmp_path / "sweep2.log").read_text()
+        logs = {scheduler: tmp_path / "s.log", workers[1]: tmp_path / "w2.log", sweeps[1]: tmp_path / "sweep2.log"}
+        assert sweeps[1].wait(timeout=300) == 0, _tails(logs)
         rows = _read_csv(out)
-        assert [r["amp"] for r in rows] == pytest.approx([0.2, 0.4, 0.6, 0.8, 1.0, 1.2])
-        assert all(r["status"] == "completed" for r in rows)
+        assert [r["amp"] for r in rows] == pytest.approx([0.1, 0.15, 0.2, 0.25])
+        assert all(r["status"] == "completed" and r["time"] == pytest.approx(5.0) for r in rows)  # none cut short
         for r in rows:  # rows finished before the kill were not run again
             if r["amp"] in kept:
                 assert r["wall_time"] == kept[r["amp"]]
