@@ -107,3 +107,28 @@ def test_rigid_share_of_a_free_cluster(tmp_path):
     assert share < 0.5
     # stuck to the ground: nothing is free to move rigidly
     assert rigid_share(p, np.ones_like(st), p.v_ref + wobble) == (0.0, 0)
+
+
+def test_cluster_correction_moves_joined_blocks_rigidly(tmp_path):
+    # the coarse step of nlgs-cluster: velocities follow the impulses, joined pairs keep their relative velocity
+    from benchmarks.solver_lab.methods import cluster
+    from benchmarks.solver_lab.outcome import Clock
+
+    p = _captured(tmp_path)
+    ctx = Context(p)
+    r = p.r_warm.copy()
+    dyn = p.inv_mass > 0
+    inner = dyn[p.body[:, 0]] & dyn[p.body[:, 1]]
+    r[inner] = (0.0, 1e-3)  # every block–block contact clearly sticking: the blocks form clusters
+    v = law.velocity_from_impulse(p, ctx.H, r)
+    label, joined = cluster._clusters(p, r)
+    assert joined.any() and label.max() + 1 < p.q_m.shape[0]  # some blocks are joined into clusters
+    r2, v2, _ = cluster.coarse_step(ctx, v, r, Clock())
+    np.testing.assert_allclose(v2, law.velocity_from_impulse(p, ctx.H, r2), atol=1e-12)
+    assert np.abs(v2 - v).max() > 1e-9  # the correction does something
+    du = (ctx.H @ (v2 - v).ravel()).reshape(-1, 2)[joined]
+    assert np.abs(du).max() < 1e-8 * max(np.abs(v2 - v).max(), 1.0)
+    # only the joining contacts and the contacts between clusters change
+    a, b = p.body[:, 0], p.body[:, 1]
+    same = (label[a] == label[b]) & ~joined
+    np.testing.assert_array_equal(r2[same], r[same])

@@ -26,7 +26,17 @@ from benchmarks.solver_lab.outcome import Context
 from benchmarks.solver_lab.problems import load_all
 
 METHODS = dict(gauss_seidel.METHODS)
-DEFAULT_METHODS = ["nlgs", "nlgs-oracle", "nlgs-law", "nlgs-predict", "nlgs-cold", "anderson-v", "ssn-v", "alm-newton"]
+DEFAULT_METHODS = [
+    "nlgs",
+    "nlgs-oracle",
+    "nlgs-law",
+    "nlgs-predict",
+    "nlgs-cold",
+    "anderson-v",
+    "ssn-v",
+    "alm-newton",
+    "nlgs-cluster",
+]
 TARGET = 1e-5
 """m/s: the RMS contact-law residual every method is stopped at (``nlgs``: the engine's own test)."""
 RESULTS = Path(__file__).resolve().parent / "results.json"
@@ -34,9 +44,9 @@ RESULTS = Path(__file__).resolve().parent / "results.json"
 
 def _register_optional():
     # Methods in their own modules; imported here so the table runs them by name.
-    from benchmarks.solver_lab.methods import alm_newton, anderson, newton
+    from benchmarks.solver_lab.methods import alm_newton, anderson, cluster, newton
 
-    for module in (anderson, newton, alm_newton):
+    for module in (anderson, newton, alm_newton, cluster):
         METHODS.update(module.METHODS)
 
 
