@@ -88,14 +88,7 @@ class Problem:
 
     def pack(self) -> np.ndarray:
         """(C, PACK_WIDTH) from the engine's ``nlgs.prepare_contacts``."""
-        c = self.count
-        pack = np.zeros((c, nlgs.PACK_WIDTH))
-        args = (self.body, self.point, self.normal, self.gap, c, self.q_m, self.shim())
-        if "out_ra" in inspect.signature(nlgs.prepare_contacts).parameters:  # before the solver branch
-            nlgs.prepare_contacts(*args, np.zeros((c, 2)), np.zeros((c, 2)), pack)
-        else:
-            nlgs.prepare_contacts(*args, pack)
-        return pack
+        return pack_contacts(self.body, self.point, self.normal, self.gap, self.q_m, self.shim())
 
     def save(self, path: Path) -> None:
         np.savez_compressed(path, **{f.name: np.asarray(getattr(self, f.name)) for f in fields(self)})
@@ -122,3 +115,16 @@ def load_all(names: list[str] | None = None) -> list[Problem]:
             raise SystemExit(f"no captured problem named {', '.join(missing)} (have: {', '.join(order)})")
         probs = [probs[order[n]] for n in names]
     return probs
+
+
+def pack_contacts(body, point, normal, gap, q_m, shim) -> np.ndarray:
+    """(C, PACK_WIDTH) from the engine's ``nlgs.prepare_contacts`` for these contacts and bodies (``shim``:
+    the model fields it reads, as :meth:`Problem.shim`)."""
+    c = body.shape[0]
+    pack = np.zeros((c, nlgs.PACK_WIDTH))
+    args = (body, point, normal, gap, c, q_m, shim)
+    if "out_ra" in inspect.signature(nlgs.prepare_contacts).parameters:  # before the solver branch
+        nlgs.prepare_contacts(*args, np.zeros((c, 2)), np.zeros((c, 2)), pack)
+    else:
+        nlgs.prepare_contacts(*args, pack)
+    return pack

@@ -37,6 +37,7 @@ from scipy.sparse.csgraph import connected_components
 
 from benchmarks.solver_lab import law
 from benchmarks.solver_lab.outcome import Clock, Outcome
+from benchmarks.solver_lab.problems import pack_contacts
 from masonrycli.engine import nlgs
 
 SWEEPS = 20
@@ -106,9 +107,7 @@ def coarse_step(ctx, v, r, clock):
         cq[:, :2] = X
         shim = p.shim(0.0, COARSE_SWEEPS)
         shim.body_inv_mass, shim.body_inv_inertia = mc_inv[0::3], mc_inv[2::3]
-        cpack = np.zeros((n_in, nlgs.PACK_WIDTH))
-        z = np.zeros((n_in, 2))
-        nlgs.prepare_contacts(cbody, p.point[inter], p.normal[inter], p.gap[inter], n_in, cq, shim, z, z.copy(), cpack)
+        cpack = pack_contacts(cbody, p.point[inter], p.normal[inter], p.gap[inter], cq, shim)
         Hi = H[np.flatnonzero(np.repeat(inter, 2))]
         Hc = Hi @ P
         cpack[:, nlgs.P_BIAS] += (Hi @ v.ravel() - Hc @ vbar)[1::2]  # normal velocity the rigid V̄ misses
