@@ -14,7 +14,8 @@ Tolerances
 - a vertex is collinear when the cross product of its two edges is below ``1e-9 × |e1| |e2|``
   (``COLLINEAR_RTOL``) and the edges point the same way; this absorbs the float noise of clipped
   polygons, so a convexity test never trips on a 1e-17 "reflex" angle;
-- areas below ``MIN_AREA`` (1e-10 m²) are zero, above ``MAX_AREA`` (1e6 m²) absurd (wrong units).
+- areas below ``MIN_AREA`` (1e-10 m²) are zero, above ``MAX_AREA`` (1e6 m²) absurd (wrong units);
+- a vertex beyond ``MAX_COORDINATE`` (1e6 m) from the origin is absurd too.
 """
 
 from __future__ import annotations
@@ -33,6 +34,9 @@ from .values import check_positive
 COLLINEAR_RTOL = 1e-9
 MIN_AREA = 1e-10
 MAX_AREA = 1e6
+# m: a vertex farther than this from the origin is refused. Products of larger coordinates (areas, cross
+# products) overflow or lose all precision in float64, so the convexity test could no longer be trusted.
+MAX_COORDINATE = 1e6
 CONTACT_DISTANCE = 1e-3
 
 
@@ -118,6 +122,11 @@ def normalise_coords(coords, label: str) -> np.ndarray:
     if not np.all(np.isfinite(xy)):
         bad = int(np.flatnonzero(~np.all(np.isfinite(xy), axis=1))[0])
         raise GeometryError(f"{label}: vertex {bad} has a NaN or infinite coordinate")
+    if np.any(np.abs(xy) > MAX_COORDINATE):
+        bad = int(np.flatnonzero(np.any(np.abs(xy) > MAX_COORDINATE, axis=1))[0])
+        raise GeometryError(
+            f"{label}: vertex {bad} at {_fmt(xy[bad])} is absurd (coordinates must be metres, within ±{MAX_COORDINATE:g})"
+        )
     size = float(np.hypot(*(xy.max(axis=0) - xy.min(axis=0))))
     dup_tol = 1e-12 * max(size, 1e-300)
     # Drop the closing repeat and consecutive duplicates.

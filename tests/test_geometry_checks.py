@@ -54,6 +54,9 @@ def test_float_noise_on_a_straight_edge_is_not_a_reflex_vertex():
         ([[0, 0], [1e4, 0], [1e4, 1e4], [0, 1e4]], "absurd"),
         ([[0, 0], [1, 0], [np.nan, 1]], "NaN or infinite"),
         ([[0, 0], [1, 0], [np.inf, 1]], "NaN or infinite"),
+        # Found by hypothesis: products of such coordinates overflow and the convexity test accepted it.
+        ([[0, 0], [-1e300, 1e300], [0, 5], [2.4e288, -1.8e8]], "vertex 1 at"),
+        ([[0, 0], [1, 0], [1, 2e6], [0, 1]], "vertex 2 at .* is absurd"),
     ],
 )
 def test_bad_polygons_are_rejected_naming_the_block(coords, message):
