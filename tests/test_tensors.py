@@ -1,4 +1,4 @@
-"""masonrycli.tensors: DESIGN §6 cases 3–5 with exact references, triangulation, TensorComputer."""
+"""masonrycli.tensors: DESIGN §6 cases 3–5 with exact references and the TensorComputer."""
 
 from __future__ import annotations
 
@@ -6,64 +6,11 @@ import math
 
 import numpy as np
 import pytest
-from shapely.geometry import box
+from tensor_helpers import deformed, star, star_is_closed, state_arrays, triangulated_wall
 
 from masonrycli import tensors as T
 
 RHO, G = 2000.0, 9.81
-
-
-# ---------------------------------------------------------------------------------------------------
-# Helpers
-# ---------------------------------------------------------------------------------------------------
-
-
-def running_bond(rows: int, per_row: int, w: float = 0.3, h: float = 0.2):
-    """Straight-ended running bond: even rows `per_row` full blocks, odd rows a half block at each end.
-
-    Returns the rectangles (shapely boxes), centroids (N, 2), areas (N,) and the touching pairs (P, 2)
-    found by shapely (shared boundary of positive length).
-    """
-    boxes = []
-    for r in range(rows):
-        y0 = r * h
-        if r % 2 == 0:
-            xs = [k * w for k in range(per_row + 1)]
-        else:
-            xs = [0.0] + [w / 2 + k * w for k in range(per_row)] + [per_row * w]
-        boxes += [box(x0, y0, x1, y0 + h) for x0, x1 in zip(xs[:-1], xs[1:])]
-    centroids = np.array([[b.centroid.x, b.centroid.y] for b in boxes])
-    areas = np.array([b.area for b in boxes])
-    pairs = [
-        (i, j)
-        for i in range(len(boxes))
-        for j in range(i + 1, len(boxes))
-        if boxes[i].intersection(boxes[j]).length > 1e-9
-    ]
-    return boxes, centroids, areas, np.array(pairs, np.int64)
-
-
-def star(triangles, i):
-    """The fan of cell i: the triangles with apex i."""
-    return triangles[triangles[:, 0] == i]
-
-
-def star_is_closed(triangles, i):
-    """Every edge from i is shared by exactly two triangles of its fan (i is an interior block)."""
-    edges = {}
-    for t in star(triangles, i):
-        for j in t:
-            if j != i:
-                edges[j] = edges.get(j, 0) + 1
-    return len(edges) > 0 and all(c == 2 for c in edges.values())
-
-
-def state_arrays(centroids, n_supports=1):
-    n = len(centroids)
-    q = np.zeros((n + n_supports, 3))
-    q[:n, :2] = centroids
-    return q, np.zeros((n + n_supports, 3))
-
 
 # ---------------------------------------------------------------------------------------------------
 # DESIGN §6 case 4: stress algebra
@@ -209,15 +156,7 @@ def test_case3_column_block_and_cell_stress():
 
 @pytest.fixture(scope="module")
 def wall():
-    boxes, centroids, areas, pairs = running_bond(5, 5)
-    triangles = T.build_triangles(centroids, pairs)
-    return centroids, areas, pairs, triangles
-
-
-def deformed(centroids, seed, amount=0.02):
-    """Current centroids: a random irregular perturbation of the initial ones (the triangles follow)."""
-    rng = np.random.default_rng(seed)
-    return centroids + rng.normal(scale=amount, size=centroids.shape)
+    return triangulated_wall()
 
 
 @pytest.mark.parametrize("seed", [0, 1, 2])
@@ -279,136 +218,6 @@ def test_case5_interior_block_own_velocity_does_not_change_its_cell_rate(wall):
     v2 = v.copy()
     v2[i, :2] += [1.0, -1.0]
     assert np.abs(T.cell_strain_rate(n, q, v2, triangles)[i] - base[i]).max() > 1e-3
-
-
-# ---------------------------------------------------------------------------------------------------
-# Triangulation
-# ---------------------------------------------------------------------------------------------------
-
-
-def test_build_triangles_running_bond(wall):
-    centroids, _, pairs, triangles = wall
-    n = len(centroids)
-    assert triangles.dtype == np.int64 and triangles.ndim == 2 and triangles.shape[1] == 3
-    assert len(triangles) > 0
-    touching = {(min(a, b), max(a, b)) for a, b in pairs.tolist()}
-    for t in triangles.tolist():
-        for j in t[1:]:
-            assert (min(t[0], j), max(t[0], j)) in touching  # the apex touches both other blocks
-        p = centroids[t]
-        e1, e2 = p[1] - p[0], p[2] - p[0]
-        assert 0.5 * (e1[0] * e2[1] - e1[1] * e2[0]) > 1e-6  # counter-clockwise, non-degenerate
-    assert [tuple(t) for t in triangles.tolist()] == sorted(tuple(t) for t in triangles.tolist())
-    # blocks away from the wall's edge: 6 triangles (2 below, 2 above, 1 each side pair); a full block
-    # at the end of a course closes its fan over the two half blocks beside it (5 triangles)
-    interior = [i for i in range(n) if star_is_closed(triangles, i)]
-    assert len(interior) >= 9
-    assert all(len(star(triangles, i)) in (5, 6) for i in interior)
-    assert sum(len(star(triangles, i)) == 6 for i in interior) >= 9
-    # a triangle of three mutually touching blocks is in the fan of each of them
-    from shapely.geometry import Polygon
-    from shapely.ops import unary_union
-
-    keys = [tuple(sorted(t)) for t in triangles.tolist()]
-    for t, key in zip(triangles.tolist(), keys):
-        if all((min(a, b), max(a, b)) in touching for a, b in ((t[0], t[1]), (t[1], t[2]), (t[2], t[0]))):
-            assert keys.count(key) == 3
-    for fan in (star(triangles, i) for i in range(n)):  # a cell's fan never overlaps itself
-        fan_polys = [Polygon(centroids[t]) for t in fan]
-        assert unary_union(fan_polys).area == pytest.approx(sum(p.area for p in fan_polys), rel=1e-12)
-
-
-def test_build_triangles_is_deterministic_and_ignores_pair_order_repeats_and_supports(wall):
-    centroids, _, pairs, triangles = wall
-    n = len(centroids)
-    rng = np.random.default_rng(0)
-    messy = np.concatenate([pairs[:, ::-1], pairs, [[0, n], [n + 1, 3]]])
-    messy = messy[rng.permutation(len(messy))]
-    np.testing.assert_array_equal(T.build_triangles(centroids, messy), triangles)
-
-
-def test_build_triangles_fans_over_consecutive_neighbours_and_drops_slivers():
-    # square of 4 blocks touching only along its sides: each corner's fan has one triangle over its two
-    # neighbours (they need not touch each other, Fig. I.1); a gap of 180° or more is a free edge
-    c = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
-    sides = np.array([[0, 1], [1, 2], [2, 3], [3, 0]])
-    assert T.build_triangles(c, sides).tolist() == [[0, 1, 3], [1, 2, 0], [2, 3, 1], [3, 0, 2]]
-    # collinear, fewer than 3, no pairs
-    line = np.array([[0.0, 0.0], [1.0, 0.0], [2.0, 0.0]])
-    assert T.build_triangles(line, [[0, 1], [1, 2], [0, 2]]).shape == (0, 3)
-    assert T.build_triangles(c[:2], [[0, 1]]).shape == (0, 3)
-    assert T.build_triangles(c, np.zeros((0, 2))).shape == (0, 3)
-    # a ring: each voussoir touches its two neighbours only; the fan over them is a sliver (smallest
-    # angle 6° here) and is dropped, while a 12° triangle is kept
-    for half_angle, kept in ((6.0, 0), (12.0, 1)):
-        a = math.radians(half_angle)
-        ring = np.array([[-math.cos(a), -math.sin(a)], [0.0, 0.0], [math.cos(a), -math.sin(a)]])
-        assert len(T.build_triangles(ring, [[0, 1], [1, 2]])) == kept
-
-
-def test_fan_triangle_angles_are_at_least_the_minimum_in_the_paper_structures():
-    """Every kept triangle's smallest angle (measured with numpy.linalg, independently) ≥ MIN_ANGLE."""
-    boxes, centroids, _, pairs = running_bond(6, 5)
-    tri = T.build_triangles(centroids, pairs)
-    p = centroids[tri]
-    for k in range(3):
-        u, w = p[:, (k + 1) % 3] - p[:, k], p[:, (k + 2) % 3] - p[:, k]
-        cos = (u * w).sum(1) / np.linalg.norm(u, axis=1) / np.linalg.norm(w, axis=1)
-        assert np.all(np.arccos(cos) >= T.MIN_ANGLE - 1e-12)
-
-
-def test_chain_neighbours_and_chain_strain_rate_of_an_affine_field():
-    """Blocks touching exactly two blocks and no support form a chain; for v = L x + c along a straight
-    chain the rate is uᵀ L u, and along any chain it is Σ l (uᵀ L u) / Σ l (an independent formula)."""
-    rng = np.random.default_rng(5)
-    x = np.array([[0.0, 0.0], [1.0, 0.1], [2.0, 0.3], [2.8, 0.9], [3.0, 2.0]])
-    n = len(x)
-    pairs = np.array([[0, 1], [1, 2], [2, 3], [3, 4], [0, n]])  # block 0 rests on support n
-    chain = T.chain_neighbours(n, pairs)
-    assert chain[0].tolist() == [-1, -1] and chain[4].tolist() == [-1, -1]  # support / one neighbour
-    assert [sorted(c) for c in chain[1:4].tolist()] == [[0, 2], [1, 3], [2, 4]]
-    l0, c0 = rng.normal(size=(2, 2)), rng.normal(size=2)
-    q, v = state_arrays(x)
-    v[:n, :2] = x @ l0.T + c0
-    rate = T.chain_strain_rate(n, q, v, chain)
-    assert np.isnan(rate[[0, 4]]).all()
-    for i in (1, 2, 3):
-        links = x[chain[i]] - x[i]
-        length = np.linalg.norm(links, axis=1)
-        u = links / length[:, None]
-        expected = sum(ln * (ui @ l0 @ ui) for ln, ui in zip(length, u)) / length.sum()
-        assert rate[i] == pytest.approx(expected, rel=1e-12)
-    straight = np.array([[0.0, 0.0], [1.0, 1.0], [2.5, 2.5]])
-    q, v = state_arrays(straight)
-    v[:3, :2] = straight @ l0.T
-    u = np.array([1.0, 1.0]) / math.sqrt(2.0)
-    assert T.chain_strain_rate(3, q, v, T.chain_neighbours(3, [[0, 1], [1, 2]]))[1] == pytest.approx(u @ l0 @ u)
-
-
-def test_isolated_block_gets_nan_strain(wall):
-    centroids, areas, pairs, _ = wall
-    n = len(centroids)
-    far = np.concatenate([centroids, [[10.0, 0.1]]])  # block n touches nothing
-    triangles = T.build_triangles(far, pairs)
-    assert not np.isin(n, triangles)
-    tc = T.TensorComputer(n + 1, np.append(areas, 0.06), triangles)
-    assert not tc.has_triangle[n] and tc.has_triangle[:n].any()
-    q, v = state_arrays(far)
-    v[: n + 1, 0] = 0.1 * far[:, 1]  # simple shear
-    no = np.zeros((0, 2))
-    tc.step(q, v, np.zeros((0, 2), np.int32), no, no, 1e-3)
-    f = tc.fields()
-    for name in (
-        "cell_strain_rate",
-        "cell_strain",
-        "cell_principal_strain_rate",
-        "cell_principal_strain",
-        "cell_volumetric_strain",
-        "cell_deviatoric_strain_rate",
-        "cell_principal_strain_angle",
-    ):
-        assert np.all(np.isnan(f[name][n])), name
-        assert np.all(np.isfinite(f[name][tc.has_triangle])), name
 
 
 # ---------------------------------------------------------------------------------------------------
