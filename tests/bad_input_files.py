@@ -1,0 +1,315 @@
+"""Bad-input catalogue rows about input files: scenario TOML, GeoJSON, WKT and motion CSV records.
+
+Each row is (id, files, argv, exit code, fragment of the one line); tests/test_bad_input_catalogue.py runs them.
+"""
+
+from __future__ import annotations
+
+BLOCK = 'name = "b1"\npolygon = [[0, 0], [1, 0], [1, 1], [0, 1]]\n'
+GROUND = '[[support]]\nname = "ground"\npolygon = [[-2, -1], [3, -1], [3, 0], [-2, 0]]\n'
+SCENE = f"[[block]]\n{BLOCK}{GROUND}"
+
+
+def scen(run: str = "", block: str = BLOCK, extra: str = "") -> dict:
+    """A valid one-block scenario s.toml with ``run`` in [run], the block table and ``extra`` appended."""
+    head = f"[run]\n{run}\n" if run else ""
+    return {"s.toml": f"{head}[[block]]\n{block}{GROUND}{extra}"}
+
+
+def sine(motion: str) -> dict:
+    return {"s.toml": f"[[block]]\n{BLOCK}{GROUND}motion = {{ {motion} }}\n"}
+
+
+def record(csv: str) -> dict:
+    return {"q.csv": csv, "s.toml": f'[[block]]\n{BLOCK}{GROUND}motion = {{ kind = "record", file = "q.csv" }}\n'}
+
+
+def feature(coords, role: str = "block", name: str = "a", gtype: str = "Polygon") -> str:
+    import json
+
+    geometry = {"type": gtype, "coordinates": coords}
+    return json.dumps(
+        {
+            "type": "FeatureCollection",
+            "features": [{"type": "Feature", "properties": {"role": role, "name": name}, "geometry": geometry}],
+        }
+    )
+
+
+SQUARE = [[[0, 0], [1, 0], [1, 1], [0, 1], [0, 0]]]
+
+# (id, files, argv, exit code, fragment of the one line)
+FILE_ROWS = [
+    # -- scenario TOML: [run] and [material]
+    (
+        "run-duration-string",
+        scen('duration = "1.0"'),
+        ("check", "s.toml"),
+        2,
+        's.toml: [run] duration = "1.0": must be a number',
+    ),
+    ("run-dt-negative", scen("dt = -0.001"), ("check", "s.toml"), 2, "s.toml: [run] dt = -0.001: must be > 0"),
+    (
+        "run-dt-not-dividing",
+        scen("duration = 1.0\ndt = 0.3"),
+        ("check", "s.toml"),
+        2,
+        "[run] dt = 0.3: does not divide duration = 1.0",
+    ),
+    (
+        "run-too-many-steps",
+        scen("duration = 1e5\ndt = 1e-4"),
+        ("check", "s.toml"),
+        2,
+        "[run] dt = 0.0001: gives 1e+09 steps",
+    ),
+    ("run-theta", scen("theta = 0.2"), ("check", "s.toml"), 2, "[run] theta = 0.2: must be >= 0.5"),
+    ("run-record-every-0", scen("record_every = 0"), ("check", "s.toml"), 2, "[run] record_every = 0: must be >= 1"),
+    (
+        "run-max-iterations-float",
+        scen("max_iterations = 1.5"),
+        ("check", "s.toml"),
+        2,
+        "[run] max_iterations = 1.5: must be an integer",
+    ),
+    ("run-gravity-short", scen("gravity = [0]"), ("check", "s.toml"), 2, "[run] gravity = [0]: must be 2 numbers"),
+    ("run-tolerance", scen("tolerance = 2"), ("check", "s.toml"), 2, "[run] tolerance = 2: must be < 1"),
+    (
+        "run-unknown-key",
+        scen("durration = 1.0"),
+        ("check", "s.toml"),
+        2,
+        's.toml: [run] unknown key "durration" (did you mean "duration"?)',
+    ),
+    (
+        "material-friction",
+        {"s.toml": f"[material]\nfriction = -1\n{SCENE}"},
+        ("check", "s.toml"),
+        2,
+        "[material] friction = -1: must be >= 0",
+    ),
+    ("toml-syntax", {"s.toml": "[run\nduration = 1"}, ("check", "s.toml"), 2, "s.toml: TOML syntax error"),
+    (
+        "toml-not-utf8",
+        {"s.toml": b"[run]\nname = '\xff'\n"},
+        ("check", "s.toml"),
+        2,
+        "s.toml: not a UTF-8 text file (byte",
+    ),
+    ("top-level-unknown", {"s.toml": f"blok = 1\n{SCENE}"}, ("check", "s.toml"), 2, 's.toml: unknown key "blok"'),
+    # -- scenario TOML: blocks and supports
+    (
+        "no-blocks",
+        {"s.toml": "[run]\nduration = 1.0\n"},
+        ("check", "s.toml"),
+        2,
+        "s.toml: no blocks: add [[block]] tables or a [structure] builder",
+    ),
+    (
+        "duplicate-name",
+        {
+            "s.toml": f"[[block]]\n{BLOCK}[[block]]\n{BLOCK.replace('0, 0], [1, 0', '0, 2], [1, 2').replace('[1, 1], [0, 1]', '[1, 3], [0, 3]')}"
+        },
+        ("check", "s.toml"),
+        2,
+        '[[block]] #2 ("b1"): name = "b1": already used by [[block]] #1 ("b1")',
+    ),
+    (
+        "block-velocity-inf",
+        scen(block=BLOCK + "velocity = [inf, 0, 0]\n"),
+        ("check", "s.toml"),
+        2,
+        '[[block]] #1 ("b1"): velocity = [inf, 0, 0]: must be finite numbers',
+    ),
+    (
+        "block-velocity-short",
+        scen(block=BLOCK + "velocity = [1, 0]\n"),
+        ("check", "s.toml"),
+        2,
+        '[[block]] #1 ("b1"): velocity = [1, 0]: must be 3 numbers',
+    ),
+    (
+        "block-two-vertices",
+        scen(block='name = "b1"\npolygon = [[0, 0], [1, 0]]\n'),
+        ("check", "s.toml"),
+        2,
+        '[[block]] #1 ("b1"): polygon = [[0, 0], [1, 0]]: needs at least 3 vertices',
+    ),
+    (
+        "block-vertex-nan",
+        scen(block='name = "b1"\npolygon = [[0, 0], [nan, 0], [1, 1]]\n'),
+        ("check", "s.toml"),
+        2,
+        '[[block]] #1 ("b1"): polygon[1] = [nan, 0]: must be finite numbers',
+    ),
+    (
+        "block-non-convex",
+        scen(block='name = "dart"\npolygon = [[0, 0], [2, 0], [1, 0.5], [1, 2]]\n'),
+        ("check", "s.toml"),
+        2,
+        '[[block]] #1 ("dart"): ',
+    ),
+    ("block-no-polygon", scen(block='name = "b1"\n'), ("check", "s.toml"), 2, '[[block]] #1 ("b1"): polygon: missing'),
+    (
+        "block-density-zero",
+        scen(block=BLOCK + "density = 0\n"),
+        ("check", "s.toml"),
+        2,
+        '[[block]] #1 ("b1"): density = 0: must be > 0',
+    ),
+    (
+        "block-unknown-key",
+        scen(block=BLOCK + 'colour = "red"\n'),
+        ("check", "s.toml"),
+        2,
+        '[[block]] #1 ("b1"): unknown key "colour"',
+    ),
+    (
+        "block-empty-name",
+        scen(block='name = ""\npolygon = [[0, 0], [1, 0], [1, 1]]\n'),
+        ("check", "s.toml"),
+        2,
+        '[[block]] #1: name = "": must not be empty',
+    ),
+    (
+        "blocks-overlap",
+        {
+            "s.toml": '[[block]]\nname = "a"\npolygon = [[0, 0], [1, 0], [1, 1], [0, 1]]\n[[block]]\nname = "b"\npolygon = [[0.5, 0], [1.5, 0], [1.5, 1], [0.5, 1]]\n'
+        },
+        ("check", "s.toml"),
+        2,
+        '"b"',
+    ),
+    (
+        "motion-kind",
+        sine('kind = "wobble"'),
+        ("check", "s.toml"),
+        2,
+        '[[support]] #1 ("ground"): motion.kind = "wobble": unknown motion kind',
+    ),
+    (
+        "motion-missing-amplitude",
+        sine('kind = "sine", frequency = 2.0'),
+        ("check", "s.toml"),
+        2,
+        '[[support]] #1 ("ground"): motion.amplitude: missing',
+    ),
+    (
+        "motion-frequency-nan",
+        sine('kind = "sine", amplitude = 1.0, frequency = nan'),
+        ("check", "s.toml"),
+        2,
+        '[[support]] #1 ("ground"): motion.frequency = nan',
+    ),
+    (
+        "motion-unused-key",
+        sine('kind = "fixed", amplitude = 1.0'),
+        ("check", "s.toml"),
+        2,
+        '[[support]] #1 ("ground"): motion.amplitude: not used by kind "fixed"',
+    ),
+    (
+        "motion-record-missing-file",
+        sine('kind = "record", file = "nope.csv"'),
+        ("check", "s.toml"),
+        2,
+        '[[support]] #1 ("ground"): motion.file = "nope.csv": no such file',
+    ),
+    (
+        "structure-unknown-builder",
+        {"s.toml": '[structure]\nbuilder = "tower"\n'},
+        ("check", "s.toml"),
+        2,
+        's.toml: [structure] builder = "tower"',
+    ),
+    (
+        "structure-file-format",
+        {"s.toml": '[structure]\nfile = "w.txt"\n', "w.txt": ""},
+        ("check", "s.toml"),
+        2,
+        "s.toml: [structure] file = ",
+    ),
+    (
+        "structure-file-missing",
+        {"s.toml": '[structure]\nfile = "missing.geojson"\n'},
+        ("check", "s.toml"),
+        2,
+        "missing.geojson",
+    ),
+    ("scenario-missing", {}, ("check", "no-such.toml"), 2, "no-such.toml: cannot read scenario"),
+    (
+        "scenario-is-folder",
+        {"sub.toml/x": ""},
+        ("check", "sub.toml"),
+        2,
+        "sub.toml: cannot read scenario: is a directory",
+    ),
+    # -- GeoJSON (run and check read it alike)
+    ("geojson-not-json", {"g.geojson": "{ not json"}, ("check", "g.geojson"), 2, "g.geojson: "),
+    (
+        "geojson-string-coordinate",
+        {"g.geojson": feature([[[0, 0], [1, 0], [1, "x"], [0, 0]]])},
+        ("check", "g.geojson"),
+        2,
+        'g.geojson: feature 0 (block 0 "a"): coordinates must be [x, y] number pairs',
+    ),
+    (
+        "geojson-nan",
+        {"g.geojson": feature([[[0, 0], [1, 0], [1, float("nan")], [0, 0]]])},
+        ("run", "g.geojson", "--no-recording"),
+        2,
+        'g.geojson: feature 0: block 0 ("a"): vertex 2 has a NaN',
+    ),
+    ("geojson-role", {"g.geojson": feature(SQUARE, role="roof")}, ("check", "g.geojson"), 2, "g.geojson: feature 0"),
+    ("geojson-point", {"g.geojson": feature([0, 0], gtype="Point")}, ("check", "g.geojson"), 2, "g.geojson: feature 0"),
+    (
+        "geojson-non-convex",
+        {"g.geojson": feature([[[0, 0], [2, 0], [1, 0.5], [1, 2], [0, 0]]])},
+        ("check", "g.geojson"),
+        2,
+        'g.geojson: feature 0: block 0 ("a"): polygon is not convex',
+    ),
+    (
+        "geojson-no-features",
+        {"g.geojson": '{"type": "FeatureCollection", "features": []}'},
+        ("check", "g.geojson"),
+        2,
+        "g.geojson: ",
+    ),
+    ("geojson-missing", {}, ("run", "nope.geojson"), 2, "nope.geojson: no such file"),
+    # -- WKT
+    (
+        "wkt-nan",
+        {"n.wkt": "POLYGON ((0 0, nan 0, 1 1, 0 1, 0 0))\n"},
+        ("run", "n.wkt", "--no-recording"),
+        2,
+        'n.wkt: line 1: block 0 ("block-0"): vertex 1 has a NaN or infinite coordinate',
+    ),
+    ("wkt-garbage", {"n.wkt": "POLYGON ((0 0, 1 0\n"}, ("check", "n.wkt"), 2, "n.wkt: line 1"),
+    ("wkt-linestring", {"n.wkt": "LINESTRING (0 0, 1 1)\n"}, ("check", "n.wkt"), 2, "n.wkt: line 1"),
+    # -- motion CSV records
+    (
+        "csv-not-a-number",
+        record("t,v\n0,0\n1,abc\n"),
+        ("check", "s.toml"),
+        2,
+        ('[[support]] #1 ("ground"): motion.file: q.csv:3: not a number: "abc"'),
+    ),
+    (
+        "csv-four-columns",
+        record("0,0,0,0\n"),
+        ("check", "s.toml"),
+        2,
+        "q.csv:1: expected 2 columns (time, value) or 3 (time, x, y), got 4",
+    ),
+    (
+        "csv-column-mismatch",
+        record("0,0\n1,0,0\n"),
+        ("check", "s.toml"),
+        2,
+        "q.csv:2: expected 2 columns like the first sample, got 3",
+    ),
+    ("csv-decreasing", record("0,0\n1,0\n0.5,0\n"), ("check", "s.toml"), 2, "q.csv:3:"),
+    ("csv-infinite", record("0,0\n1,inf\n"), ("check", "s.toml"), 2, "q.csv:2:"),
+    ("csv-one-sample", record("0,0\n"), ("check", "s.toml"), 2, "q.csv"),
+]

@@ -1,0 +1,197 @@
+"""Bad-input catalogue rows about the command line: options of run / check / simulate / build, output paths
+and inspect. Each row is (id, files, argv, exit code, fragment); tests/test_bad_input_catalogue.py runs them.
+"""
+
+from __future__ import annotations
+
+from bad_input_files import scen
+
+WALL = ("simulate", "wall", "--duration", "0.01")
+ARCH = ("simulate", "arch", "--duration", "0.01")
+RUN = ("run", "s.toml")
+
+# (id, files, argv, exit code, fragment of the one line)
+OPTION_ROWS = [
+    # -- every option of run / check / simulate / build
+    ("opt-dt", {**scen()}, (*RUN, "--dt", "-1", "--no-recording"), 2, "--dt: dt = -1.0: must be > 0"),
+    ("opt-dt-text", {**scen()}, (*RUN, "--dt", "abc"), 2, "Invalid value for '--dt'"),
+    ("opt-duration", {**scen()}, (*RUN, "--duration", "0", "--no-recording"), 2, "--duration: duration = 0"),
+    (
+        "opt-duration-dt-steps",
+        {**scen()},
+        (*RUN, "--duration", "1e5", "--dt", "1e-4", "--no-recording"),
+        2,
+        "--duration and --dt: dt = 0.0001: gives 1e+09 steps",
+    ),
+    (
+        "opt-dt-not-dividing",
+        {**scen()},
+        (*RUN, "--dt", "0.3", "--no-recording"),
+        2,
+        "--dt: dt = 0.3: does not divide duration",
+    ),
+    ("opt-theta", {**scen()}, (*RUN, "--theta", "0.2", "--no-recording"), 2, "--theta: theta = 0.2"),
+    ("opt-friction", {**scen()}, (*RUN, "--friction", "nan", "--no-recording"), 2, "--friction: friction = nan"),
+    (
+        "opt-record-every",
+        {**scen()},
+        (*RUN, "--record-every", "0", "--no-recording"),
+        2,
+        "--record-every: record_every = 0",
+    ),
+    ("opt-tolerance", {**scen()}, (*RUN, "--tolerance", "1", "--no-recording"), 2, "--tolerance: tolerance = 1"),
+    (
+        "opt-max-iterations",
+        {**scen()},
+        (*RUN, "--max-iterations", "0", "--no-recording"),
+        2,
+        "--max-iterations: max_iterations = 0",
+    ),
+    ("opt-unknown", {**scen()}, (*RUN, "--bogus"), 2, "No such option: --bogus"),
+    ("check-opt-dt", {**scen()}, ("check", "s.toml", "--dt", "-1"), 2, "--dt: dt = -1"),
+    ("sim-density", {}, (*WALL, "--density", "-5", "--no-recording"), 2, "--density: density = -5"),
+    ("sim-thickness", {}, (*WALL, "--thickness", "0", "--no-recording"), 2, "--thickness: thickness = 0"),
+    ("sim-blocks", {}, (*WALL, "--blocks", "0", "--no-recording"), 2, "block count"),
+    (
+        "sim-blocks-impossible",
+        {},
+        (*WALL, "--blocks", "51", "--courses", "5", "--no-recording"),
+        2,
+        'builder "wall": wall: 51 blocks cannot be laid in running bond with 5 courses',
+    ),
+    (
+        "sim-length",
+        {},
+        (*WALL, "--courses", "8", "--length", "10", "--no-recording"),
+        2,
+        "length 10 m is not a whole number of 0.3 m blocks",
+    ),
+    ("sim-courses", {}, (*WALL, "--courses", "0", "--no-recording"), 2, "courses"),
+    ("sim-block-length", {}, (*WALL, "--block-length", "-0.3", "--no-recording"), 2, "block_length"),
+    (
+        "sim-settlement-wall",
+        {},
+        (*WALL, "--settlement", "0.01", "--no-recording"),
+        2,
+        "--settlement: the wall stands on one ground",
+    ),
+    (
+        "sim-settlement-negative",
+        {},
+        (*ARCH, "--settlement", "-1", "--no-recording"),
+        2,
+        "--settlement -1.0: must be >= 0",
+    ),
+    ("sim-settlement-and-amp", {}, (*ARCH, "--amp", "1", "--no-recording"), 2, "--settlement with --amp"),
+    ("sim-amp-nan", {}, (*WALL, "--amp", "nan", "--no-recording"), 2, "--amp/--freq:"),
+    ("sim-freq-negative", {}, (*WALL, "--freq", "-1", "--no-recording"), 2, "--amp/--freq:"),
+    ("sim-voussoirs", {}, (*ARCH, "--voussoirs", "1", "--no-recording"), 2, 'builder "arch"'),
+    ("sim-span", {}, (*ARCH, "--span", "-1", "--no-recording"), 2, 'builder "arch"'),
+    ("build-blocks", {}, ("build", "wall", "--blocks", "0", "--out", "w.geojson"), 2, "wall: wall: block count"),
+    (
+        "sim-block-height",
+        {},
+        (*WALL, "--block-height", "0", "--no-recording"),
+        2,
+        "wall: block_height must be a positive",
+    ),
+    (
+        "sim-pier-courses",
+        {},
+        (*ARCH, "--pier-courses", "0", "--no-recording"),
+        2,
+        "arch: pier_courses must be an integer",
+    ),
+    ("sim-ring-thickness", {}, (*ARCH, "--ring-thickness", "-1", "--no-recording"), 2, "arch: ring_thickness must be"),
+    ("sim-pier-width", {}, (*ARCH, "--pier-width", "0", "--no-recording"), 2, "arch: pier_width must be a positive"),
+    ("sim-wall-courses", {}, ("simulate", "aqueduct", "--wall-courses", "0", "--no-recording"), 2, "wall_courses must"),
+    ("sim-record-missing", {}, (*WALL, "--record", "nope.at2", "--no-recording"), 2, "nope.at2: cannot read record"),
+    ("sim-scale-alone", {}, (*WALL, "--scale", "2", "--no-recording"), 2, "--scale: goes with --record"),
+    (
+        "limit-load",
+        {},
+        ("limit", "arch", "--load", "bogus"),
+        2,
+        "--load bogus: expected one of horizontal, tilt, point",
+    ),
+    ("limit-direction", {}, ("limit", "arch", "--direction", "up"), 2, "--direction up: expected one of +x, -x"),
+    ("limit-point-no-block", {}, ("limit", "arch", "--load", "point"), 2, "--load point: name the loaded block"),
+    ("limit-friction", {}, ("limit", "arch", "--friction", "-1"), 2, "--friction: friction = -1.0: must be >= 0"),
+    # -- output paths (checked before step 1)
+    (
+        "out-exists",
+        {**scen(), "r.rrd": "old"},
+        (*RUN, "--out", "r.rrd"),
+        2,
+        "--out r.rrd: the file exists (add --force to replace it)",
+    ),
+    (
+        "history-exists",
+        {**scen(), "h.npz": "old"},
+        (*RUN, "--no-recording", "--history", "h.npz"),
+        2,
+        "--history h.npz: the file exists (add --force",
+    ),
+    ("out-suffix", {**scen()}, (*RUN, "--out", "r.txt"), 2, "--out r.txt: the file name must end in .rrd"),
+    (
+        "history-suffix",
+        {**scen()},
+        (*RUN, "--no-recording", "--history", "h.txt"),
+        2,
+        "--history h.txt: the file name must end in .npz",
+    ),
+    (
+        "out-and-history-same",
+        {**scen()},
+        (*RUN, "--out", "x.rrd", "--history", "x.rrd"),
+        2,
+        "--history x.rrd: the file name must end in .npz",
+    ),
+    (
+        "out-and-history-same-file",
+        {**scen(), "x.rrd": "", "x.npz": "@x.rrd"},
+        (*RUN, "--out", "x.rrd", "--history", "x.npz", "--force"),
+        2,
+        "--out and --history name the same file",
+    ),
+    (
+        "history-parent-is-file",
+        {**scen(), "f": ""},
+        (*RUN, "--no-recording", "--history", "f/h.npz"),
+        2,
+        "--history f/h.npz: f is not a folder",
+    ),
+    ("out-is-folder", {**scen(), "d.rrd/x": ""}, (*RUN, "--out", "d.rrd"), 2, "--out d.rrd: is a folder"),
+    (
+        "check-out-exists",
+        {**scen(), "r.rrd": "old"},
+        ("check", "s.toml", "--out", "r.rrd"),
+        2,
+        "--out r.rrd: the file exists",
+    ),
+    (
+        "build-out-exists",
+        {"w.geojson": "{}"},
+        ("build", "wall", "--out", "w.geojson"),
+        2,
+        "--out w.geojson: the file exists (add --force",
+    ),
+    ("build-out-suffix", {}, ("build", "arch", "--out", "w.txt"), 2, "--out w.txt: the file name must end in .geojson"),
+    (
+        "limit-out-exists",
+        {"r.rrd": "old"},
+        ("limit", "arch", "--out", "r.rrd"),
+        2,
+        "--out r.rrd: the file exists (add --force to replace it)",
+    ),
+    # -- inspect
+    ("inspect-missing", {}, ("inspect", "missing.rrd"), 2, "missing.rrd: no such recording"),
+    (
+        "inspect-not-rrd",
+        {"bad.rrd": "not a recording"},
+        ("inspect", "bad.rrd"),
+        2,
+        "bad.rrd: not a readable Rerun recording",
+    ),
+    ("inspect-folder", {"d.rrd/x": ""}, ("inspect", "d.rrd"), 2, "d.rrd: no such recording"),
+]
