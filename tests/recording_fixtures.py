@@ -2,12 +2,14 @@
 
 A running-bond wall of rectangles (one block of the top course is a pentagon, so the polygons are
 ragged), a ground support, a centroid triangulation, and frames with a swaying wall, random contacts
-and tensor fields named as in masonrycli.tensors.
+and tensor fields named as in masonrycli.tensors; reading rows back, and rerun's strict mode.
 """
 
 from __future__ import annotations
 
 import numpy as np
+import pytest
+import rerun as rr
 from scipy.spatial import Delaunay
 
 from masonrycli.frame import CONTACT_OPEN, CONTACT_SLIP, CONTACT_STICK, Frame
@@ -138,3 +140,26 @@ def frames(
 
 
 METADATA = {"scenario": "synthetic wall", "parameters": {"freq": 2.0, "amp": 1.0, "dt": 1e-3}, "seed": 0}
+
+
+@pytest.fixture(autouse=True)
+def strict_rerun():
+    """Any logging error raises instead of becoming a warning."""
+    before = rr.strict_mode()
+    rr.set_strict_mode(True)
+    yield
+    rr.set_strict_mode(before)
+
+
+def temporal_rows(path, entity: str, column: str) -> dict[int, list]:
+    """step -> the row's value (Python list) of `column` on `entity` (temporal chunks only)."""
+    out: dict[int, list] = {}
+    for chunk in rr.chunk.RrdReader(path).stream():
+        if chunk.entity_path != entity or chunk.is_static:
+            continue
+        batch = chunk.to_record_batch()
+        if column not in batch.schema.names:
+            continue
+        for step, value in zip(batch.column("step").to_pylist(), batch.column(column).to_pylist()):
+            out[step] = value
+    return out

@@ -2,11 +2,6 @@
 
 from __future__ import annotations
 
-import os
-import subprocess
-import sys
-import textwrap
-
 import numpy as np
 import pytest
 import rerun as rr
@@ -20,17 +15,9 @@ from masonrycli.recording.layout import FILL, INSET, PAPER_FIELDS
 from masonrycli.recording.readback import blueprint_views, field_frames
 
 import recording_fixtures as fx
+from recording_fixtures import strict_rerun, temporal_rows  # noqa: F401 (strict_rerun: autouse)
 
 N_FRAMES, BATCH = 25, 10  # three flushes, the last one partial
-
-
-@pytest.fixture(autouse=True)
-def strict_rerun():
-    """Any logging error raises instead of becoming a warning."""
-    before = rr.strict_mode()
-    rr.set_strict_mode(True)
-    yield
-    rr.set_strict_mode(before)
 
 
 @pytest.fixture(scope="module")
@@ -50,20 +37,6 @@ def written(wall, tmp_path_factory):
             rec.log_frame(f)
     rr.set_strict_mode(before)
     return path, static, frames, rec
-
-
-def temporal_rows(path, entity: str, column: str) -> dict[int, list]:
-    """step -> the row's value (Python list) of `column` on `entity` (temporal chunks only)."""
-    out: dict[int, list] = {}
-    for chunk in rr.chunk.RrdReader(path).stream():
-        if chunk.entity_path != entity or chunk.is_static:
-            continue
-        batch = chunk.to_record_batch()
-        if column not in batch.schema.names:
-            continue
-        for step, value in zip(batch.column("step").to_pylist(), batch.column(column).to_pylist()):
-            out[step] = value
-    return out
 
 
 def static_value(path, entity: str, column: str):
@@ -383,132 +356,3 @@ def test_magnified_shape(written):
     q = frames[0].block_q + m * (f.block_q - frames[0].block_q)
     np.testing.assert_allclose(np.array(rows[f.step][0])[:-1], world_outline(static, q, 0), atol=1e-4)
     assert len(rows[f.step]) == len(static.block_name) + 1  # blocks and the ground
-
-
-# ------------------------------------------------------------------------------- closing and errors
-@pytest.mark.parametrize("exc, status", [(RuntimeError("boom"), "failed"), (KeyboardInterrupt(), "interrupted")])
-def test_recording_is_complete_after_an_exception(wall, tmp_path, exc, status):
-    static, q0 = wall
-    frames = fx.frames(static, q0, 15)
-    path = tmp_path / "crash.rrd"
-    with pytest.raises(type(exc)):
-        with Recorder(path, static, fx.METADATA, batch_frames=BATCH) as rec:
-            for f in frames:
-                rec.log_frame(f)
-            raise exc
-    info = inspect_recording(path)
-    assert info["complete"] and info["frames"] == 15  # the partial batch was flushed
-    assert f"{status} at t = 0.140 s (step 140)" in info["metadata"]
-    if status == "failed":
-        assert "RuntimeError: boom" in info["metadata"]
-    rerun_cli = os.path.join(os.path.dirname(sys.executable), "rerun")
-    verify = subprocess.run(
-        [rerun_cli, "rrd", "verify", str(path)],
-        capture_output=True,
-        text=True,
-        timeout=120,
-        env={**os.environ, "RERUN_ANALYTICS": "0"},
-    )
-    assert verify.returncode == 0, verify.stderr
-
-
-def test_close_note_and_idempotence(wall, tmp_path):
-    static, q0 = wall
-    rec = Recorder(tmp_path / "x.rrd", static, fx.METADATA)
-    rec.log_frame(fx.frames(static, q0, 1)[0])
-    rec.close("interrupted", "interrupted at t = 0.0000 s (step 0 of 1000)")
-    rec.close()  # no-op
-    with pytest.raises(RuntimeError):
-        rec.log_frame(fx.frames(static, q0, 1)[0])
-    doc = inspect_recording(tmp_path / "x.rrd")["metadata"]
-    assert "**Status:** interrupted at t = 0.0000 s (step 0 of 1000)" in doc
-
-
-def test_inspect_a_file_without_footer(wall, tmp_path):
-    """A killed writer leaves no footer: inspect still reads what was flushed and says it is incomplete."""
-    path = tmp_path / "killed.rrd"
-    script = textwrap.dedent(f"""
-        import os, signal, sys
-        sys.path[:0] = {[os.path.dirname(__file__), os.path.dirname(os.path.dirname(__file__))]!r}
-        import recording_fixtures as fx
-        from masonrycli.recording import Recorder
-        static, q0 = fx.wall()
-        rec = Recorder({str(path)!r}, static, fx.METADATA, batch_frames=4)
-        for f in fx.frames(static, q0, 8):
-            rec.log_frame(f)
-        rec.rec.flush()
-        os.kill(os.getpid(), signal.SIGKILL)
-    """)
-    subprocess.run([sys.executable, "-c", script], timeout=120, env={**os.environ, "RERUN_ANALYTICS": "0"})
-    info = inspect_recording(path)
-    assert not info["complete"]
-    assert info["frames"] == 8 and info["application_id"] == "masonry"
-
-
-def test_frames_without_tensor_fields_or_contacts(wall, tmp_path):
-    static, q0 = wall
-    f = fx.frames(static, q0, 2)[1]  # step 10 (an initial frame without forces is not shown)
-    empty = type(f)(
-        **{
-            **f.__dict__,
-            "tensors": {},
-            "contact_body": np.zeros((0, 2), np.int32),
-            "contact_point": np.zeros((0, 2)),
-            "contact_normal": np.zeros((0, 2)),
-            "contact_force": np.zeros((0, 2)),
-            "contact_gap": np.zeros(0),
-            "contact_status": np.zeros(0, np.int8),
-            "contact_mobilised": np.zeros(0),
-        }
-    )
-    path = tmp_path / "empty.rrd"
-    with Recorder(path, static, fx.METADATA) as rec:
-        rec.log_frame(empty)
-    rows = temporal_rows(path, f"/{FILL}", rec_mod.layout.FIELD_BY_KEY["cell_spherical_stress"].colors)
-    assert set(rows[10]) == {cm.NAN_RGBA}
-    assert temporal_rows(path, "/structure/plane/xy/forces", "Arrows2D:vectors")[10] == []
-    assert "scale not fixed yet" in inspect_recording(path)["metadata"]
-
-
-def test_viewer_safe_text():
-    assert rec_mod.viewer_safe_text("σ ≤ 5 kPa, é — ∝ 漢") == "σ ≤ 5 kPa, é — ? ?"
-
-
-# ------------------------------------------------------------------------------------------ colormap
-def test_colormap_lookup():
-    lut = cm.VIRIDIS
-    assert len(lut) == 256 and lut.dtype == np.uint32
-    colors = cm.map_scalars(np.array([-1.0, 0.0, 0.5, 1.0, 2.0, np.nan]), 0.0, 1.0, lut)
-    assert list(colors[[0, 1, 3, 4]]) == [lut[0], lut[0], lut[-1], lut[-1]]
-    assert colors[2] in (lut[127], lut[128]) and colors[5] == cm.NAN_RGBA
-    np.testing.assert_array_equal(cm.unpack_rgba(cm.COOLWARM[[0, -1]])[:, :3], [[59, 76, 192], [180, 4, 38]])
-    assert cm.unpack_rgba(cm.COOLWARM[128])[0] == pytest.approx(221, abs=2)  # light grey at zero
-
-
-def test_nice_ceil_and_robust_max():
-    values = (0.0, 0.9, 1.0, 1.2, 2.7, 7.0, 1.1e5)
-    assert [cm.nice_ceil(x) for x in values] == [0.0, 1.0, 1.0, 1.5, 3.0, 8.0, 1.5e5]
-    assert cm.robust_max_abs(np.array([np.nan, -3.0, 1.0]), 100) == 3.0
-    assert cm.robust_max_abs(np.array([np.nan])) == 0.0
-
-
-def test_interrupt_in_the_middle_of_a_flush_still_leaves_a_complete_file(wall, tmp_path):
-    static, q0 = wall
-    path = tmp_path / "mid_flush.rrd"
-    with pytest.raises(KeyboardInterrupt):
-        with Recorder(path, static, fx.METADATA, batch_frames=5) as rec:
-            send, calls = rec.rec.send_columns, []
-
-            def flaky_send(*args, **kwargs):
-                if rec._frames == 10:  # flushing the second batch
-                    calls.append(args[0])
-                    if len(calls) == 9:  # part-way through its entities
-                        raise KeyboardInterrupt
-                return send(*args, **kwargs)
-
-            rec.rec.send_columns = flaky_send
-            for f in fx.frames(static, q0, 12):
-                rec.log_frame(f)
-    info = inspect_recording(path)
-    assert info["complete"] and "interrupted at t = 0.090 s (step 90)" in info["metadata"]
-    assert info["frames"] == 10  # the first batch, then as much of the second as was sent: no duplicates
