@@ -385,7 +385,7 @@ def _write_assembly(builder: str, opts: dict) -> None:
     from geometry_library.checks import validate_assembly
     from geometry_library.io import write_geojson
     from masonrycli.builtin import builder_options
-    from masonrycli.outputs import check_output, open_part
+    from masonrycli.outputs import check_output, written_whole
 
     target = check_output(opts.pop("out"), "--out", ".geojson", opts.pop("force"))
     options = builder_options(builder, {k: v for k, v in opts.items() if v is not None})
@@ -395,13 +395,9 @@ def _write_assembly(builder: str, opts: dict) -> None:
         raise InputError(f"{builder}: {exc}") from None
     for warning in validate_assembly(assembly):
         warn(warning)
-    open_part(target)
-    try:
-        write_geojson(assembly, target.part)
-        out = target.commit()
-    except BaseException:
-        target.discard()
-        raise
+    with written_whole(target) as part:
+        write_geojson(assembly, part)
+    out = target.path
     console.print(
         f"{builder}: {assembly.block_count} blocks and {assembly.support_count} "
         f"support{'s' if assembly.support_count != 1 else ''} → {out}"

@@ -155,6 +155,20 @@ def open_part(out: OutputFile) -> None:
         raise InputError(f"{out.option} {out.path}: cannot write: {exc.strerror or exc}") from None
 
 
+@contextlib.contextmanager
+def written_whole(out: OutputFile):
+    """For a writer that makes the whole file at once: yields the ``part`` path to write, renames it into
+    place when the block ends (``out.path`` is then where it went) and removes it on any error, Ctrl-C
+    included, before re-raising — so ``out.path`` never holds half a file."""
+    open_part(out)
+    try:
+        yield out.part
+    except BaseException:
+        out.discard()
+        raise
+    out.commit()
+
+
 def check_space(outputs: list[tuple[OutputFile, int]]) -> None:
     """Refuse a run whose outputs (estimated bytes each) would not fit in the free space of their disk."""
     need: dict[int, tuple[int, list[str], str]] = {}

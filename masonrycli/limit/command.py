@@ -18,7 +18,7 @@ from rich.text import Text
 from masonrycli.errors import InputError
 from masonrycli.limit.analysis import LimitResult, analyse
 from masonrycli.limit.problem import LiveLoad
-from masonrycli.outputs import check_output, open_part
+from masonrycli.outputs import check_output, written_whole
 
 BUILT_INS = ("wall", "arch", "aqueduct")
 SHOWN = 8
@@ -172,13 +172,9 @@ def run_limit(
         err_console.print(Text.assemble(("warning:", "yellow"), f" {warning}"))
     result = analyse(scenario, live)
     if target is not None:  # under a temporary name, renamed when complete (masonrycli.outputs)
-        open_part(target)
-        try:
-            write_recording(result, target.part)
-            out = target.commit()
-        except BaseException:
-            target.discard()
-            raise
+        with written_whole(target) as part:
+            write_recording(result, part)
+        out = target.path
     checks = []
     if verify:
         from masonrycli.limit.verify import verify as run_verify
