@@ -326,6 +326,14 @@ def aabb_pairs_bruteforce(boxes, body_dynamic):
 # ----------------------------------------------------------------------------------------------
 
 
+def course_edges(row: int, full_per_row: int, w: float) -> list[float]:
+    """x of the vertical joints of course ``row`` of a straight-ended running bond: even courses
+    ``full_per_row`` full blocks, odd ones a half block at each end."""
+    if row % 2 == 0:
+        return [i * w for i in range(full_per_row + 1)]
+    return [0.0] + [w / 2 + i * w for i in range(full_per_row)] + [full_per_row * w]
+
+
 def running_bond_wall(rows=16, full_per_row=15, block=(0.3, 0.2), ground_margin=0.5):
     """A running-bond wall on a ground support, as flat model arrays.
 
@@ -339,10 +347,7 @@ def running_bond_wall(rows=16, full_per_row=15, block=(0.3, 0.2), ground_margin=
     polys = []
     for r in range(rows):
         y0 = r * h
-        if r % 2 == 0:
-            xs = [i * w for i in range(full_per_row + 1)]
-        else:
-            xs = [0.0] + [w / 2 + i * w for i in range(full_per_row)] + [full_per_row * w]
+        xs = course_edges(r, full_per_row, w)
         for x0, x1 in zip(xs[:-1], xs[1:]):
             polys.append(rect(x0, y0, x1, y0 + h))
     length = full_per_row * w

@@ -7,6 +7,8 @@ from shapely.geometry import box
 
 from masonrycli import tensors as T
 
+from naive_collision import course_edges
+
 
 def running_bond(rows: int, per_row: int, w: float = 0.3, h: float = 0.2):
     """Straight-ended running bond: even rows `per_row` full blocks, odd rows a half block at each end.
@@ -17,10 +19,7 @@ def running_bond(rows: int, per_row: int, w: float = 0.3, h: float = 0.2):
     boxes = []
     for r in range(rows):
         y0 = r * h
-        if r % 2 == 0:
-            xs = [k * w for k in range(per_row + 1)]
-        else:
-            xs = [0.0] + [w / 2 + k * w for k in range(per_row)] + [per_row * w]
+        xs = course_edges(r, per_row, w)
         boxes += [box(x0, y0, x1, y0 + h) for x0, x1 in zip(xs[:-1], xs[1:])]
     centroids = np.array([[b.centroid.x, b.centroid.y] for b in boxes])
     areas = np.array([b.area for b in boxes])
