@@ -56,11 +56,7 @@ class ColourRange:
 
         Signed: [lo, 0] → [0, ½] and [0, hi] → [½, 1] (zero is the middle colour).
         """
-        v = np.asarray(values, dtype=np.float64)
-        if self.kind == "signed":
-            with np.errstate(invalid="ignore"):
-                return np.where(v < 0.0, 0.5 - 0.5 * v / self.lo, 0.5 + 0.5 * v / self.hi)
-        return (v - self.lo) / (self.hi - self.lo)
+        return positions(self.kind, values, self.lo, self.hi)
 
     def ticks(self, count: int = 5) -> np.ndarray:
         """``count`` (odd) tick values at evenly spaced colour positions, lo first; zero is one of them."""
@@ -82,6 +78,16 @@ class ColourRange:
         if v.size == 0:
             return 0.0
         return float((min(v.max(), self.hi) - max(v.min(), self.lo)) / (self.hi - self.lo))
+
+
+def positions(kind: ScaleKind, values: np.ndarray, lo, hi) -> np.ndarray:
+    """:meth:`ColourRange.position` with ``lo`` and ``hi`` that may be arrays broadcast against ``values``
+    (one range per frame of a batch): the same element-wise arithmetic, hence the same numbers."""
+    v = np.asarray(values, dtype=np.float64)
+    if kind == "signed":
+        with np.errstate(invalid="ignore"):
+            return np.where(v < 0.0, 0.5 - 0.5 * v / lo, 0.5 + 0.5 * v / hi)
+    return (v - lo) / (hi - lo)
 
 
 def nice_floor_negative(x: float) -> float:
@@ -137,6 +143,44 @@ class RangeTracker:
             if fitted != r:
                 self.current, self.changes = fitted, self.changes + 1
         return self.current
+
+    def follow(self, frames: np.ndarray) -> tuple[list[ColourRange], np.ndarray, np.ndarray]:
+        """:meth:`update` on each row of ``frames`` (F, ...) in turn: the range of every frame, and its
+        cells below and above that range (as :meth:`ColourRange.outside`), (F,) int each.
+
+        The same ranges as F calls of ``update``, but both rules are checked on all the frames a range
+        holds for at once: a batch costs a few numpy calls per refit instead of a dozen per frame.
+        """
+        v = np.asarray(frames, dtype=np.float64).reshape(len(frames), -1)
+        n_frames = len(v)
+        finite = np.isfinite(v)
+        defined = finite.sum(axis=1)
+        budget = np.floor(OUTSIDE_SHARE * defined)
+        top = np.where(finite, v, -np.inf).max(axis=1, initial=-np.inf)
+        bottom = np.where(finite, v, np.inf).min(axis=1, initial=np.inf)
+        ranges: list[ColourRange] = []
+        below = np.zeros(n_frames, dtype=np.int64)
+        above = np.zeros(n_frames, dtype=np.int64)
+        k = 0
+        while k < n_frames:
+            r = self.current
+            if r is not None:  # the frames from k on that keep both rules with r
+                lo_count = ((v[k:] < r.lo) & finite[k:]).sum(axis=1)
+                hi_count = ((v[k:] > r.hi) & finite[k:]).sum(axis=1)
+                with np.errstate(invalid="ignore"):  # frames without a defined cell: inf − inf
+                    span = (np.minimum(top[k:], r.hi) - np.maximum(bottom[k:], r.lo)) / (r.hi - r.lo)
+                holds = (lo_count + hi_count <= budget[k:]) & ((defined[k:] == 0) | (span >= MIN_SPAN))
+                held = int(np.argmin(holds)) if not holds.all() else len(holds)
+                ranges += [r] * held
+                below[k : k + held], above[k : k + held] = lo_count[:held], hi_count[:held]
+                k += held
+                if k == n_frames:
+                    break
+            r = self.update(v[k])  # a frame that breaks a rule (or the first one): refitted
+            ranges.append(r)
+            below[k], above[k], _ = r.outside(v[k])
+            k += 1
+        return ranges, below, above
 
     def _holds(self, r: ColourRange, values: np.ndarray) -> bool:
         below, above, defined = r.outside(values)

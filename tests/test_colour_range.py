@@ -77,3 +77,29 @@ def test_map_positions_marks_below_and_above():
     assert list(colors) == [cm.UNDER_RGBA, lut[0], lut[-1], cm.OVER_RGBA, cm.NAN_RGBA]
     assert cm.UNDER_RGBA not in lut and cm.OVER_RGBA not in lut and cm.NAN_RGBA not in lut
     assert math.isclose(cm.unpack_rgba(lut[-1])[:3].mean(), 251, abs_tol=5)  # zero is near white
+
+
+@pytest.mark.parametrize("kind", ["signed", "negative", "positive"])
+def test_follow_gives_the_ranges_and_counts_of_update_frame_by_frame(kind):
+    """``follow`` on a batch = ``update`` on each frame in turn (ranges, refits, outside counts), with
+    refits, frames without a defined cell and a range carried over from the previous batch."""
+    rng = np.random.default_rng(3)
+    amplitude = np.r_[np.geomspace(1.0, 50.0, 30), np.full(10, 50.0), np.geomspace(50.0, 0.5, 30)]
+    frames = amplitude[:, None] * rng.standard_normal((amplitude.size, 40))
+    frames = {"signed": frames, "negative": -np.abs(frames), "positive": np.abs(frames)}[kind]
+    frames[:, 7] = np.nan
+    frames[12] = np.nan  # a frame with no defined cell
+    frames[20, :3] = 1e3 * np.sign(frames[20, :3])  # outliers
+    one, batch = RangeTracker(kind, floor=1e-6), RangeTracker(kind, floor=1e-6)
+    expected = [one.update(v) for v in frames]
+    counts = [r.outside(v)[:2] for r, v in zip(expected, frames)]
+    ranges, below, above = [], [], []
+    for part in (frames[:25], frames[25:]):  # two batches: the second starts from the first's range
+        r, b, a = batch.follow(part)
+        ranges += r
+        below += b.tolist()
+        above += a.tolist()
+    assert ranges == expected
+    assert list(zip(below, above)) == counts
+    assert batch.changes == one.changes >= 3
+    assert batch.current == one.current

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import importlib.metadata
 import platform
+import re
 from typing import Final
 
 import numpy as np
@@ -120,7 +121,9 @@ def legend_markdown(force_scale: float | None, block_height: float, magnify: flo
     )
 
 
-_SAFE_EXTRA: Final = frozenset("–—‘’“”…·•×−≤≥≈°±²³µ√∞→✓∑ΔΣ")
+_SAFE_EXTRA: Final = "–—‘’“”…·•×−≤≥≈°±²³µ√∞→✓∑ΔΣ"
+_UNSAFE: Final = re.compile(f"[^\n\t\x20-\x7e\xa0-\u017f\u0370-\u045f{_SAFE_EXTRA}]")
+"""One character the viewer's font may lack (the complement of the kept ranges and signs)."""
 
 
 def viewer_safe_text(text: str) -> str:
@@ -130,12 +133,7 @@ def viewer_safe_text(text: str) -> str:
     e.g. "∝" or CJK, in a document, label or hover text. Kept: ASCII, Latin-1, Latin Extended-A, Greek,
     basic Cyrillic and a few punctuation and math signs checked in the headless viewer.
     """
-
-    def ok(c: str) -> bool:
-        o = ord(c)
-        return c in "\n\t" or 0x20 <= o < 0x7F or 0xA0 <= o < 0x180 or 0x370 <= o < 0x460 or c in _SAFE_EXTRA
-
-    return "".join(c if ok(c) else "?" for c in text)
+    return _UNSAFE.sub("?", text)
 
 
 def _flatten(d: dict, prefix: str = "") -> list[tuple[str, str]]:

@@ -37,7 +37,7 @@ import pyarrow as pa
 import rerun as rr
 
 from masonrycli.colormap import map_positions, nice_ceil, robust_max_abs, tick_label
-from masonrycli.colour_range import RangeTracker
+from masonrycli.colour_range import RangeTracker, positions
 from masonrycli.frame import Frame
 from masonrycli.joint_forces import joint_resultants
 from masonrycli.recording.arrays import FrameBatch, Polygons, partition_lengths, time_indexes, z0
@@ -148,6 +148,7 @@ class Recorder:
         # (N,) m: a glyph never reaches out of its own block (thin cut spandrel blocks of the aqueduct)
         self._glyph_cap = np.minimum(self._glyph_length, GLYPH_HALF_LENGTH * size.min(axis=1))[: self._n]
         self._trackers = {f.key: RangeTracker(f.kind, f.floor) for f in FIELDS}
+        self._labels: dict[tuple[str, object], list[str]] = {}  # (field, range) -> tick labels
         self.field_ranges: dict[str, tuple[float, float]] = {}
         """The range each field has at the last frame sent."""
         self.force_scale: float | None = None
@@ -367,21 +368,27 @@ class Recorder:
 
     def _colour_field(self, f: FieldSpec, values: np.ndarray):
         """Per frame: the range (tracked), block colours (F, N), legend labels, range ends (F,) each."""
-        n_frames = len(values)
-        colors = np.empty(values.shape, dtype=np.uint32)
+        ranges, below, above = self._trackers[f.key].follow(values)
+        lo = np.array([r.lo for r in ranges])
+        hi = np.array([r.hi for r in ranges])
+        per_frame = (-1,) + (1,) * (values.ndim - 1)
+        colors = map_positions(positions(f.kind, values, lo.reshape(per_frame), hi.reshape(per_frame)), LUTS[f.kind])
+        title = viewer_safe_text(f.title)
         labels: list[str] = []
-        lo, hi = np.empty(n_frames), np.empty(n_frames)
-        tracker = self._trackers[f.key]
-        for k in range(n_frames):  # a few numpy calls per frame; ranges depend on the frames before
-            r = tracker.update(values[k])
-            colors[k] = map_positions(r.position(values[k]), LUTS[f.kind])
-            below, above, _ = r.outside(values[k])
-            span = max(-r.lo, r.hi)
-            labels += [tick_label(v, f.unit, span, f.kind == "signed") for v in r.ticks(TICKS)]
-            labels += [viewer_safe_text(f.title), f"{below} below" if below else "", f"{above} above" if above else ""]
-            lo[k], hi[k] = r.lo, r.hi
+        for r, n_below, n_above in zip(ranges, below.tolist(), above.tolist()):
+            labels += self._tick_labels(f, r)
+            labels += [title, f"{n_below} below" if n_below else "", f"{n_above} above" if n_above else ""]
         self.field_ranges[f.key] = (float(lo[-1]), float(hi[-1]))
         return colors, labels, lo, hi
+
+    def _tick_labels(self, f: FieldSpec, r) -> list[str]:
+        """The legend's tick labels of range ``r`` (a range holds for many frames: made once per range)."""
+        labels = self._labels.get((f.key, r))
+        if labels is None:
+            span = max(-r.lo, r.hi)
+            labels = [tick_label(v, f.unit, span, f.kind == "signed") for v in r.ticks(TICKS)]
+            self._labels[(f.key, r)] = labels
+        return labels
 
     def _send_supports(self, idx: list, support_q: np.ndarray) -> None:
         poly, n_frames = self._supports, len(support_q)
