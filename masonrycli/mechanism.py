@@ -25,14 +25,14 @@ A joint is **hinged** when exactly one of its current contact points carries nor
 its other end has opened by more than ``OPENING``, and it carries at least ``LOAD_FRACTION`` × the
 mean block weight (nearly unloaded joints are not reported).
 
-All vectorised with numpy (no Python loop over joints, ends or contacts).
+The loops over ends, joints and contacts are the kernels of :mod:`masonrycli.engine.joints`.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from masonrycli.frame import CONTACT_OPEN, CONTACT_SLIP, CONTACT_STICK
+from masonrycli.engine import joints as _kernels
 
 SLIP_SPEED = 1e-3
 """m/s: a contact at the friction limit is reported as slipping only when its faces slide faster than
@@ -51,9 +51,7 @@ JOINT_FIELDS = {
 
 def reported_status(status: np.ndarray, tangential_velocity: np.ndarray) -> np.ndarray:
     """(C,) int8: the solver's contact status with slip kept only where |u_t| > ``SLIP_SPEED``."""
-    out = np.array(status, dtype=np.int8, copy=True)
-    out[(out == CONTACT_SLIP) & (np.abs(tangential_velocity) <= SLIP_SPEED)] = CONTACT_STICK
-    return out
+    return contact_states(status, tangential_velocity, np.zeros((len(status), 2)), 0.0)[0]
 
 
 def mobilised_friction(contact_r: np.ndarray, status: np.ndarray, friction: float) -> np.ndarray:
@@ -61,16 +59,16 @@ def mobilised_friction(contact_r: np.ndarray, status: np.ndarray, friction: floa
 
     ``contact_r`` (C, 2) holds the local impulses (r_t, r_n); ``friction`` is the Coulomb coefficient μ.
     """
-    closed = status != CONTACT_OPEN
-    out = np.zeros(status.shape[0])
-    denom = friction * contact_r[closed, 1]
-    out[closed] = np.divide(np.abs(contact_r[closed, 0]), denom, out=np.zeros(denom.size), where=denom > 0)
-    return out
+    # Only open / closed matters here, which the tangential speed (0 here) never changes.
+    return contact_states(status, np.zeros(len(status)), contact_r, friction)[1]
 
 
-def _rotate(theta: np.ndarray, xy: np.ndarray) -> np.ndarray:
-    c, s = np.cos(theta), np.sin(theta)
-    return np.stack([c * xy[:, 0] - s * xy[:, 1], s * xy[:, 0] + c * xy[:, 1]], axis=1)
+def contact_states(status, tangential_velocity, contact_r, friction: float) -> tuple[np.ndarray, np.ndarray]:
+    """(:func:`reported_status`, :func:`mobilised_friction` of that status) in one pass."""
+    status = np.ascontiguousarray(status, dtype=np.int8)
+    ut = np.ascontiguousarray(tangential_velocity, dtype=np.float64)
+    r = np.ascontiguousarray(contact_r, dtype=np.float64).reshape(-1, 2)
+    return _kernels.contact_states(status, ut, r, friction, SLIP_SPEED)
 
 
 class JointTracker:
@@ -94,12 +92,12 @@ class JointTracker:
         body = np.asarray(contact_body, dtype=np.int64).reshape(-1, 2)
         self.block_count = int(block_count)
         self.body_count = int(body_q0.shape[0])
-        self.end_body = body
+        self.end_body = np.ascontiguousarray(body)
         """(E, 2) bodies a, b of each joint end."""
         q0 = np.asarray(body_q0)
         # Material points and normal in the bodies' frames (θ = 0 initially, so only a translation).
-        self._local_a = np.asarray(contact_point) - q0[body[:, 0], :2]
-        self._local_b = np.asarray(contact_point) - q0[body[:, 1], :2]
+        self._local_a = np.ascontiguousarray(np.asarray(contact_point) - q0[body[:, 0], :2])
+        self._local_b = np.ascontiguousarray(np.asarray(contact_point) - q0[body[:, 1], :2])
         self._normal0 = np.asarray(contact_normal, dtype=np.float64).copy()
         self._gap0 = np.asarray(contact_gap, dtype=np.float64).copy()
         key = body[:, 0] * self.body_count + body[:, 1]
@@ -110,65 +108,42 @@ class JointTracker:
         self.joint_body = np.stack([self.key // self.body_count, self.key % self.body_count], axis=1)
         """(J, 2) bodies a < b of each joint."""
         joint_of_pair = np.cumsum(is_joint) - 1
-        self._end_joint = np.where(is_joint[inverse], joint_of_pair[inverse], -1)
+        self._end_joint = np.ascontiguousarray(np.where(is_joint[inverse], joint_of_pair[inverse], -1), dtype=np.int64)
         self.min_force = LOAD_FRACTION * mean_block_weight
 
     def opening(self, body_q: np.ndarray) -> np.ndarray:
         """(E,) m: opening of every joint end in configuration ``body_q`` (B, 3)."""
-        a, b = self.end_body[:, 0], self.end_body[:, 1]
-        xa = body_q[a, :2] + _rotate(body_q[a, 2], self._local_a)
-        xb = body_q[b, :2] + _rotate(body_q[b, 2], self._local_b)
-        n = _rotate(body_q[a, 2], self._normal0)
-        return np.einsum("ij,ij->i", xb - xa, n) + self._gap0
+        q = np.ascontiguousarray(body_q, dtype=np.float64)
+        return _kernels.openings(q, self.end_body, self._local_a, self._local_b, self._normal0, self._gap0)
 
-    def block_fields(self, body_q, contact_body, contact_r, contact_status) -> dict[str, np.ndarray]:
-        """``JOINT_FIELDS`` for configuration ``body_q`` and the current contacts (impulses r = (r_t, r_n))."""
-        n = self.block_count
+    def block_fields(self, body_q, contact_body, contact_r, contact_status, opening=None) -> dict[str, np.ndarray]:
+        """``JOINT_FIELDS`` for configuration ``body_q`` and the current contacts (impulses r = (r_t, r_n)).
+        ``opening``: :meth:`opening` of ``body_q`` if already computed."""
         # Only the ends of joints: a corner-to-corner contact has no face whose opening could be read,
         # and its normal may lie along a face that slides (the slip would be counted as opening).
-        opening = np.maximum(self.opening(body_q), 0.0)
-        max_opening = np.zeros(n)
-        in_joint = self._end_joint >= 0
-        for side in range(2):
-            owner = self.end_body[:, side]
-            blocks = (owner < n) & in_joint
-            np.maximum.at(max_opening, owner[blocks], opening[blocks])
-        rn = np.asarray(contact_r)[:, 1]
-        closed = np.where(contact_status != CONTACT_OPEN, rn, 0.0)
-        sliding = np.where(contact_status == CONTACT_SLIP, rn, 0.0)
-        load = np.zeros(n)
-        slide = np.zeros(n)
-        for side in range(2):
-            owner = np.asarray(contact_body)[:, side]
-            blocks = owner < n
-            load += np.bincount(owner[blocks], weights=closed[blocks], minlength=n)
-            slide += np.bincount(owner[blocks], weights=sliding[blocks], minlength=n)
-        ratio = np.divide(slide, load, out=np.zeros(n), where=load > 0)
+        opening = self.opening(body_q) if opening is None else opening
+        body = np.ascontiguousarray(contact_body, dtype=np.int64).reshape(-1, 2)
+        status = np.ascontiguousarray(contact_status, dtype=np.int8)
+        max_opening, ratio = _kernels.block_fields(
+            opening, self.end_body, self._end_joint, self.block_count, body, np.asarray(contact_r)[:, 1], status
+        )
         return {"block_sliding_ratio": ratio, "block_max_opening": max_opening}
 
-    def hinged(self, body_q, contact_body, contact_rn, dt: float) -> np.ndarray:
-        """(J,) bool: which joints are hinged (one end carries all the normal force, the other is open)."""
-        j = self.key.size
-        if j == 0:
+    def hinged(self, body_q, contact_body, contact_rn, dt: float, opening=None) -> np.ndarray:
+        """(J,) bool: which joints are hinged (one end carries all the normal force, the other is open).
+        ``opening``: :meth:`opening` of ``body_q`` if already computed."""
+        if self.key.size == 0:
             return np.zeros(0, dtype=bool)
-        # The joint's widest opening over its ends.
-        opening = self.opening(body_q)
-        joint_end = self._end_joint >= 0
-        widest = np.full(j, -np.inf)
-        np.maximum.at(widest, self._end_joint[joint_end], opening[joint_end])
-        # Loaded current contact points per joint, and the joint's normal force.
-        key = self._pair_key(contact_body)
-        pos = np.minimum(np.searchsorted(self.key, key), j - 1)
-        member = self.key[pos] == key
-        idx = pos[member]
-        force = np.asarray(contact_rn)[member] / dt
-        loaded = force > 0.0
-        n_loaded = np.bincount(idx, weights=loaded, minlength=j)
-        total = np.bincount(idx, weights=np.where(loaded, force, 0.0), minlength=j)
-        return (n_loaded == 1) & (widest > OPENING) & (total >= self.min_force)
+        opening = self.opening(body_q) if opening is None else opening
+        body = np.ascontiguousarray(contact_body, dtype=np.int64).reshape(-1, 2)
+        return _kernels.hinged(
+            opening, self._end_joint, self.key, self.body_count, body, contact_rn, dt, OPENING, self.min_force
+        )
 
     def hinge_points(self, contact_body, contact_point, contact_rn, hinged) -> np.ndarray:
         """(H, 2) m: the loaded contact points of the hinged joints (the hinges themselves)."""
+        if not np.any(hinged):  # the usual case, and np.isin is most of the cost
+            return np.zeros((0, 2))
         loaded = (np.asarray(contact_rn) > 0) & np.isin(self._pair_key(contact_body), self.key[hinged])
         return np.asarray(contact_point)[loaded].copy()
 

@@ -20,7 +20,7 @@ from masonrycli.engine.solver import Solver, StepStats
 from masonrycli.frame import Frame
 from masonrycli.intensity import describe as describe_intensity
 from masonrycli.intensity import intensity_measures, shaking_support
-from masonrycli.mechanism import JointTracker, mobilised_friction, reported_status
+from masonrycli.mechanism import JointTracker, contact_states
 from masonrycli.model import Model, State, build_model, initial_state
 from masonrycli.sinks import COMPLETED, DIVERGED, FAILED, INTERRUPTED
 from masonrycli.tensors import TensorComputer, build_triangles, chain_neighbours
@@ -128,13 +128,16 @@ class Simulation:
             c = self.last.contact_count
             body, point, normal = s.contact_body, s.contact_point, s.contact_normal
             force, gap = s.contact_force, s.contact_gap
-            status = reported_status(s.contact_status, s.contact_tangential_velocity(st.body_v))
             r = s.contact_r
-            mobilised = mobilised_friction(r, status, m.friction)
+            status, mobilised = contact_states(
+                s.contact_status, s.contact_tangential_velocity(st.body_v), r, m.friction
+            )
             support_force = s.support_force
             iterations, residual = self.last.iterations, self.last.residual
-            hinged, hinge_point = self.hinges()
-        joint_fields = self.joints.block_fields(st.body_q, body, r, status)
+        opening = self.joints.opening(st.body_q)  # once for both: the hinges and the block fields
+        if self.last is not None:
+            hinged, hinge_point = self.hinges(opening)
+        joint_fields = self.joints.block_fields(st.body_q, body, r, status, opening)
         support_q = st.body_q[n:].copy()
         return Frame(
             step=st.step,
@@ -165,10 +168,11 @@ class Simulation:
             nlgs_unconverged=self.unconverged,
         )
 
-    def hinges(self) -> tuple[np.ndarray, np.ndarray]:
-        """(J,) hinged flags of the joints after the last step, and (H, 2) the hinge points."""
+    def hinges(self, opening: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """(J,) hinged flags of the joints after the last step, and (H, 2) the hinge points (``opening``:
+        the joint ends' openings in the current state, if already computed)."""
         s = self.solver
-        hinged = self.joints.hinged(self.state.body_q, s.contact_body, s.contact_r[:, 1], self.model.dt)
+        hinged = self.joints.hinged(self.state.body_q, s.contact_body, s.contact_r[:, 1], self.model.dt, opening)
         return hinged, self.joints.hinge_points(s.contact_body, s.contact_point, s.contact_r[:, 1], hinged)
 
     def diverged(self) -> str:

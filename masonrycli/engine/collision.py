@@ -23,9 +23,19 @@ from typing import NamedTuple
 
 import numpy as np
 
-from .broadphase import PairBuffers, body_aabbs, candidate_pairs, world_vertices
+from ._arrays import check_array
+from ._jit import njit
+from .broadphase import (
+    PairBuffers,
+    _body_aabbs,
+    _sweep_and_prune,
+    _world_vertices,
+    body_aabbs,
+    candidate_pairs,
+    world_vertices,
+)
 from .contact_key import check_topology, decode_contact_key
-from .narrowphase import edge_normals, narrowphase
+from .narrowphase import _edge_normals, _narrowphase, edge_normals, narrowphase
 
 __all__ = ["ContactBuffers", "Contacts", "decode_contact_key", "detect_contacts", "world_vertices"]
 
@@ -93,8 +103,12 @@ class ContactBuffers:
             contact_capacity = 2 * self.pairs.pair_capacity
         self._allocate_contacts(max(int(contact_capacity), 2))
         self.contact_count = 0
+        self._checked_inputs: tuple = ()
+        """(vert_local, body_dynamic, body_vert_start) the launchers last checked against these arrays."""
+        self._checked_pairs = None  # the pair array of that check (candidate_pairs may replace it)
 
     def _allocate_contacts(self, capacity: int) -> None:
+        self._checked_inputs = ()  # new arrays: the next call checks them again
         self.contact_body = np.zeros((capacity, 2), dtype=np.int32)
         self.contact_point = np.zeros((capacity, 2), dtype=np.float64)
         self.contact_normal = np.zeros((capacity, 2), dtype=np.float64)
@@ -163,14 +177,36 @@ def detect_contacts(body_q, body_vert_start, vert_local, body_dynamic, alert, bu
     if body_vert_start is not buffers._checked_vert_start:
         check_topology(body_vert_start)
         buffers._checked_vert_start = body_vert_start
-    # Shapes and dtypes are checked by the launchers, against the buffers' arrays.
-    if not np.isfinite(body_q).all():
-        bad = int(np.flatnonzero(~np.isfinite(body_q).all(axis=1))[0])
-        raise FloatingPointError(f"detect_contacts: body {bad} has a non-finite pose {body_q[bad]}")
     alert = float(alert)
     if not alert >= 0.0:
         raise ValueError(f"detect_contacts: alert distance must be >= 0, got {alert}")
-
+    checked = buffers._checked_inputs
+    if (
+        len(checked) == 3
+        and checked[0] is vert_local
+        and checked[1] is body_dynamic
+        and checked[2] is body_vert_start
+        and buffers.pairs.pair_body is buffers._checked_pairs
+    ):
+        # The same model and buffers as the last call, checked then: one kernel call does it all.
+        check_array("world_vertices", "body_q", body_q, (buffers.body_count, 3), np.float64)
+        pairs = buffers.pairs
+        pair_count, n = _detect(
+            body_q, body_vert_start, vert_local, body_dynamic, alert,
+            buffers.vert_world, buffers.body_aabb, pairs.axis, pairs.body_order, pairs.pair_body,
+            pairs.pair_scratch, pairs.body_counter, buffers.edge_normal, buffers.body_size,
+            buffers.contact_body, buffers.contact_point, buffers.contact_normal, buffers.contact_gap,
+            buffers.contact_key,
+        )  # fmt: skip
+        if n >= 0:
+            pairs.pair_count = pair_count
+            buffers.contact_count = n
+            return n
+        if pair_count < 0:
+            _raise_non_finite(body_q)
+    # First call, other arrays, or a capacity exceeded: stage by stage through the checking launchers.
+    if not np.isfinite(body_q).all():
+        _raise_non_finite(body_q)
     world_vertices(body_q, body_vert_start, vert_local, buffers.vert_world)
     body_aabbs(buffers.vert_world, body_vert_start, alert, buffers.body_aabb)
     pair_count = candidate_pairs(buffers.body_aabb, body_dynamic, buffers.pairs)
@@ -184,4 +220,39 @@ def detect_contacts(body_q, body_vert_start, vert_local, body_dynamic, alert, bu
         buffers.contact_key,
     )  # fmt: skip
     buffers.contact_count = n
+    buffers._checked_inputs = (vert_local, body_dynamic, body_vert_start)
+    buffers._checked_pairs = buffers.pairs.pair_body
     return n
+
+
+def _raise_non_finite(body_q) -> None:
+    bad = int(np.flatnonzero(~np.isfinite(body_q).all(axis=1))[0])
+    raise FloatingPointError(f"detect_contacts: body {bad} has a non-finite pose {body_q[bad]}")
+
+
+@njit
+def _detect(
+    body_q, body_vert_start, vert_local, body_dynamic, alert,
+    vert_world, body_aabb, axis, body_order, pair_body, pair_scratch, counter, edge_normal, body_size,
+    contact_body, contact_point, contact_normal, contact_gap, contact_key,
+):  # fmt: skip
+    # The stages of detect_contacts in one call (each a kernel of .broadphase / .narrowphase):
+    #   any pose not finite                                  → (-1, -1)
+    #   world vertices, boxes grown by alert/2, sweep and prune → P pairs
+    #   P beyond the pair capacity or 2P beyond the contact capacity → (P, -1): the launcher grows
+    #   edge normals, narrow phase                           → (P, C)
+    for b in range(body_q.shape[0]):
+        for k in range(3):
+            if not np.isfinite(body_q[b, k]):
+                return -1, -1
+    _world_vertices(body_q, body_vert_start, vert_local, vert_world)
+    _body_aabbs(vert_world, body_vert_start, 0.5 * alert, body_aabb)
+    pair_count = _sweep_and_prune(body_aabb, body_dynamic, axis, body_order, pair_body, pair_scratch, counter)
+    if pair_count > pair_body.shape[0] or 2 * pair_count > contact_gap.shape[0]:
+        return pair_count, -1
+    _edge_normals(vert_world, body_vert_start, edge_normal, body_size)
+    n = _narrowphase(
+        vert_world, edge_normal, body_size, body_vert_start, pair_body, pair_count, alert,
+        contact_body, contact_point, contact_normal, contact_gap, contact_key,
+    )  # fmt: skip
+    return pair_count, n

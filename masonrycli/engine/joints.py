@@ -1,0 +1,154 @@
+"""Kernels of the joint states (:mod:`masonrycli.mechanism`): openings, hinge flags, per-block fields.
+
+They are computed for every recorded frame. In numpy each was a dozen small array operations (fancy
+indexing, ``ufunc.at``, ``bincount``), ~200 µs a frame on the 51-block wall; one pass here does the
+same arithmetic in the same order, so the results are the same bits: ``(0 + p₀) + p₁`` is how
+``einsum`` sums a two-term dot product, bins start at 0 and add their weights in contact order as
+``bincount`` does, and maxima propagate NaN as ``np.maximum``.
+
+Conventions as in :mod:`masonrycli.mechanism`: a joint *end* is an initial contact point followed with
+its two bodies; ``end_joint[e]`` is the joint of end e (−1 for a single corner contact); joint keys are
+``a·B + b`` (B bodies), sorted.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from masonrycli.engine._jit import njit
+from masonrycli.engine.contact import ContactStatus
+
+_OPEN, _STICK, _SLIP = int(ContactStatus.OPEN), int(ContactStatus.STICK), int(ContactStatus.SLIP)
+
+
+@njit
+def _openings(body_q, end_body, local_a, local_b, normal0, gap0, out):
+    # for each end e between bodies a and b:
+    #     X_a = x_a + R(θ_a)·local_a[e],  X_b = x_b + R(θ_b)·local_b[e],  n = R(θ_a)·normal0[e]
+    #     out[e] = (X_b − X_a)·n + gap0[e]
+    for e in range(end_body.shape[0]):
+        a = end_body[e, 0]
+        b = end_body[e, 1]
+        ca = math.cos(body_q[a, 2])
+        sa = math.sin(body_q[a, 2])
+        cb = math.cos(body_q[b, 2])
+        sb = math.sin(body_q[b, 2])
+        xax = body_q[a, 0] + (ca * local_a[e, 0] - sa * local_a[e, 1])
+        xay = body_q[a, 1] + (sa * local_a[e, 0] + ca * local_a[e, 1])
+        xbx = body_q[b, 0] + (cb * local_b[e, 0] - sb * local_b[e, 1])
+        xby = body_q[b, 1] + (sb * local_b[e, 0] + cb * local_b[e, 1])
+        nx = ca * normal0[e, 0] - sa * normal0[e, 1]
+        ny = sa * normal0[e, 0] + ca * normal0[e, 1]
+        out[e] = ((0.0 + (xbx - xax) * nx) + (xby - xay) * ny) + gap0[e]
+
+
+@njit
+def _nan_max(x, y):
+    # np.maximum's rule: x if x ≥ y or x is NaN, else y (so NaN from either side).
+    return x if x >= y or x != x else y
+
+
+@njit
+def _hinged(opening, end_joint, key, body_count, contact_body, contact_rn, dt, opening_limit, min_force, out):
+    # widest[j] = max opening over the ends of joint j
+    # for each current contact c of a joint j (its pair key found in `key`), with F = r_n / dt:
+    #     loaded[j] += 1 if F > 0;  total[j] += F if F > 0 else 0
+    # out[j] = exactly one loaded contact, widest > opening_limit, total ≥ min_force
+    j_count = key.shape[0]
+    widest = np.full(j_count, -np.inf)
+    for e in range(opening.shape[0]):
+        j = end_joint[e]
+        if j >= 0:
+            widest[j] = _nan_max(widest[j], opening[e])
+    loaded = np.zeros(j_count)
+    total = np.zeros(j_count)
+    for c in range(contact_body.shape[0]):
+        k = np.int64(contact_body[c, 0]) * body_count + contact_body[c, 1]
+        pos = min(np.searchsorted(key, k), j_count - 1)
+        if key[pos] != k:
+            continue
+        force = contact_rn[c] / dt
+        if force > 0.0:
+            loaded[pos] += 1.0
+            total[pos] += force
+        else:
+            total[pos] += 0.0
+    for j in range(j_count):
+        out[j] = loaded[j] == 1.0 and widest[j] > opening_limit and total[j] >= min_force
+
+
+@njit
+def _block_fields(opening, end_body, end_joint, block_count, contact_body, contact_rn, status, out_opening, out_ratio):
+    # out_opening[k] = max(0, largest opening of the ends of k's joints)    (0 without any)
+    # out_ratio[k]   = Σ r_n of k's slipping contacts / Σ r_n of its closed contacts (0 if none)
+    # Sums per side of the contact, as two bincounts added to zeros.
+    for k in range(block_count):
+        out_opening[k] = 0.0
+    for side in range(2):
+        for e in range(opening.shape[0]):
+            owner = end_body[e, side]
+            if owner < block_count and end_joint[e] >= 0:
+                out_opening[owner] = _nan_max(out_opening[owner], _nan_max(opening[e], 0.0))
+    load = np.zeros((2, block_count))
+    slide = np.zeros((2, block_count))
+    for side in range(2):
+        for c in range(contact_body.shape[0]):
+            owner = contact_body[c, side]
+            if owner < block_count:
+                load[side, owner] += contact_rn[c] if status[c] != _OPEN else 0.0
+                slide[side, owner] += contact_rn[c] if status[c] == _SLIP else 0.0
+    for k in range(block_count):
+        total = (0.0 + load[0, k]) + load[1, k]
+        sliding = (0.0 + slide[0, k]) + slide[1, k]
+        out_ratio[k] = sliding / total if total > 0.0 else 0.0
+
+
+@njit
+def _contact_states(status, tangential_velocity, contact_r, friction, slip_speed, out_status, out_mobilised):
+    # reported status: slip only where |u_t| > slip_speed (else stick)
+    # mobilised friction: |r_t| / (μ r_n) on closed contacts where μ r_n > 0, else 0
+    for c in range(status.shape[0]):
+        s = status[c]
+        if s == _SLIP and abs(tangential_velocity[c]) <= slip_speed:
+            s = _STICK
+        out_status[c] = s
+        denom = friction * contact_r[c, 1]
+        out_mobilised[c] = abs(contact_r[c, 0]) / denom if s != _OPEN and denom > 0.0 else 0.0
+
+
+def openings(body_q, end_body, local_a, local_b, normal0, gap0) -> np.ndarray:
+    """(E,) m: opening of every joint end (``end_body`` (E, 2) int64, the other arrays (E, 2) / (E,)
+    float64 in the bodies' frames) in configuration ``body_q`` (B, 3)."""
+    out = np.empty(end_body.shape[0])
+    _openings(body_q, end_body, local_a, local_b, normal0, gap0, out)
+    return out
+
+
+def hinged(opening, end_joint, key, body_count, contact_body, contact_rn, dt, opening_limit, min_force) -> np.ndarray:
+    """(J,) bool: joints with exactly one loaded current contact (r_n > 0), an end opened by more than
+    ``opening_limit`` (m), and a normal force (N) of at least ``min_force``."""
+    out = np.zeros(key.shape[0], dtype=np.bool_)
+    if key.shape[0] == 0:
+        return out
+    rn = np.ascontiguousarray(contact_rn, dtype=np.float64)
+    _hinged(opening, end_joint, key, body_count, contact_body, rn, float(dt), opening_limit, min_force, out)
+    return out
+
+
+def block_fields(opening, end_body, end_joint, block_count, contact_body, contact_rn, status):
+    """((N,) largest joint opening ≥ 0 (m), (N,) share of the normal load carried by slipping contacts)."""
+    max_opening = np.empty(block_count)
+    ratio = np.empty(block_count)
+    rn = np.ascontiguousarray(contact_rn, dtype=np.float64)
+    _block_fields(opening, end_body, end_joint, block_count, contact_body, rn, status, max_opening, ratio)
+    return max_opening, ratio
+
+
+def contact_states(status, tangential_velocity, contact_r, friction: float, slip_speed: float):
+    """((C,) int8 reported status, (C,) mobilised friction) of the solver's contacts (mechanism module)."""
+    out_status = np.empty(status.shape[0], dtype=np.int8)
+    mobilised = np.empty(status.shape[0])
+    _contact_states(status, tangential_velocity, contact_r, float(friction), float(slip_speed), out_status, mobilised)
+    return out_status, mobilised
