@@ -44,32 +44,43 @@ class JointResultants(NamedTuple):
     """(J, 2) N: resultant force on body b (body a gets −force)."""
     state: np.ndarray
     """(J,) int8: JOINT_STICK, JOINT_SLIP or JOINT_OPEN."""
+    frame: np.ndarray | None = None
+    """(J,) int64: the frame of each joint, when the contacts of several frames were passed at once."""
 
 
-def joint_resultants(contact_body, contact_point, contact_normal, contact_force, contact_status) -> JointResultants:
+def joint_resultants(
+    contact_body, contact_point, contact_normal, contact_force, contact_status, contact_frame=None
+) -> JointResultants:
     """Resultant of each joint at its point of application (module docstring); rows sorted by (a, b).
 
     Args:
         contact_body: (C, 2) int bodies (a, b) of each contact; contact_point (C, 2) m; contact_normal
             (C, 2) unit, from a to b; contact_force (C, 2) N on body b; contact_status (C,) int
             (``masonrycli.frame`` CONTACT_*).
+        contact_frame: (C,) int ≥ 0, optional: the frame of each contact, for the contacts of several
+            frames at once (a recording's batch). The joints are then those of (frame, a, b), rows sorted
+            by (frame, a, b), ``frame`` says which; each frame's rows are what it alone would give.
     """
     body = np.asarray(contact_body, dtype=np.int64).reshape(-1, 2)
     point = np.asarray(contact_point, dtype=np.float64).reshape(-1, 2)
     normal = np.asarray(contact_normal, dtype=np.float64).reshape(-1, 2)
     force = np.asarray(contact_force, dtype=np.float64).reshape(-1, 2)
     status = np.asarray(contact_status).reshape(-1)
+    frame = np.zeros(len(status), np.int64) if contact_frame is None else np.asarray(contact_frame, np.int64)
     keep = body[:, 0] != body[:, 1]  # a body against itself is no joint
     body, point, normal, force, status = body[keep], point[keep], normal[keep], force[keep], status[keep]
+    frame = frame[keep]
     # Orient every contact as (low, high) body: the force on the higher index flips with the order.
     flip = body[:, 0] > body[:, 1]
     sign = np.where(flip, -1.0, 1.0)[:, None]
     lo, hi = np.minimum(body[:, 0], body[:, 1]), np.maximum(body[:, 0], body[:, 1])
     force, normal = force * sign, normal * sign
     base = int(hi.max()) + 1 if hi.size else 1
-    keys, joint = np.unique(lo * base + hi, return_inverse=True)  # 1-D keys: far faster than rows
+    # 1-D keys (far faster than rows), sorted by (frame, a, b); sums per joint then run over its
+    # contacts in their order whatever the other frames, so a frame's numbers do not depend on them.
+    keys, joint = np.unique((frame * base + lo) * base + hi, return_inverse=True)
     joint = joint.reshape(-1)
-    pairs = np.stack([keys // base, keys % base], axis=1)
+    pairs = np.stack([keys // base % base, keys % base], axis=1)
     j = len(pairs)
     fn = np.maximum(np.einsum("ij,ij->i", force, normal), 0.0)
     weight = np.bincount(joint, weights=fn, minlength=j)
@@ -84,6 +95,7 @@ def joint_resultants(contact_body, contact_point, contact_normal, contact_force,
         point=centre[loaded] / weight[loaded, None],
         force=resultant[loaded],
         state=state[loaded],
+        frame=None if contact_frame is None else keys[loaded] // (base * base),
     )
 
 
