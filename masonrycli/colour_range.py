@@ -161,21 +161,28 @@ class RangeTracker:
         ranges: list[ColourRange] = []
         below = np.zeros(n_frames, dtype=np.int64)
         above = np.zeros(n_frames, dtype=np.int64)
-        k = 0
+        k, window = 0, 4
         while k < n_frames:
             r = self.current
-            if r is not None:  # the frames from k on that keep both rules with r
-                lo_count = ((v[k:] < r.lo) & finite[k:]).sum(axis=1)
-                hi_count = ((v[k:] > r.hi) & finite[k:]).sum(axis=1)
+            while r is not None and k < n_frames:  # the frames from k on that keep both rules with r
+                # A window that doubles while the range holds: refits early in a run come every few
+                # frames, later ones rarely.
+                w = slice(k, min(k + window, n_frames))
+                lo_count = ((v[w] < r.lo) & finite[w]).sum(axis=1)
+                hi_count = ((v[w] > r.hi) & finite[w]).sum(axis=1)
                 with np.errstate(invalid="ignore"):  # frames without a defined cell: inf − inf
-                    span = (np.minimum(top[k:], r.hi) - np.maximum(bottom[k:], r.lo)) / (r.hi - r.lo)
-                holds = (lo_count + hi_count <= budget[k:]) & ((defined[k:] == 0) | (span >= MIN_SPAN))
+                    span = (np.minimum(top[w], r.hi) - np.maximum(bottom[w], r.lo)) / (r.hi - r.lo)
+                holds = (lo_count + hi_count <= budget[w]) & ((defined[w] == 0) | (span >= MIN_SPAN))
                 held = int(np.argmin(holds)) if not holds.all() else len(holds)
                 ranges += [r] * held
                 below[k : k + held], above[k : k + held] = lo_count[:held], hi_count[:held]
                 k += held
-                if k == n_frames:
+                if held < len(holds):
+                    window = 4
                     break
+                window *= 2
+            if k == n_frames:
+                break
             r = self.update(v[k])  # a frame that breaks a rule (or the first one): refitted
             ranges.append(r)
             below[k], above[k], _ = r.outside(v[k])

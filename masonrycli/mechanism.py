@@ -142,11 +142,8 @@ class JointTracker:
 
     def hinge_points(self, contact_body, contact_point, contact_rn, hinged) -> np.ndarray:
         """(H, 2) m: the loaded contact points of the hinged joints (the hinges themselves)."""
-        if not np.any(hinged):  # the usual case, and np.isin is most of the cost
+        if not np.any(hinged):
             return np.zeros((0, 2))
-        loaded = (np.asarray(contact_rn) > 0) & np.isin(self._pair_key(contact_body), self.key[hinged])
+        body = np.ascontiguousarray(contact_body, dtype=np.int64).reshape(-1, 2)
+        loaded = _kernels.hinge_contacts(self.key, hinged, self.body_count, body, contact_rn)
         return np.asarray(contact_point)[loaded].copy()
-
-    def _pair_key(self, contact_body) -> np.ndarray:
-        body = np.asarray(contact_body, dtype=np.int64).reshape(-1, 2)
-        return body[:, 0] * self.body_count + body[:, 1]

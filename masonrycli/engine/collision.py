@@ -119,6 +119,18 @@ class ContactBuffers:
     def contact_capacity(self) -> int:
         return self.contact_gap.shape[0]
 
+    def checked_for(self, vert_local, body_dynamic, body_vert_start) -> bool:
+        """True when the last detection checked these very arrays against the buffers' current ones: the
+        next one can go straight to the fused kernel (:func:`_detect`)."""
+        checked = self._checked_inputs
+        return (
+            len(checked) == 3
+            and checked[0] is vert_local
+            and checked[1] is body_dynamic
+            and checked[2] is body_vert_start
+            and self.pairs.pair_body is self._checked_pairs
+        )
+
     @property
     def pair_count(self) -> int:
         return self.pairs.pair_count
@@ -180,14 +192,7 @@ def detect_contacts(body_q, body_vert_start, vert_local, body_dynamic, alert, bu
     alert = float(alert)
     if not alert >= 0.0:
         raise ValueError(f"detect_contacts: alert distance must be >= 0, got {alert}")
-    checked = buffers._checked_inputs
-    if (
-        len(checked) == 3
-        and checked[0] is vert_local
-        and checked[1] is body_dynamic
-        and checked[2] is body_vert_start
-        and buffers.pairs.pair_body is buffers._checked_pairs
-    ):
+    if buffers.checked_for(vert_local, body_dynamic, body_vert_start):
         # The same model and buffers as the last call, checked then: one kernel call does it all.
         check_array("world_vertices", "body_q", body_q, (buffers.body_count, 3), np.float64)
         pairs = buffers.pairs

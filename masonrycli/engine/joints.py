@@ -80,6 +80,15 @@ def _hinged(opening, end_joint, key, body_count, contact_body, contact_rn, dt, o
 
 
 @njit
+def _hinge_contacts(key, hinged, body_count, contact_body, contact_rn, out):
+    # out[c] = contact c carries normal force (r_n > 0) and its pair is a hinged joint
+    for c in range(contact_body.shape[0]):
+        k = np.int64(contact_body[c, 0]) * body_count + contact_body[c, 1]
+        pos = np.searchsorted(key, k)
+        out[c] = contact_rn[c] > 0.0 and pos < key.shape[0] and key[pos] == k and hinged[pos]
+
+
+@njit
 def _block_fields(opening, end_body, end_joint, block_count, contact_body, contact_rn, status, out_opening, out_ratio):
     # out_opening[k] = max(0, largest opening of the ends of k's joints)    (0 without any)
     # out_ratio[k]   = Σ r_n of k's slipping contacts / Σ r_n of its closed contacts (0 if none)
@@ -134,6 +143,14 @@ def hinged(opening, end_joint, key, body_count, contact_body, contact_rn, dt, op
         return out
     rn = np.ascontiguousarray(contact_rn, dtype=np.float64)
     _hinged(opening, end_joint, key, body_count, contact_body, rn, float(dt), opening_limit, min_force, out)
+    return out
+
+
+def hinge_contacts(key, hinged, body_count, contact_body, contact_rn) -> np.ndarray:
+    """(C,) bool: the contacts with r_n > 0 of the joints flagged in ``hinged`` (the hinges themselves)."""
+    out = np.zeros(contact_body.shape[0], dtype=np.bool_)
+    rn = np.ascontiguousarray(contact_rn, dtype=np.float64)
+    _hinge_contacts(key, np.ascontiguousarray(hinged, dtype=np.bool_), body_count, contact_body, rn, out)
     return out
 
 

@@ -10,6 +10,10 @@
 7. contact forces, dissipation, support work           nlgs.contact_power
 8. q_n+1 = q_n + dt (θ v_n+1 + (1 − θ) v_n)            integrate.update_q
 9. keep the keys and impulses for step 3 next time    warmstart.WarmStart.remember
+
+Steps 1–4 run as one call (fused.before_solve), and 8–9 with the step's largest penetration as
+another (fused.after_solve): the same kernels, without a launcher call around each. The first step,
+and any step whose detection needs larger buffers, goes through 1–4 one by one.
 """
 
 from __future__ import annotations
@@ -18,7 +22,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from masonrycli.engine import integrate, nlgs, warmstart
+from masonrycli.engine import fused, integrate, nlgs, warmstart
 from masonrycli.engine.collision import ContactBuffers, detect_contacts
 
 
@@ -125,12 +129,18 @@ class Solver:
     def step(self, state) -> StepStats:
         m = self.model
         k = state.step
-        top_speed = integrate.begin_step(m, state.body_q, state.body_v, self.body_q_m, self._v_old)
-        count = self.detect(self.body_q_m, self.detection_distance(top_speed))
+        support_v_next = m.support_velocity[k + 1]
+        begun = fused.before_solve(self, state, support_v_next)  # steps 1–4 in one call
         bf = self.buffers
+        if begun is None:  # first detection, capacities exceeded, a pose not finite: one by one
+            top_speed = integrate.begin_step(m, state.body_q, state.body_v, self.body_q_m, self._v_old)
+            count = self.detect(self.body_q_m, self.detection_distance(top_speed))
+            warm = self._warm.start(bf.contact_key, count, self._r)
+            integrate.free_velocity(m, self._v_old, support_v_next, state.body_v)
+        else:
+            count, warm, _ = begun
+            self._count = count
         body = bf.contact_body
-        warm = self._warm.start(bf.contact_key, count, self._r)
-        integrate.free_velocity(m, self._v_old, m.support_velocity[k + 1], state.body_v)
         nlgs.prepare_contacts(
             body, bf.contact_point, bf.contact_normal, bf.contact_gap, count, self.body_q_m, m, self._pack
         )
@@ -140,11 +150,9 @@ class Solver:
         dissipated, work = nlgs.contact_power(
             body, self._pack, self._r, count, self._v_old, state.body_v, m, self._force, self.support_force
         )
-        block_speed = integrate.update_q(m, state.body_q, self._v_old, state.body_v)
+        block_speed, penetration = fused.after_solve(self, state, count)  # steps 8–9
         state.step = k + 1
         state.time = state.step * m.dt
-        self._warm.remember(bf.contact_key, self._r, count)
-        penetration = float(max(0.0, -bf.contact_gap[:count].min())) if count else 0.0
         converged = residual <= m.tolerance and iterations < m.max_iterations
         return StepStats(
             count,

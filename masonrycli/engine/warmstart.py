@@ -146,15 +146,30 @@ class WarmStart:
         self._r = np.empty((capacity, 2))
         self._count = 0
 
+    @property
+    def key(self) -> np.ndarray:
+        """(C_prev,) int64 the previous step's contact keys, sorted."""
+        return self._key[: self._count]
+
+    @property
+    def r(self) -> np.ndarray:
+        """(≥ C_prev, 2) their final impulses (rows ``[:C_prev]``)."""
+        return self._r
+
     def start(self, key: np.ndarray, count: int, r: np.ndarray) -> int:
         """Write the starting impulses of this step's ``count`` contacts (keys ``key``) into ``r`` (C, 2);
         return how many were found in the previous step."""
-        return _warm_start(key, count, self._key[: self._count], self._r, r)
+        return _warm_start(key, count, self.key, self._r, r)
 
     def remember(self, key: np.ndarray, r: np.ndarray, count: int) -> None:
         """Keep this step's final impulses ``r`` for the next step."""
+        _remember(key, r, count, *self.reserve(count))
+
+    def reserve(self, count: int) -> tuple[np.ndarray, np.ndarray]:
+        """The (key, r) arrays that this step's ``count`` sorted keys and impulses go to (grown if needed);
+        the next :meth:`start` reads their first ``count`` rows."""
         if count > self._key.shape[0]:
             self._key = np.empty(count, dtype=np.int64)
             self._r = np.empty((count, 2))
-        _remember(key, r, count, self._key, self._r)
         self._count = count
+        return self._key, self._r

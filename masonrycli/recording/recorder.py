@@ -369,8 +369,11 @@ class Recorder:
         colors = map_positions(positions(f.kind, values, lo.reshape(per_frame), hi.reshape(per_frame)), LUTS[f.kind])
         title = viewer_safe_text(f.title)
         labels: list[str] = []
+        ticks, last = [], None
         for r, n_below, n_above in zip(ranges, below.tolist(), above.tolist()):
-            labels += self._tick_labels(f, r)
+            if r is not last:  # a range holds for many frames
+                ticks, last = self._tick_labels(f, r), r
+            labels += ticks
             labels += [title, f"{n_below} below" if n_below else "", f"{n_above} above" if n_above else ""]
         self.field_ranges[f.key] = (float(lo[-1]), float(hi[-1]))
         return colors, labels, lo, hi
