@@ -36,7 +36,7 @@ def main() -> None:
         if "--fragility-only" not in sys.argv:
             masonry(
                 "sweep", "wall", "--param", "freq=1:4:4", "--param", "amp=0.25:1.5:6", "--duration", 2,
-                "--out", f"{tmp}/wall.parquet", "--plot", IMAGES / "sweep-wall-state-map.png",
+                "--out", f"{tmp}/wall.parquet", "--plot", IMAGES / "sweep-wall-state-map.png", "--force",
             )  # fmt: skip
         records = Path(tmp) / "records"
         records.mkdir()
@@ -48,7 +48,7 @@ def main() -> None:
             write_at2(records / f"synthetic-{k + 1}.AT2", a / 9.80665, 0.01)
         masonry(
             "sweep", "wall", "--records", records, "--scale", "0.5:3:6", "--duration", 3, "--im", "pgv",
-            "--out", f"{tmp}/wall-ida.parquet", "--plot", IMAGES / "sweep-wall-fragility.png",
+            "--out", f"{tmp}/wall-ida.parquet", "--plot", IMAGES / "sweep-wall-fragility.png", "--force",
         )  # fmt: skip
 
 

@@ -14,6 +14,7 @@ import typer
 from rich.table import Table
 
 from masonrycli.errors import InputError
+from masonrycli.outputs import OutputFile
 
 BUILT_IN = ("wall", "arch", "aqueduct")
 SWEEP_DURATION = {"wall": 1.0, "arch": 2.0, "aqueduct": 2.0}
@@ -73,6 +74,12 @@ def sweep_command(
     histories: Annotated[
         Path | None, typer.Option("--histories", help="Folder for one history (.npz) per run, e.g. amp=0.5_freq=2.npz.")
     ] = None,
+    force: Annotated[
+        bool,
+        typer.Option(
+            "--force", help="Replace existing output files (finished rows of the same study are still reused)."
+        ),
+    ] = False,
 ) -> None:
     """Run a structure over a grid of parameters or a set of records on Dask; one row per run.
 
@@ -82,6 +89,7 @@ def sweep_command(
     from masonrycli.intensity import INTENSITY_MEASURES
     from masonrycli.study import store
     from masonrycli.study.axes import StudyBase, parse_axis
+    from masonrycli.study.files import check_picture
     from masonrycli.study.study import StudyRequest, run_study
     from masonrycli.study.task import check_outcome
 
@@ -107,9 +115,12 @@ def sweep_command(
         raise InputError(f"--rtol {rtol}: must be in (0, 1)")
     name = base.scenario.name
     out = store.check_out(out or Path(f"study-{name}.parquet"))
-    if recording is not None and recording.suffix != ".rrd":
-        raise InputError(f"--recording {recording}: a recording file must end in .rrd")
-    recording = None if no_recording else recording or out.with_suffix(".rrd")
+    # every output checked before the first run (the table and the histories by run_study, which knows
+    # which rows are this study's and which runs are still to make)
+    picture = check_picture(plot or out.with_suffix(".png"), "--plot", ".png", force)
+    recording = check_picture(
+        None if no_recording else recording or out.with_suffix(".rrd"), "--recording", ".rrd", force
+    )
     request = StudyRequest(
         axes=axes,
         out=out,
@@ -120,13 +131,16 @@ def sweep_command(
         workers=workers,
         stop_at_collapse=not full_runs,
         histories=histories,
+        force=force,
     )
     try:
         result = run_study(base, request, console)
     except KeyboardInterrupt:
-        err_console.print(f"interrupted: every finished row is in {out}; run the same command again to resume")
+        err_console.print(
+            f"interrupted: every finished row is in {out}; run the same command again to resume", soft_wrap=True
+        )
         raise typer.Exit(130) from None
-    _report(console, result, request, name, im, plot or out.with_suffix(".png"), recording)
+    _report(console, result, request, name, im, picture, recording)
 
 
 def _base_scenario(target: str, duration, dt):
@@ -181,27 +195,32 @@ def _records(entries: list[Path]) -> dict:
     return {p.name: record_motion(p, display=str(p)) for p in files}
 
 
-def _report(console, result, request, name: str, im: str, plot: Path, recording: Path | None) -> None:
+def _report(console, result, request, name: str, im: str, plot: OutputFile, recording: OutputFile | None) -> None:
     from masonrycli.intensity import UNITS
+    from masonrycli.outputs import written_whole
     from masonrycli.study.fragility import fit_lognormal
     from masonrycli.study.plots import fragility_curve, state_map, threshold_curve
 
     rows, axes = result.rows, request.axes
     console.print(_table(rows, result.columns, request))
     console.print(
-        f"{len(rows)} rows in {request.out} ({result.ran} runs now, {result.skipped} rows already there, "
+        f"{len(rows)} rows in {result.out} ({result.ran} runs now, {result.skipped} rows already there, "
         f"{result.failed} failed) in {result.wall_time:.1f} s"
     )
     names = [a.name for a in axes if a.name != request.find and len(a.values) > 1]
     fit = None
-    if request.find:
-        plot = threshold_curve(
-            rows, request.find, names[0] if names else None, plot, f"{name}: {request.outcome} threshold"
-        )
-    elif "record" in [a.name for a in axes]:
-        good = [r for r in rows if r.get("status") != "error"]
-        fit = fit_lognormal([r[im] for r in good], [r["state"] == "collapsed" for r in good], im)
-        plot = fragility_curve(good, im, fit, plot, f"{name}: fragility ({len(good)} runs)", UNITS[im])
+    with written_whole(plot) as part:
+        if request.find:
+            title = f"{name}: {request.outcome} threshold"
+            threshold_curve(rows, request.find, names[0] if names else None, part, title)
+        elif "record" in [a.name for a in axes]:
+            good = [r for r in rows if r.get("status") != "error"]
+            fit = fit_lognormal([r[im] for r in good], [r["state"] == "collapsed" for r in good], im)
+            fragility_curve(good, im, fit, part, f"{name}: fragility ({len(good)} runs)", UNITS[im])
+        else:
+            x, y = names[0] if names else axes[0].name, names[1] if len(names) > 1 else None
+            state_map(rows, x, y, part, name)
+    if "record" in [a.name for a in axes] and not request.find:
         if fit is None:
             console.print("fragility: no fit (every run collapsed, or none did)")
         else:
@@ -209,14 +228,13 @@ def _report(console, result, request, name: str, im: str, plot: Path, recording:
                 f"fragility ({im}): median θ = {fit.median:.4g} {UNITS[im]}, dispersion β = {fit.dispersion:.3f} "
                 f"({fit.collapsed} of {fit.runs} runs collapsed)"
             )
-    else:
-        plot = state_map(rows, names[0] if names else axes[0].name, names[1] if len(names) > 1 else None, plot, name)
-    console.print(f"plot: {plot}")
+    console.print(f"plot: {plot.path}")
     if recording is not None:
         from masonrycli.recording.study import record_study
 
-        record_study(recording, name, rows, request, fit, im, plot)
-        console.print(f"recording: {recording}")
+        with written_whole(recording) as part:
+            record_study(part, name, rows, request, fit, im, plot.path)
+        console.print(f"recording: {recording.path}")
 
 
 def _table(rows: list[dict], columns: list[str], request) -> Table:

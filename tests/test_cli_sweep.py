@@ -69,11 +69,12 @@ def test_records_sweep_fits_a_fragility_curve_and_records_the_study(block, tmp_p
 
     paths = {ch.entity_path for ch in rr.chunk.RrdReader(str(rrd)).stream()}
     assert {"/study/fragility/runs", "/study/plot", "/study/rows"} <= paths
-    again = invoke("sweep", block, "--records", folder, "--scale", "0.5:8:4", "--workers", 0, "--out", out)
+    # the plot and the recording exist now: --force replaces them and still reuses every finished row
+    again = invoke("sweep", block, "--records", folder, "--scale", "0.5:8:4", "--workers", 0, "--out", out, "--force")
     assert again.exit_code == 0 and "(0 runs now, 12 rows already there" in " ".join(again.output.split())
     # records given as files (repeatable) make the same study as their folder
     files = [a for f in sorted(folder.iterdir()) for a in ("--records", f)]
-    again = invoke("sweep", block, *files, "--scale", "0.5:8:4", "--workers", 0, "--out", out)
+    again = invoke("sweep", block, *files, "--scale", "0.5:8:4", "--workers", 0, "--out", out, "--force")
     assert again.exit_code == 0 and "(0 runs now, 12 rows already there" in " ".join(again.output.split())
     twice = invoke("sweep", block, "--records", folder, "--records", folder / "syn0.AT2", "--out", out)
     assert twice.exit_code == 2 and "two records named syn0.AT2" in twice.output
@@ -110,7 +111,8 @@ def test_grid_sweep_state_map_and_histories(block, tmp_path):
         (["-p", "scale=1,2"], "has no record motion"),
         (["-p", "amp=0.1", "--records", "nowhere"], "--records nowhere: no such file or folder"),
         (["-p", "amp=0.1", "--workers", "2", "--scheduler", "tcp://x:1"], "--workers with --scheduler"),
-        (["-p", "amp=0.1", "--recording", "x.png"], "--recording x.png: a recording file must end in .rrd"),
+        (["-p", "amp=0.1", "--recording", "x.png"], "--recording x.png: the file name must end in .rrd"),
+        (["-p", "amp=0.1", "--plot", "x.jpg"], "--plot x.jpg: the file name must end in .png"),
     ],
 )
 def test_sweep_errors_are_one_line(block, args, fragment):
@@ -118,3 +120,79 @@ def test_sweep_errors_are_one_line(block, args, fragment):
     assert result.exit_code == 2, result.output
     lines = [ln for ln in result.output.strip().splitlines() if ln.strip()]
     assert len(lines) == 1 and fragment in lines[0], result.output
+
+
+def _files(folder: Path) -> dict[str, bytes]:
+    return {p.name: p.read_bytes() for p in folder.rglob("*") if p.is_file()}
+
+
+def test_existing_outputs_are_refused_without_force_and_replaced_with_it(block, tmp_path):
+    out, h = tmp_path / "s.csv", tmp_path / "h"
+    grid = ["-p", "amp=0.05,0.1", "--duration", 0.02, "--workers", 0, "-o", out, "--histories", h]
+    assert invoke("sweep", block, *grid).exit_code == 0
+    before, png = _files(tmp_path), (tmp_path / "s.png").stat().st_ino
+    assert {"s.csv", "s.png", "s.rrd", "amp=0.05.npz", "amp=0.1.npz"} <= set(before)
+    other = ["-p", "amp=0.05,0.1", "--duration", 0.04, "--workers", 0, "-o", out]  # another study (duration)
+    cases = [
+        (other + ["--no-recording", "--plot", tmp_path / "o.png"], f"--out {out}: the file exists"),
+        (grid, f"--plot {tmp_path / 's.png'}: the file exists"),  # the same study: resumable, but its plot exists
+        (grid + ["--plot", tmp_path / "n.png", "--recording", tmp_path / "s.rrd"], "--recording"),
+        (grid[:-1] + [h] + ["-p", "friction=0.8", "--no-recording", "--plot", tmp_path / "n.png"], "--out"),
+    ]
+    for args, fragment in cases:
+        result = invoke("sweep", block, *args)
+        assert result.exit_code == 2, result.output
+        lines = result.output.strip().splitlines()
+        assert len(lines) == 1 and fragment in lines[0] and "(add --force to replace it)" in lines[0], lines
+        assert _files(tmp_path) == before  # untouched, no temporary file left
+    # the histories of runs still to make: one of them exists
+    more = ["-p", "amp=0.1,0.2", "--duration", 0.02, "--workers", 0, "-o", tmp_path / "t.csv", "--histories", h]
+    result = invoke("sweep", block, *more)
+    assert result.exit_code == 2 and f"--histories {h / 'amp=0.1.npz'}: the file exists" in result.output
+    assert _files(tmp_path) == before
+    # --force replaces: the other study's rows go, the plot and the recording are new
+    result = invoke("sweep", block, *other, "--force")
+    assert result.exit_code == 0, result.output
+    assert [r["time"] for r in read_rows(out)] == [pytest.approx(0.04)] * 2
+    after = _files(tmp_path)
+    assert (tmp_path / "s.png").stat().st_ino != png and after["s.rrd"] != before["s.rrd"]  # a new file each
+    assert not [name for name in after if name.endswith(".part") or "journal" in name]
+
+
+def test_ctrl_c_leaves_no_partial_file_and_the_same_command_resumes(block, tmp_path, monkeypatch):
+    from masonrycli.history import HistoryFile
+
+    out, h = tmp_path / "s.parquet", tmp_path / "h"
+    args = ["-p", "amp=0.05,0.1,0.2", "--duration", 0.02, "--workers", 0, "-o", out, "--histories", h]
+    frame = HistoryFile.on_frame
+    calls = []
+
+    def interrupted_third_run(self, f):  # Ctrl-C in the middle of the third run, its history half written
+        calls.append(int(f.step))
+        if calls.count(0) == 3 and int(f.step) > 0:
+            raise KeyboardInterrupt
+        frame(self, f)
+
+    monkeypatch.setattr(HistoryFile, "on_frame", interrupted_third_run)
+    result = invoke("sweep", block, *args)
+    assert result.exit_code == 130 and "run the same command again to resume" in result.output
+    assert sorted(p.name for p in h.iterdir()) == ["amp=0.05.npz", "amp=0.1.npz"]  # no .part, no .rows
+    assert [r["amp"] for r in read_rows(out)] == [0.05, 0.1]
+    table = out.read_bytes()
+
+    import pyarrow.parquet as pq
+
+    def cut_short(table, where):  # Ctrl-C while the table is being written: half a file on disk
+        Path(where).write_bytes(b"PAR1 half")
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(HistoryFile, "on_frame", frame)
+    monkeypatch.setattr(pq, "write_table", cut_short)
+    result = invoke("sweep", block, *args)
+    assert result.exit_code == 130
+    assert out.read_bytes() == table and not [p for p in tmp_path.iterdir() if p.name.endswith(".part")]
+    assert len(read_rows(out)) == 3  # the third row is in the journal
+    monkeypatch.undo()
+    result = invoke("sweep", block, *args)
+    assert result.exit_code == 0 and "(0 runs now, 3 rows already there" in " ".join(result.output.split())
+    assert [r["amp"] for r in read_rows(out)] == [0.05, 0.1, 0.2]

@@ -10,6 +10,7 @@ from scipy.stats import norm
 
 from masonrycli.errors import InputError
 from masonrycli.motion import Constant, Sine
+from masonrycli.outputs import OutputFile
 from masonrycli.records import record_motion
 from masonrycli.scenario import Material, RunConfig, scenario_from_builder
 from masonrycli.study import store
@@ -129,8 +130,8 @@ def test_rows_round_trip_and_journal(tmp_path, suffix):
     journal.append(rows[0])
     journal.close()
     assert store.read_rows(out) == [rows[0] | {"x": store.read_rows(out)[0]["x"]}]  # journal alone
-    store.write_rows(out, rows, list(rows[0]))
-    assert not store.journal_path(out).exists()
+    assert store.write_rows(OutputFile(out, "--out"), rows, list(rows[0])) == out
+    assert not store.journal_path(out).exists() and sorted(tmp_path.iterdir()) == [out]  # no temporary file
     back = store.read_rows(out)
     assert back[0]["amp"] == 0.1 + 0.2 and back[0]["study"] == "1234e567" and math.isnan(back[0]["x"])
     assert back[1]["error"] == "boom, it failed" and back[1]["record"] == "b.AT2"

@@ -10,7 +10,6 @@ as they are; the PNG is the annotated picture.
 from __future__ import annotations
 
 import math
-import os
 import uuid
 from pathlib import Path
 
@@ -30,9 +29,9 @@ STATE_RGBA = {
 
 
 def record_study(path: Path, name: str, rows: list[dict], request, fit, im: str, plot: Path) -> Path:
-    """Write the study's ``.rrd`` at ``path`` (closed, with its blueprint)."""
+    """Write the study's ``.rrd`` at ``path`` (closed, with its blueprint); the caller writes it under
+    a temporary name and renames it (``masonrycli.outputs.written_whole``)."""
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
     rec = rr.RecordingStream(APPLICATION_ID, recording_id=str(uuid.uuid4()))
     views = [rrb.TextDocumentView(origin="study/rows", name="rows")]
     if plot and Path(plot).exists():
@@ -49,10 +48,8 @@ def record_study(path: Path, name: str, rows: list[dict], request, fit, im: str,
         _log_state_map(rec, rows, names)
         views.insert(0, rrb.Spatial2DView(origin="study/state_map", name="state map"))
     rec.log("study/rows", rr.TextDocument(_markdown(name, rows), media_type=rr.MediaType.MARKDOWN), static=True)
-    tmp = path.with_name(path.name + ".part.rrd")  # renamed once complete: never half a file at ``path``
-    rec.save(tmp, default_blueprint=rrb.Blueprint(rrb.Grid(*views)))
+    rec.save(path, default_blueprint=rrb.Blueprint(rrb.Grid(*views)))
     rec.disconnect()
-    os.replace(tmp, path)
     return path
 
 

@@ -27,9 +27,8 @@ def _pyplot():
 
 
 def _save(fig, path: Path) -> Path:
-    tmp = path.with_name(path.name + ".tmp.png")
-    fig.savefig(tmp, dpi=120, bbox_inches="tight")
-    tmp.replace(path)
+    # PNG whatever the name: the caller writes a temporary ".part" file (masonrycli.outputs.written_whole)
+    fig.savefig(path, format="png", dpi=120, bbox_inches="tight")
     return path
 
 

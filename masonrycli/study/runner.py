@@ -40,10 +40,9 @@ def open_cluster(scheduler: str | None, workers: int | None):
     return Client(cluster), cluster
 
 
-def run_on_cluster(
-    client, base, driver, on_row: Callable[[dict, dict], None], stop_at_collapse: bool, history_dir: str | None = None
-) -> None:
-    """Run ``driver``'s points on ``client`` until it hands out no more; ``on_row(params, row)`` for each."""
+def run_on_cluster(client, base, driver, on_row: Callable[[dict, dict], None], *task_args) -> None:
+    """Run ``driver``'s points on ``client`` until it hands out no more; ``on_row(params, row)`` for each.
+    ``task_args``: :func:`run_task`'s arguments after the point (stop_at_collapse, history_dir, force)."""
     from distributed import as_completed
 
     # The base is a task, not scattered data: the scheduler keeps its spec and recomputes it on another
@@ -55,7 +54,7 @@ def run_on_cluster(
 
     def submit(points):
         for params in points:
-            future = client.submit(run_task, base_future, params, stop_at_collapse, history_dir, pure=False)
+            future = client.submit(run_task, base_future, params, *task_args, pure=False)
             pending[future.key] = params
             completed.add(future)
 
@@ -76,14 +75,12 @@ def _identity(value):
     return value
 
 
-def run_serially(
-    base, driver, on_row: Callable[[dict, dict], None], stop_at_collapse: bool, history_dir: str | None = None
-) -> None:
+def run_serially(base, driver, on_row: Callable[[dict, dict], None], *task_args) -> None:
     """The same as :func:`run_on_cluster` in this process, one task after the other (``--workers 0``)."""
     queue = list(driver.start())
     while queue:
         params = queue.pop(0)
-        row = run_task(base, params, stop_at_collapse, history_dir)
+        row = run_task(base, params, *task_args)
         more = driver.feed(params, row)
         on_row(params, row)
         queue += more

@@ -1,8 +1,9 @@
 """The results of a study on disk: one row per run, ``.parquet`` or ``.csv`` (the extension chooses).
 
 Finished rows are never lost: each row is appended to a journal (``<out>.journal.jsonl``, one JSON
-object per line, flushed) the moment it arrives; the table itself is rewritten atomically (temporary
-file, then rename) at the end of the study and when it is interrupted, after which the journal goes.
+object per line, flushed) the moment it arrives; the table itself is rewritten whole (temporary file,
+then rename: :mod:`masonrycli.outputs`) at the end of the study and when it is interrupted, after which
+the journal goes. Which existing table may be rewritten: :mod:`masonrycli.study.files`.
 Re-running the same study reads both and skips the rows already finished (resume). Rows carry a
 ``study`` column, a fingerprint of everything but the grid, so a different study never reuses them.
 """
@@ -13,10 +14,10 @@ import csv
 import hashlib
 import json
 import math
-import os
 from pathlib import Path
 
 from masonrycli.errors import InputError
+from masonrycli.outputs import OutputFile, written_whole
 
 SUFFIXES = (".parquet", ".csv")
 TEXT_COLUMNS = frozenset({"study", "state", "status", "error", "note", "outcome", "record"})
@@ -99,23 +100,24 @@ def _plain(value):
     return value.item() if hasattr(value, "item") else str(value)
 
 
-def write_rows(out: Path, rows: list[dict], columns: list[str]) -> None:
-    """Write ``rows`` (every key of ``columns``, in that order) atomically, then drop the journal."""
-    tmp = out.with_name(out.name + ".tmp" + out.suffix)
-    out.parent.mkdir(parents=True, exist_ok=True)
+def write_rows(out: OutputFile, rows: list[dict], columns: list[str]) -> Path:
+    """Write ``rows`` (every key of ``columns``, in that order) to ``out`` whole (temporary file renamed
+    into place, :func:`masonrycli.outputs.written_whole`), then drop the journal; returns where it went."""
     table = [{c: _plain(r.get(c)) if hasattr(r.get(c), "item") else r.get(c) for c in columns} for r in rows]
-    if out.suffix.lower() == ".parquet":
-        import pyarrow as pa
-        import pyarrow.parquet as pq
+    journal = journal_path(out.path)
+    with written_whole(out) as part:
+        if out.path.suffix.lower() == ".parquet":
+            import pyarrow as pa
+            import pyarrow.parquet as pq
 
-        pq.write_table(pa.Table.from_pylist(table), tmp)
-    else:
-        with open(tmp, "w", newline="") as fh:
-            writer = csv.DictWriter(fh, fieldnames=columns)
-            writer.writeheader()
-            writer.writerows({c: _csv_value(r[c]) for c in columns} for r in table)
-    os.replace(tmp, out)
-    journal_path(out).unlink(missing_ok=True)
+            pq.write_table(pa.Table.from_pylist(table), part)
+        else:
+            with open(part, "w", newline="") as fh:
+                writer = csv.DictWriter(fh, fieldnames=columns)
+                writer.writeheader()
+                writer.writerows({c: _csv_value(r[c]) for c in columns} for r in table)
+    journal.unlink(missing_ok=True)
+    return out.path
 
 
 def _csv_value(value):

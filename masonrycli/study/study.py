@@ -1,7 +1,8 @@
 """A study from start to finish: resume, run on the cluster, keep every row, fit, summarise.
 
 :func:`run_study` is what ``masonry sweep`` does after parsing its options; the outputs around it
-(terminal table, PNGs, Rerun recording) are in :func:`study_outputs`.
+(terminal table, PNG, Rerun recording) are made by :mod:`masonrycli.cli_sweep`; which files may be
+written: :mod:`masonrycli.study.files`.
 """
 
 from __future__ import annotations
@@ -14,7 +15,7 @@ from rich.console import Console
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 
 from masonrycli.errors import InputError
-from masonrycli.study import store
+from masonrycli.study import files, store
 from masonrycli.study.axes import Axis, StudyBase, apply_point, check_axes, grid
 from masonrycli.study.drivers import FindDriver, GridDriver
 from masonrycli.study.task import RESULT_COLUMNS
@@ -34,6 +35,8 @@ class StudyRequest:
     stop_at_collapse: bool = True
     histories: Path | None = None
     """Folder for one history file per run (written by the workers), or None."""
+    force: bool = False
+    """Replace existing files (``--force``; see :mod:`masonrycli.study.files`)."""
 
 
 @dataclass(frozen=True)
@@ -46,6 +49,8 @@ class StudyResult:
     ran: int
     wall_time: float
     failed: int = 0
+    out: Path | None = None
+    """Where the table went."""
 
 
 def prepare(base: StudyBase, request: StudyRequest) -> str:
@@ -75,18 +80,18 @@ def run_study(base: StudyBase, request: StudyRequest, console: Console) -> Study
     from masonrycli.study.runner import open_cluster, run_on_cluster, run_serially
 
     study_id = prepare(base, request)
-    previous = [r for r in store.read_rows(request.out) if r.get("study") == study_id and r.get("status") != "error"]
+    names = [a.name for a in request.axes if a.name != request.find]  # a row's key
+    points = grid([a for a in request.axes if a.name != request.find])
+    table, ours = files.open_table(request.out, study_id, request.force, names, points)
+    done = {store.row_key(r, names): r for r in ours if r.get("status") != "error"}
     if request.find:
-        names = [a.name for a in request.axes if a.name != request.find]
-        done = {store.row_key(r, names): r for r in previous}
         driver = FindDriver(request.axes, request.find, request.outcome, request.rtol, done)
         columns = names + [f"{request.find}_{s}" for s in ("threshold", "lo", "hi")]
         columns += ["outcome", "evaluations", "status", "wall_time", "note", "error", "study"]
     else:
-        names = [a.name for a in request.axes]
-        done = {store.row_key(r, names): r for r in previous}
         driver = GridDriver(request.axes, done)
         columns = names + list(RESULT_COLUMNS) + ["study"]
+    files.check_histories(request.histories, driver.start(), request.find, request.force)
     start = time.perf_counter()
     journal = store.Journal(request.out)
     progress = Progress(
@@ -119,23 +124,24 @@ def run_study(base: StudyBase, request: StudyRequest, console: Console) -> Study
     if request.histories is not None:
         request.histories.mkdir(parents=True, exist_ok=True)
         histories = str(request.histories.resolve())
+    task_args = (request.stop_at_collapse, histories, request.force)
     cluster = client = None
     try:
         with progress:
             if request.workers == 0:
-                run_serially(base, driver, on_row, request.stop_at_collapse, histories)
+                run_serially(base, driver, on_row, *task_args)
             else:
                 client, cluster = open_cluster(request.scheduler, request.workers)
-                run_on_cluster(client, base, driver, on_row, request.stop_at_collapse, histories)
+                run_on_cluster(client, base, driver, on_row, *task_args)
     finally:
         journal.close()
         rows = driver.rows()
         for r in rows:
             r.setdefault("study", study_id)
-        store.write_rows(request.out, rows, columns)
+        store.write_rows(table, rows, columns)
         if client is not None:
             client.close()
         if cluster is not None:
             cluster.close()
     failed = sum(1 for r in rows if r.get("status") == "error")
-    return StudyResult(rows, columns, driver.skipped, ran, time.perf_counter() - start, failed)
+    return StudyResult(rows, columns, driver.skipped, ran, time.perf_counter() - start, failed, table.path)

@@ -6,9 +6,8 @@
 
 from __future__ import annotations
 
+import contextlib
 import math
-import os
-import shutil
 import time
 from pathlib import Path
 
@@ -43,13 +42,18 @@ RESULT_COLUMNS = (
 """The columns every row has after its parameters (units in ``docs/sweep.md``)."""
 
 
-def run_task(base, params: dict, stop_at_collapse: bool = True, history_dir: str | None = None) -> dict:
+def run_task(
+    base, params: dict, stop_at_collapse: bool = True, history_dir: str | None = None, force: bool = False
+) -> dict:
     """Run the grid point ``params`` of ``base`` (:class:`~masonrycli.study.axes.StudyBase`): its row.
 
     With ``history_dir`` the run's history (:mod:`masonrycli.history`) is written there as
-    :func:`history_name` of the point (on the worker's file system).
+    :func:`history_name` of the point (on the worker's file system), under the policy of
+    :mod:`masonrycli.outputs`: a temporary file renamed into place when complete, an existing file
+    replaced only with ``force`` (the study checked them all before the first run).
     """
     from masonrycli.history import HistoryFile
+    from masonrycli.outputs import OutputFile, written_whole
     from masonrycli.run import Simulation, simulate
     from masonrycli.study.axes import apply_point
 
@@ -58,19 +62,16 @@ def run_task(base, params: dict, stop_at_collapse: bool = True, history_dir: str
     try:
         scenario = apply_point(base, params)
         sim = Simulation(scenario)
-        sinks = []
-        if history_dir:
-            # written beside its final name, then renamed: a reader never sees half a history; a
-            # scratch folder left by a worker killed mid-run is cleared first
-            final = Path(history_dir) / history_name(params)
-            part = final.with_name(final.name + ".part.npz")
-            shutil.rmtree(part.with_name(part.name + ".rows"), ignore_errors=True)
-            sinks.append(HistoryFile(part, sim.model.block_name, sim.model.support_name))
-        result = simulate(scenario, sinks, sim=sim, stop_at_collapse=stop_at_collapse)
-        if sinks:
-            sinks[0].run_values |= {f"intensity_{k}": v for k, v in result.intensity.items()}
-            sinks[0].close(status=result.status, note=result.message)
-            os.replace(part, final)
+        with contextlib.ExitStack() as files:
+            sinks = []
+            if history_dir:
+                out = OutputFile(Path(history_dir) / history_name(params), "--histories", force=force)
+                part = files.enter_context(written_whole(out))
+                sinks.append(HistoryFile(part, sim.model.block_name, sim.model.support_name))
+            result = simulate(scenario, sinks, sim=sim, stop_at_collapse=stop_at_collapse)
+            if sinks:
+                sinks[0].run_values |= {f"intensity_{k}": v for k, v in result.intensity.items()}
+                sinks[0].close(status=result.status, note=result.message)
     except Exception as exc:  # a failed task is reported in its row; the study goes on
         return row | empty_result(f"{type(exc).__name__}: {exc}", time.perf_counter() - start)
     out = result.outcome

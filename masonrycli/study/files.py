@@ -1,0 +1,71 @@
+"""The files a study writes, under the policy of :mod:`masonrycli.outputs`, all checked before any run.
+
+- The table (``--out``) is the study's state: an existing table whose rows are all of this study (same
+  ``study`` fingerprint, points of this grid) is resumed — its rows are kept and the new ones added, so
+  that is no overwrite. A table holding rows of another study or of points outside the grid (they would
+  be lost), an empty or unreadable one, or a journal of such rows, is refused (exit 2) unless
+  ``--force``, which replaces it; ``--force`` never drops a finished row of this study and grid.
+- The plot (``--plot``), the recording (``--recording``) and the per-run histories (``--histories``)
+  follow ``simulate``: an existing file is refused unless ``--force``. The histories checked are those
+  of the runs still to make (for ``--find``, any value of the bisected parameter at an unfinished point).
+- Every file is written as ``.NAME.<pid>.part`` and renamed into place when complete
+  (:func:`masonrycli.outputs.written_whole`), so Ctrl-C, a killed process or a failed write leaves the
+  previous file or a complete new one, never half a file.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from masonrycli.errors import InputError
+from masonrycli.outputs import OutputFile, check_output, glob_escape
+from masonrycli.study import store
+from masonrycli.study.task import history_name
+
+_ANY = "FINDVALUE"
+"""Stands for the bisected value in a history name (letters only: :func:`history_name` keeps it)."""
+
+
+def check_picture(path: Path | None, option: str, suffix: str, force: bool) -> OutputFile | None:
+    """The plot or the recording of a study, checked like ``simulate``'s outputs (None: not written)."""
+    return None if path is None else check_output(path, option, suffix, force)
+
+
+def open_table(out: Path, study_id: str, force: bool, names: list[str], points: list[dict]) -> tuple[OutputFile, list]:
+    """Check the table ``out`` for the study ``study_id`` over ``points`` (rows keyed by ``names``):
+    ``(its OutputFile, the rows of this study already in it and its journal)``. Raises
+    :class:`InputError` for a table that is not this study's unless ``force`` (see the module docstring)."""
+    suffix = out.suffix.lower()
+    try:
+        rows = store.read_rows(out)
+    except InputError:
+        if not force:
+            raise
+        rows = []
+    keys = {store.row_key(p, names) for p in points}
+    ours = [r for r in rows if r.get("study") == study_id and store.row_key(r, names) in keys]
+    foreign = len(ours) < len(rows)  # another study's rows, or points not in this grid: they would be lost
+    if out.exists():
+        table = check_output(out, "--out", suffix, force or (bool(ours) and not foreign))
+        table.force = True  # checked: this study's own table, or --force
+    else:
+        if foreign and not force:
+            journal = store.journal_path(out)
+            raise InputError(f"--out {out}: {journal} holds rows of another study or grid (add --force to replace it)")
+        table = check_output(out, "--out", suffix, force)
+    return table, ours
+
+
+def check_histories(folder: Path | None, points: list[dict], find: str | None, force: bool) -> None:
+    """Refuse (unless ``force``) the history files the runs of ``points`` would write in ``folder``
+    that exist already; with ``find`` the bisected value is unknown, so any value counts."""
+    if folder is None:
+        return
+    if folder.exists() and not folder.is_dir():
+        raise InputError(f"--histories {folder}: is not a folder")
+    names = dict.fromkeys(history_name(p | {find: _ANY} if find else p) for p in points)
+    for name in names:
+        if find:
+            taken = sorted(folder.glob(glob_escape(name).replace(_ANY, "*"))) if folder.is_dir() else []
+            name = taken[0].name if taken else name.replace(_ANY, "0")
+        check_output(folder / name, "--histories", ".npz", force)

@@ -1,0 +1,55 @@
+"""Which files a study may write (masonrycli.study.files): the table resumed only when it is this study's
+and grid's, the histories of the runs still to make — with --find, whatever the bisected value."""
+
+from __future__ import annotations
+
+import pytest
+
+from masonrycli.errors import InputError
+from masonrycli.study import store
+from masonrycli.study.files import check_histories, open_table
+
+POINTS = [{"amp": 0.1}, {"amp": 0.2}]
+
+
+def _journal(out, *rows):
+    journal = store.Journal(out)
+    for row in rows:
+        journal.append(row)
+    journal.close()
+
+
+def test_table_of_this_study_is_resumed_and_any_other_refused(tmp_path):
+    out = tmp_path / "s.csv"
+    table, ours = open_table(out, "abc", False, ["amp"], POINTS)
+    assert ours == [] and table.path == out and not table.force  # a new table: may not replace a newcomer
+    store.write_rows(table, [{"amp": 0.1, "study": "abc"}], ["amp", "study"])
+    table, ours = open_table(out, "abc", False, ["amp"], POINTS)
+    assert [r["amp"] for r in ours] == [0.1] and table.force  # resumed: rewritten with its rows kept
+    for study, points in (("xyz", POINTS), ("abc", [{"amp": 0.3}])):  # another study; a point not in the grid
+        with pytest.raises(InputError, match=r"s\.csv: the file exists \(add --force to replace it\)"):
+            open_table(out, study, False, ["amp"], points)
+        assert open_table(out, study, True, ["amp"], points)[1] == []
+    out.write_text("not, a study\n")
+    with pytest.raises(InputError, match="the file exists"):  # no row: nothing of this study to resume
+        open_table(out, "abc", False, ["amp"], POINTS)
+    out.unlink()
+    _journal(out, {"amp": 0.2, "study": "xyz"})  # the journal of an interrupted other study
+    with pytest.raises(InputError, match=r"journal\.jsonl holds rows of another study or grid \(add --force"):
+        open_table(out, "abc", False, ["amp"], POINTS)
+
+
+def test_histories_to_write_are_checked_and_find_matches_any_value(tmp_path):
+    folder = tmp_path / "h"
+    check_histories(folder, POINTS, None, False)  # a folder still to make
+    folder.mkdir()
+    (folder / "amp=0.1362_freq=2.npz").write_bytes(b"")  # a bisection point's history
+    check_histories(folder, [{"amp": 0.1, "freq": 1.0}], "amp", False)
+    with pytest.raises(InputError, match=r"--histories .*amp=0\.1362_freq=2\.npz: the file exists"):
+        check_histories(folder, [{"amp": 0.1, "freq": 2.0}, {"amp": 0.5, "freq": 2.0}], "amp", False)
+    check_histories(folder, [{"amp": 0.1, "freq": 2.0}], "amp", True)
+    with pytest.raises(InputError, match="the file exists"):
+        check_histories(folder, [{"amp": 0.1362, "freq": 2.0}], None, False)
+    (tmp_path / "f").write_text("")
+    with pytest.raises(InputError, match="--histories .*: is not a folder"):
+        check_histories(tmp_path / "f", POINTS, None, False)
