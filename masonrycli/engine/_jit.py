@@ -10,15 +10,87 @@ that changing a flag changes it everywhere.
   the contact geometry relies on exact comparisons (ties between faces, points on clipping planes).
 - no ``parallel``: threads would make the order of floating-point reductions, hence the results,
   depend on scheduling.
+
+The cache of a kernel is stamped with the source of its module **and of every engine module that module
+imports from**, transitively (:func:`source_files`). A cached kernel holds the machine code of the
+kernels it calls: ``fused._before_solve`` that of detection, integration and warm start, ``watch._watch``
+that of ``nlgs._relative_velocity``, ``warmstart`` the packed columns of ``nlgs``. numba alone stamps a
+kernel with its own file only, so an edit of a callee in another file would leave its callers' cached
+code stale.
 """
 
 from __future__ import annotations
 
 import functools
+import hashlib
+import os
+import re
 
 import numba
+from numba.core import caching
 
 njit = functools.partial(numba.njit, cache=True)
 """``numba.njit`` with the engine's flags. Use as ``@njit`` or ``@njit(...)``."""
 
 __all__ = ["njit"]
+
+
+_ENGINE = os.path.dirname(os.path.abspath(__file__))
+_IMPORT = re.compile(
+    r"^\s*from\s+(?:masonrycli\.engine\.|\.)(\w+)\s+import"  # from .x import … / masonrycli.engine.x
+    r"|^\s*from\s+(?:masonrycli\.engine|\.)\s+import\s+([\w, ]+)",  # from masonrycli.engine import x, y
+    re.M,
+)
+
+
+@functools.cache
+def source_files(path: str) -> tuple[str, ...]:
+    """The engine module ``path`` and every engine module it imports from, transitively (sorted paths)."""
+    seen: set[str] = set()
+    todo = [os.path.abspath(path)]
+    while todo:
+        file = todo.pop()
+        if file in seen or not os.path.isfile(file):
+            continue
+        seen.add(file)
+        with open(file, encoding="utf-8") as f:
+            text = f.read()
+        for single, several in _IMPORT.findall(text):
+            names = [single] if single else [n.strip() for n in several.split(",")]
+            todo += [os.path.join(_ENGINE, f"{n}.py") for n in names if n]
+    return tuple(sorted(seen))
+
+
+@functools.cache
+def _stamp(path: str) -> str:
+    h = hashlib.sha256()
+    for file in source_files(path):
+        with open(file, "rb") as f:
+            h.update(os.path.basename(file).encode() + b"\0" + f.read())
+    return h.hexdigest()
+
+
+class _EngineSources:
+    """Locator mix-in: engine kernels only, stamped by :func:`_stamp` (module docstring)."""
+
+    def get_source_stamp(self):
+        return _stamp(self._py_file)
+
+    @classmethod
+    def from_function(cls, py_func, py_file):
+        if os.path.dirname(os.path.abspath(py_file)) != _ENGINE:
+            return None
+        return super().from_function(py_func, py_file)
+
+
+class _EngineUserDir(_EngineSources, caching.UserProvidedCacheLocator):
+    """``NUMBA_CACHE_DIR`` set: there."""
+
+
+class _EngineInTree(_EngineSources, caching.InTreeCacheLocator):
+    """Next to the sources (``__pycache__``)."""
+
+
+# numba ≥ 0.60 names it CacheImpl, earlier _CacheImpl; the first locator that accepts a function is used.
+_CACHE_IMPL = getattr(caching, "CacheImpl", None) or caching._CacheImpl
+_CACHE_IMPL._locator_classes[:0] = [_EngineUserDir, _EngineInTree]
