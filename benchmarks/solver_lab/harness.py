@@ -31,11 +31,13 @@ DEFAULT_METHODS = [
     "nlgs-oracle",
     "nlgs-law",
     "nlgs-predict",
+    "nlgs-predict-half",
     "nlgs-cold",
     "anderson-v",
     "ssn-v",
     "alm-newton",
     "nlgs-cluster",
+    "nlgs-linear",
 ]
 TARGET = 1e-5
 """m/s: the RMS contact-law residual every method is stopped at (``nlgs``: the engine's own test)."""
@@ -44,9 +46,9 @@ RESULTS = Path(__file__).resolve().parent / "results.json"
 
 def _register_optional():
     # Methods in their own modules; imported here so the table runs them by name.
-    from benchmarks.solver_lab.methods import alm_newton, anderson, cluster, newton
+    from benchmarks.solver_lab.methods import alm_newton, anderson, cluster, linear, newton
 
-    for module in (anderson, newton, alm_newton, cluster):
+    for module in (anderson, newton, alm_newton, cluster, linear):
         METHODS.update(module.METHODS)
 
 

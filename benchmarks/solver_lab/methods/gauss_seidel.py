@@ -7,6 +7,7 @@ nlgs-law      the same sweeps, stopped when the contact-law residual ≤ target 
 nlgs-predict  nlgs-law started from an extrapolated warm start along persistent contacts:
               r0 = r_warm + (r_warm − r_prev2) where the contact existed two steps back, then clipped
               into the friction cone; r_warm elsewhere.
+nlgs-predict-half  the same with half the extrapolation: r0 = r_warm + (r_warm − r_prev2)/2.
 nlgs-cold     nlgs-law from r = 0 (what the warm start is worth).
 nlgs-oracle   the engine's sweeps stopped when the velocity error against the reference ≤ ORACLE_ERROR:
               not a usable stopping test (it reads the answer), the intrinsic speed of Gauss–Seidel.
@@ -74,11 +75,11 @@ def _law(start, oracle=False):
     return solve
 
 
-def predicted_start(ctx) -> np.ndarray:
+def predicted_start(ctx, beta: float = 1.0) -> np.ndarray:
     p = ctx.p
     r0 = p.r_warm.copy()
     h = p.has_prev2
-    r0[h] = 2.0 * p.r_warm[h] - p.r_prev2[h]
+    r0[h] = p.r_warm[h] + beta * (p.r_warm[h] - p.r_prev2[h])
     return project_cone(r0, p.mu)
 
 
@@ -86,6 +87,7 @@ METHODS = {
     "nlgs": engine_default,
     "nlgs-law": _law(lambda ctx: ctx.p.r_warm.copy()),
     "nlgs-predict": _law(predicted_start),
+    "nlgs-predict-half": _law(lambda ctx: predicted_start(ctx, 0.5)),
     "nlgs-cold": _law(lambda ctx: np.zeros_like(ctx.p.r_warm)),
     "nlgs-oracle": _law(lambda ctx: ctx.p.r_warm.copy(), oracle=True),
 }
