@@ -6,12 +6,10 @@ table, PNG, Rerun recording. Registered on the app by :mod:`masonrycli.cli`.
 
 from __future__ import annotations
 
-import math
 from pathlib import Path
 from typing import Annotated
 
 import typer
-from rich.table import Table
 
 from masonrycli.errors import InputError
 from masonrycli.outputs import OutputFile
@@ -200,9 +198,12 @@ def _report(console, result, request, name: str, im: str, plot: OutputFile, reco
     from masonrycli.outputs import written_whole
     from masonrycli.study.fragility import fit_lognormal
     from masonrycli.study.plots import fragility_curve, state_map, threshold_curve
+    from masonrycli.study.table import find_columns, grid_columns, study_table
 
     rows, axes = result.rows, request.axes
-    console.print(_table(rows, result.columns, request))
+    keys = [a.name for a in axes if a.name != request.find]  # what a row is keyed by
+    columns = find_columns(keys, request.find) if request.find else grid_columns(keys, im)
+    console.print(study_table(rows, columns, keys, console, result.out))
     console.print(
         f"{len(rows)} rows in {result.out} ({result.ran} runs now, {result.skipped} rows already there, "
         f"{result.failed} failed) in {result.wall_time:.1f} s"
@@ -235,34 +236,3 @@ def _report(console, result, request, name: str, im: str, plot: OutputFile, reco
         with written_whole(recording) as part:
             record_study(part, name, rows, request, fit, im, plot.path)
         console.print(f"recording: {recording.path}")
-
-
-def _table(rows: list[dict], columns: list[str], request) -> Table:
-    names = [a.name for a in request.axes if a.name != request.find]
-    if request.find:
-        shown = names + [f"{request.find}_threshold", "evaluations", "note", "error"]
-    else:
-        shown = names + [
-            "state",
-            "collapse_time",
-            "pga",
-            "residual_drift",
-            "max_opening",
-            "hinges",
-            "wall_time",
-            "error",
-        ]
-    table = Table(title=f"study ({len(rows)} rows)", title_justify="left")
-    for c in shown:
-        table.add_column(c, overflow="fold")
-    for r in rows[:40]:
-        table.add_row(*(_cell(r.get(c)) for c in shown))
-    if len(rows) > 40:
-        table.add_row(*(["…"] * len(shown)))
-    return table
-
-
-def _cell(value) -> str:
-    if isinstance(value, float):
-        return "" if math.isnan(value) else f"{value:.4g}"
-    return "" if value is None else str(value)

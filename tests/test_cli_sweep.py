@@ -196,3 +196,23 @@ def test_ctrl_c_leaves_no_partial_file_and_the_same_command_resumes(block, tmp_p
     result = invoke("sweep", block, *args)
     assert result.exit_code == 0 and "(0 runs now, 3 rows already there" in " ".join(result.output.split())
     assert [r["amp"] for r in read_rows(out)] == [0.05, 0.1, 0.2]
+
+
+def test_the_table_fits_80_columns_in_a_real_terminal_width(block, tmp_path):
+    import os
+    import subprocess
+    import sys
+
+    out = tmp_path / "s.csv"
+    args = ["-p", "amp=0.05,0.6", "-p", "freq=1,2.5", "--duration", 0.02, "--workers", 0, "-o", out, "--no-recording"]
+    env = os.environ | {"COLUMNS": "80", "RERUN_ANALYTICS": "0"}
+    cmd = [sys.executable, "-m", "masonrycli", "sweep", str(block), *map(str, args)]
+    done = subprocess.run(cmd, env=env, capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr
+    lines = done.stdout.splitlines()
+    assert max(len(line) for line in lines) <= 80, done.stdout
+    body = [line for line in lines if line.startswith("│")]
+    assert len(body) == 4 and all(line.split("│")[3].strip() in ("intact", "damaged", "collapsed") for line in body), (
+        done.stdout
+    )
+    assert "collapse: time of collapse, s" in done.stdout and "every column in" in done.stdout

@@ -1,0 +1,131 @@
+"""The study's rows as the terminal shows them: one line per row at any width, units in a legend.
+
+Headers are short (``collapse``, ``drift``, ``open``) and every value is in the unit the legend names,
+with a fixed number of decimals, so a row stays on one line. When the columns do not fit the console,
+the least needed ones go first (``sweeps``, ``peak``, ``wall``, ``hinges``, ``open``, the intensity
+measure, ``drift``, ``collapse``; the parameters and the state always stay) and the legend says which
+are not shown; a cell still too wide ends in "…". Failed rows are listed under the table with their
+error. Every column is in the table file whatever the terminal shows.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+
+from rich.console import Console, Group
+from rich.measure import Measurement
+from rich.table import Table
+from rich.text import Text
+
+from masonrycli.intensity import UNITS as IM_UNITS
+from masonrycli.study.plots import UNITS as PARAM_UNITS
+
+SHOWN_ROWS = 40
+"""Rows shown in the terminal (the rest are in the table file)."""
+SHOWN_ERRORS = 5
+
+
+@dataclass(frozen=True)
+class Column:
+    """One terminal column: its ``header``, the row's value as text, the legend's words for it, and its
+    ``drop`` rank (0: always shown; the highest goes first when the console is too narrow)."""
+
+    header: str
+    cell: Callable[[dict], str]
+    legend: str = ""
+    drop: int = 0
+
+
+def _number(value, fmt: str, scale: float = 1.0) -> str:
+    """``value × scale`` as ``fmt``; "" for a missing or NaN value; "0.00", never "-0.00"."""
+    if not isinstance(value, (int, float)) or math.isnan(value):
+        return ""
+    text = format(value * scale, fmt)
+    return text[1:] if text.startswith("-") and float(text) == 0 else text
+
+
+def _count(value) -> str:
+    return str(int(value)) if isinstance(value, (int, float)) and not math.isnan(value) else ""
+
+
+def _param(value) -> str:
+    if isinstance(value, float):
+        return "" if math.isnan(value) else f"{value:.4g}"
+    return "" if value is None else str(value)
+
+
+def _params(names: list[str]) -> list[Column]:
+    columns = []
+    for n in names:
+        unit = PARAM_UNITS.get(n.rpartition(".")[2])
+        columns.append(Column(n, lambda r, n=n: _param(r.get(n)), f"{n} {unit}" if unit else ""))
+    return columns
+
+
+def grid_columns(names: list[str], im: str) -> list[Column]:
+    """The terminal columns of a grid or record study, with ``im`` the intensity measure shown."""
+    return _params(names) + [
+        Column("state", lambda r: str(r.get("state") or "failed")),
+        Column("collapse", lambda r: _number(r.get("collapse_time"), ".2f"), "collapse: time of collapse, s", 1),
+        Column("drift", lambda r: _number(r.get("residual_drift"), ".2f", 100.0), "drift: residual, % of height", 2),
+        Column(im, lambda r: _number(r.get(im), ".3g"), f"{im} {IM_UNITS[im]}", 3),
+        Column("open", lambda r: _number(r.get("max_opening"), ".1f", 1000.0), "open: largest opening, mm", 4),
+        Column("hinges", lambda r: _count(r.get("hinges")), "", 5),
+        Column("wall", lambda r: _number(r.get("wall_time"), ".1f"), "wall: run time, s", 6),
+        Column("peak", lambda r: _number(r.get("peak_drift"), ".2f", 100.0), "peak: drift, % of height", 7),
+        Column("sweeps", lambda r: _number(r.get("sweeps_mean"), ".0f"), "sweeps: NLGS per step, mean", 8),
+    ]
+
+
+def find_columns(names: list[str], find: str) -> list[Column]:
+    """The terminal columns of a threshold search (``--find``)."""
+    unit = PARAM_UNITS.get(find.rpartition(".")[2], "")
+    return _params(names) + [
+        Column(f"{find}_threshold", lambda r: _number(r.get(f"{find}_threshold"), ".4g"), f"{find}_threshold {unit}"),
+        Column("runs", lambda r: _count(r.get("evaluations")), "runs: evaluations", 1),
+        Column("note", lambda r: str(r.get("note") or "")),
+    ]
+
+
+def study_table(rows: list[dict], columns: list[Column], names: list[str], console: Console, where) -> Group:
+    """The table (as many ``columns`` as ``console.width`` holds), its legend, and the failed rows (their
+    point: the parameters ``names``); ``where``: the table file."""
+    shown = list(columns)
+    table = _table(rows, shown)
+    while _natural_width(console, table) > console.width and max(c.drop for c in shown) > 0:
+        last = max(c.drop for c in shown)
+        shown = [c for c in shown if c.drop != last]
+        table = _table(rows, shown)
+    legend = [c.legend for c in shown if c.legend]
+    hidden = [c.header for c in columns if c not in shown]
+    if hidden:
+        legend.append(f"not shown at this width: {', '.join(hidden)}")
+    legend.append(f"every column in {where}")
+    parts = [table, Text(" · ".join(legend))]
+    failed = [r for r in rows if r.get("status") == "error"]
+    for r in failed[:SHOWN_ERRORS]:
+        point = " ".join(f"{n}={_param(r.get(n))}" for n in names)
+        parts.append(Text(f"failed: {point}: {r.get('error') or ''}"))
+    if len(failed) > SHOWN_ERRORS:
+        parts.append(Text(f"… {len(failed) - SHOWN_ERRORS} more failed rows (their error column in {where})"))
+    return Group(*parts)
+
+
+def _natural_width(console: Console, table: Table) -> int:
+    # measured without the console's limit (rich clamps a measure to the width it is given); the minimum,
+    # so a note is counted at its longest word (it wraps), every other cell whole (one word, no wrap)
+    return Measurement.get(console, console.options.update_width(1 << 16), table).minimum
+
+
+def _table(rows: list[dict], columns: list[Column]) -> Table:
+    table = Table(title=f"study ({len(rows)} rows)", title_justify="left")
+    for c in columns:
+        words = c.header == "note"  # wrapped rather than cut
+        table.add_column(c.header, no_wrap=not words, overflow="fold" if words else "ellipsis")
+    for r in rows[:SHOWN_ROWS]:
+        table.add_row(*(c.cell(r) for c in columns))
+    if len(rows) > SHOWN_ROWS:
+        table.add_row(*(["…"] * len(columns)))
+    return table

@@ -1,0 +1,64 @@
+"""The study's terminal table (masonrycli.study.table): one line per row and no line over the console's
+width at 80 columns, whatever the study (long record names, failed rows, threshold searches); more
+columns on a wider console; every value in the unit its legend names."""
+
+from __future__ import annotations
+
+import io
+import math
+
+from rich.console import Console
+
+from masonrycli.study.table import find_columns, grid_columns, study_table
+
+
+def _render(rows, columns, names, width: int) -> list[str]:
+    console = Console(width=width, file=io.StringIO(), markup=False, highlight=False)
+    console.print(study_table(rows, columns, names, console, "ida.parquet"))
+    return console.file.getvalue().splitlines()
+
+
+def _row(record: str, scale: float, state: str = "damaged", **more) -> dict:
+    row = {"record": record, "scale": scale, "state": state, "collapse_time": math.nan, "residual_drift": -1e-9}
+    row |= {"pga": 3.2345, "max_opening": 0.03025, "hinges": 2, "wall_time": 12.34, "peak_drift": 0.0123}
+    return row | {"sweeps_mean": 41.6, "status": "completed", "error": ""} | more
+
+
+ROWS = [_row(f"synthetic-record-{k}.AT2", s) for k in range(3) for s in (0.5, 1.75, 3.0)]
+ROWS[4] |= {"state": "collapsed", "collapse_time": 0.5349, "residual_drift": 0.0775}
+ROWS[7] |= {"state": "", "status": "error", "error": "ValueError: " + "a long reason " * 12}
+
+
+def test_at_80_columns_every_row_is_one_line_within_the_width():
+    lines = _render(ROWS, grid_columns(["record", "scale"], "pga"), ["record", "scale"], 80)
+    assert max(len(line) for line in lines) <= 80
+    body = [line for line in lines if line.startswith("│")]
+    assert len(body) == len(ROWS)  # no cell folded onto a second line
+    assert "│ synthetic-record-1.AT2 │ 1.75  │ collapsed │ 0.53 " in body[4]  # what a user needs is there
+    assert "7.75" in body[4] and "0.00 " in body[0]  # drift in % of height; -1e-9 is not "-0.00"
+    legend = " ".join(" ".join(lines[len(body) + 5 :]).split())
+    assert "collapse: time of collapse, s" in legend and "drift: residual, % of height" in legend
+    assert "not shown at this width: hinges, wall, peak, sweeps" in legend and "every column in ida.parquet" in legend
+    assert "failed: record=synthetic-record-2.AT2 scale=1.75: ValueError: a long reason" in legend
+
+
+def test_a_wide_console_shows_every_column_and_the_units():
+    lines = _render(ROWS, grid_columns(["record", "scale"], "pga"), ["record", "scale"], 200)
+    header = next(line for line in lines if "record" in line and "state" in line)
+    for name in ("collapse", "drift", "pga", "open", "hinges", "wall", "peak", "sweeps"):
+        assert f" {name} " in header
+    said = " ".join(lines)
+    assert "not shown" not in said and "pga m/s²" in said and "open: largest opening, mm" in said
+    assert " 30.2 " in lines[7] and " 1.23 " in lines[7] and " 12.3 " in lines[7]  # mm, % of height, s
+
+
+def test_threshold_rows_fit_80_columns():
+    rows = [
+        {"freq": f, "amp_threshold": 1.3125, "evaluations": 9, "note": "", "status": "completed", "error": ""}
+        for f in (1.0, 2.0)
+    ]
+    rows[1] |= {"amp_threshold": math.nan, "note": "no collapse up to amp = 1.5 " * 3}
+    lines = _render(rows, find_columns(["freq"], "amp"), ["freq"], 80)
+    assert max(len(line) for line in lines) <= 80
+    assert any("│ 1    │ 1.312         │ 9    │" in line for line in lines)
+    assert "amp_threshold m/s" in " ".join(lines)
