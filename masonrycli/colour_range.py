@@ -139,9 +139,13 @@ class RangeTracker:
         """The range for this frame: the current one if the frame keeps both rules, else a refit."""
         r = self.current
         if r is None or not self._holds(r, values):
-            fitted = fit_range(values, self.kind, self.floor)
-            if fitted != r:
-                self.current, self.changes = fitted, self.changes + 1
+            return self._refit(values)
+        return r
+
+    def _refit(self, values: np.ndarray) -> ColourRange:
+        fitted = fit_range(values, self.kind, self.floor)
+        if fitted != self.current:
+            self.current, self.changes = fitted, self.changes + 1
         return self.current
 
     def follow(self, frames: np.ndarray) -> tuple[list[ColourRange], np.ndarray, np.ndarray]:
@@ -183,7 +187,7 @@ class RangeTracker:
                 window *= 2
             if k == n_frames:
                 break
-            r = self.update(v[k])  # a frame that breaks a rule (or the first one): refitted
+            r = self._refit(v[k])  # a frame that breaks a rule (or the first one)
             ranges.append(r)
             below[k], above[k], _ = r.outside(v[k])
             k += 1

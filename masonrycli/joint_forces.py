@@ -78,8 +78,7 @@ def joint_resultants(
     base = int(hi.max()) + 1 if hi.size else 1
     # 1-D keys (far faster than rows), sorted by (frame, a, b); sums per joint then run over its
     # contacts in their order whatever the other frames, so a frame's numbers do not depend on them.
-    keys, joint = np.unique((frame * base + lo) * base + hi, return_inverse=True)
-    joint = joint.reshape(-1)
+    keys, joint = _unique_inverse((frame * base + lo) * base + hi)
     pairs = np.stack([keys // base % base, keys % base], axis=1)
     j = len(pairs)
     fn = np.maximum(np.einsum("ij,ij->i", force, normal), 0.0)
@@ -97,6 +96,18 @@ def joint_resultants(
         state=state[loaded],
         frame=None if contact_frame is None else keys[loaded] // (base * base),
     )
+
+
+def _unique_inverse(keys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``np.unique(keys, return_inverse=True)``, without its sort when the keys are sorted already (the
+    engine's contacts come sorted by pair, and a batch's frames in order)."""
+    if keys.size and np.all(keys[1:] >= keys[:-1]):
+        first = np.empty(keys.size, dtype=bool)
+        first[0] = True
+        np.not_equal(keys[1:], keys[:-1], out=first[1:])
+        return keys[first], np.cumsum(first) - 1
+    unique, inverse = np.unique(keys, return_inverse=True)
+    return unique, inverse.reshape(-1)
 
 
 def magnification(displacement: np.ndarray, structure_size: float, share: float = 0.05) -> float:

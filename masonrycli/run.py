@@ -8,6 +8,7 @@ when a sink cannot write (``OSError``: the result says which sink and why).
 
 from __future__ import annotations
 
+import math
 import time as _time
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -180,7 +181,7 @@ class Simulation:
         if self.last is None:
             return ""
         speed = self.last.max_block_speed
-        if not np.isfinite(speed):
+        if not math.isfinite(speed):
             return "non-finite block position or velocity"
         if speed > DIVERGENCE_SPEED:
             return f"a block reached {speed:.3g} m/s (> {DIVERGENCE_SPEED:g} m/s)"

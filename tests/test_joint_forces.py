@@ -49,3 +49,14 @@ def test_magnification_draws_the_largest_displacement_at_five_percent():
     assert magnification(d, 7.0) == 6.0  # 0.05 · 7 / 0.05 = 7 → 6 (nice, rounded down)
     assert magnification(d, 0.5) == 1.0  # already more than 5 %
     assert magnification(np.zeros((2, 3, 2)), 7.0) == 1.0
+
+
+def test_unique_inverse_is_numpys_on_sorted_and_unsorted_keys():
+    from masonrycli.joint_forces import _unique_inverse
+
+    rng = np.random.default_rng(5)
+    for keys in (np.sort(rng.integers(0, 50, 200)), rng.integers(0, 50, 200), np.zeros(0, np.int64), np.array([7])):
+        unique, inverse = _unique_inverse(keys)
+        expected, expected_inverse = np.unique(keys, return_inverse=True)
+        np.testing.assert_array_equal(unique, expected)
+        np.testing.assert_array_equal(inverse, expected_inverse.reshape(-1))

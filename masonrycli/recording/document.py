@@ -6,6 +6,7 @@ that reaches the viewer goes through ``viewer_safe_text``.
 
 from __future__ import annotations
 
+import functools
 import importlib.metadata
 import platform
 import re
@@ -153,6 +154,7 @@ def _fmt_scale(x: float | None, unit: str) -> str:
     return "not fixed yet (zero so far)" if x is None else f"{x:.4g} {unit}".strip()
 
 
+@functools.cache  # importlib.metadata scans the installed distributions: ~1 ms a call
 def _versions() -> dict[str, str]:
     def dist(name: str) -> str:
         try:
