@@ -53,11 +53,21 @@ def _warm_start(key, count, prev_key, prev_r, r):
 @njit
 def _remember(key, r, count, out_key, out_r):
     # Keys sorted (stable) with their impulses, for the next step's binary searches.
-    order = np.argsort(key[:count], kind="mergesort")
+    # Insertion sort: detection emits the contacts sorted by body pair, the keys' leading bits, so only
+    # the one or two contacts of a pair can be out of order: ~linear, and no allocation.
     for i in range(count):
-        out_key[i] = key[order[i]]
-        out_r[i, 0] = r[order[i], 0]
-        out_r[i, 1] = r[order[i], 1]
+        k = key[i]
+        r0 = r[i, 0]
+        r1 = r[i, 1]
+        j = i - 1
+        while j >= 0 and out_key[j] > k:
+            out_key[j + 1] = out_key[j]
+            out_r[j + 1, 0] = out_r[j, 0]
+            out_r[j + 1, 1] = out_r[j, 1]
+            j -= 1
+        out_key[j + 1] = k
+        out_r[j + 1, 0] = r0
+        out_r[j + 1, 1] = r1
 
 
 @njit
