@@ -95,7 +95,11 @@ RUN = {
     "tolerance": _opt(
         float, "Run", "NLGS stopping test: RMS contact-law violation of a sweep, m/s (default 1e-5; 1e-8 is tight)."
     ),
-    "max_iterations": _opt(int, "Run", "NLGS sweep cap per step (default 50000)."),
+    "max_iterations": _opt(
+        int,
+        "Run",
+        "NLGS sweep cap per step (default 50000; a step also stops after 10000 sweeps without a new lowest residual).",
+    ),
 }
 Friction = _opt(float, "Material", "Coulomb coefficient of every contact (default 0.6).")
 FRICTION = {"friction": Friction}

@@ -223,3 +223,32 @@ def test_residual_is_rms_contact_law_violation_of_the_last_sweep(sweeps):
     v, r = v0.copy(), r0.copy()
     _, before = nlgs._nlgs(body, pack, count, mu, 0.0, its - 1, v, r, status) if its > 1 else (0, np.inf)
     assert before > 1e-9
+
+
+def test_a_solve_that_stops_improving_ends_stall_sweeps_after_its_lowest_residual():
+    # These contacts converge to the floating-point floor within 8 sweeps; after that the residual only
+    # wanders around 1e-16 m/s. With a tolerance the floor never meets, the solve must stop
+    # STALL_SWEEPS sweeps after its last new low (unconverged, as at the cap) instead of running to the
+    # cap; with tolerance 0 it runs the cap exactly.
+    q, inv_mass, inv_inertia, body, point, normal, gap = _random_contacts(seed=3)
+    mu, dt, count = 0.5, 1e-3, body.shape[0]
+    pack = np.zeros((count, nlgs.PACK_WIDTH))
+    nlgs._prepare(body, point, normal, gap, count, q, inv_mass, inv_inertia, mu, dt, pack)
+    rng = np.random.default_rng(19)
+    v0 = rng.normal(scale=0.1, size=(4, 3))
+    v0[3] = 0.0
+    r0 = np.abs(rng.normal(scale=0.01, size=(count, 2)))
+    status = np.zeros(count, dtype=np.int8)
+    # The residual after each of the first sweeps, one call each: the last new low among them.
+    lows = []
+    for n in range(1, 41):
+        v, r = v0.copy(), r0.copy()
+        lows.append(nlgs._nlgs(body, pack, count, mu, 0.0, n, v, r, status)[1])
+    last_low = max(i for i in range(len(lows)) if lows[i] < min(lows[:i], default=np.inf))
+    assert 0.0 < lows[last_low] < 1e-14
+    v, r = v0.copy(), r0.copy()
+    its, res = nlgs._nlgs(body, pack, count, mu, 1e-300, 10**6, v, r, status)
+    assert its == last_low + 1 + nlgs.STALL_SWEEPS and res > 1e-300
+    v, r = v0.copy(), r0.copy()
+    its, _ = nlgs._nlgs(body, pack, count, mu, 0.0, 3 * nlgs.STALL_SWEEPS, v, r, status)
+    assert its == 3 * nlgs.STALL_SWEEPS
