@@ -8,7 +8,7 @@ import numpy as np
 import pyarrow as pa
 import rerun as rr
 
-from masonrycli.joint_forces import JOINT_OPEN, JOINT_SLIP, JOINT_STICK
+from masonrycli.joint_forces import JOINT_OPEN, JOINT_SLIP, JOINT_STICK, joint_resultants
 from masonrycli.recording.arrays import FrameBatch, partition_lengths, uniform_strips
 from masonrycli.recording.layout import (
     COMPRESSION_RGBA,
@@ -80,3 +80,24 @@ def send_joints(rec: rr.RecordingStream, idx: list, b: FrameBatch, force_scale: 
     rec.send_columns(
         HINGES, indexes=idx, columns=rr.Points2D.columns(positions=hinges.astype(np.float32)).partition(per_frame)
     )
+
+
+CONTACT_ARRAYS: Final = ("body", "point", "normal", "force", "status")
+"""The Frame.contact_* arrays a batch keeps per frame (its "contacts") for :func:`batch_joint_resultants`."""
+
+
+def batch_joint_resultants(b: FrameBatch) -> None:
+    """The batch's "joint_point", "joint_force" and "joint_state" (one array per frame) from its "contacts":
+    the resultants of all its frames in one call, each drawn on the body above its joint (up the
+    structure, whatever the index order)."""
+    contacts = b.pop("contacts")
+    per_frame = [len(c[-1]) for c in contacts]
+    frame = np.repeat(np.arange(len(contacts)), per_frame)
+    body, point, normal, force, status = (np.concatenate([c[k] for c in contacts]) for k in range(5))
+    j = joint_resultants(body.reshape(-1, 2), point, normal, force, status, frame)
+    body_y = np.concatenate([b.stack("block_q")[..., 1], b.stack("support_q")[..., 1]], axis=1)
+    sign = np.where(body_y[j.frame, j.body[:, 1]] >= body_y[j.frame, j.body[:, 0]], 1.0, -1.0)[:, None]
+    cuts = np.cumsum(np.bincount(j.frame, minlength=len(contacts)))[:-1]
+    b["joint_point"] = np.split(j.point, cuts)
+    b["joint_force"] = np.split(j.force * sign, cuts)
+    b["joint_state"] = np.split(j.state, cuts)

@@ -39,7 +39,6 @@ import rerun as rr
 from masonrycli.colormap import map_positions, nice_ceil, robust_max_abs, tick_label
 from masonrycli.colour_range import RangeTracker, positions
 from masonrycli.frame import Frame
-from masonrycli.joint_forces import joint_resultants
 from masonrycli.recording.arrays import FrameBatch, Polygons, partition_lengths, time_indexes, z0
 from masonrycli.recording.document import legend_markdown, run_document, viewer_safe_text
 from masonrycli.recording.layout import (
@@ -69,7 +68,7 @@ from masonrycli.recording.layout import (
     build_blueprint,
 )
 from masonrycli.recording.magnified import send_magnified
-from masonrycli.recording.overlays import send_axes, send_joints
+from masonrycli.recording.overlays import CONTACT_ARRAYS, batch_joint_resultants, send_axes, send_joints
 from masonrycli.recording.readback import check_complete
 from masonrycli.recording.static_content import (
     LUTS,
@@ -224,8 +223,8 @@ class Recorder:
         b.add("block_q", q)
         b.add("support_q", sq)
         b.add("support_v", np.array(frame.support_v, f64).reshape(-1, 2))
-        # The joint resultants of the whole batch are made at once when it is sent (_joint_resultants).
-        b.add("contacts", tuple(np.array(getattr(frame, f"contact_{name}")) for name in _CONTACT_ARRAYS))
+        # The joint resultants of the whole batch are made at once when it is sent (batch_joint_resultants).
+        b.add("contacts", tuple(np.array(getattr(frame, f"contact_{name}")) for name in CONTACT_ARRAYS))
         b.add("hinge_point", np.array(getattr(frame, "hinge_point", np.zeros((0, 2))), f64).reshape(-1, 2))
         for key in TENSOR_KEYS:
             b.add(key, _tensor(frame.tensors, key, self._n))
@@ -287,7 +286,7 @@ class Recorder:
 
     # ---- per-batch content
     def _send_batch(self, b: FrameBatch) -> None:
-        _joint_resultants(b)
+        batch_joint_resultants(b)
         idx = time_indexes(b)
         q = b.stack("block_q")  # (F, N, 3)
         tensors = {key: b.stack(key) for key in TENSOR_KEYS}
@@ -490,26 +489,6 @@ class Recorder:
         self.rec.log(METADATA, rr.TextDocument(viewer_safe_text(text), media_type="text/markdown"), static=True)
         legend = legend_markdown(self.force_scale, self.block_height, self.magnify)
         self.rec.log(LEGEND, rr.TextDocument(viewer_safe_text(legend), media_type="text/markdown"), static=True)
-
-
-_CONTACT_ARRAYS: Final = ("body", "point", "normal", "force", "status")
-
-
-def _joint_resultants(b: FrameBatch) -> None:
-    """The batch's "joint_point", "joint_force" and "joint_state" (one array per frame) from its "contacts":
-    the resultants of all its frames in one call, each drawn on the body above its joint (up the
-    structure, whatever the index order)."""
-    contacts = b.pop("contacts")
-    per_frame = [len(c[-1]) for c in contacts]
-    frame = np.repeat(np.arange(len(contacts)), per_frame)
-    body, point, normal, force, status = (np.concatenate([c[k] for c in contacts]) for k in range(5))
-    j = joint_resultants(body.reshape(-1, 2), point, normal, force, status, frame)
-    body_y = np.concatenate([b.stack("block_q")[..., 1], b.stack("support_q")[..., 1]], axis=1)
-    sign = np.where(body_y[j.frame, j.body[:, 1]] >= body_y[j.frame, j.body[:, 0]], 1.0, -1.0)[:, None]
-    cuts = np.cumsum(np.bincount(j.frame, minlength=len(contacts)))[:-1]
-    b["joint_point"] = np.split(j.point, cuts)
-    b["joint_force"] = np.split(j.force * sign, cuts)
-    b["joint_state"] = np.split(j.state, cuts)
 
 
 def _tensor(tensors: dict, key: str, n: int) -> np.ndarray:
