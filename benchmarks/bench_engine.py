@@ -113,12 +113,12 @@ def run_once(case: str, record: bool) -> dict:
     return {
         "wall_s": wall,
         "sim_s": result.time,
-        "sweeps_per_step": float(result.iterations.mean()),
-        "contacts_per_step": float(result.contact_count.mean()),
+        "sweeps_per_step": result.tally.sweeps_mean,
+        "contacts_per_step": result.tally.contacts_mean,
         "ns_per_contact_sweep": 1e9 * probe.nlgs_s / max(probe.contact_sweeps, 1),
         "nlgs_share": probe.nlgs_s / wall,
         "tensor_share": probe.tensor_s / wall,
-        "steps_at_cap": int((result.iterations >= sc.run.max_iterations).sum()),
+        "steps_at_cap": result.tally.capped,
         "steps": steps,
     }
 

@@ -1,12 +1,14 @@
 """Peak resident memory (RSS) of a whole `masonry` run against its length.
 
-The 51-block wall shaken at 1 m/s, 2 Hz, every step recorded (``--record-every 1``), with the recording
-and the history, for 1 s and for 20 s of simulated time (1 001 and 20 001 frames). Each run is its own
-process; its peak RSS comes from ``os.wait4`` (``ru_maxrss``, kB on Linux). The outputs are written to a
-temporary folder and removed. Accuracy is not at stake here (the same run, only longer): the history's
-last frame is checked to be at the requested time.
+``--case wall`` (default): the 51-block wall shaken at 1 m/s, 2 Hz, every step recorded
+(``--record-every 1``), with the recording and the history, for 1 s and for 20 s of simulated time (1 001
+and 20 001 frames). ``--case steps``: what the run itself keeps per step, without outputs — one block at
+rest on the ground, dt = 1e-5 s (10⁵ and 2·10⁶ steps for 1 s and 20 s), no recording, no history. Each
+run is its own process; its peak RSS comes from ``os.wait4`` (``ru_maxrss``, kB on Linux). The outputs are
+written to a temporary folder and removed. Accuracy is not at stake here (the same run, only longer):
+the history's last frame (wall) or the summary (steps) is checked to be at the requested time.
 
-    .venv/bin/python benchmarks/bench_memory.py [--durations 1 20]
+    .venv/bin/python benchmarks/bench_memory.py [--case wall|steps] [--durations 1 20]
 """
 
 from __future__ import annotations
@@ -42,17 +44,48 @@ def peak_rss(duration: float, folder: Path) -> tuple[float, float, int, float]:
     return usage.ru_maxrss / 1024, wall, frames, size
 
 
+BLOCK = """
+[run]
+dt = 1e-5
+[[block]]
+polygon = [[-0.1, 0.0], [0.1, 0.0], [0.1, 0.6], [-0.1, 0.6]]
+[[support]]
+name = "ground"
+polygon = [[-5.0, -0.5], [5.0, -0.5], [5.0, 0.0], [-5.0, 0.0]]
+"""
+
+
+def peak_rss_steps(duration: float, folder: Path) -> tuple[float, float, int, float]:
+    """(peak RSS MB, wall time s, steps, 0) of a run of one block writing nothing."""
+    scenario = folder / "block.toml"
+    scenario.write_text(BLOCK)
+    argv = [sys.executable, "-m", "masonrycli", "run", str(scenario), "--duration", f"{duration:g}"]
+    argv += ["--no-recording"]
+    t0 = time.perf_counter()
+    proc = subprocess.Popen(argv, env=dict(os.environ, RERUN_ANALYTICS="0", COLUMNS="200"), stdout=subprocess.PIPE)
+    said = proc.stdout.read().decode()
+    _, status, usage = os.wait4(proc.pid, 0)
+    wall = time.perf_counter() - t0
+    steps = round(duration / 1e-5)
+    if os.waitstatus_to_exitcode(status) != 0 or f"{steps} (t = {duration:.4f} s)" not in said:
+        raise SystemExit(f"run of {duration:g} s failed:\n{said}")
+    return usage.ru_maxrss / 1024, wall, steps, 0.0
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--durations", type=float, nargs="+", default=[1.0, 20.0])
+    parser.add_argument("--case", choices=("wall", "steps"), default="wall")
     args = parser.parse_args()
+    measure = peak_rss if args.case == "wall" else peak_rss_steps
     rows = []
     with tempfile.TemporaryDirectory(prefix="masonry-bench-memory-") as tmp:
-        peak_rss(0.01, Path(tmp))  # numba cache warm, not measured
+        measure(0.01, Path(tmp))  # numba cache warm, not measured
         for duration in args.durations:
-            rows.append((duration, *peak_rss(duration, Path(tmp))))
-    print(f"load average {os.getloadavg()[0]:.1f}; 51-block wall, --record-every 1, recording + history")
-    print("| simulated | frames | outputs | wall time | peak RSS |")
+            rows.append((duration, *measure(duration, Path(tmp))))
+    what = "51-block wall, --record-every 1, recording + history" if args.case == "wall" else "one block, dt 1e-5"
+    print(f"load average {os.getloadavg()[0]:.1f}; {what}")
+    print(f"| simulated | {'frames' if args.case == 'wall' else 'steps'} | outputs | wall time | peak RSS |")
     print("|---|---|---|---|---|")
     for duration, rss, wall, frames, size in rows:
         print(f"| {duration:g} s | {frames} | {size:.0f} MB | {wall:.0f} s | {rss:.0f} MB |")

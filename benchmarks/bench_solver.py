@@ -131,15 +131,15 @@ def run_masonry(case: str, duration: float | None, record: bool, **run_options) 
         cpu, wall = time.process_time() - t_cpu, time.perf_counter() - t_wall
     if tmp is not None:
         tmp.cleanup()
-    its = result.iterations
+    tally = result.tally
     return {
         "cpu_s": cpu,
         "wall_s": wall,
         "sim_s": result.time,
-        "sweeps_mean": float(its.mean()),
-        "sweeps_max": int(its.max()),
+        "sweeps_mean": tally.sweeps_mean,
+        "sweeps_max": tally.sweeps_max,
         "unconverged": int(result.unconverged),
-        "contacts_mean": float(result.contact_count.mean()),
+        "contacts_mean": tally.contacts_mean,
         "ns_per_contact_sweep": 1e9 * timer.cpu / max(timer.contact_sweeps, 1),
         "nlgs_share": timer.cpu / cpu if cpu > 0 else 0.0,
         "samples": {str(k): v for k, v in sampler.values.items()},

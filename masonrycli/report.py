@@ -43,24 +43,23 @@ def progress_bar(console: Console, n_steps: int):
         yield on_progress
 
 
-def summary_table(result, max_iterations: int, recording: str | None, history: str | None) -> Table:
+def summary_table(result, recording: str | None, history: str | None) -> Table:
     """The end-of-run table: steps, contacts, NLGS effort, penetration, energy, outputs."""
     table = Table(title=f"masonry run — {result.status}", show_header=False, title_justify="left")
     table.add_column("quantity", style="bold")
     table.add_column("value")
-    its = result.iterations
+    tally = result.tally
     table.add_row("steps", f"{result.steps} (t = {result.time:.4f} s)")
     table.add_row("wall time", f"{result.wall_time:.2f} s ({result.steps / max(result.wall_time, 1e-9):.0f} steps/s)")
-    if its.size:
-        table.add_row("contacts per step", f"mean {result.contact_count.mean():.0f}, max {result.contact_count.max()}")
-        table.add_row("NLGS sweeps per step", f"mean {its.mean():.1f}, max {its.max()}")
-        capped = int((its >= max_iterations).sum())
-        table.add_row("steps at the sweep cap", f"{capped} ({100.0 * capped / its.size:.1f} %)")
+    if tally.steps:
+        table.add_row("contacts per step", f"mean {tally.contacts_mean:.0f}, max {tally.contacts_max}")
+        table.add_row("NLGS sweeps per step", f"mean {tally.sweeps_mean:.1f}, max {tally.sweeps_max}")
+        table.add_row("steps at the sweep cap", f"{tally.capped} ({100.0 * tally.capped / tally.steps:.1f} %)")
         bad = result.unconverged
         table.add_row(
-            "unconverged steps", Text(f"{bad} ({100.0 * bad / its.size:.1f} %)", style="bold red" if bad else "")
+            "unconverged steps", Text(f"{bad} ({100.0 * bad / tally.steps:.1f} %)", style="bold red" if bad else "")
         )
-        table.add_row("NLGS residual (m/s)", f"max {result.residual.max():.2e}, last {result.residual[-1]:.2e}")
+        table.add_row("NLGS residual (m/s)", f"max {tally.residual_max:.2e}, last {tally.residual_last:.2e}")
     table.add_row("max penetration", f"{result.max_penetration:.3e} m")
     table.add_row("energy (kinetic + potential)", f"{result.energy_initial:.4g} J → {result.energy_final:.4g} J")
     table.add_row("dissipated at contacts", f"{result.energy_dissipated:.4g} J")

@@ -31,6 +31,48 @@ DIVERGENCE_SPEED = 1e3
 
 
 @dataclass
+class SolverTally:
+    """Running aggregates of the per-step solver statistics, in constant memory however long the run:
+    what the summary and a study's row need. Means are exact (integer totals over the step count), and the
+    largest residual is NaN once a step's was, as a maximum over the per-step array would be."""
+
+    cap: int
+    """The sweep cap (``max_iterations``): a step that used as many sweeps counts as capped."""
+    steps: int = 0
+    sweeps: int = 0
+    """NLGS sweeps, in total."""
+    sweeps_max: int = 0
+    capped: int = 0
+    contacts: int = 0
+    """Contacts over the steps, in total."""
+    contacts_max: int = 0
+    residual_max: float = 0.0
+    """m/s: the largest residual of a step."""
+    residual_last: float = 0.0
+
+    def add(self, stats: StepStats) -> None:
+        """Count one step."""
+        sweeps, contacts, residual = int(stats.iterations), int(stats.contact_count), float(stats.residual)
+        self.steps += 1
+        self.sweeps += sweeps
+        self.sweeps_max = max(self.sweeps_max, sweeps)
+        self.capped += sweeps >= self.cap
+        self.contacts += contacts
+        self.contacts_max = max(self.contacts_max, contacts)
+        if (residual > self.residual_max or residual != residual) and self.residual_max == self.residual_max:
+            self.residual_max = residual  # a NaN residual makes the maximum NaN for good
+        self.residual_last = residual
+
+    @property
+    def sweeps_mean(self) -> float:
+        return self.sweeps / self.steps if self.steps else 0.0
+
+    @property
+    def contacts_mean(self) -> float:
+        return self.contacts / self.steps if self.steps else 0.0
+
+
+@dataclass
 class RunResult:
     """What happened, for the summary table."""
 
@@ -40,11 +82,8 @@ class RunResult:
     steps: int
     time: float
     wall_time: float
-    iterations: np.ndarray
-    """(steps,) NLGS sweeps per step."""
-    residual: np.ndarray
-    """(steps,) m/s: the solver's residual per step (compared with the tolerance)."""
-    contact_count: np.ndarray
+    tally: SolverTally
+    """The solver's effort over the steps run (per-step values: the history, or a sink's ``log_step``)."""
     max_penetration: float
     energy_initial: float
     energy_final: float
@@ -213,9 +252,7 @@ def simulate(
     m = sim.model
     n_steps = m.n_steps if steps is None else min(steps, m.n_steps)
     every = scenario.run.record_every
-    iterations = np.zeros(n_steps, dtype=np.int64)
-    residual = np.zeros(n_steps)
-    contacts = np.zeros(n_steps, dtype=np.int64)
+    tally = SolverTally(scenario.run.max_iterations)
     max_pen = 0.0
     e0 = sum(sim.energies())
     frames = 0
@@ -243,7 +280,7 @@ def simulate(
     ok = emit()
     for k in range(n_steps if ok else 0):
         stats = sim.step()
-        iterations[k], residual[k], contacts[k] = stats.iterations, stats.residual, stats.contact_count
+        tally.add(stats)
         max_pen = max(max_pen, stats.max_penetration)
         done = k + 1
         for log_step in per_step:
@@ -292,9 +329,7 @@ def simulate(
         steps=done,
         time=sim.state.time,
         wall_time=_time.perf_counter() - t0,
-        iterations=iterations[:done],
-        residual=residual[:done],
-        contact_count=contacts[:done],
+        tally=tally,
         max_penetration=max_pen,
         energy_initial=e0,
         energy_final=float(sum(sim.energies())),

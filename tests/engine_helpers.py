@@ -26,3 +26,16 @@ def run_history(sc) -> tuple[dict, object]:
     result = simulate(sc, sinks=[hist])
     assert result.status == "completed", result.message
     return {k: np.asarray(v) for k, v in hist.arrays().items()}, result
+
+
+class PerStep:
+    """A sink keeping every step's solver statistics (what the run kept itself before)."""
+
+    def __init__(self):
+        self.rows = []
+
+    def on_frame(self, frame) -> None:
+        pass
+
+    def log_step(self, step: int, time_s: float, stats) -> None:
+        self.rows.append((stats.iterations, stats.residual, stats.contact_count))

@@ -13,6 +13,8 @@ from masonrycli.collapse import RULES, CollapseMonitor, CollapseRule
 from masonrycli.run import Simulation, simulate
 from masonrycli.scenario_toml import loads_scenario
 
+from engine_helpers import PerStep
+
 G = 9.81
 F = 2.0
 
@@ -92,16 +94,17 @@ def test_first_sliding_and_rocking_at_the_closed_form_threshold(width, height, f
 
 def test_slender_block_overturns_and_early_stop_keeps_the_same_steps():
     scenario = block_scenario(0.25, 1.0, 0.8, 0.5, duration=2.0)  # 2.6 × the rocking threshold
-    full = simulate(scenario)
+    full_steps, early_steps = PerStep(), PerStep()
+    full = simulate(scenario, [full_steps])
     assert full.outcome["state"] == "collapsed" and full.outcome["peak_drift"] > 0.25
     t_c = full.outcome["collapse_time"]
     assert 0.5 < t_c < 2.0 and full.extra["state"].startswith(f"collapsed at t = {t_c:.3f} s")
     sim = Simulation(scenario)
-    early = simulate(scenario, sim=sim, stop_at_collapse=True)
+    early = simulate(scenario, [early_steps], sim=sim, stop_at_collapse=True)
     assert early.status == "completed" and "stopped at collapse" in early.message
     assert early.steps == round(t_c / 1e-3) < full.steps
     assert early.outcome["collapse_time"] == t_c
-    np.testing.assert_array_equal(early.iterations, full.iterations[: early.steps])
+    assert early_steps.rows == full_steps.rows[: early.steps]
 
 
 def test_block_at_rest_is_intact():

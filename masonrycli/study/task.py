@@ -75,7 +75,7 @@ def run_task(
     except Exception as exc:  # a failed task is reported in its row; the study goes on
         return row | empty_result(f"{type(exc).__name__}: {exc}", time.perf_counter() - start)
     out = result.outcome
-    its = result.iterations
+    tally = result.tally
     row |= {
         "state": out["state"],
         "collapse_time": out["collapse_time"],
@@ -89,9 +89,9 @@ def run_task(
         "time": result.time,
         "wall_time": time.perf_counter() - start,
         "cpu_time": time.process_time() - cpu_start,
-        "sweeps_mean": float(its.mean()) if its.size else 0.0,
-        "capped_steps": int((its >= scenario.run.max_iterations).sum()),
-        "last_residual": float(result.residual[-1]) if result.residual.size else 0.0,
+        "sweeps_mean": tally.sweeps_mean,
+        "capped_steps": tally.capped,
+        "last_residual": tally.residual_last,
         "max_penetration": result.max_penetration,
         "error": result.message if result.status == "diverged" else "",
     }
