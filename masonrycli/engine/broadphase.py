@@ -18,7 +18,7 @@ import numpy as np
 from ._arrays import check_array, check_vertices
 from ._jit import njit
 
-__all__ = ["PairBuffers", "body_aabbs", "candidate_pairs", "world_vertices"]
+__all__ = ["PairBuffers", "body_aabbs", "candidate_pairs", "check_pair_inputs", "world_vertices"]
 
 
 # --------------------------------------------------------------------------------------------------
@@ -258,6 +258,15 @@ class PairBuffers:
     def pair_capacity(self) -> int:
         return self.pair_body.shape[0]
 
+    def choose_axis(self, body_aabb) -> None:
+        """First call: sweep along the axis of largest spread of the box centres (fewest boxes overlapping
+        along the sweep axis), and start from a stable numpy sort so that the kernel's insertion sort
+        only ever sees nearly sorted input."""
+        centre = body_aabb[:, :2] + body_aabb[:, 2:]
+        spread = centre.std(axis=0) if body_aabb.shape[0] else np.zeros(2)
+        self.axis = 0 if spread[0] >= spread[1] else 1
+        self.body_order[:] = np.argsort(body_aabb[:, self.axis], kind="stable")
+
     def grow(self, needed: int) -> None:
         """Make room for at least ``needed`` pairs (capacity doubles until it fits)."""
         capacity = self.pair_capacity
@@ -266,6 +275,17 @@ class PairBuffers:
         if capacity != self.pair_capacity:
             self.pair_body = np.zeros((capacity, 2), dtype=np.int32)
             self.pair_scratch = np.zeros_like(self.pair_body)
+
+
+def check_pair_inputs(body_count: int, body_dynamic, buffers: PairBuffers) -> None:
+    """Raise ValueError unless ``body_dynamic`` is (B,) bool for the B bodies ``buffers`` were made for."""
+    if body_count != buffers.body_count or body_dynamic.shape != (body_count,):
+        raise ValueError(
+            f"candidate_pairs: {body_count} boxes, {body_dynamic.shape} body_dynamic, "
+            f"buffers for {buffers.body_count} bodies"
+        )
+    if body_dynamic.dtype != np.bool_:
+        raise ValueError(f"candidate_pairs: body_dynamic must be bool, got {body_dynamic.dtype}")
 
 
 def candidate_pairs(body_aabb, body_dynamic, buffers: PairBuffers) -> int:
@@ -287,22 +307,9 @@ def candidate_pairs(body_aabb, body_dynamic, buffers: PairBuffers) -> int:
         Number of pairs; they are ``buffers.pair_body[:pair_count]`` ((a, b) with a < b, sorted by
         (a, b), int32). The order depends on the set of pairs only.
     """
-    body_count = body_aabb.shape[0]
-    if body_count != buffers.body_count or body_dynamic.shape != (body_count,):
-        raise ValueError(
-            f"candidate_pairs: {body_count} boxes, {body_dynamic.shape} body_dynamic, "
-            f"buffers for {buffers.body_count} bodies"
-        )
-    if body_dynamic.dtype != np.bool_:
-        raise ValueError(f"candidate_pairs: body_dynamic must be bool, got {body_dynamic.dtype}")
+    check_pair_inputs(body_aabb.shape[0], body_dynamic, buffers)
     if buffers.axis < 0:
-        # First call: sweep along the axis of largest spread of the box centres (fewest boxes
-        # overlapping along the sweep axis), and start from a stable numpy sort so that the
-        # kernel's insertion sort only ever sees nearly sorted input.
-        centre = body_aabb[:, :2] + body_aabb[:, 2:]
-        spread = centre.std(axis=0) if body_count else np.zeros(2)
-        buffers.axis = 0 if spread[0] >= spread[1] else 1
-        buffers.body_order[:] = np.argsort(body_aabb[:, buffers.axis], kind="stable")
+        buffers.choose_axis(body_aabb)
     while True:
         n = _sweep_and_prune(
             body_aabb,

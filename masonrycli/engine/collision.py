@@ -4,9 +4,10 @@ Stages (each a numba kernel): world vertices, bounding boxes and sweep-and-prune
 (:mod:`.broadphase`); edge normals and the separating-axis / clipping narrow phase
 (:mod:`.narrowphase`).
 
-Python orchestration only, through the checking launchers of :mod:`.broadphase` and :mod:`.narrowphase`
-(they check shapes and dtypes; their numba kernels do the work). One :class:`ContactBuffers` per model is
-reused every step, so that a step allocates nothing unless a capacity is exceeded (capacities then double).
+The stages run as one kernel call (:func:`_detect`); the launcher checks shapes and dtypes as the stage
+launchers of :mod:`.broadphase` and :mod:`.narrowphase` do, once per model and buffers, chooses the sweep
+axis at the first call and grows the buffers. One :class:`ContactBuffers` per model is reused every step,
+so that a step allocates nothing unless a capacity is exceeded (capacities then double).
 
 Typical use in the time loop::
 
@@ -23,19 +24,11 @@ from typing import NamedTuple
 
 import numpy as np
 
-from ._arrays import check_array
+from ._arrays import check_array, check_vertices
 from ._jit import njit
-from .broadphase import (
-    PairBuffers,
-    _body_aabbs,
-    _sweep_and_prune,
-    _world_vertices,
-    body_aabbs,
-    candidate_pairs,
-    world_vertices,
-)
+from .broadphase import PairBuffers, _body_aabbs, _sweep_and_prune, _world_vertices, check_pair_inputs, world_vertices
 from .contact_key import check_topology, decode_contact_key
-from .narrowphase import _edge_normals, _narrowphase, edge_normals, narrowphase
+from .narrowphase import _edge_normals, _narrowphase
 
 __all__ = ["ContactBuffers", "Contacts", "decode_contact_key", "detect_contacts", "world_vertices"]
 
@@ -192,10 +185,14 @@ def detect_contacts(body_q, body_vert_start, vert_local, body_dynamic, alert, bu
     alert = float(alert)
     if not alert >= 0.0:
         raise ValueError(f"detect_contacts: alert distance must be >= 0, got {alert}")
-    if buffers.checked_for(vert_local, body_dynamic, body_vert_start):
-        # The same model and buffers as the last call, checked then: one kernel call does it all.
-        check_array("world_vertices", "body_q", body_q, (buffers.body_count, 3), np.float64)
-        pairs = buffers.pairs
+    if not buffers.checked_for(vert_local, body_dynamic, body_vert_start):
+        # Shapes and dtypes as the stage launchers check them, once per model and buffers.
+        vertex_count, body_count = check_vertices("world_vertices", "vert_local", vert_local, body_vert_start)
+        check_array("world_vertices", "out", buffers.vert_world, (vertex_count, 2), np.float64)
+        check_pair_inputs(body_count, body_dynamic, buffers.pairs)
+    check_array("world_vertices", "body_q", body_q, (buffers.body_count, 3), np.float64)
+    pairs = buffers.pairs
+    while True:  # one kernel call, again only to choose the sweep axis (first call) or to grow
         pair_count, n = _detect(
             body_q, body_vert_start, vert_local, body_dynamic, alert,
             buffers.vert_world, buffers.body_aabb, pairs.axis, pairs.body_order, pairs.pair_body,
@@ -204,35 +201,28 @@ def detect_contacts(body_q, body_vert_start, vert_local, body_dynamic, alert, bu
             buffers.contact_key,
         )  # fmt: skip
         if n >= 0:
-            pairs.pair_count = pair_count
-            buffers.contact_count = n
-            return n
-        if pair_count < 0:
+            break
+        if pair_count == _NOT_FINITE:
             _raise_non_finite(body_q)
-    # First call, other arrays, or a capacity exceeded: stage by stage through the checking launchers.
-    if not np.isfinite(body_q).all():
-        _raise_non_finite(body_q)
-    world_vertices(body_q, body_vert_start, vert_local, buffers.vert_world)
-    body_aabbs(buffers.vert_world, body_vert_start, alert, buffers.body_aabb)
-    pair_count = candidate_pairs(buffers.body_aabb, body_dynamic, buffers.pairs)
-    if buffers.contact_capacity < 2 * pair_count:  # ≤ 2 contacts per pair: the kernel never overflows
-        buffers.grow_contacts(2 * pair_count)
-    edge_normals(buffers.vert_world, body_vert_start, buffers.edge_normal, buffers.body_size)
-    n = narrowphase(
-        buffers.vert_world, buffers.edge_normal, buffers.body_size, body_vert_start,
-        buffers.pairs.pair_body, pair_count, alert,
-        buffers.contact_body, buffers.contact_point, buffers.contact_normal, buffers.contact_gap,
-        buffers.contact_key,
-    )  # fmt: skip
+        if pair_count == _NO_AXIS:
+            pairs.choose_axis(buffers.body_aabb)
+        else:  # ≤ 2 contacts per pair: room for 2 P contacts and the narrow phase never overflows
+            pairs.grow(pair_count)
+            buffers.grow_contacts(2 * pair_count)
+    pairs.pair_count = pair_count
     buffers.contact_count = n
     buffers._checked_inputs = (vert_local, body_dynamic, body_vert_start)
-    buffers._checked_pairs = buffers.pairs.pair_body
+    buffers._checked_pairs = pairs.pair_body
     return n
 
 
 def _raise_non_finite(body_q) -> None:
     bad = int(np.flatnonzero(~np.isfinite(body_q).all(axis=1))[0])
     raise FloatingPointError(f"detect_contacts: body {bad} has a non-finite pose {body_q[bad]}")
+
+
+_NOT_FINITE = -1
+_NO_AXIS = -2
 
 
 @njit
@@ -242,16 +232,20 @@ def _detect(
     contact_body, contact_point, contact_normal, contact_gap, contact_key,
 ):  # fmt: skip
     # The stages of detect_contacts in one call (each a kernel of .broadphase / .narrowphase):
-    #   any pose not finite                                  → (-1, -1)
-    #   world vertices, boxes grown by alert/2, sweep and prune → P pairs
+    #   any pose not finite                                  → (_NOT_FINITE, -1)
+    #   world vertices, boxes grown by alert/2
+    #   no sweep axis yet (first call)                       → (_NO_AXIS, -1): the launcher chooses it
+    #   sweep and prune                                      → P pairs
     #   P beyond the pair capacity or 2P beyond the contact capacity → (P, -1): the launcher grows
     #   edge normals, narrow phase                           → (P, C)
     for b in range(body_q.shape[0]):
         for k in range(3):
             if not np.isfinite(body_q[b, k]):
-                return -1, -1
+                return _NOT_FINITE, -1
     _world_vertices(body_q, body_vert_start, vert_local, vert_world)
     _body_aabbs(vert_world, body_vert_start, 0.5 * alert, body_aabb)
+    if axis < 0:
+        return _NO_AXIS, -1
     pair_count = _sweep_and_prune(body_aabb, body_dynamic, axis, body_order, pair_body, pair_scratch, counter)
     if pair_count > pair_body.shape[0] or 2 * pair_count > contact_gap.shape[0]:
         return pair_count, -1
