@@ -30,12 +30,16 @@ one course per sweep, and a slow mode can keep velocities 1e-4 m/s off while eac
 Stagnation. On tall walls that slide (32 courses and more, shaken at 1 m/s) Gauss–Seidel can cycle: at
 step 74 of the 32-course wall the residual wanders between 7.7e-5 and 2.3e-4 m/s for 50 000 sweeps while
 hundreds of sliding bed-joint corners change status (benchmarks/README.md). Such a step never meets the
-tolerance; sweeping it to the cap cost half of that wall's run time. A solve with a tolerance > 0
-therefore also stops after STALL_SWEEPS sweeps without a new lowest residual, and the step is counted
-unconverged exactly as at the cap (that step stops after 13 305 sweeps instead of 50 000). A slowly
-converging step is not cut, since its residual keeps reaching new lows: the aqueduct's first 0.2 s, with
-steps of up to 33 292 sweeps that end just under 1e-5 m/s, is bit-identical. (Requiring a 10 % gain
-per 10 000 sweeps instead cut one of them at 28 775 sweeps and 1.34e-5 m/s.) Tolerance 0 never stalls.
+tolerance, and sweeping it to the cap cost half of that wall's run time. So when a solve with a
+tolerance > 0 goes STALL_SWEEPS sweeps without a new lowest residual, it continues by faces
+(:mod:`masonrycli.engine.faces`: the points of each face solved together, which does not cycle there)
+until the tolerance, the cap (counted in sweep units), or the faces stall in turn; a step that still
+misses the tolerance is counted unconverged as at the cap. Over 1 s of the 32-course wall this leaves
+no unconverged step (5 before, each 50 000 sweeps; the two longest steps now take 21 388 and 29 436
+sweep units). A slowly converging step is not handed over, since its residual keeps reaching new lows:
+the aqueduct's first 0.2 s, with steps of up to 33 292 sweeps that end just under 1e-5 m/s, and every
+golden history are bit-identical (a 2000-sweep window changed them and left one step of the 32-course
+wall unconverged). Tolerance 0 runs exactly the cap.
 """
 
 from __future__ import annotations
@@ -46,7 +50,7 @@ from masonrycli.engine._jit import njit
 from masonrycli.engine.contact import ContactStatus
 
 STALL_SWEEPS = 10_000
-"""A solve with a tolerance > 0 stops as stalled after this many sweeps without a new lowest residual
+"""Point sweeps without a new lowest residual after which a solve with a tolerance > 0 continues by faces
 (module doc, "Stagnation")."""
 
 # Plain ints for the kernels (the enum is for readers).
@@ -220,8 +224,7 @@ def _nlgs(contact_body, pack, count, mu, tolerance, max_iterations, v, r, status
     #                       v += M⁻¹ H_α (r_α' − r_α)
     #       residual = sqrt(Σ_α |e_α|² / C)
     #   until residual ≤ tolerance, or the cap, or (tolerance > 0) STALL_SWEEPS sweeps in a row without
-    #   a new lowest residual: the step is then unconverged either way, and sweeping on to the cap only
-    #   costs time (module doc).
+    #   a new lowest residual: sweeping on would only cycle (module doc), solve() goes on by faces.
     for c in range(count):
         _push(v, contact_body[c, 0], contact_body[c, 1], pack, c, r[c, 0], r[c, 1])
     iterations = 0
@@ -396,10 +399,14 @@ def solve(contact_body, pack, count, model, v, r, status) -> tuple[int, float]:
     Returns (iterations, residual): sweeps done, and the last sweep's RMS contact-law violation in m/s
     (module doc). Another method plugged in beside this one keeps the signature, reports its work in
     sweep equivalents (contact visits / C) and the same residual, so that the history and the
-    unconverged count mean the same thing."""
-    return _nlgs_interleaved(
-        contact_body, pack, count, model.friction, model.tolerance, model.max_iterations, v, r, status
-    )
+    unconverged count mean the same thing. A solve that stalls continues by faces (module doc); its
+    iterations are then the point sweeps plus the faces' sweep units."""
+    mu, tolerance, cap = model.friction, model.tolerance, model.max_iterations
+    iterations, residual = _nlgs_interleaved(contact_body, pack, count, mu, tolerance, cap, v, r, status)
+    if tolerance > 0.0 and residual > tolerance and iterations < cap:  # stalled, not capped
+        units, residual = faces.face_sweeps(contact_body, pack, count, mu, tolerance, cap - iterations, v, r, status)
+        iterations += units
+    return iterations, residual
 
 
 def contact_power(
@@ -426,3 +433,7 @@ def tangential_velocity(contact_body, pack, count, v) -> np.ndarray:
     out = np.empty(count)
     _tangential_velocity(contact_body, pack, count, v, out)
     return out
+
+
+# At the end: faces builds on this module's sweep primitives (a stalled solve() continues there).
+from masonrycli.engine import faces  # noqa: E402
