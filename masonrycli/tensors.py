@@ -359,6 +359,7 @@ class TensorComputer:
         self._chain_rate = np.full((1, n), np.nan)
         self._buffers = {"tensor": self._tensor, "pair": self._pair, "scalar": self._scalar, "chain": self._chain_rate}
         self._invariants_stale = False
+        self._stress_inputs: tuple | None = None  # the last step's arrays until fields() reads them
         self.reset_strain()
 
     def reset_strain(self) -> None:
@@ -377,7 +378,9 @@ class TensorComputer:
         contact_force: np.ndarray,
         dt: float,
     ) -> None:
-        """Compute every field for the state passed in and add dt · (its strain rate) to the strain.
+        """Add dt · (the strain rate of the state passed in) to the strain; the other fields of that state
+        are computed when :meth:`fields` reads them, from these same arrays (kept by reference: leave them
+        as they are until then, as the time loop does with its buffers between a step and its frame).
 
         Args:
             block_q: (B ≥ N, 3) float64 centroid x, y (m), θ (rad) — body or block array; rows ≥ N ignored.
@@ -397,21 +400,9 @@ class TensorComputer:
                 f"contact_body {contact_body.shape}, contact_point {contact_point.shape}, "
                 f"contact_force {contact_force.shape}"
             )
-        _k._tensor_step(
-            n,
-            block_q,
-            block_v,
-            self.block_volume,
-            self.triangles,
-            self.min_star_area,
-            self.chain,
-            contact_body,
-            contact_point,
-            contact_force,
-            float(dt),
-            self._tensor,
-            self._chain_rate[0],
-        )
+        _k._strain_step(n, block_q, block_v, self.triangles, self.min_star_area, float(dt), self._tensor)
+        # Stress and chain strain rate are read at recorded frames only: computed then (fields).
+        self._stress_inputs = (block_q, block_v, contact_body, contact_point, contact_force)
         self._invariants_stale = True
 
     def fields(self) -> dict[str, np.ndarray]:
@@ -421,6 +412,21 @@ class TensorComputer:
         functions of the stored tensors; they are derived here, once per ``step``, rather than in
         every ``step`` — the values are the same, and steps that are not recorded skip ~20 µs.
         """
+        if self._stress_inputs is not None:
+            q, v, body, point, force = self._stress_inputs
+            _k._stress_step(
+                self.block_count,
+                q,
+                v,
+                self.block_volume,
+                self.chain,
+                body,
+                point,
+                force,
+                self._tensor,
+                self._chain_rate[0],
+            )
+            self._stress_inputs = None
         if self._invariants_stale:
             _k._tensor_invariants(self._tensor, self._pair, self._scalar)
             self._invariants_stale = False

@@ -22,7 +22,7 @@ ISOTROPY_TOLERANCE = 1e-14
 (c = (a+d)/2) is treated as isotropic: its principal angle is reported as 0 instead of a direction
 that would only reflect round-off (and flicker from one step to the next)."""
 
-# Rows of the packed outputs of ``_tensor_step`` (see ``masonrycli.tensors.TensorComputer``).
+# Rows of the packed outputs of ``_strain_step`` / ``_stress_step`` (see ``masonrycli.tensors.TensorComputer``).
 T_BLOCK_STRESS, T_CELL_STRESS, T_CELL_STRAIN_RATE, T_CELL_STRAIN = 0, 1, 2, 3
 TENSOR_ROWS = 4
 P_STRESS, P_STRAIN_RATE, P_STRAIN = 0, 1, 2
@@ -273,41 +273,42 @@ def _principal(tensor, out_values, out_angle, out_isotropic, out_deviatoric, tra
 
 
 # ---------------------------------------------------------------------------------------------------
-# Everything for one step, one dispatch
+# One dispatch per step, one per read
 # ---------------------------------------------------------------------------------------------------
 
 
-# block stress → cell neighbours → cell stress → strain rate, chain strain rate → strain += dt·rate.
-# The invariants are derived separately (``_tensor_invariants``), only when the fields are read.
+# strain rate → strain += dt·rate: every step (the cumulated strain needs each step's rate).
 @njit
-def _tensor_step(
+def _strain_step(block_count, block_q, block_v, triangles, min_area, dt, tensor_out):
+    # Inputs: as the kernels above; Outputs: tensor_out[T_CELL_STRAIN_RATE], tensor_out[T_CELL_STRAIN] (in/out)
+    rate = tensor_out[T_CELL_STRAIN_RATE]
+    _cell_strain_rate(block_count, block_q, block_v, triangles, min_area, rate)
+    if dt != 0.0:
+        _integrate_strain(rate, dt, tensor_out[T_CELL_STRAIN])
+
+
+# block stress → cell neighbours → cell stress, chain strain rate: only when the fields are read (the
+# step's own inputs; nothing carries over from one step to the next).
+@njit
+def _stress_step(
     block_count,
     block_q,
     block_v,
     block_volume,
-    triangles,
-    min_area,
     chain,
     contact_body,
     contact_point,
     contact_force,
-    dt,
     tensor_out,
     chain_out,
 ):
-    # Inputs: as the kernels above
-    # Outputs: tensor_out (4,N,2,2) rows T_* (tensor_out[T_CELL_STRAIN] in/out: the cumulated strain),
-    #          chain_out (N,) chain strain rate
+    # Outputs: tensor_out[T_BLOCK_STRESS], tensor_out[T_CELL_STRESS], chain_out (N,) chain strain rate
     n = block_count
     block_stress = tensor_out[T_BLOCK_STRESS]
     _block_stress(n, block_q, block_volume, contact_body, contact_point, contact_force, block_stress)
     start, neighbour = _cell_neighbours(n, contact_body)
     _cell_average(n, start, neighbour, block_volume, block_stress, tensor_out[T_CELL_STRESS])
-    rate = tensor_out[T_CELL_STRAIN_RATE]
-    _cell_strain_rate(n, block_q, block_v, triangles, min_area, rate)
     _chain_strain_rate(n, block_q, block_v, chain, chain_out)
-    if dt != 0.0:
-        _integrate_strain(rate, dt, tensor_out[T_CELL_STRAIN])
 
 
 # cell stress: skew |t_xy − t_yx|/2, principal values/angle, p = (σ1+σ2)/2, q = (σ1−σ2)/2
