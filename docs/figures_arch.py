@@ -57,8 +57,9 @@ def arch(path: str, kind: str) -> None:
     )
     it = h["nlgs_iterations"][1:]
     print(
-        f"NLGS: mean {it.mean():.0f} sweeps per recorded step, {(it >= 1000).mean() * 100:.1f} % of the recorded "
-        f"steps at the 1000-sweep cap, residual max {h['nlgs_residual'][1:].max():.2e}\n"
+        f"NLGS: mean {it.mean():.0f} sweeps per recorded step (max {it.max()}), "
+        f"{int(h['nlgs_unconverged'][-1])} unconverged steps in the run, "
+        f"residual max {h['nlgs_residual'][1:].max():.2e} m/s\n"
     )
 
     ends, normal = joint_faces(run)

@@ -343,7 +343,7 @@ def wall(path: str, static: str | None) -> None:
             raise SystemExit(f"{static}: not the same wall as {path}")
         last = len(hs["time"]) - 1
         print(
-            f"Ground at rest ({static}), t = {hs['time'][last]:.3f} s (NLGS tolerance "
-            f"{hs['nlgs_residual'][last]:.2g} reached):\n"
+            f"Ground at rest ({static}), t = {hs['time'][last]:.3f} s (NLGS residual "
+            f"{hs['nlgs_residual'][last]:.2g} m/s):\n"
         )
         table(hdr, syy_rows(hs, last), fmt)
