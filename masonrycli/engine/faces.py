@@ -37,7 +37,10 @@ first round."""
 
 @njit
 def _visit(contact_body, pack, c, mu, v, r, status):
-    # One exact local solve at contact c, as the point sweep does; returns |W_αα Δr_α|².
+    # One exact local solve at contact c; returns |W_αα Δr_α|². The same arithmetic as the body of
+    # nlgs._nlgs's contact loop, which keeps its own copy on purpose: calling this function from the
+    # point sweep (even with inline="always") took 8.7 -> 47-57 ns per contact·sweep on captured steps of
+    # the 248-block wall, bit-identical results. The faces fallback pays that call; the hot sweep must not.
     a = contact_body[c, 0]
     b = contact_body[c, 1]
     ut, un = _relative_velocity(v, a, b, pack, c)
