@@ -83,3 +83,27 @@ def project_cone(r: np.ndarray, mu: float) -> np.ndarray:
     lim = mu * out[:, 1]
     out[:, 0] = np.clip(out[:, 0], -lim, lim)
     return out
+
+
+def sweeps_with_corrections(ctx, target: float, sweeps: int, cap: int, clock: Clock, correct):
+    """Engine sweeps from r_warm in chunks of ``sweeps`` until the law residual ≤ ``target`` or ``cap``
+    sweeps; after each chunk that misses it, ``correct(v, r, residual)`` returns a new (r, v) to continue
+    from, or None to keep the iterate. The residual checks are timed as "check" (the engine would do them
+    in the sweep). Returns (v, r, sweeps done, corrections tried, corrections kept, converged)."""
+    r = ctx.p.r_warm.copy()
+    v = None
+    done = tried = kept = 0
+    while done < cap:
+        with clock("sweeps"):
+            v, _ = ctx.sweep(r, sweeps)
+        done += sweeps
+        with clock("check"):
+            residual = ctx.residual(v, r)
+        if residual <= target:
+            return v, r, done, tried, kept, True
+        tried += 1
+        new = correct(v, r, residual)
+        if new is not None:
+            r, v = new
+            kept += 1
+    return v, r, done, tried, kept, False

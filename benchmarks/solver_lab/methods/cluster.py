@@ -36,7 +36,7 @@ import scipy.sparse.linalg as spla
 from scipy.sparse.csgraph import connected_components
 
 from benchmarks.solver_lab import law
-from benchmarks.solver_lab.outcome import Clock, Outcome
+from benchmarks.solver_lab.outcome import Clock, Outcome, sweeps_with_corrections
 from benchmarks.solver_lab.problems import pack_contacts
 from masonrycli.engine import nlgs
 
@@ -132,26 +132,14 @@ def coarse_step(ctx, v, r, clock):
 
 
 def cluster_nlgs(ctx, target) -> Outcome:
-    p = ctx.p
     clock = Clock()
-    r = p.r_warm.copy()
-    fine = corrections = accepted = 0
-    ok = False
-    while fine < CAP:
-        with clock("sweeps"):
-            v, _ = ctx.sweep(r, SWEEPS)
-        fine += SWEEPS
-        with clock("check"):
-            res = ctx.residual(v, r)
-        if res <= target:
-            ok = True
-            break
-        corrections += 1
+
+    def correct(v, r, res):
         r2, v2, _ = coarse_step(ctx, v, r, clock)
         with clock("check"):
-            if ctx.residual(v2, r2) <= res:
-                r, v = r2, v2
-                accepted += 1
+            return (r2, v2) if ctx.residual(v2, r2) <= res else None
+
+    v, r, fine, corrections, accepted, ok = sweeps_with_corrections(ctx, target, SWEEPS, CAP, clock, correct)
     coarse_s = sum(s for k, s in clock.phases.items() if k in ("build", "coarse", "intra"))
     out = Outcome(v, r, fine, fine + coarse_s / ctx.sweep_s, clock.phases, converged=ok)
     out.corrections, out.accepted = corrections, accepted  # read by the lab's diagnostics, not the table

@@ -27,7 +27,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from benchmarks.solver_lab import law
-from benchmarks.solver_lab.outcome import Clock, Outcome, project_cone
+from benchmarks.solver_lab.outcome import Clock, Outcome, project_cone, sweeps_with_corrections
 from masonrycli.engine import nlgs as N
 
 DELTA = 1e-2
@@ -83,25 +83,14 @@ def correction(ctx, v, r):
 
 def solve(ctx, target) -> Outcome:
     clock = Clock()
-    r = ctx.p.r_warm.copy()
-    sweeps = kept = 0
-    v = None
-    converged = False
-    while sweeps < CAP:
-        with clock("sweeps"):
-            v, _ = ctx.sweep(r, SMOOTH)
-        sweeps += SMOOTH
-        with clock("check"):
-            before = ctx.residual(v, r)
-        if before <= target:
-            converged = True
-            break
+
+    def correct(v, r, before):
         with clock("correction"):
             trial = correction(ctx, v, r)
             v_trial = law.velocity_from_impulse(ctx.p, ctx.H, trial)
-            if ctx.residual(v_trial, trial) < DROP * before:
-                r, v = trial, v_trial
-                kept += 1
+            return (trial, v_trial) if ctx.residual(v_trial, trial) < DROP * before else None
+
+    v, r, sweeps, _, kept, converged = sweeps_with_corrections(ctx, target, SMOOTH, CAP, clock, correct)
     # The engine would check the residual in the sweep (free); the correction is extra work.
     extra = clock.phases.get("correction", 0.0) / ctx.sweep_s
     return Outcome(v, r, kept, sweeps + extra, clock.phases, converged=converged)
