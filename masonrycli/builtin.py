@@ -13,7 +13,7 @@ aqueduct      346 blocks      right foundation settles at 1 cm/s                
 The overrides are the command line's options, under their Python names (None = not given): the
 builder's own options (``blocks``, ``voussoirs``...), the loading (``amp`` m/s, ``freq`` Hz,
 ``settlement`` m/s, or a ground motion ``record`` file times ``scale``), the material (``density``, ``thickness``, ``friction``) and the run settings
-(``duration``, ``dt``, ``theta``, ``record_every``, ``tolerance``, ``max_iterations``). Errors name them
+(``duration``, ``dt``, ``theta``, ``record_every``, ``tolerance``, ``max_iterations``, ``solver``). Errors name them
 as the command line spells them (``--settlement -1: must be >= 0 ...``).
 """
 
@@ -36,7 +36,7 @@ SETTLEMENT = 0.01
 PAPER_INSTANT = {"wall": ("III.2–III.5", 0.1), "arch": ("III.7–III.10", 5.0)}
 """The instant of the paper's figures for each built-in structure: (figures, t in s)."""
 
-RUN_OVERRIDES = ("duration", "dt", "theta", "record_every", "tolerance", "max_iterations")
+RUN_OVERRIDES = ("duration", "dt", "theta", "record_every", "tolerance", "max_iterations", "solver")
 MATERIAL_OVERRIDES = ("density", "thickness", "friction")
 LOADING_OVERRIDES = ("freq", "amp", "settlement", "record", "scale")
 

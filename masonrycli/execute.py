@@ -95,6 +95,7 @@ def run_metadata(scenario, sim: Simulation) -> dict:
         "gravity_m_s2": list(run.gravity),
         "nlgs_tolerance": run.tolerance,
         "nlgs_max_iterations": run.max_iterations,
+        "solver": run.solver,
         "record_every": run.record_every,
         "alert_distance_m": run.alert_distance,
         "friction": mat.friction,

@@ -57,6 +57,8 @@ class Model:
     """NLGS stopping tolerance, m/s: RMS contact-law violation of a sweep (masonrycli.engine.nlgs)."""
     max_iterations: int
     """NLGS sweep cap."""
+    solver: str
+    """Contact solver (RunConfig.solver): "nlgs-accel" or "nlgs" (masonrycli.engine.nlgs.solve)."""
     alert_distance: float
     """Contacts whose gap is below this are kept, m."""
     n_steps: int
@@ -139,6 +141,7 @@ def build_model(scenario) -> Model:
         theta=float(run.theta),
         tolerance=float(run.tolerance),
         max_iterations=int(run.max_iterations),
+        solver=str(run.solver),
         alert_distance=float(run.alert_distance),
         n_steps=n_steps,
         support_velocity=table,

@@ -29,6 +29,8 @@ MAX_DURATION = 1e5
 MAX_STEPS = 10**8
 """Steps per run: more is refused up front as a likely typo (10⁸ steps of the 51-block wall take ~1 day)."""
 MAX_COUNT = 10**9
+SOLVERS = ("nlgs-accel", "nlgs")
+"""Contact solvers a run can select (RunConfig.solver); the first is the default."""
 
 # --------------------------------------------------------------------------------------------------
 # configuration dataclasses
@@ -45,6 +47,8 @@ class RunConfig:
     gravity : (gx, gy) m/s², a vector (tilt it for tilting tests).
     tolerance : m/s, NLGS stopping test: RMS contact-law violation of a sweep (engine.nlgs), in (0, 1).
     max_iterations : NLGS sweep cap per step, >= 1.
+    solver : the contact solver, one of ``SOLVERS``: "nlgs-accel" (default) Gauss–Seidel with Nesterov
+        momentum; "nlgs" plain Gauss–Seidel, the reference to compare it with (engine.nlgs).
     record_every : record one frame every this many steps, >= 1.
     alert_distance : m, contacts with a gap below this are kept, > 0.
     """
@@ -57,6 +61,7 @@ class RunConfig:
     max_iterations: int = 50000
     record_every: int = 10
     alert_distance: float = 1e-3
+    solver: str = "nlgs-accel"
 
     def __post_init__(self):
         put = lambda k, v: object.__setattr__(self, k, v)  # noqa: E731
@@ -84,6 +89,8 @@ class RunConfig:
         put("gravity", check_vector("gravity", self.gravity))
         put("tolerance", check_real("tolerance", self.tolerance, gt=0.0, lt=1.0))
         put("max_iterations", check_int("max_iterations", self.max_iterations, ge=1, le=MAX_COUNT))
+        if self.solver not in SOLVERS:
+            raise field_error("solver", self.solver, f"must be one of {', '.join(SOLVERS)}")
         put("record_every", check_int("record_every", self.record_every, ge=1, le=MAX_COUNT))
         put("alert_distance", check_real("alert_distance", self.alert_distance, gt=0.0))
 

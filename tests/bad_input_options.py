@@ -47,6 +47,13 @@ OPTION_ROWS = [
         2,
         "--max-iterations: max_iterations = 0",
     ),
+    (
+        "opt-solver",
+        {**scen()},
+        (*RUN, "--solver", "gs", "--no-recording"),
+        2,
+        '--solver: solver = "gs": must be one of',
+    ),
     ("opt-unknown", {**scen()}, (*RUN, "--bogus"), 2, "No such option: --bogus"),
     ("check-opt-dt", {**scen()}, ("check", "s.toml", "--dt", "-1"), 2, "--dt: dt = -1"),
     ("sim-density", {}, (*WALL, "--density", "-5", "--no-recording"), 2, "--density: density = -5"),

@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from masonrycli.engine import nlgs
+from masonrycli.engine import momentum, nlgs
 
 RNG = np.random.default_rng(20261121)
 
@@ -252,3 +252,97 @@ def test_a_solve_that_stops_improving_ends_stall_sweeps_after_its_lowest_residua
     v, r = v0.copy(), r0.copy()
     its, _ = nlgs._nlgs(body, pack, count, mu, 0.0, 3 * nlgs.STALL_SWEEPS, v, r, status)
     assert its == 3 * nlgs.STALL_SWEEPS
+
+
+# --- The accelerated sweep (solver "nlgs-accel"), against a slow dense implementation ------------------
+
+
+def _slow_accelerated_sweeps(body, w_blocks, h, m_inv, v, r, mu, bias, sweeps, growth):
+    """Nesterov-accelerated Gauss–Seidel written out densely: each sweep starts from the extrapolation
+    y = x + β (x − x_prev) of the last two sweeps' (v, r), β = (j − 1)/(j + 2) with j the sweeps since the
+    last restart, and restarts (j = 1) after a sweep whose residual exceeds ``growth`` × the one before."""
+    v = v.ravel().copy()
+    v += m_inv @ h @ r.ravel()
+    v_prev, r_prev = v.copy(), r.copy()
+    beta, j, last, residual, done = 0.0, 1, np.inf, 0.0, 0
+    for done in range(1, sweeps + 1):
+        v_y = v + beta * (v - v_prev)
+        r_y = r + beta * (r - r_prev)
+        v_prev, r_prev = v.copy(), r.copy()
+        v, r = v_y, r_y
+        e2 = 0.0
+        for c in range(body.shape[0]):
+            w = w_blocks[c]
+            u_free = h[:, 2 * c : 2 * c + 2].T @ v - w @ r[c]
+            row = _packed_row((w[0, 0], w[0, 1], w[1, 1]), bias[c], mu)
+            rt, rn, _ = nlgs._local_solve(u_free[0], u_free[1], row, 0, mu)
+            dr = np.array([rt, rn]) - r[c]
+            v = v + m_inv @ h[:, 2 * c : 2 * c + 2] @ dr
+            r[c] = (rt, rn)
+            e2 += float((w @ dr) @ (w @ dr))
+        residual = np.sqrt(e2 / body.shape[0])
+        if residual == 0.0:  # an exact solution: the kernel stops there too (residual <= tolerance 0)
+            break
+        j = 1 if residual > growth * last else j
+        last = residual
+        beta = (j - 1.0) / (j + 2.0)
+        j += 1
+    return v.reshape(-1, 3), r, residual, done
+
+
+def _random_problem(seed):
+    q, inv_mass, inv_inertia, body, point, normal, gap = _random_contacts(n_contacts=9, seed=seed)
+    mu, dt, count = 0.5, 1e-3, body.shape[0]
+    pack = np.zeros((count, nlgs.PACK_WIDTH))
+    nlgs._prepare(body, point, normal, gap, count, q, inv_mass, inv_inertia, mu, dt, pack)
+    h = _dense_h(q, body, point, normal)
+    m_inv = np.diag(np.column_stack([inv_mass, inv_mass, inv_inertia]).ravel())
+    w_full = h.T @ m_inv @ h
+    w_blocks = [w_full[2 * c : 2 * c + 2, 2 * c : 2 * c + 2] for c in range(count)]
+    rng = np.random.default_rng(seed + 100)
+    v0 = rng.normal(scale=0.1, size=(4, 3))
+    v0[3] = 0.0
+    r0 = np.abs(rng.normal(scale=0.01, size=(count, 2)))
+    return body, pack, h, m_inv, w_blocks, v0, r0, mu, np.maximum(gap, 0.0) / dt
+
+
+@pytest.mark.parametrize("seed", [5, 41])  # problems that take 44 and 57 sweeps to an exact solution
+@pytest.mark.parametrize("sweeps", [1, 2, 5, 30])
+def test_accelerated_sweeps_match_a_slow_dense_implementation(seed, sweeps):
+    body, pack, h, m_inv, w_blocks, v0, r0, mu, bias = _random_problem(seed)
+    count = body.shape[0]
+    v_ref, r_ref, res_ref, its_ref = _slow_accelerated_sweeps(
+        body, w_blocks, h, m_inv, v0, r0.copy(), mu, bias, sweeps, momentum.RESTART_GROWTH
+    )
+    v, r, status = v0.copy(), r0.copy(), np.zeros(count, dtype=np.int8)
+    its, res = momentum._nlgs_accelerated(body, pack, count, mu, 0.0, sweeps, v, r, status)
+    assert its == its_ref
+    assert res == pytest.approx(res_ref, rel=1e-8, abs=1e-15)
+    np.testing.assert_allclose(r, r_ref, rtol=1e-8, atol=1e-13)
+    np.testing.assert_allclose(v, v_ref, rtol=1e-8, atol=1e-11)
+
+
+@pytest.mark.parametrize("seed", [3, 17, 23, 31])
+def test_accelerated_solve_converges_to_the_contact_law_and_the_unique_velocities(seed):
+    # Velocities of a frictional contact problem with a positive definite mass are unique (impulses need
+    # not be): the accelerated solve, tight, must land on plain Gauss–Seidel's velocities, with impulses
+    # satisfying Signorini–Coulomb at them (checked by the local solve written out here, densely).
+    body, pack, h, m_inv, w_blocks, v0, r0, mu, bias = _random_problem(seed)
+    count = body.shape[0]
+    status = np.zeros(count, dtype=np.int8)
+    v_acc, r_acc = v0.copy(), r0.copy()
+    its_acc, res_acc = momentum._nlgs_accelerated(body, pack, count, mu, 1e-13, 200000, v_acc, r_acc, status)
+    v_gs, r_gs = v0.copy(), r0.copy()
+    its_gs, _ = nlgs._nlgs(body, pack, count, mu, 1e-13, 200000, v_gs, r_gs, status)
+    assert res_acc <= 1e-13 and its_acc < 200000 and its_gs < 200000
+    np.testing.assert_allclose(v_acc, v_gs, atol=1e-9)
+    v_dense = v0.ravel() + m_inv @ h @ r_acc.ravel()
+    np.testing.assert_allclose(v_acc.ravel(), v_dense, atol=1e-12)  # v is the velocity of its impulses
+    assert np.all(r_acc[:, 1] >= 0.0) and np.all(np.abs(r_acc[:, 0]) <= mu * r_acc[:, 1] * (1 + 1e-12))
+    for c in range(count):
+        w = w_blocks[c]
+        u = h[:, 2 * c : 2 * c + 2].T @ v_dense
+        row = _packed_row((w[0, 0], w[0, 1], w[1, 1]), bias[c], mu)
+        u_free = u - w @ r_acc[c]
+        rt, rn, _ = nlgs._local_solve(u_free[0], u_free[1], row, 0, mu)
+        assert np.hypot(*(w @ (np.array([rt, rn]) - r_acc[c]))) <= 1e-11

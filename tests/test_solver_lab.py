@@ -20,9 +20,10 @@ def _captured(tmp_path):
     sc = scenario_from_builder(
         "wall", {"blocks": 7, "courses": 2}, RunConfig(duration=0.03), Material(), {"ground": SINE}
     )
-    # Step 25: at step 20 (the engine's RMS stopping test, since issue 9) one contact sits exactly on its
-    # friction limit and Gauss–Seidel settles into a stick/slip cycle at ~1e-9 m/s, above REF_RESIDUAL.
-    kept = capture_run(Simulation(sc), typical_step=25)
+    # Step 15: on this run (default solver nlgs-accel) steps 18-28 each have a contact sitting exactly on
+    # its friction limit, where the reference's Gauss–Seidel settles into a stick/slip cycle at 2-3e-9 m/s,
+    # above REF_RESIDUAL; step 15 has none (its reference converges in 500 sweeps).
+    kept = capture_run(Simulation(sc), typical_step=15)
     assert sorted(kept) == ["cold", "hard", "typical"]
     p = kept["typical"]
     p.name = "tiny"
@@ -33,7 +34,7 @@ def _captured(tmp_path):
 
 def test_reference_satisfies_the_lab_law_and_momentum(tmp_path):
     p = _captured(tmp_path)
-    assert p.step == 25 and p.count > 0 and (p.r_warm[:, 1] > 0).any()
+    assert p.step == 15 and p.count > 0 and (p.r_warm[:, 1] > 0).any()
     ctx = Context(p)
     assert p.ref_residual <= REF_RESIDUAL
     assert ctx.residual(p.v_ref, p.r_ref) <= REF_RESIDUAL

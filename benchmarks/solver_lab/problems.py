@@ -72,8 +72,11 @@ class Problem:
     def blocks(self) -> int:
         return int((self.inv_mass > 0).sum())
 
-    def shim(self, tolerance: float | None = None, max_iterations: int | None = None) -> SimpleNamespace:
-        """The few model fields the engine's nlgs launchers read (default: the engine's default settings)."""
+    def shim(
+        self, tolerance: float | None = None, max_iterations: int | None = None, solver: str = "nlgs"
+    ) -> SimpleNamespace:
+        """The few model fields the engine's nlgs launchers read (default: the engine's default tolerance and
+        cap; plain Gauss–Seidel, which the lab's Gauss–Seidel variants build on)."""
         run = RunConfig()
         tolerance = run.tolerance if tolerance is None else tolerance
         max_iterations = run.max_iterations if max_iterations is None else max_iterations
@@ -84,6 +87,7 @@ class Problem:
             dt=self.dt,
             tolerance=tolerance,
             max_iterations=max_iterations,
+            solver=solver,
         )
 
     def pack(self) -> np.ndarray:

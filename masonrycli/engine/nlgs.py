@@ -40,6 +40,9 @@ sweep units). A slowly converging step is not handed over, since its residual ke
 the aqueduct's first 0.2 s, with steps of up to 33 292 sweeps that end just under 1e-5 m/s, and every
 golden history are bit-identical (a 2000-sweep window changed them and left one step of the 32-course
 wall unconverged). Tolerance 0 runs exactly the cap.
+
+Acceleration (solver "nlgs-accel", the default; "nlgs" is the plain sweep, kept as the reference): the
+same sweep started from a Nesterov extrapolation of the last two sweeps (:mod:`masonrycli.engine.momentum`).
 """
 
 from __future__ import annotations
@@ -274,7 +277,7 @@ INTERLEAVE = 4
 
 
 @njit
-def _nlgs_interleaved(contact_body, pack, count, mu, tolerance, max_iterations, v, r, status):
+def _nlgs_interleaved(contact_body, pack, count, mu, tolerance, max_iterations, v, r, status, accelerate):
     # Detection order puts a pair's two or three contact points, and the pairs of one block, next to
     # each other: each visit then reads the velocities the visit before has just written, and the
     # sweep runs at the latency of that chain. Visiting K = INTERLEAVE runs of the contacts in turn
@@ -304,7 +307,12 @@ def _nlgs_interleaved(contact_body, pack, count, mu, tolerance, max_iterations, 
         pack_o[i, :] = pack[c, :]
         r_o[i, 0] = r[c, 0]
         r_o[i, 1] = r[c, 1]
-    iterations, residual = _nlgs(body_o, pack_o, count, mu, tolerance, max_iterations, v, r_o, status_o)
+    if accelerate:
+        iterations, residual = momentum._nlgs_accelerated(
+            body_o, pack_o, count, mu, tolerance, max_iterations, v, r_o, status_o
+        )
+    else:
+        iterations, residual = _nlgs(body_o, pack_o, count, mu, tolerance, max_iterations, v, r_o, status_o)
     for i in range(count):
         c = order[i]
         r[c, 0] = r_o[i, 0]
@@ -402,7 +410,8 @@ def solve(contact_body, pack, count, model, v, r, status) -> tuple[int, float]:
     unconverged count mean the same thing. A solve that stalls continues by faces (module doc); its
     iterations are then the point sweeps plus the faces' sweep units."""
     mu, tolerance, cap = model.friction, model.tolerance, model.max_iterations
-    iterations, residual = _nlgs_interleaved(contact_body, pack, count, mu, tolerance, cap, v, r, status)
+    accelerate = model.solver == "nlgs-accel"
+    iterations, residual = _nlgs_interleaved(contact_body, pack, count, mu, tolerance, cap, v, r, status, accelerate)
     if tolerance > 0.0 and residual > tolerance and iterations < cap:  # stalled, not capped
         units, residual = faces.face_sweeps(contact_body, pack, count, mu, tolerance, cap - iterations, v, r, status)
         iterations += units
@@ -435,5 +444,6 @@ def tangential_velocity(contact_body, pack, count, v) -> np.ndarray:
     return out
 
 
-# At the end: faces builds on this module's sweep primitives (a stalled solve() continues there).
-from masonrycli.engine import faces  # noqa: E402
+# At the end: faces and momentum build on this module's sweep primitives (a stalled solve() continues by
+# faces; the accelerated sweep is momentum's).
+from masonrycli.engine import faces, momentum  # noqa: E402
