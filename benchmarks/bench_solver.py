@@ -1,30 +1,41 @@
-"""The solver benchmark of issue 9: speed *and* accuracy of masonry's NLGS, beside pymunk and LMGC90.
+"""The solver benchmark of issues 9 and 10: speed *and* accuracy of masonry's contact solvers, side by side,
+beside pymunk and LMGC90.
 
 One command (from the repository root, in the project venv; ``pip install -e ".[bench]"`` adds pymunk)::
 
     .venv/bin/python -m benchmarks.bench_solver [--suite paper height length] [--cases ...]
-        [--repeat 3] [--duration S] [--lmgc-python PATH] [--json benchmarks/results_solver.json]
+        [--solvers nlgs-accel nlgs] [--repeat 3] [--duration S] [--lmgc-python PATH]
+        [--json benchmarks/results_solver.json]
 
 Cases: benchmarks/solver_cases.py (the paper's 51- and 248-block walls, an 8 × 6 wall, the arch and the
-aqueduct; walls of 8, 16, 32, 64 courses × 15 blocks; 8-course walls of ~500 to ~4000 blocks). For each:
+aqueduct; walls of 8, 16, 32, 64 courses × 15 blocks; 8-course walls of ~500 to ~4000 blocks).
 
-* CPU seconds per simulated second (``time.process_time``, the minimum over ``--repeat`` repeats run
-  interleaved: case A, case B, …, then again), in process, with a Rerun recording every 10 steps
-  written to a temporary file (start-up apart: measured once, below);
-* NLGS sweeps per step (mean, max), unconverged steps (residual > tolerance or at the cap), contacts per
-  step, ns per contact per sweep (CPU time inside ``nlgs.solve`` / Σ contacts × sweeps), peak memory
-  (tracemalloc peak of a 0.1 s run: numpy buffers, history, frames);
-* accuracy: slip of the top course and mean slip at 0.1 and 0.2 s (solver_cases.slips) against a tight
-  solve of the same case in the same run (tolerance 1e-7 m/s, cap 20000 sweeps), in % (for the arch and
-  the aqueduct, the mean block displacement |Δx, Δy| and that of the highest block, in %);
-* pymunk (walls; 100 solver passes, when installed): CPU s per simulated s, ratio to masonry, and its
-  slips against masonry's tight solve;
-* LMGC90 (``compas_lmgc90``, 3-D prisms; only with ``--lmgc-python``, the interpreter of a separate
-  venv where it is installed, see LMGC90.md): the 51-block wall through benchmarks/lmgc90_reference.py.
+Solvers (``--solvers``, default: every one of ``masonrycli.scenario.SOLVERS``, the default first): each
+case runs with each solver in the same benchmark run, interleaved (repeat 1: case A with solver 1,
+solver 2, pymunk, case B …; then repeat 2 …), so a ratio compares runs made under the same load. For each
+case and solver:
+
+* CPU seconds per simulated second (``time.process_time``, the minimum over ``--repeat`` repeats), in
+  process, with a Rerun recording every 10 steps written to a temporary file (start-up apart: measured
+  once, below); and the ratio of each solver's time to the default solver's (for ``nlgs``: how many
+  times faster the default is than plain Gauss–Seidel);
+* sweeps per step (mean, max; the solver's ``iterations``, in Gauss–Seidel sweep units), unconverged steps
+  (residual > tolerance or at the cap), contacts per step, ns per contact per sweep (CPU time inside
+  ``nlgs.solve`` / Σ contacts × sweeps);
+* accuracy: slip of the top course and mean slip at 0.1 and 0.2 s (solver_cases.slips) against one tight
+  solve of the same case in the same run — **plain** ``nlgs`` at tolerance 1e-7 m/s, cap 20000 sweeps,
+  whatever the solvers compared — in % (for the arch and the aqueduct, the mean block displacement
+  |Δx, Δy| and that of the highest block, in %);
+
+and once per case: peak memory (tracemalloc peak of a 0.1 s run with the first solver listed: numpy
+buffers, history, frames), pymunk (walls; 100 solver passes, when installed: CPU s per simulated s,
+each solver's time over pymunk's, and pymunk's slips against the same tight solve), LMGC90
+(``compas_lmgc90``, 3-D prisms; only with ``--lmgc-python``, the interpreter of a separate venv where it
+is installed, see LMGC90.md: the 51-block wall through benchmarks/lmgc90_reference.py).
 
 Start-up: wall-clock of ``masonry --help`` and of a fresh process that imports the engine, builds the
 51-block wall and runs its first step (numba cache warm), minimum of 3. The table goes to the terminal
-(rich), everything to ``--json``.
+(rich, one row per case and solver), everything to ``--json`` (``cases[case]["solvers"][name]``).
 """
 
 from __future__ import annotations
@@ -50,13 +61,16 @@ from benchmarks import pymunk_engine  # noqa: E402
 from benchmarks.solver_cases import CASES, course_of, is_wall, make_scenario, slips  # noqa: E402
 from masonrycli.engine import nlgs  # noqa: E402
 from masonrycli.run import Simulation, simulate  # noqa: E402
+from masonrycli.scenario import SOLVERS  # noqa: E402
 
 SUITES = {
     "paper": ["wall-51", "wall-52", "wall-248", "arch", "aqueduct"],
     "height": ["h8", "h16", "h32", "h64"],
     "length": ["l500", "l1000", "l2000", "l4000"],
 }
-TIGHT = {"tolerance": 1e-7, "max_iterations": 20000}
+TIGHT = {"tolerance": 1e-7, "max_iterations": 20000, "solver": "nlgs"}
+"""The reference of every accuracy figure: plain Gauss–Seidel far below the default tolerance."""
+DEFAULT = SOLVERS[0]
 SAMPLES = (100, 200)
 """Steps (dt = 1e-3) at which the accuracy is read: 0.1 and 0.2 s."""
 
@@ -148,9 +162,9 @@ def run_masonry(case: str, duration: float | None, record: bool, **run_options) 
     }
 
 
-def peak_memory_mb(case: str) -> float:
+def peak_memory_mb(case: str, solver: str = DEFAULT) -> float:
     tracemalloc.start()
-    run_masonry(case, 0.1, record=False)
+    run_masonry(case, 0.1, record=False, solver=solver)
     _, peak = tracemalloc.get_traced_memory()
     tracemalloc.stop()
     return peak / 2**20
@@ -203,10 +217,47 @@ def lmgc90(python: str | None) -> dict:
     return {"available": True, "wall-51": json.loads(done.stdout)}
 
 
+def summarise(runs: dict[str, list[dict]], tight: dict, pymunk_runs: list[dict]) -> dict:
+    """One case's row from its repeats: ``runs`` solver → the runs (dicts of run_masonry), ``tight`` the
+    reference run, ``pymunk_runs`` pymunk's runs (may be empty). Per solver the run of least CPU time, its
+    time per simulated second, its slip errors against ``tight`` and, when DEFAULT was run, its time over
+    the default's; pymunk's fastest run and its errors against the same reference."""
+    solvers = {}
+    for name, repeats in runs.items():
+        best = dict(min(repeats, key=lambda r: r["cpu_s"]))
+        best["cpu_per_sim_s"] = best["cpu_s"] / best["sim_s"]
+        best["cpu_runs"] = [round(r["cpu_s"], 3) for r in repeats]
+        best["error_pct"] = errors_pct(best["samples"], tight["samples"])
+        solvers[name] = best
+    if DEFAULT in solvers:
+        for row in solvers.values():
+            row["over_default"] = row["cpu_per_sim_s"] / solvers[DEFAULT]["cpu_per_sim_s"]
+    first = next(iter(solvers.values()))
+    row = {
+        "blocks": first["blocks"],
+        "solvers": solvers,
+        "tight": {k: tight[k] for k in ("sweeps_mean", "unconverged", "samples")} | {"settings": TIGHT},
+    }
+    if "nlgs" in solvers and DEFAULT in solvers and DEFAULT != "nlgs":
+        row["ratio_nlgs_over_default"] = solvers["nlgs"]["over_default"]
+    if pymunk_runs:
+        pm = min(pymunk_runs, key=lambda r: r["cpu_s"])
+        pm_per_s = pm["cpu_s"] / pm["sim_s"]
+        row["pymunk"] = {
+            "cpu_per_sim_s": pm_per_s,
+            "ratio_over_pymunk": {name: r["cpu_per_sim_s"] / pm_per_s for name, r in solvers.items()},
+            "error_pct": errors_pct({str(k): v for k, v in pm["slips"].items()}, tight["samples"]),
+        }
+    return row
+
+
 def main(argv=None) -> dict:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--suite", nargs="*", default=["paper"], choices=sorted(SUITES))
     parser.add_argument("--cases", nargs="*", help="cases instead of suites (solver_cases.CASES)")
+    parser.add_argument(
+        "--solvers", nargs="+", default=list(SOLVERS), choices=SOLVERS, help="solvers to run (default: all)"
+    )
     parser.add_argument("--repeat", type=int, default=3)
     parser.add_argument("--duration", type=float, help="simulated s per run (default: each case's own)")
     parser.add_argument("--no-pymunk", action="store_true")
@@ -217,6 +268,7 @@ def main(argv=None) -> dict:
     unknown = [c for c in cases if c not in CASES]
     if unknown:
         parser.error(f"unknown case(s): {', '.join(unknown)}")
+    solvers = list(dict.fromkeys(args.solvers))
     use_pymunk = pymunk_engine.available() and not args.no_pymunk
 
     commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True, cwd=ROOT)
@@ -224,32 +276,25 @@ def main(argv=None) -> dict:
         "date": datetime.now(UTC).strftime("%Y-%m-%d %H:%M UTC"),
         "commit": commit.stdout.strip(),
         "machine": {"python": platform.python_version(), "cpu_count": os.cpu_count(), "load": os.getloadavg()},
+        "solvers": solvers,
+        "default_solver": DEFAULT,
         "startup": startup(),
         "cases": {},
     }
-    run_masonry("wall-51", 0.02, record=True)  # compile / load every kernel and the recorder first
-    rows = {c: {"runs": [], "pymunk": []} for c in cases}
-    for _ in range(args.repeat):  # interleaved: every case once, then again
+    for solver in solvers:  # compile / load every kernel and the recorder first
+        run_masonry("wall-51", 0.02, record=True, solver=solver)
+    runs = {c: {s: [] for s in solvers} for c in cases}
+    pymunk_runs: dict[str, list] = {c: [] for c in cases}
+    for _ in range(args.repeat):  # interleaved: every case with every solver once, then again
         for case in cases:
-            rows[case]["runs"].append(run_masonry(case, args.duration, record=True))
+            for solver in solvers:
+                runs[case][solver].append(run_masonry(case, args.duration, record=True, solver=solver))
             if use_pymunk and is_wall(case):
-                rows[case]["pymunk"].append(pymunk_engine.run_wall(case, args.duration or CASES[case][2]))
+                pymunk_runs[case].append(pymunk_engine.run_wall(case, args.duration or CASES[case][2]))
     for case in cases:
-        best = min(rows[case]["runs"], key=lambda r: r["cpu_s"])
         tight = run_masonry(case, 0.2, record=False, **TIGHT)
-        row = dict(best)
-        row["cpu_per_sim_s"] = best["cpu_s"] / best["sim_s"]
-        row["cpu_runs"] = [round(r["cpu_s"], 3) for r in rows[case]["runs"]]
-        row["error_pct"] = errors_pct(best["samples"], tight["samples"])
-        row["tight"] = {k: tight[k] for k in ("sweeps_mean", "unconverged", "samples")}
-        row["peak_memory_mb"] = peak_memory_mb(case)
-        if rows[case]["pymunk"]:
-            pm = min(rows[case]["pymunk"], key=lambda r: r["cpu_s"])
-            row["pymunk"] = {
-                "cpu_per_sim_s": pm["cpu_s"] / pm["sim_s"],
-                "ratio_masonry_over_pymunk": row["cpu_per_sim_s"] / (pm["cpu_s"] / pm["sim_s"]),
-                "error_pct": errors_pct({str(k): v for k, v in pm["slips"].items()}, tight["samples"]),
-            }
+        row = summarise(runs[case], tight, pymunk_runs[case])
+        row["peak_memory_mb"] = peak_memory_mb(case, solvers[0])
         report["cases"][case] = row
     report["lmgc90"] = lmgc90(args.lmgc_python)
     args.json.write_text(json.dumps(report, indent=2))
@@ -269,34 +314,43 @@ def print_table(report: dict) -> None:
     for col in (
         "case",
         "blocks",
+        "solver",
         "CPU s / sim s",
+        f"÷ {DEFAULT}",
         "sweeps/step (max)",
         "unconv.",
         "contacts",
         "ns/contact·sweep",
         "error % top/mean 0.1 s 0.2 s",
         "peak MB",
-        "pymunk s / sim s (×)",
+        "pymunk s / sim s (solver ÷ pymunk)",
         "pymunk error %",
     ):
         table.add_column(col, justify="right")
-    for case, r in report["cases"].items():
-        pm = r.get("pymunk")
-        table.add_row(
-            case,
-            str(r["blocks"]),
-            f"{r['cpu_per_sim_s']:.3f}",
-            f"{r['sweeps_mean']:.0f} ({r['sweeps_max']})",
-            str(r["unconverged"]),
-            f"{r['contacts_mean']:.0f}",
-            f"{r['ns_per_contact_sweep']:.1f}",
-            _err(r["error_pct"]),
-            f"{r['peak_memory_mb']:.1f}",
-            f"{pm['cpu_per_sim_s']:.3f} ({pm['ratio_masonry_over_pymunk']:.2f})" if pm else "–",
-            _err(pm["error_pct"]) if pm else "–",
-        )
-    console = Console(width=200)
+    for case, row in report["cases"].items():
+        pm = row.get("pymunk")
+        for i, (name, r) in enumerate(row["solvers"].items()):
+            table.add_row(
+                case if i == 0 else "",
+                str(row["blocks"]) if i == 0 else "",
+                name,
+                f"{r['cpu_per_sim_s']:.3f}",
+                f"{r['over_default']:.2f}" if "over_default" in r else "–",
+                f"{r['sweeps_mean']:.0f} ({r['sweeps_max']})",
+                str(r["unconverged"]),
+                f"{r['contacts_mean']:.0f}",
+                f"{r['ns_per_contact_sweep']:.1f}",
+                _err(r["error_pct"]),
+                f"{row['peak_memory_mb']:.1f}" if i == 0 else "",
+                f"{pm['cpu_per_sim_s']:.3f} ({pm['ratio_over_pymunk'][name]:.2f})" if pm else "–",
+                _err(pm["error_pct"]) if pm and i == 0 else "",
+                end_section=i == len(row["solvers"]) - 1,
+            )
+    console = Console(width=220)
     console.print(table)
+    console.print(
+        f"accuracy: against plain nlgs at {TIGHT['tolerance']:g} m/s (cap {TIGHT['max_iterations']}) in the same run"
+    )
     s = report["startup"]
     console.print(
         f"start-up (CPU / wall-clock): masonry --help {s['help_cpu_s']:.2f} / {s['help_wall_s']:.2f} s, fresh "
