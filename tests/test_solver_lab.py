@@ -5,6 +5,7 @@ by the engine's NLGS must satisfy the lab's contact law and reproduce v = v_free
 """
 
 import numpy as np
+import pytest
 
 from benchmarks.solver_lab import law
 from benchmarks.solver_lab.capture import SINE, capture_run, reference
@@ -147,3 +148,53 @@ def test_linear_correction_keeps_a_solution(tmp_path):
     v = law.velocity_from_impulse(p, ctx.H, r)
     assert law.velocity_error(p, v) < 1e-7
     assert ctx.residual(v, r) < 1e-6
+
+
+def test_accelerated_method_takes_the_engine_default_and_stops_on_the_law(tmp_path):
+    # nlgs-accel is the engine's default solve: at the count it found, the lab's law residual is at the
+    # target and the impulses are those of nlgs.solve with the engine's default solver from r_warm
+    from benchmarks.solver_lab.methods import accelerated
+    from masonrycli.scenario import RunConfig
+
+    p = _captured(tmp_path)
+    ctx = Context(p)
+    ctx.accel_cost = 1.2
+    out = accelerated.accelerated(ctx, 1e-6)
+    assert out.converged and out.sweeps == 1.2 * out.iterations
+    v = law.velocity_from_impulse(p, ctx.H, out.r)
+    assert ctx.residual(v, out.r) <= 1e-6 and law.velocity_error(p, v) < 1e-4
+    r = p.r_warm.copy()
+    N.solve(
+        p.body,
+        ctx.pack,
+        p.count,
+        p.shim(0.0, out.iterations, RunConfig().solver),
+        p.v_free.copy(),
+        r,
+        np.zeros(p.count, np.int8),
+    )
+    np.testing.assert_array_equal(r, out.r)
+
+
+@pytest.mark.slow
+def test_accelerated_variants_differ_only_by_restart_growth(tmp_path):
+    # A variant's worker compiles the engine afresh with another RESTART_GROWTH (numba freezes globals):
+    # at the engine's own growth it reproduces the in-process solve bit for bit; at a growth that restarts
+    # less often it does not (the change really reached the compiled kernel).
+    from benchmarks.solver_lab.methods import accelerated
+    from masonrycli.engine import momentum
+
+    sc = scenario_from_builder(
+        "wall", {"blocks": 7, "courses": 2}, RunConfig(duration=0.002), Material(), {"ground": SINE}
+    )
+    p = capture_run(Simulation(sc), typical_step=1)["cold"]
+    p.name = "tiny-cold"
+    reference(p)
+    ctx = Context(p)
+    ctx.accel_cost = 1.0
+    base = accelerated.accelerated(ctx, 1e-7)
+    same = accelerated.variant(momentum.RESTART_GROWTH)(ctx, 1e-7)
+    assert same.iterations == base.iterations
+    np.testing.assert_array_equal(same.r, base.r)
+    other = accelerated.variant(2.0)(ctx, 1e-7)
+    assert other.iterations != base.iterations or not np.array_equal(other.r, base.r)

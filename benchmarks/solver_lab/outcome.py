@@ -25,6 +25,8 @@ class Outcome:
     phases: dict = field(default_factory=dict)
     """phase name → CPU seconds."""
     converged: bool = True
+    cpu_s: float | None = None
+    """CPU seconds of the solve when it ran in another process (the harness's clock would miss them)."""
 
 
 class Clock:
@@ -56,13 +58,16 @@ class Context:
         self.minv = law.inv_mass_diag(problem)
         self.sweep_s = np.nan
         """CPU seconds of one engine NLGS sweep on this problem (measured by the harness)."""
+        self.accel_cost = np.nan
+        """CPU time of one accelerated sweep (solver "nlgs-accel") over one plain sweep (measured by the harness)."""
 
-    def sweep(self, r: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
-        """``n`` engine NLGS sweeps from impulses ``r`` (updated in place); returns (v, status)."""
+    def sweep(self, r: np.ndarray, n: int, solver: str = "nlgs") -> tuple[np.ndarray, np.ndarray]:
+        """``n`` engine NLGS sweeps (``solver``: plain or "nlgs-accel") from impulses ``r`` (updated in place);
+        returns (v, status)."""
         p = self.p
         v = p.v_free.copy()
         status = np.zeros(p.count, dtype=np.int8)
-        nlgs.solve(p.body, self.pack, p.count, p.shim(0.0, n), v, r, status)
+        nlgs.solve(p.body, self.pack, p.count, p.shim(0.0, n, solver=solver), v, r, status)
         return v, status
 
     def residual(self, v: np.ndarray, r: np.ndarray) -> float:
