@@ -36,36 +36,6 @@ first round."""
 
 
 @njit
-def _visit(contact_body, pack, c, mu, v, r, status):
-    # One exact local solve at contact c; returns |W_αα Δr_α|². The same arithmetic as the body of
-    # nlgs._nlgs's contact loop, which keeps its own copy on purpose: calling this function from the
-    # point sweep (even with inline="always") took 8.7 -> 47-57 ns per contact·sweep on captured steps of
-    # the 248-block wall, bit-identical results. The faces fallback pays that call; the hot sweep must not.
-    a = contact_body[c, 0]
-    b = contact_body[c, 1]
-    ut, un = _relative_velocity(v, a, b, pack, c)
-    rt0 = r[c, 0]
-    rn0 = r[c, 1]
-    wtt = pack[c, P_WTT]
-    wtn = pack[c, P_WTN]
-    wnn = pack[c, P_WNN]
-    ut -= wtt * rt0 + wtn * rn0
-    un -= wtn * rt0 + wnn * rn0
-    rt, rn, st = _local_solve(ut, un, pack, c, mu)
-    status[c] = st
-    drt = rt - rt0
-    drn = rn - rn0
-    if drt == 0.0 and drn == 0.0:
-        return 0.0
-    _push(v, a, b, pack, c, drt, drn)
-    r[c, 0] = rt
-    r[c, 1] = rn
-    et = wtt * drt + wtn * drn
-    en = wtn * drt + wnn * drn
-    return et * et + en * en
-
-
-@njit
 def _face_sweeps(contact_body, pack, count, mu, tolerance, max_units, v, r, status):
     # v enters consistent with r (v = v_free + M⁻¹ H r) and leaves so.
     #   faces = runs of consecutive contacts with the same body pair
@@ -73,6 +43,10 @@ def _face_sweeps(contact_body, pack, count, mu, tolerance, max_units, v, r, stat
     #       for each face: round 1 visits its points (their |W Δr|² make the residual);
     #                      more rounds while a round moves > INNER_DROP × round 1 (≤ INNER_ROUNDS)
     #   until residual ≤ tolerance, the work cap (sweep units), or STALL_SWEEPS sweeps without a new low.
+    # A visit is the arithmetic of nlgs._nlgs's contact loop, written out here once (one call site):
+    # calling a shared visit function cost 47–57 ns per visit against 8.7 ns inline (captured steps of
+    # the 248-block wall; likely the reference counting of the arrays numba passes to a call it does not
+    # inline — not verified).
     # Returns (sweep units done, rounded up; residual).
     if count == 0:
         return 0, 0.0
@@ -94,18 +68,37 @@ def _face_sweeps(contact_body, pack, count, mu, tolerance, max_units, v, r, stat
             c0 = start[f]
             c1 = start[f + 1]
             first = 0.0
-            for c in range(c0, c1):
-                first += _visit(contact_body, pack, c, mu, v, r, status)
-            visits += c1 - c0
-            sum_e2 += first
-            if c1 - c0 == 1 or first == 0.0:
-                continue
-            for _ in range(INNER_ROUNDS - 1):
+            for rnd in range(INNER_ROUNDS):
                 moved = 0.0
                 for c in range(c0, c1):
-                    moved += _visit(contact_body, pack, c, mu, v, r, status)
+                    a = contact_body[c, 0]
+                    b = contact_body[c, 1]
+                    ut, un = _relative_velocity(v, a, b, pack, c)
+                    rt0 = r[c, 0]
+                    rn0 = r[c, 1]
+                    wtt = pack[c, P_WTT]
+                    wtn = pack[c, P_WTN]
+                    wnn = pack[c, P_WNN]
+                    ut -= wtt * rt0 + wtn * rn0
+                    un -= wtn * rt0 + wnn * rn0
+                    rt, rn, st = _local_solve(ut, un, pack, c, mu)
+                    status[c] = st
+                    drt = rt - rt0
+                    drn = rn - rn0
+                    if drt != 0.0 or drn != 0.0:
+                        _push(v, a, b, pack, c, drt, drn)
+                        r[c, 0] = rt
+                        r[c, 1] = rn
+                        et = wtt * drt + wtn * drn
+                        en = wtn * drt + wnn * drn
+                        moved += et * et + en * en
                 visits += c1 - c0
-                if moved <= INNER_DROP * first:
+                if rnd == 0:
+                    first = moved
+                    sum_e2 += first
+                    if c1 - c0 == 1 or first == 0.0:
+                        break
+                elif moved <= INNER_DROP * first:
                     break
         residual = np.sqrt(sum_e2 / count)
         if residual <= tolerance:
