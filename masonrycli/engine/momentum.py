@@ -1,18 +1,31 @@
 """Gauss–Seidel with momentum: the sweep of solver "nlgs-accel", the engine's default.
 
-Each sweep of :mod:`masonrycli.engine.nlgs` starts from a Nesterov extrapolation of the last two sweeps' impulses and velocities, with the
-momentum dropped whenever a sweep's residual grows by more than RESTART_GROWTH (adaptive restart). The
-contact law, the local solve, the residual, the stopping test and the stall rule are nlgs's, and a
-step still ends on a sweep, so what a converged step satisfies is unchanged; only the path is shorter.
-Measured on captured steps (benchmarks/README.md): 2.5–4.6× fewer sweeps on walls of 8–32 courses,
-2.4× on the arch, 5.9× on the aqueduct, at the same distance from a 1e-9 m/s reference; one accelerated
-sweep costs ~1.2× a plain one (the extrapolation reads and writes r and v once more). A restart growth
-of 1.3 or more diverges on the 248-block wall, 1.05–1.2 all converge.
+Each sweep of :mod:`masonrycli.engine.nlgs` starts from a Nesterov extrapolation of the last two sweeps'
+impulses and velocities; the momentum is dropped whenever a sweep's residual grows by more than
+RESTART_GROWTH (adaptive restart). The contact law, the local solve, the residual and the stopping test
+are nlgs's, and a step still ends on a sweep, so what a converged step satisfies is unchanged; only the
+path is shorter. Measured on captured steps (benchmarks/README.md): 2.5–4.6× fewer sweeps on walls of
+8–32 courses, 2.4× on the arch, 5.9× on the aqueduct, at the same distance from a 1e-9 m/s reference;
+one accelerated sweep costs ~1.2× a plain one (the extrapolation reads and writes r and v once more). A
+restart growth of 1.3 or more diverges on the 248-block wall; 1.05–1.2 all converge.
 
 Why momentum works here: Gauss–Seidel moves load through a stack of hyperstatic joints about one course
 per sweep, so on a wall of N courses its error decays like a diffusion, ~N² sweeps per decade. Nesterov's
 extrapolation turns that into ~N on linear problems; the restart keeps it safe where the nonsmooth law
 switches a contact between open, stick and slip (a sweep whose residual jumps has just crossed one).
+
+Where it fails: on tall sliding walls momentum can drive a step into a stick/slip cycle that plain sweeps
+do not leave either (the 32-course wall's steps 84–88: the residual wanders at 5e-5–9e-5 m/s for 60 000
+sweeps, where plain sweeps from the same warm start converge in 1219–1539 on two of them). So the accelerated solve
+has its own stall window, STALL_SWEEPS = 500 sweeps without a new lowest residual, after which
+nlgs.solve goes on by faces, as a stalled plain solve does after 10 000. On five such captured steps:
+1595–4035 sweep units in all (faces included), against 11 000–21 000 with the 10 000-sweep window.
+Whole runs (CPU s, this machine under load, the same process for each pair): 32-course wall 1 s, 22.9 s
+with this window against 38.2 s with 10 000 (plain nlgs: 69.1 s), 769 against 1131 sweep units per step,
+0 unconverged steps each; 64-course wall 0.2 s, 38.3 against 72.8 s, 1728 against 4982 units. The window
+is a trade: 200 hands over steps of the settling aqueduct and arch that were still improving (aqueduct,
+1 s: 200 sweep units per step and 6 steps over 5000, against 79 and none with a 10 000 window; 500: 68
+and none, 1.8 against 2.3 s; the arch is unchanged from 500 up).
 """
 
 from __future__ import annotations
@@ -20,14 +33,16 @@ from __future__ import annotations
 import numpy as np
 
 from masonrycli.engine._jit import njit
-from masonrycli.engine.nlgs import P_WNN, P_WTN, P_WTT, STALL_SWEEPS, _local_solve, _push, _relative_velocity
+from masonrycli.engine.nlgs import P_WNN, P_WTN, P_WTT, _local_solve, _push, _relative_velocity
 
 RESTART_GROWTH = 1.1
 """The accelerated sweep drops its momentum when a sweep's residual exceeds the previous one by this factor."""
+STALL_SWEEPS = 500
+"""Accelerated sweeps without a new lowest residual after which the solve hands over to faces (module doc)."""
 
 
 @njit
-def _nlgs_accelerated(contact_body, pack, count, mu, tolerance, max_iterations, v, r, status):
+def _nlgs_accelerated(contact_body, pack, count, mu, tolerance, max_iterations, v, r, status, stall_after):
     # _nlgs with Nesterov momentum and adaptive restart. x_k: the (r, v) a sweep leaves. The next sweep
     # starts from the extrapolated y_k = x_k + β_k (x_k − x_k−1), β_k = (j − 1)/(j + 2), j counting the
     # sweeps since the last restart; a sweep whose residual grows by more than RESTART_GROWTH restarts
@@ -39,7 +54,8 @@ def _nlgs_accelerated(contact_body, pack, count, mu, tolerance, max_iterations, 
     #       v ← v + β (v − v_prev), v_prev ← old v                         (bodies)
     #       for α in order: r_y = r_α + β (r_α − r_prev,α), r_prev,α ← r_α
     #                       the visit of _nlgs from r_y (e_α = W_αα (r_α' − r_y))
-    #       residual, stopping and stall rule as in _nlgs; then j, β from the restart rule
+    #       residual and stopping as in _nlgs, the stall rule with a window of stall_after sweeps (then
+    #       nlgs.solve goes on by faces); then j, β from the restart rule
     for c in range(count):
         _push(v, contact_body[c, 0], contact_body[c, 1], pack, c, r[c, 0], r[c, 1])
     iterations = 0
@@ -93,7 +109,7 @@ def _nlgs_accelerated(contact_body, pack, count, mu, tolerance, max_iterations, 
         if residual < best:
             best = residual
             best_at = it
-        elif tolerance > 0.0 and it - best_at >= STALL_SWEEPS:
+        elif tolerance > 0.0 and it - best_at >= stall_after:
             break
         if residual > RESTART_GROWTH * last:
             j = 1
