@@ -226,6 +226,7 @@ def test_unconverged_steps_are_counted_and_warned(tmp_path):
     r = invoke("simulate", "wall", "--duration", "0.02", "--max-iterations", "2", "--no-recording", "--history", npz)
     assert r.exit_code == 0, r.output
     assert "warning: 20 of 20 steps ended unconverged" in " ".join(r.output.split())
+    assert "20 at the 2-sweep cap" in " ".join(r.output.split())
     h = np.load(npz)
     assert h["nlgs_unconverged"][-1] == 20
     assert np.all(h["nlgs_iterations"][1:] == 2) and np.all(h["nlgs_residual"][1:] > 1e-5)
