@@ -231,7 +231,7 @@ def print_summary(console: Console, outcome: Outcome, scenario, hint: str = "") 
                 f"{result.unconverged} of {result.steps} steps ended unconverged (contact-law residual above "
                 f"--tolerance {run.tolerance:g} m/s; {result.tally.capped} at the {run.max_iterations}-sweep cap, "
                 "the others stalled: no lower residual in 10 000 sweeps by faces); their impulses and motion are "
-                "approximate. Raise --max-iterations for capped steps, try --solver nlgs, or check the history's "
+                "approximate. Raise --max-iterations for capped steps, or check the history's "
                 "nlgs_residual.",
             ),
             soft_wrap=True,
