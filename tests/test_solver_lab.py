@@ -24,7 +24,7 @@ def _captured(tmp_path):
     # Step 15: on this run (default solver nlgs-accel) steps 18-28 each have a contact sitting exactly on
     # its friction limit, where the reference's Gauss–Seidel settles into a stick/slip cycle at 2-3e-9 m/s,
     # above REF_RESIDUAL; step 15 has none (its reference converges in 500 sweeps).
-    kept = capture_run(Simulation(sc), typical_step=15)
+    kept, _ = capture_run(Simulation(sc), typical_step=15)
     assert sorted(kept) == ["cold", "hard", "typical"]
     p = kept["typical"]
     p.name = "tiny"
@@ -187,7 +187,7 @@ def test_accelerated_variants_differ_only_by_restart_growth(tmp_path):
     sc = scenario_from_builder(
         "wall", {"blocks": 7, "courses": 2}, RunConfig(duration=0.002), Material(), {"ground": SINE}
     )
-    p = capture_run(Simulation(sc), typical_step=1)["cold"]
+    p = capture_run(Simulation(sc), typical_step=1)[0]["cold"]
     p.name = "tiny-cold"
     reference(p)
     ctx = Context(p)

@@ -13,11 +13,15 @@ os.environ.setdefault("RERUN_ANALYTICS", "0")
 
 def main() -> None:
     from benchmarks.solver_lab.capture import CASES
+    from masonrycli.scenario import SOLVERS
 
     ap = argparse.ArgumentParser(prog="python -m benchmarks.solver_lab", description=__doc__)
     sub = ap.add_subparsers(dest="command", required=True)
     cap = sub.add_parser("capture", help="run the cases, keep cold/typical/hard steps with their reference")
     cap.add_argument("--cases", nargs="+", default=list(CASES), choices=list(CASES))
+    cap.add_argument(
+        "--solver", default=SOLVERS[0], choices=SOLVERS, help="the run's solver (default: the engine's default)"
+    )
     tab = sub.add_parser("table", help="run the methods on the captured problems; Markdown table + JSON")
     tab.add_argument("--methods", nargs="+", default=None)
     tab.add_argument("--problems", nargs="+", default=None)
@@ -28,7 +32,7 @@ def main() -> None:
     if args.command == "capture":
         from benchmarks.solver_lab.capture import capture
 
-        capture(args.cases)
+        capture(args.cases, args.solver)
     elif args.command == "clusters":
         from benchmarks.solver_lab.clusters import report
 

@@ -5,9 +5,10 @@
     hard     the step whose NLGS took the most sweeps from step HARD_FROM on (the latest of equals: once
              the walls crack and rock), i.e. the worst the run met after its start
 
-The run is driven from outside: ``nlgs.solve`` is wrapped and the problem copied just before the solve
-(see ``problems.py``). Then each kept problem gets its tight reference solution and is written to
-``data/<case>-<kind>.npz``.
+The run uses the engine's default solver unless ``--solver`` says otherwise (then the problems' names end
+in ``-<solver>``): its trajectory, and its hardest step, are that solver's. The run is driven from
+outside: ``nlgs.solve`` is wrapped and the problem copied just before the solve (see ``problems.py``).
+Then each kept problem gets its tight reference solution and is written to ``data/<name>.npz``.
 """
 
 from __future__ import annotations
@@ -27,6 +28,8 @@ SINE = Sine(direction=(1.0, 0.0), amplitude=1.0, frequency=2.0)
 SETTLE = Constant(velocity=(0.0, -0.01))
 TYPICAL_STEP = 300
 HARD_FROM = 20
+DEFAULT_SOLVER = RunConfig().solver
+"""The trajectory (and the "hard" step: the one *this* solver found hardest) is the run's solver's."""
 
 
 def _wall(courses: int) -> dict:
@@ -75,22 +78,27 @@ def reference(problem: Problem) -> None:
     problem.v_ref, problem.r_ref, problem.ref_sweeps, problem.ref_residual = v, r, sweeps, res
 
 
-def capture_case(case: str) -> list[Problem]:
-    """The cold, typical and hard problems of ``case`` (named ``<case>-<kind>``), without references."""
+def capture_case(case: str, solver: str = DEFAULT_SOLVER) -> tuple[list[Problem], int]:
+    """The cold, typical and hard problems of ``case`` run with ``solver`` (named ``<case>-<kind>``, with
+    ``-<solver>`` appended for a solver other than the default), without references; and the run's number of
+    unconverged steps."""
     builder, options, duration, motions = CASES[case]
-    sc = scenario_from_builder(builder, options, RunConfig(duration=duration), Material(), motions)
-    kept = capture_run(Simulation(sc), TYPICAL_STEP)
+    sc = scenario_from_builder(builder, options, RunConfig(duration=duration, solver=solver), Material(), motions)
+    kept, unconverged = capture_run(Simulation(sc), TYPICAL_STEP)
+    suffix = "" if solver == DEFAULT_SOLVER else f"-{solver}"
     for kind, p in kept.items():
-        p.name = f"{case}-{kind}"
-    return [kept[k] for k in ("cold", "typical", "hard") if k in kept]
+        p.name = f"{case}-{kind}{suffix}"
+    return [kept[k] for k in ("cold", "typical", "hard") if k in kept], unconverged
 
 
-def capture_run(sim: Simulation, typical_step: int) -> dict[str, Problem]:
-    """Step ``sim`` to its end with ``nlgs.solve`` wrapped; {"cold", "typical", "hard"} → problem."""
+def capture_run(sim: Simulation, typical_step: int) -> tuple[dict[str, Problem], int]:
+    """Step ``sim`` to its end with ``nlgs.solve`` wrapped; ({"cold", "typical", "hard"} → problem, the number
+    of steps whose solve ended above its tolerance)."""
     solver, m = sim.solver, sim.model
     hist = [(np.empty(0, np.int64), np.empty((0, 2))), (np.empty(0, np.int64), np.empty((0, 2)))]
     kept: dict[str, Problem] = {}
     hard_sweeps = -1
+    unconverged = 0
     original = nlgs.solve
 
     def snapshot(count, v, r) -> Problem:
@@ -125,10 +133,11 @@ def capture_run(sim: Simulation, typical_step: int) -> dict[str, Problem]:
         )
 
     def hooked(contact_body, pack, count, model, v, r, status, *args, **kwargs):
-        nonlocal hard_sweeps
+        nonlocal hard_sweeps, unconverged
         prob = snapshot(count, v, r)
         its, res = original(contact_body, pack, count, model, v, r, status, *args, **kwargs)
         prob.engine_sweeps = int(its)
+        unconverged += bool(res > model.tolerance)
         if prob.step == 1:
             kept["cold"] = prob
         elif prob.step == typical_step:
@@ -147,15 +156,19 @@ def capture_run(sim: Simulation, typical_step: int) -> dict[str, Problem]:
             solver.step(sim.state)
     finally:
         nlgs.solve = original
-    return kept
+    return kept, unconverged
 
 
-def capture(cases: list[str]) -> None:
+def capture(cases: list[str], solver: str = DEFAULT_SOLVER) -> None:
     DATA.mkdir(exist_ok=True)
     for case in cases:
         t = time.perf_counter()
-        probs = capture_case(case)
-        print(f"{case}: ran {CASES[case][2]:g} s in {time.perf_counter() - t:.1f} s", flush=True)
+        probs, unconverged = capture_case(case, solver)
+        took = time.perf_counter() - t
+        print(
+            f"{case}: ran {CASES[case][2]:g} s with {solver} in {took:.1f} s, {unconverged} unconverged steps",
+            flush=True,
+        )
         for p in probs:
             t = time.perf_counter()
             reference(p)

@@ -157,14 +157,16 @@ def run_table(methods: list[str] | None, problems: list[str] | None, repeat: int
 
 
 def print_growth(rows: list[dict]) -> None:
-    """Sweep units per method on the wall series (8 → 64 courses), typical and hard steps, and the ratio."""
+    """Sweep units per method on the wall series (8 → 64 courses), cold, typical and hard steps (also those
+    of a capture with another solver, ``typical-nlgs`` …), and the ratio."""
     heights = [8, 16, 32, 64]
     by = {(r["method"], r["problem"]): r for r in rows}
     methods = list(dict.fromkeys(r["method"] for r in rows))
+    kinds = list(dict.fromkeys(r["problem"].split("-", 2)[2] for r in rows if r["problem"].startswith("wall-")))
     print("\n| method | step | " + " | ".join(f"{h} courses" for h in heights) + " | 64 / 8 |")
     print("|---|---|" + "---|" * (len(heights) + 1))
     for m in methods:
-        for kind in ("typical", "hard"):
+        for kind in kinds:
             cells = [by.get((m, f"wall-{h}-{kind}")) for h in heights]
             if not any(cells):
                 continue
