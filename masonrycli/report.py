@@ -43,14 +43,24 @@ def progress_bar(console: Console, n_steps: int):
         yield on_progress
 
 
+SOLVER_NOTES = {
+    "nlgs-accel": "Gauss–Seidel with momentum; plain: --solver nlgs",
+    "nlgs": "plain Gauss–Seidel, the reference",
+}
+"""What the summary says after a solver's name (masonrycli.scenario.SOLVERS)."""
+
+
 def summary_table(result, recording: str | None, history: str | None) -> Table:
-    """The end-of-run table: steps, contacts, NLGS effort, penetration, energy, outputs."""
+    """The end-of-run table: steps, contacts, solver and its effort, penetration, energy, outputs."""
     table = Table(title=f"masonry run — {result.status}", show_header=False, title_justify="left")
     table.add_column("quantity", style="bold")
     table.add_column("value")
     tally = result.tally
     table.add_row("steps", f"{result.steps} (t = {result.time:.4f} s)")
     table.add_row("wall time", f"{result.wall_time:.2f} s ({result.steps / max(result.wall_time, 1e-9):.0f} steps/s)")
+    if result.solver:
+        note = SOLVER_NOTES.get(result.solver)
+        table.add_row("solver", f"{result.solver} ({note})" if note else result.solver)
     if tally.steps:
         table.add_row("contacts per step", f"mean {tally.contacts_mean:.0f}, max {tally.contacts_max}")
         table.add_row("NLGS sweeps per step", f"mean {tally.sweeps_mean:.1f}, max {tally.sweeps_max}")

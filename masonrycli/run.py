@@ -92,6 +92,8 @@ class RunResult:
     frames: int
     unconverged: int = 0
     """Steps whose solve did not meet its tolerance before the sweep cap."""
+    solver: str = ""
+    """The contact solver that ran (RunConfig.solver)."""
     extra: dict = field(default_factory=dict)
     """Further summary rows, label → text (e.g. the hinged joints at the end)."""
     intensity: dict = field(default_factory=dict)
@@ -337,6 +339,7 @@ def simulate(
         support_work=sim.support_work,
         frames=frames,
         unconverged=sim.unconverged,
+        solver=m.solver,
         extra=extra,
         intensity=ims,
         outcome=outcome,
