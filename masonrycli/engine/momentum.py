@@ -16,16 +16,14 @@ switches a contact between open, stick and slip (a sweep whose residual jumps ha
 
 Where it fails: on tall sliding walls momentum can drive a step into a stick/slip cycle that plain sweeps
 do not leave either (the 32-course wall's steps 84–88: the residual wanders at 5e-5–9e-5 m/s for 60 000
-sweeps, where plain sweeps from the same warm start converge in 1219–1539 on two of them). So the accelerated solve
-has its own stall window, STALL_SWEEPS = 500 sweeps without a new lowest residual, after which
-nlgs.solve goes on by faces, as a stalled plain solve does after 10 000. On five such captured steps:
-1595–4035 sweep units in all (faces included), against 11 000–21 000 with the 10 000-sweep window.
-Whole runs (CPU s, this machine under load, the same process for each pair): 32-course wall 1 s, 22.9 s
-with this window against 38.2 s with 10 000 (plain nlgs: 69.1 s), 769 against 1131 sweep units per step,
-0 unconverged steps each; 64-course wall 0.2 s, 38.3 against 72.8 s, 1728 against 4982 units. The window
-is a trade: 200 hands over steps of the settling aqueduct and arch that were still improving (aqueduct,
-1 s: 200 sweep units per step and 6 steps over 5000, against 79 and none with a 10 000 window; 500: 68
-and none, 1.8 against 2.3 s; the arch is unchanged from 500 up).
+sweeps, where plain sweeps from the same warm start converge in 1219–1539 on two of them). Such a step
+goes on by faces after STALL_SWEEPS sweeps without a new lowest residual, the plain solve's window. A
+shorter window was measured and rejected: with 500 (then faces) the 32-course wall ran 1 s in 22.6 s
+instead of 38.2 s and the 64-course wall 0.2 s in 38.3 s instead of 72.8 s (CPU, loaded machine), but step
+985 of the 248-block wall, which plain sweeps solve in 747, then ended unconverged at the 50 000 cap:
+faces are not a cure everywhere. Nor is falling back to plain sweeps, from the current iterate or from the
+warm start: on six such captured steps every rule tried left one unconverged or cost 11 000–37 000 sweeps
+on another. The window is an argument of the kernel so that such rules stay cheap to try.
 """
 
 from __future__ import annotations
@@ -37,7 +35,7 @@ from masonrycli.engine.nlgs import P_WNN, P_WTN, P_WTT, _local_solve, _push, _re
 
 RESTART_GROWTH = 1.1
 """The accelerated sweep drops its momentum when a sweep's residual exceeds the previous one by this factor."""
-STALL_SWEEPS = 500
+STALL_SWEEPS = 10_000
 """Accelerated sweeps without a new lowest residual after which the solve hands over to faces (module doc)."""
 
 

@@ -43,7 +43,7 @@ wall unconverged). Tolerance 0 runs exactly the cap.
 
 Acceleration (solver "nlgs-accel", the default; "nlgs" is the plain sweep, kept as the reference): the
 same sweep started from a Nesterov extrapolation of the last two sweeps (:mod:`masonrycli.engine.momentum`),
-with its own stall window of momentum.STALL_SWEEPS = 500 sweeps before it goes on by faces. Its
+with the same stall window (momentum.STALL_SWEEPS, 10 000 sweeps) before it goes on by faces. Its
 iterations count accelerated sweeps, each ~1.2× the time of a plain one.
 """
 
