@@ -416,3 +416,28 @@ def test_an_accelerated_solve_that_stops_improving_ends_its_window_after_its_low
         assert all(x >= seen[last_low] for x in lows[last_low + 1 : its])
     its, _ = momentum._nlgs_accelerated(body, pack, count, mu, 0.0, 150, v0.copy(), r0.copy(), status, 3)
     assert its == 150  # (an exact 0 comes at sweep 211)
+
+
+def test_a_stalled_accelerated_solve_falls_back_to_faces_then_plain_sweeps_from_the_warm_start(monkeypatch):
+    # nlgs.solve's chain for nlgs-accel: momentum until its stall window, a bounded faces pass, then plain
+    # sweeps from the warm start. Windows of 1 sweep and a 1-unit faces budget force every stage on a stack;
+    # the step must still end converged on plain Gauss–Seidel's (unique) velocities, with v the velocity of
+    # its impulses, and count every stage's work.
+    from types import SimpleNamespace
+
+    body, pack, h, m_inv, w_blocks, v0, r0, mu, bias = _stack_problem(6)
+    count = body.shape[0]
+    status = np.zeros(count, dtype=np.int8)
+    model = SimpleNamespace(friction=mu, tolerance=1e-10, max_iterations=100000, solver="nlgs")
+    v_gs, r_gs = v0.copy(), r0.copy()
+    its_gs, _ = nlgs.solve(body, pack, count, model, v_gs, r_gs, status)
+    monkeypatch.setattr(momentum, "STALL_SWEEPS", 1)
+    monkeypatch.setattr(momentum, "FACES_BUDGET", 1)
+    model = SimpleNamespace(friction=mu, tolerance=1e-10, max_iterations=100000, solver="nlgs-accel")
+    v, r = v0.copy(), r0.copy()
+    its, res = nlgs.solve(body, pack, count, model, v, r, status)
+    assert res <= 1e-10
+    np.testing.assert_allclose(v, v_gs, atol=1e-8)
+    np.testing.assert_allclose(v.ravel(), v0.ravel() + m_inv @ h @ r.ravel(), atol=1e-12)
+    # the plain restart from the warm start alone takes its_gs sweeps; the stages before it add to the count
+    assert its > its_gs

@@ -16,14 +16,18 @@ switches a contact between open, stick and slip (a sweep whose residual jumps ha
 
 Where it fails: on tall sliding walls momentum can drive a step into a stick/slip cycle that plain sweeps
 do not leave either (the 32-course wall's steps 84–88: the residual wanders at 5e-5–9e-5 m/s for 60 000
-sweeps, where plain sweeps from the same warm start converge in 1219–1539 on two of them). Such a step
-goes on by faces after STALL_SWEEPS sweeps without a new lowest residual, the plain solve's window. A
-shorter window was measured and rejected: with 500 (then faces) the 32-course wall ran 1 s in 22.6 s
-instead of 38.2 s and the 64-course wall 0.2 s in 38.3 s instead of 72.8 s (CPU, loaded machine), but step
-985 of the 248-block wall, which plain sweeps solve in 747, then ended unconverged at the 50 000 cap:
-faces are not a cure everywhere. Nor is falling back to plain sweeps, from the current iterate or from the
-warm start: on six such captured steps every rule tried left one unconverged or cost 11 000–37 000 sweeps
-on another. The window is an argument of the kernel so that such rules stay cheap to try.
+sweeps, where plain sweeps from the same warm start converge in 1219–1539 on two of them). Left to the
+plain solve's 10 000-sweep stall window, such steps made the default slower than plain Gauss–Seidel over
+the first 0.2 s of the 32- and 64-course walls (96 against 79 and 318 against 164 CPU s per simulated s).
+So nlgs.solve chains three stages for this solver, each only if the one before stalled:
+  1. accelerated sweeps until STALL_SWEEPS = 500 sweeps without a new lowest residual;
+  2. faces (masonrycli.engine.faces) for at most FACES_BUDGET = 5000 sweep units;
+  3. plain sweeps from the step's warm start, with the plain solve's own rules (10 000-sweep window, then
+     faces to the cap).
+Faces alone are no cure everywhere: on step 985 of the 248-block wall (plain sweeps: 747) they ran to the
+50 000 cap; falling back to plain sweeps alone fails where plain Gauss–Seidel cycles too (the 32-course
+wall's step 94 of the first accelerated run: 50 000 sweeps, unconverged). On six such captured steps the
+chain converges in 2281–6528 sweep units, where plain sweeps need 747–12 429 or fail once.
 """
 
 from __future__ import annotations
@@ -35,8 +39,10 @@ from masonrycli.engine.nlgs import P_WNN, P_WTN, P_WTT, _local_solve, _push, _re
 
 RESTART_GROWTH = 1.1
 """The accelerated sweep drops its momentum when a sweep's residual exceeds the previous one by this factor."""
-STALL_SWEEPS = 10_000
-"""Accelerated sweeps without a new lowest residual after which the solve hands over to faces (module doc)."""
+STALL_SWEEPS = 500
+"""Accelerated sweeps without a new lowest residual after which nlgs.solve goes on by faces (module doc)."""
+FACES_BUDGET = 5000
+"""Sweep units the faces get after a stalled accelerated solve before plain sweeps restart from the warm start."""
 
 
 @njit

@@ -42,9 +42,10 @@ golden history are bit-identical (a 2000-sweep window changed them and left one 
 wall unconverged). Tolerance 0 runs exactly the cap.
 
 Acceleration (solver "nlgs-accel", the default; "nlgs" is the plain sweep, kept as the reference): the
-same sweep started from a Nesterov extrapolation of the last two sweeps (:mod:`masonrycli.engine.momentum`),
-with the same stall window (momentum.STALL_SWEEPS, 10 000 sweeps) before it goes on by faces. Its
-iterations count accelerated sweeps, each ~1.2× the time of a plain one.
+same sweep started from a Nesterov extrapolation of the last two sweeps (:mod:`masonrycli.engine.momentum`).
+A stalled accelerated solve goes on by faces for a bounded budget, then by plain sweeps from the warm
+start (momentum module doc, "Where it fails"). Its iterations count accelerated sweeps (each ~1.2× the
+time of a plain one) plus the later stages' sweep units.
 """
 
 from __future__ import annotations
@@ -412,12 +413,36 @@ def solve(contact_body, pack, count, model, v, r, status) -> tuple[int, float]:
     (module doc). Another method plugged in beside this one keeps the signature, reports its work in
     sweep equivalents (contact visits / C) and the same residual, so that the history and the
     unconverged count mean the same thing. A solve that stalls continues by faces (module doc); its
-    iterations are then the point sweeps plus the faces' sweep units."""
+    iterations are then the point sweeps plus the faces' sweep units. With solver "nlgs-accel" a stalled
+    solve goes through the stages of the momentum module doc, and its iterations add up all of them."""
     mu, tolerance, cap = model.friction, model.tolerance, model.max_iterations
-    accelerate = model.solver == "nlgs-accel"
+    if model.solver != "nlgs-accel" or tolerance <= 0.0:
+        iterations, residual = _nlgs_interleaved(
+            contact_body, pack, count, mu, tolerance, cap, v, r, status, model.solver == "nlgs-accel", STALL_SWEEPS
+        )
+        return _faces_if_stalled(contact_body, pack, count, mu, tolerance, cap, v, r, status, iterations, residual)
+    # Accelerated (momentum module doc, "Where it fails"): momentum, then a bounded faces pass, then plain
+    # sweeps from the warm start again, each only if the one before stalled.
+    v_free, r_warm = v.copy(), r.copy()
     iterations, residual = _nlgs_interleaved(
-        contact_body, pack, count, mu, tolerance, cap, v, r, status, accelerate, momentum.STALL_SWEEPS
+        contact_body, pack, count, mu, tolerance, cap, v, r, status, True, momentum.STALL_SWEEPS
     )
+    if residual <= tolerance or iterations >= cap:
+        return iterations, residual
+    budget = min(momentum.FACES_BUDGET, cap - iterations)
+    units, residual = faces.face_sweeps(contact_body, pack, count, mu, tolerance, budget, v, r, status)
+    iterations += units
+    if residual <= tolerance or iterations >= cap:
+        return iterations, residual
+    v[:] = v_free
+    r[:count] = r_warm[:count]
+    its, residual = _nlgs_interleaved(
+        contact_body, pack, count, mu, tolerance, cap - iterations, v, r, status, False, STALL_SWEEPS
+    )
+    return _faces_if_stalled(contact_body, pack, count, mu, tolerance, cap, v, r, status, iterations + its, residual)
+
+
+def _faces_if_stalled(contact_body, pack, count, mu, tolerance, cap, v, r, status, iterations, residual):
     if tolerance > 0.0 and residual > tolerance and iterations < cap:  # stalled, not capped
         units, residual = faces.face_sweeps(contact_body, pack, count, mu, tolerance, cap - iterations, v, r, status)
         iterations += units
