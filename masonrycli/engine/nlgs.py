@@ -405,8 +405,8 @@ def solve(contact_body, pack, count, model, v, r, status) -> tuple[int, float]:
     """Solve one step's contact problem by NLGS: the engine's one entry point for a contact solver.
 
     In: ``contact_body`` (C, 2) bodies a < b, ``pack`` (C, PACK_WIDTH) from :func:`prepare_contacts`,
-    ``model`` (friction, tolerance m/s, max_iterations, solver "nlgs-accel" or "nlgs"). ``v`` (B, 3): v_free in, v_n+1 out. ``r`` (C, 2):
-    starting impulses in, (r_t, r_n) N·s out. ``status`` (C,) int8 out
+    ``model`` (friction, tolerance m/s, max_iterations, solver "nlgs-accel" or "nlgs"). ``v`` (B, 3): v_free
+    in, v_n+1 out. ``r`` (C, 2): starting impulses in, (r_t, r_n) N·s out. ``status`` (C,) int8 out
     (:class:`~masonrycli.engine.contact.ContactStatus`).
 
     Returns (iterations, residual): sweeps done, and the last sweep's RMS contact-law violation in m/s
