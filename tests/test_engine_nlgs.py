@@ -3,6 +3,8 @@ returned impulses must satisfy Signorini and Coulomb, not match stored numbers."
 
 from __future__ import annotations
 
+from types import SimpleNamespace
+
 import numpy as np
 import pytest
 
@@ -174,23 +176,28 @@ def test_contact_power_matches_dense_definitions():
     assert work == pytest.approx(-(on_support.sum(axis=0) @ v_support), rel=1e-12)
 
 
+def _slow_sweep(body, w_blocks, h, m_inv, v, r, mu, bias):
+    """One Gauss–Seidel sweep written out with the dense H and M⁻¹ (numpy, one contact at a time), updating
+    the flat v and r in place; returns its RMS of |W_αα Δr_α| (m/s), the stopping quantity of nlgs.solve."""
+    e2 = 0.0
+    for c in range(body.shape[0]):
+        w = w_blocks[c]
+        u_free = h[:, 2 * c : 2 * c + 2].T @ v - w @ r[c]
+        row = _packed_row((w[0, 0], w[0, 1], w[1, 1]), bias[c], mu)
+        rt, rn, _ = nlgs._local_solve(u_free[0], u_free[1], row, 0, mu)
+        dr = np.array([rt, rn]) - r[c]
+        v += m_inv @ h[:, 2 * c : 2 * c + 2] @ dr
+        r[c] = (rt, rn)
+        e2 += float((w @ dr) @ (w @ dr))
+    return np.sqrt(e2 / body.shape[0])
+
+
 def _slow_sweeps(body, w_blocks, h, m_inv, v, r, mu, bias, sweeps):
-    """Gauss–Seidel written out with the dense H and M⁻¹ (numpy, one contact at a time); returns the last
-    sweep's RMS of |W_αα Δr_α| (m/s), the stopping quantity of nlgs.solve."""
+    """``sweeps`` dense Gauss–Seidel sweeps from impulses r; returns (v, r, the last sweep's residual)."""
     v = v.ravel().copy()
     v += m_inv @ h @ r.ravel()
     for _ in range(sweeps):
-        e2 = 0.0
-        for c in range(body.shape[0]):
-            w = w_blocks[c]
-            u_free = h[:, 2 * c : 2 * c + 2].T @ v - w @ r[c]
-            row = _packed_row((w[0, 0], w[0, 1], w[1, 1]), bias[c], mu)
-            rt, rn, _ = nlgs._local_solve(u_free[0], u_free[1], row, 0, mu)
-            dr = np.array([rt, rn]) - r[c]
-            v += m_inv @ h[:, 2 * c : 2 * c + 2] @ dr
-            r[c] = (rt, rn)
-            e2 += float((w @ dr) @ (w @ dr))
-        residual = np.sqrt(e2 / body.shape[0])
+        residual = _slow_sweep(body, w_blocks, h, m_inv, v, r, mu, bias)
     return v.reshape(-1, 3), r, residual
 
 
@@ -270,17 +277,7 @@ def _slow_accelerated_sweeps(body, w_blocks, h, m_inv, v, r, mu, bias, sweeps, g
         r_y = r + beta * (r - r_prev)
         v_prev, r_prev = v.copy(), r.copy()
         v, r = v_y, r_y
-        e2 = 0.0
-        for c in range(body.shape[0]):
-            w = w_blocks[c]
-            u_free = h[:, 2 * c : 2 * c + 2].T @ v - w @ r[c]
-            row = _packed_row((w[0, 0], w[0, 1], w[1, 1]), bias[c], mu)
-            rt, rn, _ = nlgs._local_solve(u_free[0], u_free[1], row, 0, mu)
-            dr = np.array([rt, rn]) - r[c]
-            v = v + m_inv @ h[:, 2 * c : 2 * c + 2] @ dr
-            r[c] = (rt, rn)
-            e2 += float((w @ dr) @ (w @ dr))
-        residual = np.sqrt(e2 / body.shape[0])
+        residual = _slow_sweep(body, w_blocks, h, m_inv, v, r, mu, bias)
         if residual == 0.0:  # an exact solution: the kernel stops there too (residual <= tolerance 0)
             break
         j = 1 if residual > growth * last else j
@@ -423,8 +420,6 @@ def test_a_stalled_accelerated_solve_falls_back_to_faces_then_plain_sweeps_from_
     # sweeps from the warm start. Windows of 1 sweep and a 1-unit faces budget force every stage on a stack;
     # the step must still end converged on plain Gauss–Seidel's (unique) velocities, with v the velocity of
     # its impulses, and count every stage's work.
-    from types import SimpleNamespace
-
     body, pack, h, m_inv, w_blocks, v0, r0, mu, bias = _stack_problem(6)
     count = body.shape[0]
     status = np.zeros(count, dtype=np.int8)
