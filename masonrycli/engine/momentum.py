@@ -49,9 +49,8 @@ FACES_BUDGET = 5000
 def _nlgs_accelerated(contact_body, pack, count, mu, tolerance, max_iterations, v, r, status, stall_after):
     # _nlgs with Nesterov momentum and adaptive restart; its contact loop is _nlgs's written out again with
     # the extrapolated start (a shared visit function cost 47–57 ns per visit against 8.7 inline: faces.py).
-    # x_k: the (r, v) a sweep leaves. The next sweep
-    # starts from the extrapolated y_k = x_k + β_k (x_k − x_k−1), β_k = (j − 1)/(j + 2), j counting the
-    # sweeps since the last restart; a sweep whose residual grows by more than RESTART_GROWTH restarts
+    # x_k: the (r, v) a sweep leaves. The next sweep starts from the extrapolated
+    # y_k = x_k + β_k (x_k − x_k−1), β_k = (j − 1)/(j + 2), j counting the sweeps since the last restart; a sweep whose residual grows by more than RESTART_GROWTH restarts
     # (j = 1, β = 0: a plain sweep). v is linear in r (v = v_free + M⁻¹ H r), so extrapolating the
     # bodies' v and each contact's r alike keeps the pair consistent, and no projection is needed: the
     # visit replaces r_α by its local solution, which is in the cone, and the step ends on a sweep.
