@@ -68,6 +68,8 @@ def _nlgs_accelerated(contact_body, pack, count, mu, tolerance, max_iterations, 
     if count == 0:
         return iterations, residual
     v_prev = v.copy()
+    v_flat = v.reshape(v.size)  # views: the extrapolation of the bodies, one flat loop, is vectorised
+    v_prev_flat = v_prev.reshape(v.size)
     r_prev = r[:count].copy()
     best = np.inf
     best_at = 0
@@ -76,11 +78,10 @@ def _nlgs_accelerated(contact_body, pack, count, mu, tolerance, max_iterations, 
     beta = 0.0
     for it in range(max_iterations):
         iterations = it + 1
-        for i in range(v.shape[0]):
-            for q in range(3):
-                x = v[i, q]
-                v[i, q] = x + beta * (x - v_prev[i, q])
-                v_prev[i, q] = x
+        for i in range(v_flat.shape[0]):
+            x = v_flat[i]
+            v_flat[i] = x + beta * (x - v_prev_flat[i])
+            v_prev_flat[i] = x
         sum_e2 = 0.0
         for c in range(count):
             a = contact_body[c, 0]

@@ -304,7 +304,7 @@ def _nlgs_interleaved(
             if c < count:
                 order[i] = c
                 i += 1
-    body_o = np.empty((count, 2), dtype=contact_body.dtype)
+    body_o = np.empty((count, 2), dtype=np.uint32)  # unsigned: v[a] then compiles without a wrap-around test
     pack_o = np.empty((count, pack.shape[1]))
     r_o = np.empty((count, 2))
     status_o = np.empty(count, dtype=status.dtype)
