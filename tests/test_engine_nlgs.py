@@ -3,8 +3,6 @@ returned impulses must satisfy Signorini and Coulomb, not match stored numbers."
 
 from __future__ import annotations
 
-from types import SimpleNamespace
-
 import numpy as np
 import pytest
 
@@ -176,11 +174,12 @@ def test_contact_power_matches_dense_definitions():
     assert work == pytest.approx(-(on_support.sum(axis=0) @ v_support), rel=1e-12)
 
 
-def _slow_sweep(body, w_blocks, h, m_inv, v, r, mu, bias):
-    """One Gauss–Seidel sweep written out with the dense H and M⁻¹ (numpy, one contact at a time), updating
-    the flat v and r in place; returns its RMS of |W_αα Δr_α| (m/s), the stopping quantity of nlgs.solve."""
+def _slow_sweep(body, w_blocks, h, m_inv, v, r, mu, bias, order=None):
+    """One Gauss–Seidel sweep written out with the dense H and M⁻¹ (numpy, one contact at a time, in
+    ``order`` or in index order), updating the flat v and r in place; returns its RMS of |W_αα Δr_α| (m/s),
+    the stopping quantity of nlgs.solve."""
     e2 = 0.0
-    for c in range(body.shape[0]):
+    for c in range(body.shape[0]) if order is None else order:
         w = w_blocks[c]
         u_free = h[:, 2 * c : 2 * c + 2].T @ v - w @ r[c]
         row = _packed_row((w[0, 0], w[0, 1], w[1, 1]), bias[c], mu)
@@ -230,6 +229,29 @@ def test_residual_is_rms_contact_law_violation_of_the_last_sweep(sweeps):
     v, r = v0.copy(), r0.copy()
     _, before = nlgs._nlgs(body, pack, count, mu, 0.0, its - 1, v, r, status) if its > 1 else (0, np.inf)
     assert before > 1e-9
+
+
+@pytest.mark.parametrize("sweeps", [1, 2, 5, 12])
+def test_alternating_sweeps_match_the_dense_sweep_forward_then_backward(sweeps):
+    # alternate=True (what stalled.py resumes): sweeps 1, 3, 5, … visit the contacts in index order,
+    # sweeps 2, 4, … in reverse; the residual is the last sweep's.
+    body, pack, h, m_inv, w_blocks, v0, r0, mu, bias = _random_problem(5)
+    count = body.shape[0]
+    v_ref, r_ref = v0.ravel().copy(), r0.copy()
+    v_ref += m_inv @ h @ r_ref.ravel()
+    for k in range(sweeps):
+        order = range(count) if k % 2 == 0 else range(count - 1, -1, -1)
+        res_ref = _slow_sweep(body, w_blocks, h, m_inv, v_ref, r_ref, mu, bias, order)
+    v, r, status = v0.copy(), r0.copy(), np.zeros(count, dtype=np.int8)
+    its, res = nlgs._nlgs(body, pack, count, mu, 0.0, sweeps, v, r, status, True)
+    assert its == sweeps
+    assert res == pytest.approx(res_ref, rel=1e-9, abs=1e-15)
+    np.testing.assert_allclose(r, r_ref, rtol=1e-9, atol=1e-14)
+    np.testing.assert_allclose(v.ravel(), v_ref, rtol=1e-9, atol=1e-12)
+    if sweeps > 1:  # and it is not the one-way sweep
+        v1, r1 = v0.copy(), r0.copy()
+        nlgs._nlgs(body, pack, count, mu, 0.0, sweeps, v1, r1, status)
+        assert not np.allclose(r1, r, rtol=1e-9, atol=1e-14)
 
 
 def test_a_solve_that_stops_improving_ends_stall_sweeps_after_its_lowest_residual():
@@ -413,26 +435,3 @@ def test_an_accelerated_solve_that_stops_improving_ends_its_window_after_its_low
         assert all(x >= seen[last_low] for x in lows[last_low + 1 : its])
     its, _ = momentum._nlgs_accelerated(body, pack, count, mu, 0.0, 150, v0.copy(), r0.copy(), status, 3)
     assert its == 150  # (an exact 0 comes at sweep 211)
-
-
-def test_a_stalled_accelerated_solve_falls_back_to_faces_then_plain_sweeps_from_the_warm_start(monkeypatch):
-    # nlgs.solve's chain for nlgs-accel: momentum until its stall window, a bounded faces pass, then plain
-    # sweeps from the warm start. Windows of 1 sweep and a 1-unit faces budget force every stage on a stack;
-    # the step must still end converged on plain Gauss–Seidel's (unique) velocities, with v the velocity of
-    # its impulses, and count every stage's work.
-    body, pack, h, m_inv, w_blocks, v0, r0, mu, bias = _stack_problem(6)
-    count = body.shape[0]
-    status = np.zeros(count, dtype=np.int8)
-    model = SimpleNamespace(friction=mu, tolerance=1e-10, max_iterations=100000, solver="nlgs")
-    v_gs, r_gs = v0.copy(), r0.copy()
-    its_gs, _ = nlgs.solve(body, pack, count, model, v_gs, r_gs, status)
-    monkeypatch.setattr(momentum, "STALL_SWEEPS", 1)
-    monkeypatch.setattr(momentum, "FACES_BUDGET", 1)
-    model = SimpleNamespace(friction=mu, tolerance=1e-10, max_iterations=100000, solver="nlgs-accel")
-    v, r = v0.copy(), r0.copy()
-    its, res = nlgs.solve(body, pack, count, model, v, r, status)
-    assert res <= 1e-10
-    np.testing.assert_allclose(v, v_gs, atol=1e-8)
-    np.testing.assert_allclose(v.ravel(), v0.ravel() + m_inv @ h @ r.ravel(), atol=1e-12)
-    # the plain restart from the warm start alone takes its_gs sweeps; the stages before it add to the count
-    assert its > its_gs

@@ -19,15 +19,13 @@ do not leave either (the 32-course wall's steps 84–88: the residual wanders at
 sweeps, where plain sweeps from the same warm start converge in 1219–1539 on two of them). Left to the
 plain solve's 10 000-sweep stall window, such steps made the default slower than plain Gauss–Seidel over
 the first 0.2 s of the 32- and 64-course walls (96 against 79 and 318 against 164 CPU s per simulated s).
-So nlgs.solve chains three stages for this solver, each only if the one before stalled:
-  1. accelerated sweeps until STALL_SWEEPS = 500 sweeps without a new lowest residual;
-  2. faces (masonrycli.engine.faces) for at most FACES_BUDGET = 5000 sweep units;
-  3. plain sweeps from the step's warm start, with the plain solve's own rules (10 000-sweep window, then
-     faces to the cap).
-Faces alone are no cure everywhere: on step 985 of the 248-block wall (plain sweeps: 747) they ran to the
-50 000 cap; falling back to plain sweeps alone fails where plain Gauss–Seidel cycles too (the 32-course
-wall's step 94 of the first accelerated run: 50 000 sweeps, unconverged). On six such captured steps the
-chain converges in 2281–6528 sweep units, where plain sweeps need 747–12 429 or fail once.
+So a solve of this solver stops after STALL_SWEEPS = 500 accelerated sweeps without a new lowest
+residual, and nlgs.solve hands the step to :mod:`masonrycli.engine.stalled`, which takes alternating-direction
+sweeps from the warm start, this momentum resumed, and faces from its stalled iterate in turn, with doubling
+budgets (that module's doc has the figures). Before 2026-11-23, 23:59 UTC the stalled step went through a fixed chain
+(faces for at most 5000 sweep units, then plain sweeps from the warm start with a 10 000-sweep window, then
+faces to the cap): 17 816–23 714 sweep units on the 32-course wall's sliding steps, and one step of the
+64-course wall unconverged over 0.2 s.
 """
 
 from __future__ import annotations
@@ -40,9 +38,7 @@ from masonrycli.engine.nlgs import P_WNN, P_WTN, P_WTT, _local_solve, _push, _re
 RESTART_GROWTH = 1.1
 """The accelerated sweep drops its momentum when a sweep's residual exceeds the previous one by this factor."""
 STALL_SWEEPS = 500
-"""Accelerated sweeps without a new lowest residual after which nlgs.solve goes on by faces (module doc)."""
-FACES_BUDGET = 5000
-"""Sweep units the faces get after a stalled accelerated solve before plain sweeps restart from the warm start."""
+"""Accelerated sweeps without a new lowest residual after which nlgs.solve hands the step to stalled.py."""
 
 
 @njit

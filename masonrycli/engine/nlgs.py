@@ -43,9 +43,9 @@ wall unconverged). Tolerance 0 runs exactly the cap.
 
 Acceleration (solver "nlgs-accel", the default; "nlgs" is the plain sweep, kept as the reference): the
 same sweep started from a Nesterov extrapolation of the last two sweeps (:mod:`masonrycli.engine.momentum`).
-A stalled accelerated solve goes on by faces for a bounded budget, then by plain sweeps from the warm
-start (momentum module doc, "Where it fails"). Its iterations count accelerated sweeps (each ~1.2× the
-time of a plain one) plus the later stages' sweep units.
+A stalled accelerated solve goes on by the methods of :mod:`masonrycli.engine.stalled` (alternating-direction
+sweeps, momentum resumed, faces, in turn with doubling budgets). Its iterations count accelerated sweeps
+(each ~1.2× the time of a plain one) plus the later methods' sweep units.
 """
 
 from __future__ import annotations
@@ -224,11 +224,13 @@ def _push(v, a, b, pack, c, drt, drn):
 
 
 @njit
-def _nlgs(contact_body, pack, count, mu, tolerance, max_iterations, v, r, status):
+def _nlgs(contact_body, pack, count, mu, tolerance, max_iterations, v, r, status, alternate=False):
     # v enters as v_free and leaves as v_n+1; r enters as the warm start and leaves as the solution.
     #   v ← v_free + M⁻¹ H r_warm
     #   repeat (one sweep):
-    #       for α in order: u_free = H_αᵀ v − W_αα r_α ; r_α' = local_solve(u_free)
+    #       for α in order (alternate: every second sweep in reverse order — what a stalled accelerated
+    #       solve uses, since it breaks the stick/slip cycles of the one-way sweep; stalled.py):
+    #                       u_free = H_αᵀ v − W_αα r_α ; r_α' = local_solve(u_free)
     #                       e_α = W_αα (r_α' − r_α)      (m/s: α's violation of its law at the visit)
     #                       v += M⁻¹ H_α (r_α' − r_α)
     #       residual = sqrt(Σ_α |e_α|² / C)
@@ -245,7 +247,11 @@ def _nlgs(contact_body, pack, count, mu, tolerance, max_iterations, v, r, status
     for it in range(max_iterations):
         iterations = it + 1
         sum_e2 = 0.0
-        for c in range(count):
+        first, step = 0, 1
+        if alternate and it % 2 == 1:
+            first, step = count - 1, -1
+        for k in range(count):
+            c = first + step * k
             a = contact_body[c, 0]
             b = contact_body[c, 1]
             ut, un = _relative_velocity(v, a, b, pack, c)
@@ -284,7 +290,18 @@ INTERLEAVE = 4
 
 @njit
 def _nlgs_interleaved(
-    contact_body, pack, count, mu, tolerance, max_iterations, v, r, status, accelerate, accelerated_stall
+    contact_body,
+    pack,
+    count,
+    mu,
+    tolerance,
+    max_iterations,
+    v,
+    r,
+    status,
+    accelerate,
+    accelerated_stall,
+    alternate=False,
 ):
     # Detection order puts a pair's two or three contact points, and the pairs of one block, next to
     # each other: each visit then reads the velocities the visit before has just written, and the
@@ -320,7 +337,7 @@ def _nlgs_interleaved(
             body_o, pack_o, count, mu, tolerance, max_iterations, v, r_o, status_o, accelerated_stall
         )
     else:
-        iterations, residual = _nlgs(body_o, pack_o, count, mu, tolerance, max_iterations, v, r_o, status_o)
+        iterations, residual = _nlgs(body_o, pack_o, count, mu, tolerance, max_iterations, v, r_o, status_o, alternate)
     for i in range(count):
         c = order[i]
         r[c, 0] = r_o[i, 0]
@@ -417,32 +434,23 @@ def solve(contact_body, pack, count, model, v, r, status) -> tuple[int, float]:
     sweep equivalents (contact visits / C) and the same residual, so that the history and the
     unconverged count mean the same thing. A solve that stalls continues by faces (module doc); its
     iterations are then the point sweeps plus the faces' sweep units. With solver "nlgs-accel" a stalled
-    solve goes through the stages of the momentum module doc, and its iterations add up all of them."""
+    solve goes on by the methods of :mod:`masonrycli.engine.stalled`, and its iterations add up all of them."""
     mu, tolerance, cap = model.friction, model.tolerance, model.max_iterations
     if model.solver != "nlgs-accel" or tolerance <= 0.0:
         iterations, residual = _nlgs_interleaved(
             contact_body, pack, count, mu, tolerance, cap, v, r, status, model.solver == "nlgs-accel", STALL_SWEEPS
         )
         return _faces_if_stalled(contact_body, pack, count, mu, tolerance, cap, v, r, status, iterations, residual)
-    # Accelerated (momentum module doc, "Where it fails"): momentum, then a bounded faces pass, then plain
-    # sweeps from the warm start again, each only if the one before stalled.
-    v_free, r_warm = v.copy(), r.copy()
+    # Accelerated: momentum until its stall window; a stalled step goes on by the methods of stalled.py.
+    v_free, r_warm = v.copy(), r[:count].copy()
     iterations, residual = _nlgs_interleaved(
         contact_body, pack, count, mu, tolerance, cap, v, r, status, True, momentum.STALL_SWEEPS
     )
     if residual <= tolerance or iterations >= cap:
         return iterations, residual
-    budget = min(momentum.FACES_BUDGET, cap - iterations)
-    units, residual = faces.face_sweeps(contact_body, pack, count, mu, tolerance, budget, v, r, status)
-    iterations += units
-    if residual <= tolerance or iterations >= cap:
-        return iterations, residual
-    v[:] = v_free
-    r[:count] = r_warm[:count]
-    its, residual = _nlgs_interleaved(
-        contact_body, pack, count, mu, tolerance, cap - iterations, v, r, status, False, STALL_SWEEPS
+    return stalled.continue_stalled(
+        contact_body, pack, count, mu, tolerance, cap, v, r, status, v_free, r_warm, iterations, residual
     )
-    return _faces_if_stalled(contact_body, pack, count, mu, tolerance, cap, v, r, status, iterations + its, residual)
 
 
 def _faces_if_stalled(contact_body, pack, count, mu, tolerance, cap, v, r, status, iterations, residual):
@@ -478,6 +486,6 @@ def tangential_velocity(contact_body, pack, count, v) -> np.ndarray:
     return out
 
 
-# At the end: faces and momentum build on this module's sweep primitives (a stalled solve() continues by
-# faces; the accelerated sweep is momentum's).
-from masonrycli.engine import faces, momentum  # noqa: E402
+# At the end: faces, momentum and stalled build on this module's sweep primitives (a stalled solve()
+# continues by faces or by stalled's methods; the accelerated sweep is momentum's).
+from masonrycli.engine import faces, momentum, stalled  # noqa: E402
