@@ -10,6 +10,12 @@ that changing a flag changes it everywhere.
   the contact geometry relies on exact comparisons (ties between faces, points on clipping planes).
 - no ``parallel``: threads would make the order of floating-point reductions, hence the results,
   depend on scheduling.
+- SLP vectorisation on (numba's default is off): LLVM packs the same operation on neighbouring scalars
+  (the x and y of an impulse, the two bodies of a contact) into one vector instruction. Each lane is the
+  same IEEE operation as before and, without fastmath, nothing is reassociated or contracted, so the
+  results are bit-identical; the NLGS sweep takes ~4 % less time per contact·sweep. numba reads the
+  setting whenever it compiles, so it holds for every kernel compiled in the process (the engine is
+  numba's only user).
 
 The cache of a kernel is stamped with the source of its module **and of every engine module that module
 imports from**, transitively (:func:`source_files`). A cached kernel holds the machine code of the
@@ -27,8 +33,9 @@ import os
 import re
 
 import numba
-from numba.core import caching
+from numba.core import caching, config
 
+config.SLP_VECTORIZE = 1  # module doc
 njit = functools.partial(numba.njit, cache=True)
 """``numba.njit`` with the engine's flags. Use as ``@njit`` or ``@njit(...)``."""
 
