@@ -1,4 +1,4 @@
-"""Solver lab: ``python -m benchmarks.solver_lab capture|table|clusters`` (see benchmarks/README.md, "Solver lab")."""
+"""Solver lab: ``python -m benchmarks.solver_lab capture|table|clusters|stalled`` (see benchmarks/README.md, "Solver lab")."""
 
 from __future__ import annotations
 
@@ -28,11 +28,25 @@ def main() -> None:
     tab.add_argument("--repeat", type=int, default=3, help="interleaved repeats; CPU-time minimum is kept")
     clu = sub.add_parser("clusters", help="share of an NLGS iterate's velocity error in rigid motion of stick clusters")
     clu.add_argument("specs", nargs="+", metavar="PROBLEM:SWEEPS")
+    sta = sub.add_parser("stalled", help="capture the steps stalled.py finishes; run each method alone on them")
+    sta.add_argument("action", choices=("capture", "table"))
+    sta.add_argument("--cases", nargs="+", default=["h16", "h32", "h64"])
+    sta.add_argument("--duration", type=float, default=0.2, help="simulated s per case (capture)")
+    sta.add_argument("--steps", nargs="+", default=None, help="table: these kept steps (names, e.g. h32-100)")
+    sta.add_argument("--repeat", type=int, default=2, help="table: CPU-time minimum of this many runs")
     args = ap.parse_args()
     if args.command == "capture":
         from benchmarks.solver_lab.capture import capture
 
         capture(args.cases, args.solver)
+    elif args.command == "stalled":
+        from benchmarks.solver_lab import stalled_steps
+
+        if args.action == "capture":
+            stalled_steps.capture(args.cases, args.duration)
+        else:
+            paths = [stalled_steps.STALLED / f"{n}.npz" for n in args.steps] if args.steps else None
+            stalled_steps.table(paths, args.repeat)
     elif args.command == "clusters":
         from benchmarks.solver_lab.clusters import report
 

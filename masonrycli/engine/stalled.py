@@ -3,24 +3,30 @@
 Gauss–Seidel with momentum (the default solver, :mod:`masonrycli.engine.momentum`) converges most steps in
 tens to hundreds of sweeps. On tall walls that slide it can stall: momentum drives the step into a
 stick/slip cycle, the residual wanders above the tolerance, and the solve stops after momentum's stall
-window. No single method finishes every such step. Measured on 22 stalled steps of walls of 16, 32 and 64
-courses (benchmarks/README.md, "Stalled steps"), from the step's warm start or momentum's stalled iterate:
+window. No single method finishes every such step. Measured on 33 of the 108 steps that stall over the first
+0.2 s of the walls of 32 and 64 courses (benchmarks/README.md, "Stalled steps"; each method alone from the
+step's warm start, tolerance 1e-5 m/s, cap 50 000 sweep units):
 
-* Gauss–Seidel with alternating sweep direction (forward, backward, forward, … from the warm start)
-  converges the 32-course wall's sliding steps in 155–5225 sweeps, where one-way sweeps cycle for 10 000
-  and more: reversing the order every sweep breaks the cycle in which a sliding block lifts one corner of
-  its bed joint and the other corner takes the load. It creeps or stalls on the 64-course wall's early
-  steps (17 533–43 002 sweeps, or unconverged).
-* Momentum itself, continued past its window, converges those early 64-course steps in 2409–8041 sweeps
-  (its residual plateaus for 500–2000 sweeps there before dropping) but cycles on the sliding steps.
-* Faces (:mod:`masonrycli.engine.faces`) from momentum's stalled iterate finish a few steps neither does
-  (the 64-course wall's step 75: 2262 sweep units, where the other two stall).
+* Gauss–Seidel with alternating sweep direction (forward, backward, forward, …) converges 32 of them (the
+  32-course wall's in 227–6377 sweeps), where one-way plain sweeps stall on 10 and momentum cycles on 20:
+  reversing the order every sweep breaks the cycle in which a sliding block lifts one corner of its bed
+  joint and the other corner takes the load. It fails on the 64-course wall's first step (43 002 sweeps, unconverged) and
+  creeps on its third (16 383).
+* Momentum itself, continued past its window, converges those first 64-course steps in 1846–8041 sweeps
+  (its residual plateaus for hundreds of sweeps there before dropping), and cycles on the sliding steps.
+* Faces (:mod:`masonrycli.engine.faces`) from momentum's stalled iterate converge 32 of the 33, at ~2× a
+  point sweep's cost per unit, sometimes first (the 64-course wall's step 1: 3465 units against 5471 and
+  8327).
 
 So the methods are run round-robin from their own states, each for a budget of sweep units that doubles
 every round (FIRST_BUDGET, 2 × FIRST_BUDGET, …), until one meets the tolerance or the step's cap is
 spent. A step that one method solves in U units costs at most about 3 × 2U plus momentum's first try,
 whichever method that is; a method that stalls inside its budget (its own stall window) is dropped. At
 the cap the state with the lowest residual is kept and the step is counted unconverged, as before.
+On the 33 steps this finishes all of them in 149 423 sweep units (5.1 s CPU; alternating sweeps alone:
+124 500 units, 4.4 s, one step missed); the fixed chain it replaced (faces for at most 5000 units, plain
+sweeps from the warm start, faces to the cap) took 17 816–23 714 units on each of seven sliding steps of
+the 32-course wall captured from its own run; this takes 704–9399 on six of them and 23 998 on the seventh.
 """
 
 from __future__ import annotations

@@ -1,0 +1,123 @@
+"""Stalled steps: capture the steps whose accelerated solve stalls, and run each method alone on them.
+
+    python -m benchmarks.solver_lab stalled capture [--cases h16 h32 h64] [--duration 0.2]
+    python -m benchmarks.solver_lab stalled table
+
+``capture`` runs each case of :mod:`benchmarks.solver_cases` with the default solver and keeps the input
+of every step that :mod:`masonrycli.engine.stalled` had to finish (nlgs.solve's arguments as the engine
+passed them: body pairs, packed rows, v_free, warm start), in ``data/stalled/<case>-<step>.npz``.
+``table`` solves each kept step from its warm start with the engine's ``nlgs.solve`` and with each
+method alone, to the engine's tolerance and cap, and prints sweep units, CPU ms (minimum of --repeat) and
+whether the tolerance was met:
+
+
+    engine        nlgs.solve as shipped (momentum, then stalled.py's round-robin)
+    momentum      accelerated sweeps with no stall window
+    alternating   plain sweeps, every second one in reverse order (10 000-sweep stall window)
+    plain         plain sweeps in one direction (10 000-sweep stall window)
+    faces         faces from momentum's iterate at its 500-sweep stall
+
+(Faces' sweep units cost ~2× a point sweep's time; compare the ms.) The figures of stalled.py's module doc
+and of benchmarks/README.md, "Stalled steps", come from here.
+"""
+
+from __future__ import annotations
+
+import time
+from pathlib import Path
+from types import SimpleNamespace
+
+import numpy as np
+
+from benchmarks.solver_cases import make_scenario
+from benchmarks.solver_lab.problems import DATA
+from masonrycli.engine import faces, momentum, nlgs, stalled
+from masonrycli.run import Simulation, simulate
+
+STALLED = DATA / "stalled"
+TOLERANCE, CAP = 1e-5, 50_000
+
+
+def capture(cases: list[str], duration: float) -> None:
+    """Run ``cases`` for ``duration`` simulated s; write the input of each step stalled.py finished."""
+    STALLED.mkdir(parents=True, exist_ok=True)
+    for case in cases:
+        steps, kept = _capture_case(case, duration)
+        print(f"{case}: {steps} steps, {len(kept)} stalled: {' '.join(kept)}", flush=True)
+
+
+def _capture_case(case: str, duration: float) -> tuple[int, list[str]]:
+    solve, finish = nlgs.solve, stalled.continue_stalled
+    step, pending, kept = [0], {}, []
+
+    def watched(contact_body, pack, count, model, v, r, status):
+        pending.update(body=contact_body[:count].copy(), pack=pack[:count].copy(), v_free=v.copy())
+        pending.update(r_warm=r[:count].copy(), mu=model.friction, stalled=False)
+        out = solve(contact_body, pack, count, model, v, r, status)
+        if pending["stalled"]:
+            path = STALLED / f"{case}-{step[0]}.npz"
+            np.savez(path, **{k: val for k, val in pending.items() if k != "stalled"})
+            kept.append(path.name)
+        step[0] += 1
+        return out
+
+    def marked(*args):
+        pending["stalled"] = True
+        return finish(*args)
+
+    nlgs.solve, stalled.continue_stalled = watched, marked
+    try:
+        sc = make_scenario(case, duration)
+        simulate(sc, [], sim=Simulation(sc))
+    finally:
+        nlgs.solve, stalled.continue_stalled = solve, finish
+    return step[0], kept
+
+
+def _method(name, p, v, r, status):
+    body, pack, mu, count = p["body"], p["pack"], float(p["mu"]), p["body"].shape[0]
+    if name == "engine":
+        model = SimpleNamespace(friction=mu, tolerance=TOLERANCE, max_iterations=CAP, solver="nlgs-accel")
+        return nlgs.solve(body, pack, count, model, v, r, status)
+    if name == "faces":
+        its, res = nlgs._nlgs_interleaved(
+            body, pack, count, mu, TOLERANCE, CAP, v, r, status, True, momentum.STALL_SWEEPS
+        )
+        if res <= TOLERANCE:
+            return its, res
+        units, res = faces.face_sweeps(body, pack, count, mu, TOLERANCE, CAP - its, v, r, status)
+        return its + units, res
+    accelerate = name == "momentum"
+    return nlgs._nlgs_interleaved(
+        body, pack, count, mu, TOLERANCE, CAP, v, r, status, accelerate, CAP, name == "alternating"
+    )
+
+
+METHODS = ("engine", "momentum", "alternating", "plain", "faces")
+
+
+def table(paths: list[Path] | None = None, repeat: int = 2) -> None:
+    """Each kept step solved by each method from its warm start: sweep units (* = tolerance missed), CPU ms."""
+    paths = paths or sorted(STALLED.glob("*.npz"))
+    print("| step | contacts | " + " | ".join(METHODS) + " |")
+    print("|---|---|" + "---|" * len(METHODS))
+    totals = {m: [0, 0.0, 0] for m in METHODS}
+    for path in paths:
+        p = dict(np.load(path))
+        cells = []
+        for m in METHODS:
+            best = np.inf
+            for _ in range(repeat):
+                v, r = p["v_free"].copy(), p["r_warm"].copy()
+                status = np.zeros(r.shape[0], dtype=np.int8)
+                t = time.process_time()
+                its, res = _method(m, p, v, r, status)
+                best = min(best, 1e3 * (time.process_time() - t))
+            met = res <= TOLERANCE
+            totals[m][0] += its
+            totals[m][1] += best
+            totals[m][2] += not met
+            cells.append(f"{its}{'' if met else '*'} ({best:.0f} ms)")
+        print(f"| {path.stem} | {p['body'].shape[0]} | " + " | ".join(cells) + " |", flush=True)
+    total = [f"{u} ({ms:.0f} ms, {miss} missed)" for u, ms, miss in totals.values()]
+    print(f"| all {len(paths)} | | " + " | ".join(total) + " |")
