@@ -1,0 +1,172 @@
+"""Kernel benchmark: time per contact·sweep of the NLGS sweep, one git revision against another, on the very
+same captured steps, and whether both give the same bits.
+
+    .venv/bin/python -m benchmarks.bench_kernel --base REV [--new REV] [--case wall-248] [--duration 1]
+        [--every 10] [--rounds 5] [--json PATH]
+
+1. The working tree runs ``--case`` for ``--duration`` simulated seconds and keeps the inputs of every
+   ``--every``-th call that ``nlgs.solve`` makes to ``nlgs._nlgs_interleaved`` (the accelerated solve of
+   each step with the default solver), then the outputs the working tree gives for them.
+2. Each revision (``git archive`` of its ``masonrycli``; ``--new`` defaults to the working tree) is
+   timed in a fresh process of its own, with its own numba flags and a numba cache of its own: every
+   captured call once (compile, and the bits of v, r, status, sweeps and residual), then the whole set
+   ``PASSES`` times, CPU time (``time.process_time``) per pass.
+3. Rounds alternate the order of the revisions (base, new; new, base; …): the minimum over rounds and
+   passes is reported in ns per contact·sweep (CPU time / Σ contacts × sweeps, the sweeps each revision
+   made), with new ÷ base, and whether every output of the two revisions is bit-identical.
+
+For changes that keep the results (compiler flags, memory layout, inlining): a revision that changes the
+sweep counts changes the work, and the ratio then mixes speed per sweep with sweeps.
+"""
+
+from __future__ import annotations
+
+import argparse
+import hashlib
+import io
+import json
+import os
+import pickle
+import subprocess
+import sys
+import tarfile
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+os.environ.setdefault("RERUN_ANALYTICS", "0")
+ROOT = Path(__file__).resolve().parent.parent
+WORKTREE = "worktree"
+"""``--base`` / ``--new`` value naming the checkout this file is in, as it is on disk."""
+PASSES = 3
+"""Timed passes over the captured calls per worker process (its minimum is kept)."""
+
+
+def capture(case: str, duration: float, every: int) -> list[tuple]:
+    """Inputs of every ``every``-th call of ``nlgs._nlgs_interleaved`` made by ``nlgs.solve`` on ``case``."""
+    sys.path.insert(0, str(ROOT))
+    from benchmarks.solver_cases import make_scenario
+    from masonrycli.engine import nlgs
+    from masonrycli.run import Simulation, simulate
+
+    kernel, calls, seen = nlgs._nlgs_interleaved, [], [0]
+
+    def keep(contact_body, pack, count, *rest, **options):
+        plain_form = not options and len(rest) == 8  # the 11 arguments every revision takes
+        if plain_form and seen[0] % every == 0:
+            mu, tolerance, cap, v, r, status = rest[:6]
+            calls.append((contact_body[:count].copy(), pack[:count].copy(), count, mu, tolerance, cap)
+                         + (v.copy(), r[:count].copy(), status[:count].copy()) + tuple(rest[6:]))  # fmt: skip
+        seen[0] += plain_form
+        return kernel(contact_body, pack, count, *rest, **options)
+
+    nlgs._nlgs_interleaved = keep
+    try:
+        scenario = make_scenario(case, duration)
+        simulate(scenario, [], sim=Simulation(scenario))
+    finally:
+        nlgs._nlgs_interleaved = kernel
+    return calls
+
+
+def run_calls(kernel, calls) -> tuple[list, str]:
+    """Run every captured call on copies of its arrays: (CPU seconds per call, digest of all outputs)."""
+    digest, seconds = hashlib.sha256(), []
+    for contact_body, pack, count, mu, tolerance, cap, v, r, status, *rest in calls:
+        v, r, status = v.copy(), r.copy(), status.copy()
+        start = time.process_time()
+        sweeps, residual = kernel(contact_body, pack, count, mu, tolerance, cap, v, r, status, *rest)
+        seconds.append(time.process_time() - start)
+        digest.update(np.array([sweeps * count, residual]).tobytes() + v.tobytes() + r.tobytes() + status.tobytes())
+    return seconds, digest.hexdigest()
+
+
+def worker(package_root: str, capture_file: str) -> None:
+    """In a fresh process: time the sweep of the ``masonrycli`` under ``package_root`` (JSON to stdout)."""
+    sys.path.insert(0, package_root)
+    from masonrycli.engine import nlgs
+
+    assert Path(nlgs.__file__).is_relative_to(package_root), nlgs.__file__
+    with open(capture_file, "rb") as f:
+        calls = pickle.load(f)
+    _, digest = run_calls(nlgs._nlgs_interleaved, calls)
+    work = 0
+    for contact_body, pack, count, mu, tolerance, cap, v, r, status, *rest in calls:
+        work += count * nlgs._nlgs_interleaved(contact_body, pack, count, mu, tolerance, cap, v.copy(), r.copy(),
+                                               status.copy(), *rest)[0]  # fmt: skip
+    best = min(sum(run_calls(nlgs._nlgs_interleaved, calls)[0]) for _ in range(PASSES))
+    print(json.dumps({"cpu_s": best, "contact_sweeps": int(work), "digest": digest}))
+
+
+def checkout(revision: str, into: Path) -> str:
+    """Directory holding ``masonrycli`` as it is at ``revision`` (the working tree for WORKTREE)."""
+    if revision == WORKTREE:
+        return str(ROOT)
+    into.mkdir()
+    archive = subprocess.run(["git", "-C", str(ROOT), "archive", revision, "masonrycli"], capture_output=True)
+    if archive.returncode:
+        raise SystemExit(f"bench_kernel: git archive {revision}: {archive.stderr.decode().strip()}")
+    with tarfile.open(fileobj=io.BytesIO(archive.stdout)) as tar:
+        tar.extractall(into, filter="data")
+    return str(into)
+
+
+def compare(base: str, new: str, case: str, duration: float, every: int, rounds: int) -> dict:
+    """Capture, then time ``base`` and ``new`` in alternating fresh processes (module doc)."""
+    with tempfile.TemporaryDirectory() as tmp:
+        capture_file = Path(tmp) / "calls.pkl"
+        calls = capture(case, duration, every)
+        with open(capture_file, "wb") as f:
+            pickle.dump(calls, f)
+        roots = {name: checkout(rev, Path(tmp) / name) for name, rev in (("base", base), ("new", new))}
+        results: dict[str, list] = {"base": [], "new": []}
+        for k in range(rounds):
+            for name in ("base", "new") if k % 2 == 0 else ("new", "base"):
+                env = dict(os.environ, NUMBA_CACHE_DIR=str(Path(tmp) / f"cache-{name}"))
+                out = subprocess.run(
+                    [sys.executable, __file__, "--worker", roots[name], str(capture_file)],
+                    capture_output=True, text=True, cwd=tmp, env=env,
+                )  # fmt: skip
+                if out.returncode:
+                    raise SystemExit(f"bench_kernel: {name} worker failed:\n{out.stderr}")
+                results[name].append(json.loads(out.stdout.splitlines()[-1]))
+    row = {"case": case, "duration": duration, "every": every, "calls": len(calls), "rounds": rounds}
+    for name, rev in (("base", base), ("new", new)):
+        runs = results[name]
+        cpu = min(run["cpu_s"] for run in runs)
+        row[name] = {"revision": rev, "cpu_s": cpu, "contact_sweeps": runs[0]["contact_sweeps"],
+                     "ns_per_contact_sweep": cpu / runs[0]["contact_sweeps"] * 1e9}  # fmt: skip
+    row["new_over_base"] = row["new"]["ns_per_contact_sweep"] / row["base"]["ns_per_contact_sweep"]
+    row["bit_identical"] = len({run["digest"] for runs in results.values() for run in runs}) == 1
+    return row
+
+
+def main(argv=None) -> dict:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--base", default="HEAD", help="git revision (or 'worktree')")
+    parser.add_argument("--new", default=WORKTREE, help="git revision (default: the working tree)")
+    parser.add_argument("--case", default="wall-248", help="benchmarks.solver_cases case")
+    parser.add_argument("--duration", type=float, default=1.0, help="simulated s of the capture run")
+    parser.add_argument("--every", type=int, default=10, help="keep every n-th call")
+    parser.add_argument("--rounds", type=int, default=5)
+    parser.add_argument("--json", type=Path)
+    parser.add_argument("--worker", nargs=2, help=argparse.SUPPRESS)
+    args = parser.parse_args(argv)
+    if args.worker:
+        return worker(*args.worker)
+    row = compare(args.base, args.new, args.case, args.duration, args.every, args.rounds)
+    for name in ("base", "new"):
+        r = row[name]
+        print(f"{name:4} {r['revision']:>12}: {r['ns_per_contact_sweep']:.2f} ns per contact·sweep "
+              f"({r['cpu_s']:.4f} s CPU, {r['contact_sweeps']} contact·sweeps)")  # fmt: skip
+    print(f"new / base {row['new_over_base']:.3f}, bit-identical: {row['bit_identical']} "
+          f"({row['calls']} calls of {row['case']}, minimum of {row['rounds']} rounds × {PASSES} passes)")  # fmt: skip
+    if args.json:
+        args.json.write_text(json.dumps(row, indent=1) + "\n")
+    return row
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,44 @@
+"""The kernel benchmark's plumbing (benchmarks/bench_kernel.py): captured calls replayed on copies, one last bit
+of any output changes the digest, and a revision compared with itself is bit-identical."""
+
+import numpy as np
+import pytest
+
+from benchmarks import bench_kernel
+
+
+def _call(count=3, bodies=2):
+    rng = np.random.default_rng(1)
+    body = np.zeros((count, 2), dtype=np.int32)
+    body[:, 1] = 1
+    v, r, status = rng.normal(size=(bodies, 3)), rng.normal(size=(count, 2)), np.zeros(count, dtype=np.int8)
+    return (body, rng.normal(size=(count, 19)), count, 0.6, 1e-5, 100, v, r, status, True, 500)
+
+
+def _kernel(last_bit):
+    def kernel(contact_body, pack, count, mu, tolerance, cap, v, r, status, accelerate, stall):
+        v[0, 0] = np.nextafter(v[0, 0], np.inf) if last_bit else v[0, 0]
+        r[:] += 1.0
+        status[:] = 2
+        return 7, 1e-6
+
+    return kernel
+
+
+def test_replay_leaves_the_captured_arrays_alone_and_the_digest_sees_one_last_bit():
+    call = _call()
+    before = [np.copy(x) for x in call[6:9]]
+    seconds, same = bench_kernel.run_calls(_kernel(False), [call, call])
+    assert len(seconds) == 2 and all(s >= 0.0 for s in seconds)
+    for kept, now in zip(before, call[6:9], strict=True):
+        assert np.array_equal(kept, now)
+    assert bench_kernel.run_calls(_kernel(False), [call, call])[1] == same
+    assert bench_kernel.run_calls(_kernel(True), [call, call])[1] != same
+
+
+@pytest.mark.slow
+def test_the_working_tree_against_itself_on_the_small_wall_is_bit_identical():
+    row = bench_kernel.compare(bench_kernel.WORKTREE, bench_kernel.WORKTREE, "wall-51", 0.01, 1, 1)
+    assert row["calls"] == 10 and row["bit_identical"]
+    assert row["base"]["contact_sweeps"] == row["new"]["contact_sweeps"] > 0
+    assert row["new_over_base"] > 0.0
