@@ -286,22 +286,26 @@ def test_a_solve_that_stops_improving_ends_stall_sweeps_after_its_lowest_residua
 # --- The accelerated sweep (solver "nlgs-accel"), against a slow dense implementation ------------------
 
 
-def _slow_accelerated_sweeps(body, w_blocks, h, m_inv, v, r, mu, bias, sweeps, growth):
+def _slow_accelerated_sweeps(body, w_blocks, h, m_inv, v, r, mu, bias, sweeps, growth, turning=False):
     """Nesterov-accelerated Gauss–Seidel written out densely: each sweep starts from the extrapolation
     y = x + β (x − x_prev) of the last two sweeps' (v, r), β = (j − 1)/(j + 2) with j the sweeps since the
-    last restart, and restarts (j = 1) after a sweep whose residual exceeds ``growth`` × the one before."""
+    last restart, and restarts (j = 1) after a sweep whose residual exceeds ``growth`` × the one before.
+    ``turning``: the sweep order reverses at every restart (the kernel's ``flip``)."""
     v = v.ravel().copy()
     v += m_inv @ h @ r.ravel()
     v_prev, r_prev = v.copy(), r.copy()
     beta, j, last, residual, done = 0.0, 1, np.inf, 0.0, 0
+    order = list(range(body.shape[0]))
     for done in range(1, sweeps + 1):
         v_y = v + beta * (v - v_prev)
         r_y = r + beta * (r - r_prev)
         v_prev, r_prev = v.copy(), r.copy()
         v, r = v_y, r_y
-        residual = _slow_sweep(body, w_blocks, h, m_inv, v, r, mu, bias)
+        residual = _slow_sweep(body, w_blocks, h, m_inv, v, r, mu, bias, order)
         if residual == 0.0:  # an exact solution: the kernel stops there too (residual <= tolerance 0)
             break
+        if turning and residual > growth * last:
+            order.reverse()
         j = 1 if residual > growth * last else j
         last = residual
         beta = (j - 1.0) / (j + 2.0)
@@ -355,16 +359,20 @@ def _stack_problem(n):
 ACCEL_CASES = [(("random", s), n) for s in (5, 41) for n in (1, 2, 5, 30)] + [(("stack", 6), 60)]
 
 
+@pytest.mark.parametrize("turning", [False, True])
 @pytest.mark.parametrize(("problem", "sweeps"), ACCEL_CASES)
-def test_accelerated_sweeps_match_a_slow_dense_implementation(problem, sweeps):
+def test_accelerated_sweeps_match_a_slow_dense_implementation(problem, sweeps, turning):
+    # turning=True: the direction that turns at every restart (stalled.py's "turning" method)
     kind, arg = problem
     body, pack, h, m_inv, w_blocks, v0, r0, mu, bias = _random_problem(arg) if kind == "random" else _stack_problem(arg)
     count = body.shape[0]
     v_ref, r_ref, res_ref, its_ref = _slow_accelerated_sweeps(
-        body, w_blocks, h, m_inv, v0, r0.copy(), mu, bias, sweeps, momentum.RESTART_GROWTH
+        body, w_blocks, h, m_inv, v0, r0.copy(), mu, bias, sweeps, momentum.RESTART_GROWTH, turning
     )
     v, r, status = v0.copy(), r0.copy(), np.zeros(count, dtype=np.int8)
-    its, res = momentum._nlgs_accelerated(body, pack, count, mu, 0.0, sweeps, v, r, status, momentum.STALL_SWEEPS)
+    its, res = momentum._nlgs_accelerated(
+        body, pack, count, mu, 0.0, sweeps, v, r, status, momentum.STALL_SWEEPS, turning
+    )
     assert its == its_ref
     assert res == pytest.approx(res_ref, rel=1e-8, abs=1e-15)
     np.testing.assert_allclose(r, r_ref, rtol=1e-8, atol=1e-13)

@@ -12,6 +12,7 @@ whether the tolerance was met:
 
 
     engine        nlgs.solve as shipped (momentum, then stalled.py's round-robin)
+    turning       accelerated sweeps whose direction turns at every restart, no stall window
     momentum      accelerated sweeps with no stall window
     alternating   plain sweeps, every second one in reverse order (10 000-sweep stall window)
     plain         plain sweeps in one direction (10 000-sweep stall window)
@@ -87,13 +88,12 @@ def _method(name, p, v, r, status):
             return its, res
         units, res = faces.face_sweeps(body, pack, count, mu, TOLERANCE, CAP - its, v, r, status)
         return its + units, res
-    accelerate = name == "momentum"
-    return nlgs._nlgs_interleaved(
-        body, pack, count, mu, TOLERANCE, CAP, v, r, status, accelerate, CAP, name == "alternating"
-    )
+    accelerate = name in ("momentum", "turning")
+    alternate = name in ("turning", "alternating")
+    return nlgs._nlgs_interleaved(body, pack, count, mu, TOLERANCE, CAP, v, r, status, accelerate, CAP, alternate)
 
 
-METHODS = ("engine", "momentum", "alternating", "plain", "faces")
+METHODS = ("engine", "turning", "momentum", "alternating", "plain", "faces")
 
 
 def table(paths: list[Path] | None = None, repeat: int = 2) -> None:

@@ -42,7 +42,7 @@ STALL_SWEEPS = 500
 
 
 @njit
-def _nlgs_accelerated(contact_body, pack, count, mu, tolerance, max_iterations, v, r, status, stall_after):
+def _nlgs_accelerated(contact_body, pack, count, mu, tolerance, max_iterations, v, r, status, stall_after, flip=False):
     # _nlgs with Nesterov momentum and adaptive restart; its contact loop is _nlgs's written out again with
     # the extrapolated start (a shared visit function cost 47–57 ns per visit against 8.7 inline: faces.py).
     # x_k: the (r, v) a sweep leaves. The next sweep starts from the extrapolated
@@ -56,7 +56,8 @@ def _nlgs_accelerated(contact_body, pack, count, mu, tolerance, max_iterations, 
     #       for α in order: r_y = r_α + β (r_α − r_prev,α), r_prev,α ← r_α
     #                       the visit of _nlgs from r_y (e_α = W_αα (r_α' − r_y))
     #       residual and stopping as in _nlgs, the stall rule with a window of stall_after sweeps (then
-    #       nlgs.solve goes on by faces); then j, β from the restart rule
+    #       nlgs.solve hands the step to stalled.py); then j, β from the restart rule, and with flip the
+    #       sweep order reverses at each restart (stalled.py's "turning" method)
     for c in range(count):
         _push(v, contact_body[c, 0], contact_body[c, 1], pack, c, r[c, 0], r[c, 1])
     iterations = 0
@@ -77,6 +78,7 @@ def _nlgs_accelerated(contact_body, pack, count, mu, tolerance, max_iterations, 
     last = np.inf
     j = 1
     beta = 0.0
+    first, step = 0, 1
     for it in range(max_iterations):
         iterations = it + 1
         for i in range(v_flat.shape[0]):
@@ -84,7 +86,8 @@ def _nlgs_accelerated(contact_body, pack, count, mu, tolerance, max_iterations, 
             v_flat[i] = x + beta * (x - v_prev_flat[i])
             v_prev_flat[i] = x
         sum_e2 = 0.0
-        for c in range(count):
+        for k in range(count):
+            c = first + step * k
             a = contact_body[c, 0]
             b = contact_body[c, 1]
             ut, un = _relative_velocity(v, a, b, pack, c)
@@ -120,6 +123,8 @@ def _nlgs_accelerated(contact_body, pack, count, mu, tolerance, max_iterations, 
             break
         if residual > RESTART_GROWTH * last:
             j = 1
+            if flip:  # stalled.py: the sweep direction turns at every restart
+                first, step = (count - 1, -1) if step == 1 else (0, 1)
         last = residual
         beta = (j - 1.0) / (j + 2.0)
         j += 1

@@ -311,6 +311,7 @@ def _nlgs_interleaved(
     # paper's structures, the same sweep counts to ±4 (measured on captured steps of the 51- and
     # 248-block walls, 8- and 32-course walls, arch and aqueduct). The rows are copied into that order
     # (so the sweep reads memory in sequence), solved by _nlgs, and r, status copied back.
+    # alternate (stalled.py): plain sweeps alternate direction every sweep, accelerated ones at every restart.
     k = INTERLEAVE
     run = (count + k - 1) // k
     order = np.empty(count, dtype=np.int64)
@@ -334,7 +335,7 @@ def _nlgs_interleaved(
         r_o[i, 1] = r[c, 1]
     if accelerate:
         iterations, residual = momentum._nlgs_accelerated(
-            body_o, pack_o, count, mu, tolerance, max_iterations, v, r_o, status_o, accelerated_stall
+            body_o, pack_o, count, mu, tolerance, max_iterations, v, r_o, status_o, accelerated_stall, alternate
         )
     else:
         iterations, residual = _nlgs(body_o, pack_o, count, mu, tolerance, max_iterations, v, r_o, status_o, alternate)

@@ -1,32 +1,33 @@
-"""What a stalled accelerated solve does: three methods taken in turn, each resumed where it stopped.
+"""What a stalled accelerated solve does: four methods taken in turn, each resumed where it stopped.
 
 Gauss–Seidel with momentum (the default solver, :mod:`masonrycli.engine.momentum`) converges most steps in
 tens to hundreds of sweeps. On tall walls that slide it can stall: momentum drives the step into a
 stick/slip cycle, the residual wanders above the tolerance, and the solve stops after momentum's stall
-window. No single method finishes every such step. Measured on 33 of the 108 steps that stall over the first
+window. No single method finishes every such step. Measured on 35 of the 108 steps that stall over the first
 0.2 s of the walls of 32 and 64 courses (benchmarks/README.md, "Stalled steps"; each method alone from the
 step's warm start, tolerance 1e-5 m/s, cap 50 000 sweep units):
 
-* Gauss–Seidel with alternating sweep direction (forward, backward, forward, …) converges 32 of them (the
-  32-course wall's in 227–6377 sweeps), where one-way plain sweeps stall on 10 and momentum cycles on 20:
-  reversing the order every sweep breaks the cycle in which a sliding block lifts one corner of its bed
-  joint and the other corner takes the load. It fails on the 64-course wall's first step (43 002 sweeps, unconverged) and
-  creeps on its third (16 383).
-* Momentum itself, continued past its window, converges those first 64-course steps in 1846–8041 sweeps
-  (its residual plateaus for hundreds of sweeps there before dropping), and cycles on the sliding steps.
-* Faces (:mod:`masonrycli.engine.faces`) from momentum's stalled iterate converge 32 of the 33, at ~2× a
-  point sweep's cost per unit, sometimes first (the 64-course wall's step 1: 3465 units against 5471 and
-  8327).
+* Momentum whose sweep direction turns at every restart ("turning": forward until the residual jumps,
+  then backward, …) converges 34 of them, most in 734–5417 sweeps, where momentum in one direction cycles
+  on 20 of 33. A sliding block lifts one corner of its bed joint, the other corner takes the load, the
+  block slides back: a one-way sweep can repeat that cycle for ever, and a restart is the sign of it.
+* Gauss–Seidel with alternating sweep direction (forward, backward, forward, …) converges 32 of 33 (the
+  32-course wall's in 227–6377 sweeps), where one-way plain sweeps stall on 10.
+* Momentum in one direction, continued past its window, converges the 64-course wall's first steps (a
+  cold start: load travelling through 64 courses) in 1846–8041 sweeps, where the others need 2–5× more.
+* Faces (:mod:`masonrycli.engine.faces`) from momentum's stalled iterate converge 32 of 33, at ~2× a
+  point sweep's cost per unit, and finish first on a few (the 64-course wall's step 1: 3465 units).
 
 So the methods are run round-robin from their own states, each for a budget of sweep units that doubles
 every round (FIRST_BUDGET, 2 × FIRST_BUDGET, …), until one meets the tolerance or the step's cap is
-spent. A step that one method solves in U units costs at most about 3 × 2U plus momentum's first try,
+spent. A step that one method solves in U units costs at most about 4 × 2U plus momentum's first try,
 whichever method that is; a method that stalls inside its budget (its own stall window) is dropped. At
 the cap the state with the lowest residual is kept and the step is counted unconverged, as before.
-On the 33 steps this finishes all of them in 149 423 sweep units (5.1 s CPU; alternating sweeps alone:
-124 500 units, 4.4 s, one step missed); the fixed chain it replaced (faces for at most 5000 units, plain
-sweeps from the warm start, faces to the cap) took 17 816–23 714 units on each of seven sliding steps of
-the 32-course wall captured from its own run; this takes 704–9399 on six of them and 23 998 on the seventh.
+On the 35 steps this finishes all of them in 159 597 sweep units (5.7 s CPU); with the three methods
+other than "turning" it took 225 016 units and missed one (the 64-course wall's step 99, where only faces
+get there, in 44 797 units alone); "turning" alone 164 706 units, one missed. The fixed chain this module
+replaced (faces for at most 5000 units, plain sweeps from the warm start, faces to the cap) took
+17 816–23 714 units on each of seven sliding steps of the 32-course wall captured from its own run.
 """
 
 from __future__ import annotations
@@ -38,7 +39,7 @@ from masonrycli.engine import faces, nlgs
 FIRST_BUDGET = 2000
 """Sweep units each method gets in the first round; doubled every round (module doc)."""
 
-METHODS = ("alternating", "momentum", "faces")
+METHODS = ("turning", "alternating", "momentum", "faces")
 """The order in which a round visits the methods: the one that finishes most stalled steps first."""
 
 
@@ -62,8 +63,9 @@ def continue_stalled(
     ``v``, ``r``, ``status`` of the method that met ``tolerance`` (or, at ``cap``, of the lowest residual).
     Returns (iterations including the earlier ones, residual)."""
     states = {
+        "turning": _State(None, r_warm[:count].copy(), status[:count].copy(), np.inf),
         "alternating": _State(None, r_warm[:count].copy(), status[:count].copy(), np.inf),
-        "momentum": _State(v.copy(), r[:count].copy(), status[:count].copy(), residual),
+        "momentum": _State(v.copy(), r[:count].copy(), status[:count].copy(), residual),  # goes on
         "faces": _State(v.copy(), r[:count].copy(), status[:count].copy(), residual),
     }
     active = list(METHODS)
@@ -89,16 +91,16 @@ def continue_stalled(
 
 def _resume(name, state, contact_body, pack, count, mu, tolerance, units, v_free) -> int:
     # Each method goes on from its own iterate. The sweeps of nlgs rebuild v from v_free and r on entry
-    # (v = v_free + M⁻¹ H r), so their state is r alone; faces carry v along with r. Momentum restarts its
-    # extrapolation (β = 0) at every resume and gets the whole budget as its stall window: it has already
-    # stalled once, and what finishes the steps it finishes is going on through its plateaus.
+    # (v = v_free + M⁻¹ H r), so their state is r alone; faces carry v along with r. Momentum, turning or
+    # not, restarts its extrapolation (β = 0, forward) at every resume and gets the whole budget as its
+    # stall window: what finishes the steps it finishes is going on through its plateaus.
     if name == "faces":
         done, state.residual = faces.face_sweeps(
             contact_body, pack, count, mu, tolerance, units, state.v, state.r, state.status
         )
         return done
     state.v = v_free.copy()
-    accelerate = name == "momentum"
+    accelerate = name != "alternating"
     done, state.residual = nlgs._nlgs_interleaved(
         contact_body,
         pack,
@@ -111,7 +113,7 @@ def _resume(name, state, contact_body, pack, count, mu, tolerance, units, v_free
         state.status,
         accelerate,
         units,
-        not accelerate,
+        name != "momentum",
     )
     return done
 
