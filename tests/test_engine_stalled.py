@@ -60,3 +60,34 @@ def test_at_the_cap_the_lowest_residual_is_kept_and_the_step_counts_unconverged(
     np.testing.assert_allclose(v.ravel(), v0.ravel() + m_inv @ h @ r.ravel(), atol=1e-12)
     # the state kept is one of the methods' iterates after a sweep: impulses inside the Coulomb cone
     assert (r[:, 1] >= 0).all() and (np.abs(r[:, 0]) <= mu * r[:, 1] + 1e-15).all()
+
+
+def test_a_method_that_ends_a_round_no_lower_than_before_is_dropped(monkeypatch):
+    # The round-robin alone, with scripted methods: "turning" improves every round, "alternating" ends its
+    # second round where it ended its first (it cycles), "faces" stalls inside its first budget. Only
+    # "turning" goes on, with doubling budgets, until it meets the tolerance; every unit is counted.
+    script = {"turning": [1e-3, 1e-4, 1e-5, 1e-7], "alternating": [1e-3, 1e-3, 1e-9], "faces": [1e-3]}
+    calls = []
+
+    def scripted(name, state, contact_body, pack, count, mu, tolerance, units, v_free):
+        calls.append((name, units))
+        state.v, state.residual = v_free + len(calls), script[name].pop(0)
+        return units // 2 if name == "faces" else units
+
+    monkeypatch.setattr(stalled, "_resume", scripted)
+    monkeypatch.setattr(stalled, "METHODS", ("turning", "alternating", "faces"))
+    monkeypatch.setattr(stalled, "FIRST_BUDGET", 10)
+    count = 2
+    v, r, status = np.zeros((2, 3)), np.zeros((count, 2)), np.zeros(count, dtype=np.int8)
+    its, res = stalled.continue_stalled(None, None, count, 0.5, 1e-6, 10**6, v, r, status, np.zeros((2, 3)), r, 7, 1e-2)
+    assert calls == [
+        ("turning", 10),
+        ("alternating", 10),
+        ("faces", 10),
+        ("turning", 20),
+        ("alternating", 20),
+        ("turning", 40),
+        ("turning", 80),
+    ]
+    assert res == 1e-7 and its == 7 + 10 + 10 + 5 + 20 + 20 + 40 + 80
+    assert (v == 7).all()  # the state of the method that met the tolerance (set at the 7th call)

@@ -21,7 +21,9 @@ step's warm start, tolerance 1e-5 m/s, cap 50 000 sweep units):
 So the methods are run round-robin from their own states, each for a budget of sweep units that doubles
 every round (FIRST_BUDGET, 2 × FIRST_BUDGET, …), until one meets the tolerance or the step's cap is
 spent. A step that one method solves in U units costs at most about 4 × 2U plus momentum's first try,
-whichever method that is; a method that stalls inside its budget (its own stall window) is dropped. At
+whichever method that is. A method is dropped when it stalls inside its budget (its own stall window)
+or ends a round no lower than it ended an earlier one (it cycles: the 32-course wall's step 99 of one run
+reached the cap before this rule, and takes 27 240 units with it, faces finishing). At
 the cap the state with the lowest residual is kept and the step is counted unconverged, as before.
 On the 35 steps this finishes all of them in 159 597 sweep units (5.7 s CPU); with the three methods
 other than "turning" it took 225 016 units and missed one (the 64-course wall's step 99, where only faces
@@ -44,12 +46,14 @@ METHODS = ("turning", "alternating", "momentum", "faces")
 
 
 class _State:
-    """One method's iterate: velocities (None until first run), impulses, statuses, last residual (m/s)."""
+    """One method's iterate: velocities (None until first run), impulses, statuses, last residual and the
+    lowest residual it ended a round with (m/s)."""
 
-    __slots__ = ("v", "r", "status", "residual")
+    __slots__ = ("v", "r", "status", "residual", "low")
 
     def __init__(self, v, r, status, residual):
         self.v, self.r, self.status, self.residual = v, r, status, residual
+        self.low = np.inf
 
 
 def continue_stalled(
@@ -83,6 +87,9 @@ def continue_stalled(
                 return iterations, state.residual
             if done < units:  # stalled inside its budget: its own stall window says it will not get there
                 active.remove(name)
+            elif state.residual >= state.low:  # a whole budget, doubled, without a new low: it cycles
+                active.remove(name)
+            state.low = min(state.low, state.residual)
         budget *= 2
     best = min((s for s in states.values() if s.v is not None), key=lambda s: s.residual)
     _adopt(best, v, r, status, count)
