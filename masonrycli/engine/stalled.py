@@ -8,24 +8,26 @@ window. No single method finishes every such step. Measured on 35 of the 108 ste
 step's warm start, tolerance 1e-5 m/s, cap 50 000 sweep units):
 
 * Momentum whose sweep direction turns at every restart ("turning": forward until the residual jumps,
-  then backward, …) converges 34 of them, most in 734–5417 sweeps, where momentum in one direction cycles
-  on 20 of 33. A sliding block lifts one corner of its bed joint, the other corner takes the load, the
-  block slides back: a one-way sweep can repeat that cycle for ever, and a restart is the sign of it.
-* Gauss–Seidel with alternating sweep direction (forward, backward, forward, …) converges 32 of 33 (the
-  32-course wall's in 227–6377 sweeps), where one-way plain sweeps stall on 10.
+  then backward, …) converges 34 of them, most in 125–5005 sweeps, where momentum in one direction cycles
+  on 22. A sliding block lifts one corner of its bed joint, the other corner takes the load, the block
+  slides back: a one-way sweep can repeat that cycle for ever, and a restart is the sign of it.
+* Gauss–Seidel with alternating sweep direction (forward, backward, forward, …) converges 33 (the
+  32-course wall's in 227–6377 sweeps), where one-way plain sweeps stall on 11.
 * Momentum in one direction, continued past its window, converges the 64-course wall's first steps (a
-  cold start: load travelling through 64 courses) in 1846–8041 sweeps, where the others need 2–5× more.
-* Faces (:mod:`masonrycli.engine.faces`) from momentum's stalled iterate converge 32 of 33, at ~2× a
-  point sweep's cost per unit, and finish first on a few (the 64-course wall's step 1: 3465 units).
+  cold start: load travelling through 64 courses) in 1846–8041 sweeps, where the others need up to 5× more.
+* Faces (:mod:`masonrycli.engine.faces`) from momentum's stalled iterate converge 33, at ~2× a point
+  sweep's cost per unit, and finish first on a few (the 64-course wall's step 1: 3465 units).
 
 So the methods are run round-robin from their own states, each for a budget of sweep units that doubles
 every round (FIRST_BUDGET, 2 × FIRST_BUDGET, …), until one meets the tolerance or the step's cap is
 spent. A step that one method solves in U units costs at most about 4 × 2U plus momentum's first try,
 whichever method that is. A method is dropped when it stalls inside its budget (its own stall window)
 or ends a round no lower than it ended an earlier one (it cycles: the 32-course wall's step 99 of one run
-reached the cap before this rule, and takes 27 240 units with it, faces finishing). At
-the cap the state with the lowest residual is kept and the step is counted unconverged, as before.
-On the 35 steps this finishes all of them in 159 597 sweep units (5.7 s CPU); with the three methods
+reached the cap before this rule, and takes 27 240 units with it, faces finishing). At the cap the
+state with the lowest residual is kept and the step is counted unconverged, as before: a step that needs
+10 000 units of the one method that converges it costs about 50 000, the default cap, in this round-robin
+(the 64-course wall's step 108 of one run, faces alone 9924). On the 35 steps (before the drop rule) this
+finishes all of them in 159 597 sweep units (5.9 s CPU); with the three methods
 other than "turning" it took 225 016 units and missed one (the 64-course wall's step 99, where only faces
 get there, in 44 797 units alone); "turning" alone 164 706 units, one missed. The fixed chain this module
 replaced (faces for at most 5000 units, plain sweeps from the warm start, faces to the cap) took
