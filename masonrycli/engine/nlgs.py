@@ -43,9 +43,10 @@ wall unconverged). Tolerance 0 runs exactly the cap.
 
 Acceleration (solver "nlgs-accel", the default; "nlgs" is the plain sweep, kept as the reference): the
 same sweep started from a Nesterov extrapolation of the last two sweeps (:mod:`masonrycli.engine.momentum`).
-A stalled accelerated solve goes on by the methods of :mod:`masonrycli.engine.stalled` (alternating-direction
-sweeps, momentum resumed, faces, in turn with doubling budgets). Its iterations count accelerated sweeps
-(each ~1.2× the time of a plain one) plus the later methods' sweep units.
+A stalled accelerated solve goes on by the methods of :mod:`masonrycli.engine.stalled` (momentum turning
+its direction at restarts, alternating-direction sweeps, momentum resumed, faces, in turn with doubling
+budgets). Its iterations count accelerated sweeps (each ~1.1–1.6× the time of a plain one) plus the later
+methods' sweep units.
 """
 
 from __future__ import annotations
