@@ -22,7 +22,7 @@ def _solve(problem, solver, tolerance, cap=100000):
 
 def test_a_stalled_accelerated_solve_ends_converged_on_gauss_seidel_velocities(monkeypatch):
     # A momentum window of 1 sweep sends the step to stalled.py at once, and first budgets of 1 unit make it
-    # go round the three methods many times (budgets 1, 2, 4, …): every resume must carry its method's
+    # go round the four methods many times (budgets 1, 2, 4, …): every resume must carry its method's
     # iterate on, and the step must end converged with v the velocity of its impulses.
     problem = _stack_problem(6)
     body, pack, h, m_inv, w_blocks, v0, r0, mu, bias = problem

@@ -10,7 +10,6 @@ passed them: body pairs, packed rows, v_free, warm start), in ``data/stalled/<ca
 method alone, to the engine's tolerance and cap, and prints sweep units, CPU ms (minimum of --repeat) and
 whether the tolerance was met:
 
-
     engine        nlgs.solve as shipped (momentum, then stalled.py's round-robin)
     turning       accelerated sweeps whose direction turns at every restart, no stall window
     momentum      accelerated sweeps with no stall window
@@ -88,9 +87,13 @@ def _method(name, p, v, r, status):
             return its, res
         units, res = faces.face_sweeps(body, pack, count, mu, TOLERANCE, CAP - its, v, r, status)
         return its + units, res
-    accelerate = name in ("momentum", "turning")
-    alternate = name in ("turning", "alternating")
-    return nlgs._nlgs_interleaved(body, pack, count, mu, TOLERANCE, CAP, v, r, status, accelerate, CAP, alternate)
+    if name == "plain":
+        return nlgs._nlgs_interleaved(body, pack, count, mu, TOLERANCE, CAP, v, r, status, False, CAP)
+    # turning, momentum, alternating: stalled.py's own resume, from the warm start, with the whole cap
+    state = stalled._State(None, r, status, np.inf)
+    its = stalled._resume(name, state, body, pack, count, mu, TOLERANCE, CAP, v.copy())
+    v[:] = state.v
+    return its, state.residual
 
 
 METHODS = ("engine", "turning", "momentum", "alternating", "plain", "faces")

@@ -20,12 +20,11 @@ sweeps, where plain sweeps from the same warm start converge in 1219–1539 on t
 plain solve's 10 000-sweep stall window, such steps made the default slower than plain Gauss–Seidel over
 the first 0.2 s of the 32- and 64-course walls (96 against 79 and 318 against 164 CPU s per simulated s).
 So a solve of this solver stops after STALL_SWEEPS = 500 accelerated sweeps without a new lowest
-residual, and nlgs.solve hands the step to :mod:`masonrycli.engine.stalled`, which takes alternating-direction
-sweeps from the warm start, this momentum resumed, and faces from its stalled iterate in turn, with doubling
-budgets (that module's doc has the figures). Before 2026-11-23, 23:59 UTC the stalled step went through a fixed chain
-(faces for at most 5000 sweep units, then plain sweeps from the warm start with a 10 000-sweep window, then
-faces to the cap): 17 816–23 714 sweep units on the 32-course wall's sliding steps, and one step of the
-64-course wall unconverged over 0.2 s.
+residual, and nlgs.solve hands the step to :mod:`masonrycli.engine.stalled`: this momentum with its sweep
+direction turning at every restart (``flip``), alternating-direction sweeps, this momentum resumed, and
+faces, in turn with doubling budgets (that module's doc has the figures). The fixed chain it replaced
+(faces for at most 5000 sweep units, plain sweeps from the warm start, faces to the cap) took
+17 816–23 714 sweep units on the 32-course wall's sliding steps.
 """
 
 from __future__ import annotations
