@@ -49,9 +49,9 @@ RESULTS = Path(__file__).resolve().parent / "results.json"
 
 def _register_optional():
     # Methods in their own modules; imported here so the table runs them by name.
-    from benchmarks.solver_lab.methods import accelerated, alm_newton, anderson, cluster, linear, newton
+    from benchmarks.solver_lab.methods import accelerated, alm_newton, anderson, cluster, linear, newton, tnnmg
 
-    for module in (anderson, newton, alm_newton, cluster, linear, accelerated):
+    for module in (anderson, newton, alm_newton, cluster, linear, accelerated, tnnmg):
         METHODS.update(module.METHODS)
 
 

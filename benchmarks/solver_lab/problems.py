@@ -109,7 +109,17 @@ class Problem:
 
 
 def load_all(names: list[str] | None = None) -> list[Problem]:
-    """The captured problems, in capture order (``names``: only those)."""
+    """The captured problems, in capture order (``names``: only those; ``stalled/NAME``: a kept stalled
+    step, see stalled_steps.as_problem)."""
+    if names and any(n.startswith("stalled/") for n in names):
+        from benchmarks.solver_lab import stalled_steps
+
+        rest = [n for n in names if not n.startswith("stalled/")]
+        by_name = {p.name: p for p in load_all(rest)} if rest else {}
+        for n in names:
+            if n.startswith("stalled/"):
+                by_name[n] = stalled_steps.as_problem(stalled_steps.STALLED / f"{n.split('/', 1)[1]}.npz")
+        return [by_name[n] for n in names]
     paths = sorted(DATA.glob("*.npz"), key=lambda p: p.stat().st_mtime)
     probs = [Problem.load(p) for p in paths]
     order = {p.name: i for i, p in enumerate(probs)}

@@ -30,7 +30,7 @@ from types import SimpleNamespace
 import numpy as np
 
 from benchmarks.solver_cases import make_scenario
-from benchmarks.solver_lab.problems import DATA
+from benchmarks.solver_lab.problems import DATA, Problem
 from masonrycli.engine import faces, momentum, nlgs, stalled
 from masonrycli.run import Simulation, simulate
 
@@ -94,6 +94,39 @@ def _method(name, p, v, r, status):
     its = stalled._resume(name, state, body, pack, count, mu, TOLERANCE, CAP, v.copy())
     v[:] = state.v
     return its, state.residual
+
+
+class StalledProblem(Problem):
+    """A kept stalled step as a lab :class:`Problem` (``table --problems stalled/h32-80``): the engine's own
+    packed rows stand in for the geometry, which the stalled capture does not keep."""
+
+    stored_pack: np.ndarray | None = None
+
+    def pack(self) -> np.ndarray:
+        return self.stored_pack
+
+
+def as_problem(path: Path) -> StalledProblem:
+    """The step at ``path`` for the harness. Body inverse masses and inertias are read back from the packed
+    rows (bodies in no contact: 0, their velocity is v_free anyway); there is no reference (the engine's
+    capped solves are the point of these steps): v_ref is NaN, so the table's velocity error reads nan."""
+    z = dict(np.load(path))
+    body, pack, v_free = z["body"].astype(np.int32), z["pack"], z["v_free"]
+    n, c = v_free.shape[0], body.shape[0]
+    inv_mass, inv_inertia = np.zeros(n), np.zeros(n)
+    for side, (im, ii) in enumerate(((nlgs.P_IMA, nlgs.P_IIA), (nlgs.P_IMB, nlgs.P_IIB))):
+        inv_mass[body[:, side]] = pack[:, im]
+        inv_inertia[body[:, side]] = pack[:, ii]
+    nan = np.full((n, 3), np.nan)
+    p = StalledProblem(
+        name=f"stalled/{path.stem}", body=body, point=np.zeros((c, 2)), normal=np.zeros((c, 2)),
+        gap=np.zeros(c), key=np.arange(c), q_m=np.zeros((n, 3)), inv_mass=inv_mass, inv_inertia=inv_inertia,
+        radius=np.zeros(n), v_free=v_free, v_n=v_free.copy(), r_warm=z["r_warm"], r_prev2=z["r_warm"],
+        has_prev2=np.zeros(c, bool), mu=float(z["mu"]), dt=1e-3, step=int(path.stem.rsplit("-", 1)[1]),
+        engine_sweeps=-1, v_ref=nan, r_ref=np.full((c, 2), np.nan), ref_sweeps=0, ref_residual=np.nan,
+    )
+    p.stored_pack = pack
+    return p
 
 
 METHODS = ("engine", "turning", "momentum", "alternating", "plain", "faces")
