@@ -48,6 +48,8 @@ AL_CAP = 5
 AL_TOL = 1e-3
 """AL iterations stop when the constraint violation is below this fraction of |∇E_F| (max norms)."""
 MARGIN = 0.0
+SCALING_POWER = 2.0
+HOLD = False
 SIGMA = 1e-4
 ALPHA_MIN = 2.0**-12
 NEWTON_CAP = 200
@@ -105,11 +107,12 @@ def free_components(r, s, margin: float, normals_only: bool, g=None) -> np.ndarr
     return np.sort(np.concatenate([2 * ft, 2 * fn + 1]))
 
 
-def newton_direction(ops: Operators, rows: np.ndarray, g: np.ndarray, clock: Clock) -> tuple[np.ndarray, int]:
-    """dr (flat, zero off ``rows``) minimising E over the rows with the rest fixed; AL iterations done."""
+def newton_direction(ops: Operators, rows: np.ndarray, g: np.ndarray, clock: Clock, weight=None) -> tuple[np.ndarray, int]:
+    """dr (flat, zero off ``rows``) minimising E over the rows with the rest fixed; AL iterations done.
+    ``weight`` (per row, ≥ 1): the metric of the proximal term is multiplied by it (affine scaling)."""
     with clock("assemble"):
         HF = ops.Hd[rows]
-        d_inv = 1.0 / (EPS_REL * ops.wdiag[rows])
+        d_inv = 1.0 / (EPS_REL * ops.wdiag[rows] * (1.0 if weight is None else weight))
         K = (sp.diags(ops.m) + HF.T @ sp.diags(d_inv) @ HF).tocsc()
         gF = g[rows]
         HFt = HF.T.tocsr()
@@ -154,13 +157,28 @@ def active_set_direction(ops, r, s, rows, g, rounds, clock) -> tuple[np.ndarray,
             bad_rows = bad[rows]
             if not bad_rows.any() or k == rounds - 1:
                 break
-            target = project(trial, s)
-            target[0::2][out_n] = 0.0
             idx = rows[bad_rows]
-            fixed[idx] = target[idx] - r[idx]
+            if HOLD:  # truncate where the step leaves the box: hold those components where they are
+                fixed[idx] = 0.0
+            else:
+                target = project(trial, s)
+                target[0::2][out_n] = 0.0
+                fixed[idx] = target[idx] - r[idx]
             rows = rows[~bad_rows]
     dr = dr + fixed
     return dr, total
+
+
+def scaling(r: np.ndarray, s: np.ndarray, rows: np.ndarray) -> np.ndarray:
+    """Affine-scaling weight per free row: (typical impulse / distance to the row's bound)², ≥ 1, so the
+    proximal AL picks, among the impulse changes that give the same velocities, one that moves the
+    components near a bound least."""
+    dist = np.empty_like(r)
+    dist[1::2] = r[1::2]
+    dist[0::2] = s - np.abs(r[0::2])
+    d = dist[rows]
+    scale = float(np.median(r[1::2][r[1::2] > 0])) if (r[1::2] > 0).any() else 1.0
+    return np.maximum((scale / np.maximum(d, 1e-12 * scale)) ** SCALING_POWER, 1.0)
 
 
 def line_search(ops: Operators, r: np.ndarray, dr: np.ndarray, s: np.ndarray, g: np.ndarray, clock: Clock):
