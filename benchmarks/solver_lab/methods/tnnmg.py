@@ -6,29 +6,40 @@ With the friction thresholds frozen (Tresca, s_α = μ r̂_n,α) the impulse pro
 
 whose gradient is ∇E = u + (0, bias) (u = H v(r), v(r) = v_free + M⁻¹ Hᵀ r): its KKT conditions are
 Signorini and Tresca friction, and at s = μ r_n they are Signorini–Coulomb. W is never formed:
-E(r) = ½ wᵀ M⁻¹ w + rᵀ q with w = Hᵀ r. One iteration:
+E(r) = ½ wᵀ M⁻¹ w + rᵀ q with w = Hᵀ r. One iteration (one "Newton step"):
 
     smooth    SMOOTH engine NLGS sweeps (exact Coulomb local solves) from r;  stop if law residual ≤ target
     freeze    s = μ r_n;  F = normals with r_n > 0, tangentials with r_n > 0 and |r_t| < (1 − MARGIN) s
               (components at a bound are truncated: held fixed in the Newton step)
     Newton    minimise E over r_F, the rest fixed — in velocity space, where it is well posed (W_FF is
               singular on a hyperstatic wall): M dv = H_Fᵀ dr_F, H_F dv = −∇E_F. Augmented Lagrangian
-              with ONE Cholesky-type factor of K = M + H_Fᵀ D⁻¹ H_F (D = EPS_REL · W_αα per row):
-                  λ = 0;  repeat AL_CAP:  K dv = H_Fᵀ (λ − D⁻¹ ∇E_F);  c = H_F dv + ∇E_F;  λ −= D⁻¹ c
-              (= proximal point on E_F from dr = 0: the near-minimum-norm dr_F, self-equilibrated part
+              with ONE factor of K = M + H_Fᵀ D⁻¹ H_F (D = EPS_REL · W_αα per row; scipy's splu here):
+                λ = 0;  repeat ≤ AL_CAP:  K dv = H_Fᵀ (λ − D⁻¹ ∇E_F);  c = H_F dv + ∇E_F;  λ −= D⁻¹ c
+              (= proximal point on E_F from dr = 0: a near-minimum-norm dr_F, the self-equilibrated part
               of r kept);  dr_F = λ
     search    r(α) = P_box(r + α dr), α = 1, ½, ¼ … (≥ ALPHA_MIN): accept the first with
-              E(r(α)) ≤ E(r) + σ ∇Eᵀ(r(α) − r)  (Armijo; monotone in E for the frozen s), else keep r
+              E(r(α)) ≤ E(r) + σ ∇Eᵀ(r(α) − r)  (Armijo: monotone in E for the frozen s), else keep r
+
+EPS_REL: on the walls the equalities H_F dv = −∇E_F at an iterate's free set are inconsistent (Signorini
+biases of redundant contacts; wall-8-hard after 5 sweeps: least-squares residual up to 6e-5 m/s), so E_F
+is unbounded below and λ runs away as 1/ε: at 1e-6 every Newton step of wall-8-hard was rejected by the
+line search; 1e-2 keeps the step a regularised (proximal) Newton step.
+
+Options (each measured, see benchmarks/README.md "tnnmg"): ``inner`` Newton steps at the same s before the
+next smoothing (nested Tresca); ``inward`` also frees components at a bound whose descent direction points
+into the box (projected-Newton rule); ``rounds`` active-set passes: components the step pushes out of the
+box are put on their bound (or, ``hold``, held where they are), dropped from F, and the rest re-solved
+(one factor each); ``normals_only`` Newton on the normal components only.
 
 Iterations: Newton steps. Sweep units: the harness's (all CPU time / one engine sweep's), numpy/scipy
 included; the phases split smoothing, checks, assembly, factor, AL solves and line search.
-Variants (``METHODS``): ``tnnmg-n`` (Newton on the normal components only), ``tnnmg-s20`` (20 smoothing
-sweeps), ``tnnmg-m`` (truncation margin 0.05).
+``oracle_step`` (CLI: ``python -m benchmarks.solver_lab.methods.tnnmg PROBLEM …``) takes one Newton step
+with the reference's own statuses and thresholds — what the step is worth once the active set is right.
 """
 
 from __future__ import annotations
 
-import os
+import sys
 
 import numpy as np
 import scipy.sparse as sp
@@ -38,25 +49,21 @@ from benchmarks.solver_lab import law
 from benchmarks.solver_lab.outcome import Clock, Outcome
 from masonrycli.engine import nlgs as N
 
-os.environ.setdefault("OMP_NUM_THREADS", "1")
-
 SMOOTH = 5
 """Engine NLGS sweeps before each Newton step."""
 EPS_REL = 1e-2
-"""Penalty of a constraint row relative to its contact's W_tt / W_nn (conditions K; λ removes it)."""
+"""Penalty of a constraint row relative to its contact's W_tt / W_nn (module doc)."""
 AL_CAP = 5
 AL_TOL = 1e-3
 """AL iterations stop when the constraint violation is below this fraction of |∇E_F| (max norms)."""
 MARGIN = 0.0
-SCALING_POWER = 2.0
-HOLD = False
 SIGMA = 1e-4
 ALPHA_MIN = 2.0**-12
 NEWTON_CAP = 200
 
 
 class Operators:
-    """What one problem needs, built once (counted in the phase "setup": the engine would need it too)."""
+    """What one problem needs, built once (phase "setup")."""
 
     def __init__(self, ctx):
         p, H, pack = ctx.p, ctx.H, ctx.pack
@@ -76,6 +83,10 @@ class Operators:
     def energy(self, r: np.ndarray) -> float:
         w = self.HT @ r
         return 0.5 * float(w @ (self.minv * w)) + float(r @ self.q)
+
+    def velocity(self, r: np.ndarray) -> np.ndarray:
+        """v(r) (B, 3) for flat impulses r."""
+        return (self.ctx.p.v_free.ravel() + self.minv * (self.HT @ r)).reshape(-1, 3)
 
     def gradient(self, v: np.ndarray) -> np.ndarray:
         """∇E = H v + (0, bias) for the velocities v (B, 3) of the current r."""
@@ -107,37 +118,40 @@ def free_components(r, s, margin: float, normals_only: bool, g=None) -> np.ndarr
     return np.sort(np.concatenate([2 * ft, 2 * fn + 1]))
 
 
-def newton_direction(ops: Operators, rows: np.ndarray, g: np.ndarray, clock: Clock, weight=None) -> tuple[np.ndarray, int]:
-    """dr (flat, zero off ``rows``) minimising E over the rows with the rest fixed; AL iterations done.
-    ``weight`` (per row, ≥ 1): the metric of the proximal term is multiplied by it (affine scaling)."""
+def newton_direction(ops, rows, g, clock, eps=None, al_cap=None, al_tol=None) -> tuple[np.ndarray, int]:
+    """dr (flat, zero off ``rows``) minimising E over the rows with the rest fixed (module doc); AL
+    iterations done."""
+    eps = EPS_REL if eps is None else eps
+    al_cap = AL_CAP if al_cap is None else al_cap
+    al_tol = AL_TOL if al_tol is None else al_tol
     with clock("assemble"):
         HF = ops.Hd[rows]
-        d_inv = 1.0 / (EPS_REL * ops.wdiag[rows] * (1.0 if weight is None else weight))
+        d_inv = 1.0 / (eps * ops.wdiag[rows])
         K = (sp.diags(ops.m) + HF.T @ sp.diags(d_inv) @ HF).tocsc()
         gF = g[rows]
         HFt = HF.T.tocsr()
-    with clock("factor"):
+    with clock("factor"):  # K is symmetric positive definite: symmetric ordering, no pivoting
         lu = spla.splu(K, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0, options={"SymmetricMode": True})
     lam = np.zeros(rows.size)
     scale = float(np.abs(gF).max(initial=0.0))
     its = 0
     with clock("AL solves"):
-        while its < AL_CAP:
+        while its < al_cap:
             its += 1
             dv = lu.solve(HFt @ (lam - d_inv * gF))
             c = HF @ dv + gF
             lam -= d_inv * c
-            if np.abs(c).max(initial=0.0) <= AL_TOL * scale:
+            if np.abs(c).max(initial=0.0) <= al_tol * scale:
                 break
     dr = np.zeros_like(g)
     dr[rows] = lam
     return dr, its
 
 
-def active_set_direction(ops, r, s, rows, g, rounds, clock) -> tuple[np.ndarray, int]:
-    """``rounds`` primal-dual active-set passes on the frozen-s box QP: solve on ``rows``; components the
-    solution pushes out of the box are put on their bound (a normal at 0 takes its tangential to 0 too)
-    and removed from the free set; the gradient is updated (∇E += W Δr) and the rest re-solved.
+def active_set_direction(ops, r, s, rows, g, rounds, hold, clock) -> tuple[np.ndarray, int]:
+    """Up to ``rounds`` active-set passes on the frozen-s box QP: solve on ``rows``; components the
+    solution pushes out of the box are put on their bound (a normal at 0 takes its tangential to 0 too;
+    ``hold``: left where they are), dropped from the rows, ∇E updated by W Δr, the rest re-solved.
     Returns (dr to the last pass's point, AL iterations)."""
     fixed = np.zeros_like(r)
     total = 0
@@ -150,46 +164,29 @@ def active_set_direction(ops, r, s, rows, g, rounds, clock) -> tuple[np.ndarray,
         with clock("active set"):
             trial = r + fixed + dr
             out_n = trial[1::2] < 0.0
-            out_t = np.abs(trial[0::2]) > s
             bad = np.zeros(r.size, dtype=bool)
             bad[1::2] = out_n
-            bad[0::2] = out_t | out_n
+            bad[0::2] = (np.abs(trial[0::2]) > s) | out_n
             bad_rows = bad[rows]
             if not bad_rows.any() or k == rounds - 1:
                 break
             idx = rows[bad_rows]
-            if HOLD:  # truncate where the step leaves the box: hold those components where they are
-                fixed[idx] = 0.0
-            else:
+            if not hold:
                 target = project(trial, s)
                 target[0::2][out_n] = 0.0
                 fixed[idx] = target[idx] - r[idx]
             rows = rows[~bad_rows]
-    dr = dr + fixed
-    return dr, total
+    return dr + fixed, total
 
 
-def scaling(r: np.ndarray, s: np.ndarray, rows: np.ndarray) -> np.ndarray:
-    """Affine-scaling weight per free row: (typical impulse / distance to the row's bound)², ≥ 1, so the
-    proximal AL picks, among the impulse changes that give the same velocities, one that moves the
-    components near a bound least."""
-    dist = np.empty_like(r)
-    dist[1::2] = r[1::2]
-    dist[0::2] = s - np.abs(r[0::2])
-    d = dist[rows]
-    scale = float(np.median(r[1::2][r[1::2] > 0])) if (r[1::2] > 0).any() else 1.0
-    return np.maximum((scale / np.maximum(d, 1e-12 * scale)) ** SCALING_POWER, 1.0)
-
-
-def line_search(ops: Operators, r: np.ndarray, dr: np.ndarray, s: np.ndarray, g: np.ndarray, clock: Clock):
+def line_search(ops, r, dr, s, g, clock):
     """Projected Armijo backtracking on E; returns (new r, α) or (r, 0.0) when no step lowers E."""
     with clock("line search"):
         e0 = ops.energy(r)
         alpha = 1.0
         while alpha >= ALPHA_MIN:
             trial = project(r + alpha * dr, s)
-            step = trial - r
-            if ops.energy(trial) <= e0 + SIGMA * float(g @ step):
+            if ops.energy(trial) <= e0 + SIGMA * float(g @ (trial - r)):
                 return trial, alpha
             alpha *= 0.5
     return r, 0.0
@@ -201,12 +198,15 @@ def tnnmg(
     smooth=SMOOTH,
     margin=MARGIN,
     normals_only=False,
-    cap=NEWTON_CAP,
-    rounds=1,
     inner=1,
     inward=False,
+    rounds=1,
+    hold=False,
+    cap=NEWTON_CAP,
     trace=False,
 ) -> Outcome:
+    """The method of the module doc from r_warm; ``trace``: also the law residual after each Newton step
+    (extra checks, timed as "trace")."""
     p = ctx.p
     clock = Clock()
     with clock("setup"):
@@ -221,11 +221,10 @@ def tnnmg(
         sweeps += smooth
         with clock("check"):
             res = ctx.residual(v, r)
-            if trace:
-                stats["smoothed"].append(res)
-            if res <= target:
-                ok = True
-                break
+        stats["smoothed"].append(res)
+        if res <= target:
+            ok = True
+            break
         if newton >= cap:
             break
         flat = r.ravel().copy()
@@ -237,7 +236,7 @@ def tnnmg(
             if rows.size == 0:
                 break
             if rounds > 1:
-                dr, its = active_set_direction(ops, flat, s, rows, g, rounds, clock)
+                dr, its = active_set_direction(ops, flat, s, rows, g, rounds, hold, clock)
             else:
                 dr, its = newton_direction(ops, rows, g, clock)
             flat, alpha = line_search(ops, flat, dr, s, g, clock)
@@ -246,13 +245,51 @@ def tnnmg(
             stats["free"].append(rows.size)
             if k + 1 < inner:
                 with clock("assemble"):
-                    v = (ops.ctx.p.v_free.ravel() + ops.minv * (ops.HT @ flat)).reshape(-1, 3)
+                    v = ops.velocity(flat)
         r = flat.reshape(-1, 2)
         newton += 1
         if trace:
-            stats["newton"].append(ctx.residual(law.velocity_from_impulse(p, ctx.H, r), r))
+            with clock("trace"):
+                stats["newton"].append(ctx.residual(ops.velocity(flat), r))
     out = Outcome(v, r, newton, float(sweeps), clock.phases, converged=ok)
-    out.smooth_sweeps, out.stats = sweeps, stats  # read by the lab's diagnostics, not the table
+    out.smooth_sweeps, out.stats = sweeps, stats  # read by the lab's diagnostics and tests, not the table
+    return out
+
+
+def oracle_start(p) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(r0, s, rows) of the reference's statuses: thresholds s = μ r_ref,n; r0 = r_warm with open contacts
+    set to 0 and sliding tangentials to their reference value (in the box of s); rows = the reference's
+    closed normals and sticking tangentials."""
+    rr = p.r_ref.ravel()
+    s = p.mu * rr[1::2]
+    closed = rr[1::2] > 0.0
+    stick = closed & (np.abs(rr[0::2]) < s * (1.0 - 1e-9))
+    rows = np.sort(np.concatenate([2 * np.flatnonzero(stick), 2 * np.flatnonzero(closed) + 1]))
+    r0 = p.r_warm.ravel().copy()
+    r0[1::2][~closed] = 0.0
+    r0[0::2][~closed] = 0.0
+    slide = closed & ~stick
+    r0[0::2][slide] = rr[0::2][slide]
+    return project(r0, s), s, rows
+
+
+def oracle_step(ctx, eps: float = 1e-4, al_cap: int = 10) -> dict:
+    """One Newton step from ``oracle_start`` (the REFERENCE's statuses and thresholds), near exact (AL to
+    1e-9 relative). Returns the velocity error and law residual at the start, after the step unprojected
+    and projected, and how many components the step pushes out of the box."""
+    p = ctx.p
+    ops = Operators(ctx)
+    r0, s, rows = oracle_start(p)
+    dr, its = newton_direction(ops, rows, ops.gradient(ops.velocity(r0)), Clock(), eps, al_cap, 1e-9)
+    r1 = r0 + dr
+    r1p = project(r1, s)
+    out = {"free": int(rows.size), "al": its}
+    for key, rv in (("start", r0), ("step", r1), ("projected", r1p)):
+        v = ops.velocity(rv)
+        out[key] = (law.velocity_error(p, v), ctx.residual(v, rv.reshape(-1, 2)))
+    out["rn<0"] = int((r1[1::2] < 0.0).sum())
+    out["|rt|>s"] = int((np.abs(r1[0::2]) > s * (1.0 + 1e-9)).sum())
+    out["r_projected"] = r1p.reshape(-1, 2)
     return out
 
 
@@ -262,4 +299,32 @@ METHODS = {
     "tnnmg-n": lambda ctx, target: tnnmg(ctx, target, normals_only=True),
     "tnnmg-m": lambda ctx, target: tnnmg(ctx, target, margin=0.05),
     "tnnmg-i3": lambda ctx, target: tnnmg(ctx, target, inner=3),
+    "tnnmg-a3": lambda ctx, target: tnnmg(ctx, target, rounds=3),
 }
+
+
+def _oracle_table(names: list[str]) -> None:
+    from benchmarks.solver_lab.methods.gauss_seidel import _law_sweeps
+    from benchmarks.solver_lab.outcome import Context
+    from benchmarks.solver_lab.problems import load_all
+
+    print(
+        "| problem | free rows | velocity error m/s: start / step / projected | r_n < 0 | \\|r_t\\| > s |"
+        " NLGS sweeps to 1e-5 m/s: warm start / after the projected step |"
+    )
+    print("|---|---|---|---|---|---|")
+    for p in load_all(names):
+        ctx = Context(p)
+        o = oracle_step(ctx)
+        warm, ok_w = _law_sweeps(ctx, p.r_warm, 1e-5)
+        after, ok_a = _law_sweeps(ctx, o["r_projected"], 1e-5)
+        e = [f"{o[k][0]:.1e}" for k in ("start", "step", "projected")]
+        print(
+            f"| {p.name} | {o['free']} | {' / '.join(e)} | {o['rn<0']} | {o['|rt|>s']} |"
+            f" {warm}{'' if ok_w else '*'} / {after}{'' if ok_a else '*'} |",
+            flush=True,
+        )
+
+
+if __name__ == "__main__":
+    _oracle_table(sys.argv[1:])
