@@ -33,8 +33,9 @@ box are put on their bound (or, ``hold``, held where they are), dropped from F, 
 
 Iterations: Newton steps. Sweep units: the harness's (all CPU time / one engine sweep's), numpy/scipy
 included; the phases split smoothing, checks, assembly, factor, AL solves and line search.
-``oracle_step`` (CLI: ``python -m benchmarks.solver_lab.methods.tnnmg PROBLEM …``) takes one Newton step
-with the reference's own statuses and thresholds — what the step is worth once the active set is right.
+``oracle_step`` (CLI: ``python -m benchmarks.solver_lab.methods.tnnmg [--sweeps K] [--all] PROBLEM …``)
+takes one Newton step from the iterate after K sweeps with the statuses and the thresholds of the reference
+or of the iterate — what the step is worth once the active set and the thresholds are right.
 """
 
 from __future__ import annotations
@@ -202,6 +203,7 @@ def tnnmg(
     inward=False,
     rounds=1,
     hold=False,
+    search=True,
     cap=NEWTON_CAP,
     trace=False,
 ) -> Outcome:
@@ -239,7 +241,10 @@ def tnnmg(
                 dr, its = active_set_direction(ops, flat, s, rows, g, rounds, hold, clock)
             else:
                 dr, its = newton_direction(ops, rows, g, clock)
-            flat, alpha = line_search(ops, flat, dr, s, g, clock)
+            if search:
+                flat, alpha = line_search(ops, flat, dr, s, g, clock)
+            else:  # the full step, projected (no globalisation)
+                flat, alpha = project(flat + dr, s), 1.0
             stats["alpha"].append(alpha)
             stats["al"].append(its)
             stats["free"].append(rows.size)
@@ -256,40 +261,47 @@ def tnnmg(
     return out
 
 
-def oracle_start(p) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """(r0, s, rows) of the reference's statuses: thresholds s = μ r_ref,n; r0 = r_warm with open contacts
-    set to 0 and sliding tangentials to their reference value (in the box of s); rows = the reference's
-    closed normals and sticking tangentials."""
+def oracle_start(p, r: np.ndarray, statuses: str = "reference", thresholds: str = "reference"):
+    """(r0, s, rows) for a Newton step from the impulses ``r`` (flat) with the statuses (closed / sticking)
+    and thresholds (s = μ r_n) of the reference's impulses or of ``r`` itself ("reference" / "iterate"):
+    r0 = r with open contacts set to 0 and sliding tangentials on their bound (sign of the statuses' owner),
+    rows = the closed normals and sticking tangentials."""
     rr = p.r_ref.ravel()
-    s = p.mu * rr[1::2]
-    closed = rr[1::2] > 0.0
-    stick = closed & (np.abs(rr[0::2]) < s * (1.0 - 1e-9))
+    own = rr if statuses == "reference" else r
+    s = p.mu * (rr if thresholds == "reference" else r)[1::2]
+    s_own = p.mu * own[1::2]
+    closed = own[1::2] > 0.0
+    stick = closed & (np.abs(own[0::2]) < s_own * (1.0 - 1e-9))
     rows = np.sort(np.concatenate([2 * np.flatnonzero(stick), 2 * np.flatnonzero(closed) + 1]))
-    r0 = p.r_warm.ravel().copy()
+    r0 = r.copy()
     r0[1::2][~closed] = 0.0
     r0[0::2][~closed] = 0.0
     slide = closed & ~stick
-    r0[0::2][slide] = rr[0::2][slide]
+    r0[0::2][slide] = np.sign(own[0::2][slide]) * s[slide]
     return project(r0, s), s, rows
 
 
-def oracle_step(ctx, eps: float = 1e-4, al_cap: int = 10) -> dict:
-    """One Newton step from ``oracle_start`` (the REFERENCE's statuses and thresholds), near exact (AL to
-    1e-9 relative). Returns the velocity error and law residual at the start, after the step unprojected
-    and projected, and how many components the step pushes out of the box."""
+def oracle_step(ctx, sweeps=0, statuses="reference", thresholds="reference", eps=1e-4, al_cap=10) -> dict:
+    """One Newton step from the iterate after ``sweeps`` engine sweeps (0: the warm start) with the statuses
+    and thresholds of ``oracle_start``, near exact (AL to 1e-9 relative). Returns the velocity error and law
+    residual of the iterate, of the step unprojected and projected, and how many components the step
+    pushes out of the box."""
     p = ctx.p
     ops = Operators(ctx)
-    r0, s, rows = oracle_start(p)
+    r = p.r_warm.copy()
+    if sweeps:
+        ctx.sweep(r, sweeps)
+    r = r.ravel()
+    r0, s, rows = oracle_start(p, r, statuses, thresholds)
     dr, its = newton_direction(ops, rows, ops.gradient(ops.velocity(r0)), Clock(), eps, al_cap, 1e-9)
     r1 = r0 + dr
     r1p = project(r1, s)
-    out = {"free": int(rows.size), "al": its}
-    for key, rv in (("start", r0), ("step", r1), ("projected", r1p)):
+    out = {"free": int(rows.size), "al": its, "r_iterate": r.reshape(-1, 2), "r_projected": r1p.reshape(-1, 2)}
+    for key, rv in (("iterate", r), ("step", r1), ("projected", r1p)):
         v = ops.velocity(rv)
         out[key] = (law.velocity_error(p, v), ctx.residual(v, rv.reshape(-1, 2)))
     out["rn<0"] = int((r1[1::2] < 0.0).sum())
     out["|rt|>s"] = int((np.abs(r1[0::2]) > s * (1.0 + 1e-9)).sum())
-    out["r_projected"] = r1p.reshape(-1, 2)
     return out
 
 
@@ -303,28 +315,42 @@ METHODS = {
 }
 
 
-def _oracle_table(names: list[str]) -> None:
+def _oracle_table(names: list[str], sweeps: int, combos: list[tuple[str, str]]) -> None:
     from benchmarks.solver_lab.methods.gauss_seidel import _law_sweeps
     from benchmarks.solver_lab.outcome import Context
     from benchmarks.solver_lab.problems import load_all
 
     print(
-        "| problem | free rows | velocity error m/s: start / step / projected | r_n < 0 | \\|r_t\\| > s |"
-        " NLGS sweeps to 1e-5 m/s: warm start / after the projected step |"
+        "| problem | statuses, thresholds | free rows | velocity error m/s: iterate / step / projected | r_n < 0 |"
+        " \\|r_t\\| > s | NLGS sweeps to 1e-5 m/s: from the iterate / after the projected step |"
     )
-    print("|---|---|---|---|---|---|")
+    print("|---|---|---|---|---|---|---|")
     for p in load_all(names):
         ctx = Context(p)
-        o = oracle_step(ctx)
-        warm, ok_w = _law_sweeps(ctx, p.r_warm, 1e-5)
-        after, ok_a = _law_sweeps(ctx, o["r_projected"], 1e-5)
-        e = [f"{o[k][0]:.1e}" for k in ("start", "step", "projected")]
-        print(
-            f"| {p.name} | {o['free']} | {' / '.join(e)} | {o['rn<0']} | {o['|rt|>s']} |"
-            f" {warm}{'' if ok_w else '*'} / {after}{'' if ok_a else '*'} |",
-            flush=True,
-        )
+        base = None
+        for statuses, thresholds in combos:
+            o = oracle_step(ctx, sweeps, statuses, thresholds)
+            if base is None:
+                base = _law_sweeps(ctx, o["r_iterate"], 1e-5)
+            after, ok_a = _law_sweeps(ctx, o["r_projected"], 1e-5)
+            e = [f"{o[k][0]:.1e}" for k in ("iterate", "step", "projected")]
+            print(
+                f"| {p.name} | {statuses}, {thresholds} | {o['free']} | {' / '.join(e)} | {o['rn<0']} |"
+                f" {o['|rt|>s']} | {base[0]}{'' if base[1] else '*'} / {after}{'' if ok_a else '*'} |",
+                flush=True,
+            )
 
 
 if __name__ == "__main__":
-    _oracle_table(sys.argv[1:])
+    # python -m benchmarks.solver_lab.methods.tnnmg [--sweeps K] [--all] PROBLEM …
+    args = sys.argv[1:]
+    k = 0
+    if "--sweeps" in args:
+        i = args.index("--sweeps")
+        k = int(args[i + 1])
+        del args[i : i + 2]
+    combos = [("reference", "reference")]
+    if "--all" in args:
+        args.remove("--all")
+        combos = [(a, b) for a in ("iterate", "reference") for b in ("iterate", "reference")]
+    _oracle_table(args, k, combos)
