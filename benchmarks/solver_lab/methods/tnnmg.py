@@ -302,6 +302,12 @@ def oracle_step(ctx, sweeps=0, statuses="reference", thresholds="reference", eps
         out[key] = (law.velocity_error(p, v), ctx.residual(v, rv.reshape(-1, 2)))
     out["rn<0"] = int((r1[1::2] < 0.0).sum())
     out["|rt|>s"] = int((np.abs(r1[0::2]) > s * (1.0 + 1e-9)).sum())
+    # how far the iterate's statuses are from the reference's: contacts closed in one and open in the
+    # other, and closed in both but sticking in one and sliding in the other
+    closed = [x[1::2] > 0.0 for x in (r, p.r_ref.ravel())]
+    stick = [c & (np.abs(x[0::2]) < p.mu * x[1::2] * (1.0 - 1e-9)) for c, x in zip(closed, (r, p.r_ref.ravel()))]
+    out["closed≠"] = int((closed[0] != closed[1]).sum())
+    out["stick≠"] = int((closed[0] & closed[1] & (stick[0] != stick[1])).sum())
     return out
 
 
@@ -323,8 +329,9 @@ def _oracle_table(names: list[str], sweeps: int, combos: list[tuple[str, str]]) 
     print(
         "| problem | statuses, thresholds | free rows | velocity error m/s: iterate / step / projected | r_n < 0 |"
         " \\|r_t\\| > s | NLGS sweeps to 1e-5 m/s: from the iterate / after the projected step |"
+        " iterate vs reference: open/closed, stick/slide differ |"
     )
-    print("|---|---|---|---|---|---|---|")
+    print("|---|---|---|---|---|---|---|---|")
     for p in load_all(names):
         ctx = Context(p)
         base = None
@@ -336,7 +343,8 @@ def _oracle_table(names: list[str], sweeps: int, combos: list[tuple[str, str]]) 
             e = [f"{o[k][0]:.1e}" for k in ("iterate", "step", "projected")]
             print(
                 f"| {p.name} | {statuses}, {thresholds} | {o['free']} | {' / '.join(e)} | {o['rn<0']} |"
-                f" {o['|rt|>s']} | {base[0]}{'' if base[1] else '*'} / {after}{'' if ok_a else '*'} |",
+                f" {o['|rt|>s']} | {base[0]}{'' if base[1] else '*'} / {after}{'' if ok_a else '*'} |"
+                f" {o['closed≠']}, {o['stick≠']} |",
                 flush=True,
             )
 
