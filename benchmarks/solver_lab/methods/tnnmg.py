@@ -318,6 +318,7 @@ METHODS = {
     "tnnmg-m": lambda ctx, target: tnnmg(ctx, target, margin=0.05),
     "tnnmg-i3": lambda ctx, target: tnnmg(ctx, target, inner=3),
     "tnnmg-a3": lambda ctx, target: tnnmg(ctx, target, rounds=3),
+    "tnnmg-t10": lambda ctx, target: tnnmg(ctx, target, smooth=20, inner=10, inward=True),
 }
 
 
