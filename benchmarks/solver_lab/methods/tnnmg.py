@@ -29,10 +29,13 @@ Options (each measured, see benchmarks/README.md "tnnmg"): ``inner`` Newton step
 next smoothing (nested Tresca); ``inward`` also frees components at a bound whose descent direction points
 into the box (projected-Newton rule); ``rounds`` active-set passes: components the step pushes out of the
 box are put on their bound (or, ``hold``, held where they are), dropped from F, and the rest re-solved
-(one factor each); ``normals_only`` Newton on the normal components only.
+(one factor each); ``normals_only`` Newton on the normal components only; ``search=False`` the full
+projected step, no line search (diverges: what ``ssn-v`` did). Measured outcome: no gain over the engine's
+sweeps at any height — the step helps only at the solution's statuses and thresholds (README).
 
-Iterations: Newton steps. Sweep units: the harness's (all CPU time / one engine sweep's), numpy/scipy
-included; the phases split smoothing, checks, assembly, factor, AL solves and line search.
+Iterations: Newton steps (threshold updates with ``inner`` > 1). Sweep units: the harness's (all CPU time
+over one engine sweep's), numpy/scipy included; the phases split smoothing, checks, assembly, factor, AL
+solves and line search.
 ``oracle_step`` (CLI: ``python -m benchmarks.solver_lab.methods.tnnmg [--sweeps K] [--all] PROBLEM …``)
 takes one Newton step from the iterate after K sweeps with the statuses and the thresholds of the reference
 or of the iterate — what the step is worth once the active set and the thresholds are right.
