@@ -218,6 +218,13 @@ def _close_all(sinks: dict, status: str, note: str, result) -> tuple[list[Output
     return written, errors
 
 
+_STALLED = {
+    "nlgs": "no lower residual in 10 000 sweeps by faces",
+    "nlgs-accel": "every method of the stalled-step round-robin gave up above it",
+}
+"""What a step that ends unconverged below the cap went through, by solver (engine/nlgs.py, stalled.py)."""
+
+
 def print_summary(console: Console, outcome: Outcome, scenario, hint: str = "") -> None:
     """The summary table, the optional ``hint``, and last the command that opens the recording."""
     result = outcome.result
@@ -230,7 +237,7 @@ def print_summary(console: Console, outcome: Outcome, scenario, hint: str = "") 
                 ("warning: ", "bold red"),
                 f"{result.unconverged} of {result.steps} steps ended unconverged (contact-law residual above "
                 f"--tolerance {run.tolerance:g} m/s; {result.tally.capped} at the {run.max_iterations}-sweep cap, "
-                "the others stalled: no lower residual in 10 000 sweeps by faces); their impulses and motion are "
+                f"the others stalled: {_STALLED[run.solver]}); their impulses and motion are "
                 "approximate. Raise --max-iterations for capped steps, or check the history's "
                 "nlgs_residual.",
             ),
