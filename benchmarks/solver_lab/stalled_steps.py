@@ -119,11 +119,29 @@ def as_problem(path: Path) -> StalledProblem:
         inv_inertia[body[:, side]] = pack[:, ii]
     nan = np.full((n, 3), np.nan)
     p = StalledProblem(
-        name=f"stalled/{path.stem}", body=body, point=np.zeros((c, 2)), normal=np.zeros((c, 2)),
-        gap=np.zeros(c), key=np.arange(c), q_m=np.zeros((n, 3)), inv_mass=inv_mass, inv_inertia=inv_inertia,
-        radius=np.zeros(n), v_free=v_free, v_n=v_free.copy(), r_warm=z["r_warm"], r_prev2=z["r_warm"],
-        has_prev2=np.zeros(c, bool), mu=float(z["mu"]), dt=1e-3, step=int(path.stem.rsplit("-", 1)[1]),
-        engine_sweeps=-1, v_ref=nan, r_ref=np.full((c, 2), np.nan), ref_sweeps=0, ref_residual=np.nan,
+        name=f"stalled/{path.stem}",
+        body=body,
+        point=np.zeros((c, 2)),
+        normal=np.zeros((c, 2)),
+        gap=np.zeros(c),
+        key=np.arange(c),
+        q_m=np.zeros((n, 3)),
+        inv_mass=inv_mass,
+        inv_inertia=inv_inertia,
+        radius=np.zeros(n),
+        v_free=v_free,
+        v_n=v_free.copy(),
+        r_warm=z["r_warm"],
+        r_prev2=z["r_warm"],
+        has_prev2=np.zeros(c, bool),
+        mu=float(z["mu"]),
+        dt=1e-3,
+        step=int(path.stem.rsplit("-", 1)[1]),
+        engine_sweeps=-1,
+        v_ref=nan,
+        r_ref=np.full((c, 2), np.nan),
+        ref_sweeps=0,
+        ref_residual=np.nan,
     )
     p.stored_pack = pack
     return p
