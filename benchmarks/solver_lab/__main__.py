@@ -1,4 +1,4 @@
-"""Solver lab: ``python -m benchmarks.solver_lab capture|table|clusters|stalled`` (see benchmarks/README.md, "Solver lab")."""
+"""Solver lab: ``python -m benchmarks.solver_lab capture|table|clusters|stalled|trajectory|ordinary`` (see benchmarks/README.md, "Solver lab")."""
 
 from __future__ import annotations
 
@@ -34,7 +34,25 @@ def main() -> None:
     sta.add_argument("--duration", type=float, default=0.2, help="simulated s per case (capture)")
     sta.add_argument("--steps", nargs="+", default=None, help="table: these kept steps (names, e.g. h32-100)")
     sta.add_argument("--repeat", type=int, default=2, help="table: CPU-time minimum of this many runs")
+    tra = sub.add_parser("trajectory", help="run a case, keep every k-th step (the ordinary-step sample)")
+    tra.add_argument("--case", default="wall-248")
+    tra.add_argument("--every", type=int, default=5)
+    tra.add_argument("--duration", type=float, default=None, help="simulated s (default: the case's)")
+    ordi = sub.add_parser("ordinary", help="first-stage variants of the accelerated sweep on a trajectory sample")
+    ordi.add_argument("--case", default="wall-248")
+    ordi.add_argument("--variants", nargs="+", default=None)
+    ordi.add_argument("--repeat", type=int, default=3, help="interleaved timing rounds; CPU-time minimum kept")
     args = ap.parse_args()
+    if args.command == "trajectory":
+        from benchmarks.solver_lab.trajectory import capture as capture_trajectory
+
+        capture_trajectory(args.case, args.every, args.duration)
+        return
+    if args.command == "ordinary":
+        from benchmarks.solver_lab.ordinary import table as ordinary_table
+
+        ordinary_table(args.case, args.variants, args.repeat)
+        return
     if args.command == "capture":
         from benchmarks.solver_lab.capture import capture
 

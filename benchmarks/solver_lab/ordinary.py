@@ -1,0 +1,244 @@
+"""First-stage variants of the accelerated sweep on a trajectory sample (ordinary steps).
+
+    python -m benchmarks.solver_lab trajectory --case wall-248 --every 5
+    python -m benchmarks.solver_lab ordinary --case wall-248 [--variants NAME …] [--repeat 3]
+
+Every kept step of ``data/trajectory/<case>`` is solved again by each variant from its warm start, with
+the engine's stopping test (in-sweep RMS residual ≤ 1e-5 m/s) and the momentum's stall window (500
+sweeps without a new low: such a step would go to stalled.py; it is counted "stalled" with the sweeps
+done). The kernel below is the engine's ``momentum._nlgs_accelerated`` with its constants turned into
+arguments (numba freezes globals at compile time), on the contacts in the engine's interleaved order:
+with the engine's parameters it gives the engine's sweep counts (checked for every step, "engine" row).
+
+    a            β = (j − 1)/(j + a): the engine's a = 2 (Nesterov); larger a, less momentum
+    beta_cap     β ≤ beta_cap
+    omega        the local solution relaxed: r = r_y + ω (r_loc − r_y), clipped into the cone (the
+                 residual is still the law's, W (r_loc − r_y))
+    plain_first  that many plain sweeps (β = 0) before the momentum starts
+    growth       restart when a sweep's residual > growth × the previous one (the engine's 1.1)
+    keep         at a restart j ← max(1, keep · j) instead of 1 (0: the engine's full restart)
+    gamma        warm start extrapolated along persistent contacts, r0 = r_{n−1} + γ (r_{n−1} − r_{n−2}),
+                 clipped into the cone (γ = 0: the engine's warm start)
+
+Reported per variant, over the sample: total sweeps (deterministic; all steps and the ordinary ones,
+i.e. those the engine's momentum converged without stalling), steps stalled, CPU s of the whole sample
+(kernel calls only; minimum of interleaved rounds), and the velocity error against a tight solve of
+each step (momentum to 1e-7 m/s in-sweep RMS, cap 20 000, cached in references.npz; RMS over the blocks' point velocities, mean
+over the steps) with the mean signed x-velocity error of the blocks (a bias accumulates into slips).
+"""
+
+from __future__ import annotations
+
+import time
+
+import numba
+import numpy as np
+
+from benchmarks.solver_lab.trajectory import TRAJECTORY
+from masonrycli.engine import nlgs
+from masonrycli.engine.nlgs import P_WNN, P_WTN, P_WTT, _local_solve, _push, _relative_velocity
+
+TOLERANCE = 1e-5
+STALL = 500
+CAP = 50_000
+REF_TOLERANCE, REF_CAP = 1e-7, 20_000
+
+ENGINE = dict(a=2.0, beta_cap=1.0, omega=1.0, plain_first=0, growth=1.1, keep=0.0, gamma=0.0)
+VARIANTS = {"engine": {}}
+VARIANTS |= {f"gamma-{g:g}": {"gamma": g} for g in (0.25, 0.5, 1.0)}
+VARIANTS |= {f"a-{a:g}": {"a": a} for a in (1.0, 3.0, 4.0, 5.0)}
+VARIANTS |= {f"cap-{c:g}": {"beta_cap": c} for c in (0.8, 0.9, 0.95, 0.98)}
+VARIANTS |= {f"omega-{w:g}": {"omega": w} for w in (0.9, 1.1, 1.2, 1.3)}
+VARIANTS |= {f"plain-{p}": {"plain_first": p} for p in (2, 5, 10)}
+VARIANTS |= {f"growth-{g:g}": {"growth": g} for g in (1.02, 1.05, 1.15, 1.2)}
+VARIANTS |= {f"keep-{k:g}": {"keep": k} for k in (0.25, 0.5)}
+
+
+@numba.njit(cache=False)
+def _accelerated(body, pack, count, mu, tolerance, max_iterations, v, r, stall_after, a, beta_cap, omega,
+                 plain_first, growth, keep):
+    # momentum._nlgs_accelerated (flip=False) with its constants as arguments, plus ω, plain_first, keep.
+    for c in range(count):
+        _push(v, body[c, 0], body[c, 1], pack, c, r[c, 0], r[c, 1])
+    iterations = 0
+    residual = 0.0
+    if count == 0:
+        return iterations, residual
+    v_prev = v.copy()
+    v_flat = v.reshape(v.size)
+    v_prev_flat = v_prev.reshape(v.size)
+    rr = np.empty((count, 4))
+    for c in range(count):
+        rr[c, 0] = rr[c, 2] = r[c, 0]
+        rr[c, 1] = rr[c, 3] = r[c, 1]
+    best = np.inf
+    best_at = 0
+    last = np.inf
+    j = 1.0
+    beta = 0.0
+    for it in range(max_iterations):
+        iterations = it + 1
+        for i in range(v_flat.shape[0]):
+            x = v_flat[i]
+            v_flat[i] = x + beta * (x - v_prev_flat[i])
+            v_prev_flat[i] = x
+        sum_e2 = 0.0
+        for c in range(count):
+            ba = body[c, 0]
+            bb = body[c, 1]
+            ut, un = _relative_velocity(v, ba, bb, pack, c)
+            xt = rr[c, 0]
+            xn = rr[c, 1]
+            rt0 = xt + beta * (xt - rr[c, 2])
+            rn0 = xn + beta * (xn - rr[c, 3])
+            rr[c, 2] = xt
+            rr[c, 3] = xn
+            wtt = pack[c, P_WTT]
+            wtn = pack[c, P_WTN]
+            wnn = pack[c, P_WNN]
+            ut -= wtt * rt0 + wtn * rn0
+            un -= wtn * rt0 + wnn * rn0
+            lt, ln, st = _local_solve(ut, un, pack, c, mu)
+            rt, rn = lt, ln
+            if omega != 1.0:
+                rn = rn0 + omega * (ln - rn0)
+                if rn < 0.0:
+                    rn = 0.0
+                rt = rt0 + omega * (lt - rt0)
+                lim = mu * rn
+                if rt > lim:
+                    rt = lim
+                elif rt < -lim:
+                    rt = -lim
+            rr[c, 0] = rt
+            rr[c, 1] = rn
+            drt = rt - rt0
+            drn = rn - rn0
+            if drt != 0.0 or drn != 0.0:
+                _push(v, ba, bb, pack, c, drt, drn)
+                dlt = lt - rt0
+                dln = ln - rn0
+                et = wtt * dlt + wtn * dln
+                en = wtn * dlt + wnn * dln
+                sum_e2 += et * et + en * en
+        residual = np.sqrt(sum_e2 / count)
+        if residual <= tolerance:
+            break
+        if residual < best:
+            best = residual
+            best_at = it
+        elif tolerance > 0.0 and it - best_at >= stall_after:
+            break
+        if residual > growth * last:
+            j = max(1.0, np.floor(keep * j))
+        last = residual
+        beta = 0.0 if it + 1 < plain_first else min(beta_cap, (j - 1.0) / (j + a))
+        if it + 1 >= plain_first:
+            j += 1.0
+    for c in range(count):
+        r[c, 0] = rr[c, 0]
+        r[c, 1] = rr[c, 1]
+    return iterations, residual
+
+
+def _interleave(count: int) -> np.ndarray:
+    """The engine's visiting order (nlgs._nlgs_interleaved)."""
+    k = nlgs.INTERLEAVE
+    run = (count + k - 1) // k
+    return np.array([q * run + j for j in range(run) for q in range(k) if q * run + j < count], dtype=np.int64)
+
+
+class Step:
+    """One kept step, in the engine's interleaved order."""
+
+    def __init__(self, path):
+        z = np.load(path)
+        o = _interleave(z["body"].shape[0])
+        self.step, self.engine_sweeps, self.stalled = int(z["step"]), int(z["sweeps"]), bool(z["stalled"])
+        self.body = np.ascontiguousarray(z["body"][o].astype(np.uint32))
+        self.pack = np.ascontiguousarray(z["pack"][o])
+        self.v_free = z["v_free"]
+        self.r_warm, self.r_prev2, self.has2 = z["r_warm"][o], z["r_prev2"][o], z["has_prev2"][o]
+        self.mu = float(z["mu"])
+        self.v_ref = None
+
+    @property
+    def count(self) -> int:
+        return self.body.shape[0]
+
+    def start(self, gamma: float) -> np.ndarray:
+        r = self.r_warm.copy()
+        if gamma:
+            r[self.has2] += gamma * (self.r_warm[self.has2] - self.r_prev2[self.has2])
+            r[:, 1] = np.maximum(r[:, 1], 0.0)
+            lim = self.mu * r[:, 1]
+            r[:, 0] = np.clip(r[:, 0], -lim, lim)
+        return r
+
+    def solve(self, p: dict, tolerance=TOLERANCE, cap=CAP, stall=STALL):
+        q = ENGINE | p
+        r = self.start(q["gamma"])
+        v = self.v_free.copy()
+        its, res = _accelerated(self.body, self.pack, self.count, self.mu, tolerance, cap, v, r, stall, q["a"],
+                                q["beta_cap"], q["omega"], q["plain_first"], q["growth"], q["keep"])
+        return its, res, v, r
+
+
+def _blocks(step: Step) -> np.ndarray:
+    """Rows of v that are blocks (a support has inverse mass 0 in every contact it is in)."""
+    n = step.v_free.shape[0]
+    dyn = np.zeros(n, dtype=bool)
+    for side, col in ((0, nlgs.P_IMA), (1, nlgs.P_IMB)):
+        dyn[step.body[:, side]] |= step.pack[:, col] > 0
+    return dyn
+
+
+def table(case: str, names: list[str] | None, repeat: int) -> None:
+    steps = [Step(p) for p in sorted((TRAJECTORY / case).glob("step-*.npz"))]
+    names = names or list(VARIANTS)
+    t = time.process_time()
+    cached = TRAJECTORY / case / "references.npz"
+    refs = dict(np.load(cached)) if cached.exists() else {}
+    for s in steps:
+        if f"v{s.step}" not in refs:
+            _, res, v, _ = s.solve({}, REF_TOLERANCE, REF_CAP, REF_CAP)
+            refs[f"v{s.step}"], refs[f"res{s.step}"] = v, res
+        s.v_ref, s.ref_ok = refs[f"v{s.step}"], refs[f"res{s.step}"] <= REF_TOLERANCE
+        s.blocks = _blocks(s)
+    np.savez(cached, **refs)
+    print(f"{len(steps)} steps of {case}; references in {time.process_time() - t:.1f} s CPU,"
+          f" {sum(not s.ref_ok for s in steps)} above {REF_TOLERANCE:g} m/s at {REF_CAP} sweeps", flush=True)
+    rows = {}
+    for name in names:
+        its = np.zeros(len(steps), dtype=np.int64)
+        stalled = np.zeros(len(steps), dtype=bool)
+        err = np.zeros(len(steps))
+        bias = np.zeros(len(steps))
+        for i, s in enumerate(steps):
+            n, res, v, _ = s.solve(VARIANTS[name])
+            its[i], stalled[i] = n, res > TOLERANCE
+            d = (v - s.v_ref)[s.blocks]
+            err[i] = np.sqrt((d[:, 0] ** 2 + d[:, 1] ** 2).mean())
+            bias[i] = d[:, 0].mean()
+        rows[name] = dict(its=its, stalled=stalled, err=err, bias=bias, cpu=np.inf)
+    engine = rows.get("engine")
+    ordinary = np.array([not s.stalled for s in steps])
+    if engine is not None:
+        mismatch = [s.step for s, n in zip(steps, engine["its"]) if not s.stalled and n != s.engine_sweeps]
+        print(f"engine variant vs the run's sweep counts on ordinary steps: {len(mismatch)} differ {mismatch[:10]}")
+    for _ in range(repeat):
+        for name in names:
+            t = time.process_time()
+            for s in steps:
+                s.solve(VARIANTS[name])
+            rows[name]["cpu"] = min(rows[name]["cpu"], time.process_time() - t)
+    base = engine["its"][ordinary].sum() if engine is not None else np.nan
+    base_cpu = engine["cpu"] if engine is not None else np.nan
+    print("| variant | sweeps, all steps | ordinary steps | ÷ engine | stalled | CPU s | ÷ engine |"
+          " velocity error RMS m/s (mean) | vx bias m/s (mean) |")
+    print("|---|---|---|---|---|---|---|---|---|")
+    for name in names:
+        row = rows[name]
+        o = row["its"][ordinary].sum()
+        print(f"| {name} | {row['its'].sum()} | {o} | {o / base:.3f} | {row['stalled'].sum()} | {row['cpu']:.3f} |"
+              f" {row['cpu'] / base_cpu:.3f} | {row['err'].mean():.2e} | {row['bias'].mean():+.2e} |", flush=True)
