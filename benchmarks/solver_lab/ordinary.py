@@ -43,7 +43,7 @@ STALL = 500
 CAP = 50_000
 REF_TOLERANCE, REF_CAP = 1e-7, 20_000
 
-ENGINE = dict(a=2.0, beta_cap=1.0, omega=1.0, plain_first=0, growth=1.1, keep=0.0, gamma=0.0)
+ENGINE = dict(a=2.0, beta_cap=1.0, omega=1.0, plain_first=0, growth=1.1, keep=0.0, gamma=0.0, probe=0.0, probe_mode=0, order="engine", local=0)
 VARIANTS = {"engine": {}}
 VARIANTS |= {f"gamma-{g:g}": {"gamma": g} for g in (0.25, 0.5, 1.0)}
 VARIANTS |= {f"a-{a:g}": {"a": a} for a in (1.0, 3.0, 4.0, 5.0)}
@@ -52,11 +52,20 @@ VARIANTS |= {f"omega-{w:g}": {"omega": w} for w in (0.9, 1.1, 1.2, 1.3)}
 VARIANTS |= {f"plain-{p}": {"plain_first": p} for p in (2, 5, 10)}
 VARIANTS |= {f"growth-{g:g}": {"growth": g} for g in (1.02, 1.05, 1.15, 1.2)}
 VARIANTS |= {f"keep-{k:g}": {"keep": k} for k in (0.25, 0.5)}
+VARIANTS |= {f"probe-{k:g}-{m}": {"probe": k, "probe_mode": i} for k in (1.5, 2.0, 3.0, 5.0)
+             for i, m in enumerate(("resume", "restart", "off"))}
+VARIANTS |= {"local": {"local": 1}, "local-a-1": {"local": 1, "a": 1.0}, "local-growth-1.2": {"local": 1, "growth": 1.2}}
+VARIANTS |= {f"a-{a:g}": {"a": a} for a in (0.0, 0.5, 1.5)} | {"a-1-gamma-0.25": {"a": 1.0, "gamma": 0.25}}
+VARIANTS |= {f"a-{a:g}": {"a": a} for a in (-0.5, -0.8)}
+VARIANTS |= {f"a-0-growth-{g:g}": {"a": 0.0, "growth": g} for g in (1.05, 1.15)}
+VARIANTS |= {f"a-0-cap-{c:g}": {"a": 0.0, "beta_cap": c} for c in (0.9, 0.95, 0.98)}
+VARIANTS |= {f"fixed-{c:g}": {"a": -0.999, "beta_cap": c} for c in (0.8, 0.9, 0.95)}
+VARIANTS |= {f"order-{o}": {"order": o} for o in ("detection", "reverse", "up", "down", "up-pure", "down-pure", "random", "by-b", "by-b-pure")}
 
 
 @numba.njit(cache=False)
 def _accelerated(body, pack, count, mu, tolerance, max_iterations, v, r, stall_after, a, beta_cap, omega,
-                 plain_first, growth, keep):
+                 plain_first, growth, keep, probe, probe_mode, local, history):
     # momentum._nlgs_accelerated (flip=False) with its constants as arguments, plus ω, plain_first, keep.
     for c in range(count):
         _push(v, body[c, 0], body[c, 1], pack, c, r[c, 0], r[c, 1])
@@ -74,8 +83,11 @@ def _accelerated(body, pack, count, mu, tolerance, max_iterations, v, r, stall_a
     best = np.inf
     best_at = 0
     last = np.inf
+    st_prev = np.full(count, -1, dtype=np.int64)
     j = 1.0
     beta = 0.0
+    probing = False
+    off = False
     for it in range(max_iterations):
         iterations = it + 1
         for i in range(v_flat.shape[0]):
@@ -112,6 +124,13 @@ def _accelerated(body, pack, count, mu, tolerance, max_iterations, v, r, stall_a
                     rt = -lim
             rr[c, 0] = rt
             rr[c, 1] = rn
+            if local and st != st_prev[c]:
+                # local restart: this contact carries no momentum into the next sweep; v_prev moved by
+                # its share of v − v_prev keeps v_prev = v(r_prev) (the extrapolation stays consistent)
+                _push(v_prev, ba, bb, pack, c, rt - rr[c, 2], rn - rr[c, 3])
+                rr[c, 2] = rt
+                rr[c, 3] = rn
+            st_prev[c] = st
             drt = rt - rt0
             drn = rn - rn0
             if drt != 0.0 or drn != 0.0:
@@ -122,6 +141,8 @@ def _accelerated(body, pack, count, mu, tolerance, max_iterations, v, r, stall_a
                 en = wtn * dlt + wnn * dln
                 sum_e2 += et * et + en * en
         residual = np.sqrt(sum_e2 / count)
+        if it < history.shape[0]:
+            history[it] = residual
         if residual <= tolerance:
             break
         if residual < best:
@@ -129,12 +150,25 @@ def _accelerated(body, pack, count, mu, tolerance, max_iterations, v, r, stall_a
             best_at = it
         elif tolerance > 0.0 and it - best_at >= stall_after:
             break
-        if residual > growth * last:
+        if residual > growth * last and not probing:
             j = max(1.0, np.floor(keep * j))
         last = residual
         beta = 0.0 if it + 1 < plain_first else min(beta_cap, (j - 1.0) / (j + a))
         if it + 1 >= plain_first:
             j += 1.0
+        # probe: near the tolerance, a plain sweep measures the iterate's own violation (not the
+        # extrapolated point's); mode 0 resumes the momentum after it, 1 restarts it, 2 ends it
+        if off:
+            beta = 0.0
+        elif probe > 0.0 and residual <= probe * tolerance and not probing:
+            beta = 0.0
+            probing = True
+            if probe_mode == 1:
+                j = 2.0
+            elif probe_mode == 2:
+                off = True
+        else:
+            probing = False
     for c in range(count):
         r[c, 0] = rr[c, 0]
         r[c, 1] = rr[c, 1]
@@ -148,39 +182,72 @@ def _interleave(count: int) -> np.ndarray:
     return np.array([q * run + j for j in range(run) for q in range(k) if q * run + j < count], dtype=np.int64)
 
 
+ORDERS = ("engine", "detection", "reverse", "up", "down", "up-pure", "down-pure", "random", "by-b", "by-b-pure")
+"""Sweep orders: the engine's (detection order, 4 interleaved runs), detection order alone, the engine's
+reversed; by contact height (point y, ties by x) up or down, with the engine's interleaving or pure; random;
+by the higher body of the pair first (by-b: a block's contacts with the blocks below and left of it together)."""
+
+
+def _order(name: str, point: np.ndarray, body: np.ndarray) -> np.ndarray:
+    c = point.shape[0]
+    if name.startswith("by-b"):
+        o = np.lexsort((body[:, 0], body[:, 1]))
+        return o if name.endswith("pure") else o[_interleave(c)]
+    if name in ("engine", "reverse"):
+        o = _interleave(c)
+        return o[::-1].copy() if name == "reverse" else o
+    if name == "detection":
+        return np.arange(c)
+    if name == "random":
+        return np.random.default_rng(0).permutation(c)
+    by_y = np.lexsort((point[:, 0], point[:, 1]))
+    if name.startswith("down"):
+        by_y = by_y[::-1]
+    return by_y if name.endswith("pure") else by_y[_interleave(c)]
+
+
 class Step:
-    """One kept step, in the engine's interleaved order."""
+    """One kept step; its contacts in a given sweep order (``arrays``)."""
 
     def __init__(self, path):
         z = np.load(path)
-        o = _interleave(z["body"].shape[0])
+        self.raw = {k: z[k] for k in ("body", "pack", "r_warm", "r_prev2", "has_prev2", "point")}
         self.step, self.engine_sweeps, self.stalled = int(z["step"]), int(z["sweeps"]), bool(z["stalled"])
-        self.body = np.ascontiguousarray(z["body"][o].astype(np.uint32))
-        self.pack = np.ascontiguousarray(z["pack"][o])
         self.v_free = z["v_free"]
-        self.r_warm, self.r_prev2, self.has2 = z["r_warm"][o], z["r_prev2"][o], z["has_prev2"][o]
         self.mu = float(z["mu"])
         self.v_ref = None
+        self._by_order = {}
 
     @property
     def count(self) -> int:
-        return self.body.shape[0]
+        return self.raw["body"].shape[0]
 
-    def start(self, gamma: float) -> np.ndarray:
-        r = self.r_warm.copy()
+    def arrays(self, order: str):
+        if order not in self._by_order:
+            o = _order(order, self.raw["point"], self.raw["body"])
+            d = {k: np.ascontiguousarray(a[o]) for k, a in self.raw.items()}
+            d["body"] = d["body"].astype(np.uint32)
+            self._by_order[order] = d
+        return self._by_order[order]
+
+    def start(self, d: dict, gamma: float) -> np.ndarray:
+        r = d["r_warm"].copy()
         if gamma:
-            r[self.has2] += gamma * (self.r_warm[self.has2] - self.r_prev2[self.has2])
+            h = d["has_prev2"]
+            r[h] += gamma * (d["r_warm"][h] - d["r_prev2"][h])
             r[:, 1] = np.maximum(r[:, 1], 0.0)
             lim = self.mu * r[:, 1]
             r[:, 0] = np.clip(r[:, 0], -lim, lim)
         return r
 
-    def solve(self, p: dict, tolerance=TOLERANCE, cap=CAP, stall=STALL):
+    def solve(self, p: dict, tolerance=TOLERANCE, cap=CAP, stall=STALL, history=None):
         q = ENGINE | p
-        r = self.start(q["gamma"])
+        d = self.arrays(q["order"])
+        r = self.start(d, q["gamma"])
         v = self.v_free.copy()
-        its, res = _accelerated(self.body, self.pack, self.count, self.mu, tolerance, cap, v, r, stall, q["a"],
-                                q["beta_cap"], q["omega"], q["plain_first"], q["growth"], q["keep"])
+        its, res = _accelerated(d["body"], d["pack"], self.count, self.mu, tolerance, cap, v, r, stall, q["a"],
+                                q["beta_cap"], q["omega"], q["plain_first"], q["growth"], q["keep"], q["probe"],
+                                q["probe_mode"], q["local"], np.zeros(0) if history is None else history)
         return its, res, v, r
 
 
@@ -189,7 +256,7 @@ def _blocks(step: Step) -> np.ndarray:
     n = step.v_free.shape[0]
     dyn = np.zeros(n, dtype=bool)
     for side, col in ((0, nlgs.P_IMA), (1, nlgs.P_IMB)):
-        dyn[step.body[:, side]] |= step.pack[:, col] > 0
+        dyn[step.raw["body"][:, side]] |= step.raw["pack"][:, col] > 0
     return dyn
 
 

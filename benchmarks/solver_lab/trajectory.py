@@ -10,6 +10,7 @@ engine (``nlgs.solve`` wrapped, as ``capture.py``), keeps the input of every ``e
     v_free (B, 3), r_warm (C, 2), mu    the step's free velocities, warm start, friction
     r_prev2 (C, 2), has_prev2 (C,)      the impulses of the step before the warm start's, by contact key
                                         (0 / False where the contact did not exist then): for predictions
+    point (C, 2)                        the contact points (m), for sweep orders by position
     step, sweeps, stalled               the engine's sweep units on that step, and whether stalled.py had
                                         to finish it (momentum stalled: not an "ordinary" step)
 
@@ -65,6 +66,7 @@ def capture(case: str, every: int, duration: float | None) -> None:
                 r_prev2=r_prev2,
                 has_prev2=has2,
                 mu=model.friction,
+                point=solver.buffers.contact_point[:count].copy(),
             )
         flag[0] = False
         its, res = solve(contact_body, pack, count, model, v, r, status)
