@@ -1,4 +1,4 @@
-"""Solver lab: ``python -m benchmarks.solver_lab capture|table|clusters|stalled|trajectory|ordinary`` (see benchmarks/README.md, "Solver lab")."""
+"""Solver lab: ``python -m benchmarks.solver_lab capture|table|clusters|stalled|trajectory|ordinary|ordinary-runs`` (see benchmarks/README.md, "Solver lab")."""
 
 from __future__ import annotations
 
@@ -42,7 +42,17 @@ def main() -> None:
     ordi.add_argument("--case", default="wall-248")
     ordi.add_argument("--variants", nargs="+", default=None)
     ordi.add_argument("--repeat", type=int, default=3, help="interleaved timing rounds; CPU-time minimum kept")
+    orr = sub.add_parser("ordinary-runs", help="first-stage variants in whole runs (sweeps, unconverged, slips)")
+    orr.add_argument("--cases", nargs="+", default=["wall-248"])
+    orr.add_argument("--variants", nargs="+", default=None)
+    orr.add_argument("--duration", type=float, default=1.0)
     args = ap.parse_args()
+    if args.command == "ordinary-runs":
+        from benchmarks.solver_lab.ordinary_runs import table as runs_table
+
+        for case in args.cases:
+            runs_table(case, args.variants, args.duration)
+        return
     if args.command == "trajectory":
         from benchmarks.solver_lab.trajectory import capture as capture_trajectory
 

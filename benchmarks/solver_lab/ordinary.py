@@ -67,7 +67,7 @@ VARIANTS |= {f"order-{o}": {"order": o} for o in ("detection", "reverse", "up", 
 
 
 @numba.njit(cache=False)
-def _accelerated(body, pack, count, mu, tolerance, max_iterations, v, r, stall_after, a, beta_cap, omega,
+def _accelerated(body, pack, count, mu, tolerance, max_iterations, v, r, status, stall_after, a, beta_cap, omega,
                  plain_first, growth, keep, probe, probe_mode, local, jmin, check, check_new_low, history):
     # momentum._nlgs_accelerated (flip=False) with its constants as arguments, plus ω, plain_first, keep.
     for c in range(count):
@@ -115,6 +115,7 @@ def _accelerated(body, pack, count, mu, tolerance, max_iterations, v, r, stall_a
             ut -= wtt * rt0 + wtn * rn0
             un -= wtn * rt0 + wnn * rn0
             lt, ln, st = _local_solve(ut, un, pack, c, mu)
+            status[c] = st
             rt, rn = lt, ln
             if omega != 1.0:
                 rn = rn0 + omega * (ln - rn0)
@@ -271,7 +272,8 @@ class Step:
         d = self.arrays(q["order"])
         r = self.start(d, q["gamma"])
         v = self.v_free.copy()
-        its, res = _accelerated(d["body"], d["pack"], self.count, self.mu, tolerance, cap, v, r, stall, q["a"],
+        status = np.zeros(self.count, dtype=np.int8)
+        its, res = _accelerated(d["body"], d["pack"], self.count, self.mu, tolerance, cap, v, r, status, stall, q["a"],
                                 q["beta_cap"], q["omega"], q["plain_first"], q["growth"], q["keep"], q["probe"],
                                 q["probe_mode"], q["local"], q["jmin"], q["check"], q["check_new_low"], np.zeros(0) if history is None else history)
         return its, res, v, r
