@@ -62,6 +62,7 @@ VARIANTS |= {f"a-0-cap-{c:g}": {"a": 0.0, "beta_cap": c} for c in (0.9, 0.95, 0.
 VARIANTS |= {f"fixed-{c:g}": {"a": -0.999, "beta_cap": c} for c in (0.8, 0.9, 0.95)}
 VARIANTS |= {f"jmin-{k}": {"jmin": float(k)} for k in (3, 5, 10)}
 VARIANTS |= {f"check-{k:g}": {"check": k} for k in (1.2, 1.5, 3.0)}
+VARIANTS |= {f"a-{a:g}-check-1.2": {"a": a, "check": 1.2} for a in (0.0, -0.5)}
 VARIANTS |= {f"check-low-{k:g}": {"check": k, "check_new_low": 1} for k in (1.5, 2.0, 3.0)} | {"a-0-check-1.5": {"a": 0.0, "check": 1.5}}
 VARIANTS |= {f"order-{o}": {"order": o} for o in ("detection", "reverse", "up", "down", "up-pure", "down-pure", "random", "by-b", "by-b-pure")}
 
@@ -199,7 +200,7 @@ def _accelerated(body, pack, count, mu, tolerance, max_iterations, v, r, status,
         r[c, 1] = rr[c, 1]
     if history.shape[0] > 0:
         history[-1] = checks
-    return iterations, residual
+    return iterations + checks, residual  # a check counted as one sweep unit (it reads what a sweep reads)
 
 
 def _interleave(count: int) -> np.ndarray:
