@@ -1,4 +1,5 @@
-"""Solver lab: ``python -m benchmarks.solver_lab capture|table|clusters|stalled|trajectory|ordinary|ordinary-runs`` (see benchmarks/README.md, "Solver lab")."""
+"""Solver lab: ``python -m benchmarks.solver_lab capture|table|clusters|stalled|trajectory|ordinary|ordinary-runs``
+(see benchmarks/README.md, "Solver lab")."""
 
 from __future__ import annotations
 

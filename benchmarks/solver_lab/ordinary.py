@@ -7,24 +7,39 @@ Every kept step of ``data/trajectory/<case>`` is solved again by each variant fr
 the engine's stopping test (in-sweep RMS residual ≤ 1e-5 m/s) and the momentum's stall window (500
 sweeps without a new low: such a step would go to stalled.py; it is counted "stalled" with the sweeps
 done). The kernel below is the engine's ``momentum._nlgs_accelerated`` with its constants turned into
-arguments (numba freezes globals at compile time), on the contacts in the engine's interleaved order:
-with the engine's parameters it gives the engine's sweep counts (checked for every step, "engine" row).
+arguments (numba freezes globals at compile time, so a variant needs no process or cache of its own), on
+the contacts in the engine's interleaved order: with the engine's parameters it is the engine's solve
+(sweeps, v and r bit for bit: the "engine" row and tests/test_solver_lab_ordinary.py). Parameters:
 
     a            β = (j − 1)/(j + a): the engine's a = 2 (Nesterov); larger a, less momentum
-    beta_cap     β ≤ beta_cap
+    beta_cap     β ≤ beta_cap ("fixed-B": a = −0.999, β = B from the second sweep after a restart)
     omega        the local solution relaxed: r = r_y + ω (r_loc − r_y), clipped into the cone (the
                  residual is still the law's, W (r_loc − r_y))
     plain_first  that many plain sweeps (β = 0) before the momentum starts
     growth       restart when a sweep's residual > growth × the previous one (the engine's 1.1)
     keep         at a restart j ← max(1, keep · j) instead of 1 (0: the engine's full restart)
+    jmin         no restart before the j-th sweep since the last one
+    local        a contact whose status changed in a sweep carries no momentum into the next (v_prev moved
+                 by its share, so v = v(r) still holds)
+    probe, mode  once the residual ≤ probe × tolerance, a plain sweep (β = 0) after each accelerated one,
+                 the momentum then resumed, restarted, or ended ("off")
+    check        once the in-sweep residual ≤ check × tolerance, one pass computes the law residual of the
+                 iterate itself (v, r) (no pushes); the step stops when that is ≤ the tolerance. A check is
+                 counted as one sweep unit. ("check-low": only at a new lowest in-sweep residual)
     gamma        warm start extrapolated along persistent contacts, r0 = r_{n−1} + γ (r_{n−1} − r_{n−2}),
                  clipped into the cone (γ = 0: the engine's warm start)
+    order        the sweep order (ORDERS)
+
+``solve_skipping`` measures another idea, leaving contacts open by a margin out of the sweeps.
 
 Reported per variant, over the sample: total sweeps (deterministic; all steps and the ordinary ones,
-i.e. those the engine's momentum converged without stalling), steps stalled, CPU s of the whole sample
-(kernel calls only; minimum of interleaved rounds), and the velocity error against a tight solve of
-each step (momentum to 1e-7 m/s in-sweep RMS, cap 20 000, cached in references.npz; RMS over the blocks' point velocities, mean
-over the steps) with the mean signed x-velocity error of the blocks (a bias accumulates into slips).
+i.e. those the engine's momentum converged without stalling), the geometric mean of the per-step ratio
+to the engine's sweeps and how many steps took fewer / more, steps stalled, CPU s of the whole sample
+(kernel calls only; minimum of interleaved rounds), and the velocity error against a tight solve of each
+step (momentum to 1e-7 m/s in-sweep RMS, cap 20 000, cached in references.npz; RMS over the blocks'
+velocities, mean over the steps) with the mean signed x-velocity error of the blocks (a bias accumulates
+into slips). A kept step starts from the engine run's warm start: what a variant's savings become once
+its own warm starts follow is measured by ``ordinary_runs.py``.
 """
 
 from __future__ import annotations
@@ -43,33 +58,44 @@ STALL = 500
 CAP = 50_000
 REF_TOLERANCE, REF_CAP = 1e-7, 20_000
 
-ENGINE = dict(a=2.0, beta_cap=1.0, omega=1.0, plain_first=0, growth=1.1, keep=0.0, gamma=0.0, probe=0.0, probe_mode=0, order="engine", local=0, jmin=0.0, check=0.0, check_new_low=0)
-VARIANTS = {"engine": {}}
+ENGINE = dict(
+    a=2.0, beta_cap=1.0, omega=1.0, plain_first=0, growth=1.1, keep=0.0, probe=0.0, probe_mode=0, local=0,
+    jmin=0.0, check=0.0, check_new_low=0, gamma=0.0, order="engine",
+)  # fmt: skip
+VARIANTS: dict[str, dict] = {"engine": {}}
 VARIANTS |= {f"gamma-{g:g}": {"gamma": g} for g in (0.25, 0.5, 1.0)}
-VARIANTS |= {f"a-{a:g}": {"a": a} for a in (1.0, 3.0, 4.0, 5.0)}
+VARIANTS |= {f"a-{a:g}": {"a": a} for a in (-0.8, -0.5, 0.0, 0.5, 1.0, 1.5, 3.0, 4.0, 5.0)}
 VARIANTS |= {f"cap-{c:g}": {"beta_cap": c} for c in (0.8, 0.9, 0.95, 0.98)}
+VARIANTS |= {f"fixed-{c:g}": {"a": -0.999, "beta_cap": c} for c in (0.8, 0.9, 0.95)}
 VARIANTS |= {f"omega-{w:g}": {"omega": w} for w in (0.9, 1.1, 1.2, 1.3)}
 VARIANTS |= {f"plain-{p}": {"plain_first": p} for p in (2, 5, 10)}
 VARIANTS |= {f"growth-{g:g}": {"growth": g} for g in (1.02, 1.05, 1.15, 1.2)}
 VARIANTS |= {f"keep-{k:g}": {"keep": k} for k in (0.25, 0.5)}
-VARIANTS |= {f"probe-{k:g}-{m}": {"probe": k, "probe_mode": i} for k in (1.5, 2.0, 3.0, 5.0)
-             for i, m in enumerate(("resume", "restart", "off"))}
-VARIANTS |= {"local": {"local": 1}, "local-a-1": {"local": 1, "a": 1.0}, "local-growth-1.2": {"local": 1, "growth": 1.2}}
-VARIANTS |= {f"a-{a:g}": {"a": a} for a in (0.0, 0.5, 1.5)} | {"a-1-gamma-0.25": {"a": 1.0, "gamma": 0.25}}
-VARIANTS |= {f"a-{a:g}": {"a": a} for a in (-0.5, -0.8)}
+VARIANTS |= {f"jmin-{k}": {"jmin": float(k)} for k in (3, 5, 10)}
+VARIANTS |= {"local": {"local": 1}, "local-a-1": {"local": 1, "a": 1.0}}
+VARIANTS |= {"local-growth-1.2": {"local": 1, "growth": 1.2}}
+VARIANTS |= {
+    f"probe-{k:g}-{m}": {"probe": k, "probe_mode": i}
+    for k in (1.5, 2.0, 3.0, 5.0)
+    for i, m in enumerate(("resume", "restart", "off"))
+}
+VARIANTS |= {f"check-{k:g}": {"check": k} for k in (1.2, 1.5, 3.0)}
+VARIANTS |= {f"check-low-{k:g}": {"check": k, "check_new_low": 1} for k in (1.5, 2.0, 3.0)}
+VARIANTS |= {f"a-{a:g}-check-1.2": {"a": a, "check": 1.2} for a in (0.0, -0.5)}
 VARIANTS |= {f"a-0-growth-{g:g}": {"a": 0.0, "growth": g} for g in (1.05, 1.15)}
 VARIANTS |= {f"a-0-cap-{c:g}": {"a": 0.0, "beta_cap": c} for c in (0.9, 0.95, 0.98)}
-VARIANTS |= {f"fixed-{c:g}": {"a": -0.999, "beta_cap": c} for c in (0.8, 0.9, 0.95)}
-VARIANTS |= {f"jmin-{k}": {"jmin": float(k)} for k in (3, 5, 10)}
-VARIANTS |= {f"check-{k:g}": {"check": k} for k in (1.2, 1.5, 3.0)}
-VARIANTS |= {f"a-{a:g}-check-1.2": {"a": a, "check": 1.2} for a in (0.0, -0.5)}
-VARIANTS |= {f"check-low-{k:g}": {"check": k, "check_new_low": 1} for k in (1.5, 2.0, 3.0)} | {"a-0-check-1.5": {"a": 0.0, "check": 1.5}}
-VARIANTS |= {f"order-{o}": {"order": o} for o in ("detection", "reverse", "up", "down", "up-pure", "down-pure", "random", "by-b", "by-b-pure")}
+VARIANTS |= {"a-1-gamma-0.25": {"a": 1.0, "gamma": 0.25}}
+ORDERS = ("engine", "detection", "reverse", "up", "down", "up-pure", "down-pure", "random", "by-b", "by-b-pure")
+"""Sweep orders: the engine's (detection order, 4 interleaved runs), detection order alone, the engine's
+reversed; by contact height (point y, ties by x) up or down, with the engine's interleaving or pure; random;
+by the higher body of the pair first (by-b: a block's contacts with the blocks below and left of it together)."""
+VARIANTS |= {f"order-{o}": {"order": o} for o in ORDERS[1:]}
 
 
 @numba.njit(cache=False)
 def _accelerated(body, pack, count, mu, tolerance, max_iterations, v, r, status, stall_after, a, beta_cap, omega,
-                 plain_first, growth, keep, probe, probe_mode, local, jmin, check, check_new_low, history):
+                 plain_first, growth, keep, probe, probe_mode, local, jmin, check, check_new_low, history,
+                 norm_count=0):
     # momentum._nlgs_accelerated (flip=False) with its constants as arguments, plus ω, plain_first, keep.
     for c in range(count):
         _push(v, body[c, 0], body[c, 1], pack, c, r[c, 0], r[c, 1])
@@ -146,7 +172,7 @@ def _accelerated(body, pack, count, mu, tolerance, max_iterations, v, r, status,
                 et = wtt * dlt + wtn * dln
                 en = wtn * dlt + wnn * dln
                 sum_e2 += et * et + en * en
-        residual = np.sqrt(sum_e2 / count)
+        residual = np.sqrt(sum_e2 / (norm_count if norm_count > 0 else count))
         if it < history.shape[0]:
             history[it] = residual
         if residual <= tolerance:
@@ -210,12 +236,6 @@ def _interleave(count: int) -> np.ndarray:
     return np.array([q * run + j for j in range(run) for q in range(k) if q * run + j < count], dtype=np.int64)
 
 
-ORDERS = ("engine", "detection", "reverse", "up", "down", "up-pure", "down-pure", "random", "by-b", "by-b-pure")
-"""Sweep orders: the engine's (detection order, 4 interleaved runs), detection order alone, the engine's
-reversed; by contact height (point y, ties by x) up or down, with the engine's interleaving or pure; random;
-by the higher body of the pair first (by-b: a block's contacts with the blocks below and left of it together)."""
-
-
 def _order(name: str, point: np.ndarray, body: np.ndarray) -> np.ndarray:
     c = point.shape[0]
     if name.startswith("by-b"):
@@ -232,6 +252,16 @@ def _order(name: str, point: np.ndarray, body: np.ndarray) -> np.ndarray:
     if name.startswith("down"):
         by_y = by_y[::-1]
     return by_y if name.endswith("pure") else by_y[_interleave(c)]
+
+
+KERNEL_PARAMETERS = ("a", "beta_cap", "omega", "plain_first", "growth", "keep", "probe", "probe_mode", "local", "jmin",
+                     "check", "check_new_low")
+"""The variant parameters in the order _accelerated takes them (after stall_after)."""
+
+
+def kernel_args(params: dict) -> tuple:
+    q = ENGINE | params
+    return tuple(q[k] for k in KERNEL_PARAMETERS)
 
 
 class Step:
@@ -274,10 +304,51 @@ class Step:
         r = self.start(d, q["gamma"])
         v = self.v_free.copy()
         status = np.zeros(self.count, dtype=np.int8)
-        its, res = _accelerated(d["body"], d["pack"], self.count, self.mu, tolerance, cap, v, r, status, stall, q["a"],
-                                q["beta_cap"], q["omega"], q["plain_first"], q["growth"], q["keep"], q["probe"],
-                                q["probe_mode"], q["local"], q["jmin"], q["check"], q["check_new_low"], np.zeros(0) if history is None else history)
+        its, res = _accelerated(d["body"], d["pack"], self.count, self.mu, tolerance, cap, v, r, status, stall,
+                                *kernel_args(p), np.zeros(0) if history is None else history)
         return its, res, v, r
+
+
+def _normal_margin(v, body, pack):
+    """u_n + max(g, 0)/dt of each contact at velocities v (m/s): > 0 open."""
+    b = body.astype(np.int64)
+    dv = v[b[:, 1]] - v[b[:, 0]]
+    un = (dv[:, 0] * pack[:, nlgs.P_NX] + dv[:, 1] * pack[:, nlgs.P_NY] + v[b[:, 1], 2] * pack[:, nlgs.P_NB]
+          - v[b[:, 0], 2] * pack[:, nlgs.P_NA])
+    return un + pack[:, nlgs.P_BIAS]
+
+
+def solve_skipping(step: Step, margin: float, clock=None):
+    """The engine's accelerated solve on the contacts that can act: a contact with no warm impulse that is
+    open by more than ``margin`` m/s at the warm start is left out of the sweeps (visiting it would find it
+    open and change nothing, as long as it stays open); the RMS still divides by all C contacts. At the end
+    every left-out contact must be open at the final velocities, else the step goes on with all contacts
+    (counted in ``fallback``). Returns (sweeps, residual, v, r, left out, fallback); ``clock`` (a list) gets
+    the CPU seconds of the kernel calls and the final test."""
+    d = step.arrays("engine")
+    st = np.zeros(step.count, dtype=np.int8)
+    v0 = step.v_free.copy()
+    args = kernel_args({})
+    _accelerated(d["body"], d["pack"], step.count, step.mu, TOLERANCE, 0, v0, d["r_warm"].copy(), st, STALL, *args,
+                 np.zeros(0))
+    act = (d["r_warm"] != 0).any(axis=1) | (_normal_margin(v0, d["body"], d["pack"]) <= margin)
+    idx = np.flatnonzero(act)
+    body, pack, r = np.ascontiguousarray(d["body"][idx]), np.ascontiguousarray(d["pack"][idx]), d["r_warm"][idx].copy()
+    v = step.v_free.copy()
+    t = time.process_time()
+    its, res = _accelerated(body, pack, idx.size, step.mu, TOLERANCE, CAP, v, r, st[idx], STALL, *args, np.zeros(0),
+                            step.count)
+    out = d["r_warm"].copy() * 0.0
+    out[idx] = r
+    ok = bool((_normal_margin(v, d["body"][~act], d["pack"][~act]) >= 0.0).all())
+    if clock is not None:
+        clock.append(time.process_time() - t)
+    if not ok:
+        v = step.v_free.copy()
+        its2, res = _accelerated(d["body"], d["pack"], step.count, step.mu, TOLERANCE, CAP, v, out, st, STALL, *args,
+                                 np.zeros(0))
+        its += its2
+    return its, res, v, out, step.count - idx.size, not ok
 
 
 def _blocks(step: Step) -> np.ndarray:
@@ -330,13 +401,14 @@ def table(case: str, names: list[str] | None, repeat: int) -> None:
             rows[name]["cpu"] = min(rows[name]["cpu"], time.process_time() - t)
     base = engine["its"][ordinary].sum() if engine is not None else np.nan
     base_cpu = engine["cpu"] if engine is not None else np.nan
-    print("| variant | sweeps, all steps | ordinary steps | ÷ engine | per step ÷ engine (geo. mean) | steps fewer / more |"
-          " stalled | CPU s | ÷ engine | velocity error RMS m/s (mean) | vx bias m/s (mean) |")
+    print("| variant | sweeps, all steps | ordinary steps | ÷ engine | per step ÷ engine (geo. mean) |"
+          " steps fewer / more | stalled | CPU s | ÷ engine | velocity error RMS m/s (mean) | vx bias m/s (mean) |")
     print("|---|---|---|---|---|---|---|---|---|---|---|")
     for name in names:
         row = rows[name]
         o = row["its"][ordinary].sum()
         ratio = row["its"][ordinary] / engine["its"][ordinary]
         paired = f"{np.exp(np.log(ratio).mean()):.3f} | {(ratio < 1).sum()} / {(ratio > 1).sum()}"
-        print(f"| {name} | {row['its'].sum()} | {o} | {o / base:.3f} | {paired} | {row['stalled'].sum()} | {row['cpu']:.3f} |"
-              f" {row['cpu'] / base_cpu:.3f} | {row['err'].mean():.2e} | {row['bias'].mean():+.2e} |", flush=True)
+        print(f"| {name} | {row['its'].sum()} | {o} | {o / base:.3f} | {paired} | {row['stalled'].sum()} |"
+              f" {row['cpu']:.3f} | {row['cpu'] / base_cpu:.3f} | {row['err'].mean():.2e} |"
+              f" {row['bias'].mean():+.2e} |", flush=True)

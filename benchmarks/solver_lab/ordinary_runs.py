@@ -21,7 +21,7 @@ import numpy as np
 
 from benchmarks.bench_solver import TIGHT, errors_pct, run_masonry
 from benchmarks.solver_lab.capture import _align
-from benchmarks.solver_lab.ordinary import CAP, ENGINE, STALL, VARIANTS, _accelerated, _interleave
+from benchmarks.solver_lab.ordinary import ENGINE, STALL, VARIANTS, _accelerated, _interleave, kernel_args
 from benchmarks.solver_lab.trajectory import TRAJECTORY
 from masonrycli.engine import nlgs, stalled
 
@@ -59,10 +59,8 @@ def run_variant(case: str, params: dict, duration: float) -> dict:
             r_o[:, 0] = np.clip(r_o[:, 0], -lim, lim)
         v_free, r_warm = v.copy(), r[:count].copy()
         st_o = np.zeros(count, dtype=status.dtype)
-        its, res = _accelerated(body, pk, count, model.friction, model.tolerance, model.max_iterations, v, r_o, st_o, STALL,
-                                q["a"], q["beta_cap"], q["omega"], q["plain_first"], q["growth"], q["keep"],
-                                q["probe"], q["probe_mode"], q["local"], q["jmin"], q["check"], q["check_new_low"],
-                                np.zeros(0))
+        mu, tol, cap = model.friction, model.tolerance, model.max_iterations
+        its, res = _accelerated(body, pk, count, mu, tol, cap, v, r_o, st_o, STALL, *kernel_args(params), np.zeros(0))
         r[o] = r_o
         status[o] = st_o
         if res > model.tolerance and its < model.max_iterations:  # stalled: as nlgs.solve

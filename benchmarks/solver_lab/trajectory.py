@@ -88,7 +88,8 @@ def capture(case: str, every: int, duration: float | None) -> None:
     took = time.process_time() - t
     sweeps = np.array([s for s, _ in steps])
     stalls = [i + 1 for i, (_, st) in enumerate(steps) if st]
-    (out / "steps.json").write_text(json.dumps({"case": case, "every": every, "sweeps": sweeps.tolist(), "stalled": stalls}))
+    summary = {"case": case, "every": every, "sweeps": sweeps.tolist(), "stalled": stalls}
+    (out / "steps.json").write_text(json.dumps(summary))
     ordinary = np.array([s for s, st in steps if not st])
     print(
         f"{case}: {len(steps)} steps in {took:.1f} s CPU, {sweeps.sum()} sweep units (mean {sweeps.mean():.0f},"
