@@ -26,8 +26,9 @@ def test_lab_kernel_with_engine_parameters_is_the_engine(tmp_path, monkeypatch):
         # the same solve by the engine's launcher, from the kept (detection-order) arrays
         d = s.raw
         v_e, r_e = s.v_free.copy(), d["r_warm"].copy()
-        model = SimpleNamespace(friction=s.mu, tolerance=ordinary.TOLERANCE, max_iterations=ordinary.CAP,
-                                solver="nlgs-accel")
+        model = SimpleNamespace(
+            friction=s.mu, tolerance=ordinary.TOLERANCE, max_iterations=ordinary.CAP, solver="nlgs-accel"
+        )
         its_e, _ = nlgs.solve(d["body"], d["pack"], s.count, model, v_e, r_e, np.zeros(s.count, np.int8))
         assert its_e == its
         np.testing.assert_array_equal(v, v_e)

@@ -93,9 +93,32 @@ VARIANTS |= {f"order-{o}": {"order": o} for o in ORDERS[1:]}
 
 
 @numba.njit(cache=False)
-def _accelerated(body, pack, count, mu, tolerance, max_iterations, v, r, status, stall_after, a, beta_cap, omega,
-                 plain_first, growth, keep, probe, probe_mode, local, jmin, check, check_new_low, history,
-                 norm_count=0):
+def _accelerated(
+    body,
+    pack,
+    count,
+    mu,
+    tolerance,
+    max_iterations,
+    v,
+    r,
+    status,
+    stall_after,
+    a,
+    beta_cap,
+    omega,
+    plain_first,
+    growth,
+    keep,
+    probe,
+    probe_mode,
+    local,
+    jmin,
+    check,
+    check_new_low,
+    history,
+    norm_count=0,
+):
     # momentum._nlgs_accelerated (flip=False) with its constants as arguments, plus ω, plain_first, keep.
     for c in range(count):
         _push(v, body[c, 0], body[c, 1], pack, c, r[c, 0], r[c, 1])
@@ -254,8 +277,20 @@ def _order(name: str, point: np.ndarray, body: np.ndarray) -> np.ndarray:
     return by_y if name.endswith("pure") else by_y[_interleave(c)]
 
 
-KERNEL_PARAMETERS = ("a", "beta_cap", "omega", "plain_first", "growth", "keep", "probe", "probe_mode", "local", "jmin",
-                     "check", "check_new_low")
+KERNEL_PARAMETERS = (
+    "a",
+    "beta_cap",
+    "omega",
+    "plain_first",
+    "growth",
+    "keep",
+    "probe",
+    "probe_mode",
+    "local",
+    "jmin",
+    "check",
+    "check_new_low",
+)
 """The variant parameters in the order _accelerated takes them (after stall_after)."""
 
 
@@ -304,8 +339,20 @@ class Step:
         r = self.start(d, q["gamma"])
         v = self.v_free.copy()
         status = np.zeros(self.count, dtype=np.int8)
-        its, res = _accelerated(d["body"], d["pack"], self.count, self.mu, tolerance, cap, v, r, status, stall,
-                                *kernel_args(p), np.zeros(0) if history is None else history)
+        its, res = _accelerated(
+            d["body"],
+            d["pack"],
+            self.count,
+            self.mu,
+            tolerance,
+            cap,
+            v,
+            r,
+            status,
+            stall,
+            *kernel_args(p),
+            np.zeros(0) if history is None else history,
+        )
         return its, res, v, r
 
 
@@ -313,8 +360,12 @@ def _normal_margin(v, body, pack):
     """u_n + max(g, 0)/dt of each contact at velocities v (m/s): > 0 open."""
     b = body.astype(np.int64)
     dv = v[b[:, 1]] - v[b[:, 0]]
-    un = (dv[:, 0] * pack[:, nlgs.P_NX] + dv[:, 1] * pack[:, nlgs.P_NY] + v[b[:, 1], 2] * pack[:, nlgs.P_NB]
-          - v[b[:, 0], 2] * pack[:, nlgs.P_NA])
+    un = (
+        dv[:, 0] * pack[:, nlgs.P_NX]
+        + dv[:, 1] * pack[:, nlgs.P_NY]
+        + v[b[:, 1], 2] * pack[:, nlgs.P_NB]
+        - v[b[:, 0], 2] * pack[:, nlgs.P_NA]
+    )
     return un + pack[:, nlgs.P_BIAS]
 
 
@@ -329,15 +380,17 @@ def solve_skipping(step: Step, margin: float, clock=None):
     st = np.zeros(step.count, dtype=np.int8)
     v0 = step.v_free.copy()
     args = kernel_args({})
-    _accelerated(d["body"], d["pack"], step.count, step.mu, TOLERANCE, 0, v0, d["r_warm"].copy(), st, STALL, *args,
-                 np.zeros(0))
+    _accelerated(
+        d["body"], d["pack"], step.count, step.mu, TOLERANCE, 0, v0, d["r_warm"].copy(), st, STALL, *args, np.zeros(0)
+    )
     act = (d["r_warm"] != 0).any(axis=1) | (_normal_margin(v0, d["body"], d["pack"]) <= margin)
     idx = np.flatnonzero(act)
     body, pack, r = np.ascontiguousarray(d["body"][idx]), np.ascontiguousarray(d["pack"][idx]), d["r_warm"][idx].copy()
     v = step.v_free.copy()
     t = time.process_time()
-    its, res = _accelerated(body, pack, idx.size, step.mu, TOLERANCE, CAP, v, r, st[idx], STALL, *args, np.zeros(0),
-                            step.count)
+    its, res = _accelerated(
+        body, pack, idx.size, step.mu, TOLERANCE, CAP, v, r, st[idx], STALL, *args, np.zeros(0), step.count
+    )
     out = d["r_warm"].copy() * 0.0
     out[idx] = r
     ok = bool((_normal_margin(v, d["body"][~act], d["pack"][~act]) >= 0.0).all())
@@ -345,8 +398,9 @@ def solve_skipping(step: Step, margin: float, clock=None):
         clock.append(time.process_time() - t)
     if not ok:
         v = step.v_free.copy()
-        its2, res = _accelerated(d["body"], d["pack"], step.count, step.mu, TOLERANCE, CAP, v, out, st, STALL, *args,
-                                 np.zeros(0))
+        its2, res = _accelerated(
+            d["body"], d["pack"], step.count, step.mu, TOLERANCE, CAP, v, out, st, STALL, *args, np.zeros(0)
+        )
         its += its2
     return its, res, v, out, step.count - idx.size, not ok
 
@@ -373,8 +427,11 @@ def table(case: str, names: list[str] | None, repeat: int) -> None:
         s.v_ref, s.ref_ok = refs[f"v{s.step}"], refs[f"res{s.step}"] <= REF_TOLERANCE
         s.blocks = _blocks(s)
     np.savez(cached, **refs)
-    print(f"{len(steps)} steps of {case}; references in {time.process_time() - t:.1f} s CPU,"
-          f" {sum(not s.ref_ok for s in steps)} above {REF_TOLERANCE:g} m/s at {REF_CAP} sweeps", flush=True)
+    print(
+        f"{len(steps)} steps of {case}; references in {time.process_time() - t:.1f} s CPU,"
+        f" {sum(not s.ref_ok for s in steps)} above {REF_TOLERANCE:g} m/s at {REF_CAP} sweeps",
+        flush=True,
+    )
     rows = {}
     for name in names:
         its = np.zeros(len(steps), dtype=np.int64)
@@ -401,14 +458,19 @@ def table(case: str, names: list[str] | None, repeat: int) -> None:
             rows[name]["cpu"] = min(rows[name]["cpu"], time.process_time() - t)
     base = engine["its"][ordinary].sum() if engine is not None else np.nan
     base_cpu = engine["cpu"] if engine is not None else np.nan
-    print("| variant | sweeps, all steps | ordinary steps | ÷ engine | per step ÷ engine (geo. mean) |"
-          " steps fewer / more | stalled | CPU s | ÷ engine | velocity error RMS m/s (mean) | vx bias m/s (mean) |")
+    print(
+        "| variant | sweeps, all steps | ordinary steps | ÷ engine | per step ÷ engine (geo. mean) |"
+        " steps fewer / more | stalled | CPU s | ÷ engine | velocity error RMS m/s (mean) | vx bias m/s (mean) |"
+    )
     print("|---|---|---|---|---|---|---|---|---|---|---|")
     for name in names:
         row = rows[name]
         o = row["its"][ordinary].sum()
         ratio = row["its"][ordinary] / engine["its"][ordinary]
         paired = f"{np.exp(np.log(ratio).mean()):.3f} | {(ratio < 1).sum()} / {(ratio > 1).sum()}"
-        print(f"| {name} | {row['its'].sum()} | {o} | {o / base:.3f} | {paired} | {row['stalled'].sum()} |"
-              f" {row['cpu']:.3f} | {row['cpu'] / base_cpu:.3f} | {row['err'].mean():.2e} |"
-              f" {row['bias'].mean():+.2e} |", flush=True)
+        print(
+            f"| {name} | {row['its'].sum()} | {o} | {o / base:.3f} | {paired} | {row['stalled'].sum()} |"
+            f" {row['cpu']:.3f} | {row['cpu'] / base_cpu:.3f} | {row['err'].mean():.2e} |"
+            f" {row['bias'].mean():+.2e} |",
+            flush=True,
+        )

@@ -64,8 +64,21 @@ def run_variant(case: str, params: dict, duration: float) -> dict:
         r[o] = r_o
         status[o] = st_o
         if res > model.tolerance and its < model.max_iterations:  # stalled: as nlgs.solve
-            its, res = stalled.continue_stalled(contact_body, pack, count, model.friction, model.tolerance,
-                                                model.max_iterations, v, r, status, v_free, r_warm, its, res)
+            its, res = stalled.continue_stalled(
+                contact_body,
+                pack,
+                count,
+                model.friction,
+                model.tolerance,
+                model.max_iterations,
+                v,
+                r,
+                status,
+                v_free,
+                r_warm,
+                its,
+                res,
+            )
         if q["gamma"]:
             order = np.argsort(key, kind="stable")
             hist[0], hist[1] = hist[1], (key[order].copy(), r[:count][order].copy())
@@ -94,8 +107,10 @@ def table(case: str, names: list[str] | None, duration: float) -> None:
     names = names or ["engine"]
     tight = _tight(case, duration)
     print(f"\n{case}, {duration:g} s")
-    print("| variant | sweep units | ÷ engine | per step mean (max) | unconverged |"
-          " error % top / mean at 0.1 s | at 0.2 s |")
+    print(
+        "| variant | sweep units | ÷ engine | per step mean (max) | unconverged |"
+        " error % top / mean at 0.1 s | at 0.2 s |"
+    )
     print("|---|---|---|---|---|---|---|")
     base = None
     for name in names:
@@ -105,5 +120,8 @@ def table(case: str, names: list[str] | None, duration: float) -> None:
         base = base or total
         e = errors_pct(out["samples"], tight)
         errs = " | ".join(f"{e[k][0]:+.2f} / {e[k][1]:+.2f}" if k in e else "–" for k in ("100", "200"))
-        print(f"| {name} | {total:.0f} | {total / base:.3f} | {out['sweeps_mean']:.0f} ({out['sweeps_max']}) |"
-              f" {out['unconverged']} | {errs} |", flush=True)
+        print(
+            f"| {name} | {total:.0f} | {total / base:.3f} | {out['sweeps_mean']:.0f} ({out['sweeps_max']}) |"
+            f" {out['unconverged']} | {errs} |",
+            flush=True,
+        )
