@@ -98,7 +98,9 @@ RUN = {
     "max_iterations": _opt(
         int,
         "Run",
-        "NLGS sweep cap per step (default 50000; a step also stops after 10000 sweeps without a new lowest residual).",
+        "Sweep cap per step, in Gauss–Seidel sweep units (default 100000). A stalled step stops earlier: with "
+        "the default solver when every method of its round-robin gives up, with nlgs after 10000 sweeps without "
+        "a new lowest residual.",
     ),
     "solver": _opt(
         str,

@@ -58,7 +58,7 @@ class RunConfig:
     theta: float = 0.5
     gravity: tuple[float, float] = (0.0, -9.81)
     tolerance: float = 1e-5
-    max_iterations: int = 50000
+    max_iterations: int = 100000
     record_every: int = 10
     alert_distance: float = 1e-3
     solver: str = "nlgs-accel"

@@ -66,7 +66,7 @@ def test_defaults_and_default_names(tmp_path):
     )
     s = load_scenario(path)
     assert s.name == "my_wall"
-    assert s.run == RunConfig(1.0, 1e-3, 0.5, (0.0, -9.81), 1e-5, 50000, 10, 1e-3)
+    assert s.run == RunConfig(1.0, 1e-3, 0.5, (0.0, -9.81), 1e-5, 100000, 10, 1e-3)
     assert s.material == Material(2500.0, 1.0, 0.6)
     assert [b.name for b in s.assembly.blocks] == ["block-1", "block-2"]
     assert [b.density for b in s.assembly.blocks] == [2500.0, 1000.0]
