@@ -49,9 +49,18 @@ RESULTS = Path(__file__).resolve().parent / "results.json"
 
 def _register_optional():
     # Methods in their own modules; imported here so the table runs them by name.
-    from benchmarks.solver_lab.methods import accelerated, alm_newton, anderson, cluster, linear, newton, tnnmg
+    from benchmarks.solver_lab.methods import (
+        accelerated,
+        alart_curnier,
+        alm_newton,
+        anderson,
+        cluster,
+        linear,
+        newton,
+        tnnmg,
+    )
 
-    for module in (anderson, newton, alm_newton, cluster, linear, accelerated, tnnmg):
+    for module in (anderson, newton, alm_newton, cluster, linear, accelerated, tnnmg, alart_curnier):
         METHODS.update(module.METHODS)
 
 

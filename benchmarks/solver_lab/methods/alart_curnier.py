@@ -1,0 +1,308 @@
+"""Globalised Alart–Curnier semismooth Newton on the full Signorini–Coulomb law: ``ac``, ``ac-m500`` …
+
+Unknowns: the impulses r (2C: (r_t, r_n) per contact); v(r) = v_free + M⁻¹ Hᵀ r, u = H v(r). Per contact,
+with ρ = 1/W_αα (per component: ρ_t = 1/W_tt, ρ_n = 1/W_nn) and the Signorini bias b,
+
+    Φ_n = r_n − max(0, r_n − ρ_n (u_n + b))                      (Signorini: r_n ≥ 0 ⊥ u_n + b ≥ 0)
+    Φ_t = r_t − proj_[−s, s](r_t − ρ_t u_t),   s = μ max(r_n, 0)  (Coulomb, threshold from r_n itself)
+
+Φ = 0 exactly on the lab's contact law (law.py); unlike ``tnnmg`` the threshold s is linearised too. The
+residual is used in velocity units, F = W_αα Φ (m/s per component), so ½|F|² weighs contacts like the
+lab's law residual. Generalised Jacobian F' = A H M⁻¹ Hᵀ + B with, per contact (W = W_αα diagonal entry):
+
+    normal closed (r_n − ρ_n(u_n + b) > 0):   ∂F_n/∂u_n = 1        else ∂F_n/∂r_n = W_nn
+    tangent stick (|r_t − ρ_t u_t| < s):      ∂F_t/∂u_t = 1        else ∂F_t/∂r_t = W_tt,
+                                              ∂F_t/∂r_n = −W_tt μ sign(r_t − ρ_t u_t)  (if r_n > 0)
+
+W = H M⁻¹ Hᵀ is singular on a hyperstatic wall (impulses not unique), so the step is a Levenberg–Marquardt
+shifted one: B + λ diag(W_αα). Newton system, either the sparse saddle point in (dv, dr) over the moving
+bodies' velocities (``schur=False``), or its Schur complement on dr with the sparse W formed once per
+problem (``schur=True``, the default: measured faster, module end):
+
+    [ M      −Hᵀ       ] [dv]   [ 0 ]            (A W + B + λ D) dr = −F
+    [ A H   B + λ D    ] [dr] = [−F ]
+
+One run (pseudo-code):
+
+    r = r_warm;  PRE engine sweeps of kind KIND (0: plain warm start; 500 momentum: the stalled iterate)
+    λ = LAMBDA0
+    loop:  if lab law residual RMS(v(r), r) ≤ target: done
+           J = F'(r) + λ D;  dr = −J⁻¹ F(r)             (one splu)
+           α = 1, ½, ¼ … ≥ ALPHA_MIN: accept the first with ½|F(r + α dr)|² ≤ (1 − 2σα) ½|F(r)|²  (Armijo)
+           accepted:  r += α dr;  λ = max(λ / 4, LAMBDA_MIN) if α = 1 else λ
+           rejected:  λ = min(10 λ, LAMBDA_MAX);  WATCHDOG engine sweeps from r (nonmonotone: the merit
+                      is re-taken from wherever they leave r)
+           cap NEWTON_CAP Newton steps
+
+Iterations: Newton steps (factorisations). Sweep units: the harness's (all CPU time over one engine
+sweep's), numpy/scipy included; phases split pre-sweeps, watchdog sweeps, law checks, assembly, factor,
+solve and line search. ``newton_step_ms`` times one step (assembly + splu + solve) alone for the README's
+"what an engine version would cost". Measured outcome: benchmarks/README.md, "Alart–Curnier".
+"""
+
+from __future__ import annotations
+
+import sys
+import time
+
+import numpy as np
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+
+from benchmarks.solver_lab.outcome import Clock, Outcome
+from masonrycli.engine import nlgs as N
+
+LAMBDA0 = 1e-3
+LAMBDA_MIN = 1e-8
+LAMBDA_MAX = 1.0
+SIGMA = 1e-4
+ALPHA_MIN = 2.0**-10
+WATCHDOG = 20
+"""Engine sweeps after a rejected Newton step."""
+NEWTON_CAP = 100
+PERMC = "MMD_AT_PLUS_A"
+"""splu ordering of the velocity-space matrix, symmetric mode without pivoting (the matrix is nearly
+symmetric, only sliding rows break the symmetry): 12.8 ms and 1.9e5 factor nonzeros on wall-64-hard
+(992 blocks) against 16.7 ms / 3.5e5 with COLAMD and partial pivoting, 359 ms / 2.4e6 with MMD pivoting."""
+
+
+class Residual:
+    """F(r) and its generalised Jacobian for one problem (built once: H restricted to moving bodies, sparse
+    W = H M⁻¹ Hᵀ, W_αα, bias)."""
+
+    def __init__(self, ctx, form: str = "velocity"):
+        p, pack = ctx.p, ctx.pack
+        self.ctx, self.form = ctx, form
+        self.minv = ctx.minv
+        self.HT = ctx.H.T.tocsr()
+        self.dyn = np.flatnonzero(ctx.minv > 0)
+        self.Hd = ctx.H[:, self.dyn].tocsr()
+        self.HdT = self.Hd.T.tocsr()
+        self.md = 1.0 / ctx.minv[self.dyn]
+        self.wdiag = np.stack([pack[:, N.P_WTT], pack[:, N.P_WNN]], axis=1).ravel()
+        self.bias = pack[:, N.P_BIAS].copy()
+        self.mu = p.mu
+        self.vfree = p.v_free.ravel().copy()
+        c = p.count
+        self.n = 2 * c
+        if form == "schur":
+            self.W = (self.Hd @ sp.diags(ctx.minv[self.dyn]) @ self.Hd.T).tocsr()
+        # sparsity pattern of B: the diagonal and the (t, n) entry of each contact
+        self.b_rows = np.concatenate([np.arange(2 * c), 2 * np.arange(c)])
+        self.b_cols = np.concatenate([np.arange(2 * c), 2 * np.arange(c) + 1])
+
+    def velocity(self, r: np.ndarray) -> np.ndarray:
+        """v(r), flat (3B,)."""
+        return self.vfree + self.minv * (self.HT @ r)
+
+    def evaluate(self, r: np.ndarray):
+        """(F (2C,) m/s, the pieces the Jacobian needs) at flat r."""
+        u = self.ctx.H @ self.velocity(r)
+        rt, rn = r[0::2], r[1::2]
+        ut, un = u[0::2], u[1::2]
+        wt, wn = self.wdiag[0::2], self.wdiag[1::2]
+        x = rn - (un + self.bias) / wn
+        closed = x > 0.0
+        s = self.mu * np.maximum(rn, 0.0)
+        y = rt - ut / wt
+        stick = np.abs(y) < s
+        F = np.empty_like(r)
+        F[1::2] = wn * (rn - np.maximum(x, 0.0))
+        F[0::2] = wt * (rt - np.clip(y, -s, s))
+        # at r_n = 0 the threshold's derivative is taken as 1 where the normal is closed: the step is about
+        # to load the contact, and the limit μ r_n must follow it (else a closing contact's tangential
+        # row says r_t = 0 and the finite-difference check of the step fails there)
+        return F, (closed, stick, np.sign(y), (rn > 0.0) | ((rn == 0.0) & closed))
+
+    def jacobian(self, state, lam: float):
+        """The Newton matrix for F'(r) + λ D in the form ``self.form`` (module doc), with what ``direction``
+        needs to recover dr: (matrix CSC, per-contact 2×2 B⁻¹ pieces, A)."""
+        closed, stick, sy, loaded = state
+        a = np.empty(self.n)
+        a[1::2] = closed
+        a[0::2] = stick
+        wt, wn = self.wdiag[0::2], self.wdiag[1::2]
+        diag = np.empty(self.n)
+        diag[1::2] = np.where(closed, 0.0, wn)
+        diag[0::2] = np.where(stick, 0.0, wt)
+        diag += lam * self.wdiag
+        tn = np.where(~stick & loaded, -wt * self.mu * sy, 0.0)
+        if self.form == "velocity":
+            # B per contact = [[b_tt, b_tn], [0, b_nn]] (upper triangular): dr = B⁻¹(−F − A H dv), and
+            # M dv = Hᵀ dr gives (M + Hᵀ B⁻¹A H) dv = −Hᵀ B⁻¹ F
+            btt, bnn = diag[0::2], diag[1::2]
+            an = a[1::2]
+            g_diag = a / diag
+            g_tn = -tn * an / (btt * bnn)
+            c = self.n // 2
+            G = sp.csr_matrix(
+                (np.concatenate([g_diag, g_tn]), (self.b_rows, self.b_cols)),
+                shape=(self.n, self.n),
+            )
+            K = (sp.diags(self.md) + self.Hd.T @ G @ self.Hd).tocsc()
+            return K, (btt, bnn, tn, c), a
+        B = sp.csr_matrix((np.concatenate([diag, tn]), (self.b_rows, self.b_cols)), shape=(self.n, self.n))
+        if self.form == "schur":
+            return (sp.diags(a) @ self.W + B).tocsc(), None, a
+        return sp.bmat([[sp.diags(self.md), -self.Hd.T], [sp.diags(a) @ self.Hd, B]], format="csc"), None, a
+
+    def binv(self, bpieces, x: np.ndarray) -> np.ndarray:
+        """B⁻¹ x for the per-contact upper-triangular B."""
+        btt, bnn, tn, _ = bpieces
+        out = np.empty_like(x)
+        out[1::2] = x[1::2] / bnn
+        out[0::2] = (x[0::2] - tn * out[1::2]) / btt
+        return out
+
+    def direction(self, jac, F) -> np.ndarray:
+        K, bpieces, a = jac
+        if self.form == "velocity":
+            lu = spla.splu(K, permc_spec=PERMC, diag_pivot_thresh=0.0, options={"SymmetricMode": True})
+            dv = lu.solve(-(self.HdT @ self.binv(bpieces, F)))
+            return self.binv(bpieces, -F - a * (self.Hd @ dv))
+        lu = spla.splu(K)
+        if self.form == "schur":
+            return lu.solve(-F)
+        rhs = np.concatenate([np.zeros(self.dyn.size), -F])
+        return lu.solve(rhs)[self.dyn.size :]
+
+
+def alart_curnier(
+    ctx,
+    target,
+    pre=0,
+    pre_kind="nlgs-accel",
+    form="velocity",
+    cap=NEWTON_CAP,
+    watchdog=WATCHDOG,
+    lam0=LAMBDA0,
+    lam_min=LAMBDA_MIN,
+    grow_below=0.0,
+    memory=1,
+    smooth=0,
+) -> Outcome:
+    """The method of the module doc from r_warm after ``pre`` engine sweeps of ``pre_kind``."""
+    p = ctx.p
+    clock = Clock()
+    with clock("setup"):
+        res = Residual(ctx, form)
+    r = p.r_warm.copy()
+    sweeps = 0
+    if pre:
+        with clock("pre-sweeps"):
+            ctx.sweep(r, pre, pre_kind)
+        sweeps += pre
+    flat = r.ravel().copy()
+    lam = lam0
+    recent: list[float] = []
+    newton = rejected = 0
+    ok = False
+    stats = {"alpha": [], "law": [], "merit": [], "lambda": []}
+    while True:
+        with clock("check"):
+            v = res.velocity(flat).reshape(-1, 3)
+            law_rms = ctx.residual(v, flat.reshape(-1, 2))
+        stats["law"].append(law_rms)
+        if law_rms <= target:
+            ok = True
+            break
+        if newton >= cap:
+            break
+        with clock("assemble"):
+            F, state = res.evaluate(flat)
+            f0 = 0.5 * float(F @ F)
+            recent = (recent + [f0])[-memory:]  # nonmonotone (Grippo–Lampariello–Lucidi) for memory > 1
+            J = res.jacobian(state, lam)
+        with clock("factor+solve"):
+            dr = res.direction(J, F)
+        newton += 1
+        alpha = 1.0
+        accepted = False
+        with clock("line search"):
+            while alpha >= ALPHA_MIN:
+                trial = flat + alpha * dr
+                Ft, _ = res.evaluate(trial)
+                if 0.5 * float(Ft @ Ft) <= max(recent) - 2.0 * SIGMA * alpha * f0:
+                    accepted = True
+                    break
+                alpha *= 0.5
+        stats["alpha"].append(alpha if accepted else 0.0)
+        stats["merit"].append(f0)
+        stats["lambda"].append(lam)
+        if accepted:
+            flat = trial
+            if smooth:  # hybrid: Gauss–Seidel repairs the local kinks the step crossed
+                r = flat.reshape(-1, 2).copy()
+                with clock("smoothing sweeps"):
+                    ctx.sweep(r, smooth)
+                sweeps += smooth
+                flat = r.ravel().copy()
+                recent = []
+            if alpha == 1.0:
+                lam = max(lam / 4.0, lam_min)
+            elif alpha < grow_below:  # a short step: the model is poor, shift more (LM trust-region rule)
+                lam = min(4.0 * lam, LAMBDA_MAX)
+        else:
+            rejected += 1
+            lam = min(10.0 * lam, LAMBDA_MAX)
+            recent = []
+            if watchdog:
+                r = flat.reshape(-1, 2).copy()
+                with clock("watchdog sweeps"):
+                    ctx.sweep(r, watchdog)
+                sweeps += watchdog
+                flat = r.ravel().copy()
+    r = flat.reshape(-1, 2)
+    v = res.velocity(flat).reshape(-1, 3)
+    out = Outcome(v, r, newton, float(sweeps), clock.phases, converged=ok)
+    out.rejected, out.engine_sweeps, out.stats = rejected, sweeps, stats
+    return out
+
+
+def newton_step_ms(ctx, repeat: int = 3, form: str = "velocity") -> dict:
+    """CPU ms of one Newton step (assembly; splu + solve) from the warm start, minimum of ``repeat``; the
+    matrix's size and nonzeros."""
+    res = Residual(ctx, form)
+    flat = ctx.p.r_warm.ravel().copy()
+    best = {"assemble": np.inf, "factor+solve": np.inf}
+    for _ in range(repeat):
+        t = time.process_time()
+        F, state = res.evaluate(flat)
+        jac = res.jacobian(state, LAMBDA0)
+        t1 = time.process_time()
+        res.direction(jac, F)
+        t2 = time.process_time()
+        best["assemble"] = min(best["assemble"], 1e3 * (t1 - t))
+        best["factor+solve"] = min(best["factor+solve"], 1e3 * (t2 - t1))
+    best["size"], best["nnz"] = jac[0].shape[0], jac[0].nnz
+    return best
+
+
+METHODS = {
+    "ac": alart_curnier,
+    "ac-s20": lambda ctx, target: alart_curnier(ctx, target, pre=20, pre_kind="nlgs"),
+    "ac-m500": lambda ctx, target: alart_curnier(ctx, target, pre=500),
+    "ac-saddle": lambda ctx, target: alart_curnier(ctx, target, form="saddle"),
+    "ac-schur": lambda ctx, target: alart_curnier(ctx, target, form="schur"),
+}
+
+
+if __name__ == "__main__":
+    # python -m benchmarks.solver_lab.methods.alart_curnier PROBLEM …: one Newton step's cost, both forms
+    from benchmarks.solver_lab.harness import sweep_seconds
+    from benchmarks.solver_lab.outcome import Context
+    from benchmarks.solver_lab.problems import load_all
+
+    print("| problem | blocks | contacts | form | size | nnz | assemble ms | factor+solve ms | sweep units |")
+    print("|---|---|---|---|---|---|---|---|---|")
+    for prob in load_all(sys.argv[1:]):
+        ctx = Context(prob)
+        sweep_ms = 1e3 * sweep_seconds(ctx, 3)["nlgs"]
+        for form in ("velocity", "saddle", "schur"):
+            t = newton_step_ms(ctx, 3, form)
+            units = (t["assemble"] + t["factor+solve"]) / sweep_ms
+            print(
+                f"| {prob.name} | {prob.blocks} | {prob.count} | {form} | {t['size']} |"
+                f" {t['nnz']} | {t['assemble']:.1f} | {t['factor+solve']:.1f} | {units:.0f} |",
+                flush=True,
+            )
