@@ -100,16 +100,18 @@ def cold():
     return p
 
 
-def test_newton_matrix_matches_finite_differences_and_a_dense_solve(cold):
+@pytest.mark.parametrize("augmented", [False, True])
+def test_newton_matrix_matches_finite_differences_and_a_dense_solve(cold, augmented):
     ctx = Context(cold)
     rng = np.random.default_rng(3)
     # a point away from the kinks: loaded contacts, a mix of statuses
     r = cold.r_ref.ravel() + rng.normal(scale=0.05, size=2 * cold.count) * np.abs(cold.r_ref.ravel()).max()
     lam = 1e-3
-    res = A.Residual(ctx, "schur")
+    res = A.Residual(ctx, "schur", augmented)
     F, state = res.evaluate(r)
-    closed, stick, _, loaded = state
-    assert closed.any() and (~closed).any() and stick.any() and (~stick & closed).any()
+    a, _, _, btn = state
+    closed, stick, slide = a[1::2] > 0, a[0::2] > 0, btn != 0
+    assert closed.any() and (~closed).any() and stick.any() and slide.any()
     J_fd = np.empty((r.size, r.size))
     h = 1e-7 * np.abs(r).max()
     for j in range(r.size):
@@ -120,7 +122,7 @@ def test_newton_matrix_matches_finite_differences_and_a_dense_solve(cold):
     np.testing.assert_allclose(J, J_fd, atol=1e-6 * np.abs(J_fd).max())
     dr_dense = np.linalg.solve(J_fd + lam * np.diag(res.wdiag), -F)
     for form in ("velocity", "saddle", "schur"):
-        other = A.Residual(ctx, form)
+        other = A.Residual(ctx, form, augmented)
         dr = other.direction(other.jacobian(state, lam), F)
         np.testing.assert_allclose(dr, dr_dense, atol=1e-6 * np.abs(dr_dense).max(), err_msg=form)
 

@@ -70,9 +70,9 @@ class Residual:
     """F(r) and its generalised Jacobian for one problem (built once: H restricted to moving bodies, sparse
     W = H M⁻¹ Hᵀ, W_αα, bias)."""
 
-    def __init__(self, ctx, form: str = "velocity"):
+    def __init__(self, ctx, form: str = "velocity", augmented: bool = False):
         p, pack = ctx.p, ctx.pack
-        self.ctx, self.form = ctx, form
+        self.ctx, self.form, self.augmented = ctx, form, augmented
         self.minv = ctx.minv
         self.HT = ctx.H.T.tocsr()
         self.dyn = np.flatnonzero(ctx.minv > 0)
@@ -96,70 +96,77 @@ class Residual:
         return self.vfree + self.minv * (self.HT @ r)
 
     def evaluate(self, r: np.ndarray):
-        """(F (2C,) m/s, the pieces the Jacobian needs) at flat r."""
+        """(F (2C,) m/s, the Jacobian's pieces) at flat r. Pieces, per contact, of the upper-triangular 2×2
+        blocks A = ∂F/∂u = [[a_t, a_tn], [0, a_n]] and B = ∂F/∂r = [[b_t, b_tn], [0, b_n]]."""
         u = self.ctx.H @ self.velocity(r)
         rt, rn = r[0::2], r[1::2]
         ut, un = u[0::2], u[1::2]
         wt, wn = self.wdiag[0::2], self.wdiag[1::2]
         x = rn - (un + self.bias) / wn
         closed = x > 0.0
-        s = self.mu * np.maximum(rn, 0.0)
+        # threshold: μ r_n⁺ (default) or μ x⁺ (``augmented``, Alart–Curnier's original: 0 once the normal
+        # opens). At r_n = 0 (x = 0) its derivative is taken as 1 where the normal is closed: the step is
+        # about to load the contact, and the limit must follow it
+        base = x if self.augmented else rn
+        s = self.mu * np.maximum(base, 0.0)
+        loaded = (base > 0.0) | ((base == 0.0) & closed)
         y = rt - ut / wt
         stick = np.abs(y) < s
         F = np.empty_like(r)
         F[1::2] = wn * (rn - np.maximum(x, 0.0))
         F[0::2] = wt * (rt - np.clip(y, -s, s))
-        # at r_n = 0 the threshold's derivative is taken as 1 where the normal is closed: the step is about
-        # to load the contact, and the limit μ r_n must follow it (else a closing contact's tangential
-        # row says r_t = 0 and the finite-difference check of the step fails there)
-        return F, (closed, stick, np.sign(y), (rn > 0.0) | ((rn == 0.0) & closed))
-
-    def jacobian(self, state, lam: float):
-        """The Newton matrix for F'(r) + λ D in the form ``self.form`` (module doc), with what ``direction``
-        needs to recover dr: (matrix CSC, per-contact 2×2 B⁻¹ pieces, A)."""
-        closed, stick, sy, loaded = state
+        slide = ~stick & loaded
+        sy = np.sign(y)
         a = np.empty(self.n)
         a[1::2] = closed
         a[0::2] = stick
-        wt, wn = self.wdiag[0::2], self.wdiag[1::2]
-        diag = np.empty(self.n)
-        diag[1::2] = np.where(closed, 0.0, wn)
-        diag[0::2] = np.where(stick, 0.0, wt)
-        diag += lam * self.wdiag
-        tn = np.where(~stick & loaded, -wt * self.mu * sy, 0.0)
-        if self.form == "velocity":
-            # B per contact = [[b_tt, b_tn], [0, b_nn]] (upper triangular): dr = B⁻¹(−F − A H dv), and
-            # M dv = Hᵀ dr gives (M + Hᵀ B⁻¹A H) dv = −Hᵀ B⁻¹ F
-            btt, bnn = diag[0::2], diag[1::2]
-            an = a[1::2]
-            g_diag = a / diag
-            g_tn = -tn * an / (btt * bnn)
-            c = self.n // 2
-            G = sp.csr_matrix(
-                (np.concatenate([g_diag, g_tn]), (self.b_rows, self.b_cols)),
-                shape=(self.n, self.n),
-            )
-            K = (sp.diags(self.md) + self.Hd.T @ G @ self.Hd).tocsc()
-            return K, (btt, bnn, tn, c), a
-        B = sp.csr_matrix((np.concatenate([diag, tn]), (self.b_rows, self.b_cols)), shape=(self.n, self.n))
-        if self.form == "schur":
-            return (sp.diags(a) @ self.W + B).tocsc(), None, a
-        return sp.bmat([[sp.diags(self.md), -self.Hd.T], [sp.diags(a) @ self.Hd, B]], format="csc"), None, a
+        b = np.empty(self.n)
+        b[1::2] = np.where(closed, 0.0, wn)
+        b[0::2] = np.where(stick, 0.0, wt)
+        btn = np.where(slide, -wt * self.mu * sy, 0.0)  # ∂F_t/∂r_n through s
+        # augmented: s also depends on u_n (∂x/∂u_n = −1/W_nn)
+        atn = np.where(slide, wt / wn * self.mu * sy, 0.0) if self.augmented else np.zeros_like(btn)
+        return F, (a, atn, b, btn)
 
-    def binv(self, bpieces, x: np.ndarray) -> np.ndarray:
-        """B⁻¹ x for the per-contact upper-triangular B."""
-        btt, bnn, tn, _ = bpieces
+    def _blocks(self, diag, tn) -> sp.csr_matrix:
+        return sp.csr_matrix((np.concatenate([diag, tn]), (self.b_rows, self.b_cols)), shape=(self.n, self.n))
+
+    def jacobian(self, state, lam: float):
+        """The Newton matrix for F'(r) + λ D in the form ``self.form`` (module doc), and the pieces
+        ``direction`` needs to recover dr."""
+        a, atn, b, btn = state
+        b = b + lam * self.wdiag
+        if self.form == "velocity":
+            # per contact B is upper triangular: dr = B⁻¹(−F − A H dv), and M dv = Hᵀ dr gives
+            # (M + Hᵀ B⁻¹A H) dv = −Hᵀ B⁻¹ F;  B⁻¹A = [[a_t/b_t, a_tn/b_t − b_tn a_n/(b_t b_n)], [0, a_n/b_n]]
+            bt, bn = b[0::2], b[1::2]
+            g_tn = atn / bt - btn * a[1::2] / (bt * bn)
+            G = self._blocks(a / b, g_tn)
+            K = (sp.diags(self.md) + self.HdT @ G @ self.Hd).tocsc()
+            return K, (b, btn, a, atn)
+        A, B = self._blocks(a, atn), self._blocks(b, btn)
+        if self.form == "schur":
+            return (A @ self.W + B).tocsc(), None
+        return sp.bmat([[sp.diags(self.md), -self.HdT], [A @ self.Hd, B]], format="csc"), None
+
+    @staticmethod
+    def _upper_solve(b, btn, x: np.ndarray) -> np.ndarray:
+        """B⁻¹ x for the per-contact upper-triangular B (diagonal b, (t, n) entry btn)."""
         out = np.empty_like(x)
-        out[1::2] = x[1::2] / bnn
-        out[0::2] = (x[0::2] - tn * out[1::2]) / btt
+        out[1::2] = x[1::2] / b[1::2]
+        out[0::2] = (x[0::2] - btn * out[1::2]) / b[0::2]
         return out
 
     def direction(self, jac, F) -> np.ndarray:
-        K, bpieces, a = jac
+        K, pieces = jac
         if self.form == "velocity":
+            b, btn, a, atn = pieces
             lu = spla.splu(K, permc_spec=PERMC, diag_pivot_thresh=0.0, options={"SymmetricMode": True})
-            dv = lu.solve(-(self.HdT @ self.binv(bpieces, F)))
-            return self.binv(bpieces, -F - a * (self.Hd @ dv))
+            dv = lu.solve(-(self.HdT @ self._upper_solve(b, btn, F)))
+            hdv = self.Hd @ dv
+            ahdv = a * hdv
+            ahdv[0::2] += atn * hdv[1::2]
+            return self._upper_solve(b, btn, -F - ahdv)
         lu = spla.splu(K)
         if self.form == "schur":
             return lu.solve(-F)
@@ -180,12 +187,13 @@ def alart_curnier(
     grow_below=0.0,
     memory=1,
     smooth=0,
+    augmented=False,
 ) -> Outcome:
     """The method of the module doc from r_warm after ``pre`` engine sweeps of ``pre_kind``."""
     p = ctx.p
     clock = Clock()
     with clock("setup"):
-        res = Residual(ctx, form)
+        res = Residual(ctx, form, augmented)
     r = p.r_warm.copy()
     sweeps = 0
     if pre:
@@ -282,6 +290,8 @@ METHODS = {
     "ac": alart_curnier,
     "ac-s20": lambda ctx, target: alart_curnier(ctx, target, pre=20, pre_kind="nlgs"),
     "ac-m500": lambda ctx, target: alart_curnier(ctx, target, pre=500),
+    "ac-aug": lambda ctx, target: alart_curnier(ctx, target, augmented=True),
+    "ac-aug-m500": lambda ctx, target: alart_curnier(ctx, target, pre=500, augmented=True),
     "ac-saddle": lambda ctx, target: alart_curnier(ctx, target, form="saddle"),
     "ac-schur": lambda ctx, target: alart_curnier(ctx, target, form="schur"),
 }
