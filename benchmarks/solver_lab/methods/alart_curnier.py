@@ -1,33 +1,38 @@
-"""Globalised Alart–Curnier semismooth Newton on the full Signorini–Coulomb law: ``ac``, ``ac-m500`` …
+"""Globalised Alart–Curnier semismooth Newton on the full Signorini–Coulomb law: ``ac``, ``ac-gs10`` …
 
 Unknowns: the impulses r (2C: (r_t, r_n) per contact); v(r) = v_free + M⁻¹ Hᵀ r, u = H v(r). Per contact,
 with ρ = 1/W_αα (per component: ρ_t = 1/W_tt, ρ_n = 1/W_nn) and the Signorini bias b,
 
     Φ_n = r_n − max(0, r_n − ρ_n (u_n + b))                      (Signorini: r_n ≥ 0 ⊥ u_n + b ≥ 0)
-    Φ_t = r_t − proj_[−s, s](r_t − ρ_t u_t),   s = μ max(r_n, 0)  (Coulomb, threshold from r_n itself)
+    Φ_t = r_t − proj_[−s, s](r_t − ρ_t u_t),   s = μ max(r_n, 0)  (Coulomb; ``augmented``: s = μ max(x, 0),
+                                                                    x = r_n − ρ_n (u_n + b), AC's original)
 
 Φ = 0 exactly on the lab's contact law (law.py); unlike ``tnnmg`` the threshold s is linearised too. The
 residual is used in velocity units, F = W_αα Φ (m/s per component), so ½|F|² weighs contacts like the
-lab's law residual. Generalised Jacobian F' = A H M⁻¹ Hᵀ + B with, per contact (W = W_αα diagonal entry):
+lab's law residual. Generalised Jacobian F' = A H M⁻¹ Hᵀ + B, A = ∂F/∂u and B = ∂F/∂r upper-triangular
+2×2 per contact (W = the W_αα diagonal entry):
 
-    normal closed (r_n − ρ_n(u_n + b) > 0):   ∂F_n/∂u_n = 1        else ∂F_n/∂r_n = W_nn
-    tangent stick (|r_t − ρ_t u_t| < s):      ∂F_t/∂u_t = 1        else ∂F_t/∂r_t = W_tt,
-                                              ∂F_t/∂r_n = −W_tt μ sign(r_t − ρ_t u_t)  (if r_n > 0)
+    normal closed (x > 0):                ∂F_n/∂u_n = 1        else ∂F_n/∂r_n = W_nn
+    tangent stick (|r_t − ρ_t u_t| < s):  ∂F_t/∂u_t = 1        else ∂F_t/∂r_t = W_tt and, through s,
+                                          ∂F_t/∂r_n = −W_tt μ σ  (augmented: also ∂F_t/∂u_n = W_tt/W_nn μ σ),
+                                          σ = sign(r_t − ρ_t u_t)
 
-W = H M⁻¹ Hᵀ is singular on a hyperstatic wall (impulses not unique), so the step is a Levenberg–Marquardt
-shifted one: B + λ diag(W_αα). Newton system, either the sparse saddle point in (dv, dr) over the moving
-bodies' velocities (``schur=False``), or its Schur complement on dr with the sparse W formed once per
-problem (``schur=True``, the default: measured faster, module end):
+W = H M⁻¹ Hᵀ is singular on a hyperstatic wall (impulses not unique), so the step is Levenberg–Marquardt
+shifted: B + λ D, D = diag(W_αα). Three equivalent forms of the Newton system (tested equal): the sparse
+saddle point in (dv, dr) over the moving bodies ("saddle"), its Schur complement on dr with the sparse W
+formed once ("schur"), and — the default, 5–10× cheaper — dr eliminated (B + λD is invertible, 2×2 per
+contact), leaving the 3B_dyn velocity system ("velocity"):
 
-    [ M      −Hᵀ       ] [dv]   [ 0 ]            (A W + B + λ D) dr = −F
-    [ A H   B + λ D    ] [dr] = [−F ]
+    (M + Hᵀ (B + λD)⁻¹ A H) dv = −Hᵀ (B + λD)⁻¹ F,    dr = (B + λD)⁻¹ (−F − A H dv)
 
 One run (pseudo-code):
 
     r = r_warm;  PRE engine sweeps of kind KIND (0: plain warm start; 500 momentum: the stalled iterate)
     λ = LAMBDA0
     loop:  if lab law residual RMS(v(r), r) ≤ target: done
-           J = F'(r) + λ D;  dr = −J⁻¹ F(r)             (one splu)
+           [polish_every = K: every K Newton steps, plain engine sweeps from a COPY of r, in chunks 20, 40,
+            … up to POLISH_CAP · 2^min(polishes before, 2) sweeps: if they reach the target, done with their r]
+           dr = −(F'(r) + λ D)⁻¹ F(r)                    (one splu of the velocity system)
            α = 1, ½, ¼ … ≥ ALPHA_MIN: accept the first with ½|F(r + α dr)|² ≤ (1 − 2σα) ½|F(r)|²  (Armijo)
            accepted:  r += α dr;  λ = max(λ / 4, LAMBDA_MIN) if α = 1 else λ
            rejected:  λ = min(10 λ, LAMBDA_MAX);  WATCHDOG engine sweeps from r (nonmonotone: the merit
@@ -35,9 +40,12 @@ One run (pseudo-code):
            cap NEWTON_CAP Newton steps
 
 Iterations: Newton steps (factorisations). Sweep units: the harness's (all CPU time over one engine
-sweep's), numpy/scipy included; phases split pre-sweeps, watchdog sweeps, law checks, assembly, factor,
-solve and line search. ``newton_step_ms`` times one step (assembly + splu + solve) alone for the README's
-"what an engine version would cost". Measured outcome: benchmarks/README.md, "Alart–Curnier".
+sweep's), numpy/scipy included; phases split pre-sweeps, polish and watchdog sweeps, law checks, assembly,
+factor+solve and line search. ``python -m benchmarks.solver_lab.methods.alart_curnier PROBLEM …`` times one
+Newton step (assembly; splu + solve) in the three forms. Options tried and kept for the record (README):
+``grow_below`` (λ × 4 after a step shorter than that), ``memory`` (nonmonotone Armijo over the last merits),
+``smooth`` (engine sweeps after every accepted step). Measured outcome: benchmarks/README.md,
+"Alart–Curnier".
 """
 
 from __future__ import annotations
@@ -61,7 +69,9 @@ WATCHDOG = 20
 """Engine sweeps after a rejected Newton step."""
 NEWTON_CAP = 100
 POLISH_CAP = 1260
-"""Plain sweeps the first polish may take (20 + 40 + … + 640); doubled at each further polish."""
+"""Plain sweeps the first polish may take (20 + 40 + … + 640); doubled at each further polish, at most
+POLISH_DOUBLINGS times (unbounded doubling cost aqueduct-shaken-hard 321 000 polish sweeps in 8 polishes)."""
+POLISH_DOUBLINGS = 2
 PERMC = "MMD_AT_PLUS_A"
 """splu ordering of the velocity-space matrix, symmetric mode without pivoting (the matrix is nearly
 symmetric, only sliding rows break the symmetry): 12.8 ms and 1.9e5 factor nonzeros on wall-64-hard
@@ -222,7 +232,7 @@ def alart_curnier(
             break
         if polish_every and newton and newton % polish_every == 0:
             with clock("polish sweeps"):
-                r, done, hit = _polish(ctx, flat, target, polish_cap << len(stats["polish"]))
+                r, done, hit = _polish(ctx, flat, target, polish_cap << min(len(stats["polish"]), POLISH_DOUBLINGS))
             sweeps += done
             stats["polish"].append(done)
             if hit:
