@@ -331,6 +331,8 @@ METHODS = {
     "ac-gs5": lambda ctx, target: alart_curnier(ctx, target, polish_every=5),
     "ac-gs10": lambda ctx, target: alart_curnier(ctx, target, polish_every=10),
     "ac-aug-gs10": lambda ctx, target: alart_curnier(ctx, target, polish_every=10, augmented=True),
+    "ac-l3": lambda ctx, target: alart_curnier(ctx, target, lam_min=LAMBDA0),
+    "ac-aug-l3": lambda ctx, target: alart_curnier(ctx, target, lam_min=LAMBDA0, augmented=True),
     "ac-aug": lambda ctx, target: alart_curnier(ctx, target, augmented=True),
     "ac-aug-m500": lambda ctx, target: alart_curnier(ctx, target, pre=500, augmented=True),
     "ac-saddle": lambda ctx, target: alart_curnier(ctx, target, form="saddle"),
