@@ -44,8 +44,8 @@ sweep's), numpy/scipy included; phases split pre-sweeps, polish and watchdog swe
 factor+solve and line search. ``python -m benchmarks.solver_lab.methods.alart_curnier PROBLEM …`` times one
 Newton step (assembly; splu + solve) in the three forms. Options tried and kept for the record (README):
 ``grow_below`` (λ × 4 after a step shorter than that), ``memory`` (nonmonotone Armijo over the last merits),
-``smooth`` (engine sweeps after every accepted step). Measured outcome: benchmarks/README.md,
-"Alart–Curnier".
+``smooth`` (engine sweeps after every accepted step). ``lam_min`` = LAMBDA0 (``ac-l3``, ``ac-aug-l3``) holds the shift at 1e-3: fewer, longer steps (the best
+pure-Newton variant with ``augmented``). Measured outcome: benchmarks/README.md, "Alart–Curnier".
 """
 
 from __future__ import annotations
