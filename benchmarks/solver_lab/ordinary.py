@@ -46,11 +46,11 @@ from __future__ import annotations
 
 import time
 
-import numba
 import numpy as np
 
 from benchmarks.solver_lab.trajectory import TRAJECTORY
 from masonrycli.engine import nlgs
+from masonrycli.engine._jit import njit
 from masonrycli.engine.nlgs import P_WNN, P_WTN, P_WTT, _local_solve, _push, _relative_velocity
 
 TOLERANCE = 1e-5
@@ -92,7 +92,7 @@ by the higher body of the pair first (by-b: a block's contacts with the blocks b
 VARIANTS |= {f"order-{o}": {"order": o} for o in ORDERS[1:]}
 
 
-@numba.njit(cache=False)
+@njit(cache=False)  # the engine's flags (masonrycli/engine/_jit.py); not cached: a lab copy
 def _accelerated(
     body,
     pack,
