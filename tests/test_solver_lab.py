@@ -183,14 +183,9 @@ def test_accelerated_variants_differ_only_by_restart_growth(tmp_path):
     # less often it does not (the change really reached the compiled kernel).
     from benchmarks.solver_lab.methods import accelerated
     from masonrycli.engine import momentum
+    from tests.solver_lab_helpers import tiny_cold_problem
 
-    sc = scenario_from_builder(
-        "wall", {"blocks": 7, "courses": 2}, RunConfig(duration=0.002), Material(), {"ground": SINE}
-    )
-    p = capture_run(Simulation(sc), typical_step=1)[0]["cold"]
-    p.name = "tiny-cold"
-    reference(p)
-    ctx = Context(p)
+    ctx = Context(tiny_cold_problem())
     ctx.accel_cost = 1.0
     base = accelerated.accelerated(ctx, 1e-7)
     same = accelerated.variant(momentum.RESTART_GROWTH)(ctx, 1e-7)

@@ -12,12 +12,10 @@ import pytest
 import scipy.sparse as sp
 
 from benchmarks.solver_lab import law
-from benchmarks.solver_lab.capture import SINE, capture_run, reference
 from benchmarks.solver_lab.methods import alart_curnier as A
 from benchmarks.solver_lab.outcome import Context
 from masonrycli.engine import nlgs as N
-from masonrycli.run import Simulation
-from masonrycli.scenario import Material, RunConfig, scenario_from_builder
+from tests.solver_lab_helpers import tiny_cold_problem
 
 G, DT, MASS, WIDTH, HEIGHT, MU = 9.81, 1e-3, 2.0, 0.4, 0.2, 0.6
 
@@ -90,14 +88,7 @@ def test_phi_vanishes_on_an_open_contact():
 
 @pytest.fixture(scope="module")
 def cold():
-    sc = scenario_from_builder(
-        "wall", {"blocks": 7, "courses": 2}, RunConfig(duration=0.002), Material(), {"ground": SINE}
-    )
-    p = capture_run(Simulation(sc), typical_step=1)[0]["cold"]
-    p.name = "tiny-cold"
-    reference(p)
-    assert p.ref_residual <= 1e-9
-    return p
+    return tiny_cold_problem()
 
 
 @pytest.mark.parametrize("augmented", [False, True])

@@ -10,24 +10,15 @@ import numpy as np
 import pytest
 
 from benchmarks.solver_lab import law
-from benchmarks.solver_lab.capture import SINE, capture_run, reference
 from benchmarks.solver_lab.methods import tnnmg as T
 from benchmarks.solver_lab.outcome import Clock, Context
 from masonrycli.engine import nlgs as N
-from masonrycli.run import Simulation
-from masonrycli.scenario import Material, RunConfig, scenario_from_builder
+from tests.solver_lab_helpers import tiny_cold_problem
 
 
 @pytest.fixture(scope="module")
 def cold():
-    sc = scenario_from_builder(
-        "wall", {"blocks": 7, "courses": 2}, RunConfig(duration=0.002), Material(), {"ground": SINE}
-    )
-    p = capture_run(Simulation(sc), typical_step=1)[0]["cold"]
-    p.name = "tiny-cold"
-    reference(p)
-    assert p.ref_residual <= 1e-9
-    return p
+    return tiny_cold_problem()
 
 
 def _dense(ctx):
