@@ -1,4 +1,4 @@
-"""Solver lab: ``python -m benchmarks.solver_lab capture|table|clusters|stalled|trajectory|ordinary|ordinary-runs``
+"""Solver lab: ``python -m benchmarks.solver_lab capture|table|clusters|stalled|trajectory|ordinary|ordinary-runs|ensemble``
 (see benchmarks/README.md, "Solver lab")."""
 
 from __future__ import annotations
@@ -13,6 +13,7 @@ os.environ.setdefault("RERUN_ANALYTICS", "0")
 
 
 def main() -> None:
+    from benchmarks.solver_lab import ensemble
     from benchmarks.solver_lab.capture import CASES
     from masonrycli.scenario import SOLVERS
 
@@ -47,7 +48,11 @@ def main() -> None:
     orr.add_argument("--cases", nargs="+", default=["wall-248"])
     orr.add_argument("--variants", nargs="+", default=None)
     orr.add_argument("--duration", type=float, default=1.0)
+    ensemble.add_arguments(sub)
     args = ap.parse_args()
+    if args.command == "ensemble":
+        ensemble.main(args)
+        return
     if args.command == "ordinary-runs":
         from benchmarks.solver_lab.ordinary_runs import table as runs_table
 
