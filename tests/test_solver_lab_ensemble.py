@@ -29,20 +29,22 @@ def _doc(runs):
 
 def test_run_writes_per_run_figures_keyed_by_motion(tmp_path):
     out = tmp_path / "a.json"
-    ensemble.run(["h8"], [(1.0, 2.0, 0.0), (0.8, 2.5, 0.0)], 0.004, out, jitter=1e-3)
+    ensemble.run(["h8"], [(1.0, 2.0, 0.0), (0.8, 2.5, 0.0)], 0.004, out, jitter=1e-3, copies=range(2))
     doc = json.loads(out.read_text())
     assert doc["engine"]["path"] and doc["duration"] == 0.004
     runs = doc["runs"]
-    assert [(r["case"], r["amplitude"], r["frequency"], r["phase"]) for r in runs] == [
-        ("h8", 1.0, 2.0, 0.0),
-        ("h8", 0.8, 2.5, 0.0),
+    assert [(r["case"], r["amplitude"], r["frequency"], r["phase"], r["copy"]) for r in runs] == [
+        ("h8", 1.0, 2.0, 0.0, 0),
+        ("h8", 1.0, 2.0, 0.0, 1),
+        ("h8", 0.8, 2.5, 0.0, 0),
+        ("h8", 0.8, 2.5, 0.0, 1),
     ]  # the nominal motion, not the jittered one: the key compare pairs by
     for r in runs:
         assert r["steps"] == 4 == len(r["units"]) and r["jitter"] == 1e-3
         assert r["total"] == sum(r["units"]) and r["max"] == max(r["units"]) and r["mean"] == r["total"] / 4
         assert r["unconverged"] == 0 and r["cpu_s"] >= 0.0 and not r["diverged"]
     same = ensemble.compare(out, out)["h8"]
-    assert same["geomean"] == 1.0 and same["equal"] == 2 and same["interval90"] == (1.0, 1.0)
+    assert same["geomean"] == 1.0 and same["equal"] == 4 and same["interval90"] == (1.0, 1.0)
 
 
 def test_compare_figures_by_hand(tmp_path):
@@ -58,18 +60,22 @@ def test_compare_figures_by_hand(tmp_path):
         [_run("w", 1.2, 800.0, cpu=1.0), _run("w", 1.0, 50.0, unconverged=1), _run("w", 1.1, 200.0)]
         + [_run("v", 1.0, 40.0), _run("v", 1.0, 32.0, frequency=1.5)]
     )
-    pa, pb = tmp_path / "a.json", tmp_path / "b.json"
-    pa.write_text(json.dumps(a))
+    pa, pa2, pb = tmp_path / "a.json", tmp_path / "a2.json", tmp_path / "b.json"
+    pa.write_text(json.dumps(_doc(a["runs"][:2])))  # A in two files, pooled by compare
+    pa2.write_text(json.dumps(_doc(a["runs"][2:])))
     pb.write_text(json.dumps(b))
-    out = ensemble.compare(pa, pb)
+    out = ensemble.compare(f"{pa},{pa2}", pb)
     w, v = out["w"], out["v"]
     assert w["runs"] == 3 and w["geomean"] == pytest.approx(1.0) and w["median"] == 1.0
     assert (w["min"], w["max"], w["better"], w["worse"], w["equal"]) == (0.5, 2.0, 1, 1, 1)
     assert w["interval90"] == pytest.approx((2 ** (-2 / 3), 2 ** (2 / 3)))
     assert w["total_ratio"] == pytest.approx(1.5) and w["unconverged"] == (2, 1)
+    lo, hi = w["total_interval90"]  # sums of resampled runs: between the smallest and largest run ratio
+    assert 0.5 <= lo < 1.5 < hi <= 2.0
     assert w["cpu_ratio"] == pytest.approx(3.0 / 5.0)
     assert v["runs"] == 2 and v["geomean"] == pytest.approx(0.8) and v["interval90"] == pytest.approx((0.8, 0.8))
     assert v["better"] == 2 and math.isclose(v["total_ratio"], 0.8)
+    assert v["total_interval90"] == pytest.approx((0.8, 0.8))
 
 
 def test_motion_text():

@@ -48,6 +48,9 @@ MOTIONS = tuple((a, f, 0.0) for a in AMPLITUDES for f in FREQUENCIES)
 """(amplitude m/s, frequency Hz, phase rad): 12 motions around the paper's (1 m/s, 2 Hz), peak ground
 accelerations 0.93–1.92 g, all above μ g = 0.6 g so every wall slides on its base. Phase 0: the ground
 starts at rest as in the paper (a phase would start it with a velocity jump)."""
+COPY_STEP = 1e-6
+"""Copy k of a motion has its amplitude × (1 + k · COPY_STEP): another trajectory of the same motion (a
+change of 1e-6 moves a wall's run as much as any change of the solver's path does)."""
 BOOTSTRAP, SEED = 10_000, 0
 
 
@@ -80,8 +83,8 @@ def engine_commit() -> dict:
     }
 
 
-def run_one(case: str, motion: tuple[float, float, float], duration: float, jitter: float = 0.0) -> dict:
-    """One unrecorded run of ``case`` shaken by ``motion`` (amplitude × (1 + jitter)); per-run figures."""
+def run_one(case: str, motion: tuple[float, float, float], duration: float, jitter: float = 0.0, copy: int = 0) -> dict:
+    """One unrecorded run of ``case`` shaken by ``motion``, amplitude × (1 + jitter + copy · COPY_STEP)."""
     from benchmarks.solver_cases import CASES
     from masonrycli.motion import Sine
     from masonrycli.run import Simulation
@@ -91,7 +94,7 @@ def run_one(case: str, motion: tuple[float, float, float], duration: float, jitt
     if list(motions) != ["ground"]:
         raise ValueError(f"{case}: not a case shaken by its ground")
     amplitude, frequency, phase = motion
-    ground = Sine(amplitude=amplitude * (1.0 + jitter), frequency=frequency, phase=phase)
+    ground = Sine(amplitude=amplitude * (1.0 + jitter + copy * COPY_STEP), frequency=frequency, phase=phase)
     scenario = scenario_from_builder(builder, options, RunConfig(duration=duration), Material(), {"ground": ground})
     sim = Simulation(scenario)
     units = []
@@ -109,6 +112,7 @@ def run_one(case: str, motion: tuple[float, float, float], duration: float, jitt
         "phase": phase,
         "duration": duration,
         "jitter": jitter,
+        "copy": copy,
         "steps": int(u.size),
         "mean": float(u.mean()),
         "max": int(u.max()),
@@ -120,7 +124,9 @@ def run_one(case: str, motion: tuple[float, float, float], duration: float, jitt
     }
 
 
-def run(cases: list[str], motions, duration: float, out: Path | None, jitter: float = 0.0) -> dict:
+def run(
+    cases: list[str], motions, duration: float, out: Path | None, jitter: float = 0.0, copies: range = range(1)
+) -> dict:
     """Run every case under every motion; print a line a run and each case's spread; write ``out``."""
     from benchmarks.solver_cases import make_scenario
     from masonrycli.run import simulate
@@ -131,15 +137,16 @@ def run(cases: list[str], motions, duration: float, out: Path | None, jitter: fl
     print(f"engine {engine['commit'][:10]}{dirty} at {engine['path']}; {duration:g} s a run", flush=True)
     runs = []
     for case in cases:
-        print(f"\n{case}\n| A m/s | f Hz | φ | mean units | max | unconverged | CPU s |\n|---|---|---|---|---|---|---|")
+        print(f"\n{case}\n| A m/s | f Hz | φ | copy | mean units | max | unconverged | CPU s |\n" + "|---" * 8 + "|")
         for motion in motions:
-            r = run_one(case, motion, duration, jitter)
-            runs.append(r)
-            print(
-                f"| {r['amplitude']:g} | {r['frequency']:g} | {r['phase']:g} | {r['mean']:.0f} | {r['max']} |"
-                f" {r['unconverged']} | {r['cpu_s']:.1f} |",
-                flush=True,
-            )
+            for copy in copies:
+                r = run_one(case, motion, duration, jitter, copy)
+                runs.append(r)
+                print(
+                    f"| {r['amplitude']:g} | {r['frequency']:g} | {r['phase']:g} | {copy} | {r['mean']:.0f} | {r['max']} |"
+                    f" {r['unconverged']} | {r['cpu_s']:.1f} |",
+                    flush=True,
+                )
         print(spread_line([r["mean"] for r in runs if r["case"] == case]))
     doc = {"engine": engine, "duration": duration, "jitter": jitter, "runs": runs}
     if out is not None:
@@ -159,7 +166,7 @@ def spread_line(means: list[float]) -> str:
 
 
 def _key(r: dict) -> tuple:
-    return (r["case"], r["amplitude"], r["frequency"], r["phase"], r["duration"])
+    return (r["case"], r["amplitude"], r["frequency"], r["phase"], r["duration"], r.get("copy", 0))
 
 
 def pair_runs(a: dict, b: dict) -> dict[str, list[tuple[dict, dict]]]:
@@ -175,10 +182,12 @@ def pair_runs(a: dict, b: dict) -> dict[str, list[tuple[dict, dict]]]:
 def summarise(pairs: list[tuple[dict, dict]], resamples: int = BOOTSTRAP, seed: int = SEED) -> dict:
     """Figures of one case's pairs: ratio B/A of the per-run mean units, and the totals (module doc)."""
     ratio = np.array([rb["mean"] / ra["mean"] for ra, rb in pairs])
+    total_a = np.array([ra["total"] for ra, _ in pairs], dtype=float)
+    total_b = np.array([rb["total"] for _, rb in pairs], dtype=float)
     logs = np.log(ratio)
-    rng = np.random.default_rng(seed)
-    boot = np.exp(logs[rng.integers(0, logs.size, size=(resamples, logs.size))].mean(axis=1))
-    lo, hi = np.percentile(boot, [5.0, 95.0])
+    pick = np.random.default_rng(seed).integers(0, logs.size, size=(resamples, logs.size))  # resampled runs
+    lo, hi = np.percentile(np.exp(logs[pick].mean(axis=1)), [5.0, 95.0])
+    sum_lo, sum_hi = np.percentile(total_b[pick].sum(axis=1) / total_a[pick].sum(axis=1), [5.0, 95.0])
     return {
         "runs": int(ratio.size),
         "geomean": float(math.exp(logs.mean())),
@@ -189,21 +198,31 @@ def summarise(pairs: list[tuple[dict, dict]], resamples: int = BOOTSTRAP, seed: 
         "worse": int((ratio > 1.0).sum()),
         "equal": int((ratio == 1.0).sum()),
         "interval90": (float(lo), float(hi)),
-        "total_ratio": sum(rb["total"] for _, rb in pairs) / sum(ra["total"] for ra, _ in pairs),
+        "total_ratio": float(total_b.sum() / total_a.sum()),
+        "total_interval90": (float(sum_lo), float(sum_hi)),
         "unconverged": (sum(ra["unconverged"] for ra, _ in pairs), sum(rb["unconverged"] for _, rb in pairs)),
         "cpu_ratio": sum(rb["cpu_s"] for _, rb in pairs) / max(sum(ra["cpu_s"] for ra, _ in pairs), 1e-9),
     }
 
 
-def compare(path_a: Path, path_b: Path) -> dict[str, dict]:
+def load(paths: str | Path) -> dict:
+    """The runs of one JSON file, or of several (``"a.json,b.json"``: their runs pooled, engine of the first)."""
+    docs = [json.loads(Path(p).read_text()) for p in str(paths).split(",")]
+    commits = {d["engine"]["commit"] for d in docs}
+    if len(commits) > 1:
+        print(f"warning: {paths} pools the runs of several engines: {sorted(c[:10] for c in commits)}")
+    return {"engine": docs[0]["engine"], "runs": [r for d in docs for r in d["runs"]]}
+
+
+def compare(path_a: str | Path, path_b: str | Path) -> dict[str, dict]:
     """Print the per-case table of B against A; return the figures by case."""
-    a, b = json.loads(Path(path_a).read_text()), json.loads(Path(path_b).read_text())
-    for name, doc in (("A", a), ("B", b)):
+    a, b = load(path_a), load(path_b)
+    for name, doc, path in (("A", a, path_a), ("B", b, path_b)):
         e = doc["engine"]
-        print(f"{name}: {path_a if name == 'A' else path_b}: engine {e['commit'][:10]}{' (dirty)' * e['dirty']}")
+        print(f"{name}: {path}: engine {e['commit'][:10]}{' (dirty)' * e['dirty']}")
     print(
         "\n| case | runs | B/A geo. mean [90 % interval] | median | min – max | better / worse / equal |"
-        " Σ units B/A | unconverged A / B | CPU B/A |\n|---|---|---|---|---|---|---|---|---|"
+        " Σ units B/A [90 %] | unconverged A / B | CPU B/A |\n|---|---|---|---|---|---|---|---|---|"
     )
     out = {}
     for case, pairs in pair_runs(a, b).items():
@@ -212,7 +231,8 @@ def compare(path_a: Path, path_b: Path) -> dict[str, dict]:
         print(
             f"| {case} | {s['runs']} | {s['geomean']:.3f} [{lo:.3f}, {hi:.3f}] | {s['median']:.3f} |"
             f" {s['min']:.3f} – {s['max']:.3f} | {s['better']} / {s['worse']} / {s['equal']} |"
-            f" {s['total_ratio']:.3f} | {s['unconverged'][0]} / {s['unconverged'][1]} | {s['cpu_ratio']:.2f} |"
+            f" {s['total_ratio']:.3f} [{s['total_interval90'][0]:.3f}, {s['total_interval90'][1]:.3f}] |"
+            f" {s['unconverged'][0]} / {s['unconverged'][1]} | {s['cpu_ratio']:.2f} |"
         )
     unpaired = len(a["runs"]) + len(b["runs"]) - 2 * sum(len(p) for p in pair_runs(a, b).values())
     if unpaired:
@@ -229,15 +249,18 @@ def add_arguments(sub) -> None:
     r.add_argument("--duration", type=float, default=DURATION, help="simulated s a run")
     r.add_argument("--motions", nargs="+", type=parse_motion, default=None, metavar="A,F[,PHASE]")
     r.add_argument("--jitter", type=float, default=0.0, help="amplitudes × (1 + EPS), keyed as nominal")
+    r.add_argument("--copies", type=int, default=1, help="runs a motion, amplitude × (1 + k·1e-6), k = 0 …")
+    r.add_argument("--first-copy", type=int, default=0, help="k of the first copy (to extend an ensemble)")
     r.add_argument("--out", type=Path, default=None)
     c = act.add_parser("compare", help="B against A, runs paired by motion")
-    c.add_argument("a", type=Path)
-    c.add_argument("b", type=Path)
+    c.add_argument("a", help="A's JSON (several: comma-separated, runs pooled)")
+    c.add_argument("b", help="B's JSON (several: comma-separated, runs pooled)")
 
 
 def main(args) -> None:
     if args.action == "run":
-        run(args.cases, args.motions or MOTIONS, args.duration, args.out, args.jitter)
+        copies = range(args.first_copy, args.first_copy + args.copies)
+        run(args.cases, args.motions or MOTIONS, args.duration, args.out, args.jitter, copies)
     else:
         compare(args.a, args.b)
 
