@@ -63,7 +63,8 @@ def parse_motion(text: str) -> tuple[float, float, float]:
 
 
 def engine_commit() -> dict:
-    """Where ``masonrycli`` was imported from, its checkout's commit, and whether masonrycli/ is dirty."""
+    """Where ``masonrycli`` was imported from, its checkout's commit, the last commit that changed
+    masonrycli/, and whether masonrycli/ has uncommitted changes."""
     import masonrycli
 
     package = Path(masonrycli.__file__).resolve().parent
@@ -79,6 +80,7 @@ def engine_commit() -> dict:
     return {
         "path": str(root),
         "commit": git("rev-parse", "HEAD"),
+        "engine_commit": git("log", "-1", "--format=%H", "--", "masonrycli"),  # the last one to change it
         "dirty": bool(git("status", "--porcelain", "masonrycli")),
     }
 
@@ -134,7 +136,11 @@ def run(
     simulate(make_scenario("h8", 0.003))  # compile or load the engine's kernels outside the timed runs
     engine = engine_commit()
     dirty = " (masonrycli/ modified)" if engine["dirty"] else ""
-    print(f"engine {engine['commit'][:10]}{dirty} at {engine['path']}; {duration:g} s a run", flush=True)
+    print(
+        f"checkout {engine['commit'][:10]} (masonrycli/ last changed in {engine['engine_commit'][:10]}){dirty}"
+        f" at {engine['path']}; {duration:g} s a run",
+        flush=True,
+    )
     runs = []
     for case in cases:
         print(f"\n{case}\n| A m/s | f Hz | φ | copy | mean units | max | unconverged | CPU s |\n" + "|---" * 8 + "|")
@@ -219,7 +225,8 @@ def compare(path_a: str | Path, path_b: str | Path) -> dict[str, dict]:
     a, b = load(path_a), load(path_b)
     for name, doc, path in (("A", a, path_a), ("B", b, path_b)):
         e = doc["engine"]
-        print(f"{name}: {path}: engine {e['commit'][:10]}{' (dirty)' * e['dirty']}")
+        since = f", masonrycli/ of {e['engine_commit'][:10]}" if "engine_commit" in e else ""
+        print(f"{name}: {path}: checkout {e['commit'][:10]}{since}{' (dirty)' * e['dirty']}")
     print(
         "\n| case | runs | B/A geo. mean [90 % interval] | median | min – max | better / worse / equal |"
         " Σ units B/A [90 %] | unconverged A / B | CPU B/A |\n|---|---|---|---|---|---|---|---|---|"
