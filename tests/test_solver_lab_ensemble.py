@@ -84,3 +84,13 @@ def test_motion_text():
     with pytest.raises(ValueError):
         ensemble.parse_motion("1")
     assert len(ensemble.MOTIONS) == 12 and (1.0, 2.0, 0.0) in ensemble.MOTIONS
+
+
+def test_shifted_copies_pair_an_engine_with_itself(tmp_path):
+    runs = [_run("s", 1.0, 100.0) | {"copy": 0}, _run("s", 1.0, 300.0) | {"copy": 1}, _run("s", 1.0, 150.0)]
+    runs[2]["copy"] = 2
+    path = tmp_path / "s.json"
+    path.write_text(json.dumps(_doc(runs)))
+    s = ensemble.compare(path, path, shift=1)["s"]  # copy 1 against 0, copy 2 against 1: ratios 3 and 0.5
+    assert s["runs"] == 2 and s["geomean"] == pytest.approx(math.sqrt(1.5)) and (s["better"], s["worse"]) == (1, 1)
+    assert s["total_ratio"] == pytest.approx(4500 / 4000)

@@ -171,13 +171,14 @@ def spread_line(means: list[float]) -> str:
     )
 
 
-def _key(r: dict) -> tuple:
-    return (r["case"], r["amplitude"], r["frequency"], r["phase"], r["duration"], r.get("copy", 0))
+def _key(r: dict, shift: int = 0) -> tuple:
+    return (r["case"], r["amplitude"], r["frequency"], r["phase"], r["duration"], r.get("copy", 0) - shift)
 
 
-def pair_runs(a: dict, b: dict) -> dict[str, list[tuple[dict, dict]]]:
-    """Case → [(run of A, run of B)] for the motions both files ran, in A's order."""
-    by_key = {_key(r): r for r in b["runs"]}
+def pair_runs(a: dict, b: dict, shift: int = 0) -> dict[str, list[tuple[dict, dict]]]:
+    """Case → [(run of A, run of B)] for the motions both files ran, in A's order; ``shift``: B's copy
+    k + shift is A's copy k's partner (an engine against itself: the ratios a change of path alone makes)."""
+    by_key = {_key(r, shift): r for r in b["runs"]}
     pairs: dict[str, list[tuple[dict, dict]]] = {}
     for r in a["runs"]:
         if _key(r) in by_key:
@@ -220,7 +221,7 @@ def load(paths: str | Path) -> dict:
     return {"engine": docs[0]["engine"], "runs": [r for d in docs for r in d["runs"]]}
 
 
-def compare(path_a: str | Path, path_b: str | Path) -> dict[str, dict]:
+def compare(path_a: str | Path, path_b: str | Path, shift: int = 0) -> dict[str, dict]:
     """Print the per-case table of B against A; return the figures by case."""
     a, b = load(path_a), load(path_b)
     for name, doc, path in (("A", a, path_a), ("B", b, path_b)):
@@ -232,7 +233,8 @@ def compare(path_a: str | Path, path_b: str | Path) -> dict[str, dict]:
         " Σ units B/A [90 %] | unconverged A / B | CPU B/A |\n|---|---|---|---|---|---|---|---|---|"
     )
     out = {}
-    for case, pairs in pair_runs(a, b).items():
+    paired = pair_runs(a, b, shift)
+    for case, pairs in paired.items():
         s = out[case] = summarise(pairs)
         lo, hi = s["interval90"]
         print(
@@ -241,7 +243,7 @@ def compare(path_a: str | Path, path_b: str | Path) -> dict[str, dict]:
             f" {s['total_ratio']:.3f} [{s['total_interval90'][0]:.3f}, {s['total_interval90'][1]:.3f}] |"
             f" {s['unconverged'][0]} / {s['unconverged'][1]} | {s['cpu_ratio']:.2f} |"
         )
-    unpaired = len(a["runs"]) + len(b["runs"]) - 2 * sum(len(p) for p in pair_runs(a, b).values())
+    unpaired = len(a["runs"]) + len(b["runs"]) - 2 * sum(len(p) for p in paired.values())
     if unpaired:
         print(f"\n{unpaired} runs without a partner (another motion, duration or case) left out")
     return out
@@ -262,6 +264,7 @@ def add_arguments(sub) -> None:
     c = act.add_parser("compare", help="B against A, runs paired by motion")
     c.add_argument("a", help="A's JSON (several: comma-separated, runs pooled)")
     c.add_argument("b", help="B's JSON (several: comma-separated, runs pooled)")
+    c.add_argument("--shift-copy", type=int, default=0, help="pair A's copy k with B's copy k + SHIFT")
 
 
 def main(args) -> None:
@@ -269,7 +272,7 @@ def main(args) -> None:
         copies = range(args.first_copy, args.first_copy + args.copies)
         run(args.cases, args.motions or MOTIONS, args.duration, args.out, args.jitter, copies)
     else:
-        compare(args.a, args.b)
+        compare(args.a, args.b, args.shift_copy)
 
 
 if __name__ == "__main__":  # another checkout's engine: PYTHONPATH=CHECKOUT python …/ensemble.py run …
