@@ -1,20 +1,21 @@
 """Ensembles of short runs: a solver change judged on many trajectories at once, as a distribution.
 
     python -m benchmarks.solver_lab ensemble run --cases h32 h64 [--duration 0.15] [--motions A,F[,PHASE] …]
-                                                 [--jitter EPS] --out FILE.json
-    python -m benchmarks.solver_lab ensemble compare A.json B.json
+                                                 [--copies K] [--jitter EPS] --out FILE.json
+    python -m benchmarks.solver_lab ensemble compare A.json[,A2.json …] B.json[,…] [--shift-copy K]
 
 A step solved differently within the tolerance puts a run on another trajectory, with other hard steps:
-one run's mean sweep units a step moves by ±10–20 % with any change of the solver's path, so a change
-worth 5–15 % cannot be read from one run. ``run`` therefore runs each case (a wall of
-:mod:`benchmarks.solver_cases`, at its dt, μ and default solver) once per ground motion of a set — the
-paper's sine with other amplitudes and frequencies, v(t) = A sin(2π f t + φ) — for a short time, without
-recording, and keeps per run: mean, max and total sweep units a step (``StepStats.iterations``: the
+one run's mean sweep units a step moves by tens of % with any change of the solver's path (on the
+32-course wall by up to 10× for an amplitude changed by 1e-6), so a change worth 5–15 % cannot be read
+from one run. ``run`` therefore runs each case (a wall of :mod:`benchmarks.solver_cases`, at its dt, μ
+and default solver) once per ground motion of a set — the paper's sine with other amplitudes and
+frequencies, v(t) = A sin(2π f t + φ) — and ``--copies K`` times per motion (amplitude × (1 + k · 1e-6),
+k = 0 … K − 1: other trajectories of the same motion), for a short time, without recording, and keeps per run: mean, max and total sweep units a step (``StepStats.iterations``: the
 solver's work in sweep equivalents, the figure of the run's history), unconverged steps, CPU s of the
 time loop, and every step's units. The JSON also holds the git commit of the engine that ran (the
 checkout ``masonrycli`` was imported from, and whether its ``masonrycli/`` had uncommitted changes).
 
-``compare`` pairs the runs of two files by (case, motion, duration) and prints, per case, the ratio B/A
+``compare`` pairs the runs of two files by (case, motion, duration, copy) and prints, per case, the ratio B/A
 of each run's mean sweep units summarised: geometric mean, median, min, max, runs better / worse /
 equal, a bootstrap 90 % interval of the geometric mean (resampling the runs, fixed seed: deterministic),
 the ratio of the summed units, unconverged steps of A and B, and the CPU ratio (indicative only on a
@@ -26,8 +27,9 @@ the checkout has this module (a branch rebased on main), or, for a checkout with
 ``PYTHONPATH=CHECKOUT python /path/to/benchmarks/solver_lab/ensemble.py run …`` (this file imports only
 ``benchmarks.solver_cases`` and ``masonrycli``, both taken from CHECKOUT).
 
-``--jitter EPS`` multiplies every amplitude by 1 + EPS and keeps the nominal motion as the key: compared
-with a run without it, it gives the ratios a mere change of path makes (the null distribution).
+The ratios a mere change of path makes (the null distribution, to read B/A against): ``compare A.json
+A.json --shift-copy 1`` pairs each copy k with copy k + 1 of the same engine; ``--jitter EPS`` multiplies
+every amplitude by 1 + EPS and keeps the nominal motion as the key.
 """
 
 from __future__ import annotations
