@@ -5,8 +5,11 @@ A run ends in one of three **states**:
 ``collapsed``
     at some step (the *time of collapse*) one of the following held:
 
-    * a block has fallen by more than ``drop`` × its own height (the height of its bounding box as
-      built) — stones on the ground, a voussoir through the arch;
+    * a block has fallen by more than ``drop`` × its height — stones on the ground, a voussoir through
+      the arch. The fall is counted below the deepest settlement of a support at that step (a block
+      riding a settling foundation down has not fallen), and the height is the block's own (its
+      bounding box as built) but at least the median block height (the aqueduct's spandrel blocks
+      cut along the extrados are down to 3.6 cm: a 4 cm settlement is not their collapse);
     * a block has turned by more than ``turn`` (45° by default) — overturned (a slender block past its
       tipping angle only goes on falling);
     * the top of the structure has drifted, relative to the shaking ground, by more than ``drift`` ×
@@ -91,7 +94,11 @@ class CollapseMonitor:
         q0 = model.body_q0
         self.q0 = q0.copy()
         heights = np.array([np.ptp(v[:, 1]) for v in vertices_by_block]) if n else np.zeros(0)
-        self.block_height = heights
+        # The fall is measured in units of at least a median block: a sliver's own height is no scale.
+        self.block_height = np.maximum(heights, float(np.median(heights))) if n else heights
+        self._q0_fall = q0.copy()
+        """q0 with the blocks' y lowered by the current settlement (what ``watch_step`` measures falls from)."""
+        self._settlement = 0.0
         ys = np.concatenate([v[:, 1] for v in vertices_by_block]) if n else np.zeros(1)
         self.height = float(np.ptp(ys)) or 1.0
         top_y = q0[:n, 1].max() if n else 0.0
@@ -114,7 +121,12 @@ class CollapseMonitor:
         """One step: ``body_q``/``body_v`` (B, 3) after ``solver``'s step."""
         if not self.n:
             return
-        rock, slide, fall, turn, top_dx = watch_step(solver, body_q, body_v, self.q0, self.block_height, self.top)
+        n = self.n
+        settlement = max(0.0, float(np.max(self.q0[n:, 1] - body_q[n:, 1]))) if body_q.shape[0] > n else 0.0
+        if settlement != self._settlement:
+            self._settlement = settlement
+            self._q0_fall[:n, 1] = self.q0[:n, 1] - settlement
+        rock, slide, fall, turn, top_dx = watch_step(solver, body_q, body_v, self._q0_fall, self.block_height, self.top)
         self.observe(time, rock, slide, fall, turn, top_dx - self._ground_dx(body_q))
 
     def observe(self, time: float, rock: float, slide: float, fall: float, turn: float, drift: float) -> None:

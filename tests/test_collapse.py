@@ -111,3 +111,40 @@ def test_block_at_rest_is_intact():
     result = simulate(block_scenario(0.8, 0.4, 0.6, 0.0))
     assert result.outcome["state"] == "intact" and result.outcome["hinges"] == 0
     assert result.extra["state"].startswith("intact (residual drift")
+
+
+class _Watch:
+    """Stands in for the solver in CollapseMonitor.update: no contacts."""
+
+    _count = 0
+    _pack = np.zeros((1, 1))
+    _status = np.zeros(1, dtype=np.int8)
+    buffers = SimpleNamespace(contact_body=np.zeros((1, 2), dtype=np.int32))
+
+
+def test_a_sliver_riding_a_settling_support_has_not_fallen():
+    # A 1 m block and a 0.04 m sliver (the aqueduct's spandrel blocks cut along the extrados are down
+    # to 3.6 cm) on a support that settles 5 cm, carrying both with it: nothing fell. Before, the
+    # sliver's 5 cm drop was 1.25 × its own height and the default aqueduct "collapsed at t = 4.414 s".
+    verts = [
+        np.array([[0, 0], [1, 0], [1, 1], [0, 1]], float),
+        np.array([[1, 0], [2, 0], [2, 0.04], [1, 0.04]], float),
+    ]
+    q0 = np.array([[0.5, 0.5, 0.0], [1.5, 0.02, 0.0], [1.0, -0.5, 0.0]])
+    mon = CollapseMonitor(SimpleNamespace(block_count=2, body_q0=q0), verts, None, CollapseRule())
+    q = q0.copy()
+    q[:, 1] -= 0.05
+    mon.update(1.0, _Watch(), q, np.zeros_like(q))
+    assert mon.collapse_time is None
+    # the same sliver dropping 5 cm while its support stays put still has not fallen by a median
+    # block height (0.52 m) ...
+    q = q0.copy()
+    q[1, 1] -= 0.05
+    mon.update(2.0, _Watch(), q, np.zeros_like(q))
+    assert mon.collapse_time is None
+    # ... but a block falling more than that past the settlement of the support has.
+    q = q0.copy()
+    q[:, 1] -= 0.05
+    q[1, 1] -= 0.6
+    mon.update(3.0, _Watch(), q, np.zeros_like(q))
+    assert mon.collapse_time == 3.0 and "fell" in mon.collapse_reason
