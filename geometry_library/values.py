@@ -66,6 +66,19 @@ def check_positive(label: str, **values) -> None:
             raise GeometryError(f"{label}: {key} must be a positive number, got {value!r}")
 
 
+MAX_BLOCKS = 100_000
+"""Most blocks a builder makes: more is a likely typo (``--blocks 100000000`` used to build for minutes
+and fill the memory before anything was said). The largest benchmark wall has 3996 blocks."""
+
+
+def check_block_total(label: str, total: int, what: str = "", bound: bool = False) -> None:
+    """Raise a one-line GeometryError when ``what`` (the options, for the message) makes more than
+    :data:`MAX_BLOCKS` blocks (``bound``: ``total`` is an upper bound of the count, not the count)."""
+    if total > MAX_BLOCKS:
+        makes = f"{what} makes up to " if bound else f"{what} makes " if what else ""
+        raise GeometryError(f"{label}: {makes}{total} blocks, more than {MAX_BLOCKS} (a likely typo)")
+
+
 def check_count(label: str, minimum: int = 1, **values) -> None:
     """Raise a one-line GeometryError unless every value is an integer ≥ ``minimum``."""
     for key, value in values.items():

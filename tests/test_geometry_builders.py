@@ -161,6 +161,21 @@ def test_wall_errors_are_one_line(kwargs, match):
     assert "\n" not in str(info.value)
 
 
+@pytest.mark.parametrize(
+    "build, kwargs, match",
+    [
+        (build_wall, dict(blocks=10**8), "wall: 100000000 blocks, more than 100000"),
+        (build_wall, dict(blocks=None, courses=10**5, length=3.0), "100000 courses of length 3 m makes 1050000 blocks"),
+        (build_arch, dict(voussoirs=10**8), "100000000 voussoirs and 17 pier courses makes 100000068 blocks"),
+        (build_aqueduct, dict(wall_courses=10**5), "100000 wall courses .* makes up to 2100098 blocks"),
+    ],
+)
+def test_absurd_block_counts_are_refused_before_building(build, kwargs, match):
+    # Each used to build for minutes (the aqueduct's for hours) and fill the memory; now refused at once.
+    with pytest.raises(GeometryError, match=match):
+        build(**kwargs)
+
+
 # --- arch ------------------------------------------------------------------------------------
 
 

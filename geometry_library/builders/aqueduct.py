@@ -21,12 +21,13 @@ Block order: the arch's 98 blocks, then the wall bottom course first, left to ri
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 from shapely.geometry import Polygon
 
 from ..blocks import Assembly, GeometryError
-from ..values import check_count, check_positive
+from ..values import check_block_total, check_count, check_positive
 from ._common import make_block, name_width
 from .arch import ArchSpec, arch_parts
 from .spandrel import spandrel_blocks
@@ -68,6 +69,15 @@ class AqueductSpec(ArchSpec):
             raise GeometryError(
                 f"aqueduct: the wall top ({top:g} m) is below the crown of the extrados ({crown:g} m); add wall_courses"
             )
+        # Bound the spandrel count before cutting it: every course spans the width between the piers'
+        # outer faces, at most one block per block length plus the two ends.
+        per_course = math.ceil(2.0 * geom.half_width / self.block_length) + 2
+        check_block_total(
+            "aqueduct",
+            len(blocks) + self.wall_courses * per_course,
+            f"{self.wall_courses} wall courses of {self.block_length:g} m blocks over {2.0 * geom.half_width:g} m",
+            bound=True,
+        )
         region = Polygon(geom.extrados)
         pieces = spandrel_blocks(
             region,

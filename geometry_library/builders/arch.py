@@ -31,7 +31,7 @@ import numpy as np
 from shapely.geometry import box
 
 from ..blocks import SUPPORT_ROLES, Assembly, Block, GeometryError, Support
-from ..values import check_count, check_positive
+from ..values import check_block_total, check_count, check_positive
 from ._common import make_block, make_support, name_width
 
 
@@ -118,6 +118,7 @@ def arch_parts(spec: ArchSpec) -> tuple[list[Block], list[Support], ArchGeometry
     left_role, right_role = spec.left_role, spec.right_role
     check_count("arch", 2, voussoirs=voussoirs)
     check_count("arch", 1, pier_courses=pier_courses)
+    check_block_total("arch", voussoirs + 4 * pier_courses, f"{voussoirs} voussoirs and {pier_courses} pier courses")
     check_positive(
         "arch",
         span=span,

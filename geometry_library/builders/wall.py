@@ -33,7 +33,7 @@ from dataclasses import dataclass
 from shapely.geometry import box
 
 from ..blocks import Assembly, Block, GeometryError
-from ..values import check_positive, number_problem
+from ..values import check_block_total, check_positive, number_problem
 from ._common import make_block, make_support, name_width
 
 
@@ -89,6 +89,7 @@ def wall_layouts(blocks: int) -> list[tuple[int, int]]:
     """Every (courses, full_per_course) with courses·n + ⌊courses/2⌋ == blocks, fewest courses first."""
     if number_problem(blocks, integer=True, ge=1) is not None:
         raise GeometryError(f"wall: block count must be a positive integer, got {blocks!r}")
+    check_block_total("wall", blocks)
     out = []
     for c in range(1, blocks + 1):
         rest = blocks - c // 2
@@ -130,6 +131,7 @@ def wall_layout(
         if courses is None or n_pinned is None:
             raise GeometryError("wall: give a block count, or both courses and length")
         blocks = courses * n_pinned + courses // 2
+        check_block_total("wall", blocks, f"{courses} courses of length {length:g} m")
     candidates = wall_layouts(blocks)
     if courses is not None:
         candidates = [(c, n) for c, n in candidates if c == courses]
