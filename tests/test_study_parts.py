@@ -14,7 +14,7 @@ from masonrycli.outputs import OutputFile
 from masonrycli.records import record_motion
 from masonrycli.scenario import Material, RunConfig, scenario_from_builder
 from masonrycli.study import store
-from masonrycli.study.axes import Axis, StudyBase, apply_point, grid, parse_axis
+from masonrycli.study.axes import Axis, StudyBase, apply_point, check_axes, grid, parse_axis
 from masonrycli.study.drivers import FindDriver, GridDriver
 from masonrycli.study.fragility import fit_lognormal
 from masonrycli.study.task import check_outcome, empty_result, reached, run_task
@@ -34,9 +34,12 @@ def test_parse_axis_forms_and_errors():
         ("amp=a,b", "'a' is not a number"),
         ("amp=nan", "values must be finite"),
         ("blocks=12.5", "blocks takes whole numbers"),
+        ("amp=0:1:1000000000", "N = 1000000000 values, more than 1000000"),  # used to allocate for minutes
     ]:
         with pytest.raises(InputError, match=fragment):
             parse_axis(text)
+    with pytest.raises(InputError, match=r"grid has 1000000000000 points \(1000000 amp × 1000000 freq\)"):
+        check_axes([parse_axis("amp=0:1:1000000"), parse_axis("freq=1:2:1000000")])
     assert grid([Axis("a", (1, 2)), Axis("b", (3, 4))]) == [
         {"a": 1, "b": 3},
         {"a": 1, "b": 4},

@@ -31,6 +31,9 @@ MOTION_PARAMS = {"amp": ("sine", "amplitude"), "freq": ("sine", "frequency"), "p
 MOTION_PARAMS["scale"] = ("record", "scale")
 RUN_PARAMS = ("duration", "dt", "theta", "tolerance", "max_iterations")
 INT_PARAMS = ("max_iterations",)
+MAX_RUNS = 10**6
+"""Most values on an axis, and most runs in a grid: more is a likely typo (``amp=0:1:1000000000``
+used to allocate the values for minutes before anything was said)."""
 
 
 @dataclass(frozen=True)
@@ -66,6 +69,8 @@ def parse_axis(text: str) -> Axis:
             raise InputError(f"{where}: N must be >= 2 for a range (or give one value)")
         if not hi >= lo:
             raise InputError(f"{where}: HI must be >= LO")
+        if n > MAX_RUNS:
+            raise InputError(f"{where}: N = {n} values, more than {MAX_RUNS} (a likely typo)")
         values = tuple(float(v) for v in np.linspace(lo, hi, n))
     else:
         values = tuple(_number(p, where) for p in spec.split(","))
@@ -107,6 +112,10 @@ def check_axes(axes: list[Axis]) -> None:
     dup = {n for n in names if names.count(n) > 1}
     if dup:
         raise InputError(f"--param {sorted(dup)[0]}: given twice")
+    runs = math.prod(len(a.values) for a in axes)
+    if runs > MAX_RUNS:
+        sizes = " × ".join(f"{len(a.values)} {a.name}" for a in axes)
+        raise InputError(f"--param: the grid has {runs} points ({sizes}), more than {MAX_RUNS} (a likely typo)")
 
 
 def apply_point(base, params: dict):
