@@ -188,8 +188,10 @@ def _execute(scenario, opts: dict, hint: str = "") -> None:
     the code of how the run ended."""
     from masonrycli.execute import execute, plan_outputs, print_summary
     from masonrycli.interrupt import StopRun, exit_code, signal_name
+    from masonrycli.scenario import check_sampling
     from masonrycli.sinks import DIVERGED, FAILED
 
+    check_sampling(scenario)
     if opts["magnify"] is not None and not opts["magnify"] >= 1.0:
         raise InputError(f"--magnify {opts['magnify']}: must be >= 1")
     outputs = plan_outputs(
@@ -362,9 +364,10 @@ def check_command(scenario_file: ScenarioFile, **opts) -> None:
     """Validate what `masonry run` would run, with the same arguments, and print a summary (blocks,
     supports, mass, bounding box, steps, outputs); nothing is computed or written."""
     from masonrycli.execute import plan_outputs
-    from masonrycli.scenario import scenario_summary
+    from masonrycli.scenario import check_sampling, scenario_summary
 
     scenario = _load(scenario_file, opts)
+    check_sampling(scenario)
     if opts["magnify"] is not None and not opts["magnify"] >= 1.0:
         raise InputError(f"--magnify {opts['magnify']}: must be >= 1")
     outputs = plan_outputs(

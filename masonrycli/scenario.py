@@ -252,6 +252,21 @@ def _block_mass(block: Block) -> float:
     return float(mass_properties(block.vertices, block.density, block.thickness).mass)
 
 
+def check_sampling(scenario: Scenario) -> None:
+    """Raise :class:`InputError` for a sine faster than the time step can follow: above 1/(2 dt) the
+    steps sample it at aliased phases (``--freq 1e9`` at dt = 1e-3 s sampled sin(2π·10⁶·k) = 0: the ground
+    never moved, and nothing said so). Called once the command line's overrides are applied."""
+    dt = scenario.run.dt
+    source = str(scenario.source)
+    where = "" if source.startswith("builder:") or not source else f"{source}: "
+    for support, m in zip(scenario.assembly.supports, scenario.motions):
+        if m.kind == "sine" and m.amplitude != 0.0 and m.frequency * dt > 0.5:
+            raise InputError(
+                f'{where}support "{support.name}": frequency = {m.frequency:g} Hz is above 1/(2 dt) = {0.5 / dt:g} Hz, '
+                f"the fastest sine dt = {dt:g} s can follow (dt = {0.05 / m.frequency:.3g} s gives 20 steps a period)"
+            )
+
+
 def scenario_summary(scenario: Scenario) -> dict:
     """Numbers for ``masonry check``: counts, total mass (kg), bounding box (m), run settings, warnings."""
     asm = scenario.assembly

@@ -91,6 +91,14 @@ def test_check_prints_summary():
         (("simulate", "wall", "--blocks", 0, "--duration", 0.01), ["block count", "0"]),
         (("simulate", "wall", "--density", -5, "--duration", 0.01), ["density"]),
         (("simulate", "arch", "--settlement", -1, "--duration", 0.01), ["--settlement"]),
+        # a sine the steps alias (1e9 Hz at dt = 1e-3 s sampled 0 at every step: the ground never moved)
+        (("simulate", "wall", "--freq", 1e9, "--duration", 0.01), ['"ground": frequency = 1e+09 Hz', "500 Hz"]),
+        (
+            ("check", DATA / "validation" / "harmonic_ground.toml", "--dt", 0.5),
+            ["harmonic_ground.toml", "2 Hz", "1 Hz"],
+        ),
+        # absurd block counts used to build for minutes with no word
+        (("simulate", "wall", "--blocks", 10**8, "--duration", 0.01), ["100000000 blocks", "likely typo"]),
     ],
 )
 def test_bad_input_is_one_line_exit_2(args, fragments, tmp_path):

@@ -323,3 +323,19 @@ def test_every_builder_option_has_a_checked_type():
         for f in dataclasses.fields(spec_cls):
             with pytest.raises(InputError, match=rf'^builder "{name}": {f.name} = \[\]: must be '):
                 scenario_from_builder(name, {f.name: []}, RunConfig(), Material(), {})
+
+
+def test_check_sampling_refuses_a_sine_above_half_the_step_rate():
+    from masonrycli.scenario import check_sampling
+
+    scenario = load_scenario(DATA / "block_on_ground.toml")  # 2 Hz, dt = 1e-3 s
+    check_sampling(scenario)
+    fast = dataclasses.replace(scenario, run=dataclasses.replace(scenario.run, dt=0.25))  # 2 Hz × 0.25 s = 0.5
+    check_sampling(fast)  # two steps a period: still followed
+    too_fast = dataclasses.replace(scenario, run=dataclasses.replace(scenario.run, dt=0.5))
+    with pytest.raises(
+        InputError, match=r'block_on_ground.toml: support "ground": frequency = 2 Hz is above 1/\(2 dt\) = 1 Hz'
+    ):
+        check_sampling(too_fast)
+    still = dataclasses.replace(too_fast, motions=(dataclasses.replace(too_fast.motions[0], amplitude=0.0),))
+    check_sampling(still)  # a sine of zero amplitude moves nothing: any frequency

@@ -124,7 +124,7 @@ def apply_point(base, params: dict):
     Order: builder options (rebuild), run and material settings, the record, then motion parameters
     (so ``scale`` applies to the record chosen on the same point). Raises :class:`InputError`.
     """
-    from masonrycli.scenario import scenario_from_builder
+    from masonrycli.scenario import check_sampling, scenario_from_builder
 
     scenario = base.scenario
     builder = scenario.structure.get("builder")
@@ -165,7 +165,9 @@ def apply_point(base, params: dict):
             )
         for j in targets:
             motions[j] = _replace(motions[j], {attr: value}, where=f"--param {key}")
-    return dataclasses.replace(scenario, motions=tuple(motions))
+    scenario = dataclasses.replace(scenario, motions=tuple(motions))
+    check_sampling(scenario)
+    return scenario
 
 
 def _builder_option(builder, name: str) -> bool:
