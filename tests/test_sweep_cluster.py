@@ -134,3 +134,30 @@ def _read_csv(path: Path) -> list[dict]:
     from masonrycli.study.store import read_rows
 
     return read_rows(path)
+
+
+def test_ctrl_c_on_a_local_cluster_study_is_one_line(tmp_path):
+    # Ctrl-C goes to the terminal's whole process group: the LocalCluster's worker processes got it too,
+    # and each printed a KeyboardInterrupt traceback (30 lines each) above the study's one-line message.
+    out = tmp_path / "study.csv"
+    sweep = [sys.executable, "-m", "masonrycli", "sweep", "wall", "--param", "blocks=12", "--duration", "5"]
+    sweep += ["--param", "amp=0.1:0.25:6", "--workers", "2", "--out", out, "--no-recording"]
+    log = tmp_path / "sweep.log"
+    proc = subprocess.Popen(
+        sweep,
+        stdout=open(log, "w"),
+        stderr=subprocess.STDOUT,
+        env=ENV,
+        start_new_session=True,
+        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),  # as in a terminal, whoever runs pytest
+    )
+    try:
+        _wait(lambda: len(_journal_rows(out)) >= 1, 240, "a finished row", {proc: log})
+        os.killpg(proc.pid, signal.SIGINT)
+        assert proc.wait(timeout=120) == 130, _tails({proc: log})
+    finally:
+        _kill(proc)
+    text = log.read_text()
+    assert "Traceback" not in text and "KeyboardInterrupt" not in text, text
+    assert "interrupted: every finished row is in" in text
+    assert 1 <= len(_read_csv(out)) < 6

@@ -15,6 +15,8 @@ from __future__ import annotations
 
 import logging
 import os
+import signal
+import threading
 from collections.abc import Callable
 
 from masonrycli.errors import InputError
@@ -34,9 +36,18 @@ def open_cluster(scheduler: str | None, workers: int | None):
     n = workers or os.cpu_count() or 1
     # ":0": the scheduler's HTTP endpoints (it serves them even without a dashboard) on a free port, so
     # two studies at once do not fight over 8787
-    cluster = LocalCluster(
-        n_workers=n, threads_per_worker=1, processes=True, dashboard_address=":0", silence_logs=logging.ERROR
-    )
+    # Ctrl-C reaches the terminal's whole process group: a worker process that took it printed a
+    # KeyboardInterrupt traceback each. Started with SIGINT ignored (kept across exec), the workers leave
+    # the interrupt to this process, which closes the cluster.
+    main = threading.current_thread() is threading.main_thread()  # signal.signal works only there
+    previous = signal.signal(signal.SIGINT, signal.SIG_IGN) if main else None
+    try:
+        cluster = LocalCluster(
+            n_workers=n, threads_per_worker=1, processes=True, dashboard_address=":0", silence_logs=logging.ERROR
+        )
+    finally:
+        if main:
+            signal.signal(signal.SIGINT, previous)
     return Client(cluster), cluster
 
 
