@@ -115,6 +115,8 @@ def sweep_command(
     out = store.check_out(out or Path(f"study-{name}.parquet"))
     # every output checked before the first run (the table and the histories by run_study, which knows
     # which rows are this study's and which runs are still to make)
+    if no_recording and recording is not None:
+        raise InputError(f"--recording {recording} with --no-recording: choose one")
     picture = check_picture(plot or out.with_suffix(".png"), "--plot", ".png", force)
     recording = check_picture(
         None if no_recording else recording or out.with_suffix(".rrd"), "--recording", ".rrd", force

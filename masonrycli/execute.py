@@ -49,6 +49,8 @@ class Outputs:
 
 def plan_outputs(scenario, out: Path | None, history: Path | None, *, no_recording: bool, force: bool) -> Outputs:
     """Check the output paths and the free space before anything is computed (raises InputError)."""
+    if no_recording and out is not None:  # it was ignored: the recording asked for was silently not written
+        raise InputError(f"--out {out} with --no-recording: choose one")
     rec = None
     if not no_recording:
         if out is None:

@@ -99,6 +99,8 @@ def test_check_prints_summary():
         ),
         # absurd block counts used to build for minutes with no word
         (("simulate", "wall", "--blocks", 10**8, "--duration", 0.01), ["100000000 blocks", "likely typo"]),
+        # --out was ignored: the recording asked for was silently not written
+        (("simulate", "wall", "--duration", 0.01, "--out", "x.rrd"), ["--out x.rrd with --no-recording"]),
     ],
 )
 def test_bad_input_is_one_line_exit_2(args, fragments, tmp_path):

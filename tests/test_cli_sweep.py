@@ -113,6 +113,7 @@ def test_grid_sweep_state_map_and_histories(block, tmp_path):
         (["-p", "amp=0.1", "--workers", "2", "--scheduler", "tcp://x:1"], "--workers with --scheduler"),
         (["-p", "amp=0.1", "--recording", "x.png"], "--recording x.png: the file name must end in .rrd"),
         (["-p", "amp=0.1", "--plot", "x.jpg"], "--plot x.jpg: the file name must end in .png"),
+        (["-p", "amp=0.1", "--recording", "x.rrd", "--no-recording"], "--recording x.rrd with --no-recording"),
     ],
 )
 def test_sweep_errors_are_one_line(block, args, fragment):
