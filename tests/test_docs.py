@@ -60,3 +60,18 @@ def test_every_module_is_listed(page, section):
     assert len(modules) > 40  # the search above found the packages
     missing = [str(p.relative_to(ROOT)) for p in modules if p.stem not in words]
     assert not missing, f"{page} ({section}) does not list: {', '.join(missing)}"
+
+
+def test_readme_history_table_names_every_array(tmp_path):
+    # Four arrays (the principal strains and their directions) were written but not in the table.
+    import numpy as np
+
+    from cli_helpers import invoke
+
+    npz = tmp_path / "h.npz"
+    args = ("run", ROOT / "tests" / "data" / "validation" / "column5.toml", "--duration", 0.01, "--no-recording")
+    assert invoke(*args, "--history", npz).exit_code == 0
+    text = (ROOT / "README.md").read_text()
+    table = text[text.index("**The history**") : text.index("## Troubleshooting")]
+    documented = set(re.findall(r"`([a-z_0-9]+)`", table))
+    assert set(np.load(npz).files) <= documented, sorted(set(np.load(npz).files) - documented)
