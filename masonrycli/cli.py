@@ -293,7 +293,11 @@ def _load(scenario_file: Path, opts: dict):
     return override_run(with_record(scenario, record, scale), **_pop(opts, RUN, FRICTION))
 
 
-@app.command("run")
+@app.command(
+    "run",
+    short_help="Run any scenario file (or a GeoJSON / WKT geometry file, supports fixed); options given here "
+    "override the file's values.",
+)
 @user_errors
 @with_options(RUN, STOP, FRICTION, OUTPUT, FORCE, RECORD)
 def run_command(scenario_file: ScenarioFile, **opts) -> None:
@@ -357,7 +361,11 @@ def limit_command(
     )
 
 
-@app.command("check")
+@app.command(
+    "check",
+    short_help="Validate what `masonry run` would run, with the same arguments, and print a summary (blocks, "
+    "supports, mass, bounding box, steps, outputs); nothing is computed or written.",
+)
 @user_errors
 @with_options(RUN, STOP, FRICTION, OUTPUT, FORCE, RECORD)
 def check_command(scenario_file: ScenarioFile, **opts) -> None:

@@ -267,3 +267,15 @@ def test_solver_option_runs_either_solver_to_the_same_motion(tmp_path):
         q[solver] = h["block_q"]
     np.testing.assert_array_equal(q[None], q["nlgs-accel"])  # the default
     assert np.abs(q["nlgs"][..., :2] - q["nlgs-accel"][..., :2]).max() < 5e-4  # m, after 0.1 s of shaking
+
+
+def test_command_list_keeps_each_summary_on_one_line():
+    # The list showed run's and check's docstrings with their source line breaks ("options given here" /
+    # "override the file's values." on two lines of a 120-column terminal).
+    from masonrycli.cli import app
+
+    from cli_helpers import runner
+
+    out = runner.invoke(app, ["--help"], env={"COLUMNS": "250"}).output
+    assert "options given here override the file's values." in out
+    assert "print a summary (blocks, supports, mass" in out
