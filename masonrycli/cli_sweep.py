@@ -6,12 +6,15 @@ table, PNG, Rerun recording. Registered on the app by :mod:`masonrycli.cli`.
 
 from __future__ import annotations
 
+import signal
+import threading
 from pathlib import Path
 from typing import Annotated
 
 import typer
 
 from masonrycli.errors import InputError
+from masonrycli.interrupt import exit_code, signal_name
 from masonrycli.outputs import OutputFile
 
 BUILT_IN = ("wall", "arch", "aqueduct")
@@ -133,13 +136,28 @@ def sweep_command(
         histories=histories,
         force=force,
     )
+    # SIGTERM (kill, a batch system's time limit) takes Ctrl-C's way out: the finished rows are written and
+    # the cluster closed. Before, it killed the command outright: no table, and multiprocessing's
+    # "leaked semaphore" warning on stderr.
+    stopped_by = [signal.SIGINT]
+
+    def on_sigterm(signum, frame):
+        stopped_by[0] = signum
+        raise KeyboardInterrupt
+
+    main = threading.current_thread() is threading.main_thread()  # signal.signal works only there
+    previous = signal.signal(signal.SIGTERM, on_sigterm) if main else None
     try:
         result = run_study(base, request, console)
     except KeyboardInterrupt:
+        how = "" if stopped_by[0] == signal.SIGINT else f" ({signal_name(stopped_by[0])})"
         err_console.print(
-            f"interrupted: every finished row is in {out}; run the same command again to resume", soft_wrap=True
+            f"interrupted{how}: every finished row is in {out}; run the same command again to resume", soft_wrap=True
         )
-        raise typer.Exit(130) from None
+        raise typer.Exit(exit_code(stopped_by[0])) from None
+    finally:
+        if main:
+            signal.signal(signal.SIGTERM, previous)
     _report(console, result, request, name, im, picture, recording)
 
 

@@ -161,3 +161,23 @@ def test_ctrl_c_on_a_local_cluster_study_is_one_line(tmp_path):
     assert "Traceback" not in text and "KeyboardInterrupt" not in text, text
     assert "interrupted: every finished row is in" in text
     assert 1 <= len(_read_csv(out)) < 6
+
+
+def test_sigterm_on_a_study_writes_the_finished_rows_and_exits_143(tmp_path):
+    # SIGTERM to the command alone (kill PID, a batch system's time limit) killed it outright: no table,
+    # and multiprocessing's "leaked semaphore" warning on stderr. Now it goes Ctrl-C's way.
+    out = tmp_path / "study.csv"
+    sweep = [sys.executable, "-m", "masonrycli", "sweep", "wall", "--param", "blocks=12", "--duration", "5"]
+    sweep += ["--param", "amp=0.1:0.25:6", "--workers", "2", "--out", out, "--no-recording"]
+    log = tmp_path / "sweep.log"
+    proc = _spawn(sweep, log)
+    try:
+        _wait(lambda: len(_journal_rows(out)) >= 1, 240, "a finished row", {proc: log})
+        proc.send_signal(signal.SIGTERM)
+        assert proc.wait(timeout=120) == 143, _tails({proc: log})
+    finally:
+        _kill(proc)
+    lines = [ln for ln in log.read_text().splitlines() if ln.strip()]
+    assert lines[-1].startswith("interrupted (SIGTERM): every finished row is in"), lines
+    assert not any("semaphore" in ln or "Traceback" in ln for ln in lines), lines
+    assert 1 <= len(_read_csv(out)) < 6
