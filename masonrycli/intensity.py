@@ -13,7 +13,8 @@ name        unit   meaning
 ``pga``     m/s²   peak |a|
 ``pgv``     m/s    peak |v|
 ``arias``   m/s    Arias intensity π/(2g) ∫ a² dt (eqsig, g = 9.81 m/s²)
-``d5_95``   s      significant duration: time between 5 % and 95 % of the Arias intensity
+``d5_95``   s      significant duration: time between 5 % and 95 % of the Arias intensity (NaN when
+                   no sample lies between them: a run of a few steps)
 ``sa``      m/s²   5 %-damped pseudo-spectral acceleration at ``sa_period`` (eqsig, Nigam–Jennings)
 =========== ====== ==========================================================================
 """
@@ -44,8 +45,12 @@ def intensity_measures(velocity, dt: float, sa_period: float = SA_PERIOD) -> dic
     if not np.any(acc):  # a still or constant-velocity ground has no intensity (and eqsig would divide by 0)
         return out | {"arias": 0.0, "d5_95": 0.0, "sa": 0.0}
     signal = eqsig.AccSignal(acc, dt)
-    out["arias"] = float(im.calc_arias_intensity(signal)[-1])
-    out["d5_95"] = float(im.calc_sig_dur(signal))
+    arias = im.calc_arias_intensity(signal)
+    out["arias"] = float(arias[-1])
+    # eqsig's D5–95 indexes the samples strictly between 5 % and 95 % of the final Arias intensity: a run of
+    # a few steps may have none (two steps of a sine from rest), and the duration is then not resolved
+    between = (arias > 0.05 * arias[-1]) & (arias < 0.95 * arias[-1])
+    out["d5_95"] = float(im.calc_sig_dur(signal)) if between.any() else float("nan")
     out["sa"] = float(eqsig.sdof.pseudo_response_spectra(acc, dt, np.array([sa_period]), SA_DAMPING)[2][0])
     return out
 

@@ -279,3 +279,10 @@ def test_command_list_keeps_each_summary_on_one_line():
     out = runner.invoke(app, ["--help"], env={"COLUMNS": "250"}).output
     assert "options given here override the file's values." in out
     assert "print a summary (blocks, supports, mass" in out
+
+
+def test_a_two_step_run_completes():
+    # It wrote its outputs, then ended in "internal error: IndexError" (exit 1) computing D5–95.
+    result = invoke("simulate", "wall", "--duration", 0.002, "--no-recording")
+    assert result.exit_code == 0, result.output
+    assert "D5–95 nan s" in " ".join(result.output.split())

@@ -48,3 +48,18 @@ def test_still_ground_and_shaking_support():
     assert shaking_support([Fixed(), Constant(velocity=(0, -0.01)), rec]) == 2
     assert shaking_support([Fixed()]) is None
     assert describe({"pga": 9.80665, "pgv": 1, "arias": 2, "d5_95": 3, "sa": 4}).startswith("PGA 9.81 m/s² (1 g)")
+
+
+def test_a_run_of_two_steps_has_no_resolved_significant_duration():
+    # `masonry simulate wall --duration 0.002` ended in "internal error: IndexError" (exit 1) after
+    # writing its outputs: eqsig's D5–95 indexes the samples strictly between 5 % and 95 % of the Arias
+    # intensity, and two steps of a sine from rest have none. The other measures stand.
+    dt = 1e-3
+    t = np.arange(3) * dt
+    v = Sine(amplitude=1.0, frequency=2.0).velocity_at(t)[:, 0]
+    ims = intensity_measures(v, dt)
+    assert np.isnan(ims["d5_95"])
+    acc = np.diff(v) / dt
+    assert ims["pga"] == pytest.approx(np.abs(acc).max()) and ims["pgv"] == pytest.approx(np.abs(v).max())
+    # Arias by the trapezoid rule over the two acceleration samples
+    assert ims["arias"] == pytest.approx(np.pi / (2 * 9.81) * dt * (acc[0] ** 2 + acc[1] ** 2) / 2, rel=1e-9)
