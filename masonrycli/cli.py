@@ -192,8 +192,7 @@ def _execute(scenario, opts: dict, hint: str = "") -> None:
     from masonrycli.sinks import DIVERGED, FAILED
 
     check_sampling(scenario)
-    if opts["magnify"] is not None and not opts["magnify"] >= 1.0:
-        raise InputError(f"--magnify {opts['magnify']}: must be >= 1")
+    _check_magnify(opts["magnify"])
     outputs = plan_outputs(
         scenario, opts["out"], opts["history"], no_recording=opts["no_recording"], force=opts["force"]
     )
@@ -227,6 +226,16 @@ def _execute(scenario, opts: dict, hint: str = "") -> None:
         raise typer.Exit(exit_code(outcome.signum))
     if result.status == DIVERGED:
         raise typer.Exit(EXIT_DIVERGED)
+
+
+MAX_MAGNIFY = 1e6
+"""Largest --magnify: beyond it a millimetre is drawn a kilometre long (1e300 overflowed the recording's
+float32 coordinates to inf, with a RuntimeWarning)."""
+
+
+def _check_magnify(magnify: float | None) -> None:
+    if magnify is not None and not 1.0 <= magnify <= MAX_MAGNIFY:
+        raise InputError(f"--magnify {magnify:g}: must be between 1 and {MAX_MAGNIFY:g}")
 
 
 def _pop(opts: dict, *groups: dict) -> dict:
@@ -376,8 +385,7 @@ def check_command(scenario_file: ScenarioFile, **opts) -> None:
 
     scenario = _load(scenario_file, opts)
     check_sampling(scenario)
-    if opts["magnify"] is not None and not opts["magnify"] >= 1.0:
-        raise InputError(f"--magnify {opts['magnify']}: must be >= 1")
+    _check_magnify(opts["magnify"])
     outputs = plan_outputs(
         scenario, opts["out"], opts["history"], no_recording=opts["no_recording"], force=opts["force"]
     )

@@ -99,6 +99,11 @@ def test_check_prints_summary():
         ),
         # absurd block counts used to build for minutes with no word
         (("simulate", "wall", "--blocks", 10**8, "--duration", 0.01), ["100000000 blocks", "likely typo"]),
+        (
+            ("simulate", "wall", "--duration", 0.01, "--magnify", 1e300),
+            ["--magnify 1e+300: must be between 1 and 1e+06"],
+        ),
+        (("simulate", "wall", "--duration", 0.01, "--magnify", 0.5), ["--magnify 0.5: must be between 1"]),
         # --out was ignored: the recording asked for was silently not written
         (("simulate", "wall", "--duration", 0.01, "--out", "x.rrd"), ["--out x.rrd with --no-recording"]),
     ],
