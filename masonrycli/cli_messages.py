@@ -43,6 +43,10 @@ def user_errors(func):
             return func(*args, **kwargs)
         except (InputError, GeometryError) as exc:
             fail(str(exc).splitlines()[0] if str(exc) else type(exc).__name__)
+        except BrokenPipeError:
+            # the reader of stdout went away (`masonry limit arch --json | head -c 100`): not bad input;
+            # click stops quietly with exit 1, as it does when the pipe breaks outside a command
+            raise
         except OSError as exc:
             fail(f"{exc.filename or ''}: {exc.strerror or exc}".lstrip(": "))
 

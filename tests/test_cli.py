@@ -291,3 +291,18 @@ def test_a_two_step_run_completes():
     result = invoke("simulate", "wall", "--duration", 0.002, "--no-recording")
     assert result.exit_code == 0, result.output
     assert "D5–95 nan s" in " ".join(result.output.split())
+
+
+def test_a_closed_stdout_is_not_bad_input(tmp_path):
+    # `masonry limit arch --json | head -c 10` printed "error: Broken pipe" and exit 2 (bad input); now it
+    # stops quietly as click does for the other commands (exit 1, nothing on stderr).
+    import os
+    import subprocess
+    import sys
+
+    env = os.environ | {"RERUN_ANALYTICS": "0"}
+    cmd = [sys.executable, "-m", "masonrycli", "limit", DATA / "validation" / "column5.toml", "--json"]
+    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, env=env)
+    proc.stdout.close()  # the reader is gone before the first write
+    err = proc.stderr.read().decode()
+    assert proc.wait(timeout=120) == 1 and err == "", err
