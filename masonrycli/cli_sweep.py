@@ -244,6 +244,14 @@ def _report(console, result, request, name: str, im: str, plot: OutputFile, reco
     if "record" in [a.name for a in axes] and not request.find:
         if fit is None:
             console.print("fragility: no fit (every run collapsed, or none did)")
+        elif fit.separated is not None:
+            stood, fell = fit.separated
+            unit = UNITS[im]
+            console.print(
+                f"fragility ({im}): not resolved — every collapse ({im} ≥ {fell:.4g} {unit}) is above every run "
+                f"that stood (≤ {stood:.4g} {unit}): the median θ is anywhere between, the dispersion β → 0; more "
+                f"records or scales are needed ({fit.collapsed} of {fit.runs} runs collapsed)"
+            )
         else:
             console.print(
                 f"fragility ({im}): median θ = {fit.median:.4g} {UNITS[im]}, dispersion β = {fit.dispersion:.3f} "

@@ -167,3 +167,12 @@ def test_lognormal_fit_recovers_known_median_and_dispersion():
     assert fit.median == pytest.approx(theta, rel=0.05) and fit.dispersion == pytest.approx(beta, rel=0.1)
     assert fit.probability([theta])[0] == pytest.approx(0.5, abs=0.03)
     assert fit_lognormal([1, 2], [True, True]) is None and fit_lognormal([1], [True]) is None
+    assert fit.separated is None
+
+
+def test_lognormal_fit_of_separated_runs_says_the_dispersion_is_not_resolved():
+    # Every collapse above every run that stood: the likelihood grows without end as β -> 0, and the fit
+    # stopped near its 0.01 bound, which `masonry sweep` printed as "dispersion β = 0.016".
+    fit = fit_lognormal([1.0, 1.5, 2.0, 3.0, 4.0], [False, False, False, True, True], "pgv")
+    assert fit.separated == (2.0, 3.0) and 2.0 <= fit.median <= 3.0 and fit.dispersion < 0.05
+    assert fit_lognormal([1.0, 2.0, 3.0, 4.0], [False, True, False, True]).separated is None

@@ -85,7 +85,8 @@ def _log_fragility(rec, rows: list[dict], fit, im: str) -> None:
     if fit is not None and np.isfinite(x).any():
         grid = np.linspace(0, np.nanmax(x) * 1.2, 200)[1:]
         curve = np.stack([grid, fit.probability(grid)], axis=1)
-        label = viewer_safe_text(f"lognormal: median {fit.median:.3g}, dispersion {fit.dispersion:.2f}")
+        text = f"median {fit.median:.3g}, dispersion {fit.dispersion:.2f}"
+        label = viewer_safe_text("lognormal: " + ("not resolved (runs separated)" if fit.separated else text))
         rec.log("study/fragility/fit", rr.LineStrips2D([curve], labels=[label]), static=True)
 
 

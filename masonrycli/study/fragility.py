@@ -22,6 +22,9 @@ class Fragility:
     runs: int
     collapsed: int
     im: str
+    separated: tuple[float, float] | None = None
+    """(highest IM that stood, lowest that collapsed) when every collapse lies above every survivor: the
+    likelihood then grows without end as β -> 0, so β is only the bound the fit stopped at (not resolved)."""
 
     def probability(self, x) -> np.ndarray:
         from scipy.stats import norm
@@ -58,10 +61,12 @@ def fit_lognormal(im, collapsed, name: str = "im") -> Fragility | None:
     start[1] = min(max(start[1], bounds[1][0]), bounds[1][1])
     options = {"xatol": 1e-10, "fatol": 1e-12, "maxiter": 4000}
     best = minimize(nll, start, method="Nelder-Mead", bounds=bounds, options=options)
+    stood, fell = float(x[~y].max()), float(x[y].min())
     return Fragility(
         median=float(math.exp(best.x[0])),
         dispersion=float(math.exp(best.x[1])),
         runs=int(x.size),
         collapsed=int(y.sum()),
         im=name,
+        separated=(stood, fell) if stood < fell else None,
     )

@@ -88,7 +88,9 @@ def fragility_curve(rows: list[dict], im: str, fit, path: Path, title: str, unit
             fit.probability(grid),
             "-",
             color="#1f5fa8",
-            label=f"lognormal: θ = {fit.median:.3g} {unit}, β = {fit.dispersion:.2f}",
+            label="lognormal: not resolved (runs separated: β → 0)"
+            if fit.separated
+            else f"lognormal: θ = {fit.median:.3g} {unit}, β = {fit.dispersion:.2f}",
         )
     ax.set_xlabel(f"{im} ({unit})")
     ax.set_ylabel("P(collapse)")
