@@ -143,22 +143,23 @@ def run(
         f" at {engine['path']}; {duration:g} s a run",
         flush=True,
     )
-    runs = []
+    runs: list[dict] = []
+    doc = {"engine": engine, "duration": duration, "jitter": jitter, "runs": runs}
     for case in cases:
         print(f"\n{case}\n| A m/s | f Hz | φ | copy | mean units | max | unconverged | CPU s |\n" + "|---" * 8 + "|")
         for motion in motions:
             for copy in copies:
                 r = run_one(case, motion, duration, jitter, copy)
                 runs.append(r)
+                if out is not None:  # after every run: an ensemble stopped halfway keeps what it ran
+                    out.write_text(json.dumps(doc, indent=1))
                 print(
                     f"| {r['amplitude']:g} | {r['frequency']:g} | {r['phase']:g} | {copy} | {r['mean']:.0f} | {r['max']} |"
                     f" {r['unconverged']} | {r['cpu_s']:.1f} |",
                     flush=True,
                 )
         print(spread_line([r["mean"] for r in runs if r["case"] == case]))
-    doc = {"engine": engine, "duration": duration, "jitter": jitter, "runs": runs}
     if out is not None:
-        out.write_text(json.dumps(doc, indent=1))
         print(f"\nwrote {out}")
     return doc
 
