@@ -42,6 +42,7 @@ def test_each_method_alone_finishes_the_step(monkeypatch):
     v_gs, _, _, _ = _solve(problem, "nlgs", 1e-10)
     monkeypatch.setattr(momentum, "STALL_SWEEPS", 1)
     monkeypatch.setattr(stalled, "FIRST_BUDGET", 3)
+    monkeypatch.setattr(stalled, "NEWTON_LAST_ROUND", 99)  # alone, newton must go on past its one round
     for method in stalled.METHODS:
         monkeypatch.setattr(stalled, "METHODS", (method,))
         v, r, its, res = _solve(problem, "nlgs-accel", 1e-10)
@@ -56,32 +57,42 @@ def test_at_the_cap_the_lowest_residual_is_kept_and_the_step_counts_unconverged(
     monkeypatch.setattr(stalled, "FIRST_BUDGET", 2)
     cap = 40
     v, r, its, res = _solve(problem, "nlgs-accel", 1e-14, cap=cap)
-    assert its == cap and res > 1e-14
+    # faces count a face sweep as a few units and may pass the cap by their last sweep (here 2 units given, 5 done)
+    assert cap <= its <= cap + 3 and res > 1e-14
     np.testing.assert_allclose(v.ravel(), v0.ravel() + m_inv @ h @ r.ravel(), atol=1e-12)
     # the state kept is one of the methods' iterates after a sweep: impulses inside the Coulomb cone
     assert (r[:, 1] >= 0).all() and (np.abs(r[:, 0]) <= mu * r[:, 1] + 1e-15).all()
 
 
 def test_a_method_that_ends_a_round_no_lower_than_before_is_dropped(monkeypatch):
-    # The round-robin alone, with scripted methods: "turning" improves every round, "alternating" ends its
-    # second round where it ended its first (it cycles), "faces" stalls inside its first budget. Only
-    # "turning" goes on, with doubling budgets, until it meets the tolerance; every unit is counted.
-    script = {"turning": [1e-3, 1e-4, 1e-5, 1e-7], "alternating": [1e-3, 1e-3, 1e-9], "faces": [1e-3]}
+    # The round-robin alone, with scripted methods: "turning" improves every round, "newton" gets twice the
+    # budget in the first round only, "alternating" ends its second round where it ended its first (it
+    # cycles), "faces" stalls inside its first budget. Only "turning" goes on, with doubling budgets, until
+    # it meets the tolerance; every unit is counted.
+    script = {
+        "turning": [1e-3, 1e-4, 1e-5, 1e-7],
+        "newton": [1e-4, 1e-9],
+        "alternating": [1e-3, 1e-3, 1e-9],
+        "faces": [1e-3],
+    }
     calls = []
 
-    def scripted(name, state, contact_body, pack, count, mu, tolerance, units, v_free):
+    def scripted(name, state, contact_body, pack, count, mu, tolerance, units, v_free, limit):
         calls.append((name, units))
         state.v, state.residual = v_free + len(calls), script[name].pop(0)
         return units // 2 if name == "faces" else units
 
     monkeypatch.setattr(stalled, "_resume", scripted)
-    monkeypatch.setattr(stalled, "METHODS", ("turning", "alternating", "faces"))
+    monkeypatch.setattr(stalled, "METHODS", ("turning", "newton", "alternating", "faces"))
+    monkeypatch.setattr(stalled, "NEWTON_BUDGET", 2)
+    monkeypatch.setattr(stalled, "NEWTON_LAST_ROUND", 0)
     monkeypatch.setattr(stalled, "FIRST_BUDGET", 10)
     count = 2
     v, r, status = np.zeros((2, 3)), np.zeros((count, 2)), np.zeros(count, dtype=np.int8)
     its, res = stalled.continue_stalled(None, None, count, 0.5, 1e-6, 10**6, v, r, status, np.zeros((2, 3)), r, 7, 1e-2)
     assert calls == [
         ("turning", 10),
+        ("newton", 20),
         ("alternating", 10),
         ("faces", 10),
         ("turning", 20),
@@ -89,5 +100,5 @@ def test_a_method_that_ends_a_round_no_lower_than_before_is_dropped(monkeypatch)
         ("turning", 40),
         ("turning", 80),
     ]
-    assert res == 1e-7 and its == 7 + 10 + 10 + 5 + 20 + 20 + 40 + 80
-    assert (v == 7).all()  # the state of the method that met the tolerance (set at the 7th call)
+    assert res == 1e-7 and its == 7 + 10 + 20 + 10 + 5 + 20 + 20 + 40 + 80
+    assert (v == 8).all()  # the state of the method that met the tolerance (set at the 8th call)

@@ -41,24 +41,32 @@ from __future__ import annotations
 
 import numpy as np
 
-from masonrycli.engine import faces, nlgs
+from masonrycli.engine import faces, newton, nlgs
 
 FIRST_BUDGET = 2000
 """Sweep units each method gets in the first round; doubled every round (module doc)."""
 
-METHODS = ("turning", "alternating", "momentum", "faces")
+METHODS = ("turning", "newton", "alternating", "momentum", "faces")
 """The order in which a round visits the methods: the one that finishes most stalled steps first."""
+
+
+NEWTON_BUDGET = 2
+"""newton's budget in a round, in units of the others'."""
+
+NEWTON_LAST_ROUND = 0
+"""The last round (0-based) in which "newton" takes part."""
 
 
 class _State:
     """One method's iterate: velocities (None until first run), impulses, statuses, last residual and the
     lowest residual it ended a round with (m/s)."""
 
-    __slots__ = ("v", "r", "status", "residual", "low")
+    __slots__ = ("v", "r", "status", "residual", "low", "iterate", "shift")
 
     def __init__(self, v, r, status, residual):
         self.v, self.r, self.status, self.residual = v, r, status, residual
         self.low = np.inf
+        self.iterate = None  # newton: its own iterate, r being that of its last check sweep
 
 
 def continue_stalled(
@@ -72,6 +80,7 @@ def continue_stalled(
     ``v``, ``r``, ``status`` of the method that met ``tolerance`` (or, at ``cap``, of the lowest residual).
     Returns (iterations including the earlier ones, residual)."""
     states = {
+        "newton": _State(None, r_warm[:count].copy(), status[:count].copy(), np.inf),
         "turning": _State(None, r_warm[:count].copy(), status[:count].copy(), np.inf),
         "alternating": _State(None, r_warm[:count].copy(), status[:count].copy(), np.inf),
         "momentum": _State(v.copy(), r[:count].copy(), status[:count].copy(), residual),  # goes on
@@ -79,13 +88,17 @@ def continue_stalled(
     }
     active = list(METHODS)
     budget = FIRST_BUDGET
+    round_ = 0
     while iterations < cap and active:
         for name in list(active):
-            units = min(budget, cap - iterations)
+            if name == "newton" and round_ > NEWTON_LAST_ROUND:
+                active.remove(name)
+                continue
+            units = min(budget * (NEWTON_BUDGET if name == "newton" else 1), cap - iterations)
             if units <= 0:
                 break
             state = states[name]
-            done = _resume(name, state, contact_body, pack, count, mu, tolerance, units, v_free)
+            done = _resume(name, state, contact_body, pack, count, mu, tolerance, units, v_free, cap - iterations)
             iterations += done
             if state.residual <= tolerance:
                 _adopt(state, v, r, status, count)
@@ -96,16 +109,38 @@ def continue_stalled(
                 active.remove(name)
             state.low = min(state.low, state.residual)
         budget *= 2
+        round_ += 1
     best = min((s for s in states.values() if s.v is not None), key=lambda s: s.residual)
     _adopt(best, v, r, status, count)
     return iterations, best.residual
 
 
-def _resume(name, state, contact_body, pack, count, mu, tolerance, units, v_free) -> int:
+def _resume(name, state, contact_body, pack, count, mu, tolerance, units, v_free, limit) -> int:
     # Each method goes on from its own iterate. The sweeps of nlgs rebuild v from v_free and r on entry
     # (v = v_free + M⁻¹ H r), so their state is r alone; faces carry v along with r. Momentum, turning or
     # not, restarts its extrapolation (β = 0, forward) at every resume and gets the whole budget as its
     # stall window: what finishes the steps it finishes is going on through its plateaus.
+    if name == "newton":
+        if state.iterate is None:
+            state.iterate = state.r.copy()
+            state.v = v_free.copy()
+            state.shift = [newton.LAMBDA]
+        done, state.residual = newton.newton_steps(
+            contact_body,
+            pack,
+            count,
+            mu,
+            tolerance,
+            units,
+            limit,
+            v_free,
+            state.iterate,
+            state.r,
+            state.v,
+            state.status,
+            state.shift,
+        )
+        return done
     if name == "faces":
         done, state.residual = faces.face_sweeps(
             contact_body, pack, count, mu, tolerance, units, state.v, state.r, state.status

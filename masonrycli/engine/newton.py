@@ -1,0 +1,290 @@
+"""Alart–Curnier semismooth Newton on one step's contact problem: the fifth method of a stalled solve.
+
+Unknowns: the impulses r (C, 2); v(r) = v_free + M⁻¹ H r, u = Hᵀ v(r) (nlgs's notation). Per contact, with
+W = W_αα's diagonal entries (W_tt, W_nn; 1/W is Alart–Curnier's step ρ) and the Signorini bias b,
+
+    x   = r_n − (u_n + b) / W_nn
+    F_n = W_nn (r_n − max(x, 0))                         (Signorini: r_n ≥ 0 ⊥ u_n + b ≥ 0)
+    F_t = W_tt (r_t − clip(y, −s, s)),  y = r_t − u_t / W_tt,  s = μ max(x, 0)   (Coulomb; AC's original
+                                                         augmented threshold: the limit opens with x)
+
+F = 0 exactly on nlgs's contact law, in velocity units (m/s per component). Its generalised Jacobian is
+F' = A Hᵀ M⁻¹ H + B with A = ∂F/∂u and B = ∂F/∂r upper triangular 2×2 per contact:
+
+    closed (x > 0):               ∂F_n/∂u_n = 1                  else ∂F_n/∂r_n = W_nn
+    stick (|y| < s):              ∂F_t/∂u_t = 1                  else ∂F_t/∂r_t = W_tt, and sliding with
+                                  x > 0, σ = sign(y):  ∂F_t/∂r_n = −W_tt μ σ,  ∂F_t/∂u_n = W_tt μ σ / W_nn
+
+Hᵀ M⁻¹ H is singular on a hyperstatic wall, so the step is Levenberg–Marquardt shifted, B → B + λ D,
+D = diag(W), λ held at LAMBDA. B + λD is invertible per contact, so dr is eliminated and the Newton system is
+the 3B velocity system (sparse, one scipy splu per Newton step):
+
+    (M + H (B + λD)⁻¹ A Hᵀ) dv = −H (B + λD)⁻¹ F,    dr = (B + λD)⁻¹ (−F − A Hᵀ dv)
+
+One resume for a budget of sweep units (stalled.py; the state r carries over between resumes):
+
+    loop while units < budget:
+        F = F(r);  K, rhs = the system above;  dr from splu(K)          (NEWTON_UNITS)
+        α = 1, ½, ¼ … ≥ ALPHA_MIN: accept the first with ½|F(r + α dr)|² ≤ (1 − 2σα) ½|F(r)|²  (Armijo)
+        accepted: r += α dr
+        rejected: WATCHDOG plain engine sweeps from r                   (WATCHDOG units)
+        check: one plain engine sweep from a copy of r                  (1 unit): its residual is the
+               engine's measure (nlgs module doc); the swept copy is the state the method reports
+               (v, r, status consistent); ≤ tolerance → done
+
+Units. A Newton step's CPU time is not deterministic, so it counts a fixed NEWTON_UNITS sweep units: the
+lab's measured cost of one step (assembly, splu, solve and line search) on the 496- and 992-block walls
+(benchmarks/README.md, "Alart–Curnier": ≈ 185 units, ~4 ms / 8 ms). Every engine sweep counts one.
+splu of the same matrix gives the same factors, so the iterates are bit-identical from run to run.
+
+Lab figures (variant ``ac-aug-l3``, from the step's warm start, alone): 8 of 9 captured stalled steps of
+the 32- and 64-course walls converged in 0.14–0.93× the engine's units (h64-108 7041 against 51 926,
+h32-99 6709 against 27 240, h32-106 2839 against 13 238); h32-87 not converged. From momentum's stalled
+iterate instead of the warm start it does worse, hence stalled.py starts it from r_warm.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+
+from masonrycli.engine import nlgs
+from masonrycli.engine._jit import njit
+from masonrycli.engine.nlgs import P_BIAS, P_IIA, P_IIB, P_IMA, P_IMB, P_NA, P_NB, P_NX, P_NY, P_TA, P_TB, P_WNN, P_WTT
+
+LAMBDA = 1e-3
+"""Levenberg–Marquardt shift λ (× diag W): the lowest; × 10 after a rejected step, ÷ 4 after a full one."""
+LAMBDA_MAX = 1.0
+SIGMA = 1e-4
+"""Armijo's sufficient-decrease constant."""
+ALPHA_MIN = 2.0**-10
+"""Shortest step the line search tries before the Newton step is rejected."""
+WATCHDOG = 20
+"""Plain engine sweeps after a rejected Newton step."""
+NEWTON_UNITS = 200
+"""Sweep units one Newton step counts (module doc, "Units")."""
+NEWTON_SHARE = 0.5
+"""Share of a resume's budget spent on Newton steps; the rest goes to the sweeps from the Newton iterate."""
+PERMC = "MMD_AT_PLUS_A"
+"""splu ordering: symmetric mode without pivoting (the matrix is nearly symmetric; the lab measured 12.8 ms
+and 1.9e5 factor nonzeros at 992 blocks against 16.7 ms / 3.5e5 with COLAMD and partial pivoting)."""
+
+# Columns of the per-contact Jacobian pieces (module doc): A = [[a_t, a_tn], [0, a_n]], B = [[b_t, b_tn], [0, b_n]].
+J_AT, J_AN, J_ATN, J_BT, J_BN, J_BTN = 0, 1, 2, 3, 4, 5
+
+
+@njit(inline="always")
+def _rows(pack, c):
+    # Hᵀ's two rows for contact c on (a's dofs, b's dofs), as nlgs._relative_velocity reads them:
+    #   u_t = (v_b − v_a)·t + ω_b (r_b×t) − ω_a (r_a×t),  t = (n_y, −n_x);  u_n likewise with n.
+    nx = pack[c, P_NX]
+    ny = pack[c, P_NY]
+    return (-ny, nx, -pack[c, P_TA], ny, -nx, pack[c, P_TB]), (-nx, -ny, -pack[c, P_NA], nx, ny, pack[c, P_NB])
+
+
+@njit
+def _velocity(contact_body, pack, count, v_free, r, out_v):
+    # v = v_free + M⁻¹ H r (nlgs._push of every impulse).
+    out_v[:] = v_free
+    for c in range(count):
+        nlgs._push(out_v, contact_body[c, 0], contact_body[c, 1], pack, c, r[c, 0], r[c, 1])
+
+
+@njit
+def _phi(contact_body, pack, count, mu, v, r, out_f, out_jac):
+    # F(r) per contact (module doc) at velocities v = v(r), its Jacobian pieces in out_jac (C, 6);
+    # returns the merit ½|F|².
+    merit = 0.0
+    for c in range(count):
+        ut, un = nlgs._relative_velocity(v, contact_body[c, 0], contact_body[c, 1], pack, c)
+        wt = pack[c, P_WTT]
+        wn = pack[c, P_WNN]
+        rt = r[c, 0]
+        rn = r[c, 1]
+        x = rn - (un + pack[c, P_BIAS]) / wn
+        closed = x > 0.0
+        s = mu * x if closed else 0.0
+        y = rt - ut / wt
+        stick = abs(y) < s
+        ft = wt * (rt - min(max(y, -s), s))
+        fn = wn * (rn - (x if closed else 0.0))
+        out_f[c, 0] = ft
+        out_f[c, 1] = fn
+        merit += 0.5 * (ft * ft + fn * fn)
+        sy = 1.0 if y > 0.0 else (-1.0 if y < 0.0 else 0.0)
+        slide = closed and not stick
+        out_jac[c, J_AT] = 1.0 if stick else 0.0
+        out_jac[c, J_AN] = 1.0 if closed else 0.0
+        out_jac[c, J_ATN] = wt / wn * mu * sy if slide else 0.0
+        out_jac[c, J_BT] = 0.0 if stick else wt
+        out_jac[c, J_BN] = 0.0 if closed else wn
+        out_jac[c, J_BTN] = -wt * mu * sy if slide else 0.0
+    return merit
+
+
+@njit
+def _merit(contact_body, pack, count, mu, v_free, r, v_work, f_work, jac_work):
+    # ½|F(r)|² (the line search's test): v(r), then F.
+    _velocity(contact_body, pack, count, v_free, r, v_work)
+    return _phi(contact_body, pack, count, mu, v_work, r, f_work, jac_work)
+
+
+@njit
+def _system(contact_body, pack, count, lam, f, jac, body_count, rows, cols, vals, rhs):
+    # COO triplets of K = M + H G Hᵀ and rhs = −H (B + λD)⁻¹ F over the 3B velocity dofs, where per contact
+    #   B' = B + λ diag(W_tt, W_nn),  G = B'⁻¹ A = [[a_t/b_t, a_tn/b_t − b_tn a_n/(b_t b_n)], [0, a_n/b_n]]
+    #   K += h_iᵀ G_ij h_j over the 6 dofs of (a, b) that move (a support's inverse mass is 0: its rows stay
+    #   the identity, its rhs 0, so dv = 0 there), K_dd = m (1/inverse mass) or 1 for a body that cannot move.
+    # Returns the number of triplets written (rows/cols/vals sized 3B + 36 C).
+    n = 0
+    for d in range(3 * body_count):
+        rows[d] = d
+        cols[d] = d
+        vals[d] = 1.0
+        rhs[d] = 0.0
+    for c in range(count):
+        a = contact_body[c, 0]
+        b = contact_body[c, 1]
+        if pack[c, P_IMA] > 0.0:
+            vals[3 * a] = 1.0 / pack[c, P_IMA]
+            vals[3 * a + 1] = 1.0 / pack[c, P_IMA]
+            vals[3 * a + 2] = 1.0 / pack[c, P_IIA]
+        if pack[c, P_IMB] > 0.0:
+            vals[3 * b] = 1.0 / pack[c, P_IMB]
+            vals[3 * b + 1] = 1.0 / pack[c, P_IMB]
+            vals[3 * b + 2] = 1.0 / pack[c, P_IIB]
+    n = 3 * body_count
+    ht = np.empty(6)
+    hn = np.empty(6)
+    dof = np.empty(6, dtype=np.int64)
+    moves = np.empty(6, dtype=np.bool_)
+    for c in range(count):
+        a = contact_body[c, 0]
+        b = contact_body[c, 1]
+        rt_, rn_ = _rows(pack, c)
+        for k in range(6):
+            ht[k] = rt_[k]
+            hn[k] = rn_[k]
+            dof[k] = 3 * a + k if k < 3 else 3 * b + k - 3
+            moves[k] = pack[c, P_IMA] > 0.0 if k < 3 else pack[c, P_IMB] > 0.0
+        bt = jac[c, J_BT] + lam * pack[c, P_WTT]
+        bn = jac[c, J_BN] + lam * pack[c, P_WNN]
+        gt = jac[c, J_AT] / bt
+        gn = jac[c, J_AN] / bn
+        gtn = jac[c, J_ATN] / bt - jac[c, J_BTN] * jac[c, J_AN] / (bt * bn)
+        zn = f[c, 1] / bn  # z = B'⁻¹ F (upper triangular)
+        zt = (f[c, 0] - jac[c, J_BTN] * zn) / bt
+        for i in range(6):
+            if not moves[i]:
+                continue
+            rhs[dof[i]] -= ht[i] * zt + hn[i] * zn
+            # row i of Hᵀ… : (h_t,i, h_n,i) G (h_t,j, h_n,j)ᵀ
+            left_t = ht[i] * gt
+            left_n = ht[i] * gtn + hn[i] * gn
+            for j in range(6):
+                if not moves[j]:
+                    continue
+                rows[n] = dof[i]
+                cols[n] = dof[j]
+                vals[n] = left_t * ht[j] + left_n * hn[j]
+                n += 1
+    return n
+
+
+@njit
+def _step_back(contact_body, pack, count, lam, f, jac, dv, out_dr):
+    # dr = B'⁻¹ (−F − A Hᵀ dv) per contact.
+    for c in range(count):
+        ut, un = nlgs._relative_velocity(dv, contact_body[c, 0], contact_body[c, 1], pack, c)
+        bt = jac[c, J_BT] + lam * pack[c, P_WTT]
+        bn = jac[c, J_BN] + lam * pack[c, P_WNN]
+        xt = -f[c, 0] - jac[c, J_AT] * ut - jac[c, J_ATN] * un
+        xn = -f[c, 1] - jac[c, J_AN] * un
+        drn = xn / bn
+        out_dr[c, 0] = (xt - jac[c, J_BTN] * drn) / bt
+        out_dr[c, 1] = drn
+
+
+def newton_direction(contact_body, pack, count, v_free, f, jac, lam=LAMBDA):
+    """dr (C, 2) of the shifted Newton system (module doc) at F = ``f`` (C, 2) with Jacobian pieces ``jac``."""
+    bodies = v_free.shape[0]
+    size = 3 * bodies + 36 * count
+    rows, cols = np.empty(size, dtype=np.int64), np.empty(size, dtype=np.int64)
+    vals, rhs = np.empty(size), np.empty(3 * bodies)
+    n = _system(contact_body, pack, count, lam, f, jac, bodies, rows, cols, vals, rhs)
+    K = sp.csc_matrix((vals[:n], (rows[:n], cols[:n])), shape=(3 * bodies, 3 * bodies))
+    lu = spla.splu(K, permc_spec=PERMC, diag_pivot_thresh=0.0, options={"SymmetricMode": True})
+    dv = lu.solve(rhs).reshape(bodies, 3)
+    dr = np.empty((count, 2))
+    _step_back(contact_body, pack, count, lam, f, jac, dv, dr)
+    return dr
+
+
+def newton_matrix(contact_body, pack, count, bodies, f, jac, lam=LAMBDA):
+    """(K (3B × 3B csc), rhs (3B,)) of the velocity system, for tests."""
+    size = 3 * bodies + 36 * count
+    rows, cols = np.empty(size, dtype=np.int64), np.empty(size, dtype=np.int64)
+    vals, rhs = np.empty(size), np.empty(3 * bodies)
+    n = _system(contact_body, pack, count, lam, f, jac, bodies, rows, cols, vals, rhs)
+    return sp.csc_matrix((vals[:n], (rows[:n], cols[:n])), shape=(3 * bodies, 3 * bodies)), rhs
+
+
+def phi(contact_body, pack, count, mu, v_free, r):
+    """(F (C, 2) m/s, Jacobian pieces (C, 6), merit ½|F|²) at impulses ``r``."""
+    v = np.empty_like(v_free)
+    f, jac = np.empty((count, 2)), np.empty((count, 6))
+    _velocity(contact_body, pack, count, v_free, r, v)
+    merit = _phi(contact_body, pack, count, mu, v, r, f, jac)
+    return f, jac, merit
+
+
+def newton_steps(
+    contact_body, pack, count, mu, tolerance, units, limit, v_free, r, r_out, v, status, shift
+) -> tuple[int, float]:
+    """One resume of the method (module doc) for a budget of ``units`` sweep units, never beyond ``limit``
+    (the step's cap): Newton steps from the iterate ``r`` (C, 2, updated in place) for NEWTON_SHARE of the
+    budget, then turning momentum sweeps from a copy of it for the rest, until ``tolerance``. ``r_out``,
+    ``v``, ``status`` get the sweeps' state (consistent: v = v_free + M⁻¹ H r_out). ``shift``: [λ], carried
+    from resume to resume. Returns (units done, the sweeps' residual m/s)."""
+    done = 0
+    residual = np.inf
+    f, jac = np.empty((count, 2)), np.empty((count, 6))
+    ft, jt = np.empty((count, 2)), np.empty((count, 6))
+    work = np.empty_like(v_free)
+    while done < units * NEWTON_SHARE and done + NEWTON_UNITS + WATCHDOG + 1 <= limit:
+        merit = _merit(contact_body, pack, count, mu, v_free, r, work, f, jac)
+        try:
+            dr = newton_direction(contact_body, pack, count, v_free, f, jac, shift[0])
+        except RuntimeError:  # splu: an exactly singular pivot (not seen); the step then counts as rejected
+            dr = None
+        done += NEWTON_UNITS
+        alpha = 1.0
+        accepted = False
+        while dr is not None and alpha >= ALPHA_MIN:
+            trial = r + alpha * dr
+            if (
+                _merit(contact_body, pack, count, mu, v_free, trial, work, ft, jt)
+                <= (1.0 - 2.0 * SIGMA * alpha) * merit
+            ):
+                accepted = True
+                break
+            alpha *= 0.5
+        if accepted:
+            r[:] = trial
+            if alpha == 1.0:
+                shift[0] = max(shift[0] / 4.0, LAMBDA)
+        else:  # a poor model: shift more, and let plain sweeps move r where the line search could not
+            shift[0] = min(10.0 * shift[0], LAMBDA_MAX)
+            work[:] = v_free
+            nlgs._nlgs_interleaved(contact_body, pack, count, mu, 0.0, WATCHDOG, work, r, status, False, 0)
+            done += WATCHDOG
+    sweeps = min(max(units - done, 1), limit - done)
+    if sweeps > 0:
+        r_out[:] = r
+        v[:] = v_free
+        d, residual = nlgs._nlgs_interleaved(
+            contact_body, pack, count, mu, tolerance, sweeps, v, r_out, status, True, sweeps, True
+        )
+        done += d
+    return done, residual
