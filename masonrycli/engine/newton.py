@@ -21,21 +21,23 @@ the 3B velocity system (sparse, one scipy splu per Newton step):
 
     (M + H (B + λD)⁻¹ A Hᵀ) dv = −H (B + λD)⁻¹ F,    dr = (B + λD)⁻¹ (−F − A Hᵀ dv)
 
-One resume for a budget of sweep units (stalled.py; the state r carries over between resumes):
+One resume for a budget of U sweep units (stalled.py; the iterate r and λ carry over between resumes):
 
-    loop while units < budget:
+    while units < NEWTON_SHARE · U:
         F = F(r);  K, rhs = the system above;  dr from splu(K)          (NEWTON_UNITS)
         α = 1, ½, ¼ … ≥ ALPHA_MIN: accept the first with ½|F(r + α dr)|² ≤ (1 − 2σα) ½|F(r)|²  (Armijo)
-        accepted: r += α dr
-        rejected: WATCHDOG plain engine sweeps from r                   (WATCHDOG units)
-        check: one plain engine sweep from a copy of r                  (1 unit): its residual is the
-               engine's measure (nlgs module doc); the swept copy is the state the method reports
-               (v, r, status consistent); ≤ tolerance → done
+        accepted: r += α dr;  λ = max(λ / 4, LAMBDA) if α = 1
+        rejected: λ = min(10 λ, LAMBDA_MAX);  WATCHDOG plain engine sweeps from r   (WATCHDOG units)
+    the rest of U: momentum sweeps turning at restarts (stalled.py's "turning") from a COPY of r, to the
+    tolerance: their residual is the engine's measure (nlgs module doc), their (v, r, status) the state
+    the method reports (consistent), while the next resume goes on from the Newton iterate r
 
-Units. A Newton step's CPU time is not deterministic, so it counts a fixed NEWTON_UNITS sweep units: the
-lab's measured cost of one step (assembly, splu, solve and line search) on the 496- and 992-block walls
-(benchmarks/README.md, "Alart–Curnier": ≈ 185 units, ~4 ms / 8 ms). Every engine sweep counts one.
-splu of the same matrix gives the same factors, so the iterates are bit-identical from run to run.
+Newton alone converges linearly near the solution (λ held, short steps): on the 32-course wall's step
+that turning needs 21 377 units for, its own RMS of F falls from 3e-3 to 1e-5 in ~25 steps (5000 units),
+while turning sweeps from its iterate after 10 steps finish in ~1000 units. On the 98 stalled steps of
+the 32- and 64-course walls' first 0.2 s (captured from the run, each replayed through stalled.py) that
+hybrid takes 0.71× the round-robin's units without it (408 422 → 291 118 units; 0.99× with plain sweeps
+instead of turning ones, 1.23× with Newton steps and a one-sweep check alone).
 
 Lab figures (variant ``ac-aug-l3``, from the step's warm start, alone): 8 of 9 captured stalled steps of
 the 32- and 64-course walls converged in 0.14–0.93× the engine's units (h64-108 7041 against 51 926,

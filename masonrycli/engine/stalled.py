@@ -35,6 +35,18 @@ other than "turning" it took 225 016 units and missed one (the 64-course wall's 
 get there, in 44 797 units alone); "turning" alone 164 706 units, one missed. The fixed chain this module
 replaced (faces for at most 5000 units, plain sweeps from the warm start, faces to the cap) took
 17 816–23 714 units on each of seven sliding steps of the 32-course wall captured from its own run.
+
+Alart–Curnier Newton (:mod:`masonrycli.engine.newton`, "newton": Newton steps from the warm start for
+half its budget, then turning sweeps from its iterate) goes second, with twice the others' budget, in the
+first round only: on the 98 stalled steps of the 32- and 64-course walls' first 0.2 s, replayed, it
+finishes the steps the others take 20 000–50 000 units for in 3000–4000 (the 64-course wall's 51 404 in
+3783), and the round-robin takes 0.71× the units it took without it (0.77× with newton's budget equal to
+the others' in the first two rounds, 0.85× in every round, 1.20× first in the order). Whole runs, first
+0.2 s (sweep units a step, mean / max): 32 courses 1282 / 30 521 against 1353 / 27 240, 64 courses
+1514 / 27 232 against 1780 / 51 926, none unconverged; first 0.3 s: 1044 against 1078 and 1634
+against 1694; the 248-block wall's 1 s unchanged (151 / 3196). The whole runs gain far less than the
+replay: a step solved differently (within the tolerance) sends the run on another trajectory with
+other stalled steps. NOT on main for that reason (2026-11-27, acengine branch).
 """
 
 from __future__ import annotations
@@ -51,10 +63,11 @@ METHODS = ("turning", "newton", "alternating", "momentum", "faces")
 
 
 NEWTON_BUDGET = 2
-"""newton's budget in a round, in units of the others'."""
+"""newton's budget in a round, in units of the others' (module doc)."""
 
 NEWTON_LAST_ROUND = 0
-"""The last round (0-based) in which "newton" takes part."""
+"""The last round (0-based) in which "newton" takes part: it finishes the steps it finishes in its first
+budget, and later ones cost more than they save (module doc)."""
 
 
 class _State:
@@ -66,7 +79,7 @@ class _State:
     def __init__(self, v, r, status, residual):
         self.v, self.r, self.status, self.residual = v, r, status, residual
         self.low = np.inf
-        self.iterate = None  # newton: its own iterate, r being that of its last check sweep
+        self.iterate = None  # newton: its Newton iterate; r is that of its last sweeps
 
 
 def continue_stalled(
