@@ -17,28 +17,40 @@ F' = A Hᵀ M⁻¹ H + B with A = ∂F/∂u and B = ∂F/∂r upper triangular 2
 
 Hᵀ M⁻¹ H is singular on a hyperstatic wall, so the step is Levenberg–Marquardt shifted, B → B + λ D,
 D = diag(W), λ held at LAMBDA. B + λD is invertible per contact, so dr is eliminated and the Newton system is
-the 3B velocity system (sparse, one scipy splu per Newton step):
+the 3B velocity system, banded when bodies are numbered by position (one banded LU per Newton step,
+:mod:`masonrycli.engine.banded`; the bodies in the order banded.body_order gives, once per resume):
 
     (M + H (B + λD)⁻¹ A Hᵀ) dv = −H (B + λD)⁻¹ F,    dr = (B + λD)⁻¹ (−F − A Hᵀ dv)
 
 One resume for a budget of U sweep units (stalled.py; the iterate r and λ carry over between resumes):
 
     while units < NEWTON_SHARE · U:
-        F = F(r);  K, rhs = the system above;  dr from splu(K)          (NEWTON_UNITS)
+        F = F(r);  K, rhs = the system above, into the band;  dr from its LU   (NEWTON_UNITS)
         α = 1, ½, ¼ … ≥ ALPHA_MIN: accept the first with ½|F(r + α dr)|² ≤ (1 − 2σα) ½|F(r)|²  (Armijo)
         accepted: r += α dr;  λ = max(λ / 4, LAMBDA) if α = 1
         rejected: λ = min(10 λ, LAMBDA_MAX);  WATCHDOG plain engine sweeps from r   (WATCHDOG units)
     the rest of U: momentum sweeps turning at restarts (stalled.py's "turning") from a COPY of r, to the
-    tolerance: their residual is the engine's measure (nlgs module doc), their (v, r, status) the state
-    the method reports (consistent), while the next resume goes on from the Newton iterate r
+    tolerance or POLISH_STALL sweeps without a new low: their residual is the engine's measure (nlgs
+    module doc), their (v, r, status) the state the method reports (consistent), while the next resume
+    goes on from the Newton iterate r
 
 Newton alone converges linearly near the solution (λ held, short steps): on the 32-course wall's step
-that turning needs 21 377 units for, its own RMS of F falls from 3e-3 to 1e-5 in ~25 steps (5000 units),
-while turning sweeps from its iterate after 10 steps finish in ~1000 units. On the 98 stalled steps of
-the 32- and 64-course walls' first 0.2 s (captured from the run, each replayed through stalled.py) that
-hybrid takes 0.71× the round-robin's units without it (408 422 → 291 118 units; 0.99× with plain sweeps
-instead of turning ones, 1.23× with Newton steps and a one-sweep check alone).
+that turning needs 21 377 units for, its own RMS of F falls from 3e-3 to 1e-5 in ~25 steps, while turning
+sweeps from its iterate after 10 steps finish in ~1000 units; hence 10 Newton steps a first resume
+(NEWTON_SHARE of stalled.py's 2 × 2000 units) and sweeps from there.
 
+Units. A Newton step costs 46–60 turning sweeps of the same step in CPU (the banded assembly, LU and solve:
+1.2–1.8 ms at 497 bodies, 3.2–4.4 ms at 993, against 30–36 µs and 64–87 µs a sweep; six captured stalled
+steps of the 32- and 64-course walls, CPU minimum of 15 on a loaded machine), plus ~4 evaluations of F in
+its line search at ~1 sweep each: NEWTON_UNITS = 60, a constant so that sweep counts stay deterministic.
+scipy's splu of the same matrix (COO assembly, MMD ordering) took 100–150 sweeps a step, counted as 200.
+
+On the 98 stalled steps of the 32- and 64-course walls' first 0.2 s (captured from main's runs, each
+replayed through stalled.continue_stalled): 408 422 units without this method, 291 118 with it second in
+the order at 200 units a step (splu), 260 206 at 60 units (banded), 256 810 with the polish's stall window,
+233 323 also in the second round, 194 066 (0.48×) first in the order: 10 Newton steps and their sweeps
+then finish 92 of the 98 steps. Chunked sweeps between groups of Newton steps (20, 40, 80 … sweeps every
+5 or 10 steps) took 264 842–272 864 at 60 units.
 Lab figures (variant ``ac-aug-l3``, from the step's warm start, alone): 8 of 9 captured stalled steps of
 the 32- and 64-course walls converged in 0.14–0.93× the engine's units (h64-108 7041 against 51 926,
 h32-99 6709 against 27 240, h32-106 2839 against 13 238); h32-87 not converged. From momentum's stalled
@@ -48,10 +60,8 @@ iterate instead of the warm start it does worse, hence stalled.py starts it from
 from __future__ import annotations
 
 import numpy as np
-import scipy.sparse as sp
-import scipy.sparse.linalg as spla
 
-from masonrycli.engine import nlgs
+from masonrycli.engine import banded, nlgs
 from masonrycli.engine._jit import njit
 from masonrycli.engine.nlgs import P_BIAS, P_IIA, P_IIB, P_IMA, P_IMB, P_NA, P_NB, P_NX, P_NY, P_TA, P_TB, P_WNN, P_WTT
 
@@ -64,14 +74,14 @@ ALPHA_MIN = 2.0**-10
 """Shortest step the line search tries before the Newton step is rejected."""
 WATCHDOG = 20
 """Plain engine sweeps after a rejected Newton step."""
-NEWTON_UNITS = 200
+NEWTON_UNITS = 60
 """Sweep units one Newton step counts (module doc, "Units")."""
-NEWTON_SHARE = 0.5
-"""Share of a resume's budget spent on Newton steps; the rest goes to the sweeps from the Newton iterate."""
-PERMC = "MMD_AT_PLUS_A"
-"""splu ordering: symmetric mode without pivoting (the matrix is nearly symmetric; the lab measured 12.8 ms
-and 1.9e5 factor nonzeros at 992 blocks against 16.7 ms / 3.5e5 with COLAMD and partial pivoting)."""
-
+NEWTON_SHARE = 0.15
+"""Share of a resume's budget spent on Newton steps (10 steps of stalled.py's first 4000 units); the rest
+goes to the sweeps from the Newton iterate."""
+POLISH_STALL = 1000
+"""Sweeps from the Newton iterate without a new lowest residual after which the resume ends (the method is
+then dropped by stalled.py's rule, the budget left to the others)."""
 # Columns of the per-contact Jacobian pieces (module doc): A = [[a_t, a_tn], [0, a_n]], B = [[b_t, b_tn], [0, b_n]].
 J_AT, J_AN, J_ATN, J_BT, J_BN, J_BTN = 0, 1, 2, 3, 4, 5
 
@@ -133,30 +143,26 @@ def _merit(contact_body, pack, count, mu, v_free, r, v_work, f_work, jac_work):
 
 
 @njit
-def _system(contact_body, pack, count, lam, f, jac, body_count, rows, cols, vals, rhs):
-    # COO triplets of K = M + H G Hᵀ and rhs = −H (B + λD)⁻¹ F over the 3B velocity dofs, where per contact
+def _system(contact_body, pack, count, lam, f, jac, body_count, position, w, band, rhs):
+    # K = M + H G Hᵀ into the band (banded.py's storage, half-bandwidth w dofs), rhs = −H (B + λD)⁻¹ F, over
+    # the 3B velocity dofs with body x's at 3 position[x] + (0, 1, 2); per contact
     #   B' = B + λ diag(W_tt, W_nn),  G = B'⁻¹ A = [[a_t/b_t, a_tn/b_t − b_tn a_n/(b_t b_n)], [0, a_n/b_n]]
     #   K += h_iᵀ G_ij h_j over the 6 dofs of (a, b) that move (a support's inverse mass is 0: its rows stay
     #   the identity, its rhs 0, so dv = 0 there), K_dd = m (1/inverse mass) or 1 for a body that cannot move.
-    # Returns the number of triplets written (rows/cols/vals sized 3B + 36 C).
-    n = 0
+    band[:, :] = 0.0
     for d in range(3 * body_count):
-        rows[d] = d
-        cols[d] = d
-        vals[d] = 1.0
+        band[d, w] = 1.0
         rhs[d] = 0.0
     for c in range(count):
-        a = contact_body[c, 0]
-        b = contact_body[c, 1]
-        if pack[c, P_IMA] > 0.0:
-            vals[3 * a] = 1.0 / pack[c, P_IMA]
-            vals[3 * a + 1] = 1.0 / pack[c, P_IMA]
-            vals[3 * a + 2] = 1.0 / pack[c, P_IIA]
-        if pack[c, P_IMB] > 0.0:
-            vals[3 * b] = 1.0 / pack[c, P_IMB]
-            vals[3 * b + 1] = 1.0 / pack[c, P_IMB]
-            vals[3 * b + 2] = 1.0 / pack[c, P_IIB]
-    n = 3 * body_count
+        for side in range(2):
+            x = contact_body[c, side]
+            im = pack[c, P_IMA] if side == 0 else pack[c, P_IMB]
+            ii = pack[c, P_IIA] if side == 0 else pack[c, P_IIB]
+            if im > 0.0:
+                d = 3 * position[x]
+                band[d, w] = 1.0 / im
+                band[d + 1, w] = 1.0 / im
+                band[d + 2, w] = 1.0 / ii
     ht = np.empty(6)
     hn = np.empty(6)
     dof = np.empty(6, dtype=np.int64)
@@ -168,7 +174,7 @@ def _system(contact_body, pack, count, lam, f, jac, body_count, rows, cols, vals
         for k in range(6):
             ht[k] = rt_[k]
             hn[k] = rn_[k]
-            dof[k] = 3 * a + k if k < 3 else 3 * b + k - 3
+            dof[k] = 3 * position[a] + k if k < 3 else 3 * position[b] + k - 3
             moves[k] = pack[c, P_IMA] > 0.0 if k < 3 else pack[c, P_IMB] > 0.0
         bt = jac[c, J_BT] + lam * pack[c, P_WTT]
         bn = jac[c, J_BN] + lam * pack[c, P_WNN]
@@ -187,11 +193,22 @@ def _system(contact_body, pack, count, lam, f, jac, body_count, rows, cols, vals
             for j in range(6):
                 if not moves[j]:
                     continue
-                rows[n] = dof[i]
-                cols[n] = dof[j]
-                vals[n] = left_t * ht[j] + left_n * hn[j]
-                n += 1
-    return n
+                band[dof[i], dof[j] - dof[i] + w] += left_t * ht[j] + left_n * hn[j]
+
+
+@njit
+def _direction(contact_body, pack, count, lam, f, jac, body_count, position, w, band, rhs, dv, out_dr):
+    # dv from the banded system (position order), back to body order, then dr. False on a zero pivot (banded.py).
+    _system(contact_body, pack, count, lam, f, jac, body_count, position, w, band, rhs)
+    n = 3 * body_count
+    if banded.band_lu(band, n, w) >= 0:
+        return False
+    banded.band_solve(band, n, w, rhs)
+    for x in range(body_count):
+        for k in range(3):
+            dv[x, k] = rhs[3 * position[x] + k]
+    _step_back(contact_body, pack, count, lam, f, jac, dv, out_dr)
+    return True
 
 
 @njit
@@ -208,28 +225,42 @@ def _step_back(contact_body, pack, count, lam, f, jac, dv, out_dr):
         out_dr[c, 1] = drn
 
 
-def newton_direction(contact_body, pack, count, v_free, f, jac, lam=LAMBDA):
-    """dr (C, 2) of the shifted Newton system (module doc) at F = ``f`` (C, 2) with Jacobian pieces ``jac``."""
+class Band:
+    """The work arrays of banded Newton steps on one step's problem: the body order and half-bandwidth
+    (banded.body_order), the band (3B, 2w + 1), the right-hand side and dv."""
+
+    def __init__(self, contact_body, pack, count, bodies):
+        coupled = (pack[:count, P_IMA] > 0.0) & (pack[:count, P_IMB] > 0.0)
+        self.position, width = banded.body_order(contact_body[:count], coupled, bodies)
+        self.w = 3 * width + 2  # a body's 3 dofs and its neighbour's at most width bodies away
+        self.band = np.empty((3 * bodies, 2 * self.w + 1))
+        self.rhs = np.empty(3 * bodies)
+        self.dv = np.empty((bodies, 3))
+
+
+def newton_direction(contact_body, pack, count, v_free, f, jac, lam=LAMBDA, band=None):
+    """dr (C, 2) of the shifted Newton system (module doc) at F = ``f`` (C, 2) with Jacobian pieces ``jac``,
+    or None if the banded elimination meets a zero pivot. ``band``: a :class:`Band` of this problem to reuse."""
     bodies = v_free.shape[0]
-    size = 3 * bodies + 36 * count
-    rows, cols = np.empty(size, dtype=np.int64), np.empty(size, dtype=np.int64)
-    vals, rhs = np.empty(size), np.empty(3 * bodies)
-    n = _system(contact_body, pack, count, lam, f, jac, bodies, rows, cols, vals, rhs)
-    K = sp.csc_matrix((vals[:n], (rows[:n], cols[:n])), shape=(3 * bodies, 3 * bodies))
-    lu = spla.splu(K, permc_spec=PERMC, diag_pivot_thresh=0.0, options={"SymmetricMode": True})
-    dv = lu.solve(rhs).reshape(bodies, 3)
+    band = band or Band(contact_body, pack, count, bodies)
     dr = np.empty((count, 2))
-    _step_back(contact_body, pack, count, lam, f, jac, dv, dr)
-    return dr
+    ok = _direction(
+        contact_body, pack, count, lam, f, jac, bodies, band.position, band.w, band.band, band.rhs, band.dv, dr
+    )
+    return dr if ok else None
 
 
 def newton_matrix(contact_body, pack, count, bodies, f, jac, lam=LAMBDA):
-    """(K (3B × 3B csc), rhs (3B,)) of the velocity system, for tests."""
-    size = 3 * bodies + 36 * count
-    rows, cols = np.empty(size, dtype=np.int64), np.empty(size, dtype=np.int64)
-    vals, rhs = np.empty(size), np.empty(3 * bodies)
-    n = _system(contact_body, pack, count, lam, f, jac, bodies, rows, cols, vals, rhs)
-    return sp.csc_matrix((vals[:n], (rows[:n], cols[:n])), shape=(3 * bodies, 3 * bodies)), rhs
+    """(K (3B × 3B dense, body order), rhs (3B,)) of the velocity system, for tests."""
+    band = Band(contact_body, pack, count, bodies)
+    _system(contact_body, pack, count, lam, f, jac, bodies, band.position, band.w, band.band, band.rhs)
+    n, w = 3 * bodies, band.w
+    dofs = (3 * band.position[:, None] + np.arange(3)).ravel()  # body order → band order
+    dense = np.zeros((n, n))
+    for i in range(n):
+        lo, hi = max(0, i - w), min(n - 1, i + w)
+        dense[i, lo : hi + 1] = band.band[i, lo - i + w : hi - i + w + 1]
+    return dense[np.ix_(dofs, dofs)], band.rhs[dofs]
 
 
 def phi(contact_body, pack, count, mu, v_free, r):
@@ -241,12 +272,33 @@ def phi(contact_body, pack, count, mu, v_free, r):
     return f, jac, merit
 
 
+def _newton_step(contact_body, pack, count, mu, v_free, r, status, shift, band, work, f, jac, ft, jt) -> int:
+    # One globalised Newton step from r (in place; module doc); returns the units it counts.
+    merit = _merit(contact_body, pack, count, mu, v_free, r, work, f, jac)
+    dr = newton_direction(contact_body, pack, count, v_free, f, jac, shift[0], band)  # None: rejected
+    alpha = 1.0
+    while dr is not None and alpha >= ALPHA_MIN:
+        trial = r + alpha * dr
+        if _merit(contact_body, pack, count, mu, v_free, trial, work, ft, jt) <= (1.0 - 2.0 * SIGMA * alpha) * merit:
+            r[:] = trial
+            if alpha == 1.0:
+                shift[0] = max(shift[0] / 4.0, LAMBDA)
+            return NEWTON_UNITS
+        alpha *= 0.5
+    # a poor model: shift more, and let plain sweeps move r where the line search could not
+    shift[0] = min(10.0 * shift[0], LAMBDA_MAX)
+    work[:] = v_free
+    nlgs._nlgs_interleaved(contact_body, pack, count, mu, 0.0, WATCHDOG, work, r, status, False, 0)
+    return NEWTON_UNITS + WATCHDOG
+
+
 def newton_steps(
     contact_body, pack, count, mu, tolerance, units, limit, v_free, r, r_out, v, status, shift
 ) -> tuple[int, float]:
     """One resume of the method (module doc) for a budget of ``units`` sweep units, never beyond ``limit``
     (the step's cap): Newton steps from the iterate ``r`` (C, 2, updated in place) for NEWTON_SHARE of the
-    budget, then turning momentum sweeps from a copy of it for the rest, until ``tolerance``. ``r_out``,
+    budget, then turning momentum sweeps from a copy of it for the rest, until ``tolerance`` or a stall of
+    POLISH_STALL sweeps. ``r_out``,
     ``v``, ``status`` get the sweeps' state (consistent: v = v_free + M⁻¹ H r_out). ``shift``: [λ], carried
     from resume to resume. Returns (units done, the sweeps' residual m/s)."""
     done = 0
@@ -254,39 +306,16 @@ def newton_steps(
     f, jac = np.empty((count, 2)), np.empty((count, 6))
     ft, jt = np.empty((count, 2)), np.empty((count, 6))
     work = np.empty_like(v_free)
+    band = Band(contact_body, pack, count, v_free.shape[0])
+    args = (contact_body, pack, count, mu, v_free, r, status, shift, band, work, f, jac, ft, jt)
     while done < units * NEWTON_SHARE and done + NEWTON_UNITS + WATCHDOG + 1 <= limit:
-        merit = _merit(contact_body, pack, count, mu, v_free, r, work, f, jac)
-        try:
-            dr = newton_direction(contact_body, pack, count, v_free, f, jac, shift[0])
-        except RuntimeError:  # splu: an exactly singular pivot (not seen); the step then counts as rejected
-            dr = None
-        done += NEWTON_UNITS
-        alpha = 1.0
-        accepted = False
-        while dr is not None and alpha >= ALPHA_MIN:
-            trial = r + alpha * dr
-            if (
-                _merit(contact_body, pack, count, mu, v_free, trial, work, ft, jt)
-                <= (1.0 - 2.0 * SIGMA * alpha) * merit
-            ):
-                accepted = True
-                break
-            alpha *= 0.5
-        if accepted:
-            r[:] = trial
-            if alpha == 1.0:
-                shift[0] = max(shift[0] / 4.0, LAMBDA)
-        else:  # a poor model: shift more, and let plain sweeps move r where the line search could not
-            shift[0] = min(10.0 * shift[0], LAMBDA_MAX)
-            work[:] = v_free
-            nlgs._nlgs_interleaved(contact_body, pack, count, mu, 0.0, WATCHDOG, work, r, status, False, 0)
-            done += WATCHDOG
+        done += _newton_step(*args)
     sweeps = min(max(units - done, 1), limit - done)
     if sweeps > 0:
         r_out[:] = r
         v[:] = v_free
         d, residual = nlgs._nlgs_interleaved(
-            contact_body, pack, count, mu, tolerance, sweeps, v, r_out, status, True, sweeps, True
+            contact_body, pack, count, mu, tolerance, sweeps, v, r_out, status, True, POLISH_STALL, True
         )
         done += d
     return done, residual

@@ -1,4 +1,4 @@
-"""What a stalled accelerated solve does: four methods taken in turn, each resumed where it stopped.
+"""What a stalled accelerated solve does: five methods taken in turn, each resumed where it stopped.
 
 Gauss–Seidel with momentum (the default solver, :mod:`masonrycli.engine.momentum`) converges most steps in
 tens to hundreds of sweeps. On tall walls that slide it can stall: momentum drives the step into a
@@ -36,17 +36,15 @@ get there, in 44 797 units alone); "turning" alone 164 706 units, one missed. Th
 replaced (faces for at most 5000 units, plain sweeps from the warm start, faces to the cap) took
 17 816–23 714 units on each of seven sliding steps of the 32-course wall captured from its own run.
 
-Alart–Curnier Newton (:mod:`masonrycli.engine.newton`, "newton": Newton steps from the warm start for
-half its budget, then turning sweeps from its iterate) goes second, with twice the others' budget, in the
-first round only: on the 98 stalled steps of the 32- and 64-course walls' first 0.2 s, replayed, it
-finishes the steps the others take 20 000–50 000 units for in 3000–4000 (the 64-course wall's 51 404 in
-3783), and the round-robin takes 0.71× the units it took without it (0.77× with newton's budget equal to
-the others' in the first two rounds, 0.85× in every round, 1.20× first in the order). Whole runs, first
-0.2 s (sweep units a step, mean / max): 32 courses 1282 / 30 521 against 1353 / 27 240, 64 courses
-1514 / 27 232 against 1780 / 51 926, none unconverged; first 0.3 s: 1044 against 1078 and 1634
-against 1694; the 248-block wall's 1 s unchanged (151 / 3196). The whole runs gain far less than the
-replay: a step solved differently (within the tolerance) sends the run on another trajectory with
-other stalled steps. NOT on main for that reason (2026-11-27, acengine branch).
+Alart–Curnier Newton (:mod:`masonrycli.engine.newton`, "newton": 10 Newton steps from the warm start,
+then turning sweeps from its iterate) goes first, with twice the others' budget, in the first two rounds
+only. On the 98 stalled steps of the 32- and 64-course walls' first 0.2 s, replayed, the round-robin takes
+194 066 units with it against 408 422 without (0.48×); it finishes 92 of them, the 64-course wall's
+51 404-unit step in ~2700. Second in the order and in the first round only it took 256 810 (the order of
+the acengine branch, where a Newton step solved by scipy's splu counted 200 units: 291 118); first but
+in the first round only 225 553. Whole runs (sweep units a step, mean / max, none unconverged): first
+0.2 s of the 32-course wall 935 / 27 929 against 1353 / 27 240, of the 64-course wall 1267 / 55 765
+against 1780 / 51 926 (benchmarks/README.md, "Alart–Curnier in the engine").
 """
 
 from __future__ import annotations
@@ -58,16 +56,16 @@ from masonrycli.engine import faces, newton, nlgs
 FIRST_BUDGET = 2000
 """Sweep units each method gets in the first round; doubled every round (module doc)."""
 
-METHODS = ("turning", "newton", "alternating", "momentum", "faces")
+METHODS = ("newton", "turning", "alternating", "momentum", "faces")
 """The order in which a round visits the methods: the one that finishes most stalled steps first."""
 
 
 NEWTON_BUDGET = 2
 """newton's budget in a round, in units of the others' (module doc)."""
 
-NEWTON_LAST_ROUND = 0
-"""The last round (0-based) in which "newton" takes part: it finishes the steps it finishes in its first
-budget, and later ones cost more than they save (module doc)."""
+NEWTON_LAST_ROUND = 1
+"""The last round (0-based) in which "newton" takes part: it finishes most steps it finishes in its first
+two budgets (module doc)."""
 
 
 class _State:
