@@ -36,6 +36,10 @@ def main() -> None:
     sta.add_argument("--duration", type=float, default=0.2, help="simulated s per case (capture)")
     sta.add_argument("--steps", nargs="+", default=None, help="table: these kept steps (names, e.g. h32-100)")
     sta.add_argument("--repeat", type=int, default=2, help="table: CPU-time minimum of this many runs")
+    sta.add_argument("--methods", nargs="+", default=None, help="table: these methods only (default: all)")
+    sta.add_argument(
+        "--cap", type=int, default=50_000, help="table: sweep units a step (the engine's since c128652: 100 000)"
+    )
     tra = sub.add_parser("trajectory", help="run a case, keep every k-th step (the ordinary-step sample)")
     tra.add_argument("--case", default="wall-248")
     tra.add_argument("--every", type=int, default=5)
@@ -80,7 +84,7 @@ def main() -> None:
             stalled_steps.capture(args.cases, args.duration)
         else:
             paths = [stalled_steps.STALLED / f"{n}.npz" for n in args.steps] if args.steps else None
-            stalled_steps.table(paths, args.repeat)
+            stalled_steps.table(paths, args.repeat, args.methods or stalled_steps.METHODS, args.cap)
     elif args.command == "clusters":
         from benchmarks.solver_lab.clusters import report
 

@@ -16,6 +16,10 @@ whether the tolerance was met:
     alternating   plain sweeps, every second one in reverse order (10 000-sweep stall window)
     plain         plain sweeps in one direction (10 000-sweep stall window)
     faces         faces from momentum's iterate at its 500-sweep stall
+    newton        stalled.py's Alart–Curnier resume (Newton steps, then turning sweeps) with the whole cap
+
+``table --methods engine --cap 100000`` gives the engine alone at its default cap (the figure of benchmarks/README.md, "Alart–Curnier in the
+engine": 101 kept steps of h32 and h64).
 
 (Faces' sweep units cost ~2× a point sweep's time; compare the ms.) The figures of stalled.py's module doc
 and of benchmarks/README.md, "Stalled steps", come from here.
@@ -74,24 +78,24 @@ def _capture_case(case: str, duration: float) -> tuple[int, list[str]]:
     return step[0], kept
 
 
-def _method(name, p, v, r, status):
+def _method(name, p, v, r, status, cap=CAP):
     body, pack, mu, count = p["body"], p["pack"], float(p["mu"]), p["body"].shape[0]
     if name == "engine":
-        model = SimpleNamespace(friction=mu, tolerance=TOLERANCE, max_iterations=CAP, solver="nlgs-accel")
+        model = SimpleNamespace(friction=mu, tolerance=TOLERANCE, max_iterations=cap, solver="nlgs-accel")
         return nlgs.solve(body, pack, count, model, v, r, status)
     if name == "faces":
         its, res = nlgs._nlgs_interleaved(
-            body, pack, count, mu, TOLERANCE, CAP, v, r, status, True, momentum.STALL_SWEEPS
+            body, pack, count, mu, TOLERANCE, cap, v, r, status, True, momentum.STALL_SWEEPS
         )
         if res <= TOLERANCE:
             return its, res
-        units, res = faces.face_sweeps(body, pack, count, mu, TOLERANCE, CAP - its, v, r, status)
+        units, res = faces.face_sweeps(body, pack, count, mu, TOLERANCE, cap - its, v, r, status)
         return its + units, res
     if name == "plain":
-        return nlgs._nlgs_interleaved(body, pack, count, mu, TOLERANCE, CAP, v, r, status, False, CAP)
-    # turning, momentum, alternating: stalled.py's own resume, from the warm start, with the whole cap
+        return nlgs._nlgs_interleaved(body, pack, count, mu, TOLERANCE, cap, v, r, status, False, cap)
+    # turning, momentum, alternating, newton: stalled.py's own resume, from the warm start, with the whole cap
     state = stalled._State(None, r, status, np.inf)
-    its = stalled._resume(name, state, body, pack, count, mu, TOLERANCE, CAP, v.copy())
+    its = stalled._resume(name, state, body, pack, count, mu, TOLERANCE, cap, v.copy(), cap)
     v[:] = state.v
     return its, state.residual
 
@@ -147,25 +151,26 @@ def as_problem(path: Path) -> StalledProblem:
     return p
 
 
-METHODS = ("engine", "turning", "momentum", "alternating", "plain", "faces")
+METHODS = ("engine", "turning", "momentum", "alternating", "plain", "faces", "newton")
 
 
-def table(paths: list[Path] | None = None, repeat: int = 2) -> None:
-    """Each kept step solved by each method from its warm start: sweep units (* = tolerance missed), CPU ms."""
+def table(paths: list[Path] | None = None, repeat: int = 2, methods=METHODS, cap: int = CAP) -> None:
+    """Each kept step solved by each of ``methods`` from its warm start, to ``cap`` sweep units: sweep units
+    (* = tolerance missed), CPU ms."""
     paths = paths or sorted(STALLED.glob("*.npz"))
-    print("| step | contacts | " + " | ".join(METHODS) + " |")
-    print("|---|---|" + "---|" * len(METHODS))
-    totals = {m: [0, 0.0, 0] for m in METHODS}
+    print("| step | contacts | " + " | ".join(methods) + " |")
+    print("|---|---|" + "---|" * len(methods))
+    totals = {m: [0, 0.0, 0] for m in methods}
     for path in paths:
         p = dict(np.load(path))
         cells = []
-        for m in METHODS:
+        for m in methods:
             best = np.inf
             for _ in range(repeat):
                 v, r = p["v_free"].copy(), p["r_warm"].copy()
                 status = np.zeros(r.shape[0], dtype=np.int8)
                 t = time.process_time()
-                its, res = _method(m, p, v, r, status)
+                its, res = _method(m, p, v, r, status, cap)
                 best = min(best, 1e3 * (time.process_time() - t))
             met = res <= TOLERANCE
             totals[m][0] += its
