@@ -102,3 +102,27 @@ def test_a_method_that_ends_a_round_no_lower_than_before_is_dropped(monkeypatch)
     ]
     assert res == 1e-7 and its == 7 + 10 + 20 + 10 + 5 + 20 + 20 + 40 + 80
     assert (v == 8).all()  # the state of the method that met the tolerance (set at the 8th call)
+
+
+def test_newton_stopping_inside_its_budget_is_resumed_in_the_next_round(monkeypatch):
+    # Scripted: newton's sweeps stall inside its first budget (half of it done) without meeting the
+    # tolerance; unlike the other methods it is not dropped for that, and its second resume finishes.
+    script = {"newton": [1e-4, 1e-7], "turning": [1e-3, 1e-3], "faces": [1e-3]}
+    calls = []
+
+    def scripted(name, state, contact_body, pack, count, mu, tolerance, units, v_free, limit):
+        calls.append((name, units))
+        state.v, state.residual = v_free + len(calls), script[name].pop(0)
+        return units // 2 if name in ("newton", "faces") else units
+
+    monkeypatch.setattr(stalled, "_resume", scripted)
+    monkeypatch.setattr(stalled, "METHODS", ("newton", "turning", "faces"))
+    monkeypatch.setattr(stalled, "NEWTON_BUDGET", 2)
+    monkeypatch.setattr(stalled, "NEWTON_LAST_ROUND", 1)
+    monkeypatch.setattr(stalled, "FIRST_BUDGET", 10)
+    count = 2
+    v, r, status = np.zeros((2, 3)), np.zeros((count, 2)), np.zeros(count, dtype=np.int8)
+    its, res = stalled.continue_stalled(None, None, count, 0.5, 1e-6, 10**6, v, r, status, np.zeros((2, 3)), r, 7, 1e-2)
+    assert calls == [("newton", 20), ("turning", 10), ("faces", 10), ("newton", 40)]
+    assert res == 1e-7 and its == 7 + 10 + 10 + 5 + 20
+    assert (v == 4).all()

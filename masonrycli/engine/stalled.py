@@ -21,7 +21,8 @@ step's warm start, tolerance 1e-5 m/s, cap 50 000 sweep units):
 So the methods are run round-robin from their own states, each for a budget of sweep units that doubles
 every round (FIRST_BUDGET, 2 × FIRST_BUDGET, …), until one meets the tolerance or the step's cap is
 spent. A step that one method solves in U units costs at most about 4 × 2U plus momentum's first try,
-whichever method that is. A method is dropped when it stalls inside its budget (its own stall window)
+whichever method that is. A method is dropped when it stalls inside its budget (its own stall window;
+not newton, whose sweeps stalling says nothing of its Newton iterate, which the next resume goes on from)
 or ends a round no lower than it ended an earlier one (it cycles: the 32-course wall's step 99 of one run
 reached the cap before this rule, and takes 27 240 units with it, faces finishing). At the cap the
 state with the lowest residual is kept and the step is counted unconverged, as before: a step that needs
@@ -114,8 +115,8 @@ def continue_stalled(
             if state.residual <= tolerance:
                 _adopt(state, v, r, status, count)
                 return iterations, state.residual
-            if done < units:  # stalled inside its budget: its own stall window says it will not get there
-                active.remove(name)
+            if done < units and name != "newton":  # stalled inside its budget: its own stall window says it
+                active.remove(name)  # will not get there (newton's sweeps stalled, its Newton iterate goes on)
             elif state.residual >= state.low:  # a whole budget, doubled, without a new low: it cycles
                 active.remove(name)
             state.low = min(state.low, state.residual)
