@@ -24,7 +24,7 @@ the 3B velocity system, banded when bodies are numbered by position (one banded 
 
 One resume for a budget of U sweep units (stalled.py; the iterate r and λ carry over between resumes):
 
-    while units < NEWTON_SHARE · U:
+    while units < NEWTON_SHARES[k] · U:               (k: this resume's number, the last share after)
         F = F(r);  K, rhs = the system above, into the band;  dr from its LU   (NEWTON_UNITS)
         α = 1, ½, ¼ … ≥ ALPHA_MIN: accept the first with ½|F(r + α dr)|² ≤ (1 − 2σα) ½|F(r)|²  (Armijo)
         accepted: r += α dr;  λ = max(λ / 4, LAMBDA) if α = 1
@@ -37,7 +37,11 @@ One resume for a budget of U sweep units (stalled.py; the iterate r and λ carry
 Newton alone converges linearly near the solution (λ held, short steps): on the 32-course wall's step
 that turning needs 21 377 units for, its own RMS of F falls from 3e-3 to 1e-5 in ~25 steps, while turning
 sweeps from its iterate after 10 steps finish in ~1000 units; hence 10 Newton steps a first resume
-(NEWTON_SHARE of stalled.py's 2 × 2000 units) and sweeps from there.
+(NEWTON_SHARES[0] of stalled.py's 2 × 2000 units) and sweeps from there; a step still not solved gets
+40 in the next resume (NEWTON_SHARES[1]), the iterate going on: of 5 steps that ended unconverged in
+ensemble runs (all five methods dropped or the cap), 3 then converge in 12 643–13 455 units (with 20
+Newton steps again, 1 of them; with 66, 3; with 106, 4), while the 98-step replay below takes 212 312
+units instead of 194 066 (one step, h32's 25 446-unit one: 37 446 instead of 19 678).
 
 Units. A Newton step costs 46–60 turning sweeps of the same step in CPU (the banded assembly, LU and solve:
 1.2–1.8 ms at 497 bodies, 3.2–4.4 ms at 993, against 30–36 µs and 64–87 µs a sweep; six captured stalled
@@ -76,9 +80,10 @@ WATCHDOG = 20
 """Plain engine sweeps after a rejected Newton step."""
 NEWTON_UNITS = 60
 """Sweep units one Newton step counts (module doc, "Units")."""
-NEWTON_SHARE = 0.15
-"""Share of a resume's budget spent on Newton steps (10 steps of stalled.py's first 4000 units); the rest
-goes to the sweeps from the Newton iterate."""
+NEWTON_SHARES = (0.15, 0.3)
+"""Share of the budget spent on Newton steps in the first resume (10 steps of stalled.py's first 4000 units)
+and in later ones (40 of its 8000: a step that gets there needs more of them); the rest goes to the sweeps
+from the Newton iterate."""
 POLISH_STALL = 1000
 """Sweeps from the Newton iterate without a new lowest residual after which the resume ends (the method is
 then dropped by stalled.py's rule, the budget left to the others)."""
@@ -293,10 +298,10 @@ def _newton_step(contact_body, pack, count, mu, v_free, r, status, shift, band, 
 
 
 def newton_steps(
-    contact_body, pack, count, mu, tolerance, units, limit, v_free, r, r_out, v, status, shift
+    contact_body, pack, count, mu, tolerance, units, limit, v_free, r, r_out, v, status, shift, share=NEWTON_SHARES[0]
 ) -> tuple[int, float]:
     """One resume of the method (module doc) for a budget of ``units`` sweep units, never beyond ``limit``
-    (the step's cap): Newton steps from the iterate ``r`` (C, 2, updated in place) for NEWTON_SHARE of the
+    (the step's cap): Newton steps from the iterate ``r`` (C, 2, updated in place) for ``share`` of the
     budget, then turning momentum sweeps from a copy of it for the rest, until ``tolerance`` or a stall of
     POLISH_STALL sweeps. ``r_out``,
     ``v``, ``status`` get the sweeps' state (consistent: v = v_free + M⁻¹ H r_out). ``shift``: [λ], carried
@@ -308,7 +313,7 @@ def newton_steps(
     work = np.empty_like(v_free)
     band = Band(contact_body, pack, count, v_free.shape[0])
     args = (contact_body, pack, count, mu, v_free, r, status, shift, band, work, f, jac, ft, jt)
-    while done < units * NEWTON_SHARE and done + NEWTON_UNITS + WATCHDOG + 1 <= limit:
+    while done < units * share and done + NEWTON_UNITS + WATCHDOG + 1 <= limit:
         done += _newton_step(*args)
     sweeps = min(max(units - done, 1), limit - done)
     if sweeps > 0:

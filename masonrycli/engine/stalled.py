@@ -21,10 +21,11 @@ step's warm start, tolerance 1e-5 m/s, cap 50 000 sweep units):
 So the methods are run round-robin from their own states, each for a budget of sweep units that doubles
 every round (FIRST_BUDGET, 2 × FIRST_BUDGET, …), until one meets the tolerance or the step's cap is
 spent. A step that one method solves in U units costs at most about 4 × 2U plus momentum's first try,
-whichever method that is. A method is dropped when it stalls inside its budget (its own stall window;
-not newton, whose sweeps stalling says nothing of its Newton iterate, which the next resume goes on from)
+whichever method that is. A method is dropped when it stalls inside its budget (its own stall window)
 or ends a round no lower than it ended an earlier one (it cycles: the 32-course wall's step 99 of one run
-reached the cap before this rule, and takes 27 240 units with it, faces finishing). At the cap the
+reached the cap before this rule, and takes 27 240 units with it, faces finishing). Not newton: its sweeps
+start from a new Newton iterate at each resume, so their stall or residual says little of that iterate; it
+leaves after round NEWTON_LAST_ROUND. At the cap the
 state with the lowest residual is kept and the step is counted unconverged, as before: a step that needs
 10 000 units of the one method that converges it costs about 50 000 in this round-robin (the 64-course
 wall's step 108 of one run, faces alone 9924: 51 926 units), which is why the default cap
@@ -73,12 +74,13 @@ class _State:
     """One method's iterate: velocities (None until first run), impulses, statuses, last residual and the
     lowest residual it ended a round with (m/s)."""
 
-    __slots__ = ("v", "r", "status", "residual", "low", "iterate", "shift")
+    __slots__ = ("v", "r", "status", "residual", "low", "iterate", "shift", "resumes")
 
     def __init__(self, v, r, status, residual):
         self.v, self.r, self.status, self.residual = v, r, status, residual
         self.low = np.inf
         self.iterate = None  # newton: its Newton iterate; r is that of its last sweeps
+        self.resumes = 0
 
 
 def continue_stalled(
@@ -115,8 +117,10 @@ def continue_stalled(
             if state.residual <= tolerance:
                 _adopt(state, v, r, status, count)
                 return iterations, state.residual
-            if done < units and name != "newton":  # stalled inside its budget: its own stall window says it
-                active.remove(name)  # will not get there (newton's sweeps stalled, its Newton iterate goes on)
+            if name == "newton":  # its sweeps' stall or residual says little of its Newton iterate, which
+                pass  # goes on at the next resume: it leaves after NEWTON_LAST_ROUND only
+            elif done < units:  # stalled inside its budget: its own stall window says it will not get there
+                active.remove(name)
             elif state.residual >= state.low:  # a whole budget, doubled, without a new low: it cycles
                 active.remove(name)
             state.low = min(state.low, state.residual)
@@ -151,7 +155,9 @@ def _resume(name, state, contact_body, pack, count, mu, tolerance, units, v_free
             state.v,
             state.status,
             state.shift,
+            newton.NEWTON_SHARES[min(state.resumes, len(newton.NEWTON_SHARES) - 1)],
         )
+        state.resumes += 1
         return done
     if name == "faces":
         done, state.residual = faces.face_sweeps(
