@@ -53,8 +53,10 @@ On the 98 stalled steps of the 32- and 64-course walls' first 0.2 s (captured fr
 replayed through stalled.continue_stalled): 408 422 units without this method, 291 118 with it second in
 the order at 200 units a step (splu), 260 206 at 60 units (banded), 256 810 with the polish's stall window,
 233 323 also in the second round, 194 066 (0.48×) first in the order: 10 Newton steps and their sweeps
-then finish 92 of the 98 steps. Chunked sweeps between groups of Newton steps (20, 40, 80 … sweeps every
-5 or 10 steps) took 264 842–272 864 at 60 units.
+then finish 92 of the 98 steps; 212 312 (0.52×) with 40 Newton steps in the second resume (above).
+Chunked sweeps between groups of Newton steps (20, 40, 80 … sweeps every 5 or 10 steps) took
+264 842–272 864 at 60 units.
+
 Lab figures (variant ``ac-aug-l3``, from the step's warm start, alone): 8 of 9 captured stalled steps of
 the 32- and 64-course walls converged in 0.14–0.93× the engine's units (h64-108 7041 against 51 926,
 h32-99 6709 against 27 240, h32-106 2839 against 13 238); h32-87 not converged. From momentum's stalled

@@ -39,14 +39,16 @@ replaced (faces for at most 5000 units, plain sweeps from the warm start, faces 
 17 816–23 714 units on each of seven sliding steps of the 32-course wall captured from its own run.
 
 Alart–Curnier Newton (:mod:`masonrycli.engine.newton`, "newton": 10 Newton steps from the warm start,
-then turning sweeps from its iterate) goes first, with twice the others' budget, in the first two rounds
-only. On the 98 stalled steps of the 32- and 64-course walls' first 0.2 s, replayed, the round-robin takes
-194 066 units with it against 408 422 without (0.48×); it finishes 92 of them, the 64-course wall's
-51 404-unit step in ~2700. Second in the order and in the first round only it took 256 810 (the order of
-the acengine branch, where a Newton step solved by scipy's splu counted 200 units: 291 118); first but
-in the first round only 225 553. Whole runs (sweep units a step, mean / max, none unconverged): first
-0.2 s of the 32-course wall 935 / 27 929 against 1353 / 27 240, of the 64-course wall 1267 / 55 765
-against 1780 / 51 926 (benchmarks/README.md, "Alart–Curnier in the engine").
+then turning sweeps from its iterate; 40 more in its second resume) goes first, with twice the others'
+budget, in the first two rounds only, and the drop rules leave it alone. On the 98 stalled steps of the
+32- and 64-course walls' first 0.2 s, replayed, the round-robin takes 212 312 units with it against
+408 422 without (0.52×); it finishes most of them, the 64-course wall's 51 404-unit step in ~2700.
+Second in the order and in the first round only it took 256 810 (291 118 on the acengine branch, where
+a Newton step solved by scipy's splu counted 200 units). Whole runs (sweep units a step, mean / max,
+none unconverged): first 0.2 s of the 32-course wall 1108 / 38 137 against 1353 / 27 240, of the
+64-course wall 1302 / 17 584 against 1780 / 51 926, the 248-block wall's 1 s 163 / 10 309 against
+151 / 3196 (another path from step 400 on). Ensembles of short runs: benchmarks/README.md, "Alart–Curnier
+in the engine".
 """
 
 from __future__ import annotations
