@@ -289,12 +289,15 @@ ScenarioFile = Annotated[
 def _load(scenario_file: Path, opts: dict):
     """The scenario of a TOML, GeoJSON or WKT file with the command line's record and run options
     (taken out of ``opts``) applied."""
-    from masonrycli.builtin import override_run, with_record
+    from masonrycli.builtin import DEFAULT_DURATION, override_run, with_record
     from masonrycli.scenario import scenario_from_geometry_file
     from masonrycli.scenario_toml import load_scenario
     from masonrycli.structure import GEOMETRY_SUFFIXES
 
     record, scale = _pop(opts, RECORD).values()
+    if str(scenario_file) in DEFAULT_DURATION and not scenario_file.exists():  # a built-in name
+        name = str(scenario_file)
+        raise InputError(f"{name}: not a file; the built-in structures are run with `masonry simulate {name}`")
     if scenario_file.suffix.lower() in GEOMETRY_SUFFIXES:
         scenario = scenario_from_geometry_file(scenario_file)
     else:

@@ -80,6 +80,15 @@ def test_check_prints_summary():
     assert rows["total mass"] == "800 kg"  # 5 blocks of 0.4 x 0.2 m at 2000 kg/m³
 
 
+@pytest.mark.parametrize(("command", "name"), [("check", "wall"), ("run", "arch")])
+def test_a_built_in_name_given_as_scenario_file_points_to_simulate(command, name, tmp_path, monkeypatch):
+    """QA: `masonry check wall` said "wall: cannot read scenario: No such file or directory"."""
+    monkeypatch.chdir(tmp_path)  # no file called `wall` here
+    result = invoke(command, name)
+    assert_one_line_error(result, f"{name}: not a file", f"masonry simulate {name}")
+    assert "No such file" not in result.output
+
+
 @pytest.mark.parametrize(
     "args, fragments",
     [
