@@ -490,7 +490,7 @@ def inspect_command(
     console.print(table)
     if info.get("metadata"):
         console.print(info["metadata"])
-    if info.get("truncated") or not info.get("complete", True):
+    if info["truncated"]:
         warn(
             f"{recording}: truncated (its writer did not finish: killed, or the disk was full) — "
             f"{info['frames']} frames up to its last complete chunk"

@@ -16,6 +16,7 @@ from masonrycli.recording import Recorder, inspect_recording
 from masonrycli.recording.layout import FILL
 
 import recording_fixtures as fx
+from cli_helpers import invoke
 from recording_fixtures import strict_rerun, temporal_rows  # noqa: F401 (strict_rerun: autouse)
 
 BATCH = 10  # frames per flush
@@ -82,8 +83,18 @@ def test_inspect_a_file_without_footer(wall, tmp_path):
     """)
     subprocess.run([sys.executable, "-c", script], timeout=120, env={**os.environ, "RERUN_ANALYTICS": "0"})
     info = inspect_recording(path)
-    assert not info["complete"]
+    assert not info["complete"] and info["truncated"]
     assert info["frames"] == 8 and info["application_id"] == "masonry"
+    # QA: the table said "truncated False" under a warning saying "truncated"; now both say it
+    result = invoke("inspect", path)
+    assert result.exit_code == 0, result.output
+    rows = dict(
+        [c.strip() for c in line.strip().strip("│").split("│")]
+        for line in result.output.splitlines()
+        if line.count("│") == 3
+    )
+    assert rows["truncated"] == "True" and rows["complete"] == "False"
+    assert "truncated (its writer did not finish" in " ".join(result.output.split())
 
 
 def test_frames_without_tensor_fields_or_contacts(wall, tmp_path):

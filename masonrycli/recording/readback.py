@@ -73,7 +73,8 @@ def inspect_recording(path: str | os.PathLike) -> dict:
     Keys: application_id, recording_id, frames (distinct `step` values of the recorded frames; solver
     health is logged for every step besides), steps (first, last frame) or None, time_span (first, last
     frame's sim_time, s) or None, entity_paths (sorted, with the leading "/"), has_blueprint, complete
-    (footer present), truncated (cut in a message), metadata (the run document's Markdown, or None).
+    (footer present), truncated (the writer did not finish: no footer, or cut in a message; what
+    ``masonry inspect`` warns about), metadata (the run document's Markdown, or None).
     """
     with tempfile.TemporaryDirectory(prefix="masonry-inspect-") as scratch:
         return _summarise(*_open_reader(os.fspath(path), scratch), path)
@@ -120,7 +121,9 @@ def _summarise(reader: rr.chunk.RrdReader, truncated: bool, path) -> dict:
         "entity_paths": sorted(paths),
         "has_blueprint": bool(reader.blueprints()),
         "complete": complete,
-        "truncated": truncated,
+        # a killed writer leaves no footer but whole messages: truncated too (it was "False" under the
+        # inspect warning saying "truncated")
+        "truncated": truncated or not complete,
         "metadata": metadata,
     }
 
