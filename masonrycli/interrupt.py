@@ -14,6 +14,7 @@ Outside the main thread (where Python cannot install handlers) the context does 
 
 from __future__ import annotations
 
+import contextlib
 import os
 import signal
 import threading
@@ -65,6 +66,19 @@ class StopSignals:
     def closing(self) -> None:
         """From now on signals are acknowledged and otherwise ignored until the files are closed."""
         self.phase = "closing"
+
+    @contextlib.contextmanager
+    def held(self):
+        """In the setup phase: a signal during the block only sets :attr:`signum` and is raised as
+        :class:`StopRun` once the block is over, so a file the block writes whole (``masonry limit``'s
+        recording) is not cut."""
+        previous, self.phase = self.phase, "stepping"
+        try:
+            yield
+        finally:
+            self.phase = previous
+        if previous == "setup" and self.signum is not None:
+            raise StopRun(self.signum)
 
     def requested(self) -> bool:
         return self.signum is not None

@@ -105,3 +105,19 @@ def test_stop_signals_phases():
         time.sleep(0.1)
         assert stop.repeats == 2 and stop.signum == signal.SIGINT
     assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
+
+
+def test_a_held_signal_is_raised_when_the_block_ends():
+    """`masonry limit` writes its recording in a held block: a signal there lets the block finish, then
+    raises StopRun (in the setup phase); without a signal the block changes nothing."""
+    finished = []
+    with StopSignals() as stop:
+        with stop.held():
+            finished.append("quiet")
+        with pytest.raises(StopRun) as info:
+            with stop.held():
+                os.kill(os.getpid(), signal.SIGTERM)
+                time.sleep(0.1)  # the handler runs here and only notes the signal
+                finished.append("file")
+        assert finished == ["quiet", "file"] and info.value.signum == signal.SIGTERM
+        assert stop.phase == "setup"

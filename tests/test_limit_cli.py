@@ -88,3 +88,59 @@ def test_infeasible_structure_is_one_line_exit_2(tmp_path):
         '[[support]]\nname = "ground"\npolygon = [[-1, -1], [0.3, -1], [0.3, 0], [-1, 0]]\n'
     )
     assert_one_line_error(invoke("limit", path), "no equilibrium")
+
+
+# SIGTERM sent from inside the step named, in a real process (the default handler would kill pytest).
+_SIGTERM_SCRIPT = """
+import os, signal, sys, time
+import masonrycli.limit.verify as verify
+import masonrycli.recording.limit as recording
+
+def sigterm():
+    os.kill(os.getpid(), signal.SIGTERM)
+    time.sleep(0.2)  # the handler runs here (or at once)
+
+if sys.argv[1] == "recording":
+    write = recording.write_limit_recording
+    def write_limit_recording(*args):
+        sigterm()
+        write(*args)
+    recording.write_limit_recording = write_limit_recording
+else:
+    def run_check(*args, **kwargs):
+        sigterm()
+        raise AssertionError("not stopped")
+    verify.run_check = run_check
+sys.argv = ["masonry", *sys.argv[2:]]
+from masonrycli.cli import main
+main()
+"""
+
+
+@pytest.mark.parametrize("during", ["recording", "verify"])
+def test_sigterm_during_verify_says_so_exits_143_and_keeps_the_recording(during, column_file, tmp_path):
+    """QA: SIGTERM during `limit --verify` exited -15 with no message. Now it goes the way of simulate and
+    sweep: one line 'interrupted (SIGTERM): ...', exit 143, and the --out recording complete (a signal
+    while it is written waits for it)."""
+    import os
+    import subprocess
+    import sys
+
+    from masonrycli.recording import inspect_recording
+
+    out = tmp_path / "col.rrd"
+    argv = ["limit", str(column_file), "--load", "tilt", "--verify", "--out", str(out)]
+    proc = subprocess.run(
+        [sys.executable, "-c", _SIGTERM_SCRIPT, during, *argv],
+        capture_output=True,
+        text=True,
+        timeout=300,
+        env=dict(os.environ, RERUN_ANALYTICS="0"),
+    )
+    assert proc.returncode == 143, (proc.returncode, proc.stdout, proc.stderr)
+    lines = [ln for ln in proc.stderr.splitlines() if ln.strip()]
+    assert len(lines) == 1 and lines[0].startswith("interrupted (SIGTERM): "), proc.stderr
+    assert "Traceback" not in proc.stdout + proc.stderr and f"{out}" in lines[0]
+    info = inspect_recording(out)
+    assert info["complete"] and not info["truncated"] and info["has_blueprint"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["col.rrd"]  # no temporary file left

@@ -8,14 +8,18 @@ prints exactly one JSON object on stdout and nothing else (warnings go to stderr
 from __future__ import annotations
 
 import json
+import signal
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
+import typer
 from rich.console import Console
 from rich.table import Table
 from rich.text import Text
 
 from masonrycli.errors import InputError
+from masonrycli.interrupt import StopRun, StopSignals, exit_code, signal_name
 from masonrycli.limit.analysis import LimitResult, analyse
 from masonrycli.limit.problem import LiveLoad
 from masonrycli.outputs import check_output, written_whole
@@ -162,27 +166,32 @@ def run_limit(
     err_console: Console,
     force: bool = False,
 ) -> None:
-    """``masonry limit``: analyse, optionally record and verify, then print a table or one JSON object."""
-    target = None if out is None else check_output(out, "--out", ".rrd", force)
-    live = LiveLoad(load, direction, block)
-    scenario = resolve_structure(structure, friction)
-    if verify and live.kind == "point":
-        raise InputError("--verify: the engine has no point loads; verify a horizontal or tilt load")
-    for warning in scenario.warnings:
-        err_console.print(Text.assemble(("warning:", "yellow"), f" {warning}"))
-    result = analyse(scenario, live)
-    if target is not None:  # under a temporary name, renamed when complete (masonrycli.outputs)
-        with written_whole(target) as part:
-            write_recording(result, part)
-        out = target.path
-    checks = []
-    if verify:
-        from masonrycli.limit.verify import verify as run_verify
+    """``masonry limit``: analyse, optionally record and verify, then print a table or one JSON object.
 
-        if not as_json:
-            console.print(result_table(result, out))
-            console.print("running the engine at 0.95 λ and 1.05 λ …", style="dim")
-        checks = run_verify(scenario, result)
+    Ctrl-C or SIGTERM stops it (:mod:`masonrycli.interrupt`) with one line on stderr and exit 130 / 143, as
+    ``simulate`` and ``sweep`` do (SIGTERM killed it before: exit -15, no word); one that arrives while the
+    recording is written waits for it to be whole.
+    """
+    done = _Done()
+    with StopSignals() as signals:
+        try:
+            checks = _analyse(
+                structure,
+                LiveLoad(load, direction, block),
+                friction,
+                verify,
+                out,
+                force,
+                done,
+                signals,
+                console=None if as_json else console,
+                err_console=err_console,
+            )
+        except StopRun as stop:
+            how = "" if stop.signum == signal.SIGINT else f" ({signal_name(stop.signum)})"  # as `masonry sweep`
+            err_console.print(f"interrupted{how}: {done.describe()}", soft_wrap=True)
+            raise typer.Exit(exit_code(stop.signum)) from None
+    result, out = done.result, done.out
     if as_json:
         summary = result.summary() | {"recording": str(out) if out else None}
         if verify:
@@ -193,3 +202,47 @@ def run_limit(
         console.print(result_table(result, out))
     else:
         console.print(verify_table(checks))
+
+
+@dataclass
+class _Done:
+    """How far ``masonry limit`` got: what the line of an interrupted one says."""
+
+    result: LimitResult | None = None
+    out: Path | None = None
+    """The recording, once it is complete on disk."""
+    verifying: bool = False
+
+    def describe(self) -> str:
+        if self.result is None:
+            return "before λ was found; nothing was written"
+        said = f"λ = {self.result.load_factor:.4f}"
+        if self.out is not None:
+            said += f", the recording {self.out} is complete"
+        return said + "; --verify did not finish" if self.verifying else said
+
+
+def _analyse(structure, live, friction, verify, out, force, done: _Done, signals, *, console, err_console):
+    """The work of :func:`run_limit`, filling ``done`` as it goes; returns the --verify checks. ``console``:
+    where the result table goes before --verify runs (None with --json)."""
+    target = None if out is None else check_output(out, "--out", ".rrd", force)
+    scenario = resolve_structure(structure, friction)
+    if verify and live.kind == "point":
+        raise InputError("--verify: the engine has no point loads; verify a horizontal or tilt load")
+    for warning in scenario.warnings:
+        err_console.print(Text.assemble(("warning:", "yellow"), f" {warning}"))
+    done.result = analyse(scenario, live)
+    if target is not None:
+        with signals.held():  # a signal now waits until the recording is whole and in place
+            with written_whole(target) as part:  # under a temporary name, renamed when complete
+                write_recording(done.result, part)
+            done.out = target.path
+    if not verify:
+        return []
+    from masonrycli.limit.verify import verify as run_verify
+
+    done.verifying = True
+    if console is not None:
+        console.print(result_table(done.result, done.out))
+        console.print("running the engine at 0.95 λ and 1.05 λ …", style="dim")
+    return run_verify(scenario, done.result)
