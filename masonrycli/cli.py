@@ -2,11 +2,8 @@
 
 from __future__ import annotations
 
-import functools
-import inspect
 import os
 import sys
-import typing
 from pathlib import Path
 from typing import Annotated
 
@@ -16,6 +13,22 @@ from rich.table import Table
 from geometry_library.blocks import GeometryError
 from masonrycli import __version__
 from masonrycli.cli_messages import OneLineUsageErrors, console, err_console, fail, say, user_errors, warn
+from masonrycli.cli_options import (
+    AQUEDUCT,
+    ARCH,
+    BLOCK_MATERIAL,
+    FORCE,
+    FRICTION,
+    GEO_OUT,
+    LOADING,
+    OUTPUT,
+    RECORD,
+    RUN,
+    STOP,
+    WALL,
+    Friction,
+    with_options,
+)
 from masonrycli.errors import EXIT_DIVERGED, EXIT_INTERNAL, EXIT_OUTPUT_FAILED, InputError
 
 app = typer.Typer(
@@ -50,137 +63,6 @@ def main_callback(
 # -- shared options -------------------------------------------------------------------------------
 # Each group maps a parameter name to its option; ``with_options`` adds groups to a command, so the
 # commands that share them declare each option once.
-
-
-def _opt(kind: type, panel: str, help: str, *decls: str):
-    """An optional ``kind`` value (None when not given), listed under ``panel`` in --help."""
-    return Annotated[kind | None, typer.Option(*decls, help=help, rich_help_panel=panel)]
-
-
-WALL = {
-    "blocks": _opt(int, "Structure", "Number of blocks (default 51; 248 for the paper's large wall)."),
-    "courses": _opt(int, "Structure", "Number of courses (with --length and no --blocks: the count follows)."),
-    "length": _opt(float, "Structure", "Wall length, m, a whole number of blocks."),
-    "block_length": _opt(float, "Structure", "Block length, m (default 0.30)."),
-    "block_height": _opt(float, "Structure", "Block height, m (default 0.20)."),
-}
-ARCH = {
-    "voussoirs": _opt(int, "Structure", "Voussoirs in the arch (default 30)."),
-    "pier_courses": _opt(int, "Structure", "Courses per pier, 2 blocks each (default 17)."),
-    "span": _opt(float, "Structure", "Clear span of the arch, m (default 3.6)."),
-    "ring_thickness": _opt(float, "Structure", "Arch ring thickness, m (default 0.35)."),
-    "pier_width": _opt(float, "Structure", "Pier width, m (default 0.90)."),
-}
-AQUEDUCT = {**ARCH, "wall_courses": _opt(int, "Structure", "Courses of the spandrel walls (default 18).")}
-LOADING = {
-    "freq": _opt(float, "Loading", "Ground velocity frequency, Hz.", "--freq"),
-    "amp": _opt(float, "Loading", "Horizontal ground velocity amplitude, m/s.", "--amp"),
-    "settlement": _opt(float, "Loading", "Downward velocity of the right foundation, m/s."),
-}
-RECORD = {
-    "record": _opt(
-        Path,
-        "Loading",
-        "Ground motion record shaking the ground/foundations instead of the sine: PEER .AT2 (g) or CSV "
-        "(time, velocity). Baseline-corrected; window and vertical component in a scenario file.",
-        "--record",
-    ),
-    "scale": _opt(float, "Loading", "Multiplies the --record.", "--scale"),
-}
-RUN = {
-    "duration": _opt(float, "Run", "Simulated time, s."),
-    "dt": _opt(float, "Run", "Time step, s (default 1e-3).", "--dt"),
-    "theta": _opt(float, "Run", "Moreau–Jean θ in [0.5, 1] (default 0.5)."),
-    "record_every": _opt(int, "Run", "Steps between recorded frames (default 10)."),
-    "tolerance": _opt(
-        float, "Run", "NLGS stopping test: RMS contact-law violation of a sweep, m/s (default 1e-5; 1e-8 is tight)."
-    ),
-    "max_iterations": _opt(
-        int,
-        "Run",
-        "Sweep cap per step, in Gauss–Seidel sweep units (default 100000). A stalled step stops earlier: with "
-        "the default solver when every method of its round-robin gives up, with nlgs after 10000 sweeps without "
-        "a new lowest residual.",
-    ),
-    "solver": _opt(
-        str,
-        "Run",
-        "Contact solver: nlgs-accel (default; Gauss–Seidel with momentum, 2-4x fewer sweeps) or nlgs (plain "
-        "Gauss–Seidel, the reference).",
-    ),
-}
-Friction = _opt(float, "Material", "Coulomb coefficient of every contact (default 0.6).")
-FRICTION = {"friction": Friction}
-BLOCK_MATERIAL = {
-    "density": _opt(float, "Material", "Block density, kg/m³ (default 2500)."),
-    "thickness": _opt(float, "Material", "Out-of-plane thickness, m (default 1)."),
-}
-OUTPUT = {
-    "out": _opt(Path, "Output", "Recording (.rrd). Default: recordings/<scenario>-<timestamp>.rrd.", "--out", "-o"),
-    "no_recording": Annotated[
-        bool, typer.Option("--no-recording", help="Write no .rrd recording.", rich_help_panel="Output")
-    ],
-    "history": _opt(Path, "Output", "History file (.npz), one row per recorded frame.", "--history"),
-    "magnify": _opt(
-        float,
-        "Output",
-        "Displacement factor of the recording's magnified deformed shape (default: the largest displacement "
-        "drawn as 5 % of the structure's size).",
-        "--magnify",
-    ),
-}
-STOP = {
-    "stop_at_collapse": Annotated[
-        bool,
-        typer.Option(
-            "--stop-at-collapse",
-            help="End the run once the structure has collapsed (docs/collapse.md).",
-            rich_help_panel="Run",
-        ),
-    ]
-}
-FORCE = {
-    "force": Annotated[
-        bool,
-        typer.Option(
-            "--force", help="Replace output files that exist (default: refuse, exit 2).", rich_help_panel="Output"
-        ),
-    ]
-}
-GEO_OUT = {"out": Annotated[Path, typer.Option("--out", "-o", help="GeoJSON file to write (.geojson).")]}
-
-
-def with_options(*groups: dict):
-    """Add the options of ``groups`` (after the command's own parameters) to a Typer command.
-
-    The command takes them as keyword arguments (``**opts``). Options default to None (flags to False,
-    an option without a default stays required).
-    """
-
-    def decorate(func):
-        own = [p for p in inspect.signature(func, eval_str=True).parameters.values() if p.kind != p.VAR_KEYWORD]
-        added = [
-            inspect.Parameter(name, inspect.Parameter.KEYWORD_ONLY, annotation=ann, default=_default(ann))
-            for group in groups
-            for name, ann in group.items()
-        ]
-
-        @functools.wraps(func)
-        def command(**kwargs):
-            return func(**kwargs)
-
-        command.__signature__ = inspect.Signature([*own, *added])
-        return command
-
-    return decorate
-
-
-def _default(annotation):
-    """None for an optional value, False for a flag, required (no default) otherwise."""
-    kind = typing.get_args(annotation)[0]
-    if kind is bool:
-        return False
-    return None if type(None) in typing.get_args(kind) else inspect.Parameter.empty
 
 
 def _execute(scenario, opts: dict, hint: str = "") -> None:
