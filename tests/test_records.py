@@ -113,6 +113,12 @@ def test_at2_reader_formats_and_units(tmp_path):
     write_at2(tmp_path / "a.at2", [0.1, -0.2, 0.3, 0.0, 0.5, 0.25, 9.0], 0.005)
     # an older NGA header: "NPTS, DT" after the numbers; more values than NPTS are ignored
     (tmp_path / "b.AT2").write_text("title\nstation\nunits of g\n   3   0.0200   NPTS, DT\n 0.1 0.2\n 0.3 0.4\n")
+    # NGA's older header, "UNITS OF G." followed by the filter corners, is g
+    (tmp_path / "c.AT2").write_text(
+        "PEER\nIMPERIAL VALLEY\nACCELERATION TIME HISTORY IN UNITS OF G. FILTER POINTS: HP=0.1 Hz\n"
+        "   2   0.0100   NPTS, DT\n 0.1 0.2\n"
+    )
+    assert load_at2(tmp_path / "c.AT2")[1].tolist() == [0.1, 0.2]
     dt, acc = load_at2(tmp_path / "a.at2")
     assert dt == 0.005 and acc.tolist() == [0.1, -0.2, 0.3, 0.0, 0.5, 0.25, 9.0]
     dt, acc = load_at2(tmp_path / "b.AT2")
@@ -132,6 +138,20 @@ def test_at2_reader_formats_and_units(tmp_path):
         ("a\nb\nc\nNPTS= 4, DT= 0.01 SEC\n0.1 0.2 0.3\n", "bad.AT2: header says NPTS = 4 but the file holds 3"),
         ("a\nb\nc\nNPTS= 3, DT= 0 SEC\n0.1 0.2 0.3\n", "bad.AT2:4: DT must be > 0"),
         ("a\nb\n", "bad.AT2: not a PEER .AT2 file"),
+        # the header's own word on units and quantity (samples would be read as g: 100-1000x off)
+        (
+            "PEER\nx\nACCELERATION TIME SERIES IN UNITS OF CM/S/S\nNPTS= 3, DT= 0.01 SEC\n0.1 0.2 0.3\n",
+            "bad.AT2:3: the header says units of CM/S/S; an .AT2 record holds acceleration in g",
+        ),
+        (
+            "PEER\nx\nVELOCITY TIME SERIES IN UNITS OF CM/S\nNPTS= 3, DT= 0.01 SEC\n0.1 0.2 0.3\n",
+            'bad.AT2:3: the header says velocity ("VELOCITY TIME SERIES IN UNITS OF CM/S")',
+        ),
+        (
+            "PEER\nx\nDISPLACEMENT TIME SERIES IN UNITS OF CM\nNPTS= 3, DT= 0.01 SEC\n0.1 0.2 0.3\n",
+            "bad.AT2:3: the header says displacement",
+        ),
+        ("PEER\nx\nUNITS OF GAL\nNPTS= 3, DT= 0.01 SEC\n0.1 0.2 0.3\n", "bad.AT2:3: the header says units of GAL"),
     ],
 )
 def test_at2_errors_name_file_and_line(tmp_path, text, expected):
