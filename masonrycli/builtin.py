@@ -20,12 +20,13 @@ as the command line spells them (``--settlement -1: must be >= 0 ...``).
 from __future__ import annotations
 
 import dataclasses
+import math
 from pathlib import Path
 
 from masonrycli.errors import InputError
 from masonrycli.motion import Constant, Record, Sine
 from masonrycli.records import record_motion
-from masonrycli.scenario import Material, RunConfig, Scenario, scenario_from_builder
+from masonrycli.scenario import MAX_DURATION, Material, RunConfig, Scenario, scenario_from_builder
 
 DEFAULT_DURATION = {"wall": 1.0, "arch": 5.0, "aqueduct": 5.0}
 """s, simulated time of each built-in scenario."""
@@ -160,9 +161,22 @@ def builtin(name: str, **overrides) -> Scenario:
     reserved = (*RUN_OVERRIDES, *MATERIAL_OVERRIDES, *LOADING_OVERRIDES)
     options = {k: v for k, v in overrides.items() if k not in reserved and v is not None}
     options = builder_options(name, options)
-    run = RunConfig(duration=DEFAULT_DURATION[name])
+    run = RunConfig(duration=_duration(name, motions, overrides))
     scenario = scenario_from_builder(name, options, run, material, motions)
     return override_run(scenario, **_given(overrides, RUN_OVERRIDES))
+
+
+def _duration(name: str, motions: dict, overrides: dict) -> float:
+    """s: the built-in's default duration, or with a ground-motion record and no --duration the whole
+    record, in whole steps of the run's dt (the default 1 s of the wall cut a 40 s record to its first
+    second)."""
+    ends = [m.end_time for m in motions.values() if m.kind == "record"]
+    if not ends or overrides.get("duration") is not None:
+        return DEFAULT_DURATION[name]
+    dt = RunConfig.dt if overrides.get("dt") is None else overrides["dt"]
+    if not (isinstance(dt, (int, float)) and 0.0 < dt < math.inf):
+        return DEFAULT_DURATION[name]  # override_run names the bad --dt
+    return min(max(1, math.ceil(max(ends) / dt - 1e-9)) * dt, MAX_DURATION)
 
 
 def paper_instant_hint(name: str, run: RunConfig) -> str:

@@ -70,7 +70,7 @@ def _execute(scenario, opts: dict, hint: str = "") -> None:
     the code of how the run ended."""
     from masonrycli.execute import execute, plan_outputs, print_summary
     from masonrycli.interrupt import StopRun, exit_code, signal_name
-    from masonrycli.scenario import check_sampling
+    from masonrycli.scenario import check_sampling, record_warnings
     from masonrycli.sinks import DIVERGED, FAILED
 
     check_sampling(scenario)
@@ -78,7 +78,7 @@ def _execute(scenario, opts: dict, hint: str = "") -> None:
     outputs = plan_outputs(
         scenario, opts["out"], opts["history"], no_recording=opts["no_recording"], force=opts["force"]
     )
-    for warning in scenario.warnings:
+    for warning in (*scenario.warnings, *record_warnings(scenario)):
         warn(warning)
     try:
         outcome = execute(
@@ -266,7 +266,7 @@ def check_command(scenario_file: ScenarioFile, **opts) -> None:
     """Validate what `masonry run` would run, with the same arguments, and print a summary (blocks,
     supports, mass, bounding box, steps, outputs); nothing is computed or written."""
     from masonrycli.execute import plan_outputs
-    from masonrycli.scenario import check_sampling, scenario_summary
+    from masonrycli.scenario import check_sampling, record_warnings, scenario_summary
 
     scenario = _load(scenario_file, opts)
     check_sampling(scenario)
@@ -291,7 +291,7 @@ def check_command(scenario_file: ScenarioFile, **opts) -> None:
     for out_file in outputs.files():
         table.add_row("recording" if out_file.option == "--out" else "history", str(out_file.path))
     console.print(table)
-    for warning in scenario.warnings:
+    for warning in (*scenario.warnings, *record_warnings(scenario)):
         warn(warning)
 
 

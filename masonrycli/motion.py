@@ -373,6 +373,12 @@ class Record(Motion):
         return time, value, nodal_v, baseline
 
     @property
+    def end_time(self) -> float:
+        """s on the run's clock: the last sample used (after the window's shift to t = 0); the record
+        has shaken all it holds by then."""
+        return float(self._arrays[0][-1])
+
+    @property
     def baseline_correction(self) -> dict:
         """What the baseline correction subtracted, for the run document: ``{"baseline": "quadratic",
         "c1": [x, y], "c2": [x, y], "length": T}`` (m/s, s; see the module docstring), or

@@ -267,6 +267,22 @@ def check_sampling(scenario: Scenario) -> None:
             )
 
 
+def record_warnings(scenario: Scenario) -> list[str]:
+    """One line per record that goes on after the run ends: its shaking after that is not applied (a
+    40 s PEER record run for the built-in wall's 1 s was cut to its first second, and nothing said so)."""
+    run = scenario.run
+    late: dict[tuple[str, float], list[str]] = {}
+    for support, m in zip(scenario.assembly.supports, scenario.motions):
+        if m.kind == "record" and m.end_time > run.duration + 0.5 * run.dt:
+            name = os.path.basename(m.source) if m.source else "(inline)"
+            late.setdefault((name, m.end_time), []).append(f'"{support.name}"')
+    return [
+        f"support{'s' if len(names) > 1 else ''} {', '.join(names)}: the record {name} lasts {end:g} s but the run "
+        f"{run.duration:g} s; its shaking after t = {run.duration:g} s is not applied (--duration {end:g} runs it all)"
+        for (name, end), names in late.items()
+    ]
+
+
 def scenario_summary(scenario: Scenario) -> dict:
     """Numbers for ``masonry check``: counts, total mass (kg), bounding box (m), run settings, warnings."""
     asm = scenario.assembly

@@ -96,3 +96,16 @@ def test_paper_instant_hint_only_within_the_run():
     )
     assert paper_instant_hint("arch", RunConfig(duration=1.0)) == ""
     assert paper_instant_hint("aqueduct", RunConfig(duration=5.0)) == ""
+
+
+def test_a_record_without_duration_runs_whole_in_steps_of_dt():
+    # quake_velocity.csv ends at 0.4 s; the wall's default is 1 s, the arch's 5 s: both run the record
+    assert builtin("wall", record=RECORD).run.duration == pytest.approx(0.4)
+    assert builtin("wall", record=RECORD).run.n_steps == 400
+    arch = builtin("arch", record=RECORD, dt=0.003)
+    assert arch.run.n_steps == 134 and arch.run.duration >= 0.4  # ceil(0.4 / 0.003)
+    assert builtin("wall", record=RECORD, duration=2.0).run.duration == 2.0  # --duration says otherwise
+    assert builtin("wall").run.duration == 1.0
+    for dt in (-1.0, float("nan")):  # a bad --dt is named, not a duration made from it
+        with pytest.raises(InputError, match=r"^--dt: dt = "):
+            builtin("wall", record=RECORD, dt=dt)

@@ -115,3 +115,20 @@ def test_run_document_holds_the_baseline_correction(at2):
     corr = meta["baseline_corrections"]
     assert set(corr) == {"left-foundation"} and corr["left-foundation"] == motion.baseline_correction
     assert corr["left-foundation"]["baseline"] == "quadratic" and len(corr["left-foundation"]["c1"]) == 2
+
+
+def test_record_longer_than_the_run_is_run_whole_or_warned(at2, tmp_path):
+    # the 2 s record on the built-in wall (default 1 s): the whole record without --duration
+    npz = tmp_path / "whole.npz"
+    result = invoke("simulate", "wall", "--blocks", 12, "--record", at2, "--no-recording", "--history", npz)
+    assert result.exit_code == 0, result.output
+    assert float(np.load(npz)["time"][-1]) == pytest.approx(2.0) and "warning" not in result.output
+    # a shorter --duration: run as asked, and one line says what is left out
+    result = invoke("simulate", "wall", "--blocks", 12, "--record", at2, "--duration", 0.05, "--no-recording")
+    assert result.exit_code == 0, result.output
+    assert (
+        'warning: support "ground": the record quake.AT2 lasts 2 s but the run 0.05 s; its shaking after '
+        "t = 0.05 s is not applied (--duration 2 runs it all)" in result.output
+    )
+    result = invoke("check", DATA / "quake_record.toml", "--record", at2)  # the file's 0.5 s
+    assert result.exit_code == 0 and "the record quake.AT2 lasts 2 s but the run 0.5 s" in result.output

@@ -339,3 +339,17 @@ def test_check_sampling_refuses_a_sine_above_half_the_step_rate():
         check_sampling(too_fast)
     still = dataclasses.replace(too_fast, motions=(dataclasses.replace(too_fast.motions[0], amplitude=0.0),))
     check_sampling(still)  # a sine of zero amplitude moves nothing: any frequency
+
+
+def test_record_warnings_name_a_record_that_outlasts_the_run():
+    from masonrycli.scenario import record_warnings
+
+    scenario = load_scenario(DATA / "quake_record.toml")  # quake_velocity.csv: samples 0 ... 0.4 s; run 0.5 s
+    assert record_warnings(scenario) == []
+    short = dataclasses.replace(scenario, run=dataclasses.replace(scenario.run, duration=0.2))
+    assert record_warnings(short) == [
+        'support "ground": the record quake_velocity.csv lasts 0.4 s but the run 0.2 s; its shaking after '
+        "t = 0.2 s is not applied (--duration 0.4 runs it all)"
+    ]
+    windowed = dataclasses.replace(short, motions=(dataclasses.replace(short.motions[0], window=(0.2, 0.4)),))
+    assert record_warnings(windowed) == []  # the window moves 0.2 ... 0.4 s to 0 ... 0.2 s: all of it is run
