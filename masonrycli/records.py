@@ -20,6 +20,7 @@ import numpy as np
 
 from masonrycli.errors import InputError
 from masonrycli.motion import Record
+from masonrycli.record_units import check_at2_header, check_csv_header
 from masonrycli.values import format_value, quote_string, shorten
 
 _SPLIT = re.compile(r"\s*[,;]\s*|\s+")
@@ -112,7 +113,7 @@ def load_at2(path, display: str | None = None) -> tuple[float, np.ndarray]:
         raise InputError(
             f"{name}:4: expected NPTS and DT (e.g. NPTS=  3930, DT=   .0100 SEC), got {shorten(lines[3].strip(), 40)}"
         )
-    _check_at2_units(lines[:3], name)
+    check_at2_header(lines[:3], name)
     npts, dt = int(match.group(1)), _number(match.group(2), f"{name}:4")
     if not (math.isfinite(dt) and dt > 0.0) or npts < 2:
         raise InputError(f"{name}:4: DT must be > 0 and NPTS >= 2, got DT = {format_value(dt)}, NPTS = {npts}")
@@ -126,31 +127,6 @@ def load_at2(path, display: str | None = None) -> tuple[float, np.ndarray]:
     if len(values) < npts:
         raise InputError(f"{name}: header says NPTS = {npts} but the file holds {len(values)} samples")
     return dt, np.asarray(values[:npts], dtype=np.float64)
-
-
-# "ACCELERATION TIME SERIES IN UNITS OF G" (NGA-West2), "... TIME HISTORY IN UNITS OF G. FILTER ..." (older);
-# PEER's .VT2 / .DT2 files say VELOCITY ... CM/S, DISPLACEMENT ... CM in the same place
-_AT2_UNITS = re.compile(r"UNITS\s+OF\s+([^\s,;]+)", re.IGNORECASE)
-_AT2_OTHER_SERIES = re.compile(r"\b(VELOCITY|DISPLACEMENT)\b", re.IGNORECASE)
-
-
-def _check_at2_units(header: list[str], name: str) -> None:
-    """Refuse an .AT2 file whose free header lines say it holds something else than acceleration in g:
-    the samples would be read as g (a .VT2 velocity file renamed, or cm/s² samples, taken 100-1000x
-    too large). A header that names no unit is taken at its word: PEER's format is g."""
-    for lineno, line in enumerate(header, start=1):
-        other = _AT2_OTHER_SERIES.search(line)
-        if other and not re.search(r"\bACCELERATION\b", line, re.IGNORECASE):
-            raise InputError(
-                f"{name}:{lineno}: the header says {other.group(1).lower()} "
-                f"({shorten(line.strip(), 50)}); an .AT2 record holds acceleration in g"
-            )
-        unit = _AT2_UNITS.search(line)
-        if unit and unit.group(1).rstrip(".").upper() != "G":
-            raise InputError(
-                f"{name}:{lineno}: the header says units of {unit.group(1).rstrip('.')}; an .AT2 record holds "
-                "acceleration in g (convert the samples, or give them as a CSV with quantity and scale)"
-            )
 
 
 def _number(text: str, where: str) -> float:
@@ -223,9 +199,13 @@ def record_motion(
     if native is not None and quantity not in (None, native):
         raise InputError(f"{display or path}: an .AT2 file holds acceleration, not {quantity}")
     quantity = quantity or native or "velocity"
+    if native is None:
+        check_csv_header(path, display or str(path), quantity, scale)
     vertical_source = ""
     if vertical is not None:
         vtime, vvalue, vnative = read_record(vertical)
+        if vnative is None:
+            check_csv_header(vertical, str(vertical), quantity, scale)
         if vnative != native:
             raise InputError(f"{vertical}: the vertical component must be in the same format as {path}")
         time, value = combine_vertical(time, value, vtime, vvalue, str(path), str(vertical))
@@ -296,6 +276,8 @@ def _table_file(table: dict, key: str, base_dir: str):
         raise InputError(f"motion.{key} = {quote_string(file)}: no such file (looked for {resolved})")
     try:
         time, value, native = read_record(resolved, display=file)
+        if native is None:
+            check_csv_header(resolved, file, table.get("quantity", "velocity"), table.get("scale", 1.0))
     except InputError as exc:
         raise InputError(f"motion.{key}: {exc}") from None
     return time, value, native, resolved

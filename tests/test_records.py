@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from masonrycli.errors import InputError
-from masonrycli.records import G_STANDARD, load_at2, load_record_csv, record_motion
+from masonrycli.records import G_STANDARD, load_at2, load_record_csv, record_fields, record_motion
 
 from synthetic_records import band_limited, closed_form, write_at2
 
@@ -231,3 +231,14 @@ def test_scenario_record_errors(tmp_path, motion, expected):
     with pytest.raises(InputError) as exc:
         loads_scenario(SCENARIO.replace("MOTION", motion), source="s.toml", base_dir=tmp_path)
     assert expected in one_line(exc)
+
+
+def test_csv_header_units_reach_record_motion_and_scenario_files(tmp_path):
+    f = tmp_path / "q.csv"
+    f.write_text("time,v (cm/s)\n0,0\n0.1,5\n")
+    with pytest.raises(InputError, match=r"^q.csv:1: the header gives velocity in cm/s"):
+        record_motion(f, display="q.csv")
+    assert record_motion(f, scale=0.01).velocity_at([0.1])[0, 0] == pytest.approx(0.05)
+    with pytest.raises(InputError, match=r"^motion.file: q.csv:1: the header gives velocity in cm/s"):
+        record_fields({"file": "q.csv"}, str(tmp_path))
+    assert record_fields({"file": "q.csv", "scale": 0.01}, str(tmp_path))["time"] == (0.0, 0.1)

@@ -1,0 +1,110 @@
+"""What a record file's own header says about its units, checked against how it is read.
+
+A record's samples carry no units: an .AT2 file is read as acceleration in g, a CSV file as velocity
+in m/s (or what a scenario file's ``quantity`` and ``scale`` say), times in s. A header that says
+otherwise means the samples would be taken 100–1000× too large, or as the wrong quantity, and the run
+would still say "completed". So a header that *names* other units is refused with one line saying
+what and where; a header that names none is taken at its word (PEER's format is g, a CSV is SI):
+
+* .AT2 (:func:`check_at2_header`): ``UNITS OF CM/S/S`` (anything but G), or a ``VELOCITY`` /
+  ``DISPLACEMENT`` series (PEER's .VT2 / .DT2 files, renamed).
+* CSV (:func:`check_csv_header`), the one text line allowed before the samples: times in ms; an
+  acceleration header read as velocity or the reverse; cm/s, mm/s, g, gal or cm/s² values read with
+  scale 1 (a scale other than 1 is taken as the conversion).
+
+The patterns look for whole words, so ``time_ms`` and ``acc (g)`` match but ``rms`` and ``ground`` do not.
+"""
+
+from __future__ import annotations
+
+import re
+
+from masonrycli.errors import InputError
+from masonrycli.values import shorten
+
+_AT2_UNITS = re.compile(r"UNITS\s+OF\s+([^\s,;]+)", re.IGNORECASE)
+_AT2_OTHER_SERIES = re.compile(r"\b(VELOCITY|DISPLACEMENT)\b", re.IGNORECASE)
+
+
+def check_at2_header(header: list[str], name: str) -> None:
+    """Raise :class:`InputError` if the 3 free lines of an .AT2 ``header`` say the samples are not
+    acceleration in g (``name:LINE: the header says units of CM/S/S; ...``)."""
+    for lineno, line in enumerate(header, start=1):
+        other = _AT2_OTHER_SERIES.search(line)
+        if other and not re.search(r"\bACCELERATION\b", line, re.IGNORECASE):
+            raise InputError(
+                f"{name}:{lineno}: the header says {other.group(1).lower()} "
+                f"({shorten(line.strip(), 50)}); an .AT2 record holds acceleration in g"
+            )
+        unit = _AT2_UNITS.search(line)
+        if unit and unit.group(1).rstrip(".").upper() != "G":
+            raise InputError(
+                f"{name}:{lineno}: the header says units of {unit.group(1).rstrip('.')}; an .AT2 record holds "
+                "acceleration in g (convert the samples, or give them as a CSV with quantity and scale)"
+            )
+
+
+def _words(*alternatives: str) -> re.Pattern:
+    # whole words: not inside a longer run of letters ("_" and brackets are boundaries)
+    return re.compile(r"(?<![a-z])(" + "|".join(alternatives) + r")(?![a-z0-9^²])", re.IGNORECASE)
+
+
+_TIME_MS = _words("ms", "msec", "milliseconds?")
+_ACCELERATION = _words("acc", "accel", "accn", "accelerations?", r"m/s\^?2", "m/s²", "m/s/s", "gal", "g", r"cm/s\^?2")
+_VELOCITY = _words("vel", "velocity", "velocities", "speed", "m/s", "cm/s", "mm/s")
+# units that need a scale to be SI: unit -> (quantity, the factor to m/s or m/s²)
+_SCALED = {
+    "cm/s": ("velocity", 0.01),
+    "mm/s": ("velocity", 0.001),
+    "g": ("acceleration", 9.81),
+    "gal": ("acceleration", 0.01),
+    "cm/s2": ("acceleration", 0.01),
+    "cm/s^2": ("acceleration", 0.01),
+}
+_SCALED_UNIT = _words(*(re.escape(u) for u in _SCALED))
+
+
+def csv_header(path) -> tuple[int, str] | None:
+    """``(line number, text)`` of the header line of a CSV record (the one non-numeric line before the
+    first sample, after blank and ``#`` lines), or None. The file was read once already."""
+    with open(path, encoding="utf-8-sig") as fh:
+        for lineno, line in enumerate(fh, start=1):
+            stripped = line.strip()
+            if not stripped or stripped.startswith("#"):
+                continue
+            fields = [f for f in re.split(r"\s*[,;]\s*|\s+", stripped) if f]
+            try:
+                [float(f) for f in fields]
+            except ValueError:
+                return lineno, stripped
+            return None
+    return None
+
+
+def check_csv_header(path, name: str, quantity, scale) -> None:
+    """Raise :class:`InputError` if the header of the CSV record at ``path`` names units that disagree
+    with reading it as ``quantity`` ("velocity" m/s or "acceleration" m/s²) times ``scale``, or gives
+    times in ms. Values that are not a known quantity or a number are left to the Record's own checks."""
+    found = csv_header(path)
+    if found is None or quantity not in ("velocity", "acceleration"):
+        return
+    lineno, text = found
+    where, shown = f"{name}:{lineno}", shorten(text, 40)
+    if _TIME_MS.search(text):
+        raise InputError(f"{where}: the header gives times in ms ({shown}); record times are read in s")
+    says_acc, says_vel = bool(_ACCELERATION.search(text)), bool(_VELOCITY.search(text))
+    other = "acceleration" if quantity == "velocity" else "velocity"
+    if (says_acc and not says_vel and quantity == "velocity") or (says_vel and not says_acc and quantity != "velocity"):
+        unit = "m/s" if quantity == "velocity" else "m/s²"
+        raise InputError(
+            f"{where}: the header says {other} ({shown}) but the samples are read as {quantity}, {unit} "
+            f'(a scenario file\'s record motion takes quantity = "{other}"; --record reads a CSV as velocity)'
+        )
+    unit = _SCALED_UNIT.search(text)
+    if unit and isinstance(scale, (int, float)) and scale == 1.0:
+        kind, factor = _SCALED[unit.group(1).lower()]
+        if kind == quantity:
+            raise InputError(
+                f"{where}: the header gives {kind} in {unit.group(1)} ({shown}) but the samples are read in "
+                f"{'m/s' if kind == 'velocity' else 'm/s²'} (a scale of {factor:g} converts them)"
+            )

@@ -1,0 +1,74 @@
+"""A record header's own word on its units: refused where it disagrees with how the samples are read."""
+
+from __future__ import annotations
+
+import pytest
+
+from masonrycli.errors import InputError
+from masonrycli.record_units import check_at2_header, check_csv_header, csv_header
+
+
+def check(tmp_path, text, quantity="velocity", scale=1.0):
+    f = tmp_path / "q.csv"
+    f.write_text(text)
+    check_csv_header(f, "q.csv", quantity, scale)
+
+
+SAMPLES = "0,0\n0.01,0.5\n0.02,0.1\n"
+
+
+@pytest.mark.parametrize(
+    "header, quantity, scale, expected",
+    [
+        ("time_ms,vel", "velocity", 1.0, 'q.csv:1: the header gives times in ms ("time_ms,vel"); record times'),
+        ("t [msec], v", "velocity", 1.0, "q.csv:1: the header gives times in ms"),
+        ("time (s),acc (g)", "velocity", 1.0, 'q.csv:1: the header says acceleration ("time (s),acc (g)") but the'),
+        ("Time,Ground acceleration [m/s^2]", "velocity", 9.81, "the header says acceleration"),
+        ("time,velocity", "acceleration", 1.0, "the header says velocity"),
+        ("time,velocity (cm/s)", "velocity", 1.0, "q.csv:1: the header gives velocity in cm/s"),
+        ("time,v_mm/s", "velocity", 1.0, 'in mm/s ("time,v_mm/s") but the samples are read in m/s (a scale of 0.001'),
+        ("time,acc (g)", "acceleration", 1.0, 'acceleration in g ("time,acc (g)") but the samples are read in m/s²'),
+        ("time,a [gal]", "acceleration", 1.0, "acceleration in gal"),
+        ("time,a [cm/s2]", "acceleration", 1.0, "acceleration in cm/s2"),
+    ],
+)
+def test_header_disagreeing_with_the_reading_is_one_line(tmp_path, header, quantity, scale, expected):
+    with pytest.raises(InputError) as exc:
+        check(tmp_path, header + "\n" + SAMPLES, quantity, scale)
+    msg = str(exc.value)
+    assert expected in msg and "\n" not in msg
+
+
+@pytest.mark.parametrize(
+    "header, quantity, scale",
+    [
+        ("time,velocity", "velocity", 1.0),
+        ("t [s]; v [m/s]", "velocity", 1.0),
+        ("time,vx,vy", "velocity", 1.0),
+        ("time,rms,ground", "velocity", 1.0),  # words that merely contain "ms" or "g"
+        ("time,velocity (cm/s)", "velocity", 0.01),  # the scale converts it
+        ("time,acc (g)", "acceleration", 9.80665),
+        ("time, acc [m/s^2]", "acceleration", 1.0),
+        ("time,items", "acceleration", 1.0),
+    ],
+)
+def test_header_that_agrees_or_names_nothing_is_read(tmp_path, header, quantity, scale):
+    check(tmp_path, header + "\n" + SAMPLES, quantity, scale)
+
+
+def test_csv_header_is_the_line_before_the_samples(tmp_path):
+    f = tmp_path / "q.csv"
+    f.write_text("\ufeff# a comment\n\ntime,v\n0,0\n1,1\n")
+    assert csv_header(f) == (3, "time,v")
+    f.write_text("0,0\ntime_ms,v\n")  # no header: the loader reports the stray line
+    assert csv_header(f) is None
+
+
+def test_at2_header_units():
+    check_at2_header(["PEER", "x", "ACCELERATION TIME SERIES IN UNITS OF G"], "a.AT2")
+    check_at2_header(["title", "station", "units of g"], "a.AT2")
+    check_at2_header(["a", "b", "c"], "a.AT2")  # no unit named: PEER's g
+    with pytest.raises(InputError, match=r"^a.AT2:3: the header says units of CM/S/S; an .AT2 record holds"):
+        check_at2_header(["PEER", "x", "ACCELERATION TIME SERIES IN UNITS OF CM/S/S"], "a.AT2")
+    with pytest.raises(InputError, match=r"^a.AT2:3: the header says velocity"):
+        check_at2_header(["PEER", "x", "VELOCITY TIME SERIES IN UNITS OF CM/S"], "a.AT2")
