@@ -73,8 +73,8 @@ class RunConfig:
             raise field_error(
                 "dt",
                 self.dt,
-                f"gives {self.duration / self.dt:.3g} steps for duration "
-                f"{format_value(self.duration)} (at most {MAX_STEPS:.0e})",
+                f"gives {self.duration / self.dt:,.0f} steps for duration "
+                f"{format_value(self.duration)} (at most {MAX_STEPS:,})",
             )
         steps = self.duration / self.dt
         if abs(steps - round(steps)) > 1e-6 * max(1.0, steps):

@@ -61,7 +61,7 @@ FILE_ROWS = [
         scen("duration = 1e5\ndt = 1e-4"),
         ("check", "s.toml"),
         2,
-        "[run] dt = 0.0001: gives 1e+09 steps",
+        "[run] dt = 0.0001: gives 1,000,000,000 steps",
     ),
     ("run-theta", scen("theta = 0.2"), ("check", "s.toml"), 2, "[run] theta = 0.2: must be >= 0.5"),
     ("run-record-every-0", scen("record_every = 0"), ("check", "s.toml"), 2, "[run] record_every = 0: must be >= 1"),

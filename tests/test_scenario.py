@@ -353,3 +353,10 @@ def test_record_warnings_name_a_record_that_outlasts_the_run():
     ]
     windowed = dataclasses.replace(short, motions=(dataclasses.replace(short.motions[0], window=(0.2, 0.4)),))
     assert record_warnings(windowed) == []  # the window moves 0.2 ... 0.4 s to 0 ... 0.2 s: all of it is run
+
+
+def test_too_many_steps_says_how_many_exactly():
+    # 1.001e8 steps was "gives 1e+08 steps ... (at most 1e+08)": the refusal read like a contradiction
+    with pytest.raises(InputError) as exc:
+        RunConfig(duration=1001.0, dt=1e-5)
+    assert str(exc.value) == "dt = 1e-05: gives 100,100,000 steps for duration 1001.0 (at most 100,000,000)"
