@@ -60,7 +60,13 @@ def sweep_command(
         typer.Option("--workers", help="Worker processes of the local cluster (default: one per core; 0: no cluster)."),
     ] = None,
     full_runs: Annotated[bool, typer.Option("--full-runs", help="Do not stop a run when it collapses.")] = False,
-    duration: Annotated[float | None, typer.Option(help="Simulated time of every run, s.")] = None,
+    duration: Annotated[
+        float | None,
+        typer.Option(
+            help="Simulated time of every run, s (default: the scenario file's; a built-in's 1-2 s, or over --records "
+            "the longest record)."
+        ),
+    ] = None,
     dt: Annotated[float | None, typer.Option("--dt", help="Time step, s.")] = None,
     im: Annotated[
         str, typer.Option("--im", help="Intensity measure of the fragility curve: pga, pgv, arias, sa.")
@@ -100,7 +106,8 @@ def sweep_command(
         from masonrycli.study.axes import Axis
 
         motions = _records(records)
-        base = StudyBase(base.scenario, motions)
+        whole = duration is None and target in BUILT_IN  # a scenario file's [run] duration stands
+        base = StudyBase(_record_duration(base.scenario, motions, whole, err_console), motions)
         axes.insert(0, Axis("record", tuple(motions)))
     if scale is not None:
         axes.append(parse_axis(f"scale={scale}"))
@@ -188,6 +195,30 @@ def _base_scenario(target: str, duration, dt):
             scenario = dataclasses.replace(scenario, run=dataclasses.replace(scenario.run, **changes))
         except InputError as exc:
             raise InputError(f"--{next(iter(changes))}: {exc}") from None
+    return scenario
+
+
+def _record_duration(scenario, motions: dict, whole: bool, err_console):
+    """``scenario`` lasting the longest record (whole steps of its dt) if ``whole`` (a built-in without
+    --duration: its 1 s cut every record of an IDA to its first second). Else, if the run is shorter
+    than some records, one warning line says so."""
+    import dataclasses
+    import math
+
+    from masonrycli.scenario import MAX_DURATION
+
+    run = scenario.run
+    longest = max(m.end_time for m in motions.values())
+    if whole:
+        steps = max(1, math.ceil(longest / run.dt - 1e-9))
+        return dataclasses.replace(scenario, run=dataclasses.replace(run, duration=min(steps * run.dt, MAX_DURATION)))
+    late = [name for name, m in motions.items() if m.end_time > run.duration + 0.5 * run.dt]
+    if late:
+        err_console.print(
+            f"warning: the runs' {run.duration:g} s are shorter than {len(late)} of {len(motions)} records "
+            f"(longest {longest:g} s, {late[0]}): their shaking after t = {run.duration:g} s is not applied",
+            soft_wrap=True,
+        )
     return scenario
 
 

@@ -222,3 +222,25 @@ def test_the_table_fits_80_columns_in_a_real_terminal_width(block, tmp_path):
         done.stdout
     )
     assert "collapse: time of collapse, s" in done.stdout and "every column in" in done.stdout
+
+
+def test_records_run_whole_on_a_built_in_and_a_shorter_run_is_warned(block, tmp_path):
+    # the built-in wall's 1 s cut every record to its first second: without --duration the runs last the
+    # longest record; a scenario file keeps its [run] duration, and a record longer than the runs is named
+    folder = tmp_path / "records"
+    folder.mkdir()
+    t, u, v, a = band_limited(1.5, 0.01, [1.0, 2.5], [0.003, 0.001], seed=0)
+    write_at2(folder / "long.AT2", a / G_STANDARD, 0.01)
+    (folder / "short.csv").write_text("time,velocity\n0,0\n0.2,0.01\n0.4,0\n")
+    out = tmp_path / "whole.csv"
+    result = invoke("sweep", "wall", "--records", folder, "--workers", 0, "--out", out, "--no-recording")
+    assert result.exit_code == 0, result.output
+    assert {(r["record"], r["steps"]) for r in read_rows(out)} == {("long.AT2", 1500), ("short.csv", 1500)}
+    assert "warning" not in result.output
+    result = invoke("sweep", block, "--records", folder, "--workers", 0, "--out", tmp_path / "b.csv", "--no-recording")
+    assert result.exit_code == 0, result.output
+    assert {r["steps"] for r in read_rows(tmp_path / "b.csv")} == {500}  # the file's 1 s at dt = 2e-3
+    assert (
+        "warning: the runs' 1 s are shorter than 1 of 2 records (longest 1.5 s, long.AT2): their shaking after "
+        "t = 1 s is not applied" in " ".join(result.output.split())
+    )
