@@ -29,6 +29,9 @@ MAX_DURATION = 1e5
 MAX_STEPS = 10**8
 """Steps per run: more is refused up front as a likely typo (10⁸ steps of the 51-block wall take ~1 day)."""
 MAX_COUNT = 10**9
+MAX_FRICTION = 1e3
+"""Largest Coulomb μ: masonry joints have 0.4–1 and μ = 1000 already forbids sliding; beyond ~1e7 the limit
+analysis LP lost the weight against the friction cone's size and called the wall unable to stand."""
 SOLVERS = ("nlgs-accel", "nlgs")
 """Contact solvers a run can select (RunConfig.solver); the first is the default."""
 
@@ -104,7 +107,7 @@ class RunConfig:
 class Material:
     """Defaults for every block, and the friction of every contact.
 
-    density : kg/m³, > 0.  thickness : m, out of plane, > 0.  friction : Coulomb μ, >= 0.
+    density : kg/m³, > 0.  thickness : m, out of plane, > 0.  friction : Coulomb μ, in [0, MAX_FRICTION].
     """
 
     density: float = 2500.0
@@ -115,6 +118,12 @@ class Material:
         object.__setattr__(self, "density", check_real("density", self.density, gt=0.0))
         object.__setattr__(self, "thickness", check_real("thickness", self.thickness, gt=0.0))
         object.__setattr__(self, "friction", check_real("friction", self.friction, ge=0.0))
+        if self.friction > MAX_FRICTION:
+            raise field_error(
+                "friction",
+                self.friction,
+                f"must be <= {MAX_FRICTION:g} (a likely typo: {MAX_FRICTION:g} already forbids sliding)",
+            )
 
 
 @dataclass(frozen=True, eq=False)

@@ -101,6 +101,9 @@ def test_programmatic_config_errors():
         RunConfig(dt=-0.001)
     with pytest.raises(InputError, match=r"^friction = -1\.0: must be >= 0$"):
         Material(friction=-1.0)
+    with pytest.raises(InputError, match=r"^friction = 1001\.0: must be <= 1000 \(a likely typo"):
+        Material(friction=1001.0)
+    assert Material(friction=1000.0).friction == 1000.0
     with pytest.raises(InputError, match=r"^theta = 0\.2: must be >= 0\.5$"):
         dataclasses.replace(RunConfig(), theta=0.2)
 
