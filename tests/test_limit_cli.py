@@ -36,6 +36,7 @@ def test_table_names_lambda_and_mechanism(column_file, tmp_path):
     result = invoke("limit", column_file, "--load", "tilt", "--direction", "-x", "--out", out)
     assert result.exit_code == 0, result.output
     assert "0.6667" in result.output and "b0|ground" in result.output
+    assert "3 blocks, 1 support, friction μ = 0.9" in result.output  # was "1 supports"
     assert out.stat().st_size > 0
 
 

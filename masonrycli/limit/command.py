@@ -60,7 +60,10 @@ def result_table(result: LimitResult, out: Path | None) -> Table:
     table = Table(title=f"masonry limit — {result.scenario_name}", show_header=False, title_justify="left")
     table.add_column("quantity", style="bold")
     table.add_column("value")
-    table.add_row("structure", f"{s['blocks']} blocks, {s['supports']} supports, friction μ = {s['friction']:g}")
+    counts = ", ".join(
+        f"{n} {what}{'s' if n != 1 else ''}" for n, what in ((s["blocks"], "block"), (s["supports"], "support"))
+    )
+    table.add_row("structure", f"{counts}, friction μ = {s['friction']:g}")
     table.add_row("joints", f"{s['joints']} ({s['contact_points']} contact points, from the engine's detection)")
     table.add_row("live load", result.load.describe())
     lam = Text(f"{result.load_factor:.4f}", style="bold")  # Text: the consoles parse no markup
