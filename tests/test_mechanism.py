@@ -116,3 +116,24 @@ def test_mobilised_friction_is_the_used_share_of_coulomb_friction():
     got = mobilised_friction(r, status, 0.6)
     np.testing.assert_allclose(got, [0.5, 1.0, 1.0, 0.0, 0.0], rtol=1e-15)
     assert mobilised_friction(np.zeros((0, 2)), np.zeros(0, dtype=np.int8), 0.6).shape == (0,)
+
+
+def test_blocks_facing_across_a_gap_are_not_a_joint():
+    # A raised alert distance also detects block 1's top face against a block 2 hanging 0.15 m above it:
+    # two initial "contacts" with gap 0.15 m. They were a joint opened by 150 mm from the start (a wall at
+    # rest reported damaged); only contacts within JOINT_GAP are joint ends.
+    from masonrycli.mechanism import JOINT_GAP
+
+    q0 = np.vstack([Q0, [[0.5, 2.65, 0.0]]])
+    body = np.vstack([BODY, [[1, 3], [1, 3]]])
+    point = np.vstack([POINT, [[0.0, 2.0], [1.0, 2.0]]])
+    normal = np.vstack([NORMAL, [[0.0, 1.0], [0.0, 1.0]]])
+    gap = np.concatenate([GAP, [0.15, 0.15]])
+    jt = JointTracker(body, point, normal, gap, q0, block_count=3, mean_block_weight=10.0)
+    np.testing.assert_array_equal(jt.joint_body, [[0, 1], [0, 2]])
+    f = jt.block_fields(q0, np.zeros((0, 2), int), np.zeros((0, 2)), np.zeros(0, np.int8))
+    np.testing.assert_array_equal(f["block_max_opening"], [0.0, 0.0, 0.0])
+    # a joint built with a gap within JOINT_GAP (a hand-drawn geometry) stays a joint
+    gap[4:] = 0.5 * JOINT_GAP
+    jt = JointTracker(body, point, normal, gap, q0, block_count=3, mean_block_weight=10.0)
+    np.testing.assert_array_equal(jt.joint_body, [[0, 1], [0, 2], [1, 3]])
