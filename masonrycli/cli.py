@@ -366,6 +366,8 @@ def inspect_command(
             continue
         if key in ("steps", "time_span") and isinstance(value, (list, tuple)) and len(value) == 2:
             value = f"{value[0]} … {value[1]}" + (" s" if key == "time_span" else "")
+        elif value is None:  # a study's or a mechanism's recording has no sim_time ("None" before)
+            value = "—"
         elif isinstance(value, (list, tuple)):
             value = "\n".join(map(str, value))
         table.add_row(key, str(value))

@@ -74,6 +74,8 @@ def test_records_sweep_fits_a_fragility_curve_and_records_the_study(block, tmp_p
 
     paths = {ch.entity_path for ch in rr.chunk.RrdReader(str(rrd)).stream()}
     assert {"/study/fragility/runs", "/study/plot", "/study/rows"} <= paths
+    shown = invoke("inspect", rrd)  # a study has no time line: a dash, not Python's "None"
+    assert shown.exit_code == 0 and "None" not in shown.output and "time_span      │ —" in shown.output
     # the plot and the recording exist now: --force replaces them and still reuses every finished row
     again = invoke("sweep", block, "--records", folder, "--scale", "0.5:8:4", "--workers", 0, "--out", out, "--force")
     assert again.exit_code == 0 and "(0 runs now, 12 rows already there" in " ".join(again.output.split())
