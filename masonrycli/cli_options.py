@@ -51,7 +51,9 @@ RECORD = {
     "scale": _opt(float, "Loading", "Multiplies the --record.", "--scale"),
 }
 RUN = {
-    "duration": _opt(float, "Run", "Simulated time, s (default: the built-in's or the file's; simulate --record: the whole record)."),
+    "duration": _opt(
+        float, "Run", "Simulated time, s (default: the built-in's or the file's; simulate --record: the whole record)."
+    ),
     "dt": _opt(float, "Run", "Time step, s (default 1e-3).", "--dt"),
     "theta": _opt(float, "Run", "Moreau–Jean θ in [0.5, 1] (default 0.5)."),
     "record_every": _opt(int, "Run", "Steps between recorded frames (default 10)."),
