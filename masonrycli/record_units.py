@@ -8,6 +8,8 @@ what and where; a header that names none is taken at its word (PEER's format is 
 
 * .AT2 (:func:`check_at2_header`): ``UNITS OF CM/S/S`` (anything but G), or a ``VELOCITY`` /
   ``DISPLACEMENT`` series (PEER's .VT2 / .DT2 files, renamed).
+* .AT2 samples (:func:`check_at2_sample`): beyond ``MAX_AT2_G`` (10 g) they are not g — cm/s² under a
+  header that says g, or a header that names no unit.
 * CSV (:func:`check_csv_header`), the one text line allowed before the samples: times in ms; an
   acceleration header read as velocity or the reverse; cm/s, mm/s, g, gal or cm/s² values read with
   scale 1 (a scale other than 1 is taken as the conversion).
@@ -42,6 +44,19 @@ def check_at2_header(header: list[str], name: str) -> None:
                 f"{name}:{lineno}: the header says units of {unit.group(1).rstrip('.')}; an .AT2 record holds "
                 "acceleration in g (convert the samples, or give them as a CSV with quantity and scale)"
             )
+
+
+MAX_AT2_G = 10.0
+"""g: the strongest records ever measured peak at 3-4 g; an .AT2 sample beyond 10 g is in other units."""
+
+
+def check_at2_sample(value: float, where: str) -> None:
+    """Raise :class:`InputError` for an .AT2 sample beyond ``MAX_AT2_G`` (read as g, 981 cm/s² = 981 g)."""
+    if abs(value) > MAX_AT2_G:
+        raise InputError(
+            f"{where}: sample {value:g} g is beyond {MAX_AT2_G:g} g: the samples are not in g (cm/s²?); "
+            "an .AT2 record holds acceleration in g"
+        )
 
 
 def _words(*alternatives: str) -> re.Pattern:

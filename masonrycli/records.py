@@ -20,7 +20,7 @@ import numpy as np
 
 from masonrycli.errors import InputError
 from masonrycli.motion import Record
-from masonrycli.record_units import check_at2_header, check_csv_header
+from masonrycli.record_units import check_at2_header, check_at2_sample, check_csv_header
 from masonrycli.values import format_value, quote_string, shorten
 
 _SPLIT = re.compile(r"\s*[,;]\s*|\s+")
@@ -123,6 +123,8 @@ def load_at2(path, display: str | None = None) -> tuple[float, np.ndarray]:
             x = _number(field, f"{name}:{lineno}")
             if not math.isfinite(x):
                 raise InputError(f"{name}:{lineno}: values must be finite, got {shorten(field, 40)}")
+            if len(values) < npts:
+                check_at2_sample(x, f"{name}:{lineno}")
             values.append(x)
     if len(values) < npts:
         raise InputError(f"{name}: header says NPTS = {npts} but the file holds {len(values)} samples")

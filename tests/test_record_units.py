@@ -72,3 +72,11 @@ def test_at2_header_units():
         check_at2_header(["PEER", "x", "ACCELERATION TIME SERIES IN UNITS OF CM/S/S"], "a.AT2")
     with pytest.raises(InputError, match=r"^a.AT2:3: the header says velocity"):
         check_at2_header(["PEER", "x", "VELOCITY TIME SERIES IN UNITS OF CM/S"], "a.AT2")
+
+
+def test_at2_samples_beyond_ten_g_are_not_g():
+    from masonrycli.record_units import MAX_AT2_G, check_at2_sample
+
+    check_at2_sample(-MAX_AT2_G, "a.AT2:5")
+    with pytest.raises(InputError, match=r"^a.AT2:7: sample 294.2 g is beyond 10 g: the samples are not in g"):
+        check_at2_sample(294.2, "a.AT2:7")

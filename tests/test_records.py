@@ -152,6 +152,8 @@ def test_at2_reader_formats_and_units(tmp_path):
             "bad.AT2:3: the header says displacement",
         ),
         ("PEER\nx\nUNITS OF GAL\nNPTS= 3, DT= 0.01 SEC\n0.1 0.2 0.3\n", "bad.AT2:3: the header says units of GAL"),
+        # cm/s² samples under a header that names no unit (or says g): 294 "g"
+        ("a\nb\nc\nNPTS= 3, DT= 0.01 SEC\n0.1 0.2\n-294.2\n", "bad.AT2:6: sample -294.2 g is beyond 10 g"),
     ],
 )
 def test_at2_errors_name_file_and_line(tmp_path, text, expected):
