@@ -374,12 +374,18 @@ def run_outcome(sim: Simulation, hinges: int) -> dict:
 def describe_outcome(outcome: dict) -> str:
     """``collapsed at t = 0.53 s (a block fell ...)``, ``damaged (residual drift 0.31 %, 2 hinges, ...)``."""
     tail = (
-        f"residual drift {100 * outcome['residual_drift']:.3g} % of the height, {outcome['hinges']} hinges, "
-        f"largest opening {1000 * outcome['max_opening']:.3g} mm"
+        f"residual drift {_shown(100 * outcome['residual_drift'])} % of the height, {outcome['hinges']} hinges, "
+        f"largest opening {_shown(1000 * outcome['max_opening'])} mm"
     )
     if outcome["state"] == "collapsed":
         return f"collapsed at t = {outcome['collapse_time']:.3f} s ({outcome['collapse_reason']})"
     return f"{outcome['state']} ({tail})"
+
+
+def _shown(value: float) -> str:
+    """3 significant digits, and 0 below 1e-6 (% or mm): a wall at rest read 'residual drift 2.16e-17 % ...,
+    largest opening 1.67e-32 mm', round-off dressed as a measurement."""
+    return "0" if abs(value) < 1e-6 else f"{value:.3g}"
 
 
 def applied_intensity(scenario, model: Model, steps: int | None = None) -> dict[str, float]:

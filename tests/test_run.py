@@ -56,3 +56,14 @@ def test_memory_of_a_run_does_not_grow_with_its_steps():
     peak(100)  # numba's first call allocates for itself
     small, large = peak(1_000), peak(8_000)
     assert large - small < 24 * 7_000 / 10, (small, large)  # a tenth of what the arrays took (+190 kB before)
+
+
+def test_outcome_shows_round_off_as_zero():
+    from masonrycli.run import describe_outcome
+
+    rest = {"state": "intact", "residual_drift": 2.16e-19, "hinges": 0, "max_opening": 1.67e-35}
+    assert describe_outcome(rest) == "intact (residual drift 0 % of the height, 0 hinges, largest opening 0 mm)"
+    moved = {"state": "damaged", "residual_drift": 0.0031, "hinges": 2, "max_opening": 5.41e-6}
+    assert (
+        describe_outcome(moved) == "damaged (residual drift 0.31 % of the height, 2 hinges, largest opening 0.00541 mm)"
+    )
