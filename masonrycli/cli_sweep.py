@@ -102,12 +102,14 @@ def sweep_command(
 
     base = StudyBase(_base_scenario(target, duration, dt), {})
     axes = [parse_axis(p) for p in param or []]
+    late: list[str] = []  # warnings about records longer than the runs
     if records:
         from masonrycli.study.axes import Axis
 
         motions = _records(records)
         whole = duration is None and target in BUILT_IN  # a scenario file's [run] duration stands
-        base = StudyBase(_record_duration(base.scenario, motions, whole, err_console), motions)
+        scenario, late = _record_duration(base.scenario, motions, whole)
+        base = StudyBase(scenario, motions)
         axes.insert(0, Axis("record", tuple(motions)))
     if scale is not None:
         axes.append(parse_axis(f"scale={scale}"))
@@ -142,6 +144,8 @@ def sweep_command(
         stop_at_collapse=not full_runs,
         histories=histories,
         force=force,
+        warnings=tuple(late),
+        warn=lambda line: err_console.print(f"warning: {line}", soft_wrap=True),
     )
     # SIGTERM (kill, a batch system's time limit) takes Ctrl-C's way out: the finished rows are written and
     # the cluster closed. Before, it killed the command outright: no table, and multiprocessing's
@@ -198,10 +202,11 @@ def _base_scenario(target: str, duration, dt):
     return scenario
 
 
-def _record_duration(scenario, motions: dict, whole: bool, err_console):
-    """``scenario`` lasting the longest record (whole steps of its dt) if ``whole`` (a built-in without
-    --duration: its 1 s cut every record of an IDA to its first second). Else, if the run is shorter
-    than some records, one warning line says so."""
+def _record_duration(scenario, motions: dict, whole: bool):
+    """``(scenario, warnings)``: the scenario lasting the longest record (whole steps of its dt) if
+    ``whole`` (a built-in without --duration: its 1 s cut every record of an IDA to its first second);
+    else, if the runs are shorter than some records, one line saying so (printed once the request is
+    checked)."""
     import dataclasses
     import math
 
@@ -211,15 +216,15 @@ def _record_duration(scenario, motions: dict, whole: bool, err_console):
     longest = max(m.end_time for m in motions.values())
     if whole:
         steps = max(1, math.ceil(longest / run.dt - 1e-9))
-        return dataclasses.replace(scenario, run=dataclasses.replace(run, duration=min(steps * run.dt, MAX_DURATION)))
+        run = dataclasses.replace(run, duration=min(steps * run.dt, MAX_DURATION))
+        return dataclasses.replace(scenario, run=run), []
     late = [name for name, m in motions.items() if m.end_time > run.duration + 0.5 * run.dt]
-    if late:
-        err_console.print(
-            f"warning: the runs' {run.duration:g} s are shorter than {len(late)} of {len(motions)} records "
-            f"(longest {longest:g} s, {late[0]}): their shaking after t = {run.duration:g} s is not applied",
-            soft_wrap=True,
-        )
-    return scenario
+    if not late:
+        return scenario, []
+    return scenario, [
+        f"the runs' {run.duration:g} s are shorter than {len(late)} of {len(motions)} records (longest "
+        f"{longest:g} s, {late[0]}): their shaking after t = {run.duration:g} s is not applied"
+    ]
 
 
 def _records(entries: list[Path]) -> dict:

@@ -246,3 +246,10 @@ def test_records_run_whole_on_a_built_in_and_a_shorter_run_is_warned(block, tmp_
         "warning: the runs' 1 s are shorter than 1 of 2 records (longest 1.5 s, long.AT2): their shaking after "
         "t = 1 s is not applied" in " ".join(result.output.split())
     )
+    # bad input stays one line: the warning comes once the request is checked, not beside its error
+    fixed = tmp_path / "fixed.toml"
+    fixed.write_text(BLOCK.replace('motion = { kind = "sine", amplitude = 0.1, frequency = 2.0 }', ""))
+    result = invoke("sweep", fixed, "--records", folder, "--workers", 0, "--out", tmp_path / "f.csv")
+    assert result.exit_code == 2 and result.output.strip().splitlines() == [
+        "error: record: fixed has no shaking support (give one a sine or record motion)"
+    ]

@@ -8,6 +8,7 @@ written: :mod:`masonrycli.study.files`.
 from __future__ import annotations
 
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -37,6 +38,11 @@ class StudyRequest:
     """Folder for one history file per run (written by the workers), or None."""
     force: bool = False
     """Replace existing files (``--force``; see :mod:`masonrycli.study.files`)."""
+    warnings: tuple[str, ...] = ()
+    """Lines for the user once every check has passed, before the first run (a warning printed earlier
+    came out beside the one-line error of a bad request)."""
+    warn: Callable[[str], None] | None = None
+    """Where ``warnings`` go (the command line's stderr)."""
 
 
 @dataclass(frozen=True)
@@ -92,6 +98,8 @@ def run_study(base: StudyBase, request: StudyRequest, console: Console) -> Study
         driver = GridDriver(request.axes, done)
         columns = names + list(RESULT_COLUMNS) + ["study"]
     files.check_histories(request.histories, driver.start(), request.find, request.force)
+    for line in request.warnings if request.warn is not None else ():
+        request.warn(line)
     start = time.perf_counter()
     journal = store.Journal(request.out)
     progress = Progress(
