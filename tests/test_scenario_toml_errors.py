@@ -18,7 +18,7 @@ RUN_ERRORS = [
     ("dt = -0.001", "[run] dt = -0.001: must be > 0"),
     ("dt = 0", "[run] dt = 0: must be > 0"),
     ("dt = 2.0", "[run] dt = 2.0: must be <= duration (1.0)"),
-    ("dt = 1e-12", "[run] dt = 1e-12: gives 1e+12 steps"),
+    ("dt = 1e-12", "[run] dt = 1e-12: gives 1,000,000,000,000 steps"),
     ("duration = 0.0", "[run] duration = 0.0: must be > 0"),
     ("duration = -1", "[run] duration = -1: must be > 0"),
     ("duration = 1e6", "[run] duration = 1000000.0: must be <= 100000"),
