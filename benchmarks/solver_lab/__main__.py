@@ -1,4 +1,4 @@
-"""Solver lab: ``python -m benchmarks.solver_lab capture|table|clusters|stalled|trajectory|ordinary|ordinary-runs|ensemble``
+"""Solver lab: ``python -m benchmarks.solver_lab capture|table|clusters|stalled|trajectory|ordinary|newton-ordinary|ordinary-runs|ensemble``
 (see benchmarks/README.md, "Solver lab")."""
 
 from __future__ import annotations
@@ -44,10 +44,16 @@ def main() -> None:
     tra.add_argument("--case", default="wall-248")
     tra.add_argument("--every", type=int, default=5)
     tra.add_argument("--duration", type=float, default=None, help="simulated s (default: the case's)")
+    tra.add_argument("--name", default=None, help="data/trajectory/NAME (default: the case's name)")
     ordi = sub.add_parser("ordinary", help="first-stage variants of the accelerated sweep on a trajectory sample")
     ordi.add_argument("--case", default="wall-248")
     ordi.add_argument("--variants", nargs="+", default=None)
     ordi.add_argument("--repeat", type=int, default=3, help="interleaved timing rounds; CPU-time minimum kept")
+    nwo = sub.add_parser("newton-ordinary", help="Newton-type first stages on a trajectory sample's ordinary steps")
+    nwo.add_argument("--sample", default="nwt-wall-248", help="data/trajectory/SAMPLE")
+    nwo.add_argument("--every", type=int, default=1, help="every k-th ordinary step of the sample")
+    nwo.add_argument("--variants", nargs="+", default=None)
+    nwo.add_argument("--spread", action="store_true", help="also: how far apart two tight solves are")
     orr = sub.add_parser("ordinary-runs", help="first-stage variants in whole runs (sweeps, unconverged, slips)")
     orr.add_argument("--cases", nargs="+", default=["wall-248"])
     orr.add_argument("--variants", nargs="+", default=None)
@@ -66,7 +72,12 @@ def main() -> None:
     if args.command == "trajectory":
         from benchmarks.solver_lab.trajectory import capture as capture_trajectory
 
-        capture_trajectory(args.case, args.every, args.duration)
+        capture_trajectory(args.case, args.every, args.duration, args.name)
+        return
+    if args.command == "newton-ordinary":
+        from benchmarks.solver_lab.newton_ordinary import table as newton_table
+
+        newton_table(args.sample, args.every, args.variants, args.spread)
         return
     if args.command == "ordinary":
         from benchmarks.solver_lab.ordinary import table as ordinary_table

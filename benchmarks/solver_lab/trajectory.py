@@ -1,10 +1,10 @@
 """A trajectory sample: every k-th step of one run, kept as the engine's solver saw it.
 
-    python -m benchmarks.solver_lab trajectory --case wall-248 [--every 5] [--duration 1]
+    python -m benchmarks.solver_lab trajectory --case wall-248 [--every 5] [--duration 1] [--name DIR]
 
 Runs a case of :mod:`benchmarks.solver_cases` with the engine's default solver and, from outside the
 engine (``nlgs.solve`` wrapped, as ``capture.py``), keeps the input of every ``every``-th step in
-``data/trajectory/<case>/step-NNNN.npz``:
+``data/trajectory/<case>/step-NNNN.npz`` (``--name``: another directory than the case's):
 
     body (C, 2), pack (C, PACK_WIDTH)   the contacts as nlgs.solve got them
     v_free (B, 3), r_warm (C, 2), mu    the step's free velocities, warm start, friction
@@ -34,9 +34,9 @@ from masonrycli.run import Simulation
 TRAJECTORY = DATA / "trajectory"
 
 
-def capture(case: str, every: int, duration: float | None) -> None:
-    """Run ``case`` and keep every ``every``-th step (module doc)."""
-    out = TRAJECTORY / case
+def capture(case: str, every: int, duration: float | None, name: str | None = None) -> None:
+    """Run ``case`` and keep every ``every``-th step (module doc) in ``data/trajectory/<name or case>``."""
+    out = TRAJECTORY / (name or case)
     out.mkdir(parents=True, exist_ok=True)
     for old in out.glob("step-*.npz"):
         old.unlink()
