@@ -14,6 +14,10 @@ sweeps, plus ``newton.NEWTON_UNITS`` (60) per Newton direction; oracle variants 
                          the sweeps' iterate (its Alart–Curnier active set) with shift λ = L, the full step
                          (-ls: Armijo's search on ½|F|² as the engine's) projected into the cone; R such
                          rounds; then the sweeps. K = 0: from the warm start.
+    sK-lL                K momentum sweeps, then one Newton direction on the linear piece the sweeps'
+                         statuses name (open: r = 0; stick: u = (0, −b); slip in the direction of r_t:
+                         u_n = −b, r_t = ±μ r_n), shift L, full step, cone, sweeps: an active set
+                         "frozen from the NLGS statuses" (idea (b) of the issue)
     oracle-v             the velocities of a tight solve (momentum to 1e-9 m/s, 20 000 sweeps) reached
                          exactly by the smallest W⁻¹-weighted impulse change dr (H dr = M Δv, a sparse
                          solve of H W⁻¹ Hᵀ over the blocks' dofs), projected into the cone: what idea (a) of
@@ -39,7 +43,7 @@ import scipy.sparse.linalg as spl
 
 from benchmarks.solver_lab.trajectory import TRAJECTORY
 from masonrycli.engine import newton, nlgs
-from masonrycli.engine.nlgs import P_IIA, P_IIB, P_IMA, P_IMB, P_WNN, P_WTT
+from masonrycli.engine.nlgs import P_BIAS, P_IIA, P_IIB, P_IMA, P_IMB, P_WNN, P_WTT
 
 TOLERANCE = 1e-5
 STALL, CAP = 500, 20_000
@@ -58,6 +62,10 @@ VARIANTS = (
     "n60-l1e-3",
     "n100-l1e-3",
     "n200-l1e-3",
+    "s30-l1e-3",
+    "s100-l1e-3",
+    "s200-l1e-3",
+    "s100-l3e-3",
     "oracle-v",
     "oracle-pieces-l1e-4-n1",
     "oracle-pieces-l1e-4-n4",
@@ -186,6 +194,43 @@ def _oracle_pieces(s: Step, lam, n):
     return s.sweeps(cone(r, s.mu))[:2]
 
 
+def _piece(s: Step, status, r):
+    # Jacobian pieces (newton.J_*) of the linear piece the statuses name; slip's σ = sign(r_t).
+    wt, wn, mu, j = s.pack[:, P_WTT], s.pack[:, P_WNN], s.mu, newton
+    jac = np.zeros((s.count, 6))
+    op, sk, sl = (status == nlgs.STATUS_OPEN), (status == nlgs.STATUS_STICK), (status == nlgs.STATUS_SLIP)
+    sig = np.sign(r[:, 0])
+    jac[op, j.J_BT], jac[op, j.J_BN] = wt[op], wn[op]
+    jac[sk, j.J_AT], jac[sk, j.J_AN] = 1.0, 1.0
+    jac[sl, j.J_AN], jac[sl, j.J_BT] = 1.0, wt[sl]
+    jac[sl, j.J_ATN], jac[sl, j.J_BTN] = (wt / wn * mu * sig)[sl], (-wt * mu * sig)[sl]
+    return jac
+
+
+def _piece_value(s: Step, jac, r):
+    # F on that piece: A (u + (0, b)) + B r (the Alart–Curnier function where the piece is the active one).
+    j = newton
+    v = s.velocity(r)
+    u = np.array([nlgs._relative_velocity(v, s.body[c, 0], s.body[c, 1], s.pack, c) for c in range(s.count)])
+    un = u[:, 1] + s.pack[:, P_BIAS]
+    f = np.empty((s.count, 2))
+    f[:, 0] = jac[:, j.J_AT] * u[:, 0] + jac[:, j.J_ATN] * un + jac[:, j.J_BT] * r[:, 0] + jac[:, j.J_BTN] * r[:, 1]
+    f[:, 1] = jac[:, j.J_AN] * un + jac[:, j.J_BN] * r[:, 1]
+    return f
+
+
+def _status_piece(s: Step, k, lam):
+    its, res, _, r, status = s.sweeps(s.r_warm, cap=k)
+    if res <= TOLERANCE:
+        return its, res
+    jac = _piece(s, status, r)
+    dr = newton.newton_direction(s.body, s.pack, s.count, s.v_free, _piece_value(s, jac, r), jac, lam)
+    if dr is not None:
+        r = cone(r + dr, s.mu)
+    n, res = s.sweeps(r)[:2]
+    return its + newton.NEWTON_UNITS + n, res
+
+
 def run_variant(s: Step, name: str):
     """(units, final residual) of variant ``name`` on step ``s`` (module doc)."""
     if name == "momentum":
@@ -195,6 +240,9 @@ def run_variant(s: Step, name: str):
     m = re.fullmatch(r"oracle-pieces-l([0-9.e-]+)-n(\d+)", name)
     if m:
         return _oracle_pieces(s, float(m[1]), int(m[2]))
+    m = re.fullmatch(r"s(\d+)-l([0-9.e-]+)", name)
+    if m:
+        return _status_piece(s, int(m[1]), float(m[2]))
     m = re.fullmatch(r"n(\d+)-l([0-9.e-]+?)(-ls)?(?:-x(\d+))?", name)
     if not m:
         raise SystemExit(f"unknown variant {name}")
@@ -207,7 +255,7 @@ def spread(steps) -> None:
         _, res0, v_0, r_0, _ = s.sweeps(np.zeros_like(s.r_warm), CAP, CAP, TIGHT)
         print(
             f"step {s.step}: two tight solves (from the warm start / from 0, residuals"
-            f" ≤ {max(res0, TIGHT):.1e} m/s): |Δv| max {np.abs(v_a - v_0).max():.1e} m/s (rad/s),"
+            f" {max(res0, TIGHT):.1e} m/s at most): |Δv| max {np.abs(v_a - v_0).max():.1e} m/s (rad/s),"
             f" |Δr| max {np.abs(r_a - r_0).max():.1e} N·s",
             flush=True,
         )
