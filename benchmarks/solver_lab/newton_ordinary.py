@@ -10,10 +10,11 @@ residual ≤ 1e-5 m/s) holds: what a variant adds must make those sweeps fewer t
 sweeps, plus ``newton.NEWTON_UNITS`` (60) per Newton direction; oracle variants count their sweeps only.
 
     momentum             the engine (ordinary steps: momentum alone; equals the run's units, checked)
-    nK-lL[-ls][-xR]      K momentum sweeps, then a Newton direction of :mod:`masonrycli.engine.newton` at
+    nK-lL[-ls][-xR][-free]  K momentum sweeps, then a Newton direction of :mod:`masonrycli.engine.newton` at
                          the sweeps' iterate (its Alart–Curnier active set) with shift λ = L, the full step
                          (-ls: Armijo's search on ½|F|² as the engine's) projected into the cone; R such
-                         rounds; then the sweeps. K = 0: from the warm start.
+                         rounds; then the sweeps. K = 0: from the warm start. -free: the cone only
+                         before the closing sweeps (R undamped semismooth Newton steps, F's own iterate)
     sK-lL                K momentum sweeps, then one Newton direction on the linear piece the sweeps'
                          statuses name (open: r = 0; stick: u = (0, −b); slip in the direction of r_t:
                          u_n = −b, r_t = ±μ r_n), shift L, full step, cone, sweeps: an active set
@@ -62,6 +63,9 @@ VARIANTS = (
     "n60-l1e-3",
     "n100-l1e-3",
     "n200-l1e-3",
+    "n0-l1e-6",
+    "n0-l1e-2-x3-free",
+    "n0-l1e-1-x3-free",
     "s30-l1e-3",
     "s100-l1e-3",
     "s200-l1e-3",
@@ -132,7 +136,7 @@ def cone(r, mu):
     return out
 
 
-def _newton_rounds(s: Step, k, lam, search, rounds):
+def _newton_rounds(s: Step, k, lam, search, rounds, free=False):
     units, r = 0, s.r_warm.copy()
     for _ in range(rounds):
         if k > 0:
@@ -151,20 +155,25 @@ def _newton_rounds(s: Step, k, lam, search, rounds):
                 break
             t /= 2
         if t >= newton.ALPHA_MIN:
-            r = cone(r + t * dr, s.mu)
-    its, res = s.sweeps(r)[:2]
+            r = r + t * dr if free else cone(r + t * dr, s.mu)
+    its, res = s.sweeps(cone(r, s.mu))[:2]
     return units + its, res
+
+
+def min_norm_change(s: Step, dv):
+    """The impulse change dr (C, 2) of smallest W⁻¹-weighted norm that moves the blocks' velocities by
+    ``dv`` (B, 3): H dr = M dv on the blocks' dofs (a sparse solve of H W⁻¹ Hᵀ)."""
+    h, minv = s.rows()
+    dyn = minv > 0
+    w = sp.diags(np.stack([1 / s.pack[:, P_WTT], 1 / s.pack[:, P_WNN]], 1).ravel())
+    hd = h[dyn]
+    y = spl.spsolve((hd @ w @ hd.T).tocsc(), dv.ravel()[dyn] / minv[dyn])
+    return (w @ (hd.T @ y)).reshape(-1, 2)
 
 
 def _oracle_v(s: Step):
     v_ref, _ = s.tight
-    h, minv = s.rows()
-    dyn = minv > 0
-    dv = (v_ref - s.velocity(s.r_warm)).ravel()[dyn] / minv[dyn]  # M Δv on the blocks' dofs
-    w = sp.diags(np.stack([1 / s.pack[:, P_WTT], 1 / s.pack[:, P_WNN]], 1).ravel())
-    hd = h[dyn]
-    y = spl.spsolve((hd @ w @ hd.T).tocsc(), dv)
-    dr = (w @ (hd.T @ y)).reshape(-1, 2)
+    dr = min_norm_change(s, v_ref - s.velocity(s.r_warm))
     return s.sweeps(cone(s.r_warm + dr, s.mu))[:2]
 
 
@@ -243,10 +252,10 @@ def run_variant(s: Step, name: str):
     m = re.fullmatch(r"s(\d+)-l([0-9.e-]+)", name)
     if m:
         return _status_piece(s, int(m[1]), float(m[2]))
-    m = re.fullmatch(r"n(\d+)-l([0-9.e-]+?)(-ls)?(?:-x(\d+))?", name)
+    m = re.fullmatch(r"n(\d+)-l([0-9.e-]+?)(-ls)?(?:-x(\d+))?(-free)?", name)
     if not m:
         raise SystemExit(f"unknown variant {name}")
-    return _newton_rounds(s, int(m[1]), float(m[2]), bool(m[3]), int(m[4] or 1))
+    return _newton_rounds(s, int(m[1]), float(m[2]), bool(m[3]), int(m[4] or 1), bool(m[5]))
 
 
 def spread(steps) -> None:
