@@ -54,6 +54,7 @@ def main() -> None:
     nwo.add_argument("--every", type=int, default=1, help="every k-th ordinary step of the sample")
     nwo.add_argument("--variants", nargs="+", default=None)
     nwo.add_argument("--spread", action="store_true", help="also: how far apart two tight solves are")
+    nwo.add_argument("--feasibility", action="store_true", help="also: the oracles' impulses against the cone")
     orr = sub.add_parser("ordinary-runs", help="first-stage variants in whole runs (sweeps, unconverged, slips)")
     orr.add_argument("--cases", nargs="+", default=["wall-248"])
     orr.add_argument("--variants", nargs="+", default=None)
@@ -77,7 +78,7 @@ def main() -> None:
     if args.command == "newton-ordinary":
         from benchmarks.solver_lab.newton_ordinary import table as newton_table
 
-        newton_table(args.sample, args.every, args.variants, args.spread)
+        newton_table(args.sample, args.every, args.variants, args.spread, args.feasibility)
         return
     if args.command == "ordinary":
         from benchmarks.solver_lab.ordinary import table as ordinary_table

@@ -30,7 +30,8 @@ sweeps, plus ``newton.NEWTON_UNITS`` (60) per Newton direction; oracle variants 
 Reported per variant: sweep units over the steps (sum, ÷ momentum's, mean, median, geometric mean of the
 per-step ratio, steps better / worse), steps whose closing sweeps stalled (unconverged), the mean final
 residual, and the CPU ms per step (one run; indicative only). ``--spread`` prints, per step, how far apart
-two tight solves are (from the warm start and from r = 0): the solution set of a hyperstatic wall.
+two tight solves are (from the warm start and from r = 0): the solution set of a hyperstatic wall;
+``--feasibility`` how far the oracles' impulses are from the cone and what projecting them does.
 """
 
 from __future__ import annotations
@@ -270,7 +271,32 @@ def spread(steps) -> None:
         )
 
 
-def table(sample: str, every: int, names: list[str] | None, show_spread: bool) -> None:
+def feasibility(steps, lam=1e-4, n=4) -> None:
+    """Why the oracles do not finish a step: how far their impulses are from the cone, and what the cone
+    projection then does to the velocities (max over the dofs, m/s or rad/s)."""
+    for s in steps:
+        v_ref, r_ref = s.tight
+        r = s.r_warm + min_norm_change(s, v_ref - s.velocity(s.r_warm))
+        rc = cone(r, s.mu)
+        line = (
+            f"step {s.step}: oracle-v: the cone moves r by {np.abs(rc - r).max():.1e} N·s, v by"
+            f" {np.abs(s.velocity(rc) - v_ref).max():.1e};"
+        )
+        jac = _piece(s, s.sweeps(r_ref, cap=1)[4], r_ref)
+        r = s.r_warm.copy()
+        for _ in range(n):
+            r = r + newton.newton_direction(s.body, s.pack, s.count, s.v_free, _piece_value(s, jac, r), jac, lam)
+        rc = cone(r, s.mu)
+        print(
+            f"{line} oracle-pieces-l{lam:g}-n{n}: |F_piece| {np.abs(_piece_value(s, jac, r)).max():.1e} m/s,"
+            f" r_n < 0 at {(r[:, 1] < -1e-9).sum()} and |r_t| > μ r_n at"
+            f" {(np.abs(r[:, 0]) > s.mu * r[:, 1] + 1e-9).sum()} of {s.count} contacts, the cone moves r by"
+            f" {np.abs(rc - r).max():.1e} N·s, v by {np.abs(s.velocity(rc) - s.velocity(r)).max():.1e}",
+            flush=True,
+        )
+
+
+def table(sample: str, every: int, names: list[str] | None, show_spread: bool, show_feasibility=False) -> None:
     paths = sorted((TRAJECTORY / sample).glob("step-*.npz"))
     steps = [s for s in (Step(p) for p in paths) if not s.stalled][::every]
     names = names or list(VARIANTS)
@@ -297,3 +323,5 @@ def table(sample: str, every: int, names: list[str] | None, show_spread: bool) -
         )
     if show_spread:
         spread(steps[:: max(1, len(steps) // 6)])
+    if show_feasibility:
+        feasibility(steps[:: max(1, len(steps) // 8)])

@@ -61,6 +61,13 @@ Lab figures (variant ``ac-aug-l3``, from the step's warm start, alone): 8 of 9 c
 the 32- and 64-course walls converged in 0.14–0.93× the engine's units (h64-108 7041 against 51 926,
 h32-99 6709 against 27 240, h32-106 2839 against 13 238); h32-87 not converged. From momentum's stalled
 iterate instead of the warm start it does worse, hence stalled.py starts it from r_warm.
+
+Not on ordinary steps (those momentum converges without stalling): one direction from the warm start or
+from momentum's iterate after 10–200 sweeps, λ 1e-6–1e-1, with or without the line search or the active
+set frozen from the sweeps' statuses, then sweeps, takes 1.06–4.4× momentum's units on the 248-block
+wall's and at best 0.985× (noise) on the 32- and 64-course walls' (benchmarks/README.md, "Newton-type
+steps on ordinary steps"): a wall's solution set is a continuum of self-stresses, and the sweeps' work
+there is choosing one inside the cone, which F's Newton step does not do.
 """
 
 from __future__ import annotations
