@@ -23,6 +23,9 @@ sweeps, plus ``newton.NEWTON_UNITS`` (60) per Newton direction; oracle variants 
                          exactly by the smallest W⁻¹-weighted impulse change dr (H dr = M Δv, a sparse
                          solve of H W⁻¹ Hᵀ over the blocks' dofs), projected into the cone: what idea (a) of
                          the issue, "keep the Newton step's dv, pick another dr", can give at best
+    oracle-s             the converse of oracle-v: the tight solve's impulses moved by the smallest
+                         W⁻¹-norm change back to the warm start's velocities (its self-stress, the
+                         warm start's motion), projected into the cone
     oracle-pieces-lL-nN  N Levenberg–Marquardt Newton steps (shift L) on the linear piece of the
                          Alart–Curnier function the tight solve lies on (its open / stick / slip set, known
                          in advance): what an exact active-set guess can give
@@ -72,6 +75,7 @@ VARIANTS = (
     "s200-l1e-3",
     "s100-l3e-3",
     "oracle-v",
+    "oracle-s",
     "oracle-pieces-l1e-4-n1",
     "oracle-pieces-l1e-4-n4",
 )
@@ -178,6 +182,12 @@ def _oracle_v(s: Step):
     return s.sweeps(cone(s.r_warm + dr, s.mu))[:2]
 
 
+def _oracle_s(s: Step):
+    v_ref, r_ref = s.tight
+    dr = min_norm_change(s, s.velocity(s.r_warm) - v_ref)
+    return s.sweeps(cone(r_ref + dr, s.mu))[:2]
+
+
 def _oracle_pieces(s: Step, lam, n):
     # F on the tight solve's linear piece: F_piece(r) = F(r_ref) + A Hᵀ (v(r) − v_ref) + B (r − r_ref).
     v_ref, r_ref = s.tight
@@ -247,6 +257,8 @@ def run_variant(s: Step, name: str):
         return s.sweeps(s.r_warm)[:2]
     if name == "oracle-v":
         return _oracle_v(s)
+    if name == "oracle-s":
+        return _oracle_s(s)
     m = re.fullmatch(r"oracle-pieces-l([0-9.e-]+)-n(\d+)", name)
     if m:
         return _oracle_pieces(s, float(m[1]), int(m[2]))
