@@ -53,3 +53,13 @@ def test_histories_to_write_are_checked_and_find_matches_any_value(tmp_path):
     (tmp_path / "f").write_text("")
     with pytest.raises(InputError, match="--histories .*: is not a folder"):
         check_histories(tmp_path / "f", POINTS, None, False)
+
+
+def test_an_unwritable_journal_names_the_out_option(tmp_path):
+    # "error: /proc/s.csv.journal.jsonl: No such file or directory" named no option
+    blocker = tmp_path / "file"
+    blocker.write_text("")
+    with pytest.raises(
+        InputError, match=r"^--out .*file/sub/s\.csv: cannot write its journal s\.csv\.journal\.jsonl: "
+    ):
+        store.Journal(blocker / "sub" / "s.csv")

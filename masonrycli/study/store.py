@@ -84,8 +84,11 @@ class Journal:
 
     def __init__(self, out: Path):
         self.path = journal_path(out)
-        self.path.parent.mkdir(parents=True, exist_ok=True)
-        self._fh = open(self.path, "a")
+        try:
+            self.path.parent.mkdir(parents=True, exist_ok=True)
+            self._fh = open(self.path, "a")
+        except OSError as exc:  # said "error: /proc/s.csv.journal.jsonl: No such file ...": no option named
+            raise InputError(f"--out {out}: cannot write its journal {self.path.name}: {exc.strerror or exc}") from None
 
     def append(self, row: dict) -> None:
         self._fh.write(json.dumps(row, default=_plain) + "\n")
