@@ -379,6 +379,11 @@ class Record(Motion):
         return float(self._arrays[0][-1])
 
     @property
+    def sample_interval(self) -> float:
+        """s: the shortest spacing of the samples used (a step longer than this skips samples)."""
+        return float(np.diff(self._arrays[0]).min())
+
+    @property
     def baseline_correction(self) -> dict:
         """What the baseline correction subtracted, for the run document: ``{"baseline": "quadratic",
         "c1": [x, y], "c2": [x, y], "length": T}`` (m/s, s; see the module docstring), or

@@ -363,3 +363,16 @@ def test_too_many_steps_says_how_many_exactly():
     with pytest.raises(InputError) as exc:
         RunConfig(duration=1001.0, dt=1e-5)
     assert str(exc.value) == "dt = 1e-05: gives 100,100,000 steps for duration 1001.0 (at most 100,000,000)"
+
+
+def test_record_warnings_name_a_record_sampled_finer_than_dt():
+    from masonrycli.scenario import record_warnings
+
+    scenario = load_scenario(DATA / "quake_record.toml")  # samples every 0.1 s; dt = 1e-3
+    coarse = dataclasses.replace(scenario, run=dataclasses.replace(scenario.run, dt=0.25))
+    assert record_warnings(coarse) == [
+        'support "ground": the record quake_velocity.csv is sampled every 0.1 s, finer than dt = 0.25 s: the steps '
+        "skip samples and alias its content above 2 Hz (dt = 0.1 follows every sample)"
+    ]
+    exact = dataclasses.replace(scenario, run=dataclasses.replace(scenario.run, dt=0.1))
+    assert record_warnings(exact) == []
