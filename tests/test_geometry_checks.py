@@ -124,6 +124,15 @@ def test_block_touching_nothing_is_a_warning():
     assert validate_assembly(asm(box(0, 5e-4, 1, 1), supports=[GROUND])) == []
 
 
+def test_no_support_at_all_is_a_warning():
+    # a GeoJSON wall whose ground had no "role": "support" ran as 52 falling blocks, reported collapsed
+    warnings = validate_assembly(asm(box(0, 0, 1, 1), box(0, 1, 1, 2)))
+    assert warnings == [
+        "no supports: nothing holds the 2 blocks up, they fall freely (in GeoJSON a feature is a block unless "
+        'its properties say "role": "support")'
+    ]
+
+
 def test_bad_support_role_and_density():
     with pytest.raises(GeometryError, match=r'support 0 \("ground"\): role'):
         validate_assembly(asm(box(0, 0, 1, 1), supports=[Support(box(-1, -1, 2, 0), "ground", "moving")]))
