@@ -35,7 +35,8 @@ def fail(message: str, code: int = EXIT_BAD_INPUT) -> None:
 
 
 def user_errors(func):
-    """Turn bad input into one line on stderr and exit code 2 — never a traceback."""
+    """Turn bad input into one line on stderr and exit code 2, and a Ctrl-C that reaches here into one line
+    and exit 130 — never a traceback."""
 
     @functools.wraps(func)
     def wrapper(*args, **kwargs):
@@ -49,6 +50,10 @@ def user_errors(func):
             raise
         except OSError as exc:
             fail(f"{exc.filename or ''}: {exc.strerror or exc}".lstrip(": "))
+        except KeyboardInterrupt:
+            # Ctrl-C before a command's own handling takes over (building the structure, reading a record,
+            # the LP): typer turned it into exit 130 without a word. Files are written whole or not at all.
+            fail("Ctrl-C: stopped before any output was written", 130)
 
     return wrapper
 

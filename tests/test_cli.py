@@ -315,3 +315,37 @@ def test_a_closed_stdout_is_not_bad_input(tmp_path):
     proc.stdout.close()  # the reader is gone before the first write
     err = proc.stderr.read().decode()
     assert proc.wait(timeout=120) == 1 and err == "", err
+
+
+def test_ctrl_c_before_the_run_is_one_line_and_exit_130(monkeypatch):
+    # a Ctrl-C while the structure is built (before the run's own signal handling) exited 130 without a word
+    import masonrycli.builtin
+
+    def interrupted(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(masonrycli.builtin, "builtin", interrupted)
+    result = invoke("simulate", "wall", "--duration", 0.01, "--no-recording")
+    assert result.exit_code == 130
+    assert result.output.strip() == "error: Ctrl-C: stopped before any output was written"
+
+
+def test_ctrl_c_while_masonry_starts_is_one_line_and_exit_130(monkeypatch, capsys):
+    # a Ctrl-C in the first half second (Python importing typer, rich, numpy) printed a KeyboardInterrupt
+    # traceback: the entry point imports the command line inside its own try
+    import importlib.abc
+    import sys
+
+    from masonrycli.__main__ import main
+
+    class Interrupted(importlib.abc.MetaPathFinder):
+        def find_spec(self, name, path=None, target=None):
+            if name == "masonrycli.cli":
+                raise KeyboardInterrupt
+
+    monkeypatch.delitem(sys.modules, "masonrycli.cli")
+    monkeypatch.setattr(sys, "meta_path", [Interrupted(), *sys.meta_path])
+    with pytest.raises(SystemExit) as exc:
+        main()
+    assert exc.value.code == 130
+    assert capsys.readouterr().err == "error: Ctrl-C while masonry was starting: nothing was run\n"
