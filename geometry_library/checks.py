@@ -29,7 +29,7 @@ from shapely.geometry import Polygon
 from shapely.strtree import STRtree
 
 from .blocks import SUPPORT_ROLES, Assembly, GeometryError
-from .values import check_positive
+from .values import check_material
 
 COLLINEAR_RTOL = 1e-9
 MIN_AREA = 1e-10
@@ -221,7 +221,7 @@ def validate_assembly(
     for i, block in enumerate(assembly.blocks):
         label = body_label(i, block.name)
         polys.append(normalise_polygon(block.polygon, i, block.name))
-        check_positive(label, density=block.density, thickness=block.thickness)
+        check_material(label, density=block.density, thickness=block.thickness)
         labels.append(label)
     for j, support in enumerate(assembly.supports):
         label = body_label(j, support.name, "support")

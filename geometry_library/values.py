@@ -66,6 +66,21 @@ def check_positive(label: str, **values) -> None:
             raise GeometryError(f"{label}: {key} must be a positive number, got {value!r}")
 
 
+MATERIAL_RANGE = {"density": (1e-3, 1e5, "kg/m³"), "thickness": (1e-6, 1e3, "m")}
+"""Sensible density and out-of-plane thickness: outside, a likely typo (the densest element is 22 590 kg/m³).
+The dynamics does not depend on them (rigid blocks: masses cancel), but at 1e300 the engine divided by
+zero ("internal error") and at 1e-300 a resting wall was reported collapsed at its first step."""
+
+
+def check_material(label: str, **values) -> None:
+    """:func:`check_positive`, then each of ``density`` / ``thickness`` within ``MATERIAL_RANGE``."""
+    check_positive(label, **values)
+    for key, value in values.items():
+        lo, hi, unit = MATERIAL_RANGE[key]
+        if not lo <= value <= hi:
+            raise GeometryError(f"{label}: {key} {value:g} {unit} is absurd (a likely typo: {lo:g} to {hi:g} {unit})")
+
+
 MAX_BLOCKS = 100_000
 """Most blocks a builder makes: more is a likely typo (``--blocks 100000000`` used to build for minutes
 and fill the memory before anything was said). The largest benchmark wall has 3996 blocks."""

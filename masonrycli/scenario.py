@@ -19,6 +19,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from geometry_library.blocks import Assembly, Block
+from geometry_library.values import MATERIAL_RANGE
 from masonrycli.errors import InputContext, InputError
 from masonrycli.motion import Fixed, Motion
 from masonrycli.structure import build_structure, check_finite_tree, read_geometry, structure_warnings
@@ -107,7 +108,8 @@ class RunConfig:
 class Material:
     """Defaults for every block, and the friction of every contact.
 
-    density : kg/m³, > 0.  thickness : m, out of plane, > 0.  friction : Coulomb μ, in [0, MAX_FRICTION].
+    density : kg/m³, thickness : m, out of plane, both within MATERIAL_RANGE.  friction : Coulomb μ, in
+    [0, MAX_FRICTION].
     """
 
     density: float = 2500.0
@@ -115,8 +117,11 @@ class Material:
     friction: float = 0.6
 
     def __post_init__(self):
-        object.__setattr__(self, "density", check_real("density", self.density, gt=0.0))
-        object.__setattr__(self, "thickness", check_real("thickness", self.thickness, gt=0.0))
+        for key, (lo, hi, unit) in MATERIAL_RANGE.items():
+            value = check_real(key, getattr(self, key), gt=0.0)
+            if not lo <= value <= hi:
+                raise field_error(key, value, f"must be between {lo:g} and {hi:g} {unit} (a likely typo)")
+            object.__setattr__(self, key, value)
         object.__setattr__(self, "friction", check_real("friction", self.friction, ge=0.0))
         if self.friction > MAX_FRICTION:
             raise field_error(

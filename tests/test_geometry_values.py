@@ -63,3 +63,20 @@ def test_input_style_messages():
         check_int("record_every", 0, ge=1, le=10**9)
     with pytest.raises(InputError, match=r"^record_every = 2\.5: must be an integer$"):
         check_int("record_every", 2.5, ge=1, le=10**9)
+
+
+def test_material_outside_its_range_is_absurd():
+    # thickness 1e300 divided by zero in the engine ("internal error"), density 1e-300 reported a resting
+    # wall collapsed at its first step; the dynamics is the same over the whole range
+    from geometry_library.values import check_material
+
+    check_material("block 0", density=1e-3, thickness=1e3)
+    check_material("block 0", density=1e5, thickness=1e-6)
+    with pytest.raises(
+        GeometryError, match=r"^block 0: thickness 1e\+300 m is absurd \(a likely typo: 1e-06 to 1000 m\)$"
+    ):
+        check_material("block 0", thickness=1e300)
+    with pytest.raises(GeometryError, match=r"^block 0: density 1e-300 kg/m³ is absurd"):
+        check_material("block 0", density=1e-300)
+    with pytest.raises(GeometryError, match="must be a positive number"):
+        check_material("block 0", density=-1.0)

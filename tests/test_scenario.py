@@ -104,6 +104,10 @@ def test_programmatic_config_errors():
     with pytest.raises(InputError, match=r"^friction = 1001\.0: must be <= 1000 \(a likely typo"):
         Material(friction=1001.0)
     assert Material(friction=1000.0).friction == 1000.0
+    with pytest.raises(InputError, match=r"^thickness = 1e\+300: must be between 1e-06 and 1000 m \(a likely typo\)$"):
+        Material(thickness=1e300)
+    with pytest.raises(InputError, match=r"^density = 1e-300: must be between 0.001 and 100000 kg/m³"):
+        Material(density=1e-300)
     with pytest.raises(InputError, match=r"^theta = 0\.2: must be >= 0\.5$"):
         dataclasses.replace(RunConfig(), theta=0.2)
 
