@@ -295,6 +295,18 @@ def check_command(scenario_file: ScenarioFile, **opts) -> None:
         warn(warning)
 
 
+def _check_material(opts: dict) -> None:
+    """--density / --thickness checked as simulate checks them (the message names the option)."""
+    from masonrycli.scenario import Material
+
+    for key in ("density", "thickness"):
+        if opts.get(key) is not None:
+            try:
+                Material(**{key: opts[key]})
+            except InputError as exc:
+                raise InputError(f"--{key}: {exc}") from None
+
+
 def _write_assembly(builder: str, opts: dict) -> None:
     """Build, check and write the GeoJSON under a temporary name, renamed onto ``--out`` when complete."""
     from geometry_library.builders import BUILDERS
@@ -304,11 +316,13 @@ def _write_assembly(builder: str, opts: dict) -> None:
     from masonrycli.outputs import check_output, written_whole
 
     target = check_output(opts.pop("out"), "--out", ".geojson", opts.pop("force"))
+    _check_material(opts)
     options = builder_options(builder, {k: v for k, v in opts.items() if v is not None})
     try:
         assembly = BUILDERS[builder](**options).build()
-    except (ValueError, GeometryError) as exc:
-        raise InputError(f"{builder}: {exc}") from None
+    except (ValueError, GeometryError) as exc:  # the builders' messages start with their name
+        msg = str(exc)
+        raise InputError(msg if msg.startswith(f"{builder}:") else f"{builder}: {msg}") from None
     for warning in validate_assembly(assembly):
         warn(warning)
     with written_whole(target) as part:

@@ -94,7 +94,15 @@ OPTION_ROWS = [
     ("sim-freq-negative", {}, (*WALL, "--freq", "-1", "--no-recording"), 2, "--amp/--freq:"),
     ("sim-voussoirs", {}, (*ARCH, "--voussoirs", "1", "--no-recording"), 2, 'builder "arch"'),
     ("sim-span", {}, (*ARCH, "--span", "-1", "--no-recording"), 2, 'builder "arch"'),
-    ("build-blocks", {}, ("build", "wall", "--blocks", "0", "--out", "w.geojson"), 2, "wall: wall: block count"),
+    # the builder's name once (it read "error: wall: wall: block count ...")
+    ("build-blocks", {}, ("build", "wall", "--blocks", "0", "--out", "w.geojson"), 2, "error: wall: block count"),
+    (
+        "build-density",
+        {},
+        ("build", "wall", "--density", "1e9", "--out", "w.geojson"),
+        2,
+        "--density: density = 1000000000.0: must be between 0.001 and 100000 kg/m³",
+    ),
     (
         "sim-block-height",
         {},
