@@ -30,7 +30,8 @@ def load_record_csv(path, display: str | None = None) -> tuple[np.ndarray, np.nd
     """Read a tabulated motion record.
 
     Format: one sample per line, ``time,value`` (2 columns: a value along the motion's direction) or
-    ``time,x,y`` (3 columns: a vector). Separators: comma, semicolon or white space. Blank lines and
+    ``time,x,y`` (3 columns: a vector). Separators: comma, semicolon or white space; on a line with
+    semicolons, commas are decimal commas (``0,01;0,5``). Blank lines and
     lines starting with ``#`` are skipped; a single non-numeric header line before the first sample is
     allowed. Times in s, strictly increasing, at least 2 samples; all values finite.
 
@@ -48,7 +49,7 @@ def load_record_csv(path, display: str | None = None) -> tuple[np.ndarray, np.nd
         stripped = line.strip()
         if not stripped or stripped.startswith("#"):
             continue
-        fields = [f for f in _SPLIT.split(stripped) if f != ""]
+        fields = _fields(stripped)
         try:
             nums = [float(f) for f in fields]
         except ValueError:
@@ -77,6 +78,16 @@ def load_record_csv(path, display: str | None = None) -> tuple[np.ndarray, np.nd
     if len(times) < 2:
         raise InputError(f"{name}: a record needs at least 2 samples, found {len(times)}")
     return np.asarray(times, dtype=np.float64), np.asarray(values, dtype=np.float64)
+
+
+def _fields(line: str) -> list[str]:
+    """The fields of a CSV line. A line with ``;`` is split on ``;`` alone and its decimal commas read as
+    points (``0;0,5``, a European spreadsheet's CSV): split on commas too, it was taken for a
+    (time, x, y) record, 0,5 becoming x = 0, y = 5 m/s, and the run said completed."""
+    if ";" not in line:
+        return [f for f in _SPLIT.split(line) if f != ""]
+    fields = [f.strip() for f in line.split(";") if f.strip() != ""]
+    return [f.replace(",", ".") if f.count(",") == 1 and "." not in f else f for f in fields]
 
 
 def _read_text(path, name: str) -> str:

@@ -32,6 +32,18 @@ def test_load_record_csv_formats(tmp_path):
     np.testing.assert_array_equal(v, [[1, 2], [3, 4], [5, 6]])
 
 
+def test_semicolon_csv_has_decimal_commas(tmp_path):
+    # a European spreadsheet's CSV: "0;0,5" was split on the comma too and read as (time, x, y) = (0, 0, 5)
+    f = tmp_path / "eu.csv"
+    f.write_text("time;velocity\n0;0,0\n1;0,5\n2;1,0\n3,5;-0,25\n")
+    t, v = load_record_csv(f)
+    np.testing.assert_array_equal(t, [0.0, 1.0, 2.0, 3.5])
+    np.testing.assert_array_equal(v, [0.0, 0.5, 1.0, -0.25])
+    f.write_text("t;v\n0;1,234.5\n1;2\n")  # a thousands separator is not a decimal comma
+    with pytest.raises(InputError, match=r'eu.csv:2: not a number: "1,234.5"'):
+        load_record_csv(f, display="eu.csv")
+
+
 def test_record_motion_source_is_absolute():
     m = record_motion(DATA / "quake_velocity.csv", scale=2.0)
     assert Path(m.source).is_absolute() and Path(m.source).name == "quake_velocity.csv"
