@@ -278,3 +278,24 @@ def test_aqueduct_is_mirror_symmetric(built):
     for b in wall:
         mirrored = b.vertices * [-1.0, 1.0]
         assert tuple(np.round(np.sort(mirrored, axis=0).ravel(), 9)) in shapes
+
+
+@pytest.mark.parametrize(
+    "span",
+    [
+        0.5,  # a voussoir corner at x = -0.6 cos 60° = -0.30000000000000004, on the joint at -0.3
+        2.4176914536,  # a voussoir corner 1e-11 m to the right of the joint at -1.35
+    ],
+)
+def test_aqueduct_builds_when_an_extrados_vertex_falls_on_a_joint(span):
+    # Both failed with "spandrel: could not split a wall piece into convex blocks (builder bug)": the
+    # piece beside the joint had a 6e-17 / 2e-11 m edge whose round-off angle looked reflex.
+    a = build_aqueduct(span=span)
+    assert max_pairwise_overlap(a) < 1e-9
+    assert all(is_convex(b.vertices) for b in a.blocks)
+    assert validate_assembly(a) == []
+    # The blocks tile the envelope minus the opening (rectangle under the springing + half polygon).
+    r_i, n = 0.5 * span, 30
+    half_width, top = r_i + 0.9, Y_S + 18 * H
+    opening = 2 * r_i * Y_S + 0.5 * n * r_i**2 * math.sin(math.pi / n)
+    assert sum(b.polygon.area for b in a.blocks) == pytest.approx(2 * half_width * top - opening, abs=1e-9)

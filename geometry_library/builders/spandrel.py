@@ -177,10 +177,19 @@ def _reflex(xy: np.ndarray) -> np.ndarray:
 
 
 def _clean(xy: np.ndarray) -> np.ndarray:
-    """Drop straight-angle vertices and zero-width spikes (both |cross| ≤ tol) from a CCW ring."""
+    """Drop from a CCW ring the vertices that shape nothing: straight angles, zero-width spikes, and
+    any vertex whose triangle with its two neighbours is dust (area ≤ DUST).
+
+    The dust rule is for an extrados vertex falling on, or a hair beside, a vertical joint: span 0.5 m
+    puts the voussoir corner at x = -0.6 cos 60° = -0.30000000000000004 against the joint at -0.3,
+    span 2.4176914536 one 1e-11 m beside the joint at -1.35. The piece then has an edge of 6e-17 or
+    2e-11 m whose angle is round-off but far above the collinearity tolerance relative to that edge:
+    the vertex looked reflex, every cut resolving it cut off dust, and the build failed. Dropping it
+    moves the piece's outline by at most DUST m² (the overlap check allows 1e-9 m²).
+    """
     while len(xy) > 3:
         cross, scale = _turn_cross(xy)
-        flat = np.flatnonzero(np.abs(cross) <= COLLINEAR_RTOL * scale)
+        flat = np.flatnonzero((np.abs(cross) <= COLLINEAR_RTOL * scale) | (np.abs(cross) <= 2.0 * DUST))
         if flat.size == 0:
             break
         xy = np.delete(xy, flat[0], axis=0)
