@@ -97,6 +97,7 @@ def sweep_command(
     from masonrycli.study import store
     from masonrycli.study.axes import StudyBase, parse_axis
     from masonrycli.study.files import check_picture
+    from masonrycli.study.runner import check_scheduler
     from masonrycli.study.study import StudyRequest, run_study
     from masonrycli.study.task import check_outcome
 
@@ -119,7 +120,8 @@ def sweep_command(
         raise InputError(f"--im {im}: expected one of pga, pgv, arias, sa")
     if workers is not None and workers < 0:
         raise InputError(f"--workers {workers}: must be >= 0")
-    if workers is not None and scheduler:
+    scheduler = check_scheduler(scheduler)
+    if workers is not None and scheduler is not None:
         raise InputError("--workers with --scheduler: the existing cluster has its own workers")
     if not (0 < rtol < 1):
         raise InputError(f"--rtol {rtol}: must be in (0, 1)")

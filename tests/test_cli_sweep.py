@@ -10,6 +10,7 @@ import pytest
 from typer.testing import CliRunner
 
 from masonrycli.cli import app
+from masonrycli.errors import InputError
 from masonrycli.records import G_STANDARD
 from masonrycli.study.store import read_rows
 
@@ -121,6 +122,12 @@ def test_grid_sweep_state_map_and_histories(block, tmp_path):
         (["-p", "amp=0.1", "--recording", "x.png"], "--recording x.png: the file name must end in .rrd"),
         (["-p", "amp=0.1", "--plot", "x.jpg"], "--plot x.jpg: the file name must end in .png"),
         (["-p", "amp=0.1", "--recording", "x.rrd", "--no-recording"], "--recording x.rrd with --no-recording"),
+        # these four ended in a Dask traceback (exit 1); the empty one started a LocalCluster instead
+        (["-p", "amp=0.1", "--scheduler", "foo"], "--scheduler 'foo': not an address with a port from 1 to 65535"),
+        (["-p", "amp=0.1", "--scheduler", "http://h:8786"], "--scheduler http://h:8786: http:// is not supported"),
+        (["-p", "amp=0.1", "--scheduler", "tls://h:8786"], "tls:// is not supported (expected tcp://HOST:PORT"),
+        (["-p", "amp=0.1", "--scheduler", "tcp://h:99999"], "a port from 1 to 65535"),  # waited 20 s
+        (["-p", "amp=0.1", "--scheduler", ""], "--scheduler '': not an address"),
     ],
 )
 def test_sweep_errors_are_one_line(block, args, fragment):
@@ -128,6 +135,21 @@ def test_sweep_errors_are_one_line(block, args, fragment):
     assert result.exit_code == 2, result.output
     lines = [ln for ln in result.output.strip().splitlines() if ln.strip()]
     assert len(lines) == 1 and fragment in lines[0], result.output
+
+
+def test_a_scheduler_that_cannot_be_reached_leaves_no_file(block, tmp_path, monkeypatch):
+    # The table (header only) was written before the cluster was reached: the corrected command then
+    # said "--out s.csv: the file exists". Connecting to a closed port takes Dask's 20 s timeout, so the
+    # refusal is simulated here; the real one was checked by hand (tcp://127.0.0.1:18787: the same line).
+    from masonrycli.study import runner
+
+    def unreachable(scheduler, workers):
+        raise InputError(f"--scheduler {scheduler}: cannot connect (OSError: Timed out)")
+
+    monkeypatch.setattr(runner, "open_cluster", unreachable)
+    result = invoke("sweep", block, "-p", "amp=0.1", "--scheduler", "tcp://127.0.0.1:1", "-o", tmp_path / "s.csv")
+    assert result.exit_code == 2 and "--scheduler tcp://127.0.0.1:1: cannot connect" in result.output
+    assert [p.name for p in tmp_path.iterdir()] == ["block.toml"]
 
 
 def _files(folder: Path) -> dict[str, bytes]:

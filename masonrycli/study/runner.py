@@ -23,6 +23,25 @@ from masonrycli.errors import InputError
 from masonrycli.study.task import empty_result, run_task
 
 
+def check_scheduler(address: str | None) -> str | None:
+    """``address`` if it is a Dask scheduler address this command can use, ``tcp://HOST:PORT`` (or
+    ``HOST:PORT``); else a one-line :class:`InputError`. Before, ``foo``, ``http://…``, ``tls://…`` and
+    ``ucx://…`` ended in a Dask traceback (exit 1), ``tcp://h:99999`` waited 20 s to time out, and an empty
+    ``--scheduler ''`` silently started a LocalCluster instead."""
+    if address is None:
+        return None
+    expected = "expected tcp://HOST:PORT, the address `dask scheduler` prints"
+    scheme, sep, rest = address.strip().partition("://")
+    if not sep:
+        scheme, rest = "tcp", address.strip()
+    if scheme != "tcp":
+        raise InputError(f"--scheduler {address}: {scheme}:// is not supported ({expected})")
+    host, colon, port = rest.rpartition(":")
+    if not colon or not host or not port.isdigit() or not 1 <= int(port) <= 65535:
+        raise InputError(f"--scheduler {address!r}: not an address with a port from 1 to 65535 ({expected})")
+    return address.strip()
+
+
 def open_cluster(scheduler: str | None, workers: int | None):
     """``(client, cluster)``: a client of ``scheduler``, or of a new LocalCluster (then also returned,
     to be closed by the caller) with ``workers`` processes (default: one per core)."""
@@ -31,7 +50,7 @@ def open_cluster(scheduler: str | None, workers: int | None):
     if scheduler:
         try:
             return Client(scheduler, timeout="20s"), None
-        except (OSError, TimeoutError) as exc:
+        except (OSError, TimeoutError, ValueError) as exc:
             raise InputError(f"--scheduler {scheduler}: cannot connect ({type(exc).__name__}: {exc})") from None
     n = workers or os.cpu_count() or 1
     # ":0": the scheduler's HTTP endpoints (it serves them even without a dashboard) on a free port, so

@@ -101,7 +101,14 @@ def run_study(base: StudyBase, request: StudyRequest, console: Console) -> Study
     for line in request.warnings if request.warn is not None else ():
         request.warn(line)
     start = time.perf_counter()
-    journal = store.Journal(request.out)
+    # The cluster first: a --scheduler that cannot be reached is bad input, refused before any file is
+    # written (it left a header-only table, which the corrected command then refused as existing).
+    client, cluster = open_cluster(request.scheduler, request.workers) if request.workers != 0 else (None, None)
+    try:
+        journal = store.Journal(request.out)
+    except BaseException:
+        _close(client, cluster)
+        raise
     progress = Progress(
         TextColumn("[bold]sweep"),
         BarColumn(),
@@ -128,18 +135,16 @@ def run_study(base: StudyBase, request: StudyRequest, console: Console) -> Study
         driver.finished.clear()
         progress.update(bar, states=f"{ran} runs: " + ", ".join(f"{k} {v}" for k, v in sorted(counts.items())))
 
-    histories = None
-    if request.histories is not None:
-        request.histories.mkdir(parents=True, exist_ok=True)
-        histories = str(request.histories.resolve())
-    task_args = (request.stop_at_collapse, histories, request.force)
-    cluster = client = None
     try:
+        histories = None
+        if request.histories is not None:
+            request.histories.mkdir(parents=True, exist_ok=True)
+            histories = str(request.histories.resolve())
+        task_args = (request.stop_at_collapse, histories, request.force)
         with progress:
-            if request.workers == 0:
+            if client is None:
                 run_serially(base, driver, on_row, *task_args)
             else:
-                client, cluster = open_cluster(request.scheduler, request.workers)
                 run_on_cluster(client, base, driver, on_row, *task_args)
     finally:
         journal.close()
@@ -147,9 +152,13 @@ def run_study(base: StudyBase, request: StudyRequest, console: Console) -> Study
         for r in rows:
             r.setdefault("study", study_id)
         store.write_rows(table, rows, columns)
-        if client is not None:
-            client.close()
-        if cluster is not None:
-            cluster.close()
+        _close(client, cluster)
     failed = sum(1 for r in rows if r.get("status") == "error")
     return StudyResult(rows, columns, driver.skipped, ran, time.perf_counter() - start, failed, table.path)
+
+
+def _close(client, cluster) -> None:
+    if client is not None:
+        client.close()
+    if cluster is not None:
+        cluster.close()
