@@ -144,3 +144,14 @@ def test_bad_loads_are_refused(kwargs, match):
 def test_unknown_block_is_named_with_suggestions():
     with pytest.raises(InputError, match=r"--block b01: no such block \(did you mean b1, b0\?\)"):
         analyse(column(2, 0.4, 0.2, 0.6), LiveLoad("point", block="b01"))
+
+
+@pytest.mark.parametrize("alert", [0.6, 1e9])
+def test_a_raised_alert_distance_adds_no_joint_across_a_gap(alert):
+    # A column of 4 blocks 0.3 × 0.25 overturns at λ = B/(nH) = 0.3 whatever contacts the run watches.
+    # With alert_distance 0.6 the LP also had "joints" between blocks 0.25 and 0.5 m apart, carrying
+    # force across the gaps (the 51-block wall: λ 0.544 at 0.5 m, 0.569 at 1e9, against 0.464).
+    sc = column(4, 0.3, 0.25, 0.45, alert_distance=alert)
+    joints = find_joints(build_model(sc))
+    assert [tuple(b) for b in joints.joint_body] == [(0, 1), (0, 4), (1, 2), (2, 3)]
+    assert analyse(sc, LiveLoad("horizontal")).load_factor == pytest.approx(0.3, rel=REL)

@@ -1,8 +1,12 @@
 """Joints of an assembly for limit analysis: the engine's contacts, grouped per pair of bodies.
 
 The contact points come from :func:`masonrycli.engine.collision.detect_contacts` — the very detection the
-time loop runs — in the initial configuration, with the model's alert distance. So every assembly the
-engine can run can also be analysed, and a joint here is a joint there.
+time loop runs — in the initial configuration, within the model's alert distance but at most
+:data:`~masonrycli.mechanism.JOINT_GAP` (1 mm, the default alert distance). So every assembly the engine
+can run can also be analysed, and a joint here is a joint there. The cap: with ``[run] alert_distance =
+0.5`` the 51-block wall had "joints" between blocks 0.2 m apart (and with 1e9 between its two ends),
+which carried the LP's forces across the gaps: λ 0.544 / 0.569 instead of 0.464, with hinges such as
+``c01-b01|c01-b08``.
 
 A *joint* is one pair of bodies (a < b; supports come after the blocks) with its contact points: two
 for a face-to-face joint (the ends of the shared segment), one for a corner touching a face. All the
@@ -17,6 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from masonrycli.engine.collision import ContactBuffers, detect_contacts
+from masonrycli.mechanism import JOINT_GAP
 from masonrycli.model import Model
 
 
@@ -58,11 +63,11 @@ class Joints:
 
 
 def find_joints(model: Model) -> Joints:
-    """The joints of ``model`` in its initial configuration (engine contact detection, model alert distance)."""
+    """The joints of ``model`` in its initial configuration (engine contact detection within the model's
+    alert distance, at most JOINT_GAP: module doc)."""
     buffers = ContactBuffers(model.body_vert_start)
-    count = detect_contacts(
-        model.body_q0, model.body_vert_start, model.vert_local, model.body_dynamic, model.alert_distance, buffers
-    )
+    reach = min(model.alert_distance, JOINT_GAP)
+    count = detect_contacts(model.body_q0, model.body_vert_start, model.vert_local, model.body_dynamic, reach, buffers)
     c = buffers.view()
     body = np.asarray(c.contact_body[:count], dtype=np.int64)
     # detect_contacts sorts by pair already; a stable sort keeps that promise explicit and cheap.
