@@ -1,0 +1,282 @@
+"""Hard steps: capture the steps that cost the engine most in ensemble runs, and replay rule variants on them.
+
+    python -m benchmarks.solver_lab hard capture [--cases h32 h64] [--copy 0] [--min-units 1000]
+    python -m benchmarks.solver_lab hard replay --variants main ns-… [--min-units 2500] [--out FILE.json]
+    python -m benchmarks.solver_lab hard table FILE.json [FILE.json …]
+
+A whole run is chaotic (an amplitude changed by 1e-6 gives another trajectory, ensemble.py), so a change of
+the stalled-step rules cannot be judged on one run; replaying the same captured steps through ``nlgs.solve``
+is deterministic. ``capture`` runs each case under the ensemble's motions (ensemble.MOTIONS, copy ``--copy``,
+ensemble.DURATION) with the engine as it is, and keeps the input nlgs.solve got at every step that took
+``--min-units`` sweep units or more (body pairs, packed rows, v_free, warm start r, status, μ, tolerance,
+cap) in ``data/hard/<case>-a<A>-f<F>-c<copy>-<step>.npz``, with the units and residual the engine spent on it
+(``index-<case>-c<copy>.json``). The per-step units of the run are printed beside the run's total so that they can be
+checked against an ensemble file of the same engine (the same motion and copy give the same units).
+
+``replay`` solves each kept step with ``--min-units`` or more by nlgs.solve from its warm start, once per
+variant: a variant is a set of module constants of momentum.py, stalled.py and newton.py set for the
+replay (VARIANTS below), restored after. Per step: units, converged, and the method that finished it
+(the last one stalled.py resumed; "momentum0" for momentum's own first solve). ``table`` prints, per
+variant: total units, steps converged, steps above 10 000 units, ratio to the first file's total, and
+which method finished how many steps.
+"""
+
+from __future__ import annotations
+
+import json
+import time
+from pathlib import Path
+from types import SimpleNamespace
+
+import numpy as np
+
+from benchmarks.solver_lab.problems import DATA
+from masonrycli.engine import momentum, newton, nlgs, stalled
+
+HARD = DATA / "hard"
+BIG = 10_000
+"""Units above which a step counts as one of the costliest (the distribution's tail in the table)."""
+
+VARIANTS: dict[str, dict[str, object]] = {
+    "main": {},
+    "stall300": {"momentum.STALL_SWEEPS": 300},
+    "stall200": {"momentum.STALL_SWEEPS": 200},
+    "stall1000": {"momentum.STALL_SWEEPS": 1000},
+    "lambda3e-4": {"newton.LAMBDA": 3e-4},
+    "lambda1e-4": {"newton.LAMBDA": 1e-4},
+    "lambda3e-3": {"newton.LAMBDA": 3e-3},
+    "shares.1-.3": {"newton.NEWTON_SHARES": (0.1, 0.3)},
+    "shares.25-.3": {"newton.NEWTON_SHARES": (0.25, 0.3)},
+    "shares.15-.5": {"newton.NEWTON_SHARES": (0.15, 0.5)},
+    "shares.15-.15": {"newton.NEWTON_SHARES": (0.15, 0.15)},
+    "nlast0": {"stalled.NEWTON_LAST_ROUND": 0},
+    "nlast2": {"stalled.NEWTON_LAST_ROUND": 2},
+    "nbudget1": {"stalled.NEWTON_BUDGET": 1},
+    "nbudget3": {"stalled.NEWTON_BUDGET": 3},
+    "polish500": {"newton.POLISH_STALL": 500},
+    "polish2000": {"newton.POLISH_STALL": 2000},
+    "first1000": {"stalled.FIRST_BUDGET": 1000},
+    "first4000": {"stalled.FIRST_BUDGET": 4000},
+    "order-tfam": {"stalled.METHODS": ("newton", "turning", "faces", "alternating", "momentum")},
+    "order-tn": {"stalled.METHODS": ("turning", "newton", "alternating", "momentum", "faces")},
+    "no-momentum": {"stalled.METHODS": ("newton", "turning", "alternating", "faces")},
+    "no-alternating": {"stalled.METHODS": ("newton", "turning", "momentum", "faces")},
+}
+
+
+def _key(case: str, motion, copy: int, step: int) -> str:
+    return f"{case}-a{motion[0]:g}-f{motion[1]:g}-c{copy}-{step}"
+
+
+def capture(cases: list[str], copy: int, min_units: int, motions=None, duration: float | None = None) -> None:
+    """Run ``cases`` under the ensemble's motions; keep the steps of ``min_units`` or more (module doc)."""
+    from benchmarks.solver_lab import ensemble
+
+    HARD.mkdir(parents=True, exist_ok=True)
+    for case in cases:
+        index_path = HARD / f"index-{case}-c{copy}.json"  # one a capture process: cases run in parallel
+        index = json.loads(index_path.read_text()) if index_path.exists() else {}
+        for motion in motions or ensemble.MOTIONS:
+            kept, units = _capture_run(case, motion, copy, min_units, duration or ensemble.DURATION)
+            index.update(kept)
+            index_path.write_text(json.dumps(index, indent=1))
+            u = np.array(units)
+            print(
+                f"{case} A {motion[0]:g} f {motion[1]:g} copy {copy}: {u.size} steps, total {u.sum()} units,"
+                f" kept {len(kept)} (≥ {min_units}), {int((u >= 2500).sum())} of ≥ 2500",
+                flush=True,
+            )
+
+
+def _capture_run(case, motion, copy, min_units, duration) -> tuple[dict, list[int]]:
+    from benchmarks.solver_cases import CASES
+    from benchmarks.solver_lab.ensemble import COPY_STEP
+    from masonrycli.motion import Sine
+    from masonrycli.run import Simulation
+    from masonrycli.scenario import Material, RunConfig, scenario_from_builder
+
+    builder, options, _, _ = CASES[case]
+    amplitude, frequency, phase = motion
+    ground = Sine(amplitude=amplitude * (1.0 + copy * COPY_STEP), frequency=frequency, phase=phase)
+    scenario = scenario_from_builder(builder, options, RunConfig(duration=duration), Material(), {"ground": ground})
+    sim = Simulation(scenario)
+    solve = nlgs.solve
+    step, kept, units = [0], {}, []
+
+    def watched(contact_body, pack, count, model, v, r, status):
+        inputs = {
+            "body": contact_body[:count].copy(),
+            "pack": pack[:count].copy(),
+            "v_free": v.copy(),
+            "r_warm": r[:count].copy(),
+            "status": status[:count].copy(),
+        }
+        out = solve(contact_body, pack, count, model, v, r, status)
+        if out[0] >= min_units:
+            name = _key(case, motion, copy, step[0])
+            params = {"mu": model.friction, "tolerance": model.tolerance, "cap": model.max_iterations}
+            np.savez_compressed(HARD / f"{name}.npz", **inputs, **params)
+            kept[name] = {"case": case, "step": step[0], "units": int(out[0]), "residual": float(out[1])}
+            kept[name].update(params, contacts=int(count), bodies=int(v.shape[0]), solver=model.solver)
+        return out
+
+    nlgs.solve = watched
+    try:
+        for _ in range(sim.model.n_steps):
+            units.append(int(sim.step().iterations))
+            step[0] += 1
+    finally:
+        nlgs.solve = solve
+    return kept, units
+
+
+def _set(overrides: dict[str, object]) -> dict[str, object]:
+    modules = {"momentum": momentum, "newton": newton, "stalled": stalled, "nlgs": nlgs}
+    old = {}
+    for name, value in overrides.items():
+        module, attr = name.split(".")
+        old[name] = getattr(modules[module], attr)
+        setattr(modules[module], attr, value)
+    return old
+
+
+def replay_step(name: str) -> dict:
+    """One kept step through nlgs.solve from its warm start: units, residual, the method that finished."""
+    z = np.load(HARD / f"{name}.npz")
+    body, pack, count = z["body"].astype(np.int32), z["pack"], z["body"].shape[0]
+    v, r, status = z["v_free"].copy(), z["r_warm"].copy(), z["status"].copy()
+    model = SimpleNamespace(
+        friction=float(z["mu"]), tolerance=float(z["tolerance"]), max_iterations=int(z["cap"]), solver="nlgs-accel"
+    )
+    log = []
+    resume = stalled._resume
+
+    def logged(method, state, *args):
+        done = resume(method, state, *args)
+        log.append((method, done))
+        return done
+
+    stalled._resume = logged
+    try:
+        t = time.process_time()
+        units, residual = nlgs.solve(body, pack, count, model, v, r, status)
+        cpu = time.process_time() - t
+    finally:
+        stalled._resume = resume
+    converged = residual <= model.tolerance
+    by = (log[-1][0] if log else "momentum0") if converged else "-"
+    return {
+        "units": int(units),
+        "residual": float(residual),
+        "converged": bool(converged),
+        "by": by,
+        "methods": [m for m, _ in log],
+        "cpu_s": round(cpu, 4),
+    }
+
+
+def replay(variants: list[str], min_units: int, max_units: int | None, out: Path | None, cases=None) -> dict:
+    """Each variant over the kept steps with min_units ≤ engine units < max_units; results to ``out``."""
+    index = {n: e for path in sorted(HARD.glob("index-*.json")) for n, e in json.loads(path.read_text()).items()}
+    names = sorted(
+        n
+        for n, e in index.items()
+        if e["units"] >= min_units
+        and (max_units is None or e["units"] < max_units)
+        and e["case"] in (cases or [e["case"]])
+    )
+    doc = {
+        "min_units": min_units,
+        "max_units": max_units,
+        "steps": names,
+        "engine": {n: index[n]["units"] for n in names},
+        "variants": {},
+    }
+    for variant in variants:
+        overrides = VARIANTS[variant] if variant in VARIANTS else _parse(variant)
+        old = _set(overrides)
+        try:
+            results = {}
+            t = time.process_time()
+            for name in names:
+                results[name] = replay_step(name)
+        finally:
+            _set(old)
+        doc["variants"][variant] = {"overrides": {k: str(v) for k, v in overrides.items()}, "steps": results}
+        print(summary_line(variant, results, doc["engine"]) + f" ({time.process_time() - t:.0f} CPU s)", flush=True)
+        if out is not None:
+            out.write_text(json.dumps(doc, indent=1))
+    return doc
+
+
+def _parse(text: str) -> dict[str, object]:
+    """``"newton.LAMBDA=3e-4+stalled.FIRST_BUDGET=1000"`` → overrides (values by Python's literal syntax)."""
+    import ast
+
+    overrides = {}
+    for part in text.split("+"):
+        key, value = part.split("=")
+        overrides[key] = ast.literal_eval(value)
+    return overrides
+
+
+def summary_line(variant: str, results: dict, engine: dict | None = None) -> str:
+    u = np.array([s["units"] for s in results.values()])
+    missed = sum(not s["converged"] for s in results.values())
+    same = ""
+    if engine:
+        same = f", {sum(results[n]['units'] == engine[n] for n in results)} steps as captured"
+    return (
+        f"| {variant} | {u.sum()} | {len(u) - missed} / {len(u)} | {int((u > BIG).sum())} |"
+        f" {int(((u >= 2500) & (u <= BIG)).sum())} | {int(u.max())} |{same}"
+    )
+
+
+def table(paths: list[Path]) -> None:
+    """Per variant of the replay files: totals, converged, tail, finishing method (module doc)."""
+    base = None
+    print("| variant | units | ratio | converged | > 10 000 | 2500–10 000 | max | finished by |\n" + "|---" * 8 + "|")
+    for path in paths:
+        doc = json.loads(Path(path).read_text())
+        for variant, v in doc["variants"].items():
+            res = v["steps"]
+            u = np.array([s["units"] for s in res.values()])
+            base = base or u.sum()
+            missed = sum(not s["converged"] for s in res.values())
+            by: dict[str, int] = {}
+            for s in res.values():
+                by[s["by"]] = by.get(s["by"], 0) + 1
+            finished = ", ".join(f"{k} {n}" for k, n in sorted(by.items(), key=lambda kv: -kv[1]))
+            print(
+                f"| {variant} | {u.sum()} | {u.sum() / base:.3f} | {len(u) - missed} / {len(u)} | {int((u > BIG).sum())} |"
+                f" {int(((u >= 2500) & (u <= BIG)).sum())} | {int(u.max())} | {finished} |"
+            )
+
+
+def add_arguments(sub) -> None:
+    """The ``hard`` subcommand's parser."""
+    hard = sub.add_parser("hard", help="capture the costliest steps of ensemble runs; replay rule variants")
+    act = hard.add_subparsers(dest="action", required=True)
+    c = act.add_parser("capture")
+    c.add_argument("--cases", nargs="+", default=["h32", "h64"])
+    c.add_argument("--copy", type=int, default=0)
+    c.add_argument("--min-units", type=int, default=1000)
+    r = act.add_parser("replay")
+    r.add_argument(
+        "--variants", nargs="+", default=["main"], help=f"names ({', '.join(VARIANTS)}) or MOD.NAME=VALUE[+…]"
+    )
+    r.add_argument("--min-units", type=int, default=2500)
+    r.add_argument("--max-units", type=int, default=None)
+    r.add_argument("--cases", nargs="+", default=None)
+    r.add_argument("--out", type=Path, default=None)
+    t = act.add_parser("table")
+    t.add_argument("files", nargs="+", type=Path)
+
+
+def main(args) -> None:
+    if args.action == "capture":
+        capture(args.cases, args.copy, args.min_units)
+    elif args.action == "replay":
+        replay(args.variants, args.min_units, args.max_units, args.out, args.cases)
+    else:
+        table(args.files)
