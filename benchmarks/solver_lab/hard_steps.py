@@ -60,6 +60,11 @@ VARIANTS: dict[str, dict[str, object]] = {
     "order-tfam": {"stalled.METHODS": ("newton", "turning", "faces", "alternating", "momentum")},
     "order-tn": {"stalled.METHODS": ("turning", "newton", "alternating", "momentum", "faces")},
     "no-momentum": {"stalled.METHODS": ("newton", "turning", "alternating", "faces")},
+    "ahead1": {"stalled.NEWTON_AHEAD": 1},
+    "ahead1-nlast2": {"stalled.NEWTON_AHEAD": 1, "stalled.NEWTON_LAST_ROUND": 2},
+    "ahead2-nlast2": {"stalled.NEWTON_AHEAD": 2, "stalled.NEWTON_LAST_ROUND": 2},
+    "first1000-nb4": {"stalled.FIRST_BUDGET": 1000, "stalled.NEWTON_BUDGET": 4},
+    "first500-nb8": {"stalled.FIRST_BUDGET": 500, "stalled.NEWTON_BUDGET": 8},
     "no-alternating": {"stalled.METHODS": ("newton", "turning", "momentum", "faces")},
 }
 
@@ -153,16 +158,23 @@ def replay_step(name: str) -> dict:
 
     def logged(method, state, *args):
         done = resume(method, state, *args)
-        log.append((method, done))
+        log.append((method, done, float(state.residual)))
         return done
 
-    stalled._resume = logged
+    entry = []
+    finish = stalled.continue_stalled
+
+    def entered(*args):
+        entry.append((int(args[11]), float(args[12])))  # momentum's units and residual at its stall
+        return finish(*args)
+
+    stalled._resume, stalled.continue_stalled = logged, entered
     try:
         t = time.process_time()
         units, residual = nlgs.solve(body, pack, count, model, v, r, status)
         cpu = time.process_time() - t
     finally:
-        stalled._resume = resume
+        stalled._resume, stalled.continue_stalled = resume, finish
     converged = residual <= model.tolerance
     by = (log[-1][0] if log else "momentum0") if converged else "-"
     return {
@@ -170,8 +182,9 @@ def replay_step(name: str) -> dict:
         "residual": float(residual),
         "converged": bool(converged),
         "by": by,
-        "methods": [m for m, _ in log],
+        "methods": [[m, d, f"{res:.2e}"] for m, d, res in log],
         "cpu_s": round(cpu, 4),
+        "stalled_at": entry[0] if entry else None,
     }
 
 

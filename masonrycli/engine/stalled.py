@@ -72,6 +72,10 @@ NEWTON_LAST_ROUND = 1
 two budgets (module doc)."""
 
 
+NEWTON_AHEAD = 1
+"""Further resumes "newton" makes right after its first, in round 0, before the other methods start."""
+
+
 class _State:
     """One method's iterate: velocities (None until first run), impulses, statuses, last residual and the
     lowest residual it ended a round with (m/s)."""
@@ -105,15 +109,22 @@ def continue_stalled(
     active = list(METHODS)
     budget = FIRST_BUDGET
     round_ = 0
+    newton_resumes = 0
     while iterations < cap and active:
-        for name in list(active):
-            if name == "newton" and round_ > NEWTON_LAST_ROUND:
-                active.remove(name)
+        # newton makes NEWTON_AHEAD more resumes right after its first, in round 0 (module doc)
+        for name in [m for m in active for _ in range(1 + NEWTON_AHEAD if m == "newton" and round_ == 0 else 1)]:
+            state = states[name]
+            if name == "newton" and newton_resumes > NEWTON_LAST_ROUND:
+                if name in active:
+                    active.remove(name)
                 continue
-            units = min(budget * (NEWTON_BUDGET if name == "newton" else 1), cap - iterations)
+            if name == "newton":  # its k-th resume gets the budget of round k, ahead or not
+                units = min(FIRST_BUDGET * 2**newton_resumes * NEWTON_BUDGET, cap - iterations)
+                newton_resumes += 1
+            else:
+                units = min(budget, cap - iterations)
             if units <= 0:
                 break
-            state = states[name]
             done = _resume(name, state, contact_body, pack, count, mu, tolerance, units, v_free, cap - iterations)
             iterations += done
             if state.residual <= tolerance:
