@@ -119,6 +119,7 @@ def test_newton_stopping_inside_its_budget_is_resumed_in_the_next_round(monkeypa
     monkeypatch.setattr(stalled, "METHODS", ("newton", "turning", "faces"))
     monkeypatch.setattr(stalled, "NEWTON_BUDGET", 2)
     monkeypatch.setattr(stalled, "NEWTON_LAST_ROUND", 1)
+    monkeypatch.setattr(stalled, "NEWTON_AHEAD", 0)
     monkeypatch.setattr(stalled, "FIRST_BUDGET", 10)
     count = 2
     v, r, status = np.zeros((2, 3)), np.zeros((count, 2)), np.zeros(count, dtype=np.int8)
@@ -126,3 +127,28 @@ def test_newton_stopping_inside_its_budget_is_resumed_in_the_next_round(monkeypa
     assert calls == [("newton", 20), ("turning", 10), ("faces", 10), ("newton", 40)]
     assert res == 1e-7 and its == 7 + 10 + 10 + 5 + 20
     assert (v == 4).all()
+
+
+def test_newton_ahead_makes_its_second_resume_before_the_others_start(monkeypatch):
+    # Scripted: with NEWTON_AHEAD = 1 newton's two resumes (budgets of rounds 0 and 1) come first; it then
+    # leaves (NEWTON_LAST_ROUND = 1: two resumes), and the others go round from their first budget.
+    script = {"newton": [1e-4, 1e-4], "turning": [1e-3, 1e-4, 1e-7], "faces": [1e-3]}
+    calls = []
+
+    def scripted(name, state, contact_body, pack, count, mu, tolerance, units, v_free, limit):
+        calls.append((name, units))
+        state.v, state.residual = v_free + len(calls), script[name].pop(0)
+        return units // 2 if name == "faces" else units
+
+    monkeypatch.setattr(stalled, "_resume", scripted)
+    monkeypatch.setattr(stalled, "METHODS", ("newton", "turning", "faces"))
+    monkeypatch.setattr(stalled, "NEWTON_BUDGET", 2)
+    monkeypatch.setattr(stalled, "NEWTON_LAST_ROUND", 1)
+    monkeypatch.setattr(stalled, "NEWTON_AHEAD", 1)
+    monkeypatch.setattr(stalled, "FIRST_BUDGET", 10)
+    count = 2
+    v, r, status = np.zeros((2, 3)), np.zeros((count, 2)), np.zeros(count, dtype=np.int8)
+    its, res = stalled.continue_stalled(None, None, count, 0.5, 1e-6, 10**6, v, r, status, np.zeros((2, 3)), r, 7, 1e-2)
+    assert calls == [("newton", 20), ("newton", 40), ("turning", 10), ("faces", 10), ("turning", 20), ("turning", 40)]
+    assert res == 1e-7 and its == 7 + 20 + 40 + 10 + 5 + 20 + 40
+    assert (v == 6).all()

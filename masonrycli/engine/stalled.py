@@ -49,6 +49,16 @@ none unconverged): first 0.2 s of the 32-course wall 1108 / 38 137 against 1353 
 64-course wall 1302 / 17 584 against 1780 / 51 926, the 248-block wall's 1 s 163 / 10 309 against
 151 / 3196 (another path from step 400 on). Ensembles of short runs: benchmarks/README.md, "Alart–Curnier
 in the engine".
+
+Newton's second resume comes right after its first (NEWTON_AHEAD), before the other methods' first
+round: of the steps that take 2500 units or more in ensemble runs of the 32- and 64-course walls, most
+that newton finishes it finishes in its second resume, and in the round-robin each of them first paid
+the four other methods' 8000 units of round 0 (the 32-course wall's replay: 45 of its 61 steps above
+10 000 units are newton's, at 12 500–19 000 units). Replayed (benchmarks/README.md, "Hard steps"; 342
+steps of ≥ 2500 units from 24 ensemble runs): 3 291 823 units → 2 769 636 (0.84×; the 32-course wall's
+1 501 801 → 1 171 832, the 64-course wall's 1 790 022 → 1 597 804), as many converged; the 886 steps of
+1000–2500 units 1 273 140 → 1 275 355 (steps newton's first resume finishes do not change). So "newton"
+leaves after its second resume, i.e. takes part in round 0 only (NEWTON_LAST_ROUND counts its resumes).
 """
 
 from __future__ import annotations
@@ -68,12 +78,12 @@ NEWTON_BUDGET = 2
 """newton's budget in a round, in units of the others' (module doc)."""
 
 NEWTON_LAST_ROUND = 1
-"""The last round (0-based) in which "newton" takes part: it finishes most steps it finishes in its first
-two budgets (module doc)."""
-
+"""The last resume (0-based) "newton" makes, its k-th with the budget of round k: it finishes most steps it
+finishes in its first two budgets (module doc)."""
 
 NEWTON_AHEAD = 1
-"""Further resumes "newton" makes right after its first, in round 0, before the other methods start."""
+"""Further resumes "newton" makes right after its first, in round 0, before the other methods start
+(module doc, last paragraph)."""
 
 
 class _State:
