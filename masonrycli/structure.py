@@ -134,7 +134,9 @@ def build_structure(builder: str, options: dict, density: float, thickness: floa
     try:
         assembly = spec_cls(**kwargs).build()
     except ValueError as exc:  # GeometryError, InputError, bad values; a TypeError is a bug: not hidden
-        raise InputError(f'builder "{builder}": {one_line(exc)}') from None
+        msg = one_line(exc)  # the builders' messages start with their name: not twice ('builder "wall": wall: …')
+        msg = msg[len(builder) + 2 :] if msg.startswith(f"{builder}: ") else msg
+        raise InputError(f'builder "{builder}": {msg}') from None
     if not isinstance(assembly, Assembly):
         raise InputError(f'builder "{builder}" returned {type(assembly).__name__}, not an Assembly')
     return assembly

@@ -89,6 +89,13 @@ def _row(amp, threshold):
     return row | {"slide_time": 0.01 if amp >= threshold else math.nan}
 
 
+def test_a_point_the_builder_refuses_names_the_point_and_the_builder_once(arch_base):
+    # said 'builder "arch": arch: ring_thickness ...' (the builder twice, the point not at all)
+    with pytest.raises(InputError) as info:
+        apply_point(arch_base, {"pier_width": 0.2, "amp": 0.5})
+    assert str(info.value).startswith('--param pier_width=0.2: builder "arch": ring_thickness 0.35 m is wider')
+
+
 def test_find_driver_bisects_to_rtol_and_reports_the_ends():
     axes = [Axis("amp", (0.1, 0.4, 0.7, 1.0)), Axis("freq", (1.0, 2.0, 3.0))]
     thresholds = {1.0: 0.55, 2.0: 0.05, 3.0: 5.0}

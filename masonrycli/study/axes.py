@@ -132,9 +132,13 @@ def apply_point(base, params: dict):
     if options:
         names = [s.name for s in scenario.assembly.supports]
         structure = {k: v for k, v in scenario.structure.items() if k != "builder"}
-        scenario = scenario_from_builder(
-            builder, structure | options, scenario.run, scenario.material, dict(zip(names, scenario.motions))
-        )
+        try:
+            scenario = scenario_from_builder(
+                builder, structure | options, scenario.run, scenario.material, dict(zip(names, scenario.motions))
+            )
+        except InputError as exc:  # say which point: "--param span=7: builder ...", not the builder alone
+            point = " ".join(f"{k}={v:g}" if isinstance(v, float) else f"{k}={v}" for k, v in options.items())
+            raise InputError(f"--param {point}: {exc}") from None
     run_changes = {k: v for k, v in params.items() if k in RUN_PARAMS}
     if run_changes:
         scenario = dataclasses.replace(scenario, run=_replace(scenario.run, run_changes))
