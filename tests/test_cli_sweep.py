@@ -103,8 +103,16 @@ def test_grid_sweep_state_map_and_histories(block, tmp_path):
 
     import rerun as rr
 
-    paths = {ch.entity_path for ch in rr.chunk.RrdReader(str(tmp_path / "grid.rrd")).stream()}
-    assert {"/study/state_map", "/study/plot", "/study/rows"} <= paths
+    chunks = list(rr.chunk.RrdReader(str(tmp_path / "grid.rrd")).stream())
+    assert {"/study/state_map", "/study/plot", "/study/rows"} <= {ch.entity_path for ch in chunks}
+    # Drawn y up as in the PNG (Rerun's 2-D views point y down: it showed the smaller friction on top),
+    # the labels on hover only (drawn, they overlapped into one unreadable line).
+    found = {}
+    for ch in chunks:
+        if ch.entity_path == "/study/state_map":
+            batch = ch.to_record_batch()
+            found |= {n: batch.column(n).to_pylist()[0] for n in batch.schema.names if ":" in n}
+    assert found["Transform3D:scale"] == [[1.0, -1.0, 1.0]] and found["Points2D:show_labels"] == [False]
 
 
 @pytest.mark.parametrize(

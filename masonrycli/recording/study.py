@@ -5,6 +5,12 @@ parameters (``study/state_map``), the fragility curve with its runs (``study/fra
 threshold curve (``study/thresholds``), the PNG the command also wrote (``study/plot``), and the rows
 as a markdown table (``study/rows``). Axes are in the parameters' own units, so a 2-D view shows them
 as they are; the PNG is the annotated picture.
+
+Rerun's 2-D views draw y downward: each picture entity gets a static y-flip transform and its view looks
+at it from ``study`` (an origin's own transform is not applied in its view), so larger values are up, as
+in the PNG — before, the state map showed freq = 1 Hz above 2 Hz and the fragility curve upside down.
+The state map's labels ("amp=0.25 freq=1: intact") are shown on hover only: drawn, a 6 × 2 grid's
+overlapped into an unreadable line.
 """
 
 from __future__ import annotations
@@ -40,13 +46,15 @@ def record_study(path: Path, name: str, rows: list[dict], request, fit, im: str,
     names = [a.name for a in request.axes if a.name != request.find and len(a.values) > 1]
     if request.find:
         _log_thresholds(rec, rows, request.find, names)
-        views.insert(0, rrb.Spatial2DView(origin="study/thresholds", name="thresholds"))
+        entity, title = "study/thresholds", "thresholds"
     elif fit is not None or "record" in [a.name for a in request.axes]:
         _log_fragility(rec, rows, fit, im)
-        views.insert(0, rrb.Spatial2DView(origin="study/fragility", name="fragility"))
+        entity, title = "study/fragility", "fragility"
     else:
         _log_state_map(rec, rows, names)
-        views.insert(0, rrb.Spatial2DView(origin="study/state_map", name="state map"))
+        entity, title = "study/state_map", "state map"
+    rec.log(entity, rr.Transform3D(scale=[1.0, -1.0, 1.0]), static=True)  # y up (module doc)
+    views.insert(0, rrb.Spatial2DView(origin="study", contents=[f"+ /{entity}/**"], name=title))
     rec.log("study/rows", rr.TextDocument(_markdown(name, rows), media_type=rr.MediaType.MARKDOWN), static=True)
     rec.save(path, default_blueprint=rrb.Blueprint(rrb.Grid(*views)))
     rec.disconnect()
@@ -73,7 +81,8 @@ def _log_state_map(rec, rows: list[dict], names: list[str]) -> None:
     ]
     span = np.ptp(pos, axis=0) if len(pos) else np.ones(2)
     radius = 0.02 * float(max(span.max(), 1e-9))
-    rec.log("study/state_map", rr.Points2D(pos, colors=colours, labels=labels, radii=radius), static=True)
+    points = rr.Points2D(pos, colors=colours, labels=labels, radii=radius, show_labels=False)
+    rec.log("study/state_map", points, static=True)
 
 
 def _log_fragility(rec, rows: list[dict], fit, im: str) -> None:
