@@ -299,3 +299,11 @@ def test_aqueduct_builds_when_an_extrados_vertex_falls_on_a_joint(span):
     half_width, top = r_i + 0.9, Y_S + 18 * H
     opening = 2 * r_i * Y_S + 0.5 * n * r_i**2 * math.sin(math.pi / n)
     assert sum(b.polygon.area for b in a.blocks) == pytest.approx(2 * half_width * top - opening, abs=1e-9)
+
+
+def test_aqueduct_too_few_wall_courses_names_the_option():
+    # The message is read by CLI users (--wall-courses) and scenario-file users (wall_courses) alike.
+    with pytest.raises(
+        GeometryError, match=r"below the crown .* \(--wall-courses, or wall_courses in a scenario file\)"
+    ):
+        build_aqueduct(wall_courses=2)

@@ -67,7 +67,7 @@ class AqueductSpec(ArchSpec):
         crown = geom.springing + geom.extrados_radius
         if top < crown:
             raise GeometryError(
-                f"aqueduct: the wall top ({top:g} m) is below the crown of the extrados ({crown:g} m); add wall_courses"
+                f"aqueduct: the wall top ({top:g} m) is below the crown of the extrados ({crown:g} m); raise the wall courses (--wall-courses, or wall_courses in a scenario file)"
             )
         # Bound the spandrel count before cutting it: every course spans the width between the piers'
         # outer faces, at most one block per block length plus the two ends.
