@@ -1,4 +1,4 @@
-"""Solver lab: ``python -m benchmarks.solver_lab capture|table|clusters|stalled|trajectory|ordinary|newton-ordinary|ordinary-runs|ensemble|hard``
+"""Solver lab: ``python -m benchmarks.solver_lab capture|table|clusters|stalled|trajectory|ordinary|newton-ordinary|ordinary-runs|ensemble|hard|hard-methods``
 (see benchmarks/README.md, "Solver lab")."""
 
 from __future__ import annotations
@@ -13,7 +13,7 @@ os.environ.setdefault("RERUN_ANALYTICS", "0")
 
 
 def main() -> None:
-    from benchmarks.solver_lab import ensemble, hard_steps
+    from benchmarks.solver_lab import ensemble, hard_methods, hard_steps
     from benchmarks.solver_lab.capture import CASES
     from masonrycli.scenario import SOLVERS
 
@@ -61,7 +61,11 @@ def main() -> None:
     orr.add_argument("--duration", type=float, default=1.0)
     ensemble.add_arguments(sub)
     hard_steps.add_arguments(sub)
+    hard_methods.add_arguments(sub)
     args = ap.parse_args()
+    if args.command == "hard-methods":
+        hard_methods.main(args)
+        return
     if args.command == "hard":
         hard_steps.main(args)
         return
