@@ -6,9 +6,17 @@ from __future__ import annotations
 from types import SimpleNamespace
 
 import numpy as np
+import pytest
 
-from masonrycli.engine import momentum, nlgs, stalled
+from masonrycli.engine import bodies, momentum, nlgs, stalled
 from tests.test_engine_nlgs import _stack_problem
+
+
+@pytest.fixture(autouse=True)
+def _round_robin_only(monkeypatch):
+    # Most tests here are of the round-robin: momentum in body order ahead of it is off (BODIES_UNITS = 0)
+    # unless a test turns it back on.
+    monkeypatch.setattr(stalled, "BODIES_UNITS", 0)
 
 
 def _solve(problem, solver, tolerance, cap=100000):
@@ -152,3 +160,39 @@ def test_newton_ahead_makes_its_second_resume_before_the_others_start(monkeypatc
     assert calls == [("newton", 20), ("newton", 40), ("turning", 10), ("faces", 10), ("turning", 20), ("turning", 40)]
     assert res == 1e-7 and its == 7 + 20 + 40 + 10 + 5 + 20 + 40
     assert (v == 6).all()
+
+
+def test_momentum_in_body_order_goes_first_and_finishes_the_step(monkeypatch):
+    problem = _stack_problem(6)
+    body, pack, h, m_inv, w_blocks, v0, r0, mu, bias = problem
+    v_gs, _, _, _ = _solve(problem, "nlgs", 1e-10)
+    monkeypatch.setattr(momentum, "STALL_SWEEPS", 1)
+    monkeypatch.setattr(stalled, "BODIES_UNITS", 16_000)
+
+    def never(*args):
+        raise AssertionError("the round-robin ran")
+
+    monkeypatch.setattr(stalled, "_resume", never)
+    v, r, its, res = _solve(problem, "nlgs-accel", 1e-10)
+    assert res <= 1e-10
+    np.testing.assert_allclose(v, v_gs, atol=1e-8)
+    np.testing.assert_allclose(v.ravel(), v0.ravel() + m_inv @ h @ r.ravel(), atol=1e-12)
+
+
+def test_a_body_order_solve_that_misses_hands_over_with_its_units_counted(monkeypatch):
+    calls = []
+
+    def scripted(name, state, contact_body, pack, count, mu, tolerance, units, v_free, limit):
+        calls.append((name, units))
+        state.v, state.residual = v_free + len(calls), 1e-7
+        return units
+
+    monkeypatch.setattr(stalled, "BODIES_UNITS", 50)
+    monkeypatch.setattr(bodies, "body_order_sweeps", lambda *args: (37, 1e-3))
+    monkeypatch.setattr(stalled, "_resume", scripted)
+    monkeypatch.setattr(stalled, "METHODS", ("turning",))
+    monkeypatch.setattr(stalled, "FIRST_BUDGET", 10)
+    count = 2
+    v, r, status = np.zeros((2, 3)), np.zeros((count, 2)), np.zeros(count, dtype=np.int8)
+    its, res = stalled.continue_stalled(None, None, count, 0.5, 1e-6, 10**6, v, r, status, np.zeros((2, 3)), r, 7, 1e-2)
+    assert calls == [("turning", 10)] and its == 7 + 37 + 10 and res == 1e-7

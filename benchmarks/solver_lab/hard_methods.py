@@ -25,7 +25,11 @@ the step counts as not converged):
     adapt-W / mom-adapt-W   ω per contact: halved (floor W) when the contact's status flips, else raised
     random / mom-random     a new pseudo-random contact order every sweep (seed 0)
     mom-random-faces        a new pseudo-random order of the faces every sweep
-    bodies / bodies-alt     body-wise block Gauss–Seidel (10 inner rounds, drop 1e-6)
+    bodies / bodies-alt     body-wise block Gauss–Seidel (10 inner rounds, drop 1e-6; -alt: bodies in
+                            reverse order every second sweep)
+    bodies-5                the same, at most 5 inner rounds, drop 1e-2
+    bodies-1 / bodies-1-alt one inner round: point sweeps in body order, each contact visited once from
+                            each of its bodies with mass (twice per sweep but at the supports)
 
 ``table`` prints per method: steps converged, units (a step not converged counted at CAP), geometric mean
 of the per-step ratio to the engine's units (not converged: CAP / engine), steps it beats every existing
@@ -42,6 +46,7 @@ import numpy as np
 
 from benchmarks.solver_lab.problems import DATA
 from benchmarks.solver_lab.stalled_steps import _method as existing_method
+from masonrycli.engine import stalled
 from masonrycli.engine import sweep_variants as sv
 
 HARD = DATA / "hard"
@@ -57,10 +62,12 @@ def _variant(**kw):
     return run
 
 
-def _bodies(alternate):
+def _bodies(alternate, rounds=10, drop=1e-6, accelerate=False):
     def run(z, v, r, status, cap):
         body, pack, count, mu = z["body"], z["pack"], z["body"].shape[0], float(z["mu"])
-        return sv.body_sweeps(body, pack, count, mu, TOLERANCE, cap, v, r, status, alternate=alternate, stall=STALL)
+        return sv.body_sweeps(
+            body, pack, count, mu, TOLERANCE, cap, v, r, status, rounds, drop, alternate, STALL, accelerate
+        )
 
     return run
 
@@ -82,6 +89,10 @@ NEW = {
     "mom-relax-0.7-random": _variant(omega=0.7, order=sv.ORDER_RANDOM, accelerate=True),
     "bodies": _bodies(False),
     "bodies-alt": _bodies(True),
+    "bodies-1": _bodies(False, rounds=1),
+    "bodies-1-alt": _bodies(True, rounds=1),
+    "bodies-5": _bodies(False, rounds=5, drop=1e-2),
+    "bodies-1-mom": _bodies(False, rounds=1, accelerate=True),
 }
 
 
@@ -181,10 +192,185 @@ def add_arguments(sub) -> None:
     r.add_argument("--steps-every", type=int, nargs=2, default=(3, 10), metavar=("BIG", "MID"))
     t = act.add_parser("table")
     t.add_argument("files", nargs="+", type=Path)
+    p = act.add_parser("replay")
+    p.add_argument("--variants", nargs="+", required=True, help=", ".join(REPLAYS))
+    p.add_argument("--out", type=Path, required=True)
+    p.add_argument("--min-units", type=int, default=None, help="every kept step with this many engine units or more")
+    p.add_argument("--steps-every", type=int, nargs=2, default=(3, 10), metavar=("BIG", "MID"))
 
 
 def main(args) -> None:
     if args.action == "run":
         run(args.methods, args.out, *args.steps_every)
+    elif args.action == "replay":
+        index = _index()
+        if args.min_units is None:
+            names = sample(*args.steps_every)
+        else:
+            names = sorted(n for n, e in index.items() if e["units"] >= args.min_units)
+        replay(args.variants, names, args.out)
     else:
         table(args.files)
+
+
+# Replay: the round-robin of stalled.py with body-wise sweeps as one more method, through nlgs.solve.
+
+
+def _round_robin(
+    methods,
+    rounds,
+    factor,
+    last,
+    accelerate,
+    ahead,
+    contact_body,
+    pack,
+    count,
+    mu,
+    tolerance,
+    cap,
+    v,
+    r,
+    status,
+    v_free,
+    r_warm,
+    its,
+    res,
+):
+    # stalled.continue_stalled with ``methods`` in its order, where "bodies" is body_sweeps with ``rounds``
+    # inner rounds from the warm start (v rebuilt from v_free at each resume, its budget as stall window),
+    # ``factor`` × the others' budget, in rounds 0 … ``last`` only; the others stalled.py's own resumes;
+    # the same budgets and drop rules. ``ahead`` > 0: before the round-robin, bodies alone from the warm
+    # start for at most ``ahead`` units, stall window ``ahead[1]`` sweeps; its r then goes on in the round-robin.
+    if ahead:
+        vb, rb, sb = v_free.copy(), r_warm[:count].copy(), status[:count].copy()
+        done, got = sv.body_sweeps(
+            contact_body, pack, count, mu, tolerance, ahead[0], vb, rb, sb, rounds, 1e-2, False, ahead[1], accelerate
+        )
+        its += done
+        if got <= tolerance:
+            v[:] = vb
+            r[:count] = rb
+            status[:count] = sb
+            return its, got
+        r_warm = r_warm.copy()  # the others start from the warm start as before
+    states = {
+        "newton": stalled._State(None, r_warm[:count].copy(), status[:count].copy(), np.inf),
+        "turning": stalled._State(None, r_warm[:count].copy(), status[:count].copy(), np.inf),
+        "alternating": stalled._State(None, r_warm[:count].copy(), status[:count].copy(), np.inf),
+        "bodies": stalled._State(None, r_warm[:count].copy(), status[:count].copy(), np.inf),
+        "momentum": stalled._State(v.copy(), r[:count].copy(), status[:count].copy(), res),
+        "faces": stalled._State(v.copy(), r[:count].copy(), status[:count].copy(), res),
+    }
+    active = list(methods)
+    budget, round_ = stalled.FIRST_BUDGET, 0
+    while its < cap and active:
+        for name in list(active):
+            if (name == "newton" and round_ > stalled.NEWTON_LAST_ROUND) or (name == "bodies" and round_ > last):
+                active.remove(name)
+                continue
+            share = stalled.NEWTON_BUDGET if name == "newton" else factor if name == "bodies" else 1
+            units = min(budget * share, cap - its)
+            if units <= 0:
+                break
+            state = states[name]
+            if name == "bodies":
+                state.v = v_free.copy()
+                done, state.residual = sv.body_sweeps(
+                    contact_body,
+                    pack,
+                    count,
+                    mu,
+                    tolerance,
+                    units,
+                    state.v,
+                    state.r,
+                    state.status,
+                    rounds,
+                    1e-2,
+                    False,
+                    units,
+                    accelerate,
+                )
+            else:
+                done = stalled._resume(name, state, contact_body, pack, count, mu, tolerance, units, v_free, cap - its)
+            its += done
+            if state.residual <= tolerance:
+                stalled._adopt(state, v, r, status, count)
+                return its, state.residual
+            if name != "newton" and (done < units or state.residual >= state.low):
+                active.remove(name)
+            state.low = min(state.low, state.residual)
+        budget *= 2
+        round_ += 1
+    best = min((s for s in states.values() if s.v is not None), key=lambda s: s.residual)
+    stalled._adopt(best, v, r, status, count)
+    return its, best.residual
+
+
+_FIRST = ("bodies",) + stalled.METHODS
+_SECOND = stalled.METHODS[:1] + ("bodies",) + stalled.METHODS[1:]
+REPLAYS = {
+    "main": None,
+    "bodies-first": (_FIRST, 1, 1, 99, False, None),
+    "bodies-second": (_SECOND, 1, 1, 99, False, None),
+    "mom-bodies-first": (_FIRST, 1, 1, 99, True, None),
+    "mom-bodies-first-x2": (_FIRST, 1, 2, 99, True, None),
+    "mom-bodies-first-x4": (_FIRST, 1, 4, 99, True, None),
+    "mom-bodies-second": (_SECOND, 1, 1, 99, True, None),
+    "mom-bodies-ahead-16k-s2000": (stalled.METHODS, 1, 1, 99, True, (16000, 2000)),
+    "mom-bodies-ahead-30k-s2000": (stalled.METHODS, 1, 1, 99, True, (30000, 2000)),
+    "mom-bodies-ahead-16k-s1000": (stalled.METHODS, 1, 1, 99, True, (16000, 1000)),
+    "mom-bodies-ahead-16k-s8000": (stalled.METHODS, 1, 1, 99, True, (16000, 8000)),
+    "mom-bodies-ahead-25k-s10000": (stalled.METHODS, 1, 1, 99, True, (25000, 10000)),
+}
+"""Replay variants: None is stalled.py as it is; else (the round-robin's methods in order, bodies' inner rounds,
+bodies' budget in units of the others', the last round (0-based) bodies takes part in, bodies with momentum,
+(units, stall sweeps) of bodies alone ahead of the round-robin or None)."""
+
+
+def replay(variants: list[str], names: list[str], out: Path) -> None:
+    """Each step of ``names`` through nlgs.solve from its warm start, stalled.continue_stalled replaced by
+    the variant's round-robin; units, residual per step to ``out``."""
+    from types import SimpleNamespace
+
+    from masonrycli.engine import nlgs
+
+    index = _index()
+    doc = json.loads(out.read_text()) if out.exists() else {"replays": {}}
+    doc["engine"] = {n: index[n]["units"] for n in names}
+    finish = stalled.continue_stalled
+    for variant in variants:
+        spec = REPLAYS[variant]
+        if spec is not None:
+            stalled.continue_stalled = lambda *a, spec=spec: _round_robin(*spec, *a)
+        try:
+            t = time.process_time()
+            res = {}
+            for name in names:
+                z = np.load(HARD / f"{name}.npz")
+                body, pack, count = z["body"].astype(np.int32), z["pack"], z["body"].shape[0]
+                v, r, status = z["v_free"].copy(), z["r_warm"].copy(), z["status"].copy()
+                model = SimpleNamespace(
+                    friction=float(z["mu"]),
+                    tolerance=float(z["tolerance"]),
+                    max_iterations=int(z["cap"]),
+                    solver="nlgs-accel",
+                )
+                units, residual = nlgs.solve(body, pack, count, model, v, r, status)
+                res[name] = {
+                    "units": int(units),
+                    "residual": float(residual),
+                    "converged": bool(residual <= model.tolerance),
+                }
+        finally:
+            stalled.continue_stalled = finish
+        doc["replays"][variant] = res
+        out.write_text(json.dumps(doc, indent=1))
+        u = np.array([s["units"] for s in res.values()])
+        e = np.array([doc["engine"][n] for n in res])
+        print(
+            f"| {variant} | {u.sum()} | {u.sum() / e.sum():.3f} | {sum(not s['converged'] for s in res.values())} |"
+            f" {int((u > BIG).sum())} | {int(u.max())} | ({time.process_time() - t:.0f} CPU s)",
+            flush=True,
+        )

@@ -251,7 +251,9 @@ def _moves(pack, c, side):
 
 
 @njit
-def _body_sweeps(contact_body, pack, count, mu, tolerance, max_units, v, r, status, rounds, drop, alternate, stall):
+def _body_sweeps(
+    contact_body, pack, count, mu, tolerance, max_units, v, r, status, rounds, drop, alternate, stall, accelerate=False
+):
     # v enters as v_free, r as the start; both leave consistent.
     #   groups: for each body with mass (a support's inverse mass is 0 in its rows), its contacts
     #   repeat (one sweep; alternate: bodies in reverse order every second sweep):
@@ -259,6 +261,8 @@ def _body_sweeps(contact_body, pack, count, mu, tolerance, max_units, v, r, stat
     #                      Σ|W Δr|² > drop × the first round's, at most ``rounds``
     #                      (a contact's e_α counts in the residual at its first visit in the sweep)
     #   until residual ≤ tolerance, max_units sweep units, or stall sweeps without a new low.
+    #   accelerate: each sweep starts from r ← r + β (r − r_prev), v ← v + β (v − v_prev) (all contacts and
+    #   bodies at once, so v stays v_free + M⁻¹ H r), β and its restart as in momentum.py.
     for c in range(count):
         _push(v, contact_body[c, 0], contact_body[c, 1], pack, c, r[c, 0], r[c, 1])
     if count == 0:
@@ -280,12 +284,29 @@ def _body_sweeps(contact_body, pack, count, mu, tolerance, max_units, v, r, stat
                 members[fill[body]] = c
                 fill[body] += 1
     seen = np.full(count, -1, dtype=np.int64)
+    r_prev = r[:count].copy()
+    v_prev = v.copy()
+    v_flat = v.reshape(v.size)
+    v_prev_flat = v_prev.reshape(v.size)
+    beta = 0.0
+    j = 1
+    last = np.inf
     visits = 0
     residual = 0.0
     best = np.inf
     best_at = 0
     sweep = 0
     while visits < max_units * count:
+        if accelerate:
+            for i in range(v_flat.shape[0]):
+                x = v_flat[i]
+                v_flat[i] = x + beta * (x - v_prev_flat[i])
+                v_prev_flat[i] = x
+            for c in range(count):
+                for k in range(2):
+                    x = r[c, k]
+                    r[c, k] = x + beta * (x - r_prev[c, k])
+                    r_prev[c, k] = x
         sum_e2 = 0.0
         for i in range(bodies):
             body = bodies - 1 - i if alternate and sweep % 2 == 1 else i
@@ -340,6 +361,12 @@ def _body_sweeps(contact_body, pack, count, mu, tolerance, max_units, v, r, stat
             best_at = sweep
         elif sweep - best_at >= stall:
             break
+        if accelerate:
+            if residual > RESTART_GROWTH * last:
+                j = 1
+            last = residual
+            beta = (j - 1.0) / (j + 2.0)
+            j += 1
     return (visits + count - 1) // count, residual
 
 
@@ -357,9 +384,10 @@ def body_sweeps(
     drop=1e-6,
     alternate=False,
     stall=10_000,
+    accelerate=False,
 ) -> tuple[int, float]:
     """Body-wise block Gauss–Seidel (module doc) from impulses ``r`` (C, 2), in place; ``v`` (B, 3) enters as
     the free velocities and leaves as v_free + M⁻¹ H r; ``status`` (C,) out. Returns (sweep units, residual)."""
     return _body_sweeps(
-        contact_body, pack, count, mu, tolerance, max_units, v, r, status, rounds, drop, alternate, stall
+        contact_body, pack, count, mu, tolerance, max_units, v, r, status, rounds, drop, alternate, stall, accelerate
     )

@@ -1,0 +1,165 @@
+"""Gauss–Seidel in body order with momentum: the first method of a stalled solve.
+
+The engine's sweeps visit the contacts in detection order (interleaved, nlgs._nlgs_interleaved). Here a
+sweep goes through the bodies in turn and visits, for each body with mass, every contact of that body:
+a contact between two blocks is visited twice in a sweep (once from each block), a contact with a
+support once. So each block's corners are solved one after the other with the block's velocity fresh,
+and the load a block takes from below is passed on to the blocks it carries before the sweep leaves the
+block. Each sweep starts from a Nesterov extrapolation of the last two sweeps' impulses and velocities,
+restarted when the residual grows by more than momentum.RESTART_GROWTH, as in
+:mod:`masonrycli.engine.momentum` (the extrapolation is applied to every contact and body at the sweep's
+start, so v stays v_free + M⁻¹ H r).
+
+Why: on the hard steps of the 32- and 64-course walls (tall walls sliding on their base, where momentum in
+detection order cycles between stick and slip and stalled.py's other methods take thousands of sweep
+units), measured alone from the step's warm start on 64 steps captured from 24 ensemble runs
+(benchmarks/README.md, "New methods on hard steps"; tolerance 1e-5 m/s, cap 50 000): this converges all
+64 in 150 139 sweep units, where the engine took 956 975 (geometric mean of the per-step ratio 0.14;
+on the 41 steps of ≥ 10 000 engine units 0.11), and the best of stalled.py's methods alone converge 54
+(faces, 977 723 units, not converged counted at the cap; Alart–Curnier Newton 54, 923 744). The same
+sweeps without momentum converge 62 in 625 858; in detection order, momentum alone converges 18.
+
+The residual is the engine's (nlgs module doc): RMS over the contacts of |W_αα Δr_α| at the contact's
+first visit in the sweep. Work is counted in sweep units, contact visits / C (a sweep is ~1.9 units on a
+wall: every block–block contact twice).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from masonrycli.engine import momentum  # its RESTART_GROWTH; a module import, as momentum imports nlgs
+from masonrycli.engine._jit import njit
+from masonrycli.engine.nlgs import (
+    P_IIA,
+    P_IIB,
+    P_IMA,
+    P_IMB,
+    P_WNN,
+    P_WTN,
+    P_WTT,
+    _local_solve,
+    _push,
+    _relative_velocity,
+)
+
+
+@njit
+def _body_lists(contact_body, pack, count, bodies):
+    # CSR lists of each body's contacts, for the bodies with mass (a support's inverse mass and inertia are
+    # 0 in its rows: it has no list), contacts in their order. Returns (start (B + 1,), members).
+    start = np.zeros(bodies + 1, dtype=np.int64)
+    for c in range(count):
+        if pack[c, P_IMA] > 0.0 or pack[c, P_IIA] > 0.0:
+            start[contact_body[c, 0] + 1] += 1
+        if pack[c, P_IMB] > 0.0 or pack[c, P_IIB] > 0.0:
+            start[contact_body[c, 1] + 1] += 1
+    for i in range(bodies):
+        start[i + 1] += start[i]
+    members = np.empty(start[bodies], dtype=np.int64)
+    fill = start[:bodies].copy()
+    for c in range(count):
+        if pack[c, P_IMA] > 0.0 or pack[c, P_IIA] > 0.0:
+            members[fill[contact_body[c, 0]]] = c
+            fill[contact_body[c, 0]] += 1
+        if pack[c, P_IMB] > 0.0 or pack[c, P_IIB] > 0.0:
+            members[fill[contact_body[c, 1]]] = c
+            fill[contact_body[c, 1]] += 1
+    return start, members
+
+
+@njit
+def _body_order_sweeps(contact_body, pack, count, mu, tolerance, max_units, v, r, status, stall):
+    # v enters as v_free, r as the start; both leave consistent (v = v_free + M⁻¹ H r).
+    #   v ← v_free + M⁻¹ H r ; order = for each body with mass, its contacts (CSR lists) ; β = 0
+    #   repeat (one sweep):
+    #       r ← r + β (r − r_prev), v ← v + β (v − v_prev)                    (every contact and body)
+    #       for α in order: r_α' = local_solve(H_αᵀ v − W r_α) ; v += M⁻¹ H_α (r_α' − r_α) ; r_α = r_α'
+    #                       e_α = W (r_α' − r_α) counts in the residual at α's first visit in the sweep
+    #       residual = sqrt(Σ e_α² / C)
+    #       until residual ≤ tolerance, max_units sweep units (visits / C), or stall sweeps without a
+    #       new lowest residual; restart (β = 0) when the residual grows by > RESTART_GROWTH
+    # Every contact is visited in a sweep (one of its bodies has mass), so the extrapolated impulses,
+    # which may leave the friction cone, are all replaced by local solutions before the sweep ends.
+    # Returns (sweep units, rounded up; residual).
+    for c in range(count):
+        _push(v, contact_body[c, 0], contact_body[c, 1], pack, c, r[c, 0], r[c, 1])
+    if count == 0:
+        return 0, 0.0
+    start, members = _body_lists(contact_body, pack, count, v.shape[0])
+    visits_per_sweep = members.shape[0]
+    seen = np.full(count, -1, dtype=np.int64)
+    r_prev = r[:count].copy()
+    v_prev = v.copy()
+    v_flat = v.reshape(v.size)
+    v_prev_flat = v_prev.reshape(v.size)
+    beta = 0.0
+    j = 1
+    last = np.inf
+    best = np.inf
+    best_at = 0
+    residual = np.inf  # no sweep done (max_units ≤ 0): nothing is known
+    visits = 0
+    sweep = 0
+    while visits < max_units * count:
+        for i in range(v_flat.shape[0]):
+            x = v_flat[i]
+            v_flat[i] = x + beta * (x - v_prev_flat[i])
+            v_prev_flat[i] = x
+        for c in range(count):
+            for k in range(2):
+                x = r[c, k]
+                r[c, k] = x + beta * (x - r_prev[c, k])
+                r_prev[c, k] = x
+        sum_e2 = 0.0
+        for m in range(visits_per_sweep):
+            c = members[m]
+            a = contact_body[c, 0]
+            b = contact_body[c, 1]
+            ut, un = _relative_velocity(v, a, b, pack, c)
+            rt0 = r[c, 0]
+            rn0 = r[c, 1]
+            wtt = pack[c, P_WTT]
+            wtn = pack[c, P_WTN]
+            wnn = pack[c, P_WNN]
+            ut -= wtt * rt0 + wtn * rn0
+            un -= wtn * rt0 + wnn * rn0
+            rt, rn, st = _local_solve(ut, un, pack, c, mu)
+            status[c] = st
+            drt = rt - rt0
+            drn = rn - rn0
+            e2 = 0.0
+            if drt != 0.0 or drn != 0.0:
+                _push(v, a, b, pack, c, drt, drn)
+                r[c, 0] = rt
+                r[c, 1] = rn
+                et = wtt * drt + wtn * drn
+                en = wtn * drt + wnn * drn
+                e2 = et * et + en * en
+            if seen[c] != sweep:
+                seen[c] = sweep
+                sum_e2 += e2
+        visits += visits_per_sweep
+        sweep += 1
+        residual = np.sqrt(sum_e2 / count)
+        if residual <= tolerance:
+            break
+        if residual < best:
+            best = residual
+            best_at = sweep
+        elif sweep - best_at >= stall:
+            break
+        if residual > momentum.RESTART_GROWTH * last:
+            j = 1
+        last = residual
+        beta = (j - 1.0) / (j + 2.0)
+        j += 1
+    return (visits + count - 1) // count, residual
+
+
+def body_order_sweeps(contact_body, pack, count, mu, tolerance, max_units, v, r, status, stall) -> tuple[int, float]:
+    """Momentum sweeps in body order (module doc) from impulses ``r`` (C, 2), in place; ``v`` (B, 3) enters
+    as the free velocities and leaves as v_free + M⁻¹ H r; ``status`` (C,) out. Stops at ``tolerance``
+    (m/s), after ``max_units`` sweep units (the sweep that crosses it ends), or after ``stall`` sweeps
+    without a new lowest residual. Returns (sweep units done, residual m/s)."""
+    return _body_order_sweeps(contact_body, pack, count, mu, tolerance, max_units, v, r, status, stall)
