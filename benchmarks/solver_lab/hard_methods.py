@@ -21,6 +21,7 @@ the step counts as not converged):
 
     relax-W          plain sweeps under-relaxed by ω = W (forward order)
     relax-W-alt      the same, alternating direction
+    mom              momentum in detection order (the engine's "momentum" without its interleaving)
     mom-relax-W      momentum's extrapolation, then the relaxed visit, projected into the cone
     adapt-W / mom-adapt-W   ω per contact: halved (floor W) when the contact's status flips, else raised
     random / mom-random     a new pseudo-random contact order every sweep (seed 0)
@@ -77,6 +78,7 @@ NEW = {
     "relax-0.7": _variant(omega=0.7),
     "relax-0.9": _variant(omega=0.9),
     "relax-0.7-alt": _variant(omega=0.7, order=sv.ORDER_ALTERNATE),
+    "mom": _variant(accelerate=True),
     "mom-relax-0.7": _variant(omega=0.7, accelerate=True),
     "mom-relax-0.9": _variant(omega=0.9, accelerate=True),
     "mom-relax-0.7-turn": _variant(omega=0.7, accelerate=True, order=sv.ORDER_TURN),

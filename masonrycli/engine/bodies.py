@@ -17,7 +17,12 @@ units), measured alone from the step's warm start on 64 steps captured from 24 e
 64 in 150 139 sweep units, where the engine took 956 975 (geometric mean of the per-step ratio 0.14;
 on the 41 steps of ≥ 10 000 engine units 0.11), and the best of stalled.py's methods alone converge 54
 (faces, 977 723 units, not converged counted at the cap; Alart–Curnier Newton 54, 923 744). The same
-sweeps without momentum converge 62 in 625 858; in detection order, momentum alone converges 18.
+sweeps without momentum converge 62 in 625 858. What matters is the second visit: detection order is
+already sorted by each contact's lower body, so momentum in detection order is this body order with each
+contact visited once, from its lower body, and it converges 19 (the engine's interleaved order 18).
+On ordinary steps (those momentum converges without stalling; 30 of the 32-course wall, 26 of the
+64-course wall) it takes 1.42× / 1.36× momentum's units, at 1.3–1.4× the CPU per unit (the indirect
+visit order): it is for stalled steps only.
 
 The residual is the engine's (nlgs module doc): RMS over the contacts of |W_αα Δr_α| at the contact's
 first visit in the sweep. Work is counted in sweep units, contact visits / C (a sweep is ~1.9 units on a
