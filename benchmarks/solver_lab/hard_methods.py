@@ -16,7 +16,7 @@ Existing methods (those of stalled.py, as benchmarks/solver_lab/stalled_steps.py
     turning, momentum, alternating, newton   stalled.py's own resume with the whole cap
     faces                                    faces from momentum's iterate at its 500-sweep stall
 
-New ones (masonrycli/engine/sweep_variants.py; a stall window of STALL sweeps without a new low, then
+New ones (benchmarks/solver_lab/sweep_variants.py; a stall window of STALL sweeps without a new low, then
 the step counts as not converged):
 
     relax-W          plain sweeps under-relaxed by ω = W (forward order)
@@ -45,10 +45,10 @@ from pathlib import Path
 
 import numpy as np
 
+from benchmarks.solver_lab import sweep_variants as sv
 from benchmarks.solver_lab.problems import DATA
 from benchmarks.solver_lab.stalled_steps import _method as existing_method
 from masonrycli.engine import stalled
-from masonrycli.engine import sweep_variants as sv
 
 HARD = DATA / "hard"
 TOLERANCE, CAP, STALL, BIG = 1e-5, 50_000, 10_000, 10_000

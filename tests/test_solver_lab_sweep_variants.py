@@ -1,12 +1,12 @@
-"""Sweep variants for stalled steps (masonrycli.engine.sweep_variants), against dense numpy references."""
+"""Sweep variants for stalled steps (benchmarks.solver_lab.sweep_variants: lab kernels), against dense numpy references."""
 
 import numpy as np
 import pytest
 from test_engine_faces import _faces_problem
 from test_engine_nlgs import _dense_h, _packed_row, _random_contacts, _slow_sweeps
 
+from benchmarks.solver_lab import sweep_variants as sv
 from masonrycli.engine import nlgs
-from masonrycli.engine import sweep_variants as sv
 from masonrycli.engine.momentum import RESTART_GROWTH
 
 
