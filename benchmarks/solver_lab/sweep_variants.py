@@ -31,12 +31,9 @@ from __future__ import annotations
 import numpy as np
 
 from masonrycli.engine._jit import njit
+from masonrycli.engine.bodies import _body_lists
 from masonrycli.engine.momentum import RESTART_GROWTH
 from masonrycli.engine.nlgs import (
-    P_IIA,
-    P_IIB,
-    P_IMA,
-    P_IMB,
     P_WNN,
     P_WTN,
     P_WTT,
@@ -242,14 +239,6 @@ def variant_sweeps(
     )
 
 
-@njit(inline="always")
-def _moves(pack, c, side):
-    # Whether contact c's body on ``side`` (0: a, 1: b) has mass: a support's inverse mass and inertia are 0.
-    if side == 0:
-        return pack[c, P_IMA] > 0.0 or pack[c, P_IIA] > 0.0
-    return pack[c, P_IMB] > 0.0 or pack[c, P_IIB] > 0.0
-
-
 @njit
 def _body_sweeps(
     contact_body, pack, count, mu, tolerance, max_units, v, r, status, rounds, drop, alternate, stall, accelerate=False
@@ -268,21 +257,7 @@ def _body_sweeps(
     if count == 0:
         return 0, 0.0
     bodies = v.shape[0]
-    degree = np.zeros(bodies + 1, dtype=np.int64)
-    for c in range(count):
-        for side in range(2):
-            if _moves(pack, c, side):
-                degree[contact_body[c, side] + 1] += 1
-    for i in range(bodies):
-        degree[i + 1] += degree[i]
-    members = np.empty(degree[bodies], dtype=np.int64)
-    fill = degree[:bodies].copy()
-    for c in range(count):
-        for side in range(2):
-            if _moves(pack, c, side):
-                body = contact_body[c, side]
-                members[fill[body]] = c
-                fill[body] += 1
+    degree, members = _body_lists(contact_body, pack, count, bodies)  # the engine's CSR lists (bodies.py)
     seen = np.full(count, -1, dtype=np.int64)
     r_prev = r[:count].copy()
     v_prev = v.copy()
