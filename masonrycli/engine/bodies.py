@@ -87,6 +87,8 @@ def _body_order_sweeps(contact_body, pack, count, mu, tolerance, max_units, v, r
     # Every contact is visited in a sweep (one of its bodies has mass), so the extrapolated impulses,
     # which may leave the friction cone, are all replaced by local solutions before the sweep ends.
     # Returns (sweep units, rounded up; residual).
+    # The visit is nlgs's written out again, as in momentum.py and faces.py: a shared visit function cost
+    # 47–57 ns per visit against 8.7 inline (faces.py's measurement).
     for c in range(count):
         _push(v, contact_body[c, 0], contact_body[c, 1], pack, c, r[c, 0], r[c, 1])
     if count == 0:
