@@ -74,7 +74,8 @@ def test_records_sweep_fits_a_fragility_curve_and_records_the_study(block, tmp_p
     import rerun as rr
 
     paths = {ch.entity_path for ch in rr.chunk.RrdReader(str(rrd)).stream()}
-    assert {"/study/fragility/runs", "/study/plot", "/study/rows"} <= paths
+    assert {"/study/fragility/fit", "/study/fragility/runs/collapsed", "/study/plot", "/study/rows"} <= paths
+    check_fragility_reads_as_a_plot(rrd, rows)
     shown = invoke("inspect", rrd)  # a study has no time line: a dash, not Python's "None"
     assert shown.exit_code == 0 and "None" not in shown.output and "time_span      │ —" in shown.output
     # the plot and the recording exist now: --force replaces them and still reuses every finished row
@@ -86,6 +87,40 @@ def test_records_sweep_fits_a_fragility_curve_and_records_the_study(block, tmp_p
     assert again.exit_code == 0 and "(0 runs now, 12 rows already there" in " ".join(again.output.split())
     twice = invoke("sweep", block, "--records", folder, "--records", folder / "syn0.AT2", "--out", out)
     assert twice.exit_code == 2 and "two records named syn0.AT2" in twice.output
+
+
+def check_fragility_reads_as_a_plot(rrd: Path, rows: list[dict]) -> None:
+    """The fragility curve opens as a plot with its own axes: P(collapse) 0-1 against the IM from 0 to
+    past the largest run (in a 2-D view with one scale for both it read as a flat line 60 m/s² long and
+    1 high), each run at 0 or 1 at its own PGA, the fitted curve rising from 0 to 1."""
+    import rerun as rr
+
+    from masonrycli.recording.readback import blueprint_views
+
+    assert blueprint_views(rrd)["fragility"]["kind"] == "TimeSeries"
+    reader = rr.chunk.RrdReader(str(rrd))
+    layout = {}
+    for chunk in reader.stream(store=reader.blueprints()[0]):
+        batch = chunk.to_record_batch()
+        layout |= {n: batch.column(n).to_pylist()[-1][0] for n in batch.schema.names if ":" in n}
+    timeline = "pga (mm/s²)"  # thousandths of the IM's unit: a sequence time line is an integer
+    assert layout["TimePanelBlueprint:timeline"] == timeline  # the time line the plot is drawn against
+    assert layout["ScalarAxis:range"] == [-0.05, 1.05]
+    top = max(r["pga"] for r in rows)
+    assert layout["TimeAxis:view_range"]["start"] == 0 and layout["TimeAxis:view_range"]["end"] >= 1000 * top
+    series: dict[str, tuple[list, list]] = {}
+    for chunk in reader.stream():
+        if not chunk.is_static and chunk.entity_path.startswith("/study/fragility/"):
+            batch = chunk.to_record_batch()
+            ticks, values = series.setdefault(chunk.entity_path.rsplit("/", 1)[1], ([], []))
+            ticks += batch.column(timeline).to_pylist()
+            values += [v[0] for v in batch.column("Scalars:scalars").to_pylist()]
+    for state in ("intact", "damaged", "collapsed"):
+        expected = sorted(round(1000 * r["pga"]) for r in rows if r["state"] == state)
+        ticks, values = series.get(state, ([], []))
+        assert sorted(ticks) == expected and set(values) <= {1.0 if state == "collapsed" else 0.0}
+    ticks, p = series["fit"]
+    assert ticks[0] == 0 and p[0] == 0.0 and p[-1] > 0.99 and np.all(np.diff(p) >= 0)
 
 
 def test_grid_sweep_state_map_and_histories(block, tmp_path):
