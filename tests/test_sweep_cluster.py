@@ -25,7 +25,10 @@ from masonrycli.study.task import RESULT_COLUMNS
 
 pytestmark = pytest.mark.slow
 BIN = Path(sys.executable).parent
-ENV = os.environ | {"RERUN_ANALYTICS": "0", "PYTHONUNBUFFERED": "1"}
+ROOT = Path(__file__).resolve().parent.parent  # the checkout under test
+# Commands and workers import the checkout under test (a worker imported the venv's editable install
+# while `python -m masonrycli` took the working directory's: other code, which the command now refuses)
+ENV = os.environ | {"RERUN_ANALYTICS": "0", "PYTHONUNBUFFERED": "1", "PYTHONPATH": str(ROOT)}
 
 
 def test_local_cluster_rows_equal_the_runs_made_one_by_one(tmp_path):
@@ -128,6 +131,83 @@ def test_scheduler_and_worker_processes_kill_the_worker_and_resume(tmp_path):
     finally:
         for proc in sweeps + workers + [scheduler]:
             _kill(proc)
+
+
+def _worker_without_masonry(tmp_path: Path) -> list:
+    """A Python environment with Dask but no masonry: a venv of the same interpreter that sees this
+    venv's site-packages through a path file, which does not process their .pth files (so not the
+    editable install's finder either)."""
+    import sysconfig
+
+    venv = tmp_path / "no-masonry"
+    subprocess.run([sys.executable, "-m", "venv", "--without-pip", venv], check=True)
+    python = venv / "bin" / "python"
+    site = subprocess.run(
+        [python, "-c", "import sysconfig; print(sysconfig.get_paths()['purelib'])"], capture_output=True, text=True
+    ).stdout.strip()
+    Path(site, "project.pth").write_text(sysconfig.get_paths()["purelib"] + "\n")
+    return [python, "-m", "distributed.cli.dask_worker"]
+
+
+def test_workers_with_another_masonry_or_none_are_refused_before_any_file(tmp_path):
+    # A worker with another masonry ran the study's tasks without a word (rows of other code in the
+    # table); one without masonry failed every run, an error row each. The command now asks every
+    # worker (the probe runs there) and refuses with one line, exit 2, before writing anything.
+    sched_file = tmp_path / "scheduler.json"
+    scheduler = _spawn(
+        [BIN / "dask", "scheduler", "--port", "0", "--no-dashboard", "--scheduler-file", sched_file], tmp_path / "s.log"
+    )
+    logs = {scheduler: tmp_path / "s.log"}
+    other = tmp_path / "other"  # a masonry of another release, first on the worker's path
+    for package, text in (("masonrycli", '__version__ = "0.0.9"\n'), ("geometry_library", "")):
+        (other / package).mkdir(parents=True)
+        (other / package / "__init__.py").write_text(text)
+    work = tmp_path / "work"
+    work.mkdir()
+    try:
+        _wait(sched_file.exists, 60, "the scheduler file", logs)
+        address = json.loads(sched_file.read_text())["address"]
+        args = [address, "--nworkers", "1", "--nthreads", "1", "--no-dashboard"]
+        sweep = [sys.executable, "-m", "masonrycli", "sweep", "wall", "--param", "blocks=12", "--duration", "0.05"]
+        sweep += ["--param", "amp=0.1,0.2", "--scheduler", address, "--out", "study.csv"]
+        ours = subprocess.run(
+            [sys.executable, "-c", "from masonrycli.study.versions import *; print(describe(this_version()))"],
+            capture_output=True, text=True, env=ENV, cwd=work,
+        ).stdout.strip()  # fmt: skip
+        assert ours.startswith("masonry 0.1.0 (source ")
+        cases = [
+            ([BIN / "dask", "worker"], {"PYTHONPATH": str(other)}, "runs masonry 0.0.9 (source "),
+            (
+                _worker_without_masonry(tmp_path),
+                {"PYTHONPATH": ""},
+                "runs no masonry (ModuleNotFoundError: No module named 'masonrycli')",
+            ),
+            ([BIN / "dask", "worker"], {"PYTHONPATH": str(ROOT)}, None),  # the same masonry: the study runs
+        ]
+        for command, extra, said in cases:
+            log = tmp_path / f"w{len(logs)}.log"
+            worker = subprocess.Popen(
+                [*command, *args], stdout=open(log, "w"), stderr=subprocess.STDOUT, env=ENV | extra,
+                cwd=tmp_path, start_new_session=True,
+            )  # fmt: skip
+            logs[worker] = log
+            try:
+                _wait(lambda log=log: "Registered to" in log.read_text(), 120, "the worker", logs)
+                done = subprocess.run(sweep, capture_output=True, text=True, env=ENV, cwd=work, timeout=300)
+            finally:
+                _kill(worker)
+                del logs[worker]
+            if said is None:
+                assert done.returncode == 0, done.stdout + done.stderr
+                assert len(_read_csv(work / "study.csv")) == 2
+                continue
+            lines = [ln for ln in (done.stdout + done.stderr).splitlines() if ln.strip()]
+            assert done.returncode == 2 and len(lines) == 1, lines
+            assert lines[0].startswith(f"error: --scheduler {address}: worker tcp://"), lines
+            assert said in lines[0] and f"this command runs {ours}" in lines[0], lines
+            assert list(work.iterdir()) == []  # no table, journal, plot or recording
+    finally:
+        _kill(scheduler)
 
 
 def _read_csv(path: Path) -> list[dict]:

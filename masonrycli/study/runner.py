@@ -2,8 +2,10 @@
 
 By default a ``LocalCluster`` with one single-threaded worker *process* per core (the engine is
 serial numba code holding the GIL, so threads would not help); ``--scheduler tcp://host:8786`` uses an
-existing cluster instead, whose workers need only ``pip install masonry``. The base scenario is one
-task whose result the other tasks share, so each task ships only its parameters and returns one row.
+existing cluster instead, whose workers need only ``pip install masonry`` — the same masonry as the
+command's, checked on every worker before anything is written (:mod:`masonrycli.study.versions`). The
+base scenario is one task whose result the other tasks share, so each task ships only its parameters
+and returns one row.
 
 Rows come back in completion order; the driver (:mod:`masonrycli.study.drivers`) decides what runs
 next. A task that fails inside the run returns an error row (:func:`~masonrycli.study.task.run_task`);
@@ -48,10 +50,18 @@ def open_cluster(scheduler: str | None, workers: int | None):
     from distributed import Client, LocalCluster
 
     if scheduler:
+        from masonrycli.study.versions import check_workers
+
         try:
-            return Client(scheduler, timeout="20s"), None
+            client = Client(scheduler, timeout="20s")
         except (OSError, TimeoutError, ValueError) as exc:
             raise InputError(f"--scheduler {scheduler}: cannot connect ({type(exc).__name__}: {exc})") from None
+        try:
+            check_workers(client, scheduler)  # its workers run this masonry, or nothing is written
+        except BaseException:
+            client.close()
+            raise
+        return client, None
     n = workers or os.cpu_count() or 1
     # ":0": the scheduler's HTTP endpoints (it serves them even without a dashboard) on a free port, so
     # two studies at once do not fight over 8787
