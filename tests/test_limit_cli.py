@@ -40,6 +40,15 @@ def test_table_names_lambda_and_mechanism(column_file, tmp_path):
     assert out.stat().st_size > 0
 
 
+def test_no_friction_gives_zero_not_minus_zero(column_file):
+    # A frictionless column slides at once: λ = 0, which HiGHS returns as -0.0 ("λ = -0.0000 (tilt ψ =
+    # -0.00°)", "collapse load -0 N", "load_factor": -0.0 in the JSON)
+    table = invoke("limit", column_file, "--friction", "0")
+    assert table.exit_code == 0 and "0.0000  (tilt ψ = 0.00°)" in table.output and "-0" not in table.output
+    data = json.loads(invoke("limit", column_file, "--friction", "0", "--json").stdout)
+    assert str(data["load_factor"]) == "0.0" and str(data["collapse_load_N"]) == "0.0"
+
+
 def test_point_load_on_a_named_block(column_file):
     result = runner.invoke(app, ["limit", str(column_file), "--load", "point", "--block", "b2", "--json"])
     data = json.loads(result.stdout)

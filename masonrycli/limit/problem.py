@@ -211,7 +211,7 @@ def solve_limit(
     # Dual of  min −λ, A z = b:  y with Aᵀy ≤ c. The mechanism is u = −y, back in unscaled rows.
     velocity = (-res.eqlin.marginals * scale).reshape(-1, 3)
     return LPSolution(
-        load_factor=float(res.x[-1]),
+        load_factor=float(res.x[-1]) + 0.0,  # HiGHS's λ at its bound 0 is -0.0 (shown as λ = -0.0000, -0 N)
         contact_force=force,
         block_velocity=velocity / max(_fastest_point(model, velocity), 1e-300),
         solve_time=elapsed,
