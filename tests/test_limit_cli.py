@@ -102,6 +102,18 @@ def test_infeasible_structure_is_one_line_exit_2(tmp_path):
     assert_one_line_error(invoke("limit", path), "no equilibrium")
 
 
+@pytest.mark.parametrize("gy", ["0.0", "-1e-300"])
+def test_zero_gravity_is_one_line_exit_2(gy, tmp_path):
+    # a scenario file may set gravity = [0, 0] (masonry run floats the blocks): limit ended in a
+    # ZeroDivisionError traceback, exit 1; at 1e-300 m/s² it said "no equilibrium" for a block on the ground
+    path = tmp_path / "space.toml"
+    path.write_text(
+        f"[run]\ngravity = [0.0, {gy}]\n[[block]]\npolygon = [[0, 0], [1, 0], [1, 1], [0, 1]]\n"
+        '[[support]]\nname = "ground"\npolygon = [[-1, -1], [2, -1], [2, 0], [-1, 0]]\n'
+    )
+    assert_one_line_error(invoke("limit", path), "gravity is zero or negligible", "λ times a weight")
+
+
 # SIGTERM sent from inside the step named, in a real process (the default handler would kill pytest).
 _SIGTERM_SCRIPT = """
 import os, signal, sys, time

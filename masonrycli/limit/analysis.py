@@ -14,7 +14,7 @@ import numpy as np
 
 from masonrycli.limit.joints import Joints, find_joints, joint_names
 from masonrycli.limit.kinematics import JointMotion, joint_motion
-from masonrycli.limit.problem import LiveLoad, LPSolution, load_vectors, solve_limit
+from masonrycli.limit.problem import LimitError, LiveLoad, LPSolution, load_vectors, solve_limit
 from masonrycli.limit.thrust import ThrustLine, thrust_line
 from masonrycli.model import Model, build_model
 
@@ -110,9 +110,21 @@ def _finite(value):
     return [float(v) for v in arr] if np.ndim(value) else float(arr[0])
 
 
+MIN_GRAVITY = 1e-6
+"""m/s²: below this the blocks' weight is taken as zero (a microgravity experiment has ~1e-5)."""
+
+
 def analyse_model(model: Model, load: LiveLoad, scenario_name: str = "") -> LimitResult:
     """Limit analysis of a built model (supports are rigid and fixed whatever their motion in a run)."""
     t0 = time.perf_counter()
+    g = float(np.hypot(*model.gravity))
+    # λ does not depend on |g|, but the LP is scaled by the weight: at g = 0 a ZeroDivisionError, at
+    # 1e-300 m/s² "no equilibrium" for a block standing on the ground
+    if not g >= MIN_GRAVITY:
+        raise LimitError(
+            f"gravity is zero or negligible (|g| = {g:.3g} m/s², [run] gravity): the blocks weigh nothing, and "
+            "every load of limit analysis is λ times a weight"
+        )
     joints = find_joints(model)
     dead, live, reference = load_vectors(model, load)
     solution = solve_limit(model, joints, dead, live)
