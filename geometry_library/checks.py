@@ -20,7 +20,6 @@ Tolerances
 
 from __future__ import annotations
 
-import math
 from collections.abc import Sequence
 
 import numpy as np
@@ -244,8 +243,9 @@ def validate_assembly(
     warnings: list[str] = []
     if assembly.support_count == 0:
         warnings.append(
-            f"no supports: nothing holds the {n_blocks} block{'s' if n_blocks != 1 else ''} up, they fall freely "
-            '(in GeoJSON a feature is a block unless its properties say "role": "support")'
+            f"no supports: nothing holds the {n_blocks} block{'s' if n_blocks != 1 else ''} up, "
+            f"{'they fall' if n_blocks != 1 else 'it falls'} freely (in GeoJSON a feature is a block unless its "
+            'properties say "role": "support"; in WKT a line is one unless it starts with "support NAME:")'
         )
 
     # Bounding boxes of slivers (a fine arch's voussoirs) meet ~N²/20 others: one union first, and the
@@ -283,7 +283,10 @@ def validate_assembly(
     touched[near_a[near_a != near_b]] = True
     for i in np.flatnonzero(~touched).tolist():
         others = np.delete(geoms, i)
-        gap = float(shapely.distance(geoms[i], others).min()) if others.size else math.inf
+        if not others.size:  # said "nearest body inf m away"
+            warnings.append(f"{labels[i]} touches nothing (it is the only body): it will fall freely")
+            continue
+        gap = float(shapely.distance(geoms[i], others).min())
         warnings.append(
             f"{labels[i]} touches nothing (nearest body {gap:.3g} m away, more than "
             f"{contact_distance:g} m): it will fall freely"

@@ -129,8 +129,12 @@ def test_no_support_at_all_is_a_warning():
     warnings = validate_assembly(asm(box(0, 0, 1, 1), box(0, 1, 1, 2)))
     assert warnings == [
         "no supports: nothing holds the 2 blocks up, they fall freely (in GeoJSON a feature is a block unless "
-        'its properties say "role": "support")'
+        'its properties say "role": "support"; in WKT a line is one unless it starts with "support NAME:")'
     ]
+    # a one-line WKT file: "the 1 block up, they fall" and "nearest body inf m away" before
+    alone = validate_assembly(asm(box(0, 0, 1, 1), names=["solo"]))
+    assert alone[0].startswith("no supports: nothing holds the 1 block up, it falls freely (")
+    assert alone[1] == 'block 0 ("solo") touches nothing (it is the only body): it will fall freely'
 
 
 def test_bad_support_role_and_density():
