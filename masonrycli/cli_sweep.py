@@ -158,20 +158,28 @@ def sweep_command(
         stopped_by[0] = signum
         raise KeyboardInterrupt
 
+    # The handler stays for the plot and the recording: a SIGTERM there killed the command outright (exit
+    # -15, a hidden .s.png.<pid>.part left beside the table), and Ctrl-C there said "stopped before any
+    # output was written" with the whole table written.
     main = threading.current_thread() is threading.main_thread()  # signal.signal works only there
     previous = signal.signal(signal.SIGTERM, on_sigterm) if main else None
+    result, written = None, []
     try:
         result = run_study(base, request, console)
+        _report(console, result, request, name, im, picture, recording, written)
     except KeyboardInterrupt:
         how = "" if stopped_by[0] == signal.SIGINT else f" ({signal_name(stopped_by[0])})"
-        err_console.print(
-            f"interrupted{how}: every finished row is in {out}; run the same command again to resume", soft_wrap=True
-        )
+        if result is None:
+            said = f"every finished row is in {out}; run the same command again to resume"
+        else:  # the study is complete: what is missing is a picture
+            missing = [str(f.path) for f in (picture, recording) if f is not None and f.path not in written]
+            again = "with --force (no run is made again)" if written else "(no run is made again)"
+            said = f"every row is in {out}, but not written: {', '.join(missing)}; run the same command {again}"
+        err_console.print(f"interrupted{how}: {said}", soft_wrap=True)
         raise typer.Exit(exit_code(stopped_by[0])) from None
     finally:
         if main:
             signal.signal(signal.SIGTERM, previous)
-    _report(console, result, request, name, im, picture, recording)
 
 
 def _base_scenario(target: str, duration, dt):
@@ -251,7 +259,11 @@ def _records(entries: list[Path]) -> dict:
     return {p.name: record_motion(p, display=str(p)) for p in files}
 
 
-def _report(console, result, request, name: str, im: str, plot: OutputFile, recording: OutputFile | None) -> None:
+def _report(
+    console, result, request, name: str, im: str, plot: OutputFile, recording: OutputFile | None, written: list
+) -> None:
+    """The table on the terminal, the fit, the plot and the recording; ``written`` gets each file's path
+    once it is in place."""
     from masonrycli.intensity import UNITS
     from masonrycli.outputs import written_whole
     from masonrycli.study.fragility import fit_lognormal
@@ -295,10 +307,12 @@ def _report(console, result, request, name: str, im: str, plot: OutputFile, reco
                 f"fragility ({im}): median θ = {fit.median:.4g} {UNITS[im]}, dispersion β = {fit.dispersion:.3f} "
                 f"({fit.collapsed} of {fit.runs} runs collapsed)"
             )
+    written.append(plot.path)
     console.print(f"plot: {plot.path}")
     if recording is not None:
         from masonrycli.recording.study import record_study
 
         with written_whole(recording) as part:
             record_study(part, name, rows, request, fit, im, plot.path)
+        written.append(recording.path)
         console.print(f"recording: {recording.path}")

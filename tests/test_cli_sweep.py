@@ -271,6 +271,49 @@ def test_ctrl_c_leaves_no_partial_file_and_the_same_command_resumes(block, tmp_p
     assert [r["amp"] for r in read_rows(out)] == [0.05, 0.1, 0.2]
 
 
+def test_a_signal_while_the_pictures_are_written_says_what_is_missing(block, tmp_path, monkeypatch):
+    # The study is done, the plot and recording are being written. SIGTERM there killed the command
+    # outright (exit -15, a hidden .s.png.<pid>.part beside the table); Ctrl-C said "stopped before any
+    # output was written" with the whole table written.
+    import os
+    import signal
+
+    import masonrycli.recording.study as recording_study
+    import masonrycli.study.plots as plots
+
+    out = tmp_path / "s.csv"
+    args = ["sweep", block, "-p", "amp=0.05,0.1", "--duration", 0.02, "--workers", 0, "-o", out]
+    drawn = plots.state_map
+
+    def ctrl_c_in_the_plot(rows, x, y, path, title):
+        Path(path).write_bytes(b"half a PNG")
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(plots, "state_map", ctrl_c_in_the_plot)
+    result = invoke(*args)
+    said = " ".join(result.output.split())
+    assert result.exit_code == 130, result.output
+    assert f"interrupted: every row is in {out}, but not written: {tmp_path / 's.png'}, {tmp_path / 's.rrd'}" in said
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["block.toml", "s.csv"]  # no .part left
+    monkeypatch.setattr(plots, "state_map", drawn)
+
+    def sigterm_in_the_recording(*args):
+        os.kill(os.getpid(), signal.SIGTERM)  # the command's handler turns it into Ctrl-C's way out
+        raise AssertionError("not stopped")
+
+    monkeypatch.setattr(recording_study, "record_study", sigterm_in_the_recording)
+    result = invoke(*args)
+    said = " ".join(result.output.split())
+    assert result.exit_code == 143, result.output
+    assert f"interrupted (SIGTERM): every row is in {out}, but not written: {tmp_path / 's.rrd'}; " in said
+    assert "run the same command with --force (no run is made again)" in said  # the plot is there now
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["block.toml", "s.csv", "s.png"]
+    monkeypatch.undo()
+    result = invoke(*args, "--force")
+    assert result.exit_code == 0 and "(0 runs now, 2 rows already there" in " ".join(result.output.split())
+    assert (tmp_path / "s.rrd").stat().st_size > 0
+
+
 def test_the_table_fits_80_columns_in_a_real_terminal_width(block, tmp_path):
     import os
     import subprocess
