@@ -73,8 +73,33 @@ def _body_lists(contact_body, pack, count, bodies):
     return start, members
 
 
+@njit(inline="always")
+def _cycling_windows(window_state, residual, best, window, level):
+    # The hand-over test (stalled.py's module doc, "Hand-over"): after each sweep,
+    #   log_sum += log(residual) ; n += 1
+    #   at the window's end (n = window): g = exp(log_sum / window), the window's level (geometric mean of
+    #       its residuals); the window cycles if g > level × best (best: the lowest residual so far);
+    #       run = run + 1 if it cycles, else 0; log_sum = n = 0
+    # window_state = [log_sum, n, run]; returns run, the cycling windows in a row.
+    # Why the level and not the lowest residual: a step that cycles dips now and then to a new low by a
+    # hair, which restarts a stall window, while its level stays 2-5x above that low; a step that
+    # converges slowly keeps its level near its low.
+    window_state[0] += np.log(residual)
+    window_state[1] += 1.0
+    if window_state[1] >= window:
+        if np.exp(window_state[0] / window) > level * best:
+            window_state[2] += 1.0
+        else:
+            window_state[2] = 0.0
+        window_state[0] = 0.0
+        window_state[1] = 0.0
+    return window_state[2]
+
+
 @njit
-def _body_order_sweeps(contact_body, pack, count, mu, tolerance, max_units, v, r, status, stall):
+def _body_order_sweeps(
+    contact_body, pack, count, mu, tolerance, max_units, v, r, status, stall, window, level, cycling, history
+):
     # v enters as v_free, r as the start; both leave consistent (v = v_free + M⁻¹ H r).
     #   v ← v_free + M⁻¹ H r ; order = for each body with mass, its contacts (CSR lists) ; β = 0
     #   repeat (one sweep):
@@ -82,10 +107,13 @@ def _body_order_sweeps(contact_body, pack, count, mu, tolerance, max_units, v, r
     #       for α in order: r_α' = local_solve(H_αᵀ v − W r_α) ; v += M⁻¹ H_α (r_α' − r_α) ; r_α = r_α'
     #                       e_α = W (r_α' − r_α) counts in the residual at α's first visit in the sweep
     #       residual = sqrt(Σ e_α² / C)
-    #       until residual ≤ tolerance, max_units sweep units (visits / C), or stall sweeps without a
-    #       new lowest residual; restart (β = 0) when the residual grows by > RESTART_GROWTH
+    #       until residual ≤ tolerance, max_units sweep units (visits / C), stall sweeps without a new
+    #       lowest residual, or `cycling` windows of `window` sweeps in a row whose level is above
+    #       level × the lowest residual (_cycling_windows; cycling = 0: never);
+    #       restart (β = 0) when the residual grows by > RESTART_GROWTH
     # Every contact is visited in a sweep (one of its bodies has mass), so the extrapolated impulses,
     # which may leave the friction cone, are all replaced by local solutions before the sweep ends.
+    # history (the lab's instrument): the residual of sweep s goes to history[s] while s < its length.
     # Returns (sweep units, rounded up; residual).
     # The visit is nlgs's written out again, as in momentum.py and faces.py: a shared visit function cost
     # 47–57 ns per visit against 8.7 inline (faces.py's measurement).
@@ -105,6 +133,7 @@ def _body_order_sweeps(contact_body, pack, count, mu, tolerance, max_units, v, r
     last = np.inf
     best = np.inf
     best_at = 0
+    window_state = np.zeros(3)
     residual = np.inf  # no sweep done (max_units ≤ 0): nothing is known
     visits = 0
     sweep = 0
@@ -149,12 +178,16 @@ def _body_order_sweeps(contact_body, pack, count, mu, tolerance, max_units, v, r
         visits += visits_per_sweep
         sweep += 1
         residual = np.sqrt(sum_e2 / count)
+        if sweep <= history.shape[0]:
+            history[sweep - 1] = residual
         if residual <= tolerance:
             break
         if residual < best:
             best = residual
             best_at = sweep
         elif sweep - best_at >= stall:
+            break
+        if cycling > 0 and _cycling_windows(window_state, residual, best, window, level) >= cycling:
             break
         if residual > momentum.RESTART_GROWTH * last:
             j = 1
@@ -164,9 +197,32 @@ def _body_order_sweeps(contact_body, pack, count, mu, tolerance, max_units, v, r
     return (visits + count - 1) // count, residual
 
 
-def body_order_sweeps(contact_body, pack, count, mu, tolerance, max_units, v, r, status, stall) -> tuple[int, float]:
+_NO_HISTORY = np.empty(0)
+
+
+def body_order_sweeps(
+    contact_body,
+    pack,
+    count,
+    mu,
+    tolerance,
+    max_units,
+    v,
+    r,
+    status,
+    stall,
+    window=1,
+    level=np.inf,
+    cycling=0,
+    history=_NO_HISTORY,
+) -> tuple[int, float]:
     """Momentum sweeps in body order (module doc) from impulses ``r`` (C, 2), in place; ``v`` (B, 3) enters
     as the free velocities and leaves as v_free + M⁻¹ H r; ``status`` (C,) out. Stops at ``tolerance``
-    (m/s), after ``max_units`` sweep units (the sweep that crosses it ends), or after ``stall`` sweeps
-    without a new lowest residual. Returns (sweep units done, residual m/s)."""
-    return _body_order_sweeps(contact_body, pack, count, mu, tolerance, max_units, v, r, status, stall)
+    (m/s), after ``max_units`` sweep units (the sweep that crosses it ends), after ``stall`` sweeps
+    without a new lowest residual, or after ``cycling`` windows of ``window`` sweeps in a row whose level
+    (geometric mean of their residuals) is above ``level`` × the lowest residual so far (0: never).
+    ``history`` (float array, optional): the residual of each sweep, as many as it holds. Returns (sweep
+    units done, residual m/s)."""
+    return _body_order_sweeps(
+        contact_body, pack, count, mu, tolerance, max_units, v, r, status, stall, window, level, cycling, history
+    )

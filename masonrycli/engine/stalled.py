@@ -86,6 +86,12 @@ BODIES_UNITS = 16_000
 """Sweep units that momentum in body order (:mod:`masonrycli.engine.bodies`) gets alone, before the round-robin."""
 BODIES_STALL = 8000
 """Its sweeps without a new lowest residual after which the round-robin takes over."""
+BODIES_WINDOW = 500
+"""Sweeps over which the hand-over rule takes the stage's residual level (module doc, "Hand-over")."""
+BODIES_LEVEL = 1.8
+"""A window whose level (geometric mean of its residuals) is above this × the stage's lowest residual cycles."""
+BODIES_CYCLING = 4
+"""Cycling windows in a row after which the stage hands over to the round-robin (0: never)."""
 
 FIRST_BUDGET = 2000
 """Sweep units each method gets in the first round; doubled every round (module doc)."""
@@ -135,7 +141,19 @@ def continue_stalled(
         v_b, r_b, status_b = v_free.copy(), r_warm[:count].copy(), status[:count].copy()
         units = min(BODIES_UNITS, cap - iterations)
         done, residual_b = bodies.body_order_sweeps(
-            contact_body, pack, count, mu, tolerance, units, v_b, r_b, status_b, BODIES_STALL
+            contact_body,
+            pack,
+            count,
+            mu,
+            tolerance,
+            units,
+            v_b,
+            r_b,
+            status_b,
+            BODIES_STALL,
+            BODIES_WINDOW,
+            BODIES_LEVEL,
+            BODIES_CYCLING,
         )
         iterations += done
         if residual_b <= tolerance or (iterations >= cap and residual_b < residual):
