@@ -196,3 +196,18 @@ def test_a_body_order_solve_that_misses_hands_over_with_its_units_counted(monkey
     v, r, status = np.zeros((2, 3)), np.zeros((count, 2)), np.zeros(count, dtype=np.int8)
     its, res = stalled.continue_stalled(None, None, count, 0.5, 1e-6, 10**6, v, r, status, np.zeros((2, 3)), r, 7, 1e-2)
     assert calls == [("turning", 10)] and its == 7 + 37 + 10 and res == 1e-7
+
+
+def test_the_body_order_stage_gets_the_hand_over_rule(monkeypatch):
+    # stalled.py's constants reach the stage's kernel (window, level, cycling windows; bodies module).
+    seen = []
+    monkeypatch.setattr(stalled, "BODIES_UNITS", 50)
+    monkeypatch.setattr(stalled, "BODIES_WINDOW", 3)
+    monkeypatch.setattr(stalled, "BODIES_LEVEL", 2.5)
+    monkeypatch.setattr(stalled, "BODIES_CYCLING", 2)
+    monkeypatch.setattr(bodies, "body_order_sweeps", lambda *args: seen.append(args[5:]) or (37, 1e-7))
+    count = 2
+    v, r, status = np.zeros((2, 3)), np.zeros((count, 2)), np.zeros(count, dtype=np.int8)
+    its, res = stalled.continue_stalled(None, None, count, 0.5, 1e-6, 10**6, v, r, status, np.zeros((2, 3)), r, 7, 1e-2)
+    assert its == 7 + 37 and res == 1e-7
+    assert [s[:1] + s[4:] for s in seen] == [(50, stalled.BODIES_STALL, 3, 2.5, 2)]

@@ -65,7 +65,7 @@ def record_step(name: str) -> dict | None:
         v_b, r_b, status_b = v_free.copy(), r_warm[:count].copy(), status[:count].copy()
         t = time.process_time()
         done, res = bodies.body_order_sweeps(
-            contact_body, pack, count, mu, tolerance, RECORD_UNITS, v_b, r_b, status_b, 10**9, history
+            contact_body, pack, count, mu, tolerance, RECORD_UNITS, v_b, r_b, status_b, 10**9, history=history
         )
         out["stage_cpu_s"] = time.process_time() - t
         out["history"] = history[~np.isnan(history)]
@@ -180,3 +180,66 @@ def evaluate(steps: dict[str, dict], rule, budget: int = 16_000) -> dict:
             converged = d["robin_residual"] <= d["tolerance"]
         out[name] = {"units": units, "converged": converged, "stage": stage, "finished": finished}
     return out
+
+
+RULES: dict[str, tuple] = {
+    "as shipped (stall 8000)": ("stall", 8000, 16_000),
+    "stall 500": ("stall", 500, 16_000),
+    "stall 1000": ("stall", 1000, 16_000),
+    "stall 2000": ("stall", 2000, 16_000),
+    "units 4000": ("stall", 8000, 4000),
+    "no stage": ("stall", 8000, 0),
+    **{
+        f"level {w} × {lv} × {k}": ("level", (w, lv, k), 16_000)
+        for w, lv, k in [(500, 1.6, 4), (500, 1.7, 4), (500, 1.8, 3), (500, 1.8, 4), (500, 1.8, 5), (500, 2.0, 4)]
+        + [(400, 1.8, 4), (400, 1.8, 5), (250, 1.7, 4), (1000, 1.8, 2)]
+    },
+}
+"""Rules ``table`` replays: the engine's stall window or budget, and level rules (window, level, cycling)."""
+
+
+def _rule(kind, arg):
+    return stall_rule(arg) if kind == "stall" else level_rule(*arg)
+
+
+def table(paths: list[Path], rules: list[str] | None = None) -> None:
+    """Per rule and recording: units (× the first rule's), converged, steps the stage finished, and steps it
+    would have finished but handed over ("early": their trajectory changes in a whole run)."""
+    sets = {Path(p).stem: load(Path(p)) for p in paths}
+    names = rules or list(RULES)
+    ref = {k: evaluate(st, _rule(*RULES[names[0]][:2]), RULES[names[0]][2]) for k, st in sets.items()}
+    head = " | ".join(f"{k}: units (×) | conv. | finished | early" for k in sets)
+    print(f"| rule | {head} |\n|---|" + "---|" * (4 * len(sets)))
+    for name in names:
+        kind, arg, budget = RULES[name]
+        cells = []
+        for k, st in sets.items():
+            ev = evaluate(st, _rule(kind, arg), budget)
+            units = sum(e["units"] for e in ev.values())
+            base = sum(e["units"] for e in ref[k].values())
+            early = sum(ref[k][n]["finished"] and not ev[n]["finished"] for n in st)
+            conv = sum(e["converged"] for e in ev.values())
+            fin = sum(e["finished"] for e in ev.values())
+            cells.append(f"{units:,} ({units / base:.3f}) | {conv} / {len(ev)} | {fin} | {early}".replace(",", " "))
+        print(f"| {name} | " + " | ".join(cells) + " |")
+
+
+def add_arguments(sub) -> None:
+    """The ``handover`` subcommand's parser."""
+    p = sub.add_parser("handover", help="the body-order stage's residual histories on hard steps; hand-over rules")
+    act = p.add_subparsers(dest="action", required=True)
+    r = act.add_parser("record")
+    r.add_argument("--cases", nargs="+", default=["wall-248"])
+    r.add_argument("--min-units", type=int, default=2500)
+    r.add_argument("--max-units", type=int, default=None)
+    r.add_argument("--out", type=Path, required=True)
+    t = act.add_parser("table")
+    t.add_argument("files", nargs="+", type=Path)
+    t.add_argument("--rules", nargs="+", default=None, help=f"of: {', '.join(RULES)}")
+
+
+def main(args) -> None:
+    if args.action == "record":
+        record(args.cases, args.min_units, args.max_units, args.out)
+    else:
+        table(args.files, args.rules)

@@ -1,7 +1,8 @@
 """What a stalled accelerated solve does: momentum in body order, then five methods taken in turn.
 
 First, from the step's warm start, momentum sweeps that visit the contacts body by body
-(:mod:`masonrycli.engine.bodies`) for at most BODIES_UNITS sweep units (stall window BODIES_STALL sweeps).
+(:mod:`masonrycli.engine.bodies`) for at most BODIES_UNITS sweep units (stall window BODIES_STALL sweeps),
+or until they cycle (next paragraph).
 On 64 hard steps of the 32- and 64-course walls' ensemble runs, alone, they converge all 64 in 150 139
 units where the round-robin below took 956 975 (benchmarks/README.md, "New methods on hard steps"); the
 same steps replayed through nlgs.solve with this stage ahead of the round-robin take 218 460 (0.23×),
@@ -10,6 +11,22 @@ unconverged against 5. Ensembles of 48 short runs a wall: mean sweep units a ste
 0.80] on the 32-course wall, 0.65× [0.59, 0.72] on the 64-course wall, unconverged steps 5 → 7 and
 13 → 2. Only a step they do not finish goes on to the round-robin described next, which is what the
 rest of this doc measured before that stage existed.
+
+Hand-over. On the 248-block wall the stage finished none of 21 captured steps of ≥ 2500 units: it spent
+its 16 000 units on each, and the round-robin then finished 20 of them in ~600 (newton's first resume).
+On the 32- and 64-course walls it finishes 178 of 179 and 142 of 142 stalled steps, a few only after
+3000–7000 sweeps. Their residual histories (benchmarks/README.md, "The body-order stage's hand-over")
+tell the two apart: where the stage fails, its residual cycles (stick/slip) around a level 1.4–6× the
+lowest residual, which it reached in an early dip, and new lows by a hair keep restarting any stall
+window; where it succeeds slowly, the residual stays near its low on a plateau or a slow descent (level
+within 1.05–1.5× on most). So every BODIES_WINDOW sweeps the window's level (geometric mean of its
+residuals) is compared with BODIES_LEVEL × the lowest residual so far, and BODIES_CYCLING such windows in
+a row (2000 sweeps, ~4000 units) hand the step over. The round-robin starts from the warm start and
+momentum's iterate, not from the stage's, so a step the stage would not have finished ends with the
+same solution as before in fewer units; only a step it would have finished later changes. Replayed
+through nlgs.solve: the 248-block wall's 21 steps 402 494 → 173 892 units, the 32-course wall's 192
+steps of ≥ 2500 units 534 217 → 520 829, the 64-course wall's 150 665 570 → 668 013, as many converged;
+the stage hands over early on 1 + 1 of their steps that it would have finished.
 
 Gauss–Seidel with momentum (the default solver, :mod:`masonrycli.engine.momentum`) converges most steps in
 tens to hundreds of sweeps. On tall walls that slide it can stall: momentum drives the step into a
