@@ -1,8 +1,8 @@
 """What a stalled accelerated solve does: momentum in body order, then five methods taken in turn.
 
 First, from the step's warm start, momentum sweeps that visit the contacts body by body
-(:mod:`masonrycli.engine.bodies`) for at most BODIES_UNITS sweep units (stall window BODIES_STALL sweeps),
-or until they cycle (next paragraph).
+(:mod:`masonrycli.engine.bodies`) for at most BODIES_UNITS sweep units (stall window BODIES_STALL sweeps;
+a hand-over when they cycle was measured and is off, next paragraph).
 On 64 hard steps of the 32- and 64-course walls' ensemble runs, alone, they converge all 64 in 150 139
 units where the round-robin below took 956 975 (benchmarks/README.md, "New methods on hard steps"); the
 same steps replayed through nlgs.solve with this stage ahead of the round-robin take 218 460 (0.23×),
@@ -12,21 +12,24 @@ unconverged against 5. Ensembles of 48 short runs a wall: mean sweep units a ste
 13 → 2. Only a step they do not finish goes on to the round-robin described next, which is what the
 rest of this doc measured before that stage existed.
 
-Hand-over. On the 248-block wall the stage finished none of 21 captured steps of ≥ 2500 units: it spent
-its 16 000 units on each, and the round-robin then finished 20 of them in ~600 (newton's first resume).
-On the 32- and 64-course walls it finishes 178 of 179 and 142 of 142 stalled steps, a few only after
-3000–7000 sweeps. Their residual histories (benchmarks/README.md, "The body-order stage's hand-over")
-tell the two apart: where the stage fails, its residual cycles (stick/slip) around a level 1.4–6× the
-lowest residual, which it reached in an early dip, and new lows by a hair keep restarting any stall
-window; where it succeeds slowly, the residual stays near its low on a plateau or a slow descent (level
-within 1.05–1.5× on most). So every BODIES_WINDOW sweeps the window's level (geometric mean of its
-residuals) is compared with BODIES_LEVEL × the lowest residual so far, and BODIES_CYCLING such windows in
-a row (2000 sweeps, ~4000 units) hand the step over. The round-robin starts from the warm start and
-momentum's iterate, not from the stage's, so a step the stage would not have finished ends with the
-same solution as before in fewer units; only a step it would have finished later changes. Replayed
-through nlgs.solve: the 248-block wall's 21 steps 402 494 → 173 892 units, the 32-course wall's 192
-steps of ≥ 2500 units 534 217 → 520 829, the 64-course wall's 150 665 570 → 668 013, as many converged;
-the stage hands over early on 1 + 1 of their steps that it would have finished.
+Hand-over (measured, off: BODIES_CYCLING = 0). On the 248-block wall the stage finished none of 21
+captured steps of ≥ 2500 units: it spent its 16 000 units on each, and the round-robin then finished 20
+of them in ~600 (newton's first resume). On the 32- and 64-course walls it finishes 178 of 179 and 142 of
+142 stalled steps, a few only after 3000–7000 sweeps. Their residual histories (benchmarks/README.md,
+"The body-order stage's hand-over") tell most of them apart: where the stage fails, its residual cycles
+(stick/slip) around a level 1.4–6× the lowest residual, reached in an early dip, and new lows by a hair
+keep restarting any stall window; where it succeeds slowly, the residual stays near its low (level
+within 1.05–1.5× on most). So with BODIES_CYCLING > 0, every BODIES_WINDOW sweeps the window's level
+(geometric mean of its residuals) is compared with BODIES_LEVEL × the lowest residual so far, and
+BODIES_CYCLING such windows in a row hand the step over (bodies._cycling_windows). The round-robin starts
+from the warm start and momentum's iterate, not from the stage's, so a step the stage would not have
+finished ends with the same solution in fewer units. With 500 × 1.8 × 4: replayed, the 248-block wall's
+21 steps 402 494 → 173 892 units, the 32-course wall's 192 steps 534 217 → 520 829, the 64-course
+wall's 150 665 570 → 668 013, as many converged; ensembles of 48 runs a wall, mean units a step 0.954
+[0.931, 0.975] (248-block wall, unconverged 3 → 3), 0.995 [0.974, 1.016] (32 courses, 7 → 8), 1.001
+[0.985, 1.019] (64 courses, 2 → 3). Not on: more unconverged steps on the tall walls, and a step that
+cycles for 2000 sweeps and then converges is handed to a round-robin that may cost 10× more (the
+64-course wall's 1.15 m/s 1.7 Hz step 128: 10 041 → 98 160 units).
 
 Gauss–Seidel with momentum (the default solver, :mod:`masonrycli.engine.momentum`) converges most steps in
 tens to hundreds of sweeps. On tall walls that slide it can stall: momentum drives the step into a
@@ -107,8 +110,9 @@ BODIES_WINDOW = 500
 """Sweeps over which the hand-over rule takes the stage's residual level (module doc, "Hand-over")."""
 BODIES_LEVEL = 1.8
 """A window whose level (geometric mean of its residuals) is above this × the stage's lowest residual cycles."""
-BODIES_CYCLING = 4
-"""Cycling windows in a row after which the stage hands over to the round-robin (0: never)."""
+BODIES_CYCLING = 0
+"""Cycling windows in a row after which the stage hands over to the round-robin (0: never, the default: 4
+was measured and not shipped, module doc "Hand-over")."""
 
 FIRST_BUDGET = 2000
 """Sweep units each method gets in the first round; doubled every round (module doc)."""
