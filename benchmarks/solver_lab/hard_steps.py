@@ -1,7 +1,8 @@
 """Hard steps: capture the steps that cost the engine most in ensemble runs, and replay rule variants on them.
 
     python -m benchmarks.solver_lab hard capture [--cases h32 h64] [--copy 0] [--min-units 1000]
-    python -m benchmarks.solver_lab hard replay --variants main ns-… [--min-units 2500] [--out FILE.json]
+                                                 [--motions A,F …] [--duration S] [--dir DIR]
+    python -m benchmarks.solver_lab hard replay --variants main ns-… [--min-units 2500] [--out FILE.json] [--dir DIR]
     python -m benchmarks.solver_lab hard table FILE.json [FILE.json …]
 
 A whole run is chaotic (an amplitude changed by 1e-6 gives another trajectory, ensemble.py), so a change of
@@ -12,6 +13,8 @@ ensemble.DURATION) with the engine as it is, and keeps the input nlgs.solve got 
 cap) in ``data/hard/<case>-a<A>-f<F>-c<copy>-<step>.npz``, with the units and residual the engine spent on it
 (``index-<case>-c<copy>.json``). The per-step units of the run are printed beside the run's total so that they can be
 checked against an ensemble file of the same engine (the same motion and copy give the same units).
+``--dir`` captures into (and replays from) another directory than ``data/hard``: a set per engine, since a
+capture describes the engine that ran it (``data/hard`` is that of 88c12c6 for h32 / h64).
 
 ``replay`` solves each kept step with ``--min-units`` or more by nlgs.solve from its warm start, once per
 variant: a variant is a set of module constants of momentum.py, stalled.py and newton.py set for the
@@ -73,16 +76,18 @@ def _key(case: str, motion, copy: int, step: int) -> str:
     return f"{case}-a{motion[0]:g}-f{motion[1]:g}-c{copy}-{step}"
 
 
-def capture(cases: list[str], copy: int, min_units: int, motions=None, duration: float | None = None) -> None:
+def capture(
+    cases: list[str], copy: int, min_units: int, motions=None, duration: float | None = None, directory: Path = HARD
+) -> None:
     """Run ``cases`` under the ensemble's motions; keep the steps of ``min_units`` or more (module doc)."""
     from benchmarks.solver_lab import ensemble
 
-    HARD.mkdir(parents=True, exist_ok=True)
+    directory.mkdir(parents=True, exist_ok=True)
     for case in cases:
-        index_path = HARD / f"index-{case}-c{copy}.json"  # one a capture process: cases run in parallel
+        index_path = directory / f"index-{case}-c{copy}.json"  # one a capture process: cases run in parallel
         index = json.loads(index_path.read_text()) if index_path.exists() else {}
         for motion in motions or ensemble.MOTIONS:
-            kept, units = _capture_run(case, motion, copy, min_units, duration or ensemble.DURATION)
+            kept, units = _capture_run(case, motion, copy, min_units, duration or ensemble.DURATION, directory)
             index.update(kept)
             index_path.write_text(json.dumps(index, indent=1))
             u = np.array(units)
@@ -93,7 +98,7 @@ def capture(cases: list[str], copy: int, min_units: int, motions=None, duration:
             )
 
 
-def _capture_run(case, motion, copy, min_units, duration) -> tuple[dict, list[int]]:
+def _capture_run(case, motion, copy, min_units, duration, directory=HARD) -> tuple[dict, list[int]]:
     from benchmarks.solver_cases import CASES
     from benchmarks.solver_lab.ensemble import COPY_STEP
     from masonrycli.motion import Sine
@@ -120,7 +125,7 @@ def _capture_run(case, motion, copy, min_units, duration) -> tuple[dict, list[in
         if out[0] >= min_units:
             name = _key(case, motion, copy, step[0])
             params = {"mu": model.friction, "tolerance": model.tolerance, "cap": model.max_iterations}
-            np.savez_compressed(HARD / f"{name}.npz", **inputs, **params)
+            np.savez_compressed(directory / f"{name}.npz", **inputs, **params)
             kept[name] = {"case": case, "step": step[0], "units": int(out[0]), "residual": float(out[1])}
             kept[name].update(params, contacts=int(count), bodies=int(v.shape[0]), solver=model.solver)
         return out
@@ -145,9 +150,9 @@ def _set(overrides: dict[str, object]) -> dict[str, object]:
     return old
 
 
-def replay_step(name: str) -> dict:
+def replay_step(name: str, directory: Path = HARD) -> dict:
     """One kept step through nlgs.solve from its warm start: units, residual, the method that finished."""
-    z = np.load(HARD / f"{name}.npz")
+    z = np.load(directory / f"{name}.npz")
     body, pack, count = z["body"].astype(np.int32), z["pack"], z["body"].shape[0]
     v, r, status = z["v_free"].copy(), z["r_warm"].copy(), z["status"].copy()
     model = SimpleNamespace(
@@ -188,9 +193,11 @@ def replay_step(name: str) -> dict:
     }
 
 
-def replay(variants: list[str], min_units: int, max_units: int | None, out: Path | None, cases=None) -> dict:
+def replay(
+    variants: list[str], min_units: int, max_units: int | None, out: Path | None, cases=None, directory: Path = HARD
+) -> dict:
     """Each variant over the kept steps with min_units ≤ engine units < max_units; results to ``out``."""
-    index = {n: e for path in sorted(HARD.glob("index-*.json")) for n, e in json.loads(path.read_text()).items()}
+    index = {n: e for path in sorted(directory.glob("index-*.json")) for n, e in json.loads(path.read_text()).items()}
     names = sorted(
         n
         for n, e in index.items()
@@ -199,6 +206,7 @@ def replay(variants: list[str], min_units: int, max_units: int | None, out: Path
         and e["case"] in (cases or [e["case"]])
     )
     doc = {
+        "dir": str(directory),
         "min_units": min_units,
         "max_units": max_units,
         "steps": names,
@@ -212,7 +220,7 @@ def replay(variants: list[str], min_units: int, max_units: int | None, out: Path
             results = {}
             t = time.process_time()
             for name in names:
-                results[name] = replay_step(name)
+                results[name] = replay_step(name, directory)
         finally:
             _set(old)
         doc["variants"][variant] = {"overrides": {k: str(v) for k, v in overrides.items()}, "steps": results}
@@ -274,6 +282,9 @@ def add_arguments(sub) -> None:
     c.add_argument("--cases", nargs="+", default=["h32", "h64"])
     c.add_argument("--copy", type=int, default=0)
     c.add_argument("--min-units", type=int, default=1000)
+    c.add_argument("--motions", nargs="+", default=None, help="A,F[,PHASE] … (default: the ensemble's 12)")
+    c.add_argument("--duration", type=float, default=None, help="s (default: the ensemble's)")
+    c.add_argument("--dir", type=Path, default=HARD, help="where the steps go (default data/hard)")
     r = act.add_parser("replay")
     r.add_argument(
         "--variants", nargs="+", default=["main"], help=f"names ({', '.join(VARIANTS)}) or MOD.NAME=VALUE[+…]"
@@ -282,14 +293,18 @@ def add_arguments(sub) -> None:
     r.add_argument("--max-units", type=int, default=None)
     r.add_argument("--cases", nargs="+", default=None)
     r.add_argument("--out", type=Path, default=None)
+    r.add_argument("--dir", type=Path, default=HARD, help="the captured set (default data/hard)")
     t = act.add_parser("table")
     t.add_argument("files", nargs="+", type=Path)
 
 
 def main(args) -> None:
     if args.action == "capture":
-        capture(args.cases, args.copy, args.min_units)
+        from benchmarks.solver_lab.ensemble import parse_motion
+
+        motions = [parse_motion(m) for m in args.motions] if args.motions else None
+        capture(args.cases, args.copy, args.min_units, motions, args.duration, args.dir)
     elif args.action == "replay":
-        replay(args.variants, args.min_units, args.max_units, args.out, args.cases)
+        replay(args.variants, args.min_units, args.max_units, args.out, args.cases, args.dir)
     else:
         table(args.files)

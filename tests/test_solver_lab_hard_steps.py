@@ -1,0 +1,18 @@
+"""The lab's hard-step capture and replay (benchmarks/solver_lab/hard_steps.py): a set captured into a
+directory of one's choice replays from it, and the engine's replay gives each step the units the run spent."""
+
+import json
+
+from benchmarks.solver_lab import hard_steps
+
+
+def test_capture_into_a_directory_replays_from_it(tmp_path):
+    # h8 (8 courses) for 4 steps of 1 ms, every step kept (min_units 1): the set goes to tmp_path alone.
+    hard_steps.capture(["h8"], 0, 1, motions=[(1.0, 2.0, 0.0)], duration=0.004, directory=tmp_path)
+    index = json.loads((tmp_path / "index-h8-c0.json").read_text())
+    assert len(index) == 4
+    assert all((tmp_path / f"{name}.npz").exists() for name in index)
+    doc = hard_steps.replay(["main"], 1, None, None, directory=tmp_path)
+    assert doc["dir"] == str(tmp_path) and doc["steps"] == sorted(index)
+    replayed = doc["variants"]["main"]["steps"]
+    assert {n: s["units"] for n, s in replayed.items()} == {n: e["units"] for n, e in index.items()}
