@@ -16,3 +16,12 @@ def test_capture_into_a_directory_replays_from_it(tmp_path):
     assert doc["dir"] == str(tmp_path) and doc["steps"] == sorted(index)
     replayed = doc["variants"]["main"]["steps"]
     assert {n: s["units"] for n, s in replayed.items()} == {n: e["units"] for n, e in index.items()}
+    # A momentum window of 1 sweep hands every step that does not converge in momentum's first sweeps to
+    # stalled.py: such a step records where momentum stalled, and one its body-order stage finishes is
+    # labelled "bodies", not "momentum0" (momentum's own solve).
+    forced = hard_steps.replay(["momentum.STALL_SWEEPS=1"], 1, None, None, directory=tmp_path)
+    steps = forced["variants"]["momentum.STALL_SWEEPS=1"]["steps"].values()
+    handed = [s for s in steps if s["stalled_at"] is not None]
+    assert handed and all(s["by"] != "momentum0" for s in handed)
+    assert all(s["by"] == "momentum0" for s in steps if s["stalled_at"] is None and s["converged"])
+    assert any(s["by"] == "bodies" for s in handed)

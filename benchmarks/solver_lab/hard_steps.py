@@ -19,7 +19,8 @@ capture describes the engine that ran it (``data/hard`` is that of 88c12c6 for h
 ``replay`` solves each kept step with ``--min-units`` or more by nlgs.solve from its warm start, once per
 variant: a variant is a set of module constants of momentum.py, stalled.py and newton.py set for the
 replay (VARIANTS below), restored after. Per step: units, converged, and the method that finished it
-(the last one stalled.py resumed; "momentum0" for momentum's own first solve). ``table`` prints, per
+(the last one stalled.py resumed; "momentum0" for momentum's own first solve, "bodies" for stalled.py's
+body-order stage ahead of its round-robin). ``table`` prints, per
 variant: total units, steps converged, steps above 10 000 units, ratio to the first file's total, and
 which method finished how many steps.
 """
@@ -181,7 +182,8 @@ def replay_step(name: str, directory: Path = HARD) -> dict:
     finally:
         stalled._resume, stalled.continue_stalled = resume, finish
     converged = residual <= model.tolerance
-    by = (log[-1][0] if log else "momentum0") if converged else "-"
+    first = "bodies" if entry else "momentum0"  # handed to stalled.py, finished before its round-robin
+    by = (log[-1][0] if log else first) if converged else "-"
     return {
         "units": int(units),
         "residual": float(residual),
