@@ -78,11 +78,12 @@ def _key(case: str, motion, copy: int, step: int) -> str:
 
 
 def capture(
-    cases: list[str], copy: int, min_units: int, motions=None, duration: float | None = None, directory: Path = HARD
+    cases: list[str], copy: int, min_units: int, motions=None, duration: float | None = None, directory=None
 ) -> None:
     """Run ``cases`` under the ensemble's motions; keep the steps of ``min_units`` or more (module doc)."""
     from benchmarks.solver_lab import ensemble
 
+    directory = directory or HARD  # read at the call: tests point HARD elsewhere
     directory.mkdir(parents=True, exist_ok=True)
     for case in cases:
         index_path = directory / f"index-{case}-c{copy}.json"  # one a capture process: cases run in parallel
@@ -99,7 +100,7 @@ def capture(
             )
 
 
-def _capture_run(case, motion, copy, min_units, duration, directory=HARD) -> tuple[dict, list[int]]:
+def _capture_run(case, motion, copy, min_units, duration, directory) -> tuple[dict, list[int]]:
     from benchmarks.solver_cases import CASES
     from benchmarks.solver_lab.ensemble import COPY_STEP
     from masonrycli.motion import Sine
@@ -151,9 +152,9 @@ def _set(overrides: dict[str, object]) -> dict[str, object]:
     return old
 
 
-def replay_step(name: str, directory: Path = HARD) -> dict:
+def replay_step(name: str, directory=None) -> dict:
     """One kept step through nlgs.solve from its warm start: units, residual, the method that finished."""
-    z = np.load(directory / f"{name}.npz")
+    z = np.load((directory or HARD) / f"{name}.npz")
     body, pack, count = z["body"].astype(np.int32), z["pack"], z["body"].shape[0]
     v, r, status = z["v_free"].copy(), z["r_warm"].copy(), z["status"].copy()
     model = SimpleNamespace(
@@ -196,9 +197,10 @@ def replay_step(name: str, directory: Path = HARD) -> dict:
 
 
 def replay(
-    variants: list[str], min_units: int, max_units: int | None, out: Path | None, cases=None, directory: Path = HARD
+    variants: list[str], min_units: int, max_units: int | None, out: Path | None, cases=None, directory=None
 ) -> dict:
     """Each variant over the kept steps with min_units ≤ engine units < max_units; results to ``out``."""
+    directory = directory or HARD
     index = {n: e for path in sorted(directory.glob("index-*.json")) for n, e in json.loads(path.read_text()).items()}
     names = sorted(
         n
@@ -286,7 +288,7 @@ def add_arguments(sub) -> None:
     c.add_argument("--min-units", type=int, default=1000)
     c.add_argument("--motions", nargs="+", default=None, help="A,F[,PHASE] … (default: the ensemble's 12)")
     c.add_argument("--duration", type=float, default=None, help="s (default: the ensemble's)")
-    c.add_argument("--dir", type=Path, default=HARD, help="where the steps go (default data/hard)")
+    c.add_argument("--dir", type=Path, default=None, help="where the steps go (default data/hard)")
     r = act.add_parser("replay")
     r.add_argument(
         "--variants", nargs="+", default=["main"], help=f"names ({', '.join(VARIANTS)}) or MOD.NAME=VALUE[+…]"
@@ -295,7 +297,7 @@ def add_arguments(sub) -> None:
     r.add_argument("--max-units", type=int, default=None)
     r.add_argument("--cases", nargs="+", default=None)
     r.add_argument("--out", type=Path, default=None)
-    r.add_argument("--dir", type=Path, default=HARD, help="the captured set (default data/hard)")
+    r.add_argument("--dir", type=Path, default=None, help="the captured set (default data/hard)")
     t = act.add_parser("table")
     t.add_argument("files", nargs="+", type=Path)
 
