@@ -19,12 +19,20 @@ do not leave either (the 32-course wall's steps 84–88: the residual wanders at
 sweeps, where plain sweeps from the same warm start converge in 1219–1539 on two of them). Left to the
 plain solve's 10 000-sweep stall window, such steps made the default slower than plain Gauss–Seidel over
 the first 0.2 s of the 32- and 64-course walls (96 against 79 and 318 against 164 CPU s per simulated s).
-So a solve of this solver stops after STALL_SWEEPS = 500 accelerated sweeps without a new lowest
-residual, and nlgs.solve hands the step to :mod:`masonrycli.engine.stalled`: this momentum with its sweep
+So a solve of this solver stops after STALL_SWEEPS accelerated sweeps without a new lowest residual, and
+nlgs.solve hands the step to :mod:`masonrycli.engine.stalled`: this momentum with its sweep
 direction turning at every restart (``flip``), alternating-direction sweeps, this momentum resumed, and
 faces, in turn with doubling budgets (that module's doc has the figures). The fixed chain it replaced
 (faces for at most 5000 sweep units, plain sweeps from the warm start, faces to the cap) took
 17 816–23 714 sweep units on the 32-course wall's sliding steps.
+
+The window was 500 sweeps until stalled.py put momentum in body order ahead of its round-robin, a stage
+that finishes almost every stalled step of the tall walls from the warm start: momentum's 500-sweep
+plateau was then 23–45 % of their hard steps' units (benchmarks/README.md, "Momentum's stall window").
+With 200 the stage gets them sooner. Ensembles of 48 runs a wall against 500: mean sweep units a step
+0.614× [90 %: 0.535, 0.707] on the 32-course wall, 0.878× [0.807, 0.960] on the 64-course wall, 0.969×
+[0.923, 1.013] on the 248-block wall; unconverged steps 7 → 1, 2 → 4, 3 → 0. 100 costs the 248-block
+wall 4 % (its steps with plateaus that momentum finishes go to the stage, which costs more on them).
 """
 
 from __future__ import annotations
@@ -36,8 +44,9 @@ from masonrycli.engine.nlgs import P_WNN, P_WTN, P_WTT, _local_solve, _push, _re
 
 RESTART_GROWTH = 1.1
 """The accelerated sweep drops its momentum when a sweep's residual exceeds the previous one by this factor."""
-STALL_SWEEPS = 500
-"""Accelerated sweeps without a new lowest residual after which nlgs.solve hands the step to stalled.py."""
+STALL_SWEEPS = 200
+"""Accelerated sweeps without a new lowest residual after which nlgs.solve hands the step to stalled.py
+(module doc, last paragraph)."""
 
 
 @njit

@@ -12,6 +12,13 @@ unconverged against 5. Ensembles of 48 short runs a wall: mean sweep units a ste
 13 → 2. Only a step they do not finish goes on to the round-robin described next, which is what the
 rest of this doc measured before that stage existed.
 
+Since the stage finishes nearly every step the tall walls hand over, momentum's stall window decides
+how much a hard step spends before it starts: 500 sweeps until 2026-11-27, then 200 (momentum.py's doc:
+ensembles 0.61× / 0.88× / 0.97× mean units on the 32-, 64-course and 248-block walls). The order of the
+round-robin behind the stage no longer matters there: newton, first, finishes nearly all it gets, and
+momentum second (newton, momentum, turning, alternating, faces) gave every replayed hard step of five
+sets its units under the order below (benchmarks/README.md, "Momentum's stall window").
+
 Hand-over (measured, off: BODIES_CYCLING = 0). On the 248-block wall the stage finished none of 21
 captured steps of ≥ 2500 units: it spent its 16 000 units on each, and the round-robin then finished 20
 of them in ~600 (newton's first resume). On the 32- and 64-course walls it finishes 178 of 179 and 142 of
