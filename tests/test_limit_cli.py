@@ -81,6 +81,8 @@ def test_built_in_arch_by_name():
         (["arch", "--load", "wind"], ["--load wind"]),
         (["arch", "--load", "point"], ["--block NAME"]),
         (["arch", "--load", "point", "--block", "v99"], ["--block v99", "no such block"]),
+        # a support named as the loaded block: "no such block (1 blocks, e.g. ...)" for a one-block file
+        (["arch", "--load", "point", "--block", "left-foundation"], ["--block left-foundation: a support, not a"]),
         (["arch", "--direction", "up"], ["--direction up"]),
         (["arch", "--friction", "-1"], ["--friction"]),
         # the LP called the wall unable to carry its own weight at μ = 1e8 ("no equilibrium ..."): refused
@@ -91,6 +93,12 @@ def test_built_in_arch_by_name():
 )
 def test_bad_input_is_one_line(args, fragments):
     assert_one_line_error(invoke("limit", *args), *fragments)
+
+
+def test_an_unknown_block_of_a_one_block_file_is_counted_in_the_singular(tmp_path):
+    path = tmp_path / "one.toml"
+    path.write_text(dump_scenario(column(1, 0.4, 0.8, 0.9)))
+    assert_one_line_error(invoke("limit", path, "--load", "point", "--block", "zzz"), "no such block (1 block, e.g.")
 
 
 def test_infeasible_structure_is_one_line_exit_2(tmp_path):

@@ -95,9 +95,12 @@ def load_vectors(model: Model, load: LiveLoad) -> tuple[np.ndarray, np.ndarray, 
     direction = np.asarray(DIRECTIONS[load.direction])
     if load.kind == "point":
         names = list(model.block_name)
+        if load.block in model.support_name:  # said "no such block (1 blocks, e.g. block-0)"
+            raise InputError(f"--block {load.block}: a support, not a block (supports are rigid and fixed here)")
         if load.block not in names:
             close = difflib.get_close_matches(str(load.block), names, n=3)
-            hint = f" (did you mean {', '.join(close)}?)" if close else f" ({n} blocks, e.g. {', '.join(names[:3])})"
+            count = f"{n} block{'s' if n != 1 else ''}"
+            hint = f" (did you mean {', '.join(close)}?)" if close else f" ({count}, e.g. {', '.join(names[:3])})"
             raise InputError(f"--block {load.block}: no such block{hint}")
         i = names.index(load.block)
         live[i, :2] = mass[i] * g * direction
