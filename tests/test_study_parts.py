@@ -183,3 +183,28 @@ def test_lognormal_fit_of_separated_runs_says_the_dispersion_is_not_resolved():
     fit = fit_lognormal([1.0, 1.5, 2.0, 3.0, 4.0], [False, False, False, True, True], "pgv")
     assert fit.separated == (2.0, 3.0) and 2.0 <= fit.median <= 3.0 and fit.dispersion < 0.05
     assert fit_lognormal([1.0, 2.0, 3.0, 4.0], [False, True, False, True]).separated is None
+
+
+def test_closing_the_cluster_silences_its_teardown_logs(capfd):
+    # Stopped with 20 000 tasks queued, the LocalCluster's scheduler (in this process) printed 21-47
+    # "CRITICAL - Closed comm ... while trying to write" tracebacks under the one-line "interrupted".
+    import logging
+    import sys
+
+    from masonrycli.study.study import _close
+
+    handler = logging.StreamHandler(sys.stderr)  # as distributed's own handler
+    scheduler = logging.getLogger("distributed.scheduler")
+    scheduler.addHandler(handler)
+
+    class Closing:
+        def close(self):
+            scheduler.critical("Closed comm <BatchedSend: closed> while trying to write")
+
+    try:
+        _close(Closing(), Closing())
+        assert capfd.readouterr().err == ""
+        scheduler.critical("after")  # logging works again once the cluster is closed
+        assert "after" in capfd.readouterr().err
+    finally:
+        scheduler.removeHandler(handler)

@@ -7,6 +7,7 @@ written: :mod:`masonrycli.study.files`.
 
 from __future__ import annotations
 
+import logging
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -158,7 +159,14 @@ def run_study(base: StudyBase, request: StudyRequest, console: Console) -> Study
 
 
 def _close(client, cluster) -> None:
-    if client is not None:
-        client.close()
-    if cluster is not None:
-        cluster.close()
+    # Stopped with thousands of tasks still queued, the LocalCluster's scheduler (in this process) logged
+    # "CRITICAL - Closed comm ... while trying to write" and a traceback, up to dozens of times, for its
+    # messages to the client being closed: teardown noise under the one-line "interrupted" message.
+    logging.disable(logging.CRITICAL)
+    try:
+        if client is not None:
+            client.close()
+        if cluster is not None:
+            cluster.close()
+    finally:
+        logging.disable(logging.NOTSET)
