@@ -155,6 +155,9 @@ def test_grid_sweep_state_map_and_histories(block, tmp_path):
     [
         (["-p", "bogus=1"], "--param bogus: unknown parameter"),
         (["-p", "amp=1:2"], "--param amp=1:2: a range is LO:HI:N"),
+        # a repeated value ran twice, into two rows of one key
+        (["-p", "amp=0.1,0.2,0.1"], "--param amp: the value 0.1 is given twice (each point runs once)"),
+        (["-p", "amp=0.1:0.1:3"], "--param amp: the value 0.1 is given twice"),
         ([], "nothing to sweep"),
         (["-p", "amp=0.1,0.2", "--find", "freq"], "--find freq: give its range too"),
         (["-p", "amp=0.1,0.2", "--outcome", "fall"], "--outcome fall: expected collapse, sliding"),
@@ -197,6 +200,17 @@ def test_a_scheduler_that_cannot_be_reached_leaves_no_file(block, tmp_path, monk
 
 def _files(folder: Path) -> dict[str, bytes]:
     return {p.name: p.read_bytes() for p in folder.rglob("*") if p.is_file()}
+
+
+@pytest.mark.skipif(not Path("/proc/self").is_dir(), reason="needs Linux's /proc, where no folder can be made")
+def test_a_histories_folder_that_cannot_be_made_leaves_no_file(block, tmp_path):
+    # it said "error: /proc/x: No such file or directory" (no option) after writing a header-only table,
+    # which the corrected command then refused as existing
+    out, histories = tmp_path / "s.csv", Path("/proc/masonry-histories")
+    result = invoke("sweep", block, "-p", "amp=0.1", "--workers", 0, "-o", out, "--histories", histories)
+    said = " ".join(result.output.split())
+    assert result.exit_code == 2 and said.startswith(f"error: --histories {histories}: cannot make the folder ("), said
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["block.toml"]
 
 
 def test_existing_outputs_are_refused_without_force_and_replaced_with_it(block, tmp_path):

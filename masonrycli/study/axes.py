@@ -112,6 +112,10 @@ def check_axes(axes: list[Axis]) -> None:
     dup = {n for n in names if names.count(n) > 1}
     if dup:
         raise InputError(f"--param {sorted(dup)[0]}: given twice")
+    for axis in axes:  # each point runs once: a repeated value ran twice into two rows of one key
+        seen = [v for i, v in enumerate(axis.values) if v in axis.values[:i]]
+        if seen:
+            raise InputError(f"--param {axis.name}: the value {seen[0]} is given twice (each point runs once)")
     runs = math.prod(len(a.values) for a in axes)
     if runs > MAX_RUNS:
         sizes = " × ".join(f"{len(a.values)} {a.name}" for a in axes)

@@ -106,6 +106,11 @@ def run_study(base: StudyBase, request: StudyRequest, console: Console) -> Study
     # written (it left a header-only table, which the corrected command then refused as existing).
     client, cluster = open_cluster(request.scheduler, request.workers) if request.workers != 0 else (None, None)
     try:
+        if request.histories is not None:  # before the journal: a folder that cannot be made is bad input
+            try:  # (it left a header-only table and "error: /proc/x: No such file or directory")
+                request.histories.mkdir(parents=True, exist_ok=True)
+            except OSError as exc:
+                raise InputError(f"--histories {request.histories}: cannot make the folder ({exc.strerror})") from None
         journal = store.Journal(request.out)
     except BaseException:
         _close(client, cluster)
@@ -139,7 +144,6 @@ def run_study(base: StudyBase, request: StudyRequest, console: Console) -> Study
     try:
         histories = None
         if request.histories is not None:
-            request.histories.mkdir(parents=True, exist_ok=True)
             histories = str(request.histories.resolve())
         task_args = (request.stop_at_collapse, histories, request.force)
         with progress:
