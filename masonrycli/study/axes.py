@@ -113,9 +113,11 @@ def check_axes(axes: list[Axis]) -> None:
     if dup:
         raise InputError(f"--param {sorted(dup)[0]}: given twice")
     for axis in axes:  # each point runs once: a repeated value ran twice into two rows of one key
-        seen = [v for i, v in enumerate(axis.values) if v in axis.values[:i]]
-        if seen:
-            raise InputError(f"--param {axis.name}: the value {seen[0]} is given twice (each point runs once)")
+        seen = set()
+        for v in axis.values:  # a set: an axis may hold a million values
+            if v in seen:
+                raise InputError(f"--param {axis.name}: the value {v} is given twice (each point runs once)")
+            seen.add(v)
     runs = math.prod(len(a.values) for a in axes)
     if runs > MAX_RUNS:
         sizes = " × ".join(f"{len(a.values)} {a.name}" for a in axes)
