@@ -123,6 +123,51 @@ def check_fragility_reads_as_a_plot(rrd: Path, rows: list[dict]) -> None:
     assert ticks[0] == 0 and p[0] == 0.0 and p[-1] > 0.99 and np.all(np.diff(p) >= 0)
 
 
+def blueprint_layout(rrd: Path) -> dict:
+    """The last value of every blueprint property of the recording (``"ScalarAxis:range"`` ...)."""
+    import rerun as rr
+
+    reader = rr.chunk.RrdReader(str(rrd))
+    layout = {}
+    for chunk in reader.stream(store=reader.blueprints()[0]):
+        batch = chunk.to_record_batch()
+        layout |= {n: batch.column(n).to_pylist()[-1][0] for n in batch.schema.names if ":" in n}
+    return layout
+
+
+def test_find_threshold_curve_reads_as_a_plot(block, tmp_path):
+    """The threshold curve (amp_threshold in m/s against friction 0.1-0.2) opens as a plot with its own
+    axes: in a 2-D view with one scale for both it read as a flat line; each point at its own friction
+    on the time line in thousandths of it, the y axis from 0 to above the largest threshold."""
+    import rerun as rr
+
+    from masonrycli.recording.readback import blueprint_views
+
+    out, rrd = tmp_path / "find.csv", tmp_path / "find.rrd"
+    args = ["-p", "amp=0.02:0.4:3", "--find", "amp", "-p", "friction=0.1,0.2", "--outcome", "sliding"]
+    result = invoke("sweep", block, *args, "--duration", 0.3, "--workers", 0, "--out", out, "--recording", rrd)
+    assert result.exit_code == 0, result.output
+    rows = read_rows(out)
+    found = {r["friction"]: r["amp_threshold"] for r in rows}
+    assert len(found) == 2 and all(np.isfinite(v) for v in found.values())
+    assert blueprint_views(rrd)["thresholds"]["kind"] == "TimeSeries"
+    layout = blueprint_layout(rrd)
+    timeline = "friction (/1000)"  # a sequence time line is an integer: thousandths of the friction
+    assert layout["TimePanelBlueprint:timeline"] == timeline
+    low, high = layout["ScalarAxis:range"]
+    assert low == 0.0 and max(found.values()) < high < 2 * max(found.values())
+    view = layout["TimeAxis:view_range"]
+    assert view["start"] <= 100 and view["end"] >= 200
+    series = {}
+    for chunk in rr.chunk.RrdReader(str(rrd)).stream():
+        if not chunk.is_static and chunk.entity_path.startswith("/study/thresholds/"):
+            batch = chunk.to_record_batch()
+            values = [v[0] for v in batch.column("Scalars:scalars").to_pylist()]
+            series[chunk.entity_path] = dict(zip(batch.column(timeline).to_pylist(), values))
+    expected = {round(1000 * f): t for f, t in found.items()}
+    assert series == {"/study/thresholds/line": expected, "/study/thresholds/points": expected}
+
+
 def test_grid_sweep_state_map_and_histories(block, tmp_path):
     out = tmp_path / "grid.parquet"
     args = ["-p", "amp=0.05,0.6", "-p", "friction=0.3,0.8", "--duration", 0.3, "--workers", 0, "-o", out]

@@ -1,9 +1,9 @@
 """Rerun recording of a study (``masonry sweep --recording study.rrd``).
 
-The state map as coloured points over the two swept parameters (``study/state_map``) or the threshold
-curve (``study/thresholds``), the PNG the command also wrote (``study/plot``), and the rows as a
-markdown table (``study/rows``), all static; the fragility curve of a records study (``study/fragility``)
-is a plot on its own time line (below). Axes are in the parameters' own units, so a 2-D view shows them
+The state map as coloured points over the two swept parameters (``study/state_map``), the PNG the
+command also wrote (``study/plot``), and the rows as a markdown table (``study/rows``), all static; the
+fragility curve of a records study (``study/fragility``) and the threshold curve of ``--find``
+(``study/thresholds``) are plots on their own time lines (below). Axes are in the parameters' own units, so a 2-D view shows them
 as they are; the PNG is the annotated picture.
 
 Rerun's 2-D views draw y downward: each picture entity gets a static y-flip transform and its view looks
@@ -18,6 +18,11 @@ axes. It is drawn in a time-series view instead, whose axes are scaled apart and
 a sequence time line in thousandths of the intensity's unit (``pga (mm/s²)``: a sequence is an integer,
 so 1 mm/s² is its resolution), y the probability fixed at [−0.05, 1.05]; the runs are points at 0 or 1
 coloured by state, the fraction collapsed at each scale and the fitted lognormal as in the PNG.
+
+The threshold curve read flat the same way (``amp_threshold`` 0.08–0.23 m/s against ``blocks`` 12–48
+or ``friction`` 0.1–0.3): it is plotted the same way, against the other swept parameter's own time line
+(``blocks``, whole numbers, in its unit; ``friction (/1000)``, ``freq (mHz)`` in thousandths), y from 0
+to 1.1 × the largest threshold.
 """
 
 from __future__ import annotations
@@ -33,6 +38,7 @@ import rerun.blueprint as rrb
 from masonrycli.intensity import UNITS
 from masonrycli.recording.document import viewer_safe_text
 from masonrycli.recording.recorder import APPLICATION_ID
+from masonrycli.study.plots import UNITS as PARAM_UNITS
 
 STATE_RGBA = {
     "intact": (46, 158, 91, 255),
@@ -53,34 +59,51 @@ def record_study(path: Path, name: str, rows: list[dict], request, fit, im: str,
         views.insert(0, rrb.Spatial2DView(origin="study/plot", name="plot"))
     names = [a.name for a in request.axes if a.name != request.find and len(a.values) > 1]
     panels = []
-    if request.find or not (fit is not None or "record" in [a.name for a in request.axes]):
-        if request.find:
-            _log_thresholds(rec, rows, request.find, names)
-            entity, title = "study/thresholds", "thresholds"
-        else:
-            _log_state_map(rec, rows, names)
-            entity, title = "study/state_map", "state map"
-        rec.log(entity, rr.Transform3D(scale=[1.0, -1.0, 1.0]), static=True)  # y up (module doc)
-        views.insert(0, rrb.Spatial2DView(origin="study", contents=[f"+ /{entity}/**"], name=title))
+    if request.find:
+        timeline, start, end, y_range = _log_thresholds(rec, rows, request.find, names)
+        legend = rrb.PlotLegend(corner="RightBottom")  # below a rising or flat curve (y from 0)
+        view, panel = _plot_view("study/thresholds", "thresholds", timeline, (start, end), y_range, legend)
+        views.insert(0, view)
+        panels.append(panel)
+    elif fit is None and "record" not in [a.name for a in request.axes]:
+        _log_state_map(rec, rows, names)
+        rec.log("study/state_map", rr.Transform3D(scale=[1.0, -1.0, 1.0]), static=True)  # y up (module doc)
+        views.insert(0, rrb.Spatial2DView(origin="study", contents=["+ /study/state_map/**"], name="state map"))
     else:
         timeline, end = _log_fragility(rec, rows, fit, im)
-        # the whole curve from IM = 0 (a time-series view otherwise shows a window around the cursor)
-        whole = rr.TimeRange(start=rrb.TimeRangeBoundary.absolute(seq=0), end=rrb.TimeRangeBoundary.absolute(seq=end))
-        axis_x = rrb.TimeAxis(view_range=whole)
-        axis_y = rrb.ScalarAxis(range=(-0.05, 1.05), zoom_lock=True)
         legend = rrb.PlotLegend(corner="RightBottom")  # high IM, P = 0: where runs are fewest
-        views.insert(
-            0,
-            rrb.TimeSeriesView(
-                origin="study/fragility", name="fragility", axis_x=axis_x, axis_y=axis_y, plot_legend=legend
-            ),
-        )
-        # a time-series view plots against the time panel's time line: open on the intensity's
-        panels.append(rrb.TimePanel(state="collapsed", timeline=timeline, play_state="paused"))
+        view, panel = _plot_view("study/fragility", "fragility", timeline, (0, end), (-0.05, 1.05), legend)
+        views.insert(0, view)
+        panels.append(panel)
     rec.log("study/rows", rr.TextDocument(_markdown(name, rows), media_type=rr.MediaType.MARKDOWN), static=True)
     rec.save(path, default_blueprint=rrb.Blueprint(rrb.Grid(*views), *panels))
     rec.disconnect()
     return path
+
+
+def _plot_view(origin: str, name: str, timeline: str, x_range, y_range, legend):
+    """A time-series view of ``origin`` plotted against the sequence time line ``timeline`` (module doc),
+    x shown over ``x_range`` (ticks), y fixed at ``y_range``, and the time panel that opens on that time
+    line (a time-series view plots against the time panel's time line)."""
+    # the whole curve (a time-series view otherwise shows a window around the cursor)
+    start, end = (rrb.TimeRangeBoundary.absolute(seq=int(t)) for t in x_range)
+    axis_x = rrb.TimeAxis(view_range=rr.TimeRange(start=start, end=end))
+    axis_y = rrb.ScalarAxis(range=tuple(float(v) for v in y_range), zoom_lock=True)
+    view = rrb.TimeSeriesView(origin=origin, name=name, axis_x=axis_x, axis_y=axis_y, plot_legend=legend)
+    return view, rrb.TimePanel(state="collapsed", timeline=timeline, play_state="paused")
+
+
+def _series(rec, entity: str, timeline: str, per_unit: float, at, values, style) -> None:
+    """``values`` against ``at`` (sorted; non-finite pairs dropped) as scalars on the sequence time line
+    ``timeline`` whose tick is ``1 / per_unit`` of ``at``'s unit; ``style`` names and colours the series."""
+    at, values = np.asarray(at, dtype=np.float64), np.asarray(values, dtype=np.float64)
+    keep = np.isfinite(at) & np.isfinite(values)
+    rec.log(entity, style, static=True)
+    if keep.any():
+        order = np.argsort(at[keep], kind="stable")
+        ticks = np.rint(at[keep][order] * per_unit).astype(np.int64)
+        column = rr.Scalars.columns(scalars=values[keep][order])
+        rec.send_columns(entity, indexes=[rr.TimeColumn(timeline, sequence=ticks)], columns=column)
 
 
 def _number(value) -> float:
@@ -121,13 +144,7 @@ def _log_fragility(rec, rows: list[dict], fit, im: str) -> tuple[str, int]:
     collapsed = np.array([r.get("state") == "collapsed" for r in good], dtype=bool)
 
     def series(entity: str, at, values, style) -> None:
-        keep = np.isfinite(at) & np.isfinite(values)
-        rec.log(entity, style, static=True)
-        if keep.any():
-            order = np.argsort(at[keep], kind="stable")
-            ticks = np.rint(np.asarray(at)[keep][order] * 1000.0).astype(np.int64)
-            column = rr.Scalars.columns(scalars=np.asarray(values, dtype=np.float64)[keep][order])
-            rec.send_columns(entity, indexes=[rr.TimeColumn(timeline, sequence=ticks)], columns=column)
+        _series(rec, entity, timeline, 1000.0, at, values, style)
 
     for state in ("intact", "damaged", "collapsed"):
         sel = np.array([r.get("state") == state for r in good], dtype=bool)
@@ -153,12 +170,47 @@ def _log_fragility(rec, rows: list[dict], fit, im: str) -> tuple[str, int]:
     return timeline, int(np.rint(1200.0 * top)) + 1
 
 
-def _log_thresholds(rec, rows: list[dict], find: str, names: list[str]) -> None:
-    key = f"{find}_threshold"
+def _log_thresholds(rec, rows: list[dict], find: str, names: list[str]) -> tuple[str, int, int, tuple]:
+    """``<find>_threshold`` against the first other swept parameter (the point's index without one) as
+    scalars on that parameter's time line (module doc): in its own unit when every value is a whole
+    number (``blocks``), else in thousandths of it (``friction (/1000)``, ``freq (mHz)``); a record name
+    is drawn by its index. Returns the time line, the x range in its ticks and the y range."""
     x = names[0] if names else None
-    pts = np.array([[_number(r[x]) if x else float(i), _number(r[key])] for i, r in enumerate(rows)])
-    pts = pts[np.isfinite(pts).all(axis=1)] if len(pts) else pts.reshape(0, 2)
-    rec.log("study/thresholds", rr.LineStrips2D([pts]) if len(pts) > 1 else rr.Points2D(pts), static=True)
+    values = [r.get(x) for r in rows] if x else list(range(len(rows)))
+    if any(isinstance(v, str) for v in values):
+        order = sorted(set(values), key=str)
+        at, timeline, per_unit = np.array([order.index(v) for v in values], dtype=np.float64), f"{x} (index)", 1.0
+    else:
+        at = np.array([_number(v) for v in values], dtype=np.float64)
+        unit = PARAM_UNITS.get(x.rpartition(".")[2], "") if x else ""
+        whole = bool(np.all(at[np.isfinite(at)] == np.rint(at[np.isfinite(at)])))
+        per_unit = 1.0 if whole else 1000.0
+        name = x or "point"
+        timeline = (
+            (f"{name} ({unit})" if unit else name) if whole else (f"{name} (m{unit})" if unit else f"{name} (/1000)")
+        )
+    threshold = np.array([_number(r.get(f"{find}_threshold")) for r in rows], dtype=np.float64)
+    unit = PARAM_UNITS.get(find.rpartition(".")[2], "")
+    label = viewer_safe_text(f"{find}_threshold ({unit})" if unit else f"{find}_threshold")
+    _series(
+        rec,
+        "study/thresholds/line",
+        timeline,
+        per_unit,
+        at,
+        threshold,
+        rr.SeriesLines(colors=[(208, 48, 48)], names=[label], widths=[2.0]),
+    )
+    style = rr.SeriesPoints(colors=[(208, 48, 48)], names=[label + ": points"], marker_sizes=[4.0])
+    _series(rec, "study/thresholds/points", timeline, per_unit, at, threshold, style)
+    ok = np.isfinite(at) & np.isfinite(threshold)
+    ticks = np.rint(at[ok] * per_unit) if ok.any() else np.zeros(1)
+    span = max(float(ticks.max() - ticks.min()), 1.0)
+    x_range = (int(min(0.0, ticks.min() - 0.05 * span)), int(np.ceil(ticks.max() + 0.05 * span)))
+    top = float(threshold[ok].max()) if ok.any() else 1.0
+    low = float(threshold[ok].min()) if ok.any() else 0.0
+    y_range = (min(0.0, 1.1 * low), 1.1 * top if top > 0 else 1.0)
+    return timeline, x_range[0], x_range[1], y_range
 
 
 def _markdown(name: str, rows: list[dict]) -> str:
