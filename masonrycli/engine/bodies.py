@@ -50,6 +50,15 @@ from masonrycli.engine.nlgs import (
     _relative_velocity,
 )
 
+C_SWEEP, C_J, C_LAST, C_BEST, C_BEST_AT, C_BETA, C_RESIDUAL, C_REASON, C_WINDOW = range(9)
+"""Slots of a stage's carry (float array of CARRY_SIZE): sweeps done, the momentum counter j, the last
+residual, the lowest and its sweep, β of the next sweep, the residual, why it stopped (STOP_*), and
+_cycling_windows' [log_sum, n, run] from C_WINDOW on. All a later call needs to go on as one long call."""
+CARRY_SIZE = C_WINDOW + 3
+STOP_BUDGET, STOP_TOLERANCE, STOP_STALL, STOP_CYCLING = range(4)
+"""carry[C_REASON]: the budget ran out (or max_units ≤ 0), the tolerance was met, the stall window, the
+hand-over rule (cycling windows)."""
+
 
 @njit
 def _body_lists(contact_body, pack, count, bodies):
@@ -100,9 +109,28 @@ def _cycling_windows(window_state, residual, best, window, level):
 
 @njit
 def _body_order_sweeps(
-    contact_body, pack, count, mu, tolerance, max_units, v, r, status, stall, window, level, cycling, history
+    contact_body,
+    pack,
+    count,
+    mu,
+    tolerance,
+    max_units,
+    v,
+    r,
+    status,
+    stall,
+    window,
+    level,
+    cycling,
+    history,
+    carry,
+    r_prev,
+    v_prev,
 ):
     # v enters as v_free, r as the start; both leave consistent (v = v_free + M⁻¹ H r).
+    # Or it goes on where an earlier call stopped (carry[C_SWEEP] > 0: stalled.py re-enters the stage after a
+    # hand-over): v, r, r_prev, v_prev and carry as that call left them, v not rebuilt (rebuilding it from
+    # v_free would round differently, and the resumed sweeps would not be the ones one long call makes).
     #   v ← v_free + M⁻¹ H r ; order = for each body with mass, its contacts (CSR lists) ; β = 0
     #   repeat (one sweep):
     #       r ← r + β (r − r_prev), v ← v + β (v − v_prev)                    (every contact and body)
@@ -119,26 +147,34 @@ def _body_order_sweeps(
     # Returns (sweep units, rounded up; residual).
     # The visit is nlgs's written out again, as in momentum.py and faces.py: a shared visit function cost
     # 47–57 ns per visit against 8.7 inline (faces.py's measurement).
-    for c in range(count):
-        _push(v, contact_body[c, 0], contact_body[c, 1], pack, c, r[c, 0], r[c, 1])
     if count == 0:
         return 0, 0.0
+    sweep = int(carry[C_SWEEP])
+    if sweep == 0:
+        for c in range(count):
+            _push(v, contact_body[c, 0], contact_body[c, 1], pack, c, r[c, 0], r[c, 1])
+        r_prev[:count] = r[:count]
+        v_prev[:] = v
+        carry[C_J] = 1.0
+        carry[C_LAST] = np.inf
+        carry[C_BEST] = np.inf
+        carry[C_BEST_AT] = 0.0
+        carry[C_BETA] = 0.0
+        carry[C_WINDOW : C_WINDOW + 3] = 0.0
     start, members = _body_lists(contact_body, pack, count, v.shape[0])
     visits_per_sweep = members.shape[0]
     seen = np.full(count, -1, dtype=np.int64)
-    r_prev = r[:count].copy()
-    v_prev = v.copy()
     v_flat = v.reshape(v.size)
     v_prev_flat = v_prev.reshape(v.size)
-    beta = 0.0
-    j = 1
-    last = np.inf
-    best = np.inf
-    best_at = 0
-    window_state = np.zeros(3)
-    residual = np.inf  # no sweep done (max_units ≤ 0): nothing is known
+    beta = carry[C_BETA]
+    j = int(carry[C_J])
+    last = carry[C_LAST]
+    best = carry[C_BEST]
+    best_at = int(carry[C_BEST_AT])
+    window_state = carry[C_WINDOW : C_WINDOW + 3]  # a view: _cycling_windows updates carry
+    residual = np.inf if sweep == 0 else carry[C_RESIDUAL]  # no sweep done (max_units ≤ 0): nothing is known
+    reason = STOP_BUDGET
     visits = 0
-    sweep = 0
     while visits < max_units * count:
         for i in range(v_flat.shape[0]):
             x = v_flat[i]
@@ -182,20 +218,32 @@ def _body_order_sweeps(
         residual = np.sqrt(sum_e2 / count)
         if sweep <= history.shape[0]:
             history[sweep - 1] = residual
-        if residual <= tolerance:
-            break
-        if residual < best:
-            best = residual
-            best_at = sweep
-        elif sweep - best_at >= stall:
-            break
-        if cycling > 0 and _cycling_windows(window_state, residual, best, window, level) >= cycling:
-            break
+        # the next sweep's extrapolation, set before the stopping tests so that carry holds it at any stop
         if residual > momentum.RESTART_GROWTH * last:
             j = 1
         last = residual
         beta = (j - 1.0) / (j + 2.0)
         j += 1
+        if residual <= tolerance:
+            reason = STOP_TOLERANCE
+            break
+        if residual < best:
+            best = residual
+            best_at = sweep
+        elif sweep - best_at >= stall:
+            reason = STOP_STALL
+            break
+        if cycling > 0 and _cycling_windows(window_state, residual, best, window, level) >= cycling:
+            reason = STOP_CYCLING
+            break
+    carry[C_SWEEP] = sweep
+    carry[C_J] = j
+    carry[C_LAST] = last
+    carry[C_BEST] = best
+    carry[C_BEST_AT] = best_at
+    carry[C_BETA] = beta
+    carry[C_RESIDUAL] = residual
+    carry[C_REASON] = reason
     return (visits + count - 1) // count, residual
 
 
@@ -217,14 +265,52 @@ def body_order_sweeps(
     level=np.inf,
     cycling=0,
     history=_NO_HISTORY,
+    stage=None,
 ) -> tuple[int, float]:
     """Momentum sweeps in body order (module doc) from impulses ``r`` (C, 2), in place; ``v`` (B, 3) enters
     as the free velocities and leaves as v_free + M⁻¹ H r; ``status`` (C,) out. Stops at ``tolerance``
     (m/s), after ``max_units`` sweep units (the sweep that crosses it ends), after ``stall`` sweeps
     without a new lowest residual, or after ``cycling`` windows of ``window`` sweeps in a row whose level
     (geometric mean of their residuals) is above ``level`` × the lowest residual so far (0: never).
-    ``history`` (float array, optional): the residual of each sweep, as many as it holds. Returns (sweep
-    units done, residual m/s)."""
+    ``history`` (float array, optional): the residual of each sweep, as many as it holds. ``stage``
+    (optional, from new_stage): the run's state; a call with the ``stage``, ``v``, ``r`` and ``status``
+    an earlier call left goes on from where it stopped, as one long call would (its stall window too;
+    ``stage.carry[C_REASON]`` says why a call stopped). Returns (sweep units done, residual m/s)."""
+    if stage is None:
+        stage = new_stage(count, v.shape[0])
     return _body_order_sweeps(
-        contact_body, pack, count, mu, tolerance, max_units, v, r, status, stall, window, level, cycling, history
+        contact_body,
+        pack,
+        count,
+        mu,
+        tolerance,
+        max_units,
+        v,
+        r,
+        status,
+        stall,
+        window,
+        level,
+        cycling,
+        history,
+        stage.carry,
+        stage.r_prev,
+        stage.v_prev,
     )
+
+
+class Stage:
+    """A run of the stage that can go on: its carry (C_* slots) and the impulses and velocities of the sweep
+    before the last (the extrapolation's). Its iterate (v, r, status) is the caller's."""
+
+    __slots__ = ("carry", "r_prev", "v_prev")
+
+    def __init__(self, count: int, bodies: int):
+        self.carry = np.zeros(CARRY_SIZE)
+        self.r_prev = np.zeros((count, 2))
+        self.v_prev = np.zeros((bodies, 3))
+
+
+def new_stage(count: int, bodies: int) -> Stage:
+    """A stage not yet run (carry[C_SWEEP] = 0: the first call builds v from v_free)."""
+    return Stage(count, bodies)

@@ -121,6 +121,11 @@ BODIES_CYCLING = 0
 """Cycling windows in a row after which the stage hands over to the round-robin (0: never, the default: 4
 was measured and not shipped, module doc "Hand-over")."""
 
+BODIES_REENTER = 2
+"""After a hand-over, the round-robin's resumes (in its order, newton's ahead counted) after which the stage
+goes on from where it stopped, once, for the rest of its BODIES_UNITS (module doc, "Re-entry"); it does
+also if the round-robin ends first. 0: never."""
+
 FIRST_BUDGET = 2000
 """Sweep units each method gets in the first round; doubled every round (module doc)."""
 
@@ -165,9 +170,12 @@ def continue_stalled(
     Returns (iterations including the earlier ones, residual)."""
     # First momentum in body order from the warm start, alone (bodies module doc: it converges the hard
     # steps in a fraction of the round-robin's units); the round-robin below only if it does not.
+    stage = None  # the stage's iterate, kept with its run when the hand-over rule stops it (it may re-enter)
+    run, stage_left = None, 0
     if BODIES_UNITS > 0:
         v_b, r_b, status_b = v_free.copy(), r_warm[:count].copy(), status[:count].copy()
         units = min(BODIES_UNITS, cap - iterations)
+        run = bodies.new_stage(count, v.shape[0])
         done, residual_b = bodies.body_order_sweeps(
             contact_body,
             pack,
@@ -182,6 +190,7 @@ def continue_stalled(
             BODIES_WINDOW,
             BODIES_LEVEL,
             BODIES_CYCLING,
+            stage=run,
         )
         iterations += done
         if residual_b <= tolerance or (iterations >= cap and residual_b < residual):
@@ -189,6 +198,8 @@ def continue_stalled(
             return iterations, residual_b
         if iterations >= cap:
             return iterations, residual
+        if BODIES_REENTER > 0 and run.carry[bodies.C_REASON] == bodies.STOP_CYCLING:
+            stage, stage_left = _State(v_b, r_b, status_b, residual_b), BODIES_UNITS - done
     states = {
         "newton": _State(None, r_warm[:count].copy(), status[:count].copy(), np.inf),
         "turning": _State(None, r_warm[:count].copy(), status[:count].copy(), np.inf),
@@ -200,6 +211,7 @@ def continue_stalled(
     budget = FIRST_BUDGET
     round_ = 0
     newton_resumes = 0
+    resumes = 0  # the round-robin's, for the stage's re-entry
     while iterations < cap and active:
         # newton makes NEWTON_AHEAD more resumes right after its first, in round 0 (module doc)
         for name in [m for m in active for _ in range(1 + NEWTON_AHEAD if m == "newton" and round_ == 0 else 1)]:
@@ -220,6 +232,14 @@ def continue_stalled(
             if state.residual <= tolerance:
                 _adopt(state, v, r, status, count)
                 return iterations, state.residual
+            resumes += 1
+            if stage is not None and resumes == BODIES_REENTER:
+                iterations += _reenter(
+                    stage, run, min(stage_left, cap - iterations), contact_body, pack, count, mu, tolerance
+                )
+                if stage.residual <= tolerance:
+                    _adopt(stage, v, r, status, count)
+                    return iterations, stage.residual
             if name == "newton":  # its sweeps' stall or residual says little of its Newton iterate, which
                 pass  # goes on at the next resume: it leaves after NEWTON_LAST_ROUND only
             elif done < units:  # stalled inside its budget: its own stall window says it will not get there
@@ -229,9 +249,24 @@ def continue_stalled(
             state.low = min(state.low, state.residual)
         budget *= 2
         round_ += 1
-    best = min((s for s in states.values() if s.v is not None), key=lambda s: s.residual)
+    if stage is not None and resumes < BODIES_REENTER:  # the round-robin ended first: the stage's turn
+        iterations += _reenter(stage, run, min(stage_left, cap - iterations), contact_body, pack, count, mu, tolerance)
+        if stage.residual <= tolerance:
+            _adopt(stage, v, r, status, count)
+            return iterations, stage.residual
+    candidates = [s for s in states.values() if s.v is not None] + ([stage] if stage is not None else [])
+    best = min(candidates, key=lambda s: s.residual)
     _adopt(best, v, r, status, count)
     return iterations, best.residual
+
+
+def _reenter(stage, run, units, contact_body, pack, count, mu, tolerance) -> int:
+    # The stage goes on from where its hand-over stopped it, as one long run would (bodies.Stage), for the
+    # units it had left, without the hand-over rule (it already handed over) and with its stall window.
+    done, stage.residual = bodies.body_order_sweeps(
+        contact_body, pack, count, mu, tolerance, units, stage.v, stage.r, stage.status, BODIES_STALL, stage=run
+    )
+    return done
 
 
 def _resume(name, state, contact_body, pack, count, mu, tolerance, units, v_free, limit) -> int:
