@@ -188,7 +188,7 @@ def test_a_body_order_solve_that_misses_hands_over_with_its_units_counted(monkey
         return units
 
     monkeypatch.setattr(stalled, "BODIES_UNITS", 50)
-    monkeypatch.setattr(bodies, "body_order_sweeps", lambda *args: (37, 1e-3))
+    monkeypatch.setattr(bodies, "body_order_sweeps", lambda *args, **kw: (37, 1e-3))
     monkeypatch.setattr(stalled, "_resume", scripted)
     monkeypatch.setattr(stalled, "METHODS", ("turning",))
     monkeypatch.setattr(stalled, "FIRST_BUDGET", 10)
@@ -205,7 +205,7 @@ def test_the_body_order_stage_gets_the_hand_over_rule(monkeypatch):
     monkeypatch.setattr(stalled, "BODIES_WINDOW", 3)
     monkeypatch.setattr(stalled, "BODIES_LEVEL", 2.5)
     monkeypatch.setattr(stalled, "BODIES_CYCLING", 2)
-    monkeypatch.setattr(bodies, "body_order_sweeps", lambda *args: seen.append(args[5:]) or (37, 1e-7))
+    monkeypatch.setattr(bodies, "body_order_sweeps", lambda *args, **kw: seen.append(args[5:]) or (37, 1e-7))
     count = 2
     v, r, status = np.zeros((2, 3)), np.zeros((count, 2)), np.zeros(count, dtype=np.int8)
     its, res = stalled.continue_stalled(None, None, count, 0.5, 1e-6, 10**6, v, r, status, np.zeros((2, 3)), r, 7, 1e-2)
