@@ -144,3 +144,37 @@ def test_the_stage_hands_over_after_that_many_cycling_windows_in_a_row():
     v, r, status = v_free.copy(), r0.copy(), np.zeros(count, dtype=np.int8)
     _, res_off = bodies.body_order_sweeps(body, pack, count, mu, 1e-300, 300, v, r, status, 10**9, window, 1.0, 0)
     assert res_off == history[-1] != res  # cycling = 0: never
+
+
+def test_a_stage_handed_over_goes_on_as_one_long_run():
+    # stalled.py re-enters the stage after a hand-over (its module doc, "Re-entry"): the second call, with the
+    # run the first left, must sweep as one uninterrupted call would — same residuals, same impulses and
+    # velocities to the bit (the extrapolation, its restart counter and the stall window carried, v not
+    # rebuilt from v_free).
+    body, pack, h, m_inv, v_free, r0, mu, bias = _problem(5)
+    count = body.shape[0]
+    probe = np.full(400, np.nan)
+    v, r, status = v_free.copy(), r0.copy(), np.zeros(count, dtype=np.int8)
+    bodies.body_order_sweeps(body, pack, count, mu, 1e-300, 300, v, r, status, 10**9, history=probe)
+    tolerance = probe[~np.isnan(probe)][-1]  # the long run meets it at a sweep the split run must meet too
+    long_history = np.full(400, np.nan)
+    v_long, r_long, status_long = v_free.copy(), r0.copy(), np.zeros(count, dtype=np.int8)
+    units_long, res_long = bodies.body_order_sweeps(
+        body, pack, count, mu, tolerance, 10**6, v_long, r_long, status_long, 10**9, history=long_history
+    )
+    history = np.full(400, np.nan)
+    v, r, status = v_free.copy(), r0.copy(), np.zeros(count, dtype=np.int8)
+    run = bodies.new_stage(count, v_free.shape[0])
+    first, _ = bodies.body_order_sweeps(
+        body, pack, count, mu, tolerance, 10**6, v, r, status, 10**9, 7, 1.0, 3, history=history, stage=run
+    )
+    assert run.carry[bodies.C_REASON] == bodies.STOP_CYCLING and 0 < first < units_long
+    second, res = bodies.body_order_sweeps(
+        body, pack, count, mu, tolerance, 10**6, v, r, status, 10**9, history=history, stage=run
+    )
+    assert run.carry[bodies.C_REASON] == bodies.STOP_TOLERANCE and res == res_long
+    np.testing.assert_array_equal(history, long_history)
+    np.testing.assert_array_equal(r, r_long)
+    np.testing.assert_array_equal(v, v_long)
+    np.testing.assert_array_equal(status, status_long)
+    assert units_long <= first + second <= units_long + 1  # each call rounds its visits up to whole units

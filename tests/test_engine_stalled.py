@@ -211,3 +211,87 @@ def test_the_body_order_stage_gets_the_hand_over_rule(monkeypatch):
     its, res = stalled.continue_stalled(None, None, count, 0.5, 1e-6, 10**6, v, r, status, np.zeros((2, 3)), r, 7, 1e-2)
     assert its == 7 + 37 and res == 1e-7
     assert [s[:1] + s[4:] for s in seen] == [(50, stalled.BODIES_STALL, 3, 2.5, 2)]
+
+
+def _scripted_stage(monkeypatch, reason, converges_at_reentry):
+    # The stage's kernel stood in for: its first call stops for `reason` at 37 units; a later call (the
+    # re-entry) gets the run the first left and converges or not. Returns the list of its calls.
+    calls = []
+
+    def stage(*args, stage=None, **kw):
+        calls.append(("stage", args[5], stage))
+        if len(calls) == 1:
+            stage.carry[bodies.C_REASON] = reason
+            return 37, 1e-3
+        args[6][:] = 42.0  # v: the stage's iterate, adopted if it converges
+        return 20, 1e-7 if converges_at_reentry else 2e-3
+
+    monkeypatch.setattr(bodies, "body_order_sweeps", stage)
+    return calls
+
+
+def _robin_that_never_converges(monkeypatch, calls):
+    def scripted(name, state, contact_body, pack, count, mu, tolerance, units, v_free, limit):
+        calls.append((name, units))
+        state.v, state.residual = v_free + len(calls), 1e-3 + 1e-6 * len(calls)
+        return units
+
+    monkeypatch.setattr(stalled, "_resume", scripted)
+    monkeypatch.setattr(stalled, "METHODS", ("newton", "turning"))
+    monkeypatch.setattr(stalled, "FIRST_BUDGET", 10)
+    monkeypatch.setattr(stalled, "BODIES_UNITS", 50)
+    monkeypatch.setattr(stalled, "BODIES_CYCLING", 4)
+
+
+def _continue(cap=10**6):
+    count = 2
+    v, r, status = np.zeros((2, 3)), np.zeros((count, 2)), np.zeros(count, dtype=np.int8)
+    its, res = stalled.continue_stalled(None, None, count, 0.5, 1e-6, cap, v, r, status, np.zeros((2, 3)), r, 7, 1e-2)
+    return its, res, v
+
+
+def test_a_stage_that_handed_over_re_enters_after_newton_for_the_rest_of_its_units(monkeypatch):
+    # module doc, "Re-entry": after BODIES_REENTER = 2 round-robin resumes (newton's two, in round 0) the
+    # stage goes on from its own run for the units it had left (50 - 37), and its converged iterate is kept.
+    calls = _scripted_stage(monkeypatch, bodies.STOP_CYCLING, True)
+    _robin_that_never_converges(monkeypatch, calls)
+    monkeypatch.setattr(stalled, "BODIES_REENTER", 2)
+    its, res, v = _continue()
+    assert [c[:2] for c in calls] == [("stage", 50), ("newton", 20), ("newton", 40), ("stage", 13)]
+    assert calls[3][2] is calls[0][2]  # the same run goes on
+    assert its == 7 + 37 + 20 + 40 + 20 and res == 1e-7 and (v == 42.0).all()
+
+
+def test_a_stage_re_enters_once_and_only_after_the_hand_over_rule(monkeypatch):
+    # Not converged at its re-entry: the round-robin goes on and the stage does not come back. A stage that
+    # stopped for its stall window or budget does not re-enter at all; nor with BODIES_REENTER = 0.
+    for reason, reenter, expect in [
+        (bodies.STOP_CYCLING, 2, 1),
+        (bodies.STOP_STALL, 2, 0),
+        (bodies.STOP_BUDGET, 2, 0),
+        (bodies.STOP_CYCLING, 0, 0),
+    ]:
+        calls = _scripted_stage(monkeypatch, reason, False)
+        _robin_that_never_converges(monkeypatch, calls)
+        monkeypatch.setattr(stalled, "BODIES_REENTER", reenter)
+        _continue(cap=7 + 37 + 400)
+        assert sum(c[0] == "stage" for c in calls) == 1 + expect, (reason, reenter)
+        assert [c[0] for c in calls][-1] != "stage"  # the round-robin had the last word, to its cap
+
+
+def test_a_stage_re_enters_when_the_round_robin_ends_before_its_turn(monkeypatch):
+    # All methods dropped (newton after its two resumes, turning when a round ends no lower than the last)
+    # before the BODIES_REENTER-th resume: the stage still gets the units it had left.
+    calls = _scripted_stage(monkeypatch, bodies.STOP_CYCLING, True)
+    _robin_that_never_converges(monkeypatch, calls)
+    monkeypatch.setattr(stalled, "BODIES_REENTER", 99)
+    its, res, v = _continue()
+    assert [c[:2] for c in calls] == [
+        ("stage", 50),
+        ("newton", 20),
+        ("newton", 40),
+        ("turning", 10),
+        ("turning", 20),
+        ("stage", 13),
+    ]
+    assert its == 7 + 37 + 20 + 40 + 10 + 20 + 20 and res == 1e-7 and (v == 42.0).all()

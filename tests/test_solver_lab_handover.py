@@ -52,6 +52,7 @@ def test_a_rule_replayed_offline_costs_what_the_engine_spends(captured, monkeypa
     monkeypatch.setattr(stalled, "BODIES_WINDOW", max(window, 1))
     monkeypatch.setattr(stalled, "BODIES_LEVEL", level)
     monkeypatch.setattr(stalled, "BODIES_CYCLING", cycling)
+    monkeypatch.setattr(stalled, "BODIES_REENTER", 0)  # the offline sum is that of a stage that never re-enters
     engine = hard_steps.replay_step("col-1")
     assert offline["units"] == engine["units"] and offline["converged"] == engine["converged"]
     assert offline["finished"] == (not engine["methods"])  # the round-robin never ran
