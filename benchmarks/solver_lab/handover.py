@@ -17,7 +17,8 @@ recordings a step: ``record`` replays each kept step (``hard_steps``' capture, `
 window, keeping every sweep's residual, and then the round-robin alone (``stalled.BODIES_UNITS = 0``). Per
 step: momentum's units and its residual at the stall, the stage's units a sweep (body-order visits / C),
 its history, the round-robin's units and residual. ``table`` evaluates rules (``RULES``) on the
-recordings, the cap ignored (100 000: only a step that already fails reaches it).
+recordings, the cap ignored (100 000: only a step that already fails reaches it). The stage's re-entry
+(``stalled.BODIES_REENTER``) is not modelled: the units are those of the engine with it 0.
 """
 
 from __future__ import annotations

@@ -38,6 +38,17 @@ wall's 150 665 570 → 668 013, as many converged; ensembles of 48 runs a wall, 
 cycles for 2000 sweeps and then converges is handed to a round-robin that may cost 10× more (the
 64-course wall's 1.15 m/s 1.7 Hz step 128: 10 041 → 98 160 units).
 
+Re-entry (with the hand-over; measured, off with it). A handed-over stage keeps its run
+(bodies.Stage: iterate, extrapolation, stall window) and, after BODIES_REENTER = 2 of the round-robin's
+resumes (newton's two in round 0, which finish the 248-block wall's steps), goes on for the units it had
+left, once, as one long run would; also when the round-robin ends first. Step 128 above then costs
+15 142 (after 1 resume 11 719, but the 32-course wall's step 121, which newton's second resume finishes,
+8581 → 20 604; after round 0, 23 145). Replayed, the same as the hand-over alone but for the 248-block
+wall's one unconverged step, which pays the stage's remaining units again (37 294 → 49 345, main's
+figure): 402 494 → 185 943. At the cap the round-robin's lowest residual is adopted, never the
+stage's. Ensembles (benchmarks/README.md, "A way back to the stage"): see there; not on (BODIES_CYCLING
+= 0 leaves the engine main's, bit for bit).
+
 Gauss–Seidel with momentum (the default solver, :mod:`masonrycli.engine.momentum`) converges most steps in
 tens to hundreds of sweeps. On tall walls that slide it can stall: momentum drives the step into a
 stick/slip cycle, the residual wanders above the tolerance, and the solve stops after momentum's stall
