@@ -47,10 +47,10 @@ left, once, as one long run would; also when the round-robin ends first. Step 12
 wall's one unconverged step, which pays the stage's remaining units again (37 294 → 49 345, main's
 figure): 402 494 → 185 943. At the cap the round-robin's lowest residual is adopted, never the
 stage's (adopting it when lowest put h32 runs on trajectories with 13 unconverged steps against 7).
-Ensembles of 48 runs a wall against main at STALL_SWEEPS 500 (benchmarks/README.md, "A way back to the stage"): 0.960
-[0.937, 0.980] on the 248-block wall (unconverged 3 → 3), 0.996 [0.977, 1.017] on the 32-course wall
-(7 → 8, the hand-over's extra step, met on another trajectory). Not on, with the hand-over: BODIES_CYCLING
-= 0 leaves the engine main's, bit for bit.
+Ensembles of 48 runs a wall against main with momentum.STALL_SWEEPS 500 (benchmarks/README.md, "A way
+back to the stage"): 0.960 [0.937, 0.980] on the 248-block wall (unconverged 3 → 3), 0.996 [0.977,
+1.017] on the 32-course wall (7 → 8, the hand-over's extra step, met on another trajectory). Not on, with
+the hand-over: BODIES_CYCLING = 0 leaves the engine main's, bit for bit.
 
 Gauss–Seidel with momentum (the default solver, :mod:`masonrycli.engine.momentum`) converges most steps in
 tens to hundreds of sweeps. On tall walls that slide it can stall: momentum drives the step into a
