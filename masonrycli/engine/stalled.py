@@ -49,8 +49,9 @@ figure): 402 494 → 185 943. At the cap the round-robin's lowest residual is ad
 stage's (adopting it when lowest put h32 runs on trajectories with 13 unconverged steps against 7).
 Ensembles of 48 runs a wall against main with momentum.STALL_SWEEPS 500 (benchmarks/README.md, "A way
 back to the stage"): 0.960 [0.937, 0.980] on the 248-block wall (unconverged 3 → 3), 0.996 [0.977,
-1.017] on the 32-course wall (7 → 8, the hand-over's extra step, met on another trajectory). Not on, with
-the hand-over: BODIES_CYCLING = 0 leaves the engine main's, bit for bit.
+1.017] on the 32-course wall (7 → 8), 0.994 [0.982, 1.005] on the 64-course wall (2 → 3; step 128 15 142
+units): the hand-over's extra unconverged steps, met on other trajectories, remain. Not on, with the
+hand-over: BODIES_CYCLING = 0 leaves the engine main's, bit for bit.
 
 Gauss–Seidel with momentum (the default solver, :mod:`masonrycli.engine.momentum`) converges most steps in
 tens to hundreds of sweeps. On tall walls that slide it can stall: momentum drives the step into a
