@@ -94,3 +94,16 @@ def test_shifted_copies_pair_an_engine_with_itself(tmp_path):
     s = ensemble.compare(path, path, shift=1)["s"]  # copy 1 against 0, copy 2 against 1: ratios 3 and 0.5
     assert s["runs"] == 2 and s["geomean"] == pytest.approx(math.sqrt(1.5)) and (s["better"], s["worse"]) == (1, 1)
     assert s["total_ratio"] == pytest.approx(4500 / 4000)
+
+
+def test_set_changes_the_engine_for_these_runs_only(tmp_path):
+    from masonrycli.engine import momentum
+
+    window = momentum.STALL_SWEEPS
+    plain = ensemble.run(["h8"], [(1.0, 2.0, 0.0)], 0.003, tmp_path / "a.json")
+    varied = ensemble.run(["h8"], [(1.0, 2.0, 0.0)], 0.003, tmp_path / "b.json", override="momentum.STALL_SWEEPS=1")
+    assert momentum.STALL_SWEEPS == window  # restored
+    assert varied["engine"]["override"] == "momentum.STALL_SWEEPS=1" and "override" not in plain["engine"]
+    assert json.loads((tmp_path / "b.json").read_text())["engine"]["override"] == "momentum.STALL_SWEEPS=1"
+    # a one-sweep window sends the cold first step to stalled.py at once: other sweep units
+    assert varied["runs"][0]["units"] != plain["runs"][0]["units"]

@@ -1,7 +1,8 @@
 """Ensembles of short runs: a solver change judged on many trajectories at once, as a distribution.
 
     python -m benchmarks.solver_lab ensemble run --cases h32 h64 [--duration 0.15] [--motions A,F[,PHASE] …]
-                                                 [--copies K] [--jitter EPS] --out FILE.json
+                                                 [--copies K] [--jitter EPS] [--set MOD.NAME=VALUE[+…]]
+                                                 --out FILE.json
     python -m benchmarks.solver_lab ensemble compare A.json[,A2.json …] B.json[,…] [--shift-copy K]
 
 A step solved differently within the tolerance puts a run on another trajectory, with other hard steps:
@@ -129,9 +130,31 @@ def run_one(case: str, motion: tuple[float, float, float], duration: float, jitt
 
 
 def run(
-    cases: list[str], motions, duration: float, out: Path | None, jitter: float = 0.0, copies: range = range(1)
+    cases: list[str],
+    motions,
+    duration: float,
+    out: Path | None,
+    jitter: float = 0.0,
+    copies: range = range(1),
+    override: str = "",
 ) -> dict:
-    """Run every case under every motion; print a line a run and each case's spread; write ``out``."""
+    """Run every case under every motion; print a line a run and each case's spread; write ``out``.
+
+    ``override`` (``"momentum.STALL_SWEEPS=200+stalled.BODIES_CYCLING=4"``, as ``hard replay``'s variants)
+    sets engine constants for these runs only and is kept in the JSON as ``engine["override"]``: a rule
+    change is judged on ensembles before it is written into the engine."""
+    if override:
+        from benchmarks.solver_lab.hard_steps import _parse, _set
+
+        old = _set(_parse(override))
+        try:
+            return _run(cases, motions, duration, out, jitter, copies, override)
+        finally:
+            _set(old)
+    return _run(cases, motions, duration, out, jitter, copies, override)
+
+
+def _run(cases, motions, duration, out, jitter, copies, override) -> dict:
     from benchmarks.solver_cases import make_scenario
     from masonrycli.run import simulate
 
@@ -145,6 +168,9 @@ def run(
     )
     runs: list[dict] = []
     doc = {"engine": engine, "duration": duration, "jitter": jitter, "runs": runs}
+    if override:
+        engine["override"] = override
+        print(f"engine constants set for these runs: {override}", flush=True)
     for case in cases:
         print(f"\n{case}\n| A m/s | f Hz | φ | copy | mean units | max | unconverged | CPU s |\n" + "|---" * 8 + "|")
         for motion in motions:
@@ -264,6 +290,7 @@ def add_arguments(sub) -> None:
     r.add_argument("--copies", type=int, default=1, help="runs a motion, amplitude × (1 + k·1e-6), k = 0 …")
     r.add_argument("--first-copy", type=int, default=0, help="k of the first copy (to extend an ensemble)")
     r.add_argument("--out", type=Path, default=None)
+    r.add_argument("--set", default="", metavar="MOD.NAME=VALUE[+…]", help="engine constants for these runs")
     c = act.add_parser("compare", help="B against A, runs paired by motion")
     c.add_argument("a", help="A's JSON (several: comma-separated, runs pooled)")
     c.add_argument("b", help="B's JSON (several: comma-separated, runs pooled)")
@@ -273,7 +300,7 @@ def add_arguments(sub) -> None:
 def main(args) -> None:
     if args.action == "run":
         copies = range(args.first_copy, args.first_copy + args.copies)
-        run(args.cases, args.motions or MOTIONS, args.duration, args.out, args.jitter, copies)
+        run(args.cases, args.motions or MOTIONS, args.duration, args.out, args.jitter, copies, args.set)
     else:
         compare(args.a, args.b, args.shift_copy)
 
