@@ -39,13 +39,14 @@ def _make_probe():
         digest = hashlib.sha256()
         for package in packages:
             root = os.path.dirname(os.path.abspath(package.__file__))
-            for folder, subfolders, names in sorted(os.walk(root)):
-                subfolders[:] = sorted(d for d in subfolders if d != "__pycache__")
-                for name in sorted(n for n in names if n.endswith(".py")):
-                    path = os.path.join(folder, name)
-                    digest.update(f"{package.__name__}/{os.path.relpath(path, root)}".encode() + b"\0")
-                    with open(path, "rb") as fh:
-                        digest.update(fh.read())
+            sources = []
+            for folder, subfolders, names in os.walk(root):  # lazily, so the pruning below takes effect
+                subfolders[:] = [d for d in subfolders if d != "__pycache__"]
+                sources += [os.path.relpath(os.path.join(folder, n), root) for n in names if n.endswith(".py")]
+            for relative in sorted(sources):  # one order on every machine, whatever the file system's
+                digest.update(f"{package.__name__}/{relative}".encode() + b"\0")
+                with open(os.path.join(root, relative), "rb") as fh:
+                    digest.update(fh.read())
         return str(getattr(packages[0], "__version__", "unknown")), digest.hexdigest()[:12]
 
     return probe
