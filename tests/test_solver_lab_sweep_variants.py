@@ -2,8 +2,9 @@
 
 import numpy as np
 import pytest
+from test_engine_bodies import _problem as _bodies_problem
 from test_engine_faces import _faces_problem
-from test_engine_nlgs import _dense_h, _packed_row, _random_contacts, _slow_sweeps
+from test_engine_nlgs import _packed_row, _slow_sweeps
 
 from benchmarks.solver_lab import sweep_variants as sv
 from masonrycli.engine import nlgs
@@ -11,17 +12,8 @@ from masonrycli.engine.momentum import RESTART_GROWTH
 
 
 def _problem(seed=17):
-    q, inv_mass, inv_inertia, body, point, normal, gap = _random_contacts(seed=seed)
-    mu, dt, count = 0.5, 1e-3, body.shape[0]
-    pack = np.zeros((count, nlgs.PACK_WIDTH))
-    nlgs._prepare(body, point, normal, gap, count, q, inv_mass, inv_inertia, mu, dt, pack)
-    h = _dense_h(q, body, point, normal)
-    m_inv = np.diag(np.column_stack([inv_mass, inv_mass, inv_inertia]).ravel())
-    rng = np.random.default_rng(seed + 2)
-    v_free = rng.normal(scale=0.1, size=(4, 3))
-    v_free[3] = 0.0
-    r0 = np.abs(rng.normal(scale=0.01, size=(count, 2)))
-    return body, pack, h, m_inv, v_free, r0, mu, np.maximum(gap, 0.0) / dt
+    """The body-order tests' random problem (three bodies and a support)."""
+    return _bodies_problem(seed)
 
 
 def _reference(body, h, m_inv, v_free, r, mu, bias, sweeps, omega, accelerate, alternate, adaptive, status):
