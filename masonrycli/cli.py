@@ -364,10 +364,11 @@ def inspect_command(
     recording: Annotated[Path, typer.Argument(help="Recording (.rrd).", metavar="REC.rrd")],
 ) -> None:
     """Summarise a recording: scenario, frames, time span, entities."""
-    from masonrycli.recording import inspect_recording
+    from masonrycli.recording import inspect_recording, recording_path_problem
 
-    if not recording.is_file():
-        raise InputError(f"{recording}: no such recording")
+    problem = recording_path_problem(recording)
+    if problem:
+        raise InputError(problem)
     try:
         info = inspect_recording(recording)
     except Exception as exc:  # a corrupt or foreign file: say so in one line

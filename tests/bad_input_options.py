@@ -214,5 +214,12 @@ OPTION_ROWS = [
         2,
         "bad.rrd: not a readable Rerun recording",
     ),
-    ("inspect-folder", {"d.rrd/x": ""}, ("inspect", "d.rrd"), 2, "d.rrd: no such recording"),
+    ("inspect-folder", {"d.rrd/x": ""}, ("inspect", "d.rrd"), 2, "d.rrd: a folder, not a recording (it holds no .rrd"),
+    (
+        "inspect-folder-of-recordings",
+        {"recs/a.rrd": "", "recs/b.rrd": "", "recs/notes.txt": ""},
+        ("inspect", "recs"),
+        2,
+        "recs: a folder, not a recording; it holds 2 recordings (a.rrd, b.rrd): give one, e.g. masonry inspect recs/",
+    ),
 ]

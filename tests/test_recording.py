@@ -356,3 +356,25 @@ def test_magnified_shape(written):
     q = frames[0].block_q + m * (f.block_q - frames[0].block_q)
     np.testing.assert_allclose(np.array(rows[f.step][0])[:-1], world_outline(static, q, 0), atol=1e-4)
     assert len(rows[f.step]) == len(static.block_name) + 1  # blocks and the ground
+
+
+def test_recording_path_problem_names_a_folders_recordings(tmp_path):
+    """A folder is said to be one (``inspect recordings`` said "no such recording"): its .rrd files are
+    named, the first three by name and the rest counted, and the newest is the one suggested."""
+    import os
+
+    from masonrycli.recording import recording_path_problem
+
+    folder = tmp_path / "recs"
+    folder.mkdir()
+    assert recording_path_problem(folder) == f"{folder}: a folder, not a recording (it holds no .rrd file)"
+    for age, name in enumerate(["e.rrd", "a.rrd", "c.rrd", "b.rrd", "d.rrd"]):
+        (folder / name).write_bytes(b"")
+        os.utime(folder / name, ns=(10**18, 10**18 - age * 10**9))  # e.rrd the newest
+    (folder / "sub.rrd").mkdir()  # a folder named like a recording is not one
+    assert recording_path_problem(folder) == (
+        f"{folder}: a folder, not a recording; it holds 5 recordings (a.rrd, b.rrd, c.rrd and 2 more): "
+        f"give one, e.g. masonry inspect {folder / 'e.rrd'} (the newest)"
+    )
+    assert recording_path_problem(folder / "a.rrd") is None
+    assert recording_path_problem(folder / "missing.rrd") == f"{folder / 'missing.rrd'}: no such recording"

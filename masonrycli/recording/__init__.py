@@ -5,7 +5,8 @@
 - ``document``: the run document (status, parameters, scales, versions) shown beside the views.
 - ``static_content``: ``RecordingStatic`` and what is logged once (styles, drawing plane, colour bars).
 - ``arrays``: posed polygons, Arrow line strips and the frame buffer behind ``send_columns``.
-- ``readback``: ``inspect_recording`` (summary of a file) and ``screenshot_recording`` (headless viewer).
+- ``readback``: ``inspect_recording`` (summary of a file), ``recording_path_problem`` (a missing path or a
+  folder, in one line) and ``screenshot_recording`` (headless viewer).
 - ``_rerun_private``: the only use of rerun's private API, kept small and explained there.
 """
 
@@ -29,7 +30,7 @@ from masonrycli.recording.layout import (
     FieldSpec,
     build_blueprint,
 )
-from masonrycli.recording.readback import inspect_recording, screenshot_recording
+from masonrycli.recording.readback import inspect_recording, recording_path_problem, screenshot_recording
 from masonrycli.recording.recorder import APPLICATION_ID, Recorder
 from masonrycli.recording.static_content import RecordingStatic
 
@@ -48,6 +49,7 @@ __all__ = [
     "RecordingStatic",
     "build_blueprint",
     "inspect_recording",
+    "recording_path_problem",
     "screenshot_recording",
     "viewer_safe_text",
 ]

@@ -43,6 +43,36 @@ def check_complete(path: str | os.PathLike) -> None:
         raise OSError(errno.EIO, f"the recording is incomplete on disk ({cause})") from None
 
 
+_FOLDER_NAMES = 3  # recordings named in the message about a folder; the rest are counted
+
+
+def recording_path_problem(path: str | os.PathLike) -> str | None:
+    """What stops ``path`` from being read as a recording, in one line (None when it is a file): it does not
+    exist, or it is a folder — then the ``.rrd`` files directly in it are named (the first few by name)
+    and the newest is suggested, as ``masonry inspect recordings`` usually means the last run."""
+    shown = os.fspath(path)
+    if os.path.isfile(path):
+        return None
+    if not os.path.isdir(path):
+        return f"{shown}: no such recording"
+    try:
+        with os.scandir(path) as entries:
+            found = sorted((e for e in entries if e.name.endswith(".rrd") and e.is_file()), key=lambda e: e.name)
+    except OSError:  # a folder we may not list: say what it is, no more
+        found = []
+    if not found:
+        return f"{shown}: a folder, not a recording (it holds no .rrd file)"
+    names = ", ".join(e.name for e in found[:_FOLDER_NAMES])
+    more = f" and {len(found) - _FOLDER_NAMES} more" if len(found) > _FOLDER_NAMES else ""
+    newest = max(found, key=lambda e: (e.stat().st_mtime_ns, e.name))
+    count = f"{len(found)} recording" + ("s" if len(found) > 1 else "")
+    return (
+        f"{shown}: a folder, not a recording; it holds {count} ({names}{more}): "
+        f"give one, e.g. masonry inspect {os.path.join(shown, newest.name)}"
+        + (" (the newest)" if len(found) > 1 else "")
+    )
+
+
 def _open_reader(path: str, scratch: str) -> tuple[rr.chunk.RrdReader, bool]:
     """A reader of ``path``; a file cut in the middle of a message (a killed writer, a full disk) is read
     up to its last complete message, from a shortened copy in ``scratch``. Returns (reader, truncated)."""
