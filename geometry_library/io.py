@@ -31,7 +31,11 @@ A ``MULTIPOLYGON`` or ``GEOMETRYCOLLECTION`` of polygons gives one block per mem
 ``<label>-<k>`` when labelled); the whole file may also be one such geometry spread over lines.
 WKT carries no density or thickness: the reader's arguments apply to every block.
 
-Errors are one-line :class:`GeometryError` messages naming the file and the feature / line.
+Errors are one-line :class:`GeometryError` messages naming the file, the feature / line and, once known,
+the body as every message names one (:func:`~geometry_library.checks.body_label`), in one format::
+
+    walls.geojson: feature 3: block 2 ("B12"): polygon is not convex (reflex vertex at (1, 2))
+    walls.wkt: line 5: support 0 ("ground"): polygon has holes; blocks are solid
 """
 
 from __future__ import annotations
@@ -48,7 +52,7 @@ import shapely.wkt
 from shapely.geometry import GeometryCollection, MultiPolygon, Polygon
 
 from .blocks import SUPPORT_ROLES, Assembly, Block, GeometryError, Support
-from .checks import polygon_from_coords
+from .checks import body_label, polygon_from_coords
 from .values import check_positive
 
 _LABEL = re.compile(
@@ -108,7 +112,7 @@ def read_geojson(path, density: float = 2500.0, thickness: float = 1.0) -> Assem
     blocks: list[Block] = []
     supports: list[Support] = []
     for k, feature in enumerate(features):
-        where = f"{path}: feature {k}"
+        feature_at = where = f"{path}: feature {k}"  # the body's label is added once its role is read
         if not isinstance(feature, dict) or feature.get("type") != "Feature":
             raise GeometryError(f"{where}: not a GeoJSON Feature")
         props = feature.get("properties") or {}
@@ -119,7 +123,7 @@ def read_geojson(path, density: float = 2500.0, thickness: float = 1.0) -> Assem
             raise GeometryError(f"{where}: role must be 'block' or 'support', got {role!r}")
         index = len(blocks) if role == "block" else len(supports)
         name = str(props.get("name", f"{role}-{index}"))
-        where = f'{where} ({role} {index} "{name}")'
+        where = f"{feature_at}: {body_label(index, name, role)}"
         geometry = feature.get("geometry")
         gtype = geometry.get("type") if isinstance(geometry, dict) else None
         if gtype != "Polygon":
@@ -136,7 +140,7 @@ def read_geojson(path, density: float = 2500.0, thickness: float = 1.0) -> Assem
         try:
             polygon = polygon_from_coords(coords, index, name, role)
         except GeometryError as exc:
-            raise GeometryError(f"{path}: feature {k}: {exc}") from None
+            raise GeometryError(f"{feature_at}: {exc}") from None  # exc starts with the body's label
         if role == "block":
             blocks.append(
                 Block(
@@ -255,9 +259,9 @@ def read_wkt(path, density: float = 2500.0, thickness: float = 1.0) -> Assembly:
             label = name if len(polys) == 1 or name is None else f"{name}-{k + 1}"
             label = label or f"{role}-{index}"
             if poly.is_empty:
-                raise GeometryError(f'{where}: {role} {index} ("{label}"): polygon is empty')
+                raise GeometryError(f"{where}: {body_label(index, label, role)}: polygon is empty")
             if poly.interiors:
-                raise GeometryError(f'{where}: {role} {index} ("{label}"): polygon has holes; blocks are solid')
+                raise GeometryError(f"{where}: {body_label(index, label, role)}: polygon has holes; blocks are solid")
             try:
                 polygon = polygon_from_coords(np.asarray(poly.exterior.coords)[:, :2], index, label, role)
             except GeometryError as exc:

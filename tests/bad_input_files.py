@@ -251,7 +251,7 @@ FILE_ROWS = [
         {"g.geojson": feature([[[0, 0], [1, 0], [1, "x"], [0, 0]]])},
         ("check", "g.geojson"),
         2,
-        'g.geojson: feature 0 (block 0 "a"): coordinates must be [x, y] number pairs',
+        'g.geojson: feature 0: block 0 ("a"): coordinates must be [x, y] number pairs',
     ),
     (
         "geojson-nan",

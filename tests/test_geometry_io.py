@@ -115,6 +115,56 @@ def test_geojson_errors_name_file_and_feature(tmp_path):
     assert "feature 0" in text and "density" in text
 
 
+_BAD_FEATURES = [  # (feature 1 of a file whose feature 0 is a good block, the body named or None, message)
+    ("not a feature", {"type": "Point"}, None, "not a GeoJSON Feature"),
+    ("properties", {"type": "Feature", "properties": [1], "geometry": None}, None, "'properties' must be an object"),
+    ("role", feature(SQ, role="roof", name="B12"), None, "role must be 'block' or 'support', got 'roof'"),
+    (
+        "point",
+        {"type": "Feature", "properties": {"name": "B12"}, "geometry": {"type": "Point"}},
+        "block 1",
+        "geometry must be a Polygon, got 'Point'",
+    ),
+    (
+        "empty",
+        {"type": "Feature", "properties": {"name": "B12"}, "geometry": {"type": "Polygon"}},
+        "block 1",
+        "Polygon has no coordinates",
+    ),
+    (
+        "holes",
+        {"type": "Feature", "properties": {"name": "B12"}, "geometry": {"type": "Polygon", "coordinates": [SQ, SQ]}},
+        "block 1",
+        "1 hole(s)",
+    ),
+    ("coordinates", feature([[0, 0], [1, "x"], [1, 1]], name="B12"), "block 1", "coordinates must be [x, y] number"),
+    ("concave", feature([[0, 0], [2, 0], [2, 2], [1, 0.5], [0, 2], [0, 0]], name="B12"), "block 1", "not convex"),
+    ("nan", feature([[0, 0], [1, 0], [1, float("nan")], [0, 0]], name="B12"), "block 1", "vertex 2 has a NaN"),
+    ("density", feature(SQ, name="B12", density="heavy"), "block 1", "density"),
+    ("thickness", feature(SQ, name="B12", thickness=-1), "block 1", "thickness"),
+    ("velocity", feature(SQ, name="B12", velocity=[1, 2]), "block 1", "velocity must be [vx, vy, omega]"),
+    ("support role", feature(SQ, role="support", name="B12", support_role="wobbly"), "support 0", "support_role"),
+    (
+        "support concave",
+        feature([[0, 0], [2, 0], [2, 2], [1, 0.5], [0, 2]], role="support", name="B12"),
+        "support 0",
+        "not convex",
+    ),
+]
+
+
+@pytest.mark.parametrize("case, bad, body, message", _BAD_FEATURES, ids=[row[0] for row in _BAD_FEATURES])
+def test_geojson_errors_name_a_feature_in_one_format(tmp_path, case, bad, body, message):
+    """Every GeoJSON error names the feature as ``FILE: feature K: `` and, once its role is read, the body as
+    every other message does (``block 1 ("B12")``): a polygon's checks said ``feature 1: block 1 ("B12")``
+    and the reader's own ``feature 1 (block 1 "B12")`` before."""
+    path = write(tmp_path, [feature(SQ, name="A1"), bad])
+    text = one_line_error(read_geojson, path)
+    start = f"{path}: feature 1: " + (f'{body} ("B12"): ' if body else "")
+    assert text.startswith(start), text
+    assert message in text[len(start) :], text
+
+
 def test_wkt_lines_labels_and_supports(tmp_path):
     path = tmp_path / "blocks.wkt"
     path.write_text(
