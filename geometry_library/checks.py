@@ -16,10 +16,21 @@ Tolerances
   polygons, so a convexity test never trips on a 1e-17 "reflex" angle;
 - areas below ``MIN_AREA`` (1e-10 m²) are zero, above ``MAX_AREA`` (1e6 m²) absurd (wrong units);
 - a vertex beyond ``MAX_COORDINATE`` (1e6 m) from the origin is absurd too.
+
+Normalised once
+---------------
+Normalising costs ~0.2 ms a polygon (validity, SVD, vertex loops) and is idempotent: a normalised ring
+comes back unchanged. The builders and readers normalise every body and ``validate_assembly`` normalised
+them all again (an 8000-voussoir arch: 16 140 passes for 8070 bodies). Polygons made here by
+:func:`normalised_polygon` are remembered by identity (shapely geometries are immutable; a weak map, so
+nothing is kept alive), and :func:`normalise_polygon` hands such a polygon back as it is. Any other
+polygon, e.g. one a user put in a ``Block`` by hand or one that came back from another process, is
+normalised and checked in full.
 """
 
 from __future__ import annotations
 
+import weakref
 from collections.abc import Sequence
 
 import numpy as np
@@ -38,6 +49,10 @@ MAX_AREA = 1e6
 # products) overflow or lose all precision in float64, so the convexity test could no longer be trusted.
 MAX_COORDINATE = 1e6
 CONTACT_DISTANCE = 1e-3
+
+# id -> polygon made by normalised_polygon; the entry goes when the polygon does, so an id is never
+# matched by a later object that reuses it.
+_NORMALISED: weakref.WeakValueDictionary[int, Polygon] = weakref.WeakValueDictionary()
 
 
 def body_label(index: int, name: str, kind: str = "block") -> str:
@@ -178,11 +193,21 @@ def polygon_from_coords(coords, index: int, name: str, kind: str = "block") -> P
     ------
     GeometryError, e.g. ``block 7 ("c3-b2"): polygon is not convex (reflex vertex at (1, 2))``.
     """
-    return Polygon(normalise_coords(coords, body_label(index, name, kind)))
+    return normalised_polygon(coords, body_label(index, name, kind))
+
+
+def normalised_polygon(coords, label: str) -> Polygon:
+    """``Polygon(normalise_coords(coords, label))``, remembered as normalised (module docstring)."""
+    polygon = Polygon(normalise_coords(coords, label))
+    _NORMALISED[id(polygon)] = polygon
+    return polygon
 
 
 def normalise_polygon(geometry, index: int, name: str, kind: str = "block") -> Polygon:
-    """Like :func:`polygon_from_coords` for a shapely geometry: also rejects holes and other types."""
+    """Like :func:`polygon_from_coords` for a shapely geometry: also rejects holes and other types. A
+    polygon made by :func:`normalised_polygon` is returned as it is (normalising it again gives it back)."""
+    if _NORMALISED.get(id(geometry)) is geometry:
+        return geometry
     label = body_label(index, name, kind)
     if not isinstance(geometry, Polygon):
         kind_name = getattr(geometry, "geom_type", type(geometry).__name__)
@@ -191,7 +216,7 @@ def normalise_polygon(geometry, index: int, name: str, kind: str = "block") -> P
         raise GeometryError(f"{label}: polygon is empty")
     if len(geometry.interiors) > 0:
         raise GeometryError(f"{label}: polygon has {len(geometry.interiors)} hole(s); blocks are solid")
-    return Polygon(normalise_coords(np.asarray(geometry.exterior.coords)[:, :2], label))
+    return normalised_polygon(np.asarray(geometry.exterior.coords)[:, :2], label)
 
 
 def validate_assembly(

@@ -149,3 +149,58 @@ def test_350_blocks_are_checked_quickly():
     start = time.perf_counter()
     assert validate_assembly(aqueduct) == []
     assert time.perf_counter() - start < 1.0
+
+
+def _counting(monkeypatch):
+    """Count passes of the polygon clean-up (checks.normalise_coords) from here on."""
+    from geometry_library import checks
+
+    calls = [0]
+    real = checks.normalise_coords
+
+    def counted(coords, label):
+        calls[0] += 1
+        return real(coords, label)
+
+    monkeypatch.setattr(checks, "normalise_coords", counted)
+    return calls
+
+
+@pytest.mark.parametrize(
+    "builder, options",
+    [("wall", {}), ("wall", {"blocks": 248}), ("arch", {"voussoirs": 300}), ("aqueduct", {})],
+    ids=["wall-51", "wall-248", "arch-300", "aqueduct"],
+)
+def test_built_polygons_are_cleaned_once(builder, options, monkeypatch):
+    """A builder's polygons are normalised when built and not again by validate_assembly (it ran the clean-up
+    twice: 2 × 8070 passes for an 8000-voussoir arch, ~0.2 ms each); what validate_assembly finds is what the
+    second pass found, as the clean-up gives a normalised ring back unchanged."""
+    from geometry_library import checks
+    from geometry_library.builders import BUILDERS
+
+    calls = _counting(monkeypatch)
+    assembly = BUILDERS[builder](**options).build()
+    bodies = assembly.blocks + assembly.supports
+    assert calls[0] == len(bodies)
+    warnings = validate_assembly(assembly)
+    assert calls[0] == len(bodies)  # 2 × len(bodies) before
+    for body in bodies:  # idempotent: a second pass gives each polygon back exactly
+        again = checks.normalise_coords(np.asarray(body.polygon.exterior.coords)[:, :2], body.name)
+        np.testing.assert_array_equal(again, np.asarray(body.polygon.exterior.coords)[:-1])
+    checks._NORMALISED.clear()  # forget them: validate_assembly cleans every body up again, same answer
+    assert validate_assembly(assembly) == warnings
+    assert calls[0] == 3 * len(bodies)
+
+
+def test_a_polygon_not_made_by_the_clean_up_is_still_checked(monkeypatch):
+    """The skip is by identity: a hand-made polygon, even one equal to a cleaned-up one, is cleaned up and
+    checked; a non-convex one is still refused."""
+    made = polygon_from_coords(SQUARE, 0, "a")
+    calls = _counting(monkeypatch)
+    ground = Support(box(-1, -1, 2, 0), "ground")
+    assert validate_assembly(Assembly((Block(made, "a"),), (ground,))) == []
+    assert calls[0] == 1  # the ground only
+    assert validate_assembly(Assembly((Block(Polygon(made.exterior.coords), "a"),), (ground,))) == []
+    assert calls[0] == 3
+    concave = Polygon([(0, 0), (2, 0), (2, 2), (1, 0.5), (0, 2)])
+    raises_one_line(r'block 0 \("a"\): polygon is not convex', validate_assembly, Assembly((Block(concave, "a"),)))

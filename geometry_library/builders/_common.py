@@ -6,7 +6,7 @@ import numpy as np
 from shapely.geometry import Polygon
 
 from ..blocks import Block, Support
-from ..checks import normalise_coords
+from ..checks import normalised_polygon
 
 
 def name_width(count: int) -> int:
@@ -20,7 +20,7 @@ def clean_polygon(coords_or_polygon, name: str) -> Polygon:
         coords = np.asarray(coords_or_polygon.exterior.coords)[:, :2]
     else:
         coords = coords_or_polygon
-    return Polygon(normalise_coords(coords, f'built block "{name}"'))
+    return normalised_polygon(coords, f'built block "{name}"')  # validate_assembly will not redo it
 
 
 def make_block(polygon, name: str, density: float, thickness: float) -> Block:
