@@ -12,6 +12,7 @@ from pathlib import Path
 import pytest
 
 from masonrycli.errors import InputError
+from masonrycli.study import versions
 from masonrycli.study.versions import check_workers, describe, this_version
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -42,12 +43,23 @@ def test_the_digest_follows_the_source_not_where_it_lies(tmp_path):
 
 
 class _Client:
+    """Client.run's parts that check_workers calls: sync(_run, probe, ..., callback_timeout)."""
+
     def __init__(self, answers):
         self.answers = answers
 
-    def run(self, function, on_error):
+    def sync(self, function, *args, callback_timeout, **kwargs):
+        assert callback_timeout == versions.PROBE_TIMEOUT
+        return function(*args, **kwargs)
+
+    def _run(self, function, on_error):
         assert on_error == "return" and function() == this_version()  # the probe, as run here
+        if isinstance(self.answers, BaseException):
+            raise self.answers
         return self.answers
+
+    def scheduler_info(self):
+        return {"workers": {"tcp://a:1": {}, "tcp://b:2": {}}}
 
 
 def test_the_refusal_names_the_worker_and_both_versions():
@@ -62,3 +74,62 @@ def test_the_refusal_names_the_worker_and_both_versions():
     )
     with pytest.raises(InputError, match=r"worker tcp://a:1 could not be asked \(OSError: gone\)"):
         check_workers(_Client({"tcp://a:1": OSError("gone")}), "tcp://s:8786")
+
+    with pytest.raises(InputError) as err:  # Client.run waited as long as a worker took, without a word
+        check_workers(_Client(TimeoutError()), "tcp://s:8786")
+    assert str(err.value) == (
+        "--scheduler tcp://s:8786: the workers (2) did not all answer the masonry check within 60 s (a worker "
+        "inside a long call answers when it ends); try again when they are free"
+    )
+
+
+def test_the_probe_hashes_the_source_once_per_process(monkeypatch):
+    """Every run now carries its worker's answer: the source is hashed once, not once a run."""
+    import hashlib
+
+    import masonrycli
+
+    made = []
+    real = hashlib.sha256
+    monkeypatch.setattr(hashlib, "sha256", lambda *a: made.append(1) or real(*a))
+    first = this_version()  # may have been answered before this test: then 0 hashes here
+    monkeypatch.delattr(masonrycli, "_masonry_probe_answer")
+    assert [this_version() for _ in range(3)] == [first] * 3
+    assert len(made) == 1
+
+
+class _Opened:
+    """Counts its unpickling (in this process)."""
+
+    opened = 0
+
+    def __reduce__(self):
+        return (_Opened._open, ())
+
+    @staticmethod
+    def _open():
+        _Opened.opened += 1
+        return "the base"
+
+
+def test_a_run_answers_with_its_masonry_and_runs_only_for_the_same(monkeypatch):
+    """The task of a point: probe, then the run only if the worker's masonry is the driver's; its inputs are
+    opened once per process and only then (a worker without masonry could not open them)."""
+    import cloudpickle
+
+    keep, run = versions.make_task()
+    ours = this_version()
+    # another masonry: the inputs are not even opened (these bytes are not a pickle), nothing runs
+    assert run(("0.0.9", "abc"), b"not a pickle", {"amp": 0.3}) == (ours, "?", None)
+    payload = keep(cloudpickle.dumps((lambda base, params, x: (base, params, x), _Opened())))
+    _Opened.opened = 0
+    for amp in (0.1, 0.2):
+        assert run(ours, payload, {"amp": amp}, 7) == (ours, "?", ("the base", {"amp": amp}, 7))
+    assert _Opened.opened == 1
+    versions.check_result(ours, "tcp://w:1", {"amp": 0.1}, ours)
+    with pytest.raises(versions.WorkerMismatch) as err:
+        versions.check_result(("0.0.9", "abc"), "tcp://w:1", {"amp": 0.1, "record": "a.AT2"}, ours)
+    assert str(err.value) == (
+        f"worker tcp://w:1 runs masonry 0.0.9 (source abc), this command runs {describe(ours)}: its run of "
+        "amp=0.1 record=a.AT2 is not kept and the study stops"
+    )

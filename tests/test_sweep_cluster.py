@@ -261,3 +261,101 @@ def test_sigterm_on_a_study_writes_the_finished_rows_and_exits_143(tmp_path):
     assert lines[-1].startswith("interrupted (SIGTERM): every finished row is in"), lines
     assert not any("semaphore" in ln or "Traceback" in ln for ln in lines), lines
     assert 1 <= len(_read_csv(out)) < 6
+
+
+def _other_masonry(tmp_path: Path) -> Path:
+    """A folder holding a masonry of another release (version 0.0.9, no code), for a worker's path."""
+    other = tmp_path / "other"
+    for package, text in (("masonrycli", '__version__ = "0.0.9"\n'), ("geometry_library", "")):
+        (other / package).mkdir(parents=True)
+        (other / package / "__init__.py").write_text(text)
+    return other
+
+
+def test_a_worker_with_another_masonry_joining_mid_study_is_refused_and_the_rows_kept(tmp_path, monkeypatch):
+    # The check before the study asks the workers present then; one that joined later ran its tasks with its
+    # own masonry (here: error rows, 'No module named masonrycli.study'; rows of other code in general).
+    # Each result now says which masonry made it. A real LocalCluster (one worker process, this masonry)
+    # passes the check; once the first row is in, a `dask worker` of masonry 0.0.9 joins and the first
+    # worker leaves (one task in flight, so the next one can only go to the newcomer): its result stops the
+    # study with one line, and the row before it is in the table.
+    from distributed import Client, LocalCluster
+
+    from masonrycli.errors import InputError
+    from masonrycli.study import runner, store
+    from masonrycli.study.versions import describe, this_version
+
+    other = _other_masonry(tmp_path)
+    out = tmp_path / "study.csv"
+    cluster = LocalCluster(n_workers=1, threads_per_worker=1, processes=True, dashboard_address=":0")
+    client = Client(cluster)
+    monkeypatch.setattr(runner, "MIN_IN_FLIGHT", 1)
+    monkeypatch.setattr(runner, "IN_FLIGHT_PER_THREAD", 1)
+    late, append = [], store.Journal.append
+
+    def replace_the_worker_after_the_first_row(journal, row):
+        append(journal, row)
+        if late:
+            return
+        (first,) = client.scheduler_info()["workers"]
+        late.append(
+            subprocess.Popen(
+                [BIN / "dask", "worker", cluster.scheduler_address, "--nthreads", "1", "--no-dashboard"],
+                stdout=open(tmp_path / "late.log", "w"),
+                stderr=subprocess.STDOUT,
+                env=ENV | {"PYTHONPATH": str(other)},
+                cwd=tmp_path,
+                start_new_session=True,
+            )  # fmt: skip
+        )
+        client.wait_for_workers(2, timeout=120)
+        client.retire_workers([first], close_workers=True)
+
+    monkeypatch.setattr(store.Journal, "append", replace_the_worker_after_the_first_row)
+    scenario = scenario_from_builder(
+        "wall", {"blocks": 12}, RunConfig(duration=0.2), Material(), {"ground": Sine(amplitude=0.1, frequency=2.0)}
+    )
+    request = StudyRequest(axes=[parse_axis("amp=0.1:0.2:6")], out=out, scheduler=cluster.scheduler_address)
+    try:
+        with pytest.raises(InputError) as err:
+            run_study(StudyBase(scenario), request, Console(quiet=True))
+    finally:
+        for proc in late:
+            _kill(proc)
+        client.close()
+        cluster.close()
+    said = str(err.value)
+    assert "\n" not in said and said.startswith(f"--scheduler {cluster.scheduler_address}: worker tcp://"), said
+    assert "runs masonry 0.0.9 (source " in said and f"this command runs {describe(this_version())}" in said
+    assert said.endswith(
+        f"is not kept and the study stops; every finished row is in {out} (the same command resumes the study "
+        "once every worker runs this masonry)"
+    ), said
+    rows = _read_csv(out)
+    assert [r["amp"] for r in rows] == [0.1] and rows[0]["status"] == "completed"
+    assert not out.with_name(out.name + ".journal.jsonl").exists()  # the table holds every finished row
+
+
+def test_the_masonry_check_waits_60_s_at_most(tmp_path, monkeypatch):
+    # A worker that does not answer (stopped here; busy inside a long numba call in life) kept the check,
+    # and the command, waiting without a word.
+    from distributed import Client, LocalCluster
+
+    from masonrycli.errors import InputError
+    from masonrycli.study import versions
+
+    monkeypatch.setattr(versions, "PROBE_TIMEOUT", 2.0)
+    cluster = LocalCluster(n_workers=1, threads_per_worker=1, processes=True, dashboard_address=":0")
+    client = Client(cluster)
+    (pid,) = client.run(os.getpid).values()
+    try:
+        versions.check_workers(client, cluster.scheduler_address)  # answers: passes
+        os.kill(pid, signal.SIGSTOP)
+        start = time.monotonic()
+        with pytest.raises(InputError, match=r"the workers \(1\) did not all answer the masonry check within 2 s"):
+            versions.check_workers(client, cluster.scheduler_address)
+        assert time.monotonic() - start < 30
+    finally:
+        os.kill(pid, signal.SIGCONT)
+        client.close()
+        cluster.close()

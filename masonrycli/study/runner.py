@@ -15,7 +15,9 @@ row: each is a run of its own parameters.
 Rows come back in completion order; the driver (:mod:`masonrycli.study.drivers`) decides what runs
 next. A task that fails inside the run returns an error row (:func:`~masonrycli.study.task.run_task`);
 a task lost with its worker is retried elsewhere by the scheduler, and if it keeps killing workers
-(``KilledWorker``) or the cluster fails it otherwise, its row says so.
+(``KilledWorker``) or the cluster fails it otherwise, its row says so. Each result carries the masonry
+of the worker that made it; one from another masonry (a worker that joined after the check, or whose
+source changed on disk) stops the study (:class:`~masonrycli.study.versions.WorkerMismatch`).
 """
 
 from __future__ import annotations
@@ -105,13 +107,19 @@ def run_on_cluster(client, base, driver, on_row: Callable[[dict, dict], None], *
     ``task_args``: :func:`run_task`'s arguments after the point (stop_at_collapse, history_dir, force).
     At most ``limit`` tasks (default :func:`in_flight_limit`) are submitted at a time, the next one as
     each comes back."""
+    import cloudpickle
     from distributed import as_completed
 
+    from masonrycli.study.versions import check_result, make_task, this_version
+
     limit = limit or in_flight_limit(client)
+    ours = this_version()
+    keep, run = make_task()  # sent by value: a worker with another masonry, or none, answers (versions.py)
     # The base is a task, not scattered data: the scheduler keeps its spec and recomputes it on another
     # worker if the worker holding it dies (scattered data would be lost with its worker, and every task
-    # depending on it cancelled).
-    base_future = client.submit(_identity, base, pure=False)
+    # depending on it cancelled). It travels pickled with the function that runs a point, opened on the
+    # worker once its masonry is known to be this one.
+    base_future = client.submit(keep, cloudpickle.dumps((run_task, base)), pure=False)
     waiting = deque(driver.start())
     pending = {}
     completed = as_completed()
@@ -119,7 +127,7 @@ def run_on_cluster(client, base, driver, on_row: Callable[[dict, dict], None], *
     def submit():
         while waiting and len(pending) < limit:
             params = waiting.popleft()
-            future = client.submit(run_task, base_future, params, *task_args, pure=False)
+            future = client.submit(run, ours, base_future, params, *task_args, pure=False)
             pending[future.key] = params
             completed.add(future)
 
@@ -127,17 +135,15 @@ def run_on_cluster(client, base, driver, on_row: Callable[[dict, dict], None], *
     for future in completed:
         params = pending.pop(future.key)
         try:
-            row = future.result()
+            answer, worker, row = future.result()
         except Exception as exc:  # the task never returned (KilledWorker, a cluster failure)
             row = params | empty_result(f"{type(exc).__name__}: {exc}", 0.0)
+        else:
+            check_result(answer, worker, params, ours)  # another masonry's row is not kept
         future.release()
         waiting.extendleft(reversed(driver.feed(params, row)))  # a search's next step first: its row sooner
         on_row(params, row)
         submit()
-
-
-def _identity(value):
-    return value
 
 
 def run_serially(base, driver, on_row: Callable[[dict, dict], None], *task_args) -> None:

@@ -21,6 +21,7 @@ from masonrycli.study import files, store
 from masonrycli.study.axes import Axis, StudyBase, apply_point, check_axes, grid
 from masonrycli.study.drivers import FindDriver, GridDriver
 from masonrycli.study.task import RESULT_COLUMNS
+from masonrycli.study.versions import WorkerMismatch
 
 
 @dataclass(frozen=True)
@@ -151,6 +152,12 @@ def run_study(base: StudyBase, request: StudyRequest, console: Console) -> Study
                 run_serially(base, driver, on_row, *task_args)
             else:
                 run_on_cluster(client, base, driver, on_row, *task_args)
+    except WorkerMismatch as exc:  # the rows before it are kept (written below), the study resumable
+        where = f"--scheduler {request.scheduler}" if request.scheduler else "the local cluster"
+        raise InputError(
+            f"{where}: {exc}; every finished row is in {request.out} (the same command resumes the study "
+            "once every worker runs this masonry)"
+        ) from None
     finally:
         journal.close()
         rows = driver.rows()

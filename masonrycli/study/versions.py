@@ -15,12 +15,24 @@ The probe is run on every worker with ``Client.run``. It is built inside :func:`
 cloudpickle sends its code by value (a module-level function would be sent as a reference to
 ``masonrycli.study.versions``, which a worker without masonry, or with an older one, cannot import);
 it imports only the standard library before it looks for masonry. The same probe describes this
-process, so both sides are measured the same way.
+process, so both sides are measured the same way. Its answer is computed once per process and kept on
+the imported ``masonrycli`` module (hashing the source takes milliseconds; once per run would add up).
+
+The check before the study asks the workers present then, and waits at most :data:`PROBE_TIMEOUT`
+for them (a worker inside a long numba call answers only when the call ends: the command waited as
+long, without a word). Workers that join later are checked by every run: the task a worker runs
+(:func:`make_task`, also sent by value) probes first and returns its answer and its address with the
+row; it does not run a point for another masonry, and the driver refuses such a result
+(:class:`WorkerMismatch`). The run's inputs travel pickled, opened after the probe, so a worker without
+masonry answers too instead of failing to read them.
 """
 
 from __future__ import annotations
 
 from masonrycli.errors import InputError
+
+PROBE_TIMEOUT = 60.0
+"""s: how long the check before a study waits for every worker's answer."""
 
 
 def _make_probe():
@@ -36,6 +48,9 @@ def _make_probe():
             packages = [importlib.import_module(name) for name in ("masonrycli", "geometry_library")]
         except Exception as exc:  # noqa: BLE001 - any failure to import is "no usable masonry"
             return None, f"{type(exc).__name__}: {exc}"
+        known = getattr(packages[0], "_masonry_probe_answer", None)  # once per process (module doc)
+        if known is not None:
+            return known
         digest = hashlib.sha256()
         for package in packages:
             root = os.path.dirname(os.path.abspath(package.__file__))
@@ -47,7 +62,9 @@ def _make_probe():
                 digest.update(f"{package.__name__}/{relative}".encode() + b"\0")
                 with open(os.path.join(root, relative), "rb") as fh:
                     digest.update(fh.read())
-        return str(getattr(packages[0], "__version__", "unknown")), digest.hexdigest()[:12]
+        answer = str(getattr(packages[0], "__version__", "unknown")), digest.hexdigest()[:12]
+        packages[0]._masonry_probe_answer = answer
+        return answer
 
     return probe
 
@@ -65,9 +82,18 @@ def describe(found) -> str:
 
 def check_workers(client, scheduler: str) -> None:
     """Refuse (one-line :class:`InputError`) a cluster with a worker whose masonry differs from this
-    process's, naming the worker and both versions. Workers that join later are not checked."""
+    process's, naming the worker and both versions, or that does not answer within :data:`PROBE_TIMEOUT`.
+    Workers that join later are checked by each run (:func:`make_task`)."""
     ours = this_version()
-    found = client.run(_make_probe(), on_error="return")  # {worker address: result or exception}
+    try:  # Client.run with a deadline (Client.run is this same call without one)
+        found = client.sync(client._run, _make_probe(), on_error="return", callback_timeout=PROBE_TIMEOUT)
+    except TimeoutError:
+        workers = len(client.scheduler_info().get("workers", {}))
+        raise InputError(
+            f"--scheduler {scheduler}: the workers ({workers}) did not all answer the masonry check within "
+            f"{PROBE_TIMEOUT:g} s (a worker inside a long call answers when it ends); try again when they are free"
+        ) from None
+    # {worker address: result or exception}
     wrong = {}
     for worker, theirs in sorted(found.items()):
         if isinstance(theirs, BaseException):
@@ -81,3 +107,56 @@ def check_workers(client, scheduler: str) -> None:
             f"--scheduler {scheduler}: worker {worker}{more} {what}, this command runs {describe(ours)}; "
             "install the same masonry on every worker"
         )
+
+
+class WorkerMismatch(InputError):
+    """A run's result came from a worker whose masonry differs from this process's (it was not kept)."""
+
+    def __init__(self, worker: str, theirs, ours, params: dict):
+        point = " ".join(f"{k}={v:g}" if isinstance(v, float) else f"{k}={v}" for k, v in params.items())
+        super().__init__(
+            f"worker {worker} runs {describe(theirs)}, this command runs {describe(ours)}: its run of {point} "
+            "is not kept and the study stops"
+        )
+
+
+def make_task():
+    """``(keep, run)``, the two functions a study sends to its workers, by value (module doc).
+
+    ``keep(payload)`` returns its argument: the task holding the pickled ``(run_task, base)``.
+    ``run(expected, payload, params, *task_args)`` returns ``(answer, worker address, row)``: the worker's
+    probe answer and, if it equals ``expected``, ``run_task(base, params, *task_args)`` (else None, not
+    run). The payload is unpickled once per worker process (kept with the payload it came from)."""
+    probe = _make_probe()
+
+    def keep(payload):
+        return payload
+
+    def run(expected, payload, params, *task_args):
+        import pickle
+        import sys
+
+        answer = probe()
+        try:
+            from distributed import get_worker
+
+            worker = get_worker().address
+        except Exception:  # noqa: BLE001 - outside a worker (never in a study): no address to name
+            worker = "?"
+        if tuple(answer) != tuple(expected):
+            return answer, worker, None
+        module = sys.modules["masonrycli"]
+        opened = getattr(module, "_study_payload", None)
+        if opened is None or opened[0] is not payload:  # by identity: the worker holds one copy per study
+            opened = (payload, pickle.loads(payload))
+            module._study_payload = opened
+        run_task, base = opened[1]
+        return answer, worker, run_task(base, params, *task_args)
+
+    return keep, run
+
+
+def check_result(answer, worker: str, params: dict, ours) -> None:
+    """Raise :class:`WorkerMismatch` unless ``answer`` (a run's probe answer) is ``ours``."""
+    if tuple(answer) != tuple(ours):
+        raise WorkerMismatch(worker, answer, ours, params)
