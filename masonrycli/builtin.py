@@ -59,15 +59,23 @@ def override_run(scenario: Scenario, *, friction: float | None = None, **run_val
 
     The values are applied together (``--duration 0.3 --dt 0.3`` is fine whatever the file's duration);
     if that fails, the message names the option wrong on its own (``--dt: dt = -1.0: must be > 0``), else
-    the options together (``--duration and --dt: ...``).
+    the options together (``--duration and --dt: ...``). An option is wrong on its own when, applied
+    alone, it fails with the very message of the whole set: ``--dt 1e-9 --duration 0.5`` fails alone
+    against the file's 1 s ("1,000,000,000 steps for duration 1.0") but together on 500,000,000 steps for
+    0.5 s, which is what the message must say.
     """
     run_changes = _given(run_values, RUN_OVERRIDES)
     try:
         run = dataclasses.replace(scenario.run, **run_changes)
-    except InputError:
+    except InputError as together:
         for key, value in run_changes.items():
-            _replace(scenario.run, f"--{key.replace('_', '-')}", **{key: value})
-        run = _replace(scenario.run, " and ".join(f"--{k.replace('_', '-')}" for k in run_changes), **run_changes)
+            try:
+                dataclasses.replace(scenario.run, **{key: value})
+            except InputError as alone:
+                if str(alone) == str(together):
+                    raise InputError(f"--{key.replace('_', '-')}: {together}") from None
+        names = " and ".join(f"--{k.replace('_', '-')}" for k in run_changes)
+        raise InputError(f"{names}: {together}") from None
     material = scenario.material
     if friction is not None:
         material = _replace(material, "--friction", friction=friction)

@@ -183,8 +183,7 @@ def sweep_command(
 
 
 def _base_scenario(target: str, duration, dt):
-    import dataclasses
-
+    from masonrycli.builtin import override_run
     from masonrycli.motion import Sine
     from masonrycli.scenario import Material, RunConfig, scenario_from_builder
 
@@ -203,13 +202,7 @@ def _base_scenario(target: str, duration, dt):
         if not path.exists():
             raise InputError(f"{target}: no such scenario file (or built-in structure: {', '.join(BUILT_IN)})")
         scenario = load_scenario(path)
-    changes = {k: v for k, v in (("duration", duration), ("dt", dt)) if v is not None}
-    if changes:
-        try:
-            scenario = dataclasses.replace(scenario, run=dataclasses.replace(scenario.run, **changes))
-        except InputError as exc:
-            raise InputError(f"--{next(iter(changes))}: {exc}") from None
-    return scenario
+    return override_run(scenario, duration=duration, dt=dt)  # names the wrong option (--dt 0: --dt)
 
 
 def _record_duration(scenario, motions: dict, whole: bool):

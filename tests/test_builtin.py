@@ -87,6 +87,21 @@ def test_override_run_leaves_unset_values():
         override_run(s, friction=-1.0)
 
 
+def test_override_run_names_the_values_the_run_would_have():
+    # --dt 1e-9 --duration 0.5 said "--dt: ... gives 1,000,000,000 steps for duration 1.0": the wall's
+    # default duration, which this run would not have had; the message is the one of the values given
+    s = builtin("wall")
+    with pytest.raises(InputError) as info:
+        override_run(s, dt=1e-9, duration=0.5)
+    assert str(info.value) == (
+        "--duration and --dt: dt = 1e-09: gives 500,000,000 steps for duration 0.5 (at most 100,000,000)"
+    )
+    with pytest.raises(InputError, match=r"^--dt: dt = 0\.0: must be > 0$"):
+        override_run(s, duration=0.02, dt=0.0)  # wrong on its own: named alone
+    with pytest.raises(InputError, match=r"^--tolerance: tolerance = -1\.0: must be > 0$"):
+        override_run(s, record_every=0, tolerance=-1.0)  # both wrong: the one the message is about
+
+
 def test_paper_instant_hint_only_within_the_run():
     assert paper_instant_hint("wall", RunConfig(duration=1.0)) == (
         "The paper's Figs. III.2–III.5 are at t = 0.1 s (step 100): the recording opens on them, pinned there."

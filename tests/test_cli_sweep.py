@@ -219,6 +219,10 @@ def test_grid_sweep_state_map_and_histories(block, tmp_path):
         (["-p", "amp=0.1", "--scheduler", "tls://h:8786"], "tls:// is not supported (expected tcp://HOST:PORT"),
         (["-p", "amp=0.1", "--scheduler", "tcp://h:99999"], "a port from 1 to 65535"),  # waited 20 s
         (["-p", "amp=0.1", "--scheduler", ""], "--scheduler '': not an address"),
+        # a bad --dt given with --duration was blamed on --duration ("--duration: dt = 0.0: must be > 0")
+        (["-p", "amp=0.1", "--duration", "0.02", "--dt", "0"], "--dt: dt = 0.0: must be > 0"),
+        (["-p", "amp=0.1", "--duration", "0.02", "--dt", "nan"], "--dt: dt = nan: must be a finite number"),
+        (["-p", "amp=0.1", "--duration", "-1", "--dt", "0.01"], "--duration: duration = -1.0: must be > 0"),
     ],
 )
 def test_sweep_errors_are_one_line(block, args, fragment):
