@@ -16,7 +16,13 @@ def main() -> None:
     except KeyboardInterrupt:
         sys.stderr.write("error: Ctrl-C while masonry was starting: nothing was run\n")
         raise SystemExit(130) from None
-    cli_main()
+    try:
+        cli_main()
+    except SystemExit as stop:  # stopped by a signal: the rest of the way out ignores a second one
+        from masonrycli.interrupt import ignore_signals_while_exiting
+
+        ignore_signals_while_exiting(stop.code)
+        raise
 
 
 if __name__ == "__main__":

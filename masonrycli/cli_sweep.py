@@ -14,7 +14,7 @@ from typing import Annotated
 import typer
 
 from masonrycli.errors import InputError
-from masonrycli.interrupt import exit_code, signal_name
+from masonrycli.interrupt import already_stopping, exit_code, signal_name
 from masonrycli.outputs import OutputFile
 
 BUILT_IN = ("wall", "arch", "aqueduct")
@@ -152,23 +152,32 @@ def sweep_command(
     # SIGTERM (kill, a batch system's time limit) takes Ctrl-C's way out: the finished rows are written and
     # the cluster closed. Before, it killed the command outright: no table, and multiprocessing's
     # "leaked semaphore" warning on stderr.
-    stopped_by = [signal.SIGINT]
-
-    def on_sigterm(signum, frame):
-        stopped_by[0] = signum
-        raise KeyboardInterrupt
-
     # The handler stays for the plot and the recording: a SIGTERM there killed the command outright (exit
     # -15, a hidden .s.png.<pid>.part left beside the table), and Ctrl-C there said "stopped before any
     # output was written" with the whole table written.
+    # Only the first signal stops the study; later ones are acknowledged and ignored, as in a run's closing
+    # phase (masonrycli.interrupt): a second Ctrl-C while the table was written cut it (only the journal
+    # left, under "every finished row is in s.parquet"), and one after it killed the process (exit -2).
+    stopped_by: list[int] = []
+    stop_signals = (signal.SIGINT, signal.SIGTERM)
+
+    def on_signal(signum, frame):
+        if stopped_by:
+            already_stopping(signum)
+            return
+        stopped_by.append(signum)
+        raise KeyboardInterrupt
+
     main = threading.current_thread() is threading.main_thread()  # signal.signal works only there
-    previous = signal.signal(signal.SIGTERM, on_sigterm) if main else None
+    previous = {sig: signal.signal(sig, on_signal) for sig in stop_signals} if main else {}
     result, written = None, []
     try:
         result = run_study(base, request, console)
         _report(console, result, request, name, im, picture, recording, written)
     except KeyboardInterrupt:
-        how = "" if stopped_by[0] == signal.SIGINT else f" ({signal_name(stopped_by[0])})"
+        signum = stopped_by[0] if stopped_by else signal.SIGINT
+        stopped_by.append(signum)  # from here on every signal is a repeat
+        how = "" if signum == signal.SIGINT else f" ({signal_name(signum)})"
         if result is None:
             said = f"every finished row is in {out}; run the same command again to resume"
         else:  # the study is complete: what is missing is a picture
@@ -176,10 +185,10 @@ def sweep_command(
             again = "with --force (no run is made again)" if written else "(no run is made again)"
             said = f"every row is in {out}, but not written: {', '.join(missing)}; run the same command {again}"
         err_console.print(f"interrupted{how}: {said}", soft_wrap=True)
-        raise typer.Exit(exit_code(stopped_by[0])) from None
+        raise typer.Exit(exit_code(signum)) from None
     finally:
-        if main:
-            signal.signal(signal.SIGTERM, previous)
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
 
 
 def _base_scenario(target: str, duration, dt):

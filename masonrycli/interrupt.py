@@ -10,6 +10,11 @@ Three phases, because what a signal may safely do depends on what is under way:
   never raised, so a second Ctrl-C or a ``kill`` during shutdown cannot lose a file.
 
 Outside the main thread (where Python cannot install handlers) the context does nothing.
+
+After a command has stopped on a signal (exit 130 / 143), :func:`ignore_signals_while_exiting` lets the
+interpreter shut down undisturbed: Python puts its handlers back to the default action when it finalizes,
+so a second Ctrl-C in those last hundred milliseconds killed the process (exit -2 after the one-line
+"interrupted" message) — not what the first one did.
 """
 
 from __future__ import annotations
@@ -90,5 +95,18 @@ class StopSignals:
                 raise StopRun(signum)
             return
         self.repeats += 1
-        # os.write: no buffered I/O inside a signal handler (it may interrupt a print).
-        os.write(2, f"{signal_name(signum)}: already stopping — finishing the output files\n".encode())
+        already_stopping(signum)
+
+
+def already_stopping(signum: int) -> None:
+    """What a repeated signal prints, once a stop is under way (on stderr, one line)."""
+    # os.write: no buffered I/O inside a signal handler (it may interrupt a print).
+    os.write(2, f"{signal_name(signum)}: already stopping — finishing the output files\n".encode())
+
+
+def ignore_signals_while_exiting(code) -> None:
+    """If ``code`` is a signal's exit code (130, 143), ignore SIGINT and SIGTERM from now on (module doc).
+    SIG_IGN, unlike a Python handler, survives the interpreter's finalization. Main thread only."""
+    if code in tuple(exit_code(s) for s in SIGNALS) and threading.current_thread() is threading.main_thread():
+        for sig in SIGNALS:
+            signal.signal(sig, signal.SIG_IGN)

@@ -424,3 +424,81 @@ def test_records_run_whole_on_a_built_in_and_a_shorter_run_is_warned(block, tmp_
     assert result.exit_code == 2 and result.output.strip().splitlines() == [
         "error: record: fixed has no shaking support (give one a sine or record motion)"
     ]
+
+
+def test_a_second_ctrl_c_while_the_table_is_written_is_ignored(block, tmp_path, monkeypatch, capfd):
+    # A second Ctrl-C during the shutdown cut the table being written (only the journal left, under
+    # "every finished row is in s.parquet"). Now only the first signal stops; a repeat is acknowledged.
+    import os
+    import signal
+    import time
+
+    from masonrycli.study import runner, store
+
+    out = tmp_path / "s.parquet"
+    ran, written = runner.run_task, store.write_rows
+
+    def ctrl_c_in_the_second_run(base, params, *args):
+        if params["amp"] == 0.1:
+            os.kill(os.getpid(), signal.SIGINT)
+            time.sleep(5)  # the handler raises here
+            raise AssertionError("not stopped")
+        return ran(base, params, *args)
+
+    def ctrl_c_again_while_written(*args):
+        os.kill(os.getpid(), signal.SIGINT)
+        time.sleep(0.2)  # the handler runs here (it raised KeyboardInterrupt: no table)
+        return written(*args)
+
+    monkeypatch.setattr(runner, "run_task", ctrl_c_in_the_second_run)
+    monkeypatch.setattr(store, "write_rows", ctrl_c_again_while_written)
+    result = invoke("sweep", block, "-p", "amp=0.05,0.1,0.2", "--duration", 0.02, "--workers", 0, "-o", out)
+    assert result.exit_code == 130, result.output
+    assert f"interrupted: every finished row is in {out}; run the same command again" in " ".join(result.output.split())
+    assert [r["amp"] for r in read_rows(out)] == [0.05]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["block.toml", "s.parquet"]  # the journal went with it
+    assert "Ctrl-C: already stopping — finishing the output files" in capfd.readouterr().err
+
+
+@pytest.mark.slow
+def test_a_second_ctrl_c_on_the_way_out_ends_like_the_first(block, tmp_path):
+    # A real process, two real Ctrl-C: the first mid-study, the second as the "interrupted" line comes out
+    # (Python puts its handlers back to the default when it exits: that one killed the process, exit -2).
+    import os
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    root = Path(__file__).resolve().parent.parent
+    env = os.environ | {"RERUN_ANALYTICS": "0", "PYTHONUNBUFFERED": "1", "PYTHONPATH": str(root)}
+    out = tmp_path / "s.csv"
+    journal = tmp_path / "s.csv.journal.jsonl"
+    sweep = [sys.executable, "-m", "masonrycli", "sweep", "wall", "--param", "blocks=12", "--duration", "5"]
+    sweep += ["--param", "amp=0.1:0.25:6", "--workers", "0", "--out", out]
+    proc = subprocess.Popen(
+        sweep, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, env=env, cwd=tmp_path, text=True,
+        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),  # as in a terminal
+    )  # fmt: skip
+    try:
+        end = time.monotonic() + 240
+        while not (journal.exists() and journal.read_text().endswith("}\n")):  # a finished row
+            assert proc.poll() is None and time.monotonic() < end, proc.stdout.read()
+            time.sleep(0.05)
+        proc.send_signal(signal.SIGINT)
+        lines = []
+        for line in proc.stdout:
+            lines.append(line)
+            if line.startswith("interrupted"):
+                proc.send_signal(signal.SIGINT)
+                break
+        lines += proc.stdout.readlines()
+        assert proc.wait(timeout=120) == 130, lines
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
+    said = [ln for ln in lines if ln.strip() and not ln.startswith("Ctrl-C: already stopping")]  # the 2nd's
+    assert said[-1].startswith("interrupted: every finished row is in"), lines
+    assert not any("Traceback" in ln or "KeyboardInterrupt" in ln for ln in lines), lines
+    assert 1 <= len(read_rows(out)) < 6 and not journal.exists()

@@ -121,3 +121,25 @@ def test_a_held_signal_is_raised_when_the_block_ends():
                 finished.append("file")
         assert finished == ["quiet", "file"] and info.value.signum == signal.SIGTERM
         assert stop.phase == "setup"
+
+
+def test_signals_are_ignored_on_the_way_out_of_a_stopped_command():
+    """After exit 130 / 143 the interpreter's shutdown ignores SIGINT and SIGTERM (its own reset of the
+    handlers let a second Ctrl-C kill the process); any other exit leaves them alone."""
+    import signal
+
+    from masonrycli.interrupt import ignore_signals_while_exiting
+
+    before = {s: signal.getsignal(s) for s in (signal.SIGINT, signal.SIGTERM)}
+    try:
+        for code in (0, 1, 2, None, "error"):
+            ignore_signals_while_exiting(code)
+            assert {s: signal.getsignal(s) for s in before} == before
+        for code in (130, 143):
+            ignore_signals_while_exiting(code)
+            assert all(signal.getsignal(s) is signal.SIG_IGN for s in before)
+            for s, handler in before.items():
+                signal.signal(s, handler)
+    finally:
+        for s, handler in before.items():
+            signal.signal(s, handler)
