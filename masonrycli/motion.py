@@ -114,6 +114,10 @@ class Motion:
         """One human-readable line, e.g. ``sine 1 m/s · sin(2π·2 Hz·t) along (1, 0)``."""
         raise NotImplementedError
 
+    def peak_speed(self, duration: float) -> float:
+        """m/s, the largest |v(t)| for 0 <= t <= ``duration`` (an upper bound for a sine: its amplitude)."""
+        return 0.0
+
     def toml_fields(self, inline_records: bool = False) -> dict:
         """The ``motion = {...}`` table of this motion, ``kind`` first (what the scenario writer emits)."""
         raise NotImplementedError
@@ -161,6 +165,9 @@ class Constant(Motion):
     def describe(self) -> str:
         return f"constant velocity {_vec(self.velocity)} m/s"
 
+    def peak_speed(self, duration: float) -> float:
+        return math.hypot(*self.velocity)
+
     def toml_fields(self, inline_records: bool = False) -> dict:
         return {"kind": self.kind, "velocity": list(self.velocity)}
 
@@ -201,6 +208,9 @@ class Sine(Motion):
         ph = f" + {_g(self.phase)}" if self.phase else ""
         return f"sine {_g(self.amplitude)} m/s · sin(2π·{_g(self.frequency)} Hz·t{ph}) along {_vec(self.direction)}"
 
+    def peak_speed(self, duration: float) -> float:
+        return abs(self.amplitude)
+
     def toml_fields(self, inline_records: bool = False) -> dict:
         return {
             "kind": self.kind,
@@ -237,6 +247,9 @@ class Ramp(Motion):
     def describe(self) -> str:
         until = "" if math.isinf(self.until) else f" until {_g(self.until)} s"
         return f"ramp acceleration {_vec(self.acceleration)} m/s²{until}"
+
+    def peak_speed(self, duration: float) -> float:
+        return math.hypot(*self.acceleration) * min(self.until, max(duration, 0.0))
 
     def toml_fields(self, inline_records: bool = False) -> dict:
         kv = {"kind": self.kind, "acceleration": list(self.acceleration)}
@@ -420,6 +433,14 @@ class Record(Motion):
                 s = (np.clip(t, time[0], time[-1]) - time[0])[:, None] / (time[-1] - time[0])
                 out -= baseline[0] * s + baseline[1] * (s * s)
         return out
+
+    def peak_speed(self, duration: float) -> float:
+        # at the samples used and at the run's end: exact for a velocity record (linear between
+        # samples); for an acceleration record the velocity between samples is quadratic and may
+        # slightly exceed its samples' (enough to tell 1 m/s from a typo's 1e300)
+        time = self._arrays[0]
+        t = np.append(time[time <= duration], duration)
+        return float(np.hypot(*self.velocity_at(t).T).max())
 
     def describe(self) -> str:
         src = os.path.basename(self.source) if self.source else "inline"

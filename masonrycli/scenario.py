@@ -33,6 +33,10 @@ MAX_COUNT = 10**9
 MAX_FRICTION = 1e3
 """Largest Coulomb μ: masonry joints have 0.4–1 and μ = 1000 already forbids sliding; beyond ~1e7 the limit
 analysis LP lost the weight against the friction cone's size and called the wall unable to stand."""
+MAX_SUPPORT_SPEED = 1e3
+"""m/s — a support moving faster is refused as a likely typo: run.py calls a block that fast diverged
+(``--amp 1e30`` ran and reported the wall "collapsed at t = 0.001 s", exit 0; a record of 1e300 m/s too,
+with numpy's overflow warnings)."""
 SOLVERS = ("nlgs-accel", "nlgs")
 """Contact solvers a run can select (RunConfig.solver); the first is the default."""
 
@@ -269,11 +273,18 @@ def _block_mass(block: Block) -> float:
 def check_sampling(scenario: Scenario) -> None:
     """Raise :class:`InputError` for a sine faster than the time step can follow: above 1/(2 dt) the
     steps sample it at aliased phases (``--freq 1e9`` at dt = 1e-3 s sampled sin(2π·10⁶·k) = 0: the ground
-    never moved, and nothing said so). Called once the command line's overrides are applied."""
+    never moved, and nothing said so); and for a support moving faster than ``MAX_SUPPORT_SPEED`` within
+    the run. Called once the command line's overrides are applied."""
     dt = scenario.run.dt
     source = str(scenario.source)
     where = "" if source.startswith("builder:") or not source else f"{source}: "
     for support, m in zip(scenario.assembly.supports, scenario.motions):
+        peak = m.peak_speed(scenario.run.duration)
+        if not peak <= MAX_SUPPORT_SPEED:
+            raise InputError(
+                f'{where}support "{support.name}": {m.describe()} moves at up to {peak:.3g} m/s, more than '
+                f"{MAX_SUPPORT_SPEED:g} m/s (a likely typo: a block that fast is a diverged run)"
+            )
         if m.kind == "sine" and m.amplitude != 0.0 and m.frequency * dt > 0.5:
             raise InputError(
                 f'{where}support "{support.name}": frequency = {m.frequency:g} Hz is above 1/(2 dt) = {0.5 / dt:g} Hz, '

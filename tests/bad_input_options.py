@@ -128,6 +128,16 @@ OPTION_ROWS = [
     ("sim-wall-courses", {}, ("simulate", "aqueduct", "--wall-courses", "0", "--no-recording"), 2, "wall_courses must"),
     ("sim-record-missing", {}, (*WALL, "--record", "nope.at2", "--no-recording"), 2, "nope.at2: cannot read record"),
     ("sim-scale-alone", {}, (*WALL, "--scale", "2", "--no-recording"), 2, "--scale: goes with --record"),
+    # an absurd support speed ran to exit 0 ("collapsed at t = 0.001 s"; the CSV with numpy's overflow warnings)
+    ("sim-amp-absurd", {}, (*WALL, "--amp", "1e30", "--no-recording"), 2, 'support "ground": sine 1e+30 m/s'),
+    ("sim-settlement-absurd", {}, (*ARCH, "--settlement", "1e9", "--no-recording"), 2, "up to 1e+09 m/s, more than"),
+    (
+        "sim-record-absurd",
+        {"huge.csv": "0,1e300\n1,-1e300\n"},
+        (*WALL, "--record", "huge.csv", "--no-recording"),
+        2,
+        "record of velocity (huge.csv, 2 samples, 0–1 s) along (1, 0) moves at up to 1e+300 m/s",
+    ),
     (
         "limit-load",
         {},

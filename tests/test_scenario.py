@@ -348,6 +348,39 @@ def test_check_sampling_refuses_a_sine_above_half_the_step_rate():
     check_sampling(still)  # a sine of zero amplitude moves nothing: any frequency
 
 
+def test_check_sampling_refuses_a_support_faster_than_a_diverged_block():
+    # --amp 1e30 ran (exit 0, "collapsed at t = 0.001 s"), --settlement 1e9 too, and a CSV record of
+    # 1e300 m/s printed numpy's overflow warnings: a support that fast is a typo, refused like the others
+    from masonrycli import run as run_module
+    from masonrycli.motion import Ramp, Record
+    from masonrycli.scenario import MAX_SUPPORT_SPEED, check_sampling
+
+    scenario = load_scenario(DATA / "block_on_ground.toml")  # 1 m/s sine, 1 s
+    assert MAX_SUPPORT_SPEED == run_module.DIVERGENCE_SPEED  # what the run itself calls diverged
+
+    def moving(motion):
+        return dataclasses.replace(scenario, motions=(motion,))
+
+    check_sampling(moving(dataclasses.replace(scenario.motions[0], amplitude=-1000.0)))  # at the limit
+    with pytest.raises(InputError) as info:
+        check_sampling(moving(dataclasses.replace(scenario.motions[0], amplitude=1e30)))
+    assert str(info.value) == (
+        f'{scenario.source}: support "ground": sine 1e+30 m/s · sin(2π·2 Hz·t) along (1, 0) moves at up to '
+        "1e+30 m/s, more than 1000 m/s (a likely typo: a block that fast is a diverged run)"
+    )
+    with pytest.raises(InputError, match=r"constant velocity \(0, -1e\+09\) m/s moves at up to 1e\+09 m/s"):
+        check_sampling(moving(Constant(velocity=(0.0, -1e9))))
+    # a ramp reaches a·min(until, duration): 2000 m/s² for the run's 1 s is too fast, for 0.4 s not
+    with pytest.raises(InputError, match=r"moves at up to 2e\+03 m/s"):
+        check_sampling(moving(Ramp(acceleration=(2000.0, 0.0))))
+    check_sampling(moving(Ramp(acceleration=(2000.0, 0.0), until=0.4)))
+    # a record: what it reaches within the run (its samples after the run's end do not count)
+    fast_late = Record(time=(0.0, 1.0, 2.0, 3.0), value=(0.0, 1.0, 1.0, 1e300), quantity="velocity")
+    check_sampling(moving(fast_late))
+    with pytest.raises(InputError, match=r"record of velocity \(inline, 4 samples, 0–3 s\).* up to 1e\+300 m/s"):
+        check_sampling(dataclasses.replace(moving(fast_late), run=dataclasses.replace(scenario.run, duration=3.0)))
+
+
 def test_record_warnings_name_a_record_that_outlasts_the_run():
     from masonrycli.scenario import record_warnings
 

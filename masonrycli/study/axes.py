@@ -143,8 +143,7 @@ def apply_point(base, params: dict):
                 builder, structure | options, scenario.run, scenario.material, dict(zip(names, scenario.motions))
             )
         except InputError as exc:  # say which point: "--param span=7: builder ...", not the builder alone
-            point = " ".join(f"{k}={v:g}" if isinstance(v, float) else f"{k}={v}" for k, v in options.items())
-            raise InputError(f"--param {point}: {exc}") from None
+            raise InputError(f"--param {_point(options)}: {exc}") from None
     run_changes = {k: v for k, v in params.items() if k in RUN_PARAMS}
     if run_changes:
         scenario = dataclasses.replace(scenario, run=_replace(scenario.run, run_changes))
@@ -176,8 +175,15 @@ def apply_point(base, params: dict):
         for j in targets:
             motions[j] = _replace(motions[j], {attr: value}, where=f"--param {key}")
     scenario = dataclasses.replace(scenario, motions=tuple(motions))
-    check_sampling(scenario)
+    try:
+        check_sampling(scenario)
+    except InputError as exc:  # the point, not only the support: "--param amp=1e+30: support ..."
+        raise InputError(f"--param {_point(params)}: {exc}") from None
     return scenario
+
+
+def _point(params: dict) -> str:
+    return " ".join(f"{k}={v:g}" if isinstance(v, float) else f"{k}={v}" for k, v in params.items())
 
 
 def _builder_option(builder, name: str) -> bool:
