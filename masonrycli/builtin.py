@@ -123,22 +123,36 @@ def _loading(name: str, amp, freq, settlement, record, scale) -> dict:
         return {support: motion for support in shaken}
     if scale is not None:
         raise InputError("--scale: goes with --record (it multiplies the record)")
-    freq = SHAKE_FREQUENCY if freq is None else freq
+    loading_freq, freq = freq, SHAKE_FREQUENCY if freq is None else freq
     if name == "wall":
         if settlement:
             raise InputError("--settlement: the wall stands on one ground; settlement applies to arch and aqueduct")
         amp = SHAKE_AMPLITUDE if amp is None else amp
         return {"ground": _sine(amp, freq)} if amp else {}
+    if settlement is not None and not math.isfinite(settlement):
+        raise InputError(f"--settlement {settlement}: must be a finite number (a downward velocity, m/s)")
+    if settlement is not None and settlement < 0:
+        raise InputError(f"--settlement {settlement}: must be >= 0 (a downward velocity, m/s)")
+    # the messages name what was given: "--amp 1" alone said "--settlement with --amp" (the default
+    # settlement), and "--freq 3" without --amp was ignored without a word
+    _sine(0.0 if amp is None else amp, freq)  # a bad --amp / --freq is named first
+    settles = f"the {name} settles its right foundation" + (" by default" if settlement is None else "")
+    if settlement is None and amp:
+        raise InputError(f"--amp {amp:g}: {settles}; shake both foundations with --settlement 0 --amp {amp:g}")
+    if settlement and amp:
+        raise InputError("--settlement with --amp: choose one loading (settle or shake)")
+    if amp is None and loading_freq is not None:
+        if settlement == 0:
+            raise InputError(f"--freq {freq:g} without --amp: nothing shakes the {name} (give --amp A)")
+        raise InputError(
+            f"--freq {freq:g}: {settles}; shake both foundations with --settlement 0 --amp A --freq {freq:g}"
+        )
     settlement = SETTLEMENT if settlement is None else settlement
     amp = 0.0 if amp is None else amp
-    if settlement < 0:
-        raise InputError(f"--settlement {settlement}: must be >= 0 (a downward velocity, m/s)")
     motions = {}
     if amp:
         motions = {"left-foundation": _sine(amp, freq), "right-foundation": _sine(amp, freq)}
     if settlement:
-        if amp:
-            raise InputError("--settlement with --amp: choose one loading (settle or shake)")
         motions["right-foundation"] = Constant(velocity=(0.0, -settlement))
     return motions
 

@@ -89,7 +89,38 @@ OPTION_ROWS = [
         2,
         "--settlement -1.0: must be >= 0",
     ),
-    ("sim-settlement-and-amp", {}, (*ARCH, "--amp", "1", "--no-recording"), 2, "--settlement with --amp"),
+    # "--amp 1" alone said "--settlement with --amp" (the settlement was the default, not given)
+    (
+        "sim-amp-on-settling-arch",
+        {},
+        (*ARCH, "--amp", "1", "--no-recording"),
+        2,
+        "--amp 1: the arch settles its right foundation by default; shake both foundations with --settlement 0",
+    ),
+    (
+        "sim-settlement-and-amp",
+        {},
+        (*ARCH, "--settlement", "0.01", "--amp", "1", "--no-recording"),
+        2,
+        "--settlement with --amp",
+    ),
+    # these two ran: the frequency of no sine was ignored without a word
+    ("sim-freq-on-settling-arch", {}, (*ARCH, "--freq", "3", "--no-recording"), 2, "--freq 3: the arch settles"),
+    (
+        "sim-freq-without-amp",
+        {},
+        ("simulate", "aqueduct", "--settlement", "0", "--freq", "3", "--duration", "0.01", "--no-recording"),
+        2,
+        "--freq 3 without --amp: nothing shakes the aqueduct (give --amp A)",
+    ),
+    # it said "velocity = [0.0, nan]: must be finite numbers" (no option)
+    (
+        "sim-settlement-nan",
+        {},
+        (*ARCH, "--settlement", "nan", "--no-recording"),
+        2,
+        "--settlement nan: must be a finite",
+    ),
     ("sim-amp-nan", {}, (*WALL, "--amp", "nan", "--no-recording"), 2, "--amp/--freq:"),
     ("sim-freq-negative", {}, (*WALL, "--freq", "-1", "--no-recording"), 2, "--amp/--freq:"),
     ("sim-voussoirs", {}, (*ARCH, "--voussoirs", "1", "--no-recording"), 2, 'builder "arch"'),
