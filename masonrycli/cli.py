@@ -74,7 +74,7 @@ def _execute(scenario, opts: dict, hint: str = "") -> None:
     from masonrycli.sinks import DIVERGED, FAILED
 
     check_sampling(scenario)
-    _check_magnify(opts["magnify"])
+    _check_magnify(opts["magnify"], opts["no_recording"])
     outputs = plan_outputs(
         scenario, opts["out"], opts["history"], no_recording=opts["no_recording"], force=opts["force"]
     )
@@ -115,9 +115,11 @@ MAX_MAGNIFY = 1e6
 float32 coordinates to inf, with a RuntimeWarning)."""
 
 
-def _check_magnify(magnify: float | None) -> None:
+def _check_magnify(magnify: float | None, no_recording: bool) -> None:
     if magnify is not None and not 1.0 <= magnify <= MAX_MAGNIFY:
         raise InputError(f"--magnify {magnify:g}: must be between 1 and {MAX_MAGNIFY:g}")
+    if magnify is not None and no_recording:  # it was ignored, as --out was: nothing draws the shape
+        raise InputError(f"--magnify {magnify:g} with --no-recording: choose one (it draws in the recording)")
 
 
 def _pop(opts: dict, *groups: dict) -> dict:
@@ -270,7 +272,7 @@ def check_command(scenario_file: ScenarioFile, **opts) -> None:
 
     scenario = _load(scenario_file, opts)
     check_sampling(scenario)
-    _check_magnify(opts["magnify"])
+    _check_magnify(opts["magnify"], opts["no_recording"])
     outputs = plan_outputs(
         scenario, opts["out"], opts["history"], no_recording=opts["no_recording"], force=opts["force"]
     )

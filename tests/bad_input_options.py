@@ -158,6 +158,8 @@ OPTION_ROWS = [
     ("sim-pier-width", {}, (*ARCH, "--pier-width", "0", "--no-recording"), 2, '"arch": pier_width must be a positive'),
     ("sim-wall-courses", {}, ("simulate", "aqueduct", "--wall-courses", "0", "--no-recording"), 2, "wall_courses must"),
     ("sim-record-missing", {}, (*WALL, "--record", "nope.at2", "--no-recording"), 2, "nope.at2: cannot read record"),
+    # it was ignored without a word (the magnified shape is drawn in the recording only)
+    ("sim-magnify-no-recording", {}, (*WALL, "--magnify", "5", "--no-recording"), 2, "--magnify 5 with --no-recording"),
     ("sim-scale-alone", {}, (*WALL, "--scale", "2", "--no-recording"), 2, "--scale: goes with --record"),
     # an absurd support speed ran to exit 0 ("collapsed at t = 0.001 s"; the CSV with numpy's overflow warnings)
     ("sim-amp-absurd", {}, (*WALL, "--amp", "1e30", "--no-recording"), 2, 'support "ground": sine 1e+30 m/s'),
