@@ -131,9 +131,14 @@ def sweep_command(
     # which rows are this study's and which runs are still to make)
     if no_recording and recording is not None:
         raise InputError(f"--recording {recording} with --no-recording: choose one")
-    picture = check_picture(plot or out.with_suffix(".png"), "--plot", ".png", force)
+    # the default files beside --out are named as such: "--plot s.png: the file exists" named an option
+    # the user had not given
+    picture = check_picture(plot or out.with_suffix(".png"), "--plot" if plot else "--out's plot", ".png", force)
     recording = check_picture(
-        None if no_recording else recording or out.with_suffix(".rrd"), "--recording", ".rrd", force
+        None if no_recording else recording or out.with_suffix(".rrd"),
+        "--recording" if recording else "--out's recording",
+        ".rrd",
+        force,
     )
     request = StudyRequest(
         axes=axes,

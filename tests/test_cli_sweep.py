@@ -272,8 +272,10 @@ def test_existing_outputs_are_refused_without_force_and_replaced_with_it(block, 
     other = ["-p", "amp=0.05,0.1", "--duration", 0.04, "--workers", 0, "-o", out]  # another study (duration)
     cases = [
         (other + ["--no-recording", "--plot", tmp_path / "o.png"], f"--out {out}: the file exists"),
-        (grid, f"--plot {tmp_path / 's.png'}: the file exists"),  # the same study: resumable, but its plot exists
+        # the same study: resumable, but its plot exists (it said "--plot s.png", an option not given)
+        (grid, f"--out's plot {tmp_path / 's.png'}: the file exists"),
         (grid + ["--plot", tmp_path / "n.png", "--recording", tmp_path / "s.rrd"], "--recording"),
+        (grid + ["--plot", tmp_path / "n.png"], f"--out's recording {tmp_path / 's.rrd'}: the file exists"),
         (grid[:-1] + [h] + ["-p", "friction=0.8", "--no-recording", "--plot", tmp_path / "n.png"], "--out"),
     ]
     for args, fragment in cases:
