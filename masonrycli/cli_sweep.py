@@ -6,15 +6,15 @@ table, PNG, Rerun recording. Registered on the app by :mod:`masonrycli.cli`.
 
 from __future__ import annotations
 
+import contextlib
 import signal
-import threading
 from pathlib import Path
 from typing import Annotated
 
 import typer
 
 from masonrycli.errors import InputError
-from masonrycli.interrupt import already_stopping, exit_code, signal_name
+from masonrycli.interrupt import FirstSignalStops, exit_code, signal_name
 from masonrycli.outputs import OutputFile
 
 BUILT_IN = ("wall", "arch", "aqueduct")
@@ -163,37 +163,22 @@ def sweep_command(
     # Only the first signal stops the study; later ones are acknowledged and ignored, as in a run's closing
     # phase (masonrycli.interrupt): a second Ctrl-C while the table was written cut it (only the journal
     # left, under "every finished row is in s.parquet"), and one after it killed the process (exit -2).
-    stopped_by: list[int] = []
-    stop_signals = (signal.SIGINT, signal.SIGTERM)
-
-    def on_signal(signum, frame):
-        if stopped_by:
-            already_stopping(signum)
-            return
-        stopped_by.append(signum)
-        raise KeyboardInterrupt
-
-    main = threading.current_thread() is threading.main_thread()  # signal.signal works only there
-    previous = {sig: signal.signal(sig, on_signal) for sig in stop_signals} if main else {}
     result, written = None, []
-    try:
-        result = run_study(base, request, console)
-        _report(console, result, request, name, im, picture, recording, written)
-    except KeyboardInterrupt:
-        signum = stopped_by[0] if stopped_by else signal.SIGINT
-        stopped_by.append(signum)  # from here on every signal is a repeat
-        how = "" if signum == signal.SIGINT else f" ({signal_name(signum)})"
-        if result is None:
-            said = f"every finished row is in {out}; run the same command again to resume"
-        else:  # the study is complete: what is missing is a picture
-            missing = [str(f.path) for f in (picture, recording) if f is not None and f.path not in written]
-            again = "with --force (no run is made again)" if written else "(no run is made again)"
-            said = f"every row is in {out}, but not written: {', '.join(missing)}; run the same command {again}"
-        err_console.print(f"interrupted{how}: {said}", soft_wrap=True)
-        raise typer.Exit(exit_code(signum)) from None
-    finally:
-        for sig, handler in previous.items():
-            signal.signal(sig, handler)
+    with FirstSignalStops() as signals:
+        try:
+            result = run_study(base, request, console)
+            _report(console, result, request, name, im, picture, recording, written, signals)
+        except KeyboardInterrupt:
+            signum = signals.stopping()
+            how = "" if signum == signal.SIGINT else f" ({signal_name(signum)})"
+            if result is None:
+                said = f"every finished row is in {out}; run the same command again to resume"
+            else:  # the study is complete: what is missing is a picture
+                missing = [str(f.path) for f in (picture, recording) if f is not None and f.path not in written]
+                again = "with --force (no run is made again)" if written else "(no run is made again)"
+                said = f"every row is in {out}, but not written: {', '.join(missing)}; run the same command {again}"
+            err_console.print(f"interrupted{how}: {said}", soft_wrap=True)
+            raise typer.Exit(exit_code(signum)) from None
 
 
 def _base_scenario(target: str, duration, dt):
@@ -267,10 +252,18 @@ def _records(entries: list[Path]) -> dict:
 
 
 def _report(
-    console, result, request, name: str, im: str, plot: OutputFile, recording: OutputFile | None, written: list
+    console,
+    result,
+    request,
+    name: str,
+    im: str,
+    plot: OutputFile,
+    recording: OutputFile | None,
+    written: list,
+    signals: FirstSignalStops,
 ) -> None:
     """The table on the terminal, the fit, the plot and the recording; ``written`` gets each file's path
-    once it is in place."""
+    as it is renamed into place, a signal held between the two (:func:`_recorded`)."""
     from masonrycli.intensity import UNITS
     from masonrycli.outputs import written_whole
     from masonrycli.study.fragility import fit_lognormal
@@ -287,7 +280,7 @@ def _report(
     )
     names = [a.name for a in axes if a.name != request.find and len(a.values) > 1]
     fit = None
-    with written_whole(plot) as part:
+    with written_whole(plot, around_commit=_recorded(signals, written, plot)) as part:
         if request.find:
             title = f"{name}: {request.outcome} threshold"
             threshold_curve(rows, request.find, names[0] if names else None, part, title)
@@ -314,12 +307,19 @@ def _report(
                 f"fragility ({im}): median θ = {fit.median:.4g} {UNITS[im]}, dispersion β = {fit.dispersion:.3f} "
                 f"({fit.collapsed} of {fit.runs} runs collapsed)"
             )
-    written.append(plot.path)
     console.print(f"plot: {plot.path}")
     if recording is not None:
         from masonrycli.recording.study import record_study
 
-        with written_whole(recording) as part:
+        with written_whole(recording, around_commit=_recorded(signals, written, recording)) as part:
             record_study(part, name, rows, request, fit, im, plot.path)
-        written.append(recording.path)
         console.print(f"recording: {recording.path}")
+
+
+@contextlib.contextmanager
+def _recorded(signals: FirstSignalStops, written: list, out: OutputFile):
+    """Around a report file's rename: the file is added to ``written`` once in place, a signal held until
+    then — one arriving between the rename and the record named the file "not written"."""
+    with signals.held():
+        yield
+        written.append(out.path)

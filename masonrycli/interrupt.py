@@ -11,6 +11,10 @@ Three phases, because what a signal may safely do depends on what is under way:
 
 Outside the main thread (where Python cannot install handlers) the context does nothing.
 
+:class:`FirstSignalStops` is the same rule for a command that stops by ``KeyboardInterrupt`` (``masonry
+sweep``): the first signal raises it, later ones are acknowledged and ignored, and a block can hold it
+(a report file renamed into place and recorded as written, with no signal between the two).
+
 After a command has stopped on a signal (exit 130 / 143), :func:`ignore_signals_while_exiting` lets the
 interpreter shut down undisturbed: Python puts its handlers back to the default action when it finalizes,
 so a second Ctrl-C in those last hundred milliseconds killed the process (exit -2 after the one-line
@@ -96,6 +100,60 @@ class StopSignals:
             return
         self.repeats += 1
         already_stopping(signum)
+
+
+class FirstSignalStops:
+    """Handlers for a command that stops by ``KeyboardInterrupt`` (``masonry sweep``: its study and its
+    report): the first SIGINT or SIGTERM raises it — at once, or at the end of a :meth:`held` block — and
+    :attr:`signum` says which; later ones are acknowledged on stderr and ignored, so the shutdown that
+    follows the first (the table written, the cluster closed) is not cut. Main thread only, as above."""
+
+    def __init__(self) -> None:
+        self.signum: int | None = None
+        self._holding = False
+        self._deferred = False
+        self._previous: dict[int, object] = {}
+
+    def __enter__(self) -> FirstSignalStops:
+        if threading.current_thread() is threading.main_thread():
+            for sig in SIGNALS:
+                self._previous[sig] = signal.signal(sig, self._handle)
+        return self
+
+    def __exit__(self, *exc) -> None:
+        for sig, handler in self._previous.items():
+            signal.signal(sig, handler)
+        self._previous.clear()
+
+    def stopping(self) -> int:
+        """The signal that stopped the command (SIGINT for a KeyboardInterrupt of other origin); from now
+        on every signal is a repeat."""
+        if self.signum is None:
+            self.signum = signal.SIGINT
+        return self.signum
+
+    @contextlib.contextmanager
+    def held(self):
+        """A first signal during the block is raised when the block is over: a file renamed into place
+        inside it is also recorded as written inside it, with no signal between the two."""
+        self._holding = True
+        try:
+            yield
+        finally:
+            self._holding = False
+        if self._deferred:
+            self._deferred = False
+            raise KeyboardInterrupt
+
+    def _handle(self, signum, _frame) -> None:
+        if self.signum is not None:
+            already_stopping(signum)
+            return
+        self.signum = signum
+        if self._holding:
+            self._deferred = True
+            return
+        raise KeyboardInterrupt
 
 
 def already_stopping(signum: int) -> None:

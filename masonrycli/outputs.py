@@ -156,17 +156,19 @@ def open_part(out: OutputFile) -> None:
 
 
 @contextlib.contextmanager
-def written_whole(out: OutputFile):
+def written_whole(out: OutputFile, around_commit=None):
     """For a writer that makes the whole file at once: yields the ``part`` path to write, renames it into
     place when the block ends (``out.path`` is then where it went) and removes it on any error, Ctrl-C
-    included, before re-raising — so ``out.path`` never holds half a file."""
+    included, before re-raising — so ``out.path`` never holds half a file. ``around_commit``: a context
+    manager entered around the rename (a caller holding signals there and recording the file as written)."""
     open_part(out)
     try:
         yield out.part
     except BaseException:
         out.discard()
         raise
-    out.commit()
+    with around_commit if around_commit is not None else contextlib.nullcontext():
+        out.commit()
 
 
 def check_space(outputs: list[tuple[OutputFile, int]]) -> None:

@@ -505,3 +505,31 @@ def test_a_second_ctrl_c_on_the_way_out_ends_like_the_first(block, tmp_path):
     assert said[-1].startswith("interrupted: every finished row is in"), lines
     assert not any("Traceback" in ln or "KeyboardInterrupt" in ln for ln in lines), lines
     assert 1 <= len(read_rows(out)) < 6 and not journal.exists()
+
+
+def test_a_signal_just_after_the_plot_is_renamed_does_not_call_it_missing(block, tmp_path, monkeypatch):
+    # A signal between the plot's rename and the command's record of it said "not written: s.png, s.rrd"
+    # with s.png in place. The rename and the record are one step for signals now.
+    import os
+    import signal
+    import time
+
+    from masonrycli.outputs import OutputFile
+
+    out = tmp_path / "s.csv"
+    commit = OutputFile.commit
+
+    def ctrl_c_right_after_the_rename(self):
+        where = commit(self)
+        if where.suffix == ".png":
+            os.kill(os.getpid(), signal.SIGINT)
+            time.sleep(0.2)  # the handler runs here (it raised: the plot was not recorded as written)
+        return where
+
+    monkeypatch.setattr(OutputFile, "commit", ctrl_c_right_after_the_rename)
+    result = invoke("sweep", block, "-p", "amp=0.05,0.1", "--duration", 0.02, "--workers", 0, "-o", out)
+    said = " ".join(result.output.split())
+    assert result.exit_code == 130, result.output
+    assert f"interrupted: every row is in {out}, but not written: {tmp_path / 's.rrd'}; " in said
+    assert "run the same command with --force (no run is made again)" in said
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["block.toml", "s.csv", "s.png"]

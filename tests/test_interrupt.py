@@ -143,3 +143,26 @@ def test_signals_are_ignored_on_the_way_out_of_a_stopped_command():
     finally:
         for s, handler in before.items():
             signal.signal(s, handler)
+
+
+def test_first_signal_stops_held_blocks_and_repeats():
+    """masonry sweep's handlers: the first signal raises KeyboardInterrupt (at the end of a held block if it
+    came inside one), later ones are acknowledged and ignored; the handlers are restored after."""
+    from masonrycli.interrupt import FirstSignalStops
+
+    before = signal.getsignal(signal.SIGTERM)
+    with FirstSignalStops() as signals:
+        done = []
+        with pytest.raises(KeyboardInterrupt):
+            with signals.held():
+                os.kill(os.getpid(), signal.SIGTERM)
+                time.sleep(0.1)  # the handler runs here and only records it
+                done.append("after the signal")
+        assert done == ["after the signal"] and signals.stopping() == signal.SIGTERM
+        os.kill(os.getpid(), signal.SIGINT)  # a repeat: acknowledged, ignored
+        time.sleep(0.1)
+    assert signal.getsignal(signal.SIGTERM) is before
+    with FirstSignalStops() as signals, pytest.raises(KeyboardInterrupt):
+        os.kill(os.getpid(), signal.SIGINT)
+        time.sleep(5)
+    assert signals.signum == signal.SIGINT
