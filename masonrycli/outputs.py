@@ -56,7 +56,7 @@ def _numbered(path: Path, k: int) -> Path:
 def free_name(path: Path) -> Path:
     """``path``, or the first ``stem-k.suffix`` (k = 2, 3…) that neither exists nor is being written."""
     k = 1
-    while _numbered(path, k).exists() or _being_written(_numbered(path, k)):
+    while os.path.lexists(_numbered(path, k)) or _being_written(_numbered(path, k)):
         k += 1
     return _numbered(path, k)
 
@@ -119,8 +119,9 @@ def check_output(path: Path, option: str, suffix: str, force: bool, *, default_n
         raise InputError(f"{where}: the file name must end in {suffix}")
     if path.is_dir():
         raise InputError(f"{where}: is a folder")
-    if path.exists() and not force:
-        raise InputError(f"{where}: the file exists (add --force to replace it)")
+    if os.path.lexists(path) and not force:  # a link to a missing file too: the run wrote "x-2.rrd" instead
+        broken = "" if path.exists() else f", a link to the missing {os.readlink(path)}"
+        raise InputError(f"{where}: the file exists{broken} (add --force to replace it)")
     if path.exists() and not os.access(path, os.W_OK):
         raise InputError(f"{where}: the file exists and is read-only")
     folder = path.parent

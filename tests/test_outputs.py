@@ -98,6 +98,23 @@ def test_existing_outputs_are_kept_unless_force(tmp_path):
     assert leftovers(tmp_path) == []
 
 
+def test_a_link_to_a_missing_file_is_an_existing_output(tmp_path):
+    """--out x.rrd where x.rrd is a link to a missing file ran and wrote x-2.rrd, a name nobody asked for."""
+    link = tmp_path / "x.rrd"
+    os.symlink(tmp_path / "gone" / "x.rrd", link)
+    result = invoke("run", COLUMN, "--duration", 0.01, "--out", link)
+    assert result.exit_code == 2, result.output
+    said = " ".join(result.output.split())
+    assert f"--out {link}: the file exists, a link to the missing {tmp_path / 'gone' / 'x.rrd'}" in said
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["x.rrd"] and link.is_symlink()
+    result = invoke("run", COLUMN, "--duration", 0.01, "--out", link, "--force")  # replaces the link itself
+    assert result.exit_code == 0, result.output
+    assert not link.is_symlink() and link.read_bytes()[:4] == b"RRF2" and not (tmp_path / "gone").exists()
+    os.symlink(tmp_path / "gone", tmp_path / "y-2.rrd")
+    (tmp_path / "y.rrd").write_bytes(b"")
+    assert free_name(tmp_path / "y.rrd") == tmp_path / "y-3.rrd"  # a default name skips a broken link too
+
+
 def test_out_and_history_naming_one_file_is_refused(tmp_path):
     """Finding 2: --out X.rrd --history X.rrd replaced the recording with the history and exited 0."""
     x = tmp_path / "x.rrd"
