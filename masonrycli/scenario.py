@@ -271,10 +271,11 @@ def _block_mass(block: Block) -> float:
 
 
 def check_sampling(scenario: Scenario) -> None:
-    """Raise :class:`InputError` for a sine faster than the time step can follow: above 1/(2 dt) the
+    """Raise :class:`InputError` for a sine faster than the time step can follow: at or above 1/(2 dt) the
     steps sample it at aliased phases (``--freq 1e9`` at dt = 1e-3 s sampled sin(2π·10⁶·k) = 0: the ground
-    never moved, and nothing said so); and for a support moving faster than ``MAX_SUPPORT_SPEED`` within
-    the run. Called once the command line's overrides are applied."""
+    never moved, and nothing said so; at exactly 1/(2 dt), two steps a period, ``--dt 0.25`` on the 2 Hz
+    wall, it is sampled at sin(π·k) = 0 too: PGA 3e-15 m/s², exit 0); and for a support moving faster
+    than ``MAX_SUPPORT_SPEED`` within the run. Called once the command line's overrides are applied."""
     dt = scenario.run.dt
     source = str(scenario.source)
     where = "" if source.startswith("builder:") or not source else f"{source}: "
@@ -285,10 +286,11 @@ def check_sampling(scenario: Scenario) -> None:
                 f'{where}support "{support.name}": {m.describe()} moves at up to {peak:.3g} m/s, more than '
                 f"{MAX_SUPPORT_SPEED:g} m/s (a likely typo: a block that fast is a diverged run)"
             )
-        if m.kind == "sine" and m.amplitude != 0.0 and m.frequency * dt > 0.5:
+        if m.kind == "sine" and m.amplitude != 0.0 and m.frequency * dt >= 0.5:
             raise InputError(
-                f'{where}support "{support.name}": frequency = {m.frequency:g} Hz is above 1/(2 dt) = {0.5 / dt:g} Hz, '
-                f"the fastest sine dt = {dt:g} s can follow (dt = {0.05 / m.frequency:.3g} s gives 20 steps a period)"
+                f'{where}support "{support.name}": frequency = {m.frequency:g} Hz is '
+                f"{'above' if m.frequency * dt > 0.5 else 'at'} 1/(2 dt) = {0.5 / dt:g} Hz: steps of dt = {dt:g} s "
+                f"sample it at aliased phases (dt = {0.05 / m.frequency:.3g} s gives 20 steps a period)"
             )
 
 

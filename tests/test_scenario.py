@@ -337,8 +337,12 @@ def test_check_sampling_refuses_a_sine_above_half_the_step_rate():
 
     scenario = load_scenario(DATA / "block_on_ground.toml")  # 2 Hz, dt = 1e-3 s
     check_sampling(scenario)
-    fast = dataclasses.replace(scenario, run=dataclasses.replace(scenario.run, dt=0.25))  # 2 Hz × 0.25 s = 0.5
-    check_sampling(fast)  # two steps a period: still followed
+    fast = dataclasses.replace(scenario, run=dataclasses.replace(scenario.run, dt=0.2))  # 2 Hz × 0.2 s = 0.4
+    check_sampling(fast)  # 2.5 steps a period: still followed
+    # two steps a period sample sin(π·k) = 0: the wall's ground never moved (PGA 3e-15 m/s², exit 0)
+    at_limit = dataclasses.replace(scenario, run=dataclasses.replace(scenario.run, dt=0.25))
+    with pytest.raises(InputError, match=r'support "ground": frequency = 2 Hz is at 1/\(2 dt\) = 2 Hz: steps of'):
+        check_sampling(at_limit)
     too_fast = dataclasses.replace(scenario, run=dataclasses.replace(scenario.run, dt=0.5))
     with pytest.raises(
         InputError, match=r'block_on_ground.toml: support "ground": frequency = 2 Hz is above 1/\(2 dt\) = 1 Hz'
