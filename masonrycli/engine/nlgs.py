@@ -252,7 +252,7 @@ def _nlgs(contact_body, pack, count, mu, tolerance, max_iterations, v, r, status
         if alternate and it % 2 == 1:
             first, step = count - 1, -1
         for k in range(count):
-            c = first + step * k
+            c = np.uint64(first + step * k)  # unsigned: no wrap-around test per row access (momentum.py)
             a = contact_body[c, 0]
             b = contact_body[c, 1]
             ut, un = _relative_velocity(v, a, b, pack, c)
