@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from masonrycli.engine.warmstart import WarmStart
+from masonrycli.engine.warmstart import WarmStart, _warm_start
 
 
 def test_remembered_keys_are_sorted_stably_and_found_again():
@@ -25,6 +25,33 @@ def test_remembered_keys_are_sorted_stably_and_found_again():
         np.testing.assert_array_equal(out, np.reshape([first[k] for k in unique], (-1, 2)))
         fresh = np.full((2, 2), np.nan)
         assert warm.start(np.array([-1, 10**6]), 2, fresh) == 0 and not fresh.any()
+
+
+def test_each_key_finds_the_row_a_binary_search_finds():
+    # The search starts from the previous key's row and gallops (warmstart._warm_start): whatever the
+    # order of the keys (sorted, near-sorted, shuffled, repeated, absent, beyond either end), the row and
+    # so the impulse must be np.searchsorted's.
+    rng = np.random.default_rng(7)
+    for trial in range(400):
+        prev = np.sort(rng.integers(0, 80, int(rng.integers(0, 60))))
+        if trial % 3 == 0:
+            prev = np.unique(prev)
+        n = prev.size
+        key = rng.integers(-5, 90, int(rng.integers(0, 60)))
+        if trial % 4 < 2:
+            key = np.sort(key)
+        if trial % 4 == 1 and key.size > 3:
+            key[1], key[2] = key[2], key[1]
+        prev_r = rng.standard_normal((n + 2, 2))
+        out = np.full((key.size, 2), np.nan)
+        hits = _warm_start(key, key.size, prev, prev_r, out)
+        i = np.searchsorted(prev, key)
+        found = i < n
+        found[found] = prev[i[found]] == key[found]
+        expected = np.zeros((key.size, 2))
+        expected[found] = prev_r[i[found]]
+        assert hits == found.sum()
+        np.testing.assert_array_equal(out, expected)
 
 
 def _wall_at_rest(alert: float):
