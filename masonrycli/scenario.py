@@ -14,6 +14,7 @@ the file and the key, e.g. ``wall.toml: [run] dt = -0.001: must be > 0``.
 from __future__ import annotations
 
 import dataclasses
+import math
 import os
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -33,6 +34,8 @@ MAX_COUNT = 10**9
 MAX_FRICTION = 1e3
 """Largest Coulomb μ: masonry joints have 0.4–1 and μ = 1000 already forbids sliding; beyond ~1e7 the limit
 analysis LP lost the weight against the friction cone's size and called the wall unable to stand."""
+MAX_GRAVITY = 1e4
+"""m/s² — a larger gravity vector is refused as a likely typo (≈ 1000 g; ``gravity = [0, -1e9]`` ran)."""
 MAX_SUPPORT_SPEED = 1e3
 """m/s — a support moving faster is refused as a likely typo: run.py calls a block that fast diverged
 (``--amp 1e30`` ran and reported the wall "collapsed at t = 0.001 s", exit 0; a record of 1e300 m/s too,
@@ -95,6 +98,12 @@ class RunConfig:
             )
         put("theta", check_real("theta", self.theta, ge=0.5, le=1.0))
         put("gravity", check_vector("gravity", self.gravity))
+        if math.hypot(*self.gravity) > MAX_GRAVITY:
+            raise field_error(
+                "gravity",
+                self.gravity,
+                f"|g| = {math.hypot(*self.gravity):.3g} m/s² is more than {MAX_GRAVITY:g} (about 1000 g; a likely typo)",
+            )
         put("tolerance", check_real("tolerance", self.tolerance, gt=0.0, lt=1.0))
         put("max_iterations", check_int("max_iterations", self.max_iterations, ge=1, le=MAX_COUNT))
         if self.solver not in SOLVERS:

@@ -73,6 +73,13 @@ FILE_ROWS = [
         "[run] max_iterations = 1.5: must be an integer",
     ),
     ("run-gravity-short", scen("gravity = [0]"), ("check", "s.toml"), 2, "[run] gravity = [0]: must be 2 numbers"),
+    (  # it ran (a block on the ground at 1e8 g, "intact")
+        "run-gravity-absurd",
+        scen("gravity = [0, -1e9]"),
+        ("check", "s.toml"),
+        2,
+        "[run] gravity = [0.0, -1000000000.0]: |g| = 1e+09 m/s² is more than 10000 (about 1000 g; a likely typo)",
+    ),
     ("run-tolerance", scen("tolerance = 2"), ("check", "s.toml"), 2, "[run] tolerance = 2: must be < 1"),
     (
         "run-unknown-key",
