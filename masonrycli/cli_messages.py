@@ -72,7 +72,8 @@ class OneLineUsageErrors(typer.core.TyperGroup):
             sys.exit(exc.exit_code)  # as click and typer do
         except click_errors.UsageError as exc:
             command = exc.ctx.command_path if exc.ctx is not None else "masonry"
-            say("error", "bold red", f"{exc.format_message()} ({command} --help lists the options)")
+            listed = "commands" if exc.format_message().startswith("No such command") else "options"
+            say("error", "bold red", f"{exc.format_message()} ({command} --help lists the {listed})")
             sys.exit(exc.exit_code)
         except click_errors.ClickException as exc:
             say("error", "bold red", exc.format_message())

@@ -275,8 +275,8 @@ def _report(
     columns = find_columns(keys, request.find) if request.find else grid_columns(keys, im)
     console.print(study_table(rows, columns, keys, console, result.out))
     console.print(
-        f"{len(rows)} rows in {result.out} ({result.ran} runs now, {result.skipped} rows already there, "
-        f"{result.failed} failed) in {result.wall_time:.1f} s"
+        f"{_n(len(rows), 'row')} in {result.out} ({_n(result.ran, 'run')} now, {_n(result.skipped, 'row')} already "
+        f"there, {result.failed} failed) in {result.wall_time:.1f} s"
     )
     names = [a.name for a in axes if a.name != request.find and len(a.values) > 1]
     fit = None
@@ -323,3 +323,8 @@ def _recorded(signals: FirstSignalStops, written: list, out: OutputFile):
     with signals.held():
         yield
         written.append(out.path)
+
+
+def _n(count: int, word: str) -> str:
+    """``1 row``, ``2 rows``, ``0 rows`` (it said "1 rows in s.csv (1 runs now, ...)")."""
+    return f"{count} {word}{'' if count == 1 else 's'}"

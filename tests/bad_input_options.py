@@ -55,6 +55,14 @@ OPTION_ROWS = [
         '--solver: solver = "gs": must be one of',
     ),
     ("opt-unknown", {**scen()}, (*RUN, "--bogus"), 2, "No such option: --bogus"),
+    # it said "(masonry simulate --help lists the options)" of a subcommand
+    (
+        "cmd-unknown",
+        {},
+        ("simulate", "tower"),
+        2,
+        "simulate --help lists the commands)",
+    ),
     ("check-opt-dt", {**scen()}, ("check", "s.toml", "--dt", "-1"), 2, "--dt: dt = -1"),
     ("sim-density", {}, (*WALL, "--density", "-5", "--no-recording"), 2, "--density: density = -5"),
     ("sim-thickness", {}, (*WALL, "--thickness", "0", "--no-recording"), 2, "--thickness: thickness = 0"),

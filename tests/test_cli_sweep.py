@@ -168,6 +168,18 @@ def test_find_threshold_curve_reads_as_a_plot(block, tmp_path):
     assert series == {"/study/thresholds/line": expected, "/study/thresholds/points": expected}
 
 
+def test_the_counts_line_says_one_row(block, tmp_path):
+    # it said "1 rows in s.csv (1 runs now, 0 rows already there, 0 failed)"
+    args = ["-p", "amp=0.1", "--duration", 0.02, "--workers", 0, "-o", tmp_path / "s.csv", "--no-recording"]
+    result = invoke("sweep", block, *args)
+    assert result.exit_code == 0, result.output
+    assert f"1 row in {tmp_path / 's.csv'} (1 run now, 0 rows already there, 0 failed)" in " ".join(
+        result.output.split()
+    )
+    again = " ".join(invoke("sweep", block, *args, "--force").output.split())
+    assert "(0 runs now, 1 row already there, 0 failed)" in again
+
+
 def test_grid_sweep_state_map_and_histories(block, tmp_path):
     out = tmp_path / "grid.parquet"
     args = ["-p", "amp=0.05,0.6", "-p", "friction=0.3,0.8", "--duration", 0.3, "--workers", 0, "-o", out]

@@ -62,3 +62,10 @@ def test_threshold_rows_fit_80_columns():
     assert max(len(line) for line in lines) <= 80
     assert any("│ 1    │ 1.312         │ 9    │" in line for line in lines)
     assert "amp_threshold m/s" in " ".join(lines)
+
+
+def test_a_unitless_threshold_has_no_empty_legend_entry():
+    # --find friction printed "friction_threshold  · runs: evaluations": a name with no unit after it
+    rows = [{"blocks": 51, "friction_threshold": 0.42, "evaluations": 7, "note": "", "status": "completed"}]
+    legend = " ".join(_render(rows, find_columns(["blocks"], "friction"), ["blocks"], 120))
+    assert "friction_threshold  ·" not in legend and "runs: evaluations" in legend

@@ -83,7 +83,12 @@ def find_columns(names: list[str], find: str) -> list[Column]:
     """The terminal columns of a threshold search (``--find``)."""
     unit = PARAM_UNITS.get(find.rpartition(".")[2], "")
     return _params(names) + [
-        Column(f"{find}_threshold", lambda r: _number(r.get(f"{find}_threshold"), ".4g"), f"{find}_threshold {unit}"),
+        # a unitless parameter (friction) has no legend entry: it read "friction_threshold  · runs: ..."
+        Column(
+            f"{find}_threshold",
+            lambda r: _number(r.get(f"{find}_threshold"), ".4g"),
+            unit and f"{find}_threshold {unit}",
+        ),
         Column("runs", lambda r: _count(r.get("evaluations")), "runs: evaluations", 1),
         Column("note", lambda r: str(r.get("note") or "")),
     ]
