@@ -29,11 +29,23 @@ from masonrycli.report import progress_bar, summary_table
 from masonrycli.run import RunResult, Simulation, simulate
 from masonrycli.sinks import COMPLETED, FAILED
 
-HISTORY_BYTES_PER_BLOCK = 400
-"""Upper estimate of one block's share of a history row (measured: 326 B for the walls)."""
+HISTORY_BYTES_PER_BLOCK = 500
+"""Upper estimate of one block's share of a history row (measured: 326 B for the walls, 420 B for an arch of
+60 voussoirs, whose blocks have more joints)."""
+HISTORY_STATIC_BYTES = 20_000
+"""... and of what a history holds however short (names, joints, intensity measures)."""
 RECORDING_BYTES_PER_BLOCK = 500
 """Upper estimate of one block's share of a recorded frame (measured: 405 B for the walls)."""
 FRAME_OVERHEAD_BYTES = 2000
+RECORDING_STATIC_BYTES = 600_000
+"""Upper estimate of what a recording holds however short: blueprint, legends, document, static geometry
+(measured: 452 kB for the 51-block wall's 10 steps, 548 kB for the aqueduct's 2; without it a 0.1 s run
+was let start on a disk it then filled, exit 4)."""
+RECORDING_STATIC_BYTES_PER_BLOCK = 300
+"""... and its share per block (measured: 703 kB for 1004 blocks and 2 steps, one frame of ~400 kB in it)."""
+RECORDING_BYTES_PER_STEP = 200
+"""Upper estimate of the per-step series (solver sweeps, residual, contacts: measured ~150 B a step for
+the wall at --record-every 1000, 603 kB for 1000 steps)."""
 
 
 @dataclass
@@ -59,11 +71,21 @@ def plan_outputs(scenario, out: Path | None, history: Path | None, *, no_recordi
             rec = check_output(out, "--out", ".rrd", force)
     hist = check_output(history, "--history", ".npz", force) if history is not None else None
     check_distinct(rec, hist)
-    frames = scenario.run.n_steps // scenario.run.record_every + 2
-    n = scenario.assembly.block_count
-    sizes = [(rec, RECORDING_BYTES_PER_BLOCK), (hist, HISTORY_BYTES_PER_BLOCK)]
-    check_space([(o, frames * (per_block * n + FRAME_OVERHEAD_BYTES)) for o, per_block in sizes if o is not None])
+    check_space([(o, size) for o, size in zip((rec, hist), output_sizes(scenario)) if o is not None])
     return Outputs(rec, hist)
+
+
+def output_sizes(scenario) -> tuple[int, int]:
+    """Upper estimates of the recording's and the history's sizes, bytes (what check_space compares)."""
+    steps, n = scenario.run.n_steps, scenario.assembly.block_count
+    frames = steps // scenario.run.record_every + 2
+    recording = (
+        RECORDING_STATIC_BYTES
+        + RECORDING_STATIC_BYTES_PER_BLOCK * n
+        + RECORDING_BYTES_PER_STEP * steps
+        + frames * (RECORDING_BYTES_PER_BLOCK * n + FRAME_OVERHEAD_BYTES)
+    )
+    return recording, HISTORY_STATIC_BYTES + frames * (HISTORY_BYTES_PER_BLOCK * n + FRAME_OVERHEAD_BYTES)
 
 
 @dataclass
