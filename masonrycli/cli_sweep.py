@@ -13,7 +13,7 @@ from typing import Annotated
 
 import typer
 
-from masonrycli.errors import InputError
+from masonrycli.errors import NOT_A_FILE, InputError
 from masonrycli.interrupt import FirstSignalStops, exit_code, signal_name
 from masonrycli.outputs import OutputFile
 
@@ -243,7 +243,7 @@ def _records(entries: list[Path]) -> dict:
         elif entry.is_file():
             files.append(entry)
         else:
-            raise InputError(f"--records {entry}: no such file or folder")
+            raise InputError(f"--records {entry}: {NOT_A_FILE if entry.exists() else 'no such file or folder'}")
     names = [p.name for p in files]
     twice = sorted({n for n in names if names.count(n) > 1})
     if twice:

@@ -18,6 +18,24 @@ class InputError(ValueError):
     """Bad user input (scenario file, option, geometry). ``str(err)`` is one line saying what and where."""
 
 
+NOT_A_FILE = "not a regular file (a device, a pipe or a socket)"
+"""What input readers say of a path that exists but is no file: reading ``/dev/zero`` or a named pipe never
+ended (the run hung before its first line), and the commands that test ``is_file()`` called it missing."""
+
+
+def special_file(path) -> bool:
+    """True for a path that exists and is neither a regular file nor a folder (checked without opening it:
+    opening a named pipe waits for a writer)."""
+    import os
+    import stat
+
+    try:
+        mode = os.stat(path).st_mode
+    except OSError:
+        return False
+    return not (stat.S_ISREG(mode) or stat.S_ISDIR(mode))
+
+
 def one_line(text: str) -> str:
     """``text`` on one line: every run of whitespace (newlines included) becomes one space."""
     return " ".join(str(text).split())

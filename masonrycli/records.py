@@ -18,7 +18,7 @@ import re
 
 import numpy as np
 
-from masonrycli.errors import InputError
+from masonrycli.errors import NOT_A_FILE, InputError, special_file
 from masonrycli.motion import Record
 from masonrycli.record_units import check_at2_header, check_at2_sample, check_csv_header
 from masonrycli.values import format_value, quote_string, shorten
@@ -91,6 +91,8 @@ def _fields(line: str) -> list[str]:
 
 
 def _read_text(path, name: str) -> str:
+    if special_file(path):
+        raise InputError(f"{name}: cannot read record: {NOT_A_FILE}")
     try:
         with open(path, "rb") as fh:
             raw = fh.read()
@@ -286,7 +288,8 @@ def _table_file(table: dict, key: str, base_dir: str):
         raise InputError(f"motion.{key} = {format_value(file)[:40]}: must be a file name")
     resolved = os.path.abspath(os.path.join(base_dir, file))
     if not os.path.isfile(resolved):
-        raise InputError(f"motion.{key} = {quote_string(file)}: no such file (looked for {resolved})")
+        missing = NOT_A_FILE if os.path.exists(resolved) else "no such file"
+        raise InputError(f"motion.{key} = {quote_string(file)}: {missing} (looked for {resolved})")
     try:
         time, value, native = read_record(resolved, display=file)
         if native is None:

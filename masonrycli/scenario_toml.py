@@ -19,7 +19,7 @@ from pathlib import Path
 import numpy as np
 
 from geometry_library.blocks import Assembly, Block, GeometryError, Support
-from masonrycli.errors import InputContext, InputError, one_line
+from masonrycli.errors import NOT_A_FILE, InputContext, InputError, one_line, special_file
 from masonrycli.motion import MOTION_KINDS, Fixed, Motion
 from masonrycli.records import record_fields
 from masonrycli.scenario import Material, RunConfig, Scenario
@@ -61,6 +61,8 @@ def load_scenario(path) -> Scenario:
     Raises :class:`InputError` (one line naming the file and the key) on any problem.
     """
     fname = os.fspath(path)
+    if special_file(fname):
+        raise InputError(f"{fname}: cannot read scenario: {NOT_A_FILE}")
     try:
         raw = Path(fname).read_bytes()
     except IsADirectoryError:

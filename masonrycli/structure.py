@@ -16,7 +16,7 @@ from pathlib import Path
 
 from geometry_library.blocks import Assembly, GeometryError
 from geometry_library.values import is_integer, is_real
-from masonrycli.errors import InputContext, InputError, one_line
+from masonrycli.errors import NOT_A_FILE, InputContext, InputError, one_line
 from masonrycli.values import field_error, quote_string
 
 GEOMETRY_SUFFIXES = (".geojson", ".json", ".wkt")
@@ -37,7 +37,8 @@ def read_geometry(
             f"file = {quote_string(path)}: unknown geometry format (expected {', '.join(GEOMETRY_SUFFIXES)})",
         )
     if not os.path.isfile(path):
-        raise ctx.error(where, f"file = {quote_string(path)}: no such file" if where else "no such file")
+        missing = NOT_A_FILE if os.path.exists(path) else "no such file"
+        raise ctx.error(where, f"file = {quote_string(path)}: {missing}" if where else missing)
     reader = geo_io.read_wkt if suffix == ".wkt" else geo_io.read_geojson
     try:
         return reader(path, density=density, thickness=thickness)

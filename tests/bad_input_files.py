@@ -40,6 +40,25 @@ SQUARE = [[[0, 0], [1, 0], [1, 1], [0, 1], [0, 0]]]
 
 # (id, files, argv, exit code, fragment of the one line)
 FILE_ROWS = [
+    # paths that exist but are no file: /dev/zero was read for ever (the command hung), and the commands
+    # that ask is_file() called it missing ("no such scenario or geometry file", "no such recording")
+    ("scenario-dev-zero", {}, ("run", "/dev/zero"), 2, "/dev/zero: cannot read scenario: not a regular file"),
+    ("limit-dev-zero", {}, ("limit", "/dev/zero"), 2, "/dev/zero: not a regular file (a device, a pipe or a socket)"),
+    ("inspect-dev-zero", {}, ("inspect", "/dev/zero"), 2, "/dev/zero: not a regular file"),
+    (
+        "sweep-records-dev-zero",
+        {},
+        ("sweep", "wall", "--records", "/dev/zero"),
+        2,
+        "--records /dev/zero: not a regular",
+    ),
+    (
+        "scenario-record-dev-zero",
+        scen(extra='motion = { kind = "record", file = "/dev/zero" }\n'),
+        ("check", "s.toml"),
+        2,
+        'motion.file = "/dev/zero": not a regular file (a device, a pipe or a socket)',
+    ),
     # -- scenario TOML: [run] and [material]
     (
         "run-duration-string",

@@ -86,6 +86,31 @@ def test_load_record_csv_unreadable(tmp_path):
     assert "latin1.csv: not a UTF-8 text file" in one_line(exc)
 
 
+def test_a_pipe_or_a_device_is_refused_without_reading_it(tmp_path):
+    # "--record /dev/zero" read for ever (memory growing) and a named pipe blocked in open() waiting for a
+    # writer: the command hung before its first line. The read runs in a thread so that the old hang fails
+    # the test instead of stopping the suite.
+    import os
+    import threading
+
+    pipe = tmp_path / "pipe.csv"
+    os.mkfifo(pipe)
+    for path in (pipe, Path("/dev/zero")):
+        said = []
+
+        def read(path=path, said=said):
+            try:
+                load_record_csv(path)
+            except InputError as exc:
+                said.append(str(exc))
+
+        reader = threading.Thread(target=read, daemon=True)
+        reader.start()
+        reader.join(10.0)
+        assert not reader.is_alive(), f"reading {path} did not end"
+        assert said == [f"{path}: cannot read record: not a regular file (a device, a pipe or a socket)"]
+
+
 # ------------------------------------------------------------------------------------------- .AT2
 
 FREQS, AMPS = [0.7, 1.3, 2.1, 2.9], [0.02, 0.015, 0.01, 0.006]  # band 0.7–2.9 Hz, displacement amplitudes m

@@ -18,7 +18,7 @@ from rich.console import Console
 from rich.table import Table
 from rich.text import Text
 
-from masonrycli.errors import InputError
+from masonrycli.errors import NOT_A_FILE, InputError, special_file
 from masonrycli.interrupt import StopRun, StopSignals, exit_code, signal_name
 from masonrycli.limit.analysis import LimitResult, analyse
 from masonrycli.limit.problem import LiveLoad
@@ -41,6 +41,8 @@ def resolve_structure(structure: str, friction: float | None):
     path = Path(structure)
     if structure in BUILT_INS and not path.exists():
         scenario = scenario_from_builder(structure, {}, RunConfig(), Material(), {})
+    elif special_file(path):
+        raise InputError(f"{structure}: {NOT_A_FILE}")
     elif not path.is_file():
         raise InputError(f"{structure}: no such scenario or geometry file (built-ins: {', '.join(BUILT_INS)})")
     elif path.suffix.lower() in GEOMETRY_SUFFIXES:

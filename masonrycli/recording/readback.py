@@ -19,6 +19,7 @@ import numpy as np
 import pyarrow as pa
 import rerun as rr
 
+from masonrycli.errors import NOT_A_FILE
 from masonrycli.recording._rerun_private import viewer_pid
 from masonrycli.recording.layout import BLOCKS, CHAIN_KEY, FIELDS, HOVER_VALUES, METADATA, PER_STEP_SERIES, SERIES
 
@@ -54,7 +55,7 @@ def recording_path_problem(path: str | os.PathLike) -> str | None:
     if os.path.isfile(path):
         return None
     if not os.path.isdir(path):
-        return f"{shown}: no such recording"
+        return f"{shown}: {NOT_A_FILE if os.path.exists(path) else 'no such recording'}"
     try:
         with os.scandir(path) as entries:
             found = sorted((e for e in entries if e.name.endswith(".rrd") and e.is_file()), key=lambda e: e.name)
