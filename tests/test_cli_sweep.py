@@ -236,6 +236,8 @@ def test_grid_sweep_state_map_and_histories(block, tmp_path):
         (["-p", "amp=0.1", "--duration", "0.02", "--dt", "nan"], "--dt: dt = nan: must be a finite number"),
         (["-p", "amp=0.1", "--duration", "-1", "--dt", "0.01"], "--duration: duration = -1.0: must be > 0"),
         (["-p", "amp=0.1,1e30"], "--param amp=1e+30: "),  # it ran, exit 0
+        # both rows ran at 0.5 m/s, under the names amp=0.1 and amp=0.2
+        (["-p", "amp=0.1,0.2", "-p", "ground.amp=0.5"], "--param ground.amp: sets the amplitude of support 'ground'"),
     ],
 )
 def test_sweep_errors_are_one_line(block, args, fragment):

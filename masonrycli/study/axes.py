@@ -158,6 +158,7 @@ def apply_point(base, params: dict):
         for j in shaking:
             motions[j] = record
     names = [s.name for s in scenario.assembly.supports]
+    set_by: dict[tuple[int, str], str] = {}  # (support, field) -> the parameter that set it
     for key, value in params.items():
         support, _, short = key.rpartition(".")
         if short not in MOTION_PARAMS:
@@ -173,6 +174,13 @@ def apply_point(base, params: dict):
                 f"--param {key}: {scenario.name} has no {kind} motion{' on ' + support if support else ''}"
             )
         for j in targets:
+            # "-p amp=1,2 -p ground.amp=0.5" ran both rows at 0.5 m/s under the names amp=1 and amp=2
+            other = set_by.setdefault((j, attr), key)
+            if other != key:
+                raise InputError(
+                    f"--param {key}: sets the {attr} of support {names[j]!r}, which --param {other} sets too "
+                    "(give one of them)"
+                )
             motions[j] = _replace(motions[j], {attr: value}, where=f"--param {key}")
     scenario = dataclasses.replace(scenario, motions=tuple(motions))
     try:
