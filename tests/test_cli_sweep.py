@@ -240,7 +240,10 @@ def test_grid_sweep_state_map_and_histories(block, tmp_path):
         (["-p", "amp=0.1,0.2", "-p", "ground.amp=0.5"], "--param ground.amp: sets the amplitude of support 'ground'"),
     ],
 )
-def test_sweep_errors_are_one_line(block, args, fragment):
+def test_sweep_errors_are_one_line(block, args, fragment, tmp_path, monkeypatch):
+    # in a folder of its own: a row that ran (before its refusal existed) wrote study-block.parquet and .png
+    # into the working directory, and every later row then said "--out's plot study-block.png: the file exists"
+    monkeypatch.chdir(tmp_path)
     result = invoke("sweep", block, *args)
     assert result.exit_code == 2, result.output
     lines = [ln for ln in result.output.strip().splitlines() if ln.strip()]
