@@ -9,6 +9,7 @@ is renamed into place, so what was computed is kept and a path never holds half 
 from __future__ import annotations
 
 import platform
+import shlex
 import shutil
 import sys
 import warnings
@@ -270,9 +271,9 @@ def print_summary(console: Console, outcome: Outcome, scenario, hint: str = "") 
     if hint and "--out" in paths:
         console.print(hint, soft_wrap=True)
     if "--out" in paths:
-        console.print(
-            Text.assemble("Open the recording:  ", (f"{rerun_command()} {paths['--out']}", "bold")), soft_wrap=True
-        )
+        # quoted for the shell: "rerun my runs/w.rrd" opened "my" and "runs/w.rrd"
+        command = f"{shlex.quote(rerun_command())} {shlex.quote(paths['--out'])}"
+        console.print(Text.assemble("Open the recording:  ", (command, "bold")), soft_wrap=True)
 
 
 def rerun_command() -> str:

@@ -172,6 +172,19 @@ def test_last_line_opens_the_recording(tmp_path):
     assert last.startswith("Open the recording:") and last.endswith(f"rerun {rrd}"), last
 
 
+def test_the_last_line_is_a_command_the_shell_runs(tmp_path):
+    """A recording path with a space or a quote was printed as is: pasted into a shell, "rerun my runs/w.rrd"
+    asked rerun for two files."""
+    import shlex
+
+    rrd = tmp_path / "my runs" / "it's.rrd"
+    result = invoke("simulate", "wall", "--duration", 0.01, "--out", rrd)
+    assert result.exit_code == 0, result.output
+    last = result.output.strip().splitlines()[-1]
+    words = shlex.split(last.removeprefix("Open the recording:"))
+    assert words[0].endswith("rerun") and words[1:] == [str(rrd)], last
+
+
 def test_courses_and_length_choose_the_wall(tmp_path):
     """Finding 8: --courses/--length without --blocks always failed ("51 blocks cannot be laid…")."""
     npz = tmp_path / "h.npz"
