@@ -13,16 +13,16 @@ import sys
 def main() -> None:
     try:
         from masonrycli.cli import main as cli_main
+        from masonrycli.interrupt import ignore_signals_while_exiting
     except KeyboardInterrupt:
         sys.stderr.write("error: Ctrl-C while masonry was starting: nothing was run\n")
         raise SystemExit(130) from None
     try:
         cli_main()
-    except SystemExit as stop:  # stopped by a signal: the rest of the way out ignores a second one
-        from masonrycli.interrupt import ignore_signals_while_exiting
-
-        ignore_signals_while_exiting(stop.code)
-        raise
+    finally:
+        # the command is over, however it ended (its files whole, or removed): a signal from here on could
+        # only cut the interpreter's shutdown (exit -2, or a traceback from an atexit callback)
+        ignore_signals_while_exiting()
 
 
 if __name__ == "__main__":

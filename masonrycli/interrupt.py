@@ -15,10 +15,12 @@ Outside the main thread (where Python cannot install handlers) the context does 
 sweep``): the first signal raises it, later ones are acknowledged and ignored, and a block can hold it
 (a report file renamed into place and recorded as written, with no signal between the two).
 
-After a command has stopped on a signal (exit 130 / 143), :func:`ignore_signals_while_exiting` lets the
-interpreter shut down undisturbed: Python puts its handlers back to the default action when it finalizes,
-so a second Ctrl-C in those last hundred milliseconds killed the process (exit -2 after the one-line
-"interrupted" message) — not what the first one did.
+Once a command is over — whatever its exit code — :func:`ignore_signals_while_exiting` lets the interpreter
+shut down undisturbed: Python puts its handlers back to the default action when it finalizes, so a Ctrl-C
+in those last hundred milliseconds killed the process (exit -2 after the one-line "interrupted" message of
+a stopped run, or after ``masonry build`` had written its file whole), and one slightly earlier, in the
+``atexit`` callbacks, printed a ``KeyboardInterrupt`` traceback. Every output is closed by then, so there
+is nothing left for a signal to stop.
 """
 
 from __future__ import annotations
@@ -162,9 +164,10 @@ def already_stopping(signum: int) -> None:
     os.write(2, f"{signal_name(signum)}: already stopping — finishing the output files\n".encode())
 
 
-def ignore_signals_while_exiting(code) -> None:
-    """If ``code`` is a signal's exit code (130, 143), ignore SIGINT and SIGTERM from now on (module doc).
-    SIG_IGN, unlike a Python handler, survives the interpreter's finalization. Main thread only."""
-    if code in tuple(exit_code(s) for s in SIGNALS) and threading.current_thread() is threading.main_thread():
+def ignore_signals_while_exiting() -> None:
+    """Ignore SIGINT and SIGTERM from now on: the command is over and the process is on its way out
+    (module doc). SIG_IGN, unlike a Python handler, survives the interpreter's finalization. Main thread
+    only."""
+    if threading.current_thread() is threading.main_thread():
         for sig in SIGNALS:
             signal.signal(sig, signal.SIG_IGN)

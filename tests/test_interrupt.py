@@ -123,26 +123,60 @@ def test_a_held_signal_is_raised_when_the_block_ends():
         assert stop.phase == "setup"
 
 
-def test_signals_are_ignored_on_the_way_out_of_a_stopped_command():
-    """After exit 130 / 143 the interpreter's shutdown ignores SIGINT and SIGTERM (its own reset of the
-    handlers let a second Ctrl-C kill the process); any other exit leaves them alone."""
+def test_signals_are_ignored_on_the_way_out():
+    """Once called (by the entry point, after any command) SIGINT and SIGTERM are ignored: the
+    interpreter's own reset of the handlers let a late Ctrl-C kill the process."""
     import signal
 
     from masonrycli.interrupt import ignore_signals_while_exiting
 
     before = {s: signal.getsignal(s) for s in (signal.SIGINT, signal.SIGTERM)}
     try:
-        for code in (0, 1, 2, None, "error"):
-            ignore_signals_while_exiting(code)
-            assert {s: signal.getsignal(s) for s in before} == before
-        for code in (130, 143):
-            ignore_signals_while_exiting(code)
-            assert all(signal.getsignal(s) is signal.SIG_IGN for s in before)
-            for s, handler in before.items():
-                signal.signal(s, handler)
+        ignore_signals_while_exiting()
+        assert all(signal.getsignal(s) is signal.SIG_IGN for s in before)
     finally:
         for s, handler in before.items():
             signal.signal(s, handler)
+
+
+LATE_CTRL_C = """
+import atexit, os, signal, sys, time
+
+def late_ctrl_c():  # the last atexit callback: the command's output is complete
+    os.kill(os.getpid(), signal.SIGINT)
+    time.sleep(0.2)  # a Python handler runs here
+    sys.stderr.write("exited normally\\n")
+
+atexit.register(late_ctrl_c)
+sys.argv = ["masonry", *sys.argv[1:]]
+from masonrycli.__main__ import main
+main()
+"""
+
+
+@pytest.mark.parametrize("code", [0, 2], ids=["written", "bad-input"])
+def test_a_ctrl_c_after_the_command_is_over_is_ignored(code, tmp_path):
+    """QA: a Ctrl-C after `masonry build` had written its file whole (the interpreter shutting down) killed
+    it (exit -2) or, in an atexit callback, printed a KeyboardInterrupt traceback; the file was complete.
+    Now the exit code is the command's (0, or 2 for bad input), with no traceback."""
+    out = tmp_path / "w.geojson"
+    argv = ["build", "wall", "--out", str(out)] + (["--blocks", "-1"] if code else [])
+    proc = subprocess.run(
+        [sys.executable, "-c", LATE_CTRL_C, *argv],
+        env=dict(os.environ, RERUN_ANALYTICS="0"),
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert proc.returncode == code, proc.stderr
+    assert "Traceback" not in proc.stderr and "KeyboardInterrupt" not in proc.stderr, proc.stderr
+    assert proc.stderr.endswith("exited normally\n")
+    if code == 0:
+        import json
+
+        assert len(json.loads(out.read_text())["features"]) == 52  # 51 blocks and the ground
+    else:
+        assert not out.exists() and proc.stderr.startswith("error: ")
 
 
 def test_first_signal_stops_held_blocks_and_repeats():
