@@ -130,6 +130,8 @@ def check_output(path: Path, option: str, suffix: str, force: bool, *, default_n
         raise InputError(f"{where}: {existing} is not a folder")
     if not os.access(existing, os.W_OK | os.X_OK):
         raise InputError(f"{where}: cannot write in {existing} (permission denied)")
+    if shutil.disk_usage(existing).total == 0:  # /proc, /sys: writable to root, yet no file can be made there
+        raise InputError(f"{where}: cannot write in {existing} (a system folder, not a disk)")
     return OutputFile(path, option, force=force, default_name=default_name)
 
 

@@ -256,6 +256,19 @@ OPTION_ROWS = [
         2,
         "--out r.rrd: the file exists (add --force to replace it)",
     ),
+    # /proc is writable to root, yet no file can be made there; it said "the run would write about
+    # 699.8 kB but /proc has 0 B free (shorten --duration …)"
+    ("out-in-proc", {}, (*WALL, "--out", "/proc/x.rrd"), 2, "--out /proc/x.rrd: cannot write in /proc ("),
+    (
+        "history-in-proc",
+        {},
+        (*WALL, "--no-recording", "--history", "/proc/x.npz"),
+        2,
+        "--history /proc/x.npz: cannot write in /proc (",
+    ),
+    ("build-out-in-proc", {}, ("build", "wall", "--out", "/proc/w.geojson"), 2, "--out /proc/w.geojson: cannot write"),
+    # it said "error: : no such scenario or geometry file"
+    ("limit-empty-name", {}, ("limit", ""), 2, "the structure argument is empty (''): give wall, arch, aqueduct or"),
     # -- inspect
     ("inspect-missing", {}, ("inspect", "missing.rrd"), 2, "missing.rrd: no such recording"),
     (

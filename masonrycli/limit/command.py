@@ -39,6 +39,10 @@ def resolve_structure(structure: str, friction: float | None):
     from masonrycli.structure import GEOMETRY_SUFFIXES
 
     path = Path(structure)
+    if not structure.strip():  # Path("") is the working folder: it said "error: : no such scenario …"
+        raise InputError(
+            f"the structure argument is empty ({structure!r}): give wall, arch, aqueduct or a scenario file"
+        )
     if structure in BUILT_INS and not path.exists():
         scenario = scenario_from_builder(structure, {}, RunConfig(), Material(), {})
     elif special_file(path):
