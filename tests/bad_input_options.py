@@ -278,6 +278,21 @@ OPTION_ROWS = [
         2,
         "bad.rrd: not a readable Rerun recording",
     ),
+    # another of masonry's files: rerun's raw 'expected FourCC header "RRF2", got "PK\u{3}\u{4}"' before
+    (
+        "inspect-history",
+        {"H.npz": b"PK\x03\x04" + bytes(60)},
+        ("inspect", "H.npz"),
+        2,
+        "H.npz: a run history (.npz), not a recording; inspect reads the .rrd recordings that --out writes",
+    ),
+    (
+        "inspect-scenario",
+        {**scen()},
+        ("inspect", "s.toml"),
+        2,
+        "s.toml: a scenario file (TOML; run it with masonry run), not a recording",
+    ),
     ("inspect-folder", {"d.rrd/x": ""}, ("inspect", "d.rrd"), 2, "d.rrd: a folder, not a recording (it holds no .rrd"),
     (
         "inspect-folder-of-recordings",

@@ -46,14 +46,42 @@ def check_complete(path: str | os.PathLike) -> None:
 
 _FOLDER_NAMES = 3  # recordings named in the message about a folder; the rest are counted
 
+_RRD_MAGIC = b"RRF"  # a recording's first bytes ("RRF2" now; the digit is the format version)
+_OTHER_FILES = {  # suffix: what masonry writes or reads under it, for a file that is not a recording
+    ".npz": "a run history (.npz)",
+    ".toml": "a scenario file (TOML; run it with masonry run)",
+    ".geojson": "a geometry file (GeoJSON; run it with masonry run)",
+    ".json": "a geometry file (GeoJSON; run it with masonry run)",
+    ".wkt": "a geometry file (WKT; run it with masonry run)",
+    ".parquet": "a sweep table (.parquet)",
+    ".csv": "a table (.csv)",
+    ".png": "an image (.png)",
+}
+
+
+def _foreign_file(path: str | os.PathLike) -> str | None:
+    """What a file that is not a recording is, from its suffix, when its first bytes are not a recording's
+    (rerun's own error spoke of a "FourCC header"); None for a recording, and for a ``.rrd`` or an unknown
+    suffix (its content is then reported as not readable)."""
+    kind = _OTHER_FILES.get(os.path.splitext(os.fspath(path))[1].lower())
+    if kind is None:
+        return None
+    try:
+        with open(path, "rb") as f:
+            if f.read(len(_RRD_MAGIC)) == _RRD_MAGIC:
+                return None
+    except OSError:  # unreadable: the reader says why
+        return None
+    return f"{os.fspath(path)}: {kind}, not a recording; inspect reads the .rrd recordings that --out writes"
+
 
 def recording_path_problem(path: str | os.PathLike) -> str | None:
-    """What stops ``path`` from being read as a recording, in one line (None when it is a file): it does not
-    exist, or it is a folder — then the ``.rrd`` files directly in it are named (the first few by name)
+    """What stops ``path`` from being read as a recording, in one line (None when it is a file that may be
+    one): it is another of masonry's files (a history, a scenario), it does not exist, or it is a folder — then the ``.rrd`` files directly in it are named (the first few by name)
     and the newest is suggested, as ``masonry inspect recordings`` usually means the last run."""
     shown = os.fspath(path)
     if os.path.isfile(path):
-        return None
+        return _foreign_file(path)
     if not os.path.isdir(path):
         return f"{shown}: {NOT_A_FILE if os.path.exists(path) else 'no such recording'}"
     try:
