@@ -84,7 +84,7 @@ class Assembly:
     def support_count(self) -> int:
         return len(self.supports)
 
-    def bounds(self) -> tuple[float, float, float, float]:
-        """(xmin, ymin, xmax, ymax) over blocks and supports, m."""
-        polys = [b.polygon for b in self.blocks] + [s.polygon for s in self.supports]
+    def bounds(self, *, blocks_only: bool = False) -> tuple[float, float, float, float]:
+        """(xmin, ymin, xmax, ymax) over blocks and supports (or the blocks only), m."""
+        polys = [b.polygon for b in self.blocks] + ([] if blocks_only else [s.polygon for s in self.supports])
         return tuple(shapely.total_bounds(np.array(polys, dtype=object)).tolist())

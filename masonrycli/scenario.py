@@ -40,6 +40,10 @@ MAX_SUPPORT_SPEED = 1e3
 """m/s — a support moving faster is refused as a likely typo: run.py calls a block that fast diverged
 (``--amp 1e30`` ran and reported the wall "collapsed at t = 0.001 s", exit 0; a record of 1e300 m/s too,
 with numpy's overflow warnings)."""
+MAX_BLOCK_SPEED = 1e3
+"""m/s — an initial block velocity moving a point of the block faster (|v| + |ω|·r, r the farthest vertex
+from the centroid) is refused as a likely typo: run.py calls a block that fast diverged (a block given
+``velocity = [1e9, 0, 0]`` ended as exit 3, "diverged at step 1")."""
 SOLVERS = ("nlgs-accel", "nlgs")
 """Contact solvers a run can select (RunConfig.solver); the first is the default."""
 
@@ -61,7 +65,8 @@ class RunConfig:
     solver : the contact solver, one of ``SOLVERS``: "nlgs-accel" (default) Gauss–Seidel with Nesterov
         momentum; "nlgs" plain Gauss–Seidel, the reference to compare it with (engine.nlgs).
     record_every : record one frame every this many steps, >= 1.
-    alert_distance : m, contacts with a gap below this are kept, > 0.
+    alert_distance : m, contacts with a gap below this are kept, > 0 (and at most the structure's extent:
+        :class:`Scenario` checks that, knowing the blocks).
     """
 
     duration: float = 1.0
@@ -185,6 +190,9 @@ class Scenario:
                 for s, m in zip(self.assembly.supports, motions)
             )
             object.__setattr__(self, "assembly", Assembly(blocks=self.assembly.blocks, supports=supports))
+        where = "" if self.source.startswith("builder:") or not self.source else f"{self.source}: "
+        _check_initial_velocities(self.assembly, where)
+        _check_alert_distance(self.run.alert_distance, self.assembly, where)
 
     @property
     def block_count(self) -> int:
@@ -197,6 +205,56 @@ class Scenario:
     @property
     def friction(self) -> float:
         return self.material.friction
+
+
+def block_speed_problem(block: Block) -> str | None:
+    """``velocity = [...]: ...`` when the block's initial velocity moves one of its points faster than
+    ``MAX_BLOCK_SPEED``, else None."""
+    from geometry_library.mass import mass_properties
+
+    vx, vy, omega = block.velocity
+    if vx == 0.0 and vy == 0.0 and omega == 0.0:
+        return None
+    xy = block.vertices
+    centroid = mass_properties(xy).centroid
+    speed = math.hypot(vx, vy) + abs(omega) * max(math.hypot(*(p - centroid)) for p in xy)
+    if speed <= MAX_BLOCK_SPEED:
+        return None
+    return str(
+        field_error(
+            "velocity",
+            list(block.velocity),
+            f"a point of the block would move at {speed:.3g} m/s, more than {MAX_BLOCK_SPEED:g} m/s "
+            "(a likely typo: a block that fast is a diverged run)",
+        )
+    )
+
+
+def _check_initial_velocities(assembly: Assembly, where: str) -> None:
+    """:func:`block_speed_problem` for every block (the TOML reader checks its own with its locator first),
+    the block numbered from 1 in file order as geometry_library's messages number it."""
+    from geometry_library.checks import body_label
+
+    for i, block in enumerate(assembly.blocks, start=1):
+        problem = block_speed_problem(block)
+        if problem:
+            raise InputError(f"{where}{body_label(i, block.name)}: {problem}")
+
+
+def _check_alert_distance(alert_distance: float, assembly: Assembly, where: str) -> None:
+    """Refuse an alert distance longer than the structure (the larger side of the blocks' bounding box):
+    a gap that large is no contact (``alert_distance = 1e9`` was accepted)."""
+    if not assembly.blocks:
+        return
+    xmin, ymin, xmax, ymax = assembly.bounds(blocks_only=True)
+    extent = max(xmax - xmin, ymax - ymin)
+    if alert_distance > extent:
+        raise field_error(
+            f"{where}[run] alert_distance",
+            alert_distance,
+            f"longer than the structure ({extent:.3g} m, the larger side of its blocks' bounding box); a "
+            "likely typo: contacts closer than this are kept (default 0.001 m)",
+        )
 
 
 # --------------------------------------------------------------------------------------------------

@@ -22,7 +22,7 @@ from geometry_library.blocks import Assembly, Block, GeometryError, Support
 from masonrycli.errors import NOT_A_FILE, InputContext, InputError, one_line, special_file
 from masonrycli.motion import MOTION_KINDS, Fixed, Motion
 from masonrycli.records import record_fields
-from masonrycli.scenario import Material, RunConfig, Scenario
+from masonrycli.scenario import Material, RunConfig, Scenario, block_speed_problem
 from masonrycli.structure import build_structure, check_finite_tree, read_geometry, structure_warnings
 from masonrycli.values import check_real, check_vector, field_error, format_value, quote_key, quote_string
 
@@ -277,7 +277,11 @@ def _parse_block(i: int, table: dict, material: Material, ctx: InputContext, nam
         raise ctx.error(loc, str(exc)) from None
     _check_unique(name, loc, names, ctx)
     polygon = _polygon(coords, i - 1, name, "block", ctx, loc)
-    return Block(polygon=polygon, name=name, density=density, thickness=thickness, velocity=velocity)
+    block = Block(polygon=polygon, name=name, density=density, thickness=thickness, velocity=velocity)
+    problem = block_speed_problem(block)
+    if problem:  # velocity = [1e9, 0, 0] ran and ended as exit 3, "diverged at step 1"
+        raise ctx.error(loc, problem)
+    return block
 
 
 def _parse_support(i: int, table: dict, ctx: InputContext, names: dict) -> tuple[Support, Motion]:

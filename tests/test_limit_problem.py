@@ -146,11 +146,12 @@ def test_unknown_block_is_named_with_suggestions():
         analyse(column(2, 0.4, 0.2, 0.6), LiveLoad("point", block="b01"))
 
 
-@pytest.mark.parametrize("alert", [0.6, 1e9])
+@pytest.mark.parametrize("alert", [0.6, 1.0])
 def test_a_raised_alert_distance_adds_no_joint_across_a_gap(alert):
     # A column of 4 blocks 0.3 × 0.25 overturns at λ = B/(nH) = 0.3 whatever contacts the run watches.
     # With alert_distance 0.6 the LP also had "joints" between blocks 0.25 and 0.5 m apart, carrying
-    # force across the gaps (the 51-block wall: λ 0.544 at 0.5 m, 0.569 at 1e9, against 0.464).
+    # force across the gaps (the 51-block wall: λ 0.544 at 0.5 m, 0.569 at 1e9, against 0.464). 1.0 m is
+    # the column's height, the largest alert distance a scenario accepts (1e9 is refused since).
     sc = column(4, 0.3, 0.25, 0.45, alert_distance=alert)
     joints = find_joints(build_model(sc))
     assert [tuple(b) for b in joints.joint_body] == [(0, 1), (0, 4), (1, 2), (2, 3)]

@@ -385,6 +385,68 @@ def test_check_sampling_refuses_a_support_faster_than_a_diverged_block():
         check_sampling(dataclasses.replace(moving(fast_late), run=dataclasses.replace(scenario.run, duration=3.0)))
 
 
+def test_an_initial_velocity_faster_than_a_diverged_block_is_refused(tmp_path):
+    # velocity = [1e9, 0, 0] ran and ended as exit 3, "diverged at step 1": refused like a support that fast,
+    # by the speed of the block's fastest point |v| + |ω|·r (r: farthest vertex from the centroid)
+    from masonrycli import run as run_module
+    from masonrycli.scenario import MAX_BLOCK_SPEED, scenario_from_geometry_file
+
+    assert MAX_BLOCK_SPEED == run_module.DIVERGENCE_SPEED
+    r = math.hypot(0.2, 0.1)  # the 0.4 m × 0.2 m block: centroid (0.2, 0.1), a corner at r from it
+
+    def scenario(velocity: str):
+        return loads_scenario(BLOCK + f"velocity = {velocity}\n" + GROUND, source=str(tmp_path / "v.toml"))
+
+    for fine in ("[1000.0, 0.0, 0.0]", "[600.0, -800.0, 0.0]", f"[0.0, 0.0, {0.999 * 1000 / r}]"):
+        scenario(fine)
+    for fast in ("[1e9, 0.0, 0.0]", "[800.0, 800.0, 0.0]", f"[0.0, 0.0, {1.001 * 1000 / r}]", "[999.0, 0.0, -10.0]"):
+        with pytest.raises(InputError, match=r'v\.toml: \[\[block\]\] #1 \("b1"\): velocity = \[.*\]: a point of the '):
+            scenario(fast)
+    with pytest.raises(InputError) as info:
+        scenario("[1e9, 0.0, 0.0]")
+    assert str(info.value) == (
+        f'{tmp_path / "v.toml"}: [[block]] #1 ("b1"): velocity = [1000000000.0, 0.0, 0.0]: a point of the block '
+        "would move at 1e+09 m/s, more than 1000 m/s (a likely typo: a block that fast is a diverged run)"
+    )
+    # a GeoJSON block's velocity: the same check, the block numbered from 1 as in the file
+    geo = tmp_path / "g.geojson"
+    square = [[[0, 0], [1, 0], [1, 1], [0, 1], [0, 0]]]
+    features = [
+        {"type": "Feature", "properties": {"role": "block", "name": n, "velocity": v}, "geometry": g}
+        for n, v, g in (
+            ("a", [0, 0, 0], {"type": "Polygon", "coordinates": square}),
+            ("b", [0, 0, 5000], {"type": "Polygon", "coordinates": [[[x, y + 1] for x, y in square[0]]]}),
+        )
+    ]
+    import json
+
+    geo.write_text(json.dumps({"type": "FeatureCollection", "features": features}))
+    with pytest.raises(InputError) as info:
+        scenario_from_geometry_file(geo)
+    assert str(info.value).startswith(f'{geo}: block 2 ("b"): velocity = [0.0, 0.0, 5000.0]: a point of the block')
+
+
+def test_an_alert_distance_longer_than_the_structure_is_refused(tmp_path):
+    # alert_distance = 1e9 was accepted: a gap longer than the blocks' extent is no contact
+    # b2: 0.4 m × 0.2 m, 0.1 m above b1; the two span 0.4 m × 0.5 m
+    two = BLOCK + '[[block]]\nname = "b2"\npolygon = [[0.0, 0.3], [0.4, 0.3], [0.4, 0.5], [0.0, 0.5]]\n'
+
+    def scenario(alert: float, blocks: str = two):
+        text = f"[run]\nalert_distance = {alert!r}\n" + blocks + GROUND
+        return loads_scenario(text, source=str(tmp_path / "a.toml"))
+
+    assert scenario(0.5).run.alert_distance == 0.5  # the extent itself: accepted
+    assert scenario(0.4, BLOCK).run.alert_distance == 0.4  # one block: its width
+    with pytest.raises(InputError) as info:
+        scenario(0.41, BLOCK)
+    assert str(info.value) == (
+        f"{tmp_path / 'a.toml'}: [run] alert_distance = 0.41: longer than the structure (0.4 m, the larger side "
+        "of its blocks' bounding box); a likely typo: contacts closer than this are kept (default 0.001 m)"
+    )
+    with pytest.raises(InputError, match=r"\[run\] alert_distance = 1000000000.0: longer than the structure \(0.5 m"):
+        scenario(1e9)
+
+
 def test_record_warnings_name_a_record_that_outlasts_the_run():
     from masonrycli.scenario import record_warnings
 
