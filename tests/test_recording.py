@@ -378,3 +378,11 @@ def test_recording_path_problem_names_a_folders_recordings(tmp_path):
     )
     assert recording_path_problem(folder / "a.rrd") is None
     assert recording_path_problem(folder / "missing.rrd") == f"{folder / 'missing.rrd'}: no such recording"
+
+
+def test_the_blueprint_opens_following_sim_time(written):
+    """A file opens with the cursor at the start of the time line, before the first frame (the solver
+    health of step 1): paused there, every live tab was empty. Following opens on the last frame."""
+    from masonrycli.recording.readback import blueprint_time_panel
+
+    assert blueprint_time_panel(written[0]) == {"timeline": "sim_time", "play_state": "following"}

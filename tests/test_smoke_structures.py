@@ -8,6 +8,7 @@ import pytest
 from typer.testing import CliRunner
 
 from masonrycli.cli import app
+from masonrycli.colormap import BLUES, COOLWARM, unpack_rgba
 from masonrycli.recording import inspect_recording, screenshot_recording
 
 pytestmark = pytest.mark.slow
@@ -32,6 +33,22 @@ def test_structure_runs_and_opens_in_viewer(name, tmp_path):
     info = inspect_recording(rrd)
     assert info["application_id"] == "masonry" and info["has_blueprint"] and info["complete"]
     assert info["frames"] == 20  # the initial state (no force yet) is in the history only
-    reports = screenshot_recording(rrd, tmp_path / f"{name}.png", time_s=0.1)
+    png = tmp_path / f"{name}.png"
+    reports = screenshot_recording(rrd, png, at_open=True)  # where the viewer puts the cursor itself
     assert reports == []
-    assert (tmp_path / f"{name}.png").stat().st_size > 10_000
+    # The structure is drawn at first open: the live tab (p, blues) or the wall's Fig. III.2 tab (pinned to
+    # 0.1 s, blue-grey-red). Before, a run without paper tabs (the arch for 0.2 s) opened on the start of
+    # the time line, before its first frame: the colour bar alone.
+    assert fill_share(png) > 0.03
+
+
+def fill_share(png) -> float:
+    """Share of the structure panel's pixels (left of the colour bar, above the legend) in a fill colour."""
+    import PIL.Image as image_module
+
+    rgb = np.asarray(image_module.open(png).convert("RGB"))[60:870, :850].astype(np.int32)
+    lut = np.concatenate([unpack_rgba(BLUES), unpack_rgba(COOLWARM)])[::4, :3].astype(np.int32)
+    mask = np.zeros(rgb.shape[:2], dtype=bool)
+    for c in lut:
+        mask |= np.abs(rgb - c).sum(axis=-1) < 8
+    return float(mask.mean())

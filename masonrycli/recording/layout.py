@@ -190,7 +190,8 @@ def build_blueprint(
 
     Tabs: the live main view (forces, principal stress, ``main_field``), with ``paper`` = (t, figure
     numbers) the paper's four figures pinned to t, the four fields live, the magnified deformed shape,
-    the joint states. Opens paused on ``sim_time``.
+    the joint states. Opens on ``sim_time`` following the end of the data: at the last frame of a finished
+    run, and on the newest frame of a run still being written.
     """
     main = FIELD_BY_KEY[main_field]
     by_key = {f.key: f for f in FIELDS}
@@ -248,5 +249,8 @@ def build_blueprint(
         rrb.Horizontal(structure, right, column_shares=[3, 2]),
         rrb.BlueprintPanel(state="collapsed"),
         rrb.SelectionPanel(state="collapsed"),
-        rrb.TimePanel(state="collapsed", timeline="sim_time", play_state="paused"),
+        # Following, not paused: a file opens with the cursor at the start of its time line, where the solver
+        # health of step 1 lies but no frame yet (the first is at step record_every): every live tab was
+        # empty at first open (the colour bar alone). Following puts the cursor on the last frame.
+        rrb.TimePanel(state="collapsed", timeline="sim_time", play_state="following"),
     )

@@ -209,6 +209,23 @@ def blueprint_views(path: str | os.PathLike) -> dict[str, dict]:
     return {v["name"]: v for v in by_id.values() if "name" in v}
 
 
+def blueprint_time_panel(path: str | os.PathLike) -> dict:
+    """The embedded blueprint's time panel: {"timeline": name or None, "play_state": "paused", "playing",
+    "following" or None} (None: not set, the viewer's default)."""
+    out: dict = {"timeline": None, "play_state": None}
+    names = {1: "paused", 2: "playing", 3: "following"}  # rerun.blueprint.components.PlayState
+    reader = rr.chunk.RrdReader(os.fspath(path))
+    for chunk in reader.stream(store=reader.blueprints()[0]):
+        if chunk.entity_path != "/time_panel":
+            continue
+        batch = chunk.to_record_batch()
+        if "TimePanelBlueprint:timeline" in batch.schema.names:
+            out["timeline"] = batch.column("TimePanelBlueprint:timeline").to_pylist()[-1][0]
+        if "TimePanelBlueprint:play_state" in batch.schema.names:
+            out["play_state"] = names[batch.column("TimePanelBlueprint:play_state").to_pylist()[-1][0]]
+    return out
+
+
 def field_frames(path: str | os.PathLike) -> dict[int, dict]:
     """Per recorded step: {"time": s, "values": hover values by field key (N,), "ranges": field key ->
     the colour range logged for that frame}. The volumetric strain rate is the one the fill shows (the
@@ -264,11 +281,13 @@ def screenshot_recording(
     timeout: float = 60,
     *,
     tabs_dir: str | os.PathLike | None = None,
+    at_open: bool = False,
 ) -> list[str]:
     """Open a recording in a headless viewer, save a PNG of the window, return the views' error reports.
 
     ``time_s``: the ``sim_time`` shown, s (None: the last frame's). The cursor is set on ``sim_time`` (the
-    timeline the blueprint opens on and the paper-figure tabs are pinned on). The PNG shows the default layout. A hidden tab
+    timeline the blueprint opens on and the paper-figure tabs are pinned on); with ``at_open`` it is left
+    where the viewer put it on opening the file (``time_s`` ignored): what a user sees first. The PNG shows the default layout. A hidden tab
     is not drawn and cannot report, so every tab is then brought to the front in turn (saved as
     ``tabs_dir/tab<i>.png`` if given). Returns "view: severity: summary" for every report of every view;
     empty means healthy. Needs a Vulkan driver (Debian: mesa-vulkan-drivers libvulkan1).
@@ -299,10 +318,11 @@ def screenshot_recording(
             if time.monotonic() > deadline:
                 raise TimeoutError(f"viewer did not load {rrd_path} within {timeout} s")
             time.sleep(0.2)
-        if time_s is None:
-            line = next((t for r in recs for t in r.timelines if t.name == "sim_time"), None)
-            time_s = 1e-9 * line.end if line is not None and line.end is not None else 0.0
-        viewer.set_time("sim_time", duration=float(time_s), play_state="paused")
+        if not at_open:
+            if time_s is None:
+                line = next((t for r in recs for t in r.timelines if t.name == "sim_time"), None)
+                time_s = 1e-9 * line.end if line is not None and line.end is not None else 0.0
+            viewer.set_time("sim_time", duration=float(time_s), play_state="paused")
         _settle(viewer)
         viewer.save_screenshot(os.path.abspath(png_path))
         reports = {v.view_id: (v.name, v.reports) for v in viewer.get_state().views}
