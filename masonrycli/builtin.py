@@ -207,10 +207,25 @@ def _duration(name: str, motions: dict, overrides: dict) -> float:
     return min(max(1, math.ceil(max(ends) / dt - 1e-9)) * dt, MAX_DURATION)
 
 
-def paper_instant_hint(name: str, run: RunConfig) -> str:
+def paper_loading(name: str) -> dict[str, str]:
+    """Support name -> ``Motion.describe()`` of the paper's loading of built-in ``name`` (its default; the
+    supports not named are fixed)."""
+    return {support: m.describe() for support, m in _loading(name, None, None, None, None, None).items()}
+
+
+def is_paper_loading(name: str, supports: dict[str, str]) -> bool:
+    """Whether ``supports`` (support name -> ``Motion.describe()``, as in a recording's metadata) is the
+    paper's loading of built-in ``name``: the paper's figures describe that loading only (a wall shaken by
+    an earthquake record is at rest at the paper's 0.1 s)."""
+    if name not in DEFAULT_DURATION:
+        return False
+    return {k: v for k, v in supports.items() if v != "fixed"} == paper_loading(name)
+
+
+def paper_instant_hint(name: str, run: RunConfig, supports: dict[str, str] | None = None) -> str:
     """Where the paper's figures of ``name`` are in the run (the recording's tabs pinned there), or "" (none,
-    or after the run)."""
-    if name not in PAPER_INSTANT:
+    after the run, or ``supports`` — support name -> ``Motion.describe()`` — not the paper's loading)."""
+    if name not in PAPER_INSTANT or (supports is not None and not is_paper_loading(name, supports)):
         return ""
     figs, t = PAPER_INSTANT[name]
     step = round(t / run.dt)

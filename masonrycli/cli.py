@@ -135,7 +135,8 @@ def _simulate(name: str, opts: dict) -> None:
 
     outputs = _pop(opts, OUTPUT, FORCE, STOP)
     scenario = builtin(name, **opts)
-    _execute(scenario, outputs, paper_instant_hint(name, scenario.run))
+    supports = {s.name: m.describe() for s, m in zip(scenario.assembly.supports, scenario.motions)}
+    _execute(scenario, outputs, paper_instant_hint(name, scenario.run, supports))
 
 
 @simulate_app.command("wall")

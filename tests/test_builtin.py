@@ -120,6 +120,20 @@ def test_paper_instant_hint_only_within_the_run():
     assert paper_instant_hint("aqueduct", RunConfig(duration=5.0)) == ""
 
 
+def test_paper_instant_hint_only_under_the_papers_loading():
+    def supports(name, **loading):
+        s = builtin(name, **loading)
+        return {sup.name: m.describe() for sup, m in zip(s.assembly.supports, s.motions)}
+
+    run = RunConfig(duration=5.0)
+    assert paper_instant_hint("wall", run, supports("wall", freq=2.0, amp=1.0)).startswith("The paper's Figs.")
+    assert paper_instant_hint("wall", run, supports("wall", blocks=248)).startswith("The paper's Figs.")
+    assert paper_instant_hint("arch", run, supports("arch")).startswith("The paper's Figs.")
+    assert paper_instant_hint("wall", run, supports("wall", freq=5.0)) == ""
+    assert paper_instant_hint("wall", run, supports("wall", record=RECORD)) == ""
+    assert paper_instant_hint("arch", run, supports("arch", settlement=0.0, amp=1.0)) == ""
+
+
 def test_a_record_without_duration_runs_whole_in_steps_of_dt():
     # quake_velocity.csv ends at 0.4 s; the wall's default is 1 s, the arch's 5 s: both run the record
     assert builtin("wall", record=RECORD).run.duration == pytest.approx(0.4)

@@ -132,3 +132,17 @@ def test_record_longer_than_the_run_is_run_whole_or_warned(at2, tmp_path):
     )
     result = invoke("check", DATA / "quake_record.toml", "--record", at2)  # the file's 0.5 s
     assert result.exit_code == 0 and "the record quake.AT2 lasts 2 s but the run 0.5 s" in result.output
+
+
+def test_a_wall_shaken_by_a_record_has_no_paper_figure_tabs(at2, tmp_path):
+    """The paper's Figs. III.2–III.5 are the sine's (1 m/s at 2 Hz) at 0.1 s: the record's run opened on
+    tabs named after them, pinned where the record had barely started, and the command said so."""
+    from masonrycli.recording.readback import blueprint_views
+
+    rrd = tmp_path / "quake.rrd"
+    result = invoke("simulate", "wall", "--blocks", 12, "--record", at2, "--duration", 0.12, "--out", rrd)
+    assert result.exit_code == 0, result.output
+    assert "paper's Figs" not in result.output
+    views = blueprint_views(rrd)
+    assert not any(name.startswith("Fig.") or v["pinned"] for name, v in views.items())
+    assert any(name.startswith("Live: joint forces") for name in views)

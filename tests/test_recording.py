@@ -8,6 +8,7 @@ import rerun as rr
 
 from masonrycli import colormap as cm
 from masonrycli import recording as rec_mod
+from masonrycli.builtin import paper_loading
 from masonrycli.colour_range import MIN_SPAN, OUTSIDE_SHARE
 from masonrycli.joint_forces import joint_resultants
 from masonrycli.recording import ENTITY_PATHS, FIELDS, Recorder, inspect_recording
@@ -80,7 +81,8 @@ def test_embedded_blueprint_has_the_views(written, wall, tmp_path):
     assert not any(v["pinned"] for v in views.values())  # no paper instant for a synthetic run
     # A wall long enough for the paper's instant gets the four figures, pinned to t = 0.1 s on sim_time.
     static, q0 = wall
-    with Recorder(tmp_path / "w.rrd", static, {**fx.METADATA, "scenario": "wall", "duration_s": 1.0}) as rec:
+    paper = {**fx.METADATA, "scenario": "wall", "duration_s": 1.0, "supports": paper_loading("wall")}
+    with Recorder(tmp_path / "w.rrd", static, paper) as rec:
         rec.log_frame(fx.frames(static, q0, 1)[0])
     views = blueprint_views(tmp_path / "w.rrd")
     pinned = {n: v["pinned"] for n, v in views.items() if v["pinned"]}
@@ -386,3 +388,22 @@ def test_the_blueprint_opens_following_sim_time(written):
     from masonrycli.recording.readback import blueprint_time_panel
 
     assert blueprint_time_panel(written[0]) == {"timeline": "sim_time", "play_state": "following"}
+
+
+@pytest.mark.parametrize(
+    "supports",
+    [
+        {"ground": "record of acceleration (synthetic-1.AT2, 301 samples, 0-3 s, baseline-corrected) × 2 along (1, 0)"},
+        {"ground": "sine 1 m/s · sin(2π·5 Hz·t) along (1, 0)"},
+        {},
+    ],
+)
+def test_no_paper_figure_tabs_under_another_loading(wall, tmp_path, supports):
+    """The paper's figures show the paper's loading: a wall shaken by a record (at rest at 0.1 s) opened
+    on tabs named "Fig. III.2 … at t = 0.1 s"."""
+    static, q0 = wall
+    meta = {**fx.METADATA, "scenario": "wall", "duration_s": 1.0, "supports": supports}
+    with Recorder(tmp_path / "w.rrd", static, meta) as rec:
+        rec.log_frame(fx.frames(static, q0, 1)[0])
+    views = blueprint_views(tmp_path / "w.rrd")
+    assert not any(v["pinned"] or name.startswith("Fig.") for name, v in views.items())

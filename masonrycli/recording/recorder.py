@@ -36,6 +36,7 @@ import numpy as np
 import pyarrow as pa
 import rerun as rr
 
+from masonrycli.builtin import is_paper_loading
 from masonrycli.colormap import map_positions, nice_ceil, robust_max_abs, tick_label
 from masonrycli.colour_range import RangeTracker, positions
 from masonrycli.frame import Frame
@@ -115,7 +116,8 @@ class Recorder:
     (KeyboardInterrupt: "interrupted") and the time of the last frame; the file is complete either way.
     ``magnify``: the magnified view's factor (None: the largest displacement of the run drawn as 5 % of
     the structure's size, ``masonrycli.joint_forces.magnification``). The paper-figure tabs are added
-    for the scenarios of ``layout.PAPER_FIGURES`` whose ``duration_s`` reaches the paper's instant.
+    for the scenarios of ``layout.PAPER_FIGURES`` under the paper's loading whose ``duration_s`` reaches
+    the paper's instant (``paper_figures``).
     """
 
     def __init__(
@@ -161,9 +163,7 @@ class Recorder:
         self._ref: tuple[np.ndarray, np.ndarray, float] | None = None  # first block_q, support_q, E_pot
         self._batch, self._steps = FrameBatch(), FrameBatch()
         self._poses: list[tuple[int, float, np.ndarray, np.ndarray]] = []  # for the magnified view
-        paper = PAPER_FIGURES.get(str(self.metadata.get("scenario")))
-        duration = self.metadata.get("duration_s")
-        self.paper = paper if paper is not None and duration is not None and float(duration) >= paper[0] else None
+        self.paper = paper_figures(self.metadata)
         meta_json = json.dumps(self.metadata, sort_keys=True, default=str)
         self.recording_id = str(uuid.uuid5(_RECORDING_NAMESPACE, meta_json))
         self.rec = rr.RecordingStream(application_id, recording_id=self.recording_id)
@@ -489,6 +489,21 @@ class Recorder:
         self.rec.log(METADATA, rr.TextDocument(viewer_safe_text(text), media_type="text/markdown"), static=True)
         legend = legend_markdown(self.force_scale, self.block_height, self.magnify)
         self.rec.log(LEGEND, rr.TextDocument(viewer_safe_text(legend), media_type="text/markdown"), static=True)
+
+
+def paper_figures(metadata: dict) -> tuple[float, tuple[str, ...]] | None:
+    """(instant s, figure numbers) of the paper's figures for a run described by ``metadata``, or None.
+
+    Only under the paper's loading (``metadata["supports"]``, support name -> ``Motion.describe()``): the
+    wall shaken by an earthquake record, or at 5 Hz, opened on tabs named "Fig. III.2" pinned to 0.1 s,
+    where a record has barely started (strain rates at the 1e-4 1/s floor of the colour range).
+    """
+    name = str(metadata.get("scenario"))
+    paper = PAPER_FIGURES.get(name)
+    duration = metadata.get("duration_s")
+    if paper is None or duration is None or float(duration) < paper[0]:
+        return None
+    return paper if is_paper_loading(name, metadata.get("supports") or {}) else None
 
 
 def _tensor(tensors: dict, key: str, n: int) -> np.ndarray:
