@@ -97,7 +97,9 @@ def check_fragility_reads_as_a_plot(rrd: Path, rows: list[dict]) -> None:
 
     from masonrycli.recording.readback import blueprint_views
 
-    assert blueprint_views(rrd)["fragility"]["kind"] == "TimeSeries"
+    # the view's name gives its axes (the plot draws none): "#2000" on x was 2 m/s² of pga
+    assert blueprint_views(rrd)["fragility: P(collapse) against pga (mm/s²)"]["kind"] == "TimeSeries"
+    assert panel_states(rrd) == {"/blueprint_panel": "collapsed", "/selection_panel": "collapsed"}
     reader = rr.chunk.RrdReader(str(rrd))
     layout = {}
     for chunk in reader.stream(store=reader.blueprints()[0]):
@@ -121,6 +123,21 @@ def check_fragility_reads_as_a_plot(rrd: Path, rows: list[dict]) -> None:
         assert sorted(ticks) == expected and set(values) <= {1.0 if state == "collapsed" else 0.0}
     ticks, p = series["fit"]
     assert ticks[0] == 0 and p[0] == 0.0 and p[-1] > 0.99 and np.all(np.diff(p) >= 0)
+
+
+def panel_states(rrd: Path) -> dict[str, str]:
+    """The blueprint and selection panels' states: open (Rerun's default) they took two fifths of the
+    window from the study's three views."""
+    import rerun as rr
+
+    names = {1: "hidden", 2: "collapsed", 3: "expanded"}
+    reader = rr.chunk.RrdReader(str(rrd))
+    out = {}
+    for chunk in reader.stream(store=reader.blueprints()[0]):
+        batch = chunk.to_record_batch()
+        if "PanelBlueprint:state" in batch.schema.names:
+            out[chunk.entity_path] = names[batch.column("PanelBlueprint:state").to_pylist()[-1][0]]
+    return out
 
 
 def blueprint_layout(rrd: Path) -> dict:
@@ -150,14 +167,23 @@ def test_find_threshold_curve_reads_as_a_plot(block, tmp_path):
     rows = read_rows(out)
     found = {r["friction"]: r["amp_threshold"] for r in rows}
     assert len(found) == 2 and all(np.isfinite(v) for v in found.values())
-    assert blueprint_views(rrd)["thresholds"]["kind"] == "TimeSeries"
+    assert blueprint_views(rrd)["thresholds: amp (m/s) against friction (/1000)"]["kind"] == "TimeSeries"
+    assert panel_states(rrd) == {"/blueprint_panel": "collapsed", "/selection_panel": "collapsed"}
     layout = blueprint_layout(rrd)
     timeline = "friction (/1000)"  # a sequence time line is an integer: thousandths of the friction
     assert layout["TimePanelBlueprint:timeline"] == timeline
     low, high = layout["ScalarAxis:range"]
     assert low == 0.0 and max(found.values()) < high < 2 * max(found.values())
     view = layout["TimeAxis:view_range"]
-    assert view["start"] <= 100 and view["end"] >= 200
+    assert view["start"] <= 100 and view["end"] >= 200 + 0.05 * 100  # a margin beside the last point
+    # The view shows no more than the time line holds: its ends are marked on it (outside the plot), else
+    # the last point sat on the right edge, half cut.
+    extent = [
+        ch.to_record_batch().column(timeline).to_pylist()
+        for ch in rr.chunk.RrdReader(str(rrd)).stream()
+        if ch.entity_path == "/study/extent"
+    ]
+    assert extent == [[view["start"], view["end"]]]
     series = {}
     for chunk in rr.chunk.RrdReader(str(rrd)).stream():
         if not chunk.is_static and chunk.entity_path.startswith("/study/thresholds/"):
@@ -205,6 +231,22 @@ def test_grid_sweep_state_map_and_histories(block, tmp_path):
             batch = ch.to_record_batch()
             found |= {n: batch.column(n).to_pylist()[0] for n in batch.schema.names if ":" in n}
     assert found["Transform3D:scale"] == [[1.0, -1.0, 1.0]] and found["Points2D:show_labels"] == [False]
+    # The axes: each swept value drawn once beside the map, the view's name says which way each runs (it
+    # was four unlabelled dots on black), the side panels collapsed.
+    axes = {}
+    for ch in chunks:
+        if ch.entity_path == "/study/state_map/axes":
+            batch = ch.to_record_batch()
+            axes |= {n: batch.column(n).to_pylist()[0] for n in batch.schema.names if ":" in n}
+    assert axes["Points2D:labels"] == ["amp=0.05", "amp=0.6", "friction=0.3", "friction=0.8"]
+    assert axes["Points2D:show_labels"] == [True]
+    x_labels, y_labels = np.array(axes["Points2D:positions"][:2]), np.array(axes["Points2D:positions"][2:])
+    assert list(x_labels[:, 0]) == pytest.approx([0.05, 0.6]) and np.all(x_labels[:, 1] < 0.3)
+    assert list(y_labels[:, 1]) == pytest.approx([0.3, 0.8]) and np.all(y_labels[:, 0] < 0.05)
+    from masonrycli.recording.readback import blueprint_views
+
+    assert blueprint_views(tmp_path / "grid.rrd")["state map: amp (m/s) right, friction up"]["kind"] == "2D"
+    assert panel_states(tmp_path / "grid.rrd") == {"/blueprint_panel": "collapsed", "/selection_panel": "collapsed"}
 
 
 @pytest.mark.parametrize(

@@ -10,7 +10,9 @@ Rerun's 2-D views draw y downward: each picture entity gets a static y-flip tran
 at it from ``study`` (an origin's own transform is not applied in its view), so larger values are up, as
 in the PNG — before, the state map showed freq = 1 Hz above 2 Hz and the fragility curve upside down.
 The state map's labels ("amp=0.25 freq=1: intact") are shown on hover only: drawn, a 6 × 2 grid's
-overlapped into an unreadable line.
+overlapped into an unreadable line. Its axes are drawn as labels, each swept value once below the lowest
+row and left of the leftmost column (``study/state_map/axes``); every view's name says what its axes are
+(the plots draw no axis title, the 2-D view no axis), and the side panels open collapsed.
 
 The fragility curve is a probability (0–1) against an intensity (pga 1–60 m/s², pgv 0.1–5 m/s): a 2-D
 view has one scale for both axes, so it showed the curve as a flat line 60 units long and 1 high, without
@@ -32,6 +34,7 @@ import uuid
 from pathlib import Path
 
 import numpy as np
+import pyarrow as pa
 import rerun as rr
 import rerun.blueprint as rrb
 
@@ -58,21 +61,32 @@ def record_study(path: Path, name: str, rows: list[dict], request, fit, im: str,
         rec.log("study/plot", rr.EncodedImage(path=plot), static=True)
         views.insert(0, rrb.Spatial2DView(origin="study/plot", name="plot"))
     names = [a.name for a in request.axes if a.name != request.find and len(a.values) > 1]
-    panels = []
+    # The views fill the window: the blueprint, selection and time panels (Rerun's defaults: open) took
+    # two fifths of it; the plots' time panel stays collapsed, it only names the x axis's time line.
+    panels = [rrb.BlueprintPanel(state="collapsed"), rrb.SelectionPanel(state="collapsed")]
     if request.find:
         timeline, start, end, y_range = _log_thresholds(rec, rows, request.find, names)
         legend = rrb.PlotLegend(corner="RightBottom")  # below a rising or flat curve (y from 0)
-        view, panel = _plot_view("study/thresholds", "thresholds", timeline, (start, end), y_range, legend)
+        unit = PARAM_UNITS.get(request.find.rpartition(".")[2], "")
+        title = viewer_safe_text(
+            f"thresholds: {request.find}" + (f" ({unit})" if unit else "") + f" against {timeline}"
+        )
+        _time_line_extent(rec, timeline, start, end)
+        view, panel = _plot_view("study/thresholds", title, timeline, (start, end), y_range, legend)
         views.insert(0, view)
         panels.append(panel)
     elif fit is None and "record" not in [a.name for a in request.axes]:
         _log_state_map(rec, rows, names)
         rec.log("study/state_map", rr.Transform3D(scale=[1.0, -1.0, 1.0]), static=True)  # y up (module doc)
-        views.insert(0, rrb.Spatial2DView(origin="study", contents=["+ /study/state_map/**"], name="state map"))
+        axes = ", ".join(f"{_with_unit(n)} {way}" for n, way in zip(names, ("right", "up")))
+        title = viewer_safe_text(f"state map: {axes}" if axes else "state map")
+        views.insert(0, rrb.Spatial2DView(origin="study", contents=["+ /study/state_map/**"], name=title))
+        panels.append(rrb.TimePanel(state="collapsed"))
     else:
         timeline, end = _log_fragility(rec, rows, fit, im)
         legend = rrb.PlotLegend(corner="RightBottom")  # high IM, P = 0: where runs are fewest
-        view, panel = _plot_view("study/fragility", "fragility", timeline, (0, end), (-0.05, 1.05), legend)
+        title = viewer_safe_text(f"fragility: P(collapse) against {timeline}")
+        view, panel = _plot_view("study/fragility", title, timeline, (0, end), (-0.05, 1.05), legend)
         views.insert(0, view)
         panels.append(panel)
     rec.log("study/rows", rr.TextDocument(_markdown(name, rows), media_type=rr.MediaType.MARKDOWN), static=True)
@@ -93,6 +107,13 @@ def _plot_view(origin: str, name: str, timeline: str, x_range, y_range, legend):
     return view, rrb.TimePanel(state="collapsed", timeline=timeline, play_state="paused")
 
 
+def _time_line_extent(rec, timeline: str, start: int, end: int) -> None:
+    """Mark ``start`` and ``end`` on the time line, outside the plots: a time-series view shows no more
+    than the time line holds, whatever its view range says (the last point sat on the right edge)."""
+    column = rr.AnyValues.columns(time_line_extent=pa.array([float(start), float(end)]))
+    rec.send_columns("study/extent", indexes=[rr.TimeColumn(timeline, sequence=[start, end])], columns=column)
+
+
 def _series(rec, entity: str, timeline: str, per_unit: float, at, values, style) -> None:
     """``values`` against ``at`` (sorted; non-finite pairs dropped) as scalars on the sequence time line
     ``timeline`` whose tick is ``1 / per_unit`` of ``at``'s unit; ``style`` names and colours the series."""
@@ -104,6 +125,11 @@ def _series(rec, entity: str, timeline: str, per_unit: float, at, values, style)
         ticks = np.rint(at[keep][order] * per_unit).astype(np.int64)
         column = rr.Scalars.columns(scalars=values[keep][order])
         rec.send_columns(entity, indexes=[rr.TimeColumn(timeline, sequence=ticks)], columns=column)
+
+
+def _with_unit(name: str) -> str:
+    unit = PARAM_UNITS.get(name.rpartition(".")[2], "")
+    return f"{name} ({unit})" if unit else name
 
 
 def _number(value) -> float:
@@ -128,6 +154,28 @@ def _log_state_map(rec, rows: list[dict], names: list[str]) -> None:
     radius = 0.02 * float(max(span.max(), 1e-9))
     points = rr.Points2D(pos, colors=colours, labels=labels, radii=radius, show_labels=False)
     rec.log("study/state_map", points, static=True)
+    # The axes, as drawn labels (a 2-D view has none): each swept value once, below the lowest row and
+    # left of the leftmost column — the map was unlabelled dots on black.
+    ticks, texts = [], []
+    if len(pos):
+        lo, span = pos.min(axis=0), np.maximum(np.ptp(pos, axis=0), 1e-9)
+        for axis, n in enumerate(names[:2]):
+            for value in sorted({r[n] for r in rows}, key=lambda v: coord({n: v}, n)):
+                at = (
+                    [coord({n: value}, n), lo[1] - 0.12 * span[1]]
+                    if axis == 0
+                    else [lo[0] - 0.2 * span[0], coord({n: value}, n)]
+                )
+                ticks.append(at)
+                texts.append(viewer_safe_text(f"{n}={value}"))
+    axes = rr.Points2D(
+        np.array(ticks, dtype=np.float32).reshape(-1, 2),
+        labels=texts,
+        radii=0.0,
+        colors=(220, 220, 220, 255),
+        show_labels=True,
+    )
+    rec.log("study/state_map/axes", axes, static=True)
 
 
 def fragility_timeline(im: str) -> str:
@@ -204,9 +252,12 @@ def _log_thresholds(rec, rows: list[dict], find: str, names: list[str]) -> tuple
     style = rr.SeriesPoints(colors=[(208, 48, 48)], names=[label + ": points"], marker_sizes=[4.0])
     _series(rec, "study/thresholds/points", timeline, per_unit, at, threshold, style)
     ok = np.isfinite(at) & np.isfinite(threshold)
-    ticks = np.rint(at[ok] * per_unit) if ok.any() else np.zeros(1)
-    span = max(float(ticks.max() - ticks.min()), 1.0)
-    x_range = (int(min(0.0, ticks.min() - 0.05 * span)), int(np.ceil(ticks.max() + 0.05 * span)))
+    # Every swept point is in the view, found or not, with a margin beside the outermost: the range was
+    # the found points' alone, so one found point (friction 0.6; none at 0.3) sat on the right edge, cut.
+    swept = np.isfinite(at)
+    ticks = np.rint(at[swept] * per_unit) if swept.any() else np.zeros(1)
+    span = max(float(ticks.max() - ticks.min()), 0.1 * float(np.abs(ticks).max()), 1.0)
+    x_range = (int(np.floor(min(0.0, ticks.min() - 0.05 * span))), int(np.ceil(ticks.max() + 0.05 * span)))
     top = float(threshold[ok].max()) if ok.any() else 1.0
     low = float(threshold[ok].min()) if ok.any() else 0.0
     y_range = (min(0.0, 1.1 * low), 1.1 * top if top > 0 else 1.0)
