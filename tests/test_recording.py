@@ -83,7 +83,8 @@ def test_embedded_blueprint_has_the_views(written, wall, tmp_path):
     static, q0 = wall
     paper = {**fx.METADATA, "scenario": "wall", "duration_s": 1.0, "supports": paper_loading("wall")}
     with Recorder(tmp_path / "w.rrd", static, paper) as rec:
-        rec.log_frame(fx.frames(static, q0, 1)[0])
+        for f in fx.frames(static, q0, 11):  # to step 100, t = 0.1 s
+            rec.log_frame(f)
     views = blueprint_views(tmp_path / "w.rrd")
     pinned = {n: v["pinned"] for n, v in views.items() if v["pinned"]}
     assert sorted(pinned) == sorted(
@@ -407,3 +408,18 @@ def test_no_paper_figure_tabs_under_another_loading(wall, tmp_path, supports):
         rec.log_frame(fx.frames(static, q0, 1)[0])
     views = blueprint_views(tmp_path / "w.rrd")
     assert not any(v["pinned"] or name.startswith("Fig.") for name, v in views.items())
+
+
+def test_a_run_ended_before_the_paper_instant_opens_without_its_tabs(wall, tmp_path):
+    """Ctrl-C (or --stop-at-collapse) before 0.1 s: no frame at the paper's instant, so its pinned tabs
+    were empty and the recording opened on the first. The layout is sent again without them at close."""
+    static, q0 = wall
+    paper = {**fx.METADATA, "scenario": "wall", "duration_s": 1.0, "supports": paper_loading("wall")}
+    with pytest.raises(KeyboardInterrupt):
+        with Recorder(tmp_path / "w.rrd", static, paper) as rec:
+            for f in fx.frames(static, q0, 5):  # to step 40, t = 0.04 s
+                rec.log_frame(f)
+            raise KeyboardInterrupt
+    views = blueprint_views(tmp_path / "w.rrd")
+    assert not any(v["pinned"] or name.startswith("Fig.") for name, v in views.items())
+    assert any(name.startswith("Live: joint forces") for name in views) and rec.paper is None

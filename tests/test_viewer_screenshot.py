@@ -10,6 +10,7 @@ import ctypes.util
 import numpy as np
 import pytest
 
+from masonrycli.builtin import paper_loading
 from masonrycli.colormap import BLUES, unpack_rgba
 from masonrycli.recording import Recorder, screenshot_recording
 from masonrycli.recording.layout import SUPPORT_FILL_RGBA
@@ -76,3 +77,21 @@ def test_blocks_are_drawn_y_up_with_field_colours(screenshot):
     block_rows, ground_rows = np.nonzero(blocks)[0], np.nonzero(ground)[0]
     # y up: the ground is below the wall on screen (larger row index); the legend bar is above it too.
     assert np.median(ground_rows) > np.percentile(block_rows, 97)
+
+
+def test_a_run_ended_before_the_paper_instant_opens_on_its_structure(tmp_path):
+    """Interrupted at 0.04 s, before the paper's 0.1 s: the recording opened on the tab pinned to 0.1 s,
+    where no frame is — the colour bar and the triangulation on black. It opens on the live tab."""
+    import PIL.Image as image_module
+
+    static, q0 = fx.wall(5, 6)
+    rrd, png = tmp_path / "wall.rrd", tmp_path / "open.png"
+    paper = {**fx.METADATA, "scenario": "wall", "duration_s": 1.0, "supports": paper_loading("wall")}
+    with pytest.raises(KeyboardInterrupt):
+        with Recorder(rrd, static, paper, batch_frames=8) as rec:
+            for f in fx.frames(static, q0, 5):
+                rec.log_frame(f)
+            raise KeyboardInterrupt
+    assert screenshot_recording(rrd, png, timeout=120, at_open=True) == []
+    main = np.asarray(image_module.open(png).convert("RGB"))[60:1000, :850]
+    assert near(main, unpack_rgba(BLUES)[:, :3]).mean() > 0.05  # the blocks, filled by p (blues)

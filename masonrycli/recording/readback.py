@@ -187,12 +187,29 @@ def _summarise(reader: rr.chunk.RrdReader, truncated: bool, path) -> dict:
     }
 
 
+def _last_blueprint(reader: rr.chunk.RrdReader):
+    """The blueprint sent last (the viewer opens on the last default): ``blueprints()`` is in no particular
+    order, so the one whose chunks were logged last (``log_time``)."""
+
+    def logged(entry) -> int:
+        times = [
+            chunk.to_record_batch().column("log_time").cast(pa.int64()).to_numpy().max(initial=0)
+            for chunk in reader.stream(store=entry)
+            if "log_time" in chunk.to_record_batch().schema.names
+        ]
+        return int(max(times, default=0))
+
+    return max(reader.blueprints(), key=logged)
+
+
 def blueprint_views(path: str | os.PathLike) -> dict[str, dict]:
-    """The embedded blueprint's views: name -> {"kind", "origin", "pinned"}; ``pinned`` is (timeline,
-    start s, end s) for a view whose visible time range is fixed, else None."""
+    """The views of the recording's last default blueprint (the one the viewer opens on; a run that ended
+    before the paper's instant sends a second one without the pinned tabs): name -> {"kind", "origin",
+    "pinned"}; ``pinned`` is (timeline, start s, end s) for a view whose visible time range is fixed,
+    else None."""
     reader = rr.chunk.RrdReader(os.fspath(path))
     by_id: dict[str, dict] = {}
-    for chunk in reader.stream(store=reader.blueprints()[0]):
+    for chunk in reader.stream(store=_last_blueprint(reader)):
         batch = chunk.to_record_batch()
         parts = chunk.entity_path.strip("/").split("/")
         if parts[0] != "view" or len(parts) < 2:
@@ -215,7 +232,7 @@ def blueprint_time_panel(path: str | os.PathLike) -> dict:
     out: dict = {"timeline": None, "play_state": None}
     names = {1: "paused", 2: "playing", 3: "following"}  # rerun.blueprint.components.PlayState
     reader = rr.chunk.RrdReader(os.fspath(path))
-    for chunk in reader.stream(store=reader.blueprints()[0]):
+    for chunk in reader.stream(store=_last_blueprint(reader)):
         if chunk.entity_path != "/time_panel":
             continue
         batch = chunk.to_record_batch()

@@ -169,6 +169,7 @@ class Recorder:
         self.rec = rr.RecordingStream(application_id, recording_id=self.recording_id)
         os.makedirs(os.path.dirname(os.path.abspath(self.path)), exist_ok=True)
         with _io_errors(self.path):
+            self._main_field = main_field
             self.rec.save(self.path, default_blueprint=build_blueprint(main_field, self.paper))
             log_static(self.rec, static, self._blocks, self._supports)
             tolerance = self.metadata.get("nlgs_tolerance")
@@ -276,6 +277,7 @@ class Recorder:
                     error = err
                     note = f"{note} (recording flush failed: {err!r})".strip()
                 self._log_metadata(status, note)
+                self._unpin_unreached_paper_instant()
             finally:
                 self.rec.disconnect()
         check_complete(self.path)
@@ -283,6 +285,17 @@ class Recorder:
             if status == COMPLETED:
                 raise error
             warnings.warn(f"recording flush failed while closing: {error!r}", RuntimeWarning, stacklevel=2)
+
+    def _unpin_unreached_paper_instant(self) -> None:
+        """A run that ended before the paper's instant (Ctrl-C, --stop-at-collapse, a failure) has no frame
+        there: its tabs pinned to the instant were empty (the colour bar and the triangulation) and the
+        recording opened on the first. The layout is sent again without them; the last default wins."""
+        if self.paper is None:
+            return
+        reached = self._last is not None and self._last[1] >= self.paper[0] - 0.5 * self.static.dt
+        if not reached:
+            self.paper = None
+            self.rec.send_blueprint(build_blueprint(self._main_field, None), make_active=True, make_default=True)
 
     # ---- per-batch content
     def _send_batch(self, b: FrameBatch) -> None:
