@@ -1,9 +1,10 @@
 """Validation and normalisation of block polygons, and whole-assembly checks.
 
-Every error is a :class:`GeometryError` whose message is one line naming the body, for example::
+Every error is a :class:`GeometryError` whose message is one line naming the body, numbered from 1 in
+the order of the file (:func:`body_label`), for example::
 
     block 7 ("c03-b02"): polygon is not convex (reflex vertex at (0.45, 0.6))
-    blocks 3 ("c01-b04") and 4 ("c01-b05") overlap by 2.5e-03 m² (tolerance 1e-09 m²)
+    blocks 4 ("c01-b04") and 5 ("c01-b05") overlap by 2.5e-03 m² (tolerance 1e-09 m²)
 
 Normalised polygons are counter-clockwise, without the closing repeat, without duplicate or
 collinear consecutive vertices (collinear points are allowed on input and silently removed).
@@ -56,8 +57,10 @@ _NORMALISED: weakref.WeakValueDictionary[int, Polygon] = weakref.WeakValueDictio
 
 
 def body_label(index: int, name: str, kind: str = "block") -> str:
-    """``block 7 ("c03-b02")`` — how every message names a body."""
-    return f'{kind} {index} ("{name}")'
+    """``block 7 ("c03-b02")`` for ``blocks[6]`` — how every message names a body: ``index`` is its
+    0-based position among the bodies of its kind, shown from 1 as the user counts them in the file (the
+    TOML reader's ``[[block]] #7``; the overlap message said ``blocks 0 ("block-1")``)."""
+    return f'{kind} {index + 1} ("{name}")'
 
 
 def _fmt(p: Sequence[float]) -> str:
@@ -293,7 +296,7 @@ def validate_assembly(
         a, b, area = bad[0]
         more = f" (and {len(bad) - 1} more overlapping pair(s))" if len(bad) > 1 else ""
         if b < n_blocks:
-            what = f'blocks {a} ("{names[a]}") and {b} ("{names[b]}")'
+            what = f'blocks {a + 1} ("{names[a]}") and {b + 1} ("{names[b]}")'
         else:
             what = f"{labels[a]} and {labels[b]}"
         raise GeometryError(f"{what} overlap by {area:.3g} m² (tolerance {overlap_tolerance:.3g} m²){more}")

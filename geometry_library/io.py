@@ -35,7 +35,10 @@ Errors are one-line :class:`GeometryError` messages naming the file, the feature
 the body as every message names one (:func:`~geometry_library.checks.body_label`), in one format::
 
     walls.geojson: feature 3: block 2 ("B12"): polygon is not convex (reflex vertex at (1, 2))
-    walls.wkt: line 5: support 0 ("ground"): polygon has holes; blocks are solid
+    walls.wkt: line 5: support 1 ("ground"): polygon has holes; blocks are solid
+
+Features, lines and bodies are all numbered from 1 (feature 3 is the third in the file, block 2 the
+second block), and unnamed bodies are called ``block-1``, ``block-2``, … as in a TOML scenario.
 """
 
 from __future__ import annotations
@@ -111,7 +114,7 @@ def read_geojson(path, density: float = 2500.0, thickness: float = 1.0) -> Assem
         raise GeometryError(f"{path}: FeatureCollection has no 'features' list")
     blocks: list[Block] = []
     supports: list[Support] = []
-    for k, feature in enumerate(features):
+    for k, feature in enumerate(features, start=1):  # numbered from 1, as the bodies are (body_label)
         feature_at = where = f"{path}: feature {k}"  # the body's label is added once its role is read
         if not isinstance(feature, dict) or feature.get("type") != "Feature":
             raise GeometryError(f"{where}: not a GeoJSON Feature")
@@ -122,7 +125,7 @@ def read_geojson(path, density: float = 2500.0, thickness: float = 1.0) -> Assem
         if role not in ("block", "support"):
             raise GeometryError(f"{where}: role must be 'block' or 'support', got {role!r}")
         index = len(blocks) if role == "block" else len(supports)
-        name = str(props.get("name", f"{role}-{index}"))
+        name = str(props.get("name", f"{role}-{index + 1}"))  # block-1 first, as in a TOML file
         where = f"{feature_at}: {body_label(index, name, role)}"
         geometry = feature.get("geometry")
         gtype = geometry.get("type") if isinstance(geometry, dict) else None
@@ -257,7 +260,7 @@ def read_wkt(path, density: float = 2500.0, thickness: float = 1.0) -> Assembly:
         for k, poly in enumerate(polys):
             index = len(blocks) if role == "block" else len(supports)
             label = name if len(polys) == 1 or name is None else f"{name}-{k + 1}"
-            label = label or f"{role}-{index}"
+            label = label or f"{role}-{index + 1}"
             if poly.is_empty:
                 raise GeometryError(f"{where}: {body_label(index, label, role)}: polygon is empty")
             if poly.interiors:

@@ -235,7 +235,7 @@ def _check_initial_velocities(assembly: Assembly, where: str) -> None:
     the block numbered from 1 in file order as geometry_library's messages number it."""
     from geometry_library.checks import body_label
 
-    for i, block in enumerate(assembly.blocks, start=1):
+    for i, block in enumerate(assembly.blocks):
         problem = block_speed_problem(block)
         if problem:
             raise InputError(f"{where}{body_label(i, block.name)}: {problem}")

@@ -61,7 +61,7 @@ def test_float_noise_on_a_straight_edge_is_not_a_reflex_vertex():
 )
 def test_bad_polygons_are_rejected_naming_the_block(coords, message):
     text = raises_one_line(message, polygon_from_coords, coords, 7, "c3-b2")
-    assert text.startswith('block 7 ("c3-b2"): ')
+    assert text.startswith('block 8 ("c3-b2"): ')  # index 7: the eighth block, numbered from 1
 
 
 def asm(*polys, supports=(), names=None):
@@ -80,26 +80,26 @@ def test_valid_stack_passes_without_warnings():
 def test_non_convex_block_in_assembly_is_named():
     bad = Polygon([(0, 1), (2, 1), (2, 3), (1, 1.5), (0, 3)])
     text = raises_one_line("not convex", validate_assembly, asm(box(0, 0, 2, 1), bad, names=["a", "c3-b2"]))
-    assert text.startswith('block 1 ("c3-b2")')
+    assert text.startswith('block 2 ("c3-b2")')
 
 
 def test_holes_are_rejected():
     holed = Polygon(box(0, 0, 1, 1).exterior.coords, [box(0.4, 0.4, 0.6, 0.6).exterior.coords])
     text = raises_one_line("hole", validate_assembly, asm(holed, names=["h"]))
-    assert text.startswith('block 0 ("h")')
+    assert text.startswith('block 1 ("h")')
 
 
 def test_overlapping_blocks_name_both_and_the_area():
     a = asm(box(0, 0, 1, 1), box(0.9, 0, 1.9, 1), supports=[GROUND], names=["left", "right"])
     text = raises_one_line("overlap", validate_assembly, a)
-    assert 'blocks 0 ("left") and 1 ("right")' in text
+    assert 'blocks 1 ("left") and 2 ("right")' in text  # numbered from 1, as every message (said 0 and 1)
     assert "0.1 m²" in text
 
 
 def test_block_sunk_into_a_support_is_an_overlap():
     a = asm(box(0, -0.01, 1, 1), supports=[GROUND], names=["sunk"])
     text = raises_one_line("overlap", validate_assembly, a)
-    assert 'block 0 ("sunk")' in text and 'support 0 ("ground")' in text and "0.01 m²" in text
+    assert 'block 1 ("sunk")' in text and 'support 1 ("ground")' in text and "0.01 m²" in text
 
 
 def test_overlap_below_tolerance_is_accepted_and_tolerance_is_configurable():
@@ -112,14 +112,14 @@ def test_overlap_below_tolerance_is_accepted_and_tolerance_is_configurable():
 def test_duplicate_names():
     a = asm(box(0, 0, 1, 1), box(1, 0, 2, 1), names=["x", "x"], supports=[GROUND])
     text = raises_one_line("duplicate name", validate_assembly, a)
-    assert text == 'block 1 ("x"): duplicate name, also used by block 0 ("x")'
+    assert text == 'block 2 ("x"): duplicate name, also used by block 1 ("x")'
 
 
 def test_block_touching_nothing_is_a_warning():
     a = asm(box(0, 0, 1, 1), box(5, 3, 6, 4), supports=[GROUND], names=["ok", "floating"])
     warnings = validate_assembly(a)
     assert len(warnings) == 1
-    assert warnings[0].startswith('block 1 ("floating") touches nothing')
+    assert warnings[0].startswith('block 2 ("floating") touches nothing')
     # A gap below the contact distance (1e-3 m) counts as touching.
     assert validate_assembly(asm(box(0, 5e-4, 1, 1), supports=[GROUND])) == []
 
@@ -134,14 +134,14 @@ def test_no_support_at_all_is_a_warning():
     # a one-line WKT file: "the 1 block up, they fall" and "nearest body inf m away" before
     alone = validate_assembly(asm(box(0, 0, 1, 1), names=["solo"]))
     assert alone[0].startswith("no supports: nothing holds the 1 block up, it falls freely (")
-    assert alone[1] == 'block 0 ("solo") touches nothing (it is the only body): it will fall freely'
+    assert alone[1] == 'block 1 ("solo") touches nothing (it is the only body): it will fall freely'
 
 
 def test_bad_support_role_and_density():
-    with pytest.raises(GeometryError, match=r'support 0 \("ground"\): role'):
+    with pytest.raises(GeometryError, match=r'support 1 \("ground"\): role'):
         validate_assembly(asm(box(0, 0, 1, 1), supports=[Support(box(-1, -1, 2, 0), "ground", "moving")]))
     bad = Assembly((Block(box(0, 0, 1, 1), "d", density=-1.0),), (GROUND,))
-    raises_one_line(r'block 0 \("d"\): density', validate_assembly, bad)
+    raises_one_line(r'block 1 \("d"\): density', validate_assembly, bad)
 
 
 def test_350_blocks_are_checked_quickly():
@@ -203,4 +203,4 @@ def test_a_polygon_not_made_by_the_clean_up_is_still_checked(monkeypatch):
     assert validate_assembly(Assembly((Block(Polygon(made.exterior.coords), "a"),), (ground,))) == []
     assert calls[0] == 3
     concave = Polygon([(0, 0), (2, 0), (2, 2), (1, 0.5), (0, 2)])
-    raises_one_line(r'block 0 \("a"\): polygon is not convex', validate_assembly, Assembly((Block(concave, "a"),)))
+    raises_one_line(r'block 1 \("a"\): polygon is not convex', validate_assembly, Assembly((Block(concave, "a"),)))

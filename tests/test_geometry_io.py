@@ -70,7 +70,7 @@ def test_geojson_defaults_and_properties(tmp_path):
         ],
     )
     a = read_geojson(path, density=1800.0, thickness=0.8)
-    assert [(b.name, b.density, b.thickness) for b in a.blocks] == [("block-0", 1800.0, 0.8), ("top", 2000.0, 0.5)]
+    assert [(b.name, b.density, b.thickness) for b in a.blocks] == [("block-1", 1800.0, 0.8), ("top", 2000.0, 0.5)]
     assert [(s.name, s.role) for s in a.supports] == [("pad", "fixed")]
     assert a.supports[0].polygon.exterior.is_ccw
 
@@ -97,11 +97,11 @@ def test_geojson_errors_name_file_and_feature(tmp_path):
 
     point = {"type": "Feature", "properties": {"name": "p"}, "geometry": {"type": "Point", "coordinates": [0, 0]}}
     text = one_line_error(read_geojson, write(tmp_path, [feature(SQ), point], "pt.geojson"))
-    assert "pt.geojson: feature 1" in text and "must be a Polygon, got 'Point'" in text
+    assert "pt.geojson: feature 2" in text and "must be a Polygon, got 'Point'" in text
 
     concave = [[0, 0], [2, 0], [2, 2], [1, 0.5], [0, 2], [0, 0]]
     text = one_line_error(read_geojson, write(tmp_path, [feature(SQ), feature(concave, name="c3-b2")], "cc.geojson"))
-    assert text.startswith(str(tmp_path / "cc.geojson") + ': feature 1: block 1 ("c3-b2"): polygon is not convex')
+    assert text.startswith(str(tmp_path / "cc.geojson") + ': feature 2: block 2 ("c3-b2"): polygon is not convex')
 
     holed = {"type": "Feature", "properties": {"name": "h"}, "geometry": {"type": "Polygon", "coordinates": [SQ, SQ]}}
     assert "hole" in one_line_error(read_geojson, write(tmp_path, [holed], "h.geojson"))
@@ -109,45 +109,45 @@ def test_geojson_errors_name_file_and_feature(tmp_path):
     text = one_line_error(
         read_geojson, write(tmp_path, [feature(SQ, role="support", support_role="wobbly")], "r.geojson")
     )
-    assert "feature 0" in text and "support_role" in text
+    assert "feature 1" in text and "support_role" in text
 
     text = one_line_error(read_geojson, write(tmp_path, [feature(SQ, density="heavy")], "d.geojson"))
-    assert "feature 0" in text and "density" in text
+    assert "feature 1" in text and "density" in text
 
 
-_BAD_FEATURES = [  # (feature 1 of a file whose feature 0 is a good block, the body named or None, message)
+_BAD_FEATURES = [  # (feature 2 of a file whose feature 1 is a good block, the body named or None, message)
     ("not a feature", {"type": "Point"}, None, "not a GeoJSON Feature"),
     ("properties", {"type": "Feature", "properties": [1], "geometry": None}, None, "'properties' must be an object"),
     ("role", feature(SQ, role="roof", name="B12"), None, "role must be 'block' or 'support', got 'roof'"),
     (
         "point",
         {"type": "Feature", "properties": {"name": "B12"}, "geometry": {"type": "Point"}},
-        "block 1",
+        "block 2",
         "geometry must be a Polygon, got 'Point'",
     ),
     (
         "empty",
         {"type": "Feature", "properties": {"name": "B12"}, "geometry": {"type": "Polygon"}},
-        "block 1",
+        "block 2",
         "Polygon has no coordinates",
     ),
     (
         "holes",
         {"type": "Feature", "properties": {"name": "B12"}, "geometry": {"type": "Polygon", "coordinates": [SQ, SQ]}},
-        "block 1",
+        "block 2",
         "1 hole(s)",
     ),
-    ("coordinates", feature([[0, 0], [1, "x"], [1, 1]], name="B12"), "block 1", "coordinates must be [x, y] number"),
-    ("concave", feature([[0, 0], [2, 0], [2, 2], [1, 0.5], [0, 2], [0, 0]], name="B12"), "block 1", "not convex"),
-    ("nan", feature([[0, 0], [1, 0], [1, float("nan")], [0, 0]], name="B12"), "block 1", "vertex 2 has a NaN"),
-    ("density", feature(SQ, name="B12", density="heavy"), "block 1", "density"),
-    ("thickness", feature(SQ, name="B12", thickness=-1), "block 1", "thickness"),
-    ("velocity", feature(SQ, name="B12", velocity=[1, 2]), "block 1", "velocity must be [vx, vy, omega]"),
-    ("support role", feature(SQ, role="support", name="B12", support_role="wobbly"), "support 0", "support_role"),
+    ("coordinates", feature([[0, 0], [1, "x"], [1, 1]], name="B12"), "block 2", "coordinates must be [x, y] number"),
+    ("concave", feature([[0, 0], [2, 0], [2, 2], [1, 0.5], [0, 2], [0, 0]], name="B12"), "block 2", "not convex"),
+    ("nan", feature([[0, 0], [1, 0], [1, float("nan")], [0, 0]], name="B12"), "block 2", "vertex 2 has a NaN"),
+    ("density", feature(SQ, name="B12", density="heavy"), "block 2", "density"),
+    ("thickness", feature(SQ, name="B12", thickness=-1), "block 2", "thickness"),
+    ("velocity", feature(SQ, name="B12", velocity=[1, 2]), "block 2", "velocity must be [vx, vy, omega]"),
+    ("support role", feature(SQ, role="support", name="B12", support_role="wobbly"), "support 1", "support_role"),
     (
         "support concave",
         feature([[0, 0], [2, 0], [2, 2], [1, 0.5], [0, 2]], role="support", name="B12"),
-        "support 0",
+        "support 1",
         "not convex",
     ),
 ]
@@ -156,11 +156,12 @@ _BAD_FEATURES = [  # (feature 1 of a file whose feature 0 is a good block, the b
 @pytest.mark.parametrize("case, bad, body, message", _BAD_FEATURES, ids=[row[0] for row in _BAD_FEATURES])
 def test_geojson_errors_name_a_feature_in_one_format(tmp_path, case, bad, body, message):
     """Every GeoJSON error names the feature as ``FILE: feature K: `` and, once its role is read, the body as
-    every other message does (``block 1 ("B12")``): a polygon's checks said ``feature 1: block 1 ("B12")``
-    and the reader's own ``feature 1 (block 1 "B12")`` before."""
+    every other message does (``block 2 ("B12")``), both numbered from 1 as the user counts them: a
+    polygon's checks said ``feature 1: block 1 ("B12")`` and the reader's own ``feature 1 (block 1 "B12")``
+    before, and both counted from 0 ("feature 0" was the first)."""
     path = write(tmp_path, [feature(SQ, name="A1"), bad])
     text = one_line_error(read_geojson, path)
-    start = f"{path}: feature 1: " + (f'{body} ("B12"): ' if body else "")
+    start = f"{path}: feature 2: " + (f'{body} ("B12"): ' if body else "")
     assert text.startswith(start), text
     assert message in text[len(start) :], text
 
@@ -175,7 +176,7 @@ def test_wkt_lines_labels_and_supports(tmp_path):
         "support ground driven: POLYGON ((-2 -1, 3 -1, 3 0, -2 0, -2 -1))\n"
     )
     a = read_wkt(path, density=2000.0)
-    assert [b.name for b in a.blocks] == ["block-0", "top"]
+    assert [b.name for b in a.blocks] == ["block-1", "top"]  # block-1 first, as in a TOML file
     assert a.blocks[0].density == 2000.0
     assert [(s.name, s.role) for s in a.supports] == [("ground", "driven")]
 
@@ -188,7 +189,7 @@ def test_wkt_collection_file_and_multipolygon(tmp_path):
         "GEOMETRYCOLLECTION (POLYGON ((0 0, 1 0, 1 1, 0 1, 0 0)), POLYGON ((1 0, 2 0, 2 1, 1 1, 1 0)),"
         " POLYGON ((0 1, 1 1, 1 2, 0 2, 0 1)))"
     )
-    assert [b.name for b in read_wkt(path).blocks] == ["block-0", "block-1", "block-2"]
+    assert [b.name for b in read_wkt(path).blocks] == ["block-1", "block-2", "block-3"]
 
 
 def test_wkt_round_trip(tmp_path):
@@ -205,7 +206,7 @@ def test_wkt_errors_name_file_and_line(tmp_path):
     path.write_text("POLYGON ((0 0, 1 0, 1 1, 0 1, 0 0))\nLINESTRING (0 0, 1 1)\n")
     assert "line 2" in one_line_error(read_wkt, path)
     path.write_text("a: POLYGON ((0 0, 1 0, 1 1, 0 1, 0 0))\nc3-b2: POLYGON ((0 0, 2 0, 2 2, 1 0.5, 0 2, 0 0))\n")
-    assert 'line 2: block 1 ("c3-b2"): polygon is not convex' in one_line_error(read_wkt, path)
+    assert 'line 2: block 2 ("c3-b2"): polygon is not convex' in one_line_error(read_wkt, path)
     with pytest.raises(GeometryError, match="cannot read file"):
         read_wkt(tmp_path / "missing.wkt")
 

@@ -56,16 +56,16 @@ def _rotated_voussoir(degrees: float) -> Assembly:
         (ARCH, []),
         (build_aqueduct(), []),  # cut spandrel blocks: joints off by float noise, below the tolerance
         # one voussoir of 400 turned by 0.5° about its centre: into both neighbours
-        (_rotated_voussoir(0.5), 'error: blocks 182 ("v149") and 183 ("v150") overlap by'),
-        (_rotated_voussoir(1e-4), "error: blocks 182"),  # 5e-9 m² into each neighbour (tolerance 1e-9)
+        (_rotated_voussoir(0.5), 'error: blocks 183 ("v149") and 184 ("v150") overlap by'),
+        (_rotated_voussoir(1e-4), "error: blocks 183"),  # 5e-9 m² into each neighbour (tolerance 1e-9)
         # a block floating above the arch, and a foundation sunk into the other
         (
             Assembly(ARCH.blocks + (Block(box(0, 9, 0.3, 9.2), "loose"),), ARCH.supports),
-            ['block 468 ("loose") touches nothing'],
+            ['block 469 ("loose") touches nothing'],
         ),
         (
             Assembly(ARCH.blocks, ARCH.supports + (Support(box(-3, -0.6, 3, -0.4), "slab"),)),
-            ['support 0 ("left-foundation") and support 2 ("slab") overlap by', 'support 1 ("right-foundation") and'],
+            ['support 1 ("left-foundation") and support 3 ("slab") overlap by', 'support 2 ("right-foundation") and'],
         ),
         (Assembly((Block(box(0, 0, 1, 1), "a"), Block(box(1.0005, 0, 2, 1), "b")), (GROUND,)), []),  # gap < 1 mm
         (Assembly((Block(box(0, 0, 1, 1), "a"), Block(box(1.0011, 0, 2, 1), "b")), (GROUND,)), []),  # on the ground

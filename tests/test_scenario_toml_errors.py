@@ -138,14 +138,23 @@ def test_real_overlap_check(tmp_path):
     assert "overlap" in msg and '"b1"' in msg and '"b2"' in msg
 
 
+def test_overlapping_blocks_are_numbered_as_the_reader_numbers_them(tmp_path):
+    # the third and fourth [[block]] tables, unnamed: it said 'blocks 2 ("block-3") and 3 ("block-4")'
+    # where every other message of the reader says [[block]] #3 ("block-3")
+    square = "[[block]]\npolygon = [[{x}, {y}], [{x1}, {y}], [{x1}, {y1}], [{x}, {y1}]]\n"
+    blocks = "".join(square.format(x=x, y=y, x1=x + 1, y1=y + 1) for x, y in ((0, 0), (1, 0), (0, 1), (0.5, 1.5)))
+    msg = load_error(tmp_path, blocks + GROUND)
+    assert msg.endswith('blocks 3 ("block-3") and 4 ("block-4") overlap by 0.25 m² (tolerance 1e-09 m²)'), msg
+
+
 def test_validate_assembly_errors_and_warnings(tmp_path, monkeypatch):
     import geometry_library.checks as checks
 
     def overlapping(assembly):
-        raise GeometryError('block 0 ("b1") overlaps block 1 ("b2")')
+        raise GeometryError('block 1 ("b1") overlaps block 2 ("b2")')
 
     monkeypatch.setattr(checks, "validate_assembly", overlapping)
-    assert load_error(tmp_path, BLOCK + BLOCK2) == 'block 0 ("b1") overlaps block 1 ("b2")'
+    assert load_error(tmp_path, BLOCK + BLOCK2) == 'block 1 ("b1") overlaps block 2 ("b2")'
 
     monkeypatch.setattr(checks, "validate_assembly", lambda a: ["blocks b1 and b2 are 2 mm apart", "multi\nline"])
     s = load_scenario(write(tmp_path, BLOCK + BLOCK2))
