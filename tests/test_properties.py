@@ -90,7 +90,7 @@ def test_random_polygon_is_convex_or_one_line(coords, kind):
     try:
         poly = polygon_from_coords(coords, 0, "p", kind)
     except GeometryError as exc:
-        assert len(str(exc).splitlines()) == 1 and str(exc).startswith(f'{kind} 0 ("p")')
+        assert len(str(exc).splitlines()) == 1 and str(exc).startswith(f'{kind} 1 ("p")')  # index 0, shown from 1
     else:
         assert poly.is_valid and poly.area > 0 and math.isclose(poly.convex_hull.area, poly.area, rel_tol=1e-9)
 
