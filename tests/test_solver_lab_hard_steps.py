@@ -25,3 +25,20 @@ def test_capture_into_a_directory_replays_from_it(tmp_path):
     assert handed and all(s["by"] != "momentum0" for s in handed)
     assert all(s["by"] == "momentum0" for s in steps if s["stalled_at"] is None and s["converged"])
     assert any(s["by"] == "bodies" for s in handed)
+
+
+def test_capture_with_constants_set_replays_under_the_same_variant(tmp_path):
+    # A capture with --set runs the variant's trajectory: its steps replayed under that variant get the
+    # units the capture run spent on them, each entry names the override, and the constant is restored.
+    from masonrycli.engine import momentum
+
+    before = momentum.STALL_SWEEPS
+    variant = "momentum.STALL_SWEEPS=1"
+    hard_steps.capture(["h8"], 0, 1, [(1.0, 2.0, 0.0)], 0.004, tmp_path, override=variant)
+    assert momentum.STALL_SWEEPS == before
+    index = json.loads((tmp_path / "index-h8-c0.json").read_text())
+    assert len(index) == 4 and all(e["override"] == variant for e in index.values())
+    doc = hard_steps.replay([variant], 1, None, None, directory=tmp_path)
+    assert {n: s["units"] for n, s in doc["variants"][variant]["steps"].items()} == {
+        n: e["units"] for n, e in index.items()
+    }

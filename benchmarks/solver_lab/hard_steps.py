@@ -1,7 +1,7 @@
 """Hard steps: capture the steps that cost the engine most in ensemble runs, and replay rule variants on them.
 
     python -m benchmarks.solver_lab hard capture [--cases h32 h64] [--copy 0] [--min-units 1000]
-                                                 [--motions A,F …] [--duration S] [--dir DIR]
+                                                 [--motions A,F …] [--duration S] [--dir DIR] [--set MOD.NAME=V+…]
     python -m benchmarks.solver_lab hard replay --variants main ns-… [--min-units 2500] [--out FILE.json] [--dir DIR]
     python -m benchmarks.solver_lab hard table FILE.json [FILE.json …]
 
@@ -14,7 +14,9 @@ cap) in ``data/hard/<case>-a<A>-f<F>-c<copy>-<step>.npz``, with the units and re
 (``index-<case>-c<copy>.json``). The per-step units of the run are printed beside the run's total so that they can be
 checked against an ensemble file of the same engine (the same motion and copy give the same units).
 ``--dir`` captures into (and replays from) another directory than ``data/hard``: a set per engine, since a
-capture describes the engine that ran it (``data/hard`` is that of 88c12c6 for h32 / h64).
+capture describes the engine that ran it (``data/hard`` is that of 88c12c6 for h32 / h64). ``--set`` runs the
+capture with module constants set as a replay variant's (``MOD.NAME=VALUE[+…]``, kept in the index as
+``override``): the steps of a variant's trajectory, which leaves main's at its first changed step.
 
 ``replay`` solves each kept step with ``--min-units`` or more by nlgs.solve from its warm start, once per
 variant: a variant is a set of module constants of momentum.py, stalled.py and newton.py set for the
@@ -35,7 +37,7 @@ from types import SimpleNamespace
 import numpy as np
 
 from benchmarks.solver_lab.problems import DATA
-from masonrycli.engine import momentum, newton, nlgs, stalled
+from masonrycli.engine import bodies, momentum, newton, nlgs, stalled
 
 HARD = DATA / "hard"
 BIG = 10_000
@@ -78,18 +80,36 @@ def _key(case: str, motion, copy: int, step: int) -> str:
 
 
 def capture(
-    cases: list[str], copy: int, min_units: int, motions=None, duration: float | None = None, directory=None
+    cases: list[str],
+    copy: int,
+    min_units: int,
+    motions=None,
+    duration: float | None = None,
+    directory=None,
+    override: str | None = None,
 ) -> None:
-    """Run ``cases`` under the ensemble's motions; keep the steps of ``min_units`` or more (module doc)."""
-    from benchmarks.solver_lab import ensemble
-
+    """Run ``cases`` under the ensemble's motions; keep the steps of ``min_units`` or more (module doc), with
+    the constants of ``override`` (``MOD.NAME=VALUE[+…]``) set for the capture."""
     directory = directory or HARD  # read at the call: tests point HARD elsewhere
     directory.mkdir(parents=True, exist_ok=True)
+    old = _set(_parse(override)) if override else {}
+    try:
+        _capture_cases(cases, copy, min_units, motions, duration, directory, override)
+    finally:
+        _set(old)
+
+
+def _capture_cases(cases, copy, min_units, motions, duration, directory, override) -> None:
+    from benchmarks.solver_lab import ensemble
+
     for case in cases:
         index_path = directory / f"index-{case}-c{copy}.json"  # one a capture process: cases run in parallel
         index = json.loads(index_path.read_text()) if index_path.exists() else {}
         for motion in motions or ensemble.MOTIONS:
             kept, units = _capture_run(case, motion, copy, min_units, duration or ensemble.DURATION, directory)
+            if override:
+                for entry in kept.values():
+                    entry["override"] = override
             index.update(kept)
             index_path.write_text(json.dumps(index, indent=1))
             u = np.array(units)
@@ -143,7 +163,7 @@ def _capture_run(case, motion, copy, min_units, duration, directory) -> tuple[di
 
 
 def _set(overrides: dict[str, object]) -> dict[str, object]:
-    modules = {"momentum": momentum, "newton": newton, "stalled": stalled, "nlgs": nlgs}
+    modules = {"momentum": momentum, "newton": newton, "stalled": stalled, "nlgs": nlgs, "bodies": bodies}
     old = {}
     for name, value in overrides.items():
         module, attr = name.split(".")
@@ -289,6 +309,7 @@ def add_arguments(sub) -> None:
     c.add_argument("--motions", nargs="+", default=None, help="A,F[,PHASE] … (default: the ensemble's 12)")
     c.add_argument("--duration", type=float, default=None, help="s (default: the ensemble's)")
     c.add_argument("--dir", type=Path, default=None, help="where the steps go (default data/hard)")
+    c.add_argument("--set", default=None, metavar="MOD.NAME=VALUE[+…]", help="engine constants for the capture")
     r = act.add_parser("replay")
     r.add_argument(
         "--variants", nargs="+", default=["main"], help=f"names ({', '.join(VARIANTS)}) or MOD.NAME=VALUE[+…]"
@@ -307,7 +328,7 @@ def main(args) -> None:
         from benchmarks.solver_lab.ensemble import parse_motion
 
         motions = [parse_motion(m) for m in args.motions] if args.motions else None
-        capture(args.cases, args.copy, args.min_units, motions, args.duration, args.dir)
+        capture(args.cases, args.copy, args.min_units, motions, args.duration, args.dir, args.set)
     elif args.action == "replay":
         replay(args.variants, args.min_units, args.max_units, args.out, args.cases, args.dir)
     else:
