@@ -1,6 +1,6 @@
 """The body-order stage's hand-over: record its residual histories on captured hard steps, replay hand-over rules.
 
-    python -m benchmarks.solver_lab handover record --cases wall-248 [--min-units 2500] [--max-units N] --out H.npz
+    python -m benchmarks.solver_lab handover record --cases wall-248 [--min-units 2500] [--max-units N] [--dir DIR] --out H.npz
     python -m benchmarks.solver_lab handover table H.npz [H2.npz …] [--rules …]
 
 A stalled step goes to ``stalled.continue_stalled``: momentum in body order (``bodies.body_order_sweeps``,
@@ -37,8 +37,9 @@ RECORD_UNITS = 32_000
 """Sweep units the stage gets in a recording: twice the engine's BODIES_UNITS, to see what more would buy."""
 
 
-def _names(cases, min_units, max_units) -> list[str]:
-    index = {n: e for path in sorted(HARD.glob("index-*.json")) for n, e in json.loads(path.read_text()).items()}
+def _names(cases, min_units, max_units, directory=None) -> list[str]:
+    directory = directory or HARD
+    index = {n: e for path in sorted(directory.glob("index-*.json")) for n, e in json.loads(path.read_text()).items()}
     return sorted(
         n
         for n, e in index.items()
@@ -46,10 +47,10 @@ def _names(cases, min_units, max_units) -> list[str]:
     )
 
 
-def record_step(name: str) -> dict | None:
-    """One kept step: momentum until its stall, then the stage alone (history) and the round-robin alone.
-    None if momentum converges the step (no hand-over)."""
-    z = np.load(HARD / f"{name}.npz")
+def record_step(name: str, directory=None) -> dict | None:
+    """One kept step (of ``directory``, default data/hard): momentum until its stall, then the stage alone
+    (history) and the round-robin alone. None if momentum converges the step (no hand-over)."""
+    z = np.load((directory or HARD) / f"{name}.npz")
     body, pack, count = z["body"].astype(np.int32), z["pack"], z["body"].shape[0]
     v, r, status = z["v_free"].copy(), z["r_warm"].copy(), z["status"].copy()
     model = SimpleNamespace(
@@ -93,13 +94,14 @@ def record_step(name: str) -> dict | None:
     return out
 
 
-def record(cases: list[str], min_units: int, max_units: int | None, out: Path) -> None:
-    """Record every kept step of ``cases`` (module doc) into ``out`` (.npz: one array per field and step)."""
-    names = _names(cases, min_units, max_units)
+def record(cases: list[str], min_units: int, max_units: int | None, out: Path, directory=None) -> None:
+    """Record every kept step of ``cases`` (module doc; of the captured set ``directory``, default data/hard)
+    into ``out`` (.npz: one array per field and step)."""
+    names = _names(cases, min_units, max_units, directory)
     arrays: dict[str, np.ndarray] = {}
     t = time.process_time()
     for i, name in enumerate(names):
-        rec = record_step(name)
+        rec = record_step(name, directory)
         if rec is None:
             continue
         for key, value in rec.items():
@@ -234,6 +236,7 @@ def add_arguments(sub) -> None:
     r.add_argument("--min-units", type=int, default=2500)
     r.add_argument("--max-units", type=int, default=None)
     r.add_argument("--out", type=Path, required=True)
+    r.add_argument("--dir", type=Path, default=None, help="the captured set (default data/hard)")
     t = act.add_parser("table")
     t.add_argument("files", nargs="+", type=Path)
     t.add_argument("--rules", nargs="+", default=None, help=f"of: {', '.join(RULES)}")
@@ -241,6 +244,6 @@ def add_arguments(sub) -> None:
 
 def main(args) -> None:
     if args.action == "record":
-        record(args.cases, args.min_units, args.max_units, args.out)
+        record(args.cases, args.min_units, args.max_units, args.out, args.dir)
     else:
         table(args.files, args.rules)
