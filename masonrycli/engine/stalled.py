@@ -2,7 +2,7 @@
 
 First, from the step's warm start, momentum sweeps that visit the contacts body by body
 (:mod:`masonrycli.engine.bodies`) for at most BODIES_UNITS sweep units (stall window BODIES_STALL sweeps;
-a hand-over when they cycle was measured and is off, next paragraph).
+they hand over to the round-robin earlier when their residual cycles, "Hand-over" below).
 On 64 hard steps of the 32- and 64-course walls' ensemble runs, alone, they converge all 64 in 150 139
 units where the round-robin below took 956 975 (benchmarks/README.md, "New methods on hard steps"); the
 same steps replayed through nlgs.solve with this stage ahead of the round-robin take 218 460 (0.23×),
@@ -19,15 +19,15 @@ round-robin behind the stage no longer matters there: newton, first, finishes ne
 momentum second (newton, momentum, turning, alternating, faces) gave every replayed hard step of five
 sets its units under the order below (benchmarks/README.md, "Momentum's stall window").
 
-Hand-over (measured, off: BODIES_CYCLING = 0). On the 248-block wall the stage finished none of 21
-captured steps of ≥ 2500 units: it spent its 16 000 units on each, and the round-robin then finished 20
-of them in ~600 (newton's first resume). On the 32- and 64-course walls it finishes 178 of 179 and 142 of
-142 stalled steps, a few only after 3000–7000 sweeps. Their residual histories (benchmarks/README.md,
-"The body-order stage's hand-over") tell most of them apart: where the stage fails, its residual cycles
-(stick/slip) around a level 1.4–6× the lowest residual, reached in an early dip, and new lows by a hair
-keep restarting any stall window; where it succeeds slowly, the residual stays near its low (level
-within 1.05–1.5× on most). So with BODIES_CYCLING > 0, every BODIES_WINDOW sweeps the window's level
-(geometric mean of its residuals) is compared with BODIES_LEVEL × the lowest residual so far, and
+Hand-over (on since 2026-11-27: 8 windows of 500 sweeps at level 1.8, this part's last paragraph). On the
+248-block wall the stage finished none of 21 captured steps of ≥ 2500 units: it spent its 16 000 units on
+each, and the round-robin then finished 20 of them in ~600 (newton's first resume). On the 32- and 64-course
+walls it finishes 178 of 179 and 142 of 142 stalled steps, a few only after 3000–7000 sweeps. Their residual
+histories (benchmarks/README.md, "The body-order stage's hand-over") tell most of them apart: where the stage
+fails, its residual cycles (stick/slip) around a level 1.4–6× the lowest residual, reached in an early dip,
+and new lows by a hair keep restarting any stall window; where it succeeds slowly, the residual stays near its
+low (level within 1.05–1.5× on most). So with BODIES_CYCLING > 0, every BODIES_WINDOW sweeps the window's
+level (geometric mean of its residuals) is compared with BODIES_LEVEL × the lowest residual so far, and
 BODIES_CYCLING such windows in a row hand the step over (bodies._cycling_windows). The round-robin starts
 from the warm start and momentum's iterate, not from the stage's, so a step the stage would not have
 finished ends with the same solution in fewer units. With 500 × 1.8 × 4: replayed, the 248-block wall's
@@ -38,7 +38,20 @@ wall's 150 665 570 → 668 013, as many converged; ensembles of 48 runs a wall, 
 cycles for 2000 sweeps and then converges is handed to a round-robin that may cost 10× more (the
 64-course wall's 1.15 m/s 1.7 Hz step 128: 10 041 → 98 160 units).
 
-Re-entry (with the hand-over; measured, off with it). A handed-over stage keeps its run
+With window 200 (momentum.STALL_SWEEPS, since 674490b) and re-entry, 4 × 1.4 made the 32-course wall's
+ensemble 1.024 [0.986, 1.066] (unconverged 1 → 3): it hands over steps the stage finishes after 2000–4000
+sweeps (on the 255 steps of ≥ 2500 units of main's own 48 runs, 32 steps in 22 runs), and newton's solution of
+such a step differs from the stage's by 4e-3–1.4e-2 m/s (both meet the 1e-5 m/s residual; the stage run on to
+a residual of 1.3e-7 or 2.5e-6 is 1.7–3.5e-2 m/s from either), so the run leaves main's path; on those paths,
+17 of 25 changed runs met more steps of ≥ 2500 units (2 fewer). Cycling = 8 windows (not before sweep 4000) at
+level 1.8 hands over 3 of the 255 (1.6 × 8: 7) and keeps most of the gain on steps the stage never finishes
+(wall-248's 45 hard steps of the ed257db set replayed: 955 083 → 671 907 units; 4 × 1.4: 491 776). Ensembles
+of 48 runs a wall against main's (benchmarks/README.md, "The hand-over, again"): mean units a step 0.983
+[0.972, 0.993] on the 248-block wall, 0.994 [0.985, 0.999] on the 64-course wall, 1.000 [0.988, 1.015] on the
+32-course wall; unconverged 0 → 0, 4 → 4, 1 → 0. So BODIES_CYCLING = 8, BODIES_LEVEL = 1.8,
+BODIES_WINDOW = 500.
+
+Re-entry (with the hand-over, on with it). A handed-over stage keeps its run
 (bodies.Stage: iterate, extrapolation, stall window) and, after BODIES_REENTER = 2 of the round-robin's
 resumes (newton's two in round 0, which finish the 248-block wall's steps), goes on for the units it had
 left, once, as one long run would; also when the round-robin ends first. Step 128 above then costs
@@ -50,8 +63,8 @@ stage's (adopting it when lowest put h32 runs on trajectories with 13 unconverge
 Ensembles of 48 runs a wall against main with momentum.STALL_SWEEPS 500 (benchmarks/README.md, "A way
 back to the stage"): 0.960 [0.937, 0.980] on the 248-block wall (unconverged 3 → 3), 0.996 [0.977,
 1.017] on the 32-course wall (7 → 8), 0.994 [0.982, 1.005] on the 64-course wall (2 → 3; step 128 15 142
-units): the hand-over's extra unconverged steps, met on other trajectories, remain. Not on, with the
-hand-over: BODIES_CYCLING = 0 leaves the engine main's, bit for bit.
+units): the hand-over's extra unconverged steps, met on other trajectories, remain. It ships with the
+hand-over at 8 × 1.8 (above; BODIES_CYCLING = 0 turns both off).
 
 Gauss–Seidel with momentum (the default solver, :mod:`masonrycli.engine.momentum`) converges most steps in
 tens to hundreds of sweeps. On tall walls that slide it can stall: momentum drives the step into a
@@ -132,9 +145,9 @@ BODIES_WINDOW = 500
 """Sweeps over which the hand-over rule takes the stage's residual level (module doc, "Hand-over")."""
 BODIES_LEVEL = 1.8
 """A window whose level (geometric mean of its residuals) is above this × the stage's lowest residual cycles."""
-BODIES_CYCLING = 0
-"""Cycling windows in a row after which the stage hands over to the round-robin (0: never, the default: 4
-was measured and not shipped, module doc "Hand-over")."""
+BODIES_CYCLING = 8
+"""Cycling windows in a row after which the stage hands over to the round-robin (0: never; 8, i.e. not before
+sweep 4000, since 2026-11-27: module doc "Hand-over")."""
 
 BODIES_REENTER = 2
 """After a hand-over, the round-robin's resumes (in its order, newton's ahead counted) after which the stage
