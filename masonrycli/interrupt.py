@@ -50,16 +50,14 @@ def signal_name(signum: int) -> str:
     return "Ctrl-C" if signum == signal.SIGINT else signal.Signals(signum).name
 
 
-class StopSignals:
-    """Context manager installing the handlers; starts in the setup phase."""
+class _Handlers:
+    """Installs :meth:`_handle` for :data:`SIGNALS` on entry (main thread only) and puts the previous
+    handlers back on exit."""
 
     def __init__(self) -> None:
-        self.signum: int | None = None
-        self.phase = "setup"
-        self.repeats = 0
         self._previous: dict[int, object] = {}
 
-    def __enter__(self) -> StopSignals:
+    def __enter__(self):
         if threading.current_thread() is threading.main_thread():
             for sig in SIGNALS:
                 self._previous[sig] = signal.signal(sig, self._handle)
@@ -69,6 +67,19 @@ class StopSignals:
         for sig, handler in self._previous.items():
             signal.signal(sig, handler)
         self._previous.clear()
+
+    def _handle(self, signum, _frame) -> None:
+        raise NotImplementedError
+
+
+class StopSignals(_Handlers):
+    """Context manager installing the handlers; starts in the setup phase."""
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.signum: int | None = None
+        self.phase = "setup"
+        self.repeats = 0
 
     def stepping(self) -> None:
         """From now on a signal asks the time loop to stop after its current step."""
@@ -104,28 +115,17 @@ class StopSignals:
         already_stopping(signum)
 
 
-class FirstSignalStops:
+class FirstSignalStops(_Handlers):
     """Handlers for a command that stops by ``KeyboardInterrupt`` (``masonry sweep``: its study and its
     report): the first SIGINT or SIGTERM raises it — at once, or at the end of a :meth:`held` block — and
     :attr:`signum` says which; later ones are acknowledged on stderr and ignored, so the shutdown that
     follows the first (the table written, the cluster closed) is not cut. Main thread only, as above."""
 
     def __init__(self) -> None:
+        super().__init__()
         self.signum: int | None = None
         self._holding = False
         self._deferred = False
-        self._previous: dict[int, object] = {}
-
-    def __enter__(self) -> FirstSignalStops:
-        if threading.current_thread() is threading.main_thread():
-            for sig in SIGNALS:
-                self._previous[sig] = signal.signal(sig, self._handle)
-        return self
-
-    def __exit__(self, *exc) -> None:
-        for sig, handler in self._previous.items():
-            signal.signal(sig, handler)
-        self._previous.clear()
 
     def stopping(self) -> int:
         """The signal that stopped the command (SIGINT for a KeyboardInterrupt of other origin); from now
