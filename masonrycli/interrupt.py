@@ -59,8 +59,12 @@ class _Handlers:
 
     def __enter__(self):
         if threading.current_thread() is threading.main_thread():
-            for sig in SIGNALS:
-                self._previous[sig] = signal.signal(sig, self._handle)
+            try:
+                for sig in SIGNALS:
+                    self._previous[sig] = signal.signal(sig, self._handle)
+            except BaseException:  # a signal between two installs (StopRun): __exit__ will not run
+                self.__exit__()
+                raise
         return self
 
     def __exit__(self, *exc) -> None:

@@ -200,3 +200,25 @@ def test_first_signal_stops_held_blocks_and_repeats():
         os.kill(os.getpid(), signal.SIGINT)
         time.sleep(5)
     assert signals.signum == signal.SIGINT
+
+
+def test_a_signal_while_the_handlers_are_installed_puts_the_first_back(monkeypatch):
+    # A Ctrl-C between installing SIGINT's handler and SIGTERM's raises StopRun out of __enter__, so
+    # __exit__ never runs: SIGINT's handler stayed installed and every later Ctrl-C was a "repeat",
+    # acknowledged and ignored.
+    import masonrycli.interrupt as interrupt
+
+    install = signal.signal
+    before = signal.getsignal(signal.SIGINT)
+
+    def signal_arrives_at_sigterm(sig, handler):
+        if sig == signal.SIGTERM and handler not in (signal.SIG_DFL, signal.SIG_IGN) and callable(handler):
+            handler(signal.SIGINT, None)  # in the setup phase: raises StopRun
+        return install(sig, handler)
+
+    monkeypatch.setattr(interrupt.signal, "signal", signal_arrives_at_sigterm)
+    with pytest.raises(StopRun):
+        with StopSignals():
+            pass
+    monkeypatch.undo()
+    assert signal.getsignal(signal.SIGINT) is before
