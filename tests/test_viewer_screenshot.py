@@ -95,3 +95,30 @@ def test_a_run_ended_before_the_paper_instant_opens_on_its_structure(tmp_path):
     assert screenshot_recording(rrd, png, timeout=120, at_open=True) == []
     main = np.asarray(image_module.open(png).convert("RGB"))[60:1000, :850]
     assert near(main, unpack_rgba(BLUES)[:, :3]).mean() > 0.05  # the blocks, filled by p (blues)
+
+
+def longest_runs(mask: np.ndarray) -> np.ndarray:
+    """(W,) the longest vertical run of True in each column of an (H, W) mask."""
+    best, cur = np.zeros(mask.shape[1], int), np.zeros(mask.shape[1], int)
+    for row in mask:
+        cur = np.where(row, cur + 1, 0)
+        best = np.maximum(best, cur)
+    return best
+
+
+def test_the_colour_bar_is_not_covered_by_its_labels(screenshot):
+    """The tick labels (centred on their anchors, 0.6 bar widths right of the bar) hid a band of the bar
+    at every tick, and "1 above" covered the top tick: the bar's longest uncovered run was 104 of its
+    ~250 px in the 51-block wall's Fig. III.2 tab. The labels now stand clear: the bar is whole."""
+    import PIL.Image as image_module
+
+    png, _, _ = screenshot
+    rgb = np.asarray(image_module.open(png).convert("RGB"))[60:1000, :1150].astype(np.int32)
+    lut = unpack_rgba(BLUES)[:, :3].astype(np.int32)  # the live tab shows p
+    mask = np.min([np.abs(rgb - c).sum(axis=-1) for c in lut], axis=0) < 24
+    runs = longest_runs(mask)
+    bar = np.nonzero(runs >= 0.6 * runs.max())[0]  # the bar's columns: the longest unbroken colours
+    rows = np.nonzero(mask[:, bar].any(axis=1))[0]
+    # a bar, not the blocks (with the labels over it, no run of the bar outgrew the blocks' own)
+    assert bar.max() - bar.min() < 40 and rows.max() - rows.min() > 150
+    assert runs.max() >= 0.95 * (rows.max() - rows.min() + 1)
