@@ -12,8 +12,9 @@ Three phases, because what a signal may safely do depends on what is under way:
 Outside the main thread (where Python cannot install handlers) the context does nothing.
 
 :class:`FirstSignalStops` is the same rule for a command that stops by ``KeyboardInterrupt`` (``masonry
-sweep``): the first signal raises it, later ones are acknowledged and ignored, and a block can hold it
-(a report file renamed into place and recorded as written, with no signal between the two).
+sweep``): the first signal raises it, later ones are acknowledged and ignored (after the context too,
+once a signal has stopped the command: it is on its way out), and a block can hold it (a report file
+renamed into place and recorded as written, with no signal between the two).
 
 Once a command is over — whatever its exit code — :func:`ignore_signals_while_exiting` lets the interpreter
 shut down undisturbed: Python puts its handlers back to the default action when it finalizes, so a Ctrl-C
@@ -130,6 +131,16 @@ class FirstSignalStops(_Handlers):
         self.signum: int | None = None
         self._holding = False
         self._deferred = False
+
+    def __exit__(self, *exc) -> None:
+        # Stopped: the command is leaving with exit 130/143 and has said what it wrote. Python's handlers,
+        # put back here, would turn a second Ctrl-C on the rest of the way out (typer's exit, weakref and
+        # atexit callbacks) into "stopped before any output was written" or a KeyboardInterrupt traceback
+        # under the complete table (CI, 2026-11-27 18:25 UTC); ignored instead, as once the command is over.
+        stopped = self.signum is not None and bool(self._previous)
+        super().__exit__(*exc)
+        if stopped:
+            ignore_signals_while_exiting()
 
     def stopping(self) -> int:
         """The signal that stopped the command (SIGINT for a KeyboardInterrupt of other origin); from now

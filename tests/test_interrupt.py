@@ -181,10 +181,14 @@ def test_a_ctrl_c_after_the_command_is_over_is_ignored(code, tmp_path):
 
 def test_first_signal_stops_held_blocks_and_repeats():
     """masonry sweep's handlers: the first signal raises KeyboardInterrupt (at the end of a held block if it
-    came inside one), later ones are acknowledged and ignored; the handlers are restored after."""
+    came inside one), later ones are acknowledged and ignored — after the context too, since a stopped
+    command is on its way out; a context that no signal stopped puts the handlers back."""
     from masonrycli.interrupt import FirstSignalStops
 
     before = signal.getsignal(signal.SIGTERM)
+    with FirstSignalStops():
+        pass
+    assert signal.getsignal(signal.SIGTERM) is before
     with FirstSignalStops() as signals:
         done = []
         with pytest.raises(KeyboardInterrupt):
@@ -195,7 +199,11 @@ def test_first_signal_stops_held_blocks_and_repeats():
         assert done == ["after the signal"] and signals.stopping() == signal.SIGTERM
         os.kill(os.getpid(), signal.SIGINT)  # a repeat: acknowledged, ignored
         time.sleep(0.1)
-    assert signal.getsignal(signal.SIGTERM) is before
+    # stopped: a signal on the rest of the way out (typer's exit, atexit callbacks) is ignored, not raised
+    assert signal.getsignal(signal.SIGTERM) is signal.SIG_IGN and signal.getsignal(signal.SIGINT) is signal.SIG_IGN
+    os.kill(os.getpid(), signal.SIGINT)
+    time.sleep(0.1)
+    signal.signal(signal.SIGINT, signal.default_int_handler)
     with FirstSignalStops() as signals, pytest.raises(KeyboardInterrupt):
         os.kill(os.getpid(), signal.SIGINT)
         time.sleep(5)
