@@ -1,7 +1,8 @@
 """Rerun recording of a run: the only package that imports rerun.
 
 - ``recorder``: ``Recorder`` writes one run's ``.rrd`` from its frames; ``RecordingStatic`` is its input.
-- ``layout``: entity paths, field specs, colours, scale constants, the default blueprint.
+- ``layout``: entity paths, field specs, colours, scale constants, the default blueprint, the paper's tabs.
+- ``field_colours``: each field's colour range followed frame by frame, block colours and legend labels.
 - ``document``: the run document (status, parameters, scales, versions) shown beside the views.
 - ``static_content``: ``RecordingStatic`` and what is logged once (styles, drawing plane, colour bars).
 - ``arrays``: posed polygons, Arrow line strips and the frame buffer behind ``send_columns``.

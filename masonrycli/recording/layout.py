@@ -12,6 +12,7 @@ import rerun as rr
 import rerun.blueprint as rrb
 from rerun.blueprint.encodings import ComponentSourceKind, VisualizerComponentMapping
 
+from masonrycli.builtin import is_paper_loading
 from masonrycli.colour_range import ScaleKind
 
 ROBUST_PERCENTILE: Final = 98.0  # the glyph scales come from this percentile of |value|
@@ -254,3 +255,18 @@ def build_blueprint(
         # empty at first open (the colour bar alone). Following puts the cursor on the last frame.
         rrb.TimePanel(state="collapsed", timeline="sim_time", play_state="following"),
     )
+
+
+def paper_figures(metadata: dict) -> tuple[float, tuple[str, ...]] | None:
+    """(instant s, figure numbers) of the paper's figures for a run described by ``metadata``, or None.
+
+    Only under the paper's loading (``metadata["supports"]``, support name -> ``Motion.describe()``): the
+    wall shaken by an earthquake record, or at 5 Hz, opened on tabs named "Fig. III.2" pinned to 0.1 s,
+    where a record has barely started (strain rates at the 1e-4 1/s floor of the colour range).
+    """
+    name = str(metadata.get("scenario"))
+    paper = PAPER_FIGURES.get(name)
+    duration = metadata.get("duration_s")
+    if paper is None or duration is None or float(duration) < paper[0]:
+        return None
+    return paper if is_paper_loading(name, metadata.get("supports") or {}) else None

@@ -36,12 +36,11 @@ import numpy as np
 import pyarrow as pa
 import rerun as rr
 
-from masonrycli.builtin import is_paper_loading
-from masonrycli.colormap import map_positions, nice_ceil, robust_max_abs, tick_label
-from masonrycli.colour_range import RangeTracker, positions
+from masonrycli.colormap import nice_ceil, robust_max_abs
 from masonrycli.frame import Frame
 from masonrycli.recording.arrays import FrameBatch, Polygons, partition_lengths, time_indexes, z0
 from masonrycli.recording.document import legend_markdown, run_document, viewer_safe_text
+from masonrycli.recording.field_colours import FieldColours
 from masonrycli.recording.layout import (
     AXES,
     BLOCKS,
@@ -55,7 +54,6 @@ from masonrycli.recording.layout import (
     LEGEND,
     METADATA,
     PAPER_FIELDS,
-    PAPER_FIGURES,
     RESULTANT_LENGTH,
     RESULTANT_PERCENTILE,
     ROBUST_PERCENTILE,
@@ -65,14 +63,13 @@ from masonrycli.recording.layout import (
     SUPPORT_OUTLINES,
     TENSOR_KEYS,
     XY,
-    FieldSpec,
     build_blueprint,
+    paper_figures,
 )
 from masonrycli.recording.magnified import send_magnified
 from masonrycli.recording.overlays import CONTACT_ARRAYS, batch_joint_resultants, send_axes, send_joints
 from masonrycli.recording.readback import check_complete
 from masonrycli.recording.static_content import (
-    LUTS,
     TICKS,
     RecordingStatic,
     inset_local,
@@ -148,9 +145,8 @@ class Recorder:
         self._glyph_length = GLYPH_HALF_LENGTH * float(np.median(size.min(axis=1)))
         # (N,) m: a glyph never reaches out of its own block (thin cut spandrel blocks of the aqueduct)
         self._glyph_cap = np.minimum(self._glyph_length, GLYPH_HALF_LENGTH * size.min(axis=1))[: self._n]
-        self._trackers = {f.key: RangeTracker(f.kind, f.floor) for f in FIELDS}
-        self._labels: dict[tuple[str, object], list[str]] = {}  # (field, range) -> tick labels
-        self.field_ranges: dict[str, tuple[float, float]] = {}
+        self._colours = FieldColours(FIELDS)
+        self.field_ranges = self._colours.field_ranges
         """The range each field has at the last frame sent."""
         self.force_scale: float | None = None
         """m per N of the joint resultants, fixed at the first batch with a loaded joint."""
@@ -341,7 +337,7 @@ class Recorder:
         columns = [*rr.Mesh3D.columns(vertex_positions=z0(verts)).partition(per_vertex)]
         hover = [*rr.Points2D.columns(positions=q[..., :2].reshape(-1, 2).astype(np.float32)).partition(per_block)]
         for f in FIELDS:
-            colors, labels, lo, hi = self._colour_field(f, tensors[f.key])
+            colors, labels, lo, hi = self._colours.colour(f, tensors[f.key])
             archetype = f.colors.removesuffix(":colors")
             columns += rr.DynamicArchetype.columns(
                 archetype, components={"colors": rr.components.ColorBatch(colors[:, self._blocks.owner].reshape(-1))}
@@ -371,33 +367,6 @@ class Recorder:
         self.rec.send_columns(
             BLOCKS, indexes=idx, columns=[*hover, *rr.AnyValues.columns(**values).partition(per_block)]
         )
-
-    def _colour_field(self, f: FieldSpec, values: np.ndarray):
-        """Per frame: the range (tracked), block colours (F, N), legend labels, range ends (F,) each."""
-        ranges, below, above = self._trackers[f.key].follow(values)
-        lo = np.array([r.lo for r in ranges])
-        hi = np.array([r.hi for r in ranges])
-        per_frame = (-1,) + (1,) * (values.ndim - 1)
-        colors = map_positions(positions(f.kind, values, lo.reshape(per_frame), hi.reshape(per_frame)), LUTS[f.kind])
-        title = viewer_safe_text(f.title)
-        labels: list[str] = []
-        ticks, last = [], None
-        for r, n_below, n_above in zip(ranges, below.tolist(), above.tolist()):
-            if r is not last:  # a range holds for many frames
-                ticks, last = self._tick_labels(f, r), r
-            labels += ticks
-            labels += [title, f"{n_below} below" if n_below else "", f"{n_above} above" if n_above else ""]
-        self.field_ranges[f.key] = (float(lo[-1]), float(hi[-1]))
-        return colors, labels, lo, hi
-
-    def _tick_labels(self, f: FieldSpec, r) -> list[str]:
-        """The legend's tick labels of range ``r`` (a range holds for many frames: made once per range)."""
-        labels = self._labels.get((f.key, r))
-        if labels is None:
-            span = max(-r.lo, r.hi)
-            labels = [tick_label(v, f.unit, span, f.kind == "signed") for v in r.ticks(TICKS)]
-            self._labels[(f.key, r)] = labels
-        return labels
 
     def _send_supports(self, idx: list, support_q: np.ndarray) -> None:
         poly, n_frames = self._supports, len(support_q)
@@ -496,27 +465,12 @@ class Recorder:
             glyph_length=self._glyph_length,
             axis_scale=self.axis_scale,
             field_ranges=self.field_ranges,
-            range_changes={k: t.changes for k, t in self._trackers.items()},
+            range_changes=self._colours.range_changes(),
             magnify=self.magnify,
         )
         self.rec.log(METADATA, rr.TextDocument(viewer_safe_text(text), media_type="text/markdown"), static=True)
         legend = legend_markdown(self.force_scale, self.block_height, self.magnify)
         self.rec.log(LEGEND, rr.TextDocument(viewer_safe_text(legend), media_type="text/markdown"), static=True)
-
-
-def paper_figures(metadata: dict) -> tuple[float, tuple[str, ...]] | None:
-    """(instant s, figure numbers) of the paper's figures for a run described by ``metadata``, or None.
-
-    Only under the paper's loading (``metadata["supports"]``, support name -> ``Motion.describe()``): the
-    wall shaken by an earthquake record, or at 5 Hz, opened on tabs named "Fig. III.2" pinned to 0.1 s,
-    where a record has barely started (strain rates at the 1e-4 1/s floor of the colour range).
-    """
-    name = str(metadata.get("scenario"))
-    paper = PAPER_FIGURES.get(name)
-    duration = metadata.get("duration_s")
-    if paper is None or duration is None or float(duration) < paper[0]:
-        return None
-    return paper if is_paper_loading(name, metadata.get("supports") or {}) else None
 
 
 def _tensor(tensors: dict, key: str, n: int) -> np.ndarray:

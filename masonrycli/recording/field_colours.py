@@ -1,0 +1,57 @@
+"""The colour of each tensor field: its range followed frame by frame, block colours, legend labels.
+
+One :class:`FieldColours` per recording. A field's range (``masonrycli.colour_range.RangeTracker``) is refitted
+when the data leave it or shrink well inside it; each range's tick labels are made once, since a range
+holds for many frames. No rerun here: the recorder sends what this computes.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from masonrycli.colormap import map_positions, tick_label
+from masonrycli.colour_range import RangeTracker, positions
+from masonrycli.recording.document import viewer_safe_text
+from masonrycli.recording.layout import FieldSpec
+from masonrycli.recording.static_content import LUTS, TICKS
+
+
+class FieldColours:
+    """Range trackers and tick labels of ``fields`` (a tuple of :class:`FieldSpec`)."""
+
+    def __init__(self, fields) -> None:
+        self._trackers = {f.key: RangeTracker(f.kind, f.floor) for f in fields}
+        self._labels: dict[tuple[str, object], list[str]] = {}  # (field, range) -> tick labels
+        self.field_ranges: dict[str, tuple[float, float]] = {}
+        """The range each field has at the last frame coloured."""
+
+    def range_changes(self) -> dict[str, int]:
+        """How often each field's range was refitted."""
+        return {k: t.changes for k, t in self._trackers.items()}
+
+    def colour(self, f: FieldSpec, values: np.ndarray):
+        """Per frame: the range (tracked), block colours (F, N), legend labels, range ends (F,) each."""
+        ranges, below, above = self._trackers[f.key].follow(values)
+        lo = np.array([r.lo for r in ranges])
+        hi = np.array([r.hi for r in ranges])
+        per_frame = (-1,) + (1,) * (values.ndim - 1)
+        colors = map_positions(positions(f.kind, values, lo.reshape(per_frame), hi.reshape(per_frame)), LUTS[f.kind])
+        title = viewer_safe_text(f.title)
+        labels: list[str] = []
+        ticks, last = [], None
+        for r, n_below, n_above in zip(ranges, below.tolist(), above.tolist()):
+            if r is not last:  # a range holds for many frames
+                ticks, last = self._tick_labels(f, r), r
+            labels += ticks
+            labels += [title, f"{n_below} below" if n_below else "", f"{n_above} above" if n_above else ""]
+        self.field_ranges[f.key] = (float(lo[-1]), float(hi[-1]))
+        return colors, labels, lo, hi
+
+    def _tick_labels(self, f: FieldSpec, r) -> list[str]:
+        """The legend's tick labels of range ``r`` (a range holds for many frames: made once per range)."""
+        labels = self._labels.get((f.key, r))
+        if labels is None:
+            span = max(-r.lo, r.hi)
+            labels = [tick_label(v, f.unit, span, f.kind == "signed") for v in r.ticks(TICKS)]
+            self._labels[(f.key, r)] = labels
+        return labels
