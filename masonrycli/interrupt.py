@@ -137,10 +137,14 @@ class FirstSignalStops(_Handlers):
         # put back here, would turn a second Ctrl-C on the rest of the way out (typer's exit, weakref and
         # atexit callbacks) into "stopped before any output was written" or a KeyboardInterrupt traceback
         # under the complete table (CI, 2026-11-27 18:25 UTC); ignored instead, as once the command is over.
-        stopped = self.signum is not None and bool(self._previous)
-        super().__exit__(*exc)
-        if stopped:
+        # SIG_IGN replaces our handlers directly: restoring Python's first, even for a moment, let a signal
+        # that arrived just before (it runs at the next bytecode boundary, with the handler installed then)
+        # meet the default handler (CI at 017b831).
+        if self.signum is not None and self._previous:
             ignore_signals_while_exiting()
+            self._previous.clear()
+        else:
+            super().__exit__(*exc)
 
     def stopping(self) -> int:
         """The signal that stopped the command (SIGINT for a KeyboardInterrupt of other origin); from now

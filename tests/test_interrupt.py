@@ -230,3 +230,26 @@ def test_a_signal_while_the_handlers_are_installed_puts_the_first_back(monkeypat
             pass
     monkeypatch.undo()
     assert signal.getsignal(signal.SIGINT) is before
+
+
+def test_a_stopped_context_never_puts_pythons_handler_back_on_its_way_out(monkeypatch):
+    # A second Ctrl-C that arrived as the sweep's context closed ran at the next bytecode boundary with the
+    # handler installed *then*: __exit__ put Python's default_int_handler back before ignoring signals, and
+    # in that moment the repeat became a KeyboardInterrupt ("stopped before any output was written" under
+    # the "interrupted" line; CI at 017b831). Every handler installed on the way out must be SIG_IGN.
+    import masonrycli.interrupt as interrupt
+    from masonrycli.interrupt import FirstSignalStops
+
+    install, installed = signal.signal, []
+    with FirstSignalStops() as signals:
+        with pytest.raises(KeyboardInterrupt):
+            os.kill(os.getpid(), signal.SIGINT)
+            time.sleep(5)
+
+        def record(sig, handler):
+            installed.append(handler)
+            return install(sig, handler)
+
+        monkeypatch.setattr(interrupt.signal, "signal", record)
+    monkeypatch.undo()
+    assert signals.signum == signal.SIGINT and installed and all(h is signal.SIG_IGN for h in installed), installed
