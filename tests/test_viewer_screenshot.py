@@ -122,3 +122,22 @@ def test_the_colour_bar_is_not_covered_by_its_labels(screenshot):
     # a bar, not the blocks (with the labels over it, no run of the bar outgrew the blocks' own)
     assert bar.max() - bar.min() < 40 and rows.max() - rows.min() > 150
     assert runs.max() >= 0.95 * (rows.max() - rows.min() + 1)
+
+
+def test_the_block_hover_targets_are_small_dots(screenshot):
+    """The hover targets (a point per block carrying its values) were 0.15 block sizes wide, "in the
+    block's colour, so they do not show": rerun shades points and ignores their alpha over the fill mesh,
+    so each showed as a grey ring: 10 177 px changed over this wall's 28 blocks. They are dots of 2.5 ui
+    points at the centroids now, which the legend names: 200 px changed (about 7 a block)."""
+    import PIL.Image as image_module
+
+    from masonrycli.recording.layout import BLOCKS
+
+    _, _, tmp = screenshot
+    rrd, n_blocks = tmp / "wall.rrd", len(fx.wall(5, 6)[0].block_name)
+    with_dots, without = tmp / "with.png", tmp / "without.png"
+    assert screenshot_recording(rrd, with_dots, time_s=None, timeout=120) == []
+    assert screenshot_recording(rrd, without, time_s=None, timeout=120, without=(f"/{BLOCKS}",)) == []
+    a, b = (np.asarray(image_module.open(p).convert("RGB"))[60:1000, :1150].astype(int) for p in (with_dots, without))
+    changed = int((np.abs(a - b).sum(axis=-1) > 24).sum())
+    assert 0 < changed <= 30 * n_blocks

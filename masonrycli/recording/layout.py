@@ -148,12 +148,12 @@ UNDEFORMED_RGBA: Final = 0x6E6E6EFF
 HINGE_RGBA: Final = 0xFFD700FF
 COMPRESSION_RGBA: Final = 0x141414FF  # principal axis with a negative value (near black)
 TENSION_RGBA: Final = 0xDC00DCFF  # principal axis with a positive value (magenta)
+CENTROID_RGBA: Final = 0x282828FF  # the dot at each block's centroid, the hover target of its values
+CENTROID_RADIUS: Final = -2.5  # ui points: a dot of the same size at every zoom
 
 
 def _fill_colours(f: FieldSpec) -> dict:
-    """Blueprint overrides: the fill mesh takes its vertex colours from field ``f``'s component, and the
-    hover points (one per block, under the pointer wherever it is on the block) the same block colours,
-    so they do not show."""
+    """Blueprint override: the fill mesh takes its vertex colours from field ``f``'s component."""
 
     def source(target: str, component: str) -> VisualizerComponentMapping:
         return VisualizerComponentMapping(
@@ -162,15 +162,13 @@ def _fill_colours(f: FieldSpec) -> dict:
 
     return {
         f"/{FILL}": [rr.Mesh3D.from_fields().visualizer(mappings=[source("Mesh3D:vertex_colors", f.colors)])],
-        f"/{BLOCKS}": [rr.Points2D.from_fields().visualizer(mappings=[source("Points2D:colors", f.colors)])],
     }
 
 
 def _structure_view(name: str, f: FieldSpec, extra: tuple[str, ...] = (), at: float | None = None) -> rrb.Spatial2DView:
     """A tab of the structure coloured by field ``f``; ``at``: pinned to that sim_time (s), else live.
     Hover points (block values) in the tabs of the paper's fields."""
-    hover = (BLOCKS,) if f in PAPER_FIELDS else ()
-    paths = (SUPPORT_FILL, FILL, f.bar, *hover, SUPPORT_OUTLINES, f.labels, *extra)
+    paths = (SUPPORT_FILL, FILL, f.bar, BLOCKS, SUPPORT_OUTLINES, f.labels, *extra)
     pinned = None
     if at is not None:
         moment = rrb.TimeRangeBoundary.absolute(seconds=at)

@@ -299,12 +299,15 @@ def screenshot_recording(
     *,
     tabs_dir: str | os.PathLike | None = None,
     at_open: bool = False,
+    without: tuple[str, ...] = (),
 ) -> list[str]:
     """Open a recording in a headless viewer, save a PNG of the window, return the views' error reports.
 
     ``time_s``: the ``sim_time`` shown, s (None: the last frame's). The cursor is set on ``sim_time`` (the
     timeline the blueprint opens on and the paper-figure tabs are pinned on); with ``at_open`` it is left
-    where the viewer put it on opening the file (``time_s`` ignored): what a user sees first. The PNG shows the default layout. A hidden tab
+    where the viewer put it on opening the file (``time_s`` ignored): what a user sees first. The PNG shows the
+    default layout, less the entities ``without`` (paths with the leading "/": compare two shots to see what
+    an entity adds to the picture). A hidden tab
     is not drawn and cannot report, so every tab is then brought to the front in turn (saved as
     ``tabs_dir/tab<i>.png`` if given). Returns "view: severity: summary" for every report of every view;
     empty means healthy. Needs a Vulkan driver (Debian: mesa-vulkan-drivers libvulkan1).
@@ -335,6 +338,13 @@ def screenshot_recording(
             if time.monotonic() > deadline:
                 raise TimeoutError(f"viewer did not load {rrd_path} within {timeout} s")
             time.sleep(0.2)
+        if without:
+            layout = viewer.get_blueprint(of="recording").blueprint
+            for entry in layout.values():
+                query = entry.get("ViewContents", {}).get("query")
+                if isinstance(query, list):
+                    entry["ViewContents"]["query"] = [q for q in query if q.removeprefix("+ ") not in without]
+            viewer.set_blueprint(layout, of="recording")
         if not at_open:
             if time_s is None:
                 line = next((t for r in recs for t in r.timelines if t.name == "sim_time"), None)

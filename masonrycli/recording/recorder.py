@@ -53,7 +53,6 @@ from masonrycli.recording.layout import (
     INSET,
     LEGEND,
     METADATA,
-    PAPER_FIELDS,
     RESULTANT_LENGTH,
     RESULTANT_PERCENTILE,
     ROBUST_PERCENTILE,
@@ -342,10 +341,6 @@ class Recorder:
             columns += rr.DynamicArchetype.columns(
                 archetype, components={"colors": rr.components.ColorBatch(colors[:, self._blocks.owner].reshape(-1))}
             ).partition(per_vertex)
-            if f in PAPER_FIELDS:  # the joint-state tabs have no hover points
-                hover += rr.DynamicArchetype.columns(
-                    archetype, components={"colors": rr.components.ColorBatch(colors.reshape(-1))}
-                ).partition(per_block)
             self.rec.send_columns(
                 f.labels,
                 indexes=idx,

@@ -23,6 +23,8 @@ from masonrycli.recording.arrays import Polygons, uniform_strips, z0
 from masonrycli.recording.document import viewer_safe_text
 from masonrycli.recording.layout import (
     BLOCKS,
+    CENTROID_RADIUS,
+    CENTROID_RGBA,
     FILL,
     FORCES,
     HINGE_RGBA,
@@ -80,13 +82,12 @@ def log_static(rec: rr.RecordingStream, st: RecordingStatic, blocks: Polygons, s
         rr.Mesh3D.from_fields(triangle_indices=supports.fan, albedo_factor=SUPPORT_FILL_RGBA),
         static=True,
     )
-    # Hover targets: a dot at each block's centroid, in the block's colour (each view maps its field).
-    first = np.asarray(st.block_vert_start[:-1], dtype=np.intp)
-    loc = blocks.local
-    size = (np.maximum.reduceat(loc, first) - np.minimum.reduceat(loc, first)) if blocks.count else np.ones((0, 2))
+    # A small dark dot at each block's centroid carrying its name and values (the hover target; the
+    # legend says so). They were 0.15 block sizes wide "in the block's colour, so they do not show": rerun
+    # shades points as spheres and ignores their alpha over a mesh, so they showed as grey rings.
     rec.log(
         BLOCKS,
-        rr.Points2D.from_fields(radii=0.15 * size.min(axis=1), draw_order=5.0),
+        rr.Points2D.from_fields(radii=CENTROID_RADIUS, colors=CENTROID_RGBA, draw_order=5.0),
         rr.AnyValues(name=[viewer_safe_text(str(n)) for n in st.block_name]),
         static=True,
     )
@@ -242,4 +243,5 @@ def log_legend(rec: rr.RecordingStream, f: FieldSpec, legend_box: tuple[float, f
         vertex_colors=np.concatenate([colors, np.repeat(np.array([UNDER_RGBA, OVER_RGBA], np.uint32), 3)]),
     )
     rec.log(f.bar, bar, static=True)
-    rec.log(f.labels, rr.Points2D.from_fields(radii=-0.5, show_labels=True, colors=LEGEND_TEXT_RGBA), static=True)
+    # radius 0: the labels alone (at -0.5 ui points a white speck showed beside each label)
+    rec.log(f.labels, rr.Points2D.from_fields(radii=0.0, show_labels=True, colors=LEGEND_TEXT_RGBA), static=True)
