@@ -266,6 +266,7 @@ def _report(
     as it is renamed into place, a signal held between the two (:func:`_recorded`)."""
     from masonrycli.intensity import UNITS
     from masonrycli.outputs import written_whole
+    from masonrycli.study.curves import searched_range
     from masonrycli.study.fragility import fit_lognormal
     from masonrycli.study.plots import fragility_curve, state_map, threshold_curve
     from masonrycli.study.table import find_columns, grid_columns, study_table
@@ -283,7 +284,8 @@ def _report(
     with written_whole(plot, around_commit=_recorded(signals, written, plot)) as part:
         if request.find:
             title = f"{name}: {request.outcome} threshold"
-            threshold_curve(rows, request.find, names[0] if names else None, part, title)
+            searched = searched_range(request)
+            threshold_curve(rows, request.find, names[0] if names else None, part, title, searched)
         elif "record" in [a.name for a in axes]:
             good = [r for r in rows if r.get("status") != "error"]
             fit = fit_lognormal([r[im] for r in good], [r["state"] == "collapsed" for r in good], im)

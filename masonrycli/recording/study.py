@@ -19,12 +19,14 @@ view has one scale for both axes, so it showed the curve as a flat line 60 units
 axes. It is drawn in a time-series view instead, whose axes are scaled apart and labelled: the x axis is
 a sequence time line in thousandths of the intensity's unit (``pga (mm/s²)``: a sequence is an integer,
 so 1 mm/s² is its resolution), y the probability fixed at [−0.05, 1.05]; the runs are points at 0 or 1
-coloured by state, the fraction collapsed at each scale and the fitted lognormal as in the PNG.
+coloured by state, the fraction collapsed at each scale and the fitted lognormal: the series, colours
+and legend labels of the PNG (``masonrycli.study.curves``; red was a collapsed run here and the fraction
+per scale there).
 
 The threshold curve read flat the same way (``amp_threshold`` 0.08–0.23 m/s against ``blocks`` 12–48
 or ``friction`` 0.1–0.3): it is plotted the same way, against the other swept parameter's own time line
 (``blocks``, whole numbers, in its unit; ``friction (/1000)``, ``freq (mHz)`` in thousandths), y from 0
-to 1.1 × the largest threshold.
+to 1.1 × the largest threshold; the points without one are marked at the searched range's end.
 """
 
 from __future__ import annotations
@@ -41,14 +43,17 @@ import rerun.blueprint as rrb
 from masonrycli.intensity import UNITS
 from masonrycli.recording.document import viewer_safe_text
 from masonrycli.recording.recorder import APPLICATION_ID
-from masonrycli.study.plots import UNITS as PARAM_UNITS
+from masonrycli.study.curves import (
+    STATE_COLOURS,
+    axis_positions,
+    fragility_series,
+    rgb,
+    searched_range,
+    threshold_series,
+)
+from masonrycli.study.curves import UNITS as PARAM_UNITS
 
-STATE_RGBA = {
-    "intact": (46, 158, 91, 255),
-    "damaged": (240, 160, 48, 255),
-    "collapsed": (208, 48, 48, 255),
-    "": (160, 160, 160, 255),
-}
+STATE_RGBA = {state: (*rgb(colour), 255) for state, colour in STATE_COLOURS.items()}
 
 
 def record_study(path: Path, name: str, rows: list[dict], request, fit, im: str, plot: Path) -> Path:
@@ -65,7 +70,7 @@ def record_study(path: Path, name: str, rows: list[dict], request, fit, im: str,
     # two fifths of it; the plots' time panel stays collapsed, it only names the x axis's time line.
     panels = [rrb.BlueprintPanel(state="collapsed"), rrb.SelectionPanel(state="collapsed")]
     if request.find:
-        timeline, start, end, y_range = _log_thresholds(rec, rows, request.find, names)
+        timeline, start, end, y_range = _log_thresholds(rec, rows, request.find, names, searched_range(request))
         legend = rrb.PlotLegend(corner="RightBottom")  # below a rising or flat curve (y from 0)
         unit = PARAM_UNITS.get(request.find.rpartition(".")[2], "")
         title = viewer_safe_text(
@@ -183,53 +188,41 @@ def fragility_timeline(im: str) -> str:
     return f"{im} (m{UNITS[im]})"
 
 
+def _send_curve(rec, base: str, timeline: str, per_unit: float, series) -> None:
+    """The curve's series (``masonrycli.study.curves``: the PNG draws the same ones) under ``base``."""
+    for c in series:
+        label = viewer_safe_text(c.label)
+        if c.marker == "line":
+            style = rr.SeriesLines(colors=[rgb(c.colour)], names=[label], widths=[2.0])
+        else:
+            marker = {"tick": "circle"}.get(c.marker, c.marker)  # a tick reads as a dot at this size
+            size = 6.0 if c.marker in ("up", "down") else 4.0
+            style = rr.SeriesPoints(colors=[rgb(c.colour)], names=[label], markers=[marker], marker_sizes=[size])
+        _series(rec, f"{base}/{c.key}", timeline, per_unit, c.x, c.y, style)
+
+
 def _log_fragility(rec, rows: list[dict], fit, im: str) -> tuple[str, int]:
     """Runs, fraction collapsed per scale and fitted curve as scalars on the IM's time line (module doc);
     returns the time line's name and the end of the curve on it (1.2 × the largest IM, in its ticks)."""
     timeline = fragility_timeline(im)
     good = [r for r in rows if r.get("status") != "error"]
+    _send_curve(rec, "study/fragility", timeline, 1000.0, fragility_series(good, im, fit, UNITS[im]))
     x = np.array([_number(r.get(im)) for r in good], dtype=np.float64)
-    collapsed = np.array([r.get("state") == "collapsed" for r in good], dtype=bool)
-
-    def series(entity: str, at, values, style) -> None:
-        _series(rec, entity, timeline, 1000.0, at, values, style)
-
-    for state in ("intact", "damaged", "collapsed"):
-        sel = np.array([r.get("state") == state for r in good], dtype=bool)
-        style = rr.SeriesPoints(colors=[STATE_RGBA[state][:3]], names=[f"runs: {state}"], marker_sizes=[4.0])
-        series(f"study/fragility/runs/{state}", x[sel], collapsed[sel].astype(np.float64), style)
-    if good and "scale" in good[0]:
-        scales = sorted({r["scale"] for r in good})
-        pick = [np.array([r["scale"] == s for r in good]) for s in scales]
-        mean_x = np.array([np.nanmean(x[p]) if np.isfinite(x[p]).any() else np.nan for p in pick])
-        fraction = np.array([collapsed[p].mean() for p in pick])
-        style = rr.SeriesPoints(
-            colors=[(235, 235, 235)], names=["fraction collapsed per scale"], markers=["diamond"], marker_sizes=[5.0]
-        )
-        series("study/fragility/fraction", mean_x, fraction, style)
-    if fit is not None and np.isfinite(x).any():
-        # from IM = 0 (P = 0), so the time line starts at 0 and the axis is labelled in round numbers
-        grid = np.unique(np.rint(np.linspace(0, np.nanmax(x) * 1.2, 300) * 1000.0)) / 1000.0
-        text = f"median {fit.median:.3g}, dispersion {fit.dispersion:.2f}"
-        label = viewer_safe_text("lognormal: " + ("not resolved (runs separated)" if fit.separated else text))
-        style = rr.SeriesLines(colors=[(31, 95, 168)], names=[label], widths=[2.0])
-        series("study/fragility/fit", grid, fit.probability(grid), style)
     top = np.nanmax(x) if np.isfinite(x).any() else 1.0
     return timeline, int(np.rint(1200.0 * top)) + 1
 
 
-def _log_thresholds(rec, rows: list[dict], find: str, names: list[str]) -> tuple[str, int, int, tuple]:
+def _log_thresholds(rec, rows: list[dict], find: str, names: list[str], searched) -> tuple[str, int, int, tuple]:
     """``<find>_threshold`` against the first other swept parameter (the point's index without one) as
     scalars on that parameter's time line (module doc): in its own unit when every value is a whole
     number (``blocks``), else in thousandths of it (``friction (/1000)``, ``freq (mHz)``); a record name
-    is drawn by its index. Returns the time line, the x range in its ticks and the y range."""
+    is drawn by its index. The points without a threshold are marked at the end of the ``searched``
+    range. Returns the time line, the x range in its ticks and the y range."""
     x = names[0] if names else None
-    values = [r.get(x) for r in rows] if x else list(range(len(rows)))
-    if any(isinstance(v, str) for v in values):
-        order = sorted(set(values), key=str)
-        at, timeline, per_unit = np.array([order.index(v) for v in values], dtype=np.float64), f"{x} (index)", 1.0
+    at, by_name = axis_positions(rows, x)
+    if by_name is not None:
+        timeline, per_unit = f"{x} (index)", 1.0
     else:
-        at = np.array([_number(v) for v in values], dtype=np.float64)
         unit = PARAM_UNITS.get(x.rpartition(".")[2], "") if x else ""
         whole = bool(np.all(at[np.isfinite(at)] == np.rint(at[np.isfinite(at)])))
         per_unit = 1.0 if whole else 1000.0
@@ -237,29 +230,19 @@ def _log_thresholds(rec, rows: list[dict], find: str, names: list[str]) -> tuple
         timeline = (
             (f"{name} ({unit})" if unit else name) if whole else (f"{name} (m{unit})" if unit else f"{name} (/1000)")
         )
-    threshold = np.array([_number(r.get(f"{find}_threshold")) for r in rows], dtype=np.float64)
-    unit = PARAM_UNITS.get(find.rpartition(".")[2], "")
-    label = viewer_safe_text(f"{find}_threshold ({unit})" if unit else f"{find}_threshold")
-    _series(
-        rec,
-        "study/thresholds/line",
-        timeline,
-        per_unit,
-        at,
-        threshold,
-        rr.SeriesLines(colors=[(208, 48, 48)], names=[label], widths=[2.0]),
-    )
-    style = rr.SeriesPoints(colors=[(208, 48, 48)], names=[label + ": points"], marker_sizes=[4.0])
-    _series(rec, "study/thresholds/points", timeline, per_unit, at, threshold, style)
-    ok = np.isfinite(at) & np.isfinite(threshold)
+    series = threshold_series(rows, find, at, searched)
+    _send_curve(rec, "study/thresholds", timeline, per_unit, series)
     # Every swept point is in the view, found or not, with a margin beside the outermost: the range was
     # the found points' alone, so one found point (friction 0.6; none at 0.3) sat on the right edge, cut.
     swept = np.isfinite(at)
     ticks = np.rint(at[swept] * per_unit) if swept.any() else np.zeros(1)
     span = max(float(ticks.max() - ticks.min()), 0.1 * float(np.abs(ticks).max()), 1.0)
     x_range = (int(np.floor(min(0.0, ticks.min() - 0.05 * span))), int(np.ceil(ticks.max() + 0.05 * span)))
-    top = float(threshold[ok].max()) if ok.any() else 1.0
-    low = float(threshold[ok].min()) if ok.any() else 0.0
+    # the y range holds the found thresholds and the marks of the points without one
+    shown = np.concatenate([c.y for c in series if c.marker != "line"])
+    shown = shown[np.isfinite(shown)]
+    top = float(shown.max()) if shown.size else 1.0
+    low = float(shown.min()) if shown.size else 0.0
     y_range = (min(0.0, 1.1 * low), 1.1 * top if top > 0 else 1.0)
     return timeline, x_range[0], x_range[1], y_range
 

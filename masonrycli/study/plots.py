@@ -3,8 +3,12 @@
 * **state map** — one cell per run over two swept parameters, coloured intact / damaged / collapsed
   (failed runs grey), the collapse time written in collapsed cells; one swept parameter gives a strip.
 * **fragility curve** — the fraction of runs collapsed at each stripe (same scale) against the mean
-  intensity measure, every run as a tick at 0 or 1, and the fitted lognormal curve.
-* **threshold curve** — ``<param>_threshold`` against the other swept parameter (``--find``).
+  intensity measure, every run as a tick at 0 or 1 coloured by its state, and the fitted lognormal curve.
+* **threshold curve** — ``<param>_threshold`` against the other swept parameter (``--find``), the
+  points without a threshold in the searched range marked at its end.
+
+What the two curves show (series, colours, legend labels) is ``masonrycli.study.curves``', shared with
+the recording.
 """
 
 from __future__ import annotations
@@ -13,8 +17,15 @@ from pathlib import Path
 
 import numpy as np
 
-UNITS = {"amp": "m/s", "freq": "Hz", "phase": "rad", "duration": "s", "dt": "s"}
-STATE_COLOURS = {"intact": "#2e9e5b", "damaged": "#f0a030", "collapsed": "#d03030", "": "#a0a0a0"}
+from masonrycli.study.curves import (
+    STATE_COLOURS,
+    axis_positions,
+    fragility_series,
+    threshold_series,
+    with_unit,
+)
+
+_MARKERS = {"circle": "o", "tick": "|", "diamond": "D", "up": "^", "down": "v"}
 
 
 def _pyplot():
@@ -30,11 +41,6 @@ def _save(fig, path: Path) -> Path:
     # PNG whatever the name: the caller writes a temporary ".part" file (masonrycli.outputs.written_whole)
     fig.savefig(path, format="png", dpi=120, bbox_inches="tight")
     return path
-
-
-def _label(name: str) -> str:
-    unit = UNITS.get(name.rpartition(".")[2])
-    return f"{name} ({unit})" if unit else name
 
 
 def state_map(rows: list[dict], x: str, y: str | None, path: Path, title: str) -> Path:
@@ -55,10 +61,10 @@ def state_map(rows: list[dict], x: str, y: str | None, path: Path, title: str) -
     ax.set_xlim(-0.5, len(xs) - 0.5)
     ax.set_ylim(-0.5, len(ys) - 0.5)
     ax.set_xticks(range(len(xs)), [f"{v:g}" if not isinstance(v, str) else v for v in xs], rotation=45)
-    ax.set_xlabel(_label(x))
+    ax.set_xlabel(with_unit(x))
     if y:
         ax.set_yticks(range(len(ys)), [f"{v:g}" if not isinstance(v, str) else v for v in ys])
-        ax.set_ylabel(_label(y))
+        ax.set_ylabel(with_unit(y))
     else:
         ax.set_yticks([])
     handles = [Patch(color=STATE_COLOURS[s], label=s) for s in ("intact", "damaged", "collapsed")]
@@ -69,53 +75,73 @@ def state_map(rows: list[dict], x: str, y: str | None, path: Path, title: str) -
     return path
 
 
-def fragility_curve(rows: list[dict], im: str, fit, path: Path, title: str, unit: str) -> Path:
-    """PNG: runs (ticks at 0/1), collapsed fraction per scale stripe, and the fitted lognormal."""
+def _draw(ax, series) -> None:
+    """The curve's series (``masonrycli.study.curves``), each with its legend entry; empty ones left out. A
+    line followed by its own points (same data and colour) is drawn as one, one legend entry."""
+    series = [c for c in series if len(c.x)]
+    for i, c in enumerate(series):
+        after = series[i + 1] if i + 1 < len(series) else None
+        if c.marker == "line" and after is not None and after.colour == c.colour and np.array_equal(after.x, c.x):
+            ax.plot(c.x, c.y, "o-", color=c.colour, label=c.label)
+        elif (
+            i
+            and series[i - 1].marker == "line"
+            and series[i - 1].colour == c.colour
+            and np.array_equal(series[i - 1].x, c.x)
+        ):
+            continue  # drawn with its line
+        elif c.marker == "line":
+            ax.plot(c.x, c.y, "-", color=c.colour, label=c.label)
+        else:
+            size = 12 if c.marker == "tick" else 6
+            ax.plot(c.x, c.y, _MARKERS[c.marker], color=c.colour, ms=size, linestyle="none", label=c.label)
+
+
+def fragility_figure(rows: list[dict], im: str, fit, title: str, unit: str):
+    """The fragility curve's figure (``fragility_series``): runs at 0 / 1 by state, the fraction collapsed
+    per scale stripe, the fitted lognormal."""
     plt = _pyplot()
     fig, ax = plt.subplots(figsize=(6.0, 4.0))
-    x = np.array([r[im] for r in rows], dtype=float)
-    c = np.array([r.get("state") == "collapsed" for r in rows], dtype=float)
-    ax.plot(x, c, "|", color="#555555", ms=12, label="runs (collapsed = 1)")
-    if rows and "scale" in rows[0]:
-        for s in sorted({r["scale"] for r in rows}):
-            sel = np.array([r["scale"] == s for r in rows])
-            ax.plot(np.nanmean(x[sel]), c[sel].mean(), "o", color="#d03030")
-        ax.plot([], [], "o", color="#d03030", label="fraction collapsed per scale")
-    if fit is not None:
-        grid = np.linspace(0, np.nanmax(x) * 1.2, 300)[1:]
-        ax.plot(
-            grid,
-            fit.probability(grid),
-            "-",
-            color="#1f5fa8",
-            label="lognormal: not resolved (runs separated: β → 0)"
-            if fit.separated
-            else f"lognormal: θ = {fit.median:.3g} {unit}, β = {fit.dispersion:.2f}",
-        )
+    _draw(ax, fragility_series(rows, im, fit, unit))
     ax.set_xlabel(f"{im} ({unit})")
     ax.set_ylabel("P(collapse)")
     ax.set_ylim(-0.05, 1.05)
     ax.legend(loc="lower right", fontsize=8)
     ax.set_title(title, fontsize=10)
+    return fig
+
+
+def fragility_curve(rows: list[dict], im: str, fit, path: Path, title: str, unit: str) -> Path:
+    """PNG of :func:`fragility_figure`."""
+    fig = fragility_figure(rows, im, fit, title, unit)
     path = _save(fig, path)
-    plt.close(fig)
+    _pyplot().close(fig)
     return path
 
 
-def threshold_curve(rows: list[dict], find: str, x: str | None, path: Path, title: str) -> Path:
-    """PNG of ``<find>_threshold`` against parameter ``x`` (a bar per point without another axis)."""
+def threshold_figure(rows: list[dict], find: str, x: str | None, title: str, searched: tuple[float, float]):
+    """``<find>_threshold`` against parameter ``x`` (the points in order without one), the points where
+    none was found marked at the end of the searched range (``threshold_series``)."""
     plt = _pyplot()
     fig, ax = plt.subplots(figsize=(6.0, 4.0))
-    key = f"{find}_threshold"
-    if x:
-        pts = sorted((r[x], r[key]) for r in rows)
-        ax.plot([p[0] for p in pts], [p[1] for p in pts], "o-", color="#d03030")
-        ax.set_xlabel(_label(x))
-    else:
-        ax.bar([0], [rows[0][key]] if rows else [0], color="#d03030")
-        ax.set_xticks([])
-    ax.set_ylabel(key)
+    at, names = axis_positions(rows, x)
+    _draw(ax, threshold_series(rows, find, at, searched))
+    if names is not None:
+        ax.set_xticks(range(len(names)), names, rotation=45)
+    ax.set_xlabel(with_unit(x) if x else "point")
+    ax.set_ylabel(with_unit(find).replace(find, f"{find}_threshold", 1))
+    ax.set_ylim(0.0, 1.1 * max(ax.get_ylim()[1], 0.0) or 1.0)  # room above a mark at the range's top
+    if ax.get_legend_handles_labels()[0]:
+        ax.legend(loc="lower right", fontsize=8)
     ax.set_title(title, fontsize=10)
+    return fig
+
+
+def threshold_curve(
+    rows: list[dict], find: str, x: str | None, path: Path, title: str, searched: tuple[float, float]
+) -> Path:
+    """PNG of :func:`threshold_figure`."""
+    fig = threshold_figure(rows, find, x, title, searched)
     path = _save(fig, path)
-    plt.close(fig)
+    _pyplot().close(fig)
     return path

@@ -20,7 +20,7 @@ from rich.table import Table
 from rich.text import Text
 
 from masonrycli.intensity import UNITS as IM_UNITS
-from masonrycli.study.plots import UNITS as PARAM_UNITS
+from masonrycli.study.curves import UNITS as PARAM_UNITS
 
 SHOWN_ROWS = 40
 """Rows shown in the terminal (the rest are in the table file)."""

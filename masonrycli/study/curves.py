@@ -1,0 +1,143 @@
+"""What a study's curves show, once for both pictures: the series of the fragility and threshold curves.
+
+Each curve is a list of :class:`Series` — legend label, colour, marker, points — that ``study.plots``
+draws in the PNG (matplotlib) and ``recording.study`` in the recording (rerun), so a colour and its legend
+entry mean the same in both. Before, they were chosen apart and disagreed: red was "the fraction collapsed
+per scale" in the PNG and "a collapsed run" in the recording, the runs grey ticks in one and coloured by
+state in the other, and a threshold search that found none (``no collapse up to amp = 1.5``) was in
+neither.
+
+Colours are hex strings chosen to read on the PNG's white and the viewer's near-black backgrounds.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+STATE_COLOURS = {"intact": "#2e9e5b", "damaged": "#f0a030", "collapsed": "#d03030", "": "#a0a0a0"}
+"""A run's state (``""``: failed) -> colour: the state map's cells, the fragility curve's runs."""
+FRACTION_COLOUR = "#9b59d0"  # purple: no state's colour (it was red, a collapsed run's colour, in the PNG)
+FIT_COLOUR = "#1f5fa8"
+THRESHOLD_COLOUR = "#d03030"
+NOT_FOUND_COLOUR = "#8c8c8c"  # grey: no threshold in the searched range
+
+UNITS = {"amp": "m/s", "freq": "Hz", "phase": "rad", "duration": "s", "dt": "s"}
+"""A swept parameter's unit, by its last dotted part."""
+
+
+@dataclass(frozen=True)
+class Series:
+    """One legend entry: ``label``, ``colour`` (hex), ``marker`` ("line", "circle", "tick", "diamond", "up",
+    "down"), and its points (``x``, ``y``, finite)."""
+
+    key: str  # the entity name under the curve's path in the recording
+    label: str
+    colour: str
+    marker: str
+    x: np.ndarray
+    y: np.ndarray
+
+
+def rgb(colour: str) -> tuple[int, int, int]:
+    """``"#d03030"`` -> (208, 48, 48)."""
+    return tuple(int(colour[i : i + 2], 16) for i in (1, 3, 5))
+
+
+def with_unit(name: str) -> str:
+    unit = UNITS.get(name.rpartition(".")[2], "")
+    return f"{name} ({unit})" if unit else name
+
+
+def _number(value) -> float:
+    return float(value) if isinstance(value, (int, float)) else math.nan
+
+
+def axis_positions(rows: list[dict], x: str | None) -> tuple[np.ndarray, list[str] | None]:
+    """Each row's position along parameter ``x``: its value; for names (records), the index of its name
+    in their sorted list, with that list; without a parameter, the row's index."""
+    if not x:
+        return np.arange(len(rows), dtype=np.float64), None
+    values = [r.get(x) for r in rows]
+    if any(isinstance(v, str) for v in values):
+        names = sorted({str(v) for v in values})
+        return np.array([names.index(str(v)) for v in values], dtype=np.float64), names
+    return np.array([_number(v) for v in values], dtype=np.float64), None
+
+
+def searched_range(request) -> tuple[float, float]:
+    """The lowest and highest value a threshold search of ``request`` (``--find``) tries first."""
+    values = next(a.values for a in request.axes if a.name == request.find)
+    return float(min(values)), float(max(values))
+
+
+def fit_label(fit, unit: str) -> str:
+    if fit.separated:
+        return "lognormal: not resolved (runs separated: β → 0)"
+    return f"lognormal: θ = {fit.median:.3g} {unit}, β = {fit.dispersion:.2f}"
+
+
+def fragility_series(rows: list[dict], im: str, fit, unit: str) -> list[Series]:
+    """The runs at 0 or 1 by state, the fraction collapsed per scale (at the scale's mean IM), the
+    fitted lognormal from IM = 0 to 1.2 × the largest (300 points); ``rows`` without the failed runs."""
+    x = np.array([_number(r.get(im)) for r in rows], dtype=np.float64)
+    collapsed = np.array([r.get("state") == "collapsed" for r in rows], dtype=bool)
+    out = []
+    for state in ("intact", "damaged", "collapsed"):
+        sel = np.array([r.get("state") == state for r in rows], dtype=bool) & np.isfinite(x)
+        y = np.full(int(sel.sum()), 1.0 if state == "collapsed" else 0.0)
+        out.append(Series(f"runs/{state}", f"runs: {state}", STATE_COLOURS[state], "tick", x[sel], y))
+    if rows and "scale" in rows[0]:
+        scales = sorted({r["scale"] for r in rows})
+        pick = [np.array([r["scale"] == s for r in rows]) for s in scales]
+        mean_x = np.array([np.nanmean(x[p]) if np.isfinite(x[p]).any() else np.nan for p in pick])
+        fraction = np.array([collapsed[p].mean() for p in pick])
+        ok = np.isfinite(mean_x)
+        out.append(
+            Series("fraction", "fraction collapsed per scale", FRACTION_COLOUR, "diamond", mean_x[ok], fraction[ok])
+        )
+    if fit is not None and np.isfinite(x).any():
+        # from IM = 0 in steps of 1/1000 of the unit (the recording's time line is in thousandths)
+        grid = np.unique(np.rint(np.linspace(0, np.nanmax(x) * 1.2, 300) * 1000.0)) / 1000.0
+        out.append(Series("fit", fit_label(fit, unit), FIT_COLOUR, "line", grid, fit.probability(grid)))
+    return out
+
+
+def threshold_series(rows: list[dict], find: str, at: np.ndarray, searched: tuple[float, float]) -> list[Series]:
+    """``<find>_threshold`` at ``at`` (each row's position on the x axis) as a line with its points, and
+    the points where the search found none, marked at the searched range's top (``searched`` = the
+    lowest and highest value tried first) when the outcome was not reached up to it, at its bottom when
+    it was reached already there; a failed search (status error) is left out."""
+    at = np.asarray(at, dtype=np.float64)
+    y = np.array([_number(r.get(f"{find}_threshold")) for r in rows], dtype=np.float64)
+    hi = np.array([_number(r.get(f"{find}_hi")) for r in rows], dtype=np.float64)
+    searched_ok = np.array([r.get("status") != "error" for r in rows], dtype=bool)
+    found = np.isfinite(y) & np.isfinite(at)
+    none = ~np.isfinite(y) & np.isfinite(at) & searched_ok
+    above, below = none & ~np.isfinite(hi), none & np.isfinite(hi)  # hi: the lowest value that reached it
+    order = np.argsort(at[found], kind="stable")
+    label = f"{with_unit(find).replace(find, find + '_threshold', 1)}"
+    outcome = next((r.get("outcome") for r in rows if r.get("outcome")), "outcome")
+    lo_v, hi_v = searched
+    return [
+        Series("line", label, THRESHOLD_COLOUR, "line", at[found][order], y[found][order]),
+        Series("points", label + ": points", THRESHOLD_COLOUR, "circle", at[found][order], y[found][order]),
+        Series(
+            "not_found/above",
+            f"none found: no {outcome} up to {find} = {hi_v:g}",
+            NOT_FOUND_COLOUR,
+            "up",
+            at[above],
+            np.full(int(above.sum()), float(hi_v)),
+        ),
+        Series(
+            "not_found/below",
+            f"none found: {outcome} already at {find} = {lo_v:g}",
+            NOT_FOUND_COLOUR,
+            "down",
+            at[below],
+            np.full(int(below.sum()), float(lo_v)),
+        ),
+    ]

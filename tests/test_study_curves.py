@@ -1,0 +1,120 @@
+"""The study's curves mean the same in the PNG and the recording (masonrycli.study.curves).
+
+The PNG's figure is caught at ``savefig``; the recording is read back: every legend entry of one has the
+same label and colour in the other. Before, red was "fraction collapsed per scale" in the PNG and "runs:
+collapsed" in the recording, and a threshold search that found none was in neither.
+"""
+
+from __future__ import annotations
+
+import math
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+import rerun as rr
+from matplotlib.colors import to_rgb
+
+from masonrycli.colormap import unpack_rgba
+from masonrycli.recording.study import record_study
+from masonrycli.study import plots
+from masonrycli.study.curves import NOT_FOUND_COLOUR, STATE_COLOURS, rgb
+from masonrycli.study.fragility import fit_lognormal
+
+# 12 runs of 3 records at 4 scales: collapses from pga 5.5 m/s² up but one (7.2) and one below (3.0),
+# so the lognormal fit is resolved
+FRAGILITY_ROWS = [
+    {
+        "record": f"r{k}",
+        "scale": s,
+        "pga": 2.0 * s * (1 + 0.1 * k),
+        "state": "collapsed"
+        if (2.0 * s * (1 + 0.1 * k) > 5.5) != ((k, s) in ((2, 3.0), (0, 1.5)))
+        else ("damaged" if s > 1 else "intact"),
+        "status": "completed",
+    }
+    for k in range(3)
+    for s in (0.5, 1.5, 3.0, 4.0)
+]
+
+
+@pytest.fixture
+def png_figures(monkeypatch):
+    """The figures the PNG writers save, legend entries as {label: (r, g, b)} (0-255)."""
+    import matplotlib.figure
+
+    caught: list[dict] = []
+
+    def catch(fig, path, **kwargs):
+        handles, labels = fig.axes[0].get_legend_handles_labels()
+        caught.append({lab: tuple(round(255 * c) for c in to_rgb(h.get_color())) for h, lab in zip(handles, labels)})
+        with open(path, "wb") as fh:
+            fh.write(b"\x89PNG")
+
+    monkeypatch.setattr(matplotlib.figure.Figure, "savefig", catch)
+    return caught
+
+
+def recorded_series(rrd, base: str) -> dict[str, dict]:
+    """{entity: {"label", "rgb", "x" (time line ticks), "y"}} of the recording's series under ``base``."""
+    out: dict[str, dict] = {}
+    for ch in rr.chunk.RrdReader(str(rrd)).stream():
+        if not ch.entity_path.startswith(f"/{base}/"):
+            continue
+        batch = ch.to_record_batch()
+        entry = out.setdefault(ch.entity_path, {"x": [], "y": []})
+        names = batch.schema.names
+        for kind in ("SeriesPoints", "SeriesLines"):
+            if f"{kind}:names" in names:
+                entry["label"] = batch.column(f"{kind}:names").to_pylist()[-1][0]
+                packed = batch.column(f"{kind}:colors").to_pylist()[-1][0]
+                entry["rgb"] = tuple(int(v) for v in unpack_rgba(np.array([packed]))[0, :3])
+        if "Scalars:scalars" in names:
+            time_line = next(n for n in names if ":" not in n and not n.startswith("rerun") and n != "log_time")
+            entry["x"] += batch.column(time_line).to_pylist()
+            entry["y"] += [v[0] for v in batch.column("Scalars:scalars").to_pylist()]
+    return out
+
+
+def test_the_fragility_curve_has_the_same_colours_and_legend_in_the_png_and_the_recording(png_figures, tmp_path):
+    rows = FRAGILITY_ROWS
+    fit = fit_lognormal([r["pga"] for r in rows], [r["state"] == "collapsed" for r in rows], "pga")
+    plots.fragility_curve(rows, "pga", fit, tmp_path / "f.png", "fragility", "m/s²")
+    request = SimpleNamespace(axes=[SimpleNamespace(name="record", values=("r0", "r1", "r2"))], find=None)
+    rrd = record_study(tmp_path / "f.rrd", "s", rows, request, fit, "pga", tmp_path / "f.png")
+    png = png_figures[0]
+    drawn = {s["label"]: s["rgb"] for s in recorded_series(rrd, "study/fragility").values() if s["x"]}
+    assert png == drawn  # the same entries, the same colours
+    # the runs are coloured by their state in both (the PNG's were grey ticks, "runs (collapsed = 1)")
+    for state in ("intact", "damaged", "collapsed"):
+        assert png[f"runs: {state}"] == rgb(STATE_COLOURS[state])
+    assert len(set(png.values())) == len(png)  # no colour means two things
+    assert fit.separated is None and f"lognormal: θ = {fit.median:.3g} m/s², β = {fit.dispersion:.2f}" in png
+
+
+def test_points_without_a_threshold_are_marked_at_the_searched_range_ends(png_figures, tmp_path):
+    """``no collapse up to amp = 1.5`` (amp_threshold NaN, no bracket) was missing from both pictures: it is
+    a mark at 1.5 in both, with its legend entry; one reached already at the lowest amplitude at 0.25."""
+    nan = math.nan
+    rows = [
+        {"freq": 1.0, "amp_threshold": 1.334, "amp_lo": 1.324, "amp_hi": 1.344, "outcome": "collapse"},
+        {"freq": 2.0, "amp_threshold": nan, "amp_lo": nan, "amp_hi": nan, "outcome": "collapse"},
+        {"freq": 3.0, "amp_threshold": nan, "amp_lo": nan, "amp_hi": 0.25, "outcome": "collapse"},
+        {"freq": 4.0, "amp_threshold": 0.9, "amp_lo": 0.89, "amp_hi": 0.91, "outcome": "collapse"},
+    ]
+    for r in rows:
+        r |= {"status": "completed", "note": ""}
+    plots.threshold_curve(rows, "amp", "freq", tmp_path / "t.png", "thresholds", (0.25, 1.5))
+    axes = [SimpleNamespace(name="amp", values=(0.25, 0.875, 1.5)), SimpleNamespace(name="freq", values=(1, 2, 3, 4))]
+    request = SimpleNamespace(axes=axes, find="amp")
+    rrd = record_study(tmp_path / "t.rrd", "s", rows, request, None, "pga", tmp_path / "t.png")
+    series = recorded_series(rrd, "study/thresholds")
+    above = series["/study/thresholds/not_found/above"]
+    below = series["/study/thresholds/not_found/below"]
+    # on the time line "freq (Hz)" (whole numbers: in Hz)
+    assert above["x"] == [2] and above["y"] == [1.5] and below["x"] == [3] and below["y"] == [0.25]
+    assert series["/study/thresholds/line"]["x"] == [1, 4]
+    png = png_figures[0]
+    assert png[above["label"]] == png[below["label"]] == above["rgb"] == rgb(NOT_FOUND_COLOUR)
+    assert above["label"] == "none found: no collapse up to amp = 1.5"
+    assert png["amp_threshold (m/s)"] == series["/study/thresholds/line"]["rgb"]
