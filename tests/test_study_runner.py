@@ -61,3 +61,60 @@ def test_an_explicit_limit_is_kept(client, monkeypatch):
         client, "s", Driver(40), lambda p, r: held.append(len(client.futures)), False, None, False, limit=3
     )
     assert len(held) == 40 and max(held) <= 4
+
+
+class Listener:
+    """A TCP service on a free local port that is not a Dask scheduler: it accepts and says ``greeting``
+    (or nothing) and keeps the connection open."""
+
+    def __init__(self, greeting: bytes):
+        import socket
+        import threading
+
+        self.sock = socket.socket()
+        self.sock.bind(("127.0.0.1", 0))
+        self.sock.listen()
+        self.address = f"tcp://127.0.0.1:{self.sock.getsockname()[1]}"
+        self.greeting, self.held = greeting, []
+        threading.Thread(target=self._serve, daemon=True).start()
+
+    def _serve(self):
+        while True:
+            try:
+                conn, _ = self.sock.accept()
+            except OSError:
+                return
+            self.held.append(conn)
+            if self.greeting:
+                conn.sendall(self.greeting)
+
+    def close(self):
+        self.sock.close()
+        for conn in self.held:
+            conn.close()
+
+
+@pytest.mark.parametrize(
+    "greeting",
+    [b"", b"SSH-2.0-OpenSSH_9.2\r\n" * 4],
+    ids=["silent (an HTTP port waiting for a request)", "talking (another protocol)"],
+)
+def test_a_scheduler_address_where_no_dask_scheduler_answers_is_one_line(greeting, monkeypatch):
+    # Before: an HTTP server on the port (the dashboard's 8787, say) held the command forever, Client's own
+    # timeout notwithstanding; a service that spoke first ended in a MemoryError traceback (exit 1), Dask
+    # reading its bytes as a frame count ("Unable to allocate 3.07 EiB").
+    import time
+
+    from masonrycli.errors import InputError
+
+    monkeypatch.setattr(runner, "CONNECT_TIMEOUT", 2.0)
+    monkeypatch.setattr(runner, "CONNECT_GRACE", 1.0)
+    listener = Listener(greeting)
+    start = time.monotonic()
+    try:
+        with pytest.raises(InputError, match=r"^--scheduler tcp://127\.0\.0\.1:\d+: ") as raised:
+            runner.open_cluster(listener.address, None)
+    finally:
+        listener.close()
+    assert time.monotonic() - start < 2.0 + runner.CONNECT_GRACE + 5.0
+    assert "\n" not in str(raised.value) and "Dask scheduler" in str(raised.value)

@@ -60,10 +60,7 @@ def open_cluster(scheduler: str | None, workers: int | None):
     if scheduler:
         from masonrycli.study.versions import check_workers
 
-        try:
-            client = Client(scheduler, timeout="20s")
-        except (OSError, TimeoutError, ValueError) as exc:
-            raise InputError(f"--scheduler {scheduler}: cannot connect ({type(exc).__name__}: {exc})") from None
+        client = _connect(Client, scheduler)
         try:
             check_workers(client, scheduler)  # its workers run this masonry, or nothing is written
         except BaseException:
@@ -86,6 +83,48 @@ def open_cluster(scheduler: str | None, workers: int | None):
         if main:
             signal.signal(signal.SIGINT, previous)
     return Client(cluster), cluster
+
+
+CONNECT_TIMEOUT = 20.0
+"""s: how long ``Client`` may try to reach the scheduler."""
+CONNECT_GRACE = 10.0
+"""s: how much longer the command waits for ``Client`` to give up before it says no scheduler answered."""
+
+
+def _connect(Client, scheduler: str):
+    """A ``Client`` of ``scheduler``, or a one-line :class:`InputError`.
+
+    The client is made in a thread the command waits for at most ``CONNECT_TIMEOUT + CONNECT_GRACE``:
+    a port where something else listens (the dashboard's HTTP port 8787, say, waiting for a request)
+    held ``Client`` forever, its own timeout notwithstanding; a thread left waiting there is a daemon and
+    ends with the command. A service that speaks first made Dask read its bytes as a frame count
+    (MemoryError: "Unable to allocate 3.07 EiB", a traceback): any failure but a connection's is "not
+    a Dask scheduler"."""
+    made: dict = {}
+
+    def connect():
+        try:
+            made["client"] = Client(scheduler, timeout=f"{CONNECT_TIMEOUT:g}s")
+        except BaseException as exc:  # noqa: BLE001 - reported below, in the command's thread
+            made["error"] = exc
+
+    thread = threading.Thread(target=connect, name="masonry-scheduler-connect", daemon=True)
+    thread.start()
+    thread.join(CONNECT_TIMEOUT + CONNECT_GRACE)
+    if thread.is_alive():
+        raise InputError(
+            f"--scheduler {scheduler}: no Dask scheduler answered within {CONNECT_TIMEOUT + CONNECT_GRACE:g} s "
+            "(something listens there but does not speak Dask: the dashboard's port, or another service?)"
+        )
+    error = made.get("error")
+    if isinstance(error, (OSError, TimeoutError)):
+        raise InputError(f"--scheduler {scheduler}: cannot connect ({type(error).__name__}: {error})") from None
+    if isinstance(error, Exception):
+        why = ": ".join([type(error).__name__, *str(error).splitlines()[:1]])
+        raise InputError(f"--scheduler {scheduler}: not a Dask scheduler (its answer is not Dask's protocol: {why})")
+    if error is not None:
+        raise error
+    return made["client"]
 
 
 IN_FLIGHT_PER_THREAD = 4
