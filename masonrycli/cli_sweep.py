@@ -171,7 +171,10 @@ def sweep_command(
         except KeyboardInterrupt:
             signum = signals.stopping()
             how = "" if signum == signal.SIGINT else f" ({signal_name(signum)})"
-            if result is None:
+            if result is None and not (out.exists() or store.journal_path(out).exists()):
+                # stopped before the table was opened (while a --scheduler was reached): there is no file
+                said = "stopped before any row was finished; nothing was written"
+            elif result is None:
                 said = f"every finished row is in {out}; run the same command again to resume"
             else:  # the study is complete: what is missing is a picture
                 missing = [str(f.path) for f in (picture, recording) if f is not None and f.path not in written]

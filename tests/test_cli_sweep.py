@@ -307,6 +307,21 @@ def test_a_scheduler_that_cannot_be_reached_leaves_no_file(block, tmp_path, monk
     assert [p.name for p in tmp_path.iterdir()] == ["block.toml"]
 
 
+def test_ctrl_c_while_the_scheduler_is_reached_says_nothing_was_written(block, tmp_path, monkeypatch):
+    # Ctrl-C during the (up to 30 s) wait for a --scheduler said "interrupted: every finished row is in s.csv;
+    # run the same command again to resume", and there was no s.csv.
+    from masonrycli.study import runner
+
+    def interrupted(scheduler, workers):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(runner, "open_cluster", interrupted)
+    result = invoke("sweep", block, "-p", "amp=0.1", "--scheduler", "tcp://127.0.0.1:1", "-o", tmp_path / "s.csv")
+    said = " ".join(result.output.split())
+    assert result.exit_code == 130 and "interrupted: stopped before any row was finished; nothing was written" in said
+    assert [p.name for p in tmp_path.iterdir()] == ["block.toml"]
+
+
 def _files(folder: Path) -> dict[str, bytes]:
     return {p.name: p.read_bytes() for p in folder.rglob("*") if p.is_file()}
 
