@@ -7,6 +7,7 @@ table, PNG, Rerun recording. Registered on the app by :mod:`masonrycli.cli`.
 from __future__ import annotations
 
 import contextlib
+import os
 import signal
 from pathlib import Path
 from typing import Annotated
@@ -102,12 +103,14 @@ def sweep_command(
     from masonrycli.study.task import check_outcome
 
     base = StudyBase(_base_scenario(target, duration, dt), {})
+    name = base.scenario.name
+    out = store.check_out(out or Path(f"study-{name}.parquet"))
     axes = [parse_axis(p) for p in param or []]
     late: list[str] = []  # warnings about records longer than the runs
     if records:
         from masonrycli.study.axes import Axis
 
-        motions = _records(records)
+        motions = _records(records, out)
         whole = duration is None and target in BUILT_IN  # a scenario file's [run] duration stands
         scenario, late = _record_duration(base.scenario, motions, whole)
         base = StudyBase(scenario, motions)
@@ -125,8 +128,7 @@ def sweep_command(
         raise InputError("--workers with --scheduler: the existing cluster has its own workers")
     if not (0 < rtol < 1):
         raise InputError(f"--rtol {rtol}: must be in (0, 1)")
-    name = base.scenario.name
-    out = store.check_out(out or Path(f"study-{name}.parquet"))
+    _check_out_reads_nothing(out, base)
     # every output checked before the first run (the table and the histories by run_study, which knows
     # which rows are this study's and which runs are still to make)
     if no_recording and recording is not None:
@@ -232,14 +234,18 @@ def _record_duration(scenario, motions: dict, whole: bool):
     ]
 
 
-def _records(entries: list[Path]) -> dict:
-    """Record motions by file name, from files and the .AT2 / .csv files of folders."""
+def _records(entries: list[Path], out: Path) -> dict:
+    """Record motions by file name, from files and the .AT2 / .csv files of folders (but the study's
+    table ``out``: kept in its records' folder, it was read as a record by the same command run again,
+    "recs/ida.csv:2: not a number", so the study could not be resumed)."""
     from masonrycli.records import record_motion
 
     files = []
     for entry in entries:
         if entry.is_dir():
-            found = sorted(p for p in entry.iterdir() if p.suffix.lower() in (".at2", ".csv"))
+            found = sorted(
+                p for p in entry.iterdir() if p.suffix.lower() in (".at2", ".csv") and not _same_file(p, out)
+            )
             if not found:
                 raise InputError(f"--records {entry}: no .AT2 or .csv record in it")
             files += found
@@ -252,6 +258,22 @@ def _records(entries: list[Path]) -> dict:
     if twice:
         raise InputError(f"--records: two records named {twice[0]} (rows are keyed by the file name)")
     return {p.name: record_motion(p, display=str(p)) for p in files}
+
+
+def _same_file(a, b) -> bool:
+    try:
+        return os.path.samefile(a, b)
+    except OSError:  # one of them does not exist (yet)
+        return False
+
+
+def _check_out_reads_nothing(out: Path, base) -> None:
+    """Refuse an ``--out`` that is a record file the study reads: with ``--force`` the table replaced it
+    (``--records rec.csv --out rec.csv --force``: the record was lost)."""
+    motions = (*base.scenario.motions, *base.records.values())
+    for source in (s for m in motions for s in (getattr(m, "source", ""), getattr(m, "vertical_source", ""))):
+        if source and _same_file(out, source):
+            raise InputError(f"--out {out}: is the record {source} (the table would replace it)")
 
 
 def _report(

@@ -322,6 +322,52 @@ def test_ctrl_c_while_the_scheduler_is_reached_says_nothing_was_written(block, t
     assert [p.name for p in tmp_path.iterdir()] == ["block.toml"]
 
 
+def _velocity_csv(path: Path) -> Path:
+    path.write_text("time,v\n" + "".join(f"{0.01 * i:.2f},{0.05 * (i % 2):.2f}\n" for i in range(30)))
+    return path
+
+
+def test_a_study_table_in_its_records_folder_is_not_read_as_a_record(block, tmp_path):
+    # `--records recs --out recs/ida.csv`: the first run wrote recs/ida.csv; the same command again (to resume,
+    # as the docs say) read the table as a record: "error: recs/ida.csv:2: not a number: "a.csv"", exit 2.
+    folder = tmp_path / "recs"
+    folder.mkdir()
+    _velocity_csv(folder / "a.csv"), _velocity_csv(folder / "b.csv")
+    args = ("sweep", block, "--records", folder, "--workers", 0, "--duration", 0.1, "--no-recording")
+    first = invoke(*args, "--out", folder / "ida.csv")
+    assert first.exit_code == 0, first.output
+    again = invoke(*args, "--out", folder / "ida.csv", "--force")
+    assert again.exit_code == 0, again.output
+    said = " ".join(again.output.split())
+    assert "2 rows in" in said and "(0 runs now, 2 rows already there, 0 failed)" in said, said
+    assert {r["record"] for r in read_rows(folder / "ida.csv")} == {"a.csv", "b.csv"}
+
+
+def test_a_record_given_as_the_study_table_is_refused_not_replaced(block, tmp_path):
+    # `--records rec.csv --out rec.csv --force` replaced the record with the study's table (the record lost).
+    record = _velocity_csv(tmp_path / "rec.csv")
+    kept = record.read_bytes()
+    result = invoke("sweep", block, "--records", record, "--workers", 0, "--out", record, "--force", "--no-recording")
+    assert result.exit_code == 2
+    assert result.output.strip() == f"error: --out {record}: is the record {record} (the table would replace it)"
+    assert record.read_bytes() == kept and sorted(p.name for p in tmp_path.iterdir()) == ["block.toml", "rec.csv"]
+
+
+def test_a_scenario_record_file_given_as_the_study_table_is_refused(tmp_path):
+    record = _velocity_csv(tmp_path / "quake.csv")
+    kept = record.read_bytes()
+    scenario = tmp_path / "quake.toml"
+    scenario.write_text(
+        BLOCK.replace('{ kind = "sine", amplitude = 0.1, frequency = 2.0 }', '{ kind = "record", file = "quake.csv" }')
+    )
+    result = invoke(
+        "sweep", scenario, "-p", "scale=0.5,1", "--workers", 0, "--out", record, "--force", "--no-recording"
+    )
+    assert result.exit_code == 2
+    assert result.output.strip() == f"error: --out {record}: is the record {record} (the table would replace it)"
+    assert record.read_bytes() == kept
+
+
 def _files(folder: Path) -> dict[str, bytes]:
     return {p.name: p.read_bytes() for p in folder.rglob("*") if p.is_file()}
 
