@@ -20,12 +20,13 @@ from masonrycli.cli_options import (
     FORCE,
     FRICTION,
     GEO_OUT,
-    LOADING,
     OUTPUT,
     RECORD,
     RUN,
+    SETTLED_LOADING,
     STOP,
     WALL,
+    WALL_LOADING,
     Friction,
     with_options,
 )
@@ -141,7 +142,7 @@ def _simulate(name: str, opts: dict) -> None:
 
 @simulate_app.command("wall")
 @user_errors
-@with_options(WALL, LOADING, RECORD, RUN, STOP, FRICTION, BLOCK_MATERIAL, OUTPUT, FORCE)
+@with_options(WALL, WALL_LOADING, RECORD, RUN, STOP, FRICTION, BLOCK_MATERIAL, OUTPUT, FORCE)
 def simulate_wall(**opts) -> None:
     """The paper's running-bond wall on a shaken ground (default 51 blocks, 1 m/s at 2 Hz for 1 s)."""
     _simulate("wall", opts)
@@ -149,7 +150,7 @@ def simulate_wall(**opts) -> None:
 
 @simulate_app.command("arch")
 @user_errors
-@with_options(ARCH, LOADING, RECORD, RUN, STOP, FRICTION, BLOCK_MATERIAL, OUTPUT, FORCE)
+@with_options(ARCH, SETTLED_LOADING, RECORD, RUN, STOP, FRICTION, BLOCK_MATERIAL, OUTPUT, FORCE)
 def simulate_arch(**opts) -> None:
     """The paper's 98-block arch on two piers; default: right foundation settles at 1 cm/s for 5 s."""
     _simulate("arch", opts)
@@ -157,7 +158,7 @@ def simulate_arch(**opts) -> None:
 
 @simulate_app.command("aqueduct")
 @user_errors
-@with_options(AQUEDUCT, LOADING, RECORD, RUN, STOP, FRICTION, BLOCK_MATERIAL, OUTPUT, FORCE)
+@with_options(AQUEDUCT, SETTLED_LOADING, RECORD, RUN, STOP, FRICTION, BLOCK_MATERIAL, OUTPUT, FORCE)
 def simulate_aqueduct(**opts) -> None:
     """A segment of the Arles aqueduct (98 arch + 248 wall blocks); default: settlement 1 cm/s for 5 s.
 

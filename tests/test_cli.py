@@ -27,6 +27,36 @@ def test_help_and_version():
     assert result.exit_code == 0 and "--freq" in result.output and "--amp" in result.output
 
 
+def _option_help(command: list[str]) -> dict[str, str]:
+    """Each option of ``masonry COMMAND --help`` with its help text (joined over wrapped lines)."""
+    from masonrycli.cli import app
+
+    from cli_helpers import runner
+
+    out = runner.invoke(app, [*command, "--help"], env={"COLUMNS": "250"}).output
+    options, name = {}, None
+    for line in out.splitlines():
+        cells = line.strip("│ ").split()
+        if cells and cells[0].startswith("--"):
+            name = cells[0]
+            options[name] = " ".join(cells[2:])
+        elif name and cells and not line.startswith(("╭", "╰")):
+            options[name] += " " + " ".join(cells)
+    return options
+
+
+def test_simulate_help_lists_only_what_the_structure_takes_with_its_defaults():
+    # `simulate wall --help` offered --settlement ("Downward velocity of the right foundation"), which the
+    # wall always refuses, and --freq / --amp / --scale showed no default (the wall is shaken at 1 m/s, 2 Hz).
+    wall = _option_help(["simulate", "wall"])
+    assert "--settlement" not in wall
+    assert "(default 2)" in wall["--freq"] and "(default 1;" in wall["--amp"] and "(default 1)" in wall["--scale"]
+    for name in ("arch", "aqueduct"):
+        options = _option_help(["simulate", name])
+        assert "(default 0.01;" in options["--settlement"] and "--settlement 0" in options["--amp"]
+        assert "(default 2" in options["--freq"]
+
+
 def test_simulate_wall_short_run_writes_recording_and_history(tmp_path):
     rrd, npz = tmp_path / "wall.rrd", tmp_path / "wall.npz"
     result = invoke("simulate", "wall", "--freq", 2, "--amp", 1, "--duration", 0.05, "--out", rrd, "--history", npz)
