@@ -77,3 +77,30 @@ def test_readme_history_table_names_every_array(tmp_path):
     documented = set(re.findall(r"`([a-z_0-9]+)`", table))
     written = set(np.load(npz).files)
     assert "intensity_pga" in written and written <= documented, sorted(written - documented)
+
+
+def _table_keys(text: str, heading: str) -> set[str]:
+    """The backquoted names in the first column of the table under ``heading`` (up to the next heading)."""
+    section = text[text.index(heading) :].split("\n#", 1)[0]
+    return set(re.findall(r"^\| `([a-z_]+)`", section, flags=re.M))
+
+
+def test_scenario_format_tables_list_every_key_the_reader_takes():
+    # `[run] solver` was read (README: `[run] solver = "nlgs"`) but missing from the [run] table.
+    import dataclasses
+
+    from masonrycli.scenario import Material, RunConfig
+    from masonrycli.scenario_toml import BLOCK_KEYS, SUPPORT_KEYS
+
+    text = (ROOT / "docs" / "scenario-format.md").read_text()
+    assert _table_keys(text, "## `[run]`") == {f.name for f in dataclasses.fields(RunConfig)}
+    assert _table_keys(text, "## `[material]`") == {f.name for f in dataclasses.fields(Material)}
+    assert _table_keys(text, "## `[[block]]`") == set(BLOCK_KEYS)
+    assert _table_keys(text, "## `[[support]]`") == set(SUPPORT_KEYS)
+
+
+def test_scenario_format_counts_bodies_as_the_messages_do():
+    # The page said geometry messages "count bodies from 0, as the model does" after they were numbered
+    # from 1 (1b09016), next to its own example "blocks 4 ("b4") and 5 ("b5") overlap".
+    text = (ROOT / "docs" / "scenario-format.md").read_text()
+    assert "from 0" not in text
