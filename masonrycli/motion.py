@@ -55,7 +55,6 @@ from typing import ClassVar
 
 import numpy as np
 
-from geometry_library.values import is_real
 from masonrycli.values import check_real, check_vector, field_error, format_value
 
 RECORD_QUANTITIES = ("velocity", "acceleration")
@@ -322,14 +321,16 @@ class Record(Motion):
         for i in range(1, len(t)):
             if not t[i] > t[i - 1]:
                 raise field_error(f"time[{i}]", t[i], f"must be > the previous time {format_value(t[i - 1])}")
-        if all(is_real(v) for v in value):
-            v = tuple(check_real(f"value[{i}]", x) for i, x in enumerate(value))
-        else:
+        # the first sample says which: [x, y] pairs, or numbers along the direction (judged from all of
+        # them, [1.0, "b"] blamed value[0] = 1.0 for not being 2 numbers [x, y])
+        if isinstance(value[0], (list, tuple, np.ndarray)):
             v = tuple(check_vector(f"value[{i}]", x) for i, x in enumerate(value))
+        else:
+            v = tuple(check_real(f"value[{i}]", x) for i, x in enumerate(value))
         _put(self, "time", t)
         _put(self, "value", v)
         if self.window is not None:
-            w = check_vector("window", self.window)
+            w = check_vector("window", self.window, names="[start, end]")
             if not w[1] > w[0]:
                 raise field_error("window", w, "must be [start, end] with end > start")
             inside = sum(1 for x in t if w[0] <= x <= w[1])

@@ -288,7 +288,9 @@ def _table_file(table: dict, key: str, base_dir: str):
         raise InputError(f"motion.{key} = {format_value(file)[:40]}: must be a file name")
     resolved = os.path.abspath(os.path.join(base_dir, file))
     if not os.path.isfile(resolved):
-        missing = NOT_A_FILE if os.path.exists(resolved) else "no such file"
+        missing = (
+            "is a directory" if os.path.isdir(resolved) else NOT_A_FILE if os.path.exists(resolved) else "no such file"
+        )
         raise InputError(f"motion.{key} = {quote_string(file)}: {missing} (looked for {resolved})")
     try:
         time, value, native = read_record(resolved, display=file)

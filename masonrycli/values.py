@@ -98,12 +98,13 @@ def check_int(key: str, value, *, ge: int, le: int) -> int:
     return int(value)
 
 
-def check_vector(key: str, value, size: int = 2) -> tuple[float, ...]:
-    """Return ``value`` as a tuple of ``size`` finite floats or raise ``InputError`` naming ``key``."""
+def check_vector(key: str, value, size: int = 2, names: str | None = None) -> tuple[float, ...]:
+    """Return ``value`` as a tuple of ``size`` finite floats or raise ``InputError`` naming ``key``;
+    ``names`` spells the expected form in the message (default ``[x, y]`` / ``[vx, vy, omega]``)."""
     if isinstance(value, np.ndarray):
         value = value.tolist()
     if not isinstance(value, (list, tuple)) or len(value) != size or not all(is_real(v) for v in value):
-        names = {2: "[x, y]", 3: "[vx, vy, omega]"}.get(size, f"{size} numbers")
+        names = names or {2: "[x, y]", 3: "[vx, vy, omega]"}.get(size, f"{size} numbers")
         raise field_error(key, value, f"must be {size} numbers {names}")
     out = tuple(float(v) for v in value)
     if not all(math.isfinite(v) for v in out):

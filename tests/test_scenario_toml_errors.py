@@ -215,6 +215,19 @@ MOTION_ERRORS = [
     ),
     ('{ kind = "record", file = 3 }', "motion.file = 3: must be a file name"),
     ('"sine"', 'motion = "sine": must be a table'),
+    # these said "must be 2 numbers [x, y]" (a window is [start, end]; a 1-component value a number) and
+    # file = "." "not a regular file (a device, a pipe or a socket)" (a folder)
+    (
+        '{ kind = "record", time = [0.0, 1.0], value = [1.0, 2.0], window = [0.5] }',
+        "motion.window = [0.5]: must be 2 numbers [start, end]",
+    ),
+    ('{ kind = "record", time = [0.0, 1.0], value = ["a", "b"] }', 'motion.value[0] = "a": must be a number'),
+    ('{ kind = "record", time = [0.0, 1.0], value = [1.0, "b"] }', 'motion.value[1] = "b": must be a number'),
+    (
+        '{ kind = "record", time = [0.0, 1.0], value = [[1.0, 2.0], [3.0]] }',
+        "motion.value[1] = [3.0]: must be 2 numbers [x, y]",
+    ),
+    ('{ kind = "record", file = "." }', 'motion.file = ".": is a directory (looked for '),
 ]
 
 
