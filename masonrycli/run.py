@@ -350,7 +350,8 @@ def simulate(
 def run_outcome(sim: Simulation, hinges: int) -> dict:
     """The structure's state and the indicators behind it (:mod:`masonrycli.collapse`): ``state``,
     ``collapse_time`` (s, NaN if none), ``collapse_reason``, ``residual_drift`` and ``peak_drift``
-    (× height), ``max_opening`` (m), ``hinges``, ``slide_time`` / ``rock_time`` (s, NaN if none),
+    (× height), ``max_opening`` (m), ``max_displacement`` (m, the largest block's relative to the
+    shaking ground: damage beyond 5 mm), ``hinges``, ``slide_time`` / ``rock_time`` (s, NaN if none),
     ``max_slide_speed`` (m/s), ``max_rock_speed`` (rad/s)."""
     mon, q = sim.monitor, sim.state.body_q
     opening = sim.joints.opening(q) if sim.joints.key.size else np.zeros(0)
@@ -363,6 +364,7 @@ def run_outcome(sim: Simulation, hinges: int) -> dict:
         "residual_drift": mon.drift(q) / mon.height,
         "peak_drift": mon.peak_drift,
         "max_opening": max_opening,
+        "max_displacement": mon.max_block_displacement(q),
         "hinges": hinges,
         "slide_time": nan if mon.slide_time is None else mon.slide_time,
         "rock_time": nan if mon.rock_time is None else mon.rock_time,
@@ -377,6 +379,8 @@ def describe_outcome(outcome: dict) -> str:
         f"residual drift {_shown(100 * outcome['residual_drift'])} % of the height, {outcome['hinges']} hinges, "
         f"largest opening {_shown(1000 * outcome['max_opening'])} mm"
     )
+    if "max_displacement" in outcome:  # a block moved off its place damages too: the line shows by how much
+        tail += f", largest block displacement {_shown(1000 * outcome['max_displacement'])} mm"
     if outcome["state"] == "collapsed":
         return f"collapsed at t = {outcome['collapse_time']:.3f} s ({outcome['collapse_reason']})"
     return f"{outcome['state']} ({tail})"

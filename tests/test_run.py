@@ -9,6 +9,7 @@ import tracemalloc
 from types import SimpleNamespace
 
 import numpy as np
+import pytest
 from test_collapse import block_scenario
 
 from masonrycli.motion import Sine
@@ -67,3 +68,30 @@ def test_outcome_shows_round_off_as_zero():
     assert (
         describe_outcome(moved) == "damaged (residual drift 0.31 % of the height, 2 hinges, largest opening 0.00541 mm)"
     )
+
+
+def test_a_block_displaced_without_drift_or_opening_says_why_it_is_damaged():
+    # A block falling freely 1e6 m from the rest (the far block of a scenario) made the summary read
+    # "damaged (residual drift 0 % of the height, 0 hinges, largest opening 0 mm)": damaged by the block's
+    # displacement (> 5 mm, docs/collapse.md), which the line did not show.
+    from masonrycli.run import describe_outcome
+    from masonrycli.scenario_toml import loads_scenario
+
+    sc = loads_scenario(
+        """
+[run]
+duration = 0.05
+[[support]]
+name = "ground"
+polygon = [[-5, -1], [5, -1], [5, 0], [-5, 0]]
+[[block]]
+polygon = [[0, 0], [1, 0], [1, 1], [0, 1]]
+[[block]]
+polygon = [[999990, 0], [999991, 0], [999991, 1], [999990, 1]]
+"""
+    )
+    outcome = simulate(sc).outcome
+    # θ = 0.5 integrates a constant acceleration exactly: the free block has fallen g t² / 2
+    assert outcome["max_displacement"] == pytest.approx(0.5 * 9.81 * 0.05**2, rel=1e-9)
+    said = describe_outcome(outcome)
+    assert said.startswith("damaged (") and "largest block displacement 12.3 mm" in said, said
