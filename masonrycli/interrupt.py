@@ -156,14 +156,19 @@ class FirstSignalStops(_Handlers):
     @contextlib.contextmanager
     def held(self):
         """A first signal during the block is raised when the block is over: a file renamed into place
-        inside it is also recorded as written inside it, with no signal between the two."""
+        inside it is also recorded as written inside it, with no signal between the two.
+
+        If the block raises (the rename failed), its error goes on instead, as out of
+        :meth:`StopSignals.held`: it says what went wrong, and the command is leaving anyway — the signal
+        stays in :attr:`signum` (so later ones are repeats) but is not raised later: a deferral kept past
+        the block made the next held block raise a KeyboardInterrupt for it, after the error."""
         self._holding = True
         try:
             yield
         finally:
-            self._holding = False
-        if self._deferred:
-            self._deferred = False
+            self._holding = False  # first: a signal from now on raises at once instead of being deferred
+            deferred, self._deferred = self._deferred, False
+        if deferred:
             raise KeyboardInterrupt
 
     def _handle(self, signum, _frame) -> None:

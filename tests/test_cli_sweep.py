@@ -655,3 +655,33 @@ def test_a_signal_just_after_the_plot_is_renamed_does_not_call_it_missing(block,
     assert f"interrupted: every row is in {out}, but not written: {tmp_path / 's.rrd'}; " in said
     assert "run the same command with --force (no run is made again)" in said
     assert sorted(p.name for p in tmp_path.iterdir()) == ["block.toml", "s.csv", "s.png"]
+
+
+def test_a_signal_held_while_the_plot_s_rename_fails_reports_the_error(block, tmp_path, monkeypatch):
+    # A Ctrl-C held around the plot's rename, and the rename then fails: the error is what the user needs
+    # (the plot is missing because of it), in one line with its exit code, as without the signal — not an
+    # "interrupted" line, and no traceback.
+    import errno
+    import os
+    import signal
+    import time
+
+    from masonrycli.outputs import OutputFile
+
+    out = tmp_path / "s.csv"
+    commit = OutputFile.commit
+
+    def ctrl_c_then_a_failed_rename(self):
+        if self.path.suffix != ".png":
+            return commit(self)
+        os.kill(os.getpid(), signal.SIGINT)
+        time.sleep(0.2)  # the handler runs here and holds the signal
+        raise OSError(errno.EACCES, "Permission denied", str(self.path))
+
+    monkeypatch.setattr(OutputFile, "commit", ctrl_c_then_a_failed_rename)
+    result = invoke("sweep", block, "-p", "amp=0.05,0.1", "--duration", 0.02, "--workers", 0, "-o", out)
+    said = " ".join(result.output.split())
+    assert result.exit_code == 2, result.output
+    assert f"error: {tmp_path / 's.png'}: Permission denied" in said
+    assert "interrupted" not in said and "Traceback" not in said
+    assert len(read_rows(out)) == 2

@@ -210,6 +210,27 @@ def test_first_signal_stops_held_blocks_and_repeats():
     assert signals.signum == signal.SIGINT
 
 
+def test_an_error_in_a_held_block_goes_on_and_leaves_no_signal_behind():
+    # A signal held in a block whose body then failed (the report's rename: OSError) stayed deferred: the
+    # error went on, and the next held block raised a KeyboardInterrupt for that old signal at its end.
+    # The error goes on (it says what went wrong), the signal is recorded, and nothing is raised later.
+    from masonrycli.interrupt import FirstSignalStops
+
+    with FirstSignalStops() as signals:
+        with pytest.raises(OSError, match="rename failed"):
+            with signals.held():
+                os.kill(os.getpid(), signal.SIGTERM)
+                time.sleep(0.1)  # the handler runs here and only records it
+                raise OSError("rename failed")
+        assert signals.signum == signal.SIGTERM
+        done = []
+        with signals.held():
+            done.append("next block")
+        os.kill(os.getpid(), signal.SIGINT)  # a repeat: acknowledged, ignored
+        time.sleep(0.1)
+        assert done == ["next block"] and signals.stopping() == signal.SIGTERM
+
+
 def test_a_signal_while_the_handlers_are_installed_puts_the_first_back(monkeypatch):
     # A Ctrl-C between installing SIGINT's handler and SIGTERM's raises StopRun out of __enter__, so
     # __exit__ never runs: SIGINT's handler stayed installed and every later Ctrl-C was a "repeat",
