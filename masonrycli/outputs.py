@@ -167,11 +167,11 @@ def written_whole(out: OutputFile, around_commit=None):
     open_part(out)
     try:
         yield out.part
-    except BaseException:
+        with around_commit if around_commit is not None else contextlib.nullcontext():
+            out.commit()
+    except BaseException:  # the rename too: a failed one left the hidden part file beside the path
         out.discard()
         raise
-    with around_commit if around_commit is not None else contextlib.nullcontext():
-        out.commit()
 
 
 def check_space(outputs: list[tuple[OutputFile, int]]) -> None:

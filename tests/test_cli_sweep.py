@@ -685,3 +685,4 @@ def test_a_signal_held_while_the_plot_s_rename_fails_reports_the_error(block, tm
     assert f"error: {tmp_path / 's.png'}: Permission denied" in said
     assert "interrupted" not in said and "Traceback" not in said
     assert len(read_rows(out)) == 2
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["block.toml", "s.csv"]  # no .s.png.<pid>.part
