@@ -43,40 +43,44 @@ def test_the_digest_follows_the_source_not_where_it_lies(tmp_path):
 
 
 class _Client:
-    """Client.run's parts that check_workers calls: sync(_run, probe, ..., callback_timeout)."""
-
-    def __init__(self, answers):
-        self.answers = answers
-
-    def sync(self, function, *args, callback_timeout, **kwargs):
-        assert callback_timeout == versions.PROBE_TIMEOUT
-        return function(*args, **kwargs)
-
-    def _run(self, function, on_error):
-        assert on_error == "return" and function() == this_version()  # the probe, as run here
-        if isinstance(self.answers, BaseException):
-            raise self.answers
-        return self.answers
+    """What check_workers asks of the study's client: the scheduler's address and its workers."""
 
     def scheduler_info(self):
-        return {"workers": {"tcp://a:1": {}, "tcp://b:2": {}}}
+        return {"address": "tcp://s:8786", "workers": {"tcp://a:1": {}, "tcp://b:2": {}}}
 
 
-def test_the_refusal_names_the_worker_and_both_versions():
+def _answering(answers):
+    """``ask_workers`` with these answers (or this exception), checking what it was asked."""
+
+    def ask_workers(address, function, timeout):
+        assert address == "tcp://s:8786" and timeout == versions.PROBE_TIMEOUT
+        assert function() == this_version()  # the probe, as run here
+        if isinstance(answers, BaseException):
+            raise answers
+        return answers
+
+    return ask_workers
+
+
+def test_the_refusal_names_the_worker_and_both_versions(monkeypatch):
     ours = this_version()
-    check_workers(_Client({"tcp://a:1": ours, "tcp://b:2": list(ours)}), "tcp://s:8786")  # all the same
+    monkeypatch.setattr(versions, "ask_workers", _answering({"tcp://a:1": ours, "tcp://b:2": list(ours)}))
+    check_workers(_Client(), "tcp://s:8786")  # all the same
     answers = {"tcp://a:1": ours, "tcp://b:2": ("0.0.9", "abc"), "tcp://c:3": (None, "ModuleNotFoundError: x")}
+    monkeypatch.setattr(versions, "ask_workers", _answering(answers))
     with pytest.raises(InputError) as err:
-        check_workers(_Client(answers), "tcp://s:8786")
+        check_workers(_Client(), "tcp://s:8786")
     assert str(err.value) == (
         "--scheduler tcp://s:8786: worker tcp://b:2 (and 1 more of 3 workers) runs masonry 0.0.9 (source abc), "
         f"this command runs {describe(ours)}; install the same masonry on every worker"
     )
+    monkeypatch.setattr(versions, "ask_workers", _answering({"tcp://a:1": OSError("gone")}))
     with pytest.raises(InputError, match=r"worker tcp://a:1 could not be asked \(OSError: gone\)"):
-        check_workers(_Client({"tcp://a:1": OSError("gone")}), "tcp://s:8786")
+        check_workers(_Client(), "tcp://s:8786")
 
+    monkeypatch.setattr(versions, "ask_workers", _answering(TimeoutError()))
     with pytest.raises(InputError) as err:  # Client.run waited as long as a worker took, without a word
-        check_workers(_Client(TimeoutError()), "tcp://s:8786")
+        check_workers(_Client(), "tcp://s:8786")
     assert str(err.value) == (
         "--scheduler tcp://s:8786: the workers (2) did not all answer the masonry check within 60 s (a worker "
         "inside a long call answers when it ends); try again when they are free"
@@ -133,3 +137,23 @@ def test_a_run_answers_with_its_masonry_and_runs_only_for_the_same(monkeypatch):
         f"worker tcp://w:1 runs masonry 0.0.9 (source abc), this command runs {describe(ours)}: its run of "
         "amp=0.1 record=a.AT2 is not kept and the study stops"
     )
+
+
+def test_the_study_uses_only_distributed_s_public_api():
+    # The check's deadline was Client.sync(client._run, ..., callback_timeout=): a private coroutine of
+    # distributed, free to change in any release. No private attribute of a Dask object in masonrycli.
+    import ast
+
+    dask_objects = {"client", "cluster", "future", "scheduler", "worker"}
+    private = []
+    for path in sorted((ROOT / "masonrycli").rglob("*.py")):
+        for node in ast.walk(ast.parse(path.read_text())):
+            if (
+                isinstance(node, ast.Attribute)
+                and isinstance(node.value, ast.Name)
+                and node.value.id in dask_objects
+                and node.attr.startswith("_")
+                and not node.attr.startswith("__")
+            ):
+                private.append(f"{path.relative_to(ROOT)}:{node.lineno} {node.value.id}.{node.attr}")
+    assert private == []

@@ -85,8 +85,8 @@ def check_workers(client, scheduler: str) -> None:
     process's, naming the worker and both versions, or that does not answer within :data:`PROBE_TIMEOUT`.
     Workers that join later are checked by each run (:func:`make_task`)."""
     ours = this_version()
-    try:  # Client.run with a deadline (Client.run is this same call without one)
-        found = client.sync(client._run, _make_probe(), on_error="return", callback_timeout=PROBE_TIMEOUT)
+    try:
+        found = ask_workers(client.scheduler_info()["address"], _make_probe(), PROBE_TIMEOUT)
     except TimeoutError:
         workers = len(client.scheduler_info().get("workers", {}))
         raise InputError(
@@ -107,6 +107,28 @@ def check_workers(client, scheduler: str) -> None:
             f"--scheduler {scheduler}: worker {worker}{more} {what}, this command runs {describe(ours)}; "
             "install the same masonry on every worker"
         )
+
+
+def ask_workers(address: str, function, timeout: float) -> dict:
+    """``Client.run(function, on_error="return")`` on every worker of the scheduler at ``address``:
+    ``{worker address: result or exception}``, or :class:`TimeoutError` after ``timeout`` s.
+
+    ``Client.run`` (public) has no deadline, so it is awaited under one, by an asynchronous client of
+    its own (a connection for the check; the study's client is synchronous). ``Client.run`` rather than
+    a task per worker (``submit(..., workers=[w])``): it runs beside the worker's tasks, not behind them
+    (a cluster busy with another study answers at once; a task would wait for a free thread)."""
+    import asyncio
+
+    from distributed import Client
+
+    async def ask():
+        async with Client(address, asynchronous=True, set_as_default=False, timeout=timeout) as client:
+            return await client.run(function, on_error="return")
+
+    async def ask_in_time():
+        return await asyncio.wait_for(ask(), timeout)
+
+    return asyncio.run(ask_in_time())
 
 
 class WorkerMismatch(InputError):
