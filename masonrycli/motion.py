@@ -387,6 +387,11 @@ class Record(Motion):
         return time, value, nodal_v, baseline
 
     @property
+    def start_time(self) -> float:
+        """s on the run's clock: the first sample used (0 with a window; a CSV's own first time else)."""
+        return float(self._arrays[0][0])
+
+    @property
     def end_time(self) -> float:
         """s on the run's clock: the last sample used (after the window's shift to t = 0); the record
         has shaken all it holds by then."""

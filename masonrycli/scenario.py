@@ -364,19 +364,25 @@ def check_sampling(scenario: Scenario) -> None:
 def record_warnings(scenario: Scenario) -> list[str]:
     """One line per record that the run does not follow whole:
 
+    * it starts after the run ends (a CSV stamped with clock times, 100.0, 100.1, … s): the run never
+      reaches a sample, and said "completed … intact";
+
     * it goes on after the run ends: its shaking after that is not applied (a 40 s PEER record run for
       the built-in wall's 1 s was cut to its first second, and nothing said so);
     * it is sampled more finely than dt: the steps see its velocity every dt only, and its content above
       1/(2 dt) comes back aliased (the record's counterpart of check_sampling's sine).
     """
     run = scenario.run
+    unseen: dict[tuple[str, float, float], list[str]] = {}
     late: dict[tuple[str, float], list[str]] = {}
     fine: dict[tuple[str, float], list[str]] = {}
     for support, m in zip(scenario.assembly.supports, scenario.motions):
         if m.kind != "record":
             continue
         name = os.path.basename(m.source) if m.source else "(inline)"
-        if m.end_time > run.duration + 0.5 * run.dt:
+        if m.start_time >= run.duration:
+            unseen.setdefault((name, m.start_time, m.end_time), []).append(f'"{support.name}"')
+        elif m.end_time > run.duration + 0.5 * run.dt:
             late.setdefault((name, m.end_time), []).append(f'"{support.name}"')
         if m.sample_interval < run.dt * (1.0 - 1e-9):
             fine.setdefault((name, m.sample_interval), []).append(f'"{support.name}"')
@@ -384,15 +390,24 @@ def record_warnings(scenario: Scenario) -> list[str]:
     def who(names: list[str]) -> str:
         return f"support{'s' if len(names) > 1 else ''} {', '.join(names)}"
 
-    return [
-        f"{who(names)}: the record {name} lasts {end:g} s but the run {run.duration:g} s; its shaking after "
-        f"t = {run.duration:g} s is not applied (--duration {end:g} runs it all)"
-        for (name, end), names in late.items()
-    ] + [
-        f"{who(names)}: the record {name} is sampled every {step:g} s, finer than dt = {run.dt:g} s: the steps skip "
-        f"samples and alias its content above {0.5 / run.dt:g} Hz (dt = {step:g} follows every sample)"
-        for (name, step), names in fine.items()
-    ]
+    return (
+        [
+            f"{who(names)}: the record {name} starts at t = {start:g} s, after the run's {run.duration:g} s: none "
+            "of its shaking is applied (record times count from the run's t = 0; a scenario file's "
+            f"window = [{start:g}, {end:g}] moves it there)"
+            for (name, start, end), names in unseen.items()
+        ]
+        + [
+            f"{who(names)}: the record {name} lasts {end:g} s but the run {run.duration:g} s; its shaking after "
+            f"t = {run.duration:g} s is not applied (--duration {end:g} runs it all)"
+            for (name, end), names in late.items()
+        ]
+        + [
+            f"{who(names)}: the record {name} is sampled every {step:g} s, finer than dt = {run.dt:g} s: the steps skip "
+            f"samples and alias its content above {0.5 / run.dt:g} Hz (dt = {step:g} follows every sample)"
+            for (name, step), names in fine.items()
+        ]
+    )
 
 
 def scenario_summary(scenario: Scenario) -> dict:

@@ -461,6 +461,21 @@ def test_record_warnings_name_a_record_that_outlasts_the_run():
     assert record_warnings(windowed) == []  # the window moves 0.2 ... 0.4 s to 0 ... 0.2 s: all of it is run
 
 
+def test_record_warnings_name_a_record_that_starts_after_the_run_ends(tmp_path):
+    # A CSV stamped with clock times (100.0, 100.1, 100.2 s) run for 1 s: the ground never saw a sample, the
+    # run said "completed ... intact", and the only warning read "the record lasts 100.2 s but the run 1 s;
+    # its shaking after t = 1 s is not applied".
+    from masonrycli.scenario import record_warnings
+
+    (tmp_path / "late.csv").write_text("time,v\n100.0,0.0\n100.1,0.1\n100.2,0.0\n")
+    text = BLOCK + GROUND + 'motion = { kind = "record", file = "late.csv" }\n'
+    scenario = loads_scenario(text, source=str(tmp_path / "s.toml"), base_dir=tmp_path)
+    assert record_warnings(scenario) == [
+        'support "ground": the record late.csv starts at t = 100 s, after the run\'s 1 s: none of its shaking is '
+        "applied (record times count from the run's t = 0; a scenario file's window = [100, 100.2] moves it there)"
+    ]
+
+
 def test_too_many_steps_says_how_many_exactly():
     # 1.001e8 steps was "gives 1e+08 steps ... (at most 1e+08)": the refusal read like a contradiction
     with pytest.raises(InputError) as exc:
