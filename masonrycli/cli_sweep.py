@@ -46,10 +46,16 @@ def sweep_command(
     find: Annotated[
         str | None, typer.Option("--find", help="Bisect this parameter for the smallest value giving --outcome.")
     ] = None,
+    # None when not given: without --find they were ignored without a word (a grid ran instead)
     outcome: Annotated[
-        str, typer.Option("--outcome", help="What --find looks for: collapse, sliding, rocking or drift:X.")
-    ] = "collapse",
-    rtol: Annotated[float, typer.Option("--rtol", help="Relative width at which --find stops bisecting.")] = 0.005,
+        str | None,
+        typer.Option(
+            "--outcome", help="What --find looks for: collapse, sliding, rocking or drift:X (default collapse)."
+        ),
+    ] = None,
+    rtol: Annotated[
+        float | None, typer.Option("--rtol", help="Relative width at which --find stops bisecting (default 0.005).")
+    ] = None,
     out: Annotated[
         Path | None, typer.Option("--out", "-o", help="Results, .parquet or .csv (one row per run).")
     ] = None,
@@ -126,6 +132,11 @@ def sweep_command(
     scheduler = check_scheduler(scheduler)
     if workers is not None and scheduler is not None:
         raise InputError("--workers with --scheduler: the existing cluster has its own workers")
+    outcome = None if outcome is None else check_outcome(outcome)
+    for option, value in (("--outcome", outcome), ("--rtol", rtol)):
+        if value is not None and find is None:
+            raise InputError(f"{option} {value}: goes with --find (a grid reports every run's state)")
+    outcome, rtol = outcome or "collapse", 0.005 if rtol is None else rtol
     if not (0 < rtol < 1):
         raise InputError(f"--rtol {rtol}: must be in (0, 1)")
     _check_out_reads_nothing(out, base)
@@ -146,7 +157,7 @@ def sweep_command(
         axes=axes,
         out=out,
         find=find,
-        outcome=check_outcome(outcome),
+        outcome=outcome,
         rtol=rtol,
         scheduler=scheduler,
         workers=workers,

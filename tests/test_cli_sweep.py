@@ -280,6 +280,10 @@ def test_grid_sweep_state_map_and_histories(block, tmp_path):
         (["-p", "amp=0.1,1e30"], "--param amp=1e+30: "),  # it ran, exit 0
         # both rows ran at 0.5 m/s, under the names amp=0.1 and amp=0.2
         (["-p", "amp=0.1,0.2", "-p", "ground.amp=0.5"], "--param ground.amp: sets the amplitude of support 'ground'"),
+        # without --find these were ignored: a grid ran and reported states, not the outcome asked for
+        (["-p", "amp=0.1,0.2", "--outcome", "sliding"], "--outcome sliding: goes with --find"),
+        (["-p", "amp=0.1,0.2", "--outcome", "collapse"], "--outcome collapse: goes with --find"),
+        (["-p", "amp=0.1,0.2", "--rtol", "0.1"], "--rtol 0.1: goes with --find"),
     ],
 )
 def test_sweep_errors_are_one_line(block, args, fragment, tmp_path, monkeypatch):
