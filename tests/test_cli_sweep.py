@@ -347,6 +347,22 @@ def test_a_study_table_in_its_records_folder_is_not_read_as_a_record(block, tmp_
     assert {r["record"] for r in read_rows(folder / "ida.csv")} == {"a.csv", "b.csv"}
 
 
+def test_a_record_edited_since_the_table_was_written_is_not_taken_as_done(block, tmp_path):
+    # A study's fingerprint knew a --records file by its path, scale and sample count: a record whose values
+    # were corrected (0.05 -> 0.45 m/s) kept its rows, "0 runs now, 1 row already there", pgv still 0.05 m/s.
+    folder = tmp_path / "recs"
+    folder.mkdir()
+    record = _velocity_csv(folder / "a.csv")
+    args = ("sweep", block, "--records", folder, "--workers", 0, "--duration", 0.1, "--no-recording", "--out")
+    out = tmp_path / "s.csv"
+    assert invoke(*args, out).exit_code == 0
+    assert read_rows(out)[0]["pgv"] == pytest.approx(0.05)
+    record.write_text(record.read_text().replace(",0.05\n", ",0.45\n"))
+    forced = invoke(*args, out, "--force")
+    assert forced.exit_code == 0 and "(1 run now, 0 rows already there" in " ".join(forced.output.split())
+    assert read_rows(out)[0]["pgv"] == pytest.approx(0.45)
+
+
 def test_a_record_given_as_the_study_table_is_refused_not_replaced(block, tmp_path):
     # `--records rec.csv --out rec.csv --force` replaced the record with the study's table (the record lost).
     record = _velocity_csv(tmp_path / "rec.csv")

@@ -7,12 +7,14 @@ written: :mod:`masonrycli.study.files`.
 
 from __future__ import annotations
 
+import hashlib
 import logging
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
+import numpy as np
 from rich.console import Console
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 
@@ -61,6 +63,14 @@ class StudyResult:
     """Where the table went."""
 
 
+def _samples_digest(record) -> str:
+    """SHA-1 of a record's sample times and values, and of how they are read."""
+    digest = hashlib.sha1(np.asarray(record.time, dtype=np.float64).tobytes())
+    digest.update(np.asarray(record.value, dtype=np.float64).tobytes())
+    digest.update(repr((record.quantity, record.direction, record.window, record.baseline)).encode())
+    return digest.hexdigest()
+
+
 def prepare(base: StudyBase, request: StudyRequest) -> str:
     """Check the request against the base (a bad axis fails here, before any cluster starts) and
     return the study's fingerprint."""
@@ -76,7 +86,9 @@ def prepare(base: StudyBase, request: StudyRequest) -> str:
             raise InputError(f"--find {request.find}: needs a numeric range LO:HI:N with N >= 2")
     for point in grid(request.axes)[:1] + grid(request.axes)[-1:]:
         apply_point(base, point)  # raises InputError for an unknown or impossible parameter
-    records = {name: (r.source, r.scale, len(r.time)) for name, r in base.records.items()}
+    # a record by its samples, not its path and length: one corrected since (same file, same sample count)
+    # kept its rows ("0 runs now, 1 row already there", the old pgv)
+    records = {name: (r.source, r.scale, _samples_digest(r)) for name, r in base.records.items()}
     settings = (request.find, request.outcome if request.find else None, request.rtol if request.find else None)
     return store.fingerprint(
         dump_scenario(base.scenario, inline_records=True), records, settings, request.stop_at_collapse
