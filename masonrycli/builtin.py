@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import os
 from pathlib import Path
 
 from masonrycli.errors import InputError
@@ -111,6 +112,16 @@ def with_record(scenario: Scenario, record: Path | None, scale: float | None) ->
             raise InputError("--scale: goes with --record (it multiplies the record)")
         return scenario
     shaking = [m.kind in ("sine", "record") for m in scenario.motions]
+    if not any(shaking) and os.path.abspath(scenario.source or "") == scenario.structure.get("file"):
+        # a GeoJSON / WKT file run as it is: it has no place for a motion, "give one a sine" was no way out
+        file = os.path.basename(scenario.source)
+        if not scenario.assembly.supports:
+            raise InputError(f"--record: {file} has no support to shake (every body in it is a block)")
+        raise InputError(
+            f"--record: {file} holds no motion (its supports are fixed); shake one in a scenario file: "
+            f'[structure] file = "{file}" and a [[support]] name = "{scenario.assembly.supports[0].name}" with '
+            'motion = { kind = "record", file = ... } (docs/scenario-format.md)'
+        )
     if not any(shaking):
         raise InputError(f"--record: {scenario.name} has no shaking support (give one a sine or record motion)")
     motion = record_motion_option(record, scale)

@@ -78,6 +78,20 @@ def test_record_option_errors_are_one_line(at2, args, fragment):
     assert len(lines) == 1 and fragment in lines[0], result.output
 
 
+def test_record_on_a_geometry_file_says_how_to_shake_it(at2, tmp_path):
+    # `run wall.geojson --record q.AT2` said "wall has no shaking support (give one a sine or record motion)":
+    # a geometry file has no place for a motion (every support is fixed); a scenario file names its supports.
+    geo = tmp_path / "wall.geojson"
+    assert invoke("build", "wall", "--blocks", 7, "--out", geo).exit_code == 0
+    result = invoke("run", geo, "--record", at2)
+    assert result.exit_code == 2
+    assert " ".join(result.output.split()) == (
+        "error: --record: wall.geojson holds no motion (its supports are fixed); shake one in a scenario file: "
+        '[structure] file = "wall.geojson" and a [[support]] name = "ground" with motion = { kind = "record", '
+        "file = ... } (docs/scenario-format.md)"
+    )
+
+
 def test_stop_at_collapse_ends_the_run_when_the_block_overturns(tmp_path):
     (tmp_path / "slender.toml").write_text(
         """
