@@ -24,7 +24,13 @@ SWEEP_DURATION = {"wall": 1.0, "arch": 2.0, "aqueduct": 2.0}
 
 
 def sweep_command(
-    target: Annotated[str, typer.Argument(help="wall, arch, aqueduct, or a scenario file (TOML).", metavar="TARGET")],
+    target: Annotated[
+        str,
+        typer.Argument(
+            help="wall, arch, aqueduct, a scenario file (TOML) or a GeoJSON / WKT geometry (supports fixed).",
+            metavar="TARGET",
+        ),
+    ],
     param: Annotated[
         list[str] | None,
         typer.Option(
@@ -211,12 +217,16 @@ def _base_scenario(target: str, duration, dt):
             target, options, RunConfig(duration=SWEEP_DURATION[target]), Material(), motions
         )
     else:
+        from masonrycli.scenario import scenario_from_geometry_file
         from masonrycli.scenario_toml import load_scenario
+        from masonrycli.structure import GEOMETRY_SUFFIXES
 
         path = Path(target)
         if not path.exists():
             raise InputError(f"{target}: no such scenario file (or built-in structure: {', '.join(BUILT_IN)})")
-        scenario = load_scenario(path)
+        # a GeoJSON / WKT file as `masonry run` takes it (it said "TOML syntax error: Invalid statement")
+        geometry = path.suffix.lower() in GEOMETRY_SUFFIXES
+        scenario = scenario_from_geometry_file(path) if geometry else load_scenario(path)
     return override_run(scenario, duration=duration, dt=dt)  # names the wrong option (--dt 0: --dt)
 
 

@@ -363,6 +363,18 @@ def test_a_record_edited_since_the_table_was_written_is_not_taken_as_done(block,
     assert read_rows(out)[0]["pgv"] == pytest.approx(0.45)
 
 
+def test_a_geometry_file_is_swept_as_run_runs_it(tmp_path):
+    # `sweep wall.geojson` said "wall.geojson: TOML syntax error: Invalid statement (at line 1, column 1)";
+    # run, check and limit take a GeoJSON / WKT file as it is (supports fixed).
+    geo = tmp_path / "wall.geojson"
+    assert invoke("build", "wall", "--blocks", 7, "--out", geo).exit_code == 0
+    out = tmp_path / "g.csv"
+    args = ("-p", "friction=0.5,0.6", "--duration", 0.01, "--workers", 0, "--no-recording", "--out", out)
+    result = invoke("sweep", geo, *args)
+    assert result.exit_code == 0, result.output
+    assert [r["friction"] for r in read_rows(out)] == [0.5, 0.6]
+
+
 def test_a_record_given_as_the_study_table_is_refused_not_replaced(block, tmp_path):
     # `--records rec.csv --out rec.csv --force` replaced the record with the study's table (the record lost).
     record = _velocity_csv(tmp_path / "rec.csv")
