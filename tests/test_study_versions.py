@@ -42,6 +42,31 @@ def test_the_digest_follows_the_source_not_where_it_lies(tmp_path):
     assert changed != ours and changed.startswith("masonry 0.1.0 (source ")
 
 
+CHANGE_AFTER_IMPORT = """
+import pathlib, sys
+import masonrycli
+import masonrycli.study.versions as versions
+builder = pathlib.Path(sys.argv[1]) / "geometry_library" / "builders" / "wall.py"
+builder.write_text(builder.read_text() + "\\n")  # after the import: this process runs the code it read before
+print(versions.describe(versions.this_version()))
+"""
+
+
+def test_the_digest_is_of_the_source_the_process_imported(tmp_path):
+    # A long-lived worker that had imported masonry before its checkout changed reported the new files'
+    # digest (hashed when first asked) while running the old code: its rows were kept as this code's.
+    for package in ("masonrycli", "geometry_library"):
+        shutil.copytree(ROOT / package, tmp_path / package, ignore=shutil.ignore_patterns("__pycache__"))
+    ours = describe(this_version())
+    out = subprocess.run(
+        [sys.executable, "-c", CHANGE_AFTER_IMPORT, str(tmp_path)],
+        capture_output=True, text=True, env={"PYTHONPATH": str(tmp_path)}, cwd=tmp_path,
+    )  # fmt: skip
+    assert out.stdout.strip() == ours, out.stdout + out.stderr  # the code it loaded: ours
+    fresh = _version_of(tmp_path)  # a process started after the change
+    assert fresh != ours and fresh.startswith("masonry 0.1.0 (source ")
+
+
 class _Client:
     """What check_workers asks of the study's client: the scheduler's address and its workers."""
 
@@ -87,19 +112,26 @@ def test_the_refusal_names_the_worker_and_both_versions(monkeypatch):
     )
 
 
-def test_the_probe_hashes_the_source_once_per_process(monkeypatch):
-    """Every run now carries its worker's answer: the source is hashed once, not once a run."""
+def test_the_probe_reads_no_file(monkeypatch):
+    """Every run carries its worker's answer: the source was hashed once, when masonry was imported."""
     import hashlib
 
     import masonrycli
 
-    made = []
-    real = hashlib.sha256
-    monkeypatch.setattr(hashlib, "sha256", lambda *a: made.append(1) or real(*a))
-    first = this_version()  # may have been answered before this test: then 0 hashes here
-    monkeypatch.delattr(masonrycli, "_masonry_probe_answer")
-    assert [this_version() for _ in range(3)] == [first] * 3
-    assert len(made) == 1
+    monkeypatch.setattr(hashlib, "sha256", lambda *a: pytest.fail("hashed again"))
+    answers = [this_version() for _ in range(3)]
+    assert answers == [(masonrycli.__version__, masonrycli.SOURCE_DIGEST)] * 3
+
+
+def test_a_masonry_from_before_the_import_digest_is_described_by_its_files(monkeypatch):
+    """A worker whose masonry has no SOURCE_DIGEST: the probe hashes its files, as that masonry did."""
+    import masonrycli
+    from masonrycli.source_digest import source_digest
+
+    digest = masonrycli.SOURCE_DIGEST
+    assert source_digest() == digest  # the files are those imported
+    monkeypatch.delattr(masonrycli, "SOURCE_DIGEST")
+    assert this_version() == (masonrycli.__version__, digest)
 
 
 class _Opened:

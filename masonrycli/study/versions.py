@@ -15,8 +15,10 @@ The probe is run on every worker with ``Client.run``. It is built inside :func:`
 cloudpickle sends its code by value (a module-level function would be sent as a reference to
 ``masonrycli.study.versions``, which a worker without masonry, or with an older one, cannot import);
 it imports only the standard library before it looks for masonry. The same probe describes this
-process, so both sides are measured the same way. Its answer is computed once per process and kept on
-the imported ``masonrycli`` module (hashing the source takes milliseconds; once per run would add up).
+process, so both sides are measured the same way. The digest is :data:`masonrycli.SOURCE_DIGEST`, taken
+when the process imported masonry (:mod:`masonrycli.source_digest`): of the code it runs, not of the files
+on disk when asked — a long-lived worker whose checkout changed since it started reported the new files
+while running the old code. A worker whose masonry predates it is described by its files as they are.
 
 The check before the study asks the workers present then, and waits at most :data:`PROBE_TIMEOUT`
 for them (a worker inside a long numba call answers only when the call ends: the command waited as
@@ -30,6 +32,7 @@ masonry answers too instead of failing to read them.
 from __future__ import annotations
 
 from masonrycli.errors import InputError
+from masonrycli.source_digest import source_digest
 
 PROBE_TIMEOUT = 60.0
 """s: how long the check before a study waits for every worker's answer."""
@@ -38,33 +41,19 @@ PROBE_TIMEOUT = 60.0
 def _make_probe():
     """The probe: a function of no arguments returning ``(version, source digest)``, or ``(None, why)``
     when masonry cannot be imported. Nested so that it travels by value (module doc)."""
+    digest_of = source_digest  # travels with the probe, by value (masonrycli.source_digest)
 
     def probe():
-        import hashlib
         import importlib
-        import os
 
         try:
             packages = [importlib.import_module(name) for name in ("masonrycli", "geometry_library")]
         except Exception as exc:  # noqa: BLE001 - any failure to import is "no usable masonry"
             return None, f"{type(exc).__name__}: {exc}"
-        known = getattr(packages[0], "_masonry_probe_answer", None)  # once per process (module doc)
-        if known is not None:
-            return known
-        digest = hashlib.sha256()
-        for package in packages:
-            root = os.path.dirname(os.path.abspath(package.__file__))
-            sources = []
-            for folder, subfolders, names in os.walk(root):  # lazily, so the pruning below takes effect
-                subfolders[:] = [d for d in subfolders if d != "__pycache__"]
-                sources += [os.path.relpath(os.path.join(folder, n), root) for n in names if n.endswith(".py")]
-            for relative in sorted(sources):  # one order on every machine, whatever the file system's
-                digest.update(f"{package.__name__}/{relative}".encode() + b"\0")
-                with open(os.path.join(root, relative), "rb") as fh:
-                    digest.update(fh.read())
-        answer = str(getattr(packages[0], "__version__", "unknown")), digest.hexdigest()[:12]
-        packages[0]._masonry_probe_answer = answer
-        return answer
+        digest = getattr(packages[0], "SOURCE_DIGEST", None)  # of the source it imported (module doc)
+        if digest is None:  # a masonry from before SOURCE_DIGEST: its files as they are now
+            digest = digest_of()
+        return str(getattr(packages[0], "__version__", "unknown")), digest
 
     return probe
 
