@@ -36,6 +36,14 @@ def special_file(path) -> bool:
     return not (stat.S_ISREG(mode) or stat.S_ISDIR(mode))
 
 
+def not_utf8(name: str, raw: bytes, exc: UnicodeDecodeError) -> InputError:
+    """The error for a text input that is not UTF-8: a UTF-16 file (Excel's "Unicode Text", Notepad's
+    "Unicode") is named as such, where "not a UTF-8 text file (byte 0)" left the user to guess."""
+    if raw[:2] in (b"\xff\xfe", b"\xfe\xff"):
+        return InputError(f"{name}: a UTF-16 text file (it starts with UTF-16's byte-order mark); save it as UTF-8")
+    return InputError(f"{name}: not a UTF-8 text file (byte {exc.start})")
+
+
 def one_line(text: str) -> str:
     """``text`` on one line: every run of whitespace (newlines included) becomes one space."""
     return " ".join(str(text).split())

@@ -18,7 +18,7 @@ import re
 
 import numpy as np
 
-from masonrycli.errors import NOT_A_FILE, InputError, special_file
+from masonrycli.errors import NOT_A_FILE, InputError, not_utf8, special_file
 from masonrycli.motion import Record
 from masonrycli.record_units import check_at2_header, check_at2_sample, check_csv_header
 from masonrycli.values import format_value, quote_string, shorten
@@ -103,7 +103,7 @@ def _read_text(path, name: str) -> str:
     try:
         return raw.decode("utf-8-sig")
     except UnicodeDecodeError as exc:
-        raise InputError(f"{name}: not a UTF-8 text file (byte {exc.start})") from None
+        raise not_utf8(name, raw, exc) from None
 
 
 # "NPTS=  3930, DT=   .0100 SEC" (NGA-West2) or "3930   0.0100   NPTS, DT" (older NGA files)

@@ -19,7 +19,7 @@ from pathlib import Path
 import numpy as np
 
 from geometry_library.blocks import Assembly, Block, GeometryError, Support
-from masonrycli.errors import NOT_A_FILE, InputContext, InputError, one_line, special_file
+from masonrycli.errors import NOT_A_FILE, InputContext, InputError, not_utf8, one_line, special_file
 from masonrycli.motion import MOTION_KINDS, Fixed, Motion
 from masonrycli.records import record_fields
 from masonrycli.scenario import Material, RunConfig, Scenario, block_speed_problem
@@ -72,7 +72,7 @@ def load_scenario(path) -> Scenario:
     try:
         text = raw.decode("utf-8-sig")  # tolerate the byte-order mark some Windows editors add
     except UnicodeDecodeError as exc:
-        raise InputError(f"{fname}: not a UTF-8 text file (byte {exc.start})") from None
+        raise not_utf8(fname, raw, exc) from None
     base_dir = os.path.dirname(os.path.abspath(fname))
     return loads_scenario(text, source=fname, base_dir=base_dir, default_name=Path(fname).stem)
 

@@ -86,6 +86,16 @@ def test_load_record_csv_unreadable(tmp_path):
     assert "latin1.csv: not a UTF-8 text file" in one_line(exc)
 
 
+def test_a_utf16_record_is_named_as_such(tmp_path):
+    # Excel's "Unicode Text" export is UTF-16 with a byte-order mark: "not a UTF-8 text file (byte 0)" left the
+    # user to guess what byte 0 was.
+    f = tmp_path / "excel.csv"
+    f.write_bytes("time\tv\n0\t0\n0.1\t0.1\n".encode("utf-16"))
+    with pytest.raises(InputError) as exc:
+        load_record_csv(f)
+    assert one_line(exc) == f"{f}: a UTF-16 text file (it starts with UTF-16's byte-order mark); save it as UTF-8"
+
+
 def test_a_pipe_or_a_device_is_refused_without_reading_it(tmp_path):
     # "--record /dev/zero" read for ever (memory growing) and a named pipe blocked in open() waiting for a
     # writer: the command hung before its first line. The read runs in a thread so that the old hang fails

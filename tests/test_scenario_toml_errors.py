@@ -285,3 +285,9 @@ def test_unreadable_files(tmp_path):
     (tmp_path / "latin.toml").write_bytes(b'name = "caf\xe9"\n')
     with pytest.raises(InputError, match=r"latin\.toml: not a UTF-8 text file"):
         load_scenario(tmp_path / "latin.toml")
+    utf16 = tmp_path / "utf16.toml"  # Windows' Notepad "Unicode": "not a UTF-8 text file (byte 0)" before
+    utf16.write_bytes(BLOCK.encode("utf-16"))
+    with pytest.raises(
+        InputError, match=r"utf16\.toml: a UTF-16 text file \(it starts with UTF-16's byte-order mark\)"
+    ):
+        load_scenario(utf16)
