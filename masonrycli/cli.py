@@ -268,7 +268,7 @@ def limit_command(
 @with_options(RUN, STOP, FRICTION, OUTPUT, FORCE, RECORD)
 def check_command(scenario_file: ScenarioFile, **opts) -> None:
     """Validate what `masonry run` would run, with the same arguments, and print a summary (blocks,
-    supports, mass, bounding box, steps, outputs); nothing is computed or written."""
+    supports, mass, bounding box, steps, the loading, outputs); nothing is computed or written."""
     from masonrycli.execute import plan_outputs
     from masonrycli.scenario import check_sampling, record_warnings, scenario_summary
 
@@ -292,6 +292,9 @@ def check_command(scenario_file: ScenarioFile, **opts) -> None:
     table.add_row(
         "time", f"{info['duration']:g} s in {info['n_steps']} steps of {info['dt']:g} s, θ = {info['theta']:g}"
     )
+    # the loading, as run will apply it (a --record and its --scale included): it was not shown at all
+    driven = [f"{m['name']}: {m['motion']}" for m in info["support_motions"] if m["role"] != "fixed"]
+    table.add_row("loading", "\n".join(driven) or "none (every support fixed)")
     for out_file in outputs.files():
         table.add_row("recording" if out_file.option == "--out" else "history", str(out_file.path))
     console.print(table)

@@ -106,8 +106,25 @@ def test_check_prints_summary():
         "friction": f"{doc['material']['friction']:g}",
         "time": f"{run['duration']:g} s in {round(run['duration'] / run['dt'])} steps of {run['dt']:g} s, "
         f"θ = {run['theta']:g}",
+        "loading": "none (every support fixed)",
     }
     assert rows["total mass"] == "800 kg"  # 5 blocks of 0.4 x 0.2 m at 2000 kg/m³
+
+
+def test_check_shows_how_each_support_moves(tmp_path):
+    # `check` showed blocks, mass, time and outputs but not the loading: with --record q.AT2 --scale 0.5 nothing
+    # on the screen said which supports the record drives, at what scale, how long it is.
+    from synthetic_records import write_at2
+
+    at2 = tmp_path / "q.AT2"
+    write_at2(at2, 0.1 * np.sin(np.linspace(0.0, 6.0, 200)), 0.01)
+    result = invoke("check", DATA / "quake_record.toml", "--record", at2, "--scale", 0.5)
+    assert result.exit_code == 0, result.output
+    said = " ".join(result.output.split())
+    assert "loading │ ground: record of acceleration (q.AT2, 200 samples, 0–1.99 s," in said, said
+    assert "baseline-corrected) × 0.5" in said, said
+    arch = " ".join(invoke("check", DATA / "arch_settlement.toml").output.split())
+    assert "loading │ right-foundation: constant velocity (0, -0.01) m/s" in arch, arch
 
 
 @pytest.mark.parametrize(("command", "name"), [("check", "wall"), ("run", "arch")])
