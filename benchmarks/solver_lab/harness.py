@@ -55,12 +55,13 @@ def _register_optional():
         alm_newton,
         anderson,
         cluster,
+        joint,
         linear,
         newton,
         tnnmg,
     )
 
-    for module in (anderson, newton, alm_newton, cluster, linear, accelerated, tnnmg, alart_curnier):
+    for module in (anderson, newton, alm_newton, cluster, linear, accelerated, tnnmg, alart_curnier, joint):
         METHODS.update(module.METHODS)
 
 
