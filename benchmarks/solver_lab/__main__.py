@@ -1,4 +1,4 @@
-"""Solver lab: ``python -m benchmarks.solver_lab capture|table|clusters|stalled|trajectory|ordinary|newton-ordinary|ordinary-runs|ensemble|hard|hard-methods|handover``
+"""Solver lab: ``python -m benchmarks.solver_lab capture|table|clusters|stalled|trajectory|ordinary|newton-ordinary|joint-ordinary|ordinary-runs|ensemble|hard|hard-methods|handover``
 (see benchmarks/README.md, "Solver lab")."""
 
 from __future__ import annotations
@@ -55,6 +55,11 @@ def main() -> None:
     nwo.add_argument("--variants", nargs="+", default=None)
     nwo.add_argument("--spread", action="store_true", help="also: how far apart two tight solves are")
     nwo.add_argument("--feasibility", action="store_true", help="also: the oracles' impulses against the cone")
+    jor = sub.add_parser("joint-ordinary", help="joint-block Gauss–Seidel on a trajectory sample's ordinary steps")
+    jor.add_argument("--sample", default="nwt-wall-248", help="data/trajectory/SAMPLE")
+    jor.add_argument("--every", type=int, default=1, help="every k-th ordinary step of the sample")
+    jor.add_argument("--repeat", type=int, default=2, help="interleaved timing rounds; CPU-time minimum kept")
+    jor.add_argument("--plain", action="store_true", help="also joint-gs (no momentum)")
     orr = sub.add_parser("ordinary-runs", help="first-stage variants in whole runs (sweeps, unconverged, slips)")
     orr.add_argument("--cases", nargs="+", default=["wall-248"])
     orr.add_argument("--variants", nargs="+", default=None)
@@ -91,6 +96,11 @@ def main() -> None:
         from benchmarks.solver_lab.newton_ordinary import table as newton_table
 
         newton_table(args.sample, args.every, args.variants, args.spread, args.feasibility)
+        return
+    if args.command == "joint-ordinary":
+        from benchmarks.solver_lab.joint_ordinary import table as joint_table
+
+        joint_table(args.sample, args.every, args.repeat, args.plain)
         return
     if args.command == "ordinary":
         from benchmarks.solver_lab.ordinary import table as ordinary_table
