@@ -18,7 +18,8 @@ in detection order (the control rows ``pointwise-…``); ``rounds`` = 2 a cheap 
         for each joint J in detection order:
             r_0 = r_y on J's points
             repeat ≤ rounds: for α in J: the engine's visit (u_free = H_αᵀ v − W_αα r_α, exact local
-                             solve, v += M⁻¹ H_α Δr_α); stop when max_α |W_αα Δr_α| ≤ INNER_TOL
+                             solve, v += M⁻¹ H_α Δr_α); stop when the round moved no point's
+                             velocity u_α = H_αᵀ v by more than INNER_TOL
             e_α = W_αα (r_α − r_0,α) for α in J           (the joint's analogue of the engine's e_α)
         in-sweep residual = sqrt(Σ |e_α|² / C); restart as the engine (growth 1.1: j = 1) ; β = (j−1)/(j+2)
         (check) the lab's law residual of the iterate (law.py, here in the kernel): stop when ≤ target
@@ -50,7 +51,7 @@ from masonrycli.engine._jit import njit
 from masonrycli.engine.nlgs import P_WNN, P_WTN, P_WTT, _local_solve, _push, _relative_velocity
 
 INNER_TOL = 1e-12
-"""m/s: a joint is solved when a round moves none of its points' velocities (|W_αα Δr_α|) by more."""
+"""m/s: a joint is solved when a round moves none of its points' relative velocities u_α by more."""
 ROUNDS_EXACT = 200
 """Most rounds of the inner Gauss–Seidel on one joint (a joint not solved to INNER_TOL by then is counted)."""
 GROWTH = 1.1
@@ -101,6 +102,7 @@ def _joint_sweeps(body, pack, starts, joints, count, mu, target, max_sweeps, rou
     v_prev = v.copy()
     r_prev = r.copy()
     r0 = np.empty((count, 2))
+    u_last = np.empty((count, 2))
     sweeps = 0
     law = -1.0
     last = np.inf
@@ -129,9 +131,12 @@ def _joint_sweeps(body, pack, starts, joints, count, mu, target, max_sweeps, rou
             for c in range(c0, c1):
                 r0[c, 0] = r[c, 0]
                 r0[c, 1] = r[c, 1]
+            for c in range(c0, c1):
+                ut, un = _relative_velocity(v, body[c, 0], body[c, 1], pack, c)
+                u_last[c, 0] = ut
+                u_last[c, 1] = un
             solved = False
             for _ in range(rounds):
-                moved = 0.0
                 for c in range(c0, c1):  # the engine's visit (nlgs._nlgs), written out at one call site
                     a = body[c, 0]
                     b = body[c, 1]
@@ -150,10 +155,16 @@ def _joint_sweeps(body, pack, starts, joints, count, mu, target, max_sweeps, rou
                         _push(v, a, b, pack, c, drt, drn)
                         r[c, 0] = rt
                         r[c, 1] = rn
-                        et = wtt * drt + wtn * drn
-                        en = wtn * drt + wnn * drn
-                        moved = max(moved, et * et + en * en)
                 visits += c1 - c0
+                # Converged when the round left the joint's point velocities where they were: on a face in
+                # stick–stick the two tangential rows nearly coincide (W singular to rounding), and the
+                # impulses drift along that null direction by ~1e-10 N·s a round without moving anything.
+                moved = 0.0
+                for c in range(c0, c1):
+                    ut, un = _relative_velocity(v, body[c, 0], body[c, 1], pack, c)
+                    moved = max(moved, (ut - u_last[c, 0]) ** 2 + (un - u_last[c, 1]) ** 2)
+                    u_last[c, 0] = ut
+                    u_last[c, 1] = un
                 if c1 - c0 == 1 or moved <= INNER_TOL * INNER_TOL:
                     solved = True
                     break
