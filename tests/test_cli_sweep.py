@@ -243,6 +243,20 @@ def test_grid_sweep_state_map_and_histories(block, tmp_path):
     x_labels, y_labels = np.array(axes["Points2D:positions"][:2]), np.array(axes["Points2D:positions"][2:])
     assert list(x_labels[:, 0]) == pytest.approx([0.05, 0.6]) and np.all(x_labels[:, 1] < 0.3)
     assert list(y_labels[:, 1]) == pytest.approx([0.3, 0.8]) and np.all(y_labels[:, 0] < 0.05)
+    # The key names the colours (the recording did not; the PNG has a legend), in the PNG's colours,
+    # in a row under the map's x labels
+    key = {}
+    for ch in chunks:
+        if ch.entity_path == "/study/state_map/key":
+            batch = ch.to_record_batch()
+            key |= {n: batch.column(n).to_pylist() for n in batch.schema.names if ":" in n}
+    from masonrycli.colormap import unpack_rgba
+    from masonrycli.study.curves import STATE_COLOURS, rgb
+
+    assert key["Points2D:labels"][0] == ["intact", "damaged", "collapsed", "failed"]
+    drawn = [tuple(int(v) for v in c[:3]) for c in unpack_rgba(np.array(key["Points2D:colors"][0], np.uint32))]
+    assert drawn == [rgb(STATE_COLOURS[s]) for s in ("intact", "damaged", "collapsed", "")]
+    assert np.all(np.array(key["Points2D:positions"][0])[:, 1] < x_labels[:, 1].min())
     from masonrycli.recording.readback import blueprint_views
 
     assert blueprint_views(tmp_path / "grid.rrd")["state map: amp (m/s) right, friction up"]["kind"] == "2D"

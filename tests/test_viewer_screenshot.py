@@ -141,3 +141,22 @@ def test_the_block_hover_targets_are_small_dots(screenshot):
     a, b = (np.asarray(image_module.open(p).convert("RGB"))[60:1000, :1150].astype(int) for p in (with_dots, without))
     changed = int((np.abs(a - b).sum(axis=-1) > 24).sum())
     assert 0 < changed <= 30 * n_blocks
+
+
+def test_a_recording_of_static_data_alone_is_shown(tmp_path):
+    """A study's state map is all static: no time line. The screenshot waited for one until its timeout
+    (TimeoutError after 300 s on `masonry sweep wall --param freq=1,2,3 --param amp=0.5,1`)."""
+    import time
+    from types import SimpleNamespace
+
+    from masonrycli.recording.study import record_study
+
+    rows = [
+        {"freq": f, "amp": a, "state": s, "status": "completed"}
+        for (f, a), s in zip([(1, 0.5), (1, 1.0), (2, 0.5), (2, 1.0)], ["intact", "damaged", "damaged", "collapsed"])
+    ]
+    axes = [SimpleNamespace(name="freq", values=(1, 2)), SimpleNamespace(name="amp", values=(0.5, 1.0))]
+    rrd = record_study(tmp_path / "map.rrd", "s", rows, SimpleNamespace(axes=axes, find=None), None, "pga", None)
+    start = time.monotonic()
+    assert screenshot_recording(rrd, tmp_path / "map.png", timeout=60, at_open=True) == []
+    assert time.monotonic() - start < 45 and png_size(tmp_path / "map.png") == (1920, 1080)

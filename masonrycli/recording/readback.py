@@ -330,11 +330,18 @@ def screenshot_recording(
                     raise
                 time.sleep(0.2)
         viewer.open(os.path.abspath(rrd_path))
+        loaded_at = None
         while True:  # until the file is loaded and its timelines are known
             state = viewer.get_state()
             recs = [r for r in state.recordings if r.timelines]
-            if not state.loading and recs and state.views:
-                break
+            if not state.loading and state.views and state.recordings:
+                loaded_at = loaded_at or time.monotonic()
+                # a recording of static data alone (a study's state map) has no time line: it waited
+                # for one until the timeout
+                if recs or time.monotonic() - loaded_at > _STATIC_ONLY_WAIT:
+                    break
+            else:
+                loaded_at = None
             if time.monotonic() > deadline:
                 raise TimeoutError(f"viewer did not load {rrd_path} within {timeout} s")
             time.sleep(0.2)
@@ -345,7 +352,7 @@ def screenshot_recording(
                 if isinstance(query, list):
                     entry["ViewContents"]["query"] = [q for q in query if q.removeprefix("+ ") not in without]
             viewer.set_blueprint(layout, of="recording")
-        if not at_open:
+        if not at_open and recs:  # a static-only recording has no time to set
             if time_s is None:
                 line = next((t for r in recs for t in r.timelines if t.name == "sim_time"), None)
                 time_s = 1e-9 * line.end if line is not None and line.end is not None else 0.0
@@ -385,6 +392,9 @@ def screenshot_recording(
         if viewer_pid(viewer) is not None and pid is not None:  # quit failed: end the shim's process group
             with contextlib.suppress(ProcessLookupError, PermissionError):
                 os.killpg(pid, signal.SIGKILL)
+
+
+_STATIC_ONLY_WAIT = 2.0  # s loaded with views but no time line: a recording of static data alone
 
 
 def _settle(viewer, paints: int = 2, pause: float = 0.2) -> None:

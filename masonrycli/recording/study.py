@@ -1,6 +1,6 @@
 """Rerun recording of a study (``masonry sweep --recording study.rrd``).
 
-The state map as coloured points over the two swept parameters (``study/state_map``), the PNG the
+The state map as coloured points over the two swept parameters (``study/state_map``, with a key of its colours), the PNG the
 command also wrote (``study/plot``), and the rows as a markdown table (``study/rows``), all static; the
 fragility curve of a records study (``study/fragility``) and the threshold curve of ``--find``
 (``study/thresholds``) are plots on their own time lines (below). Axes are in the parameters' own units, so a 2-D view shows them
@@ -156,7 +156,11 @@ def _log_state_map(rec, rows: list[dict], names: list[str]) -> None:
         viewer_safe_text(" ".join(f"{n}={r[n]}" for n in names) + f": {r.get('state') or 'failed'}") for r in rows
     ]
     span = np.ptp(pos, axis=0) if len(pos) else np.ones(2)
-    radius = 0.02 * float(max(span.max(), 1e-9))
+    # a fifth of the closest two swept values (either axis): dots of 2 % of the span were specks beside
+    # the labels on a 3 × 2 grid
+    gaps = np.concatenate([np.diff(np.unique(pos[:, k])) for k in range(2)]) if len(pos) else np.zeros(0)
+    gaps = gaps[gaps > 0]
+    radius = max(0.2 * float(gaps.min()) if gaps.size else 0.0, 0.02 * float(max(span.max(), 1e-9)))
     points = rr.Points2D(pos, colors=colours, labels=labels, radii=radius, show_labels=False)
     rec.log("study/state_map", points, static=True)
     # The axes, as drawn labels (a 2-D view has none): each swept value once, below the lowest row and
@@ -181,6 +185,21 @@ def _log_state_map(rec, rows: list[dict], names: list[str]) -> None:
         show_labels=True,
     )
     rec.log("study/state_map/axes", axes, static=True)
+    # The key, a row under the map's x labels (the PNG's legend): the map's colours were not named in
+    # the recording. (Right of the map, the view's fit cut it in half.)
+    if len(pos):
+        step = max(0.15 * float(max(span.max(), 1e-9)), 4.5 * radius)  # a label sits under its dot
+        states = ("intact", "damaged", "collapsed", "")
+        x0, width = float(pos[:, 0].min()), max(float(span[0]), 3.0 * step)
+        y0 = float(pos[:, 1].min()) - 0.12 * float(max(span[1], 1e-9)) - step
+        key = rr.Points2D(
+            np.array([[x0 + i * width / 3.0, y0] for i in range(len(states))], np.float32),
+            colors=np.array([STATE_RGBA[s] for s in states], dtype=np.uint8),
+            labels=[s or "failed" for s in states],
+            radii=radius,
+            show_labels=True,
+        )
+        rec.log("study/state_map/key", key, static=True)
 
 
 def fragility_timeline(im: str) -> str:
