@@ -63,7 +63,10 @@ def sweep_command(
         float | None, typer.Option("--rtol", help="Relative width at which --find stops bisecting (default 0.005).")
     ] = None,
     out: Annotated[
-        Path | None, typer.Option("--out", "-o", help="Results, .parquet or .csv (one row per run).")
+        Path | None,
+        typer.Option(
+            "--out", "-o", help="Results, .parquet or .csv (one row per run; default study-<scenario>.parquet)."
+        ),
     ] = None,
     scheduler: Annotated[
         str | None, typer.Option("--scheduler", help="Address of an existing Dask scheduler, tcp://HOST:8786.")
@@ -84,7 +87,10 @@ def sweep_command(
     im: Annotated[
         str, typer.Option("--im", help="Intensity measure of the fragility curve: pga, pgv, arias, sa.")
     ] = "pga",
-    plot: Annotated[Path | None, typer.Option("--plot", help="PNG of the state map / fragility / thresholds.")] = None,
+    plot: Annotated[
+        Path | None,
+        typer.Option("--plot", help="PNG of the state map / fragility / thresholds (default: beside --out, .png)."),
+    ] = None,
     recording: Annotated[
         Path | None, typer.Option("--recording", help="Rerun recording of the study (default: beside --out, .rrd).")
     ] = None,

@@ -57,6 +57,15 @@ def test_simulate_help_lists_only_what_the_structure_takes_with_its_defaults():
         assert "(default 2" in options["--freq"]
 
 
+def test_sweep_help_gives_the_default_file_names():
+    # --out and --plot said nothing of where the table and the picture go when not given (study-<scenario>.parquet
+    # in the working folder, the plot beside it), while --recording did
+    options = _option_help(["sweep"])
+    assert "default study-<scenario>.parquet" in options["--out"]
+    assert "(default: beside --out, .png)" in options["--plot"]
+    assert "(default: beside --out, .rrd)" in options["--recording"]
+
+
 def test_simulate_wall_short_run_writes_recording_and_history(tmp_path):
     rrd, npz = tmp_path / "wall.rrd", tmp_path / "wall.npz"
     result = invoke("simulate", "wall", "--freq", 2, "--amp", 1, "--duration", 0.05, "--out", rrd, "--history", npz)
