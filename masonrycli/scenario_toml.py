@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import dataclasses
 import difflib
+import math
 import os
 import tomllib
 from pathlib import Path
@@ -340,9 +341,18 @@ def _parse_motion(table, ctx: InputContext, loc: str) -> Motion:
         except InputError as exc:
             raise ctx.error(loc, str(exc)) from None
     try:
-        return cls(**args)
+        motion = cls(**args)
     except InputError as exc:
         raise ctx.error(loc, f"motion.{exc}") from None
+    if kind == "sine" and motion.frequency == 0.0 and motion.amplitude and abs(math.sin(motion.phase)) < 1e-12:
+        # it ran: amplitude · sin(0) = 0, the ground never moved ("intact"); --freq 0 --amp 1 was refused
+        raise ctx.error(
+            loc,
+            f"motion.frequency = {format_value(table['frequency'])}: the velocity {motion.amplitude:g} m/s · "
+            f"sin(2π·0·t + {motion.phase:g}) is 0, nothing moves (amplitude = 0 for no shaking; a steady velocity "
+            'is kind = "constant")',
+        )
+    return motion
 
 
 # --------------------------------------------------------------------------------------------------

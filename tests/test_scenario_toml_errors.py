@@ -215,6 +215,12 @@ MOTION_ERRORS = [
     ),
     ('{ kind = "record", file = 3 }', "motion.file = 3: must be a file name"),
     ('"sine"', 'motion = "sine": must be a table'),
+    # it ran: 1 m/s · sin(2π·0·t) is 0, the ground never moved, "intact" (--freq 0 --amp 1 is refused)
+    (
+        '{ kind = "sine", amplitude = 1.0, frequency = 0.0 }',
+        "motion.frequency = 0.0: the velocity 1 m/s · sin(2π·0·t + 0) is 0, nothing moves (amplitude = 0 for no "
+        'shaking; a steady velocity is kind = "constant")',
+    ),
     # these said "must be 2 numbers [x, y]" (a window is [start, end]; a 1-component value a number) and
     # file = "." "not a regular file (a device, a pipe or a socket)" (a folder)
     (
