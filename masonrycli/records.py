@@ -83,10 +83,12 @@ def load_record_csv(path, display: str | None = None) -> tuple[np.ndarray, np.nd
 def _fields(line: str) -> list[str]:
     """The fields of a CSV line. A line with ``;`` is split on ``;`` alone and its decimal commas read as
     points (``0;0,5``, a European spreadsheet's CSV): split on commas too, it was taken for a
-    (time, x, y) record, 0,5 becoming x = 0, y = 5 m/s, and the run said completed."""
-    if ";" not in line:
+    (time, x, y) record, 0,5 becoming x = 0, y = 5 m/s, and the run said completed. A line with a tab
+    and a comma is split on tabs alone likewise (``0<TAB>0,5``, the spreadsheet's tab-delimited text)."""
+    separator = ";" if ";" in line else "\t" if "\t" in line and "," in line else None
+    if separator is None:
         return [f for f in _SPLIT.split(line) if f != ""]
-    fields = [f.strip() for f in line.split(";") if f.strip() != ""]
+    fields = [f.strip() for f in line.split(separator) if f.strip() != ""]
     return [f.replace(",", ".") if f.count(",") == 1 and "." not in f else f for f in fields]
 
 

@@ -44,6 +44,18 @@ def test_semicolon_csv_has_decimal_commas(tmp_path):
         load_record_csv(f, display="eu.csv")
 
 
+def test_tab_separated_csv_has_decimal_commas(tmp_path):
+    # Excel's "Text (Tab delimited)" in a European locale: "0\t0,5" was split on the comma too and read as a
+    # (time, x, y) record (0, 0, 5): a vertical ground velocity of 5 m/s, without a word
+    f = tmp_path / "eu.txt.csv"
+    f.write_text("time\tvelocity\n0\t0,0\n1\t0,5\n2\t1,0\n3\t-0,25\n")
+    t, v = load_record_csv(f)
+    np.testing.assert_array_equal(t, [0.0, 1.0, 2.0, 3.0])
+    np.testing.assert_array_equal(v, [0.0, 0.5, 1.0, -0.25])
+    f.write_text("0.0\t1.5\n0.5\t2.5\n")  # points stay points
+    np.testing.assert_array_equal(load_record_csv(f)[1], [1.5, 2.5])
+
+
 def test_record_motion_source_is_absolute():
     m = record_motion(DATA / "quake_velocity.csv", scale=2.0)
     assert Path(m.source).is_absolute() and Path(m.source).name == "quake_velocity.csv"
