@@ -49,6 +49,18 @@ def test_no_friction_gives_zero_not_minus_zero(column_file):
     assert str(data["load_factor"]) == "0.0" and str(data["collapse_load_N"]) == "0.0"
 
 
+def test_verify_at_zero_lambda_says_there_is_nothing_to_verify(column_file):
+    # λ = 0 (frictionless): --verify ran the unloaded column twice, "0.95" and "1.05" × 0, and printed a red
+    # "no" under "predicted" for the second (it stands: no load at all), exit 0, no word why.
+    result = invoke("limit", column_file, "--friction", "0", "--verify")
+    said = " ".join(result.output.split())
+    assert result.exit_code == 0, result.output
+    assert "--verify: λ = 0, so 0.95 λ and 1.05 λ are both the unloaded structure: nothing to verify" in said, said
+    assert "predicted" not in said
+    data = json.loads(runner.invoke(app, ["limit", str(column_file), "--friction", "0", "--verify", "--json"]).stdout)
+    assert data["verify"] == []
+
+
 def test_point_load_on_a_named_block(column_file):
     result = runner.invoke(app, ["limit", str(column_file), "--load", "point", "--block", "b2", "--json"])
     data = json.loads(result.stdout)

@@ -209,7 +209,7 @@ def run_limit(
         return
     if not verify:
         console.print(result_table(result, out))
-    else:
+    elif checks:
         console.print(verify_table(checks))
 
 
@@ -247,6 +247,17 @@ def _analyse(structure, live, friction, verify, out, force, done: _Done, signals
                 write_recording(done.result, part)
             done.out = target.path
     if not verify:
+        return []
+    if done.result.load_factor <= 1e-12:
+        # 0.95 λ and 1.05 λ are the same unloaded structure: the engine ran it twice and the second row read a
+        # red "no" under "predicted" (it stands: there is no load)
+        if console is not None:
+            console.print(result_table(done.result, done.out))
+        err_console.print(
+            "--verify: λ = 0, so 0.95 λ and 1.05 λ are both the unloaded structure: nothing to verify "
+            "(a joint slides or opens under any live load)",
+            soft_wrap=True,
+        )
         return []
     from masonrycli.limit.verify import verify as run_verify
 
