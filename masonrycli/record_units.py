@@ -11,7 +11,7 @@ what and where; a header that names none is taken at its word (PEER's format is 
 * .AT2 samples (:func:`check_at2_sample`): beyond ``MAX_AT2_G`` (10 g) they are not g — cm/s² under a
   header that says g, or a header that names no unit.
 * CSV (:func:`check_csv_header`), the one text line allowed before the samples: times in ms; an
-  acceleration header read as velocity or the reverse; cm/s, mm/s, g, gal or cm/s² values read with
+  acceleration header read as velocity or the reverse; cm/s, mm/s, in/s, ft/s, g, gal, cm/s², in/s² or ft/s² values read with
   scale 1 (a scale other than 1 is taken as the conversion).
 
 The patterns look for whole words, so ``time_ms`` and ``acc (g)`` match but ``rms`` and ``ground`` do not.
@@ -65,8 +65,11 @@ def _words(*alternatives: str) -> re.Pattern:
 
 
 _TIME_MS = _words("ms", "msec", "milliseconds?")
-_ACCELERATION = _words("acc", "accel", "accn", "accelerations?", r"m/s\^?2", "m/s²", "m/s/s", "gal", "g", r"cm/s\^?2")
-_VELOCITY = _words("vel", "velocity", "velocities", "speed", "m/s", "cm/s", "mm/s")
+_ACCELERATION = _words(
+    "acc", "accel", "accn", "accelerations?", r"m/s\^?2", "m/s²", "m/s/s", "gal", "g", r"cm/s\^?2",
+    r"in/s\^?2", "in/s²", r"ft/s\^?2", "ft/s²",
+)  # fmt: skip
+_VELOCITY = _words("vel", "velocity", "velocities", "speed", "m/s", "cm/s", "mm/s", "in/s", "ft/s")
 # units that need a scale to be SI: unit -> (quantity, the factor to m/s or m/s²)
 _SCALED = {
     "cm/s": ("velocity", 0.01),
@@ -75,6 +78,15 @@ _SCALED = {
     "gal": ("acceleration", 0.01),
     "cm/s2": ("acceleration", 0.01),
     "cm/s^2": ("acceleration", 0.01),
+    # US units: read as SI they were 39x (in) and 3.3x (ft) too large, without a word
+    "in/s": ("velocity", 0.0254),
+    "ft/s": ("velocity", 0.3048),
+    "in/s2": ("acceleration", 0.0254),
+    "in/s^2": ("acceleration", 0.0254),
+    "in/s²": ("acceleration", 0.0254),
+    "ft/s2": ("acceleration", 0.3048),
+    "ft/s^2": ("acceleration", 0.3048),
+    "ft/s²": ("acceleration", 0.3048),
 }
 _SCALED_UNIT = _words(*(re.escape(u) for u in _SCALED))
 

@@ -30,6 +30,17 @@ SAMPLES = "0,0\n0.01,0.5\n0.02,0.1\n"
         ("time,acc (g)", "acceleration", 1.0, 'acceleration in g ("time,acc (g)") but the samples are read in m/s²'),
         ("time,a [gal]", "acceleration", 1.0, "acceleration in gal"),
         ("time,a [cm/s2]", "acceleration", 1.0, "acceleration in cm/s2"),
+        # US units were read as SI without a word: in/s 39x, ft/s 3.3x too large
+        (
+            "time,vel (in/s)",
+            "velocity",
+            1.0,
+            'velocity in in/s ("time,vel (in/s)") but the samples are read in m/s (a scale of 0.0254',
+        ),
+        ("time,v [ft/s]", "velocity", 1.0, "velocity in ft/s"),
+        ("time,acc (in/s^2)", "acceleration", 1.0, "acceleration in in/s^2"),
+        ("time,a (ft/s2)", "acceleration", 1.0, "(a scale of 0.3048 converts them)"),
+        ("time,acc (in/s2)", "velocity", 1.0, "the header says acceleration"),
     ],
 )
 def test_header_disagreeing_with_the_reading_is_one_line(tmp_path, header, quantity, scale, expected):
@@ -50,6 +61,8 @@ def test_header_disagreeing_with_the_reading_is_one_line(tmp_path, header, quant
         ("time,acc (g)", "acceleration", 9.80665),
         ("time, acc [m/s^2]", "acceleration", 1.0),
         ("time,items", "acceleration", 1.0),
+        ("time,vel (in/s)", "velocity", 0.0254),
+        ("time (s), position in s-curve", "velocity", 1.0),
     ],
 )
 def test_header_that_agrees_or_names_nothing_is_read(tmp_path, header, quantity, scale):
