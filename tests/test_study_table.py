@@ -42,6 +42,19 @@ def test_at_80_columns_every_row_is_one_line_within_the_width():
     assert "failed: record=synthetic-record-2.AT2 scale=1.75: ValueError: a long reason" in legend
 
 
+def test_a_long_record_name_leaves_room_for_the_state(tmp_path):
+    # A PEER-style name of 60 characters took the whole 80 columns: "state" read "inta…", every other column
+    # was dropped ("not shown at this width: collapse, drift, pga, open, …")
+    name = "RSN6_IMPVALL.I_I-ELC180_very_long_station_name_component.AT2"
+    rows = [_row(name, 0.5, "intact"), _row("b.AT2", 1.0, "collapsed", collapse_time=0.5349)]
+    lines = _render(rows, grid_columns(["record", "scale"], "pga"), ["record", "scale"], 80)
+    assert max(len(line) for line in lines) <= 80
+    body = [line for line in lines if line.startswith("│")]
+    assert "│ intact " in body[0] and "│ collapsed │ 0.53 " in body[1], lines
+    assert body[0].startswith("│ RSN6_IMPVALL") and "component.AT2 │" in body[0]  # both ends of the name kept
+    assert "every column in ida.parquet" in " ".join(" ".join(lines).split())
+
+
 def test_a_wide_console_shows_every_column_and_the_units():
     lines = _render(ROWS, grid_columns(["record", "scale"], "pga"), ["record", "scale"], 200)
     header = next(line for line in lines if "record" in line and "state" in line)

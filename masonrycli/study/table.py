@@ -56,11 +56,25 @@ def _param(value) -> str:
     return "" if value is None else str(value)
 
 
+NAME_WIDTH = 28
+"""Characters of a text parameter (a record's file name) shown in a cell: a PEER name of 60 took the whole
+80 columns, the state read "inta…" and every other column was dropped."""
+
+
+def _short(text: str) -> str:
+    """``text`` cut in the middle to ``NAME_WIDTH`` (both ends tell records apart: the event, the component)."""
+    if len(text) <= NAME_WIDTH:
+        return text
+    head = (NAME_WIDTH - 1) // 2
+    return text[:head] + "…" + text[-(NAME_WIDTH - 1 - head) :]
+
+
 def _params(names: list[str]) -> list[Column]:
     columns = []
     for n in names:
         unit = PARAM_UNITS.get(n.rpartition(".")[2])
-        columns.append(Column(n, lambda r, n=n: _param(r.get(n)), f"{n} {unit}" if unit else ""))
+        cell = lambda r, n=n: _short(_param(r.get(n))) if isinstance(r.get(n), str) else _param(r.get(n))  # noqa: E731
+        columns.append(Column(n, cell, f"{n} {unit}" if unit else ""))
     return columns
 
 
