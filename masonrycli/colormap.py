@@ -9,8 +9,12 @@ Rerun has no colormap for geometry, so block fills are coloured here. Colours ar
 - ``BLUES`` (sequential, dark blue at the most negative end, near white at 0) for fields that are
   <= 0 (the spherical stress p: compression is blue, as on the diverging map);
 - ``NAN_RGBA`` (mid grey) for a value that is NaN (a block with no triangle, no contact...);
-- ``UNDER_RGBA`` (black) and ``OVER_RGBA`` (white) for values beyond the range's low / high end — a
-  colour no map uses, so an over-range cell never passes for an end-of-range one.
+- ``UNDER_RGBA`` (magenta) and ``OVER_RGBA`` (lime green) for values beyond the range's low / high end:
+  colours far from every map's (CIE76 ΔE >= 45 from every entry of the three maps and the NaN grey), so one
+  rule serves all fields and an out-of-range cell never passes for an end-of-range one. They were black and
+  white: white is ΔE 3 from the top of ``BLUES`` (p = 0), so on the spherical-stress scale "above the range"
+  read as "0 kPa". Not black (the compression glyphs are near black) nor the tension glyphs' darker magenta
+  for "above" (a cell above the p range is in tension, where those glyphs are drawn).
 """
 
 from __future__ import annotations
@@ -79,8 +83,8 @@ COOLWARM: Final = pack_rgba(make_lut(_COOLWARM_STOPS))
 BLUES: Final = pack_rgba(make_lut(_BLUES_STOPS))
 """(256,) uint32: sequential, dark blue (low, most negative) to near white (high, zero)."""
 NAN_RGBA: Final = int(pack_rgba(np.array([128, 128, 128])))
-UNDER_RGBA: Final = int(pack_rgba(np.array([0, 0, 0])))
-OVER_RGBA: Final = int(pack_rgba(np.array([255, 255, 255])))
+UNDER_RGBA: Final = int(pack_rgba(np.array([255, 0, 255])))
+OVER_RGBA: Final = int(pack_rgba(np.array([0, 255, 0])))
 
 
 def map_scalars(values: np.ndarray, lo: float, hi: float, lut: np.ndarray, nan_rgba: int = NAN_RGBA) -> np.ndarray:

@@ -295,6 +295,20 @@ def test_fill_colours_follow_the_field_with_ranges_that_follow_the_data(tmp_path
         assert len(set(ranges)) >= 2  # the data grew 20×: the range followed
 
 
+def test_colour_bar_end_caps_stand_apart_from_the_bar(written):
+    """Each field's bar as recorded: the below / above caps (the last 6 vertices) are far from every colour
+    of the bar (the spherical-stress bar's top, 0 kPa, and its white "above" cap read as one)."""
+    from test_colormap import min_distances
+
+    path = written[0]
+    for f in FIELDS:
+        colours = np.array(static_value(path, f"/{f.bar}", "Mesh3D:vertex_colors"), dtype=np.uint32)
+        bar, caps = colours[:-6], colours[-6:]
+        for cap in set(caps.tolist()):
+            delta_e, rgb = min_distances(cap, bar)
+            assert delta_e > 40.0 and rgb > 100.0, (f.key, hex(cap), delta_e, rgb)
+
+
 def test_nan_field_values_are_grey(written):
     path, static, frames, _ = written
     spec = rec_mod.layout.FIELD_BY_KEY["cell_volumetric_strain_rate"]

@@ -116,8 +116,8 @@ def legend_markdown(force_scale: float | None, block_height: float, magnify: flo
         "- **Joint forces**: one arrow per joint, the resultant of its contact forces on the body above it, "
         f"centred on its point of application (line of thrust); length proportional to the force, {scale}. Green = sticking, "
         "orange = sliding, red = open at one end (turning about the other). Yellow dots: hinges.\n"
-        "- **Fills**: colour bar beside the structure; grey = undefined (NaN), black = below the range, "
-        "white = above it. Small dark dots: the blocks' centroids; hover one for the block's name and values.\n"
+        "- **Fills**: colour bar beside the structure; grey = undefined (NaN), magenta = below the range, "
+        "lime green = above it. Small dark dots: the blocks' centroids; hover one for the block's name and values.\n"
         f"- **Magnified deformed shape**: displacements and rotations {factor}; grey = as built."
     )
 
