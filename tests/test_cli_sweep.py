@@ -97,8 +97,10 @@ def check_fragility_reads_as_a_plot(rrd: Path, rows: list[dict]) -> None:
 
     from masonrycli.recording.readback import blueprint_views
 
-    # the view's name gives its axes (the plot draws none): "#2000" on x was 2 m/s² of pga
-    assert blueprint_views(rrd)["fragility: P(collapse) against pga (mm/s²)"]["kind"] == "TimeSeries"
+    # the view's name gives its axes (the plot draws none) and how to read the x ticks, "#2000" (2 m/s² of
+    # pga): the name said "pga (mm/s²)" alone
+    name = "fragility: P(collapse) against pga in mm/s² (#1000 = 1 m/s²)"
+    assert blueprint_views(rrd)[name]["kind"] == "TimeSeries"
     assert panel_states(rrd) == {"/blueprint_panel": "collapsed", "/selection_panel": "collapsed"}
     reader = rr.chunk.RrdReader(str(rrd))
     layout = {}
@@ -167,10 +169,11 @@ def test_find_threshold_curve_reads_as_a_plot(block, tmp_path):
     rows = read_rows(out)
     found = {r["friction"]: r["amp_threshold"] for r in rows}
     assert len(found) == 2 and all(np.isfinite(v) for v in found.values())
-    assert blueprint_views(rrd)["thresholds: amp (m/s) against friction (/1000)"]["kind"] == "TimeSeries"
+    # how to read the x ticks "#100 … #200" (the name said "friction (/1000)")
+    assert blueprint_views(rrd)["thresholds: amp (m/s) against friction × 1000 (#1000 = 1)"]["kind"] == "TimeSeries"
     assert panel_states(rrd) == {"/blueprint_panel": "collapsed", "/selection_panel": "collapsed"}
     layout = blueprint_layout(rrd)
-    timeline = "friction (/1000)"  # a sequence time line is an integer: thousandths of the friction
+    timeline = "friction (×1000)"  # a sequence time line is an integer: thousandths of the friction
     assert layout["TimePanelBlueprint:timeline"] == timeline
     low, high = layout["ScalarAxis:range"]
     assert low == 0.0 and max(found.values()) < high < 2 * max(found.values())

@@ -25,8 +25,13 @@ per scale there).
 
 The threshold curve read flat the same way (``amp_threshold`` 0.08–0.23 m/s against ``blocks`` 12–48
 or ``friction`` 0.1–0.3): it is plotted the same way, against the other swept parameter's own time line
-(``blocks``, whole numbers, in its unit; ``friction (/1000)``, ``freq (mHz)`` in thousandths), y from 0
+(``blocks``, whole numbers, in its unit; ``friction (×1000)``, ``freq (mHz)`` in thousandths), y from 0
 to 1.1 × the largest threshold; the points without one are marked at the searched range's end.
+
+The plot's x ticks read "#1000 … #7000" whatever the time line's name: Rerun 0.41 draws a sequence as
+"#n", a duration as "+n ms", and a time-series view has no x-axis title nor a scalar x axis (a bar chart
+has one, but draws bars). So the view's name states the scale with an example, "pga in mm/s² (#1000 = 1
+m/s²)", "friction × 1000 (#1000 = 1)" (:func:`x_scale`); before, only "(mm/s²)" or "(/1000)" hinted it.
 """
 
 from __future__ import annotations
@@ -70,12 +75,12 @@ def record_study(path: Path, name: str, rows: list[dict], request, fit, im: str,
     # two fifths of it; the plots' time panel stays collapsed, it only names the x axis's time line.
     panels = [rrb.BlueprintPanel(state="collapsed"), rrb.SelectionPanel(state="collapsed")]
     if request.find:
-        timeline, start, end, y_range = _log_thresholds(rec, rows, request.find, names, searched_range(request))
+        timeline, against, start, end, y_range = _log_thresholds(
+            rec, rows, request.find, names, searched_range(request)
+        )
         legend = rrb.PlotLegend(corner="RightBottom")  # below a rising or flat curve (y from 0)
         unit = PARAM_UNITS.get(request.find.rpartition(".")[2], "")
-        title = viewer_safe_text(
-            f"thresholds: {request.find}" + (f" ({unit})" if unit else "") + f" against {timeline}"
-        )
+        title = viewer_safe_text(f"thresholds: {request.find}" + (f" ({unit})" if unit else "") + f" against {against}")
         _time_line_extent(rec, timeline, start, end)
         view, panel = _plot_view("study/thresholds", title, timeline, (start, end), y_range, legend)
         views.insert(0, view)
@@ -90,7 +95,7 @@ def record_study(path: Path, name: str, rows: list[dict], request, fit, im: str,
     else:
         timeline, end = _log_fragility(rec, rows, fit, im)
         legend = rrb.PlotLegend(corner="RightBottom")  # high IM, P = 0: where runs are fewest
-        title = viewer_safe_text(f"fragility: P(collapse) against {timeline}")
+        title = viewer_safe_text(f"fragility: P(collapse) against {x_scale(im, UNITS[im], 1000.0)[1]}")
         view, panel = _plot_view("study/fragility", title, timeline, (0, end), (-0.05, 1.05), legend)
         views.insert(0, view)
         panels.append(panel)
@@ -204,7 +209,19 @@ def _log_state_map(rec, rows: list[dict], names: list[str]) -> None:
 
 def fragility_timeline(im: str) -> str:
     """The sequence time line the fragility curve is plotted on: thousandths of the IM's unit."""
-    return f"{im} (m{UNITS[im]})"
+    return x_scale(im, UNITS[im], 1000.0)[0]
+
+
+def x_scale(name: str, unit: str, per_unit: float) -> tuple[str, str]:
+    """(time line name, what the view's name says of the x axis) for ``name`` in ``unit`` plotted at
+    ``per_unit`` ticks per unit (1 or 1000): the ticks read "#n", so in thousandths the example "#1000 =
+    1 unit" says how to read them (module doc)."""
+    if per_unit == 1.0:
+        timeline = f"{name} ({unit})" if unit else name
+        return timeline, timeline
+    if unit:
+        return f"{name} (m{unit})", f"{name} in m{unit} (#1000 = 1 {unit})"
+    return f"{name} (×1000)", f"{name} × 1000 (#1000 = 1)"
 
 
 def _send_curve(rec, base: str, timeline: str, per_unit: float, series) -> None:
@@ -231,24 +248,23 @@ def _log_fragility(rec, rows: list[dict], fit, im: str) -> tuple[str, int]:
     return timeline, int(np.rint(1200.0 * top)) + 1
 
 
-def _log_thresholds(rec, rows: list[dict], find: str, names: list[str], searched) -> tuple[str, int, int, tuple]:
+def _log_thresholds(rec, rows: list[dict], find: str, names: list[str], searched) -> tuple[str, str, int, int, tuple]:
     """``<find>_threshold`` against the first other swept parameter (the point's index without one) as
     scalars on that parameter's time line (module doc): in its own unit when every value is a whole
-    number (``blocks``), else in thousandths of it (``friction (/1000)``, ``freq (mHz)``); a record name
+    number (``blocks``), else in thousandths of it (``friction (×1000)``, ``freq (mHz)``); a record name
     is drawn by its index. The points without a threshold are marked at the end of the ``searched``
-    range. Returns the time line, the x range in its ticks and the y range."""
+    range. Returns the time line, the view name's x part (:func:`x_scale`), the x range in its ticks and
+    the y range."""
     x = names[0] if names else None
     at, by_name = axis_positions(rows, x)
     if by_name is not None:
         timeline, per_unit = f"{x} (index)", 1.0
+        against = timeline
     else:
         unit = PARAM_UNITS.get(x.rpartition(".")[2], "") if x else ""
         whole = bool(np.all(at[np.isfinite(at)] == np.rint(at[np.isfinite(at)])))
         per_unit = 1.0 if whole else 1000.0
-        name = x or "point"
-        timeline = (
-            (f"{name} ({unit})" if unit else name) if whole else (f"{name} (m{unit})" if unit else f"{name} (/1000)")
-        )
+        timeline, against = x_scale(x or "point", unit, per_unit)
     series = threshold_series(rows, find, at, searched)
     _send_curve(rec, "study/thresholds", timeline, per_unit, series)
     # Every swept point is in the view, found or not, with a margin beside the outermost: the range was
@@ -263,7 +279,7 @@ def _log_thresholds(rec, rows: list[dict], find: str, names: list[str], searched
     top = float(shown.max()) if shown.size else 1.0
     low = float(shown.min()) if shown.size else 0.0
     y_range = (min(0.0, 1.1 * low), 1.1 * top if top > 0 else 1.0)
-    return timeline, x_range[0], x_range[1], y_range
+    return timeline, against, x_range[0], x_range[1], y_range
 
 
 def _markdown(name: str, rows: list[dict]) -> str:
