@@ -6,7 +6,7 @@ The policy (README, "Outputs and overwriting"):
   unless ``--force`` is given. Two outputs naming the same file are refused.
 - Default recording names ``recordings/<name>-<YYYYmmdd-HHMMSS>.rrd`` never collide: a name already on
   disk, or being written by another run, takes ``-2``, ``-3``… Scenario names are reduced to
-  ``[A-Za-z0-9._-]`` so they cannot leave ``recordings/``.
+  letters, digits and ``._-`` so they cannot leave ``recordings/``.
 - Every file is written as a hidden ``.<name>.<pid>.part`` beside its target and renamed onto it when
   complete, so the path holds either the previous file or a complete new one, whatever happens to the
   process. Without ``--force`` the rename cannot replace a file that appeared during the run either (a hard
@@ -27,7 +27,7 @@ from masonrycli.errors import InputError
 
 RECORDINGS_DIR = Path("recordings")
 
-_UNSAFE = re.compile(r"[^A-Za-z0-9._-]+")
+_UNSAFE = re.compile(r"[^\w.-]+")  # \w: letters and digits of any script ("voûte" lost its û), and _
 
 
 def safe_name(name: str) -> str:

@@ -28,7 +28,18 @@ def leftovers(folder: Path) -> list[str]:
 
 
 @pytest.mark.parametrize(
-    "name, stem", [("../../x", "x"), ("a b/c", "a-b-c"), ("..", "run"), ("wall", "wall"), ("/etc/passwd", "etc-passwd")]
+    "name, stem",
+    [
+        ("../../x", "x"),
+        ("a b/c", "a-b-c"),
+        ("..", "run"),
+        ("wall", "wall"),
+        ("/etc/passwd", "etc-passwd"),
+        # a letter is a letter: "voûte-arles" was written recordings/vo-te-arles-….rrd, "mur-é" mur-….rrd
+        ("voûte-arles", "voûte-arles"),
+        ("mur-é", "mur-é"),
+        ("🧱", "run"),
+    ],
 )
 def test_safe_name_stays_in_its_folder(name, stem):
     assert safe_name(name) == stem
