@@ -16,7 +16,7 @@ import typer
 
 from masonrycli.errors import NOT_A_FILE, InputError
 from masonrycli.interrupt import FirstSignalStops, exit_code, signal_name
-from masonrycli.outputs import OutputFile
+from masonrycli.outputs import OutputFile, safe_name
 
 BUILT_IN = ("wall", "arch", "aqueduct")
 SWEEP_DURATION = {"wall": 1.0, "arch": 2.0, "aqueduct": 2.0}
@@ -122,7 +122,8 @@ def sweep_command(
 
     base = StudyBase(_base_scenario(target, duration, dt), {})
     name = base.scenario.name
-    out = store.check_out(out or Path(f"study-{name}.parquet"))
+    # the name reduced as recordings name it: "../../evil" made a folder "study-.." and wrote beside it
+    out = store.check_out(out or Path(f"study-{safe_name(name)}.parquet"))
     axes = [parse_axis(p) for p in param or []]
     late: list[str] = []  # warnings about records longer than the runs
     if records:

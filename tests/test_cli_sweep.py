@@ -397,6 +397,23 @@ def test_a_geometry_file_is_swept_as_run_runs_it(tmp_path):
     assert [r["friction"] for r in read_rows(out)] == [0.5, 0.6]
 
 
+def test_the_default_table_name_stays_in_the_working_folder(tmp_path, monkeypatch):
+    # name = "../../evil" in the scenario file: the default --out "study-../../evil.parquet" made a folder
+    # "study-.." and wrote evil.parquet and evil.png beside it (a name with more "../" left the folder)
+    work = tmp_path / "a" / "b"
+    work.mkdir(parents=True)
+    monkeypatch.chdir(work)
+    (work / "e.toml").write_text('name = "../../evil"\n' + BLOCK)
+    result = invoke("sweep", "e.toml", "-p", "amp=0.1", "--duration", 0.01, "--workers", 0, "--no-recording")
+    assert result.exit_code == 0, result.output
+    assert sorted(p.name for p in work.iterdir()) == ["e.toml", "study-evil.parquet", "study-evil.png"]
+    assert sorted(p.name for p in tmp_path.rglob("*") if p.is_file()) == [
+        "e.toml",
+        "study-evil.parquet",
+        "study-evil.png",
+    ]
+
+
 def test_a_record_given_as_the_study_table_is_refused_not_replaced(block, tmp_path):
     # `--records rec.csv --out rec.csv --force` replaced the record with the study's table (the record lost).
     record = _velocity_csv(tmp_path / "rec.csv")
