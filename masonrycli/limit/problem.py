@@ -28,6 +28,7 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.optimize import linprog
 
+from geometry_library.checks import body_label
 from masonrycli.errors import InputError
 from masonrycli.limit.joints import Joints
 from masonrycli.model import Model
@@ -173,8 +174,10 @@ def _check_supported(model: Model, joints: Joints) -> None:
     body = joints.contact_body.ravel()
     touched[body[body < n]] = True
     if not touched.all():
-        name = model.block_name[int(np.flatnonzero(~touched)[0])]
-        raise LimitError(f"block {name} touches nothing: it has no support, so no equilibrium exists")
+        index = int(np.flatnonzero(~touched)[0])
+        raise LimitError(
+            f"{body_label(index, model.block_name[index])} touches nothing: it has no support, so no equilibrium exists"
+        )
 
 
 def _status_error(status: int, message: str, what: str) -> LimitError:
