@@ -134,7 +134,9 @@ def _loading(name: str, amp, freq, settlement, record, scale) -> dict:
     if record is not None:
         if amp is not None or freq is not None or settlement:
             given = "--amp" if amp is not None else "--freq" if freq is not None else "--settlement"
-            raise InputError(f"--record with {given}: choose one loading (the record replaces the sine)")
+            # a settlement is no sine: "(the record replaces the sine)" said of --settlement read wrong
+            why = "shakes both foundations instead" if given == "--settlement" else "replaces the sine"
+            raise InputError(f"--record with {given}: choose one loading (the record {why})")
         shaken = ("ground",) if name == "wall" else ("left-foundation", "right-foundation")
         motion = record_motion_option(record, scale)
         return {support: motion for support in shaken}
