@@ -47,7 +47,6 @@ from ..checks import COLLINEAR_RTOL, _next, _turn_cross, is_convex, signed_area
 
 DUST = 1e-10  # m², pieces below this are clipping noise
 EXHAUSTIVE = 2  # pieces with at most this many reflex vertices get an exhaustive split search
-_MEMO: dict[bytes, tuple] = {}  # convex_split results of the current spandrel_blocks call
 
 
 def _components(geom) -> list[Polygon]:
@@ -87,7 +86,7 @@ def _shared_length(a: Polygon, b: Polygon) -> float:
 
 
 def _course_blocks(
-    joints: list[float], y0: float, y1: float, region: Polygon, centre: np.ndarray, limits: Limits
+    joints: list[float], y0: float, y1: float, region: Polygon, centre: np.ndarray, limits: Limits, memo: dict
 ) -> list[Polygon]:
     """Steps 1–3 for one course: cut, split into convex blocks, and drop vertical joints next to
     slivers (quality < 1) until none is left or no joint can help."""
@@ -101,7 +100,7 @@ def _course_blocks(
                 cache[(a, b)] = [
                     r
                     for piece in _components(box(a, y0, b, y1).difference(region))
-                    for r in convex_split(_ring(piece), centre, limits)[1]
+                    for r in convex_split(_ring(piece), centre, limits, memo)[1]
                 ]
             parts += [(k, r) for r in cache[(a, b)]]
         small = [
@@ -276,11 +275,15 @@ def _split_key(parts: list[np.ndarray], limits: Limits) -> tuple:
     return (q[0], -len(parts), tuple(q))
 
 
-def convex_split(xy: np.ndarray, centre: np.ndarray, limits: Limits) -> tuple[tuple, list[np.ndarray]]:
+def convex_split(
+    xy: np.ndarray, centre: np.ndarray, limits: Limits, memo: dict | None = None
+) -> tuple[tuple, list[np.ndarray]]:
     """Step 3: split a CCW ring into convex rings by straight cuts from its reflex vertices.
 
     Returns (ranking key, parts) for the best decomposition found: the one whose worst part has
-    the highest :meth:`Limits.quality` (ties: fewer parts, then the next-worst part, ...).
+    the highest :meth:`Limits.quality` (ties: fewer parts, then the next-worst part, ...). ``memo``: ring
+    bytes -> result, shared by the calls of one ``centre`` and ``limits`` (a course splits the same
+    pieces again as its joints are dropped); None: a fresh one.
 
     Pseudo-code::
 
@@ -291,10 +294,11 @@ def convex_split(xy: np.ndarray, centre: np.ndarray, limits: Limits) -> tuple[tu
             decompose both sides recursively
         return the best-ranked decomposition
     """
+    memo = {} if memo is None else memo
     xy = _clean(xy)
     memo_key = xy.tobytes()
-    if memo_key in _MEMO:
-        return _MEMO[memo_key]
+    if memo_key in memo:
+        return memo[memo_key]
     reflex = _reflex(xy)
     if reflex.size == 0:
         return _split_key([xy], limits), [xy]
@@ -306,16 +310,16 @@ def convex_split(xy: np.ndarray, centre: np.ndarray, limits: Limits) -> tuple[tu
         # Many reflex vertices (a fine extrados along a long piece): greedy, to bound the search —
         # take the cut whose two sides rank best as they are, then split those.
         a, b = max(cuts, key=lambda ab: _split_key(list(ab), limits))
-        parts = convex_split(a, centre, limits)[1] + convex_split(b, centre, limits)[1]
+        parts = convex_split(a, centre, limits, memo)[1] + convex_split(b, centre, limits, memo)[1]
         best = (_split_key(parts, limits), parts)
     else:
         best = None
         for a, b in cuts:
-            parts = convex_split(a, centre, limits)[1] + convex_split(b, centre, limits)[1]
+            parts = convex_split(a, centre, limits, memo)[1] + convex_split(b, centre, limits, memo)[1]
             key = _split_key(parts, limits)
             if best is None or key > best[0]:
                 best = (key, parts)
-    _MEMO[memo_key] = best
+    memo[memo_key] = best
     return best
 
 
@@ -349,7 +353,7 @@ def spandrel_blocks(
     hair : m — a sliver that cannot be merged is dropped only if thinner than this.
     """
     limits = Limits(min_fraction * block_length * block_height, min_thickness * block_height)
-    _MEMO.clear()
+    memo: dict[bytes, tuple] = {}
     half = 0.5 * block_length
     mid = 0.5 * (x_min + x_max)
     pieces: list[tuple[int, Polygon]] = []
@@ -364,9 +368,8 @@ def spandrel_blocks(
             for k in range(k_lo, k_hi + 1)
             if (k - shift) % 2 == 0 and x_min + 1e-9 < mid + k * half < x_max - 1e-9
         ]
-        for poly in _course_blocks([x_min, *inner, x_max], y0, y1, region, centre, limits):
+        for poly in _course_blocks([x_min, *inner, x_max], y0, y1, region, centre, limits, memo):
             pieces.append((c, poly))
-    _MEMO.clear()
     pieces = _merge_slivers(pieces, centre, limits, hair)
     pieces.sort(key=lambda cp: (cp[0], cp[1].centroid.x))
     return pieces
@@ -386,6 +389,7 @@ def _merge_slivers(pieces: list[tuple[int, Polygon]], centre: np.ndarray, limits
     """
     pieces = list(pieces)
     kept: set[int] = set()  # ids of slivers we gave up on
+    memo: dict[bytes, tuple] = {}  # convex_split's, for this centre and these limits
     for _ in range(10 * len(pieces) + 10):
         small = [
             (q, k) for k, (c, p) in enumerate(pieces) if (q := limits.quality(_ring(p))) < 1.0 and id(p) not in kept
@@ -403,7 +407,7 @@ def _merge_slivers(pieces: list[tuple[int, Polygon]], centre: np.ndarray, limits
                 continue
             ring = _ring(union)
             try:
-                parts = [ring] if is_convex(ring) else convex_split(ring, centre, limits)[1]
+                parts = [ring] if is_convex(ring) else convex_split(ring, centre, limits, memo)[1]
             except GeometryError:  # a degenerate union (pieces touching at a vertex)
                 continue
             key = _split_key(parts, limits)
