@@ -18,6 +18,8 @@ CONTACT_OPEN, CONTACT_STICK, CONTACT_SLIP = ContactStatus.OPEN, ContactStatus.ST
 
 @dataclass(frozen=True, eq=False)
 class Frame:
+    """The state of a run at one recorded step (module doc); arrays are float64 unless stated."""
+
     step: int
     """Time-step index (0 = initial state)."""
     time: float
@@ -61,6 +63,7 @@ class Frame:
     nlgs_residual: float
     """m/s: RMS contact-law violation of that step's last sweep, the quantity compared with the tolerance."""
     contact_count: int
+    """C, the step's contacts (the length of the ``contact_*`` arrays)."""
     joint_body: np.ndarray = field(default_factory=lambda: np.zeros((0, 2), dtype=np.int64))
     """(J, 2) bodies of each joint (pairs touching along a face initially; see masonrycli.mechanism)."""
     joint_hinged: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=bool))

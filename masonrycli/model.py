@@ -66,7 +66,9 @@ class Model:
     support_velocity: SupportVelocity
     """``support_velocity[k]`` (S, 2) m/s: imposed support velocity at t_k = k·dt, k = 0 … n_steps."""
     block_name: tuple
+    """(N,) str: the blocks' names, scenario order."""
     support_name: tuple
+    """(S,) str: the supports' names, scenario order."""
 
     @property
     def body_count(self) -> int:
@@ -82,7 +84,9 @@ class State:
     body_v: np.ndarray
     """(B, 3) vx, vy (m/s), ω (rad/s)."""
     step: int = 0
+    """Time steps taken since t = 0."""
     time: float = 0.0
+    """Simulated time, s."""
 
     def copy(self) -> State:
         return State(self.body_q.copy(), self.body_v.copy(), self.step, self.time)

@@ -39,16 +39,21 @@ class SolverTally:
     cap: int
     """The sweep cap (``max_iterations``): a step that used as many sweeps counts as capped."""
     steps: int = 0
+    """Steps counted."""
     sweeps: int = 0
     """NLGS sweeps, in total."""
     sweeps_max: int = 0
+    """The most sweeps of one step."""
     capped: int = 0
+    """Steps that used the whole sweep cap."""
     contacts: int = 0
     """Contacts over the steps, in total."""
     contacts_max: int = 0
+    """The most contacts of one step."""
     residual_max: float = 0.0
     """m/s: the largest residual of a step."""
     residual_last: float = 0.0
+    """m/s: the last step's residual."""
 
     def add(self, stats: StepStats) -> None:
         """Count one step."""
@@ -77,19 +82,29 @@ class RunResult:
     """What happened, for the summary table."""
 
     status: str
-    """"completed", "interrupted", "diverged" or "error"."""
+    """One of :data:`masonrycli.sinks.STATUSES` but "running": "completed", "interrupted", "diverged" or "failed"."""
     message: str
+    """One line on how the run stopped ("" when it ran all its steps)."""
     steps: int
+    """Time steps run."""
     time: float
+    """Simulated time reached, s."""
     wall_time: float
+    """Elapsed time of the loop, s."""
     tally: SolverTally
     """The solver's effort over the steps run (per-step values: the history, or a sink's ``log_step``)."""
     max_penetration: float
+    """m: the largest penetration at detection over the steps run."""
     energy_initial: float
+    """J: kinetic + potential at t = 0 (per block thickness)."""
     energy_final: float
+    """J: kinetic + potential at the end."""
     energy_dissipated: float
+    """J: dissipated at the contacts since t = 0."""
     support_work: float
+    """J: work of the supports on the blocks since t = 0."""
     frames: int
+    """Frames handed to the sinks."""
     unconverged: int = 0
     """Steps whose solve did not meet its tolerance before the sweep cap."""
     solver: str = ""

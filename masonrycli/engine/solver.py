@@ -28,9 +28,14 @@ from masonrycli.engine.collision import ContactBuffers, detect_contacts
 
 @dataclass(frozen=True)
 class StepStats:
+    """What one step did, for the run's tally, its progress bar and its divergence test."""
+
     contact_count: int
+    """C, contacts detected at the step's configuration."""
     iterations: int
+    """Sweep units the contact solver spent (masonrycli.engine.nlgs.solve)."""
     residual: float
+    """m/s: RMS contact-law violation of the last sweep, the quantity compared with the tolerance."""
     dissipated: float
     """Energy dissipated at the contacts during the step, J."""
     support_work: float
@@ -71,18 +76,22 @@ class Solver:
     # Views of the last step's contacts -------------------------------------------------------
     @property
     def contact_body(self) -> np.ndarray:
+        """(C, 2) int32: bodies a, b of each contact (the normal points from a to b)."""
         return self.buffers.contact_body[: self._count]
 
     @property
     def contact_point(self) -> np.ndarray:
+        """(C, 2) m: contact points, world coordinates, at the detection configuration."""
         return self.buffers.contact_point[: self._count]
 
     @property
     def contact_normal(self) -> np.ndarray:
+        """(C, 2) unit normals from body a to body b."""
         return self.buffers.contact_normal[: self._count]
 
     @property
     def contact_gap(self) -> np.ndarray:
+        """(C,) m: gaps at detection (negative: penetration)."""
         return self.buffers.contact_gap[: self._count]
 
     @property
