@@ -76,11 +76,17 @@ def make_lut(stops: tuple[tuple[float, int, int, int], ...], size: int = LUT_SIZ
     return np.round(np.stack([np.interp(x, pos, rgb[:, k]) for k in range(3)], axis=1)).astype(np.uint8)
 
 
-VIRIDIS: Final = pack_rgba(make_lut(_VIRIDIS_STOPS))
+def _shared(lut: np.ndarray) -> np.ndarray:
+    # every field and recording maps through the same table: a write into it would recolour them all
+    lut.setflags(write=False)
+    return lut
+
+
+VIRIDIS: Final = _shared(pack_rgba(make_lut(_VIRIDIS_STOPS)))
 """(256,) uint32: sequential, dark purple (low) to yellow (high)."""
-COOLWARM: Final = pack_rgba(make_lut(_COOLWARM_STOPS))
+COOLWARM: Final = _shared(pack_rgba(make_lut(_COOLWARM_STOPS)))
 """(256,) uint32: diverging, blue (low) - light grey (middle) - red (high)."""
-BLUES: Final = pack_rgba(make_lut(_BLUES_STOPS))
+BLUES: Final = _shared(pack_rgba(make_lut(_BLUES_STOPS)))
 """(256,) uint32: sequential, dark blue (low, most negative) to near white (high, zero)."""
 NAN_RGBA: Final = int(pack_rgba(np.array([128, 128, 128])))
 UNDER_RGBA: Final = int(pack_rgba(np.array([255, 0, 255])))

@@ -18,6 +18,14 @@ def test_colormap_lookup():
     assert cm.unpack_rgba(cm.COOLWARM[128])[0] == pytest.approx(221, abs=2)  # light grey at zero
 
 
+@pytest.mark.parametrize("name", ["VIRIDIS", "COOLWARM", "BLUES"])
+def test_shared_tables_cannot_be_written(name):
+    # one table colours every field of every recording: a caller's write would recolour the others
+    lut = getattr(cm, name)
+    with pytest.raises(ValueError, match="read-only"):
+        lut[0] = 0
+
+
 def test_nice_ceil_and_robust_max():
     values = (0.0, 0.9, 1.0, 1.2, 2.7, 7.0, 1.1e5)
     assert [cm.nice_ceil(x) for x in values] == [0.0, 1.0, 1.0, 1.5, 3.0, 8.0, 1.5e5]
