@@ -8,7 +8,6 @@ from pathlib import Path
 from typing import Annotated
 
 import typer
-from rich.table import Table
 
 from geometry_library.blocks import GeometryError
 from masonrycli import __version__
@@ -270,6 +269,7 @@ def check_command(scenario_file: ScenarioFile, **opts) -> None:
     """Validate what `masonry run` would run, with the same arguments, and print a summary (blocks,
     supports, mass, bounding box, steps, the loading, outputs); nothing is computed or written."""
     from masonrycli.execute import plan_outputs
+    from masonrycli.report import check_table
     from masonrycli.scenario import check_sampling, record_warnings, scenario_summary
 
     scenario = _load(scenario_file, opts)
@@ -278,26 +278,7 @@ def check_command(scenario_file: ScenarioFile, **opts) -> None:
     outputs = plan_outputs(
         scenario, opts["out"], opts["history"], no_recording=opts["no_recording"], force=opts["force"]
     )
-    info = scenario_summary(scenario)
-    table = Table(title=f"{scenario_file} — valid", show_header=False, title_justify="left")
-    table.add_column("", style="bold")
-    table.add_column("")
-    xmin, ymin, xmax, ymax = info["bounding_box"]
-    table.add_row("scenario", str(info["name"]))
-    table.add_row("blocks", str(info["blocks"]))
-    table.add_row("supports", str(info["supports"]))
-    table.add_row("total mass", f"{info['total_mass']:.6g} kg")
-    table.add_row("bounding box", f"x {xmin:.4g} … {xmax:.4g} m, y {ymin:.4g} … {ymax:.4g} m")
-    table.add_row("friction", f"{info['friction']:g}")
-    table.add_row(
-        "time", f"{info['duration']:g} s in {info['n_steps']} steps of {info['dt']:g} s, θ = {info['theta']:g}"
-    )
-    # the loading, as run will apply it (a --record and its --scale included): it was not shown at all
-    driven = [f"{m['name']}: {m['motion']}" for m in info["support_motions"] if m["role"] != "fixed"]
-    table.add_row("loading", "\n".join(driven) or "none (every support fixed)")
-    for out_file in outputs.files():
-        table.add_row("recording" if out_file.option == "--out" else "history", str(out_file.path))
-    console.print(table)
+    console.print(check_table(str(scenario_file), scenario_summary(scenario), outputs.files()))
     for warning in (*scenario.warnings, *record_warnings(scenario)):
         warn(warning)
 
@@ -372,6 +353,7 @@ def inspect_command(
 ) -> None:
     """Summarise a recording: scenario, frames, time span, entities."""
     from masonrycli.recording import inspect_recording, recording_path_problem
+    from masonrycli.report import recording_table
 
     problem = recording_path_problem(recording)
     if problem:
@@ -380,20 +362,7 @@ def inspect_command(
         info = inspect_recording(recording)
     except Exception as exc:  # a corrupt or foreign file: say so in one line
         raise InputError(f"{recording}: not a readable Rerun recording ({type(exc).__name__}: {exc})") from None
-    table = Table(title=str(recording), show_header=False, title_justify="left")
-    table.add_column("", style="bold")
-    table.add_column("")
-    for key, value in info.items():
-        if key == "metadata":
-            continue
-        if key in ("steps", "time_span") and isinstance(value, (list, tuple)) and len(value) == 2:
-            value = f"{value[0]} … {value[1]}" + (" s" if key == "time_span" else "")
-        elif value is None:  # a study's or a mechanism's recording has no sim_time ("None" before)
-            value = "—"
-        elif isinstance(value, (list, tuple)):
-            value = "\n".join(map(str, value))
-        table.add_row(key, str(value))
-    console.print(table)
+    console.print(recording_table(str(recording), info))
     if info.get("metadata"):
         console.print(info["metadata"])
     if info["truncated"]:

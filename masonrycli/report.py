@@ -1,4 +1,5 @@
-"""What the user sees in the terminal: a rich progress bar during a run and a summary table after it."""
+"""What the user sees in the terminal: a rich progress bar during a run and a summary table after it, the
+tables of ``masonry check`` and ``masonry inspect``."""
 
 from __future__ import annotations
 
@@ -82,4 +83,50 @@ def summary_table(result, recording: str | None, history: str | None) -> Table:
         table.add_row("history", history)
     if recording:
         table.add_row("recording", recording)
+    return table
+
+
+def _two_columns(title: str) -> Table:
+    table = Table(title=title, show_header=False, title_justify="left")
+    table.add_column("", style="bold")
+    table.add_column("")
+    return table
+
+
+def check_table(scenario_file: str, info: dict, output_files) -> Table:
+    """``masonry check``'s table: ``info`` of :func:`masonrycli.scenario.scenario_summary`, the files a run
+    would write (:class:`masonrycli.outputs.OutputFile`)."""
+    table = _two_columns(f"{scenario_file} — valid")
+    xmin, ymin, xmax, ymax = info["bounding_box"]
+    table.add_row("scenario", str(info["name"]))
+    table.add_row("blocks", str(info["blocks"]))
+    table.add_row("supports", str(info["supports"]))
+    table.add_row("total mass", f"{info['total_mass']:.6g} kg")
+    table.add_row("bounding box", f"x {xmin:.4g} … {xmax:.4g} m, y {ymin:.4g} … {ymax:.4g} m")
+    table.add_row("friction", f"{info['friction']:g}")
+    table.add_row(
+        "time", f"{info['duration']:g} s in {info['n_steps']} steps of {info['dt']:g} s, θ = {info['theta']:g}"
+    )
+    # the loading, as run will apply it (a --record and its --scale included): it was not shown at all
+    driven = [f"{m['name']}: {m['motion']}" for m in info["support_motions"] if m["role"] != "fixed"]
+    table.add_row("loading", "\n".join(driven) or "none (every support fixed)")
+    for out_file in output_files:
+        table.add_row("recording" if out_file.option == "--out" else "history", str(out_file.path))
+    return table
+
+
+def recording_table(recording: str, info: dict) -> Table:
+    """``masonry inspect``'s table: ``info`` of :func:`masonrycli.recording.inspect_recording` but its
+    metadata (printed below the table)."""
+    table = _two_columns(recording)
+    for key, value in info.items():
+        if key == "metadata":
+            continue
+        if key in ("steps", "time_span") and isinstance(value, (list, tuple)) and len(value) == 2:
+            value = f"{value[0]} … {value[1]}" + (" s" if key == "time_span" else "")
+        elif value is None:  # a study's or a mechanism's recording has no sim_time ("None" before)
+            value = "—"
+        elif isinstance(value, (list, tuple)):
+            value = "\n".join(map(str, value))
+        table.add_row(key, str(value))
     return table
