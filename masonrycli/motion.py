@@ -87,6 +87,15 @@ def _time_column(t) -> np.ndarray:
     return t
 
 
+class _Directed:
+    """The ``unit_direction`` of the kinds with a ``direction`` (Sine, Record)."""
+
+    @property
+    def unit_direction(self) -> np.ndarray:
+        """``direction`` normalised, shape (2,)."""
+        return np.asarray(self.direction, dtype=np.float64) / math.hypot(*self.direction)
+
+
 class Motion:
     """Base of the motion kinds: the interface every support motion offers.
 
@@ -157,9 +166,7 @@ class Constant(Motion):
         _put(self, "velocity", check_vector("velocity", self.velocity))
 
     def velocity_at(self, t) -> np.ndarray:
-        out = np.zeros((_time_column(t).shape[0], 2), dtype=np.float64)
-        out[:] = self.velocity
-        return out
+        return np.tile(np.asarray(self.velocity, dtype=np.float64), (_time_column(t).shape[0], 1))
 
     def describe(self) -> str:
         return f"constant velocity {_vec(self.velocity)} m/s"
@@ -172,7 +179,7 @@ class Constant(Motion):
 
 
 @dataclass(frozen=True, kw_only=True)
-class Sine(Motion):
+class Sine(_Directed, Motion):
     """``amplitude`` (m/s) · sin(2π ``frequency`` (Hz) · t + ``phase`` (rad)) along ``direction``
     (normalised on use)."""
 
@@ -191,17 +198,9 @@ class Sine(Motion):
         _put(self, "frequency", check_real("frequency", self.frequency, ge=0.0))
         _put(self, "phase", check_real("phase", self.phase))
 
-    @property
-    def unit_direction(self) -> np.ndarray:
-        """``direction`` normalised, shape (2,)."""
-        return np.asarray(self.direction, dtype=np.float64) / math.hypot(*self.direction)
-
     def velocity_at(self, t) -> np.ndarray:
-        t = _time_column(t)
-        out = np.zeros((t.shape[0], 2), dtype=np.float64)
-        s = self.amplitude * np.sin(2.0 * np.pi * self.frequency * t + self.phase)
-        out[:] = s[:, None] * self.unit_direction[None, :]
-        return out
+        s = self.amplitude * np.sin(2.0 * np.pi * self.frequency * _time_column(t) + self.phase)
+        return s[:, None] * self.unit_direction[None, :]
 
     def describe(self) -> str:
         ph = f" + {_g(self.phase)}" if self.phase else ""
@@ -237,11 +236,8 @@ class Ramp(Motion):
         _put(self, "until", check_real("until", self.until, gt=0.0, allow_inf=True))
 
     def velocity_at(self, t) -> np.ndarray:
-        t = _time_column(t)
-        out = np.zeros((t.shape[0], 2), dtype=np.float64)
-        tc = np.clip(t, 0.0, self.until)
-        out[:] = tc[:, None] * np.asarray(self.acceleration)[None, :]
-        return out
+        tc = np.clip(_time_column(t), 0.0, self.until)
+        return tc[:, None] * np.asarray(self.acceleration, dtype=np.float64)[None, :]
 
     def describe(self) -> str:
         until = "" if math.isinf(self.until) else f" until {_g(self.until)} s"
@@ -258,7 +254,7 @@ class Ramp(Motion):
 
 
 @dataclass(frozen=True, kw_only=True)
-class Record(Motion):
+class Record(_Directed, Motion):
     """A tabulated velocity or acceleration history (see the module docstring).
 
     time : (n,) s, strictly increasing, n >= 2.
@@ -337,11 +333,6 @@ class Record(Motion):
             if inside < 2:
                 raise field_error("window", w, f"holds {inside} samples of the record (at least 2 needed)")
             _put(self, "window", w)
-
-    @property
-    def unit_direction(self) -> np.ndarray:
-        """``direction`` normalised, shape (2,)."""
-        return np.asarray(self.direction, dtype=np.float64) / math.hypot(*self.direction)
 
     @property
     def is_vector(self) -> bool:
