@@ -51,6 +51,18 @@ class LimitResult:
     def sliding_joints(self) -> list[str]:
         return [n for n, s in zip(self.names, self.motion.joint_sliding) if s]
 
+    def hinges_largest_first(self) -> list[str]:
+        """The hinges, the fastest-turning first (|Δω| × joint length): the mechanism's main hinges lead."""
+        order = np.argsort(-self.motion.joint_turn, kind="stable")
+        names = self.names
+        return [names[k] for k in order if self.motion.joint_hinged[k]]
+
+    def sliding_largest_first(self) -> list[str]:
+        """The sliding joints, the fastest-sliding first."""
+        order = np.argsort(-self.motion.joint_slide, kind="stable")
+        names = self.names
+        return [names[k] for k in order if self.motion.joint_sliding[k]]
+
     @property
     def moving_blocks(self) -> list[str]:
         return [n for n, m in zip(self.model.block_name, self.motion.block_moving) if m]

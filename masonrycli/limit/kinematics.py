@@ -41,6 +41,10 @@ class JointMotion:
     """(J,) bool: the joint's faces turn about one of its ends."""
     joint_sliding: np.ndarray
     """(J,) bool: the joint's faces slide along each other."""
+    joint_turn: np.ndarray
+    """(J,) |Δω| × joint length [-]: how fast the joint's faces turn relative to each other (0 for corners)."""
+    joint_slide: np.ndarray
+    """(J,) largest |Δv·t| over the joint's points [-]."""
     hinge_point: np.ndarray
     """(H, 2) m: the end that stays closed of each hinged joint (hinged joints in order)."""
     block_moving: np.ndarray
@@ -72,7 +76,8 @@ def joint_motion(model: Model, joints: Joints, block_velocity: np.ndarray, tol: 
     first, last = joints.joint_start[:-1], joints.joint_start[1:] - 1
     length = np.hypot(*(point[last] - point[first]).T)
     face = joints.joint_points >= 2
-    hinged = face & (np.abs(turn) * length > tol)
+    turn_rate = np.where(face, np.abs(turn) * length, 0.0)
+    hinged = turn_rate > tol
     j = joints.contact_joint
     slide = np.zeros(joints.joint_count)
     np.maximum.at(slide, j, np.abs(sliding))
@@ -84,6 +89,8 @@ def joint_motion(model: Model, joints: Joints, block_velocity: np.ndarray, tol: 
         contact_sliding=sliding,
         joint_hinged=hinged,
         joint_sliding=slide > tol,
+        joint_turn=turn_rate,
+        joint_slide=slide,
         hinge_point=point[closed[hinged]].copy(),
         block_moving=speed > tol,
     )
