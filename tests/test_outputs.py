@@ -174,28 +174,6 @@ def test_commit_replaces_only_with_force(tmp_path):
     assert free_name(target) == tmp_path / "a-2.npz"
 
 
-def test_last_line_opens_the_recording(tmp_path):
-    """Finding 12: the README says the last line of a run is the command that opens the recording."""
-    rrd = tmp_path / "w.rrd"
-    result = invoke("simulate", "wall", "--duration", 0.11, "--out", rrd)
-    assert result.exit_code == 0, result.output
-    last = result.output.strip().splitlines()[-1]
-    assert last.startswith("Open the recording:") and last.endswith(f"rerun {rrd}"), last
-
-
-def test_the_last_line_is_a_command_the_shell_runs(tmp_path):
-    """A recording path with a space or a quote was printed as is: pasted into a shell, "rerun my runs/w.rrd"
-    asked rerun for two files."""
-    import shlex
-
-    rrd = tmp_path / "my runs" / "it's.rrd"
-    result = invoke("simulate", "wall", "--duration", 0.01, "--out", rrd)
-    assert result.exit_code == 0, result.output
-    last = result.output.strip().splitlines()[-1]
-    words = shlex.split(last.removeprefix("Open the recording:"))
-    assert words[0].endswith("rerun") and words[1:] == [str(rrd)], last
-
-
 def test_courses_and_length_choose_the_wall(tmp_path):
     """Finding 8: --courses/--length without --blocks always failed ("51 blocks cannot be laid…")."""
     npz = tmp_path / "h.npz"
@@ -255,31 +233,6 @@ def test_outputs_that_would_not_fit_are_refused(tmp_path, monkeypatch):
     assert result.exit_code == 2, result.output
     assert "the run would write about" in result.output and "1.0 MB free" in result.output
     assert leftovers(tmp_path) == [] and not (tmp_path / "recordings").exists()
-
-
-@pytest.mark.parametrize(
-    "args",
-    [
-        ("simulate", "wall", "--duration", 0.01),  # a short run: the recording is mostly its static part
-        ("simulate", "wall", "--duration", 0.3, "--record-every", 100),  # few frames, many per-step series
-        ("simulate", "arch", "--duration", 0.002, "--voussoirs", 60),
-        ("simulate", "wall", "--duration", 0.05, "--record-every", 1),
-    ],
-)
-def test_the_size_estimate_is_an_upper_bound(args, tmp_path):
-    """The estimate left out the recording's static part: the 51-block wall's 0.1 s was let start on a 1 MB
-    disk (estimate ~0.6 MB; it wrote 0.63 MB of recording + its history) and failed there, exit 4."""
-    from masonrycli.builtin import builtin
-    from masonrycli.execute import output_sizes
-
-    rrd, npz = tmp_path / "r.rrd", tmp_path / "h.npz"
-    result = invoke(*args, "--out", rrd, "--history", npz)
-    assert result.exit_code == 0, result.output
-    options = dict(zip(args[2::2], args[3::2]))
-    scenario = builtin(args[1], **{k.lstrip("-").replace("-", "_"): v for k, v in options.items()})
-    recording, history = output_sizes(scenario)
-    assert rrd.stat().st_size <= recording <= 4 * rrd.stat().st_size + 10**6
-    assert npz.stat().st_size <= history <= 4 * npz.stat().st_size + 10**5
 
 
 def test_history_write_failure_stops_the_run(tmp_path, monkeypatch):

@@ -1,0 +1,170 @@
+"""masonrycli.execute: a run with its outputs. A one-block scenario of 20 steps is executed into temporary
+outputs: the history and the recording are renamed into place whole; an engine error still closes them
+as "failed"; a stop before step 1 leaves no file at all. Also the output plan, the size estimate and the
+summary's last line (the command that opens the recording)."""
+
+from __future__ import annotations
+
+import io
+import math
+import os
+import signal
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+from rich.console import Console
+from shapely.geometry import box
+
+from geometry_library.blocks import Assembly, Block, Support
+from masonrycli import execute as execute_module
+from masonrycli.errors import InputError
+from masonrycli.execute import execute, plan_outputs
+from masonrycli.interrupt import StopRun
+from masonrycli.motion import Sine
+from masonrycli.recording import inspect_recording
+from masonrycli.run import Simulation
+from masonrycli.scenario import Material, RunConfig, Scenario
+
+from cli_helpers import invoke
+
+AMP, FREQ, DT, STEPS, EVERY = 0.01, 2.0, 1e-3, 20, 5
+# v(t) = AMP cos(2π FREQ t): the ground's peak speed is AMP, at t = 0
+SHAKE = Sine(amplitude=AMP, frequency=FREQ, phase=math.pi / 2)
+
+
+def _scenario() -> Scenario:
+    block = Block(box(-0.2, 0.0, 0.2, 0.2), "b")
+    ground = Support(box(-1.0, -0.1, 1.0, 0.0), "ground")
+    run = RunConfig(duration=STEPS * DT, dt=DT, record_every=EVERY)
+    return Scenario("one-block", run, Material(), Assembly((block,), (ground,)), (SHAKE,))
+
+
+def _quiet() -> Console:
+    return Console(file=io.StringIO(), width=120)
+
+
+def _planned(tmp_path: Path, force: bool = False):
+    sc = _scenario()
+    return sc, plan_outputs(sc, tmp_path / "r.rrd", tmp_path / "h.npz", no_recording=False, force=force)
+
+
+def test_a_run_leaves_a_whole_history_and_recording_in_place(tmp_path):
+    sc, outputs = _planned(tmp_path)
+    outcome = execute(sc, outputs, console=_quiet())
+    assert outcome.result.status == "completed" and outcome.errors == [] and outcome.signum is None
+    assert [o.option for o in outcome.written] == ["--out", "--history"]
+    assert sorted(os.listdir(tmp_path)) == ["h.npz", "r.rrd"]  # renamed into place, no temporary file
+    h = np.load(tmp_path / "h.npz")
+    assert str(h["status"]) == "completed"
+    assert h["step"].tolist() == list(range(0, STEPS + 1, EVERY))  # the initial state and every 5th step
+    assert h["time"] == pytest.approx(h["step"] * DT, abs=1e-15)
+    # the ground's intensity, written into the history after the run: the peak of A cos(2π f t) is A (t = 0),
+    # its peak step-to-step acceleration the largest difference quotient over the run's steps
+    t = np.arange(STEPS + 1) * DT
+    assert float(h["intensity_pgv"]) == pytest.approx(AMP, rel=1e-12)
+    pga = np.abs(np.diff(AMP * np.cos(2 * math.pi * FREQ * t))).max() / DT
+    assert float(h["intensity_pga"]) == pytest.approx(pga, rel=1e-9)
+    info = inspect_recording(tmp_path / "r.rrd")
+    assert info["complete"] and info["frames"] == len(h["step"]) - 1  # the initial state: the history only
+    assert "completed" in info["metadata"]
+
+
+def test_an_engine_error_closes_the_outputs_as_failed_and_is_raised(tmp_path, monkeypatch):
+    """Raised in the first step: the history holds the initial state, the recording no frame, both whole."""
+    error = FloatingPointError("synthetic engine error")
+
+    def failing(self):
+        raise error
+
+    monkeypatch.setattr(Simulation, "step", failing)
+    sc, outputs = _planned(tmp_path)
+    with pytest.raises(FloatingPointError) as info:
+        execute(sc, outputs, console=_quiet())
+    assert info.value is error  # re-raised as it was, after the outputs were closed
+    assert sorted(os.listdir(tmp_path)) == ["h.npz", "r.rrd"]
+    h = np.load(tmp_path / "h.npz")
+    assert str(h["status"]) == "failed" and str(h["note"]) == "the run stopped on an unexpected error"
+    assert h["step"].tolist() == [0]
+    rec = inspect_recording(tmp_path / "r.rrd")
+    assert rec["complete"] and rec["frames"] == 0 and "failed" in rec["metadata"]
+
+
+def test_a_stop_before_step_one_leaves_no_file_and_keeps_the_previous_one(tmp_path, monkeypatch):
+    """A Ctrl-C while the simulation is set up raises StopRun; the temporary files are removed, and the
+    file that --force would have replaced is untouched."""
+    (tmp_path / "r.rrd").write_bytes(b"the previous recording")
+
+    def interrupted(scenario):
+        os.kill(os.getpid(), signal.SIGINT)
+        time.sleep(1.0)  # the handler raises StopRun here
+        raise AssertionError("no StopRun in the setup phase")
+
+    monkeypatch.setattr(execute_module, "Simulation", interrupted)
+    sc, outputs = _planned(tmp_path, force=True)
+    with pytest.raises(StopRun) as info:
+        execute(sc, outputs, console=_quiet())
+    assert info.value.signum == signal.SIGINT
+    assert os.listdir(tmp_path) == ["r.rrd"]
+    assert (tmp_path / "r.rrd").read_bytes() == b"the previous recording"
+
+
+def test_the_plan_names_the_outputs_asked_for(tmp_path, monkeypatch):
+    sc = _scenario()
+    with pytest.raises(InputError, match="--out .* with --no-recording: choose one"):
+        plan_outputs(sc, tmp_path / "r.rrd", None, no_recording=True, force=False)
+    none = plan_outputs(sc, None, None, no_recording=True, force=False)
+    assert none.files() == []
+    monkeypatch.chdir(tmp_path)
+    default = plan_outputs(sc, None, tmp_path / "h.npz", no_recording=False, force=False)
+    assert default.recording.path.parent.name == "recordings" and default.recording.path.name.startswith("one-block-")
+    assert default.recording.path.suffix == ".rrd" and default.history.path == tmp_path / "h.npz"
+    assert os.listdir(tmp_path) == []  # planning writes nothing
+
+
+@pytest.mark.parametrize(
+    "args",
+    [
+        ("simulate", "wall", "--duration", 0.01),  # a short run: the recording is mostly its static part
+        ("simulate", "wall", "--duration", 0.3, "--record-every", 100),  # few frames, many per-step series
+        ("simulate", "arch", "--duration", 0.002, "--voussoirs", 60),
+        ("simulate", "wall", "--duration", 0.05, "--record-every", 1),
+    ],
+)
+def test_the_size_estimate_is_an_upper_bound(args, tmp_path):
+    """The estimate left out the recording's static part: the 51-block wall's 0.1 s was let start on a 1 MB
+    disk (estimate ~0.6 MB; it wrote 0.63 MB of recording + its history) and failed there, exit 4."""
+    from masonrycli.builtin import builtin
+    from masonrycli.execute import output_sizes
+
+    rrd, npz = tmp_path / "r.rrd", tmp_path / "h.npz"
+    result = invoke(*args, "--out", rrd, "--history", npz)
+    assert result.exit_code == 0, result.output
+    options = dict(zip(args[2::2], args[3::2]))
+    scenario = builtin(args[1], **{k.lstrip("-").replace("-", "_"): v for k, v in options.items()})
+    recording, history = output_sizes(scenario)
+    assert rrd.stat().st_size <= recording <= 4 * rrd.stat().st_size + 10**6
+    assert npz.stat().st_size <= history <= 4 * npz.stat().st_size + 10**5
+
+
+def test_last_line_opens_the_recording(tmp_path):
+    """Finding 12: the README says the last line of a run is the command that opens the recording."""
+    rrd = tmp_path / "w.rrd"
+    result = invoke("simulate", "wall", "--duration", 0.11, "--out", rrd)
+    assert result.exit_code == 0, result.output
+    last = result.output.strip().splitlines()[-1]
+    assert last.startswith("Open the recording:") and last.endswith(f"rerun {rrd}"), last
+
+
+def test_the_last_line_is_a_command_the_shell_runs(tmp_path):
+    """A recording path with a space or a quote was printed as is: pasted into a shell, "rerun my runs/w.rrd"
+    asked rerun for two files."""
+    import shlex
+
+    rrd = tmp_path / "my runs" / "it's.rrd"
+    result = invoke("simulate", "wall", "--duration", 0.01, "--out", rrd)
+    assert result.exit_code == 0, result.output
+    last = result.output.strip().splitlines()[-1]
+    words = shlex.split(last.removeprefix("Open the recording:"))
+    assert words[0].endswith("rerun") and words[1:] == [str(rrd)], last
