@@ -10,7 +10,6 @@ import numpy as np
 from masonrycli.history import History, HistoryFile
 from masonrycli.run import Simulation, simulate
 from masonrycli.scenario import Material, RunConfig, scenario_from_builder
-from masonrycli.sinks import STATUSES, FrameSink
 
 
 def wall(duration: float, record_every: int = 1):
@@ -75,14 +74,3 @@ def test_support_velocities_are_not_tabulated_for_the_whole_run():
     for k in (0, 1, 4095, 4096, 123_457, 500_000):
         assert np.array_equal(table[k], full[k])  # bit-identical to the whole table
     assert len(table._rows) <= SupportVelocity.CHUNK
-
-
-def test_sinks_share_one_contract(tmp_path):
-    from masonrycli.recording import Recorder
-
-    assert {"running", "completed", "interrupted", "diverged", "failed"} == set(STATUSES)
-    hist = HistoryFile(tmp_path / "h.npz", ["a"], [])
-    assert isinstance(hist, FrameSink) and isinstance(History(["a"], []), FrameSink)
-    hist.close("interrupted", "stopped")
-    assert str(np.load(tmp_path / "h.npz")["note"]) == "stopped"
-    assert all(callable(getattr(Recorder, name, None)) for name in ("on_frame", "close"))
