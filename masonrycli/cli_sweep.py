@@ -14,7 +14,7 @@ from typing import Annotated
 
 import typer
 
-from masonrycli.errors import NOT_A_FILE, InputError
+from masonrycli.errors import EXIT_ROWS_FAILED, NOT_A_FILE, InputError
 from masonrycli.interrupt import FirstSignalStops, exit_code, signal_name
 from masonrycli.outputs import OutputFile, safe_name
 
@@ -194,6 +194,14 @@ def sweep_command(
         try:
             result = run_study(base, request, console)
             _report(console, result, request, name, im, picture, recording, written, signals)
+            if result.failed:
+                # a script saw exit 0 under "2 failed" (histories on a full disk): a failed run is no outcome
+                err_console.print(
+                    f"error: {result.failed} of {_n(len(result.rows), 'row')} failed (the reason is in their "
+                    f"error column in {result.out}); run the same command again to retry them",
+                    soft_wrap=True,
+                )
+                raise typer.Exit(EXIT_ROWS_FAILED)
         except KeyboardInterrupt:
             signum = signals.stopping()
             how = "" if signum == signal.SIGINT else f" ({signal_name(signum)})"

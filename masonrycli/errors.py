@@ -4,7 +4,8 @@ and the exit codes.
 Exit codes (README, "Troubleshooting"): 0 the run completed (or the command succeeded) · 1 internal error
 (an engine bug; ``MASONRY_DEBUG=1`` shows the traceback) · 2 bad input, including an output path that
 cannot be written, checked before step 1 · 3 the run diverged · 4 an output could not be written during
-the run (disk full, folder removed) · 128 + signal number when stopped by a signal (130 Ctrl-C, 143 SIGTERM).
+the run (disk full, folder removed) · 5 a study (``masonry sweep``) finished with failed runs (rows with
+``status = error``: an engine error or an output that could not be written; the table is whole) · 128 + signal number when stopped by a signal (130 Ctrl-C, 143 SIGTERM).
 """
 
 EXIT_OK = 0
@@ -12,6 +13,7 @@ EXIT_INTERNAL = 1
 EXIT_BAD_INPUT = 2
 EXIT_DIVERGED = 3
 EXIT_OUTPUT_FAILED = 4
+EXIT_ROWS_FAILED = 5
 
 
 class InputError(ValueError):

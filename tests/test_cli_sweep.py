@@ -757,3 +757,28 @@ def test_a_signal_held_while_the_plot_s_rename_fails_reports_the_error(block, tm
     assert "interrupted" not in said and "Traceback" not in said
     assert len(read_rows(out)) == 2
     assert sorted(p.name for p in tmp_path.iterdir()) == ["block.toml", "s.csv"]  # no .s.png.<pid>.part
+
+
+def test_failed_rows_give_exit_5_after_the_whole_table(block, tmp_path, monkeypatch):
+    # Two of three runs failed (histories on a full disk): the study said "2 failed" and exited 0, so a
+    # script took it for a complete study.
+    from masonrycli import run
+
+    real = run.simulate
+
+    def full_disk(scenario, sinks, **kw):
+        if scenario.motions[0].amplitude > 0.15:
+            raise OSError(28, "No space left on device")
+        return real(scenario, sinks, **kw)
+
+    monkeypatch.setattr(run, "simulate", full_disk)
+    out = tmp_path / "s.csv"
+    args = ["-p", "amp=0.1,0.2,0.3", "--duration", 0.02, "--workers", 0, "-o", out, "--no-recording"]
+    result = invoke("sweep", block, *args)
+    assert result.exit_code == 5, result.output
+    assert len(read_rows(out)) == 3 and (tmp_path / "s.png").exists()  # the table and the plot are whole
+    said = " ".join(result.output.split())
+    assert f"error: 2 of 3 rows failed (the reason is in their error column in {out}); run the same" in said, said
+    monkeypatch.setattr(run, "simulate", real)
+    again = invoke("sweep", block, *args, "--force")  # --force: the plot exists
+    assert again.exit_code == 0 and "(2 runs now, 1 row already there, 0 failed)" in again.output, again.output
