@@ -211,3 +211,17 @@ def test_a_long_hinge_list_shows_the_fastest_turning_joints_first():
         invoke("limit", "aqueduct", "--load", "point", "--block", "v15", "--direction", "-y").output.split()
     )
     assert f"{len(result.hinges)}, the 8 fastest: {', '.join(fastest)}" in shown, shown
+
+
+def test_verify_headers_read_whole_at_80_columns(column_file, monkeypatch):
+    # At 80 columns the headers were cut to "displacem…" and "similari…".
+    monkeypatch.setenv("COLUMNS", "80")
+    result = runner.invoke(app, ["limit", str(column_file), "--verify"], env={"COLUMNS": "80"})
+    assert result.exit_code == 0, result.output
+    lines = result.output.splitlines()
+    assert max(len(line) for line in lines) <= 80
+    start = next(k for k, line in enumerate(lines) if line.startswith("┏"))
+    header = " ".join(" ".join(lines[start + 1 : start + 3]).replace("┃", " ").split())
+    assert "…" not in header, header
+    for word in ("predicted", "largest", "move", "similarity", "hinges", "shared"):
+        assert word in header.split(), header

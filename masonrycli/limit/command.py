@@ -94,8 +94,10 @@ def result_table(result: LimitResult, out: Path | None) -> Table:
 
 def verify_table(checks) -> Table:
     table = Table(title="--verify: the NSCD engine under gravity tilted to atan(f·λ)", title_justify="left")
-    for col in ("f", "tilt", "engine", "predicted", "max displacement", "mechanism similarity", "hinges shared"):
-        table.add_column(col)
+    # Short header words, each column at least as wide as its longest word: at 80 columns rich cut
+    # "max displacement" and "mechanism similarity" to "displacem…" and "similari…".
+    for col in ("f", "tilt", "engine", "predicted", "largest move", "similarity", "hinges shared"):
+        table.add_column(col, min_width=max(len(word) for word in col.split()))
     for c in checks:
         table.add_row(
             f"{c.factor:g}",
