@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import functools
 import sys
+import warnings
 
 import typer
 import typer.core
@@ -13,7 +14,7 @@ from rich.text import Text
 from typer._click import exceptions as click_errors  # typer 0.29 vendors click; no public name
 
 from geometry_library.blocks import GeometryError
-from masonrycli.errors import EXIT_BAD_INPUT, InputError
+from masonrycli.errors import EXIT_BAD_INPUT, InputError, RecordWarning
 
 # No markup and no highlighting: file names, TOML tables ("[run]") and values ("[inf, 0, 0]") print as given.
 console = Console(markup=False, highlight=False)
@@ -41,7 +42,10 @@ def user_errors(func):
     @functools.wraps(func)
     def wrapper(*args, **kwargs):
         try:
-            return func(*args, **kwargs)
+            with warnings.catch_warnings():  # restores showwarning on the way out
+                warnings.simplefilter("always", RecordWarning)
+                warnings.showwarning = _show_warning(warnings.showwarning)
+                return func(*args, **kwargs)
         except (InputError, GeometryError) as exc:
             fail(str(exc).splitlines()[0] if str(exc) else type(exc).__name__)
         except BrokenPipeError:
@@ -56,6 +60,19 @@ def user_errors(func):
             fail("Ctrl-C: stopped before any output was written", 130)
 
     return wrapper
+
+
+def _show_warning(previous):
+    """A ``warnings.showwarning`` that prints a :class:`RecordWarning` as one ``warning: …`` line (Python's
+    own format added the file and line of the reader's source) and leaves the others to ``previous``."""
+
+    def show(message, category, filename, lineno, file=None, line=None):
+        if issubclass(category, RecordWarning):
+            warn(str(message))
+        else:
+            previous(message, category, filename, lineno, file, line)
+
+    return show
 
 
 class OneLineUsageErrors(typer.core.TyperGroup):

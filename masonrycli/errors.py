@@ -16,6 +16,11 @@ EXIT_OUTPUT_FAILED = 4
 EXIT_ROWS_FAILED = 5
 
 
+class RecordWarning(UserWarning):
+    """An input read with a remark (an .AT2 file with samples beyond its NPTS); the command line prints it
+    as one ``warning: …`` line (:func:`masonrycli.cli_messages.user_errors`)."""
+
+
 class InputError(ValueError):
     """Bad user input (scenario file, option, geometry). ``str(err)`` is one line saying what and where."""
 

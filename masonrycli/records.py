@@ -15,10 +15,11 @@ from __future__ import annotations
 import math
 import os
 import re
+import warnings
 
 import numpy as np
 
-from masonrycli.errors import NOT_A_FILE, InputError, not_utf8, special_file
+from masonrycli.errors import NOT_A_FILE, InputError, RecordWarning, not_utf8, special_file
 from masonrycli.motion import Record
 from masonrycli.record_units import check_at2_header, check_at2_sample, check_csv_header
 from masonrycli.values import format_value, quote_string, shorten
@@ -143,6 +144,16 @@ def load_at2(path, display: str | None = None) -> tuple[float, np.ndarray]:
             values.append(x)
     if len(values) < npts:
         raise InputError(f"{name}: header says NPTS = {npts} but the file holds {len(values)} samples")
+    if len(values) > npts:
+        # the header is the record's definition (trailing values are padding or another file's tail), but
+        # dropping them without a word hid a header that may be the mistake
+        warnings.warn(
+            RecordWarning(
+                f"{name}: header says NPTS = {npts} but the file holds {len(values)} samples; the "
+                f"{len(values) - npts} after the first {npts} are ignored"
+            ),
+            stacklevel=2,
+        )
     return dt, np.asarray(values[:npts], dtype=np.float64)
 
 

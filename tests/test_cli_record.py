@@ -160,3 +160,16 @@ def test_a_wall_shaken_by_a_record_has_no_paper_figure_tabs(at2, tmp_path):
     views = blueprint_views(rrd)
     assert not any(name.startswith("Fig.") or v["pinned"] for name, v in views.items())
     assert any(name.startswith("Live: joint forces") for name in views)
+
+
+def test_an_at2_file_with_samples_beyond_npts_says_so_once(tmp_path):
+    # The samples after NPTS were dropped without a word (deliberately: the header defines the record), so
+    # a header that was the mistake went unnoticed.
+    at2 = tmp_path / "long.AT2"
+    at2.write_text("PEER\nstation\nunits of g\nNPTS=     4, DT=   .0100 SEC\n 0.01 0.02 0.03 0.02\n 0.01 0.0\n")
+    result = invoke("check", DATA / "quake_record.toml", "--record", at2)
+    assert result.exit_code == 0, result.output
+    said = [ln for ln in result.output.splitlines() if ln.startswith("warning:")]
+    line = f"warning: {at2}: header says NPTS = 4 but the file holds 6 samples; the 2 after the first 4 are ignored"
+    assert said == [line], result.output
+    assert "4 samples" in " ".join(result.output.split())  # still read as 4: the behaviour is kept

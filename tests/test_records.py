@@ -7,7 +7,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from masonrycli.errors import InputError
+from masonrycli.errors import InputError, RecordWarning
 from masonrycli.records import G_STANDARD, load_at2, load_record_csv, record_fields, record_motion
 
 from synthetic_records import band_limited, closed_form, write_at2
@@ -170,7 +170,7 @@ def _phases():
 
 def test_at2_reader_formats_and_units(tmp_path):
     write_at2(tmp_path / "a.at2", [0.1, -0.2, 0.3, 0.0, 0.5, 0.25, 9.0], 0.005)
-    # an older NGA header: "NPTS, DT" after the numbers; more values than NPTS are ignored
+    # an older NGA header: "NPTS, DT" after the numbers; more values than NPTS are ignored, with a warning
     (tmp_path / "b.AT2").write_text("title\nstation\nunits of g\n   3   0.0200   NPTS, DT\n 0.1 0.2\n 0.3 0.4\n")
     # NGA's older header, "UNITS OF G." followed by the filter corners, is g
     (tmp_path / "c.AT2").write_text(
@@ -180,9 +180,11 @@ def test_at2_reader_formats_and_units(tmp_path):
     assert load_at2(tmp_path / "c.AT2")[1].tolist() == [0.1, 0.2]
     dt, acc = load_at2(tmp_path / "a.at2")
     assert dt == 0.005 and acc.tolist() == [0.1, -0.2, 0.3, 0.0, 0.5, 0.25, 9.0]
-    dt, acc = load_at2(tmp_path / "b.AT2")
+    with pytest.warns(RecordWarning, match=r"b.AT2: header says NPTS = 3 but the file holds 4 samples; the 1 after"):
+        dt, acc = load_at2(tmp_path / "b.AT2")
     assert dt == 0.02 and acc.tolist() == [0.1, 0.2, 0.3]
-    m = record_motion(tmp_path / "b.AT2", scale=0.5, baseline="none")
+    with pytest.warns(RecordWarning):
+        m = record_motion(tmp_path / "b.AT2", scale=0.5, baseline="none")
     assert m.time == (0.0, 0.02, 0.04)
     np.testing.assert_allclose(m.value, [0.1 * G_STANDARD, 0.2 * G_STANDARD, 0.3 * G_STANDARD], rtol=1e-15)
     # velocity at the 2nd sample: scale · trapezoid = 0.5 · 0.02 · (0.1 + 0.2) g / 2
