@@ -194,7 +194,15 @@ def test_find_threshold_curve_reads_as_a_plot(block, tmp_path):
             values = [v[0] for v in batch.column("Scalars:scalars").to_pylist()]
             series[chunk.entity_path] = dict(zip(batch.column(timeline).to_pylist(), values))
     expected = {round(1000 * f): t for f, t in found.items()}
-    assert series == {"/study/thresholds/line": expected, "/study/thresholds/points": expected}
+    # the line and its points are one entity, one legend entry (two listed "amp_threshold (m/s)" and
+    # "amp_threshold (m/s): points"), as in the PNG
+    assert series == {"/study/thresholds/line": expected}
+    styles = {}
+    for chunk in rr.chunk.RrdReader(str(rrd)).stream():
+        if chunk.is_static and chunk.entity_path == "/study/thresholds/line":
+            batch = chunk.to_record_batch()
+            styles |= {n: batch.column(n).to_pylist()[-1] for n in batch.schema.names if n.endswith(":names")}
+    assert styles == {"SeriesLines:names": ["amp_threshold (m/s)"], "SeriesPoints:names": ["amp_threshold (m/s)"]}
 
 
 def test_the_counts_line_says_one_row(block, tmp_path):

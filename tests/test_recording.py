@@ -64,17 +64,20 @@ def test_application_id_blueprint_and_entity_paths(written):
     reader = rr.chunk.RrdReader(path)
     (recording,) = reader.recordings()
     assert recording.application_id == "masonry"
-    assert len(reader.blueprints()) == 1
+    # the layout of the start and the one sent at close (the magnified tab names its factor); the last wins
+    assert len(reader.blueprints()) == 2
     paths = {chunk.entity_path for chunk in reader.stream()}
     assert {f"/{p}" for p in ENTITY_PATHS} <= paths
 
 
 def test_embedded_blueprint_has_the_views(written, wall, tmp_path):
-    path, *_ = written
+    path, *_, rec = written
     views = blueprint_views(path)
     spatial = {n for n, v in views.items() if v["kind"] == "2D" and v["origin"] == "/structure/plane"}
     assert {f"Live: {f.title}" for f in PAPER_FIELDS} < spatial
-    assert {"Magnified deformed shape", "Joint states: sliding ratio", "Joint states: largest opening"} < spatial
+    # the magnified tab names its factor (set at close: the tab was "Magnified deformed shape" alone)
+    assert rec.magnify > 0 and f"Magnified deformed shape × {rec.magnify:g}" in spatial
+    assert {"Joint states: sliding ratio", "Joint states: largest opening"} < spatial
     assert any(n.startswith("Live: joint forces") for n in spatial)
     assert sum(v["kind"] == "TimeSeries" for v in views.values()) == 9
     assert views["Run"]["origin"] == "/run/metadata" and views["Legend"]["origin"] == "/run/legend"
@@ -333,7 +336,15 @@ def test_legend_labels_per_frame_and_run_document(written):
         assert f"{lo:.4g} … {hi:.4g}" in doc
         labels = temporal_rows(path, f"/{f.labels}", "Points2D:labels")
         last = labels[frames[-1].step]
-        assert len(last) == 8 and last[5] == f.title  # five ticks, the title, below / above counts
+        assert last[5] == f.title  # five ticks, the title, then the below / above counts there are
+        # an empty count is no label at all: its point drew an empty box beside the bar
+        for frame in frames:
+            assert all(labels[frame.step])
+            if f.key not in frame.tensors:  # the joint states: made by the recorder from the contacts
+                continue
+            values, (lo_f, hi_f) = frame.tensors[f.key], read[frame.step]["ranges"][f.key]
+            counts = [f"{n} {way}" for n, way in (((values < lo_f).sum(), "below"), ((values > hi_f).sum(), "above"))]
+            assert labels[frame.step][6:] == [c for c in counts if not c.startswith("0 ")], (f.key, frame.step)
         assert read[frames[-1].step]["ranges"][f.key] == (lo, hi)
     legend = static_value(path, "/run/legend", "TextDocument:text")
     assert "Joint forces" in legend[0] and "Magnified" in legend[0]

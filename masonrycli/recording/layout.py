@@ -183,13 +183,16 @@ def _structure_view(name: str, f: FieldSpec, extra: tuple[str, ...] = (), at: fl
 
 
 def build_blueprint(
-    main_field: str = "cell_spherical_stress", paper: tuple[float, tuple[str, ...]] | None = None
+    main_field: str = "cell_spherical_stress",
+    paper: tuple[float, tuple[str, ...]] | None = None,
+    magnify: float | None = None,
 ) -> rrb.Blueprint:
     """Structure tabs and the on-screen legend (left); time series and the run document (right).
 
     Tabs: the live main view (forces, principal stress, ``main_field``), with ``paper`` = (t, figure
     numbers) the paper's four figures pinned to t, the four fields live, the magnified deformed shape,
-    the joint states. Opens on ``sim_time`` following the end of the data: at the last frame of a finished
+    the joint states. ``magnify``: the magnified view's factor, in its tab's name when known (the
+    default factor is known when the run closes, which sends the layout again). Opens on ``sim_time`` following the end of the data: at the last frame of a finished
     run, and on the newest frame of a run still being written.
     """
     main = FIELD_BY_KEY[main_field]
@@ -210,7 +213,7 @@ def build_blueprint(
         rrb.Spatial2DView(
             origin=f"/{PLANE}",
             contents=[f"+ /{x}" for x in (UNDEFORMED, MAGNIFIED)],
-            name="Magnified deformed shape",
+            name="Magnified deformed shape" + (f" × {magnify:g}" if magnify else ""),
         ),
         _structure_view("Joint states: sliding ratio", sliding, joints),
         _structure_view("Joint states: largest opening", opening, joints),

@@ -165,7 +165,7 @@ class Recorder:
         os.makedirs(os.path.dirname(os.path.abspath(self.path)), exist_ok=True)
         with _io_errors(self.path):
             self._main_field = main_field
-            self.rec.save(self.path, default_blueprint=build_blueprint(main_field, self.paper))
+            self.rec.save(self.path, default_blueprint=build_blueprint(main_field, self.paper, magnify))
             log_static(self.rec, static, self._blocks, self._supports)
             tolerance = self.metadata.get("nlgs_tolerance")
             self._log10_tolerance = float(np.log10(tolerance)) if tolerance else np.nan
@@ -272,7 +272,7 @@ class Recorder:
                     error = err
                     note = f"{note} (recording flush failed: {err!r})".strip()
                 self._log_metadata(status, note)
-                self._unpin_unreached_paper_instant()
+                self._send_final_layout()
             finally:
                 self.rec.disconnect()
         check_complete(self.path)
@@ -281,16 +281,17 @@ class Recorder:
                 raise error
             warnings.warn(f"recording flush failed while closing: {error!r}", RuntimeWarning, stacklevel=2)
 
-    def _unpin_unreached_paper_instant(self) -> None:
-        """A run that ended before the paper's instant (Ctrl-C, --stop-at-collapse, a failure) has no frame
-        there: its tabs pinned to the instant were empty (the colour bar and the triangulation) and the
-        recording opened on the first. The layout is sent again without them; the last default wins."""
-        if self.paper is None:
-            return
-        reached = self._last is not None and self._last[1] >= self.paper[0] - 0.5 * self.static.dt
-        if not reached:
-            self.paper = None
-            self.rec.send_blueprint(build_blueprint(self._main_field, None), make_active=True, make_default=True)
+    def _send_final_layout(self) -> None:
+        """The layout again, the last default wins: with the magnified view's factor in its tab's name (the
+        default factor is known now; the tab did not say it), and without the tabs pinned to the paper's
+        instant when the run ended before it (Ctrl-C, --stop-at-collapse, a failure): they had no frame
+        there, were empty (the colour bar and the triangulation) and the recording opened on the first."""
+        if self.paper is not None:
+            reached = self._last is not None and self._last[1] >= self.paper[0] - 0.5 * self.static.dt
+            if not reached:
+                self.paper = None
+        layout = build_blueprint(self._main_field, self.paper, self.magnify)
+        self.rec.send_blueprint(layout, make_active=True, make_default=True)
 
     # ---- per-batch content
     def _send_batch(self, b: FrameBatch) -> None:
@@ -341,6 +342,8 @@ class Recorder:
             columns += rr.DynamicArchetype.columns(
                 archetype, components={"colors": rr.components.ColorBatch(colors[:, self._blocks.owner].reshape(-1))}
             ).partition(per_vertex)
+            # no point for an empty count ("0 below" is left out): an empty label still drew its box
+            shown = np.array([bool(t) for t in labels]).reshape(n_frames, TICKS + 3)
             self.rec.send_columns(
                 f.labels,
                 indexes=idx,
@@ -348,8 +351,9 @@ class Recorder:
                     # positions with the labels at every frame: a view pinned to an instant reads a time
                     # range, which joins no static positions to temporal labels
                     *rr.Points2D.columns(
-                        positions=np.tile(self._label_anchors, (n_frames, 1)), labels=labels
-                    ).partition(partition_lengths(n_frames, TICKS + 3)),
+                        positions=np.tile(self._label_anchors, (n_frames, 1))[shown.reshape(-1)],
+                        labels=[t for t in labels if t],
+                    ).partition(shown.sum(axis=1)),
                     *rr.AnyValues.columns(range_lo=pa.array(lo), range_hi=pa.array(hi)),
                 ],
             )

@@ -126,10 +126,11 @@ def _time_line_extent(rec, timeline: str, start: int, end: int) -> None:
 
 def _series(rec, entity: str, timeline: str, per_unit: float, at, values, style) -> None:
     """``values`` against ``at`` (sorted; non-finite pairs dropped) as scalars on the sequence time line
-    ``timeline`` whose tick is ``1 / per_unit`` of ``at``'s unit; ``style`` names and colours the series."""
+    ``timeline`` whose tick is ``1 / per_unit`` of ``at``'s unit; ``style`` (archetypes) names and colours
+    the series."""
     at, values = np.asarray(at, dtype=np.float64), np.asarray(values, dtype=np.float64)
     keep = np.isfinite(at) & np.isfinite(values)
-    rec.log(entity, style, static=True)
+    rec.log(entity, *style, static=True)
     if keep.any():
         order = np.argsort(at[keep], kind="stable")
         ticks = np.rint(at[keep][order] * per_unit).astype(np.int64)
@@ -225,16 +226,35 @@ def x_scale(name: str, unit: str, per_unit: float) -> tuple[str, str]:
 
 
 def _send_curve(rec, base: str, timeline: str, per_unit: float, series) -> None:
-    """The curve's series (``masonrycli.study.curves``: the PNG draws the same ones) under ``base``."""
-    for c in series:
+    """The curve's series (``masonrycli.study.curves``: the PNG draws the same ones) under ``base``.
+
+    A line followed by its own points (same data and colour; the threshold curve) is one entity with both
+    styles under the line's name, one legend entry as in the PNG: as two entities the legend listed
+    "amp_threshold (m/s)" and "amp_threshold (m/s): points"."""
+    series = list(series)
+    for i, c in enumerate(series):
+        before = series[i - 1] if i else None
+        if before is not None and before.marker == "line" and _same_points(before, c):
+            continue  # sent with its line
+        after = series[i + 1] if i + 1 < len(series) else None
         label = viewer_safe_text(c.label)
         if c.marker == "line":
-            style = rr.SeriesLines(colors=[rgb(c.colour)], names=[label], widths=[2.0])
+            style = [rr.SeriesLines(colors=[rgb(c.colour)], names=[label], widths=[2.0])]
+            if after is not None and after.marker != "line" and _same_points(c, after):
+                style.append(_points_style(after, label))
         else:
-            marker = {"tick": "circle"}.get(c.marker, c.marker)  # a tick reads as a dot at this size
-            size = 6.0 if c.marker in ("up", "down") else 4.0
-            style = rr.SeriesPoints(colors=[rgb(c.colour)], names=[label], markers=[marker], marker_sizes=[size])
+            style = [_points_style(c, label)]
         _series(rec, f"{base}/{c.key}", timeline, per_unit, c.x, c.y, style)
+
+
+def _same_points(a, b) -> bool:
+    return a.colour == b.colour and np.array_equal(a.x, b.x) and np.array_equal(a.y, b.y)
+
+
+def _points_style(c, label: str) -> rr.SeriesPoints:
+    marker = {"tick": "circle"}.get(c.marker, c.marker)  # a tick reads as a dot at this size
+    size = 6.0 if c.marker in ("up", "down") else 4.0
+    return rr.SeriesPoints(colors=[rgb(c.colour)], names=[label], markers=[marker], marker_sizes=[size])
 
 
 def _log_fragility(rec, rows: list[dict], fit, im: str) -> tuple[str, int]:
