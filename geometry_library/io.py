@@ -26,6 +26,7 @@ geometry, optionally preceded by a label and a colon::
     c01-b01: POLYGON ((...))                                # block "c01-b01"
     block c01-b02: POLYGON ((...))
     support ground fixed: POLYGON ((...))                   # support, role fixed or driven
+    support: POLYGON ((...))                                # support "support-<j>", fixed
 
 A ``MULTIPOLYGON`` or ``GEOMETRYCOLLECTION`` of polygons gives one block per member (named
 ``<label>-<k>`` when labelled); the whole file may also be one such geometry spread over lines.
@@ -62,6 +63,8 @@ _LABEL = re.compile(
     r"^\s*(?:(?P<role>block|support)\s+)?(?P<name>[^\s:]+)(?:\s+(?P<srole>fixed|driven))?\s*:\s*(?P<wkt>.+)$",
     re.IGNORECASE,
 )
+_ROLE_ONLY = re.compile(r"^\s*(?P<role>block|support)(?:\s+(?P<srole>fixed|driven))?\s*:\s*(?P<wkt>.+)$", re.IGNORECASE)
+"""A role with no name (``support : POLYGON …``): _LABEL read its role word as the name of a block."""
 
 
 def _read_text(path: Path) -> str:
@@ -245,9 +248,10 @@ def read_wkt(path, density: float = 2500.0, thickness: float = 1.0) -> Assembly:
         entries.append((f"{path}: line {lines[0][0]}", None, None, None, " ".join(t for _, t in lines)))
     else:
         for n, line in lines:
-            m = _LABEL.match(line)
+            m = _ROLE_ONLY.match(line) or _LABEL.match(line)
             if m and not line.upper().startswith(("POLYGON", "MULTIPOLYGON", "GEOMETRYCOLLECTION")):
-                entries.append((f"{path}: line {n}", m["role"], m["name"], m["srole"], m["wkt"]))
+                name = m.groupdict().get("name")
+                entries.append((f"{path}: line {n}", m["role"], name, m["srole"], m["wkt"]))
             else:
                 entries.append((f"{path}: line {n}", None, None, None, line))
     blocks: list[Block] = []

@@ -215,3 +215,24 @@ def test_write_wkt_rejects_names_it_cannot_label(tmp_path):
     a = Assembly((Block(box(0, 0, 1, 1), "has space"),))
     with pytest.raises(GeometryError, match="cannot be written to WKT"):
         write_wkt(a, tmp_path / "x.wkt")
+
+
+def test_wkt_a_role_without_a_name_is_that_role_named_by_number(tmp_path):
+    # "support : POLYGON …" (the name left out before the colon) was read as a *block* named "support",
+    # and "support fixed: …" as a support named "support"; the format says an unlabelled body is named
+    # by number, so they are supports support-1, support-2 (and "block: …" is block-1).
+    path = tmp_path / "roles.wkt"
+    path.write_text(
+        "block: POLYGON ((0 0, 1 0, 1 1, 0 1, 0 0))\n"
+        "support : POLYGON ((-2 -1, 3 -1, 3 0, -2 0, -2 -1))\n"
+        "support driven: POLYGON ((-2 -2, 3 -2, 3 -1, -2 -1, -2 -2))\n"
+        "block block: POLYGON ((0 1, 1 1, 1 2, 0 2, 0 1))\n"  # a block named "block", as write_wkt writes it
+        "support fixed fixed: POLYGON ((-2 -3, 3 -3, 3 -2, -2 -2, -2 -3))\n"  # a support named "fixed"
+    )
+    a = read_wkt(path)
+    assert [b.name for b in a.blocks] == ["block-1", "block"]
+    assert [(s.name, s.role) for s in a.supports] == [
+        ("support-1", "fixed"),
+        ("support-2", "driven"),
+        ("fixed", "fixed"),
+    ]
