@@ -14,7 +14,7 @@ from typing import Annotated
 
 import typer
 
-from masonrycli.errors import EXIT_ROWS_FAILED, NOT_A_FILE, InputError
+from masonrycli.errors import EXIT_DIVERGED, EXIT_ROWS_FAILED, NOT_A_FILE, InputError
 from masonrycli.interrupt import FirstSignalStops, exit_code, signal_name
 from masonrycli.outputs import OutputFile, safe_name
 
@@ -194,14 +194,7 @@ def sweep_command(
         try:
             result = run_study(base, request, console)
             _report(console, result, request, name, im, picture, recording, written, signals)
-            if result.failed:
-                # a script saw exit 0 under "2 failed" (histories on a full disk): a failed run is no outcome
-                err_console.print(
-                    f"error: {result.failed} of {_n(len(result.rows), 'row')} failed (the reason is in their "
-                    f"error column in {result.out}); run the same command again to retry them",
-                    soft_wrap=True,
-                )
-                raise typer.Exit(EXIT_ROWS_FAILED)
+            _exit_for_failed_rows(result, err_console)
         except KeyboardInterrupt:
             signum = signals.stopping()
             how = "" if signum == signal.SIGINT else f" ({signal_name(signum)})"
@@ -216,6 +209,27 @@ def sweep_command(
                 said = f"every row is in {out}, but not written: {', '.join(missing)}; run the same command {again}"
             err_console.print(f"interrupted{how}: {said}", soft_wrap=True)
             raise typer.Exit(exit_code(signum)) from None
+
+
+def _exit_for_failed_rows(result, err_console) -> None:
+    """Exit 5 when rows failed, else 3 when runs diverged (as ``masonry simulate``), each with one line:
+    a script saw exit 0 under "2 failed" (histories on a full disk). A collapse is an outcome, not this."""
+    total = _n(len(result.rows), "row")
+    diverged = sum(1 for r in result.rows if r.get("status") == "diverged")
+    if result.failed:
+        err_console.print(
+            f"error: {result.failed} of {total} failed (the reason is in their error column in {result.out}); "
+            "run the same command again to retry them",
+            soft_wrap=True,
+        )
+    if diverged:
+        err_console.print(
+            f"error: {diverged} of {total} diverged (status diverged, where in their error column in "
+            f"{result.out}); a smaller dt (--dt, or --param dt=...) may follow them",
+            soft_wrap=True,
+        )
+    if result.failed or diverged:
+        raise typer.Exit(EXIT_ROWS_FAILED if result.failed else EXIT_DIVERGED)
 
 
 def _base_scenario(target: str, duration, dt):

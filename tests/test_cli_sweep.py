@@ -790,3 +790,28 @@ def test_failed_rows_give_exit_5_after_the_whole_table(block, tmp_path, monkeypa
     monkeypatch.setattr(run, "simulate", real)
     again = invoke("sweep", block, *args, "--force")  # --force: the plot exists
     assert again.exit_code == 0 and "(2 runs now, 1 row already there, 0 failed)" in again.output, again.output
+
+
+def test_diverged_rows_give_exit_3_as_simulate_does(block, tmp_path, monkeypatch):
+    # A diverged run (exit 3 from `masonry simulate`) left a row with status diverged and exit 0.
+    import dataclasses
+
+    from masonrycli import run
+
+    real = run.simulate
+
+    def diverging(scenario, sinks, **kw):
+        result = real(scenario, sinks, **kw)
+        if scenario.motions[0].amplitude > 0.15:
+            return dataclasses.replace(result, status="diverged", message="diverged at t = 0.0100 s")
+        return result
+
+    monkeypatch.setattr(run, "simulate", diverging)
+    out = tmp_path / "s.csv"
+    result = invoke(
+        "sweep", block, "-p", "amp=0.1,0.2", "--duration", 0.02, "--workers", 0, "-o", out, "--no-recording"
+    )
+    assert result.exit_code == 3, result.output
+    assert [r["status"] for r in read_rows(out)] == ["completed", "diverged"]
+    said = " ".join(result.output.split())
+    assert f"error: 1 of 2 rows diverged (status diverged, where in their error column in {out}); a smaller" in said
