@@ -19,7 +19,7 @@ def test_exit_codes_are_the_readme_troubleshooting_table():
     table = README.read_text(encoding="utf-8").split("## Troubleshooting", 1)[1].split("\n\n", 2)[1]
     documented = {int(m) for m in re.findall(r"^\| (\d+) \|", table, flags=re.M)}
     constants = {v for k, v in vars(errors).items() if k.startswith("EXIT_")}
-    assert documented == constants == {0, 1, 2, 3, 4}
+    assert documented == constants and len(constants) == len([k for k in vars(errors) if k.startswith("EXIT_")])
     row = {int(m[0]): m[1] for m in re.findall(r"^\| (\d+) \| (.*)$", table, flags=re.M)}
     assert "completed" in row[errors.EXIT_OK] and "internal error" in row[errors.EXIT_INTERNAL]
     assert "bad input" in row[errors.EXIT_BAD_INPUT] and "diverged" in row[errors.EXIT_DIVERGED]
