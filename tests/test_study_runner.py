@@ -118,3 +118,26 @@ def test_a_scheduler_address_where_no_dask_scheduler_answers_is_one_line(greetin
         listener.close()
     assert time.monotonic() - start < 2.0 + runner.CONNECT_GRACE + 5.0
     assert "\n" not in str(raised.value) and "Dask scheduler" in str(raised.value)
+
+
+def _distributed_log_level() -> int:
+    import logging
+
+    return logging.getLogger("distributed.worker").getEffectiveLevel()
+
+
+def test_local_cluster_workers_log_nothing_below_critical():
+    # A worker's heartbeat that met the scheduler closing on SIGTERM printed an ERROR line and a
+    # StreamClosedError traceback under the "interrupted" line (CI at ace4a71). Its logs say nothing a user
+    # needs: a run's errors come back in its row.
+    import logging
+
+    from masonrycli.study import runner
+
+    client, cluster = runner.open_cluster(None, 1)
+    try:
+        levels = client.run(_distributed_log_level)
+    finally:
+        client.close()
+        cluster.close()
+    assert levels and all(level >= logging.CRITICAL for level in levels.values()), levels

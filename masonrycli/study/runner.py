@@ -82,7 +82,24 @@ def open_cluster(scheduler: str | None, workers: int | None):
     finally:
         if main:
             signal.signal(signal.SIGINT, previous)
-    return Client(cluster), cluster
+    client = Client(cluster)
+    try:
+        # A worker process's logs are teardown noise under the one-line "interrupted" message: one whose
+        # heartbeat met the closing scheduler printed "Failed to communicate with scheduler during heartbeat"
+        # and a StreamClosedError traceback (CI, 2026-11-27). A run's own errors come back in its row.
+        # (silence_logs above does not reach the worker processes.)
+        client.run(quiet_worker_logs)
+    except BaseException:
+        client.close()
+        cluster.close()
+        raise
+    return client, cluster
+
+
+def quiet_worker_logs() -> None:
+    """Run on each worker of a study's LocalCluster: its ``distributed`` logger to CRITICAL (see
+    :func:`open_cluster`)."""
+    logging.getLogger("distributed").setLevel(logging.CRITICAL)
 
 
 CONNECT_TIMEOUT = 20.0
