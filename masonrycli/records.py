@@ -87,6 +87,8 @@ def _fields(line: str) -> list[str]:
     (time, x, y) record, 0,5 becoming x = 0, y = 5 m/s, and the run said completed. A line with a tab
     and a comma is split on tabs alone likewise (``0<TAB>0,5``, the spreadsheet's tab-delimited text)."""
     separator = ";" if ";" in line else "\t" if "\t" in line and "," in line else None
+    if separator == "\t" and any(f.strip().startswith(",") or f.strip().endswith(",") for f in line.split("\t")):
+        separator = None  # a comma beside a tab separates: "0.01,<TAB>0.5", a CSV aligned with tabs
     if separator is None:
         return [f for f in _SPLIT.split(line) if f != ""]
     fields = [f.strip() for f in line.split(separator) if f.strip() != ""]

@@ -56,6 +56,16 @@ def test_tab_separated_csv_has_decimal_commas(tmp_path):
     np.testing.assert_array_equal(load_record_csv(f)[1], [1.5, 2.5])
 
 
+def test_comma_separated_csv_aligned_with_tabs(tmp_path):
+    # "0.01,<TAB>0.5": the comma separates (a CSV whose columns are aligned with tabs), as before the
+    # tab-delimited rule: split on tabs alone it read '"0.01,": not a number'
+    f = tmp_path / "aligned.csv"
+    f.write_text("time,\tvel\n0.00,\t0.0\n0.01,\t0.5\n0.02 ,\t-0.25\n")
+    t, v = load_record_csv(f)
+    np.testing.assert_array_equal(t, [0.0, 0.01, 0.02])
+    np.testing.assert_array_equal(v, [0.0, 0.5, -0.25])
+
+
 def test_record_motion_source_is_absolute():
     m = record_motion(DATA / "quake_velocity.csv", scale=2.0)
     assert Path(m.source).is_absolute() and Path(m.source).name == "quake_velocity.csv"
