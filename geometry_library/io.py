@@ -248,7 +248,10 @@ def read_wkt(path, density: float = 2500.0, thickness: float = 1.0) -> Assembly:
         entries.append((f"{path}: line {lines[0][0]}", None, None, None, " ".join(t for _, t in lines)))
     else:
         for n, line in lines:
-            m = _ROLE_ONLY.match(line) or _LABEL.match(line)
+            m = _ROLE_ONLY.match(line)
+            if m and m["srole"] and m["role"].lower() == "block":
+                m = None  # "block fixed: …" is a block named "fixed" (a block has no support role): write_wkt's
+            m = m or _LABEL.match(line)
             if m and not line.upper().startswith(("POLYGON", "MULTIPOLYGON", "GEOMETRYCOLLECTION")):
                 name = m.groupdict().get("name")
                 entries.append((f"{path}: line {n}", m["role"], name, m["srole"], m["wkt"]))

@@ -236,3 +236,13 @@ def test_wkt_a_role_without_a_name_is_that_role_named_by_number(tmp_path):
         ("support-2", "driven"),
         ("fixed", "fixed"),
     ]
+
+
+def test_wkt_round_trip_keeps_blocks_named_like_a_support_role(tmp_path):
+    # write_wkt writes a block named "fixed" as "block fixed: …": a block has no support role, so that is its
+    # name (the role-only rule read it as an unnamed block, "block-1", and the round trip lost the name)
+    a = Assembly(
+        (Block(box(0, 0, 1, 1), "fixed"), Block(box(0, 1, 1, 2), "driven")),
+        (Support(box(-2, -1, 3, 0), "ground", "fixed"),),
+    )
+    same_assembly(read_wkt(write_wkt(a, tmp_path / "named.wkt")), a, materials=False)
