@@ -39,11 +39,18 @@ def _make_source_digest():
             sources = []
             for folder, subfolders, names in os.walk(root):  # lazily, so the pruning below takes effect
                 subfolders[:] = [d for d in subfolders if d != "__pycache__"]
-                sources += [os.path.relpath(os.path.join(folder, n), root) for n in names if n.endswith(".py")]
+                # regular files only: an editor's lock file (Emacs: ".#cli.py", a symbolic link to nothing)
+                # made open() raise inside "import masonrycli", and every command ended in a traceback
+                paths = [os.path.join(folder, n) for n in names if n.endswith(".py")]
+                sources += [os.path.relpath(p, root) for p in paths if os.path.isfile(p)]
             for relative in sorted(sources):  # one order on every machine, whatever the file system's
+                try:
+                    with open(os.path.join(root, relative), "rb") as fh:
+                        content = fh.read()
+                except FileNotFoundError:  # gone since the walk (a save in progress): as if never listed
+                    continue
                 digest.update(f"{name}/{relative}".encode() + b"\0")
-                with open(os.path.join(root, relative), "rb") as fh:
-                    digest.update(fh.read())
+                digest.update(content)
         return digest.hexdigest()[:12]
 
     return source_digest

@@ -189,3 +189,17 @@ def test_the_study_uses_only_distributed_s_public_api():
             ):
                 private.append(f"{path.relative_to(ROOT)}:{node.lineno} {node.value.id}.{node.attr}")
     assert private == []
+
+
+def test_the_digest_skips_what_is_not_a_source_file(tmp_path, monkeypatch):
+    """An editor's lock file (Emacs: '.#cli.py', a symbolic link to nothing) beside the sources: open() of it
+    raised FileNotFoundError inside 'import masonrycli', and every command ended in a traceback."""
+    from masonrycli.source_digest import source_digest
+
+    package = tmp_path / "digest_probe_pkg"
+    package.mkdir()
+    (package / "__init__.py").write_text("x = 1\n")
+    monkeypatch.syspath_prepend(str(tmp_path))
+    clean = source_digest(("digest_probe_pkg",))
+    (package / ".#__init__.py").symlink_to(tmp_path / "user@host.1234")  # what Emacs leaves while editing
+    assert source_digest(("digest_probe_pkg",)) == clean
