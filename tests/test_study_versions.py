@@ -203,3 +203,21 @@ def test_the_digest_skips_what_is_not_a_source_file(tmp_path, monkeypatch):
     clean = source_digest(("digest_probe_pkg",))
     (package / ".#__init__.py").symlink_to(tmp_path / "user@host.1234")  # what Emacs leaves while editing
     assert source_digest(("digest_probe_pkg",)) == clean
+
+
+def test_the_check_asks_at_the_address_the_command_was_given(monkeypatch):
+    """A scheduler in a container or behind a tunnel reports an address of its own (tcp://172.17.0.2:8786)
+    that this machine may not reach: the check connects where the study's client did (--scheduler)."""
+    asked = []
+
+    class Tunnelled:
+        def scheduler_info(self):
+            return {"address": "tcp://172.17.0.2:8786", "workers": {"tcp://a:1": {}}}
+
+    def ask_workers(address, function, timeout):
+        asked.append(address)
+        return {"tcp://a:1": this_version()}
+
+    monkeypatch.setattr(versions, "ask_workers", ask_workers)
+    check_workers(Tunnelled(), "tcp://localhost:18786")
+    assert asked == ["tcp://localhost:18786"]

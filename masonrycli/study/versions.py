@@ -75,7 +75,9 @@ def check_workers(client, scheduler: str) -> None:
     Workers that join later are checked by each run (:func:`make_task`)."""
     ours = this_version()
     try:
-        found = ask_workers(client.scheduler_info()["address"], _make_probe(), PROBE_TIMEOUT)
+        # where the study's client connected: the address the scheduler reports may not be reachable from
+        # here (a container's own IP, a tunnel's far end)
+        found = ask_workers(scheduler, _make_probe(), PROBE_TIMEOUT)
     except TimeoutError:
         workers = len(client.scheduler_info().get("workers", {}))
         raise InputError(
