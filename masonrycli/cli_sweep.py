@@ -224,8 +224,8 @@ def _exit_for_failed_rows(result, err_console) -> None:
         )
     if diverged:
         err_console.print(
-            f"error: {diverged} of {total} diverged (status diverged, where in their error column in "
-            f"{result.out}); a smaller dt (--dt, or --param dt=...) may follow them",
+            f"error: {diverged} of {total} diverged (their error column in {result.out} says when); "
+            "a smaller dt (--dt, or --param dt=...) may follow them",
             soft_wrap=True,
         )
     if result.failed or diverged:

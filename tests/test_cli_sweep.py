@@ -814,4 +814,5 @@ def test_diverged_rows_give_exit_3_as_simulate_does(block, tmp_path, monkeypatch
     assert result.exit_code == 3, result.output
     assert [r["status"] for r in read_rows(out)] == ["completed", "diverged"]
     said = " ".join(result.output.split())
-    assert f"error: 1 of 2 rows diverged (status diverged, where in their error column in {out}); a smaller" in said
+    assert f"error: 1 of 2 rows diverged (their error column in {out} says when); a smaller" in said
+    assert [r["error"] for r in read_rows(out)] == ["", "diverged at t = 0.0100 s"]
