@@ -118,3 +118,29 @@ def test_points_without_a_threshold_are_marked_at_the_searched_range_ends(png_fi
     assert png[above["label"]] == png[below["label"]] == above["rgb"] == rgb(NOT_FOUND_COLOUR)
     assert above["label"] == "none found: no collapse up to amp = 1.5"
     assert png["amp_threshold (m/s)"] == series["/study/thresholds/line"]["rgb"]
+
+
+@pytest.mark.parametrize("which", ["state_map", "fragility_curve", "threshold_curve"])
+def test_a_figure_is_closed_when_saving_it_fails(which, monkeypatch, tmp_path):
+    """A disk full (or a Ctrl-C) at savefig left the figure open: a long-lived process (a notebook, the
+    Dask client) kept one more figure per study."""
+    import matplotlib.figure
+    import matplotlib.pyplot as plt
+
+    def fail(fig, path, **kwargs):
+        raise OSError("No space left on device")
+
+    monkeypatch.setattr(matplotlib.figure.Figure, "savefig", fail)
+    rows = FRAGILITY_ROWS
+    before = set(plt.get_fignums())
+    with pytest.raises(OSError):
+        if which == "state_map":
+            rows = [r | {"collapse_time": 1.0} for r in rows]
+            plots.state_map(rows, "scale", "record", tmp_path / "m.png", "states")
+        elif which == "fragility_curve":
+            fit = fit_lognormal([r["pga"] for r in rows], [r["state"] == "collapsed" for r in rows], "pga")
+            plots.fragility_curve(rows, "pga", fit, tmp_path / "f.png", "fragility", "m/s²")
+        else:
+            rows = [{"freq": 1.0, "amp_threshold": 1.3, "amp_lo": 1.2, "amp_hi": 1.4, "outcome": "collapse"}]
+            plots.threshold_curve(rows, "amp", "freq", tmp_path / "t.png", "thresholds", (0.25, 1.5))
+    assert set(plt.get_fignums()) == before

@@ -70,9 +70,10 @@ def state_map(rows: list[dict], x: str, y: str | None, path: Path, title: str) -
     handles = [Patch(color=STATE_COLOURS[s], label=s) for s in ("intact", "damaged", "collapsed")]
     ax.legend(handles=handles, loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False)
     ax.set_title(title, fontsize=10)
-    path = _save(fig, path)
-    plt.close(fig)
-    return path
+    try:
+        return _save(fig, path)
+    finally:
+        plt.close(fig)  # also when saving fails: a long-lived process would keep every figure
 
 
 def _draw(ax, series) -> None:
@@ -114,9 +115,10 @@ def fragility_figure(rows: list[dict], im: str, fit, title: str, unit: str):
 def fragility_curve(rows: list[dict], im: str, fit, path: Path, title: str, unit: str) -> Path:
     """PNG of :func:`fragility_figure`."""
     fig = fragility_figure(rows, im, fit, title, unit)
-    path = _save(fig, path)
-    _pyplot().close(fig)
-    return path
+    try:
+        return _save(fig, path)
+    finally:
+        _pyplot().close(fig)  # also when saving fails: a long-lived process would keep every figure
 
 
 def threshold_figure(rows: list[dict], find: str, x: str | None, title: str, searched: tuple[float, float]):
@@ -142,6 +144,7 @@ def threshold_curve(
 ) -> Path:
     """PNG of :func:`threshold_figure`."""
     fig = threshold_figure(rows, find, x, title, searched)
-    path = _save(fig, path)
-    _pyplot().close(fig)
-    return path
+    try:
+        return _save(fig, path)
+    finally:
+        _pyplot().close(fig)  # also when saving fails: a long-lived process would keep every figure
