@@ -208,3 +208,17 @@ def test_closing_the_cluster_silences_its_teardown_logs(capfd):
         assert "after" in capfd.readouterr().err
     finally:
         scheduler.removeHandler(handler)
+
+
+def test_a_run_whose_output_failed_is_an_error_row_with_its_message(arch_base, tmp_path, monkeypatch):
+    """simulate returns status "failed" (no exception) when a history write fails mid-run: the row said
+    status "failed" with an empty error column, was not counted as failed and not run again on resume."""
+    from masonrycli.history import HistoryFile
+
+    def disk_full(self, frame):
+        raise OSError(28, "No space left on device")
+
+    monkeypatch.setattr(HistoryFile, "on_frame", disk_full)
+    row = run_task(arch_base, {"amp": 0.5}, history_dir=str(tmp_path))
+    assert row["status"] == "error" and row["state"] == "" and row["amp"] == 0.5
+    assert row["error"].startswith("failed: stopped at t = ") and "No space left on device" in row["error"]

@@ -120,7 +120,8 @@ def run_study(base: StudyBase, request: StudyRequest, console: Console) -> Study
     names = [a.name for a in request.axes if a.name != request.find]  # a row's key
     points = grid([a for a in request.axes if a.name != request.find])
     table, ours = files.open_table(request.out, study_id, request.force, names, points)
-    done = {store.row_key(r, names): r for r in ours if r.get("status") != "error"}
+    # run again: error rows, and "failed" ones (tables written before those became error rows)
+    done = {store.row_key(r, names): r for r in ours if r.get("status") not in ("error", "failed")}
     if request.find:
         driver = FindDriver(request.axes, request.find, request.outcome, request.rtol, done)
         columns = names + [f"{request.find}_{s}" for s in ("threshold", "lo", "hi")]

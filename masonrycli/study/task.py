@@ -76,15 +76,18 @@ def run_task(
         return row | empty_result(f"{type(exc).__name__}: {exc}", time.perf_counter() - start)
     out = result.outcome
     tally = result.tally
+    # a run that stopped early without raising (status "failed": an output's write failed mid-run;
+    # "interrupted") did not finish: an error row like any failed task, counted and run again on resume
+    failed = result.status not in ("completed", "diverged")
     row |= {
-        "state": out["state"],
+        "state": "" if failed else out["state"],
         "collapse_time": out["collapse_time"],
         "energy_dissipated": result.energy_dissipated,
     }
     row |= {name: result.intensity.get(name, math.nan) for name in INTENSITY_MEASURES}
     row |= {k: out[k] for k in ("residual_drift", "peak_drift", "max_opening", "hinges", "slide_time", "rock_time")}
     row |= {
-        "status": result.status,
+        "status": "error" if failed else result.status,
         "steps": result.steps,
         "time": result.time,
         "wall_time": time.perf_counter() - start,
@@ -93,7 +96,9 @@ def run_task(
         "capped_steps": tally.capped,
         "last_residual": tally.residual_last,
         "max_penetration": result.max_penetration,
-        "error": result.message if result.status == "diverged" else "",
+        "error": f"{result.status}: {result.message}"
+        if failed
+        else (result.message if result.status == "diverged" else ""),
     }
     return row
 
