@@ -141,3 +141,60 @@ def test_local_cluster_workers_log_nothing_below_critical():
         client.close()
         cluster.close()
     assert levels and all(level >= logging.CRITICAL for level in levels.values()), levels
+
+
+class SlowClient:
+    """A ``Client`` that connects ``delay`` s after it is made (``interrupt``: Ctrl-C in the main thread
+    first); every one made is in ``made``."""
+
+    made: list = []
+    delay = 0.6
+    interrupt = False
+
+    def __init__(self, scheduler, timeout=None):
+        import signal
+        import threading
+        import time
+
+        if self.interrupt:  # a real SIGINT during the wait: it wakes the main thread, as a Ctrl-C does
+            time.sleep(0.05)
+            signal.pthread_kill(threading.main_thread().ident, signal.SIGINT)
+        time.sleep(self.delay)
+        self.closed = False
+        SlowClient.made.append(self)
+
+    def close(self):
+        self.closed = True
+
+
+def _wait_for_made(n: int = 1, within: float = 5.0) -> list:
+    import time
+
+    end = time.monotonic() + within
+    while len(SlowClient.made) < n and time.monotonic() < end:
+        time.sleep(0.02)
+    time.sleep(0.1)  # the thread's close after the append
+    return SlowClient.made
+
+
+@pytest.mark.parametrize("interrupt", [False, True], ids=["gave up waiting", "Ctrl-C while waiting"])
+def test_a_client_that_connects_after_the_command_gave_up_is_closed(interrupt, monkeypatch):
+    # Before: the thread's Client connected after the 20 + 10 s wait (or a Ctrl-C during it) and stayed
+    # open, the process's default client, in a long-lived process (a notebook) until it ended.
+    from masonrycli.errors import InputError
+
+    monkeypatch.setattr(runner, "CONNECT_TIMEOUT", 0.1)
+    monkeypatch.setattr(runner, "CONNECT_GRACE", 0.1)
+    monkeypatch.setattr(SlowClient, "made", [])
+    monkeypatch.setattr(SlowClient, "interrupt", interrupt)
+    with pytest.raises(KeyboardInterrupt if interrupt else InputError):
+        runner._connect(SlowClient, "tcp://127.0.0.1:1")
+    made = _wait_for_made()
+    assert len(made) == 1 and made[0].closed
+
+
+def test_a_client_that_connects_in_time_is_returned_open(monkeypatch):
+    monkeypatch.setattr(SlowClient, "made", [])
+    monkeypatch.setattr(SlowClient, "delay", 0.05)
+    client = runner._connect(SlowClient, "tcp://127.0.0.1:1")
+    assert client is SlowClient.made[0] and not client.closed

@@ -116,32 +116,58 @@ def _connect(Client, scheduler: str):
     held ``Client`` forever, its own timeout notwithstanding; a thread left waiting there is a daemon and
     ends with the command. A service that speaks first made Dask read its bytes as a frame count
     (MemoryError: "Unable to allocate 3.07 EiB", a traceback): any failure but a connection's is "not
-    a Dask scheduler"."""
+    a Dask scheduler". A client that connects after the command gave up waiting (or was interrupted
+    while waiting) is closed by the thread: nobody else would, and it was the process's default client."""
     made: dict = {}
+    lock = threading.Lock()  # the thread hands its client over, or closes it once the command gave up
 
     def connect():
         try:
-            made["client"] = Client(scheduler, timeout=f"{CONNECT_TIMEOUT:g}s")
+            client = Client(scheduler, timeout=f"{CONNECT_TIMEOUT:g}s")
         except BaseException as exc:  # noqa: BLE001 - reported below, in the command's thread
-            made["error"] = exc
+            with lock:
+                made["error"] = exc
+            return
+        with lock:
+            if not made.get("given_up"):
+                made["client"] = client
+                return
+        client.close()
+
+    def give_up():
+        """Stop waiting: the thread closes a client it makes later; one it made already is closed here."""
+        with lock:
+            made["given_up"] = True
+            late = made.pop("client", None)
+        if late is not None:
+            late.close()
 
     thread = threading.Thread(target=connect, name="masonry-scheduler-connect", daemon=True)
-    thread.start()
-    thread.join(CONNECT_TIMEOUT + CONNECT_GRACE)
-    if thread.is_alive():
-        raise InputError(
-            f"--scheduler {scheduler}: no Dask scheduler answered within {CONNECT_TIMEOUT + CONNECT_GRACE:g} s "
-            "(something listens there but does not speak Dask: the dashboard's port, or another service?)"
-        )
-    error = made.get("error")
-    if isinstance(error, (OSError, TimeoutError)):
-        raise InputError(f"--scheduler {scheduler}: cannot connect ({type(error).__name__}: {error})") from None
-    if isinstance(error, Exception):
-        why = ": ".join([type(error).__name__, *str(error).splitlines()[:1]])
-        raise InputError(f"--scheduler {scheduler}: not a Dask scheduler (its answer is not Dask's protocol: {why})")
-    if error is not None:
-        raise error
-    return made["client"]
+    try:
+        thread.start()
+        thread.join(CONNECT_TIMEOUT + CONNECT_GRACE)
+        with lock:
+            waiting = "client" not in made and "error" not in made
+            made["given_up"] = waiting
+        if waiting:
+            raise InputError(
+                f"--scheduler {scheduler}: no Dask scheduler answered within {CONNECT_TIMEOUT + CONNECT_GRACE:g} s "
+                "(something listens there but does not speak Dask: the dashboard's port, or another service?)"
+            )
+        error = made.get("error")
+        if isinstance(error, (OSError, TimeoutError)):
+            raise InputError(f"--scheduler {scheduler}: cannot connect ({type(error).__name__}: {error})") from None
+        if isinstance(error, Exception):
+            why = ": ".join([type(error).__name__, *str(error).splitlines()[:1]])
+            raise InputError(
+                f"--scheduler {scheduler}: not a Dask scheduler (its answer is not Dask's protocol: {why})"
+            )
+        if error is not None:
+            raise error
+        return made["client"]
+    except BaseException:  # given up, or Ctrl-C while waiting (also just after the wait)
+        give_up()
+        raise
 
 
 IN_FLIGHT_PER_THREAD = 4
