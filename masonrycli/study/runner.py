@@ -148,8 +148,7 @@ def _connect(Client, scheduler: str):
         thread.join(CONNECT_TIMEOUT + CONNECT_GRACE)
         with lock:
             waiting = "client" not in made and "error" not in made
-            made["given_up"] = waiting
-        if waiting:
+        if waiting:  # the raise gives up (below): a client that arrives from now on is closed
             raise InputError(
                 f"--scheduler {scheduler}: no Dask scheduler answered within {CONNECT_TIMEOUT + CONNECT_GRACE:g} s "
                 "(something listens there but does not speak Dask: the dashboard's port, or another service?)"
