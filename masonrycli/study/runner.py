@@ -22,6 +22,7 @@ source changed on disk) stops the study (:class:`~masonrycli.study.versions.Work
 
 from __future__ import annotations
 
+import gc
 import logging
 import os
 import signal
@@ -125,14 +126,21 @@ def _connect(Client, scheduler: str):
         try:
             client = Client(scheduler, timeout=f"{CONNECT_TIMEOUT:g}s")
         except BaseException as exc:  # noqa: BLE001 - reported below, in the command's thread
+            # The error is kept without its traceback, which holds the half-made Client, whose
+            # finaliser stops its IO loop under distributed's one class-wide LoopRunner lock. Left to a
+            # later garbage collection, it ran inside the next LocalCluster's start, which holds that
+            # lock: the process hung (CI, 2026-11-27). Collected here, in this thread, nothing holds it.
+            exc.__traceback__ = exc.__context__ = exc.__cause__ = None
             with lock:
                 made["error"] = exc
+        else:
+            with lock:
+                if not made.get("given_up"):
+                    made["client"] = client
+                    return
+            client.close()
             return
-        with lock:
-            if not made.get("given_up"):
-                made["client"] = client
-                return
-        client.close()
+        gc.collect()  # out of the except block, where the traceback was still held
 
     def give_up():
         """Stop waiting: the thread closes a client it makes later; one it made already is closed here."""
