@@ -1,26 +1,25 @@
 """``masonry sweep``: a study of one structure over a grid of parameters or a set of records, on Dask.
 
-Thin: options -> base scenario and :class:`~masonrycli.study.study.StudyRequest` -> run_study ->
-table, PNG, Rerun recording. Registered on the app by :mod:`masonrycli.cli`.
+Thin: options -> :func:`~masonrycli.study.plan.plan_study` (every check, the base scenario and the
+:class:`~masonrycli.study.study.StudyRequest`) -> run_study -> table, PNG, Rerun recording; messages and
+exit codes. Registered on the app by :mod:`masonrycli.cli`.
 """
 
 from __future__ import annotations
 
 import contextlib
-import os
 import signal
 from pathlib import Path
-from typing import Annotated
+from typing import TYPE_CHECKING, Annotated
 
 import typer
 
-from masonrycli.errors import EXIT_DIVERGED, EXIT_ROWS_FAILED, NOT_A_FILE, InputError
+from masonrycli.errors import EXIT_DIVERGED, EXIT_ROWS_FAILED
 from masonrycli.interrupt import FirstSignalStops, exit_code, signal_name
-from masonrycli.outputs import OutputFile, safe_name
+from masonrycli.outputs import OutputFile
 
-BUILT_IN = ("wall", "arch", "aqueduct")
-SWEEP_DURATION = {"wall": 1.0, "arch": 2.0, "aqueduct": 2.0}
-"""s: default simulated time of a built-in structure in a study."""
+if TYPE_CHECKING:
+    from masonrycli.study.plan import StudyPlan
 
 
 def sweep_command(
@@ -112,72 +111,30 @@ def sweep_command(
     [bold]masonry sweep wall --param amp=0.1:1.0:10 --param freq=0.5:4:8 --out study.parquet[/bold]
     """
     from masonrycli.cli import console, err_console
-    from masonrycli.intensity import INTENSITY_MEASURES
     from masonrycli.study import store
-    from masonrycli.study.axes import StudyBase, parse_axis
-    from masonrycli.study.files import check_picture
-    from masonrycli.study.runner import check_scheduler
-    from masonrycli.study.study import StudyRequest, run_study
-    from masonrycli.study.task import check_outcome
+    from masonrycli.study.plan import plan_study
+    from masonrycli.study.study import run_study
 
-    base = StudyBase(_base_scenario(target, duration, dt), {})
-    name = base.scenario.name
-    # the name reduced as recordings name it: "../../evil" made a folder "study-.." and wrote beside it
-    out = store.check_out(out or Path(f"study-{safe_name(name)}.parquet"))
-    axes = [parse_axis(p) for p in param or []]
-    late: list[str] = []  # warnings about records longer than the runs
-    if records:
-        from masonrycli.study.axes import Axis
-
-        motions = _records(records, out)
-        whole = duration is None and target in BUILT_IN  # a scenario file's [run] duration stands
-        scenario, late = _record_duration(base.scenario, motions, whole)
-        base = StudyBase(scenario, motions)
-        axes.insert(0, Axis("record", tuple(motions)))
-    if scale is not None:
-        axes.append(parse_axis(f"scale={scale}"))
-    if not axes:
-        raise InputError("nothing to sweep: give --param NAME=..., or --records DIR")
-    if im not in INTENSITY_MEASURES or im == "d5_95":
-        raise InputError(f"--im {im}: expected one of pga, pgv, arias, sa")
-    if workers is not None and workers < 0:
-        raise InputError(f"--workers {workers}: must be >= 0")
-    scheduler = check_scheduler(scheduler)
-    if workers is not None and scheduler is not None:
-        raise InputError("--workers with --scheduler: the existing cluster has its own workers")
-    outcome = None if outcome is None else check_outcome(outcome)
-    for option, value in (("--outcome", outcome), ("--rtol", rtol)):
-        if value is not None and find is None:
-            raise InputError(f"{option} {value}: goes with --find (a grid reports every run's state)")
-    outcome, rtol = outcome or "collapse", 0.005 if rtol is None else rtol
-    if not (0 < rtol < 1):
-        raise InputError(f"--rtol {rtol}: must be in (0, 1)")
-    _check_out_reads_nothing(out, base)
-    # every output checked before the first run (the table and the histories by run_study, which knows
-    # which rows are this study's and which runs are still to make)
-    if no_recording and recording is not None:
-        raise InputError(f"--recording {recording} with --no-recording: choose one")
-    # the default files beside --out are named as such: "--plot s.png: the file exists" named an option
-    # the user had not given
-    picture = check_picture(plot or out.with_suffix(".png"), "--plot" if plot else "--out's plot", ".png", force)
-    recording = check_picture(
-        None if no_recording else recording or out.with_suffix(".rrd"),
-        "--recording" if recording else "--out's recording",
-        ".rrd",
-        force,
-    )
-    request = StudyRequest(
-        axes=axes,
-        out=out,
+    plan = plan_study(
+        target,
+        params=param,
+        records=records,
+        scale=scale,
         find=find,
         outcome=outcome,
         rtol=rtol,
+        out=out,
         scheduler=scheduler,
         workers=workers,
         stop_at_collapse=not full_runs,
+        duration=duration,
+        dt=dt,
+        im=im,
+        plot=plot,
+        recording=recording,
+        no_recording=no_recording,
         histories=histories,
         force=force,
-        warnings=tuple(late),
         warn=lambda line: err_console.print(f"warning: {line}", soft_wrap=True),
     )
     # SIGTERM (kill, a batch system's time limit) takes Ctrl-C's way out: the finished rows are written and
@@ -189,11 +146,11 @@ def sweep_command(
     # Only the first signal stops the study; later ones are acknowledged and ignored, as in a run's closing
     # phase (masonrycli.interrupt): a second Ctrl-C while the table was written cut it (only the journal
     # left, under "every finished row is in s.parquet"), and one after it killed the process (exit -2).
-    result, written = None, []
+    out, result, written = plan.request.out, None, []
     with FirstSignalStops() as signals:
         try:
-            result = run_study(base, request, console)
-            _report(console, result, request, name, im, picture, recording, written, signals)
+            result = run_study(plan.base, plan.request, console)
+            _report(console, result, plan, im, written, signals)
             _exit_for_failed_rows(result, err_console)
         except KeyboardInterrupt:
             signum = signals.stopping()
@@ -204,7 +161,8 @@ def sweep_command(
             elif result is None:
                 said = f"every finished row is in {out}; run the same command again to resume"
             else:  # the study is complete: what is missing is a picture
-                missing = [str(f.path) for f in (picture, recording) if f is not None and f.path not in written]
+                files = (plan.picture, plan.recording)
+                missing = [str(f.path) for f in files if f is not None and f.path not in written]
                 again = "with --force (no run is made again)" if written else "(no run is made again)"
                 said = f"every row is in {out}, but not written: {', '.join(missing)}; run the same command {again}"
             err_console.print(f"interrupted{how}: {said}", soft_wrap=True)
@@ -232,111 +190,7 @@ def _exit_for_failed_rows(result, err_console) -> None:
         raise typer.Exit(EXIT_ROWS_FAILED if result.failed else EXIT_DIVERGED)
 
 
-def _base_scenario(target: str, duration, dt):
-    from masonrycli.builtin import override_run
-    from masonrycli.motion import Sine
-    from masonrycli.scenario import Material, RunConfig, scenario_from_builder
-
-    if target in BUILT_IN:
-        # a shaken structure: 1 m/s at 2 Hz on the ground (wall) or both foundations (arch, aqueduct)
-        shaken = ("ground",) if target == "wall" else ("left-foundation", "right-foundation")
-        motions = {s: Sine(amplitude=1.0, frequency=2.0) for s in shaken}
-        options = {"blocks": 51} if target == "wall" else {}
-        scenario = scenario_from_builder(
-            target, options, RunConfig(duration=SWEEP_DURATION[target]), Material(), motions
-        )
-    else:
-        from masonrycli.scenario import scenario_from_geometry_file
-        from masonrycli.scenario_toml import load_scenario
-        from masonrycli.structure import GEOMETRY_SUFFIXES
-
-        path = Path(target)
-        if not path.exists():
-            raise InputError(f"{target}: no such scenario file (or built-in structure: {', '.join(BUILT_IN)})")
-        # a GeoJSON / WKT file as `masonry run` takes it (it said "TOML syntax error: Invalid statement")
-        geometry = path.suffix.lower() in GEOMETRY_SUFFIXES
-        scenario = scenario_from_geometry_file(path) if geometry else load_scenario(path)
-    return override_run(scenario, duration=duration, dt=dt)  # names the wrong option (--dt 0: --dt)
-
-
-def _record_duration(scenario, motions: dict, whole: bool):
-    """``(scenario, warnings)``: the scenario lasting the longest record (whole steps of its dt) if
-    ``whole`` (a built-in without --duration: its 1 s cut every record of an IDA to its first second);
-    else, if the runs are shorter than some records, one line saying so (printed once the request is
-    checked)."""
-    import dataclasses
-    import math
-
-    from masonrycli.scenario import MAX_DURATION
-
-    run = scenario.run
-    longest = max(m.end_time for m in motions.values())
-    if whole:
-        steps = max(1, math.ceil(longest / run.dt - 1e-9))
-        run = dataclasses.replace(run, duration=min(steps * run.dt, MAX_DURATION))
-        return dataclasses.replace(scenario, run=run), []
-    late = [name for name, m in motions.items() if m.end_time > run.duration + 0.5 * run.dt]
-    if not late:
-        return scenario, []
-    return scenario, [
-        f"the runs' {run.duration:g} s are shorter than {len(late)} of {len(motions)} records (longest "
-        f"{longest:g} s, {late[0]}): their shaking after t = {run.duration:g} s is not applied"
-    ]
-
-
-def _records(entries: list[Path], out: Path) -> dict:
-    """Record motions by file name, from files and the .AT2 / .csv files of folders (but the study's
-    table ``out``: kept in its records' folder, it was read as a record by the same command run again,
-    "recs/ida.csv:2: not a number", so the study could not be resumed)."""
-    from masonrycli.records import record_motion
-
-    files = []
-    for entry in entries:
-        if entry.is_dir():
-            found = sorted(
-                p for p in entry.iterdir() if p.suffix.lower() in (".at2", ".csv") and not _same_file(p, out)
-            )
-            if not found:
-                raise InputError(f"--records {entry}: no .AT2 or .csv record in it")
-            files += found
-        elif entry.is_file():
-            files.append(entry)
-        else:
-            raise InputError(f"--records {entry}: {NOT_A_FILE if entry.exists() else 'no such file or folder'}")
-    names = [p.name for p in files]
-    twice = sorted({n for n in names if names.count(n) > 1})
-    if twice:
-        raise InputError(f"--records: two records named {twice[0]} (rows are keyed by the file name)")
-    return {p.name: record_motion(p, display=str(p)) for p in files}
-
-
-def _same_file(a, b) -> bool:
-    try:
-        return os.path.samefile(a, b)
-    except OSError:  # one of them does not exist (yet)
-        return False
-
-
-def _check_out_reads_nothing(out: Path, base) -> None:
-    """Refuse an ``--out`` that is a record file the study reads: with ``--force`` the table replaced it
-    (``--records rec.csv --out rec.csv --force``: the record was lost)."""
-    motions = (*base.scenario.motions, *base.records.values())
-    for source in (s for m in motions for s in (getattr(m, "source", ""), getattr(m, "vertical_source", ""))):
-        if source and _same_file(out, source):
-            raise InputError(f"--out {out}: is the record {source} (the table would replace it)")
-
-
-def _report(
-    console,
-    result,
-    request,
-    name: str,
-    im: str,
-    plot: OutputFile,
-    recording: OutputFile | None,
-    written: list,
-    signals: FirstSignalStops,
-) -> None:
+def _report(console, result, plan: StudyPlan, im: str, written: list, signals: FirstSignalStops) -> None:
     """The table on the terminal, the fit, the plot and the recording; ``written`` gets each file's path
     as it is renamed into place, a signal held between the two (:func:`_recorded`)."""
     from masonrycli.intensity import UNITS
@@ -346,6 +200,7 @@ def _report(
     from masonrycli.study.plots import fragility_curve, state_map, threshold_curve
     from masonrycli.study.table import find_columns, grid_columns, study_table
 
+    request, name, plot, recording = plan.request, plan.name, plan.picture, plan.recording
     rows, axes = result.rows, request.axes
     keys = [a.name for a in axes if a.name != request.find]  # what a row is keyed by
     columns = find_columns(keys, request.find) if request.find else grid_columns(keys, im)

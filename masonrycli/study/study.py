@@ -1,8 +1,8 @@
 """A study from start to finish: resume, run on the cluster, keep every row, fit, summarise.
 
-:func:`run_study` is what ``masonry sweep`` does after parsing its options; the outputs around it
-(terminal table, PNG, Rerun recording) are made by :mod:`masonrycli.cli_sweep`; which files may be
-written: :mod:`masonrycli.study.files`.
+:func:`run_study` is what ``masonry sweep`` does once :mod:`masonrycli.study.plan` has checked its
+options; the outputs around it (terminal table, PNG, Rerun recording) are made by
+:mod:`masonrycli.cli_sweep`; which files may be written: :mod:`masonrycli.study.files`.
 """
 
 from __future__ import annotations

@@ -1,0 +1,228 @@
+"""From what ``masonry sweep`` was given to a checked study: base scenario, request, report files.
+
+:func:`plan_study` takes the command's options as they come (None: not given) and checks them together
+before anything runs or is written: the axes (``--param``, ``--records``, ``--scale``), the options that
+only go together (``--outcome`` / ``--rtol`` with ``--find``, ``--workers`` without ``--scheduler``,
+``--recording`` without ``--no-recording``), and the files beside the table. A bad option raises a one-line
+:class:`~masonrycli.errors.InputError` (exit 2) naming it. What it returns is what
+:func:`~masonrycli.study.study.run_study` and the report of :mod:`masonrycli.cli_sweep` take; the table and
+the histories are checked by ``run_study``, which knows which rows are this study's and which runs are
+still to make.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+
+from masonrycli.errors import NOT_A_FILE, InputError
+from masonrycli.outputs import OutputFile, safe_name
+from masonrycli.study import store
+from masonrycli.study.axes import Axis, StudyBase, parse_axis
+from masonrycli.study.files import check_picture
+from masonrycli.study.study import StudyRequest
+
+BUILT_IN = ("wall", "arch", "aqueduct")
+SWEEP_DURATION = {"wall": 1.0, "arch": 2.0, "aqueduct": 2.0}
+"""s: default simulated time of a built-in structure in a study."""
+
+
+@dataclass(frozen=True)
+class StudyPlan:
+    """A study checked before its first run: what :func:`~masonrycli.study.study.run_study` takes, and the
+    report files written after it."""
+
+    base: StudyBase
+    request: StudyRequest
+    name: str
+    """The scenario's name (the titles of the plot and the recording)."""
+    picture: OutputFile
+    """The PNG (``--plot``, default beside ``--out``)."""
+    recording: OutputFile | None
+    """The Rerun recording (``--recording``, default beside ``--out``), None with ``--no-recording``."""
+
+
+def plan_study(
+    target: str,
+    *,
+    params: list[str] | None = None,
+    records: list[Path] | None = None,
+    scale: str | None = None,
+    find: str | None = None,
+    outcome: str | None = None,
+    rtol: float | None = None,
+    out: Path | None = None,
+    scheduler: str | None = None,
+    workers: int | None = None,
+    stop_at_collapse: bool = True,
+    duration: float | None = None,
+    dt: float | None = None,
+    im: str = "pga",
+    plot: Path | None = None,
+    recording: Path | None = None,
+    no_recording: bool = False,
+    histories: Path | None = None,
+    force: bool = False,
+    warn: Callable[[str], None] | None = None,
+) -> StudyPlan:
+    """The study of ``target`` (``wall``, ``arch``, ``aqueduct``, a scenario file or a geometry file) that
+    ``masonry sweep`` runs with these options, each named as the command line names it; ``warn`` gets
+    the warnings (runs shorter than records) once ``run_study`` has checked the table. Raises
+    :class:`InputError`, the first problem in one line, before any run or file."""
+    from masonrycli.intensity import INTENSITY_MEASURES
+    from masonrycli.study.runner import check_scheduler
+    from masonrycli.study.task import check_outcome
+
+    base = StudyBase(_base_scenario(target, duration, dt), {})
+    name = base.scenario.name
+    # the name reduced as recordings name it: "../../evil" made a folder "study-.." and wrote beside it
+    out = store.check_out(out or Path(f"study-{safe_name(name)}.parquet"))
+    axes = [parse_axis(p) for p in params or []]
+    late: list[str] = []  # warnings about records longer than the runs
+    if records:
+        motions = _records(records, out)
+        whole = duration is None and target in BUILT_IN  # a scenario file's [run] duration stands
+        scenario, late = _record_duration(base.scenario, motions, whole)
+        base = StudyBase(scenario, motions)
+        axes.insert(0, Axis("record", tuple(motions)))
+    if scale is not None:
+        axes.append(parse_axis(f"scale={scale}"))
+    if not axes:
+        raise InputError("nothing to sweep: give --param NAME=..., or --records DIR")
+    if im not in INTENSITY_MEASURES or im == "d5_95":
+        raise InputError(f"--im {im}: expected one of pga, pgv, arias, sa")
+    if workers is not None and workers < 0:
+        raise InputError(f"--workers {workers}: must be >= 0")
+    scheduler = check_scheduler(scheduler)
+    if workers is not None and scheduler is not None:
+        raise InputError("--workers with --scheduler: the existing cluster has its own workers")
+    outcome = None if outcome is None else check_outcome(outcome)
+    for option, value in (("--outcome", outcome), ("--rtol", rtol)):
+        if value is not None and find is None:
+            raise InputError(f"{option} {value}: goes with --find (a grid reports every run's state)")
+    outcome, rtol = outcome or "collapse", 0.005 if rtol is None else rtol
+    if not (0 < rtol < 1):
+        raise InputError(f"--rtol {rtol}: must be in (0, 1)")
+    _check_out_reads_nothing(out, base)
+    if no_recording and recording is not None:
+        raise InputError(f"--recording {recording} with --no-recording: choose one")
+    # the default files beside --out are named as such: "--plot s.png: the file exists" named an option
+    # the user had not given
+    picture = check_picture(plot or out.with_suffix(".png"), "--plot" if plot else "--out's plot", ".png", force)
+    recorded = check_picture(
+        None if no_recording else recording or out.with_suffix(".rrd"),
+        "--recording" if recording else "--out's recording",
+        ".rrd",
+        force,
+    )
+    request = StudyRequest(
+        axes=axes,
+        out=out,
+        find=find,
+        outcome=outcome,
+        rtol=rtol,
+        scheduler=scheduler,
+        workers=workers,
+        stop_at_collapse=stop_at_collapse,
+        histories=histories,
+        force=force,
+        warnings=tuple(late),
+        warn=warn,
+    )
+    return StudyPlan(base, request, name, picture, recorded)
+
+
+def _base_scenario(target: str, duration, dt):
+    from masonrycli.builtin import override_run
+    from masonrycli.motion import Sine
+    from masonrycli.scenario import Material, RunConfig, scenario_from_builder
+
+    if target in BUILT_IN:
+        # a shaken structure: 1 m/s at 2 Hz on the ground (wall) or both foundations (arch, aqueduct)
+        shaken = ("ground",) if target == "wall" else ("left-foundation", "right-foundation")
+        motions = {s: Sine(amplitude=1.0, frequency=2.0) for s in shaken}
+        options = {"blocks": 51} if target == "wall" else {}
+        scenario = scenario_from_builder(
+            target, options, RunConfig(duration=SWEEP_DURATION[target]), Material(), motions
+        )
+    else:
+        from masonrycli.scenario import scenario_from_geometry_file
+        from masonrycli.scenario_toml import load_scenario
+        from masonrycli.structure import GEOMETRY_SUFFIXES
+
+        path = Path(target)
+        if not path.exists():
+            raise InputError(f"{target}: no such scenario file (or built-in structure: {', '.join(BUILT_IN)})")
+        # a GeoJSON / WKT file as `masonry run` takes it (it said "TOML syntax error: Invalid statement")
+        geometry = path.suffix.lower() in GEOMETRY_SUFFIXES
+        scenario = scenario_from_geometry_file(path) if geometry else load_scenario(path)
+    return override_run(scenario, duration=duration, dt=dt)  # names the wrong option (--dt 0: --dt)
+
+
+def _record_duration(scenario, motions: dict, whole: bool):
+    """``(scenario, warnings)``: the scenario lasting the longest record (whole steps of its dt) if
+    ``whole`` (a built-in without --duration: its 1 s cut every record of an IDA to its first second);
+    else, if the runs are shorter than some records, one line saying so (printed once the request is
+    checked)."""
+    import dataclasses
+    import math
+
+    from masonrycli.scenario import MAX_DURATION
+
+    run = scenario.run
+    longest = max(m.end_time for m in motions.values())
+    if whole:
+        steps = max(1, math.ceil(longest / run.dt - 1e-9))
+        run = dataclasses.replace(run, duration=min(steps * run.dt, MAX_DURATION))
+        return dataclasses.replace(scenario, run=run), []
+    late = [name for name, m in motions.items() if m.end_time > run.duration + 0.5 * run.dt]
+    if not late:
+        return scenario, []
+    return scenario, [
+        f"the runs' {run.duration:g} s are shorter than {len(late)} of {len(motions)} records (longest "
+        f"{longest:g} s, {late[0]}): their shaking after t = {run.duration:g} s is not applied"
+    ]
+
+
+def _records(entries: list[Path], out: Path) -> dict:
+    """Record motions by file name, from files and the .AT2 / .csv files of folders (but the study's
+    table ``out``: kept in its records' folder, it was read as a record by the same command run again,
+    "recs/ida.csv:2: not a number", so the study could not be resumed)."""
+    from masonrycli.records import record_motion
+
+    files = []
+    for entry in entries:
+        if entry.is_dir():
+            found = sorted(
+                p for p in entry.iterdir() if p.suffix.lower() in (".at2", ".csv") and not _same_file(p, out)
+            )
+            if not found:
+                raise InputError(f"--records {entry}: no .AT2 or .csv record in it")
+            files += found
+        elif entry.is_file():
+            files.append(entry)
+        else:
+            raise InputError(f"--records {entry}: {NOT_A_FILE if entry.exists() else 'no such file or folder'}")
+    names = [p.name for p in files]
+    twice = sorted({n for n in names if names.count(n) > 1})
+    if twice:
+        raise InputError(f"--records: two records named {twice[0]} (rows are keyed by the file name)")
+    return {p.name: record_motion(p, display=str(p)) for p in files}
+
+
+def _same_file(a, b) -> bool:
+    try:
+        return os.path.samefile(a, b)
+    except OSError:  # one of them does not exist (yet)
+        return False
+
+
+def _check_out_reads_nothing(out: Path, base) -> None:
+    """Refuse an ``--out`` that is a record file the study reads: with ``--force`` the table replaced it
+    (``--records rec.csv --out rec.csv --force``: the record was lost)."""
+    motions = (*base.scenario.motions, *base.records.values())
+    for source in (s for m in motions for s in (getattr(m, "source", ""), getattr(m, "vertical_source", ""))):
+        if source and _same_file(out, source):
+            raise InputError(f"--out {out}: is the record {source} (the table would replace it)")

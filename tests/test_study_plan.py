@@ -1,0 +1,109 @@
+"""The options of ``masonry sweep`` checked into a study (masonrycli.study.plan), without the command line:
+each bad or conflicting option is one line naming it, the first problem wins, and nothing is written
+before the study runs."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from masonrycli.errors import InputError
+from masonrycli.records import G_STANDARD
+from masonrycli.study.plan import plan_study
+
+from synthetic_records import band_limited, write_at2
+
+BLOCK = """
+[run]
+duration = 0.5
+dt = 2e-3
+[[block]]
+polygon = [[-0.1, 0.0], [0.1, 0.0], [0.1, 0.6], [-0.1, 0.6]]
+[[support]]
+name = "ground"
+polygon = [[-5.0, -0.5], [5.0, -0.5], [5.0, 0.0], [-5.0, 0.0]]
+motion = { kind = "sine", amplitude = 0.1, frequency = 2.0 }
+"""
+
+
+@pytest.fixture
+def block(tmp_path, monkeypatch) -> str:
+    monkeypatch.chdir(tmp_path)  # the default table, plot and recording are named in the working folder
+    (tmp_path / "block.toml").write_text(BLOCK)
+    return "block.toml"
+
+
+def _refused(target: str, **options) -> str:
+    with pytest.raises(InputError) as refused:
+        plan_study(target, **options)
+    return str(refused.value)
+
+
+def test_a_bad_axis_is_one_line_naming_it(block):
+    assert _refused(block, params=["amp=1:2"]) == "--param amp=1:2: a range is LO:HI:N (e.g. amp=0.1:1.0:10)"
+    # the axes are checked before the options that go together: the first problem is the one said
+    assert _refused(block, params=["amp=1:2"], workers=2, scheduler="tcp://x:1").startswith("--param amp=1:2:")
+
+
+@pytest.mark.parametrize(
+    "options, message",
+    [
+        ({"params": []}, "nothing to sweep: give --param NAME=..., or --records DIR"),
+        (
+            {"workers": 2, "scheduler": "tcp://x:1"},
+            "--workers with --scheduler: the existing cluster has its own workers",
+        ),
+        ({"workers": -1}, "--workers -1: must be >= 0"),
+        ({"rtol": 0.1}, "--rtol 0.1: goes with --find (a grid reports every run's state)"),
+        ({"outcome": "sliding"}, "--outcome sliding: goes with --find (a grid reports every run's state)"),
+        ({"find": "amp", "rtol": 1.0}, "--rtol 1.0: must be in (0, 1)"),
+        ({"recording": Path("x.rrd"), "no_recording": True}, "--recording x.rrd with --no-recording: choose one"),
+        ({"im": "d5_95"}, "--im d5_95: expected one of pga, pgv, arias, sa"),
+    ],
+)
+def test_conflicting_or_bad_options_are_one_line_naming_them(block, options, message):
+    options = {"params": ["amp=0.1,0.2"]} | options
+    assert _refused(block, **options) == message
+
+
+def test_a_checked_study_has_the_defaults_and_nothing_is_written(block, tmp_path):
+    plan = plan_study(block, params=["amp=0.1,0.2"], no_recording=True, stop_at_collapse=False)
+    request = plan.request
+    assert request.out == Path(f"study-{plan.name}.parquet")
+    assert (request.outcome, request.rtol, request.find, request.stop_at_collapse) == ("collapse", 0.005, None, False)
+    assert [(a.name, a.values) for a in request.axes] == [("amp", (0.1, 0.2))]
+    # the plot beside the table is named as the --out's: the user gave no --plot
+    assert plan.picture.path == request.out.with_suffix(".png") and plan.recording is None
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["block.toml"]
+
+
+def _record(folder: Path, seconds: float) -> Path:
+    folder.mkdir()
+    t, u, v, a = band_limited(seconds, 0.01, [1.0, 2.5], [0.03, 0.01], seed=0)
+    write_at2(folder / "syn0.AT2", a / G_STANDARD, 0.01)
+    return folder
+
+
+def test_records_make_the_first_axis_and_the_runs_shorter_than_them_a_warning(block, tmp_path):
+    folder = _record(tmp_path / "records", 1.0)
+    said = []
+    plan = plan_study(block, records=[folder], scale="0.5,1", out=Path("s.csv"), warn=said.append)
+    assert [(a.name, a.values) for a in plan.request.axes] == [("record", ("syn0.AT2",)), ("scale", (0.5, 1.0))]
+    # the scenario file's 0.5 s stands; the warning is said by run_study once the table is checked
+    assert plan.base.scenario.run.duration == 0.5 and said == []
+    assert plan.request.warnings == (
+        "the runs' 0.5 s are shorter than 1 of 1 records (longest 1 s, syn0.AT2): their shaking after t = 0.5 s "
+        "is not applied",
+    )
+    assert plan.request.warn == said.append
+
+
+def test_a_built_in_without_duration_lasts_the_longest_record(block, tmp_path):
+    folder = _record(tmp_path / "records", 1.5)
+    plan = plan_study("wall", records=[folder], out=Path("s.csv"))
+    run = plan.base.scenario.run
+    assert run.duration == pytest.approx(1.5) and plan.request.warnings == ()
+    # with a --duration the runs are that long, and shorter than the record
+    plan = plan_study("wall", records=[folder], out=Path("s.csv"), duration=1.0)
+    assert plan.base.scenario.run.duration == 1.0 and "shorter than 1 of 1 records" in plan.request.warnings[0]
