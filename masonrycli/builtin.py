@@ -15,6 +15,9 @@ builder's own options (``blocks``, ``voussoirs``...), the loading (``amp`` m/s, 
 ``settlement`` m/s, or a ground motion ``record`` file times ``scale``), the material (``density``, ``thickness``, ``friction``) and the run settings
 (``duration``, ``dt``, ``theta``, ``record_every``, ``tolerance``, ``max_iterations``, ``solver``). Errors name them
 as the command line spells them (``--settlement -1: must be >= 0 ...``).
+
+The same overrides serve the other commands' structures: :func:`file_scenario` (a scenario or geometry
+file, ``masonry run`` / ``check``) and :func:`build_assembly` (the builders' assemblies, ``masonry build``).
 """
 
 from __future__ import annotations
@@ -129,6 +132,24 @@ def with_record(scenario: Scenario, record: Path | None, scale: float | None) ->
     return dataclasses.replace(scenario, motions=motions)
 
 
+def file_scenario(path: Path, *, record: Path | None = None, scale: float | None = None, **overrides) -> Scenario:
+    """The scenario of a TOML, GeoJSON or WKT file (``masonry run`` / ``check``) driven by ``record`` times
+    ``scale`` if given (:func:`with_record`), with the run settings and the friction of ``overrides``
+    (:func:`override_run`). A built-in's name that is no file is told where it runs."""
+    from masonrycli.scenario import scenario_from_geometry_file
+    from masonrycli.scenario_toml import load_scenario
+    from masonrycli.structure import GEOMETRY_SUFFIXES
+
+    if str(path) in DEFAULT_DURATION and not path.exists():  # a built-in name
+        name = str(path)
+        raise InputError(f"{name}: not a file; the built-in structures are run with `masonry simulate {name}`")
+    if path.suffix.lower() in GEOMETRY_SUFFIXES:
+        scenario = scenario_from_geometry_file(path)
+    else:
+        scenario = load_scenario(path)
+    return override_run(with_record(scenario, record, scale), **overrides)
+
+
 def _loading(name: str, amp, freq, settlement, record, scale) -> dict:
     """Support name -> motion of the built-in loading, with the loading overrides applied."""
     if record is not None:
@@ -185,6 +206,24 @@ def builder_options(name: str, options: dict) -> dict:
     if {"courses", "length"} <= options.keys():
         return {**options, "blocks": None}
     return options if options.keys() & {"courses", "length"} else {"blocks": 51, **options}  # spec default: 51
+
+
+def build_assembly(name: str, **overrides):
+    """The assembly of builder ``name`` that ``masonry build`` writes, from the builder's options and
+    ``density`` / ``thickness`` (None: not given), checked as ``simulate`` checks them (the message names
+    the option); a builder's error is one line starting with its name."""
+    from geometry_library.blocks import GeometryError
+    from geometry_library.builders import BUILDERS
+
+    for key in ("density", "thickness"):
+        if overrides.get(key) is not None:
+            _replace(Material(), f"--{key}", **{key: overrides[key]})
+    options = builder_options(name, {k: v for k, v in overrides.items() if v is not None})
+    try:
+        return BUILDERS[name](**options).build()
+    except (ValueError, GeometryError) as exc:  # the builders' messages start with their name
+        msg = str(exc)
+        raise InputError(msg if msg.startswith(f"{name}:") else f"{name}: {msg}") from None
 
 
 def builtin(name: str, **overrides) -> Scenario:

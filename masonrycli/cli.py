@@ -68,16 +68,12 @@ def main_callback(
 def _execute(scenario, opts: dict, hint: str = "") -> None:
     """Check the outputs (``opts``: the OUTPUT, FORCE and STOP options), run, print the summary; exit with
     the code of how the run ended."""
-    from masonrycli.execute import execute, plan_outputs, print_summary
+    from masonrycli.execute import execute, print_summary
     from masonrycli.interrupt import StopRun, exit_code, signal_name
-    from masonrycli.scenario import check_sampling, record_warnings
+    from masonrycli.scenario import record_warnings
     from masonrycli.sinks import DIVERGED, FAILED
 
-    check_sampling(scenario)
-    _check_magnify(opts["magnify"], opts["no_recording"])
-    outputs = plan_outputs(
-        scenario, opts["out"], opts["history"], no_recording=opts["no_recording"], force=opts["force"]
-    )
+    outputs = _check_run(scenario, opts)
     for warning in (*scenario.warnings, *record_warnings(scenario)):
         warn(warning)
     try:
@@ -110,16 +106,18 @@ def _execute(scenario, opts: dict, hint: str = "") -> None:
         raise typer.Exit(EXIT_DIVERGED)
 
 
-MAX_MAGNIFY = 1e6
-"""Largest --magnify: beyond it a millimetre is drawn a kilometre long (1e300 overflowed the recording's
-float32 coordinates to inf, with a RuntimeWarning)."""
+def _check_run(scenario, opts: dict):
+    """The checked outputs of ``scenario`` (``opts``: the OUTPUT and FORCE options)."""
+    from masonrycli.execute import check_run
 
-
-def _check_magnify(magnify: float | None, no_recording: bool) -> None:
-    if magnify is not None and not 1.0 <= magnify <= MAX_MAGNIFY:
-        raise InputError(f"--magnify {magnify:g}: must be between 1 and {MAX_MAGNIFY:g}")
-    if magnify is not None and no_recording:  # it was ignored, as --out was: nothing draws the shape
-        raise InputError(f"--magnify {magnify:g} with --no-recording: choose one (it draws in the recording)")
+    return check_run(
+        scenario,
+        opts["out"],
+        opts["history"],
+        no_recording=opts["no_recording"],
+        force=opts["force"],
+        magnify=opts["magnify"],
+    )
 
 
 def _pop(opts: dict, *groups: dict) -> dict:
@@ -174,20 +172,9 @@ ScenarioFile = Annotated[
 def _load(scenario_file: Path, opts: dict):
     """The scenario of a TOML, GeoJSON or WKT file with the command line's record and run options
     (taken out of ``opts``) applied."""
-    from masonrycli.builtin import DEFAULT_DURATION, override_run, with_record
-    from masonrycli.scenario import scenario_from_geometry_file
-    from masonrycli.scenario_toml import load_scenario
-    from masonrycli.structure import GEOMETRY_SUFFIXES
+    from masonrycli.builtin import file_scenario
 
-    record, scale = _pop(opts, RECORD).values()
-    if str(scenario_file) in DEFAULT_DURATION and not scenario_file.exists():  # a built-in name
-        name = str(scenario_file)
-        raise InputError(f"{name}: not a file; the built-in structures are run with `masonry simulate {name}`")
-    if scenario_file.suffix.lower() in GEOMETRY_SUFFIXES:
-        scenario = scenario_from_geometry_file(scenario_file)
-    else:
-        scenario = load_scenario(scenario_file)
-    return override_run(with_record(scenario, record, scale), **_pop(opts, RUN, FRICTION))
+    return file_scenario(scenario_file, **_pop(opts, RECORD, RUN, FRICTION))
 
 
 @app.command(
@@ -268,49 +255,25 @@ def limit_command(
 def check_command(scenario_file: ScenarioFile, **opts) -> None:
     """Validate what `masonry run` would run, with the same arguments, and print a summary (blocks,
     supports, mass, bounding box, steps, the loading, outputs); nothing is computed or written."""
-    from masonrycli.execute import plan_outputs
     from masonrycli.report import check_table
-    from masonrycli.scenario import check_sampling, record_warnings, scenario_summary
+    from masonrycli.scenario import record_warnings, scenario_summary
 
     scenario = _load(scenario_file, opts)
-    check_sampling(scenario)
-    _check_magnify(opts["magnify"], opts["no_recording"])
-    outputs = plan_outputs(
-        scenario, opts["out"], opts["history"], no_recording=opts["no_recording"], force=opts["force"]
-    )
+    outputs = _check_run(scenario, opts)
     console.print(check_table(str(scenario_file), scenario_summary(scenario), outputs.files()))
     for warning in (*scenario.warnings, *record_warnings(scenario)):
         warn(warning)
 
 
-def _check_material(opts: dict) -> None:
-    """--density / --thickness checked as simulate checks them (the message names the option)."""
-    from masonrycli.scenario import Material
-
-    for key in ("density", "thickness"):
-        if opts.get(key) is not None:
-            try:
-                Material(**{key: opts[key]})
-            except InputError as exc:
-                raise InputError(f"--{key}: {exc}") from None
-
-
 def _write_assembly(builder: str, opts: dict) -> None:
     """Build, check and write the GeoJSON under a temporary name, renamed onto ``--out`` when complete."""
-    from geometry_library.builders import BUILDERS
     from geometry_library.checks import validate_assembly
     from geometry_library.io import write_geojson
-    from masonrycli.builtin import builder_options
+    from masonrycli.builtin import build_assembly
     from masonrycli.outputs import check_output, written_whole
 
     target = check_output(opts.pop("out"), "--out", ".geojson", opts.pop("force"))
-    _check_material(opts)
-    options = builder_options(builder, {k: v for k, v in opts.items() if v is not None})
-    try:
-        assembly = BUILDERS[builder](**options).build()
-    except (ValueError, GeometryError) as exc:  # the builders' messages start with their name
-        msg = str(exc)
-        raise InputError(msg if msg.startswith(f"{builder}:") else f"{builder}: {msg}") from None
+    assembly = build_assembly(builder, **opts)
     for warning in validate_assembly(assembly):
         warn(warning)
     with written_whole(target) as part:

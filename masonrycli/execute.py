@@ -60,6 +60,30 @@ class Outputs:
         return [o for o in (self.recording, self.history) if o is not None]
 
 
+MAX_MAGNIFY = 1e6
+"""Largest --magnify: beyond it a millimetre is drawn a kilometre long (1e300 overflowed the recording's
+float32 coordinates to inf, with a RuntimeWarning)."""
+
+
+def check_run(
+    scenario, out: Path | None, history: Path | None, *, no_recording: bool, force: bool, magnify: float | None
+) -> Outputs:
+    """Everything checked before a run (what ``masonry check`` stops after): the time step against the
+    supports' motions, ``--magnify``, then the outputs (:func:`plan_outputs`). Raises InputError."""
+    from masonrycli.scenario import check_sampling
+
+    check_sampling(scenario)
+    check_magnify(magnify, no_recording)
+    return plan_outputs(scenario, out, history, no_recording=no_recording, force=force)
+
+
+def check_magnify(magnify: float | None, no_recording: bool) -> None:
+    if magnify is not None and not 1.0 <= magnify <= MAX_MAGNIFY:
+        raise InputError(f"--magnify {magnify:g}: must be between 1 and {MAX_MAGNIFY:g}")
+    if magnify is not None and no_recording:  # it was ignored, as --out was: nothing draws the shape
+        raise InputError(f"--magnify {magnify:g} with --no-recording: choose one (it draws in the recording)")
+
+
 def plan_outputs(scenario, out: Path | None, history: Path | None, *, no_recording: bool, force: bool) -> Outputs:
     """Check the output paths and the free space before anything is computed (raises InputError)."""
     if no_recording and out is not None:  # it was ignored: the recording asked for was silently not written

@@ -6,7 +6,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from masonrycli.builtin import builtin, override_run, paper_instant_hint
+from masonrycli.builtin import build_assembly, builtin, file_scenario, override_run, paper_instant_hint
 from masonrycli.errors import InputError
 from masonrycli.motion import Constant, Fixed, Sine
 from masonrycli.records import record_motion
@@ -150,3 +150,50 @@ def test_a_record_without_duration_runs_whole_in_steps_of_dt():
     for dt in (-1.0, float("nan")):  # a bad --dt is named, not a duration made from it
         with pytest.raises(InputError, match=r"^--dt: dt = "):
             builtin("wall", record=RECORD, dt=dt)
+
+
+ONE_BLOCK = """
+[run]
+duration = 1.0
+dt = 2e-3
+[[block]]
+polygon = [[-0.1, 0.0], [0.1, 0.0], [0.1, 0.6], [-0.1, 0.6]]
+[[support]]
+name = "ground"
+polygon = [[-5.0, -0.5], [5.0, -0.5], [5.0, 0.0], [-5.0, 0.0]]
+motion = { kind = "sine", amplitude = 0.1, frequency = 2.0 }
+"""
+
+
+def test_a_file_scenario_takes_the_record_and_the_run_overrides(tmp_path, monkeypatch):
+    path = tmp_path / "block.toml"
+    path.write_text(ONE_BLOCK)
+    s = file_scenario(path, record=RECORD, scale=2.0, duration=0.5, dt=None, friction=0.3)
+    assert (s.run.duration, s.run.dt, s.material.friction) == (0.5, 2e-3, 0.3)
+    assert motions_by_name(s) == {"ground": record_motion(RECORD, scale=2.0, display=str(RECORD))}
+    with pytest.raises(InputError) as info:
+        file_scenario(path, scale=2.0)
+    assert str(info.value) == "--scale: goes with --record (it multiplies the record)"
+    monkeypatch.chdir(tmp_path)  # no file named wall here
+    with pytest.raises(InputError) as info:
+        file_scenario(Path("wall"))
+    assert str(info.value) == "wall: not a file; the built-in structures are run with `masonry simulate wall`"
+
+
+@pytest.mark.parametrize(
+    "options, message",
+    [
+        ({"blocks": 3, "density": -1.0}, "--density: density = -1.0: must be > 0"),
+        ({"thickness": 1e9}, "--thickness: thickness = 1000000000.0: must be between 1e-06 and 1000 m (a likely typo)"),
+        ({"blocks": 0}, "wall: block count must be a positive integer, got 0"),
+    ],
+)
+def test_build_assembly_refuses_a_bad_option_in_one_line_naming_it(options, message):
+    with pytest.raises(InputError) as info:
+        build_assembly("wall", **options)
+    assert str(info.value) == message
+
+
+def test_build_assembly_is_the_builders_with_the_commands_defaults():
+    assert build_assembly("wall", blocks=None, density=None).block_count == 51  # the paper's wall
+    assert build_assembly("wall", blocks=3, thickness=0.5).block_count == 3

@@ -5,6 +5,7 @@ summary's last line (the command that opens the recording)."""
 
 from __future__ import annotations
 
+import dataclasses
 import io
 import math
 import os
@@ -20,7 +21,7 @@ from shapely.geometry import box
 from geometry_library.blocks import Assembly, Block, Support
 from masonrycli import execute as execute_module
 from masonrycli.errors import InputError
-from masonrycli.execute import execute, plan_outputs
+from masonrycli.execute import check_run, execute, plan_outputs
 from masonrycli.interrupt import StopRun
 from masonrycli.motion import Sine
 from masonrycli.recording import inspect_recording
@@ -121,6 +122,30 @@ def test_the_plan_names_the_outputs_asked_for(tmp_path, monkeypatch):
     assert default.recording.path.parent.name == "recordings" and default.recording.path.name.startswith("one-block-")
     assert default.recording.path.suffix == ".rrd" and default.history.path == tmp_path / "h.npz"
     assert os.listdir(tmp_path) == []  # planning writes nothing
+
+
+@pytest.mark.parametrize(
+    "options, message",
+    [
+        # --magnify is checked before the outputs: its message, not "--out ... with --no-recording"
+        ({"magnify": 1e7}, "--magnify 1e+07: must be between 1 and 1e+06"),
+        ({"magnify": 2.0}, "--magnify 2 with --no-recording: choose one (it draws in the recording)"),
+        ({"magnify": None}, "--out r.rrd with --no-recording: choose one"),
+    ],
+)
+def test_check_run_says_the_first_bad_option_in_one_line(options, message, tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(InputError) as info:
+        check_run(_scenario(), Path("r.rrd"), None, no_recording=True, force=False, **options)
+    assert str(info.value) == message
+
+
+def test_check_run_refuses_a_step_too_long_for_the_motion(tmp_path):
+    fast = dataclasses.replace(_scenario(), motions=(Sine(amplitude=AMP, frequency=600.0),))  # dt = 1 ms
+    with pytest.raises(InputError, match=r"frequency = 600 Hz is above 1/\(2 dt\) = 500 Hz"):
+        check_run(fast, tmp_path / "r.rrd", None, no_recording=False, force=False, magnify=None)
+    outputs = check_run(_scenario(), tmp_path / "r.rrd", None, no_recording=False, force=False, magnify=10.0)
+    assert outputs.recording.path == tmp_path / "r.rrd" and outputs.history is None
 
 
 @pytest.mark.parametrize(
