@@ -152,24 +152,10 @@ def test_a_record_without_duration_runs_whole_in_steps_of_dt():
             builtin("wall", record=RECORD, dt=dt)
 
 
-ONE_BLOCK = """
-[run]
-duration = 1.0
-dt = 2e-3
-[[block]]
-polygon = [[-0.1, 0.0], [0.1, 0.0], [0.1, 0.6], [-0.1, 0.6]]
-[[support]]
-name = "ground"
-polygon = [[-5.0, -0.5], [5.0, -0.5], [5.0, 0.0], [-5.0, 0.0]]
-motion = { kind = "sine", amplitude = 0.1, frequency = 2.0 }
-"""
-
-
 def test_a_file_scenario_takes_the_record_and_the_run_overrides(tmp_path, monkeypatch):
-    path = tmp_path / "block.toml"
-    path.write_text(ONE_BLOCK)
+    path = Path(__file__).parent / "data" / "block_on_ground.toml"  # 1 s in steps of 1 ms, μ = 0.6
     s = file_scenario(path, record=RECORD, scale=2.0, duration=0.5, dt=None, friction=0.3)
-    assert (s.run.duration, s.run.dt, s.material.friction) == (0.5, 2e-3, 0.3)
+    assert (s.run.duration, s.run.dt, s.material.friction) == (0.5, 1e-3, 0.3)
     assert motions_by_name(s) == {"ground": record_motion(RECORD, scale=2.0, display=str(RECORD))}
     with pytest.raises(InputError) as info:
         file_scenario(path, scale=2.0)

@@ -4,6 +4,7 @@ before the study runs."""
 
 from __future__ import annotations
 
+import shutil
 from pathlib import Path
 
 import pytest
@@ -14,23 +15,13 @@ from masonrycli.study.plan import plan_study
 
 from synthetic_records import band_limited, write_at2
 
-BLOCK = """
-[run]
-duration = 0.5
-dt = 2e-3
-[[block]]
-polygon = [[-0.1, 0.0], [0.1, 0.0], [0.1, 0.6], [-0.1, 0.6]]
-[[support]]
-name = "ground"
-polygon = [[-5.0, -0.5], [5.0, -0.5], [5.0, 0.0], [-5.0, 0.0]]
-motion = { kind = "sine", amplitude = 0.1, frequency = 2.0 }
-"""
+BLOCK = Path(__file__).parent / "data" / "block_on_ground.toml"  # a sine-shaken block, 1 s
 
 
 @pytest.fixture
 def block(tmp_path, monkeypatch) -> str:
     monkeypatch.chdir(tmp_path)  # the default table, plot and recording are named in the working folder
-    (tmp_path / "block.toml").write_text(BLOCK)
+    shutil.copy(BLOCK, tmp_path / "block.toml")
     return "block.toml"
 
 
@@ -75,7 +66,7 @@ def test_a_checked_study_has_the_defaults_and_nothing_is_written(block, tmp_path
     assert [(a.name, a.values) for a in request.axes] == [("amp", (0.1, 0.2))]
     # the plot beside the table is named as the --out's: the user gave no --plot
     assert plan.picture.path == request.out.with_suffix(".png") and plan.recording is None
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["block.toml"]
+    assert [p.name for p in tmp_path.iterdir()] == ["block.toml"]
 
 
 def _record(folder: Path, seconds: float) -> Path:
@@ -86,14 +77,14 @@ def _record(folder: Path, seconds: float) -> Path:
 
 
 def test_records_make_the_first_axis_and_the_runs_shorter_than_them_a_warning(block, tmp_path):
-    folder = _record(tmp_path / "records", 1.0)
+    folder = _record(tmp_path / "records", 1.5)
     said = []
     plan = plan_study(block, records=[folder], scale="0.5,1", out=Path("s.csv"), warn=said.append)
     assert [(a.name, a.values) for a in plan.request.axes] == [("record", ("syn0.AT2",)), ("scale", (0.5, 1.0))]
-    # the scenario file's 0.5 s stands; the warning is said by run_study once the table is checked
-    assert plan.base.scenario.run.duration == 0.5 and said == []
+    # the scenario file's 1 s stands; the warning is said by run_study once the table is checked
+    assert plan.base.scenario.run.duration == 1.0 and said == []
     assert plan.request.warnings == (
-        "the runs' 0.5 s are shorter than 1 of 1 records (longest 1 s, syn0.AT2): their shaking after t = 0.5 s "
+        "the runs' 1 s are shorter than 1 of 1 records (longest 1.5 s, syn0.AT2): their shaking after t = 1 s "
         "is not applied",
     )
     assert plan.request.warn == said.append
