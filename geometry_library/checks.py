@@ -11,12 +11,40 @@ collinear consecutive vertices (collinear points are allowed on input and silent
 
 Tolerances
 ----------
-- two consecutive vertices closer than ``1e-12 ×`` the polygon's size are one vertex;
-- a vertex is collinear when the cross product of its two edges is below ``1e-9 × |e1| |e2|``
-  (``COLLINEAR_RTOL``) and the edges point the same way; this absorbs the float noise of clipped
-  polygons, so a convexity test never trips on a 1e-17 "reflex" angle;
-- areas below ``MIN_AREA`` (1e-10 m²) are zero, above ``MAX_AREA`` (1e6 m²) absurd (wrong units);
-- a vertex beyond ``MAX_COORDINATE`` (1e6 m) from the origin is absurd too.
+They scale with the block, so a file exact to float32 (GIS / CAD exports: ~7 significant digits) or to
+0.1 mm (a wall drawn in CAD) is accepted and cleaned, whatever the units' origin, while a real dent or
+overlap is refused. A block's *width* is ``w = area / size`` (size: its bounding-box diagonal; 0.17 m for
+a 0.3 × 0.2 m block, 0.7 mm for a sliver voussoir of a 8000-block arch) and its *shape tolerance* is
+``h = SHAPE_RTOL × w`` (``SHAPE_RTOL`` = 2e-3: 0.33 mm on a 0.3 × 0.2 m block):
+
+- two consecutive vertices closer than ``h`` are one vertex;
+- a vertex less than ``h`` from the line through its two neighbours (and between them) is removed, on
+  either side: a mid-edge vertex that rounding put just outside the edge (it would overlap the
+  neighbour) or just inside (it would be "reflex"). The least deep goes first, until none is left, so
+  the result is a fixed point (cleaning it again gives it back);
+- a vertex more than ``h`` inside that line is a reflex vertex: the polygon is not convex;
+- two bodies overlapping by at most ``OVERLAP_RTOL × `` the smaller one's area (1e-3, i.e. a sliver
+  ``h / 2`` deep along a whole face) are accepted; ``validate_assembly(overlap_tolerance=…)`` sets an
+  absolute tolerance in m² instead.
+
+Why 2e-3 of the width. Rounding to float32 moves a vertex by up to 2⁻²⁴ × its coordinate (6e-8 m at
+1 m, 6e-5 m at 1000 m); rounding to 0.1 mm by up to 0.07 mm; the worst depth of a rounded mid-edge
+vertex is about twice that (0.14 mm for 0.1 mm). ``h`` is above these for blocks wider than ~7 cm and,
+for 0.3 × 0.2 m blocks, coordinates up to ~2 km from the origin, and three times below a 1 mm dent or overlap on a 0.3 × 0.2 m
+block, which is refused. Removing a vertex within ``h`` changes the block's area by at most
+``h × size / 2 = SHAPE_RTOL / 2 × area`` (0.1 %), and on a 0.3 × 0.2 m block moves a face by a third of the
+default contact detection distance (1 mm) at most. (The old tests, 1e-9 relative angle and 1e-9 m² of
+overlap, refused the built-in aqueduct exported in float32 — a spandrel block's rounded corner off a
+voussoir's sloping extrados overlaps it by 8e-9 m² — and the arch with a vertex split on its joints.)
+
+Coordinates far from the origin in float32 (a local map grid) are coarse: when every coordinate is a
+float32 value and the float32 resolution there exceeds a tenth of the smallest ``h``,
+``validate_assembly`` warns (one line), and a refusal says to shift the coordinates near the origin.
+
+Units sanity bounds, not rounding tolerances: areas below ``MIN_AREA`` (1e-10 m², a 10 µm square) are
+zero, above ``MAX_AREA`` (1e6 m²) absurd (wrong units); a vertex beyond ``MAX_COORDINATE`` (1e6 m) from
+the origin is absurd too. ``COLLINEAR_RTOL`` (1e-9 × |e1| |e2| on the cross product) is the exact-geometry
+test of :func:`is_convex`, which the builders use on float64 geometry they construct.
 
 Normalised once
 ---------------
@@ -44,6 +72,12 @@ from .union_screen import union_screen
 from .values import check_material
 
 COLLINEAR_RTOL = 1e-9
+# Shape tolerance h = SHAPE_RTOL × width of the block (module docstring, Tolerances).
+SHAPE_RTOL = 2e-3
+# Overlap tolerance of a pair: OVERLAP_RTOL × the smaller body's area (a sliver h / 2 deep along a face).
+OVERLAP_RTOL = 1e-3
+# float32 keeps 24 bits: a value x is rounded by at most 2⁻²⁴ |x|.
+FLOAT32_RTOL = 2.0**-24
 MIN_AREA = 1e-10
 MAX_AREA = 1e6
 # m: a vertex farther than this from the origin is refused. Products of larger coordinates (areas, cross
@@ -114,6 +148,61 @@ def is_convex(xy: np.ndarray) -> bool:
     return bool(len(xy) >= 3 and np.all(cross > COLLINEAR_RTOL * scale))
 
 
+def shape_tolerance(xy: np.ndarray) -> float:
+    """The shape tolerance ``h`` of a ring (k, 2), m: ``SHAPE_RTOL × |area| / size`` (module docstring)."""
+    size = float(np.hypot(*(xy.max(axis=0) - xy.min(axis=0))))
+    return SHAPE_RTOL * abs(signed_area(xy)) / size if size > 0.0 else 0.0
+
+
+def _depth(xy: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Signed distance of every vertex from the line through its two neighbours (> 0: a convex turn of a
+    CCW ring, < 0: reflex), and whether the vertex lies between them (its two edges point the same way)."""
+    e_in = xy - _prev(xy)
+    e_out = _next(xy) - xy
+    cross = e_in[:, 0] * e_out[:, 1] - e_in[:, 1] * e_out[:, 0]  # = chord × distance
+    chord = np.hypot(*(e_in + e_out).T)
+    depth = np.divide(cross, chord, out=np.zeros_like(cross), where=chord > 0.0)  # a spike tip: 0, not between
+    return depth, np.einsum("ij,ij->i", e_in, e_out) > 0.0
+
+
+def _clean(xy: np.ndarray, h: float) -> tuple[np.ndarray, np.ndarray]:
+    """One pass of the clean-up at tolerance ``h`` of a CCW ring: vertices closer than h merged, then
+    vertices within h of their neighbours' line removed, the least deep first. Returns the ring and the
+    depths of its vertices (:func:`_depth`)."""
+    while len(xy) > 3:
+        close = np.flatnonzero(np.hypot(*(_next(xy) - xy).T) <= h)
+        if close.size == 0:
+            break
+        xy = np.delete(xy, (close[0] + 1) % len(xy), axis=0)  # keep the first of the two
+    while True:
+        depth, between = _depth(xy)
+        flat = np.flatnonzero(between & (np.abs(depth) <= h))
+        if flat.size == 0 or len(xy) <= 3:
+            return xy, depth
+        xy = np.delete(xy, flat[np.argmin(np.abs(depth[flat]))], axis=0)
+
+
+def _float32_resolution(xy: np.ndarray) -> float | None:
+    """How far float32 rounding may have moved these coordinates, m (2⁻²⁴ × the largest |coordinate|), if
+    every one is a float32 value (a float32 export); None if one is not."""
+    xy = np.asarray(xy, dtype=np.float64)
+    if xy.size and np.array_equal(xy.astype(np.float32).astype(np.float64), xy):
+        return FLOAT32_RTOL * float(np.abs(xy).max())
+    return None
+
+
+def _float32_hint(xy: np.ndarray, h: float, whose: str = "its") -> str:
+    """The end of a refusal when float32 rounding is a tenth of the tolerance ``h`` or more (else "")."""
+    resolution = _float32_resolution(xy)
+    if resolution is None or resolution < 0.1 * h:
+        return ""
+    far = resolution / FLOAT32_RTOL
+    return (
+        f"; {whose} coordinates are float32 values, exact only to ±{resolution:.2g} m this far ({far:,.0f} m) from "
+        "the origin: shift them near the origin or export them in float64"
+    )
+
+
 def normalise_coords(coords, label: str) -> np.ndarray:
     """Check a ring of vertices and return it normalised (CCW, no repeats, no collinear vertices).
 
@@ -174,11 +263,19 @@ def normalise_coords(coords, label: str) -> np.ndarray:
         raise GeometryError(f"{label}: polygon area {abs(area):.3g} m² is absurd (coordinates must be metres)")
     if area < 0.0:
         xy = xy[::-1]
-    xy = _remove_collinear(xy)
-    cross, scale = _turn_cross(xy)
-    reflex = np.flatnonzero(cross <= COLLINEAR_RTOL * scale)
+    given = xy
+    h = SHAPE_RTOL * abs(area) / size  # shape_tolerance(xy): duplicates removed leave the bounding box as it was
+    while True:  # to a fixed point: h follows the area, so a normalised ring comes back unchanged
+        cleaned, depth = _clean(xy, h)
+        if len(cleaned) == len(xy):
+            break
+        xy = cleaned
+        h = shape_tolerance(xy)
+    reflex = np.flatnonzero(depth <= h)  # inside the neighbours' line by more than h (or a spike's tip)
     if reflex.size:
-        raise GeometryError(f"{label}: polygon is not convex (reflex vertex at {_fmt(xy[reflex[0]])})")
+        raise GeometryError(
+            f"{label}: polygon is not convex (reflex vertex at {_fmt(xy[reflex[0]])}){_float32_hint(given, h)}"
+        )
     return np.ascontiguousarray(xy)
 
 
@@ -224,7 +321,7 @@ def normalise_polygon(geometry, index: int, name: str, kind: str = "block") -> P
 
 def validate_assembly(
     assembly: Assembly,
-    overlap_tolerance: float = 1e-9,
+    overlap_tolerance: float | None = None,
     contact_distance: float = CONTACT_DISTANCE,
 ) -> list[str]:
     """Check every body of ``assembly`` and their overlaps; return warnings, raise on errors.
@@ -232,12 +329,14 @@ def validate_assembly(
     Errors (GeometryError, one line naming the body): not a polygon / holes / NaN / fewer than 3
     vertices / self-intersection / zero or absurd area / non-convex; non-positive density or
     thickness; unknown support role; duplicate names; no blocks; a block overlapping another block
-    or a support by more than ``overlap_tolerance`` m².
+    or a support by more than ``OVERLAP_RTOL`` × the smaller one's area (module docstring, Tolerances),
+    or by more than ``overlap_tolerance`` m² if given.
 
     Warnings: no support at all (everything falls: a GeoJSON drawn without ``"role": "support"`` on its
     ground ran as 52 falling blocks and was reported collapsed); a block farther than
     ``contact_distance`` m from every other body (it touches nothing); two supports overlapping
-    (supports never interact, so this is harmless but suspicious).
+    (supports never interact, so this is harmless but suspicious); coordinates that are all float32 values
+    so far from the origin that their rounding is a tenth of the smallest shape tolerance or more.
 
     Overlaps and contacts are cleared by one union of all bodies (:mod:`geometry_library.union_screen`),
     else found pairwise with a shapely STRtree: an 8000-voussoir arch, whose slivers' bounding boxes meet
@@ -268,7 +367,18 @@ def validate_assembly(
     n_blocks = assembly.block_count
     geoms = np.array(polys, dtype=object)
     tree = STRtree(geoms)
+    body_areas = shapely.area(geoms)
+    x0, y0, x1, y1 = shapely.bounds(geoms).T
+    h_min = SHAPE_RTOL * float(np.min(body_areas / np.hypot(x1 - x0, y1 - y0)))  # smallest shape tolerance
+    coords = shapely.get_coordinates(geoms)
     warnings: list[str] = []
+    resolution = _float32_resolution(coords)
+    if resolution is not None and resolution >= 0.1 * h_min:
+        warnings.append(
+            f"coordinates are all float32 values reaching {resolution / FLOAT32_RTOL:,.0f} m from the origin, where "
+            f"float32 keeps only ±{resolution:.2g} m ({resolution / h_min:.0%} of the narrowest body's shape "
+            f"tolerance, {h_min:.2g} m): shift them near the origin or export them in float64 for exact geometry"
+        )
     if assembly.support_count == 0:
         warnings.append(
             f"no supports: nothing holds the {n_blocks} block{'s' if n_blocks != 1 else ''} up, "
@@ -278,28 +388,35 @@ def validate_assembly(
 
     # Bounding boxes of slivers (a fine arch's voussoirs) meet ~N²/20 others: one union first, and the
     # pairwise search below (the reference) only when it cannot clear the bodies (union_screen.py).
-    touched = union_screen(geoms, n_blocks, overlap_tolerance)
+    # tolerance of a pair: OVERLAP_RTOL × the smaller area; the screen must use the smallest of them
+    screen_tolerance = OVERLAP_RTOL * float(body_areas.min()) if overlap_tolerance is None else overlap_tolerance
+    touched = union_screen(geoms, n_blocks, screen_tolerance)
     left, right = tree.query(geoms if touched is None else geoms[n_blocks:], predicate="intersects")
     left = left if touched is None else left + n_blocks  # then only supports on supports, for warnings
     pair = left < right
     left, right = left[pair], right[pair]
     areas = shapely.area(shapely.intersection(geoms[left], geoms[right])) if left.size else np.zeros(0)
+    if overlap_tolerance is None:
+        tolerances = OVERLAP_RTOL * np.minimum(body_areas[left], body_areas[right])
+    else:
+        tolerances = np.full(len(areas), float(overlap_tolerance))
     bad = []
-    for a, b, area in zip(left.tolist(), right.tolist(), areas.tolist()):
-        if area <= overlap_tolerance:
+    for a, b, area, tol in zip(left.tolist(), right.tolist(), areas.tolist(), tolerances.tolist()):
+        if area <= tol:
             continue
         if a >= n_blocks:  # support / support
             warnings.append(f"{labels[a]} and {labels[b]} overlap by {area:.3g} m² (supports only)")
             continue
-        bad.append((a, b, area))
+        bad.append((a, b, area, tol))
     if bad:
-        a, b, area = bad[0]
+        a, b, area, tol = bad[0]
         more = f" (and {len(bad) - 1} more overlapping pair(s))" if len(bad) > 1 else ""
         if b < n_blocks:
             what = f'blocks {a + 1} ("{names[a]}") and {b + 1} ("{names[b]}")'
         else:
             what = f"{labels[a]} and {labels[b]}"
-        raise GeometryError(f"{what} overlap by {area:.3g} m² (tolerance {overlap_tolerance:.3g} m²){more}")
+        hint = _float32_hint(coords, h_min, "their")
+        raise GeometryError(f"{what} overlap by {area:.3g} m² (tolerance {tol:.3g} m²){more}{hint}")
 
     if touched is None:
         touched = np.zeros(n_blocks, dtype=bool)

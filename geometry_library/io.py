@@ -255,6 +255,8 @@ def read_wkt(path, density: float = 2500.0, thickness: float = 1.0) -> Assembly:
             if m and not line.upper().startswith(("POLYGON", "MULTIPOLYGON", "GEOMETRYCOLLECTION")):
                 name = m.groupdict().get("name")
                 entries.append((f"{path}: line {n}", m["role"], name, m["srole"], m["wkt"]))
+            elif ":" in line:  # WKT has no colon: a label the patterns refused (": POLYGON …" said "Unknown type: ':'")
+                raise _bad_label(f"{path}: line {n}", line.split(":", 1)[0])
             else:
                 entries.append((f"{path}: line {n}", None, None, None, line))
     blocks: list[Block] = []
@@ -281,6 +283,15 @@ def read_wkt(path, density: float = 2500.0, thickness: float = 1.0) -> Assembly:
             else:
                 supports.append(Support(polygon, label, (srole or "fixed").lower()))
     return Assembly(tuple(blocks), tuple(supports))
+
+
+def _bad_label(where: str, label: str) -> GeometryError:
+    """The error for a line whose text before its colon is not a label."""
+    what = "nothing before the colon" if not label.strip() else f"{label.strip()!r} before the colon is not a label"
+    return GeometryError(
+        f"{where}: {what}; expected 'NAME: POLYGON ((…))', 'block NAME: …', 'support [NAME] [fixed|driven]: …' "
+        "or the WKT alone (a name has no spaces or colons)"
+    )
 
 
 def _complete(text: str) -> bool:

@@ -1,5 +1,6 @@
 """Polygon normalisation and assembly validation: every error names the body, on one line."""
 
+import dataclasses
 import time
 
 import numpy as np
@@ -12,6 +13,9 @@ from geometry_library import (
     GeometryError,
     Support,
     build_aqueduct,
+    build_arch,
+    build_wall,
+    checks,
     polygon_from_coords,
     validate_assembly,
 )
@@ -204,3 +208,141 @@ def test_a_polygon_not_made_by_the_clean_up_is_still_checked(monkeypatch):
     assert calls[0] == 3
     concave = Polygon([(0, 0), (2, 0), (2, 2), (1, 0.5), (0, 2)])
     raises_one_line(r'block 1 \("a"\): polygon is not convex', validate_assembly, Assembly((Block(concave, "a"),)))
+
+
+# --- Tolerances relative to the block: float32 / 0.1 mm rounding accepted and cleaned, real defects refused ---
+
+
+def f32(xy) -> np.ndarray:
+    """Coordinates as a float32 export writes them (np.float32(x).item() of each)."""
+    return np.asarray(xy, dtype=np.float64).astype(np.float32).astype(np.float64)
+
+
+def with_midpoints(xy) -> np.ndarray:
+    """A vertex in the middle of every edge, as a CAD polyline split where a neighbour's corner is."""
+    xy = np.asarray(xy, dtype=np.float64)
+    return np.stack([xy, (xy + np.roll(xy, -1, axis=0)) / 2], axis=1).reshape(-1, 2)
+
+
+def exported(assembly: Assembly, transform) -> Assembly:
+    """The assembly with every body's vertices passed through ``transform`` (unchecked polygons)."""
+    blocks = tuple(dataclasses.replace(b, polygon=Polygon(transform(b.vertices))) for b in assembly.blocks)
+    supports = tuple(dataclasses.replace(s, polygon=Polygon(transform(s.vertices))) for s in assembly.supports)
+    return Assembly(blocks, supports)
+
+
+def assert_same_ring(got, want, tol: float) -> None:
+    """Same vertices, in the same cyclic order, each within ``tol`` (m) of the reference."""
+    got, want = np.asarray(got)[:, :2], np.asarray(want)[:, :2]
+    if np.array_equal(got[0], got[-1]):
+        got = got[:-1]
+    if np.array_equal(want[0], want[-1]):
+        want = want[:-1]
+    assert got.shape == want.shape, (got, want)
+    errors = [np.abs(np.roll(got, k, axis=0) - want).max() for k in range(len(got))]
+    assert min(errors) <= tol, (min(errors), tol)
+
+
+def _cleaned(assembly: Assembly, reference: Assembly, tol_rel: float, tol_abs: float = 0.0) -> None:
+    """Each body of ``assembly`` normalised is the body of ``reference`` within ``tol_rel`` × the structure's
+    largest coordinate (float32 rounds relative to the coordinate) + ``tol_abs`` m."""
+    bodies = [(b, "block") for b in assembly.blocks] + [(s, "support") for s in assembly.supports]
+    refs = reference.blocks + reference.supports
+    largest = max(float(np.abs(body.vertices).max()) for body in refs)
+    for (body, kind), ref in zip(bodies, refs):
+        poly = polygon_from_coords(np.asarray(body.polygon.exterior.coords), 0, body.name, kind)
+        assert_same_ring(poly.exterior.coords, ref.vertices, tol_rel * largest + tol_abs)
+
+
+@pytest.mark.parametrize("build", [build_wall, build_arch, build_aqueduct], ids=["wall", "arch", "aqueduct"])
+@pytest.mark.parametrize("midpoints", [False, True], ids=["as-built", "mid-edge-vertices"])
+def test_a_float32_export_is_accepted_and_cleaned_back_to_the_float64_polygons(build, midpoints):
+    """The built-in structures rounded to float32 (GIS / CAD export), also with a vertex in the middle of
+    every edge: no error, no warning, and the normalised polygons are the float64 ones within 1e-6 of the
+    structure's size (its largest coordinate). With the 1e-9 tolerances the arch's rounded mid-edge vertices that fall inside their edge
+    were "not convex" (block 36 "v02"), and the aqueduct as built overlapped by 8e-9 m² where a spandrel
+    block's rounded corner leaves the voussoir's sloping extrados (blocks 36 "v02" and 106 "wall-c02-b04")."""
+    built = build()
+    export = (lambda xy: f32(with_midpoints(xy))) if midpoints else f32
+    rounded = exported(built, export)
+    assert validate_assembly(rounded) == []
+    _cleaned(rounded, built, 1e-6)
+    if midpoints and build is build_arch:
+        sides = []
+        for block in built.blocks:
+            xy = export(block.vertices)  # CCW: cross < 0 at a vertex inside its edge (reflex), > 0 outside
+            e_in, e_out = xy - np.roll(xy, 1, axis=0), np.roll(xy, -1, axis=0) - xy
+            cross = (e_in[:, 0] * e_out[:, 1] - e_in[:, 1] * e_out[:, 0])[1::2]  # at the midpoints
+            sides += np.sign(cross).tolist()
+        assert sides.count(-1) > 10 and sides.count(1) > 10, sides
+
+
+@pytest.mark.parametrize("build", [build_arch, build_aqueduct], ids=["arch", "aqueduct"])
+def test_a_drawing_exact_to_0_1_mm_is_accepted(build):
+    """Coordinates rounded to 0.1 mm (CAD), with a vertex in the middle of every edge: accepted without a
+    warning, each vertex within the rounding (0.05 mm per coordinate) of the exact one. The aqueduct
+    overlapped by 3e-6 m² (blocks 37 "v03" and 113 "wall-c03-b03") with the 1e-9 m² tolerance."""
+    built = build()
+    rounded = exported(built, lambda xy: np.round(with_midpoints(xy), 4))
+    assert validate_assembly(rounded) == []
+    _cleaned(rounded, built, 0.0, 0.5e-4 * np.sqrt(2.0))
+
+
+def test_the_clean_up_of_rounded_vertices_is_a_fixed_point():
+    """A normalised polygon comes back unchanged (the identity cache relies on it), also when rounded
+    mid-edge vertices were removed to get it."""
+    for block in build_arch().blocks:
+        once = checks.normalise_coords(f32(with_midpoints(block.vertices)), block.name)
+        np.testing.assert_array_equal(checks.normalise_coords(once, block.name), once)
+
+
+RECT = [[0, 0], [0.3, 0], [0.3, 0.2]]  # a 0.3 × 0.2 m block, its top edge dented or bulged at the middle
+
+
+def test_a_real_1_mm_dent_is_refused_a_0_1_mm_one_is_removed():
+    # shape tolerance of this block: 2e-3 × its width, area / diagonal = 0.06 / 0.36 m: 0.33 mm
+    dent = [*RECT, [0.15, 0.199], [0, 0.2]]
+    assert raises_one_line("not convex", polygon_from_coords, dent, 0, "dent") == (
+        'block 1 ("dent"): polygon is not convex (reflex vertex at (0.15, 0.199))'
+    )
+    raises_one_line("not convex", polygon_from_coords, f32(dent), 0, "dent")  # float32 changes nothing
+    for y in (0.1999, 0.2001, 0.2 - 3e-4):  # 0.1 mm in, 0.1 mm out, 0.3 mm in: removed
+        cleaned = polygon_from_coords([*RECT, [0.15, y], [0, 0.2]], 0, "b")
+        assert_same_ring(cleaned.exterior.coords, [*RECT, [0, 0.2]], 0.0)
+    bulge = polygon_from_coords([*RECT, [0.15, 0.201], [0, 0.2]], 0, "b")  # 1 mm out: a real, convex vertex
+    assert len(bulge.exterior.coords) == 6
+
+
+def test_a_real_1_mm_overlap_is_refused_a_0_1_mm_one_accepted():
+    a = Block(box(0, 0, 0.3, 0.2), "a")
+    real = asm(a.polygon, box(0.299, 0, 0.599, 0.2), supports=[GROUND], names=["a", "b"])
+    # 2e-4 m² into a 0.06 m² block; tolerance 1e-3 × 0.06 m² (a sliver 0.17 mm deep along the 0.3 m face)
+    assert raises_one_line("overlap", validate_assembly, real) == (
+        'blocks 1 ("a") and 2 ("b") overlap by 0.0002 m² (tolerance 6e-05 m²)'
+    )
+    rounding = asm(a.polygon, box(0.2999, 0, 0.5999, 0.2), supports=[GROUND], names=["a", "b"])
+    assert validate_assembly(rounding) == []  # 2e-5 m²
+
+
+def test_float32_on_a_local_grid_1000_m_off_is_accepted_with_one_warning():
+    """x, y + 1000 m (a site grid) in float32: rounded by at most 2⁻²⁴ × 1003 m = 6e-5 m, a quarter of the smallest block's
+    shape tolerance (half blocks 0.15 × 0.2 m: 0.24 mm). Accepted, cleaned to the float64 polygons within that
+    rounding, with one line saying so; 10 km off, rounding (6e-4 m) exceeds the tolerance and the split arch
+    is refused, saying to shift the coordinates."""
+    for built in (build_wall(), build_arch()):
+        shifted = exported(built, lambda xy: xy + 1000.0)
+        rounded = exported(built, lambda xy: f32(with_midpoints(xy + 1000.0)))
+        warnings = validate_assembly(rounded)
+        far = f"{max(np.abs(b.vertices).max() for b in shifted.blocks + shifted.supports):,.0f}"
+        assert len(warnings) == 1 and warnings[0].startswith(
+            f"coordinates are all float32 values reaching {far} m from the origin, where float32 keeps only ±6e-05 m"
+        ), warnings
+        assert warnings[0].endswith("shift them near the origin or export them in float64 for exact geometry")
+        _cleaned(rounded, shifted, 0.0, 2.0 * 2.0**-24 * 1010.0)
+        assert validate_assembly(exported(built, lambda xy: f32(xy))) == []  # near the origin: silent
+    far = exported(build_arch(), lambda xy: f32(with_midpoints(xy + [1e4, 0.0])))
+    assert raises_one_line("not convex", validate_assembly, far) == (
+        'block 40 ("v06"): polygon is not convex (reflex vertex at (9998.49, 4.37901)); its coordinates are float32 '
+        "values, exact only to ±0.0006 m this far (9,999 m) from the origin: shift them near the origin or export "
+        "them in float64"
+    )

@@ -211,6 +211,26 @@ def test_wkt_errors_name_file_and_line(tmp_path):
         read_wkt(tmp_path / "missing.wkt")
 
 
+@pytest.mark.parametrize(
+    "line, what",
+    [
+        (": POLYGON ((0 0, 1 0, 1 1, 0 1, 0 0))", "nothing before the colon"),  # said "Unknown type: ':'"
+        ("  :POLYGON ((0 0, 1 0, 1 1, 0 1, 0 0))", "nothing before the colon"),
+        (
+            "c3 b2: POLYGON ((0 0, 1 0, 1 1, 0 1, 0 0))",
+            "'c3 b2' before the colon is not a label",
+        ),  # "Unknown type: 'C3'"
+    ],
+)
+def test_wkt_a_line_whose_label_is_not_one_says_what_is_expected(line, what, tmp_path):
+    path = tmp_path / "labels.wkt"
+    path.write_text("support ground: POLYGON ((-2 -1, 3 -1, 3 0, -2 0, -2 -1))\n" + line + "\n")
+    assert one_line_error(read_wkt, path) == (
+        f"{path}: line 2: {what}; expected 'NAME: POLYGON ((…))', 'block NAME: …', 'support [NAME] [fixed|driven]: "
+        "…' or the WKT alone (a name has no spaces or colons)"
+    )
+
+
 def test_write_wkt_rejects_names_it_cannot_label(tmp_path):
     a = Assembly((Block(box(0, 0, 1, 1), "has space"),))
     with pytest.raises(GeometryError, match="cannot be written to WKT"):
