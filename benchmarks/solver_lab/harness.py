@@ -55,13 +55,14 @@ def _register_optional():
         alm_newton,
         anderson,
         cluster,
+        ipm,
         joint,
         linear,
         newton,
         tnnmg,
     )
 
-    for module in (anderson, newton, alm_newton, cluster, linear, accelerated, tnnmg, alart_curnier, joint):
+    for module in (anderson, newton, alm_newton, cluster, linear, accelerated, tnnmg, alart_curnier, joint, ipm):
         METHODS.update(module.METHODS)
 
 
@@ -91,6 +92,7 @@ def measure(ctx: Context, method: str, target: float) -> dict:
         "method": method,
         "problem": p.name,
         "iterations": out.iterations,
+        "detail": out.detail,
         "sweeps": out.sweeps,
         "cpu_ms": 1e3 * cpu,
         "phases_ms": {k: 1e3 * s for k, s in out.phases.items()},
@@ -148,7 +150,7 @@ def run_table(methods: list[str] | None, problems: list[str] | None, repeat: int
             flag = "" if row["converged"] else " (not converged)"
             flag += " v≠v(r)" if row["v_mismatch"] > 1e-9 else ""
             print(
-                f"| {prob.name} | {prob.blocks} | {prob.count} | {m}{flag} | {row['iterations']} | {row['sweeps']:.0f} |"
+                f"| {prob.name} | {prob.blocks} | {prob.count} | {m}{flag} | {row['iterations']}{' (' + row['detail'] + ')' if row['detail'] else ''} | {row['sweeps']:.0f} |"
                 f" {row['cpu_ms']:.2f} ({_fmt_phases(row['phases_ms'])}) | {row['v_error']:.1e} |"
                 f" {row['law_residual']:.1e} / {row['law_residual_max']:.1e} |",
                 flush=True,

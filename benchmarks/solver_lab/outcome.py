@@ -26,7 +26,10 @@ class Outcome:
     """phase name → CPU seconds."""
     converged: bool = True
     cpu_s: float | None = None
-    """CPU seconds of the solve when it ran in another process (the harness's clock would miss them)."""
+    """CPU seconds of the solve when it ran in another process (the harness's clock would miss them), or
+    when part of the call is not the method's work (an untimed search)."""
+    detail: str = ""
+    """Counts beside ``iterations`` (e.g. outer rounds, closing sweeps), printed with them."""
 
 
 class Clock:
