@@ -131,7 +131,7 @@ class Operators:
         both = (ii >= 0) & (jj >= 0)
         w = int(np.abs(ii - jj)[both].max(initial=0))
         self.w = w
-        outer = [np.einsum("ci,cj->cij", J[:, k], J[:, l]) for k, l in ((0, 0), (0, 1), (1, 0), (1, 1))]
+        outer = [np.einsum("ci,cj->cij", J[:, k], J[:, j]) for k, j in ((0, 0), (0, 1), (1, 0), (1, 1))]
         cid = np.broadcast_to(np.arange(c)[:, None, None], (c, 6, 6))
         lower = both & (ii >= jj)
         flat = ((ii - jj) * n + jj)[lower]
