@@ -1,4 +1,4 @@
-"""Solver lab: ``python -m benchmarks.solver_lab capture|table|clusters|stalled|trajectory|ordinary|newton-ordinary|joint-ordinary|ordinary-runs|ensemble|hard|hard-methods|handover``
+"""Solver lab: ``python -m benchmarks.solver_lab capture|table|clusters|stalled|trajectory|ordinary|newton-ordinary|joint-ordinary|ipm-ordinary|ordinary-runs|ensemble|hard|hard-methods|handover``
 (see benchmarks/README.md, "Solver lab")."""
 
 from __future__ import annotations
@@ -60,6 +60,10 @@ def main() -> None:
     jor.add_argument("--every", type=int, default=1, help="every k-th ordinary step of the sample")
     jor.add_argument("--repeat", type=int, default=2, help="interleaved timing rounds; CPU-time minimum kept")
     jor.add_argument("--plain", action="store_true", help="also joint-gs (no momentum)")
+    ipo = sub.add_parser("ipm-ordinary", help="the interior-point method on a trajectory sample's ordinary steps")
+    ipo.add_argument("--sample", default="nwt-wall-248", help="data/trajectory/SAMPLE")
+    ipo.add_argument("--every", type=int, default=1, help="every k-th ordinary step of the sample")
+    ipo.add_argument("--loose", type=float, nargs="+", default=[1e-4, 3e-5], help="m/s: IPM to this, then sweeps")
     orr = sub.add_parser("ordinary-runs", help="first-stage variants in whole runs (sweeps, unconverged, slips)")
     orr.add_argument("--cases", nargs="+", default=["wall-248"])
     orr.add_argument("--variants", nargs="+", default=None)
@@ -96,6 +100,11 @@ def main() -> None:
         from benchmarks.solver_lab.newton_ordinary import table as newton_table
 
         newton_table(args.sample, args.every, args.variants, args.spread, args.feasibility)
+        return
+    if args.command == "ipm-ordinary":
+        from benchmarks.solver_lab.ipm_ordinary import table as ipm_table
+
+        ipm_table(args.sample, args.every, tuple(args.loose))
         return
     if args.command == "joint-ordinary":
         from benchmarks.solver_lab.joint_ordinary import table as joint_table

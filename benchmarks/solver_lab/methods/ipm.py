@@ -23,24 +23,37 @@ One Mehrotra iteration (x is always recomputed from λ, so the dual residual is 
     step α = min(1, 0.995 · largest step keeping z, λ > 0) on (λ, z); x ← x(λ)
 
 The factorisation is LAPACK's banded Cholesky (scipy ``cholesky_banded``) of K in the engine's body order
-(``banded.body_order``), assembled by one fixed sparse map from the 3C entries of the G_α to the band.
+(``banded.body_order``), assembled by one fixed sparse map from the G_α entries to the band.
 
-Outer rounds (Coulomb, not Tresca): s ← μ |u_t| of the last iterate, the IPM restarted (Mehrotra's
-starting point heuristic, from the current impulses), until the lab's RMS law residual ≤ the target.
+The shift s = μ|u_t| (Coulomb, not Tresca) makes the problem nonconvex. Three ways to handle it:
 
-Methods (every one stopped on the lab's law residual of (v(r), r), like the rest of the lab):
+    rounds      s frozen for a whole IPM; then s ← s + θ (μ|u_t| − s) and the IPM restarted (Mehrotra's
+                starting point heuristic from the current impulses) — the De Saxcé fixed point
+    each        s ← μ|u_t| of the current iterate at every iteration (K as above, s not differentiated)
+    newton      the same, and s linearised in the Newton matrix where a contact slides (2μ|u_t| >
+                SLIP_RATIO × its smaller slack): ∂s = μ sg ∂u_t, so dz = Ã dx + rp with Ã = A + μ sg e H_t
+                on both rows; K = M + Aᵀ D Ã is then non-symmetric (banded LU, LAPACK gbtrf); a step shorter
+                than FALLBACK_STEP is replaced by the frozen-s step of the same iterate
 
-    ipm          outer rounds: each round's IPM runs until its own frozen-s problem is solved
-                 (RMS primal residual and complementarity measure ≤ INNER_FRACTION · target), then the law
-                 residual is checked; s from the warm start's velocities in the first round
-    ipm-each     one IPM, s ← μ |u_t| of the current iterate at every iteration (no rounds)
-    ipm-close    ipm-each stopped as soon as the law residual ≤ LOOSE (1e-3 m/s), then the engine's
-                 accelerated sweeps ("nlgs-accel" kernel) from its impulses to the target
-    ipm-close4   the same with LOOSE 1e-4 m/s
+Methods (every one stopped on the lab's law residual of (v(r), r) ≤ target, checked every iteration, like
+the rest of the lab; cap ITER_CAP iterations):
 
-``iterations``: IPM iterations; the phases also carry "rounds" and "closing sweeps" (counts, not seconds)
-in ``Outcome.detail``. Sweep units: CPU time over one engine sweep (the harness's rule), closing sweeps
-included at their CPU time; the untimed search for the closing sweep count is excluded (``cpu_s``).
+    ipm            rounds, θ = 1; a round ends when its frozen-s problem is solved (RMS primal residual
+                   and RMS min(z, W_nn λ) ≤ INNER_FRACTION · target); s from the warm start's velocities first
+    ipm-damped     rounds, θ = ½ (undamped, s oscillates)
+    ipm-each       each
+    ipm-newton     newton
+    ipm-oracle-s   one IPM with s frozen at the reference's μ|u_t| (reads the answer: the cost of the convex
+                   part alone, the self-stress under the inequalities)
+    ipm-close      ipm-newton stopped at the law residual LOOSE (1e-3 m/s), then the engine's accelerated
+                   sweeps ("nlgs-accel" kernel, tolerance 0) from its impulses to the target
+    ipm-close4, ipm-close-3e-5   the same from 1e-4 and 3e-5 m/s
+
+Start: impulses from the warm start (λ± = (r_n ± r_t/μ)/2, clipped at 0), then Mehrotra's shift into the
+interior. ``iterations``: IPM iterations; ``Outcome.detail`` the rounds and closing sweeps. Sweep units: the
+harness's rule (CPU time over one engine sweep), closing sweeps included at their CPU time; the untimed
+search for the closing sweep count and the one-off "setup" (band order and assembly map, numpy) are not
+counted (``cpu_s``): a compiled version would assemble the band directly each step.
 """
 
 from __future__ import annotations
@@ -62,9 +75,9 @@ INNER_FRACTION = 0.1
 ITER_CAP = 200
 """IPM iterations a solve (over all rounds)."""
 ROUND_CAP = 30
-D_CAP = 1e10
-"""The barrier weights λ/z are capped at this × the largest block mass (the banded Cholesky broke down at
-ratios ~1e13 on wall-64's typical step)."""
+D_CAP = 1e12
+"""The barrier weights λ/z are capped at this × the largest block mass (uncapped, the banded Cholesky broke
+down on wall-64's hard step; 1e10 doubled ipm-oracle-s's iterations on wall-64's typical step, 40 → 21)."""
 STEP_FRACTION = 0.995
 FALLBACK_STEP = 0.1
 """ipm-newton: a linearised-shift step shorter than this is replaced by the frozen-shift step."""
@@ -198,6 +211,8 @@ class Operators:
         ab = (self.S_general @ g).reshape(3 * self.w + 1, self.n)
         ab[2 * self.w] += self.m
         lu, piv, info = lapack.dgbtrf(ab, self.w, self.w, overwrite_ab=True)
+        if info != 0:
+            raise np.linalg.LinAlgError(f"banded LU: zero pivot {info}")
         return "lu", (lu, piv)
 
     def solve(self, fac, rhs):
@@ -328,9 +343,12 @@ def run_ipm(ctx, target, stop_at, clock, mode="rounds", theta=1.0, lam_start=Non
                     s = mu * np.abs(u[:, 0])
                     if mode == "newton":
                         sg = slip_sign(ops, u, z)
-                x1, lam1, z1, alpha = iterate(ops, x, lam, z, s, sg)
-                if sg is not None and alpha < FALLBACK_STEP:  # a poor linearisation: s frozen instead
-                    x1, lam1, z1, alpha = iterate(ops, x, lam, z, s, None)
+                try:
+                    x1, lam1, z1, alpha = iterate(ops, x, lam, z, s, sg)
+                    if sg is not None and alpha < FALLBACK_STEP:  # a poor linearisation: s frozen instead
+                        x1, lam1, z1, alpha = iterate(ops, x, lam, z, s, None)
+                except np.linalg.LinAlgError:  # the factor broke down: stop with the last iterate
+                    break
                 x, lam, z = x1, lam1, z1
             its += 1
             with clock("check"):
