@@ -71,9 +71,11 @@ def test_frozen_shift_qp_matches_scipy(cold):
     )
     assert res.success
     lam, x, z = I._start(ops, np.zeros((cold.count, 2)), ops.bias + s)
-    for _ in range(60):
+    for _ in range(60):  # to convergence; past it the barrier weights' ill-conditioning only adds noise
         x, lam, z, _ = I.iterate(ops, x, lam, z, s)
-    assert float((z * lam).mean()) < 1e-10
+        if float((z * lam).mean()) < 1e-11:
+            break
+    assert float((z * lam).mean()) < 1e-11
     np.testing.assert_allclose(x, res.x, atol=1e-7)
     # KKT of the QP: M (x − x_free) = Aᵀ λ with λ ≥ 0 — the impulses r = Eᵀλ reproduce the velocities
     np.testing.assert_allclose(m * (x - x_free), A.T @ np.concatenate([lam[:, 0], lam[:, 1]]), atol=1e-9)
