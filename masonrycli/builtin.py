@@ -18,22 +18,31 @@ as the command line spells them (``--settlement -1: must be >= 0 ...``).
 
 The same overrides serve the other commands' structures: :func:`file_scenario` (a scenario or geometry
 file, ``masonry run`` / ``check``) and :func:`build_assembly` (the builders' assemblies, ``masonry build``).
+
+:func:`target_scenario` resolves the TARGET of ``run`` / ``check``, ``sweep`` and ``limit`` (a built-in
+name, a scenario TOML or a GeoJSON / WKT file): a target that is none of them gets the same one line from
+every command (they said "no such scenario file", "no such scenario or geometry file" or "cannot read
+scenario: No such file or directory" for one missing file).
 """
 
 from __future__ import annotations
 
 import dataclasses
+import difflib
 import math
 import os
+from collections.abc import Callable
 from pathlib import Path
 
-from masonrycli.errors import InputError
+from masonrycli.errors import NOT_A_FILE, InputError, special_file
 from masonrycli.motion import Constant, Record, Sine
 from masonrycli.records import record_motion
 from masonrycli.scenario import MAX_DURATION, Material, RunConfig, Scenario, scenario_from_builder
 
 DEFAULT_DURATION = {"wall": 1.0, "arch": 5.0, "aqueduct": 5.0}
 """s, simulated time of each built-in scenario."""
+BUILT_IN = tuple(DEFAULT_DURATION)
+"""The built-in structures' names, as a command's TARGET spells them."""
 SHAKE_AMPLITUDE, SHAKE_FREQUENCY = 1.0, 2.0
 """m/s and Hz: the wall's ground velocity (the paper's shaking)."""
 SETTLEMENT = 0.01
@@ -132,22 +141,63 @@ def with_record(scenario: Scenario, record: Path | None, scale: float | None) ->
     return dataclasses.replace(scenario, motions=motions)
 
 
-def file_scenario(path: Path, *, record: Path | None = None, scale: float | None = None, **overrides) -> Scenario:
-    """The scenario of a TOML, GeoJSON or WKT file (``masonry run`` / ``check``) driven by ``record`` times
-    ``scale`` if given (:func:`with_record`), with the run settings and the friction of ``overrides``
-    (:func:`override_run`). A built-in's name that is no file is told where it runs."""
+def is_built_in(target: str | os.PathLike) -> bool:
+    """Whether a command's TARGET names a built-in structure: its name, unless a file of that name is
+    here (a folder ``wall/`` of recordings is no scenario: ``masonry limit wall`` said "no such scenario
+    or geometry file")."""
+    return os.fspath(target) in DEFAULT_DURATION and not os.path.isfile(target)
+
+
+def target_scenario(target: str | os.PathLike, built_in: Callable[[str], Scenario] | None = None) -> Scenario:
+    """The scenario a command's TARGET names: ``built_in(name)`` for a built-in name (None: the command
+    takes files only, and the message says where the built-ins run), else a scenario file (TOML) or a
+    geometry file (GeoJSON / WKT, every support fixed). A target that is none of them raises the same
+    one-line :class:`InputError` from every command, naming it."""
     from masonrycli.scenario import scenario_from_geometry_file
     from masonrycli.scenario_toml import load_scenario
     from masonrycli.structure import GEOMETRY_SUFFIXES
 
-    if str(path) in DEFAULT_DURATION and not path.exists():  # a built-in name
-        name = str(path)
-        raise InputError(f"{name}: not a file; the built-in structures are run with `masonry simulate {name}`")
-    if path.suffix.lower() in GEOMETRY_SUFFIXES:
-        scenario = scenario_from_geometry_file(path)
-    else:
-        scenario = load_scenario(path)
-    return override_run(with_record(scenario, record, scale), **overrides)
+    target = os.fspath(target)
+    if not target.strip():  # Path("") is the working folder: it said "error: : no such scenario …"
+        raise InputError(f"the structure argument is empty ({target!r}): give wall, arch, aqueduct or a scenario file")
+    if is_built_in(target):
+        if built_in is None:
+            raise InputError(f"{target}: not a file; the built-in structures are run with `masonry simulate {target}`")
+        return built_in(target)
+    problem = _target_problem(target)
+    if problem:
+        raise InputError(f"{target}: {problem}")
+    path = Path(target)  # as the commands read it before: "./s.toml" is the scenario "s.toml"
+    return scenario_from_geometry_file(path) if path.suffix.lower() in GEOMETRY_SUFFIXES else load_scenario(path)
+
+
+def _target_problem(target: str) -> str:
+    """Why ``target`` is no file to read ("" if it is one), checked before a reader opens it: each reader
+    said it its own way ("cannot read scenario: is a directory", a folder named .geojson "not a regular
+    file", an unreadable one "cannot read file (PermissionError: [Errno 13] …)")."""
+    if special_file(target):  # checked without opening it: opening a named pipe waits for a writer
+        return NOT_A_FILE
+    if os.path.isdir(target):
+        return "is a directory, not a scenario or geometry file"
+    if not os.path.exists(target):
+        bare = os.sep not in target and not Path(target).suffix  # "wal", not "wal.toml" or "runs/wal"
+        close = difflib.get_close_matches(target.lower(), BUILT_IN, n=1) if bare else []
+        hint = f"did you mean {close[0]}?" if close else f"built-in structures: {', '.join(BUILT_IN)}"
+        return f"no such scenario or geometry file ({hint})"
+    try:
+        open(target, "rb").close()
+    except OSError as exc:
+        return f"cannot read file: {exc.strerror or exc}"
+    return ""
+
+
+def file_scenario(
+    path: str | os.PathLike, *, record: Path | None = None, scale: float | None = None, **overrides
+) -> Scenario:
+    """The scenario of a TOML, GeoJSON or WKT file (``masonry run`` / ``check``, :func:`target_scenario`:
+    a built-in's name is told where it runs) driven by ``record`` times ``scale`` if given
+    (:func:`with_record`), with the run settings and the friction of ``overrides`` (:func:`override_run`)."""
+    return override_run(with_record(target_scenario(path), record, scale), **overrides)
 
 
 def _loading(name: str, amp, freq, settlement, record, scale) -> dict:

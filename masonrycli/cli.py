@@ -164,12 +164,14 @@ def simulate_aqueduct(**opts) -> None:
     _simulate("aqueduct", opts)
 
 
+# a str, checked by builtin.target_scenario as sweep's and limit's targets are: click's Path said of an
+# unreadable file "Invalid value for 'SCENARIO.toml': path 's.toml' is not readable", and made "" the folder "."
 ScenarioFile = Annotated[
-    Path, typer.Argument(help="Scenario file (TOML), or a GeoJSON / WKT geometry.", metavar="SCENARIO.toml")
+    str, typer.Argument(help="Scenario file (TOML), or a GeoJSON / WKT geometry.", metavar="SCENARIO.toml")
 ]
 
 
-def _load(scenario_file: Path, opts: dict):
+def _load(scenario_file: str, opts: dict):
     """The scenario of a TOML, GeoJSON or WKT file with the command line's record and run options
     (taken out of ``opts``) applied."""
     from masonrycli.builtin import file_scenario
@@ -260,7 +262,7 @@ def check_command(scenario_file: ScenarioFile, **opts) -> None:
 
     scenario = _load(scenario_file, opts)
     outputs = _check_run(scenario, opts)
-    console.print(check_table(str(scenario_file), scenario_summary(scenario), outputs.files()))
+    console.print(check_table(str(Path(scenario_file)), scenario_summary(scenario), outputs.files()))
     for warning in (*scenario.warnings, *record_warnings(scenario)):
         warn(warning)
 

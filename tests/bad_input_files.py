@@ -42,7 +42,7 @@ SQUARE = [[[0, 0], [1, 0], [1, 1], [0, 1], [0, 0]]]
 FILE_ROWS = [
     # paths that exist but are no file: /dev/zero was read for ever (the command hung), and the commands
     # that ask is_file() called it missing ("no such scenario or geometry file", "no such recording")
-    ("scenario-dev-zero", {}, ("run", "/dev/zero"), 2, "/dev/zero: cannot read scenario: not a regular file"),
+    ("scenario-dev-zero", {}, ("run", "/dev/zero"), 2, "/dev/zero: not a regular file (a device, a pipe or a socket)"),
     ("limit-dev-zero", {}, ("limit", "/dev/zero"), 2, "/dev/zero: not a regular file (a device, a pipe or a socket)"),
     ("inspect-dev-zero", {}, ("inspect", "/dev/zero"), 2, "/dev/zero: not a regular file"),
     (
@@ -262,13 +262,13 @@ FILE_ROWS = [
         2,
         "missing.geojson",
     ),
-    ("scenario-missing", {}, ("check", "no-such.toml"), 2, "no-such.toml: cannot read scenario"),
+    ("scenario-missing", {}, ("check", "no-such.toml"), 2, "no-such.toml: no such scenario or geometry file"),
     (
         "scenario-is-folder",
         {"sub.toml/x": ""},
         ("check", "sub.toml"),
         2,
-        "sub.toml: cannot read scenario: is a directory",
+        "sub.toml: is a directory, not a scenario or geometry file",
     ),
     # -- GeoJSON (run and check read it alike)
     ("geojson-not-json", {"g.geojson": "{ not json"}, ("check", "g.geojson"), 2, "g.geojson: "),
@@ -302,7 +302,7 @@ FILE_ROWS = [
         2,
         "g.geojson: ",
     ),
-    ("geojson-missing", {}, ("run", "nope.geojson"), 2, "nope.geojson: no such file"),
+    ("geojson-missing", {}, ("run", "nope.geojson"), 2, "nope.geojson: no such scenario or geometry file"),
     # -- WKT
     (
         "wkt-nan",

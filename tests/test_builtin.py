@@ -6,7 +6,15 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from masonrycli.builtin import build_assembly, builtin, file_scenario, override_run, paper_instant_hint
+from masonrycli.builtin import (
+    build_assembly,
+    builtin,
+    file_scenario,
+    is_built_in,
+    override_run,
+    paper_instant_hint,
+    target_scenario,
+)
 from masonrycli.errors import InputError
 from masonrycli.motion import Constant, Fixed, Sine
 from masonrycli.records import record_motion
@@ -164,6 +172,40 @@ def test_a_file_scenario_takes_the_record_and_the_run_overrides(tmp_path, monkey
     with pytest.raises(InputError) as info:
         file_scenario(Path("wall"))
     assert str(info.value) == "wall: not a file; the built-in structures are run with `masonry simulate wall`"
+
+
+def test_a_target_is_a_built_in_name_unless_a_file_of_that_name_is_here(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    one_block = (Path(__file__).parent / "data" / "block_on_ground.toml").read_text()
+    assert is_built_in("wall") and not is_built_in("wall.toml") and not is_built_in("Wall")
+    assert target_scenario("arch", lambda name: f"the built-in {name}") == "the built-in arch"
+    (tmp_path / "arch").mkdir()  # a folder of that name: still the built-in
+    assert target_scenario("arch", lambda name: f"the built-in {name}") == "the built-in arch"
+    (tmp_path / "wall").write_text(one_block)  # a file: the file, for every command
+    assert not is_built_in("wall")
+    assert target_scenario("wall", lambda name: None).name == "block-on-harmonic-ground"
+    assert target_scenario(Path("./wall")).source == "wall"  # read as the commands read it before
+
+
+@pytest.mark.parametrize(
+    ("target", "message"),
+    [
+        ("wal", "wal: no such scenario or geometry file (did you mean wall?)"),
+        ("WALL", "WALL: no such scenario or geometry file (did you mean wall?)"),
+        ("arches", "arches: no such scenario or geometry file (did you mean arch?)"),
+        # a file name or a path names no built-in
+        ("arch.toml", "arch.toml: no such scenario or geometry file (built-in structures: wall, arch, aqueduct)"),
+        ("runs/wal", "runs/wal: no such scenario or geometry file (built-in structures: wall, arch, aqueduct)"),
+        ("bridge", "bridge: no such scenario or geometry file (built-in structures: wall, arch, aqueduct)"),
+        (".", ".: is a directory, not a scenario or geometry file"),
+        (" ", "the structure argument is empty (' '): give wall, arch, aqueduct or a scenario file"),
+    ],
+)
+def test_a_bad_target_is_named_in_one_line(target, message, tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(InputError) as info:
+        target_scenario(target, lambda name: pytest.fail(f"built {name}"))
+    assert str(info.value) == message
 
 
 @pytest.mark.parametrize(

@@ -18,13 +18,12 @@ from rich.console import Console
 from rich.table import Table
 from rich.text import Text
 
-from masonrycli.errors import NOT_A_FILE, InputError, special_file
+from masonrycli.errors import InputError
 from masonrycli.interrupt import StopRun, StopSignals, exit_code, signal_name
 from masonrycli.limit.analysis import LimitResult, analyse
 from masonrycli.limit.problem import LiveLoad
 from masonrycli.outputs import check_output, written_whole
 
-BUILT_INS = ("wall", "arch", "aqueduct")
 SHOWN = 8
 """Joint names listed in the terminal table (all of them are in --json)."""
 THRUST_SHOWN = 0.02
@@ -32,27 +31,12 @@ THRUST_SHOWN = 0.02
 
 
 def resolve_structure(structure: str, friction: float | None):
-    """A scenario from a built-in name, a scenario file or a geometry file; ``friction`` overrides μ."""
-    from masonrycli.builtin import override_run
-    from masonrycli.scenario import Material, RunConfig, scenario_from_builder, scenario_from_geometry_file
-    from masonrycli.scenario_toml import load_scenario
-    from masonrycli.structure import GEOMETRY_SUFFIXES
+    """A scenario from a built-in name (the builder's defaults, no motion), a scenario file or a geometry
+    file (:func:`~masonrycli.builtin.target_scenario`); ``friction`` overrides μ."""
+    from masonrycli.builtin import override_run, target_scenario
+    from masonrycli.scenario import Material, RunConfig, scenario_from_builder
 
-    path = Path(structure)
-    if not structure.strip():  # Path("") is the working folder: it said "error: : no such scenario …"
-        raise InputError(
-            f"the structure argument is empty ({structure!r}): give wall, arch, aqueduct or a scenario file"
-        )
-    if structure in BUILT_INS and not path.exists():
-        scenario = scenario_from_builder(structure, {}, RunConfig(), Material(), {})
-    elif special_file(path):
-        raise InputError(f"{structure}: {NOT_A_FILE}")
-    elif not path.is_file():
-        raise InputError(f"{structure}: no such scenario or geometry file (built-ins: {', '.join(BUILT_INS)})")
-    elif path.suffix.lower() in GEOMETRY_SUFFIXES:
-        scenario = scenario_from_geometry_file(path)
-    else:
-        scenario = load_scenario(path)
+    scenario = target_scenario(structure, lambda name: scenario_from_builder(name, {}, RunConfig(), Material(), {}))
     return override_run(scenario, friction=friction)
 
 

@@ -17,6 +17,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
+from masonrycli.builtin import is_built_in, override_run, target_scenario
 from masonrycli.errors import NOT_A_FILE, InputError
 from masonrycli.outputs import OutputFile, safe_name
 from masonrycli.study import store
@@ -24,7 +25,6 @@ from masonrycli.study.axes import Axis, StudyBase, parse_axis
 from masonrycli.study.files import check_picture
 from masonrycli.study.study import StudyRequest
 
-BUILT_IN = ("wall", "arch", "aqueduct")
 SWEEP_DURATION = {"wall": 1.0, "arch": 2.0, "aqueduct": 2.0}
 """s: default simulated time of a built-in structure in a study."""
 
@@ -83,7 +83,7 @@ def plan_study(
     late: list[str] = []  # warnings about records longer than the runs
     if records:
         motions = _records(records, out)
-        whole = duration is None and target in BUILT_IN  # a scenario file's [run] duration stands
+        whole = duration is None and is_built_in(target)  # a scenario file's [run] duration stands
         scenario, late = _record_duration(base.scenario, motions, whole)
         base = StudyBase(scenario, motions)
         axes.insert(0, Axis("record", tuple(motions)))
@@ -135,30 +135,20 @@ def plan_study(
 
 
 def _base_scenario(target: str, duration, dt):
-    from masonrycli.builtin import override_run
+    scenario = target_scenario(target, _shaken)  # a GeoJSON / WKT file as `masonry run` takes it
+    return override_run(scenario, duration=duration, dt=dt)  # names the wrong option (--dt 0: --dt)
+
+
+def _shaken(name: str):
+    """The built-in structure ``name`` of a study: 1 m/s at 2 Hz on the ground (wall) or both foundations
+    (arch, aqueduct), for ``SWEEP_DURATION``."""
     from masonrycli.motion import Sine
     from masonrycli.scenario import Material, RunConfig, scenario_from_builder
 
-    if target in BUILT_IN:
-        # a shaken structure: 1 m/s at 2 Hz on the ground (wall) or both foundations (arch, aqueduct)
-        shaken = ("ground",) if target == "wall" else ("left-foundation", "right-foundation")
-        motions = {s: Sine(amplitude=1.0, frequency=2.0) for s in shaken}
-        options = {"blocks": 51} if target == "wall" else {}
-        scenario = scenario_from_builder(
-            target, options, RunConfig(duration=SWEEP_DURATION[target]), Material(), motions
-        )
-    else:
-        from masonrycli.scenario import scenario_from_geometry_file
-        from masonrycli.scenario_toml import load_scenario
-        from masonrycli.structure import GEOMETRY_SUFFIXES
-
-        path = Path(target)
-        if not path.exists():
-            raise InputError(f"{target}: no such scenario file (or built-in structure: {', '.join(BUILT_IN)})")
-        # a GeoJSON / WKT file as `masonry run` takes it (it said "TOML syntax error: Invalid statement")
-        geometry = path.suffix.lower() in GEOMETRY_SUFFIXES
-        scenario = scenario_from_geometry_file(path) if geometry else load_scenario(path)
-    return override_run(scenario, duration=duration, dt=dt)  # names the wrong option (--dt 0: --dt)
+    shaken = ("ground",) if name == "wall" else ("left-foundation", "right-foundation")
+    motions = {s: Sine(amplitude=1.0, frequency=2.0) for s in shaken}
+    options = {"blocks": 51} if name == "wall" else {}
+    return scenario_from_builder(name, options, RunConfig(duration=SWEEP_DURATION[name]), Material(), motions)
 
 
 def _record_duration(scenario, motions: dict, whole: bool):
