@@ -56,13 +56,26 @@ def _register_optional():
         anderson,
         cluster,
         ipm,
+        ipm_lcp,
         joint,
         linear,
         newton,
         tnnmg,
     )
 
-    for module in (anderson, newton, alm_newton, cluster, linear, accelerated, tnnmg, alart_curnier, joint, ipm):
+    for module in (
+        anderson,
+        newton,
+        alm_newton,
+        cluster,
+        linear,
+        accelerated,
+        tnnmg,
+        alart_curnier,
+        joint,
+        ipm,
+        ipm_lcp,
+    ):
         METHODS.update(module.METHODS)
 
 

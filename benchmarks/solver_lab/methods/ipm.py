@@ -208,6 +208,10 @@ class Operators:
                 dp + dm,
             ]
         )
+        return self.factor_blocks(g)
+
+    def factor_blocks(self, g):
+        """Banded LU of K = M + Σ_α J_αᵀ G_α J_α for any 2×2 G_α, ``g`` = (G_tt, G_tn, G_nt, G_nn) concatenated."""
         ab = (self.S_general @ g).reshape(3 * self.w + 1, self.n)
         ab[2 * self.w] += self.m
         lu, piv, info = lapack.dgbtrf(ab, self.w, self.w, overwrite_ab=True)
