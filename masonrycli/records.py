@@ -21,10 +21,9 @@ import numpy as np
 
 from masonrycli.errors import NOT_A_FILE, InputError, RecordWarning, not_utf8, special_file
 from masonrycli.motion import Record
-from masonrycli.record_units import check_at2_header, check_at2_sample, check_csv_header
+from masonrycli.record_text import at2_text, csv_text, number
+from masonrycli.record_units import check_at2_header, check_csv_header
 from masonrycli.values import format_value, quote_string, shorten
-
-_SPLIT = re.compile(r"\s*[,;]\s*|\s+")
 
 
 def load_record_csv(path, display: str | None = None) -> tuple[np.ndarray, np.ndarray]:
@@ -41,58 +40,7 @@ def load_record_csv(path, display: str | None = None) -> tuple[np.ndarray, np.nd
     ``display`` is the file name used in messages (default: ``path`` as given).
     """
     name = display if display is not None else str(path)
-    text = _read_text(path, name)
-    times: list[float] = []
-    values: list = []
-    ncol = 0
-    header_seen = False
-    for lineno, line in enumerate(text.splitlines(), start=1):
-        stripped = line.strip()
-        if not stripped or stripped.startswith("#"):
-            continue
-        fields = _fields(stripped)
-        try:
-            nums = [float(f) for f in fields]
-        except ValueError:
-            if not times and not header_seen:
-                header_seen = True
-                continue
-            bad = next(f for f in fields if not _is_float(f))
-            raise InputError(f"{name}:{lineno}: not a number: {shorten(bad, 40)}") from None
-        if ncol == 0:
-            if len(nums) not in (2, 3):
-                raise InputError(
-                    f"{name}:{lineno}: expected 2 columns (time, value) or 3 (time, x, y), got {len(nums)}"
-                )
-            ncol = len(nums)
-        elif len(nums) != ncol:
-            raise InputError(f"{name}:{lineno}: expected {ncol} columns like the first sample, got {len(nums)}")
-        if not all(math.isfinite(x) for x in nums):
-            raise InputError(f"{name}:{lineno}: values must be finite, got {shorten(stripped, 40)}")
-        if times and not nums[0] > times[-1]:
-            raise InputError(
-                f"{name}:{lineno}: time {format_value(nums[0])} is not after the previous sample's "
-                f"{format_value(times[-1])} (times must be strictly increasing)"
-            )
-        times.append(nums[0])
-        values.append(nums[1] if ncol == 2 else (nums[1], nums[2]))
-    if len(times) < 2:
-        raise InputError(f"{name}: a record needs at least 2 samples, found {len(times)}")
-    return np.asarray(times, dtype=np.float64), np.asarray(values, dtype=np.float64)
-
-
-def _fields(line: str) -> list[str]:
-    """The fields of a CSV line. A line with ``;`` is split on ``;`` alone and its decimal commas read as
-    points (``0;0,5``, a European spreadsheet's CSV): split on commas too, it was taken for a
-    (time, x, y) record, 0,5 becoming x = 0, y = 5 m/s, and the run said completed. A line with a tab
-    and a comma is split on tabs alone likewise (``0<TAB>0,5``, the spreadsheet's tab-delimited text)."""
-    separator = ";" if ";" in line else "\t" if "\t" in line and "," in line else None
-    if separator == "\t" and any(f.strip().startswith(",") or f.strip().endswith(",") for f in line.split("\t")):
-        separator = None  # a comma beside a tab separates: "0.01,<TAB>0.5", a CSV aligned with tabs
-    if separator is None:
-        return [f for f in _SPLIT.split(line) if f != ""]
-    fields = [f.strip() for f in line.split(separator) if f.strip() != ""]
-    return [f.replace(",", ".") if f.count(",") == 1 and "." not in f else f for f in fields]
+    return csv_text(_read_text(path, name), name)
 
 
 def _read_text(path, name: str) -> str:
@@ -106,9 +54,13 @@ def _read_text(path, name: str) -> str:
     except OSError as exc:
         raise InputError(f"{name}: cannot read record: {exc.strerror or exc}") from None
     try:
-        return raw.decode("utf-8-sig")
+        text = raw.decode("utf-8-sig")
     except UnicodeDecodeError as exc:
         raise not_utf8(name, raw, exc) from None
+    if "\r" in text and text.count("\r") == text.count("\r\n"):
+        # Windows line ends: the same lines to splitlines, and chunks numpy can read (record_text)
+        text = text.replace("\r\n", "\n")
+    return text
 
 
 # "NPTS=  3930, DT=   .0100 SEC" (NGA-West2) or "3930   0.0100   NPTS, DT" (older NGA files)
@@ -123,8 +75,9 @@ def load_at2(path, display: str | None = None) -> tuple[float, np.ndarray]:
     samples, several per line. Raises :class:`InputError` (``<file>:<line>: <problem>``).
     """
     name = display if display is not None else str(path)
-    lines = _read_text(path, name).splitlines()
-    if len(lines) < 5:
+    text = _read_text(path, name)
+    lines, pos = _head(text, 4)
+    if pos is None:
         raise InputError(f"{name}: not a PEER .AT2 file (expected 4 header lines, then the samples)")
     match = _AT2_NEW.search(lines[3]) or _AT2_OLD.search(lines[3])
     if not match:
@@ -132,18 +85,10 @@ def load_at2(path, display: str | None = None) -> tuple[float, np.ndarray]:
             f"{name}:4: expected NPTS and DT (e.g. NPTS=  3930, DT=   .0100 SEC), got {shorten(lines[3].strip(), 40)}"
         )
     check_at2_header(lines[:3], name)
-    npts, dt = int(match.group(1)), _number(match.group(2), f"{name}:4")
+    npts, dt = int(match.group(1)), number(match.group(2), f"{name}:4")
     if not (math.isfinite(dt) and dt > 0.0) or npts < 2:
         raise InputError(f"{name}:4: DT must be > 0 and NPTS >= 2, got DT = {format_value(dt)}, NPTS = {npts}")
-    values: list[float] = []
-    for lineno, line in enumerate(lines[4:], start=5):
-        for field in line.split():
-            x = _number(field, f"{name}:{lineno}")
-            if not math.isfinite(x):
-                raise InputError(f"{name}:{lineno}: values must be finite, got {shorten(field, 40)}")
-            if len(values) < npts:
-                check_at2_sample(x, f"{name}:{lineno}")
-            values.append(x)
+    values = at2_text(text, pos, name, npts)
     if len(values) < npts:
         raise InputError(f"{name}: header says NPTS = {npts} but the file holds {len(values)} samples")
     if len(values) > npts:
@@ -156,22 +101,21 @@ def load_at2(path, display: str | None = None) -> tuple[float, np.ndarray]:
             ),
             stacklevel=2,
         )
-    return dt, np.asarray(values[:npts], dtype=np.float64)
+    return dt, values[:npts].copy()
 
 
-def _number(text: str, where: str) -> float:
-    try:
-        return float(text)
-    except ValueError:
-        raise InputError(f"{where}: not a number: {shorten(text, 40)}") from None
-
-
-def _is_float(text: str) -> bool:
-    try:
-        float(text)
-    except ValueError:
-        return False
-    return True
+def _head(text: str, n: int) -> tuple[list[str], int | None]:
+    """The first ``n`` lines of ``text`` (as ``splitlines`` cuts them) and where the line after them
+    starts, or None if there is no such line: read from a prefix, not from every line of the file."""
+    size = 4096
+    while True:
+        parts = text[:size].splitlines(keepends=True)
+        if len(parts) > n or size >= len(text):
+            break  # with a line after them, the first n are whole (a "\r\n" is not cut)
+        size *= 4
+    if len(parts) <= n:
+        return [p.splitlines()[0] for p in parts], None
+    return [p.splitlines()[0] for p in parts[:n]], sum(len(p) for p in parts[:n])
 
 
 G_STANDARD = 9.80665
