@@ -241,3 +241,34 @@ def test_record_window_and_baseline_validation():
         Record(time=(0, 1), value=(1, 2), window=(1, 0))
     with pytest.raises(InputError, match='baseline = "linear": must be "quadratic" or "none"'):
         Record(time=(0, 1), value=(1, 2), baseline="linear")
+
+
+def test_a_record_of_floats_is_checked_at_once_with_the_same_messages():
+    # a record file's samples (Python floats) are checked with numpy: 3 million check_real calls took 7 s.
+    # The same record given with ints (checked item by item) is the reference.
+    n = 100_001
+    t = [i * 0.01 for i in range(n)]
+    v = [math.sin(x) for x in t]
+    fast = Record(time=tuple(t), value=tuple(v), window=(1.0, 2.0))
+    slow = Record(time=(0, *t[1:]), value=(0, *v[1:]), window=(1, 2))
+    assert fast == slow and type(fast.time[0]) is float and fast._arrays[0].size == 101
+    pairs = Record(time=tuple(t), value=tuple(zip(v, v)))
+    assert pairs.value == tuple((float(x), float(x)) for x in v) and pairs.is_vector
+    for k, bad, message in [
+        (70_000, "time", "time[70000] = 699.99: must be > the previous time 699.99"),
+        (90_000, "nan", "time[90000] = nan: must be a finite number"),
+        (80_000, "value", "value[80000] = inf: must be a finite number"),
+        (60_000, "pair", "value[60000] = [0.5, nan]: must be finite"),
+    ]:
+        tt, vv = list(t), list(v) if bad != "pair" else list(zip(v, v))
+        if bad == "time":
+            tt[k] = tt[k - 1]
+        elif bad == "nan":
+            tt[k] = math.nan
+        elif bad == "value":
+            vv[k] = math.inf
+        else:
+            vv[k] = (0.5, math.nan)
+        with pytest.raises(InputError) as exc:
+            Record(time=tuple(tt), value=tuple(vv))
+        assert message in one_line(exc)
