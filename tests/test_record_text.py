@@ -136,9 +136,11 @@ def three_million_rows() -> str:
         ("1999999,nan", 'big.csv:2000001: values must be finite, got "1999999,nan"'),
     ],
 )
-def test_an_error_deep_in_a_big_file_names_its_line_and_reads_few_lines_one_by_one(tmp_path, monkeypatch, bad, message):
+def test_an_error_deep_in_a_big_file_names_its_line_and_reads_few_lines_one_by_one(
+    tmp_path, monkeypatch, three_million_rows, bad, message
+):
     # 3 million rows (a 4 h record at 200 Hz); the row on line 2 000 001 is bad
-    text = big_record(3_000_000).replace("\n1999999,0.5\n", f"\n{bad}\n")
+    text = three_million_rows.replace("\n1999999,0.5\n", f"\n{bad}\n")
     f = tmp_path / "big.csv"
     f.write_text(text)
     read = []
