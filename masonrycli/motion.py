@@ -47,6 +47,7 @@ Units: m/s, m/s², s, Hz, rad.
 from __future__ import annotations
 
 import functools
+import itertools
 import math
 import os
 from collections.abc import Sequence
@@ -262,12 +263,14 @@ def _finite_floats(seq, pairs: bool = False) -> tuple | None:
     if pairs:
         if set(map(type, seq)) != {tuple} or set(map(len, seq)) != {2}:
             return None
-        items = [x for pair in seq for x in pair]
+        if set(map(type, itertools.chain.from_iterable(seq))) != {float}:
+            return None
+        numbers = np.fromiter(itertools.chain.from_iterable(seq), dtype=np.float64, count=2 * len(seq))
     else:
-        items = seq
-    if set(map(type, items)) != {float} or not np.isfinite(np.asarray(items, dtype=np.float64)).all():
-        return None
-    return tuple(seq)
+        if set(map(type, seq)) != {float}:
+            return None
+        numbers = np.fromiter(seq, dtype=np.float64, count=len(seq))
+    return tuple(seq) if np.isfinite(numbers).all() else None
 
 
 @dataclass(frozen=True, kw_only=True)
