@@ -252,7 +252,7 @@ def read_wkt(path, density: float = 2500.0, thickness: float = 1.0) -> Assembly:
             if m and m["srole"] and m["role"].lower() == "block":
                 m = None  # "block fixed: …" is a block named "fixed" (a block has no support role): write_wkt's
             m = m or _LABEL.match(line)
-            if m and not line.upper().startswith(("POLYGON", "MULTIPOLYGON", "GEOMETRYCOLLECTION")):
+            if m:  # a name before a colon (WKT has none): "polygon1: POLYGON …" is the block polygon1
                 name = m.groupdict().get("name")
                 entries.append((f"{path}: line {n}", m["role"], name, m["srole"], m["wkt"]))
             elif ":" in line:  # WKT has no colon: a label the patterns refused (": POLYGON …" said "Unknown type: ':'")

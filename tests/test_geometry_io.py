@@ -231,6 +231,17 @@ def test_wkt_a_line_whose_label_is_not_one_says_what_is_expected(line, what, tmp
     )
 
 
+@pytest.mark.parametrize("name", ["polygon1", "Polygon-left", "multipolygon_a", "GeometryCollection2"])
+def test_wkt_a_name_that_starts_like_a_wkt_type_is_a_name(name, tmp_path):
+    """A label is a name before a colon, and WKT has no colon: "polygon1: POLYGON …" (which
+    "block polygon1: …" reads) was taken for WKT and refused ("'polygon1' before the colon is not a label")."""
+    path = tmp_path / "names.wkt"
+    path.write_text(
+        f"support ground: POLYGON ((-2 -1, 3 -1, 3 0, -2 0, -2 -1))\n{name}: POLYGON ((0 0, 1 0, 1 1, 0 1, 0 0))\n"
+    )
+    assert [b.name for b in read_wkt(path).blocks] == [name]
+
+
 def test_write_wkt_rejects_names_it_cannot_label(tmp_path):
     a = Assembly((Block(box(0, 0, 1, 1), "has space"),))
     with pytest.raises(GeometryError, match="cannot be written to WKT"):
