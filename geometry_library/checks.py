@@ -15,7 +15,9 @@ They scale with the block, so a file exact to float32 (GIS / CAD exports: ~7 sig
 0.1 mm (a wall drawn in CAD) is accepted and cleaned, whatever the units' origin, while a real dent or
 overlap is refused. A block's *width* is ``w = area / size`` (size: its bounding-box diagonal; 0.17 m for
 a 0.3 × 0.2 m block, 0.7 mm for a sliver voussoir of a 8000-block arch) and its *shape tolerance* is
-``h = SHAPE_RTOL × w`` (``SHAPE_RTOL`` = 2e-3: 0.33 mm on a 0.3 × 0.2 m block):
+``h = SHAPE_RTOL × w`` (``SHAPE_RTOL`` = 2e-3: 0.33 mm on a 0.3 × 0.2 m block), at most
+``MAX_SHAPE_TOLERANCE`` = 0.5 mm, half the contact detection distance (a 20 × 2 m ground's 4 mm removed a
+3 mm crown: the block resting on it floated above the cleaned ground, out of contact):
 
 - two consecutive vertices closer than ``h`` are one vertex;
 - a vertex less than ``h`` from the line through its two neighbours (and between them) is removed, on
@@ -74,6 +76,9 @@ from .values import check_material
 COLLINEAR_RTOL = 1e-9
 # Shape tolerance h = SHAPE_RTOL × width of the block (module docstring, Tolerances).
 SHAPE_RTOL = 2e-3
+# m: h never exceeds half the default contact detection distance (CONTACT_DISTANCE below): a removed vertex
+# of a wide support (20 × 2 m: 2e-3 × 1 m = 4 mm) must not leave the block resting on it out of contact.
+MAX_SHAPE_TOLERANCE = 5e-4
 # Overlap tolerance of a pair: OVERLAP_RTOL × the smaller body's area (a sliver h / 2 deep along a face).
 OVERLAP_RTOL = 1e-3
 # float32 keeps 24 bits: a value x is rounded by at most 2⁻²⁴ |x|.
@@ -149,9 +154,10 @@ def is_convex(xy: np.ndarray) -> bool:
 
 
 def shape_tolerance(xy: np.ndarray) -> float:
-    """The shape tolerance ``h`` of a ring (k, 2), m: ``SHAPE_RTOL × |area| / size`` (module docstring)."""
+    """The shape tolerance ``h`` of a ring (k, 2), m: ``SHAPE_RTOL × |area| / size``, at most
+    ``MAX_SHAPE_TOLERANCE`` (module docstring)."""
     size = float(np.hypot(*(xy.max(axis=0) - xy.min(axis=0))))
-    return SHAPE_RTOL * abs(signed_area(xy)) / size if size > 0.0 else 0.0
+    return min(SHAPE_RTOL * abs(signed_area(xy)) / size, MAX_SHAPE_TOLERANCE) if size > 0.0 else 0.0
 
 
 def _depth(xy: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -264,7 +270,9 @@ def normalise_coords(coords, label: str) -> np.ndarray:
     if area < 0.0:
         xy = xy[::-1]
     given = xy
-    h = SHAPE_RTOL * abs(area) / size  # shape_tolerance(xy): duplicates removed leave the bounding box as it was
+    h = min(
+        SHAPE_RTOL * abs(area) / size, MAX_SHAPE_TOLERANCE
+    )  # shape_tolerance(xy): duplicates removed leave the bounding box as it was
     while True:  # to a fixed point: h follows the area, so a normalised ring comes back unchanged
         cleaned, depth = _clean(xy, h)
         if len(cleaned) == len(xy):

@@ -313,6 +313,22 @@ def test_a_real_1_mm_dent_is_refused_a_0_1_mm_one_is_removed():
     assert len(bulge.exterior.coords) == 6
 
 
+def test_a_wide_support_keeps_a_3_mm_crown_and_refuses_a_3_mm_hollow():
+    """A 20 × 2 m ground's width (1 m) made its tolerance 4 mm: a 3 mm crown at mid-top was removed, and a
+    block resting on it floated 3 mm above the cleaned ground (it fell at t = 0, "touches nothing"); a 3 mm
+    hollow was filled. The tolerance stops at half the contact detection distance, as on a 0.3 m block."""
+    top = [[-10, -2], [10, -2], [10, 0]]
+    crown = polygon_from_coords([*top, [0, 0.003], [-10, 0]], 0, "ground", "support")
+    assert_same_ring(crown.exterior.coords, [*top, [0, 0.003], [-10, 0]], 0.0)
+    rests = Block(box(-0.15, 0.003, 0.15, 0.203), "b")
+    assert validate_assembly(Assembly((rests,), (Support(crown, "ground"),))) == []  # it touches the crown
+    assert raises_one_line("not convex", polygon_from_coords, [*top, [0, -0.003], [-10, 0]], 0, "g", "support") == (
+        'support 1 ("g"): polygon is not convex (reflex vertex at (0, -0.003))'
+    )
+    rounded = polygon_from_coords([*top, [0, 1e-4], [-10, 0]], 0, "ground", "support")  # 0.1 mm: removed
+    assert_same_ring(rounded.exterior.coords, [*top, [-10, 0]], 0.0)
+
+
 def test_a_real_1_mm_overlap_is_refused_a_0_1_mm_one_accepted():
     a = Block(box(0, 0, 0.3, 0.2), "a")
     real = asm(a.polygon, box(0.299, 0, 0.599, 0.2), supports=[GROUND], names=["a", "b"])
