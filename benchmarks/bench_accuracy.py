@@ -28,70 +28,18 @@ import argparse
 import json
 import os
 import subprocess
-import time
 from datetime import UTC, datetime
 from pathlib import Path
-
-import numpy as np
 
 os.environ.setdefault("RERUN_ANALYTICS", "0")
 ROOT = Path(__file__).resolve().parent.parent
 
-from benchmarks.bench_solver import TIGHT, _Sampler, errors_pct  # noqa: E402
-from benchmarks.solver_cases import CASES, make_scenario  # noqa: E402
-from masonrycli.run import Simulation, simulate  # noqa: E402
+from benchmarks.solver_cases import CASES  # noqa: E402
+from benchmarks.solver_reference import SECOND, TIGHT, errors_pct, parse_spec, run, spec_of  # noqa: E402
 from masonrycli.scenario import SOLVERS  # noqa: E402
 
-BENCH_REFERENCE = f"{TIGHT['solver']}:{TIGHT['tolerance']:.0e}:{TIGHT['max_iterations']}".replace("e-0", "e-")
+BENCH_REFERENCE = spec_of(TIGHT)
 """bench_solver's tight solve as a spec: the first reference by default."""
-
-
-def parse_spec(spec: str) -> dict:
-    """``SOLVER:TOLERANCE[:CAP]`` → run options {solver, tolerance[, max_iterations]}."""
-    parts = spec.split(":")
-    if len(parts) not in (2, 3) or parts[0] not in SOLVERS:
-        raise ValueError(f"{spec!r}: expected SOLVER:TOLERANCE[:CAP], SOLVER one of {', '.join(SOLVERS)}")
-    options = {"solver": parts[0], "tolerance": float(parts[1])}
-    if len(parts) == 3:
-        options["max_iterations"] = int(parts[2])
-    return options
-
-
-class _Residuals:
-    """A sink keeping every step's final residual and whether it converged."""
-
-    def __init__(self):
-        self.residual: list[float] = []
-        self.unconverged = 0
-
-    def on_frame(self, frame) -> None:
-        """Frames are the sampler's business."""
-
-    def log_step(self, step, time, stats) -> None:
-        self.residual.append(stats.residual)
-        self.unconverged += not stats.converged
-
-
-def run(case: str, duration: float, **options) -> dict:
-    """One run of ``case`` with run ``options``: CPU s, sweeps, unconverged steps, residuals, slips."""
-    sc = make_scenario(case, duration, **options)
-    sim = Simulation(sc)
-    sampler, residuals = _Sampler(sim, case), _Residuals()
-    t = time.process_time()
-    result = simulate(sc, [sampler, residuals], sim=sim)
-    cpu = time.process_time() - t
-    res = np.array(residuals.residual)
-    return {
-        "options": options,
-        "cpu_s": cpu,
-        "sweeps_mean": result.tally.sweeps_mean,
-        "sweeps_max": result.tally.sweeps_max,
-        "unconverged": residuals.unconverged,
-        "residual_median": float(np.median(res)),
-        "residual_max": float(res.max()),
-        "samples": {str(k): v for k, v in sampler.values.items()},
-        "status": result.status,
-    }
 
 
 def compare(runs: dict[str, dict], references: list[str]) -> None:
@@ -130,7 +78,7 @@ def main(argv=None) -> dict:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--cases", nargs="+", required=True, choices=sorted(c for c in CASES if c[0] in "hw"))
     parser.add_argument("--duration", type=float, default=0.2, help="simulated s (samples at 0.1 and 0.2 s)")
-    parser.add_argument("--references", nargs="+", default=[BENCH_REFERENCE, "nlgs-accel:1e-7:20000"])
+    parser.add_argument("--references", nargs="+", default=[BENCH_REFERENCE, spec_of(SECOND)])
     parser.add_argument("--solver", default=SOLVERS[0], choices=SOLVERS)
     parser.add_argument("--tolerances", nargs="*", type=float, default=[1e-4, 3e-5, 1e-5, 3e-6, 1e-6])
     parser.add_argument("--json", type=Path)
@@ -140,8 +88,7 @@ def main(argv=None) -> dict:
     except ValueError as exc:
         parser.error(str(exc))
     specs |= {
-        f"{args.solver}:{tol:.0e}".replace("e-0", "e-"): {"solver": args.solver, "tolerance": tol}
-        for tol in args.tolerances
+        spec_of(options): options for options in ({"solver": args.solver, "tolerance": tol} for tol in args.tolerances)
     }
     commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True, cwd=ROOT)
     report = {

@@ -5,7 +5,7 @@ One command (from the repository root, in the project venv; ``pip install -e ".[
 
     .venv/bin/python -m benchmarks.bench_solver [--suite paper height length] [--cases ...]
         [--solvers nlgs-accel nlgs] [--repeat 3] [--duration S] [--lmgc-python PATH]
-        [--json benchmarks/results_solver.json]
+        [--second-reference nlgs-accel:1e-7:20000 | none] [--json benchmarks/results_solver.json]
 
 Cases: benchmarks/solver_cases.py (the paper's 51- and 248-block walls, an 8 × 6 wall, the arch and the
 aqueduct; walls of 8, 16, 32, 64 courses × 15 blocks; 8-course walls of ~500 to ~4000 blocks).
@@ -25,9 +25,19 @@ case and solver:
 * accuracy: slip of the top course and mean slip at 0.1 and 0.2 s (solver_cases.slips) against one tight
   solve of the same case in the same run — **plain** ``nlgs`` at tolerance 1e-7 m/s, cap 20000 sweeps,
   whatever the solvers compared — in % (for the arch and the aqueduct, the mean block displacement
-  |Δx, Δy| and that of the highest block, in %);
+  |Δx, Δy| and that of the highest block, in %); an error marked ``≈`` is no larger than the references'
+  spread at that sample and measure (below): the reference cannot tell it from zero;
 
-and once per case: peak memory (tracemalloc peak of a 0.1 s run with the first solver listed: numpy
+and once per case, the reference (benchmarks/solver_reference.py): the tight solve's unconverged steps
+(residual above 1e-7 m/s or at the cap), those at the cap and its largest final residual (on the 32-course
+wall it ends at the cap on 195 of 200 steps, on the 64-course one on all 200: it is not a converged solve);
+and a second tight solve (``--second-reference SOLVER:TOLERANCE[:CAP]``, default ``nlgs-accel:1e-7:20000``,
+the other solver at the same tolerance and cap — the cheapest independent one bench_accuracy measured),
+with the same counts, and the *spread*: its slips in % of the first reference's. The second reference is on
+by default although it costs as much as the first (0.2 s of the case: 7 s of CPU on the 248-block wall, about
+110 s on 32 courses, 250 s on 64), because without it an error on a tall wall cannot be read (bench_accuracy:
+tight solves of h32 differ by 0.4–0.75 %); ``--second-reference none`` skips it for a speed-only run.
+The rest, once per case: peak memory (tracemalloc peak of a 0.1 s run with the first solver listed: numpy
 buffers, history, frames), pymunk (walls; 100 solver passes, when installed: CPU s per simulated s,
 each solver's time over pymunk's, and pymunk's slips against the same tight solve), LMGC90
 (``compas_lmgc90``, 3-D prisms; only with ``--lmgc-python``, the interpreter of a separate venv where it
@@ -35,7 +45,10 @@ is installed, see LMGC90.md: the 51-block wall through benchmarks/lmgc90_referen
 
 Start-up: wall-clock of ``masonry --help`` and of a fresh process that imports the engine, builds the
 51-block wall and runs its first step (numba cache warm), minimum of 3. The table goes to the terminal
-(rich, one row per case and solver), everything to ``--json`` (``cases[case]["solvers"][name]``).
+(rich, one row per case and solver), everything to ``--json``: ``cases[case]["solvers"][name]`` (its
+``error_pct`` and ``unresolved``, step → (top, mean)), ``cases[case]["tight"]`` and ``["second"]`` (the
+references: ``unconverged``, ``capped``, ``residual_max``, ``samples``, ``settings``, ``cpu_s``) and
+``cases[case]["spread_pct"]``.
 """
 
 from __future__ import annotations
@@ -58,7 +71,18 @@ os.environ.setdefault("RERUN_ANALYTICS", "0")
 ROOT = Path(__file__).resolve().parent.parent
 
 from benchmarks import pymunk_engine  # noqa: E402
-from benchmarks.solver_cases import CASES, course_of, is_wall, make_scenario, slips  # noqa: E402
+from benchmarks.solver_cases import CASES, is_wall, make_scenario  # noqa: E402
+from benchmarks.solver_reference import (  # noqa: E402
+    SECOND,
+    TIGHT,
+    Sampler,
+    errors_pct,
+    parse_spec,
+    spec_of,
+    spread_pct,
+    unresolved,
+)
+from benchmarks.solver_reference import run as run_reference  # noqa: E402
 from masonrycli.engine import nlgs  # noqa: E402
 from masonrycli.run import Simulation, simulate  # noqa: E402
 from masonrycli.scenario import SOLVERS  # noqa: E402
@@ -68,36 +92,7 @@ SUITES = {
     "height": ["h8", "h16", "h32", "h64"],
     "length": ["l500", "l1000", "l2000", "l4000"],
 }
-TIGHT = {"tolerance": 1e-7, "max_iterations": 20000, "solver": "nlgs"}
-"""The reference of every accuracy figure: plain Gauss–Seidel far below the default tolerance."""
 DEFAULT = SOLVERS[0]
-SAMPLES = (100, 200)
-"""Steps (dt = 1e-3) at which the accuracy is read: 0.1 and 0.2 s."""
-
-
-class _Sampler:
-    """A sink keeping the displacement measures at the sample steps."""
-
-    def __init__(self, sim: Simulation, case: str):
-        m = sim.model
-        self.n = m.block_count
-        self.q0 = m.body_q0[: self.n].copy()
-        self.ground0 = m.body_q0[self.n :].copy()
-        self.course = course_of(m.block_name) if is_wall(case) else None
-        self.values: dict[int, tuple[float, float]] = {}
-
-    def close(self, status: str = "completed", note: str = "") -> None:
-        """Nothing to write (the sink protocol of masonrycli.run.simulate)."""
-
-    def on_frame(self, frame) -> None:
-        if frame.step not in SAMPLES:
-            return
-        if self.course is not None:
-            ground_dx = frame.support_q[0, 0] - self.ground0[0, 0]
-            self.values[frame.step] = slips(self.q0[:, 0], frame.block_q[:, 0], ground_dx, self.course)
-        else:
-            d = np.hypot(*(frame.block_q[:, :2] - self.q0[:, :2]).T)
-            self.values[frame.step] = (float(d[np.argmax(self.q0[:, 1])]), float(d.mean()))
 
 
 class _SolveTimer:
@@ -127,7 +122,7 @@ def run_masonry(case: str, duration: float | None, record: bool, **run_options) 
     """One run of ``case``; CPU time of ``simulate`` only (scenario and model built before)."""
     sc = make_scenario(case, duration, **run_options)
     sim = Simulation(sc)
-    sampler = _Sampler(sim, case)
+    sampler = Sampler(sim, case)
     sinks: list = [sampler]
     recorder = tmp = None
     if record:
@@ -170,16 +165,6 @@ def peak_memory_mb(case: str, solver: str = DEFAULT) -> float:
     return peak / 2**20
 
 
-def errors_pct(samples: dict, reference: dict) -> dict:
-    """Relative error (%) of each (top, mean) sample against the reference's."""
-    out = {}
-    for step, (top, mean) in samples.items():
-        if step in reference:
-            rt, rm = reference[step]
-            out[step] = (100.0 * (top - rt) / abs(rt), 100.0 * (mean - rm) / abs(rm))
-    return out
-
-
 def startup() -> dict:
     """`masonry --help`, and a fresh process to the end of the first step (numba cache warm): minimum of 3
     of the wall-clock and of the CPU time (user + system) of the child process. On a shared machine the
@@ -217,17 +202,21 @@ def lmgc90(python: str | None) -> dict:
     return {"available": True, "wall-51": json.loads(done.stdout)}
 
 
-def summarise(runs: dict[str, list[dict]], tight: dict, pymunk_runs: list[dict]) -> dict:
+def summarise(runs: dict[str, list[dict]], tight: dict, pymunk_runs: list[dict], second: dict | None = None) -> dict:
     """One case's row from its repeats: ``runs`` solver → the runs (dicts of run_masonry), ``tight`` the
-    reference run, ``pymunk_runs`` pymunk's runs (may be empty). Per solver the run of least CPU time, its
-    time per simulated second, its slip errors against ``tight`` and, when DEFAULT was run, its time over
-    the default's; pymunk's fastest run and its errors against the same reference."""
+    reference run and ``second`` the second reference (solver_reference.run; may be None), ``pymunk_runs``
+    pymunk's runs (may be empty). Per solver the run of least CPU time, its time per simulated second, its
+    slip errors against ``tight``, which of them are no larger than the two references' spread
+    (``unresolved``) and, when DEFAULT was run, its time over the default's; pymunk's fastest run and its
+    errors against the same reference."""
+    spread = spread_pct(tight, second) if second else {}
     solvers = {}
     for name, repeats in runs.items():
         best = dict(min(repeats, key=lambda r: r["cpu_s"]))
         best["cpu_per_sim_s"] = best["cpu_s"] / best["sim_s"]
         best["cpu_runs"] = [round(r["cpu_s"], 3) for r in repeats]
         best["error_pct"] = errors_pct(best["samples"], tight["samples"])
+        best["unresolved"] = unresolved(best["error_pct"], spread)
         solvers[name] = best
     if DEFAULT in solvers:
         for row in solvers.values():
@@ -236,8 +225,11 @@ def summarise(runs: dict[str, list[dict]], tight: dict, pymunk_runs: list[dict])
     row = {
         "blocks": first["blocks"],
         "solvers": solvers,
-        "tight": {k: tight[k] for k in ("sweeps_mean", "unconverged", "samples")} | {"settings": TIGHT},
+        "tight": _reference(tight),
     }
+    if second:
+        row["second"] = _reference(second)
+        row["spread_pct"] = spread
     if "nlgs" in solvers and DEFAULT in solvers and DEFAULT != "nlgs":
         row["ratio_nlgs_over_default"] = solvers["nlgs"]["over_default"]
     if pymunk_runs:
@@ -248,7 +240,14 @@ def summarise(runs: dict[str, list[dict]], tight: dict, pymunk_runs: list[dict])
             "ratio_over_pymunk": {name: r["cpu_per_sim_s"] / pm_per_s for name, r in solvers.items()},
             "error_pct": errors_pct({str(k): v for k, v in pm["slips"].items()}, tight["samples"]),
         }
+        row["pymunk"]["unresolved"] = unresolved(row["pymunk"]["error_pct"], spread)
     return row
+
+
+def _reference(run: dict) -> dict:
+    """What the JSON keeps of a reference run: its effort, how far from converged, its slips, its settings."""
+    keys = ("cpu_s", "sweeps_mean", "unconverged", "capped", "residual_max", "samples")
+    return {k: run[k] for k in keys if k in run} | {"settings": run.get("options", TIGHT)}
 
 
 def main(argv=None) -> dict:
@@ -262,8 +261,19 @@ def main(argv=None) -> dict:
     parser.add_argument("--duration", type=float, help="simulated s per run (default: each case's own)")
     parser.add_argument("--no-pymunk", action="store_true")
     parser.add_argument("--lmgc-python", help="interpreter of a venv with compas_lmgc90 installed")
+    parser.add_argument(
+        "--second-reference",
+        default=spec_of(SECOND),
+        help="SOLVER:TOLERANCE[:CAP] of the second tight solve, or 'none' to skip it (default: %(default)s)",
+    )
     parser.add_argument("--json", type=Path, default=ROOT / "benchmarks" / "results_solver.json")
     args = parser.parse_args(argv)
+    second_options = None
+    if args.second_reference != "none":
+        try:
+            second_options = parse_spec(args.second_reference)
+        except ValueError as exc:
+            parser.error(str(exc))
     cases = args.cases or [c for s in args.suite for c in SUITES[s]]
     unknown = [c for c in cases if c not in CASES]
     if unknown:
@@ -278,6 +288,7 @@ def main(argv=None) -> dict:
         "machine": {"python": platform.python_version(), "cpu_count": os.cpu_count(), "load": os.getloadavg()},
         "solvers": solvers,
         "default_solver": DEFAULT,
+        "references": [spec_of(TIGHT)] + ([spec_of(second_options)] if second_options else []),
         "startup": startup(),
         "cases": {},
     }
@@ -292,8 +303,9 @@ def main(argv=None) -> dict:
             if use_pymunk and is_wall(case):
                 pymunk_runs[case].append(pymunk_engine.run_wall(case, args.duration or CASES[case][2]))
     for case in cases:
-        tight = run_masonry(case, 0.2, record=False, **TIGHT)
-        row = summarise(runs[case], tight, pymunk_runs[case])
+        tight = run_reference(case, 0.2, **TIGHT)
+        second = run_reference(case, 0.2, **second_options) if second_options else None
+        row = summarise(runs[case], tight, pymunk_runs[case], second)
         row["peak_memory_mb"] = peak_memory_mb(case, solvers[0])
         report["cases"][case] = row
     report["lmgc90"] = lmgc90(args.lmgc_python)
@@ -302,8 +314,19 @@ def main(argv=None) -> dict:
     return report
 
 
-def _err(e: dict) -> str:
-    return " ".join(f"{e[s][0]:+.2f}/{e[s][1]:+.2f}" if s in e else "–" for s in ("100", "200"))
+def _err(e: dict, unresolved: dict | None = None) -> str:
+    """Errors top/mean at 0.1 and 0.2 s; '≈' after one no larger than the references' spread there."""
+
+    def one(step: str, i: int) -> str:
+        return f"{e[step][i]:+.2f}" + ("≈" if (unresolved or {}).get(step, (False, False))[i] else "")
+
+    return " ".join(f"{one(s, 0)}/{one(s, 1)}" if s in e else "–" for s in ("100", "200"))
+
+
+def _ref(row: dict) -> str:
+    """The tight solve's unconverged (capped) steps and largest residual; the second reference's below."""
+    refs = [row["tight"]] + ([row["second"]] if "second" in row else [])
+    return "\n".join(f"{r['unconverged']} ({r.get('capped', '?')}) {r.get('residual_max', np.nan):.1e}" for r in refs)
 
 
 def print_table(report: dict) -> None:
@@ -322,6 +345,8 @@ def print_table(report: dict) -> None:
         "contacts",
         "ns/contact·sweep",
         "error % top/mean 0.1 s 0.2 s",
+        "ref. spread % top/mean 0.1 s 0.2 s",
+        "ref. unconv. (capped) max residual m/s",
         "peak MB",
         "pymunk s / sim s (solver ÷ pymunk)",
         "pymunk error %",
@@ -340,16 +365,29 @@ def print_table(report: dict) -> None:
                 str(r["unconverged"]),
                 f"{r['contacts_mean']:.0f}",
                 f"{r['ns_per_contact_sweep']:.1f}",
-                _err(r["error_pct"]),
+                _err(r["error_pct"], r.get("unresolved")),
+                (_err(row["spread_pct"]) if "spread_pct" in row else "–") if i == 0 else "",
+                _ref(row) if i == 0 else "",
                 f"{row['peak_memory_mb']:.1f}" if i == 0 else "",
                 f"{pm['cpu_per_sim_s']:.3f} ({pm['ratio_over_pymunk'][name]:.2f})" if pm else "–",
-                _err(pm["error_pct"]) if pm and i == 0 else "",
+                _err(pm["error_pct"], pm.get("unresolved")) if pm and i == 0 else "",
                 end_section=i == len(row["solvers"]) - 1,
             )
     console = Console(width=220)
     console.print(table)
+    refs = report.get("references", [spec_of(TIGHT)])
     console.print(
-        f"accuracy: against plain nlgs at {TIGHT['tolerance']:g} m/s (cap {TIGHT['max_iterations']}) in the same run"
+        f"accuracy: against {refs[0]} (SOLVER:TOLERANCE m/s:CAP sweeps) in the same run, 0.2 s; "
+        + (
+            f"ref. spread: {refs[1]}'s slips in % of it; ≈: an error no larger than the spread at that sample "
+            "and measure, not resolved by the reference"
+            if len(refs) > 1
+            else "no second reference (--second-reference none): the reference's spread is unknown"
+        )
+    )
+    console.print(
+        "ref. unconv. (capped): the references' steps above their tolerance (those at the sweep cap), "
+        "and their largest final residual (m/s)"
     )
     s = report["startup"]
     console.print(
