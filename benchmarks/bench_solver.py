@@ -73,6 +73,7 @@ ROOT = Path(__file__).resolve().parent.parent
 from benchmarks import pymunk_engine  # noqa: E402
 from benchmarks.solver_cases import CASES, is_wall, make_scenario  # noqa: E402
 from benchmarks.solver_reference import (  # noqa: E402
+    SAMPLES,
     SECOND,
     TIGHT,
     Sampler,
@@ -314,13 +315,14 @@ def main(argv=None) -> dict:
     return report
 
 
-def _err(e: dict, unresolved: dict | None = None) -> str:
-    """Errors top/mean at 0.1 and 0.2 s; '≈' after one no larger than the references' spread there."""
+def _err(e: dict, unresolved: dict | None = None, steps=tuple(str(k) for k in SAMPLES)) -> str:
+    """Errors top/mean at the samples (0.1 and 0.2 s); '≈' after one no larger than the references' spread
+    there."""
 
     def one(step: str, i: int) -> str:
         return f"{e[step][i]:+.2f}" + ("≈" if (unresolved or {}).get(step, (False, False))[i] else "")
 
-    return " ".join(f"{one(s, 0)}/{one(s, 1)}" if s in e else "–" for s in ("100", "200"))
+    return " ".join(f"{one(s, 0)}/{one(s, 1)}" if s in e else "–" for s in steps)
 
 
 def _ref(row: dict) -> str:

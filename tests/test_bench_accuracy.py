@@ -1,27 +1,13 @@
 """The accuracy-reference benchmark's bookkeeping (benchmarks/bench_accuracy.py): run specs, which run is
-compared with which reference, and a run's residual and slip figures."""
+compared with which reference, and the table (the runs themselves: test_solver_reference.py)."""
 
 import pytest
 
-from benchmarks import bench_accuracy
-from benchmarks.solver_cases import make_scenario
-from masonrycli.run import simulate
-
-
-def test_a_spec_names_solver_tolerance_and_an_optional_cap():
-    assert bench_accuracy.parse_spec("nlgs:1e-7:20000") == {
-        "solver": "nlgs",
-        "tolerance": 1e-7,
-        "max_iterations": 20000,
-    }
-    assert bench_accuracy.parse_spec("nlgs-accel:3e-6") == {"solver": "nlgs-accel", "tolerance": 3e-6}
-    for bad in ("sor:1e-7", "nlgs", "nlgs:1e-7:2:3"):
-        with pytest.raises(ValueError):
-            bench_accuracy.parse_spec(bad)
+from benchmarks import bench_accuracy, solver_reference
 
 
 def test_the_first_reference_is_bench_solvers_tight_solve():
-    assert bench_accuracy.parse_spec(bench_accuracy.BENCH_REFERENCE) == {
+    assert solver_reference.parse_spec(bench_accuracy.BENCH_REFERENCE) == {
         "solver": "nlgs",
         "tolerance": 1e-7,
         "max_iterations": 20000,
@@ -51,14 +37,6 @@ def _figures() -> dict:
         "residual_median": 1e-6,
         "residual_max": 2e-6,
     }
-
-
-def test_a_run_keeps_every_steps_residual_and_the_slips_at_the_samples():
-    r = bench_accuracy.run("wall-51", 0.1, solver="nlgs", tolerance=1e-6)
-    direct = simulate(make_scenario("wall-51", 0.1, solver="nlgs", tolerance=1e-6)).tally
-    assert r["sweeps_mean"] == direct.sweeps_mean and r["residual_max"] == direct.residual_max
-    assert 0.0 < r["residual_median"] <= r["residual_max"] <= 1e-6 and r["unconverged"] == 0
-    assert list(r["samples"]) == ["100"]
 
 
 def test_an_unknown_reference_solver_is_refused():

@@ -54,7 +54,8 @@ def test_the_two_solvers_take_different_paths():
     assert runs[0]["sweeps_mean"] != runs[1]["sweeps_mean"]
 
 
-def test_an_unknown_solver_is_refused():
+@pytest.mark.parametrize("argv", [["--solvers", "sor"], ["--second-reference", "sor:1e-7"]])
+def test_an_unknown_solver_is_refused(argv):
     with pytest.raises(SystemExit) as exit_info:
-        bench_solver.main(["--solvers", "sor"])
+        bench_solver.main(argv)
     assert exit_info.value.code == 2
