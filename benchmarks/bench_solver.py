@@ -34,9 +34,13 @@ wall it ends at the cap on 195 of 200 steps, on the 64-course one on all 200: it
 and a second tight solve (``--second-reference SOLVER:TOLERANCE[:CAP]``, default ``nlgs-accel:1e-7:20000``,
 the other solver at the same tolerance and cap — the cheapest independent one bench_accuracy measured),
 with the same counts, and the *spread*: its slips in % of the first reference's. The second reference is on
-by default although it costs as much as the first (0.2 s of the case: 7 s of CPU on the 248-block wall, about
-110 s on 32 courses, 250 s on 64), because without it an error on a tall wall cannot be read (bench_accuracy:
-tight solves of h32 differ by 0.4–0.75 %); ``--second-reference none`` skips it for a speed-only run.
+by default: it costs about as much as the first (0.2 s of the case, 99802b3: 16 s of CPU on the 248-block
+wall against the first's 17 s, 121 s on 32 courses against 84 s; bench_accuracy: 250 s on 64): 138 s of
+about 505 s of CPU in a default run (repeat 3) of those two cases, +38 %, not double; and without it an error
+on a tall wall cannot be read (bench_accuracy: tight solves of h32 differ by 0.4–0.75 %). ``--second-reference none``
+skips it for a speed-only run. The spread of two references is one sample of the reference's uncertainty,
+and it depends on the second one: ``nlgs-accel`` at cap 20 000 is the least converged of bench_accuracy's on h32
+(worst residual 1.3e-4 m/s; spread 1.36 % top at 0.2 s where tighter pairs differ by 0.4–0.75 %).
 The rest, once per case: peak memory (tracemalloc peak of a 0.1 s run with the first solver listed: numpy
 buffers, history, frames), pymunk (walls; 100 solver passes, when installed: CPU s per simulated s,
 each solver's time over pymunk's, and pymunk's slips against the same tight solve), LMGC90
