@@ -57,6 +57,7 @@ def _register_optional():
         cluster,
         ipm,
         ipm_lcp,
+        ipm_shift,
         joint,
         linear,
         newton,
@@ -75,6 +76,7 @@ def _register_optional():
         joint,
         ipm,
         ipm_lcp,
+        ipm_shift,
     ):
         METHODS.update(module.METHODS)
 

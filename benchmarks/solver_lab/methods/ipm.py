@@ -308,6 +308,15 @@ def iterate(ops, x, lam, z, s, sg=None):
     return ops.velocity(lam), lam, z, alpha
 
 
+def guarded_iterate(ops, x, lam, z, s, sg=None):
+    """``iterate``; a linearised-shift step shorter than FALLBACK_STEP (a poor linearisation) is replaced by
+    the frozen-shift step of the same iterate. Returns (x, λ, z); LinAlgError if the factor breaks down."""
+    x1, lam1, z1, alpha = iterate(ops, x, lam, z, s, sg)
+    if sg is not None and alpha < FALLBACK_STEP:
+        x1, lam1, z1, alpha = iterate(ops, x, lam, z, s, None)
+    return x1, lam1, z1
+
+
 def slip_sign(ops, u, z):
     """sg (C,): sign of u_t at the contacts that slide, 0 elsewhere (s = μ|u_t| has a kink at u_t = 0, where
     the interior point's sticking contacts sit: there u_t ~ z is small, of either sign). Sliding: one row
@@ -318,9 +327,9 @@ def slip_sign(ops, u, z):
 
 def run_ipm(ctx, target, stop_at, clock, mode="rounds", theta=1.0, lam_start=None):
     """Mehrotra IPMs on the step (module doc). ``mode``: "rounds" (s frozen per round, s ← s + θ (μ|u_t| − s)
-    between rounds), "each" (s ← μ|u_t| every iteration) or "newton" (the same, s linearised in the Newton
-    matrix). Stops when the lab's RMS law residual ≤ ``stop_at`` (checked after each round, or each
-    iteration). Returns (v, r, iterations, rounds, residual)."""
+    between rounds), "each" (s ← μ|u_t| every iteration), "newton" (the same, s linearised in the Newton
+    matrix) or "frozen" (one IPM at the shift of ``lam_start``'s velocities, like "oracle"). Stops when the
+    lab's RMS law residual ≤ ``stop_at`` (checked after each round, or each iteration). Returns (v, r, iterations, rounds, residual)."""
     p = ctx.p
     ops = operators(ctx, clock)
     mu = p.mu
@@ -348,25 +357,22 @@ def run_ipm(ctx, target, stop_at, clock, mode="rounds", theta=1.0, lam_start=Non
                     if mode == "newton":
                         sg = slip_sign(ops, u, z)
                 try:
-                    x1, lam1, z1, alpha = iterate(ops, x, lam, z, s, sg)
-                    if sg is not None and alpha < FALLBACK_STEP:  # a poor linearisation: s frozen instead
-                        x1, lam1, z1, alpha = iterate(ops, x, lam, z, s, None)
+                    x, lam, z = guarded_iterate(ops, x, lam, z, s, sg)
                 except np.linalg.LinAlgError:  # the factor broke down: stop with the last iterate
                     break
-                x, lam, z = x1, lam1, z1
             its += 1
             with clock("check"):
                 v = ops.full_velocity(p, x)
                 residual = ctx.residual(v, ops.impulse(lam))
                 if residual <= stop_at:
                     return v, ops.impulse(lam), its, rounds, residual
-                if mode in ("rounds", "oracle"):
+                if mode in ("rounds", "oracle", "frozen"):
                     u = ops.contact_velocity(x)
                     rp_rms = float(np.sqrt(((ops.rows(u, ops.bias + s) - z) ** 2).mean()))
                     if max(rp_rms, _complementarity(ops, z, lam)) <= INNER_FRACTION * target:
                         inner_done = True
                         break
-        if not inner_done or mode == "oracle":
+        if not inner_done or mode in ("oracle", "frozen"):
             break
         with clock("ipm"):  # next round: s towards this iterate's, restarted from its impulses
             s = s + theta * (mu * np.abs(ops.contact_velocity(x)[:, 0]) - s)
@@ -395,13 +401,16 @@ def _plain(mode: str, theta: float = 1.0):
 _closing: dict = {}  # (method, problem, target) → (sweeps, converged): the search is not timed, do it once
 
 
-def closing(loose: float, mode: str):
+def closing(loose: float, mode: str, start=None):
+    """``start(ctx, clock)``: the IPM's starting λ (C, 2) instead of the warm start's (a predictor, timed)."""
+
     def solve(ctx, target) -> Outcome:
         clock = Clock()
         t0 = time.process_time()
-        v, r, its, rounds, res = run_ipm(ctx, target, loose, clock, mode)
+        lam_start = None if start is None else start(ctx, clock)
+        v, r, its, rounds, res = run_ipm(ctx, target, loose, clock, mode, lam_start=lam_start)
         ipm_s = time.process_time() - t0
-        key = (loose, mode, ctx.p.name, target)
+        key = (loose, mode, start, ctx.p.name, target)
         if res <= target:
             n, ok = 0, True
         else:
