@@ -168,7 +168,17 @@ def target_scenario(target: str | os.PathLike, built_in: Callable[[str], Scenari
     if problem:
         raise InputError(f"{target}: {problem}")
     path = Path(target)  # as the commands read it before: "./s.toml" is the scenario "s.toml"
-    return scenario_from_geometry_file(path) if path.suffix.lower() in GEOMETRY_SUFFIXES else load_scenario(path)
+    if path.suffix.lower() in GEOMETRY_SUFFIXES:
+        return scenario_from_geometry_file(path)
+    try:
+        return load_scenario(path)
+    except InputError as exc:
+        if path.suffix.lower() == ".toml":
+            raise
+        # "notes.txt: TOML syntax error …" left a user who meant a geometry file guessing why TOML
+        raise InputError(
+            f"{exc} (read as a scenario TOML: a geometry file's name ends in {', '.join(GEOMETRY_SUFFIXES)})"
+        ) from None
 
 
 def _target_problem(target: str) -> str:

@@ -225,3 +225,18 @@ def test_build_assembly_refuses_a_bad_option_in_one_line_naming_it(options, mess
 def test_build_assembly_is_the_builders_with_the_commands_defaults():
     assert build_assembly("wall", blocks=None, density=None).block_count == 51  # the paper's wall
     assert build_assembly("wall", blocks=3, thickness=0.5).block_count == 3
+
+
+def test_a_file_not_named_toml_that_is_no_toml_says_how_it_was_read(tmp_path):
+    # "notes.txt: TOML syntax error …" did not say why a WKT saved as .txt was read as TOML
+    wkt = tmp_path / "wall.wkt.txt"
+    wkt.write_text("POLYGON ((0 0, 1 0, 1 1, 0 1, 0 0))\n")
+    with pytest.raises(InputError) as raised:
+        target_scenario(wkt)
+    message = str(raised.value)
+    assert "\n" not in message and message.startswith(f"{wkt}: TOML syntax error")
+    assert message.endswith("(read as a scenario TOML: a geometry file's name ends in .geojson, .json, .wkt)")
+    toml = tmp_path / "bad.toml"  # a .toml file is a scenario by its name: no hint
+    toml.write_text("POLYGON ((0 0, 1 0, 1 1, 0 1, 0 0))\n")
+    with pytest.raises(InputError, match=r"TOML syntax error[^(]*\(at line 1, column \d+\)$"):
+        target_scenario(toml)

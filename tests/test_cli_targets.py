@@ -29,7 +29,11 @@ BAD_TARGETS = [
     ("/dev/null", f"/dev/null: {NOT_A_FILE}"),
     ("", "the structure argument is empty (''): give wall, arch, aqueduct or a scenario file"),
     ("locked.toml", "locked.toml: cannot read file: Permission denied"),
-    ("notes.txt", 'notes.txt: unknown key "a" (expected one of: name, run, material, structure, block, support)'),
+    (
+        "notes.txt",
+        'notes.txt: unknown key "a" (expected one of: name, run, material, structure, block, support)'
+        " (read as a scenario TOML: a geometry file's name ends in .geojson, .json, .wkt)",
+    ),
 ]
 
 
