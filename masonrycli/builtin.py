@@ -270,20 +270,17 @@ def builder_options(name: str, options: dict) -> dict:
 
 def build_assembly(name: str, **overrides):
     """The assembly of builder ``name`` that ``masonry build`` writes, from the builder's options and
-    ``density`` / ``thickness`` (None: not given), checked as ``simulate`` checks them (the message names
-    the option); a builder's error is one line starting with its name."""
-    from geometry_library.blocks import GeometryError
-    from geometry_library.builders import BUILDERS
+    ``density`` / ``thickness`` (None: not given), built and checked as ``simulate`` builds them
+    (:func:`~masonrycli.structure.build_structure`): the same mistake gets the same line (build said
+    "wall: block count …" where simulate and sweep said 'builder "wall": block count …')."""
+    from masonrycli.structure import build_structure
 
+    material = Material()
     for key in ("density", "thickness"):
         if overrides.get(key) is not None:
-            _replace(Material(), f"--{key}", **{key: overrides[key]})
-    options = builder_options(name, {k: v for k, v in overrides.items() if v is not None})
-    try:
-        return BUILDERS[name](**options).build()
-    except (ValueError, GeometryError) as exc:  # the builders' messages start with their name
-        msg = str(exc)
-        raise InputError(msg if msg.startswith(f"{name}:") else f"{name}: {msg}") from None
+            material = _replace(material, f"--{key}", **{key: overrides[key]})
+    given = {k: v for k, v in overrides.items() if v is not None and k not in ("density", "thickness")}
+    return build_structure(name, builder_options(name, given), material.density, material.thickness)
 
 
 def builtin(name: str, **overrides) -> Scenario:

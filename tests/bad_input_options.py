@@ -134,7 +134,13 @@ OPTION_ROWS = [
     ("sim-voussoirs", {}, (*ARCH, "--voussoirs", "1", "--no-recording"), 2, 'builder "arch"'),
     ("sim-span", {}, (*ARCH, "--span", "-1", "--no-recording"), 2, 'builder "arch"'),
     # the builder's name once (it read "error: wall: wall: block count ...")
-    ("build-blocks", {}, ("build", "wall", "--blocks", "0", "--out", "w.geojson"), 2, "error: wall: block count"),
+    (
+        "build-blocks",
+        {},
+        ("build", "wall", "--blocks", "0", "--out", "w.geojson"),
+        2,
+        'error: builder "wall": block count',
+    ),
     (
         "build-density",
         {},

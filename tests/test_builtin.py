@@ -213,13 +213,26 @@ def test_a_bad_target_is_named_in_one_line(target, message, tmp_path, monkeypatc
     [
         ({"blocks": 3, "density": -1.0}, "--density: density = -1.0: must be > 0"),
         ({"thickness": 1e9}, "--thickness: thickness = 1000000000.0: must be between 1e-06 and 1000 m (a likely typo)"),
-        ({"blocks": 0}, "wall: block count must be a positive integer, got 0"),
+        ({"blocks": 0}, 'builder "wall": block count must be a positive integer, got 0'),
     ],
 )
 def test_build_assembly_refuses_a_bad_option_in_one_line_naming_it(options, message):
     with pytest.raises(InputError) as info:
         build_assembly("wall", **options)
     assert str(info.value) == message
+
+
+@pytest.mark.parametrize(
+    "name, options", [("wall", {"blocks": 0}), ("wall", {"courses": 0}), ("arch", {"voussoirs": 1})]
+)
+def test_build_assembly_refuses_a_bad_builder_option_as_simulate_does(name, options):
+    """`masonry build wall --blocks 0` said "wall: block count …", `masonry simulate wall --blocks 0` (and
+    sweep's --param) 'builder "wall": block count …': one mistake, one line."""
+    with pytest.raises(InputError) as built:
+        build_assembly(name, **options)
+    with pytest.raises(InputError) as simulated:
+        builtin(name, **options)
+    assert str(built.value) == str(simulated.value)
 
 
 def test_build_assembly_is_the_builders_with_the_commands_defaults():
