@@ -192,11 +192,28 @@ def _clean(xy: np.ndarray, h: float) -> tuple[np.ndarray, np.ndarray]:
 
 def _float32_resolution(xy: np.ndarray) -> float | None:
     """How far float32 rounding may have moved these coordinates, m (2⁻²⁴ × the largest |coordinate|), if
-    every one is a float32 value (a float32 export); None if one is not."""
+    every one is a float32 value and one at least shows the rounding (a float32 export); None if not.
+
+    Short decimals that float32 holds exactly (5000.5, 0.25) are what a user typed, nothing was rounded:
+    1 × 0.5 m blocks drawn at x = 5000 m were told to "export them in float64". A decimal float32 cannot
+    hold comes back with a long tail (1000.3 → 1000.2999877929688): at least one coordinate of a real
+    export has more significant digits than a float32 export prints (9)."""
     xy = np.asarray(xy, dtype=np.float64)
-    if xy.size and np.array_equal(xy.astype(np.float32).astype(np.float64), xy):
-        return FLOAT32_RTOL * float(np.abs(xy).max())
-    return None
+    if not xy.size or not np.array_equal(xy.astype(np.float32).astype(np.float64), xy):
+        return None
+    if all(_significant_digits(v) <= FLOAT32_DIGITS for v in np.unique(xy)):
+        return None
+    return FLOAT32_RTOL * float(np.abs(xy).max())
+
+
+FLOAT32_DIGITS = 9
+"""Significant decimal digits that always round-trip a float32 (FLT_DECIMAL_DIG)."""
+
+
+def _significant_digits(value: float) -> int:
+    """Significant digits of the shortest decimal that gives ``value`` back (5000.5 → 5, 0.25 → 2)."""
+    text = np.format_float_scientific(value, unique=True, trim="-")
+    return len(text.split("e")[0].replace("-", "").replace(".", ""))
 
 
 def _float32_hint(xy: np.ndarray, h: float, whose: str = "its") -> str:
@@ -379,7 +396,8 @@ def validate_assembly(
     tree = STRtree(geoms)
     body_areas = shapely.area(geoms)
     x0, y0, x1, y1 = shapely.bounds(geoms).T
-    h_min = SHAPE_RTOL * float(np.min(body_areas / np.hypot(x1 - x0, y1 - y0)))  # smallest shape tolerance
+    widths = body_areas / np.hypot(x1 - x0, y1 - y0)
+    h_min = min(SHAPE_RTOL * float(np.min(widths)), MAX_SHAPE_TOLERANCE)  # the smallest shape tolerance
     coords = shapely.get_coordinates(geoms)
     warnings: list[str] = []
     resolution = _float32_resolution(coords)

@@ -362,3 +362,25 @@ def test_float32_on_a_local_grid_1000_m_off_is_accepted_with_one_warning():
         "values, exact only to ±0.0006 m this far (9,999 m) from the origin: shift them near the origin or export "
         "them in float64"
     )
+
+
+def test_short_decimals_far_from_the_origin_are_typed_not_float32_rounded():
+    # 1 × 0.5 m blocks drawn at x = 5000 m: every coordinate is a float32 value, but nothing was rounded;
+    # they were told to "shift them near the origin or export them in float64" (review, 2026-11-27)
+    ground = Support(box(4990, -1, 5010, 0), "ground")
+    typed = asm(box(5000, 0, 5001, 0.5), box(5001, 0, 5002, 0.5), supports=[ground], names=["a", "b"])
+    assert validate_assembly(typed) == []
+    # the same blocks 0.3 m over: 5000.3 is no float32 value; rounded to one it is an export, and warned
+    over = [box(5000.3, 0, 5001.3, 0.5), box(5001.3, 0, 5002.3, 0.5)]
+    exported_f32 = asm(
+        *[Polygon(np.asarray(p.exterior.coords).astype(np.float32).astype(np.float64)) for p in over],
+        supports=[ground],
+        names=["a", "b"],
+    )
+    warnings = validate_assembly(exported_f32)
+    assert warnings == [  # the tolerance of 1 × 0.5 m blocks is the cap, 0.5 mm (not 2e-3 × 0.447 m = 0.89 mm)
+        "coordinates are all float32 values reaching 5,010 m from the origin, where float32 keeps only ±0.0003 m "
+        "(60% of the narrowest body's shape tolerance, 0.0005 m): shift them near the origin or export them in "
+        "float64 for exact geometry"
+    ]
+    assert checks._significant_digits(5000.5) == 5 and checks._significant_digits(float(np.float32(5000.3))) > 9
