@@ -130,26 +130,43 @@ def test_a_client_that_failed_to_connect_is_collected_before_the_command_goes_on
     # start, under distributed's class-wide LoopRunner lock that the finaliser also takes: the process hung
     # (CI at 72dc25a, this module's log-level test). Nothing may be left for a later collection.
     import gc
-    import socket
 
     from distributed import Client
 
     from masonrycli.errors import InputError
 
-    with socket.socket() as probe:  # a free port where nothing listens: refused at once
-        probe.bind(("127.0.0.1", 0))
-        port = probe.getsockname()[1]
     monkeypatch.setattr(runner, "CONNECT_TIMEOUT", 2.0)
+    listener = Listener(b"SSH-2.0-OpenSSH_9.2\r\n" * 4)  # Client fails on its answer
     gc.collect()
     gc.disable()  # only the command's own collection counts
     try:
         before = {id(o) for o in gc.get_objects() if isinstance(o, Client)}
-        with pytest.raises(InputError, match="cannot connect"):
-            runner.open_cluster(f"tcp://127.0.0.1:{port}", None)
+        with pytest.raises(InputError, match="not a Dask scheduler"):
+            runner.open_cluster(listener.address, None)
         left = [o for o in gc.get_objects() if isinstance(o, Client) and id(o) not in before]
     finally:
         gc.enable()
+        listener.close()
     assert left == []  # before: the failed Client (closed, its IO loop still to stop in its finaliser)
+
+
+def test_a_port_where_nothing_listens_is_refused_at_once():
+    # Client retried a refused connection for its whole 20 s timeout before the one line
+    import socket
+    import time
+
+    from masonrycli.errors import InputError
+
+    with socket.socket() as probe:  # a free port where nothing listens
+        probe.bind(("127.0.0.1", 0))
+        port = probe.getsockname()[1]
+    start = time.monotonic()
+    with pytest.raises(InputError) as raised:
+        runner.open_cluster(f"tcp://127.0.0.1:{port}", None)
+    assert time.monotonic() - start < runner.PROBE_TIMEOUT
+    assert str(raised.value) == (
+        f"--scheduler tcp://127.0.0.1:{port}: cannot connect (nothing listens at 127.0.0.1:{port}: connection refused)"
+    )
 
 
 def _distributed_log_level() -> int:
@@ -217,6 +234,7 @@ def test_a_client_that_connects_after_the_command_gave_up_is_closed(interrupt, m
 
     monkeypatch.setattr(runner, "CONNECT_TIMEOUT", 0.1)
     monkeypatch.setattr(runner, "CONNECT_GRACE", 0.1)
+    monkeypatch.setattr(runner, "_refused", lambda scheduler: "")  # the fake client's port 1 is closed
     monkeypatch.setattr(SlowClient, "made", [])
     monkeypatch.setattr(SlowClient, "interrupt", interrupt)
     with pytest.raises(KeyboardInterrupt if interrupt else InputError):
@@ -226,6 +244,7 @@ def test_a_client_that_connects_after_the_command_gave_up_is_closed(interrupt, m
 
 
 def test_a_client_that_connects_in_time_is_returned_open(monkeypatch):
+    monkeypatch.setattr(runner, "_refused", lambda scheduler: "")
     monkeypatch.setattr(SlowClient, "made", [])
     monkeypatch.setattr(SlowClient, "delay", 0.05)
     client = runner._connect(SlowClient, "tcp://127.0.0.1:1")

@@ -119,6 +119,9 @@ def _connect(Client, scheduler: str):
     (MemoryError: "Unable to allocate 3.07 EiB", a traceback): any failure but a connection's is "not
     a Dask scheduler". A client that connects after the command gave up waiting (or was interrupted
     while waiting) is closed by the thread: nobody else would, and it was the process's default client."""
+    refused = _refused(scheduler)
+    if refused:
+        raise InputError(f"--scheduler {scheduler}: cannot connect ({refused})")
     made: dict = {}
     lock = threading.Lock()  # the thread hands its client over, or closes it once the command gave up
 
@@ -175,6 +178,35 @@ def _connect(Client, scheduler: str):
     except BaseException:  # given up, or Ctrl-C while waiting (also just after the wait)
         give_up()
         raise
+
+
+PROBE_TIMEOUT = 2.0
+"""s: how long :func:`_refused` waits for a plain TCP connection."""
+
+
+def _refused(scheduler: str) -> str:
+    """Why nothing can answer at a ``tcp://`` scheduler address ("" if something may): a port where
+    nothing listens refuses a plain TCP connection at once, while ``Client`` retried it for its whole
+    ``CONNECT_TIMEOUT`` (a mistyped port waited 20 s for its one line). Any other address, scheme or
+    failure (a timeout, an unknown host) is left to ``Client``, which says what it met."""
+    import socket
+
+    from distributed.comm.addressing import parse_address, parse_host_port
+
+    try:
+        scheme, location = parse_address(scheduler)
+        host, port = parse_host_port(location)
+    except Exception:  # noqa: BLE001 - not ours to judge: Client reports a malformed address
+        return ""
+    if scheme != "tcp":
+        return ""
+    try:
+        socket.create_connection((host, port), timeout=PROBE_TIMEOUT).close()
+    except ConnectionRefusedError:
+        return f"nothing listens at {host}:{port}: connection refused"
+    except OSError:
+        return ""
+    return ""
 
 
 IN_FLIGHT_PER_THREAD = 4
