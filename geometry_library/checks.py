@@ -4,7 +4,7 @@ Every error is a :class:`GeometryError` whose message is one line naming the bod
 the order of the file (:func:`body_label`), for example::
 
     block 7 ("c03-b02"): polygon is not convex (reflex vertex at (0.45, 0.6))
-    blocks 4 ("c01-b04") and 5 ("c01-b05") overlap by 2.5e-03 m² (tolerance 1e-09 m²)
+    blocks 4 ("c01-b04") and 5 ("c01-b05") overlap by 2.5e-05 m², 7 mm deep (tolerance 6e-05 m², 0.5 mm deep)
 
 Normalised polygons are counter-clockwise, without the closing repeat, without duplicate or
 collinear consecutive vertices (collinear points are allowed on input and silently removed).
@@ -27,7 +27,16 @@ a 0.3 × 0.2 m block, 0.7 mm for a sliver voussoir of a 8000-block arch) and its
 - a vertex more than ``h`` inside that line is a reflex vertex: the polygon is not convex;
 - two bodies overlapping by at most ``OVERLAP_RTOL × `` the smaller one's area (1e-3, i.e. a sliver
   ``h / 2`` deep along a whole face) are accepted; ``validate_assembly(overlap_tolerance=…)`` sets an
-  absolute tolerance in m² instead.
+  absolute tolerance in m² instead;
+- and only if the overlap is at most ``OVERLAP_MAX_DEPTH`` (0.5 mm, half the contact detection distance)
+  deep: an area alone let a 0.3 × 0.2 m block's corner sit 7 mm inside the ground (a 45° corner's
+  triangle, 4.9e-5 m², is under 6e-5 m²) — seven times the distance at which the engine sees a contact.
+  The depth is the overlap's *thickness*: the minimum width of the (convex) intersection, over its
+  edges the largest distance of a vertex to the edge's line — for a corner inside a face the corner's
+  distance to it, for a face sunk along its length how far it is sunk; a few vertices, so cheap, and it
+  needs no choice of direction. Absolute, not ``h``: the engine's contact distance is absolute, and a
+  rounded joint (0.14 mm at 0.1 mm rounding, 0.1 µm in float32 at 1 m) stays far below it. Small
+  bodies are held by the area: a 1.6 cm square's 45° corner 0.5 mm deep is already over 1e-3 of its area.
 
 Why 2e-3 of the width. Rounding to float32 moves a vertex by up to 2⁻²⁴ × its coordinate (6e-8 m at
 1 m, 6e-5 m at 1000 m); rounding to 0.1 mm by up to 0.07 mm; the worst depth of a rounded mid-edge
@@ -83,6 +92,8 @@ SHAPE_RTOL = 2e-3
 MAX_SHAPE_TOLERANCE = 5e-4
 # Overlap tolerance of a pair: OVERLAP_RTOL × the smaller body's area (a sliver h / 2 deep along a face).
 OVERLAP_RTOL = 1e-3
+# m: the deepest overlap accepted (the overlap's minimum width; module docstring, Tolerances).
+OVERLAP_MAX_DEPTH = MAX_SHAPE_TOLERANCE
 # float32 keeps 24 bits: a value x is rounded by at most 2⁻²⁴ |x|.
 FLOAT32_RTOL = 2.0**-24
 MIN_AREA = 1e-10
@@ -346,6 +357,23 @@ def normalise_polygon(geometry, index: int, name: str, kind: str = "block") -> P
     return normalised_polygon(np.asarray(geometry.exterior.coords)[:, :2], label)
 
 
+def overlap_depth(overlap) -> float:
+    """How deep an overlap is, m: the minimum width of the overlap region (convex, being the intersection
+    of two convex bodies; its hull is taken against rounding), i.e. over its edges the largest distance of
+    a vertex to the edge's line (module docstring, Tolerances). 0 for an empty or flat overlap."""
+    xy = shapely.get_coordinates(shapely.convex_hull(overlap))[:-1]
+    if len(xy) < 3:
+        return 0.0
+    edge = _next(xy) - xy
+    length = np.hypot(edge[:, 0], edge[:, 1])
+    keep = length > 0.0
+    edge, start, length = edge[keep], xy[keep], length[keep]
+    # distance[i, j]: of vertex j to the line of edge i
+    rel = xy[None, :, :] - start[:, None, :]
+    distance = np.abs(edge[:, None, 0] * rel[:, :, 1] - edge[:, None, 1] * rel[:, :, 0]) / length[:, None]
+    return float(distance.max(axis=1).min())
+
+
 def validate_assembly(
     assembly: Assembly,
     overlap_tolerance: float | None = None,
@@ -357,7 +385,7 @@ def validate_assembly(
     vertices / self-intersection / zero or absurd area / non-convex; non-positive density or
     thickness; unknown support role; duplicate names; no blocks; a block overlapping another block
     or a support by more than ``OVERLAP_RTOL`` × the smaller one's area (module docstring, Tolerances),
-    or by more than ``overlap_tolerance`` m² if given.
+    or by more than ``overlap_tolerance`` m² if given, or more than ``OVERLAP_MAX_DEPTH`` deep (either way).
 
     Warnings: no support at all (everything falls: a GeoJSON drawn without ``"role": "support"`` on its
     ground ran as 52 falling blocks and was reported collapsed); a block farther than
@@ -418,33 +446,45 @@ def validate_assembly(
     # pairwise search below (the reference) only when it cannot clear the bodies (union_screen.py).
     # tolerance of a pair: OVERLAP_RTOL × the smaller area; the screen must use the smallest of them
     screen_tolerance = OVERLAP_RTOL * float(body_areas.min()) if overlap_tolerance is None else overlap_tolerance
+    # and below the area of any overlap deeper than OVERLAP_MAX_DEPTH: a convex region of minimum width w
+    # covers at least w² / √3 (Pál: the equilateral triangle is the least), and the screen clears a pair only
+    # if it overlaps by less than 3/4 of its tolerance, so D² / 2 (< 4/3 × D² / √3) proves no overlap too deep
+    screen_tolerance = min(screen_tolerance, 0.5 * OVERLAP_MAX_DEPTH**2)
     touched = union_screen(geoms, n_blocks, screen_tolerance)
     left, right = tree.query(geoms if touched is None else geoms[n_blocks:], predicate="intersects")
     left = left if touched is None else left + n_blocks  # then only supports on supports, for warnings
     pair = left < right
     left, right = left[pair], right[pair]
-    areas = shapely.area(shapely.intersection(geoms[left], geoms[right])) if left.size else np.zeros(0)
+    overlaps = shapely.intersection(geoms[left], geoms[right]) if left.size else np.zeros(0, dtype=object)
+    areas = shapely.area(overlaps) if left.size else np.zeros(0)
     if overlap_tolerance is None:
         tolerances = OVERLAP_RTOL * np.minimum(body_areas[left], body_areas[right])
     else:
         tolerances = np.full(len(areas), float(overlap_tolerance))
+    # Only an overlap of at least D² / 2 m² can be deeper than D (Pál, above): the rest need no depth.
+    deep_enough = 0.5 * OVERLAP_MAX_DEPTH**2
     bad = []
-    for a, b, area, tol in zip(left.tolist(), right.tolist(), areas.tolist(), tolerances.tolist()):
-        if area <= tol:
+    for k, (a, b, area, tol) in enumerate(zip(left.tolist(), right.tolist(), areas.tolist(), tolerances.tolist())):
+        if area <= tol and (area < deep_enough or overlap_depth(overlaps[k]) <= OVERLAP_MAX_DEPTH):
             continue
         if a >= n_blocks:  # support / support
             warnings.append(f"{labels[a]} and {labels[b]} overlap by {area:.3g} m² (supports only)")
             continue
-        bad.append((a, b, area, tol))
+        bad.append((a, b, area, tol, overlaps[k]))
     if bad:
-        a, b, area, tol = bad[0]
+        a, b, area, tol, overlap = bad[0]
         more = f" (and {len(bad) - 1} more overlapping pair(s))" if len(bad) > 1 else ""
         if b < n_blocks:
             what = f'blocks {a + 1} ("{names[a]}") and {b + 1} ("{names[b]}")'
         else:
             what = f"{labels[a]} and {labels[b]}"
         hint = _float32_hint(coords, h_min, "their")
-        raise GeometryError(f"{what} overlap by {area:.3g} m² (tolerance {tol:.3g} m²){more}{hint}")
+        depth = overlap_depth(overlap)
+        depth = f"{depth * 1e3:.2g} mm deep" if depth < 0.1 else f"{depth:.3g} m deep"
+        raise GeometryError(
+            f"{what} overlap by {area:.3g} m², {depth} (tolerance {tol:.3g} m², "
+            f"{OVERLAP_MAX_DEPTH * 1e3:g} mm deep){more}{hint}"
+        )
 
     if touched is None:
         touched = np.zeros(n_blocks, dtype=bool)

@@ -5,6 +5,7 @@ import time
 
 import numpy as np
 import pytest
+from shapely import affinity
 from shapely.geometry import Polygon, box
 
 from geometry_library import (
@@ -334,10 +335,28 @@ def test_a_real_1_mm_overlap_is_refused_a_0_1_mm_one_accepted():
     real = asm(a.polygon, box(0.299, 0, 0.599, 0.2), supports=[GROUND], names=["a", "b"])
     # 2e-4 m² into a 0.06 m² block; tolerance 1e-3 × 0.06 m² (a sliver 0.17 mm deep along the 0.3 m face)
     assert raises_one_line("overlap", validate_assembly, real) == (
-        'blocks 1 ("a") and 2 ("b") overlap by 0.0002 m² (tolerance 6e-05 m²)'
+        'blocks 1 ("a") and 2 ("b") overlap by 0.0002 m², 1 mm deep (tolerance 6e-05 m², 0.5 mm deep)'
     )
     rounding = asm(a.polygon, box(0.2999, 0, 0.5999, 0.2), supports=[GROUND], names=["a", "b"])
     assert validate_assembly(rounding) == []  # 2e-5 m²
+
+
+def test_a_corner_7_mm_inside_the_ground_is_refused_though_its_area_is_within_tolerance():
+    """A 0.3 × 0.2 m block at 45° whose corner is d inside the ground overlaps it by d² (4.9e-5 m² at 7 mm,
+    under the 6e-5 m² area tolerance): it was accepted, seven times deeper than the 1 mm contact distance.
+    The overlap's depth (its minimum width: the corner's distance to the ground's face) must be ≤ 0.5 mm.
+    0.6 mm (3.6e-7 m²) is also refused: the union screen, which clears by area, used to let it through."""
+
+    def corner_in(depth):
+        block = affinity.translate(affinity.rotate(box(0, 0, 0.3, 0.2), 45, origin=(0, 0)), 0, -depth)
+        return asm(block, supports=[GROUND], names=["tilted"])
+
+    assert raises_one_line("overlap", validate_assembly, corner_in(7e-3)) == (
+        'block 1 ("tilted") and support 1 ("ground") overlap by 4.9e-05 m², 7 mm deep (tolerance 6e-05 m², 0.5 mm deep)'
+    )
+    assert "0.6 mm deep" in raises_one_line("overlap", validate_assembly, corner_in(6e-4))
+    assert validate_assembly(corner_in(4e-4)) == []
+    assert checks.overlap_depth(box(0, 0, 0.3, 1e-4)) == pytest.approx(1e-4)  # a face sunk 0.1 mm: 0.1 mm
 
 
 def test_float32_on_a_local_grid_1000_m_off_is_accepted_with_one_warning():

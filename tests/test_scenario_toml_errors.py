@@ -144,7 +144,9 @@ def test_overlapping_blocks_are_numbered_as_the_reader_numbers_them(tmp_path):
     square = "[[block]]\npolygon = [[{x}, {y}], [{x1}, {y}], [{x1}, {y1}], [{x}, {y1}]]\n"
     blocks = "".join(square.format(x=x, y=y, x1=x + 1, y1=y + 1) for x, y in ((0, 0), (1, 0), (0, 1), (0.5, 1.5)))
     msg = load_error(tmp_path, blocks + GROUND)
-    assert msg.endswith('blocks 3 ("block-3") and 4 ("block-4") overlap by 0.25 m² (tolerance 0.001 m²)'), msg
+    assert msg.endswith(
+        'blocks 3 ("block-3") and 4 ("block-4") overlap by 0.25 m², 0.5 m deep (tolerance 0.001 m², 0.5 mm deep)'
+    ), msg
 
 
 def test_validate_assembly_errors_and_warnings(tmp_path, monkeypatch):
