@@ -112,6 +112,34 @@ def test_programmatic_config_errors():
         dataclasses.replace(RunConfig(), theta=0.2)
 
 
+def test_a_hand_made_block_is_simulated_as_validate_assembly_checked_it():
+    """A Block made in Python with a vertex 0.2 mm inside its bottom edge (within the 0.33 mm shape
+    tolerance of a 0.3 × 0.2 m block) passes validate_assembly, which checks the cleaned polygon; the
+    engine was given the non-convex 5-vertex one. Now the scenario holds the cleaned rectangle, so the
+    model (what the engine and the recording get) has its 4 corners; a real 1 mm dent is refused."""
+    from shapely.geometry import Polygon, box
+
+    from geometry_library import validate_assembly
+    from masonrycli.run import Simulation
+    from masonrycli.scenario import Scenario
+
+    def scenario(dent):
+        block = Block(Polygon([(0, 0), (0.15, dent), (0.3, 0), (0.3, 0.2), (0, 0.2)]), "dented")
+        ground = Support(box(-1, -0.1, 1, 0), "ground")
+        return Scenario("hand-made", RunConfig(duration=0.01), Material(), Assembly((block,), (ground,)), (Fixed(),))
+
+    dented = scenario(2e-4)
+    assert validate_assembly(dented.assembly) == []
+    model = Simulation(dented).model
+    corners = model.vert_local[model.body_vert_start[0] : model.body_vert_start[1]] + model.body_q0[0, :2]
+    assert sorted(map(tuple, np.round(corners, 12).tolist())) == [(0, 0), (0, 0.2), (0.3, 0), (0.3, 0.2)]
+    assert len(dented.assembly.blocks[0].vertices) == 4
+    with pytest.raises(
+        InputError, match=r'^block 1 \("dented"\): polygon is not convex \(reflex vertex at \(0.15, 0.001\)\)$'
+    ):
+        scenario(1e-3)
+
+
 # ----------------------------------------------------------------------------------------- builders
 
 
