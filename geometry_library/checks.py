@@ -67,7 +67,8 @@ them all again (an 8000-voussoir arch: 16 140 passes for 8070 bodies). Polygons 
 :func:`normalised_polygon` are remembered by identity (shapely geometries are immutable; a weak map, so
 nothing is kept alive), and :func:`normalise_polygon` hands such a polygon back as it is. Any other
 polygon, e.g. one a user put in a ``Block`` by hand or one that came back from another process, is
-normalised and checked in full.
+normalised and checked in full; if that leaves its ring exactly as it was (an unpickled normalised
+polygon), the polygon itself is remembered and handed back, so a process checks it once.
 """
 
 from __future__ import annotations
@@ -343,7 +344,9 @@ def normalised_polygon(coords, label: str) -> Polygon:
 
 def normalise_polygon(geometry, index: int, name: str, kind: str = "block") -> Polygon:
     """Like :func:`polygon_from_coords` for a shapely geometry: also rejects holes and other types. A
-    polygon made by :func:`normalised_polygon` is returned as it is (normalising it again gives it back)."""
+    polygon made by :func:`normalised_polygon` is returned as it is (normalising it again gives it back),
+    and so is one whose ring the normalisation leaves as it was (remembered: one that came back from
+    another process is checked once there, not at every ``Scenario`` made from it)."""
     if _NORMALISED.get(id(geometry)) is geometry:
         return geometry
     label = body_label(index, name, kind)
@@ -354,7 +357,12 @@ def normalise_polygon(geometry, index: int, name: str, kind: str = "block") -> P
         raise GeometryError(f"{label}: polygon is empty")
     if len(geometry.interiors) > 0:
         raise GeometryError(f"{label}: polygon has {len(geometry.interiors)} hole(s); blocks are solid")
-    return normalised_polygon(np.asarray(geometry.exterior.coords)[:, :2], label)
+    given = np.asarray(geometry.exterior.coords)
+    polygon = normalised_polygon(given[:, :2], label)
+    if np.array_equal(given, np.asarray(polygon.exterior.coords)):  # it was normalised already (unpickled)
+        _NORMALISED[id(geometry)] = geometry
+        return geometry
+    return polygon
 
 
 def overlap_depth(overlap) -> float:
