@@ -401,6 +401,28 @@ def _plain(mode: str, theta: float = 1.0):
 _closing: dict = {}  # (method, problem, target) → (sweeps, converged): the search is not timed, do it once
 
 
+def close(ctx, v, r, res, target, method: tuple, clock):
+    """The engine's accelerated sweeps from an IPM's impulses ``r`` (updated in place) to ``target``:
+    ``(sweeps, converged, v, CPU s of the sweeps)``. The fewest sweeps that reach it are searched once per
+    ``method`` and problem, in steps of ~10 %, untimed; only the final run of that many is timed."""
+    if res <= target:
+        return 0, True, v, 0.0
+    key = (*method, ctx.p.name, target)
+    if key not in _closing:
+        n, ok = 0, False
+        while n < CAP and not ok:
+            n += max(1, n // 10)
+            rr = r.copy()
+            vv, _ = ctx.sweep(rr, n, "nlgs-accel")
+            ok = ctx.residual(vv, rr) <= target
+        _closing[key] = n, ok
+    n, ok = _closing[key]
+    t1 = time.process_time()
+    with clock("sweeps"):
+        v, _ = ctx.sweep(r, n, "nlgs-accel")
+    return n, ok, v, time.process_time() - t1
+
+
 def closing(loose: float, mode: str, start=None):
     """``start(ctx, clock)``: the IPM's starting λ (C, 2) instead of the warm start's (a predictor, timed)."""
 
@@ -410,25 +432,8 @@ def closing(loose: float, mode: str, start=None):
         lam_start = None if start is None else start(ctx, clock)
         v, r, its, rounds, res = run_ipm(ctx, target, loose, clock, mode, lam_start=lam_start)
         ipm_s = time.process_time() - t0
-        key = (loose, mode, start, ctx.p.name, target)
-        if res <= target:
-            n, ok = 0, True
-        else:
-            if key not in _closing:
-                n, ok = 0, False
-                while n < CAP and not ok:
-                    n += max(1, n // 10)
-                    rr = r.copy()
-                    vv, _ = ctx.sweep(rr, n, "nlgs-accel")
-                    ok = ctx.residual(vv, rr) <= target
-                _closing[key] = n, ok
-            n, ok = _closing[key]
-        t1 = time.process_time()
-        if n:
-            with clock("sweeps"):
-                v, _ = ctx.sweep(r, n, "nlgs-accel")
-        cpu_s = ipm_s + time.process_time() - t1
-        return _outcome(clock, v, r, its, rounds, 0.0 if ok else np.inf, target, cpu_s, closing=n)
+        n, ok, v, sweeps_s = close(ctx, v, r, res, target, ("ipm", loose, mode, start), clock)
+        return _outcome(clock, v, r, its, rounds, 0.0 if ok else np.inf, target, ipm_s + sweeps_s, closing=n)
 
     return solve
 

@@ -34,7 +34,6 @@ import time
 import numpy as np
 
 from benchmarks.solver_lab.methods import ipm
-from benchmarks.solver_lab.methods.gauss_seidel import CAP
 from benchmarks.solver_lab.outcome import Clock, Outcome
 
 STEP_FRACTION = 0.995
@@ -157,34 +156,14 @@ def plain(ctx, target) -> Outcome:
     return Outcome(v, r, its, 0.0, clock.phases, converged=res <= target, cpu_s=cpu)
 
 
-_closing: dict = {}
-
-
 def closing(loose):
     def solve(ctx, target) -> Outcome:
         clock = Clock()
         t0 = time.process_time()
         v, r, its, res = run(ctx, loose, clock)
         ipm_s = time.process_time() - t0 - clock.phases.get("setup", 0.0)
-        key = (loose, ctx.p.name, target)
-        if res <= target:
-            n, ok = 0, True
-        else:
-            if key not in _closing:
-                n, ok = 0, False
-                while n < CAP and not ok:
-                    n += max(1, n // 10)
-                    rr = r.copy()
-                    vv, _ = ctx.sweep(rr, n, "nlgs-accel")
-                    ok = ctx.residual(vv, rr) <= target
-                _closing[key] = n, ok
-            n, ok = _closing[key]
-        t1 = time.process_time()
-        if n:
-            with clock("sweeps"):
-                v, _ = ctx.sweep(r, n, "nlgs-accel")
-        cpu = ipm_s + time.process_time() - t1
-        return Outcome(v, r, its, 0.0, clock.phases, converged=ok, cpu_s=cpu, detail=f"{n} closing sweeps")
+        n, ok, v, sweeps_s = ipm.close(ctx, v, r, res, target, ("ipm-lcp", loose), clock)
+        return Outcome(v, r, its, 0.0, clock.phases, converged=ok, cpu_s=ipm_s + sweeps_s, detail=f"{n} closing sweeps")
 
     return solve
 
