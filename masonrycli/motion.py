@@ -47,7 +47,6 @@ Units: m/s, m/s², s, Hz, rad.
 from __future__ import annotations
 
 import functools
-import itertools
 import math
 import os
 from collections.abc import Sequence
@@ -56,7 +55,7 @@ from typing import ClassVar
 
 import numpy as np
 
-from masonrycli.values import check_real, check_vector, field_error, format_value
+from masonrycli.values import check_real, check_vector, field_error, finite_floats, format_value
 
 RECORD_QUANTITIES = ("velocity", "acceleration")
 BASELINES = ("quadratic", "none")
@@ -254,25 +253,6 @@ class Ramp(Motion):
         return kv
 
 
-def _finite_floats(seq, pairs: bool = False) -> tuple | None:
-    """``tuple(seq)`` when every item is a finite Python float (``pairs``: a 2-tuple of them), what
-    check_real / check_vector would return item by item; None otherwise (then they name the bad one).
-    A record file's 3 million samples were checked one call each: 7 s before the run began."""
-    if not seq:
-        return None
-    if pairs:
-        if set(map(type, seq)) != {tuple} or set(map(len, seq)) != {2}:
-            return None
-        if set(map(type, itertools.chain.from_iterable(seq))) != {float}:
-            return None
-        numbers = np.fromiter(itertools.chain.from_iterable(seq), dtype=np.float64, count=2 * len(seq))
-    else:
-        if set(map(type, seq)) != {float}:
-            return None
-        numbers = np.fromiter(seq, dtype=np.float64, count=len(seq))
-    return tuple(seq) if np.isfinite(numbers).all() else None
-
-
 @dataclass(frozen=True, kw_only=True)
 class Record(_Directed, Motion):
     """A tabulated velocity or acceleration history (see the module docstring).
@@ -333,7 +313,7 @@ class Record(_Directed, Motion):
             raise field_error("time", time, f"a record needs at least 2 samples, got {len(time)}")
         if len(value) != len(time):
             raise field_error("value", value, f"has {len(value)} samples but time has {len(time)}")
-        t = _finite_floats(time)
+        t = finite_floats(time)
         if t is None:
             t = tuple(check_real(f"time[{i}]", x) for i, x in enumerate(time))
         times = np.asarray(t, dtype=np.float64)
@@ -344,11 +324,11 @@ class Record(_Directed, Motion):
         # the first sample says which: [x, y] pairs, or numbers along the direction (judged from all of
         # them, [1.0, "b"] blamed value[0] = 1.0 for not being 2 numbers [x, y])
         if isinstance(value[0], (list, tuple, np.ndarray)):
-            v = _finite_floats(value, pairs=True)
+            v = finite_floats(value, pairs=True)
             if v is None:
                 v = tuple(check_vector(f"value[{i}]", x) for i, x in enumerate(value))
         else:
-            v = _finite_floats(value)
+            v = finite_floats(value)
             if v is None:
                 v = tuple(check_real(f"value[{i}]", x) for i, x in enumerate(value))
         _put(self, "time", t)

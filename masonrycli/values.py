@@ -8,6 +8,7 @@ write Python values as TOML text that ``tomllib`` reads back bit for bit.
 
 from __future__ import annotations
 
+import itertools
 import math
 import re
 
@@ -114,3 +115,22 @@ def check_vector(key: str, value, size: int = 2, names: str | None = None) -> tu
 
 # --------------------------------------------------------------------------------------------------
 # Motion
+
+
+def finite_floats(seq, pairs: bool = False) -> tuple | None:
+    """``tuple(seq)`` when every item is a finite Python float (``pairs``: a 2-tuple of them), what
+    check_real / check_vector would return item by item; None otherwise (then they name the bad one).
+    A record file's 3 million samples were checked one call each: 7 s before the run began."""
+    if not seq:
+        return None
+    if pairs:
+        if set(map(type, seq)) != {tuple} or set(map(len, seq)) != {2}:
+            return None
+        if set(map(type, itertools.chain.from_iterable(seq))) != {float}:
+            return None
+        numbers = np.fromiter(itertools.chain.from_iterable(seq), dtype=np.float64, count=2 * len(seq))
+    else:
+        if set(map(type, seq)) != {float}:
+            return None
+        numbers = np.fromiter(seq, dtype=np.float64, count=len(seq))
+    return tuple(seq) if np.isfinite(numbers).all() else None
