@@ -257,17 +257,22 @@ def _start(ops, lam0, c):
     lam = lam0.copy()
     x = ops.velocity(lam)
     z = ops.rows(ops.contact_velocity(x), c)
-    dz = max(-1.5 * z.min(), 0.0)
-    dl = max(-1.5 * lam.min(), 0.0)
-    z = z + dz
-    lam = lam + dl
+    z, lam = interior(z, lam)
+    return lam, ops.velocity(lam), z
+
+
+def interior(z: np.ndarray, lam: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Mehrotra's starting point: slacks ``z`` and multipliers ``lam`` shifted strictly positive, then
+    balanced so that neither complementarity product is far below the other."""
+    z = z + max(-1.5 * z.min(), 0.0)
+    lam = lam + max(-1.5 * lam.min(), 0.0)
     zl = float((z * lam).sum())
     if zl <= 0.0:
         z, lam = z + 1e-3, lam + 1e-3
         zl = float((z * lam).sum())
     z = z + 0.5 * zl / lam.sum()
     lam = lam + 0.5 * zl / z.sum()
-    return lam, ops.velocity(lam), z
+    return z, lam
 
 
 def _max_step(v, dv):

@@ -78,15 +78,7 @@ def _start(ops, r0):
     x = _velocity(ops, y)
     u = ops.contact_velocity(x)
     y[:, 3] = np.abs(u[:, 0])
-    w = _rows(ops, u, y)
-    w = w + max(-1.5 * w.min(), 0.0)
-    y = y + max(-1.5 * y.min(), 0.0)
-    wy = float((w * y).sum())
-    if wy <= 0.0:
-        w, y = w + 1e-3, y + 1e-3
-        wy = float((w * y).sum())
-    w = w + 0.5 * wy / y.sum()
-    y = y + 0.5 * wy / w.sum()
+    w, y = ipm.interior(_rows(ops, u, y), y)
     return _velocity(ops, y), y, w
 
 
