@@ -82,6 +82,7 @@ from shapely.geometry import Polygon
 from shapely.strtree import STRtree
 
 from .blocks import SUPPORT_ROLES, Assembly, GeometryError
+from .float32 import FLOAT32_RTOL, float32_hint, float32_resolution
 from .union_screen import union_screen
 from .values import check_material
 
@@ -95,8 +96,6 @@ MAX_SHAPE_TOLERANCE = 5e-4
 OVERLAP_RTOL = 1e-3
 # m: the deepest overlap accepted (the overlap's minimum width; module docstring, Tolerances).
 OVERLAP_MAX_DEPTH = MAX_SHAPE_TOLERANCE
-# float32 keeps 24 bits: a value x is rounded by at most 2⁻²⁴ |x|.
-FLOAT32_RTOL = 2.0**-24
 MIN_AREA = 1e-10
 MAX_AREA = 1e6
 # m: a vertex farther than this from the origin is refused. Products of larger coordinates (areas, cross
@@ -202,44 +201,6 @@ def _clean(xy: np.ndarray, h: float) -> tuple[np.ndarray, np.ndarray]:
         xy = np.delete(xy, flat[np.argmin(np.abs(depth[flat]))], axis=0)
 
 
-def _float32_resolution(xy: np.ndarray) -> float | None:
-    """How far float32 rounding may have moved these coordinates, m (2⁻²⁴ × the largest |coordinate|), if
-    every one is a float32 value and one at least shows the rounding (a float32 export); None if not.
-
-    Short decimals that float32 holds exactly (5000.5, 0.25) are what a user typed, nothing was rounded:
-    1 × 0.5 m blocks drawn at x = 5000 m were told to "export them in float64". A decimal float32 cannot
-    hold comes back with a long tail (1000.3 → 1000.2999877929688): at least one coordinate of a real
-    export has more significant digits than a float32 export prints (9)."""
-    xy = np.asarray(xy, dtype=np.float64)
-    if not xy.size or not np.array_equal(xy.astype(np.float32).astype(np.float64), xy):
-        return None
-    if all(_significant_digits(v) <= FLOAT32_DIGITS for v in np.unique(xy)):
-        return None
-    return FLOAT32_RTOL * float(np.abs(xy).max())
-
-
-FLOAT32_DIGITS = 9
-"""Significant decimal digits that always round-trip a float32 (FLT_DECIMAL_DIG)."""
-
-
-def _significant_digits(value: float) -> int:
-    """Significant digits of the shortest decimal that gives ``value`` back (5000.5 → 5, 0.25 → 2)."""
-    text = np.format_float_scientific(value, unique=True, trim="-")
-    return len(text.split("e")[0].replace("-", "").replace(".", ""))
-
-
-def _float32_hint(xy: np.ndarray, h: float, whose: str = "its") -> str:
-    """The end of a refusal when float32 rounding is a tenth of the tolerance ``h`` or more (else "")."""
-    resolution = _float32_resolution(xy)
-    if resolution is None or resolution < 0.1 * h:
-        return ""
-    far = resolution / FLOAT32_RTOL
-    return (
-        f"; {whose} coordinates are float32 values, exact only to ±{resolution:.2g} m this far ({far:,.0f} m) from "
-        "the origin: shift them near the origin or export them in float64"
-    )
-
-
 def normalise_coords(coords, label: str) -> np.ndarray:
     """Check a ring of vertices and return it normalised (CCW, no repeats, no collinear vertices).
 
@@ -313,7 +274,7 @@ def normalise_coords(coords, label: str) -> np.ndarray:
     reflex = np.flatnonzero(depth <= h)  # inside the neighbours' line by more than h (or a spike's tip)
     if reflex.size:
         raise GeometryError(
-            f"{label}: polygon is not convex (reflex vertex at {_fmt(xy[reflex[0]])}){_float32_hint(given, h)}"
+            f"{label}: polygon is not convex (reflex vertex at {_fmt(xy[reflex[0]])}){float32_hint(given, h)}"
         )
     return np.ascontiguousarray(xy)
 
@@ -436,7 +397,7 @@ def validate_assembly(
     h_min = min(SHAPE_RTOL * float(np.min(widths)), MAX_SHAPE_TOLERANCE)  # the smallest shape tolerance
     coords = shapely.get_coordinates(geoms)
     warnings: list[str] = []
-    resolution = _float32_resolution(coords)
+    resolution = float32_resolution(coords)
     if resolution is not None and resolution >= 0.1 * h_min:
         warnings.append(
             f"coordinates are all float32 values reaching {resolution / FLOAT32_RTOL:,.0f} m from the origin, where "
@@ -486,7 +447,7 @@ def validate_assembly(
             what = f'blocks {a + 1} ("{names[a]}") and {b + 1} ("{names[b]}")'
         else:
             what = f"{labels[a]} and {labels[b]}"
-        hint = _float32_hint(coords, h_min, "their")
+        hint = float32_hint(coords, h_min, "their")
         depth = overlap_depth(overlap)
         depth = f"{depth * 1e3:.2g} mm deep" if depth < 0.1 else f"{depth:.3g} m deep"
         raise GeometryError(

@@ -17,6 +17,7 @@ from geometry_library import (
     build_arch,
     build_wall,
     checks,
+    float32,
     polygon_from_coords,
     validate_assembly,
 )
@@ -407,4 +408,4 @@ def test_short_decimals_far_from_the_origin_are_typed_not_float32_rounded():
         "(60% of the narrowest body's shape tolerance, 0.0005 m): shift them near the origin or export them in "
         "float64 for exact geometry"
     ]
-    assert checks._significant_digits(5000.5) == 5 and checks._significant_digits(float(np.float32(5000.3))) > 9
+    assert float32._significant_digits(5000.5) == 5 and float32._significant_digits(float(np.float32(5000.3))) > 9
