@@ -55,7 +55,7 @@ from typing import ClassVar
 
 import numpy as np
 
-from masonrycli.values import check_real, check_vector, field_error, finite_floats, format_value
+from masonrycli.values import check_real, check_samples, check_vector, field_error, format_value
 
 RECORD_QUANTITIES = ("velocity", "acceleration")
 BASELINES = ("quadratic", "none")
@@ -313,9 +313,7 @@ class Record(_Directed, Motion):
             raise field_error("time", time, f"a record needs at least 2 samples, got {len(time)}")
         if len(value) != len(time):
             raise field_error("value", value, f"has {len(value)} samples but time has {len(time)}")
-        t = finite_floats(time)
-        if t is None:
-            t = tuple(check_real(f"time[{i}]", x) for i, x in enumerate(time))
+        t = check_samples("time", time)
         times = np.asarray(t, dtype=np.float64)
         later = times[1:] > times[:-1]
         if not later.all():
@@ -323,14 +321,7 @@ class Record(_Directed, Motion):
             raise field_error(f"time[{i}]", t[i], f"must be > the previous time {format_value(t[i - 1])}")
         # the first sample says which: [x, y] pairs, or numbers along the direction (judged from all of
         # them, [1.0, "b"] blamed value[0] = 1.0 for not being 2 numbers [x, y])
-        if isinstance(value[0], (list, tuple, np.ndarray)):
-            v = finite_floats(value, pairs=True)
-            if v is None:
-                v = tuple(check_vector(f"value[{i}]", x) for i, x in enumerate(value))
-        else:
-            v = finite_floats(value)
-            if v is None:
-                v = tuple(check_real(f"value[{i}]", x) for i, x in enumerate(value))
+        v = check_samples("value", value, pairs=isinstance(value[0], (list, tuple, np.ndarray)))
         _put(self, "time", t)
         _put(self, "value", v)
         if self.window is not None:
