@@ -1,4 +1,5 @@
-"""The layering the project keeps: each heavy library is imported by one package only.
+"""The layering the project keeps: each heavy library is imported by one package only; and every
+non-trivial engine kernel opens with its pseudo-code.
 
 numba by the engine (masonrycli/engine; the solver lab compiles its research copies of engine kernels
 through the engine's ``_jit.njit``, so the flags stay the engine's), rerun by the recording package,
@@ -8,6 +9,7 @@ as references; the product and the benchmarks may not reach around the layer.
 
 from __future__ import annotations
 
+import ast
 import re
 from pathlib import Path
 
@@ -37,3 +39,31 @@ def test_library_is_imported_by_its_package_only(library):
     assert importers, f"no module imports {library}: the test would pass vacuously"
     outside = sorted(p for p in importers if not p.startswith(owner + "/"))
     assert not outside, f"{library} imported outside {owner}: {outside}"
+
+
+KERNEL_LINES = 10
+"""A kernel longer than this (decorator and signature excluded) is non-trivial."""
+
+
+def _kernels_without_pseudo_code() -> list[str]:
+    # A kernel's pseudo-code is a comment block right above its decorator or right below its signature.
+    missing = []
+    for path in sorted((ROOT / "masonrycli" / "engine").glob("*.py")):
+        lines = path.read_text(encoding="utf-8").splitlines()
+        for node in ast.walk(ast.parse("\n".join(lines))):
+            if not isinstance(node, ast.FunctionDef):
+                continue
+            if not any("njit" in ast.unparse(d) for d in node.decorator_list):
+                continue
+            first_statement = node.body[0].lineno  # 1-based
+            if first_statement + KERNEL_LINES > node.end_lineno:
+                continue
+            above = lines[min(d.lineno for d in node.decorator_list) - 2].lstrip()
+            inside = lines[first_statement - 2].lstrip()  # the line before the first statement
+            if not (above.startswith("#") or inside.startswith("#")):
+                missing.append(f"{path.relative_to(ROOT).as_posix()}:{node.lineno} {node.name}")
+    return missing
+
+
+def test_every_non_trivial_kernel_opens_with_its_pseudo_code():
+    assert not _kernels_without_pseudo_code(), "kernels without a pseudo-code comment"

@@ -104,6 +104,16 @@ def _remember(key, r, count, out_key, out_r):
 
 @njit
 def _static_guess(contact_body, pack, count, body_q, body_mass, block_count, gravity, dt, r):
+    # The load-path guess of the module doc:
+    #   r ← 0; up = −g/|g|; CSR lists of each body's contacts
+    #   held ← supports; for each block k from the lowest up (height along up):
+    #       held[k] if a contact holding k up (_holding: s > HOLDS_UP) touches a held body
+    #   load_k = m_k |g| dt
+    #   for each held block k from the highest down:
+    #       r_n = load_k / Σ s over k's holding contacts to held bodies; each such contact gets r_n,
+    #       and the body o on its other side load_o += r_n s
+    # Why lowest-up then highest-down: a block is held only through held bodies below it, and a body
+    # must have received the load of everything above before it passes its own down.
     body_count = body_q.shape[0]
     g = np.sqrt(gravity[0] ** 2 + gravity[1] ** 2)
     for c in range(count):
