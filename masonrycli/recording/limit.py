@@ -65,13 +65,15 @@ class MechanismDrawing:
     support_vert_local: np.ndarray
     """(Vs, 2) m."""
     support_q0: np.ndarray
-    """(S, 3)."""
+    """(S, 3) centroid x, y (m), θ = 0."""
     hinge_point: np.ndarray
-    """(H, 2) m, and ``hinge_block`` (H,) int: the block that carries it into the mechanism copy."""
+    """(H, 2) m: the hinges."""
     hinge_block: np.ndarray
+    """(H,) int: the block that carries each hinge into the mechanism copy."""
     sliding_point: np.ndarray
-    """(K, 2) m: the middle of each sliding joint, and ``sliding_block`` (K,) int as for the hinges."""
+    """(K, 2) m: the middle of each sliding joint."""
     sliding_block: np.ndarray
+    """(K,) int: the block that carries each sliding point into the mechanism copy."""
     thrust_point: np.ndarray
     """(P, 2) m: centres of pressure of the loaded joints."""
     document: str
