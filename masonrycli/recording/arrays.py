@@ -1,6 +1,8 @@
 """Arrays for ``send_columns``: CSR polygons posed per frame, ragged line strips as Arrow, the frame buffer.
 
-Everything here works on whole batches of frames at once (no Python loop over frames or blocks).
+Everything done per frame works on whole batches of frames at once (no Python loop over frames or
+blocks); only :class:`Polygons`' index arrays are built with one loop over the polygons, once per
+recording.
 """
 
 from __future__ import annotations
