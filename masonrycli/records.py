@@ -4,6 +4,7 @@ Two formats, chosen by the file's extension:
 
 * ``.AT2`` (PEER NGA): acceleration in g, one component per file, a 4-line header whose last line
   gives ``NPTS`` and ``DT`` (see :func:`load_at2`); samples at t = 0, DT, 2 DT, ...
+* ``.VT2`` / ``.DT2`` (PEER's velocity and displacement series) are refused, naming the .AT2;
 * anything else is CSV: one sample per line, ``time,value`` or ``time,x,y`` (see :func:`load_record_csv`).
 
 :func:`record_motion` makes the motion (scale, window, optional vertical component, baseline
@@ -126,10 +127,26 @@ def is_at2(path) -> bool:
     return os.fspath(path).lower().endswith(".at2")
 
 
+_PEER_OTHER = {".vt2": "velocity (.VT2, cm/s)", ".dt2": "displacement (.DT2, cm)"}
+"""PEER's other series of a component. Read as CSV they failed on their header's second line (`not a
+number: "Imperial Valley..."`), which said nothing of the format."""
+
+
+def check_not_peer_other(path, name: str) -> None:
+    """Raise :class:`InputError` for a PEER .VT2 / .DT2 file: masonry reads the .AT2 of the component."""
+    what = _PEER_OTHER.get(os.path.splitext(os.fspath(path))[1].lower())
+    if what is not None:
+        raise InputError(
+            f"{name}: a PEER {what} record; give the same component's acceleration record (.AT2, in g), "
+            "which masonry integrates, or a CSV of velocity"
+        )
+
+
 def read_record(path, display: str | None = None) -> tuple[np.ndarray, np.ndarray, str | None]:
     """``(time (n,) s, value (n,) or (n, 2), quantity)`` of a record file: an .AT2 file gives its
     acceleration in m/s² and quantity ``"acceleration"``; a CSV file gives its columns as they are and
     quantity None (the caller says what the values are)."""
+    check_not_peer_other(path, display if display is not None else str(path))
     if is_at2(path):
         dt, acc = load_at2(path, display)
         return np.arange(acc.size) * dt, acc * G_STANDARD, "acceleration"

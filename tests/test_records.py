@@ -108,6 +108,22 @@ def test_load_record_csv_unreadable(tmp_path):
     assert "latin1.csv: not a UTF-8 text file" in one_line(exc)
 
 
+@pytest.mark.parametrize(("suffix", "what"), [(".VT2", "velocity (.VT2, cm/s)"), (".dt2", "displacement (.DT2, cm)")])
+def test_a_peer_velocity_or_displacement_file_names_the_at2(tmp_path, suffix, what):
+    # A PEER .VT2 was read as a CSV: 'x.VT2:2: not a number: "Imperial Valley..."', nothing about the format.
+    f = tmp_path / f"RSN6_IMPVALL.I_I-ELC180{suffix}"
+    f.write_text(
+        "PEER NGA STRONG MOTION DATABASE RECORD\nImperial Valley, 5/19/1940, El Centro Array #9, 180\n"
+        "VELOCITY TIME SERIES IN UNITS OF CM/S\nNPTS=  3, DT=   .0100 SEC\n 0.1 0.2 0.3\n"
+    )
+    with pytest.raises(InputError) as exc:
+        record_motion(f)
+    assert one_line(exc) == (
+        f"{f}: a PEER {what} record; give the same component's acceleration record (.AT2, in g), "
+        "which masonry integrates, or a CSV of velocity"
+    )
+
+
 def test_a_utf16_record_is_named_as_such(tmp_path):
     # Excel's "Unicode Text" export is UTF-16 with a byte-order mark: "not a UTF-8 text file (byte 0)" left the
     # user to guess what byte 0 was.
