@@ -81,6 +81,21 @@ def check_material(label: str, **values) -> None:
             raise GeometryError(f"{label}: {key} {value:g} {unit} is absurd (a likely typo: {lo:g} to {hi:g} {unit})")
 
 
+DIMENSION_RANGE = (1e-3, 1e3)
+"""Sensible builder dimensions, m (block sizes, span, ring, pier, depths): outside, a likely typo or other
+units. ``--block-height 1e5`` built a 600 km wall and ``--block-length 1e-9`` a wall of 1 nm blocks, both run
+without a word (the area bounds of :mod:`geometry_library.checks` are per block and far looser)."""
+
+
+def check_dimensions(label: str, **values) -> None:
+    """:func:`check_positive`, then each value within ``DIMENSION_RANGE``."""
+    check_positive(label, **values)
+    lo, hi = DIMENSION_RANGE
+    for key, value in values.items():
+        if not lo <= value <= hi:
+            raise GeometryError(f"{label}: {key} {value:g} m is absurd (a likely typo: {lo:g} to {hi:g} m)")
+
+
 MAX_BLOCKS = 100_000
 """Most blocks a builder makes: more is a likely typo (``--blocks 100000000`` used to build for minutes
 and fill the memory before anything was said). The largest benchmark wall has 3996 blocks."""

@@ -21,6 +21,7 @@ from geometry_library import (
     validate_assembly,
     wall_layout,
 )
+from geometry_library.values import DIMENSION_RANGE, check_dimensions
 
 L, H = 0.30, 0.20
 # Default arch: span 3.6 m, ring 0.35 m, piers 0.90 m wide × 17 courses of 0.20 m.
@@ -159,6 +160,31 @@ def test_wall_errors_are_one_line(kwargs, match):
     with pytest.raises(GeometryError, match=match) as info:
         build_wall(**kwargs)
     assert "\n" not in str(info.value)
+
+
+@pytest.mark.parametrize(
+    "build, kwargs, match",
+    [
+        (
+            build_wall,
+            dict(block_length=1e-9),
+            r"wall: block_length 1e-09 m is absurd \(a likely typo: 0.001 to 1000 m\)",
+        ),
+        (build_wall, dict(block_height=1e5), "wall: block_height 100000 m is absurd"),
+        (build_wall, dict(ground_depth=1e4), "wall: ground_depth 10000 m is absurd"),
+        (build_arch, dict(span=1e-6), "arch: span 1e-06 m is absurd"),
+        (build_arch, dict(span=1e5), "arch: span 100000 m is absurd"),
+        (build_arch, dict(pier_course_height=1e-4), "arch: pier_course_height 0.0001 m is absurd"),
+        (build_aqueduct, dict(block_height=5e3), "aqueduct: block_height 5000 m is absurd"),
+    ],
+)
+def test_absurd_dimensions_are_refused(build, kwargs, match):
+    # Were built and run without a word: --block-height 1e5 a 600 km wall, --block-length 1e-9 blocks of 1 nm,
+    # --span 1e-6 an arch of 1 µm reported "intact".
+    with pytest.raises(GeometryError, match=match) as info:
+        build(**kwargs)
+    assert "\n" not in str(info.value)
+    check_dimensions("x", lo=DIMENSION_RANGE[0], hi=DIMENSION_RANGE[1])  # the bounds themselves are accepted
 
 
 @pytest.mark.parametrize(

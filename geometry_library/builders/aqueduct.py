@@ -27,7 +27,7 @@ from dataclasses import dataclass
 from shapely.geometry import Polygon
 
 from ..blocks import Assembly, GeometryError
-from ..values import check_block_total, check_count, check_positive
+from ..values import check_block_total, check_count, check_dimensions
 from ._common import make_block, name_width
 from .arch import ArchSpec, arch_parts
 from .spandrel import spandrel_blocks
@@ -61,7 +61,7 @@ class AqueductSpec(ArchSpec):
         Raises GeometryError (one line) for invalid parameters, or a wall top below the crown.
         """
         check_count("aqueduct", 1, wall_courses=self.wall_courses)
-        check_positive("aqueduct", block_length=self.block_length, block_height=self.block_height)
+        check_dimensions("aqueduct", block_length=self.block_length, block_height=self.block_height)
         blocks, supports, geom = arch_parts(self)
         top = geom.springing + self.wall_courses * self.block_height
         crown = geom.springing + geom.extrados_radius

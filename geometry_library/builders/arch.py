@@ -31,7 +31,7 @@ import numpy as np
 from shapely.geometry import box
 
 from ..blocks import SUPPORT_ROLES, Assembly, Block, GeometryError, Support
-from ..values import check_block_total, check_count, check_positive
+from ..values import check_block_total, check_count, check_dimensions, check_positive
 from ._common import make_block, make_support, name_width
 
 
@@ -119,14 +119,13 @@ def arch_parts(spec: ArchSpec) -> tuple[list[Block], list[Support], ArchGeometry
     check_count("arch", 2, voussoirs=voussoirs)
     check_count("arch", 1, pier_courses=pier_courses)
     check_block_total("arch", voussoirs + 4 * pier_courses, f"{voussoirs} voussoirs and {pier_courses} pier courses")
-    check_positive(
+    check_positive("arch", density=density, thickness=thickness)
+    check_dimensions(
         "arch",
         span=span,
         ring_thickness=ring_thickness,
         pier_width=pier_width,
         pier_course_height=pier_course_height,
-        density=density,
-        thickness=thickness,
         foundation_depth=foundation_depth,
     )
     if ring_thickness > pier_width:

@@ -33,7 +33,7 @@ from dataclasses import dataclass
 from shapely.geometry import box
 
 from ..blocks import Assembly, Block, GeometryError
-from ..values import check_block_total, check_positive, number_problem
+from ..values import check_block_total, check_dimensions, check_positive, number_problem
 from ._common import make_block, make_support, name_width
 
 
@@ -117,7 +117,7 @@ def wall_layout(
     ------
     GeometryError (one line) when the count cannot be made with the given constraints.
     """
-    check_positive("wall", block_length=block_length, block_height=block_height)
+    check_dimensions("wall", block_length=block_length, block_height=block_height)
     n_pinned = None
     if length is not None:
         check_positive("wall", length=length)
@@ -195,7 +195,8 @@ class WallSpec:
         ordered course by course, left to right; one support ``"ground"``."""
         block_height, density, thickness = self.block_height, self.density, self.thickness
         layout = wall_layout(self.blocks, self.courses, self.length, self.block_length, block_height)
-        check_positive("wall", density=density, thickness=thickness, ground_depth=self.ground_depth)
+        check_positive("wall", density=density, thickness=thickness)
+        check_dimensions("wall", ground_depth=self.ground_depth)
         if self.ground_margin < 0:
             raise GeometryError(f"wall: ground_margin must be ≥ 0, got {self.ground_margin!r}")
         x0 = -0.5 * layout.length
