@@ -34,7 +34,7 @@ import os
 from collections.abc import Callable
 from pathlib import Path
 
-from masonrycli.errors import NOT_A_FILE, InputError, special_file
+from masonrycli.errors import NOT_A_FILE, InputError, file_kind, special_file
 from masonrycli.motion import Constant, Record, Sine
 from masonrycli.records import record_motion
 from masonrycli.scenario import MAX_DURATION, Material, RunConfig, Scenario, scenario_from_builder
@@ -175,6 +175,9 @@ def target_scenario(target: str | os.PathLike, built_in: Callable[[str], Scenari
     except InputError as exc:
         if path.suffix.lower() == ".toml":
             raise
+        other = file_kind(path, "a scenario (TOML) or a geometry file (GeoJSON / WKT)")
+        if other is not None:
+            raise other from None
         # "notes.txt: TOML syntax error …" left a user who meant a geometry file guessing why TOML
         raise InputError(
             f"{exc} (read as a scenario TOML: a geometry file's name ends in {', '.join(GEOMETRY_SUFFIXES)})"

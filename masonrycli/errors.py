@@ -43,6 +43,40 @@ def special_file(path) -> bool:
     return not (stat.S_ISREG(mode) or stat.S_ISDIR(mode))
 
 
+FILE_KINDS = {  # suffix: (what a file of it is, what to do with it), for an input read as another kind
+    ".rrd": ("a Rerun recording (.rrd)", "masonry inspect summarises it"),
+    ".npz": ("a run history (.npz)", ""),
+    ".parquet": ("a sweep table (.parquet)", ""),
+    ".png": ("an image (.png)", ""),
+    ".xlsx": ("a spreadsheet (.xlsx)", "save the sheet as CSV"),
+    ".xls": ("a spreadsheet (.xls)", "save the sheet as CSV"),
+    ".ods": ("a spreadsheet (.ods)", "save the sheet as CSV"),
+    ".toml": ("a scenario file (TOML)", "masonry run runs it"),
+    ".geojson": ("a geometry file (GeoJSON)", "masonry run runs it"),
+    ".json": ("a geometry file (GeoJSON)", "masonry run runs it"),
+    ".wkt": ("a geometry file (WKT)", "masonry run runs it"),
+    ".csv": ("a CSV table", "a record goes in --record or a scenario's record motion"),
+    ".at2": ("an earthquake record (.AT2)", "a record goes in --record or a scenario's record motion"),
+}
+"""Reading a recording as a scenario said "not a UTF-8 text file (byte 31)", a GeoJSON as a record
+"wall.geojson:2: not a number": the input's name says what it is."""
+
+
+def file_kind(path, expected: str, skip: tuple[str, ...] = (), name: str | None = None) -> InputError | None:
+    """The error for an input whose suffix names another kind of file than the one ``expected`` (said in
+    the message: "a scenario"), or None (an unknown suffix, or one in ``skip``: the reader decides).
+    ``name``: the input as the messages name it (default: ``path``)."""
+    import os
+
+    suffix = os.path.splitext(os.fspath(path))[1].lower()
+    if suffix not in FILE_KINDS or suffix in skip:
+        return None
+    kind, hint = FILE_KINDS[suffix]
+    return InputError(
+        f"{os.fspath(path) if name is None else name}: {kind}, not {expected}{'; ' if hint else ''}{hint}"
+    )
+
+
 def not_utf8(name: str, raw: bytes, exc: UnicodeDecodeError) -> InputError:
     """The error for a text input that is not UTF-8: a UTF-16 file (Excel's "Unicode Text", Notepad's
     "Unicode") is named as such, where "not a UTF-8 text file (byte 0)" left the user to guess."""

@@ -20,7 +20,7 @@ import warnings
 
 import numpy as np
 
-from masonrycli.errors import NOT_A_FILE, InputError, RecordWarning, not_utf8, special_file
+from masonrycli.errors import NOT_A_FILE, InputError, RecordWarning, file_kind, not_utf8, special_file
 from masonrycli.motion import Record
 from masonrycli.record_text import at2_text, csv_text, number
 from masonrycli.record_units import check_at2_header, check_csv_header
@@ -146,7 +146,11 @@ def read_record(path, display: str | None = None) -> tuple[np.ndarray, np.ndarra
     """``(time (n,) s, value (n,) or (n, 2), quantity)`` of a record file: an .AT2 file gives its
     acceleration in m/s² and quantity ``"acceleration"``; a CSV file gives its columns as they are and
     quantity None (the caller says what the values are)."""
-    check_not_peer_other(path, display if display is not None else str(path))
+    name = display if display is not None else str(path)
+    check_not_peer_other(path, name)
+    other = file_kind(path, "a ground-motion record (a PEER .AT2 file or a CSV)", (".csv", ".at2"), name)
+    if other is not None and os.path.isfile(path):  # a missing one: the reader says so
+        raise other
     if is_at2(path):
         dt, acc = load_at2(path, display)
         return np.arange(acc.size) * dt, acc * G_STANDARD, "acceleration"

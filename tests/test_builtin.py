@@ -240,6 +240,38 @@ def test_build_assembly_is_the_builders_with_the_commands_defaults():
     assert build_assembly("wall", blocks=3, thickness=0.5).block_count == 3
 
 
+@pytest.mark.parametrize(
+    ("name", "content", "said"),
+    [
+        (
+            "wall.rrd",
+            b"RRF2\x00\x01",
+            "a Rerun recording (.rrd), not a scenario (TOML) or a geometry file (GeoJSON / WKT); masonry inspect summarises it",
+        ),
+        ("wall.npz", b"PK\x03\x04\x14", "a run history (.npz), not a scenario"),
+        (
+            "quake.csv",
+            b"time,v\n0,0\n0.1,1\n",
+            "a CSV table, not a scenario (TOML) or a geometry file (GeoJSON / WKT); a record goes in --record",
+        ),
+        (
+            "quake.AT2",
+            b"PEER\nx\nACCELERATION\nNPTS= 2, DT= .01 SEC\n0 1\n",
+            "an earthquake record (.AT2), not a scenario",
+        ),
+    ],
+)
+def test_another_of_masonrys_files_as_a_target_is_named(tmp_path, name, content, said):
+    # "wall.rrd: not a UTF-8 text file (byte 31) (read as a scenario TOML: …)" for a recording given to run / check /
+    # limit / sweep; a record CSV: "TOML syntax error: Expected '=' after a key …"
+    path = tmp_path / name
+    path.write_bytes(content)
+    with pytest.raises(InputError) as raised:
+        target_scenario(path)
+    assert str(raised.value).startswith(f"{path}: {said}")
+    assert "\n" not in str(raised.value)
+
+
 def test_a_file_not_named_toml_that_is_no_toml_says_how_it_was_read(tmp_path):
     # "notes.txt: TOML syntax error …" did not say why a WKT saved as .txt was read as TOML
     wkt = tmp_path / "wall.wkt.txt"

@@ -124,6 +124,32 @@ def test_a_peer_velocity_or_displacement_file_names_the_at2(tmp_path, suffix, wh
     )
 
 
+@pytest.mark.parametrize(
+    ("name", "said"),
+    [
+        (
+            "wall.geojson",
+            "a geometry file (GeoJSON), not a ground-motion record (a PEER .AT2 file or a CSV); masonry run runs it",
+        ),
+        (
+            "quake.xlsx",
+            "a spreadsheet (.xlsx), not a ground-motion record (a PEER .AT2 file or a CSV); save the sheet as CSV",
+        ),
+        ("run.rrd", "a Rerun recording (.rrd), not a ground-motion record"),
+        ("wall.toml", "a scenario file (TOML), not a ground-motion record"),
+    ],
+)
+def test_another_kind_of_file_as_a_record_is_named(tmp_path, name, said):
+    # A GeoJSON was read as a CSV: 'wall.geojson:2: not a number: "\"type\":"'; a workbook "not a UTF-8 text file".
+    f = tmp_path / name
+    f.write_text('{\n "type": "FeatureCollection"\n}\n')
+    with pytest.raises(InputError) as exc:
+        record_motion(f)
+    assert one_line(exc).startswith(f"{f}: {said}")
+    with pytest.raises(InputError, match="cannot read record: No such file"):  # a missing one: said so first
+        record_motion(tmp_path / f"missing-{name}")
+
+
 def test_a_utf16_record_is_named_as_such(tmp_path):
     # Excel's "Unicode Text" export is UTF-16 with a byte-order mark: "not a UTF-8 text file (byte 0)" left the
     # user to guess what byte 0 was.
