@@ -1,10 +1,11 @@
 """Reading big ground-motion records: CPU seconds of the readers and of ``simulate wall --record``.
 
 Writes records of ``--rows`` samples (default 3 million: 4 h at 200 Hz) in a temporary folder — CSV
-``time,velocity`` (2 columns), ``time,vx,vy`` (3), ``time;velocity`` with decimal commas, and a PEER
-.AT2 of 5 samples a line — then times ``load_record_csv`` / ``load_at2`` (CPU time, minimum of
-``--repeat``) and, with ``--command``, the whole ``masonry simulate wall --record FILE --duration 0.05
---no-recording`` in a fresh process (its CPU time, user + system, minimum of ``--repeat``).
+``time,velocity`` (2 columns), ``time,vx,vy`` (3), ``time;velocity`` with decimal commas, one velocity
+a line (read with a time step, ``--record-dt``), and a PEER .AT2 of 5 samples a line — then times
+``load_record_csv`` / ``load_at2`` (CPU time, minimum of ``--repeat``) and, with ``--command``, the
+whole ``masonry simulate wall --record FILE --duration 0.05 --no-recording`` in a fresh process
+(its CPU time, user + system, minimum of ``--repeat``).
 
     .venv/bin/python -m benchmarks.bench_records [--rows 3000000] [--repeat 3] [--command]
 """
@@ -24,10 +25,13 @@ import numpy as np
 
 from masonrycli.records import load_at2, load_record_csv
 
+TIME_STEP = 0.005
+"""s, the samples' spacing (the one-column file is read with it)."""
+
 
 def write_records(folder: str, rows: int) -> dict[str, str]:
-    """The four record files of ``rows`` samples (dt 5 ms, a 1.3 Hz burst on noise), by name."""
-    t = np.arange(rows) * 0.005
+    """The five record files of ``rows`` samples (dt 5 ms, a 1.3 Hz burst on noise), by name."""
+    t = np.arange(rows) * TIME_STEP
     rng = np.random.default_rng(0)
     a = 0.05 * np.sin(2 * np.pi * 1.3 * t) * np.exp(-(((t - t[-1] / 2) / (t[-1] / 4 + 1)) ** 2))
     a = a + 0.001 * rng.standard_normal(rows)
@@ -36,6 +40,7 @@ def write_records(folder: str, rows: int) -> dict[str, str]:
         "2 columns": ("r2.csv", "time,velocity\n", (f"{x},{y}" for x, y in zip(ts, vs))),
         "3 columns": ("r3.csv", "time,vx,vy\n", (f"{x},{y},{y}" for x, y in zip(ts, vs))),
         "decimal commas": ("eu.csv", "time;velocity\n", (f"{x};{y:.6f}".replace(".", ",") for x, y in zip(ts, a))),
+        "1 column": ("r1.csv", "velocity\n", iter(vs)),
         ".AT2": (
             "r.AT2",
             f"PEER NGA STRONG MOTION DATABASE RECORD\nSYNTHETIC\nACCELERATION TIME SERIES IN UNITS OF G\n"
@@ -57,7 +62,10 @@ def read_seconds(path: str, repeat: int) -> float:
         start = time.process_time()
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            load_at2(path) if path.endswith(".AT2") else load_record_csv(path)
+            if path.endswith(".AT2"):
+                load_at2(path)
+            else:
+                load_record_csv(path, time_step=TIME_STEP if path.endswith("r1.csv") else None)
         best = min(best, time.process_time() - start)
     return best
 
@@ -65,6 +73,8 @@ def read_seconds(path: str, repeat: int) -> float:
 def command_seconds(path: str, repeat: int) -> float:
     """CPU seconds (user + system) of the whole command, in a fresh process, minimum of ``repeat``."""
     args = [sys.executable, "-m", "masonrycli", "simulate", "wall", "--record", path, "--duration", "0.05"]
+    if path.endswith("r1.csv"):
+        args += ["--record-dt", str(TIME_STEP)]
     best = float("inf")
     for _ in range(repeat):
         before = resource.getrusage(resource.RUSAGE_CHILDREN)

@@ -35,7 +35,7 @@ from collections.abc import Callable
 from pathlib import Path
 
 from masonrycli.errors import NOT_A_FILE, InputError, file_kind, special_file
-from masonrycli.motion import Constant, Record, Sine
+from masonrycli.motion import Constant, Record, Sine, time_step_problem
 from masonrycli.records import record_motion
 from masonrycli.scenario import MAX_DURATION, Material, RunConfig, Scenario, scenario_from_builder
 
@@ -52,7 +52,7 @@ PAPER_INSTANT = {"wall": ("III.2–III.5", 0.1), "arch": ("III.7–III.10", 5.0)
 
 RUN_OVERRIDES = ("duration", "dt", "theta", "record_every", "tolerance", "max_iterations", "solver")
 MATERIAL_OVERRIDES = ("density", "thickness", "friction")
-LOADING_OVERRIDES = ("freq", "amp", "settlement", "record", "scale")
+LOADING_OVERRIDES = ("freq", "amp", "settlement", "record", "scale", "record_dt")
 
 
 def _given(values: dict, keys) -> dict:
@@ -108,20 +108,26 @@ def _sine(amp: float, freq: float) -> Sine:
     return sine
 
 
-def record_motion_option(path: Path, scale: float | None) -> Record:
-    """The ground motion of a ``--record`` file (.AT2 or CSV), multiplied by ``scale``."""
+def record_motion_option(path: Path, scale: float | None, record_dt: float | None = None) -> Record:
+    """The ground motion of a ``--record`` file (.AT2 or CSV), multiplied by ``scale``; ``record_dt``: the
+    spacing of a one-column CSV's samples, s."""
+    if record_dt is not None:
+        problem = time_step_problem(record_dt)
+        if problem:
+            raise InputError(f"--record-dt {record_dt:g}: {problem}")
     try:
-        return record_motion(path, scale=1.0 if scale is None else scale, display=str(path))
+        return record_motion(path, scale=1.0 if scale is None else scale, display=str(path), time_step=record_dt)
     except InputError as exc:
         msg = str(exc)
         raise InputError(msg if msg.startswith(str(path)) else f"--record {path}: {msg}") from None
 
 
-def with_record(scenario: Scenario, record: Path | None, scale: float | None) -> Scenario:
+def with_record(
+    scenario: Scenario, record: Path | None, scale: float | None, record_dt: float | None = None
+) -> Scenario:
     """``scenario`` with every shaking support (sine or record motion) driven by the ``record`` file."""
     if record is None:
-        if scale is not None:
-            raise InputError("--scale: goes with --record (it multiplies the record)")
+        _record_options_alone(scale, record_dt)
         return scenario
     shaking = [m.kind in ("sine", "record") for m in scenario.motions]
     if not any(shaking) and os.path.abspath(scenario.source or "") == scenario.structure.get("file"):
@@ -136,7 +142,7 @@ def with_record(scenario: Scenario, record: Path | None, scale: float | None) ->
         )
     if not any(shaking):
         raise InputError(f"--record: {scenario.name} has no shaking support (give one a sine or record motion)")
-    motion = record_motion_option(record, scale)
+    motion = record_motion_option(record, scale, record_dt)
     motions = tuple(motion if shake else m for shake, m in zip(shaking, scenario.motions))
     return dataclasses.replace(scenario, motions=motions)
 
@@ -204,16 +210,29 @@ def _target_problem(target: str) -> str:
     return ""
 
 
+def _record_options_alone(scale: float | None, record_dt: float | None) -> None:
+    """Refuse --scale and --record-dt given without --record."""
+    if scale is not None:
+        raise InputError("--scale: goes with --record (it multiplies the record)")
+    if record_dt is not None:
+        raise InputError("--record-dt: goes with --record (the time between the samples of a one-column file)")
+
+
 def file_scenario(
-    path: str | os.PathLike, *, record: Path | None = None, scale: float | None = None, **overrides
+    path: str | os.PathLike,
+    *,
+    record: Path | None = None,
+    scale: float | None = None,
+    record_dt: float | None = None,
+    **overrides,
 ) -> Scenario:
     """The scenario of a TOML, GeoJSON or WKT file (``masonry run`` / ``check``, :func:`target_scenario`:
     a built-in's name is told where it runs) driven by ``record`` times ``scale`` if given
     (:func:`with_record`), with the run settings and the friction of ``overrides`` (:func:`override_run`)."""
-    return override_run(with_record(target_scenario(path), record, scale), **overrides)
+    return override_run(with_record(target_scenario(path), record, scale, record_dt), **overrides)
 
 
-def _loading(name: str, amp, freq, settlement, record, scale) -> dict:
+def _loading(name: str, amp, freq, settlement, record, scale, record_dt=None) -> dict:
     """Support name -> motion of the built-in loading, with the loading overrides applied."""
     if record is not None:
         if amp is not None or freq is not None or settlement:
@@ -222,10 +241,9 @@ def _loading(name: str, amp, freq, settlement, record, scale) -> dict:
             why = "shakes both foundations instead" if given == "--settlement" else "replaces the sine"
             raise InputError(f"--record with {given}: choose one loading (the record {why})")
         shaken = ("ground",) if name == "wall" else ("left-foundation", "right-foundation")
-        motion = record_motion_option(record, scale)
+        motion = record_motion_option(record, scale, record_dt)
         return {support: motion for support in shaken}
-    if scale is not None:
-        raise InputError("--scale: goes with --record (it multiplies the record)")
+    _record_options_alone(scale, record_dt)
     loading_freq, freq = freq, SHAKE_FREQUENCY if freq is None else freq
     if name == "wall":
         if settlement:

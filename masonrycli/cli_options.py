@@ -65,6 +65,13 @@ RECORD = {
         "--record",
     ),
     "scale": _opt(float, "Loading", "Multiplies the --record (default 1).", "--scale"),
+    "record_dt": _opt(
+        float,
+        "Loading",
+        "Seconds between the samples of a --record CSV of one value per line (no time column); samples at "
+        "t = 0, dt, 2 dt, ...",
+        "--record-dt",
+    ),
 }
 RUN = {
     "duration": _opt(

@@ -19,33 +19,18 @@ Kinds
     velocity after ``until`` (an acceleration pulse; ``until = inf`` by default).
 :class:`Record` (``record``)
     A tabulated velocity or acceleration history (earthquake record). ``time`` (n,) s; ``value`` either
-    n numbers applied along d̂ (``direction``) or n (x, y) pairs. Values are multiplied by ``scale``.
-
-    * ``quantity = "velocity"``: the velocity is interpolated linearly between samples; before the first
-      sample it holds the first value, after the last sample it holds the last value.
-    * ``quantity = "acceleration"``: the acceleration is interpolated linearly between samples and
-      integrated exactly from v = 0 at the first sample. At the samples this *is* the cumulative
-      trapezoid rule; between samples the velocity follows the exact (quadratic) integral of the linear
-      acceleration rather than a chord, so that the velocity is the integral of the interpolated
-      acceleration everywhere. Before the first sample v = 0 (the ground is at rest); after the last
-      sample the acceleration is taken as zero, so the velocity holds its final integrated value.
-    * ``baseline = "quadratic"`` (the default for acceleration records): integrated records drift (noise
-      and rounding in the samples add up), so the integrated velocity v is corrected by the smallest
-      polynomial that brings the ground back to rest where it started. With s = (t − t₀)/T over the
-      record (length T), v_c(t) = v(t) − (c₁ s + c₂ s²) where c₁ + c₂ = v(T) (ends at rest) and
-      T (c₁/2 + c₂/3) = ∫v dt (ends where it started): c₂ = 3 v(T) − 6 D/T, c₁ = 6 D/T − 2 v(T),
-      D = ∫₀ᵀ v dt computed exactly for the piecewise-quadratic v. The acceleration changes by the
-      straight line (c₁ + 2 c₂ s)/T. For a record that already ends at rest where it started (a
-      processed PEER record) c₁ and c₂ are tiny and the correction is invisible. ``baseline = "none"``
-      integrates as is. The coefficients are in :attr:`Record.baseline_correction`.
-    * ``window = [a, b]``: only the samples with a <= t <= b are used, moved so that the first of them
-      is at t = 0.
+    n numbers applied along d̂ (``direction``) or n (x, y) pairs, kept as read-only float64 arrays (a
+    3-million-sample record as Python tuples cost 0.7 s of start-up). Values are multiplied by
+    ``scale``; ``quantity`` says whether they are velocities (interpolated linearly) or accelerations
+    (integrated exactly, ``baseline`` drift-corrected); ``window = [a, b]`` uses only the samples with
+    a <= t <= b, moved to start at t = 0. How: :mod:`masonrycli.record_velocity`.
 
 Units: m/s, m/s², s, Hz, rad.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 import math
 import os
@@ -55,6 +40,8 @@ from typing import ClassVar
 
 import numpy as np
 
+from geometry_library.values import number_problem
+from masonrycli.record_velocity import RecordArrays, record_arrays, record_velocity
 from masonrycli.values import check_real, check_samples, check_vector, field_error, format_value
 
 RECORD_QUANTITIES = ("velocity", "acceleration")
@@ -253,23 +240,44 @@ class Ramp(Motion):
         return kv
 
 
-@dataclass(frozen=True, kw_only=True)
-class Record(_Directed, Motion):
-    """A tabulated velocity or acceleration history (see the module docstring).
+MIN_TIME_STEP, MAX_TIME_STEP = 1e-6, 1.0
+"""s: the sample spacing a one-column record may be given (accelerographs sample at 50-1000 Hz): beyond 1 s
+a likely typo (10 for 10 ms stretched the record 1000-fold), below 1 µs no accelerogram."""
 
-    time : (n,) s, strictly increasing, n >= 2.
-    value : n floats (along ``direction``) or n (x, y) pairs, m/s or m/s² (before ``scale``).
+
+def time_step_problem(value) -> str | None:
+    """What is wrong with ``value`` as the time step of a one-column record (s), or None."""
+    problem = number_problem(value, gt=0.0)
+    if problem is None and not MIN_TIME_STEP <= float(value) <= MAX_TIME_STEP:
+        problem = (
+            f"must be within {MIN_TIME_STEP:g}–{MAX_TIME_STEP:g} s, likely a typo (accelerographs sample every "
+            "1–20 ms; 10 for 10 ms would stretch the record 1000-fold)"
+        )
+    return problem
+
+
+@dataclass(frozen=True, kw_only=True, eq=False)
+class Record(_Directed, Motion):
+    """A tabulated velocity or acceleration history (see :mod:`masonrycli.record_velocity`).
+
+    time : (n,) s, strictly increasing, n >= 2; kept as a read-only float64 array.
+    value : n floats (along ``direction``) or n (x, y) pairs, m/s or m/s² (before ``scale``); kept as a
+        read-only float64 array (n,) or (n, 2).
     direction : (dx, dy) axis of a 1-component record; normalised on use.
     quantity : "velocity" | "acceleration" — what ``value`` holds.
     scale : multiplies ``value``.
     window : (a, b) s, or None — the part of the record used, moved to start at t = 0.
-    baseline : "quadratic" | "none" — drift correction of acceleration records (module docstring).
+    baseline : "quadratic" | "none" — drift correction of acceleration records.
     source : where the record came from (absolute file path, or "" for inline data).
     vertical_source : file of the vertical component (then ``value`` holds (x, y) pairs), or "".
+    time_step : s, the spacing of a one-column file's samples (``time`` is then 0, time_step, 2 time_step,
+        …), or None: the samples came with their times.
+
+    Equal records have equal fields, the samples compared as arrays; the hash takes their ends only.
     """
 
-    time: tuple[float, ...] = ()
-    value: tuple = ()
+    time: np.ndarray = ()
+    value: np.ndarray = ()
     direction: tuple[float, float] = (1.0, 0.0)
     quantity: str = "velocity"
     scale: float = 1.0
@@ -277,12 +285,14 @@ class Record(_Directed, Motion):
     baseline: str = "quadratic"
     source: str = ""
     vertical_source: str = ""
+    time_step: float | None = None
 
     kind: ClassVar[str] = "record"
     TOML_KEYS: ClassVar[tuple[str, ...]] = (
         "kind",
         "file",
         "vertical",
+        "time_step",
         "time",
         "value",
         "quantity",
@@ -302,41 +312,68 @@ class Record(_Directed, Motion):
         for key in ("source", "vertical_source"):
             if not isinstance(getattr(self, key), str):
                 raise field_error(key, getattr(self, key), "must be a string")
+        if self.time_step is not None:
+            problem = time_step_problem(self.time_step)
+            if problem:
+                raise field_error("time_step", self.time_step, problem)
+            _put(self, "time_step", float(self.time_step))
         time, value = self.time, self.value
-        if isinstance(time, np.ndarray):
-            time = time.tolist()
-        if isinstance(value, np.ndarray):
-            value = value.tolist()
-        if not isinstance(time, (list, tuple)) or not isinstance(value, (list, tuple)):
+        if not all(isinstance(x, (list, tuple)) or (isinstance(x, np.ndarray) and x.ndim) for x in (time, value)):
             raise field_error("time", time, "time and value must be sequences")
         if len(time) < 2:
             raise field_error("time", time, f"a record needs at least 2 samples, got {len(time)}")
         if len(value) != len(time):
             raise field_error("value", value, f"has {len(value)} samples but time has {len(time)}")
         t = check_samples("time", time)
-        times = np.asarray(t, dtype=np.float64)
-        later = times[1:] > times[:-1]
+        later = t[1:] > t[:-1]
         if not later.all():
             i = int(np.argmin(later)) + 1
             raise field_error(f"time[{i}]", t[i], f"must be > the previous time {format_value(t[i - 1])}")
         # the first sample says which: [x, y] pairs, or numbers along the direction (judged from all of
         # them, [1.0, "b"] blamed value[0] = 1.0 for not being 2 numbers [x, y])
         v = check_samples("value", value, pairs=isinstance(value[0], (list, tuple, np.ndarray)))
+        if self.time_step is not None and not np.array_equal(t, np.arange(t.size) * self.time_step):
+            raise field_error("time_step", self.time_step, "the times are not 0, time_step, 2 time_step, ...")
         _put(self, "time", t)
         _put(self, "value", v)
         if self.window is not None:
             w = check_vector("window", self.window, names="[start, end]")
             if not w[1] > w[0]:
                 raise field_error("window", w, "must be [start, end] with end > start")
-            inside = int(np.count_nonzero((times >= w[0]) & (times <= w[1])))
+            inside = int(np.count_nonzero((t >= w[0]) & (t <= w[1])))
             if inside < 2:
                 raise field_error("window", w, f"holds {inside} samples of the record (at least 2 needed)")
             _put(self, "window", w)
 
+    def _settings(self) -> tuple:
+        return tuple(getattr(self, f.name) for f in dataclasses.fields(self) if f.name not in ("time", "value"))
+
+    def __eq__(self, other) -> bool:
+        if type(other) is not type(self):
+            return NotImplemented
+        return (
+            self._settings() == other._settings()
+            and np.array_equal(self.time, other.time)
+            and self.value.shape == other.value.shape
+            and np.array_equal(self.value, other.value)
+        )
+
+    def __hash__(self) -> int:
+        return hash((self._settings(), self.value.shape, float(self.time[0]), float(self.time[-1])))
+
+    def __getstate__(self) -> dict:
+        # pickled for a study's workers: without the cached _arrays (3 more arrays of the record's size)
+        return {k: v for k, v in self.__dict__.items() if k != "_arrays"}
+
+    def __setstate__(self, state: dict) -> None:
+        for key in ("time", "value"):
+            state[key].setflags(write=False)  # unpickled arrays are writeable
+        self.__dict__.update(state)
+
     @property
     def is_vector(self) -> bool:
         """True for (x, y) records, False for 1-component records applied along ``direction``."""
-        return bool(self.value) and isinstance(self.value[0], tuple)
+        return self.value.ndim == 2
 
     @property
     def corrected(self) -> bool:
@@ -344,62 +381,36 @@ class Record(_Directed, Motion):
         return self.quantity == "acceleration" and self.baseline == "quadratic"
 
     @functools.cached_property
-    def _arrays(self):
-        """Precomputed (time (n,), value (n,2) scaled, nodal velocity (n,2) uncorrected, baseline (2, 2)).
-
-        ``baseline`` rows are c₁ and c₂ (m/s, one column per axis), zero when not corrected.
-        """
-        time = np.asarray(self.time, dtype=np.float64)
-        value = np.asarray(self.value, dtype=np.float64)
-        if value.ndim == 1:
-            value = value[:, None] * self.unit_direction[None, :]
-        value = value * self.scale
-        if self.window is not None:
-            keep = (time >= self.window[0]) & (time <= self.window[1])
-            time, value = time[keep] - time[keep][0], value[keep]
-        baseline = np.zeros((2, 2))
-        if self.quantity == "acceleration":
-            # cumulative trapezoid from v = 0 at the first sample
-            h = np.diff(time)[:, None]
-            nodal_v = np.zeros_like(value)
-            nodal_v[1:] = np.cumsum(0.5 * h * (value[:-1] + value[1:]), axis=0)
-            if self.baseline == "quadratic":
-                # D = exact integral of the piecewise-quadratic velocity, interval by interval:
-                #   ∫₀ʰ (v_i + a_i τ + (a_{i+1} − a_i) τ²/(2h)) dτ = h v_i + h² a_i / 2 + h² (a_{i+1} − a_i) / 6
-                d = (h * nodal_v[:-1] + h * h * value[:-1] / 2.0 + h * h * (value[1:] - value[:-1]) / 6.0).sum(axis=0)
-                length, v_end = time[-1] - time[0], nodal_v[-1]
-                baseline[1] = 3.0 * v_end - 6.0 * d / length
-                baseline[0] = 6.0 * d / length - 2.0 * v_end
-        else:
-            nodal_v = value
-        for a in (time, value, nodal_v, baseline):
-            a.setflags(write=False)
-        return time, value, nodal_v, baseline
+    def _arrays(self) -> RecordArrays:
+        """The samples prepared for evaluation: direction, scale, window, integration, baseline."""
+        return record_arrays(
+            self.time, self.value, self.unit_direction, self.scale, self.window, self.quantity, self.baseline
+        )
 
     @property
     def start_time(self) -> float:
         """s on the run's clock: the first sample used (0 with a window; a CSV's own first time else)."""
-        return float(self._arrays[0][0])
+        return float(self._arrays.time[0])
 
     @property
     def end_time(self) -> float:
         """s on the run's clock: the last sample used (after the window's shift to t = 0); the record
         has shaken all it holds by then."""
-        return float(self._arrays[0][-1])
+        return float(self._arrays.time[-1])
 
     @property
     def sample_interval(self) -> float:
         """s: the shortest spacing of the samples used (a step longer than this skips samples)."""
-        return float(np.diff(self._arrays[0]).min())
+        return float(np.diff(self._arrays.time).min())
 
     @property
     def baseline_correction(self) -> dict:
         """What the baseline correction subtracted, for the run document: ``{"baseline": "quadratic",
-        "c1": [x, y], "c2": [x, y], "length": T}`` (m/s, s; see the module docstring), or
+        "c1": [x, y], "c2": [x, y], "length": T}`` (m/s, s; see :mod:`masonrycli.record_velocity`), or
         ``{"baseline": "none"}``."""
         if not self.corrected:
             return {"baseline": "none"}
-        time, _, _, baseline = self._arrays
+        time, baseline = self._arrays.time, self._arrays.baseline
         return {
             "baseline": "quadratic",
             "formula": "v_c(t) = v(t) - (c1 s + c2 s^2), s = t/T",
@@ -409,32 +420,13 @@ class Record(_Directed, Motion):
         }
 
     def velocity_at(self, t) -> np.ndarray:
-        t = _time_column(t)
-        out = np.zeros((t.shape[0], 2), dtype=np.float64)
-        time, value, nodal_v, baseline = self._arrays
-        if self.quantity == "velocity":
-            out[:, 0] = np.interp(t, time, value[:, 0])
-            out[:, 1] = np.interp(t, time, value[:, 1])
-        else:
-            # exact integral of the piecewise-linear acceleration:
-            #   i = interval holding t (clamped), tau = clip(t - t_i, 0, h_i)
-            #   v = v_i + a_i tau + (a_{i+1} - a_i) tau^2 / (2 h_i)
-            # tau clamps to 0 before the record (v = v_0 = 0) and to h_i after it (v = v_n).
-            i = np.clip(np.searchsorted(time, t, side="right") - 1, 0, time.shape[0] - 2)
-            h = (time[i + 1] - time[i])[:, None]
-            tau = np.clip(t - time[i], 0.0, h[:, 0])[:, None]
-            a0, a1 = value[i], value[i + 1]
-            out[:] = nodal_v[i] + a0 * tau + (a1 - a0) * (tau * tau) / (2.0 * h)
-            if self.corrected:
-                s = (np.clip(t, time[0], time[-1]) - time[0])[:, None] / (time[-1] - time[0])
-                out -= baseline[0] * s + baseline[1] * (s * s)
-        return out
+        return record_velocity(_time_column(t), self._arrays, self.quantity, self.corrected)
 
     def peak_speed(self, duration: float) -> float:
         # at the samples used and at the run's end: exact for a velocity record (linear between
         # samples); for an acceleration record the velocity between samples is quadratic and may
         # slightly exceed its samples' (enough to tell 1 m/s from a typo's 1e300)
-        time = self._arrays[0]
+        time = self._arrays.time
         t = np.append(time[time <= duration], duration)
         return float(np.hypot(*self.velocity_at(t).T).max())
 
@@ -444,10 +436,11 @@ class Record(_Directed, Motion):
         if self.vertical_source:
             src += f" + vertical {os.path.basename(self.vertical_source)}"
         scale = "" if self.scale == 1.0 else f" × {_g(self.scale)}"
+        every = "" if self.time_step is None else f" every {_g(self.time_step)} s"
         window = "" if self.window is None else f", window {_g(self.window[0])}–{_g(self.window[1])} s"
         corrected = ", baseline-corrected" if self.corrected else ""
         return (
-            f"record of {self.quantity} ({src}, {len(self.time)} samples, "
+            f"record of {self.quantity} ({src}, {len(self.time)} samples{every}, "
             f"{_g(self.time[0])}–{_g(self.time[-1])} s{window}{corrected}){scale}{axis}"
         )
 
@@ -457,9 +450,11 @@ class Record(_Directed, Motion):
             kv["file"] = self.source
             if self.vertical_source:
                 kv["vertical"] = self.vertical_source
+            if self.time_step is not None:
+                kv["time_step"] = self.time_step
         else:
-            kv["time"] = list(self.time)
-            kv["value"] = [list(v) if isinstance(v, tuple) else v for v in self.value]
+            kv["time"] = self.time.tolist()
+            kv["value"] = self.value.tolist()
         kv.update(quantity=self.quantity, scale=self.scale)
         if not self.is_vector:
             kv["direction"] = list(self.direction)

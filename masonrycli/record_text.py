@@ -43,12 +43,18 @@ _OTHER_BREAKS = "\r\v\f\x1c\x1d\x1e"
 
 class CsvState:
     """What the lines read so far say about the next: the column count (0 before the first sample),
-    whether the one header line was seen, the last sample's time (None before the first)."""
+    whether the one header line was seen, the last sample's time (None before the first, and in a
+    one-column file), whether the file is read as one value per line (a time step was given)."""
 
-    def __init__(self):
+    def __init__(self, one_column: bool = False):
         self.ncol = 0
         self.header_seen = False
         self.last_time: float | None = None
+        self.one_column = one_column
+
+
+NO_TIME_STEP = "give the time between samples: --record-dt SECONDS (a scenario's record table: time_step = SECONDS)"
+"""What a one-column file read without a time step is told to do (a file of one value per line has no times)."""
 
 
 def csv_lines(lines, first: int, name: str, state: CsvState) -> tuple[list, list]:
@@ -64,21 +70,22 @@ def csv_lines(lines, first: int, name: str, state: CsvState) -> tuple[list, list
         try:
             nums = [float(f) for f in fields]
         except ValueError:
-            if state.last_time is None and not state.header_seen:
+            if state.ncol == 0 and not state.header_seen:
                 state.header_seen = True
                 continue
             bad = next(f for f in fields if not _is_float(f))
             raise InputError(f"{name}:{lineno}: not a number: {shorten(bad, 40)}") from None
         if state.ncol == 0:
-            if len(nums) not in (2, 3):
-                raise InputError(
-                    f"{name}:{lineno}: expected 2 columns (time, value) or 3 (time, x, y), got {len(nums)}"
-                )
+            _first_columns(len(nums), f"{name}:{lineno}", state.one_column)
             state.ncol = len(nums)
         elif len(nums) != state.ncol:
-            raise InputError(f"{name}:{lineno}: expected {state.ncol} columns like the first sample, got {len(nums)}")
+            columns = "1 column" if state.ncol == 1 else f"{state.ncol} columns"
+            raise InputError(f"{name}:{lineno}: expected {columns} like the first sample, got {len(nums)}")
         if not all(math.isfinite(x) for x in nums):
             raise InputError(f"{name}:{lineno}: values must be finite, got {shorten(stripped, 40)}")
+        if state.ncol == 1:
+            values.append(nums[0])  # no time: the caller spaces the samples by the time step
+            continue
         if state.last_time is not None and not nums[0] > state.last_time:
             raise InputError(
                 f"{name}:{lineno}: time {format_value(nums[0])} is not after the previous sample's "
@@ -88,6 +95,20 @@ def csv_lines(lines, first: int, name: str, state: CsvState) -> tuple[list, list
         values.append(nums[1] if state.ncol == 2 else (nums[1], nums[2]))
         state.last_time = nums[0]
     return times, values
+
+
+def _first_columns(count: int, where: str, one_column: bool) -> None:
+    """Raise :class:`InputError` unless the first sample's ``count`` columns are a layout the file may have:
+    1 with a time step given, else 2 (time, value) or 3 (time, x, y)."""
+    if one_column and count != 1:
+        raise InputError(
+            f"{where}: {count} columns, but a time step was given: it is for a file of one value per line "
+            "(this one has a time column: leave out --record-dt / time_step)"
+        )
+    if not one_column and count == 1:
+        raise InputError(f"{where}: one value per line, no times: {NO_TIME_STEP}")
+    if not one_column and count not in (2, 3):
+        raise InputError(f"{where}: expected 2 columns (time, value) or 3 (time, x, y), got {count}")
 
 
 def _fields(line: str) -> list[str]:
@@ -104,14 +125,15 @@ def _fields(line: str) -> list[str]:
     return [f.replace(",", ".") if f.count(",") == 1 and "." not in f else f for f in fields]
 
 
-def csv_text(text: str, name: str) -> tuple[np.ndarray, np.ndarray]:
-    """``(time (n,), value (n,) or (n, 2))`` of a CSV record's text, chunk by chunk (module docstring)."""
-    state = CsvState()
+def csv_text(text: str, name: str, time_step: float | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """``(time (n,), value (n,) or (n, 2))`` of a CSV record's text, chunk by chunk (module docstring).
+    With ``time_step`` (s) the file holds one value per line, at t = 0, time_step, 2 time_step, ..."""
+    state = CsvState(one_column=time_step is not None)
     times: list[np.ndarray] = []
     values: list[np.ndarray] = []
 
     def keep(t, v):
-        if len(t):
+        if len(v):
             times.append(np.asarray(t, dtype=np.float64))
             values.append(np.asarray(v, dtype=np.float64))
 
@@ -125,8 +147,10 @@ def csv_text(text: str, name: str) -> tuple[np.ndarray, np.ndarray]:
         pos, lineno = end + 1, lineno + len(lines)
     for chunk in _chunks(text, pos):
         rows = _fast_csv_rows(chunk, state.ncol)
-        if rows is not None and _rows_hold(rows, state.last_time):
-            if len(rows):
+        if rows is not None and _rows_hold(rows, None if state.ncol == 1 else state.last_time):
+            if len(rows) and state.ncol == 1:
+                keep((), rows[:, 0])
+            elif len(rows):
                 keep(rows[:, 0], rows[:, 1] if state.ncol == 2 else rows[:, 1:])
                 state.last_time = float(rows[-1, 0])
             lineno += chunk.count("\n") + 1
@@ -134,18 +158,25 @@ def csv_text(text: str, name: str) -> tuple[np.ndarray, np.ndarray]:
             lines = (chunk + "\n").splitlines()
             keep(*csv_lines(lines, lineno, name, state))
             lineno += len(lines)
-    count = sum(t.size for t in times)
+    return _samples(times, values, name, time_step)
+
+
+def csv_reference(text: str, name: str, time_step: float | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`csv_text` read line by line only: the reference the chunked reading is tested against."""
+    times, values = csv_lines(text.splitlines(), 1, name, CsvState(one_column=time_step is not None))
+    return _samples([times], [values] if values else [], name, time_step)
+
+
+def _samples(times: list, values: list, name: str, time_step: float | None) -> tuple[np.ndarray, np.ndarray]:
+    """The record's ``(time, value)`` from its parts, at least 2 samples; a one-column file's times spaced
+    by ``time_step`` (as an .AT2 file's are by its DT)."""
+    count = sum(len(v) for v in values)
     if count < 2:
         raise InputError(f"{name}: a record needs at least 2 samples, found {count}")
-    return np.concatenate(times), np.concatenate(values)
-
-
-def csv_reference(text: str, name: str) -> tuple[np.ndarray, np.ndarray]:
-    """:func:`csv_text` read line by line only: the reference the chunked reading is tested against."""
-    times, values = csv_lines(text.splitlines(), 1, name, CsvState())
-    if len(times) < 2:
-        raise InputError(f"{name}: a record needs at least 2 samples, found {len(times)}")
-    return np.asarray(times, dtype=np.float64), np.asarray(values, dtype=np.float64)
+    value = np.concatenate([np.asarray(v, dtype=np.float64) for v in values])
+    if time_step is not None:
+        return np.arange(count) * time_step, value
+    return np.concatenate([np.asarray(t, dtype=np.float64) for t in times]), value
 
 
 def _fast_csv_rows(chunk: str, ncol: int) -> np.ndarray | None:
@@ -188,9 +219,12 @@ def _fast_csv_rows(chunk: str, ncol: int) -> np.ndarray | None:
 
 
 def _rows_hold(rows: np.ndarray, last_time: float | None) -> bool:
-    """True when ``rows`` pass :func:`csv_lines`'s checks: finite, times increasing from ``last_time``."""
+    """True when ``rows`` pass :func:`csv_lines`'s checks: finite, times increasing from ``last_time``
+    (one-column rows: finite only)."""
     if not len(rows):
         return True
+    if rows.shape[1] == 1:
+        return bool(np.isfinite(rows).all())
     t = rows[:, 0]
     return bool(np.isfinite(rows).all() and (last_time is None or t[0] > last_time) and (t[1:] > t[:-1]).all())
 

@@ -5,7 +5,8 @@ Two formats, chosen by the file's extension:
 * ``.AT2`` (PEER NGA): acceleration in g, one component per file, a 4-line header whose last line
   gives ``NPTS`` and ``DT`` (see :func:`load_at2`); samples at t = 0, DT, 2 DT, ...
 * ``.VT2`` / ``.DT2`` (PEER's velocity and displacement series) are refused, naming the .AT2;
-* anything else is CSV: one sample per line, ``time,value`` or ``time,x,y`` (see :func:`load_record_csv`).
+* anything else is CSV: one sample per line, ``time,value`` or ``time,x,y``, or one ``value`` per line
+  given a time step (samples at t = 0, dt, 2 dt, ...; see :func:`load_record_csv`).
 
 :func:`record_motion` makes the motion (scale, window, optional vertical component, baseline
 correction); :func:`record_fields` does the same for a scenario's ``motion = { kind = "record", ... }``.
@@ -21,17 +22,18 @@ import warnings
 import numpy as np
 
 from masonrycli.errors import NOT_A_FILE, InputError, RecordWarning, file_kind, not_utf8, special_file
-from masonrycli.motion import Record
+from masonrycli.motion import Record, time_step_problem
 from masonrycli.record_text import at2_text, csv_text, number
 from masonrycli.record_units import check_at2_header, check_csv_header
 from masonrycli.values import format_value, quote_string, shorten
 
 
-def load_record_csv(path, display: str | None = None) -> tuple[np.ndarray, np.ndarray]:
+def load_record_csv(path, display: str | None = None, time_step: float | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Read a tabulated motion record.
 
     Format: one sample per line, ``time,value`` (2 columns: a value along the motion's direction) or
-    ``time,x,y`` (3 columns: a vector). Separators: comma, semicolon or white space; on a line with
+    ``time,x,y`` (3 columns: a vector); with ``time_step`` (s), one ``value`` per line (1 column, no
+    times: the samples are at t = 0, time_step, 2 time_step, ...; a file with times is refused). Separators: comma, semicolon or white space; on a line with
     semicolons, commas are decimal commas (``0,01;0,5``). Blank lines and
     lines starting with ``#`` are skipped; a single non-numeric header line before the first sample is
     allowed. Times in s, strictly increasing, at least 2 samples; all values finite.
@@ -41,7 +43,7 @@ def load_record_csv(path, display: str | None = None) -> tuple[np.ndarray, np.nd
     ``display`` is the file name used in messages (default: ``path`` as given).
     """
     name = display if display is not None else str(path)
-    return csv_text(_read_text(path, name), name)
+    return csv_text(_read_text(path, name), name, time_step)
 
 
 def _read_text(path, name: str) -> str:
@@ -142,25 +144,26 @@ def check_not_peer_other(path, name: str) -> None:
         )
 
 
-def read_record(path, display: str | None = None) -> tuple[np.ndarray, np.ndarray, str | None]:
+def read_record(path, display: str | None = None, time_step: float | None = None) -> tuple:
     """``(time (n,) s, value (n,) or (n, 2), quantity)`` of a record file: an .AT2 file gives its
     acceleration in m/s² and quantity ``"acceleration"``; a CSV file gives its columns as they are and
-    quantity None (the caller says what the values are)."""
+    quantity None (the caller says what the values are). ``time_step``: the CSV holds one value per
+    line at that spacing (s); an .AT2 file has its own (its header's DT) and is refused with one."""
     name = display if display is not None else str(path)
     check_not_peer_other(path, name)
     other = file_kind(path, "a ground-motion record (a PEER .AT2 file or a CSV)", (".csv", ".at2"), name)
     if other is not None and os.path.isfile(path):  # a missing one: the reader says so
         raise other
     if is_at2(path):
+        if time_step is not None:
+            raise InputError(
+                f"{display or path}: an .AT2 file gives its own time step (DT in its header): --record-dt / "
+                "time_step goes with a CSV of one value per line"
+            )
         dt, acc = load_at2(path, display)
         return np.arange(acc.size) * dt, acc * G_STANDARD, "acceleration"
-    time, value = load_record_csv(path, display)
+    time, value = load_record_csv(path, display, time_step)
     return time, value, None
-
-
-def _pairs(value: np.ndarray) -> tuple:
-    # (x, y) tuples zipped from the columns: 2.3 s for 3 million rows through a list of lists, 1.0 s so
-    return tuple(value.tolist()) if value.ndim == 1 else tuple(zip(value[:, 0].tolist(), value[:, 1].tolist()))
 
 
 def combine_vertical(time, value, vtime, vvalue, name: str, vname: str) -> tuple[np.ndarray, np.ndarray]:
@@ -184,14 +187,17 @@ def record_motion(
     window=None,
     baseline: str = "quadratic",
     display: str | None = None,
+    time_step: float | None = None,
 ) -> Record:
     """A :class:`~masonrycli.motion.Record` from a record file (.AT2 or CSV, see :func:`read_record`).
 
     ``quantity`` defaults to "acceleration" for .AT2 files (the only one they hold) and "velocity" for
     CSV. ``vertical`` is the file of the vertical component (the record then acts along x and y and
-    ``direction`` is not used). ``source`` is the absolute path of the file.
+    ``direction`` is not used). ``source`` is the absolute path of the file. ``time_step`` (s): the
+    files hold one value per line at that spacing (checked before they are read).
     """
-    time, value, native = read_record(path, display)
+    time_step = _time_step(time_step, "time_step")
+    time, value, native = read_record(path, display, time_step)
     if native is not None and quantity not in (None, native):
         raise InputError(f"{display or path}: an .AT2 file holds acceleration, not {quantity}")
     quantity = quantity or native or "velocity"
@@ -199,7 +205,7 @@ def record_motion(
         check_csv_header(path, display or str(path), quantity, scale)
     vertical_source = ""
     if vertical is not None:
-        vtime, vvalue, vnative = read_record(vertical)
+        vtime, vvalue, vnative = read_record(vertical, time_step=time_step)
         if vnative is None:
             check_csv_header(vertical, str(vertical), quantity, scale)
         if vnative != native:
@@ -208,15 +214,26 @@ def record_motion(
         vertical_source = os.path.abspath(os.fspath(vertical))
     return Record(
         direction=tuple(direction),
-        time=tuple(time.tolist()),
-        value=_pairs(value),
+        time=time,
+        value=value,
         quantity=quantity,
         scale=scale,
         window=window,
         baseline=baseline,
         source=os.path.abspath(os.fspath(path)),
         vertical_source=vertical_source,
+        time_step=time_step,
     )
+
+
+def _time_step(value, key: str) -> float | None:
+    """``value`` checked as a record's time step (None: not given); ``key`` names it in the message."""
+    if value is None:
+        return None
+    problem = time_step_problem(value)
+    if problem:
+        raise InputError(f"{key} = {format_value(value)[:40]}: {problem}")
+    return float(value)
 
 
 def record_fields(table: dict, base_dir: str) -> dict:
@@ -231,11 +248,14 @@ def record_fields(table: dict, base_dir: str) -> dict:
         raise InputError("motion.file: give either file or inline time and value, not both")
     if "vertical" in table and not has_file:
         raise InputError("motion.vertical: goes with file (the horizontal component's file)")
+    if "time_step" in table and not has_file:
+        raise InputError("motion.time_step: goes with file, a CSV of one value per line (inline samples give time)")
     if has_file:
-        time, value, native, source = _table_file(table, "file", base_dir)
-        out = {"source": source}
+        time_step = _time_step(table.get("time_step"), "motion.time_step")
+        time, value, native, source = _table_file(table, "file", base_dir, time_step)
+        out = {"source": source, "time_step": time_step}
         if "vertical" in table:
-            vtime, vvalue, vnative, vsource = _table_file(table, "vertical", base_dir)
+            vtime, vvalue, vnative, vsource = _table_file(table, "vertical", base_dir, time_step)
             if vnative != native:
                 raise InputError(f"motion.vertical: must be in the same format as {table['file']}")
             try:
@@ -251,7 +271,7 @@ def record_fields(table: dict, base_dir: str) -> dict:
             if table.get("quantity", native) != native:
                 raise InputError(f"motion.quantity: {table['file']} holds {native}")
             out["quantity"] = native
-        return out | {"time": tuple(time.tolist()), "value": _pairs(value)}
+        return out | {"time": time, "value": value}
     for key in ("time", "value"):
         if key not in table:
             raise InputError(f'motion.{key}: missing (kind "record" needs file, or time and value)')
@@ -263,7 +283,7 @@ def record_fields(table: dict, base_dir: str) -> dict:
     return {"time": table["time"], "value": value}
 
 
-def _table_file(table: dict, key: str, base_dir: str):
+def _table_file(table: dict, key: str, base_dir: str, time_step: float | None):
     file = table[key]
     if not isinstance(file, str) or not file:
         raise InputError(f"motion.{key} = {format_value(file)[:40]}: must be a file name")
@@ -274,7 +294,7 @@ def _table_file(table: dict, key: str, base_dir: str):
         )
         raise InputError(f"motion.{key} = {quote_string(file)}: {missing} (looked for {resolved})")
     try:
-        time, value, native = read_record(resolved, display=file)
+        time, value, native = read_record(resolved, display=file, time_step=time_step)
         if native is None:
             check_csv_header(resolved, file, table.get("quantity", "velocity"), table.get("scale", 1.0))
     except InputError as exc:

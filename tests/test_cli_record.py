@@ -173,3 +173,78 @@ def test_an_at2_file_with_samples_beyond_npts_says_so_once(tmp_path):
     line = f"warning: {at2}: header says NPTS = 4 but the file holds 6 samples; the 2 after the first 4 are ignored"
     assert said == [line], result.output
     assert "4 samples" in " ".join(result.output.split())  # still read as 4: the behaviour is kept
+
+
+@pytest.fixture
+def one_column(tmp_path):
+    """A velocity record of one value per line (a header, no times) and the same record with times i·dt."""
+    v = band_limited(0.3, 0.01, [3.0, 5.0], [0.002, 0.001], seed=4)[2].tolist()
+    (tmp_path / "one.csv").write_text("ground velocity\n" + "".join(f"{x!r}\n" for x in v))
+    (tmp_path / "two.csv").write_text("".join(f"{i * 0.01!r},{x!r}\n" for i, x in enumerate(v)))
+    return tmp_path / "one.csv", tmp_path / "two.csv"
+
+
+def test_record_dt_reads_a_one_column_record_on_simulate_run_and_check(one_column, tmp_path):
+    one, two = one_column
+    npz = tmp_path / "h.npz"
+    result = invoke(
+        "simulate", "wall", "--blocks", 12, "--record", one, "--record-dt", 0.01, "--scale", 0.5,
+        "--duration", 0.3, "--record-every", 1, "--no-recording", "--history", npz,
+    )  # fmt: skip
+    assert result.exit_code == 0, result.output
+    h = np.load(npz)
+    np.testing.assert_array_equal(h["support_v"][:, 0, :], record_motion(two, scale=0.5).velocity_at(h["time"]))
+    result = invoke(
+        "run", DATA / "quake_record.toml", "--record", one, "--record-dt", 0.01, "--no-recording", "--history", npz,
+        "--force",
+    )  # fmt: skip
+    assert result.exit_code == 0, result.output
+    h = np.load(npz)
+    np.testing.assert_array_equal(h["support_v"][:, 0, :], record_motion(two).velocity_at(h["time"]))
+    result = invoke("check", DATA / "quake_record.toml", "--record", one, "--record-dt", 0.01)
+    assert result.exit_code == 0, result.output
+    said = " ".join(result.output.replace("│", " ").split())  # the table's cell, wrapped over two lines
+    assert "ground: record of velocity (one.csv, 31 samples every 0.01 s, 0–0.3 s) along (1, 0)" in said, said
+
+
+@pytest.mark.parametrize(
+    "args, line",
+    [
+        (
+            ["--record", "ONE"],
+            "error: ONE:2: one value per line, no times: give the time between samples: --record-dt SECONDS (a "
+            "scenario's record table: time_step = SECONDS)",
+        ),
+        (
+            ["--record", "TWO", "--record-dt", 0.01],
+            "error: TWO:1: 2 columns, but a time step was given: it is for a file of one value per line (this one "
+            "has a time column: leave out --record-dt / time_step)",
+        ),
+        (
+            ["--record", "AT2", "--record-dt", 0.01],
+            "error: AT2: an .AT2 file gives its own time step (DT in its header): --record-dt / time_step goes "
+            "with a CSV of one value per line",
+        ),
+        (
+            ["--record-dt", 0.01],
+            "error: --record-dt: goes with --record (the time between the samples of a one-column file)",
+        ),
+        (["--record", "ONE", "--record-dt", 0], "error: --record-dt 0: must be > 0"),
+        (["--record", "ONE", "--record-dt", -0.01], "error: --record-dt -0.01: must be > 0"),
+        (["--record", "ONE", "--record-dt", "nan"], "error: --record-dt nan: must be a finite number"),
+        (["--record", "ONE", "--record-dt", "inf"], "error: --record-dt inf: must be a finite number"),
+        (
+            ["--record", "ONE", "--record-dt", 10],
+            "error: --record-dt 10: must be within 1e-06–1 s, likely a typo (accelerographs sample every 1–20 ms; "
+            "10 for 10 ms would stretch the record 1000-fold)",
+        ),
+    ],
+)
+@pytest.mark.parametrize("command", [["simulate", "wall"], ["run", DATA / "quake_record.toml"]])
+def test_record_dt_errors_are_one_line(one_column, at2, command, args, line):
+    files = {"ONE": one_column[0], "TWO": one_column[1], "AT2": at2}
+    result = invoke(*command, *[files.get(a, a) if isinstance(a, str) else a for a in args], "--no-recording")
+    assert result.exit_code == 2, result.output
+    for name, path in files.items():
+        line = line.replace(f"error: {name}", f"error: {path}")
+    assert result.output.strip() == line and "Traceback" not in result.output

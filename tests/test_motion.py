@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+import dataclasses
 import math
+import pickle
 from pathlib import Path
 
 import numpy as np
@@ -251,9 +253,9 @@ def test_a_record_of_floats_is_checked_at_once_with_the_same_messages():
     v = [math.sin(x) for x in t]
     fast = Record(time=tuple(t), value=tuple(v), window=(1.0, 2.0))
     slow = Record(time=(0, *t[1:]), value=(0, *v[1:]), window=(1, 2))
-    assert fast == slow and type(fast.time[0]) is float and fast._arrays[0].size == 101
+    assert fast == slow and fast.time.dtype == np.float64 and fast._arrays[0].size == 101
     pairs = Record(time=tuple(t), value=tuple(zip(v, v)))
-    assert pairs.value == tuple((float(x), float(x)) for x in v) and pairs.is_vector
+    assert pairs.value.tolist() == [[float(x), float(x)] for x in v] and pairs.is_vector
     for k, bad, message in [
         (70_000, "time", "time[70000] = 699.99: must be > the previous time 699.99"),
         (90_000, "nan", "time[90000] = nan: must be a finite number"),
@@ -272,3 +274,47 @@ def test_a_record_of_floats_is_checked_at_once_with_the_same_messages():
         with pytest.raises(InputError) as exc:
             Record(time=tuple(tt), value=tuple(vv))
         assert message in one_line(exc)
+
+
+def test_a_record_holds_read_only_float64_arrays():
+    # a 3-million-sample record built Python tuples of its samples: 0.7 s before the run began
+    t, v = np.arange(5) * 0.1, np.array([0.0, 1.0, -1.0, 0.5, 0.0])
+    m = Record(time=t, value=v)
+    assert m.time.dtype == m.value.dtype == np.float64 and m.time.shape == m.value.shape == (5,)
+    assert not m.time.flags.writeable and not m.value.flags.writeable
+    t[1] = 99.0  # the caller's arrays were copied: the record does not change with them
+    assert m.time[1] == 0.1 and t.flags.writeable
+    with pytest.raises(ValueError):
+        m.value[0] = 1.0
+    again = dataclasses.replace(m, scale=2.0)  # a study's scale axis: the samples are shared, not copied
+    assert again.time is m.time and again.value is m.value
+    pairs = Record(time=[0, 1, 2], value=np.array([[1, 2], [3, 4], [5, 6]], dtype=np.float32))
+    assert pairs.is_vector and pairs.value.dtype == np.float64 and pairs.value.tolist() == [[1, 2], [3, 4], [5, 6]]
+
+
+def test_records_compare_hash_and_pickle_by_their_samples():
+    m = Record(time=(0.0, 0.1, 0.2), value=(1.0, 2.0, 3.0), quantity="acceleration", window=(0.0, 0.15))
+    same = Record(time=[0, 0.1, 0.2], value=np.array([1, 2, 3]), quantity="acceleration", window=(0, 0.15))
+    assert m == same and hash(m) == hash(same) and len({m, same}) == 1
+    assert m != dataclasses.replace(m, value=(1.0, 2.0, 3.5))
+    assert m != dataclasses.replace(m, time=(0.0, 0.1, 0.25))
+    assert m != dataclasses.replace(m, baseline="none")
+    assert m != Record(time=(0.0, 0.1, 0.2), value=((1.0, 1.0), (2.0, 2.0), (3.0, 3.0)), quantity="acceleration")
+    assert m != Sine(amplitude=1.0, frequency=1.0) and m != "record"
+    m.velocity_at([0.05])  # fills the cache of prepared arrays, which a pickle leaves out (it is rebuilt)
+    back = pickle.loads(pickle.dumps(m))
+    assert back == m and "_arrays" not in back.__dict__ and len(pickle.dumps(m)) < 1000
+    assert not back.time.flags.writeable and not back.value.flags.writeable
+    assert back.velocity_at([0.05, 0.3]).tobytes() == m.velocity_at([0.05, 0.3]).tobytes()
+
+
+def test_a_record_time_step_spaces_its_times():
+    m = Record(time=np.arange(4) * 0.02, value=(0.0, 1.0, 0.0, -1.0), time_step=0.02)
+    assert m.time_step == 0.02 and "4 samples every 0.02 s, 0–0.06 s" in m.describe()
+    with pytest.raises(InputError) as exc:
+        Record(time=(0.0, 0.02, 0.05), value=(0.0, 1.0, 0.0), time_step=0.02)
+    assert one_line(exc) == "time_step = 0.02: the times are not 0, time_step, 2 time_step, ..."
+    for bad, problem in [(0, "must be > 0"), (math.nan, "must be a finite number"), (2.0, "must be within 1e-06–1 s")]:
+        with pytest.raises(InputError) as exc:
+            Record(time=(0.0, 1.0), value=(0.0, 1.0), time_step=bad)
+        assert problem in one_line(exc)

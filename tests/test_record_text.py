@@ -168,6 +168,77 @@ def test_a_big_file_is_read_by_numpy(tmp_path, monkeypatch):
     assert read == [["time,velocity"], ["0,0.5"]]  # the header, and the first sample: its column count
 
 
+# -------------------------------------------------------------------------------------------- one column
+
+# one value per line (a time step given): the layouts a one-column file may come in
+ONE_COLUMN = {
+    "plain": ("", ["{v}\n"]),
+    "header": ("acceleration\n", ["{v}\n"]),
+    "comment, spaces": ("# station 12\nvalue\n", ["  {v}  \n"]),
+    "windows line ends": ("v\r\n", ["{v}\r\n"]),
+    "blank lines": ("", ["{v}\n", "\n"]),
+    "form feeds": ("v\x0c", ["{v}\x0c\n"]),
+}
+
+
+def one_column_text(layout: str, n: int = 60, seed: int = 0) -> str:
+    head, lines = ONE_COLUMN[layout]
+    rng = random.Random(seed)
+    styles = [repr, lambda x: f"{x:.17g}", lambda x: f"{x:.3e}", lambda x: f"{x:.6f}"]
+    values = [rng.choice(styles)(rng.uniform(-5, 5) * 10 ** rng.randint(-12, 3)) for _ in range(n)]
+    return head + "".join(lines[i % len(lines)].format(v=v) for i, v in enumerate(values))
+
+
+@pytest.mark.parametrize("layout", ONE_COLUMN)
+@pytest.mark.parametrize("chunk", [1, 37, rt.CHUNK_CHARS])
+def test_one_column_reads_bit_for_bit_as_line_by_line(monkeypatch, layout, chunk):
+    monkeypatch.setattr(rt, "CHUNK_CHARS", chunk)
+    for seed in range(3):
+        text = one_column_text(layout, seed=seed)
+        ref = rt.csv_reference(text, "a.csv", time_step=0.01)
+        got = rt.csv_text(text, "a.csv", time_step=0.01)
+        assert same(got, ref) and got[1].ndim == 1, layout
+        # the values are the lines' numbers, in order; the times 0, dt, 2 dt, ... (as an .AT2 file's)
+        lines = [line for line in text.splitlines() if not line.startswith("#")]
+        numbers = [float(x) for line in lines for x in line.split() if x[0] in "-0123456789"]
+        assert got[1].tolist() == numbers and got[0].tolist() == [i * 0.01 for i in range(len(numbers))]
+    body = one_column_text("plain")
+    assert rt._fast_csv_rows(body, 1) is not None  # else the test compared the per-line reading with itself
+
+
+ONE_COLUMN_ERRORS = [
+    ("0.1\n0.2\nabc\n", 'a.csv:3: not a number: "abc"'),
+    ("v\n0.1\n0.2\n0.3,0.4\n", "a.csv:4: expected 1 column like the first sample, got 2"),
+    ("0.1\nnan\n", 'a.csv:2: values must be finite, got "nan"'),
+    ("v\n0.5\n", "a.csv: a record needs at least 2 samples, found 1"),
+    ("t,v\n0,0.5\n0.01,0.6\n", "a.csv:2: 2 columns, but a time step was given: it is for a file of one value"),
+    ("0 1 2\n", "a.csv:1: 3 columns, but a time step was given"),
+]
+
+
+@pytest.mark.parametrize("text, message", ONE_COLUMN_ERRORS)
+@pytest.mark.parametrize("chunk", [1, 5, rt.CHUNK_CHARS])
+def test_one_column_errors_are_those_of_the_line_by_line_reading(monkeypatch, text, message, chunk):
+    monkeypatch.setattr(rt, "CHUNK_CHARS", chunk)
+    with pytest.raises(InputError) as ref:
+        rt.csv_reference(text, "a.csv", time_step=0.01)
+    with pytest.raises(InputError) as got:
+        rt.csv_text(text, "a.csv", time_step=0.01)
+    assert str(got.value) == str(ref.value) and str(got.value).startswith(message)
+
+
+@pytest.mark.parametrize("chunk", [1, rt.CHUNK_CHARS])
+def test_one_column_without_a_time_step_says_to_give_one(monkeypatch, chunk):
+    monkeypatch.setattr(rt, "CHUNK_CHARS", chunk)
+    for text, line in [("0.1\n0.2\n", 1), ("acc\n\n0.1\n0.2\n", 3)]:
+        with pytest.raises(InputError) as got:
+            rt.csv_text(text, "a.csv")
+        assert str(got.value) == (
+            f"a.csv:{line}: one value per line, no times: give the time between samples: --record-dt SECONDS "
+            "(a scenario's record table: time_step = SECONDS)"
+        )
+
+
 # --------------------------------------------------------------------------------------------------- .AT2
 
 

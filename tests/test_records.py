@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 from pathlib import Path
 
 import numpy as np
@@ -237,7 +238,7 @@ def test_at2_reader_formats_and_units(tmp_path):
     assert dt == 0.02 and acc.tolist() == [0.1, 0.2, 0.3]
     with pytest.warns(RecordWarning):
         m = record_motion(tmp_path / "b.AT2", scale=0.5, baseline="none")
-    assert m.time == (0.0, 0.02, 0.04)
+    assert m.time.tolist() == [0.0, 0.02, 0.04]
     np.testing.assert_allclose(m.value, [0.1 * G_STANDARD, 0.2 * G_STANDARD, 0.3 * G_STANDARD], rtol=1e-15)
     # velocity at the 2nd sample: scale · trapezoid = 0.5 · 0.02 · (0.1 + 0.2) g / 2
     assert m.velocity_at([0.02])[0, 0] == pytest.approx(0.5 * 0.02 * 0.15 * G_STANDARD, rel=1e-12)
@@ -356,4 +357,130 @@ def test_csv_header_units_reach_record_motion_and_scenario_files(tmp_path):
     assert record_motion(f, scale=0.01).velocity_at([0.1])[0, 0] == pytest.approx(0.05)
     with pytest.raises(InputError, match=r"^motion.file: q.csv:1: the header gives velocity in cm/s"):
         record_fields({"file": "q.csv"}, str(tmp_path))
-    assert record_fields({"file": "q.csv", "scale": 0.01}, str(tmp_path))["time"] == (0.0, 0.1)
+    assert record_fields({"file": "q.csv", "scale": 0.01}, str(tmp_path))["time"].tolist() == [0.0, 0.1]
+
+
+# ------------------------------------------------------------------------------------ one value per line
+
+
+def one_and_two_columns(folder: Path, values, dt: float, name: str = "a") -> tuple[Path, Path]:
+    """A one-column file of ``values`` (with a header) and the 2-column file the user means by it: the
+    same values at times i·dt, written out here (Python's own i * dt), not by the reader."""
+    one, two = folder / f"{name}1.csv", folder / f"{name}2.csv"
+    one.write_text("samples\n" + "".join(f"{v!r}\n" for v in values))
+    two.write_text("time,samples\n" + "".join(f"{i * dt!r},{v!r}\n" for i, v in enumerate(values)))
+    return one, two
+
+
+def same_samples(a, b) -> None:
+    for x, y in [(a.time, b.time), (a.value, b.value), *zip(a._arrays, b._arrays)]:
+        assert x.dtype == y.dtype and x.shape == y.shape and x.tobytes() == y.tobytes()
+
+
+ONE_COLUMN_SETTINGS = [
+    dict(quantity="acceleration"),
+    dict(quantity="acceleration", scale=0.5, window=(0.3, 1.2), baseline="none", direction=(3.0, 4.0)),
+    dict(quantity="velocity", scale=2.0, window=(0.05, 0.5)),
+]
+
+
+@pytest.mark.parametrize("settings", ONE_COLUMN_SETTINGS)
+def test_a_one_column_file_is_its_two_column_file_with_times_i_dt(tmp_path, settings):
+    t, u, v, a = band_limited(1.5, 0.005, [1.5, 3.0], [0.01, 0.004], seed=2)
+    one, two = one_and_two_columns(tmp_path, a.tolist(), 0.005)
+    got = record_motion(one, time_step=0.005, **settings)
+    ref = record_motion(two, **settings)
+    same_samples(got, ref)
+    assert got.time_step == 0.005 and ref.time_step is None and got.quantity == settings["quantity"]
+    probe = np.linspace(-0.1, 2.0, 777)
+    assert got.velocity_at(probe).tobytes() == ref.velocity_at(probe).tobytes()
+    assert got.baseline_correction == ref.baseline_correction
+    # the same record but for where it came from and how its times were given
+    assert got == dataclasses.replace(ref, source=str(one), time_step=0.005)
+
+
+def test_one_column_files_with_a_vertical_component(tmp_path):
+    rng = np.random.default_rng(5)
+    h, v = rng.normal(size=50).tolist(), rng.normal(size=40).tolist()
+    h1, h2 = one_and_two_columns(tmp_path, h, 0.01, "h")
+    v1, v2 = one_and_two_columns(tmp_path, v, 0.01, "v")
+    got = record_motion(h1, vertical=v1, time_step=0.01, quantity="acceleration", window=(0.05, 0.3))
+    ref = record_motion(h2, vertical=v2, quantity="acceleration", window=(0.05, 0.3))
+    same_samples(got, ref)
+    assert got.is_vector and got.time.size == 40  # the shorter component sets the length
+
+
+def test_a_one_column_file_in_a_scenario_reads_and_writes_back(tmp_path):
+    from masonrycli.scenario_toml import dump_scenario, loads_scenario
+
+    values = np.random.default_rng(6).normal(scale=0.1, size=300).tolist()
+    one, two = one_and_two_columns(tmp_path, values, 0.01, "q")
+    motion = '{ kind = "record", file = "FILE", TIME_STEP quantity = "acceleration", scale = 2.0, window = [0.5, 2.5] }'
+    got = loads_scenario(
+        SCENARIO.replace("MOTION", motion.replace("FILE", one.name).replace("TIME_STEP", "time_step = 0.01,")),
+        base_dir=tmp_path,
+    )
+    ref = loads_scenario(
+        SCENARIO.replace("MOTION", motion.replace("FILE", two.name).replace("TIME_STEP", "")), base_dir=tmp_path
+    )
+    same_samples(got.motions[0], ref.motions[0])
+    assert got.motions[0] == record_motion(one, time_step=0.01, quantity="acceleration", scale=2.0, window=(0.5, 2.5))
+    text = dump_scenario(got)
+    assert "time_step = 0.01" in text
+    assert loads_scenario(text, base_dir="/").motions == got.motions
+    inline = loads_scenario(dump_scenario(got, inline_records=True)).motions[0]  # times written, no time_step
+    assert inline.time_step is None
+    same_samples(inline, ref.motions[0])
+
+
+@pytest.mark.parametrize(
+    "motion, expected",
+    [
+        (
+            '{ kind = "record", file = "one.csv" }',
+            "motion.file: one.csv:1: one value per line, no times: give the time between samples: --record-dt "
+            "SECONDS (a scenario's record table: time_step = SECONDS)",
+        ),
+        (
+            '{ kind = "record", file = "two.csv", time_step = 0.01 }',
+            "motion.file: two.csv:1: 2 columns, but a time step was given: it is for a file of one value per line "
+            "(this one has a time column: leave out --record-dt / time_step)",
+        ),
+        (
+            '{ kind = "record", file = "three.csv", time_step = 0.01 }',
+            "motion.file: three.csv:2: 3 columns, but a time step was given",
+        ),
+        (
+            '{ kind = "record", file = "h.AT2", time_step = 0.01 }',
+            "motion.file: h.AT2: an .AT2 file gives its own time step (DT in its header): --record-dt / time_step "
+            "goes with a CSV of one value per line",
+        ),
+        (
+            '{ kind = "record", time = [0.0, 1.0], value = [1.0, 2.0], time_step = 1.0 }',
+            "motion.time_step: goes with file, a CSV of one value per line (inline samples give time)",
+        ),
+        ('{ kind = "record", file = "one.csv", time_step = 0.0 }', "motion.time_step = 0.0: must be > 0"),
+        ('{ kind = "record", file = "one.csv", time_step = -0.01 }', "motion.time_step = -0.01: must be > 0"),
+        ('{ kind = "record", file = "one.csv", time_step = nan }', "motion.time_step = nan: must be a finite number"),
+        ('{ kind = "record", file = "one.csv", time_step = inf }', "motion.time_step = inf: must be a finite number"),
+        ('{ kind = "record", file = "one.csv", time_step = "0.01" }', 'motion.time_step = "0.01": must be a number'),
+        ('{ kind = "record", file = "one.csv", time_step = true }', "motion.time_step = true: must be a number"),
+        (
+            '{ kind = "record", file = "one.csv", time_step = 10 }',
+            "motion.time_step = 10: must be within 1e-06–1 s, likely a typo (accelerographs sample every 1–20 ms; "
+            "10 for 10 ms would stretch the record 1000-fold)",
+        ),
+        ('{ kind = "record", file = "one.csv", time_step = 1e-9 }', "motion.time_step = 1e-09: must be within"),
+    ],
+)
+def test_one_column_errors_in_a_scenario(tmp_path, motion, expected):
+    from masonrycli.scenario_toml import loads_scenario
+
+    write_at2(tmp_path / "h.AT2", [0.0, 0.1, 0.2], 0.01)
+    (tmp_path / "one.csv").write_text("0.1\n0.2\n0.3\n")
+    (tmp_path / "two.csv").write_text("0,0.1\n0.01,0.2\n")
+    (tmp_path / "three.csv").write_text("t,x,y\n0,0.1,0.2\n")
+    with pytest.raises(InputError) as exc:
+        loads_scenario(SCENARIO.replace("MOTION", motion), source="s.toml", base_dir=tmp_path)
+    message = one_line(exc)
+    assert message.startswith('s.toml: [[support]] #1 ("ground"): ' + expected), message

@@ -133,8 +133,8 @@ def test_round_trip_explicit(round_trip_file, tmp_path, monkeypatch):
     assert [x.role for x in s.assembly.supports] == ["fixed"] + ["driven"] * 8
     assert s.assembly.blocks[2].name == "block-3"
     assert s.motions[5].source == str(tmp_path / "records" / "quake.csv")
-    assert s.motions[5].value == (0.1, 0.3333333333333333, -0.7)
-    assert s.motions[6].value == ((0.0, 0.0), (1e-3, -2e-3), (0.25, 0.125))
+    assert s.motions[5].value.tolist() == [0.1, 0.3333333333333333, -0.7]
+    assert s.motions[6].value.tolist() == [[0.0, 0.0], [1e-3, -2e-3], [0.25, 0.125]]
 
     text = dump_scenario(s)
     # load from elsewhere: record files are written as absolute paths
