@@ -28,15 +28,16 @@ from masonrycli.record_units import check_at2_header, check_csv_header
 from masonrycli.values import format_value, quote_string, shorten
 
 
-def load_record_csv(path, display: str | None = None, time_step: float | None = None) -> tuple[np.ndarray, np.ndarray]:
+def load_record_csv(path, display: str | None = None, time_step: float | None = None):
     """Read a tabulated motion record.
 
     Format: one sample per line, ``time,value`` (2 columns: a value along the motion's direction) or
     ``time,x,y`` (3 columns: a vector); with ``time_step`` (s), one ``value`` per line (1 column, no
-    times: the samples are at t = 0, time_step, 2 time_step, ...; a file with times is refused). Separators: comma, semicolon or white space; on a line with
-    semicolons, commas are decimal commas (``0,01;0,5``). Blank lines and
-    lines starting with ``#`` are skipped; a single non-numeric header line before the first sample is
-    allowed. Times in s, strictly increasing, at least 2 samples; all values finite.
+    times: the samples are at t = 0, time_step, 2 time_step, ...; a file with times is refused).
+    Separators: comma, semicolon or white space; on a line with semicolons, commas are decimal commas
+    (``0,01;0,5``). Blank lines and lines starting with ``#`` are skipped; a single non-numeric header
+    line before the first sample is allowed. Times in s, strictly increasing, at least 2 samples; all
+    values finite.
 
     Returns ``(time (n,), value (n,) or (n, 2))`` float64 arrays.
     Raises :class:`InputError` with a one-line message ``<file>:<line>: <problem>``.

@@ -75,7 +75,7 @@ def test_apply_point_changes_what_it_names(arch_base, tmp_path):
     rec = record_motion(_csv(tmp_path), quantity="acceleration")
     base = StudyBase(arch_base.scenario, {"q.csv": rec})
     s = apply_point(base, {"record": "q.csv", "scale": 2.0})
-    assert s.motions[0].scale == 2.0 and s.motions[0].time == rec.time and s.motions[1].kind == "constant"
+    assert s.motions[0].scale == 2.0 and s.motions[0].time is rec.time and s.motions[1].kind == "constant"
 
 
 def _csv(tmp_path):
