@@ -274,6 +274,22 @@ _STALLED = {
 """What a step that ends unconverged below the cap went through, by solver (engine/nlgs.py, stalled.py)."""
 
 
+def unconverged_warning(unconverged: int, steps: int, capped: int, run) -> str:
+    """The warning's text for ``unconverged`` of ``steps`` steps, ``capped`` of them at the sweep cap of
+    ``run`` (a RunConfig); the rest stalled. It said "20 at the 2-sweep cap, the others stalled: every method
+    … gave up" when there were no others."""
+    stalled = unconverged - capped
+    why = [f"{capped} at the {run.max_iterations}-sweep cap"] if capped else []
+    if stalled:
+        why.append(f"{'the other ' if capped else ''}{stalled} stalled: {_STALLED[run.solver]}")
+    advice = "Raise --max-iterations for capped steps, or check" if capped else "Check"
+    return (
+        f"{unconverged} of {steps} steps ended unconverged (contact-law residual above --tolerance "
+        f"{run.tolerance:g} m/s; {', '.join(why)}); their impulses and motion are approximate. "
+        f"{advice} the history's nlgs_residual."
+    )
+
+
 def print_summary(console: Console, outcome: Outcome, scenario, hint: str = "") -> None:
     """The summary table, the optional ``hint``, and last the command that opens the recording."""
     result = outcome.result
@@ -281,17 +297,8 @@ def print_summary(console: Console, outcome: Outcome, scenario, hint: str = "") 
     console.print(summary_table(result, paths.get("--out"), paths.get("--history")))
     if result is not None and result.unconverged:
         run = scenario.run
-        console.print(
-            Text.assemble(
-                ("warning: ", "bold red"),
-                f"{result.unconverged} of {result.steps} steps ended unconverged (contact-law residual above "
-                f"--tolerance {run.tolerance:g} m/s; {result.tally.capped} at the {run.max_iterations}-sweep cap, "
-                f"the others stalled: {_STALLED[run.solver]}); their impulses and motion are "
-                "approximate. Raise --max-iterations for capped steps, or check the history's "
-                "nlgs_residual.",
-            ),
-            soft_wrap=True,
-        )
+        text = unconverged_warning(result.unconverged, result.steps, result.tally.capped, run)
+        console.print(Text.assemble(("warning: ", "bold red"), text), soft_wrap=True)
     if hint and "--out" in paths:
         console.print(hint, soft_wrap=True)
     if "--out" in paths:

@@ -324,13 +324,8 @@ def test_unconverged_steps_are_counted_and_warned(tmp_path):
     r = invoke("simulate", "wall", "--duration", "0.02", "--max-iterations", "2", "--no-recording", "--history", npz)
     assert r.exit_code == 0, r.output
     assert "warning: 20 of 20 steps ended unconverged" in " ".join(r.output.split())
-    assert "20 at the 2-sweep cap" in " ".join(r.output.split())
-    # What the default solver's stalled steps go through, and plain NLGS's.
-    assert "stalled-step round-robin" in " ".join(r.output.split())
-    plain = invoke(
-        "simulate", "wall", "--duration", "0.01", "--max-iterations", "2", "--solver", "nlgs", "--no-recording"
-    )
-    assert plain.exit_code == 0 and "sweeps by faces" in " ".join(plain.output.split()), plain.output
+    assert "20 at the 2-sweep cap); their" in " ".join(r.output.split())  # none stalled: not said
+    # (what stalled steps go through, by solver: test_execute.py, unconverged_warning)
     h = np.load(npz)
     assert h["nlgs_unconverged"][-1] == 20
     assert np.all(h["nlgs_iterations"][1:] == 2) and np.all(h["nlgs_residual"][1:] > 1e-5)

@@ -21,7 +21,7 @@ from shapely.geometry import box
 from geometry_library.blocks import Assembly, Block, Support
 from masonrycli import execute as execute_module
 from masonrycli.errors import InputError
-from masonrycli.execute import check_run, execute, plan_outputs
+from masonrycli.execute import check_run, execute, plan_outputs, unconverged_warning
 from masonrycli.interrupt import StopRun
 from masonrycli.motion import Sine
 from masonrycli.recording import inspect_recording
@@ -193,3 +193,16 @@ def test_the_last_line_is_a_command_the_shell_runs(tmp_path):
     last = result.output.strip().splitlines()[-1]
     words = shlex.split(last.removeprefix("Open the recording:"))
     assert words[0].endswith("rerun") and words[1:] == [str(rrd)], last
+
+
+def test_the_unconverged_warning_names_only_the_causes_there_were():
+    # "20 at the 2-sweep cap, the others stalled: every method … gave up" when none had stalled.
+    run = RunConfig(max_iterations=2, tolerance=1e-5)
+    capped_only = unconverged_warning(20, 20, 20, run)
+    assert "(contact-law residual above --tolerance 1e-05 m/s; 20 at the 2-sweep cap); their" in capped_only
+    assert "stalled" not in capped_only and "Raise --max-iterations for capped steps" in capped_only
+    both = unconverged_warning(141, 500, 32, run)
+    assert "32 at the 2-sweep cap, the other 109 stalled: every method of the stalled-step round-robin" in both
+    stalled_only = unconverged_warning(3, 500, 0, dataclasses.replace(run, solver="nlgs"))
+    assert "m/s; 3 stalled: no lower residual in 10 000 sweeps by faces); " in stalled_only
+    assert "cap" not in stalled_only and stalled_only.endswith("Check the history's nlgs_residual.")
