@@ -37,6 +37,18 @@ def test_a_bad_axis_is_one_line_naming_it(block):
     assert _refused(block, params=["amp=1:2"], workers=2, scheduler="tcp://x:1").startswith("--param amp=1:2:")
 
 
+def test_a_repeated_axis_or_a_search_without_its_range_comes_before_the_files_beside_out(block, tmp_path):
+    # "--out's plot s.png: the file exists" was said first; with --force the run then said "given twice"
+    (tmp_path / "s.png").write_bytes(b"png")
+    twice = {"params": ["amp=0.1", "amp=0.2"], "out": Path("s.csv")}
+    assert _refused(block, **twice) == "--param amp: given twice"
+    alone = {"params": ["amp=0.1,0.2"], "find": "freq", "out": Path("s.csv")}
+    assert _refused(block, **alone) == "--find freq: give its range too, e.g. --param freq=0.1:1.0:4"
+    one = {"params": ["amp=0.1"], "find": "amp", "out": Path("s.csv")}
+    assert _refused(block, **one) == "--find amp: needs a numeric range LO:HI:N with N >= 2"
+    assert _refused(block, params=["amp=0.1,0.2"], out=Path("s.csv")).startswith("--out's plot s.png: the file exists")
+
+
 @pytest.mark.parametrize(
     "options, message",
     [

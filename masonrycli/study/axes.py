@@ -107,6 +107,18 @@ def grid(axes: list[Axis]) -> list[dict]:
     return [dict(zip(names, combo)) for combo in itertools.product(*(a.values for a in axes))]
 
 
+def check_find(axes: list[Axis], find: str | None) -> None:
+    """Raise :class:`InputError` unless ``--find NAME`` (None: no search) has a numeric range among the axes."""
+    if find is None:
+        return
+    names = [a.name for a in axes]
+    if find not in names:
+        raise InputError(f"--find {find}: give its range too, e.g. --param {find}=0.1:1.0:4")
+    axis = axes[names.index(find)]
+    if isinstance(axis.values[0], str) or len(axis.values) < 2:
+        raise InputError(f"--find {find}: needs a numeric range LO:HI:N with N >= 2")
+
+
 def check_axes(axes: list[Axis]) -> None:
     names = [a.name for a in axes]
     dup = {n for n in names if names.count(n) > 1}

@@ -21,7 +21,7 @@ from masonrycli.builtin import is_built_in, override_run, target_scenario
 from masonrycli.errors import NOT_A_FILE, InputError
 from masonrycli.outputs import OutputFile, safe_name
 from masonrycli.study import store
-from masonrycli.study.axes import Axis, StudyBase, parse_axis
+from masonrycli.study.axes import Axis, StudyBase, check_axes, check_find, parse_axis
 from masonrycli.study.files import check_picture
 from masonrycli.study.study import StudyRequest
 
@@ -91,6 +91,9 @@ def plan_study(
         axes.append(parse_axis(f"scale={scale}"))
     if not axes:
         raise InputError("nothing to sweep: give --param NAME=..., or --records DIR")
+    # before the files beside --out: "--param amp: given twice" came after "--out's plot s.png: the file exists"
+    check_axes(axes)
+    check_find(axes, find)
     if im not in INTENSITY_MEASURES or im == "d5_95":
         raise InputError(f"--im {im}: expected one of pga, pgv, arias, sa")
     if workers is not None and workers < 0:

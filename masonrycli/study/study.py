@@ -20,7 +20,7 @@ from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, T
 
 from masonrycli.errors import InputError
 from masonrycli.study import files, store
-from masonrycli.study.axes import Axis, StudyBase, apply_point, check_axes, grid
+from masonrycli.study.axes import Axis, StudyBase, apply_point, check_axes, check_find, grid
 from masonrycli.study.drivers import FindDriver, GridDriver
 from masonrycli.study.task import RESULT_COLUMNS
 from masonrycli.study.versions import WorkerMismatch
@@ -94,13 +94,7 @@ def prepare(base: StudyBase, request: StudyRequest) -> str:
     from masonrycli.scenario_toml import dump_scenario
 
     check_axes(request.axes)
-    if request.find is not None:
-        names = [a.name for a in request.axes]
-        if request.find not in names:
-            raise InputError(f"--find {request.find}: give its range too, e.g. --param {request.find}=0.1:1.0:4")
-        axis = request.axes[names.index(request.find)]
-        if isinstance(axis.values[0], str) or len(axis.values) < 2:
-            raise InputError(f"--find {request.find}: needs a numeric range LO:HI:N with N >= 2")
+    check_find(request.axes, request.find)
     for point in points_to_check(request.axes):
         apply_point(base, point)  # raises InputError for an unknown or impossible parameter
     # a record by its samples, not its path and length: one corrected since (same file, same sample count)
