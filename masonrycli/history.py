@@ -8,7 +8,8 @@ Arrays (T frames, N blocks, S supports), block order = scenario order:
     nlgs_unconverged (T,) steps since t = 0 that ended unconverged (residual > tolerance or at the cap)
     energy_kinetic (T,) J · energy_potential (T,) J · energy_dissipated (T,) J (cumulated)
     support_work (T,) J (cumulated) · every per-block tensor field of masonrycli.tensors.TENSOR_FIELDS
-    joint_body (J,2) · joint_hinged (T,J) bool · hinge_count (T,)  (see masonrycli.mechanism)
+    joint_body (J,2) body indices, blocks then supports (N + s: support s) · joint_hinged (T,J) bool ·
+    hinge_count (T,)  (see masonrycli.mechanism)
     block_name (N,) · support_name (S,) · status () str (masonrycli.sinks.STATUSES) · note () str
     intensity_pga, intensity_pgv, intensity_arias, intensity_d5_95, intensity_sa () — the ground motion as
     applied (masonrycli.intensity), when a support shakes
