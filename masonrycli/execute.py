@@ -91,7 +91,15 @@ def plan_outputs(scenario, out: Path | None, history: Path | None, *, no_recordi
     rec = None
     if not no_recording:
         if out is None:
-            rec = OutputFile(default_recording_path(scenario.name), "--out", default_name=True)
+            # checked as --out is: a file named "recordings" here gave "internal error: NotADirectoryError"
+            path = default_recording_path(scenario.name)
+            try:
+                rec = check_output(path, "--out", ".rrd", False, default_name=True)
+            except InputError as exc:
+                problem = str(exc).removeprefix(f"--out {path}: ")
+                raise InputError(
+                    f"the default recording {path}: {problem} (give --out R.rrd, or --no-recording)"
+                ) from None
         else:
             rec = check_output(out, "--out", ".rrd", force)
     hist = check_output(history, "--history", ".npz", force) if history is not None else None

@@ -106,7 +106,7 @@ class OutputFile:
 
     def discard(self) -> None:
         """Remove the temporary file (and a history's temporary folder), if any."""
-        with contextlib.suppress(FileNotFoundError):
+        with contextlib.suppress(FileNotFoundError, NotADirectoryError):  # never made: its folder is a file
             os.unlink(self.part)
         shutil.rmtree(self.part.with_name(self.part.name + ".rows"), ignore_errors=True)  # a history's rows
 

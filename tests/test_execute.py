@@ -9,6 +9,7 @@ import dataclasses
 import io
 import math
 import os
+import re
 import signal
 import time
 from pathlib import Path
@@ -24,6 +25,7 @@ from masonrycli.errors import InputError
 from masonrycli.execute import check_run, execute, plan_outputs, unconverged_warning
 from masonrycli.interrupt import StopRun
 from masonrycli.motion import Sine
+from masonrycli.outputs import OutputFile
 from masonrycli.recording import inspect_recording
 from masonrycli.run import Simulation
 from masonrycli.scenario import Material, RunConfig, Scenario
@@ -122,6 +124,22 @@ def test_the_plan_names_the_outputs_asked_for(tmp_path, monkeypatch):
     assert default.recording.path.parent.name == "recordings" and default.recording.path.name.startswith("one-block-")
     assert default.recording.path.suffix == ".rrd" and default.history.path == tmp_path / "h.npz"
     assert os.listdir(tmp_path) == []  # planning writes nothing
+
+
+def test_a_file_where_the_default_recordings_folder_goes_is_bad_input(tmp_path, monkeypatch):
+    # "internal error: NotADirectoryError: … 'recordings/.wall-….rrd.<pid>.part'", exit 1: the default path was
+    # not checked, and removing its part file raised over the InputError that said why.
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "recordings").write_text("notes")
+    with pytest.raises(InputError) as info:
+        plan_outputs(_scenario(), None, None, no_recording=False, force=False)
+    assert re.fullmatch(
+        r"the default recording recordings/one-block-\d{8}-\d{6}\.rrd: recordings is not a folder "
+        r"\(give --out R\.rrd, or --no-recording\)",
+        str(info.value),
+    )
+    OutputFile(tmp_path / "recordings" / "x.rrd", "--out").discard()  # nothing to remove, nothing raised
+    assert os.listdir(tmp_path) == ["recordings"]
 
 
 @pytest.mark.parametrize(
