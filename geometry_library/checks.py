@@ -230,7 +230,8 @@ def normalise_coords(coords, label: str) -> np.ndarray:
     if np.any(np.abs(xy) > MAX_COORDINATE):
         bad = int(np.flatnonzero(np.any(np.abs(xy) > MAX_COORDINATE, axis=1))[0])
         raise GeometryError(
-            f"{label}: vertex {bad} at {_fmt(xy[bad])} is absurd (coordinates must be metres, within ±{MAX_COORDINATE:g})"
+            f"{label}: vertex {bad} at {_fmt(xy[bad])} is more than {MAX_COORDINATE:g} m from the origin "
+            "(coordinates are metres near the origin: move a map grid's, UTM or national, to a local origin)"
         )
     size = float(np.hypot(*(xy.max(axis=0) - xy.min(axis=0))))
     dup_tol = 1e-12 * max(size, 1e-300)

@@ -62,7 +62,9 @@ def test_float_noise_on_a_straight_edge_is_not_a_reflex_vertex():
         ([[0, 0], [1, 0], [np.inf, 1]], "NaN or infinite"),
         # Found by hypothesis: products of such coordinates overflow and the convexity test accepted it.
         ([[0, 0], [-1e300, 1e300], [0, 5], [2.4e288, -1.8e8]], "vertex 1 at"),
-        ([[0, 0], [1, 0], [1, 2e6], [0, 1]], "vertex 2 at .* is absurd"),
+        # a survey in a map grid (Lambert-93 northings are 6.1e6-7.1e6 m) was called "absurd (coordinates must
+        # be metres …)": they are metres, far from the origin
+        ([[0, 0], [1, 0], [1, 2e6], [0, 1]], r"vertex 2 at \(1, 2e\+06\) is more than 1e\+06 m from the origin .*UTM"),
     ],
 )
 def test_bad_polygons_are_rejected_naming_the_block(coords, message):
