@@ -311,8 +311,8 @@ def test_grid_sweep_state_map_and_histories(block, tmp_path):
         (["-p", "amp=0.1,0.2", "--rtol", "0.1"], "--rtol 0.1: goes with --find"),
         # a bad value inside an axis (only its ends were checked) ran into an error row, and the study said
         # "3 rows ... 1 failed"
-        (["-p", "friction=0.5,-1,0.6"], "--param: friction = -1.0: must be >= 0"),
-        (["-p", "dt=0.002:0.004:3"], "--param: dt = 0.003: does not divide duration = 1.0"),
+        (["-p", "friction=0.5,-1,0.6"], "--param friction=-1: friction = -1.0: must be >= 0"),
+        (["-p", "dt=0.002:0.004:3"], "--param dt=0.003: dt = 0.003: does not divide duration = 1.0"),
         (["-p", "amp=0.1,1e30,0.2", "-p", "freq=1,2"], "--param amp=1e+30 freq=1: "),
     ],
 )

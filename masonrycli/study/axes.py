@@ -158,9 +158,14 @@ def apply_point(base, params: dict):
             raise InputError(f"--param {_point(options)}: {exc}") from None
     run_changes = {k: v for k, v in params.items() if k in RUN_PARAMS}
     if run_changes:
-        scenario = dataclasses.replace(scenario, run=_replace(scenario.run, run_changes))
+        # "--param dt=0.003: dt = 0.003: does not divide …" (it said "--param: dt = …", no point)
+        run = _replace(scenario.run, run_changes, where=f"--param {_point(run_changes)}")
+        scenario = dataclasses.replace(scenario, run=run)
     if "friction" in params:
-        scenario = dataclasses.replace(scenario, material=_replace(scenario.material, {"friction": params["friction"]}))
+        friction = {"friction": params["friction"]}
+        scenario = dataclasses.replace(
+            scenario, material=_replace(scenario.material, friction, where=f"--param {_point(friction)}")
+        )
     motions = list(scenario.motions)
     if "record" in params:
         record = base.records[params["record"]]
