@@ -3,7 +3,7 @@
 GeoJSON
 -------
 A ``FeatureCollection`` with one ``Polygon`` feature per body (coordinates in metres, exterior ring
-only). Feature properties:
+only; a ``MultiPolygon`` of one part, as QGIS saves polygon layers, is that polygon). Feature properties:
 
 =================  =========================================================================
 ``role``           ``"block"`` (default) or ``"support"``
@@ -132,9 +132,17 @@ def read_geojson(path, density: float = 2500.0, thickness: float = 1.0) -> Assem
         where = f"{feature_at}: {body_label(index, name, role)}"
         geometry = feature.get("geometry")
         gtype = geometry.get("type") if isinstance(geometry, dict) else None
-        if gtype != "Polygon":
+        rings = geometry.get("coordinates") if gtype in ("Polygon", "MultiPolygon") else None
+        if gtype == "MultiPolygon":  # QGIS saves a polygon layer as MultiPolygons, most of one part
+            if not isinstance(rings, list) or len(rings) != 1:
+                parts = len(rings) if isinstance(rings, list) else 0
+                raise GeometryError(
+                    f"{where}: a MultiPolygon of {parts} parts; a feature is one body (split it into single "
+                    "parts, e.g. QGIS's Multipart to Singleparts)"
+                )
+            rings = rings[0]
+        elif gtype != "Polygon":
             raise GeometryError(f"{where}: geometry must be a Polygon, got {gtype!r}")
-        rings = geometry.get("coordinates")
         if not isinstance(rings, list) or not rings:
             raise GeometryError(f"{where}: Polygon has no coordinates")
         if len(rings) > 1:

@@ -75,6 +75,18 @@ def test_geojson_defaults_and_properties(tmp_path):
     assert a.supports[0].polygon.exterior.is_ccw
 
 
+def test_geojson_a_multipolygon_of_one_part_is_that_polygon(tmp_path):
+    # QGIS saves a polygon layer as MultiPolygons: "geometry must be a Polygon, got 'MultiPolygon'" refused every
+    # feature of a wall edited there
+    plain = [feature(SQ, name="b"), feature([[-2, -1], [3, -1], [3, 0], [-2, 0], [-2, -1]], role="support")]
+    multi = [dict(f, geometry={"type": "MultiPolygon", "coordinates": [f["geometry"]["coordinates"]]}) for f in plain]
+    a, b = read_geojson(write(tmp_path, plain, "plain.geojson")), read_geojson(write(tmp_path, multi, "multi.geojson"))
+    assert [x.polygon.equals_exact(y.polygon, 0) for x, y in zip(a.blocks + a.supports, b.blocks + b.supports)] == [
+        True,
+        True,
+    ]
+
+
 def one_line_error(fn, *args):
     with pytest.raises(GeometryError) as info:
         fn(*args)
@@ -136,6 +148,16 @@ _BAD_FEATURES = [  # (feature 2 of a file whose feature 1 is a good block, the b
         {"type": "Feature", "properties": {"name": "B12"}, "geometry": {"type": "Polygon", "coordinates": [SQ, SQ]}},
         "block 2",
         "1 hole(s)",
+    ),
+    (
+        "multipolygon",
+        {
+            "type": "Feature",
+            "properties": {"name": "B12"},
+            "geometry": {"type": "MultiPolygon", "coordinates": [[SQ]] * 2},
+        },
+        "block 2",
+        "a MultiPolygon of 2 parts; a feature is one body (split it into single parts",
     ),
     ("coordinates", feature([[0, 0], [1, "x"], [1, 1]], name="B12"), "block 2", "coordinates must be [x, y] number"),
     ("concave", feature([[0, 0], [2, 0], [2, 2], [1, 0.5], [0, 2], [0, 0]], name="B12"), "block 2", "not convex"),
