@@ -3,7 +3,8 @@
 GeoJSON
 -------
 A ``FeatureCollection`` with one ``Polygon`` feature per body (coordinates in metres, exterior ring
-only; a ``MultiPolygon`` of one part, as QGIS saves polygon layers, is that polygon). Feature properties:
+only; a ``MultiPolygon`` of one part, as QGIS saves polygon layers, is that polygon). Feature properties
+(a ``null`` one is not given: its default applies):
 
 =================  =========================================================================
 ``role``           ``"block"`` (default) or ``"support"``
@@ -124,6 +125,9 @@ def read_geojson(path, density: float = 2500.0, thickness: float = 1.0) -> Assem
         props = feature.get("properties") or {}
         if not isinstance(props, dict):
             raise GeometryError(f"{where}: 'properties' must be an object")
+        # null is not given (a GIS writes an empty attribute cell as null): a block was named "None" and a
+        # null density refused ("must be a positive number, got None")
+        props = {key: value for key, value in props.items() if value is not None}
         role = props.get("role", "block")
         if role not in ("block", "support"):
             raise GeometryError(f"{where}: role must be 'block' or 'support', got {role!r}")

@@ -87,6 +87,15 @@ def test_geojson_a_multipolygon_of_one_part_is_that_polygon(tmp_path):
     ]
 
 
+def test_geojson_a_null_property_is_not_given(tmp_path):
+    # a GIS writes an empty attribute cell as null: the block was named "None", a null density refused
+    nulls = dict(role=None, name=None, density=None, thickness=None, velocity=None)
+    ground = feature([[-2, -1], [3, -1], [3, 0], [-2, 0], [-2, -1]], role="support", name="g", support_role=None)
+    a = read_geojson(write(tmp_path, [feature(SQ, **nulls), ground]), density=1800.0, thickness=0.8)
+    assert [(b.name, b.density, b.thickness) for b in a.blocks] == [("block-1", 1800.0, 0.8)]
+    assert [(s.name, s.role) for s in a.supports] == [("g", "fixed")]
+
+
 def one_line_error(fn, *args):
     with pytest.raises(GeometryError) as info:
         fn(*args)
