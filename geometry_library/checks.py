@@ -257,7 +257,14 @@ def normalise_coords(coords, label: str) -> np.ndarray:
         raise GeometryError(f"{label}: polygon self-intersects ({reason})")
     area = signed_area(xy)
     if abs(area) < MIN_AREA:
-        raise GeometryError(f"{label}: polygon area {abs(area):.3g} m² is zero or too small")
+        # GeoJSON is longitude / latitude unless told otherwise (RFC 7946; QGIS exports so by default): a 0.3 m
+        # block is then 3e-6 "m" wide, and the message said only "too small"
+        on_globe = bool(np.all(np.abs(xy[:, 0]) <= 180.0) and np.all(np.abs(xy[:, 1]) <= 90.0))
+        degrees = on_globe and 0.0 < size < 1e-3 and float(np.abs(xy).max()) > 1e3 * size
+        hint = (
+            " (longitude / latitude in degrees? coordinates are metres: export in a projected CRS)" if degrees else ""
+        )
+        raise GeometryError(f"{label}: polygon area {abs(area):.3g} m² is zero or too small{hint}")
     if abs(area) > MAX_AREA:
         raise GeometryError(f"{label}: polygon area {abs(area):.3g} m² is absurd (coordinates must be metres)")
     if area < 0.0:

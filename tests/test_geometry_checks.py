@@ -56,7 +56,12 @@ def test_float_noise_on_a_straight_edge_is_not_a_reflex_vertex():
         ([[0, 0], [1, 0], [1, 0], [0, 0]], "fewer than 3 distinct"),
         ([[0, 0], [1, 1], [1, 0], [0, 1]], "self-intersects"),
         ([[0, 0], [1, 0], [2, 0], [3, 0]], "zero area"),
-        ([[0, 0], [1e-6, 0], [1e-6, 1e-6], [0, 1e-6]], "zero or too small"),
+        ([[0, 0], [1e-6, 0], [1e-6, 1e-6], [0, 1e-6]], r"zero or too small$"),  # near the origin: no degrees hint
+        # a 0.3 × 0.2 m block exported by QGIS in longitude / latitude (GeoJSON's default) said only "too small"
+        (
+            [[4.63, 43.68], [4.63 + 2.7e-6, 43.68], [4.63 + 2.7e-6, 43.68 + 1.8e-6], [4.63, 43.68 + 1.8e-6]],
+            r"zero or too small \(longitude / latitude in degrees\? coordinates are metres: export in a projected CRS\)",
+        ),
         ([[0, 0], [1e4, 0], [1e4, 1e4], [0, 1e4]], "absurd"),
         ([[0, 0], [1, 0], [np.nan, 1]], "NaN or infinite"),
         ([[0, 0], [1, 0], [np.inf, 1]], "NaN or infinite"),
