@@ -26,7 +26,7 @@ from masonrycli.errors import InputError
 from masonrycli.history import HistoryFile
 from masonrycli.interrupt import StopSignals
 from masonrycli.outputs import OutputFile, check_distinct, check_output, check_space, default_recording_path, open_part
-from masonrycli.report import progress_bar, summary_table
+from masonrycli.report import progress_bar, slow_start_notice, summary_table
 from masonrycli.run import RunResult, Simulation, simulate
 from masonrycli.sinks import COMPLETED, FAILED
 
@@ -198,7 +198,8 @@ def execute(
         try:
             for out in outputs.files():
                 open_part(out)
-            sim = Simulation(scenario)
+            with slow_start_notice():  # a first run compiles the kernels here and in step 1
+                sim = Simulation(scenario)
             for out in outputs.files():
                 try:
                     sinks[out] = _open_sink(out, outputs, scenario, sim, magnify)

@@ -3,6 +3,8 @@ tables of ``masonry check`` and ``masonry inspect``."""
 
 from __future__ import annotations
 
+import sys
+import threading
 import time
 from contextlib import contextmanager
 
@@ -10,6 +12,35 @@ from rich.console import Console
 from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
 from rich.table import Table
 from rich.text import Text
+
+SLOW_START = (
+    "starting: a first run (or the first after an update) compiles the numba kernels, about 30 s of CPU; "
+    "later runs start in about a second"
+)
+
+
+@contextmanager
+def slow_start_notice(after: float = 3.0, stream=None):
+    """On a terminal, say why nothing shows when setting a run up takes more than ``after`` s. A first run
+    compiles the kernels: 15 s with no line at all, then a progress bar at step 0 for 15 s more, and a user
+    new to it took the command for hung (README, Quick start). Not on a pipe or a file: logs and tests keep
+    their lines."""
+    stream = sys.stderr if stream is None else stream
+    if not stream.isatty():
+        yield
+        return
+
+    def notice():
+        stream.write(SLOW_START + "\n")
+        stream.flush()
+
+    timer = threading.Timer(after, notice)
+    timer.daemon = True
+    timer.start()
+    try:
+        yield
+    finally:
+        timer.cancel()
 
 
 @contextmanager

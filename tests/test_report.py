@@ -1,9 +1,12 @@
 """The terminal tables (masonrycli/report.py): the summary names the solver that ran; inspect's rows."""
 
+import io
+import time
+
 import pytest
 from rich.console import Console
 
-from masonrycli.report import SOLVER_NOTES, recording_table, summary_table
+from masonrycli.report import SLOW_START, SOLVER_NOTES, recording_table, slow_start_notice, summary_table
 from masonrycli.run import simulate
 from masonrycli.scenario import SOLVERS
 from tests.engine_helpers import scenario
@@ -36,3 +39,25 @@ def test_inspect_rows_spell_spans_and_missing_values():
     info = {"steps": [0, 40], "time_span": (0.0, 0.2), "sim_time": None, "entities": ["a"], "metadata": {"k": 1}}
     rows = _rows(recording_table("r.rrd", info))
     assert rows == {"steps": "0 … 40", "time_span": "0.0 … 0.2 s", "sim_time": "—", "entities": "a"}
+
+
+class _Terminal(io.StringIO):
+    def __init__(self, tty: bool):
+        super().__init__()
+        self.tty = tty
+
+    def isatty(self) -> bool:
+        return self.tty
+
+
+def test_a_slow_start_on_a_terminal_says_why():
+    # a first run sat 15 s with no line, then 15 s on a progress bar at step 0: taken for hung
+    slow, fast, piped = _Terminal(True), _Terminal(True), _Terminal(False)
+    with slow_start_notice(after=0.01, stream=slow):
+        time.sleep(0.2)
+    with slow_start_notice(after=5.0, stream=fast):
+        pass
+    with slow_start_notice(after=0.01, stream=piped):
+        time.sleep(0.2)
+    assert slow.getvalue() == SLOW_START + "\n" and "compiles the numba kernels" in SLOW_START
+    assert fast.getvalue() == "" and piped.getvalue() == ""  # quick, or not a terminal: nothing
