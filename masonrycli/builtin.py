@@ -36,6 +36,7 @@ from pathlib import Path
 
 from masonrycli.errors import NOT_A_FILE, InputError, file_kind, special_file
 from masonrycli.motion import Constant, Record, Sine, time_step_problem
+from masonrycli.record_text import NoTimeStep
 from masonrycli.records import record_motion
 from masonrycli.scenario import MAX_DURATION, Material, RunConfig, Scenario, scenario_from_builder
 
@@ -108,15 +109,23 @@ def _sine(amp: float, freq: float) -> Sine:
     return sine
 
 
-def record_motion_option(path: Path, scale: float | None, record_dt: float | None = None) -> Record:
-    """The ground motion of a ``--record`` file (.AT2 or CSV), multiplied by ``scale``; ``record_dt``: the
-    spacing of a one-column CSV's samples, s."""
+def check_record_dt(record_dt: float | None) -> float | None:
+    """``--record-dt`` (simulate, run, check, sweep) checked as a record's time step; None: not given."""
     if record_dt is not None:
         problem = time_step_problem(record_dt)
         if problem:
             raise InputError(f"--record-dt {record_dt:g}: {problem}")
+    return record_dt
+
+
+def record_motion_option(path: Path, scale: float | None, record_dt: float | None = None) -> Record:
+    """The ground motion of a ``--record`` file (.AT2 or CSV), multiplied by ``scale``; ``record_dt``: the
+    spacing of a one-column CSV's samples, s."""
+    check_record_dt(record_dt)
     try:
         return record_motion(path, scale=1.0 if scale is None else scale, display=str(path), time_step=record_dt)
+    except NoTimeStep as exc:
+        raise exc.give("--record-dt SECONDS") from None
     except InputError as exc:
         msg = str(exc)
         raise InputError(msg if msg.startswith(str(path)) else f"--record {path}: {msg}") from None

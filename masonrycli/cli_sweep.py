@@ -45,6 +45,14 @@ def sweep_command(
             "--records", help="Record files (.AT2 or CSV) or folders of them, repeatable: one axis 'record' over them."
         ),
     ] = None,
+    record_dt: Annotated[
+        float | None,
+        typer.Option(
+            "--record-dt",
+            help="Seconds between the samples of the --records CSVs of one value per line (no time column); "
+            "the other files keep their own times.",
+        ),
+    ] = None,
     scale: Annotated[
         str | None, typer.Option("--scale", help="Record scale axis, e.g. 0.25:2:8 (= --param scale=...).")
     ] = None,
@@ -119,6 +127,7 @@ def sweep_command(
         target,
         params=param,
         records=records,
+        record_dt=record_dt,
         scale=scale,
         find=find,
         outcome=outcome,

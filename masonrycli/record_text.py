@@ -53,8 +53,26 @@ class CsvState:
         self.one_column = one_column
 
 
-NO_TIME_STEP = "give the time between samples: --record-dt SECONDS (a scenario's record table: time_step = SECONDS)"
-"""What a one-column file read without a time step is told to do (a file of one value per line has no times)."""
+ANY_TIME_STEP = "--record-dt SECONDS (a scenario's record table: time_step = SECONDS)"
+"""How a one-column file read without a time step is told to give one, by a caller that does not know which
+way its command has (a file of one value per line has no times)."""
+
+
+class NoTimeStep(InputError):
+    """A file of one value per line read without a time step, at ``where`` (``file:line``). The message
+    names ``how`` to give one; a command that has one way says it with :meth:`give` (``masonry run s.toml``
+    was told ``--record-dt``, which goes with ``--record``, of the scenario's own record file)."""
+
+    def __init__(self, where: str, how: str = ANY_TIME_STEP):
+        self.where, self.how = where, how
+        super().__init__(f"{where}: one value per line, no times: give the time between samples: {how}")
+
+    def give(self, how: str) -> NoTimeStep:
+        """The same refusal, naming ``how`` (``--record-dt SECONDS``) as the way to give the time step."""
+        return NoTimeStep(self.where, how)
+
+    def __reduce__(self):  # pickled with the arguments of __init__, not the message it makes of them
+        return NoTimeStep, (self.where, self.how)
 
 
 def csv_lines(lines, first: int, name: str, state: CsvState) -> tuple[list, list]:
@@ -106,7 +124,7 @@ def _first_columns(count: int, where: str, one_column: bool) -> None:
             "(this one has a time column: leave out --record-dt / time_step)"
         )
     if not one_column and count == 1:
-        raise InputError(f"{where}: one value per line, no times: {NO_TIME_STEP}")
+        raise NoTimeStep(where)
     if not one_column and count not in (2, 3):
         raise InputError(f"{where}: expected 2 columns (time, value) or 3 (time, x, y), got {count}")
 

@@ -23,7 +23,7 @@ import numpy as np
 
 from masonrycli.errors import NOT_A_FILE, InputError, RecordWarning, file_kind, not_utf8, special_file
 from masonrycli.motion import Record, time_step_problem
-from masonrycli.record_text import at2_text, csv_text, number
+from masonrycli.record_text import NoTimeStep, at2_text, csv_text, number
 from masonrycli.record_units import check_at2_header, check_csv_header
 from masonrycli.values import format_value, quote_string, shorten
 
@@ -298,6 +298,8 @@ def _table_file(table: dict, key: str, base_dir: str, time_step: float | None):
         time, value, native = read_record(resolved, display=file, time_step=time_step)
         if native is None:
             check_csv_header(resolved, file, table.get("quantity", "velocity"), table.get("scale", 1.0))
+    except NoTimeStep as exc:  # --record-dt goes with --record, not with the scenario's own record file
+        raise InputError(f"motion.{key}: {exc.give('time_step = SECONDS in the record table')}") from None
     except InputError as exc:
         raise InputError(f"motion.{key}: {exc}") from None
     return time, value, native, resolved

@@ -212,8 +212,7 @@ def test_record_dt_reads_a_one_column_record_on_simulate_run_and_check(one_colum
     [
         (
             ["--record", "ONE"],
-            "error: ONE:2: one value per line, no times: give the time between samples: --record-dt SECONDS (a "
-            "scenario's record table: time_step = SECONDS)",
+            "error: ONE:2: one value per line, no times: give the time between samples: --record-dt SECONDS",
         ),
         (
             ["--record", "TWO", "--record-dt", 0.01],

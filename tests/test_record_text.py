@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+import pickle
 import random
 
 import numpy as np
@@ -237,6 +238,10 @@ def test_one_column_without_a_time_step_says_to_give_one(monkeypatch, chunk):
             f"a.csv:{line}: one value per line, no times: give the time between samples: --record-dt SECONDS "
             "(a scenario's record table: time_step = SECONDS)"
         )
+        # a command with one way to give it names that way; the refusal pickles as it was made
+        assert isinstance(got.value, rt.NoTimeStep) and str(got.value.give("T")).endswith("samples: T")
+        back = pickle.loads(pickle.dumps(got.value.give("T")))
+        assert str(back) == str(got.value.give("T")) and back.where == f"a.csv:{line}"
 
 
 # --------------------------------------------------------------------------------------------------- .AT2

@@ -438,8 +438,9 @@ def test_a_one_column_file_in_a_scenario_reads_and_writes_back(tmp_path):
     [
         (
             '{ kind = "record", file = "one.csv" }',
-            "motion.file: one.csv:1: one value per line, no times: give the time between samples: --record-dt "
-            "SECONDS (a scenario's record table: time_step = SECONDS)",
+            # --record-dt goes with --record: of the scenario's own file, the table's key is the way
+            "motion.file: one.csv:1: one value per line, no times: give the time between samples: time_step = "
+            "SECONDS in the record table",
         ),
         (
             '{ kind = "record", file = "two.csv", time_step = 0.01 }',

@@ -110,3 +110,59 @@ def test_a_built_in_without_duration_lasts_the_longest_record(block, tmp_path):
     # with a --duration the runs are that long, and shorter than the record
     plan = plan_study("wall", records=[folder], out=Path("s.csv"), duration=1.0)
     assert plan.base.scenario.run.duration == 1.0 and "shorter than 1 of 1 records" in plan.request.warnings[0]
+
+
+def _mixed_set(folder: Path) -> int:
+    """A record set of each kind: an .AT2 file (DT 5 ms), a CSV of one value per line and the same velocity
+    with its times i·0.01 s written out here (Python's i * 0.01, not the reader's); the .AT2's NPTS."""
+    folder.mkdir()
+    t, u, v, a = band_limited(0.4, 0.005, [2.0, 4.0], [0.01, 0.005], seed=1)
+    write_at2(folder / "syn.AT2", a / G_STANDARD, 0.005)
+    values = v[::2].tolist()
+    (folder / "one.csv").write_text("velocity\n" + "".join(f"{x!r}\n" for x in values))
+    (folder / "two.csv").write_text("time,velocity\n" + "".join(f"{i * 0.01!r},{x!r}\n" for i, x in enumerate(values)))
+    return t.size
+
+
+def test_record_dt_spaces_the_one_column_files_of_a_set_and_no_other(block, tmp_path):
+    import dataclasses
+
+    npts = _mixed_set(tmp_path / "records")
+    records = plan_study(block, records=[Path("records")], record_dt=0.01, out=Path("s.csv")).base.records
+    one, at2, two = records["one.csv"], records["syn.AT2"], records["two.csv"]
+    # the one-column file is the file with times i·0.01 s; the others keep their own times
+    assert one == dataclasses.replace(two, source=one.source, time_step=0.01) and one.time_step == 0.01
+    assert two.time_step is None and two.time.tolist() == [i * 0.01 for i in range(two.time.size)]
+    assert at2.time_step is None and at2.time.tolist() == [i * 0.005 for i in range(npts)]
+
+
+@pytest.mark.parametrize(
+    "options, message",
+    [
+        (
+            {"records": [Path("records")]},
+            "records/one.csv:2: one value per line, no times: give the time between samples: --record-dt SECONDS",
+        ),
+        (
+            {"records": [Path("records/two.csv"), Path("records/syn.AT2")], "record_dt": 0.01},
+            "--record-dt 0.01: no file of --records is one value per line (the .AT2 files and the CSVs with a time "
+            "column keep their own times): leave it out",
+        ),
+        (
+            {"params": ["amp=0.1"], "record_dt": 0.01},
+            "--record-dt: goes with --records (the time between the samples of its one-column files)",
+        ),
+        # the value is checked as simulate checks it, before any file is read
+        ({"records": [Path("nowhere")], "record_dt": 0.0}, "--record-dt 0: must be > 0"),
+        ({"records": [Path("nowhere")], "record_dt": float("nan")}, "--record-dt nan: must be a finite number"),
+        (
+            {"records": [Path("records")], "record_dt": 10.0},
+            "--record-dt 10: must be within 1e-06–1 s, likely a typo (accelerographs sample every 1–20 ms; 10 for "
+            "10 ms would stretch the record 1000-fold)",
+        ),
+    ],
+)
+def test_record_dt_refusals_are_one_line_naming_it(block, tmp_path, options, message):
+    _mixed_set(tmp_path / "records")
+    assert _refused(block, out=Path("s.csv"), **options) == message
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["block.toml", "records"]

@@ -17,7 +17,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
-from masonrycli.builtin import is_built_in, override_run, target_scenario
+from masonrycli.builtin import check_record_dt, is_built_in, override_run, target_scenario
 from masonrycli.errors import NOT_A_FILE, InputError
 from masonrycli.outputs import OutputFile, safe_name
 from masonrycli.study import store
@@ -49,6 +49,7 @@ def plan_study(
     *,
     params: list[str] | None = None,
     records: list[Path] | None = None,
+    record_dt: float | None = None,
     scale: str | None = None,
     find: str | None = None,
     outcome: str | None = None,
@@ -81,8 +82,10 @@ def plan_study(
     out = store.check_out(out or Path(f"study-{safe_name(name)}.parquet"))
     axes = [parse_axis(p) for p in params or []]
     late: list[str] = []  # warnings about records longer than the runs
+    if check_record_dt(record_dt) is not None and not records:
+        raise InputError("--record-dt: goes with --records (the time between the samples of its one-column files)")
     if records:
-        motions = _records(records, out)
+        motions = _records(records, out, record_dt)
         whole = duration is None and is_built_in(target)  # a scenario file's [run] duration stands
         scenario, late = _record_duration(base.scenario, motions, whole)
         base = StudyBase(scenario, motions)
@@ -179,12 +182,11 @@ def _record_duration(scenario, motions: dict, whole: bool):
     ]
 
 
-def _records(entries: list[Path], out: Path) -> dict:
+def _records(entries: list[Path], out: Path, record_dt: float | None) -> dict:
     """Record motions by file name, from files and the .AT2 / .csv files of folders (but the study's
     table ``out``: kept in its records' folder, it was read as a record by the same command run again,
-    "recs/ida.csv:2: not a number", so the study could not be resumed)."""
-    from masonrycli.records import record_motion
-
+    "recs/ida.csv:2: not a number", so the study could not be resumed). ``record_dt`` (--record-dt, s):
+    the spacing of the samples of the CSVs of one value per line; refused when no file is one."""
     files = []
     for entry in entries:
         if entry.is_dir():
@@ -202,7 +204,30 @@ def _records(entries: list[Path], out: Path) -> dict:
     twice = sorted({n for n in names if names.count(n) > 1})
     if twice:
         raise InputError(f"--records: two records named {twice[0]} (rows are keyed by the file name)")
-    return {p.name: record_motion(p, display=str(p)) for p in files}
+    motions = {p.name: _record(p, record_dt) for p in files}
+    if record_dt is not None and all(m.time_step is None for m in motions.values()):
+        # as simulate refuses --record-dt with a file that has times: a time step no file takes is a mistake
+        raise InputError(
+            f"--record-dt {record_dt:g}: no file of --records is one value per line (the .AT2 files and the CSVs "
+            "with a time column keep their own times): leave it out"
+        )
+    return motions
+
+
+def _record(path: Path, record_dt: float | None):
+    """The motion of one file of a record set: a CSV of one value per line with its samples ``record_dt``
+    apart, any other file with its own times (a mixed set: the time step is for its one-column files).
+    The file's first sample says which: read without a time step, a one-column file is refused there,
+    before the rest of it is parsed, and read again with the time step."""
+    from masonrycli.record_text import NoTimeStep
+    from masonrycli.records import record_motion
+
+    try:
+        return record_motion(path, display=str(path))
+    except NoTimeStep as exc:
+        if record_dt is None:
+            raise exc.give("--record-dt SECONDS") from None
+        return record_motion(path, display=str(path), time_step=record_dt)
 
 
 def _same_file(a, b) -> bool:

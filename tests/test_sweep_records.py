@@ -1,0 +1,48 @@
+"""``masonry sweep --records`` over a set holding a CSV of one value per line, with ``--record-dt``: the
+records reach the worker processes of a LocalCluster (pickled, their samples read-only arrays) and the
+one-column file's rows are those of the same samples given with a time column; the time step is part of
+the study (another one is another study)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+from typer.testing import CliRunner
+
+from masonrycli.cli import app
+from masonrycli.study.store import read_rows
+from masonrycli.study.task import RESULT_COLUMNS
+
+from synthetic_records import band_limited
+
+pytestmark = pytest.mark.slow  # a LocalCluster of a worker process
+BLOCK = Path(__file__).parent / "data" / "block_on_ground.toml"  # a sine-shaken block, 1 s
+
+
+def invoke(*args):
+    return CliRunner().invoke(app, [str(a) for a in args], terminal_width=200)
+
+
+def test_a_set_with_a_one_column_file_sweeps_on_worker_processes(tmp_path):
+    folder = tmp_path / "records"
+    folder.mkdir()
+    v = band_limited(0.2, 0.01, [3.0, 5.0], [0.004, 0.002], seed=4)[2].tolist()
+    (folder / "one.csv").write_text("velocity\n" + "".join(f"{x!r}\n" for x in v))
+    (folder / "two.csv").write_text("time,velocity\n" + "".join(f"{i * 0.01!r},{x!r}\n" for i, x in enumerate(v)))
+    out = tmp_path / "s.csv"
+    args = ["sweep", BLOCK, "--records", folder, "--scale", "1,10", "--duration", 0.2, "--out", out, "--no-recording"]
+    result = invoke(*args, "--record-dt", 0.01, "--workers", 1)
+    assert result.exit_code == 0, result.output
+    rows = {(r["record"], r["scale"]): r for r in read_rows(out)}
+    assert len(rows) == 4 and {r["status"] for r in rows.values()} == {"completed"}
+    same = [c for c in RESULT_COLUMNS if c not in ("wall_time", "cpu_time")]
+    for scale in (1.0, 10.0):
+        one, two = rows["one.csv", scale], rows["two.csv", scale]
+        assert [repr(one[c]) for c in same] == [repr(two[c]) for c in same], scale  # bit for bit, NaN as NaN
+    assert rows["one.csv", 10.0]["pgv"] == pytest.approx(10 * max(abs(x) for x in v))
+    # the same time step makes the same study (its rows reused); another is another record, another study
+    again = invoke(*args, "--record-dt", 0.01, "--workers", 0, "--force")
+    assert again.exit_code == 0 and "(0 runs now, 4 rows already there, 0 failed)" in again.output, again.output
+    again = invoke(*args, "--record-dt", 0.02, "--workers", 0, "--force")
+    assert again.exit_code == 0 and "(4 runs now, 0 rows already there, 0 failed)" in again.output, again.output
