@@ -219,8 +219,11 @@ def _sweep_and_prune(body_aabb, body_dynamic, axis, body_order, pair_body, pair_
             n += 1
     if n > capacity:
         return n
-    _counting_sort_pairs(pair_body, n, 1, body_count, pair_scratch, counter)
-    _counting_sort_pairs(pair_scratch, n, 0, body_count, pair_body, counter)
+    # np.int64, not the literals: numba compiles a callee once per argument type it sees while it infers
+    # the caller's types, and the literals 0, 1 and the first type of n (the literal 0) made 4 copies
+    n, by_a, by_b = np.int64(n), np.int64(0), np.int64(1)
+    _counting_sort_pairs(pair_body, n, by_b, body_count, pair_scratch, counter)
+    _counting_sort_pairs(pair_scratch, n, by_a, body_count, pair_body, counter)
     return n
 
 

@@ -79,7 +79,8 @@ def _nlgs_accelerated(contact_body, pack, count, mu, tolerance, max_iterations, 
     #       nlgs.solve hands the step to stalled.py); then j, β from the restart rule, and with flip the
     #       sweep order reverses at each restart (stalled.py's "turning" method)
     for c in range(count):
-        _push(v, contact_body[c, 0], contact_body[c, 1], pack, c, r[c, 0], r[c, 1])
+        # c unsigned as in the sweep below: one compiled _push serves both
+        _push(v, contact_body[c, 0], contact_body[c, 1], pack, np.uint64(c), r[c, 0], r[c, 1])
     iterations = 0
     residual = 0.0
     if count == 0:

@@ -238,7 +238,8 @@ def _nlgs(contact_body, pack, count, mu, tolerance, max_iterations, v, r, status
     #   until residual ≤ tolerance, or the cap, or (tolerance > 0) STALL_SWEEPS sweeps in a row without
     #   a new lowest residual: sweeping on would only cycle (module doc), solve() goes on by faces.
     for c in range(count):
-        _push(v, contact_body[c, 0], contact_body[c, 1], pack, c, r[c, 0], r[c, 1])
+        # c unsigned as in the sweep below: one compiled _push serves both
+        _push(v, contact_body[c, 0], contact_body[c, 1], pack, np.uint64(c), r[c, 0], r[c, 1])
     iterations = 0
     residual = 0.0
     if count == 0:
@@ -289,64 +290,21 @@ INTERLEAVE = 4
 """The sweep visits the contacts in this many interleaved runs of detection order (see _nlgs_interleaved)."""
 
 
-@njit
 def _nlgs_interleaved(
-    contact_body,
-    pack,
-    count,
-    mu,
-    tolerance,
-    max_iterations,
-    v,
-    r,
-    status,
-    accelerate,
-    accelerated_stall,
-    alternate=False,
+    contact_body, pack, count, mu, tolerance, max_iterations, v, r, status, accelerate, accelerated_stall, alternate=False
 ):
-    # Detection order puts a pair's two or three contact points, and the pairs of one block, next to
-    # each other: each visit then reads the velocities the visit before has just written, and the
-    # sweep runs at the latency of that chain. Visiting K = INTERLEAVE runs of the contacts in turn
-    #   order = run 0's 1st, run 1's 1st, …, run K−1's 1st, run 0's 2nd, …   (runs: C/K contacts each)
-    # gives the processor K independent chains to overlap: 15–35 % less time per contact·sweep on the
-    # paper's structures, the same sweep counts to ±4 (measured on captured steps of the 51- and
-    # 248-block walls, 8- and 32-course walls, arch and aqueduct). The rows are copied into that order
-    # (so the sweep reads memory in sequence), solved by _nlgs, and r, status copied back.
-    # alternate (stalled.py): plain sweeps alternate direction every sweep, accelerated ones at every restart.
-    k = INTERLEAVE
-    run = (count + k - 1) // k
-    order = np.empty(count, dtype=np.int64)
-    i = 0
-    for j in range(run):
-        for q in range(k):
-            c = q * run + j
-            if c < count:
-                order[i] = c
-                i += 1
-    body_o = np.empty((count, 2), dtype=np.uint32)  # unsigned: v[a] then compiles without a wrap-around test
-    pack_o = np.empty((count, PACK_WIDTH))
-    r_o = np.empty((count, 2))
-    status_o = np.empty(count, dtype=status.dtype)
-    for i in range(count):
-        c = order[i]
-        body_o[i, 0] = contact_body[c, 0]
-        body_o[i, 1] = contact_body[c, 1]
-        for j in range(PACK_WIDTH):  # not pack_o[i, :] = pack[c, :]: numba's slice copy cost ~20 ns a row more
-            pack_o[i, j] = pack[c, j]
-        r_o[i, 0] = r[c, 0]
-        r_o[i, 1] = r[c, 1]
+    """The sweeps in interleaved order (:mod:`masonrycli.engine.interleaved`): momentum's
+    (``accelerate``, stall window ``accelerated_stall``) or the plain ones; ``alternate`` as in
+    stalled.py. Returns (iterations, residual). Two kernels rather than one with the flag as an argument:
+    a run compiles only the sweep it uses (the plain one cost 1.5 s of the first run's compilation)."""
+    args = (contact_body, pack, count, mu, tolerance, max_iterations, v, r, status)
     if accelerate:
-        iterations, residual = momentum._nlgs_accelerated(
-            body_o, pack_o, count, mu, tolerance, max_iterations, v, r_o, status_o, accelerated_stall, alternate
-        )
-    else:
-        iterations, residual = _nlgs(body_o, pack_o, count, mu, tolerance, max_iterations, v, r_o, status_o, alternate)
-    for i in range(count):
-        c = order[i]
-        r[c, 0] = r_o[i, 0]
-        r[c, 1] = r_o[i, 1]
-        status[c] = status_o[i]
-    return iterations, residual
+        if alternate:
+            return interleaved._accelerated(*args, accelerated_stall, True)
+        return interleaved._accelerated(*args, accelerated_stall)  # flip omitted: compiled out
+    if alternate:
+        return interleaved._plain(*args, True)
+    return interleaved._plain(*args)
 
 
 @njit
@@ -491,4 +449,4 @@ def tangential_velocity(contact_body, pack, count, v) -> np.ndarray:
 
 # At the end: faces, momentum and stalled build on this module's sweep primitives (a stalled solve()
 # continues by faces or by stalled's methods; the accelerated sweep is momentum's).
-from masonrycli.engine import faces, momentum, stalled  # noqa: E402
+from masonrycli.engine import faces, interleaved, momentum, stalled  # noqa: E402
