@@ -30,6 +30,9 @@ the same from one step to the next: see :mod:`.contact_key`.
 
 The work is split in three kernels per pair, called by :func:`_collide_pair`: :func:`_choose_faces`
 (steps 1–3), :func:`_clip_incident` (step 4) and :func:`_write_pair_contacts` (step 5).
+They are ordinary kernels, not inlined by numba (``inline="always"``): LLVM inlines them into the loop
+anyway (detect_contacts 27.6–28.4 µs on captured steps of the 51-block wall with numba's inlining or
+without), and numba's inlining cost 1.3 s of CPU of a first run's compilation.
 """
 
 from __future__ import annotations
@@ -115,7 +118,7 @@ def edge_normals(vert_world, body_vert_start, edge_normal=None, body_size=None):
     return edge_normal, body_size
 
 
-@njit(inline="always")
+@njit
 def _max_face_separation(vert, normal, s1, n1, s2, n2, alert):
     # Largest separation of polygon 2 along the outward edge normals of polygon 1:
     #     for each edge i of 1:  sep_i = min_{w ∈ 2} n_i · (w − v_i)
@@ -142,7 +145,7 @@ def _max_face_separation(vert, normal, s1, n1, s2, n2, alert):
     return best, best_edge
 
 
-@njit(inline="always")
+@njit
 def _choose_faces(vert, normal, size_a, size_b, sa, na, sb, nb, alert):
     # Steps 1–3: separating axes, reference face, incident edge.
     #   sep_a, e_a = max face separation of b along a's normals   (> alert → no contact)
@@ -186,7 +189,7 @@ def _choose_faces(vert, normal, size_a, size_b, sa, na, sb, nb, alert):
     return e, e2, k, k2, ref_is_b, rs, is_, tol
 
 
-@njit(inline="always")
+@njit
 def _clip_incident(vert, rs, e, e2, is_, k, k2, nx, ny, tol):
     # Step 4: clip the incident segment w1 = I[k] → w2 = I[k2] to the side planes of R's edge e.
     #   frame of the edge v1 = R[e] → v2 = R[e2]: u = (−n_y, n_x) (n is u turned by −90°), L = u·(v2 − v1);
@@ -263,7 +266,7 @@ def _clip_incident(vert, rs, e, e2, is_, k, k2, nx, ny, tol):
     return True, length, (p1x, p1y, g1, t1, t01, side1), (p2x, p2y, g2, t2, t02, side2)
 
 
-@njit(inline="always")
+@njit
 def _write_pair_contacts(
     a, b, ref_is_b, e, e2, k, k2, nx, ny, length, tol, alert, end1, end2, c,
     contact_body, contact_point, contact_normal, contact_gap, contact_key,
@@ -326,7 +329,7 @@ def _write_pair_contacts(
     return c
 
 
-@njit(inline="always")
+@njit
 def _collide_pair(
     vert, normal, size_a, size_b, sa, na, sb, nb, a, b, alert, c,
     contact_body, contact_point, contact_normal, contact_gap, contact_key,
@@ -356,7 +359,7 @@ def _narrowphase(
 ):  # fmt: skip
     # for each candidate pair p (in the given order): append its 0..2 contacts (see _collide_pair).
     # Contacts beyond the capacity are counted, not written. Returns the number of contacts.
-    c = 0
+    c = np.int64(0)  # not 0: numba would compile _collide_pair for the literal 0 as well (broadphase.py)
     for p in range(pair_count):
         a = pair_body[p, 0]
         b = pair_body[p, 1]

@@ -291,7 +291,18 @@ INTERLEAVE = 4
 
 
 def _nlgs_interleaved(
-    contact_body, pack, count, mu, tolerance, max_iterations, v, r, status, accelerate, accelerated_stall, alternate=False
+    contact_body,
+    pack,
+    count,
+    mu,
+    tolerance,
+    max_iterations,
+    v,
+    r,
+    status,
+    accelerate,
+    accelerated_stall,
+    alternate=False,
 ):
     """The sweeps in interleaved order (:mod:`masonrycli.engine.interleaved`): momentum's
     (``accelerate``, stall window ``accelerated_stall``) or the plain ones; ``alternate`` as in
