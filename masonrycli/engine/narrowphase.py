@@ -30,9 +30,9 @@ the same from one step to the next: see :mod:`.contact_key`.
 
 The work is split in three kernels per pair, called by :func:`_collide_pair`: :func:`_choose_faces`
 (steps 1–3), :func:`_clip_incident` (step 4) and :func:`_write_pair_contacts` (step 5).
-They are ordinary kernels, not inlined by numba (``inline="always"``): LLVM inlines them into the loop
-anyway (detect_contacts 27.6–28.4 µs on captured steps of the 51-block wall with numba's inlining or
-without), and numba's inlining cost 1.3 s of CPU of a first run's compilation.
+They are ordinary kernels, not inlined by numba (``inline="always"``): that no longer made the loop
+faster (detect_contacts 27.6–28.4 µs on captured steps of the 51-block wall with it or without), and it
+cost 1.3 s of CPU of a first run's compilation.
 """
 
 from __future__ import annotations
