@@ -22,8 +22,6 @@ factorisation overwrites it with L (unit lower, below the diagonal) and U (on an
 from __future__ import annotations
 
 import numpy as np
-import scipy.sparse as sp
-from scipy.sparse.csgraph import reverse_cuthill_mckee
 
 from masonrycli.engine._jit import njit
 
@@ -85,6 +83,11 @@ def body_order(contact_body, coupled, bodies) -> tuple[np.ndarray, int]:
     if a.size == 0:
         return position, 0
     natural = int(np.abs(a - b).max())
+    # scipy imported here: only a stalled step's Newton gets here, and importing it at the top cost every
+    # start of masonry ~0.15 s of CPU (importing the CLI and the time loop: 0.73 -> 0.58 s)
+    import scipy.sparse as sp
+    from scipy.sparse.csgraph import reverse_cuthill_mckee
+
     graph = sp.csr_matrix((np.ones(a.size), (a, b)), shape=(bodies, bodies))
     order = reverse_cuthill_mckee((graph + graph.T).tocsr(), symmetric_mode=True)
     rcm = np.empty(bodies, dtype=np.int64)
