@@ -15,16 +15,17 @@ from rich.text import Text
 
 SLOW_START = (
     "starting: building the model (a first run, or the first after an update, also compiles the numba "
-    "kernels: about 30 s of CPU; later runs of a small structure start in about a second)"
+    "kernels: about 20 s of CPU; later runs of a small structure start in about a second)"
 )
 
 
 @contextmanager
 def slow_start_notice(after: float = 5.0, stream=None):
     """On a terminal, say why nothing shows when setting a run up takes more than ``after`` s. A first run
-    compiles the kernels: 15 s with no line at all, then a progress bar at step 0 for 15 s more, and a user
-    new to it took the command for hung (README, Quick start). A warm start takes 0.6 s for 4000 blocks, 3.8 s
-    for 20 000 (2026-11-28). Not on a pipe or a file: logs and tests keep their lines."""
+    compiled the kernels for ~30 s of CPU (2026-11-27; ~20 s since 2026-11-28): 15 s with no line at all,
+    then a progress bar at step 0 for 15 s more, and a user new to it took the command for hung (README,
+    Quick start). A warm start takes 0.6 s for 4000 blocks, 3.8 s for 20 000 (2026-11-28). Not on a pipe or
+    a file: logs and tests keep their lines."""
     stream = sys.stderr if stream is None else stream
     if not stream.isatty():
         yield
