@@ -111,8 +111,14 @@ def read_geojson(path, density: float = 2500.0, thickness: float = 1.0) -> Assem
     except json.JSONDecodeError as exc:
         raise GeometryError(f"{path}: invalid JSON ({exc.msg} at line {exc.lineno}, column {exc.colno})") from None
     if not isinstance(data, dict) or data.get("type") != "FeatureCollection":
-        got = data.get("type") if isinstance(data, dict) else type(data).__name__
-        raise GeometryError(f"{path}: expected a GeoJSON FeatureCollection, got {got!r}")
+        # "got None" said nothing of a JSON file that is no GeoJSON (a package.json, a settings file)
+        if not isinstance(data, dict):
+            got = f"a JSON {type(data).__name__}"
+        elif "type" not in data:
+            got = 'a JSON object with no "type" (not GeoJSON)'
+        else:
+            got = repr(data["type"])
+        raise GeometryError(f"{path}: expected a GeoJSON FeatureCollection, got {got}")
     features = data.get("features")
     if not isinstance(features, list):
         raise GeometryError(f"{path}: FeatureCollection has no 'features' list")

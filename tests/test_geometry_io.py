@@ -114,7 +114,12 @@ def test_geojson_errors_name_file_and_feature(tmp_path):
 
     not_fc = tmp_path / "fc.geojson"
     not_fc.write_text(json.dumps({"type": "Feature"}))
-    assert "expected a GeoJSON FeatureCollection" in one_line_error(read_geojson, not_fc)
+    assert "expected a GeoJSON FeatureCollection, got 'Feature'" in one_line_error(read_geojson, not_fc)
+    not_fc.write_text(json.dumps({"name": "masonry", "version": "0.1.0"}))  # it said "got None"
+    text = one_line_error(read_geojson, not_fc)
+    assert text.endswith('expected a GeoJSON FeatureCollection, got a JSON object with no "type" (not GeoJSON)')
+    not_fc.write_text("[1, 2]")
+    assert one_line_error(read_geojson, not_fc).endswith("got a JSON list")
 
     point = {"type": "Feature", "properties": {"name": "p"}, "geometry": {"type": "Point", "coordinates": [0, 0]}}
     text = one_line_error(read_geojson, write(tmp_path, [feature(SQ), point], "pt.geojson"))
