@@ -399,6 +399,15 @@ class Record(_Directed, Motion):
         return float(self._arrays.time[-1])
 
     @property
+    def peak_acceleration(self) -> float:
+        """m/s²: the largest acceleration of the samples used, scaled (of the samples for an acceleration
+        record; between them for a velocity one), before the baseline correction."""
+        a = self._arrays
+        if self.quantity != "acceleration":
+            return float(np.hypot(*(np.diff(a.value, axis=0) / np.diff(a.time)[:, None]).T).max())
+        return float(np.hypot(*a.value.T).max())
+
+    @property
     def sample_interval(self) -> float:
         """s: the shortest spacing of the samples used (a step longer than this skips samples)."""
         return float(np.diff(self._arrays.time).min())

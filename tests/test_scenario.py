@@ -522,3 +522,27 @@ def test_record_warnings_name_a_record_sampled_finer_than_dt():
     ]
     exact = dataclasses.replace(scenario, run=dataclasses.replace(scenario.run, dt=0.1))
     assert record_warnings(exact) == []
+
+
+def test_record_warnings_name_a_record_beyond_10_g_as_scaled(tmp_path):
+    # A CSV of velocity in cm/s read as m/s (no header to say so), or an .AT2 given --scale 9.81 "to convert g",
+    # ran "completed … collapsed" at hundreds of g without a word.
+    from masonrycli.scenario import record_warnings
+
+    (tmp_path / "cms.csv").write_text("time,v\n0,0\n0.01,0.5\n0.02,0\n0.03,-0.5\n0.04,0\n")  # 50 m/s² as m/s
+    text = BLOCK + GROUND + 'motion = { kind = "record", file = "cms.csv", scale = 3.0 }\n'
+    scenario = loads_scenario(text, source=str(tmp_path / "s.toml"), base_dir=tmp_path)
+    assert scenario.motions[-1].peak_acceleration == pytest.approx(150.0)  # 0.5 m/s in 0.01 s, times 3
+    late = 'support "ground": the record cms.csv lasts 0.04 s'
+    assert [w for w in record_warnings(scenario) if not w.startswith(late)] == [
+        'support "ground": the record cms.csv peaks at 15.3 g as applied (scale 3); the strongest earthquakes '
+        "reach 3–4 g: check its units and the scale"
+    ]
+    gentle = dataclasses.replace(scenario, motions=(dataclasses.replace(scenario.motions[-1], scale=1.0),))
+    assert not any("peaks" in w for w in record_warnings(gentle))  # 5.1 g: strong, not absurd
+    from masonrycli.motion import Record
+
+    accel = Record(
+        time=(0.0, 0.1, 0.2), value=((0.0, 0.0), (3.0, 4.0), (-1.0, 0.0)), quantity="acceleration", scale=2.0
+    )
+    assert accel.peak_acceleration == pytest.approx(10.0)  # |(3, 4)| × 2, of the samples themselves
