@@ -1,4 +1,5 @@
-"""One resultant per joint: what an engineer reads as a force chain or a line of thrust (numpy only).
+"""One resultant per joint: what an engineer reads as a force chain or a line of thrust (the sums over
+each joint's contacts are a kernel of :mod:`masonrycli.engine.joints`).
 
 A *joint* here is a pair of bodies in contact in the current frame (two blocks, or a block and a
 support). Its contact points carry forces F_c (on body b of the pair (a, b), normal n_c from a to b);
@@ -28,7 +29,7 @@ from typing import Final, NamedTuple
 
 import numpy as np
 
-from masonrycli.frame import CONTACT_OPEN, CONTACT_SLIP
+from masonrycli.engine import joints as _kernels
 
 JOINT_STICK: Final = 0
 JOINT_SLIP: Final = 1
@@ -68,26 +69,20 @@ def joint_resultants(
     status = np.asarray(contact_status).reshape(-1)
     frame = np.zeros(len(status), np.int64) if contact_frame is None else np.asarray(contact_frame, np.int64)
     keep = body[:, 0] != body[:, 1]  # a body against itself is no joint
-    body, point, normal, force, status = body[keep], point[keep], normal[keep], force[keep], status[keep]
-    frame = frame[keep]
+    if not keep.all():
+        body, point, normal, force, status = body[keep], point[keep], normal[keep], force[keep], status[keep]
+        frame = frame[keep]
     # Orient every contact as (low, high) body: the force on the higher index flips with the order.
     flip = body[:, 0] > body[:, 1]
-    sign = np.where(flip, -1.0, 1.0)[:, None]
     lo, hi = np.minimum(body[:, 0], body[:, 1]), np.maximum(body[:, 0], body[:, 1])
-    force, normal = force * sign, normal * sign
     base = int(hi.max()) + 1 if hi.size else 1
     # 1-D keys (far faster than rows), sorted by (frame, a, b); sums per joint then run over its
     # contacts in their order whatever the other frames, so a frame's numbers do not depend on them.
     keys, joint = _unique_inverse((frame * base + lo) * base + hi)
     pairs = np.stack([keys // base % base, keys % base], axis=1)
-    j = len(pairs)
-    fn = np.maximum(np.einsum("ij,ij->i", force, normal), 0.0)
-    weight = np.bincount(joint, weights=fn, minlength=j)
-    resultant = np.stack([np.bincount(joint, weights=force[:, k], minlength=j) for k in range(2)], axis=1)
-    centre = np.stack([np.bincount(joint, weights=fn * point[:, k], minlength=j) for k in range(2)], axis=1)
-    slipping = np.bincount(joint, weights=(status == CONTACT_SLIP), minlength=j) > 0
-    opened = np.bincount(joint, weights=(status == CONTACT_OPEN), minlength=j) > 0
-    state = np.where(slipping, JOINT_SLIP, np.where(opened, JOINT_OPEN, JOINT_STICK)).astype(np.int8)
+    # Σ over each joint's contacts (the normal force fn = max(F·n, 0), F, fn·p, slip and open flags) in one
+    # pass of a kernel: the same sums in the same order as bincount's, ~8x faster on a recording's batch.
+    weight, resultant, centre, state = _kernels.resultant_sums(joint, len(pairs), flip, force, normal, point, status)
     loaded = weight > 0.0
     return JointResultants(
         body=pairs[loaded],

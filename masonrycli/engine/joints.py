@@ -1,4 +1,5 @@
-"""Kernels of the joint states (:mod:`masonrycli.mechanism`): openings, hinge flags, per-block fields.
+"""Kernels of the joint states (:mod:`masonrycli.mechanism`): openings, hinge flags, per-block fields; and
+the sums behind the recording's joint resultants (:mod:`masonrycli.joint_forces`).
 
 They are computed for every recorded frame. In numpy each was a dozen small array operations (fancy
 indexing, ``ufunc.at``, ``bincount``), ~200 µs a frame on the 51-block wall; one pass here does the
@@ -142,6 +143,39 @@ def _contact_states(status, tangential_velocity, contact_r, friction, slip_speed
         out_mobilised[c] = abs(contact_r[c, 0]) / denom if s != _OPEN and denom > 0.0 else 0.0
 
 
+@njit
+def _resultant_sums(joint, flip, force, normal, point, status, weight, resultant, centre, state):
+    # for each contact c, in order, of joint j = joint[c], with s = −1 if its bodies are flipped, else 1:
+    #     f = s·force[c], n = s·normal[c], fn = max((0 + f_x n_x) + f_y n_y, 0)   (einsum's sum, np.maximum)
+    #     weight[j] += fn;  resultant[j] += f;  centre[j] += fn · point[c]      (bins from 0, as bincount)
+    #     slipping[j] |= status[c] == SLIP;  opened[j] |= status[c] == OPEN
+    # state[j] = SLIP if slipping, else OPEN if opened, else STICK (joint_forces' JOINT_* values 1, 2, 0)
+    j_count = weight.shape[0]
+    slipping = np.zeros(j_count, dtype=np.bool_)
+    opened = np.zeros(j_count, dtype=np.bool_)
+    for j in range(j_count):
+        weight[j] = 0.0
+        resultant[j, 0] = 0.0
+        resultant[j, 1] = 0.0
+        centre[j, 0] = 0.0
+        centre[j, 1] = 0.0
+    for c in range(joint.shape[0]):
+        j = joint[c]
+        s = -1.0 if flip[c] else 1.0
+        fx = force[c, 0] * s
+        fy = force[c, 1] * s
+        fn = _nan_max((0.0 + fx * (normal[c, 0] * s)) + fy * (normal[c, 1] * s), 0.0)
+        weight[j] += fn
+        resultant[j, 0] += fx
+        resultant[j, 1] += fy
+        centre[j, 0] += fn * point[c, 0]
+        centre[j, 1] += fn * point[c, 1]
+        slipping[j] |= status[c] == _SLIP
+        opened[j] |= status[c] == _OPEN
+    for j in range(j_count):
+        state[j] = 1 if slipping[j] else (2 if opened[j] else 0)
+
+
 def openings(body_q, end_body, local_a, local_b, normal0, gap0) -> np.ndarray:
     """(E,) m: opening of every joint end (``end_body`` (E, 2) int64, the other arrays (E, 2) / (E,)
     float64 in the bodies' frames) in configuration ``body_q`` (B, 3)."""
@@ -184,3 +218,24 @@ def contact_states(status, tangential_velocity, contact_r, friction: float, slip
     mobilised = np.empty(status.shape[0])
     _contact_states(status, tangential_velocity, contact_r, float(friction), float(slip_speed), out_status, mobilised)
     return out_status, mobilised
+
+
+def resultant_sums(joint, j_count: int, flip, force, normal, point, status):
+    """Per joint (``joint`` (C,) its index 0..j_count−1 for each contact, in contact order): (weight (J,) Σ
+    compressive normal force, resultant (J, 2) Σ force, centre (J, 2) Σ normal force · point, state (J,)
+    int8), the forces and normals turned by −1 where ``flip`` (the bodies in (high, low) order)."""
+    weight, state = np.empty(j_count), np.empty(j_count, dtype=np.int8)
+    resultant, centre = np.empty((j_count, 2)), np.empty((j_count, 2))
+    _resultant_sums(
+        np.ascontiguousarray(joint, dtype=np.int64),
+        np.ascontiguousarray(flip, dtype=np.bool_),
+        np.ascontiguousarray(force, dtype=np.float64),
+        np.ascontiguousarray(normal, dtype=np.float64),
+        np.ascontiguousarray(point, dtype=np.float64),
+        np.ascontiguousarray(status, dtype=np.int8),
+        weight,
+        resultant,
+        centre,
+        state,
+    )
+    return weight, resultant, centre, state

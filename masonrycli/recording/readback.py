@@ -278,6 +278,30 @@ def field_frames(path: str | os.PathLike) -> dict[int, dict]:
     return out
 
 
+_RUN_CLOCK = re.compile(r"(\*\*Wall time:\*\* )[0-9.]+( s)|(\| started \| )[^|]*")
+
+
+def recording_rows(path: str | os.PathLike) -> dict[str, list[str]]:
+    """Every entity's rows, comparable between two runs of the same command: ``{entity: sorted rows}``, a row
+    the ``repr`` of its time columns and component values (no row ids, so chunking does not matter); static
+    entities as ``"static <entity>"`` with their last row only (the one in force), the run document's wall
+    time and start time masked, the recording's own start time (``/__properties``) left out."""
+    temporal: dict[str, list[str]] = {}
+    static: dict[str, list[str]] = {}
+    for chunk in rr.chunk.RrdReader(os.fspath(path)).stream():
+        if chunk.entity_path == "/__properties":
+            continue
+        batch = chunk.to_record_batch()
+        names = sorted(n for n in batch.schema.names if n != "rerun.controls.RowId")
+        columns = [(n, batch.column(n).to_pylist()) for n in names]
+        rows = [repr([(n, values[i]) for n, values in columns]) for i in range(batch.num_rows)]
+        if chunk.is_static:
+            static[f"static {chunk.entity_path}"] = [_RUN_CLOCK.sub(r"\1\2\3", rows[-1])]
+        else:
+            temporal.setdefault(chunk.entity_path, []).extend(rows)
+    return {entity: sorted(rows) for entity, rows in temporal.items()} | static
+
+
 # ---------------------------------------------------------------------------------------- headless viewer
 def _free_port() -> int:
     with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as s:
