@@ -62,7 +62,9 @@ def joint_resultants(
             frames at once (a recording's batch). The joints are then those of (frame, a, b), rows sorted
             by (frame, a, b), ``frame`` says which; each frame's rows are what it alone would give.
     """
-    body = np.asarray(contact_body, dtype=np.int64).reshape(-1, 2)
+    body = np.asarray(contact_body).reshape(-1, 2)
+    if body.dtype.kind not in "iu":
+        body = body.astype(np.int64)
     point = np.asarray(contact_point, dtype=np.float64).reshape(-1, 2)
     normal = np.asarray(contact_normal, dtype=np.float64).reshape(-1, 2)
     force = np.asarray(contact_force, dtype=np.float64).reshape(-1, 2)
@@ -73,12 +75,10 @@ def joint_resultants(
         body, point, normal, force, status = body[keep], point[keep], normal[keep], force[keep], status[keep]
         frame = frame[keep]
     # Orient every contact as (low, high) body: the force on the higher index flips with the order.
-    flip = body[:, 0] > body[:, 1]
-    lo, hi = np.minimum(body[:, 0], body[:, 1]), np.maximum(body[:, 0], body[:, 1])
-    base = int(hi.max()) + 1 if hi.size else 1
     # 1-D keys (far faster than rows), sorted by (frame, a, b); sums per joint then run over its
     # contacts in their order whatever the other frames, so a frame's numbers do not depend on them.
-    keys, joint = _unique_inverse((frame * base + lo) * base + hi)
+    keys, flip, base = _kernels.joint_keys(body, frame)
+    keys, joint = _unique_inverse(keys)
     pairs = np.stack([keys // base % base, keys % base], axis=1)
     # Σ over each joint's contacts (the normal force fn = max(F·n, 0), F, fn·p, slip and open flags) in one
     # pass of a kernel: the same sums in the same order as bincount's, ~8x faster on a recording's batch.

@@ -150,6 +150,23 @@ def _contact_states(status, tangential_velocity, contact_r, friction, slip_speed
 
 
 @njit
+def _joint_keys(body, frame, keys, flip):
+    # base = 1 + the largest body index (1 without contacts)
+    # for each contact c: flip[c] = a > b;  keys[c] = (frame[c]·base + min(a, b))·base + max(a, b)
+    # returns base
+    base = 0
+    for c in range(body.shape[0]):
+        base = max(base, body[c, 0], body[c, 1])
+    base += 1
+    for c in range(body.shape[0]):
+        a = np.int64(body[c, 0])
+        b = np.int64(body[c, 1])
+        flip[c] = a > b
+        keys[c] = (frame[c] * base + min(a, b)) * base + max(a, b)
+    return base
+
+
+@njit
 def _resultant_sums(joint, flip, force, normal, point, status, weight, resultant, centre, state):
     # for each contact c, in order, of joint j = joint[c], with s = −1 if its bodies are flipped, else 1:
     #     f = s·force[c], n = s·normal[c], fn = max((0 + f_x n_x) + f_y n_y, 0)   (einsum's sum, np.maximum)
@@ -224,6 +241,14 @@ def contact_states(status, tangential_velocity, contact_r, friction: float, slip
     mobilised = np.empty(status.shape[0])
     _contact_states(status, tangential_velocity, contact_r, float(friction), float(slip_speed), out_status, mobilised)
     return out_status, mobilised
+
+
+def joint_keys(body, frame) -> tuple[np.ndarray, np.ndarray, int]:
+    """((C,) int64 key (frame·B + low body)·B + high body, (C,) bool flip (a > b), B = 1 + the largest body
+    index) of contacts between bodies ``body`` (C, 2) int in frames ``frame`` (C,) int ≥ 0."""
+    keys, flip = np.empty(body.shape[0], dtype=np.int64), np.empty(body.shape[0], dtype=np.bool_)
+    base = _joint_keys(np.ascontiguousarray(body), np.ascontiguousarray(frame, dtype=np.int64), keys, flip)
+    return keys, flip, int(base)
 
 
 def resultant_sums(joint, j_count: int, flip, force, normal, point, status):
