@@ -406,7 +406,8 @@ class TensorComputer:
         self._invariants_stale = True
 
     def fields(self) -> dict[str, np.ndarray]:
-        """Copies of all ``TENSOR_FIELDS``, name → (N, *shape) float64 array, in ``TENSOR_FIELDS`` order.
+        """Copies of all ``TENSOR_FIELDS``, name → (N, *shape) float64 C-contiguous array, in ``TENSOR_FIELDS``
+        order (rows of one copy of each packed buffer: a later ``step`` leaves them as they are).
 
         The invariants (principal values and angles, p, q, volumetric, deviatoric, skew) are pure
         functions of the stored tensors; they are derived here, once per ``step``, rather than in
@@ -430,7 +431,9 @@ class TensorComputer:
         if self._invariants_stale:
             _k._tensor_invariants(self._tensor, self._pair, self._scalar)
             self._invariants_stale = False
-        return {name: self._buffers[kind][row].copy() for name, (kind, row) in _LAYOUT.items()}
+        # One copy of each packed buffer (4 copies, not 18): each field is a contiguous row of its copy.
+        copies = {kind: buffer.copy() for kind, buffer in self._buffers.items()}
+        return {name: copies[kind][row] for name, (kind, row) in _LAYOUT.items()}
 
 
 def _f64(a) -> np.ndarray:

@@ -137,3 +137,18 @@ def test_blocks_facing_across_a_gap_are_not_a_joint():
     gap[4:] = 0.5 * JOINT_GAP
     jt = JointTracker(body, point, normal, gap, q0, block_count=3, mean_block_weight=10.0)
     np.testing.assert_array_equal(jt.joint_body, [[0, 1], [0, 2], [1, 3]])
+
+
+def test_key_row_finds_what_a_binary_search_finds_from_any_hint():
+    """engine.joints._key_row (galloping from the last row found) against np.searchsorted: the same row for
+    every key present, −1 for keys absent, below, between and above, whatever the hint."""
+    from masonrycli.engine.joints import _key_row
+
+    rng = np.random.default_rng(2)
+    for n in (0, 1, 2, 7, 300):
+        key = np.unique(rng.integers(0, 4 * n + 1, n).astype(np.int64))[: max(n, 0)]
+        for k in range(-2, 4 * n + 4):
+            i = int(np.searchsorted(key, k))
+            expected = i if i < len(key) and key[i] == k else -1
+            for hint in {0, len(key) // 2, max(len(key) - 1, 0), len(key), int(rng.integers(0, len(key) + 1))}:
+                assert _key_row(key, np.int64(k), hint) == expected, (n, k, hint)

@@ -58,18 +58,26 @@ def _nan_max(x, y):
 
 
 @njit
-def _lower_bound(key, k):
-    # np.searchsorted(key, k) of a sorted int64 array: the first position whose key is ≥ k (len if none).
-    # Written out: numba's searchsorted compiled its generic comparisons (floats, complex) for ~0.5 s of CPU.
-    lo = 0
-    hi = key.shape[0]
-    while lo < hi:
-        mid = (lo + hi) >> 1
-        if key[mid] < k:
-            lo = mid + 1
+def _key_row(key, k, hint):
+    # the row of k in the sorted, distinct keys `key`, or −1. The contacts come sorted by pair, so the next
+    # contact's key is at or just after the row found for the last one (`hint`): gallop forward from there
+    # (rows hint, hint+1, hint+3, hint+7, ... while key ≤ k), then search the last stride only; from row 0
+    # when key[hint] > k. A contact costs a few comparisons instead of a search over all the joints.
+    # Written out, not np.searchsorted: numba's compiled its generic comparisons for ~0.5 s of CPU.
+    n = key.shape[0]
+    lo = hint if hint < n and key[hint] <= k else 0
+    step = 1
+    while lo + step < n and key[lo + step] <= k:
+        lo += step
+        step *= 2
+    hi = min(lo + step, n)  # key[lo] ≤ k (or lo = 0) and key[hi] > k (or hi = n): bisect [lo, hi)
+    while hi - lo > 1:
+        mid = (lo + hi) // 2
+        if key[mid] <= k:
+            lo = mid
         else:
             hi = mid
-    return lo
+    return lo if lo < n and key[lo] == k else -1
 
 
 @njit
@@ -86,11 +94,13 @@ def _hinged(opening, end_joint, key, body_count, contact_body, contact_rn, dt, o
             widest[j] = _nan_max(widest[j], opening[e])
     loaded = np.zeros(j_count)
     total = np.zeros(j_count)
+    pos = 0
     for c in range(contact_body.shape[0]):
         k = np.int64(contact_body[c, 0]) * body_count + contact_body[c, 1]
-        pos = min(_lower_bound(key, k), j_count - 1)
-        if key[pos] != k:
+        row = _key_row(key, k, pos)
+        if row < 0:
             continue
+        pos = row
         force = contact_rn[c] / dt
         if force > 0.0:
             loaded[pos] += 1.0
@@ -104,10 +114,13 @@ def _hinged(opening, end_joint, key, body_count, contact_body, contact_rn, dt, o
 @njit
 def _hinge_contacts(key, hinged, body_count, contact_body, contact_rn, out):
     # out[c] = contact c carries normal force (r_n > 0) and its pair is a hinged joint
+    pos = 0
     for c in range(contact_body.shape[0]):
         k = np.int64(contact_body[c, 0]) * body_count + contact_body[c, 1]
-        pos = _lower_bound(key, k)
-        out[c] = contact_rn[c] > 0.0 and pos < key.shape[0] and key[pos] == k and hinged[pos]
+        row = _key_row(key, k, pos)
+        if row >= 0:
+            pos = row
+        out[c] = contact_rn[c] > 0.0 and row >= 0 and hinged[row]
 
 
 @njit
