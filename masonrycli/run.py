@@ -166,7 +166,8 @@ class Simulation:
         return integrate.energies(self.model, self.state.body_q, self.state.body_v)
 
     def frame(self) -> Frame:
-        """Snapshot of the current state and the last step's contacts and tensors."""
+        """Snapshot of the current state and the last step's contacts and tensors: every array is the frame's
+        own (copied from the engine's buffers), so the sinks keep them without copying (sinks.FrameSink)."""
         m, st, s = self.model, self.state, self.solver
         n = m.block_count
         kinetic, potential = self.energies()

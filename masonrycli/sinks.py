@@ -26,7 +26,8 @@ class FrameSink(Protocol):
     """Receives every recorded frame, then one ``close``."""
 
     def on_frame(self, frame: Frame) -> None:
-        """Take one frame (copy what must outlive the call: the engine reuses its buffers)."""
+        """Take one frame. Its arrays are its own (``Simulation.frame`` copies the engine's buffers, which the
+        engine reuses) and nobody modifies them afterwards: a sink keeps what it needs without copying."""
 
     def close(self, status: str, note: str = "") -> None:
         """Finish the output; ``status`` is one of :data:`STATUSES`, ``note`` one line (may be empty)."""

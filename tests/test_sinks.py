@@ -49,3 +49,28 @@ def test_sinks_share_one_contract(tmp_path):
     h = np.load(tmp_path / "h.npz")
     assert (str(h["status"]), str(h["note"])) == ("interrupted", "stopped")
     assert all(callable(getattr(Recorder, name, None)) for name in ("on_frame", "close"))
+
+
+def test_a_frames_arrays_are_its_own():
+    """FrameSink: sinks keep a frame's arrays without copying, so no two frames share memory (the engine
+    reuses its buffers) and a frame is unchanged by the steps after it."""
+    from masonrycli.run import Simulation
+    from masonrycli.scenario import Material, RunConfig, scenario_from_builder
+
+    sim = Simulation(scenario_from_builder("wall", {"blocks": 51}, RunConfig(duration=0.02), Material(), {}))
+    for _ in range(3):
+        sim.step()
+    first = sim.frame()
+
+    def arrays(frame):
+        fields = {k: v for k, v in vars(frame).items() if isinstance(v, np.ndarray) and k != "joint_body"}
+        return fields | {f"tensors.{k}": v for k, v in frame.tensors.items()}
+
+    kept = {k: v.copy() for k, v in arrays(first).items()}
+    for _ in range(5):
+        sim.step()
+    later = arrays(sim.frame())
+    for name, value in arrays(first).items():
+        assert np.array_equal(value, kept[name], equal_nan=value.dtype.kind == "f"), name
+        assert not any(np.shares_memory(value, other) for other in later.values()), name
+    assert not np.array_equal(first.block_q, later["block_q"])

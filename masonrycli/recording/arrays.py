@@ -72,7 +72,7 @@ partition_lengths = np.full  # (n_frames, instances per frame) -> partition leng
 
 
 class FrameBatch(dict):
-    """name -> list of per-frame copies since the last flush (the engine may reuse its buffers)."""
+    """name -> list of per-frame arrays since the last flush (a frame's own arrays: sinks.FrameSink)."""
 
     def add(self, name: str, value) -> None:
         self.setdefault(name, []).append(value)

@@ -196,8 +196,8 @@ class Recorder:
         if self._closed:
             raise RuntimeError("Recorder is closed")
         f64 = np.float64
-        q = np.array(frame.block_q, f64)
-        sq = np.array(frame.support_q, f64).reshape(-1, 3)
+        q = np.asarray(frame.block_q, f64)
+        sq = np.asarray(frame.support_q, f64).reshape(-1, 3)
         if self._ref is None:
             self._ref = (q, sq, float(frame.energy_potential))
             self._legend_box, self._size = log_plane(self.rec, self._blocks, self._supports, q, sq)
@@ -218,10 +218,10 @@ class Recorder:
         b.add("scalars", [float(getattr(frame, name)) for name in SCALARS])
         b.add("block_q", q)
         b.add("support_q", sq)
-        b.add("support_v", np.array(frame.support_v, f64).reshape(-1, 2))
+        b.add("support_v", np.asarray(frame.support_v, f64).reshape(-1, 2))
         # The joint resultants of the whole batch are made at once when it is sent (batch_joint_resultants).
-        b.add("contacts", tuple(np.array(getattr(frame, f"contact_{name}")) for name in CONTACT_ARRAYS))
-        b.add("hinge_point", np.array(getattr(frame, "hinge_point", np.zeros((0, 2))), f64).reshape(-1, 2))
+        b.add("contacts", tuple(np.asarray(getattr(frame, f"contact_{name}")) for name in CONTACT_ARRAYS))
+        b.add("hinge_point", np.asarray(getattr(frame, "hinge_point", np.zeros((0, 2))), f64).reshape(-1, 2))
         for key in TENSOR_KEYS:
             b.add(key, _tensor(frame.tensors, key, self._n))
         self._poses.append((int(frame.step), float(frame.time), q.astype(np.float32), sq.astype(np.float32)))
@@ -473,7 +473,8 @@ class Recorder:
 
 
 def _tensor(tensors: dict, key: str, n: int) -> np.ndarray:
-    """A float64 copy of tensors[key]; NaN of the expected shape when the field is missing."""
+    """tensors[key] as float64 of the expected shape (no copy: a frame's arrays are its own, sinks.FrameSink);
+    NaN of that shape when the field is missing."""
     shape = (n, 2) if key in ("cell_principal_stress", "cell_principal_strain_rate") else (n,)
     value = tensors.get(key) if tensors else None
-    return np.full(shape, np.nan) if value is None else np.array(value, dtype=np.float64).reshape(shape)
+    return np.full(shape, np.nan) if value is None else np.asarray(value, dtype=np.float64).reshape(shape)
