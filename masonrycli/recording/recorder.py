@@ -343,7 +343,7 @@ class Recorder:
                 archetype, components={"colors": rr.components.ColorBatch(colors[:, self._blocks.owner].reshape(-1))}
             ).partition(per_vertex)
             # no point for an empty count ("0 below" is left out): an empty label still drew its box
-            shown = np.array([bool(t) for t in labels]).reshape(n_frames, TICKS + 3)
+            shown = np.array(labels, dtype=object).astype(bool).reshape(n_frames, TICKS + 3)
             self.rec.send_columns(
                 f.labels,
                 indexes=idx,
@@ -352,7 +352,7 @@ class Recorder:
                     # range, which joins no static positions to temporal labels
                     *rr.Points2D.columns(
                         positions=np.tile(self._label_anchors, (n_frames, 1))[shown.reshape(-1)],
-                        labels=[t for t in labels if t],
+                        labels=pa.array(labels, type=pa.utf8()).filter(shown.reshape(-1)),  # not a list: 2x faster
                     ).partition(shown.sum(axis=1)),
                     *rr.AnyValues.columns(range_lo=pa.array(lo), range_hi=pa.array(hi)),
                 ],
