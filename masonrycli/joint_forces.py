@@ -74,35 +74,19 @@ def joint_resultants(
     if not keep.all():
         body, point, normal, force, status = body[keep], point[keep], normal[keep], force[keep], status[keep]
         frame = frame[keep]
-    # Orient every contact as (low, high) body: the force on the higher index flips with the order.
-    # 1-D keys (far faster than rows), sorted by (frame, a, b); sums per joint then run over its
-    # contacts in their order whatever the other frames, so a frame's numbers do not depend on them.
-    keys, flip, base = _kernels.joint_keys(body, frame)
-    keys, joint = _unique_inverse(keys)
-    pairs = np.stack([keys // base % base, keys % base], axis=1)
-    # Σ over each joint's contacts (the normal force fn = max(F·n, 0), F, fn·p, slip and open flags) in one
-    # pass of a kernel: the same sums in the same order as bincount's, ~8x faster on a recording's batch.
-    weight, resultant, centre, state = _kernels.resultant_sums(joint, len(pairs), flip, force, normal, point, status)
-    loaded = weight > 0.0
+    # Each contact oriented as (low, high) body (the force on the higher index flips with the order) and
+    # keyed (frame, low, high): the engine's contacts come sorted by pair and a batch's frames in order, so
+    # a joint's contacts are one run and a kernel sums each run in one pass, in contact order. Otherwise
+    # they are put in key order first, stably: each joint's contacts keep their order, hence the same sums.
+    rows = _kernels.resultants(body, frame, force, normal, point, status)
+    if rows is None:
+        keys, _, _ = _kernels.joint_keys(body, frame)
+        order = np.argsort(keys, kind="stable")
+        rows = _kernels.resultants(body[order], frame[order], force[order], normal[order], point[order], status[order])
+    pairs, centre, resultant, state, joint_frame = rows
     return JointResultants(
-        body=pairs[loaded],
-        point=centre[loaded] / weight[loaded, None],
-        force=resultant[loaded],
-        state=state[loaded],
-        frame=None if contact_frame is None else keys[loaded] // (base * base),
+        body=pairs, point=centre, force=resultant, state=state, frame=None if contact_frame is None else joint_frame
     )
-
-
-def _unique_inverse(keys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """``np.unique(keys, return_inverse=True)``, without its sort when the keys are sorted already (the
-    engine's contacts come sorted by pair, and a batch's frames in order)."""
-    if keys.size and np.all(keys[1:] >= keys[:-1]):
-        first = np.empty(keys.size, dtype=bool)
-        first[0] = True
-        np.not_equal(keys[1:], keys[:-1], out=first[1:])
-        return keys[first], np.cumsum(first) - 1
-    unique, inverse = np.unique(keys, return_inverse=True)
-    return unique, inverse.reshape(-1)
 
 
 def magnification(displacement: np.ndarray, structure_size: float, share: float = 0.05) -> float:

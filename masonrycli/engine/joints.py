@@ -180,36 +180,62 @@ def _joint_keys(body, frame, keys, flip):
 
 
 @njit
-def _resultant_sums(joint, flip, force, normal, point, status, weight, resultant, centre, state):
-    # for each contact c, in order, of joint j = joint[c], with s = −1 if its bodies are flipped, else 1:
-    #     f = s·force[c], n = s·normal[c], fn = max((0 + f_x n_x) + f_y n_y, 0)   (einsum's sum, np.maximum)
-    #     weight[j] += fn;  resultant[j] += f;  centre[j] += fn · point[c]      (bins from 0, as bincount)
-    #     slipping[j] |= status[c] == SLIP;  opened[j] |= status[c] == OPEN
-    # state[j] = SLIP if slipping, else OPEN if opened, else STICK (joint_forces' JOINT_* values 1, 2, 0)
-    j_count = weight.shape[0]
-    slipping = np.zeros(j_count, dtype=np.bool_)
-    opened = np.zeros(j_count, dtype=np.bool_)
-    for j in range(j_count):
-        weight[j] = 0.0
-        resultant[j, 0] = 0.0
-        resultant[j, 1] = 0.0
-        centre[j, 0] = 0.0
-        centre[j, 1] = 0.0
-    for c in range(joint.shape[0]):
-        j = joint[c]
-        s = -1.0 if flip[c] else 1.0
-        fx = force[c, 0] * s
-        fy = force[c, 1] * s
-        fn = _nan_max((0.0 + fx * (normal[c, 0] * s)) + fy * (normal[c, 1] * s), 0.0)
-        weight[j] += fn
-        resultant[j, 0] += fx
-        resultant[j, 1] += fy
-        centre[j, 0] += fn * point[c, 0]
-        centre[j, 1] += fn * point[c, 1]
-        slipping[j] |= status[c] == _SLIP
-        opened[j] |= status[c] == _OPEN
-    for j in range(j_count):
-        state[j] = 1 if slipping[j] else (2 if opened[j] else 0)
+def _resultants(body, frame, force, normal, point, status, out_body, out_point, out_force, out_state, out_frame):
+    # base = 1 + the largest body index; key of contact c = (frame·base + min(a, b))·base + max(a, b)
+    # if the keys are not in order: return −1 (the caller puts the contacts in order first)
+    # a joint = a run of equal keys; over its contacts in order, with s = −1 if a > b (flipped), else 1:
+    #     f = s·force, n = s·normal, fn = max((0 + f_x n_x) + f_y n_y, 0)   (einsum's sum, np.maximum)
+    #     weight += fn;  resultant += f;  centre += fn · point;  slipping |= SLIP;  opened |= OPEN
+    #     (sums from 0 in contact order: bincount's)
+    # a joint with weight > 0 is a row: bodies (low, high), centre / weight, resultant, state (SLIP if
+    # slipping, else OPEN if opened, else STICK: joint_forces' 1, 2, 0), frame; returns the row count
+    n = body.shape[0]
+    base = 0
+    for c in range(n):
+        base = max(base, body[c, 0], body[c, 1])
+    base += 1
+    keys = np.empty(n, dtype=np.int64)
+    for c in range(n):
+        a = np.int64(body[c, 0])
+        b = np.int64(body[c, 1])
+        keys[c] = (frame[c] * base + min(a, b)) * base + max(a, b)
+        if c > 0 and keys[c] < keys[c - 1]:
+            return -1
+    rows = 0
+    c = 0
+    while c < n:
+        key = keys[c]
+        weight = 0.0
+        rx = 0.0
+        ry = 0.0
+        cx = 0.0
+        cy = 0.0
+        slipping = False
+        opened = False
+        while c < n and keys[c] == key:
+            s = -1.0 if body[c, 0] > body[c, 1] else 1.0
+            fx = force[c, 0] * s
+            fy = force[c, 1] * s
+            fn = _nan_max((0.0 + fx * (normal[c, 0] * s)) + fy * (normal[c, 1] * s), 0.0)
+            weight += fn
+            rx += fx
+            ry += fy
+            cx += fn * point[c, 0]
+            cy += fn * point[c, 1]
+            slipping |= status[c] == _SLIP
+            opened |= status[c] == _OPEN
+            c += 1
+        if weight > 0.0:
+            out_body[rows, 0] = key // base % base
+            out_body[rows, 1] = key % base
+            out_point[rows, 0] = cx / weight
+            out_point[rows, 1] = cy / weight
+            out_force[rows, 0] = rx
+            out_force[rows, 1] = ry
+            out_state[rows] = 1 if slipping else (2 if opened else 0)
+            out_frame[rows] = key // (base * base)
+            rows += 1
+    return rows
 
 
 def openings(body_q, end_body, local_a, local_b, normal0, gap0) -> np.ndarray:
@@ -264,22 +290,20 @@ def joint_keys(body, frame) -> tuple[np.ndarray, np.ndarray, int]:
     return keys, flip, int(base)
 
 
-def resultant_sums(joint, j_count: int, flip, force, normal, point, status):
-    """Per joint (``joint`` (C,) its index 0..j_count−1 for each contact, in contact order): (weight (J,) Σ
-    compressive normal force, resultant (J, 2) Σ force, centre (J, 2) Σ normal force · point, state (J,)
-    int8), the forces and normals turned by −1 where ``flip`` (the bodies in (high, low) order)."""
-    weight, state = np.empty(j_count), np.empty(j_count, dtype=np.int8)
-    resultant, centre = np.empty((j_count, 2)), np.empty((j_count, 2))
-    _resultant_sums(
-        np.ascontiguousarray(joint, dtype=np.int64),
-        np.ascontiguousarray(flip, dtype=np.bool_),
+def resultants(body, frame, force, normal, point, status):
+    """The loaded joints of contacts whose keys (:func:`joint_keys`) are in order, one row each, in that order:
+    (bodies (J, 2) int64, point (J, 2), force (J, 2), state (J,) int8, frame (J,) int64); None when the keys
+    are not in order. ``body`` (C, 2) int; ``frame`` (C,) int; the forces and normals turned by −1 where
+    a > b; ``status`` (C,) int8."""
+    n = body.shape[0]
+    out = (np.empty((n, 2), np.int64), np.empty((n, 2)), np.empty((n, 2)), np.empty(n, np.int8), np.empty(n, np.int64))
+    rows = _resultants(
+        np.ascontiguousarray(body),
+        np.ascontiguousarray(frame, dtype=np.int64),
         np.ascontiguousarray(force, dtype=np.float64),
         np.ascontiguousarray(normal, dtype=np.float64),
         np.ascontiguousarray(point, dtype=np.float64),
         np.ascontiguousarray(status, dtype=np.int8),
-        weight,
-        resultant,
-        centre,
-        state,
+        *out,
     )
-    return weight, resultant, centre, state
+    return None if rows < 0 else tuple(x[:rows] for x in out)

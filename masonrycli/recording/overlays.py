@@ -82,22 +82,13 @@ def send_joints(rec: rr.RecordingStream, idx: list, b: FrameBatch, force_scale: 
     )
 
 
-CONTACT_ARRAYS: Final = ("body", "point", "normal", "force", "status")
-"""The Frame.contact_* arrays a batch keeps per frame (its "contacts") for :func:`batch_joint_resultants`."""
-
-
-def batch_joint_resultants(b: FrameBatch) -> None:
-    """The batch's "joint_point", "joint_force" and "joint_state" (one array per frame) from its "contacts":
-    the resultants of all its frames in one call, each drawn on the body above its joint (up the
-    structure, whatever the index order)."""
-    contacts = b.pop("contacts")
-    per_frame = [len(c[-1]) for c in contacts]
-    frame = np.repeat(np.arange(len(contacts)), per_frame)
-    body, point, normal, force, status = (np.concatenate([c[k] for c in contacts]) for k in range(5))
-    j = joint_resultants(body.reshape(-1, 2), point, normal, force, status, frame)
-    body_y = np.concatenate([b.stack("block_q")[..., 1], b.stack("support_q")[..., 1]], axis=1)
-    sign = np.where(body_y[j.frame, j.body[:, 1]] >= body_y[j.frame, j.body[:, 0]], 1.0, -1.0)[:, None]
-    cuts = np.cumsum(np.bincount(j.frame, minlength=len(contacts)))[:-1]
-    b["joint_point"] = np.split(j.point, cuts)
-    b["joint_force"] = np.split(j.force * sign, cuts)
-    b["joint_state"] = np.split(j.state, cuts)
+def frame_joint_resultants(frame, block_q: np.ndarray, support_q: np.ndarray):
+    """One frame's joint resultants (point, force, state per joint), each force drawn on the body above its
+    joint (up the structure, whatever the index order). Made when the frame comes, while its contacts are
+    still in the cache: the same rows as the frame's share of a batch's (``joint_resultants``)."""
+    j = joint_resultants(
+        frame.contact_body, frame.contact_point, frame.contact_normal, frame.contact_force, frame.contact_status
+    )
+    body_y = np.concatenate([block_q[:, 1], support_q[:, 1]])
+    sign = np.where(body_y[j.body[:, 1]] >= body_y[j.body[:, 0]], 1.0, -1.0)[:, None]
+    return j.point, j.force * sign, j.state

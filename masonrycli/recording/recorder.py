@@ -66,7 +66,7 @@ from masonrycli.recording.layout import (
     paper_figures,
 )
 from masonrycli.recording.magnified import send_magnified
-from masonrycli.recording.overlays import CONTACT_ARRAYS, batch_joint_resultants, send_axes, send_joints
+from masonrycli.recording.overlays import frame_joint_resultants, send_axes, send_joints
 from masonrycli.recording.readback import check_complete
 from masonrycli.recording.static_content import (
     TICKS,
@@ -219,8 +219,8 @@ class Recorder:
         b.add("block_q", q)
         b.add("support_q", sq)
         b.add("support_v", np.asarray(frame.support_v, f64).reshape(-1, 2))
-        # The joint resultants of the whole batch are made at once when it is sent (batch_joint_resultants).
-        b.add("contacts", tuple(np.asarray(getattr(frame, f"contact_{name}")) for name in CONTACT_ARRAYS))
+        for name, value in zip(("joint_point", "joint_force", "joint_state"), frame_joint_resultants(frame, q, sq)):
+            b.add(name, value)
         b.add("hinge_point", np.asarray(getattr(frame, "hinge_point", np.zeros((0, 2))), f64).reshape(-1, 2))
         for key in TENSOR_KEYS:
             b.add(key, _tensor(frame.tensors, key, self._n))
@@ -295,7 +295,6 @@ class Recorder:
 
     # ---- per-batch content
     def _send_batch(self, b: FrameBatch) -> None:
-        batch_joint_resultants(b)
         idx = time_indexes(b)
         q = b.stack("block_q")  # (F, N, 3)
         tensors = {key: b.stack(key) for key in TENSOR_KEYS}
