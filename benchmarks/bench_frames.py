@@ -130,7 +130,9 @@ def compare(base: str, new: str, command: list[str], rounds: int, keep: Path | N
             roots[name] = str(into) if into.is_dir() else checkout(rev, into)
         for k in range(rounds):
             for name in ("base", "new") if k % 2 == 0 else ("new", "base"):
-                env = dict(os.environ, NUMBA_CACHE_DIR=str(kept / f"cache-{Path(roots[name]).name}"))
+                env = dict(os.environ)
+                if roots[name] != str(ROOT):  # a checkout: a numba cache of its own (the worktree keeps its own)
+                    env["NUMBA_CACHE_DIR"] = str(kept / f"cache-{Path(roots[name]).name}")
                 stem = str(Path(tmp) / f"out-{name}")
                 cmd = [sys.executable, __file__, "--worker", roots[name], stem, "--", *command]
                 out = subprocess.run(cmd, capture_output=True, text=True, cwd=tmp, env=env)
