@@ -55,6 +55,7 @@ def _register_optional():
         alm_newton,
         anderson,
         cluster,
+        cpg,
         ipm,
         ipm_lcp,
         ipm_shift,
@@ -77,6 +78,7 @@ def _register_optional():
         ipm,
         ipm_lcp,
         ipm_shift,
+        cpg,
     ):
         METHODS.update(module.METHODS)
 
