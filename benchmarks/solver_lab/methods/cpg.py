@@ -54,8 +54,8 @@ import numpy as np
 from benchmarks.solver_lab.outcome import Clock, Outcome
 from masonrycli.engine import nlgs as N
 
-ITER_CAP = 20_000
-"""CPG iterations a solve (2 matvecs each: ~40 000 matvecs, the order of the sweep variants' 50 000 cap)."""
+ITER_CAP = 10_000
+"""CPG iterations a solve (2 matvecs each: 20 000 matvecs, 5–50× what momentum's sweeps need on these steps)."""
 INNER_FRACTION = 0.1
 """cpg-frozen: a round ends when the frozen QP's RMS natural residual ≤ this × target (m/s)."""
 BACKTRACK = 30
@@ -175,10 +175,11 @@ def shift(ops, u):
     return ops.mu * np.abs(u[:, 0])
 
 
-def run_cpg(ctx, target, clock, precondition=False, mode="each", monotone=False, cap=None):
+def run_cpg(ctx, target, clock, precondition=False, mode="each", monotone=False, cap=None, s_fixed=None):
     """CPG on the step (module doc). ``mode``: "each" (s ← μ|u_t| every iteration), "frozen" (De Saxcé
     rounds) or "oracle" (s frozen at the reference's); ``monotone``: the restart rule that keeps f(r) at the
-    iteration's shift from growing. Returns (v (B, 3), r, iterations, rounds, restarts, matvecs, residual)."""
+    iteration's shift from growing. ``s_fixed``: the convex QP at this shift, stopped on its natural residual
+    (for tests). Returns (v (B, 3), r, iterations, rounds, restarts, matvecs, residual)."""
     p = ctx.p
     cap = ITER_CAP if cap is None else cap
     with clock("setup"):
@@ -187,13 +188,19 @@ def run_cpg(ctx, target, clock, precondition=False, mode="each", monotone=False,
         r = ops.project_cone(p.r_warm.astype(float))
         v, u = ops.velocity(r)
         s = shift(ops, (ops.H @ p.v_ref.ravel()).reshape(-1, 2) if mode == "oracle" else u)
+        if s_fixed is not None:
+            mode, s = "fixed", s_fixed
         g = ops.gradient(u, s)
         w = d = ops.project_tangent(ops.faces(r), -ops.P_inv(g))
         steepest = True
     its = restarts = 0
     rounds = 1
+
+    def measure():
+        return ops.natural_residual(r, g) if mode == "fixed" else ctx.residual(v.reshape(-1, 3), r)
+
     with clock("check"):
-        residual = ctx.residual(v.reshape(-1, 3), r)
+        residual = measure()
     while residual > target and its < cap:
         with clock("cpg"):
             gd = -float((g * d).sum())
@@ -242,7 +249,7 @@ def run_cpg(ctx, target, clock, precondition=False, mode="each", monotone=False,
                 steepest = True
             continue
         with clock("check"):
-            residual = ctx.residual(v.reshape(-1, 3), r)
+            residual = measure()
             if residual <= target:
                 break
             new_round = mode == "frozen" and ops.natural_residual(r, g) <= INNER_FRACTION * target
@@ -277,8 +284,8 @@ def _method(precondition: bool, mode: str, monotone: bool = False):
 METHODS = {
     "cpg": _method(False, "each"),
     "cpg-pre": _method(True, "each"),
-    "cpg-frozen": _method(False, "frozen"),
-    "cpg-pre-frozen": _method(True, "frozen"),
-    "cpg-oracle-s": _method(False, "oracle"),
-    "cpg-pre-oracle-s": _method(True, "oracle"),
+    "cpg-mono": _method(False, "each", monotone=True),
+    "cpg-pre-mono": _method(True, "each", monotone=True),
+    "cpg-pre-mono-frozen": _method(True, "frozen", monotone=True),
+    "cpg-pre-mono-oracle-s": _method(True, "oracle", monotone=True),
 }
