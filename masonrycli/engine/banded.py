@@ -36,7 +36,7 @@ def band_lu(band, n, w):
     #           l = A[i, k] / p; A[i, k] = l
     #           A[i, k+1 … k+w] −= l · u             (contiguous: row i's column j sits at j − i + w)
     # Fill-in stays inside the band. Returns −1, or the first column whose pivot is 0 or not finite.
-    u = np.empty(w)
+    u = np.empty(w, np.float64)
     for k in range(n):
         p = band[k, w]
         if p == 0.0 or not np.isfinite(p):
@@ -90,7 +90,7 @@ def body_order(contact_body, coupled, bodies) -> tuple[np.ndarray, int]:
 
     graph = sp.csr_matrix((np.ones(a.size), (a, b)), shape=(bodies, bodies))
     order = reverse_cuthill_mckee((graph + graph.T).tocsr(), symmetric_mode=True)
-    rcm = np.empty(bodies, dtype=np.int64)
+    rcm = np.empty(bodies, np.int64)
     rcm[order] = np.arange(bodies)
     width = int(np.abs(rcm[a] - rcm[b]).max())
     if width < natural:

@@ -65,7 +65,8 @@ hand-over rule (cycling windows)."""
 def _body_lists(contact_body, pack, count, bodies):
     # CSR lists of each body's contacts, for the bodies with mass (a support's inverse mass and inertia are
     # 0 in its rows: it has no list), contacts in their order. Returns (start (B + 1,), members).
-    start = np.zeros(bodies + 1, dtype=np.int64)
+    start = np.empty(bodies + 1, np.int64)
+    start[:] = 0
     for c in range(count):
         if pack[c, P_IMA] > 0.0 or pack[c, P_IIA] > 0.0:
             start[contact_body[c, 0] + 1] += 1
@@ -73,7 +74,7 @@ def _body_lists(contact_body, pack, count, bodies):
             start[contact_body[c, 1] + 1] += 1
     for i in range(bodies):
         start[i + 1] += start[i]
-    members = np.empty(start[bodies], dtype=np.int64)
+    members = np.empty(start[bodies], np.int64)
     fill = start[:bodies].copy()
     for c in range(count):
         if pack[c, P_IMA] > 0.0 or pack[c, P_IIA] > 0.0:
@@ -164,7 +165,8 @@ def _body_order_sweeps(
         carry[C_WINDOW : C_WINDOW + 3] = 0.0
     start, members = _body_lists(contact_body, pack, count, v.shape[0])
     visits_per_sweep = members.shape[0]
-    seen = np.full(count, -1, dtype=np.int64)
+    seen = np.empty(count, np.int64)
+    seen[:] = -1
     v_flat = v.reshape(v.size)
     v_prev_flat = v_prev.reshape(v.size)
     beta = carry[C_BETA]

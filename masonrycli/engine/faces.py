@@ -50,7 +50,7 @@ def _face_sweeps(contact_body, pack, count, mu, tolerance, max_units, v, r, stat
     # Returns (sweep units done, rounded up; residual).
     if count == 0:
         return 0, 0.0
-    start = np.empty(count + 1, dtype=np.int64)
+    start = np.empty(count + 1, np.int64)
     faces = 0
     for c in range(count):
         if c == 0 or contact_body[c, 0] != contact_body[c - 1, 0] or contact_body[c, 1] != contact_body[c - 1, 1]:

@@ -14,7 +14,7 @@ import numpy as np
 from masonrycli.engine._jit import njit
 
 
-@njit
+@njit(inline="always")
 def _begin_step(body_q, body_v, body_radius, dt, theta, out_q, out_v_old):
     # One pass over the bodies at the start of a step:
     #   q_m = q_n + (1 − θ)·dt·v_n  (supports translate with their imposed velocity), v_old = v_n,
@@ -31,7 +31,7 @@ def _begin_step(body_q, body_v, body_radius, dt, theta, out_q, out_v_old):
     return top
 
 
-@njit
+@njit(inline="always")
 def _free_velocity(body_v, body_dynamic, gravity, dt, support_v_next, block_count, out_v):
     # Blocks: v_free = v_n + dt·g. Supports: their imposed velocity at t_n+1 (no rotation).
     for b in range(body_v.shape[0]):
@@ -46,7 +46,7 @@ def _free_velocity(body_v, body_dynamic, gravity, dt, support_v_next, block_coun
             out_v[b, 2] = 0.0
 
 
-@njit
+@njit(inline="always")
 def _update_q(body_q, body_v_old, body_v_new, dt, theta, block_count):
     # q_n+1 = q_n + dt·(θ v_n+1 + (1 − θ) v_n), in place; in the same pass, for the divergence check,
     # whether every block's q and v are finite and the top block speed |v| (NaN if not finite).

@@ -27,13 +27,13 @@ from masonrycli.engine._jit import njit
 from masonrycli.engine.nlgs import INTERLEAVE, PACK_WIDTH, _nlgs
 
 
-@njit
+@njit(inline="always")
 def _in_order(contact_body, pack, count, r, status):
     # order = the interleaved visit order above; (bodies, pack rows, r, status) copied into it.
     # Returns (order, bodies, pack, r, status) in that order.
     k = INTERLEAVE
     run = (count + k - 1) // k
-    order = np.empty(count, dtype=np.int64)
+    order = np.empty(count, np.int64)
     i = 0
     for j in range(run):
         for q in range(k):
@@ -41,10 +41,10 @@ def _in_order(contact_body, pack, count, r, status):
             if c < count:
                 order[i] = c
                 i += 1
-    body_o = np.empty((count, 2), dtype=np.uint32)  # unsigned: v[a] then compiles without a wrap-around test
-    pack_o = np.empty((count, PACK_WIDTH))
-    r_o = np.empty((count, 2))
-    status_o = np.empty(count, dtype=status.dtype)
+    body_o = np.empty((count, 2), np.uint32)  # unsigned: v[a] then compiles without a wrap-around test
+    pack_o = np.empty((count, PACK_WIDTH), np.float64)
+    r_o = np.empty((count, 2), np.float64)
+    status_o = np.empty(count, np.int8)
     for i in range(count):
         c = order[i]
         body_o[i, 0] = contact_body[c, 0]
@@ -56,7 +56,7 @@ def _in_order(contact_body, pack, count, r, status):
     return order, body_o, pack_o, r_o, status_o
 
 
-@njit
+@njit(inline="always")
 def _back(order, count, r_o, status_o, r, status):
     # r, status of contact order[i] ← row i of the sweep's arrays.
     for i in range(count):

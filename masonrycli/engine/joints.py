@@ -30,8 +30,8 @@ def _openings(body_q, end_body, local_a, local_b, normal0, gap0, out):
     #     X_a = x_a + R(θ_a)·local_a[e],  X_b = x_b + R(θ_b)·local_b[e],  n = R(θ_a)·normal0[e]
     #     out[e] = (X_b − X_a)·n + gap0[e]
     # cos θ and sin θ once per body (a body has several ends: the same values, a fifth of the calls)
-    cos = np.empty(body_q.shape[0])
-    sin = np.empty(body_q.shape[0])
+    cos = np.empty(body_q.shape[0], np.float64)
+    sin = np.empty(body_q.shape[0], np.float64)
     for k in range(body_q.shape[0]):
         cos[k] = math.cos(body_q[k, 2])
         sin[k] = math.sin(body_q[k, 2])
@@ -87,13 +87,16 @@ def _hinged(opening, end_joint, key, body_count, contact_body, contact_rn, dt, o
     #     loaded[j] += 1 if F > 0;  total[j] += F if F > 0 else 0
     # out[j] = exactly one loaded contact, widest > opening_limit, total ≥ min_force
     j_count = key.shape[0]
-    widest = np.full(j_count, -np.inf)
+    widest = np.empty(j_count, np.float64)
+    widest[:] = -np.inf
     for e in range(opening.shape[0]):
         j = end_joint[e]
         if j >= 0:
             widest[j] = _nan_max(widest[j], opening[e])
-    loaded = np.zeros(j_count)
-    total = np.zeros(j_count)
+    loaded = np.empty(j_count, np.float64)
+    loaded[:] = 0.0
+    total = np.empty(j_count, np.float64)
+    total[:] = 0.0
     pos = 0
     for c in range(contact_body.shape[0]):
         k = np.int64(contact_body[c, 0]) * body_count + contact_body[c, 1]
@@ -135,8 +138,10 @@ def _block_fields(opening, end_body, end_joint, block_count, contact_body, conta
             owner = end_body[e, side]
             if owner < block_count and end_joint[e] >= 0:
                 out_opening[owner] = _nan_max(out_opening[owner], _nan_max(opening[e], 0.0))
-    load = np.zeros((2, block_count))
-    slide = np.zeros((2, block_count))
+    load = np.empty((2, block_count), np.float64)
+    load[:] = 0.0
+    slide = np.empty((2, block_count), np.float64)
+    slide[:] = 0.0
     for side in range(2):
         for c in range(contact_body.shape[0]):
             owner = contact_body[c, side]
@@ -194,7 +199,7 @@ def _resultants(body, frame, force, normal, point, status, out_body, out_point, 
     for c in range(n):
         base = max(base, body[c, 0], body[c, 1])
     base += 1
-    keys = np.empty(n, dtype=np.int64)
+    keys = np.empty(n, np.int64)
     for c in range(n):
         a = np.int64(body[c, 0])
         b = np.int64(body[c, 1])
@@ -241,7 +246,7 @@ def _resultants(body, frame, force, normal, point, status, out_body, out_point, 
 def openings(body_q, end_body, local_a, local_b, normal0, gap0) -> np.ndarray:
     """(E,) m: opening of every joint end (``end_body`` (E, 2) int64, the other arrays (E, 2) / (E,)
     float64 in the bodies' frames) in configuration ``body_q`` (B, 3)."""
-    out = np.empty(end_body.shape[0])
+    out = np.empty(end_body.shape[0], np.float64)
     _openings(body_q, end_body, local_a, local_b, normal0, gap0, out)
     return out
 
@@ -267,8 +272,8 @@ def hinge_contacts(key, hinged, body_count, contact_body, contact_rn) -> np.ndar
 
 def block_fields(opening, end_body, end_joint, block_count, contact_body, contact_rn, status):
     """((N,) largest joint opening ≥ 0 (m), (N,) share of the normal load carried by slipping contacts)."""
-    max_opening = np.empty(block_count)
-    ratio = np.empty(block_count)
+    max_opening = np.empty(block_count, np.float64)
+    ratio = np.empty(block_count, np.float64)
     rn = np.ascontiguousarray(contact_rn, dtype=np.float64)
     _block_fields(opening, end_body, end_joint, block_count, contact_body, rn, status, max_opening, ratio)
     return max_opening, ratio
@@ -276,8 +281,8 @@ def block_fields(opening, end_body, end_joint, block_count, contact_body, contac
 
 def contact_states(status, tangential_velocity, contact_r, friction: float, slip_speed: float):
     """((C,) int8 reported status, (C,) mobilised friction) of the solver's contacts (mechanism module)."""
-    out_status = np.empty(status.shape[0], dtype=np.int8)
-    mobilised = np.empty(status.shape[0])
+    out_status = np.empty(status.shape[0], np.int8)
+    mobilised = np.empty(status.shape[0], np.float64)
     _contact_states(status, tangential_velocity, contact_r, float(friction), float(slip_speed), out_status, mobilised)
     return out_status, mobilised
 

@@ -90,7 +90,7 @@ def _nlgs_accelerated(contact_body, pack, count, mu, tolerance, max_iterations, 
     v_prev_flat = v_prev.reshape(v.size)
     # The sweep keeps each contact's (r_t, r_n, r_prev,t, r_prev,n) in one row of rr: one array fewer to
     # address in the contact loop (1–2 % less time per contact·sweep), r copied back at the end.
-    rr = np.empty((count, 4))
+    rr = np.empty((count, 4), np.float64)
     for c in range(count):
         rr[c, 0] = rr[c, 2] = r[c, 0]
         rr[c, 1] = rr[c, 3] = r[c, 1]

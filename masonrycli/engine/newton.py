@@ -177,10 +177,10 @@ def _system(contact_body, pack, count, lam, f, jac, body_count, position, w, ban
                 band[d, w] = 1.0 / im
                 band[d + 1, w] = 1.0 / im
                 band[d + 2, w] = 1.0 / ii
-    ht = np.empty(6)
-    hn = np.empty(6)
-    dof = np.empty(6, dtype=np.int64)
-    moves = np.empty(6, dtype=np.bool_)
+    ht = np.empty(6, np.float64)
+    hn = np.empty(6, np.float64)
+    dof = np.empty(6, np.int64)
+    moves = np.empty(6, np.bool_)
     for c in range(count):
         a = contact_body[c, 0]
         b = contact_body[c, 1]

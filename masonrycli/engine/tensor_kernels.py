@@ -52,7 +52,7 @@ SCALAR_ROWS = 10
 #     if b is a block: σ_b += (I − G_b) ⊗ (+F)
 # σ_i /= V_i
 # (with G as the reference point the inertia term of eq. 7 vanishes, so eq. 8 holds in dynamics too)
-@njit
+@njit(inline="always")
 def _block_stress(block_count, block_q, block_volume, contact_body, contact_point, contact_force, out):
     # Inputs: block_q (>=N,3) m, block_volume (N,) m³, contact_* (C,...) ; Outputs: out (N,2,2) Pa
     out[:] = 0.0
@@ -83,10 +83,11 @@ def _block_stress(block_count, block_q, block_volume, contact_body, contact_poin
 # count the block–block contacts of each block → CSR start (N+1,)
 # scatter the other block of each contact into neighbour (2·C_bb,)  (duplicates kept: a pair with two
 # contact points appears twice; the cell average skips repeats with a stamp array)
-@njit
+@njit(inline="always")
 def _cell_neighbours(block_count, contact_body):
     # Inputs: contact_body (C,2) ; Returns: start (N+1,) int64, neighbour (start[N],) int64
-    start = np.zeros(block_count + 1, np.int64)
+    start = np.empty(block_count + 1, np.int64)
+    start[:] = 0
     for c in range(contact_body.shape[0]):
         a = contact_body[c, 0]
         b = contact_body[c, 1]
@@ -112,10 +113,11 @@ def _cell_neighbours(block_count, contact_body):
 
 # cell(i) = {i} ∪ {distinct blocks j listed as i's neighbours}
 # out_i = Σ_{j ∈ cell(i)} V_j t_j / Σ_{j ∈ cell(i)} V_j
-@njit
+@njit(inline="always")
 def _cell_average(block_count, start, neighbour, block_volume, block_tensor, out):
     # Inputs: CSR start/neighbour, block_volume (N,), block_tensor (N,2,2) ; Outputs: out (N,2,2)
-    stamp = np.full(block_count, -1, np.int64)
+    stamp = np.empty(block_count, np.int64)
+    stamp[:] = -1
     for i in range(block_count):
         stamp[i] = i
         w = block_volume[i]
@@ -159,7 +161,8 @@ def _cell_average(block_count, start, neighbour, block_volume, block_tensor, out
 @njit
 def _cell_strain_rate(block_count, block_q, block_v, triangles, min_area, out):
     # Inputs: block_q, block_v (>=N,3), triangles (T,3), min_area (N,) m² ; Outputs: out (N,2,2) 1/s
-    area = np.zeros(block_count)
+    area = np.empty(block_count, np.float64)
+    area[:] = 0.0
     out[:] = 0.0
     for t in range(triangles.shape[0]):
         i = triangles[t, 0]
@@ -198,7 +201,7 @@ def _cell_strain_rate(block_count, block_q, block_v, triangles, min_area, out):
 # block i in a one-block chain between blocks j and k (chain[i] = (j, k), −1 otherwise):
 #     ε̇_i = d(l_ij + l_ik)/dt / (l_ij + l_ik),  dl_ij/dt = u_ij · (v_j − v_i),  u_ij = (x_j − x_i)/l_ij
 # (the 1-D strain rate of the chain's two links: > 0 when the joints open, as at a hinge)
-@njit
+@njit(inline="always")
 def _chain_strain_rate(block_count, block_q, block_v, chain, out):
     # Inputs: block_q, block_v (>=N,3), chain (N,2) int64 ; Outputs: out (N,) 1/s, NaN off chains
     for i in range(block_count):

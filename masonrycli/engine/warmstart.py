@@ -41,7 +41,7 @@ HOLDS_UP = 0.5
 """A contact holds a body up when its normal on that body is within 60° of up (cos 60° = ½)."""
 
 
-@njit
+@njit(inline="always")
 def _warm_start(key, count, prev_key, prev_r, r):
     # For each contact: i = the first row of last step's sorted keys with prev_key[i] ≥ key[c] (what a
     # binary search, np.searchsorted, finds); r ← prev_r[i] if prev_key[i] = key[c], else 0.
@@ -84,7 +84,7 @@ def _warm_start(key, count, prev_key, prev_r, r):
     return hits
 
 
-@njit
+@njit(inline="always")
 def _remember(key, r, count, out_key, out_r):
     # Keys sorted (stable) with their impulses, for the next step's binary searches.
     # Insertion sort: detection emits the contacts sorted by body pair, the keys' leading bits, so only
@@ -127,14 +127,15 @@ def _static_guess(contact_body, pack, count, body_mass, block_count, gravity, dt
     upy = -gravity[1] / g
     reach = g * dt  # m/s: a contact whose bias (gap/dt) exceeds this does not close within the step
     # Contacts of each body, compressed rows: contacts of k are index[start[k]:start[k + 1]].
-    start = np.zeros(body_count + 1, dtype=np.int64)
+    start = np.empty(body_count + 1, np.int64)
+    start[:] = 0
     for c in range(count):
         start[contact_body[c, 0] + 1] += 1
         start[contact_body[c, 1] + 1] += 1
     for k in range(body_count):
         start[k + 1] += start[k]
     fill = start[:-1].copy()
-    index = np.empty(2 * count, dtype=np.int64)
+    index = np.empty(2 * count, np.int64)
     for c in range(count):
         for side in range(2):
             k = contact_body[c, side]
@@ -142,7 +143,8 @@ def _static_guess(contact_body, pack, count, body_mass, block_count, gravity, dt
             fill[k] += 1
     # Held blocks, from the lowest up: a block is held when a contact that holds it up touches a
     # support or a held block. A load path must end on a support: a falling stack gets no impulse.
-    held = np.zeros(body_count, dtype=np.bool_)
+    held = np.empty(body_count, np.bool_)
+    held[:] = False
     for k in range(block_count, body_count):
         held[k] = True
     for k in order:
@@ -152,7 +154,8 @@ def _static_guess(contact_body, pack, count, body_mass, block_count, gravity, dt
             if s > HOLDS_UP and held[other]:
                 held[k] = True
                 break
-    load = np.zeros(body_count)
+    load = np.empty(body_count, np.float64)
+    load[:] = 0.0
     for k in range(block_count):
         load[k] = body_mass[k] * g * dt
     for j in range(block_count - 1, -1, -1):  # from the highest down
@@ -210,7 +213,7 @@ class WarmStart:
     """The previous step's contact keys (sorted) and impulses, carried over to the next step."""
 
     def __init__(self, capacity: int):
-        self._key = np.empty(capacity, dtype=np.int64)
+        self._key = np.empty(capacity, np.int64)
         self._r = np.empty((capacity, 2))
         self._count = 0
 
@@ -237,7 +240,7 @@ class WarmStart:
         """The (key, r) arrays that this step's ``count`` sorted keys and impulses go to (grown if needed);
         the next :meth:`start` reads their first ``count`` rows."""
         if count > self._key.shape[0]:
-            self._key = np.empty(count, dtype=np.int64)
+            self._key = np.empty(count, np.int64)
             self._r = np.empty((count, 2))
         self._count = count
         return self._key, self._r
