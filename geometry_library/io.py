@@ -15,6 +15,10 @@ only; a ``MultiPolygon`` of one part, as QGIS saves polygon layers, is that poly
 ``support_role``   ``"fixed"`` (default) or ``"driven"``, supports only
 =================  =========================================================================
 
+Other properties are not read: ``read_geojson`` lists them (with the first body carrying each) in its
+``unknown`` argument, for its caller to warn about, except a GIS's feature-id columns (``id``, ``fid``,
+``ogc_fid``, ``objectid``, any case) that a QGIS or ogr2ogr export adds to every layer.
+
 Blocks keep the order of their features, supports too. :func:`write_geojson` writes the same
 format with full float precision, so ``read_geojson(write_geojson(a))`` gives back ``a``.
 
@@ -68,6 +72,12 @@ _ROLE_ONLY = re.compile(r"^\s*(?P<role>block|support)(?:\s+(?P<srole>fixed|drive
 """A role with no name (``support : POLYGON …``): _LABEL read its role word as the name of a block."""
 
 
+GEOJSON_PROPERTIES = ("role", "name", "density", "thickness", "velocity", "support_role")
+"""The feature properties the reader uses."""
+GIS_ID_COLUMNS = ("id", "fid", "ogc_fid", "objectid")
+"""Feature ids a GIS export adds to every layer (compared lower-case): not read, not reported."""
+
+
 def _read_text(path: Path) -> str:
     try:
         return path.read_text(encoding="utf-8")
@@ -90,13 +100,15 @@ def _velocity(value, where: str) -> tuple[float, float, float]:
     return v
 
 
-def read_geojson(path, density: float = 2500.0, thickness: float = 1.0) -> Assembly:
+def read_geojson(path, density: float = 2500.0, thickness: float = 1.0, unknown: dict | None = None) -> Assembly:
     """Read an assembly from a GeoJSON FeatureCollection (format in the module docstring).
 
     Parameters
     ----------
     path : str or Path.
     density : kg/m³, thickness : m — defaults for blocks without those properties.
+    unknown : a dict given receives each property key the reader does not use (not in GEOJSON_PROPERTIES nor
+        GIS_ID_COLUMNS) → the first body carrying it (``feature 2, block 2 ("B2")``), in file order.
 
     Raises
     ------
@@ -140,6 +152,10 @@ def read_geojson(path, density: float = 2500.0, thickness: float = 1.0) -> Assem
         index = len(blocks) if role == "block" else len(supports)
         name = str(props.get("name", f"{role}-{index + 1}"))  # block-1 first, as in a TOML file
         where = f"{feature_at}: {body_label(index, name, role)}"
+        if unknown is not None:
+            for key in props:
+                if key not in GEOJSON_PROPERTIES and str(key).lower() not in GIS_ID_COLUMNS:
+                    unknown.setdefault(key, f"feature {k}, {body_label(index, name, role)}")
         geometry = feature.get("geometry")
         gtype = geometry.get("type") if isinstance(geometry, dict) else None
         rings = geometry.get("coordinates") if gtype in ("Polygon", "MultiPolygon") else None

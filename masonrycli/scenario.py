@@ -342,8 +342,9 @@ def scenario_from_geometry_file(path) -> Scenario:
     path = os.fspath(path)
     ctx = InputContext(path, os.path.dirname(os.path.abspath(path)))
     material = Material()
-    assembly = read_geometry(path, material.density, material.thickness, ctx, where="")
-    warnings = structure_warnings(assembly, ctx)
+    notes: list[str] = []
+    assembly = read_geometry(path, material.density, material.thickness, ctx, where="", notes=notes)
+    warnings = (*notes, *structure_warnings(assembly, ctx))
     return Scenario(
         name=Path(path).stem,
         run=RunConfig(),

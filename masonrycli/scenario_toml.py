@@ -11,7 +11,6 @@ scenario format uses, with floats spelled by ``repr`` so that a reload gives bit
 from __future__ import annotations
 
 import dataclasses
-import difflib
 import math
 import os
 import tomllib
@@ -25,7 +24,15 @@ from masonrycli.motion import MOTION_KINDS, Fixed, Motion
 from masonrycli.records import record_fields
 from masonrycli.scenario import Material, RunConfig, Scenario, block_speed_problem
 from masonrycli.structure import build_structure, check_finite_tree, read_geometry, structure_warnings
-from masonrycli.values import check_real, check_vector, field_error, format_value, quote_key, quote_string
+from masonrycli.values import (
+    check_real,
+    check_vector,
+    field_error,
+    format_value,
+    quote_key,
+    quote_string,
+    unknown_key,
+)
 
 TOP_LEVEL_KEYS = ("name", "run", "material", "structure", "block", "support")
 BLOCK_KEYS = ("name", "polygon", "density", "thickness", "velocity")
@@ -37,12 +44,6 @@ ALL_MOTION_KEYS = tuple(dict.fromkeys(k for cls in MOTION_KINDS.values() for k i
 
 # --------------------------------------------------------------------------------------------------
 # reading
-
-
-def _unknown_key(key, known) -> str:
-    close = difflib.get_close_matches(str(key), list(known), n=1)
-    hint = f' (did you mean "{close[0]}"?)' if close else f" (expected one of: {', '.join(known)})"
-    return f"unknown key {quote_string(str(key))}{hint}"
 
 
 def _check_name(key: str, value) -> str:
@@ -109,7 +110,7 @@ def _config(cls, table: dict, ctx: InputContext, section: str):
     names = [f.name for f in dataclasses.fields(cls)]
     for key in table:
         if key not in names:
-            raise ctx.error(f"[{section}]", _unknown_key(key, names))
+            raise ctx.error(f"[{section}]", unknown_key(key, names))
     try:
         return cls(**table)
     except InputError as exc:
@@ -119,7 +120,7 @@ def _config(cls, table: dict, ctx: InputContext, section: str):
 def _parse_document(doc: dict, ctx: InputContext, default_name: str) -> Scenario:
     for key in doc:
         if key not in TOP_LEVEL_KEYS:
-            raise ctx.error("", _unknown_key(key, TOP_LEVEL_KEYS))
+            raise ctx.error("", unknown_key(key, TOP_LEVEL_KEYS))
     try:
         name = _check_name("name", doc["name"]) if "name" in doc else default_name
     except InputError as exc:
@@ -128,6 +129,7 @@ def _parse_document(doc: dict, ctx: InputContext, default_name: str) -> Scenario
     material = _config(Material, _table(doc, "material", ctx), ctx, "material")
     block_tables = _array_of_tables(doc, "block", ctx)
     support_tables = _array_of_tables(doc, "support", ctx)
+    notes: list[str] = []  # warnings of a geometry file (its properties not used)
 
     if "structure" in doc:
         structure = _table(doc, "structure", ctx)
@@ -147,7 +149,7 @@ def _parse_document(doc: dict, ctx: InputContext, default_name: str) -> Scenario
             if not isinstance(file, str):
                 raise ctx.error("[structure]", f"file = {format_value(file)[:40]}: must be a string")
             path = os.path.abspath(os.path.join(ctx.base_dir, file))
-            assembly = read_geometry(path, material.density, material.thickness, ctx)
+            assembly = read_geometry(path, material.density, material.thickness, ctx, notes=notes)
             what = f"file {quote_string(file)}"
             structure_info = {"file": path}
         else:
@@ -180,7 +182,7 @@ def _parse_document(doc: dict, ctx: InputContext, default_name: str) -> Scenario
                             f"{key}: not allowed with a [structure] "
                             f"({what} makes the supports; give only name and motion)",
                         )
-                    raise ctx.error(loc, _unknown_key(key, BUILDER_SUPPORT_KEYS))
+                    raise ctx.error(loc, unknown_key(key, BUILDER_SUPPORT_KEYS))
             if "name" not in table:
                 raise ctx.error(loc, f"name: missing ({what} supports: {', '.join(known)})")
             sname = table["name"]
@@ -210,7 +212,7 @@ def _parse_document(doc: dict, ctx: InputContext, default_name: str) -> Scenario
         motions = tuple(motions_list)
         structure_info = {}
 
-    warnings = structure_warnings(assembly, ctx)
+    warnings = (*notes, *structure_warnings(assembly, ctx))
     return Scenario(
         name=name,
         run=run,
@@ -265,7 +267,7 @@ def _parse_block(i: int, table: dict, material: Material, ctx: InputContext, nam
     loc = _locator("block", i, table, default_name)
     for key in table:
         if key not in BLOCK_KEYS:
-            raise ctx.error(loc, _unknown_key(key, BLOCK_KEYS))
+            raise ctx.error(loc, unknown_key(key, BLOCK_KEYS))
     try:
         name = _check_name("name", table.get("name", default_name))
         if "polygon" not in table:
@@ -290,7 +292,7 @@ def _parse_support(i: int, table: dict, ctx: InputContext, names: dict) -> tuple
     loc = _locator("support", i, table, default_name)
     for key in table:
         if key not in SUPPORT_KEYS:
-            raise ctx.error(loc, _unknown_key(key, SUPPORT_KEYS))
+            raise ctx.error(loc, unknown_key(key, SUPPORT_KEYS))
     try:
         name = _check_name("name", table.get("name", default_name))
         if "polygon" not in table:
@@ -316,7 +318,7 @@ def _parse_motion(table, ctx: InputContext, loc: str) -> Motion:
         )
     for key in table:
         if key not in ALL_MOTION_KEYS:
-            raise ctx.error(loc, "motion: " + _unknown_key(key, ALL_MOTION_KEYS))
+            raise ctx.error(loc, "motion: " + unknown_key(key, ALL_MOTION_KEYS))
     if "kind" not in table:
         raise ctx.error(loc, f"motion.kind: missing (one of {', '.join(MOTION_KINDS)})")
     kind = table["kind"]

@@ -17,17 +17,18 @@ from pathlib import Path
 from geometry_library.blocks import Assembly, GeometryError
 from geometry_library.values import is_integer, is_real
 from masonrycli.errors import NOT_A_FILE, InputContext, InputError, one_line
-from masonrycli.values import field_error, quote_string
+from masonrycli.values import did_you_mean, field_error, quote_string
 
 GEOMETRY_SUFFIXES = (".geojson", ".json", ".wkt")
 
 
 def read_geometry(
-    path: str, density: float, thickness: float, ctx: InputContext, where: str = "[structure]"
+    path: str, density: float, thickness: float, ctx: InputContext, where: str = "[structure]", notes=None
 ) -> Assembly:
     """Blocks and supports of a GeoJSON or WKT file (``geometry_library.io``), with ``density`` and
     ``thickness`` (the material's) as defaults. ``where`` is the table naming the file ("" when the file
-    is the scenario itself: ``masonry run wall.geojson``)."""
+    is the scenario itself: ``masonry run wall.geojson``). ``notes``: a list given receives the one-line
+    warning of :func:`unread_properties_warning`, if any."""
     from geometry_library import io as geo_io
 
     suffix = Path(path).suffix.lower()
@@ -39,14 +40,31 @@ def read_geometry(
     if not os.path.isfile(path):
         missing = NOT_A_FILE if os.path.exists(path) else "no such file"
         raise ctx.error(where, f"file = {quote_string(path)}: {missing}" if where else missing)
-    reader = geo_io.read_wkt if suffix == ".wkt" else geo_io.read_geojson
+    unknown: dict = {}
     try:
-        return reader(path, density=density, thickness=thickness)
+        if suffix == ".wkt":
+            return geo_io.read_wkt(path, density=density, thickness=thickness)
+        assembly = geo_io.read_geojson(path, density=density, thickness=thickness, unknown=unknown)
+        if unknown and notes is not None:
+            notes.append(unread_properties_warning(path, unknown, geo_io.GEOJSON_PROPERTIES))
+        return assembly
     except (GeometryError, ValueError) as exc:
         msg = one_line(exc)
         if not where and msg.startswith(f"{path}:"):  # the reader named the file already
             raise InputError(msg) from None
         raise ctx.error(where, msg) from None
+
+
+def unread_properties_warning(path: str, unknown: dict, known) -> str:
+    """One line for the GeoJSON properties the reader does not use (``unknown``: key → first body): a
+    per-block ``friction`` or a misspelt ``densty`` was ignored without a word, the run using the defaults."""
+    items = []
+    for key, first in unknown.items():
+        hint = did_you_mean(key, known)
+        if not hint and str(key).lower() == "friction":  # one coefficient for every contact, not a block's
+            hint = " (friction is the scenario file's [material] friction, one for every contact)"
+        items.append(f"{quote_string(str(key))}{hint} first on {first}")
+    return f"{path}: properties not used, ignored (used: {', '.join(known)}): {'; '.join(items)}"
 
 
 def structure_warnings(assembly: Assembly, ctx: InputContext) -> tuple[str, ...]:

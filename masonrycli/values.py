@@ -8,6 +8,7 @@ write Python values as TOML text that ``tomllib`` reads back bit for bit.
 
 from __future__ import annotations
 
+import difflib
 import itertools
 import math
 import re
@@ -71,6 +72,19 @@ _BARE_KEY = re.compile(r"^[A-Za-z0-9_-]+$")
 
 def quote_key(key: str) -> str:
     return key if _BARE_KEY.match(key) else quote_string(key)
+
+
+def did_you_mean(key, known) -> str:
+    """`` (did you mean "density"?)`` for a near-miss of a ``known`` key (``densty``), else ""."""
+    close = difflib.get_close_matches(str(key), list(known), n=1)
+    return f' (did you mean "{close[0]}"?)' if close else ""
+
+
+def unknown_key(key, known) -> str:
+    """``unknown key "densty" (did you mean "density"?)``, or the known keys when none is close: the TOML
+    reader's message for a key it does not read (the GeoJSON reader's warning shares :func:`did_you_mean`)."""
+    hint = did_you_mean(key, known) or f" (expected one of: {', '.join(known)})"
+    return f"unknown key {quote_string(str(key))}{hint}"
 
 
 def shorten(value, limit: int = 60) -> str:

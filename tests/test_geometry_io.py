@@ -96,6 +96,23 @@ def test_geojson_a_null_property_is_not_given(tmp_path):
     assert [(s.name, s.role) for s in a.supports] == [("g", "fixed")]
 
 
+def test_geojson_properties_it_does_not_use_are_listed_with_their_first_body(tmp_path):
+    # a per-block friction or a misspelt densty was ignored without a word; a GIS's feature ids are not news
+    ground = feature([[-2, -1], [3, -1], [3, 0], [-2, 0], [-2, -1]], role="support", name="g", fid=1, colour="grey")
+    blocks = [feature(SQ, name="a", densty=2000, FID=2, friction=0.7), feature(SQ, name="b", friction=0.7, id=3)]
+    unknown: dict = {}
+    a = read_geojson(write(tmp_path, [ground, *blocks]), density=1800.0, unknown=unknown)
+    assert unknown == {
+        "colour": 'feature 1, support 1 ("g")',
+        "densty": 'feature 2, block 1 ("a")',
+        "friction": 'feature 2, block 1 ("a")',
+    }
+    assert a.blocks[0].density == 1800.0  # densty is not density
+    unknown.clear()  # a null is not given: nothing to report
+    read_geojson(write(tmp_path, [feature(SQ, name="a", friction=None, density=2000.0)]), unknown=unknown)
+    assert unknown == {}
+
+
 def one_line_error(fn, *args):
     with pytest.raises(GeometryError) as info:
         fn(*args)

@@ -113,6 +113,24 @@ def test_a_geometry_file_takes_the_material_where_it_says_nothing(tmp_path):
     assert structure_warnings(a, CTX) == ()
 
 
+def test_geojson_properties_not_used_give_one_warning_with_near_misses(tmp_path):
+    # the reader used the material's density for a block whose "densty" said 2000, and no per-block friction
+    block = {"name": "a", "densty": 2000, "friction": 0.7, "fid": 1, "colour": "red"}
+    path = _geojson(tmp_path / "w.geojson", (block, RECT), ({"role": "support", "name": "g"}, GROUND))
+    notes: list[str] = []
+    read_geometry(path, 2500.0, 1.0, CTX, notes=notes)
+    (note,) = notes
+    assert note == (
+        f"{path}: properties not used, ignored (used: role, name, density, thickness, velocity, support_role): "
+        '"densty" (did you mean "density"?) first on feature 1, block 1 ("a"); '
+        '"friction" (friction is the scenario file\'s [material] friction, one for every contact) first on '
+        'feature 1, block 1 ("a"); "colour" first on feature 1, block 1 ("a")'
+    )
+    clean = _geojson(tmp_path / "c.geojson", ({"name": "a", "density": 2000, "id": 4}, RECT))
+    read_geometry(clean, 2500.0, 1.0, CTX, notes=notes)
+    assert len(notes) == 1
+
+
 def test_geometry_file_errors_name_the_table_or_only_the_file(tmp_path):
     with pytest.raises(InputError, match=r'^s\.toml: \[structure\] file = "w\.dxf": unknown geometry format'):
         read_geometry("w.dxf", 2500.0, 1.0, CTX)
