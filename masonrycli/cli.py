@@ -27,6 +27,7 @@ from masonrycli.cli_options import (
     WALL,
     WALL_LOADING,
     Friction,
+    file_defaults,
     with_options,
 )
 from masonrycli.errors import EXIT_DIVERGED, EXIT_INTERNAL, EXIT_OUTPUT_FAILED, InputError
@@ -171,6 +172,9 @@ ScenarioFile = Annotated[
 ]
 
 
+RUN_FROM_FILE, FRICTION_FROM_FILE = file_defaults(RUN), file_defaults(FRICTION)  # run and check: the file's values
+
+
 def _load(scenario_file: str, opts: dict):
     """The scenario of a TOML, GeoJSON or WKT file with the command line's record and run options
     (taken out of ``opts``) applied."""
@@ -185,7 +189,7 @@ def _load(scenario_file: str, opts: dict):
     "override the file's values.",
 )
 @user_errors
-@with_options(RUN, STOP, FRICTION, OUTPUT, FORCE, RECORD)
+@with_options(RUN_FROM_FILE, STOP, FRICTION_FROM_FILE, OUTPUT, FORCE, RECORD)
 def run_command(scenario_file: ScenarioFile, **opts) -> None:
     """Run any scenario file (or a GeoJSON / WKT geometry file, supports fixed); options given here
     override the file's values."""
@@ -253,7 +257,7 @@ def limit_command(
     "supports, mass, bounding box, steps, outputs); nothing is computed or written.",
 )
 @user_errors
-@with_options(RUN, STOP, FRICTION, OUTPUT, FORCE, RECORD)
+@with_options(RUN_FROM_FILE, STOP, FRICTION_FROM_FILE, OUTPUT, FORCE, RECORD)
 def check_command(scenario_file: ScenarioFile, **opts) -> None:
     """Validate what `masonry run` would run, with the same arguments, and print a summary (blocks,
     supports, mass, bounding box, steps, the loading, outputs); nothing is computed or written."""

@@ -6,8 +6,10 @@ option (its flag, help text and panel) is written once for every command that ha
 
 from __future__ import annotations
 
+import copy
 import functools
 import inspect
+import re
 import typing
 from pathlib import Path
 from typing import Annotated
@@ -99,6 +101,26 @@ RUN = {
 }
 Friction = _opt(float, "Material", "Coulomb coefficient of every contact (default 0.6).")
 FRICTION = {"friction": Friction}
+
+_BUILT_IN_DEFAULT = re.compile(r"\(default ([^;)]*)")
+"""The "(default 1e-3" of a help text: the built-in value, which a scenario file's replaces."""
+
+
+def file_defaults(group: dict) -> dict:
+    """``group`` with each "(default …)" of its help texts saying the scenario file's value is the default:
+    ``run --help`` said "(default 1e-3)" for --dt although a file's [run] dt = 2e-4 is what runs."""
+    out = {}
+    for name, annotation in group.items():
+        kind, info = typing.get_args(annotation)
+        info = copy.copy(info)
+        info.help = _BUILT_IN_DEFAULT.sub(r"(default: the scenario file's value, else \1", info.help, count=1)
+        info.help = info.help.replace(
+            "the built-in's or the file's; simulate --record: the whole record", "the scenario file's value"
+        )
+        out[name] = Annotated[kind, info]
+    return out
+
+
 BLOCK_MATERIAL = {
     "density": _opt(float, "Material", "Block density, kg/m³ (default 2500)."),
     "thickness": _opt(float, "Material", "Out-of-plane thickness, m (default 1)."),

@@ -57,6 +57,37 @@ def test_simulate_help_lists_only_what_the_structure_takes_with_its_defaults():
         assert "(default 2" in options["--freq"]
 
 
+def test_run_and_check_help_give_the_scenario_files_values_as_defaults():
+    # `run --help` said "(default 1e-3)" for --dt, although a file's [run] dt is what runs
+    for command in (["run"], ["check"]):
+        options = _option_help(command)
+        assert "(default: the scenario file's value, else 1e-3)" in options["--dt"]
+        assert "(default: the scenario file's value, else 0.5)" in options["--theta"]
+        assert "(default: the scenario file's value, else 0.6)" in options["--friction"]
+        assert (
+            "(default: the scenario file's value)" in options["--duration"] and "simulate" not in options["--duration"]
+        )
+    simulate = _option_help(["simulate", "wall"])
+    assert "(default 1e-3)" in simulate["--dt"] and "(default 0.6)" in simulate["--friction"]
+
+
+def test_geojson_properties_not_used_are_warned_by_run_and_check(tmp_path):
+    ring = [[0, 0], [0.3, 0], [0.3, 0.2], [0, 0.2], [0, 0]]
+    ground = [[-1, -0.2], [2, -0.2], [2, 0], [-1, 0], [-1, -0.2]]
+    features = [
+        {"type": "Feature", "properties": props, "geometry": {"type": "Polygon", "coordinates": [xy]}}
+        for props, xy in (({"role": "support", "fid": 1}, ground), ({"name": "B1", "densty": 2000}, ring))
+    ]
+    path = tmp_path / "w.json"
+    path.write_text(json.dumps({"type": "FeatureCollection", "features": features}))
+    (tmp_path / "s.toml").write_text('[structure]\nfile = "w.json"\n')
+    for args in (["check", path], ["check", tmp_path / "s.toml"], ["run", path, "--duration", 0.002, "--no-recording"]):
+        result = invoke(*args)
+        assert result.exit_code == 0, result.output
+        (line,) = [ln for ln in result.output.splitlines() if ln.startswith("warning:")]
+        assert '"densty" (did you mean "density"?) first on feature 2, block 1 ("B1")' in line and "fid" not in line
+
+
 def test_sweep_help_gives_the_default_file_names():
     # --out and --plot said nothing of where the table and the picture go when not given (study-<scenario>.parquet
     # in the working folder, the plot beside it), while --recording did
