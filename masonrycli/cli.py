@@ -278,7 +278,8 @@ def _write_assembly(builder: str, opts: dict) -> None:
     from masonrycli.builtin import build_assembly
     from masonrycli.outputs import check_output, written_whole
 
-    target = check_output(opts.pop("out"), "--out", ".geojson", opts.pop("force"))
+    # .json too: `masonry run` reads a .json file as GeoJSON (GEOMETRY_SUFFIXES), build refused to write one
+    target = check_output(opts.pop("out"), "--out", (".geojson", ".json"), opts.pop("force"))
     assembly = build_assembly(builder, **opts)
     for warning in validate_assembly(assembly):
         warn(warning)

@@ -19,7 +19,16 @@ import typer
 
 def _opt(kind: type, panel: str, help: str, *decls: str):
     """An optional ``kind`` value (None when not given), listed under ``panel`` in --help."""
-    return Annotated[kind | None, typer.Option(*decls, help=help, rich_help_panel=panel)]
+    parser = {"parser": path_value} if kind is Path else {}
+    return Annotated[kind | None, typer.Option(*decls, help=help, rich_help_panel=panel, **parser)]
+
+
+def path_value(text: str) -> Path:
+    """A path option's value: ``""`` is refused as empty (``Path("")`` is ".", so ``--out ""`` said
+    "--out .: the file name must end in .rrd" and ``--record ""`` ".: is a directory")."""
+    if not str(text).strip():
+        raise typer.BadParameter("the path is empty")
+    return Path(text)
 
 
 WALL = {
@@ -157,7 +166,11 @@ FORCE = {
         ),
     ]
 }
-GEO_OUT = {"out": Annotated[Path, typer.Option("--out", "-o", help="GeoJSON file to write (.geojson).")]}
+GEO_OUT = {
+    "out": Annotated[
+        Path, typer.Option("--out", "-o", parser=path_value, help="GeoJSON file to write (.geojson or .json).")
+    ]
+}
 
 
 def with_options(*groups: dict):

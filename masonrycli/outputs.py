@@ -111,12 +111,16 @@ class OutputFile:
         shutil.rmtree(self.part.with_name(self.part.name + ".rows"), ignore_errors=True)  # a history's rows
 
 
-def check_output(path: Path, option: str, suffix: str, force: bool, *, default_name: bool = False) -> OutputFile:
-    """Check ``path`` before anything is computed: suffix, not a folder, not existing (unless ``force``),
-    its folder creatable and writable. Raises :class:`InputError` naming the option and the path."""
+def check_output(
+    path: Path, option: str, suffix: str | tuple[str, ...], force: bool, *, default_name: bool = False
+) -> OutputFile:
+    """Check ``path`` before anything is computed: suffix (one, or a tuple of accepted ones), not a folder,
+    not existing (unless ``force``), its folder creatable and writable. Raises :class:`InputError` naming
+    the option and the path."""
     where = f"{option} {path}"
-    if path.suffix.lower() != suffix:
-        raise InputError(f"{where}: the file name must end in {suffix}")
+    suffixes = (suffix,) if isinstance(suffix, str) else suffix
+    if path.suffix.lower() not in suffixes:
+        raise InputError(f"{where}: the file name must end in {' or '.join(suffixes)}")
     if path.is_dir():
         raise InputError(f"{where}: is a folder")
     if os.path.lexists(path) and not force:  # a link to a missing file too: the run wrote "x-2.rrd" instead

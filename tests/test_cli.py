@@ -200,6 +200,11 @@ def test_a_built_in_name_given_as_scenario_file_points_to_simulate(command, name
             ["--magnify 1e+300: must be between 1 and 1e+06"],
         ),
         (("simulate", "wall", "--duration", 0.01, "--magnify", 0.5), ["--magnify 0.5: must be between 1"]),
+        # Path("") is ".": "--out .: the file name must end in .rrd", "--record ''" ".: is a directory"
+        (("simulate", "wall", "--duration", 0.01, "--history", ""), ["--history", "the path is empty"]),
+        (("simulate", "wall", "--duration", 0.01, "--record", ""), ["--record", "the path is empty"]),
+        (("build", "wall", "--out", ""), ["--out", "the path is empty"]),
+        (("build", "wall", "--out", "w.txt"), ["--out w.txt: the file name must end in .geojson or .json"]),
         # --out was ignored: the recording asked for was silently not written
         (("simulate", "wall", "--duration", 0.01, "--out", "x.rrd"), ["--out x.rrd with --no-recording"]),
     ],
@@ -281,7 +286,7 @@ def test_build_writes_geojson_that_runs(builder, args, blocks, supports, tmp_pat
     from shapely.geometry import shape
     from shapely.strtree import STRtree
 
-    out = tmp_path / f"{builder}.geojson"
+    out = tmp_path / f"{builder}.{'json' if supports == 2 else 'geojson'}"  # .json: `run` reads it as GeoJSON
     result = invoke("build", builder, *args, "--out", out)
     assert result.exit_code == 0, result.output
     features = json.loads(out.read_text())["features"]

@@ -256,3 +256,14 @@ def test_history_write_failure_stops_the_run(tmp_path, monkeypatch):
     assert not npz.exists() and leftovers(tmp_path) == []
     assert rrd.exists()  # what was computed is kept where possible
     assert os.listdir(tmp_path) == ["r.rrd"]
+
+
+def test_an_output_may_accept_several_suffixes(tmp_path):
+    # build --out w.json was refused although `run` reads .json as GeoJSON
+    from masonrycli.errors import InputError
+    from masonrycli.outputs import check_output
+
+    for name in ("w.geojson", "w.JSON"):
+        assert check_output(tmp_path / name, "--out", (".geojson", ".json"), False).path == tmp_path / name
+    with pytest.raises(InputError, match=r"--out .*w\.txt: the file name must end in \.geojson or \.json$"):
+        check_output(tmp_path / "w.txt", "--out", (".geojson", ".json"), False)
