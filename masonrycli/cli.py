@@ -28,6 +28,7 @@ from masonrycli.cli_options import (
     WALL_LOADING,
     Friction,
     file_defaults,
+    path_value,
     with_options,
 )
 from masonrycli.errors import EXIT_DIVERGED, EXIT_INTERNAL, EXIT_OUTPUT_FAILED, InputError
@@ -229,7 +230,8 @@ def limit_command(
         bool, typer.Option("--verify", help="Run the NSCD engine at 0.95 λ and 1.05 λ (tilted gravity) and compare.")
     ] = False,
     out: Annotated[
-        Path | None, typer.Option("--out", "-o", help="Write the mechanism recording (.rrd).", metavar="REC.rrd")
+        Path | None,
+        typer.Option("--out", "-o", parser=path_value, help="Write the mechanism recording (.rrd).", metavar="REC.rrd"),
     ] = None,
     force: Annotated[bool, typer.Option("--force", help="Replace the --out file if it exists.")] = False,
 ) -> None:

@@ -14,6 +14,7 @@ from typing import TYPE_CHECKING, Annotated
 
 import typer
 
+from masonrycli.cli_options import path_value
 from masonrycli.errors import EXIT_DIVERGED, EXIT_ROWS_FAILED
 from masonrycli.interrupt import FirstSignalStops, exit_code, signal_name
 from masonrycli.outputs import OutputFile
@@ -42,7 +43,9 @@ def sweep_command(
     records: Annotated[
         list[Path] | None,
         typer.Option(
-            "--records", help="Record files (.AT2 or CSV) or folders of them, repeatable: one axis 'record' over them."
+            "--records",
+            parser=path_value,
+            help="Record files (.AT2 or CSV) or folders of them, repeatable: one axis 'record' over them.",
         ),
     ] = None,
     record_dt: Annotated[
@@ -72,7 +75,10 @@ def sweep_command(
     out: Annotated[
         Path | None,
         typer.Option(
-            "--out", "-o", help="Results, .parquet or .csv (one row per run; default study-<scenario>.parquet)."
+            "--out",
+            "-o",
+            parser=path_value,
+            help="Results, .parquet or .csv (one row per run; default study-<scenario>.parquet).",
         ),
     ] = None,
     scheduler: Annotated[
@@ -96,16 +102,26 @@ def sweep_command(
     ] = "pga",
     plot: Annotated[
         Path | None,
-        typer.Option("--plot", help="PNG of the state map / fragility / thresholds (default: beside --out, .png)."),
+        typer.Option(
+            "--plot",
+            parser=path_value,
+            help="PNG of the state map / fragility / thresholds (default: beside --out, .png).",
+        ),
     ] = None,
     recording: Annotated[
-        Path | None, typer.Option("--recording", help="Rerun recording of the study (default: beside --out, .rrd).")
+        Path | None,
+        typer.Option(
+            "--recording", parser=path_value, help="Rerun recording of the study (default: beside --out, .rrd)."
+        ),
     ] = None,
     no_recording: Annotated[
         bool, typer.Option("--no-recording", help="Write no Rerun recording of the study.")
     ] = False,
     histories: Annotated[
-        Path | None, typer.Option("--histories", help="Folder for one history (.npz) per run, e.g. amp=0.5_freq=2.npz.")
+        Path | None,
+        typer.Option(
+            "--histories", parser=path_value, help="Folder for one history (.npz) per run, e.g. amp=0.5_freq=2.npz."
+        ),
     ] = None,
     force: Annotated[
         bool,

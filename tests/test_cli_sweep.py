@@ -817,3 +817,11 @@ def test_diverged_rows_give_exit_3_as_simulate_does(block, tmp_path, monkeypatch
     said = " ".join(result.output.split())
     assert f"error: 1 of 2 rows diverged (their error column in {out} says when); a smaller" in said
     assert [r["error"] for r in read_rows(out)] == ["", "diverged at t = 0.0100 s"]
+
+
+@pytest.mark.parametrize("option", ["--out", "--plot", "--recording", "--histories", "--records"])
+def test_an_empty_path_is_said_to_be_empty(option):
+    # Path("") is ".": sweep took --out "" as the folder "."
+    from cli_helpers import assert_one_line_error, invoke
+
+    assert_one_line_error(invoke("sweep", "wall", "--param", "amp=0.1", option, ""), option, "the path is empty")

@@ -225,3 +225,10 @@ def test_verify_headers_read_whole_at_80_columns(column_file, monkeypatch):
     assert "…" not in header, header
     for word in ("predicted", "largest", "move", "similarity", "hinges", "shared"):
         assert word in header.split(), header
+
+
+def test_an_empty_out_is_said_to_be_empty():
+    # Path("") is ".": "--out .: the file name must end in .rrd"
+    from cli_helpers import assert_one_line_error, invoke
+
+    assert_one_line_error(invoke("limit", "wall", "--out", ""), "--out", "the path is empty")
