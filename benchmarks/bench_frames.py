@@ -32,27 +32,14 @@ import os
 import subprocess
 import sys
 import tempfile
-import time
 from pathlib import Path
+
+from benchmarks.bench_phases import _timed
 
 os.environ.setdefault("RERUN_ANALYTICS", "0")
 ROOT = Path(__file__).resolve().parent.parent
 DEFAULT_COMMAND = ("simulate", "wall", "--blocks", "248", "--duration", "0.2", "--record-every", "1")
 PARTS = ("frame", "frame.tensors", "frame.joints", "history", "record", "record.send", "record.resultants", "run")
-
-
-def _timed(owner, name: str, key: str, totals: dict) -> None:
-    """Replace ``owner.name`` by a wrapper adding its CPU time to ``totals[key]``."""
-    inner = getattr(owner, name)
-
-    def timed(*args, **kwargs):
-        start = time.process_time()
-        try:
-            return inner(*args, **kwargs)
-        finally:
-            totals[key] = totals.get(key, 0.0) + time.process_time() - start
-
-    setattr(owner, name, timed)
 
 
 def worker(package_root: str, out: str, command: list[str]) -> None:

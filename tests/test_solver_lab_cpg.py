@@ -8,13 +8,12 @@ the frozen-shift problem solved by scipy's SLSQP in velocity space from dense ma
 
 import numpy as np
 import pytest
-from scipy.optimize import minimize
 
 from benchmarks.solver_lab import law
 from benchmarks.solver_lab.methods import cpg as G
 from benchmarks.solver_lab.outcome import Clock, Context
 from masonrycli.engine import nlgs as N
-from tests.solver_lab_helpers import tiny_cold_problem
+from tests.solver_lab_helpers import frozen_shift_qp, tiny_cold_problem
 
 
 @pytest.fixture(scope="module")
@@ -65,22 +64,10 @@ def test_frozen_shift_qp_matches_scipy(cold, precondition):
     m = 1.0 / ctx.minv[dyn]
     mu = p.mu
     s = np.random.default_rng(5).uniform(0.0, 2e-3, p.count)
-    c = ctx.pack[:, N.P_BIAS] + s + u_sup[:, 1]
-    A = np.vstack([hn + mu * ht, hn - mu * ht])
-    b = np.concatenate([c + mu * u_sup[:, 0], c - mu * u_sup[:, 0]])
-    x_free = p.v_free.ravel()[dyn]
-    res = minimize(
-        lambda x: 0.5 * (x - x_free) @ (m * (x - x_free)),
-        x_free,
-        jac=lambda x: m * (x - x_free),
-        constraints=[{"type": "ineq", "fun": lambda x: A @ x + b, "jac": lambda x: A}],
-        method="SLSQP",
-        options={"ftol": 1e-15, "maxiter": 500},
-    )
-    assert res.success
+    x_ref = frozen_shift_qp(ht, hn, u_sup, m, p.v_free.ravel()[dyn], ctx.pack[:, N.P_BIAS], mu, s)
     v, r, its, _, _, _, natural = G.run_cpg(ctx, 1e-10, Clock(), precondition, monotone=True, cap=5000, s_fixed=s)
     assert natural <= 1e-10 and its < 5000
-    np.testing.assert_allclose(v.ravel()[dyn], res.x, atol=1e-7)
+    np.testing.assert_allclose(v.ravel()[dyn], x_ref, atol=1e-7)
     assert (r[:, 1] >= 0).all() and (np.abs(r[:, 0]) <= mu * r[:, 1] + 1e-12).all()
 
 
