@@ -186,7 +186,7 @@ def _joint_keys(body, frame, keys, flip):
 
 @njit
 def _resultants(body, frame, force, normal, point, status, out_body, out_point, out_force, out_state, out_frame):
-    # base = 1 + the largest body index; key of contact c = (frame·base + min(a, b))·base + max(a, b)
+    # keys, flips, base of the contacts (_joint_keys: key = (frame·base + min(a, b))·base + max(a, b))
     # if the keys are not in order: return −1 (the caller puts the contacts in order first)
     # a joint = a run of equal keys; over its contacts in order, with s = −1 if a > b (flipped), else 1:
     #     f = s·force, n = s·normal, fn = max((0 + f_x n_x) + f_y n_y, 0)   (einsum's sum, np.maximum)
@@ -195,16 +195,11 @@ def _resultants(body, frame, force, normal, point, status, out_body, out_point, 
     # a joint with weight > 0 is a row: bodies (low, high), centre / weight, resultant, state (SLIP if
     # slipping, else OPEN if opened, else STICK: joint_forces' 1, 2, 0), frame; returns the row count
     n = body.shape[0]
-    base = 0
-    for c in range(n):
-        base = max(base, body[c, 0], body[c, 1])
-    base += 1
     keys = np.empty(n, np.int64)
-    for c in range(n):
-        a = np.int64(body[c, 0])
-        b = np.int64(body[c, 1])
-        keys[c] = (frame[c] * base + min(a, b)) * base + max(a, b)
-        if c > 0 and keys[c] < keys[c - 1]:
+    flip = np.empty(n, np.bool_)
+    base = _joint_keys(body, frame, keys, flip)
+    for c in range(1, n):
+        if keys[c] < keys[c - 1]:
             return -1
     rows = 0
     c = 0
@@ -218,7 +213,7 @@ def _resultants(body, frame, force, normal, point, status, out_body, out_point, 
         slipping = False
         opened = False
         while c < n and keys[c] == key:
-            s = -1.0 if body[c, 0] > body[c, 1] else 1.0
+            s = -1.0 if flip[c] else 1.0
             fx = force[c, 0] * s
             fy = force[c, 1] * s
             fn = _nan_max((0.0 + fx * (normal[c, 0] * s)) + fy * (normal[c, 1] * s), 0.0)
