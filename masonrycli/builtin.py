@@ -36,7 +36,7 @@ from pathlib import Path
 
 from masonrycli.errors import NOT_A_FILE, InputError, file_kind, special_file
 from masonrycli.motion import Constant, Record, Sine, time_step_problem
-from masonrycli.record_text import NoTimeStep
+from masonrycli.record_text import NoTimeStep, TimeStepNotUsed
 from masonrycli.records import record_motion
 from masonrycli.scenario import MAX_DURATION, Material, RunConfig, Scenario, scenario_from_builder
 
@@ -126,6 +126,8 @@ def record_motion_option(path: Path, scale: float | None, record_dt: float | Non
         return record_motion(path, scale=1.0 if scale is None else scale, display=str(path), time_step=record_dt)
     except NoTimeStep as exc:
         raise exc.give("--record-dt SECONDS") from None
+    except TimeStepNotUsed as exc:  # the message named time_step, a scenario's key, not the option given
+        raise exc.named("--record-dt") from None
     except InputError as exc:
         msg = str(exc)
         raise InputError(msg if msg.startswith(str(path)) else f"--record {path}: {msg}") from None

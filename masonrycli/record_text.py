@@ -75,6 +75,24 @@ class NoTimeStep(InputError):
         return NoTimeStep, (self.where, self.how)
 
 
+class TimeStepNotUsed(InputError):
+    """A time step given for a file that has its own times (a time column, an .AT2 file's DT), at ``where``
+    (``file:line`` or ``file``). ``problem`` says why, with ``{key}`` where the time step is named: the
+    command line's ``--record-dt``, a scenario's ``time_step`` (the default, the Python keyword); a caller
+    words it as its user gave it with :meth:`named` (both names in one line told neither which to leave out)."""
+
+    def __init__(self, where: str, problem: str, key: str = "time_step"):
+        self.where, self.problem, self.key = where, problem, key
+        super().__init__(f"{where}: {problem.format(key=key)}")
+
+    def named(self, key: str) -> TimeStepNotUsed:
+        """The same refusal, naming the time step ``key`` (``--record-dt``)."""
+        return TimeStepNotUsed(self.where, self.problem, key)
+
+    def __reduce__(self):  # pickled with the arguments of __init__, not the message it makes of them
+        return TimeStepNotUsed, (self.where, self.problem, self.key)
+
+
 def csv_lines(lines, first: int, name: str, state: CsvState) -> tuple[list, list]:
     """``(times, values)`` of CSV ``lines``, the first being line ``first`` of the file (the reference
     reading; see :func:`masonrycli.records.load_record_csv` for the format). Raises :class:`InputError`."""
@@ -119,9 +137,10 @@ def _first_columns(count: int, where: str, one_column: bool) -> None:
     """Raise :class:`InputError` unless the first sample's ``count`` columns are a layout the file may have:
     1 with a time step given, else 2 (time, value) or 3 (time, x, y)."""
     if one_column and count != 1:
-        raise InputError(
-            f"{where}: {count} columns, but a time step was given: it is for a file of one value per line "
-            "(this one has a time column: leave out --record-dt / time_step)"
+        raise TimeStepNotUsed(
+            where,
+            f"{count} columns, but a time step was given: it is for a file of one value per line "
+            "(this one has a time column: leave out {key})",
         )
     if not one_column and count == 1:
         raise NoTimeStep(where)

@@ -23,7 +23,7 @@ import numpy as np
 
 from masonrycli.errors import NOT_A_FILE, InputError, RecordWarning, file_kind, not_utf8, special_file
 from masonrycli.motion import Record, time_step_problem
-from masonrycli.record_text import NoTimeStep, at2_text, csv_text, number
+from masonrycli.record_text import NoTimeStep, TimeStepNotUsed, at2_text, csv_text, number
 from masonrycli.record_units import check_at2_header, check_csv_header
 from masonrycli.values import format_value, quote_string, shorten
 
@@ -157,9 +157,9 @@ def read_record(path, display: str | None = None, time_step: float | None = None
         raise other
     if is_at2(path):
         if time_step is not None:
-            raise InputError(
-                f"{display or path}: an .AT2 file gives its own time step (DT in its header): --record-dt / "
-                "time_step goes with a CSV of one value per line"
+            raise TimeStepNotUsed(
+                display or str(path),
+                "an .AT2 file gives its own time step (DT in its header): {key} goes with a CSV of one value per line",
             )
         dt, acc = load_at2(path, display)
         return np.arange(acc.size) * dt, acc * G_STANDARD, "acceleration"

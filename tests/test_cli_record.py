@@ -217,12 +217,12 @@ def test_record_dt_reads_a_one_column_record_on_simulate_run_and_check(one_colum
         (
             ["--record", "TWO", "--record-dt", 0.01],
             "error: TWO:1: 2 columns, but a time step was given: it is for a file of one value per line (this one "
-            "has a time column: leave out --record-dt / time_step)",
+            "has a time column: leave out --record-dt)",
         ),
         (
             ["--record", "AT2", "--record-dt", 0.01],
-            "error: AT2: an .AT2 file gives its own time step (DT in its header): --record-dt / time_step goes "
-            "with a CSV of one value per line",
+            "error: AT2: an .AT2 file gives its own time step (DT in its header): --record-dt goes with a CSV "
+            "of one value per line",
         ),
         (
             ["--record-dt", 0.01],

@@ -244,6 +244,21 @@ def test_one_column_without_a_time_step_says_to_give_one(monkeypatch, chunk):
         assert str(back) == str(got.value.give("T")) and back.where == f"a.csv:{line}"
 
 
+def test_a_time_column_with_a_time_step_names_the_time_step_as_the_caller_gave_it():
+    with pytest.raises(InputError) as got:
+        rt.csv_text("t,v\n0,0.5\n0.01,0.6\n", "a.csv", time_step=0.01)
+    # the Python keyword (a scenario's key too); the command line names its option, never both
+    assert str(got.value).endswith("(this one has a time column: leave out time_step)")
+    assert isinstance(got.value, rt.TimeStepNotUsed)
+    named = got.value.named("--record-dt")
+    assert str(named) == (
+        "a.csv:2: 2 columns, but a time step was given: it is for a file of one value per line (this one has a "
+        "time column: leave out --record-dt)"
+    )
+    back = pickle.loads(pickle.dumps(named))
+    assert str(back) == str(named) and back.where == "a.csv:2"
+
+
 # --------------------------------------------------------------------------------------------------- .AT2
 
 

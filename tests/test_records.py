@@ -445,7 +445,7 @@ def test_a_one_column_file_in_a_scenario_reads_and_writes_back(tmp_path):
         (
             '{ kind = "record", file = "two.csv", time_step = 0.01 }',
             "motion.file: two.csv:1: 2 columns, but a time step was given: it is for a file of one value per line "
-            "(this one has a time column: leave out --record-dt / time_step)",
+            "(this one has a time column: leave out time_step)",
         ),
         (
             '{ kind = "record", file = "three.csv", time_step = 0.01 }',
@@ -453,8 +453,8 @@ def test_a_one_column_file_in_a_scenario_reads_and_writes_back(tmp_path):
         ),
         (
             '{ kind = "record", file = "h.AT2", time_step = 0.01 }',
-            "motion.file: h.AT2: an .AT2 file gives its own time step (DT in its header): --record-dt / time_step "
-            "goes with a CSV of one value per line",
+            "motion.file: h.AT2: an .AT2 file gives its own time step (DT in its header): time_step goes with a "
+            "CSV of one value per line",
         ),
         (
             '{ kind = "record", time = [0.0, 1.0], value = [1.0, 2.0], time_step = 1.0 }',
