@@ -15,9 +15,10 @@ only; a ``MultiPolygon`` of one part, as QGIS saves polygon layers, is that poly
 ``support_role``   ``"fixed"`` (default) or ``"driven"``, supports only
 =================  =========================================================================
 
-Other properties are not read: ``read_geojson`` lists them (with the first body carrying each) in its
-``unknown`` argument, for its caller to warn about, except a GIS's feature-id columns (``id``, ``fid``,
-``ogc_fid``, ``objectid``, any case) that a QGIS or ogr2ogr export adds to every layer.
+Other properties, and a block's on a support or a support's on a block, are not read: ``read_geojson`` lists
+them (with the first body carrying each) in its ``unknown`` argument, for its caller to warn about, except a
+GIS's feature-id columns (``id``, ``fid``, ``ogc_fid``, ``objectid``, any case) that a QGIS or ogr2ogr export
+adds to every layer.
 
 Blocks keep the order of their features, supports too. :func:`write_geojson` writes the same
 format with full float precision, so ``read_geojson(write_geojson(a))`` gives back ``a``.
@@ -74,6 +75,10 @@ _ROLE_ONLY = re.compile(r"^\s*(?P<role>block|support)(?:\s+(?P<srole>fixed|drive
 
 GEOJSON_PROPERTIES = ("role", "name", "density", "thickness", "velocity", "support_role")
 """The feature properties the reader uses."""
+BLOCK_PROPERTIES = ("density", "thickness", "velocity")
+"""The properties read on blocks only: on a support they are not used (listed in ``unknown``)."""
+SUPPORT_PROPERTIES = ("support_role",)
+"""The properties read on supports only: on a block they are not used (listed in ``unknown``)."""
 GIS_ID_COLUMNS = ("id", "fid", "ogc_fid", "objectid")
 """Feature ids a GIS export adds to every layer (compared lower-case): not read, not reported."""
 
@@ -152,9 +157,10 @@ def read_geojson(path, density: float = 2500.0, thickness: float = 1.0, unknown:
         index = len(blocks) if role == "block" else len(supports)
         name = str(props.get("name", f"{role}-{index + 1}"))  # block-1 first, as in a TOML file
         where = f"{feature_at}: {body_label(index, name, role)}"
-        if unknown is not None:
+        if unknown is not None:  # a support's velocity (or density) was not read either, without a word
+            elsewhere = SUPPORT_PROPERTIES if role == "block" else BLOCK_PROPERTIES
             for key in props:
-                if key not in GEOJSON_PROPERTIES and str(key).lower() not in GIS_ID_COLUMNS:
+                if key in elsewhere or (key not in GEOJSON_PROPERTIES and str(key).lower() not in GIS_ID_COLUMNS):
                     unknown.setdefault(key, f"feature {k}, {body_label(index, name, role)}")
         geometry = feature.get("geometry")
         gtype = geometry.get("type") if isinstance(geometry, dict) else None

@@ -55,12 +55,21 @@ def read_geometry(
         raise ctx.error(where, msg) from None
 
 
+_MISPLACED = {  # a property read on the other role's bodies (geometry_library.io): why it was not read here
+    "density": " (read on blocks only: a support has no mass)",
+    "thickness": " (read on blocks only: a support has no mass)",
+    "velocity": " (read on blocks only: a support moves by a scenario file's [[support]] motion)",
+    "support_role": " (read on supports only)",
+}
+
+
 def unread_properties_warning(path: str, unknown: dict, known) -> str:
     """One line for the GeoJSON properties the reader does not use (``unknown``: key → first body): a
-    per-block ``friction`` or a misspelt ``densty`` was ignored without a word, the run using the defaults."""
+    per-block ``friction`` or a misspelt ``densty`` was ignored without a word, the run using the defaults,
+    and so was a support's ``velocity`` (a block's property: the support stayed fixed)."""
     items = []
     for key, first in unknown.items():
-        hint = did_you_mean(key, known)
+        hint = _MISPLACED.get(key) or did_you_mean(key, known)
         if not hint and str(key).lower() == "friction":  # one coefficient for every contact, not a block's
             hint = " (friction is the scenario file's [material] friction, one for every contact)"
         items.append(f"{quote_string(str(key))}{hint} first on {first}")

@@ -113,6 +113,22 @@ def test_geojson_properties_it_does_not_use_are_listed_with_their_first_body(tmp
     assert unknown == {}
 
 
+def test_geojson_a_property_of_the_other_role_is_listed_as_not_used(tmp_path):
+    # a support's velocity was not read (the support stayed fixed) and nothing said so
+    ground = feature([[-2, -1], [3, -1], [3, 0], [-2, 0], [-2, -1]], role="support", name="g", velocity=[1, 0, 0])
+    pad = feature([[3, -1], [4, -1], [4, 0], [3, 0], [3, -1]], role="support", name="p", density=2000, thickness=1)
+    block = feature(SQ, name="a", support_role="driven", density=1800.0, velocity=[0, 0, 0])
+    unknown: dict = {}
+    a = read_geojson(write(tmp_path, [ground, pad, block]), unknown=unknown)
+    assert unknown == {
+        "velocity": 'feature 1, support 1 ("g")',
+        "density": 'feature 2, support 2 ("p")',
+        "thickness": 'feature 2, support 2 ("p")',
+        "support_role": 'feature 3, block 1 ("a")',
+    }
+    assert a.blocks[0].density == 1800.0 and [s.role for s in a.supports] == ["fixed", "fixed"]
+
+
 def one_line_error(fn, *args):
     with pytest.raises(GeometryError) as info:
         fn(*args)

@@ -131,6 +131,20 @@ def test_geojson_properties_not_used_give_one_warning_with_near_misses(tmp_path)
     assert len(notes) == 1
 
 
+def test_a_property_of_the_other_role_is_warned_about_with_why(tmp_path):
+    # the user gave the ground a velocity to shake it: it stayed fixed, the run "intact", and nothing said why
+    ground = {"role": "support", "name": "g", "velocity": [0.5, 0, 0], "thickness": 1.0}
+    path = _geojson(tmp_path / "w.geojson", ({"name": "a", "support_role": "fixed"}, RECT), (ground, GROUND))
+    notes: list[str] = []
+    read_geometry(path, 2500.0, 1.0, CTX, notes=notes)
+    assert notes == [
+        f"{path}: properties not used, ignored (used: role, name, density, thickness, velocity, support_role): "
+        '"support_role" (read on supports only) first on feature 1, block 1 ("a"); "velocity" (read on blocks '
+        'only: a support moves by a scenario file\'s [[support]] motion) first on feature 2, support 1 ("g"); '
+        '"thickness" (read on blocks only: a support has no mass) first on feature 2, support 1 ("g")'
+    ]
+
+
 def test_geometry_file_errors_name_the_table_or_only_the_file(tmp_path):
     with pytest.raises(InputError, match=r'^s\.toml: \[structure\] file = "w\.dxf": unknown geometry format'):
         read_geometry("w.dxf", 2500.0, 1.0, CTX)
