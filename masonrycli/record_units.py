@@ -19,6 +19,7 @@ The patterns look for whole words, so ``time_ms`` and ``acc (g)`` match but ``rm
 
 from __future__ import annotations
 
+import io
 import re
 
 from masonrycli.errors import InputError
@@ -91,10 +92,31 @@ _SCALED = {
 _SCALED_UNIT = _words(*(re.escape(u) for u in _SCALED))
 
 
+def record_text(raw: bytes) -> str:
+    """The text of a record file's bytes: UTF-8 (a byte-order mark dropped), else Windows-1252, Latin-1 where
+    a byte is undefined there. Raises UnicodeDecodeError (UTF-8's) for UTF-16 or bytes that are not text.
+
+    Excel's "CSV (comma delimited)" is in the Windows code page and accelerograms name their station in
+    Latin-1: a header's "(m/s²)" or "données" made the file "not a UTF-8 text file (byte 28)". The samples
+    are ASCII in any of these, so only the header and comments read differently — and a header's units
+    (², µ) read right in the code page, not as replacement characters."""
+    try:
+        return raw.decode("utf-8-sig")
+    except UnicodeDecodeError:
+        if raw[:2] in (b"\xff\xfe", b"\xfe\xff") or b"\x00" in raw:  # UTF-16, or not text at all
+            raise
+    try:
+        return raw.decode("cp1252")
+    except UnicodeDecodeError:
+        return raw.decode("latin-1")
+
+
 def csv_header(path) -> tuple[int, str] | None:
     """``(line number, text)`` of the header line of a CSV record (the one non-numeric line before the
     first sample, after blank and ``#`` lines), or None. The file was read once already."""
-    with open(path, encoding="utf-8-sig") as fh:
+    with open(path, "rb") as raw:
+        text = record_text(raw.read())
+    with io.StringIO(text, newline=None) as fh:  # lines as a text-mode open cuts them
         for lineno, line in enumerate(fh, start=1):
             stripped = line.strip()
             if not stripped or stripped.startswith("#"):

@@ -24,7 +24,7 @@ import numpy as np
 from masonrycli.errors import NOT_A_FILE, InputError, RecordWarning, file_kind, not_utf8, special_file
 from masonrycli.motion import Record, time_step_problem
 from masonrycli.record_text import NoTimeStep, TimeStepNotUsed, at2_text, csv_text, number
-from masonrycli.record_units import check_at2_header, check_csv_header
+from masonrycli.record_units import check_at2_header, check_csv_header, record_text
 from masonrycli.values import format_value, quote_string, shorten
 
 
@@ -44,7 +44,17 @@ def load_record_csv(path, display: str | None = None, time_step: float | None = 
     ``display`` is the file name used in messages (default: ``path`` as given).
     """
     name = display if display is not None else str(path)
-    return csv_text(_read_text(path, name), name, time_step)
+    text = _read_text(path, name)
+    try:
+        return csv_text(text, name, time_step)
+    except InputError:
+        lines, _ = _head(text, 4)  # a PEER record saved as .txt said 'q.txt:2: not a number: "SYNTH"'
+        if len(lines) == 4 and (_AT2_NEW.search(lines[3]) or _AT2_OLD.search(lines[3])):
+            raise InputError(
+                f"{name}: a PEER .AT2 record (its line 4 gives NPTS and DT) read as a CSV: the file's suffix "
+                f"chooses the format, name it {os.path.splitext(os.path.basename(os.fspath(path)))[0]}.AT2"
+            ) from None
+        raise
 
 
 def _read_text(path, name: str) -> str:
@@ -58,7 +68,7 @@ def _read_text(path, name: str) -> str:
     except OSError as exc:
         raise InputError(f"{name}: cannot read record: {exc.strerror or exc}") from None
     try:
-        text = raw.decode("utf-8-sig")
+        text = record_text(raw)  # UTF-8, else the Windows code page (a spreadsheet's CSV)
     except UnicodeDecodeError as exc:
         raise not_utf8(name, raw, exc) from None
     if "\r" in text and text.count("\r") == text.count("\r\n"):

@@ -102,11 +102,52 @@ def test_load_record_csv_unreadable(tmp_path):
     with pytest.raises(InputError) as exc:
         load_record_csv(tmp_path)
     assert "is a directory" in one_line(exc)
-    f = tmp_path / "latin1.csv"
+    f = tmp_path / "latin1.csv"  # not UTF-8: read in the Windows code page, where the line shows what it holds
     f.write_bytes(b"0,1\n1,\xe9\n")
     with pytest.raises(InputError) as exc:
         load_record_csv(f)
+    assert one_line(exc).endswith('latin1.csv:2: not a number: "é"')
+    f.write_bytes(b"0,1\n1,\x00\xe9\n")  # a NUL byte: no text file
+    with pytest.raises(InputError) as exc:
+        load_record_csv(f)
     assert "latin1.csv: not a UTF-8 text file" in one_line(exc)
+
+
+def test_a_spreadsheet_csv_in_the_windows_code_page_is_read(tmp_path):
+    # Excel's "CSV (comma delimited)" and many accelerograms' headers are not UTF-8: "(m/s²)", "données" and
+    # a station's "é" made the file "not a UTF-8 text file (byte 28)"; the samples are ASCII in any code page
+    body = "".join(f"{0.01 * i:.2f};{0.1 * (i % 3):.1f}\n".replace(".", ",") for i in range(5))
+    f = tmp_path / "excel.csv"
+    f.write_bytes(("temps (s);vitesse (m/s) données\n" + body).encode("cp1252"))
+    reference = tmp_path / "utf8.csv"
+    reference.write_text("temps (s);vitesse (m/s) données\n" + body, encoding="utf-8")
+    for got, want in zip(load_record_csv(f), load_record_csv(reference)):
+        assert np.array_equal(got, want)
+    # the header's units read in the code page: "m/s²" is an acceleration, refused when read as velocity
+    f.write_bytes(("t (s);a (m/s²)\n" + body).encode("cp1252"))
+    with pytest.raises(InputError, match=r"excel\.csv:1: the header says acceleration"):
+        record_motion(f, quantity="velocity")
+    assert record_motion(f, quantity="acceleration").quantity == "acceleration"
+    at2 = tmp_path / "station.AT2"  # an .AT2 file naming its station in Latin-1
+    at2.write_bytes(
+        b"PEER NGA\nSt\xe9 Baume 1909, 0\nACCELERATION TIME SERIES IN UNITS OF G\nNPTS= 3, DT= .01 SEC\n0 1 0\n"
+    )
+    assert load_at2(at2)[1].tolist() == [0.0, 1.0, 0.0]
+
+
+def test_a_peer_record_named_txt_is_named_so(tmp_path):
+    # a PEER record saved as .txt was read as a CSV: 'q.txt:2: not a number: "IMPERIAL"', nothing about why
+    f = tmp_path / "RSN6.txt"
+    f.write_text(
+        "PEER NGA\nIMPERIAL VALLEY 1940, EL CENTRO, 180\nACCELERATION TIME SERIES IN UNITS OF G\n"
+        "NPTS=  3, DT=   .0100 SEC\n 0.0 0.1 0.0\n"
+    )
+    with pytest.raises(InputError) as exc:
+        load_record_csv(f)
+    assert one_line(exc) == (
+        f"{f}: a PEER .AT2 record (its line 4 gives NPTS and DT) read as a CSV: the file's suffix chooses the "
+        "format, name it RSN6.AT2"
+    )
 
 
 @pytest.mark.parametrize(("suffix", "what"), [(".VT2", "velocity (.VT2, cm/s)"), (".dt2", "displacement (.DT2, cm)")])
