@@ -72,11 +72,11 @@ def _execute(scenario, opts: dict, hint: str = "") -> None:
     the code of how the run ended."""
     from masonrycli.execute import execute, print_summary
     from masonrycli.interrupt import StopRun, exit_code, signal_name
-    from masonrycli.scenario import record_warnings
+    from masonrycli.scenario_warnings import scenario_warnings
     from masonrycli.sinks import DIVERGED, FAILED
 
     outputs = _check_run(scenario, opts)
-    for warning in (*scenario.warnings, *record_warnings(scenario)):
+    for warning in scenario_warnings(scenario):
         warn(warning)
     try:
         outcome = execute(
@@ -264,12 +264,13 @@ def check_command(scenario_file: ScenarioFile, **opts) -> None:
     """Validate what `masonry run` would run, with the same arguments, and print a summary (blocks,
     supports, mass, bounding box, steps, the loading, outputs); nothing is computed or written."""
     from masonrycli.report import check_table
-    from masonrycli.scenario import record_warnings, scenario_summary
+    from masonrycli.scenario import scenario_summary
+    from masonrycli.scenario_warnings import scenario_warnings
 
     scenario = _load(scenario_file, opts)
     outputs = _check_run(scenario, opts)
     console.print(check_table(str(Path(scenario_file)), scenario_summary(scenario), outputs.files()))
-    for warning in (*scenario.warnings, *record_warnings(scenario)):
+    for warning in scenario_warnings(scenario):
         warn(warning)
 
 

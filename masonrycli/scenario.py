@@ -23,8 +23,6 @@ from geometry_library.blocks import Assembly, Block, GeometryError
 from geometry_library.values import MATERIAL_RANGE
 from masonrycli.errors import InputContext, InputError
 from masonrycli.motion import Fixed, Motion
-from masonrycli.record_units import MAX_AT2_G
-from masonrycli.records import G_STANDARD
 from masonrycli.structure import build_structure, check_finite_tree, read_geometry, structure_warnings
 from masonrycli.values import check_int, check_real, check_vector, field_error, format_value, quote_string
 
@@ -389,65 +387,6 @@ def check_sampling(scenario: Scenario) -> None:
                 f"{'above' if m.frequency * dt > 0.5 else 'at'} 1/(2 dt) = {0.5 / dt:g} Hz: steps of dt = {dt:g} s "
                 f"sample it at aliased phases (dt = {0.05 / m.frequency:.3g} s gives 20 steps a period)"
             )
-
-
-def record_warnings(scenario: Scenario) -> list[str]:
-    """One line per record that the run does not follow whole:
-
-    * it starts after the run ends (a CSV stamped with clock times, 100.0, 100.1, … s): the run never
-      reaches a sample, and said "completed … intact";
-
-    * it goes on after the run ends: its shaking after that is not applied (a 40 s PEER record run for
-      the built-in wall's 1 s was cut to its first second, and nothing said so);
-    * it is sampled more finely than dt: the steps see its velocity every dt only, and its content above
-      1/(2 dt) comes back aliased (the record's counterpart of check_sampling's sine);
-    * it peaks beyond 10 g as scaled (no earthquake comes near: a CSV in cm/s read as m/s, or a scale
-      meant as a unit conversion applied twice, ran "completed … collapsed" without a word).
-    """
-    run = scenario.run
-    unseen: dict[tuple[str, float, float], list[str]] = {}
-    late: dict[tuple[str, float], list[str]] = {}
-    fine: dict[tuple[str, float], list[str]] = {}
-    strong: dict[tuple[str, float, float], list[str]] = {}
-    for support, m in zip(scenario.assembly.supports, scenario.motions):
-        if m.kind != "record":
-            continue
-        name = os.path.basename(m.source) if m.source else "(inline)"
-        if m.start_time >= run.duration:
-            unseen.setdefault((name, m.start_time, m.end_time), []).append(f'"{support.name}"')
-        elif m.end_time > run.duration + 0.5 * run.dt:
-            late.setdefault((name, m.end_time), []).append(f'"{support.name}"')
-        if m.sample_interval < run.dt * (1.0 - 1e-9):
-            fine.setdefault((name, m.sample_interval), []).append(f'"{support.name}"')
-        if m.peak_acceleration > MAX_AT2_G * G_STANDARD:
-            strong.setdefault((name, m.peak_acceleration / G_STANDARD, m.scale), []).append(f'"{support.name}"')
-
-    def who(names: list[str]) -> str:
-        return f"support{'s' if len(names) > 1 else ''} {', '.join(names)}"
-
-    return (
-        [
-            f"{who(names)}: the record {name} starts at t = {start:g} s, after the run's {run.duration:g} s: none "
-            "of its shaking is applied (record times count from the run's t = 0; a scenario file's "
-            f"window = [{start:g}, {end:g}] moves it there)"
-            for (name, start, end), names in unseen.items()
-        ]
-        + [
-            f"{who(names)}: the record {name} lasts {end:g} s but the run {run.duration:g} s; its shaking after "
-            f"t = {run.duration:g} s is not applied (--duration {end:g} runs it all)"
-            for (name, end), names in late.items()
-        ]
-        + [
-            f"{who(names)}: the record {name} is sampled every {step:g} s, finer than dt = {run.dt:g} s: the steps skip "
-            f"samples and alias its content above {0.5 / run.dt:g} Hz (dt = {step:g} follows every sample)"
-            for (name, step), names in fine.items()
-        ]
-        + [
-            f"{who(names)}: the record {name} peaks at {peak:.3g} g as applied (scale {scale:g}); the strongest "
-            f"earthquakes reach 3–4 g: check its units and the scale"
-            for (name, peak, scale), names in strong.items()
-        ]
-    )
 
 
 def scenario_summary(scenario: Scenario) -> dict:

@@ -475,74 +475,8 @@ def test_an_alert_distance_longer_than_the_structure_is_refused(tmp_path):
         scenario(1e9)
 
 
-def test_record_warnings_name_a_record_that_outlasts_the_run():
-    from masonrycli.scenario import record_warnings
-
-    scenario = load_scenario(DATA / "quake_record.toml")  # quake_velocity.csv: samples 0 ... 0.4 s; run 0.5 s
-    assert record_warnings(scenario) == []
-    short = dataclasses.replace(scenario, run=dataclasses.replace(scenario.run, duration=0.2))
-    assert record_warnings(short) == [
-        'support "ground": the record quake_velocity.csv lasts 0.4 s but the run 0.2 s; its shaking after '
-        "t = 0.2 s is not applied (--duration 0.4 runs it all)"
-    ]
-    windowed = dataclasses.replace(short, motions=(dataclasses.replace(short.motions[0], window=(0.2, 0.4)),))
-    assert record_warnings(windowed) == []  # the window moves 0.2 ... 0.4 s to 0 ... 0.2 s: all of it is run
-
-
-def test_record_warnings_name_a_record_that_starts_after_the_run_ends(tmp_path):
-    # A CSV stamped with clock times (100.0, 100.1, 100.2 s) run for 1 s: the ground never saw a sample, the
-    # run said "completed ... intact", and the only warning read "the record lasts 100.2 s but the run 1 s;
-    # its shaking after t = 1 s is not applied".
-    from masonrycli.scenario import record_warnings
-
-    (tmp_path / "late.csv").write_text("time,v\n100.0,0.0\n100.1,0.1\n100.2,0.0\n")
-    text = BLOCK + GROUND + 'motion = { kind = "record", file = "late.csv" }\n'
-    scenario = loads_scenario(text, source=str(tmp_path / "s.toml"), base_dir=tmp_path)
-    assert record_warnings(scenario) == [
-        'support "ground": the record late.csv starts at t = 100 s, after the run\'s 1 s: none of its shaking is '
-        "applied (record times count from the run's t = 0; a scenario file's window = [100, 100.2] moves it there)"
-    ]
-
-
 def test_too_many_steps_says_how_many_exactly():
     # 1.001e8 steps was "gives 1e+08 steps ... (at most 1e+08)": the refusal read like a contradiction
     with pytest.raises(InputError) as exc:
         RunConfig(duration=1001.0, dt=1e-5)
     assert str(exc.value) == "dt = 1e-05: gives 100,100,000 steps for duration 1001.0 (at most 100,000,000)"
-
-
-def test_record_warnings_name_a_record_sampled_finer_than_dt():
-    from masonrycli.scenario import record_warnings
-
-    scenario = load_scenario(DATA / "quake_record.toml")  # samples every 0.1 s; dt = 1e-3
-    coarse = dataclasses.replace(scenario, run=dataclasses.replace(scenario.run, dt=0.25))
-    assert record_warnings(coarse) == [
-        'support "ground": the record quake_velocity.csv is sampled every 0.1 s, finer than dt = 0.25 s: the steps '
-        "skip samples and alias its content above 2 Hz (dt = 0.1 follows every sample)"
-    ]
-    exact = dataclasses.replace(scenario, run=dataclasses.replace(scenario.run, dt=0.1))
-    assert record_warnings(exact) == []
-
-
-def test_record_warnings_name_a_record_beyond_10_g_as_scaled(tmp_path):
-    # A CSV of velocity in cm/s read as m/s (no header to say so), or an .AT2 given --scale 9.81 "to convert g",
-    # ran "completed … collapsed" at hundreds of g without a word.
-    from masonrycli.scenario import record_warnings
-
-    (tmp_path / "cms.csv").write_text("time,v\n0,0\n0.01,0.5\n0.02,0\n0.03,-0.5\n0.04,0\n")  # 50 m/s² as m/s
-    text = BLOCK + GROUND + 'motion = { kind = "record", file = "cms.csv", scale = 3.0 }\n'
-    scenario = loads_scenario(text, source=str(tmp_path / "s.toml"), base_dir=tmp_path)
-    assert scenario.motions[-1].peak_acceleration == pytest.approx(150.0)  # 0.5 m/s in 0.01 s, times 3
-    late = 'support "ground": the record cms.csv lasts 0.04 s'
-    assert [w for w in record_warnings(scenario) if not w.startswith(late)] == [
-        'support "ground": the record cms.csv peaks at 15.3 g as applied (scale 3); the strongest earthquakes '
-        "reach 3–4 g: check its units and the scale"
-    ]
-    gentle = dataclasses.replace(scenario, motions=(dataclasses.replace(scenario.motions[-1], scale=1.0),))
-    assert not any("peaks" in w for w in record_warnings(gentle))  # 5.1 g: strong, not absurd
-    from masonrycli.motion import Record
-
-    accel = Record(
-        time=(0.0, 0.1, 0.2), value=((0.0, 0.0), (3.0, 4.0), (-1.0, 0.0)), quantity="acceleration", scale=2.0
-    )
-    assert accel.peak_acceleration == pytest.approx(10.0)  # |(3, 4)| × 2, of the samples themselves

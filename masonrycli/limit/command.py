@@ -225,11 +225,13 @@ class _Done:
 def _analyse(structure, live, friction, verify, out, force, done: _Done, signals, *, console, err_console):
     """The work of :func:`run_limit`, filling ``done`` as it goes; returns the --verify checks. ``console``:
     where the result table goes before --verify runs (None with --json)."""
+    from masonrycli.scenario_warnings import setting_warnings
+
     target = None if out is None else check_output(out, "--out", ".rrd", force)
     scenario = resolve_structure(structure, friction)
     if verify and live.kind == "point":
         raise InputError("--verify: the engine has no point loads; verify a horizontal or tilt load")
-    for warning in scenario.warnings:
+    for warning in (*scenario.warnings, *setting_warnings(scenario)):  # not its records': it has no time
         err_console.print(Text.assemble(("warning:", "yellow"), f" {warning}"))
     done.result = analyse(scenario, live)
     if target is not None:

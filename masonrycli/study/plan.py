@@ -134,10 +134,20 @@ def plan_study(
         stop_at_collapse=stop_at_collapse,
         histories=histories,
         force=force,
-        warnings=tuple(late),
+        warnings=(*_scenario_warnings(base.scenario, records), *late),
         warn=warn,
     )
     return StudyPlan(base, request, name, picture, recorded)
+
+
+def _scenario_warnings(scenario, records) -> list[str]:
+    """The warnings ``masonry run`` prints for the study's base scenario (a block touching nothing, a GeoJSON
+    property not used, gravity pointing up: the sweep ran every point without a word); with ``--records``
+    its own record is not run, so not its records' (the set's are in ``late``)."""
+    from masonrycli.scenario_warnings import record_warnings, scenario_warnings
+
+    said = scenario_warnings(scenario)
+    return [w for w in said if w not in record_warnings(scenario)] if records else said
 
 
 def _base_scenario(target: str, duration, dt):

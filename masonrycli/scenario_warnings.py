@@ -1,0 +1,120 @@
+"""What a valid scenario may still have wrong: one line each for ``masonry run``, ``simulate``, ``check``,
+``limit`` and ``sweep`` to print before anything runs.
+
+* :func:`record_warnings`: a record the run does not follow whole (it starts after the run ends, goes on
+  after it, is sampled finer than dt, or peaks beyond 10 g as scaled).
+* :func:`setting_warnings`: settings in the wrong units or sign — a gravity pointing up (the blocks fly
+  off, or limit analysis finds "no equilibrium") or far from 9.81 m/s² (cm/s², or g), a density below
+  any masonry unit's (t/m³ or g/cm³: stresses and forces 1000× too small, the motion unchanged).
+* :func:`scenario_warnings`: those and the scenario's own (geometry: a block touching nothing, no
+  support, a GeoJSON property not used).
+
+Warnings, not errors: each of these has a use (a foam-block model, a tilt beyond 90°) the checks cannot
+rule out, but run as they are they said "completed" with nothing to tell the usual mistake apart.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+
+from masonrycli.record_units import MAX_AT2_G
+from masonrycli.records import G_STANDARD
+from masonrycli.scenario import Scenario
+
+MIN_DENSITY = 100.0
+"""kg/m³: lighter blocks are warned about (masonry units weigh 1200–3000 kg/m³, timber 400–700): a density in
+t/m³ or g/cm³ (2.5 for stone) is 1000× too small."""
+GRAVITY_RANGE = (0.5 * G_STANDARD, 2.0 * G_STANDARD)
+"""m/s²: a gravity of another size is warned about: cm/s² (981) or g (1) — but not one below 0.01 g, which is
+no gravity on purpose (limit analysis refuses it in its own line)."""
+
+
+def scenario_warnings(scenario: Scenario) -> list[str]:
+    """Every warning of ``scenario``: its own (geometry), its settings', its records'."""
+    return [*scenario.warnings, *setting_warnings(scenario), *record_warnings(scenario)]
+
+
+def setting_warnings(scenario: Scenario) -> list[str]:
+    """One line for a gravity pointing up or of an unlikely size, one for densities below ``MIN_DENSITY``."""
+    out = []
+    gx, gy = scenario.run.gravity
+    size = math.hypot(gx, gy)
+    shown = f"[run] gravity = [{gx:g}, {gy:g}]"
+    if gy > 0.0:
+        out.append(
+            f"{shown} points up (y is up: the blocks fall towards -y, [0, -9.81]; a tilting test turns it by "
+            "less than 90°)"
+        )
+    if size >= 0.01 * G_STANDARD and not GRAVITY_RANGE[0] <= size <= GRAVITY_RANGE[1]:
+        out.append(
+            f"{shown} is {size:g} m/s², {size / G_STANDARD:.3g} g: gravity is in m/s² ([0, -9.81]; not cm/s², not g)"
+        )
+    light = [b for b in scenario.assembly.blocks if b.density < MIN_DENSITY]
+    if light:
+        first = light[0]
+        which = f'block "{first.name}"' if len(light) == 1 else f'{len(light)} blocks (first "{first.name}")'
+        out.append(
+            f"{which}: density {first.density:g} kg/m³, lighter than any masonry unit (stone 2000–2800 kg/m³): a "
+            f"density in t/m³ or g/cm³ makes the stresses and forces {1000:g}× too small"
+        )
+    return out
+
+
+def record_warnings(scenario: Scenario) -> list[str]:
+    """One line per record that the run does not follow whole:
+
+    * it starts after the run ends (a CSV stamped with clock times, 100.0, 100.1, … s): the run never
+      reaches a sample, and said "completed … intact";
+
+    * it goes on after the run ends: its shaking after that is not applied (a 40 s PEER record run for
+      the built-in wall's 1 s was cut to its first second, and nothing said so);
+    * it is sampled more finely than dt: the steps see its velocity every dt only, and its content above
+      1/(2 dt) comes back aliased (the record's counterpart of check_sampling's sine);
+    * it peaks beyond 10 g as scaled (no earthquake comes near: a CSV in cm/s read as m/s, or a scale
+      meant as a unit conversion applied twice, ran "completed … collapsed" without a word).
+    """
+    run = scenario.run
+    unseen: dict[tuple[str, float, float], list[str]] = {}
+    late: dict[tuple[str, float], list[str]] = {}
+    fine: dict[tuple[str, float], list[str]] = {}
+    strong: dict[tuple[str, float, float], list[str]] = {}
+    for support, m in zip(scenario.assembly.supports, scenario.motions):
+        if m.kind != "record":
+            continue
+        name = os.path.basename(m.source) if m.source else "(inline)"
+        if m.start_time >= run.duration:
+            unseen.setdefault((name, m.start_time, m.end_time), []).append(f'"{support.name}"')
+        elif m.end_time > run.duration + 0.5 * run.dt:
+            late.setdefault((name, m.end_time), []).append(f'"{support.name}"')
+        if m.sample_interval < run.dt * (1.0 - 1e-9):
+            fine.setdefault((name, m.sample_interval), []).append(f'"{support.name}"')
+        if m.peak_acceleration > MAX_AT2_G * G_STANDARD:
+            strong.setdefault((name, m.peak_acceleration / G_STANDARD, m.scale), []).append(f'"{support.name}"')
+
+    def who(names: list[str]) -> str:
+        return f"support{'s' if len(names) > 1 else ''} {', '.join(names)}"
+
+    return (
+        [
+            f"{who(names)}: the record {name} starts at t = {start:g} s, after the run's {run.duration:g} s: none "
+            "of its shaking is applied (record times count from the run's t = 0; a scenario file's "
+            f"window = [{start:g}, {end:g}] moves it there)"
+            for (name, start, end), names in unseen.items()
+        ]
+        + [
+            f"{who(names)}: the record {name} lasts {end:g} s but the run {run.duration:g} s; its shaking after "
+            f"t = {run.duration:g} s is not applied (--duration {end:g} runs it all)"
+            for (name, end), names in late.items()
+        ]
+        + [
+            f"{who(names)}: the record {name} is sampled every {step:g} s, finer than dt = {run.dt:g} s: the steps skip "
+            f"samples and alias its content above {0.5 / run.dt:g} Hz (dt = {step:g} follows every sample)"
+            for (name, step), names in fine.items()
+        ]
+        + [
+            f"{who(names)}: the record {name} peaks at {peak:.3g} g as applied (scale {scale:g}); the strongest "
+            f"earthquakes reach 3–4 g: check its units and the scale"
+            for (name, peak, scale), names in strong.items()
+        ]
+    )

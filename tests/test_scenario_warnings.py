@@ -1,0 +1,121 @@
+"""What a valid scenario may still have wrong (masonrycli.scenario_warnings): records the run does not follow
+whole, a gravity pointing up or in other units, densities in t/m³; and that every command prints them."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import pytest
+from scenario_helpers import BLOCK, DATA, GROUND
+
+from masonrycli.scenario_toml import load_scenario, loads_scenario
+from masonrycli.scenario_warnings import record_warnings, scenario_warnings, setting_warnings
+
+from cli_helpers import invoke
+
+
+def test_record_warnings_name_a_record_that_outlasts_the_run():
+    scenario = load_scenario(DATA / "quake_record.toml")  # quake_velocity.csv: samples 0 ... 0.4 s; run 0.5 s
+    assert record_warnings(scenario) == []
+    short = dataclasses.replace(scenario, run=dataclasses.replace(scenario.run, duration=0.2))
+    assert record_warnings(short) == [
+        'support "ground": the record quake_velocity.csv lasts 0.4 s but the run 0.2 s; its shaking after '
+        "t = 0.2 s is not applied (--duration 0.4 runs it all)"
+    ]
+    windowed = dataclasses.replace(short, motions=(dataclasses.replace(short.motions[0], window=(0.2, 0.4)),))
+    assert record_warnings(windowed) == []  # the window moves 0.2 ... 0.4 s to 0 ... 0.2 s: all of it is run
+
+
+def test_record_warnings_name_a_record_that_starts_after_the_run_ends(tmp_path):
+    # A CSV stamped with clock times (100.0, 100.1, 100.2 s) run for 1 s: the ground never saw a sample, the
+    # run said "completed ... intact", and the only warning read "the record lasts 100.2 s but the run 1 s;
+    # its shaking after t = 1 s is not applied".
+    (tmp_path / "late.csv").write_text("time,v\n100.0,0.0\n100.1,0.1\n100.2,0.0\n")
+    text = BLOCK + GROUND + 'motion = { kind = "record", file = "late.csv" }\n'
+    scenario = loads_scenario(text, source=str(tmp_path / "s.toml"), base_dir=tmp_path)
+    assert record_warnings(scenario) == [
+        'support "ground": the record late.csv starts at t = 100 s, after the run\'s 1 s: none of its shaking is '
+        "applied (record times count from the run's t = 0; a scenario file's window = [100, 100.2] moves it there)"
+    ]
+
+
+def test_record_warnings_name_a_record_sampled_finer_than_dt():
+    scenario = load_scenario(DATA / "quake_record.toml")  # samples every 0.1 s; dt = 1e-3
+    coarse = dataclasses.replace(scenario, run=dataclasses.replace(scenario.run, dt=0.25))
+    assert record_warnings(coarse) == [
+        'support "ground": the record quake_velocity.csv is sampled every 0.1 s, finer than dt = 0.25 s: the steps '
+        "skip samples and alias its content above 2 Hz (dt = 0.1 follows every sample)"
+    ]
+    exact = dataclasses.replace(scenario, run=dataclasses.replace(scenario.run, dt=0.1))
+    assert record_warnings(exact) == []
+
+
+def test_record_warnings_name_a_record_beyond_10_g_as_scaled(tmp_path):
+    # A CSV of velocity in cm/s read as m/s (no header to say so), or an .AT2 given --scale 9.81 "to convert g",
+    # ran "completed … collapsed" at hundreds of g without a word.
+    (tmp_path / "cms.csv").write_text("time,v\n0,0\n0.01,0.5\n0.02,0\n0.03,-0.5\n0.04,0\n")  # 50 m/s² as m/s
+    text = BLOCK + GROUND + 'motion = { kind = "record", file = "cms.csv", scale = 3.0 }\n'
+    scenario = loads_scenario(text, source=str(tmp_path / "s.toml"), base_dir=tmp_path)
+    assert scenario.motions[-1].peak_acceleration == pytest.approx(150.0)  # 0.5 m/s in 0.01 s, times 3
+    late = 'support "ground": the record cms.csv lasts 0.04 s'
+    assert [w for w in record_warnings(scenario) if not w.startswith(late)] == [
+        'support "ground": the record cms.csv peaks at 15.3 g as applied (scale 3); the strongest earthquakes '
+        "reach 3–4 g: check its units and the scale"
+    ]
+    gentle = dataclasses.replace(scenario, motions=(dataclasses.replace(scenario.motions[-1], scale=1.0),))
+    assert not any("peaks" in w for w in record_warnings(gentle))  # 5.1 g: strong, not absurd
+    from masonrycli.motion import Record
+
+    accel = Record(
+        time=(0.0, 0.1, 0.2), value=((0.0, 0.0), (3.0, 4.0), (-1.0, 0.0)), quantity="acceleration", scale=2.0
+    )
+    assert accel.peak_acceleration == pytest.approx(10.0)  # |(3, 4)| × 2, of the samples themselves
+
+
+def _scenario(tmp_path, run="", density=2000.0):
+    text = f"[run]\nduration = 0.1\n{run}\n[material]\ndensity = {density}\n" + BLOCK + GROUND
+    return loads_scenario(text, source=str(tmp_path / "s.toml"), base_dir=tmp_path)
+
+
+def test_gravity_pointing_up_or_in_other_units_is_warned_about(tmp_path):
+    # gravity = [0, 9.81] ran "completed … damaged" (the block flew 0.2 m up); limit said "no equilibrium"
+    assert setting_warnings(_scenario(tmp_path)) == []
+    assert setting_warnings(_scenario(tmp_path, "gravity = [0.0, 9.81]")) == [
+        "[run] gravity = [0, 9.81] points up (y is up: the blocks fall towards -y, [0, -9.81]; a tilting test "
+        "turns it by less than 90°)"
+    ]
+    assert setting_warnings(_scenario(tmp_path, "gravity = [0.0, -981.0]")) == [
+        "[run] gravity = [0, -981] is 981 m/s², 100 g: gravity is in m/s² ([0, -9.81]; not cm/s², not g)"
+    ]
+    assert "is 1 m/s²" in setting_warnings(_scenario(tmp_path, "gravity = [0.0, -1.0]"))[0]
+    # a tilting table (30°) and no gravity at all are what they say
+    assert setting_warnings(_scenario(tmp_path, "gravity = [4.905, -8.4957]")) == []
+    assert setting_warnings(_scenario(tmp_path, "gravity = [0.0, 0.0]")) == []
+    assert setting_warnings(_scenario(tmp_path, "gravity = [0.0, -1e-300]")) == []  # none, on purpose
+
+
+def test_a_density_in_tonnes_per_cubic_metre_is_warned_about(tmp_path):
+    # density = 2.5 (t/m³) ran as 2.5 kg/m³: the same motion, every stress and force 1000× too small
+    (light,) = setting_warnings(_scenario(tmp_path, density=2.5))
+    assert light == (
+        'block "b1": density 2.5 kg/m³, lighter than any masonry unit (stone 2000–2800 kg/m³): a density in t/m³ '
+        "or g/cm³ makes the stresses and forces 1000× too small"
+    )
+    assert setting_warnings(_scenario(tmp_path, density=450.0)) == []  # timber blocks of a lab model
+
+
+def test_every_command_prints_the_warnings(tmp_path):
+    # sweep printed none of them: a block touching nothing, gravity up, a GeoJSON property not used
+    path = tmp_path / "up.toml"
+    path.write_text("[run]\nduration = 0.01\ngravity = [0.0, 9.81]\n" + BLOCK + GROUND)
+    scenario = load_scenario(path)
+    assert scenario_warnings(scenario) == setting_warnings(scenario)
+    out = tmp_path / "s.csv"
+    for args in (
+        ["check", path],
+        ["run", path, "--no-recording"],
+        ["limit", path],
+        ["sweep", path, "-p", "friction=0.5", "--workers", 0, "--no-recording", "--out", out],
+    ):
+        said = " ".join(invoke(*args).output.split())
+        assert "warning: [run] gravity = [0, 9.81] points up" in said, (args, said)
