@@ -128,6 +128,13 @@ def check_output(
         raise InputError(f"{where}: the file exists{broken} (add --force to replace it)")
     if path.exists() and not os.access(path, os.W_OK):
         raise InputError(f"{where}: the file exists and is read-only")
+    check_folder(path, where)
+    return OutputFile(path, option, force=force, default_name=default_name)
+
+
+def check_folder(path: Path, where: str) -> None:
+    """Raise :class:`InputError` (``where: problem``) unless ``path``'s folder exists or can be made, and is
+    writable, on a disk."""
     folder = path.parent
     existing = next((p for p in (folder, *folder.parents) if p.exists()), Path("."))
     if not existing.is_dir():
@@ -136,7 +143,6 @@ def check_output(
         raise InputError(f"{where}: cannot write in {existing} (permission denied)")
     if shutil.disk_usage(existing).total == 0:  # /proc, /sys: writable to root, yet no file can be made there
         raise InputError(f"{where}: cannot write in {existing} (a system folder, not a disk)")
-    return OutputFile(path, option, force=force, default_name=default_name)
 
 
 def check_distinct(*outputs: OutputFile | None) -> None:

@@ -160,3 +160,12 @@ def test_existing_outputs_are_refused_without_force_and_replaced_with_it(block, 
     after = _files(tmp_path)
     assert (tmp_path / "s.png").stat().st_ino != png and after["s.rrd"] != before["s.rrd"]  # a new file each
     assert not [name for name in after if name.endswith(".part") or "journal" in name]
+
+
+def test_a_table_in_a_folder_that_is_a_file_names_out(block, tmp_path):
+    # it said "--out's plot t.sh/s.png: t.sh is not a folder": an option not given, for the table's own folder
+    (tmp_path / "notes.txt").write_text("x")
+    out = tmp_path / "notes.txt" / "s.csv"
+    result = invoke("sweep", block, "-p", "amp=0.1", "--workers", 0, "--out", out)
+    assert result.exit_code == 2
+    assert result.output.strip() == f"error: --out {out}: {tmp_path / 'notes.txt'} is not a folder"

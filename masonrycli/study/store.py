@@ -17,7 +17,7 @@ import math
 from pathlib import Path
 
 from masonrycli.errors import InputError
-from masonrycli.outputs import OutputFile, written_whole
+from masonrycli.outputs import OutputFile, check_folder, written_whole
 
 SUFFIXES = (".parquet", ".csv")
 TEXT_COLUMNS = frozenset({"study", "state", "status", "error", "note", "outcome", "record"})
@@ -29,6 +29,7 @@ def check_out(path: Path) -> Path:
         raise InputError(f"--out {path}: a study is written as .parquet or .csv")
     if path.exists() and path.is_dir():
         raise InputError(f"--out {path}: is a directory")
+    check_folder(path, f"--out {path}")  # first: "--out's plot t.sh/s.png: t.sh is not a folder" named the plot
     return path
 
 
