@@ -203,3 +203,16 @@ def test_diverged_rows_give_exit_3_as_simulate_does(block, tmp_path, monkeypatch
     said = " ".join(result.output.split())
     assert f"error: 1 of 2 rows diverged (their error column in {out} says when); a smaller" in said
     assert [r["error"] for r in read_rows(out)] == ["", "diverged at t = 0.0100 s"]
+
+
+def test_a_misspelt_parameter_is_said_before_the_outputs_that_exist(block, tmp_path, monkeypatch):
+    # with the last study's plot in place, "-p Amp=0.1" said "--out's plot study-block.png: the file exists (add
+    # --force …)"; with --force, then, "unknown parameter"
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "study-block.png").write_bytes(b"last study's plot")
+    result = invoke("sweep", block, "-p", "Amp=0.1", "--workers", 0)
+    assert result.exit_code == 2
+    assert (
+        result.output.strip()
+        == 'error: --param Amp: unknown parameter (did you mean "amp"?) (see masonry sweep --help)'
+    )

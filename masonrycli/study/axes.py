@@ -26,6 +26,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from masonrycli.errors import InputError
+from masonrycli.values import did_you_mean
 
 MOTION_PARAMS = {"amp": ("sine", "amplitude"), "freq": ("sine", "frequency"), "phase": ("sine", "phase")}
 MOTION_PARAMS["scale"] = ("record", "scale")
@@ -180,7 +181,10 @@ def apply_point(base, params: dict):
         support, _, short = key.rpartition(".")
         if short not in MOTION_PARAMS:
             if key not in RUN_PARAMS and key not in ("friction", "record") and key not in options:
-                raise InputError(f"--param {key}: unknown parameter (see masonry sweep --help)")
+                known = [*MOTION_PARAMS, *RUN_PARAMS, "friction", "record", *_builder_options(builder)]
+                raise InputError(
+                    f"--param {key}: unknown parameter{did_you_mean(key, known)} (see masonry sweep --help)"
+                )
             continue
         kind, attr = MOTION_PARAMS[short]
         targets = [j for j, m in enumerate(motions) if m.kind == kind and (not support or names[j] == support)]
@@ -212,11 +216,16 @@ def _point(params: dict) -> str:
 
 
 def _builder_option(builder, name: str) -> bool:
+    return name in _builder_options(builder)
+
+
+def _builder_options(builder) -> list[str]:
+    """The options of ``builder`` (None: not a builder scenario, no options)."""
     if not builder:
-        return False
+        return []
     from geometry_library.builders import BUILDERS
 
-    return name in {f.name for f in dataclasses.fields(BUILDERS[builder])}
+    return [f.name for f in dataclasses.fields(BUILDERS[builder])]
 
 
 def _replace(obj, changes: dict, where: str = ""):

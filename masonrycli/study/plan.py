@@ -21,9 +21,9 @@ from masonrycli.builtin import check_record_dt, is_built_in, override_run, targe
 from masonrycli.errors import NOT_A_FILE, InputError
 from masonrycli.outputs import OutputFile, safe_name
 from masonrycli.study import store
-from masonrycli.study.axes import Axis, StudyBase, check_axes, check_find, parse_axis
+from masonrycli.study.axes import Axis, StudyBase, apply_point, check_axes, check_find, parse_axis
 from masonrycli.study.files import check_picture
-from masonrycli.study.study import StudyRequest
+from masonrycli.study.study import StudyRequest, points_to_check
 
 SWEEP_DURATION = {"wall": 1.0, "arch": 2.0, "aqueduct": 2.0}
 """s: default simulated time of a built-in structure in a study."""
@@ -97,6 +97,8 @@ def plan_study(
     # before the files beside --out: "--param amp: given twice" came after "--out's plot s.png: the file exists"
     check_axes(axes)
     check_find(axes, find)
+    for point in points_to_check(axes):  # before the files: "-p Amp=0.1" said "--out's plot … exists" first
+        apply_point(base, point)
     if im not in INTENSITY_MEASURES or im == "d5_95":
         raise InputError(f"--im {im}: expected one of pga, pgv, arias, sa")
     if workers is not None and workers < 0:
