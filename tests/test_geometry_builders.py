@@ -150,7 +150,9 @@ def test_wall_courses_and_length_options():
     "kwargs, match",
     [
         (dict(blocks=51, courses=4), "51 blocks cannot be laid in running bond with 4 courses"),
-        (dict(blocks=51, length=1.0), "length 1 m is not a whole number"),
+        # the lengths that fit beside it are named (it said only "not a whole number of 0.3 m blocks")
+        (dict(blocks=51, length=1.0), r"length 1 m is not a whole number of 0.3 m blocks \(0.9 m is 3, 1.2 m is 4\)"),
+        (dict(blocks=51, length=0.1), r"length 0.1 m is not a whole number of 0.3 m blocks \(0.3 m is 1\)$"),
         (dict(blocks=51, courses=5, length=2.4), "cannot be laid"),
         (dict(blocks=0), "positive integer"),
         (dict(block_length=-0.3), "block_length must be a positive"),

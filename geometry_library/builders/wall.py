@@ -124,7 +124,11 @@ def wall_layout(
         n_float = length / block_length
         n_pinned = round(n_float)
         if n_pinned < 1 or abs(n_float - n_pinned) > 1e-9 * max(1.0, n_float):
-            raise GeometryError(f"wall: length {length:g} m is not a whole number of {block_length:g} m blocks")
+            lo = max(1, math.floor(n_float))  # the lengths that fit on either side, to pick from
+            fits = ", ".join(f"{k * block_length:g} m is {k}" for k in sorted({lo, math.floor(n_float) + 1}))
+            raise GeometryError(
+                f"wall: length {length:g} m is not a whole number of {block_length:g} m blocks ({fits})"
+            )
     if courses is not None and number_problem(courses, integer=True, ge=1) is not None:
         raise GeometryError(f"wall: courses must be a positive integer, got {courses!r}")
     if blocks is None:
