@@ -290,7 +290,7 @@ def _write_assembly(builder: str, opts: dict) -> None:
         write_geojson(assembly, part)
     out = target.path
     console.print(
-        f"{builder}: {assembly.block_count} blocks and {assembly.support_count} "
+        f"{builder}: {assembly.block_count} block{'s' if assembly.block_count != 1 else ''} and {assembly.support_count} "
         f"support{'s' if assembly.support_count != 1 else ''} → {out}"
     )
 

@@ -272,6 +272,13 @@ def test_engine_error_mid_run_keeps_frames(tmp_path, monkeypatch):
     assert _frames_in(rrd) == 2
 
 
+def test_build_says_one_block_in_the_singular(tmp_path):
+    # "wall: 1 blocks and 1 support → w.geojson"
+    result = invoke("build", "wall", "--blocks", 1, "--out", tmp_path / "w.geojson")
+    said = " ".join(result.output.split())  # the console wraps a long path
+    assert result.exit_code == 0 and f"wall: 1 block and 1 support → {tmp_path / 'w.geojson'}" in said
+
+
 @pytest.mark.parametrize(
     "builder, args, blocks, supports",
     [
