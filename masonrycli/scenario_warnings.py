@@ -72,13 +72,16 @@ def record_warnings(scenario: Scenario) -> list[str]:
     * it is sampled more finely than dt: the steps see its velocity every dt only, and its content above
       1/(2 dt) comes back aliased (the record's counterpart of check_sampling's sine);
     * it peaks beyond 10 g as scaled (no earthquake comes near: a CSV in cm/s read as m/s, or a scale
-      meant as a unit conversion applied twice, ran "completed … collapsed" without a word).
+      meant as a unit conversion applied twice, ran "completed … collapsed" without a word);
+    * it is an .AT2 file (in g, converted on reading) scaled by g (9.81, or 981 for cm/s²): converted twice,
+      a 0.3 g record ran at 2.9 g, under the 10 g line.
     """
     run = scenario.run
     unseen: dict[tuple[str, float, float], list[str]] = {}
     late: dict[tuple[str, float], list[str]] = {}
     fine: dict[tuple[str, float], list[str]] = {}
     strong: dict[tuple[str, float, float], list[str]] = {}
+    twice: dict[tuple[str, float, float], list[str]] = {}
     for support, m in zip(scenario.assembly.supports, scenario.motions):
         if m.kind != "record":
             continue
@@ -89,7 +92,9 @@ def record_warnings(scenario: Scenario) -> list[str]:
             late.setdefault((name, m.end_time), []).append(f'"{support.name}"')
         if m.sample_interval < run.dt * (1.0 - 1e-9):
             fine.setdefault((name, m.sample_interval), []).append(f'"{support.name}"')
-        if m.peak_acceleration > MAX_AT2_G * G_STANDARD:
+        if name.lower().endswith(".at2") and any(abs(m.scale / g - 1.0) < 0.02 for g in (G_STANDARD, 100 * G_STANDARD)):
+            twice.setdefault((name, m.peak_acceleration / G_STANDARD, m.scale), []).append(f'"{support.name}"')
+        elif m.peak_acceleration > MAX_AT2_G * G_STANDARD:
             strong.setdefault((name, m.peak_acceleration / G_STANDARD, m.scale), []).append(f'"{support.name}"')
 
     def who(names: list[str]) -> str:
@@ -116,5 +121,10 @@ def record_warnings(scenario: Scenario) -> list[str]:
             f"{who(names)}: the record {name} peaks at {peak:.3g} g as applied (scale {scale:g}); the strongest "
             f"earthquakes reach 3–4 g: check its units and the scale"
             for (name, peak, scale), names in strong.items()
+        ]
+        + [
+            f"{who(names)}: the record {name} is read in g and converted to m/s² already; scale {scale:g} converts "
+            f"it again ({peak:.3g} g as applied; the scale multiplies the record, 1 is as recorded)"
+            for (name, peak, scale), names in twice.items()
         ]
     )

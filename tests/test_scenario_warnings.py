@@ -119,3 +119,25 @@ def test_every_command_prints_the_warnings(tmp_path):
     ):
         said = " ".join(invoke(*args).output.split())
         assert "warning: [run] gravity = [0, 9.81] points up" in said, (args, said)
+
+
+@pytest.mark.parametrize("scale", [9.81, 9.80665, 981.0])
+def test_an_at2_record_scaled_by_g_is_warned_about(tmp_path, scale):
+    # --scale 9.81 "to convert g" on an .AT2 (converted on reading): a 0.3 g record ran at 2.9 g, no word
+    from synthetic_records import write_at2
+
+    write_at2(tmp_path / "q.AT2", [0.0, 0.3, -0.2, 0.0], 0.01)
+    text = (
+        "[run]\nduration = 0.03\n"
+        + BLOCK
+        + GROUND
+        + f'motion = {{ kind = "record", file = "q.AT2", scale = {scale} }}\n'
+    )
+    scenario = loads_scenario(text, source=str(tmp_path / "s.toml"), base_dir=tmp_path)
+    peak = 0.3 * scale
+    assert record_warnings(scenario) == [
+        f'support "ground": the record q.AT2 is read in g and converted to m/s² already; scale {scale:g} converts it '
+        f"again ({peak:.3g} g as applied; the scale multiplies the record, 1 is as recorded)"
+    ]
+    text = text.replace(f"scale = {scale}", "scale = 2.0")  # a scale, not a unit
+    assert record_warnings(loads_scenario(text, source=str(tmp_path / "s.toml"), base_dir=tmp_path)) == []
