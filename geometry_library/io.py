@@ -85,9 +85,17 @@ GIS_ID_COLUMNS = ("id", "fid", "ogc_fid", "objectid")
 
 def _read_text(path: Path) -> str:
     try:
-        return path.read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as exc:
+        raw = path.read_bytes()
+    except OSError as exc:
         raise GeometryError(f"{path}: cannot read file ({exc.__class__.__name__}: {exc})") from None
+    try:
+        return raw.decode("utf-8")
+    except UnicodeDecodeError as exc:  # it said "(UnicodeDecodeError: 'utf-8' codec can't decode byte 0xe9 …)"
+        line = raw.count(b"\n", 0, exc.start) + 1
+        raise GeometryError(
+            f"{path}:{line}: not a UTF-8 text file (byte {exc.start}, 0x{raw[exc.start]:02x}: a character saved in "
+            "another encoding, such as Windows-1252); save it as UTF-8 (a GIS export: choose the UTF-8 encoding)"
+        ) from None
 
 
 def _number(value, what: str, where: str) -> float:

@@ -82,7 +82,15 @@ def not_utf8(name: str, raw: bytes, exc: UnicodeDecodeError) -> InputError:
     "Unicode") is named as such, where "not a UTF-8 text file (byte 0)" left the user to guess."""
     if raw[:2] in (b"\xff\xfe", b"\xfe\xff"):
         return InputError(f"{name}: a UTF-16 text file (it starts with UTF-16's byte-order mark); save it as UTF-8")
-    return InputError(f"{name}: not a UTF-8 text file (byte {exc.start})")
+    if b"\x00" in raw:  # no text in any encoding: saving it "as UTF-8" is no advice
+        return InputError(f"{name}: not a text file (it holds NUL bytes: a binary file)")
+    # the line, and what to do: "not a UTF-8 text file (byte 18)" left a user to count bytes for a "è" typed
+    # in a comment by an editor saving in the Windows code page
+    line = raw.count(b"\n", 0, exc.start) + 1
+    return InputError(
+        f"{name}:{line}: not a UTF-8 text file (byte {exc.start}, 0x{raw[exc.start]:02x}: a character saved in "
+        "another encoding, such as Windows-1252); save it as UTF-8"
+    )
 
 
 def one_line(text: str) -> str:

@@ -120,7 +120,7 @@ FILE_ROWS = [
         {"s.toml": b"[run]\nname = '\xff'\n"},
         ("check", "s.toml"),
         2,
-        "s.toml: not a UTF-8 text file (byte",
+        "s.toml:2: not a UTF-8 text file (byte 14, 0xff",
     ),
     ("top-level-unknown", {"s.toml": f"blok = 1\n{SCENE}"}, ("check", "s.toml"), 2, 's.toml: unknown key "blok"'),
     # -- scenario TOML: blocks and supports

@@ -53,7 +53,10 @@ def test_text_that_is_not_utf8_says_where_or_that_it_is_utf16():
     raw = "t;v\n0;é".encode("latin-1")
     with pytest.raises(UnicodeDecodeError) as info:
         raw.decode("utf-8")
-    assert str(not_utf8("q.csv", raw, info.value)) == "q.csv: not a UTF-8 text file (byte 6)"
+    assert str(not_utf8("q.csv", raw, info.value)) == (
+        "q.csv:2: not a UTF-8 text file (byte 6, 0xe9: a character saved in another encoding, such as Windows-1252); "
+        "save it as UTF-8"
+    )
     for encoding in ("utf-16-le", "utf-16-be"):
         raw = "\ufefft v\n0 0\n".encode(encoding)
         with pytest.raises(UnicodeDecodeError) as info:

@@ -141,6 +141,14 @@ def test_geojson_errors_name_file_and_feature(tmp_path):
     missing = one_line_error(read_geojson, tmp_path / "nope.geojson")
     assert "nope.geojson: cannot read file" in missing
 
+    # a GIS export in the Windows code page: it said "(UnicodeDecodeError: 'utf-8' codec can't decode byte 0xe9 …)"
+    latin = tmp_path / "latin.geojson"
+    latin.write_bytes(b'{"type": "FeatureCollection",\n "features": [{"properties": {"name": "pi\xe9droit"}}]}')
+    assert one_line_error(read_geojson, latin) == (
+        f"{latin}:2: not a UTF-8 text file (byte 71, 0xe9: a character saved in another encoding, such as "
+        "Windows-1252); save it as UTF-8 (a GIS export: choose the UTF-8 encoding)"
+    )
+
     bad_json = tmp_path / "bad.geojson"
     bad_json.write_text("{ not json")
     assert "bad.geojson: invalid JSON" in one_line_error(read_geojson, bad_json)

@@ -110,7 +110,7 @@ def test_load_record_csv_unreadable(tmp_path):
     f.write_bytes(b"0,1\n1,\x00\xe9\n")  # a NUL byte: no text file
     with pytest.raises(InputError) as exc:
         load_record_csv(f)
-    assert "latin1.csv: not a UTF-8 text file" in one_line(exc)
+    assert one_line(exc) == f"{f}: not a text file (it holds NUL bytes: a binary file)"
 
 
 def test_a_spreadsheet_csv_in_the_windows_code_page_is_read(tmp_path):

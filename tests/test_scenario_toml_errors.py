@@ -291,7 +291,7 @@ def test_unreadable_files(tmp_path):
     with pytest.raises(InputError, match="is a directory"):
         load_scenario(tmp_path)
     (tmp_path / "latin.toml").write_bytes(b'name = "caf\xe9"\n')
-    with pytest.raises(InputError, match=r"latin\.toml: not a UTF-8 text file"):
+    with pytest.raises(InputError, match=r"latin\.toml:1: not a UTF-8 text file .*; save it as UTF-8$"):
         load_scenario(tmp_path / "latin.toml")
     utf16 = tmp_path / "utf16.toml"  # Windows' Notepad "Unicode": "not a UTF-8 text file (byte 0)" before
     utf16.write_bytes(BLOCK.encode("utf-16"))
