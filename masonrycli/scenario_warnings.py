@@ -5,7 +5,8 @@
   after it, is sampled finer than dt, or peaks beyond 10 g as scaled).
 * :func:`setting_warnings`: settings in the wrong units or sign — a gravity pointing up (the blocks fly
   off, or limit analysis finds "no equilibrium") or far from 9.81 m/s² (cm/s², or g), a density below
-  any masonry unit's (t/m³ or g/cm³: stresses and forces 1000× too small, the motion unchanged).
+  any masonry unit's (t/m³ or g/cm³: stresses and forces 1000× too small, the motion unchanged), a block
+  larger than any stone (a drawing in millimetres).
 * :func:`scenario_warnings`: those and the scenario's own (geometry: a block touching nothing, no
   support, a GeoJSON property not used).
 
@@ -25,6 +26,9 @@ from masonrycli.scenario import Scenario
 MIN_DENSITY = 100.0
 """kg/m³: lighter blocks are warned about (masonry units weigh 1200–3000 kg/m³, timber 400–700): a density in
 t/m³ or g/cm³ (2.5 for stone) is 1000× too small."""
+MAX_BLOCK_SIZE = 20.0
+"""m: a block whose bounding box is longer is warned about (the largest cut stones, Baalbek's, are 20 m long): a
+drawing in millimetres (a 300 × 200 mm block read as 300 × 200 m)."""
 GRAVITY_RANGE = (0.5 * G_STANDARD, 2.0 * G_STANDARD)
 """m/s²: a gravity of another size is warned about: cm/s² (981) or g (1) — but not one below 0.01 g, which is
 no gravity on purpose (limit analysis refuses it in its own line)."""
@@ -36,7 +40,8 @@ def scenario_warnings(scenario: Scenario) -> list[str]:
 
 
 def setting_warnings(scenario: Scenario) -> list[str]:
-    """One line for a gravity pointing up or of an unlikely size, one for densities below ``MIN_DENSITY``."""
+    """One line for a gravity pointing up or of an unlikely size, one for densities below ``MIN_DENSITY``, one
+    for blocks larger than ``MAX_BLOCK_SIZE``."""
     out = []
     gx, gy = scenario.run.gravity
     size = math.hypot(gx, gy)
@@ -58,7 +63,22 @@ def setting_warnings(scenario: Scenario) -> list[str]:
             f"{which}: density {first.density:g} kg/m³, lighter than any masonry unit (stone 2000–2800 kg/m³): a "
             f"density in t/m³ or g/cm³ makes the stresses and forces {1000:g}× too small"
         )
+    big = [b for b in scenario.assembly.blocks if _size(b) > MAX_BLOCK_SIZE]
+    if big:
+        first = big[0]
+        x0, y0, x1, y1 = first.polygon.bounds
+        which = f'block "{first.name}"' if len(big) == 1 else f'{len(big)} blocks (first "{first.name}")'
+        out.append(
+            f"{which}: {x1 - x0:g} × {y1 - y0:g} m, larger than any cut stone ({MAX_BLOCK_SIZE:g} m): coordinates are "
+            "metres (a drawing in millimetres: divide them by 1000)"
+        )
     return out
+
+
+def _size(block) -> float:
+    """m: the longer side of the block's bounding box."""
+    x0, y0, x1, y1 = block.polygon.bounds
+    return max(x1 - x0, y1 - y0)
 
 
 def record_warnings(scenario: Scenario) -> list[str]:

@@ -141,3 +141,17 @@ def test_an_at2_record_scaled_by_g_is_warned_about(tmp_path, scale):
     ]
     text = text.replace(f"scale = {scale}", "scale = 2.0")  # a scale, not a unit
     assert record_warnings(loads_scenario(text, source=str(tmp_path / "s.toml"), base_dir=tmp_path)) == []
+
+
+def test_a_drawing_in_millimetres_is_warned_about(tmp_path):
+    # a 300 × 200 mm block drawn in mm ran as a 300 × 200 m block of 1.5e8 kg, "completed"
+    text = (
+        '[run]\nduration = 0.1\n[[block]]\nname = "b1"\npolygon = [[0, 0], [300, 0], [300, 200], [0, 200]]\n'
+        '[[support]]\nname = "g"\npolygon = [[-100, -50], [400, -50], [400, 0], [-100, 0]]\n'
+    )
+    scenario = loads_scenario(text, source=str(tmp_path / "s.toml"), base_dir=tmp_path)
+    assert setting_warnings(scenario) == [
+        'block "b1": 300 × 200 m, larger than any cut stone (20 m): coordinates are metres (a drawing in '
+        "millimetres: divide them by 1000)"
+    ]
+    assert setting_warnings(_scenario(tmp_path)) == []  # 0.4 × 0.2 m
