@@ -37,7 +37,7 @@ from types import SimpleNamespace
 import numpy as np
 
 from benchmarks.solver_lab.problems import DATA
-from masonrycli.engine import bodies, momentum, newton, nlgs, stalled
+from masonrycli.engine import bodies, momentum, newton, nlgs, shrink, stalled
 
 HARD = DATA / "hard"
 BIG = 10_000
@@ -163,7 +163,14 @@ def _capture_run(case, motion, copy, min_units, duration, directory) -> tuple[di
 
 
 def _set(overrides: dict[str, object]) -> dict[str, object]:
-    modules = {"momentum": momentum, "newton": newton, "stalled": stalled, "nlgs": nlgs, "bodies": bodies}
+    modules = {
+        "momentum": momentum,
+        "newton": newton,
+        "stalled": stalled,
+        "nlgs": nlgs,
+        "bodies": bodies,
+        "shrink": shrink,
+    }
     old = {}
     for name, value in overrides.items():
         module, attr = name.split(".")

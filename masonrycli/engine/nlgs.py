@@ -312,6 +312,8 @@ def _nlgs_interleaved(
     if accelerate:
         if alternate:
             return interleaved._accelerated(*args, accelerated_stall, True)
+        if shrink.CHECK_EVERY > 0:
+            return interleaved._shrinking(*args, accelerated_stall, shrink.CHECK_EVERY)
         return interleaved._accelerated(*args, accelerated_stall)  # flip omitted: compiled out
     if alternate:
         return interleaved._plain(*args, True)
@@ -460,4 +462,4 @@ def tangential_velocity(contact_body, pack, count, v) -> np.ndarray:
 
 # At the end: faces, momentum and stalled build on this module's sweep primitives (a stalled solve()
 # continues by faces or by stalled's methods; the accelerated sweep is momentum's).
-from masonrycli.engine import faces, interleaved, momentum, stalled  # noqa: E402
+from masonrycli.engine import faces, interleaved, momentum, shrink, stalled  # noqa: E402
