@@ -3,6 +3,8 @@ left out, checked every few sweeps and before it stops."""
 
 from __future__ import annotations
 
+from types import SimpleNamespace
+
 import numpy as np
 import pytest
 
@@ -126,21 +128,22 @@ def test_the_walls_between_which_contacts_close_do_change_the_left_out_set():
     assert any(differs)
 
 
-def test_the_engine_uses_the_shrinking_sweep_when_asked(monkeypatch):
-    # nlgs._nlgs_interleaved routes the accelerated first stage to interleaved._shrinking when
-    # shrink.CHECK_EVERY > 0: the same result as that kernel called on the same input.
+def test_the_engine_uses_the_shrinking_sweep_for_the_first_stage_when_asked(monkeypatch):
+    # nlgs.solve sends the accelerated first stage to interleaved._shrinking when shrink.CHECK_EVERY > 0
+    # (stalled.py's methods keep their own sweeps): the same result as that kernel on the same input.
     problem = _column_between_walls(6, 9, (0.0, 3e-4), warm=False)
     body, pack, v0, r0 = problem[:4]
     count = body.shape[0]
+    model = SimpleNamespace(friction=MU, tolerance=1e-9, max_iterations=5000, solver="nlgs-accel")
     outs = []
     for route in ("engine", "kernel"):
         v, r, status = v0.copy(), r0.copy(), np.zeros(count, np.int8)
         if route == "engine":
             monkeypatch.setattr(shrink, "CHECK_EVERY", 8)
-            its = nlgs._nlgs_interleaved(body, pack, count, MU, 1e-9, 5000, v, r, status, True, 200)
+            its = nlgs.solve(body, pack, count, model, v, r, status)
             monkeypatch.setattr(shrink, "CHECK_EVERY", 0)
         else:
-            its = interleaved._shrinking(body, pack, count, MU, 1e-9, 5000, v, r, status, 200, 8)
+            its = interleaved._shrinking(body, pack, count, MU, 1e-9, 5000, v, r, status, momentum.STALL_SWEEPS, 8)
         outs.append((its, v, r, status))
-    assert outs[0][0] == outs[1][0]
+    assert outs[0][0] == outs[1][0] and outs[0][0][1] <= 1e-9
     assert all(np.array_equal(x, y) for x, y in zip(outs[0][1:], outs[1][1:]))

@@ -312,8 +312,6 @@ def _nlgs_interleaved(
     if accelerate:
         if alternate:
             return interleaved._accelerated(*args, accelerated_stall, True)
-        if shrink.CHECK_EVERY > 0:
-            return interleaved._shrinking(*args, accelerated_stall, shrink.CHECK_EVERY)
         return interleaved._accelerated(*args, accelerated_stall)  # flip omitted: compiled out
     if alternate:
         return interleaved._plain(*args, True)
@@ -417,9 +415,14 @@ def solve(contact_body, pack, count, model, v, r, status) -> tuple[int, float]:
         return _faces_if_stalled(contact_body, pack, count, mu, tolerance, cap, v, r, status, iterations, residual)
     # Accelerated: momentum until its stall window; a stalled step goes on by the methods of stalled.py.
     v_free, r_warm = v.copy(), r[:count].copy()
-    iterations, residual = _nlgs_interleaved(
-        contact_body, pack, count, mu, tolerance, cap, v, r, status, True, momentum.STALL_SWEEPS
-    )
+    if shrink.CHECK_EVERY > 0:  # the first stage only: stalled.py's methods keep their sweeps
+        iterations, residual = interleaved._shrinking(
+            contact_body, pack, count, mu, tolerance, cap, v, r, status, momentum.STALL_SWEEPS, shrink.CHECK_EVERY
+        )
+    else:
+        iterations, residual = _nlgs_interleaved(
+            contact_body, pack, count, mu, tolerance, cap, v, r, status, True, momentum.STALL_SWEEPS
+        )
     if residual <= tolerance or iterations >= cap:
         return iterations, residual
     return stalled.continue_stalled(
