@@ -298,7 +298,8 @@ def _table_file(table: dict, key: str, base_dir: str, time_step: float | None):
     file = table[key]
     if not isinstance(file, str) or not file:
         raise InputError(f"motion.{key} = {format_value(file)[:40]}: must be a file name")
-    resolved = os.path.abspath(os.path.join(base_dir, file))
+    # "~/records/q.AT2" was looked for as <scenario folder>/~/records/q.AT2: no shell expands a TOML string
+    resolved = os.path.abspath(os.path.join(base_dir, os.path.expanduser(file)))
     if not os.path.isfile(resolved):
         missing = (
             "is a directory" if os.path.isdir(resolved) else NOT_A_FILE if os.path.exists(resolved) else "no such file"

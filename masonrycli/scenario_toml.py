@@ -148,7 +148,7 @@ def _parse_document(doc: dict, ctx: InputContext, default_name: str) -> Scenario
             file = structure["file"]
             if not isinstance(file, str):
                 raise ctx.error("[structure]", f"file = {format_value(file)[:40]}: must be a string")
-            path = os.path.abspath(os.path.join(ctx.base_dir, file))
+            path = os.path.abspath(os.path.join(ctx.base_dir, os.path.expanduser(file)))  # "~/w.geojson" too
             assembly = read_geometry(path, material.density, material.thickness, ctx, notes=notes)
             what = f"file {quote_string(file)}"
             structure_info = {"file": path}

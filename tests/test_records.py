@@ -348,6 +348,18 @@ motion = MOTION
 """
 
 
+def test_a_scenario_record_file_under_the_home_folder(tmp_path, monkeypatch):
+    # file = "~/records/q.AT2" was looked for as <scenario folder>/~/records/q.AT2, "no such file"
+    from masonrycli.scenario_toml import loads_scenario
+
+    monkeypatch.setenv("HOME", str(tmp_path / "home"))
+    (tmp_path / "home" / "records").mkdir(parents=True)
+    write_at2(tmp_path / "home" / "records" / "q.AT2", [0.0, 0.1, 0.0], 0.01)
+    motion = '{ kind = "record", file = "~/records/q.AT2" }'
+    s = loads_scenario(SCENARIO.replace("MOTION", motion), base_dir=tmp_path / "elsewhere")
+    assert s.motions[0].source == str(tmp_path / "home" / "records" / "q.AT2")
+
+
 def test_scenario_record_with_at2_vertical_window_and_round_trip(tmp_path):
     from masonrycli.scenario_toml import dump_scenario, loads_scenario
 

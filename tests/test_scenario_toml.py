@@ -219,6 +219,18 @@ def test_relative_record_path_resolves_against_scenario_folder(tmp_path, monkeyp
     assert s.motions[0].is_vector
 
 
+def test_a_geometry_file_under_the_home_folder(tmp_path, monkeypatch):
+    # [structure] file = "~/walls/w.geojson" was looked for as <scenario folder>/~/walls/w.geojson
+    from geometry_library.builders import build_wall
+    from geometry_library.io import write_geojson
+
+    monkeypatch.setenv("HOME", str(tmp_path / "home"))
+    (tmp_path / "home" / "walls").mkdir(parents=True)
+    write_geojson(build_wall(blocks=3), tmp_path / "home" / "walls" / "w.geojson")
+    s = loads_scenario('[structure]\nfile = "~/walls/w.geojson"\n', source="s.toml", base_dir=tmp_path)
+    assert s.block_count == 3 and s.structure == {"file": str(tmp_path / "home" / "walls" / "w.geojson")}
+
+
 def test_missing_record_file_names_resolved_path(tmp_path):
     text = BLOCK + GROUND.replace("polygon", 'motion = { kind = "record", file = "nope.csv" }\npolygon')
     msg = load_error(tmp_path, text)
