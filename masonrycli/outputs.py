@@ -119,10 +119,10 @@ def check_output(
     the option and the path."""
     where = f"{option} {path}"
     suffixes = (suffix,) if isinstance(suffix, str) else suffix
+    if path.is_dir():  # first: "--out recordings/" said "the file name must end in .rrd"
+        raise InputError(f"{where}: is a folder (name a file in it: {path / ('NAME' + suffixes[0])})")
     if path.suffix.lower() not in suffixes:
         raise InputError(f"{where}: the file name must end in {' or '.join(suffixes)}")
-    if path.is_dir():
-        raise InputError(f"{where}: is a folder")
     if os.path.lexists(path) and not force:  # a link to a missing file too: the run wrote "x-2.rrd" instead
         broken = "" if path.exists() else f", a link to the missing {os.readlink(path)}"
         raise InputError(f"{where}: the file exists{broken} (add --force to replace it)")

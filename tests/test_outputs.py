@@ -267,3 +267,13 @@ def test_an_output_may_accept_several_suffixes(tmp_path):
         assert check_output(tmp_path / name, "--out", (".geojson", ".json"), False).path == tmp_path / name
     with pytest.raises(InputError, match=r"--out .*w\.txt: the file name must end in \.geojson or \.json$"):
         check_output(tmp_path / "w.txt", "--out", (".geojson", ".json"), False)
+
+
+def test_a_folder_given_as_the_output_says_so_first(tmp_path):
+    # --out recordings/ said "the file name must end in .rrd", as if a name were wrong, not a folder given
+    from masonrycli.errors import InputError
+    from masonrycli.outputs import check_output
+
+    with pytest.raises(InputError) as info:
+        check_output(tmp_path, "--out", ".rrd", False)
+    assert str(info.value) == f"--out {tmp_path}: is a folder (name a file in it: {tmp_path / 'NAME.rrd'})"
