@@ -99,8 +99,10 @@ def override_run(scenario: Scenario, *, friction: float | None = None, **run_val
 def _sine(amp: float, freq: float) -> Sine:
     try:
         sine = Sine(direction=(1.0, 0.0), amplitude=amp, frequency=freq)
-    except InputError as exc:
-        raise InputError(f"--amp/--freq: {exc}") from None
+    except InputError as exc:  # the option of the field: "--amp nan" said "--amp/--freq: amplitude = nan: …"
+        field = str(exc).split(" ", 1)[0]
+        option = {"amplitude": "--amp", "frequency": "--freq"}.get(field, "--amp/--freq")
+        raise InputError(f"{option}: {exc}") from None
     if amp and freq == 0.0:  # it ran: amp·sin(0) = 0, the ground never moved ("intact", exit 0)
         raise InputError(
             f"--freq 0: the velocity {amp:g} m/s · sin(2π·0·t) is 0, nothing moves (--amp 0 for no shaking; a "

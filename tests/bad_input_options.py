@@ -129,8 +129,8 @@ OPTION_ROWS = [
         2,
         "--settlement nan: must be a finite",
     ),
-    ("sim-amp-nan", {}, (*WALL, "--amp", "nan", "--no-recording"), 2, "--amp/--freq:"),
-    ("sim-freq-negative", {}, (*WALL, "--freq", "-1", "--no-recording"), 2, "--amp/--freq:"),
+    ("sim-amp-nan", {}, (*WALL, "--amp", "nan", "--no-recording"), 2, "--amp: amplitude = nan: must be"),
+    ("sim-freq-negative", {}, (*WALL, "--freq", "-1", "--no-recording"), 2, "--freq: frequency = -1.0: must be"),
     ("sim-voussoirs", {}, (*ARCH, "--voussoirs", "1", "--no-recording"), 2, 'builder "arch"'),
     ("sim-span", {}, (*ARCH, "--span", "-1", "--no-recording"), 2, 'builder "arch"'),
     # the builder's name once (it read "error: wall: wall: block count ...")

@@ -67,10 +67,10 @@ def test_overrides_reach_structure_loading_material_and_run():
         ("aqueduct", {"freq": 3.0}, "--freq 3: the aqueduct settles its right foundation by default; shake"),
         ("arch", {"settlement": 0.0, "freq": 3.0}, "--freq 3 without --amp: nothing shakes the arch"),
         ("arch", {"settlement": float("nan")}, "--settlement nan: must be a finite number"),
-        ("arch", {"freq": -1.0}, "--amp/--freq: frequency = -1.0: must be >= 0"),
+        ("arch", {"freq": -1.0}, "--freq: frequency = -1.0: must be >= 0"),
         ("wall", {"freq": 0.0}, "--freq 0: the velocity 1 m/s · sin(2π·0·t) is 0, nothing moves"),  # ran, intact
         ("arch", {"settlement": 0.0, "amp": 1.0, "freq": 0.0}, "--freq 0: the velocity 1 m/s · sin(2π·0·t) is 0"),
-        ("wall", {"freq": -2.0}, "--amp/--freq: frequency = -2.0: must be >= 0"),
+        ("wall", {"freq": -2.0}, "--freq: frequency = -2.0: must be >= 0"),
         ("wall", {"density": 0.0, "friction": -1.0}, "--density: density = 0.0: must be > 0"),
         ("wall", {"dt": 2.0}, "--dt: dt = 2.0: must be <= duration (1.0)"),
         ("wall", {"duration": 0.01, "dt": 0.02}, "--duration and --dt: dt = 0.02: must be <= duration (0.01)"),
