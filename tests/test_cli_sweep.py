@@ -33,6 +33,8 @@ def block(tmp_path) -> Path:
         (["-p", "amp=0.1,0.2", "--find", "freq"], "--find freq: give its range too"),
         (["-p", "amp=0.1,0.2", "--outcome", "fall"], "--outcome fall: expected collapse, sliding"),
         (["-p", "amp=0.1,0.2", "--out", "x.txt"], "a study is written as .parquet or .csv"),
+        # 100 worker processes of ~200 MB on a 2-core machine (10 meant): each run uses one core
+        (["-p", "amp=0.1", "--workers", "100000"], "--workers 100000: more than 4 per core ("),
         (["-p", "scale=1,2"], "has no record motion"),
         (["-p", "amp=0.1", "--records", "nowhere"], "--records nowhere: no such file or folder"),
         (["-p", "amp=0.1", "--workers", "2", "--scheduler", "tcp://x:1"], "--workers with --scheduler"),

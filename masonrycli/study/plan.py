@@ -44,6 +44,10 @@ class StudyPlan:
     """The Rerun recording (``--recording``, default beside ``--out``), None with ``--no-recording``."""
 
 
+MAX_WORKERS_PER_CORE = 4
+"""``--workers`` beyond this many per core is refused as a likely typo (each worker is a process of ~200 MB)."""
+
+
 def plan_study(
     target: str,
     *,
@@ -103,6 +107,14 @@ def plan_study(
         raise InputError(f"--im {im}: expected one of pga, pgv, arias, sa")
     if workers is not None and workers < 0:
         raise InputError(f"--workers {workers}: must be >= 0")
+    cores = os.cpu_count() or 1
+    if workers is not None and workers > MAX_WORKERS_PER_CORE * cores:
+        # "--workers 100" (10 meant) started 100 processes of ~200 MB on a 2-core laptop: a run is
+        # single-threaded, so workers beyond the cores only wait, holding their memory
+        raise InputError(
+            f"--workers {workers}: more than {MAX_WORKERS_PER_CORE} per core ({cores} cores here; a run uses one "
+            "core, the default is one worker per core)"
+        )
     scheduler = check_scheduler(scheduler)
     if workers is not None and scheduler is not None:
         raise InputError("--workers with --scheduler: the existing cluster has its own workers")
