@@ -1,4 +1,4 @@
-"""Solver lab: ``python -m benchmarks.solver_lab capture|table|clusters|stalled|trajectory|ordinary|newton-ordinary|joint-ordinary|ipm-ordinary|ordinary-runs|ensemble|hard|hard-methods|handover``
+"""Solver lab: ``python -m benchmarks.solver_lab capture|table|clusters|stalled|trajectory|ordinary|newton-ordinary|joint-ordinary|ipm-ordinary|ordinary-runs|ensemble|hard|hard-methods|handover|tall``
 (see benchmarks/README.md, "Solver lab")."""
 
 from __future__ import annotations
@@ -13,7 +13,7 @@ os.environ.setdefault("RERUN_ANALYTICS", "0")
 
 
 def main() -> None:
-    from benchmarks.solver_lab import ensemble, handover, hard_methods, hard_steps
+    from benchmarks.solver_lab import ensemble, handover, hard_methods, hard_steps, tall_steps
     from benchmarks.solver_lab.capture import CASES
     from masonrycli.scenario import SOLVERS
 
@@ -72,7 +72,11 @@ def main() -> None:
     hard_steps.add_arguments(sub)
     hard_methods.add_arguments(sub)
     handover.add_arguments(sub)
+    tall_steps.add_arguments(sub)
     args = ap.parse_args()
+    if args.command == "tall":
+        tall_steps.main(args)
+        return
     if args.command == "handover":
         handover.main(args)
         return
