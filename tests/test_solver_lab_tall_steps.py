@@ -27,7 +27,7 @@ def test_run_counts_each_method_and_its_answers_meet_the_law(tmp_path, monkeypat
     for name, entry in steps.items():
         # the engine as it runs today spends on each step what the capture run spent on it
         assert entry["engine"]["units"] == index[name.split("/")[1]]["units"]
-        for m in ("ipm-pred", "ipm-pred-close4"):
+        for m in ("ipm-pred", "ipm-pred-close4", "ipm-pred-bodies"):
             e = entry[m]
             expect = 100 + e["iterations"] * tall_steps.MATVEC_UNITS + e["closing"]
             expect += e["factors"]["chol"] * units["chol"]["h32"] + e["factors"]["lu"] * units["lu"]["h32"]
@@ -50,8 +50,9 @@ def test_closing_sweeps_meet_the_engines_tolerance_from_any_impulses(tmp_path):
     hard_steps.capture(["h8"], 0, 1, motions=[(1.0, 2.0, 0.0)], duration=0.002, directory=tmp_path)
     path = sorted(tmp_path.glob("h8-*.npz"))[-1]
     ctx = Context(as_problem(path))
-    r = np.zeros_like(ctx.p.r_warm)  # a cold start
-    n, res, v = tall_steps._closing(ctx, r, 20_000)
-    assert 0 < n < 20_000 and res <= tall_steps.TOLERANCE
-    np.testing.assert_allclose(law.velocity_from_impulse(ctx.p, ctx.H, r), v, atol=1e-12)
-    assert ctx.residual(v, r) <= 2e-5
+    for body_order in (False, True):
+        r = np.zeros_like(ctx.p.r_warm)  # a cold start
+        n, res, v = tall_steps._closing(ctx, r, 20_000, body_order)
+        assert 0 < n < 20_000 and res <= tall_steps.TOLERANCE
+        np.testing.assert_allclose(law.velocity_from_impulse(ctx.p, ctx.H, r), v, atol=1e-12)
+        assert ctx.residual(v, r) <= 2e-5

@@ -15,6 +15,8 @@ steps of ≥ 2500 units, at df779f6). Each is solved from its warm start:
                       one frozen-shift IPM (ipm.run_ipm "frozen"), then accelerated sweeps to the tolerance
     ipm-pred-close4   the same predictor, ipm-newton to 1e-4 m/s, then accelerated sweeps
     cpg-mono          methods/cpg.py's monotone CPG (s ← μ|u_t| each iteration)
+    ipm-pred-bodies   ipm-pred with the engine's body-order momentum (bodies.py, stalled.py's stage, stall
+                      window stalled.BODIES_STALL, no hand-over) as its closing sweeps (new here)
 
 Units, deterministic and at the compiled floor (so favourable to the lab methods): an engine accelerated
 sweep 1 (as the engine counts them); an IPM factorisation FACTOR_UNITS[kind][case] (LAPACK's banded Cholesky
@@ -24,7 +26,8 @@ the engine's momentum kernel with its own in-sweep stopping test (tolerance 1e-5
 they would run inside the engine. Each lab method's budget on a step is BUDGET × the engine's units (at least
 MIN_BUDGET, at most CAP): a method that misses it is counted at what it spent, flagged, and a step the engine
 needs is still needed after it. Accuracy: the lab's RMS law residual of (v(r), r) of every result (law.py), and
-the largest velocity difference from the engine's solution (these steps have no tight reference).
+``dv``, the largest difference of any velocity component (vx, vy in m/s, ω in rad/s) of the dynamic bodies from the
+engine's answer (these steps have no tight reference).
 """
 
 from __future__ import annotations
@@ -41,7 +44,7 @@ from benchmarks.solver_lab.methods import cpg, ipm, ipm_shift
 from benchmarks.solver_lab.outcome import Clock, Context
 from benchmarks.solver_lab.problems import DATA
 from benchmarks.solver_lab.stalled_steps import as_problem
-from masonrycli.engine import nlgs
+from masonrycli.engine import bodies, nlgs, stalled
 
 TOLERANCE, ENGINE_CAP, CAP = 1e-5, 100_000, 50_000
 BUDGET, MIN_BUDGET = 2.0, 5000
@@ -50,7 +53,7 @@ MATVEC_UNITS = 4
 FACTOR_UNITS = {"chol": {"h32": 45.0, "h64": 39.0}, "lu": {"h32": 100.0, "h64": 92.0}}
 """Banded factorisation + two solves over one engine sweep (``factor-units`` at 03:59 UTC 28 Nov: h32-80, h64-0)."""
 SETS = {"stalled": DATA / "stalled", "paper32": DATA / "hard-paper-h32", "paper64": DATA / "hard-paper-h64"}
-METHODS = ("engine", "ipm-pred", "ipm-pred-close4", "cpg-mono")
+METHODS = ("engine", "ipm-pred", "ipm-pred-close4", "cpg-mono", "ipm-pred-bodies")
 CASES = ("h32", "h64")
 
 
@@ -103,18 +106,23 @@ class _Counted:
         ipm.Operators.factor = self._factor
 
 
-def _closing(ctx, r, budget) -> tuple[int, float, np.ndarray]:
-    """The engine's momentum sweeps from impulses r (in place) to its tolerance, no stall window."""
+def _closing(ctx, r, budget, body_order=False) -> tuple[int, float, np.ndarray]:
+    """The engine's momentum sweeps from impulses r (in place) to its tolerance, no stall window; or, with
+    ``body_order``, its body-order momentum with the stage's stall window (units as the engine counts them)."""
     p = ctx.p
     v = p.v_free.copy()
     status = np.zeros(p.count, np.int8)
-    n, res = nlgs._nlgs_interleaved(
-        p.body, ctx.pack, p.count, p.mu, TOLERANCE, max(budget, 1), v, r, status, True, max(budget, 1)
-    )
+    budget = max(budget, 1)
+    if body_order:
+        n, res = bodies.body_order_sweeps(
+            p.body, ctx.pack, p.count, p.mu, TOLERANCE, budget, v, r, status, stalled.BODIES_STALL
+        )
+    else:
+        n, res = nlgs._nlgs_interleaved(p.body, ctx.pack, p.count, p.mu, TOLERANCE, budget, v, r, status, True, budget)
     return int(n), float(res), v
 
 
-def ipm_method(ctx, case, budget, loose, mode) -> dict:
+def ipm_method(ctx, case, budget, loose, mode, body_order=False) -> dict:
     clock = Clock()
     with _Counted() as counted:
         lam = ipm_shift.predict(ctx, clock)
@@ -123,7 +131,7 @@ def ipm_method(ctx, case, budget, loose, mode) -> dict:
     units += sum(k * FACTOR_UNITS[kind].get(case, FACTOR_UNITS[kind]["h32"]) for kind, k in counted.count.items())
     closing = 0
     if res > TOLERANCE:
-        closing, res, v = _closing(ctx, r, int(budget - units))
+        closing, res, v = _closing(ctx, r, int(budget - units), body_order)
         units += closing
     return {
         "units": int(round(units)),
@@ -142,7 +150,7 @@ def cpg_method(ctx, budget) -> dict:
     return {"units": int(matvecs), "iterations": its, "restarts": restarts, "residual": res, "v": v, "r": r}
 
 
-def run(methods, out: Path, only=None) -> None:
+def run(methods, out: Path, only=None, cap: int = CAP) -> None:
     doc = json.loads(out.read_text()) if out.exists() else {"steps": {}}
     doc["factor_units"], doc["matvec_units"] = FACTOR_UNITS, MATVEC_UNITS
     for name, path in steps():
@@ -156,7 +164,7 @@ def run(methods, out: Path, only=None) -> None:
         if "engine" in methods or "engine" not in entry:
             entry["engine"] = {k: eng[k] for k in ("units", "residual", "cpu_s")}
             entry["engine"]["law"] = ctx.residual(law.velocity_from_impulse(prob, ctx.H, eng["r"]), eng["r"])
-        budget = int(min(CAP, max(MIN_BUDGET, BUDGET * entry["engine"]["units"])))
+        budget = int(min(cap, max(MIN_BUDGET, BUDGET * entry["engine"]["units"])))
         dyn = prob.inv_mass > 0
         for m in methods:
             if m == "engine":
@@ -166,8 +174,8 @@ def run(methods, out: Path, only=None) -> None:
                 if m == "cpg-mono":
                     res = cpg_method(ctx, budget)
                 else:
-                    loose, mode = (TOLERANCE, "frozen") if m == "ipm-pred" else (1e-4, "newton")
-                    res = ipm_method(ctx, _case(name), budget, loose, mode)
+                    loose, mode = (1e-4, "newton") if m == "ipm-pred-close4" else (TOLERANCE, "frozen")
+                    res = ipm_method(ctx, _case(name), budget, loose, mode, m == "ipm-pred-bodies")
             cpu = time.process_time() - t
             v_r = law.velocity_from_impulse(prob, ctx.H, res["r"])
             row = {k: val for k, val in res.items() if k not in ("v", "r")}
@@ -192,28 +200,36 @@ def _cell(m, e) -> str:
 
 
 def _row(name, entry, methods) -> str:
-    return f"| {name} | {entry['contacts']} | " + " | ".join(_cell(m, entry[m]) for m in methods if m in entry) + " |"
+    cells = (_cell(m, entry[m]) if m in entry else "–" for m in methods)
+    return f"| {name} | {entry['contacts']} | " + " | ".join(cells) + " |"
 
 
 def table(paths: list[Path]) -> None:
     """The run files merged: one row per step, then the totals per wall (module doc)."""
     doc = {"steps": {}}
-    for path in paths:
-        doc["steps"].update(json.loads(Path(path).read_text())["steps"])
+    for path in paths:  # files of other methods on the same steps add columns
+        for name, entry in json.loads(Path(path).read_text())["steps"].items():
+            doc["steps"].setdefault(name, {}).update(entry)
     methods = [m for m in METHODS if any(m in e for e in doc["steps"].values())]
     print("| step | contacts | " + " | ".join(methods) + " |\n|---|---|" + "---|" * len(methods))
     for name, entry in doc["steps"].items():
         print(_row(name, entry, methods))
-    for case in CASES:
-        rows = [e for n, e in doc["steps"].items() if _case(n) == case]
-        cells = []
-        for m in methods:
-            es = [e[m] for e in rows if m in e]
-            units = sum(e["units"] for e in es)
-            missed = sum(not (e["residual"] <= TOLERANCE if m == "engine" else e["converged"]) for e in es)
-            cpu = sum(e["cpu_s"] for e in es)
-            cells.append(f"{units} ({missed} missed, {cpu:.0f} CPU s)")
-        print(f"| all {case} ({len(rows)}) | | " + " | ".join(cells) + " |")
+    groups = [(f"{tag} {case}", tag, case) for tag in SETS for case in CASES] + [
+        (f"all {case}", "", case) for case in CASES
+    ]
+    for label, tag, case in groups:
+        rows = [e for n, e in doc["steps"].items() if _case(n) == case and n.startswith(tag)]
+        if rows:
+            print(f"| {label} ({len(rows)}) | | " + " | ".join(_total(m, rows) for m in methods) + " |")
+
+
+def _total(m, rows) -> str:
+    es = [e[m] for e in rows if m in e]
+    units = sum(e["units"] for e in es)
+    missed = sum(not (e["residual"] <= TOLERANCE if m == "engine" else e["converged"]) for e in es)
+    cpu = sum(e["cpu_s"] for e in es)
+    steps = f"{len(es)} steps, " if len(es) < len(rows) else ""
+    return f"{units} ({steps}{missed} missed, {cpu:.0f} CPU s)"
 
 
 def factor_units(repeat: int = 7) -> None:
@@ -252,6 +268,7 @@ def add_arguments(sub) -> None:
     r.add_argument("--methods", nargs="+", default=list(METHODS), choices=METHODS)
     r.add_argument("--out", type=Path, required=True)
     r.add_argument("--only", nargs="+", default=None, help="steps whose name contains one of these")
+    r.add_argument("--cap", type=int, default=CAP, help="a lab method's budget on a step at most (units)")
     t = act.add_parser("table")
     t.add_argument("files", nargs="+", type=Path)
     act.add_parser("factor-units")
@@ -259,7 +276,7 @@ def add_arguments(sub) -> None:
 
 def main(args) -> None:
     if args.action == "run":
-        run(args.methods, args.out, args.only)
+        run(args.methods, args.out, args.only, args.cap)
     elif args.action == "table":
         table(args.files)
     else:
