@@ -19,6 +19,8 @@ from __future__ import annotations
 import math
 import os
 
+import numpy as np
+
 from masonrycli.record_units import MAX_AT2_G
 from masonrycli.records import G_STANDARD
 from masonrycli.scenario import Scenario
@@ -29,6 +31,9 @@ t/m³ or g/cm³ (2.5 for stone) is 1000× too small."""
 MAX_BLOCK_SIZE = 20.0
 """m: a block whose bounding box is longer is warned about (the largest cut stones, Baalbek's, are 20 m long): a
 drawing in millimetres (a 300 × 200 mm block read as 300 × 200 m)."""
+NUMBERED_SAMPLES = 50
+"""Records with at least this many samples at t = 0, 1, 2, … s (or 1, 2, 3, …) are warned about: sample numbers
+(no accelerograph samples once a second)."""
 GRAVITY_RANGE = (0.5 * G_STANDARD, 2.0 * G_STANDARD)
 """m/s²: a gravity of another size is warned about: cm/s² (981) or g (1) — but not one below 0.01 g, which is
 no gravity on purpose (limit analysis refuses it in its own line)."""
@@ -95,6 +100,8 @@ def record_warnings(scenario: Scenario) -> list[str]:
       meant as a unit conversion applied twice, ran "completed … collapsed" without a word);
     * it is an .AT2 file (in g, converted on reading) scaled by g (9.81, or 981 for cm/s²): converted twice,
       a 0.3 g record ran at 2.9 g, under the 10 g line.
+    * its times are 0, 1, 2, … s: a spreadsheet's sample numbers (a 1000-sample record ran as 1000 s at 1 Hz,
+      or, numbered from 1, "starts after the run ends" with a window as the advice).
     """
     run = scenario.run
     unseen: dict[tuple[str, float, float], list[str]] = {}
@@ -102,11 +109,14 @@ def record_warnings(scenario: Scenario) -> list[str]:
     fine: dict[tuple[str, float], list[str]] = {}
     strong: dict[tuple[str, float, float], list[str]] = {}
     twice: dict[tuple[str, float, float], list[str]] = {}
+    numbered: dict[tuple[str, float], list[str]] = {}
     for support, m in zip(scenario.assembly.supports, scenario.motions):
         if m.kind != "record":
             continue
         name = os.path.basename(m.source) if m.source else "(inline)"
-        if m.start_time >= run.duration:
+        if _numbered(m.time):  # its window and length warnings would be about sample numbers read as s
+            numbered.setdefault((name, float(m.time[0])), []).append(f'"{support.name}"')
+        elif m.start_time >= run.duration:
             unseen.setdefault((name, m.start_time, m.end_time), []).append(f'"{support.name}"')
         elif m.end_time > run.duration + 0.5 * run.dt:
             late.setdefault((name, m.end_time), []).append(f'"{support.name}"')
@@ -147,4 +157,16 @@ def record_warnings(scenario: Scenario) -> list[str]:
             f"it again ({peak:.3g} g as applied; the scale multiplies the record, 1 is as recorded)"
             for (name, peak, scale), names in twice.items()
         ]
+        + [
+            f"{who(names)}: the record {name} has its samples at t = {first:g}, {first + 1:g}, {first + 2:g}, … s: "
+            "sample numbers, not times? (give its times in s, or its values alone with --record-dt / time_step)"
+            for (name, first), names in numbered.items()
+        ]
     )
+
+
+def _numbered(time) -> bool:
+    """The sample times are 0, 1, 2, … or 1, 2, 3, … (at least ``NUMBERED_SAMPLES`` of them): a spreadsheet's
+    row numbers taken for times, a 1000-sample accelerogram then lasting 1000 s at 1 Hz."""
+    n = len(time)
+    return n >= NUMBERED_SAMPLES and float(time[0]) in (0.0, 1.0) and bool(np.all(np.diff(time) == 1.0))

@@ -155,3 +155,21 @@ def test_a_drawing_in_millimetres_is_warned_about(tmp_path):
         "millimetres: divide them by 1000)"
     ]
     assert setting_warnings(_scenario(tmp_path)) == []  # 0.4 × 0.2 m
+
+
+@pytest.mark.parametrize("first", [0, 1])
+def test_sample_numbers_taken_for_times_are_warned_about(tmp_path, first):
+    # a spreadsheet's row numbers as the time column: from 0 the 1000 samples ran as 1000 s at 1 Hz without a
+    # word; from 1 the warning was "starts at t = 1 s, after the run's 0.5 s … window = [1, 1000] moves it there"
+    rows = "".join(f"{i},{0.1 * (i % 3)}\n" for i in range(first, first + 100))
+    (tmp_path / "idx.csv").write_text("n,acc\n" + rows)
+    motion = 'motion = { kind = "record", file = "idx.csv", quantity = "acceleration" }\n'
+    text = "[run]\nduration = 0.5\n" + BLOCK + GROUND + motion
+    scenario = loads_scenario(text, source=str(tmp_path / "s.toml"), base_dir=tmp_path)
+    assert record_warnings(scenario) == [
+        f'support "ground": the record idx.csv has its samples at t = {first}, {first + 1}, {first + 2}, … s: sample '
+        "numbers, not times? (give its times in s, or its values alone with --record-dt / time_step)"
+    ]
+    short = "".join(f"{i},{0.1 * (i % 3)}\n" for i in range(10))  # a few breakpoints a second apart: a pulse
+    (tmp_path / "idx.csv").write_text("t,acc\n" + short)
+    assert not any("sample numbers" in w for w in record_warnings(loads_scenario(text, base_dir=tmp_path)))
