@@ -123,6 +123,23 @@ def test_infeasible_structure_is_one_line_exit_2(tmp_path):
     assert_one_line_error(invoke("limit", path), "no equilibrium")
 
 
+def test_a_refusal_a_warning_explains_is_one_line_with_it(tmp_path):
+    # a block touching nothing was said twice (a warning, then the error in its words); under a gravity
+    # pointing up "no equilibrium" came with no reason on its line
+    floating = tmp_path / "floating.toml"
+    floating.write_text(
+        '[[block]]\nname = "a"\npolygon = [[0, 1], [1, 1], [1, 2], [0, 2]]\n'
+        '[[support]]\nname = "ground"\npolygon = [[-1, -1], [2, -1], [2, 0], [-1, 0]]\n'
+    )
+    assert_one_line_error(invoke("limit", floating), 'block 1 ("a") touches nothing: it has no support')
+    up = tmp_path / "up.toml"
+    up.write_text(
+        "[run]\ngravity = [0.0, 9.81]\n[[block]]\npolygon = [[0, 0], [1, 0], [1, 1], [0, 1]]\n"
+        '[[support]]\nname = "ground"\npolygon = [[-1, -1], [2, -1], [2, 0], [-1, 0]]\n'
+    )
+    assert_one_line_error(invoke("limit", up), "no equilibrium", "([run] gravity = [0, 9.81] points up (y is up")
+
+
 @pytest.mark.parametrize("gy", ["0.0", "-1e-300"])
 def test_zero_gravity_is_one_line_exit_2(gy, tmp_path):
     # a scenario file may set gravity = [0, 0] (masonry run floats the blocks): limit ended in a

@@ -21,7 +21,7 @@ from rich.text import Text
 from masonrycli.errors import InputError
 from masonrycli.interrupt import StopRun, StopSignals, exit_code, signal_name
 from masonrycli.limit.analysis import LimitResult, analyse
-from masonrycli.limit.problem import LiveLoad
+from masonrycli.limit.problem import LimitError, LiveLoad
 from masonrycli.outputs import check_output, written_whole
 
 SHOWN = 8
@@ -231,9 +231,15 @@ def _analyse(structure, live, friction, verify, out, force, done: _Done, signals
     scenario = resolve_structure(structure, friction)
     if verify and live.kind == "point":
         raise InputError("--verify: the engine has no point loads; verify a horizontal or tilt load")
-    for warning in (*scenario.warnings, *setting_warnings(scenario)):  # not its records': it has no time
+    settings = setting_warnings(scenario)  # not its records': it has no time
+    try:
+        done.result = analyse(scenario, live)
+    except LimitError as exc:
+        # one line, as any refusal: a block touching nothing was said twice (a warning, then the error in the
+        # same words); a setting's warning is the reason ("no equilibrium" under a gravity pointing up)
+        raise LimitError(f"{exc} ({'; '.join(settings)})" if settings else str(exc)) from None
+    for warning in (*scenario.warnings, *settings):
         err_console.print(Text.assemble(("warning:", "yellow"), f" {warning}"))
-    done.result = analyse(scenario, live)
     if target is not None:
         with signals.held():  # a signal now waits until the recording is whole and in place
             with written_whole(target) as part:  # under a temporary name, renamed when complete
