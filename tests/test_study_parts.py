@@ -96,6 +96,21 @@ def test_a_point_the_builder_refuses_names_the_point_and_the_builder_once(arch_b
     assert str(info.value).startswith('--param pier_width=0.2: builder "arch": ring_thickness 0.35 m is wider')
 
 
+def test_find_driver_says_when_the_outcome_comes_below_a_value():
+    # "--find friction --outcome sliding": a block slides below a friction; the row said only "sliding already
+    # at friction = 0.1", the threshold empty, as if it slid at every friction
+    driver = FindDriver([Axis("friction", (0.1, 0.7, 2.0))], "friction", "sliding", 0.005, done={})
+    queue = driver.start()
+    while queue:
+        p = queue.pop()
+        queue += driver.feed(p, _row(-p["friction"], -1.28))  # slides while friction < 1.28
+    (row,) = driver.rows()
+    assert math.isnan(row["friction_threshold"]) and row["note"] == (
+        "sliding already at friction = 0.1, not at friction = 2: it comes below a value here; --find looks for "
+        "the smallest value that brings it (a grid shows where it stops)"
+    )
+
+
 def test_find_driver_bisects_to_rtol_and_reports_the_ends():
     axes = [Axis("amp", (0.1, 0.4, 0.7, 1.0)), Axis("freq", (1.0, 2.0, 3.0))]
     thresholds = {1.0: 0.55, 2.0: 0.05, 3.0: 5.0}
@@ -114,6 +129,7 @@ def test_find_driver_bisects_to_rtol_and_reports_the_ends():
     assert math.isnan(rows[2.0]["amp_threshold"]) and "collapse already at amp = 0.1" in rows[2.0]["note"]
     assert math.isnan(rows[3.0]["amp_threshold"]) and "no collapse up to amp = 1" in rows[3.0]["note"]
     assert runs == 12 + 7 and len(driver.finished) == 3
+    assert "not at" not in rows[2.0]["note"]  # it collapses at every amplitude tried
     # resume: a finished point is not searched again
     again = FindDriver(axes, "amp", "collapse", 0.005, done={store.row_key(rows[1.0], ["freq"]): rows[1.0]})
     assert {p["freq"] for p in again.start()} == {2.0, 3.0} and again.skipped == 1

@@ -105,6 +105,12 @@ class FindDriver:
             below = [v for v in search.values if v < first]
             if not below:
                 search.note = f"{self.outcome} already at {self.find} = {first:g}"
+                no = [v for v in search.values if not search.results[v]]
+                if no:  # "--find friction --outcome sliding": it slides below a friction, not above one
+                    search.note += (
+                        f", not at {self.find} = {no[-1]:g}: it comes below a value here; --find looks for the "
+                        "smallest value that brings it (a grid shows where it stops)"
+                    )
                 return self._finish(key, point, search)
             search.lo, search.hi = below[-1], first
         else:
