@@ -22,7 +22,7 @@ from geometry_library.blocks import Assembly, Block, GeometryError, Support
 from masonrycli.errors import NOT_A_FILE, InputContext, InputError, not_utf8, one_line, special_file
 from masonrycli.motion import MOTION_KINDS, Fixed, Motion
 from masonrycli.records import record_fields
-from masonrycli.scenario import Material, RunConfig, Scenario, block_speed_problem
+from masonrycli.scenario import Material, RunConfig, Scenario, block_speed_problem, idle_driven_supports
 from masonrycli.structure import build_structure, check_finite_tree, read_geometry, structure_warnings
 from masonrycli.values import (
     check_real,
@@ -196,6 +196,7 @@ def _parse_document(doc: dict, ctx: InputContext, default_name: str) -> Scenario
                 raise ctx.error(loc, f"name = {quote_string(sname)}: support given twice")
             motions_by_support[sname] = _parse_motion(table.get("motion"), ctx, loc)
         motions = tuple(motions_by_support.get(s.name, Fixed()) for s in assembly.supports)
+        notes += idle_driven_supports(assembly, motions)
     else:
         blocks = []
         names: dict[str, str] = {}
