@@ -74,8 +74,8 @@ def setting_warnings(scenario: Scenario) -> list[str]:
         x0, y0, x1, y1 = first.polygon.bounds
         which = f'block "{first.name}"' if len(big) == 1 else f'{len(big)} blocks (first "{first.name}")'
         out.append(
-            f"{which}: {x1 - x0:g} × {y1 - y0:g} m, larger than any cut stone ({MAX_BLOCK_SIZE:g} m): coordinates are "
-            "metres (a drawing in millimetres: divide them by 1000)"
+            f"{which}: {x1 - x0:g} × {y1 - y0:g} m, larger than any cut stone ({MAX_BLOCK_SIZE:g} m): lengths are in "
+            "metres (millimetres? divide the coordinates, or --block-length / --block-height, by 1000)"
         )
     return out
 

@@ -153,10 +153,13 @@ def test_a_drawing_in_millimetres_is_warned_about(tmp_path):
     )
     scenario = loads_scenario(text, source=str(tmp_path / "s.toml"), base_dir=tmp_path)
     assert setting_warnings(scenario) == [
-        'block "b1": 300 × 200 m, larger than any cut stone (20 m): coordinates are metres (a drawing in '
-        "millimetres: divide them by 1000)"
+        'block "b1": 300 × 200 m, larger than any cut stone (20 m): lengths are in metres (millimetres? divide the '
+        "coordinates, or --block-length / --block-height, by 1000)"
     ]
     assert setting_warnings(_scenario(tmp_path)) == []  # 0.4 × 0.2 m
+    from masonrycli.builtin import builtin
+
+    assert any("300 × 200 m" in w for w in setting_warnings(builtin("wall", block_length=300.0, block_height=200.0)))
 
 
 @pytest.mark.parametrize("first", [0, 1])
