@@ -342,6 +342,8 @@ def scenario_from_geometry_file(path) -> Scenario:
     material = Material()
     notes: list[str] = []
     assembly = read_geometry(path, material.density, material.thickness, ctx, where="", notes=notes)
+    from masonrycli.scenario_warnings import idle_driven_supports
+
     motions = tuple(Fixed() for _ in assembly.supports)
     warnings = (*notes, *idle_driven_supports(assembly, motions), *structure_warnings(assembly, ctx))
     return Scenario(
@@ -354,20 +356,6 @@ def scenario_from_geometry_file(path) -> Scenario:
         structure={"file": os.path.abspath(path)},
         warnings=warnings,
     )
-
-
-def idle_driven_supports(assembly: Assembly, motions) -> list[str]:
-    """One line for the supports the structure marks driven (a GeoJSON's ``support_role``, a builder's
-    ``right_role``) that no motion drives: the role follows the motion, so they stay fixed — and the run
-    said "loading: none" with nothing about the role given."""
-    idle = [s.name for s, m in zip(assembly.supports, motions) if s.role == "driven" and m.kind == "fixed"]
-    if not idle:
-        return []
-    names = ", ".join(quote_string(n) for n in idle)
-    return [
-        f"support{'s' if len(idle) > 1 else ''} {names}: driven, but given no motion, so fixed (a scenario file's "
-        "[[support]] table with its name and a motion drives it)"
-    ]
 
 
 # --------------------------------------------------------------------------------------------------

@@ -22,7 +22,8 @@ from geometry_library.blocks import Assembly, Block, GeometryError, Support
 from masonrycli.errors import NOT_A_FILE, InputContext, InputError, not_utf8, one_line, special_file
 from masonrycli.motion import MOTION_KINDS, Fixed, Motion
 from masonrycli.records import record_fields
-from masonrycli.scenario import Material, RunConfig, Scenario, block_speed_problem, idle_driven_supports
+from masonrycli.scenario import Material, RunConfig, Scenario, block_speed_problem
+from masonrycli.scenario_warnings import idle_driven_supports
 from masonrycli.structure import build_structure, check_finite_tree, read_geometry, structure_warnings
 from masonrycli.values import (
     check_real,

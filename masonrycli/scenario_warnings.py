@@ -7,6 +7,7 @@
   off, or limit analysis finds "no equilibrium") or far from 9.81 m/s² (cm/s², or g), a density below
   any masonry unit's (t/m³ or g/cm³: stresses and forces 1000× too small, the motion unchanged), a block
   larger than any stone (a drawing in millimetres).
+* :func:`idle_driven_supports`: a support marked driven (a GeoJSON's ``support_role``) that no motion drives.
 * :func:`scenario_warnings`: those and the scenario's own (geometry: a block touching nothing, no
   support, a GeoJSON property not used).
 
@@ -24,6 +25,7 @@ import numpy as np
 from masonrycli.record_units import MAX_AT2_G
 from masonrycli.records import G_STANDARD
 from masonrycli.scenario import Scenario
+from masonrycli.values import quote_string
 
 MIN_DENSITY = 100.0
 """kg/m³: lighter blocks are warned about (masonry units weigh 1200–3000 kg/m³, timber 400–700): a density in
@@ -84,6 +86,20 @@ def _size(block) -> float:
     """m: the longer side of the block's bounding box."""
     x0, y0, x1, y1 = block.polygon.bounds
     return max(x1 - x0, y1 - y0)
+
+
+def idle_driven_supports(assembly, motions) -> list[str]:
+    """One line for the supports the structure marks driven (a GeoJSON's ``support_role``, a builder's
+    ``right_role``) that no motion drives: the role follows the motion, so they stay fixed — and the run
+    said "loading: none" with nothing about the role given."""
+    idle = [s.name for s, m in zip(assembly.supports, motions) if s.role == "driven" and m.kind == "fixed"]
+    if not idle:
+        return []
+    names = ", ".join(quote_string(n) for n in idle)
+    return [
+        f"support{'s' if len(idle) > 1 else ''} {names}: driven, but given no motion, so fixed (a scenario file's "
+        "[[support]] table with its name and a motion drives it)"
+    ]
 
 
 def record_warnings(scenario: Scenario) -> list[str]:

@@ -178,3 +178,40 @@ def test_sample_numbers_taken_for_times_are_warned_about(tmp_path, first):
     short = "".join(f"{i},{0.1 * (i % 3)}\n" for i in range(10))  # a few breakpoints a second apart: a pulse
     (tmp_path / "idx.csv").write_text("t,acc\n" + short)
     assert not any("sample numbers" in w for w in record_warnings(loads_scenario(text, base_dir=tmp_path)))
+
+
+def test_a_driven_support_without_a_motion_is_warned_about(tmp_path):
+    # support_role = "driven" in a GeoJSON run as it is: the support stayed fixed, "loading: none", no word
+    import json
+
+    from masonrycli.scenario import scenario_from_geometry_file
+
+    ring = [[-2, -0.5], [2, -0.5], [2, 0], [-2, 0], [-2, -0.5]]
+    block = {
+        "type": "Feature",
+        "properties": {"name": "a"},
+        "geometry": {"type": "Polygon", "coordinates": [[[0, 0], [0.3, 0], [0.3, 0.2], [0, 0.2], [0, 0]]]},
+    }
+    ground = {
+        "type": "Feature",
+        "properties": {"role": "support", "name": "g", "support_role": "driven"},
+        "geometry": {"type": "Polygon", "coordinates": [ring]},
+    }
+    path = tmp_path / "w.geojson"
+    path.write_text(json.dumps({"type": "FeatureCollection", "features": [ground, block]}))
+    s = scenario_from_geometry_file(path)
+    assert s.motions[0].kind == "fixed" and s.assembly.supports[0].role == "fixed"
+    assert (
+        'support "g": driven, but given no motion, so fixed (a scenario file\'s [[support]] table with its '
+        "name and a motion drives it)" in s.warnings
+    )
+    # a scenario file naming the file and giving the motion: no warning
+    (tmp_path / "s.toml").write_text(
+        '[structure]\nfile = "w.geojson"\n[[support]]\nname = "g"\n'
+        'motion = { kind = "sine", amplitude = 0.1, frequency = 2.0 }\n'
+    )
+    assert not any("driven" in w for w in load_scenario(tmp_path / "s.toml").warnings)
+    (tmp_path / "n.toml").write_text('[structure]\nfile = "w.geojson"\n')  # naming it, no motion
+    assert any(
+        w.startswith('support "g": driven, but given no motion') for w in load_scenario(tmp_path / "n.toml").warnings
+    )
