@@ -218,3 +218,15 @@ def test_a_misspelt_parameter_is_said_before_the_outputs_that_exist(block, tmp_p
         result.output.strip()
         == 'error: --param Amp: unknown parameter (did you mean "amp"?) (see masonry sweep --help)'
     )
+
+
+def test_a_builder_option_on_a_structure_read_from_a_file_says_why(tmp_path):
+    # "--param voussoirs: unknown parameter" for an arch read from GeoJSON: an option of the arch builder
+    geo = tmp_path / "arch.geojson"
+    assert invoke("build", "arch", "--out", geo).exit_code == 0
+    result = invoke("sweep", geo, "-p", "voussoirs=10,20", "--workers", 0, "--out", tmp_path / "s.csv")
+    assert result.exit_code == 2
+    assert result.output.strip() == (
+        "error: --param voussoirs: unknown parameter (an option of the arch, aqueduct builders: this structure is "
+        "read, not built) (see masonry sweep --help)"
+    )

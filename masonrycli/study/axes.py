@@ -182,9 +182,8 @@ def apply_point(base, params: dict):
         if short not in MOTION_PARAMS:
             if key not in RUN_PARAMS and key not in ("friction", "record") and key not in options:
                 known = [*MOTION_PARAMS, *RUN_PARAMS, "friction", "record", *_builder_options(builder)]
-                raise InputError(
-                    f"--param {key}: unknown parameter{did_you_mean(key, known)} (see masonry sweep --help)"
-                )
+                hint = did_you_mean(key, known) or _not_built(builder, key)
+                raise InputError(f"--param {key}: unknown parameter{hint} (see masonry sweep --help)")
             continue
         kind, attr = MOTION_PARAMS[short]
         targets = [j for j, m in enumerate(motions) if m.kind == kind and (not support or names[j] == support)]
@@ -217,6 +216,17 @@ def _point(params: dict) -> str:
 
 def _builder_option(builder, name: str) -> bool:
     return name in _builder_options(builder)
+
+
+def _not_built(builder, name: str) -> str:
+    """`` (an option of builder "arch": …)`` when ``name`` is a builder's option but the study's structure is
+    not built (a geometry file, explicit blocks): "--param voussoirs: unknown parameter" said nothing of why."""
+    from geometry_library.builders import BUILDERS
+
+    owners = [b for b in BUILDERS if name in _builder_options(b)]
+    if builder or not owners:
+        return ""
+    return f" (an option of the {', '.join(owners)} builder{'s' if len(owners) > 1 else ''}: this structure is read, not built)"
 
 
 def _builder_options(builder) -> list[str]:
