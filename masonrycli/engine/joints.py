@@ -97,7 +97,7 @@ def _hinged(opening, end_joint, key, body_count, contact_body, contact_rn, dt, o
     loaded[:] = 0.0
     total = np.empty(j_count, np.float64)
     total[:] = 0.0
-    pos = 0
+    pos = np.int64(0)  # not 0: numba would compile _key_row for the literal 0 as well (broadphase.py)
     for c in range(contact_body.shape[0]):
         k = np.int64(contact_body[c, 0]) * body_count + contact_body[c, 1]
         row = _key_row(key, k, pos)
@@ -117,7 +117,7 @@ def _hinged(opening, end_joint, key, body_count, contact_body, contact_rn, dt, o
 @njit
 def _hinge_contacts(key, hinged, body_count, contact_body, contact_rn, out):
     # out[c] = contact c carries normal force (r_n > 0) and its pair is a hinged joint
-    pos = 0
+    pos = np.int64(0)  # as in _hinged
     for c in range(contact_body.shape[0]):
         k = np.int64(contact_body[c, 0]) * body_count + contact_body[c, 1]
         row = _key_row(key, k, pos)
