@@ -8,9 +8,10 @@ same captured steps, and whether both give the same bits.
    ``--every``-th call that ``nlgs.solve`` makes to ``nlgs._nlgs_interleaved`` (the accelerated solve of
    each step with the default solver), then the outputs the working tree gives for them.
 2. Each revision (``git archive`` of its ``masonrycli``; ``--new`` defaults to the working tree) is
-   timed in a fresh process of its own, with its own numba flags and a numba cache of its own: every
-   captured call once (compile, and the bits of v, r, status, sweeps and residual), then the whole set
-   ``PASSES`` times, CPU time (``time.process_time``) per pass.
+   timed in a fresh process of its own, with its own numba flags and a numba cache of its own (the working
+   tree's own cache, as in bench_frames: :func:`worker_env`): every captured call once (compile, and the
+   bits of v, r, status, sweeps and residual), then the whole set ``PASSES`` times, CPU time
+   (``time.process_time``) per pass.
 3. Rounds alternate the order of the revisions (base, new; new, base; …): the minimum over rounds and
    passes is reported in ns per contact·sweep (CPU time / Σ contacts × sweeps, the sweeps each revision
    made), with new ÷ base, and whether every output of the two revisions is bit-identical.
@@ -113,6 +114,16 @@ def checkout(revision: str, into: Path) -> str:
     return str(into)
 
 
+def worker_env(root: str, tmp: Path) -> dict:
+    """A worker's environment: a checkout gets a numba cache of its own in ``tmp``; the working tree keeps its
+    own (as bench_frames does), so comparing it with itself compiles once, and not at all when its kernels
+    are already cached (a test run that compiled them before: 2 full compiles less in bench_phases' test)."""
+    env = dict(os.environ)
+    if root != str(ROOT):
+        env["NUMBA_CACHE_DIR"] = str(tmp / f"cache-{Path(root).name}")
+    return env
+
+
 def compare(base: str, new: str, case: str, duration: float, every: int, rounds: int) -> dict:
     """Capture, then time ``base`` and ``new`` in alternating fresh processes (module doc)."""
     with tempfile.TemporaryDirectory() as tmp:
@@ -124,7 +135,7 @@ def compare(base: str, new: str, case: str, duration: float, every: int, rounds:
         results: dict[str, list] = {"base": [], "new": []}
         for k in range(rounds):
             for name in ("base", "new") if k % 2 == 0 else ("new", "base"):
-                env = dict(os.environ, NUMBA_CACHE_DIR=str(Path(tmp) / f"cache-{name}"))
+                env = worker_env(roots[name], Path(tmp))
                 out = subprocess.run(
                     [sys.executable, __file__, "--worker", roots[name], str(capture_file)],
                     capture_output=True, text=True, cwd=tmp, env=env,

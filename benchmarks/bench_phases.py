@@ -6,7 +6,7 @@ the same bits.
 
 Each revision (``git archive`` of its ``masonrycli``, as benchmarks/bench_kernel.py does; ``--new``
 defaults to the working tree) runs ``--case`` in fresh processes of its own, with a numba cache of its
-own, rounds alternating the order (base, new; new, base; …). A run is the solver benchmark's
+own (bench_kernel.worker_env), rounds alternating the order (base, new; new, base; …). A run is the solver benchmark's
 (bench_solver.run_masonry: the scenario built first, then ``simulate`` timed, a Rerun recording every 10
 steps unless ``--no-record``), after a 0.02 s warm-up run, with the step's launchers wrapped to add up
 their CPU time (``time.process_time``, ~0.7 µs a call on this machine):
@@ -113,14 +113,14 @@ def worker(package_root: str, case: str, duration: float, record: bool) -> None:
 
 def compare(base: str, new: str, case: str, duration: float, rounds: int, record: bool) -> dict:
     """Time ``base`` and ``new`` in alternating fresh processes (module doc)."""
-    from benchmarks.bench_kernel import checkout
+    from benchmarks.bench_kernel import checkout, worker_env
 
     results: dict[str, list] = {"base": [], "new": []}
     with tempfile.TemporaryDirectory() as tmp:
         roots = {name: checkout(rev, Path(tmp) / name) for name, rev in (("base", base), ("new", new))}
         for k in range(rounds):
             for name in ("base", "new") if k % 2 == 0 else ("new", "base"):
-                env = dict(os.environ, NUMBA_CACHE_DIR=str(Path(tmp) / f"cache-{name}"))
+                env = worker_env(roots[name], Path(tmp))
                 cmd = [sys.executable, __file__, "--worker", roots[name], case, str(duration), str(int(record))]
                 out = subprocess.run(cmd, capture_output=True, text=True, cwd=ROOT, env=env)
                 if out.returncode:
