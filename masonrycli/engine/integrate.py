@@ -25,7 +25,7 @@ def _begin_step(body_q, body_v, body_radius, dt, theta, out_q, out_v_old):
         for k in range(3):
             out_q[b, k] = body_q[b, k] + h * body_v[b, k]
             out_v_old[b, k] = body_v[b, k]
-        speed = np.sqrt(body_v[b, 0] ** 2 + body_v[b, 1] ** 2) + abs(body_v[b, 2]) * body_radius[b]
+        speed = np.sqrt(body_v[b, 0] * body_v[b, 0] + body_v[b, 1] * body_v[b, 1]) + abs(body_v[b, 2]) * body_radius[b]
         if speed > top:
             top = speed
     return top
@@ -58,7 +58,7 @@ def _update_q(body_q, body_v_old, body_v_new, dt, theta, block_count):
             if b < block_count and not (np.isfinite(body_q[b, k]) and np.isfinite(body_v_new[b, k])):
                 finite = False
         if b < block_count:
-            speed = np.sqrt(body_v_new[b, 0] ** 2 + body_v_new[b, 1] ** 2)
+            speed = np.sqrt(body_v_new[b, 0] * body_v_new[b, 0] + body_v_new[b, 1] * body_v_new[b, 1])
             if speed > top:
                 top = speed
     return top if finite else np.nan
@@ -71,7 +71,8 @@ def _energies(body_q, body_v, body_mass, body_inertia, gravity, block_count):
     potential = 0.0
     for b in range(block_count):
         m = body_mass[b]
-        kinetic += 0.5 * m * (body_v[b, 0] ** 2 + body_v[b, 1] ** 2) + 0.5 * body_inertia[b] * body_v[b, 2] ** 2
+        vx, vy, w = body_v[b, 0], body_v[b, 1], body_v[b, 2]
+        kinetic += 0.5 * m * (vx * vx + vy * vy) + 0.5 * body_inertia[b] * (w * w)
         potential -= m * (gravity[0] * body_q[b, 0] + gravity[1] * body_q[b, 1])
     return kinetic, potential
 

@@ -117,7 +117,7 @@ def _static_guess(contact_body, pack, count, body_mass, block_count, gravity, dt
     # Why lowest-up then highest-down: a block is held only through held bodies below it, and a body
     # must have received the load of everything above before it passes its own down.
     body_count = body_mass.shape[0]
-    g = np.sqrt(gravity[0] ** 2 + gravity[1] ** 2)
+    g = np.sqrt(gravity[0] * gravity[0] + gravity[1] * gravity[1])
     for c in range(count):
         r[c, 0] = 0.0
         r[c, 1] = 0.0
