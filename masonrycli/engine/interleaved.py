@@ -67,12 +67,12 @@ def _back(order, count, r_o, status_o, r, status):
 
 
 @njit
-def _accelerated(contact_body, pack, count, mu, tolerance, max_iterations, v, r, status, stall, flip=False):
-    # in order → momentum._nlgs_accelerated(stall window ``stall``, ``flip``) → back.
+def _accelerated(contact_body, pack, count, mu, tolerance, max_iterations, v, v_flat, r, status, stall, flip=False):
+    # in order → momentum._momentum_sweeps(stall window ``stall``, ``flip``; v_flat: v viewed as (3B,)) → back.
     # Returns (iterations, residual).
     order, body_o, pack_o, r_o, status_o = _in_order(contact_body, pack, count, r, status)
-    iterations, residual = momentum._nlgs_accelerated(
-        body_o, pack_o, count, mu, tolerance, max_iterations, v, r_o, status_o, stall, flip
+    iterations, residual = momentum._momentum_sweeps(
+        body_o, pack_o, count, mu, tolerance, max_iterations, v, v_flat, r_o, status_o, stall, flip
     )
     _back(order, count, r_o, status_o, r, status)
     return iterations, residual

@@ -53,7 +53,7 @@ STALL_SWEEPS = 200
 def _extrapolate(x, x_prev, beta):
     # x ← x + β (x − x_prev), x_prev ← old x, element by element (the bodies' velocities, once a sweep).
     # Its own function: compiled apart from the sweep, LLVM vectorises the loop (several doubles an
-    # operation, each lane the same IEEE operations, so the same bits); inside _nlgs_accelerated it stayed scalar.
+    # operation, each lane the same IEEE operations, so the same bits); inside the sweep it stayed scalar.
     # 3 % less time per contact·sweep on wall-248 (762 velocities against 1233 contacts a sweep).
     for i in range(x.shape[0]):
         xi = x[i]
@@ -63,6 +63,18 @@ def _extrapolate(x, x_prev, beta):
 
 @njit
 def _nlgs_accelerated(contact_body, pack, count, mu, tolerance, max_iterations, v, r, status, stall_after, flip=False):
+    # _momentum_sweeps with v viewed flat here (tests, the solver lab). The engine's launcher passes a view
+    # numpy made instead: numba's reshape compiles a shape check, 0.35 s of a first run's CPU.
+    v_flat = v.reshape(v.size)
+    return _momentum_sweeps(
+        contact_body, pack, count, mu, tolerance, max_iterations, v, v_flat, r, status, stall_after, flip
+    )
+
+
+@njit
+def _momentum_sweeps(
+    contact_body, pack, count, mu, tolerance, max_iterations, v, v_flat, r, status, stall_after, flip=False
+):
     # _nlgs with Nesterov momentum and adaptive restart; its contact loop is _nlgs's written out again with
     # the extrapolated start (a shared visit function cost 47–57 ns per visit against 8.7 inline: faces.py).
     # x_k: the (r, v) a sweep leaves. The next sweep starts from the extrapolated
@@ -85,9 +97,8 @@ def _nlgs_accelerated(contact_body, pack, count, mu, tolerance, max_iterations, 
     residual = 0.0
     if count == 0:
         return iterations, residual
-    v_prev = v.copy()
-    v_flat = v.reshape(v.size)  # views: the extrapolation of the bodies is one flat loop (_extrapolate)
-    v_prev_flat = v_prev.reshape(v.size)
+    # v_flat: v viewed as (3B,), so that the extrapolation of the bodies is one flat loop (_extrapolate)
+    v_prev_flat = v_flat.copy()
     # The sweep keeps each contact's (r_t, r_n, r_prev,t, r_prev,n) in one row of rr: one array fewer to
     # address in the contact loop (1–2 % less time per contact·sweep), r copied back at the end.
     rr = np.empty((count, 4), np.float64)

@@ -308,11 +308,14 @@ def _nlgs_interleaved(
     (``accelerate``, stall window ``accelerated_stall``) or the plain ones; ``alternate`` as in
     stalled.py. Returns (iterations, residual). Two kernels rather than one with the flag as an argument:
     a run compiles only the sweep it uses (the plain one cost 1.5 s of the first run's compilation)."""
-    args = (contact_body, pack, count, mu, tolerance, max_iterations, v, r, status)
     if accelerate:
+        if not v.flags.c_contiguous:  # v.reshape would copy: the sweep's flat view of v must be v
+            raise ValueError("the body velocities v must be a C-contiguous array")
+        args = (contact_body, pack, count, mu, tolerance, max_iterations, v, v.reshape(-1), r, status)
         if alternate:
             return interleaved._accelerated(*args, accelerated_stall, True)
         return interleaved._accelerated(*args, accelerated_stall)  # flip omitted: compiled out
+    args = (contact_body, pack, count, mu, tolerance, max_iterations, v, r, status)
     if alternate:
         return interleaved._plain(*args, True)
     return interleaved._plain(*args)
