@@ -27,6 +27,7 @@ from masonrycli.cli_options import (
     WALL,
     WALL_LOADING,
     Friction,
+    choice_value,
     file_defaults,
     path_value,
     with_options,
@@ -220,10 +221,13 @@ def limit_command(
         ),
     ],
     load: Annotated[
-        str, typer.Option(help="horizontal (λ × weight), tilt (tilting table, tan ψ = λ) or point (on --block).")
+        str,
+        typer.Option(
+            parser=choice_value, help="horizontal (λ × weight), tilt (tilting table, tan ψ = λ) or point (on --block)."
+        ),
     ] = "horizontal",
     block: Annotated[str | None, typer.Option(help="Block carrying the point load (λ × its weight).")] = None,
-    direction: Annotated[str, typer.Option(help="+x or -x (a point load also +y or -y).")] = "+x",
+    direction: Annotated[str, typer.Option(parser=choice_value, help="+x or -x (a point load also +y or -y).")] = "+x",
     friction: Friction = None,
     as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object on stdout, nothing else.")] = False,
     verify: Annotated[

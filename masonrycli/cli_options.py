@@ -17,10 +17,16 @@ from typing import Annotated
 import typer
 
 
-def _opt(kind: type, panel: str, help: str, *decls: str):
+def _opt(kind: type, panel: str, help: str, *decls: str, parser=None):
     """An optional ``kind`` value (None when not given), listed under ``panel`` in --help."""
-    parser = {"parser": path_value} if kind is Path else {}
+    parser = {"parser": parser or path_value} if kind is Path or parser else {}
     return Annotated[kind | None, typer.Option(*decls, help=help, rich_help_panel=panel, **parser)]
+
+
+def choice_value(text: str) -> str:
+    """A choice option's value (--im, --outcome, --solver, --load, --direction) in lower case, the
+    spelling its help lists: "--im PGV" said "expected one of pga, pgv, arias, sa"."""
+    return str(text).strip().lower()
 
 
 def path_value(text: str) -> Path:
@@ -106,6 +112,7 @@ RUN = {
         "Run",
         "Contact solver: nlgs-accel (default; Gauss–Seidel with momentum, 2-4x fewer sweeps) or nlgs (plain "
         "Gauss–Seidel, the reference).",
+        parser=choice_value,
     ),
 }
 Friction = _opt(float, "Material", "Coulomb coefficient of every contact (default 0.6).")

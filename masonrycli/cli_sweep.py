@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING, Annotated
 
 import typer
 
-from masonrycli.cli_options import path_value
+from masonrycli.cli_options import choice_value, path_value
 from masonrycli.errors import EXIT_DIVERGED, EXIT_ROWS_FAILED
 from masonrycli.interrupt import FirstSignalStops, exit_code, signal_name
 from masonrycli.outputs import OutputFile
@@ -66,7 +66,9 @@ def sweep_command(
     outcome: Annotated[
         str | None,
         typer.Option(
-            "--outcome", help="What --find looks for: collapse, sliding, rocking or drift:X (default collapse)."
+            "--outcome",
+            parser=choice_value,
+            help="What --find looks for: collapse, sliding, rocking or drift:X (default collapse).",
         ),
     ] = None,
     rtol: Annotated[
@@ -98,7 +100,10 @@ def sweep_command(
     ] = None,
     dt: Annotated[float | None, typer.Option("--dt", help="Time step, s.")] = None,
     im: Annotated[
-        str, typer.Option("--im", help="Intensity measure of the fragility curve: pga, pgv, arias, sa.")
+        str,
+        typer.Option(
+            "--im", parser=choice_value, help="Intensity measure of the fragility curve: pga, pgv, arias, sa."
+        ),
     ] = "pga",
     plot: Annotated[
         Path | None,

@@ -461,3 +461,17 @@ def test_ctrl_c_while_masonry_starts_is_one_line_and_exit_130(monkeypatch, capsy
         main()
     assert exc.value.code == 130
     assert capsys.readouterr().err == "error: Ctrl-C while masonry was starting: nothing was run\n"
+
+
+def test_choice_options_take_any_case_and_help_lists_the_lower_case(tmp_path):
+    # "sweep --im PGV" said "--im PGV: expected one of pga, pgv, arias, sa"; "limit --load Tilt",
+    # "--direction -X", "--outcome Sliding" and "--solver NLGS" likewise
+    r = invoke("limit", "wall", "--load", "Tilt", "--direction", "-X", "--json")
+    assert r.exit_code == 0, r.output
+    r = invoke("simulate", "wall", "--solver", "NLGS", "--duration", "0.01", "--no-recording")
+    assert r.exit_code == 0, r.output
+    out = tmp_path / "s.csv"
+    sweep = ("sweep", "wall", "-p", "amp=0.1,0.2", "--find", "amp", "--outcome", "Sliding", "--im", "PGV")
+    r = invoke(*sweep, "--duration", "0.05", "--workers", "0", "--no-recording", "-o", out)
+    assert r.exit_code == 0, r.output
+    assert "pga, pgv, arias, sa" in invoke("sweep", "--help").output
