@@ -84,14 +84,22 @@ def worker(package_root: str, out: str, command: list[str]) -> None:
 
 def same_outputs(a: str, b: str) -> dict[str, bool]:
     """Whether the runs written at ``a`` and ``b`` (stems) recorded the same rows and history arrays."""
+    import json
+
     import numpy as np
 
     from masonrycli.recording.readback import recording_rows
 
     with np.load(f"{a}.npz") as x, np.load(f"{b}.npz") as y:
         history = sorted(x.files) == sorted(y.files) and all(
-            x[k].dtype == y[k].dtype and np.array_equal(x[k], y[k], equal_nan=x[k].dtype.kind == "f") for k in x.files
+            x[k].dtype == y[k].dtype and np.array_equal(x[k], y[k], equal_nan=x[k].dtype.kind == "f")
+            for k in x.files
+            if k != "run"
         )
+        if history and "run" in x.files:  # the parameters, without the clock and the code (two revisions)
+            clock = ("started", "commit", "source_digest")
+            run_a, run_b = (json.loads(str(h["run"])) for h in (x, y))
+            history = all(run_a.get(k) == run_b.get(k) for k in run_a.keys() | run_b.keys() if k not in clock)
     rows_a, rows_b = recording_rows(f"{a}.rrd"), recording_rows(f"{b}.rrd")
     differ = sorted(k for k in rows_a.keys() | rows_b.keys() if rows_a.get(k) != rows_b.get(k))
     return {"history": history, "recording": not differ, "differ": differ}

@@ -21,7 +21,7 @@ import numpy as np
 from rich.console import Console
 from rich.text import Text
 
-from masonrycli import __version__
+from masonrycli import SOURCE_DIGEST, __version__
 from masonrycli.errors import InputError
 from masonrycli.history import HistoryFile
 from masonrycli.interrupt import StopSignals
@@ -29,6 +29,7 @@ from masonrycli.outputs import OutputFile, check_distinct, check_output, check_s
 from masonrycli.report import progress_bar, slow_start_notice, summary_table
 from masonrycli.run import RunResult, Simulation, simulate
 from masonrycli.sinks import COMPLETED, FAILED
+from masonrycli.source_digest import source_commit
 
 HISTORY_BYTES_PER_BLOCK = 500
 """Upper estimate of one block's share of a history row (measured: 326 B for the walls, 420 B for an arch of
@@ -159,6 +160,8 @@ def run_metadata(scenario, sim: Simulation) -> dict:
         "density_kg_m3": mat.density,
         "thickness_m": mat.thickness,
         "masonry": __version__,
+        "commit": source_commit(),
+        "source_digest": SOURCE_DIGEST,
         "python": platform.python_version(),
         "numpy": np.__version__,
         "started": datetime.now().isoformat(timespec="seconds"),
@@ -236,7 +239,9 @@ def execute(
 def _open_sink(out: OutputFile, outputs: Outputs, scenario, sim: Simulation, magnify: float | None = None):
     """The history or the recorder writing ``out``'s temporary file."""
     if out is outputs.history:
-        return HistoryFile(out.part, sim.model.block_name, sim.model.support_name)
+        history = HistoryFile(out.part, sim.model.block_name, sim.model.support_name)
+        history.run_info = run_metadata(scenario, sim)
+        return history
     from masonrycli.recording import Recorder
 
     return Recorder(out.part, recording_static(sim), run_metadata(scenario, sim), magnify=magnify)

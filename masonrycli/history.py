@@ -16,10 +16,16 @@ Arrays (T frames, N blocks, S supports), block order = scenario order:
 
 :class:`HistoryFile` (the command line's sink) streams every row to disk as it comes, so memory stays
 flat however long the run; :class:`History` keeps the rows in memory for tests and scripts.
+
+A history file describes itself, for whoever opens it with plain numpy and no documentation: ``units``
+(K, 2) str, one row per array of the file — its name and its unit / meaning (:data:`UNITS`), so
+``dict(np.load(f)["units"])`` — and ``run`` () str, the JSON of the run's parameters (scenario, dt, solver,
+tolerance, the commit and source digest of the masonry that ran it; the recording's run document).
 """
 
 from __future__ import annotations
 
+import json
 import os
 import shutil
 import zipfile
@@ -28,7 +34,9 @@ from pathlib import Path
 import numpy as np
 
 from masonrycli.frame import Frame
+from masonrycli.mechanism import JOINT_FIELDS
 from masonrycli.sinks import COMPLETED
+from masonrycli.tensors import TENSOR_FIELDS
 
 _SCALARS = (
     "time",
@@ -43,6 +51,41 @@ _SCALARS = (
     "support_work",
 )
 _ARRAYS = ("block_q", "block_v", "support_q", "support_v", "support_force")
+UNITS: dict[str, str] = {
+    "time": "s, time of the frame",
+    "step": "step index (time / dt)",
+    "contact_count": "contacts of the step ending at the frame",
+    "nlgs_iterations": "NLGS sweeps of the step ending at the frame",
+    "nlgs_residual": "m/s, RMS contact-law violation of the last sweep (compared with the tolerance)",
+    "nlgs_unconverged": "steps since t = 0 that ended unconverged (residual > tolerance or at the cap)",
+    "energy_kinetic": "J",
+    "energy_potential": "J, -sum m g.x",
+    "energy_dissipated": "J, dissipated at contacts since t = 0",
+    "support_work": "J, work of the supports on the blocks since t = 0",
+    "block_q": "(T,N,3) centroid x, y (m); rotation from the initial orientation (rad, counter-clockwise)",
+    "block_v": "(T,N,3) vx, vy (m/s), angular velocity (rad/s)",
+    "support_q": "(T,S,3) support centroid x, y (m), rotation (rad)",
+    "support_v": "(T,S,2) imposed velocity vx, vy (m/s)",
+    "support_force": "(T,S,2) N per block thickness, total contact force of the blocks on the support",
+    **{name: f"{unit}, {text}" for name, (_, unit, text) in (TENSOR_FIELDS | JOINT_FIELDS).items()},
+    "joint_hinged": "(T,J) bool, joint hinged (one end carries all the normal force, the other is open)",
+    "hinge_count": "hinged joints at the frame",
+    "block_name": "(N,) block names, the order of every block axis",
+    "support_name": "(S,) support names",
+    "joint_body": "(J,2) the two bodies of each joint: index into block_name, or N + s for support s",
+    "status": "completed, interrupted, diverged or failed",
+    "note": "where and why the run stopped",
+    "intensity_pga": "m/s2, peak ground acceleration as applied",
+    "intensity_pgv": "m/s, peak ground velocity as applied",
+    "intensity_arias": "m/s, Arias intensity",
+    "intensity_d5_95": "s, significant duration D5-95",
+    "intensity_sa": "m/s2, spectral acceleration at 0.5 s, 5 % damping",
+    "units": "(K,2) this table: array name, unit / meaning",
+    "run": "JSON of the run's parameters (scenario, dt, solver, commit, ...)",
+}
+"""Unit and meaning of every history array (written into the file as ``units``); T frames, N blocks, S
+supports, J joints."""
+
 _ROW_BUFFER = 1 << 16  # bytes of write buffer per array file (37 files: 2.4 MB at most)
 
 
@@ -117,6 +160,8 @@ class HistoryFile:
         self.joint_body = np.zeros((0, 2), dtype=np.int64)
         self.run_values: dict[str, float] = {}
         """One value per run (e.g. ``intensity_pga``), written as 0-d arrays; set before :meth:`close`."""
+        self.run_info: dict = {}
+        """The run's parameters (:func:`masonrycli.execute.run_metadata`), written as ``run`` (JSON)."""
         self._files: dict[str, tuple] = {}  # name -> (open raw file, dtype, row shape)
         self._closed = False
 
@@ -151,6 +196,9 @@ class HistoryFile:
                 "status": np.asarray(status),
                 "note": np.asarray(note),
             } | {name: np.asarray(value) for name, value in self.run_values.items()}
+            constants["run"] = np.asarray(json.dumps(self.run_info, default=str, ensure_ascii=False))
+            names = [*self._files, *constants, "units"]
+            constants["units"] = np.array([[n, UNITS.get(n, "")] for n in names], dtype=str)
             with zipfile.ZipFile(self.path, "w", zipfile.ZIP_STORED, allowZip64=True) as zf:
                 for name, (_, dtype, shape) in self._files.items():
                     with zf.open(f"{name}.npy", "w", force_zip64=True) as member:

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import dataclasses
 import io
+import json
 import math
 import os
 import re
@@ -20,6 +21,7 @@ from rich.console import Console
 from shapely.geometry import box
 
 from geometry_library.blocks import Assembly, Block, Support
+from masonrycli import SOURCE_DIGEST
 from masonrycli import execute as execute_module
 from masonrycli.errors import InputError
 from masonrycli.execute import check_run, execute, plan_outputs, unconverged_warning
@@ -29,6 +31,7 @@ from masonrycli.outputs import OutputFile
 from masonrycli.recording import inspect_recording
 from masonrycli.run import Simulation
 from masonrycli.scenario import Material, RunConfig, Scenario
+from masonrycli.source_digest import source_commit
 
 from cli_helpers import invoke
 
@@ -72,6 +75,10 @@ def test_a_run_leaves_a_whole_history_and_recording_in_place(tmp_path):
     info = inspect_recording(tmp_path / "r.rrd")
     assert info["complete"] and info["frames"] == len(h["step"]) - 1  # the initial state: the history only
     assert "completed" in info["metadata"]
+    # both files name the code that made them (before: "masonry 0.1.0" only, the same for every commit)
+    run = json.loads(str(h["run"]))
+    assert run["scenario"] == "one-block" and run["dt_s"] == DT and run["source_digest"] == SOURCE_DIGEST
+    assert run["commit"] == source_commit() and run["commit"] in info["metadata"]
 
 
 def test_an_engine_error_closes_the_outputs_as_failed_and_is_raised(tmp_path, monkeypatch):

@@ -3,6 +3,7 @@ history, and both histories and the recorder honour the one sink contract."""
 
 from __future__ import annotations
 
+import json
 import tracemalloc
 
 import numpy as np
@@ -26,12 +27,29 @@ def test_history_file_matches_the_in_memory_history(tmp_path):
     result = simulate(sc, [memory, streamed])
     streamed.close(result.status, result.message)
     on_disk, expected = np.load(path), memory.arrays()
-    assert set(on_disk.files) == set(expected) | {"status", "note"}
+    assert set(on_disk.files) == set(expected) | {"status", "note", "units", "run"}
     for name, value in expected.items():
         nan_ok = value.dtype.kind == "f"
         assert on_disk[name].dtype == value.dtype and np.array_equal(on_disk[name], value, equal_nan=nan_ok), name
     assert str(on_disk["status"]) == "completed" and on_disk["time"].shape == (7,)
     assert not streamed.scratch.exists()
+
+
+def test_history_file_names_the_unit_of_every_array_it_holds(tmp_path):
+    # a user with the file and plain numpy: dict(h["units"]) has a non-empty row for every array, and "run"
+    # is the JSON of the parameters it was given (before: neither, the units only in the README)
+    sc = wall(0.002)
+    path = tmp_path / "h.npz"
+    streamed = HistoryFile(path, [b.name for b in sc.assembly.blocks], [s.name for s in sc.assembly.supports])
+    streamed.run_info = {"scenario": "wall", "dt_s": 0.001, "commit": "abc1234"}
+    streamed.run_values["intensity_pgv"] = 1.0
+    result = simulate(sc, [streamed])
+    streamed.close(result.status, result.message)
+    h = np.load(path)
+    units = dict(h["units"])
+    assert set(units) == set(h.files) and all(units.values())
+    assert units["time"].startswith("s") and units["cell_stress"].startswith("Pa") and "rad" in units["block_q"]
+    assert json.loads(str(h["run"])) == {"scenario": "wall", "dt_s": 0.001, "commit": "abc1234"}
 
 
 def test_history_file_memory_is_flat_in_the_frame_count(tmp_path):

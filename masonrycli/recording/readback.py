@@ -278,14 +278,15 @@ def field_frames(path: str | os.PathLike) -> dict[int, dict]:
     return out
 
 
-_RUN_CLOCK = re.compile(r"(\*\*Wall time:\*\* )[0-9.]+( s)|(\| started \| )[^|]*")
+_RUN_CLOCK = re.compile(r"(\*\*Wall time:\*\* )[0-9.]+( s)|(\| (?:started|commit|source_digest) \| )[^|]*")
+"""What differs between two runs of one command: the clock, and the code (two revisions compared)."""
 
 
 def recording_rows(path: str | os.PathLike) -> dict[str, list[str]]:
     """Every entity's rows, comparable between two runs of the same command: ``{entity: sorted rows}``, a row
     the ``repr`` of its time columns and component values (no row ids, so chunking does not matter); static
     entities as ``"static <entity>"`` with their last row only (the one in force), the run document's wall
-    time and start time masked, the recording's own start time (``/__properties``) left out."""
+    time, start time, commit and source digest masked, the recording's own start time (``/__properties``) left out."""
     temporal: dict[str, list[str]] = {}
     static: dict[str, list[str]] = {}
     for chunk in rr.chunk.RrdReader(os.fspath(path)).stream():

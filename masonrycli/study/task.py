@@ -52,6 +52,7 @@ def run_task(
     :mod:`masonrycli.outputs`: a temporary file renamed into place when complete, an existing file
     replaced only with ``force`` (the study checked them all before the first run).
     """
+    from masonrycli.execute import run_metadata
     from masonrycli.history import HistoryFile
     from masonrycli.outputs import OutputFile, written_whole
     from masonrycli.run import Simulation, simulate
@@ -68,6 +69,7 @@ def run_task(
                 out = OutputFile(Path(history_dir) / history_name(params), "--histories", force=force)
                 part = files.enter_context(written_whole(out))
                 sinks.append(HistoryFile(part, sim.model.block_name, sim.model.support_name))
+                sinks[0].run_info = run_metadata(scenario, sim) | {"study_point": params}
             result = simulate(scenario, sinks, sim=sim, stop_at_collapse=stop_at_collapse)
             if sinks:
                 sinks[0].run_values |= {f"intensity_{k}": v for k, v in result.intensity.items()}
