@@ -39,6 +39,8 @@ def test_at_80_columns_every_row_is_one_line_within_the_width():
     legend = " ".join(" ".join(lines[len(body) + 5 :]).split())
     assert "collapse: time of collapse, s" in legend and "drift: residual, % of height" in legend
     assert "not shown at this width: hinges, wall, peak, sweeps" in legend and "every column in ida.parquet" in legend
+    # the file's drifts are fractions of the height, its openings metres (before: only the terminal's % and mm named)
+    assert "in SI units (drifts × height, openings m)" in legend
     assert "failed: record=synthetic-record-2.AT2 scale=1.75: ValueError: a long reason" in legend
 
 
