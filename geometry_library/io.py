@@ -73,6 +73,11 @@ _ROLE_ONLY = re.compile(r"^\s*(?P<role>block|support)(?:\s+(?P<srole>fixed|drive
 """A role with no name (``support : POLYGON …``): _LABEL read its role word as the name of a block."""
 
 
+def _word(value):
+    """An enumerated word (a role) in lower case, as a WKT label's is read; anything else as given."""
+    return value.strip().lower() if isinstance(value, str) else value
+
+
 GEOJSON_PROPERTIES = ("role", "name", "density", "thickness", "velocity", "support_role")
 """The feature properties the reader uses."""
 BLOCK_PROPERTIES = ("density", "thickness", "velocity")
@@ -159,7 +164,7 @@ def read_geojson(path, density: float = 2500.0, thickness: float = 1.0, unknown:
         # null is not given (a GIS writes an empty attribute cell as null): a block was named "None" and a
         # null density refused ("must be a positive number, got None")
         props = {key: value for key, value in props.items() if value is not None}
-        role = props.get("role", "block")
+        role = _word(props.get("role", "block"))  # "Support" was "role must be 'block' or 'support'"
         if role not in ("block", "support"):
             raise GeometryError(f"{where}: role must be 'block' or 'support', got {role!r}")
         index = len(blocks) if role == "block" else len(supports)
@@ -206,7 +211,7 @@ def read_geojson(path, density: float = 2500.0, thickness: float = 1.0, unknown:
                 )
             )
         else:
-            srole = props.get("support_role", "fixed")
+            srole = _word(props.get("support_role", "fixed"))
             if srole not in SUPPORT_ROLES:
                 raise GeometryError(f"{where}: support_role must be one of {SUPPORT_ROLES}, got {srole!r}")
             supports.append(Support(polygon, name, srole))

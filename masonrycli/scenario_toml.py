@@ -324,6 +324,8 @@ def _parse_motion(table, ctx: InputContext, loc: str) -> Motion:
     if "kind" not in table:
         raise ctx.error(loc, f"motion.kind: missing (one of {', '.join(MOTION_KINDS)})")
     kind = table["kind"]
+    if isinstance(kind, str):  # kind = "Sine" was "unknown motion kind (expected one of …, sine, …)"
+        kind = kind.strip().lower()
     if not isinstance(kind, str) or kind not in MOTION_KINDS:
         raise ctx.error(
             loc,

@@ -354,3 +354,15 @@ def test_wkt_round_trip_keeps_blocks_named_like_a_support_role(tmp_path):
         (Support(box(-2, -1, 3, 0), "ground", "fixed"),),
     )
     same_assembly(read_wkt(write_wkt(a, tmp_path / "named.wkt")), a, materials=False)
+
+
+def test_geojson_roles_are_read_in_any_case(tmp_path):
+    # role = "Support" was "feature 2: role must be 'block' or 'support', got 'Support'"
+    ground = feature([[-2, -1], [3, -1], [3, 0], [-2, 0], [-2, -1]], role="Support", name="g", support_role="Driven")
+    a = read_geojson(write(tmp_path, [feature(SQ, name="a", role="BLOCK"), ground]))
+    assert [b.name for b in a.blocks] == ["a"] and [(s.name, s.role) for s in a.supports] == [("g", "driven")]
+
+
+def test_arch_support_roles_are_read_in_any_case():
+    arch = build_arch(voussoirs=10, pier_courses=2, right_role="Driven")
+    assert [s.role for s in arch.supports] == ["fixed", "driven"]

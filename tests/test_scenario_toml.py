@@ -243,3 +243,11 @@ def test_bad_record_row_names_scenario_csv_and_line(tmp_path):
     (tmp_path / "q.csv").write_text("t,v\n0,0\n0.1,x\n")
     text = BLOCK + GROUND.replace("polygon", 'motion = { kind = "record", file = "q.csv" }\npolygon')
     assert load_error(tmp_path, text) == '[[support]] #1 ("ground"): motion.file: q.csv:3: not a number: "x"'
+
+
+def test_motion_kind_is_read_in_any_case(tmp_path):
+    # kind = "Sine" was 'unknown motion kind (expected one of fixed, constant, sine, ramp, record)'
+    text = Path(DATA / "block_on_ground.toml").read_text().replace('kind = "sine"', 'kind = "Sine"')
+    path = tmp_path / "s.toml"
+    path.write_text(text)
+    assert load_scenario(path).motions[0].kind == "sine"

@@ -115,7 +115,8 @@ def arch_parts(spec: ArchSpec) -> tuple[list[Block], list[Support], ArchGeometry
     ring_thickness, pier_width, pier_course_height = spec.ring_thickness, spec.pier_width, spec.pier_course_height
     density, thickness = spec.density, spec.thickness
     foundation_margin, foundation_depth = spec.foundation_margin, spec.foundation_depth
-    left_role, right_role = spec.left_role, spec.right_role
+    # "Driven" as "driven", as a GeoJSON's support_role
+    left_role, right_role = (r.strip().lower() if isinstance(r, str) else r for r in (spec.left_role, spec.right_role))
     check_count("arch", 2, voussoirs=voussoirs)
     check_count("arch", 1, pier_courses=pier_courses)
     check_block_total("arch", voussoirs + 4 * pier_courses, f"{voussoirs} voussoirs and {pier_courses} pier courses")
