@@ -79,6 +79,8 @@ def test_a_run_leaves_a_whole_history_and_recording_in_place(tmp_path):
     run = json.loads(str(h["run"]))
     assert run["scenario"] == "one-block" and run["dt_s"] == DT and run["source_digest"] == SOURCE_DIGEST
     assert run["commit"] == source_commit() and run["commit"] in info["metadata"]
+    head = f"**solver:** nlgs-accel · **masonry** {run['masonry']}, commit {run['commit']}, source {SOURCE_DIGEST}"
+    assert head in info["metadata"].split("## Parameters")[0]
 
 
 def test_an_engine_error_closes_the_outputs_as_failed_and_is_raised(tmp_path, monkeypatch):

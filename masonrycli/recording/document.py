@@ -64,6 +64,10 @@ def run_document(
         f"**dt:** {dt:g} s · **friction:** {friction:g} · "
         f"**blocks:** {blocks} · **supports:** {supports}",
         "",
+        # what made it, on the first lines a user sees (before: the solver and the code only far down the table)
+        f"**solver:** {metadata.get('solver', '—')} · **masonry** {metadata.get('masonry', '—')}, "
+        f"commit {metadata.get('commit', '—')}, source {metadata.get('source_digest', '—')}",
+        "",
         "## Parameters",
         "",
         "| parameter | value |",

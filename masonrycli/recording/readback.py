@@ -280,6 +280,8 @@ def field_frames(path: str | os.PathLike) -> dict[int, dict]:
 
 _RUN_CLOCK = re.compile(r"(\*\*Wall time:\*\* )[0-9.]+( s)|(\| (?:started|commit|source_digest) \| )[^|]*")
 """What differs between two runs of one command: the clock, and the code (two revisions compared)."""
+_RUN_CODE = re.compile(r"(, commit )[^,]*(, source )[0-9a-z ]+")
+"""The code in the run document's heading (``**masonry** 0.1.0, commit f935f83, source 4583eaac5ced``)."""
 
 
 def recording_rows(path: str | os.PathLike) -> dict[str, list[str]]:
@@ -297,7 +299,7 @@ def recording_rows(path: str | os.PathLike) -> dict[str, list[str]]:
         columns = [(n, batch.column(n).to_pylist()) for n in names]
         rows = [repr([(n, values[i]) for n, values in columns]) for i in range(batch.num_rows)]
         if chunk.is_static:
-            static[f"static {chunk.entity_path}"] = [_RUN_CLOCK.sub(r"\1\2\3", rows[-1])]
+            static[f"static {chunk.entity_path}"] = [_RUN_CODE.sub(r"\1\2", _RUN_CLOCK.sub(r"\1\2\3", rows[-1]))]
         else:
             temporal.setdefault(chunk.entity_path, []).extend(rows)
     return {entity: sorted(rows) for entity, rows in temporal.items()} | static
