@@ -8,6 +8,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from masonrycli import SOURCE_DIGEST
 from masonrycli.cli import app
 from masonrycli.scenario_toml import dump_scenario
 
@@ -30,6 +31,7 @@ def test_json_is_one_object_with_the_load_factor_hinges_and_sliding_joints(colum
     assert data["hinges"] == ["b0|ground"] and data["sliding_joints"] == []
     assert data["solve_time_s"] > 0 and data["tilt_angle_deg"] > 0
     assert {"line_of_thrust", "mechanism", "collapse_load_N", "hinge_points"} <= set(data)
+    assert data["source_digest"] == SOURCE_DIGEST and data["commit"] and data["masonry"]  # what answered
 
 
 def test_table_names_lambda_and_mechanism(column_file, tmp_path):

@@ -18,11 +18,13 @@ from rich.console import Console
 from rich.table import Table
 from rich.text import Text
 
+from masonrycli import SOURCE_DIGEST, __version__
 from masonrycli.errors import InputError
 from masonrycli.interrupt import StopRun, StopSignals, exit_code, signal_name
 from masonrycli.limit.analysis import LimitResult, analyse
 from masonrycli.limit.problem import LimitError, LiveLoad
 from masonrycli.outputs import check_output, written_whole
+from masonrycli.source_digest import source_commit
 
 SHOWN = 8
 """Joint names listed in the terminal table (all of them are in --json)."""
@@ -193,7 +195,9 @@ def run_limit(
             raise typer.Exit(exit_code(stop.signum)) from None
     result, out = done.result, done.out
     if as_json:
-        summary = result.summary() | {"recording": str(out) if out else None}
+        # the code that answered, as a run's history and recording name it (before: no version, no commit)
+        made_by = {"masonry": __version__, "commit": source_commit(), "source_digest": SOURCE_DIGEST}
+        summary = result.summary() | {"recording": str(out) if out else None} | made_by
         if verify:
             summary["verify"] = [c.summary() for c in checks]
         print(json.dumps(summary, allow_nan=False))
