@@ -73,6 +73,10 @@ def source_commit() -> str:
         return done.stdout.strip()
 
     try:
+        # A wheel in a virtual environment inside some other repository (a user's project) would
+        # otherwise be named by that repository's commit: only a checkout whose top is masonry's counts.
+        if os.path.realpath(git("rev-parse", "--show-toplevel")) != os.path.realpath(root):
+            return "not a git checkout"
         commit = git("rev-parse", "--short=7", "HEAD")
         changed = git("status", "--porcelain", "--untracked-files=no", "--", "masonrycli", "geometry_library")
     except (OSError, subprocess.SubprocessError):  # no git, not a checkout, or git too slow
