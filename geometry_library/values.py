@@ -36,11 +36,22 @@ def _bound(b) -> str:
     return str(b) if is_integer(b) else f"{b:g}"
 
 
+def _unquoted(text: str) -> str:
+    """`` (write 2500, without quotes)`` for a string that reads as a number, else ""."""
+    try:
+        float(text)
+    except ValueError:
+        return ""
+    return f" (write {text.strip()}, without quotes)"
+
+
 def number_problem(value, *, integer=False, gt=None, ge=None, lt=None, le=None, allow_inf=False) -> str | None:
     """What is wrong with ``value`` as a (finite) number within the given bounds, or None.
 
     ``integer``: it must be an int. ``allow_inf``: +inf passes (before the bounds are checked).
     """
+    if isinstance(value, str):  # density = "2500" said "must be a number", which "2500" reads as
+        return f"must be {'an integer' if integer else 'a number'}, not a string{_unquoted(value)}"
     if integer and not is_integer(value):
         return "must be an integer"
     if not is_real(value):
@@ -62,8 +73,10 @@ def number_problem(value, *, integer=False, gt=None, ge=None, lt=None, le=None, 
 def check_positive(label: str, **values) -> None:
     """Raise a one-line GeometryError unless every value is a finite number > 0."""
     for key, value in values.items():
-        if number_problem(value, gt=0.0) is not None:
-            raise GeometryError(f"{label}: {key} must be a positive number, got {value!r}")
+        problem = number_problem(value, gt=0.0)
+        if problem is not None:
+            what = problem.removeprefix("must be ") if isinstance(value, str) else "a positive number"
+            raise GeometryError(f"{label}: {key} must be {what}, got {value!r}")
 
 
 MATERIAL_RANGE = {"density": (1e-3, 1e5, "kg/m³"), "thickness": (1e-6, 1e3, "m")}

@@ -17,7 +17,10 @@ from masonrycli.values import check_int, check_real
         (1.5, {}, None),
         (np.float32(2.0), {"gt": 0.0}, None),
         (True, {}, "must be a number"),
-        ("2", {}, "must be a number"),
+        ("2", {}, "must be a number, not a string (write 2, without quotes)"),  # was "must be a number"
+        (" 1e-3", {"gt": 0.0}, "must be a number, not a string (write 1e-3, without quotes)"),
+        ("abc", {}, "must be a number, not a string"),
+        ("10", {"integer": True}, "must be an integer, not a string (write 10, without quotes)"),
         (None, {}, "must be a number"),
         (math.nan, {}, "must be a finite number"),
         (math.inf, {}, "must be a finite number"),
@@ -49,6 +52,9 @@ def test_geometry_style_messages():
         check_positive("wall", a=0.1, b=-1.0)
     with pytest.raises(GeometryError, match=r"^block 3: density must be a positive number, got True$"):
         check_positive("block 3", density=True)
+    # a GeoJSON's "density": "2500" said "density must be a positive number, got '2500'"
+    with pytest.raises(GeometryError, match=r"^b 1: density must be a number, not a string \(write 2500, without"):
+        check_positive("b 1", density="2500")
     check_count("arch", 2, voussoirs=np.int64(2))
     with pytest.raises(GeometryError, match=r"^arch: voussoirs must be an integer ≥ 2, got 1$"):
         check_count("arch", 2, voussoirs=1)

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import pytest
-from scenario_helpers import BLOCK, BLOCK2, GROUND, XY_CSV, load_error, write
+from scenario_helpers import BLOCK, BLOCK2, DATA, GROUND, XY_CSV, load_error, write
 
 from geometry_library.blocks import GeometryError
 from masonrycli.errors import InputError
@@ -24,7 +24,7 @@ RUN_ERRORS = [
     ("duration = 1e6", "[run] duration = 1000000.0: must be <= 100000"),
     ("duration = inf", "[run] duration = inf: must be a finite number"),
     ("duration = nan", "[run] duration = nan: must be a finite number"),
-    ('duration = "1 s"', '[run] duration = "1 s": must be a number'),
+    ('duration = "1 s"', '[run] duration = "1 s": must be a number, not a string'),
     ("theta = 0.4", "[run] theta = 0.4: must be >= 0.5"),
     ("theta = 1.01", "[run] theta = 1.01: must be <= 1"),
     ("tolerance = 0.0", "[run] tolerance = 0.0: must be > 0"),
@@ -56,7 +56,7 @@ MATERIAL_ERRORS = [
     ("density = 0.0", "[material] density = 0.0: must be > 0"),
     ("density = -inf", "[material] density = -inf: must be a finite number"),
     ("thickness = -1", "[material] thickness = -1: must be > 0"),
-    ('thickness = "1m"', '[material] thickness = "1m": must be a number'),
+    ('thickness = "1m"', '[material] thickness = "1m": must be a number, not a string'),
     ("mu = 0.6", '[material] unknown key "mu" (expected one of: density, thickness, friction)'),
 ]
 
@@ -299,3 +299,10 @@ def test_unreadable_files(tmp_path):
         InputError, match=r"utf16\.toml: a UTF-16 text file \(it starts with UTF-16's byte-order mark\)"
     ):
         load_scenario(utf16)
+
+
+def test_a_number_given_as_a_string_says_so(tmp_path):
+    # density = "2500" said '[material] density = "2500": must be a number'
+    text = (DATA / "block_on_ground.toml").read_text().replace("density = 2000.0", 'density = "2500"')
+    message = load_error(tmp_path, text)
+    assert message.endswith('[material] density = "2500": must be a number, not a string (write 2500, without quotes)')
