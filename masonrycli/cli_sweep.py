@@ -88,7 +88,10 @@ def sweep_command(
     ] = None,
     workers: Annotated[
         int | None,
-        typer.Option("--workers", help="Worker processes of the local cluster (default: one per core; 0: no cluster)."),
+        typer.Option(
+            "--workers",
+            help="Worker processes of the local cluster (default: one per core; never more than the runs; 0: no cluster).",
+        ),
     ] = None,
     full_runs: Annotated[bool, typer.Option("--full-runs", help="Do not stop a run when it collapses.")] = False,
     duration: Annotated[

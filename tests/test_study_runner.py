@@ -249,3 +249,15 @@ def test_a_client_that_connects_in_time_is_returned_open(monkeypatch):
     monkeypatch.setattr(SlowClient, "delay", 0.05)
     client = runner._connect(SlowClient, "tcp://127.0.0.1:1")
     assert client is SlowClient.made[0] and not client.closed
+
+
+def test_local_cluster_has_no_more_workers_than_runs():
+    # "-p amp=0.1,0.2 --workers 4" started 4 worker processes (~200 MB each) for 2 runs
+    from masonrycli.study import runner
+
+    client, cluster = runner.open_cluster(None, 4, runs=2)
+    try:
+        assert len(client.scheduler_info()["workers"]) == 2
+    finally:
+        client.close()
+        cluster.close()

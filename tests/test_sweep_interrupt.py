@@ -22,7 +22,7 @@ def test_ctrl_c_while_the_scheduler_is_reached_says_nothing_was_written(block, t
     # run the same command again to resume", and there was no s.csv.
     from masonrycli.study import runner
 
-    def interrupted(scheduler, workers):
+    def interrupted(scheduler, workers, runs):
         raise KeyboardInterrupt
 
     monkeypatch.setattr(runner, "open_cluster", interrupted)

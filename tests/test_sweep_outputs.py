@@ -26,7 +26,7 @@ def test_a_scheduler_that_cannot_be_reached_leaves_no_file(block, tmp_path, monk
     # refusal is simulated here; the real one was checked by hand (tcp://127.0.0.1:18787: the same line).
     from masonrycli.study import runner
 
-    def unreachable(scheduler, workers):
+    def unreachable(scheduler, workers, runs):
         raise InputError(f"--scheduler {scheduler}: cannot connect (OSError: Timed out)")
 
     monkeypatch.setattr(runner, "open_cluster", unreachable)

@@ -53,9 +53,10 @@ def check_scheduler(address: str | None) -> str | None:
     return address.strip()
 
 
-def open_cluster(scheduler: str | None, workers: int | None):
+def open_cluster(scheduler: str | None, workers: int | None, runs: int | None = None):
     """``(client, cluster)``: a client of ``scheduler``, or of a new LocalCluster (then also returned,
-    to be closed by the caller) with ``workers`` processes (default: one per core)."""
+    to be closed by the caller) with ``workers`` processes (default: one per core), at most ``runs`` (the
+    runs that can go at once): "-p amp=0.1,0.2 --workers 4" started 4 processes of ~200 MB, 2 of them idle."""
     from distributed import Client, LocalCluster
 
     if scheduler:
@@ -69,6 +70,8 @@ def open_cluster(scheduler: str | None, workers: int | None):
             raise
         return client, None
     n = workers or os.cpu_count() or 1
+    if runs is not None:
+        n = max(1, min(n, runs))
     # ":0": the scheduler's HTTP endpoints (it serves them even without a dashboard) on a free port, so
     # two studies at once do not fight over 8787
     # Ctrl-C reaches the terminal's whole process group: a worker process that took it printed a

@@ -129,7 +129,9 @@ def run_study(base: StudyBase, request: StudyRequest, console: Console) -> Study
     start = time.perf_counter()
     # The cluster first: a --scheduler that cannot be reached is bad input, refused before any file is
     # written (it left a header-only table, which the corrected command then refused as existing).
-    client, cluster = open_cluster(request.scheduler, request.workers) if request.workers != 0 else (None, None)
+    # no more local workers than the runs that can go at once (the grid's, a search's initial values)
+    runs = len(driver.start())
+    client, cluster = open_cluster(request.scheduler, request.workers, runs) if request.workers != 0 else (None, None)
     try:
         if request.histories is not None:  # before the journal: a folder that cannot be made is bad input
             try:  # (it left a header-only table and "error: /proc/x: No such file or directory")
