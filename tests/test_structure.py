@@ -1,6 +1,6 @@
 """masonrycli.structure: builder options checked against the spec and the material's defaults, geometry
 files read with the material's defaults, validation warnings on one line and errors at their place.
-(The TOML spellings of the option errors are in test_scenario.py; these are the module's own rules.)"""
+(The TOML spellings of the option errors are in test_scenario_builders.py; these are the module's own rules.)"""
 
 from __future__ import annotations
 
