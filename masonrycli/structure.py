@@ -15,7 +15,7 @@ import os
 from pathlib import Path
 
 from geometry_library.blocks import Assembly, GeometryError
-from geometry_library.values import is_integer, is_real
+from geometry_library.values import number_problem
 from masonrycli.errors import NOT_A_FILE, InputContext, InputError, one_line
 from masonrycli.values import did_you_mean, field_error, quote_string
 
@@ -125,12 +125,11 @@ def _check_option_type(key: str, value, spec_field: dataclasses.Field):
     if value is None and (spec_field.default is None or "None" in ann):
         return value  # programmatic callers may pass None where the builder accepts it
     expected = _OPTION_TYPES[ann]
-    if expected == "number":
-        if not is_real(value):
-            raise field_error(key, value, "must be a number")
-        return float(value)
-    if expected == "int" and not is_integer(value):
-        raise field_error(key, value, "must be an integer")
+    if expected in ("number", "int"):  # the wording of every numeric setting ('not a string' for "1.2")
+        problem = number_problem(value, integer=expected == "int", allow_inf=True)
+        if problem is not None:
+            raise field_error(key, value, problem)
+        return float(value) if expected == "number" else value
     if expected == "bool" and not isinstance(value, bool):
         raise field_error(key, value, "must be true or false")
     if expected == "str" and not isinstance(value, str):

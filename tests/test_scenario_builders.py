@@ -94,7 +94,7 @@ BUILDER_ERRORS = [
     ("bayz = 3", '[structure] unknown option "bayz" of builder "fake" (did you mean "bays"?)'),
     ("bays = 2.5", "[structure] bays = 2.5: must be an integer"),
     ("bays = true", "[structure] bays = true: must be an integer"),
-    ('height = "tall"', '[structure] height = "tall": must be a number'),
+    ('height = "tall"', '[structure] height = "tall": must be a number, not a string'),
     ("height = nan", "[structure] height = nan: must be a finite number"),
     ("label = 3", "[structure] label = 3: must be a string"),
     ("bays = 0", '[structure] builder "fake": bays = 0: must be >= 1'),
