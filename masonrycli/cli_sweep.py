@@ -60,7 +60,12 @@ def sweep_command(
         str | None, typer.Option("--scale", help="Record scale axis, e.g. 0.25:2:8 (= --param scale=...).")
     ] = None,
     find: Annotated[
-        str | None, typer.Option("--find", help="Bisect this parameter for the smallest value giving --outcome.")
+        str | None,
+        typer.Option(
+            "--find",
+            help="Bisect this parameter for the smallest value giving --outcome (the largest, when it comes below "
+            "a value: at LO, not at HI).",
+        ),
     ] = None,
     # None when not given: without --find they were ignored without a word (a grid ran instead)
     outcome: Annotated[

@@ -18,7 +18,7 @@ from matplotlib.colors import to_rgb
 from masonrycli.colormap import unpack_rgba
 from masonrycli.recording.study import record_study
 from masonrycli.study import plots
-from masonrycli.study.curves import NOT_FOUND_COLOUR, STATE_COLOURS, rgb
+from masonrycli.study.curves import NOT_FOUND_COLOUR, STATE_COLOURS, rgb, threshold_series
 from masonrycli.study.fragility import fit_lognormal
 
 # 12 runs of 3 records at 4 scales: collapses from pga 5.5 m/s² up but one (7.2) and one below (3.0),
@@ -118,6 +118,24 @@ def test_points_without_a_threshold_are_marked_at_the_searched_range_ends(png_fi
     assert png[above["label"]] == png[below["label"]] == above["rgb"] == rgb(NOT_FOUND_COLOUR)
     assert above["label"] == "none found: no collapse up to amp = 1.5"
     assert png["amp_threshold (m/s)"] == series["/study/thresholds/line"]["rgb"]
+
+
+def test_a_threshold_the_outcome_holds_below_says_so_in_the_legend():
+    """``--find friction --outcome sliding``: the block slides below the curve, not above it as for an
+    amplitude; the line's label says which (rows of an upward search keep their label)."""
+    rows = [
+        {"amp": a, "friction_threshold": t, "friction_hi": t, "holds": "below", "outcome": "sliding"}
+        | {"status": "completed"}
+        for a, t in ((0.3, 0.384), (0.6, 0.769))
+    ]
+    line = threshold_series(rows, "friction", np.array([0.3, 0.6]), (0.1, 1.0))[0]
+    assert line.label == "friction_threshold: sliding below it" and list(line.y) == [0.384, 0.769]
+    mixed = [rows[0], rows[1] | {"holds": "above"}]
+    assert threshold_series(mixed, "friction", np.array([0.3, 0.6]), (0.1, 1.0))[0].label == (
+        "friction_threshold: sliding above it, below where holds = below"
+    )
+    upward = [r | {"holds": "above"} for r in rows]
+    assert threshold_series(upward, "friction", np.array([0.3, 0.6]), (0.1, 1.0))[0].label == "friction_threshold"
 
 
 @pytest.mark.parametrize("which", ["state_map", "fragility_curve", "threshold_curve"])

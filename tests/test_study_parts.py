@@ -96,19 +96,56 @@ def test_a_point_the_builder_refuses_names_the_point_and_the_builder_once(arch_b
     assert str(info.value).startswith('--param pier_width=0.2: builder "arch": ring_thickness 0.35 m is wider')
 
 
-def test_find_driver_says_when_the_outcome_comes_below_a_value():
-    # "--find friction --outcome sliding": a block slides below a friction; the row said only "sliding already
-    # at friction = 0.1", the threshold empty, as if it slid at every friction
-    driver = FindDriver([Axis("friction", (0.1, 0.7, 2.0))], "friction", "sliding", 0.005, done={})
+def _search(driver: FindDriver, outcome_at) -> list[dict]:
+    """Run ``driver`` to the end, the fake run at each point producing the outcome where ``outcome_at``."""
     queue = driver.start()
     while queue:
         p = queue.pop()
-        queue += driver.feed(p, _row(-p["friction"], -1.28))  # slides while friction < 1.28
-    (row,) = driver.rows()
-    assert math.isnan(row["friction_threshold"]) and row["note"] == (
-        "sliding already at friction = 0.1, not at friction = 2: it comes below a value here; --find looks for "
-        "the smallest value that brings it (a grid shows where it stops)"
+        queue += driver.feed(p, _row(1.0 if outcome_at(p) else -1.0, 0.0))
+    return driver.rows()
+
+
+def test_find_driver_bisects_an_outcome_that_comes_below_a_value():
+    # "--find friction --outcome sliding": a block slides below a friction. The row said "sliding already at
+    # friction = 0.1, not at friction = 2: it comes below a value here", with no threshold; now the mirrored
+    # bracket: the largest friction that slides, the smallest that does not
+    driver = FindDriver([Axis("friction", (0.1, 0.7, 2.0))], "friction", "sliding", 0.005, done={})
+    (row,) = _search(driver, lambda p: p["friction"] < 1.28)
+    assert row["holds"] == "below" and row["note"] == "" and row["status"] == "completed"
+    assert row["friction_lo"] < 1.28 <= row["friction_hi"]
+    assert row["friction_hi"] - row["friction_lo"] <= 0.005 * row["friction_hi"]
+    assert abs(row["friction_threshold"] - 1.28) <= 0.0025 * 1.28
+    # 3 values, then the bracket 0.7..2 halved until narrower than 0.5 % of its top
+    assert row["evaluations"] == 3 + math.ceil(math.log2((2.0 - 0.7) / (0.005 * 1.28)))
+
+
+def test_find_driver_notes_an_outcome_at_both_ends_or_neither():
+    axis = [Axis("friction", (0.1, 0.7, 2.0))]
+    (row,) = _search(FindDriver(axis, "friction", "sliding", 0.005, done={}), lambda p: True)
+    assert math.isnan(row["friction_threshold"]) and row["holds"] == ""
+    assert row["note"] == "sliding already at friction = 0.1" and row["friction_hi"] == 0.1  # the curve's mark
+    (row,) = _search(FindDriver(axis, "friction", "sliding", 0.005, done={}), lambda p: False)
+    assert math.isnan(row["friction_threshold"]) and row["holds"] == "" and math.isnan(row["friction_hi"])
+    assert row["note"] == "no sliding up to friction = 2"
+    # at both ends, not between: neither direction fits; the note says so and a grid shows the rest
+    (row,) = _search(FindDriver(axis, "friction", "sliding", 0.005, done={}), lambda p: p["friction"] != 0.7)
+    assert math.isnan(row["friction_threshold"]) and row["holds"] == "" and row["note"] == (
+        "sliding already at friction = 0.1, not at friction = 0.7, again at friction = 2: it comes and goes over "
+        "the range (a grid shows where it holds)"
     )
+
+
+def test_find_driver_searches_again_a_row_that_said_the_outcome_comes_below():
+    # a table written before the downward search: its row had no threshold and that note; resumed, it is run
+    # again (and an upward row of then is kept, marked as found upwards)
+    axes = [Axis("friction", (0.1, 0.7, 2.0)), Axis("amp", (0.2, 0.4))]
+    old_below = {"amp": 0.2, "friction_threshold": math.nan, "note": "sliding already at friction = 0.1, not at "
+                 "friction = 2: it comes below a value here; --find looks for the smallest value that brings it"}
+    old_above = {"amp": 0.4, "friction_threshold": 0.9, "note": ""}
+    done = {store.row_key(r, ["amp"]): r for r in (old_below, old_above)}
+    driver = FindDriver(axes, "friction", "sliding", 0.005, done=done)
+    assert {p["amp"] for p in driver.start()} == {0.2} and driver.skipped == 1
+    assert [r["holds"] for r in driver.rows()] == ["above"]
 
 
 def test_find_driver_bisects_to_rtol_and_reports_the_ends():
@@ -129,6 +166,7 @@ def test_find_driver_bisects_to_rtol_and_reports_the_ends():
     assert math.isnan(rows[2.0]["amp_threshold"]) and "collapse already at amp = 0.1" in rows[2.0]["note"]
     assert math.isnan(rows[3.0]["amp_threshold"]) and "no collapse up to amp = 1" in rows[3.0]["note"]
     assert runs == 12 + 7 and len(driver.finished) == 3
+    assert r["holds"] == "above" and rows[2.0]["holds"] == rows[3.0]["holds"] == ""
     assert "not at" not in rows[2.0]["note"]  # it collapses at every amplitude tried
     # resume: a finished point is not searched again
     again = FindDriver(axes, "amp", "collapse", 0.005, done={store.row_key(rows[1.0], ["freq"]): rows[1.0]})

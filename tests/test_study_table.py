@@ -69,13 +69,14 @@ def test_a_wide_console_shows_every_column_and_the_units():
 
 def test_threshold_rows_fit_80_columns():
     rows = [
-        {"freq": f, "amp_threshold": 1.3125, "evaluations": 9, "note": "", "status": "completed", "error": ""}
+        {"freq": f, "amp_threshold": 1.3125, "holds": "above", "evaluations": 9, "note": "", "status": "completed"}
+        | {"error": ""}
         for f in (1.0, 2.0)
     ]
-    rows[1] |= {"amp_threshold": math.nan, "note": "no collapse up to amp = 1.5 " * 3}
+    rows[1] |= {"amp_threshold": math.nan, "holds": "", "note": "no collapse up to amp = 1.5 " * 3}
     lines = _render(rows, find_columns(["freq"], "amp"), ["freq"], 80)
     assert max(len(line) for line in lines) <= 80
-    assert any("│ 1    │ 1.312         │ 9    │" in line for line in lines)
+    assert any("│ 1    │ 1.312         │ above │ 9    │" in line for line in lines)
     assert "amp_threshold m/s" in " ".join(lines)
 
 

@@ -1,12 +1,14 @@
-"""``masonry sweep --find amp`` against closed-form thresholds of a block on a sine-shaken ground.
+"""``masonry sweep --find`` against closed-form thresholds of a block on a sine-shaken ground.
 
 Ground velocity A·sin(2πft), so the ground acceleration peaks at 2πfA (at t = 0 and t = 1/(2f) = 0.25 s,
 inside the 0.3 s run). A block of width B and height
-H with friction μ slides once 2πfA > μg (if μ < B/H) and rocks once 2πfA > g·B/H (if B/H < μ).
+H with friction μ slides once 2πfA > μg (if μ < B/H) and rocks once 2πfA > g·B/H (if B/H < μ): upwards in
+A, and downwards in μ — it slides iff μ < 2πfA/g.
 """
 
 from __future__ import annotations
 
+import csv
 import math
 from pathlib import Path
 
@@ -31,13 +33,13 @@ polygon = [[{x0}, 0.0], [{x1}, 0.0], [{x1}, {h}], [{x0}, {h}]]
 [[support]]
 name = "ground"
 polygon = [[-5.0, -0.5], [5.0, -0.5], [5.0, 0.0], [-5.0, 0.0]]
-motion = {{ kind = "sine", amplitude = 0.1, frequency = {f} }}
+motion = {{ kind = "sine", amplitude = {a}, frequency = {f} }}
 """
 
 
-def block_file(tmp_path: Path, width: float, height: float, mu: float) -> Path:
+def block_file(tmp_path: Path, width: float, height: float, mu: float, amp: float = 0.1) -> Path:
     path = tmp_path / "block.toml"
-    path.write_text(SCENARIO.format(g=G, mu=mu, x0=-width / 2, x1=width / 2, h=height, f=F))
+    path.write_text(SCENARIO.format(g=G, mu=mu, x0=-width / 2, x1=width / 2, h=height, f=F, a=amp))
     return path
 
 
@@ -63,3 +65,29 @@ def test_find_reproduces_the_closed_form_threshold(tmp_path, width, height, mu, 
     assert (rows[0]["amp_hi"] - rows[0]["amp_lo"]) <= 0.005 * rows[0]["amp_hi"]
     assert "amp_threshold" in result.output and (tmp_path / "find.png").stat().st_size > 0
     assert (tmp_path / "find.rrd").stat().st_size > 0  # the study recording, beside --out by default
+
+
+def test_find_friction_finds_the_friction_below_which_the_block_slides(tmp_path):
+    """``--find friction --outcome sliding``: the block slides at low friction, not at high; the search
+    finds μ* = 2πfA/g (the peak ground acceleration over g) from below and says the outcome holds below it.
+    B/H = 2 > μ over the whole range, so it slides rather than rocks. Before, the row said "sliding already
+    at friction = 0.1, not at friction = 1: it comes below a value here", with no threshold."""
+    amp = 0.3
+    closed_form = 2 * math.pi * F * amp / G  # 0.3843
+    out = tmp_path / "find.csv"
+    args = [str(block_file(tmp_path, 0.8, 0.4, 0.6, amp)), "--param", "friction=0.1:1.0:3", "--find", "friction"]
+    args += ["--outcome", "sliding", "--workers", "0", "--out", str(out), "--no-recording"]
+    result = runner.invoke(app, ["sweep", *args], terminal_width=200)
+    assert result.exit_code == 0, result.output
+    with open(out, newline="") as fh:
+        rows = list(csv.DictReader(fh))
+    assert len(rows) == 1 and rows[0]["status"] == "completed" and rows[0]["note"] == ""
+    row = {k: float(rows[0][k]) for k in ("friction_threshold", "friction_lo", "friction_hi")}
+    assert rows[0]["holds"] == "below"
+    assert row["friction_threshold"] == pytest.approx(closed_form, rel=0.01)
+    # nothing slides at or above the closed form; just below it the slip is too small to be seen
+    assert row["friction_lo"] <= closed_form and row["friction_hi"] > 0.995 * closed_form
+    assert (row["friction_hi"] - row["friction_lo"]) <= 0.005 * row["friction_hi"]
+    # the terminal says which side too: the holds column and its legend
+    line = next(line for line in result.output.splitlines() if f"{row['friction_threshold']:.4g}" in line)
+    assert "below" in line and "holds: the outcome above / below the threshold" in " ".join(result.output.split())

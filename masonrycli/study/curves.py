@@ -109,7 +109,8 @@ def threshold_series(rows: list[dict], find: str, at: np.ndarray, searched: tupl
     """``<find>_threshold`` at ``at`` (each row's position on the x axis) as a line with its points, and
     the points where the search found none, marked at the searched range's top (``searched`` = the
     lowest and highest value tried first) when the outcome was not reached up to it, at its bottom when
-    it was reached already there; a failed search (status error) is left out."""
+    it was reached already there; a failed search (status error) is left out. The line's label says when
+    the outcome holds below the threshold (``holds``)."""
     at = np.asarray(at, dtype=np.float64)
     y = np.array([_number(r.get(f"{find}_threshold")) for r in rows], dtype=np.float64)
     hi = np.array([_number(r.get(f"{find}_hi")) for r in rows], dtype=np.float64)
@@ -120,6 +121,11 @@ def threshold_series(rows: list[dict], find: str, at: np.ndarray, searched: tupl
     order = np.argsort(at[found], kind="stable")
     label = f"{with_unit(find).replace(find, find + '_threshold', 1)}"
     outcome = next((r.get("outcome") for r in rows if r.get("outcome")), "outcome")
+    sides = {r.get("holds") for r, f in zip(rows, found) if f}
+    if sides == {"below"}:  # --find friction --outcome sliding: the curve bounds the outcome from above
+        label += f": {outcome} below it"
+    elif "below" in sides:
+        label += f": {outcome} above it, below where holds = below"
     lo_v, hi_v = searched
     return [
         Series("line", label, THRESHOLD_COLOUR, "line", at[found][order], y[found][order]),

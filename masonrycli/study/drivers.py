@@ -5,11 +5,20 @@ points) and finally gives the study's rows (``rows``). The runner (:mod:`masonry
 the Dask side and knows nothing of grids or bisection; the drivers know nothing of Dask.
 
 Threshold search (``--find amp``): for every point of the other axes, the values of the ``amp`` axis
-(``amp=LO:HI:N``) are run first, all at once; the smallest value producing the outcome and the value
-below it bracket the threshold, which is then bisected until the bracket is narrower than ``rtol`` ×
-its upper end. The threshold reported is the middle of the final bracket (so it is within rtol / 2 of
-every value in the bracket). A point whose LO already produces the outcome, or whose HI does not, has
-no threshold in the range: NaN, and the note says which end.
+(``amp=LO:HI:N``) are run first, all at once; they bracket the threshold, which is then bisected until the
+bracket is narrower than ``rtol`` × its upper end. The threshold reported is the middle of the final bracket
+(so it is within rtol / 2 of every value in the bracket). Which way the outcome goes is read from the ends
+of the range:
+
+* not at LO (or at both ends or neither): it comes *above* a value (``--find amp --outcome collapse``). The
+  bracket is the smallest value producing the outcome and the value below it; ``holds = "above"``.
+* at LO and not at HI: it comes *below* a value (``--find friction --outcome sliding``: a block slides at
+  low friction). The same bracket mirrored: the largest value producing it and the value above it;
+  ``holds = "below"``.
+
+A point where no value produces the outcome, or LO already does and so does HI, has no threshold in the
+range: NaN, ``holds`` empty, and the note says which (``<find>_hi`` is LO when LO already produces it: the
+threshold curve marks the point there).
 """
 
 from __future__ import annotations
@@ -59,10 +68,13 @@ class _Search:
         self.wall_time = 0.0
         self.error = ""
         self.note = ""
+        self.holds = ""
+        """"above": the outcome holds at values above the threshold, "below": below it, "": none found."""
 
 
 class FindDriver:
-    """Bisect ``find`` for the smallest value producing ``outcome`` at every point of the other axes."""
+    """Bisect ``find`` for the threshold of ``outcome`` at every point of the other axes: the smallest value
+    producing it, or the largest when it comes below a value (module doc)."""
 
     def __init__(self, axes: list[Axis], find: str, outcome: str, rtol: float, done: dict):
         self.find, self.outcome, self.rtol = find, outcome, rtol
@@ -72,7 +84,7 @@ class FindDriver:
         self.names = [a.name for a in self.others]
         self.points = grid(self.others)
         self.searches = {row_key(p, self.names): _Search(self.values) for p in self.points}
-        self._rows = {k: done[k] for k in self.searches if k in done}
+        self._rows = {k: _resumed(done[k], find) for k in self.searches if k in done and not _stale(done[k])}
         self.skipped = len(self._rows)
         self.total = len(self.points)
         self.finished: list[dict] = []
@@ -97,25 +109,12 @@ class FindDriver:
         if search.error:
             return self._finish(key, point, search)
         if math.isnan(search.hi):  # the initial values are all in: bracket the threshold
-            yes = [v for v in search.values if search.results[v]]
-            if not yes:
-                search.note = f"no {self.outcome} up to {self.find} = {search.values[-1]:g}"
+            if not self._bracket(search):
                 return self._finish(key, point, search)
-            first = yes[0]
-            below = [v for v in search.values if v < first]
-            if not below:
-                search.note = f"{self.outcome} already at {self.find} = {first:g}"
-                no = [v for v in search.values if not search.results[v]]
-                if no:  # "--find friction --outcome sliding": it slides below a friction, not above one
-                    search.note += (
-                        f", not at {self.find} = {no[-1]:g}: it comes below a value here; --find looks for the "
-                        "smallest value that brings it (a grid shows where it stops)"
-                    )
-                return self._finish(key, point, search)
-            search.lo, search.hi = below[-1], first
         else:
             value = params[self.find]
-            if search.results[value]:
+            # the end of the bracket on the outcome's side moves: hi above (the outcome holds above), lo below
+            if search.results[value] == (search.holds == "above"):
                 search.hi = value
             else:
                 search.lo = value
@@ -123,12 +122,42 @@ class FindDriver:
             return self._finish(key, point, search)
         return [point | {self.find: 0.5 * (search.lo + search.hi)}]
 
+    def _bracket(self, search: _Search) -> bool:
+        """Bracket the threshold from the initial values (module doc); False, with a note, when the range
+        holds none."""
+        values, results, find = search.values, search.results, self.find
+        yes = [v for v in values if results[v]]
+        if not yes:
+            search.note = f"no {self.outcome} up to {find} = {values[-1]:g}"
+            return False
+        if results[values[0]] and not results[values[-1]]:  # it comes below a value: the mirrored bracket
+            last = yes[-1]
+            search.lo, search.hi = last, min(v for v in values if v > last)
+            search.holds = "below"
+            return True
+        first = yes[0]
+        below = [v for v in values if v < first]
+        if not below:  # at LO, and at HI too
+            search.hi = first  # the lowest value producing it (the threshold curve's mark), lo stays NaN
+            search.note = f"{self.outcome} already at {find} = {first:g}"
+            no = [v for v in values if not results[v]]
+            if no:
+                search.note += (
+                    f", not at {find} = {no[0]:g}, again at {find} = {values[-1]:g}: it comes and goes over the "
+                    "range (a grid shows where it holds)"
+                )
+            return False
+        search.lo, search.hi = below[-1], first
+        search.holds = "above"
+        return True
+
     def _finish(self, key, point: dict, search: _Search) -> list[dict]:
         threshold = 0.5 * (search.lo + search.hi)
         self._rows[key] = point | {
             f"{self.find}_threshold": threshold,
             f"{self.find}_lo": search.lo,
             f"{self.find}_hi": search.hi,
+            "holds": search.holds if math.isfinite(threshold) else "",
             "outcome": self.outcome,
             "evaluations": search.evaluations,
             "status": "error" if search.error else "completed",
@@ -141,3 +170,17 @@ class FindDriver:
 
     def rows(self) -> list[dict]:
         return [self._rows[k] for k in (row_key(p, self.names) for p in self.points) if k in self._rows]
+
+
+def _stale(row: dict) -> bool:
+    """A row of a search made before ``holds``: an outcome coming below a value was reported with no threshold
+    (its note said "it comes below a value here"); it is searched again."""
+    return "it comes below a value here" in str(row.get("note") or "")
+
+
+def _resumed(row: dict, find: str) -> dict:
+    """A finished row as resumed: one written before ``holds`` existed found its threshold upwards."""
+    if not row.get("holds"):
+        threshold = row.get(f"{find}_threshold")
+        row = row | {"holds": "above" if isinstance(threshold, (int, float)) and math.isfinite(threshold) else ""}
+    return row

@@ -119,7 +119,7 @@ def run_study(base: StudyBase, request: StudyRequest, console: Console) -> Study
     if request.find:
         driver = FindDriver(request.axes, request.find, request.outcome, request.rtol, done)
         columns = names + [f"{request.find}_{s}" for s in ("threshold", "lo", "hi")]
-        columns += ["outcome", "evaluations", "status", "wall_time", "note", "error", "study"]
+        columns += ["holds", "outcome", "evaluations", "status", "wall_time", "note", "error", "study"]
     else:
         driver = GridDriver(request.axes, done)
         columns = names + list(RESULT_COLUMNS) + ["study"]

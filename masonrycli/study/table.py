@@ -103,6 +103,8 @@ def find_columns(names: list[str], find: str) -> list[Column]:
             lambda r: _number(r.get(f"{find}_threshold"), ".4g"),
             unit and f"{find}_threshold {unit}",
         ),
+        # which side of the threshold the outcome is on: "below" for --find friction --outcome sliding
+        Column("holds", lambda r: str(r.get("holds") or ""), "holds: the outcome above / below the threshold"),
         Column("runs", lambda r: _count(r.get("evaluations")), "runs: evaluations", 1),
         Column("note", lambda r: str(r.get("note") or "")),
     ]
