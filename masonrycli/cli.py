@@ -326,9 +326,22 @@ def build_aqueduct_command(**opts) -> None:
 @app.command("inspect")
 @user_errors
 def inspect_command(
-    recording: Annotated[Path, typer.Argument(help="Recording (.rrd).", metavar="REC.rrd")],
+    recording: Annotated[
+        Path, typer.Argument(help="Recording (.rrd) or run history (.npz).", metavar="REC.rrd|H.npz")
+    ],
 ) -> None:
-    """Summarise a recording: scenario, frames, time span, entities."""
+    """Summarise a recording (scenario, frames, time span, entities) or a run history (the run's
+    parameters, status, frames, time span, and each array's shape, dtype and unit)."""
+    from masonrycli.history_inspect import inspect_history, is_history
+
+    if is_history(recording):
+        from masonrycli.report import history_tables
+
+        table, lines = history_tables(str(recording), inspect_history(recording))
+        console.print(table)
+        for line in lines:
+            console.print(line, soft_wrap=True)
+        return
     from masonrycli.recording import inspect_recording, recording_path_problem
     from masonrycli.report import recording_table
 

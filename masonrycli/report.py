@@ -162,3 +162,21 @@ def recording_table(recording: str, info: dict) -> Table:
             value = "\n".join(map(str, value))
         table.add_row(key, str(value))
     return table
+
+
+
+def history_tables(history: str, info: dict) -> tuple[Table, list[str]]:
+    """``masonry inspect H.npz``: a table of the run (:func:`masonrycli.history_inspect.run_rows`, as a
+    recording's rows), then one line per array (name, shape, dtype, unit / meaning) in aligned columns — a
+    line each, never wrapped into a box (a table of 49 arrays cut names and folded meanings over 3-5
+    lines at 80 columns), so ``masonry inspect H.npz | grep stress`` finds an array."""
+    from masonrycli.history_inspect import array_rows, run_rows
+
+    table = _two_columns(f"{history} — run history")
+    for label, value in run_rows(info):
+        table.add_row(label, value)
+    rows = [("array", "shape", "dtype", "unit / meaning (T frames, N blocks, S supports, J joints)")]
+    rows += array_rows(info)
+    widths = [max(len(row[i]) for row in rows) for i in range(3)]
+    lines = ["  ".join([*(cell.ljust(w) for cell, w in zip(row[:3], widths)), row[3]]) for row in rows]
+    return table, lines

@@ -284,13 +284,14 @@ OPTION_ROWS = [
         2,
         "bad.rrd: not a readable Rerun recording",
     ),
-    # another of masonry's files: rerun's raw 'expected FourCC header "RRF2", got "PK\u{3}\u{4}"' before
+    # a damaged history: rerun's raw 'expected FourCC header "RRF2", got "PK\u{3}\u{4}"' at first, then
+    # "a run history (.npz), not a recording" (inspect summarises histories since)
     (
-        "inspect-history",
+        "inspect-damaged-history",
         {"H.npz": b"PK\x03\x04" + bytes(60)},
         ("inspect", "H.npz"),
         2,
-        "H.npz: a run history (.npz), not a recording; inspect reads the .rrd recordings that --out writes",
+        "H.npz: not a readable history (.npz): BadZipFile: File is not a zip file",
     ),
     (
         "inspect-scenario",

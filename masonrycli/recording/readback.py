@@ -48,7 +48,6 @@ _FOLDER_NAMES = 3  # recordings named in the message about a folder; the rest ar
 
 _RRD_MAGIC = b"RRF"  # a recording's first bytes ("RRF2" now; the digit is the format version)
 _OTHER_FILES = {  # suffix: what masonry writes or reads under it, for a file that is not a recording
-    ".npz": "a run history (.npz)",
     ".toml": "a scenario file (TOML; run it with masonry run)",
     ".geojson": "a geometry file (GeoJSON; run it with masonry run)",
     ".json": "a geometry file (GeoJSON; run it with masonry run)",

@@ -1,0 +1,163 @@
+"""``masonry inspect H.npz`` (masonrycli/history_inspect.py): a run history summarised from the file alone —
+the run's parameters and status, frames and time span, one line per array with its shape, dtype and unit —
+for a real run's history, an interrupted one, a sweep's, one written before histories described themselves;
+a damaged file or an archive that is no history is one line and exit code 2. Before: every .npz was
+refused ("a run history (.npz), not a recording")."""
+
+from __future__ import annotations
+
+import json
+import re
+
+import numpy as np
+import pytest
+
+from cli_helpers import assert_one_line_error, invoke
+from masonrycli.builtin import builtin
+from masonrycli.execute import run_metadata
+from masonrycli.history import HistoryFile
+from masonrycli.history_inspect import NOT_RECORDED, inspect_history, is_history
+from masonrycli.run import Simulation, simulate
+
+
+@pytest.fixture(scope="module")
+def history(tmp_path_factory):
+    """The history of a real 20-step run of the wall (a frame every 10 steps: 3 frames)."""
+    path = tmp_path_factory.mktemp("inspect") / "h.npz"
+    result = invoke("simulate", "wall", "--duration", 0.02, "--history", path, "--no-recording")
+    assert result.exit_code == 0, result.output
+    return path
+
+
+def _array_lines(output: str) -> dict[str, str]:
+    """The array lines of inspect's output: name -> the rest of the line."""
+    lines = output.splitlines()
+    start = next(i for i, line in enumerate(lines) if line.startswith("array "))
+    return {line.split()[0]: line.split(None, 1)[1] for line in lines[start + 1 :] if line.strip()}
+
+
+def _rows(output: str) -> dict[str, str]:
+    """The boxed table's rows: label -> value (a wrapped value's lines joined)."""
+    rows: dict[str, str] = {}
+    last = None
+    for line in output.splitlines():
+        cells = re.match(r"│ (.*?)\s*│ (.*?)\s*│$", line)
+        if not cells:
+            continue
+        label, value = cells.groups()
+        if label:
+            rows[label] = value
+            last = label
+        else:
+            rows[last] += " " + value
+    return rows
+
+
+def test_a_run_history_is_summarised_from_its_own_arrays(history):
+    result = invoke("inspect", history)
+    assert result.exit_code == 0, result.output
+    with np.load(history) as npz:
+        arrays = {name: npz[name] for name in npz.files}
+    run, units = json.loads(str(arrays["run"])), dict(arrays["units"])
+    rows = _rows(result.output)
+    assert rows["scenario"] == "wall (builder:wall)"
+    assert rows["status"] == "completed"
+    assert rows["solver"] == "nlgs-accel"
+    assert rows["tolerance"].startswith("1e-05 m/s")
+    assert rows["dt"].startswith("0.001 s (duration 0.02 s")
+    assert f"commit {run['commit']}" in rows["masonry"] and f"source {run['source_digest']}" in rows["masonry"]
+    # frames, steps and time span as the file holds them: 3 frames at steps 0, 10, 20
+    assert rows["frames"] == "3" and rows["steps"] == "0 … 20" and rows["time_span"] == "0 … 0.02 s"
+    assert rows["bodies"] == f"51 blocks, 1 support, {arrays['joint_body'].shape[0]} joints"
+    lines = _array_lines(result.output)
+    assert set(lines) == set(arrays)  # one line per array, none cut or left out
+    for name, value in arrays.items():
+        shape, dtype = value.shape, "str" if value.dtype.kind == "U" else value.dtype.name
+        shape_text = "(" + ", ".join(map(str, shape)) + ("," if len(shape) == 1 else "") + ")"
+        assert lines[name].startswith(shape_text), (name, lines[name])
+        assert f" {dtype} " in lines[name] and lines[name].endswith(units[name]), (name, lines[name])
+    assert lines["intensity_pga"].startswith(f"() = {float(arrays['intensity_pga']):.4g} ")
+    assert units["block_q"].startswith("(T,N,3) centroid x, y (m)")
+
+
+def test_an_interrupted_history_says_where_it_stopped(tmp_path):
+    scenario = builtin("wall", duration=0.02)
+    sim = Simulation(scenario)
+    sink = HistoryFile(tmp_path / "i.npz", sim.model.block_name, sim.model.support_name)
+    sink.run_info = run_metadata(scenario, sim)
+    result = simulate(scenario, [sink], sim=sim, stop=lambda: True)  # a Ctrl-C after the first step
+    sink.close(result.status, result.message)
+    info = inspect_history(tmp_path / "i.npz")
+    assert (info["status"], info["frames"], info["steps"]) == ("interrupted", 2, (0, 1))
+    shown = invoke("inspect", tmp_path / "i.npz")
+    assert shown.exit_code == 0, shown.output
+    assert _rows(shown.output)["status"] == "interrupted: interrupted at t = 0.0010 s (step 1 of 20)"
+
+
+def test_a_sweep_history_names_its_study_point(history, tmp_path):
+    with np.load(history) as npz:
+        arrays = {name: npz[name] for name in npz.files}
+    run = json.loads(str(arrays["run"])) | {"study_point": {"amp": 0.5, "freq": 2.0}}  # as study/task.py adds it
+    np.savez(tmp_path / "amp=0.5_freq=2.npz", **(arrays | {"run": np.asarray(json.dumps(run))}))
+    shown = invoke("inspect", tmp_path / "amp=0.5_freq=2.npz")
+    assert shown.exit_code == 0, shown.output
+    assert _rows(shown.output)["study point"] == "amp = 0.5, freq = 2.0"
+
+
+def test_an_old_history_without_units_or_run_is_summarised(tmp_path):
+    """Written before histories carried units, run and status: what is missing is said, not guessed."""
+    old = tmp_path / "old.npz"
+    time = np.array([0.0, 0.01, 0.02])
+    np.savez(
+        old,
+        time=time,
+        step=np.array([0, 10, 20]),
+        block_q=np.zeros((3, 2, 3)),
+        block_name=np.array(["b0", "b1"]),
+        support_name=np.array(["ground"]),
+    )
+    shown = invoke("inspect", old)
+    assert shown.exit_code == 0, shown.output
+    rows = _rows(shown.output)
+    for label in ("scenario", "status", "solver", "tolerance", "dt", "masonry"):
+        assert rows[label] == NOT_RECORDED, (label, rows[label])
+    assert rows["frames"] == "3" and rows["time_span"] == "0 … 0.02 s" and rows["bodies"] == "2 blocks, 1 support"
+    assert rows["units"].startswith(NOT_RECORDED)
+    lines = _array_lines(shown.output)
+    assert set(lines) == {"time", "step", "block_q", "block_name", "support_name"}
+    assert lines["block_q"] == f"(3, 2, 3)  float64  {NOT_RECORDED}"
+    assert all(line.endswith(NOT_RECORDED) for line in lines.values())
+
+
+def test_damaged_files_and_other_archives_are_one_line(history, tmp_path):
+    zeros = tmp_path / "zeros.npz"
+    zeros.write_bytes(b"PK\x03\x04" + bytes(60))
+    assert_one_line_error(invoke("inspect", zeros), "zeros.npz: not a readable history (.npz): BadZipFile")
+    cut = tmp_path / "cut.npz"  # a copy stopped half way: no central directory
+    cut.write_bytes(history.read_bytes()[: history.stat().st_size // 2])
+    assert_one_line_error(invoke("inspect", cut), "cut.npz: not a readable history (.npz)")
+    text = tmp_path / "notes.npz"
+    text.write_text("time,x\n0,1\n")
+    assert_one_line_error(invoke("inspect", text), "notes.npz: not a readable history (.npz)")
+    other = tmp_path / "weights.npz"
+    np.savez(other, w=np.ones(3), b=np.zeros(2))
+    assert_one_line_error(
+        invoke("inspect", other),
+        "weights.npz: a NumPy archive (.npz) but not a run history (no time array; it holds w, b); "
+        "inspect reads recordings (.rrd) and histories (--history H.npz)",
+    )
+    pickled = tmp_path / "pickled.npz"
+    np.savez(pickled, time=np.zeros(2), run=np.array([{"a": 1}], dtype=object))
+    assert_one_line_error(invoke("inspect", pickled), "pickled.npz: not a readable history (.npz)")
+
+
+def test_a_history_under_another_name_is_still_a_history(history, tmp_path):
+    renamed = tmp_path / "h.data"
+    renamed.write_bytes(history.read_bytes())
+    assert is_history(renamed) and is_history(history)
+    assert not is_history(tmp_path / "missing.rrd") and not is_history(tmp_path)
+    assert_one_line_error(invoke("inspect", tmp_path / "missing.npz"), "missing.npz: no such history")
+    (tmp_path / "d.npz").mkdir()
+    assert_one_line_error(invoke("inspect", tmp_path / "d.npz"), "d.npz: a folder, not a history")
+    shown = invoke("inspect", renamed)
+    assert shown.exit_code == 0 and _rows(shown.output)["scenario"] == "wall (builder:wall)", shown.output
