@@ -9,12 +9,17 @@ words its message in its own style around it:
 - masonrycli (scenario files, options, motions): ``masonrycli.values.check_real`` / ``check_int`` raise
   ``InputError("<key> = <value>: <reason>")``.
 
+A number written as a string with its unit (``"1 s"``, ``"2500 kg/m3"``) is told the number to write and
+the unit the setting is read in (:data:`SETTING_UNITS`), or, for another unit (``"20 ms"``), to convert it:
+never converted here.
+
 A bool is not a number here (``True`` is an int to Python, never a density or a count to a user).
 """
 
 from __future__ import annotations
 
 import math
+import re
 
 import numpy as np
 
@@ -36,22 +41,106 @@ def _bound(b) -> str:
     return str(b) if is_integer(b) else f"{b:g}"
 
 
-def _unquoted(text: str) -> str:
-    """`` (write 2500, without quotes)`` for a string that reads as a number, else ""."""
+SETTING_UNITS: dict[str, str] = {
+    # [run]
+    "duration": "s",
+    "dt": "s",
+    "theta": "",
+    "tolerance": "m/s",
+    "max_iterations": "",
+    "record_every": "",
+    "alert_distance": "m",
+    # [material], [[block]], GeoJSON properties
+    "density": "kg/m³",
+    "thickness": "m",
+    "friction": "",
+    # motions
+    "amplitude": "m/s",
+    "frequency": "Hz",
+    "phase": "rad",
+    "until": "s",
+    "scale": "",
+    "time_step": "s",
+    # builder options ([structure], masonry build / simulate)
+    **dict.fromkeys(
+        (
+            "length",
+            "block_length",
+            "block_height",
+            "ground_margin",
+            "ground_depth",
+            "span",
+            "ring_thickness",
+            "pier_width",
+            "pier_course_height",
+            "foundation_margin",
+            "foundation_depth",
+            "min_thickness",
+        ),
+        "m",
+    ),
+    **dict.fromkeys(("blocks", "courses", "voussoirs", "pier_courses", "wall_courses", "min_fraction"), ""),
+}
+"""The unit each numeric setting is read in, as docs/scenario-format.md documents it ("": a plain number,
+a count or a ratio): what a value written with its unit ("1 s", "2500 kg/m3") is told to become."""
+
+_SPELLINGS = {  # a unit -> how users write it, compared after _spelled (lower case, no spaces, ² ³ ^ ** as digits)
+    "s": ("s", "sec", "secs", "second", "seconds"),
+    "m": ("m", "meter", "meters", "metre", "metres"),
+    "kg/m³": ("kg/m3", "kgm-3", "kg.m-3", "kg·m-3", "kg*m-3"),
+    "m/s": ("m/s", "ms-1", "m.s-1", "m·s-1", "m/sec"),
+    "Hz": ("hz", "hertz", "1/s", "s-1", "/s", "cps"),
+    "rad": ("rad", "radian", "radians"),
+}
+_NUMBER_AND_UNIT = re.compile(
+    r"\s*([+-]?(?:\d+(?:\.\d*)?|\.\d+)(?:[eE][+-]?\d+)?)\s*([A-Za-zµμ°][^\n]*?)\s*"
+)
+
+
+def _spelled(unit: str) -> str:
+    text = unit.lower().replace(" ", "").replace("**", "").replace("^", "")
+    return text.replace("²", "2").replace("³", "3")
+
+
+def same_unit(written: str, unit: str) -> bool:
+    """True when ``written`` ("kg/m^3", "Seconds") is a spelling of ``unit`` (a key of ``_SPELLINGS``)."""
+    return _spelled(written) in {_spelled(s) for s in (unit, *_SPELLINGS.get(unit, ()))}
+
+
+def _string_hint(text: str, unit: str | None) -> str:
+    """What to write instead of the string ``text``: `` (write 2500, without quotes)`` for a number in
+    quotes; for a number and a unit (``"1 s"``, ``"0.5m"``), the number alone and the unit the setting is
+    read in — or, when the unit written is another (``"20 ms"`` for a time in s), that it must be converted,
+    never converting it here (a guess at what "t" or "ms" meant would be silent); else ""."""
     try:
         float(text)
+        return f" (write {text.strip()}, without quotes)"
     except ValueError:
+        pass
+    found = _NUMBER_AND_UNIT.fullmatch(text)
+    if found is None:
         return ""
-    return f" (write {text.strip()}, without quotes)"
+    number, written = found.groups()
+    if unit is None:  # a setting of no known unit (a sample of an inline record): the number alone
+        return f' (write {number}, without "{written}", in SI units)'
+    if unit == "":
+        return f' (write {number}, without "{written}": this setting has no unit)'
+    if same_unit(written, unit):
+        return f" (write {number}, in {unit}, without the unit)"
+    return f" (it is read in {unit}: convert {text.strip()} to {unit} and write the number alone)"
 
 
-def number_problem(value, *, integer=False, gt=None, ge=None, lt=None, le=None, allow_inf=False) -> str | None:
+def number_problem(
+    value, *, integer=False, gt=None, ge=None, lt=None, le=None, allow_inf=False, unit: str | None = None
+) -> str | None:
     """What is wrong with ``value`` as a (finite) number within the given bounds, or None.
 
-    ``integer``: it must be an int. ``allow_inf``: +inf passes (before the bounds are checked).
+    ``integer``: it must be an int. ``allow_inf``: +inf passes (before the bounds are checked). ``unit``:
+    the unit the setting is read in (:data:`SETTING_UNITS`; "" for none), named when ``value`` is a string
+    of a number and a unit (``"1 s"``); None when not known.
     """
     if isinstance(value, str):  # density = "2500" said "must be a number", which "2500" reads as
-        return f"must be {'an integer' if integer else 'a number'}, not a string{_unquoted(value)}"
+        return f"must be {'an integer' if integer else 'a number'}, not a string{_string_hint(value, unit)}"
     if integer and not is_integer(value):
         return "must be an integer"
     if not is_real(value):
@@ -73,7 +162,7 @@ def number_problem(value, *, integer=False, gt=None, ge=None, lt=None, le=None, 
 def check_positive(label: str, **values) -> None:
     """Raise a one-line GeometryError unless every value is a finite number > 0."""
     for key, value in values.items():
-        problem = number_problem(value, gt=0.0)
+        problem = number_problem(value, gt=0.0, unit=SETTING_UNITS.get(key))
         if problem is not None:
             what = problem.removeprefix("must be ") if isinstance(value, str) else "a positive number"
             raise GeometryError(f"{label}: {key} must be {what}, got {value!r}")

@@ -247,7 +247,7 @@ a likely typo (10 for 10 ms stretched the record 1000-fold), below 1 µs no acce
 
 def time_step_problem(value) -> str | None:
     """What is wrong with ``value`` as the time step of a one-column record (s), or None."""
-    problem = number_problem(value, gt=0.0)
+    problem = number_problem(value, gt=0.0, unit="s")
     if problem is None and not MIN_TIME_STEP <= float(value) <= MAX_TIME_STEP:
         problem = (
             f"must be within {MIN_TIME_STEP:g}–{MAX_TIME_STEP:g} s, likely a typo (accelerographs sample every "

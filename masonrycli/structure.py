@@ -15,7 +15,7 @@ import os
 from pathlib import Path
 
 from geometry_library.blocks import Assembly, GeometryError
-from geometry_library.values import number_problem
+from geometry_library.values import SETTING_UNITS, number_problem
 from masonrycli.errors import NOT_A_FILE, InputContext, InputError, one_line
 from masonrycli.values import did_you_mean, field_error, quote_string
 
@@ -126,7 +126,7 @@ def _check_option_type(key: str, value, spec_field: dataclasses.Field):
         return value  # programmatic callers may pass None where the builder accepts it
     expected = _OPTION_TYPES[ann]
     if expected in ("number", "int"):  # the wording of every numeric setting ('not a string' for "1.2")
-        problem = number_problem(value, integer=expected == "int", allow_inf=True)
+        problem = number_problem(value, integer=expected == "int", allow_inf=True, unit=SETTING_UNITS.get(key))
         if problem is not None:
             raise field_error(key, value, problem)
         return float(value) if expected == "number" else value

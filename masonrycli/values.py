@@ -15,7 +15,7 @@ import re
 
 import numpy as np
 
-from geometry_library.values import is_real, number_problem
+from geometry_library.values import SETTING_UNITS, is_real, number_problem
 from masonrycli.errors import InputError
 
 
@@ -99,7 +99,7 @@ def field_error(key: str, value, reason: str) -> InputError:
 
 def check_real(key: str, value, *, gt=None, ge=None, le=None, lt=None, allow_inf: bool = False) -> float:
     """Return ``value`` as a float or raise ``InputError`` naming ``key``."""
-    problem = number_problem(value, gt=gt, ge=ge, lt=lt, le=le, allow_inf=allow_inf)
+    problem = number_problem(value, gt=gt, ge=ge, lt=lt, le=le, allow_inf=allow_inf, unit=SETTING_UNITS.get(key))
     if problem is not None:
         raise field_error(key, value, problem)
     return float(value)
@@ -107,7 +107,7 @@ def check_real(key: str, value, *, gt=None, ge=None, le=None, lt=None, allow_inf
 
 def check_int(key: str, value, *, ge: int, le: int) -> int:
     """Return ``value`` as an int or raise ``InputError`` naming ``key``."""
-    problem = number_problem(value, integer=True, ge=ge, le=le)
+    problem = number_problem(value, integer=True, ge=ge, le=le, unit=SETTING_UNITS.get(key))
     if problem is not None:
         raise field_error(key, value, problem)
     return int(value)

@@ -99,6 +99,31 @@ def test_scenario_format_tables_list_every_key_the_reader_takes():
     assert _table_keys(text, "## `[[support]]`") == set(SUPPORT_KEYS)
 
 
+def test_setting_units_are_the_documented_ones():
+    """The unit a "1 s"-style message names (geometry_library.values.SETTING_UNITS) is the one the scenario
+    format's tables give the key: each table row of a key with a unit names that unit, and a row of a key
+    without one names none of the units."""
+    from geometry_library.values import SETTING_UNITS
+
+    text = (ROOT / "docs" / "scenario-format.md").read_text()
+    rows = {}
+    for heading in ("## `[run]`", "## `[material]`", "## `[[block]]`"):
+        section = text[text.index(heading) :].split("\n#", 1)[0]
+        rows |= dict(re.findall(r"^\| `([a-z_]+)` \|([^\n]*)", section, flags=re.M))
+    checked = 0
+    for key, unit in SETTING_UNITS.items():
+        if key not in rows:
+            continue
+        cells = rows[key].replace("m/s²", "")  # gravity's, on no number row
+        checked += 1
+        if unit:
+            assert re.search(rf"(?<![\w/]){re.escape(unit)}(?![\w/²³])", cells), (key, unit, rows[key])
+        else:
+            for other in ("kg/m³", "m/s", "Hz", "rad"):
+                assert other not in cells, (key, other, rows[key])
+    assert checked == 10  # duration dt theta tolerance max_iterations record_every alert_distance density thickness friction
+
+
 def test_scenario_format_counts_bodies_as_the_messages_do():
     # The page said geometry messages "count bodies from 0, as the model does" after they were numbered
     # from 1 (1b09016), next to its own example "blocks 4 ("b4") and 5 ("b5") overlap".

@@ -6,7 +6,15 @@ import numpy as np
 import pytest
 
 from geometry_library.blocks import GeometryError
-from geometry_library.values import check_count, check_positive, is_integer, is_real, number_problem
+from geometry_library.values import (
+    SETTING_UNITS,
+    check_count,
+    check_positive,
+    is_integer,
+    is_real,
+    number_problem,
+    same_unit,
+)
 from masonrycli.errors import InputError
 from masonrycli.values import check_int, check_real
 
@@ -41,6 +49,51 @@ def test_number_problem(value, kwargs, reason):
     assert number_problem(value, **kwargs) == reason
 
 
+@pytest.mark.parametrize(
+    "value, unit, reason",
+    [
+        # "1 s" said "must be a number, not a string": which number, in which unit, was left to guess
+        ("1 s", "s", "must be a number, not a string (write 1, in s, without the unit)"),
+        ("0.5m", "m", "must be a number, not a string (write 0.5, in m, without the unit)"),
+        ("2 Hz", "Hz", "must be a number, not a string (write 2, in Hz, without the unit)"),
+        ("2500 kg/m3", "kg/m³", "must be a number, not a string (write 2500, in kg/m³, without the unit)"),
+        ("2500 kg/m^3", "kg/m³", "must be a number, not a string (write 2500, in kg/m³, without the unit)"),
+        ("2500 kg/m³", "kg/m³", "must be a number, not a string (write 2500, in kg/m³, without the unit)"),
+        (" 1e-3 Seconds ", "s", "must be a number, not a string (write 1e-3, in s, without the unit)"),
+        ("1 m/s", "m/s", "must be a number, not a string (write 1, in m/s, without the unit)"),
+        # another unit than the setting's: said, never converted here
+        ("20 ms", "s", "must be a number, not a string (it is read in s: convert 20 ms to s and write the number alone)"),
+        (
+            "2.5 t/m3",
+            "kg/m³",
+            "must be a number, not a string (it is read in kg/m³: convert 2.5 t/m3 to kg/m³ and write the number alone)",
+        ),
+        ("90°", "rad", "must be a number, not a string (it is read in rad: convert 90° to rad and write the number alone)"),
+        ("1 m/s", "m", "must be a number, not a string (it is read in m: convert 1 m/s to m and write the number alone)"),
+        ("0.6 mu", "", 'must be a number, not a string (write 0.6, without "mu": this setting has no unit)'),
+        ("0.5 m/s", None, 'must be a number, not a string (write 0.5, without "m/s", in SI units)'),
+        ("1,5 m", "m", "must be a number, not a string"),  # a decimal comma: no number to name
+        ("one s", "s", "must be a number, not a string"),
+        ("2500", "kg/m³", "must be a number, not a string (write 2500, without quotes)"),
+    ],
+)
+def test_a_number_written_with_its_unit_is_told_what_to_write(value, unit, reason):
+    assert number_problem(value, gt=0.0, unit=unit) == reason
+
+
+def test_an_integer_written_with_a_unit():
+    assert number_problem("51 blocks", integer=True, unit="") == (
+        'must be an integer, not a string (write 51, without "blocks": this setting has no unit)'
+    )
+
+
+def test_every_setting_unit_has_its_spellings():
+    assert set(SETTING_UNITS.values()) - {""} <= {"s", "m", "kg/m³", "m/s", "Hz", "rad"}
+    for unit in set(SETTING_UNITS.values()) - {""}:
+        assert same_unit(unit, unit) and not same_unit("furlong", unit)
+    assert same_unit("KG/M**3", "kg/m³") and same_unit("m s-1", "m/s") and not same_unit("ms", "s")
+
+
 def test_is_real_and_is_integer_reject_bools():
     assert is_real(3) and is_real(np.float64(0.1)) and not is_real(False) and not is_real(np.bool_(False))
     assert is_integer(np.int32(4)) and not is_integer(4.0) and not is_integer(True)
@@ -55,6 +108,9 @@ def test_geometry_style_messages():
     # a GeoJSON's "density": "2500" said "density must be a positive number, got '2500'"
     with pytest.raises(GeometryError, match=r"^b 1: density must be a number, not a string \(write 2500, without"):
         check_positive("b 1", density="2500")
+    # a GeoJSON's "density": "2500 kg/m3" (the unit of the property named too)
+    with pytest.raises(GeometryError, match=r"^b 1: density must be a number, not a string \(write 2500, in kg/m³, "):
+        check_positive("b 1", density="2500 kg/m3")
     check_count("arch", 2, voussoirs=np.int64(2))
     with pytest.raises(GeometryError, match=r"^arch: voussoirs must be an integer ≥ 2, got 1$"):
         check_count("arch", 2, voussoirs=1)

@@ -101,6 +101,36 @@ BUILDER_ERRORS = [
 ]
 
 
+@pytest.mark.parametrize(
+    "line, expected",
+    [
+        ('length = "2.4 m"', '[structure] length = "2.4 m": must be a number, not a string (write 2.4, in m, without the unit)'),
+        (
+            'block_height = "200 mm"',
+            '[structure] block_height = "200 mm": must be a number, not a string (it is read in m: convert 200 mm to m '
+            "and write the number alone)",
+        ),
+        (
+            'blocks = "51 blocks"',
+            '[structure] blocks = "51 blocks": must be an integer, not a string (write 51, without "blocks": this '
+            "setting has no unit)",
+        ),
+    ],
+)
+def test_real_builder_options_written_with_units(tmp_path, line, expected):
+    assert load_error(tmp_path, f'[structure]\nbuilder = "wall"\n{line}\n') == expected
+
+
+def test_every_numeric_builder_option_has_a_unit():
+    """A new builder option would get no unit in the "written with a unit" message: SETTING_UNITS must name it."""
+    from geometry_library.values import SETTING_UNITS
+
+    for name, spec in builders_pkg.BUILDERS.items():
+        for field in dataclasses.fields(spec):
+            if field.type.split("|")[0].strip() in ("float", "int"):
+                assert field.name in SETTING_UNITS, (name, field.name)
+
+
 @pytest.mark.parametrize("line, expected", BUILDER_ERRORS, ids=[e[0] for e in BUILDER_ERRORS])
 def test_builder_option_errors(tmp_path, fake_builders, line, expected):
     assert load_error(tmp_path, f'[structure]\nbuilder = "fake"\n{line}\n') == expected

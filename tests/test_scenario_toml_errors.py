@@ -24,7 +24,19 @@ RUN_ERRORS = [
     ("duration = 1e6", "[run] duration = 1000000.0: must be <= 100000"),
     ("duration = inf", "[run] duration = inf: must be a finite number"),
     ("duration = nan", "[run] duration = nan: must be a finite number"),
-    ('duration = "1 s"', '[run] duration = "1 s": must be a number, not a string'),
+    ('duration = "1 s"', '[run] duration = "1 s": must be a number, not a string (write 1, in s, without the unit)'),
+    (
+        'dt = "20 ms"',
+        '[run] dt = "20 ms": must be a number, not a string (it is read in s: convert 20 ms to s and write the number alone)',
+    ),
+    (
+        'tolerance = "1e-5 m/s"',
+        '[run] tolerance = "1e-5 m/s": must be a number, not a string (write 1e-5, in m/s, without the unit)',
+    ),
+    (
+        'record_every = "10 steps"',
+        '[run] record_every = "10 steps": must be an integer, not a string (write 10, without "steps": this setting has no unit)',
+    ),
     ("theta = 0.4", "[run] theta = 0.4: must be >= 0.5"),
     ("theta = 1.01", "[run] theta = 1.01: must be <= 1"),
     ("tolerance = 0.0", "[run] tolerance = 0.0: must be > 0"),
@@ -56,7 +68,16 @@ MATERIAL_ERRORS = [
     ("density = 0.0", "[material] density = 0.0: must be > 0"),
     ("density = -inf", "[material] density = -inf: must be a finite number"),
     ("thickness = -1", "[material] thickness = -1: must be > 0"),
-    ('thickness = "1m"', '[material] thickness = "1m": must be a number, not a string'),
+    ('thickness = "1m"', '[material] thickness = "1m": must be a number, not a string (write 1, in m, without the unit)'),
+    (
+        'density = "2500 kg/m3"',
+        '[material] density = "2500 kg/m3": must be a number, not a string (write 2500, in kg/m³, without the unit)',
+    ),
+    (
+        'density = "2.5 t/m3"',
+        '[material] density = "2.5 t/m3": must be a number, not a string (it is read in kg/m³: convert 2.5 t/m3 to '
+        "kg/m³ and write the number alone)",
+    ),
     ("mu = 0.6", '[material] unknown key "mu" (expected one of: density, thickness, friction)'),
 ]
 
@@ -306,3 +327,45 @@ def test_a_number_given_as_a_string_says_so(tmp_path):
     text = (DATA / "block_on_ground.toml").read_text().replace("density = 2000.0", 'density = "2500"')
     message = load_error(tmp_path, text)
     assert message.endswith('[material] density = "2500": must be a number, not a string (write 2500, without quotes)')
+
+
+@pytest.mark.parametrize(
+    "motion, expected",
+    [
+        (
+            'kind = "sine", amplitude = 1.0, frequency = "2 Hz"',
+            'frequency = "2 Hz": must be a number, not a string (write 2, in Hz, without the unit)',
+        ),
+        (
+            'kind = "sine", amplitude = "1 m/s", frequency = 2.0',
+            'amplitude = "1 m/s": must be a number, not a string (write 1, in m/s, without the unit)',
+        ),
+        (
+            'kind = "sine", amplitude = 1.0, frequency = 2.0, phase = "90°"',
+            'phase = "90°": must be a number, not a string (it is read in rad: convert 90° to rad and write the '
+            "number alone)",
+        ),
+        (
+            'kind = "ramp", acceleration = [1.0, 0.0], until = "0.5 s"',
+            'until = "0.5 s": must be a number, not a string (write 0.5, in s, without the unit)',
+        ),
+        (
+            'kind = "record", file = "q.csv", time_step = "10 ms"',
+            'time_step = "10 ms": must be a number, not a string (it is read in s: convert 10 ms to s and write the '
+            "number alone)",
+        ),
+    ],
+    ids=["frequency", "amplitude", "phase-degrees", "until", "time-step-ms"],
+)
+def test_motion_numbers_written_with_units(tmp_path, motion, expected):
+    (tmp_path / "q.csv").write_text("0.1\n0.2\n0.3\n")
+    msg = load_error(tmp_path, BLOCK + GROUND + f"motion = {{ {motion} }}\n")
+    assert msg.startswith('[[support]] #1 ("ground"): ') and msg.endswith(expected), msg
+
+
+def test_block_density_written_with_its_unit(tmp_path):
+    msg = load_error(tmp_path, BLOCK + BLOCK2 + 'density = "2400 kg/m3"\n')
+    assert msg == (
+        '[[block]] #2 ("b2"): density = "2400 kg/m3": must be a number, not a string (write 2400, in kg/m³, '
+        "without the unit)"
+    )
