@@ -216,8 +216,9 @@ RECORDED_FIELDS = (
 
 def recorded_ranges(h: dict, key: str) -> list:
     """The colour range of ``key`` at every frame, as ``masonrycli.recording`` logs it: a
-    ``masonrycli.colour_range.RangeTracker`` fed the frames from the first computed one on (the initial
-    state is not shown); the volumetric strain rate falls back on the chain strain rate. Entry 0: None."""
+    ``masonrycli.colour_range.RangeTracker`` fed the frames from the first computed one on; the initial
+    state (entry 0, t = 0) takes the range of the frame after it. The volumetric strain rate falls back
+    on the chain strain rate."""
     from masonrycli.colour_range import RangeTracker
     from masonrycli.recording.layout import CHAIN_KEY, FIELD_BY_KEY
 
@@ -226,7 +227,8 @@ def recorded_ranges(h: dict, key: str) -> list:
     if key == "cell_volumetric_strain_rate" and CHAIN_KEY in h:
         v = np.where(np.isnan(v), h[CHAIN_KEY], v)
     tracker = RangeTracker(spec.kind, spec.floor)
-    return [None] + [tracker.update(v[i]) for i in range(1, v.shape[0])]
+    ranges = [tracker.update(v[i]) for i in range(1, v.shape[0])]
+    return ranges[:1] + ranges
 
 
 def colour_ranges(run: Run, i: int) -> str:

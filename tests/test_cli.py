@@ -230,7 +230,7 @@ def test_overlapping_blocks_are_named(tmp_path):
 
 
 def _frames_in(rrd: Path) -> int:
-    """Frames shown in the recording (the initial state, before any force, is in the history only)."""
+    """Frames shown in the recording (the initial state, t = 0, first: the history's frames)."""
     from masonrycli.recording import inspect_recording
 
     info = inspect_recording(rrd)
@@ -248,7 +248,7 @@ def test_divergence_leaves_complete_outputs(tmp_path, monkeypatch):
     assert "diverged" in result.output
     h = np.load(npz)
     assert str(h["status"]) == "diverged"
-    assert _frames_in(rrd) == len(h["time"]) - 1
+    assert _frames_in(rrd) == len(h["time"])
 
 
 def test_engine_error_mid_run_keeps_frames(tmp_path, monkeypatch):
@@ -269,7 +269,7 @@ def test_engine_error_mid_run_keeps_frames(tmp_path, monkeypatch):
     h = np.load(npz)
     assert str(h["status"]) == "failed"
     assert list(h["step"]) == [0, 10, 20]
-    assert _frames_in(rrd) == 2
+    assert _frames_in(rrd) == 3
 
 
 def test_build_says_one_block_in_the_singular(tmp_path):
@@ -354,7 +354,8 @@ def test_inspect_summarises_a_recording(tmp_path):
     assert invoke("simulate", "wall", "--duration", 0.03, "--out", rrd).exit_code == 0
     result = invoke("inspect", rrd)
     assert result.exit_code == 0, result.output
-    assert "masonry" in result.output and "10 … 30" in result.output and "/structure/plane/xy/blocks" in result.output
+    assert "masonry" in result.output and "/structure/plane/xy/blocks" in result.output
+    assert "steps          │ 0 … 30" in result.output  # from the initial frame (it began at 10)
     bad = tmp_path / "bad.rrd"
     bad.write_bytes(b"not a recording")
     assert_one_line_error(invoke("inspect", bad), "bad.rrd")

@@ -73,7 +73,8 @@ def test_a_run_leaves_a_whole_history_and_recording_in_place(tmp_path):
     pga = np.abs(np.diff(AMP * np.cos(2 * math.pi * FREQ * t))).max() / DT
     assert float(h["intensity_pga"]) == pytest.approx(pga, rel=1e-9)
     info = inspect_recording(tmp_path / "r.rrd")
-    assert info["complete"] and info["frames"] == len(h["step"]) - 1  # the initial state: the history only
+    # the same frames in both, the initial state first (it was in the history only: the recording began at step 5)
+    assert info["complete"] and info["frames"] == len(h["step"]) and info["steps"] == (0, STEPS)
     assert "completed" in info["metadata"]
     # both files name the code that made them (before: "masonry 0.1.0" only, the same for every commit)
     run = json.loads(str(h["run"]))
@@ -84,7 +85,7 @@ def test_a_run_leaves_a_whole_history_and_recording_in_place(tmp_path):
 
 
 def test_an_engine_error_closes_the_outputs_as_failed_and_is_raised(tmp_path, monkeypatch):
-    """Raised in the first step: the history holds the initial state, the recording no frame, both whole."""
+    """Raised in the first step: the history and the recording hold the initial state, both whole."""
     error = FloatingPointError("synthetic engine error")
 
     def failing(self):
@@ -100,7 +101,7 @@ def test_an_engine_error_closes_the_outputs_as_failed_and_is_raised(tmp_path, mo
     assert str(h["status"]) == "failed" and str(h["note"]) == "the run stopped on an unexpected error"
     assert h["step"].tolist() == [0]
     rec = inspect_recording(tmp_path / "r.rrd")
-    assert rec["complete"] and rec["frames"] == 0 and "failed" in rec["metadata"]
+    assert rec["complete"] and rec["frames"] == 1 and rec["steps"] == (0, 0) and "failed" in rec["metadata"]
 
 
 def test_a_stop_before_step_one_leaves_no_file_and_keeps_the_previous_one(tmp_path, monkeypatch):

@@ -350,8 +350,9 @@ def test_legend_labels_per_frame_and_run_document(written):
     assert "Joint forces" in legend[0] and "Magnified" in legend[0]
 
 
-def test_solver_health_once_per_step_and_no_empty_first_frame(wall, tmp_path):
-    """log_step values are logged at every step; the initial frame without forces is not shown."""
+def test_solver_health_once_per_step_and_the_initial_frame_shown(wall, tmp_path):
+    """log_step values are logged at every step; the initial frame without forces is shown at t = 0 (it was
+    left out: the recording began at the first computed frame, step 10)."""
     static, q0 = wall
     frames = fx.frames(static, q0, 4)
     empty = type(frames[0])(**{**frames[0].__dict__, "contact_force": np.zeros_like(frames[0].contact_force)})
@@ -372,7 +373,7 @@ def test_solver_health_once_per_step_and_no_empty_first_frame(wall, tmp_path):
     assert sorted(iterations) == list(range(1, 31)) == sorted(residual)
     assert iterations[7] == [17.0]
     np.testing.assert_allclose(residual[7], [-4.0, -4.0])  # log10 residual, log10 tolerance
-    assert inspect_recording(path)["steps"] == (10, 30) and inspect_recording(path)["frames"] == 3
+    assert inspect_recording(path)["steps"] == (0, 30) and inspect_recording(path)["frames"] == 4
 
 
 def test_magnified_shape(written):
@@ -448,3 +449,41 @@ def test_a_run_ended_before_the_paper_instant_opens_without_its_tabs(wall, tmp_p
     views = blueprint_views(tmp_path / "w.rrd")
     assert not any(v["pinned"] or name.startswith("Fig.") for name, v in views.items())
     assert any(name.startswith("Live: joint forces") for name in views) and rec.paper is None
+
+
+def test_a_run_s_recording_opens_at_t0_on_the_structure_as_built(tmp_path):
+    """A run's first frame is the structure as built, at rest, at t = 0 (the recording began at the first
+    computed frame, step 10: scrubbing to the start never showed it): the blocks at their built centroids
+    and the ground at its built place (both computed here from the builder's polygons, apart from the
+    engine), no joint force yet, the stresses undefined (grey) with the colour range of the next frame;
+    the same frames as the history."""
+    from shapely.geometry import Polygon
+
+    from cli_helpers import invoke
+    from geometry_library.builders import build_wall
+    from masonrycli.recording.layout import FIELD_BY_KEY, FORCES, HINGES, SUPPORT_OUTLINES
+
+    rrd, npz = tmp_path / "w.rrd", tmp_path / "w.npz"
+    result = invoke("simulate", "wall", "--duration", 0.02, "--out", rrd, "--history", npz)
+    assert result.exit_code == 0, result.output
+    info = inspect_recording(rrd)
+    assert info["frames"] == 3 and info["steps"] == (0, 20) and info["time_span"] == pytest.approx((0.0, 0.02))
+    h = np.load(npz)
+    assert h["step"].tolist() == [0, 10, 20]  # the history had the initial frame already
+    built = build_wall()
+    centroids = np.array([Polygon(b.vertices).centroid.coords[0] for b in built.blocks])
+    hover = temporal_rows(str(rrd), f"/{rec_mod.layout.BLOCKS}", "Points2D:positions")
+    assert sorted(hover) == [0, 10, 20]
+    np.testing.assert_allclose(np.array(hover[0]), centroids, atol=1e-6)  # float32 in the file
+    assert np.abs(np.array(hover[10]) - centroids).max() > 1e-6  # it moves after: not a static copy
+    np.testing.assert_allclose(h["block_q"][0, :, :2], centroids, atol=1e-12)
+    ground = np.array(temporal_rows(str(rrd), f"/{SUPPORT_OUTLINES}", "LineStrips2D:strips")[0][0])
+    built_ground = np.array(built.supports[0].polygon.exterior.coords)
+    assert {tuple(np.round(p, 5)) for p in ground} == {tuple(np.round(p, 5)) for p in built_ground}
+    assert temporal_rows(str(rrd), f"/{FORCES}", "Arrows2D:vectors")[0] == []
+    assert temporal_rows(str(rrd), f"/{HINGES}", "Points2D:positions").get(0, []) == []
+    p = FIELD_BY_KEY["cell_spherical_stress"]
+    assert set(temporal_rows(str(rrd), f"/{FILL}", p.colors)[0]) == {cm.NAN_RGBA}
+    read = field_frames(rrd)
+    assert np.isnan(read[0]["values"]["cell_spherical_stress"]).all()
+    assert read[0]["ranges"] == read[10]["ranges"]

@@ -76,7 +76,7 @@ def test_inspect_a_file_without_footer(wall, tmp_path):
         from masonrycli.recording import Recorder
         static, q0 = fx.wall()
         rec = Recorder({str(path)!r}, static, fx.METADATA, batch_frames=4)
-        for f in fx.frames(static, q0, 8):
+        for f in fx.frames(static, q0, 9):  # two batches: the initial frame and 4 more, then 4
             rec.log_frame(f)
         rec.rec.flush()
         os.kill(os.getpid(), signal.SIGKILL)
@@ -84,7 +84,7 @@ def test_inspect_a_file_without_footer(wall, tmp_path):
     subprocess.run([sys.executable, "-c", script], timeout=120, env={**os.environ, "RERUN_ANALYTICS": "0"})
     info = inspect_recording(path)
     assert not info["complete"] and info["truncated"]
-    assert info["frames"] == 8 and info["application_id"] == "masonry"
+    assert info["frames"] == 9 and info["application_id"] == "masonry"
     # QA: the table said "truncated False" under a warning saying "truncated"; now both say it
     result = invoke("inspect", path)
     assert result.exit_code == 0, result.output
@@ -99,7 +99,7 @@ def test_inspect_a_file_without_footer(wall, tmp_path):
 
 def test_frames_without_tensor_fields_or_contacts(wall, tmp_path):
     static, q0 = wall
-    f = fx.frames(static, q0, 2)[1]  # step 10 (an initial frame without forces is not shown)
+    f = fx.frames(static, q0, 2)[1]  # step 10 (a computed frame: the initial one takes the range of the next)
     empty = type(f)(
         **{
             **f.__dict__,
@@ -134,7 +134,7 @@ def test_interrupt_in_the_middle_of_a_flush_still_leaves_a_complete_file(wall, t
             send, calls = rec.rec.send_columns, []
 
             def flaky_send(*args, **kwargs):
-                if rec._frames == 10:  # flushing the second batch
+                if rec._frames == 11:  # flushing the second batch (the first: the initial frame and 5 more)
                     calls.append(args[0])
                     if len(calls) == 9:  # part-way through its entities
                         raise KeyboardInterrupt
@@ -144,5 +144,5 @@ def test_interrupt_in_the_middle_of_a_flush_still_leaves_a_complete_file(wall, t
             for f in fx.frames(static, q0, 12):
                 rec.log_frame(f)
     info = inspect_recording(path)
-    assert info["complete"] and "interrupted at t = 0.090 s (step 90)" in info["metadata"]
-    assert info["frames"] == 10  # the first batch, then as much of the second as was sent: no duplicates
+    assert info["complete"] and "interrupted at t = 0.100 s (step 100)" in info["metadata"]
+    assert info["frames"] == 11  # the first batch, then as much of the second as was sent: no duplicates

@@ -63,15 +63,15 @@ def test_a_recording_without_footer_is_noticed(recording, tmp_path):
 def test_inspect_reads_a_truncated_recording(recording, tmp_path):
     """Finding 9: `masonry inspect` could not read a truncated recording — the file a kill or a full disk leaves."""
     whole = inspect_recording(recording)
-    # 300 frames: steps 1 … 300 (the initial state, before any force, is in the history only)
-    assert whole["frames"] == 300 and whole["complete"] and not whole["truncated"]
+    # 301 frames: steps 0 … 300 (the initial state, as built, then every step)
+    assert whole["frames"] == 301 and whole["complete"] and not whole["truncated"]
     cut = tmp_path / "cut.rrd"
     with open(recording, "rb") as src, open(cut, "wb") as dst:
         # a third: the last third holds the magnified shape, written when the recorder closes
         dst.write(src.read(recording.stat().st_size // 3))
     info = inspect_recording(cut)
     assert info["truncated"] and not info["complete"] and 0 < info["frames"] < whole["frames"]
-    assert info["steps"] == (1, info["frames"])
+    assert info["steps"] == (0, info["frames"] - 1)
     result = invoke("inspect", cut)
     assert result.exit_code == 0, result.output
     assert f"truncated (its writer did not finish: killed, or the disk was full) — {info['frames']} frames" in (
@@ -88,21 +88,21 @@ def test_recorder_writes_to_the_file_every_second(tmp_path, monkeypatch):
     import recording_fixtures as fx
 
     static, q0 = fx.wall()
-    frames = fx.frames(static, q0, 103)
+    frames = fx.frames(static, q0, 104)
     path = tmp_path / "r.rrd"
     rec = recorder.Recorder(path, static, fx.METADATA, batch_frames=100)
-    for frame in frames[:100]:  # the first batch: written, and fixes every scale
+    for frame in frames[:101]:  # the first batch (the initial frame and 100 more): written, fixes every scale
         rec.on_frame(frame)
     assert rec._scales_fixed()
     size = path.stat().st_size
-    rec.on_frame(frames[100])  # less than FLUSH_SECONDS later: buffered
+    rec.on_frame(frames[101])  # less than FLUSH_SECONDS later: buffered
     assert path.stat().st_size == size
     monkeypatch.setattr(recorder, "FLUSH_SECONDS", 0.0)
-    rec.on_frame(frames[101])  # FLUSH_SECONDS have passed: on disk now, with the frame before
+    rec.on_frame(frames[102])  # FLUSH_SECONDS have passed: on disk now, with the frame before
     assert path.stat().st_size > size
-    copy = tmp_path / "copy.rrd"  # what a SIGKILL now would leave: no footer, 102 frames
+    copy = tmp_path / "copy.rrd"  # what a SIGKILL now would leave: no footer, 103 frames
     shutil.copyfile(path, copy)
-    assert inspect_recording(copy)["frames"] == 102
-    rec.on_frame(frames[102])
+    assert inspect_recording(copy)["frames"] == 103
+    rec.on_frame(frames[103])
     rec.close()
-    assert inspect_recording(path)["frames"] == 103
+    assert inspect_recording(path)["frames"] == 104

@@ -32,7 +32,7 @@ def test_structure_runs_and_opens_in_viewer(name, tmp_path):
     assert h["block_q"].shape == (21, BLOCKS[name], 3)
     info = inspect_recording(rrd)
     assert info["application_id"] == "masonry" and info["has_blueprint"] and info["complete"]
-    assert info["frames"] == 20  # the initial state (no force yet) is in the history only
+    assert info["frames"] == 21 and info["steps"] == (0, 200)  # the initial state (t = 0), as in the history
     png = tmp_path / f"{name}.png"
     reports = screenshot_recording(rrd, png, at_open=True)  # where the viewer puts the cursor itself
     assert reports == []

@@ -29,9 +29,21 @@ class FieldColours:
         """How often each field's range was refitted."""
         return {k: t.changes for k, t in self._trackers.items()}
 
-    def colour(self, f: FieldSpec, values: np.ndarray):
-        """Per frame: the range (tracked), block colours (F, N), legend labels, range ends (F,) each."""
-        ranges, below, above = self._trackers[f.key].follow(values)
+    def colour(self, f: FieldSpec, values: np.ndarray, initial: int = 0):
+        """Per frame: the range (tracked), block colours (F, N), legend labels, range ends (F,) each.
+
+        The ``initial`` first frames (the state as built, before the first step: NaN stresses, zero strains)
+        take the range of the frame after them and are not shown to the tracker: fitted to them, the range
+        was refitted at the first computed frame, one refit more per field saying nothing."""
+        tracker = self._trackers[f.key]
+        if 0 < initial < len(values):
+            ranges, below, above = tracker.follow(values[initial:])
+            first = [ranges[0].outside(v)[:2] for v in values[:initial]]
+            ranges = [ranges[0]] * initial + ranges
+            below = np.concatenate([np.array([c[0] for c in first], dtype=below.dtype), below])
+            above = np.concatenate([np.array([c[1] for c in first], dtype=above.dtype), above])
+        else:  # a batch of the initial frame alone (a run stopped in its first step): fitted to it
+            ranges, below, above = tracker.follow(values)
         lo = np.array([r.lo for r in ranges])
         hi = np.array([r.hi for r in ranges])
         per_frame = (-1,) + (1,) * (values.ndim - 1)

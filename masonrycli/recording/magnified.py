@@ -1,8 +1,9 @@
 """The magnified deformed shape: every block (and support) at x0 + m (x − x0), rotated by m θ.
 
 Logged when the recorder closes: the default factor m (``masonrycli.joint_forces.magnification``) needs
-the largest displacement of the run. Only outlines (line strips), every ``MAGNIFIED_EVERY``-th frame and
-the last: the mechanism reads as well at half the frame rate, for half the bytes.
+the largest displacement of the run. Only outlines (line strips), the initial frame (t = 0), every
+``MAGNIFIED_EVERY``-th computed frame and the last: the mechanism reads as well at half the frame rate, for
+half the bytes.
 """
 
 from __future__ import annotations
@@ -33,7 +34,9 @@ def send_magnified(
     """Send the magnified outlines of ``poses`` (step, time, block_q, support_q per frame) about ``ref``
     (the first block_q, support_q); returns the factor used (``magnify``, or the default for ``size`` m)."""
     ref_q, ref_sq = ref
-    poses = poses[:-1][::MAGNIFIED_EVERY] + poses[-1:]
+    # the initial pose (step 0, as built), then every other computed frame as before it was recorded
+    initial = 1 if len(poses) > 1 and poses[0][0] == 0 else 0
+    poses = poses[:initial] + poses[initial:-1][::MAGNIFIED_EVERY] + poses[-1:]
     q = np.stack([p[2] for p in poses]).astype(np.float64)
     sq = np.stack([p[3] for p in poses]).astype(np.float64)
     m = magnification(q[..., :2] - ref_q[None, :, :2], size) if magnify is None else float(magnify)

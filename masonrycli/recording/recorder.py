@@ -3,8 +3,12 @@
 One ``.rrd`` per run from an explicit ``rr.RecordingStream``, with an embedded default blueprint.
 Constants are logged static; frames are buffered and sent with ``send_columns`` every ``batch_frames``
 frames, one array per entity kind. Timelines ``step`` (sequence) and ``sim_time`` (duration). Entity
-paths: ``layout.ENTITY_PATHS``. The initial frame, before any contact force, only sets the references
-(drawing plane, as-built shape): the recording starts at the first computed frame.
+paths: ``layout.ENTITY_PATHS``. The initial frame (step 0, t = 0: the structure as built, at rest, before
+the first step) sets the references (drawing plane, as-built shape) and is logged like any other, so the
+recording starts at t = 0 as the history does: no contacts and no forces yet (the first step's solve makes
+them), so no joint arrows and no glyphs; the stresses and strain rates are undefined there (NaN: grey), the
+cumulated strain, sliding ratio and openings 0. It takes the colour ranges of the first computed frame and
+does not count towards a batch's ``batch_frames`` nor fix a scale, so every later frame reads as before.
 
 What is logged per frame, once each: the block fill mesh's vertex positions (float32, inset so the
 joints show) with one colour component per field (each view maps its own, ``layout.FIELDS``); a hover
@@ -209,9 +213,6 @@ class Recorder:
             for f in FIELDS:
                 log_legend(self.rec, f, self._legend_box)
             self._label_anchors = legend_positions(self._legend_box).astype(np.float32)
-            force = np.asarray(frame.contact_force, f64)
-            if int(frame.step) == 0 and not np.any(force != 0.0):
-                return  # the state before the first step: no forces, no stress, nothing to show
         b = self._batch
         b.add("step", int(frame.step))
         b.add("time", float(frame.time))
@@ -228,7 +229,7 @@ class Recorder:
         self._last = (int(frame.step), float(frame.time))
         self._frames += 1
         due = time.perf_counter() - self._flushed >= FLUSH_SECONDS and self._scales_fixed()
-        if len(b["step"]) >= self.batch_frames or due:
+        if len(b["step"]) - _initial(b) >= self.batch_frames or due:
             with _io_errors(self.path):
                 self.flush()
                 self.rec.flush()  # to the file: a killed run loses at most about FLUSH_SECONDS of frames
@@ -301,9 +302,10 @@ class Recorder:
         # A voussoir of a bare ring has no cell strain rate; its strain rate along the ring stands in.
         vsr = tensors["cell_volumetric_strain_rate"]
         tensors["cell_volumetric_strain_rate"] = np.where(np.isnan(vsr), tensors[CHAIN_KEY], vsr)
-        if self._fix_scales(tensors, b):
+        initial = _initial(b)  # the state as built: no scale from it (module doc)
+        if self._fix_scales({k: v[initial:] for k, v in tensors.items()}, b):
             self._log_metadata(RUNNING, "")
-        self._send_blocks(idx, q, tensors)
+        self._send_blocks(idx, q, tensors, initial)
         self._send_supports(idx, b.stack("support_q"))
         self._send_axes(idx, q, tensors)
         self._send_joints(idx, b)
@@ -327,8 +329,9 @@ class Recorder:
                 self.axis_scale[name], fixed = m, True
         return fixed
 
-    def _send_blocks(self, idx: list, q: np.ndarray, tensors: dict[str, np.ndarray]) -> None:
-        """The fill (positions once, a colour component per field), legends, hover points and values."""
+    def _send_blocks(self, idx: list, q: np.ndarray, tensors: dict[str, np.ndarray], initial: int = 0) -> None:
+        """The fill (positions once, a colour component per field), legends, hover points and values; the
+        ``initial`` first frames (the state as built) take the colour range of the frame after them."""
         n_frames = len(q)
         verts = self._fill.world(q)  # (F, V, 2)
         n_vert = verts.shape[1]
@@ -336,7 +339,7 @@ class Recorder:
         columns = [*rr.Mesh3D.columns(vertex_positions=z0(verts)).partition(per_vertex)]
         hover = [*rr.Points2D.columns(positions=q[..., :2].reshape(-1, 2).astype(np.float32)).partition(per_block)]
         for f in FIELDS:
-            colors, labels, lo, hi = self._colours.colour(f, tensors[f.key])
+            colors, labels, lo, hi = self._colours.colour(f, tensors[f.key], initial)
             archetype = f.colors.removesuffix(":colors")
             columns += rr.DynamicArchetype.columns(
                 archetype, components={"colors": rr.components.ColorBatch(colors[:, self._blocks.owner].reshape(-1))}
@@ -469,6 +472,12 @@ class Recorder:
         self.rec.log(METADATA, rr.TextDocument(viewer_safe_text(text), media_type="text/markdown"), static=True)
         legend = legend_markdown(self.force_scale, self.block_height, self.magnify)
         self.rec.log(LEGEND, rr.TextDocument(viewer_safe_text(legend), media_type="text/markdown"), static=True)
+
+
+def _initial(b: FrameBatch) -> int:
+    """1 if the batch opens with the initial frame (step 0: the structure as built), else 0."""
+    steps = b.get("step")
+    return 1 if steps and steps[0] == 0 else 0
 
 
 def _tensor(tensors: dict, key: str, n: int) -> np.ndarray:
