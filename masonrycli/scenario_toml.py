@@ -25,6 +25,7 @@ from masonrycli.records import record_fields
 from masonrycli.scenario import Material, RunConfig, Scenario, block_speed_problem
 from masonrycli.scenario_warnings import idle_driven_supports
 from masonrycli.structure import build_structure, check_finite_tree, read_geometry, structure_warnings
+from masonrycli.toml_lines import with_line
 from masonrycli.values import (
     check_real,
     check_vector,
@@ -90,7 +91,10 @@ def loads_scenario(
         doc = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise ctx.error("", f"TOML syntax error: {exc}") from None
-    return _parse_document(doc, ctx, default_name)
+    try:
+        return _parse_document(doc, ctx, default_name)
+    except InputError as exc:  # the line of the key it names, where the text shows it unambiguously
+        raise InputError(with_line(str(exc), ctx.fname, text)) from None
 
 
 def _table(doc: dict, key: str, ctx: InputContext) -> dict:

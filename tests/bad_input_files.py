@@ -65,9 +65,9 @@ FILE_ROWS = [
         scen('duration = "1.0"'),
         ("check", "s.toml"),
         2,
-        's.toml: [run] duration = "1.0": must be a number',
+        's.toml:2: [run] duration = "1.0": must be a number',
     ),
-    ("run-dt-negative", scen("dt = -0.001"), ("check", "s.toml"), 2, "s.toml: [run] dt = -0.001: must be > 0"),
+    ("run-dt-negative", scen("dt = -0.001"), ("check", "s.toml"), 2, "s.toml:2: [run] dt = -0.001: must be > 0"),
     (
         "run-dt-not-dividing",
         scen("duration = 1.0\ndt = 0.3"),
@@ -105,7 +105,7 @@ FILE_ROWS = [
         scen("durration = 1.0"),
         ("check", "s.toml"),
         2,
-        's.toml: [run] unknown key "durration" (did you mean "duration"?)',
+        's.toml:2: [run] unknown key "durration" (did you mean "duration"?)',
     ),
     (
         "material-friction",
@@ -122,7 +122,7 @@ FILE_ROWS = [
         2,
         "s.toml:2: not a UTF-8 text file (byte 14, 0xff",
     ),
-    ("top-level-unknown", {"s.toml": f"blok = 1\n{SCENE}"}, ("check", "s.toml"), 2, 's.toml: unknown key "blok"'),
+    ("top-level-unknown", {"s.toml": f"blok = 1\n{SCENE}"}, ("check", "s.toml"), 2, 's.toml:1: unknown key "blok"'),
     # -- scenario TOML: blocks and supports
     (
         "no-blocks",
@@ -246,14 +246,14 @@ FILE_ROWS = [
         {"s.toml": '[structure]\nbuilder = "tower"\n'},
         ("check", "s.toml"),
         2,
-        's.toml: [structure] builder = "tower"',
+        's.toml:2: [structure] builder = "tower"',
     ),
     (
         "structure-file-format",
         {"s.toml": '[structure]\nfile = "w.txt"\n', "w.txt": ""},
         ("check", "s.toml"),
         2,
-        "s.toml: [structure] file = ",
+        "s.toml:2: [structure] file = ",
     ),
     (
         "structure-file-missing",

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 import numpy as np
@@ -32,8 +33,9 @@ def load_error(tmp_path: Path, text: str, name: str = "wall.toml") -> str:
         load_scenario(path)
     msg = str(exc.value)
     assert "\n" not in msg and msg == msg.strip()
-    assert msg.startswith(f"{path}: "), msg
-    return msg[len(str(path)) + 2 :]  # the part after "<file>: "
+    where = re.match(rf"{re.escape(str(path))}(:[1-9][0-9]*)?: ", msg)  # the key's line: tests/test_toml_lines.py
+    assert where, msg
+    return msg[where.end() :]  # the part after "<file>: " or "<file>:<line>: "
 
 
 def assert_same_scenario(a: Scenario, b: Scenario):

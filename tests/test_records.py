@@ -537,4 +537,5 @@ def test_one_column_errors_in_a_scenario(tmp_path, motion, expected):
     with pytest.raises(InputError) as exc:
         loads_scenario(SCENARIO.replace("MOTION", motion), source="s.toml", base_dir=tmp_path)
     message = one_line(exc)
-    assert message.startswith('s.toml: [[support]] #1 ("ground"): ' + expected), message
+    # the line of the motion (SCENARIO's 9th: its motion = { … } inline table, tests/test_toml_lines.py)
+    assert message.startswith('s.toml:9: [[support]] #1 ("ground"): ' + expected), message

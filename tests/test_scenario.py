@@ -205,12 +205,12 @@ def test_an_initial_velocity_faster_than_a_diverged_block_is_refused(tmp_path):
     for fine in ("[1000.0, 0.0, 0.0]", "[600.0, -800.0, 0.0]", f"[0.0, 0.0, {0.999 * 1000 / r}]"):
         scenario(fine)
     for fast in ("[1e9, 0.0, 0.0]", "[800.0, 800.0, 0.0]", f"[0.0, 0.0, {1.001 * 1000 / r}]", "[999.0, 0.0, -10.0]"):
-        with pytest.raises(InputError, match=r'v\.toml: \[\[block\]\] #1 \("b1"\): velocity = \[.*\]: a point of the '):
+        with pytest.raises(InputError, match=r'v\.toml:4: \[\[block\]\] #1 \("b1"\): velocity = \[.*\]: a point of the '):
             scenario(fast)
     with pytest.raises(InputError) as info:
         scenario("[1e9, 0.0, 0.0]")
     assert str(info.value) == (
-        f'{tmp_path / "v.toml"}: [[block]] #1 ("b1"): velocity = [1000000000.0, 0.0, 0.0]: a point of the block '
+        f'{tmp_path / "v.toml"}:4: [[block]] #1 ("b1"): velocity = [1000000000.0, 0.0, 0.0]: a point of the block '
         "would move at 1e+09 m/s, more than 1000 m/s (a likely typo: a block that fast is a diverged run)"
     )
     # a GeoJSON block's velocity: the same check, the block numbered from 1 as in the file
@@ -245,7 +245,7 @@ def test_an_alert_distance_longer_than_the_structure_is_refused(tmp_path):
     with pytest.raises(InputError) as info:
         scenario(0.41, BLOCK)
     assert str(info.value) == (
-        f"{tmp_path / 'a.toml'}: [run] alert_distance = 0.41: longer than the structure (0.4 m, the larger side "
+        f"{tmp_path / 'a.toml'}:2: [run] alert_distance = 0.41: longer than the structure (0.4 m, the larger side "
         "of its blocks' bounding box); a likely typo: contacts closer than this are kept (default 0.001 m)"
     )
     with pytest.raises(InputError, match=r"\[run\] alert_distance = 1000000000.0: longer than the structure \(0.5 m"):

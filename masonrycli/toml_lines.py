@@ -1,0 +1,123 @@
+"""The line of a scenario file an error is about: ``wall.toml:4: [run] duration = "1 s": …``.
+
+tomllib gives no positions, so the line is found in the text and then proved by tomllib itself: each
+place where the key is written (``duration =``, ``run.duration =``, inside ``motion = { …, frequency =
+… }``) is renamed in a copy of the text, the copy parsed, and the place is the key's only if the key has
+moved, under the new name, to the table the message names (``[run]``, the 2nd ``[[block]]``, the motion of
+the 1st ``[[support]]``). A look-alike in a string, a comment, another table or another ``[[block]]`` does
+not move it; TOML allows a key once per table, so a place that moves it is the one. When none does (the
+key is missing, or written as a table header), or the message names no key, no line is given — a wrong
+line would be worse than none.
+"""
+
+from __future__ import annotations
+
+import re
+import tomllib
+
+_PROBE = "masonry_probe_key_7f3a"
+_MAX_PROBES = 8  # parses of the text at most, the likely places first: an error message stays quick
+_MAX_PROBED_CHARS = 4_000_000  # text x probes: a scenario of 100 000 inline blocks is not parsed 8 times
+
+# the message after "<file>: ": where (a table, an array table's entry) then what
+_WHERE = re.compile(r'\[(\[?)([A-Za-z_][\w-]*)\]\]?(?: #(\d+))?(?: \("(?:[^"\\]|\\.)*"\))?:? ')
+_KEY = re.compile(r"(?:motion\.)?([A-Za-z_][\w-]*)(?:\[\d+\])*(?: = |: )")
+_NAMED = re.compile(r'(motion: )?unknown (?:key|option) "([A-Za-z_][\w-]*)"')
+_HEADER = re.compile(r"^[ \t]*\[(\[?)[ \t]*([A-Za-z_][\w.-]*)[ \t]*\]", re.M)
+
+
+def message_key(message: str) -> tuple[tuple, str] | None:
+    """(table path, key) that ``message`` (the part after ``<file>: ``) is about, or None.
+
+    ``[run] dt = 0: …`` -> (("run",), "dt"); ``[[block]] #2 ("b2"): density = …`` -> (("block", 1),
+    "density"); ``[[support]] #1: motion.frequency = …`` -> (("support", 0, "motion"), "frequency");
+    ``[run] unknown key "dtt" …`` -> (("run",), "dtt"); ``name = 3: …`` -> ((), "name")."""
+    path: tuple = ()
+    where = _WHERE.match(message)
+    rest = message
+    if where:
+        is_array, table, index = where.groups()
+        if bool(is_array) != (index is not None):
+            return None
+        path = (table, int(index) - 1) if index is not None else (table,)
+        rest = message[where.end() :]
+    named = _NAMED.match(rest)
+    if named:
+        return (path + ("motion",) if named.group(1) else path), named.group(2)
+    key = _KEY.match(rest)
+    if key is None:  # "polygon is not convex", "no blocks: …": about no one key
+        return None
+    if rest.startswith("motion."):
+        path += ("motion",)
+    return path, key.group(1)
+
+
+def _table(doc, path: tuple):
+    node = doc
+    for part in path:
+        if isinstance(part, int):
+            if not isinstance(node, list) or part >= len(node):
+                return None
+        elif not isinstance(node, dict) or part not in node:
+            return None
+        node = node[part]
+    return node if isinstance(node, dict) else None
+
+
+def _contexts(text: str, offsets: list[int]) -> list[tuple[str, int]]:
+    """The table header above each of the ascending ``offsets`` as a naive reader sees it (its name, the
+    count of its ``[[name]]`` so far, from 0), in one pass: only to try the likely places first (tomllib
+    decides)."""
+    out, name, counts = [], "", {}
+    headers = _HEADER.finditer(text)
+    header = next(headers, None)
+    for offset in offsets:
+        while header is not None and header.start() < offset:
+            name = header.group(2)
+            if header.group(1):
+                counts[name] = counts.get(name, 0) + 1
+            header = next(headers, None)
+        out.append((name, counts.get(name.split(".")[0], 0) - 1))
+    return out
+
+
+def key_line(text: str, path: tuple, key: str) -> int | None:
+    """The line (from 1) where ``key`` of the table at ``path`` is written in the TOML ``text``, or None."""
+    spelled = re.escape(key)
+    places = [
+        m
+        for m in re.finditer(rf"(?<![\w\"'-])(?:{spelled}|\"{spelled}\"|'{spelled}')(?=[ \t]*=(?!=))", text)
+        if not text[text.rfind("\n", 0, m.start()) + 1 : m.start()].lstrip().startswith("#")
+    ]
+
+    def unlikely(match, context) -> bool:
+        name, count = context
+        if not path:
+            return name != ""
+        if name.split(".")[0] != path[0] and not (name == "" and text[match.start() - 1 : match.start()] == "."):
+            return True
+        return len(path) > 1 and isinstance(path[1], int) and count != path[1]
+
+    contexts = _contexts(text, [m.start() for m in places])
+    places = [m for _, m in sorted(zip(contexts, places), key=lambda cm: unlikely(cm[1], cm[0]))]
+    budget = min(_MAX_PROBES, _MAX_PROBED_CHARS // max(len(text), 1))
+    for match in places[:budget]:
+        probe = text[: match.start()] + _PROBE + text[match.end() :]
+        try:
+            table = _table(tomllib.loads(probe), path)
+        except (tomllib.TOMLDecodeError, RecursionError):
+            continue
+        if table is not None and _PROBE in table and key not in table:
+            return text.count("\n", 0, match.start()) + 1
+    return None
+
+
+def with_line(message: str, fname: str, text: str) -> str:
+    """``message`` (``<fname>: <what>``) as ``<fname>:<line>: <what>`` when the key it names is found
+    (:func:`key_line`), else unchanged."""
+    head = f"{fname}: "
+    if not message.startswith(head):
+        return message
+    found = message_key(message[len(head) :])
+    line = key_line(text, *found) if found else None
+    return message if line is None else f"{fname}:{line}: {message[len(head):]}"
