@@ -31,7 +31,7 @@ BAD_TARGETS = [
     ("locked.toml", "locked.toml: cannot read file: Permission denied"),
     (
         "notes.txt",
-        'notes.txt: unknown key "a" (expected one of: name, run, material, structure, block, support)'
+        'notes.txt:1: unknown key "a" (expected one of: name, run, material, structure, block, support)'
         " (read as a scenario TOML: a geometry file's name ends in .geojson, .json, .wkt)",
     ),
 ]
