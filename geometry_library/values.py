@@ -92,9 +92,7 @@ _SPELLINGS = {  # a unit -> how users write it, compared after _spelled (lower c
     "Hz": ("hz", "hertz", "1/s", "s-1", "/s", "cps"),
     "rad": ("rad", "radian", "radians"),
 }
-_NUMBER_AND_UNIT = re.compile(
-    r"\s*([+-]?(?:\d+(?:\.\d*)?|\.\d+)(?:[eE][+-]?\d+)?)\s*([A-Za-zµμ°][^\n]*?)\s*"
-)
+_NUMBER_AND_UNIT = re.compile(r"\s*([+-]?(?:\d+(?:\.\d*)?|\.\d+)(?:[eE][+-]?\d+)?)\s*([A-Za-zµμ°][^\n]*?)\s*")
 
 
 def _spelled(unit: str) -> str:

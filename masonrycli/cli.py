@@ -326,9 +326,7 @@ def build_aqueduct_command(**opts) -> None:
 @app.command("inspect")
 @user_errors
 def inspect_command(
-    recording: Annotated[
-        Path, typer.Argument(help="Recording (.rrd) or run history (.npz).", metavar="REC.rrd|H.npz")
-    ],
+    recording: Annotated[Path, typer.Argument(help="Recording (.rrd) or run history (.npz).", metavar="REC.rrd|H.npz")],
 ) -> None:
     """Summarise a recording (scenario, frames, time span, entities) or a run history (the run's
     parameters, status, frames, time span, and each array's shape, dtype and unit)."""

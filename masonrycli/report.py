@@ -164,7 +164,6 @@ def recording_table(recording: str, info: dict) -> Table:
     return table
 
 
-
 def history_tables(history: str, info: dict) -> tuple[Table, list[str]]:
     """``masonry inspect H.npz``: a table of the run (:func:`masonrycli.history_inspect.run_rows`, as a
     recording's rows), then one line per array (name, shape, dtype, unit / meaning) in aligned columns — a

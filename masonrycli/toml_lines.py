@@ -120,4 +120,4 @@ def with_line(message: str, fname: str, text: str) -> str:
         return message
     found = message_key(message[len(head) :])
     line = key_line(text, *found) if found else None
-    return message if line is None else f"{fname}:{line}: {message[len(head):]}"
+    return message if line is None else f"{fname}:{line}: {message[len(head) :]}"

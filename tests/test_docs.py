@@ -121,7 +121,9 @@ def test_setting_units_are_the_documented_ones():
         else:
             for other in ("kg/m³", "m/s", "Hz", "rad"):
                 assert other not in cells, (key, other, rows[key])
-    assert checked == 10  # duration dt theta tolerance max_iterations record_every alert_distance density thickness friction
+    assert (
+        checked == 10
+    )  # duration dt theta tolerance max_iterations record_every alert_distance density thickness friction
 
 
 def test_scenario_format_counts_bodies_as_the_messages_do():

@@ -371,8 +371,12 @@ def test_arch_support_roles_are_read_in_any_case():
 def test_geojson_numbers_written_with_their_units(tmp_path):
     """A GIS attribute typed as text with its unit: the value to write and the unit it is read in."""
     path = write(tmp_path, [feature(SQ, name="a", density="2400 kg/m3")])
-    with pytest.raises(GeometryError, match=r"density must be a number, not a string \(write 2400, in kg/m³, without the unit\)"):
+    with pytest.raises(
+        GeometryError, match=r"density must be a number, not a string \(write 2400, in kg/m³, without the unit\)"
+    ):
         read_geojson(path)
     path = write(tmp_path, [feature(SQ, name="a", thickness="50 cm")], name="cm.geojson")
-    with pytest.raises(GeometryError, match=r"thickness must be a number, not a string \(it is read in m: convert 50 cm to m"):
+    with pytest.raises(
+        GeometryError, match=r"thickness must be a number, not a string \(it is read in m: convert 50 cm to m"
+    ):
         read_geojson(path)

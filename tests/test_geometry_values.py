@@ -62,14 +62,26 @@ def test_number_problem(value, kwargs, reason):
         (" 1e-3 Seconds ", "s", "must be a number, not a string (write 1e-3, in s, without the unit)"),
         ("1 m/s", "m/s", "must be a number, not a string (write 1, in m/s, without the unit)"),
         # another unit than the setting's: said, never converted here
-        ("20 ms", "s", "must be a number, not a string (it is read in s: convert 20 ms to s and write the number alone)"),
+        (
+            "20 ms",
+            "s",
+            "must be a number, not a string (it is read in s: convert 20 ms to s and write the number alone)",
+        ),
         (
             "2.5 t/m3",
             "kg/m³",
             "must be a number, not a string (it is read in kg/m³: convert 2.5 t/m3 to kg/m³ and write the number alone)",
         ),
-        ("90°", "rad", "must be a number, not a string (it is read in rad: convert 90° to rad and write the number alone)"),
-        ("1 m/s", "m", "must be a number, not a string (it is read in m: convert 1 m/s to m and write the number alone)"),
+        (
+            "90°",
+            "rad",
+            "must be a number, not a string (it is read in rad: convert 90° to rad and write the number alone)",
+        ),
+        (
+            "1 m/s",
+            "m",
+            "must be a number, not a string (it is read in m: convert 1 m/s to m and write the number alone)",
+        ),
         ("0.6 mu", "", 'must be a number, not a string (write 0.6, without "mu": this setting has no unit)'),
         ("0.5 m/s", None, 'must be a number, not a string (write 0.5, without "m/s", in SI units)'),
         ("1,5 m", "m", "must be a number, not a string"),  # a decimal comma: no number to name

@@ -12,12 +12,13 @@ import re
 import numpy as np
 import pytest
 
-from cli_helpers import assert_one_line_error, invoke
 from masonrycli.builtin import builtin
 from masonrycli.execute import run_metadata
 from masonrycli.history import HistoryFile
 from masonrycli.history_inspect import NOT_RECORDED, inspect_history, is_history
 from masonrycli.run import Simulation, simulate
+
+from cli_helpers import assert_one_line_error, invoke
 
 
 @pytest.fixture(scope="module")

@@ -459,9 +459,10 @@ def test_a_run_s_recording_opens_at_t0_on_the_structure_as_built(tmp_path):
     the same frames as the history."""
     from shapely.geometry import Polygon
 
-    from cli_helpers import invoke
     from geometry_library.builders import build_wall
     from masonrycli.recording.layout import FIELD_BY_KEY, FORCES, HINGES, SUPPORT_OUTLINES
+
+    from cli_helpers import invoke
 
     rrd, npz = tmp_path / "w.rrd", tmp_path / "w.npz"
     result = invoke("simulate", "wall", "--duration", 0.02, "--out", rrd, "--history", npz)

@@ -205,7 +205,9 @@ def test_an_initial_velocity_faster_than_a_diverged_block_is_refused(tmp_path):
     for fine in ("[1000.0, 0.0, 0.0]", "[600.0, -800.0, 0.0]", f"[0.0, 0.0, {0.999 * 1000 / r}]"):
         scenario(fine)
     for fast in ("[1e9, 0.0, 0.0]", "[800.0, 800.0, 0.0]", f"[0.0, 0.0, {1.001 * 1000 / r}]", "[999.0, 0.0, -10.0]"):
-        with pytest.raises(InputError, match=r'v\.toml:4: \[\[block\]\] #1 \("b1"\): velocity = \[.*\]: a point of the '):
+        with pytest.raises(
+            InputError, match=r'v\.toml:4: \[\[block\]\] #1 \("b1"\): velocity = \[.*\]: a point of the '
+        ):
             scenario(fast)
     with pytest.raises(InputError) as info:
         scenario("[1e9, 0.0, 0.0]")

@@ -104,7 +104,10 @@ BUILDER_ERRORS = [
 @pytest.mark.parametrize(
     "line, expected",
     [
-        ('length = "2.4 m"', '[structure] length = "2.4 m": must be a number, not a string (write 2.4, in m, without the unit)'),
+        (
+            'length = "2.4 m"',
+            '[structure] length = "2.4 m": must be a number, not a string (write 2.4, in m, without the unit)',
+        ),
         (
             'block_height = "200 mm"',
             '[structure] block_height = "200 mm": must be a number, not a string (it is read in m: convert 200 mm to m '

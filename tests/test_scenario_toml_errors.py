@@ -68,7 +68,10 @@ MATERIAL_ERRORS = [
     ("density = 0.0", "[material] density = 0.0: must be > 0"),
     ("density = -inf", "[material] density = -inf: must be a finite number"),
     ("thickness = -1", "[material] thickness = -1: must be > 0"),
-    ('thickness = "1m"', '[material] thickness = "1m": must be a number, not a string (write 1, in m, without the unit)'),
+    (
+        'thickness = "1m"',
+        '[material] thickness = "1m": must be a number, not a string (write 1, in m, without the unit)',
+    ),
     (
         'density = "2500 kg/m3"',
         '[material] density = "2500 kg/m3": must be a number, not a string (write 2500, in kg/m³, without the unit)',

@@ -129,9 +129,14 @@ def test_find_driver_notes_an_outcome_at_both_ends_or_neither():
     assert row["note"] == "no sliding up to friction = 2"
     # at both ends, not between: neither direction fits; the note says so and a grid shows the rest
     (row,) = _search(FindDriver(axis, "friction", "sliding", 0.005, done={}), lambda p: p["friction"] != 0.7)
-    assert math.isnan(row["friction_threshold"]) and row["holds"] == "" and row["note"] == (
-        "sliding already at friction = 0.1, not at friction = 0.7, again at friction = 2: it comes and goes over "
-        "the range (a grid shows where it holds)"
+    assert (
+        math.isnan(row["friction_threshold"])
+        and row["holds"] == ""
+        and row["note"]
+        == (
+            "sliding already at friction = 0.1, not at friction = 0.7, again at friction = 2: it comes and goes over "
+            "the range (a grid shows where it holds)"
+        )
     )
 
 
@@ -139,8 +144,12 @@ def test_find_driver_searches_again_a_row_that_said_the_outcome_comes_below():
     # a table written before the downward search: its row had no threshold and that note; resumed, it is run
     # again (and an upward row of then is kept, marked as found upwards)
     axes = [Axis("friction", (0.1, 0.7, 2.0)), Axis("amp", (0.2, 0.4))]
-    old_below = {"amp": 0.2, "friction_threshold": math.nan, "note": "sliding already at friction = 0.1, not at "
-                 "friction = 2: it comes below a value here; --find looks for the smallest value that brings it"}
+    old_below = {
+        "amp": 0.2,
+        "friction_threshold": math.nan,
+        "note": "sliding already at friction = 0.1, not at "
+        "friction = 2: it comes below a value here; --find looks for the smallest value that brings it",
+    }
     old_above = {"amp": 0.4, "friction_threshold": 0.9, "note": ""}
     done = {store.row_key(r, ["amp"]): r for r in (old_below, old_above)}
     driver = FindDriver(axes, "friction", "sliding", 0.005, done=done)

@@ -43,7 +43,10 @@ def line_of(text: str, fragment: str, nth: int = 1) -> int:
 def test_a_run_setting(tmp_path):
     text = 'name = "t"\n\n[run]\ndt = 1e-3\nduration = "1 s"\n' + block("b1", 0.0)
     line, message = error(tmp_path, text)
-    assert (line, message) == (5, '[run] duration = "1 s": must be a number, not a string (write 1, in s, without the unit)')
+    assert (line, message) == (
+        5,
+        '[run] duration = "1 s": must be a number, not a string (write 1, in s, without the unit)',
+    )
 
 
 def test_look_alikes_in_strings_comments_and_other_tables_are_not_taken(tmp_path):
@@ -83,7 +86,7 @@ def test_the_entry_of_an_array_of_tables(tmp_path):
     assert message.startswith('[[block]] #2 ("b2"): density = "2.5 t/m3"')
     assert line == line_of(text, 'density = "2.5 t/m3"', nth=1) == 8
     # the same key in [material] (valid) and in a block (not): the block's line
-    text = '[material]\nthickness = 1.0\n' + block("b1", 0.0, 'thickness = "1m"\n')
+    text = "[material]\nthickness = 1.0\n" + block("b1", 0.0, 'thickness = "1m"\n')
     assert error(tmp_path, text)[0] == 6
 
 
@@ -105,25 +108,30 @@ def test_a_motion_inline_or_in_its_sub_table(tmp_path):
         + '[support.motion]\nkind = "sine"\namplitude = 1.0\nfrequency = "2 Hz"\n'
     )
     assert error(tmp_path, table)[0] == line_of(table, 'frequency = "2 Hz"') == 17
-    unknown = block("b1", 0.0) + f'[[support]]\nname = "g"\npolygon = {GROUND}\nmotion = {{ kind = "sine", freq = 2.0 }}\n'
+    unknown = (
+        block("b1", 0.0) + f'[[support]]\nname = "g"\npolygon = {GROUND}\nmotion = {{ kind = "sine", freq = 2.0 }}\n'
+    )
     line, message = error(tmp_path, unknown)
     assert message.startswith('[[support]] #1 ("g"): motion: unknown key "freq"')
     assert line == line_of(unknown, "freq = 2.0") == 7
 
 
 def test_unknown_keys_top_level_keys_and_vertices(tmp_path):
-    assert error(tmp_path, '[run]\ndt = 1e-3\ndtt = 0.1\n' + block("b1", 0.0)) == (
+    assert error(tmp_path, "[run]\ndt = 1e-3\ndtt = 0.1\n" + block("b1", 0.0)) == (
         3,
         '[run] unknown key "dtt" (did you mean "dt"?)',
     )
-    assert error(tmp_path, '\nname = 3\n' + block("b1", 0.0)) == (2, "name = 3: must be a string")
+    assert error(tmp_path, "\nname = 3\n" + block("b1", 0.0)) == (2, "name = 3: must be a string")
     text = '[[block]]\nname = "b1"\npolygon = [\n  [0.0, 0.0],\n  [1.0],\n  [1.0, 1.0],\n]\n'
     assert error(tmp_path, text) == (3, '[[block]] #1 ("b1"): polygon[1] = [1.0]: must be 2 numbers [x, y]')
 
 
 def test_no_line_when_the_key_is_not_written_or_none_is_named(tmp_path):
     # a missing key, a block's geometry, a builder's own message: no key line to give
-    missing = block("b1", 0.0) + f'[[support]]\nname = "g"\npolygon = {GROUND}\nmotion = {{ kind = "sine", frequency = 2.0 }}\n'
+    missing = (
+        block("b1", 0.0)
+        + f'[[support]]\nname = "g"\npolygon = {GROUND}\nmotion = {{ kind = "sine", frequency = 2.0 }}\n'
+    )
     assert error(tmp_path, missing) == (
         None,
         '[[support]] #1 ("g"): motion.amplitude: missing (required for kind "sine")',
