@@ -43,6 +43,10 @@ def test_a_set_with_a_one_column_file_sweeps_on_worker_processes(tmp_path):
     assert rows["one.csv", 10.0]["pgv"] == pytest.approx(10 * max(abs(x) for x in v))
     # the same time step makes the same study (its rows reused); another is another record, another study
     again = invoke(*args, "--record-dt", 0.01, "--workers", 0, "--force")
-    assert again.exit_code == 0 and "(0 runs now, 4 rows already there, 0 failed)" in again.output, again.output
+    assert again.exit_code == 0 and "(0 runs now, 4 rows already there, 0 failed)" in " ".join(again.output.split()), (
+        again.output
+    )
     again = invoke(*args, "--record-dt", 0.02, "--workers", 0, "--force")
-    assert again.exit_code == 0 and "(4 runs now, 0 rows already there, 0 failed)" in again.output, again.output
+    assert again.exit_code == 0 and "(4 runs now, 0 rows already there, 0 failed)" in " ".join(again.output.split()), (
+        again.output
+    )
