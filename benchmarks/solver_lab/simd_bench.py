@@ -1,0 +1,127 @@
+"""Coloured SIMD sweeps (simd_sweep.py) against the engine's accelerated sweep on captured steps.
+
+    python -m benchmarks.solver_lab.simd_bench [--case wall-248] [--duration 1] [--every 10] [--rounds 5]
+        [--variants split fused noalias] [--reference]
+
+The steps: the inputs of every ``--every``-th accelerated first-stage call that ``nlgs.solve`` makes on
+``--case`` (bench_kernel.capture). On each, the engine's ``nlgs._nlgs_interleaved`` (momentum, interleaved
+order) and each coloured variant run from the same inputs to the engine's tolerance, stall window 200.
+Timing: ``--rounds`` rounds, each running the engine and then every variant over all steps (the order
+rotated from round to round), CPU time (``time.process_time``) per pass; the minimum over rounds.
+Reported per method: sweeps per step, ns per contact·sweep (CPU / Σ contacts × sweeps), CPU per step of
+the first stage, steps ending above the tolerance (stalled: the engine would hand them to stalled.py),
+and with ``--reference`` the distance of v from a tight solve of the same step (momentum to 1e-9 m/s,
+then plain NLGS if that stalls): RMS over the step's bodies and components, then mean and max over steps.
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+
+import numpy as np
+
+from benchmarks.bench_kernel import capture
+from benchmarks.solver_lab import simd_sweep
+from masonrycli.engine import nlgs
+
+TIGHT = 1e-9
+TIGHT_CAP = 200_000
+
+
+def _engine(call):
+    contact_body, pack, count, mu, tolerance, cap, v, r, status, accelerate, stall = call
+    v, r, status = v.copy(), r.copy(), status.copy()
+    sweeps, residual = nlgs._nlgs_interleaved(contact_body, pack, count, mu, tolerance, cap, v, r, status,
+                                              accelerate, stall)  # fmt: skip
+    return sweeps, residual, v
+
+
+def _coloured(call, variant):
+    contact_body, pack, count, mu, tolerance, cap, v, r, status, accelerate, stall = call
+    v, r, status = v.copy(), r.copy(), status.copy()
+    sweeps, residual, _ = simd_sweep.solve(contact_body, pack, count, mu, tolerance, cap, v, r, status, stall,
+                                           variant)  # fmt: skip
+    return sweeps, residual, v
+
+
+def _tight(call):
+    contact_body, pack, count, mu, tolerance, cap, v, r, status, accelerate, stall = call
+    v1, r1, s1 = v.copy(), r.copy(), status.copy()
+    _, residual = nlgs._nlgs_interleaved(contact_body, pack, count, mu, TIGHT, TIGHT_CAP, v1, r1, s1, True,
+                                         nlgs.STALL_SWEEPS)  # fmt: skip
+    if residual > TIGHT:
+        v1, r1, s1 = v.copy(), r.copy(), status.copy()
+        _, residual = nlgs._nlgs_interleaved(contact_body, pack, count, mu, TIGHT, TIGHT_CAP, v1, r1, s1, False,
+                                             nlgs.STALL_SWEEPS)  # fmt: skip
+    return v1, residual
+
+
+def run(case, duration, every, rounds, variants, reference):
+    calls = capture(case, duration, every)
+    methods = {"engine": _engine} | {v: (lambda call, v=v: _coloured(call, v)) for v in variants}
+    outcome = {}
+    for name, method in methods.items():  # compile, and the outcome of every step
+        outcome[name] = [method(call) for call in calls]
+    cpu = {name: np.inf for name in methods}
+    names = list(methods)
+    for k in range(rounds):
+        for name in names[k % len(names) :] + names[: k % len(names)]:
+            start = time.process_time()
+            for call in calls:
+                methods[name](call)
+            cpu[name] = min(cpu[name], time.process_time() - start)
+    refs = [_tight(call) for call in calls] if reference else None
+    counts = np.array([call[2] for call in calls])
+    tolerance = calls[0][4]
+    rows = []
+    for name in names:
+        sweeps = np.array([o[0] for o in outcome[name]])
+        residual = np.array([o[1] for o in outcome[name]])
+        row = {
+            "method": name,
+            "sweeps": sweeps.mean(),
+            "ns": cpu[name] / float((sweeps * counts).sum()) * 1e9,
+            "ms_step": cpu[name] / len(calls) * 1e3,
+            "stalled": int((residual > tolerance).sum()),
+        }
+        if refs is not None:
+            err = np.array([np.sqrt(np.mean((o[2] - ref[0]) ** 2)) for o, ref in zip(outcome[name], refs)])
+            row["err_mean"], row["err_max"] = err.mean(), err.max()
+        rows.append(row)
+    colours = [simd_sweep.solve(*call[:4], call[4], call[5], call[6].copy(), call[7].copy(), call[8].copy(),
+                                call[10])[2] for call in calls]  # fmt: skip
+    print(f"{case} {duration} s, every {every}th first-stage call: {len(calls)} steps, {counts.mean():.0f} contacts "
+          f"a step, tolerance {tolerance:g} m/s, minimum of {rounds} rounds" + (
+          f"; reference: tight solve to {TIGHT:g} (worst residual {max(r[1] for r in refs):.1e})" if refs else ""))  # fmt: skip
+    engine = rows[0]
+    print("| method | sweeps/step | ns per contact·sweep | first stage ms/step | ÷ engine | stalled steps |"
+          + (" v error mean / max (m/s) |" if refs else ""))  # fmt: skip
+    print("|---|---|---|---|---|---|" + ("---|" if refs else ""))
+    for row in rows:
+        line = (f"| {row['method']} | {row['sweeps']:.1f} | {row['ns']:.2f} | {row['ms_step']:.3f} | "
+                f"{row['ms_step'] / engine['ms_step']:.2f} | {row['stalled']} |")  # fmt: skip
+        if refs is not None:
+            line += f" {row['err_mean']:.2e} / {row['err_max']:.2e} |"
+        print(line)
+    print(
+        f"colours a step: {np.mean(colours):.1f} (min {min(colours)}, max {max(colours)}); "
+        f"contacts a colour {np.mean(counts / np.array(colours)):.0f} on average"
+    )
+    return rows
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--case", default="wall-248")
+    parser.add_argument("--duration", type=float, default=1.0)
+    parser.add_argument("--every", type=int, default=10)
+    parser.add_argument("--rounds", type=int, default=5)
+    parser.add_argument("--variants", nargs="*", default=["split", "fused"])
+    parser.add_argument("--reference", action="store_true")
+    args = parser.parse_args(argv)
+    return run(args.case, args.duration, args.every, args.rounds, args.variants, args.reference)
+
+
+if __name__ == "__main__":
+    main()
