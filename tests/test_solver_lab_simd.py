@@ -80,7 +80,7 @@ def _solve(problem, variant, tolerance, cap=200_000):
     return out, v, r
 
 
-@pytest.mark.parametrize("variant", ["split", "fused", "split2"])
+@pytest.mark.parametrize("variant", ["split", "fused", "split2", "blocks"])
 def test_coloured_sweeps_converge_to_the_tight_solution(problem, variant):
     (sweeps, residual, colours), v, r = _solve(problem, variant, 1e-10)
     assert residual <= 1e-10 and colours >= 2 and sweeps > 1
@@ -103,7 +103,8 @@ def test_level_schedule_replays_the_engines_sweep_bit_for_bit(problem):
     assert np.array_equal(v, v2) and np.array_equal(r, r2)
 
 
-def test_the_same_step_gives_the_same_bits(problem):
-    a = _solve(problem, "split", 1e-8)
-    b = _solve(problem, "split", 1e-8)
+@pytest.mark.parametrize("variant", ["split", "blocks"])
+def test_the_same_step_gives_the_same_bits(problem, variant):
+    a = _solve(problem, variant, 1e-8)
+    b = _solve(problem, variant, 1e-8)
     assert a[0] == b[0] and np.array_equal(a[1], b[1]) and np.array_equal(a[2], b[2])

@@ -348,21 +348,15 @@ def sorted_arrays(contact_body, pack, count, r, order):
 def build(variant: str):
     """The coloured first stage with phase A as ``variant``: "fused" (one loop, indirect reads of v: LLVM
     cannot bound them for its alias checks and leaves it scalar), "split" (_gather_u scalar, then
-    _solve_u vectorised), "noalias" (fused, compiled with numba's noalias flag on its arguments: then
-    vectorised with gathers; the flag is not a public numba option). Returns the kernel
+    _solve_u vectorised), "split2", "levels" / "levels+fused", "sym+split" (benchmarks/README.md). A
+    "noalias" phase A (fused, compiled with numba's private noalias flag: vectorised, with gathers) was
+    measured and removed: only the engine may import numba. Returns the kernel
     (contact_body, pack, count, mu, tolerance, cap, v, v_flat, r, status, stall) → (iterations,
     residual, colours)."""
-    schedule, _, phase = variant.rpartition("+")  # "levels+noalias": the level schedule, phase A noalias
+    schedule, _, phase = variant.rpartition("+")  # "levels+fused": the level schedule, phase A fused
     if phase == "levels":
         schedule, phase = "levels", "split"
-    if phase == "noalias":
-        import numba
-        from numba.core import cpu, options
-
-        cpu.CPUTargetOptions.no_alias = options.TargetOptions.Mapping("noalias")
-        phase_a = numba.njit(no_alias=True, error_model="numpy", no_cfunc_wrapper=True)(_phase_a.py_func)
-    else:
-        phase_a = _phase_a
+    phase_a = _phase_a
     split = phase in ("split", "split2")
     deltas = phase == "split2"
     exact = schedule == "levels"
@@ -481,7 +475,11 @@ def solve(
     contact_body, pack, count, mu, tolerance, cap, v, r, status, stall_after=momentum.STALL_SWEEPS, variant="split"
 ):
     """The coloured first stage on one step's arrays (as nlgs._nlgs_interleaved takes them).
-    Returns (iterations, residual, colours)."""
+    Returns (iterations, residual, colours). Variant "blocks": simd_blocks.py's layout in 8-contact blocks."""
+    if variant == "blocks":
+        from benchmarks.solver_lab import simd_blocks  # it builds on this module
+
+        return simd_blocks.solve(contact_body, pack, count, mu, tolerance, cap, v, r, status, stall_after)
     if variant not in _KERNELS:
         _KERNELS[variant] = build(variant)
     return _KERNELS[variant](contact_body, pack, count, mu, tolerance, cap, v, v.reshape(-1), r, status, stall_after)
