@@ -22,7 +22,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from benchmarks.solver_lab.simd_schedule import MASK_WORDS, colour, levels  # noqa: F401 (re-exported)
+from benchmarks.solver_lab.simd_schedule import MASK_WORDS, colour, lanes, levels  # noqa: F401 (re-exported)
 from masonrycli.engine import momentum, nlgs
 from masonrycli.engine._jit import njit
 from masonrycli.engine.nlgs import (
@@ -360,6 +360,7 @@ def build(variant: str):
     split = phase in ("split", "split2")
     deltas = phase == "split2"
     exact = schedule == "levels"
+    by_lanes = schedule == "lanes"  # "lanes+split": groups of the 8-run interleaved order (simd_schedule.lanes)
     symmetric = schedule == "sym"  # "sym+split": the colours' order turns every sweep (symmetric GS)
 
     @njit(cache=False)
@@ -376,6 +377,10 @@ def build(variant: str):
             pos = order.copy()  # visit position of each sorted row
             for i in range(count):
                 order[i] = visit[pos[i]]
+        elif by_lanes:
+            start = np.empty(count + 1, np.int64)
+            n_colours = lanes(contact_body, pack, count, body_count, order, start)
+            pos = order
         else:
             start = np.empty(MASK_WORDS * 64 + 1, np.int64)
             n_colours = colour(contact_body, pack, count, body_count, order, start)
