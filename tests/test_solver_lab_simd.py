@@ -7,6 +7,7 @@ colouring's definition checked by brute force, and the tight solve the lab's cap
 import numpy as np
 import pytest
 from solver_lab_helpers import tiny_cold_problem
+from test_engine_nlgs import _packed_row, _random_problem, _stack_problem
 
 from benchmarks.solver_lab import law, simd_sweep
 from benchmarks.solver_lab.outcome import Context
@@ -128,3 +129,85 @@ def test_lane_groups_are_the_8_run_interleaved_order_in_independent_groups(probl
                     seen.add(int(problem.body[c, side]))
     # on this 7-block wall the runs are short and meet: some groups had to be split into single visits
     assert groups > run
+
+
+def test_branch_free_local_solve_on_edge_inputs():
+    # each branch at its boundary, a W_tn that reverses the free direction, degenerate rows as _prepare
+    # writes them (W⁻¹ zeroed; then also both sliding denominators): the engine's bits and statuses
+    mu, w_diag, w_coupled = 0.5, (1.0, 0.0, 1.0), (1.0, 0.9, 1.0)
+    cases = [  # (u_t, u_n, W, bias, the status _local_solve's definition gives)
+        (0.3, 0.2, w_diag, 0.0, nlgs.STATUS_OPEN),
+        (0.0, 0.0, w_diag, 0.0, nlgs.STATUS_OPEN),  # u_n + bias = 0 is open
+        (0.1, -1.0, w_diag, 0.0, nlgs.STATUS_STICK),
+        (-0.0, -1.0, w_diag, 0.0, nlgs.STATUS_STICK),
+        (2.0, -1.0, w_diag, 0.0, nlgs.STATUS_SLIP),
+        (-2.0, -1.0, w_diag, 0.0, nlgs.STATUS_SLIP),
+        (0.5, -1.0, w_diag, 0.2, nlgs.STATUS_SLIP),
+        (0.6, -1.0, w_coupled, 0.0, nlgs.STATUS_SLIP),
+        (-0.6, -1.0, w_coupled, 0.0, nlgs.STATUS_SLIP),
+    ]
+    rows = [_packed_row(w, bias, mu)[0] for _, _, w, bias, _ in cases]
+    degenerate = _packed_row(w_diag, 0.0, mu)[0]
+    degenerate[[nlgs.P_ITT, nlgs.P_ITN, nlgs.P_INN]] = 0.0
+    no_slide = degenerate.copy()
+    no_slide[[nlgs.P_ISP, nlgs.P_ISM]] = 0.0
+    pack = np.vstack(rows + [degenerate, no_slide, no_slide])
+    ut = np.array([c[0] for c in cases] + [0.3, 0.3, -0.3])
+    un = np.array([c[1] for c in cases] + [-1.0, -1.0, -1.0])
+    out = []
+    for kernel in (simd_sweep.local_solve_many, simd_sweep.local_solve_bf_many):
+        r, st = np.empty((len(ut), 2)), np.empty(len(ut), np.int8)
+        kernel(ut, un, pack, mu, r, st)
+        out.append((r, st))
+    (r_ref, s_ref), (r_bf, s_bf) = out
+    assert s_ref[: len(cases)].tolist() == [c[4] for c in cases]
+    assert np.array_equal(r_ref.view(np.int64), r_bf.view(np.int64)) and np.array_equal(s_ref, s_bf)
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_colouring_of_random_joints_through_supports(seed):
+    # 40 blocks and 3 supports, 300 contacts in joints of 1–3 points between random pairs
+    rng = np.random.default_rng(seed)
+    inv_mass, inv_inertia = np.r_[rng.uniform(0.5, 2, 40), np.zeros(3)], np.r_[rng.uniform(1, 5, 40), np.zeros(3)]
+    pairs = []
+    while len(pairs) < 300:
+        a, b = sorted(rng.choice(43, 2, replace=False))
+        pairs += [(a, b)] * int(rng.integers(1, 4)) if a < 40 else []
+    body = np.array(pairs[:300], np.int32)
+    pack = np.zeros((300, nlgs.PACK_WIDTH))
+    pack[:, nlgs.P_IMA], pack[:, nlgs.P_IIA] = inv_mass[body[:, 0]], inv_inertia[body[:, 0]]
+    pack[:, nlgs.P_IMB], pack[:, nlgs.P_IIB] = inv_mass[body[:, 1]], inv_inertia[body[:, 1]]
+    order, start = np.empty(300, np.int64), np.empty(simd_sweep.MASK_WORDS * 64 + 1, np.int64)
+    n = simd_sweep.colour(body, pack, 300, 43, order, start)
+    assert np.array_equal(np.sort(order), np.arange(300)) and (np.diff(start[: n + 1]) > 0).all()
+    for k in range(n):
+        rows = order[start[k] : start[k + 1]]
+        movable = [x for c in rows for x in body[c] if x < 40]
+        assert len(movable) == len(set(movable)), k
+    assert n <= 2 * np.bincount(body[body < 40], minlength=40).max() - 1  # greedy's bound
+    # contacts of five blocks on one support: one colour
+    on_support = np.zeros((5, nlgs.PACK_WIDTH))
+    on_support[:, nlgs.P_IMA] = on_support[:, nlgs.P_IIA] = 1.0
+    n = simd_sweep.colour(np.array([(i, 40) for i in range(5)], np.int32), on_support, 5, 43, order, start)
+    assert n == 1
+
+
+@pytest.mark.parametrize(("problem", "sweeps"), [(("random", 5), 30), (("random", 41), 12), (("stack", 6), 60)])
+def test_coloured_sweeps_are_momentum_gauss_seidel_in_colour_order(problem, sweeps):
+    # No two visits of a colour share a movable body, so the coloured sweeps must give what the engine's
+    # sequential momentum sweeps give on the contacts renumbered in colour order (tolerance 0: the cap).
+    kind, arg = problem
+    body, pack, _, _, _, v0, r0, mu, _ = _random_problem(arg) if kind == "random" else _stack_problem(arg)
+    count = body.shape[0]
+    order, start = np.empty(count, np.int64), np.empty(simd_sweep.MASK_WORDS * 64 + 1, np.int64)
+    assert simd_sweep.colour(body, pack, count, v0.shape[0], order, start) > 1
+    v, r, status = v0.copy(), r0.copy(), np.zeros(count, np.int8)
+    its, res, _ = simd_sweep.solve(body, pack, count, mu, 0.0, sweeps, v, r, status, sweeps)
+    v_s, r_s, st_s = v0.copy(), r0[order].copy(), np.zeros(count, np.int8)
+    its_s, res_s = momentum._nlgs_accelerated(np.ascontiguousarray(body[order]), np.ascontiguousarray(pack[order]),
+                                              count, mu, 0.0, sweeps, v_s, r_s, st_s, momentum.STALL_SWEEPS)  # fmt: skip
+    assert its == its_s == sweeps
+    assert res == pytest.approx(res_s, rel=1e-12, abs=1e-18)  # only the residual's summation order differs
+    np.testing.assert_allclose(v, v_s, rtol=1e-12, atol=1e-15)
+    np.testing.assert_allclose(r[order], r_s, rtol=1e-12, atol=1e-15)
+    assert np.array_equal(status[order], st_s)
