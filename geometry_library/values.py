@@ -105,6 +105,31 @@ def same_unit(written: str, unit: str) -> bool:
     return _spelled(written) in {_spelled(s) for s in (unit, *_SPELLINGS.get(unit, ()))}
 
 
+OPTION_UNITS: dict[str, str] = {
+    "amp": "m/s",
+    "freq": "Hz",
+    "settlement": "m/s",
+    "record_dt": "s",
+    "rtol": "",
+    "workers": "",
+    "magnify": "",
+    "block": "",
+}
+"""The unit of each numeric command-line option or sweep axis whose name is not a setting's (--amp,
+--freq, --record-dt, …; the others go by SETTING_UNITS)."""
+
+
+def unit_of(name: str) -> str | None:
+    """The unit a setting, option or sweep axis ``name`` is read in ("": none), None when not known."""
+    return SETTING_UNITS.get(name, OPTION_UNITS.get(name))
+
+
+def unit_hint(text: str, unit: str | None) -> str:
+    """What to write instead of ``text`` given where a number is read in ``unit`` (:func:`_string_hint`):
+    the command line's options use it too (``--dt 20ms``)."""
+    return _string_hint(text, unit)
+
+
 def _string_hint(text: str, unit: str | None) -> str:
     """What to write instead of the string ``text``: `` (write 2500, without quotes)`` for a number in
     quotes; for a number and a unit (``"1 s"``, ``"0.5m"``), the number alone and the unit the setting is

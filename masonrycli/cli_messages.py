@@ -14,6 +14,7 @@ from rich.text import Text
 from typer._click import exceptions as click_errors  # typer 0.29 vendors click; no public name
 
 from geometry_library.blocks import GeometryError
+from geometry_library.values import unit_hint, unit_of
 from masonrycli.errors import EXIT_BAD_INPUT, InputError, RecordWarning
 
 # No markup and no highlighting: file names, TOML tables ("[run]") and values ("[inf, 0, 0]") print as given.
@@ -90,9 +91,28 @@ class OneLineUsageErrors(typer.core.TyperGroup):
         except click_errors.UsageError as exc:
             command = exc.ctx.command_path if exc.ctx is not None else "masonry"
             listed = "commands" if exc.format_message().startswith("No such command") else "options"
-            say("error", "bold red", f"{exc.format_message()} ({command} --help lists the {listed})")
+            said = _number_with_unit(exc) or f"{exc.format_message()} ({command} --help lists the {listed})"
+            say("error", "bold red", said)
             sys.exit(exc.exit_code)
         except click_errors.ClickException as exc:
             say("error", "bold red", exc.format_message())
             sys.exit(exc.exit_code)
         sys.exit(code if isinstance(code, int) else 0)
+
+
+def _number_with_unit(exc) -> str | None:
+    """``--dt 20ms: must be a number (it is read in s: convert 20 ms to s and write the number alone)`` for
+    a numeric option given a number and a unit ("1s", "20 ms", "0.5m/s"), ``--dt abc: must be a number`` for
+    other text, in place of the parser's "Invalid value for '--dt': Input should be a valid number"; None for
+    any other usage error."""
+    param, cause = getattr(exc, "param", None), exc.__cause__
+    try:
+        first = cause.errors()[0]  # typer converts through pydantic: the value as typed is kept there
+    except (AttributeError, IndexError, TypeError):
+        return None
+    kind = {"float_parsing": "a number", "int_parsing": "an integer"}.get(first.get("type"))
+    text = first.get("input")
+    if param is None or kind is None or not isinstance(text, str):
+        return None
+    hint = unit_hint(text, unit_of(param.name))
+    return f"{max(param.opts, key=len)} {text.strip()}: must be {kind}{hint}"

@@ -14,7 +14,7 @@ RUN = ("run", "s.toml")
 OPTION_ROWS = [
     # -- every option of run / check / simulate / build
     ("opt-dt", {**scen()}, (*RUN, "--dt", "-1", "--no-recording"), 2, "--dt: dt = -1.0: must be > 0"),
-    ("opt-dt-text", {**scen()}, (*RUN, "--dt", "abc"), 2, "Invalid value for '--dt'"),
+    ("opt-dt-text", {**scen()}, (*RUN, "--dt", "abc"), 2, "--dt abc: must be a number"),
     ("opt-duration", {**scen()}, (*RUN, "--duration", "0", "--no-recording"), 2, "--duration: duration = 0"),
     (
         "opt-duration-dt-steps",

@@ -25,6 +25,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from geometry_library.values import unit_hint, unit_of
 from masonrycli.errors import InputError
 from masonrycli.values import did_you_mean
 
@@ -61,7 +62,7 @@ def parse_axis(text: str) -> Axis:
         parts = spec.split(":")
         if len(parts) != 3:
             raise InputError(f"{where}: a range is LO:HI:N (e.g. amp=0.1:1.0:10)")
-        lo, hi = (_number(p, where) for p in parts[:2])
+        lo, hi = (_number(p, where, name) for p in parts[:2])
         try:
             n = int(parts[2])
         except ValueError:
@@ -74,7 +75,7 @@ def parse_axis(text: str) -> Axis:
             raise InputError(f"{where}: N = {n} values, more than {MAX_RUNS} (a likely typo)")
         values = tuple(float(v) for v in np.linspace(lo, hi, n))
     else:
-        values = tuple(_number(p, where) for p in spec.split(","))
+        values = tuple(_number(p, where, name) for p in spec.split(","))
     if name.split(".")[-1] in INT_PARAMS or _is_builder_int(name):
         if not all(float(v).is_integer() for v in values):
             raise InputError(f"{where}: {name} takes whole numbers")
@@ -82,11 +83,12 @@ def parse_axis(text: str) -> Axis:
     return Axis(name, values)
 
 
-def _number(text: str, where: str) -> float:
+def _number(text: str, where: str, name: str) -> float:
     try:
         value = float(text)
     except ValueError:
-        raise InputError(f"{where}: {text.strip()!r} is not a number") from None
+        hint = unit_hint(text, unit_of(name.split(".")[-1]))  # "0.1m/s": what to write
+        raise InputError(f"{where}: {text.strip()!r} is not a number{hint}") from None
     if not math.isfinite(value):
         raise InputError(f"{where}: values must be finite")
     return value
