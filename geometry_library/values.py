@@ -105,23 +105,29 @@ def same_unit(written: str, unit: str) -> bool:
     return _spelled(written) in {_spelled(s) for s in (unit, *_SPELLINGS.get(unit, ()))}
 
 
+OPTION_SETTINGS: dict[str, str] = {
+    "amp": "amplitude",
+    "freq": "frequency",
+    "settlement": "amplitude",
+    "record_dt": "time_step",
+}
+"""The setting a command-line option or sweep axis stands for when its name is another (--amp is a
+motion's amplitude, --record-dt a record's time_step): its unit is that setting's in SETTING_UNITS."""
+
 OPTION_UNITS: dict[str, str] = {
-    "amp": "m/s",
-    "freq": "Hz",
-    "settlement": "m/s",
-    "record_dt": "s",
     "rtol": "",
     "workers": "",
     "magnify": "",
     "block": "",
 }
-"""The unit of each numeric command-line option or sweep axis whose name is not a setting's (--amp,
---freq, --record-dt, …; the others go by SETTING_UNITS)."""
+"""The unit of each numeric option with no scenario setting (their help: --rtol a relative width,
+--workers a count, --magnify a factor, limit's --block an index): the one place they are added."""
 
 
 def unit_of(name: str) -> str | None:
     """The unit a setting, option or sweep axis ``name`` is read in ("": none), None when not known."""
-    return SETTING_UNITS.get(name, OPTION_UNITS.get(name))
+    setting = OPTION_SETTINGS.get(name, name)
+    return SETTING_UNITS[setting] if setting in SETTING_UNITS else OPTION_UNITS.get(name)
 
 
 def unit_hint(text: str, unit: str | None) -> str:
@@ -150,7 +156,8 @@ def _string_hint(text: str, unit: str | None) -> str:
         return f' (write {number}, without "{written}": this setting has no unit)'
     if same_unit(written, unit):
         return f" (write {number}, in {unit}, without the unit)"
-    return f" (it is read in {unit}: convert {text.strip()} to {unit} and write the number alone)"
+    spaced = number + ("" if written.startswith("°") else " ") + written  # "20ms": convert 20 ms; "90°" stays
+    return f" (it is read in {unit}: convert {spaced} to {unit} and write the number alone)"
 
 
 def number_problem(

@@ -13,11 +13,15 @@ RUN = ("simulate", "wall", "--duration", "0.01", "--no-recording")
     "option, value, message",
     [
         ("--dt", "0.001s", "--dt 0.001s: must be a number (write 0.001, in s, without the unit)"),
-        ("--dt", "20ms", "--dt 20ms: must be a number (it is read in s: convert 20ms to s and write the number alone)"),
+        (
+            "--dt",
+            "20ms",
+            "--dt 20ms: must be a number (it is read in s: convert 20 ms to s and write the number alone)",
+        ),
         ("--amp", "1m/s", "--amp 1m/s: must be a number (write 1, in m/s, without the unit)"),
         ("--amp", "3 cm/s", "--amp 3 cm/s: must be a number (it is read in m/s: convert 3 cm/s to m/s"),
         ("--freq", "2Hz", "--freq 2Hz: must be a number (write 2, in Hz, without the unit)"),
-        ("--density", "2.5t/m3", "--density 2.5t/m3: must be a number (it is read in kg/m³: convert 2.5t/m3"),
+        ("--density", "2.5t/m3", "--density 2.5t/m3: must be a number (it is read in kg/m³: convert 2.5 t/m3 to kg/m³"),
         (
             "--friction",
             "0.6mu",
@@ -35,6 +39,85 @@ def test_a_number_option_given_text_says_what_to_write(option, value, message):
         assert result.output.strip().endswith("--dt abc: must be a number")
 
 
+@pytest.mark.parametrize(
+    "args, message",
+    [
+        # same unit, other unit, unitless option, plain garbage — on each command that takes numbers
+        (
+            ("run", "/no/such.toml", "--duration", "1s"),
+            "--duration 1s: must be a number (write 1, in s, without the unit)",
+        ),
+        (
+            ("check", "/no/such.toml", "--record-dt", "10ms"),
+            "--record-dt 10ms: must be a number (it is read in s: convert 10 ms",
+        ),
+        (
+            ("simulate", "arch", "--settlement", "1cm/s"),
+            "--settlement 1cm/s: must be a number (it is read in m/s: convert 1 cm/s",
+        ),
+        (
+            ("build", "arch", "--span", "2m", "--out", "x.geojson"),
+            "--span 2m: must be a number (write 2, in m, without the unit)",
+        ),
+        (
+            ("limit", "wall", "--friction", "0.6mu"),
+            '--friction 0.6mu: must be a number (write 0.6, without "mu": this setting has',
+        ),
+        (
+            ("sweep", "wall", "--param", "amp=1", "--dt", "20ms"),
+            "--dt 20ms: must be a number (it is read in s: convert 20 ms to s",
+        ),
+        (("sweep", "wall", "--param", "amp=1", "--rtol", "1%"), "--rtol 1%: must be a number"),
+        (
+            ("sweep", "wall", "--param", "amp=1", "--workers", "2cores"),
+            '--workers 2cores: must be an integer (write 2, without "cores"',
+        ),
+        # --param: a value, a range bound, plain garbage
+        (
+            ("sweep", "wall", "--param", "freq=2Hz,3"),
+            "--param freq=2Hz,3: '2Hz' is not a number (write 2, in Hz, without the unit)",
+        ),
+        (
+            ("sweep", "wall", "--param", "amp=0.1:20cm/s:3"),
+            "--param amp=0.1:20cm/s:3: '20cm/s' is not a number (it is read in m/s: convert 20 cm/s to m/s and write",
+        ),
+        (
+            ("sweep", "wall", "--param", "amp=0.1m/s:1:3"),
+            "'0.1m/s' is not a number (write 0.1, in m/s, without the unit)",
+        ),
+        (("sweep", "wall", "--param", "amp=abc"), "--param amp=abc: 'abc' is not a number"),
+    ],
+)
+def test_every_command_says_what_to_write_for_its_numbers(args, message):
+    result = invoke(*args)
+    assert_one_line_error(result, message)
+    if message.endswith("is not a number") or message.endswith("must be a number"):
+        assert result.output.strip().endswith(message)  # plain garbage: no hint
+
+
+def test_every_numeric_option_has_a_known_unit():
+    """An option added without a unit in SETTING_UNITS (by its setting) or OPTION_UNITS gives no hint."""
+    import typing
+
+    import typer
+
+    from geometry_library.values import unit_of
+    from masonrycli.cli import app
+
+    commands = typer.main.get_command(app).commands
+    numeric = [
+        (name, p.name)
+        for group in ("simulate", "run", "check", "limit", "build", "sweep")
+        for name, command in (getattr(commands[group], "commands", None) or {group: commands[group]}).items()
+        for p in command.params
+        if {float, int} & {(a := p.type_descriptor.annotation), *typing.get_args(a)}
+    ]
+    assert len(numeric) > 20
+    assert [option for option in numeric if unit_of(option[1]) is None] == []
+
+
 def test_other_usage_errors_keep_their_message_and_the_help_pointer():
     assert_one_line_error(invoke(*RUN, "--no-such-option"), "No such option", "--help lists the options")
     assert_one_line_error(invoke(*RUN, "--amp", "nan"), "--amp: amplitude = nan: must be a finite number")
+    assert_one_line_error(invoke(*RUN, "--amp", "inf"), "--amp: amplitude = inf: must be a finite number")
+    assert invoke(*RUN, "--amp", "-1").exit_code == 0  # a sine of opposite sign: accepted, as before

@@ -33,7 +33,7 @@ def test_parse_axis_forms_and_errors():
         ("amp=1:2:1", "N must be >= 2"),
         ("amp=a,b", "'a' is not a number$"),
         ("amp=0.1m/s:1:3", r"'0.1m/s' is not a number \(write 0.1, in m/s, without the unit\)"),
-        ("amp=0.1,2Hz", r"'2Hz' is not a number \(it is read in m/s: convert 2Hz to m/s"),
+        ("amp=0.1,2Hz", r"'2Hz' is not a number \(it is read in m/s: convert 2 Hz to m/s"),
         ("freq=2 Hz", r"'2 Hz' is not a number \(write 2, in Hz, without the unit\)"),
         ("friction=0.6mu", r"\(write 0.6, without \"mu\": this setting has no unit\)"),
         ("amp=nan", "values must be finite"),
