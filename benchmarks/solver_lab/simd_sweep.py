@@ -357,7 +357,8 @@ def build(variant: str):
     if phase == "levels":
         schedule, phase = "levels", "split"
     phase_a = _phase_a
-    split = phase in ("split", "split2")
+    split = phase in ("split", "split2", "split4")
+    pad4 = phase == "split4"  # bodies' velocities padded to 4 doubles: a body's (vx, vy, ω) one 256-bit row
     deltas = phase == "split2"
     exact = schedule == "levels"
     by_lanes = schedule == "lanes"  # "lanes+split": groups of the 8-run interleaved order (simd_schedule.lanes)
@@ -413,9 +414,16 @@ def build(variant: str):
         if deltas:  # the sweeps work on vw: v, then the scratch slots
             vw[:n3] = v_flat
             v_work = vw
+        elif pad4:  # the sweeps work on v4: body b at 4b … 4b + 2, offsets 4·body
+            v_work = np.zeros(4 * body_count, np.float64)
+            v_work.reshape(body_count, 4)[:, :3] = v_flat.reshape(body_count, 3)
+            for i in range(count):
+                ia[i] = ia[i] // np.uint64(3) * np.uint64(4)
+                ib[i] = ib[i] // np.uint64(3) * np.uint64(4)
+            n3 = 4 * body_count
         else:
             v_work = v_flat
-        v_prev_flat = v_flat.copy()
+        v_prev_flat = v_work[:n3].copy()
         iterations = 0
         residual = 0.0
         best = np.inf
@@ -463,6 +471,8 @@ def build(variant: str):
             j += 1
         if deltas:
             v_flat[:] = vw[:n3]
+        if pad4:
+            v_flat.reshape(body_count, 3)[:, :] = v_work.reshape(body_count, 4)[:, :3]
         for i in range(count):
             c = order[i]
             r[c, 0] = X[0, i]
