@@ -118,10 +118,10 @@ OPTION_UNITS: dict[str, str] = {
     "rtol": "",
     "workers": "",
     "magnify": "",
-    "block": "",
 }
 """The unit of each numeric option with no scenario setting (their help: --rtol a relative width,
---workers a count, --magnify a factor, limit's --block an index): the one place they are added."""
+--workers a count, --magnify a factor): the one place they are added. (limit's --block is a block's
+name, not a number.)"""
 
 
 def unit_of(name: str) -> str | None:
