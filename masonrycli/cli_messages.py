@@ -114,5 +114,12 @@ def _number_with_unit(exc) -> str | None:
     text = first.get("input")
     if param is None or kind is None or not isinstance(text, str):
         return None
-    hint = unit_hint(text, unit_of(param.name))
-    return f"{max(param.opts, key=len)} {text.strip()}: must be {kind}{hint}"
+    try:  # "--blocks 51.5": a number, not a whole one; "(write 51.5, without quotes)" read a quote never typed
+        float(text)
+        hint = ""
+    except ValueError:
+        hint = unit_hint(text, unit_of(param.name))
+    shown = text.strip()
+    if not shown.isprintable():  # "--dt $'1\nx'" printed two lines
+        shown = shown.encode("unicode_escape").decode("ascii")
+    return f"{max(param.opts, key=len)} {shown}: must be {kind}{hint}"

@@ -121,3 +121,19 @@ def test_other_usage_errors_keep_their_message_and_the_help_pointer():
     assert_one_line_error(invoke(*RUN, "--amp", "nan"), "--amp: amplitude = nan: must be a finite number")
     assert_one_line_error(invoke(*RUN, "--amp", "inf"), "--amp: amplitude = inf: must be a finite number")
     assert invoke(*RUN, "--amp", "-1").exit_code == 0  # a sine of opposite sign: accepted, as before
+
+
+def test_a_whole_number_option_given_a_fraction_or_a_control_character_says_so_on_one_line(tmp_path):
+    # "--blocks 51.5" said "(write 51.5, without quotes)": no quote was typed, and 51.5 is what was refused
+    result = invoke(*RUN, "--blocks", "51.5")
+    assert_one_line_error(result, "--blocks 51.5: must be an integer")
+    assert result.output.strip().endswith("--blocks 51.5: must be an integer")
+    # a newline in the value printed the message on two lines
+    assert_one_line_error(invoke(*RUN, "--dt", "1\nx"), "--dt 1\\nx: must be a number")
+
+
+def test_the_scale_axis_is_named_by_its_option(tmp_path):
+    # "--scale 0.5x:2:3" was reported as "--param scale=0.5x:2:3", an option not typed
+    (tmp_path / "r.csv").write_text("0.01\n0.02\n0.0\n")
+    args = ("sweep", "wall", "--records", tmp_path, "--record-dt", "0.01", "--scale", "0.5x:2:3")
+    assert_one_line_error(invoke(*args), "--scale 0.5x:2:3: '0.5x' is not a number (write 0.5, without \"x\"")

@@ -51,9 +51,10 @@ class Axis:
         return float(min(self.values)), float(max(self.values))
 
 
-def parse_axis(text: str) -> Axis:
-    """``amp=0.1:1.0:10`` / ``amp=0.2,0.8`` / ``blocks=51`` -> :class:`Axis`. Raises :class:`InputError`."""
-    where = f"--param {text}"
+def parse_axis(text: str, where: str = "") -> Axis:
+    """``amp=0.1:1.0:10`` / ``amp=0.2,0.8`` / ``blocks=51`` -> :class:`Axis`. Raises :class:`InputError`
+    naming ``where`` (default ``--param TEXT``; ``--scale 0.5:2:4`` for the option that makes the axis)."""
+    where = where or f"--param {text}"
     name, sep, spec = text.partition("=")
     name = name.strip()
     if not sep or not name or not spec.strip():

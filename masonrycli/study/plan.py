@@ -95,7 +95,7 @@ def plan_study(
         base = StudyBase(scenario, motions)
         axes.insert(0, Axis("record", tuple(motions)))
     if scale is not None:
-        axes.append(parse_axis(f"scale={scale}"))
+        axes.append(parse_axis(f"scale={scale}", where=f"--scale {scale}"))  # it said "--param scale=..."
     if not axes:
         raise InputError("nothing to sweep: give --param NAME=..., or --records DIR")
     # before the files beside --out: "--param amp: given twice" came after "--out's plot s.png: the file exists"
