@@ -1,7 +1,7 @@
 """Coloured momentum sweeps with every per-contact quantity in one flat array of 8-contact blocks (AoSoA).
 
 simd_sweep.py's split phase A vectorises only while LLVM can bound every array it touches for its
-run-time alias checks; computing the bodies' velocity changes there as well (variant "split2", so that
+run-time alias checks; computing the bodies' velocity changes there as well (variant "split2", measured and since removed, so that
 phase B only adds them) made it "too many memory checks needed" (LLVM's remark), and it stayed scalar. Here each colour's contacts are
 padded to whole blocks of LANES contacts, and every per-contact row (constants, u, momentum state,
 velocity changes, |e|², status) of a block lies in one flat array at
@@ -22,7 +22,7 @@ from __future__ import annotations
 import numpy as np
 
 from benchmarks.solver_lab.simd_schedule import MASK_WORDS, colour
-from benchmarks.solver_lab.simd_sweep import _PACK_OF_K, K_ROWS, RESTART_GROWTH, _local_solve_bf
+from benchmarks.solver_lab.simd_sweep import _PACK_OF_K, K_ROWS, _local_solve_bf, _momentum_rule
 from masonrycli.engine import momentum, nlgs
 from masonrycli.engine._jit import njit
 from masonrycli.engine.nlgs import P_IIA, P_IIB, P_IMA, P_IMB
@@ -108,7 +108,7 @@ def _gather(b0, b1, ia, ib, Q, v):
 
 @njit(cache=False, error_model="numpy")  # numpy: the fallback's division by zero gives inf, no early exit
 def _solve(b0, b1, Q, beta, mu):
-    # Blocks b0 … b1 − 1, all lanes at once: momentum's visit from u (simd_sweep._solve_u2's arithmetic).
+    # Blocks b0 … b1 − 1, all lanes at once: momentum's visit from u (simd_sweep._visit's arithmetic, then nlgs._push's products).
     for blk in range(b1 - b0):
         base = _U(b0 + blk) * BLOCK
         for lane in range(LANES):
@@ -182,7 +182,6 @@ def block_sweeps(contact_body, pack, count, mu, tolerance, max_iterations, v, v_
     n_slots = ia.shape[0]
     n3 = 3 * body_count
     vw = np.zeros(3 * (body_count + n_slots), np.float64)  # v, then the slots' scratch velocities
-    vw[:n3] = v_flat
     for p in range(count):  # v ← v_free + M⁻¹ H r_warm
         nlgs._push(v, contact_body[p, 0], contact_body[p, 1], pack, np.uint64(p), r[p, 0], r[p, 1])
     vw[:n3] = v_flat
@@ -205,18 +204,11 @@ def block_sweeps(contact_body, pack, count, mu, tolerance, max_iterations, v, v_
             _solve(b0, b1, Q, beta, mu)
             sum_e2 += _push(b0, b1, wa, wb, Q, vw)
         residual = np.sqrt(sum_e2 / count)
-        if residual <= tolerance:
+        stop, best, best_at, last, j, beta = _momentum_rule(
+            residual, tolerance, it, best, best_at, last, j, stall_after
+        )
+        if stop:
             break
-        if residual < best:
-            best = residual
-            best_at = it
-        elif tolerance > 0.0 and it - best_at >= stall_after:
-            break
-        if residual > RESTART_GROWTH * last:
-            j = 1
-        last = residual
-        beta = (j - 1.0) / (j + 2.0)
-        j += 1
     v_flat[:] = vw[:n3]
     for s in range(n_slots):
         c = slot_contact[s]

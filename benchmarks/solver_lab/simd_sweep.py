@@ -140,46 +140,60 @@ def _phase_b_levels(lo, hi, ia, ib, K, v, D, pos, e2):
         e2[pos[i]] = D[2, i]
 
 
+@njit(inline="always")
+def _u(i, ia, ib, K, v):
+    # u = H_αᵀ v of sorted row i (nlgs._relative_velocity on the SoA rows; a, b flat offsets into v).
+    a = ia[i]
+    b = ib[i]
+    nx = K[K_NX, i]
+    ny = K[K_NY, i]
+    dvx = v[b] - v[a]
+    dvy = v[b + np.uint64(1)] - v[a + np.uint64(1)]
+    wa = v[a + np.uint64(2)]
+    wb = v[b + np.uint64(2)]
+    return dvx * ny - dvy * nx + wb * K[K_TB, i] - wa * K[K_TA, i], dvx * nx + dvy * ny + wb * K[K_NB, i] - wa * K[
+        K_NA, i
+    ]
+
+
+@njit(inline="always")
+def _visit(i, ut, un, K, beta, mu, X, D, status):
+    # The visit of row i from its u, up to (not including) the push: the extrapolated start, the
+    # branch-free local solve, Δr and |e_α|² into D. X rows: 0 r_t, 1 r_n (x_k in, x_k+1 out), 2 r_t,prev,
+    # 3 r_n,prev; D rows: 0 Δr_t, 1 Δr_n, 2 |e_α|².
+    xt = X[0, i]
+    xn = X[1, i]
+    rt0 = xt + beta * (xt - X[2, i])
+    rn0 = xn + beta * (xn - X[3, i])
+    X[2, i] = xt
+    X[3, i] = xn
+    wtt = K[K_WTT, i]
+    wtn = K[K_WTN, i]
+    wnn = K[K_WNN, i]
+    ut -= wtt * rt0 + wtn * rn0
+    un -= wtn * rt0 + wnn * rn0
+    rt, rn, st = _local_solve_bf(ut, un, K[K_BIAS, i], wtt, wtn, wnn, K[K_ITT, i], K[K_ITN, i], K[K_INN, i],
+                                 K[K_ISP, i], K[K_ISM, i], mu)  # fmt: skip
+    status[i] = st
+    X[0, i] = rt
+    X[1, i] = rn
+    drt = rt - rt0
+    drn = rn - rn0
+    D[0, i] = drt
+    D[1, i] = drn
+    et = wtt * drt + wtn * drn
+    en = wtn * drt + wnn * drn
+    D[2, i] = et * et + en * en
+
+
 @njit(cache=False, error_model="numpy")  # numpy: a division by zero gives inf, no early exit to raise
 def _phase_a(lo, hi, ia, ib, K, v, beta, mu, X, D, status):
-    # The visits of rows lo … hi − 1 (one colour) up to, not including, the push: reads v, writes only
-    # the per-contact buffers. X rows: 0 r_t, 1 r_n (x_k in, x_k+1 out), 2 r_t,prev, 3 r_n,prev;
-    # D rows: 0 Δr_t, 1 Δr_n, 2 |e_α|².
+    # "fused": the visits of rows lo … hi − 1 (one colour) up to the push in one loop: reads v, writes
+    # only the per-contact buffers (LLVM cannot bound the indirect reads for its alias checks: scalar).
     for k in range(hi - lo):
         i = np.uint64(lo + k)  # unsigned: no wrap-around test per access (momentum.py), contiguous rows
-        a = ia[i]
-        b = ib[i]
-        nx = K[K_NX, i]
-        ny = K[K_NY, i]
-        dvx = v[b] - v[a]
-        dvy = v[b + np.uint64(1)] - v[a + np.uint64(1)]
-        wa = v[a + np.uint64(2)]
-        wb = v[b + np.uint64(2)]
-        ut = dvx * ny - dvy * nx + wb * K[K_TB, i] - wa * K[K_TA, i]
-        un = dvx * nx + dvy * ny + wb * K[K_NB, i] - wa * K[K_NA, i]
-        xt = X[0, i]
-        xn = X[1, i]
-        rt0 = xt + beta * (xt - X[2, i])
-        rn0 = xn + beta * (xn - X[3, i])
-        X[2, i] = xt
-        X[3, i] = xn
-        wtt = K[K_WTT, i]
-        wtn = K[K_WTN, i]
-        wnn = K[K_WNN, i]
-        ut -= wtt * rt0 + wtn * rn0
-        un -= wtn * rt0 + wnn * rn0
-        rt, rn, st = _local_solve_bf(ut, un, K[K_BIAS, i], wtt, wtn, wnn, K[K_ITT, i], K[K_ITN, i], K[K_INN, i],
-                                     K[K_ISP, i], K[K_ISM, i], mu)  # fmt: skip
-        status[i] = st
-        X[0, i] = rt
-        X[1, i] = rn
-        drt = rt - rt0
-        drn = rn - rn0
-        D[0, i] = drt
-        D[1, i] = drn
-        et = wtt * drt + wtn * drn
-        en = wtn * drt + wnn * drn
-        D[2, i] = et * et + en * en
+        ut, un = _u(i, ia, ib, K, v)
+        _visit(i, ut, un, K, beta, mu, X, D, status)
 
 
 @njit(cache=False)
@@ -187,113 +201,34 @@ def _gather_u(lo, hi, ia, ib, K, v, U):
     # Split phase A, first half (scalar: indirect reads): U rows 0, 1 = u_t, u_n of rows lo … hi − 1.
     for k in range(hi - lo):
         i = np.uint64(lo + k)
-        a = ia[i]
-        b = ib[i]
-        nx = K[K_NX, i]
-        ny = K[K_NY, i]
-        dvx = v[b] - v[a]
-        dvy = v[b + np.uint64(1)] - v[a + np.uint64(1)]
-        wa = v[a + np.uint64(2)]
-        wb = v[b + np.uint64(2)]
-        U[0, i] = dvx * ny - dvy * nx + wb * K[K_TB, i] - wa * K[K_TA, i]
-        U[1, i] = dvx * nx + dvy * ny + wb * K[K_NB, i] - wa * K[K_NA, i]
+        U[0, i], U[1, i] = _u(i, ia, ib, K, v)
 
 
 @njit(cache=False, error_model="numpy")
 def _solve_u(lo, hi, K, U, beta, mu, X, D, status):
-    # Split phase A, second half (every access contiguous, so LLVM can bound them for its alias checks):
-    # from u in U, the rest of _phase_a.
+    # Split phase A, second half (every access contiguous, so LLVM can bound them for its alias checks and
+    # vectorises it 8-wide): from u in U, the rest of _phase_a.
     for k in range(hi - lo):
         i = np.uint64(lo + k)
-        ut = U[0, i]
-        un = U[1, i]
-        xt = X[0, i]
-        xn = X[1, i]
-        rt0 = xt + beta * (xt - X[2, i])
-        rn0 = xn + beta * (xn - X[3, i])
-        X[2, i] = xt
-        X[3, i] = xn
-        wtt = K[K_WTT, i]
-        wtn = K[K_WTN, i]
-        wnn = K[K_WNN, i]
-        ut -= wtt * rt0 + wtn * rn0
-        un -= wtn * rt0 + wnn * rn0
-        rt, rn, st = _local_solve_bf(ut, un, K[K_BIAS, i], wtt, wtn, wnn, K[K_ITT, i], K[K_ITN, i], K[K_INN, i],
-                                     K[K_ISP, i], K[K_ISM, i], mu)  # fmt: skip
-        status[i] = st
-        X[0, i] = rt
-        X[1, i] = rn
-        drt = rt - rt0
-        drn = rn - rn0
-        D[0, i] = drt
-        D[1, i] = drn
-        et = wtt * drt + wtn * drn
-        en = wtn * drt + wnn * drn
-        D[2, i] = et * et + en * en
+        _visit(i, U[0, i], U[1, i], K, beta, mu, X, D, status)
 
 
-@njit(cache=False, error_model="numpy")
-def _solve_u2(lo, hi, K, U, beta, mu, X, D, status):
-    # _solve_u that also computes the bodies' velocity changes M⁻¹ H Δr (nlgs._push's arithmetic), so that
-    # the scalar phase B only adds them: D rows 0–2 Δv of a (to subtract), 3–5 Δv of b (to add), 6 |e_α|².
-    for k in range(hi - lo):
-        i = np.uint64(lo + k)
-        ut = U[0, i]
-        un = U[1, i]
-        xt = X[0, i]
-        xn = X[1, i]
-        rt0 = xt + beta * (xt - X[2, i])
-        rn0 = xn + beta * (xn - X[3, i])
-        X[2, i] = xt
-        X[3, i] = xn
-        wtt = K[K_WTT, i]
-        wtn = K[K_WTN, i]
-        wnn = K[K_WNN, i]
-        ut -= wtt * rt0 + wtn * rn0
-        un -= wtn * rt0 + wnn * rn0
-        rt, rn, st = _local_solve_bf(ut, un, K[K_BIAS, i], wtt, wtn, wnn, K[K_ITT, i], K[K_ITN, i], K[K_INN, i],
-                                     K[K_ISP, i], K[K_ISM, i], mu)  # fmt: skip
-        status[i] = st
-        X[0, i] = rt
-        X[1, i] = rn
-        drt = rt - rt0
-        drn = rn - rn0
-        nx = K[K_NX, i]
-        ny = K[K_NY, i]
-        px = drt * ny + drn * nx
-        py = -drt * nx + drn * ny
-        ima = K[K_IMA, i]
-        D[0, i] = ima * px
-        D[1, i] = ima * py
-        D[2, i] = K[K_IIA, i] * (K[K_TA, i] * drt + K[K_NA, i] * drn)
-        imb = K[K_IMB, i]
-        D[3, i] = imb * px
-        D[4, i] = imb * py
-        D[5, i] = K[K_IIB, i] * (K[K_TB, i] * drt + K[K_NB, i] * drn)
-        et = wtt * drt + wtn * drn
-        en = wtn * drt + wnn * drn
-        D[6, i] = et * et + en * en
-
-
-@njit(cache=False)
-def _phase_b2(lo, hi, wa, wb, v, D):
-    # Phase B without a branch: every contact adds its velocity changes (±0 for one that did not move:
-    # v unchanged but for the sign of a zero). wa, wb: where a's and b's changes go, 3·body, or for a
-    # support a scratch slot of the contact's own past the bodies (a support receives only ±0, and a
-    # shared slot would chain the colour's stores to the ground through memory).
-    sum_e2 = 0.0
-    for k in range(hi - lo):
-        i = np.uint64(lo + k)
-        a = wa[i]
-        b = wb[i]
-        v[a] -= D[0, i]
-        v[a + np.uint64(1)] -= D[1, i]
-        v[a + np.uint64(2)] -= D[2, i]
-        v[b] += D[3, i]
-        v[b + np.uint64(1)] += D[4, i]
-        v[b + np.uint64(2)] += D[5, i]
-        sum_e2 += D[6, i]
-    return sum_e2
+@njit(inline="always")
+def _momentum_rule(residual, tolerance, it, best, best_at, last, j, stall_after):
+    # momentum._momentum_sweeps's rule after a sweep: stop at the tolerance or after stall_after sweeps
+    # without a new lowest residual; else restart (j = 1) when the residual grew by more than
+    # RESTART_GROWTH, and the next β = (j − 1)/(j + 2). Returns (stop, best, best_at, last, j, beta).
+    if residual <= tolerance:
+        return True, best, best_at, last, j, 0.0
+    if residual < best:
+        best = residual
+        best_at = it
+    elif tolerance > 0.0 and it - best_at >= stall_after:
+        return True, best, best_at, last, j, 0.0
+    if residual > RESTART_GROWTH * last:
+        j = 1
+    beta = (j - 1.0) / (j + 2.0)
+    return False, best, best_at, residual, j + 1, beta
 
 
 @njit(inline="always")
@@ -348,18 +283,18 @@ def sorted_arrays(contact_body, pack, count, r, order):
 def build(variant: str):
     """The coloured first stage with phase A as ``variant``: "fused" (one loop, indirect reads of v: LLVM
     cannot bound them for its alias checks and leaves it scalar), "split" (_gather_u scalar, then
-    _solve_u vectorised), "split2", "levels" / "levels+fused", "sym+split" (benchmarks/README.md). A
-    "noalias" phase A (fused, compiled with numba's private noalias flag: vectorised, with gathers) was
-    measured and removed: only the engine may import numba. Returns the kernel
+    _solve_u vectorised), "split4" (split on velocities padded to 4 doubles a body), "levels" /
+    "levels+fused", "lanes+split", "sym+split" (benchmarks/README.md). Measured and removed: a "noalias"
+    phase A (fused, compiled with numba's private noalias flag; only the engine may import numba) and
+    "split2" (split with the push's products computed in the vector loop: not vectorised, 15.8 ns). Returns the kernel
     (contact_body, pack, count, mu, tolerance, cap, v, v_flat, r, status, stall) → (iterations,
     residual, colours)."""
     schedule, _, phase = variant.rpartition("+")  # "levels+fused": the level schedule, phase A fused
     if phase == "levels":
         schedule, phase = "levels", "split"
     phase_a = _phase_a
-    split = phase in ("split", "split2", "split4")
+    split = phase in ("split", "split4")
     pad4 = phase == "split4"  # bodies' velocities padded to 4 doubles: a body's (vx, vy, ω) one 256-bit row
-    deltas = phase == "split2"
     exact = schedule == "levels"
     by_lanes = schedule == "lanes"  # "lanes+split": groups of the 8-run interleaved order (simd_schedule.lanes)
     symmetric = schedule == "sym"  # "sym+split": the colours' order turns every sweep (symmetric GS)
@@ -388,19 +323,7 @@ def build(variant: str):
             pos = order
         ia, ib, K, X = sorted_arrays(contact_body, pack, count, r, order)
         e2 = np.zeros(count, np.float64)
-        D = np.empty((7, count), np.float64)
-        # write offsets for _phase_b2: supports to scratch slots 3·(B + i) of a working copy of v
-        wa = ia.copy()
-        wb = ib.copy()
-        if deltas:
-            for i in range(count):
-                if K[K_IMA, i] == 0.0 and K[K_IIA, i] == 0.0:
-                    wa[i] = 3 * (body_count + i)
-                if K[K_IMB, i] == 0.0 and K[K_IIB, i] == 0.0:
-                    wb[i] = 3 * (body_count + i)
-            vw = np.zeros(3 * (body_count + count), np.float64)
-        else:
-            vw = np.zeros(0, np.float64)
+        D = np.empty((3, count), np.float64)
         U = np.empty((2, count), np.float64)
         st_s = np.empty(count, np.int8)
         if exact:  # v ← v_free + M⁻¹ H r_warm, in the engine's order
@@ -411,10 +334,7 @@ def build(variant: str):
             for i in range(count):
                 _push_k(v_flat, ia[i], ib[i], K, i, X[0, i], X[1, i])
         n3 = v_flat.shape[0]
-        if deltas:  # the sweeps work on vw: v, then the scratch slots
-            vw[:n3] = v_flat
-            v_work = vw
-        elif pad4:  # the sweeps work on v4: body b at 4b … 4b + 2, offsets 4·body
+        if pad4:  # the sweeps work on v4: body b at 4b … 4b + 2, offsets 4·body
             v_work = np.zeros(4 * body_count, np.float64)
             v_work.reshape(body_count, 4)[:, :3] = v_flat.reshape(body_count, 3)
             for i in range(count):
@@ -439,17 +359,12 @@ def build(variant: str):
                 k = n_colours - 1 - kc if symmetric and it % 2 == 1 else kc
                 lo = start[k]
                 hi = start[k + 1]
-                if deltas:
-                    _gather_u(lo, hi, ia, ib, K, v_work, U)
-                    _solve_u2(lo, hi, K, U, beta, mu, X, D, st_s)
-                elif split:
+                if split:
                     _gather_u(lo, hi, ia, ib, K, v_work, U)
                     _solve_u(lo, hi, K, U, beta, mu, X, D, st_s)
                 else:
                     phase_a(lo, hi, ia, ib, K, v_work, beta, mu, X, D, st_s)
-                if deltas:
-                    sum_e2 += _phase_b2(lo, hi, wa, wb, v_work, D)
-                elif exact:
+                if exact:
                     _phase_b_levels(lo, hi, ia, ib, K, v_work, D, pos, e2)
                 else:
                     sum_e2 += _phase_b(lo, hi, ia, ib, K, v_work, D)
@@ -457,20 +372,11 @@ def build(variant: str):
                 for p in range(count):
                     sum_e2 += e2[p]
             residual = np.sqrt(sum_e2 / count)
-            if residual <= tolerance:
+            stop, best, best_at, last, j, beta = _momentum_rule(
+                residual, tolerance, it, best, best_at, last, j, stall_after
+            )
+            if stop:
                 break
-            if residual < best:
-                best = residual
-                best_at = it
-            elif tolerance > 0.0 and it - best_at >= stall_after:
-                break
-            if residual > RESTART_GROWTH * last:
-                j = 1
-            last = residual
-            beta = (j - 1.0) / (j + 2.0)
-            j += 1
-        if deltas:
-            v_flat[:] = vw[:n3]
         if pad4:
             v_flat.reshape(body_count, 3)[:, :] = v_work.reshape(body_count, 4)[:, :3]
         for i in range(count):
