@@ -82,16 +82,7 @@ def levels(contact_body, pack, count, body_count, out_order, out_start):
     # a support only ever receives ±0, whose order does not matter). Then a counting sort: out_order =
     # visit positions by level (in visit order within a level), out_start as colour(). Returns
     # (levels, visit order: the contact of each position).
-    kk = nlgs.INTERLEAVE
-    run = (count + kk - 1) // kk
-    visit = np.empty(count, np.int64)
-    i = 0
-    for j in range(run):
-        for q in range(kk):
-            c = q * run + j
-            if c < count:
-                visit[i] = c
-                i += 1
+    visit = interleaved_order(count, nlgs.INTERLEAVE)
     last = np.full(body_count, -1, np.int64)
     lev = np.empty(count, np.int64)
     n_levels = 0
@@ -129,21 +120,36 @@ LANES = 8
 
 
 @njit(cache=False)
+def interleaved_order(count, k):
+    # interleaved.py's visit order with k runs: run 0's j-th contact, run 1's, …, run k−1's, then the
+    # (j+1)-th (runs of ⌈count / k⌉ contacts in detection order). Returns the contact of each position.
+    run = (count + k - 1) // k
+    visit = np.empty(count, np.int64)
+    i = 0
+    for j in range(run):
+        for q in range(k):
+            c = q * run + j
+            if c < count:
+                visit[i] = c
+                i += 1
+    return visit
+
+
+@njit(cache=False)
 def lanes(contact_body, pack, count, body_count, out_order, out_start):
     # Groups of the 8-run interleaved order: group j = run 0's j-th contact, run 1's, …, run 7's (runs:
     # stretches of detection order, as interleaved.py's 4). A group whose contacts share a movable body is
     # split into groups of one, in the same order, so running the groups in turn is Gauss–Seidel in that
     # order whatever the group's visits do at once. out_start (≥ count + 1 long). Returns the groups.
+    out_order[:] = interleaved_order(count, LANES)
     run = (count + LANES - 1) // LANES
     groups = 0
     i = 0
     out_start[0] = 0
     for j in range(run):
         first = i
-        for q in range(LANES):
-            c = q * run + j
-            if c < count:
-                out_order[i] = c
+        for q in range(LANES):  # group j: the next ≤ LANES contacts of that order
+            if q * run + j < count:
                 i += 1
         clash = False
         for x in range(first, i):
