@@ -1,4 +1,4 @@
-"""Driving the command line in tests: one CliRunner, invoke with any arguments, one-line error checks."""
+"""Driving the command line in tests: one CliRunner, invoke with any arguments, one-line error checks, words."""
 
 from __future__ import annotations
 
@@ -11,6 +11,11 @@ runner = CliRunner()
 
 def invoke(*args):
     return runner.invoke(app, [str(a) for a in args])
+
+
+def words(text: str) -> str:
+    """``text`` with every run of whitespace one space: the console wraps a line where a path's length puts it."""
+    return " ".join(text.split())
 
 
 def assert_one_line_error(result, *fragments):

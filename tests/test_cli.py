@@ -11,7 +11,7 @@ import pytest
 
 from masonrycli import __version__
 
-from cli_helpers import assert_one_line_error, invoke
+from cli_helpers import assert_one_line_error, invoke, words
 
 DATA = Path(__file__).parent / "data"
 
@@ -160,10 +160,10 @@ def test_check_shows_how_each_support_moves(tmp_path):
     write_at2(at2, 0.1 * np.sin(np.linspace(0.0, 6.0, 200)), 0.01)
     result = invoke("check", DATA / "quake_record.toml", "--record", at2, "--scale", 0.5)
     assert result.exit_code == 0, result.output
-    said = " ".join(result.output.split())
+    said = words(result.output)
     assert "loading │ ground: record of acceleration (q.AT2, 200 samples, 0–1.99 s," in said, said
     assert "baseline-corrected) × 0.5" in said, said
-    arch = " ".join(invoke("check", DATA / "arch_settlement.toml").output.split())
+    arch = words(invoke("check", DATA / "arch_settlement.toml").output)
     assert "loading │ right-foundation: constant velocity (0, -0.01) m/s" in arch, arch
 
 
@@ -275,7 +275,7 @@ def test_engine_error_mid_run_keeps_frames(tmp_path, monkeypatch):
 def test_build_says_one_block_in_the_singular(tmp_path):
     # "wall: 1 blocks and 1 support → w.geojson"
     result = invoke("build", "wall", "--blocks", 1, "--out", tmp_path / "w.geojson")
-    said = " ".join(result.output.split())  # the console wraps a long path
+    said = words(result.output)  # the console wraps a long path
     assert result.exit_code == 0 and f"wall: 1 block and 1 support → {tmp_path / 'w.geojson'}" in said
 
 
@@ -367,8 +367,8 @@ def test_unconverged_steps_are_counted_and_warned(tmp_path):
     npz = tmp_path / "h.npz"
     r = invoke("simulate", "wall", "--duration", "0.02", "--max-iterations", "2", "--no-recording", "--history", npz)
     assert r.exit_code == 0, r.output
-    assert "warning: 20 of 20 steps ended unconverged" in " ".join(r.output.split())
-    assert "20 at the 2-sweep cap); their" in " ".join(r.output.split())  # none stalled: not said
+    assert "warning: 20 of 20 steps ended unconverged" in words(r.output)
+    assert "20 at the 2-sweep cap); their" in words(r.output)  # none stalled: not said
     # (what stalled steps go through, by solver: test_execute.py, unconverged_warning)
     h = np.load(npz)
     assert h["nlgs_unconverged"][-1] == 20
@@ -412,7 +412,7 @@ def test_a_two_step_run_completes():
     # It wrote its outputs, then ended in "internal error: IndexError" (exit 1) computing D5–95.
     result = invoke("simulate", "wall", "--duration", 0.002, "--no-recording")
     assert result.exit_code == 0, result.output
-    assert "D5–95 nan s" in " ".join(result.output.split())
+    assert "D5–95 nan s" in words(result.output)
 
 
 def test_a_closed_stdout_is_not_bad_input(tmp_path):

@@ -11,6 +11,7 @@ from typer.testing import CliRunner
 from masonrycli.cli import app
 from masonrycli.records import G_STANDARD, record_motion
 
+from cli_helpers import words
 from synthetic_records import band_limited, write_at2
 
 DATA = Path(__file__).parent / "data"
@@ -85,7 +86,7 @@ def test_record_on_a_geometry_file_says_how_to_shake_it(at2, tmp_path):
     assert invoke("build", "wall", "--blocks", 7, "--out", geo).exit_code == 0
     result = invoke("run", geo, "--record", at2)
     assert result.exit_code == 2
-    assert " ".join(result.output.split()) == (
+    assert words(result.output) == (
         "error: --record: wall.geojson holds no motion (its supports are fixed); shake one in a scenario file: "
         '[structure] file = "wall.geojson" and a [[support]] name = "ground" with motion = { kind = "record", '
         "file = ... } (docs/scenario-format.md)"
@@ -110,7 +111,7 @@ motion = { kind = "sine", amplitude = 0.5, frequency = 2.0 }
     npz = tmp_path / "h.npz"
     result = invoke("run", tmp_path / "slender.toml", "--stop-at-collapse", "--no-recording", "--history", npz)
     assert result.exit_code == 0, result.output
-    said = " ".join(result.output.split())
+    said = words(result.output)
     assert "stopped at collapse" in said and "collapsed at t =" in said
     t_end = float(np.load(npz)["time"][-1])
     assert 0.5 < t_end < 2.5
@@ -172,7 +173,7 @@ def test_an_at2_file_with_samples_beyond_npts_says_so_once(tmp_path):
     said = [ln for ln in result.output.splitlines() if ln.startswith("warning:")]
     line = f"warning: {at2}: header says NPTS = 4 but the file holds 6 samples; the 2 after the first 4 are ignored"
     assert said == [line], result.output
-    assert "4 samples" in " ".join(result.output.split())  # still read as 4: the behaviour is kept
+    assert "4 samples" in words(result.output)  # still read as 4: the behaviour is kept
 
 
 @pytest.fixture
@@ -203,7 +204,7 @@ def test_record_dt_reads_a_one_column_record_on_simulate_run_and_check(one_colum
     np.testing.assert_array_equal(h["support_v"][:, 0, :], record_motion(two).velocity_at(h["time"]))
     result = invoke("check", DATA / "quake_record.toml", "--record", one, "--record-dt", 0.01)
     assert result.exit_code == 0, result.output
-    said = " ".join(result.output.replace("│", " ").split())  # the table's cell, wrapped over two lines
+    said = words(result.output.replace("│", " "))  # the table's cell, wrapped over two lines
     assert "ground: record of velocity (one.csv, 31 samples every 0.01 s, 0–0.3 s) along (1, 0)" in said, said
 
 

@@ -12,6 +12,7 @@ import pytest
 from masonrycli.records import G_STANDARD
 from masonrycli.study.store import read_rows
 
+from cli_helpers import words
 from sweep_helpers import BLOCK, invoke, write_block
 from synthetic_records import band_limited, write_at2
 
@@ -88,10 +89,8 @@ def test_the_counts_line_says_one_row(block, tmp_path):
     args = ["-p", "amp=0.1", "--duration", 0.02, "--workers", 0, "-o", tmp_path / "s.csv", "--no-recording"]
     result = invoke("sweep", block, *args)
     assert result.exit_code == 0, result.output
-    assert f"1 row in {tmp_path / 's.csv'} (1 run now, 0 rows already there, 0 failed)" in " ".join(
-        result.output.split()
-    )
-    again = " ".join(invoke("sweep", block, *args, "--force").output.split())
+    assert f"1 row in {tmp_path / 's.csv'} (1 run now, 0 rows already there, 0 failed)" in words(result.output)
+    again = words(invoke("sweep", block, *args, "--force").output)
     assert "(0 runs now, 1 row already there, 0 failed)" in again
 
 
@@ -145,7 +144,7 @@ def test_records_run_whole_on_a_built_in_and_a_shorter_run_is_warned(block, tmp_
     assert {r["steps"] for r in read_rows(tmp_path / "b.csv")} == {500}  # the file's 1 s at dt = 2e-3
     assert (
         "warning: the runs' 1 s are shorter than 1 of 2 records (longest 1.5 s, long.AT2): their shaking after "
-        "t = 1 s is not applied" in " ".join(result.output.split())
+        "t = 1 s is not applied" in words(result.output)
     )
     # bad input stays one line: the warning comes once the request is checked, not beside its error
     fixed = tmp_path / "fixed.toml"
@@ -174,12 +173,12 @@ def test_failed_rows_give_exit_5_after_the_whole_table(block, tmp_path, monkeypa
     result = invoke("sweep", block, *args)
     assert result.exit_code == 5, result.output
     assert len(read_rows(out)) == 3 and (tmp_path / "s.png").exists()  # the table and the plot are whole
-    said = " ".join(result.output.split())
+    said = words(result.output)
     assert f"error: 2 of 3 rows failed (the reason is in their error column in {out}); run the same" in said, said
     monkeypatch.setattr(run, "simulate", real)
     again = invoke("sweep", block, *args, "--force")  # --force: the plot exists
     # words, not lines: the console wraps the line with the table's path, where depends on the path's length
-    said = " ".join(again.output.split())
+    said = words(again.output)
     assert again.exit_code == 0 and "(2 runs now, 1 row already there, 0 failed)" in said, again.output
 
 
@@ -204,7 +203,7 @@ def test_diverged_rows_give_exit_3_as_simulate_does(block, tmp_path, monkeypatch
     )
     assert result.exit_code == 3, result.output
     assert [r["status"] for r in read_rows(out)] == ["completed", "diverged"]
-    said = " ".join(result.output.split())
+    said = words(result.output)
     assert f"error: 1 of 2 rows diverged (their error column in {out} says when); a smaller" in said
     assert [r["error"] for r in read_rows(out)] == ["", "diverged at t = 0.0100 s"]
 

@@ -12,7 +12,7 @@ from masonrycli import SOURCE_DIGEST
 from masonrycli.cli import app
 from masonrycli.scenario_toml import dump_scenario
 
-from cli_helpers import assert_one_line_error, invoke, runner
+from cli_helpers import assert_one_line_error, invoke, runner, words
 from limit_helpers import column
 
 
@@ -56,7 +56,7 @@ def test_verify_at_zero_lambda_says_there_is_nothing_to_verify(column_file):
     # λ = 0 (frictionless): --verify ran the unloaded column twice, "0.95" and "1.05" × 0, and printed a red
     # "no" under "predicted" for the second (it stands: no load at all), exit 0, no word why.
     result = invoke("limit", column_file, "--friction", "0", "--verify")
-    said = " ".join(result.output.split())
+    said = words(result.output)
     assert result.exit_code == 0, result.output
     assert "--verify: λ = 0, so 0.95 λ and 1.05 λ are both the unloaded structure: nothing to verify" in said, said
     assert "predicted" not in said
@@ -226,9 +226,7 @@ def test_a_long_hinge_list_shows_the_fastest_turning_joints_first():
     turn = np.abs(omega[j.joint_body[:, 1]] - omega[j.joint_body[:, 0]]) * length * (j.joint_points >= 2)
     fastest = [result.names[k] for k in np.argsort(-turn)[:2]]
     assert fastest[0] == "v15|v16"  # the crown hinge under the load, as on the bare arch
-    shown = " ".join(
-        invoke("limit", "aqueduct", "--load", "point", "--block", "v15", "--direction", "-y").output.split()
-    )
+    shown = words(invoke("limit", "aqueduct", "--load", "point", "--block", "v15", "--direction", "-y").output)
     assert f"{len(result.hinges)}, the 8 fastest: {', '.join(fastest)}" in shown, shown
 
 
@@ -240,7 +238,7 @@ def test_verify_headers_read_whole_at_80_columns(column_file, monkeypatch):
     lines = result.output.splitlines()
     assert max(len(line) for line in lines) <= 80
     start = next(k for k, line in enumerate(lines) if line.startswith("┏"))
-    header = " ".join(" ".join(lines[start + 1 : start + 3]).replace("┃", " ").split())
+    header = words(" ".join(lines[start + 1 : start + 3]).replace("┃", " "))
     assert "…" not in header, header
     for word in ("predicted", "largest", "move", "similarity", "hinges", "shared"):
         assert word in header.split(), header

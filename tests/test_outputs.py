@@ -15,6 +15,8 @@ from typer.testing import CliRunner
 from masonrycli.cli import app
 from masonrycli.outputs import OutputFile, default_recording_path, free_name, open_part, part_path, safe_name
 
+from cli_helpers import words
+
 DATA = Path(__file__).parent / "data"
 COLUMN = DATA / "validation" / "column5.toml"
 
@@ -115,7 +117,7 @@ def test_a_link_to_a_missing_file_is_an_existing_output(tmp_path):
     os.symlink(tmp_path / "gone" / "x.rrd", link)
     result = invoke("run", COLUMN, "--duration", 0.01, "--out", link)
     assert result.exit_code == 2, result.output
-    said = " ".join(result.output.split())
+    said = words(result.output)
     assert f"--out {link}: the file exists, a link to the missing {tmp_path / 'gone' / 'x.rrd'}" in said
     assert sorted(p.name for p in tmp_path.iterdir()) == ["x.rrd"] and link.is_symlink()
     result = invoke("run", COLUMN, "--duration", 0.01, "--out", link, "--force")  # replaces the link itself

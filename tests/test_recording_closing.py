@@ -16,7 +16,7 @@ from masonrycli.recording import Recorder, inspect_recording
 from masonrycli.recording.layout import FILL
 
 import recording_fixtures as fx
-from cli_helpers import invoke
+from cli_helpers import invoke, words
 from recording_fixtures import strict_rerun, temporal_rows  # noqa: F401 (strict_rerun: autouse)
 
 BATCH = 10  # frames per flush
@@ -94,7 +94,7 @@ def test_inspect_a_file_without_footer(wall, tmp_path):
         if line.count("│") == 3
     )
     assert rows["truncated"] == "True" and rows["complete"] == "False"
-    assert "truncated (its writer did not finish" in " ".join(result.output.split())
+    assert "truncated (its writer did not finish" in words(result.output)
 
 
 def test_frames_without_tensor_fields_or_contacts(wall, tmp_path):

@@ -13,6 +13,8 @@ from typer.testing import CliRunner
 from masonrycli.cli import app
 from masonrycli.recording.readback import check_complete, inspect_recording
 
+from cli_helpers import words
+
 
 def invoke(*args):
     return CliRunner().invoke(app, [str(a) for a in args])
@@ -75,7 +77,7 @@ def test_inspect_reads_a_truncated_recording(recording, tmp_path):
     result = invoke("inspect", cut)
     assert result.exit_code == 0, result.output
     assert f"truncated (its writer did not finish: killed, or the disk was full) — {info['frames']} frames" in (
-        " ".join(result.output.split())
+        words(result.output)
     )
     shutil.rmtree(tmp_path)
 

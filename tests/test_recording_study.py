@@ -12,6 +12,7 @@ import pytest
 from masonrycli.records import G_STANDARD
 from masonrycli.study.store import read_rows
 
+from cli_helpers import words
 from sweep_helpers import invoke, write_block
 from synthetic_records import band_limited, write_at2
 
@@ -41,7 +42,7 @@ def test_records_sweep_fits_a_fragility_curve_and_records_the_study(block, tmp_p
         pga = [r["pga"] for r in rows if r["record"] == name]
         scale = [r["scale"] for r in rows if r["record"] == name]
         np.testing.assert_allclose(np.array(pga) / pga[0], np.array(scale) / scale[0], rtol=1e-6)
-    said = " ".join(result.output.split())  # the console wraps long lines
+    said = words(result.output)  # the console wraps long lines
     # these runs are separated by the PGA (every collapse above every run that stood): the line says the
     # dispersion is not resolved and where the gap is (it printed "dispersion β = 0.0..", the fit's bound)
     stood = max(r["pga"] for r in rows if r["state"] != "collapsed")
@@ -59,11 +60,11 @@ def test_records_sweep_fits_a_fragility_curve_and_records_the_study(block, tmp_p
     assert shown.exit_code == 0 and "None" not in shown.output and "time_span      │ —" in shown.output
     # the plot and the recording exist now: --force replaces them and still reuses every finished row
     again = invoke("sweep", block, "--records", folder, "--scale", "0.5:8:4", "--workers", 0, "--out", out, "--force")
-    assert again.exit_code == 0 and "(0 runs now, 12 rows already there" in " ".join(again.output.split())
+    assert again.exit_code == 0 and "(0 runs now, 12 rows already there" in words(again.output)
     # records given as files (repeatable) make the same study as their folder
     files = [a for f in sorted(folder.iterdir()) for a in ("--records", f)]
     again = invoke("sweep", block, *files, "--scale", "0.5:8:4", "--workers", 0, "--out", out, "--force")
-    assert again.exit_code == 0 and "(0 runs now, 12 rows already there" in " ".join(again.output.split())
+    assert again.exit_code == 0 and "(0 runs now, 12 rows already there" in words(again.output)
     twice = invoke("sweep", block, "--records", folder, "--records", folder / "syn0.AT2", "--out", out)
     assert twice.exit_code == 2 and "two records named syn0.AT2" in twice.output
 

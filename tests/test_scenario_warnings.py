@@ -11,7 +11,7 @@ from scenario_helpers import BLOCK, DATA, GROUND
 from masonrycli.scenario_toml import load_scenario, loads_scenario
 from masonrycli.scenario_warnings import record_warnings, scenario_warnings, setting_warnings
 
-from cli_helpers import invoke
+from cli_helpers import invoke, words
 
 
 def test_record_warnings_name_a_record_that_outlasts_the_run():
@@ -116,10 +116,10 @@ def test_every_command_prints_the_warnings(tmp_path):
         ["run", path, "--no-recording"],
         ["sweep", path, "-p", "friction=0.5", "--workers", 0, "--no-recording", "--out", out],
     ):
-        said = " ".join(invoke(*args).output.split())
+        said = words(invoke(*args).output)
         assert "warning: [run] gravity = [0, 9.81] points up" in said, (args, said)
     # limit cannot stand the block on a ground above it: its one-line refusal gives the reason
-    said = " ".join(invoke("limit", path).output.split())
+    said = words(invoke("limit", path).output)
     assert said.startswith("error: no equilibrium") and "([run] gravity = [0, 9.81] points up" in said
 
 

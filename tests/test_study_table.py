@@ -11,6 +11,8 @@ from rich.console import Console
 
 from masonrycli.study.table import find_columns, grid_columns, study_table
 
+from cli_helpers import words
+
 
 def _render(rows, columns, names, width: int) -> list[str]:
     console = Console(width=width, file=io.StringIO(), markup=False, highlight=False)
@@ -36,7 +38,7 @@ def test_at_80_columns_every_row_is_one_line_within_the_width():
     assert len(body) == len(ROWS)  # no cell folded onto a second line
     assert "│ synthetic-record-1.AT2 │ 1.75  │ collapsed │ 0.53 " in body[4]  # what a user needs is there
     assert "7.75" in body[4] and "0.00 " in body[0]  # drift in % of height; -1e-9 is not "-0.00"
-    legend = " ".join(" ".join(lines[len(body) + 5 :]).split())
+    legend = words(" ".join(lines[len(body) + 5 :]))
     assert "collapse: time of collapse, s" in legend and "drift: residual, % of height" in legend
     assert "not shown at this width: hinges, wall, peak, sweeps" in legend and "every column in ida.parquet" in legend
     # the file's drifts are fractions of the height, its openings metres (before: only the terminal's % and mm named)
@@ -54,7 +56,7 @@ def test_a_long_record_name_leaves_room_for_the_state(tmp_path):
     body = [line for line in lines if line.startswith("│")]
     assert "│ intact " in body[0] and "│ collapsed │ 0.53 " in body[1], lines
     assert body[0].startswith("│ RSN6_IMPVALL") and "component.AT2 │" in body[0]  # both ends of the name kept
-    assert "every column in ida.parquet" in " ".join(" ".join(lines).split())
+    assert "every column in ida.parquet" in words(" ".join(lines))
 
 
 def test_a_wide_console_shows_every_column_and_the_units():

@@ -23,6 +23,8 @@ from masonrycli.study.axes import StudyBase, apply_point, parse_axis
 from masonrycli.study.study import StudyRequest, run_study
 from masonrycli.study.task import RESULT_COLUMNS
 
+from cli_helpers import words
+
 pytestmark = pytest.mark.slow
 BIN = Path(sys.executable).parent
 ROOT = Path(__file__).resolve().parent.parent  # the checkout under test
@@ -127,7 +129,7 @@ def test_scheduler_and_worker_processes_kill_the_worker_and_resume(tmp_path):
         for r in rows:  # rows finished before the kill were not run again
             if r["amp"] in kept:
                 assert r["wall_time"] == kept[r["amp"]]
-        assert f"{len(kept)} rows already there" in " ".join((tmp_path / "sweep2.log").read_text().split())
+        assert f"{len(kept)} rows already there" in words((tmp_path / "sweep2.log").read_text())
     finally:
         for proc in sweeps + workers + [scheduler]:
             _kill(proc)

@@ -18,6 +18,8 @@ from typer.testing import CliRunner
 
 from masonrycli.cli import app
 
+from cli_helpers import words
+
 G, F = 9.81, 2.0
 runner = CliRunner()
 
@@ -90,4 +92,4 @@ def test_find_friction_finds_the_friction_below_which_the_block_slides(tmp_path)
     assert (row["friction_hi"] - row["friction_lo"]) <= 0.005 * row["friction_hi"]
     # the terminal says which side too: the holds column and its legend
     line = next(line for line in result.output.splitlines() if f"{row['friction_threshold']:.4g}" in line)
-    assert "below" in line and "holds: the outcome above / below the threshold" in " ".join(result.output.split())
+    assert "below" in line and "holds: the outcome above / below the threshold" in words(result.output)

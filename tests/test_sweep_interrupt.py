@@ -9,6 +9,7 @@ import pytest
 
 from masonrycli.study.store import read_rows
 
+from cli_helpers import words
 from sweep_helpers import invoke, write_block
 
 
@@ -27,7 +28,7 @@ def test_ctrl_c_while_the_scheduler_is_reached_says_nothing_was_written(block, t
 
     monkeypatch.setattr(runner, "open_cluster", interrupted)
     result = invoke("sweep", block, "-p", "amp=0.1", "--scheduler", "tcp://127.0.0.1:1", "-o", tmp_path / "s.csv")
-    said = " ".join(result.output.split())
+    said = words(result.output)
     assert result.exit_code == 130 and "interrupted: stopped before any row was finished; nothing was written" in said
     assert [p.name for p in tmp_path.iterdir()] == ["block.toml"]
 
@@ -67,7 +68,7 @@ def test_ctrl_c_leaves_no_partial_file_and_the_same_command_resumes(block, tmp_p
     assert len(read_rows(out)) == 3  # the third row is in the journal
     monkeypatch.undo()
     result = invoke("sweep", block, *args)
-    assert result.exit_code == 0 and "(0 runs now, 3 rows already there" in " ".join(result.output.split())
+    assert result.exit_code == 0 and "(0 runs now, 3 rows already there" in words(result.output)
     assert [r["amp"] for r in read_rows(out)] == [0.05, 0.1, 0.2]
 
 
@@ -91,7 +92,7 @@ def test_a_signal_while_the_pictures_are_written_says_what_is_missing(block, tmp
 
     monkeypatch.setattr(plots, "state_map", ctrl_c_in_the_plot)
     result = invoke(*args)
-    said = " ".join(result.output.split())
+    said = words(result.output)
     assert result.exit_code == 130, result.output
     assert f"interrupted: every row is in {out}, but not written: {tmp_path / 's.png'}, {tmp_path / 's.rrd'}" in said
     assert sorted(p.name for p in tmp_path.iterdir()) == ["block.toml", "s.csv"]  # no .part left
@@ -103,14 +104,14 @@ def test_a_signal_while_the_pictures_are_written_says_what_is_missing(block, tmp
 
     monkeypatch.setattr(recording_study, "record_study", sigterm_in_the_recording)
     result = invoke(*args)
-    said = " ".join(result.output.split())
+    said = words(result.output)
     assert result.exit_code == 143, result.output
     assert f"interrupted (SIGTERM): every row is in {out}, but not written: {tmp_path / 's.rrd'}; " in said
     assert "run the same command with --force (no run is made again)" in said  # the plot is there now
     assert sorted(p.name for p in tmp_path.iterdir()) == ["block.toml", "s.csv", "s.png"]
     monkeypatch.undo()
     result = invoke(*args, "--force")
-    assert result.exit_code == 0 and "(0 runs now, 2 rows already there" in " ".join(result.output.split())
+    assert result.exit_code == 0 and "(0 runs now, 2 rows already there" in words(result.output)
     assert (tmp_path / "s.rrd").stat().st_size > 0
 
 
@@ -142,7 +143,7 @@ def test_a_second_ctrl_c_while_the_table_is_written_is_ignored(block, tmp_path, 
     monkeypatch.setattr(store, "write_rows", ctrl_c_again_while_written)
     result = invoke("sweep", block, "-p", "amp=0.05,0.1,0.2", "--duration", 0.02, "--workers", 0, "-o", out)
     assert result.exit_code == 130, result.output
-    assert f"interrupted: every finished row is in {out}; run the same command again" in " ".join(result.output.split())
+    assert f"interrupted: every finished row is in {out}; run the same command again" in words(result.output)
     assert [r["amp"] for r in read_rows(out)] == [0.05]
     assert sorted(p.name for p in tmp_path.iterdir()) == ["block.toml", "s.parquet"]  # the journal went with it
     assert "Ctrl-C: already stopping — finishing the output files" in capfd.readouterr().err
@@ -213,7 +214,7 @@ def test_a_signal_just_after_the_plot_is_renamed_does_not_call_it_missing(block,
 
     monkeypatch.setattr(OutputFile, "commit", ctrl_c_right_after_the_rename)
     result = invoke("sweep", block, "-p", "amp=0.05,0.1", "--duration", 0.02, "--workers", 0, "-o", out)
-    said = " ".join(result.output.split())
+    said = words(result.output)
     assert result.exit_code == 130, result.output
     assert f"interrupted: every row is in {out}, but not written: {tmp_path / 's.rrd'}; " in said
     assert "run the same command with --force (no run is made again)" in said
@@ -243,7 +244,7 @@ def test_a_signal_held_while_the_plot_s_rename_fails_reports_the_error(block, tm
 
     monkeypatch.setattr(OutputFile, "commit", ctrl_c_then_a_failed_rename)
     result = invoke("sweep", block, "-p", "amp=0.05,0.1", "--duration", 0.02, "--workers", 0, "-o", out)
-    said = " ".join(result.output.split())
+    said = words(result.output)
     assert result.exit_code == 2, result.output
     assert f"error: {tmp_path / 's.png'}: Permission denied" in said
     assert "interrupted" not in said and "Traceback" not in said

@@ -12,6 +12,7 @@ import pytest
 from masonrycli.errors import InputError
 from masonrycli.study.store import read_rows
 
+from cli_helpers import words
 from sweep_helpers import BLOCK, invoke, velocity_csv, write_block
 
 
@@ -46,7 +47,7 @@ def test_a_study_table_in_its_records_folder_is_not_read_as_a_record(block, tmp_
     assert first.exit_code == 0, first.output
     again = invoke(*args, "--out", folder / "ida.csv", "--force")
     assert again.exit_code == 0, again.output
-    said = " ".join(again.output.split())
+    said = words(again.output)
     assert "2 rows in" in said and "(0 runs now, 2 rows already there, 0 failed)" in said, said
     assert {r["record"] for r in read_rows(folder / "ida.csv")} == {"a.csv", "b.csv"}
 
@@ -63,7 +64,7 @@ def test_a_record_edited_since_the_table_was_written_is_not_taken_as_done(block,
     assert read_rows(out)[0]["pgv"] == pytest.approx(0.05)
     record.write_text(record.read_text().replace(",0.05\n", ",0.45\n"))
     forced = invoke(*args, out, "--force")
-    assert forced.exit_code == 0 and "(1 run now, 0 rows already there" in " ".join(forced.output.split())
+    assert forced.exit_code == 0 and "(1 run now, 0 rows already there" in words(forced.output)
     assert read_rows(out)[0]["pgv"] == pytest.approx(0.45)
 
 
@@ -120,7 +121,7 @@ def test_a_histories_folder_that_cannot_be_made_leaves_no_file(block, tmp_path):
     assert Path("/proc/self").is_dir(), "needs Linux's /proc, where no folder can be made"
     out, histories = tmp_path / "s.csv", Path("/proc/masonry-histories")
     result = invoke("sweep", block, "-p", "amp=0.1", "--workers", 0, "-o", out, "--histories", histories)
-    said = " ".join(result.output.split())
+    said = words(result.output)
     # refused before the folder is made: /proc is no disk (root may write there, yet no file can be made)
     assert result.exit_code == 2 and said.startswith(f"error: --histories {histories}"), said
     assert "cannot make the folder (" in said or ": cannot write in /proc (" in said, said

@@ -14,6 +14,7 @@ from masonrycli.cli import app
 from masonrycli.study.store import read_rows
 from masonrycli.study.task import RESULT_COLUMNS
 
+from cli_helpers import words
 from synthetic_records import band_limited
 
 pytestmark = pytest.mark.slow  # a LocalCluster of a worker process
@@ -43,10 +44,6 @@ def test_a_set_with_a_one_column_file_sweeps_on_worker_processes(tmp_path):
     assert rows["one.csv", 10.0]["pgv"] == pytest.approx(10 * max(abs(x) for x in v))
     # the same time step makes the same study (its rows reused); another is another record, another study
     again = invoke(*args, "--record-dt", 0.01, "--workers", 0, "--force")
-    assert again.exit_code == 0 and "(0 runs now, 4 rows already there, 0 failed)" in " ".join(again.output.split()), (
-        again.output
-    )
+    assert again.exit_code == 0 and "(0 runs now, 4 rows already there, 0 failed)" in words(again.output), again.output
     again = invoke(*args, "--record-dt", 0.02, "--workers", 0, "--force")
-    assert again.exit_code == 0 and "(4 runs now, 0 rows already there, 0 failed)" in " ".join(again.output.split()), (
-        again.output
-    )
+    assert again.exit_code == 0 and "(4 runs now, 0 rows already there, 0 failed)" in words(again.output), again.output
