@@ -35,7 +35,8 @@ from collections.abc import Callable
 from pathlib import Path
 
 from masonrycli.errors import NOT_A_FILE, InputError, file_kind, special_file
-from masonrycli.motion import Constant, Record, Sine, time_step_problem
+from masonrycli.motion import Constant, Sine
+from masonrycli.record_motion import Record, time_step_problem
 from masonrycli.record_text import NoTimeStep, TimeStepNotUsed
 from masonrycli.records import record_motion
 from masonrycli.scenario import MAX_DURATION, Material, RunConfig, Scenario, scenario_from_builder

@@ -1,4 +1,4 @@
-"""Reading ground-motion records from files into :class:`~masonrycli.motion.Record` motions.
+"""Reading ground-motion records from files into :class:`~masonrycli.record_motion.Record` motions.
 
 Two formats, chosen by the file's extension:
 
@@ -22,7 +22,7 @@ import warnings
 import numpy as np
 
 from masonrycli.errors import NOT_A_FILE, InputError, RecordWarning, file_kind, not_utf8, special_file
-from masonrycli.motion import Record, time_step_problem
+from masonrycli.record_motion import Record, time_step_problem
 from masonrycli.record_text import NoTimeStep, TimeStepNotUsed, at2_text, csv_text, number
 from masonrycli.record_units import check_at2_header, check_csv_header, record_text
 from masonrycli.values import format_value, quote_string, shorten
@@ -200,7 +200,7 @@ def record_motion(
     display: str | None = None,
     time_step: float | None = None,
 ) -> Record:
-    """A :class:`~masonrycli.motion.Record` from a record file (.AT2 or CSV, see :func:`read_record`).
+    """A :class:`~masonrycli.record_motion.Record` from a record file (.AT2 or CSV, see :func:`read_record`).
 
     ``quantity`` defaults to "acceleration" for .AT2 files (the only one they hold) and "velocity" for
     CSV. ``vertical`` is the file of the vertical component (the record then acts along x and y and
@@ -248,7 +248,7 @@ def _time_step(value, key: str) -> float | None:
 
 
 def record_fields(table: dict, base_dir: str) -> dict:
-    """The :class:`~masonrycli.motion.Record` arguments for the data of a scenario's record table:
+    """The :class:`~masonrycli.record_motion.Record` arguments for the data of a scenario's record table:
     ``file`` (and ``vertical``) read relative to ``base_dir``, or inline ``time`` and ``value``.
 
     Raises :class:`InputError` with a message naming the key (``motion.file = "q.csv": no such file ...``).

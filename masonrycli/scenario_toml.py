@@ -20,7 +20,8 @@ import numpy as np
 
 from geometry_library.blocks import Assembly, Block, GeometryError, Support
 from masonrycli.errors import NOT_A_FILE, InputContext, InputError, not_utf8, one_line, special_file
-from masonrycli.motion import MOTION_KINDS, Fixed, Motion
+from masonrycli.motion import Constant, Fixed, Motion, Ramp, Sine
+from masonrycli.record_motion import Record
 from masonrycli.records import record_fields
 from masonrycli.scenario import Material, RunConfig, Scenario, block_speed_problem
 from masonrycli.scenario_warnings import idle_driven_supports
@@ -40,6 +41,9 @@ TOP_LEVEL_KEYS = ("name", "run", "material", "structure", "block", "support")
 BLOCK_KEYS = ("name", "polygon", "density", "thickness", "velocity")
 SUPPORT_KEYS = ("name", "polygon", "motion")
 BUILDER_SUPPORT_KEYS = ("name", "motion")
+
+MOTION_KINDS: dict[str, type[Motion]] = {cls.kind: cls for cls in (Fixed, Constant, Sine, Ramp, Record)}
+"""TOML ``kind`` -> motion class."""
 
 ALL_MOTION_KEYS = tuple(dict.fromkeys(k for cls in MOTION_KINDS.values() for k in cls.TOML_KEYS))
 

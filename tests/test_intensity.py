@@ -7,7 +7,8 @@ import pytest
 from scipy import signal
 
 from masonrycli.intensity import SA_DAMPING, describe, intensity_measures, shaking_support
-from masonrycli.motion import Constant, Fixed, Record, Sine
+from masonrycli.motion import Constant, Fixed, Sine
+from masonrycli.record_motion import Record
 
 
 def test_sine_ground_closed_forms():

@@ -161,7 +161,8 @@ def test_check_sampling_refuses_a_support_faster_than_a_diverged_block():
     # --amp 1e30 ran (exit 0, "collapsed at t = 0.001 s"), --settlement 1e9 too, and a CSV record of
     # 1e300 m/s printed numpy's overflow warnings: a support that fast is a typo, refused like the others
     from masonrycli import run as run_module
-    from masonrycli.motion import Ramp, Record
+    from masonrycli.motion import Ramp
+    from masonrycli.record_motion import Record
     from masonrycli.scenario import MAX_SUPPORT_SPEED, check_sampling
 
     scenario = load_scenario(DATA / "block_on_ground.toml")  # 1 m/s sine, 1 s

@@ -64,7 +64,7 @@ def test_record_warnings_name_a_record_beyond_10_g_as_scaled(tmp_path):
     ]
     gentle = dataclasses.replace(scenario, motions=(dataclasses.replace(scenario.motions[-1], scale=1.0),))
     assert not any("peaks" in w for w in record_warnings(gentle))  # 5.1 g: strong, not absurd
-    from masonrycli.motion import Record
+    from masonrycli.record_motion import Record
 
     accel = Record(
         time=(0.0, 0.1, 0.2), value=((0.0, 0.0), (3.0, 4.0), (-1.0, 0.0)), quantity="acceleration", scale=2.0
