@@ -13,9 +13,10 @@ does not count towards a batch's ``batch_frames`` nor fix a scale, so every late
 What is logged per frame, once each: the block fill mesh's vertex positions (float32, inset so the
 joints show) with one colour component per field (each view maps its own, ``layout.FIELDS``); a hover
 point per block with its values (float32); the principal-axis glyphs; one resultant arrow per joint
-(``masonrycli.joint_forces``); hinges; each field's colour range and legend labels. Solver health
-(sweeps, residual, contacts) is logged for every step (``log_step``). The magnified deformed shape is
-logged when the recorder closes, when the largest displacement of the run is known.
+(``masonrycli.joint_forces``); hinges; each field's colour range and legend labels; the time series
+(energies, displacements, support motion: ``series``). Solver health (sweeps, residual, contacts) is
+logged for every step (``log_step``). The magnified deformed shape is logged when the recorder closes,
+when the largest displacement of the run is known.
 
 Scales: colour ranges follow the data (``masonrycli.colour_range.RangeTracker``, checked every frame);
 the joint-resultant scale (``RESULTANT_LENGTH`` block heights for the 95th percentile resultant of the
@@ -61,7 +62,6 @@ from masonrycli.recording.layout import (
     RESULTANT_PERCENTILE,
     ROBUST_PERCENTILE,
     SCALARS,
-    SERIES,
     SUPPORT_FILL,
     SUPPORT_OUTLINES,
     TENSOR_KEYS,
@@ -72,6 +72,7 @@ from masonrycli.recording.layout import (
 from masonrycli.recording.magnified import send_magnified
 from masonrycli.recording.overlays import frame_joint_resultants, send_axes, send_joints
 from masonrycli.recording.readback import check_complete
+from masonrycli.recording.series import send_series, send_steps
 from masonrycli.recording.static_content import (
     TICKS,
     RecordingStatic,
@@ -248,7 +249,7 @@ class Recorder:
         if batch:
             self._send_batch(batch)
         if steps:
-            self._send_steps(steps)
+            send_steps(self.rec, steps, self._log10_tolerance)
 
     def close(self, status: str = COMPLETED, note: str = "") -> None:
         """Flush, log the magnified shape, write the final run document and disconnect (which writes the
@@ -309,7 +310,7 @@ class Recorder:
         self._send_supports(idx, b.stack("support_q"))
         self._send_axes(idx, q, tensors)
         self._send_joints(idx, b)
-        self._send_series(idx, b, q)
+        send_series(self.rec, idx, b, q, self._ref, self._n)
 
     def _fix_scales(self, tensors: dict[str, np.ndarray], b: FrameBatch) -> bool:
         """Fix the force and glyph scales not fixed yet from this batch if it has data; True if any was."""
@@ -395,45 +396,6 @@ class Recorder:
 
     def _send_joints(self, idx: list, b: FrameBatch) -> None:
         send_joints(self.rec, idx, b, self.force_scale)
-
-    def _send_series(self, idx: list, b: FrameBatch, q: np.ndarray) -> None:
-        n_frames = len(q)
-        ref_q, ref_sq, ref_pot = self._ref
-        kinetic, potential, dissipated, work = np.array(b["scalars"]).T  # SCALARS order
-        moved = q[..., :2] - ref_q[None, :, :2]
-        sq, sv = b.stack("support_q"), b.stack("support_v")
-        series = {
-            "energy_small": np.stack([kinetic, dissipated], axis=1),
-            "energy_large": np.stack([potential - ref_pot, work], axis=1),
-            "energy_balance": kinetic + (potential - ref_pot) + dissipated - work,
-            "max_displacement": np.sqrt((moved**2).sum(-1)).max(axis=1) if self._n else np.zeros(n_frames),
-            "support_velocity": sv,
-            "support_displacement": sq[..., :2] - ref_sq[None, :, :2],
-        }
-        self._send_scalars(idx, series)
-
-    def _send_steps(self, s: FrameBatch) -> None:
-        iterations, residual, contacts = np.array(s["values"]).T
-        with np.errstate(divide="ignore"):
-            log_residual = np.log10(residual)
-        tolerance = np.full(len(residual), self._log10_tolerance)
-        self._send_scalars(
-            time_indexes(s),
-            {"iterations": iterations, "residual": np.stack([log_residual, tolerance], 1), "contacts": contacts},
-        )
-
-    def _send_scalars(self, idx: list, series: dict[str, np.ndarray]) -> None:
-        for key, values in series.items():
-            n_rows = len(values)
-            values = np.asarray(values, dtype=np.float64).reshape(n_rows, -1)
-            if values.shape[1]:
-                self.rec.send_columns(
-                    SERIES[key],
-                    indexes=idx,
-                    columns=rr.Scalars.columns(scalars=values.reshape(-1)).partition(
-                        partition_lengths(n_rows, values.shape[1])
-                    ),
-                )
 
     def _send_magnified(self) -> None:
         if self._poses and self._ref is not None:

@@ -1,0 +1,69 @@
+"""The recording's time series: energies, displacements and support motion per frame, solver health per step.
+
+What the time-series views plot (entity paths ``layout.SERIES``), each a set of scalars against the
+timelines: per frame, the kinetic and dissipated energy, the potential energy (from the as-built state's)
+and the supports' work, the energy balance error, the largest block displacement and the supports'
+velocity and displacement (from the as-built state); per step (``Recorder.log_step``), the NLGS sweeps,
+log10 of the residual beside log10 of the tolerance, and the contact count.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import rerun as rr
+
+from masonrycli.recording.arrays import FrameBatch, partition_lengths, time_indexes
+from masonrycli.recording.layout import SERIES
+
+
+def send_series(
+    rec: rr.RecordingStream,
+    idx: list,
+    b: FrameBatch,
+    q: np.ndarray,
+    ref: tuple[np.ndarray, np.ndarray, float],
+    n_blocks: int,
+) -> None:
+    """The per-frame series of a batch ``b`` (``q`` (F, N, 3) its block poses); ``ref``: the as-built block
+    and support poses and potential energy."""
+    n_frames = len(q)
+    ref_q, ref_sq, ref_pot = ref
+    kinetic, potential, dissipated, work = np.array(b["scalars"]).T  # SCALARS order
+    moved = q[..., :2] - ref_q[None, :, :2]
+    sq, sv = b.stack("support_q"), b.stack("support_v")
+    series = {
+        "energy_small": np.stack([kinetic, dissipated], axis=1),
+        "energy_large": np.stack([potential - ref_pot, work], axis=1),
+        "energy_balance": kinetic + (potential - ref_pot) + dissipated - work,
+        "max_displacement": np.sqrt((moved**2).sum(-1)).max(axis=1) if n_blocks else np.zeros(n_frames),
+        "support_velocity": sv,
+        "support_displacement": sq[..., :2] - ref_sq[None, :, :2],
+    }
+    _send_scalars(rec, idx, series)
+
+
+def send_steps(rec: rr.RecordingStream, s: FrameBatch, log10_tolerance: float) -> None:
+    """The solver health of the steps buffered in ``s`` (``values``: sweeps, residual, contacts per step)."""
+    iterations, residual, contacts = np.array(s["values"]).T
+    with np.errstate(divide="ignore"):
+        log_residual = np.log10(residual)
+    tolerance = np.full(len(residual), log10_tolerance)
+    _send_scalars(
+        rec,
+        time_indexes(s),
+        {"iterations": iterations, "residual": np.stack([log_residual, tolerance], 1), "contacts": contacts},
+    )
+
+
+def _send_scalars(rec: rr.RecordingStream, idx: list, series: dict[str, np.ndarray]) -> None:
+    for key, values in series.items():
+        n_rows = len(values)
+        values = np.asarray(values, dtype=np.float64).reshape(n_rows, -1)
+        if values.shape[1]:
+            rec.send_columns(
+                SERIES[key],
+                indexes=idx,
+                columns=rr.Scalars.columns(scalars=values.reshape(-1)).partition(
+                    partition_lengths(n_rows, values.shape[1])
+                ),
+            )
