@@ -201,8 +201,9 @@ def execute(
         try:
             for out in outputs.files():
                 open_part(out)
-            with slow_start_notice():  # a first run compiles the kernels here and in step 1
-                sim = Simulation(scenario)
+            with signals.setup_work():  # a Ctrl-C inside numba's compiler stops the run (interrupt.py)
+                with slow_start_notice():  # a first run compiles the kernels here and in step 1
+                    sim = Simulation(scenario)
             for out in outputs.files():
                 try:
                     sinks[out] = _open_sink(out, outputs, scenario, sim, magnify)

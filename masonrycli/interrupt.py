@@ -11,6 +11,14 @@ Three phases, because what a signal may safely do depends on what is under way:
 
 Outside the main thread (where Python cannot install handlers) the context does nothing.
 
+A handler's raise can land where Python cannot pass an exception on: a first run compiles the numba kernels
+for seconds, and numba's compiler calls back into Python through ctypes (llvmlite's object cache), where an
+exception is reported as "Exception ignored …" with a traceback and dropped. A Ctrl-C there printed that
+traceback, then the compile failed on its own (``RuntimeError: no compiled object yet``), reported as an
+internal error with exit 1 instead of the stop. So while the handlers are installed a dropped exception of
+theirs is not printed but noted (:attr:`dropped`), and :meth:`StopSignals.setup_work` raises the stop
+instead of the error it caused.
+
 :class:`FirstSignalStops` is the same rule for a command that stops by ``KeyboardInterrupt`` (``masonry
 sweep``): the first signal raises it, later ones are acknowledged and ignored (after the context too,
 once a signal has stopped the command: it is on its way out), and a block can hold it (a report file
@@ -29,6 +37,7 @@ from __future__ import annotations
 import contextlib
 import os
 import signal
+import sys
 import threading
 
 SIGNALS = (signal.SIGINT, signal.SIGTERM)
@@ -57,9 +66,15 @@ class _Handlers:
 
     def __init__(self) -> None:
         self._previous: dict[int, object] = {}
+        self._raised: BaseException | None = None
+        self._hook = None
+        self.dropped = False
+        """The exception a handler raised was dropped by Python (module doc): the signal stopped nothing."""
 
     def __enter__(self):
         if threading.current_thread() is threading.main_thread():
+            self._hook = sys.unraisablehook
+            sys.unraisablehook = self._unraisable
             try:
                 for sig in SIGNALS:
                     self._previous[sig] = signal.signal(sig, self._handle)
@@ -72,6 +87,19 @@ class _Handlers:
         for sig, handler in self._previous.items():
             signal.signal(sig, handler)
         self._previous.clear()
+        if self._hook is not None:
+            sys.unraisablehook, self._hook = self._hook, None
+
+    def _raise(self, exc: BaseException):
+        """Raise ``exc`` from a handler, remembered so that :meth:`_unraisable` knows it."""
+        self._raised = exc
+        raise exc
+
+    def _unraisable(self, unraisable) -> None:
+        if self._raised is not None and unraisable.exc_value is self._raised:
+            self.dropped = True  # said by the command's own stop line, not by a traceback
+            return
+        self._hook(unraisable)
 
     def _handle(self, signum, _frame) -> None:
         raise NotImplementedError
@@ -110,11 +138,24 @@ class StopSignals(_Handlers):
     def requested(self) -> bool:
         return self.signum is not None
 
+    @contextlib.contextmanager
+    def setup_work(self):
+        """Around work of the setup phase that may compile numba kernels: a StopRun that Python dropped there
+        (module doc) is raised instead of the error it caused, or at the end of the block if the work went on."""
+        try:
+            yield
+        except Exception:
+            if self.dropped:
+                raise StopRun(self.signum) from None
+            raise
+        if self.dropped:
+            raise StopRun(self.signum)
+
     def _handle(self, signum, _frame) -> None:
         if self.signum is None:
             self.signum = signum
             if self.phase == "setup":
-                raise StopRun(signum)
+                self._raise(StopRun(signum))
             return
         self.repeats += 1
         already_stopping(signum)
@@ -179,7 +220,7 @@ class FirstSignalStops(_Handlers):
         if self._holding:
             self._deferred = True
             return
-        raise KeyboardInterrupt
+        self._raise(KeyboardInterrupt())
 
 
 def already_stopping(signum: int) -> None:

@@ -2,6 +2,10 @@
 
 from __future__ import annotations
 
+import ctypes
+import os
+import time
+
 from typer.testing import CliRunner
 
 from masonrycli.cli import app
@@ -25,3 +29,15 @@ def assert_one_line_error(result, *fragments):
     assert len(lines) == 1, result.output
     for fragment in fragments:
         assert fragment in lines[0], lines[0]
+
+
+def signal_inside_a_ctypes_callback(signum: int) -> None:
+    """Send ``signum`` to this process from inside a ctypes callback, where numba's compiler calls back into
+    Python (llvmlite's object cache) on a first run: an exception a handler raises there cannot leave the
+    callback, and ctypes reports it as "Exception ignored …" and drops it."""
+
+    def callback():
+        os.kill(os.getpid(), signum)
+        time.sleep(0.2)  # the handler runs here
+
+    ctypes.CFUNCTYPE(None)(callback)()

@@ -33,7 +33,7 @@ from masonrycli.run import Simulation
 from masonrycli.scenario import Material, RunConfig, Scenario
 from masonrycli.source_digest import source_commit
 
-from cli_helpers import invoke
+from cli_helpers import invoke, signal_inside_a_ctypes_callback
 
 AMP, FREQ, DT, STEPS, EVERY = 0.01, 2.0, 1e-3, 20, 5
 # v(t) = AMP cos(2π FREQ t): the ground's peak speed is AMP, at t = 0
@@ -121,6 +121,25 @@ def test_a_stop_before_step_one_leaves_no_file_and_keeps_the_previous_one(tmp_pa
     assert info.value.signum == signal.SIGINT
     assert os.listdir(tmp_path) == ["r.rrd"]
     assert (tmp_path / "r.rrd").read_bytes() == b"the previous recording"
+
+
+def test_a_stop_inside_numbas_compiler_is_a_stop_not_an_internal_error(tmp_path, monkeypatch, capfd):
+    """Walk-through, 2026-11-28: a Ctrl-C landing in a ctypes callback of the first compile was dropped (a
+    StopRun traceback on stderr) and the compile failed with a RuntimeError: `masonry simulate` said
+    "internal error … the recording and history hold every frame computed before it" and exited 1. Now it is
+    the stop before step 1: StopRun, no file left, nothing on stderr."""
+
+    def compile_interrupted(scenario):
+        signal_inside_a_ctypes_callback(signal.SIGINT)
+        raise RuntimeError("no compiled object yet for <Library '_narrowphase'>")
+
+    monkeypatch.setattr(execute_module, "Simulation", compile_interrupted)
+    sc, outputs = _planned(tmp_path)
+    with pytest.raises(StopRun) as info:
+        execute(sc, outputs, console=_quiet())
+    assert info.value.signum == signal.SIGINT
+    assert os.listdir(tmp_path) == []
+    assert "Traceback" not in capfd.readouterr().err
 
 
 def test_the_plan_names_the_outputs_asked_for(tmp_path, monkeypatch):

@@ -15,6 +15,8 @@ import pytest
 
 from masonrycli.interrupt import StopRun, StopSignals, exit_code
 
+from cli_helpers import signal_inside_a_ctypes_callback
+
 
 def start(tmp_path: Path, *extra: str) -> tuple[subprocess.Popen, Path, Path]:
     rrd, npz = tmp_path / "w.rrd", tmp_path / "w.npz"
@@ -105,6 +107,31 @@ def test_stop_signals_phases():
         time.sleep(0.1)
         assert stop.repeats == 2 and stop.signum == signal.SIGINT
     assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
+
+
+def test_a_stop_dropped_inside_a_ctypes_callback_still_stops_the_setup(capfd):
+    """Walk-through, 2026-11-28: Ctrl-C during a first run's numba compile printed "Exception ignored on calling
+    ctypes callback function" with a StopRun traceback, then "internal error: RuntimeError: no compiled object
+    yet", exit 1. The dropped StopRun is not printed, and setup work raises it instead of the error it caused,
+    or at the end of the block if the work went on."""
+    with StopSignals() as stop:
+        with pytest.raises(StopRun) as info:
+            with stop.setup_work():
+                signal_inside_a_ctypes_callback(signal.SIGINT)
+                raise RuntimeError("no compiled object yet for <Library '_narrowphase'>")  # numba, after the drop
+        assert info.value.signum == signal.SIGINT and stop.dropped
+    went_on = []
+    with StopSignals() as stop:
+        with pytest.raises(StopRun) as info:
+            with stop.setup_work():
+                signal_inside_a_ctypes_callback(signal.SIGTERM)
+                went_on.append("compiled")
+        assert info.value.signum == signal.SIGTERM and went_on == ["compiled"]
+    with StopSignals() as stop:  # an error with no signal is the error
+        with pytest.raises(RuntimeError):
+            with stop.setup_work():
+                raise RuntimeError("an engine bug")
+    assert "Traceback" not in capfd.readouterr().err
 
 
 def test_a_held_signal_is_raised_when_the_block_ends():

@@ -12,7 +12,7 @@ from masonrycli import SOURCE_DIGEST
 from masonrycli.cli import app
 from masonrycli.scenario_toml import dump_scenario
 
-from cli_helpers import assert_one_line_error, invoke, runner, words
+from cli_helpers import assert_one_line_error, invoke, runner, signal_inside_a_ctypes_callback, words
 from limit_helpers import column
 
 
@@ -208,6 +208,25 @@ def test_sigterm_during_verify_says_so_exits_143_and_keeps_the_recording(during,
     info = inspect_recording(out)
     assert info["complete"] and not info["truncated"] and info["has_blueprint"]
     assert sorted(p.name for p in tmp_path.iterdir()) == ["col.rrd"]  # no temporary file left
+
+
+def test_ctrl_c_inside_numbas_compiler_is_the_interrupted_line(column_file, monkeypatch, capfd):
+    """Walk-through, 2026-11-28: the analysis compiles the engine's contact detection on a first run; a Ctrl-C
+    landing in one of numba's ctypes callbacks was dropped (a traceback) and the compile's RuntimeError
+    came out as an internal error. Now: the one interrupted line, exit 130."""
+    import signal
+
+    import masonrycli.limit.command as command
+
+    def compile_interrupted(scenario, live):
+        signal_inside_a_ctypes_callback(signal.SIGINT)
+        raise RuntimeError("no compiled object yet for <Library '_narrowphase'>")
+
+    monkeypatch.setattr(command, "analyse", compile_interrupted)
+    result = invoke("limit", column_file)
+    assert result.exit_code == 130, result.output
+    assert words(result.output) == "interrupted: before λ was found; nothing was written"
+    assert "Traceback" not in capfd.readouterr().err
 
 
 def test_a_long_hinge_list_shows_the_fastest_turning_joints_first():

@@ -177,18 +177,19 @@ def run_limit(
     done = _Done()
     with StopSignals() as signals:
         try:
-            checks = _analyse(
-                structure,
-                LiveLoad(load, direction, block),
-                friction,
-                verify,
-                out,
-                force,
-                done,
-                signals,
-                console=None if as_json else console,
-                err_console=err_console,
-            )
+            with signals.setup_work():  # the analysis and --verify compile numba kernels on a first run
+                checks = _analyse(
+                    structure,
+                    LiveLoad(load, direction, block),
+                    friction,
+                    verify,
+                    out,
+                    force,
+                    done,
+                    signals,
+                    console=None if as_json else console,
+                    err_console=err_console,
+                )
         except StopRun as stop:
             how = "" if stop.signum == signal.SIGINT else f" ({signal_name(stop.signum)})"  # as `masonry sweep`
             err_console.print(f"interrupted{how}: {done.describe()}", soft_wrap=True)
