@@ -1,5 +1,5 @@
 """The layering the project keeps: each heavy library is imported by one package only; and every
-non-trivial engine kernel opens with its pseudo-code.
+non-trivial engine kernel opens with its pseudo-code; and no module holds more than 500 lines.
 
 numba by the engine (masonrycli/engine; the solver lab compiles its research copies of engine kernels
 through the engine's ``_jit.njit``, so the flags stay the engine's), rerun by the recording package,
@@ -67,3 +67,25 @@ def _kernels_without_pseudo_code() -> list[str]:
 
 def test_every_non_trivial_kernel_opens_with_its_pseudo_code():
     assert not _kernels_without_pseudo_code(), "kernels without a pseudo-code comment"
+
+
+MODULE_LINES = 500
+"""One concept per module: a module longer than this holds more than one (the house rule)."""
+
+
+def _long_modules() -> list[str]:
+    long = []
+    for top in CHECKED:
+        for path in sorted((ROOT / top).rglob("*.py")):
+            if "solver_lab/data" in path.as_posix():
+                continue
+            count = len(path.read_text(encoding="utf-8").splitlines())
+            if count > MODULE_LINES:
+                long.append(f"{path.relative_to(ROOT).as_posix()} ({count} lines)")
+    return long
+
+
+def test_modules_hold_at_most_500_lines():
+    checked = sum(1 for top in CHECKED for _ in (ROOT / top).rglob("*.py"))
+    assert checked > 100, "too few modules found: the test would pass vacuously"
+    assert not _long_modules(), f"modules over {MODULE_LINES} lines: {_long_modules()}"
