@@ -4,12 +4,18 @@ References: the engine's own local solve and sweep (nlgs._local_solve, nlgs._nlg
 colouring's definition checked by brute force, and the tight solve the lab's capture keeps per problem.
 """
 
+import functools
+import os
+import subprocess
+import sys
+from pathlib import Path
+
 import numpy as np
 import pytest
 from solver_lab_helpers import tiny_cold_problem
 from test_engine_nlgs import _packed_row, _random_problem, _stack_problem
 
-from benchmarks.solver_lab import law, simd_sweep
+from benchmarks.solver_lab import law, simd_lanes, simd_sweep
 from benchmarks.solver_lab.outcome import Context
 from masonrycli.engine import momentum, nlgs
 
@@ -81,7 +87,7 @@ def _solve(problem, variant, tolerance, cap=200_000):
     return out, v, r
 
 
-@pytest.mark.parametrize("variant", ["split", "fused", "blocks", "lanes+split", "split4"])
+@pytest.mark.parametrize("variant", ["split", "fused", "blocks", "lanes+split", "split4", "lanes+vec"])
 def test_coloured_sweeps_converge_to_the_tight_solution(problem, variant):
     (sweeps, residual, colours), v, r = _solve(problem, variant, 1e-10)
     assert residual <= 1e-10 and colours >= 2 and sweeps > 1
@@ -211,3 +217,67 @@ def test_coloured_sweeps_are_momentum_gauss_seidel_in_colour_order(problem, swee
     np.testing.assert_allclose(v, v_s, rtol=1e-12, atol=1e-15)
     np.testing.assert_allclose(r[order], r_s, rtol=1e-12, atol=1e-15)
     assert np.array_equal(status[order], st_s)
+
+
+def _lane_groups(body, pack, count, bodies):
+    # simd_lanes' group kinds: (full groups of 8, partial groups, split groups)
+    order, start = np.empty(count, np.int64), np.empty(count + 1, np.int64)
+    groups = simd_sweep.lanes(body, pack, count, bodies, order, start)
+    ia, ib, K, X = simd_sweep.sorted_arrays(body, pack, count, np.zeros((count, 2)), order)
+    _, _, gmask, clash = simd_lanes.pack_groups(count, order, start, groups, K, X)
+    full = (gmask == simd_lanes.FULL) & ~clash
+    return int(full.sum()), int(((gmask != simd_lanes.FULL) & ~clash).sum()), int(clash.sum())
+
+
+@functools.cache
+def _lane_problem(name):
+    if name == "tiny":
+        tiny = tiny_cold_problem()
+        return tiny.body, tiny.pack(), tiny.v_free, tiny.r_warm, tiny.mu
+    stack = _stack_problem(39)  # 78 contacts: runs of 10, the last of 8, so groups 8 and 9 have 7 lanes
+    return stack[0], stack[1], stack[5], stack[6], stack[7]
+
+
+@pytest.mark.parametrize(("name", "tolerance", "cap"), [("tiny", 1e-9, 10_000), ("tiny", 0.0, 40),
+                                                        ("stack", 1e-9, 10_000), ("stack", 0.0, 60)])  # fmt: skip
+def test_explicit_vector_lanes_are_the_scalar_lanes_bit_for_bit(name, tolerance, cap):
+    # simd_lanes (explicit <8 x double>) against simd_sweep's "lanes+split" (the scalar lane groups): the
+    # same sweeps, residual, v, r and statuses to the bit, through all three kinds of group. Tolerance 0:
+    # after every sweep count up to cap (one residual differs in its last bit only now and then).
+    body, pack, v0, r0, mu = _lane_problem(name)
+    count = body.shape[0]
+    full, partial, split = _lane_groups(body, pack, count, v0.shape[0])
+    assert (full > 0 and partial > 0) if name == "stack" else split > 0
+    for sweeps in range(1, cap + 1) if tolerance == 0.0 else [cap]:
+        out = []
+        for variant in ("lanes+split", "lanes+vec"):
+            v, r, st = v0.copy(), r0.copy(), np.zeros(count, np.int8)
+            its, res, _ = simd_sweep.solve(body, pack, count, mu, tolerance, sweeps, v, r, st, sweeps, variant)
+            out.append((its, res, v, r, st))
+        (its, res, v, r, st), (its2, res2, v2, r2, st2) = out
+        assert its == its2 and res == res2 and (its == sweeps) == (tolerance == 0.0)
+        assert _same_bits(v, v2) and _same_bits(r, r2) and np.array_equal(st, st2)
+        assert res <= tolerance or tolerance == 0.0
+
+
+def _same_bits(a, b):
+    return np.array_equal(a.view(np.int64), b.view(np.int64))
+
+
+def test_explicit_vector_lanes_on_narrower_vectors():
+    # Compiled for Haswell (AVX2: LLVM splits each <8 x double> into two ymm halves, and scalarises the
+    # scatters), the stack's cases above give the same bits. A fresh process (numba reads the CPU name at
+    # import) with its own cache.
+    root = Path(__file__).resolve().parent.parent
+    env = dict(os.environ, NUMBA_CPU_NAME="haswell", NUMBA_CPU_FEATURES="", PYTHONPATH=str(root),
+               NUMBA_CACHE_DIR=str(root / ".pytest_cache" / "numba-haswell"))  # fmt: skip
+    code = (
+        "import sys; sys.path.insert(0, 'tests'); import test_solver_lab_simd as t\n"
+        "for cap in (0.0, 60), (1e-9, 10_000): t.test_explicit_vector_lanes_are_the_scalar_lanes_bit_for_bit('stack', *cap)\n"
+        "from benchmarks.solver_lab import simd_lanes\n"
+        "asm = ''.join(simd_lanes.lane_sweeps.inspect_asm().values())\n"
+        "assert 'zmm' not in asm and 'ymm' in asm, 'not compiled for AVX2'\n"
+        "print('ok')\n"
+    )
+    done = subprocess.run([sys.executable, "-c", code], cwd=root, env=env, capture_output=True, text=True)
+    assert done.returncode == 0 and done.stdout.strip() == "ok", done.stderr[-2000:]

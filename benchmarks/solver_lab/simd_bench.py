@@ -129,8 +129,13 @@ def asm_summary():
     simd_sweep._solve_u(0, n, K, U, 0.0, 0.5, X, D, st)
     simd_sweep._phase_a(0, n, ia, ia, K, v, 0.0, 0.5, X, D, st)
     simd_sweep._phase_b(0, n, ia, ia, K, v, D)
+    from benchmarks.solver_lab import simd_lanes
+
+    body, pack = np.zeros((n, 2), np.int32), np.zeros((n, nlgs.PACK_WIDTH))
+    simd_lanes.solve(body, pack, 0, 0.5, 1e-5, 10, np.zeros((n, 3)), np.zeros((n, 2)), st, 10)  # count 0: types only
     kernels = {"split: _gather_u": simd_sweep._gather_u, "split: _solve_u": simd_sweep._solve_u,
-               "fused: _phase_a": simd_sweep._phase_a, "_phase_b": simd_sweep._phase_b}  # fmt: skip
+               "fused: _phase_a": simd_sweep._phase_a, "_phase_b": simd_sweep._phase_b,
+               "lanes+vec: lane_sweeps": simd_lanes.lane_sweeps}  # fmt: skip
     for name, kernel in kernels.items():
         for asm in kernel.inspect_asm().values():
             lines = asm.splitlines()
@@ -138,7 +143,7 @@ def asm_summary():
             packed = sum(bool(re.match(r"v.*pd$", o)) and not o.startswith("vmov") for o in ops)
             scalar = sum(bool(re.match(r"v.*sd$", o)) and not o.startswith("vmov") for o in ops)
             print(f"{name}: {len(ops)} instructions, zmm in {sum('zmm' in x for x in lines)} lines, ymm in "
-                  f"{sum('ymm' in x for x in lines)}, gathers {sum('gather' in o for o in ops)}, packed double ops "
+                  f"{sum('ymm' in x for x in lines)}, gathers {sum('gather' in o for o in ops)}, scatters {sum('scatter' in o for o in ops)}, packed double ops "
                   f"{packed}, scalar double ops {scalar}")  # fmt: skip
 
 

@@ -396,7 +396,12 @@ def solve(
     contact_body, pack, count, mu, tolerance, cap, v, r, status, stall_after=momentum.STALL_SWEEPS, variant="split"
 ):
     """The coloured first stage on one step's arrays (as nlgs._nlgs_interleaved takes them).
-    Returns (iterations, residual, colours). Variant "blocks": simd_blocks.py's layout in 8-contact blocks."""
+    Returns (iterations, residual, colours). Variant "blocks": simd_blocks.py's layout in 8-contact blocks;
+    "lanes+vec": simd_lanes.py's explicit vectors (returns the groups as colours)."""
+    if variant == "lanes+vec":  # simd_lanes.py: the lanes' groups in explicit vectors
+        from benchmarks.solver_lab import simd_lanes  # it builds on this module
+
+        return simd_lanes.solve(contact_body, pack, count, mu, tolerance, cap, v, r, status, stall_after)
     if variant == "blocks":
         from benchmarks.solver_lab import simd_blocks  # it builds on this module
 
