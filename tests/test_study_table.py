@@ -87,3 +87,11 @@ def test_a_unitless_threshold_has_no_empty_legend_entry():
     rows = [{"blocks": 51, "friction_threshold": 0.42, "evaluations": 7, "note": "", "status": "completed"}]
     legend = " ".join(_render(rows, find_columns(["blocks"], "friction"), ["blocks"], 120))
     assert "friction_threshold  ·" not in legend and "runs: evaluations" in legend
+
+
+def test_the_title_counts_the_rows_in_the_singular_and_plural():
+    # `masonry sweep block.toml --param amp=0.05:1.0:3 --find amp --outcome sliding` (docs/sweep.md) titled its
+    # one row "study (1 rows)"
+    columns, names = grid_columns(["record", "scale"], "pga"), ["record", "scale"]
+    assert _render(ROWS[:1], columns, names, 80)[0].strip() == "study (1 row)"
+    assert _render(ROWS, columns, names, 80)[0].strip() == f"study ({len(ROWS)} rows)"

@@ -142,7 +142,8 @@ def _natural_width(console: Console, table: Table) -> int:
 
 
 def _table(rows: list[dict], columns: list[Column]) -> Table:
-    table = Table(title=f"study ({len(rows)} rows)", title_justify="left")
+    count = f"{len(rows)} row" + ("" if len(rows) == 1 else "s")  # a --find of one point said "study (1 rows)"
+    table = Table(title=f"study ({count})", title_justify="left")
     for c in columns:
         words = c.header == "note"  # wrapped rather than cut
         table.add_column(c.header, no_wrap=not words, overflow="fold" if words else "ellipsis")
