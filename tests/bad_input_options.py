@@ -308,4 +308,20 @@ OPTION_ROWS = [
         2,
         "recs: a folder, not a recording; it holds 2 recordings (a.rrd, b.rrd): give one, e.g. masonry inspect recs/",
     ),
+    # walk-through 2026-11-28: the command suggested for a folder with a space could not be pasted
+    # ("masonry inspect my recs/a.rrd"), and an .AT2 record got rerun's 'Not an RRD file: expected FourCC header'
+    (
+        "inspect-folder-with-a-space",
+        {"my recs/a.rrd": ""},
+        ("inspect", "my recs"),
+        2,
+        "my recs: a folder, not a recording; it holds 1 recording (a.rrd): give one, e.g. masonry inspect 'my recs/a.rrd'",
+    ),
+    (
+        "inspect-at2-record",
+        {"q.AT2": "PEER NGA STRONG MOTION DATABASE RECORD\n"},
+        ("inspect", "q.AT2"),
+        2,
+        "q.AT2: a ground-motion record (PEER .AT2; simulate and run take it with --record), not a recording",
+    ),
 ]

@@ -7,6 +7,7 @@ import contextlib
 import errno
 import os
 import re
+import shlex
 import shutil
 import signal
 import socket
@@ -55,6 +56,7 @@ _OTHER_FILES = {  # suffix: what masonry writes or reads under it, for a file th
     ".parquet": "a sweep table (.parquet)",
     ".csv": "a table (.csv)",
     ".png": "an image (.png)",
+    ".at2": "a ground-motion record (PEER .AT2; simulate and run take it with --record)",
 }
 
 
@@ -96,7 +98,7 @@ def recording_path_problem(path: str | os.PathLike) -> str | None:
     count = f"{len(found)} recording" + ("s" if len(found) > 1 else "")
     return (
         f"{shown}: a folder, not a recording; it holds {count} ({names}{more}): "
-        f"give one, e.g. masonry inspect {os.path.join(shown, newest.name)}"
+        f"give one, e.g. masonry inspect {shlex.quote(os.path.join(shown, newest.name))}"  # a command to paste
         + (" (the newest)" if len(found) > 1 else "")
     )
 
