@@ -89,7 +89,7 @@ class OneLineUsageErrors(typer.core.TyperGroup):
             console.print(exc.ctx.get_help(), markup=True)
             sys.exit(exc.exit_code)  # as click and typer do
         except click_errors.UsageError as exc:
-            command = exc.ctx.command_path if exc.ctx is not None else "masonry"
+            command = exc.ctx.command_path if exc.ctx is not None else self._path_of(args)
             listed = "commands" if exc.format_message().startswith("No such command") else "options"
             said = _number_with_unit(exc) or f"{exc.format_message()} ({command} --help lists the {listed})"
             say("error", "bold red", said)
@@ -98,6 +98,19 @@ class OneLineUsageErrors(typer.core.TyperGroup):
             say("error", "bold red", exc.format_message())
             sys.exit(exc.exit_code)
         sys.exit(code if isinstance(code, int) else 0)
+
+    def _path_of(self, args) -> str:
+        """The command line's command (``masonry simulate wall``) for an error raised without its context:
+        the parser's "Option '--duration' requires an argument" pointed to ``masonry --help``, which lists
+        no --duration."""
+        path, group = ["masonry"], self
+        for arg in sys.argv[1:] if args is None else args:
+            command = getattr(group, "commands", {}).get(arg)  # a group's subcommands; a command has none
+            if command is None:
+                break
+            path.append(arg)
+            group = command
+        return " ".join(path)
 
 
 def _number_with_unit(exc) -> str | None:

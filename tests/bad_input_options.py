@@ -63,6 +63,21 @@ OPTION_ROWS = [
         2,
         "simulate --help lists the commands)",
     ),
+    # walk-through 2026-11-28: an option missing its value pointed to "masonry --help" (no --duration there)
+    (
+        "opt-without-value",
+        {},
+        (*WALL, "--duration"),
+        2,
+        "Option '--duration' requires an argument. (masonry simulate wall --help lists the options)",
+    ),
+    (
+        "opt-without-value-run",
+        {**scen()},
+        (*RUN, "--dt"),
+        2,
+        "Option '--dt' requires an argument. (masonry run --help lists the options)",
+    ),
     ("check-opt-dt", {**scen()}, ("check", "s.toml", "--dt", "-1"), 2, "--dt: dt = -1"),
     ("sim-density", {}, (*WALL, "--density", "-5", "--no-recording"), 2, "--density: density = -5"),
     ("sim-thickness", {}, (*WALL, "--thickness", "0", "--no-recording"), 2, "--thickness: thickness = 0"),
