@@ -66,6 +66,16 @@ def _memory(src, idx, at, bits, dst_scatter, dst_scalar, dst_masked, out):
     V.masked_store(dst_masked, 3, x, m)
 
 
+@njit(cache=False)
+def _rows(src, idx, at, dst, out):
+    # gather_rows of src's 4-double rows idx[at + k] into out (x, y, w); scatter_rows of (x + 1, y, w) to dst
+    x, y, w = V.gather_rows(src, idx, at)
+    V.store(out, 0, x)
+    V.store(out, 8, y)
+    V.store(out, 16, w)
+    V.scatter_rows(dst, idx, at, x + V.splat(1.0), y, w)
+
+
 def _random(rng, n=8):
     # normal values with some zeros of both signs, infinities, NaNs and ties between a and b
     a, b = rng.normal(size=n), rng.normal(size=n)
@@ -128,6 +138,23 @@ def test_gathers_and_scatters_are_numpys(seed):
         assert _same(d, e)
 
 
+@pytest.mark.parametrize("seed", range(10))
+def test_rows_are_numpys(seed):
+    rng = np.random.default_rng(seed)
+    bodies = 20
+    src, dst = rng.normal(size=4 * bodies), rng.normal(size=4 * bodies)
+    before = dst.copy()
+    pick = rng.choice(bodies, 8, replace=False)
+    idx = np.r_[np.zeros(2), 4 * pick].astype(np.int64)
+    out = np.empty(24)
+    _rows(src, idx, 2, dst, out)
+    rows = src.reshape(bodies, 4)[pick]
+    assert _same(out, np.r_[rows[:, 0], rows[:, 1], rows[:, 2]])
+    expect = before.reshape(bodies, 4).copy()
+    expect[pick] = np.column_stack([rows[:, 0] + 1.0, rows[:, 1], rows[:, 2], np.zeros(8)])
+    assert _same(dst, expect.ravel())
+
+
 def test_scatter_to_one_address_keeps_the_last_lane():
     idx = np.full(8, 2, np.int64)
     for kernel_bits in (0b00010110, 0xFF):
@@ -145,7 +172,7 @@ def test_the_same_on_narrower_vectors():
         "import sys; sys.path.insert(0, 'tests'); import test_engine_vector as t\n"
         "for s in range(6): t.test_arithmetic_and_masks_are_numpys_bit_for_bit(s); "
         "t.test_gathers_and_scatters_are_numpys(s)\n"
-        "t.test_scatter_to_one_address_keeps_the_last_lane()\n"
+        "t.test_scatter_to_one_address_keeps_the_last_lane(); t.test_rows_are_numpys(0)\n"
         "asm = ''.join(t._memory.inspect_asm().values())\n"
         "assert 'zmm' not in asm and 'ymm' in asm and 'vscatter' not in asm, 'not compiled for AVX2'\n"
         "print('ok')\n"

@@ -241,8 +241,8 @@ def _lane_problem(name):
 @pytest.mark.parametrize(("name", "tolerance", "cap"), [("tiny", 1e-9, 10_000), ("tiny", 0.0, 40),
                                                         ("stack", 1e-9, 10_000), ("stack", 0.0, 60)])  # fmt: skip
 def test_explicit_vector_lanes_are_the_scalar_lanes_bit_for_bit(name, tolerance, cap):
-    # simd_lanes (explicit <8 x double>) against simd_sweep's "lanes+split" (the scalar lane groups): the
-    # same sweeps, residual, v, r and statuses to the bit, through all three kinds of group. Tolerance 0:
+    # simd_lanes (explicit <8 x double>; "lanes+vec4": velocities padded to 4 doubles a body) against
+    # simd_sweep's "lanes+split" (the scalar lane groups): the same sweeps, residual, v, r and statuses to the bit, through all three kinds of group. Tolerance 0:
     # after every sweep count up to cap (one residual differs in its last bit only now and then).
     body, pack, v0, r0, mu = _lane_problem(name)
     count = body.shape[0]
@@ -250,14 +250,15 @@ def test_explicit_vector_lanes_are_the_scalar_lanes_bit_for_bit(name, tolerance,
     assert (full > 0 and partial > 0) if name == "stack" else split > 0
     for sweeps in range(1, cap + 1) if tolerance == 0.0 else [cap]:
         out = []
-        for variant in ("lanes+split", "lanes+vec"):
+        for variant in ("lanes+split", "lanes+vec", "lanes+vec4"):
             v, r, st = v0.copy(), r0.copy(), np.zeros(count, np.int8)
             its, res, _ = simd_sweep.solve(body, pack, count, mu, tolerance, sweeps, v, r, st, sweeps, variant)
             out.append((its, res, v, r, st))
-        (its, res, v, r, st), (its2, res2, v2, r2, st2) = out
-        assert its == its2 and res == res2 and (its == sweeps) == (tolerance == 0.0)
-        assert _same_bits(v, v2) and _same_bits(r, r2) and np.array_equal(st, st2)
-        assert res <= tolerance or tolerance == 0.0
+        its, res, v, r, st = out[0]
+        assert (its == sweeps) == (tolerance == 0.0) and (res <= tolerance or tolerance == 0.0)
+        for its2, res2, v2, r2, st2 in out[1:]:
+            assert its == its2 and res == res2
+            assert _same_bits(v, v2) and _same_bits(r, r2) and np.array_equal(st, st2)
 
 
 def _same_bits(a, b):
@@ -275,7 +276,7 @@ def test_explicit_vector_lanes_on_narrower_vectors():
         "import sys; sys.path.insert(0, 'tests'); import test_solver_lab_simd as t\n"
         "for cap in (0.0, 60), (1e-9, 10_000): t.test_explicit_vector_lanes_are_the_scalar_lanes_bit_for_bit('stack', *cap)\n"
         "from benchmarks.solver_lab import simd_lanes\n"
-        "asm = ''.join(simd_lanes.lane_sweeps.inspect_asm().values())\n"
+        "asm = ''.join(simd_lanes.lane_sweeps.inspect_asm().values()) + ''.join(simd_lanes.lane_sweeps_rows.inspect_asm().values())\n"
         "assert 'zmm' not in asm and 'ymm' in asm, 'not compiled for AVX2'\n"
         "print('ok')\n"
     )

@@ -3,6 +3,7 @@
     python -m benchmarks.solver_lab.simd_bench [--case wall-248] [--duration 1] [--every 10] [--rounds 5]
         [--variants split fused levels] [--reference]
     python -m benchmarks.solver_lab.simd_bench --asm
+    python -m benchmarks.solver_lab.simd_bench --whole-run lanes+vec4 [--case wall-248] [--duration 1] [--rounds 3]
 
 The steps: the inputs of every ``--every``-th accelerated first-stage call that ``nlgs.solve`` makes on
 ``--case`` (bench_kernel.capture). On each, the engine's ``nlgs._nlgs_interleaved`` (momentum, interleaved
@@ -119,6 +120,56 @@ def run(case, duration, every, rounds, variants, reference):
     return rows
 
 
+def whole_runs(case, duration, rounds, rows):
+    """Whole runs of ``case``: the engine as it is, and with its first stage (nlgs.solve's first call of
+    ``_nlgs_interleaved``, momentum to the stall window) done by simd_lanes ("lanes+vec", or "lanes+vec4"
+    with ``rows``); stalled steps go on by stalled.py in both. Rounds interleaved, CPU minimum; top-course /
+    mean slip at 0.1 and 0.2 s against a tight solve (plain NLGS at 1e-7 m/s, bench_solver's TIGHT)."""
+    from benchmarks.bench_solver import run_masonry
+    from benchmarks.solver_lab import simd_lanes
+    from benchmarks.solver_reference import TIGHT, errors_pct
+
+    kernel, solve = nlgs._nlgs_interleaved, nlgs.solve
+    first = [False]
+
+    def first_stage(contact_body, pack, count, mu, tolerance, cap, v, r, status, accelerate, stall, *rest):
+        if first[0] and accelerate and not rest:
+            first[0] = False
+            return simd_lanes.solve(contact_body, pack, count, mu, tolerance, cap, v, r, status, stall, rows)[:2]
+        return kernel(contact_body, pack, count, mu, tolerance, cap, v, r, status, accelerate, stall, *rest)
+
+    def solve_lanes(*args):
+        first[0] = True
+        try:
+            return solve(*args)
+        finally:
+            first[0] = False
+
+    def one(lanes, seconds):
+        if lanes:
+            nlgs._nlgs_interleaved, nlgs.solve = first_stage, solve_lanes
+        try:
+            return run_masonry(case, seconds, False)
+        finally:
+            nlgs._nlgs_interleaved, nlgs.solve = kernel, solve
+
+    one(True, 0.003)  # compile
+    runs = {False: [], True: []}
+    for k in range(rounds):
+        for lanes in (False, True) if k % 2 == 0 else (True, False):
+            runs[lanes].append(one(lanes, duration))
+    reference = run_masonry(case, min(duration, 0.2), False, **TIGHT)["samples"]
+    for lanes, rows_ in runs.items():
+        best = min(rows_, key=lambda x: x["cpu_s"])
+        errs = "  ".join(f"{int(k) / 1000:g} s {t:+.2f} / {m:+.2f} %" for k, (t, m) in
+                         errors_pct(best["samples"], reference).items())  # fmt: skip
+        name = ("lanes+vec4" if rows else "lanes+vec") if lanes else "engine"
+        print(f"{case} {name}: {best['cpu_s'] / best['sim_s']:.3f} CPU s per sim s (solve {best['nlgs_share']:.0%}), "
+              f"{best['sweeps_mean']:.1f} sweeps a step (max {best['sweeps_max']}), unconverged "
+              f"{best['unconverged']}; top / mean slip error {errs}")  # fmt: skip
+    return runs
+
+
 def asm_summary():
     """What LLVM made of each phase (``inspect_asm``): instructions, lines naming zmm / ymm registers,
     gathers, packed and scalar double operations (moves left out)."""
@@ -132,10 +183,12 @@ def asm_summary():
     from benchmarks.solver_lab import simd_lanes
 
     body, pack = np.zeros((n, 2), np.int32), np.zeros((n, nlgs.PACK_WIDTH))
-    simd_lanes.solve(body, pack, 0, 0.5, 1e-5, 10, np.zeros((n, 3)), np.zeros((n, 2)), st, 10)  # count 0: types only
+    for rows in (False, True):  # count 0: only the types
+        simd_lanes.solve(body, pack, 0, 0.5, 1e-5, 10, np.zeros((n, 3)), np.zeros((n, 2)), st, 10, rows)
     kernels = {"split: _gather_u": simd_sweep._gather_u, "split: _solve_u": simd_sweep._solve_u,
                "fused: _phase_a": simd_sweep._phase_a, "_phase_b": simd_sweep._phase_b,
-               "lanes+vec: lane_sweeps": simd_lanes.lane_sweeps}  # fmt: skip
+               "lanes+vec: lane_sweeps": simd_lanes.lane_sweeps,
+               "lanes+vec4: lane_sweeps_rows": simd_lanes.lane_sweeps_rows}  # fmt: skip
     for name, kernel in kernels.items():
         for asm in kernel.inspect_asm().values():
             lines = asm.splitlines()
@@ -156,9 +209,12 @@ def main(argv=None):
     parser.add_argument("--variants", nargs="*", default=["split", "fused"])
     parser.add_argument("--reference", action="store_true")
     parser.add_argument("--asm", action="store_true", help="only print what LLVM made of each phase")
+    parser.add_argument("--whole-run", choices=["lanes+vec", "lanes+vec4"], help="whole runs (whole_runs)")
     args = parser.parse_args(argv)
     if args.asm:
         return asm_summary()
+    if args.whole_run:
+        return whole_runs(args.case, args.duration, args.rounds, args.whole_run == "lanes+vec4")
     return run(args.case, args.duration, args.every, args.rounds, args.variants, args.reference)
 
 

@@ -15,9 +15,12 @@ one group's visit is written on ``<8 x double>`` vectors, one lane a contact:
         Σ|e_α|²: the lanes added one by one, in lane order, to a group sum that starts at 0
 
 A full group (8 lanes, no clash: all of wall-248's) gathers with 8 scalar loads a vector and scatters
-with 8 scalar stores (every lane stores; where it does not push, the value it read); a partial or split
-group uses the masked hardware gathers and scatters (vgatherqpd, vscatterqpd). On this Zen 5 the
-hardware ones cost more: 5.6–6.2 ns per contact·sweep against 4.4 (benchmarks/README.md).
+with 8 scalar stores (every lane stores; where it does not push, the value it read); with ``rows``
+("lanes+vec4") the sweeps' velocities are padded to 4 doubles a body and a full group reads and writes
+one 256-bit row a lane (_vector.gather_rows / scatter_rows: a third of the memory operations). A
+partial or split group uses the masked hardware gathers and scatters (vgatherqpd, vscatterqpd). On this
+Zen 5 the hardware ones cost more: 5.6–6.2 ns per contact·sweep against 4.4 (benchmarks/README.md).
+The local solve's fallback (two divisions) is computed only when a lane selects it (a singular W).
 
 Every lane does the scalar code's IEEE operations on the same operands (no fast-math: nothing contracted
 or reassociated), so the sweeps, residuals, v and r are those of "lanes+split" bit for bit. The one
@@ -74,7 +77,8 @@ FULL = (1 << W) - 1
 @njit(inline="always")
 def _local_solve_v(ut, un, bias, wtt, wtn, wnn, itt, itn, inn, isp, ism, mu):
     # simd_sweep._local_solve_bf on vectors, line for line (the same operations, in the same order, on
-    # the same operands): all candidates in all lanes, then the first valid one in _local_solve's order.
+    # the same operands): all candidates in all lanes, then the first valid one in _local_solve's order;
+    # only the fallback, which no lane selects unless its W is singular, is skipped when none does.
     zero = V.splat(0.0)
     target = -bias - un
     rts = -itt * ut + itn * target
@@ -86,10 +90,15 @@ def _local_solve_v(ut, un, bias, wtt, wtn, wnn, itt, itn, inn, isp, ism, mu):
     rnm = target * ism
     rtm = mu * rnm
     okm = (ism > zero) & (-(ut + wtt * rtm + wtn * rnm) >= zero)
-    rnf = target / wnn
-    rtf = -ut / wtt
-    lim = mu * rnf
-    rtf = V.select(rtf > lim, lim, V.select(rtf < -lim, -lim, rtf))
+    is_open = un + bias >= zero
+    if V.bits_of(~(is_open | stick | okp | okm)) != 0:  # a lane takes the fallback (a singular W)
+        rnf = target / wnn
+        rtf = -ut / wtt
+        lim = mu * rnf
+        rtf = V.select(rtf > lim, lim, V.select(rtf < -lim, -lim, rtf))
+    else:  # no lane selects it: its two divisions skipped
+        rnf = zero
+        rtf = zero
     pos = ut >= zero
     neg = ~pos
     first_ok = (pos & okp) | (neg & okm)
@@ -103,7 +112,6 @@ def _local_solve_v(ut, un, bias, wtt, wtn, wnn, itt, itn, inn, isp, ism, mu):
     rt = V.select(stick, rts, rt)
     rn = V.select(stick, rns, rn)
     st = V.select(stick, V.splat(STATUS_STICK), V.splat(STATUS_SLIP))
-    is_open = un + bias >= zero
     rt = V.select(is_open, zero, rt)
     rn = V.select(is_open, zero, rn)
     st = V.select(is_open, V.splat(STATUS_OPEN), st)
@@ -111,11 +119,14 @@ def _local_solve_v(ut, un, bias, wtt, wtn, wnn, itt, itn, inn, isp, ism, mu):
 
 
 @njit(inline="always")
-def _group(j, act, Q, IA, IB, v, beta, mu, full):
+def _group(j, act, Q, IA, IB, v, beta, mu, full, rows):
     # The visit of group j's lanes in mask act (module doc). Returns the group's Σ|e_α|², lane by lane.
     q0 = j * ROWS * W
     at = j * W
-    if full:  # all 8 lanes, no clash: plain loads, one a lane
+    if full and rows:  # all 8 lanes, no clash, 4 doubles a body: one 256-bit row a lane
+        vax, vay, waa = V.gather_rows(v, IA, at)
+        vbx, vby, wbb = V.gather_rows(v, IB, at)
+    elif full:  # all 8 lanes, no clash: plain loads, one a double
         vax = V.gather_scalar(v, IA, at, 0)
         vay = V.gather_scalar(v, IA, at, 1)
         waa = V.gather_scalar(v, IA, at, 2)
@@ -174,7 +185,10 @@ def _group(j, act, Q, IA, IB, v, beta, mu, full):
     nbx = vbx + imb * px
     nby = vby + imb * py
     nbw = wbb + iib * (tb * drt + nb * drn)
-    if full:  # every lane stores, the old value where it does not push (a support: unchanged)
+    if full and rows:  # every lane stores, the old value where it does not push (a support: unchanged)
+        V.scatter_rows(v, IA, at, V.select(push_a, nax, vax), V.select(push_a, nay, vay), V.select(push_a, naw, waa))
+        V.scatter_rows(v, IB, at, V.select(push_b, nbx, vbx), V.select(push_b, nby, vby), V.select(push_b, nbw, wbb))
+    elif full:
         V.scatter_scalar(v, IA, at, 0, V.select(push_a, nax, vax))
         V.scatter_scalar(v, IA, at, 1, V.select(push_a, nay, vay))
         V.scatter_scalar(v, IA, at, 2, V.select(push_a, naw, waa))
@@ -229,65 +243,86 @@ def pack_groups(count, order, start, groups, K, X):
     return Q, slot, gmask, clash
 
 
-@njit(cache=False, error_model="numpy")  # numpy: a division by zero gives inf (as the reference's)
-def lane_sweeps(contact_body, pack, count, mu, tolerance, max_iterations, v, v_flat, r, status, stall_after):
-    # simd_sweep's "lanes+split" (momentum._momentum_sweeps, flip omitted, in the 8-run order's groups)
-    # with each group's visit in vectors (_group). Returns (iterations, residual, groups).
-    if count == 0:
-        return 0, 0.0, 0
-    body_count = v.shape[0]
-    order = np.empty(count, np.int64)
-    start = np.empty(count + 1, np.int64)
-    groups = lanes(contact_body, pack, count, body_count, order, start)
-    ia, ib, K, X = sorted_arrays(contact_body, pack, count, r, order)
-    for i in range(count):  # v ← v_free + M⁻¹ H r_warm, in visit order (as the reference)
-        _push_k(v_flat, ia[i], ib[i], K, i, X[0, i], X[1, i])
-    Q, slot, gmask, clash = pack_groups(count, order, start, groups, K, X)
-    run = gmask.shape[0]
-    IA = np.zeros(run * W, np.int64)
-    IB = np.zeros(run * W, np.int64)
-    for p in range(count):
-        IA[slot[p]] = ia[p]
-        IB[slot[p]] = ib[p]
-    v_prev_flat = v_flat.copy()
-    iterations = 0
-    residual = 0.0
-    best = np.inf
-    best_at = 0
-    last = np.inf
-    j_restart = 1
-    beta = 0.0
-    for it in range(max_iterations):
-        iterations = it + 1
-        momentum._extrapolate(v_flat, v_prev_flat, beta)
-        vbeta = V.splat(beta)
-        vmu = V.splat(mu)
-        sum_e2 = 0.0
-        for j in range(run):
-            if clash[j]:  # the reference's groups of one, in lane order
-                for q in range(W):
-                    if gmask[j] >> q & 1:
-                        sum_e2 += _group(j, V.mask_bits(1 << q), Q, IA, IB, v_flat, vbeta, vmu, False)
-            elif gmask[j] == FULL:
-                sum_e2 += _group(j, V.mask_bits(FULL), Q, IA, IB, v_flat, vbeta, vmu, True)
-            else:
-                sum_e2 += _group(j, V.mask_bits(gmask[j]), Q, IA, IB, v_flat, vbeta, vmu, False)
-        residual = np.sqrt(sum_e2 / count)
-        stop, best, best_at, last, j_restart, beta = _momentum_rule(
-            residual, tolerance, it, best, best_at, last, j_restart, stall_after
-        )
-        if stop:
-            break
-    for p in range(count):
-        c = order[p]
-        base = slot[p] // W * ROWS * W + slot[p] % W
-        r[c, 0] = Q[base + R_XT * W]
-        r[c, 1] = Q[base + R_XN * W]
-        status[c] = np.int8(Q[base + R_ST * W])
-    return iterations, residual, groups
+def _build(rows):
+    @njit(cache=False, error_model="numpy")  # numpy: a division by zero gives inf (as the reference's)
+    def lane_sweeps(contact_body, pack, count, mu, tolerance, max_iterations, v, v_flat, r, status, stall_after):
+        # simd_sweep's "lanes+split" (momentum._momentum_sweeps, flip omitted, in the 8-run order's groups)
+        # with each group's visit in vectors (_group). Returns (iterations, residual, groups).
+        if count == 0:
+            return 0, 0.0, 0
+        body_count = v.shape[0]
+        order = np.empty(count, np.int64)
+        start = np.empty(count + 1, np.int64)
+        groups = lanes(contact_body, pack, count, body_count, order, start)
+        ia, ib, K, X = sorted_arrays(contact_body, pack, count, r, order)
+        for i in range(count):  # v ← v_free + M⁻¹ H r_warm, in visit order (as the reference)
+            _push_k(v_flat, ia[i], ib[i], K, i, X[0, i], X[1, i])
+        Q, slot, gmask, clash = pack_groups(count, order, start, groups, K, X)
+        run = gmask.shape[0]
+        IA = np.zeros(run * W, np.int64)
+        IB = np.zeros(run * W, np.int64)
+        stride = 4 if rows else 3  # doubles a body in the sweeps' velocities v_work
+        for p in range(count):
+            IA[slot[p]] = ia[p] // 3 * stride
+            IB[slot[p]] = ib[p] // 3 * stride
+        if rows:  # body b at 4b … 4b + 2 (4b + 3: padding, never read into a result)
+            v_work = np.zeros(4 * body_count, np.float64)
+            v_work.reshape(body_count, 4)[:, :3] = v_flat.reshape(body_count, 3)
+        else:
+            v_work = v_flat
+        v_prev_flat = v_work.copy()
+        iterations = 0
+        residual = 0.0
+        best = np.inf
+        best_at = 0
+        last = np.inf
+        j_restart = 1
+        beta = 0.0
+        for it in range(max_iterations):
+            iterations = it + 1
+            momentum._extrapolate(v_work, v_prev_flat, beta)  # the same per element
+            vbeta = V.splat(beta)
+            vmu = V.splat(mu)
+            sum_e2 = 0.0
+            for j in range(run):
+                if clash[j]:  # the reference's groups of one, in lane order
+                    for q in range(W):
+                        if gmask[j] >> q & 1:
+                            sum_e2 += _group(j, V.mask_bits(1 << q), Q, IA, IB, v_work, vbeta, vmu, False, rows)
+                elif gmask[j] == FULL:
+                    sum_e2 += _group(j, V.mask_bits(FULL), Q, IA, IB, v_work, vbeta, vmu, True, rows)
+                else:
+                    sum_e2 += _group(j, V.mask_bits(gmask[j]), Q, IA, IB, v_work, vbeta, vmu, False, rows)
+            residual = np.sqrt(sum_e2 / count)
+            stop, best, best_at, last, j_restart, beta = _momentum_rule(
+                residual, tolerance, it, best, best_at, last, j_restart, stall_after
+            )
+            if stop:
+                break
+        if rows:
+            v_flat.reshape(body_count, 3)[:, :] = v_work.reshape(body_count, 4)[:, :3]
+        for p in range(count):
+            c = order[p]
+            base = slot[p] // W * ROWS * W + slot[p] % W
+            r[c, 0] = Q[base + R_XT * W]
+            r[c, 1] = Q[base + R_XN * W]
+            status[c] = np.int8(Q[base + R_ST * W])
+        return iterations, residual, groups
+
+    return lane_sweeps
 
 
-def solve(contact_body, pack, count, mu, tolerance, cap, v, r, status, stall_after=momentum.STALL_SWEEPS):
-    """The explicitly vectorised lane sweeps on one step's arrays (as simd_sweep.solve takes them).
+lane_sweeps = _build(rows=False)
+lane_sweeps_rows = _build(rows=True)
+
+
+def solve(contact_body, pack, count, mu, tolerance, cap, v, r, status, stall_after=momentum.STALL_SWEEPS, rows=False):
+    """The explicitly vectorised lane sweeps on one step's arrays (as simd_sweep.solve takes them); rows:
+    velocities padded to 4 doubles a body, a full group's gathered and scattered a 256-bit row a lane.
     Returns (iterations, residual, groups)."""
-    return lane_sweeps(contact_body, pack, count, mu, tolerance, cap, v, v.reshape(-1), r, status, stall_after)
+    v_flat = v.reshape(-1)
+    if not np.shares_memory(v, v_flat):
+        raise ValueError("v must be C-contiguous: the sweeps write v through its flat view")
+    return (lane_sweeps_rows if rows else lane_sweeps)(
+        contact_body, pack, count, mu, tolerance, cap, v, v_flat, r, status, stall_after
+    )

@@ -398,10 +398,11 @@ def solve(
     """The coloured first stage on one step's arrays (as nlgs._nlgs_interleaved takes them).
     Returns (iterations, residual, colours). Variant "blocks": simd_blocks.py's layout in 8-contact blocks;
     "lanes+vec": simd_lanes.py's explicit vectors (returns the groups as colours)."""
-    if variant == "lanes+vec":  # simd_lanes.py: the lanes' groups in explicit vectors
+    if variant in ("lanes+vec", "lanes+vec4"):  # simd_lanes.py: the lanes' groups in explicit vectors
         from benchmarks.solver_lab import simd_lanes  # it builds on this module
 
-        return simd_lanes.solve(contact_body, pack, count, mu, tolerance, cap, v, r, status, stall_after)
+        rows = variant == "lanes+vec4"
+        return simd_lanes.solve(contact_body, pack, count, mu, tolerance, cap, v, r, status, stall_after, rows)
     if variant == "blocks":
         from benchmarks.solver_lab import simd_blocks  # it builds on this module
 

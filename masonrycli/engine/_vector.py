@@ -29,9 +29,14 @@ What each one emits:
 - ``scatter(arr, idx, i, shift, a, m)``: ``llvm.masked.scatter.v8f64.v8p0``: ``arr[idx[i + k] + shift] =
   a[k]`` for the lanes of m (LLVM orders overlapping lanes from first to last).
 - ``gather_scalar(arr, idx, i, shift)`` / ``scatter_scalar(arr, idx, i, shift, a)``: the same for all 8
-  lanes as 8 scalar ``load``\ s + ``insertelement`` / ``extractelement`` + 8 scalar ``store``\ s in lane
+  lanes as 8 scalar loads + ``insertelement`` / ``extractelement`` + 8 scalar stores in lane
   order: on Zen 5 cheaper than the hardware instructions for 8 scattered doubles, and a scalar store
   forwards to the next scalar load of the same double.
+- ``gather_rows(arr, idx, i)`` / ``scatter_rows(arr, idx, i, x, y, w)``: for arrays of 4-double rows
+  (a body's velocity and one padding double at ``idx[i + k]``): 8 ``<4 x double>`` loads and a tree of
+  shuffles (``shufflevector``, an 8 × 4 transpose), giving the rows' first three components as three vectors
+  (x, y, w); back, three vectors transposed into 8 rows ``(x_k, y_k, w_k, 0.0)`` stored by 8 ``<4 x
+  double>`` stores in lane order. A third of the memory operations of the scalar forms.
 - ``mask_bits(b)`` / ``bits_of(m)``: an integer's low 8 bits as a mask (lane k = bit k) and back
   (``trunc`` / ``zext`` and ``bitcast`` between ``i8`` and ``<8 x i1>``).
 
@@ -345,3 +350,71 @@ def scatter_scalar(typingctx, arr, idx, i, shift, a):
         return context.get_dummy_value()
 
     return signature(types.none, arr, idx, i, shift, a), codegen
+
+
+def _rows_type(t):
+    return isinstance(t, types.Array) and t.dtype == types.float64 and t.ndim == 1 and t.layout == "C"
+
+
+_V4D = ir.VectorType(_D, 4)
+
+
+def _mask(values):
+    return ir.Constant(ir.VectorType(ir.IntType(32), len(values)), list(values))
+
+
+@intrinsic
+def gather_rows(typingctx, arr, idx, i):
+    # (x, y, w): lane k = arr[idx[i + k] + 0, 1, 2], read as one 4-double row a lane (offsets 4·body)
+    if not (_rows_type(arr) and _is_index_array(idx) and isinstance(i, types.Integer)):
+        return None
+    ret = types.UniTuple(f64x8, 3)
+
+    def codegen(context, builder, sig, args):
+        data = _data(context, builder, sig.args[0], args[0])
+        ip = builder.gep(
+            _data(context, builder, sig.args[1], args[1]), [_as_i64(context, builder, args[2], sig.args[2])]
+        )
+        rows = []
+        for k in range(WIDTH):
+            p = builder.gep(data, [builder.load(builder.gep(ip, [ir.Constant(_I64, k)]), align=8)])
+            rows.append(builder.load(builder.bitcast(p, _V4D.as_pointer()), align=8))
+        # pairs of rows side by side, then component c of each: a two-level shuffle tree (a transpose)
+        pairs = [builder.shuffle_vector(rows[2 * k], rows[2 * k + 1], _mask(range(8))) for k in range(4)]
+        out = []
+        for c in range(3):
+            lo = builder.shuffle_vector(pairs[0], pairs[1], _mask([c, 4 + c, 8 + c, 12 + c]))
+            hi = builder.shuffle_vector(pairs[2], pairs[3], _mask([c, 4 + c, 8 + c, 12 + c]))
+            out.append(builder.shuffle_vector(lo, hi, _mask(range(8))))
+        return context.make_tuple(builder, sig.return_type, out)
+
+    return signature(ret, arr, idx, i), codegen
+
+
+@intrinsic
+def scatter_rows(typingctx, arr, idx, i, x, y, w):
+    # arr[idx[i + k] + 0 … 3] = (x[k], y[k], w[k], 0.0) for k = 0 … 7 in lane order: one 4-double row a lane
+    ok = _rows_type(arr) and _is_index_array(idx) and isinstance(i, types.Integer)
+    if not ok or x != f64x8 or y != f64x8 or w != f64x8:
+        return None
+
+    def codegen(context, builder, sig, args):
+        data = _data(context, builder, sig.args[0], args[0])
+        ip = builder.gep(
+            _data(context, builder, sig.args[1], args[1]), [_as_i64(context, builder, args[2], sig.args[2])]
+        )
+        x, y, w = args[3:6]
+        zero = ir.Constant(_V8D, [0.0] * WIDTH)
+        # (x_k, y_k) and (w_k, 0) pairs of even and odd lanes, then each lane's row from them
+        xy = [builder.shuffle_vector(x, y, _mask([j + s for j in range(0, 8, 2) for s in (0, 8)])),
+              builder.shuffle_vector(x, y, _mask([j + 1 + s for j in range(0, 8, 2) for s in (0, 8)]))]  # fmt: skip
+        wz = [builder.shuffle_vector(w, zero, _mask([j + s for j in range(0, 8, 2) for s in (0, 8)])),
+              builder.shuffle_vector(w, zero, _mask([j + 1 + s for j in range(0, 8, 2) for s in (0, 8)]))]  # fmt: skip
+        for k in range(WIDTH):
+            j = 2 * (k // 2)  # lane k sits at 2·(k // 2) of its parity's pair vectors
+            row = builder.shuffle_vector(xy[k % 2], wz[k % 2], _mask([j, j + 1, 8 + j, 9 + j]))
+            p = builder.gep(data, [builder.load(builder.gep(ip, [ir.Constant(_I64, k)]), align=8)])
+            builder.store(row, builder.bitcast(p, _V4D.as_pointer()), align=8)
+        return context.get_dummy_value()
+
+    return signature(types.none, arr, idx, i, x, y, w), codegen
