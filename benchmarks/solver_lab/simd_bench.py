@@ -4,6 +4,7 @@
         [--variants split fused levels] [--reference]
     python -m benchmarks.solver_lab.simd_bench --asm
     python -m benchmarks.solver_lab.simd_bench --whole-run lanes+vec4 [--case wall-248] [--duration 1] [--rounds 3]
+        [--ensemble OUT [--copies 2]]
 
 The steps: the inputs of every ``--every``-th accelerated first-stage call that ``nlgs.solve`` makes on
 ``--case`` (bench_kernel.capture). On each, the engine's ``nlgs._nlgs_interleaved`` (momentum, interleaved
@@ -20,8 +21,10 @@ step's bodies and components, then mean and max over steps. ``--asm``: what LLVM
 from __future__ import annotations
 
 import argparse
+import contextlib
 import re
 import time
+from pathlib import Path
 
 import numpy as np
 
@@ -120,38 +123,60 @@ def run(case, duration, every, rounds, variants, reference):
     return rows
 
 
-def whole_runs(case, duration, rounds, rows):
-    """Whole runs of ``case``: the engine as it is, and with its first stage (nlgs.solve's first call of
-    ``_nlgs_interleaved``, momentum to the stall window) done by simd_lanes ("lanes+vec", or "lanes+vec4"
-    with ``rows``); stalled steps go on by stalled.py in both. Rounds interleaved, CPU minimum; top-course /
-    mean slip at 0.1 and 0.2 s against a tight solve (plain NLGS at 1e-7 m/s, bench_solver's TIGHT)."""
-    from benchmarks.bench_solver import run_masonry
+@contextlib.contextmanager
+def first_stage_by_lanes(rows, lanes=True):
+    """While open, ``nlgs.solve``'s first stage (its first call of ``_nlgs_interleaved``: momentum to the
+    stall window) is done by simd_lanes ("lanes+vec", or "lanes+vec4" with ``rows``; with ``lanes`` False
+    by the engine, only counted); stalled steps go on by stalled.py as in the engine. Yields a tally:
+    first-stage CPU s and sweeps, steps handed to stalled.py."""
     from benchmarks.solver_lab import simd_lanes
-    from benchmarks.solver_reference import TIGHT, errors_pct
+    from masonrycli.engine import stalled
 
-    kernel, solve = nlgs._nlgs_interleaved, nlgs.solve
-    first = [False]
+    kernel, solve, cont = nlgs._nlgs_interleaved, nlgs.solve, stalled.continue_stalled
+    first, tally = [False], {"first_cpu": 0.0, "first_sweeps": 0, "stalled": 0}
 
     def first_stage(contact_body, pack, count, mu, tolerance, cap, v, r, status, accelerate, stall, *rest):
-        if first[0] and accelerate and not rest:
-            first[0] = False
-            return simd_lanes.solve(contact_body, pack, count, mu, tolerance, cap, v, r, status, stall, rows)[:2]
-        return kernel(contact_body, pack, count, mu, tolerance, cap, v, r, status, accelerate, stall, *rest)
+        if not (first[0] and accelerate and not rest):
+            return kernel(contact_body, pack, count, mu, tolerance, cap, v, r, status, accelerate, stall, *rest)
+        first[0] = False
+        t = time.process_time()
+        if lanes:
+            out = simd_lanes.solve(contact_body, pack, count, mu, tolerance, cap, v, r, status, stall, rows)[:2]
+        else:
+            out = kernel(contact_body, pack, count, mu, tolerance, cap, v, r, status, accelerate, stall)
+        tally["first_cpu"] += time.process_time() - t
+        tally["first_sweeps"] += out[0]
+        return out
 
-    def solve_lanes(*args):
+    def solve_first(*args):
         first[0] = True
         try:
             return solve(*args)
         finally:
             first[0] = False
 
+    def counted(*args):
+        tally["stalled"] += 1
+        return cont(*args)
+
+    nlgs._nlgs_interleaved, nlgs.solve, stalled.continue_stalled = first_stage, solve_first, counted
+    try:
+        yield tally
+    finally:
+        nlgs._nlgs_interleaved, nlgs.solve, stalled.continue_stalled = kernel, solve, cont
+
+
+def whole_runs(case, duration, rounds, rows):
+    """Whole runs of ``case``: the engine as it is, and with its first stage done by simd_lanes
+    (first_stage_by_lanes). Rounds interleaved, CPU minimum; top-course / mean slip at 0.1 and 0.2 s
+    against a tight solve (plain NLGS at 1e-7 m/s, bench_solver's TIGHT)."""
+    from benchmarks.bench_solver import run_masonry
+    from benchmarks.solver_reference import TIGHT, errors_pct
+
     def one(lanes, seconds):
-        if lanes:
-            nlgs._nlgs_interleaved, nlgs.solve = first_stage, solve_lanes
-        try:
-            return run_masonry(case, seconds, False)
-        finally:
-            nlgs._nlgs_interleaved, nlgs.solve = kernel, solve
+        with first_stage_by_lanes(rows, lanes) as tally:
+            row = run_masonry(case, seconds, False)
+        return row | tally
 
     one(True, 0.003)  # compile
     runs = {False: [], True: []}
@@ -166,8 +191,22 @@ def whole_runs(case, duration, rounds, rows):
         name = ("lanes+vec4" if rows else "lanes+vec") if lanes else "engine"
         print(f"{case} {name}: {best['cpu_s'] / best['sim_s']:.3f} CPU s per sim s (solve {best['nlgs_share']:.0%}), "
               f"{best['sweeps_mean']:.1f} sweeps a step (max {best['sweeps_max']}), unconverged "
-              f"{best['unconverged']}; top / mean slip error {errs}")  # fmt: skip
+              f"{best['unconverged']}, handed to stalled.py {best['stalled']}; first stage "
+              f"{best['first_cpu'] / best['sim_s']:.3f} CPU s per sim s, {best['first_sweeps']} sweeps; top / mean "
+              f"slip error {errs}")  # fmt: skip
     return runs
+
+
+def ensembles(cases, duration, copies, rows, out):
+    """solver_lab.ensemble's runs (12 ground motions × ``copies``) of the engine, written to OUT-engine.json,
+    and with the first stage by simd_lanes, to OUT-lanes.json; then ``ensemble compare`` of the two."""
+    from benchmarks.solver_lab import ensemble
+
+    paths = [Path(f"{out}-engine.json"), Path(f"{out}-lanes.json")]
+    for lanes, path in zip((False, True), paths):
+        with first_stage_by_lanes(rows, lanes):
+            ensemble.run(cases, ensemble.MOTIONS, duration, path, copies=range(copies))
+    return ensemble.compare(*paths)
 
 
 def asm_summary():
@@ -210,9 +249,13 @@ def main(argv=None):
     parser.add_argument("--reference", action="store_true")
     parser.add_argument("--asm", action="store_true", help="only print what LLVM made of each phase")
     parser.add_argument("--whole-run", choices=["lanes+vec", "lanes+vec4"], help="whole runs (whole_runs)")
+    parser.add_argument("--ensemble", metavar="OUT", help="with --whole-run: ensembles of short runs (ensembles)")
+    parser.add_argument("--copies", type=int, default=2, help="--ensemble: runs a motion")
     args = parser.parse_args(argv)
     if args.asm:
         return asm_summary()
+    if args.whole_run and args.ensemble:
+        return ensembles([args.case], args.duration, args.copies, args.whole_run == "lanes+vec4", args.ensemble)
     if args.whole_run:
         return whole_runs(args.case, args.duration, args.rounds, args.whole_run == "lanes+vec4")
     return run(args.case, args.duration, args.every, args.rounds, args.variants, args.reference)
