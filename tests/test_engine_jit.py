@@ -1,10 +1,16 @@
-"""engine._jit: a kernel's cache is stamped with every engine module it draws compiled code from."""
+"""engine._jit: a kernel's cache is stamped with every engine module it draws compiled code from; a kernel
+only kernels call has no Python entry, and a call from Python says so instead of crashing."""
 
 from __future__ import annotations
 
 import os
+import subprocess
+import sys
 
-from masonrycli.engine import _jit, broadphase, fused, watch
+import numpy as np
+import pytest
+
+from masonrycli.engine import _jit, broadphase, fused, joints, narrowphase, watch
 
 
 def _names(module) -> set[str]:
@@ -36,3 +42,30 @@ def test_engine_kernels_use_the_engine_stamp(tmp_path, monkeypatch):
     _jit.source_files.cache_clear()
     assert _jit._stamp.__wrapped__(str(copy / "fused.py")) != before
     _jit.source_files.cache_clear()
+
+
+def test_a_kernel_only_kernel_called_from_python_raises_instead_of_crashing():
+    # Without the guard numba jumps to the null entry point of the missing wrapper: a segmentation fault,
+    # so the call runs in a child process, whose exit code tells the two apart.
+    code = (
+        "from masonrycli.engine import joints\n"
+        "try:\n    joints._nan_max(1.0, 2.0)\n"
+        "except TypeError as e:\n    print(e)\n"
+    )
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr
+    assert "masonrycli.engine.joints._nan_max is called from kernels only" in done.stdout
+    assert isinstance(joints._nan_max, _jit._KernelOnly)
+    assert joints._nan_max.targetoptions["no_cpython_wrapper"] is True
+
+
+def test_kernels_calling_kernel_only_kernels_still_run():
+    # collide_polygons calls _collide_pair, which calls the kernel_only _choose_faces, _clip_incident and
+    # _write_pair_contacts: a unit square resting on a wider one touches it at its two bottom corners.
+    assert isinstance(narrowphase._choose_faces, _jit._KernelOnly)
+    square = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
+    ground = np.array([[-1.0, -1.0], [2.0, -1.0], [2.0, 0.0], [-1.0, 0.0]])
+    point, normal, gap, _ = narrowphase.collide_polygons(ground, square, 1e-3)
+    assert sorted(point[:, 0].tolist()) == pytest.approx([0.0, 1.0])
+    assert normal.tolist() == [[0.0, 1.0], [0.0, 1.0]]
+    assert gap.tolist() == [0.0, 0.0]

@@ -53,7 +53,7 @@ def _kernels_without_pseudo_code() -> list[str]:
         for node in ast.walk(ast.parse("\n".join(lines))):
             if not isinstance(node, ast.FunctionDef):
                 continue
-            if not any("njit" in ast.unparse(d) for d in node.decorator_list):
+            if not any(k in ast.unparse(d) for d in node.decorator_list for k in ("njit", "kernel_only")):
                 continue
             first_statement = node.body[0].lineno  # 1-based
             if first_statement + KERNEL_LINES > node.end_lineno:

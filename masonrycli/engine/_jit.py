@@ -7,8 +7,16 @@ that changing a flag changes it everywhere.
   start does not recompile.
 - ``no_cfunc_wrapper``: numba otherwise builds, optimises and compiles with every kernel a C-callable
   wrapper, used only when a kernel is passed as a first-class function value, which the engine never
-  does: ~0.02 s of CPU a kernel, 5 % of a first run's compilation. (``no_cpython_wrapper`` would save
-  as much again on kernels called only by kernels, but a call from Python then crashes the process.)
+  does: ~0.02 s of CPU a kernel, 5 % of a first run's compilation.
+- :func:`kernel_only` for a kernel that only kernels call, never Python (not the product, the tests or
+  the benchmarks): ``no_cpython_wrapper`` as well, no CPython wrapper (argument unboxing, result boxing)
+  built, optimised and compiled with it. The wrapper's cost grows with the arguments: 0.28 s of
+  ``momentum._momentum_sweeps``'s 1.0 s (12 arguments, one omitted). numba would jump to a null entry
+  point on a call from Python (a segmentation fault); the dispatcher's class is swapped for one whose
+  Python call raises a TypeError naming the kernel instead. The kernels that call it link its code as
+  before: the same results, bit for bit (the golden histories). numba compiles a library function (``np.empty``,
+  ``max`` of two floats) once per set of caller flags, so one such call in a kernel_only kernel compiles
+  it once more (~0.03 s): a kernel whose wrapper is cheap stays :data:`njit`.
 - no ``fastmath``: it allows reassociation and contraction, which change results in the last bits from
   one build or machine to the next. The engine promises bit-identical output for the same input, and
   the contact geometry relies on exact comparisons (ties between faces, points on clipping planes).
@@ -48,12 +56,32 @@ import re
 
 import numba
 from numba.core import caching, config
+from numba.core.registry import CPUDispatcher
 
 config.SLP_VECTORIZE = 1  # module doc
 njit = functools.partial(numba.njit, cache=True, no_cfunc_wrapper=True)
 """``numba.njit`` with the engine's flags. Use as ``@njit`` or ``@njit(...)``."""
 
-__all__ = ["njit"]
+__all__ = ["kernel_only", "njit"]
+
+
+class _KernelOnly(CPUDispatcher):
+    """A :func:`kernel_only` kernel: compiled without a Python entry, so a call from Python raises here
+    instead of jumping to a null entry point (a segmentation fault)."""
+
+    def __call__(self, *args, **kwargs):
+        f = self.py_func
+        raise TypeError(
+            f"{f.__module__}.{f.__qualname__} is called from kernels only (_jit.kernel_only): it has no Python "
+            "entry; decorate it with njit to call it from Python"
+        )
+
+
+def kernel_only(func):
+    """:data:`njit` for a kernel that only kernels call, never Python (module doc): no CPython wrapper."""
+    dispatcher = njit(func, no_cpython_wrapper=True)
+    dispatcher.__class__ = _KernelOnly  # same layout: a Python call now goes to _KernelOnly.__call__
+    return dispatcher
 
 
 _ENGINE = os.path.dirname(os.path.abspath(__file__))

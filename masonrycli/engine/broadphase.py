@@ -16,7 +16,7 @@ import math
 import numpy as np
 
 from ._arrays import check_array, check_vertices
-from ._jit import njit
+from ._jit import kernel_only, njit
 
 __all__ = ["PairBuffers", "body_aabbs", "candidate_pairs", "check_pair_inputs", "world_vertices"]
 
@@ -137,7 +137,7 @@ def body_aabbs(vert_world, body_vert_start, alert, out=None):
 # --------------------------------------------------------------------------------------------------
 
 
-@njit
+@kernel_only
 def _sort_bodies(body_aabb, axis, body_order):
     # Insertion sort of body_order by the key (box lower bound along `axis`, body index).
     # The order is kept from one step to the next and bodies move little, so it is nearly sorted
@@ -158,7 +158,7 @@ def _sort_bodies(body_aabb, axis, body_order):
         body_order[j + 1] = k
 
 
-@njit
+@kernel_only
 def _counting_sort_pairs(src, n, column, body_count, dst, counter):
     # Stable counting sort of the rows src[:n] by src[:, column] ∈ [0, body_count) into dst[:n].
     for i in range(body_count + 1):

@@ -31,7 +31,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._jit import njit
+from ._jit import kernel_only
 
 __all__ = ["KEY_LIMIT_BODIES", "KEY_LIMIT_VERTICES", "check_topology", "decode_contact_key"]
 
@@ -41,7 +41,7 @@ KEY_LIMIT_VERTICES = 256
 """Vertex count per polygon must be at most this for the contact key to be unique."""
 
 
-@njit
+@kernel_only
 def _make_key(a, b, owner_is_b, vertex, edge):
     return (
         (np.int64(a) << 40)
@@ -52,7 +52,7 @@ def _make_key(a, b, owner_is_b, vertex, edge):
     )
 
 
-@njit
+@kernel_only
 def _end_label(side, t0, ivtx, e, e2, k, length, snap, ref_is_b):
     # Feature label (owner_is_b, vertex, edge) of one end of the clipped incident segment.
     #   raw:  clipped at side s → R's vertex (e or e2) against I's incident edge k

@@ -18,7 +18,7 @@ import math
 
 import numpy as np
 
-from masonrycli.engine._jit import njit
+from masonrycli.engine._jit import kernel_only, njit
 from masonrycli.engine.contact import ContactStatus
 
 _OPEN, _STICK, _SLIP = int(ContactStatus.OPEN), int(ContactStatus.STICK), int(ContactStatus.SLIP)
@@ -51,7 +51,7 @@ def _openings(body_q, end_body, local_a, local_b, normal0, gap0, out):
         out[e] = ((0.0 + (xbx - xax) * nx) + (xby - xay) * ny) + gap0[e]
 
 
-@njit
+@kernel_only
 def _nan_max(x, y):
     # np.maximum's rule: x if x ≥ y or x is NaN, else y (so NaN from either side).
     return x if x >= y or x != x else y

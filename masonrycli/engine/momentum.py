@@ -39,7 +39,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from masonrycli.engine._jit import njit
+from masonrycli.engine._jit import kernel_only, njit
 from masonrycli.engine.nlgs import P_WNN, P_WTN, P_WTT, _local_solve, _push, _relative_velocity
 
 RESTART_GROWTH = 1.1
@@ -71,7 +71,7 @@ def _nlgs_accelerated(contact_body, pack, count, mu, tolerance, max_iterations, 
     )
 
 
-@njit
+@kernel_only
 def _momentum_sweeps(
     contact_body, pack, count, mu, tolerance, max_iterations, v, v_flat, r, status, stall_after, flip=False
 ):

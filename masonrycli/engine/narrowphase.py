@@ -42,7 +42,7 @@ import math
 import numpy as np
 
 from ._arrays import check_array, check_vertices
-from ._jit import njit
+from ._jit import kernel_only, njit
 from .contact_key import _end_label, _make_key, check_topology
 
 __all__ = ["REF_TOL_ABS", "REF_TOL_REL", "collide_polygons", "edge_normals", "narrowphase"]
@@ -118,7 +118,7 @@ def edge_normals(vert_world, body_vert_start, edge_normal=None, body_size=None):
     return edge_normal, body_size
 
 
-@njit
+@kernel_only
 def _max_face_separation(vert, normal, s1, n1, s2, n2, alert):
     # Largest separation of polygon 2 along the outward edge normals of polygon 1:
     #     for each edge i of 1:  sep_i = min_{w ∈ 2} n_i · (w − v_i)
@@ -145,7 +145,7 @@ def _max_face_separation(vert, normal, s1, n1, s2, n2, alert):
     return best, best_edge
 
 
-@njit
+@kernel_only
 def _choose_faces(vert, normal, size_a, size_b, sa, na, sb, nb, alert):
     # Steps 1–3: separating axes, reference face, incident edge.
     #   sep_a, e_a = max face separation of b along a's normals   (> alert → no contact)
@@ -189,7 +189,7 @@ def _choose_faces(vert, normal, size_a, size_b, sa, na, sb, nb, alert):
     return e, e2, k, k2, ref_is_b, rs, is_, tol
 
 
-@njit
+@kernel_only
 def _clip_incident(vert, rs, e, e2, is_, k, k2, nx, ny, tol):
     # Step 4: clip the incident segment w1 = I[k] → w2 = I[k2] to the side planes of R's edge e.
     #   frame of the edge v1 = R[e] → v2 = R[e2]: u = (−n_y, n_x) (n is u turned by −90°), L = u·(v2 − v1);
@@ -266,7 +266,7 @@ def _clip_incident(vert, rs, e, e2, is_, k, k2, nx, ny, tol):
     return True, length, (p1x, p1y, g1, t1, t01, side1), (p2x, p2y, g2, t2, t02, side2)
 
 
-@njit
+@kernel_only
 def _write_pair_contacts(
     a, b, ref_is_b, e, e2, k, k2, nx, ny, length, tol, alert, end1, end2, c,
     contact_body, contact_point, contact_normal, contact_gap, contact_key,

@@ -34,7 +34,7 @@ import math
 
 import numpy as np
 
-from masonrycli.engine._jit import njit
+from masonrycli.engine._jit import kernel_only, njit
 from masonrycli.engine.nlgs import P_BIAS, P_NX, P_NY
 
 HOLDS_UP = 0.5
@@ -176,7 +176,7 @@ def _static_guess(contact_body, pack, count, body_mass, block_count, gravity, dt
                 load[other] += rn * s
 
 
-@njit
+@kernel_only
 def _holding(contact_body, pack, c, k, upx, upy, reach):
     # (s, other): s = the up-component of the unit normal impulse contact c puts on body k (the normal n
     # points from a to b: r_n n pushes b along n and a along −n); other = the body on the other side.
