@@ -170,3 +170,19 @@ def test_a_table_in_a_folder_that_is_a_file_names_out(block, tmp_path):
     result = invoke("sweep", block, "-p", "amp=0.1", "--workers", 0, "--out", out)
     assert result.exit_code == 2
     assert result.output.strip() == f"error: --out {out}: {tmp_path / 'notes.txt'} is not a folder"
+
+
+@pytest.mark.parametrize("content", [b"garbage", b"PAR1 not a table"], ids=["short", "magic"])
+def test_an_unreadable_table_is_refused_naming_out_and_force_replaces_it(block, tmp_path, content):
+    # walk-through 2026-11-28: "error: s.parquet: cannot read the existing study (ArrowInvalid: …)" named no
+    # option and no way out, though --force replaces it as it replaces any existing output
+    out = tmp_path / "s.parquet"
+    out.write_bytes(content)
+    grid = ["-p", "amp=0.05,0.1", "--duration", 0.02, "--workers", 0, "-o", out]
+    result = invoke("sweep", block, *grid)
+    assert result.exit_code == 2, result.output
+    line = words(result.output)
+    assert line.startswith(f"error: --out {out}: cannot read the existing study (ArrowInvalid: "), line
+    assert line.endswith("(add --force to replace it)") and out.read_bytes() == content
+    assert invoke("sweep", block, *grid, "--force").exit_code == 0
+    assert len(read_rows(out)) == 2

@@ -38,9 +38,9 @@ def open_table(out: Path, study_id: str, force: bool, names: list[str], points: 
     suffix = out.suffix.lower()
     try:
         rows = store.read_rows(out)
-    except InputError:
+    except InputError as exc:  # not a table (a file named like one, a cut or foreign one): --force replaces it
         if not force:
-            raise
+            raise InputError(f"--out {exc} (add --force to replace it)") from None
         rows = []
     keys = {store.row_key(p, names) for p in points}
     ours = [r for r in rows if r.get("study") == study_id and store.row_key(r, names) in keys]
