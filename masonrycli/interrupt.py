@@ -17,7 +17,8 @@ exception is reported as "Exception ignored …" with a traceback and dropped. A
 traceback, then the compile failed on its own (``RuntimeError: no compiled object yet``), reported as an
 internal error with exit 1 instead of the stop. So while the handlers are installed a dropped exception of
 theirs is not printed but noted (:attr:`dropped`), and :meth:`StopSignals.setup_work` raises the stop
-instead of the error it caused.
+instead of the error it caused; :func:`raise_dropped` does so for code that catches errors itself (``masonry
+sweep --workers 0`` made that error a failed row, went on, and took every later Ctrl-C for a repeat).
 
 :class:`FirstSignalStops` is the same rule for a command that stops by ``KeyboardInterrupt`` (``masonry
 sweep``): the first signal raises it, later ones are acknowledged and ignored (after the context too,
@@ -75,6 +76,7 @@ class _Handlers:
         if threading.current_thread() is threading.main_thread():
             self._hook = sys.unraisablehook
             sys.unraisablehook = self._unraisable
+            _INSTALLED.append(self)
             try:
                 for sig in SIGNALS:
                     self._previous[sig] = signal.signal(sig, self._handle)
@@ -87,8 +89,13 @@ class _Handlers:
         for sig, handler in self._previous.items():
             signal.signal(sig, handler)
         self._previous.clear()
+        self._release_hook()
+
+    def _release_hook(self) -> None:
         if self._hook is not None:
             sys.unraisablehook, self._hook = self._hook, None
+        if self in _INSTALLED:
+            _INSTALLED.remove(self)
 
     def _raise(self, exc: BaseException):
         """Raise ``exc`` from a handler, remembered so that :meth:`_unraisable` knows it."""
@@ -184,6 +191,7 @@ class FirstSignalStops(_Handlers):
         if self.signum is not None and self._previous:
             ignore_signals_while_exiting()
             self._previous.clear()
+            self._release_hook()
         else:
             super().__exit__(*exc)
 
@@ -221,6 +229,19 @@ class FirstSignalStops(_Handlers):
             self._deferred = True
             return
         self._raise(KeyboardInterrupt())
+
+
+_INSTALLED: list[_Handlers] = []
+"""The contexts whose handlers are installed, the innermost last."""
+
+
+def raise_dropped() -> None:
+    """Raise again the stop that the innermost context's handler raised where Python dropped it (module
+    doc), for code that would take the error it caused for its own; nothing when there is none."""
+    if _INSTALLED and _INSTALLED[-1].dropped:
+        handlers = _INSTALLED[-1]
+        handlers.dropped = False
+        raise handlers._raised
 
 
 def already_stopping(signum: int) -> None:

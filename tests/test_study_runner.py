@@ -261,3 +261,33 @@ def test_local_cluster_has_no_more_workers_than_runs():
     finally:
         client.close()
         cluster.close()
+
+
+@pytest.mark.parametrize("failed", [True, False], ids=["the-run-failed", "the-run-went-on"])
+def test_a_ctrl_c_dropped_inside_numbas_compiler_stops_a_serial_study(failed, monkeypatch, capfd):
+    # walk-through 2026-11-28, `masonry sweep … --workers 0` with an empty numba cache, Ctrl-C 2.4 s in: the
+    # KeyboardInterrupt raised in a ctypes callback of the compile was dropped, the run failed ("RuntimeError: no
+    # compiled object yet"), the study went on to exit 5, and every later Ctrl-C was taken for a repeat
+    import signal
+
+    from masonrycli.interrupt import FirstSignalStops
+
+    from cli_helpers import signal_inside_a_ctypes_callback
+
+    def task(base, params):
+        if params["amp"] == 0.0:
+            signal_inside_a_ctypes_callback(signal.SIGINT)
+        return params | {"status": "error" if failed else "completed"}
+
+    monkeypatch.setattr(runner, "run_task", task)
+    rows, before = [], {s: signal.getsignal(s) for s in (signal.SIGINT, signal.SIGTERM)}
+    try:
+        with FirstSignalStops() as signals:
+            with pytest.raises(KeyboardInterrupt):
+                runner.run_serially("base", Driver(3), lambda params, row: rows.append(row))
+            assert signals.stopping() == signal.SIGINT
+    finally:  # a stopped context leaves both signals ignored, for the command's way out: not pytest's
+        for s, handler in before.items():
+            signal.signal(s, handler)
+    assert rows == ([] if failed else [{"amp": 0.0, "status": "completed"}])  # a failed row is not kept
+    assert "Traceback" not in capfd.readouterr().err

@@ -272,10 +272,15 @@ def run_on_cluster(client, base, driver, on_row: Callable[[dict, dict], None], *
 
 def run_serially(base, driver, on_row: Callable[[dict, dict], None], *task_args) -> None:
     """The same as :func:`run_on_cluster` in this process, one task after the other (``--workers 0``)."""
+    from masonrycli.interrupt import raise_dropped
+
     queue = list(driver.start())
     while queue:
         params = queue.pop(0)
         row = run_task(base, params, *task_args)
+        if row["status"] == "error":
+            raise_dropped()  # a Ctrl-C inside numba's compiler (interrupt.py) failed the run: a stop, no row
         more = driver.feed(params, row)
         on_row(params, row)
         queue += more
+        raise_dropped()  # one dropped there while the run went on: the row is kept, then the stop
