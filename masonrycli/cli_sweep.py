@@ -242,11 +242,6 @@ def _report(console, result, plan: StudyPlan, im: str, written: list, signals: F
     rows, axes = result.rows, request.axes
     keys = [a.name for a in axes if a.name != request.find]  # what a row is keyed by
     columns = find_columns(keys, request.find) if request.find else grid_columns(keys, im)
-    console.print(study_table(rows, columns, keys, console, result.out))
-    console.print(
-        f"{_n(len(rows), 'row')} in {result.out} ({_n(result.ran, 'run')} now, {_n(result.skipped, 'row')} already "
-        f"there, {result.failed} failed) in {result.wall_time:.1f} s"
-    )
     names = [a.name for a in axes if a.name != request.find and len(a.values) > 1]
     fit = None
     with written_whole(plot, around_commit=_recorded(signals, written, plot)) as part:
@@ -261,6 +256,18 @@ def _report(console, result, plan: StudyPlan, im: str, written: list, signals: F
         else:
             x, y = names[0] if names else axes[0].name, names[1] if len(names) > 1 else None
             state_map(rows, x, y, part, name)
+    if recording is not None:
+        from masonrycli.recording.study import record_study
+
+        with written_whole(recording, around_commit=_recorded(signals, written, recording)) as part:
+            record_study(part, name, rows, request, fit, im, plot.path)
+    # said once both are written: a reader of stdout that goes away (`masonry sweep … | head`) broke the pipe
+    # at the first line after the table, and the plot and the recording were never written
+    console.print(study_table(rows, columns, keys, console, result.out))
+    console.print(
+        f"{_n(len(rows), 'row')} in {result.out} ({_n(result.ran, 'run')} now, {_n(result.skipped, 'row')} already "
+        f"there, {result.failed} failed) in {result.wall_time:.1f} s"
+    )
     if "record" in [a.name for a in axes] and not request.find:
         if fit is None:
             console.print("fragility: no fit (every run collapsed, or none did)")
@@ -279,10 +286,6 @@ def _report(console, result, plan: StudyPlan, im: str, written: list, signals: F
             )
     console.print(f"plot: {plot.path}")
     if recording is not None:
-        from masonrycli.recording.study import record_study
-
-        with written_whole(recording, around_commit=_recorded(signals, written, recording)) as part:
-            record_study(part, name, rows, request, fit, im, plot.path)
         console.print(f"recording: {recording.path}")
 
 

@@ -231,3 +231,25 @@ def test_a_builder_option_on_a_structure_read_from_a_file_says_why(tmp_path):
         "error: --param voussoirs: unknown parameter (an option of the arch, aqueduct builders: this structure is "
         "read, not built) (see masonry sweep --help)"
     )
+
+
+def test_a_reader_of_stdout_that_goes_away_leaves_the_plot_and_the_recording(tmp_path):
+    # walk-through 2026-11-28: `masonry sweep … | head -2` wrote the table only: the pipe broke at the first
+    # line printed after the table, before the plot and the recording were written (exit 1, nothing said)
+    import os
+    import subprocess
+    import sys
+
+    block, out = write_block(tmp_path), tmp_path / "s.csv"
+    argv = ["sweep", str(block), "-p", "amp=0.05,0.1", "--duration", "0.02", "--workers", "0", "-o", str(out)]
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "masonrycli", *argv],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.DEVNULL,
+        env=dict(os.environ, RERUN_ANALYTICS="0"),
+    )
+    proc.stdout.readline()  # `head -1`: the first line, then the reader is gone
+    proc.stdout.close()
+    proc.wait(timeout=300)
+    assert {p.name for p in tmp_path.iterdir()} >= {"s.csv", "s.png", "s.rrd"}
+    assert len(read_rows(out)) == 2
