@@ -162,3 +162,13 @@ def test_a_figure_is_closed_when_saving_it_fails(which, monkeypatch, tmp_path):
             rows = [{"freq": 1.0, "amp_threshold": 1.3, "amp_lo": 1.2, "amp_hi": 1.4, "outcome": "collapse"}]
             plots.threshold_curve(rows, "amp", "freq", tmp_path / "t.png", "thresholds", (0.25, 1.5))
     assert set(plt.get_fignums()) == before
+
+
+def test_a_search_of_one_point_is_ticked_as_that_point():
+    # walk-through 2026-11-28: `masonry sweep block.toml --param amp=0.05:1.0:3 --find amp --outcome sliding`
+    # (docs/sweep.md) drew its one threshold over an x axis ticked -0.04, -0.02, 0.00, 0.02, 0.04 "point"
+    row = {"amp_threshold": 0.4684, "amp_lo": 0.466, "amp_hi": 0.4707, "outcome": "sliding", "status": "completed"}
+    fig = plots.threshold_figure([row], "amp", None, "sliding threshold", (0.05, 1.0))
+    ax = fig.axes[0]
+    assert list(ax.get_xticks()) == [0] and [t.get_text() for t in ax.get_xticklabels()] == ["1"]
+    assert ax.get_xlabel() == "point"

@@ -130,6 +130,8 @@ def threshold_figure(rows: list[dict], find: str, x: str | None, title: str, sea
     _draw(ax, threshold_series(rows, find, at, searched))
     if names is not None:
         ax.set_xticks(range(len(names)), names, rotation=45)
+    elif not x:  # the points in order, numbered from 1 (one point was ticked -0.04 … 0.04 around 0)
+        ax.set_xticks(range(len(rows)), [str(i + 1) for i in range(len(rows))])
     ax.set_xlabel(with_unit(x) if x else "point")
     ax.set_ylabel(with_unit(find).replace(find, f"{find}_threshold", 1))
     ax.set_ylim(0.0, 1.1 * max(ax.get_ylim()[1], 0.0) or 1.0)  # room above a mark at the range's top
