@@ -31,9 +31,12 @@ _UNSAFE = re.compile(r"[^\w.-]+")  # \w: letters and digits of any script ("voû
 
 
 def safe_name(name: str) -> str:
-    """A scenario name as a file-name stem that stays in its folder: ``../../x`` → ``x``, ``a b`` → ``a-b``."""
+    """A scenario name as a file-name stem that stays in its folder: ``../../x`` → ``x``, ``a b`` → ``a-b``;
+    at most 80 bytes of whole characters (80 characters of a CJK name were 240 bytes: with the time stamp
+    and the temporary name's additions, more than a file system's 255)."""
     stem = _UNSAFE.sub("-", str(name)).strip(".-")
-    return re.sub(r"\.{2,}", ".", stem)[:80] or "run"
+    stem = re.sub(r"\.{2,}", ".", stem)
+    return os.fsencode(stem)[:80].decode(errors="ignore").strip(".-") or "run"
 
 
 def part_path(path: Path) -> Path:
@@ -106,7 +109,8 @@ class OutputFile:
 
     def discard(self) -> None:
         """Remove the temporary file (and a history's temporary folder), if any."""
-        with contextlib.suppress(FileNotFoundError, NotADirectoryError):  # never made: its folder is a file
+        # never made (its folder is a file, its name too long: the error that says so must not be replaced)
+        with contextlib.suppress(OSError):
             os.unlink(self.part)
         shutil.rmtree(self.part.with_name(self.part.name + ".rows"), ignore_errors=True)  # a history's rows
 
@@ -119,6 +123,7 @@ def check_output(
     the option and the path."""
     where = f"{option} {path}"
     suffixes = (suffix,) if isinstance(suffix, str) else suffix
+    _check_name_length(path, where)  # first: a name too long made path.is_dir() raise
     if path.is_dir():  # first: "--out recordings/" said "the file name must end in .rrd"
         raise InputError(f"{where}: is a folder (name a file in it: {path / ('NAME' + suffixes[0])})")
     if path.suffix.lower() not in suffixes:
@@ -130,6 +135,27 @@ def check_output(
         raise InputError(f"{where}: the file exists and is read-only")
     check_folder(path, where)
     return OutputFile(path, option, force=force, default_name=default_name)
+
+
+_PART_ADDS = len(".") + len(".4194304.part.rows")
+"""Bytes the longest temporary name adds to a file's: a history's rows folder, the largest Linux pid."""
+
+
+def _check_name_length(path: Path, where: str) -> None:
+    """Raise :class:`InputError` if the temporary names of ``path`` are too long for its file system: a name
+    of 252 bytes is a valid file, but its ``.NAME.<pid>.part`` was refused when opened (internal error,
+    exit 1: removing the temporary file that was never made raised again)."""
+    folder = next((p for p in (path.parent, *path.parent.parents) if p.is_dir()), Path("."))
+    try:
+        limit = os.pathconf(folder, "PC_NAME_MAX")
+    except (OSError, ValueError):
+        limit = 255
+    size = len(os.fsencode(path.name))
+    if size + _PART_ADDS > limit:
+        raise InputError(
+            f"{where}: the file name is {size} bytes long, at most {limit - _PART_ADDS} here (it is written "
+            f"under a temporary name .NAME.<pid>.part first; the file system allows {limit})"
+        )
 
 
 def check_folder(path: Path, where: str) -> None:

@@ -48,6 +48,35 @@ def test_safe_name_stays_in_its_folder(name, stem):
     assert Path("recordings", safe_name(name)).resolve().parent == Path("recordings").resolve()
 
 
+def test_safe_name_is_at_most_80_bytes_of_whole_characters():
+    # 80 characters of a CJK name were 240 bytes: recordings/<name>-<stamp>.rrd and its temporary name passed
+    # the file system's 255
+    assert safe_name("墙" * 100) == "墙" * 26  # 78 bytes: a 27th (81) would pass 80
+    assert safe_name("a" * 100) == "a" * 80
+
+
+@pytest.mark.parametrize("size", [248, 260])
+def test_a_name_too_long_for_its_temporary_name_is_bad_input(size, tmp_path):
+    # walk-through 2026-11-28: --out a{248}.rrd is a valid name, but its .NAME.<pid>.part is not: "internal error:
+    # OSError: [Errno 36] File name too long" (exit 1), removing the temporary file never made raising again;
+    # a{260}.rrd said "a….rrd: File name too long" without the option
+    for option in ("--out", "--history"):
+        path = tmp_path / ("a" * size + (".rrd" if option == "--out" else ".npz"))
+        extra = () if option == "--out" else ("--no-recording",)
+        result = invoke("run", COLUMN, "--duration", 0.01, option, path, *extra)
+        assert result.exit_code == 2, result.output
+        assert words(result.output) == (
+            f"error: {option} {path}: the file name is {size + 4} bytes long, at most 236 here (it is written "
+            "under a temporary name .NAME.<pid>.part first; the file system allows 255)"
+        )
+        assert list(tmp_path.iterdir()) == []
+
+
+def test_discarding_a_temporary_file_never_made_raises_nothing(tmp_path):
+    out = OutputFile(tmp_path / ("a" * 250 + ".npz"), "--history")
+    out.discard()  # ENAMETOOLONG from unlink, as FileNotFoundError: nothing to remove
+
+
 def test_scenario_name_cannot_leave_recordings(tmp_path, monkeypatch):
     """Finding 2: name = "../../x" wrote outside recordings/."""
     work = tmp_path / "a" / "b"
