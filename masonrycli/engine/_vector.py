@@ -40,8 +40,8 @@ What each one emits:
 - ``mask_bits(b)`` / ``bits_of(m)``: an integer's low 8 bits as a mask (lane k = bit k) and back
   (``trunc`` / ``zext`` and ``bitcast`` between ``i8`` and ``<8 x i1>``).
 
-Used by the solver lab's explicitly vectorised lane sweep (benchmarks/solver_lab/simd_lanes.py); the
-engine's own kernels do not use it.
+Used by the default solver's first stage (:mod:`masonrycli.engine.lane_sweeps`) and by the solver lab's
+lane sweeps it came from (benchmarks/solver_lab/simd_lanes.py).
 """
 
 from __future__ import annotations

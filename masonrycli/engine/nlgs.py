@@ -288,6 +288,10 @@ def _nlgs(contact_body, pack, count, mu, tolerance, max_iterations, v, r, status
 
 INTERLEAVE = 4
 """The sweep visits the contacts in this many interleaved runs of detection order (see _nlgs_interleaved)."""
+LANES = False
+"""The accelerated solve's first stage by :mod:`masonrycli.engine.lane_sweeps` (8 runs, 8 contacts visited
+at once in vectors); False: by the scalar sweep in INTERLEAVE runs (interleaved._accelerated), the
+default until the lane sweeps replaced it (benchmarks/README.md, explicit vectors addendum)."""
 
 
 def _nlgs_interleaved(
@@ -302,12 +306,19 @@ def _nlgs_interleaved(
     status,
     accelerate,
     accelerated_stall,
-    alternate=False,
+    alternate=None,
 ):
     """The sweeps in interleaved order (:mod:`masonrycli.engine.interleaved`): momentum's
     (``accelerate``, stall window ``accelerated_stall``) or the plain ones; ``alternate`` as in
-    stalled.py. Returns (iterations, residual). Two kernels rather than one with the flag as an argument:
-    a run compiles only the sweep it uses (the plain one cost 1.5 s of the first run's compilation)."""
+    stalled.py. ``alternate`` omitted with ``accelerate``: the first stage of :func:`solve`, by the lane
+    sweeps when LANES (the benchmarks that capture the first stage hook this function's 11-argument
+    calls); stalled.py's and newton.py's sweeps pass it. Returns (iterations, residual). Two kernels rather
+    than one with the flag as an argument: a run compiles only the sweep it uses (the plain one cost 1.5 s
+    of the first run's compilation)."""
+    if accelerate and alternate is None and LANES:
+        return lane_sweeps._lane_sweeps(
+            contact_body, pack, count, mu, tolerance, max_iterations, v, r, status, accelerated_stall
+        )
     if accelerate:
         if not v.flags.c_contiguous:  # v.reshape would copy: the sweep's flat view of v must be v
             raise ValueError("the body velocities v must be a C-contiguous array")
@@ -420,7 +431,8 @@ def solve(contact_body, pack, count, model, v, r, status) -> tuple[int, float]:
             contact_body, pack, count, mu, tolerance, cap, v, r, status, model.solver == "nlgs-accel", STALL_SWEEPS
         )
         return _faces_if_stalled(contact_body, pack, count, mu, tolerance, cap, v, r, status, iterations, residual)
-    # Accelerated: momentum until its stall window; a stalled step goes on by the methods of stalled.py.
+    # Accelerated: momentum (the lane sweeps, LANES) until its stall window; a stalled step goes on by the
+    # methods of stalled.py.
     v_free, r_warm = v.copy(), r[:count].copy()
     if shrink.CHECK_EVERY > 0:  # the first stage only: stalled.py's methods keep their sweeps
         iterations, residual = interleaved._shrinking(
@@ -472,4 +484,4 @@ def tangential_velocity(contact_body, pack, count, v) -> np.ndarray:
 
 # At the end: faces, momentum and stalled build on this module's sweep primitives (a stalled solve()
 # continues by faces or by stalled's methods; the accelerated sweep is momentum's).
-from masonrycli.engine import faces, interleaved, momentum, shrink, stalled  # noqa: E402
+from masonrycli.engine import faces, interleaved, lane_sweeps, momentum, shrink, stalled  # noqa: E402
