@@ -55,6 +55,26 @@ def test_histories_to_write_are_checked_and_find_matches_any_value(tmp_path):
         check_histories(tmp_path / "f", POINTS, None, False)
 
 
+def test_a_history_an_interrupted_run_of_this_study_wrote_is_not_refused(tmp_path):
+    # walk-through 2026-11-28: Ctrl-C left the histories of the runs in flight (the workers finish them) without
+    # their rows; the same command refused to resume. Only this study's own histories are let through.
+    import json
+
+    import numpy as np
+
+    folder = tmp_path / "h"
+    folder.mkdir()
+    np.savez(folder / "amp=0.1.npz", run=np.array(json.dumps({"study": "abc", "study_table": "/s.csv"})))
+    np.savez(folder / "amp=0.2.npz", run=np.array(json.dumps({"study": "xyz", "study_table": "/s.csv"})))
+    check_histories(folder, POINTS[:1], None, False, ("abc", "/s.csv"))
+    with pytest.raises(InputError, match=r"amp=0\.2\.npz: the file exists \(add --force"):
+        check_histories(folder, POINTS, None, False, ("abc", "/s.csv"))
+    with pytest.raises(InputError, match=r"amp=0\.1\.npz: the file exists"):  # the same study, another table
+        check_histories(folder, POINTS[:1], None, False, ("abc", "/t.csv"))
+    with pytest.raises(InputError, match=r"amp=0\.1\.npz: the file exists"):
+        check_histories(folder, POINTS[:1], None, False)  # no study named: any file is another's
+
+
 def test_an_unwritable_journal_names_the_out_option(tmp_path):
     # "error: /proc/s.csv.journal.jsonl: No such file or directory" named no option
     blocker = tmp_path / "file"

@@ -289,3 +289,21 @@ def test_a_run_whose_output_failed_is_an_error_row_with_its_message(arch_base, t
     row = run_task(arch_base, {"amp": 0.5}, history_dir=str(tmp_path))
     assert row["status"] == "error" and row["state"] == "" and row["amp"] == 0.5
     assert row["error"].startswith("failed: stopped at t = ") and "No space left on device" in row["error"]
+
+
+def test_a_history_of_the_same_study_is_replaced_another_is_kept(arch_base, tmp_path):
+    # walk-through 2026-11-28: Ctrl-C on `masonry sweep wall … --histories hist`: the workers finished the runs in
+    # flight and wrote their histories, whose rows the table never got; the same command then refused to resume
+    # ("--histories hist/amp=1.10909.npz: the file exists (add --force to replace it)")
+    import json
+
+    import numpy as np
+
+    for _ in range(2):  # the second run of the same study replaces the first's history
+        row = run_task(arch_base, {"amp": 0.5}, history_dir=str(tmp_path), study=("abc", "/s.csv"))
+        assert row["status"] == "completed", row
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["amp=0.5.npz"]
+    run = json.loads(str(np.load(tmp_path / "amp=0.5.npz")["run"]))
+    assert (run["study"], run["study_table"]) == ("abc", "/s.csv")
+    run_task(arch_base, {"amp": 0.5}, history_dir=str(tmp_path), study=("xyz", "/s.csv"))  # another study's: kept
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["amp=0.5-2.npz", "amp=0.5.npz"]

@@ -20,7 +20,7 @@ from pathlib import Path
 from masonrycli.errors import InputError
 from masonrycli.outputs import OutputFile, check_output, glob_escape
 from masonrycli.study import store
-from masonrycli.study.task import history_name
+from masonrycli.study.task import history_name, made_by_study
 
 _ANY = "FINDVALUE"
 """Stands for the bisected value in a history name (letters only: :func:`history_name` keeps it)."""
@@ -56,9 +56,12 @@ def open_table(out: Path, study_id: str, force: bool, names: list[str], points: 
     return table, ours
 
 
-def check_histories(folder: Path | None, points: list[dict], find: str | None, force: bool) -> None:
+def check_histories(
+    folder: Path | None, points: list[dict], find: str | None, force: bool, study: tuple[str, str] | None = None
+) -> None:
     """Refuse (unless ``force``) the history files the runs of ``points`` would write in ``folder``
-    that exist already; with ``find`` the bisected value is unknown, so any value counts."""
+    that exist already, but for those an earlier run of the same ``study`` wrote (:func:`made_by_study`);
+    with ``find`` the bisected value is unknown, so any value counts."""
     if folder is None:
         return
     if folder.exists() and not folder.is_dir():
@@ -68,4 +71,4 @@ def check_histories(folder: Path | None, points: list[dict], find: str | None, f
         if find:
             taken = sorted(folder.glob(glob_escape(name).replace(_ANY, "*"))) if folder.is_dir() else []
             name = taken[0].name if taken else name.replace(_ANY, "0")
-        check_output(folder / name, "--histories", ".npz", force)
+        check_output(folder / name, "--histories", ".npz", force or made_by_study(folder / name, study))

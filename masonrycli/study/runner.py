@@ -228,7 +228,8 @@ def in_flight_limit(client) -> int:
 
 def run_on_cluster(client, base, driver, on_row: Callable[[dict, dict], None], *task_args, limit=None) -> None:
     """Run ``driver``'s points on ``client`` until it hands out no more; ``on_row(params, row)`` for each.
-    ``task_args``: :func:`run_task`'s arguments after the point (stop_at_collapse, history_dir, force).
+    ``task_args``: :func:`run_task`'s arguments after the point (stop_at_collapse, history_dir, force,
+    study).
     At most ``limit`` tasks (default :func:`in_flight_limit`) are submitted at a time, the next one as
     each comes back."""
     import cloudpickle

@@ -123,7 +123,8 @@ def run_study(base: StudyBase, request: StudyRequest, console: Console) -> Study
     else:
         driver = GridDriver(request.axes, done)
         columns = names + list(RESULT_COLUMNS) + ["study"]
-    files.check_histories(request.histories, driver.start(), request.find, request.force)
+    study = (study_id, str(request.out.resolve()))  # whose histories may be replaced (study/task.py)
+    files.check_histories(request.histories, driver.start(), request.find, request.force, study)
     for line in request.warnings if request.warn is not None else ():
         request.warn(line)
     start = time.perf_counter()
@@ -172,7 +173,7 @@ def run_study(base: StudyBase, request: StudyRequest, console: Console) -> Study
         histories = None
         if request.histories is not None:
             histories = str(request.histories.resolve())
-        task_args = (request.stop_at_collapse, histories, request.force)
+        task_args = (request.stop_at_collapse, histories, request.force, study)
         with progress:
             if client is None:
                 run_serially(base, driver, on_row, *task_args)

@@ -7,6 +7,7 @@
 from __future__ import annotations
 
 import contextlib
+import json
 import math
 import time
 from pathlib import Path
@@ -43,14 +44,20 @@ RESULT_COLUMNS = (
 
 
 def run_task(
-    base, params: dict, stop_at_collapse: bool = True, history_dir: str | None = None, force: bool = False
+    base,
+    params: dict,
+    stop_at_collapse: bool = True,
+    history_dir: str | None = None,
+    force: bool = False,
+    study: tuple[str, str] | None = None,
 ) -> dict:
     """Run the grid point ``params`` of ``base`` (:class:`~masonrycli.study.axes.StudyBase`): its row.
 
     With ``history_dir`` the run's history (:mod:`masonrycli.history`) is written there as
     :func:`history_name` of the point (on the worker's file system), under the policy of
     :mod:`masonrycli.outputs`: a temporary file renamed into place when complete, an existing file
-    replaced only with ``force`` (the study checked them all before the first run).
+    replaced only with ``force`` or when an earlier run of the same ``study`` (its fingerprint and its
+    table) wrote it (:func:`made_by_study`; the study checked them all before the first run).
     """
     from masonrycli.execute import run_metadata
     from masonrycli.history import HistoryFile
@@ -66,10 +73,13 @@ def run_task(
         with contextlib.ExitStack() as files:
             sinks = []
             if history_dir:
-                out = OutputFile(Path(history_dir) / history_name(params), "--histories", force=force)
+                path = Path(history_dir) / history_name(params)
+                out = OutputFile(path, "--histories", force=force or made_by_study(path, study))
                 part = files.enter_context(written_whole(out))
                 sinks.append(HistoryFile(part, sim.model.block_name, sim.model.support_name))
                 sinks[0].run_info = run_metadata(scenario, sim) | {"study_point": params}
+                if study:
+                    sinks[0].run_info |= {"study": study[0], "study_table": study[1]}
             result = simulate(scenario, sinks, sim=sim, stop_at_collapse=stop_at_collapse)
             if sinks:
                 sinks[0].run_values |= {f"intensity_{k}": v for k, v in result.intensity.items()}
@@ -109,6 +119,22 @@ def history_name(params: dict) -> str:
     """``amp=0.5_freq=2.npz``: the file name of a point's history (characters unsafe in names -> "-")."""
     text = "_".join(f"{k}={v:g}" if isinstance(v, float) else f"{k}={v}" for k, v in params.items())
     return "".join(c if c.isalnum() or c in "=._-" else "-" for c in text) + ".npz"
+
+
+def made_by_study(path: Path, study: tuple[str, str] | None) -> bool:
+    """Whether ``path`` is a history that a run of ``study`` (its fingerprint, its table) wrote. A study
+    stopped by Ctrl-C (or killed) leaves the histories of its runs in flight, which the workers finish,
+    without their rows: the same command then refused to resume ("--histories …/amp=1.10909.npz: the file
+    exists"). Such a file is made again and may be replaced; any other needs ``--force`` (the same study
+    into another table too: that table's row is its history)."""
+    if not study or not path.is_file():
+        return False
+    try:
+        with np.load(path) as history:
+            run = json.loads(str(history["run"]))
+    except Exception:  # not a history
+        return False
+    return (run.get("study"), run.get("study_table")) == tuple(study)
 
 
 def empty_result(error: str, wall_time: float) -> dict:
