@@ -49,7 +49,7 @@ STALL_SWEEPS = 200
 (module doc, last paragraph)."""
 
 
-@njit
+@kernel_only
 def _extrapolate(x, x_prev, beta):
     # x ← x + β (x − x_prev), x_prev ← old x, element by element (the bodies' velocities, once a sweep).
     # Its own function: compiled apart from the sweep, LLVM vectorises the loop (several doubles an
