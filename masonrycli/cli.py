@@ -354,10 +354,15 @@ def inspect_command(
     if info.get("metadata"):
         console.print(info["metadata"])
     if info["truncated"]:
-        warn(
-            f"{recording}: truncated (its writer did not finish: killed, or the disk was full) — "
-            f"{info['frames']} frames up to its last complete chunk"
+        from masonrycli.outputs import part_writer
+
+        pid = part_writer(recording)
+        why = (
+            f"a run still going (pid {pid}) writes it"
+            if pid
+            else "its writer did not finish: killed, or the disk was full"
         )
+        warn(f"{recording}: truncated ({why}) — {info['frames']} frames up to its last complete chunk")
 
 
 def main() -> None:

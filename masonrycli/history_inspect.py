@@ -12,10 +12,12 @@ from __future__ import annotations
 import json
 import os
 import zipfile
+from pathlib import Path
 
 import numpy as np
 
 from masonrycli.errors import NOT_A_FILE, InputError, one_line
+from masonrycli.outputs import being_written
 
 NOT_RECORDED = "not recorded"
 _ZIP_MAGIC = b"PK\x03\x04"
@@ -71,7 +73,12 @@ def inspect_history(path: str | os.PathLike) -> dict:
     if not os.path.isfile(path):
         if os.path.isdir(path):
             raise InputError(f"{shown}: a folder, not a history")
-        raise InputError(f"{shown}: {NOT_A_FILE if os.path.exists(path) else 'no such history'}")
+        if os.path.exists(path):
+            raise InputError(f"{shown}: {NOT_A_FILE}")
+        live = being_written(Path(path))
+        if live is not None:  # streamed as raw rows, made an .npz at the end: nothing to read before it
+            raise InputError(f"{shown}: not there yet: a run still going (pid {live[1]}) writes it, whole at its end")
+        raise InputError(f"{shown}: no such history")
     try:
         with zipfile.ZipFile(path) as zf:
             members = [m for m in zf.namelist() if m.endswith(".npy")]

@@ -48,6 +48,33 @@ def _being_written(path: Path) -> bool:
     return any(path.parent.glob(f".{glob_escape(path.name)}.*.part")) if path.parent.is_dir() else False
 
 
+def part_writer(part: Path) -> int | None:
+    """The process id in a temporary name ``.NAME.<pid>.part`` when that process is running, else None."""
+    match = re.fullmatch(r"\..+\.(\d+)\.part", Path(part).name)
+    if match is None:
+        return None
+    pid = int(match.group(1))
+    try:
+        os.kill(pid, 0)
+    except PermissionError:  # another user's process: running
+        return pid
+    except (ProcessLookupError, OverflowError):  # ended (killed: its file was left), or no such number
+        return None
+    return pid
+
+
+def being_written(path: Path) -> tuple[Path, int] | None:
+    """The temporary file a running process writes ``path`` under (and its pid), if any: a run still going
+    (``masonry inspect`` said "no such recording" of it)."""
+    if not path.parent.is_dir():
+        return None
+    for part in sorted(path.parent.glob(f".{glob_escape(path.name)}.*.part")):
+        pid = part_writer(part)
+        if pid is not None:
+            return part, pid
+    return None
+
+
 def glob_escape(text: str) -> str:
     return re.sub(r"([*?\[])", r"[\1]", text)
 

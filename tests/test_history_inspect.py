@@ -7,6 +7,7 @@ refused ("a run history (.npz), not a recording")."""
 from __future__ import annotations
 
 import json
+import os
 import re
 
 import numpy as np
@@ -158,6 +159,12 @@ def test_a_history_under_another_name_is_still_a_history(history, tmp_path):
     assert is_history(renamed) and is_history(history)
     assert not is_history(tmp_path / "missing.rrd") and not is_history(tmp_path)
     assert_one_line_error(invoke("inspect", tmp_path / "missing.npz"), "missing.npz: no such history")
+    # walk-through 2026-11-28: a history a run still going writes said "no such history"
+    (tmp_path / f".live.npz.{os.getpid()}.part").write_bytes(b"")
+    assert_one_line_error(
+        invoke("inspect", tmp_path / "live.npz"),
+        f"live.npz: not there yet: a run still going (pid {os.getpid()}) writes it, whole at its end",
+    )
     (tmp_path / "d.npz").mkdir()
     assert_one_line_error(invoke("inspect", tmp_path / "d.npz"), "d.npz: a folder, not a history")
     shown = invoke("inspect", renamed)

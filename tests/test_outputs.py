@@ -13,7 +13,16 @@ import pytest
 from typer.testing import CliRunner
 
 from masonrycli.cli import app
-from masonrycli.outputs import OutputFile, default_recording_path, free_name, open_part, part_path, safe_name
+from masonrycli.outputs import (
+    OutputFile,
+    being_written,
+    default_recording_path,
+    free_name,
+    open_part,
+    part_path,
+    part_writer,
+    safe_name,
+)
 
 from cli_helpers import words
 
@@ -308,3 +317,18 @@ def test_a_folder_given_as_the_output_says_so_first(tmp_path):
     with pytest.raises(InputError) as info:
         check_output(tmp_path, "--out", ".rrd", False)
     assert str(info.value) == f"--out {tmp_path}: is a folder (name a file in it: {tmp_path / 'NAME.rrd'})"
+
+
+def test_a_temporary_file_is_being_written_only_while_its_process_runs(tmp_path):
+    import subprocess
+    import sys
+
+    target = tmp_path / "r.rrd"
+    assert being_written(target) is None
+    ended = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"], capture_output=True, text=True)
+    (tmp_path / f".r.rrd.{ended.stdout.strip()}.part").write_bytes(b"")  # left by a process that is gone
+    assert being_written(target) is None
+    live = tmp_path / f".r.rrd.{os.getpid()}.part"
+    live.write_bytes(b"")
+    assert being_written(target) == (live, os.getpid()) and part_writer(live) == os.getpid()
+    assert part_writer(target) is None

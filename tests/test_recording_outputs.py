@@ -4,6 +4,7 @@ footer is noticed at close, and ``inspect`` reads a truncated file up to its las
 from __future__ import annotations
 
 import errno
+import os
 import shutil
 
 import numpy as np
@@ -79,6 +80,21 @@ def test_inspect_reads_a_truncated_recording(recording, tmp_path):
     assert f"truncated (its writer did not finish: killed, or the disk was full) — {info['frames']} frames" in (
         words(result.output)
     )
+    # walk-through 2026-11-28: the temporary file of a run still going was said to be of a killed writer
+    live = tmp_path / f".run.rrd.{os.getpid()}.part"
+    os.replace(cut, live)
+    result = invoke("inspect", live)
+    assert result.exit_code == 0, result.output
+    assert f"truncated (a run still going (pid {os.getpid()}) writes it) — {info['frames']} frames" in (
+        words(result.output)
+    )
+    # and its target, not there until the run ends, was "no such recording"
+    result = invoke("inspect", tmp_path / "run.rrd")
+    assert words(result.output) == (
+        f"error: {tmp_path / 'run.rrd'}: not there yet: a run still going (pid {os.getpid()}) writes it as "
+        f"{live.name}, renamed to it when the run ends; masonry inspect {live} shows it so far"
+    )
+    assert result.exit_code == 2
     shutil.rmtree(tmp_path)
 
 

@@ -15,12 +15,14 @@ import sys
 import tempfile
 import time
 import warnings
+from pathlib import Path
 
 import numpy as np
 import pyarrow as pa
 import rerun as rr
 
 from masonrycli.errors import NOT_A_FILE
+from masonrycli.outputs import being_written
 from masonrycli.recording._rerun_private import viewer_pid
 from masonrycli.recording.layout import BLOCKS, CHAIN_KEY, FIELDS, HOVER_VALUES, METADATA, PER_STEP_SERIES, SERIES
 
@@ -84,7 +86,16 @@ def recording_path_problem(path: str | os.PathLike) -> str | None:
     if os.path.isfile(path):
         return _foreign_file(path)
     if not os.path.isdir(path):
-        return f"{shown}: {NOT_A_FILE if os.path.exists(path) else 'no such recording'}"
+        if os.path.exists(path):
+            return f"{shown}: {NOT_A_FILE}"
+        live = being_written(Path(path))
+        if live is None:
+            return f"{shown}: no such recording"
+        part, pid = live
+        return (
+            f"{shown}: not there yet: a run still going (pid {pid}) writes it as {part.name}, renamed to it when "
+            f"the run ends; masonry inspect {shlex.quote(os.fspath(part))} shows it so far"
+        )
     try:
         with os.scandir(path) as entries:
             found = sorted((e for e in entries if e.name.endswith(".rrd") and e.is_file()), key=lambda e: e.name)
