@@ -1,6 +1,7 @@
 """The lab's trajectory sample and first-stage variants (benchmarks/solver_lab/trajectory.py, ordinary.py,
 ordinary_runs.py): with the engine's parameters the lab kernel must be the engine's accelerated solve, or
-none of the variants' figures compare with the engine."""
+none of the variants' figures compare with the engine. The lab kernel is the scalar first stage in 4 runs
+(momentum.py), the engine's until the lane sweeps replaced it: the engine runs here with nlgs.LANES off."""
 
 from types import SimpleNamespace
 
@@ -12,6 +13,7 @@ from masonrycli.engine import nlgs
 
 
 def _sample(tmp_path, monkeypatch):
+    monkeypatch.setattr(nlgs, "LANES", False)
     monkeypatch.setattr(trajectory, "TRAJECTORY", tmp_path)
     trajectory.capture("wall-51", every=4, duration=0.03)
     return [ordinary.Step(p) for p in sorted((tmp_path / "wall-51").glob("step-*.npz"))]
@@ -54,7 +56,8 @@ def test_check_stops_on_the_iterate_residual(tmp_path, monkeypatch):
         assert its - history[-1] <= plain and res <= ordinary.TOLERANCE
 
 
-def test_engine_variant_in_a_whole_run_is_the_engine_run():
+def test_engine_variant_in_a_whole_run_is_the_engine_run(monkeypatch):
+    monkeypatch.setattr(nlgs, "LANES", False)
     engine = run_masonry("wall-51", 0.05, record=False)
     lab = ordinary_runs.run_variant("wall-51", {}, 0.05)
     assert lab["sweeps_mean"] == engine["sweeps_mean"] and lab["sweeps_max"] == engine["sweeps_max"]

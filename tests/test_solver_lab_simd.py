@@ -99,13 +99,14 @@ def test_coloured_sweeps_converge_to_the_tight_solution(problem, variant):
 
 
 def test_level_schedule_replays_the_engines_sweep_bit_for_bit(problem):
-    # the "levels" variant runs the engine's interleaved visit order level by level: the same sweeps
+    # the "levels" variant runs the engine's interleaved visit order (INTERLEAVE runs: the scalar momentum
+    # sweep, alternate passed so that it is not the lane sweeps' first stage) level by level: the same sweeps
     tol = 1e-7
     (sweeps, residual, _), v, r = _solve(problem, "levels", tol)
     v2, r2 = problem.v_free.copy(), problem.r_warm.copy()
     s2 = np.zeros(problem.count, np.int8)
     sweeps2, residual2 = nlgs._nlgs_interleaved(problem.body, problem.pack(), problem.count, problem.mu, tol,
-                                                200_000, v2, r2, s2, True, momentum.STALL_SWEEPS)  # fmt: skip
+                                                200_000, v2, r2, s2, True, momentum.STALL_SWEEPS, False)  # fmt: skip
     assert sweeps == sweeps2 and residual == residual2
     assert np.array_equal(v, v2) and np.array_equal(r, r2)
 

@@ -1,5 +1,9 @@
 """Gauss–Seidel with momentum: the sweep of solver "nlgs-accel", the engine's default.
 
+This module's kernel is the scalar sweep in the engine's interleaved order (4 runs): stalled.py's momentum
+stages use it, and the first stage did until :mod:`masonrycli.engine.lane_sweeps` (the same rule, 8 runs,
+8 contacts visited at once in vectors) replaced it there (``nlgs.LANES``).
+
 Each sweep of :mod:`masonrycli.engine.nlgs` starts from a Nesterov extrapolation of the last two sweeps'
 impulses and velocities; the momentum is dropped whenever a sweep's residual grows by more than
 RESTART_GROWTH (adaptive restart). The contact law, the local solve, the residual and the stopping test

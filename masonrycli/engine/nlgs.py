@@ -42,8 +42,9 @@ golden history are bit-identical (a 2000-sweep window changed them and left one 
 wall unconverged). Tolerance 0 runs exactly the cap.
 
 Acceleration (solver "nlgs-accel", the default; "nlgs" is the plain sweep, kept as the reference): the
-same sweep started from a Nesterov extrapolation of the last two sweeps (:mod:`masonrycli.engine.momentum`).
-A stalled accelerated solve goes on by the methods of :mod:`masonrycli.engine.stalled` (momentum turning
+same sweep started from a Nesterov extrapolation of the last two sweeps (:mod:`masonrycli.engine.momentum`),
+its first stage visiting the contacts in 8 interleaved runs, 8 contacts at once in vectors
+(:mod:`masonrycli.engine.lane_sweeps`; ``LANES``). A stalled accelerated solve goes on by the methods of :mod:`masonrycli.engine.stalled` (momentum turning
 its direction at restarts, alternating-direction sweeps, momentum resumed, faces, in turn with doubling
 budgets). Its iterations count accelerated sweeps (each ~1.1–1.6× the time of a plain one) plus the later
 methods' sweep units.
@@ -288,7 +289,7 @@ def _nlgs(contact_body, pack, count, mu, tolerance, max_iterations, v, r, status
 
 INTERLEAVE = 4
 """The sweep visits the contacts in this many interleaved runs of detection order (see _nlgs_interleaved)."""
-LANES = False
+LANES = True
 """The accelerated solve's first stage by :mod:`masonrycli.engine.lane_sweeps` (8 runs, 8 contacts visited
 at once in vectors); False: by the scalar sweep in INTERLEAVE runs (interleaved._accelerated), the
 default until the lane sweeps replaced it (benchmarks/README.md, explicit vectors addendum)."""
