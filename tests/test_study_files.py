@@ -83,3 +83,26 @@ def test_an_unwritable_journal_names_the_out_option(tmp_path):
         InputError, match=r"^--out .*file/sub/s\.csv: cannot write its journal s\.csv\.journal\.jsonl: "
     ):
         store.Journal(blocker / "sub" / "s.csv")
+
+
+def test_the_half_written_histories_of_gone_workers_are_removed(tmp_path):
+    # walk-through 2026-11-28: Ctrl-C on `masonry sweep wall … --histories hist` left .amp=….npz.<pid>.part files
+    # and .part.rows folders of the LocalCluster's workers, which died inside their runs (2 and 4 in two tries)
+    import os
+    import subprocess
+    import sys
+
+    from masonrycli.study.files import remove_abandoned_parts
+
+    gone = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"], capture_output=True, text=True)
+    dead = f".amp=0.5.npz.{gone.stdout.strip()}.part"
+    live = f".amp=0.6.npz.{os.getpid()}.part"  # a run still going: kept
+    (tmp_path / dead).write_bytes(b"")
+    (tmp_path / (dead + ".rows")).mkdir()
+    (tmp_path / (dead + ".rows") / "block_q.raw").write_bytes(b"x")
+    (tmp_path / live).write_bytes(b"")
+    (tmp_path / "amp=0.4.npz").write_bytes(b"a finished history")
+    remove_abandoned_parts(tmp_path)
+    assert sorted(p.name for p in tmp_path.iterdir()) == [live, "amp=0.4.npz"]
+    remove_abandoned_parts(None)
+    remove_abandoned_parts(tmp_path / "missing")

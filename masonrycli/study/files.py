@@ -15,10 +15,11 @@
 
 from __future__ import annotations
 
+import shutil
 from pathlib import Path
 
 from masonrycli.errors import InputError
-from masonrycli.outputs import OutputFile, check_output, glob_escape
+from masonrycli.outputs import OutputFile, check_output, glob_escape, part_writer
 from masonrycli.study import store
 from masonrycli.study.task import history_name, made_by_study
 
@@ -72,3 +73,20 @@ def check_histories(
             taken = sorted(folder.glob(glob_escape(name).replace(_ANY, "*"))) if folder.is_dir() else []
             name = taken[0].name if taken else name.replace(_ANY, "0")
         check_output(folder / name, "--histories", ".npz", force or made_by_study(folder / name, study))
+
+
+def remove_abandoned_parts(folder: Path | None) -> None:
+    """Remove the temporary files of histories whose writer is gone. A study stopped by Ctrl-C closes its
+    LocalCluster, whose workers die inside the runs in flight: their ``.NAME.<pid>.part`` files (and a
+    history's ``.rows`` folder) stayed in ``--histories``, as after a ``kill -9``. Local workers only: the pid
+    of a remote worker says nothing here."""
+    if folder is None or not folder.is_dir():
+        return
+    for part in [*folder.glob(".*.npz.*.part"), *folder.glob(".*.npz.*.part.rows")]:
+        writer = part.with_name(part.name.removesuffix(".rows"))
+        if part_writer(writer) is not None:  # a run still going (another study in the same folder)
+            continue
+        if part.is_dir():
+            shutil.rmtree(part, ignore_errors=True)
+        else:
+            part.unlink(missing_ok=True)

@@ -192,6 +192,8 @@ def run_study(base: StudyBase, request: StudyRequest, console: Console) -> Study
             r.setdefault("study", study_id)
         store.write_rows(table, rows, columns)
         _close(client, cluster)
+        if request.scheduler is None:  # its workers are gone: what they left half-written is of no one
+            files.remove_abandoned_parts(request.histories)
     failed = sum(1 for r in rows if r.get("status") == "error")
     return StudyResult(rows, columns, driver.skipped, ran, time.perf_counter() - start, failed, table.path)
 
