@@ -1,5 +1,6 @@
 """engine._jit: a kernel's cache is stamped with every engine module it draws compiled code from; a kernel
-only kernels call has no Python entry, and a call from Python says so instead of crashing."""
+only kernels call in a run has no Python entry, and a call from Python runs its twin instead of crashing;
+numba's option values are replaced by the same dict."""
 
 from __future__ import annotations
 
@@ -44,17 +45,20 @@ def test_engine_kernels_use_the_engine_stamp(tmp_path, monkeypatch):
     _jit.source_files.cache_clear()
 
 
-def test_a_kernel_only_kernel_called_from_python_raises_instead_of_crashing():
-    # Without the guard numba jumps to the null entry point of the missing wrapper: a segmentation fault,
-    # so the call runs in a child process, whose exit code tells the two apart.
+def test_a_kernel_only_kernel_called_from_python_runs_its_twin_instead_of_crashing():
+    # Without the twin numba jumps to the null entry point of the missing wrapper: a segmentation fault,
+    # so the calls run in a child process, whose exit code tells the two apart.
     code = (
+        "import math\n"
         "from masonrycli.engine import joints\n"
-        "try:\n    joints._nan_max(1.0, 2.0)\n"
-        "except TypeError as e:\n    print(e)\n"
+        "print(joints._nan_max(1.0, 2.0), joints._nan_max(3.0, -1.0), math.isnan(joints._nan_max(math.nan, 0.0)))\n"
+        "print(sorted(joints._nan_max.overloads), sorted(joints._nan_max._python_twin.overloads))\n"
     )
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300)
     assert done.returncode == 0, done.stderr
-    assert "masonrycli.engine.joints._nan_max is called from kernels only" in done.stdout
+    values, compiled = done.stdout.splitlines()
+    assert values == "2.0 3.0 True"
+    assert compiled == "[] [(float64, float64)]"  # the twin compiled, the kernel itself not at all
     assert isinstance(joints._nan_max, _jit._KernelOnly)
     assert joints._nan_max.targetoptions["no_cpython_wrapper"] is True
 

@@ -8,13 +8,15 @@ that changing a flag changes it everywhere.
 - ``no_cfunc_wrapper``: numba otherwise builds, optimises and compiles with every kernel a C-callable
   wrapper, used only when a kernel is passed as a first-class function value, which the engine never
   does: ~0.02 s of CPU a kernel, 5 % of a first run's compilation.
-- :func:`kernel_only` for a kernel that only kernels call, never Python (not the product, the tests or
-  the benchmarks): ``no_cpython_wrapper`` as well, no CPython wrapper (argument unboxing, result boxing)
-  built, optimised and compiled with it. The wrapper's cost grows with the arguments: 0.28 s of
+- :func:`kernel_only` for a kernel that a run calls only from kernels (Python calls it in tests and tools
+  at most): ``no_cpython_wrapper`` as well, no CPython wrapper (argument unboxing, result boxing) built,
+  optimised and compiled with it. The wrapper's cost grows with the arguments: 0.28 s of
   ``momentum._momentum_sweeps``'s 1.0 s (12 arguments, one omitted). numba would jump to a null entry
   point on a call from Python (a segmentation fault); the dispatcher's class is swapped for one whose
-  Python call raises a TypeError naming the kernel instead. The kernels that call it link its code as
-  before: the same results, bit for bit (the golden histories). numba compiles a library function (``np.empty``,
+  Python call compiles a twin instead, the same function under another name (its own cache files) with
+  a wrapper, and runs it: the tests call the same code, and a run that called it from Python would
+  compile it twice, not crash. The kernels that call it link its code as before: the same results, bit
+  for bit (the golden histories). numba compiles a library function (``np.empty``,
   ``max`` of two floats) once per set of caller flags, so one such call in a kernel_only kernel compiles
   it once more (~0.03 s): a kernel whose wrapper is cheap stays :data:`njit`.
 - no ``fastmath``: it allows reassociation and contraction, which change results in the last bits from
@@ -60,6 +62,7 @@ import functools
 import hashlib
 import os
 import re
+import types
 
 import numba
 from numba.core import caching, compiler, config, targetconfig
@@ -73,19 +76,28 @@ __all__ = ["kernel_only", "njit"]
 
 
 class _KernelOnly(CPUDispatcher):
-    """A :func:`kernel_only` kernel: compiled without a Python entry, so a call from Python raises here
-    instead of jumping to a null entry point (a segmentation fault)."""
+    """A :func:`kernel_only` kernel: compiled without a Python entry. A call from Python (tests, tools)
+    runs its twin, the same function compiled by :data:`njit` with a Python entry, instead of jumping to
+    the kernel's null entry point (a segmentation fault)."""
 
     def __call__(self, *args, **kwargs):
-        f = self.py_func
-        raise TypeError(
-            f"{f.__module__}.{f.__qualname__} is called from kernels only (_jit.kernel_only): it has no Python "
-            "entry; decorate it with njit to call it from Python"
-        )
+        twin = self.__dict__.get("_python_twin")
+        if twin is None:
+            f = self.py_func
+            copy = types.FunctionType(f.__code__, f.__globals__, f.__name__, f.__defaults__, f.__closure__)
+            copy.__qualname__ = f.__qualname__ + PYTHON_TWIN  # its own cache files: it has a Python entry
+            copy.__module__ = f.__module__
+            twin = self._python_twin = njit(copy)
+        return twin(*args, **kwargs)
+
+
+PYTHON_TWIN = "__python_twin"
+"""Suffix of the qualified name of a kernel_only kernel's twin (in --kernels tables, the cache's files)."""
 
 
 def kernel_only(func):
-    """:data:`njit` for a kernel that only kernels call, never Python (module doc): no CPython wrapper."""
+    """:data:`njit` for a kernel that kernels call, and Python only in tests and tools (module doc): no
+    CPython wrapper; a Python call compiles and runs a twin that has one."""
     dispatcher = njit(func, no_cpython_wrapper=True)
     dispatcher.__class__ = _KernelOnly  # same layout: a Python call now goes to _KernelOnly.__call__
     return dispatcher

@@ -57,7 +57,7 @@ def _nan_max(x, y):
     return x if x >= y or x != x else y
 
 
-@njit
+@kernel_only
 def _key_row(key, k, hint):
     # the row of k in the sorted, distinct keys `key`, or −1. The contacts come sorted by pair, so the next
     # contact's key is at or just after the row found for the last one (`hint`): gallop forward from there

@@ -329,7 +329,7 @@ def _write_pair_contacts(
     return c
 
 
-@njit
+@kernel_only
 def _collide_pair(
     vert, normal, size_a, size_b, sa, na, sb, nb, a, b, alert, c,
     contact_body, contact_point, contact_normal, contact_gap, contact_key,

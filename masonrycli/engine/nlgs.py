@@ -54,7 +54,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from masonrycli.engine._jit import njit
+from masonrycli.engine._jit import kernel_only, njit
 from masonrycli.engine.contact import ContactStatus
 
 STALL_SWEEPS = 10_000
@@ -193,7 +193,7 @@ def _local_solve(ut, un, pack, c, mu):
     return rt, rn, STATUS_SLIP
 
 
-@njit
+@kernel_only
 def _relative_velocity(v, a, b, pack, c):
     # u = H_αᵀ v: b's contact point velocity minus a's, on (t, n); with t = (n_y, −n_x),
     #   u_t = (v_b − v_a)·t + ω_b (r_b×t) − ω_a (r_a×t),   u_n likewise with n.
@@ -206,7 +206,7 @@ def _relative_velocity(v, a, b, pack, c):
     return ut, un
 
 
-@njit
+@kernel_only
 def _push(v, a, b, pack, c, drt, drn):
     # v_b += M_b⁻¹ H_b Δr, v_a −= M_a⁻¹ H_a Δr  (impulse Δr_t t + Δr_n n at the contact point).
     # Branch-free: a support's inverse mass and inertia are 0, so it gets +0 (its imposed velocity

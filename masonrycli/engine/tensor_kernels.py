@@ -15,7 +15,7 @@ import math
 
 import numpy as np
 
-from masonrycli.engine._jit import njit
+from masonrycli.engine._jit import kernel_only, njit
 
 ISOTROPY_TOLERANCE = 1e-14
 """A 2×2 tensor whose anisotropy r = √(((a−d)/2)² + b²) is at most this fraction of |c| + r
@@ -224,7 +224,7 @@ def _chain_strain_rate(block_count, block_q, block_v, chain, out):
 
 # strain_i += dt · rate_i where rate_i is finite (a block without triangle has NaN strain from the
 # start and keeps it; a transiently undefined rate — folded star — leaves the strain unchanged)
-@njit
+@kernel_only
 def _integrate_strain(rate, dt, strain):
     # Inputs: rate (N,2,2) 1/s, dt s ; In/out: strain (N,2,2)
     for i in range(rate.shape[0]):
@@ -243,7 +243,7 @@ def _integrate_strain(rate, dt, strain):
 # [[a, b], [b, d]]:  c = (a+d)/2,  r = hypot((a−d)/2, b)  (no cancellation, no overflow)
 #     λ1 = c + r ≥ λ2 = c − r,  φ = ½ atan2(2b, a−d) ∈ (−π/2, π/2]  (direction of λ1, CCW from x)
 # atan2 gives −π only for b = −0.0 with a < d: fold it to +π (φ = π/2); isotropic (r ≈ 0) → φ = 0.
-@njit
+@kernel_only
 def _sym_eig2(a, b, d):
     c = 0.5 * (a + d)
     h = 0.5 * (a - d)
