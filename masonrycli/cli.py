@@ -39,6 +39,7 @@ app = typer.Typer(
     rich_markup_mode="rich",
     no_args_is_help=True,
     add_completion=False,
+    context_settings={"help_option_names": ["-h", "--help"]},  # "-h" said "No such option" (no short option uses it)
     help="Dynamic analysis of dry-stone masonry: rigid blocks, Coulomb friction, NSCD, "
     "the cell stress and strain tensors of Chetouane et al. (2003), Rerun recordings.",
 )

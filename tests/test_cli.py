@@ -27,6 +27,15 @@ def test_help_and_version():
     assert result.exit_code == 0 and "--freq" in result.output and "--amp" in result.output
 
 
+@pytest.mark.parametrize(
+    "command", [(), ("simulate",), ("simulate", "wall"), ("build", "arch"), ("sweep",), ("inspect",)]
+)
+def test_h_is_help(command):
+    # walk-through 2026-11-28: "masonry -h" said "error: No such option: -h (masonry --help lists the options)"
+    result = invoke(*command, "-h")
+    assert result.exit_code == 0 and result.output == invoke(*command, "--help").output
+
+
 def _option_help(command: list[str]) -> dict[str, str]:
     """Each option of ``masonry COMMAND --help`` with its help text (joined over wrapped lines)."""
     from masonrycli.cli import app
