@@ -291,3 +291,40 @@ def test_a_ctrl_c_dropped_inside_numbas_compiler_stops_a_serial_study(failed, mo
             signal.signal(s, handler)
     assert rows == ([] if failed else [{"amp": 0.0, "status": "completed"}])  # a failed row is not kept
     assert "Traceback" not in capfd.readouterr().err
+
+
+def test_a_sigterm_while_the_local_cluster_starts_stops_once_it_is_up_and_closes_it(monkeypatch):
+    # walk-through 2026-11-28: SIGTERM 0.8-1.2 s into `masonry sweep` raised inside the half-started LocalCluster;
+    # "interrupted (SIGTERM): …" was followed by a traceback of distributed's exit hook (AssertionError:
+    # Status.init). Now the start finishes, the signal is raised then, and the cluster is closed.
+    import os
+    import signal
+    import time
+
+    import distributed
+
+    from masonrycli.interrupt import FirstSignalStops
+
+    seen = {}
+
+    class Cluster:
+        def __init__(self, **kwargs):
+            seen["sigint"] = signal.getsignal(signal.SIGINT)  # what the worker processes inherit
+            os.kill(os.getpid(), signal.SIGTERM)
+            time.sleep(0.2)  # a handler would run here
+            seen["started"] = True
+
+        def close(self):
+            seen["closed"] = True
+
+    monkeypatch.setattr(distributed, "LocalCluster", Cluster)
+    before = {s: signal.getsignal(s) for s in (signal.SIGINT, signal.SIGTERM)}
+    try:
+        with FirstSignalStops() as signals:
+            with pytest.raises(KeyboardInterrupt):
+                runner.open_cluster(None, 2)
+            assert signals.stopping() == signal.SIGTERM
+    finally:
+        for s, handler in before.items():
+            signal.signal(s, handler)
+    assert seen == {"sigint": signal.SIG_IGN, "started": True, "closed": True}

@@ -76,28 +76,62 @@ def open_cluster(scheduler: str | None, workers: int | None, runs: int | None = 
     # two studies at once do not fight over 8787
     # Ctrl-C reaches the terminal's whole process group: a worker process that took it printed a
     # KeyboardInterrupt traceback each. Started with SIGINT ignored (kept across exec), the workers leave
-    # the interrupt to this process, which closes the cluster.
-    main = threading.current_thread() is threading.main_thread()  # signal.signal works only there
-    previous = signal.signal(signal.SIGINT, signal.SIG_IGN) if main else None
-    try:
+    # the interrupt to this process, which closes the cluster (_WhileWorkersStart).
+    held = _WhileWorkersStart()
+    with held:
         cluster = LocalCluster(
             n_workers=n, threads_per_worker=1, processes=True, dashboard_address=":0", silence_logs=logging.ERROR
         )
-    finally:
-        if main:
-            signal.signal(signal.SIGINT, previous)
-    client = Client(cluster)
+    client = None
     try:
+        held.deliver()  # a SIGTERM of the start stops the command now, the cluster closed below
+        client = Client(cluster)
         # A worker process's logs are teardown noise under the one-line "interrupted" message: one whose
         # heartbeat met the closing scheduler printed "Failed to communicate with scheduler during heartbeat"
         # and a StreamClosedError traceback (CI, 2026-11-27). A run's own errors come back in its row.
         # (silence_logs above does not reach the worker processes.)
         client.run(quiet_worker_logs)
     except BaseException:
-        client.close()
+        if client is not None:
+            client.close()
         cluster.close()
         raise
     return client, cluster
+
+
+class _WhileWorkersStart:
+    """Around a LocalCluster's start: SIGINT ignored, for the worker processes to inherit (a Ctrl-C of those
+    seconds is lost: the disposition is the process's, and no thread of it can keep the signal for later —
+    README, known limits); SIGTERM noted, and :meth:`deliver` raises it again once the cluster is up, where
+    closing it works. Before, a SIGTERM raised inside the half-started cluster, whose exit hook then printed a
+    traceback (AssertionError: Status.init) under the "interrupted (SIGTERM)" line. Outside the main thread
+    (no signal handlers there) it does nothing."""
+
+    def __init__(self) -> None:
+        self.main = threading.current_thread() is threading.main_thread()
+        self.terminated = False
+
+    def __enter__(self):
+        if self.main:
+            self._sigint = signal.signal(signal.SIGINT, signal.SIG_IGN)
+            self._sigterm = signal.signal(signal.SIGTERM, self._note)
+        return self
+
+    def _note(self, _signum, _frame) -> None:
+        self.terminated = True
+
+    def __exit__(self, *exc) -> None:
+        if self.main:
+            signal.signal(signal.SIGINT, self._sigint)
+            signal.signal(signal.SIGTERM, self._sigterm)
+            if exc[0] is not None:  # the start failed: its error goes on, a noted SIGTERM after it
+                self.deliver()
+
+    def deliver(self) -> None:
+        """Raise a noted SIGTERM again: the command's own handler takes it now."""
+        if self.terminated:
+            self.terminated = False
+            signal.raise_signal(signal.SIGTERM)
 
 
 def quiet_worker_logs() -> None:
