@@ -90,9 +90,16 @@ def pack_lanes(contact_body, pack, count, v, r):
             if c >= count:
                 break
             _push(v, contact_body[c, 0], contact_body[c, 1], pack, np.uint64(c), r[c, 0], r[c, 1])
-    Q = np.zeros(run * ROWS * W, np.float64)
-    IA = np.zeros(run * W, np.int64)
-    IB = np.zeros(run * W, np.int64)
+    # np.empty and a fill, not np.zeros (_jit's rule): np.zeros compiled 2 signatures and a fill of its own,
+    # 0.1 s of a first run's CPU (benchmarks/README.md, "Cold start"); absent lanes keep these zeros
+    Q = np.empty(run * ROWS * W, np.float64)
+    IA = np.empty(run * W, np.int64)
+    IB = np.empty(run * W, np.int64)
+    for i in range(Q.shape[0]):
+        Q[i] = 0.0
+    for i in range(IA.shape[0]):
+        IA[i] = 0
+        IB[i] = 0
     for c in range(count):
         j = c % run
         q = c // run
