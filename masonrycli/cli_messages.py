@@ -99,6 +99,20 @@ class OneLineUsageErrors(typer.core.TyperGroup):
             sys.exit(exc.exit_code)
         sys.exit(code if isinstance(code, int) else 0)
 
+    # A Ctrl-C while the arguments are read (the command's own handling, user_errors, has not begun): typer
+    # made it exit 130 without a word (1 in 10 tries at 0.39 s into `masonry sweep …`). Nothing is written yet.
+    def make_context(self, *args, **kwargs):
+        try:
+            return super().make_context(*args, **kwargs)
+        except KeyboardInterrupt:
+            fail("Ctrl-C: stopped before any output was written", 130)
+
+    def invoke(self, ctx):
+        try:
+            return super().invoke(ctx)
+        except KeyboardInterrupt:  # a subcommand's arguments; a command's own stop never comes out as one
+            fail("Ctrl-C: stopped before any output was written", 130)
+
     def _path_of(self, args) -> str:
         """The command line's command (``masonry simulate wall``) for an error raised without its context:
         the parser's "Option '--duration' requires an argument" pointed to ``masonry --help``, which lists
