@@ -218,14 +218,17 @@ def _lane_sweeps(contact_body, pack, count, mu, tolerance, max_iterations, v, r,
         sum_e2 = 0.0
         for j in range(run):
             m = gmask[j]
-            if clash[j]:  # Gauss–Seidel: one lane at a time, in lane order
-                for q in range(W):
-                    if m >> q & 1:
-                        sum_e2 += _group(j, V.mask_bits(1 << q), Q, IA, IB, v4, vbeta, vmu, False)
-            elif m == FULL:
+            if m == FULL and not clash[j]:
                 sum_e2 += _group(j, V.mask_bits(FULL), Q, IA, IB, v4, vbeta, vmu, True)
-            else:
-                sum_e2 += _group(j, V.mask_bits(m), Q, IA, IB, v4, vbeta, vmu, False)
+                continue
+            # A clashing group, Gauss–Seidel: one lane at a time, in lane order; a partial one: its lanes
+            # at once. One call site for both: numba inlines _group at each (inline="always"), and a
+            # third copy was 0.5 s of a first run's CPU (benchmarks/README.md, "Cold start").
+            visits = W if clash[j] else 1
+            for q in range(visits):
+                act = 1 << q if clash[j] else m
+                if m & act:
+                    sum_e2 += _group(j, V.mask_bits(act), Q, IA, IB, v4, vbeta, vmu, False)
         residual = np.sqrt(sum_e2 / count)
         if residual <= tolerance:
             break
