@@ -73,23 +73,3 @@ def test_kernels_calling_kernel_only_kernels_still_run():
     assert sorted(point[:, 0].tolist()) == pytest.approx([0.0, 1.0])
     assert normal.tolist() == [[0.0, 1.0], [0.0, 1.0]]
     assert gap.tolist() == [0.0, 0.0]
-
-
-def test_numba_option_values_are_replaced_by_the_same_dict():
-    from numba.core import compiler, targetconfig
-
-    assert _jit.FASTER_OPTION_VALUES  # numba as _jit was written against: the faster values are in use
-    assert targetconfig.TargetConfig.values is _jit._option_values
-    original = _jit._NUMBA_OPTION_VALUES
-    flags = compiler.Flags()
-    assert _jit._option_values(flags) == original(flags)
-    for name, option in compiler.Flags.options.items():  # each option set, one at a time, then all of them
-        one = compiler.Flags()
-        one._values[name] = flags._values[name] = option.default  # set (is_set), at its default
-        assert _jit._option_values(one) == original(one), name
-    flags.nrt = True
-    flags.no_cpython_wrapper = True
-    flags.error_model = "numpy"
-    assert _jit._option_values(flags) == original(flags)
-    assert _jit._option_values(flags) != _jit._option_values(compiler.Flags())
-    assert hash(flags) == hash(tuple(sorted(original(flags))))  # TargetConfig.__hash__ reads values()

@@ -41,13 +41,6 @@ that changing a flag changes it everywhere.
   setting whenever it compiles, so it holds for every kernel compiled in the process (the engine is
   numba's only user).
 
-numba's compiler spends ~3 % of a first run's CPU building option dicts: each typing of a call to a
-library function (``np.empty``, an operator on arrays, ...) looks its implementation up in a cache keyed
-by the compilation's flags, and hashing or comparing flags calls ``TargetConfig.values``, a property call
-per option, ~40 of them (26 000 comparisons and 32 000 hashes in a first run). :func:`_option_values`
-builds the same dict from the class's defaults and the options set, and replaces it when it gives what
-numba's own gives (checked at import): the same lookups, so the same compiled code, in less time.
-
 The cache of a kernel is stamped with the source of its module **and of every engine module that module
 imports from**, transitively (:func:`source_files`). A cached kernel holds the machine code of the
 kernels it calls: ``fused._before_solve`` that of detection, integration and warm start, ``watch._watch``
@@ -65,7 +58,7 @@ import re
 import types
 
 import numba
-from numba.core import caching, compiler, config, targetconfig
+from numba.core import caching, config
 from numba.core.registry import CPUDispatcher
 
 config.SLP_VECTORIZE = 1  # module doc
@@ -162,36 +155,3 @@ class _EngineInTree(_EngineSources, caching.InTreeCacheLocator):
 # numba ≥ 0.60 names it CacheImpl, earlier _CacheImpl; the first locator that accepts a function is used.
 _CACHE_IMPL = getattr(caching, "CacheImpl", None) or caching._CacheImpl
 _CACHE_IMPL._locator_classes[:0] = [_EngineUserDir, _EngineInTree]
-
-
-def _option_values(config_):
-    # TargetConfig.values, the same dict built without a property call per option (module doc): the
-    # class's option defaults, then the options set on this instance (_values holds only options).
-    cls = type(config_)
-    defaults = _DEFAULTS.get(cls)
-    if defaults is None:
-        defaults = _DEFAULTS[cls] = {name: option.default for name, option in cls.options.items()}
-    return {**defaults, **config_._values}
-
-
-_DEFAULTS: dict[type, dict] = {}
-_NUMBA_OPTION_VALUES = targetconfig.TargetConfig.values
-
-
-def _faster_option_values() -> bool:
-    """Install :func:`_option_values` as ``TargetConfig.values`` if it gives what numba's own gives on
-    compilation flags with options set and unset (numba's class as this module was written against)."""
-    original = _NUMBA_OPTION_VALUES
-    if getattr(original, "__qualname__", "") != "TargetConfig.values":
-        return False  # numba changed
-    flags = compiler.Flags()
-    flags.no_cpython_wrapper = True
-    flags.error_model = "numpy"
-    if _option_values(flags) != original(flags) or _option_values(compiler.Flags()) != original(compiler.Flags()):
-        return False
-    targetconfig.TargetConfig.values = _option_values
-    return True
-
-
-FASTER_OPTION_VALUES = _faster_option_values()
-"""Whether numba's ``TargetConfig.values`` is :func:`_option_values` in this process."""
