@@ -1,9 +1,10 @@
 """The default solver's first stage in lane groups (engine/lanes.py, engine/lane_sweeps.py).
 
 Reference: a plain-Python implementation in this file of the same sweeps, one contact at a time —
-Gauss–Seidel with momentum (momentum.py's rule) in the interleaved order with 8 runs, the residual summed
-per group of 8 as the vector code does — and the solver lab's scalar lane sweep ("lanes+split"). Bit for
-bit: every lane does the scalar visit's IEEE operations on the same operands.
+Gauss–Seidel with momentum (momentum.py's rule) in the interleaved order with 8 runs, a clashing group's
+lanes sub-group by sub-group, the residual summed per (sub-)group as the vector code does — and, where no
+group clashes, the solver lab's scalar lane sweep ("lanes+split"). Bit for bit: every lane does the scalar
+visit's IEEE operations on the same operands.
 """
 
 import math
@@ -47,13 +48,21 @@ def _local_solve(ut, un, p, mu):
 
 
 def _groups(body, pack, count):
-    # [(contacts of group j in lane order, clash)], the 8-run interleaved order's groups
+    # [[contacts of each sub-group, in lane order]] of each group of the 8-run interleaved order: lane q
+    # (contact q·run + j) joins the first sub-group with no contact on a body it moves (greedy colouring)
     run = -(-count // 8)
     out = []
     for j in range(run):
-        cs = [q * run + j for q in range(8) if q * run + j < count]
-        moved = [int(body[c, s]) for c in cs for s in (0, 1) if _moves(pack[c], s)]
-        out.append((cs, len(moved) != len(set(moved))))
+        subs = []
+        for c in (q * run + j for q in range(8) if q * run + j < count):
+            mine = {int(body[c, s]) for s in (0, 1) if _moves(pack[c], s)}
+            for sub in subs:
+                if not mine & {int(body[d, s]) for d in sub for s in (0, 1) if _moves(pack[d], s)}:
+                    sub.append(c)
+                    break
+            else:
+                subs.append([c])
+        out.append(subs)
     return out
 
 
@@ -76,17 +85,18 @@ def _push(v, a, b, p, drt, drn, supports_too):
 
 def slow_lane_sweeps(body, pack, count, mu, tolerance, cap, v0, r0, stall_after):
     """Plain Python: momentum's sweeps (momentum._momentum_sweeps, flip omitted) visiting contact
-    q·run + j for j = 0 …, q = 0 … 7, one at a time; Σ|e_α|² summed per group (from 0, in lane order;
-    each contact of a clashing group its own group). The warm start pushed in visit order into every body,
-    the sweeps' pushes into movable bodies only. Returns (iterations, residual, v, r, status)."""
+    q·run + j for j = 0 …, q = 0 … 7, one at a time, a clashing group's lanes sub-group by sub-group;
+    Σ|e_α|² summed per sub-group (from 0, in lane order). The warm start pushed group by group in lane
+    order into every body, the sweeps' pushes into movable bodies only. Returns (iterations, residual, v,
+    r, status)."""
     P = [[float(x) for x in row] for row in pack[:count]]
     v = [[float(x) for x in row] for row in v0]
     x = [[float(r0[c, 0]), float(r0[c, 1])] for c in range(count)]
     prev = [list(xc) for xc in x]
     status = [0] * count
     groups = _groups(body, pack, count)
-    for cs, _ in groups:
-        for c in cs:
+    for subs in groups:
+        for c in sorted(c for sub in subs for c in sub):
             _push(v, int(body[c, 0]), int(body[c, 1]), P[c], x[c][0], x[c][1], True)
     v_prev = [list(row) for row in v]
     its, residual, best, best_at, last, j, beta = 0, 0.0, math.inf, 0, math.inf, 1, 0.0
@@ -98,9 +108,9 @@ def slow_lane_sweeps(body, pack, count, mu, tolerance, cap, v0, r0, stall_after)
                 row[k] = xi + beta * (xi - v_prev[i][k])
                 v_prev[i][k] = xi
         total = 0.0
-        for cs, clash in groups:
+        for sub in (sub for subs in groups for sub in subs):
             s = 0.0
-            for c in cs:
+            for c in sub:
                 p, a, b = P[c], int(body[c, 0]), int(body[c, 1])
                 dvx, dvy = v[b][0] - v[a][0], v[b][1] - v[a][1]
                 ut = dvx * p[N.P_NY] - dvy * p[N.P_NX] + v[b][2] * p[N.P_TB] - v[a][2] * p[N.P_TA]
@@ -118,12 +128,8 @@ def slow_lane_sweeps(body, pack, count, mu, tolerance, cap, v0, r0, stall_after)
                 if drt != 0.0 or drn != 0.0:
                     _push(v, a, b, p, drt, drn, False)
                 et, en = wtt * drt + wtn * drn, wtn * drt + wnn * drn
-                if clash:
-                    total += 0.0 + (et * et + en * en)
-                else:
-                    s += et * et + en * en
-            if not clash:
-                total += s
+                s += et * et + en * en
+            total += s
         residual = math.sqrt(total / count)
         if residual <= tolerance:
             break
@@ -146,8 +152,10 @@ def _problem(n):
 
 def _kinds(body, pack):
     groups = _groups(body, pack, body.shape[0])
-    return {"full": sum(len(cs) == 8 and not k for cs, k in groups),
-            "partial": sum(len(cs) < 8 and not k for cs, k in groups), "clash": sum(k for _, k in groups)}  # fmt: skip
+    return {"full": sum(len(subs) == 1 and len(subs[0]) == 8 for subs in groups),
+            "partial": sum(len(subs) == 1 and len(subs[0]) < 8 for subs in groups),
+            "clash": sum(len(subs) > 1 for subs in groups),
+            "multi": sum(any(len(sub) > 1 for sub in subs) for subs in groups if len(subs) > 1)}  # fmt: skip
 
 
 def _same_bits(a, b):
@@ -162,14 +170,14 @@ def _run(body, pack, v0, r0, mu, tolerance, cap, stall=momentum.STALL_SWEEPS):
 
 
 # stack(6): 12 contacts, runs of 2: two partial groups that both clash (the bed joints of one block are
-# 2 contacts apart); stack(11): 22 contacts, runs of 3, clashing and partial groups; stack(39): 78
-# contacts, runs of 10, full groups and two partial ones (7 lanes).
+# 2 contacts apart), split into sub-groups of several lanes; stack(11): 22 contacts, runs of 3, clashing
+# and partial groups; stack(39): 78 contacts, runs of 10, full groups and two partial ones (7 lanes).
 @pytest.mark.parametrize(("n", "tolerance", "cap"), [(6, 0.0, 40), (11, 1e-9, 5000), (11, 0.0, 25), (39, 1e-9, 10_000),
                                                      (39, 0.0, 60)])  # fmt: skip
 def test_lane_sweeps_are_the_plain_python_order_bit_for_bit(n, tolerance, cap):
     body, pack, v0, r0, mu = _problem(n)
     kinds = _kinds(body, pack)
-    assert (kinds["full"] > 0 and kinds["partial"] > 0) if n == 39 else kinds["clash"] > 0, kinds
+    assert (kinds["full"] > 0 and kinds["partial"] > 0) if n == 39 else kinds["multi"] > 0, kinds
     for sweeps in (1, 2, 3, 7, cap) if tolerance == 0.0 else (cap,):
         its, res, v, r, st = _run(body, pack, v0, r0, mu, tolerance, sweeps, stall=sweeps)
         its_ref, res_ref, v_ref, r_ref, st_ref = slow_lane_sweeps(
@@ -191,9 +199,12 @@ def test_a_stall_window_stops_the_sweeps_as_the_reference():
 def test_lane_sweeps_are_the_labs_scalar_lanes_bit_for_bit():
     from benchmarks.solver_lab import simd_sweep
 
-    for n in (6, 39):
+    # without clashes (the stack of 39: full and partial groups) the order is the lab's "lanes+split"; a
+    # clashing group there is visited lane by lane, here by sub-groups (lanes.py)
+    for n in (39,):
         body, pack, v0, r0, mu = _problem(n)
         count = body.shape[0]
+        assert _kinds(body, pack)["clash"] == 0
         its, res, v, r, st = _run(body, pack, v0, r0, mu, 1e-9, 10_000, stall=10_000)
         v2, r2, st2 = v0.copy(), r0.copy(), np.zeros(count, np.int8)
         its2, res2, _ = simd_sweep.solve(body, pack, count, mu, 1e-9, 10_000, v2, r2, st2, 10_000, "lanes+split")

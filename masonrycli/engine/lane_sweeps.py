@@ -6,7 +6,7 @@ window after which nlgs.solve hands the step to :mod:`masonrycli.engine.stalled`
 side on ``<8 x double>`` vectors (:mod:`masonrycli.engine._vector`), one lane a contact:
 
     per sweep: v ← v + β (v − v_prev)            (momentum._extrapolate)
-    per group j (a clashing group: one lane at a time, in lane order):
+    per group j (a clashing group: each of its sub-groups in turn, lanes.py):
         gather v_a, v_b → u = H_αᵀ v; the extrapolated start r_y, u_free = u − W r_y; the branch-free
         local solve (every candidate computed in all lanes, then the first valid one in
         nlgs._local_solve's order selected); Δr, e_α = W Δr
@@ -110,21 +110,17 @@ def _local_solve_v(ut, un, bias, wtt, wtn, wnn, itt, itn, inn, isp, ism, mu):
 @njit(inline="always")
 def _group(j, act, Q, IA, IB, v4, beta, mu, full):
     # The visit of group j's lanes in mask act (module doc), on the AoSoA rows Q and the padded v4.
-    #   full (8 lanes, no clash): one 256-bit row a body read and written (gather_rows / scatter_rows;
-    #   every lane writes back, the value it read where it does not push); else masked gathers/scatters.
+    #   read: one 256-bit row a body and lane (gather_rows; an absent lane reads body 0, offset 0, and
+    #         its zero rows make it open: nothing computed from it is stored)
+    #   full (8 lanes, no clash): written back the same way (scatter_rows; every lane writes, the value
+    #         it read where it does not push); else (a partial group or a sub-group) the pushing lanes of
+    #         act only, by scalar stores in lane order (on Zen 5 the masked hardware scatters cost more:
+    #         benchmarks/README.md, explicit vectors addendum).
     # Returns the group's Σ|e_α|², its lanes added in lane order.
     q0 = j * ROWS * W
     at = j * W
-    if full:
-        vax, vay, waa = V.gather_rows(v4, IA, at)
-        vbx, vby, wbb = V.gather_rows(v4, IB, at)
-    else:
-        vax = V.gather(v4, IA, at, 0, act)
-        vay = V.gather(v4, IA, at, 1, act)
-        waa = V.gather(v4, IA, at, 2, act)
-        vbx = V.gather(v4, IB, at, 0, act)
-        vby = V.gather(v4, IB, at, 1, act)
-        wbb = V.gather(v4, IB, at, 2, act)
+    vax, vay, waa = V.gather_rows(v4, IA, at)
+    vbx, vby, wbb = V.gather_rows(v4, IB, at)
     nx = V.load(Q, q0 + P_NX * W)
     ny = V.load(Q, q0 + P_NY * W)
     ta = V.load(Q, q0 + P_TA * W)
@@ -174,12 +170,19 @@ def _group(j, act, Q, IA, IB, v4, beta, mu, full):
         V.scatter_rows(v4, IA, at, V.select(push_a, nax, vax), V.select(push_a, nay, vay), V.select(push_a, naw, waa))
         V.scatter_rows(v4, IB, at, V.select(push_b, nbx, vbx), V.select(push_b, nby, vby), V.select(push_b, nbw, wbb))
     else:
-        V.scatter(v4, IA, at, 0, nax, push_a)
-        V.scatter(v4, IA, at, 1, nay, push_a)
-        V.scatter(v4, IA, at, 2, naw, push_a)
-        V.scatter(v4, IB, at, 0, nbx, push_b)
-        V.scatter(v4, IB, at, 1, nby, push_b)
-        V.scatter(v4, IB, at, 2, nbw, push_b)
+        pa = V.bits_of(push_a)
+        pb = V.bits_of(push_b)
+        for q in range(W):
+            if pa >> q & 1:
+                o = IA[at + q]
+                v4[o] = V.lane(nax, q)
+                v4[o + 1] = V.lane(nay, q)
+                v4[o + 2] = V.lane(naw, q)
+            if pb >> q & 1:
+                o = IB[at + q]
+                v4[o] = V.lane(nbx, q)
+                v4[o + 1] = V.lane(nby, q)
+                v4[o + 2] = V.lane(nbw, q)
     et = wtt * drt + wtn * drn
     en = wtn * drt + wnn * drn
     e2 = V.select(act, et * et + en * en, zero)  # an absent lane's is +0: adding it changes no bit
@@ -189,19 +192,19 @@ def _group(j, act, Q, IA, IB, v4, beta, mu, full):
     return s
 
 
-@njit(error_model="numpy")  # numpy: the fallback's division by a zero W gives inf, as the scalar sweep's
+@njit
 def _lane_sweeps(contact_body, pack, count, mu, tolerance, max_iterations, v, r, status, stall_after):
     # v: v_free in, v_n+1 out; r: warm start in, impulses out (as momentum._momentum_sweeps, flip omitted).
     #   Q, IA, IB, groups, v4 ← lanes.pack_lanes (v ← v_free + M⁻¹ H r_warm on the way)
-    #   repeat: _extrapolate(v4); for each group: _group (lane by lane if it clashes)
+    #   repeat: _extrapolate(v4); for each group: _group on each of its sub-groups (one unless it clashes)
     #           residual = sqrt(Σ|e_α|² / C); stop at the tolerance, the cap or the stall window;
     #           restart (j = 1) when the residual grew by more than RESTART_GROWTH; β = (j − 1)/(j + 2)
     #   v, r, status ← lanes.unpack_lanes
     # Returns (iterations, residual).
     if count == 0:
         return 0, 0.0
-    Q, IA, IB, gmask, clash, v4 = pack_lanes(contact_body, pack, count, v, r)
-    run = gmask.shape[0]
+    Q, IA, IB, sub, nsub, v4 = pack_lanes(contact_body, pack, count, v, r)
+    run = nsub.shape[0]
     v_prev = v4.copy()
     vmu = V.splat(mu)
     iterations = 0
@@ -217,18 +220,16 @@ def _lane_sweeps(contact_body, pack, count, mu, tolerance, max_iterations, v, r,
         vbeta = V.splat(beta)
         sum_e2 = 0.0
         for j in range(run):
-            m = gmask[j]
-            if m == FULL and not clash[j]:
+            # all 8 lanes, no clash: full a constant in this inlined copy (one copy for both kinds, the flag
+            # known at run time only, cost ~1.5 ns a contact·sweep: 4.1 -> 5.8 on a step of the 248-block wall)
+            if sub[j, 0] == FULL:
                 sum_e2 += _group(j, V.mask_bits(FULL), Q, IA, IB, v4, vbeta, vmu, True)
                 continue
-            # A clashing group, Gauss–Seidel: one lane at a time, in lane order; a partial one: its lanes
-            # at once. One call site for both: numba inlines _group at each (inline="always"), and a
-            # third copy was 0.5 s of a first run's CPU (benchmarks/README.md, "Cold start").
-            visits = W if clash[j] else 1
-            for q in range(visits):
-                act = 1 << q if clash[j] else m
-                if m & act:
-                    sum_e2 += _group(j, V.mask_bits(act), Q, IA, IB, v4, vbeta, vmu, False)
+            # a partial group; a clashing one's sub-groups in turn (lanes.py). Two call sites in all: numba
+            # inlines _group at each, and a third copy was 0.5 s of a first run's CPU (benchmarks/README.md,
+            # "Cold start")
+            for k in range(nsub[j]):
+                sum_e2 += _group(j, V.mask_bits(sub[j, k]), Q, IA, IB, v4, vbeta, vmu, False)
         residual = np.sqrt(sum_e2 / count)
         if residual <= tolerance:
             break

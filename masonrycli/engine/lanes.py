@@ -9,9 +9,16 @@ detection order, and
 
 The 8 contacts of a group are visited at once, one lane of a ``<8 x double>`` each. That is Gauss–Seidel
 in this order exactly when no two of them move the same body (a support, zero inverse mass and inertia,
-is only read). A group where two do (a *clash*: rare, runs are C/8 contacts apart in detection order) is
-visited lane by lane. The last groups have fewer than 8 lanes when C is not a multiple of 8 (lane q is
-present when q·run + j < C).
+is only read). A group where two do (a *clash*) is split into sub-groups without one, by greedy colouring
+in lane order (lane q joins the first sub-group none of whose lanes it clashes with), visited in turn:
+Gauss–Seidel in the order "the sub-groups' lanes, sub-group by sub-group". Clashes are rare where runs
+(C/8 contacts of detection order) are far apart in the structure: none on the 248-block and taller walls
+or the arch, 1 % of the groups on the aqueduct; but on the 8-course wall a run is about a course, lane q
+and q + 1 meet on the blocks between them, and 54 % of the groups clash. Visited lane by lane, those
+lanes formed one chain of dependent visits (19 ns per contact·sweep on its steps against 7.9 for the
+4-run scalar sweep); split by colour, a group takes two vector visits (lanes 0, 2, 4, 6 and 1, 3, 5, 7).
+The last groups have fewer than 8 lanes when C is not a multiple of 8 (lane q is present when
+q·run + j < C).
 
 Data layout (AoSoA): group j's values are ROWS rows of 8 doubles, lane q's value of row ``row`` at
 ``(j · ROWS + row) · 8 + q``, so that every vector load and store of the visit is one contiguous 64-byte
@@ -47,49 +54,67 @@ def _moves(pack, c, side):
 
 
 @njit(inline="always")
-def _groups(contact_body, pack, count, run, gmask, clash):
-    # For each group j: gmask[j] = its lanes (bit q: contact q·run + j exists), clash[j] = two of its
-    # contacts move one body (then visited lane by lane). Pairs of lanes compared directly: 28 pairs of
-    # 4 bodies, cheaper than marking bodies in a table the size of the model.
+def _groups(contact_body, pack, count, run, bodies, sub, nsub):
+    # For each group j, its sub-groups (module doc): sub[j, k] = lane mask of sub-group k < nsub[j].
+    #   in[body] = the sub-groups of group j holding a lane that moves body (valid while seen[body] = j)
+    #   for each lane q present (contact q·run + j < C), in lane order:
+    #       k = the lowest sub-group holding none of the bodies q moves (greedy colouring; k = 0 unless
+    #           the group clashes); sub[j, k] |= bit q; in[each body q moves] |= bit k
+    # Bitmasks per body rather than comparing the 28 pairs of lanes: the pairs took 145 µs a step on the
+    # 248-block wall (whose sweeps take ~600 µs a step), the masks ~5.
+    seen = np.empty(bodies, np.int64)
+    held = np.empty(bodies, np.int64)
+    for b in range(bodies):
+        seen[b] = -1
     for j in range(run):
-        m = 0
-        hit = False
+        n = 0
         for q in range(W):
-            cx = q * run + j
-            if cx >= count:
+            c = q * run + j
+            if c >= count:
                 break
-            m |= 1 << q
-            for p in range(q):
-                cy = p * run + j
-                for sx in range(2):
-                    if not _moves(pack, cx, sx):
-                        continue
-                    for sy in range(2):
-                        if _moves(pack, cy, sy) and contact_body[cx, sx] == contact_body[cy, sy]:
-                            hit = True
-        gmask[j] = m
-        clash[j] = hit
+            busy = 0
+            for side in range(2):
+                b = contact_body[c, side]
+                if _moves(pack, c, side) and seen[b] == j:
+                    busy |= held[b]
+            k = 0
+            while busy >> k & 1:
+                k += 1
+            if k == n:
+                sub[j, k] = 0
+                n += 1
+            sub[j, k] |= 1 << q
+            for side in range(2):
+                b = contact_body[c, side]
+                if _moves(pack, c, side):
+                    if seen[b] != j:
+                        seen[b] = j
+                        held[b] = 0
+                    held[b] |= 1 << k
+        nsub[j] = n
 
 
 @njit(inline="always")
 def pack_lanes(contact_body, pack, count, v, r):
     # The first stage's arrays, in group order (module doc):
-    #   gmask, clash                        _groups
-    #   v ← v_free + M⁻¹ H r_warm           scalar pushes in visit order (nlgs._push: supports get ±0)
+    #   sub, nsub                           _groups
+    #   v ← v_free + M⁻¹ H r_warm           scalar pushes group by group in lane order (nlgs._push:
+    #                                       supports get ±0)
     #   Q[(j·ROWS + row)·8 + q]             pack row and r of contact q·run + j (r_prev = r)
     #   IA, IB [j·8 + q]                    offsets 4a, 4b of its bodies in v4 (0 in absent lanes)
     #   v4[4b … 4b + 2] = v[b], v4[4b + 3] = 0
-    # Returns (Q, IA, IB, gmask, clash, v4).
+    # Returns (Q, IA, IB, sub, nsub, v4).
     run = (count + W - 1) // W
-    gmask = np.empty(run, np.int64)
-    clash = np.empty(run, np.bool_)
-    _groups(contact_body, pack, count, run, gmask, clash)
-    for j in range(run):  # visit order: the reference sweeps push the warm start in it
+    sub = np.empty((run, W), np.int64)
+    nsub = np.empty(run, np.int64)
+    _groups(contact_body, pack, count, run, v.shape[0], sub, nsub)
+    for j in range(run):  # the order of the lab's lane sweeps (simd_lanes), whose bits these are
         for q in range(W):
             c = q * run + j
             if c >= count:
                 break
-            _push(v, contact_body[c, 0], contact_body[c, 1], pack, np.uint64(c), r[c, 0], r[c, 1])
+            # unsigned as the sweeps' calls (interleaved.py's rows): one compiled _push serves all of them
+            _push(v, np.uint32(contact_body[c, 0]), np.uint32(contact_body[c, 1]), pack, np.uint64(c), r[c, 0], r[c, 1])
     # np.empty and a fill, not np.zeros (_jit's rule): np.zeros compiled 2 signatures and a fill of its own,
     # 0.1 s of a first run's CPU (benchmarks/README.md, "Cold start"); absent lanes keep these zeros
     Q = np.empty(run * ROWS * W, np.float64)
@@ -119,7 +144,7 @@ def pack_lanes(contact_body, pack, count, v, r):
         v4[4 * b + 1] = v[b, 1]
         v4[4 * b + 2] = v[b, 2]
         v4[4 * b + 3] = 0.0
-    return Q, IA, IB, gmask, clash, v4
+    return Q, IA, IB, sub, nsub, v4
 
 
 @njit(inline="always")
