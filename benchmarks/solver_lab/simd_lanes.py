@@ -66,56 +66,12 @@ from benchmarks.solver_lab.simd_sweep import (
 from masonrycli.engine import _vector as V
 from masonrycli.engine import momentum
 from masonrycli.engine._jit import njit
-from masonrycli.engine.nlgs import STATUS_OPEN, STATUS_SLIP, STATUS_STICK
+from masonrycli.engine.lane_sweeps import _local_solve_v  # the engine's, which this lab code became
 
 W = V.WIDTH
 R_XT, R_XN, R_PT, R_PN, R_ST = K_ROWS, K_ROWS + 1, K_ROWS + 2, K_ROWS + 3, K_ROWS + 4
 ROWS = K_ROWS + 5
 FULL = (1 << W) - 1
-
-
-@njit(inline="always")
-def _local_solve_v(ut, un, bias, wtt, wtn, wnn, itt, itn, inn, isp, ism, mu):
-    # simd_sweep._local_solve_bf on vectors, line for line (the same operations, in the same order, on
-    # the same operands): all candidates in all lanes, then the first valid one in _local_solve's order;
-    # only the fallback, which no lane selects unless its W is singular, is skipped when none does.
-    zero = V.splat(0.0)
-    target = -bias - un
-    rts = -itt * ut + itn * target
-    rns = -itn * ut + inn * target
-    stick = (inn > zero) & (rns >= zero) & (V.vabs(rts) <= mu * rns)
-    rnp = target * isp
-    rtp = -mu * rnp
-    okp = (isp > zero) & (ut + wtt * rtp + wtn * rnp >= zero)
-    rnm = target * ism
-    rtm = mu * rnm
-    okm = (ism > zero) & (-(ut + wtt * rtm + wtn * rnm) >= zero)
-    is_open = un + bias >= zero
-    if V.bits_of(~(is_open | stick | okp | okm)) != 0:  # a lane takes the fallback (a singular W)
-        rnf = target / wnn
-        rtf = -ut / wtt
-        lim = mu * rnf
-        rtf = V.select(rtf > lim, lim, V.select(rtf < -lim, -lim, rtf))
-    else:  # no lane selects it: its two divisions skipped
-        rnf = zero
-        rtf = zero
-    pos = ut >= zero
-    neg = ~pos
-    first_ok = (pos & okp) | (neg & okm)
-    second_ok = (pos & okm) | (neg & okp)
-    rt1 = V.select(pos, rtp, rtm)
-    rn1 = V.select(pos, rnp, rnm)
-    rt2 = V.select(pos, rtm, rtp)
-    rn2 = V.select(pos, rnm, rnp)
-    rt = V.select(first_ok, rt1, V.select(second_ok, rt2, rtf))
-    rn = V.select(first_ok, rn1, V.select(second_ok, rn2, rnf))
-    rt = V.select(stick, rts, rt)
-    rn = V.select(stick, rns, rn)
-    st = V.select(stick, V.splat(STATUS_STICK), V.splat(STATUS_SLIP))
-    rt = V.select(is_open, zero, rt)
-    rn = V.select(is_open, zero, rn)
-    st = V.select(is_open, V.splat(STATUS_OPEN), st)
-    return rt, rn, st
 
 
 @njit(inline="always")
