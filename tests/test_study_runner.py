@@ -293,10 +293,12 @@ def test_a_ctrl_c_dropped_inside_numbas_compiler_stops_a_serial_study(failed, mo
     assert "Traceback" not in capfd.readouterr().err
 
 
-def test_a_sigterm_while_the_local_cluster_starts_stops_once_it_is_up_and_closes_it(monkeypatch):
+@pytest.mark.parametrize("sig", ["SIGINT", "SIGTERM"])
+def test_a_signal_while_the_local_cluster_starts_stops_once_it_is_up_and_closes_it(monkeypatch, sig):
     # walk-through 2026-11-28: SIGTERM 0.8-1.2 s into `masonry sweep` raised inside the half-started LocalCluster;
     # "interrupted (SIGTERM): …" was followed by a traceback of distributed's exit hook (AssertionError:
-    # Status.init). Now the start finishes, the signal is raised then, and the cluster is closed.
+    # Status.init). Now the start finishes, the signal is raised then, and the cluster is closed. A Ctrl-C
+    # there was lost (SIGINT ignored by the whole process): now it goes the same way.
     import os
     import signal
     import time
@@ -306,11 +308,14 @@ def test_a_sigterm_while_the_local_cluster_starts_stops_once_it_is_up_and_closes
     from masonrycli.interrupt import FirstSignalStops
 
     seen = {}
+    signum = signal.Signals[sig]
 
     class Cluster:
         def __init__(self, **kwargs):
-            seen["sigint"] = signal.getsignal(signal.SIGINT)  # what the worker processes inherit
-            os.kill(os.getpid(), signal.SIGTERM)
+            seen["sigint"] = signal.getsignal(signal.SIGINT)
+            seen["blocked"] = signal.SIGINT in signal.pthread_sigmask(signal.SIG_BLOCK, set())  # for the workers
+            seen["preload"] = kwargs["preload"]
+            os.kill(os.getpid(), signum)
             time.sleep(0.2)  # a handler would run here
             seen["started"] = True
 
@@ -323,8 +328,23 @@ def test_a_sigterm_while_the_local_cluster_starts_stops_once_it_is_up_and_closes
         with FirstSignalStops() as signals:
             with pytest.raises(KeyboardInterrupt):
                 runner.open_cluster(None, 2)
-            assert signals.stopping() == signal.SIGTERM
+            assert signals.stopping() == signum
+            assert signal.SIGINT not in signal.pthread_sigmask(signal.SIG_BLOCK, set())  # unblocked again
     finally:
         for s, handler in before.items():
             signal.signal(s, handler)
-    assert seen == {"sigint": signal.SIG_IGN, "started": True, "closed": True}
+    assert seen.pop("sigint") not in (signal.SIG_IGN, signal.SIG_DFL, signal.default_int_handler)
+    assert seen == {"blocked": True, "preload": ["masonrycli.study.runner"], "started": True, "closed": True}
+
+
+def test_a_worker_process_ignores_sigint_from_its_start():
+    # dask_setup runs in each worker process of a study's LocalCluster (a preload): a terminal's Ctrl-C
+    # reaches them too, and is the command's to act on
+    import signal
+
+    before = signal.getsignal(signal.SIGINT)
+    try:
+        runner.dask_setup(None)
+        assert signal.getsignal(signal.SIGINT) == signal.SIG_IGN
+    finally:
+        signal.signal(signal.SIGINT, before)

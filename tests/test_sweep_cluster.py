@@ -265,6 +265,65 @@ def test_sigterm_on_a_study_writes_the_finished_rows_and_exits_143(tmp_path):
     assert 1 <= len(_read_csv(out)) < 6
 
 
+# The command, with a thread that signals once the first worker process exists: mid-start, that worker
+# still importing Python's modules. SIGINT goes to the whole process group (a terminal's Ctrl-C).
+_SIGNAL_AT_THE_START = """
+import multiprocessing, os, signal, sys, threading, time
+import distributed
+from masonrycli.__main__ import main
+
+SIG = signal.Signals[sys.argv[1]]
+
+class Cluster(distributed.LocalCluster):
+    def __init__(self, *args, **kwargs):
+        def signal_the_start():
+            while not multiprocessing.active_children():
+                time.sleep(0.002)
+            if SIG == signal.SIGINT:
+                os.killpg(0, SIG)
+            else:
+                os.kill(os.getpid(), SIG)
+            print("signalled", flush=True)
+        threading.Thread(target=signal_the_start, daemon=True).start()
+        super().__init__(*args, **kwargs)
+
+distributed.LocalCluster = Cluster
+sys.argv = ["masonry", *sys.argv[2:]]
+main()
+"""
+
+
+@pytest.mark.parametrize("sig", ["SIGINT", "SIGTERM"])
+def test_a_signal_while_the_local_cluster_starts_stops_the_study(tmp_path, sig):
+    # walk-through 2026-11-28: a Ctrl-C while the LocalCluster started (0.8-1.2 s into the command) was
+    # lost, SIGINT being ignored by the whole process for the workers to inherit: the study ran, exit 0.
+    out = tmp_path / "study.csv"
+    sweep = [sys.executable, "-c", _SIGNAL_AT_THE_START, sig, "sweep", "wall", "--param", "blocks=12"]
+    sweep += ["--duration", "5", "--param", "amp=0.1:0.25:6", "--workers", "2", "--out", out, "--no-recording"]
+    log = tmp_path / "sweep.log"
+    proc = subprocess.Popen(
+        sweep,
+        stdout=open(log, "w"),
+        stderr=subprocess.STDOUT,
+        env=ENV,
+        start_new_session=True,
+        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),  # as in a terminal, whoever runs pytest
+    )
+    try:
+        assert proc.wait(timeout=120) == (130 if sig == "SIGINT" else 143), _tails({proc: log})
+    finally:
+        _kill(proc)
+    lines = [ln for ln in log.read_text().splitlines() if ln.strip()]
+    how = "" if sig == "SIGINT" else " (SIGTERM)"
+    assert (
+        lines[0] == "signalled"
+        and lines[-1] == f"interrupted{how}: stopped before any row was finished; nothing was written"
+    )
+    # nor did a worker take the Ctrl-C: no KeyboardInterrupt traceback from one still starting
+    assert len(lines) == 2, lines
+    assert not out.exists() and not _journal_rows(out)
+
+
 def _other_masonry(tmp_path: Path) -> Path:
     """A folder holding a masonry of another release (version 0.0.9, no code), for a worker's path."""
     other = tmp_path / "other"

@@ -29,6 +29,7 @@ import signal
 import threading
 from collections import deque
 from collections.abc import Callable
+from multiprocessing import resource_tracker
 
 from masonrycli.errors import InputError
 from masonrycli.study.task import empty_result, run_task
@@ -75,16 +76,22 @@ def open_cluster(scheduler: str | None, workers: int | None, runs: int | None = 
     # ":0": the scheduler's HTTP endpoints (it serves them even without a dashboard) on a free port, so
     # two studies at once do not fight over 8787
     # Ctrl-C reaches the terminal's whole process group: a worker process that took it printed a
-    # KeyboardInterrupt traceback each. Started with SIGINT ignored (kept across exec), the workers leave
-    # the interrupt to this process, which closes the cluster (_WhileWorkersStart).
+    # KeyboardInterrupt traceback each. The workers ignore SIGINT themselves (dask_setup below, run in each
+    # at its start) and start with it blocked (_WhileWorkersStart), so this process keeps its own handler:
+    # it closes the cluster on a Ctrl-C, one of the start too.
     held = _WhileWorkersStart()
-    with held:
-        cluster = LocalCluster(
-            n_workers=n, threads_per_worker=1, processes=True, dashboard_address=":0", silence_logs=logging.ERROR
-        )
-    client = None
-    try:
-        held.deliver()  # a SIGTERM of the start stops the command now, the cluster closed below
+    cluster = client = None
+    try:  # the start inside: a signal on the way out of `with held` raises with the cluster known, and closed
+        with held:
+            cluster = LocalCluster(
+                n_workers=n,
+                threads_per_worker=1,
+                processes=True,
+                dashboard_address=":0",
+                silence_logs=logging.ERROR,
+                preload=[__name__],
+            )
+        held.deliver()  # a Ctrl-C or SIGTERM of the start stops the command now, the cluster closed below
         client = Client(cluster)
         # A worker process's logs are teardown noise under the one-line "interrupted" message: one whose
         # heartbeat met the closing scheduler printed "Failed to communicate with scheduler during heartbeat"
@@ -94,44 +101,66 @@ def open_cluster(scheduler: str | None, workers: int | None, runs: int | None = 
     except BaseException:
         if client is not None:
             client.close()
-        cluster.close()
+        if cluster is not None:
+            cluster.close()
         raise
     return client, cluster
 
 
 class _WhileWorkersStart:
-    """Around a LocalCluster's start: SIGINT ignored, for the worker processes to inherit (a Ctrl-C of those
-    seconds is lost: the disposition is the process's, and no thread of it can keep the signal for later —
-    README, known limits); SIGTERM noted, and :meth:`deliver` raises it again once the cluster is up, where
-    closing it works. Before, a SIGTERM raised inside the half-started cluster, whose exit hook then printed a
-    traceback (AssertionError: Status.init) under the "interrupted (SIGTERM)" line. Outside the main thread
-    (no signal handlers there) it does nothing."""
+    """Around a LocalCluster's start: SIGINT and SIGTERM noted, and :meth:`deliver` raises the first again
+    once the cluster is up, where closing it works (a signal raised inside the half-started cluster made
+    its exit hook print a traceback, AssertionError: Status.init, under the "interrupted" line). SIGINT is
+    also blocked in this thread, and so in the threads the start creates, which spawn the worker processes:
+    a process starts with its parent thread's mask (kept across exec), so a Ctrl-C of a worker's first second,
+    before its :func:`dask_setup` ignores SIGINT, stays pending there instead of a KeyboardInterrupt
+    traceback. This process still takes the signal: a thread from before the start takes it for the handler
+    (Python runs it in the main thread), or it waits until the main thread unblocks it on the way out.
+
+    Before, SIGINT was ignored here instead, for the workers to inherit; but a disposition is the whole
+    process's, and a Ctrl-C of those 0.6 s was lost: the study ran to exit 0 (walk-through 2026-11-28).
+    Outside the main thread (no signal handlers there) it does nothing."""
 
     def __init__(self) -> None:
         self.main = threading.current_thread() is threading.main_thread()
-        self.terminated = False
+        self.signum: int | None = None
 
     def __enter__(self):
         if self.main:
-            self._sigint = signal.signal(signal.SIGINT, signal.SIG_IGN)
-            self._sigterm = signal.signal(signal.SIGTERM, self._note)
+            # multiprocessing's resource tracker, started by the first worker's queues, unblocks SIGINT in
+            # the thread that starts it (the cluster's IO loop, whose threads spawn the workers): started
+            # here first, it is only reused there
+            resource_tracker.ensure_running()
+            self._previous = {sig: signal.signal(sig, self._note) for sig in (signal.SIGINT, signal.SIGTERM)}
+            self._mask = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
         return self
 
-    def _note(self, _signum, _frame) -> None:
-        self.terminated = True
+    def _note(self, signum, _frame) -> None:
+        if self.signum is None:
+            self.signum = signum
 
     def __exit__(self, *exc) -> None:
         if self.main:
-            signal.signal(signal.SIGINT, self._sigint)
-            signal.signal(signal.SIGTERM, self._sigterm)
-            if exc[0] is not None:  # the start failed: its error goes on, a noted SIGTERM after it
+            # a pending Ctrl-C runs _note inside this call (pthread_sigmask runs the handlers it unblocked)
+            signal.pthread_sigmask(signal.SIG_SETMASK, self._mask)
+            for sig, handler in self._previous.items():
+                signal.signal(sig, handler)
+            if exc[0] is not None:  # the start failed: its error goes on, a noted signal after it
                 self.deliver()
 
     def deliver(self) -> None:
-        """Raise a noted SIGTERM again: the command's own handler takes it now."""
-        if self.terminated:
-            self.terminated = False
-            signal.raise_signal(signal.SIGTERM)
+        """Raise a noted signal again: the command's own handler takes it now."""
+        if self.signum is not None:
+            signum, self.signum = self.signum, None
+            signal.raise_signal(signum)
+
+
+def dask_setup(worker) -> None:
+    """Run by each worker process of a study's LocalCluster as it starts (a Dask preload): SIGINT ignored,
+    so a Ctrl-C in the terminal is left to the command, which closes the cluster (:func:`open_cluster`).
+    Setting SIG_IGN also drops a Ctrl-C that waited, blocked, for this moment."""
+    if threading.current_thread() is threading.main_thread():
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
 
 
 def quiet_worker_logs() -> None:
