@@ -4,10 +4,15 @@ Logged when the recorder closes: the default factor m (``masonrycli.joint_forces
 the largest displacement of the run. Only outlines (line strips), the initial frame (t = 0), every
 ``MAGNIFIED_EVERY``-th computed frame and the last: the mechanism reads as well at half the frame rate, for
 half the bytes.
+
+Until then the poses wait on disk (:class:`PoseSpool`), not in memory: a run of a million frames would
+otherwise hold them all (~0.8 kB a frame for the 51-block wall) until it ends.
 """
 
 from __future__ import annotations
 
+import os
+import tempfile
 from typing import Final
 
 import numpy as np
@@ -21,33 +26,88 @@ from masonrycli.recording.layout import MAGNIFIED
 MAGNIFIED_EVERY: Final = 2
 
 
+class PoseSpool:
+    """Every frame's (step, time, block_q, support_q), float32 poses, appended to an anonymous temporary file
+    in ``folder`` (the output's: the same disk): ``tempfile.TemporaryFile`` has no name on Linux (O_TMPFILE;
+    elsewhere it is unlinked at once or on close), so nothing is left behind whatever ends the process —
+    close, Ctrl-C, SIGTERM or SIGKILL. RAM held: the file object's write buffer, whatever the frame count."""
+
+    def __init__(self, folder: str, n_blocks: int, n_supports: int) -> None:
+        self.dtype = np.dtype(
+            [("step", "<i8"), ("time", "<f8"), ("q", "<f4", (n_blocks, 3)), ("sq", "<f4", (n_supports, 3))]
+        )
+        self.count = 0
+        self._file = tempfile.TemporaryFile(dir=folder, prefix=".masonry-poses-")
+
+    def append(self, step: int, time_s: float, q: np.ndarray, sq: np.ndarray) -> None:
+        row = np.empty((), self.dtype)
+        row["step"], row["time"], row["q"], row["sq"] = step, time_s, q, sq
+        self._file.write(row.tobytes())
+        self.count += 1
+
+    def read(self, first: int, stop: int) -> np.ndarray:
+        """Rows ``first`` to ``stop`` (excluded), a structured array in memory."""
+        self._file.flush()
+        size = self.dtype.itemsize
+        data = os.pread(self._file.fileno(), (stop - first) * size, first * size)
+        return np.frombuffer(data, self.dtype)
+
+    def close(self) -> None:
+        self._file.close()
+
+
+def selected(count: int, first_step: int) -> tuple[int, int]:
+    """(initial, n_mid) of the frames drawn among ``count``: the initial pose (step 0, as built) if it opens
+    the run and is not its only frame, every ``MAGNIFIED_EVERY``-th computed frame before the last, the last."""
+    initial = 1 if count > 1 and first_step == 0 else 0
+    return initial, len(range(initial, count - 1, MAGNIFIED_EVERY))
+
+
+def _chunks(spool: PoseSpool, batch_frames: int):
+    """The drawn frames of ``spool``, ``batch_frames`` at a time, each chunk read from disk on its own."""
+    n = spool.count
+    if n == 0:
+        return
+    initial, n_mid = selected(n, int(spool.read(0, 1)["step"][0]))
+    total = initial + n_mid + 1
+    for start in range(0, total, batch_frames):
+        k = np.arange(start, min(start + batch_frames, total))
+        rows = np.where(k < initial, k, np.where(k < initial + n_mid, initial + MAGNIFIED_EVERY * (k - initial), n - 1))
+        lo = int(rows[0])
+        yield spool.read(lo, int(rows[-1]) + 1)[rows - lo]
+
+
 def send_magnified(
     rec: rr.RecordingStream,
     blocks: Polygons,
     supports: Polygons,
-    poses: list[tuple[int, float, np.ndarray, np.ndarray]],
+    poses: PoseSpool,
     ref: tuple[np.ndarray, np.ndarray],
     magnify: float | None,
     size: float,
     batch_frames: int,
 ) -> float:
-    """Send the magnified outlines of ``poses`` (step, time, block_q, support_q per frame) about ``ref``
-    (the first block_q, support_q); returns the factor used (``magnify``, or the default for ``size`` m)."""
+    """Send the magnified outlines of the frames in ``poses`` about ``ref`` (the first block_q, support_q);
+    returns the factor used (``magnify``, or the default for ``size`` m)."""
     ref_q, ref_sq = ref
-    # the initial pose (step 0, as built), then every other computed frame as before it was recorded
-    initial = 1 if len(poses) > 1 and poses[0][0] == 0 else 0
-    poses = poses[:initial] + poses[initial:-1][::MAGNIFIED_EVERY] + poses[-1:]
-    q = np.stack([p[2] for p in poses]).astype(np.float64)
-    sq = np.stack([p[3] for p in poses]).astype(np.float64)
-    m = magnification(q[..., :2] - ref_q[None, :, :2], size) if magnify is None else float(magnify)
-    for start in range(0, len(q), batch_frames):
-        part = slice(start, start + batch_frames)
-        batch = FrameBatch(step=[p[0] for p in poses[part]], time=[p[1] for p in poses[part]])
-        n_frames = len(batch["step"])
-        sets = [blocks.outlines(blocks.world(ref_q + m * (q[part] - ref_q)))]
+    if magnify is None:  # one pass over the file: the displacement of largest norm, as a (1, 2) array
+        largest, norm2 = np.zeros((0, 2)), -1.0
+        for chunk in _chunks(poses, batch_frames):
+            d = (chunk["q"].astype(np.float64)[..., :2] - ref_q[None, :, :2]).reshape(-1, 2)
+            if d.size and (d2 := (d**2).sum(axis=1)).max() > norm2:  # sqrt is monotonic: the same maximum
+                k = int(np.argmax(d2))
+                largest, norm2 = d[k : k + 1], float(d2[k])
+        m = magnification(largest, size)
+    else:
+        m = float(magnify)
+    for chunk in _chunks(poses, batch_frames):
+        q, sq = chunk["q"].astype(np.float64), chunk["sq"].astype(np.float64)
+        batch = FrameBatch(step=chunk["step"].tolist(), time=chunk["time"].tolist())
+        n_frames = len(chunk)
+        sets = [blocks.outlines(blocks.world(ref_q + m * (q - ref_q)))]
         count = blocks.count
         if supports.count:
-            sets.append(supports.outlines(supports.world(ref_sq + m * (sq[part] - ref_sq))))
+            sets.append(supports.outlines(supports.world(ref_sq + m * (sq - ref_sq))))
             count += supports.count
         # frame by frame: that frame's blocks, then its supports
         strips = [arr.slice(k * (len(arr) // n_frames), len(arr) // n_frames) for k in range(n_frames) for arr in sets]

@@ -15,8 +15,10 @@ joints show) with one colour component per field (each view maps its own, ``layo
 point per block with its values (float32); the principal-axis glyphs; one resultant arrow per joint
 (``masonrycli.joint_forces``); hinges; each field's colour range and legend labels; the time series
 (energies, displacements, support motion: ``series``). Solver health (sweeps, residual, contacts) is
-logged for every step (``log_step``). The magnified deformed shape is logged when the recorder closes,
-when the largest displacement of the run is known.
+logged for every step (``log_step``), sent with the frames or every ``STEP_BATCH`` steps. The magnified
+deformed shape is logged when the recorder closes, when the largest displacement of the run is known; its
+poses wait in an anonymous temporary file until then (``magnified.PoseSpool``). Memory held does not grow
+with the run but for rerun's own index of the chunks written (the file's footer, per batch sent).
 
 Scales: colour ranges follow the data (``masonrycli.colour_range.RangeTracker``, checked every frame);
 the joint-resultant scale (``RESULTANT_LENGTH`` block heights for the 95th percentile resultant of the
@@ -69,7 +71,7 @@ from masonrycli.recording.layout import (
     build_blueprint,
     paper_figures,
 )
-from masonrycli.recording.magnified import send_magnified
+from masonrycli.recording.magnified import PoseSpool, send_magnified
 from masonrycli.recording.overlays import frame_joint_resultants, send_axes, send_joints
 from masonrycli.recording.readback import check_complete
 from masonrycli.recording.series import send_series, send_steps
@@ -87,6 +89,7 @@ from masonrycli.sinks import COMPLETED, FAILED, INTERRUPTED, RUNNING
 
 APPLICATION_ID: Final = "masonry"
 _RECORDING_NAMESPACE: Final = uuid.UUID("6f1c4f5e-9b0e-4c51-a0a6-3f0d6c1e2a77")
+STEP_BATCH: Final = 10_000  # steps' solver health buffered at most between sends (~2 MB)
 FLUSH_SECONDS: Final = 1.0  # s of wall-clock time between writes to the file, once the scales are fixed
 
 
@@ -162,7 +165,7 @@ class Recorder:
         self._frames, self._last = 0, None  # frames logged; (step, time) of the last one
         self._ref: tuple[np.ndarray, np.ndarray, float] | None = None  # first block_q, support_q, E_pot
         self._batch, self._steps = FrameBatch(), FrameBatch()
-        self._poses: list[tuple[int, float, np.ndarray, np.ndarray]] = []  # for the magnified view
+        self._poses: PoseSpool | None = None  # for the magnified view: on disk, not in RAM (its module doc)
         self.paper = paper_figures(self.metadata)
         meta_json = json.dumps(self.metadata, sort_keys=True, default=str)
         self.recording_id = str(uuid.uuid5(_RECORDING_NAMESPACE, meta_json))
@@ -193,6 +196,10 @@ class Recorder:
         s.add("step", int(step))
         s.add("time", float(time_s))
         s.add("values", (float(stats.iterations), float(stats.residual), float(stats.contact_count)))
+        if len(s["step"]) >= STEP_BATCH:  # many steps a frame (--record-every 10⁶): bounded all the same
+            self._steps = FrameBatch()
+            with _io_errors(self.path):
+                send_steps(self.rec, s, self._log10_tolerance)
 
     def on_frame(self, frame: Frame) -> None:
         """Buffer one frame (the :class:`~masonrycli.sinks.FrameSink` method); sends the buffer when it holds
@@ -214,6 +221,9 @@ class Recorder:
             for f in FIELDS:
                 log_legend(self.rec, f, self._legend_box)
             self._label_anchors = legend_positions(self._legend_box).astype(np.float32)
+            folder = os.path.dirname(os.path.abspath(self.path))
+            with _io_errors(self.path):
+                self._poses = PoseSpool(folder, self._n, self._supports.count)
         b = self._batch
         b.add("step", int(frame.step))
         b.add("time", float(frame.time))
@@ -226,7 +236,7 @@ class Recorder:
         b.add("hinge_point", np.asarray(getattr(frame, "hinge_point", np.zeros((0, 2))), f64).reshape(-1, 2))
         for key in TENSOR_KEYS:
             b.add(key, _tensor(frame.tensors, key, self._n))
-        self._poses.append((int(frame.step), float(frame.time), q.astype(np.float32), sq.astype(np.float32)))
+        self._poses.append(int(frame.step), float(frame.time), q, sq)  # float32 on disk, as they were kept
         self._last = (int(frame.step), float(frame.time))
         self._frames += 1
         due = time.perf_counter() - self._flushed >= FLUSH_SECONDS and self._scales_fixed()
@@ -276,6 +286,8 @@ class Recorder:
                 self._log_metadata(status, note)
                 self._send_final_layout()
             finally:
+                if self._poses is not None:
+                    self._poses.close()
                 self.rec.disconnect()
         check_complete(self.path)
         if error is not None:
@@ -398,7 +410,7 @@ class Recorder:
         send_joints(self.rec, idx, b, self.force_scale)
 
     def _send_magnified(self) -> None:
-        if self._poses and self._ref is not None:
+        if self._poses is not None and self._poses.count and self._ref is not None:
             self.magnify = send_magnified(
                 self.rec,
                 self._blocks,

@@ -1,0 +1,108 @@
+"""The recorder's memory does not grow with the run: the magnified view's poses wait in an anonymous file,
+the steps' solver health is sent every ``STEP_BATCH`` steps; the magnified rows are those of every frame
+kept in memory (restated here), also for an interrupted run."""
+
+from __future__ import annotations
+
+import dataclasses
+import gc
+import os
+import tracemalloc
+
+import numpy as np
+import pytest
+
+import masonrycli.recording.recorder as recorder
+from masonrycli.joint_forces import magnification
+from masonrycli.recording import Recorder
+
+import recording_fixtures as fx
+from recording_fixtures import strict_rerun, temporal_rows  # noqa: F401 (strict_rerun: autouse)
+
+MAGNIFIED = "/structure/plane/xy/magnified"
+
+
+class _Stats:
+    iterations, residual, contact_count = 3, 1e-6, 7
+
+
+@pytest.fixture(scope="module")
+def wall():
+    return fx.wall()
+
+
+def _traced_after(rec: Recorder, frames: list, start: int, count: int) -> int:
+    for i in range(start, start + count):
+        rec.log_frame(dataclasses.replace(frames[i % len(frames)], step=10 * i, time=1e-2 * i))
+    gc.collect()
+    return tracemalloc.get_traced_memory()[0]
+
+
+def test_memory_held_per_frame_and_per_step_does_not_grow(wall, tmp_path):
+    """Python memory held by the recorder, N frames then 4N: was ~600 bytes a frame (each frame's poses kept
+    for the magnified view, 15 blocks) and ~190 bytes a step (solver health buffered until the next frame)."""
+    static, q0 = wall
+    frames = fx.frames(static, q0, 20)
+    rec = Recorder(tmp_path / "x.rrd", static, fx.METADATA, batch_frames=50)
+    tracemalloc.start()
+    try:
+        first = _traced_after(rec, frames, 0, 401)  # past the first batches (scales fixed)
+        later = _traced_after(rec, frames, 401, 1200)
+        for i in range(recorder.STEP_BATCH):
+            rec.log_step(i, 1e-3 * i, _Stats)
+        steps_first = tracemalloc.get_traced_memory()[0]
+        for i in range(recorder.STEP_BATCH, 5 * recorder.STEP_BATCH):
+            rec.log_step(i, 1e-3 * i, _Stats)
+        steps_later = tracemalloc.get_traced_memory()[0]
+    finally:
+        tracemalloc.stop()
+        rec.close()
+    assert (later - first) / 1200 < 60, f"{(later - first) / 1200:.0f} bytes a frame"
+    assert (steps_later - steps_first) / (4 * recorder.STEP_BATCH) < 10
+    assert os.listdir(tmp_path) == ["x.rrd"]
+
+
+@pytest.mark.parametrize("interrupted", [False, True])
+def test_magnified_rows_are_every_frame_kept_in_memory(wall, tmp_path, monkeypatch, interrupted):
+    """The initial frame, every other computed frame and the last, magnified by the factor of their largest
+    displacement, as the recorder drew them when it held every pose (float32) in a list; no file but the
+    recording in the output's folder, during the run (the spool has no name) and after it."""
+    static, q0 = wall
+    monkeypatch.setattr(recorder, "STEP_BATCH", 7)  # steps sent on their own too: the same rows
+    frames = fx.frames(static, q0, 26)
+    path = tmp_path / "m.rrd"
+    with pytest.raises(KeyboardInterrupt) if interrupted else _no_error():
+        with Recorder(path, static, fx.METADATA, batch_frames=4) as rec:
+            for f in frames:
+                rec.log_frame(f)
+                rec.log_step(f.step, f.time, _Stats)
+            assert os.listdir(tmp_path) == ["m.rrd"]
+            if interrupted:
+                raise KeyboardInterrupt
+    assert os.listdir(tmp_path) == ["m.rrd"]
+    kept = [frames[0], *frames[1:-1][::2], frames[-1]]
+    ref = frames[0].block_q
+    q = [np.asarray(f.block_q, np.float32).astype(np.float64) for f in kept]
+    m = magnification(
+        np.stack(q)[..., :2] - ref[None, :, :2], rec._size
+    )  # the structure's size, as the recorder took it
+    assert rec.magnify == m
+    rows = temporal_rows(path, MAGNIFIED, "LineStrips2D:strips")
+    assert sorted(rows) == [f.step for f in kept]
+    for f, qf in zip(kept, q):
+        drawn = ref + m * (qf - ref)
+        for b in (0, len(static.block_name) - 1):
+            s, e = static.block_vert_start[b], static.block_vert_start[b + 1]
+            c, sn = np.cos(drawn[b, 2]), np.sin(drawn[b, 2])
+            outline = drawn[b, :2] + static.block_vert_local[s:e] @ np.array([[c, -sn], [sn, c]]).T
+            np.testing.assert_allclose(np.array(rows[f.step][b])[:-1], outline, rtol=0, atol=1e-6)
+    residual = temporal_rows(path, "/series/solver/log10_residual", "Scalars:scalars")
+    assert sorted(residual) == [f.step for f in frames]
+
+
+class _no_error:
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        return False
