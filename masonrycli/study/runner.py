@@ -58,7 +58,13 @@ def open_cluster(scheduler: str | None, workers: int | None, runs: int | None = 
     """``(client, cluster)``: a client of ``scheduler``, or of a new LocalCluster (then also returned,
     to be closed by the caller) with ``workers`` processes (default: one per core), at most ``runs`` (the
     runs that can go at once): "-p amp=0.1,0.2 --workers 4" started 4 processes of ~200 MB, 2 of them idle."""
-    from distributed import Client, LocalCluster
+    # distributed's first import defines its dataclasses by exec(): a KeyboardInterrupt raised inside one,
+    # even caught, made `python -m masonrycli` exit -2 after the stop line (CPython 3.11 flags it as unhandled;
+    # 2 in 24 Ctrl-Cs 0.45-0.6 s in). Held over the import, the signal is raised after it.
+    importing = _WhileWorkersStart(spawning=False)
+    with importing:
+        from distributed import Client, LocalCluster
+    importing.deliver()
 
     if scheduler:
         from masonrycli.study.versions import check_workers
@@ -121,18 +127,20 @@ class _WhileWorkersStart:
     process's, and a Ctrl-C of those 0.6 s was lost: the study ran to exit 0 (walk-through 2026-11-28).
     Outside the main thread (no signal handlers there) it does nothing."""
 
-    def __init__(self) -> None:
+    def __init__(self, spawning: bool = True) -> None:
         self.main = threading.current_thread() is threading.main_thread()
+        self.spawning = spawning  # False: the signals noted only (no process is started in the block)
         self.signum: int | None = None
 
     def __enter__(self):
         if self.main:
-            # multiprocessing's resource tracker, started by the first worker's queues, unblocks SIGINT in
-            # the thread that starts it (the cluster's IO loop, whose threads spawn the workers): started
-            # here first, it is only reused there
-            resource_tracker.ensure_running()
+            if self.spawning:
+                # multiprocessing's resource tracker, started by the first worker's queues, unblocks SIGINT
+                # in the thread that starts it (the cluster's IO loop, whose threads spawn the workers):
+                # started here first, it is only reused there
+                resource_tracker.ensure_running()
             self._previous = {sig: signal.signal(sig, self._note) for sig in (signal.SIGINT, signal.SIGTERM)}
-            self._mask = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+            self._mask = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT} if self.spawning else set())
         return self
 
     def _note(self, signum, _frame) -> None:
