@@ -123,3 +123,23 @@ class _no_error:
 
     def __exit__(self, *exc):
         return False
+
+
+def test_a_full_disk_under_the_spool_still_leaves_a_complete_recording(wall, tmp_path, monkeypatch):
+    """The poses' file is written on the output's disk: a write failing there (ENOSPC when its buffer goes
+    out at close) stops the run as an output failure, and the recording still gets its footer."""
+    from masonrycli.recording.magnified import PoseSpool
+    from masonrycli.recording.readback import inspect_recording
+
+    def full(self, first, stop):
+        raise OSError(28, "No space left on device")
+
+    monkeypatch.setattr(PoseSpool, "read", full)
+    monkeypatch.setattr(PoseSpool, "close", lambda self: full(self, 0, 0))
+    static, q0 = wall
+    path = tmp_path / "full.rrd"
+    with pytest.raises(OSError, match="No space left"):
+        with Recorder(path, static, fx.METADATA, batch_frames=4) as rec:
+            for f in fx.frames(static, q0, 9):
+                rec.log_frame(f)
+    assert inspect_recording(path)["complete"]

@@ -286,9 +286,10 @@ class Recorder:
                 self._log_metadata(status, note)
                 self._send_final_layout()
             finally:
-                if self._poses is not None:
-                    self._poses.close()
                 self.rec.disconnect()
+                if self._poses is not None:  # after the footer: a full disk here must not cost the file
+                    with contextlib.suppress(OSError):
+                        self._poses.close()
         check_complete(self.path)
         if error is not None:
             if status == COMPLETED:
