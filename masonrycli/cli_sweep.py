@@ -190,7 +190,12 @@ def sweep_command(
             result = run_study(plan.base, plan.request, console)
             _report(console, result, plan, im, written, signals)
             _exit_for_failed_rows(result, err_console)
-        except KeyboardInterrupt:
+        except (KeyboardInterrupt, Exception) as exc:
+            if not isinstance(exc, KeyboardInterrupt) and not signals.raised():
+                raise  # an error of its own (a rename that failed while a signal was held): said as such
+            # An error after the first signal is the KeyboardInterrupt that its handler raised, replaced by the
+            # code it landed in: numpy's structured comparison (np.unique in a block's polygon check) made it
+            # "TypeError: Cannot compare structured arrays", a traceback and exit 1 (1 in ~100 Ctrl-Cs 0.7 s in).
             signum = signals.stopping()
             how = "" if signum == signal.SIGINT else f" ({signal_name(signum)})"
             if result is None and not (out.exists() or store.journal_path(out).exists()):

@@ -195,6 +195,11 @@ class FirstSignalStops(_Handlers):
         else:
             super().__exit__(*exc)
 
+    def raised(self) -> bool:
+        """The first signal's handler raised its KeyboardInterrupt (it was not held): an error that comes out
+        instead is that interrupt, replaced by the code it landed in (``masonry sweep``)."""
+        return self._raised is not None
+
     def stopping(self) -> int:
         """The signal that stopped the command (SIGINT for a KeyboardInterrupt of other origin); from now
         on every signal is a repeat."""

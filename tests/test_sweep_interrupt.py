@@ -250,3 +250,39 @@ def test_a_signal_held_while_the_plot_s_rename_fails_reports_the_error(block, tm
     assert "interrupted" not in said and "Traceback" not in said
     assert len(read_rows(out)) == 2
     assert sorted(p.name for p in tmp_path.iterdir()) == ["block.toml", "s.csv"]  # no .s.png.<pid>.part
+
+
+def test_a_ctrl_c_that_code_turns_into_an_error_still_stops_the_study(block, tmp_path, monkeypatch):
+    # numpy's structured comparison (np.unique(..., axis=0) in a block's polygon check) replaced the handler's
+    # KeyboardInterrupt with "TypeError: Cannot compare structured arrays": a traceback, exit 1 (0.7 s in).
+    import os
+    import signal
+    import time
+
+    from masonrycli.study import study
+
+    def ctrl_c_replaced_by_an_error(*args):
+        try:
+            os.kill(os.getpid(), signal.SIGINT)
+            time.sleep(5)  # the handler raises here
+        except KeyboardInterrupt:
+            raise TypeError("Cannot compare structured arrays unless they have a common dtype.") from None
+        raise AssertionError("not stopped")
+
+    monkeypatch.setattr(study, "prepare", ctrl_c_replaced_by_an_error)
+    out = tmp_path / "s.csv"
+    result = invoke("sweep", block, "-p", "amp=0.05,0.1", "--duration", 0.02, "--workers", 0, "-o", out)
+    assert result.exit_code == 130, result.output
+    assert words(result.output).endswith("interrupted: stopped before any row was finished; nothing was written")
+    assert "Traceback" not in result.output and "TypeError" not in result.output
+
+
+def test_an_error_without_a_signal_is_not_taken_for_one(block, tmp_path, monkeypatch):
+    from masonrycli.study import study
+
+    def broken(*args):
+        raise TypeError("a bug")
+
+    monkeypatch.setattr(study, "prepare", broken)
+    result = invoke("sweep", block, "-p", "amp=0.05,0.1", "--duration", 0.02, "--workers", 0, "-o", tmp_path / "s.csv")
+    assert result.exit_code != 130 and isinstance(result.exception, TypeError), result.output
