@@ -55,8 +55,13 @@ def test_local_cluster_rows_equal_the_runs_made_one_by_one(tmp_path):
     assert {r["state"] for r in rows} >= {"damaged"} and set(rows[0]) == {"amp", "freq", *RESULT_COLUMNS, "study"}
 
 
-def _spawn(args, log: Path):
-    return subprocess.Popen(args, stdout=open(log, "w"), stderr=subprocess.STDOUT, env=ENV, start_new_session=True)
+def _spawn(args, log: Path, terminal: bool = False):
+    """Start ``args`` in a session of its own, output to ``log``; ``terminal``: with SIGINT at its default
+    as in a terminal, whoever runs pytest (a Ctrl-C is then sent to the group by ``os.killpg``)."""
+    preexec = (lambda: signal.signal(signal.SIGINT, signal.SIG_DFL)) if terminal else None
+    return subprocess.Popen(
+        args, stdout=open(log, "w"), stderr=subprocess.STDOUT, env=ENV, start_new_session=True, preexec_fn=preexec
+    )
 
 
 def _kill(proc, sig=signal.SIGKILL):
@@ -225,14 +230,7 @@ def test_ctrl_c_on_a_local_cluster_study_is_one_line(tmp_path):
     sweep = [sys.executable, "-m", "masonrycli", "sweep", "wall", "--param", "blocks=12", "--duration", "5"]
     sweep += ["--param", "amp=0.1:0.25:6", "--workers", "2", "--out", out, "--no-recording"]
     log = tmp_path / "sweep.log"
-    proc = subprocess.Popen(
-        sweep,
-        stdout=open(log, "w"),
-        stderr=subprocess.STDOUT,
-        env=ENV,
-        start_new_session=True,
-        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),  # as in a terminal, whoever runs pytest
-    )
+    proc = _spawn(sweep, log, terminal=True)
     try:
         _wait(lambda: len(_journal_rows(out)) >= 1, 240, "a finished row", {proc: log})
         os.killpg(proc.pid, signal.SIGINT)
@@ -301,14 +299,7 @@ def test_a_signal_while_the_local_cluster_starts_stops_the_study(tmp_path, sig):
     sweep = [sys.executable, "-c", _SIGNAL_AT_THE_START, sig, "sweep", "wall", "--param", "blocks=12"]
     sweep += ["--duration", "5", "--param", "amp=0.1:0.25:6", "--workers", "2", "--out", out, "--no-recording"]
     log = tmp_path / "sweep.log"
-    proc = subprocess.Popen(
-        sweep,
-        stdout=open(log, "w"),
-        stderr=subprocess.STDOUT,
-        env=ENV,
-        start_new_session=True,
-        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),  # as in a terminal, whoever runs pytest
-    )
+    proc = _spawn(sweep, log, terminal=True)
     try:
         assert proc.wait(timeout=120) == (130 if sig == "SIGINT" else 143), _tails({proc: log})
     finally:
