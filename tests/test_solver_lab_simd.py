@@ -5,19 +5,15 @@ colouring's definition checked by brute force, and the tight solve the lab's cap
 """
 
 import functools
-import os
-import subprocess
-import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
 from solver_lab_helpers import tiny_cold_problem
 from test_engine_nlgs import _packed_row, _random_problem, _stack_problem
 
-from benchmarks.solver_lab import law, simd_lanes, simd_sweep
+from benchmarks.solver_lab import law, simd_sweep
 from benchmarks.solver_lab.outcome import Context
-from masonrycli.engine import momentum, nlgs
+from masonrycli.engine import lanes, momentum, nlgs
 
 
 @pytest.fixture(scope="module")
@@ -221,13 +217,12 @@ def test_coloured_sweeps_are_momentum_gauss_seidel_in_colour_order(problem, swee
 
 
 def _lane_groups(body, pack, count, bodies):
-    # simd_lanes' group kinds: (full groups of 8, partial groups, split groups)
-    order, start = np.empty(count, np.int64), np.empty(count + 1, np.int64)
-    groups = simd_sweep.lanes(body, pack, count, bodies, order, start)
-    ia, ib, K, X = simd_sweep.sorted_arrays(body, pack, count, np.zeros((count, 2)), order)
-    _, _, gmask, clash = simd_lanes.pack_groups(count, order, start, groups, K, X)
-    full = (gmask == simd_lanes.FULL) & ~clash
-    return int(full.sum()), int(((gmask != simd_lanes.FULL) & ~clash).sum()), int(clash.sum())
+    # The engine's lane groups (engine/lanes.py) by kind: (full groups of 8, partial groups, clashing groups)
+    run = (count + lanes.W - 1) // lanes.W
+    sub, nsub = np.empty((run, lanes.W), np.int64), np.empty(run, np.int64)
+    lanes._groups(body, pack, count, run, bodies, sub, nsub)
+    one = nsub == 1
+    return int((one & (sub[:, 0] == lanes.FULL)).sum()), int((one & (sub[:, 0] != lanes.FULL)).sum()), int((~one).sum())
 
 
 @functools.cache
@@ -239,47 +234,41 @@ def _lane_problem(name):
     return stack[0], stack[1], stack[5], stack[6], stack[7]
 
 
-@pytest.mark.parametrize(("name", "tolerance", "cap"), [("tiny", 1e-9, 10_000), ("tiny", 0.0, 40),
-                                                        ("stack", 1e-9, 10_000), ("stack", 0.0, 60)])  # fmt: skip
-def test_explicit_vector_lanes_are_the_scalar_lanes_bit_for_bit(name, tolerance, cap):
-    # simd_lanes (explicit <8 x double>; "lanes+vec4": velocities padded to 4 doubles a body) against
-    # simd_sweep's "lanes+split" (the scalar lane groups): the same sweeps, residual, v, r and statuses to the bit, through all three kinds of group. Tolerance 0:
-    # after every sweep count up to cap (one residual differs in its last bit only now and then).
+def _lanes_run(name, variant, tolerance, sweeps):
     body, pack, v0, r0, mu = _lane_problem(name)
-    count = body.shape[0]
-    full, partial, split = _lane_groups(body, pack, count, v0.shape[0])
-    assert (full > 0 and partial > 0) if name == "stack" else split > 0
+    v, r, st = v0.copy(), r0.copy(), np.zeros(body.shape[0], np.int8)
+    its, res, groups = simd_sweep.solve(body, pack, body.shape[0], mu, tolerance, sweeps, v, r, st, sweeps, variant)
+    return its, res, groups, v, r, st
+
+
+@pytest.mark.parametrize(("tolerance", "cap"), [(1e-9, 10_000), (0.0, 60)])
+def test_lanes_vec_is_the_engines_first_stage_and_the_scalar_lanes_without_clashes(tolerance, cap):
+    # "lanes+vec" is the engine's lane sweeps (engine/lane_sweeps.py); on a problem whose lane groups do
+    # not clash (the stack: full and 7-lane groups) their order is simd_sweep's scalar "lanes+split", so
+    # the same sweeps, residual, v, r and statuses to the bit, and as many visits a sweep. Tolerance 0:
+    # after every sweep count up to cap.
+    body, pack, v0, _, _ = _lane_problem("stack")
+    full, partial, clashing = _lane_groups(body, pack, body.shape[0], v0.shape[0])
+    assert full > 0 and partial > 0 and clashing == 0
     for sweeps in range(1, cap + 1) if tolerance == 0.0 else [cap]:
-        out = []
-        for variant in ("lanes+split", "lanes+vec", "lanes+vec4"):
-            v, r, st = v0.copy(), r0.copy(), np.zeros(count, np.int8)
-            its, res, _ = simd_sweep.solve(body, pack, count, mu, tolerance, sweeps, v, r, st, sweeps, variant)
-            out.append((its, res, v, r, st))
-        its, res, v, r, st = out[0]
+        its, res, groups, v, r, st = _lanes_run("stack", "lanes+split", tolerance, sweeps)
+        its2, res2, groups2, v2, r2, st2 = _lanes_run("stack", "lanes+vec", tolerance, sweeps)
         assert (its == sweeps) == (tolerance == 0.0) and (res <= tolerance or tolerance == 0.0)
-        for its2, res2, v2, r2, st2 in out[1:]:
-            assert its == its2 and res == res2
-            assert _same_bits(v, v2) and _same_bits(r, r2) and np.array_equal(st, st2)
+        assert its == its2 and res == res2 and groups == groups2 == full + partial
+        assert _same_bits(v, v2) and _same_bits(r, r2) and np.array_equal(st, st2)
+
+
+def test_lanes_vec_splits_clashing_groups_by_colour():
+    # On the tiny wall every group clashes: "lanes+split" visits such a group lane by lane, the engine
+    # (greedy colouring, lanes.py) in fewer sub-groups; both reach the tolerance.
+    body, pack, v0, _, _ = _lane_problem("tiny")
+    count = body.shape[0]
+    full, partial, clashing = _lane_groups(body, pack, count, v0.shape[0])
+    assert clashing > 0
+    scalar, engine = (_lanes_run("tiny", variant, 1e-9, 10_000) for variant in ("lanes+split", "lanes+vec"))
+    assert scalar[2] > engine[2] >= full + partial + 2 * clashing
+    assert scalar[1] <= 1e-9 and engine[1] <= 1e-9
 
 
 def _same_bits(a, b):
     return np.array_equal(a.view(np.int64), b.view(np.int64))
-
-
-def test_explicit_vector_lanes_on_narrower_vectors():
-    # Compiled for Haswell (AVX2: LLVM splits each <8 x double> into two ymm halves, and scalarises the
-    # scatters), the stack's cases above give the same bits. A fresh process (numba reads the CPU name at
-    # import) with its own cache.
-    root = Path(__file__).resolve().parent.parent
-    env = dict(os.environ, NUMBA_CPU_NAME="haswell", NUMBA_CPU_FEATURES="", PYTHONPATH=str(root),
-               NUMBA_CACHE_DIR=str(root / ".pytest_cache" / "numba-haswell"))  # fmt: skip
-    code = (
-        "import sys; sys.path.insert(0, 'tests'); import test_solver_lab_simd as t\n"
-        "for cap in (0.0, 60), (1e-9, 10_000): t.test_explicit_vector_lanes_are_the_scalar_lanes_bit_for_bit('stack', *cap)\n"
-        "from benchmarks.solver_lab import simd_lanes\n"
-        "asm = ''.join(simd_lanes.lane_sweeps.inspect_asm().values()) + ''.join(simd_lanes.lane_sweeps_rows.inspect_asm().values())\n"
-        "assert 'zmm' not in asm and 'ymm' in asm, 'not compiled for AVX2'\n"
-        "print('ok')\n"
-    )
-    done = subprocess.run([sys.executable, "-c", code], cwd=root, env=env, capture_output=True, text=True)
-    assert done.returncode == 0 and done.stdout.strip() == "ok", done.stderr[-2000:]

@@ -3,12 +3,13 @@
     python -m benchmarks.solver_lab.simd_bench [--case wall-248] [--duration 1] [--every 10] [--rounds 5]
         [--variants split fused levels] [--reference]
     python -m benchmarks.solver_lab.simd_bench --asm
-    python -m benchmarks.solver_lab.simd_bench --whole-run lanes+vec4 [--case wall-248] [--duration 1] [--rounds 3]
+    python -m benchmarks.solver_lab.simd_bench --whole-run [--case wall-248] [--duration 1] [--rounds 3]
         [--ensemble OUT [--copies 2]]
 
 The steps: the inputs of every ``--every``-th accelerated first-stage call that ``nlgs.solve`` makes on
-``--case`` (bench_kernel.capture). On each, the engine's ``nlgs._nlgs_interleaved`` (momentum, interleaved
-order) and each coloured variant run from the same inputs to the engine's tolerance, stall window 200.
+``--case`` (bench_kernel.capture). On each, the engine's ``nlgs._nlgs_interleaved`` (momentum; the lane
+sweeps while ``nlgs.LANES``, the default, else the 4-run interleaved order) and each coloured variant run
+from the same inputs to the engine's tolerance, stall window 200.
 Timing: ``--rounds`` rounds, each running the engine and then every variant over all steps (the order
 rotated from round to round), CPU time (``time.process_time``) per pass; the minimum over rounds.
 Reported per method: sweeps per step, ns per contact·sweep (CPU / Σ contacts × sweeps), CPU per step of
@@ -16,6 +17,8 @@ the first stage, steps ending above the tolerance (stalled: the engine would han
 and with ``--reference`` the distance of v from a tight solve of the same step (momentum to 1e-9 m/s with
 no stall window, cap TIGHT_CAP; plain NLGS if that misses it, the closer of the two kept): RMS over the
 step's bodies and components, then mean and max over steps. ``--asm``: what LLVM made of each phase.
+``--whole-run``: whole runs with the engine's first stage by its lane sweeps (``nlgs.LANES``, the default)
+and by the 4-run scalar sweep (``LANES`` False); "lanes+vec" in ``--variants`` is the lane sweeps alone.
 """
 
 from __future__ import annotations
@@ -124,15 +127,15 @@ def run(case, duration, every, rounds, variants, reference):
 
 
 @contextlib.contextmanager
-def first_stage_by_lanes(rows, lanes=True):
-    """While open, ``nlgs.solve``'s first stage (its first call of ``_nlgs_interleaved``: momentum to the
-    stall window) is done by simd_lanes ("lanes+vec", or "lanes+vec4" with ``rows``; with ``lanes`` False
-    by the engine, only counted); stalled steps go on by stalled.py as in the engine. Yields a tally:
-    first-stage CPU s and sweeps, steps handed to stalled.py."""
-    from benchmarks.solver_lab import simd_lanes
+def first_stage_by_lanes(lanes=True):
+    """While open, ``nlgs.LANES`` is ``lanes``: ``nlgs.solve``'s first stage (its first call of
+    ``_nlgs_interleaved``: momentum to the stall window) is the engine's lane sweeps (engine/lane_sweeps.py,
+    the default) or, False, the 4-run scalar sweep (interleaved._accelerated, the default before them);
+    stalled steps go on by stalled.py either way. Yields a tally: first-stage CPU s and sweeps, steps handed
+    to stalled.py."""
     from masonrycli.engine import stalled
 
-    kernel, solve, cont = nlgs._nlgs_interleaved, nlgs.solve, stalled.continue_stalled
+    kernel, solve, cont, flag = nlgs._nlgs_interleaved, nlgs.solve, stalled.continue_stalled, nlgs.LANES
     first, tally = [False], {"first_cpu": 0.0, "first_sweeps": 0, "stalled": 0}
 
     def first_stage(contact_body, pack, count, mu, tolerance, cap, v, r, status, accelerate, stall, *rest):
@@ -140,10 +143,7 @@ def first_stage_by_lanes(rows, lanes=True):
             return kernel(contact_body, pack, count, mu, tolerance, cap, v, r, status, accelerate, stall, *rest)
         first[0] = False
         t = time.process_time()
-        if lanes:
-            out = simd_lanes.solve(contact_body, pack, count, mu, tolerance, cap, v, r, status, stall, rows)[:2]
-        else:
-            out = kernel(contact_body, pack, count, mu, tolerance, cap, v, r, status, accelerate, stall)
+        out = kernel(contact_body, pack, count, mu, tolerance, cap, v, r, status, accelerate, stall)
         tally["first_cpu"] += time.process_time() - t
         tally["first_sweeps"] += out[0]
         return out
@@ -159,26 +159,28 @@ def first_stage_by_lanes(rows, lanes=True):
         tally["stalled"] += 1
         return cont(*args)
 
-    nlgs._nlgs_interleaved, nlgs.solve, stalled.continue_stalled = first_stage, solve_first, counted
+    nlgs._nlgs_interleaved, nlgs.solve, stalled.continue_stalled, nlgs.LANES = first_stage, solve_first, counted, lanes
     try:
         yield tally
     finally:
-        nlgs._nlgs_interleaved, nlgs.solve, stalled.continue_stalled = kernel, solve, cont
+        nlgs._nlgs_interleaved, nlgs.solve, stalled.continue_stalled, nlgs.LANES = kernel, solve, cont, flag
 
 
-def whole_runs(case, duration, rounds, rows):
-    """Whole runs of ``case``: the engine as it is, and with its first stage done by simd_lanes
-    (first_stage_by_lanes). Rounds interleaved, CPU minimum; top-course / mean slip at 0.1 and 0.2 s
-    against a tight solve (plain NLGS at 1e-7 m/s, bench_solver's TIGHT)."""
+def whole_runs(case, duration, rounds):
+    """Whole runs of ``case`` with the engine's first stage by the 4-run scalar sweep (``nlgs.LANES``
+    False) and by the lane sweeps (True, the default): first_stage_by_lanes. Rounds interleaved, CPU
+    minimum; top-course / mean slip at 0.1 and 0.2 s against a tight solve (plain NLGS at 1e-7 m/s,
+    bench_solver's TIGHT)."""
     from benchmarks.bench_solver import run_masonry
     from benchmarks.solver_reference import TIGHT, errors_pct
 
     def one(lanes, seconds):
-        with first_stage_by_lanes(rows, lanes) as tally:
+        with first_stage_by_lanes(lanes) as tally:
             row = run_masonry(case, seconds, False)
         return row | tally
 
-    one(True, 0.003)  # compile
+    one(True, 0.003)  # compile both
+    one(False, 0.003)
     runs = {False: [], True: []}
     for k in range(rounds):
         for lanes in (False, True) if k % 2 == 0 else (True, False):
@@ -188,7 +190,7 @@ def whole_runs(case, duration, rounds, rows):
         best = min(rows_, key=lambda x: x["cpu_s"])
         errs = "  ".join(f"{int(k) / 1000:g} s {t:+.2f} / {m:+.2f} %" for k, (t, m) in
                          errors_pct(best["samples"], reference).items())  # fmt: skip
-        name = ("lanes+vec4" if rows else "lanes+vec") if lanes else "engine"
+        name = "LANES=True (lane sweeps)" if lanes else "LANES=False (4-run scalar)"
         print(f"{case} {name}: {best['cpu_s'] / best['sim_s']:.3f} CPU s per sim s (solve {best['nlgs_share']:.0%}), "
               f"{best['sweeps_mean']:.1f} sweeps a step (max {best['sweeps_max']}), unconverged "
               f"{best['unconverged']}, handed to stalled.py {best['stalled']}; first stage "
@@ -197,16 +199,29 @@ def whole_runs(case, duration, rounds, rows):
     return runs
 
 
-def ensembles(cases, duration, copies, rows, out):
-    """solver_lab.ensemble's runs (12 ground motions × ``copies``) of the engine, written to OUT-engine.json,
-    and with the first stage by simd_lanes, to OUT-lanes.json; then ``ensemble compare`` of the two."""
+def ensembles(cases, duration, copies, out):
+    """solver_lab.ensemble's runs (12 ground motions × ``copies``) with the 4-run scalar first stage
+    (``nlgs.LANES`` False), written to OUT-scalar.json, and with the lane sweeps (True), to OUT-lanes.json;
+    then ``ensemble compare`` of the two."""
     from benchmarks.solver_lab import ensemble
 
-    paths = [Path(f"{out}-engine.json"), Path(f"{out}-lanes.json")]
+    paths = [Path(f"{out}-scalar.json"), Path(f"{out}-lanes.json")]
     for lanes, path in zip((False, True), paths):
-        with first_stage_by_lanes(rows, lanes):
+        with first_stage_by_lanes(lanes):
             ensemble.run(cases, ensemble.MOTIONS, duration, path, copies=range(copies))
     return ensemble.compare(*paths)
+
+
+def _fresh_lane_sweeps():
+    # The engine's kernel compiled in this process: numba shows no machine code of a kernel it loaded from
+    # its cache (engine/__pycache__), so compile a twin with the cache off (_jit.njit's flags otherwise).
+    from masonrycli.engine import _jit, lane_sweeps
+
+    kernel = _jit.njit(cache=False)(lane_sweeps._lane_sweeps.py_func)
+    n = 8
+    body, pack = np.zeros((n, 2), np.int32), np.zeros((n, nlgs.PACK_WIDTH))
+    kernel(body, pack, 0, 0.5, 1e-5, 10, np.zeros((n, 3)), np.zeros((n, 2)), np.zeros(n, np.int8), 10)  # the types
+    return kernel
 
 
 def asm_summary():
@@ -219,15 +234,9 @@ def asm_summary():
     simd_sweep._solve_u(0, n, K, U, 0.0, 0.5, X, D, st)
     simd_sweep._phase_a(0, n, ia, ia, K, v, 0.0, 0.5, X, D, st)
     simd_sweep._phase_b(0, n, ia, ia, K, v, D)
-    from benchmarks.solver_lab import simd_lanes
-
-    body, pack = np.zeros((n, 2), np.int32), np.zeros((n, nlgs.PACK_WIDTH))
-    for rows in (False, True):  # count 0: only the types
-        simd_lanes.solve(body, pack, 0, 0.5, 1e-5, 10, np.zeros((n, 3)), np.zeros((n, 2)), st, 10, rows)
     kernels = {"split: _gather_u": simd_sweep._gather_u, "split: _solve_u": simd_sweep._solve_u,
                "fused: _phase_a": simd_sweep._phase_a, "_phase_b": simd_sweep._phase_b,
-               "lanes+vec: lane_sweeps": simd_lanes.lane_sweeps,
-               "lanes+vec4: lane_sweeps_rows": simd_lanes.lane_sweeps_rows}  # fmt: skip
+               "lanes+vec: the engine's lane_sweeps._lane_sweeps": _fresh_lane_sweeps()}  # fmt: skip
     for name, kernel in kernels.items():
         for asm in kernel.inspect_asm().values():
             lines = asm.splitlines()
@@ -248,16 +257,16 @@ def main(argv=None):
     parser.add_argument("--variants", nargs="*", default=["split", "fused"])
     parser.add_argument("--reference", action="store_true")
     parser.add_argument("--asm", action="store_true", help="only print what LLVM made of each phase")
-    parser.add_argument("--whole-run", choices=["lanes+vec", "lanes+vec4"], help="whole runs (whole_runs)")
+    parser.add_argument("--whole-run", action="store_true", help="whole runs, nlgs.LANES True and False (whole_runs)")
     parser.add_argument("--ensemble", metavar="OUT", help="with --whole-run: ensembles of short runs (ensembles)")
     parser.add_argument("--copies", type=int, default=2, help="--ensemble: runs a motion")
     args = parser.parse_args(argv)
     if args.asm:
         return asm_summary()
     if args.whole_run and args.ensemble:
-        return ensembles([args.case], args.duration, args.copies, args.whole_run == "lanes+vec4", args.ensemble)
+        return ensembles([args.case], args.duration, args.copies, args.ensemble)
     if args.whole_run:
-        return whole_runs(args.case, args.duration, args.rounds, args.whole_run == "lanes+vec4")
+        return whole_runs(args.case, args.duration, args.rounds)
     return run(args.case, args.duration, args.every, args.rounds, args.variants, args.reference)
 
 

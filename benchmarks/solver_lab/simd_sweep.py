@@ -23,7 +23,8 @@ from __future__ import annotations
 import numpy as np
 
 from benchmarks.solver_lab.simd_schedule import MASK_WORDS, colour, lanes, levels  # noqa: F401 (re-exported)
-from masonrycli.engine import momentum, nlgs
+from masonrycli.engine import lane_sweeps, momentum, nlgs
+from masonrycli.engine import lanes as lanes_  # "lanes" is simd_schedule's schedule here
 from masonrycli.engine._jit import njit
 from masonrycli.engine.nlgs import (
     P_BIAS,
@@ -392,17 +393,29 @@ def build(variant: str):
 _KERNELS: dict = {}
 
 
+def _engine_lanes(contact_body, pack, count, mu, tolerance, cap, v, r, status, stall_after):
+    # The engine's first stage, and its visits a sweep: lanes._groups' sub-groups, Σ nsub over the groups
+    # (the same count as "lanes+split"'s colours where no group clashes; fewer where one does: split by
+    # colour there, lane by lane in "lanes+split").
+    its, residual = lane_sweeps._lane_sweeps(contact_body, pack, count, mu, tolerance, cap, v, r, status, stall_after)
+    if count == 0:
+        return its, residual, 0
+    run = (count + lanes_.W - 1) // lanes_.W
+    sub, nsub = np.empty((run, lanes_.W), np.int64), np.empty(run, np.int64)
+    lanes_._groups(contact_body, pack, count, run, v.shape[0], sub, nsub)
+    return its, residual, int(nsub.sum())
+
+
 def solve(
     contact_body, pack, count, mu, tolerance, cap, v, r, status, stall_after=momentum.STALL_SWEEPS, variant="split"
 ):
     """The coloured first stage on one step's arrays (as nlgs._nlgs_interleaved takes them).
     Returns (iterations, residual, colours). Variant "blocks": simd_blocks.py's layout in 8-contact blocks;
-    "lanes+vec": simd_lanes.py's explicit vectors (returns the groups as colours)."""
-    if variant in ("lanes+vec", "lanes+vec4"):  # simd_lanes.py: the lanes' groups in explicit vectors
-        from benchmarks.solver_lab import simd_lanes  # it builds on this module
-
-        rows = variant == "lanes+vec4"
-        return simd_lanes.solve(contact_body, pack, count, mu, tolerance, cap, v, r, status, stall_after, rows)
+    "lanes+vec": the engine's lane sweeps (engine/lane_sweeps.py, the default's first stage; the lab's
+    explicit-vector prototype, simd_lanes.py, became them), the lane groups' visits (sub-groups of a
+    clashing group counted one each) as colours."""
+    if variant == "lanes+vec":
+        return _engine_lanes(contact_body, pack, count, mu, tolerance, cap, v, r, status, stall_after)
     if variant == "blocks":
         from benchmarks.solver_lab import simd_blocks  # it builds on this module
 

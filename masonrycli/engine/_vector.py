@@ -40,8 +40,8 @@ What each one emits:
 - ``mask_bits(b)`` / ``bits_of(m)``: an integer's low 8 bits as a mask (lane k = bit k) and back
   (``trunc`` / ``zext`` and ``bitcast`` between ``i8`` and ``<8 x i1>``).
 
-Used by the default solver's first stage (:mod:`masonrycli.engine.lane_sweeps`) and by the solver lab's
-lane sweeps it came from (benchmarks/solver_lab/simd_lanes.py).
+Used by the default solver's first stage (:mod:`masonrycli.engine.lane_sweeps`), which the solver lab
+now calls too (its "lanes+vec"; the lab prototype it came from is in the history, benchmarks/README.md).
 """
 
 from __future__ import annotations

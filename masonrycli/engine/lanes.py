@@ -108,7 +108,7 @@ def pack_lanes(contact_body, pack, count, v, r):
     sub = np.empty((run, W), np.int64)
     nsub = np.empty(run, np.int64)
     _groups(contact_body, pack, count, run, v.shape[0], sub, nsub)
-    for j in range(run):  # the order of the lab's lane sweeps (simd_lanes), whose bits these are
+    for j in range(run):  # group by group in lane order: the solver lab's "lanes+split" order, whose bits these are
         for q in range(W):
             c = q * run + j
             if c >= count:
