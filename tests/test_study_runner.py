@@ -4,6 +4,8 @@ gives its row once, with the points a driver hands out on the way."""
 
 from __future__ import annotations
 
+import re
+
 import pytest
 
 from masonrycli.study import runner
@@ -166,6 +168,23 @@ def test_a_port_where_nothing_listens_is_refused_at_once():
     assert time.monotonic() - start < runner.PROBE_TIMEOUT
     assert str(raised.value) == (
         f"--scheduler tcp://127.0.0.1:{port}: cannot connect (nothing listens at 127.0.0.1:{port}: connection refused)"
+    )
+
+
+def test_a_host_that_does_not_exist_is_refused_at_once():
+    # Client retried the name lookup for its whole 20 s timeout before the one line (.invalid: RFC 6761,
+    # never a host)
+    import time
+
+    from masonrycli.errors import InputError
+
+    start = time.monotonic()
+    with pytest.raises(InputError) as raised:
+        runner.open_cluster("nosuchhost.invalid:8786", None)
+    assert time.monotonic() - start < runner.CONNECT_TIMEOUT / 2
+    assert re.fullmatch(
+        r"--scheduler nosuchhost\.invalid:8786: cannot connect \(no host named nosuchhost\.invalid: [^\n]+\)",
+        str(raised.value),
     )
 
 

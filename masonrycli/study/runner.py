@@ -261,8 +261,10 @@ PROBE_TIMEOUT = 2.0
 def _refused(scheduler: str) -> str:
     """Why nothing can answer at a ``tcp://`` scheduler address ("" if something may): a port where
     nothing listens refuses a plain TCP connection at once, while ``Client`` retried it for its whole
-    ``CONNECT_TIMEOUT`` (a mistyped port waited 20 s for its one line). Any other address, scheme or
-    failure (a timeout, an unknown host) is left to ``Client``, which says what it met."""
+    ``CONNECT_TIMEOUT`` (a mistyped port waited 20 s for its one line); so did a host name the resolver
+    does not know (``nosuchhost.invalid:8786``). Any other address, scheme or failure (a TCP connection
+    not made within PROBE_TIMEOUT: a firewall, a far or busy host) is left to ``Client`` and its
+    ``CONNECT_TIMEOUT``, which says what it met."""
     import socket
 
     from distributed.comm.addressing import parse_address, parse_host_port
@@ -278,6 +280,8 @@ def _refused(scheduler: str) -> str:
         socket.create_connection((host, port), timeout=PROBE_TIMEOUT).close()
     except ConnectionRefusedError:
         return f"nothing listens at {host}:{port}: connection refused"
+    except socket.gaierror as error:  # Client retried the lookup for its 20 s: the name stays unknown
+        return f"no host named {host}: {error.strerror}"
     except OSError:
         return ""
     return ""
