@@ -6,7 +6,7 @@ A solver's accuracy is its top-course and mean slip (benchmarks.solver_cases.sli
 aqueduct, the highest block's and the mean displacement) at 0.1 and 0.2 s in % of a tight solve's. On tall
 walls a tight solve stops at its sweep cap short of its tolerance (plain ``nlgs`` at 1e-7 m/s, cap 20 000:
 195 of 200 steps of the 32-course wall, all 200 of the 64-course wall), and two equally tight solves of a
-hyperstatic wall take different trajectories (benchmarks/README.md, "Is the tight solve a reference on tall
+hyperstatic wall take different trajectories (benchmarks/JOURNAL.md, "Is the tight solve a reference on tall
 walls?"). So a reference run keeps its unconverged and capped steps and its largest residual, and a second
 reference from another solver gives the *spread* (its slips in % of the first's): an error no larger than
 the spread, at the same sample and measure, is not resolved by the reference.

@@ -106,7 +106,7 @@ def _windows_run(residuals, window, level):
 
 
 def test_a_stage_that_cycles_above_an_early_dip_counts_cycling_windows():
-    # The 248-block wall's failing steps (benchmarks/README.md, "Hand-over"): one early dip to a low the
+    # The 248-block wall's failing steps (benchmarks/JOURNAL.md, "Hand-over"): one early dip to a low the
     # stage never sees again, then a stick/slip cycle between 2x and 8x that low.
     cycle = np.tile([4e-5, 1.6e-4, 8e-5, 4e-5], 500)
     residuals = np.concatenate([[3e-4, 2e-5], cycle])

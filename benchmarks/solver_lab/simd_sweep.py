@@ -15,7 +15,7 @@ One sweep = for each colour
     phase B (scalar: the scatter into v): v += M⁻¹ H Δr for each contact that moved, Σ|e_α|².
 
 Lab prototype: timed on captured steps against the engine's accelerated sweep by
-``python -m benchmarks.solver_lab.simd_bench`` (benchmarks/README.md, "Coloured SIMD sweeps").
+``python -m benchmarks.solver_lab.simd_bench`` (benchmarks/JOURNAL.md, "Coloured SIMD sweeps").
 """
 
 from __future__ import annotations
@@ -285,7 +285,7 @@ def build(variant: str):
     """The coloured first stage with phase A as ``variant``: "fused" (one loop, indirect reads of v: LLVM
     cannot bound them for its alias checks and leaves it scalar), "split" (_gather_u scalar, then
     _solve_u vectorised), "split4" (split on velocities padded to 4 doubles a body), "levels" /
-    "levels+fused", "lanes+split", "sym+split" (benchmarks/README.md). Measured and removed: a "noalias"
+    "levels+fused", "lanes+split", "sym+split" (benchmarks/JOURNAL.md). Measured and removed: a "noalias"
     phase A (fused, compiled with numba's private noalias flag; only the engine may import numba) and
     "split2" (split with the push's products computed in the vector loop: not vectorised, 15.8 ns). Returns the kernel
     (contact_body, pack, count, mu, tolerance, cap, v, v_flat, r, status, stall) → (iterations,

@@ -18,11 +18,11 @@ whether the tolerance was met:
     faces         faces from momentum's iterate at its 500-sweep stall
     newton        stalled.py's Alart–Curnier resume (Newton steps, then turning sweeps) with the whole cap
 
-``table --methods engine --cap 100000`` gives the engine alone at its default cap (the figure of benchmarks/README.md, "Alart–Curnier in the
+``table --methods engine --cap 100000`` gives the engine alone at its default cap (the figure of benchmarks/JOURNAL.md, "Alart–Curnier in the
 engine": 101 kept steps of h32 and h64).
 
 (Faces' sweep units cost ~2× a point sweep's time; compare the ms.) The figures of stalled.py's module doc
-and of benchmarks/README.md, "Stalled steps", come from here.
+and of benchmarks/JOURNAL.md, "Stalled steps", come from here.
 """
 
 from __future__ import annotations

@@ -4,7 +4,7 @@ A step whose accelerated solve stalls (:mod:`masonrycli.engine.stalled`) is on a
 one-way sweeps can cycle: a block lifts one corner of its bed joint, the other corner takes the load, the
 block slides back. Three ways of breaking such a cycle that the round-robin of stalled.py does not try,
 written as one kernel each so that the solver lab can run them alone on captured hard steps
-(benchmarks/solver_lab/hard_methods.py; figures in benchmarks/README.md, "New methods on hard steps"):
+(benchmarks/solver_lab/hard_methods.py; figures in benchmarks/JOURNAL.md, "New methods on hard steps"):
 
 * under-relaxation (``omega`` < 1): r_α ← r_α + ω (r_α^loc − r_α), which stays in the friction cone
   (a convex combination of two points of it), plain or after a Nesterov extrapolation as in

@@ -1,7 +1,7 @@
 """Explicit 8-wide vectors of doubles for numba kernels: a type, its arithmetic, loads, gathers, scatters.
 
 numba has no SIMD types; LLVM's loop vectoriser decides alone what runs in vectors, and it leaves loops
-it cannot prove safe or profitable scalar (the solver lab's 8-contact groups: benchmarks/README.md,
+it cannot prove safe or profitable scalar (the solver lab's 8-contact groups: benchmarks/JOURNAL.md,
 "Coloured SIMD sweeps"). This module gives kernels LLVM's own vector type ``<8 x double>`` as a numba
 type, :data:`f64x8`, and ``<8 x i1>`` as :data:`mask8`, so that a kernel can say which operations run
 side by side. Each operation below emits one LLVM instruction or intrinsic on the whole vector, the
@@ -41,7 +41,7 @@ What each one emits:
   (``trunc`` / ``zext`` and ``bitcast`` between ``i8`` and ``<8 x i1>``).
 
 Used by the default solver's first stage (:mod:`masonrycli.engine.lane_sweeps`), which the solver lab
-now calls too (its "lanes+vec"; the lab prototype it came from is in the history, benchmarks/README.md).
+now calls too (its "lanes+vec"; the lab prototype it came from is in the history, benchmarks/JOURNAL.md).
 """
 
 from __future__ import annotations

@@ -13,7 +13,7 @@ start, so v stays v_free + M⁻¹ H r).
 Why: on the hard steps of the 32- and 64-course walls (tall walls sliding on their base, where momentum in
 detection order cycles between stick and slip and stalled.py's other methods take thousands of sweep
 units), measured alone from the step's warm start on 64 steps captured from 24 ensemble runs
-(benchmarks/README.md, "New methods on hard steps"; tolerance 1e-5 m/s, cap 50 000): this converges all
+(benchmarks/JOURNAL.md, "New methods on hard steps"; tolerance 1e-5 m/s, cap 50 000): this converges all
 64 in 150 139 sweep units, where the engine took 956 975 (geometric mean of the per-step ratio 0.14;
 on the 41 steps of ≥ 10 000 engine units 0.11), and the best of stalled.py's methods alone converge 54
 (faces, 977 723 units, not converged counted at the cap; Alart–Curnier Newton 54, 923 744). The same

@@ -10,7 +10,7 @@ hundred sweeps.
 Here each face is solved (nearly) exactly before moving on: its points are visited in turn, again and
 again, until one round changes their velocities by less than INNER_DROP of what the first round did
 (at most INNER_ROUNDS rounds). Measured on captured steps where point Gauss–Seidel never met 1e-5 m/s
-(benchmarks/README.md): the 32-course wall's step 74 reaches it after 21 179 sweeps (56 397 sweep units)
+(benchmarks/JOURNAL.md): the 32-course wall's step 74 reaches it after 21 179 sweeps (56 397 sweep units)
 and the solver lab's wall-32-hard, whose 211 500-sweep point reference ends at 3e-4 m/s, after 4181
 sweeps (9153 units). On steps point Gauss–Seidel does converge, faces cost 1.5–5× its sweep units,
 which is why this is the fallback and not the default.

@@ -15,7 +15,7 @@ side on ``<8 x double>`` vectors (:mod:`masonrycli.engine._vector`), one lane a 
 
 Why: the scalar sweep runs at the latency of its visits' chain (interleaved.py), and LLVM's own loop
 vectoriser leaves 8-contact loops scalar. Measured on captured steps of the 248-block wall
-(benchmarks/README.md, explicit vectors addendum): 0.57× the CPU of the 4-run scalar sweep per step on
+(benchmarks/JOURNAL.md, explicit vectors addendum): 0.57× the CPU of the 4-run scalar sweep per step on
 Zen 5 (AVX-512), 0.77× compiled for Haswell (AVX2), at the same sweep counts and error.
 
 Exactness: every lane does the scalar visit's IEEE operations on the same operands (no fast-math), so
@@ -115,7 +115,7 @@ def _group(j, act, Q, IA, IB, v4, beta, mu, full):
     #   full (8 lanes, no clash): written back the same way (scatter_rows; every lane writes, the value
     #         it read where it does not push); else (a partial group or a sub-group) the pushing lanes of
     #         act only, by scalar stores in lane order (on Zen 5 the masked hardware scatters cost more:
-    #         benchmarks/README.md, explicit vectors addendum).
+    #         benchmarks/JOURNAL.md, explicit vectors addendum).
     # Returns the group's Σ|e_α|², its lanes added in lane order.
     q0 = j * ROWS * W
     at = j * W
@@ -226,7 +226,7 @@ def _lane_sweeps(contact_body, pack, count, mu, tolerance, max_iterations, v, r,
                 sum_e2 += _group(j, V.mask_bits(FULL), Q, IA, IB, v4, vbeta, vmu, True)
                 continue
             # a partial group; a clashing one's sub-groups in turn (lanes.py). Two call sites in all: numba
-            # inlines _group at each, and a third copy was 0.5 s of a first run's CPU (benchmarks/README.md,
+            # inlines _group at each, and a third copy was 0.5 s of a first run's CPU (benchmarks/JOURNAL.md,
             # "Cold start")
             for k in range(nsub[j]):
                 sum_e2 += _group(j, V.mask_bits(sub[j, k]), Q, IA, IB, v4, vbeta, vmu, False)

@@ -26,7 +26,7 @@ row. Rows 0 … PACK_WIDTH − 1 are the packed constants of :mod:`masonrycli.en
 ``P_NX`` …), then the momentum state r_t, r_n, r_prev,t, r_prev,n and the status (a double). The body
 velocities are copied padded to 4 doubles a body, so that a full group reads and writes one 256-bit row
 a lane (``_vector.gather_rows`` / ``scatter_rows``): a third of the memory operations of 3 doubles a
-body read one by one (benchmarks/README.md, explicit vectors addendum).
+body read one by one (benchmarks/JOURNAL.md, explicit vectors addendum).
 """
 
 from __future__ import annotations
@@ -116,7 +116,7 @@ def pack_lanes(contact_body, pack, count, v, r):
             # unsigned as the sweeps' calls (interleaved.py's rows): one compiled _push serves all of them
             _push(v, np.uint32(contact_body[c, 0]), np.uint32(contact_body[c, 1]), pack, np.uint64(c), r[c, 0], r[c, 1])
     # np.empty and a fill, not np.zeros (_jit's rule): np.zeros compiled 2 signatures and a fill of its own,
-    # 0.1 s of a first run's CPU (benchmarks/README.md, "Cold start"); absent lanes keep these zeros
+    # 0.1 s of a first run's CPU (benchmarks/JOURNAL.md, "Cold start"); absent lanes keep these zeros
     Q = np.empty(run * ROWS * W, np.float64)
     IA = np.empty(run * W, np.int64)
     IB = np.empty(run * W, np.int64)

@@ -8,7 +8,7 @@ Each sweep of :mod:`masonrycli.engine.nlgs` starts from a Nesterov extrapolation
 impulses and velocities; the momentum is dropped whenever a sweep's residual grows by more than
 RESTART_GROWTH (adaptive restart). The contact law, the local solve, the residual and the stopping test
 are nlgs's, and a step still ends on a sweep, so what a converged step satisfies is unchanged; only the
-path is shorter. Measured on captured steps (benchmarks/README.md): 2.5–4.6× fewer sweeps on walls of
+path is shorter. Measured on captured steps (benchmarks/JOURNAL.md): 2.5–4.6× fewer sweeps on walls of
 8–32 courses, 2.4× on the arch, 5.9× on the aqueduct, at the same distance from a 1e-9 m/s reference;
 one accelerated sweep costs ~1.2× a plain one (the extrapolation reads and writes r and v once more). A
 restart growth of 1.3 or more diverges on the 248-block wall; 1.05–1.2 all converge.
@@ -32,7 +32,7 @@ faces, in turn with doubling budgets (that module's doc has the figures). The fi
 
 The window was 500 sweeps until stalled.py put momentum in body order ahead of its round-robin, a stage
 that finishes almost every stalled step of the tall walls from the warm start: momentum's 500-sweep
-plateau was then 23–45 % of their hard steps' units (benchmarks/README.md, "Momentum's stall window").
+plateau was then 23–45 % of their hard steps' units (benchmarks/JOURNAL.md, "Momentum's stall window").
 With 200 the stage gets them sooner. Ensembles of 48 runs a wall against 500: mean sweep units a step
 0.614× [90 %: 0.535, 0.707] on the 32-course wall, 0.878× [0.807, 0.960] on the 64-course wall, 0.969×
 [0.923, 1.013] on the 248-block wall; unconverged steps 7 → 1, 2 → 4, 3 → 0. 100 costs the 248-block

@@ -65,7 +65,7 @@ iterate instead of the warm start it does worse, hence stalled.py starts it from
 Not on ordinary steps (those momentum converges without stalling): one direction from the warm start or
 from momentum's iterate after 10–200 sweeps, λ 1e-6–1e-1, with or without the line search or the active
 set frozen from the sweeps' statuses, then sweeps, takes 1.06–4.4× momentum's units on the 248-block
-wall's and at best 0.985× (noise) on the 32- and 64-course walls' (benchmarks/README.md, "Newton-type
+wall's and at best 0.985× (noise) on the 32- and 64-course walls' (benchmarks/JOURNAL.md, "Newton-type
 steps on ordinary steps"): a wall's solution set is a continuum of self-stresses, and the sweeps' work
 there is choosing one inside the cone, which F's Newton step does not do.
 """

@@ -21,7 +21,7 @@ contacts,
 
 and the solve stops after the first sweep with residual ≤ tolerance (default 1e-5 m/s, a thousandth of
 the velocity gravity adds in a 1 ms step), or at the sweep cap (then the step is unconverged and is
-counted as such). Measured on walls of 8–32 courses (benchmarks/README.md): the old test, the relative
+counted as such). Measured on walls of 8–32 courses (benchmarks/JOURNAL.md, "Choosing the stopping test"): the old test, the relative
 change of the impulses, stops on stagnation and is ~10x looser in tall walls than on one block; the
 largest violation instead of the RMS plateaus near 1e-5 m/s on single corner contacts and never meets a
 tight tolerance. The RMS is not a bound on the block velocities' error: Gauss–Seidel moves load about
@@ -29,7 +29,7 @@ one course per sweep, and a slow mode can keep velocities 1e-4 m/s off while eac
 
 Stagnation. On tall walls that slide (32 courses and more, shaken at 1 m/s) Gauss–Seidel can cycle: at
 step 74 of the 32-course wall the residual wanders between 7.7e-5 and 2.3e-4 m/s for 50 000 sweeps while
-hundreds of sliding bed-joint corners change status (benchmarks/README.md). Such a step never meets the
+hundreds of sliding bed-joint corners change status (benchmarks/JOURNAL.md, "Sweep order"). Such a step never meets the
 tolerance, and sweeping it to the cap cost half of that wall's run time. So when a solve with a
 tolerance > 0 goes STALL_SWEEPS sweeps without a new lowest residual, it continues by faces
 (:mod:`masonrycli.engine.faces`: the points of each face solved together, which does not cycle there)
@@ -292,7 +292,7 @@ INTERLEAVE = 4
 LANES = True
 """The accelerated solve's first stage by :mod:`masonrycli.engine.lane_sweeps` (8 runs, 8 contacts visited
 at once in vectors); False: by the scalar sweep in INTERLEAVE runs (interleaved._accelerated), the
-default until the lane sweeps replaced it (benchmarks/README.md, explicit vectors addendum)."""
+default until the lane sweeps replaced it (benchmarks/JOURNAL.md, explicit vectors addendum)."""
 
 
 def _nlgs_interleaved(

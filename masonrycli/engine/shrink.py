@@ -25,7 +25,7 @@ While no left-out contact closes, the sweeps are momentum's bit for bit (the act
 the same velocities, the left-out ones push nothing). The iterations count sweeps, as momentum's: the
 stall window and the cap mean the same, and a partial sweep counts one.
 
-Off by default (CHECK_EVERY = 0), measured (benchmarks/README.md, "Shrinking sweeps"): with 16, 0.99× the
+Off by default (CHECK_EVERY = 0), measured (benchmarks/JOURNAL.md, "Shrinking sweeps"): with 16, 0.99× the
 sweeps and 0.89× the first stage's CPU on wall-248's steps from the engine's warm starts, but that is ~8 %
 of a step, within what any change of path moves one run by: on the benchmark's own wall-248 trajectory
 10 % more sweeps ate it (2.33 → 2.37 CPU s per simulated s), and h32's 0.2 s met a stalled step of 93 427

@@ -4,7 +4,7 @@ First, from the step's warm start, momentum sweeps that visit the contacts body 
 (:mod:`masonrycli.engine.bodies`) for at most BODIES_UNITS sweep units (stall window BODIES_STALL sweeps;
 they hand over to the round-robin earlier when their residual cycles, "Hand-over" below).
 On 64 hard steps of the 32- and 64-course walls' ensemble runs, alone, they converge all 64 in 150 139
-units where the round-robin below took 956 975 (benchmarks/README.md, "New methods on hard steps"); the
+units where the round-robin below took 956 975 (benchmarks/JOURNAL.md, "New methods on hard steps"); the
 same steps replayed through nlgs.solve with this stage ahead of the round-robin take 218 460 (0.23×),
 none above 13 209 units; all 342 kept steps of ≥ 2500 units 1 207 789 against 3 291 823 (0.37×), none
 unconverged against 5. Ensembles of 48 short runs a wall: mean sweep units a step 0.70× [90 %: 0.61,
@@ -17,13 +17,13 @@ how much a hard step spends before it starts: 500 sweeps until 2026-11-27, then 
 ensembles 0.61× / 0.88× / 0.97× mean units on the 32-, 64-course and 248-block walls). The order of the
 round-robin behind the stage no longer matters there: newton, first, finishes nearly all it gets, and
 momentum second (newton, momentum, turning, alternating, faces) gave every replayed hard step of five
-sets its units under the order below (benchmarks/README.md, "Momentum's stall window").
+sets its units under the order below (benchmarks/JOURNAL.md, "Momentum's stall window").
 
 Hand-over (on since 2026-11-27: 8 windows of 500 sweeps at level 1.8, this part's last paragraph). On the
 248-block wall the stage finished none of 21 captured steps of ≥ 2500 units: it spent its 16 000 units on
 each, and the round-robin then finished 20 of them in ~600 (newton's first resume). On the 32- and 64-course
 walls it finishes 178 of 179 and 142 of 142 stalled steps, a few only after 3000–7000 sweeps. Their residual
-histories (benchmarks/README.md, "The body-order stage's hand-over") tell most of them apart: where the stage
+histories (benchmarks/JOURNAL.md, "The body-order stage's hand-over") tell most of them apart: where the stage
 fails, its residual cycles (stick/slip) around a level 1.4–6× the lowest residual, reached in an early dip,
 and new lows by a hair keep restarting any stall window; where it succeeds slowly, the residual stays near its
 low (level within 1.05–1.5× on most). So with BODIES_CYCLING > 0, every BODIES_WINDOW sweeps the window's
@@ -46,7 +46,7 @@ a residual of 1.3e-7 or 2.5e-6 is 1.7–3.5e-2 m/s from either), so the run leav
 17 of 25 changed runs met more steps of ≥ 2500 units (2 fewer). Cycling = 8 windows (not before sweep 4000) at
 level 1.8 hands over 3 of the 255 (1.6 × 8: 7) and keeps most of the gain on steps the stage never finishes
 (wall-248's 45 hard steps of the ed257db set replayed: 955 083 → 671 907 units; 4 × 1.4: 491 776). Ensembles
-of 48 runs a wall against main's (benchmarks/README.md, "The hand-over, again"): mean units a step 0.983
+of 48 runs a wall against main's (benchmarks/JOURNAL.md, "The hand-over, again"): mean units a step 0.983
 [0.972, 0.993] on the 248-block wall, 0.994 [0.985, 0.999] on the 64-course wall, 1.000 [0.988, 1.015] on the
 32-course wall; unconverged 0 → 0, 4 → 4, 1 → 0. So BODIES_CYCLING = 8, BODIES_LEVEL = 1.8,
 BODIES_WINDOW = 500.
@@ -60,7 +60,7 @@ left, once, as one long run would; also when the round-robin ends first. Step 12
 wall's one unconverged step, which pays the stage's remaining units again (37 294 → 49 345, main's
 figure): 402 494 → 185 943. At the cap the round-robin's lowest residual is adopted, never the
 stage's (adopting it when lowest put h32 runs on trajectories with 13 unconverged steps against 7).
-Ensembles of 48 runs a wall against main with momentum.STALL_SWEEPS 500 (benchmarks/README.md, "A way
+Ensembles of 48 runs a wall against main with momentum.STALL_SWEEPS 500 (benchmarks/JOURNAL.md, "A way
 back to the stage"): 0.960 [0.937, 0.980] on the 248-block wall (unconverged 3 → 3), 0.996 [0.977,
 1.017] on the 32-course wall (7 → 8), 0.994 [0.982, 1.005] on the 64-course wall (2 → 3; step 128 15 142
 units): the hand-over's extra unconverged steps, met on other trajectories, remain. It ships with the
@@ -70,7 +70,7 @@ Gauss–Seidel with momentum (the default solver, :mod:`masonrycli.engine.moment
 tens to hundreds of sweeps. On tall walls that slide it can stall: momentum drives the step into a
 stick/slip cycle, the residual wanders above the tolerance, and the solve stops after momentum's stall
 window. No single method finishes every such step. Measured on 35 of the 108 steps that stall over the first
-0.2 s of the walls of 32 and 64 courses (benchmarks/README.md, "Stalled steps"; each method alone from the
+0.2 s of the walls of 32 and 64 courses (benchmarks/JOURNAL.md, "Stalled steps"; each method alone from the
 step's warm start, tolerance 1e-5 m/s, cap 50 000 sweep units):
 
 * Momentum whose sweep direction turns at every restart ("turning": forward until the residual jumps,
@@ -113,13 +113,13 @@ Second in the order and in the first round only it took 256 810 (291 118 on the 
 a Newton step solved by scipy's splu counted 200 units). Whole runs (sweep units a step, mean / max,
 none unconverged): first 0.2 s of the 32-course wall 1108 / 38 137 against 1353 / 27 240, of the
 64-course wall 1302 / 17 584 against 1780 / 51 926, the 248-block wall's 1 s 163 / 10 309 against
-151 / 3196 (another path from step 400 on). Ensembles of short runs: benchmarks/README.md, "Alart–Curnier
+151 / 3196 (another path from step 400 on). Ensembles of short runs: benchmarks/JOURNAL.md, "Alart–Curnier
 in the engine".
 
 Newton's second resume comes right after its first (NEWTON_AHEAD), before the other methods' first
 round: in the round-robin a step that newton finishes in its second resume first paid the four other
 methods' 8000 units of round 0, and such steps are most of the costliest (in ensemble runs of the
-32-course wall, replayed: 40 of its 61 steps above 10 000 units, at 12 574–18 794 units each). Replayed (benchmarks/README.md, "Hard steps"; 342
+32-course wall, replayed: 40 of its 61 steps above 10 000 units, at 12 574–18 794 units each). Replayed (benchmarks/JOURNAL.md, "Hard steps"; 342
 steps of ≥ 2500 units from 24 ensemble runs): 3 291 823 units → 2 769 636 (0.84×; the 32-course wall's
 1 501 801 → 1 171 832, the 64-course wall's 1 790 022 → 1 597 804), as many converged; the 886 steps of
 1000–2500 units 1 273 140 → 1 275 355 (steps newton's first resume finishes do not change). So "newton"

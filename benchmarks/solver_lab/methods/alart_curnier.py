@@ -42,10 +42,10 @@ One run (pseudo-code):
 Iterations: Newton steps (factorisations). Sweep units: the harness's (all CPU time over one engine
 sweep's), numpy/scipy included; phases split pre-sweeps, polish and watchdog sweeps, law checks, assembly,
 factor+solve and line search. ``python -m benchmarks.solver_lab.methods.alart_curnier PROBLEM …`` times one
-Newton step (assembly; splu + solve) in the three forms. Options tried and kept for the record (README):
+Newton step (assembly; splu + solve) in the three forms. Options tried and kept for the record (benchmarks/JOURNAL.md):
 ``grow_below`` (λ × 4 after a step shorter than that), ``memory`` (nonmonotone Armijo over the last merits),
 ``smooth`` (engine sweeps after every accepted step). ``lam_min`` = LAMBDA0 (``ac-l3``, ``ac-aug-l3``) holds the shift at 1e-3: fewer, longer steps (the best
-pure-Newton variant with ``augmented``). Measured outcome: benchmarks/README.md, "Alart–Curnier".
+pure-Newton variant with ``augmented``). Measured outcome: benchmarks/JOURNAL.md, "Alart–Curnier".
 """
 
 from __future__ import annotations

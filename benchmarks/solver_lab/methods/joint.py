@@ -1,6 +1,6 @@
 """Gauss–Seidel by joints: each joint (all contact points between one pair of bodies) solved exactly in turn.
 
-The lab's finding on ordinary steps ("Newton-type steps on ordinary steps", benchmarks/README.md): what the
+The lab's finding on ordinary steps ("Newton-type steps on ordinary steps", benchmarks/JOURNAL.md): what the
 point sweeps spend their time on is how the impulses are shared among a joint's points and across the
 hyperstatic joints, not the blocks' motion. This method removes the first part: a sweep visits one *joint*
 at a time (the detection emits a pair's points next to each other; on every captured problem a joint has 1

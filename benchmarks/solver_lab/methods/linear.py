@@ -31,7 +31,7 @@ from benchmarks.solver_lab.outcome import Clock, Outcome, project_cone, sweeps_w
 from masonrycli.engine import nlgs as N
 
 DELTA = 1e-2
-"""Compliance of a constraint row relative to its contact's W_αα (1e-4 and 1e-6: worse, see README)."""
+"""Compliance of a constraint row relative to its contact's W_αα (1e-4 and 1e-6: worse, see benchmarks/JOURNAL.md, "Two more methods")."""
 SMOOTH = 10
 """Engine sweeps between corrections."""
 DROP = 0.5

@@ -25,13 +25,13 @@ biases of redundant contacts; wall-8-hard after 5 sweeps: least-squares residual
 is unbounded below and λ runs away as 1/ε: at 1e-6 every Newton step of wall-8-hard was rejected by the
 line search; 1e-2 keeps the step a regularised (proximal) Newton step.
 
-Options (each measured, see benchmarks/README.md "tnnmg"): ``inner`` Newton steps at the same s before the
+Options (each measured, see benchmarks/JOURNAL.md "tnnmg"): ``inner`` Newton steps at the same s before the
 next smoothing (nested Tresca); ``inward`` also frees components at a bound whose descent direction points
 into the box (projected-Newton rule); ``rounds`` active-set passes: components the step pushes out of the
 box are put on their bound (or, ``hold``, held where they are), dropped from F, and the rest re-solved
 (one factor each); ``normals_only`` Newton on the normal components only; ``search=False`` the full
 projected step, no line search (diverges: what ``ssn-v`` did). Measured outcome: no gain over the engine's
-sweeps at any height — the step helps only at the solution's statuses and thresholds (README).
+sweeps at any height — the step helps only at the solution's statuses and thresholds (benchmarks/JOURNAL.md, "tnnmg").
 
 Iterations: Newton steps (threshold updates with ``inner`` > 1). Sweep units: the harness's (all CPU time
 over one engine sweep's), numpy/scipy included; the phases split smoothing, checks, assembly, factor, AL
