@@ -114,6 +114,16 @@ class Lmgc:
         self.lib.lmgc90_get_all_bodies(arr, n)
         return [tuple(b.coor) for b in arr]
 
+    def poses(self):
+        """(centre of mass (B, 3), frame (B, 3, 3)) of every body. A material point moves as
+        X(t) = c(t) + F(t)ᵀ F(0) (X(0) − c(0)) (compas_lmgc90's ``Solver._update_meshes``)."""
+        import numpy as np
+
+        n = self.lib.lmgc90_get_nb_bodies()
+        arr = (Body3D * n)()
+        self.lib.lmgc90_get_all_bodies(arr, n)
+        return np.array([tuple(b.coor) for b in arr]), np.array([tuple(b.frame) for b in arr]).reshape(n, 3, 3)
+
     def inters(self):
         n = self.lib.lmgc90_get_nb_inters()
         arr = (Inter3D * max(n, 1))()

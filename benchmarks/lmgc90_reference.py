@@ -83,33 +83,38 @@ def log(*a):
 # geometry
 
 
+def prism(xy, depth: float = DEPTH) -> dict:
+    """The 2-D polygon ``xy`` ((V, 2) vertices, no closing repeat) extruded to a 3-D prism for
+    ``Solver.geometry_from_v_f``: (x, y) → (x, z), depth along y in [−depth/2, depth/2], every face wound
+    outwards."""
+    import numpy as np
+
+    n = len(xy)
+    v = [[x, -depth / 2, y] for x, y in xy] + [[x, depth / 2, y] for x, y in xy]
+    faces = [list(range(n)), list(range(n, 2 * n))]
+    faces += [[i, (i + 1) % n, n + (i + 1) % n, n + i] for i in range(n)]
+    V = np.array(v)
+    c = V.mean(axis=0)
+    out = []
+    for f in faces:  # wind every face outwards
+        p = V[f]
+        if np.dot(np.cross(p[1] - p[0], p[2] - p[0]), p.mean(axis=0) - c) < 0:
+            f = f[::-1]
+        out.append(f)
+    return {"vertices": v, "faces": out}
+
+
 def wall_prisms():
-    """The 51 blocks and the ground of ``build_wall(blocks=51)`` as 3-D prisms: (x, y) → (x, z), depth
-    along y in [−DEPTH/2, DEPTH/2]. Returns (blocks as {"vertices", "faces"}, course of each block)."""
+    """The 51 blocks and the ground of ``build_wall(blocks=51)`` as 3-D prisms (:func:`prism`).
+    Returns (blocks as {"vertices", "faces"}, course of each block)."""
     sys.path.insert(0, str(ROOT))
     import numpy as np
 
     from geometry_library.builders import build_wall
 
     assembly = build_wall(blocks=BLOCKS)
-
-    def prism(polygon):
-        xy = np.asarray(polygon.exterior.coords)[:-1]
-        n = len(xy)
-        v = [[x, -DEPTH / 2, y] for x, y in xy] + [[x, DEPTH / 2, y] for x, y in xy]
-        faces = [list(range(n)), list(range(n, 2 * n))]
-        faces += [[i, (i + 1) % n, n + (i + 1) % n, n + i] for i in range(n)]
-        V = np.array(v)
-        c = V.mean(axis=0)
-        out = []
-        for f in faces:  # wind every face outwards
-            p = V[f]
-            if np.dot(np.cross(p[1] - p[0], p[2] - p[0]), p.mean(axis=0) - c) < 0:
-                f = f[::-1]
-            out.append(f)
-        return {"vertices": v, "faces": out}
-
-    prisms = [prism(b.polygon) for b in assembly.blocks] + [prism(s.polygon) for s in assembly.supports]
+    bodies = [*assembly.blocks, *assembly.supports]
+    prisms = [prism(np.asarray(b.polygon.exterior.coords)[:-1]) for b in bodies]
     courses = [int(b.name.split("-")[0][1:]) for b in assembly.blocks]
     return prisms, courses
 
