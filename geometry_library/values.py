@@ -26,6 +26,27 @@ import numpy as np
 from .blocks import GeometryError
 
 
+class TypedNumber(float):
+    """A float as the user typed it on the command line (``text``: "0", "1e-9"), for messages only: they
+    echoed "--rtol 0" as "0.0" and "--thickness 1e9" as "1000000000.0". A float in every other respect
+    (repr, str, arithmetic, pickling), so no digest or written value changes; float(x) is the plain one."""
+
+    text: str
+
+    def __new__(cls, value: float, text: str):
+        number = super().__new__(cls, value)
+        number.text = text.strip()
+        return number
+
+    def __getnewargs__(self):  # pickle (a Dask task's scenario) and deepcopy: __new__ takes the text too
+        return float(self), self.text
+
+
+def shown(value) -> str:
+    """``value`` for a message: as typed (a :class:`TypedNumber`), else its repr."""
+    return value.text if isinstance(value, TypedNumber) else repr(value)
+
+
 def is_real(value) -> bool:
     """An int or a float (numpy's too), not a bool."""
     return isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(value, (bool, np.bool_))
@@ -195,7 +216,7 @@ def check_positive(label: str, **values) -> None:
         problem = number_problem(value, gt=0.0, unit=SETTING_UNITS.get(key))
         if problem is not None:
             what = problem.removeprefix("must be ") if isinstance(value, str) else "a positive number"
-            raise GeometryError(f"{label}: {key} must be {what}, got {value!r}")
+            raise GeometryError(f"{label}: {key} must be {what}, got {shown(value)}")
 
 
 MATERIAL_RANGE = {"density": (1e-3, 1e5, "kg/m³"), "thickness": (1e-6, 1e3, "m")}

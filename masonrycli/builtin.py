@@ -40,6 +40,7 @@ from masonrycli.record_motion import Record, time_step_problem
 from masonrycli.record_text import NoTimeStep, TimeStepNotUsed
 from masonrycli.records import record_motion
 from masonrycli.scenario import MAX_DURATION, Material, RunConfig, Scenario, scenario_from_builder
+from masonrycli.values import option_text
 
 DEFAULT_DURATION = {"wall": 1.0, "arch": 5.0, "aqueduct": 5.0}
 """s, simulated time of each built-in scenario."""
@@ -117,7 +118,7 @@ def check_record_dt(record_dt: float | None) -> float | None:
     if record_dt is not None:
         problem = time_step_problem(record_dt)
         if problem:
-            raise InputError(f"--record-dt {record_dt:g}: {problem}")
+            raise InputError(f"--record-dt {option_text(record_dt)}: {problem}")
     return record_dt
 
 
@@ -265,9 +266,9 @@ def _loading(name: str, amp, freq, settlement, record, scale, record_dt=None) ->
         amp = SHAKE_AMPLITUDE if amp is None else amp
         return {"ground": _sine(amp, freq)} if amp else {}
     if settlement is not None and not math.isfinite(settlement):
-        raise InputError(f"--settlement {settlement}: must be a finite number (a downward velocity, m/s)")
+        raise InputError(f"--settlement {option_text(settlement)}: must be a finite number (a downward velocity, m/s)")
     if settlement is not None and settlement < 0:
-        raise InputError(f"--settlement {settlement}: must be >= 0 (a downward velocity, m/s)")
+        raise InputError(f"--settlement {option_text(settlement)}: must be >= 0 (a downward velocity, m/s)")
     # the messages name what was given: "--amp 1" alone said "--settlement with --amp" (the default
     # settlement), and "--freq 3" without --amp was ignored without a word
     _sine(0.0 if amp is None else amp, freq)  # a bad --amp / --freq is named first

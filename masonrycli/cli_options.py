@@ -15,11 +15,15 @@ from pathlib import Path
 from typing import Annotated
 
 import typer
+from pydantic import TypeAdapter
+
+from geometry_library.values import TypedNumber
 
 
 def _opt(kind: type, panel: str, help: str, *decls: str, parser=None):
     """An optional ``kind`` value (None when not given), listed under ``panel`` in --help."""
-    parser = {"parser": parser or path_value} if kind is Path or parser else {}
+    parser = parser or {Path: path_value, float: number_value}.get(kind)
+    parser = {"parser": parser} if parser else {}
     return Annotated[kind | None, typer.Option(*decls, help=help, rich_help_panel=panel, **parser)]
 
 
@@ -27,6 +31,16 @@ def choice_value(text: str) -> str:
     """A choice option's value (--im, --outcome, --solver, --load, --direction) in lower case, the
     spelling its help lists: "--im PGV" said "expected one of pga, pgv, arias, sa"."""
     return str(text).strip().lower()
+
+
+_FLOAT = TypeAdapter(float)
+
+
+def number_value(text: str) -> TypedNumber:
+    """A float option's value that remembers how it was typed, for the messages that echo it ("--rtol 0:
+    must be in (0, 1)", was "0.0"). Parsed as typer parses a float (pydantic's lax float), so a value that
+    is not a number fails as before (cli_messages: "--dt 20ms: must be a number ...")."""
+    return TypedNumber(_FLOAT.validate_python(text), str(text))
 
 
 def path_value(text: str) -> Path:
@@ -59,7 +73,7 @@ WALL_LOADING = {
     "freq": _opt(float, "Loading", "Ground velocity frequency, Hz (default 2).", "--freq"),
     "amp": _opt(float, "Loading", "Horizontal ground velocity amplitude, m/s (default 1; 0: no shaking).", "--amp"),
     # not listed, but taken: refused with why ("the wall stands on one ground …"), not "No such option"
-    "settlement": Annotated[float | None, typer.Option(hidden=True)],
+    "settlement": Annotated[float | None, typer.Option(hidden=True, parser=number_value)],
 }
 SETTLED_LOADING = {
     "freq": _opt(float, "Loading", "Foundations' velocity frequency, Hz (default 2; with --amp).", "--freq"),

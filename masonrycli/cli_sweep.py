@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING, Annotated
 
 import typer
 
-from masonrycli.cli_options import choice_value, path_value
+from masonrycli.cli_options import choice_value, number_value, path_value
 from masonrycli.errors import EXIT_DIVERGED, EXIT_ROWS_FAILED
 from masonrycli.interrupt import FirstSignalStops, exit_code, signal_name
 from masonrycli.outputs import OutputFile
@@ -52,6 +52,7 @@ def sweep_command(
         float | None,
         typer.Option(
             "--record-dt",
+            parser=number_value,
             help="Seconds between the samples of the --records CSVs of one value per line (no time column); "
             "the other files keep their own times.",
         ),
@@ -77,7 +78,10 @@ def sweep_command(
         ),
     ] = None,
     rtol: Annotated[
-        float | None, typer.Option("--rtol", help="Relative width at which --find stops bisecting (default 0.005).")
+        float | None,
+        typer.Option(
+            "--rtol", parser=number_value, help="Relative width at which --find stops bisecting (default 0.005)."
+        ),
     ] = None,
     out: Annotated[
         Path | None,
@@ -102,11 +106,12 @@ def sweep_command(
     duration: Annotated[
         float | None,
         typer.Option(
+            parser=number_value,
             help="Simulated time of every run, s (default: the scenario file's; a built-in's 1-2 s, or over --records "
-            "the longest record)."
+            "the longest record).",
         ),
     ] = None,
-    dt: Annotated[float | None, typer.Option("--dt", help="Time step, s.")] = None,
+    dt: Annotated[float | None, typer.Option("--dt", parser=number_value, help="Time step, s.")] = None,
     im: Annotated[
         str,
         typer.Option(

@@ -30,6 +30,7 @@ from masonrycli.report import progress_bar, slow_start_notice, summary_table
 from masonrycli.run import RunResult, Simulation, simulate
 from masonrycli.sinks import COMPLETED, FAILED
 from masonrycli.source_digest import source_commit
+from masonrycli.values import option_text
 
 HISTORY_BYTES_PER_BLOCK = 500
 """Upper estimate of one block's share of a history row (measured: 326 B for the walls, 420 B for an arch of
@@ -80,9 +81,11 @@ def check_run(
 
 def check_magnify(magnify: float | None, no_recording: bool) -> None:
     if magnify is not None and not 1.0 <= magnify <= MAX_MAGNIFY:
-        raise InputError(f"--magnify {magnify:g}: must be between 1 and {MAX_MAGNIFY:g}")
+        raise InputError(f"--magnify {option_text(magnify)}: must be between 1 and {MAX_MAGNIFY:g}")
     if magnify is not None and no_recording:  # it was ignored, as --out was: nothing draws the shape
-        raise InputError(f"--magnify {magnify:g} with --no-recording: choose one (it draws in the recording)")
+        raise InputError(
+            f"--magnify {option_text(magnify)} with --no-recording: choose one (it draws in the recording)"
+        )
 
 
 def plan_outputs(scenario, out: Path | None, history: Path | None, *, no_recording: bool, force: bool) -> Outputs:

@@ -136,15 +136,17 @@ class Material:
 
     def __post_init__(self):
         for key, (lo, hi, unit) in MATERIAL_RANGE.items():
-            value = check_real(key, getattr(self, key), gt=0.0)
+            given = getattr(self, key)  # as given (an option's TypedNumber: its text) for the message
+            value = check_real(key, given, gt=0.0)
             if not lo <= value <= hi:
-                raise field_error(key, value, f"must be between {lo:g} and {hi:g} {unit} (a likely typo)")
+                raise field_error(key, given, f"must be between {lo:g} and {hi:g} {unit} (a likely typo)")
             object.__setattr__(self, key, value)
-        object.__setattr__(self, "friction", check_real("friction", self.friction, ge=0.0))
+        given = self.friction
+        object.__setattr__(self, "friction", check_real("friction", given, ge=0.0))
         if self.friction > MAX_FRICTION:
             raise field_error(
                 "friction",
-                self.friction,
+                given,
                 f"must be <= {MAX_FRICTION:g} (a likely typo: {MAX_FRICTION:g} already forbids sliding)",
             )
 

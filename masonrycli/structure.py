@@ -15,7 +15,7 @@ import os
 from pathlib import Path
 
 from geometry_library.blocks import Assembly, GeometryError
-from geometry_library.values import SETTING_UNITS, number_problem
+from geometry_library.values import SETTING_UNITS, TypedNumber, number_problem
 from masonrycli.errors import NOT_A_FILE, InputContext, InputError, one_line
 from masonrycli.values import did_you_mean, field_error, quote_string
 
@@ -129,7 +129,9 @@ def _check_option_type(key: str, value, spec_field: dataclasses.Field):
         problem = number_problem(value, integer=expected == "int", allow_inf=True, unit=SETTING_UNITS.get(key))
         if problem is not None:
             raise field_error(key, value, problem)
-        return float(value) if expected == "number" else value
+        if expected == "number":  # an option's TypedNumber kept: the builder's message echoes it as typed
+            return value if type(value) is TypedNumber else float(value)
+        return value
     if expected == "bool" and not isinstance(value, bool):
         raise field_error(key, value, "must be true or false")
     if expected == "str" and not isinstance(value, str):

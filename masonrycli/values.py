@@ -15,7 +15,7 @@ import re
 
 import numpy as np
 
-from geometry_library.values import SETTING_UNITS, is_real, number_problem
+from geometry_library.values import SETTING_UNITS, TypedNumber, is_real, number_problem
 from masonrycli.errors import InputError
 
 
@@ -88,8 +88,14 @@ def unknown_key(key, known) -> str:
 
 
 def shorten(value, limit: int = 60) -> str:
-    text = format_value(value)
+    text = value.text if isinstance(value, TypedNumber) else format_value(value)  # an option's: as typed
     return text if len(text) <= limit else text[: limit - 3] + "..."
+
+
+def option_text(value) -> str:
+    """A command-line option's value for a message: as typed (a :class:`TypedNumber`: "--rtol 0", not
+    "0.0"), else str (a value given in Python)."""
+    return value.text if isinstance(value, TypedNumber) else str(value)
 
 
 def field_error(key: str, value, reason: str) -> InputError:

@@ -13,7 +13,7 @@ RUN = ("run", "s.toml")
 # (id, files, argv, exit code, fragment of the one line)
 OPTION_ROWS = [
     # -- every option of run / check / simulate / build
-    ("opt-dt", {**scen()}, (*RUN, "--dt", "-1", "--no-recording"), 2, "--dt: dt = -1.0: must be > 0"),
+    ("opt-dt", {**scen()}, (*RUN, "--dt", "-1", "--no-recording"), 2, "--dt: dt = -1: must be > 0"),
     ("opt-dt-text", {**scen()}, (*RUN, "--dt", "abc"), 2, "--dt abc: must be a number"),
     ("opt-duration", {**scen()}, (*RUN, "--duration", "0", "--no-recording"), 2, "--duration: duration = 0"),
     (
@@ -110,7 +110,7 @@ OPTION_ROWS = [
         {},
         (*ARCH, "--settlement", "-1", "--no-recording"),
         2,
-        "--settlement -1.0: must be >= 0",
+        "--settlement -1: must be >= 0",
     ),
     # "--amp 1" alone said "--settlement with --amp" (the settlement was the default, not given)
     (
@@ -145,9 +145,12 @@ OPTION_ROWS = [
         "--settlement nan: must be a finite",
     ),
     ("sim-amp-nan", {}, (*WALL, "--amp", "nan", "--no-recording"), 2, "--amp: amplitude = nan: must be"),
-    ("sim-freq-negative", {}, (*WALL, "--freq", "-1", "--no-recording"), 2, "--freq: frequency = -1.0: must be"),
+    ("sim-freq-negative", {}, (*WALL, "--freq", "-1", "--no-recording"), 2, "--freq: frequency = -1: must be"),
     ("sim-voussoirs", {}, (*ARCH, "--voussoirs", "1", "--no-recording"), 2, 'builder "arch"'),
     ("sim-span", {}, (*ARCH, "--span", "-1", "--no-recording"), 2, 'builder "arch"'),
+    # a float option's value echoed as typed: these said "= 0.0", "= 2.0"
+    ("sim-dt-zero", {}, (*WALL, "--dt", "0", "--no-recording"), 2, "--dt: dt = 0: must be > 0"),
+    ("sim-theta-two", {}, (*WALL, "--theta", "2", "--no-recording"), 2, "--theta: theta = 2: must be <= 1"),
     # the builder's name once (it read "error: wall: wall: block count ...")
     (
         "build-blocks",
@@ -161,7 +164,7 @@ OPTION_ROWS = [
         {},
         ("build", "wall", "--density", "1e9", "--out", "w.geojson"),
         2,
-        "--density: density = 1000000000.0: must be between 0.001 and 100000 kg/m³",
+        "--density: density = 1e9: must be between 0.001 and 100000 kg/m³",
     ),
     (
         "sim-block-height",
@@ -209,7 +212,7 @@ OPTION_ROWS = [
     ),
     ("limit-direction", {}, ("limit", "arch", "--direction", "up"), 2, "--direction up: expected one of +x, -x"),
     ("limit-point-no-block", {}, ("limit", "arch", "--load", "point"), 2, "--load point: name the loaded block"),
-    ("limit-friction", {}, ("limit", "arch", "--friction", "-1"), 2, "--friction: friction = -1.0: must be >= 0"),
+    ("limit-friction", {}, ("limit", "arch", "--friction", "-1"), 2, "--friction: friction = -1: must be >= 0"),
     # -- output paths (checked before step 1)
     (
         "out-exists",

@@ -152,3 +152,29 @@ def test_a_ctrl_c_while_the_arguments_are_read_is_one_line(argv, monkeypatch):
     result = invoke(*argv)
     assert result.exit_code == 130, result.output
     assert result.output.strip() == "error: Ctrl-C: stopped before any output was written"
+
+
+@pytest.mark.parametrize(
+    "args, line",
+    [
+        # a float option's value as the user typed it: these said 0.0, 1000000000.0, -1.0 (typer had made
+        # the text a float before the check)
+        (("sweep", "wall", "-p", "amp=0.1:1:4", "--find", "amp", "--rtol", "0"), "--rtol 0: must be in (0, 1)"),
+        (RUN + ("--length", "0"), 'builder "wall": length must be a positive number, got 0'),
+        (
+            RUN + ("--density", "1e9"),
+            "--density: density = 1e9: must be between 0.001 and 100000 kg/m³ (a likely typo)",
+        ),
+        (RUN + ("--dt", "0e0"), "--dt: dt = 0e0: must be > 0"),
+        (
+            ("simulate", "arch", "--settlement", "-1", "--no-recording"),
+            "--settlement -1: must be >= 0 (a downward velocity, m/s)",
+        ),
+        (("limit", "arch", "--friction", "-1"), "--friction: friction = -1: must be >= 0"),
+        (RUN + ("--magnify", "0.50"), "--magnify 0.50: must be between 1 and 1e+06"),
+    ],
+)
+def test_a_float_option_is_echoed_as_typed(args, line):
+    result = invoke(*args)
+    assert_one_line_error(result)
+    assert result.output.strip() == f"error: {line}"

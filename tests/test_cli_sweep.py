@@ -49,9 +49,12 @@ def block(tmp_path) -> Path:
         (["-p", "amp=0.1", "--scheduler", "tcp://h:99999"], "a port from 1 to 65535"),  # waited 20 s
         (["-p", "amp=0.1", "--scheduler", ""], "--scheduler '': not an address"),
         # a bad --dt given with --duration was blamed on --duration ("--duration: dt = 0.0: must be > 0")
-        (["-p", "amp=0.1", "--duration", "0.02", "--dt", "0"], "--dt: dt = 0.0: must be > 0"),
+        (["-p", "amp=0.1", "--duration", "0.02", "--dt", "0"], "--dt: dt = 0: must be > 0"),  # said 0.0: as typed
         (["-p", "amp=0.1", "--duration", "0.02", "--dt", "nan"], "--dt: dt = nan: must be a finite number"),
-        (["-p", "amp=0.1", "--duration", "-1", "--dt", "0.01"], "--duration: duration = -1.0: must be > 0"),
+        (["-p", "amp=0.1", "--duration", "-1", "--dt", "0.01"], "--duration: duration = -1: must be > 0"),
+        (["-p", "amp=0.1:1:4", "--find", "amp", "--rtol", "0"], "--rtol 0: must be in (0, 1)"),  # said 0.0
+        (["-p", "amp=0.1:1:4", "--find", "amp", "--rtol", "1e0"], "--rtol 1e0: must be in (0, 1)"),
+        (["-p", "amp=0.1", "--rtol", "0.010"], "--rtol 0.010: goes with --find"),
         (["-p", "amp=0.1,1e30"], "--param amp=1e+30: "),  # it ran, exit 0
         # both rows ran at 0.5 m/s, under the names amp=0.1 and amp=0.2
         (["-p", "amp=0.1,0.2", "-p", "ground.amp=0.5"], "--param ground.amp: sets the amplitude of support 'ground'"),

@@ -24,6 +24,7 @@ from masonrycli.study import store
 from masonrycli.study.axes import Axis, StudyBase, apply_point, check_axes, check_find, parse_axis
 from masonrycli.study.files import check_picture
 from masonrycli.study.study import StudyRequest, points_to_check
+from masonrycli.values import option_text
 
 SWEEP_DURATION = {"wall": 1.0, "arch": 2.0, "aqueduct": 2.0}
 """s: default simulated time of a built-in structure in a study."""
@@ -121,10 +122,10 @@ def plan_study(
     outcome = None if outcome is None else check_outcome(outcome)
     for option, value in (("--outcome", outcome), ("--rtol", rtol)):
         if value is not None and find is None:
-            raise InputError(f"{option} {value}: goes with --find (a grid reports every run's state)")
+            raise InputError(f"{option} {option_text(value)}: goes with --find (a grid reports every run's state)")
     outcome, rtol = outcome or "collapse", 0.005 if rtol is None else rtol
     if not (0 < rtol < 1):
-        raise InputError(f"--rtol {rtol}: must be in (0, 1)")
+        raise InputError(f"--rtol {option_text(rtol)}: must be in (0, 1)")
     _check_out_reads_nothing(out, base)
     if no_recording and recording is not None:
         raise InputError(f"--recording {recording} with --no-recording: choose one")
