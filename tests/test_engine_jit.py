@@ -11,7 +11,7 @@ import sys
 import numpy as np
 import pytest
 
-from masonrycli.engine import _jit, broadphase, fused, joints, narrowphase, watch
+from masonrycli.engine import _jit, broadphase, contact_key, fused, joints, narrowphase, watch
 
 
 def _names(module) -> set[str]:
@@ -64,9 +64,11 @@ def test_a_kernel_only_kernel_called_from_python_runs_its_twin_instead_of_crashi
 
 
 def test_kernels_calling_kernel_only_kernels_still_run():
-    # collide_polygons calls _collide_pair, which calls the kernel_only _choose_faces, _clip_incident and
-    # _write_pair_contacts: a unit square resting on a wider one touches it at its two bottom corners.
-    assert isinstance(narrowphase._choose_faces, _jit._KernelOnly)
+    # collide_polygons calls the kernel_only _collide_pair (its twin), which calls the kernel_only
+    # contact_key._end_label and _make_key: a unit square resting on a wider one touches it at its two
+    # bottom corners.
+    assert isinstance(narrowphase._collide_pair, _jit._KernelOnly)
+    assert isinstance(contact_key._end_label, _jit._KernelOnly)
     square = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
     ground = np.array([[-1.0, -1.0], [2.0, -1.0], [2.0, 0.0], [-1.0, 0.0]])
     point, normal, gap, _ = narrowphase.collide_polygons(ground, square, 1e-3)

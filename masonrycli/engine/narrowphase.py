@@ -28,11 +28,15 @@ on a wide ground gives its two bottom corners; a corner on a face gives one poin
 Each contact carries a key naming the touching features (vertex of one body against edge of the other),
 the same from one step to the next: see :mod:`.contact_key`.
 
-The work is split in three kernels per pair, called by :func:`_collide_pair`: :func:`_choose_faces`
-(steps 1–3), :func:`_clip_incident` (step 4) and :func:`_write_pair_contacts` (step 5).
-They are ordinary kernels, not inlined by numba (``inline="always"``): that no longer made the loop
-faster (detect_contacts 27.6–28.4 µs on captured steps of the 51-block wall with it or without), and it
-cost 1.3 s of CPU of a first run's compilation.
+The work is split in three functions per pair, called by :func:`_collide_pair`: :func:`_choose_faces`
+(steps 1–3, with :func:`_max_face_separation`), :func:`_clip_incident` (step 4) and
+:func:`_write_pair_contacts` (step 5). numba inlines the four into :func:`_collide_pair`
+(``inline="always"``), which stays a kernel of its own (:func:`~._jit.kernel_only`): as four kernels of
+their own, each call (arrays and tuples passed through numba's calling convention) cost ~5 ns, 19 µs of
+the 126 µs the narrow phase took on a step of the 248-block wall (645 pairs; 107 µs inlined, the same
+contacts; benchmarks/README.md, "Solver", 2026-11-28 speed). Inlining :func:`_collide_pair` into the
+loop as well saves 7 µs more but costs 1.5 s of CPU of a first run's compilation (its code is then
+optimised again inside each caller of :func:`_narrowphase`); inlining the four costs none (bench_cold).
 """
 
 from __future__ import annotations
@@ -118,7 +122,7 @@ def edge_normals(vert_world, body_vert_start, edge_normal=None, body_size=None):
     return edge_normal, body_size
 
 
-@kernel_only
+@njit(inline="always")
 def _max_face_separation(vert, normal, s1, n1, s2, n2, alert):
     # Largest separation of polygon 2 along the outward edge normals of polygon 1:
     #     for each edge i of 1:  sep_i = min_{w ∈ 2} n_i · (w − v_i)
@@ -145,7 +149,7 @@ def _max_face_separation(vert, normal, s1, n1, s2, n2, alert):
     return best, best_edge
 
 
-@kernel_only
+@njit(inline="always")
 def _choose_faces(vert, normal, size_a, size_b, sa, na, sb, nb, alert):
     # Steps 1–3: separating axes, reference face, incident edge.
     #   sep_a, e_a = max face separation of b along a's normals   (> alert → no contact)
@@ -189,7 +193,7 @@ def _choose_faces(vert, normal, size_a, size_b, sa, na, sb, nb, alert):
     return e, e2, k, k2, ref_is_b, rs, is_, tol
 
 
-@kernel_only
+@njit(inline="always")
 def _clip_incident(vert, rs, e, e2, is_, k, k2, nx, ny, tol):
     # Step 4: clip the incident segment w1 = I[k] → w2 = I[k2] to the side planes of R's edge e.
     #   frame of the edge v1 = R[e] → v2 = R[e2]: u = (−n_y, n_x) (n is u turned by −90°), L = u·(v2 − v1);
@@ -266,7 +270,7 @@ def _clip_incident(vert, rs, e, e2, is_, k, k2, nx, ny, tol):
     return True, length, (p1x, p1y, g1, t1, t01, side1), (p2x, p2y, g2, t2, t02, side2)
 
 
-@kernel_only
+@njit(inline="always")
 def _write_pair_contacts(
     a, b, ref_is_b, e, e2, k, k2, nx, ny, length, tol, alert, end1, end2, c,
     contact_body, contact_point, contact_normal, contact_gap, contact_key,
