@@ -21,6 +21,8 @@ settings, see lmgc90_binding.CONFIGS).
   plane, plus its largest out-of-plane displacement and tilt) and every contact's bodies, in-plane point
   and normal force (N). ``compare`` reduces both to the measures of ``arch_joints`` (joint openings,
   hinges, per-joint resultants) over the joints of the initial polygons and prints a Markdown report.
+* Cost: CPU seconds of the stepping loop (``time.process_time``). Ours excludes the first step but not a
+  kernel numba compiles lazily later (0.4 CPU s for 5 s with a warm cache, 4 s on a cold one).
 """
 
 from __future__ import annotations
@@ -344,7 +346,7 @@ def main(argv=None):
         docs = [json.loads(Path(p).read_text()) for p in (args.reference, args.other)]
         cmp = compare(*docs)
         if args.json:
-            Path(args.json).write_text(json.dumps(cmp, indent=1))
+            Path(args.json).write_text(json.dumps(cmp, separators=(",", ":")) + "\n")
         print(report(cmp, tuple(d["code"] for d in docs)))
         return
     times = sorted(float(t) for t in args.times.split(",") if t)
