@@ -8,8 +8,9 @@ Three commands, each writing or reading JSON (findings: benchmarks/LMGC90.md, "T
 
 ``run`` options: ``--times 0.5,1,2,3,5`` (s: snapshots, the last one is the duration), ``--settlement
 0.01`` (m/s downwards, right foundation; 0 for the structure standing under gravity alone),
-``--tolerance`` (ours only, m/s, default the scenario's 1e-5), ``--config matched`` (LMGC90's NLGS
-settings, see lmgc90_binding.CONFIGS).
+``--tolerance`` (ours: m/s, default the scenario's 1e-5; LMGC90: the tol of its norm, default the
+config's), ``--cap`` (LMGC90: at most this many NLGS sweeps a step), ``--config matched`` (LMGC90's NLGS
+settings, see lmgc90_binding.CONFIGS). The findings' ``tight`` LMGC90 run is ``--tolerance 1e-6 --cap 20000``.
 
 * The arch is ``geometry_library.builders.build_arch()`` (98 blocks on two piers, two foundation
   supports), what ``masonry simulate arch`` runs. LMGC90 (compas_lmgc90 0.1.11: 3-D only, RBDY3/POLYR,
