@@ -34,9 +34,10 @@ The work is split in three functions per pair, called by :func:`_collide_pair`: 
 (``inline="always"``), which stays a kernel of its own (:func:`~._jit.kernel_only`): as four kernels of
 their own, each call (arrays and tuples passed through numba's calling convention) cost ~5 ns, 19 µs of
 the 126 µs the narrow phase took on a step of the 248-block wall (645 pairs; 107 µs inlined, the same
-contacts; benchmarks/README.md, "Solver", 2026-11-28 speed). Inlining :func:`_collide_pair` into the
-loop as well saves 7 µs more but costs 1.5 s of CPU of a first run's compilation (its code is then
-optimised again inside each caller of :func:`_narrowphase`); inlining the four costs none (bench_cold).
+contacts; benchmarks/JOURNAL.md, "Solver", "Where a wall-248 step goes at the lane sweeps"). Inlining
+:func:`_collide_pair` into the loop as well saves 7 µs more but costs 1.5 s of CPU of a first run's
+compilation (its code is then optimised again inside each caller of :func:`_narrowphase`); inlining the
+four costs none (bench_cold).
 """
 
 from __future__ import annotations
