@@ -94,8 +94,14 @@ def shorten(value, limit: int = 60) -> str:
 
 def option_text(value) -> str:
     """A command-line option's value for a message: as typed (a :class:`TypedNumber`: "--rtol 0", not
-    "0.0"), else str (a value given in Python)."""
-    return value.text if isinstance(value, TypedNumber) else str(value)
+    "0.0"), else a float in the shortest of ``:g`` and repr that gives it back exactly ("1e+07", "2", not
+    "10000000.0", "2.0"), anything else as str (a value given in Python)."""
+    if isinstance(value, TypedNumber):
+        return value.text
+    if isinstance(value, float) and math.isfinite(value):
+        short = f"{value:g}"
+        return short if float(short) == value else repr(float(value))
+    return str(value)
 
 
 def field_error(key: str, value, reason: str) -> InputError:

@@ -61,7 +61,7 @@ def test_overrides_reach_structure_loading_material_and_run():
     "name, overrides, message",
     [
         ("wall", {"settlement": 0.01}, "--settlement: the wall stands on one ground; settlement applies to arch"),
-        ("arch", {"settlement": -1.0}, "--settlement -1.0: must be >= 0 (a downward velocity, m/s)"),
+        ("arch", {"settlement": -1.0}, "--settlement -1: must be >= 0 (a downward velocity, m/s)"),
         ("arch", {"settlement": 0.01, "amp": 1.0}, "--settlement with --amp: choose one loading (settle or shake)"),
         ("arch", {"amp": 1.0}, "--amp 1: the arch settles its right foundation by default; shake both"),
         ("aqueduct", {"freq": 3.0}, "--freq 3: the aqueduct settles its right foundation by default; shake"),

@@ -60,7 +60,7 @@ def test_a_repeated_axis_or_a_search_without_its_range_comes_before_the_files_be
         ({"workers": -1}, "--workers -1: must be >= 0"),
         ({"rtol": 0.1}, "--rtol 0.1: goes with --find (a grid reports every run's state)"),
         ({"outcome": "sliding"}, "--outcome sliding: goes with --find (a grid reports every run's state)"),
-        ({"find": "amp", "rtol": 1.0}, "--rtol 1.0: must be in (0, 1)"),
+        ({"find": "amp", "rtol": 1.0}, "--rtol 1: must be in (0, 1)"),
         ({"recording": Path("x.rrd"), "no_recording": True}, "--recording x.rrd with --no-recording: choose one"),
         ({"im": "d5_95"}, "--im d5_95: expected one of pga, pgv, arias, sa"),
     ],
