@@ -218,9 +218,7 @@ def test_coloured_sweeps_are_momentum_gauss_seidel_in_colour_order(problem, swee
 
 def _lane_groups(body, pack, count, bodies):
     # The engine's lane groups (engine/lanes.py) by kind: (full groups of 8, partial groups, clashing groups)
-    run = (count + lanes.W - 1) // lanes.W
-    sub, nsub = np.empty((run, lanes.W), np.int64), np.empty(run, np.int64)
-    lanes._groups(body, pack, count, run, bodies, sub, nsub)
+    _, _, _, sub, nsub, _ = lanes.pack_lanes(body, pack, count, np.zeros((bodies, 3)), np.zeros((count, 2)))
     one = nsub == 1
     return int((one & (sub[:, 0] == lanes.FULL)).sum()), int((one & (sub[:, 0] != lanes.FULL)).sum()), int((~one).sum())
 

@@ -394,15 +394,13 @@ _KERNELS: dict = {}
 
 
 def _engine_lanes(contact_body, pack, count, mu, tolerance, cap, v, r, status, stall_after):
-    # The engine's first stage, and its visits a sweep: lanes._groups' sub-groups, Σ nsub over the groups
+    # The engine's first stage, and its visits a sweep: lanes.pack_lanes' sub-groups, Σ nsub over the groups
     # (the same count as "lanes+split"'s colours where no group clashes; fewer where one does: split by
     # colour there, lane by lane in "lanes+split").
     its, residual = lane_sweeps._lane_sweeps(contact_body, pack, count, mu, tolerance, cap, v, r, status, stall_after)
     if count == 0:
         return its, residual, 0
-    run = (count + lanes_.W - 1) // lanes_.W
-    sub, nsub = np.empty((run, lanes_.W), np.int64), np.empty(run, np.int64)
-    lanes_._groups(contact_body, pack, count, run, v.shape[0], sub, nsub)
+    nsub = lanes_.pack_lanes(contact_body, pack, count, np.zeros_like(v), np.zeros((count, 2)))[4]
     return its, residual, int(nsub.sum())
 
 

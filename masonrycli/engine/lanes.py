@@ -34,7 +34,7 @@ from __future__ import annotations
 import numpy as np
 
 from masonrycli.engine._jit import njit
-from masonrycli.engine.nlgs import P_IIA, P_IIB, P_IMA, P_IMB, PACK_WIDTH, _push
+from masonrycli.engine.nlgs import P_IIA, P_IIB, P_IMA, P_IMB, P_NA, P_NB, P_NX, P_NY, P_TA, P_TB, PACK_WIDTH
 
 W = 8
 """Lanes: contacts of a group (``_vector.WIDTH``)."""
@@ -43,78 +43,88 @@ ROWS = PACK_WIDTH + 5
 """Rows of a group: the packed constants, r_t, r_n, r_prev,t, r_prev,n, status."""
 FULL = (1 << W) - 1
 """The lane mask of a group with all 8 lanes."""
+TILE = 16
+"""Groups whose rows pack_lanes fills at once (16 × 1.5 kB of rows, and 8 runs of 16 pack rows, in L1)."""
 
 
 @njit(inline="always")
-def _moves(pack, c, side):
-    # Contact c moves its body a (side 0) or b (side 1): a support has zero inverse mass and inertia.
+def _moves(Q, base, side):
+    # The lane at Q[base] (a group's rows, offset by its lane) moves its body a (side 0) or b (side 1): a
+    # support has zero inverse mass and inertia.
     if side == 0:
-        return pack[c, P_IMA] > 0.0 or pack[c, P_IIA] > 0.0
-    return pack[c, P_IMB] > 0.0 or pack[c, P_IIB] > 0.0
+        return Q[base + P_IMA * W] > 0.0 or Q[base + P_IIA * W] > 0.0
+    return Q[base + P_IMB * W] > 0.0 or Q[base + P_IIB * W] > 0.0
 
 
 @njit(inline="always")
-def _groups(contact_body, pack, count, run, bodies, sub, nsub):
-    # For each group j, its sub-groups (module doc): sub[j, k] = lane mask of sub-group k < nsub[j].
-    #   in[body] = the sub-groups of group j holding a lane that moves body (valid while seen[body] = j)
+def _sub_groups(Q, IA, IB, count, run, j, seen, held, sub):
+    # Group j's sub-groups (module doc): sub[j, k] = lane mask of sub-group k; returns their number.
+    #   held[body] = the sub-groups of group j holding a lane that moves body (valid while seen[body] = j)
     #   for each lane q present (contact q·run + j < C), in lane order:
     #       k = the lowest sub-group holding none of the bodies q moves (greedy colouring; k = 0 unless
-    #           the group clashes); sub[j, k] |= bit q; in[each body q moves] |= bit k
+    #           the group clashes); sub[j, k] |= bit q; held[each body q moves] |= bit k
     # Bitmasks per body rather than comparing the 28 pairs of lanes: the pairs took 145 µs a step on the
     # 248-block wall (whose sweeps take ~600 µs a step), the masks ~5.
-    seen = np.empty(bodies, np.int64)
-    held = np.empty(bodies, np.int64)
-    for b in range(bodies):
-        seen[b] = -1
-    for j in range(run):
-        n = 0
-        for q in range(W):
-            c = q * run + j
-            if c >= count:
-                break
-            busy = 0
-            for side in range(2):
-                b = contact_body[c, side]
-                if _moves(pack, c, side) and seen[b] == j:
-                    busy |= held[b]
-            k = 0
-            while busy >> k & 1:
-                k += 1
-            if k == n:
-                sub[j, k] = 0
-                n += 1
-            sub[j, k] |= 1 << q
-            for side in range(2):
-                b = contact_body[c, side]
-                if _moves(pack, c, side):
-                    if seen[b] != j:
-                        seen[b] = j
-                        held[b] = 0
-                    held[b] |= 1 << k
-        nsub[j] = n
+    n = 0
+    for q in range(W):
+        if q * run + j >= count:
+            break
+        base = j * ROWS * W + q
+        busy = 0
+        for side in range(2):
+            b = (IA[j * W + q] if side == 0 else IB[j * W + q]) >> 2
+            if _moves(Q, base, side) and seen[b] == j:
+                busy |= held[b]
+        k = 0
+        while busy >> k & 1:
+            k += 1
+        if k == n:
+            sub[j, k] = 0
+            n += 1
+        sub[j, k] |= 1 << q
+        for side in range(2):
+            b = (IA[j * W + q] if side == 0 else IB[j * W + q]) >> 2
+            if _moves(Q, base, side):
+                if seen[b] != j:
+                    seen[b] = j
+                    held[b] = 0
+                held[b] |= 1 << k
+    return n
+
+
+@njit(inline="always")
+def _push_lane(v, Q, base, a, b):
+    # v ← v + M⁻¹ H r of the lane at Q[base] (its r in rows R_XT, R_XN): nlgs._push's operations on the same
+    # values (the rows are copies of the pack), so the same bits; a support gets ±0.
+    drt = Q[base + R_XT * W]
+    drn = Q[base + R_XN * W]
+    nx = Q[base + P_NX * W]
+    ny = Q[base + P_NY * W]
+    px = drt * ny + drn * nx
+    py = -drt * nx + drn * ny
+    ima = Q[base + P_IMA * W]
+    v[a, 0] -= ima * px
+    v[a, 1] -= ima * py
+    v[a, 2] -= Q[base + P_IIA * W] * (Q[base + P_TA * W] * drt + Q[base + P_NA * W] * drn)
+    imb = Q[base + P_IMB * W]
+    v[b, 0] += imb * px
+    v[b, 1] += imb * py
+    v[b, 2] += Q[base + P_IIB * W] * (Q[base + P_TB * W] * drt + Q[base + P_NB * W] * drn)
 
 
 @njit(inline="always")
 def pack_lanes(contact_body, pack, count, v, r):
     # The first stage's arrays, in group order (module doc):
-    #   sub, nsub                           _groups
-    #   v ← v_free + M⁻¹ H r_warm           scalar pushes group by group in lane order (nlgs._push:
-    #                                       supports get ±0)
-    #   Q[(j·ROWS + row)·8 + q]             pack row and r of contact q·run + j (r_prev = r)
+    #   Q[(j·ROWS + row)·8 + q]             pack row and r of contact q·run + j (r_prev = r), absent lanes 0
     #   IA, IB [j·8 + q]                    offsets 4a, 4b of its bodies in v4 (0 in absent lanes)
+    #   per group j: sub[j], nsub[j]        _sub_groups
+    #                v ← v + M⁻¹ H r_warm   its lanes' pushes in lane order (_push_lane; v enters as v_free)
     #   v4[4b … 4b + 2] = v[b], v4[4b + 3] = 0
     # Returns (Q, IA, IB, sub, nsub, v4).
+    # Q is filled TILE groups at a time, and the sub-groups and pushes read Q, not the pack: pack rows
+    # q·run + j of one group lie C/8 rows apart, and reading them group by group took 44 µs a step on the
+    # 248-block wall against 31 (benchmarks/JOURNAL.md, "Where a wall-248 step goes at the lane sweeps").
     run = (count + W - 1) // W
-    sub = np.empty((run, W), np.int64)
-    nsub = np.empty(run, np.int64)
-    _groups(contact_body, pack, count, run, v.shape[0], sub, nsub)
-    for j in range(run):  # group by group in lane order: the solver lab's "lanes+split" order, whose bits these are
-        for q in range(W):
-            c = q * run + j
-            if c >= count:
-                break
-            # unsigned as the sweeps' calls (interleaved.py's rows): one compiled _push serves all of them
-            _push(v, np.uint32(contact_body[c, 0]), np.uint32(contact_body[c, 1]), pack, np.uint64(c), r[c, 0], r[c, 1])
     # np.empty and a fill, not np.zeros (_jit's rule): np.zeros compiled 2 signatures and a fill of its own,
     # 0.1 s of a first run's CPU (benchmarks/JOURNAL.md, "Cold start"); absent lanes keep these zeros
     Q = np.empty(run * ROWS * W, np.float64)
@@ -125,19 +135,35 @@ def pack_lanes(contact_body, pack, count, v, r):
     for i in range(IA.shape[0]):
         IA[i] = 0
         IB[i] = 0
-    for c in range(count):
-        j = c % run
-        q = c // run
-        base = j * ROWS * W + q
-        for row in range(PACK_WIDTH):
-            Q[base + row * W] = pack[c, row]
-        Q[base + R_XT * W] = r[c, 0]
-        Q[base + R_PT * W] = r[c, 0]
-        Q[base + R_XN * W] = r[c, 1]
-        Q[base + R_PN * W] = r[c, 1]
-        IA[j * W + q] = 4 * contact_body[c, 0]
-        IB[j * W + q] = 4 * contact_body[c, 1]
+    for j0 in range(0, run, TILE):
+        j1 = min(j0 + TILE, run)
+        for q in range(W):
+            for j in range(j0, j1):
+                c = q * run + j
+                if c >= count:
+                    break
+                base = j * ROWS * W + q
+                for row in range(PACK_WIDTH):
+                    Q[base + row * W] = pack[c, row]
+                Q[base + R_XT * W] = r[c, 0]
+                Q[base + R_PT * W] = r[c, 0]
+                Q[base + R_XN * W] = r[c, 1]
+                Q[base + R_PN * W] = r[c, 1]
+                IA[j * W + q] = 4 * contact_body[c, 0]
+                IB[j * W + q] = 4 * contact_body[c, 1]
+    sub = np.empty((run, W), np.int64)
+    nsub = np.empty(run, np.int64)
     bodies = v.shape[0]
+    seen = np.empty(bodies, np.int64)
+    held = np.empty(bodies, np.int64)
+    for b in range(bodies):
+        seen[b] = -1
+    for j in range(run):  # group by group in lane order: the solver lab's "lanes+split" order, whose bits these are
+        nsub[j] = _sub_groups(Q, IA, IB, count, run, j, seen, held, sub)
+        for q in range(W):
+            if q * run + j >= count:
+                break
+            _push_lane(v, Q, j * ROWS * W + q, IA[j * W + q] >> 2, IB[j * W + q] >> 2)
     v4 = np.empty(4 * bodies, np.float64)
     for b in range(bodies):
         v4[4 * b] = v[b, 0]
@@ -155,8 +181,12 @@ def unpack_lanes(Q, count, v4, v, r, status):
         v[b, 0] = v4[4 * b]
         v[b, 1] = v4[4 * b + 1]
         v[b, 2] = v4[4 * b + 2]
-    for c in range(count):
-        base = (c % run) * ROWS * W + c // run
-        r[c, 0] = Q[base + R_XT * W]
-        r[c, 1] = Q[base + R_XN * W]
-        status[c] = np.int8(Q[base + R_ST * W])
+    for j in range(run):  # group by group: Q read where it lies (c in order took 2.5 µs more a step)
+        for q in range(W):
+            c = q * run + j
+            if c >= count:
+                break
+            base = j * ROWS * W + q
+            r[c, 0] = Q[base + R_XT * W]
+            r[c, 1] = Q[base + R_XN * W]
+            status[c] = np.int8(Q[base + R_ST * W])
