@@ -151,6 +151,29 @@ def test_block_on_ground_does_not_creep_or_sink(tmp_path):
     assert result.max_penetration < 1e-5
 
 
+@pytest.mark.parametrize("solver", ["nlgs-accel", "nlgs"])
+def test_arch_at_rest_does_not_wander(solver):
+    # The paper's 98-block arch under gravity alone, supports fixed: the exact Moreau–Jean solution stays
+    # where it starts (every sticking contact ends each step with u = 0). Bound from the stopping test:
+    # T × tolerance, the distance one contact violating its law by the tolerance for the whole run
+    # travels. The solve stopped at the tolerance alone let the arch wander by 0.14 mm in 2 s (7× that
+    # bound; engine/solver.py, "At rest").
+    from masonrycli.builtin import builtin
+    from masonrycli.engine.solver import Solver
+    from masonrycli.model import build_model, initial_state
+
+    duration = 2.0
+    m = build_model(builtin("arch", settlement=0.0, duration=duration, solver=solver))
+    state, solver_ = initial_state(m), Solver(m)
+    n = m.block_count
+    q0 = state.body_q[:n, :2].copy()
+    largest = 0.0
+    for _ in range(round(duration / m.dt)):
+        assert solver_.step(state).converged
+        largest = max(largest, float(np.hypot(*(state.body_q[:n, :2] - q0).T).max()))
+    assert largest <= duration * m.tolerance
+
+
 @pytest.mark.parametrize("height", [2.0, 10.0])
 def test_fast_impact_does_not_penetrate(height, tmp_path):
     """A block dropped from 10 m hits the ground at 14 m/s, 14 mm per step: contacts must be found
