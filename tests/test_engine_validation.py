@@ -174,6 +174,21 @@ def test_arch_at_rest_does_not_wander(solver):
     assert largest <= duration * m.tolerance
 
 
+def test_arch_at_rest_keeps_the_sweep_cap():
+    # A step at rest is solved on past the tolerance (engine/solver.py, "At rest"), but --max-iterations
+    # caps a step's sweeps whatever they are spent on: the extra sweeps once took steps the ordinary solve
+    # had converged to 1001-1013 sweep units under a cap of 50 and reported them capped and unconverged.
+    from masonrycli.builtin import builtin
+    from masonrycli.engine.solver import Solver
+    from masonrycli.model import build_model, initial_state
+
+    cap = 50
+    m = build_model(builtin("arch", settlement=0.0, duration=0.2, max_iterations=cap))
+    state, solver_ = initial_state(m), Solver(m)
+    for _ in range(200):
+        assert solver_.step(state).iterations <= cap
+
+
 @pytest.mark.parametrize("height", [2.0, 10.0])
 def test_fast_impact_does_not_penetrate(height, tmp_path):
     """A block dropped from 10 m hits the ground at 14 m/s, 14 mm per step: contacts must be found

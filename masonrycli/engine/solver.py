@@ -25,7 +25,8 @@ spread over many joints. Nothing pulls the blocks back, so the arch wanders in i
 with momentum or plain sweeps, θ = ½ or 1 (benchmarks/JOURNAL.md, "A structure at rest"). A step
 at rest (every block slower than REST_SPEED at the end of the previous step, supports still) is
 therefore solved on from its solution to REST_TIGHTEN × the tolerance, for at most REST_BUDGET sweep
-units (the result with the lower residual is kept). At rest that is cheap (the arch's steps take 2.6
+units and below the run's sweep cap (the result with the lower residual is kept; the step's iterations
+count these sweeps too). At rest that is cheap (the arch's steps take 2.6
 sweeps on average at 1e-7 m/s against 4.4 at 1e-5: a structure that stays put converges from its warm
 start), and a moving structure never pays it.
 """
@@ -47,7 +48,8 @@ the 98-block arch at 1e-5 m/s), so this is the speed of an error, not of a motio
 REST_TIGHTEN = 0.01
 """A step at rest is solved on to this fraction of the run's tolerance (module doc, "At rest")."""
 REST_BUDGET = 1000
-"""Sweep units at most that a step at rest spends beyond its ordinary solve."""
+"""Sweep units at most that a step at rest spends beyond its ordinary solve (and never so many that the
+step's total reaches the run's sweep cap, max_iterations)."""
 
 
 @dataclass(frozen=True)
@@ -188,8 +190,11 @@ class Solver:
         if rest:
             np.copyto(self._v_free, state.body_v)
         iterations, residual = nlgs.solve(body, self._pack, count, m, state.body_v, self._r, self._status)
-        if rest and m.tolerance * REST_TIGHTEN < residual <= m.tolerance:
-            more, residual = self._settle(state, count, residual)
+        # The continuation stays below the run's sweep cap: a step whose ordinary solve met the tolerance
+        # must not be reported capped or unconverged for the extra sweeps (nor spend more than the cap).
+        budget = min(REST_BUDGET, m.max_iterations - 1 - iterations)
+        if rest and budget > 0 and m.tolerance * REST_TIGHTEN < residual <= m.tolerance:
+            more, residual = self._settle(state, count, residual, budget)
             iterations += more
         dissipated, work = nlgs.contact_power(
             body, self._pack, self._r, count, self._v_old, state.body_v, m, self._force, self.support_force
@@ -225,19 +230,22 @@ class Solver:
             return False
         return not (np.any(support_v_next) or np.any(self._v_old[n:]))
 
-    def _settle(self, state, count: int, residual: float) -> tuple[int, float]:
+    def _settle(self, state, count: int, residual: float, budget: int) -> tuple[int, float]:
         """Solve a step at rest on from its solution (r, status of the ordinary solve; v from v_free) to
-        REST_TIGHTEN × the tolerance, for at most REST_BUDGET sweep units; keep whichever of the two results
-        has the lower residual. Returns (sweep units spent here, residual kept)."""
+        REST_TIGHTEN × the tolerance, for at most ``budget`` (≤ REST_BUDGET) sweep units; keep whichever of
+        the two results has the lower residual. Returns (sweep units spent here, residual kept)."""
         m = self.model
         if self._rest_model[0] is not m:
             tight = dataclasses.replace(m, tolerance=m.tolerance * REST_TIGHTEN, max_iterations=REST_BUDGET)
             self._rest_model = (m, tight)
+        tight = self._rest_model[1]
+        if budget < REST_BUDGET:  # near the run's own cap (a small --max-iterations)
+            tight = dataclasses.replace(tight, max_iterations=budget)
         v, r, status = state.body_v, self._r[:count], self._status[:count]
         kept = v.copy(), r.copy(), status.copy()
         np.copyto(v, self._v_free)
         bf = self.buffers
-        more, settled = nlgs.solve(bf.contact_body, self._pack, count, self._rest_model[1], v, self._r, self._status)
+        more, settled = nlgs.solve(bf.contact_body, self._pack, count, tight, v, self._r, self._status)
         if settled > residual:  # the continuation ended worse: back to the ordinary solve's result
             np.copyto(v, kept[0])
             np.copyto(r, kept[1])
