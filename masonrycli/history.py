@@ -55,7 +55,7 @@ UNITS: dict[str, str] = {
     "time": "s, time of the frame",
     "step": "step index (time / dt)",
     "contact_count": "contacts of the step ending at the frame",
-    "nlgs_iterations": "NLGS sweeps of the step ending at the frame",
+    "nlgs_iterations": "NLGS sweeps of the step ending at the frame (at rest: with the continuation's)",
     "nlgs_residual": "m/s, RMS contact-law violation of the last sweep (compared with the tolerance)",
     "nlgs_unconverged": "steps since t = 0 that ended unconverged (residual > tolerance or at the cap)",
     "energy_kinetic": "J",
