@@ -188,6 +188,18 @@ def test_a_host_that_does_not_exist_is_refused_at_once():
     )
 
 
+def test_a_name_lookup_that_may_pass_on_a_retry_is_left_to_client(monkeypatch):
+    # Only "no such name" is final: a resolver that did not answer in time (EAI_AGAIN) may answer
+    # Client's retries within its CONNECT_TIMEOUT, so the scheduler is not refused as "no host named ...".
+    import socket
+
+    def lookup_fails(*args, **kwargs):
+        raise socket.gaierror(socket.EAI_AGAIN, "Temporary failure in name resolution")
+
+    monkeypatch.setattr(socket, "create_connection", lookup_fails)
+    assert runner._refused("tcp://scheduler.example:8786") == ""
+
+
 def _distributed_log_level() -> int:
     import logging
 

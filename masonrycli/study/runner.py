@@ -281,7 +281,9 @@ def _refused(scheduler: str) -> str:
     except ConnectionRefusedError:
         return f"nothing listens at {host}:{port}: connection refused"
     except socket.gaierror as error:  # Client retried the lookup for its 20 s: the name stays unknown
-        return f"no host named {host}: {error.strerror}"
+        if error.errno in (socket.EAI_NONAME, getattr(socket, "EAI_NODATA", socket.EAI_NONAME)):
+            return f"no host named {host}: {error.strerror}"
+        return ""  # EAI_AGAIN (a resolver that did not answer in time) and the like: may pass on a retry
     except OSError:
         return ""
     return ""
