@@ -120,3 +120,22 @@ def test_eccentricity_is_read_in_the_moved_body_a_frame():
     total, ecc = joint_resultants(joints, [[0, 1]], [point_now], [2.0], q0, q)
     assert total[0] == 2.0
     np.testing.assert_allclose(ecc[0], 0.25, atol=1e-12)  # a quarter of the face from the middle, towards end 1
+
+
+def test_opening_and_slip_are_read_along_body_a_s_turned_face():
+    # The lower block (a) turns by phi about its top-left corner and the upper one (b) slides by s along
+    # x: the measures are taken along a's face turned with a (n = R(phi) n0, t = n turned +90 deg), which
+    # only a relative rotation together with a slip tells apart from b's face (an O(phi s) difference).
+    phi, s = -0.01, 0.003
+    joints = face_joints([SQUARE, SQUARE + (0.0, 1.0)])
+    q0 = np.array([[0.5, 0.5, 0.0], [0.5, 1.5, 0.0]])
+    q = np.array([_rotate_about(q0[0], np.array([0.0, 1.0]), phi), q0[1] + (s, 0.0, 0.0)])
+    opening, slip, rel = end_openings(joints, q0, q)
+    right = int(joints.end[0][1, 0] > joints.end[0][0, 0])  # the end at x = 1
+    # end (0, 1): on a it stays, on b it moved to (s, 1); end (1, 1): on a at (cos phi, 1 + sin phi), on b
+    # at (1 + s, 1); n = (-sin phi, cos phi), t = (-cos phi, -sin phi)
+    np.testing.assert_allclose(opening[0, 1 - right], -s * math.sin(phi), rtol=1e-12)
+    np.testing.assert_allclose(slip[0, 1 - right], -s * math.cos(phi), rtol=1e-12)
+    np.testing.assert_allclose(opening[0, right], -(1.0 + s) * math.sin(phi), rtol=1e-12)
+    np.testing.assert_allclose(slip[0, right], 1.0 - (1.0 + s) * math.cos(phi), rtol=1e-9)
+    np.testing.assert_allclose(rel, [-phi])
