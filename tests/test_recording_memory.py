@@ -15,6 +15,7 @@ import pytest
 import masonrycli.recording.recorder as recorder
 from masonrycli.joint_forces import magnification
 from masonrycli.recording import Recorder
+from masonrycli.recording.readback import recording_rows
 
 import recording_fixtures as fx
 from recording_fixtures import strict_rerun, temporal_rows  # noqa: F401 (strict_rerun: autouse)
@@ -48,7 +49,8 @@ def traced_after(start, count):
 
 static, q0 = fx.wall()
 frames = fx.frames(static, q0, 20)
-rec = recorder.Recorder({path!r}, static, fx.METADATA, batch_frames=50)
+# batches of 50 throughout: what a batch holds while it is buffered is not what this measures
+rec = recorder.Recorder({path!r}, static, fx.METADATA, batch_frames=50, long_batch_frames=50)
 first = traced_after(0, 401)  # past the first batches (scales fixed)
 later = traced_after(401, 1200)
 for i in range(recorder.STEP_BATCH):
@@ -143,3 +145,36 @@ def test_a_full_disk_under_the_spool_still_leaves_a_complete_recording(wall, tmp
             for f in fx.frames(static, q0, 9):
                 rec.log_frame(f)
     assert inspect_recording(path)["complete"]
+
+
+@pytest.mark.parametrize("interrupted", [False, True])
+def test_long_batches_once_the_scales_are_fixed(wall, tmp_path, monkeypatch, interrupted):
+    """The first batch fixes the scales (``batch_frames``); after it, ``long_batch_frames`` a batch (rerun's
+    index of the chunks written, kept for the footer, grows by batch sent), with the same rows as batches of
+    ``batch_frames`` throughout, for a finished and for an interrupted run."""
+    monkeypatch.setattr(recorder, "FLUSH_SECONDS", 1e9)  # by frame count only, however slow the machine
+    static, q0 = wall
+    frames = fx.frames(static, q0, 31)
+    rows, sent = {}, []
+    original = Recorder._send_batch
+
+    def send_batch(self, b):
+        if self.long_batch_frames == 12:
+            sent.append(len(b["step"]))
+        original(self, b)
+
+    monkeypatch.setattr(Recorder, "_send_batch", send_batch)
+    for long in (4, 12):
+        path = tmp_path / f"b{long}.rrd"
+        with pytest.raises(KeyboardInterrupt) if interrupted else _no_error():
+            with Recorder(path, static, fx.METADATA, batch_frames=4, long_batch_frames=long) as rec:
+                for f in frames:
+                    assert rec._batch_size() == (long if rec._scales_fixed() else 4)
+                    rec.log_frame(f)
+                if interrupted:
+                    raise KeyboardInterrupt
+        rows[long] = recording_rows(path)
+    assert sent == [5, 12, 12, 2]  # the initial frame and 4 (scales fixed), then 12 a batch, the rest at close
+    assert rows[12] == rows[4]
+    with Recorder(tmp_path / "d.rrd", static, fx.METADATA) as rec:
+        assert rec.long_batch_frames == recorder.LONG_BATCH_BLOCK_FRAMES // len(static.block_name)  # the default

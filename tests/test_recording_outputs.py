@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 from typer.testing import CliRunner
 
+import masonrycli.recording.recorder as recorder
 from masonrycli.cli import app
 from masonrycli.recording.readback import check_complete, inspect_recording
 
@@ -24,7 +25,9 @@ def invoke(*args):
 @pytest.fixture(scope="module")
 def recording(tmp_path_factory):
     rrd = tmp_path_factory.mktemp("rec") / "w.rrd"
-    result = invoke("simulate", "wall", "--duration", 0.3, "--record-every", 1, "--out", rrd)
+    with pytest.MonkeyPatch.context() as mp:  # a send every 100 frames: a file cut at a third holds some
+        mp.setattr(recorder, "LONG_BATCH_BLOCK_FRAMES", 0)  # batches of batch_frames (100) throughout
+        result = invoke("simulate", "wall", "--duration", 0.3, "--record-every", 1, "--out", rrd)
     assert result.exit_code == 0, result.output
     return rrd
 
@@ -43,6 +46,7 @@ def test_full_disk_at_the_recorder_stops_the_run(tmp_path, monkeypatch):
         original(self)
 
     monkeypatch.setattr(Recorder, "flush", full_disk)
+    monkeypatch.setattr(recorder, "LONG_BATCH_BLOCK_FRAMES", 0)  # a send at frame 201: the disk fills mid-run
     rrd, npz = tmp_path / "w.rrd", tmp_path / "h.npz"
     result = invoke("simulate", "wall", "--duration", 0.3, "--record-every", 1, "--out", rrd, "--history", npz)
     assert result.exit_code == 4, result.output

@@ -1,8 +1,8 @@
 """The recorder: writes one run's ``.rrd`` from its frames (and its steps' solver health).
 
 One ``.rrd`` per run from an explicit ``rr.RecordingStream``, with an embedded default blueprint.
-Constants are logged static; frames are buffered and sent with ``send_columns`` every ``batch_frames``
-frames, one array per entity kind. Timelines ``step`` (sequence) and ``sim_time`` (duration). Entity
+Constants are logged static; frames are buffered and sent with ``send_columns`` in batches (below), one
+array per entity kind. Timelines ``step`` (sequence) and ``sim_time`` (duration). Entity
 paths: ``layout.ENTITY_PATHS``. The initial frame (step 0, t = 0: the structure as built, at rest, before
 the first step) sets the references (drawing plane, as-built shape) and is logged like any other, so the
 recording starts at t = 0 as the history does: no contacts and no forces yet (the first step's solve makes
@@ -18,7 +18,15 @@ point per block with its values (float32); the principal-axis glyphs; one result
 logged for every step (``log_step``), sent with the frames or every ``STEP_BATCH`` steps. The magnified
 deformed shape is logged when the recorder closes, when the largest displacement of the run is known; its
 poses wait in an anonymous temporary file until then (``magnified.PoseSpool``). Memory held does not grow
-with the run but for rerun's own index of the chunks written (the file's footer, per batch sent).
+with the run but for rerun's own index of the chunks written (the file's footer, ~22 chunks a batch sent).
+
+Batches: ``batch_frames`` (100) frames until the scales are fixed (they come from the first batch with
+data), then ``long_batch_frames``: fewer batches, a smaller index (~2 kB a frame at 100 frames a batch),
+but a batch costs about 1.5 kB per block and frame while it is sent, hence ``LONG_BATCH_BLOCK_FRAMES`` over
+the block count (the 51-block wall: 392 frames; 248 blocks: 100, as before; benchmarks/README.md,
+"Memory"). Once the scales are fixed a batch is also sent when ``FLUSH_SECONDS`` have passed, so a killed
+run loses at most about a second of frames and a slow run's file stays current. The rows do not depend on
+where the batches end (``readback.recording_rows``).
 
 Scales: colour ranges follow the data (``masonrycli.colour_range.RangeTracker``, checked every frame);
 the joint-resultant scale (``RESULTANT_LENGTH`` block heights for the 95th percentile resultant of the
@@ -91,6 +99,7 @@ APPLICATION_ID: Final = "masonry"
 _RECORDING_NAMESPACE: Final = uuid.UUID("6f1c4f5e-9b0e-4c51-a0a6-3f0d6c1e2a77")
 STEP_BATCH: Final = 10_000  # steps' solver health buffered at most between sends (~2 MB)
 FLUSH_SECONDS: Final = 1.0  # s of wall-clock time between writes to the file, once the scales are fixed
+LONG_BATCH_BLOCK_FRAMES: Final = 20_000  # blocks x frames a batch once the scales are fixed (module doc, "Batches")
 
 
 @contextlib.contextmanager
@@ -118,10 +127,12 @@ class Recorder:
 
     Leaving the ``with`` block by an exception closes the recording with status "failed"
     (KeyboardInterrupt: "interrupted") and the time of the last frame; the file is complete either way.
-    ``magnify``: the magnified view's factor (None: the largest displacement of the run drawn as 5 % of
-    the structure's size, ``masonrycli.joint_forces.magnification``). The paper-figure tabs are added
-    for the scenarios of ``layout.PAPER_FIGURES`` under the paper's loading whose ``duration_s`` reaches
-    the paper's instant (``paper_figures``).
+    ``batch_frames``: frames a batch until the scales are fixed; ``long_batch_frames`` after (None:
+    ``LONG_BATCH_BLOCK_FRAMES`` over the block count; at least ``batch_frames``). ``magnify``: the magnified
+    view's factor (None: the largest displacement of the run drawn as 5 % of the structure's size,
+    ``masonrycli.joint_forces.magnification``). The paper-figure tabs are added for the scenarios of
+    ``layout.PAPER_FIGURES`` under the paper's loading whose ``duration_s`` reaches the paper's instant
+    (``paper_figures``).
     """
 
     def __init__(
@@ -134,6 +145,7 @@ class Recorder:
         *,
         main_field: str = "cell_spherical_stress",
         magnify: float | None = None,
+        long_batch_frames: int | None = None,
     ) -> None:
         if main_field not in FIELD_BY_KEY:
             raise ValueError(f"main_field must be one of {sorted(FIELD_BY_KEY)}, not {main_field!r}")
@@ -145,6 +157,8 @@ class Recorder:
         self._supports = Polygons(static.support_vert_start, static.support_vert_local)
         self._fill: Polygons | None = None  # inset blocks, once the structure's size is known
         self._n = n = self._blocks.count
+        long = LONG_BATCH_BLOCK_FRAMES // max(1, n) if long_batch_frames is None else long_batch_frames
+        self.long_batch_frames = max(self.batch_frames, int(long))
         first = np.asarray(static.block_vert_start[:-1], dtype=np.intp)
         loc = self._blocks.local
         size = (np.maximum.reduceat(loc, first) - np.minimum.reduceat(loc, first)) if n else np.ones((1, 2))
@@ -203,8 +217,9 @@ class Recorder:
 
     def on_frame(self, frame: Frame) -> None:
         """Buffer one frame (the :class:`~masonrycli.sinks.FrameSink` method); sends the buffer when it holds
-        ``batch_frames`` frames, or when ``FLUSH_SECONDS`` have passed and every scale is fixed (the scales
-        come from whole batches, so the recording's content does not depend on the machine's speed)."""
+        ``batch_frames`` frames (``long_batch_frames`` once the scales are fixed), or when ``FLUSH_SECONDS``
+        have passed and every scale is fixed (the scales come from whole batches, so the recording's content
+        does not depend on the machine's speed)."""
         if self._closed:
             raise RuntimeError("Recorder is closed")
         f64 = np.float64
@@ -240,13 +255,17 @@ class Recorder:
         self._last = (int(frame.step), float(frame.time))
         self._frames += 1
         due = time.perf_counter() - self._flushed >= FLUSH_SECONDS and self._scales_fixed()
-        if len(b["step"]) - _initial(b) >= self.batch_frames or due:
+        if len(b["step"]) - _initial(b) >= self._batch_size() or due:
             with _io_errors(self.path):
                 self.flush()
                 self.rec.flush()  # to the file: a killed run loses at most about FLUSH_SECONDS of frames
             self._flushed = time.perf_counter()
 
     log_frame = on_frame
+
+    def _batch_size(self) -> int:
+        """Frames a batch: ``batch_frames`` until the scales are fixed, then ``long_batch_frames``."""
+        return self.long_batch_frames if self._scales_fixed() else self.batch_frames
 
     def _scales_fixed(self) -> bool:
         """The force and glyph scales come from the first batch with data; the colour ranges follow each frame."""
@@ -420,7 +439,7 @@ class Recorder:
                 self._ref[:2],
                 self.magnify,
                 self._size,
-                self.batch_frames,
+                self.long_batch_frames,
             )
 
     # ---- run document
