@@ -24,7 +24,7 @@ from geometry_library.values import MATERIAL_RANGE
 from masonrycli.errors import InputContext, InputError
 from masonrycli.motion import Fixed, Motion
 from masonrycli.structure import build_structure, check_finite_tree, read_geometry, structure_warnings
-from masonrycli.values import check_int, check_real, check_vector, field_error, format_value, quote_string
+from masonrycli.values import check_int, check_real, check_vector, field_error, quote_string, shorten
 
 MAX_DURATION = 1e5
 """s — longer runs are refused as a likely typo."""
@@ -81,24 +81,23 @@ class RunConfig:
 
     def __post_init__(self):
         put = lambda k, v: object.__setattr__(self, k, v)  # noqa: E731
+        # as given (an option's TypedNumber keeps its text) for the messages below: "--dt 2" said "dt = 2.0"
+        dt, duration = self.dt, shorten(self.duration)
         put("duration", check_real("duration", self.duration, gt=0.0, le=MAX_DURATION))
         put("dt", check_real("dt", self.dt, gt=0.0))
         if self.dt > self.duration:
-            raise field_error("dt", self.dt, f"must be <= duration ({format_value(self.duration)})")
+            raise field_error("dt", dt, f"must be <= duration ({duration})")
         if self.duration / self.dt > MAX_STEPS:
             raise field_error(
-                "dt",
-                self.dt,
-                f"gives {self.duration / self.dt:,.0f} steps for duration "
-                f"{format_value(self.duration)} (at most {MAX_STEPS:,})",
+                "dt", dt, f"gives {self.duration / self.dt:,.0f} steps for duration {duration} (at most {MAX_STEPS:,})"
             )
         steps = self.duration / self.dt
         if abs(steps - round(steps)) > 1e-6 * max(1.0, steps):
             n = max(1, round(steps))
             raise field_error(
                 "dt",
-                self.dt,
-                f"does not divide duration = {format_value(self.duration)} ({steps:.6g} steps); "
+                dt,
+                f"does not divide duration = {duration} ({steps:.6g} steps); "
                 f"use dt = {self.duration / n:.6g} ({n} steps) or change the duration",
             )
         put("theta", check_real("theta", self.theta, ge=0.5, le=1.0))

@@ -21,7 +21,7 @@ OPTION_ROWS = [
         {**scen()},
         (*RUN, "--duration", "1e5", "--dt", "1e-4", "--no-recording"),
         2,
-        "--duration and --dt: dt = 0.0001: gives 1,000,000,000 steps for duration 100000.0 (at most 100,000,000)",
+        "--duration and --dt: dt = 1e-4: gives 1,000,000,000 steps for duration 1e5 (at most 100,000,000)",
     ),
     (
         "opt-dt-not-dividing",

@@ -172,6 +172,17 @@ def test_a_ctrl_c_while_the_arguments_are_read_is_one_line(argv, monkeypatch):
         ),
         (("limit", "arch", "--friction", "-1"), "--friction: friction = -1: must be >= 0"),
         (RUN + ("--magnify", "0.50"), "--magnify 0.50: must be between 1 and 1e+06"),
+        # RunConfig's dt-against-duration checks echoed the floats: "dt = 2.0", "duration 100000.0"
+        (("simulate", "wall", "--no-recording", "--dt", "2"), "--dt: dt = 2: must be <= duration (1.0)"),
+        (
+            ("simulate", "wall", "--no-recording", "--duration", "1e5", "--dt", "1e-4"),
+            "--duration and --dt: dt = 1e-4: gives 1,000,000,000 steps for duration 1e5 (at most 100,000,000)",
+        ),
+        (
+            ("simulate", "wall", "--no-recording", "--duration", "0.50", "--dt", "0.3"),
+            "--duration and --dt: dt = 0.3: does not divide duration = 0.50"
+            " (1.66667 steps); use dt = 0.25 (2 steps) or change the duration",
+        ),  # fmt: skip
     ],
 )
 def test_a_float_option_is_echoed_as_typed(args, line):
