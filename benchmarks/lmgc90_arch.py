@@ -1,27 +1,31 @@
-"""LMGC90 vs our engine on the paper's 98-block arch (right foundation settling), joint for joint.
+"""LMGC90 vs our engine on the paper's 98-block arch or 346-block aqueduct (right foundation settling), joint for joint.
 
-Three commands, each writing or reading JSON (findings: benchmarks/LMGC90.md, "The arch, joint for joint")::
+Three commands, each writing or reading JSON (findings: benchmarks/LMGC90.md, "The arch, joint for joint"
+and "The aqueduct, joint for joint")::
 
     /work/lmgc-venv/bin/python benchmarks/lmgc90_arch.py run lmgc90 --out arch-lmgc90.json
     PYTHONPATH=. .venv/bin/python benchmarks/lmgc90_arch.py run ours --out arch-ours.json
     python benchmarks/lmgc90_arch.py compare arch-lmgc90.json arch-ours.json   # either interpreter
 
-``run`` options: ``--times 0.5,1,2,3,5`` (s: snapshots, the last one is the duration), ``--settlement
+``run`` options: ``--structure arch|aqueduct`` (default arch), ``--times 0.5,1,2,3,5`` (s: snapshots, the last one is the duration), ``--settlement
 0.01`` (m/s downwards, right foundation; 0 for the structure standing under gravity alone),
 ``--tolerance`` (ours: m/s, default the scenario's 1e-5; LMGC90: the tol of its norm, default the
 config's), ``--cap`` (LMGC90: at most this many NLGS sweeps a step), ``--config matched`` (LMGC90's NLGS
 settings, see lmgc90_binding.CONFIGS). The findings' ``tight`` LMGC90 run is ``--tolerance 1e-6 --cap 20000``.
 
 * The arch is ``geometry_library.builders.build_arch()`` (98 blocks on two piers, two foundation
-  supports), what ``masonry simulate arch`` runs. LMGC90 (compas_lmgc90 0.1.11: 3-D only, RBDY3/POLYR,
+  supports), what ``masonry simulate arch`` runs; the aqueduct ``build_aqueduct()`` (the arch and 248
+  spandrel wall blocks), what ``masonry simulate aqueduct`` runs. LMGC90 (compas_lmgc90 0.1.11: 3-D only, RBDY3/POLYR,
   PRPRx) gets every block and support extruded to a 1.0 m deep prism (lmgc90_reference.prism), ρ = 2500,
   IQS_CLB μ = 0.6, alert 1e-3 m, dt = 1e-3 s, θ = 0.5, gravity −9.81 (hard-wired); the left foundation is
   fixed on its 6 dofs, the right one driven at Vz = −settlement, its 5 other dofs fixed. Ours:
-  ``builtin("arch", settlement=...)`` with the same dt, θ, μ, ρ, alert, thickness 1 m.
+  ``builtin(structure, settlement=...)`` with the same dt, θ, μ, ρ, alert, thickness 1 m.
 * A snapshot per time holds every body's 2-D pose (x, y, θ; LMGC90's x, z and its rotation in the x–z
   plane, plus its largest out-of-plane displacement and tilt) and every contact's bodies, in-plane point
-  and normal force (N). ``compare`` reduces both to the measures of ``arch_joints`` (joint openings,
-  hinges, per-joint resultants) over the joints of the initial polygons and prints a Markdown report.
+  and normal force (N). ``compare`` (``joints_compare``) reduces both to the measures of ``arch_joints``
+  (joint openings, hinges, sliding, per-joint resultants) over the joints of the initial polygons and
+  prints a Markdown report. Its keys of the arch's first comparison are unchanged (the saved arch
+  comparisons are reproduced bit for bit).
 * Cost: CPU seconds of the stepping loop (``time.process_time``). Ours excludes the first step but not a
   kernel numba compiles lazily later (0.4 CPU s for 5 s with a warm cache, 4 s on a cold one).
 """
@@ -30,7 +34,6 @@ from __future__ import annotations
 
 import argparse
 import json
-import math
 import sys
 import time
 from pathlib import Path
@@ -39,15 +42,18 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
 # siblings: this script's folder is first on sys.path when it runs
-from arch_joints import OPENING, diff_stats, end_openings, face_joints, joint_resultants, joint_states  # noqa: E402
+from joints_compare import compare, report  # noqa: E402
 from lmgc90_reference import ALERT, DEPTH, DT, MU, RHO, THETA, log, prism  # noqa: E402
 
+STRUCTURES = ("arch", "aqueduct")
 
-def arch_bodies():
-    """(names, (V, 2) vertex arrays of the blocks then the supports, block count N) of the default arch."""
-    from geometry_library.builders import build_arch
 
-    assembly = build_arch()
+def structure_bodies(structure: str = "arch"):
+    """(names, (V, 2) vertex arrays of the blocks then the supports, block count N) of the default
+    ``structure`` ("arch": build_arch(), "aqueduct": build_aqueduct())."""
+    from geometry_library.builders import build_aqueduct, build_arch
+
+    assembly = {"arch": build_arch, "aqueduct": build_aqueduct}[structure]()
     bodies = [*assembly.blocks, *assembly.supports]
     return [b.name for b in bodies], [b.vertices for b in bodies], len(assembly.blocks)
 
@@ -60,13 +66,15 @@ def steps_of(times):
 # LMGC90 (run with the reference venv's interpreter)
 
 
-def run_lmgc(times, settlement: float, config_name: str, tol: float | None = None, cap: int | None = None) -> dict:
+def run_lmgc(
+    times, settlement: float, config_name: str, tol: float | None = None, cap: int | None = None, structure="arch"
+) -> dict:
     import numpy as np
     from compas_lmgc90.solver import Solver
     from lmgc90_binding import CONFIGS, Lmgc
 
     lmgc = Lmgc()
-    names, polys, n = arch_bodies()
+    names, polys, n = structure_bodies(structure)
     solver = Solver(dt=DT, theta=THETA, density=RHO)
     solver.geometry_from_v_f([prism(p) for p in polys])
     left, right = names.index("left-foundation"), names.index("right-foundation")
@@ -140,7 +148,7 @@ def lmgc_snapshot(lmgc, k, c0, f0) -> dict:
 # ours (run with the project venv's interpreter)
 
 
-def run_ours(times, settlement: float, tolerance: float | None) -> dict:
+def run_ours(times, settlement: float, tolerance: float | None, structure: str = "arch") -> dict:
     import numpy as np
 
     from masonrycli.builtin import builtin
@@ -148,7 +156,7 @@ def run_ours(times, settlement: float, tolerance: float | None) -> dict:
 
     wanted = steps_of(times)
     extra = {} if tolerance is None else {"tolerance": tolerance}
-    sc = builtin("arch", settlement=settlement, duration=max(wanted) * DT, **extra)
+    sc = builtin(structure, settlement=settlement, duration=max(wanted) * DT, **extra)
     run, mat = sc.run, sc.material
     assert (run.dt, run.theta, run.alert_distance, mat.friction, mat.density, mat.thickness) == (
         DT,
@@ -157,7 +165,7 @@ def run_ours(times, settlement: float, tolerance: float | None) -> dict:
         MU,
         RHO,
         DEPTH,
-    ), "the arch scenario's defaults are not the LMGC90 run's"
+    ), f"the {structure} scenario's defaults are not the LMGC90 run's"
     sim = Simulation(sc)
     q0 = sim.state.body_q.tolist()
     sim.step()  # numba compile / cache load: this first step is timed apart
@@ -192,146 +200,12 @@ def run_ours(times, settlement: float, tolerance: float | None) -> dict:
     }
 
 
-# --------------------------------------------------------------------------------------------------
-# comparison (pure numpy)
-
-
-def end_names(names, polys, joints) -> list[tuple[str, str]]:
-    """What each joint end is: "intrados" / "extrados" on a joint of a voussoir (nearer the arch centre
-    or not), "inner" / "outer" on a bed joint of a pier (nearer x = 0 or not), "lower" / "upper" on a
-    head joint."""
-    import numpy as np
-
-    voussoir = [nm.startswith("v") for nm in names]
-    springing = max(p[:, 1].max() for p, nm in zip(polys, names) if "pier" in nm)
-    radii = [np.hypot(p[:, 0], p[:, 1] - springing) for p, v in zip(polys, voussoir) if v]
-    r_mid = 0.5 * (min(r.min() for r in radii) + max(r.max() for r in radii))
-    out = []
-    for (a, b), ends, n in zip(joints.body, joints.end, joints.normal):
-        if voussoir[a] or voussoir[b]:
-            key, words = np.hypot(ends[:, 0], ends[:, 1] - springing), ("intrados", "extrados")
-            key = key > r_mid
-        elif abs(n[1]) > abs(n[0]):
-            key, words = np.abs(ends[:, 0]) > np.abs(ends[:, 0]).min(), ("inner", "outer")
-        else:
-            key, words = ends[:, 1] > ends[:, 1].min(), ("lower", "upper")
-        out.append(tuple(words[int(k)] for k in key))
-    return out
-
-
-def state_label(state: int, ends) -> str:
-    """A joint's state (arch_joints.joint_states) in words: a hinge is named by the end it turns about."""
-    return ("closed", f"hinge@{ends[0]}", f"hinge@{ends[1]}", "open")[state]
-
-
-def compare(a: dict, b: dict) -> dict:
-    """Joint-for-joint comparison of two ``run`` documents (``a`` the reference) over every joint of the
-    initial arch (``ring``: the joints of a voussoir). Returns a JSON-able dict; :func:`report` formats it."""
-    import numpy as np
-
-    names, polys, n = arch_bodies()
-    joints = face_joints(polys)
-    ends = end_names(names, polys, joints)
-    ring = np.array([names[i].startswith("v") or names[j].startswith("v") for i, j in joints.body])
-    label = [f"{names[i]}|{names[j]}" for i, j in joints.body]
-    q0a, q0b = np.array(a["q0"]), np.array(b["q0"])  # each code's own initial poses
-    out = {
-        "joints": len(label),
-        "ring_joints": int(ring.sum()),
-        "n_blocks": n,
-        "times": [],
-        "q0_diff_m": diff_stats(q0a[:, :2], q0b[:, :2]),
-        "opening_threshold_m": OPENING,
-    }
-    for sa, sb in zip(a["snapshots"], b["snapshots"]):
-        assert sa["step"] == sb["step"], "the two runs' snapshots are not at the same steps"
-        rows = {}
-        for key, s, q0 in (("a", sa, q0a), ("b", sb, q0b)):
-            q = np.array(s["q"])
-            opening, slip, rel = end_openings(joints, q0, q)
-            total, ecc = joint_resultants(joints, s["contact_body"], s["contact_point"], s["contact_fn"], q0, q)
-            rows[key] = dict(q=q, opening=opening, rel=rel, state=joint_states(opening), fn=total, ecc=ecc)
-        ra, rb = rows["a"], rows["b"]
-        da, db = ra["q"][:n, :2] - q0a[:n, :2], rb["q"][:n, :2] - q0b[:n, :2]
-        same = ra["state"] == rb["state"]
-        word = lambda r, j: state_label(int(r["state"][j]), ends[j])  # noqa: E731
-        loaded = ring & (ra["fn"] > 0) & (rb["fn"] > 0)
-        out["times"].append(
-            {
-                "t": sa["t"],
-                "displacement_diff_m": diff_stats(da, db),
-                "displacement_max_m": [float(np.hypot(*da.T).max()), float(np.hypot(*db.T).max())],
-                "rotation_diff_rad": diff_stats(ra["q"][:n, 2] - q0a[:n, 2], rb["q"][:n, 2] - q0b[:n, 2]),
-                "ring_max_opening_diff_m": diff_stats(ra["opening"][ring].max(axis=1), rb["opening"][ring].max(axis=1)),
-                "ring_rel_rotation_diff_rad": diff_stats(ra["rel"][ring], rb["rel"][ring]),
-                "states_agree": int(same.sum()),
-                "ring_states_agree": int(same[ring].sum()),
-                "hinges": [[f"{label[j]} {word(r, j)}" for j in np.flatnonzero(r["state"])] for r in (ra, rb)],
-                "disagree": [
-                    f"{label[j]}: {word(ra, j)} (openings {1e3 * ra['opening'][j, 0]:.3f}, "
-                    f"{1e3 * ra['opening'][j, 1]:.3f} mm) vs {word(rb, j)} ({1e3 * rb['opening'][j, 0]:.3f}, "
-                    f"{1e3 * rb['opening'][j, 1]:.3f} mm)"
-                    for j in np.flatnonzero(~same)
-                ],
-                "ring_fn_total_N": [float(ra["fn"][ring].sum()), float(rb["fn"][ring].sum())],
-                "ring_fn_ratio_minus_1": diff_stats(ra["fn"][loaded] / rb["fn"][loaded], np.ones(int(loaded.sum()))),
-                "ring_ecc_diff_m": diff_stats(ra["ecc"][loaded], rb["ecc"][loaded]),
-                "per_ring_joint": [
-                    {
-                        "joint": label[j],
-                        "ends": ends[j],
-                        "state": [word(r, j) for r in (ra, rb)],
-                        "opening_mm": [[round(1e3 * x, 4) for x in r["opening"][j]] for r in (ra, rb)],
-                        "rel_rotation_mrad": [round(1e3 * float(r["rel"][j]), 4) for r in (ra, rb)],
-                        "fn_N": [round(float(r["fn"][j]), 1) for r in (ra, rb)],
-                        "ecc_mm": [
-                            None if math.isnan(r["ecc"][j]) else round(1e3 * float(r["ecc"][j]), 2) for r in (ra, rb)
-                        ],
-                    }
-                    for j in np.flatnonzero(ring)
-                ],
-            }
-        )
-    return out
-
-
-def report(cmp: dict, names=("LMGC90", "ours")) -> str:
-    """Markdown summary of :func:`compare`: one row per time, then the hinges and the disagreements."""
-    a, b = names
-    lines = [
-        f"| t (s) | joints in the same state, ring (of {cmp['ring_joints']}) / all (of {cmp['joints']}) | "
-        f"hinges {a} / {b} | block displacement \\|diff\\| median / RMS / max (mm) | largest block displacement "
-        f"{a} / {b} (mm) | ring joints' max opening \\|diff\\| median / max (mm) | ring joints' Fn / "
-        f"{b}'s − 1, median / max \\|·\\| | eccentricity \\|diff\\| median / max (mm) |",
-        "| --- | --- | --- | --- | --- | --- | --- | --- |",
-    ]
-    for r in cmp["times"]:
-        d, o, f, e = (
-            r["displacement_diff_m"],
-            r["ring_max_opening_diff_m"],
-            r["ring_fn_ratio_minus_1"],
-            r["ring_ecc_diff_m"],
-        )
-        lines.append(
-            f"| {r['t']:g} | {r['ring_states_agree']} / {r['states_agree']} | "
-            f"{len(r['hinges'][0])} / {len(r['hinges'][1])} | "
-            f"{1e3 * d['median']:.3f} / {1e3 * d['rms']:.3f} / {1e3 * d['max']:.3f} | "
-            f"{1e3 * r['displacement_max_m'][0]:.2f} / {1e3 * r['displacement_max_m'][1]:.2f} | "
-            f"{1e3 * o['median']:.4f} / {1e3 * o['max']:.4f} | {f['median']:.4f} / {f['max']:.4f} | "
-            f"{1e3 * e['median']:.1f} / {1e3 * e['max']:.1f} |"
-        )
-    for r in cmp["times"]:
-        lines.append(f"\nt = {r['t']:g} s: {a} hinges: {', '.join(r['hinges'][0]) or '-'}")
-        lines.append(f"t = {r['t']:g} s: {b} hinges: {', '.join(r['hinges'][1]) or '-'}")
-        lines += [f"  differs: {line}" for line in r["disagree"]]
-    return "\n".join(lines)
-
-
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     sub = ap.add_subparsers(dest="command", required=True)
     r = sub.add_parser("run")
     r.add_argument("engine", choices=("lmgc90", "ours"))
+    r.add_argument("--structure", choices=STRUCTURES, default="arch")
     r.add_argument("--times", default="0.5,1,2,3,5")
     r.add_argument("--settlement", type=float, default=0.01)
     r.add_argument("--tolerance", type=float, default=None, help="m/s, ours; LMGC90: its 'Quad ' norm's tol")
@@ -345,17 +219,28 @@ def main(argv=None):
     args = ap.parse_args(argv)
     if args.command == "compare":
         docs = [json.loads(Path(p).read_text()) for p in (args.reference, args.other)]
-        cmp = compare(*docs)
+        structures = [d.get("structure", "arch") for d in docs]
+        assert structures[0] == structures[1], f"the two runs are of different structures: {structures}"
+        cmp = compare(*docs, *structure_bodies(docs[0].get("structure", "arch")))
         if args.json:
             Path(args.json).write_text(json.dumps(cmp, separators=(",", ":")) + "\n")
         print(report(cmp, tuple(d["code"] for d in docs)))
         return
     times = sorted(float(t) for t in args.times.split(",") if t)
     if args.engine == "lmgc90":
-        doc = run_lmgc(times, args.settlement, args.config, args.tolerance, args.cap)
+        doc = run_lmgc(times, args.settlement, args.config, args.tolerance, args.cap, args.structure)
     else:
-        doc = run_ours(times, args.settlement, args.tolerance)
-    doc.update(settlement=args.settlement, times=times, dt=DT, theta=THETA, mu=MU, rho=RHO, alert=ALERT)
+        doc = run_ours(times, args.settlement, args.tolerance, args.structure)
+    doc.update(
+        structure=args.structure,
+        settlement=args.settlement,
+        times=times,
+        dt=DT,
+        theta=THETA,
+        mu=MU,
+        rho=RHO,
+        alert=ALERT,
+    )
     Path(args.out).write_text(json.dumps(doc))
     log(f"{args.engine}: {doc.get('cpu_s', doc.get('cpu_s_after_first_step')):.1f} CPU s, wrote {args.out}")
 
