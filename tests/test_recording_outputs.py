@@ -128,3 +128,54 @@ def test_recorder_writes_to_the_file_every_second(tmp_path, monkeypatch):
     rec.on_frame(frames[103])
     rec.close()
     assert inspect_recording(path)["frames"] == 104
+
+
+_LIMITED = """
+import resource, runpy, signal, sys
+signal.signal(signal.SIGXFSZ, signal.SIG_IGN)  # a write past the limit fails with EFBIG, as on a full disk
+import masonrycli.recording.readback as readback
+readback.WRITE_STALL_SECONDS = 1.0  # a stopped writer found sooner (5 s in a real run)
+limit = int(sys.argv[1])
+resource.setrlimit(resource.RLIMIT_FSIZE, (limit, limit))
+sys.argv = ["masonry", *sys.argv[2:]]
+runpy.run_module("masonrycli", run_name="__main__")
+"""
+
+
+def test_a_recording_whose_writes_fail_at_the_end_is_an_error_not_a_hang(tmp_path):
+    """rerun's file writer stops at its first failed write and never answers again: the recorder's final
+    disconnect (and the stream's __del__, and rerun's exit handler) then waited for it forever, the command
+    hung after its summary (4 of 9 runs with limits between 560 and 680 kB: a race in rerun, so four limits
+    are tried there). Here every file the command writes
+    is limited in size (RLIMIT_FSIZE, in a process of its own: the writes fail with EFBIG as on a full
+    disk) below the recording's size and above the history's: the command ends with exit 4 and one error
+    line naming --out, leaves no .rrd and no temporary file, and its history holds every frame of a run
+    without the limit."""
+    import subprocess
+    import sys
+
+    root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    args = ["simulate", "wall", "--duration", "0.3", "--out", "w.rrd", "--history", "h.npz"]
+    ref = tmp_path / "ref"
+    ref.mkdir()
+    done = subprocess.run([sys.executable, "-m", "masonrycli", *args], cwd=ref, capture_output=True, text=True,
+                          env=dict(os.environ, PYTHONPATH=root), timeout=120)  # fmt: skip
+    assert done.returncode == 0, done.stderr
+    rrd_size, npz_size = (ref / "w.rrd").stat().st_size, (ref / "h.npz").stat().st_size
+    assert npz_size < 0.6 * rrd_size  # 581 and 1033 kB at 87f3ff3
+    reference = np.load(ref / "h.npz")
+    for k, share in enumerate((0.6, 0.62, 0.64, 0.66, 0.9)):  # 0.9: in the last message, found by its footer
+        limit = int(share * rrd_size)
+        run = tmp_path / f"limit{k}"
+        run.mkdir()
+        done = subprocess.run([sys.executable, "-c", _LIMITED, str(limit), *args], cwd=run, capture_output=True,
+                              text=True, env=dict(os.environ, PYTHONPATH=root), timeout=30)  # fmt: skip
+        assert done.returncode == 4, (limit, done.stdout[-2000:], done.stderr[-2000:])
+        lines = [ln for ln in done.stderr.splitlines() if ln.strip()]
+        assert len(lines) == 1 and lines[0].startswith("error: cannot write --out w.rrd: "), done.stderr
+        assert "incomplete" in lines[0] and "Traceback" not in done.stdout + done.stderr
+        assert sorted(p.name for p in run.iterdir()) == ["h.npz"]
+        history = np.load(run / "h.npz")
+        assert str(history["status"]) == "failed"  # the run's outputs failed; its frames are all there
+        for key in ("step", "time", "block_q", "block_v", "cell_stress"):
+            assert np.array_equal(history[key], reference[key], equal_nan=True), key  # the same bits: NaN at t = 0

@@ -47,6 +47,56 @@ def check_complete(path: str | os.PathLike) -> None:
         raise OSError(errno.EIO, f"the recording is incomplete on disk ({cause})") from None
 
 
+WRITE_STALL_SECONDS = 5.0
+"""s the file may stop growing while rerun's writer still has messages for it before the writer is taken
+for stopped (wait_written)."""
+
+
+def wait_written(rec, path: str | os.PathLike) -> None:
+    """Wait until rerun's file writer has written everything ``rec`` was sent; ``OSError`` if it cannot.
+
+    rerun 0.41's file sink stops at its first failed write (a full disk, a file-size limit: "Failed to
+    write log stream ... File too large") and then never answers: ``disconnect`` and ``flush()`` waited for
+    it forever, the command hung at the end of its run with nothing said. Here ``flush`` is asked with a
+    short timeout, again while the file still grows (a slow disk writing a large batch), and the writer is
+    given up when rerun says it has shut down or the file has not grown for WRITE_STALL_SECONDS; the stream
+    is then abandoned (:func:`_abandon`) and must not be disconnected."""
+    size, since = -1, time.monotonic()
+    while True:
+        try:
+            rec.flush(timeout_sec=1.0)
+            return
+        except RuntimeError as exc:
+            why = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+            if "timed out" in why:
+                try:
+                    now = os.path.getsize(path)
+                except OSError:
+                    now = -1
+                if now != size:
+                    size, since = now, time.monotonic()
+                    continue
+                if time.monotonic() - since < WRITE_STALL_SECONDS:
+                    continue
+                why = f"nothing written for {WRITE_STALL_SECONDS:g} s"
+            _abandon(rec)
+            folder = os.path.dirname(os.path.abspath(path))
+            if shutil.disk_usage(folder).free < 1 << 20:
+                raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC)) from None
+            raise OSError(errno.EIO, f"rerun's writer stopped, the recording is incomplete ({why})") from None
+
+
+def _abandon(rec) -> None:
+    """Never release ``rec``, whose writer stopped: its ``__del__`` disconnects it (and rerun's exit handler
+    flushes every stream), which waited forever for that writer, after the command had said its error. One
+    reference leaked on purpose (the stream is never freed), and rerun's exit handler unregistered: every
+    other stream masonry opens is disconnected explicitly before the process ends."""
+    import ctypes
+
+    ctypes.pythonapi.Py_IncRef(ctypes.py_object(rec))
+    rr.unregister_shutdown()
+
+
 _FOLDER_NAMES = 3  # recordings named in the message about a folder; the rest are counted
 
 _RRD_MAGIC = b"RRF"  # a recording's first bytes ("RRF2" now; the digit is the format version)

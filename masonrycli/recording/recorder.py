@@ -81,7 +81,7 @@ from masonrycli.recording.layout import (
 )
 from masonrycli.recording.magnified import PoseSpool, send_magnified
 from masonrycli.recording.overlays import frame_joint_resultants, send_axes, send_joints
-from masonrycli.recording.readback import check_complete
+from masonrycli.recording.readback import check_complete, wait_written
 from masonrycli.recording.series import send_series, send_steps
 from masonrycli.recording.static_content import (
     TICKS,
@@ -151,7 +151,7 @@ class Recorder:
             raise ValueError(f"main_field must be one of {sorted(FIELD_BY_KEY)}, not {main_field!r}")
         self.path, self.static, self.metadata = os.fspath(path), static, dict(metadata)
         self.batch_frames = max(1, int(batch_frames))
-        self._t0, self._closed = time.perf_counter(), False
+        self._t0, self._closed, self._stopped = time.perf_counter(), False, False
         self._flushed = self._t0
         self._blocks = Polygons(static.block_vert_start, static.block_vert_local)
         self._supports = Polygons(static.support_vert_start, static.support_vert_local)
@@ -258,7 +258,7 @@ class Recorder:
         if len(b["step"]) - _initial(b) >= self._batch_size() or due:
             with _io_errors(self.path):
                 self.flush()
-                self.rec.flush()  # to the file: a killed run loses at most about FLUSH_SECONDS of frames
+                self._wait_written()  # to the file: a killed run loses at most about FLUSH_SECONDS of frames
             self._flushed = time.perf_counter()
 
     log_frame = on_frame
@@ -271,6 +271,14 @@ class Recorder:
         """The force and glyph scales come from the first batch with data; the colour ranges follow each frame."""
         return self.force_scale is not None and len(self.axis_scale) == len(AXES)
 
+    def _wait_written(self) -> None:
+        """readback.wait_written; after its OSError ``_stopped``: close neither sends nor disconnects."""
+        try:
+            wait_written(self.rec, self.path)
+        except OSError:
+            self._stopped = True
+            raise
+
     def flush(self) -> None:
         """Send the buffered frames and steps now."""
         batch, self._batch = self._batch, FrameBatch()  # an interrupted send loses a batch, never duplicates
@@ -281,9 +289,9 @@ class Recorder:
             send_steps(self.rec, steps, self._log10_tolerance)
 
     def close(self, status: str = COMPLETED, note: str = "") -> None:
-        """Flush, log the magnified shape, write the final run document and disconnect (which writes the
-        file's footer), then read the file's footer back: rerun's writer thread reports no I/O error, so a
-        full disk shows only as a file without one — raised as ``OSError``.
+        """Flush, log the magnified shape, write the final run document, wait for rerun's writer
+        (readback.wait_written: stopped by a full disk, ``OSError``, no disconnect) and disconnect (which
+        writes the footer), then read the footer back (a full disk may show only there: ``OSError``).
 
         ``status``: one of :data:`masonrycli.sinks.STATUSES`; ``note``: one line, e.g.
         "interrupted at t = 0.412 s (step 412)" (without a note, the last frame's time is given).
@@ -291,6 +299,13 @@ class Recorder:
         if self._closed:
             return
         self._closed = True
+        if self._stopped:  # the run already stopped on the writer's OSError: the file stays incomplete
+            if self._poses is not None:
+                with contextlib.suppress(OSError):
+                    self._poses.close()
+            if status == COMPLETED:
+                raise OSError(errno.EIO, "the recording is incomplete (rerun's writer stopped during the run)")
+            return
         error: Exception | None = None
         with _io_errors(self.path):
             try:
@@ -305,10 +320,13 @@ class Recorder:
                 self._log_metadata(status, note)
                 self._send_final_layout()
             finally:
-                self.rec.disconnect()
-                if self._poses is not None:  # after the footer: a full disk here must not cost the file
-                    with contextlib.suppress(OSError):
-                        self._poses.close()
+                try:
+                    self._wait_written()  # its OSError (the writer stopped) skips the disconnect
+                    self.rec.disconnect()
+                finally:
+                    if self._poses is not None:  # after the footer: a full disk here must not cost the file
+                        with contextlib.suppress(OSError):
+                            self._poses.close()
         check_complete(self.path)
         if error is not None:
             if status == COMPLETED:
