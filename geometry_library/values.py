@@ -28,8 +28,10 @@ from .blocks import GeometryError
 
 class TypedNumber(float):
     """A float as the user typed it on the command line (``text``: "0", "1e-9"), for messages only: they
-    echoed "--rtol 0" as "0.0" and "--thickness 1e9" as "1000000000.0". A float in every other respect
-    (repr, str, arithmetic, pickling), so no digest or written value changes; float(x) is the plain one."""
+    echoed "--rtol 0" as "0.0" and "--thickness 1e9" as "1000000000.0". A float in repr, str, hash,
+    equality, JSON, TOML (format_value) and numpy arrays, so no digest or written value changes (study
+    fingerprints hash reprs); arithmetic gives plain floats, and float(x) is the plain one. Pickled, it
+    stays a TypedNumber (other bytes than a float's: nothing hashes pickles, Dask tasks are pure=False)."""
 
     text: str
 

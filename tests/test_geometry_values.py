@@ -154,3 +154,27 @@ def test_material_outside_its_range_is_absurd():
         check_material("block 0", density=1e-300)
     with pytest.raises(GeometryError, match="must be a positive number"):
         check_material("block 0", density=-1.0)
+
+
+def test_a_typed_number_writes_and_hashes_as_the_float_it_is():
+    # An option's value keeps its text for messages only (cli_options.number_value): every value written
+    # or digested from a scenario must be the plain float's, and a Dask worker's copy keeps the text.
+    import json
+    import pickle
+
+    from geometry_library.values import TypedNumber
+    from masonrycli.values import format_value
+
+    for text in ("0.1", "1e9", "2e-3", "-0", "3"):
+        typed, plain = TypedNumber(float(text), text), float(text)
+        assert (repr(typed), str(typed), hash(typed), format_value(typed)) == (
+            repr(plain),
+            str(plain),
+            hash(plain),
+            format_value(plain),
+        )
+        assert json.dumps([typed]) == json.dumps([plain])
+        assert np.array([typed]).dtype == np.float64 and np.array([typed]).tobytes() == np.array([plain]).tobytes()
+        assert type(typed + 0.0) is float and type(float(typed)) is float
+        back = pickle.loads(pickle.dumps(typed))
+        assert type(back) is TypedNumber and back.text == text and repr(back) == repr(plain)
