@@ -15,7 +15,7 @@ from typing import TYPE_CHECKING, Annotated
 import typer
 
 from masonrycli.cli_options import choice_value, number_value, path_value
-from masonrycli.errors import EXIT_DIVERGED, EXIT_ROWS_FAILED
+from masonrycli.errors import EXIT_DIVERGED, EXIT_OUTPUT_FAILED, EXIT_ROWS_FAILED
 from masonrycli.interrupt import FirstSignalStops, exit_code, signal_name
 from masonrycli.outputs import OutputFile
 
@@ -269,8 +269,13 @@ def _report(console, result, plan: StudyPlan, im: str, written: list, signals: F
     if recording is not None:
         from masonrycli.recording.study import record_study
 
-        with written_whole(recording, around_commit=_recorded(signals, written, recording)) as part:
-            record_study(part, name, rows, request, fit, im, plot.path)
+        try:
+            with written_whole(recording, around_commit=_recorded(signals, written, recording)) as part:
+                record_study(part, name, rows, request, fit, im, plot.path)
+        except OSError as exc:  # a full disk: the table and plot are written, the recording is not (exit 4)
+            from masonrycli.cli_messages import fail
+
+            fail(f"cannot write {recording.option} {recording.path}: {exc.strerror or exc}", EXIT_OUTPUT_FAILED)
     # said once both are written: a reader of stdout that goes away (`masonry sweep … | head`) broke the pipe
     # at the first line after the table, and the plot and the recording were never written
     console.print(study_table(rows, columns, keys, console, result.out))

@@ -71,3 +71,32 @@ def test_hinge_drawn_on_both_copies_and_thrust_points_static(written):
     assert FILL in {c.entity_path.lstrip("/") for c in rr.chunk.RrdReader(path).stream()}
     thrust = [c for c in rr.chunk.RrdReader(path).stream() if c.entity_path == f"/{THRUST}" and c.is_static]
     assert thrust
+
+
+def test_a_limit_recording_that_cannot_be_written_whole_is_exit_4_and_no_file(tmp_path):
+    # With every file limited below the recording's size (RLIMIT_FSIZE, writes failing as on a full disk)
+    # `masonry limit arch --out` said nothing and exited 0 with a truncated l.rrd (limits of 40, 150 and 165
+    # of 171 kB), or hung in rerun's disconnect for good (80, 120 kB). Now: exit 4, one line naming --out,
+    # no file (the temporary one removed).
+    import os
+    import subprocess
+    import sys
+
+    from test_recording_outputs import _LIMITED
+
+    root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    env = dict(os.environ, PYTHONPATH=root)
+    args = ["limit", "arch", "--out", "l.rrd"]
+    done = subprocess.run([sys.executable, "-m", "masonrycli", *args], cwd=tmp_path, env=env, capture_output=True,
+                          text=True, timeout=120)  # fmt: skip
+    assert done.returncode == 0, done.stderr
+    size = (tmp_path / "l.rrd").stat().st_size
+    for k, share in enumerate((0.25, 0.7, 0.96)):
+        run = tmp_path / f"limit{k}"
+        run.mkdir()
+        done = subprocess.run([sys.executable, "-c", _LIMITED, str(int(share * size)), *args], cwd=run, env=env,
+                              capture_output=True, text=True, timeout=30)  # fmt: skip
+        lines = [ln for ln in done.stderr.splitlines() if ln.strip()]
+        assert done.returncode == 4 and len(lines) == 1, (share, done.stdout[-1000:], done.stderr[-1000:])
+        assert lines[0].startswith("error: cannot write --out l.rrd: ") and "incomplete" in lines[0], lines[0]
+        assert list(run.iterdir()) == []

@@ -240,3 +240,34 @@ def test_grid_sweep_state_map_and_histories(block, tmp_path):
 
     assert blueprint_views(tmp_path / "grid.rrd")["state map: amp (m/s) right, friction up"]["kind"] == "2D"
     assert panel_states(tmp_path / "grid.rrd") == {"/blueprint_panel": "collapsed", "/selection_panel": "collapsed"}
+
+
+def test_a_study_recording_that_cannot_be_written_whole_is_exit_4_the_table_kept(tmp_path):
+    # Every file limited below the study recording's size (RLIMIT_FSIZE: writes fail as on a full disk,
+    # above the table's and the plot's): exit 0 with a truncated s.rrd at 50 and 66 of 68 kB, a hang for good
+    # in rerun's save at 20 kB. Now exit 4, one line naming the recording, the table and plot kept, no .rrd.
+    import os
+    import subprocess
+    import sys
+
+    from test_recording_outputs import _LIMITED
+
+    root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    env = dict(os.environ, PYTHONPATH=root)
+    args = ["sweep", "wall", "--param", "amp=0.1,0.2", "--duration", "0.05", "--workers", "0", "--out", "s.parquet"]
+    done = subprocess.run([sys.executable, "-m", "masonrycli", *args], cwd=tmp_path, env=env, capture_output=True,
+                          text=True, timeout=120)  # fmt: skip
+    assert done.returncode == 0, done.stderr
+    sizes = {p.name: p.stat().st_size for p in tmp_path.iterdir()}
+    assert sorted(sizes) == ["s.parquet", "s.png", "s.rrd"] and sizes["s.rrd"] > 2 * max(
+        sizes["s.parquet"], sizes["s.png"]
+    )
+    for k, share in enumerate((0.3, 0.95)):
+        run = tmp_path / f"limit{k}"
+        run.mkdir()
+        done = subprocess.run([sys.executable, "-c", _LIMITED, str(int(share * sizes["s.rrd"])), *args], cwd=run,
+                              env=env, capture_output=True, text=True, timeout=30)  # fmt: skip
+        lines = [ln for ln in done.stderr.splitlines() if ln.strip()]
+        assert done.returncode == 4 and len(lines) == 1, (share, done.stdout[-1000:], done.stderr[-1000:])
+        assert lines[0].startswith("error: cannot write --out's recording s.rrd: "), lines[0]
+        assert sorted(p.name for p in run.iterdir()) == ["s.parquet", "s.png"]

@@ -19,7 +19,7 @@ from rich.table import Table
 from rich.text import Text
 
 from masonrycli import SOURCE_DIGEST, __version__
-from masonrycli.errors import InputError
+from masonrycli.errors import EXIT_OUTPUT_FAILED, InputError
 from masonrycli.interrupt import StopRun, StopSignals, exit_code, signal_name
 from masonrycli.limit.analysis import LimitResult, analyse
 from masonrycli.limit.problem import LimitError, LiveLoad
@@ -247,8 +247,13 @@ def _analyse(structure, live, friction, verify, out, force, done: _Done, signals
         err_console.print(Text.assemble(("warning:", "yellow"), f" {warning}"))
     if target is not None:
         with signals.held():  # a signal now waits until the recording is whole and in place
-            with written_whole(target) as part:  # under a temporary name, renamed when complete
-                write_recording(done.result, part)
+            try:
+                with written_whole(target) as part:  # under a temporary name, renamed when complete
+                    write_recording(done.result, part)
+            except OSError as exc:  # a full disk: as simulate's outputs, exit 4 (it said "completed", exit 0)
+                from masonrycli.cli_messages import fail
+
+                fail(f"cannot write {target.option} {target.path}: {exc.strerror or exc}", EXIT_OUTPUT_FAILED)
             done.out = target.path
     if not verify:
         return []

@@ -26,6 +26,7 @@ from masonrycli.colormap import VIRIDIS, map_scalars
 from masonrycli.recording.arrays import Polygons, z0
 from masonrycli.recording.document import viewer_safe_text
 from masonrycli.recording.layout import HINGE_RGBA, OUTLINE_RGBA, PLANE, SLIP_RGBA, SUPPORT_FILL_RGBA, XY
+from masonrycli.recording.readback import check_complete, wait_written
 from masonrycli.recording.recorder import APPLICATION_ID
 from masonrycli.recording.static_content import log_plane
 
@@ -204,5 +205,7 @@ def write_limit_recording(path: str | os.PathLike, drawing: MechanismDrawing) ->
                     [len(p) for p in points]
                 ),
             )
-    finally:
+    finally:  # a writer stopped by a full disk: OSError, no disconnect (it hung); a file without its footer too
+        wait_written(rec, path)
         rec.disconnect()
+    check_complete(path)

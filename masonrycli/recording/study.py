@@ -47,6 +47,7 @@ import rerun.blueprint as rrb
 
 from masonrycli.intensity import UNITS
 from masonrycli.recording.document import viewer_safe_text
+from masonrycli.recording.readback import check_complete, wait_written
 from masonrycli.recording.recorder import APPLICATION_ID
 from masonrycli.study.curves import (
     STATE_COLOURS,
@@ -66,6 +67,9 @@ def record_study(path: Path, name: str, rows: list[dict], request, fit, im: str,
     a temporary name and renames it (``masonrycli.outputs.written_whole``)."""
     path = Path(path)
     rec = rr.RecordingStream(APPLICATION_ID, recording_id=str(uuid.uuid4()))
+    # to the file from the start, the blueprint sent at the end: a save at the end handed rerun's writer the
+    # whole backlog at once, and when a write failed (a full disk) save waited for it forever
+    rec.save(path)
     views = [rrb.TextDocumentView(origin="study/rows", name="rows")]
     if plot and Path(plot).exists():
         rec.log("study/plot", rr.EncodedImage(path=plot), static=True)
@@ -100,8 +104,10 @@ def record_study(path: Path, name: str, rows: list[dict], request, fit, im: str,
         views.insert(0, view)
         panels.append(panel)
     rec.log("study/rows", rr.TextDocument(_markdown(name, rows), media_type=rr.MediaType.MARKDOWN), static=True)
-    rec.save(path, default_blueprint=rrb.Blueprint(rrb.Grid(*views), *panels))
+    rec.send_blueprint(rrb.Blueprint(rrb.Grid(*views), *panels), make_active=True, make_default=True)
+    wait_written(rec, path)  # a writer stopped by a full disk: OSError, no disconnect (it hung)
     rec.disconnect()
+    check_complete(path)
     return path
 
 
