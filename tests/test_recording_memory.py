@@ -178,3 +178,18 @@ def test_long_batches_once_the_scales_are_fixed(wall, tmp_path, monkeypatch, int
     assert rows[12] == rows[4]
     with Recorder(tmp_path / "d.rrd", static, fx.METADATA) as rec:
         assert rec.long_batch_frames == recorder.LONG_BATCH_BLOCK_FRAMES // len(static.block_name)  # the default
+
+
+def test_rows_of_a_time_with_a_nanosecond_remainder(wall, tmp_path):
+    """recording_rows read sim_time through datetime.timedelta (microseconds): 1.024999999 s raised
+    (found comparing the rows of `simulate wall --duration 2`); durations are compared as ns now."""
+    import dataclasses
+
+    static, q0 = wall
+    frames = fx.frames(static, q0, 3)
+    path = tmp_path / "ns.rrd"
+    with Recorder(path, static, fx.METADATA, batch_frames=2) as rec:
+        for i, f in enumerate(frames):
+            rec.log_frame(dataclasses.replace(f, time=[0.0, 1.024999999, 1.025][i]))
+    rows = [r for rows in recording_rows(path).values() for r in rows]
+    assert any("('sim_time', 1024999999)" in row for row in rows), rows[0][:300]

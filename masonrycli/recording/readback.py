@@ -358,13 +358,19 @@ def recording_rows(path: str | os.PathLike) -> dict[str, list[str]]:
             continue
         batch = chunk.to_record_batch()
         names = sorted(n for n in batch.schema.names if n != "rerun.controls.RowId")
-        columns = [(n, batch.column(n).to_pylist()) for n in names]
+        columns = [(n, _plain(batch.column(n)).to_pylist()) for n in names]
         rows = [repr([(n, values[i]) for n, values in columns]) for i in range(batch.num_rows)]
         if chunk.is_static:
             static[f"static {chunk.entity_path}"] = [_RUN_CODE.sub(r"\1\2", _RUN_CLOCK.sub(r"\1\2\3", rows[-1]))]
         else:
             temporal.setdefault(chunk.entity_path, []).extend(rows)
     return {entity: sorted(rows) for entity, rows in temporal.items()} | static
+
+
+def _plain(column: pa.Array) -> pa.Array:
+    """Durations, timestamps as int64 ns: to_pylist's timedelta raises on 1.024999999 s without pandas."""
+    time_like = pa.types.is_duration(column.type) or pa.types.is_timestamp(column.type)
+    return column.cast(pa.int64()) if time_like else column
 
 
 # ---------------------------------------------------------------------------------------- headless viewer
