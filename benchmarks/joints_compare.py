@@ -179,6 +179,18 @@ def compare(a: dict, b: dict, names, polys, n: int) -> dict:
                     for r, s in zip((ra, rb), sliding)
                 ],
                 "sliding_agree": int((sliding[0] == sliding[1]).sum()),
+                "group_sliding": {  # LMGC90 / ours / both
+                    g: [
+                        int((sliding[0] & m).sum()),
+                        int((sliding[1] & m).sum()),
+                        int((sliding[0] & sliding[1] & m).sum()),
+                    ]
+                    for g, m in groups.items()
+                },
+                "slip_ratio_minus_1_both": _stats(
+                    ra["slip"][sliding[0] & sliding[1]] / rb["slip"][sliding[0] & sliding[1]],
+                    np.ones(int((sliding[0] & sliding[1]).sum())),
+                ),
             }
         )
     return out

@@ -10,7 +10,7 @@ and "The aqueduct, joint for joint")::
 ``run`` options: ``--structure arch|aqueduct`` (default arch), ``--times 0.5,1,2,3,5`` (s: snapshots, the last one is the duration), ``--settlement
 0.01`` (m/s downwards, right foundation; 0 for the structure standing under gravity alone),
 ``--tolerance`` (ours: m/s, default the scenario's 1e-5; LMGC90: the tol of its norm, default the
-config's), ``--cap`` (LMGC90: at most this many NLGS sweeps a step), ``--config matched`` (LMGC90's NLGS
+config's), ``--cap`` (LMGC90: at most this many NLGS sweeps a step), ``--mu 0.6`` (both codes' friction coefficient), ``--config matched`` (LMGC90's NLGS
 settings, see lmgc90_binding.CONFIGS). The findings' ``tight`` LMGC90 run is ``--tolerance 1e-6 --cap 20000``.
 
 * The arch is ``geometry_library.builders.build_arch()`` (98 blocks on two piers, two foundation
@@ -67,7 +67,13 @@ def steps_of(times):
 
 
 def run_lmgc(
-    times, settlement: float, config_name: str, tol: float | None = None, cap: int | None = None, structure="arch"
+    times,
+    settlement: float,
+    config_name: str,
+    tol: float | None = None,
+    cap: int | None = None,
+    structure="arch",
+    mu: float = MU,
 ) -> dict:
     import numpy as np
     from compas_lmgc90.solver import Solver
@@ -82,7 +88,7 @@ def run_lmgc(
         solver.v_drvdof[g] = {i: np.zeros((1, 6)) for i in range(1, 7)}
     # V(t) = [v0 + v1 cos(v2 t + v3)] · min(1, v4 + v5 t) = −settlement
     solver.apply_velocity(right, "Vz", np.array([[-settlement, 0.0, 0.0, 0.0, 1.0, 0.0]]))
-    solver.contact_law("IQS_CLB", MU, alert=ALERT)
+    solver.contact_law("IQS_CLB", mu, alert=ALERT)
     solver.preprocess()
     config = dict(CONFIGS[config_name])
     if tol is not None:
@@ -148,7 +154,7 @@ def lmgc_snapshot(lmgc, k, c0, f0) -> dict:
 # ours (run with the project venv's interpreter)
 
 
-def run_ours(times, settlement: float, tolerance: float | None, structure: str = "arch") -> dict:
+def run_ours(times, settlement: float, tolerance: float | None, structure: str = "arch", mu: float = MU) -> dict:
     import numpy as np
 
     from masonrycli.builtin import builtin
@@ -156,13 +162,13 @@ def run_ours(times, settlement: float, tolerance: float | None, structure: str =
 
     wanted = steps_of(times)
     extra = {} if tolerance is None else {"tolerance": tolerance}
-    sc = builtin(structure, settlement=settlement, duration=max(wanted) * DT, **extra)
+    sc = builtin(structure, settlement=settlement, duration=max(wanted) * DT, friction=mu, **extra)
     run, mat = sc.run, sc.material
     assert (run.dt, run.theta, run.alert_distance, mat.friction, mat.density, mat.thickness) == (
         DT,
         THETA,
         ALERT,
-        MU,
+        mu,
         RHO,
         DEPTH,
     ), f"the {structure} scenario's defaults are not the LMGC90 run's"
@@ -211,6 +217,7 @@ def main(argv=None):
     r.add_argument("--tolerance", type=float, default=None, help="m/s, ours; LMGC90: its 'Quad ' norm's tol")
     r.add_argument("--cap", type=int, default=None, help="LMGC90: at most this many NLGS sweeps per step")
     r.add_argument("--config", default="matched")
+    r.add_argument("--mu", type=float, default=MU, help="Coulomb friction coefficient of every joint (both codes)")
     r.add_argument("--out", required=True)
     c = sub.add_parser("compare")
     c.add_argument("reference")
@@ -228,16 +235,16 @@ def main(argv=None):
         return
     times = sorted(float(t) for t in args.times.split(",") if t)
     if args.engine == "lmgc90":
-        doc = run_lmgc(times, args.settlement, args.config, args.tolerance, args.cap, args.structure)
+        doc = run_lmgc(times, args.settlement, args.config, args.tolerance, args.cap, args.structure, args.mu)
     else:
-        doc = run_ours(times, args.settlement, args.tolerance, args.structure)
+        doc = run_ours(times, args.settlement, args.tolerance, args.structure, args.mu)
     doc.update(
         structure=args.structure,
         settlement=args.settlement,
         times=times,
         dt=DT,
         theta=THETA,
-        mu=MU,
+        mu=args.mu,
         rho=RHO,
         alert=ALERT,
     )

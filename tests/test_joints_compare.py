@@ -95,6 +95,8 @@ def test_compare_tells_a_hinge_from_a_slide_with_the_exact_amounts():
     assert r["sliding"] == [[f"{head} 2.000 mm (hinge@lower)"], [f"{bed} 0.300 mm (closed)"]]
     assert r["max_slip_m"] == pytest.approx([s, slide], rel=1e-9) and r["max_slip_joint"] == [head, bed]
     assert r["sliding_agree"] == 1
+    assert r["group_sliding"] == {"ring": [0, 0, 0], "extrados": [0, 0, 0], "spandrel": [1, 1, 0], "piers": [0, 0, 0]}
+    assert r["slip_ratio_minus_1_both"] == {}
     # forces: the pier's bed joint 500 N in both; the wall's bed joint 1000 N at its right end against
     # 1600 N (600 at the left end): centres of pressure 0.5 m and 0.125 m from the middle
     assert r["fn_diff_N"]["median"] == pytest.approx(300.0) and r["fn_diff_N"]["max"] == pytest.approx(600.0)
