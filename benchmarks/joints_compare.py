@@ -230,7 +230,8 @@ def report(cmp: dict, names=("LMGC90", "ours")) -> str:
             "| t (s) | "
             + " | ".join(f"{g}: same state (of {cmp['groups'][g]}); hinged/open {a} / {b}" for g in groups)
             + " | in another state: of them within 0.5 mm in opening"
-            + f" | all loaded joints: Fn \\|diff\\| median / max (N; median Fn {a}) | Fn / {b}'s − 1 (≥ 1 kN), median / max"
+            + f" | all loaded joints: Fn \\|diff\\| median / max (N; median Fn {a})"
+            + f" | Fn / {b}'s − 1 (≥ 1 kN), median / max"
             f" | eccentricity \\|diff\\| median / max (mm) | largest slip {a} / {b} (mm) | sliding joints {a} / {b}"
             " (> 0.1 mm) |",
             "| --- | " + " | ".join("---" for _ in groups) + " | --- | --- | --- | --- | --- | --- |",

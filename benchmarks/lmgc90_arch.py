@@ -1,17 +1,18 @@
-"""LMGC90 vs our engine on the paper's 98-block arch or 346-block aqueduct (right foundation settling), joint for joint.
+"""LMGC90 vs our engine on the paper's 98-block arch or 346-block aqueduct (right foundation settling).
 
-Three commands, each writing or reading JSON (findings: benchmarks/LMGC90.md, "The arch, joint for joint"
-and "The aqueduct, joint for joint")::
+Joint for joint. Three commands, each writing or reading JSON (findings: benchmarks/LMGC90.md, "The arch,
+joint for joint" and "The aqueduct, joint for joint")::
 
     /work/lmgc-venv/bin/python benchmarks/lmgc90_arch.py run lmgc90 --out arch-lmgc90.json
     PYTHONPATH=. .venv/bin/python benchmarks/lmgc90_arch.py run ours --out arch-ours.json
     python benchmarks/lmgc90_arch.py compare arch-lmgc90.json arch-ours.json   # either interpreter
 
-``run`` options: ``--structure arch|aqueduct`` (default arch), ``--times 0.5,1,2,3,5`` (s: snapshots, the last one is the duration), ``--settlement
-0.01`` (m/s downwards, right foundation; 0 for the structure standing under gravity alone),
-``--tolerance`` (ours: m/s, default the scenario's 1e-5; LMGC90: the tol of its norm, default the
-config's), ``--cap`` (LMGC90: at most this many NLGS sweeps a step), ``--mu 0.6`` (both codes' friction coefficient), ``--config matched`` (LMGC90's NLGS
-settings, see lmgc90_binding.CONFIGS). The findings' ``tight`` LMGC90 run is ``--tolerance 1e-6 --cap 20000``.
+``run`` options: ``--structure arch|aqueduct`` (default arch), ``--times 0.5,1,2,3,5`` (s: snapshots, the
+last one is the duration), ``--settlement 0.01`` (m/s downwards, right foundation; 0 for the structure
+standing under gravity alone), ``--tolerance`` (ours: m/s, default the scenario's 1e-5; LMGC90: the tol of
+its norm, default the config's), ``--cap`` (LMGC90: at most this many NLGS sweeps a step), ``--mu 0.6``
+(both codes' friction coefficient), ``--config matched`` (LMGC90's NLGS settings, see
+lmgc90_binding.CONFIGS). The findings' ``tight`` LMGC90 run is ``--tolerance 1e-6 --cap 20000``.
 
 * The arch is ``geometry_library.builders.build_arch()`` (98 blocks on two piers, two foundation
   supports), what ``masonry simulate arch`` runs; the aqueduct ``build_aqueduct()`` (the arch and 248
