@@ -143,7 +143,7 @@ def _number_with_unit(exc) -> str | None:
         return None
     try:  # "--blocks 51.5": a number, not a whole one; "(write 51.5, without quotes)" read a quote never typed
         float(text)
-        hint = ""
+        hint = " (an underscore is not a digit separator here)" if "_" in text else ""
     except ValueError:
         hint = unit_hint(text, unit_of(param.name))
     shown = text.strip()

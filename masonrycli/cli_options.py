@@ -16,13 +16,14 @@ from typing import Annotated
 
 import typer
 from pydantic import TypeAdapter
+from pydantic_core import PydanticCustomError
 
 from geometry_library.values import TypedNumber
 
 
 def _opt(kind: type, panel: str, help: str, *decls: str, parser=None):
     """An optional ``kind`` value (None when not given), listed under ``panel`` in --help."""
-    parser = parser or {Path: path_value, float: number_value}.get(kind)
+    parser = parser or {Path: path_value, float: number_value, int: whole_value}.get(kind)
     parser = {"parser": parser} if parser else {}
     return Annotated[kind | None, typer.Option(*decls, help=help, rich_help_panel=panel, **parser)]
 
@@ -36,11 +37,29 @@ def choice_value(text: str) -> str:
 _FLOAT = TypeAdapter(float)
 
 
+_INT = TypeAdapter(int)
+
+
+def _no_underscore(text: str, kind: str) -> None:
+    """Refuse "1_0": Python's float() and int() (so pydantic's lax ones) read it as 10, but on the command
+    line it is a typo ("--dt 1_0" ran with dt = 10). A scenario file's TOML 1_0 stays its syntax."""
+    if "_" in str(text):
+        raise PydanticCustomError(kind, "Input should be a valid number")
+
+
 def number_value(text: str) -> TypedNumber:
     """A float option's value that remembers how it was typed, for the messages that echo it ("--rtol 0:
     must be in (0, 1)", was "0.0"). Parsed as typer parses a float (pydantic's lax float), so a value that
-    is not a number fails as before (cli_messages: "--dt 20ms: must be a number ...")."""
+    is not a number fails as before (cli_messages: "--dt 20ms: must be a number ..."), except digits with
+    underscores (:func:`_no_underscore`)."""
+    _no_underscore(text, "float_parsing")
     return TypedNumber(_FLOAT.validate_python(text), str(text))
+
+
+def whole_value(text: str) -> int:
+    """An int option's value, parsed as typer parses an int (pydantic's lax int), without underscores."""
+    _no_underscore(text, "int_parsing")
+    return _INT.validate_python(text)
 
 
 def path_value(text: str) -> Path:

@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING, Annotated
 
 import typer
 
-from masonrycli.cli_options import choice_value, number_value, path_value
+from masonrycli.cli_options import choice_value, number_value, path_value, whole_value
 from masonrycli.errors import EXIT_DIVERGED, EXIT_OUTPUT_FAILED, EXIT_ROWS_FAILED
 from masonrycli.interrupt import FirstSignalStops, exit_code, signal_name
 from masonrycli.outputs import OutputFile
@@ -99,6 +99,7 @@ def sweep_command(
         int | None,
         typer.Option(
             "--workers",
+            parser=whole_value,
             help="Worker processes of the local cluster (default: one per core; never more than the runs; 0: no cluster).",
         ),
     ] = None,

@@ -30,6 +30,9 @@ RUN = ("simulate", "wall", "--duration", "0.01", "--no-recording")
         ("--record-every", "10steps", '--record-every 10steps: must be an integer (write 10, without "steps"'),
         ("--blocks", "51 blocks", '--blocks 51 blocks: must be an integer (write 51, without "blocks"'),
         ("--dt", "abc", "--dt abc: must be a number"),
+        # float() and int() read "1_0" as 10: on the command line a typo, run with dt = 10 before
+        ("--dt", "1_0", "--dt 1_0: must be a number (an underscore is not a digit separator here)"),
+        ("--blocks", "5_1", "--blocks 5_1: must be an integer (an underscore is not a digit separator here)"),
     ],
 )
 def test_a_number_option_given_text_says_what_to_write(option, value, message):
@@ -86,6 +89,20 @@ def test_a_number_option_given_text_says_what_to_write(option, value, message):
             "'0.1m/s' is not a number (write 0.1, in m/s, without the unit)",
         ),
         (("sweep", "wall", "--param", "amp=abc"), "--param amp=abc: 'abc' is not a number"),
+        # digits with an underscore: a typo on the command line (float() reads "1_0" as 10)
+        (
+            ("sweep", "wall", "--param", "amp=1_0,2"),
+            "--param amp=1_0,2: '1_0' is not a number (an underscore is not a digit separator here)",
+        ),
+        (("sweep", "wall", "--param", "amp=1:2:1_0"), "--param amp=1:2:1_0: N = '1_0' must be a whole number"),
+        (
+            ("sweep", "wall", "--param", "amp=1", "--workers", "1_0"),
+            "--workers 1_0: must be an integer (an underscore is not a digit separator here)",
+        ),
+        (
+            ("build", "arch", "--span", "3_6", "--out", "x.geojson"),
+            "--span 3_6: must be a number (an underscore is not a digit separator here)",
+        ),
     ],
 )
 def test_every_command_says_what_to_write_for_its_numbers(args, message):

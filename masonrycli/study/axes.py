@@ -65,8 +65,10 @@ def parse_axis(text: str, where: str = "") -> Axis:
             raise InputError(f"{where}: a range is LO:HI:N (e.g. amp=0.1:1.0:10)")
         lo, hi = (_number(p, where, name) for p in parts[:2])
         try:
-            n = int(parts[2])
+            n = int(parts[2]) if "_" not in parts[2] else None
         except ValueError:
+            n = None
+        if n is None:
             raise InputError(f"{where}: N = {parts[2]!r} must be a whole number of values") from None
         if n < 1 or (n == 1 and lo != hi):
             raise InputError(f"{where}: N must be >= 2 for a range (or give one value)")
@@ -85,6 +87,8 @@ def parse_axis(text: str, where: str = "") -> Axis:
 
 
 def _number(text: str, where: str, name: str) -> float:
+    if "_" in text:  # float() reads "1_0" as 10: on the command line a typo, refused as every option refuses it
+        raise InputError(f"{where}: {text.strip()!r} is not a number (an underscore is not a digit separator here)")
     try:
         value = float(text)
     except ValueError:
