@@ -116,6 +116,15 @@ _SPELLINGS = {  # a unit -> how users write it, compared after _spelled (lower c
     "rad": ("rad", "radian", "radians"),
 }
 _NUMBER_AND_UNIT = re.compile(r"\s*([+-]?(?:\d+(?:\.\d*)?|\.\d+)(?:[eE][+-]?\d+)?)\s*([A-Za-zµμ°][^\n]*?)\s*")
+_UNIT_PART = r"[A-Za-zµμ°]+(?:(?:\^|\*\*)?-?[0-9²³])?"  # a symbol or word, one digit of power: m, m3, s-1, m^3
+_UNIT = re.compile(rf"{_UNIT_PART}(?:\s*[/.·*]\s*{_UNIT_PART}|\s+{_UNIT_PART})*")
+"""What a written unit looks like ("ms", "cm/s", "kg/m^3", "kg·m-3", "Seconds", "°"): "0x10" read as 0 and
+a unit "x10" said "convert 0 x10 to m"."""
+_NOT_A_UNIT = re.compile(
+    r"\s*[+-]?(?:0[xX][0-9a-fA-F_]*|0[oO][0-7_]*|0[bB][01_]*|[\d.]+[eE]|[\d.]+\s*[xX×]\s*\d[^\n]*)\s*"
+)
+"""A Python hex, octal or binary literal ("0x10", "0b1", "0xff": "xff" looks like a word), a number cut
+short at its exponent ("1e") or a product ("2x3", "1x10^3"): not a number and a unit."""
 
 
 def _spelled(unit: str) -> str:
@@ -170,7 +179,7 @@ def _string_hint(text: str, unit: str | None) -> str:
     except ValueError:
         pass
     found = _NUMBER_AND_UNIT.fullmatch(text)
-    if found is None:
+    if found is None or _NOT_A_UNIT.fullmatch(text) or not _UNIT.fullmatch(found.group(2)):
         return ""
     number, written = found.groups()
     if unit is None:  # a setting of no known unit (a sample of an inline record): the number alone

@@ -89,6 +89,13 @@ def test_a_number_option_given_text_says_what_to_write(option, value, message):
             "'0.1m/s' is not a number (write 0.1, in m/s, without the unit)",
         ),
         (("sweep", "wall", "--param", "amp=abc"), "--param amp=abc: 'abc' is not a number"),
+        # not a unit: a hex literal read as 0 and "x10" said "(it is read in m: convert 0 x10 to m ...)"
+        (("simulate", "wall", "--thickness", "0x10"), "--thickness 0x10: must be a number"),
+        (
+            ("build", "arch", "--ring-thickness", "0xff", "--out", "x.geojson"),
+            "--ring-thickness 0xff: must be a number",
+        ),
+        (("sweep", "wall", "--param", "amp=0x1,2"), "--param amp=0x1,2: '0x1' is not a number"),
         # digits with an underscore: a typo on the command line (float() reads "1_0" as 10)
         (
             ("sweep", "wall", "--param", "amp=1_0,2"),

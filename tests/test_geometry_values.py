@@ -86,6 +86,12 @@ def test_number_problem(value, kwargs, reason):
         ("0.5 m/s", None, 'must be a number, not a string (write 0.5, without "m/s", in SI units)'),
         ("1,5 m", "m", "must be a number, not a string"),  # a decimal comma: no number to name
         ("one s", "s", "must be a number, not a string"),
+        # not a number and a unit: said "convert 0 x10 to m" (a hex literal read as 0 and "x10")
+        ("0x10", "m", "must be a number, not a string"),
+        ("0xff", "m", "must be a number, not a string"),
+        ("1e", "m", "must be a number, not a string"),
+        ("2x3", "m", "must be a number, not a string"),
+        ("3 m;4", "m", "must be a number, not a string"),
         ("2500", "kg/m³", "must be a number, not a string (write 2500, without quotes)"),
     ],
 )
