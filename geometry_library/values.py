@@ -49,6 +49,12 @@ def shown(value) -> str:
     return value.text if isinstance(value, TypedNumber) else repr(value)
 
 
+def _g(value) -> str:
+    """``value`` for a range message: as typed (a :class:`TypedNumber`: "--span 1e9" said "span 1e+09"), else
+    in %g (a scenario file's or a GeoJSON's number)."""
+    return value.text if isinstance(value, TypedNumber) else f"{value:g}"
+
+
 def is_real(value) -> bool:
     """An int or a float (numpy's too), not a bool."""
     return isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(value, (bool, np.bool_))
@@ -242,7 +248,7 @@ def check_material(label: str, **values) -> None:
     for key, value in values.items():
         lo, hi, unit = MATERIAL_RANGE[key]
         if not lo <= value <= hi:
-            raise GeometryError(f"{label}: {key} {value:g} {unit} is absurd (a likely typo: {lo:g} to {hi:g} {unit})")
+            raise GeometryError(f"{label}: {key} {_g(value)} {unit} is absurd (a likely typo: {lo:g} to {hi:g} {unit})")
 
 
 DIMENSION_RANGE = (1e-3, 1e3)
@@ -257,7 +263,7 @@ def check_dimensions(label: str, **values) -> None:
     lo, hi = DIMENSION_RANGE
     for key, value in values.items():
         if not lo <= value <= hi:
-            raise GeometryError(f"{label}: {key} {value:g} m is absurd (a likely typo: {lo:g} to {hi:g} m)")
+            raise GeometryError(f"{label}: {key} {_g(value)} m is absurd (a likely typo: {lo:g} to {hi:g} m)")
 
 
 MAX_BLOCKS = 100_000

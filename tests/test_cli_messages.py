@@ -196,6 +196,15 @@ def test_a_ctrl_c_while_the_arguments_are_read_is_one_line(argv, monkeypatch):
         ),
         (("limit", "arch", "--friction", "-1"), "--friction: friction = -1: must be >= 0"),
         (RUN + ("--magnify", "0.50"), "--magnify 0.50: must be between 1 and 1e+06"),
+        # a builder dimension's range check said "span 1e+09 m" (geometry's check_dimensions in %g)
+        (
+            ("simulate", "arch", "--span", "1e9", "--no-recording"),
+            'builder "arch": span 1e9 m is absurd (a likely typo: 0.001 to 1000 m)',
+        ),
+        (
+            ("build", "wall", "--block-height", "1E-9", "--out", "x.geojson"),
+            'builder "wall": block_height 1E-9 m is absurd (a likely typo: 0.001 to 1000 m)',
+        ),
         # RunConfig's dt-against-duration checks echoed the floats: "dt = 2.0", "duration 100000.0"
         (("simulate", "wall", "--no-recording", "--dt", "2"), "--dt: dt = 2: must be <= duration (1.0)"),
         (

@@ -8,6 +8,7 @@ import pytest
 from geometry_library.blocks import GeometryError
 from geometry_library.values import (
     SETTING_UNITS,
+    TypedNumber,
     check_count,
     check_positive,
     is_integer,
@@ -160,6 +161,9 @@ def test_material_outside_its_range_is_absurd():
         check_material("block 0", density=1e-300)
     with pytest.raises(GeometryError, match="must be a positive number"):
         check_material("block 0", density=-1.0)
+    # a value typed on the command line is echoed as typed (said "thickness 1e+09 m")
+    with pytest.raises(GeometryError, match=r"^block 0: thickness 1e9 m is absurd"):
+        check_material("block 0", thickness=TypedNumber(1e9, "1e9"))
 
 
 def test_a_typed_number_writes_and_hashes_as_the_float_it_is():
@@ -168,7 +172,6 @@ def test_a_typed_number_writes_and_hashes_as_the_float_it_is():
     import json
     import pickle
 
-    from geometry_library.values import TypedNumber
     from masonrycli.values import format_value
 
     for text in ("0.1", "1e9", "2e-3", "-0", "3"):
