@@ -122,10 +122,28 @@ _SPELLINGS = {  # a unit -> how users write it, compared after _spelled (lower c
     "rad": ("rad", "radian", "radians"),
 }
 _NUMBER_AND_UNIT = re.compile(r"\s*([+-]?(?:\d+(?:\.\d*)?|\.\d+)(?:[eE][+-]?\d+)?)\s*([A-Za-zµμ°][^\n]*?)\s*")
-_UNIT_PART = r"[A-Za-zµμ°]+(?:(?:\^|\*\*)?-?[0-9²³])?"  # a symbol or word, one digit of power: m, m3, s-1, m^3
-_UNIT = re.compile(rf"{_UNIT_PART}(?:\s*[/.·*]\s*{_UNIT_PART}|\s+{_UNIT_PART})*")
-"""What a written unit looks like ("ms", "cm/s", "kg/m^3", "kg·m-3", "Seconds", "°"): "0x10" read as 0 and
-a unit "x10" said "convert 0 x10 to m"."""
+_SYMBOL = r"(?:[nµμumcdkg]?(?:m|s|g|t|n|pa|j|w|hz|rad|l|h|bar)|deg|°|min|hr|in|ft|yd|lbs?|kip|psi|mph|cps)"
+_WORD = (  # a unit's name, maybe prefixed, maybe plural: "Seconds", "millimetres", "kilonewton"
+    r"(?:(?:nano|micro|milli|centi|deci|kilo|mega|giga)?"
+    r"(?:sec|second|met(?:er|re)|gram|gramme|tonne|ton|newton|pascal|joule|watt|hertz|radian|degree|minute|hour"
+    r"|lit(?:er|re))s?|inch(?:es)?|foot|feet)"
+)
+_COUNT = r"(?:x|mu|times|(?:block|course|voussoir|pier|step|frame|sweep|iteration|core|worker)s?)"
+"""What a plain number, a count or a ratio is written with ("0.5x", "0.6mu", "51 blocks", "10steps",
+"2cores"): a hint only for a setting with no unit ("5x" for a thickness in m is no unit)."""
+
+
+def _unit_pattern(part: str) -> re.Pattern:
+    """Parts (each with one digit of power: m3, s-1, m^3) joined by / . · * or spaces, in any case."""
+    part = rf"{part}(?:(?:\^|\*\*)?-?[0-9²³])?"
+    return re.compile(rf"{part}(?:\s*[/.·*]\s*{part}|\s+{part})*", re.IGNORECASE)
+
+
+_UNIT = _unit_pattern(f"(?:{_SYMBOL}|{_WORD})")
+"""A written unit: SI symbols with a prefix or unit names ("ms", "cm/s", "kg/m^3", "kg·m-3", "3 kN",
+"Seconds", "°", "ft"). "12abc" said "convert 12 abc to m", "0x10" (0 and "x10") "convert 0 x10 to m"."""
+_UNITLESS = _unit_pattern(f"(?:{_SYMBOL}|{_WORD}|{_COUNT})")
+"""A written unit or what a unitless setting is written with (_COUNT)."""
 _NOT_A_UNIT = re.compile(
     r"\s*[+-]?(?:0[xX][0-9a-fA-F_]*|0[oO][0-7_]*|0[bB][01_]*|[\d.]+[eE]|[\d.]+\s*[xX×]\s*\d[^\n]*)\s*"
 )
@@ -185,7 +203,9 @@ def _string_hint(text: str, unit: str | None) -> str:
     except ValueError:
         pass
     found = _NUMBER_AND_UNIT.fullmatch(text)
-    if found is None or _NOT_A_UNIT.fullmatch(text) or not _UNIT.fullmatch(found.group(2)):
+    if found is None or _NOT_A_UNIT.fullmatch(text):
+        return ""
+    if not (_UNITLESS if unit == "" else _UNIT).fullmatch(found.group(2)):  # "12abc", "5x" for a length
         return ""
     number, written = found.groups()
     if unit is None:  # a setting of no known unit (a sample of an inline record): the number alone

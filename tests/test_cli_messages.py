@@ -30,6 +30,13 @@ RUN = ("simulate", "wall", "--duration", "0.01", "--no-recording")
         ("--record-every", "10steps", '--record-every 10steps: must be an integer (write 10, without "steps"'),
         ("--blocks", "51 blocks", '--blocks 51 blocks: must be an integer (write 51, without "blocks"'),
         ("--dt", "abc", "--dt abc: must be a number"),
+        # a hint only when a unit follows the number: "12abc" said "convert 12 abc to m", "5x" "convert 5 x"
+        ("--thickness", "12abc", "--thickness 12abc: must be a number"),
+        ("--thickness", "5x", "--thickness 5x: must be a number"),
+        ("--thickness", "3 kN", "--thickness 3 kN: must be a number (it is read in m: convert 3 kN to m and write"),
+        ("--thickness", "12mm", "--thickness 12mm: must be a number (it is read in m: convert 12 mm to m and write"),
+        ("--courses", "3abc", "--courses 3abc: must be an integer"),
+        ("--courses", "3mm", '--courses 3mm: must be an integer (write 3, without "mm": this setting has no unit)'),
         # float() and int() read "1_0" as 10: on the command line a typo, run with dt = 10 before
         ("--dt", "1_0", "--dt 1_0: must be a number (an underscore is not a digit separator here)"),
         ("--blocks", "5_1", "--blocks 5_1: must be an integer (an underscore is not a digit separator here)"),
@@ -38,8 +45,8 @@ RUN = ("simulate", "wall", "--duration", "0.01", "--no-recording")
 def test_a_number_option_given_text_says_what_to_write(option, value, message):
     result = invoke(*RUN, option, value)
     assert_one_line_error(result, message)
-    if value == "abc":
-        assert result.output.strip().endswith("--dt abc: must be a number")
+    if message.endswith(("must be a number", "must be an integer")):
+        assert result.output.strip().endswith(message)  # plain garbage: no hint
 
 
 @pytest.mark.parametrize(
@@ -89,6 +96,14 @@ def test_a_number_option_given_text_says_what_to_write(option, value, message):
             "'0.1m/s' is not a number (write 0.1, in m/s, without the unit)",
         ),
         (("sweep", "wall", "--param", "amp=abc"), "--param amp=abc: 'abc' is not a number"),
+        (("sweep", "wall", "--param", "amp=12abc,2"), "--param amp=12abc,2: '12abc' is not a number"),
+        (("sweep", "wall", "--param", "amp=5x,2"), "--param amp=5x,2: '5x' is not a number"),
+        (("sweep", "wall", "--param", "blocks=5abc,7"), "--param blocks=5abc,7: '5abc' is not a number"),
+        (
+            ("sweep", "wall", "--param", "blocks=51blocks,7"),
+            "--param blocks=51blocks,7: '51blocks' is not a number (write 51, without \"blocks\"",
+        ),
+        (("sweep", "wall", "--param", "amp=1", "--workers", "2abc"), "--workers 2abc: must be an integer"),
         # not a unit: a hex literal read as 0 and "x10" said "(it is read in m: convert 0 x10 to m ...)"
         (("simulate", "wall", "--thickness", "0x10"), "--thickness 0x10: must be a number"),
         (
@@ -115,7 +130,7 @@ def test_a_number_option_given_text_says_what_to_write(option, value, message):
 def test_every_command_says_what_to_write_for_its_numbers(args, message):
     result = invoke(*args)
     assert_one_line_error(result, message)
-    if message.endswith("is not a number") or message.endswith("must be a number"):
+    if message.endswith(("is not a number", "must be a number", "must be an integer")):
         assert result.output.strip().endswith(message)  # plain garbage: no hint
 
 

@@ -93,6 +93,23 @@ def test_number_problem(value, kwargs, reason):
         ("1e", "m", "must be a number, not a string"),
         ("2x3", "m", "must be a number, not a string"),
         ("3 m;4", "m", "must be a number, not a string"),
+        # a hint only when a unit follows the number ("12abc" said "convert 12 abc to m")
+        ("12abc", "m", "must be a number, not a string"),
+        ("12 abc", "", "must be a number, not a string"),
+        ("12 abc", None, "must be a number, not a string"),
+        ("5x", "m", "must be a number, not a string"),
+        ("5x", "", 'must be a number, not a string (write 5, without "x": this setting has no unit)'),
+        ("3 kN", "m", "must be a number, not a string (it is read in m: convert 3 kN to m and write the number alone)"),
+        (
+            "12mm",
+            "m",
+            "must be a number, not a string (it is read in m: convert 12 mm to m and write the number alone)",
+        ),
+        (
+            "2 Millimetres",
+            "m",
+            "must be a number, not a string (it is read in m: convert 2 Millimetres to m and write the number alone)",
+        ),
         ("2500", "kg/m³", "must be a number, not a string (write 2500, without quotes)"),
     ],
 )
