@@ -56,28 +56,58 @@ def face_joints(polygons, tol: float = 1e-6, min_length: float = 1e-3) -> Joints
                 continue
             n = sign * np.array([d[1], -d[0]]) / length
             edges.append((i, s, e, n))
-    lo = np.array([p.min(axis=0) for p in polys])
-    hi = np.array([p.max(axis=0) for p in polys])
+    lo = np.array([p.min(axis=0) for p in polys]).reshape(-1, 2)
+    hi = np.array([p.max(axis=0) for p in polys]).reshape(-1, 2)
     best: dict[tuple[int, int], tuple[float, np.ndarray, np.ndarray]] = {}
-    for ia, sa, ea, na in edges:
-        for ib, sb, eb, nb in edges:
-            if ib <= ia or np.any(lo[ia] > hi[ib] + tol) or np.any(lo[ib] > hi[ia] + tol):
-                continue
-            if np.dot(na, nb) > -1 + 1e-9 or abs(np.dot(sb - sa, na)) > tol or abs(np.dot(eb - sa, na)) > tol:
-                continue
-            t = (ea - sa) / np.hypot(*(ea - sa))  # along edge a
-            u = sorted((np.dot(sb - sa, t), np.dot(eb - sa, t)))
-            first, last = max(0.0, u[0]), min(np.dot(ea - sa, t), u[1])
-            if last - first <= min_length:
-                continue
-            if last - first > best.get((ia, ib), (0.0,))[0]:
-                best[(ia, ib)] = (last - first, np.array([sa + first * t, sa + last * t]), na)
+    for a, b in _candidate_edge_pairs(edges, lo, hi, tol):  # in the order of a loop over all a, then all b
+        (ia, sa, ea, na), (ib, sb, eb, nb) = edges[a], edges[b]
+        if np.dot(na, nb) > -1 + 1e-9 or abs(np.dot(sb - sa, na)) > tol or abs(np.dot(eb - sa, na)) > tol:
+            continue
+        t = (ea - sa) / np.hypot(*(ea - sa))  # along edge a
+        u = sorted((np.dot(sb - sa, t), np.dot(eb - sa, t)))
+        first, last = max(0.0, u[0]), min(np.dot(ea - sa, t), u[1])
+        if last - first <= min_length:
+            continue
+        if last - first > best.get((ia, ib), (0.0,))[0]:
+            best[(ia, ib)] = (last - first, np.array([sa + first * t, sa + last * t]), na)
     keys = sorted(best)
     return Joints(
         body=np.array(keys, dtype=np.int64).reshape(-1, 2),
         end=np.array([best[k][1] for k in keys]).reshape(-1, 2, 2),
         normal=np.array([best[k][2] for k in keys]).reshape(-1, 2),
     )
+
+
+def _candidate_edge_pairs(edges, lo, hi, tol: float) -> np.ndarray:
+    """(K, 2) indices (a, b) into ``edges`` that may lie face to face, sorted by a then b: the edges of bodies
+    ia < ib whose boxes (lo, hi) meet within ``tol``, nearly opposite normals and b's ends nearly on a's line.
+    A superset of what :func:`face_joints` keeps (its tests on these few pairs decide, exactly as before):
+    the pure-Python loop over every pair of edges took 3.8 s of CPU on the aqueduct (1 700 edges).
+
+        boxes meet:      not (lo[ia] > hi[ib] + tol or lo[ib] > hi[ia] + tol) in x and y, ia < ib
+        edge pairs:      every edge of ia with every edge of ib
+        keep if:         na · nb <= -1 + 2e-9 and |(sb − sa) · na|, |(eb − sa) · na| <= 2 tol + 1e-9 m
+    """
+    if not edges:
+        return np.zeros((0, 2), dtype=np.int64)
+    body = np.array([e[0] for e in edges])
+    s, e, n = (np.array([edge[k] for edge in edges]) for k in (1, 2, 3))
+    apart = (lo[:, None, :] > hi[None, :, :] + tol).any(axis=2)  # B x B: a few hundred bodies
+    ia, ib = np.nonzero(np.triu(~apart & ~apart.T, k=1))
+    first = np.searchsorted(body, np.arange(len(lo)))  # edges are listed body by body
+    count = np.searchsorted(body, np.arange(len(lo)), side="right") - first
+    per = count[ia] * count[ib]
+    pair = np.repeat(np.arange(len(ia)), per)
+    k = np.arange(per.sum()) - np.repeat(np.cumsum(per) - per, per)
+    a = first[ia][pair] + k // count[ib][pair]
+    b = first[ib][pair] + k % count[ib][pair]
+    na = n[a]
+    keep = (np.einsum("ij,ij->i", na, n[b]) <= -1 + 2e-9) & (
+        np.abs(np.einsum("ij,ij->i", s[b] - s[a], na)) <= 2 * tol + 1e-9
+    )
+    keep &= np.abs(np.einsum("ij,ij->i", e[b] - s[a], na)) <= 2 * tol + 1e-9
+    order = np.lexsort((b[keep], a[keep]))
+    return np.stack([a[keep][order], b[keep][order]], axis=1)
 
 
 def _rot(theta):

@@ -139,3 +139,68 @@ def test_opening_and_slip_are_read_along_body_a_s_turned_face():
     np.testing.assert_allclose(opening[0, right], -(1.0 + s) * math.sin(phi), rtol=1e-12)
     np.testing.assert_allclose(slip[0, right], 1.0 - (1.0 + s) * math.cos(phi), rtol=1e-9)
     np.testing.assert_allclose(rel, [-phi])
+
+
+def _naive_face_joints(polygons, tol=1e-6, min_length=1e-3):
+    """face_joints the slow way, for the check below: every pair of bodies, every pair of their edges, in
+    plain Python floats; an edge pair is a joint when b's edge lies on a's line (cross products within tol)
+    with the bodies on either side (the edges run opposite ways when both polygons turn the same way) and
+    their shared stretch is longer than min_length. Per pair of bodies the longest, the first on a tie."""
+    turn = [
+        math.copysign(1.0, sum(x0 * y1 - x1 * y0 for (x0, y0), (x1, y1) in zip(p, p[1:] + p[:1]))) for p in polygons
+    ]
+    found = {}
+    for i, p in enumerate(polygons):
+        for j, r in enumerate(polygons):
+            if j <= i:
+                continue
+            for k in range(len(p)):
+                (ax, ay), (bx, by) = p[k], p[(k + 1) % len(p)]
+                la = math.hypot(bx - ax, by - ay)
+                if la <= min_length:
+                    continue
+                tx, ty = (bx - ax) / la, (by - ay) / la
+                for m in range(len(r)):
+                    (cx, cy), (dx, dy) = r[m], r[(m + 1) % len(r)]
+                    lb = math.hypot(dx - cx, dy - cy)
+                    if lb <= min_length:
+                        continue
+                    off_c, off_d = tx * (cy - ay) - ty * (cx - ax), tx * (dy - ay) - ty * (dx - ax)
+                    if abs(off_c) > tol or abs(off_d) > tol:  # not on a's line
+                        continue
+                    if turn[i] * turn[j] * ((dx - cx) * tx + (dy - cy) * ty) > -lb * (1 - 1e-9):  # same side
+                        continue
+                    lo_, hi_ = sorted(((cx - ax) * tx + (cy - ay) * ty, (dx - ax) * tx + (dy - ay) * ty))
+                    lo_, hi_ = max(lo_, 0.0), min(hi_, la)
+                    if hi_ - lo_ > min_length and hi_ - lo_ > found.get((i, j), (0.0,))[0]:
+                        found[(i, j)] = (hi_ - lo_, [(ax + lo_ * tx, ay + lo_ * ty), (ax + hi_ * tx, ay + hi_ * ty)])
+    return found
+
+
+def test_face_joints_are_those_of_a_naive_search():
+    """The numpy search of face_joints against every pair of edges tried in plain Python: the built arch (100
+    bodies) and a hand-made set (a clockwise block, turned ones, a short overlap, a gap under tol, a step, a tie)."""
+    turn = np.array([[math.cos(0.3), -math.sin(0.3)], [math.sin(0.3), math.cos(0.3)]])
+    hand = [
+        SQUARE,
+        SQUARE[::-1] + (1.0, 0.0),  # clockwise, beside 0
+        SQUARE + (0.9995, 1.0),  # on 0 over 0.5 mm only (< min_length): a joint with 1, not with 0
+        SQUARE + (0.0, -1.0 - 5e-7),  # under 0 by a gap within tol
+        SQUARE @ turn.T + (5.0, 0.0),
+        (SQUARE @ turn.T) * (1.0, -1.0) + (5.0, 0.0),  # its mirror: touches it at a vertex only
+        SQUARE @ turn.T + (5.0, 0.0) + turn[:, 0],  # face to face with the turned one
+        np.array([[2.0, 0.0], [3.0, 0.0], [3.0, 0.5], [2.5, 0.5], [2.5, 1.0], [2.0, 1.0]]),  # a step beside 1
+        np.array(
+            [[10.0, 0.0], [13.0, 0.0], [13.0, 2.0], [12.0, 2.0], [12.0, 1.0], [11.0, 1.0], [11.0, 2.0], [10.0, 2.0]]
+        ),
+        SQUARE + (11.0, 1.0),  # in the U's notch: three faces of 1 m, the first found is kept
+    ]
+    a = build_arch()
+    for polygons in (hand, [np.asarray(b.vertices) for b in (*a.blocks, *a.supports)]):
+        joints = face_joints(polygons)
+        naive = _naive_face_joints([[tuple(map(float, v)) for v in p] for p in polygons])
+        assert joints.body.tolist() == sorted(map(list, naive))
+        np.testing.assert_allclose(joints.end, [naive[k][1] for k in sorted(naive)], rtol=0, atol=1e-12)
+        length = np.hypot(*(joints.end[:, 1] - joints.end[:, 0]).T)
+        np.testing.assert_allclose(length, [naive[k][0] for k in sorted(naive)], rtol=0, atol=1e-12)
+        assert len(joints.body) == (6 if polygons is hand else 165)
