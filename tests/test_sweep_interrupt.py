@@ -286,3 +286,24 @@ def test_an_error_without_a_signal_is_not_taken_for_one(block, tmp_path, monkeyp
     monkeypatch.setattr(study, "prepare", broken)
     result = invoke("sweep", block, "-p", "amp=0.05,0.1", "--duration", 0.02, "--workers", 0, "-o", tmp_path / "s.csv")
     assert result.exit_code != 130 and isinstance(result.exception, TypeError), result.output
+
+
+def test_ctrl_c_before_the_first_row_leaves_no_table_and_the_same_command_runs(block, tmp_path, monkeypatch):
+    # Ctrl-C in the first run (a 248-block wall's sweep, 12 s in: the LocalCluster still starting) wrote a
+    # header-only s.csv and said "run the same command again to resume"; the same command then said
+    # "--out s.csv: the file exists (add --force to replace it)", exit 2: there was no row of this study in it.
+    from masonrycli.study import runner
+
+    def interrupted(*args):
+        raise KeyboardInterrupt
+
+    out = tmp_path / "s.csv"
+    args = ["sweep", block, "-p", "amp=0.05,0.1", "--duration", 0.02, "--workers", 0, "-o", out]
+    monkeypatch.setattr(runner, "run_task", interrupted)
+    result = invoke(*args)
+    assert result.exit_code == 130, result.output
+    assert words(result.output).endswith("interrupted: stopped before any row was finished; nothing was written")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["block.toml"]
+    monkeypatch.undo()
+    result = invoke(*args)
+    assert result.exit_code == 0 and "(2 runs now, 0 rows already there" in words(result.output), result.output

@@ -190,7 +190,10 @@ def run_study(base: StudyBase, request: StudyRequest, console: Console) -> Study
         rows = driver.rows()
         for r in rows:
             r.setdefault("study", study_id)
-        store.write_rows(table, rows, columns)
+        if rows or table.path.exists():
+            store.write_rows(table, rows, columns)
+        else:  # stopped before any row: a header-only table held nothing, yet the same command refused it
+            store.journal_path(request.out).unlink(missing_ok=True)
         _close(client, cluster)
         if request.scheduler is None:  # its workers are gone: what they left half-written is of no one
             files.remove_abandoned_parts(request.histories)
