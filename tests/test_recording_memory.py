@@ -12,7 +12,7 @@ import sys
 import numpy as np
 import pytest
 
-import masonrycli.recording.recorder as recorder
+import masonrycli.recording.batching as batching
 from masonrycli.joint_forces import magnification
 from masonrycli.recording import Recorder
 from masonrycli.recording.readback import recording_rows
@@ -36,6 +36,7 @@ _MEASURE = """
 import dataclasses, gc, json, os, sys, tracemalloc
 sys.path[:0] = {paths!r}
 import recording_fixtures as fx
+import masonrycli.recording.batching as batching
 import masonrycli.recording.recorder as recorder
 
 class Stats:
@@ -51,18 +52,18 @@ static, q0 = fx.wall()
 frames = fx.frames(static, q0, 20)
 # batches of 50 throughout, by count only (no send by time on a loaded machine): the buffer is empty at both
 # readings (1 + 8 x 50 and 1 + 32 x 50 frames); what a batch holds while buffered is not what this measures
-recorder.FLUSH_SECONDS = 1e9
+batching.FLUSH_SECONDS = 1e9
 rec = recorder.Recorder({path!r}, static, fx.METADATA, batch_frames=50, long_batch_frames=50)
 first = traced_after(0, 401)  # past the first batches (scales fixed)
 later = traced_after(401, 1200)
-for i in range(recorder.STEP_BATCH):
+for i in range(batching.STEP_BATCH):
     rec.log_step(i, 1e-3 * i, Stats)
 steps_first = tracemalloc.get_traced_memory()[0]
-for i in range(recorder.STEP_BATCH, 5 * recorder.STEP_BATCH):
+for i in range(batching.STEP_BATCH, 5 * batching.STEP_BATCH):
     rec.log_step(i, 1e-3 * i, Stats)
 steps_later = tracemalloc.get_traced_memory()[0]
 rec.close()
-print(json.dumps({{"frame": (later - first) / 1200, "step": (steps_later - steps_first) / (4 * recorder.STEP_BATCH)}}))
+print(json.dumps({{"frame": (later - first) / 1200, "step": (steps_later - steps_first) / (4 * batching.STEP_BATCH)}}))
 sys.stdout.flush()
 os._exit(0)  # tracemalloc is never stopped: stopping it while rerun's threads run can crash CPython 3.11
 """
@@ -89,7 +90,7 @@ def test_magnified_rows_are_every_frame_kept_in_memory(wall, tmp_path, monkeypat
     displacement, as the recorder drew them when it held every pose (float32) in a list; no file but the
     recording in the output's folder, during the run (the spool has no name) and after it."""
     static, q0 = wall
-    monkeypatch.setattr(recorder, "STEP_BATCH", 7)  # steps sent on their own too: the same rows
+    monkeypatch.setattr(batching, "STEP_BATCH", 7)  # steps sent on their own too: the same rows
     frames = fx.frames(static, q0, 26)
     path = tmp_path / "m.rrd"
     with pytest.raises(KeyboardInterrupt) if interrupted else _no_error():
@@ -154,7 +155,7 @@ def test_long_batches_once_the_scales_are_fixed(wall, tmp_path, monkeypatch, int
     """The first batch fixes the scales (``batch_frames``); after it, ``long_batch_frames`` a batch (rerun's
     index of the chunks written, kept for the footer, grows by batch sent), with the same rows as batches of
     ``batch_frames`` throughout, for a finished and for an interrupted run."""
-    monkeypatch.setattr(recorder, "FLUSH_SECONDS", 1e9)  # by frame count only, however slow the machine
+    monkeypatch.setattr(batching, "FLUSH_SECONDS", 1e9)  # by frame count only, however slow the machine
     static, q0 = wall
     frames = fx.frames(static, q0, 31)
     rows, sent = {}, []
@@ -179,7 +180,7 @@ def test_long_batches_once_the_scales_are_fixed(wall, tmp_path, monkeypatch, int
     assert sent == [5, 12, 12, 2]  # the initial frame and 4 (scales fixed), then 12 a batch, the rest at close
     assert rows[12] == rows[4]
     with Recorder(tmp_path / "d.rrd", static, fx.METADATA) as rec:
-        assert rec.long_batch_frames == recorder.LONG_BATCH_BLOCK_FRAMES // len(static.block_name)  # the default
+        assert rec.long_batch_frames == batching.LONG_BATCH_BLOCK_FRAMES // len(static.block_name)  # the default
 
 
 def test_rows_of_a_time_with_a_nanosecond_remainder(wall, tmp_path):

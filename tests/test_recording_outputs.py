@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 from typer.testing import CliRunner
 
-import masonrycli.recording.recorder as recorder
+import masonrycli.recording.batching as batching
 from masonrycli.cli import app
 from masonrycli.recording.readback import check_complete, inspect_recording
 
@@ -26,7 +26,7 @@ def invoke(*args):
 def recording(tmp_path_factory):
     rrd = tmp_path_factory.mktemp("rec") / "w.rrd"
     with pytest.MonkeyPatch.context() as mp:  # a send every 100 frames: a file cut at a third holds some
-        mp.setattr(recorder, "LONG_BATCH_BLOCK_FRAMES", 0)  # batches of batch_frames (100) throughout
+        mp.setattr(batching, "LONG_BATCH_BLOCK_FRAMES", 0)  # batches of batch_frames (100) throughout
         result = invoke("simulate", "wall", "--duration", 0.3, "--record-every", 1, "--out", rrd)
     assert result.exit_code == 0, result.output
     return rrd
@@ -46,7 +46,7 @@ def test_full_disk_at_the_recorder_stops_the_run(tmp_path, monkeypatch):
         original(self)
 
     monkeypatch.setattr(Recorder, "flush", full_disk)
-    monkeypatch.setattr(recorder, "LONG_BATCH_BLOCK_FRAMES", 0)  # a send at frame 201: the disk fills mid-run
+    monkeypatch.setattr(batching, "LONG_BATCH_BLOCK_FRAMES", 0)  # a send at frame 201: the disk fills mid-run
     rrd, npz = tmp_path / "w.rrd", tmp_path / "h.npz"
     result = invoke("simulate", "wall", "--duration", 0.3, "--record-every", 1, "--out", rrd, "--history", npz)
     assert result.exit_code == 4, result.output
@@ -119,7 +119,7 @@ def test_recorder_writes_to_the_file_every_second(tmp_path, monkeypatch):
     size = path.stat().st_size
     rec.on_frame(frames[101])  # less than FLUSH_SECONDS later: buffered
     assert path.stat().st_size == size
-    monkeypatch.setattr(recorder, "FLUSH_SECONDS", 0.0)
+    monkeypatch.setattr(batching, "FLUSH_SECONDS", 0.0)
     rec.on_frame(frames[102])  # FLUSH_SECONDS have passed: on disk now, with the frame before
     assert path.stat().st_size > size
     copy = tmp_path / "copy.rrd"  # what a SIGKILL now would leave: no footer, 103 frames

@@ -15,18 +15,14 @@ joints show) with one colour component per field (each view maps its own, ``layo
 point per block with its values (float32); the principal-axis glyphs; one resultant arrow per joint
 (``masonrycli.joint_forces``); hinges; each field's colour range and legend labels; the time series
 (energies, displacements, support motion: ``series``). Solver health (sweeps, residual, contacts) is
-logged for every step (``log_step``), sent with the frames or every ``STEP_BATCH`` steps. The magnified
-deformed shape is logged when the recorder closes, when the largest displacement of the run is known; its
-poses wait in an anonymous temporary file until then (``magnified.PoseSpool``). Memory held does not grow
-with the run but for rerun's own index of the chunks written (the file's footer, ~22 chunks a batch sent).
+logged for every step (``log_step``), sent with the frames or every ``batching.STEP_BATCH`` steps. The
+magnified deformed shape is logged when the recorder closes, when the largest displacement of the run is
+known; its poses wait in an anonymous temporary file until then (``magnified.PoseSpool``). Memory held does
+not grow with the run but for rerun's own index of the chunks written (the file's footer, ~22 chunks a batch
+sent).
 
-Batches: ``batch_frames`` (100) frames until the scales are fixed (they come from the first batch with
-data), then ``long_batch_frames``: fewer batches, a smaller index (~2 kB a frame at 100 frames a batch),
-but a batch costs about 1.5 kB per block and frame while it is sent, hence ``LONG_BATCH_BLOCK_FRAMES`` over
-the block count (the 51-block wall: 392 frames; 248 blocks: 100, as before; benchmarks/README.md,
-"Memory"). Once the scales are fixed a batch is also sent when ``FLUSH_SECONDS`` have passed, so a killed
-run loses at most about a second of frames and a slow run's file stays current. The rows do not depend on
-where the batches end (``readback.recording_rows``).
+Batches: ``batch_frames`` (100) frames until the scales are fixed, then ``long_batch_frames``; also every
+``FLUSH_SECONDS`` once the scales are fixed (the rules and their reasons: ``batching``).
 
 Scales: colour ranges follow the data (``masonrycli.colour_range.RangeTracker``, checked every frame);
 the joint-resultant scale (``RESULTANT_LENGTH`` block heights for the 95th percentile resultant of the
@@ -40,8 +36,6 @@ import contextlib
 import errno
 import json
 import os
-import re
-import shutil
 import time
 import uuid
 import warnings
@@ -54,6 +48,7 @@ import rerun as rr
 from masonrycli.colormap import nice_ceil, robust_max_abs
 from masonrycli.frame import Frame
 from masonrycli.recording.arrays import FrameBatch, Polygons, partition_lengths, time_indexes, z0
+from masonrycli.recording.batching import Batching, initial_frames, io_errors, steps_due
 from masonrycli.recording.document import legend_markdown, run_document, viewer_safe_text
 from masonrycli.recording.field_colours import FieldColours
 from masonrycli.recording.layout import (
@@ -97,25 +92,6 @@ from masonrycli.sinks import COMPLETED, FAILED, INTERRUPTED, RUNNING
 
 APPLICATION_ID: Final = "masonry"
 _RECORDING_NAMESPACE: Final = uuid.UUID("6f1c4f5e-9b0e-4c51-a0a6-3f0d6c1e2a77")
-STEP_BATCH: Final = 10_000  # steps' solver health buffered at most between sends (~2 MB)
-FLUSH_SECONDS: Final = 1.0  # s of wall-clock time between writes to the file, once the scales are fixed
-LONG_BATCH_BLOCK_FRAMES: Final = 20_000  # blocks x frames a batch once the scales are fixed (module doc, "Batches")
-
-
-@contextlib.contextmanager
-def _io_errors(path: str):
-    """Rerun reports a failed write (disk full) as ``RuntimeError('… (os error 28)')``: make it the
-    ``OSError`` it is, so the run stops as an output failure rather than an engine error."""
-    try:
-        yield
-    except RuntimeError as exc:  # only rerun's writes run in these blocks
-        code = re.search(r"\(os error (\d+)\)", str(exc))
-        if code is not None:
-            raise OSError(int(code.group(1)), os.strerror(int(code.group(1)))) from None
-        folder = os.path.dirname(os.path.abspath(path))
-        if shutil.disk_usage(folder).free < 1 << 20:  # the cause rerun's message lost
-            raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC)) from None
-        raise OSError(errno.EIO, f"rerun could not write the recording ({str(exc).splitlines()[0]})") from None
 
 
 class Recorder:
@@ -128,8 +104,8 @@ class Recorder:
     Leaving the ``with`` block by an exception closes the recording with status "failed"
     (KeyboardInterrupt: "interrupted") and the time of the last frame; the file is complete either way.
     ``batch_frames``: frames a batch until the scales are fixed; ``long_batch_frames`` after (None:
-    ``LONG_BATCH_BLOCK_FRAMES`` over the block count; at least ``batch_frames``). ``magnify``: the magnified
-    view's factor (None: the largest displacement of the run drawn as 5 % of the structure's size,
+    ``batching.LONG_BATCH_BLOCK_FRAMES`` over the block count; at least ``batch_frames``). ``magnify``: the
+    magnified view's factor (None: the largest displacement of the run drawn as 5 % of the structure's size,
     ``masonrycli.joint_forces.magnification``). The paper-figure tabs are added for the scenarios of
     ``layout.PAPER_FIGURES`` under the paper's loading whose ``duration_s`` reaches the paper's instant
     (``paper_figures``).
@@ -150,15 +126,12 @@ class Recorder:
         if main_field not in FIELD_BY_KEY:
             raise ValueError(f"main_field must be one of {sorted(FIELD_BY_KEY)}, not {main_field!r}")
         self.path, self.static, self.metadata = os.fspath(path), static, dict(metadata)
-        self.batch_frames = max(1, int(batch_frames))
         self._t0, self._closed, self._stopped = time.perf_counter(), False, False
-        self._flushed = self._t0
         self._blocks = Polygons(static.block_vert_start, static.block_vert_local)
         self._supports = Polygons(static.support_vert_start, static.support_vert_local)
         self._fill: Polygons | None = None  # inset blocks, once the structure's size is known
         self._n = n = self._blocks.count
-        long = LONG_BATCH_BLOCK_FRAMES // max(1, n) if long_batch_frames is None else long_batch_frames
-        self.long_batch_frames = max(self.batch_frames, int(long))
+        self.batching = Batching(batch_frames, n, long_batch_frames)
         first = np.asarray(static.block_vert_start[:-1], dtype=np.intp)
         loc = self._blocks.local
         size = (np.maximum.reduceat(loc, first) - np.minimum.reduceat(loc, first)) if n else np.ones((1, 2))
@@ -185,7 +158,7 @@ class Recorder:
         self.recording_id = str(uuid.uuid5(_RECORDING_NAMESPACE, meta_json))
         self.rec = rr.RecordingStream(application_id, recording_id=self.recording_id)
         os.makedirs(os.path.dirname(os.path.abspath(self.path)), exist_ok=True)
-        with _io_errors(self.path):
+        with io_errors(self.path):
             self._main_field = main_field
             self.rec.save(self.path, default_blueprint=build_blueprint(main_field, self.paper, magnify))
             log_static(self.rec, static, self._blocks, self._supports)
@@ -210,16 +183,14 @@ class Recorder:
         s.add("step", int(step))
         s.add("time", float(time_s))
         s.add("values", (float(stats.iterations), float(stats.residual), float(stats.contact_count)))
-        if len(s["step"]) >= STEP_BATCH:  # many steps a frame (--record-every 10⁶): bounded all the same
+        if steps_due(s):
             self._steps = FrameBatch()
-            with _io_errors(self.path):
+            with io_errors(self.path):
                 send_steps(self.rec, s, self._log10_tolerance)
 
     def on_frame(self, frame: Frame) -> None:
-        """Buffer one frame (the :class:`~masonrycli.sinks.FrameSink` method); sends the buffer when it holds
-        ``batch_frames`` frames (``long_batch_frames`` once the scales are fixed), or when ``FLUSH_SECONDS``
-        have passed and every scale is fixed (the scales come from whole batches, so the recording's content
-        does not depend on the machine's speed)."""
+        """Buffer one frame (the :class:`~masonrycli.sinks.FrameSink` method); sends the buffer when it is
+        due (``batching.Batching.frames_due``)."""
         if self._closed:
             raise RuntimeError("Recorder is closed")
         f64 = np.float64
@@ -237,7 +208,7 @@ class Recorder:
                 log_legend(self.rec, f, self._legend_box)
             self._label_anchors = legend_positions(self._legend_box).astype(np.float32)
             folder = os.path.dirname(os.path.abspath(self.path))
-            with _io_errors(self.path):
+            with io_errors(self.path):
                 self._poses = PoseSpool(folder, self._n, self._supports.count)
         b = self._batch
         b.add("step", int(frame.step))
@@ -254,18 +225,25 @@ class Recorder:
         self._poses.append(int(frame.step), float(frame.time), q, sq)  # float32 on disk, as they were kept
         self._last = (int(frame.step), float(frame.time))
         self._frames += 1
-        due = time.perf_counter() - self._flushed >= FLUSH_SECONDS and self._scales_fixed()
-        if len(b["step"]) - _initial(b) >= self._batch_size() or due:
-            with _io_errors(self.path):
+        if self.batching.frames_due(b, self._scales_fixed()):
+            with io_errors(self.path):
                 self.flush()
                 self._wait_written()  # to the file: a killed run loses at most about FLUSH_SECONDS of frames
-            self._flushed = time.perf_counter()
+            self.batching.sent()
 
     log_frame = on_frame
 
+    @property
+    def batch_frames(self) -> int:
+        return self.batching.batch_frames
+
+    @property
+    def long_batch_frames(self) -> int:
+        return self.batching.long_batch_frames
+
     def _batch_size(self) -> int:
         """Frames a batch: ``batch_frames`` until the scales are fixed, then ``long_batch_frames``."""
-        return self.long_batch_frames if self._scales_fixed() else self.batch_frames
+        return self.batching.size(self._scales_fixed())
 
     def _scales_fixed(self) -> bool:
         """The force and glyph scales come from the first batch with data; the colour ranges follow each frame."""
@@ -307,7 +285,7 @@ class Recorder:
                 raise OSError(errno.EIO, "the recording is incomplete (rerun's writer stopped during the run)")
             return
         error: Exception | None = None
-        with _io_errors(self.path):
+        with io_errors(self.path):
             try:
                 try:
                     self.flush()
@@ -353,7 +331,7 @@ class Recorder:
         # A voussoir of a bare ring has no cell strain rate; its strain rate along the ring stands in.
         vsr = tensors["cell_volumetric_strain_rate"]
         tensors["cell_volumetric_strain_rate"] = np.where(np.isnan(vsr), tensors[CHAIN_KEY], vsr)
-        initial = _initial(b)  # the state as built: no scale from it (module doc)
+        initial = initial_frames(b)  # the state as built: no scale from it (module doc)
         if self._fix_scales({k: v[initial:] for k, v in tensors.items()}, b):
             self._log_metadata(RUNNING, "")
         self._send_blocks(idx, q, tensors, initial)
@@ -484,12 +462,6 @@ class Recorder:
         self.rec.log(METADATA, rr.TextDocument(viewer_safe_text(text), media_type="text/markdown"), static=True)
         legend = legend_markdown(self.force_scale, self.block_height, self.magnify)
         self.rec.log(LEGEND, rr.TextDocument(viewer_safe_text(legend), media_type="text/markdown"), static=True)
-
-
-def _initial(b: FrameBatch) -> int:
-    """1 if the batch opens with the initial frame (step 0: the structure as built), else 0."""
-    steps = b.get("step")
-    return 1 if steps and steps[0] == 0 else 0
 
 
 def _tensor(tensors: dict, key: str, n: int) -> np.ndarray:
