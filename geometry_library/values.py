@@ -20,6 +20,8 @@ from __future__ import annotations
 
 import math
 import re
+from collections.abc import Callable
+from typing import Any
 
 import numpy as np
 
@@ -44,15 +46,17 @@ class TypedNumber(float):
         return float(self), self.text
 
 
-def shown(value) -> str:
-    """``value`` for a message: as typed (a :class:`TypedNumber`), else its repr."""
-    return value.text if isinstance(value, TypedNumber) else repr(value)
+def shown(value, otherwise: Callable[[Any], str] = repr) -> str:
+    """``value`` for a message: as typed when it is a :class:`TypedNumber` ("--rtol 0", not "0.0"), else
+    ``otherwise(value)``, the caller's format for any other value (repr here). The one place that rule lives:
+    ``masonrycli.values.shorten`` and ``option_text`` call it with their formats."""
+    return value.text if isinstance(value, TypedNumber) else otherwise(value)
 
 
 def _g(value) -> str:
     """``value`` for a range message: as typed (a :class:`TypedNumber`: "--span 1e9" said "span 1e+09"), else
     in %g (a scenario file's or a GeoJSON's number)."""
-    return value.text if isinstance(value, TypedNumber) else f"{value:g}"
+    return shown(value, "{:g}".format)
 
 
 def is_real(value) -> bool:

@@ -15,7 +15,7 @@ import re
 
 import numpy as np
 
-from geometry_library.values import SETTING_UNITS, TypedNumber, is_real, number_problem
+from geometry_library.values import SETTING_UNITS, is_real, number_problem, shown
 from masonrycli.errors import InputError
 
 
@@ -88,16 +88,20 @@ def unknown_key(key, known) -> str:
 
 
 def shorten(value, limit: int = 60) -> str:
-    text = value.text if isinstance(value, TypedNumber) else format_value(value)  # an option's: as typed
+    """``value`` for a message, cut to ``limit`` characters: as typed (an option's :class:`TypedNumber`,
+    ``shown``), else as the scenario file writes it (``format_value``)."""
+    text = shown(value, format_value)
     return text if len(text) <= limit else text[: limit - 3] + "..."
 
 
 def option_text(value) -> str:
-    """A command-line option's value for a message: as typed (a :class:`TypedNumber`: "--rtol 0", not
-    "0.0"), else a float in the shortest of ``:g`` and repr that gives it back exactly ("1e+07", "2", not
-    "10000000.0", "2.0"), anything else as str (a value given in Python)."""
-    if isinstance(value, TypedNumber):
-        return value.text
+    """A command-line option's value for a message: as typed (a :class:`TypedNumber`, ``shown``), else a float
+    in the shortest of ``:g`` and repr that gives it back exactly ("1e+07", "2", not "10000000.0", "2.0"),
+    anything else as str (a value given in Python)."""
+    return shown(value, _exact_short)
+
+
+def _exact_short(value) -> str:
     if isinstance(value, float) and math.isfinite(value):
         short = f"{value:g}"
         return short if float(short) == value else repr(float(value))
