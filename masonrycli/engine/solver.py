@@ -93,8 +93,6 @@ class Solver:
         self._v_free = np.empty((b, 3))
         self._top_speed = None
         """m/s: top block speed at the end of the last step (None before the first)."""
-        self._rest_model = (None, None)
-        """(model, its copy with the tighter tolerance and REST_BUDGET for a cap) for _settle."""
 
     def _alloc(self, capacity: int) -> None:
         self._pack = np.zeros((capacity, nlgs.PACK_WIDTH))
@@ -235,12 +233,9 @@ class Solver:
         REST_TIGHTEN × the tolerance, for at most ``budget`` (≤ REST_BUDGET) sweep units; keep whichever of
         the two results has the lower residual. Returns (sweep units spent here, residual kept)."""
         m = self.model
-        if self._rest_model[0] is not m:
-            tight = dataclasses.replace(m, tolerance=m.tolerance * REST_TIGHTEN, max_iterations=REST_BUDGET)
-            self._rest_model = (m, tight)
-        tight = self._rest_model[1]
-        if budget < REST_BUDGET:  # near the run's own cap (a small --max-iterations)
-            tight = dataclasses.replace(tight, max_iterations=budget)
+        # The model with the tighter tolerance and the budget for a cap, made here (~4 µs; the sweeps cost
+        # far more): the model is frozen, so nothing kept between steps could go stale.
+        tight = dataclasses.replace(m, tolerance=m.tolerance * REST_TIGHTEN, max_iterations=budget)
         v, r, status = state.body_v, self._r[:count], self._status[:count]
         kept = v.copy(), r.copy(), status.copy()
         np.copyto(v, self._v_free)
