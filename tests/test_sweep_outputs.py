@@ -186,3 +186,22 @@ def test_an_unreadable_table_is_refused_naming_out_and_force_replaces_it(block, 
     assert line.endswith("(add --force to replace it)") and out.read_bytes() == content
     assert invoke("sweep", block, *grid, "--force").exit_code == 0
     assert len(read_rows(out)) == 2
+
+
+def test_each_run_of_a_fine_search_keeps_its_own_history(block, tmp_path):
+    # Histories were named with 6 significant digits: a search with --rtol 1e-6 (23 runs) left 22 files, a
+    # later run's history written over an earlier one of another amplitude under a name that was neither's.
+    import json
+
+    import numpy as np
+
+    from masonrycli.study.task import history_name
+
+    assert history_name({"amp": 0.5, "freq": 2.0}) == "amp=0.5_freq=2.npz"  # the documented names stay
+    assert history_name({"amp": float(np.linspace(0.1, 1.0, 10)[2])}) == "amp=0.3.npz"  # not 0.30000000000000004
+    h = tmp_path / "h"
+    grid = ["-p", "amp=0.1:0.1000001:3", "--duration", 0.02, "--workers", 0, "--no-recording"]
+    result = invoke("sweep", block, *grid, "-o", tmp_path / "s.csv", "--histories", h)
+    assert result.exit_code == 0, result.output
+    stored = sorted(json.loads(str(np.load(p)["run"]))["study_point"]["amp"] for p in h.iterdir())
+    assert len(stored) == 3 and stored == sorted({r["amp"] for r in read_rows(tmp_path / "s.csv")}), stored

@@ -116,8 +116,10 @@ def run_task(
 
 
 def history_name(params: dict) -> str:
-    """``amp=0.5_freq=2.npz``: the file name of a point's history (characters unsafe in names -> "-")."""
-    text = "_".join(f"{k}={v:g}" if isinstance(v, float) else f"{k}={v}" for k, v in params.items())
+    """``amp=0.5_freq=2.npz``: the file name of a point's history (characters unsafe in names -> "-"). Values
+    to 15 significant digits: 6 (``:g``) gave two points of a fine search (``--rtol 1e-6``) one name, the later
+    run's history replacing the earlier one; 15 still writes linspace's 0.30000000000000004 as 0.3."""
+    text = "_".join(f"{k}={v:.15g}" if isinstance(v, float) else f"{k}={v}" for k, v in params.items())
     return "".join(c if c.isalnum() or c in "=._-" else "-" for c in text) + ".npz"
 
 
