@@ -42,24 +42,21 @@ import warnings
 from typing import Final
 
 import numpy as np
-import pyarrow as pa
 import rerun as rr
 
 from masonrycli.colormap import nice_ceil, robust_max_abs
 from masonrycli.frame import Frame
-from masonrycli.recording.arrays import FrameBatch, Polygons, partition_lengths, time_indexes, z0
+from masonrycli.recording.arrays import FrameBatch, Polygons, time_indexes
 from masonrycli.recording.batching import Batching, initial_frames, io_errors, steps_due
 from masonrycli.recording.document import legend_markdown, run_document, viewer_safe_text
 from masonrycli.recording.field_colours import FieldColours
+from masonrycli.recording.fills import send_blocks, send_supports
 from masonrycli.recording.layout import (
     AXES,
-    BLOCKS,
     CHAIN_KEY,
     FIELD_BY_KEY,
     FIELDS,
-    FILL,
     GLYPH_HALF_LENGTH,
-    HOVER_VALUES,
     INSET,
     LEGEND,
     METADATA,
@@ -67,8 +64,6 @@ from masonrycli.recording.layout import (
     RESULTANT_PERCENTILE,
     ROBUST_PERCENTILE,
     SCALARS,
-    SUPPORT_FILL,
-    SUPPORT_OUTLINES,
     TENSOR_KEYS,
     XY,
     build_blueprint,
@@ -79,7 +74,6 @@ from masonrycli.recording.overlays import frame_joint_resultants, send_axes, sen
 from masonrycli.recording.readback import check_complete, wait_written
 from masonrycli.recording.series import send_series, send_steps
 from masonrycli.recording.static_content import (
-    TICKS,
     RecordingStatic,
     inset_local,
     legend_positions,
@@ -334,8 +328,10 @@ class Recorder:
         initial = initial_frames(b)  # the state as built: no scale from it (module doc)
         if self._fix_scales({k: v[initial:] for k, v in tensors.items()}, b):
             self._log_metadata(RUNNING, "")
-        self._send_blocks(idx, q, tensors, initial)
-        self._send_supports(idx, b.stack("support_q"))
+        send_blocks(
+            self.rec, idx, self._fill, self._blocks.owner, self._colours, self._label_anchors, q, tensors, initial
+        )
+        send_supports(self.rec, idx, self._supports, b.stack("support_q"))
         self._send_axes(idx, q, tensors)
         self._send_joints(idx, b)
         send_series(self.rec, idx, b, q, self._ref, self._n)
@@ -357,65 +353,6 @@ class Recorder:
             if name not in self.axis_scale and m > 0.0:
                 self.axis_scale[name], fixed = m, True
         return fixed
-
-    def _send_blocks(self, idx: list, q: np.ndarray, tensors: dict[str, np.ndarray], initial: int = 0) -> None:
-        """The fill (positions once, a colour component per field), legends, hover points and values; the
-        ``initial`` first frames (the state as built) take the colour range of the frame after them."""
-        n_frames = len(q)
-        verts = self._fill.world(q)  # (F, V, 2)
-        n_vert = verts.shape[1]
-        per_vertex, per_block = partition_lengths(n_frames, n_vert), partition_lengths(n_frames, self._n)
-        columns = [*rr.Mesh3D.columns(vertex_positions=z0(verts)).partition(per_vertex)]
-        hover = [*rr.Points2D.columns(positions=q[..., :2].reshape(-1, 2).astype(np.float32)).partition(per_block)]
-        for f in FIELDS:
-            colors, labels, lo, hi = self._colours.colour(f, tensors[f.key], initial)
-            archetype = f.colors.removesuffix(":colors")
-            columns += rr.DynamicArchetype.columns(
-                archetype, components={"colors": rr.components.ColorBatch(colors[:, self._blocks.owner].reshape(-1))}
-            ).partition(per_vertex)
-            # no point for an empty count ("0 below" is left out): an empty label still drew its box
-            shown = np.array(labels, dtype=object).astype(bool).reshape(n_frames, TICKS + 3)
-            self.rec.send_columns(
-                f.labels,
-                indexes=idx,
-                columns=[
-                    # positions with the labels at every frame: a view pinned to an instant reads a time
-                    # range, which joins no static positions to temporal labels
-                    *rr.Points2D.columns(
-                        positions=np.tile(self._label_anchors, (n_frames, 1))[shown.reshape(-1)],
-                        labels=pa.array(labels, type=pa.utf8()).filter(shown.reshape(-1)),  # not a list: 2x faster
-                    ).partition(shown.sum(axis=1)),
-                    *rr.AnyValues.columns(range_lo=pa.array(lo), range_hi=pa.array(hi)),
-                ],
-            )
-        self.rec.send_columns(FILL, indexes=idx, columns=columns)
-        # pyarrow arrays: AnyValues.columns turns 1-D numpy arrays into Python lists of lists (slow).
-        values = {
-            name: pa.array(tensors[key].reshape(-1).astype(np.float32), type=pa.float32())
-            for name, key in HOVER_VALUES.items()
-        }
-        self.rec.send_columns(
-            BLOCKS, indexes=idx, columns=[*hover, *rr.AnyValues.columns(**values).partition(per_block)]
-        )
-
-    def _send_supports(self, idx: list, support_q: np.ndarray) -> None:
-        poly, n_frames = self._supports, len(support_q)
-        if poly.count:
-            verts = poly.world(support_q)
-            self.rec.send_columns(
-                SUPPORT_FILL,
-                indexes=idx,
-                columns=rr.Mesh3D.columns(vertex_positions=z0(verts)).partition(
-                    partition_lengths(n_frames, verts.shape[1])
-                ),
-            )
-            self.rec.send_columns(
-                SUPPORT_OUTLINES,
-                indexes=idx,
-                columns=rr.LineStrips2D.columns(strips=poly.outlines(verts)).partition(
-                    partition_lengths(n_frames, poly.count)
-                ),
-            )
 
     def _send_axes(self, idx: list, q: np.ndarray, tensors: dict[str, np.ndarray]) -> None:
         for name, (lam, angle) in AXES.items():
