@@ -374,8 +374,22 @@ def paper_instant_hint(name: str, run: RunConfig, supports: dict[str, str] | Non
         return ""
     figs, t = PAPER_INSTANT[name]
     step = round(t / run.dt)
-    return (
-        f"The paper's Figs. {figs} are at t = {t:g} s (step {step}): the recording opens on them, pinned there."
-        if step <= run.n_steps
-        else ""
-    )
+    if step > run.n_steps:
+        return ""
+    missed = paper_instant_missed(t, run.dt, run.record_every, run.n_steps)
+    if missed:
+        return f"The paper's Figs. {figs} are at t = {t:g} s, {missed}: the recording has no tabs pinned there."
+    return f"The paper's Figs. {figs} are at t = {t:g} s (step {step}): the recording opens on them, pinned there."
+
+
+def paper_instant_missed(t: float, dt: float, record_every: int, n_steps: int) -> str:
+    """Why a run of ``n_steps`` steps of ``dt`` recording every ``record_every`` steps (and the last) has no
+    frame at the paper's instant ``t``, or "" when it has one. Without a frame there the tabs pinned to ``t``
+    showed the frame before it under the paper's instant (``--record-every 30``: t = 0.09 s; ``--record-every
+    200``: the structure as built, no stress) and the paper's figure numbers."""
+    k = round(t / dt)
+    if abs(t / dt - k) > 1e-6 * max(1.0, k):
+        return f"not a step of --dt {dt:g}"
+    if k % record_every and k != n_steps:
+        return f"step {k}, which --record-every {record_every} does not record (a divisor of {k} does)"
+    return ""

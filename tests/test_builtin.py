@@ -133,6 +133,25 @@ def test_paper_instant_hint_only_within_the_run():
     assert paper_instant_hint("aqueduct", RunConfig(duration=5.0)) == ""
 
 
+def test_paper_instant_hint_says_when_no_frame_is_recorded_there():
+    # --record-every 30 records steps 90 and 120: the hint said "pinned there" and the tabs pinned to 0.1 s
+    # showed step 90 under the paper's figure numbers (--record-every 200: the structure as built, no stress).
+    unrecorded = paper_instant_hint("wall", RunConfig(duration=1.0, record_every=30))
+    assert unrecorded == (
+        "The paper's Figs. III.2–III.5 are at t = 0.1 s, step 100, which --record-every 30 does not record (a "
+        "divisor of 100 does): the recording has no tabs pinned there."
+    )
+    assert paper_instant_hint("wall", RunConfig(duration=1.0, dt=0.008)).endswith(
+        "at t = 0.1 s, not a step of --dt 0.008: the recording has no tabs pinned there."
+    )
+    assert paper_instant_hint("wall", RunConfig(duration=1.0, record_every=25)).endswith("pinned there.")
+    assert paper_instant_hint("wall", RunConfig(duration=1.0, dt=0.004, record_every=5)).startswith(
+        "The paper's Figs. III.2–III.5 are at t = 0.1 s (step 25)"
+    )
+    # the last frame is always recorded: the arch's 5 s run has its instant at its last step
+    assert paper_instant_hint("arch", RunConfig(duration=5.0, record_every=30)).endswith("pinned there.")
+
+
 def test_paper_instant_hint_only_under_the_papers_loading():
     def supports(name, **loading):
         s = builtin(name, **loading)

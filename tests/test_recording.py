@@ -436,6 +436,19 @@ def test_no_paper_figure_tabs_under_another_loading(wall, tmp_path, supports):
     assert not any(v["pinned"] or name.startswith("Fig.") for name, v in views.items())
 
 
+@pytest.mark.parametrize(("every", "pinned"), [(10, True), (25, True), (30, False), (200, False)])
+def test_paper_figure_tabs_only_when_a_frame_is_recorded_at_the_instant(wall, tmp_path, every, pinned):
+    """``simulate wall --record-every 30`` records steps 90 and 120: the tabs named "Fig. III.2 … at t = 0.1 s"
+    showed step 90 (200: the structure as built, no stress yet)."""
+    static, q0 = wall
+    meta = {**fx.METADATA, "scenario": "wall", "duration_s": 1.0, "dt_s": 1e-3, "record_every": every}
+    with Recorder(tmp_path / "w.rrd", static, meta | {"supports": paper_loading("wall")}) as rec:
+        for f in fx.frames(static, q0, 100 // every + 2, every=every):  # past 0.1 s: the paper's instant reached
+            rec.log_frame(f)
+    views = blueprint_views(tmp_path / "w.rrd")
+    assert any(v["pinned"] and name.startswith("Fig. III.2") for name, v in views.items()) == pinned, views
+
+
 def test_a_run_ended_before_the_paper_instant_opens_without_its_tabs(wall, tmp_path):
     """Ctrl-C (or --stop-at-collapse) before 0.1 s: no frame at the paper's instant, so its pinned tabs
     were empty and the recording opened on the first. The layout is sent again without them at close."""

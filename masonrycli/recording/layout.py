@@ -12,7 +12,7 @@ import rerun as rr
 import rerun.blueprint as rrb
 from rerun.blueprint.encodings import ComponentSourceKind, VisualizerComponentMapping
 
-from masonrycli.builtin import is_paper_loading
+from masonrycli.builtin import is_paper_loading, paper_instant_missed
 from masonrycli.colour_range import ScaleKind
 
 ROBUST_PERCENTILE: Final = 98.0  # the glyph scales come from this percentile of |value|
@@ -270,4 +270,8 @@ def paper_figures(metadata: dict) -> tuple[float, tuple[str, ...]] | None:
     duration = metadata.get("duration_s")
     if paper is None or duration is None or float(duration) < paper[0]:
         return None
+    dt, every = metadata.get("dt_s"), metadata.get("record_every")
+    if dt is not None and every is not None:  # no frame at the instant: its tabs showed the frame before it
+        if paper_instant_missed(paper[0], float(dt), int(every), round(float(duration) / float(dt))):
+            return None
     return paper if is_paper_loading(name, metadata.get("supports") or {}) else None
