@@ -50,7 +50,7 @@ SHAKE_AMPLITUDE, SHAKE_FREQUENCY = 1.0, 2.0
 """m/s and Hz: the wall's ground velocity (the paper's shaking)."""
 SETTLEMENT = 0.01
 """m/s: downward velocity of the right foundation of the arch and the aqueduct (the paper's settlement)."""
-PAPER_INSTANT = {"wall": ("III.2–III.5", 0.1), "arch": ("III.7–III.10", 5.0)}
+PAPER_INSTANT = {"wall": ("III.2–III.5", 0.1), "arch": ("III.7–III.10", 5.0), "aqueduct": ("III.7–III.10", 5.0)}
 """The instant of the paper's figures for each built-in structure: (figures, t in s)."""
 
 RUN_OVERRIDES = ("duration", "dt", "theta", "record_every", "tolerance", "max_iterations", "solver")

@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 
 from masonrycli.builtin import (
+    PAPER_INSTANT,
     build_assembly,
     builtin,
     file_scenario,
@@ -130,7 +131,13 @@ def test_paper_instant_hint_only_within_the_run():
         "t = 5 s (step 10): the recording opens on them, pinned there."
     )
     assert paper_instant_hint("arch", RunConfig(duration=1.0)) == ""
-    assert paper_instant_hint("aqueduct", RunConfig(duration=5.0)) == ""
+    # the aqueduct's recording pins the tabs of Figs. III.7–III.10 at 5 s too: the summary did not say so
+    assert paper_instant_hint("aqueduct", RunConfig(duration=5.0)).endswith(
+        "(step 5000): the recording opens on them, pinned there."
+    )
+    from masonrycli.recording.layout import PAPER_FIGURES
+
+    assert {k: t for k, (_, t) in PAPER_INSTANT.items()} == {k: t for k, (t, _) in PAPER_FIGURES.items()}
 
 
 def test_paper_instant_hint_says_when_no_frame_is_recorded_there():
