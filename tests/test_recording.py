@@ -449,6 +449,19 @@ def test_paper_figure_tabs_only_when_a_frame_is_recorded_at_the_instant(wall, tm
     assert any(v["pinned"] and name.startswith("Fig. III.2") for name, v in views.items()) == pinned, views
 
 
+@pytest.mark.parametrize(("structure", "pinned"), [({"builder": "wall", "blocks": 248}, True), ({}, False)])
+def test_paper_figure_tabs_only_for_the_papers_structure(wall, tmp_path, structure, pinned):
+    """A user's wall.toml of its own blocks (the scenario named "wall" after the file; no builder) shaken at
+    1 m/s, 2 Hz opened on tabs "Fig. III.2 … at t = 0.1 s", the paper's figure numbers on another structure."""
+    static, q0 = wall
+    meta = {**fx.METADATA, "scenario": "wall", "duration_s": 1.0, "supports": paper_loading("wall")}
+    with Recorder(tmp_path / "w.rrd", static, meta | {"structure": structure}) as rec:
+        for f in fx.frames(static, q0, 12):  # to step 110: past the paper's instant
+            rec.log_frame(f)
+    views = blueprint_views(tmp_path / "w.rrd")
+    assert any(v["pinned"] and name.startswith("Fig. III.2") for name, v in views.items()) == pinned, views
+
+
 def test_a_run_ended_before_the_paper_instant_opens_without_its_tabs(wall, tmp_path):
     """Ctrl-C (or --stop-at-collapse) before 0.1 s: no frame at the paper's instant, so its pinned tabs
     were empty and the recording opened on the first. The layout is sent again without them at close."""

@@ -263,12 +263,16 @@ def paper_figures(metadata: dict) -> tuple[float, tuple[str, ...]] | None:
 
     Only under the paper's loading (``metadata["supports"]``, support name -> ``Motion.describe()``): the
     wall shaken by an earthquake record, or at 5 Hz, opened on tabs named "Fig. III.2" pinned to 0.1 s,
-    where a record has barely started (strain rates at the 1e-4 1/s floor of the colour range).
+    where a record has barely started (strain rates at the 1e-4 1/s floor of the colour range). And only for
+    the paper's structure (``metadata["structure"]``: its builder): a user's own blocks in ``wall.toml`` (the
+    scenario named "wall" after its file) shaken the paper's way opened on "Fig. III.2 … at t = 0.1 s".
     """
     name = str(metadata.get("scenario"))
     paper = PAPER_FIGURES.get(name)
     duration = metadata.get("duration_s")
     if paper is None or duration is None or float(duration) < paper[0]:
+        return None
+    if "structure" in metadata and (metadata["structure"] or {}).get("builder") != name:
         return None
     dt, every = metadata.get("dt_s"), metadata.get("record_every")
     if dt is not None and every is not None:  # no frame at the instant: its tabs showed the frame before it
