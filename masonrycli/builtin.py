@@ -367,15 +367,24 @@ def is_paper_loading(name: str, supports: dict[str, str]) -> bool:
     return {k: v for k, v in supports.items() if v != "fixed"} == paper_loading(name)
 
 
-def paper_instant_hint(name: str, run: RunConfig, supports: dict[str, str] | None = None) -> str:
+def paper_instant_hint(
+    name: str, run: RunConfig, supports: dict[str, str] | None = None, reached: float | None = None
+) -> str:
     """Where the paper's figures of ``name`` are in the run (the recording's tabs pinned there), or "" (none,
-    after the run, or ``supports`` — support name -> ``Motion.describe()`` — not the paper's loading)."""
+    after the run, or ``supports`` — support name -> ``Motion.describe()`` — not the paper's loading).
+    ``reached``: the time the run reached, s; one stopped before the instant (Ctrl-C, --stop-at-collapse) said
+    "the recording opens on them, pinned there" over a recording without those tabs."""
     if name not in PAPER_INSTANT or (supports is not None and not is_paper_loading(name, supports)):
         return ""
     figs, t = PAPER_INSTANT[name]
     step = round(t / run.dt)
     if step > run.n_steps:
         return ""
+    if reached is not None and reached < t - 0.5 * run.dt:
+        return (
+            f"The paper's Figs. {figs} are at t = {t:g} s; the run stopped before, at t = {reached:.4g} s: the "
+            "recording has no tabs pinned there."
+        )
     missed = paper_instant_missed(t, run.dt, run.record_every, run.n_steps)
     if missed:
         return f"The paper's Figs. {figs} are at t = {t:g} s, {missed}: the recording has no tabs pinned there."

@@ -69,9 +69,9 @@ def main_callback(
 # commands that share them declare each option once.
 
 
-def _execute(scenario, opts: dict, hint: str = "") -> None:
+def _execute(scenario, opts: dict, hint=None) -> None:
     """Check the outputs (``opts``: the OUTPUT, FORCE and STOP options), run, print the summary; exit with
-    the code of how the run ended."""
+    the code of how the run ended. ``hint``: the line under the summary, given the time the run reached."""
     from masonrycli.execute import execute, print_summary
     from masonrycli.interrupt import StopRun, exit_code, signal_name
     from masonrycli.scenario_warnings import scenario_warnings
@@ -99,7 +99,7 @@ def _execute(scenario, opts: dict, hint: str = "") -> None:
         )
         raise typer.Exit(EXIT_INTERNAL) from None
     result = outcome.result
-    print_summary(console, outcome, scenario, hint)
+    print_summary(console, outcome, scenario, hint(result.time) if hint is not None and result is not None else "")
     for error in outcome.errors:
         say("error", "bold red", f"cannot write {error}")
     if outcome.errors or result.status == FAILED:
@@ -138,7 +138,7 @@ def _simulate(name: str, opts: dict) -> None:
     outputs = _pop(opts, OUTPUT, FORCE, STOP)
     scenario = builtin(name, **opts)
     supports = {s.name: m.describe() for s, m in zip(scenario.assembly.supports, scenario.motions)}
-    _execute(scenario, outputs, paper_instant_hint(name, scenario.run, supports))
+    _execute(scenario, outputs, lambda reached: paper_instant_hint(name, scenario.run, supports, reached))
 
 
 @simulate_app.command("wall")

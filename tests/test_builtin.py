@@ -1,6 +1,7 @@
 """Built-in scenarios: the paper's loadings (1 m/s at 2 Hz, 1 cm/s settlement), overrides, their errors."""
 
 import math
+import signal
 from pathlib import Path
 
 import numpy as np
@@ -157,6 +158,33 @@ def test_paper_instant_hint_says_when_no_frame_is_recorded_there():
     )
     # the last frame is always recorded: the arch's 5 s run has its instant at its last step
     assert paper_instant_hint("arch", RunConfig(duration=5.0, record_every=30)).endswith("pinned there.")
+
+
+def test_paper_instant_hint_of_a_run_stopped_before_the_instant(monkeypatch, tmp_path):
+    # Ctrl-C 4 s into 'simulate arch --dt 0.0001' (t < 5 s) said "the recording opens on them, pinned there";
+    # the recording rightly had no such tabs.
+    from masonrycli.interrupt import StopSignals
+
+    from cli_helpers import invoke
+
+    assert paper_instant_hint("arch", RunConfig(duration=5.0), reached=1.2) == (
+        "The paper's Figs. III.7–III.10 are at t = 5 s; the run stopped before, at t = 1.2 s: the recording "
+        "has no tabs pinned there."
+    )
+    assert paper_instant_hint("arch", RunConfig(duration=5.0), reached=5.0).endswith("pinned there.")
+    polls = []
+
+    def ctrl_c_at_step_50(self):
+        polls.append(1)
+        if len(polls) == 50:
+            self.signum = signal.SIGINT
+        return self.signum is not None
+
+    monkeypatch.setattr(StopSignals, "requested", ctrl_c_at_step_50)
+    result = invoke("simulate", "wall", "--duration", 0.2, "--out", tmp_path / "w.rrd")
+    assert result.exit_code == 130, result.output
+    assert "the run stopped before, at t = 0.05 s: the recording has no tabs pinned there." in result.output
+    assert "opens on them" not in result.output
 
 
 def test_paper_instant_hint_only_under_the_papers_loading():
