@@ -205,3 +205,19 @@ def test_each_run_of_a_fine_search_keeps_its_own_history(block, tmp_path):
     assert result.exit_code == 0, result.output
     stored = sorted(json.loads(str(np.load(p)["run"]))["study_point"]["amp"] for p in h.iterdir())
     assert len(stored) == 3 and stored == sorted({r["amp"] for r in read_rows(tmp_path / "s.csv")}), stored
+
+
+def test_records_in_subfolders_of_a_record_folder_are_named(block, tmp_path):
+    # A set kept by station (recs/ELC/q.AT2 beside recs/top.csv) ran top.csv alone without a word; a folder
+    # holding records in subfolders only said "no .AT2 or .csv record in it".
+    recs = tmp_path / "recs"
+    (recs / "ELC").mkdir(parents=True)
+    velocity_csv(recs / "ELC" / "q.csv")
+    alone = invoke("sweep", block, "--records", recs, "--workers", 0, "-o", tmp_path / "s.csv")
+    said = f"--records {recs}: its subfolders are not read; {recs / 'ELC'} hold records (give them too)"
+    assert alone.exit_code == 2 and words(alone.output) == f"error: {said}", alone.output
+    velocity_csv(recs / "top.csv")
+    args = ["--duration", 0.02, "--workers", 0, "--no-recording", "-o", tmp_path / "s.csv"]
+    mixed = invoke("sweep", block, "--records", recs, *args)
+    assert mixed.exit_code == 0 and f"warning: {said}" in words(mixed.output), mixed.output
+    assert [r["record"] for r in read_rows(tmp_path / "s.csv")] == ["top.csv"]

@@ -90,9 +90,10 @@ def plan_study(
     if check_record_dt(record_dt) is not None and not records:
         raise InputError("--record-dt: goes with --records (the time between the samples of its one-column files)")
     if records:
-        motions = _records(records, out, record_dt)
+        motions, unread = _records(records, out, record_dt)
         whole = duration is None and is_built_in(target)  # a scenario file's [run] duration stands
         scenario, late = _record_duration(base.scenario, motions, whole)
+        late = [*unread, *late]
         base = StudyBase(scenario, motions)
         axes.insert(0, Axis("record", tuple(motions)))
     if scale is not None:
@@ -207,17 +208,24 @@ def _record_duration(scenario, motions: dict, whole: bool):
     ]
 
 
-def _records(entries: list[Path], out: Path, record_dt: float | None) -> dict:
-    """Record motions by file name, from files and the .AT2 / .csv files of folders (but the study's
-    table ``out``: kept in its records' folder, it was read as a record by the same command run again,
+def _records(entries: list[Path], out: Path, record_dt: float | None) -> tuple[dict, list[str]]:
+    """``(record motions by file name, warnings)``, from files and the .AT2 / .csv files of folders (but the
+    study's table ``out``: kept in its records' folder, it was read as a record by the same command run again,
     "recs/ida.csv:2: not a number", so the study could not be resumed). ``record_dt`` (--record-dt, s):
-    the spacing of the samples of the CSVs of one value per line; refused when no file is one."""
-    files = []
+    the spacing of the samples of the CSVs of one value per line; refused when no file is one. A folder's
+    subfolders are not read: those holding records are named (a set kept by station, recs/ELC/*.AT2 beside
+    recs/*.AT2, ran the top-level files only, without a word)."""
+    files, unread = [], []
     for entry in entries:
         if entry.is_dir():
-            found = sorted(
-                p for p in entry.iterdir() if p.suffix.lower() in (".at2", ".csv") and not _same_file(p, out)
-            )
+            found = sorted(p for p in entry.iterdir() if _is_record_file(p) and not _same_file(p, out))
+            below = sorted(d for d in entry.iterdir() if d.is_dir() and any(map(_is_record_file, d.rglob("*"))))
+            if below:
+                names = ", ".join(str(d) for d in below[:3]) + (" …" if len(below) > 3 else "")
+                said = f"--records {entry}: its subfolders are not read; {names} hold records (give them too)"
+                if not found:
+                    raise InputError(said)
+                unread.append(said)
             if not found:
                 raise InputError(f"--records {entry}: no .AT2 or .csv record in it")
             files += found
@@ -236,7 +244,11 @@ def _records(entries: list[Path], out: Path, record_dt: float | None) -> dict:
             f"--record-dt {record_dt:g}: no file of --records is one value per line (the .AT2 files and the CSVs "
             "with a time column keep their own times): leave it out"
         )
-    return motions
+    return motions, unread
+
+
+def _is_record_file(path: Path) -> bool:
+    return path.suffix.lower() in (".at2", ".csv") and path.is_file()
 
 
 def _record(path: Path, record_dt: float | None):
