@@ -64,10 +64,11 @@ def whole_value(text: str) -> int:
 
 def path_value(text: str) -> Path:
     """A path option's value: ``""`` is refused as empty (``Path("")`` is ".", so ``--out ""`` said
-    "--out .: the file name must end in .rrd" and ``--record ""`` ".: is a directory")."""
+    "--out .: the file name must end in .rrd" and ``--record ""`` ".: is a directory"); ``~`` is the home
+    folder: the shell leaves it in ``--out=~/runs/w.rrd``, which made a folder named "~" in the working one."""
     if not str(text).strip():
         raise typer.BadParameter("the path is empty")
-    return Path(text)
+    return Path(text).expanduser()
 
 
 WALL = {
