@@ -150,3 +150,26 @@ def test_interrupt_in_the_middle_of_a_flush_still_leaves_a_complete_file(wall, t
     assert info["frames"] == 11  # the first batch, then as much of the second as was sent: no duplicates
     rows = recording_rows(path)
     assert all(len(set(r)) == len(r) for r in rows.values())  # no row sent twice (the batch again at close)
+
+
+def test_the_readback_helpers_read_a_cut_recording_as_inspect_does(wall, tmp_path):
+    """A file cut in the middle of a message (a kill -9's .NAME.<pid>.part, a full disk): inspect read it up to
+    its last whole message, field_frames, blueprint_views and recording_rows raised "Message payload (start …)
+    exceeds file size"."""
+    from masonrycli.recording.readback import blueprint_views, field_frames
+
+    static, q0 = wall
+    whole, cut = tmp_path / "whole.rrd", tmp_path / "cut.rrd"
+    with Recorder(whole, static, fx.METADATA, batch_frames=4, long_batch_frames=4) as rec:
+        for f in fx.frames(static, q0, 9):
+            rec.log_frame(f)
+    data = whole.read_bytes()
+    for share in (0.8, 0.7, 0.6, 0.5, 0.4, 0.3):  # a cut inside the second batch of frames
+        cut.write_bytes(data[: int(len(data) * share)])
+        info = inspect_recording(cut)
+        if 0 < info["frames"] < 9:
+            break
+    assert info["truncated"] and 0 < info["frames"] < 9, info
+    frames = field_frames(cut)
+    assert sorted(frames) == sorted(field_frames(whole))[: info["frames"]]
+    assert blueprint_views(cut) and recording_rows(cut)

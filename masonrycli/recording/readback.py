@@ -3,6 +3,7 @@ colour ranges (for tests and docs). Screenshots from a headless viewer are in sc
 
 from __future__ import annotations
 
+import contextlib
 import errno
 import os
 import re
@@ -183,6 +184,16 @@ def _open_reader(path: str, scratch: str) -> tuple[rr.chunk.RrdReader, bool]:
     raise ValueError(f"{path}: no complete message found")
 
 
+@contextlib.contextmanager
+def _reading(path: str | os.PathLike):
+    """A reader of ``path`` as :func:`_open_reader` makes it (a file cut by a killed writer read up to its last
+    complete message): ``field_frames`` and the others raised "Message payload … exceeds file size" on the
+    recording ``masonry inspect`` summarised, a ``kill -9``'s ``.NAME.<pid>.part``."""
+    with tempfile.TemporaryDirectory(prefix="masonry-read-") as scratch, warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # "RRD file has no footer/manifest": what truncated means
+        yield _open_reader(os.fspath(path), scratch)[0]
+
+
 def inspect_recording(path: str | os.PathLike) -> dict:
     """Summary of a recording file; works without a footer too (a killed writer's file) and on a file cut
     in the middle of a message (read up to its last complete message).
@@ -265,9 +276,10 @@ def blueprint_views(path: str | os.PathLike) -> dict[str, dict]:
     before the paper's instant sends a second one without the pinned tabs): name -> {"kind", "origin",
     "pinned"}; ``pinned`` is (timeline, start s, end s) for a view whose visible time range is fixed,
     else None."""
-    reader = rr.chunk.RrdReader(os.fspath(path))
+    with _reading(path) as reader:
+        chunks = list(reader.stream(store=_last_blueprint(reader)))
     by_id: dict[str, dict] = {}
-    for chunk in reader.stream(store=_last_blueprint(reader)):
+    for chunk in chunks:
         batch = chunk.to_record_batch()
         parts = chunk.entity_path.strip("/").split("/")
         if parts[0] != "view" or len(parts) < 2:
@@ -289,8 +301,9 @@ def blueprint_time_panel(path: str | os.PathLike) -> dict:
     "following" or None} (None: not set, the viewer's default)."""
     out: dict = {"timeline": None, "play_state": None}
     names = {1: "paused", 2: "playing", 3: "following"}  # rerun.blueprint.components.PlayState
-    reader = rr.chunk.RrdReader(os.fspath(path))
-    for chunk in reader.stream(store=_last_blueprint(reader)):
+    with _reading(path) as reader:
+        chunks = list(reader.stream(store=_last_blueprint(reader)))
+    for chunk in chunks:
         if chunk.entity_path != "/time_panel":
             continue
         batch = chunk.to_record_batch()
@@ -308,7 +321,9 @@ def field_frames(path: str | os.PathLike) -> dict[int, dict]:
     out: dict[int, dict] = {}
     hover = {name: key for name, key in HOVER_VALUES.items()}
     labels = {f"/{f.labels}": f.key for f in FIELDS}
-    for chunk in rr.chunk.RrdReader(os.fspath(path)).stream():
+    with _reading(path) as reader:
+        chunks = list(reader.stream())
+    for chunk in chunks:
         if chunk.is_static:
             continue
         batch = chunk.to_record_batch()
@@ -349,7 +364,9 @@ def recording_rows(path: str | os.PathLike) -> dict[str, list[str]]:
     time, start time, commit and source digest masked, the recording's own start time (``/__properties``) left out."""
     temporal: dict[str, list[str]] = {}
     static: dict[str, list[str]] = {}
-    for chunk in rr.chunk.RrdReader(os.fspath(path)).stream():
+    with _reading(path) as reader:
+        chunks = list(reader.stream())
+    for chunk in chunks:
         if chunk.entity_path == "/__properties":
             continue
         batch = chunk.to_record_batch()
