@@ -115,11 +115,21 @@ def _array_of_tables(doc: dict, key: str, ctx: InputContext) -> list:
     return value
 
 
+WORD_KEYS = frozenset({"solver", "quantity", "baseline"})
+"""Keys whose value is a word of a fixed list, read in any case as a motion's ``kind`` and the command line's
+``--solver NLGS`` (``solver = "NLGS"`` was refused)."""
+
+
+def _words(table: dict) -> dict:
+    return {k: v.strip().lower() if k in WORD_KEYS and isinstance(v, str) else v for k, v in table.items()}
+
+
 def _config(cls, table: dict, ctx: InputContext, section: str):
     names = [f.name for f in dataclasses.fields(cls)]
     for key in table:
         if key not in names:
             raise ctx.error(f"[{section}]", unknown_key(key, names))
+    table = _words(table)
     try:
         return cls(**table)
     except InputError as exc:
@@ -348,10 +358,10 @@ def _parse_motion(table, ctx: InputContext, loc: str) -> Motion:
         if key not in table:
             raise ctx.error(loc, f'motion.{key}: missing (required for kind "{kind}")')
 
-    args = {k: v for k, v in table.items() if k not in ("kind", "file", "vertical", "time", "value")}
+    args = {k: v for k, v in _words(table).items() if k not in ("kind", "file", "vertical", "time", "value")}
     if kind == "record":
         try:
-            args.update(record_fields(table, ctx.base_dir))
+            args.update(record_fields(_words(table), ctx.base_dir))
         except InputError as exc:
             raise ctx.error(loc, str(exc)) from None
     try:

@@ -245,6 +245,18 @@ def test_bad_record_row_names_scenario_csv_and_line(tmp_path):
     assert load_error(tmp_path, text) == '[[support]] #1 ("ground"): motion.file: q.csv:3: not a number: "x"'
 
 
+def test_solver_quantity_and_baseline_are_read_in_any_case(tmp_path):
+    # solver = "NLGS" was 'must be one of nlgs-accel, nlgs' (--solver NLGS ran), quantity = "Acceleration"
+    # 'must be "velocity" or "acceleration"', baseline = "None" 'must be "quadratic" or "none"'
+    (tmp_path / "q.csv").write_text("t,a\n0,0\n0.1,1\n0.2,0\n")
+    record = 'motion = { kind = "record", file = "q.csv", quantity = "Acceleration", baseline = "None" }\npolygon'
+    path = tmp_path / "s.toml"
+    path.write_text('[run]\nsolver = "NLGS"\n' + BLOCK + GROUND.replace("polygon", record))
+    scenario = load_scenario(path)
+    assert scenario.run.solver == "nlgs"
+    assert (scenario.motions[0].quantity, scenario.motions[0].baseline) == ("acceleration", "none")
+
+
 def test_motion_kind_is_read_in_any_case(tmp_path):
     # kind = "Sine" was 'unknown motion kind (expected one of fixed, constant, sine, ramp, record)'
     text = Path(DATA / "block_on_ground.toml").read_text().replace('kind = "sine"', 'kind = "Sine"')
