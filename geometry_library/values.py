@@ -125,6 +125,8 @@ _SPELLINGS = {  # a unit -> how users write it, compared after _spelled (lower c
     "Hz": ("hz", "hertz", "1/s", "s-1", "/s", "cps"),
     "rad": ("rad", "radian", "radians"),
 }
+_DECIMAL_COMMA = re.compile(r"\s*([+-]?\d+),(\d+)\s*")
+_PERCENT = re.compile(r"\s*([+-]?(?:\d+(?:\.\d*)?|\.\d+))\s*%\s*")
 _NUMBER_AND_UNIT = re.compile(r"\s*([+-]?(?:\d+(?:\.\d*)?|\.\d+)(?:[eE][+-]?\d+)?)\s*([A-Za-zµμ°][^\n]*?)\s*")
 _SYMBOL = r"(?:[nµμumcdkg]?(?:m|s|g|t|n|pa|j|w|hz|rad|l|h|bar)|deg|°|min|hr|in|ft|yd|lbs?|kip|psi|mph|cps)"
 _WORD = (  # a unit's name, maybe prefixed, maybe plural: "Seconds", "millimetres", "kilonewton"
@@ -206,6 +208,12 @@ def _string_hint(text: str, unit: str | None) -> str:
         return f" (write {text.strip()}, without quotes)"
     except ValueError:
         pass
+    comma = _DECIMAL_COMMA.fullmatch(text)  # "0,6" (a European spreadsheet's friction) said "must be a number"
+    if comma and (len(comma.group(2)) != 3 or comma.group(1).lstrip("+-") == "0"):  # "1,500" may be 1500
+        return f" (write {comma.group(1)}.{comma.group(2)}: the decimal separator is a point)"
+    percent = _PERCENT.fullmatch(text)  # "--scale 50%": a factor of no unit, 0.5
+    if percent and unit == "":
+        return f" (write {float(percent.group(1)) / 100:g}: a percentage is written as a fraction)"
     found = _NUMBER_AND_UNIT.fullmatch(text)
     if found is None or _NOT_A_UNIT.fullmatch(text):
         return ""

@@ -40,6 +40,12 @@ RUN = ("simulate", "wall", "--duration", "0.01", "--no-recording")
         # float() and int() read "1_0" as 10: on the command line a typo, run with dt = 10 before
         ("--dt", "1_0", "--dt 1_0: must be a number (an underscore is not a digit separator here)"),
         ("--blocks", "5_1", "--blocks 5_1: must be an integer (an underscore is not a digit separator here)"),
+        # a decimal comma and a percentage said "must be a number" and no more
+        ("--friction", "0,6", "--friction 0,6: must be a number (write 0.6: the decimal separator is a point)"),
+        ("--duration", "1,5", "--duration 1,5: must be a number (write 1.5: the decimal separator is a point)"),
+        ("--duration", "1,500", "--duration 1,500: must be a number"),  # 1.5 or 1500: no guess
+        ("--friction", "60%", "--friction 60%: must be a number (write 0.6: a percentage is written as a fraction)"),
+        ("--duration", "50%", "--duration 50%: must be a number"),  # a time in s is no fraction
     ],
 )
 def test_a_number_option_given_text_says_what_to_write(option, value, message):
@@ -77,7 +83,11 @@ def test_a_number_option_given_text_says_what_to_write(option, value, message):
             ("sweep", "wall", "--param", "amp=1", "--dt", "20ms"),
             "--dt 20ms: must be a number (it is read in s: convert 20 ms to s",
         ),
-        (("sweep", "wall", "--param", "amp=1", "--rtol", "1%"), "--rtol 1%: must be a number"),
+        (
+            ("sweep", "wall", "--param", "amp=1", "--rtol", "1%"),
+            "--rtol 1%: must be a number (write 0.01: a percentage is written as a fraction)",
+        ),
+        (("sweep", "wall", "--param", "amp=1", "--rtol", "abc"), "--rtol abc: must be a number"),
         (
             ("sweep", "wall", "--param", "amp=1", "--workers", "2cores"),
             '--workers 2cores: must be an integer (write 2, without "cores"',
