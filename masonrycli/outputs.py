@@ -193,9 +193,20 @@ def check_folder(path: Path, where: str) -> None:
     if not existing.is_dir():
         raise InputError(f"{where}: {existing} is not a folder")
     if not os.access(existing, os.W_OK | os.X_OK):
-        raise InputError(f"{where}: cannot write in {existing} (permission denied)")
+        raise InputError(f"{where}: cannot write in {existing} ({_why_not_writable(existing)})")
     if shutil.disk_usage(existing).total == 0:  # /proc, /sys: writable to root, yet no file can be made there
         raise InputError(f"{where}: cannot write in {existing} (a system folder, not a disk)")
+
+
+def _why_not_writable(folder: Path) -> str:
+    """A folder on a read-only mount (a dataset, a container's root) said "permission denied", which its
+    permissions did not explain."""
+    try:
+        if os.statvfs(folder).f_flag & os.ST_RDONLY:
+            return "a read-only file system"
+    except (OSError, AttributeError):
+        pass
+    return "permission denied"
 
 
 def check_distinct(*outputs: OutputFile | None) -> None:

@@ -332,3 +332,20 @@ def test_a_temporary_file_is_being_written_only_while_its_process_runs(tmp_path)
     live.write_bytes(b"")
     assert being_written(target) == (live, os.getpid()) and part_writer(live) == os.getpid()
     assert part_writer(target) is None
+
+
+def test_a_read_only_file_system_is_named(tmp_path, monkeypatch):
+    # A folder on a read-only mount (mount -o ro: 'masonry simulate wall' there) said "cannot write in .
+    # (permission denied)", which the folder's permissions did not explain.
+    from types import SimpleNamespace
+
+    folder = tmp_path / "ro"
+    folder.mkdir()
+    access, statvfs = os.access, os.statvfs
+    monkeypatch.setattr(os, "access", lambda p, mode, **kw: False if Path(p) == folder else access(p, mode, **kw))
+    monkeypatch.setattr(
+        os, "statvfs", lambda p: SimpleNamespace(f_flag=os.ST_RDONLY) if Path(p) == folder else statvfs(p)
+    )
+    result = invoke("run", COLUMN, "--duration", 0.01, "--out", folder / "r.rrd")
+    said = f"error: --out {folder / 'r.rrd'}: cannot write in {folder} (a read-only file system)"
+    assert result.exit_code == 2 and result.output.strip() == said, result.output
