@@ -160,3 +160,31 @@ def test_a_recording_of_static_data_alone_is_shown(tmp_path):
     start = time.monotonic()
     assert screenshot_recording(rrd, tmp_path / "map.png", timeout=60, at_open=True) == []
     assert time.monotonic() - start < 45 and png_size(tmp_path / "map.png") == (1920, 1080)
+
+
+def test_every_tab_of_a_paper_run_is_shown_the_live_one_too(tmp_path):
+    """A paper run opens on its second tab (Fig. III.2); the tabs were shown from the second on, so the
+    live tab (joint forces, principal stress: the one a user reaches first) was never drawn nor checked:
+    tab1..tab11 of its 12 tabs. Now every tab not on screen at open is shown."""
+    static, q0 = fx.wall(5, 6)
+    rrd = tmp_path / "wall.rrd"
+    paper = {**fx.METADATA, "scenario": "wall", "duration_s": 0.14, "supports": paper_loading("wall")}
+    with Recorder(rrd, static, paper, batch_frames=8) as rec:
+        for f in fx.frames(static, q0, 15):  # to t = 0.14 s, past the paper's 0.1 s
+            rec.log_frame(f)
+    tabs = tmp_path / "tabs"
+    assert screenshot_recording(rrd, tmp_path / "open.png", timeout=120, at_open=True, tabs_dir=tabs) == []
+    assert sorted(p.name for p in tabs.glob("tab*.png")) == sorted(f"tab{i}.png" for i in range(12))
+
+
+def test_a_limit_recording_is_shown_at_its_last_step(tmp_path):
+    """A limit analysis records the mechanism on a `step` time line alone: the screenshot at the last
+    frame asked for `sim_time` and failed (ConnectionError: no timeline "sim_time")."""
+    from masonrycli.limit import LiveLoad, analyse
+    from masonrycli.limit.command import write_recording
+
+    from limit_helpers import column
+
+    rrd = tmp_path / "mechanism.rrd"
+    write_recording(analyse(column(2, 0.4, 0.8, 0.9), LiveLoad("horizontal")), rrd)
+    assert screenshot_recording(rrd, tmp_path / "last.png", timeout=120) == []

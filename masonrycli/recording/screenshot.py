@@ -40,12 +40,14 @@ def screenshot_recording(
     """Open a recording in a headless viewer, save a PNG of the window, return the views' error reports.
 
     ``time_s``: the ``sim_time`` shown, s (None: the last frame's). The cursor is set on ``sim_time`` (the
-    timeline the blueprint opens on and the paper-figure tabs are pinned on); with ``at_open`` it is left
+    timeline the blueprint opens on and the paper-figure tabs are pinned on; a recording without it, a
+    limit analysis, is shown at its last ``step``); with ``at_open`` it is left
     where the viewer put it on opening the file (``time_s`` ignored): what a user sees first. The PNG shows the
     default layout, less the entities ``without`` (paths with the leading "/": compare two shots to see what
     an entity adds to the picture). A hidden tab
     is not drawn and cannot report, so every tab is then brought to the front in turn (saved as
-    ``tabs_dir/tab<i>.png`` if given). Returns "view: severity: summary" for every report of every view;
+    ``tabs_dir/tab<i>.png`` if given: the i-th tab of every tab container, unless those are the tabs shown
+    at open). Returns "view: severity: summary" for every report of every view;
     empty means healthy. Needs a Vulkan driver (Debian: mesa-vulkan-drivers libvulkan1).
     """
     from rerun.experimental import ViewerClient
@@ -89,10 +91,15 @@ def screenshot_recording(
                     entry["ViewContents"]["query"] = [q for q in query if q.removeprefix("+ ") not in without]
             viewer.set_blueprint(layout, of="recording")
         if not at_open and recs:  # a static-only recording has no time to set
-            if time_s is None:
-                line = next((t for r in recs for t in r.timelines if t.name == "sim_time"), None)
-                time_s = 1e-9 * line.end if line is not None and line.end is not None else 0.0
-            viewer.set_time("sim_time", duration=float(time_s), play_state="paused")
+            line = next((t for r in recs for t in r.timelines if t.name == "sim_time"), None)
+            if line is None:  # a limit-analysis recording has the mechanism's steps alone: its last
+                step = next((t for r in recs for t in r.timelines if t.name == "step"), None)
+                if step is not None and step.end is not None:
+                    viewer.set_time("step", sequence=int(step.end), play_state="paused")
+            else:
+                if time_s is None:
+                    time_s = 1e-9 * line.end if line.end is not None else 0.0
+                viewer.set_time("sim_time", duration=float(time_s), play_state="paused")
         _settle(viewer)
         viewer.save_screenshot(os.path.abspath(png_path))
         reports = {v.view_id: (v.name, v.reports) for v in viewer.get_state().views}
@@ -102,11 +109,17 @@ def screenshot_recording(
             for c in blueprint.values()
             if c.get("ContainerBlueprint", {}).get("container_kind") == "Tabs"
         ]
-        for i in range(1, max((len(t.get("contents", [])) for t in tabs), default=0)):
+        # every tab not shown at open, the first one included: a paper run opens on its second tab, and
+        # the loop started at the second, so the live tab (forces, principal stress) was never shown
+        shown = [t.get("active_tab") or (t.get("contents") or [None])[0] for t in tabs]
+        for i in range(max((len(t.get("contents", [])) for t in tabs), default=0)):
+            picks = [t["contents"][min(i, len(t["contents"]) - 1)] for t in tabs]
+            if picks == shown:
+                continue
             if time.monotonic() > deadline:
                 raise TimeoutError(f"viewer did not show every tab of {rrd_path} within {timeout} s")
-            for t in tabs:
-                t["active_tab"] = t["contents"][min(i, len(t["contents"]) - 1)]
+            for t, pick in zip(tabs, picks):
+                t["active_tab"] = pick
             viewer.set_blueprint(blueprint, of="recording")
             _settle(viewer)
             png = viewer.take_screenshot()
