@@ -6,10 +6,22 @@ import numpy as np
 import pytest
 import rerun as rr
 
+from masonrycli.colormap import VIRIDIS
 from masonrycli.limit import LiveLoad, analyse
 from masonrycli.limit.command import write_recording
 from masonrycli.recording import inspect_recording
-from masonrycli.recording.limit import FILL, HINGES, LIMIT_PATHS, MAGNIFIED_SHARE, OUTLINES, STEPS, THRUST
+from masonrycli.recording.limit import (
+    FILL,
+    HINGES,
+    LIMIT_PATHS,
+    MAGNIFIED_SHARE,
+    OUTLINES,
+    SPEED_BAR,
+    SPEED_LABELS,
+    SPEED_TITLE,
+    STEPS,
+    THRUST,
+)
 
 from limit_helpers import column
 
@@ -71,6 +83,30 @@ def test_hinge_drawn_on_both_copies_and_thrust_points_static(written):
     assert FILL in {c.entity_path.lstrip("/") for c in rr.chunk.RrdReader(path).stream()}
     thrust = [c for c in rr.chunk.RrdReader(path).stream() if c.entity_path == f"/{THRUST}" and c.is_static]
     assert thrust
+
+
+def static_column(path, entity: str, column_name: str) -> list:
+    for chunk in rr.chunk.RrdReader(path).stream():
+        if chunk.entity_path == f"/{entity}" and chunk.is_static:
+            batch = chunk.to_record_batch()
+            if column_name in batch.schema.names:
+                return batch.column(column_name).to_pylist()[-1]
+    raise AssertionError(f"no static {column_name} on {entity}")
+
+
+def test_the_speed_colours_have_a_bar_right_of_the_mechanism(written):
+    """The mechanism copy was filled by speed (viridis) with no scale: `masonry limit arch --out` showed
+    coloured blocks and an empty band right of them. A bar now stands there, 0 to 1 of the fastest speed."""
+    path, _ = written
+    colours = np.array(static_column(path, SPEED_BAR, "Mesh3D:vertex_colors"), dtype=np.uint32)
+    bar = np.array(static_column(path, SPEED_BAR, "Mesh3D:vertex_positions"))[:, :2]
+    assert colours[0] == VIRIDIS[0] and colours[-1] == VIRIDIS[-1]  # slow at the bottom, fastest at the top
+    assert bar[np.argmax(bar[:, 1]), 1] > bar[0, 1]
+    labels = static_column(path, SPEED_LABELS, "Points2D:labels")
+    assert labels[0] == "0" and labels[-2] == "1" and labels[-1] == SPEED_TITLE
+    blocks = np.array(rows(path, OUTLINES, "LineStrips2D:strips")[STEPS], dtype=object)
+    right = max(float(np.max(np.array(strip)[:, 0])) for strip in blocks)
+    assert bar[:, 0].min() > right  # beside the mechanism copy, not over it
 
 
 def test_a_limit_recording_that_cannot_be_written_whole_is_exit_4_and_no_file(tmp_path):

@@ -3,7 +3,8 @@
 Two copies of the assembly share one drawing plane (the pinhole of ``static_content``): on the left the
 structure as built with the line of thrust (the centre of pressure of every loaded joint) and the
 hinges; on the right, shifted by 1.15 × its width, the same blocks moved along the mechanism, filled by
-their speed in it (still blocks grey), with the hinges (yellow) and sliding joints (orange) carried
+their speed in it (still blocks grey; a colour bar beside it, in fractions of the fastest block's speed),
+with the hinges (yellow) and sliding joints (orange) carried
 along. The timeline ``step`` runs the mechanism's amplitude from 0 to its full magnification, so the
 viewer can play the collapse; the last step shows it fully.
 
@@ -22,13 +23,21 @@ import numpy as np
 import rerun as rr
 import rerun.blueprint as rrb
 
-from masonrycli.colormap import VIRIDIS, map_scalars
+from masonrycli.colormap import VIRIDIS, colorbar_mesh, map_scalars
 from masonrycli.recording.arrays import Polygons, z0
 from masonrycli.recording.document import viewer_safe_text
-from masonrycli.recording.layout import HINGE_RGBA, OUTLINE_RGBA, PLANE, SLIP_RGBA, SUPPORT_FILL_RGBA, XY
+from masonrycli.recording.layout import (
+    HINGE_RGBA,
+    LEGEND_TEXT_RGBA,
+    OUTLINE_RGBA,
+    PLANE,
+    SLIP_RGBA,
+    SUPPORT_FILL_RGBA,
+    XY,
+)
 from masonrycli.recording.readback import check_complete, wait_written
 from masonrycli.recording.recorder import APPLICATION_ID
-from masonrycli.recording.static_content import log_plane
+from masonrycli.recording.static_content import TICKS, legend_positions, log_plane
 
 MAGNIFIED_SHARE: Final = 0.12
 STEPS: Final = 20
@@ -42,8 +51,11 @@ OUTLINES: Final = f"{XY}/limit/outlines"
 HINGES: Final = f"{XY}/limit/hinges"
 SLIDING: Final = f"{XY}/limit/sliding"
 THRUST: Final = f"{XY}/limit/thrust"
+SPEED_BAR: Final = "structure/limit/speed_bar"
+SPEED_LABELS: Final = f"{XY}/limit/speed_bar"
+SPEED_TITLE: Final = "Speed / fastest"
 DOCUMENT: Final = "limit/document"
-LIMIT_PATHS: Final = (PLANE, XY, FILL, SUPPORTS, OUTLINES, HINGES, SLIDING, THRUST, DOCUMENT)
+LIMIT_PATHS: Final = (PLANE, XY, FILL, SUPPORTS, OUTLINES, HINGES, SLIDING, THRUST, SPEED_BAR, SPEED_LABELS, DOCUMENT)
 _NAMESPACE: Final = uuid.UUID("2b8f0c57-64f1-4f0e-9a51-1f3c7d0e6a21")
 
 
@@ -157,7 +169,7 @@ def write_limit_recording(path: str | os.PathLike, drawing: MechanismDrawing) ->
     rec = rr.RecordingStream(APPLICATION_ID, recording_id=str(uuid.uuid5(_NAMESPACE, os.fspath(path))))
     view = rrb.Spatial2DView(
         origin=f"/{PLANE}",
-        contents=[f"+ /{p}" for p in (SUPPORTS, FILL, OUTLINES, THRUST, HINGES, SLIDING)],
+        contents=[f"+ /{p}" for p in (SUPPORTS, FILL, OUTLINES, THRUST, HINGES, SLIDING, SPEED_BAR, SPEED_LABELS)],
         name="Collapse mechanism (right, magnified) and line of thrust",
     )
     blueprint = rrb.Blueprint(
@@ -168,7 +180,8 @@ def write_limit_recording(path: str | os.PathLike, drawing: MechanismDrawing) ->
     )
     rec.save(os.fspath(path), default_blueprint=blueprint)
     try:
-        log_plane(rec, both, sup_both, poses[-1], sup_q)
+        legend_box, _ = log_plane(rec, both, sup_both, poses[-1], sup_q)
+        _log_speed_bar(rec, legend_box)
         rec.log(DOCUMENT, rr.TextDocument(viewer_safe_text(d.document), media_type=rr.MediaType.MARKDOWN), static=True)
         rec.log(
             SUPPORTS,
@@ -209,3 +222,18 @@ def write_limit_recording(path: str | os.PathLike, drawing: MechanismDrawing) ->
         wait_written(rec, path)
         rec.disconnect()
     check_complete(path)
+
+
+def _log_speed_bar(rec: rr.RecordingStream, legend_box: tuple[float, float, float, float]) -> None:
+    """The key of the mechanism copy's colours, in the room ``log_plane`` leaves right of the structure:
+    the blocks were filled by speed with no scale beside them. The mechanism is a velocity field of no
+    particular size, so the bar reads in fractions of the fastest block's speed (0 to 1)."""
+    verts, tri, colors = colorbar_mesh(legend_box, VIRIDIS)
+    rec.log(SPEED_BAR, rr.Mesh3D(vertex_positions=z0(verts), triangle_indices=tri, vertex_colors=colors), static=True)
+    anchors = legend_positions(legend_box)[: TICKS + 1]  # the ticks (bottom up) and the title
+    labels = [f"{v:g}" for v in np.linspace(0.0, 1.0, TICKS)] + [SPEED_TITLE]
+    rec.log(
+        SPEED_LABELS,
+        rr.Points2D(anchors, labels=labels, radii=0.0, colors=LEGEND_TEXT_RGBA, show_labels=True, draw_order=60.0),
+        static=True,
+    )
