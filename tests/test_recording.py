@@ -377,14 +377,20 @@ def test_solver_health_once_per_step_and_the_initial_frame_shown(wall, tmp_path)
 
 
 def test_magnified_shape(written):
+    """The blocks' displacement relative to the one shaken ground is magnified, drawn on the ground where it
+    is (the ground's travel was magnified too: the view slid by m × the ground's displacement)."""
     path, static, frames, rec = written
     rows = temporal_rows(path, "/structure/plane/xy/magnified", "LineStrips2D:strips")
     m = rec.magnify
     assert m >= 1.0
     f = frames[-1]
-    q = frames[0].block_q + m * (f.block_q - frames[0].block_q)
+    g = np.append(f.support_q[0, :2] - frames[0].support_q[0, :2], 0.0)
+    assert abs(g[0]) > 1e-3  # the fixture's ground has moved
+    q = frames[0].block_q + g + m * (f.block_q - frames[0].block_q - g)
     np.testing.assert_allclose(np.array(rows[f.step][0])[:-1], world_outline(static, q, 0), atol=1e-4)
     assert len(rows[f.step]) == len(static.block_name) + 1  # blocks and the ground
+    ground = np.array(rows[f.step][-1])[:-1]
+    np.testing.assert_allclose(ground.min(axis=0) - g[:2], np.array(rows[0][-1])[:-1].min(axis=0), atol=1e-4)
 
 
 def test_recording_path_problem_names_a_folders_recordings(tmp_path):

@@ -105,14 +105,16 @@ def test_magnified_rows_are_every_frame_kept_in_memory(wall, tmp_path, monkeypat
     kept = [frames[0], *frames[1:-1][::2], frames[-1]]
     ref = frames[0].block_q
     q = [np.asarray(f.block_q, np.float32).astype(np.float64) for f in kept]
+    # the fixture's one ground moves: the displacement relative to it is magnified (magnified.py)
+    g = [np.append(np.asarray(f.support_q, np.float32)[0, :2] - frames[0].support_q[0, :2], 0.0) for f in kept]
     m = magnification(
-        np.stack(q)[..., :2] - ref[None, :, :2], rec._size
+        np.stack(q)[..., :2] - ref[None, :, :2] - np.stack(g)[:, None, :2], rec._size
     )  # the structure's size, as the recorder took it
     assert rec.magnify == m
     rows = temporal_rows(path, MAGNIFIED, "LineStrips2D:strips")
     assert sorted(rows) == [f.step for f in kept]
-    for f, qf in zip(kept, q):
-        drawn = ref + m * (qf - ref)
+    for f, qf, gf in zip(kept, q, g):
+        drawn = ref + gf + m * (qf - ref - gf)
         for b in (0, len(static.block_name) - 1):
             s, e = static.block_vert_start[b], static.block_vert_start[b + 1]
             c, sn = np.cos(drawn[b, 2]), np.sin(drawn[b, 2])
@@ -196,3 +198,19 @@ def test_rows_of_a_time_with_a_nanosecond_remainder(wall, tmp_path):
             rec.log_frame(dataclasses.replace(f, time=[0.0, 1.024999999, 1.025][i]))
     rows = [r for rows in recording_rows(path).values() for r in rows]
     assert any("('sim_time', 1024999999)" in row for row in rows), rows[0][:300]
+
+
+def test_the_ground_is_taken_out_only_when_every_support_moves_with_it(tmp_path):
+    """Both foundations shaken alike: one translation, taken out of the magnified displacement; the arch's right
+    foundation settling beside the fixed left one: the structure's displacement is magnified as it is."""
+    from masonrycli.recording.magnified import PoseSpool, _supports_move_together
+
+    ref_sq = np.array([[-2.0, -0.25, 0.0], [2.0, -0.25, 0.0]])
+    for moves, together in (([0.05, 0.05], True), ([0.0, -0.01], False)):
+        spool = PoseSpool(str(tmp_path), 1, 2)
+        for k in range(5):
+            sq = ref_sq.copy()
+            sq[:, 0 if together else 1] += np.array(moves) * k
+            spool.append(10 * k, 0.01 * k, np.zeros((1, 3)), sq)
+        assert _supports_move_together(spool, ref_sq, 4.0, batch_frames=2) is together
+        spool.close()

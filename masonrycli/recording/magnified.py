@@ -1,4 +1,10 @@
-"""The magnified deformed shape: every block (and support) at x0 + m (x − x0), rotated by m θ.
+"""The magnified deformed shape: every block (and support) at x0 + m (x − x0), rotated by m θ; when every
+support moves by one translation g (a shaken ground, both foundations shaken alike) the blocks' displacement
+relative to it is magnified instead, on the ground where it is: x0 + g + m (x − x0 − g), supports at x0 + g.
+The shaken wall's view magnified the ground's rigid travel: ``masonry simulate wall --amp 0.3 --duration 0.5``
+(the ground travels 4.8 cm) was drawn × 2.5, wall and ground sliding 12 cm to and fro, its own largest
+displacement (0.036 mm, the summary's, relative to the ground) not seen; now × 3000. The same reference as the
+summary's "largest block displacement" and masonrycli.collapse.
 
 Logged when the recorder closes: the default factor m (``masonrycli.joint_forces.magnification``) needs
 the largest displacement of the run. Only outlines (line strips), the initial frame (t = 0), every
@@ -90,10 +96,12 @@ def send_magnified(
     """Send the magnified outlines of the frames in ``poses`` about ``ref`` (the first block_q, support_q);
     returns the factor used (``magnify``, or the default for ``size`` m)."""
     ref_q, ref_sq = ref
+    rigid = _supports_move_together(poses, ref_sq, size, batch_frames)
     if magnify is None:  # one pass over the file: the displacement of largest norm, as a (1, 2) array
         largest, norm2 = np.zeros((0, 2)), -1.0
         for chunk in _chunks(poses, batch_frames):
-            d = (chunk["q"].astype(np.float64)[..., :2] - ref_q[None, :, :2]).reshape(-1, 2)
+            g = _ground_shift(chunk, ref_sq, rigid)
+            d = (chunk["q"].astype(np.float64)[..., :2] - ref_q[None, :, :2] - g[:, None, :2]).reshape(-1, 2)
             if d.size and (d2 := (d**2).sum(axis=1)).max() > norm2:  # sqrt is monotonic: the same maximum
                 k = int(np.argmax(d2))
                 largest, norm2 = d[k : k + 1], float(d2[k])
@@ -104,10 +112,11 @@ def send_magnified(
         q, sq = chunk["q"].astype(np.float64), chunk["sq"].astype(np.float64)
         batch = FrameBatch(step=chunk["step"].tolist(), time=chunk["time"].tolist())
         n_frames = len(chunk)
-        sets = [blocks.outlines(blocks.world(ref_q + m * (q - ref_q)))]
+        back = (m - 1.0) * _ground_shift(chunk, ref_sq, rigid)[:, None, :]  # the ground's travel, not magnified
+        sets = [blocks.outlines(blocks.world(ref_q + m * (q - ref_q) - back))]
         count = blocks.count
         if supports.count:
-            sets.append(supports.outlines(supports.world(ref_sq + m * (sq - ref_sq))))
+            sets.append(supports.outlines(supports.world(ref_sq + m * (sq - ref_sq) - back)))
             count += supports.count
         # frame by frame: that frame's blocks, then its supports
         strips = [arr.slice(k * (len(arr) // n_frames), len(arr) // n_frames) for k in range(n_frames) for arr in sets]
@@ -119,3 +128,24 @@ def send_magnified(
             ),
         )
     return m
+
+
+def _supports_move_together(poses: PoseSpool, ref_sq: np.ndarray, size: float, batch_frames: int) -> bool:
+    """Whether every support moves by one translation at every drawn frame (a settling foundation beside a
+    fixed one does not: the structure's displacement is then drawn as it is)."""
+    if ref_sq.shape[0] == 0:
+        return False
+    atol = 1e-6 * max(1.0, size, float(np.abs(ref_sq[:, :2]).max()))  # float32 poses: ~1e-7 of a coordinate
+    for chunk in _chunks(poses, batch_frames):
+        d = chunk["sq"].astype(np.float64)[..., :2] - ref_sq[None, :, :2]
+        if not np.allclose(d, d[:, :1, :], rtol=0.0, atol=atol):
+            return False
+    return True
+
+
+def _ground_shift(chunk: np.ndarray, ref_sq: np.ndarray, rigid: bool) -> np.ndarray:
+    """(frames, 3): the supports' common translation at each frame of ``chunk`` (x, y, 0), zeros unless ``rigid``."""
+    shift = np.zeros((len(chunk), 3))
+    if rigid:
+        shift[:, :2] = chunk["sq"].astype(np.float64)[:, 0, :2] - ref_sq[None, 0, :2]
+    return shift
