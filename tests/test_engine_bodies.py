@@ -96,12 +96,15 @@ def test_body_order_sweeps_stop_at_the_cap():
     assert 7 <= units <= 7 + 2 and res > 0.0  # the sweep that crosses the cap ends (≤ 2 units a sweep)
 
 
-def _windows_run(residuals, window, level):
-    """bodies._cycling_windows over a residual sequence: the run of cycling windows after each sweep."""
-    state, best, runs = np.zeros(3), np.inf, []
+def _windows_run(residuals, window, level, strong=np.inf, strong_runs=None):
+    """bodies._cycling_windows over a residual sequence: the run of cycling windows after each sweep (and the run
+    of windows above ``strong`` × the low into ``strong_runs``, a list, if given)."""
+    state, best, runs = np.zeros(4), np.inf, []
     for x in residuals:
         best = min(best, x)
-        runs.append(bodies._cycling_windows(state, x, best, window, level))
+        runs.append(bodies._cycling_windows(state, x, best, window, level, strong))
+        if strong_runs is not None:
+            strong_runs.append(state[3])
     return np.array(runs)
 
 

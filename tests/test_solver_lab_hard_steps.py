@@ -42,3 +42,23 @@ def test_capture_with_constants_set_replays_under_the_same_variant(tmp_path):
     assert {n: s["units"] for n, s in doc["variants"][variant]["steps"].items()} == {
         n: e["units"] for n, e in index.items()
     }
+
+
+def test_stages_split_each_step_into_the_units_the_engine_spent(tmp_path, monkeypatch):
+    # hard stages: momentum's units, the body-order stage's calls and the round-robin's resumes add up to the
+    # units nlgs.solve spends on the step; momentum's history is one residual a sweep, ending on the residual
+    # its own solve stopped at (the first stage re-run with caps 1, 2, …). A 1-sweep window hands steps over.
+    from masonrycli.engine import momentum
+
+    hard_steps.capture(["h8"], 0, 1, motions=[(1.0, 2.0, 0.0)], duration=0.004, directory=tmp_path)
+    monkeypatch.setattr(momentum, "STALL_SWEEPS", 1)
+    doc = hard_steps.stages(1, None, tmp_path)
+    assert len(doc) == 4
+    for s in doc.values():
+        m = s["momentum"]
+        assert len(m["history"]) == m["units"] and m["low"] == min(m["history"])
+        spent = m["units"] + sum(c["units"] for c in s["stage"]) + sum(d for _, d, _ in s["resumes"])
+        assert spent == s["units"]
+        if not s["stage"]:  # momentum's own solve ended the step
+            assert m["history"][-1] == s["residual"]
+    assert any(s["stage"] for s in doc.values())

@@ -4,6 +4,7 @@
                                                  [--motions A,F …] [--duration S] [--dir DIR] [--set MOD.NAME=V+…]
     python -m benchmarks.solver_lab hard replay --variants main ns-… [--min-units 2500] [--out FILE.json] [--dir DIR]
     python -m benchmarks.solver_lab hard table FILE.json [FILE.json …]
+    python -m benchmarks.solver_lab hard stages [--dir DIR] [--min-units 400] --out FILE.json
 
 A whole run is chaotic (an amplitude changed by 1e-6 gives another trajectory, ensemble.py), so a change of
 the stalled-step rules cannot be judged on one run; replaying the same captured steps through ``nlgs.solve``
@@ -24,7 +25,11 @@ replay (VARIANTS below), restored after. Per step: units, converged, and the met
 (the last one stalled.py resumed; "momentum0" for momentum's own first solve, "bodies" for stalled.py's
 body-order stage ahead of its round-robin). ``table`` prints, per
 variant: total units, steps converged, steps above 10 000 units, ratio to the first file's total, and
-which method finished how many steps.
+which method finished how many steps. ``stages`` splits each kept step's units by stage of the chain
+(momentum's first stage until its stall window, the body-order stage's calls, each resume of the round-robin)
+with the residual history of momentum (the first stage re-run with caps 1, 2, … its sweeps: it keeps no
+history) and of the stage (``bodies.body_order_sweeps``' history), the sweep at which each first came within
+2× the tolerance, and its lowest residual: where a dear step spends its units, and whether in a tail.
 """
 
 from __future__ import annotations
@@ -305,9 +310,81 @@ def table(paths: list[Path]) -> None:
             )
 
 
+def _first_below(history: np.ndarray, level: float) -> int | None:
+    k = np.nonzero(history <= level)[0]
+    return int(k[0]) + 1 if k.size else None
+
+
+def stage_split(name: str, directory=None) -> dict:
+    """One kept step: units and residual history per stage of the chain (module doc, ``stages``)."""
+    from masonrycli.engine import lane_sweeps
+
+    z = np.load((directory or HARD) / f"{name}.npz")
+    body, pack, count = z["body"].astype(np.int32), z["pack"], z["body"].shape[0]
+    tol, mu, cap = float(z["tolerance"]), float(z["mu"]), int(z["cap"])
+
+    def first_stage(sweeps):
+        v, r, st = z["v_free"].copy(), z["r_warm"].copy(), z["status"].copy()
+        return lane_sweeps._lane_sweeps(body, pack, count, mu, tol, sweeps, v, r, st, momentum.STALL_SWEEPS)
+
+    sweeps = first_stage(cap)[0]
+    h = np.array([first_stage(k)[1] for k in range(1, sweeps + 1)])
+    out = {"tolerance": tol, "momentum": {"units": int(sweeps), "history": h.tolist()}, "stage": [], "resumes": []}
+    calls, resume, order = [], stalled._resume, bodies.body_order_sweeps
+
+    def recorded(*args, **kwargs):
+        kwargs["history"] = history = np.full(64_000, np.nan)
+        done, residual = order(*args, **kwargs)
+        reason = int(kwargs["stage"].carry[bodies.C_REASON]) if kwargs.get("stage") is not None else -1
+        calls.append(
+            {"units": int(done), "residual": residual, "reason": reason, "history": history[~np.isnan(history)]}
+        )
+        return done, residual
+
+    def logged(method, state, *args):
+        done = resume(method, state, *args)
+        out["resumes"].append([method, int(done), float(state.residual)])
+        return done
+
+    bodies.body_order_sweeps, stalled._resume = recorded, logged
+    try:
+        v, r, st = z["v_free"].copy(), z["r_warm"].copy(), z["status"].copy()
+        model = SimpleNamespace(friction=mu, tolerance=tol, max_iterations=cap, solver="nlgs-accel")
+        out["units"], out["residual"] = (float(x) for x in nlgs.solve(body, pack, count, model, v, r, st))
+    finally:
+        bodies.body_order_sweeps, stalled._resume = order, resume
+    for part, hist in [(out["momentum"], h)] + [(c, c["history"]) for c in calls]:
+        part.update(low=float(hist.min()), low_at=int(hist.argmin()) + 1, within2=_first_below(hist, 2 * tol))
+    for c in calls:
+        c["sweeps"], c["history"] = len(c["history"]), c["history"].tolist()
+        out["stage"].append(c)
+    return out
+
+
+def stages(min_units: int, out: Path | None, directory=None) -> dict:
+    """``stage_split`` of every kept step of ≥ ``min_units``, dearest first; one line each, JSON to ``out``."""
+    directory = directory or HARD
+    index = {n: e for path in sorted(directory.glob("index-*.json")) for n, e in json.loads(path.read_text()).items()}
+    names = sorted((n for n, e in index.items() if e["units"] >= min_units), key=lambda n: -index[n]["units"])
+    doc = {}
+    for name in names:
+        doc[name] = s = stage_split(name, directory)
+        tol, m = s["tolerance"], s["momentum"]
+        line = f"{name}: {s['units']:.0f} units | momentum {m['units']} (low {m['low'] / tol:.2f}× at {m['low_at']}, ≤ 2× at {m['within2']})"
+        for c in s["stage"]:
+            line += f" | stage {c['units']} ({c['sweeps']} sweeps, stop {c['reason']}, low {c['low'] / tol:.2f}× at {c['low_at']}, ≤ 2× at {c['within2']})"
+        line += "".join(f" | {m_} {d} ({res / tol:.2f}×)" for m_, d, res in s["resumes"])
+        print(line, flush=True)
+    if out is not None:
+        out.write_text(json.dumps(doc))
+    return doc
+
+
 def add_arguments(sub) -> None:
     """The ``hard`` subcommand's parser."""
-    hard = sub.add_parser("hard", help="capture the costliest steps of ensemble runs; replay rule variants")
+    hard = sub.add_parser(
+        "hard", help="capture the costliest steps of ensemble runs; replay rule variants; split by stage"
+    )
     act = hard.add_subparsers(dest="action", required=True)
     c = act.add_parser("capture")
     c.add_argument("--cases", nargs="+", default=["h32", "h64"])
@@ -328,6 +405,10 @@ def add_arguments(sub) -> None:
     r.add_argument("--dir", type=Path, default=None, help="the captured set (default data/hard)")
     t = act.add_parser("table")
     t.add_argument("files", nargs="+", type=Path)
+    g = act.add_parser("stages")
+    g.add_argument("--min-units", type=int, default=400)
+    g.add_argument("--out", type=Path, default=None)
+    g.add_argument("--dir", type=Path, default=None, help="the captured set (default data/hard)")
 
 
 def main(args) -> None:
@@ -338,5 +419,7 @@ def main(args) -> None:
         capture(args.cases, args.copy, args.min_units, motions, args.duration, args.dir, args.set)
     elif args.action == "replay":
         replay(args.variants, args.min_units, args.max_units, args.out, args.cases, args.dir)
+    elif args.action == "stages":
+        stages(args.min_units, args.out, args.dir)
     else:
         table(args.files)

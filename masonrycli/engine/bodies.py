@@ -54,8 +54,8 @@ from masonrycli.engine.nlgs import (
 C_SWEEP, C_J, C_LAST, C_BEST, C_BEST_AT, C_BETA, C_RESIDUAL, C_REASON, C_WINDOW = range(9)
 """Slots of a stage's carry (float array of CARRY_SIZE): sweeps done, the momentum counter j, the last
 residual, the lowest and its sweep, β of the next sweep, the residual, why it stopped (STOP_*), and
-_cycling_windows' [log_sum, n, run] from C_WINDOW on. All a later call needs to go on as one long call."""
-CARRY_SIZE = C_WINDOW + 3
+_cycling_windows' [log_sum, n, run, strong run] from C_WINDOW on. All a later call needs to go on as one long call."""
+CARRY_SIZE = C_WINDOW + 4
 STOP_BUDGET, STOP_TOLERANCE, STOP_STALL, STOP_CYCLING = range(4)
 """carry[C_REASON]: the budget ran out (or max_units ≤ 0), the tolerance was met, the stall window, the
 hand-over rule (cycling windows)."""
@@ -87,23 +87,29 @@ def _body_lists(contact_body, pack, count, bodies):
 
 
 @njit(inline="always")
-def _cycling_windows(window_state, residual, best, window, level):
+def _cycling_windows(window_state, residual, best, window, level, strong):
     # The hand-over test (stalled.py's module doc, "Hand-over"): after each sweep,
     #   log_sum += log(residual) ; n += 1
     #   at the window's end (n = window): g = exp(log_sum / window), the window's level (geometric mean of
     #       its residuals); the window cycles if g > level × best (best: the lowest residual so far);
-    #       run = run + 1 if it cycles, else 0; log_sum = n = 0
-    # window_state = [log_sum, n, run]; returns run, the cycling windows in a row.
+    #       run = run + 1 if it cycles, else 0; strong run likewise with g > strong × best;
+    #       log_sum = n = 0
+    # window_state = [log_sum, n, run, strong run]; returns run, the cycling windows in a row.
     # Why the level and not the lowest residual: a step that cycles dips now and then to a new low by a
     # hair, which restarts a stall window, while its level stays 2-5x above that low; a step that
     # converges slowly keeps its level near its low.
     window_state[0] += np.log(residual)
     window_state[1] += 1.0
     if window_state[1] >= window:
-        if np.exp(window_state[0] / window) > level * best:
+        g = np.exp(window_state[0] / window)
+        if g > level * best:
             window_state[2] += 1.0
         else:
             window_state[2] = 0.0
+        if g > strong * best:
+            window_state[3] += 1.0
+        else:
+            window_state[3] = 0.0
         window_state[0] = 0.0
         window_state[1] = 0.0
     return window_state[2]
@@ -124,6 +130,9 @@ def _body_order_sweeps(
     window,
     level,
     cycling,
+    far,
+    strong,
+    far_cycling,
     history,
     carry,
     r_prev,
@@ -141,7 +150,9 @@ def _body_order_sweeps(
     #       residual = sqrt(Σ e_α² / C)
     #       until residual ≤ tolerance, max_units sweep units (visits / C), stall sweeps without a new
     #       lowest residual, or `cycling` windows of `window` sweeps in a row whose level is above
-    #       level × the lowest residual (_cycling_windows; cycling = 0: never);
+    #       level × the lowest residual (_cycling_windows; cycling = 0: never), or `far_cycling` such
+    #       windows in a row while the lowest residual is above far × tolerance, or `far_cycling` windows
+    #       in a row whose level is above strong × the lowest (far_cycling = 0: never);
     #       restart (β = 0) when the residual grows by > RESTART_GROWTH
     # Every contact is visited in a sweep (one of its bodies has mass), so the extrapolated impulses,
     # which may leave the friction cone, are all replaced by local solutions before the sweep ends.
@@ -162,7 +173,7 @@ def _body_order_sweeps(
         carry[C_BEST] = np.inf
         carry[C_BEST_AT] = 0.0
         carry[C_BETA] = 0.0
-        carry[C_WINDOW : C_WINDOW + 3] = 0.0
+        carry[C_WINDOW : C_WINDOW + 4] = 0.0
     start, members = _body_lists(contact_body, pack, count, v.shape[0])
     visits_per_sweep = members.shape[0]
     seen = np.empty(count, np.int64)
@@ -174,7 +185,7 @@ def _body_order_sweeps(
     last = carry[C_LAST]
     best = carry[C_BEST]
     best_at = int(carry[C_BEST_AT])
-    window_state = carry[C_WINDOW : C_WINDOW + 3]  # a view: _cycling_windows updates carry
+    window_state = carry[C_WINDOW : C_WINDOW + 4]  # a view: _cycling_windows updates carry
     residual = np.inf if sweep == 0 else carry[C_RESIDUAL]  # no sweep done (max_units ≤ 0): nothing is known
     reason = STOP_BUDGET
     visits = 0
@@ -238,9 +249,12 @@ def _body_order_sweeps(
         elif sweep - best_at >= stall:
             reason = STOP_STALL
             break
-        if cycling > 0 and _cycling_windows(window_state, residual, best, window, level) >= cycling:
-            reason = STOP_CYCLING
-            break
+        if cycling > 0:
+            run = _cycling_windows(window_state, residual, best, window, level, strong)
+            fast = run >= far_cycling and best > far * tolerance or window_state[3] >= far_cycling
+            if run >= cycling or (far_cycling > 0 and fast):
+                reason = STOP_CYCLING
+                break
     carry[C_SWEEP] = sweep
     carry[C_J] = j
     carry[C_LAST] = last
@@ -271,12 +285,18 @@ def body_order_sweeps(
     cycling=0,
     history=_NO_HISTORY,
     stage=None,
+    far=np.inf,
+    far_cycling=0,
+    strong=np.inf,
 ) -> tuple[int, float]:
     """Momentum sweeps in body order (module doc) from impulses ``r`` (C, 2), in place; ``v`` (B, 3) enters
     as the free velocities and leaves as v_free + M⁻¹ H r; ``status`` (C,) out. Stops at ``tolerance``
     (m/s), after ``max_units`` sweep units (the sweep that crosses it ends), after ``stall`` sweeps
     without a new lowest residual, or after ``cycling`` windows of ``window`` sweeps in a row whose level
-    (geometric mean of their residuals) is above ``level`` × the lowest residual so far (0: never).
+    (geometric mean of their residuals) is above ``level`` × the lowest residual so far (0: never), or after
+    ``far_cycling`` such windows when that lowest residual is still above ``far`` × ``tolerance``, or after
+    ``far_cycling`` windows in a row whose level is above ``strong`` × the lowest (0: never; counted only
+    while ``cycling`` > 0).
     ``history`` (float array, optional): the residual of each sweep, as many as it holds. ``stage``
     (optional, from new_stage): the run's state; a call with the ``stage``, ``v``, ``r`` and ``status``
     an earlier call left goes on from where it stopped, as one long call would (its stall window too;
@@ -297,6 +317,9 @@ def body_order_sweeps(
         window,
         level,
         cycling,
+        far,
+        strong,
+        far_cycling,
         history,
         stage.carry,
         stage.r_prev,

@@ -149,10 +149,28 @@ BODIES_CYCLING = 8
 """Cycling windows in a row after which the stage hands over to the round-robin (0: never; 8, i.e. not before
 sweep 4000, since 2026-11-27: module doc "Hand-over")."""
 
+BODIES_FAR = 3.0
+"""A stage whose lowest residual is still above this × the tolerance hands over after BODIES_CYCLING_FAR cycling
+windows in a row instead of BODIES_CYCLING (module doc, measured)."""
+BODIES_STRONG = np.inf
+"""A stage whose windows' level is above this × its lowest residual hands over after BODIES_CYCLING_FAR such windows
+in a row (module doc, measured)."""
+BODIES_CYCLING_FAR = 0
+"""0: off."""
+
 BODIES_REENTER = 2
 """After a hand-over, the round-robin's resumes (in its order, newton's ahead counted) after which the stage
 goes on from where it stopped, once, for the rest of its BODIES_UNITS (module doc, "Re-entry"); it does
 also if the round-robin ends first. 0: never."""
+
+BODIES_SLICE = 0
+"""Sweep units the stage gets before newton's first resume when it has not converged by then (0: all of
+BODIES_UNITS at once); it re-enters after BODIES_SLICE_REENTER of the round-robin's resumes, with its
+hand-over rule, for the rest of BODIES_UNITS (measured, module doc)."""
+BODIES_SLICE_REENTER = 1
+
+BODIES_FROM_MOMENTUM = False
+"""The stage starts from momentum's stalled impulses instead of the step's warm start (measured, module doc)."""
 
 FIRST_BUDGET = 2000
 """Sweep units each method gets in the first round; doubled every round (module doc)."""
@@ -200,9 +218,12 @@ def continue_stalled(
     # steps in a fraction of the round-robin's units); the round-robin below only if it does not.
     stage = None  # the stage's iterate, kept with its run when the hand-over rule stops it (it may re-enter)
     run, stage_left = None, 0
+    reenter_after, keep_rule = BODIES_REENTER, False
     if BODIES_UNITS > 0:
-        v_b, r_b, status_b = v_free.copy(), r_warm[:count].copy(), status[:count].copy()
-        units = min(BODIES_UNITS, cap - iterations)
+        start = r if BODIES_FROM_MOMENTUM else r_warm
+        v_b, r_b, status_b = v_free.copy(), start[:count].copy(), status[:count].copy()
+        first = min(BODIES_SLICE, BODIES_UNITS) if BODIES_SLICE > 0 else BODIES_UNITS
+        units = min(first, cap - iterations)
         run = bodies.new_stage(count, v.shape[0])
         done, residual_b = bodies.body_order_sweeps(
             contact_body,
@@ -219,6 +240,9 @@ def continue_stalled(
             BODIES_LEVEL,
             BODIES_CYCLING,
             stage=run,
+            far=BODIES_FAR,
+            far_cycling=BODIES_CYCLING_FAR,
+            strong=BODIES_STRONG,
         )
         iterations += done
         if residual_b <= tolerance or (iterations >= cap and residual_b < residual):
@@ -226,8 +250,12 @@ def continue_stalled(
             return iterations, residual_b
         if iterations >= cap:
             return iterations, residual
-        if BODIES_REENTER > 0 and run.carry[bodies.C_REASON] == bodies.STOP_CYCLING:
+        reason = run.carry[bodies.C_REASON]
+        if BODIES_REENTER > 0 and reason == bodies.STOP_CYCLING:
             stage, stage_left = _State(v_b, r_b, status_b, residual_b), BODIES_UNITS - done
+        elif BODIES_SLICE > 0 and reason == bodies.STOP_BUDGET and done < BODIES_UNITS:  # its slice spent
+            stage, stage_left = _State(v_b, r_b, status_b, residual_b), BODIES_UNITS - done
+            reenter_after, keep_rule = BODIES_SLICE_REENTER, True
     states = {
         "newton": _State(None, r_warm[:count].copy(), status[:count].copy(), np.inf),
         "turning": _State(None, r_warm[:count].copy(), status[:count].copy(), np.inf),
@@ -261,9 +289,9 @@ def continue_stalled(
                 _adopt(state, v, r, status, count)
                 return iterations, state.residual
             resumes += 1
-            if stage is not None and resumes == BODIES_REENTER:
+            if stage is not None and resumes == reenter_after:
                 iterations += _reenter(
-                    stage, run, min(stage_left, cap - iterations), contact_body, pack, count, mu, tolerance
+                    stage, run, min(stage_left, cap - iterations), contact_body, pack, count, mu, tolerance, keep_rule
                 )
                 if stage.residual <= tolerance:
                     _adopt(stage, v, r, status, count)
@@ -277,8 +305,10 @@ def continue_stalled(
             state.low = min(state.low, state.residual)
         budget *= 2
         round_ += 1
-    if stage is not None and resumes < BODIES_REENTER:  # the round-robin ended first: the stage's turn
-        iterations += _reenter(stage, run, min(stage_left, cap - iterations), contact_body, pack, count, mu, tolerance)
+    if stage is not None and resumes < reenter_after:  # the round-robin ended first: the stage's turn
+        iterations += _reenter(
+            stage, run, min(stage_left, cap - iterations), contact_body, pack, count, mu, tolerance, keep_rule
+        )
         if stage.residual <= tolerance:
             _adopt(stage, v, r, status, count)
             return iterations, stage.residual
@@ -289,11 +319,28 @@ def continue_stalled(
     return iterations, best.residual
 
 
-def _reenter(stage, run, units, contact_body, pack, count, mu, tolerance) -> int:
+def _reenter(stage, run, units, contact_body, pack, count, mu, tolerance, keep_rule=False) -> int:
     # The stage goes on from where its hand-over stopped it, as one long run would (bodies.Stage), for the
-    # units it had left, without the hand-over rule (it already handed over) and with its stall window.
+    # units it had left, with its stall window; without the hand-over rule when that stopped it (it already
+    # handed over), with it when its slice did.
+    rule = (BODIES_WINDOW, BODIES_LEVEL, BODIES_CYCLING) if keep_rule else (1, np.inf, 0)
+    far = (BODIES_FAR, BODIES_CYCLING_FAR, BODIES_STRONG) if keep_rule else (np.inf, 0, np.inf)
     done, stage.residual = bodies.body_order_sweeps(
-        contact_body, pack, count, mu, tolerance, units, stage.v, stage.r, stage.status, BODIES_STALL, stage=run
+        contact_body,
+        pack,
+        count,
+        mu,
+        tolerance,
+        units,
+        stage.v,
+        stage.r,
+        stage.status,
+        BODIES_STALL,
+        *rule,
+        stage=run,
+        far=far[0],
+        far_cycling=far[1],
+        strong=far[2],
     )
     return done
 
