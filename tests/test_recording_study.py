@@ -232,7 +232,8 @@ def test_grid_sweep_state_map_and_histories(block, tmp_path):
     from masonrycli.colormap import unpack_rgba
     from masonrycli.study.curves import STATE_COLOURS, rgb
 
-    assert key["Points2D:labels"][0] == ["intact", "damaged", "collapsed", "failed"]
+    names = static_fields(chunks, "/study/state_map/key/names")
+    assert names["Points2D:labels"] == ["intact", "damaged", "collapsed", "failed"]
     drawn = [tuple(int(v) for v in c[:3]) for c in unpack_rgba(np.array(key["Points2D:colors"][0], np.uint32))]
     assert drawn == [rgb(STATE_COLOURS[s]) for s in ("intact", "damaged", "collapsed", "")]
     assert np.all(np.array(key["Points2D:positions"][0])[:, 1] < x_labels[:, 1].min())
@@ -271,3 +272,47 @@ def test_a_study_recording_that_cannot_be_written_whole_is_exit_4_the_table_kept
         assert done.returncode == 4 and len(lines) == 1, (share, done.stdout[-1000:], done.stderr[-1000:])
         assert lines[0].startswith("error: cannot write --out's recording s.rrd: "), lines[0]
         assert sorted(p.name for p in run.iterdir()) == ["s.parquet", "s.png"]
+
+
+def static_fields(chunks, entity: str) -> dict:
+    out = {}
+    for ch in chunks:
+        if ch.entity_path == entity:
+            batch = ch.to_record_batch()
+            out |= {n: batch.column(n).to_pylist()[0] for n in batch.schema.names if ":" in n}
+    return out
+
+
+def two_by_two(tmp_path, states=("intact", "damaged", "damaged", "collapsed")):
+    from types import SimpleNamespace
+
+    from masonrycli.recording.study import record_study
+
+    points = [(1, 0.5), (1, 1.0), (2, 0.5), (2, 1.0)]
+    rows = [
+        {"freq": f, "amp": a, "state": st, "status": "completed", "collapse_time": 0.4 if st == "collapsed" else np.nan,
+         "residual_drift": 0.0123, "pga": 3.14159, "max_opening": 0.0007, "hinges": 2, "wall_time": 1.25,
+         "peak_drift": 0.02, "sweeps_mean": 12.0, "energy_dissipated": 280.2, "study": "x"}
+        for (f, a), st in zip(points, states)
+    ]  # fmt: skip
+    axes = [SimpleNamespace(name="freq", values=(1, 2)), SimpleNamespace(name="amp", values=(0.5, 1.0))]
+    return record_study(tmp_path / "map.rrd", "wall", rows, SimpleNamespace(axes=axes, find=None), None, "pga", None)
+
+
+def test_the_state_map_labels_stand_clear_of_the_dots(tmp_path):
+    """`masonry sweep wall --param freq=1,2 --param amp=0.5,1`: the x labels ("freq=1.0") sat over the
+    lower dots, 0.06 below their centres with dots of radius 0.1, and the key's names were drawn by the key's
+    dots, on them, in their colour ("intact" green on green). Every name now stands a radius and a tenth of
+    the map's size from every dot's centre, in grey."""
+    import rerun as rr
+
+    chunks = list(rr.chunk.RrdReader(str(two_by_two(tmp_path))).stream())
+    dots = [static_fields(chunks, e) for e in ("/study/state_map", "/study/state_map/key")]
+    centres = np.concatenate([np.array(d["Points2D:positions"]) for d in dots])
+    radius = max(float(np.max(d["Points2D:radii"])) for d in dots)
+    assert all(not any(d.get("Points2D:show_labels") or [False]) for d in dots)  # the dots draw no text
+    labels = [static_fields(chunks, e) for e in ("/study/state_map/axes", "/study/state_map/key/names")]
+    anchors = np.concatenate([np.array(t["Points2D:positions"]) for t in labels])
+    assert sum(len(t["Points2D:labels"]) for t in labels) == 4 + 4  # two values per axis, four states
+    gap = np.linalg.norm(anchors[:, None, :] - centres[None, :, :], axis=-1).min()
+    assert gap >= radius + 0.1 * 1.0 - 1e-6  # the map is 1 (freq) by 0.5 (amp)

@@ -177,15 +177,20 @@ def _log_state_map(rec, rows: list[dict], names: list[str]) -> None:
     rec.log("study/state_map", points, static=True)
     # The axes, as drawn labels (a 2-D view has none): each swept value once, below the lowest row and
     # left of the leftmost column — the map was unlabelled dots on black.
+    # The labels are centred on their anchors (radius 0), about 20 px high and 60 wide: set a radius plus a
+    # share of the map's size from the dots (at 0.12 of the y span below the row, 0.2 of the x span left of
+    # the column, "freq=1.0" and "amp=1.0" overlapped the dots of a 2 × 2 map).
     ticks, texts = [], []
+    size = float(max(span.max(), 1e-9))
+    below = radius + 0.1 * size  # x labels, under the lowest row
     if len(pos):
-        lo, span = pos.min(axis=0), np.maximum(np.ptp(pos, axis=0), 1e-9)
+        lo = pos.min(axis=0)
         for axis, n in enumerate(names[:2]):
             for value in sorted({r[n] for r in rows}, key=lambda v: coord({n: v}, n)):
                 at = (
-                    [coord({n: value}, n), lo[1] - 0.12 * span[1]]
+                    [coord({n: value}, n), lo[1] - below]
                     if axis == 0
-                    else [lo[0] - 0.2 * span[0], coord({n: value}, n)]
+                    else [lo[0] - radius - 0.2 * size, coord({n: value}, n)]
                 )
                 ticks.append(at)
                 texts.append(viewer_safe_text(f"{n}={value}"))
@@ -199,19 +204,21 @@ def _log_state_map(rec, rows: list[dict], names: list[str]) -> None:
     rec.log("study/state_map/axes", axes, static=True)
     # The key, a row under the map's x labels (the PNG's legend): the map's colours were not named in
     # the recording. (Right of the map, the view's fit cut it in half.)
+    # Its names are labels of their own, in the axes' grey, under the dots: drawn by the dots themselves they
+    # sat on the dots' lower half in the dots' colour ("intact" green on green).
     if len(pos):
-        step = max(0.15 * float(max(span.max(), 1e-9)), 4.5 * radius)  # a label sits under its dot
+        step = max(0.15 * size, 4.5 * radius)
         states = ("intact", "damaged", "collapsed", "")
         x0, width = float(pos[:, 0].min()), max(float(span[0]), 3.0 * step)
-        y0 = float(pos[:, 1].min()) - 0.12 * float(max(span[1], 1e-9)) - step
-        key = rr.Points2D(
-            np.array([[x0 + i * width / 3.0, y0] for i in range(len(states))], np.float32),
-            colors=np.array([STATE_RGBA[s] for s in states], dtype=np.uint8),
-            labels=[s or "failed" for s in states],
-            radii=radius,
-            show_labels=True,
+        y0 = float(pos[:, 1].min()) - below - 0.1 * size - 2.0 * radius
+        at = np.array([[x0 + i * width / 3.0, y0] for i in range(len(states))], np.float32)
+        colours = np.array([STATE_RGBA[s] for s in states], dtype=np.uint8)
+        rec.log("study/state_map/key", rr.Points2D(at, colors=colours, radii=radius), static=True)
+        names_at = at - np.array([0.0, radius + 0.1 * size], np.float32)
+        key_names = rr.Points2D(
+            names_at, labels=[s or "failed" for s in states], radii=0.0, colors=(220, 220, 220, 255), show_labels=True
         )
-        rec.log("study/state_map/key", key, static=True)
+        rec.log("study/state_map/key/names", key_names, static=True)
 
 
 def fragility_timeline(im: str) -> str:
