@@ -316,3 +316,24 @@ def test_the_state_map_labels_stand_clear_of_the_dots(tmp_path):
     assert sum(len(t["Points2D:labels"]) for t in labels) == 4 + 4  # two values per axis, four states
     gap = np.linalg.norm(anchors[:, None, :] - centres[None, :, :], axis=-1).min()
     assert gap >= radius + 0.1 * 1.0 - 1e-6  # the map is 1 (freq) by 0.5 (amp)
+
+
+def test_the_rows_are_the_terminals_with_units_under_the_table(tmp_path):
+    """The rows were the table file's every column: 14 here, 26 from a sweep, run off the view's right
+    edge, SI values with no unit anywhere, "nan" for a run that did not collapse. They are the terminal's
+    columns now, values in the units the legend under the table names, blank where there is none."""
+    import rerun as rr
+
+    chunks = list(rr.chunk.RrdReader(str(two_by_two(tmp_path))).stream())
+    text = static_fields(chunks, "/study/rows")["TextDocument:text"][0]
+    lines = text.splitlines()
+    header = [h.strip() for h in lines[2].strip("|").split("|")]
+    assert header == ["freq", "amp", "state", "collapse", "drift", "pga", "open", "hinges", "wall", "peak", "sweeps"]
+    first, last = ([c.strip() for c in ln.strip("|").split("|")] for ln in (lines[4], lines[7]))
+    assert first[3] == "" and last[3] == "0.40"  # no collapse: blank; collapse at 0.4 s
+    assert first[4] == "1.23" and first[6] == "0.7"  # drift in % of height, opening in mm
+    assert "nan" not in text
+    assert "freq Hz · amp m/s · collapse: time of collapse, s · drift: residual, % of height · pga m/s²" in text
+    from masonrycli.recording.readback import blueprint_views
+
+    assert "runs of wall (units under the table)" in blueprint_views(tmp_path / "map.rrd")

@@ -1,7 +1,8 @@
 """Rerun recording of a study (``masonry sweep --recording study.rrd``).
 
 The state map as coloured points over the two swept parameters (``study/state_map``, with a key of its colours), the PNG the
-command also wrote (``study/plot``), and the rows as a markdown table (``study/rows``), all static; the
+command also wrote (``study/plot``), and the rows as the terminal shows them, units under the table
+(``study/rows``), all static; the
 fragility curve of a records study (``study/fragility``) and the threshold curve of ``--find``
 (``study/thresholds``) are plots on their own time lines (below). Axes are in the parameters' own units, so a 2-D view shows them
 as they are; the PNG is the annotated picture.
@@ -58,6 +59,7 @@ from masonrycli.study.curves import (
     threshold_series,
 )
 from masonrycli.study.curves import UNITS as PARAM_UNITS
+from masonrycli.study.table import find_columns, grid_columns
 
 STATE_RGBA = {state: (*rgb(colour), 255) for state, colour in STATE_COLOURS.items()}
 
@@ -70,10 +72,15 @@ def record_study(path: Path, name: str, rows: list[dict], request, fit, im: str,
     # to the file from the start, the blueprint sent at the end: a save at the end handed rerun's writer the
     # whole backlog at once, and when a write failed (a full disk) save waited for it forever
     rec.save(path)
-    views = [rrb.TextDocumentView(origin="study/rows", name="rows")]
+    # named for what they hold: "rows" and "plot" said little beside "state map: freq (Hz) right, amp (m/s) up"
+    views = [
+        rrb.TextDocumentView(origin="study/rows", name=viewer_safe_text(f"runs of {name} (units under the table)"))
+    ]
     if plot and Path(plot).exists():
         rec.log("study/plot", rr.EncodedImage(path=plot), static=True)
-        views.insert(0, rrb.Spatial2DView(origin="study/plot", name="plot"))
+        views.insert(
+            0, rrb.Spatial2DView(origin="study/plot", name=viewer_safe_text(f"{Path(plot).name} (the picture)"))
+        )
     names = [a.name for a in request.axes if a.name != request.find and len(a.values) > 1]
     # The views fill the window: the blueprint, selection and time panels (Rerun's defaults: open) took
     # two fifths of it; the plots' time panel stays collapsed, it only names the x axis's time line.
@@ -103,7 +110,10 @@ def record_study(path: Path, name: str, rows: list[dict], request, fit, im: str,
         view, panel = _plot_view("study/fragility", title, timeline, (0, end), (-0.05, 1.05), legend)
         views.insert(0, view)
         panels.append(panel)
-    rec.log("study/rows", rr.TextDocument(_markdown(name, rows), media_type=rr.MediaType.MARKDOWN), static=True)
+    keys = [a.name for a in request.axes if a.name != request.find]  # what a row is keyed by
+    columns = find_columns(keys, request.find) if request.find else grid_columns(keys, im)
+    rows_text = _markdown(name, rows, columns)
+    rec.log("study/rows", rr.TextDocument(rows_text, media_type=rr.MediaType.MARKDOWN), static=True)
     rec.send_blueprint(rrb.Blueprint(rrb.Grid(*views), *panels), make_active=True, make_default=True)
     wait_written(rec, path)  # a writer stopped by a full disk: OSError, no disconnect (it hung)
     rec.disconnect()
@@ -315,12 +325,19 @@ def _log_thresholds(rec, rows: list[dict], find: str, names: list[str], searched
     return timeline, against, x_range[0], x_range[1], y_range
 
 
-def _markdown(name: str, rows: list[dict]) -> str:
+def _markdown(name: str, rows: list[dict], columns) -> str:
+    """The rows as the terminal shows them (``masonrycli.study.table``): short headers, values in the
+    units the legend under the table names, blank where there is none. The table file's every column,
+    SI values and no units (26 columns for a grid study, "nan" for a run that did not collapse) ran off
+    the view's right edge after the first ten, with no unit anywhere."""
     if not rows:
         return f"# {name}\n\nno rows"
-    columns = [c for c in rows[0] if c != "study"]
-    lines = [f"# study: {name}", "", "| " + " | ".join(columns) + " |", "|" + "---|" * len(columns)]
+    headers = [c.header for c in columns]
+    lines = [f"# study: {name}", "", "| " + " | ".join(headers) + " |", "|" + "---|" * len(headers)]
     for r in rows[:500]:
-        cells = [f"{r[c]:.4g}" if isinstance(r[c], float) else str(r[c]) for c in columns]
-        lines.append("| " + " | ".join(cells) + " |")
+        lines.append("| " + " | ".join(c.cell(r).replace("|", "/") for c in columns) + " |")
+    legend = [c.legend for c in columns if c.legend]
+    lines += ["", " · ".join(legend), "", "Every column, in SI units, is in the table file (docs/sweep.md)."]
+    if len(rows) > 500:
+        lines.append(f"The first 500 of {len(rows)} rows.")
     return viewer_safe_text("\n".join(lines))
