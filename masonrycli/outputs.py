@@ -143,11 +143,18 @@ class OutputFile:
 
 
 def check_output(
-    path: Path, option: str, suffix: str | tuple[str, ...], force: bool, *, default_name: bool = False
+    path: Path,
+    option: str,
+    suffix: str | tuple[str, ...],
+    force: bool,
+    *,
+    default_name: bool = False,
+    make_folder: bool = False,
 ) -> OutputFile:
     """Check ``path`` before anything is computed: suffix (one, or a tuple of accepted ones), not a folder,
-    not existing (unless ``force``), its folder creatable and writable. Raises :class:`InputError` naming
-    the option and the path."""
+    not existing (unless ``force``), its folder existing (or creatable: the default name's recordings/, a
+    ``make_folder`` option's own folder) and writable. Raises :class:`InputError` naming the option and the
+    path."""
     where = f"{option} {path}"
     suffixes = (suffix,) if isinstance(suffix, str) else suffix
     _check_name_length(path, where)  # first: a name too long made path.is_dir() raise
@@ -160,7 +167,7 @@ def check_output(
         raise InputError(f"{where}: the file exists{broken} (add --force to replace it)")
     if path.exists() and not os.access(path, os.W_OK):
         raise InputError(f"{where}: the file exists and is read-only")
-    check_folder(path, where)
+    check_folder(path, where, make=default_name or make_folder)
     return OutputFile(path, option, force=force, default_name=default_name)
 
 
@@ -185,13 +192,16 @@ def _check_name_length(path: Path, where: str) -> None:
         )
 
 
-def check_folder(path: Path, where: str) -> None:
-    """Raise :class:`InputError` (``where: problem``) unless ``path``'s folder exists or can be made, and is
-    writable, on a disk."""
+def check_folder(path: Path, where: str, make: bool = False) -> None:
+    """Raise :class:`InputError` (``where: problem``) unless ``path``'s folder exists (or, with ``make``, can
+    be made) and is writable, on a disk. A missing folder was made without a word: a typo (``--out
+    reslts/w.rrd``) left a new folder and the file where no one looked."""
     folder = path.parent
     existing = next((p for p in (folder, *folder.parents) if p.exists()), Path("."))
     if not existing.is_dir():
         raise InputError(f"{where}: {existing} is not a folder")
+    if not make and existing != folder:
+        raise InputError(f"{where}: there is no folder {folder} (make it first)")
     if not os.access(existing, os.W_OK | os.X_OK):
         raise InputError(f"{where}: cannot write in {existing} ({_why_not_writable(existing)})")
     if shutil.disk_usage(existing).total == 0:  # /proc, /sys: writable to root, yet no file can be made there

@@ -492,6 +492,7 @@ def test_a_tilde_the_shell_left_is_the_home_folder(tmp_path, monkeypatch):
     # there; --history and build --out alike.
     home, work = tmp_path / "home", tmp_path / "work"
     work.mkdir()
+    (home / "runs").mkdir(parents=True)
     monkeypatch.setenv("HOME", str(home))
     monkeypatch.chdir(work)
     result = invoke("simulate", "wall", "--duration", 0.01, "--out=~/runs/w.rrd", "--history=~/runs/w.npz")

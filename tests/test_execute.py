@@ -235,6 +235,7 @@ def test_the_last_line_is_a_command_the_shell_runs(tmp_path):
     import shlex
 
     rrd = tmp_path / "my runs" / "it's.rrd"
+    rrd.parent.mkdir()
     result = invoke("simulate", "wall", "--duration", 0.01, "--out", rrd)
     assert result.exit_code == 0, result.output
     last = result.output.strip().splitlines()[-1]

@@ -349,3 +349,22 @@ def test_a_read_only_file_system_is_named(tmp_path, monkeypatch):
     result = invoke("run", COLUMN, "--duration", 0.01, "--out", folder / "r.rrd")
     said = f"error: --out {folder / 'r.rrd'}: cannot write in {folder} (a read-only file system)"
     assert result.exit_code == 2 and result.output.strip() == said, result.output
+
+
+def test_an_output_in_a_missing_folder_is_refused(tmp_path, monkeypatch):
+    # '--out /nonexist/a.rrd' made the folder /nonexist and wrote there (a typo, '--out reslts/w.rrd', left a
+    # new folder and the file where no one looked); build --out and --history alike. The default recording's
+    # recordings/ is still made.
+    monkeypatch.chdir(tmp_path)
+    for args, option, path in (
+        (("run", COLUMN, "--duration", 0.01, "--out", "reslts/w.rrd"), "--out", "reslts/w.rrd"),
+        (("run", COLUMN, "--duration", 0.01, "--no-recording", "--history", "a/b/h.npz"), "--history", "a/b/h.npz"),
+        (("build", "wall", "--out", "x/w.geojson"), "--out", "x/w.geojson"),
+    ):
+        result = invoke(*args)
+        folder = str(Path(path).parent)
+        assert result.exit_code == 2, result.output
+        assert result.output.strip() == f"error: {option} {path}: there is no folder {folder} (make it first)"
+    assert sorted(p.name for p in tmp_path.iterdir()) == []
+    assert invoke("run", COLUMN, "--duration", 0.01).exit_code == 0
+    assert [p.name for p in tmp_path.iterdir()] == ["recordings"]

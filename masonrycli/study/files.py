@@ -72,7 +72,8 @@ def check_histories(
         if find:
             taken = sorted(folder.glob(glob_escape(name).replace(_ANY, "*"))) if folder.is_dir() else []
             name = taken[0].name if taken else name.replace(_ANY, "0")
-        check_output(folder / name, "--histories", ".npz", force or made_by_study(folder / name, study))
+        made = made_by_study(folder / name, study)
+        check_output(folder / name, "--histories", ".npz", force or made, make_folder=True)  # the study makes it
 
 
 def remove_abandoned_parts(folder: Path | None) -> None:
