@@ -1,8 +1,8 @@
 """The recording's time series: energies, displacements and support motion per frame, solver health per step.
 
 What the time-series views plot (entity paths ``layout.SERIES``), each a set of scalars against the
-timelines: per frame, the kinetic and dissipated energy, the potential energy (from the as-built state's)
-and the supports' work, the energy balance error, the largest block displacement and the supports'
+timelines: per frame, the kinetic energy; the supports' work, the dissipated energy and the potential
+energy (from the as-built state's); the energy balance error, the largest block displacement and the supports'
 velocity and displacement (from the as-built state); per step (``Recorder.log_step``), the NLGS sweeps,
 log10 of the residual beside log10 of the tolerance, and the contact count.
 """
@@ -32,8 +32,8 @@ def send_series(
     moved = q[..., :2] - ref_q[None, :, :2]
     sq, sv = b.stack("support_q"), b.stack("support_v")
     series = {
-        "energy_small": np.stack([kinetic, dissipated], axis=1),
-        "energy_large": np.stack([potential - ref_pot, work], axis=1),
+        "energy_kinetic": kinetic,
+        "energy_large": np.stack([work, dissipated, potential - ref_pot], axis=1),
         "energy_balance": kinetic + (potential - ref_pot) + dissipated - work,
         "max_displacement": np.sqrt((moved**2).sum(-1)).max(axis=1) if n_blocks else np.zeros(n_frames),
         "support_velocity": sv,

@@ -103,8 +103,8 @@ def log_static(rec: rr.RecordingStream, st: RecordingStatic, blocks: Polygons, s
     rec.log(HINGES, rr.Points2D.from_fields(radii=-4.0, colors=HINGE_RGBA, draw_order=60.0), static=True)
     rec.log(MAGNIFIED, rr.LineStrips2D.from_fields(colors=MAGNIFIED_RGBA, radii=-1.0, draw_order=30.0), static=True)
     series_names = {
-        "energy_small": ["kinetic", "dissipated (cumulated)"],
-        "energy_large": ["potential change", "support work"],
+        "energy_kinetic": ["kinetic"],
+        "energy_large": ["support work", "dissipated (cumulated)", "potential change"],
         "energy_balance": ["kinetic + potential change + dissipated − support work"],
         "max_displacement": ["max block displacement"],
         "support_velocity": [f"{n} v{c}" for n in names for c in "xy"],
