@@ -185,6 +185,8 @@ def target_scenario(target: str | os.PathLike, built_in: Callable[[str], Scenari
         if built_in is None:
             raise InputError(f"{target}: not a file; the built-in structures are run with `masonry simulate {target}`")
         return built_in(target)
+    if target.startswith("~"):  # quoted, the shell left it ('masonry run "~/w.toml"'): as --out and a file key
+        target = os.path.expanduser(target)
     problem = _target_problem(target)
     if problem:
         raise InputError(f"{target}: {problem}")

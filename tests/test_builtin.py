@@ -339,3 +339,11 @@ def test_a_file_not_named_toml_that_is_no_toml_says_how_it_was_read(tmp_path):
     toml.write_text("POLYGON ((0 0, 1 0, 1 1, 0 1, 0 0))\n")
     with pytest.raises(InputError, match=r"TOML syntax error[^(]*\(at line 1, column \d+\)$"):
         target_scenario(toml)
+
+
+def test_a_target_with_a_tilde_the_shell_left_is_under_home(tmp_path, monkeypatch):
+    # 'masonry check "~/w.toml"' said "~/w.toml: no such scenario or geometry file"; a scenario's file keys
+    # and the path options read ~ as the home folder.
+    monkeypatch.setenv("HOME", str(tmp_path))
+    (tmp_path / "w.toml").write_text("[[block]]\npolygon = [[0, 0], [1, 0], [1, 1], [0, 1]]\n")
+    assert target_scenario("~/w.toml").assembly.block_count == 1
