@@ -393,6 +393,13 @@ def test_the_kinetic_energy_has_a_plot_of_its_own(written):
     assert not any("dissipated" in n and "inetic" in n for n in views)
 
 
+def test_the_residual_plot_names_its_unit(written):
+    """ "NLGS residual (log10) and tolerance": ticks -5 .. -5.3 and no unit on screen. The residual is the
+    RMS contact-law violation of a sweep in m/s (--tolerance's unit); the plot's name says so."""
+    views = blueprint_views(written[0])
+    assert views["NLGS residual and tolerance (log10 of m/s)"]["origin"] == "/series/solver/log10_residual"
+
+
 def test_magnified_shape(written):
     """The blocks' displacement relative to the one shaken ground is magnified, drawn on the ground where it
     is (the ground's travel was magnified too: the view slid by m × the ground's displacement)."""

@@ -243,7 +243,9 @@ def build_blueprint(
             plot("support_displacement", "Support displacement (m)"),
         ),
         rrb.Tabs(
-            plot("residual", "NLGS residual (log10) and tolerance"),
+            # the residual's unit (the RMS contact-law violation of a sweep, m/s, as --tolerance): the plot's
+            # ticks read -5 .. -5.3 with no unit anywhere on screen
+            plot("residual", "NLGS residual and tolerance (log10 of m/s)"),
             plot("iterations", "NLGS sweeps per step"),
             plot("contacts", "Contacts"),
         ),
