@@ -83,6 +83,10 @@ class OneLineUsageErrors(typer.core.TyperGroup):
     def main(self, args=None, prog_name=None, complete_var=None, standalone_mode=True, **extra):
         if not standalone_mode:
             return super().main(args, prog_name, complete_var, standalone_mode=False, **extra)
+        repeated = self._repeated_option(sys.argv[1:] if args is None else list(args))
+        if repeated:
+            say("error", "bold red", repeated)
+            sys.exit(EXIT_BAD_INPUT)
         try:
             code = super().main(args, prog_name, complete_var, standalone_mode=False, **extra)
         except click_errors.NoArgsIsHelpError as exc:
@@ -112,6 +116,36 @@ class OneLineUsageErrors(typer.core.TyperGroup):
             return super().invoke(ctx)
         except KeyboardInterrupt:  # a subcommand's arguments; a command's own stop never comes out as one
             fail("Ctrl-C: stopped before any output was written", 130)
+
+    def _repeated_option(self, args: list[str]) -> str | None:
+        """``--amp: given twice (0.5, then 1): give it once`` for an option of one value given twice: click
+        kept the last without a word (``simulate wall --amp 0.5 … --amp 1``, a command edited from the
+        history, ran at 1 m/s). Options given many times on purpose (``--param``, ``--records``) and flags
+        are left alone."""
+        group, rest = self, [str(a) for a in args]
+        while rest and isinstance(getattr(group, "commands", None), dict) and rest[0] in group.commands:
+            group = group.commands[rest.pop(0)]
+        options = {
+            name: p
+            for p in getattr(group, "params", [])
+            if getattr(p, "param_type_name", "") == "option" and not p.multiple and not p.is_flag and not p.count
+            for name in (*p.opts, *p.secondary_opts)
+        }
+        seen: dict[str, str] = {}
+        for k, arg in enumerate(rest):
+            if arg == "--":
+                break
+            name, eq, inline = arg.partition("=")
+            param = options.get(name)
+            if param is None:
+                continue
+            if not eq and k + 1 == len(rest):  # no value: click's "Option '--dt' requires an argument"
+                break
+            value = inline if eq else rest[k + 1]
+            if param.name in seen:
+                return f"{name}: given twice ({seen[param.name]}, then {value}): give it once"
+            seen[param.name] = value
+        return None
 
     def _path_of(self, args) -> str:
         """The command line's command (``masonry simulate wall``) for an error raised without its context:

@@ -42,10 +42,10 @@ RUN = ("simulate", "wall", "--duration", "0.01", "--no-recording")
         ("--blocks", "5_1", "--blocks 5_1: must be an integer (an underscore is not a digit separator here)"),
         # a decimal comma and a percentage said "must be a number" and no more
         ("--friction", "0,6", "--friction 0,6: must be a number (write 0.6: the decimal separator is a point)"),
-        ("--duration", "1,5", "--duration 1,5: must be a number (write 1.5: the decimal separator is a point)"),
-        ("--duration", "1,500", "--duration 1,500: must be a number"),  # 1.5 or 1500: no guess
+        ("--dt", "0,001", "--dt 0,001: must be a number (write 0.001: the decimal separator is a point)"),
+        ("--thickness", "1,500", "--thickness 1,500: must be a number"),  # 1.5 or 1500: no guess
         ("--friction", "60%", "--friction 60%: must be a number (write 0.6: a percentage is written as a fraction)"),
-        ("--duration", "50%", "--duration 50%: must be a number"),  # a time in s is no fraction
+        ("--thickness", "50%", "--thickness 50%: must be a number"),  # a length in m is no fraction
     ],
 )
 def test_a_number_option_given_text_says_what_to_write(option, value, message):
@@ -247,3 +247,38 @@ def test_a_float_option_is_echoed_as_typed(args, line):
     result = invoke(*args)
     assert_one_line_error(result)
     assert result.output.strip() == f"error: {line}"
+
+
+@pytest.mark.parametrize(
+    "args, line",
+    [
+        (("simulate", "wall", "--amp", "0.5", "--duration", "0.01", "--amp", "1"), "--amp: given twice (0.5, then 1)"),
+        (("simulate", "wall", "--freq=2", "--freq", "3"), "--freq: given twice (2, then 3)"),
+        (("limit", "arch", "-o", "a.rrd", "--out", "b.rrd"), "--out: given twice (a.rrd, then b.rrd)"),
+        (
+            ("sweep", "wall", "-p", "amp=0.1", "--out", "x.csv", "--out", "y.csv"),
+            "--out: given twice (x.csv, then y.csv)",
+        ),
+    ],
+)
+def test_an_option_of_one_value_given_twice_is_refused(args, line, tmp_path, monkeypatch):
+    # click kept the last without a word: 'simulate wall --amp 0.5 … --amp 1' (a command edited from the
+    # history) ran at 1 m/s
+    monkeypatch.chdir(tmp_path)
+    result = invoke(*args)
+    assert result.exit_code == 2 and result.output.strip() == f"error: {line}: give it once", result.output
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_options_given_many_times_on_purpose_and_flags_are_taken():
+    from masonrycli.cli import app
+
+    assert app_group(app)._repeated_option(["sweep", "wall", "-p", "amp=0.1", "-p", "freq=2"]) is None
+    assert app_group(app)._repeated_option(["simulate", "wall", "--force", "--force"]) is None
+    assert app_group(app)._repeated_option(["simulate", "wall", "--amp", "-1", "--freq", "-1"]) is None
+
+
+def app_group(app):
+    import typer.main
+
+    return typer.main.get_command(app)
