@@ -221,3 +221,19 @@ def test_records_in_subfolders_of_a_record_folder_are_named(block, tmp_path):
     mixed = invoke("sweep", block, "--records", recs, *args)
     assert mixed.exit_code == 0 and f"warning: {said}" in words(mixed.output), mixed.output
     assert [r["record"] for r in read_rows(tmp_path / "s.csv")] == ["top.csv"]
+
+
+@pytest.mark.parametrize(
+    ("args", "said"),
+    [
+        (("-p", "duration=0.02,0.04", "--duration", "2"), "--duration 2 and --param duration"),
+        (("-p", "dt=0.001,0.002", "--dt", "5e-4", "--duration", "0.02"), "--dt 5e-4 and --param dt"),
+    ],
+)
+def test_a_run_setting_given_as_option_and_axis_is_refused(block, tmp_path, args, said):
+    # '--duration 2 --param duration=0.02,0.04' ran 0.02 and 0.04 s, the 2 s said nowhere
+    result = invoke("sweep", block, *args, "--workers", 0, "-o", tmp_path / "s.csv")
+    name = said.split()[-1]
+    line = f"error: {said}: the axis sets every run's {name}; give one"
+    assert result.exit_code == 2 and words(result.output) == line, result.output
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["block.toml"]

@@ -102,6 +102,11 @@ def plan_study(
         raise InputError("nothing to sweep: give --param NAME=..., or --records DIR")
     # before the files beside --out: "--param amp: given twice" came after "--out's plot s.png: the file exists"
     check_axes(axes)
+    for option, value in (("duration", duration), ("dt", dt)):  # "--duration 2 --param duration=0.5,1" ran
+        if value is not None and option in {a.name for a in axes}:  # 0.5 and 1 s, the 2 s said nowhere
+            raise InputError(
+                f"--{option} {option_text(value)} and --param {option}: the axis sets every run's {option}; give one"
+            )
     check_find(axes, find)
     for point in points_to_check(axes):  # before the files: "-p Amp=0.1" said "--out's plot … exists" first
         apply_point(base, point)
