@@ -310,6 +310,11 @@ def read_wkt(path, density: float = 2500.0, thickness: float = 1.0) -> Assembly:
                 entries.append((f"{path}: line {n}", m["role"], name, m["srole"], m["wkt"]))
             elif ":" in line:  # WKT has no colon: a label the patterns refused (": POLYGON …" said "Unknown type: ':'")
                 raise _bad_label(f"{path}: line {n}", line.split(":", 1)[0])
+            elif (unlabelled := _NO_COLON.match(line)) is not None:  # "support g POLYGON …": "Unknown type: 'SUPPORT'"
+                raise GeometryError(
+                    f"{path}: line {n}: {unlabelled['label']!r} before {unlabelled['kind'].upper()}: a label ends "
+                    f"with a colon ('{unlabelled['label']}: {unlabelled['kind'].upper()} ((…))')"
+                )
             else:
                 entries.append((f"{path}: line {n}", None, None, None, line))
     blocks: list[Block] = []
@@ -336,6 +341,10 @@ def read_wkt(path, density: float = 2500.0, thickness: float = 1.0) -> Assembly:
             else:
                 supports.append(Support(polygon, label, (srole or "fixed").lower()))
     return Assembly(tuple(blocks), tuple(supports))
+
+
+_NO_COLON = re.compile(r"\s*(?P<label>[^\s(:][^(:]*?)\s+(?P<kind>POLYGON|MULTIPOLYGON|GEOMETRYCOLLECTION)\b", re.I)
+"""Words before the WKT with no colon after them: a label missing its colon."""
 
 
 def _bad_label(where: str, label: str) -> GeometryError:

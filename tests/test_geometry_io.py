@@ -308,6 +308,22 @@ def test_wkt_a_line_whose_label_is_not_one_says_what_is_expected(line, what, tmp
     )
 
 
+@pytest.mark.parametrize(
+    "line, label",
+    [
+        ("support ground POLYGON ((-2 -1, 3 -1, 3 0, -2 0, -2 -1))", "support ground"),
+        ("b1 polygon ((0 0, 1 0, 1 1, 0 0))", "b1"),
+    ],
+)
+def test_wkt_a_label_without_its_colon_is_named(line, label, tmp_path):
+    # "support ground POLYGON ((…))" said "cannot parse WKT (ParseException: Unknown type: 'SUPPORT')"
+    path = tmp_path / "labels.wkt"
+    path.write_text("POLYGON ((0 0, 1 0, 1 1, 0 1, 0 0))\n" + line + "\n")
+    assert one_line_error(read_wkt, path) == (
+        f"{path}: line 2: {label!r} before POLYGON: a label ends with a colon ('{label}: POLYGON ((…))')"
+    )
+
+
 @pytest.mark.parametrize("name", ["polygon1", "Polygon-left", "multipolygon_a", "GeometryCollection2"])
 def test_wkt_a_name_that_starts_like_a_wkt_type_is_a_name(name, tmp_path):
     """A label is a name before a colon, and WKT has no colon: "polygon1: POLYGON …" (which
