@@ -173,3 +173,44 @@ def test_the_readback_helpers_read_a_cut_recording_as_inspect_does(wall, tmp_pat
     frames = field_frames(cut)
     assert sorted(frames) == sorted(field_frames(whole))[: info["frames"]]
     assert blueprint_views(cut) and recording_rows(cut)
+
+
+def test_the_colour_bars_stand_right_of_where_the_blocks_went(tmp_path):
+    """The bars stood right of the structure as built: 'masonry simulate wall --amp 2 --freq 1
+    --stop-at-collapse' shook the wall 0.32 m right and it fell over the bar and its title. At close, the
+    bars and their labels move right of the farthest x a block reached and the view widens to hold them."""
+    import rerun as rr
+
+    def last_static(path, entity, column):
+        value = None
+        for chunk in rr.chunk.RrdReader(path).stream():
+            if chunk.entity_path == entity and chunk.is_static:
+                batch = chunk.to_record_batch()
+                if column in batch.schema.names:
+                    value = batch.column(column).to_pylist()[-1]
+        return value
+
+    static, q0 = fx.wall()
+    frames = fx.frames(static, q0, 12)
+    for k, f in enumerate(frames):
+        f.block_q[:, 0] += 0.1 * k  # the wall drifts right, 1.1 m by the end
+    path = tmp_path / "drift.rrd"
+    with Recorder(path, static, fx.METADATA, batch_frames=4) as rec:
+        for f in frames:
+            rec.log_frame(f)
+    start = static.block_vert_start
+    owner = np.repeat(np.arange(len(q0)), np.diff(start))
+    # unrotated outlines: the frames turn the blocks by 0.01 rad at most, under a millimetre here
+    reach = max(float((f.block_q[owner, 0] + static.block_vert_local[:, 0]).max()) for f in frames)
+    from masonrycli.recording.layout import LEGEND_BARS, PLANE
+    from masonrycli.recording.static_content import legend_positions
+
+    dx = last_static(path, f"/{LEGEND_BARS}", "Transform3D:translation")[0][0]
+    for f in rec_mod.FIELDS:
+        bar = np.array(last_static(path, f"/{f.bar}", "Mesh3D:vertex_positions"))[:, 0] + dx
+        assert bar.min() > reach + 0.01, (f.key, bar.min(), reach)
+    # the view holds the bar and its tick labels (1 image unit = 1 m; the pinhole's image starts at x0)
+    x0 = last_static(path, f"/{PLANE}", "Transform3D:translation")[0][0]
+    width = last_static(path, f"/{PLANE}", "Pinhole:resolution")[0][0]
+    ticks = legend_positions((bar.min(), 0.0, bar.max(), 1.0))[:5, 0]
+    assert x0 + width > ticks.max()

@@ -98,6 +98,8 @@ STRESS_AXES: Final = f"{XY}/stress_axes"
 MAGNIFIED: Final = f"{XY}/magnified"
 UNDEFORMED: Final = f"{XY}/undeformed"
 SUPPORT_FILL: Final = "structure/supports"
+LEGEND_BARS: Final = "structure/legend"  # parent of the colour bars: moved right of where the blocks went
+LEGEND_LABELS: Final = f"{XY}/legend"  # parent of their labels, moved with them
 METADATA: Final = "run/metadata"
 LEGEND: Final = "run/legend"
 SERIES: Final = {
@@ -127,6 +129,8 @@ ENTITY_PATHS: Final = (
     MAGNIFIED,
     UNDEFORMED,
     SUPPORT_FILL,
+    LEGEND_BARS,
+    LEGEND_LABELS,
     *(p for f in FIELDS for p in (f.bar, f.labels)),
     *SERIES.values(),
     METADATA,

@@ -59,6 +59,8 @@ from masonrycli.recording.layout import (
     GLYPH_HALF_LENGTH,
     INSET,
     LEGEND,
+    LEGEND_BARS,
+    LEGEND_LABELS,
     METADATA,
     RESULTANT_LENGTH,
     RESULTANT_PERCENTILE,
@@ -130,6 +132,9 @@ class Recorder:
         loc = self._blocks.local
         size = (np.maximum.reduceat(loc, first) - np.minimum.reduceat(loc, first)) if n else np.ones((1, 2))
         self.block_height = float(np.median(size[:, 1]))  # m, median block height: the force-arrow unit
+        # (N,) m: a block's farthest vertex from its centroid, for the reach of the run (_clear_the_legend)
+        self._radius = np.maximum.reduceat(np.hypot(*loc.T), first) if n else np.zeros(0)
+        self._reach = -np.inf
         self._glyph_length = GLYPH_HALF_LENGTH * float(np.median(size.min(axis=1)))
         # (N,) m: a glyph never reaches out of its own block (thin cut spandrel blocks of the aqueduct)
         self._glyph_cap = np.minimum(self._glyph_length, GLYPH_HALF_LENGTH * size.min(axis=1))[: self._n]
@@ -290,6 +295,7 @@ class Recorder:
                     error = err
                     note = f"{note} (recording flush failed: {err!r})".strip()
                 self._log_metadata(status, note)
+                self._clear_the_legend()
                 self._send_final_layout()
             finally:
                 try:
@@ -304,6 +310,18 @@ class Recorder:
             if status == COMPLETED:
                 raise error
             warnings.warn(f"recording flush failed while closing: {error!r}", RuntimeWarning, stacklevel=2)
+
+    def _clear_the_legend(self) -> None:
+        """The colour bars and their labels moved right of the farthest x a block reached, the view widened
+        to hold them: they stood right of the structure as built, and a wall shaken 0.32 m to the right
+        and collapsing ('masonry simulate wall --amp 2 --freq 1') covered the bar and its title."""
+        if self._ref is None:
+            return
+        q, sq, _ = self._ref
+        box, _ = log_plane(self.rec, self._blocks, self._supports, q, sq, reach=self._reach)
+        shift = rr.Transform3D(translation=[box[0] - self._legend_box[0], 0.0, 0.0])
+        for path in (LEGEND_BARS, LEGEND_LABELS):
+            self.rec.log(path, shift, static=True)
 
     def _send_final_layout(self) -> None:
         """The layout again, the last default wins: with the magnified view's factor in its tab's name (the
@@ -321,6 +339,8 @@ class Recorder:
     def _send_batch(self, b: FrameBatch) -> None:
         idx = time_indexes(b)
         q = b.stack("block_q")  # (F, N, 3)
+        if self._n:
+            self._reach = max(self._reach, float((q[..., 0] + self._radius).max()))
         tensors = {key: b.stack(key) for key in TENSOR_KEYS}
         # A voussoir of a bare ring has no cell strain rate; its strain rate along the ring stands in.
         vsr = tensors["cell_volumetric_strain_rate"]
