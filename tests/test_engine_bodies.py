@@ -181,3 +181,36 @@ def test_a_stage_handed_over_goes_on_as_one_long_run():
     np.testing.assert_array_equal(v, v_long)
     np.testing.assert_array_equal(status, status_long)
     assert units_long <= first + second <= units_long + 1  # each call rounds its visits up to whole units
+
+
+def test_windows_far_above_the_low_count_as_strong():
+    # The 248-block wall's failing steps cycle at 3-12x their low (benchmarks/JOURNAL.md, "Where the dear steps
+    # of the benchmark's wall-248 run go"); the stage's strong run counts windows above `strong` x the low.
+    cycle = np.tile([4e-5, 1.6e-4, 8e-5, 4e-5], 500)  # geometric mean 6.7e-5: 3.4 x the dip below
+    residuals = np.concatenate([[3e-4, 2e-5], cycle])
+    for strong, grows in ((3.0, True), (4.0, False)):
+        strong_runs = []
+        _windows_run(residuals, 100, 1.8, strong, strong_runs)
+        expect = np.arange(1, len(residuals) // 100 + 1) if grows else 0
+        np.testing.assert_array_equal(np.array(strong_runs)[99::100], expect)
+
+
+def test_the_stage_hands_over_sooner_far_from_the_tolerance_or_when_strongly_cycling():
+    # far_cycling windows in a row hand over when the low is above far x tolerance, or when each window's level
+    # is above strong x the low; else the `cycling` windows of the ordinary rule (module doc of stalled.py).
+    body, pack, h, m_inv, v_free, r0, mu, bias = _problem(5)
+    count = body.shape[0]
+
+    def run(tolerance, cycling, **kw):
+        v, r, status = v_free.copy(), r0.copy(), np.zeros(count, dtype=np.int8)
+        return bodies.body_order_sweeps(
+            body, pack, count, mu, tolerance, 300, v, r, status, 10**9, 7, 1.0, cycling, **kw
+        )
+
+    two = run(1e-300, 2)  # the ordinary rule at 2 windows: where the fast rules must stop
+    ten = run(1e-300, 10)
+    assert two[0] < ten[0]
+    assert run(1e-300, 10, far=1.0, far_cycling=2) == two  # the low is far above 1e-300
+    assert run(1e-300, 10, strong=1.0, far_cycling=2) == two  # every window that cycles at 1.0 is strong at 1.0
+    assert run(1e-300, 10, far=1e300, strong=1e300, far_cycling=2) == ten  # neither: the ordinary rule
+    assert run(1e-300, 10, far=1.0, far_cycling=0) == ten  # far_cycling 0: off

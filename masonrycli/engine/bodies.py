@@ -24,7 +24,8 @@ On ordinary steps (those momentum converges without stalling; 30 of the 32-cours
 64-course wall) it takes 1.42× / 1.36× momentum's units, at 1.3–1.4× the CPU per unit (the indirect
 visit order): it is for stalled steps only. It can stop on a step where it cycles (the 248-block wall's
 hard steps): after a few windows of sweeps whose residual level stays well above its lowest residual
-(_cycling_windows; stalled.py's module doc, "Hand-over"), and go on later from where
+(_cycling_windows; stalled.py's module doc, "Hand-over"; sooner when the stage stays far from the tolerance
+or its level far above its low: "Sooner"), and go on later from where
 it stopped, as one long run would (Stage: stalled.py's "Re-entry").
 
 The residual is the engine's (nlgs module doc): RMS over the contacts of |W_αα Δr_α| at the contact's

@@ -66,6 +66,20 @@ back to the stage"): 0.960 [0.937, 0.980] on the 248-block wall (unconverged 3 �
 units): the hand-over's extra unconverged steps, met on other trajectories, remain. It ships with the
 hand-over at 8 × 1.8 (above; BODIES_CYCLING = 0 turns both off).
 
+Sooner (since 2026-11-28). The 8-window rule left the 248-block wall's dearest steps at ~7900 stage units each:
+the stage cycles there at window levels 3–12 × the tolerance, far above anything it finishes, and newton's
+first resume then finishes in 600–1400. Where the stage fails on that wall its lowest residual stays above
+2 × the tolerance (the benchmark run's step 989: 3.8 ×, levels 7.7–9.6 ×) or its level above 3 × its low;
+the slow finishers of the 32-course wall sit at 1.0–1.9 × the tolerance with levels ≤ 1.9 × their low. So
+BODIES_CYCLING_FAR = 2 cycling windows in a row (not before sweep 1000) hand over when the low is above
+BODIES_FAR = 2 × the tolerance or each window's level above BODIES_STRONG = 3 × the low. A step the stage would
+not have finished gets the same solution (the round-robin starts from the warm start) in fewer units; on the
+captured steps none the stage finishes is handed over. Replayed (benchmarks/JOURNAL.md, "Where the dear steps of
+the benchmark's wall-248 run go"): the benchmark run's 58 steps of ≥ 400 units 51 875 → 45 952 (step 989 9569 →
+3646), 16 hard steps of three other wall-248 runs 165 204 → 105 975, 38 of two 32-course runs 249 469 → 239 527.
+Ensembles of 48 runs a wall against main: mean units a step 0.977 [0.965, 0.988] (248-block wall), 0.998
+[0.996, 1.000] (32 and 64 courses), unconverged 1 → 1, 9 → 9, 2 → 2.
+
 Gauss–Seidel with momentum (the default solver, :mod:`masonrycli.engine.momentum`) converges most steps in
 tens to hundreds of sweeps. On tall walls that slide it can stall: momentum drives the step into a
 stick/slip cycle, the residual wanders above the tolerance, and the solve stops after momentum's stall
@@ -149,28 +163,18 @@ BODIES_CYCLING = 8
 """Cycling windows in a row after which the stage hands over to the round-robin (0: never; 8, i.e. not before
 sweep 4000, since 2026-11-27: module doc "Hand-over")."""
 
-BODIES_FAR = 3.0
+BODIES_FAR = 2.0
 """A stage whose lowest residual is still above this × the tolerance hands over after BODIES_CYCLING_FAR cycling
-windows in a row instead of BODIES_CYCLING (module doc, measured)."""
-BODIES_STRONG = np.inf
-"""A stage whose windows' level is above this × its lowest residual hands over after BODIES_CYCLING_FAR such windows
-in a row (module doc, measured)."""
-BODIES_CYCLING_FAR = 0
-"""0: off."""
+windows in a row instead of BODIES_CYCLING (module doc, "Sooner")."""
+BODIES_STRONG = 3.0
+"""So does a stage whose windows' level is above this × its lowest residual, BODIES_CYCLING_FAR windows in a row."""
+BODIES_CYCLING_FAR = 2
+"""Windows in a row of the sooner hand-over (0: off; 2, i.e. not before sweep 1000, since 2026-11-28)."""
 
 BODIES_REENTER = 2
 """After a hand-over, the round-robin's resumes (in its order, newton's ahead counted) after which the stage
 goes on from where it stopped, once, for the rest of its BODIES_UNITS (module doc, "Re-entry"); it does
 also if the round-robin ends first. 0: never."""
-
-BODIES_SLICE = 0
-"""Sweep units the stage gets before newton's first resume when it has not converged by then (0: all of
-BODIES_UNITS at once); it re-enters after BODIES_SLICE_REENTER of the round-robin's resumes, with its
-hand-over rule, for the rest of BODIES_UNITS (measured, module doc)."""
-BODIES_SLICE_REENTER = 1
-
-BODIES_FROM_MOMENTUM = False
-"""The stage starts from momentum's stalled impulses instead of the step's warm start (measured, module doc)."""
 
 FIRST_BUDGET = 2000
 """Sweep units each method gets in the first round; doubled every round (module doc)."""
@@ -218,12 +222,9 @@ def continue_stalled(
     # steps in a fraction of the round-robin's units); the round-robin below only if it does not.
     stage = None  # the stage's iterate, kept with its run when the hand-over rule stops it (it may re-enter)
     run, stage_left = None, 0
-    reenter_after, keep_rule = BODIES_REENTER, False
     if BODIES_UNITS > 0:
-        start = r if BODIES_FROM_MOMENTUM else r_warm
-        v_b, r_b, status_b = v_free.copy(), start[:count].copy(), status[:count].copy()
-        first = min(BODIES_SLICE, BODIES_UNITS) if BODIES_SLICE > 0 else BODIES_UNITS
-        units = min(first, cap - iterations)
+        v_b, r_b, status_b = v_free.copy(), r_warm[:count].copy(), status[:count].copy()
+        units = min(BODIES_UNITS, cap - iterations)
         run = bodies.new_stage(count, v.shape[0])
         done, residual_b = bodies.body_order_sweeps(
             contact_body,
@@ -250,12 +251,8 @@ def continue_stalled(
             return iterations, residual_b
         if iterations >= cap:
             return iterations, residual
-        reason = run.carry[bodies.C_REASON]
-        if BODIES_REENTER > 0 and reason == bodies.STOP_CYCLING:
+        if BODIES_REENTER > 0 and run.carry[bodies.C_REASON] == bodies.STOP_CYCLING:
             stage, stage_left = _State(v_b, r_b, status_b, residual_b), BODIES_UNITS - done
-        elif BODIES_SLICE > 0 and reason == bodies.STOP_BUDGET and done < BODIES_UNITS:  # its slice spent
-            stage, stage_left = _State(v_b, r_b, status_b, residual_b), BODIES_UNITS - done
-            reenter_after, keep_rule = BODIES_SLICE_REENTER, True
     states = {
         "newton": _State(None, r_warm[:count].copy(), status[:count].copy(), np.inf),
         "turning": _State(None, r_warm[:count].copy(), status[:count].copy(), np.inf),
@@ -289,9 +286,9 @@ def continue_stalled(
                 _adopt(state, v, r, status, count)
                 return iterations, state.residual
             resumes += 1
-            if stage is not None and resumes == reenter_after:
+            if stage is not None and resumes == BODIES_REENTER:
                 iterations += _reenter(
-                    stage, run, min(stage_left, cap - iterations), contact_body, pack, count, mu, tolerance, keep_rule
+                    stage, run, min(stage_left, cap - iterations), contact_body, pack, count, mu, tolerance
                 )
                 if stage.residual <= tolerance:
                     _adopt(stage, v, r, status, count)
@@ -305,10 +302,8 @@ def continue_stalled(
             state.low = min(state.low, state.residual)
         budget *= 2
         round_ += 1
-    if stage is not None and resumes < reenter_after:  # the round-robin ended first: the stage's turn
-        iterations += _reenter(
-            stage, run, min(stage_left, cap - iterations), contact_body, pack, count, mu, tolerance, keep_rule
-        )
+    if stage is not None and resumes < BODIES_REENTER:  # the round-robin ended first: the stage's turn
+        iterations += _reenter(stage, run, min(stage_left, cap - iterations), contact_body, pack, count, mu, tolerance)
         if stage.residual <= tolerance:
             _adopt(stage, v, r, status, count)
             return iterations, stage.residual
@@ -319,28 +314,11 @@ def continue_stalled(
     return iterations, best.residual
 
 
-def _reenter(stage, run, units, contact_body, pack, count, mu, tolerance, keep_rule=False) -> int:
+def _reenter(stage, run, units, contact_body, pack, count, mu, tolerance) -> int:
     # The stage goes on from where its hand-over stopped it, as one long run would (bodies.Stage), for the
-    # units it had left, with its stall window; without the hand-over rule when that stopped it (it already
-    # handed over), with it when its slice did.
-    rule = (BODIES_WINDOW, BODIES_LEVEL, BODIES_CYCLING) if keep_rule else (1, np.inf, 0)
-    far = (BODIES_FAR, BODIES_CYCLING_FAR, BODIES_STRONG) if keep_rule else (np.inf, 0, np.inf)
+    # units it had left, without the hand-over rule (it already handed over) and with its stall window.
     done, stage.residual = bodies.body_order_sweeps(
-        contact_body,
-        pack,
-        count,
-        mu,
-        tolerance,
-        units,
-        stage.v,
-        stage.r,
-        stage.status,
-        BODIES_STALL,
-        *rule,
-        stage=run,
-        far=far[0],
-        far_cycling=far[1],
-        strong=far[2],
+        contact_body, pack, count, mu, tolerance, units, stage.v, stage.r, stage.status, BODIES_STALL, stage=run
     )
     return done
 
