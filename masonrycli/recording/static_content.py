@@ -106,7 +106,7 @@ def log_static(rec: rr.RecordingStream, st: RecordingStatic, blocks: Polygons, s
         "energy_kinetic": ["kinetic"],
         "energy_large": ["support work", "dissipated (cumulated)", "potential change"],
         "energy_balance": ["kinetic + potential change + dissipated − support work"],
-        "max_displacement": ["max block displacement"],
+        "max_displacement": ["max block displacement, relative to a shaken ground"],
         "support_velocity": [f"{n} v{c}" for n in names for c in "xy"],
         "support_displacement": [f"{n} u{c}" for n in names for c in "xy"],
         "iterations": ["NLGS sweeps"],
