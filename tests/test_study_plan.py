@@ -112,6 +112,27 @@ def test_a_built_in_without_duration_lasts_the_longest_record(block, tmp_path):
     assert plan.base.scenario.run.duration == 1.0 and "shorter than 1 of 1 records" in plan.request.warnings[0]
 
 
+def test_a_record_set_gets_the_warnings_simulate_gives_each_record(block, tmp_path):
+    # '--records recs --scale 9.81' (an .AT2 converted twice), '--scale 1,40' (16 g) and a record sampled
+    # every 0.5 ms on the 1 ms steps ran without a word; 'simulate --record' warns of each
+    folder = _record(tmp_path / "records", 0.5)
+    twice = plan_study("wall", records=[folder], scale="1,9.81", out=Path("a.csv")).request.warnings
+    assert len(twice) == 1 and "is read in g and converted to m/s² already; scale 9.81 converts it again" in twice[0]
+    strong = plan_study("wall", records=[folder], scale="1,400", out=Path("b.csv")).request.warnings
+    assert len(strong) == 1 and "the record syn0.AT2 peaks at" in strong[0] and "(scale 400)" in strong[0]
+    fine = tmp_path / "fine"
+    fine.mkdir()
+    t, u, v, a = band_limited(0.2, 0.0005, [2.0], [0.01], seed=0)
+    write_at2(fine / "fine.AT2", a / G_STANDARD, 0.0005)
+    said = plan_study("wall", records=[fine], out=Path("c.csv")).request.warnings
+    assert said == (
+        'support "ground": the record fine.AT2 is sampled every 0.0005 s, finer than dt = 0.001 s: the steps skip '
+        "samples and alias its content above 500 Hz (dt = 0.0005 follows every sample)",
+    )
+    # a record as it is, run whole on steps that follow it: nothing to say
+    assert plan_study("wall", records=[folder], scale="0.5,1", out=Path("d.csv")).request.warnings == ()
+
+
 def _mixed_set(folder: Path) -> int:
     """A record set of each kind: an .AT2 file (DT 5 ms), a CSV of one value per line and the same velocity
     with its times i·0.01 s written out here (Python's i * 0.01, not the reader's); the .AT2's NPTS."""

@@ -155,7 +155,7 @@ def plan_study(
         stop_at_collapse=stop_at_collapse,
         histories=histories,
         force=force,
-        warnings=(*_scenario_warnings(base.scenario, records), *late),
+        warnings=(*_scenario_warnings(base.scenario, records), *late, *_set_warnings(base, axes)),
         warn=warn,
     )
     return StudyPlan(base, request, name, picture, recorded)
@@ -169,6 +169,37 @@ def _scenario_warnings(scenario, records) -> list[str]:
 
     said = scenario_warnings(scenario)
     return [w for w in said if w not in record_warnings(scenario)] if records else said
+
+
+def _set_warnings(base: StudyBase, axes: list[Axis]) -> list[str]:
+    """What ``masonry run`` warns of each record of a ``--records`` set as the study applies it: sampled
+    finer than the runs' dt, beyond 10 g at the largest scale, an .AT2 scaled by g. A set's record at
+    DT 0.5 ms on the 1 ms steps, '--scale 9.81' on .AT2 files and '--scale 1,40' (16 g) ran without a word
+    where 'simulate --record' says each. Its length is said by ``_record_duration`` (in one line)."""
+    import dataclasses
+
+    from masonrycli.records import G_STANDARD
+    from masonrycli.scenario_warnings import record_warnings
+
+    if not base.records:
+        return []
+    by_name = {a.name: a.values for a in axes}
+    scales = [s for s in by_name.get("scale", ()) if isinstance(s, float)]
+    said: list[str] = []
+    # the largest scale (the 10 g line) and any scale of g (an .AT2 converted twice); a dt axis at its largest
+    picked = ({max(scales, key=abs)} if scales else set()) | {
+        s for s in scales if any(abs(abs(s) / g - 1) < 0.02 for g in (G_STANDARD, 100 * G_STANDARD))
+    }
+    dts = [d for d in by_name.get("dt", ()) if isinstance(d, float)]
+    for name in base.records:
+        for scale in sorted(picked) or [None]:
+            point = {"record": name} | ({} if scale is None else {"scale": scale})
+            point |= {"dt": max(dts)} if dts else {}
+            scenario = apply_point(base, point)
+            longest = max(m.end_time for m in scenario.motions if m.kind == "record")
+            run = dataclasses.replace(scenario.run, duration=max(scenario.run.duration, longest))  # not its length
+            said += [w for w in record_warnings(dataclasses.replace(scenario, run=run)) if w not in said]
+    return said
 
 
 def _base_scenario(target: str, duration, dt):
