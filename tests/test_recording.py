@@ -414,6 +414,15 @@ def test_the_largest_displacement_is_relative_to_a_shaken_ground(written):
         assert abs(relative - absolute) > 1e-4 or abs(f.support_q[0, 0] - g0[0]) < 1e-4
 
 
+def test_a_plot_of_one_named_series_has_no_legend(written):
+    """The legend box sat bottom left over the start of every curve, and on a plot of one series repeated
+    its name ("kinetic" under "Kinetic energy (J)", "contacts" under "Contacts"). Those plots have none; the
+    plots of several series, and the balance error (its legend gives the sum), keep theirs."""
+    views = blueprint_views(written[0])
+    hidden = {n for n, v in views.items() if v["kind"] == "TimeSeries" and v["legend"] is False}
+    assert hidden == {"Kinetic energy (J)", "Max block displacement (m)", "NLGS sweeps per step", "Contacts"}
+
+
 def test_magnified_shape(written):
     """The blocks' displacement relative to the one shaken ground is magnified, drawn on the ground where it
     is (the ground's travel was magnified too: the view slid by m × the ground's displacement)."""

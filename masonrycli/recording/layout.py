@@ -113,7 +113,13 @@ SERIES: Final = {
     "residual": "series/solver/log10_residual",
     "contacts": "series/contacts/count",
 }
-PER_STEP_SERIES: Final = ("iterations", "residual", "contacts")  # logged after every step, not per frame
+PER_STEP_SERIES: Final = ("iterations", "residual", "contacts")
+SINGLE_SERIES: Final = (
+    "energy_kinetic",
+    "max_displacement",
+    "iterations",
+    "contacts",
+)  # plotted without legend  # logged after every step, not per frame
 
 
 ENTITY_PATHS: Final = (
@@ -232,7 +238,10 @@ def build_blueprint(
     )
 
     def plot(key: str, name: str) -> rrb.TimeSeriesView:
-        return rrb.TimeSeriesView(origin=f"/{SERIES[key]}", name=name, axis_x=whole_run)
+        # a plot of one series whose name says it has no legend: the legend box (bottom left) hid the
+        # start of the curve and repeated the name ("kinetic" under "Kinetic energy (J)")
+        legend = rrb.PlotLegend(visible=False) if key in SINGLE_SERIES else None
+        return rrb.TimeSeriesView(origin=f"/{SERIES[key]}", name=name, axis_x=whole_run, plot_legend=legend)
 
     right = rrb.Vertical(
         rrb.Tabs(
