@@ -92,6 +92,23 @@ def test_the_fragility_curve_has_the_same_colours_and_legend_in_the_png_and_the_
     assert fit.separated is None and f"lognormal: θ = {fit.median:.3g} m/s², β = {fit.dispersion:.2f}" in png
 
 
+def test_the_legend_hides_no_run_of_the_fragility_curve():
+    # 'masonry sweep wall --records recs --scale 1:6:4': the runs that stood at pga 21 and 29 m/s² (damaged,
+    # P = 0) were drawn under the legend, at the lower right, and could not be seen
+    rows = [dict(r) for r in FRAGILITY_ROWS]
+    for r in rows:
+        if r["scale"] == 4.0:
+            r["state"] = "damaged"
+    fit = fit_lognormal([r["pga"] for r in rows], [r["state"] == "collapsed" for r in rows], "pga")
+    fig = plots.fragility_figure(rows, "pga", fit, "fragility", "m/s²")
+    fig.canvas.draw()
+    ax = fig.axes[0]
+    box = ax.get_legend().get_window_extent()
+    points = np.vstack([np.column_stack(line.get_data()) for line in ax.get_lines()])
+    shown = ax.transData.transform(points.astype(float))
+    assert not any(box.contains(x, y) for x, y in shown)
+
+
 def test_points_without_a_threshold_are_marked_at_the_searched_range_ends(png_figures, tmp_path):
     """``no collapse up to amp = 1.5`` (amp_threshold NaN, no bracket) was missing from both pictures: it is
     a mark at 1.5 in both, with its legend entry; one reached already at the lowest amplitude at 0.25."""

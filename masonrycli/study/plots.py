@@ -98,6 +98,13 @@ def _draw(ax, series) -> None:
             ax.plot(c.x, c.y, _MARKERS[c.marker], color=c.colour, ms=size, linestyle="none", label=c.label)
 
 
+def _legend_beside(ax) -> None:
+    """The legend right of the plot, as the state map's: inside, at the lower right, it hid the runs that
+    stood at the strongest shaking (P = 0 at the largest IM, the damaged runs of a fragility study) and the
+    thresholds there."""
+    ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8, frameon=False)
+
+
 def fragility_figure(rows: list[dict], im: str, fit, title: str, unit: str):
     """The fragility curve's figure (``fragility_series``): runs at 0 / 1 by state, the fraction collapsed
     per scale stripe, the fitted lognormal."""
@@ -107,7 +114,7 @@ def fragility_figure(rows: list[dict], im: str, fit, title: str, unit: str):
     ax.set_xlabel(f"{im} ({unit})")
     ax.set_ylabel("P(collapse)")
     ax.set_ylim(-0.05, 1.05)
-    ax.legend(loc="lower right", fontsize=8)
+    _legend_beside(ax)
     ax.set_title(title, fontsize=10)
     return fig
 
@@ -136,7 +143,7 @@ def threshold_figure(rows: list[dict], find: str, x: str | None, title: str, sea
     ax.set_ylabel(with_unit(find).replace(find, f"{find}_threshold", 1))
     ax.set_ylim(0.0, 1.1 * max(ax.get_ylim()[1], 0.0) or 1.0)  # room above a mark at the range's top
     if ax.get_legend_handles_labels()[0]:
-        ax.legend(loc="lower right", fontsize=8)
+        _legend_beside(ax)
     ax.set_title(title, fontsize=10)
     return fig
 
