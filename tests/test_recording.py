@@ -423,6 +423,34 @@ def test_a_plot_of_one_named_series_has_no_legend(written):
     assert hidden == {"Kinetic energy (J)", "Max block displacement (m)", "NLGS sweeps per step", "Contacts"}
 
 
+@pytest.mark.parametrize("low_steps, fixed", [(2, True), (10, False)])
+def test_the_residual_plot_is_not_ranged_by_its_first_steps(wall, tmp_path, low_steps, fixed):
+    """'masonry simulate wall --record syn1.AT2 --scale 3': the first steps converged to 1e-7.5 m/s under a
+    1e-5 tolerance, the plot spanned 2.5 decades for them and the run read as a flat line on the tolerance.
+    The range runs from a decade under the tolerance to the largest residual, unless more than 5 % of the
+    steps lie lower (then the viewer fits them all)."""
+    static, q0 = wall
+    frames = fx.frames(static, q0, 5)
+    path = tmp_path / f"r{low_steps}.rrd"
+
+    class Stats:
+        def __init__(self, k):
+            self.iterations, self.contact_count = 10, 40
+            self.residual = 1e-7 if k <= low_steps else 10.0 ** (-4.5 + 0.01 * (k % 50))  # largest 10**-4.01
+
+    with Recorder(path, static, {**fx.METADATA, "nlgs_tolerance": 1e-4}, batch_frames=2) as rec:
+        for k in range(1, 101):
+            rec.log_step(k, k * static.dt, Stats(k))
+            if k % 25 == 0:
+                rec.log_frame(frames[k // 25])
+    y_range = blueprint_views(path)["NLGS residual and tolerance (log10 of m/s)"]["y_range"]
+    if fixed:
+        lo, hi = -5.0, -4.0  # a decade under the tolerance; the tolerance over the largest residual
+        assert y_range == pytest.approx((lo - 0.05 * (hi - lo), hi + 0.05 * (hi - lo)))
+    else:
+        assert y_range is None
+
+
 def test_magnified_shape(written):
     """The blocks' displacement relative to the one shaken ground is magnified, drawn on the ground where it
     is (the ground's travel was magnified too: the view slid by m × the ground's displacement)."""

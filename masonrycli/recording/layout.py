@@ -196,8 +196,10 @@ def build_blueprint(
     main_field: str = "cell_spherical_stress",
     paper: tuple[float, tuple[str, ...]] | None = None,
     magnify: float | None = None,
+    residual_range: tuple[float, float] | None = None,
 ) -> rrb.Blueprint:
     """Structure tabs and the on-screen legend (left); time series and the run document (right).
+    ``residual_range``: the residual plot's y range (log10 of m/s; None: the viewer's fit to the data).
 
     Tabs: the live main view (forces, principal stress, ``main_field``), with ``paper`` = (t, figure
     numbers) the paper's four figures pinned to t, the four fields live, the magnified deformed shape,
@@ -237,11 +239,15 @@ def build_blueprint(
         view_range=rrb.TimeRange(rrb.TimeRangeBoundary.infinite(), rrb.TimeRangeBoundary.infinite())
     )
 
-    def plot(key: str, name: str) -> rrb.TimeSeriesView:
+    def plot(key: str, name: str, axis_y: rrb.ScalarAxis | None = None) -> rrb.TimeSeriesView:
         # a plot of one series whose name says it has no legend: the legend box (bottom left) hid the
         # start of the curve and repeated the name ("kinetic" under "Kinetic energy (J)")
         legend = rrb.PlotLegend(visible=False) if key in SINGLE_SERIES else None
-        return rrb.TimeSeriesView(origin=f"/{SERIES[key]}", name=name, axis_x=whole_run, plot_legend=legend)
+        return rrb.TimeSeriesView(
+            origin=f"/{SERIES[key]}", name=name, axis_x=whole_run, axis_y=axis_y, plot_legend=legend
+        )
+
+    residual_axis = rrb.ScalarAxis(range=residual_range) if residual_range is not None else None
 
     right = rrb.Vertical(
         rrb.Tabs(
@@ -258,7 +264,7 @@ def build_blueprint(
         rrb.Tabs(
             # the residual's unit (the RMS contact-law violation of a sweep, m/s, as --tolerance): the plot's
             # ticks read -5 .. -5.3 with no unit anywhere on screen
-            plot("residual", "NLGS residual and tolerance (log10 of m/s)"),
+            plot("residual", "NLGS residual and tolerance (log10 of m/s)", residual_axis),
             plot("iterations", "NLGS sweeps per step"),
             plot("contacts", "Contacts"),
         ),

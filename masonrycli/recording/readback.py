@@ -275,7 +275,7 @@ def blueprint_views(path: str | os.PathLike) -> dict[str, dict]:
     """The views of the recording's last default blueprint (the one the viewer opens on; a run that ended
     before the paper's instant sends a second one without the pinned tabs): name -> {"kind", "origin",
     "pinned", "legend"}; ``pinned`` is (timeline, start s, end s) for a view whose visible time range is
-    fixed, else None; ``legend``: False for a plot whose legend is hidden, else None (the viewer's default)."""
+    fixed, else None; ``legend``: False for a plot whose legend is hidden, else None (the viewer's default); ``y_range``: a plot's fixed y range or None."""
     with _reading(path) as reader:
         chunks = list(reader.stream(store=_last_blueprint(reader)))
     by_id: dict[str, dict] = {}
@@ -284,12 +284,14 @@ def blueprint_views(path: str | os.PathLike) -> dict[str, dict]:
         parts = chunk.entity_path.strip("/").split("/")
         if parts[0] != "view" or len(parts) < 2:
             continue
-        view = by_id.setdefault(parts[1], {"pinned": None, "legend": None})
+        view = by_id.setdefault(parts[1], {"pinned": None, "legend": None, "y_range": None})
         names = batch.schema.names
         if "ViewBlueprint:display_name" in names:
             view["name"] = batch.column("ViewBlueprint:display_name").to_pylist()[-1][0]
             view["kind"] = batch.column("ViewBlueprint:class_identifier").to_pylist()[-1][0]
             view["origin"] = batch.column("ViewBlueprint:space_origin").to_pylist()[-1][0]
+        if "ScalarAxis:range" in names:
+            view["y_range"] = tuple(batch.column("ScalarAxis:range").to_pylist()[-1][0])
         if "PlotLegend:visible" in names:
             view["legend"] = batch.column("PlotLegend:visible").to_pylist()[-1][0]
         if "VisibleTimeRanges:ranges" in names:
