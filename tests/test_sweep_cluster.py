@@ -140,6 +140,40 @@ def test_scheduler_and_worker_processes_kill_the_worker_and_resume(tmp_path):
             _kill(proc)
 
 
+def test_a_scheduler_killed_mid_study_is_one_line_and_the_finished_rows_kept(tmp_path):
+    # 'kill <scheduler>' mid-study made every pending run an error row, "FutureCancelledError: run-… cancelled
+    # for reason: scheduler-connection-lost …" five times, a plot of grey cells and exit 5 ("5 of 6 rows failed")
+    sched_file = tmp_path / "scheduler.json"
+    out = tmp_path / "study.csv"
+    scheduler = _spawn(
+        [BIN / "dask", "scheduler", "--port", "0", "--no-dashboard", "--scheduler-file", sched_file], tmp_path / "s.log"
+    )
+    procs = [scheduler]
+    logs = {scheduler: tmp_path / "s.log"}
+    try:
+        _wait(sched_file.exists, 60, "the scheduler file", logs)
+        address = json.loads(sched_file.read_text())["address"]
+        worker = [BIN / "dask", "worker", address, "--nworkers", "1", "--nthreads", "1", "--no-dashboard"]
+        procs.append(_spawn(worker, tmp_path / "w.log"))
+        # four runs of 30 s of the 51-block wall (2-4 s of CPU each): after the first row the others take
+        # seconds, long enough to kill the scheduler under them (runs of 5 s on 12 blocks all ended first)
+        sweep = [sys.executable, "-m", "masonrycli", "sweep", "wall", "--duration", "30"]
+        sweep += ["--param", "amp=0.2:0.35:4", "--scheduler", address, "--out", out]
+        procs.append(_spawn(sweep, tmp_path / "sweep.log"))
+        logs |= {procs[1]: tmp_path / "w.log", procs[2]: tmp_path / "sweep.log"}
+        _wait(lambda: len(_journal_rows(out)) >= 1, 240, "a finished row", logs)
+        _kill(scheduler)
+        assert procs[2].wait(timeout=120) == 2, _tails(logs)
+        said = words((tmp_path / "sweep.log").read_text())
+        assert said.startswith(f"error: --scheduler {address}: lost the connection to the scheduler with"), said
+        assert f"every finished row is in {out}" in said and "Traceback" not in said and "Cancelled" not in said
+        rows = _read_csv(out)
+        assert 1 <= len(rows) < 4 and all(r["status"] == "completed" for r in rows)  # no error row for the rest
+    finally:
+        for proc in procs:
+            _kill(proc)
+
+
 def _worker_without_masonry(tmp_path: Path) -> list:
     """A Python environment with Dask but no masonry: a venv of the same interpreter that sees this
     venv's site-packages through a path file, which does not process their .pth files (so not the

@@ -17,7 +17,9 @@ next. A task that fails inside the run returns an error row (:func:`~masonrycli.
 a task lost with its worker is retried elsewhere by the scheduler, and if it keeps killing workers
 (``KilledWorker``) or the cluster fails it otherwise, its row says so. Each result carries the masonry
 of the worker that made it; one from another masonry (a worker that joined after the check, or whose
-source changed on disk) stops the study (:class:`~masonrycli.study.versions.WorkerMismatch`).
+source changed on disk) stops the study (:class:`~masonrycli.study.versions.WorkerMismatch`). A
+scheduler that goes away mid-study stops it too (:class:`SchedulerLost`): its pending tasks are not
+failed runs.
 """
 
 from __future__ import annotations
@@ -296,6 +298,20 @@ MIN_IN_FLIGHT = 64
 87 s with 64 (104 s all submitted at once)."""
 
 
+class SchedulerLost(InputError):
+    """The client lost its scheduler mid-study: every task still pending was cancelled, none of them ran."""
+
+
+def _scheduler_lost(client, exc: Exception) -> bool:
+    """True when ``exc`` (a task's) is the client's lost connection to its scheduler, not the task's own
+    failure: a scheduler killed mid-study made every pending run an error row ('FutureCancelledError: …
+    cancelled for reason: scheduler-connection-lost …', five times over), a plot of grey cells and exit 5."""
+    from concurrent.futures import CancelledError
+
+    lost = isinstance(exc, CancelledError) and "scheduler-connection-lost" in str(exc)
+    return lost or client.status not in ("running", "newly-created")
+
+
 def in_flight_limit(client) -> int:
     """How many tasks :func:`run_on_cluster` keeps submitted: a few per worker thread, so every worker
     has its next task queued while a result travels back, and no more (module doc)."""
@@ -339,6 +355,10 @@ def run_on_cluster(client, base, driver, on_row: Callable[[dict, dict], None], *
         try:
             answer, worker, row = future.result()
         except Exception as exc:  # the task never returned (KilledWorker, a cluster failure)
+            if _scheduler_lost(client, exc):
+                raise SchedulerLost(
+                    f"lost the connection to the scheduler with {len(pending) + 1} runs pending"
+                ) from None
             row = params | empty_result(f"{type(exc).__name__}: {exc}", 0.0)
         else:
             check_result(answer, worker, params, ours)  # another masonry's row is not kept

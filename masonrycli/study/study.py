@@ -108,7 +108,7 @@ def prepare(base: StudyBase, request: StudyRequest) -> str:
 
 def run_study(base: StudyBase, request: StudyRequest, console: Console) -> StudyResult:
     """Run every row of the study not already in ``request.out``; write the table (also on Ctrl-C)."""
-    from masonrycli.study.runner import open_cluster, run_on_cluster, run_serially
+    from masonrycli.study.runner import SchedulerLost, open_cluster, run_on_cluster, run_serially
 
     study_id = prepare(base, request)
     names = [a.name for a in request.axes if a.name != request.find]  # a row's key
@@ -179,11 +179,11 @@ def run_study(base: StudyBase, request: StudyRequest, console: Console) -> Study
                 run_serially(base, driver, on_row, *task_args)
             else:
                 run_on_cluster(client, base, driver, on_row, *task_args)
-    except WorkerMismatch as exc:  # the rows before it are kept (written below), the study resumable
+    except (WorkerMismatch, SchedulerLost) as exc:  # the rows before it are kept (written below), resumable
         where = f"--scheduler {request.scheduler}" if request.scheduler else "the local cluster"
+        once = "every worker runs this masonry" if isinstance(exc, WorkerMismatch) else "the scheduler is back"
         raise InputError(
-            f"{where}: {exc}; every finished row is in {request.out} (the same command resumes the study "
-            "once every worker runs this masonry)"
+            f"{where}: {exc}; every finished row is in {request.out} (the same command resumes the study once {once})"
         ) from None
     finally:
         journal.close()
