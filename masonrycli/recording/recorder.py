@@ -135,7 +135,8 @@ class Recorder:
         # (N,) m: a block's farthest vertex from its centroid, for the reach of the run (_clear_the_legend)
         self._radius = np.maximum.reduceat(np.hypot(*loc.T), first) if n else np.zeros(0)
         self._reach = -np.inf
-        self._residuals = [0, 0, 0.0]  # steps with a residual, those a decade under the tolerance, the largest
+        # steps with a residual, those a decade under the tolerance, the largest, the smallest of the others
+        self._residuals = [0, 0, 0.0, np.inf]
         self._glyph_length = GLYPH_HALF_LENGTH * float(np.median(size.min(axis=1)))
         # (N,) m: a glyph never reaches out of its own block (thin cut spandrel blocks of the aqueduct)
         self._glyph_cap = np.minimum(self._glyph_length, GLYPH_HALF_LENGTH * size.min(axis=1))[: self._n]
@@ -185,9 +186,11 @@ class Recorder:
         s.add("values", (float(stats.iterations), float(stats.residual), float(stats.contact_count)))
         r = float(stats.residual)
         if np.isfinite(r) and r > 0:  # for the residual plot's range (residual_range)
+            low = bool(np.log10(r) < self._log10_tolerance - 1.0)
             self._residuals[0] += 1
-            self._residuals[1] += bool(np.log10(r) < self._log10_tolerance - 1.0)
+            self._residuals[1] += low
             self._residuals[2] = max(self._residuals[2], r)
+            self._residuals[3] = self._residuals[3] if low else min(self._residuals[3], r)
         if steps_due(s):
             self._steps = FrameBatch()
             with io_errors(self.path):
@@ -330,14 +333,14 @@ class Recorder:
             self.rec.log(path, shift, static=True)
 
     def residual_range(self) -> tuple[float, float] | None:
-        """The residual plot's y range, log10 of m/s: from a decade under the tolerance to the largest
-        residual (at least the tolerance), when at most 5 % of the steps lie lower; else None (the viewer's
-        fit). A record run converged its first steps far below the tolerance (1e-7.5 m/s under 1e-5): the
+        """The residual plot's y range, log10 of m/s: from the smallest residual but those more than a decade
+        under the tolerance to the largest (at least the tolerance), when at most 5 % of the steps lie that
+        low; else None (the viewer's fit). A record run converged its first steps far below the tolerance (1e-7.5 m/s under 1e-5): the
         plot spanned 2.5 decades for them, the rest of the run a flat line on the tolerance's."""
-        steps, low, worst = self._residuals
-        if not steps or not np.isfinite(self._log10_tolerance) or low > 0.05 * steps:
+        steps, low, worst, best = self._residuals
+        if not steps or not np.isfinite(self._log10_tolerance) or low > 0.05 * steps or not np.isfinite(best):
             return None
-        lo, hi = self._log10_tolerance - 1.0, max(self._log10_tolerance, float(np.log10(worst)))
+        lo, hi = float(np.log10(best)), max(self._log10_tolerance, float(np.log10(worst)))
         margin = 0.05 * (hi - lo)
         return (lo - margin, hi + margin)
 
