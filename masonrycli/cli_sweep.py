@@ -239,6 +239,20 @@ def _exit_for_failed_rows(result, err_console) -> None:
         raise typer.Exit(EXIT_ROWS_FAILED if result.failed else EXIT_DIVERGED)
 
 
+def _no_fit(rows: list[dict], axes) -> str:
+    """Why a record study has no fragility curve, and what gives one: 'no fit (every run collapsed, or none
+    did)' left the user to count which, and which way to move the scales."""
+    fell = sum(r.get("state") == "collapsed" for r in rows)
+    scaled = "scale" in [a.name for a in axes]
+    if len(rows) < 2:
+        return f"fragility: no fit ({_n(len(rows), 'run')}; a fit needs at least 2)"
+    if fell == 0:
+        more = "larger --scale values reach it" if scaled else "a --scale range reaches it"
+        return f"fragility: no fit — none of the {len(rows)} runs collapsed ({more})"
+    less = "smaller --scale values find where it stands" if scaled else "a --scale range finds where it stands"
+    return f"fragility: no fit — all {len(rows)} runs collapsed ({less})"
+
+
 def _report(console, result, plan: StudyPlan, im: str, written: list, signals: FirstSignalStops) -> None:
     """The table on the terminal, the fit, the plot and the recording; ``written`` gets each file's path
     as it is renamed into place, a signal held between the two (:func:`_recorded`)."""
@@ -254,7 +268,7 @@ def _report(console, result, plan: StudyPlan, im: str, written: list, signals: F
     keys = [a.name for a in axes if a.name != request.find]  # what a row is keyed by
     columns = find_columns(keys, request.find) if request.find else grid_columns(keys, im)
     names = [a.name for a in axes if a.name != request.find and len(a.values) > 1]
-    fit = None
+    fit, good = None, []
     with written_whole(plot, around_commit=_recorded(signals, written, plot)) as part:
         if request.find:
             title = f"{name}: {request.outcome} threshold"
@@ -286,7 +300,7 @@ def _report(console, result, plan: StudyPlan, im: str, written: list, signals: F
     )
     if "record" in [a.name for a in axes] and not request.find:
         if fit is None:
-            console.print("fragility: no fit (every run collapsed, or none did)")
+            console.print(_no_fit(good, request.axes))
         elif fit.separated is not None:
             stood, fell = fit.separated
             unit = UNITS[im]

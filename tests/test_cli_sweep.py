@@ -129,6 +129,21 @@ def test_a_geometry_file_is_swept_as_run_runs_it(tmp_path):
     assert [r["friction"] for r in read_rows(out)] == [0.5, 0.6]
 
 
+def test_a_record_study_without_a_fit_says_which_side_and_what_to_change(tmp_path):
+    # 'fragility: no fit (every run collapsed, or none did)' left the user to count which, and which way to go
+    folder = tmp_path / "records"
+    folder.mkdir()
+    t, u, v, a = band_limited(0.2, 0.01, [2.0], [0.001], seed=0)
+    write_at2(folder / "weak.AT2", a / G_STANDARD, 0.01)
+    args = ["sweep", "wall", "--records", folder, "--workers", 0, "--no-recording", "--param", "blocks=12"]
+    result = invoke(*args, "--scale", "0.5,1", "--out", tmp_path / "a.csv")
+    assert result.exit_code == 0, result.output
+    said = words(result.output)
+    assert "fragility: no fit — none of the 2 runs collapsed (larger --scale values reach it)" in said, said
+    result = invoke(*args, "--out", tmp_path / "b.csv")
+    assert "fragility: no fit (1 run; a fit needs at least 2)" in words(result.output), result.output
+
+
 def test_records_run_whole_on_a_built_in_and_a_shorter_run_is_warned(block, tmp_path):
     # the built-in wall's 1 s cut every record to its first second: without --duration the runs last the
     # longest record; a scenario file keeps its [run] duration, and a record longer than the runs is named
