@@ -37,6 +37,8 @@ def block(tmp_path) -> Path:
         # 100 worker processes of ~200 MB on a 2-core machine (10 meant): each run uses one core
         (["-p", "amp=0.1", "--workers", "100000"], "--workers 100000: more than 4 per core ("),
         (["-p", "scale=1,2"], "has no record motion"),
+        # the point at 0 Hz ran with the ground at rest, where simulate --freq 0 is refused
+        (["-p", "freq=0:2:3"], "--param freq=0: support 'ground': the velocity 0.1 m/s · sin(2π·0·t) is 0"),
         (["-p", "amp=0.1", "--records", "nowhere"], "--records nowhere: no such file or folder"),
         (["-p", "amp=0.1", "--workers", "2", "--scheduler", "tcp://x:1"], "--workers with --scheduler"),
         (["-p", "amp=0.1", "--recording", "x.png"], "--recording x.png: the file name must end in .rrd"),

@@ -209,6 +209,14 @@ def apply_point(base, params: dict):
                     "(give one of them)"
                 )
             motions[j] = _replace(motions[j], {attr: value}, where=f"--param {key}")
+    for name, m in zip(names, motions):
+        if m.kind == "sine" and m.frequency == 0.0 and m.amplitude and abs(math.sin(m.phase)) < 1e-12:
+            # 'freq=0:2:3' ran its first point with the ground at rest ("intact"), where simulate --freq 0
+            # and a scenario file's frequency = 0 are refused
+            raise InputError(
+                f"--param {_point(params)}: support {name!r}: the velocity {m.amplitude:g} m/s · sin(2π·0·t) is 0, "
+                "nothing moves (amp=0 is the point without shaking)"
+            )
     scenario = dataclasses.replace(scenario, motions=tuple(motions))
     try:
         check_sampling(scenario)
