@@ -194,6 +194,12 @@ def test_outcomes():
     for bad in ("fall", "drift:x", "drift:-1"):
         with pytest.raises(InputError):
             check_outcome(bad)
+    # "drift:50" (50 % meant) searched for a top drift of 50 heights: "no drift:50 up to …" at every point
+    with pytest.raises(InputError, match=r"drift:50: a drift of 50 × the height, .* drift:0.5 is 50 %\)$"):
+        check_outcome("drift:50")
+    with pytest.raises(InputError, match=r"\(write drift:0.05: a percentage is written as a fraction\)$"):
+        check_outcome("drift:5%")
+    assert check_outcome("drift:1") == "drift:1"
 
 
 @pytest.mark.parametrize("suffix", [".csv", ".parquet"])

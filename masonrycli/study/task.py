@@ -173,9 +173,24 @@ def check_outcome(outcome: str) -> str:
     try:
         limit = drift_limit(outcome)
     except ValueError:
+        value = outcome.partition(":")[2].strip()
+        percent = value.endswith("%") and value[:-1].strip()
+        hint = ""
+        try:  # "drift:5%": the ratio as a fraction, as --scale 50% is told
+            hint = f" (write drift:{float(percent) / 100:g}: a percentage is written as a fraction)" if percent else ""
+        except ValueError:
+            pass
         raise InputError(
             f"--outcome {outcome}: expected collapse, sliding, rocking or drift:X (X a drift ratio, e.g. drift:0.01)"
+            + hint
         ) from None
     if not (math.isfinite(limit) and limit > 0):
         raise InputError(f"--outcome {outcome}: the drift ratio must be > 0")
+    if limit > 1:
+        # "drift:50" (50 % meant) searched for a top drift of 50 × the height, which no run reaches (the wall
+        # is collapsed at 0.25): "no drift:50 up to amp = 1" for every point
+        raise InputError(
+            f"--outcome {outcome}: a drift of {limit:g} × the height, beyond the height itself (a likely typo: "
+            f"the ratio is a fraction, drift:{limit / 100:g} is {limit:g} %)"
+        )
     return outcome
