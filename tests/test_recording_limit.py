@@ -136,3 +136,30 @@ def test_a_limit_recording_that_cannot_be_written_whole_is_exit_4_and_no_file(tm
         assert done.returncode == 4 and len(lines) == 1, (share, done.stdout[-1000:], done.stderr[-1000:])
         assert lines[0].startswith("error: cannot write --out l.rrd: ") and "incomplete" in lines[0], lines[0]
         assert list(run.iterdir()) == []
+
+
+def test_many_hinges_are_smaller_dots(written, tmp_path, monkeypatch):
+    """'masonry limit aqueduct --out': 315 hinges and 380 sliding joints drawn as dots of 4 ui points covered
+    its upper wall, the blocks' speed colours hidden. Past MANY_MARKERS the dots are half the size."""
+    import dataclasses
+
+    from masonrycli.recording import limit as limit_rec
+
+    _, result = written
+    drawings = []
+    real = limit_rec.write_limit_recording
+    monkeypatch.setattr(limit_rec, "write_limit_recording", lambda path, d: drawings.append(d))
+    write_recording(result, tmp_path / "unused.rrd")
+    few = drawings[0]
+    many = dataclasses.replace(
+        few,
+        hinge_point=np.repeat(few.hinge_point, limit_rec.MANY_MARKERS + 1, axis=0),
+        hinge_block=np.repeat(few.hinge_block, limit_rec.MANY_MARKERS + 1),
+    )
+    radii = {}
+    for name, d in (("few", few), ("many", many)):
+        real(tmp_path / f"{name}.rrd", d)
+        for chunk in rr.chunk.RrdReader(tmp_path / f"{name}.rrd").stream():
+            if chunk.entity_path == f"/{HINGES}" and chunk.is_static:
+                radii[name] = chunk.to_record_batch().column("Points2D:radii").to_pylist()[-1]
+    assert radii == {"few": [-4.0], "many": [-2.0]}

@@ -42,6 +42,8 @@ from masonrycli.recording.static_content import TICKS, legend_positions, log_pla
 MAGNIFIED_SHARE: Final = 0.12
 STEPS: Final = 20
 """Frames of the amplitude animation (step 0 = undeformed, step STEPS = full magnification)."""
+MARKER_RADIUS: Final = (-4.0, -2.0)  # ui points: hinge and sliding dots, few / many (> MANY_MARKERS)
+MANY_MARKERS: Final = 60
 STILL_RGBA: Final = 0xC8C3B9FF  # blocks that do not move in the mechanism, and the undeformed copy
 THRUST_RGBA: Final = 0xD7263DFF  # centres of pressure (line of thrust)
 
@@ -194,8 +196,14 @@ def write_limit_recording(path: str | os.PathLike, drawing: MechanismDrawing) ->
         )
         rec.log(FILL, rr.Mesh3D.from_fields(triangle_indices=both.fan), static=True)
         rec.log(OUTLINES, rr.LineStrips2D.from_fields(colors=OUTLINE_RGBA, radii=-0.75, draw_order=30.0), static=True)
-        rec.log(HINGES, rr.Points2D.from_fields(radii=-4.0, colors=HINGE_RGBA, draw_order=60.0), static=True)
-        rec.log(SLIDING, rr.Points2D.from_fields(radii=-4.0, colors=SLIP_RGBA, draw_order=60.0), static=True)
+        # smaller dots when there are many: the aqueduct's 315 hinges and 380 sliding joints covered its upper
+        # wall in yellow and orange, the blocks' speed colours hidden under them
+        for path_, colour, count in (
+            (HINGES, HINGE_RGBA, len(d.hinge_point)),
+            (SLIDING, SLIP_RGBA, len(d.sliding_point)),
+        ):
+            radius = MARKER_RADIUS[count > MANY_MARKERS]
+            rec.log(path_, rr.Points2D.from_fields(radii=radius, colors=colour, draw_order=60.0), static=True)
         rec.log(THRUST, rr.Points2D(d.thrust_point, radii=-2.5, colors=THRUST_RGBA, draw_order=55.0), static=True)
         idx = [rr.TimeColumn("step", sequence=np.arange(frames))]
         rec.send_columns(
