@@ -133,6 +133,17 @@ def test_a_record_set_gets_the_warnings_simulate_gives_each_record(block, tmp_pa
     assert plan_study("wall", records=[folder], scale="0.5,1", out=Path("d.csv")).request.warnings == ()
 
 
+def test_a_dt_need_not_divide_the_built_in_s_duration_when_the_records_set_it(tmp_path):
+    # 'masonry sweep wall --records recs --dt 0.003' said "--dt: dt = 0.003: does not divide duration = 1.0"
+    # (the built-in's 1 s, which the records replace: the runs last 1.5 s, 500 steps of 0.003 s)
+    folder = _record(tmp_path / "records", 1.5)
+    run = plan_study("wall", records=[folder], dt=0.003, out=Path("s.csv")).base.scenario.run
+    assert run.dt == 0.003 and round(run.duration / run.dt) == 500 and run.duration == pytest.approx(1.5)
+    # a dt wrong on its own is still refused as the option, and a --duration still has to fit
+    assert _refused("wall", records=[folder], dt=0.0, out=Path("s.csv")) == "--dt: dt = 0.0: must be > 0"
+    assert "does not divide duration = 1.0" in _refused("wall", records=[folder], dt=0.003, duration=1.0)
+
+
 def _mixed_set(folder: Path) -> int:
     """A record set of each kind: an .AT2 file (DT 5 ms), a CSV of one value per line and the same velocity
     with its times i·0.01 s written out here (Python's i * 0.01, not the reader's); the .AT2's NPTS."""

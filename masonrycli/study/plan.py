@@ -81,7 +81,10 @@ def plan_study(
     from masonrycli.study.runner import check_scheduler
     from masonrycli.study.task import check_outcome
 
-    base = StudyBase(_base_scenario(target, duration, dt), {})
+    # a built-in swept over records runs as long as they last (below): its default duration is not the
+    # runs', so a --dt need not divide it ('--records recs --dt 0.003' said "does not divide duration = 1.0")
+    lasting = bool(records) and duration is None and is_built_in(target)
+    base = StudyBase(_base_scenario(target, duration, dt, lasting), {})
     name = base.scenario.name
     # the name reduced as recordings name it: "../../evil" made a folder "study-.." and wrote beside it
     out = store.check_out(out or Path(f"study-{safe_name(name)}.parquet"))
@@ -91,8 +94,7 @@ def plan_study(
         raise InputError("--record-dt: goes with --records (the time between the samples of its one-column files)")
     if records:
         motions, unread = _records(records, out, record_dt)
-        whole = duration is None and is_built_in(target)  # a scenario file's [run] duration stands
-        scenario, late = _record_duration(base.scenario, motions, whole)
+        scenario, late = _record_duration(base.scenario, motions, lasting)  # a file's [run] duration stands
         late = [*unread, *late]
         base = StudyBase(scenario, motions)
         axes.insert(0, Axis("record", tuple(motions)))
@@ -202,8 +204,18 @@ def _set_warnings(base: StudyBase, axes: list[Axis]) -> list[str]:
     return said
 
 
-def _base_scenario(target: str, duration, dt):
+def _base_scenario(target: str, duration, dt, lasting: bool = False):
+    """The study's scenario before its axes; ``lasting``: its duration is set later (by the records), so
+    a ``dt`` is applied with a duration it divides."""
     scenario = target_scenario(target, _shaken)  # a GeoJSON / WKT file as `masonry run` takes it
+    if lasting and dt is not None and dt > 0:
+        import math
+
+        duration = max(1, math.ceil(scenario.run.duration / dt - 1e-9)) * dt
+        try:
+            return override_run(scenario, duration=duration, dt=dt)
+        except InputError:  # refused on its own (1e-9: too many steps): said as the option alone says it
+            duration = None
     return override_run(scenario, duration=duration, dt=dt)  # names the wrong option (--dt 0: --dt)
 
 
