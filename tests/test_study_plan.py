@@ -144,6 +144,15 @@ def test_a_dt_need_not_divide_the_built_in_s_duration_when_the_records_set_it(tm
     assert "does not divide duration = 1.0" in _refused("wall", records=[folder], dt=0.003, duration=1.0)
 
 
+def test_a_sine_axis_over_records_says_their_axis_is_scale(tmp_path):
+    # '--records recs --param amp=0.5,1' said "--param amp: wall has no sine motion" (it has one, which the
+    # records replace): the records' intensity is --scale
+    folder = _record(tmp_path / "records", 0.5)
+    assert _refused("wall", records=[folder], params=["amp=0.5,1"], out=Path("s.csv")) == (
+        "--param amp: wall has no sine motion (--records drives it by the records: their axis is --scale)"
+    )
+
+
 def _mixed_set(folder: Path) -> int:
     """A record set of each kind: an .AT2 file (DT 5 ms), a CSV of one value per line and the same velocity
     with its times i·0.01 s written out here (Python's i * 0.01, not the reader's); the .AT2's NPTS."""

@@ -197,8 +197,10 @@ def apply_point(base, params: dict):
         if support and support not in names:
             raise InputError(f"--param {key}: no support named {support!r} (supports: {', '.join(names)})")
         if not targets:
+            # '--records recs --param amp=0.5,1': the record replaced the sine, and its intensity is --scale
+            instead = " (--records drives it by the records: their axis is --scale)" if "record" in params else ""
             raise InputError(
-                f"--param {key}: {scenario.name} has no {kind} motion{' on ' + support if support else ''}"
+                f"--param {key}: {scenario.name} has no {kind} motion{' on ' + support if support else ''}{instead}"
             )
         for j in targets:
             # "-p amp=1,2 -p ground.amp=0.5" ran both rows at 0.5 m/s under the names amp=1 and amp=2
