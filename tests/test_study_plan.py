@@ -153,6 +153,23 @@ def test_a_sine_axis_over_records_says_their_axis_is_scale(tmp_path):
     )
 
 
+def test_a_vertical_component_in_a_record_set_is_named(tmp_path):
+    # an unzipped NGA-West2 search (each recording's H1, H2 and UP .AT2 files) ran the vertical components
+    # along x as horizontal records, without a word
+    folder = tmp_path / "records"
+    folder.mkdir()
+    t, u, v, a = band_limited(0.5, 0.01, [2.0], [0.01], seed=0)
+    write_at2(folder / "RSN6_IMPVALL.I_I-ELC180.AT2", a / G_STANDARD, 0.01)
+    write_at2(folder / "RSN6_IMPVALL.I_I-ELCUP.AT2", a / G_STANDARD, 0.01)
+    write_at2(folder / "q3.AT2", a / G_STANDARD, 0.01, title="IMPERIAL VALLEY 10/15/79 2316, EL CENTRO ARRAY #6, UP")
+    write_at2(folder / "q4.AT2", a / G_STANDARD, 0.01, title="IMPERIAL VALLEY 10/15/79 2316, EL CENTRO ARRAY #6, 230")
+    said = plan_study("wall", records=[folder], out=Path("s.csv")).request.warnings
+    assert said == (
+        "--records: RSN6_IMPVALL.I_I-ELCUP.AT2, q3.AT2 are vertical components (PEER's UP / DWN), run along x as "
+        "the others: leave them out of the set (a scenario file's vertical = … applies one with its horizontal)",
+    )
+
+
 def _mixed_set(folder: Path) -> int:
     """A record set of each kind: an .AT2 file (DT 5 ms), a CSV of one value per line and the same velocity
     with its times i·0.01 s written out here (Python's i * 0.01, not the reader's); the .AT2's NPTS."""

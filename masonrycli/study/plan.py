@@ -286,6 +286,14 @@ def _records(entries: list[Path], out: Path, record_dt: float | None) -> tuple[d
     if twice:
         raise InputError(f"--records: two records named {twice[0]} (rows are keyed by the file name)")
     motions = {p.name: _record(p, record_dt) for p in files}
+    upright = [p.name for p in files if _vertical_at2(p)]
+    if upright:  # an unzipped NGA-West2 search holds each recording's H1, H2 and UP files, all .AT2
+        names = ", ".join(upright[:3]) + (" …" if len(upright) > 3 else "")
+        unread.append(
+            f"--records: {names} {'are vertical components' if len(upright) > 1 else 'is a vertical component'} "
+            "(PEER's UP / DWN), run along x as the others: leave them out of the set (a scenario file's "
+            "vertical = … applies one with its horizontal)"
+        )
     if record_dt is not None and all(m.time_step is None for m in motions.values()):
         # as simulate refuses --record-dt with a file that has times: a time step no file takes is a mistake
         raise InputError(
@@ -293,6 +301,22 @@ def _records(entries: list[Path], out: Path, record_dt: float | None) -> tuple[d
             "with a time column keep their own times): leave it out"
         )
     return motions, unread
+
+
+def _vertical_at2(path: Path) -> bool:
+    """An .AT2 file of a vertical component: PEER's file name ends in UP or DWN (RSN6_IMPVALL.I_I-ELCUP.AT2)
+    or its header's second line ends with the component ("…, EL CENTRO ARRAY #6, UP")."""
+    if path.suffix.lower() != ".at2":
+        return False
+    if path.stem.upper().endswith(("UP", "DWN")):
+        return True
+    try:
+        with open(path, encoding="utf-8", errors="replace") as fh:
+            fh.readline()
+            second = fh.readline()
+    except OSError:
+        return False
+    return second.rsplit(",", 1)[-1].strip().upper() in ("UP", "DWN", "VERT", "VERTICAL") if "," in second else False
 
 
 def _is_record_file(path: Path) -> bool:
