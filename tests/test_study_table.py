@@ -80,6 +80,8 @@ def test_threshold_rows_fit_80_columns():
     assert max(len(line) for line in lines) <= 80
     assert any("│ 1    │ 1.312         │ above │ 9    │" in line for line in lines)
     assert "amp_threshold m/s" in " ".join(lines)
+    # no drift, no opening in a threshold table: the file's are not named ("(drifts × height, openings m)")
+    assert words(" ".join(lines)).endswith("every column in ida.parquet, in SI units")
 
 
 def test_a_unitless_threshold_has_no_empty_legend_entry():

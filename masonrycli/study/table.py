@@ -120,11 +120,14 @@ def study_table(rows: list[dict], columns: list[Column], names: list[str], conso
         shown = [c for c in shown if c.drop != last]
         table = _table(rows, shown)
     legend = [c.legend for c in shown if c.legend]
+    headers = {c.header for c in columns}
     hidden = [c.header for c in columns if c not in shown]
     if hidden:
         legend.append(f"not shown at this width: {', '.join(hidden)}")
     # the file holds SI values: drift 0.0004 there is the terminal's 0.04 %, an opening 0.0007 m its 0.7 mm
-    legend.append(f"every column in {where}, in SI units (drifts × height, openings m)")
+    # (a threshold search's table has neither: "in SI units (drifts × height, openings m)" under amp_threshold)
+    scaled = [what for header, what in (("drift", "drifts × height"), ("open", "openings m")) if header in headers]
+    legend.append(f"every column in {where}, in SI units" + (f" ({', '.join(scaled)})" if scaled else ""))
     parts = [table, Text(" · ".join(legend))]
     failed = [r for r in rows if r.get("status") == "error"]
     for r in failed[:SHOWN_ERRORS]:
