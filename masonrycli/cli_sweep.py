@@ -239,6 +239,12 @@ def _exit_for_failed_rows(result, err_console) -> None:
         raise typer.Exit(EXIT_ROWS_FAILED if result.failed else EXIT_DIVERGED)
 
 
+def _at_zero(rows: list[dict], im: str) -> str:
+    """The runs the fit leaves out, at an IM of 0 (--scale 0:6:3): "1 of 4 runs collapsed" of 6 rows."""
+    zero = sum(1 for r in rows if not (isinstance(r.get(im), (int, float)) and r[im] > 0))
+    return f"; {_n(zero, 'run')} at {im} = 0 left out" if zero else ""
+
+
 def _no_fit(rows: list[dict], axes) -> str:
     """Why a record study has no fragility curve, and what gives one: 'no fit (every run collapsed, or none
     did)' left the user to count which, and which way to move the scales."""
@@ -307,12 +313,18 @@ def _report(console, result, plan: StudyPlan, im: str, written: list, signals: F
             console.print(
                 f"fragility ({im}): not resolved — every collapse ({im} ≥ {fell:.4g} {unit}) is above every run "
                 f"that stood (≤ {stood:.4g} {unit}): the median θ is anywhere between, the dispersion β → 0; more "
-                f"records or scales are needed ({fit.collapsed} of {fit.runs} runs collapsed)"
+                f"records or scales are needed ({fit.collapsed} of {fit.runs} runs collapsed{_at_zero(good, im)})"
+            )
+        elif fit.unbounded:
+            console.print(
+                f"fragility ({im}): not resolved — the collapses do not come at larger {im} than the runs that "
+                f"stood (the fit's dispersion β runs to its bound, {fit.dispersion:.3g}); more records or scales are "
+                f"needed ({fit.collapsed} of {fit.runs} runs collapsed{_at_zero(good, im)})"
             )
         else:
             console.print(
                 f"fragility ({im}): median θ = {fit.median:.4g} {UNITS[im]}, dispersion β = {fit.dispersion:.3f} "
-                f"({fit.collapsed} of {fit.runs} runs collapsed)"
+                f"({fit.collapsed} of {fit.runs} runs collapsed{_at_zero(good, im)})"
             )
     console.print(f"plot: {plot.path}")
     if recording is not None:

@@ -15,6 +15,7 @@ from masonrycli.records import record_motion
 from masonrycli.scenario import Material, RunConfig, scenario_from_builder
 from masonrycli.study import store
 from masonrycli.study.axes import Axis, StudyBase, apply_point, check_axes, grid, parse_axis
+from masonrycli.study.curves import fit_label
 from masonrycli.study.drivers import FindDriver, GridDriver
 from masonrycli.study.fragility import fit_lognormal
 from masonrycli.study.task import check_outcome, empty_result, reached, run_task
@@ -258,6 +259,16 @@ def test_lognormal_fit_of_separated_runs_says_the_dispersion_is_not_resolved():
     assert fit_lognormal([1.0, 2.0, 3.0, 4.0], [False, True, False, True]).separated is None
 
 
+def test_lognormal_fit_of_collapses_below_the_runs_that_stood_is_not_resolved():
+    # 'masonry sweep wall --records recs --scale=-6:6:3': the record that collapsed did so at a lower pga
+    # (21.9 m/s²) than the one that stood (29.2): the likelihood grows as β -> ∞, and the fit's bound
+    # was printed as a curve, "median θ = 25.3 m/s², dispersion β = 5.000"
+    fit = fit_lognormal([21.9, 21.9, 29.2, 29.2], [True, True, False, False], "pga")
+    assert fit.unbounded and fit.separated is None and fit_label(fit, "m/s²").startswith("lognormal: not resolved")
+    resolved = fit_lognormal([1.0, 2.0, 3.0, 4.0], [False, True, False, True])
+    assert not resolved.unbounded and fit_label(resolved, "m").startswith("lognormal: θ = ")
+
+
 def test_closing_the_cluster_silences_its_teardown_logs(capfd):
     # Stopped with 20 000 tasks queued, the LocalCluster's scheduler (in this process) printed 21-47
     # "CRITICAL - Closed comm ... while trying to write" tracebacks under the one-line "interrupted".
@@ -313,3 +324,12 @@ def test_a_history_of_the_same_study_is_replaced_another_is_kept(arch_base, tmp_
     assert (run["study"], run["study_table"]) == ("abc", "/s.csv")
     run_task(arch_base, {"amp": 0.5}, history_dir=str(tmp_path), study=("xyz", "/s.csv"))  # another study's: kept
     assert sorted(p.name for p in tmp_path.iterdir()) == ["amp=0.5-2.npz", "amp=0.5.npz"]
+
+
+def test_the_fragility_line_counts_the_runs_at_zero_intensity_it_leaves_out():
+    # '--scale 0:6:3' printed "(1 of 4 runs collapsed)" under a table of 6 rows: the 2 at pga 0 left out unsaid
+    from masonrycli.cli_sweep import _at_zero
+
+    rows = [{"pga": 0.0}, {"pga": 0.0}, {"pga": 21.9}, {"pga": math.nan}]
+    assert _at_zero(rows, "pga") == "; 3 runs at pga = 0 left out"
+    assert _at_zero([{"pga": 1.0}], "pga") == ""

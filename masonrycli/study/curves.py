@@ -76,6 +76,8 @@ def searched_range(request) -> tuple[float, float]:
 def fit_label(fit, unit: str) -> str:
     if fit.separated:
         return "lognormal: not resolved (runs separated: β → 0)"
+    if getattr(fit, "unbounded", False):
+        return "lognormal: not resolved (collapses not above the runs that stood: β → ∞)"
     return f"lognormal: θ = {fit.median:.3g} {unit}, β = {fit.dispersion:.2f}"
 
 

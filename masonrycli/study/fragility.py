@@ -25,6 +25,10 @@ class Fragility:
     separated: tuple[float, float] | None = None
     """(highest IM that stood, lowest that collapsed) when every collapse lies above every survivor: the
     likelihood then grows without end as β -> 0, so β is only the bound the fit stopped at (not resolved)."""
+    unbounded: bool = False
+    """β stopped at its upper bound (5): the collapses do not come at larger IM than the runs that stood
+    (every one below them: the likelihood grows as β -> ∞, the curve flattening to 1/2), so no curve is
+    resolved. It printed "β = 5.000" as a fit."""
 
     def probability(self, x) -> np.ndarray:
         from scipy.stats import norm
@@ -62,11 +66,13 @@ def fit_lognormal(im, collapsed, name: str = "im") -> Fragility | None:
     options = {"xatol": 1e-10, "fatol": 1e-12, "maxiter": 4000}
     best = minimize(nll, start, method="Nelder-Mead", bounds=bounds, options=options)
     stood, fell = float(x[~y].max()), float(x[y].min())
+    dispersion = float(math.exp(best.x[1]))
     return Fragility(
         median=float(math.exp(best.x[0])),
-        dispersion=float(math.exp(best.x[1])),
+        dispersion=dispersion,
         runs=int(x.size),
         collapsed=int(y.sum()),
         im=name,
         separated=(stood, fell) if stood < fell else None,
+        unbounded=dispersion > 5.0 * (1 - 1e-6),
     )
