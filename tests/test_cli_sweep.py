@@ -146,6 +146,27 @@ def test_a_record_study_without_a_fit_says_which_side_and_what_to_change(tmp_pat
     assert "fragility: no fit (1 run; a fit needs at least 2)" in words(result.output), result.output
 
 
+def test_rows_name_the_masonry_that_made_them_and_a_resume_says_when_it_differs(block, tmp_path):
+    # the study's fingerprint is of its inputs, not of the code: resumed after an upgrade, a table mixed the
+    # rows of two solvers without a word, and no row said which masonry had made it
+    from masonrycli.study.versions import this_version
+
+    ours = this_version()[1]
+    out = tmp_path / "s.csv"
+    args = ["sweep", block, "--workers", 0, "--no-recording", "--duration", 0.05, "--out", out, "--force"]
+    assert invoke(*args, "-p", "amp=0.1,0.2").exit_code == 0
+    assert [r["source"] for r in read_rows(out)] == [ours, ours]
+    text = out.read_text()
+    out.write_text(text.replace(ours, "0123456789ab", 1))  # the first row made by another masonry
+    result = invoke(*args, "-p", "amp=0.1,0.2,0.3")
+    assert result.exit_code == 0, result.output
+    assert (
+        f"warning: 1 row of {out} was made by another masonry (source 0123456789ab; this one is {ours}): kept, "
+        "not run again" in words(result.output)
+    ), result.output
+    assert [r["source"] for r in read_rows(out)] == ["0123456789ab", ours, ours]
+
+
 def test_records_run_whole_on_a_built_in_and_a_shorter_run_is_warned(block, tmp_path):
     # the built-in wall's 1 s cut every record to its first second: without --duration the runs last the
     # longest record; a scenario file keeps its [run] duration, and a record longer than the runs is named

@@ -52,7 +52,13 @@ def test_local_cluster_rows_equal_the_runs_made_one_by_one(tmp_path):
         assert row["max_opening"] == alone.outcome["max_opening"] and row["hinges"] == alone.outcome["hinges"]
         assert row["pga"] == alone.intensity["pga"] and row["sa"] == alone.intensity["sa"]
         assert row["sweeps_mean"] == alone.tally.sweeps_mean
-    assert {r["state"] for r in rows} >= {"damaged"} and set(rows[0]) == {"amp", "freq", *RESULT_COLUMNS, "study"}
+    assert {r["state"] for r in rows} >= {"damaged"} and set(rows[0]) == {
+        "amp",
+        "freq",
+        *RESULT_COLUMNS,
+        "study",
+        "source",
+    }
 
 
 def _spawn(args, log: Path, terminal: bool = False):

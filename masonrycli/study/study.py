@@ -23,7 +23,7 @@ from masonrycli.study import files, store
 from masonrycli.study.axes import Axis, StudyBase, apply_point, check_axes, check_find, grid
 from masonrycli.study.drivers import FindDriver, GridDriver
 from masonrycli.study.task import RESULT_COLUMNS
-from masonrycli.study.versions import WorkerMismatch
+from masonrycli.study.versions import WorkerMismatch, this_version
 
 
 @dataclass(frozen=True)
@@ -119,12 +119,31 @@ def run_study(base: StudyBase, request: StudyRequest, console: Console) -> Study
     if request.find:
         driver = FindDriver(request.axes, request.find, request.outcome, request.rtol, done)
         columns = names + [f"{request.find}_{s}" for s in ("threshold", "lo", "hi")]
-        columns += ["holds", "outcome", "evaluations", "status", "wall_time", "note", "error", "study"]
+        columns += ["holds", "outcome", "evaluations", "status", "wall_time", "note", "error", "study", "source"]
     else:
         driver = GridDriver(request.axes, done)
-        columns = names + list(RESULT_COLUMNS) + ["study"]
+        columns = names + list(RESULT_COLUMNS) + ["study", "source"]
+    # Each row names the masonry source that made it (every run's is the command's: versions.py). The
+    # fingerprint is of the study's inputs, not of the code: resumed after an upgrade, a table mixed rows of
+    # two solvers without a word.
+    source = this_version()[1]
+    other = [r for r in done.values() if r.get("source") != source]
     study = (study_id, str(request.out.resolve()))  # whose histories may be replaced (study/task.py)
     files.check_histories(request.histories, driver.start(), request.find, request.force, study)
+    unknown = [r for r in other if not r.get("source")]
+    if len(other) > len(unknown) and request.warn is not None:
+        made = sorted({str(r["source"]) for r in other if r.get("source")})
+        was = "was" if len(other) - len(unknown) == 1 else "were"
+        request.warn(
+            f"{_rows(len(other) - len(unknown))} of {request.out} {was} made by another masonry (source "
+            f"{', '.join(made[:3])}; this one is {source}): kept, not run again — remove them (or the file) to run "
+            "them with this one"
+        )
+    if unknown and request.warn is not None:
+        request.warn(
+            f"{_rows(len(unknown))} of {request.out} {'does' if len(unknown) == 1 else 'do'} not say which masonry "
+            "made them (written before rows named their source): kept, not run again"
+        )
     for line in request.warnings if request.warn is not None else ():
         request.warn(line)
     start = time.perf_counter()
@@ -164,6 +183,7 @@ def run_study(base: StudyBase, request: StudyRequest, console: Console) -> Study
         counts[label] = counts.get(label, 0) + 1
         for finished in driver.finished:
             finished["study"] = study_id
+            finished["source"] = source
             journal.append(finished)
             progress.advance(bar)
         driver.finished.clear()
@@ -190,6 +210,7 @@ def run_study(base: StudyBase, request: StudyRequest, console: Console) -> Study
         rows = driver.rows()
         for r in rows:
             r.setdefault("study", study_id)
+            r.setdefault("source", "")  # a row of a table written before rows named their source: unknown
         if rows or table.path.exists():
             store.write_rows(table, rows, columns)
         else:  # stopped before any row: a header-only table held nothing, yet the same command refused it
@@ -199,6 +220,10 @@ def run_study(base: StudyBase, request: StudyRequest, console: Console) -> Study
             files.remove_abandoned_parts(request.histories)
     failed = sum(1 for r in rows if r.get("status") == "error")
     return StudyResult(rows, columns, driver.skipped, ran, time.perf_counter() - start, failed, table.path)
+
+
+def _rows(n: int) -> str:
+    return f"{n} row" + ("" if n == 1 else "s")
 
 
 def _close(client, cluster) -> None:
