@@ -288,6 +288,7 @@ def _close_all(sinks: dict, status: str, note: str, result) -> tuple[list[Output
 _STALLED = {
     "nlgs": "no lower residual in 10 000 sweeps by faces",
     "nlgs-accel": "every method of the stalled-step round-robin gave up above it",
+    "nlgs-accel32": "every method of the stalled-step round-robin gave up above it",
 }
 """What a step that ends unconverged below the cap went through, by solver (engine/nlgs.py, stalled.py)."""
 

@@ -78,6 +78,7 @@ def progress_bar(console: Console, n_steps: int):
 
 SOLVER_NOTES = {
     "nlgs-accel": "Gauss–Seidel with momentum; plain: --solver nlgs",
+    "nlgs-accel32": "Gauss–Seidel with momentum, first sweeps in float32; plain: --solver nlgs",
     "nlgs": "plain Gauss–Seidel, the reference",
 }
 """What the summary says after a solver's name (masonrycli.scenario.SOLVERS)."""

@@ -44,7 +44,7 @@ MAX_BLOCK_SPEED = 1e3
 """m/s — an initial block velocity moving a point of the block faster (|v| + |ω|·r, r the farthest vertex
 from the centroid) is refused as a likely typo: run.py calls a block that fast diverged (a block given
 ``velocity = [1e9, 0, 0]`` ended as exit 3, "diverged at step 1")."""
-SOLVERS = ("nlgs-accel", "nlgs")
+SOLVERS = ("nlgs-accel", "nlgs-accel32", "nlgs")
 """Contact solvers a run can select (RunConfig.solver); the first is the default."""
 
 # --------------------------------------------------------------------------------------------------
@@ -63,7 +63,9 @@ class RunConfig:
     tolerance : m/s, NLGS stopping test: RMS contact-law violation of a sweep (engine.nlgs), in (0, 1).
     max_iterations : NLGS sweep cap per step, >= 1.
     solver : the contact solver, one of ``SOLVERS``: "nlgs-accel" (default) Gauss–Seidel with Nesterov
-        momentum; "nlgs" plain Gauss–Seidel, the reference to compare it with (engine.nlgs).
+        momentum; "nlgs-accel32" the same with its first sweeps in single precision (faster on walls of
+        about 16 courses, slower on 32: README, Performance); "nlgs" plain Gauss–Seidel, the reference to
+        compare them with (engine.nlgs).
     record_every : record one frame every this many steps, >= 1.
     alert_distance : m, contacts with a gap below this are kept, > 0 (and at most the structure's extent:
         :class:`Scenario` checks that, knowing the blocks).

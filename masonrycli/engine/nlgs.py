@@ -293,6 +293,9 @@ LANES = True
 """The accelerated solve's first stage by :mod:`masonrycli.engine.lane_sweeps` (8 runs, 8 contacts visited
 at once in vectors); False: by the scalar sweep in INTERLEAVE runs (interleaved._accelerated), the
 default until the lane sweeps replaced it (benchmarks/JOURNAL.md, explicit vectors addendum)."""
+FLOAT32 = False
+"""The lab's switch: "nlgs-accel" starts as "nlgs-accel32" does (lane_sweeps32.first_stage)."""
+ACCELERATED = ("nlgs-accel", "nlgs-accel32")  # momentum's first stage, stalled steps by stalled.py
 
 
 def _nlgs_interleaved(
@@ -317,6 +320,10 @@ def _nlgs_interleaved(
     than one with the flag as an argument: a run compiles only the sweep it uses (the plain one cost 1.5 s
     of the first run's compilation)."""
     if accelerate and alternate is None and LANES:
+        if FLOAT32 and tolerance > 0.0:
+            return lane_sweeps32.first_stage(
+                contact_body, pack, count, mu, tolerance, max_iterations, v, r, status, accelerated_stall
+            )
         return lane_sweeps._lane_sweeps(
             contact_body, pack, count, mu, tolerance, max_iterations, v, r, status, accelerated_stall
         )
@@ -416,7 +423,7 @@ def solve(contact_body, pack, count, model, v, r, status) -> tuple[int, float]:
     """Solve one step's contact problem by NLGS: the engine's one entry point for a contact solver.
 
     In: ``contact_body`` (C, 2) bodies a < b, ``pack`` (C, PACK_WIDTH) from :func:`prepare_contacts`,
-    ``model`` (friction, tolerance m/s, max_iterations, solver "nlgs-accel" or "nlgs"). ``v`` (B, 3): v_free
+    ``model`` (friction, tolerance m/s, max_iterations, solver "nlgs-accel", "nlgs-accel32" or "nlgs"). ``v`` (B, 3): v_free
     in, v_n+1 out. ``r`` (C, 2): starting impulses in, (r_t, r_n) N·s out. ``status`` (C,) int8 out
     (:class:`~masonrycli.engine.contact.ContactStatus`).
 
@@ -427,9 +434,10 @@ def solve(contact_body, pack, count, model, v, r, status) -> tuple[int, float]:
     iterations are then the point sweeps plus the faces' sweep units. With solver "nlgs-accel" a stalled
     solve goes on by the methods of :mod:`masonrycli.engine.stalled`, and its iterations add up all of them."""
     mu, tolerance, cap = model.friction, model.tolerance, model.max_iterations
-    if model.solver != "nlgs-accel" or tolerance <= 0.0:
+    accelerated = model.solver in ACCELERATED
+    if not accelerated or tolerance <= 0.0:
         iterations, residual = _nlgs_interleaved(
-            contact_body, pack, count, mu, tolerance, cap, v, r, status, model.solver == "nlgs-accel", STALL_SWEEPS
+            contact_body, pack, count, mu, tolerance, cap, v, r, status, accelerated, STALL_SWEEPS
         )
         return _faces_if_stalled(contact_body, pack, count, mu, tolerance, cap, v, r, status, iterations, residual)
     # Accelerated: momentum (the lane sweeps, LANES) until its stall window; a stalled step goes on by the
@@ -438,6 +446,10 @@ def solve(contact_body, pack, count, model, v, r, status) -> tuple[int, float]:
     if shrink.CHECK_EVERY > 0:  # the first stage only: stalled.py's methods keep their sweeps
         iterations, residual = interleaved._shrinking(
             contact_body, pack, count, mu, tolerance, cap, v, r, status, momentum.STALL_SWEEPS, shrink.CHECK_EVERY
+        )
+    elif model.solver == "nlgs-accel32" and LANES:
+        iterations, residual = lane_sweeps32.first_stage(
+            contact_body, pack, count, mu, tolerance, cap, v, r, status, momentum.STALL_SWEEPS
         )
     else:
         iterations, residual = _nlgs_interleaved(
@@ -485,4 +497,4 @@ def tangential_velocity(contact_body, pack, count, v) -> np.ndarray:
 
 # At the end: faces, momentum and stalled build on this module's sweep primitives (a stalled solve()
 # continues by faces or by stalled's methods; the accelerated sweep is momentum's).
-from masonrycli.engine import faces, interleaved, lane_sweeps, momentum, shrink, stalled  # noqa: E402
+from masonrycli.engine import faces, interleaved, lane_sweeps, lane_sweeps32, momentum, shrink, stalled  # noqa: E402
