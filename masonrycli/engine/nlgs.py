@@ -320,10 +320,6 @@ def _nlgs_interleaved(
     than one with the flag as an argument: a run compiles only the sweep it uses (the plain one cost 1.5 s
     of the first run's compilation)."""
     if accelerate and alternate is None and LANES:
-        if FLOAT32 and tolerance > 0.0:
-            return lane_sweeps32.first_stage(
-                contact_body, pack, count, mu, tolerance, max_iterations, v, r, status, accelerated_stall
-            )
         return lane_sweeps._lane_sweeps(
             contact_body, pack, count, mu, tolerance, max_iterations, v, r, status, accelerated_stall
         )
@@ -447,7 +443,7 @@ def solve(contact_body, pack, count, model, v, r, status) -> tuple[int, float]:
         iterations, residual = interleaved._shrinking(
             contact_body, pack, count, mu, tolerance, cap, v, r, status, momentum.STALL_SWEEPS, shrink.CHECK_EVERY
         )
-    elif model.solver == "nlgs-accel32" and LANES:
+    elif (model.solver == "nlgs-accel32" or FLOAT32) and LANES:  # the one place float32 is chosen
         iterations, residual = lane_sweeps32.first_stage(
             contact_body, pack, count, mu, tolerance, cap, v, r, status, momentum.STALL_SWEEPS
         )
