@@ -74,6 +74,10 @@ STALL32 = 200
 the first stage's own stall window)."""
 RESYNC = 32
 """Sweeps between the float32 stage's re-derivations of the velocities from the impulses (_resync)."""
+TOL_FACTOR = 1.0
+"""The float32 stage stops at TOL_FACTOR × the step's tolerance, the float64 sweeps finish to the tolerance.
+A lab lever (benchmarks/JOURNAL.md "Why float32 sweeps make tall walls' runs dearer"): 10 made h32's
+ensemble neutral (units 1.045) and took wall-248's gain away (CPU 0.99); 1 is what shipped."""
 
 
 @njit(inline="always")
@@ -434,7 +438,7 @@ def first_stage(contact_body, pack, count, mu, tolerance, max_iterations, v, r, 
     (iterations, residual): the sweeps of both, the float64 sweep's residual."""
     # max_iterations − 1: the float64 sweep the step ends on stays within the run's cap
     its32, _ = lane_sweeps32(
-        contact_body, pack, count, mu, tolerance, max(max_iterations - 1, 0), v, r, status,
+        contact_body, pack, count, mu, tolerance * TOL_FACTOR, max(max_iterations - 1, 0), v, r, status,
         min(stall_after, STALL32), -1, RESYNC,
     )  # fmt: skip
     its, residual = lane_sweeps._lane_sweeps(
