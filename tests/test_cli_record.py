@@ -160,7 +160,7 @@ def test_a_wall_shaken_by_a_record_has_no_paper_figure_tabs(at2, tmp_path):
     assert "paper's Figs" not in result.output
     views = blueprint_views(rrd)
     assert not any(name.startswith("Fig.") or v["pinned"] for name, v in views.items())
-    assert any(name.startswith("Live: joint forces") for name in views)
+    assert "Live" in views
 
 
 def test_an_at2_file_with_samples_beyond_npts_says_so_once(tmp_path):

@@ -12,7 +12,7 @@ from masonrycli.builtin import paper_loading
 from masonrycli.colour_range import MIN_SPAN, OUTSIDE_SHARE
 from masonrycli.joint_forces import joint_resultants
 from masonrycli.recording import ENTITY_PATHS, FIELDS, Recorder, inspect_recording
-from masonrycli.recording.layout import FILL, INSET, PAPER_FIELDS
+from masonrycli.recording.layout import FIELD_TABS, FILL, INSET, LIVE_TAB, MAGNIFIED_TAB, PLOT_NAMES
 from masonrycli.recording.readback import blueprint_views, field_frames
 
 import recording_fixtures as fx
@@ -74,11 +74,9 @@ def test_embedded_blueprint_has_the_views(written, wall, tmp_path):
     path, *_, rec = written
     views = blueprint_views(path)
     spatial = {n for n, v in views.items() if v["kind"] == "2D" and v["origin"] == "/structure/plane"}
-    assert {f"Live: {f.title}" for f in PAPER_FIELDS} < spatial
-    # the magnified tab names its factor (set at close: the tab was "Magnified deformed shape" alone)
-    assert rec.magnify > 0 and f"Magnified deformed shape × {rec.magnify:g}" in spatial
-    assert {"Joint states: sliding ratio", "Joint states: largest opening"} < spatial
-    assert any(n.startswith("Live: joint forces") for n in spatial)
+    assert {LIVE_TAB, MAGNIFIED_TAB, *FIELD_TABS.values()} == spatial
+    # the magnified view's factor (set at close) is in the Legend: in the tab's name it was cut
+    assert rec.magnify > 0 and f"× {rec.magnify:g}" in static_value(path, "/run/legend", "TextDocument:text")[0]
     assert sum(v["kind"] == "TimeSeries" for v in views.values()) == 9
     assert views["Run"]["origin"] == "/run/metadata" and views["Legend"]["origin"] == "/run/legend"
     assert not any(v["pinned"] for v in views.values())  # no paper instant for a synthetic run
@@ -90,9 +88,8 @@ def test_embedded_blueprint_has_the_views(written, wall, tmp_path):
             rec.log_frame(f)
     views = blueprint_views(tmp_path / "w.rrd")
     pinned = {n: v["pinned"] for n, v in views.items() if v["pinned"]}
-    assert sorted(pinned) == sorted(
-        f"Fig. {fig}: {f.title} at t = 0.1 s" for fig, f in zip(("III.2", "III.3", "III.4", "III.5"), PAPER_FIELDS)
-    )
+    assert sorted(pinned) == ["Fig. III.2", "Fig. III.3", "Fig. III.4", "Fig. III.5"]
+    assert "the paper's figures at t = 0.1 s" in static_value(tmp_path / "w.rrd", "/run/legend", "TextDocument:text")[0]
     assert set(pinned.values()) == {("sim_time", 0.1, 0.1)}
 
 
@@ -383,10 +380,10 @@ def test_the_kinetic_energy_has_a_plot_of_its_own(written):
     that feeds it and the potential change."""
     path, _, frames, _ = written
     views = blueprint_views(path)
-    assert views["Kinetic energy (J)"]["origin"] == "/series/energy/kinetic"
+    assert views[PLOT_NAMES["energy_kinetic"]]["origin"] == "/series/energy/kinetic"
     kinetic = fx.temporal_rows(path, "/series/energy/kinetic", "Scalars:scalars")
     assert {f.step: [f.energy_kinetic] for f in frames} == {k: list(v) for k, v in kinetic.items()}
-    large = views["Support work, dissipated energy, potential change (J)"]["origin"]
+    large = views[PLOT_NAMES["energy_large"]]["origin"]
     rows = fx.temporal_rows(path, large, "Scalars:scalars")
     last = frames[-1]
     np.testing.assert_allclose(rows[last.step][:2], [last.support_work, last.energy_dissipated])
@@ -397,7 +394,7 @@ def test_the_residual_plot_names_its_unit(written):
     """ "NLGS residual (log10) and tolerance": ticks -5 .. -5.3 and no unit on screen. The residual is the
     RMS contact-law violation of a sweep in m/s (--tolerance's unit); the plot's name says so."""
     views = blueprint_views(written[0])
-    assert views["NLGS residual and tolerance (log10 of m/s)"]["origin"] == "/series/solver/log10_residual"
+    assert views["Residual (log10 m/s)"]["origin"] == "/series/solver/log10_residual"
 
 
 def test_the_largest_displacement_is_relative_to_a_shaken_ground(written):
@@ -416,11 +413,13 @@ def test_the_largest_displacement_is_relative_to_a_shaken_ground(written):
 
 def test_a_plot_of_one_named_series_has_no_legend(written):
     """The legend box sat bottom left over the start of every curve, and on a plot of one series repeated
-    its name ("kinetic" under "Kinetic energy (J)", "contacts" under "Contacts"). Those plots have none; the
-    plots of several series, and the balance error (its legend gives the sum), keep theirs."""
+    its name ("kinetic" under "Kinetic energy (J)", "contacts" under "Contacts"). Those plots have none, nor
+    the balance error (its legend covered its first 300 ms); the plots of several series keep theirs."""
     views = blueprint_views(written[0])
     hidden = {n for n, v in views.items() if v["kind"] == "TimeSeries" and v["legend"] is False}
-    assert hidden == {"Kinetic energy (J)", "Max block displacement (m)", "NLGS sweeps per step", "Contacts"}
+    assert hidden == {
+        PLOT_NAMES[k] for k in ("energy_kinetic", "energy_balance", "max_displacement", "iterations", "contacts")
+    }
 
 
 @pytest.mark.parametrize("low_steps, fixed", [(2, True), (10, False)])
@@ -443,7 +442,7 @@ def test_the_residual_plot_is_not_ranged_by_its_first_steps(wall, tmp_path, low_
             rec.log_step(k, k * static.dt, Stats(k))
             if k % 25 == 0:
                 rec.log_frame(frames[k // 25])
-    y_range = blueprint_views(path)["NLGS residual and tolerance (log10 of m/s)"]["y_range"]
+    y_range = blueprint_views(path)[PLOT_NAMES["residual"]]["y_range"]
     if fixed:
         lo, hi = -4.5, -4.0  # the smallest but the first steps'; the tolerance over the largest residual
         assert y_range == pytest.approx((lo - 0.05 * (hi - lo), hi + 0.05 * (hi - lo)))
@@ -555,7 +554,7 @@ def test_a_run_ended_before_the_paper_instant_opens_without_its_tabs(wall, tmp_p
             raise KeyboardInterrupt
     views = blueprint_views(tmp_path / "w.rrd")
     assert not any(v["pinned"] or name.startswith("Fig.") for name, v in views.items())
-    assert any(name.startswith("Live: joint forces") for name in views) and rec.paper is None
+    assert LIVE_TAB in views and rec.paper is None
 
 
 def test_a_run_s_recording_opens_at_t0_on_the_structure_as_built(tmp_path):
@@ -595,3 +594,48 @@ def test_a_run_s_recording_opens_at_t0_on_the_structure_as_built(tmp_path):
     read = field_frames(rrd)
     assert np.isnan(read[0]["values"]["cell_spherical_stress"]).all()
     assert read[0]["ranges"] == read[10]["ranges"]
+
+
+def test_the_balance_error_is_plotted_as_a_log10_share():
+    """The balance error was plotted in joules: at round-off on the quick start's wall, its ticks read
+    "0.000 000 000 03 J". It is now log10 of its share of the largest term, by hand here."""
+    from masonrycli.recording.series import BALANCE_FLOOR, balance_log10
+
+    kinetic, potential_change, dissipated, work = (
+        np.array(x, dtype=float) for x in ([2, 1, 0], [0, -0.5, 0], [0, 0.5, 0], [1, 1, 0])
+    )
+    out = balance_log10(kinetic, potential_change, dissipated, work)
+    # |2 + 0 + 0 − 1| / 2; an exact balance; nothing moved yet
+    np.testing.assert_allclose(out, [np.log10(0.5), np.log10(BALANCE_FLOOR), np.log10(BALANCE_FLOOR)])
+
+
+def test_the_balance_error_plot_reads_the_frames_energies(written):
+    path, _, frames, _ = written
+    rows = fx.temporal_rows(path, "/series/energy/balance_error", "Scalars:scalars")
+    ref = frames[0].energy_potential  # the fixture's first frame is as built
+    for f in frames[1:]:
+        terms = [f.energy_kinetic, f.energy_potential - ref, f.energy_dissipated, f.support_work]
+        share = abs(terms[0] + terms[1] + terms[2] - terms[3]) / max(abs(x) for x in terms)
+        assert rows[f.step][0] == pytest.approx(np.log10(max(share, 1e-16)), abs=1e-9)
+
+
+def test_every_tab_name_fits_its_tab_bar(written, wall, tmp_path):
+    """The quick start's structure panel has 12 tabs in ~1150 px of a 1920 px window: with names of up to 56
+    characters ("Live: joint forces, principal stress, Spherical stress p") four were readable and the first
+    was cut; the right column showed three of its six plot tabs. Measured in the headless viewer: about
+    5.5 px a character and 33 px a tab besides (12 short tabs took 972 px); the tab bars leave ~70 px to
+    their buttons. Every name short, and distinct (a view per name)."""
+    static, q0 = wall
+    paper = {**fx.METADATA, "scenario": "wall", "duration_s": 1.0, "supports": paper_loading("wall")}
+    with Recorder(tmp_path / "w.rrd", static, paper) as rec:
+        for f in fx.frames(static, q0, 11):
+            rec.log_frame(f)
+    views = blueprint_views(tmp_path / "w.rrd")
+    structure = [n for n, v in views.items() if v["kind"] == "2D"]
+    plots = [n for n, v in views.items() if v["kind"] == "TimeSeries"]
+    assert len(structure) == 12 and len(plots) == 9  # distinct: a repeated name would merge two views here
+    assert 33 * 12 + 5.5 * sum(map(len, structure)) < 1080
+    rows = ([PLOT_NAMES[k] for k in ("energy_kinetic", "energy_balance", "energy_large", "max_displacement")],
+            [PLOT_NAMES[k] for k in ("support_velocity", "support_displacement", "residual", "iterations", "contacts")])  # fmt: skip
+    assert set(plots) == {n for row in rows for n in row}
+    assert all(33 * len(row) + 5.5 * sum(map(len, row)) < 700 for row in rows)

@@ -17,7 +17,15 @@ import rerun as rr
 
 from masonrycli import __version__ as MASONRY_VERSION
 from masonrycli.colour_range import MIN_SPAN, OUTSIDE_SHARE
-from masonrycli.recording.layout import AXES, FIELDS, ROBUST_PERCENTILE
+from masonrycli.recording.layout import (
+    AXES,
+    FIELD_TABS,
+    FIELDS,
+    LIVE_TAB,
+    MAGNIFIED_TAB,
+    ROBUST_PERCENTILE,
+    tabs_legend,
+)
 
 
 def run_document(
@@ -108,8 +116,14 @@ def run_document(
     return "\n".join(lines) + "\n"
 
 
-def legend_markdown(force_scale: float | None, block_height: float, magnify: float | None) -> str:
-    """The legend shown under the structure views (and in the run document)."""
+def legend_markdown(
+    force_scale: float | None,
+    block_height: float,
+    magnify: float | None,
+    main_field: str = "cell_spherical_stress",
+    paper_t: float | None = None,
+) -> str:
+    """The legend shown under the structure views (and in the run document): the tabs' short names first."""
     scale = (
         "scale not fixed yet"
         if not force_scale
@@ -117,12 +131,14 @@ def legend_markdown(force_scale: float | None, block_height: float, magnify: flo
     )
     factor = "set when the run closes" if magnify is None else f"× {magnify:g}"
     return (
-        "- **Joint forces**: one arrow per joint, the resultant of its contact forces on the body above it, "
+        f"{tabs_legend(main_field, paper_t)}\n"
+        f"- **Joint forces** ({LIVE_TAB}, {FIELD_TABS['block_sliding_ratio']} and {FIELD_TABS['block_max_opening']} "
+        "tabs): one arrow per joint, the resultant of its contact forces on the body above it, "
         f"centred on its point of application (line of thrust); length proportional to the force, {scale}. Green = sticking, "
         "orange = sliding, red = open at one end (turning about the other). Yellow dots: hinges.\n"
         "- **Fills**: colour bar beside the structure; grey = undefined (NaN), magenta = below the range, "
         "lime green = above it. Small dark dots: the blocks' centroids; hover one for the block's name and values.\n"
-        f"- **Magnified deformed shape**: displacements and rotations {factor}; grey = as built."
+        f"- **{MAGNIFIED_TAB}** deformed shape: displacements and rotations {factor}; grey = as built."
     )
 
 

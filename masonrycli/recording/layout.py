@@ -116,6 +116,7 @@ SERIES: Final = {
 PER_STEP_SERIES: Final = ("iterations", "residual", "contacts")
 SINGLE_SERIES: Final = (
     "energy_kinetic",
+    "energy_balance",
     "max_displacement",
     "iterations",
     "contacts",
@@ -162,6 +163,55 @@ CENTROID_RGBA: Final = 0x282828FF  # the dot at each block's centroid, the hover
 CENTROID_RADIUS: Final = -2.5  # ui points: a dot of the same size at every zoom
 
 
+LIVE_TAB: Final = "Live"
+FIELD_TABS: Final = {
+    "cell_volumetric_strain_rate": "Strain rate",
+    "cell_deviatoric_strain": "Dev. strain",
+    "cell_spherical_stress": "Stress p",
+    "cell_deviatoric_stress": "Stress q",
+    "block_sliding_ratio": "Sliding",
+    "block_max_opening": "Opening",
+}
+MAGNIFIED_TAB: Final = "Magnified"
+"""Tab names, short: the quick start's recording has 12 tabs in the structure panel (~1150 px of a 1920 px
+window), where names of up to 56 characters ("Live: joint forces, principal stress, Spherical stress p")
+left four tabs readable and cut the first. Each colour bar carries its field's full title, and the Legend
+panel says what each tab shows (:func:`tabs_legend`)."""
+PLOT_NAMES: Final = {
+    "energy_kinetic": "Kinetic (J)",
+    "energy_balance": "Balance (log10 rel.)",
+    "energy_large": "Energies (J)",
+    "max_displacement": "Max displ. (m)",
+    "support_velocity": "Support v (m/s)",
+    "support_displacement": "Support u (m)",
+    "residual": "Residual (log10 m/s)",
+    "iterations": "Sweeps per step",
+    "contacts": "Contacts",
+}
+"""Plot tab names, short for the same reason: the right column (~770 px) showed 3 of its 6 energy and
+support tabs ("Support work, dissipated energy, potential change (J)" cut). Each plot's series names say the
+rest: in its legend, or on hover for the plots of one series (SINGLE_SERIES), whose legend is hidden."""
+
+
+def paper_tab(figure: str) -> str:
+    """The tab of the paper's ``figure`` ("III.2"); its instant is in the Legend (:func:`tabs_legend`)."""
+    return f"Fig. {figure}"
+
+
+def tabs_legend(main_field: str = "cell_spherical_stress", paper_t: float | None = None) -> str:
+    """The Legend panel's line on the tabs: what each short name shows (``paper_t``: the paper's figures'
+    instant, s, when the recording has their tabs)."""
+    main = FIELD_BY_KEY[main_field].title
+    fields = ", ".join(f"{FIELD_TABS[f.key]} = {f.title.lower()}" for f in FIELDS)
+    return (
+        f"- **Tabs**: {LIVE_TAB} = joint forces, principal stress axes and {main.lower()}; "
+        + ("" if paper_t is None else f"Fig. = the paper's figures at t = {paper_t:g} s (pinned there); ")
+        + f"{fields} (the last two with joint forces and hinges); "
+        f"{MAGNIFIED_TAB} = the magnified deformed shape."
+        + ("" if paper_t is None else " All but the Fig. tabs follow the time cursor.")
+    )
+
+
 def _fill_colours(f: FieldSpec) -> dict:
     """Blueprint override: the fill mesh takes its vertex colours from field ``f``'s component."""
 
@@ -195,7 +245,6 @@ def _structure_view(name: str, f: FieldSpec, extra: tuple[str, ...] = (), at: fl
 def build_blueprint(
     main_field: str = "cell_spherical_stress",
     paper: tuple[float, tuple[str, ...]] | None = None,
-    magnify: float | None = None,
     residual_range: tuple[float, float] | None = None,
 ) -> rrb.Blueprint:
     """Structure tabs and the on-screen legend (left); time series and the run document (right).
@@ -203,9 +252,9 @@ def build_blueprint(
 
     Tabs: the live main view (forces, principal stress, ``main_field``), with ``paper`` = (t, figure
     numbers) the paper's four figures pinned to t, the four fields live, the magnified deformed shape,
-    the joint states. ``magnify``: the magnified view's factor, in its tab's name when known (the
-    default factor is known when the run closes, which sends the layout again). Opens on ``sim_time`` following the end of the data: at the last frame of a finished
-    run, and on the newest frame of a run still being written.
+    the joint states (names: :data:`LIVE_TAB`, :func:`paper_tab`, :data:`FIELD_TABS`, :data:`MAGNIFIED_TAB`).
+    Opens on ``sim_time`` following the end of the data: at the last frame of a finished run, and on the
+    newest frame of a run still being written.
     """
     main = FIELD_BY_KEY[main_field]
     by_key = {f.key: f for f in FIELDS}
@@ -213,22 +262,21 @@ def build_blueprint(
     strain_rate_extra = (TRIANGULATION,)
     extras = {vsr.key: strain_rate_extra, p.key: (STRESS_AXES,)}
     joints = (FORCES, HINGES)
-    tabs = [_structure_view(f"Live: joint forces, principal stress, {main.title}", main, (FORCES, STRESS_AXES, HINGES))]
+    tabs = [_structure_view(LIVE_TAB, main, (FORCES, STRESS_AXES, HINGES))]
     if paper is not None:
         t, figures = paper
         tabs += [
-            _structure_view(f"Fig. {fig}: {f.title} at t = {t:g} s", f, extras.get(f.key, ()), at=t)
-            for fig, f in zip(figures, PAPER_FIELDS)
+            _structure_view(paper_tab(fig), f, extras.get(f.key, ()), at=t) for fig, f in zip(figures, PAPER_FIELDS)
         ]
-    tabs += [_structure_view(f"Live: {f.title}", f, extras.get(f.key, ())) for f in PAPER_FIELDS]
+    tabs += [_structure_view(FIELD_TABS[f.key], f, extras.get(f.key, ())) for f in PAPER_FIELDS]
     tabs += [
         rrb.Spatial2DView(
             origin=f"/{PLANE}",
             contents=[f"+ /{x}" for x in (UNDEFORMED, MAGNIFIED)],
-            name="Magnified deformed shape" + (f" × {magnify:g}" if magnify else ""),
+            name=MAGNIFIED_TAB,  # its factor: the Legend (the tab's name had it, and was cut)
         ),
-        _structure_view("Joint states: sliding ratio", sliding, joints),
-        _structure_view("Joint states: largest opening", opening, joints),
+        _structure_view(FIELD_TABS[sliding.key], sliding, joints),
+        _structure_view(FIELD_TABS[opening.key], opening, joints),
     ]
     structure = rrb.Vertical(
         rrb.Tabs(*tabs, active_tab=1 if paper is not None else 0),
@@ -239,12 +287,12 @@ def build_blueprint(
         view_range=rrb.TimeRange(rrb.TimeRangeBoundary.infinite(), rrb.TimeRangeBoundary.infinite())
     )
 
-    def plot(key: str, name: str, axis_y: rrb.ScalarAxis | None = None) -> rrb.TimeSeriesView:
+    def plot(key: str, axis_y: rrb.ScalarAxis | None = None) -> rrb.TimeSeriesView:
         # a plot of one series whose name says it has no legend: the legend box (bottom left) hid the
         # start of the curve and repeated the name ("kinetic" under "Kinetic energy (J)")
         legend = rrb.PlotLegend(visible=False) if key in SINGLE_SERIES else None
         return rrb.TimeSeriesView(
-            origin=f"/{SERIES[key]}", name=name, axis_x=whole_run, axis_y=axis_y, plot_legend=legend
+            origin=f"/{SERIES[key]}", name=PLOT_NAMES[key], axis_x=whole_run, axis_y=axis_y, plot_legend=legend
         )
 
     residual_axis = rrb.ScalarAxis(range=residual_range) if residual_range is not None else None
@@ -254,19 +302,22 @@ def build_blueprint(
             # kinetic alone: beside the dissipated energy, which only grows, it read as a flat line at 0
             # (the aqueduct's 0.5 J under 250 J dissipated); the dissipated energy goes with the support
             # work that feeds it and the potential change, the balance's other large terms
-            plot("energy_kinetic", "Kinetic energy (J)"),
-            plot("energy_balance", "Energy balance error (J)"),
-            plot("energy_large", "Support work, dissipated energy, potential change (J)"),
-            plot("max_displacement", "Max block displacement (m)"),
-            plot("support_velocity", "Support velocity (m/s)"),
-            plot("support_displacement", "Support displacement (m)"),
+            plot("energy_kinetic"),
+            plot("energy_balance"),
+            plot("energy_large"),
+            plot("max_displacement"),
         ),
         rrb.Tabs(
+            # the supports (what moves the structure) beside the solver's health: six tabs in one row did
+            # not fit the column
+            plot("support_velocity"),
+            plot("support_displacement"),
             # the residual's unit (the RMS contact-law violation of a sweep, m/s, as --tolerance): the plot's
             # ticks read -5 .. -5.3 with no unit anywhere on screen
-            plot("residual", "NLGS residual and tolerance (log10 of m/s)", residual_axis),
-            plot("iterations", "NLGS sweeps per step"),
-            plot("contacts", "Contacts"),
+            plot("residual", residual_axis),
+            plot("iterations"),
+            plot("contacts"),
+            active_tab=2,  # the residual, shown at first open as before the supports joined this row
         ),
         rrb.TextDocumentView(origin=f"/{METADATA}", name="Run"),
         row_shares=[2, 2, 3],

@@ -161,7 +161,7 @@ class Recorder:
         os.makedirs(os.path.dirname(os.path.abspath(self.path)), exist_ok=True)
         with io_errors(self.path):
             self._main_field = main_field
-            self.rec.save(self.path, default_blueprint=build_blueprint(main_field, self.paper, magnify))
+            self.rec.save(self.path, default_blueprint=build_blueprint(main_field, self.paper))
             log_static(self.rec, static, self._blocks, self._supports)
             tolerance = self.metadata.get("nlgs_tolerance")
             self._log10_tolerance = float(np.log10(tolerance)) if tolerance else np.nan
@@ -353,7 +353,7 @@ class Recorder:
             reached = self._last is not None and self._last[1] >= self.paper[0] - 0.5 * self.static.dt
             if not reached:
                 self.paper = None
-        layout = build_blueprint(self._main_field, self.paper, self.magnify, self.residual_range())
+        layout = build_blueprint(self._main_field, self.paper, self.residual_range())
         self.rec.send_blueprint(layout, make_active=True, make_default=True)
 
     # ---- per-batch content
@@ -438,7 +438,8 @@ class Recorder:
             magnify=self.magnify,
         )
         self.rec.log(METADATA, rr.TextDocument(viewer_safe_text(text), media_type="text/markdown"), static=True)
-        legend = legend_markdown(self.force_scale, self.block_height, self.magnify)
+        paper_t = None if self.paper is None else self.paper[0]
+        legend = legend_markdown(self.force_scale, self.block_height, self.magnify, self._main_field, paper_t)
         self.rec.log(LEGEND, rr.TextDocument(viewer_safe_text(legend), media_type="text/markdown"), static=True)
 
 

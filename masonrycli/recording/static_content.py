@@ -105,7 +105,7 @@ def log_static(rec: rr.RecordingStream, st: RecordingStatic, blocks: Polygons, s
     series_names = {
         "energy_kinetic": ["kinetic"],
         "energy_large": ["support work", "dissipated (cumulated)", "potential change"],
-        "energy_balance": ["kinetic + potential change + dissipated − support work"],
+        "energy_balance": ["log10 |kinetic + potential change + dissipated − support work| ÷ largest term"],
         "max_displacement": ["max block displacement, relative to a shaken ground"],
         "support_velocity": [f"{n} v{c}" for n in names for c in "xy"],
         "support_displacement": [f"{n} u{c}" for n in names for c in "xy"],
