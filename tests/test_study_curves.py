@@ -137,6 +137,46 @@ def test_points_without_a_threshold_are_marked_at_the_searched_range_ends(png_fi
     assert png["amp_threshold (m/s)"] == series["/study/thresholds/line"]["rgb"]
 
 
+def test_thresholds_along_record_names_are_points_not_a_line(png_figures, tmp_path):
+    """``--records DIR --find scale``: the records sit on the x axis in alphabetical order, and a line
+    joining their thresholds read as a trend from one record to the next. Points alone, in the PNG (no
+    line drawn) and in the recording (no line entity), under the curve's own label."""
+    rows = [
+        {"record": name, "scale_threshold": t, "scale_lo": t - 0.1, "scale_hi": t + 0.1, "outcome": "collapse"}
+        | {"status": "completed", "note": ""}
+        for name, t in (("elcentro.AT2", 1.5), ("kobe.AT2", 0.8), ("northridge.AT2", 1.1))
+    ]
+    plots.threshold_curve(rows, "scale", "record", tmp_path / "t.png", "thresholds", (0.5, 3.0))
+    axes = [
+        SimpleNamespace(name="scale", values=(0.5, 3.0)),
+        SimpleNamespace(name="record", values=[r["record"] for r in rows]),
+    ]
+    rrd = record_study(
+        tmp_path / "t.rrd", "s", rows, SimpleNamespace(axes=axes, find="scale"), None, "pga", tmp_path / "t.png"
+    )
+    series = recorded_series(rrd, "study/thresholds")
+    assert "/study/thresholds/line" not in series
+    points = series["/study/thresholds/points"]
+    assert points["x"] == [0, 1, 2] and points["y"] == [1.5, 0.8, 1.1] and points["label"] == "scale_threshold"
+    assert list(png_figures[0]) == ["scale_threshold"]
+    # numeric x keeps its line (a threshold against friction is a curve)
+    assert [c.key for c in threshold_series(rows, "scale", np.arange(3.0), (0.5, 3.0))][:2] == ["line", "points"]
+
+
+def test_thresholds_along_record_names_draw_no_line_in_the_png(tmp_path, monkeypatch):
+    import matplotlib.figure
+
+    drawn = []
+    monkeypatch.setattr(matplotlib.figure.Figure, "savefig", lambda fig, path, **k: drawn.append(fig))
+    rows = [
+        {"record": n, "scale_threshold": t, "status": "completed", "outcome": "collapse"}
+        for n, t in (("a.AT2", 1.5), ("b.AT2", 0.8))
+    ]
+    plots.threshold_curve(rows, "scale", "record", tmp_path / "t.png", "thresholds", (0.5, 3.0))
+    styles = {line.get_linestyle() for line in drawn[0].axes[0].get_lines() if len(line.get_xdata())}
+    assert styles == {"None"}
+
+
 def test_a_threshold_the_outcome_holds_below_says_so_in_the_legend():
     """``--find friction --outcome sliding``: the block slides below the curve, not above it as for an
     amplitude; the line's label says which (rows of an upward search keep their label)."""

@@ -107,8 +107,12 @@ def fragility_series(rows: list[dict], im: str, fit, unit: str) -> list[Series]:
     return out
 
 
-def threshold_series(rows: list[dict], find: str, at: np.ndarray, searched: tuple[float, float]) -> list[Series]:
-    """``<find>_threshold`` at ``at`` (each row's position on the x axis) as a line with its points, and
+def threshold_series(
+    rows: list[dict], find: str, at: np.ndarray, searched: tuple[float, float], joined: bool = True
+) -> list[Series]:
+    """``<find>_threshold`` at ``at`` (each row's position on the x axis) as a line with its points (points
+    alone unless ``joined``: along record names, whose order is alphabetical, a line between two records
+    reads as a trend between them that does not exist), and
     the points where the search found none, marked at the searched range's top (``searched`` = the
     lowest and highest value tried first) when the outcome was not reached up to it, at its bottom when
     it was reached already there; a failed search (status error) is left out. The line's label says when
@@ -129,9 +133,11 @@ def threshold_series(rows: list[dict], find: str, at: np.ndarray, searched: tupl
     elif "below" in sides:
         label += f": {outcome} above it, below where holds = below"
     lo_v, hi_v = searched
+    x_found, y_found = at[found][order], y[found][order]
+    curve = [Series("line", label, THRESHOLD_COLOUR, "line", x_found, y_found)] if joined else []
     return [
-        Series("line", label, THRESHOLD_COLOUR, "line", at[found][order], y[found][order]),
-        Series("points", label + ": points", THRESHOLD_COLOUR, "circle", at[found][order], y[found][order]),
+        *curve,
+        Series("points", label + (": points" if joined else ""), THRESHOLD_COLOUR, "circle", x_found, y_found),
         Series(
             "not_found/above",
             f"none found: no {outcome} up to {find} = {hi_v:g}",

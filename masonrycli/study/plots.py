@@ -134,7 +134,7 @@ def threshold_figure(rows: list[dict], find: str, x: str | None, title: str, sea
     plt = _pyplot()
     fig, ax = plt.subplots(figsize=(6.0, 4.0))
     at, names = axis_positions(rows, x)
-    _draw(ax, threshold_series(rows, find, at, searched))
+    _draw(ax, threshold_series(rows, find, at, searched, joined=names is None))
     if names is not None:
         ax.set_xticks(range(len(names)), names, rotation=45)
     elif not x:  # the points in order, numbered from 1 (one point was ticked -0.04 … 0.04 around 0)
