@@ -154,9 +154,12 @@ def test_existing_outputs_are_refused_without_force_and_replaced_with_it(block, 
     result = invoke("sweep", block, *more)
     assert result.exit_code == 2 and f"--histories {h / 'amp=0.1.npz'}: the file exists" in result.output
     assert _files(tmp_path) == before
-    # --force replaces: the other study's rows go, the plot and the recording are new
+    # --force replaces: the other study's rows go, the plot and the recording are new; it says whose rows
+    # went (it replaced another study's table without a word of whose it was)
+    study = read_rows(out)[0]["study"]
     result = invoke("sweep", block, *other, "--force")
     assert result.exit_code == 0, result.output
+    assert f"--out {out}: --force replaces 2 rows over amp of study {study[:12]}" in words(result.output)
     assert [r["time"] for r in read_rows(out)] == [pytest.approx(0.04)] * 2
     after = _files(tmp_path)
     assert (tmp_path / "s.png").stat().st_ino != png and after["s.rrd"] != before["s.rrd"]  # a new file each

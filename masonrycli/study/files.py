@@ -32,10 +32,13 @@ def check_picture(path: Path | None, option: str, suffix: str, force: bool) -> O
     return None if path is None else check_output(path, option, suffix, force)
 
 
-def open_table(out: Path, study_id: str, force: bool, names: list[str], points: list[dict]) -> tuple[OutputFile, list]:
+def open_table(
+    out: Path, study_id: str, force: bool, names: list[str], points: list[dict], warn=None
+) -> tuple[OutputFile, list]:
     """Check the table ``out`` for the study ``study_id`` over ``points`` (rows keyed by ``names``):
     ``(its OutputFile, the rows of this study already in it and its journal)``. Raises
-    :class:`InputError` for a table that is not this study's unless ``force`` (see the module docstring)."""
+    :class:`InputError` for a table that is not this study's unless ``force`` (see the module docstring);
+    with ``force``, says through ``warn`` whose rows it replaces."""
     suffix = out.suffix.lower()
     try:
         rows = store.read_rows(out)
@@ -46,6 +49,8 @@ def open_table(out: Path, study_id: str, force: bool, names: list[str], points: 
     keys = {store.row_key(p, names) for p in points}
     ours = [r for r in rows if r.get("study") == study_id and store.row_key(r, names) in keys]
     foreign = len(ours) < len(rows)  # another study's rows, or points not in this grid: they would be lost
+    if foreign and force and warn is not None:
+        warn(f"--out {out}: --force replaces {_whose([r for r in rows if r not in ours])}")
     if out.exists():
         table = check_output(out, "--out", suffix, force or (bool(ours) and not foreign))
         table.force = True  # checked: this study's own table, or --force
@@ -55,6 +60,20 @@ def open_table(out: Path, study_id: str, force: bool, names: list[str], points: 
             raise InputError(f"--out {out}: {journal} holds rows of another study or grid (add --force to replace it)")
         table = check_output(out, "--out", suffix, force)
     return table, ours
+
+
+def _whose(rows: list[dict]) -> str:
+    """What the rows about to be dropped were: how many, over which parameters, of which study. --force
+    replaced another study's table without a word of whose it was."""
+    params = []
+    for key in rows[0]:
+        if key in ("state", "status") or key.endswith("_threshold"):
+            break  # a row's parameters come first (study.py's columns)
+        params.append(key)
+    studies = sorted({str(r.get("study") or "?")[:12] for r in rows})
+    over = f" over {', '.join(params)}" if params else ""
+    plural = "s" if len(rows) != 1 else ""
+    return f"{len(rows)} row{plural}{over} of study {', '.join(studies)} (not this study's rows or grid)"
 
 
 def check_histories(

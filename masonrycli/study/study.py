@@ -113,7 +113,7 @@ def run_study(base: StudyBase, request: StudyRequest, console: Console) -> Study
     study_id = prepare(base, request)
     names = [a.name for a in request.axes if a.name != request.find]  # a row's key
     points = grid([a for a in request.axes if a.name != request.find])
-    table, ours = files.open_table(request.out, study_id, request.force, names, points)
+    table, ours = files.open_table(request.out, study_id, request.force, names, points, request.warn)
     # run again: error rows, and "failed" ones (tables written before those became error rows)
     done = {store.row_key(r, names): r for r in ours if r.get("status") not in ("error", "failed")}
     if request.find:
