@@ -130,6 +130,18 @@ def csv_header(path) -> tuple[int, str] | None:
     return None
 
 
+def header_quantity(path) -> str | None:
+    """ "acceleration" or "velocity" when the header of the CSV record at ``path`` names that quantity or its
+    units and not the other one, else None. Where no option or key says what a CSV holds (``--record``,
+    ``--records``), this is how it is read: an accelerogram with a header "time (s), acc (m/s²)" could not be
+    run or swept at all (refused as read as velocity, with no option to say otherwise)."""
+    found = csv_header(path)
+    if found is None:
+        return None
+    says_acc, says_vel = bool(_ACCELERATION.search(found[1])), bool(_VELOCITY.search(found[1]))
+    return "acceleration" if says_acc and not says_vel else "velocity" if says_vel and not says_acc else None
+
+
 def check_csv_header(path, name: str, quantity, scale) -> None:
     """Raise :class:`InputError` if the header of the CSV record at ``path`` names units that disagree
     with reading it as ``quantity`` ("velocity" m/s or "acceleration" m/s²) times ``scale``, or gives
@@ -147,7 +159,7 @@ def check_csv_header(path, name: str, quantity, scale) -> None:
         unit = "m/s" if quantity == "velocity" else "m/s²"
         raise InputError(
             f"{where}: the header says {other} ({shown}) but the samples are read as {quantity}, {unit} "
-            f'(a scenario file\'s record motion takes quantity = "{other}"; --record reads a CSV as velocity)'
+            f'(a scenario file\'s record motion takes quantity = "{other}")'
         )
     unit = _SCALED_UNIT.search(text)
     if unit and isinstance(scale, (int, float)) and scale == 1.0:

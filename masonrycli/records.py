@@ -24,7 +24,7 @@ import numpy as np
 from masonrycli.errors import NOT_A_FILE, InputError, RecordWarning, file_kind, not_utf8, special_file
 from masonrycli.record_motion import Record, time_step_problem
 from masonrycli.record_text import NoTimeStep, TimeStepNotUsed, at2_text, csv_text, number
-from masonrycli.record_units import check_at2_header, check_csv_header, record_text
+from masonrycli.record_units import check_at2_header, check_csv_header, header_quantity, record_text
 from masonrycli.values import format_value, quote_string, shorten
 
 
@@ -202,8 +202,8 @@ def record_motion(
 ) -> Record:
     """A :class:`~masonrycli.record_motion.Record` from a record file (.AT2 or CSV, see :func:`read_record`).
 
-    ``quantity`` defaults to "acceleration" for .AT2 files (the only one they hold) and "velocity" for
-    CSV. ``vertical`` is the file of the vertical component (the record then acts along x and y and
+    ``quantity`` defaults to "acceleration" for .AT2 files (the only one they hold) and, for CSV, to the
+    quantity its header names (:func:`~masonrycli.record_units.header_quantity`), else "velocity". ``vertical`` is the file of the vertical component (the record then acts along x and y and
     ``direction`` is not used). ``source`` is the absolute path of the file. ``time_step`` (s): the
     files hold one value per line at that spacing (checked before they are read).
     """
@@ -211,7 +211,7 @@ def record_motion(
     time, value, native = read_record(path, display, time_step)
     if native is not None and quantity not in (None, native):
         raise InputError(f"{display or path}: an .AT2 file holds acceleration, not {quantity}")
-    quantity = quantity or native or "velocity"
+    quantity = quantity or native or header_quantity(path) or "velocity"  # a CSV: as its header says, else m/s
     if native is None:
         check_csv_header(path, display or str(path), quantity, scale)
     vertical_source = ""

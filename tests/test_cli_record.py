@@ -248,3 +248,25 @@ def test_record_dt_errors_are_one_line(one_column, at2, command, args, line):
     for name, path in files.items():
         line = line.replace(f"error: {name}", f"error: {path}")
     assert result.output.strip() == line and "Traceback" not in result.output
+
+
+def test_a_csv_accelerogram_is_read_as_its_header_says(tmp_path):
+    """A CSV of acceleration in m/s² (header "time (s),acc (m/s2)") was refused by --record ("the header
+    says acceleration ... but the samples are read as velocity") with no option to say otherwise: it is now
+    read as acceleration, exactly as a scenario file's quantity = "acceleration" reads it."""
+    t, u, v, a = band_limited(0.2, 0.01, [3.0, 5.0], [0.004, 0.002], seed=4)
+    csv = tmp_path / "acc.csv"
+    csv.write_text("time (s),acc (m/s2)\n" + "".join(f"{ti!r},{ai!r}\n" for ti, ai in zip(t.tolist(), a.tolist())))
+    npz = tmp_path / "h.npz"
+    args = ["simulate", "wall", "--blocks", 12, "--record", csv, "--duration", 0.1, "--record-every", 1]
+    result = invoke(*args, "--no-recording", "--history", npz)
+    assert result.exit_code == 0, result.output
+    h = np.load(npz)
+    explicit = record_motion(csv, quantity="acceleration")
+    np.testing.assert_array_equal(h["support_v"][:, 0, :], explicit.velocity_at(h["time"]))
+    assert record_motion(csv).quantity == "acceleration"
+    # a velocity header, or none, is velocity as before
+    csv.write_text("time,v (m/s)\n0,0\n0.01,0.1\n")
+    assert record_motion(csv).quantity == "velocity"
+    csv.write_text("0,0\n0.01,0.1\n")
+    assert record_motion(csv).quantity == "velocity"

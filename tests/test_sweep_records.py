@@ -7,6 +7,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import numpy as np
 import pytest
 from typer.testing import CliRunner
 
@@ -47,3 +48,22 @@ def test_a_set_with_a_one_column_file_sweeps_on_worker_processes(tmp_path):
     assert again.exit_code == 0 and "(0 runs now, 4 rows already there, 0 failed)" in words(again.output), again.output
     again = invoke(*args, "--record-dt", 0.02, "--workers", 0, "--force")
     assert again.exit_code == 0 and "(4 runs now, 0 rows already there, 0 failed)" in words(again.output), again.output
+
+
+def test_a_set_of_csv_accelerograms_is_swept(tmp_path):
+    """CSV accelerograms in m/s² could not be swept: --records read every CSV as velocity and refused their
+    "acc (m/s2)" header. Read as their header says, each row's PGA is that of its own samples."""
+    folder = tmp_path / "records"
+    folder.mkdir()
+    t, _, _, a = band_limited(0.2, 0.01, [3.0, 5.0], [0.004, 0.002], seed=4)
+    (folder / "acc.csv").write_text(
+        "time (s),acc (m/s2)\n" + "".join(f"{x!r},{y!r}\n" for x, y in zip(t.tolist(), a.tolist()))
+    )
+    out = tmp_path / "s.csv"
+    args = ["sweep", BLOCK, "--records", folder, "--scale", "1,2", "--duration", 0.2, "--out", out, "--no-recording"]
+    result = invoke(*args, "--workers", 0)
+    assert result.exit_code == 0, result.output
+    rows = {r["scale"]: r for r in read_rows(out)}
+    assert {r["status"] for r in rows.values()} == {"completed"}
+    assert rows[2.0]["pga"] == pytest.approx(2 * rows[1.0]["pga"], rel=1e-9)
+    assert rows[1.0]["pga"] == pytest.approx(np.abs(a).max(), rel=0.05)  # the record's samples, baseline-corrected
