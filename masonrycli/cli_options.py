@@ -144,8 +144,8 @@ RUN = {
     "solver": _opt(
         str,
         "Run",
-        "Contact solver: nlgs-accel (default; Gauss–Seidel with momentum, 2-4x fewer sweeps), nlgs-accel32 "
-        "(the same, first sweeps in float32: faster on walls of ~16 courses, slower on 32) or nlgs (plain "
+        "Contact solver: nlgs-accel32 (default; Gauss–Seidel with momentum, 2-4x fewer sweeps, its first "
+        "sweeps in float32, each step judged in float64), nlgs-accel (the same all in float64) or nlgs (plain "
         "Gauss–Seidel, the reference).",
         parser=choice_value,
     ),

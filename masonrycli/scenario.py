@@ -44,7 +44,7 @@ MAX_BLOCK_SPEED = 1e3
 """m/s — an initial block velocity moving a point of the block faster (|v| + |ω|·r, r the farthest vertex
 from the centroid) is refused as a likely typo: run.py calls a block that fast diverged (a block given
 ``velocity = [1e9, 0, 0]`` ended as exit 3, "diverged at step 1")."""
-SOLVERS = ("nlgs-accel", "nlgs-accel32", "nlgs")
+SOLVERS = ("nlgs-accel32", "nlgs-accel", "nlgs")
 """Contact solvers a run can select (RunConfig.solver); the first is the default."""
 
 # --------------------------------------------------------------------------------------------------
@@ -62,10 +62,11 @@ class RunConfig:
     gravity : (gx, gy) m/s², a vector (tilt it for tilting tests).
     tolerance : m/s, NLGS stopping test: RMS contact-law violation of a sweep (engine.nlgs), in (0, 1).
     max_iterations : NLGS sweep cap per step, >= 1.
-    solver : the contact solver, one of ``SOLVERS``: "nlgs-accel" (default) Gauss–Seidel with Nesterov
-        momentum; "nlgs-accel32" the same with its first sweeps in single precision (faster on walls of
-        about 16 courses, slower on 32: README, Performance); "nlgs" plain Gauss–Seidel, the reference to
-        compare them with (engine.nlgs).
+    solver : the contact solver, one of ``SOLVERS``: "nlgs-accel32" (default) Gauss–Seidel with Nesterov
+        momentum, its first sweeps in single precision and the step judged by the float64 test (0.69–0.88×
+        the CPU of "nlgs-accel" over 1 s of shaken walls of 16–64 courses: README, Performance);
+        "nlgs-accel" the same all in double precision; "nlgs" plain Gauss–Seidel, the reference to compare
+        them with (engine.nlgs).
     record_every : record one frame every this many steps, >= 1.
     alert_distance : m, contacts with a gap below this are kept, > 0 (and at most the structure's extent:
         :class:`Scenario` checks that, knowing the blocks).
@@ -79,7 +80,7 @@ class RunConfig:
     max_iterations: int = 100000
     record_every: int = 10
     alert_distance: float = 1e-3
-    solver: str = "nlgs-accel"
+    solver: str = "nlgs-accel32"
 
     def __post_init__(self):
         put = lambda k, v: object.__setattr__(self, k, v)  # noqa: E731

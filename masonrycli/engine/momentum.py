@@ -1,4 +1,4 @@
-"""Gauss–Seidel with momentum: the sweep of solver "nlgs-accel", the engine's default.
+"""Gauss–Seidel with momentum: the sweep of solvers "nlgs-accel" and "nlgs-accel32" (the default).
 
 This module's kernel is the scalar sweep in the engine's interleaved order (4 runs): stalled.py's momentum
 stages use it, and the first stage did until :mod:`masonrycli.engine.lane_sweeps` (the same rule, 8 runs,

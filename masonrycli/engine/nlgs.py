@@ -41,7 +41,7 @@ the aqueduct's first 0.2 s, with steps of up to 33 292 sweeps that end just unde
 golden history are bit-identical (a 2000-sweep window changed them and left one step of the 32-course
 wall unconverged). Tolerance 0 runs exactly the cap.
 
-Acceleration (solver "nlgs-accel", the default; "nlgs" is the plain sweep, kept as the reference): the
+Acceleration (solvers "nlgs-accel32", the default, and "nlgs-accel"; "nlgs" is the plain sweep): the
 same sweep started from a Nesterov extrapolation of the last two sweeps (:mod:`masonrycli.engine.momentum`),
 its first stage visiting the contacts in 8 interleaved runs, 8 contacts at once in vectors
 (:mod:`masonrycli.engine.lane_sweeps`; ``LANES``). A stalled accelerated solve goes on by the methods of :mod:`masonrycli.engine.stalled` (momentum turning
