@@ -48,7 +48,7 @@ PASSES = 3
 def capture(case: str, duration: float, every: int) -> list[tuple]:
     """Inputs of every ``every``-th call of ``nlgs._nlgs_interleaved`` made by ``nlgs.solve`` on ``case``."""
     sys.path.insert(0, str(ROOT))
-    from benchmarks.solver_cases import make_scenario
+    from benchmarks.solver_cases import FLOAT64, make_scenario
     from masonrycli.engine import nlgs
     from masonrycli.run import Simulation, simulate
 
@@ -65,7 +65,7 @@ def capture(case: str, duration: float, every: int) -> list[tuple]:
 
     nlgs._nlgs_interleaved = keep
     try:
-        scenario = make_scenario(case, duration)
+        scenario = make_scenario(case, duration, solver=FLOAT64)  # the float64 first stage it times
         simulate(scenario, [], sim=Simulation(scenario))
     finally:
         nlgs._nlgs_interleaved = kernel

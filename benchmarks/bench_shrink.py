@@ -34,6 +34,7 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
 from benchmarks.bench_solver import run_masonry  # noqa: E402
+from benchmarks.solver_cases import FLOAT64  # noqa: E402
 from benchmarks.solver_reference import TIGHT, errors_pct  # noqa: E402
 from masonrycli.engine import interleaved, nlgs, shrink, stalled  # noqa: E402
 
@@ -74,7 +75,7 @@ def one_run(case: str, duration: float | None, every: int, record: bool) -> dict
     nlgs._nlgs_interleaved, interleaved._shrinking = timer(sweeps), timer(shrinking)
     stalled.continue_stalled = counted
     try:
-        row = run_masonry(case, duration, record)
+        row = run_masonry(case, duration, record, solver=FLOAT64)
     finally:
         shrink.CHECK_EVERY = saved
         nlgs._nlgs_interleaved, interleaved._shrinking, stalled.continue_stalled = sweeps, shrinking, cont
@@ -116,7 +117,7 @@ def per_step(case: str, duration: float | None, values: list[int]) -> dict:
     shrink.CHECK_EVERY = 0
     nlgs._nlgs_interleaved = both
     try:
-        run_masonry(case, duration, False)
+        run_masonry(case, duration, False, solver=FLOAT64)
     finally:
         nlgs._nlgs_interleaved, shrink.CHECK_EVERY = kernel, saved
     for e in values:

@@ -46,6 +46,12 @@ for _blocks, _length in LENGTH_SERIES.items():
     CASES[f"l{_blocks}"] = ("wall", {"blocks": None, "courses": 8, "length": _length}, 1.0, {"ground": SINE})
 
 
+FLOAT64 = "nlgs-accel"
+"""The accelerated solver in double precision: the tools that time or instrument the float64 first stage
+(``nlgs._nlgs_interleaved``, the lane sweeps) run it by name since the default, "nlgs-accel32", starts in
+float32."""
+
+
 def make_scenario(case: str, duration: float | None = None, **run_options):
     """The scenario of ``case``; ``run_options`` override RunConfig fields (tolerance, max_iterations…)."""
     builder, options, default_duration, motions = CASES[case]

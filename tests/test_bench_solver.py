@@ -16,12 +16,12 @@ def _run(cpu: float, top: float, mean: float, sweeps: float = 10.0) -> dict:
 def test_summary_takes_each_solvers_fastest_repeat_and_the_ratio_between_them():
     tight = {"sweeps_mean": 999.0, "unconverged": 0, "samples": {"100": (2.0, 4.0), "200": (1.0, 1.0)}}
     runs = {
-        "nlgs-accel": [_run(0.3, 2.02, 4.0), _run(0.2, 2.02, 4.0), _run(0.25, 2.02, 4.0)],
+        SOLVERS[0]: [_run(0.3, 2.02, 4.0), _run(0.2, 2.02, 4.0), _run(0.25, 2.02, 4.0)],
         "nlgs": [_run(0.9, 1.9, 3.0), _run(0.8, 1.9, 3.0), _run(1.1, 1.9, 3.0)],
     }
     pymunk = [{"cpu_s": 0.1, "sim_s": 0.5, "slips": {100: (1.0, 2.0)}}, {"cpu_s": 0.05, "sim_s": 0.5, "slips": {}}]
     row = bench_solver.summarise(runs, tight, pymunk)
-    accel, plain = row["solvers"]["nlgs-accel"], row["solvers"]["nlgs"]
+    accel, plain = row["solvers"][SOLVERS[0]], row["solvers"]["nlgs"]
     assert accel["cpu_per_sim_s"] == pytest.approx(0.4) and plain["cpu_per_sim_s"] == pytest.approx(1.6)
     assert accel["cpu_runs"] == [0.3, 0.2, 0.25]
     assert row["ratio_nlgs_over_default"] == pytest.approx(4.0) and accel["over_default"] == pytest.approx(1.0)
@@ -30,7 +30,7 @@ def test_summary_takes_each_solvers_fastest_repeat_and_the_ratio_between_them():
     assert plain["error_pct"] == {"100": pytest.approx((-5.0, -25.0))}
     assert row["tight"]["settings"]["solver"] == "nlgs" and row["tight"]["settings"]["tolerance"] == 1e-7
     assert row["pymunk"]["cpu_per_sim_s"] == pytest.approx(0.1)  # the faster repeat, with no sample
-    assert row["pymunk"]["ratio_over_pymunk"] == {"nlgs-accel": pytest.approx(4.0), "nlgs": pytest.approx(16.0)}
+    assert row["pymunk"]["ratio_over_pymunk"] == {SOLVERS[0]: pytest.approx(4.0), "nlgs": pytest.approx(16.0)}
     assert row["pymunk"]["error_pct"] == {}
 
 

@@ -30,7 +30,7 @@ from masonrycli.motion import Sine
 from masonrycli.outputs import OutputFile
 from masonrycli.recording import inspect_recording
 from masonrycli.run import Simulation
-from masonrycli.scenario import Material, RunConfig, Scenario
+from masonrycli.scenario import SOLVERS, Material, RunConfig, Scenario
 from masonrycli.source_digest import source_commit
 
 from cli_helpers import invoke, signal_inside_a_ctypes_callback
@@ -80,7 +80,7 @@ def test_a_run_leaves_a_whole_history_and_recording_in_place(tmp_path):
     run = json.loads(str(h["run"]))
     assert run["scenario"] == "one-block" and run["dt_s"] == DT and run["source_digest"] == SOURCE_DIGEST
     assert run["commit"] == source_commit() and run["commit"] in info["metadata"]
-    head = f"**solver:** nlgs-accel · **masonry** {run['masonry']}, commit {run['commit']}, source {SOURCE_DIGEST}"
+    head = f"**solver:** {SOLVERS[0]} · **masonry** {run['masonry']}, commit {run['commit']}, source {SOURCE_DIGEST}"
     assert head in info["metadata"].split("## Parameters")[0]
 
 

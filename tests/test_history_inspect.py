@@ -18,6 +18,7 @@ from masonrycli.execute import run_metadata
 from masonrycli.history import HistoryFile
 from masonrycli.history_inspect import NOT_RECORDED, inspect_history, is_history
 from masonrycli.run import Simulation, simulate
+from masonrycli.scenario import SOLVERS
 
 from cli_helpers import assert_one_line_error, invoke
 
@@ -64,7 +65,7 @@ def test_a_run_history_is_summarised_from_its_own_arrays(history):
     rows = _rows(result.output)
     assert rows["scenario"] == "wall (builder:wall)"
     assert rows["status"] == "completed"
-    assert rows["solver"] == "nlgs-accel"
+    assert rows["solver"] == SOLVERS[0]  # the default
     assert rows["tolerance"].startswith("1e-05 m/s")
     assert rows["dt"].startswith("0.001 s (duration 0.02 s")
     assert f"commit {run['commit']}" in rows["masonry"] and f"source {run['source_digest']}" in rows["masonry"]

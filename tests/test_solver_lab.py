@@ -19,7 +19,7 @@ from masonrycli.scenario import Material, RunConfig, scenario_from_builder
 
 def _captured(tmp_path):
     sc = scenario_from_builder(
-        "wall", {"blocks": 7, "courses": 2}, RunConfig(duration=0.03), Material(), {"ground": SINE}
+        "wall", {"blocks": 7, "courses": 2}, RunConfig(duration=0.03, solver="nlgs-accel"), Material(), {"ground": SINE}
     )
     # Step 15: on this run (default solver nlgs-accel) steps 18-28 each have a contact sitting exactly on
     # its friction limit, where the reference's Gauss–Seidel settles into a stick/slip cycle at 2-3e-9 m/s,

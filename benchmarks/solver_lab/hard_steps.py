@@ -135,8 +135,10 @@ def _capture_run(case, motion, copy, min_units, duration, directory) -> tuple[di
     builder, options, _, _ = CASES[case]
     amplitude, frequency, phase = motion
     ground = Sine(amplitude=amplitude * (1.0 + copy * COPY_STEP), frequency=frequency, phase=phase)
-    scenario = scenario_from_builder(builder, options, RunConfig(duration=duration), Material(), {"ground": ground})
-    sim = Simulation(scenario)
+    scenario = scenario_from_builder(
+        builder, options, RunConfig(duration=duration, solver="nlgs-accel"), Material(), {"ground": ground}
+    )
+    sim = Simulation(scenario)  # the float64 solver: the replays' (below)
     solve = nlgs.solve
     step, kept, units = [0], {}, []
 
