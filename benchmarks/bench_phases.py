@@ -65,7 +65,7 @@ def worker(package_root: str, case: str, duration: float, record: bool) -> None:
     import numpy as np
 
     from benchmarks import bench_solver
-    from masonrycli.engine import fused, nlgs, stalled
+    from masonrycli.engine import fused, nlgs, power, stalled
     from masonrycli.recording import Recorder
 
     assert Path(nlgs.__file__).is_relative_to(package_root), nlgs.__file__
@@ -73,7 +73,7 @@ def worker(package_root: str, case: str, duration: float, record: bool) -> None:
     for owner, name, key in (
         (fused, "before_solve", "before_solve"), (nlgs, "prepare_contacts", "prepare"), (nlgs, "solve", "solve"),
         (nlgs, "_nlgs_interleaved", "solve.sweeps"), (stalled, "continue_stalled", "solve.stalled"),
-        (nlgs, "contact_power", "contact_power"), (fused, "after_solve", "after_solve"),
+        (power, "contact_power", "contact_power"), (fused, "after_solve", "after_solve"),
         (Recorder, "on_frame", "record"), (Recorder, "close", "record"),
     ):  # fmt: skip
         _timed(owner, name, key, totals)

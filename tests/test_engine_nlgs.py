@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from masonrycli.engine import momentum, nlgs
+from masonrycli.engine import momentum, nlgs, power
 
 RNG = np.random.default_rng(20261121)
 
@@ -159,7 +159,7 @@ def test_contact_power_matches_dense_definitions():
     dynamic = np.array([True, True, True, False])
     force = np.zeros((count, 2))
     support_force = np.zeros((1, 2))
-    dissipated, work = nlgs._contact_power(body, pack, r, count, v_old, v_new, dynamic, 3, dt, force, support_force)
+    dissipated, work = power._contact_power(body, pack, r, count, v_old, v_new, dynamic, 3, dt, force, support_force)
     h = _dense_h(q, body, point, normal)
     u_mean = h.T @ (0.5 * (v_old + v_new)).ravel()
     assert dissipated == pytest.approx(-(r.ravel() @ u_mean), rel=1e-12)

@@ -8,7 +8,7 @@
    no contact warm-started (first step): static guess  warmstart.static_guess
 6. NLGS → r, v_n+1                                     nlgs.solve
    a structure at rest: the solve continued to a tighter tolerance   Solver._settle
-7. contact forces, dissipation, support work           nlgs.contact_power
+7. contact forces, dissipation, support work           power.contact_power
 8. q_n+1 = q_n + dt (θ v_n+1 + (1 − θ) v_n)            integrate.update_q
 9. keep the keys and impulses for step 3 next time    warmstart.WarmStart.remember
 
@@ -39,7 +39,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from masonrycli.engine import fused, integrate, nlgs, warmstart
+from masonrycli.engine import fused, integrate, nlgs, power, warmstart
 from masonrycli.engine.collision import ContactBuffers, detect_contacts
 
 REST_SPEED = 1e-3
@@ -142,7 +142,7 @@ class Solver:
     def contact_tangential_velocity(self, body_v: np.ndarray) -> np.ndarray:
         """(C,) m/s: u_t of the last step's contacts for velocities ``body_v`` (B, 3), with the step's
         lever arms (called for recorded frames only)."""
-        return nlgs.tangential_velocity(self.buffers.contact_body, self._pack, self._count, body_v)
+        return power.tangential_velocity(self.buffers.contact_body, self._pack, self._count, body_v)
 
     def detect(self, body_q: np.ndarray, alert: float | None = None) -> int:
         """Contacts of configuration ``body_q`` within ``alert`` (default: the model's alert distance)
@@ -196,7 +196,7 @@ class Solver:
         if rest and budget > 0 and m.tolerance * REST_TIGHTEN < residual <= m.tolerance:
             more, residual = self._settle(state, count, residual, budget)
             iterations += more
-        dissipated, work = nlgs.contact_power(
+        dissipated, work = power.contact_power(
             body, self._pack, self._r, count, self._v_old, state.body_v, m, self._force, self.support_force
         )
         block_speed, penetration = fused.after_solve(self, state, count)  # steps 8–9

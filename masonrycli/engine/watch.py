@@ -30,7 +30,7 @@ def _watch(body_q, body_v, q0, height, n, top, contact_body, pack, status, count
     for c in range(count):
         if status[c] == 0:  # open
             continue
-        a, b = np.uint32(contact_body[c, 0]), np.uint32(contact_body[c, 1])  # unsigned: nlgs._contact_power
+        a, b = np.uint32(contact_body[c, 0]), np.uint32(contact_body[c, 1])  # unsigned: power._contact_power
         ut, _ = _relative_velocity(body_v, a, b, pack, np.uint64(c))
         slide = max(slide, abs(ut))
     top_dx = 0.0
