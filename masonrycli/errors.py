@@ -62,6 +62,25 @@ FILE_KINDS = {  # suffix: (what a file of it is, what to do with it), for an inp
 "wall.geojson:2: not a number": the input's name says what it is."""
 
 
+TEXT_SUFFIXES = frozenset({".toml", ".geojson", ".json", ".wkt", ".csv", ".at2"})
+"""Suffixes of text files: a binary file under one was named "a scenario file (TOML)" by inspect and --record."""
+
+
+def suffix_is_text(path) -> bool:
+    """Whether ``path``'s suffix is one of a text file masonry reads (TEXT_SUFFIXES)."""
+    import os
+
+    return os.path.splitext(os.fspath(path))[1].lower() in TEXT_SUFFIXES
+
+
+def _holds_nul(path) -> bool:
+    try:
+        with open(path, "rb") as fh:
+            return b"\x00" in fh.read(4096)
+    except OSError:  # missing or unreadable: the reader says so
+        return False
+
+
 def file_kind(path, expected: str, skip: tuple[str, ...] = (), name: str | None = None) -> InputError | None:
     """The error for an input whose suffix names another kind of file than the one ``expected`` (said in
     the message: "a scenario"), or None (an unknown suffix, or one in ``skip``: the reader decides).
@@ -72,6 +91,8 @@ def file_kind(path, expected: str, skip: tuple[str, ...] = (), name: str | None 
     if suffix not in FILE_KINDS or suffix in skip:
         return None
     kind, hint = FILE_KINDS[suffix]
+    if suffix in TEXT_SUFFIXES and _holds_nul(path):  # a binary file so named is none of these
+        kind, hint = "not a text file (it holds NUL bytes: a binary file)", ""
     return InputError(
         f"{os.fspath(path) if name is None else name}: {kind}, not {expected}{'; ' if hint else ''}{hint}"
     )

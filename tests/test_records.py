@@ -539,3 +539,19 @@ def test_one_column_errors_in_a_scenario(tmp_path, motion, expected):
     message = one_line(exc)
     # the line of the motion (SCENARIO's 9th: its motion = { … } inline table, tests/test_toml_lines.py)
     assert message.startswith('s.toml:9: [[support]] #1 ("ground"): ' + expected), message
+
+
+def test_a_binary_file_under_a_text_suffix_is_not_named_by_its_suffix(tmp_path):
+    """A binary file named bin.toml was "a scenario file (TOML)" for --record and inspect (check and run said
+    "not a text file"): its bytes are looked at before its suffix names it."""
+    from masonrycli.recording.readback import recording_path_problem
+
+    binary = tmp_path / "bin.toml"
+    binary.write_bytes(b"ab\x00cd\x01\x02")
+    with pytest.raises(InputError, match=r"bin\.toml: not a text file \(it holds NUL bytes: a binary file\), not a"):
+        record_motion(binary)
+    assert "not a text file (it holds NUL bytes" in recording_path_problem(binary)
+    text = tmp_path / "s.toml"
+    text.write_text('name = "s"\n')
+    with pytest.raises(InputError, match=r"s\.toml: a scenario file \(TOML\), not a ground-motion record"):
+        record_motion(text)
