@@ -214,3 +214,40 @@ def test_the_colour_bars_stand_right_of_where_the_blocks_went(tmp_path):
     width = last_static(path, f"/{PLANE}", "Pinhole:resolution")[0][0]
     ticks = legend_positions((bar.min(), 0.0, bar.max(), 1.0))[:5, 0]
     assert x0 + width > ticks.max()
+
+
+def test_the_view_holds_a_structure_that_went_left(tmp_path):
+    """The view was fitted left to the structure as built: a wall drifting or falling left left it. At
+    close the view widens left to the smallest x a block reached; the bars stay right of the blocks."""
+    import rerun as rr
+
+    def last_static(path, entity, column):
+        value = None
+        for chunk in rr.chunk.RrdReader(path).stream():
+            if chunk.entity_path == entity and chunk.is_static:
+                batch = chunk.to_record_batch()
+                if column in batch.schema.names:
+                    value = batch.column(column).to_pylist()[-1]
+        return value
+
+    static, q0 = fx.wall()
+    frames = fx.frames(static, q0, 12)
+    for k, f in enumerate(frames):
+        f.block_q[:, 0] -= 0.1 * k  # the wall drifts left, 1.1 m by the end
+    path = tmp_path / "left.rrd"
+    with Recorder(path, static, fx.METADATA, batch_frames=4) as rec:
+        for f in frames:
+            rec.log_frame(f)
+    start = static.block_vert_start
+    owner = np.repeat(np.arange(len(q0)), np.diff(start))
+    left = min(float((f.block_q[owner, 0] + static.block_vert_local[:, 0]).min()) for f in frames)
+    reach = max(float((f.block_q[owner, 0] + static.block_vert_local[:, 0]).max()) for f in frames)
+    from masonrycli.recording.layout import LEGEND_BARS, PLANE
+
+    x0 = last_static(path, f"/{PLANE}", "Transform3D:translation")[0][0]
+    assert x0 < left - 0.01, (x0, left)
+    dx = last_static(path, f"/{LEGEND_BARS}", "Transform3D:translation")
+    dx = dx[0][0] if dx is not None else 0.0
+    for f in rec_mod.FIELDS:
+        bar = np.array(last_static(path, f"/{f.bar}", "Mesh3D:vertex_positions"))[:, 0] + dx
+        assert bar.min() > reach + 0.01, (f.key, bar.min(), reach)

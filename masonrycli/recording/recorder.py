@@ -135,6 +135,7 @@ class Recorder:
         # (N,) m: a block's farthest vertex from its centroid, for the reach of the run (_clear_the_legend)
         self._radius = np.maximum.reduceat(np.hypot(*loc.T), first) if n else np.zeros(0)
         self._reach = -np.inf
+        self._reach_left = np.inf  # the smallest x: a collapse to the left widens the view that way
         # steps with a residual, those a decade under the tolerance, the largest, the smallest of the others
         self._residuals = [0, 0, 0.0, np.inf]
         self._glyph_length = GLYPH_HALF_LENGTH * float(np.median(size.min(axis=1)))
@@ -327,7 +328,9 @@ class Recorder:
         if self._ref is None:
             return
         q, sq, _ = self._ref
-        box, _ = log_plane(self.rec, self._blocks, self._supports, q, sq, reach=self._reach)
+        box, _ = log_plane(
+            self.rec, self._blocks, self._supports, q, sq, reach=self._reach, reach_left=self._reach_left
+        )
         shift = rr.Transform3D(translation=[box[0] - self._legend_box[0], 0.0, 0.0])
         for path in (LEGEND_BARS, LEGEND_LABELS):
             self.rec.log(path, shift, static=True)
@@ -362,6 +365,7 @@ class Recorder:
         q = b.stack("block_q")  # (F, N, 3)
         if self._n:
             self._reach = max(self._reach, float((q[..., 0] + self._radius).max()))
+            self._reach_left = min(self._reach_left, float((q[..., 0] - self._radius).min()))
         tensors = {key: b.stack(key) for key in TENSOR_KEYS}
         # A voussoir of a bare ring has no cell strain rate; its strain rate along the ring stands in.
         vsr = tensors["cell_volumetric_strain_rate"]

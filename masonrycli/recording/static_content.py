@@ -178,15 +178,18 @@ def log_plane(
     block_q: np.ndarray,
     support_q: np.ndarray,
     reach: float = -np.inf,
+    reach_left: float = np.inf,
 ) -> tuple[tuple[float, float, float, float], float]:
     """Pinhole and y-up transform sized to the structure at the first frame; returns the legend box and
     the structure's size (m). ``reach``: the largest x (m) a block reached in the run; the legend box
-    stands right of it and the view widens to hold it (the recorder's close)."""
+    stands right of it and the view widens to hold it (the recorder's close); ``reach_left``: the
+    smallest x a block reached, the view widens left to hold it (a wall falling left left the view)."""
     sup = supports.world(support_q[None])[0]
     blk = blocks.world(block_q[None])[0] if blocks.count else sup
     lo, hi = blk.min(axis=0), blk.max(axis=0)
     size = float(max(hi - lo)) or 1.0
     hi = np.array([max(float(hi[0]), float(reach)), hi[1]])
+    lo = np.array([min(float(lo[0]), float(reach_left)), lo[1]])
     if len(sup):  # show the supports, but a wide ground only a little beyond the blocks
         lo = np.minimum(lo, np.maximum(sup.min(axis=0), lo - _SUPPORT_MARGIN * size))
         hi = np.maximum(hi, np.minimum(sup.max(axis=0), hi + _SUPPORT_MARGIN * size))
