@@ -163,3 +163,16 @@ def temporal_rows(path, entity: str, column: str) -> dict[int, list]:
         for step, value in zip(batch.column("step").to_pylist(), batch.column(column).to_pylist()):
             out[step] = value
     return out
+
+
+def static_value(path, entity: str, column: str):
+    """The last static value of ``column`` logged at ``entity`` in the recording at ``path`` (None: none)."""
+    import rerun as rr
+
+    value = None
+    for chunk in rr.chunk.RrdReader(str(path)).stream():
+        if chunk.entity_path == entity and chunk.is_static:
+            batch = chunk.to_record_batch()
+            if column in batch.schema.names:
+                value = batch.column(column).to_pylist()[-1]
+    return value

@@ -40,14 +40,7 @@ def written(wall, tmp_path_factory):
     return path, static, frames, rec
 
 
-def static_value(path, entity: str, column: str):
-    value = None
-    for chunk in rr.chunk.RrdReader(path).stream():
-        if chunk.entity_path == entity and chunk.is_static:
-            batch = chunk.to_record_batch()
-            if column in batch.schema.names:
-                value = batch.column(column).to_pylist()[-1]
-    return value
+static_value = fx.static_value
 
 
 def world_outline(static, q: np.ndarray, b: int) -> np.ndarray:

@@ -179,25 +179,8 @@ def test_the_colour_bars_stand_right_of_where_the_blocks_went(tmp_path):
     """The bars stood right of the structure as built: 'masonry simulate wall --amp 2 --freq 1
     --stop-at-collapse' shook the wall 0.32 m right and it fell over the bar and its title. At close, the
     bars and their labels move right of the farthest x a block reached and the view widens to hold them."""
-    import rerun as rr
-
-    def last_static(path, entity, column):
-        value = None
-        for chunk in rr.chunk.RrdReader(path).stream():
-            if chunk.entity_path == entity and chunk.is_static:
-                batch = chunk.to_record_batch()
-                if column in batch.schema.names:
-                    value = batch.column(column).to_pylist()[-1]
-        return value
-
-    static, q0 = fx.wall()
-    frames = fx.frames(static, q0, 12)
-    for k, f in enumerate(frames):
-        f.block_q[:, 0] += 0.1 * k  # the wall drifts right, 1.1 m by the end
-    path = tmp_path / "drift.rrd"
-    with Recorder(path, static, fx.METADATA, batch_frames=4) as rec:
-        for f in frames:
-            rec.log_frame(f)
+    last_static = fx.static_value
+    path, static, q0, frames = _drifting_wall(tmp_path / "drift.rrd", 0.1)  # right, 1.1 m by the end
     start = static.block_vert_start
     owner = np.repeat(np.arange(len(q0)), np.diff(start))
     # unrotated outlines: the frames turn the blocks by 0.01 rad at most, under a millimetre here
@@ -219,25 +202,8 @@ def test_the_colour_bars_stand_right_of_where_the_blocks_went(tmp_path):
 def test_the_view_holds_a_structure_that_went_left(tmp_path):
     """The view was fitted left to the structure as built: a wall drifting or falling left left it. At
     close the view widens left to the smallest x a block reached; the bars stay right of the blocks."""
-    import rerun as rr
-
-    def last_static(path, entity, column):
-        value = None
-        for chunk in rr.chunk.RrdReader(path).stream():
-            if chunk.entity_path == entity and chunk.is_static:
-                batch = chunk.to_record_batch()
-                if column in batch.schema.names:
-                    value = batch.column(column).to_pylist()[-1]
-        return value
-
-    static, q0 = fx.wall()
-    frames = fx.frames(static, q0, 12)
-    for k, f in enumerate(frames):
-        f.block_q[:, 0] -= 0.1 * k  # the wall drifts left, 1.1 m by the end
-    path = tmp_path / "left.rrd"
-    with Recorder(path, static, fx.METADATA, batch_frames=4) as rec:
-        for f in frames:
-            rec.log_frame(f)
+    last_static = fx.static_value
+    path, static, q0, frames = _drifting_wall(tmp_path / "left.rrd", -0.1)  # left, 1.1 m by the end
     start = static.block_vert_start
     owner = np.repeat(np.arange(len(q0)), np.diff(start))
     left = min(float((f.block_q[owner, 0] + static.block_vert_local[:, 0]).min()) for f in frames)
@@ -251,3 +217,16 @@ def test_the_view_holds_a_structure_that_went_left(tmp_path):
     for f in rec_mod.FIELDS:
         bar = np.array(last_static(path, f"/{f.bar}", "Mesh3D:vertex_positions"))[:, 0] + dx
         assert bar.min() > reach + 0.01, (f.key, bar.min(), reach)
+
+
+def _drifting_wall(path, step: float):
+    """A wall whose frames drift by ``step`` m a frame (12 frames), recorded to ``path``:
+    (path, static, q0, frames)."""
+    static, q0 = fx.wall()
+    frames = fx.frames(static, q0, 12)
+    for k, f in enumerate(frames):
+        f.block_q[:, 0] += step * k
+    with Recorder(path, static, fx.METADATA, batch_frames=4) as rec:
+        for f in frames:
+            rec.log_frame(f)
+    return path, static, q0, frames
