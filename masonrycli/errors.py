@@ -64,20 +64,22 @@ FILE_KINDS = {  # suffix: (what a file of it is, what to do with it), for an inp
 
 TEXT_SUFFIXES = frozenset({".toml", ".geojson", ".json", ".wkt", ".csv", ".at2"})
 """Suffixes of text files: a binary file under one was named "a scenario file (TOML)" by inspect and --record."""
+BINARY_FILE = "not a text file (it holds NUL bytes: a binary file)"
+"""What a binary file read as text is called (no encoding makes it text: saving it "as UTF-8" is no advice)."""
 
 
-def suffix_is_text(path) -> bool:
-    """Whether ``path``'s suffix is one of a text file masonry reads (TEXT_SUFFIXES)."""
+def binary_under_text_suffix(path) -> bool:
+    """Whether ``path`` has a text file's suffix (TEXT_SUFFIXES) but NUL bytes in its first 4 kB: a binary
+    file that its name would have described as a scenario, a geometry or a record. False for a missing or
+    unreadable file (its reader says why)."""
     import os
 
-    return os.path.splitext(os.fspath(path))[1].lower() in TEXT_SUFFIXES
-
-
-def _holds_nul(path) -> bool:
+    if os.path.splitext(os.fspath(path))[1].lower() not in TEXT_SUFFIXES:
+        return False
     try:
         with open(path, "rb") as fh:
             return b"\x00" in fh.read(4096)
-    except OSError:  # missing or unreadable: the reader says so
+    except OSError:
         return False
 
 
@@ -91,8 +93,8 @@ def file_kind(path, expected: str, skip: tuple[str, ...] = (), name: str | None 
     if suffix not in FILE_KINDS or suffix in skip:
         return None
     kind, hint = FILE_KINDS[suffix]
-    if suffix in TEXT_SUFFIXES and _holds_nul(path):  # a binary file so named is none of these
-        kind, hint = "not a text file (it holds NUL bytes: a binary file)", ""
+    if binary_under_text_suffix(path):  # a binary file so named is none of these
+        kind, hint = BINARY_FILE, ""
     return InputError(
         f"{os.fspath(path) if name is None else name}: {kind}, not {expected}{'; ' if hint else ''}{hint}"
     )
@@ -104,7 +106,7 @@ def not_utf8(name: str, raw: bytes, exc: UnicodeDecodeError) -> InputError:
     if raw[:2] in (b"\xff\xfe", b"\xfe\xff"):
         return InputError(f"{name}: a UTF-16 text file (it starts with UTF-16's byte-order mark); save it as UTF-8")
     if b"\x00" in raw:  # no text in any encoding: saving it "as UTF-8" is no advice
-        return InputError(f"{name}: not a text file (it holds NUL bytes: a binary file)")
+        return InputError(f"{name}: {BINARY_FILE}")
     # the line, and what to do: "not a UTF-8 text file (byte 18)" left a user to count bytes for a "è" typed
     # in a comment by an editor saving in the Windows code page
     line = raw.count(b"\n", 0, exc.start) + 1

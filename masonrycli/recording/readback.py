@@ -18,7 +18,7 @@ import numpy as np
 import pyarrow as pa
 import rerun as rr
 
-from masonrycli.errors import NOT_A_FILE, suffix_is_text
+from masonrycli.errors import BINARY_FILE, NOT_A_FILE, binary_under_text_suffix
 from masonrycli.outputs import being_written
 from masonrycli.recording.layout import BLOCKS, CHAIN_KEY, FIELDS, HOVER_VALUES, METADATA, PER_STEP_SERIES, SERIES
 from masonrycli.recording.screenshot import _viewer_executable, screenshot_recording  # noqa: F401 (re-exported)
@@ -118,13 +118,12 @@ def _foreign_file(path: str | os.PathLike) -> str | None:
         return None
     try:
         with open(path, "rb") as f:
-            head = f.read(4096)
+            if f.read(len(_RRD_MAGIC)) == _RRD_MAGIC:
+                return None
     except OSError:  # unreadable: the reader says why
         return None
-    if head.startswith(_RRD_MAGIC):
-        return None
-    if suffix_is_text(path) and b"\x00" in head:  # a binary file under a text suffix is none of those kinds
-        kind = "not a text file (it holds NUL bytes: a binary file)"
+    if binary_under_text_suffix(path):  # a binary file under a text suffix is none of those kinds
+        kind = BINARY_FILE
     return f"{os.fspath(path)}: {kind}, not a recording; inspect reads the .rrd recordings that --out writes"
 
 
