@@ -62,3 +62,26 @@ def test_stages_split_each_step_into_the_units_the_engine_spent(tmp_path, monkey
         if not s["stage"]:  # momentum's own solve ended the step
             assert m["history"][-1] == s["residual"]
     assert any(s["stage"] for s in doc.values())
+
+
+def test_capture_by_the_float32_solver_replays_by_it(tmp_path):
+    # Steps captured from a run of "nlgs-accel32" (a shaken wall: no step at rest, which the engine would
+    # solve in float64) carry that solver: replayed, each gets the units the run spent on it, which the
+    # float64 path does not give them.
+    import numpy as np
+
+    hard_steps.capture(["h8"], 0, 1, [(1.0, 2.0, 0.0)], 0.03, tmp_path, solver="nlgs-accel32")
+    index = json.loads((tmp_path / "index-h8-c0.json").read_text())
+    assert {e["solver"] for e in index.values()} == {"nlgs-accel32"}
+    doc = hard_steps.replay(["main"], 1, None, None, directory=tmp_path)
+    assert {n: s["units"] for n, s in doc["variants"]["main"]["steps"].items()} == {
+        n: e["units"] for n, e in index.items()
+    }
+    as_float64 = {}
+    for name, entry in index.items():
+        if entry["solver"] == "nlgs-accel32":
+            z = dict(np.load(tmp_path / f"{name}.npz"))
+            z["solver"] = np.array("nlgs-accel")
+            np.savez_compressed(tmp_path / f"{name}.npz", **z)
+            as_float64[name] = hard_steps.replay_step(name, tmp_path)["units"]
+    assert any(as_float64[n] != index[n]["units"] for n in as_float64)

@@ -92,26 +92,28 @@ def capture(
     duration: float | None = None,
     directory=None,
     override: str | None = None,
+    solver: str = "nlgs-accel",
 ) -> None:
     """Run ``cases`` under the ensemble's motions; keep the steps of ``min_units`` or more (module doc), with
-    the constants of ``override`` (``MOD.NAME=VALUE[+…]``) set for the capture."""
+    the constants of ``override`` (``MOD.NAME=VALUE[+…]``) set for the capture, by ``solver`` (kept with each
+    step: its replay runs the same path)."""
     directory = directory or HARD  # read at the call: tests point HARD elsewhere
     directory.mkdir(parents=True, exist_ok=True)
     old = _set(_parse(override)) if override else {}
     try:
-        _capture_cases(cases, copy, min_units, motions, duration, directory, override)
+        _capture_cases(cases, copy, min_units, motions, duration, directory, override, solver)
     finally:
         _set(old)
 
 
-def _capture_cases(cases, copy, min_units, motions, duration, directory, override) -> None:
+def _capture_cases(cases, copy, min_units, motions, duration, directory, override, solver) -> None:
     from benchmarks.solver_lab import ensemble
 
     for case in cases:
         index_path = directory / f"index-{case}-c{copy}.json"  # one a capture process: cases run in parallel
         index = json.loads(index_path.read_text()) if index_path.exists() else {}
         for motion in motions or ensemble.MOTIONS:
-            kept, units = _capture_run(case, motion, copy, min_units, duration or ensemble.DURATION, directory)
+            kept, units = _capture_run(case, motion, copy, min_units, duration or ensemble.DURATION, directory, solver)
             if override:
                 for entry in kept.values():
                     entry["override"] = override
@@ -125,7 +127,7 @@ def _capture_cases(cases, copy, min_units, motions, duration, directory, overrid
             )
 
 
-def _capture_run(case, motion, copy, min_units, duration, directory) -> tuple[dict, list[int]]:
+def _capture_run(case, motion, copy, min_units, duration, directory, solver) -> tuple[dict, list[int]]:
     from benchmarks.solver_cases import CASES
     from benchmarks.solver_lab.ensemble import COPY_STEP
     from masonrycli.motion import Sine
@@ -136,9 +138,9 @@ def _capture_run(case, motion, copy, min_units, duration, directory) -> tuple[di
     amplitude, frequency, phase = motion
     ground = Sine(amplitude=amplitude * (1.0 + copy * COPY_STEP), frequency=frequency, phase=phase)
     scenario = scenario_from_builder(
-        builder, options, RunConfig(duration=duration, solver="nlgs-accel"), Material(), {"ground": ground}
+        builder, options, RunConfig(duration=duration, solver=solver), Material(), {"ground": ground}
     )
-    sim = Simulation(scenario)  # the float64 solver: the replays' (below)
+    sim = Simulation(scenario)
     solve = nlgs.solve
     step, kept, units = [0], {}, []
 
@@ -154,7 +156,7 @@ def _capture_run(case, motion, copy, min_units, duration, directory) -> tuple[di
         if out[0] >= min_units:
             name = _key(case, motion, copy, step[0])
             params = {"mu": model.friction, "tolerance": model.tolerance, "cap": model.max_iterations}
-            np.savez_compressed(directory / f"{name}.npz", **inputs, **params)
+            np.savez_compressed(directory / f"{name}.npz", **inputs, **params, solver=model.solver)
             kept[name] = {"case": case, "step": step[0], "units": int(out[0]), "residual": float(out[1])}
             kept[name].update(params, contacts=int(count), bodies=int(v.shape[0]), solver=model.solver)
         return out
@@ -187,13 +189,18 @@ def _set(overrides: dict[str, object]) -> dict[str, object]:
     return old
 
 
+def _solver(z) -> str:
+    """The solver a step was captured by (sets captured before 28 Nov carry none: ``nlgs-accel``)."""
+    return str(z["solver"]) if "solver" in z.files else "nlgs-accel"
+
+
 def replay_step(name: str, directory=None) -> dict:
     """One kept step through nlgs.solve from its warm start: units, residual, the method that finished."""
     z = np.load((directory or HARD) / f"{name}.npz")
     body, pack, count = z["body"].astype(np.int32), z["pack"], z["body"].shape[0]
     v, r, status = z["v_free"].copy(), z["r_warm"].copy(), z["status"].copy()
     model = SimpleNamespace(
-        friction=float(z["mu"]), tolerance=float(z["tolerance"]), max_iterations=int(z["cap"]), solver="nlgs-accel"
+        friction=float(z["mu"]), tolerance=float(z["tolerance"]), max_iterations=int(z["cap"]), solver=_solver(z)
     )
     log = []
     resume = stalled._resume
@@ -352,7 +359,7 @@ def stage_split(name: str, directory=None) -> dict:
     bodies.body_order_sweeps, stalled._resume = recorded, logged
     try:
         v, r, st = z["v_free"].copy(), z["r_warm"].copy(), z["status"].copy()
-        model = SimpleNamespace(friction=mu, tolerance=tol, max_iterations=cap, solver="nlgs-accel")
+        model = SimpleNamespace(friction=mu, tolerance=tol, max_iterations=cap, solver=_solver(z))
         out["units"], out["residual"] = (float(x) for x in nlgs.solve(body, pack, count, model, v, r, st))
     finally:
         bodies.body_order_sweeps, stalled._resume = order, resume
@@ -397,6 +404,7 @@ def add_arguments(sub) -> None:
     c.add_argument("--duration", type=float, default=None, help="s (default: the ensemble's)")
     c.add_argument("--dir", type=Path, default=None, help="where the steps go (default data/hard)")
     c.add_argument("--set", default=None, metavar="MOD.NAME=VALUE[+…]", help="engine constants for the capture")
+    c.add_argument("--solver", default="nlgs-accel", help="the run's solver (default nlgs-accel, the float64 path)")
     r = act.add_parser("replay")
     r.add_argument(
         "--variants", nargs="+", default=["main"], help=f"names ({', '.join(VARIANTS)}) or MOD.NAME=VALUE[+…]"
@@ -419,7 +427,7 @@ def main(args) -> None:
         from benchmarks.solver_lab.ensemble import parse_motion
 
         motions = [parse_motion(m) for m in args.motions] if args.motions else None
-        capture(args.cases, args.copy, args.min_units, motions, args.duration, args.dir, args.set)
+        capture(args.cases, args.copy, args.min_units, motions, args.duration, args.dir, args.set, args.solver)
     elif args.action == "replay":
         replay(args.variants, args.min_units, args.max_units, args.out, args.cases, args.dir)
     elif args.action == "stages":

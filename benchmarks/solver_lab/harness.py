@@ -61,6 +61,7 @@ def _register_optional():
         ipm_shift,
         joint,
         linear,
+        lines,
         newton,
         tnnmg,
     )
@@ -79,6 +80,7 @@ def _register_optional():
         ipm_lcp,
         ipm_shift,
         cpg,
+        lines,
     ):
         METHODS.update(module.METHODS)
 
