@@ -389,11 +389,25 @@ def check_sampling(scenario: Scenario) -> None:
                 f"{MAX_SUPPORT_SPEED:g} m/s (a likely typo: a block that fast is a diverged run)"
             )
         if m.kind == "sine" and m.amplitude != 0.0 and m.frequency * dt >= 0.5:
+            if where:  # a scenario file's line, as its other errors give: the frequency's, else the dt's
+                where = _sampling_where(source, support.name, m.frequency, dt)
             raise InputError(
                 f'{where}support "{support.name}": frequency = {m.frequency:g} Hz is '
                 f"{'above' if m.frequency * dt > 0.5 else 'at'} 1/(2 dt) = {0.5 / dt:g} Hz: steps of dt = {dt:g} s "
                 f"sample it at aliased phases (dt = {0.05 / m.frequency:.3g} s gives 20 steps a period)"
             )
+
+
+def _sampling_where(source: str, support: str, frequency: float, dt: float) -> str:
+    """``<file>:<line>: `` of the aliased sine's ``frequency`` key, else of ``[run] dt``, each only where the
+    file gives the value the run has (``--dt`` or a sweep's ``--param freq=`` may have replaced it);
+    ``<file>: `` when neither is found (a geometry file, a key not written in the file)."""
+    from masonrycli.toml_lines import file_key_line
+
+    line = file_key_line(source, ("support", support, "motion"), "frequency", frequency)
+    if line is None:
+        line = file_key_line(source, ("run",), "dt", dt)
+    return f"{source}: " if line is None else f"{source}:{line}: "
 
 
 def scenario_summary(scenario: Scenario) -> dict:

@@ -121,3 +121,39 @@ def with_line(message: str, fname: str, text: str) -> str:
     found = message_key(message[len(head) :])
     line = key_line(text, *found) if found else None
     return message if line is None else f"{fname}:{line}: {message[len(head) :]}"
+
+
+def file_key_line(source: str, path: tuple, key: str, value) -> int | None:
+    """The line of ``key`` of the table at ``path`` in the TOML file ``source`` if the file gives it
+    ``value``, else None: for checks made once the command line's values are applied (``--dt``, a sweep's
+    ``--param freq=…``), where the line of the file's other value would mislead. An entry of an array of
+    tables may be named by its ``name``: ``("support", "ground", "motion")`` (a builder's supports are
+    listed by name, in any order; an unnamed ``[[support]]`` is ``support-<n>``)."""
+    try:
+        with open(source, "rb") as f:
+            text = f.read().decode("utf-8-sig")
+        node = tomllib.loads(text)
+    except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError, RecursionError):
+        return None
+    concrete: list = []
+    for part in path:
+        if isinstance(node, list) and isinstance(part, str):
+            named = [
+                i
+                for i, e in enumerate(node)
+                if isinstance(e, dict) and e.get("name", f"{concrete[-1]}-{i + 1}") == part
+            ]
+            if len(named) != 1:
+                return None
+            part = named[0]
+        if isinstance(node, list) and isinstance(part, int) and part < len(node):
+            node = node[part]
+        elif isinstance(node, dict) and isinstance(part, str) and part in node:
+            node = node[part]
+        else:
+            return None
+        concrete.append(part)
+    given = node.get(key) if isinstance(node, dict) else None
+    if isinstance(given, bool) or given != value:  # true == 1: a boolean is no number
+        return None
+    return key_line(text, tuple(concrete), key)

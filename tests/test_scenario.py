@@ -150,7 +150,7 @@ def test_check_sampling_refuses_a_sine_above_half_the_step_rate():
         check_sampling(at_limit)
     too_fast = dataclasses.replace(scenario, run=dataclasses.replace(scenario.run, dt=0.5))
     with pytest.raises(
-        InputError, match=r'block_on_ground.toml: support "ground": frequency = 2 Hz is above 1/\(2 dt\) = 1 Hz'
+        InputError, match=r'block_on_ground.toml:26: support "ground": frequency = 2 Hz is above 1/\(2 dt\) = 1 Hz'
     ):
         check_sampling(too_fast)
     still = dataclasses.replace(too_fast, motions=(dataclasses.replace(too_fast.motions[0], amplitude=0.0),))

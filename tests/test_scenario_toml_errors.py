@@ -372,3 +372,35 @@ def test_block_density_written_with_its_unit(tmp_path):
         '[[block]] #2 ("b2"): density = "2400 kg/m3": must be a number, not a string (write 2400, in kg/m³, '
         "without the unit)"
     )
+
+
+SINE = 'motion = { kind = "sine", direction = [1.0, 0.0], amplitude = 1.0, frequency = 2.0 }\n'
+ALIASED = [  # (file text, extra arguments): 2 Hz at dt = 0.5 s is sampled at aliased phases
+    (f"[run]\nduration = 1.0\ndt = 0.5\n\n{BLOCK}\n{GROUND}{SINE}", ()),
+    (f"[run]\nduration = 1.0\ndt = 1e-3\n\n{BLOCK}\n{GROUND}{SINE}", ("--dt", "0.5")),  # the file's frequency
+    # a builder's supports are named, in any order; the motion written as a table
+    (
+        '[structure]\nbuilder = "wall"\n\n[run]\nduration = 1.0\ndt = 0.5\n\n[[support]]\nname = "ground"\n'
+        '[support.motion]\nkind = "sine"\namplitude = 1.0\n\nfrequency = 2.0\n',
+        (),
+    ),
+]
+
+
+@pytest.mark.parametrize("text, extra", ALIASED, ids=["file-dt", "option-dt", "builder-table"])
+def test_an_aliased_sine_names_the_line_of_its_frequency(tmp_path, text, extra):
+    """``masonry run s.toml`` on a sine faster than 1/(2 dt): the one line gives the file and the line of the
+    frequency key, as the file's other errors do (it gave the file alone)."""
+    from typer.testing import CliRunner
+
+    from masonrycli.cli import app
+
+    path = write(tmp_path, text, "s.toml")
+    line = next(i for i, ln in enumerate(text.split("\n"), start=1) if "frequency = 2.0" in ln)
+    result = CliRunner().invoke(app, ["run", str(path), "--no-recording", *extra])
+    assert result.exit_code == 2, result.output
+    assert "Traceback" not in result.output
+    assert result.output.strip().splitlines() == [
+        f'error: {path}:{line}: support "ground": frequency = 2 Hz is above 1/(2 dt) = 1 Hz: steps of '
+        "dt = 0.5 s sample it at aliased phases (dt = 0.025 s gives 20 steps a period)"
+    ]

@@ -178,3 +178,24 @@ def test_a_large_file_answers_quickly(tmp_path):
     line = key_line(text, ("block", 19_999), "density")
     spent = time.process_time() - start
     assert line == text.count("\n") and spent < 5.0, spent
+
+
+def test_file_key_line_only_where_the_file_gives_the_value(tmp_path):
+    """The line of a value checked after the command line applied its own (``--dt``, ``--param freq=``):
+    the key's line where the file gives the value the run has, None elsewhere (the file's other value's
+    line would mislead); an [[support]] entry found by its name."""
+    from masonrycli.toml_lines import file_key_line
+
+    text = (
+        '[run]\ndt = 1e-3\n\n[[support]]\nname = "left"\nmotion = { kind = "sine", frequency = 3.0 }\n'
+        '[[support]]\nname = "ground"\nmotion = { kind = "sine", frequency = 2.0 }\n'
+    )
+    path = tmp_path / "s.toml"
+    path.write_text(text)
+    ground = ("support", "ground", "motion")
+    assert file_key_line(str(path), ground, "frequency", 2.0) == line_of(text, "frequency = 2.0")
+    assert file_key_line(str(path), ground, "frequency", 600.0) is None  # a sweep's freq=600 point
+    assert file_key_line(str(path), ("support", "nobody", "motion"), "frequency", 2.0) is None
+    assert file_key_line(str(path), ("run",), "dt", 1e-3) == 2
+    assert file_key_line(str(path), ("run",), "dt", 0.5) is None  # --dt 0.5
+    assert file_key_line(str(tmp_path / "missing.toml"), ("run",), "dt", 1e-3) is None
