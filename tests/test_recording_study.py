@@ -56,6 +56,7 @@ def test_records_sweep_fits_a_fragility_curve_and_records_the_study(block, tmp_p
     paths = {ch.entity_path for ch in rr.chunk.RrdReader(str(rrd)).stream()}
     assert {"/study/fragility/fit", "/study/fragility/runs/collapsed", "/study/plot", "/study/rows"} <= paths
     check_fragility_reads_as_a_plot(rrd, rows)
+    assert timelines(rrd) == {"pga (mm/s²)"}  # the curve's x axis alone: no log_time, no log_tick
     shown = invoke("inspect", rrd)  # a study has no time line: a dash, not Python's "None"
     assert shown.exit_code == 0 and "None" not in shown.output and "time_span      │ —" in shown.output
     # the plot and the recording exist now: --force replaces them and still reuses every finished row
@@ -122,6 +123,28 @@ def panel_states(rrd: Path) -> dict[str, str]:
     return out
 
 
+def timelines(rrd: Path) -> set[str]:
+    """The time lines of the recording's data (not of its blueprint, which Rerun keeps on its own
+    ``log_time``): every chunk's."""
+    import rerun as rr
+
+    reader = rr.chunk.RrdReader(str(rrd))
+    (recording,) = reader.recordings()
+    return {name for chunk in reader.stream(store=recording) for name in chunk.timeline_names}
+
+
+def test_a_state_map_study_shows_no_time_line(tmp_path):
+    """`masonry sweep wall -p amp=… -p freq=…`: the map, the picture and the rows have no time. They are
+    static, on no time line, and the viewer filled the (collapsed) time panel with its own "log_time",
+    a name that meant nothing to the user (seen on a headless viewer's screenshot); the time panel is
+    hidden now."""
+    args = ["-p", "amp=0.1,0.2", "-p", "freq=1,2", "--duration", 0.05, "--workers", 0, "-o", tmp_path / "s.parquet"]
+    result = invoke("sweep", "wall", *args, "--recording", tmp_path / "s.rrd")
+    assert result.exit_code == 0, result.output
+    assert timelines(tmp_path / "s.rrd") == set()
+    assert blueprint_layout(tmp_path / "s.rrd")["TimePanelBlueprint:state"] == 1  # hidden (2: collapsed)
+
+
 def blueprint_layout(rrd: Path) -> dict:
     """The last value of every blueprint property of the recording (``"ScalarAxis:range"`` ...)."""
     import rerun as rr
@@ -177,6 +200,7 @@ def test_find_threshold_curve_reads_as_a_plot(block, tmp_path):
     # the line and its points are one entity, one legend entry (two listed "amp_threshold (m/s)" and
     # "amp_threshold (m/s): points"), as in the PNG
     assert series == {"/study/thresholds/line": expected}
+    assert timelines(rrd) == {timeline}  # the curve's x axis alone: no log_time, no log_tick
     styles = {}
     for chunk in rr.chunk.RrdReader(str(rrd)).stream():
         if chunk.is_static and chunk.entity_path == "/study/thresholds/line":

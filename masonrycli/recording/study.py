@@ -2,7 +2,8 @@
 
 The state map as coloured points over the two swept parameters (``study/state_map``, with a key of its colours), the PNG the
 command also wrote (``study/plot``), and the rows as the terminal shows them, units under the table
-(``study/rows``), all static; the
+(``study/rows``), all static, on no time line: its time panel is hidden (the viewer filled an empty one
+with a ``log_time`` of its own, a name that meant nothing there); the
 fragility curve of a records study (``study/fragility``) and the threshold curve of ``--find``
 (``study/thresholds``) are plots on their own time lines (below). Axes are in the parameters' own units, so a 2-D view shows them
 as they are; the PNG is the annotated picture.
@@ -102,7 +103,9 @@ def record_study(path: Path, name: str, rows: list[dict], request, fit, im: str,
         axes = ", ".join(f"{_with_unit(n)} {way}" for n, way in zip(names, ("right", "up")))
         title = viewer_safe_text(f"state map: {axes}" if axes else "state map")
         views.insert(0, rrb.Spatial2DView(origin="study", contents=["+ /study/state_map/**"], name=title))
-        panels.append(rrb.TimePanel(state="collapsed"))
+        # hidden: the map, the picture and the rows are static, on no time line, and the viewer fills an
+        # empty time panel with a "log_time" of its own, which meant nothing here (module doc)
+        panels.append(rrb.TimePanel(state="hidden"))
     else:
         timeline, end = _log_fragility(rec, rows, fit, im)
         legend = rrb.PlotLegend(corner="RightBottom")  # high IM, P = 0: where runs are fewest
