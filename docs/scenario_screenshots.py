@@ -29,7 +29,12 @@ SHOTS = {  # recording -> (instant s, image stem, tabs to keep: tab index -> suf
     # a 1 s run has no paper-figure tabs: tab 1 is the live volumetric strain rate, 5 the magnified shape
     "aqueduct-shaken": (1.0, "aqueduct-shaken-t1", {1: "volumetric-strain-rate", 5: "magnified"}),
 }
-STRUCTURE_PANEL = (0, 50, 1150, 878)  # the left column of the 1920 × 1080 window with its tab bar, legend excluded
+STRUCTURE_PANEL = (
+    0,
+    38,
+    1150,
+    878,
+)  # the left column of the 1920 × 1080 window with its whole tab bar, legend excluded
 WINDOW_WIDTH = 1440  # the whole-window images are downscaled to this width
 
 
