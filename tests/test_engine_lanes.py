@@ -83,12 +83,13 @@ def _push(v, a, b, p, drt, drn, supports_too):
         v[b][2] += p[N.P_IIB] * (p[N.P_TB] * drt + p[N.P_NB] * drn)
 
 
-def slow_lane_sweeps(body, pack, count, mu, tolerance, cap, v0, r0, stall_after):
+def slow_lane_sweeps(body, pack, count, mu, tolerance, cap, v0, r0, stall_after, near_level=0.0, stall_near=0):
     """Plain Python: momentum's sweeps (momentum._momentum_sweeps, flip omitted) visiting contact
     q·run + j for j = 0 …, q = 0 … 7, one at a time, a clashing group's lanes sub-group by sub-group;
     Σ|e_α|² summed per sub-group (from 0, in lane order). The warm start pushed group by group in lane
     order into every body, the sweeps' pushes into movable bodies only. Returns (iterations, residual, v,
-    r, status)."""
+    r, status). The stall window is stall_after sweeps without a new low, stall_near once the low is
+    ≤ near_level (momentum.NEAR × the tolerance in the engine)."""
     P = [[float(x) for x in row] for row in pack[:count]]
     v = [[float(x) for x in row] for row in v0]
     x = [[float(r0[c, 0]), float(r0[c, 1])] for c in range(count)]
@@ -135,7 +136,7 @@ def slow_lane_sweeps(body, pack, count, mu, tolerance, cap, v0, r0, stall_after)
             break
         if residual < best:
             best, best_at = residual, it
-        elif tolerance > 0.0 and it - best_at >= stall_after:
+        elif tolerance > 0.0 and it - best_at >= (stall_near if best <= near_level else stall_after):
             break
         if residual > momentum.RESTART_GROWTH * last:
             j = 1
@@ -194,6 +195,29 @@ def test_a_stall_window_stops_the_sweeps_as_the_reference():
     its, res, v, r, _ = _run(body, pack, v0, r0, mu, 1e-30, 10_000, stall=3)
     ref = slow_lane_sweeps(body, pack, body.shape[0], mu, 1e-30, 10_000, v0, r0, 3)
     assert its == ref[0] < 10_000 and res == ref[1] and _same_bits(v, ref[2]) and _same_bits(r, ref[3])
+
+
+def test_near_the_tolerance_the_stall_window_is_the_longer_one_as_the_reference():
+    # Tolerance 1e-30 (never met): the sweeps end on a stall. With the low ≤ near_level the window is
+    # stall_near instead of stall_after. near_level = inf: always the long window; 0: never; in between
+    # (the low the short window stops at): the short window until the low reaches it, then the long one.
+    body, pack, v0, r0, mu = _problem(39)
+    count = body.shape[0]
+
+    def kernel(near_level, stall_near):
+        v, r, st = v0.copy(), r0.copy(), np.full(count, -1, np.int8)
+        its, res = lane_sweeps._lane_sweeps(body, pack, count, mu, 1e-30, 10_000, v, r, st, 3, near_level, stall_near)
+        return its, res, v, r
+
+    short = kernel(0.0, 40)
+    assert short[:2] == _run(body, pack, v0, r0, mu, 1e-30, 10_000, stall=3)[:2]  # the old window exactly
+    long_ = kernel(np.inf, 40)
+    assert long_[0] > short[0]
+    for near_level in (np.inf, 1.5 * short[1], short[1]):
+        its, res, v, r = kernel(near_level, 40)
+        ref = slow_lane_sweeps(body, pack, count, mu, 1e-30, 10_000, v0, r0, 3, near_level, 40)
+        assert its == ref[0] and res == ref[1] and _same_bits(v, ref[2]) and _same_bits(r, ref[3])
+        assert its > short[0]  # the long window applied once the low was within near_level
 
 
 def test_lane_sweeps_are_the_labs_scalar_lanes_bit_for_bit():

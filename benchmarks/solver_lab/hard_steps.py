@@ -335,7 +335,10 @@ def stage_split(name: str, directory=None) -> dict:
 
     def first_stage(sweeps):
         v, r, st = z["v_free"].copy(), z["r_warm"].copy(), z["status"].copy()
-        return lane_sweeps._lane_sweeps(body, pack, count, mu, tol, sweeps, v, r, st, momentum.STALL_SWEEPS)
+        near, stall_near = momentum.NEAR * tol, momentum.stall_near(count)  # the float64 first stage's windows
+        return lane_sweeps._lane_sweeps(
+            body, pack, count, mu, tol, sweeps, v, r, st, momentum.STALL_SWEEPS, near, stall_near
+        )
 
     sweeps = first_stage(cap)[0]
     h = np.array([first_stage(k)[1] for k in range(1, sweeps + 1)])

@@ -193,11 +193,14 @@ def _group(j, act, Q, IA, IB, v4, beta, mu, full):
 
 
 @njit
-def _lane_sweeps(contact_body, pack, count, mu, tolerance, max_iterations, v, r, status, stall_after):
+def _lane_sweeps(
+    contact_body, pack, count, mu, tolerance, max_iterations, v, r, status, stall_after, near_level=0.0, stall_near=0
+):
     # v: v_free in, v_n+1 out; r: warm start in, impulses out (as momentum._momentum_sweeps, flip omitted).
     #   Q, IA, IB, groups, v4 ← lanes.pack_lanes (v ← v_free + M⁻¹ H r_warm on the way)
     #   repeat: _extrapolate(v4); for each group: _group on each of its sub-groups (one unless it clashes)
-    #           residual = sqrt(Σ|e_α|² / C); stop at the tolerance, the cap or the stall window;
+    #           residual = sqrt(Σ|e_α|² / C); stop at the tolerance, the cap or the stall window
+    #           (stall_after sweeps without a new low; stall_near once the low is ≤ near_level m/s);
     #           restart (j = 1) when the residual grew by more than RESTART_GROWTH; β = (j − 1)/(j + 2)
     #   v, r, status ← lanes.unpack_lanes
     # Returns (iterations, residual).
@@ -236,7 +239,7 @@ def _lane_sweeps(contact_body, pack, count, mu, tolerance, max_iterations, v, r,
         if residual < best:
             best = residual
             best_at = it
-        elif tolerance > 0.0 and it - best_at >= stall_after:
+        elif tolerance > 0.0 and it - best_at >= (stall_near if best <= near_level else stall_after):
             break
         if residual > momentum.RESTART_GROWTH * last:
             j_restart = 1

@@ -442,6 +442,7 @@ def first_stage(contact_body, pack, count, mu, tolerance, max_iterations, v, r, 
         min(stall_after, STALL32), -1, RESYNC,
     )  # fmt: skip
     its, residual = lane_sweeps._lane_sweeps(
-        contact_body, pack, count, mu, tolerance, max(max_iterations - its32, 1), v, r, status, stall_after
-    )
+        contact_body, pack, count, mu, tolerance, max(max_iterations - its32, 1), v, r, status, stall_after,
+        momentum.NEAR * tolerance, momentum.stall_near(count),
+    )  # fmt: skip
     return its32 + its, residual

@@ -37,6 +37,22 @@ With 200 the stage gets them sooner. Ensembles of 48 runs a wall against 500: me
 0.614× [90 %: 0.535, 0.707] on the 32-course wall, 0.878× [0.807, 0.960] on the 64-course wall, 0.969×
 [0.923, 1.013] on the 248-block wall; unconverged steps 7 → 1, 2 → 4, 3 → 0. 100 costs the 248-block
 wall 4 % (its steps with plateaus that momentum finishes go to the stage, which costs more on them).
+
+Near the tolerance (since 2026-11-28). A step handed over is solved again from its warm start, so a first
+stage that stalls just above the tolerance throws its progress away. On the 64-course wall that is most
+hard steps: of the 177 steps of ≥ 2500 units of its benchmark run (1 m/s, 2 Hz, 1 s), 91 stalled below
+3 × the tolerance, and the body-order stage then spent ~6800 units on each where the first stage, left
+to go on, finished in ~3200. So once its lowest residual is within NEAR × the tolerance, the float64
+first stage (lane_sweeps._lane_sweeps) waits stall_near(C) = max(STALL_SWEEPS, STALL_NEAR × C) sweeps for
+a new low (C contacts: ~600 sweeps on the 248-block wall, ~2700 on the 64-course wall): a window that
+grows with the structure, as the plateaus of momentum on a taller wall are longer. Replayed (the captured
+steps through nlgs.solve): the 64-course wall's 177 steps 1 319 183 → 898 405 units (0.68×), all
+converged (one at the cap before); the 32-course wall's 79 steps of three runs 0.976×; the 248-block
+wall's 194 steps of ≥ 400 units 1.026× (its stage is cheap: a fixed 3000 sweeps made them 1.16×).
+Ensembles of one-second runs against the rule off (benchmarks/JOURNAL.md, "Near the tolerance"): mean
+units a step 0.800× [90 %: 0.745, 0.854] on the 64-course wall (CPU 0.66×, 12 runs), 1.017× [0.953, 1.088]
+on the 32-course wall (CPU 0.97×, 36 runs), 0.997× [0.969, 1.026] on the 248-block wall (CPU 1.01×);
+unconverged steps 4 → 4, 5 → 4, 0 → 0.
 """
 
 from __future__ import annotations
@@ -51,6 +67,17 @@ RESTART_GROWTH = 1.1
 STALL_SWEEPS = 200
 """Accelerated sweeps without a new lowest residual after which nlgs.solve hands the step to stalled.py
 (module doc, last paragraph)."""
+NEAR = 3.0
+"""× the tolerance: a first stage whose lowest residual is this close waits stall_near(C) sweeps without a new
+low instead of STALL_SWEEPS before it hands the step over (module doc, "Near the tolerance")."""
+STALL_NEAR = 0.5
+"""The first stage's stall window once its lowest residual is within NEAR × the tolerance, in sweeps per
+contact of the step (at least STALL_SWEEPS): 600 sweeps on the 248-block wall, ~2700 on the 64-course wall."""
+
+
+def stall_near(count: int) -> int:
+    """Sweeps the first stage waits for a new low once it is within NEAR × the tolerance (module doc)."""
+    return max(STALL_SWEEPS, int(STALL_NEAR * count))
 
 
 @kernel_only

@@ -320,8 +320,9 @@ def _nlgs_interleaved(
     than one with the flag as an argument: a run compiles only the sweep it uses (the plain one cost 1.5 s
     of the first run's compilation)."""
     if accelerate and alternate is None and LANES:
+        near, stall_near = momentum.NEAR * tolerance, momentum.stall_near(count)
         return lane_sweeps._lane_sweeps(
-            contact_body, pack, count, mu, tolerance, max_iterations, v, r, status, accelerated_stall
+            contact_body, pack, count, mu, tolerance, max_iterations, v, r, status, accelerated_stall, near, stall_near
         )
     if accelerate:
         if not v.flags.c_contiguous:  # v.reshape would copy: the sweep's flat view of v must be v
