@@ -45,7 +45,8 @@ hard steps: of the 177 steps of ≥ 2500 units of its benchmark run (1 m/s, 2 Hz
 to go on, finished in ~3200. So once its lowest residual is within NEAR × the tolerance, the float64
 first stage (lane_sweeps._lane_sweeps) waits stall_near(C) = max(STALL_SWEEPS, STALL_NEAR × C) sweeps for
 a new low (C contacts: ~600 sweeps on the 248-block wall, ~2700 on the 64-course wall): a window that
-grows with the structure, as the plateaus of momentum on a taller wall are longer. Replayed (the captured
+grows with the structure, as the plateaus of momentum on a taller wall are longer. (The lab's levers
+nlgs.LANES = False and shrink.CHECK_EVERY > 0, whose first stages are other kernels, keep the plain window.) Replayed (the captured
 steps through nlgs.solve): the 64-course wall's 177 steps 1 319 183 → 898 405 units (0.68×), all
 converged (one at the cap before); the 32-course wall's 79 steps of three runs 0.976×; the 248-block
 wall's 194 steps of ≥ 400 units 1.026× (its stage is cheap: a fixed 3000 sweeps made them 1.16×).
