@@ -45,6 +45,9 @@ class Model:
     """(N,) m³: area × thickness."""
     body_radius: np.ndarray
     """(B,) m: largest distance from the centroid to a vertex (bounds the speed of any point)."""
+    block_depth: float
+    """The structure's height in blocks as built: the blocks' vertical extent over their median height (about
+    the courses of a wall; the solver's first stage waits longer on deeper structures, engine/momentum.py)."""
     gravity: np.ndarray
     """(2,) m/s²."""
     friction: float
@@ -139,6 +142,7 @@ def build_model(scenario) -> Model:
         body_v0=v0,
         block_volume=volume,
         body_radius=_radii(np.asarray(starts, dtype=np.int64), np.concatenate(local)),
+        block_depth=_depth(blocks),
         gravity=np.asarray(run.gravity, dtype=np.float64),
         friction=float(scenario.material.friction),
         dt=float(run.dt),
@@ -183,6 +187,15 @@ class SupportVelocity:
     def between(self, start: int, stop: int) -> np.ndarray:
         """(stop − start, S, 2) the rows of steps start … stop − 1, evaluated now (not kept)."""
         return support_velocity(self.motions, np.arange(start, stop, dtype=np.float64) * self.dt)
+
+
+def _depth(blocks) -> float:
+    """The blocks' vertical extent over their median height (0 without blocks): once per model, not per step."""
+    if not blocks:
+        return 0.0
+    low = np.array([b.vertices[:, 1].min() for b in blocks])
+    high = np.array([b.vertices[:, 1].max() for b in blocks])
+    return float((high.max() - low.min()) / np.median(high - low))
 
 
 def _radii(start: np.ndarray, local: np.ndarray) -> np.ndarray:

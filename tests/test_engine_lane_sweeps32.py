@@ -401,3 +401,36 @@ def test_solver_nlgs_accel32_is_the_float32_first_stage_and_nlgs_accel_is_not(na
         v2, r2, st2 = v0.copy(), r0.copy(), np.zeros(count, np.int8)
         ref = first(body, pack, count, mu, 1e-6, 10_000, v2, r2, st2, momentum.STALL_SWEEPS)
         assert out == ref and out[1] <= 1e-6 and _same_bits(v, v2) and _same_bits(r, r2)
+
+
+def test_the_first_stage_waits_near_the_tolerance_by_the_structures_depth(monkeypatch):
+    # nlgs.solve hands lane_sweeps32.first_stage momentum.stall_near(model): 25 sweeps a block of depth, at
+    # least STALL_SWEEPS; first_stage's float64 part is _lane_sweeps with that window within NEAR × tol
+    body, pack, v0, r0, mu = _problem("stack39")
+    count = body.shape[0]
+    seen = []
+    first = lane_sweeps32.first_stage
+
+    def spy(*args):
+        seen.append(args[-1])
+        return first(*args)
+
+    monkeypatch.setattr(lane_sweeps32, "first_stage", spy)
+    for depth, window in ((0.0, momentum.STALL_SWEEPS), (6.0, momentum.STALL_SWEEPS), (64.0, 1600)):
+        model = type("M", (_Model,), {"friction": mu, "solver": "nlgs-accel32", "block_depth": depth})
+        assert momentum.stall_near(model) == window
+        nlgs.solve(body, pack, count, model, v0.copy(), r0.copy(), np.zeros(count, np.int8))
+        assert seen[-1] == window
+    # by hand, on a step that stalls near its tolerance: the float32 stage, then the float64 one with both windows
+    stalled = first(body, pack, count, mu, 1e-30, 5000, v0.copy(), r0.copy(), np.zeros(count, np.int8), 3, 3)
+    tol = stalled[1] / 2  # where it stalled with window 3 is within NEAR × this tolerance
+    v, r, st = v0.copy(), r0.copy(), np.zeros(count, np.int8)
+    out = first(body, pack, count, mu, tol, 5000, v, r, st, 3, 40)
+    its32, _, r32, _ = _run32(body, pack, v0, r0, mu, tol, 4999, stall=3)
+    v2, r2, st2 = v0.copy(), r32.copy(), np.zeros(count, np.int8)
+    its64, res64 = lane_sweeps._lane_sweeps(
+        body, pack, count, mu, tol, 5000 - its32, v2, r2, st2, 3, momentum.NEAR * tol, 40
+    )
+    assert out == (its32 + its64, res64) and _same_bits(v, v2) and _same_bits(r, r2)
+    short = first(body, pack, count, mu, tol, 5000, v0.copy(), r0.copy(), np.zeros(count, np.int8), 3, 3)
+    assert out[0] > short[0]  # the longer window near the tolerance went on

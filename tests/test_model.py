@@ -81,3 +81,15 @@ def test_initial_state_is_a_copy():
     copied.body_v[1, 2] = 9.0
     assert m.body_q0[0, 0] == pytest.approx(0.2) and state.body_v[1, 2] == 0.5
     assert (state.step, state.time) == (0, 0.0)
+
+
+def test_block_depth_is_the_vertical_extent_over_the_median_block_height():
+    # rect 0 … 0.2 m high, tri 0.2 … 0.5 (0.3 high): extent 0.5 m over the median height 0.25 m = 2
+    assert _model().block_depth == pytest.approx(2.0)
+    # a built running-bond wall: its courses, whatever its length
+    from masonrycli.scenario import scenario_from_builder
+
+    for courses, length in ((5, 2.1), (5, 6.0), (12, 2.1)):
+        options = {"blocks": None, "courses": courses, "length": length}
+        sc = scenario_from_builder("wall", options, RunConfig(duration=DT), Material(), {})
+        assert build_model(sc).block_depth == pytest.approx(courses)

@@ -156,7 +156,8 @@ def _capture_run(case, motion, copy, min_units, duration, directory, solver) -> 
         if out[0] >= min_units:
             name = _key(case, motion, copy, step[0])
             params = {"mu": model.friction, "tolerance": model.tolerance, "cap": model.max_iterations}
-            np.savez_compressed(directory / f"{name}.npz", **inputs, **params, solver=model.solver)
+            depth = getattr(model, "block_depth", 0.0)
+            np.savez_compressed(directory / f"{name}.npz", **inputs, **params, solver=model.solver, depth=depth)
             kept[name] = {"case": case, "step": step[0], "units": int(out[0]), "residual": float(out[1])}
             kept[name].update(params, contacts=int(count), bodies=int(v.shape[0]), solver=model.solver)
         return out
@@ -200,8 +201,9 @@ def replay_step(name: str, directory=None) -> dict:
     body, pack, count = z["body"].astype(np.int32), z["pack"], z["body"].shape[0]
     v, r, status = z["v_free"].copy(), z["r_warm"].copy(), z["status"].copy()
     model = SimpleNamespace(
-        friction=float(z["mu"]), tolerance=float(z["tolerance"]), max_iterations=int(z["cap"]), solver=_solver(z)
-    )
+        friction=float(z["mu"]), tolerance=float(z["tolerance"]), max_iterations=int(z["cap"]), solver=_solver(z),
+        block_depth=float(z["depth"]) if "depth" in z.files else 0.0,
+    )  # fmt: skip
     log = []
     resume = stalled._resume
 
@@ -335,10 +337,7 @@ def stage_split(name: str, directory=None) -> dict:
 
     def first_stage(sweeps):
         v, r, st = z["v_free"].copy(), z["r_warm"].copy(), z["status"].copy()
-        near, stall_near = momentum.NEAR * tol, momentum.stall_near(count)  # the float64 first stage's windows
-        return lane_sweeps._lane_sweeps(
-            body, pack, count, mu, tol, sweeps, v, r, st, momentum.STALL_SWEEPS, near, stall_near
-        )
+        return lane_sweeps._lane_sweeps(body, pack, count, mu, tol, sweeps, v, r, st, momentum.STALL_SWEEPS)
 
     sweeps = first_stage(cap)[0]
     h = np.array([first_stage(k)[1] for k in range(1, sweeps + 1)])
@@ -362,7 +361,8 @@ def stage_split(name: str, directory=None) -> dict:
     bodies.body_order_sweeps, stalled._resume = recorded, logged
     try:
         v, r, st = z["v_free"].copy(), z["r_warm"].copy(), z["status"].copy()
-        model = SimpleNamespace(friction=mu, tolerance=tol, max_iterations=cap, solver=_solver(z))
+        depth = float(z["depth"]) if "depth" in z.files else 0.0
+        model = SimpleNamespace(friction=mu, tolerance=tol, max_iterations=cap, solver=_solver(z), block_depth=depth)
         out["units"], out["residual"] = (float(x) for x in nlgs.solve(body, pack, count, model, v, r, st))
     finally:
         bodies.body_order_sweeps, stalled._resume = order, resume

@@ -431,11 +431,12 @@ def lane_sweeps32(
     return iterations, residual
 
 
-def first_stage(contact_body, pack, count, mu, tolerance, max_iterations, v, r, status, stall_after):
+def first_stage(contact_body, pack, count, mu, tolerance, max_iterations, v, r, status, stall_after, stall_near=0):
     """The accelerated solve's first stage with a float32 start (module doc): :func:`lane_sweeps32` to
     ``tolerance`` (its own float32 test), then lane_sweeps._lane_sweeps from its impulses in float64 (v
-    re-derived from v_free, at least one sweep: the step ends on a float64 sweep and test). Returns
-    (iterations, residual): the sweeps of both, the float64 sweep's residual."""
+    re-derived from v_free, at least one sweep: the step ends on a float64 sweep and test), whose stall
+    window is ``stall_near`` once within momentum.NEAR × the tolerance (momentum.py, "Near the tolerance").
+    Returns (iterations, residual): the sweeps of both, the float64 sweep's residual."""
     # max_iterations − 1: the float64 sweep the step ends on stays within the run's cap
     its32, _ = lane_sweeps32(
         contact_body, pack, count, mu, tolerance * TOL_FACTOR, max(max_iterations - 1, 0), v, r, status,
@@ -443,6 +444,6 @@ def first_stage(contact_body, pack, count, mu, tolerance, max_iterations, v, r, 
     )  # fmt: skip
     its, residual = lane_sweeps._lane_sweeps(
         contact_body, pack, count, mu, tolerance, max(max_iterations - its32, 1), v, r, status, stall_after,
-        momentum.NEAR * tolerance, momentum.stall_near(count),
+        momentum.NEAR * tolerance, max(stall_near, stall_after),
     )  # fmt: skip
     return its32 + its, residual

@@ -42,18 +42,19 @@ Near the tolerance (since 2026-11-28). A step handed over is solved again from i
 stage that stalls just above the tolerance throws its progress away. On the 64-course wall that is most
 hard steps: of the 177 steps of ≥ 2500 units of its benchmark run (1 m/s, 2 Hz, 1 s), 91 stalled below
 3 × the tolerance, and the body-order stage then spent ~6800 units on each where the first stage, left
-to go on, finished in ~3200. So once its lowest residual is within NEAR × the tolerance, the float64
-first stage (lane_sweeps._lane_sweeps) waits stall_near(C) = max(STALL_SWEEPS, STALL_NEAR × C) sweeps for
-a new low (C contacts: ~600 sweeps on the 248-block wall, ~2700 on the 64-course wall): a window that
-grows with the structure, as the plateaus of momentum on a taller wall are longer. (The lab's levers
-nlgs.LANES = False and shrink.CHECK_EVERY > 0, whose first stages are other kernels, keep the plain window.) Replayed (the captured
-steps through nlgs.solve): the 64-course wall's 177 steps 1 319 183 → 898 405 units (0.68×), all
-converged (one at the cap before); the 32-course wall's 79 steps of three runs 0.976×; the 248-block
-wall's 194 steps of ≥ 400 units 1.026× (its stage is cheap: a fixed 3000 sweeps made them 1.16×).
-Ensembles of one-second runs against the rule off (benchmarks/JOURNAL.md, "Near the tolerance"): mean
-units a step 0.800× [90 %: 0.745, 0.854] on the 64-course wall (CPU 0.66×, 12 runs), 1.017× [0.953, 1.088]
-on the 32-course wall (CPU 0.97×, 36 runs), 0.997× [0.969, 1.026] on the 248-block wall (CPU 1.01×);
-unconverged steps 4 → 4, 5 → 4, 0 → 0.
+to go on, finished in ~3200. So once its lowest residual is within NEAR × the tolerance, the float64 part
+of the default's first stage (lane_sweeps32.first_stage: lane_sweeps._lane_sweeps after the float32
+sweeps) waits stall_near(model) = max(STALL_SWEEPS, STALL_NEAR × Model.block_depth) sweeps for a new low:
+the plateaus of momentum are longer on deeper structures, as load moves about one block a sweep. 1600 on
+the 64-course wall, 400 on the 248-block wall, 200 (unchanged) on walls of 8 courses or fewer. Replayed
+(captured steps through nlgs.solve) with fixed windows: the 64-course wall's 177 steps 1 319 183 units at
+200, 987 505 at 1000, 915 518 at 2000 (all converged from 1000 on; one at the cap at 200); the 32-course
+wall's 79 steps 0.968× at 1000; the 248-block wall's 194 steps of ≥ 400 units 1.026× at 400–600, 1.16× at
+3000. A window of ½ × the contact count instead of the depth (9050127) made the long 8-course walls dearer
+(1004 blocks: 1.20× the units over 3 runs): they have the 64-course wall's contacts, not its depth.
+"nlgs-accel" (the float64 path) and the lab levers nlgs.LANES = False and shrink.CHECK_EVERY > 0 keep the
+plain window. Ensembles of one-second runs against the rule off: benchmarks/JOURNAL.md, "Near the
+tolerance".
 """
 
 from __future__ import annotations
@@ -71,14 +72,16 @@ STALL_SWEEPS = 200
 NEAR = 3.0
 """× the tolerance: a first stage whose lowest residual is this close waits stall_near(C) sweeps without a new
 low instead of STALL_SWEEPS before it hands the step over (module doc, "Near the tolerance")."""
-STALL_NEAR = 0.5
-"""The first stage's stall window once its lowest residual is within NEAR × the tolerance, in sweeps per
-contact of the step (at least STALL_SWEEPS): 600 sweeps on the 248-block wall, ~2700 on the 64-course wall."""
+STALL_NEAR = 25.0
+"""The first stage's stall window once its lowest residual is within NEAR × the tolerance, in sweeps per block
+of the structure's depth (Model.block_depth, at least STALL_SWEEPS): 400 sweeps on the 16-course 248-block
+wall, 1600 on the 64-course wall; 200, as before, on walls of 8 courses or fewer however long."""
 
 
-def stall_near(count: int) -> int:
-    """Sweeps the first stage waits for a new low once it is within NEAR × the tolerance (module doc)."""
-    return max(STALL_SWEEPS, int(STALL_NEAR * count))
+def stall_near(model) -> int:
+    """Sweeps the first stage waits for a new low once it is within NEAR × the tolerance (module doc); a model
+    without ``block_depth`` (the lab's replays of older captures) keeps STALL_SWEEPS."""
+    return max(STALL_SWEEPS, int(STALL_NEAR * getattr(model, "block_depth", 0.0)))
 
 
 @kernel_only

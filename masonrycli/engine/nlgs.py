@@ -320,9 +320,8 @@ def _nlgs_interleaved(
     than one with the flag as an argument: a run compiles only the sweep it uses (the plain one cost 1.5 s
     of the first run's compilation)."""
     if accelerate and alternate is None and LANES:
-        near, stall_near = momentum.NEAR * tolerance, momentum.stall_near(count)
         return lane_sweeps._lane_sweeps(
-            contact_body, pack, count, mu, tolerance, max_iterations, v, r, status, accelerated_stall, near, stall_near
+            contact_body, pack, count, mu, tolerance, max_iterations, v, r, status, accelerated_stall
         )
     if accelerate:
         if not v.flags.c_contiguous:  # v.reshape would copy: the sweep's flat view of v must be v
@@ -385,8 +384,9 @@ def solve(contact_body, pack, count, model, v, r, status) -> tuple[int, float]:
         )
     elif (model.solver == "nlgs-accel32" or FLOAT32) and LANES:  # the one place float32 is chosen
         iterations, residual = lane_sweeps32.first_stage(
-            contact_body, pack, count, mu, tolerance, cap, v, r, status, momentum.STALL_SWEEPS
-        )
+            contact_body, pack, count, mu, tolerance, cap, v, r, status, momentum.STALL_SWEEPS,
+            momentum.stall_near(model),
+        )  # fmt: skip
     else:
         iterations, residual = _nlgs_interleaved(
             contact_body, pack, count, mu, tolerance, cap, v, r, status, True, momentum.STALL_SWEEPS
