@@ -384,6 +384,8 @@ def check_sampling(scenario: Scenario) -> None:
     for support, m in zip(scenario.assembly.supports, scenario.motions):
         peak = m.peak_speed(scenario.run.duration)
         if not peak <= MAX_SUPPORT_SPEED:
+            if where:  # the line of the key that sets the speed, as the aliased sine's below
+                where = _speed_where(source, support.name, m)
             raise InputError(
                 f'{where}support "{support.name}": {m.describe()} moves at up to {peak:.3g} m/s, more than '
                 f"{MAX_SUPPORT_SPEED:g} m/s (a likely typo: a block that fast is a diverged run)"
@@ -407,6 +409,23 @@ def _sampling_where(source: str, support: str, frequency: float, dt: float) -> s
     line = file_key_line(source, ("support", support, "motion"), "frequency", frequency)
     if line is None:
         line = file_key_line(source, ("run",), "dt", dt)
+    return f"{source}: " if line is None else f"{source}:{line}: "
+
+
+_SPEED_KEYS = {"sine": "amplitude", "constant": "velocity", "ramp": "acceleration"}
+"""The motion key that sets a support's peak speed, by kind (a record's is spread over its samples: none)."""
+
+
+def _speed_where(source: str, support: str, motion) -> str:
+    """``<file>:<line>: `` of the key that sets a too-fast support's speed (``amplitude``, ``velocity``,
+    ``acceleration``), only where the file gives the value the run has (``--param amp=`` may have replaced
+    it); ``<file>: `` otherwise."""
+    from masonrycli.toml_lines import file_key_line
+
+    key = _SPEED_KEYS.get(motion.kind)
+    value = getattr(motion, key, None) if key else None
+    value = list(value) if isinstance(value, tuple) else value  # a vector is a TOML array
+    line = None if value is None else file_key_line(source, ("support", support, "motion"), key, value)
     return f"{source}: " if line is None else f"{source}:{line}: "
 
 

@@ -404,3 +404,50 @@ def test_an_aliased_sine_names_the_line_of_its_frequency(tmp_path, text, extra):
         f'error: {path}:{line}: support "ground": frequency = 2 Hz is above 1/(2 dt) = 1 Hz: steps of '
         "dt = 0.5 s sample it at aliased phases (dt = 0.025 s gives 20 steps a period)"
     ]
+
+
+TOO_FAST = [  # (file text, the key's text): each support moves faster than MAX_SUPPORT_SPEED within the run
+    (f"[run]\nduration = 1.0\n\n{BLOCK}\n{GROUND}{SINE.replace('amplitude = 1.0', 'amplitude = 1e30')}", "1e30"),
+    (f'[run]\nduration = 1.0\n\n{BLOCK}\n{GROUND}motion = {{ kind = "constant", velocity = [0, -1e9] }}\n', "-1e9"),
+    # a builder's named support, its motion written as a table
+    (
+        '[structure]\nbuilder = "wall"\n\n[run]\nduration = 1.0\n\n[[support]]\nname = "ground"\n'
+        '[support.motion]\nkind = "ramp"\n\nacceleration = [2000.0, 0.0]\n',
+        "2000.0",
+    ),
+]
+
+
+@pytest.mark.parametrize("text, value", TOO_FAST, ids=["sine-amplitude", "constant-velocity", "builder-ramp"])
+def test_a_support_too_fast_names_the_line_of_its_speed(tmp_path, text, value):
+    """``masonry run s.toml`` on a support faster than a diverged block: the one line gives the file and the
+    line of the key that sets the speed (amplitude, velocity, acceleration), as the aliased sine's error does
+    (it gave the file alone)."""
+    from typer.testing import CliRunner
+
+    from masonrycli.cli import app
+
+    path = write(tmp_path, text, "s.toml")
+    line = next(i for i, ln in enumerate(text.split("\n"), start=1) if value in ln and "name" not in ln)
+    result = CliRunner().invoke(app, ["run", str(path), "--no-recording"])
+    assert result.exit_code == 2, result.output
+    assert "Traceback" not in result.output
+    (message,) = result.output.strip().splitlines()
+    assert message.startswith(f'error: {path}:{line}: support "ground": '), message
+    assert "more than 1000 m/s (a likely typo: a block that fast is a diverged run)" in message
+
+
+def test_a_support_too_fast_by_a_sweep_value_names_no_line(tmp_path):
+    """A sweep's ``--param amp=1e30`` replaces the file's amplitude: the file's line (amplitude = 1.0) would
+    mislead, so the message gives the file alone."""
+    from typer.testing import CliRunner
+
+    from masonrycli.cli import app
+
+    path = write(tmp_path, f"[run]\nduration = 1.0\n\n{BLOCK}\n{GROUND}{SINE}", "s.toml")
+    result = CliRunner().invoke(app, ["sweep", str(path), "-p", "amp=1e30", "-o", str(tmp_path / "x.parquet")])
+    assert result.exit_code == 2, result.output
+    assert result.output.strip().splitlines() == [
+        f'error: --param amp=1e+30: {path}: support "ground": sine 1e+30 m/s · sin(2π·2 Hz·t) along (1, 0) '
+        "moves at up to 1e+30 m/s, more than 1000 m/s (a likely typo: a block that fast is a diverged run)"
+    ]
