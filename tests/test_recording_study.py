@@ -241,11 +241,15 @@ def test_grid_sweep_state_map_and_histories(block, tmp_path):
         if ch.entity_path == "/study/state_map/axes":
             batch = ch.to_record_batch()
             axes |= {n: batch.column(n).to_pylist()[0] for n in batch.schema.names if ":" in n}
-    assert axes["Points2D:labels"] == ["amp=0.05", "amp=0.6", "friction=0.3", "friction=0.8"]
+    # One cell per swept value as in the PNG: the dots at the values' ranks, the values under their column
+    # and left of their row, the axes' names once (every value read "amp=0.05": close values collided).
+    assert axes["Points2D:labels"] == ["0.05", "0.6", "0.3", "0.8"]
     assert axes["Points2D:show_labels"] == [True]
+    assert static_fields(chunks, "/study/state_map/axes/names")["Points2D:labels"] == ["amp (m/s)", "friction"]
+    assert sorted(map(tuple, found["Points2D:positions"])) == [(0, 0), (0, 1), (1, 0), (1, 1)]
     x_labels, y_labels = np.array(axes["Points2D:positions"][:2]), np.array(axes["Points2D:positions"][2:])
-    assert list(x_labels[:, 0]) == pytest.approx([0.05, 0.6]) and np.all(x_labels[:, 1] < 0.3)
-    assert list(y_labels[:, 1]) == pytest.approx([0.3, 0.8]) and np.all(y_labels[:, 0] < 0.05)
+    assert list(x_labels[:, 0]) == [0, 1] and np.all(x_labels[:, 1] < 0)
+    assert list(y_labels[:, 1]) == [0, 1] and np.all(y_labels[:, 0] < 0)
     # The key names the colours (the recording did not; the PNG has a legend), in the PNG's colours,
     # in a row under the map's x labels
     key = {}
@@ -361,3 +365,111 @@ def test_the_rows_are_the_terminals_with_units_under_the_table(tmp_path):
     from masonrycli.recording.readback import blueprint_views
 
     assert "runs of wall (units under the table)" in blueprint_views(tmp_path / "map.rrd")
+
+
+def label_boxes(rrd: Path) -> tuple[dict, np.ndarray, np.ndarray]:
+    """The state map's drawn labels as boxes on screen, by entity: {entity: [(centre x, y, half width,
+    half height)]} in map units, and the dots (centre x, y, radius). A label is drawn centred on its anchor
+    at a fixed size on screen, whatever the zoom: about 8 px a character plus 10 px wide, 24 px high
+    (measured on a headless screenshot: "freq=2.0" 62 px, "collapsed" 72 px). The view (600 x 1000 px at
+    least, beside the picture and the rows in a 1920 x 1080 window) fits the dots and the anchors, filling
+    55 % of it at the most (0.6 to 0.8 measured): the pixels a map unit are underestimated, the labels
+    overestimated."""
+    import rerun as rr
+
+    chunks = list(rr.chunk.RrdReader(str(rrd)).stream())
+    dots = []
+    for entity in ("/study/state_map", "/study/state_map/key"):
+        fields = static_fields(chunks, entity)
+        at = np.array(fields["Points2D:positions"], dtype=np.float64)
+        dots.append(np.column_stack([at, np.broadcast_to(np.array(fields["Points2D:radii"], np.float64), len(at))]))
+    dots = np.concatenate(dots)
+    texts = {}
+    for entity in ("/study/state_map/axes", "/study/state_map/axes/names", "/study/state_map/key/names"):
+        fields = static_fields(chunks, entity)
+        if fields:
+            texts[entity] = (
+                np.array(fields["Points2D:positions"], np.float64).reshape(-1, 2),
+                fields["Points2D:labels"],
+            )
+    anchors = np.concatenate([at for at, _ in texts.values()])
+    points = np.concatenate([dots[:, :2] - dots[:, 2:], dots[:, :2] + dots[:, 2:], anchors])
+    span = np.maximum(np.ptp(points, axis=0), 1e-9)
+    px = 0.55 * min(600.0 / span[0], 1000.0 / span[1])
+    boxes = {
+        entity: [(x, y, (8.0 * len(t) + 10.0) / 2.0 / px, 12.0 / px) for (x, y), t in zip(at, labels)]
+        for entity, (at, labels) in texts.items()
+    }
+    return boxes, dots
+
+
+def overlapping(boxes: dict, dots: np.ndarray) -> list:
+    """Pairs of labels whose boxes meet, and labels whose box meets a dot."""
+    every = [(entity, i, b) for entity, bs in boxes.items() for i, b in enumerate(bs)]
+    found = []
+    for k, (ea, ia, (xa, ya, wa, ha)) in enumerate(every):
+        for eb, ib, (xb, yb, wb, hb) in every[k + 1 :]:
+            if abs(xa - xb) < wa + wb and abs(ya - yb) < ha + hb:
+                found.append(((ea, ia), (eb, ib)))
+        # the box's nearest point to each dot's centre, inside the dot: the label covers it
+        near = np.column_stack([np.clip(dots[:, 0], xa - wa, xa + wa), np.clip(dots[:, 1], ya - ha, ya + ha)])
+        for d in np.nonzero(np.hypot(*(near - dots[:, :2]).T) < dots[:, 2])[0]:
+            found.append(((ea, ia), ("dot", int(d))))
+    return found
+
+
+def test_the_state_map_labels_of_close_values_do_not_overlap(tmp_path):
+    """`masonry sweep wall -p amp=0.1,0.2 -p freq=1,2`: the labels were spaced from the map's largest span
+    (freq, 1 Hz), so the amp values 0.1 apart drew over each other: "amp=0.amp=0.2" on a headless
+    screenshot. Read back, no two labels' boxes (their anchors, an estimated size on screen: label_boxes)
+    meet, nor a label and a dot."""
+    args = ["-p", "amp=0.1,0.2", "-p", "freq=1,2", "--duration", 0.05, "--workers", 0, "-o", tmp_path / "s.parquet"]
+    result = invoke("sweep", "wall", *args, "--recording", tmp_path / "s.rrd")
+    assert result.exit_code == 0, result.output
+    boxes, dots = label_boxes(tmp_path / "s.rrd")
+    assert len(boxes["/study/state_map/axes"]) == 4 and len(dots) == 4 + 4
+    assert overlapping(boxes, dots) == []
+
+
+GRIDS = {
+    "readme": ([round(0.1 * k, 6) for k in range(1, 11)], [0.5 * k for k in range(1, 9)]),  # README's 10 x 8
+    "uneven": ([0.1, 0.105, 0.11, 1.0], [1, 1.01, 2, 20]),  # close values beside far ones
+    "fine": ([round(0.01 * k, 6) for k in range(1, 31)], [round(0.1 * k, 6) for k in range(1, 31)]),  # 30 x 30
+    "one axis": ([round(0.123456 * k, 6) for k in range(1, 26)], None),
+}
+
+
+@pytest.mark.parametrize("name", GRIDS)
+def test_the_state_map_labels_do_not_overlap_whatever_the_spacing(tmp_path, name):
+    """Many values, uneven ones, one axis alone: the values' labels take turns in two rows under the map and
+    two columns left of it where a cell is narrower than they are, and label every 2nd, 5th … value where
+    two lanes cannot hold them all, so that none meets another or a dot."""
+    from types import SimpleNamespace
+
+    from masonrycli.recording.study import record_study
+
+    xs, ys = GRIDS[name]
+    rows = [
+        {"amp": a, **({"freq": f} if ys else {}), "state": "intact", "status": "completed"}
+        for a in xs
+        for f in ys or [None]
+    ]
+    axes = [SimpleNamespace(name="amp", values=tuple(xs))] + (
+        [SimpleNamespace(name="freq", values=tuple(ys))] if ys else []
+    )
+    rrd = record_study(tmp_path / "map.rrd", "wall", rows, SimpleNamespace(axes=axes, find=None), None, "pga", None)
+    boxes, dots = label_boxes(rrd)
+    assert overlapping(boxes, dots) == []
+    # every value's label where a lane or two hold them, else every 2nd, 5th, 10th …, from the first
+    import rerun as rr
+
+    drawn = static_fields(list(rr.chunk.RrdReader(str(rrd)).stream()), "/study/state_map/axes")["Points2D:labels"]
+    shown = []
+    for values in (xs, ys) if ys else (xs,):
+        ticks = [f"{v:g}" for v in values]
+        every = ticks.index(drawn[len(shown) + 1]) if len(drawn) > len(shown) + 1 else len(ticks)
+        shown += ticks[::every]
+        assert every in (1, 2, 5, 10), (name, drawn)
+    assert drawn == shown
+    if name in ("readme", "uneven"):
+        assert len(drawn) == len(xs) + len(ys)

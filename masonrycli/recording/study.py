@@ -5,15 +5,20 @@ command also wrote (``study/plot``), and the rows as the terminal shows them, un
 (``study/rows``), all static, on no time line: its time panel is hidden (the viewer filled an empty one
 with a ``log_time`` of its own, a name that meant nothing there); the
 fragility curve of a records study (``study/fragility``) and the threshold curve of ``--find``
-(``study/thresholds``) are plots on their own time lines (below). Axes are in the parameters' own units, so a 2-D view shows them
-as they are; the PNG is the annotated picture.
+(``study/thresholds``) are plots on their own time lines (below), their axes in the parameters' own units;
+the state map, as the PNG's, has one cell per swept value (below); the PNG is the annotated picture.
 
 Rerun's 2-D views draw y downward: each picture entity gets a static y-flip transform and its view looks
 at it from ``study`` (an origin's own transform is not applied in its view), so larger values are up, as
 in the PNG — before, the state map showed freq = 1 Hz above 2 Hz and the fragility curve upside down.
 The state map's labels ("amp=0.25 freq=1: intact") are shown on hover only: drawn, a 6 × 2 grid's
-overlapped into an unreadable line. Its axes are drawn as labels, each swept value once below the lowest
-row and left of the leftmost column (``study/state_map/axes``); every view's name says what its axes are
+overlapped into an unreadable line. Its axes are drawn as labels, each swept value once below its
+column and left of its row (``study/state_map/axes``), the axes' names once (``…/axes/names``). Drawn
+at the values, in their units, amp = 0.1, 0.2 beside freq = 1, 2 were dots 0.1 apart on a map 1 high and
+their labels overlapped ("amp=0.amp=0.2"; 0.1, 0.105 beside 1.0 merged the dots too): the dots sit at
+the values' ranks, and the labels, of a size fixed on screen, are laid out for the view's estimated scale
+(:func:`map_scale_px`), in two lanes where a cell is narrower than they are, every 2nd, 5th … value
+where two lanes cannot hold them all (the rest on hover). Every view's name says what its axes are
 (the plots draw no axis title, the 2-D view no axis), and the side panels open collapsed.
 
 The fragility curve is a probability (0–1) against an intensity (pga 1–60 m/s², pgv 0.1–5 m/s): a 2-D
@@ -166,72 +171,140 @@ def _number(value) -> float:
     return float(value) if isinstance(value, (int, float)) else math.nan
 
 
-def _log_state_map(rec, rows: list[dict], names: list[str]) -> None:
-    # a string axis (record names) is drawn by index
-    def coord(r, n):
-        if not n:
-            return 0.0
-        values = sorted({row[n] for row in rows}, key=str)
-        return _number(r[n]) if not isinstance(r[n], str) else float(values.index(r[n]))
+# The viewer draws a label in a box of fixed size on screen, whatever the zoom: about 8 px a character plus
+# 10 px ("freq=2.0" 62 px, "collapsed" 72 px on a headless 1920 x 1080 screenshot) and 24 px high. A view
+# fits the map's points into it, here taken as 600 x 1000 px (the map's view beside the picture and the rows
+# at 1920 x 1080: 640 x 1030) and only 55 % filled (0.61 and 0.81 of the height measured): the scale is
+# underestimated, so labels laid out for it stand further apart on screen, never closer.
+LABEL_CHAR_PX, LABEL_PAD_PX, LABEL_HEIGHT_PX, LABEL_GAP_PX = 8.0, 10.0, 24.0, 6.0
+MAP_VIEW_PX, MAP_FILL = (600.0, 1000.0), 0.55
+DOT_RADIUS = 0.25  # of the grid's cell
+KEY_STATES = ("intact", "damaged", "collapsed", "")
 
-    x, y = (names + [None, None])[:2]
-    pos = np.array([[coord(r, x), coord(r, y)] for r in rows], dtype=np.float32).reshape(-1, 2)
+
+def label_width_px(text: str) -> float:
+    """Estimated width on screen of a drawn label (module constants above)."""
+    return LABEL_CHAR_PX * len(text) + LABEL_PAD_PX
+
+
+def map_scale_px(points: np.ndarray) -> float:
+    """Estimated pixels per unit of the map's view: the points' extent (dots' edges, labels' anchors)
+    fitted into the view, as the viewer does, less its margin (module constants above)."""
+    span = np.ptp(points, axis=0) if len(points) else np.ones(2)
+    span = np.maximum(span, 1e-9)
+    return MAP_FILL * min(MAP_VIEW_PX[0] / span[0], MAP_VIEW_PX[1] / span[1])
+
+
+def _lanes(count: int, sizes_px, px: float) -> tuple[list[int], list[int]]:
+    """The labels of an axis's ``count`` cells, ``sizes_px`` long on screen at ``px`` pixels a cell: which are
+    drawn and the lane (row under the map, column left of it) of each, the first where it stands clear of
+    the lane's previous label. Every value where one or two lanes hold them; else every 2nd, 5th, 10th …
+    (a lane more for each would pile the labels up further than the map is long)."""
+    for every in (k * 10**e for e in range(7) for k in (1, 2, 5)):
+        shown, lanes, last = list(range(0, count, every)), [], []  # last: per lane, its last label's (cell, size)
+        for i in shown:
+            ends = [i0 + (s0 + sizes_px[i]) / 2.0 / px + LABEL_GAP_PX / px for i0, s0 in last]
+            lane = next((k for k, end in enumerate(ends) if i >= end), len(last))
+            last[lane : lane + 1] = [(i, sizes_px[i])]
+            lanes.append(lane)
+        if len(last) <= 2:
+            return shown, lanes
+    return shown[:1], lanes[:1]
+
+
+def _tick_texts(values) -> list[str]:
+    """The values as the PNG's ticks write them ("0.1", "2"), exact where that would merge two."""
+    short = [v if isinstance(v, str) else f"{v:g}" for v in values]
+    return short if len(set(short)) == len(short) else [str(v) for v in values]
+
+
+def _map_labels(names: list[str], ticks: list[list[str]], n: tuple[int, int], px: float):
+    """Positions of the map's labels at ``px`` pixels a unit: each axis's values (``ticks``) beside its
+    cells (x: rows under the map, y: columns left of it, in lanes: :func:`_lanes`), the axes' names with
+    their units after them (x under, y above), and the key of the colours under all; returns (value
+    anchors, value texts, name anchors, name texts, key dots, key names' anchors)."""
+    h, gap, r = LABEL_HEIGHT_PX / px, LABEL_GAP_PX / px, DOT_RADIUS
+    clear = max(r, h / 2.0)  # a label's edge from a dot's centre, or from a label of the other axis
+    at, texts, title_at, titles = [], [], [], []
+    bottom, left = -r, 0.0
+    if names:
+        shown, rows = _lanes(n[0], [label_width_px(t) for t in ticks[0]], px)
+        at += [[i, -clear - gap - h / 2.0 - k * (h + gap)] for i, k in zip(shown, rows)]
+        texts += [ticks[0][i] for i in shown]
+        bottom = -clear - gap - (max(rows) + 1) * (h + gap)
+        title_at.append([(n[0] - 1) / 2.0, bottom - h / 2.0])
+        titles.append(_with_unit(names[0]))
+        bottom -= h + gap
+    if len(names) > 1:
+        widest = max(label_width_px(t) for t in ticks[1]) / px
+        shown, columns = _lanes(n[1], [LABEL_HEIGHT_PX] * n[1], px)
+        at += [[-clear - gap - widest / 2.0 - k * (widest + gap), j] for j, k in zip(shown, columns)]
+        texts += [ticks[1][j] for j in shown]
+        left = -clear - gap - widest / 2.0 - max(columns) * (widest + gap)
+        title_at.append([-clear - gap - widest / 2.0, n[1] - 1 + clear + gap + h / 2.0])
+        titles.append(_with_unit(names[1]))
+    # The key, a row under the map's x labels (the PNG's legend), from the y labels' left to at least the
+    # map's right: its names in the axes' grey under its dots (drawn by the dots, they sat on them in their
+    # colour: "intact" green on green), each clear of the next.
+    widths = [label_width_px(s or "failed") / px for s in KEY_STATES]
+    steps = [max((w0 + w1) / 2.0 + gap, 4.0 * r) for w0, w1 in zip(widths, widths[1:])]
+    spread = max(1.0, (n[0] - 1 - left) / sum(steps))
+    key_y = bottom - gap - r
+    key_at = [[left + spread * sum(steps[:i]), key_y] for i in range(len(KEY_STATES))]
+    key_names_at = [[x, key_y - clear - gap - h / 2.0] for x, _ in key_at]
+    return at, texts, title_at, titles, key_at, key_names_at
+
+
+def _log_state_map(rec, rows: list[dict], names: list[str]) -> None:
+    """The runs as dots on a grid, one cell per swept value as in the PNG (evenly spaced whatever the
+    values: amp = 0.1, 0.2 beside freq = 1, 2 were dots 0.1 apart on a map 1 high, their labels drawn over
+    each other, "amp=0.amp=0.2"), with the values, the axes' names and the key as labels laid out not to
+    overlap at the view's estimated scale (:func:`map_scale_px`). The values are on hover."""
+    names = names[:2]
+    values = [
+        sorted({r[n] for r in rows}, key=lambda v: (isinstance(v, str), v if not isinstance(v, str) else 0, str(v)))
+        for n in names
+    ]
+    index = [{v: i for i, v in enumerate(vs)} for vs in values]
+    n = (len(values[0]) if names else 1, len(values[1]) if len(names) > 1 else 1)
+    pos = np.array(
+        [[index[k][r[name]] if k < len(names) else 0 for k, name in enumerate((*names, None, None)[:2])] for r in rows],
+        dtype=np.float32,
+    ).reshape(-1, 2)
     colours = np.array([STATE_RGBA.get(r.get("state") or "", STATE_RGBA[""]) for r in rows], dtype=np.uint8)
     labels = [
         viewer_safe_text(" ".join(f"{n}={r[n]}" for n in names) + f": {r.get('state') or 'failed'}") for r in rows
     ]
-    span = np.ptp(pos, axis=0) if len(pos) else np.ones(2)
-    # a fifth of the closest two swept values (either axis): dots of 2 % of the span were specks beside
-    # the labels on a 3 × 2 grid
-    gaps = np.concatenate([np.diff(np.unique(pos[:, k])) for k in range(2)]) if len(pos) else np.zeros(0)
-    gaps = gaps[gaps > 0]
-    radius = max(0.2 * float(gaps.min()) if gaps.size else 0.0, 0.02 * float(max(span.max(), 1e-9)))
-    points = rr.Points2D(pos, colors=colours, labels=labels, radii=radius, show_labels=False)
+    points = rr.Points2D(pos, colors=colours, labels=labels, radii=DOT_RADIUS, show_labels=False)
     rec.log("study/state_map", points, static=True)
-    # The axes, as drawn labels (a 2-D view has none): each swept value once, below the lowest row and
-    # left of the leftmost column — the map was unlabelled dots on black.
-    # The labels are centred on their anchors (radius 0), about 20 px high and 60 wide: set a radius plus a
-    # share of the map's size from the dots (at 0.12 of the y span below the row, 0.2 of the x span left of
-    # the column, "freq=1.0" and "amp=1.0" overlapped the dots of a 2 × 2 map).
-    ticks, texts = [], []
-    size = float(max(span.max(), 1e-9))
-    below = radius + 0.1 * size  # x labels, under the lowest row
-    if len(pos):
-        lo = pos.min(axis=0)
-        for axis, n in enumerate(names[:2]):
-            for value in sorted({r[n] for r in rows}, key=lambda v: coord({n: v}, n)):
-                at = (
-                    [coord({n: value}, n), lo[1] - below]
-                    if axis == 0
-                    else [lo[0] - radius - 0.2 * size, coord({n: value}, n)]
-                )
-                ticks.append(at)
-                texts.append(viewer_safe_text(f"{n}={value}"))
-    axes = rr.Points2D(
-        np.array(ticks, dtype=np.float32).reshape(-1, 2),
-        labels=texts,
-        radii=0.0,
-        colors=(220, 220, 220, 255),
-        show_labels=True,
-    )
-    rec.log("study/state_map/axes", axes, static=True)
-    # The key, a row under the map's x labels (the PNG's legend): the map's colours were not named in
-    # the recording. (Right of the map, the view's fit cut it in half.)
-    # Its names are labels of their own, in the axes' grey, under the dots: drawn by the dots themselves they
-    # sat on the dots' lower half in the dots' colour ("intact" green on green).
-    if len(pos):
-        step = max(0.15 * size, 4.5 * radius)
-        states = ("intact", "damaged", "collapsed", "")
-        x0, width = float(pos[:, 0].min()), max(float(span[0]), 3.0 * step)
-        y0 = float(pos[:, 1].min()) - below - 0.1 * size - 2.0 * radius
-        at = np.array([[x0 + i * width / 3.0, y0] for i in range(len(states))], np.float32)
-        colours = np.array([STATE_RGBA[s] for s in states], dtype=np.uint8)
-        rec.log("study/state_map/key", rr.Points2D(at, colors=colours, radii=radius), static=True)
-        names_at = at - np.array([0.0, radius + 0.1 * size], np.float32)
-        key_names = rr.Points2D(
-            names_at, labels=[s or "failed" for s in states], radii=0.0, colors=(220, 220, 220, 255), show_labels=True
+    ticks = [[viewer_safe_text(t) for t in _tick_texts(vs)] for vs in values]
+    # The scale depends on the labels' extent, which depends on the scale (a label's size in map units is
+    # its size on screen over the scale): the largest scale, in steps of 10 %, at which the labels laid out
+    # for it leave an extent that gives at least that scale (then they stand at least as far apart).
+    dots = np.array([[-DOT_RADIUS, -DOT_RADIUS], [n[0] - 1 + DOT_RADIUS, n[1] - 1 + DOT_RADIUS]])
+    px = map_scale_px(dots)
+    for _ in range(100):
+        layout = _map_labels(names, ticks, n, px)
+        key = np.array(layout[4])
+        anchors = [np.array(a, dtype=np.float64).reshape(-1, 2) for a in (layout[0], layout[2], layout[5])]
+        if map_scale_px(np.concatenate([dots, *anchors, key - DOT_RADIUS, key + DOT_RADIUS])) >= px:
+            break
+        px *= 0.9
+    at, texts, title_at, titles, key_at, key_names_at = layout
+    grey = (220, 220, 220, 255)
+
+    def drawn(where, text):
+        return rr.Points2D(
+            np.array(where, np.float32).reshape(-1, 2), labels=text, radii=0.0, colors=grey, show_labels=True
         )
-        rec.log("study/state_map/key/names", key_names, static=True)
+
+    # The axes, as drawn labels (a 2-D view has none): the map was unlabelled dots on black
+    rec.log("study/state_map/axes", drawn(at, texts), static=True)
+    rec.log("study/state_map/axes/names", drawn(title_at, [viewer_safe_text(t) for t in titles]), static=True)
+    key_colours = np.array([STATE_RGBA[s] for s in KEY_STATES], dtype=np.uint8)
+    key = rr.Points2D(np.array(key_at, np.float32), colors=key_colours, radii=DOT_RADIUS)
+    rec.log("study/state_map/key", key, static=True)
+    rec.log("study/state_map/key/names", drawn(key_names_at, [s or "failed" for s in KEY_STATES]), static=True)
 
 
 def fragility_timeline(im: str) -> str:
