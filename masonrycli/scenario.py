@@ -401,15 +401,8 @@ def check_sampling(scenario: Scenario) -> None:
 
 
 def _sampling_where(source: str, support: str, frequency: float, dt: float) -> str:
-    """``<file>:<line>: `` of the aliased sine's ``frequency`` key, else of ``[run] dt``, each only where the
-    file gives the value the run has (``--dt`` or a sweep's ``--param freq=`` may have replaced it);
-    ``<file>: `` when neither is found (a geometry file, a key not written in the file)."""
-    from masonrycli.toml_lines import file_key_line
-
-    line = file_key_line(source, ("support", support, "motion"), "frequency", frequency)
-    if line is None:
-        line = file_key_line(source, ("run",), "dt", dt)
-    return f"{source}: " if line is None else f"{source}:{line}: "
+    """``<file>:<line>: `` of the aliased sine's ``frequency`` key, else of ``[run] dt``: see _file_where."""
+    return _file_where(source, (("support", support, "motion"), "frequency", frequency), (("run",), "dt", dt))
 
 
 _SPEED_KEYS = {"sine": "amplitude", "constant": "velocity", "ramp": "acceleration"}
@@ -418,15 +411,24 @@ _SPEED_KEYS = {"sine": "amplitude", "constant": "velocity", "ramp": "acceleratio
 
 def _speed_where(source: str, support: str, motion) -> str:
     """``<file>:<line>: `` of the key that sets a too-fast support's speed (``amplitude``, ``velocity``,
-    ``acceleration``), only where the file gives the value the run has (``--param amp=`` may have replaced
-    it); ``<file>: `` otherwise."""
-    from masonrycli.toml_lines import file_key_line
-
+    ``acceleration``): see _file_where."""
     key = _SPEED_KEYS.get(motion.kind)
     value = getattr(motion, key, None) if key else None
     value = list(value) if isinstance(value, tuple) else value  # a vector is a TOML array
-    line = None if value is None else file_key_line(source, ("support", support, "motion"), key, value)
-    return f"{source}: " if line is None else f"{source}:{line}: "
+    return _file_where(source, *([] if value is None else [(("support", support, "motion"), key, value)]))
+
+
+def _file_where(source: str, *candidates) -> str:
+    """``<file>:<line>: `` of the first (table path, key, value) the file gives with the value the run has
+    (``--dt`` or a sweep's ``--param`` may have replaced it: toml_lines.file_key_line); ``<file>: `` when
+    none is found (a geometry file, a key not written in the file)."""
+    from masonrycli.toml_lines import file_key_line
+
+    for path, key, value in candidates:
+        line = file_key_line(source, path, key, value)
+        if line is not None:
+            return f"{source}:{line}: "
+    return f"{source}: "
 
 
 def scenario_summary(scenario: Scenario) -> dict:
