@@ -229,3 +229,13 @@ def test_a_search_of_one_point_is_ticked_as_that_point():
     ax = fig.axes[0]
     assert list(ax.get_xticks()) == [0] and [t.get_text() for t in ax.get_xticklabels()] == ["1"]
     assert ax.get_xlabel() == "point"
+
+
+def test_the_state_maps_cells_and_ticks_are_the_same_for_both_pictures():
+    from masonrycli.study.curves import map_axis
+
+    rows = [{"amp": a} for a in (0.2, 0.1, 1.0, 0.2)]
+    assert map_axis(rows, "amp") == ([0.1, 0.2, 1.0], ["0.1", "0.2", "1"])
+    # ":g" keeps six significant digits: two values it would write alike are written exactly
+    assert map_axis([{"amp": 0.1}, {"amp": 0.1000001}], "amp")[1] == ["0.1", "0.1000001"]
+    assert map_axis([{"record": "b.AT2"}, {"record": "a.AT2"}], "record") == (["a.AT2", "b.AT2"], ["a.AT2", "b.AT2"])

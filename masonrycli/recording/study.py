@@ -60,6 +60,7 @@ from masonrycli.study.curves import (
     STATE_COLOURS,
     axis_positions,
     fragility_series,
+    map_axis,
     rgb,
     searched_range,
     threshold_series,
@@ -212,12 +213,6 @@ def _lanes(count: int, sizes_px, px: float) -> tuple[list[int], list[int]]:
     return shown[:1], lanes[:1]
 
 
-def _tick_texts(values) -> list[str]:
-    """The values as the PNG's ticks write them ("0.1", "2"), exact where that would merge two."""
-    short = [v if isinstance(v, str) else f"{v:g}" for v in values]
-    return short if len(set(short)) == len(short) else [str(v) for v in values]
-
-
 def _map_labels(names: list[str], ticks: list[list[str]], n: tuple[int, int], px: float):
     """Positions of the map's labels at ``px`` pixels a unit: each axis's values (``ticks``) beside its
     cells (x: rows under the map, y: columns left of it, in lanes: :func:`_lanes`), the axes' names with
@@ -261,10 +256,7 @@ def _log_state_map(rec, rows: list[dict], names: list[str]) -> None:
     each other, "amp=0.amp=0.2"), with the values, the axes' names and the key as labels laid out not to
     overlap at the view's estimated scale (:func:`map_scale_px`). The values are on hover."""
     names = names[:2]
-    values = [
-        sorted({r[n] for r in rows}, key=lambda v: (isinstance(v, str), v if not isinstance(v, str) else 0, str(v)))
-        for n in names
-    ]
+    values, ticks = zip(*(map_axis(rows, name) for name in names)) if names else ((), ())
     index = [{v: i for i, v in enumerate(vs)} for vs in values]
     n = (len(values[0]) if names else 1, len(values[1]) if len(names) > 1 else 1)
     pos = np.array(
@@ -277,7 +269,7 @@ def _log_state_map(rec, rows: list[dict], names: list[str]) -> None:
     ]
     points = rr.Points2D(pos, colors=colours, labels=labels, radii=DOT_RADIUS, show_labels=False)
     rec.log("study/state_map", points, static=True)
-    ticks = [[viewer_safe_text(t) for t in _tick_texts(vs)] for vs in values]
+    ticks = [[viewer_safe_text(t) for t in texts] for texts in ticks]
     # The scale depends on the labels' extent, which depends on the scale (a label's size in map units is
     # its size on screen over the scale): the largest scale, in steps of 10 %, at which the labels laid out
     # for it leave an extent that gives at least that scale (then they stand at least as far apart).

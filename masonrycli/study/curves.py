@@ -67,6 +67,15 @@ def axis_positions(rows: list[dict], x: str | None) -> tuple[np.ndarray, list[st
     return np.array([_number(v) for v in values], dtype=np.float64), None
 
 
+def map_axis(rows: list[dict], name: str) -> tuple[list, list[str]]:
+    """The state map's cells along parameter ``name``, for both pictures: its swept values in order
+    (numbers by value, then names), one cell each, and their tick texts as ``:g`` writes them ("0.1", "2"),
+    the exact values where ``:g`` would give two cells one text."""
+    values = sorted({r[name] for r in rows}, key=lambda v: (isinstance(v, str), 0 if isinstance(v, str) else v, str(v)))
+    short = [v if isinstance(v, str) else f"{v:g}" for v in values]
+    return values, short if len(set(short)) == len(short) else [str(v) for v in values]
+
+
 def searched_range(request) -> tuple[float, float]:
     """The lowest and highest value a threshold search of ``request`` (``--find``) tries first."""
     values = next(a.values for a in request.axes if a.name == request.find)

@@ -21,6 +21,7 @@ from masonrycli.study.curves import (
     STATE_COLOURS,
     axis_positions,
     fragility_series,
+    map_axis,
     threshold_series,
     with_unit,
 )
@@ -48,8 +49,8 @@ def state_map(rows: list[dict], x: str, y: str | None, path: Path, title: str) -
     from matplotlib.patches import Patch
 
     plt = _pyplot()
-    xs = sorted({r[x] for r in rows})
-    ys = sorted({r[y] for r in rows}) if y else [0]
+    xs, x_ticks = map_axis(rows, x)
+    ys, y_ticks = map_axis(rows, y) if y else ([0], [])
     fig, ax = plt.subplots(figsize=(1.2 + 0.7 * len(xs), 1.2 + 0.55 * len(ys)))
     for r in rows:
         i, j = xs.index(r[x]), ys.index(r[y]) if y else 0
@@ -60,10 +61,10 @@ def state_map(rows: list[dict], x: str, y: str | None, path: Path, title: str) -
             ax.text(i, j, f"{t:.2f} s", ha="center", va="center", fontsize=7, color="white")
     ax.set_xlim(-0.5, len(xs) - 0.5)
     ax.set_ylim(-0.5, len(ys) - 0.5)
-    ax.set_xticks(range(len(xs)), [f"{v:g}" if not isinstance(v, str) else v for v in xs], rotation=45)
+    ax.set_xticks(range(len(xs)), x_ticks, rotation=45)
     ax.set_xlabel(with_unit(x))
     if y:
-        ax.set_yticks(range(len(ys)), [f"{v:g}" if not isinstance(v, str) else v for v in ys])
+        ax.set_yticks(range(len(ys)), y_ticks)
         ax.set_ylabel(with_unit(y))
     else:
         ax.set_yticks([])
