@@ -8,6 +8,9 @@ the run (disk full, folder removed) · 5 a study (``masonry sweep``) finished wi
 ``status = error``: an engine error or an output that could not be written; the table is whole) · 128 + signal number when stopped by a signal (130 Ctrl-C, 143 SIGTERM).
 """
 
+import os
+import stat
+
 EXIT_OK = 0
 EXIT_INTERNAL = 1
 EXIT_BAD_INPUT = 2
@@ -33,9 +36,6 @@ ended (the run hung before its first line), and the commands that test ``is_file
 def special_file(path) -> bool:
     """True for a path that exists and is neither a regular file nor a folder (checked without opening it:
     opening a named pipe waits for a writer)."""
-    import os
-    import stat
-
     try:
         mode = os.stat(path).st_mode
     except OSError:
@@ -72,8 +72,6 @@ def binary_under_text_suffix(path) -> bool:
     """Whether ``path`` has a text file's suffix (TEXT_SUFFIXES) but NUL bytes in its first 4 kB: a binary
     file that its name would have described as a scenario, a geometry or a record. False for a missing or
     unreadable file (its reader says why)."""
-    import os
-
     if os.path.splitext(os.fspath(path))[1].lower() not in TEXT_SUFFIXES:
         return False
     try:
@@ -87,8 +85,6 @@ def file_kind(path, expected: str, skip: tuple[str, ...] = (), name: str | None 
     """The error for an input whose suffix names another kind of file than the one ``expected`` (said in
     the message: "a scenario"), or None (an unknown suffix, or one in ``skip``: the reader decides).
     ``name``: the input as the messages name it (default: ``path``)."""
-    import os
-
     suffix = os.path.splitext(os.fspath(path))[1].lower()
     if suffix not in FILE_KINDS or suffix in skip:
         return None
