@@ -190,9 +190,15 @@ def _set(overrides: dict[str, object]) -> dict[str, object]:
     return old
 
 
-def _solver(z) -> str:
-    """The solver a step was captured by (sets captured before 28 Nov carry none: ``nlgs-accel``)."""
-    return str(z["solver"]) if "solver" in z.files else "nlgs-accel"
+def _model(z) -> SimpleNamespace:
+    """The model fields nlgs.solve reads, as the step was captured: μ, tolerance, cap, solver and the
+    structure's depth (sets captured before 28 Nov carry no solver: ``nlgs-accel``; none before the depth: 0,
+    the plain stall window)."""
+    return SimpleNamespace(
+        friction=float(z["mu"]), tolerance=float(z["tolerance"]), max_iterations=int(z["cap"]),
+        solver=str(z["solver"]) if "solver" in z.files else "nlgs-accel",
+        block_depth=float(z["depth"]) if "depth" in z.files else 0.0,
+    )  # fmt: skip
 
 
 def replay_step(name: str, directory=None) -> dict:
@@ -200,10 +206,7 @@ def replay_step(name: str, directory=None) -> dict:
     z = np.load((directory or HARD) / f"{name}.npz")
     body, pack, count = z["body"].astype(np.int32), z["pack"], z["body"].shape[0]
     v, r, status = z["v_free"].copy(), z["r_warm"].copy(), z["status"].copy()
-    model = SimpleNamespace(
-        friction=float(z["mu"]), tolerance=float(z["tolerance"]), max_iterations=int(z["cap"]), solver=_solver(z),
-        block_depth=float(z["depth"]) if "depth" in z.files else 0.0,
-    )  # fmt: skip
+    model = _model(z)
     log = []
     resume = stalled._resume
 
@@ -361,9 +364,7 @@ def stage_split(name: str, directory=None) -> dict:
     bodies.body_order_sweeps, stalled._resume = recorded, logged
     try:
         v, r, st = z["v_free"].copy(), z["r_warm"].copy(), z["status"].copy()
-        depth = float(z["depth"]) if "depth" in z.files else 0.0
-        model = SimpleNamespace(friction=mu, tolerance=tol, max_iterations=cap, solver=_solver(z), block_depth=depth)
-        out["units"], out["residual"] = (float(x) for x in nlgs.solve(body, pack, count, model, v, r, st))
+        out["units"], out["residual"] = (float(x) for x in nlgs.solve(body, pack, count, _model(z), v, r, st))
     finally:
         bodies.body_order_sweeps, stalled._resume = order, resume
     for part, hist in [(out["momentum"], h)] + [(c, c["history"]) for c in calls]:
