@@ -1,4 +1,4 @@
-"""Solver lab: ``python -m benchmarks.solver_lab capture|table|clusters|stalled|trajectory|ordinary|newton-ordinary|joint-ordinary|ipm-ordinary|ordinary-runs|ensemble|hard|hard-methods|handover|tall``
+"""Solver lab: ``python -m benchmarks.solver_lab capture|table|clusters|stalled|trajectory|ordinary|tail|newton-ordinary|joint-ordinary|ipm-ordinary|ordinary-runs|ensemble|hard|hard-methods|handover|tall``
 (see benchmarks/README.md, "Solver lab")."""
 
 from __future__ import annotations
@@ -49,6 +49,9 @@ def main() -> None:
     ordi.add_argument("--case", default="wall-248")
     ordi.add_argument("--variants", nargs="+", default=None)
     ordi.add_argument("--repeat", type=int, default=3, help="interleaved timing rounds; CPU-time minimum kept")
+    tai = sub.add_parser("tail", help="where a sample's ordinary steps spend their sweeps near the tolerance")
+    tai.add_argument("--sample", default="wall-248", help="data/trajectory/SAMPLE")
+    tai.add_argument("--levels", nargs="+", type=float, default=None, help="in-sweep residuals (m/s)")
     nwo = sub.add_parser("newton-ordinary", help="Newton-type first stages on a trajectory sample's ordinary steps")
     nwo.add_argument("--sample", default="nwt-wall-248", help="data/trajectory/SAMPLE")
     nwo.add_argument("--every", type=int, default=1, help="every k-th ordinary step of the sample")
@@ -114,6 +117,12 @@ def main() -> None:
         from benchmarks.solver_lab.joint_ordinary import table as joint_table
 
         joint_table(args.sample, args.every, args.repeat, args.plain)
+        return
+    if args.command == "tail":
+        from benchmarks.solver_lab.tail import LEVELS
+        from benchmarks.solver_lab.tail import table as tail_table
+
+        tail_table(args.sample, tuple(args.levels or LEVELS))
         return
     if args.command == "ordinary":
         from benchmarks.solver_lab.ordinary import table as ordinary_table

@@ -414,10 +414,10 @@ def _blocks(step: Step) -> np.ndarray:
     return dyn
 
 
-def table(case: str, names: list[str] | None, repeat: int) -> None:
-    steps = [Step(p) for p in sorted((TRAJECTORY / case).glob("step-*.npz"))]
-    names = names or list(VARIANTS)
-    t = time.process_time()
+def references(case: str, steps: list[Step]) -> None:
+    """Give each step ``v_ref`` (the tight solve's velocities: momentum to REF_TOLERANCE, cap REF_CAP, cached
+    in the sample's references.npz), ``ref_ok`` (it reached REF_TOLERANCE) and ``blocks`` (rows of v that are
+    blocks)."""
     cached = TRAJECTORY / case / "references.npz"
     refs = dict(np.load(cached)) if cached.exists() else {}
     for s in steps:
@@ -427,6 +427,13 @@ def table(case: str, names: list[str] | None, repeat: int) -> None:
         s.v_ref, s.ref_ok = refs[f"v{s.step}"], refs[f"res{s.step}"] <= REF_TOLERANCE
         s.blocks = _blocks(s)
     np.savez(cached, **refs)
+
+
+def table(case: str, names: list[str] | None, repeat: int) -> None:
+    steps = [Step(p) for p in sorted((TRAJECTORY / case).glob("step-*.npz"))]
+    names = names or list(VARIANTS)
+    t = time.process_time()
+    references(case, steps)
     print(
         f"{len(steps)} steps of {case}; references in {time.process_time() - t:.1f} s CPU,"
         f" {sum(not s.ref_ok for s in steps)} above {REF_TOLERANCE:g} m/s at {REF_CAP} sweeps",
