@@ -112,6 +112,20 @@ def test_a_built_in_without_duration_lasts_the_longest_record(block, tmp_path):
     assert plan.base.scenario.run.duration == 1.0 and "shorter than 1 of 1 records" in plan.request.warnings[0]
 
 
+def test_the_runs_shorter_than_records_warning_names_the_longest_record(block, tmp_path):
+    folder = tmp_path / "records"
+    folder.mkdir()
+    for name, seconds in (("a-short.AT2", 1.5), ("b-long.AT2", 3.0)):
+        t, u, v, a = band_limited(seconds, 0.01, [1.0, 2.5], [0.03, 0.01], seed=0)
+        write_at2(folder / name, a / G_STANDARD, 0.01)
+    plan = plan_study(block, records=[folder], scale="1", out=Path("s.csv"))
+    # both are longer than the scenario's 1 s; the 3 s one is named with its 3 s, not the first late one
+    assert plan.request.warnings == (
+        "the runs' 1 s are shorter than 2 of 2 records (longest 3 s, b-long.AT2): their shaking after t = 1 s "
+        "is not applied",
+    )
+
+
 def test_a_record_set_gets_the_warnings_simulate_gives_each_record(block, tmp_path):
     # '--records recs --scale 9.81' (an .AT2 converted twice), '--scale 1,40' (16 g) and a record sampled
     # every 0.5 ms on the 1 ms steps ran without a word; 'simulate --record' warns of each

@@ -242,7 +242,9 @@ def _record_duration(scenario, motions: dict, whole: bool):
     from masonrycli.scenario import MAX_DURATION
 
     run = scenario.run
-    longest = max(m.end_time for m in motions.values())
+    # named by the longest: the first late record ("longest 3 s, quake1.csv" for a 2 s quake1.csv) misled
+    longest_name = max(motions, key=lambda name: motions[name].end_time)
+    longest = motions[longest_name].end_time
     if whole:
         steps = max(1, math.ceil(longest / run.dt - 1e-9))
         run = dataclasses.replace(run, duration=min(steps * run.dt, MAX_DURATION))
@@ -252,7 +254,7 @@ def _record_duration(scenario, motions: dict, whole: bool):
         return scenario, []
     return scenario, [
         f"the runs' {run.duration:g} s are shorter than {len(late)} of {len(motions)} records (longest "
-        f"{longest:g} s, {late[0]}): their shaking after t = {run.duration:g} s is not applied"
+        f"{longest:g} s, {longest_name}): their shaking after t = {run.duration:g} s is not applied"
     ]
 
 
