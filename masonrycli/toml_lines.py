@@ -5,9 +5,10 @@ place where the key is written (``duration =``, ``run.duration =``, inside ``mot
 … }``) is renamed in a copy of the text, the copy parsed, and the place is the key's only if the key has
 moved, under the new name, to the table the message names (``[run]``, the 2nd ``[[block]]``, the motion of
 the 1st ``[[support]]``). A look-alike in a string, a comment, another table or another ``[[block]]`` does
-not move it; TOML allows a key once per table, so a place that moves it is the one. When none does (the
-key is missing, or written as a table header), or the message names no key, no line is given — a wrong
-line would be worse than none.
+not move it; TOML allows a key once per table, so a place that moves it is the one. A key written as the
+header of a plain table (a misspelt ``[runn]``, ``[[blocks]]``) is found the same way, the header renamed.
+When none is found (the key is missing, or a header under an array of tables), or the message names no
+key, no line is given — a wrong line would be worse than none.
 """
 
 from __future__ import annotations
@@ -109,6 +110,27 @@ def key_line(text: str, path: tuple, key: str) -> int | None:
             continue
         if table is not None and _PROBE in table and key not in table:
             return text.count("\n", 0, match.start()) + 1
+    return _header_line(text, path, key, budget - min(len(places), budget))
+
+
+def _header_line(text: str, path: tuple, key: str, budget: int) -> int | None:
+    """The line of the first table header naming ``key`` of the plain table at ``path`` — ``[runn]``,
+    ``[run.extra]``, ``[[blocks]]`` (a misspelt section: ``wall.toml:1: unknown key "runn"``) — proved as a
+    key is: renamed in a copy, the header must make a table of the new name there (one in a string does
+    not). Not under an array of tables (``[support.motion]`` is the motion of the last ``[[support]]``
+    above it)."""
+    if not all(isinstance(part, str) for part in path):
+        return None
+    name = ".".join((*path, key))
+    headers = [m for m in _HEADER.finditer(text) if m.group(2) == name]
+    for m in headers[: max(budget, 0)]:
+        probe = text[: m.end(2) - len(key)] + _PROBE + text[m.end(2) :]  # the key's part of the dotted name
+        try:
+            table = _table(tomllib.loads(probe), path)
+        except (tomllib.TOMLDecodeError, RecursionError):
+            continue
+        if table is not None and _PROBE in table:
+            return text.count("\n", 0, m.start()) + 1
     return None
 
 

@@ -170,6 +170,19 @@ def test_a_key_that_is_a_table_header_gives_no_line():
     assert key_line(text, ("support", 1, "motion"), "kind") is None  # no 2nd support
 
 
+def test_a_misspelt_section_gives_the_line_of_its_header(tmp_path):
+    """docs/scenario-format.md: ``wall.toml:1: unknown key "runn"``; a header in a string is not taken."""
+    text = "# settings\n\n[runn]\nduration = 1.0\n" + block("b1", 0.0)
+    assert error(tmp_path, text) == (3, 'unknown key "runn" (did you mean "run"?)')
+    twice = block("b1", 0.0).replace("[[block]]", "[[blocks]]") * 2
+    assert error(tmp_path, twice) == (1, 'unknown key "blocks" (did you mean "block"?)')
+    sub = "[run]\ndt = 1e-3\n[run.extra]\nx = 1\n" + block("b1", 0.0)
+    line, message = error(tmp_path, sub)
+    assert line == 3 and message.startswith('[run] unknown key "extra"')
+    look_alike = 'name = """\n[runn]\n"""\n[runn]\nx = 1\n' + block("b1", 0.0)
+    assert error(tmp_path, look_alike)[0] == line_of(look_alike, "[runn]", nth=2) == 4
+
+
 def test_a_large_file_answers_quickly(tmp_path):
     """20 000 blocks, the last one wrong: the line, found in a few parses of the text."""
     rows = "".join(block(f"b{i}", 0.2 * i, "density = 2400.0\n") for i in range(19_999))
