@@ -411,11 +411,40 @@ _SPEED_KEYS = {"sine": "amplitude", "constant": "velocity", "ramp": "acceleratio
 
 def _speed_where(source: str, support: str, motion) -> str:
     """``<file>:<line>: `` of the key that sets a too-fast support's speed (``amplitude``, ``velocity``,
-    ``acceleration``): see _file_where."""
-    key = _SPEED_KEYS.get(motion.kind)
-    value = getattr(motion, key, None) if key else None
-    value = list(value) if isinstance(value, tuple) else value  # a vector is a TOML array
+    ``acceleration``; a record's ``file``, or its inline ``value``): see _file_where."""
+    if motion.kind == "record":
+        key, value = _record_key(source, motion)
+    else:
+        key = _SPEED_KEYS.get(motion.kind)
+        value = getattr(motion, key, None) if key else None
+        value = list(value) if isinstance(value, tuple) else value  # a vector is a TOML array
     return _file_where(source, *([] if value is None else [(("support", support, "motion"), key, value)]))
+
+
+def _record_key(source: str, record) -> tuple:
+    """(key, test of the file's value): the ``file`` that names the record, resolved as the scenario reads it
+    (relative to its folder, ``~``), or the inline ``value`` samples. Another file (a sweep's ``--records``)
+    is not the record: no line."""
+    if record.source:
+        folder = os.path.dirname(os.path.abspath(source))
+
+        def names_it(given) -> bool:
+            return (
+                isinstance(given, str)
+                and os.path.abspath(os.path.join(folder, os.path.expanduser(given))) == record.source
+            )
+
+        return "file", names_it
+
+    def holds_it(given) -> bool:
+        import numpy as np
+
+        try:
+            return np.array_equal(np.asarray(given, dtype=float), record.value)
+        except (TypeError, ValueError):
+            return False
+
+    return "value", holds_it
 
 
 def _file_where(source: str, *candidates) -> str:

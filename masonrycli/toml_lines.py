@@ -147,7 +147,7 @@ def with_line(message: str, fname: str, text: str) -> str:
 
 def file_key_line(source: str, path: tuple, key: str, value) -> int | None:
     """The line of ``key`` of the table at ``path`` in the TOML file ``source`` if the file gives it
-    ``value``, else None: for checks made once the command line's values are applied (``--dt``, a sweep's
+    ``value`` (or, ``value`` a function, if it holds for the file's value), else None: for checks made once the command line's values are applied (``--dt``, a sweep's
     ``--param freq=…``), where the line of the file's other value would mislead. An entry of an array of
     tables may be named by its ``name``: ``("support", "ground", "motion")`` (a builder's supports are
     listed by name, in any order; an unnamed ``[[support]]`` is ``support-<n>``)."""
@@ -176,6 +176,9 @@ def file_key_line(source: str, path: tuple, key: str, value) -> int | None:
             return None
         concrete.append(part)
     given = node.get(key) if isinstance(node, dict) else None
-    if isinstance(given, bool) or given != value:  # true == 1: a boolean is no number
+    if callable(value):  # a test of the file's value: a record's file, resolved as the scenario reads it
+        if given is None or not value(given):
+            return None
+    elif isinstance(given, bool) or given != value:  # true == 1: a boolean is no number
         return None
     return key_line(text, tuple(concrete), key)

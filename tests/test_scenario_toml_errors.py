@@ -437,6 +437,52 @@ def test_a_support_too_fast_names_the_line_of_its_speed(tmp_path, text, value):
     assert "more than 1000 m/s (a likely typo: a block that fast is a diverged run)" in message
 
 
+FAST_RECORD = "time,v (m/s)\n0,0\n0.5,2\n1,0\n"  # 2 m/s at its peak: × 1000 is 2000 m/s
+TOO_FAST_RECORDS = [  # (file text, the key's text): a record too fast, by its file or its inline samples
+    (f'{BLOCK}\n{GROUND}motion = {{ kind = "record", file = "recs/fast.csv", scale = 1000.0 }}\n', "recs/fast.csv"),
+    # the file named with "./" in a sub-table, its scale on another line: the line that names the file
+    (f'{BLOCK}\n{GROUND}[support.motion]\nkind = "record"\nscale = 1000.0\nfile = "./recs/fast.csv"\n', "fast.csv"),
+    (f'{BLOCK}\n{GROUND}[support.motion]\nkind = "record"\ntime = [0.0, 0.5, 1.0]\nvalue = [0, 2e3, 0]\n', "2e3"),
+]
+
+
+@pytest.mark.parametrize("text, value", TOO_FAST_RECORDS, ids=["file-inline-table", "file-sub-table", "inline"])
+def test_a_record_too_fast_names_the_line_of_its_file(tmp_path, text, value):
+    """A record that moves a support faster than 1000 m/s: the line of the ``file`` key that names it (or of
+    its inline ``value``), as the sine's amplitude gives its own (it gave the file alone: ``s.toml: …``)."""
+    from typer.testing import CliRunner
+
+    from masonrycli.cli import app
+
+    (tmp_path / "recs").mkdir()
+    (tmp_path / "recs" / "fast.csv").write_text(FAST_RECORD)
+    path = write(tmp_path, text, "s.toml")
+    line = next(i for i, ln in enumerate(text.split("\n"), start=1) if value in ln)
+    result = CliRunner().invoke(app, ["run", str(path), "--no-recording"])
+    assert result.exit_code == 2, result.output
+    (message,) = result.output.strip().splitlines()
+    assert message.startswith(f'error: {path}:{line}: support "ground": record of velocity ('), message
+    assert "moves at up to 2e+03 m/s, more than 1000 m/s" in message
+
+
+def test_a_record_too_fast_from_a_sweep_record_set_names_no_line(tmp_path):
+    """``sweep --records other.csv`` drives the support by another file than the one the scenario names: the
+    ``file`` line would point at a record that is not the one run."""
+    from typer.testing import CliRunner
+
+    from masonrycli.cli import app
+
+    (tmp_path / "recs").mkdir()
+    (tmp_path / "recs" / "fast.csv").write_text(FAST_RECORD)
+    (tmp_path / "other.csv").write_text(FAST_RECORD)
+    path = write(tmp_path, TOO_FAST_RECORDS[0][0].replace("scale = 1000.0", "scale = 1.0"), "s.toml")
+    args = ["sweep", str(path), "--records", str(tmp_path / "other.csv"), "--scale", "1000"]
+    result = CliRunner().invoke(app, [*args, "-o", str(tmp_path / "x.csv")])
+    assert result.exit_code == 2, result.output
+    (message,) = result.output.strip().splitlines()
+    assert f'scale=1000: {path}: support "ground": record of velocity (other.csv' in message, message
+
+
 def test_a_support_too_fast_by_a_sweep_value_names_no_line(tmp_path):
     """A sweep's ``--param amp=1e30`` replaces the file's amplitude: the file's line (amplitude = 1.0) would
     mislead, so the message gives the file alone."""
