@@ -217,12 +217,16 @@ def test_records_in_subfolders_of_a_record_folder_are_named(block, tmp_path):
     (recs / "ELC").mkdir(parents=True)
     velocity_csv(recs / "ELC" / "q.csv")
     alone = invoke("sweep", block, "--records", recs, "--workers", 0, "-o", tmp_path / "s.csv")
-    said = f"--records {recs}: its subfolders are not read; {recs / 'ELC'} hold records (give them too)"
+    said = f"--records {recs}: its subfolders are not read; {recs / 'ELC'} holds records (give them too)"
     assert alone.exit_code == 2 and words(alone.output) == f"error: {said}", alone.output
     velocity_csv(recs / "top.csv")
     args = ["--duration", 0.02, "--workers", 0, "--no-recording", "-o", tmp_path / "s.csv"]
     mixed = invoke("sweep", block, "--records", recs, *args)
     assert mixed.exit_code == 0 and f"warning: {said}" in words(mixed.output), mixed.output
+    (recs / "STN").mkdir()
+    velocity_csv(recs / "STN" / "q.csv")  # two of them: "hold"
+    both = invoke("sweep", block, "--records", recs, *args, "--force")
+    assert f"{recs / 'ELC'}, {recs / 'STN'} hold records" in words(both.output), both.output
     assert [r["record"] for r in read_rows(tmp_path / "s.csv")] == ["top.csv"]
 
 

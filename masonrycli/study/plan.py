@@ -272,7 +272,8 @@ def _records(entries: list[Path], out: Path, record_dt: float | None) -> tuple[d
             below = sorted(d for d in entry.iterdir() if d.is_dir() and any(map(_is_record_file, d.rglob("*"))))
             if below:
                 names = ", ".join(str(d) for d in below[:3]) + (" …" if len(below) > 3 else "")
-                said = f"--records {entry}: its subfolders are not read; {names} hold records (give them too)"
+                verb = "holds" if len(below) == 1 else "hold"
+                said = f"--records {entry}: its subfolders are not read; {names} {verb} records (give them too)"
                 if not found:
                     raise InputError(said)
                 unread.append(said)
