@@ -293,14 +293,20 @@ _STALLED = {
 """What a step that ends unconverged below the cap went through, by solver (engine/nlgs.py, stalled.py)."""
 
 
-def unconverged_warning(unconverged: int, steps: int, capped: int, run) -> str:
+def unconverged_warning(unconverged: int, steps: int, capped: int, run, worst: tuple[float, int] | None = None) -> str:
     """The warning's text for ``unconverged`` of ``steps`` steps, ``capped`` of them at the sweep cap of
     ``run`` (a RunConfig); the rest stalled. It said "20 at the 2-sweep cap, the others stalled: every method
-    … gave up" when there were no others."""
+    … gave up" when there were no others. ``worst``: the largest residual (m/s) and its step (1-based), said
+    with its time and its multiple of the tolerance, so that a user knows how far off and where to look."""
     stalled = unconverged - capped
     why = [f"{capped} at the {run.max_iterations}-sweep cap"] if capped else []
     if stalled:
         why.append(f"{'the other ' if capped else ''}{stalled} stalled: {_STALLED[run.solver]}")
+    if worst is not None and worst[1] > 0 and worst[0] == worst[0]:  # not before a step, not NaN
+        residual, step = worst
+        ratio = residual / run.tolerance
+        times = f"{ratio:.2g}" if ratio < 10 else f"{ratio:.0f}"  # 1.4×, 64×, 637× (not 6.4e+02×)
+        why.append(f"the worst {residual:.3g} m/s ({times}× the tolerance) at t = {step * run.dt:g} s")
     advice = "Raise --max-iterations for capped steps, or check" if capped else "Check"
     return (
         f"{unconverged} of {steps} steps ended unconverged (contact-law residual above --tolerance "
@@ -316,7 +322,9 @@ def print_summary(console: Console, outcome: Outcome, scenario, hint: str = "") 
     console.print(summary_table(result, paths.get("--out"), paths.get("--history")))
     if result is not None and result.unconverged:
         run = scenario.run
-        text = unconverged_warning(result.unconverged, result.steps, result.tally.capped, run)
+        tally = result.tally
+        worst = (tally.residual_max, tally.residual_max_step)
+        text = unconverged_warning(result.unconverged, result.steps, tally.capped, run, worst)
         console.print(Text.assemble(("warning: ", "bold red"), text), soft_wrap=True)
     if hint and "--out" in paths:
         console.print(hint, soft_wrap=True)

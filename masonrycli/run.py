@@ -54,6 +54,8 @@ class SolverTally:
     """m/s: the largest residual of a step."""
     residual_last: float = 0.0
     """m/s: the last step's residual."""
+    residual_max_step: int = 0
+    """The step (1-based) whose residual is ``residual_max``: the first such; 0 before any step."""
 
     def add(self, stats: StepStats) -> None:
         """Count one step."""
@@ -66,6 +68,7 @@ class SolverTally:
         self.contacts_max = max(self.contacts_max, contacts)
         if (residual > self.residual_max or residual != residual) and self.residual_max == self.residual_max:
             self.residual_max = residual  # a NaN residual makes the maximum NaN for good
+            self.residual_max_step = self.steps
         self.residual_last = residual
 
     @property

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import re
 import tomllib
 from pathlib import Path
 
@@ -377,11 +378,16 @@ def test_unconverged_steps_are_counted_and_warned(tmp_path):
     r = invoke("simulate", "wall", "--duration", "0.02", "--max-iterations", "2", "--no-recording", "--history", npz)
     assert r.exit_code == 0, r.output
     assert "warning: 20 of 20 steps ended unconverged" in words(r.output)
-    assert "20 at the 2-sweep cap); their" in words(r.output)  # none stalled: not said
+    assert "20 at the 2-sweep cap, the worst " in words(r.output)  # none stalled: not said
     # (what stalled steps go through, by solver: test_execute.py, unconverged_warning)
     h = np.load(npz)
     assert h["nlgs_unconverged"][-1] == 20
     assert np.all(h["nlgs_iterations"][1:] == 2) and np.all(h["nlgs_residual"][1:] > 1e-5)
+    # the worst step's residual is at least the largest the history's frames kept, said at a step's time
+    worst = re.search(r"the worst (\S+) m/s \((\S+)× the tolerance\) at t = (\S+) s\); their", words(r.output))
+    residual, times, t = float(worst[1]), float(worst[2]), float(worst[3])
+    assert residual >= h["nlgs_residual"][1:].max() and times == pytest.approx(residual / 1e-5, rel=0.05)
+    assert 0 < t <= 0.02 and round(t / 1e-3) == pytest.approx(t / 1e-3, abs=1e-9)
     npz = tmp_path / "h_default.npz"
     r = invoke("simulate", "wall", "--duration", "0.02", "--no-recording", "--history", npz)
     assert r.exit_code == 0 and "unconverged" in r.output and "warning" not in r.output, r.output

@@ -254,3 +254,13 @@ def test_the_unconverged_warning_names_only_the_causes_there_were():
     stalled_only = unconverged_warning(3, 500, 0, dataclasses.replace(run, solver="nlgs"))
     assert "m/s; 3 stalled: no lower residual in 10 000 sweeps by faces); " in stalled_only
     assert "cap" not in stalled_only and stalled_only.endswith("Check the history's nlgs_residual.")
+
+
+def test_the_unconverged_warning_says_how_far_off_and_when():
+    # "1 of 300 steps ended unconverged" left the user to find the step in the history; the worst residual
+    # (the tally's maximum and its step) is said with its time and its multiple of the tolerance
+    run = RunConfig(max_iterations=100_000, tolerance=1e-5, dt=1e-3)
+    text = unconverged_warning(1, 300, 1, run, (1.44e-5, 212))
+    assert "1 at the 100000-sweep cap, the worst 1.44e-05 m/s (1.4× the tolerance) at t = 0.212 s);" in text
+    assert "the worst" not in unconverged_warning(1, 300, 1, run, (math.nan, 212))
+    assert "the worst" not in unconverged_warning(1, 300, 1, run)

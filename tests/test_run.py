@@ -31,6 +31,7 @@ def test_tally_equals_the_figures_over_per_step_arrays():
     assert tally.capped == int((its >= 60).sum()) and tally.sweeps_max == its.max()
     assert tally.sweeps_mean == float(its.mean()) and tally.contacts_mean == float(nc.mean())  # bit for bit
     assert tally.contacts_max == nc.max() and tally.residual_max == res.max() and tally.residual_last == res[-1]
+    assert tally.residual_max_step == int(np.argmax(res)) + 1  # numpy's first maximum, steps counted from 1
 
 
 def test_a_nan_residual_makes_the_maximum_nan_as_numpy_does():
@@ -39,6 +40,7 @@ def test_a_nan_residual_makes_the_maximum_nan_as_numpy_does():
         tally.add(SimpleNamespace(iterations=3, residual=residual, contact_count=2))
     assert math.isnan(tally.residual_max) and math.isnan(np.max([1e-6, math.nan, 1e-3, 2e-7]))
     assert tally.residual_last == 2e-7 and tally.sweeps_mean == 3.0 and tally.capped == 0
+    assert tally.residual_max_step == 2 == int(np.argmax([1e-6, math.nan, 1e-3, 2e-7])) + 1
     assert SolverTally(cap=10).sweeps_mean == 0.0  # no step
 
 
