@@ -145,6 +145,24 @@ _PEER_OTHER = {".vt2": "velocity (.VT2, cm/s)", ".dt2": "displacement (.DT2, cm)
 number: "Imperial Valley..."`), which said nothing of the format."""
 
 
+def vertical_at2(path) -> bool:
+    """An .AT2 file of a vertical component: PEER's file name ends in UP or DWN (RSN6_IMPVALL.I_I-ELCUP.AT2)
+    or its header's second line ends with the component ("…, EL CENTRO ARRAY #6, UP")."""
+    path = os.fspath(path)
+    stem, suffix = os.path.splitext(os.path.basename(path))
+    if suffix.lower() != ".at2":
+        return False
+    if stem.upper().endswith(("UP", "DWN")):
+        return True
+    try:
+        with open(path, encoding="utf-8", errors="replace") as fh:
+            fh.readline()
+            second = fh.readline()
+    except OSError:
+        return False
+    return second.rsplit(",", 1)[-1].strip().upper() in ("UP", "DWN", "VERT", "VERTICAL") if "," in second else False
+
+
 def check_not_peer_other(path, name: str) -> None:
     """Raise :class:`InputError` for a PEER .VT2 / .DT2 file: masonry reads the .AT2 of the component."""
     what = _PEER_OTHER.get(os.path.splitext(os.fspath(path))[1].lower())

@@ -23,7 +23,7 @@ import os
 import numpy as np
 
 from masonrycli.record_units import MAX_AT2_G
-from masonrycli.records import G_STANDARD
+from masonrycli.records import G_STANDARD, vertical_at2
 from masonrycli.scenario import Scenario
 from masonrycli.values import quote_string
 
@@ -102,7 +102,7 @@ def idle_driven_supports(assembly, motions) -> list[str]:
     ]
 
 
-def record_warnings(scenario: Scenario) -> list[str]:
+def record_warnings(scenario: Scenario, upright: bool = True) -> list[str]:
     """One line per record that the run does not follow whole:
 
     * it starts after the run ends (a CSV stamped with clock times, 100.0, 100.1, … s): the run never
@@ -117,7 +117,10 @@ def record_warnings(scenario: Scenario) -> list[str]:
     * it is an .AT2 file (in g, converted on reading) scaled by g (9.81, or 981 for cm/s²): converted twice,
       a 0.3 g record ran at 2.9 g, under the 10 g line.
     * its times are 0, 1, 2, … s: a spreadsheet's sample numbers (a 1000-sample record ran as 1000 s at 1 Hz,
-      or, numbered from 1, "starts after the run ends" with a window as the advice).
+      or, numbered from 1, "starts after the run ends" with a window as the advice);
+    * it is an .AT2 file of a vertical component (PEER's …UP.AT2) shaking the ground horizontally: the up
+      file of an NGA-West2 zip given to ``--record`` ran along x without a word (``upright``: a sweep's
+      record set names those in one line of its own).
     """
     run = scenario.run
     unseen: dict[tuple[str, float, float], list[str]] = {}
@@ -126,6 +129,7 @@ def record_warnings(scenario: Scenario) -> list[str]:
     strong: dict[tuple[str, float, float], list[str]] = {}
     twice: dict[tuple[str, float, float], list[str]] = {}
     numbered: dict[tuple[str, float], list[str]] = {}
+    sideways: dict[str, list[str]] = {}
     for support, m in zip(scenario.assembly.supports, scenario.motions):
         if m.kind != "record":
             continue
@@ -142,6 +146,10 @@ def record_warnings(scenario: Scenario) -> list[str]:
             twice.setdefault((name, m.peak_acceleration / G_STANDARD, m.scale), []).append(f'"{support.name}"')
         elif m.peak_acceleration > MAX_AT2_G * G_STANDARD:
             strong.setdefault((name, m.peak_acceleration / G_STANDARD, m.scale), []).append(f'"{support.name}"')
+        # along x (or as the horizontal of a vertical pair): an up component along y (direction [0, 1]) is meant
+        horizontal = m.vertical_source or abs(m.direction[0]) >= abs(m.direction[1])
+        if upright and m.source and horizontal and vertical_at2(m.source):
+            sideways.setdefault(name, []).append(f'"{support.name}"')
 
     def who(names: list[str]) -> str:
         return f"support{'s' if len(names) > 1 else ''} {', '.join(names)}"
@@ -177,6 +185,11 @@ def record_warnings(scenario: Scenario) -> list[str]:
             f"{who(names)}: the record {name} has its samples at t = {first:g}, {first + 1:g}, {first + 2:g}, … s: "
             "sample numbers, not times? (give its times in s, or its values alone with --record-dt / time_step)"
             for (name, first), names in numbered.items()
+        ]
+        + [
+            f"{who(names)}: the record {name} is a vertical component (PEER's UP / DWN), applied horizontally: give "
+            "a horizontal one (H1 / H2), or this one as a scenario file's vertical = … beside its horizontal"
+            for name, names in sideways.items()
         ]
     )
 

@@ -215,3 +215,32 @@ def test_a_driven_support_without_a_motion_is_warned_about(tmp_path):
     assert any(
         w.startswith('support "g": driven, but given no motion') for w in load_scenario(tmp_path / "n.toml").warnings
     )
+
+
+def test_a_vertical_component_applied_horizontally_is_warned_about(tmp_path):
+    # the UP file of an NGA-West2 zip given to `simulate --record` ran along x without a word (a sweep's
+    # record set named it); along y, or as a scenario's vertical = …, it is where it belongs
+    from synthetic_records import write_at2
+
+    acc = [0.0, 0.02, -0.01, 0.0]
+    write_at2(tmp_path / "RSN6_IMPVALL.I_I-ELCUP.AT2", acc, 0.01)
+    write_at2(tmp_path / "RSN6_IMPVALL.I_I-ELC180.AT2", acc, 0.01)
+    write_at2(tmp_path / "q.AT2", acc, 0.01, title="IMPERIAL VALLEY 10/15/79 2316, EL CENTRO ARRAY #6, UP")
+
+    def said(motion: str) -> list[str]:
+        text = "[run]\nduration = 0.03\n" + BLOCK + GROUND + f'motion = {{ kind = "record", {motion} }}\n'
+        return record_warnings(loads_scenario(text, source=str(tmp_path / "s.toml"), base_dir=tmp_path))
+
+    up = "RSN6_IMPVALL.I_I-ELCUP.AT2"
+    for motion, name in ((f'file = "{up}"', up), ('file = "q.AT2", direction = [1.0, 0.2]', "q.AT2")):
+        assert said(motion) == [
+            f'support "ground": the record {name} is a vertical component (PEER\'s UP / DWN), applied horizontally: '
+            "give a horizontal one (H1 / H2), or this one as a scenario file's vertical = … beside its horizontal"
+        ]
+    assert said(f'file = "{up}", vertical = "RSN6_IMPVALL.I_I-ELC180.AT2"')  # the pair given the wrong way round
+    assert said(f'file = "{up}", direction = [0.0, 1.0]') == []
+    assert said(f'file = "RSN6_IMPVALL.I_I-ELC180.AT2", vertical = "{up}"') == []
+    assert said('file = "RSN6_IMPVALL.I_I-ELC180.AT2"') == []
+    # on the command line: the same line from simulate
+    output = words(invoke("simulate", "wall", "--record", tmp_path / up, "--duration", "0.03", "--no-recording").output)
+    assert f'warning: support "ground": the record {up} is a vertical component' in output, output

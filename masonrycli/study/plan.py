@@ -20,6 +20,7 @@ from pathlib import Path
 from masonrycli.builtin import check_record_dt, is_built_in, override_run, target_scenario
 from masonrycli.errors import NOT_A_FILE, InputError
 from masonrycli.outputs import OutputFile, safe_name
+from masonrycli.records import vertical_at2
 from masonrycli.study import store
 from masonrycli.study.axes import Axis, StudyBase, apply_point, check_axes, check_find, parse_axis
 from masonrycli.study.files import check_picture
@@ -200,7 +201,8 @@ def _set_warnings(base: StudyBase, axes: list[Axis]) -> list[str]:
             scenario = apply_point(base, point)
             longest = max(m.end_time for m in scenario.motions if m.kind == "record")
             run = dataclasses.replace(scenario.run, duration=max(scenario.run.duration, longest))  # not its length
-            said += [w for w in record_warnings(dataclasses.replace(scenario, run=run)) if w not in said]
+            shown = record_warnings(dataclasses.replace(scenario, run=run), upright=False)  # the set names those
+            said += [w for w in shown if w not in said]
     return said
 
 
@@ -289,7 +291,7 @@ def _records(entries: list[Path], out: Path, record_dt: float | None) -> tuple[d
     if twice:
         raise InputError(f"--records: two records named {twice[0]} (rows are keyed by the file name)")
     motions = {p.name: _record(p, record_dt) for p in files}
-    upright = [p.name for p in files if _vertical_at2(p)]
+    upright = [p.name for p in files if vertical_at2(p)]
     if upright:  # an unzipped NGA-West2 search holds each recording's H1, H2 and UP files, all .AT2
         names = ", ".join(upright[:3]) + (" …" if len(upright) > 3 else "")
         unread.append(
@@ -304,22 +306,6 @@ def _records(entries: list[Path], out: Path, record_dt: float | None) -> tuple[d
             "with a time column keep their own times): leave it out"
         )
     return motions, unread
-
-
-def _vertical_at2(path: Path) -> bool:
-    """An .AT2 file of a vertical component: PEER's file name ends in UP or DWN (RSN6_IMPVALL.I_I-ELCUP.AT2)
-    or its header's second line ends with the component ("…, EL CENTRO ARRAY #6, UP")."""
-    if path.suffix.lower() != ".at2":
-        return False
-    if path.stem.upper().endswith(("UP", "DWN")):
-        return True
-    try:
-        with open(path, encoding="utf-8", errors="replace") as fh:
-            fh.readline()
-            second = fh.readline()
-    except OSError:
-        return False
-    return second.rsplit(",", 1)[-1].strip().upper() in ("UP", "DWN", "VERT", "VERTICAL") if "," in second else False
 
 
 def _is_record_file(path: Path) -> bool:
