@@ -45,6 +45,11 @@ SLIDE_SPEED = 1e-5
 block 0.5 % past its sliding threshold reaches ~1e-4 m/s)."""
 ROCK_SPEED = 1e-4
 """rad/s: a block turning faster than this is rocking (a block at rest stays below 1e-7 rad/s)."""
+ROCK_NOISE = 2.0
+"""× tolerance / the narrowest block's smaller side: the rocking threshold's floor for small blocks. The
+solver leaves velocities wrong by up to its tolerance (m/s), a turn of about that over a block's width: a
+0.05 × 0.2 m block under a ground at 1 mm/s turned at 1.5e-4 rad/s (tolerance 1e-5 m/s: 0.75 × 1e-5 / 0.05),
+a 0.25 × 1 m one at 1.9e-5 (0.48 ×), so the small block 'rocked' from the second step on."""
 STATES = ("intact", "damaged", "collapsed")
 
 
@@ -86,7 +91,9 @@ class CollapseMonitor:
     model : the run's :class:`~masonrycli.model.Model`; ground : index of the shaking support or None.
     """
 
-    def __init__(self, model, vertices_by_block: list[np.ndarray], ground: int | None, rule: CollapseRule):
+    def __init__(
+        self, model, vertices_by_block: list[np.ndarray], ground: int | None, rule: CollapseRule, tolerance: float = 0.0
+    ):
         n = model.block_count
         self.rule = rule
         self.n = n
@@ -107,6 +114,9 @@ class CollapseMonitor:
         self.collapse_reason = ""
         self.slide_time: float | None = None
         self.rock_time: float | None = None
+        sides = [min(np.ptp(v[:, 0]), np.ptp(v[:, 1])) for v in vertices_by_block]
+        self.rock_speed = max(ROCK_SPEED, ROCK_NOISE * tolerance / min(sides)) if sides else ROCK_SPEED
+        """rad/s: turning faster than this is rocking (ROCK_SPEED, or above the solver's noise on a small block)."""
         self.peak_drift = 0.0
         self.max_slide_speed = 0.0
         self.max_rock_speed = 0.0
@@ -135,7 +145,7 @@ class CollapseMonitor:
         rule = self.rule
         self.max_rock_speed = max(self.max_rock_speed, rock)
         self.max_slide_speed = max(self.max_slide_speed, slide)
-        if self.rock_time is None and rock > ROCK_SPEED:
+        if self.rock_time is None and rock > self.rock_speed:
             self.rock_time = time
         if self.slide_time is None and slide > SLIDE_SPEED:
             self.slide_time = time

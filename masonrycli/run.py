@@ -149,7 +149,9 @@ class Simulation:
         """Steps so far whose solve did not converge (StepStats.converged false)."""
         self.last: StepStats | None = None
         vertices = [b.vertices for b in scenario.assembly.blocks]
-        self.monitor = CollapseMonitor(m, vertices, shaking_support(scenario.motions), rule_for(scenario))
+        self.monitor = CollapseMonitor(
+            m, vertices, shaking_support(scenario.motions), rule_for(scenario), scenario.run.tolerance
+        )
 
     def step(self) -> StepStats:
         stats = self.solver.step(self.state)

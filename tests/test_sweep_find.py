@@ -50,6 +50,8 @@ def block_file(tmp_path: Path, width: float, height: float, mu: float, amp: floa
     [
         (0.8, 0.4, 0.6, "sliding", 0.6 * G / (2 * math.pi * F)),  # B/H = 2: 0.4684 m/s
         (0.25, 1.0, 0.8, "rocking", G * 0.25 / (2 * math.pi * F)),  # B/H = 0.25: 0.1952 m/s
+        # a small block: the solver's 1e-5 m/s turned it at 1.5e-4 rad/s at rest, past 1e-4 ("rocking already")
+        (0.05, 0.2, 0.8, "rocking", G * 0.25 / (2 * math.pi * F)),
     ],
 )
 def test_find_reproduces_the_closed_form_threshold(tmp_path, width, height, mu, outcome, closed_form):
