@@ -4,6 +4,7 @@ thresholds are known in closed form (sliding: A·2πf > μg; rocking: A·2πf > 
 from __future__ import annotations
 
 import math
+import re
 from types import SimpleNamespace
 
 import numpy as np
@@ -148,3 +149,28 @@ def test_a_sliver_riding_a_settling_support_has_not_fallen():
     q[1, 1] -= 0.6
     mon.update(3.0, _Watch(), q, np.zeros_like(q))
     assert mon.collapse_time == 3.0 and "fell" in mon.collapse_reason
+
+
+def test_a_drift_says_whether_the_structure_slid_on_its_base_or_leans():
+    # A squat block on a ground too fast for its friction (A·2πf = 12.6 m/s² > μg) only slides: the drift rule
+    # called that "collapsed" with "the top drifted", which reads as toppling. The reason now says it slid on its
+    # base (top and base the same block, the same distance); the hand-made states tell the other cases.
+    res = simulate(block_scenario(0.4, 0.2, 0.6, 1.0, duration=1.0))
+    mon_reason = res.outcome["collapse_reason"]
+    assert mon_reason.startswith("the top drifted by more than 0.25 × the height: it slid on its base, the top ")
+    top, base = (float(x) for x in re.search(r"the top (\S+) m, the base (\S+) m$", mon_reason).groups())
+    assert top == base > 0.25 * 0.2
+    mon, q0 = two_block_monitor()
+    assert mon.base.tolist() == [0] and mon.top.tolist() == [1]
+    for lower, upper, how in (
+        (0.3, 0.3, "it slid on its base"),
+        (0.0, 0.3, "it leans"),
+        (0.15, 0.3, "it slid and leans"),
+    ):
+        m, _ = two_block_monitor()
+        q = q0.copy()
+        q[0, 0] += lower
+        q[1, 0] += upper
+        m.observe(0.1, rock=0.0, slide=0.0, fall=0.0, turn=0.0, drift=upper)
+        assert m.collapse_reason == "the top drifted by more than 0.25 × the height"  # observe: the rule alone
+        assert m._how_it_drifted(q, upper) == f": {how}, the top {upper:.3g} m, the base {lower:.3g} m"
