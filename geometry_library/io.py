@@ -63,7 +63,7 @@ from shapely.geometry import GeometryCollection, MultiPolygon, Polygon
 
 from .blocks import SUPPORT_ROLES, Assembly, Block, GeometryError, Support
 from .checks import body_label, polygon_from_coords
-from .values import check_positive
+from .values import check_positive, is_real
 
 _LABEL = re.compile(
     r"^\s*(?:(?P<role>block|support)\s+)?(?P<name>[^\s:]+)(?:\s+(?P<srole>fixed|driven))?\s*:\s*(?P<wkt>.+)$",
@@ -108,9 +108,20 @@ def _number(value, what: str, where: str) -> float:
     return float(value)
 
 
+def _real(value) -> float:
+    """A JSON number as a float: a bool or a string of a number ("1") is not one (float() took both, so
+    ``true`` was read as 1.0 without a word); an int too large for a float is infinite (the caller says so)."""
+    if not is_real(value):
+        raise TypeError(f"not a number: {value!r}")
+    try:
+        return float(value)
+    except OverflowError:  # a 400-digit integer: "int too large to convert to float" was a traceback
+        return math.inf
+
+
 def _velocity(value, where: str) -> tuple[float, float, float]:
     try:
-        v = tuple(float(x) for x in value)
+        v = tuple(_real(x) for x in value)
     except (TypeError, ValueError):
         v = ()
     if len(v) != 3 or not all(math.isfinite(x) for x in v):
@@ -193,7 +204,7 @@ def read_geojson(path, density: float = 2500.0, thickness: float = 1.0, unknown:
         if len(rings) > 1:
             raise GeometryError(f"{where}: polygon has {len(rings) - 1} hole(s); blocks are solid")
         try:
-            coords = np.array([[float(c) for c in xy[:2]] for xy in rings[0]], dtype=np.float64)
+            coords = np.array([[_real(c) for c in xy[:2]] for xy in rings[0]], dtype=np.float64)
         except (TypeError, ValueError, IndexError):
             raise GeometryError(f"{where}: coordinates must be [x, y] number pairs") from None
         try:

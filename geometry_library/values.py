@@ -245,7 +245,10 @@ def number_problem(
         return "must be an integer"
     if not is_real(value):
         return "must be a number"
-    x = value if integer else float(value)
+    try:
+        x = value if integer else float(value)
+    except OverflowError:  # an int of 400 digits (TOML and JSON read any size): "int too large to convert"
+        return "must be a finite number"
     if not integer and (math.isnan(x) or (math.isinf(x) and not (allow_inf and x > 0))):
         return "must be a finite number"
     if gt is not None and not x > gt:

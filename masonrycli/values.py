@@ -137,7 +137,10 @@ def check_vector(key: str, value, size: int = 2, names: str | None = None) -> tu
     if not isinstance(value, (list, tuple)) or len(value) != size or not all(is_real(v) for v in value):
         names = names or {2: "[x, y]", 3: "[vx, vy, omega]"}.get(size, f"{size} numbers")
         raise field_error(key, value, f"must be {size} numbers {names}")
-    out = tuple(float(v) for v in value)
+    try:
+        out = tuple(float(v) for v in value)
+    except OverflowError:  # an int of 400 digits (TOML reads any size)
+        out = (math.inf,)
     if not all(math.isfinite(v) for v in out):
         raise field_error(key, value, "must be finite numbers")
     return out

@@ -99,6 +99,20 @@ FILE_ROWS = [
         2,
         "[run] gravity = [0.0, -1000000000.0]: |g| = 1e+09 m/s² is more than 10000 (about 1000 g; a likely typo)",
     ),
+    (  # the integers below overflowed float(): a traceback
+        "run-dt-huge-integer",
+        scen(f"dt = {10**400}"),
+        ("check", "s.toml"),
+        2,
+        "s.toml:2: [run] dt = 100000000000000000000000000000000000000000000000000000000...: must be a finite number",
+    ),
+    (
+        "block-vertex-huge-integer",
+        scen(block=f'name = "b1"\npolygon = [[0, 0], [{10**400}, 0], [1, 1]]\n'),
+        ("check", "s.toml"),
+        2,
+        '[[block]] #1 ("b1"): polygon[1] = [1000000000000000000000000000000000000000000000000000000',
+    ),
     ("run-tolerance", scen("tolerance = 2"), ("check", "s.toml"), 2, "[run] tolerance = 2: must be < 1"),
     (
         "run-unknown-key",
@@ -303,6 +317,22 @@ FILE_ROWS = [
         "g.geojson: ",
     ),
     ("geojson-missing", {}, ("run", "nope.geojson"), 2, "nope.geojson: no such scenario or geometry file"),
+    # integers too large for a float (TOML and JSON read any size): "OverflowError: int too large to convert
+    # to float", a traceback; and a JSON true read as the coordinate 1.0 without a word
+    (
+        "geojson-huge-integer",
+        {"g.geojson": feature([[[0, 0], [10**400, 0], [1, 1], [0, 0]]])},
+        ("check", "g.geojson"),
+        2,
+        'g.geojson: feature 1: block 1 ("a"): vertex 1 has a NaN or infinite coordinate',
+    ),
+    (
+        "geojson-bool-coordinate",
+        {"g.geojson": feature([[[0, 0], [True, 0], [1, 1], [0, 0]]])},
+        ("check", "g.geojson"),
+        2,
+        'g.geojson: feature 1: block 1 ("a"): coordinates must be [x, y] number pairs',
+    ),
     # -- WKT
     (
         "wkt-nan",
