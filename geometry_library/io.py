@@ -151,6 +151,8 @@ def read_geojson(path, density: float = 2500.0, thickness: float = 1.0, unknown:
         data = json.loads(text)
     except json.JSONDecodeError as exc:
         raise GeometryError(f"{path}: invalid JSON ({exc.msg} at line {exc.lineno}, column {exc.colno})") from None
+    except RecursionError:  # thousands of nested [[[…]]]: the decoder recurses (a traceback, exit 1)
+        raise GeometryError(f"{path}: invalid GeoJSON (JSON nested too deeply)") from None
     if not isinstance(data, dict) or data.get("type") != "FeatureCollection":
         # "got None" said nothing of a JSON file that is no GeoJSON (a package.json, a settings file)
         if not isinstance(data, dict):

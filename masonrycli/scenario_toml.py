@@ -95,6 +95,8 @@ def loads_scenario(
         doc = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise ctx.error("", f"TOML syntax error: {exc}") from None
+    except RecursionError:  # thousands of nested [[[…]]]: tomllib recurses (a traceback, exit 1)
+        raise ctx.error("", "TOML nested too deeply (arrays or inline tables within each other)") from None
     try:
         return _parse_document(doc, ctx, default_name)
     except InputError as exc:  # the line of the key it names, where the text shows it unambiguously

@@ -136,6 +136,20 @@ FILE_ROWS = [
         2,
         "s.toml:2: not a UTF-8 text file (byte 14, 0xff",
     ),
+    (  # nested arrays made tomllib and json recurse: RecursionError, a traceback
+        "toml-nested-too-deeply",
+        {"s.toml": "a = " + "[" * 5000 + "]" * 5000 + "\n"},
+        ("check", "s.toml"),
+        2,
+        "s.toml: TOML nested too deeply",
+    ),
+    (
+        "geojson-nested-too-deeply",
+        {"g.geojson": "[" * 100000 + "]" * 100000},
+        ("check", "g.geojson"),
+        2,
+        "g.geojson: invalid GeoJSON (JSON nested too deeply)",
+    ),
     ("top-level-unknown", {"s.toml": f"blok = 1\n{SCENE}"}, ("check", "s.toml"), 2, 's.toml:1: unknown key "blok"'),
     # -- scenario TOML: blocks and supports
     (
