@@ -38,7 +38,8 @@ def read_geometry(
             f"file = {quote_string(path)}: unknown geometry format (expected {', '.join(GEOMETRY_SUFFIXES)})",
         )
     if not os.path.isfile(path):
-        missing = NOT_A_FILE if os.path.exists(path) else "no such file"
+        # a folder was called "a device, a pipe or a socket"
+        missing = "is a directory" if os.path.isdir(path) else NOT_A_FILE if os.path.exists(path) else "no such file"
         raise ctx.error(where, f"file = {quote_string(path)}: {missing}" if where else missing)
     unknown: dict = {}
     try:

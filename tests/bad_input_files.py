@@ -290,6 +290,13 @@ FILE_ROWS = [
         2,
         "missing.geojson",
     ),
+    (  # it said "not a regular file (a device, a pipe or a socket)"
+        "structure-file-is-folder",
+        {"s.toml": '[structure]\nfile = "d.geojson"\n', "d.geojson/x": ""},
+        ("check", "s.toml"),
+        2,
+        'd.geojson": is a directory',
+    ),
     ("scenario-missing", {}, ("check", "no-such.toml"), 2, "no-such.toml: no such scenario or geometry file"),
     (
         "scenario-is-folder",
