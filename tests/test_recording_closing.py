@@ -230,3 +230,26 @@ def _drifting_wall(path, step: float):
         for f in frames:
             rec.log_frame(f)
     return path, static, q0, frames
+
+
+def test_a_long_low_wall_gets_a_colour_bar_tall_enough_to_read(tmp_path):
+    """The bar was as high as the structure: on an 8-course wall 37.5 m long ('masonry simulate wall
+    --courses 8 --length 37.5') it was a 1.2 m square beside 37.5 m of wall, and its five tick labels,
+    title and count overlapped in a smear at first open. The bar is now at least 12 times as high as it is
+    wide (the paper's structures: 15 to 30, unchanged), and the view holds it and its title."""
+    from masonrycli.recording.layout import PLANE
+    from masonrycli.recording.static_content import TICKS, legend_positions
+
+    static, q0 = fx.wall(courses=2, per_course=40)  # 40 blocks long, 2 courses: 10 times as long as high
+    path = tmp_path / "long.rrd"
+    with Recorder(path, static, fx.METADATA, batch_frames=4) as rec:
+        for f in fx.frames(static, q0, 3):
+            rec.log_frame(f)
+    top = fx.static_value(path, f"/{PLANE}", "Transform3D:translation")[0][1]  # the view's upper edge, m
+    height = fx.static_value(path, f"/{PLANE}", "Pinhole:resolution")[0][1]
+    for f in rec_mod.FIELDS:
+        bar = np.array(fx.static_value(path, f"/{f.bar}", "Mesh3D:vertex_positions"))[:, :2]
+        (xa, ya), (xb, yb) = bar.min(axis=0), bar.max(axis=0)
+        assert yb - ya >= 12.0 * (xb - xa), (f.key, yb - ya, xb - xa)
+        anchors = legend_positions((xa, ya, xb, yb))
+        assert top - height < anchors[:, 1].min() and anchors[TICKS, 1] < top, (f.key, anchors, top, height)

@@ -49,6 +49,7 @@ from masonrycli.recording.layout import (
 
 _CAMERA_HEIGHT: Final = 1.0e4  # m, drawing-plane camera above z = 0
 _SUPPORT_MARGIN: Final = 0.15  # initial view: supports up to this × the structure's size beyond blocks
+_MIN_BAR_RATIO: Final = 12.0  # colour bar height / width at least (the paper's structures: 15 to 30)
 
 
 @dataclass(frozen=True)
@@ -196,7 +197,14 @@ def log_plane(
     pad, bar = 0.05 * size, 0.025 * size
     ya, yb = blk[:, 1].min(), blk[:, 1].max()
     room = 0.12 * (yb - ya)  # for the title above the bar and the over / under labels
-    legend_box = (hi[0] + 2 * pad, ya + room, hi[0] + 2 * pad + bar, yb - room)
+    # a low structure got a bar as short as itself: an 8-course wall 37.5 m long ('simulate wall
+    # --courses 8 --length 37.5') drew a square bar 1.2 m high whose five tick labels, title and count
+    # overlapped in a smear. The bar is at least _MIN_BAR_RATIO times as high as it is wide (its labels
+    # ~60 px apart), standing on the same base and rising above the structure, the view made taller to hold
+    # it and its title (at 0.14 of the bar's height above it)
+    span = max(yb - ya - 2 * room, _MIN_BAR_RATIO * bar)
+    legend_box = (hi[0] + 2 * pad, ya + room, hi[0] + 2 * pad + bar, ya + room + span)
+    hi[1] = max(hi[1], legend_box[3] + 0.14 * span + bar)
     x0, y0 = lo[0] - pad, hi[1] + pad
     resolution = [hi[0] + 3 * pad + bar + 0.2 * size - x0, y0 - lo[1] + pad]
     rec.log(
