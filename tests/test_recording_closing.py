@@ -253,3 +253,23 @@ def test_a_long_low_wall_gets_a_colour_bar_tall_enough_to_read(tmp_path):
         assert yb - ya >= 12.0 * (xb - xa), (f.key, yb - ya, xb - xa)
         anchors = legend_positions((xa, ya, xb, yb))
         assert top - height < anchors[:, 1].min() and anchors[TICKS, 1] < top, (f.key, anchors, top, height)
+
+
+def test_a_long_low_wall_keeps_its_block_fills(tmp_path):
+    """The fills were inset by 0.002 × the structure's size alone: on an 8-course wall 37.5 m long
+    ('masonry simulate wall --courses 8 --length 37.5') 0.2 m high blocks lost 7.5 cm a side, the fills were
+    5 cm high, about a pixel at first open, and every colour map read as a dark grey strip. The inset is now
+    at most 7.5 % of a median block's smaller side: each fill keeps at least 85 % of its block's height."""
+    from masonrycli.recording.layout import FILL
+
+    static, q0 = fx.wall(courses=2, per_course=100, ragged=False)  # 30 m long, 0.4 m high
+    path = tmp_path / "long.rrd"
+    frames = fx.frames(static, q0, 3)
+    with Recorder(path, static, fx.METADATA, batch_frames=4) as rec:
+        for f in frames:
+            rec.log_frame(f)
+    verts = np.array(fx.temporal_rows(path, f"/{FILL}", "Mesh3D:vertex_positions")[frames[0].step])[:, 1]
+    start = static.block_vert_start
+    fill_height = np.maximum.reduceat(verts, start[:-1]) - np.minimum.reduceat(verts, start[:-1])
+    # the frames turn a block by 0.01 rad at most: its outline's height grows by under 3 mm
+    assert fill_height.min() >= 0.85 * fx.BLOCK_H - 0.003, fill_height.min()

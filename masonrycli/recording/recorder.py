@@ -58,6 +58,7 @@ from masonrycli.recording.layout import (
     FIELDS,
     GLYPH_HALF_LENGTH,
     INSET,
+    INSET_BLOCK_CAP,
     LEGEND,
     LEGEND_BARS,
     LEGEND_LABELS,
@@ -132,6 +133,7 @@ class Recorder:
         loc = self._blocks.local
         size = (np.maximum.reduceat(loc, first) - np.minimum.reduceat(loc, first)) if n else np.ones((1, 2))
         self.block_height = float(np.median(size[:, 1]))  # m, median block height: the force-arrow unit
+        self._block_side = float(np.median(size.min(axis=1)))  # m: caps the fills' inset (INSET_BLOCK_CAP)
         # (N,) m: a block's farthest vertex from its centroid, for the reach of the run (_clear_the_legend)
         self._radius = np.maximum.reduceat(np.hypot(*loc.T), first) if n else np.zeros(0)
         self._reach = -np.inf
@@ -210,7 +212,7 @@ class Recorder:
             self._legend_box, self._size = log_plane(self.rec, self._blocks, self._supports, q, sq)
             self._fill = Polygons(
                 self.static.block_vert_start,
-                inset_local(self.static.block_vert_start, self.static.block_vert_local, INSET * self._size),
+                inset_local(self.static.block_vert_start, self.static.block_vert_local, self.fill_inset()),
             )
             log_initial_shape(self.rec, self._blocks, self.static.triangles, q, sq, self._supports)
             for f in FIELDS:
@@ -334,6 +336,11 @@ class Recorder:
         shift = rr.Transform3D(translation=[box[0] - self._legend_box[0], 0.0, 0.0])
         for path in (LEGEND_BARS, LEGEND_LABELS):
             self.rec.log(path, shift, static=True)
+
+    def fill_inset(self) -> float:
+        """How far (m) the block fills are inset: INSET × the structure's size, at most INSET_BLOCK_CAP × a
+        median block's smaller side."""
+        return min(INSET * self._size, INSET_BLOCK_CAP * self._block_side)
 
     def residual_range(self) -> tuple[float, float] | None:
         """The residual plot's y range, log10 of m/s: from the smallest residual but those more than a decade
