@@ -72,17 +72,33 @@ def main_callback(
 def _execute(scenario, opts: dict, hint=None) -> None:
     """Check the outputs (``opts``: the OUTPUT, FORCE and STOP options), run, print the summary; exit with
     the code of how the run ended. ``hint``: the line under the summary, given the time the run reached."""
-    from masonrycli.execute import execute, print_summary
-    from masonrycli.interrupt import StopRun, exit_code, signal_name
+    from masonrycli.interrupt import StopSignals
     from masonrycli.scenario_warnings import scenario_warnings
-    from masonrycli.sinks import DIVERGED, FAILED
 
     outputs = _check_run(scenario, opts)
     for warning in scenario_warnings(scenario):
         warn(warning)
+    # The run's handlers stay installed through the summary: once execute() had put Python's back, a Ctrl-C
+    # while the summary was printed said "Ctrl-C: stopped before any output was written" (exit 130) of a
+    # run whose files had just been renamed into place, and a SIGTERM killed the process mid-table (-15).
+    with StopSignals() as signals:
+        _execute_and_report(scenario, opts, hint, outputs, signals)
+
+
+def _execute_and_report(scenario, opts: dict, hint, outputs, signals) -> None:
+    """:func:`_execute`'s run and summary, under ``signals``."""
+    from masonrycli.execute import execute, print_summary
+    from masonrycli.interrupt import StopRun, exit_code, signal_name
+    from masonrycli.sinks import DIVERGED, FAILED, INTERRUPTED
+
     try:
         outcome = execute(
-            scenario, outputs, console=console, stop_at_collapse=opts["stop_at_collapse"], magnify=opts["magnify"]
+            scenario,
+            outputs,
+            console=console,
+            stop_at_collapse=opts["stop_at_collapse"],
+            magnify=opts["magnify"],
+            signals=signals,
         )
     except StopRun as stop:
         fail(f"{signal_name(stop.signum)} before the first step: nothing was written", exit_code(stop.signum))
@@ -104,8 +120,14 @@ def _execute(scenario, opts: dict, hint=None) -> None:
         say("error", "bold red", f"cannot write {error}")
     if outcome.errors or result.status == FAILED:
         raise typer.Exit(EXIT_OUTPUT_FAILED)
-    if outcome.signum is not None:
-        raise typer.Exit(exit_code(outcome.signum))
+    if signals.signum is not None:
+        if outcome.signum is None or result.status != INTERRUPTED:  # it came once the last step was over
+            say(
+                "note",
+                "yellow",
+                f"{signal_name(signals.signum)} after the last step: the run {result.status} and its files are whole",
+            )
+        raise typer.Exit(exit_code(signals.signum))
     if result.status == DIVERGED:
         raise typer.Exit(EXIT_DIVERGED)
 

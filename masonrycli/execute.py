@@ -8,6 +8,7 @@ is renamed into place, so what was computed is kept and a path never holds half 
 
 from __future__ import annotations
 
+import contextlib
 import platform
 import shlex
 import shutil
@@ -192,14 +193,22 @@ def recording_static(sim: Simulation):
 
 
 def execute(
-    scenario, outputs: Outputs, *, console: Console, stop_at_collapse: bool = False, magnify: float | None = None
+    scenario,
+    outputs: Outputs,
+    *,
+    console: Console,
+    stop_at_collapse: bool = False,
+    magnify: float | None = None,
+    signals: StopSignals | None = None,
 ) -> Outcome:
     """Run ``scenario`` writing ``outputs``; ``stop_at_collapse`` ends the run when the structure
     collapses (:mod:`masonrycli.collapse`); ``magnify``: the recording's magnified-shape factor (None:
     chosen from the run). Signals: :mod:`masonrycli.interrupt` (a stop before step 1
     raises its ``StopRun`` after removing the temporary files); an engine error is re-raised after the
-    outputs are closed with status "failed" and renamed into place."""
-    with StopSignals() as signals:
+    outputs are closed with status "failed" and renamed into place. ``signals``: a :class:`StopSignals`
+    the caller entered and keeps installed after the run (its closing phase lasting through the summary);
+    by default one of the run's own."""
+    with StopSignals() if signals is None else contextlib.nullcontext(signals) as signals:
         sinks: dict[OutputFile, object] = {}
         try:
             for out in outputs.files():

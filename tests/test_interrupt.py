@@ -301,3 +301,45 @@ def test_a_stopped_context_never_puts_pythons_handler_back_on_its_way_out(monkey
         monkeypatch.setattr(interrupt.signal, "signal", record)
     monkeypatch.undo()
     assert signals.signum == signal.SIGINT and installed and all(h is signal.SIG_IGN for h in installed), installed
+
+
+SIGNAL_IN_SUMMARY = """
+import os, signal, sys, time
+import masonrycli.execute as execute
+
+print_summary = execute.print_summary
+
+def signalled_summary(*args, **kwargs):  # the run is over, its files renamed into place
+    os.kill(os.getpid(), int(os.environ["SIGNAL"]))
+    time.sleep(0.2)  # a Python handler runs here
+    print_summary(*args, **kwargs)
+
+execute.print_summary = signalled_summary
+sys.argv = ["masonry", *sys.argv[1:]]
+from masonrycli.__main__ import main
+main()
+"""
+
+
+@pytest.mark.parametrize("sig, code", [(signal.SIGINT, 130), (signal.SIGTERM, 143)], ids=["sigint", "sigterm"])
+def test_a_signal_while_the_summary_is_printed_says_the_files_are_whole(sig, code, tmp_path):
+    """Helper-123: once execute() had put Python's handlers back, a Ctrl-C while the summary was printed said
+    "Ctrl-C: stopped before any output was written" (exit 130) of a run whose files had just replaced the
+    previous ones, and a SIGTERM killed the process mid-table (exit -15, no line). Both files were whole."""
+    rrd, npz = tmp_path / "w.rrd", tmp_path / "w.npz"
+    rrd.write_bytes(b"the previous recording")
+    argv = ["simulate", "wall", "--duration", "0.02", "--out", str(rrd), "--history", str(npz), "--force"]
+    proc = subprocess.run(
+        [sys.executable, "-c", SIGNAL_IN_SUMMARY, *argv],
+        env=dict(os.environ, RERUN_ANALYTICS="0", SIGNAL=str(int(sig))),
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert proc.returncode == code, proc.stdout + proc.stderr
+    assert "Traceback" not in proc.stderr and "before any output" not in proc.stderr, proc.stderr
+    assert "completed" in proc.stdout  # the summary, printed whole
+    assert proc.stderr.strip().endswith("after the last step: the run completed and its files are whole")
+    h = np.load(npz)
+    assert str(h["status"]) == "completed" and frames_in_recording(rrd) == len(h["time"]) == 3
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["w.npz", "w.rrd"]
