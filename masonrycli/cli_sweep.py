@@ -191,6 +191,7 @@ def sweep_command(
     # phase (masonrycli.interrupt): a second Ctrl-C while the table was written cut it (only the journal
     # left, under "every finished row is in s.parquet"), and one after it killed the process (exit -2).
     out, result, written = plan.request.out, None, []
+    previous = _identity(out)  # a table that --force would replace, left as it was by a stop before any row
     with FirstSignalStops() as signals:
         try:
             result = run_study(plan.base, plan.request, console)
@@ -207,6 +208,8 @@ def sweep_command(
             if result is None and not (out.exists() or store.journal_path(out).exists()):
                 # stopped before the table was opened (while a --scheduler was reached): there is no file
                 said = "stopped before any row was finished; nothing was written"
+            elif result is None and previous is not None and _identity(out) == previous:
+                said = f"stopped before any row was finished; nothing was written ({out} is as it was)"
             elif result is None:
                 said = f"every finished row is in {out}; run the same command again to resume"
             else:  # the study is complete: what is missing is a picture
@@ -216,6 +219,16 @@ def sweep_command(
                 said = f"every row is in {out}, but not written: {', '.join(missing)}; run the same command {again}"
             err_console.print(f"interrupted{how}: {said}", soft_wrap=True)
             raise typer.Exit(exit_code(signum)) from None
+
+
+def _identity(path: Path) -> tuple | None:
+    """Which file is at ``path`` (device, inode, size, modification time), None if none: a table written
+    anew is renamed onto the path, so a changed identity means it was replaced."""
+    try:
+        st = path.stat()
+    except OSError:
+        return None
+    return st.st_dev, st.st_ino, st.st_size, st.st_mtime_ns
 
 
 def _exit_for_failed_rows(result, err_console) -> None:

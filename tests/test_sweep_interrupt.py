@@ -307,3 +307,25 @@ def test_ctrl_c_before_the_first_row_leaves_no_table_and_the_same_command_runs(b
     monkeypatch.undo()
     result = invoke(*args)
     assert result.exit_code == 0 and "(2 runs now, 0 rows already there" in words(result.output), result.output
+
+
+def test_ctrl_c_before_the_first_row_keeps_the_table_that_force_would_replace(block, tmp_path, monkeypatch):
+    # Helper-123: with --force over another study's table, a Ctrl-C before any row was finished replaced that
+    # table by an empty one (0 rows: the other study lost for nothing) and said "every finished row is in
+    # s.csv; run the same command again to resume".
+    from masonrycli.study import runner
+
+    def interrupted(*args):
+        raise KeyboardInterrupt
+
+    out = tmp_path / "s.csv"
+    assert invoke("sweep", block, "-p", "amp=0.05", "--duration", 0.02, "--workers", 0, "-o", out).exit_code == 0
+    before = out.read_bytes()
+    monkeypatch.setattr(runner, "run_task", interrupted)
+    args = ["sweep", block, "-p", "amp=0.1,0.2", "--duration", 0.02, "--workers", 0, "-o", out, "--force"]
+    result = invoke(*args, "--no-recording")
+    assert result.exit_code == 130, result.output
+    said = f"interrupted: stopped before any row was finished; nothing was written ({out} is as it was)"
+    assert words(result.output).endswith(said), result.output
+    assert out.read_bytes() == before
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["block.toml", "s.csv", "s.png", "s.rrd"]

@@ -211,9 +211,10 @@ def run_study(base: StudyBase, request: StudyRequest, console: Console) -> Study
         for r in rows:
             r.setdefault("study", study_id)
             r.setdefault("source", "")  # a row of a table written before rows named their source: unknown
-        if rows or table.path.exists():
+        if rows:
             store.write_rows(table, rows, columns)
-        else:  # stopped before any row: a header-only table held nothing, yet the same command refused it
+        else:  # stopped before any row: a header-only table held nothing, yet the same command refused it;
+            # and the table --force would replace (another study's) became an empty one, lost for nothing
             store.journal_path(request.out).unlink(missing_ok=True)
         _close(client, cluster)
         if request.scheduler is None:  # its workers are gone: what they left half-written is of no one
