@@ -181,7 +181,10 @@ def read_geojson(path, density: float = 2500.0, thickness: float = 1.0, unknown:
         if role not in ("block", "support"):
             raise GeometryError(f"{where}: role must be 'block' or 'support', got {role!r}")
         index = len(blocks) if role == "block" else len(supports)
-        name = str(props.get("name", f"{role}-{index + 1}"))  # block-1 first, as in a TOML file
+        name = props.get("name", f"{role}-{index + 1}")  # block-1 first, as in a TOML file
+        if isinstance(name, (bool, list, dict)):  # a number is a GIS id column's (5 -> "5"); these were named
+            raise GeometryError(f"{where}: name must be a string, got {name!r}")  # "{'a': 1}", "True"
+        name = str(name)
         where = f"{feature_at}: {body_label(index, name, role)}"
         if unknown is not None:  # a support's velocity (or density) was not read either, without a word
             elsewhere = SUPPORT_PROPERTIES if role == "block" else BLOCK_PROPERTIES

@@ -354,6 +354,13 @@ FILE_ROWS = [
         2,
         'g.geojson: feature 1: block 1 ("a"): coordinates must be [x, y] number pairs',
     ),
+    (  # the block was named "{'a': 1}" (a list "['x']", true "True") without a word
+        "geojson-name-object",
+        {"g.geojson": feature(SQUARE, name={"a": 1})},
+        ("check", "g.geojson"),
+        2,
+        "g.geojson: feature 1: name must be a string, got {'a': 1}",
+    ),
     # -- WKT
     (
         "wkt-nan",
