@@ -343,3 +343,42 @@ def test_a_signal_while_the_summary_is_printed_says_the_files_are_whole(sig, cod
     h = np.load(npz)
     assert str(h["status"]) == "completed" and frames_in_recording(rrd) == len(h["time"]) == 3
     assert sorted(p.name for p in tmp_path.iterdir()) == ["w.npz", "w.rrd"]
+
+
+SIGNAL_IN_LIMIT_TABLE = """
+import os, signal, sys, time
+import masonrycli.limit.command as command
+
+result_table = command.result_table
+
+def signalled_table(*args, **kwargs):  # λ found, the recording whole and in place
+    os.kill(os.getpid(), int(os.environ["SIGNAL"]))
+    time.sleep(0.2)  # a Python handler runs here
+    return result_table(*args, **kwargs)
+
+command.result_table = signalled_table
+sys.argv = ["masonry", *sys.argv[1:]]
+from masonrycli.__main__ import main
+main()
+"""
+
+
+@pytest.mark.parametrize("sig, code", [(signal.SIGINT, 130), (signal.SIGTERM, 143)], ids=["sigint", "sigterm"])
+def test_a_signal_while_the_limit_answer_is_printed_says_the_recording_is_whole(sig, code, tmp_path):
+    """Helper-123: as for a run's summary (above), a Ctrl-C while `masonry limit` printed its table said "Ctrl-C:
+    stopped before any output was written" with its recording written, and a SIGTERM killed it (-15)."""
+    rrd = tmp_path / "l.rrd"
+    rrd.write_bytes(b"the previous recording")
+    proc = subprocess.run(
+        [sys.executable, "-c", SIGNAL_IN_LIMIT_TABLE, "limit", "arch", "--out", str(rrd), "--force"],
+        env=dict(os.environ, RERUN_ANALYTICS="0", SIGNAL=str(int(sig))),
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert proc.returncode == code, proc.stdout + proc.stderr
+    assert "Traceback" not in proc.stderr and "before any output" not in proc.stderr, proc.stderr
+    assert "0.0901" in proc.stdout  # the table, printed whole
+    said = f"after the answer was printed: λ = 0.0901, the recording {rrd} is complete"
+    assert proc.stderr.strip().endswith(said), proc.stderr
+    assert frames_in_recording(rrd) > 0 and sorted(p.name for p in tmp_path.iterdir()) == ["l.rrd"]

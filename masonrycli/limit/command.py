@@ -194,6 +194,20 @@ def run_limit(
             how = "" if stop.signum == signal.SIGINT else f" ({signal_name(stop.signum)})"  # as `masonry sweep`
             err_console.print(f"interrupted{how}: {done.describe()}", soft_wrap=True)
             raise typer.Exit(exit_code(stop.signum)) from None
+        done.verifying = False  # it finished
+        # The answer is printed under the handlers, a signal only noted: once they had been put back, a Ctrl-C
+        # here said "Ctrl-C: stopped before any output was written" with the recording written, and a SIGTERM
+        # killed the command mid-table (exit -15).
+        signals.closing()
+        _print_answer(done, checks, verify, as_json, console)
+    if signals.signum is not None:
+        said = f"{signal_name(signals.signum)} after the answer was printed: {done.describe()}"
+        err_console.print(f"note: {said}", soft_wrap=True)
+        raise typer.Exit(exit_code(signals.signum))
+
+
+def _print_answer(done, checks, verify: bool, as_json: bool, console) -> None:
+    """The result table (and the --verify table), or one JSON object."""
     result, out = done.result, done.out
     if as_json:
         # the code that answered, as a run's history and recording name it (before: no version, no commit)
