@@ -166,13 +166,18 @@ def temporal_rows(path, entity: str, column: str) -> dict[int, list]:
 
 
 def static_value(path, entity: str, column: str):
-    """The last static value of ``column`` logged at ``entity`` in the recording at ``path`` (None: none)."""
+    """The last static value of ``column`` logged at ``entity`` in the recording at ``path`` (None: none):
+    the one of the latest row id, which the viewer shows (the chunks are not stored in the order logged)."""
     import rerun as rr
 
-    value = None
+    value, latest = None, b""
     for chunk in rr.chunk.RrdReader(str(path)).stream():
         if chunk.entity_path == entity and chunk.is_static:
             batch = chunk.to_record_batch()
             if column in batch.schema.names:
-                value = batch.column(column).to_pylist()[-1]
+                for row_id, v in zip(
+                    batch.column("rerun.controls.RowId").to_pylist(), batch.column(column).to_pylist()
+                ):
+                    if v is not None and row_id > latest:  # row ids: big-endian, time first
+                        value, latest = v, row_id
     return value

@@ -273,3 +273,26 @@ def test_a_long_low_wall_keeps_its_block_fills(tmp_path):
     fill_height = np.maximum.reduceat(verts, start[:-1]) - np.minimum.reduceat(verts, start[:-1])
     # the frames turn a block by 0.01 rad at most: its outline's height grows by under 3 mm
     assert fill_height.min() >= 0.85 * fx.BLOCK_H - 0.003, fill_height.min()
+
+
+def test_centroid_dots_stay_smaller_than_small_blocks(tmp_path):
+    """The dots at the blocks' centroids were 2.5 ui points (5 px wide) whatever the blocks: on an 8-course
+    wall 37.5 m long the blocks are 4-5 px high at first open and the dots darkened every colour map. As
+    drawn at first open (the structure panel of a 1920 x 1080 window, 1150 x 840 px, fitted to the view's
+    extent) a dot is now at most a quarter of a block's smaller side wide; a small structure keeps 2.5."""
+    from masonrycli.recording.layout import BLOCKS, CENTROID_RADIUS, PLANE
+
+    def drawn(static, q0, name):  # (dot width, block's smaller side) at first open, px
+        path = tmp_path / name
+        with Recorder(path, static, fx.METADATA, batch_frames=4) as rec:
+            for f in fx.frames(static, q0, 3):
+                rec.log_frame(f)
+        w, h = fx.static_value(path, f"/{PLANE}", "Pinhole:resolution")[0]
+        px_per_m = min(1150.0 / w, 840.0 / h)
+        (r,) = fx.static_value(path, f"/{BLOCKS}", "Points2D:radii")
+        return (-2.0 * r if r < 0 else 2.0 * r * px_per_m), min(fx.BLOCK_W, fx.BLOCK_H) * px_per_m, r
+
+    dot, side, _ = drawn(*fx.wall(courses=2, per_course=100, ragged=False), "long.rrd")  # 30 m x 0.4 m
+    assert dot <= 0.25 * side + 1e-6, (dot, side)
+    _, _, r = drawn(*fx.wall(), "small.rrd")  # 1.2 m x 0.8 m: blocks ~ 100 px
+    assert r == CENTROID_RADIUS

@@ -209,7 +209,9 @@ class Recorder:
         sq = np.asarray(frame.support_q, f64).reshape(-1, 3)
         if self._ref is None:
             self._ref = (q, sq, float(frame.energy_potential))
-            self._legend_box, self._size = log_plane(self.rec, self._blocks, self._supports, q, sq)
+            self._legend_box, self._size = log_plane(
+                self.rec, self._blocks, self._supports, q, sq, block_side=self._block_side
+            )
             self._fill = Polygons(
                 self.static.block_vert_start,
                 inset_local(self.static.block_vert_start, self.static.block_vert_local, self.fill_inset()),
@@ -331,7 +333,14 @@ class Recorder:
             return
         q, sq, _ = self._ref
         box, _ = log_plane(
-            self.rec, self._blocks, self._supports, q, sq, reach=self._reach, reach_left=self._reach_left
+            self.rec,
+            self._blocks,
+            self._supports,
+            q,
+            sq,
+            reach=self._reach,
+            reach_left=self._reach_left,
+            block_side=self._block_side,
         )
         shift = rr.Transform3D(translation=[box[0] - self._legend_box[0], 0.0, 0.0])
         for path in (LEGEND_BARS, LEGEND_LABELS):
