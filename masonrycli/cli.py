@@ -313,13 +313,22 @@ def _write_assembly(builder: str, opts: dict) -> None:
     assembly = build_assembly(builder, **opts)
     for warning in validate_assembly(assembly):
         warn(warning)
-    with written_whole(target) as part:
-        write_geojson(assembly, part)
+    from masonrycli.interrupt import StopSignals, exit_code, signal_name
+
     out = target.path
-    console.print(
-        f"{builder}: {assembly.block_count} block{'s' if assembly.block_count != 1 else ''} and {assembly.support_count} "
-        f"support{'s' if assembly.support_count != 1 else ''} → {out}"
-    )
+    # A signal waits until the file is whole and said: a Ctrl-C just after the rename said "Ctrl-C: stopped
+    # before any output was written" of the file written, a SIGTERM there killed the command (-15).
+    with StopSignals() as signals:
+        signals.closing()
+        with written_whole(target) as part:
+            write_geojson(assembly, part)
+        console.print(
+            f"{builder}: {assembly.block_count} block{'s' if assembly.block_count != 1 else ''} and "
+            f"{assembly.support_count} support{'s' if assembly.support_count != 1 else ''} → {out}"
+        )
+    if signals.signum is not None:
+        say("note", "yellow", f"{signal_name(signals.signum)} while {out} was written: it is whole")
+        raise typer.Exit(exit_code(signals.signum))
 
 
 @build_app.command("wall")

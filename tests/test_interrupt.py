@@ -382,3 +382,28 @@ def test_a_signal_while_the_limit_answer_is_printed_says_the_recording_is_whole(
     said = f"after the answer was printed: λ = 0.0901, the recording {rrd} is complete"
     assert proc.stderr.strip().endswith(said), proc.stderr
     assert frames_in_recording(rrd) > 0 and sorted(p.name for p in tmp_path.iterdir()) == ["l.rrd"]
+
+
+def test_a_ctrl_c_as_build_says_what_it_wrote_keeps_the_file(tmp_path, monkeypatch):
+    """Helper-123: a Ctrl-C once `masonry build` had renamed its file into place (while it printed the line
+    naming it) said "Ctrl-C: stopped before any output was written" of the file it had just written."""
+    from typer.testing import CliRunner
+
+    import masonrycli.cli as cli
+
+    out = tmp_path / "w.geojson"
+    said = cli.console.print
+
+    def signalled(*args, **kwargs):
+        os.kill(os.getpid(), signal.SIGINT)
+        time.sleep(0.2)  # a Python handler runs here
+        said(*args, **kwargs)
+
+    monkeypatch.setattr(cli.console, "print", signalled)
+    result = CliRunner().invoke(cli.app, ["build", "wall", "--out", str(out)])
+    assert result.exit_code == 130, result.output
+    assert "before any output" not in result.output and "Traceback" not in result.output, result.output
+    assert result.output.strip().endswith(f"note: Ctrl-C while {out} was written: it is whole"), result.output
+    import json
+
+    assert len(json.loads(out.read_text())["features"]) == 52
