@@ -71,6 +71,8 @@ _ACCELERATION = _words(
     r"in/s\^?2", "in/s²", r"ft/s\^?2", "ft/s²",
 )  # fmt: skip
 _VELOCITY = _words("vel", "velocity", "velocities", "speed", "m/s", "cm/s", "mm/s", "in/s", "ft/s")
+# a displacement series was read as velocity in m/s (a header "time (s),disp (m)"), with no word
+_DISPLACEMENT = _words("disp", "displ", "displacements?")
 # units that need a scale to be SI: unit -> (quantity, the factor to m/s or m/s²)
 _SCALED = {
     "cm/s": ("velocity", 0.01),
@@ -154,6 +156,11 @@ def check_csv_header(path, name: str, quantity, scale) -> None:
     if _TIME_MS.search(text):
         raise InputError(f"{where}: the header gives times in ms ({shown}); record times are read in s")
     says_acc, says_vel = bool(_ACCELERATION.search(text)), bool(_VELOCITY.search(text))
+    if _DISPLACEMENT.search(text) and not (says_acc or says_vel):
+        raise InputError(
+            f"{where}: the header says displacement ({shown}) but a record is read as velocity (m/s) or "
+            "acceleration (m/s²): give its velocity or acceleration series"
+        )
     other = "acceleration" if quantity == "velocity" else "velocity"
     if (says_acc and not says_vel and quantity == "velocity") or (says_vel and not says_acc and quantity != "velocity"):
         unit = "m/s" if quantity == "velocity" else "m/s²"

@@ -203,6 +203,13 @@ OPTION_ROWS = [
         2,
         "record of velocity (huge.csv, 2 samples, 0–1 s) along (1, 0) moves at up to 1e+300 m/s",
     ),
+    (  # read as velocity in m/s without a word
+        "sim-record-displacement",
+        {"d.csv": "time (s),disp (m)\n0,0.1\n1,0\n"},
+        (*WALL, "--record", "d.csv", "--no-recording"),
+        2,
+        'd.csv:1: the header says displacement ("time (s),disp (m)") but a record is read as velocity (m/s) or',
+    ),
     (
         "limit-load",
         {},
