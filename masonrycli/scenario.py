@@ -30,6 +30,9 @@ MAX_DURATION = 1e5
 """s — longer runs are refused as a likely typo."""
 MAX_STEPS = 10**8
 """Steps per run: more is refused up front as a likely typo (10⁸ steps of the 51-block wall take ~1 day)."""
+MIN_DT = 1e-9
+"""s — a shorter step is refused as a likely typo: --duration 1e-310 --dt 1e-310 ran its one step, then the
+summary overflowed (t / dt = inf: an OverflowError traceback)."""
 MAX_COUNT = 10**9
 MAX_FRICTION = 1e3
 """Largest Coulomb μ: masonry joints have 0.4–1 and μ = 1000 already forbids sliding; beyond ~1e7 the limit
@@ -94,6 +97,8 @@ class RunConfig:
             raise field_error(
                 "dt", dt, f"gives {self.duration / self.dt:,.0f} steps for duration {duration} (at most {MAX_STEPS:,})"
             )
+        if self.dt < MIN_DT:  # after the steps' check, which says more of a dt too small for its duration
+            raise field_error("dt", dt, f"must be >= {MIN_DT:g} s (a likely typo)")
         steps = self.duration / self.dt
         if abs(steps - round(steps)) > 1e-6 * max(1.0, steps):
             n = max(1, round(steps))

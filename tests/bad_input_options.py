@@ -30,6 +30,13 @@ OPTION_ROWS = [
         2,
         "--dt: dt = 0.3: does not divide duration",
     ),
+    (  # one step of 1e-310 s ran, then the summary overflowed (t / dt): an OverflowError traceback
+        "opt-dt-subnormal",
+        {**scen()},
+        (*RUN, "--duration", "1e-310", "--dt", "1e-310", "--no-recording"),
+        2,
+        "--duration and --dt: dt = 1e-310: must be >= 1e-09 s (a likely typo)",
+    ),
     ("opt-theta", {**scen()}, (*RUN, "--theta", "0.2", "--no-recording"), 2, "--theta: theta = 0.2"),
     ("opt-friction", {**scen()}, (*RUN, "--friction", "nan", "--no-recording"), 2, "--friction: friction = nan"),
     (
