@@ -407,3 +407,47 @@ def test_a_ctrl_c_as_build_says_what_it_wrote_keeps_the_file(tmp_path, monkeypat
     import json
 
     assert len(json.loads(out.read_text())["features"]) == 52
+
+
+SIGTERM_WHILE_LOADING = """
+import importlib.abc, os, signal, sys, time
+
+class Signal(importlib.abc.MetaPathFinder):  # SIGTERM as a module of masonry is first loaded
+    def find_spec(self, name, path, target=None):
+        if name == os.environ["MODULE"]:
+            os.kill(os.getpid(), signal.SIGTERM)
+            time.sleep(0.2)  # a Python handler runs here
+        return None
+
+sys.meta_path.insert(0, Signal())
+sys.argv = ["masonry", *sys.argv[1:]]
+from masonrycli.__main__ import main
+main()
+"""
+
+
+@pytest.mark.parametrize(
+    "module, said",
+    [
+        ("masonrycli.cli", "error: SIGTERM while masonry was starting: nothing was run"),
+        ("masonrycli.execute", "error: SIGTERM: stopped before any output was written"),
+    ],
+    ids=["starting", "setting-up"],
+)
+def test_sigterm_before_the_run_s_own_handling_says_so(module, said, tmp_path):
+    """Helper-123: SIGTERM while Python loaded the command line (typer, rich, numpy), or while the command set
+    up (the structure built, the outputs checked), killed it without a word (exit -15), where a Ctrl-C there
+    says one line. Nothing is written in those phases: the previous file stays."""
+    out = tmp_path / "w.rrd"
+    out.write_bytes(b"the previous recording")
+    proc = subprocess.run(
+        [sys.executable, "-c", SIGTERM_WHILE_LOADING, "simulate", "wall", "--duration", "0.01", "--out", str(out)]
+        + ["--force"],
+        env=dict(os.environ, RERUN_ANALYTICS="0", MODULE=module),
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert proc.returncode == 143, proc.stderr
+    assert proc.stderr == said + "\n"
+    assert out.read_bytes() == b"the previous recording" and [p.name for p in tmp_path.iterdir()] == ["w.rrd"]
