@@ -321,6 +321,18 @@ main()
 """
 
 
+def _run_signalled(script: str, argv: list[str], sig) -> subprocess.CompletedProcess:
+    """``script`` (one of the SIGNAL_IN_* programs: masonry with one function wrapped to signal itself) run with
+    masonry's ``argv`` and the signal ``sig`` to send, in a process of its own."""
+    return subprocess.run(
+        [sys.executable, "-c", script, *argv],
+        env=dict(os.environ, RERUN_ANALYTICS="0", SIGNAL=str(int(sig))),
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+
+
 @pytest.mark.parametrize("sig, code", [(signal.SIGINT, 130), (signal.SIGTERM, 143)], ids=["sigint", "sigterm"])
 def test_a_signal_while_the_summary_is_printed_says_the_files_are_whole(sig, code, tmp_path):
     """Helper-123: once execute() had put Python's handlers back, a Ctrl-C while the summary was printed said
@@ -329,13 +341,7 @@ def test_a_signal_while_the_summary_is_printed_says_the_files_are_whole(sig, cod
     rrd, npz = tmp_path / "w.rrd", tmp_path / "w.npz"
     rrd.write_bytes(b"the previous recording")
     argv = ["simulate", "wall", "--duration", "0.02", "--out", str(rrd), "--history", str(npz), "--force"]
-    proc = subprocess.run(
-        [sys.executable, "-c", SIGNAL_IN_SUMMARY, *argv],
-        env=dict(os.environ, RERUN_ANALYTICS="0", SIGNAL=str(int(sig))),
-        capture_output=True,
-        text=True,
-        timeout=120,
-    )
+    proc = _run_signalled(SIGNAL_IN_SUMMARY, argv, sig)
     assert proc.returncode == code, proc.stdout + proc.stderr
     assert "Traceback" not in proc.stderr and "before any output" not in proc.stderr, proc.stderr
     assert "completed" in proc.stdout  # the summary, printed whole
@@ -369,13 +375,7 @@ def test_a_signal_while_the_limit_answer_is_printed_says_the_recording_is_whole(
     stopped before any output was written" with its recording written, and a SIGTERM killed it (-15)."""
     rrd = tmp_path / "l.rrd"
     rrd.write_bytes(b"the previous recording")
-    proc = subprocess.run(
-        [sys.executable, "-c", SIGNAL_IN_LIMIT_TABLE, "limit", "arch", "--out", str(rrd), "--force"],
-        env=dict(os.environ, RERUN_ANALYTICS="0", SIGNAL=str(int(sig))),
-        capture_output=True,
-        text=True,
-        timeout=120,
-    )
+    proc = _run_signalled(SIGNAL_IN_LIMIT_TABLE, ["limit", "arch", "--out", str(rrd), "--force"], sig)
     assert proc.returncode == code, proc.stdout + proc.stderr
     assert "Traceback" not in proc.stderr and "before any output" not in proc.stderr, proc.stderr
     assert "0.0901" in proc.stdout  # the table, printed whole
