@@ -366,10 +366,12 @@ _RUN_CODE = re.compile(r"(, commit )[^,]*(, source )[0-9a-z ]+")
 def recording_rows(path: str | os.PathLike) -> dict[str, list[str]]:
     """Every entity's rows, comparable between two runs of the same command: ``{entity: sorted rows}``, a row
     the ``repr`` of its time columns and component values (no row ids, so chunking does not matter); static
-    entities as ``"static <entity>"`` with their last row only (the one in force), the run document's wall
+    entities as ``"static <entity>"`` with the values in force, each component's of its latest row id (what
+    the viewer shows: a static entity may be logged again with some components, e.g. the centroid dots'
+    radii once the view is sized, and the chunks are not stored in the order logged), the run document's wall
     time, start time, commit and source digest masked, the recording's own start time (``/__properties``) left out."""
     temporal: dict[str, list[str]] = {}
-    static: dict[str, list[str]] = {}
+    latest: dict[str, dict[str, tuple[bytes, object]]] = {}
     with _reading(path) as reader:
         chunks = list(reader.stream())
     for chunk in chunks:
@@ -378,11 +380,20 @@ def recording_rows(path: str | os.PathLike) -> dict[str, list[str]]:
         batch = chunk.to_record_batch()
         names = sorted(n for n in batch.schema.names if n != "rerun.controls.RowId")
         columns = [(n, _plain(batch.column(n)).to_pylist()) for n in names]
-        rows = [repr([(n, values[i]) for n, values in columns]) for i in range(batch.num_rows)]
         if chunk.is_static:
-            static[f"static {chunk.entity_path}"] = [_RUN_CODE.sub(r"\1\2", _RUN_CLOCK.sub(r"\1\2\3", rows[-1]))]
+            in_force = latest.setdefault(chunk.entity_path, {})
+            row_ids = batch.column("rerun.controls.RowId").to_pylist()
+            for n, values in columns:
+                for row_id, value in zip(row_ids, values):  # row ids: big-endian, time first
+                    if value is not None and (n not in in_force or row_id > in_force[n][0]):
+                        in_force[n] = (row_id, value)
         else:
+            rows = [repr([(n, values[i]) for n, values in columns]) for i in range(batch.num_rows)]
             temporal.setdefault(chunk.entity_path, []).extend(rows)
+    static = {}
+    for entity, in_force in latest.items():
+        row = repr([(n, in_force[n][1]) for n in sorted(in_force)])
+        static[f"static {entity}"] = [_RUN_CODE.sub(r"\1\2", _RUN_CLOCK.sub(r"\1\2\3", row))]
     return {entity: sorted(rows) for entity, rows in temporal.items()} | static
 
 
