@@ -146,10 +146,10 @@ class CollapseMonitor:
             self._settlement = settlement
             self._q0_fall[:n, 1] = self.q0[:n, 1] - settlement
         rock, slide, fall, turn, top_dx = watch_step(solver, body_q, body_v, self._q0_fall, self.block_height, self.top)
-        before = self.collapse_time
-        self.observe(time, rock, slide, fall, turn, top_dx - self._ground_dx(body_q))
+        before, drift = self.collapse_time, top_dx - self._ground_dx(body_q)
+        self.observe(time, rock, slide, fall, turn, drift)
         if before is None and self.collapse_time is not None and self.collapse_reason.startswith(DRIFTED):
-            self.collapse_reason += self._how_it_drifted(body_q, top_dx - self._ground_dx(body_q))
+            self.collapse_reason += self._how_it_drifted(body_q, drift)
 
     def observe(self, time: float, rock: float, slide: float, fall: float, turn: float, drift: float) -> None:
         """Fold one step's indicators in: max |ω| (rad/s), max closed-contact |u_t| (m/s), max fall ×

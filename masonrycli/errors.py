@@ -33,6 +33,19 @@ NOT_A_FILE = "not a regular file (a device, a pipe or a socket)"
 ended (the run hung before its first line), and the commands that test ``is_file()`` called it missing."""
 
 
+def input_path(base_dir: str, given: str) -> str:
+    """The absolute path of a file a scenario names (a record, a geometry): relative to the scenario's folder,
+    ``~`` expanded ("~/records/q.AT2" was looked for as <folder>/~/records/q.AT2: no shell expands a TOML
+    string)."""
+    return os.path.abspath(os.path.join(base_dir, os.path.expanduser(given)))
+
+
+def not_a_file(path) -> str:
+    """Why ``path`` is no regular file to read: "is a directory" (a folder was called a device, a pipe or a
+    socket), NOT_A_FILE, or "no such file"."""
+    return "is a directory" if os.path.isdir(path) else NOT_A_FILE if os.path.exists(path) else "no such file"
+
+
 def special_file(path) -> bool:
     """True for a path that exists and is neither a regular file nor a folder (checked without opening it:
     opening a named pipe waits for a writer)."""

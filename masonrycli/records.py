@@ -21,7 +21,16 @@ import warnings
 
 import numpy as np
 
-from masonrycli.errors import NOT_A_FILE, InputError, RecordWarning, file_kind, not_utf8, special_file
+from masonrycli.errors import (
+    NOT_A_FILE,
+    InputError,
+    RecordWarning,
+    file_kind,
+    input_path,
+    not_a_file,
+    not_utf8,
+    special_file,
+)
 from masonrycli.record_motion import Record, time_step_problem
 from masonrycli.record_text import NoTimeStep, TimeStepNotUsed, at2_text, csv_text, number
 from masonrycli.record_units import check_at2_header, check_csv_header, header_quantity, record_text
@@ -316,13 +325,9 @@ def _table_file(table: dict, key: str, base_dir: str, time_step: float | None):
     file = table[key]
     if not isinstance(file, str) or not file:
         raise InputError(f"motion.{key} = {format_value(file)[:40]}: must be a file name")
-    # "~/records/q.AT2" was looked for as <scenario folder>/~/records/q.AT2: no shell expands a TOML string
-    resolved = os.path.abspath(os.path.join(base_dir, os.path.expanduser(file)))
+    resolved = input_path(base_dir, file)
     if not os.path.isfile(resolved):
-        missing = (
-            "is a directory" if os.path.isdir(resolved) else NOT_A_FILE if os.path.exists(resolved) else "no such file"
-        )
-        raise InputError(f"motion.{key} = {quote_string(file)}: {missing} (looked for {resolved})")
+        raise InputError(f"motion.{key} = {quote_string(file)}: {not_a_file(resolved)} (looked for {resolved})")
     try:
         time, value, native = read_record(resolved, display=file, time_step=time_step)
         if native is None:

@@ -21,7 +21,7 @@ from pathlib import Path
 
 from geometry_library.blocks import Assembly, Block, GeometryError
 from geometry_library.values import MATERIAL_RANGE
-from masonrycli.errors import InputContext, InputError
+from masonrycli.errors import InputContext, InputError, input_path
 from masonrycli.motion import Fixed, Motion
 from masonrycli.structure import build_structure, check_finite_tree, read_geometry, structure_warnings
 from masonrycli.values import check_int, check_real, check_vector, field_error, quote_string, shorten
@@ -434,10 +434,7 @@ def _record_key(source: str, record) -> tuple:
         folder = os.path.dirname(os.path.abspath(source))
 
         def names_it(given) -> bool:
-            return (
-                isinstance(given, str)
-                and os.path.abspath(os.path.join(folder, os.path.expanduser(given))) == record.source
-            )
+            return isinstance(given, str) and input_path(folder, given) == record.source
 
         return "file", names_it
 

@@ -19,7 +19,7 @@ from pathlib import Path
 import numpy as np
 
 from geometry_library.blocks import Assembly, Block, GeometryError, Support
-from masonrycli.errors import NOT_A_FILE, InputContext, InputError, not_utf8, one_line, special_file
+from masonrycli.errors import NOT_A_FILE, InputContext, InputError, input_path, not_utf8, one_line, special_file
 from masonrycli.motion import Constant, Fixed, Motion, Ramp, Sine
 from masonrycli.record_motion import Record
 from masonrycli.records import record_fields
@@ -169,7 +169,7 @@ def _parse_document(doc: dict, ctx: InputContext, default_name: str) -> Scenario
             file = structure["file"]
             if not isinstance(file, str):
                 raise ctx.error("[structure]", f"file = {format_value(file)[:40]}: must be a string")
-            path = os.path.abspath(os.path.join(ctx.base_dir, os.path.expanduser(file)))  # "~/w.geojson" too
+            path = input_path(ctx.base_dir, file)  # "~/w.geojson" too
             assembly = read_geometry(path, material.density, material.thickness, ctx, notes=notes)
             what = f"file {quote_string(file)}"
             structure_info = {"file": path}

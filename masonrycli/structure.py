@@ -16,7 +16,7 @@ from pathlib import Path
 
 from geometry_library.blocks import Assembly, GeometryError
 from geometry_library.values import SETTING_UNITS, TypedNumber, number_problem
-from masonrycli.errors import NOT_A_FILE, InputContext, InputError, one_line
+from masonrycli.errors import InputContext, InputError, not_a_file, one_line
 from masonrycli.values import did_you_mean, field_error, quote_string
 
 GEOMETRY_SUFFIXES = (".geojson", ".json", ".wkt")
@@ -38,8 +38,7 @@ def read_geometry(
             f"file = {quote_string(path)}: unknown geometry format (expected {', '.join(GEOMETRY_SUFFIXES)})",
         )
     if not os.path.isfile(path):
-        # a folder was called "a device, a pipe or a socket"
-        missing = "is a directory" if os.path.isdir(path) else NOT_A_FILE if os.path.exists(path) else "no such file"
+        missing = not_a_file(path)
         raise ctx.error(where, f"file = {quote_string(path)}: {missing}" if where else missing)
     unknown: dict = {}
     try:
