@@ -133,14 +133,14 @@ class Recorder:
         loc = self._blocks.local
         size = (np.maximum.reduceat(loc, first) - np.minimum.reduceat(loc, first)) if n else np.ones((1, 2))
         self.block_height = float(np.median(size[:, 1]))  # m, median block height: the force-arrow unit
-        self._block_side = float(np.median(size.min(axis=1)))  # m: caps the fills' inset (INSET_BLOCK_CAP)
+        self._block_side = float(np.median(size.min(axis=1)))  # m: the glyphs' unit; caps the fills' inset
         # (N,) m: a block's farthest vertex from its centroid, for the reach of the run (_clear_the_legend)
         self._radius = np.maximum.reduceat(np.hypot(*loc.T), first) if n else np.zeros(0)
         self._reach = -np.inf
         self._reach_left = np.inf  # the smallest x: a collapse to the left widens the view that way
         # steps with a residual, those a decade under the tolerance, the largest, the smallest of the others
         self._residuals = [0, 0, 0.0, np.inf]
-        self._glyph_length = GLYPH_HALF_LENGTH * float(np.median(size.min(axis=1)))
+        self._glyph_length = GLYPH_HALF_LENGTH * self._block_side
         # (N,) m: a glyph never reaches out of its own block (thin cut spandrel blocks of the aqueduct)
         self._glyph_cap = np.minimum(self._glyph_length, GLYPH_HALF_LENGTH * size.min(axis=1))[: self._n]
         self._colours = FieldColours(FIELDS)
