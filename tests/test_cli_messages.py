@@ -1,11 +1,14 @@
 """One-line usage errors (masonrycli/cli_messages.py): a numeric option given text, or a number with its
 unit, says what to write and in which unit the option is read (the units of docs/scenario-format.md and of
-the options' help), never converting."""
+the options' help), never converting; a closed stdout and a Ctrl-C before the run (user_errors)."""
+
+from pathlib import Path
 
 import pytest
 
 from cli_helpers import assert_one_line_error, invoke
 
+DATA = Path(__file__).parent / "data"
 RUN = ("simulate", "wall", "--duration", "0.01", "--no-recording")
 
 
@@ -282,3 +285,31 @@ def app_group(app):
     import typer.main
 
     return typer.main.get_command(app)
+
+
+def test_a_closed_stdout_is_not_bad_input(tmp_path):
+    # `masonry limit arch --json | head -c 10` printed "error: Broken pipe" and exit 2 (bad input); now it
+    # stops quietly as click does for the other commands (exit 1, nothing on stderr).
+    import os
+    import subprocess
+    import sys
+
+    env = os.environ | {"RERUN_ANALYTICS": "0"}
+    cmd = [sys.executable, "-m", "masonrycli", "limit", DATA / "validation" / "column5.toml", "--json"]
+    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, env=env)
+    proc.stdout.close()  # the reader is gone before the first write
+    err = proc.stderr.read().decode()
+    assert proc.wait(timeout=120) == 1 and err == "", err
+
+
+def test_ctrl_c_before_the_run_is_one_line_and_exit_130(monkeypatch):
+    # a Ctrl-C while the structure is built (before the run's own signal handling) exited 130 without a word
+    import masonrycli.builtin
+
+    def interrupted(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(masonrycli.builtin, "builtin", interrupted)
+    result = invoke("simulate", "wall", "--duration", 0.01, "--no-recording")
+    assert result.exit_code == 130
+    assert result.output.strip() == "error: Ctrl-C: stopped before any output was written"

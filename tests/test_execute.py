@@ -33,7 +33,7 @@ from masonrycli.run import Simulation
 from masonrycli.scenario import SOLVERS, Material, RunConfig, Scenario
 from masonrycli.source_digest import source_commit
 
-from cli_helpers import invoke, signal_inside_a_ctypes_callback
+from cli_helpers import invoke, signal_inside_a_ctypes_callback, words
 
 AMP, FREQ, DT, STEPS, EVERY = 0.01, 2.0, 1e-3, 20, 5
 # v(t) = AMP cos(2π FREQ t): the ground's peak speed is AMP, at t = 0
@@ -264,3 +264,65 @@ def test_the_unconverged_warning_says_how_far_off_and_when():
     assert "1 at the 100000-sweep cap, the worst 1.44e-05 m/s (1.4× the tolerance) at t = 0.212 s);" in text
     assert "the worst" not in unconverged_warning(1, 300, 1, run, (math.nan, 212))
     assert "the worst" not in unconverged_warning(1, 300, 1, run)
+
+
+def _frames_in(rrd: Path) -> int:
+    """Frames shown in the recording (the initial state, t = 0, first: the history's frames)."""
+    info = inspect_recording(rrd)
+    assert info["application_id"] == "masonry"
+    return info["frames"]
+
+
+def test_divergence_leaves_complete_outputs(tmp_path, monkeypatch):
+    import masonrycli.run as run_module
+
+    monkeypatch.setattr(run_module, "DIVERGENCE_SPEED", 0.05)  # the shaken wall exceeds it quickly
+    rrd, npz = tmp_path / "div.rrd", tmp_path / "div.npz"
+    result = invoke("simulate", "wall", "--duration", 0.5, "--out", rrd, "--history", npz)
+    assert result.exit_code == 3, result.output
+    assert "diverged" in result.output
+    h = np.load(npz)
+    assert str(h["status"]) == "diverged"
+    assert _frames_in(rrd) == len(h["time"])
+
+
+def test_engine_error_mid_run_keeps_frames(tmp_path, monkeypatch):
+    original = Simulation.step
+
+    def failing(self):
+        if self.state.step == 25:
+            raise FloatingPointError("synthetic failure")
+        return original(self)
+
+    monkeypatch.setattr(Simulation, "step", failing)
+    rrd, npz = tmp_path / "err.rrd", tmp_path / "err.npz"
+    result = invoke("simulate", "wall", "--duration", 0.1, "--out", rrd, "--history", npz)
+    assert result.exit_code == 1, result.output
+    assert "Traceback" not in result.output and "synthetic failure" in result.output
+    h = np.load(npz)
+    assert str(h["status"]) == "failed"
+    assert list(h["step"]) == [0, 10, 20]
+    assert _frames_in(rrd) == 3
+
+
+def test_unconverged_steps_are_counted_and_warned(tmp_path):
+    """A sweep cap too low for the tolerance: the summary, the history and a warning say how many steps."""
+    npz = tmp_path / "h.npz"
+    r = invoke("simulate", "wall", "--duration", "0.02", "--max-iterations", "2", "--no-recording", "--history", npz)
+    assert r.exit_code == 0, r.output
+    assert "warning: 20 of 20 steps ended unconverged" in words(r.output)
+    assert "20 at the 2-sweep cap, the worst " in words(r.output)  # none stalled: not said
+    # (what stalled steps go through, by solver: test_execute.py, unconverged_warning)
+    h = np.load(npz)
+    assert h["nlgs_unconverged"][-1] == 20
+    assert np.all(h["nlgs_iterations"][1:] == 2) and np.all(h["nlgs_residual"][1:] > 1e-5)
+    # the worst step's residual is at least the largest the history's frames kept, said at a step's time
+    worst = re.search(r"the worst (\S+) m/s \((\S+)× the tolerance\) at t = (\S+) s\); their", words(r.output))
+    residual, times, t = float(worst[1]), float(worst[2]), float(worst[3])
+    assert residual >= h["nlgs_residual"][1:].max() and times == pytest.approx(residual / 1e-5, rel=0.05)
+    assert 0 < t <= 0.02 and round(t / 1e-3) == pytest.approx(t / 1e-3, abs=1e-9)
+    npz = tmp_path / "h_default.npz"
+    r = invoke("simulate", "wall", "--duration", "0.02", "--no-recording", "--history", npz)
+    assert r.exit_code == 0 and "unconverged" in r.output and "warning" not in r.output, r.output
+    h = np.load(npz)
+    assert h["nlgs_unconverged"][-1] == 0 and np.all(h["nlgs_residual"] <= 1e-5)

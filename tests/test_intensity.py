@@ -10,6 +10,8 @@ from masonrycli.intensity import SA_DAMPING, describe, intensity_measures, shaki
 from masonrycli.motion import Constant, Fixed, Sine
 from masonrycli.record_motion import Record
 
+from cli_helpers import invoke, words
+
 
 def test_sine_ground_closed_forms():
     # v = A sin(2π f t) over whole cycles: PGA = 2π f A, PGV = A, Arias = π/(2g) (2π f A)^2 D / 2,
@@ -64,3 +66,10 @@ def test_a_run_of_two_steps_has_no_resolved_significant_duration():
     assert ims["pga"] == pytest.approx(np.abs(acc).max()) and ims["pgv"] == pytest.approx(np.abs(v).max())
     # Arias by the trapezoid rule over the two acceleration samples
     assert ims["arias"] == pytest.approx(np.pi / (2 * 9.81) * dt * (acc[0] ** 2 + acc[1] ** 2) / 2, rel=1e-9)
+
+
+def test_a_two_step_run_completes():
+    # It wrote its outputs, then ended in "internal error: IndexError" (exit 1) computing D5–95.
+    result = invoke("simulate", "wall", "--duration", 0.002, "--no-recording")
+    assert result.exit_code == 0, result.output
+    assert "D5–95 nan s" in words(result.output)

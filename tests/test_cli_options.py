@@ -1,0 +1,124 @@
+"""The options of every command (masonrycli/cli_options.py): what --help says of them (their defaults, only
+those a structure takes, -h as --help), choices in any case, and paths with a ~ the shell left."""
+
+from __future__ import annotations
+
+import pytest
+
+from masonrycli import __version__
+
+from cli_helpers import invoke
+
+
+def test_help_and_version():
+    result = invoke("--help")
+    assert result.exit_code == 0
+    for command in ("simulate", "run", "check", "build", "inspect"):
+        assert command in result.output
+    result = invoke("--version")
+    assert result.exit_code == 0 and __version__ in result.output
+    result = invoke("simulate", "wall", "--help")
+    assert result.exit_code == 0 and "--freq" in result.output and "--amp" in result.output
+
+
+@pytest.mark.parametrize(
+    "command", [(), ("simulate",), ("simulate", "wall"), ("build", "arch"), ("sweep",), ("inspect",)]
+)
+def test_h_is_help(command):
+    # walk-through 2026-11-28: "masonry -h" said "error: No such option: -h (masonry --help lists the options)"
+    result = invoke(*command, "-h")
+    assert result.exit_code == 0 and result.output == invoke(*command, "--help").output
+
+
+def test_command_list_keeps_each_summary_on_one_line():
+    # The list showed run's and check's docstrings with their source line breaks ("options given here" /
+    # "override the file's values." on two lines of a 120-column terminal).
+    from masonrycli.cli import app
+
+    from cli_helpers import runner
+
+    out = runner.invoke(app, ["--help"], env={"COLUMNS": "250"}).output
+    assert "options given here override the file's values." in out
+    assert "print a summary (blocks, supports, mass" in out
+
+
+def _option_help(command: list[str]) -> dict[str, str]:
+    """Each option of ``masonry COMMAND --help`` with its help text (joined over wrapped lines)."""
+    from masonrycli.cli import app
+
+    from cli_helpers import runner
+
+    out = runner.invoke(app, [*command, "--help"], env={"COLUMNS": "250"}).output
+    options, name = {}, None
+    for line in out.splitlines():
+        cells = line.strip("│ ").split()
+        if cells and cells[0].startswith("--"):
+            name = cells[0]
+            options[name] = " ".join(cells[2:])
+        elif name and cells and not line.startswith(("╭", "╰")):
+            options[name] += " " + " ".join(cells)
+    return options
+
+
+def test_simulate_help_lists_only_what_the_structure_takes_with_its_defaults():
+    # `simulate wall --help` offered --settlement ("Downward velocity of the right foundation"), which the
+    # wall always refuses, and --freq / --amp / --scale showed no default (the wall is shaken at 1 m/s, 2 Hz).
+    wall = _option_help(["simulate", "wall"])
+    assert "--settlement" not in wall
+    assert "(default 2)" in wall["--freq"] and "(default 1;" in wall["--amp"] and "(default 1)" in wall["--scale"]
+    for name in ("arch", "aqueduct"):
+        options = _option_help(["simulate", name])
+        assert "(default 0.01;" in options["--settlement"] and "--settlement 0" in options["--amp"]
+        assert "(default 2" in options["--freq"]
+
+
+def test_run_and_check_help_give_the_scenario_files_values_as_defaults():
+    # `run --help` said "(default 1e-3)" for --dt, although a file's [run] dt is what runs
+    for command in (["run"], ["check"]):
+        options = _option_help(command)
+        assert "(default: the scenario file's value, else 1e-3)" in options["--dt"]
+        assert "(default: the scenario file's value, else 0.5)" in options["--theta"]
+        assert "(default: the scenario file's value, else 0.6)" in options["--friction"]
+        assert (
+            "(default: the scenario file's value)" in options["--duration"] and "simulate" not in options["--duration"]
+        )
+    simulate = _option_help(["simulate", "wall"])
+    assert "(default 1e-3)" in simulate["--dt"] and "(default 0.6)" in simulate["--friction"]
+
+
+def test_sweep_help_gives_the_default_file_names():
+    # --out and --plot said nothing of where the table and the picture go when not given (study-<scenario>.parquet
+    # in the working folder, the plot beside it), while --recording did
+    options = _option_help(["sweep"])
+    assert "default study-<scenario>.parquet" in options["--out"]
+    assert "(default: beside --out, .png)" in options["--plot"]
+    assert "(default: beside --out, .rrd)" in options["--recording"]
+
+
+def test_choice_options_take_any_case_and_help_lists_the_lower_case(tmp_path):
+    # "sweep --im PGV" said "--im PGV: expected one of pga, pgv, arias, sa"; "limit --load Tilt",
+    # "--direction -X", "--outcome Sliding" and "--solver NLGS" likewise
+    r = invoke("limit", "wall", "--load", "Tilt", "--direction", "-X", "--json")
+    assert r.exit_code == 0, r.output
+    r = invoke("simulate", "wall", "--solver", "NLGS", "--duration", "0.01", "--no-recording")
+    assert r.exit_code == 0, r.output
+    out = tmp_path / "s.csv"
+    sweep = ("sweep", "wall", "-p", "amp=0.1,0.2", "--find", "amp", "--outcome", "Sliding", "--im", "PGV")
+    r = invoke(*sweep, "--duration", "0.05", "--workers", "0", "--no-recording", "-o", out)
+    assert r.exit_code == 0, r.output
+    assert "pga, pgv, arias, sa" in invoke("sweep", "--help").output
+
+
+def test_a_tilde_the_shell_left_is_the_home_folder(tmp_path, monkeypatch):
+    # "--out=~/runs/w.rrd" (no expansion after "=") made a folder named "~" in the working folder and wrote
+    # there; --history and build --out alike.
+    home, work = tmp_path / "home", tmp_path / "work"
+    work.mkdir()
+    (home / "runs").mkdir(parents=True)
+    monkeypatch.setenv("HOME", str(home))
+    monkeypatch.chdir(work)
+    result = invoke("simulate", "wall", "--duration", 0.01, "--out=~/runs/w.rrd", "--history=~/runs/w.npz")
+    assert result.exit_code == 0, result.output
+    assert invoke("build", "wall", "--out=~/runs/w.geojson").exit_code == 0
+    assert sorted(p.name for p in (home / "runs").iterdir()) == ["w.geojson", "w.npz", "w.rrd"]
+    assert list(work.iterdir()) == []
