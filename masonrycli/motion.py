@@ -34,6 +34,11 @@ import numpy as np
 
 from masonrycli.values import check_real, check_vector, field_error
 
+MAX_PHASE = 1e4
+"""rad — a sine's phase beyond ±this is refused as a likely typo: the sine repeats every 2π, so any phase can
+be given within one turn, and a large one only costs precision (``phase = 1e300`` swallowed 2π·f·t whole:
+sin(1e300) every step, a constant velocity that ran without a word)."""
+
 
 def _g(x: float) -> str:
     return f"{x:g}"
@@ -170,7 +175,12 @@ class Sine(_Directed, Motion):
         _direction(self)
         _put(self, "amplitude", check_real("amplitude", self.amplitude))
         _put(self, "frequency", check_real("frequency", self.frequency, ge=0.0))
+        phase = self.phase  # as given, for the message
         _put(self, "phase", check_real("phase", self.phase))
+        if abs(self.phase) > MAX_PHASE:
+            raise field_error(
+                "phase", phase, f"must be within ±{MAX_PHASE:g} rad (the sine repeats every 2π; a likely typo)"
+            )
 
     def velocity_at(self, t) -> np.ndarray:
         s = self.amplitude * np.sin(2.0 * np.pi * self.frequency * _time_column(t) + self.phase)

@@ -33,6 +33,11 @@ MAX_STEPS = 10**8
 MIN_DT = 1e-9
 """s — a shorter step is refused as a likely typo: --duration 1e-310 --dt 1e-310 ran its one step, then the
 summary overflowed (t / dt = inf: an OverflowError traceback)."""
+MIN_TOLERANCE = 1e-15
+"""m/s — a tighter NLGS tolerance is refused as a likely typo: float64 resolves a velocity of 1 m/s (the default
+shaking) to 2.2e-16 m/s, so a residual below a few of those is not a goal a solve can aim at (a 51-block wall
+ends every step at the sweep cap from 1e-12 on: benchmarks/bench_solver.py uses that as "no solve meets it";
+``--tolerance 1e-300`` ran each step to the 100 000-sweep cap)."""
 MAX_COUNT = 10**9
 MAX_FRICTION = 1e3
 """Largest Coulomb μ: masonry joints have 0.4–1 and μ = 1000 already forbids sliding; beyond ~1e7 the limit
@@ -63,7 +68,7 @@ class RunConfig:
         one), else the run would silently stop short of it. At most ``MAX_STEPS`` steps.
     theta : Moreau–Jean θ, in [0.5, 1].
     gravity : (gx, gy) m/s², a vector (tilt it for tilting tests).
-    tolerance : m/s, NLGS stopping test: RMS contact-law violation of a sweep (engine.nlgs), in (0, 1).
+    tolerance : m/s, NLGS stopping test: RMS contact-law violation of a sweep (engine.nlgs), in [MIN_TOLERANCE, 1).
     max_iterations : NLGS sweep cap per step, >= 1.
     solver : the contact solver, one of ``SOLVERS``: "nlgs-accel32" (default) Gauss–Seidel with Nesterov
         momentum, its first sweeps in single precision and the step judged by the float64 test (0.69–0.88×
@@ -116,7 +121,14 @@ class RunConfig:
                 self.gravity,
                 f"|g| = {math.hypot(*self.gravity):.3g} m/s² is more than {MAX_GRAVITY:g} (about 1000 g; a likely typo)",
             )
+        tolerance = self.tolerance  # as given, for the message
         put("tolerance", check_real("tolerance", self.tolerance, gt=0.0, lt=1.0))
+        if self.tolerance < MIN_TOLERANCE:
+            raise field_error(
+                "tolerance",
+                tolerance,
+                f"must be >= {MIN_TOLERANCE:g} m/s (float64 resolves a 1 m/s velocity to 2.2e-16 m/s; a likely typo)",
+            )
         put("max_iterations", check_int("max_iterations", self.max_iterations, ge=1, le=MAX_COUNT))
         if self.solver not in SOLVERS:
             raise field_error("solver", self.solver, f"must be one of {', '.join(SOLVERS)}")

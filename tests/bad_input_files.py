@@ -255,6 +255,13 @@ FILE_ROWS = [
         2,
         '[[support]] #1 ("ground"): motion.frequency = nan',
     ),
+    (  # sin(1e300 + 2π·f·t) is sin(1e300) at every step: a constant velocity that ran without a word
+        "motion-phase-absurd",
+        sine('kind = "sine", amplitude = 1.0, frequency = 2, phase = 1e300'),
+        ("check", "s.toml"),
+        2,
+        "motion.phase = 1e+300: must be within ±10000 rad (the sine repeats every 2π; a likely typo)",
+    ),
     (
         "motion-unused-key",
         sine('kind = "fixed", amplitude = 1.0'),

@@ -47,6 +47,14 @@ OPTION_ROWS = [
         "--record-every: record_every = 0",
     ),
     ("opt-tolerance", {**scen()}, (*RUN, "--tolerance", "1", "--no-recording"), 2, "--tolerance: tolerance = 1"),
+    (  # every step ran to the 100 000-sweep cap
+        "opt-tolerance-tiny",
+        {**scen()},
+        (*RUN, "--tolerance", "1e-300", "--no-recording"),
+        2,
+        "--tolerance: tolerance = 1e-300: must be >= 1e-15 m/s (float64 resolves a 1 m/s velocity to",
+    ),
+    ("scenario-tolerance-tiny", {**scen("tolerance = 1e-16")}, ("check", "s.toml"), 2, "tolerance = 1e-16: must be >="),
     (
         "opt-max-iterations",
         {**scen()},

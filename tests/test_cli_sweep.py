@@ -58,6 +58,7 @@ def block(tmp_path) -> Path:
         (["-p", "amp=0.1:1:4", "--find", "amp", "--rtol", "1e0"], "--rtol 1e0: must be in (0, 1)"),
         (["-p", "amp=0.1", "--rtol", "0.010"], "--rtol 0.010: goes with --find"),
         (["-p", "amp=0.1,1e30"], "--param amp=1e+30: "),  # it ran, exit 0
+        (["-p", "phase=0,1e300"], "--param phase: phase = 1e+300: must be within ±10000 rad"),  # it ran
         # both rows ran at 0.5 m/s, under the names amp=0.1 and amp=0.2
         (["-p", "amp=0.1,0.2", "-p", "ground.amp=0.5"], "--param ground.amp: sets the amplitude of support 'ground'"),
         # without --find these were ignored: a grid ran and reported states, not the outcome asked for
