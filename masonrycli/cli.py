@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import inspect
 import os
 import sys
 from pathlib import Path
@@ -208,11 +209,7 @@ def _load(scenario_file: str, opts: dict):
     return file_scenario(scenario_file, **_pop(opts, RECORD, RUN, FRICTION))
 
 
-@app.command(
-    "run",
-    short_help="Run any scenario file (or a GeoJSON / WKT geometry file, supports fixed); options given here "
-    "override the file's values.",
-)
+@app.command("run")
 @user_errors
 @with_options(RUN_FROM_FILE, STOP, FRICTION_FROM_FILE, OUTPUT, FORCE, RECORD)
 def run_command(scenario_file: ScenarioFile, **opts) -> None:
@@ -280,11 +277,7 @@ def limit_command(
     )
 
 
-@app.command(
-    "check",
-    short_help="Validate what `masonry run` would run, with the same arguments, and print a summary (blocks, "
-    "supports, mass, bounding box, steps, outputs); nothing is computed or written.",
-)
+@app.command("check")
 @user_errors
 @with_options(RUN_FROM_FILE, STOP, FRICTION_FROM_FILE, OUTPUT, FORCE, RECORD)
 def check_command(scenario_file: ScenarioFile, **opts) -> None:
@@ -395,6 +388,21 @@ def inspect_command(
             else "its writer did not finish: killed, or the disk was full"
         )
         warn(f"{recording}: truncated ({why}) — {info['frames']} frames up to its last complete chunk")
+
+
+def _one_line_summaries(*typer_apps: typer.Typer) -> None:
+    # The command lists (masonry --help, masonry simulate --help) showed a docstring with its source line
+    # breaks ("run history (the run's" / "parameters, …" on two lines) and run's and check's had a copy to
+    # avoid it, which drifted (check's left out "the loading"): each command's summary is its docstring's
+    # first paragraph on one line.
+    for typer_app in typer_apps:
+        for info in typer_app.registered_commands:
+            if info.short_help is None:
+                first = (inspect.getdoc(info.callback) or "").split("\n\n")[0]
+                info.short_help = " ".join(first.split())
+
+
+_one_line_summaries(app, simulate_app, build_app)
 
 
 def main() -> None:

@@ -30,16 +30,40 @@ def test_h_is_help(command):
     assert result.exit_code == 0 and result.output == invoke(*command, "--help").output
 
 
-def test_command_list_keeps_each_summary_on_one_line():
+@pytest.mark.parametrize(
+    "group, commands",
+    [
+        ((), ("run", "sweep", "limit", "check", "inspect", "simulate", "build")),
+        (("simulate",), ("wall", "arch", "aqueduct")),
+        (("build",), ("wall", "arch", "aqueduct")),
+    ],
+)
+def test_command_list_keeps_each_summary_on_one_line(group, commands):
     # The list showed run's and check's docstrings with their source line breaks ("options given here" /
-    # "override the file's values." on two lines of a 120-column terminal).
+    # "override the file's values." on two lines of a 120-column terminal); their fix, a copy of each
+    # docstring, left inspect's broken ("run history (the run's" / "parameters, …", walk-through 2026-11-29)
+    # and check's copy without "the loading".
     from masonrycli.cli import app
 
     from cli_helpers import runner
 
-    out = runner.invoke(app, ["--help"], env={"COLUMNS": "250"}).output
-    assert "options given here override the file's values." in out
-    assert "print a summary (blocks, supports, mass" in out
+    out = runner.invoke(app, [*group, "--help"], env={"COLUMNS": "250"}).output
+    rows = {}
+    for line in out.splitlines():
+        cells = line.strip("│ ").split(maxsplit=1)
+        if len(cells) == 2 and cells[0] in commands:
+            assert cells[0] not in rows, out  # one line each
+            rows[cells[0]] = " ".join(cells[1].split())
+    assert sorted(rows) == sorted(commands), out
+    said = {
+        "run": "options given here override the file's values.",
+        "check": "print a summary (blocks, supports, mass, bounding box, steps, the loading, outputs); nothing is "
+        "computed or written.",
+        "inspect": "a run history (the run's parameters, status, frames, time span, and each array's shape, dtype "
+        "and unit).",
+    }
+    for name, summary in rows.items():
+        assert summary.endswith(said.get(name, ".")), summary
 
 
 def _option_help(command: list[str]) -> dict[str, str]:
