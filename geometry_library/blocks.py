@@ -10,6 +10,8 @@ Coordinates are metres, density kg/m³, thickness m.
 
 from __future__ import annotations
 
+import json
+import unicodedata
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -19,8 +21,39 @@ from shapely.geometry import Polygon
 SUPPORT_ROLES = ("fixed", "driven")
 
 
+JOINT_SEPARATOR = "|"
+"""Joins the names of a joint's two bodies ("v04|v05": summaries, ``limit``'s hinges, the sweep's rows)."""
+
+
 class GeometryError(ValueError):
     """Bad geometry. The message is one line naming the block (index and name) and the problem."""
+
+
+LINE_BREAKING = ("Cc", "Zl", "Zp")
+"""Unicode categories of the characters that can end a line of text: controls (newline, U+0085) and the line
+and paragraph separators (U+2028, U+2029); str.splitlines breaks at each of these."""
+
+
+def quoted_name(name) -> str:
+    """``name`` in double quotes, every character of :data:`LINE_BREAKING` escaped (\\n, \\u2028): a bad name
+    shown in an error keeps it on one line."""
+    text = json.dumps(str(name), ensure_ascii=False)
+    return "".join(f"\\u{ord(c):04x}" if unicodedata.category(c) in LINE_BREAKING else c for c in text)
+
+
+def name_problem(name) -> str | None:
+    """Why ``name`` cannot name a body, or None. Empty (or blank) names vanish from joints ("|b") and from
+    every message; a control character (a newline) cuts a one-line message in two; and a "|" in a name made
+    joints ambiguous ("a|b|ground" is a|b on ground, or a on b|ground)."""
+    if not isinstance(name, str):
+        return "must be a string"
+    if not name.strip():
+        return "must not be empty"
+    if any(unicodedata.category(c) in LINE_BREAKING for c in name):
+        return "must not contain control characters or line breaks"
+    if JOINT_SEPARATOR in name:
+        return f'must not contain "{JOINT_SEPARATOR}" (it joins the names of a joint\'s two bodies: "v04|v05")'
+    return None
 
 
 def ccw_vertices(polygon: Polygon) -> np.ndarray:

@@ -81,7 +81,7 @@ import shapely
 from shapely.geometry import Polygon
 from shapely.strtree import STRtree
 
-from .blocks import SUPPORT_ROLES, Assembly, GeometryError
+from .blocks import SUPPORT_ROLES, Assembly, GeometryError, name_problem, quoted_name
 from .float32 import FLOAT32_RTOL, float32_hint, float32_resolution
 from .union_screen import union_screen
 from .values import check_material
@@ -379,6 +379,10 @@ def validate_assembly(
     labels: list[str] = []
     polys: list[Polygon] = []
     seen: dict[str, str] = {}
+    for k, body in enumerate((*assembly.blocks, *assembly.supports)):  # first: every message quotes the names
+        if name_problem(body.name) is not None:
+            kind, index = ("block", k) if k < assembly.block_count else ("support", k - assembly.block_count)
+            raise GeometryError(f"{kind} {index + 1}: name {quoted_name(body.name)} {name_problem(body.name)}")
     for i, block in enumerate(assembly.blocks):
         label = body_label(i, block.name)
         polys.append(normalise_polygon(block.polygon, i, block.name))

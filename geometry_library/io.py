@@ -61,7 +61,7 @@ import shapely
 import shapely.wkt
 from shapely.geometry import GeometryCollection, MultiPolygon, Polygon
 
-from .blocks import SUPPORT_ROLES, Assembly, Block, GeometryError, Support
+from .blocks import SUPPORT_ROLES, Assembly, Block, GeometryError, Support, name_problem, quoted_name
 from .checks import body_label, polygon_from_coords
 from .values import check_positive, is_real
 
@@ -181,10 +181,14 @@ def read_geojson(path, density: float = 2500.0, thickness: float = 1.0, unknown:
         if role not in ("block", "support"):
             raise GeometryError(f"{where}: role must be 'block' or 'support', got {role!r}")
         index = len(blocks) if role == "block" else len(supports)
-        name = props.get("name", f"{role}-{index + 1}")  # block-1 first, as in a TOML file
+        name = props.get("name", "")
+        if isinstance(name, str) and not name.strip():  # an empty attribute cell, as null: not given
+            name = f"{role}-{index + 1}"  # block-1 first, as in a TOML file
         if isinstance(name, (bool, list, dict)):  # a number is a GIS id column's (5 -> "5"); these were named
             raise GeometryError(f"{where}: name must be a string, got {name!r}")  # "{'a': 1}", "True"
         name = str(name)
+        if name_problem(name) is not None:  # before the label quotes it: a newline would cut it in two
+            raise GeometryError(f"{where}: name {quoted_name(name)} {name_problem(name)}")
         where = f"{feature_at}: {body_label(index, name, role)}"
         if unknown is not None:  # a support's velocity (or density) was not read either, without a word
             elsewhere = SUPPORT_PROPERTIES if role == "block" else BLOCK_PROPERTIES

@@ -18,7 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
-from geometry_library.blocks import Assembly, Block, GeometryError, Support
+from geometry_library.blocks import Assembly, Block, GeometryError, Support, name_problem
 from masonrycli.errors import NOT_A_FILE, InputContext, InputError, input_path, not_utf8, one_line, special_file
 from masonrycli.motion import Constant, Fixed, Motion, Ramp, Sine
 from masonrycli.record_motion import Record
@@ -53,12 +53,9 @@ ALL_MOTION_KEYS = tuple(dict.fromkeys(k for cls in MOTION_KINDS.values() for k i
 
 
 def _check_name(key: str, value) -> str:
-    if not isinstance(value, str):
-        raise field_error(key, value, "must be a string")
-    if not value.strip():
-        raise field_error(key, value, "must not be empty")
-    if any(ord(c) < 0x20 or ord(c) == 0x7F for c in value):
-        raise field_error(key, value, "must not contain control characters")
+    problem = name_problem(value)
+    if problem is not None:
+        raise field_error(key, value, problem)
     return value
 
 

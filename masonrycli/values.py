@@ -12,9 +12,11 @@ import difflib
 import itertools
 import math
 import re
+import unicodedata
 
 import numpy as np
 
+from geometry_library.blocks import LINE_BREAKING
 from geometry_library.values import SETTING_UNITS, is_real, number_problem, shown
 from masonrycli.errors import InputError
 
@@ -59,7 +61,7 @@ def quote_string(text: str) -> str:
             out.append("\\t")
         elif ch == "\r":
             out.append("\\r")
-        elif code < 0x20 or code == 0x7F:
+        elif unicodedata.category(ch) in LINE_BREAKING:  # U+0085, U+2028 too: a message stays one line
             out.append(f"\\u{code:04x}")
         else:
             out.append(ch)

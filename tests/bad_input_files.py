@@ -368,6 +368,45 @@ FILE_ROWS = [
         2,
         "g.geojson: feature 1: name must be a string, got {'a': 1}",
     ),
+    # a "|" joins a joint's two names: "a|b|ground" was a|b on ground, or a on b|ground (limit's hinges, the
+    # summaries); a newline (or U+2028) in a name cut every message naming the block into two lines
+    (
+        "geojson-name-bar",
+        {"g.geojson": feature(SQUARE, name="a|b")},
+        ("check", "g.geojson"),
+        2,
+        'g.geojson: feature 1: name "a|b" must not contain "|" (it joins the names of a joint\'s two bodies',
+    ),
+    (
+        "geojson-name-newline",
+        {"g.geojson": feature(SQUARE, name="a\nb")},
+        ("check", "g.geojson"),
+        2,
+        'g.geojson: feature 1: name "a\\nb" must not contain control characters or line breaks',
+    ),
+    (
+        "toml-name-bar",
+        scen(block='name = "a|b"\npolygon = [[0, 0], [1, 0], [1, 1], [0, 1]]\n'),
+        ("check", "s.toml"),
+        2,
+        's.toml:2: [[block]] #1 ("a|b"): name = "a|b": must not contain "|"',
+    ),
+    (
+        "toml-support-name-line-separator",
+        {
+            "s.toml": f'[[block]]\n{BLOCK}[[support]]\nname = "g\\u2028"\npolygon = [[-2, -1], [3, -1], [3, 0], [-2, 0]]\n'
+        },
+        ("check", "s.toml"),
+        2,
+        'name = "g\\u2028": must not contain control characters or line breaks',
+    ),
+    (
+        "wkt-name-bar",
+        {"w.wkt": "block a|b: POLYGON((0 0,1 0,1 1,0 1,0 0))\nsupport g: POLYGON((-2 -1,3 -1,3 0,-2 0,-2 -1))\n"},
+        ("check", "w.wkt"),
+        2,
+        'w.wkt: block 1: name "a|b" must not contain "|"',
+    ),
     # -- WKT
     (
         "wkt-nan",

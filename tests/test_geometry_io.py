@@ -94,6 +94,9 @@ def test_geojson_a_null_property_is_not_given(tmp_path):
     a = read_geojson(write(tmp_path, [feature(SQ, **nulls), ground]), density=1800.0, thickness=0.8)
     assert [(b.name, b.density, b.thickness) for b in a.blocks] == [("block-1", 1800.0, 0.8)]
     assert [(s.name, s.role) for s in a.supports] == [("g", "fixed")]
+    # an empty cell may be written as "" too (a blank name said 'name "" must not be empty')
+    a = read_geojson(write(tmp_path, [feature(SQ, name=""), feature(SQ, name="  "), ground]))
+    assert [b.name for b in a.blocks] == ["block-1", "block-2"]
 
 
 def test_geojson_properties_it_does_not_use_are_listed_with_their_first_body(tmp_path):
