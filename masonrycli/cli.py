@@ -30,7 +30,7 @@ from masonrycli.cli_options import (
     Friction,
     choice_value,
     file_defaults,
-    path_value,
+    file_path_value,
     with_options,
 )
 from masonrycli.errors import EXIT_DIVERGED, EXIT_INTERNAL, EXIT_OUTPUT_FAILED, InputError
@@ -255,7 +255,9 @@ def limit_command(
     ] = False,
     out: Annotated[
         Path | None,
-        typer.Option("--out", "-o", parser=path_value, help="Write the mechanism recording (.rrd).", metavar="REC.rrd"),
+        typer.Option(
+            "--out", "-o", parser=file_path_value, help="Write the mechanism recording (.rrd).", metavar="REC.rrd"
+        ),
     ] = None,
     force: Annotated[bool, typer.Option("--force", help="Replace the --out file if it exists.")] = False,
 ) -> None:

@@ -9,6 +9,7 @@ from __future__ import annotations
 import copy
 import functools
 import inspect
+import os
 import re
 import typing
 from pathlib import Path
@@ -69,6 +70,22 @@ def path_value(text: str) -> Path:
     if not str(text).strip():
         raise typer.BadParameter("the path is empty")
     return Path(text).expanduser()
+
+
+def file_path_value(text: str) -> Path:
+    """An output file's path (``--out``, ``--history``, ``--plot``, ``--recording``): as :func:`path_value`,
+    and one whose last part is empty or "." names a folder, not a file: ``Path("x.rrd/")`` is ``x.rrd``, so
+    ``--out x.rrd/`` wrote the file x.rrd without a word."""
+    path = path_value(text)
+    last = str(text).replace(os.altsep or os.sep, os.sep).rsplit(os.sep, 1)[-1]
+    # an existing folder is left to check_output, which says "is a folder (name a file in it: d/NAME.rrd)"
+    if last in ("", ".") and not path.is_dir():
+        ending = os.sep + last
+        raise typer.BadParameter(
+            f'{text}: a path ending in "{ending}" names a folder, not a file (give the file\'s name, without '
+            f'the "{ending}")'
+        )
+    return path
 
 
 WALL = {
@@ -177,11 +194,20 @@ BLOCK_MATERIAL = {
     "thickness": _opt(float, "Material", "Out-of-plane thickness, m (default 1)."),
 }
 OUTPUT = {
-    "out": _opt(Path, "Output", "Recording (.rrd). Default: recordings/<scenario>-<timestamp>.rrd.", "--out", "-o"),
+    "out": _opt(
+        Path,
+        "Output",
+        "Recording (.rrd). Default: recordings/<scenario>-<timestamp>.rrd.",
+        "--out",
+        "-o",
+        parser=file_path_value,
+    ),
     "no_recording": Annotated[
         bool, typer.Option("--no-recording", help="Write no .rrd recording.", rich_help_panel="Output")
     ],
-    "history": _opt(Path, "Output", "History file (.npz), one row per recorded frame.", "--history"),
+    "history": _opt(
+        Path, "Output", "History file (.npz), one row per recorded frame.", "--history", parser=file_path_value
+    ),
     "magnify": _opt(
         float,
         "Output",
@@ -210,7 +236,7 @@ FORCE = {
 }
 GEO_OUT = {
     "out": Annotated[
-        Path, typer.Option("--out", "-o", parser=path_value, help="GeoJSON file to write (.geojson or .json).")
+        Path, typer.Option("--out", "-o", parser=file_path_value, help="GeoJSON file to write (.geojson or .json).")
     ]
 }
 

@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING, Annotated
 
 import typer
 
-from masonrycli.cli_options import choice_value, number_value, path_value, whole_value
+from masonrycli.cli_options import choice_value, file_path_value, number_value, path_value, whole_value
 from masonrycli.errors import EXIT_DIVERGED, EXIT_OUTPUT_FAILED, EXIT_ROWS_FAILED
 from masonrycli.interrupt import FirstSignalStops, exit_code, signal_name
 from masonrycli.outputs import OutputFile
@@ -88,7 +88,7 @@ def sweep_command(
         typer.Option(
             "--out",
             "-o",
-            parser=path_value,
+            parser=file_path_value,
             help="Results, .parquet or .csv (one row per run; default study-<scenario>.parquet).",
         ),
     ] = None,
@@ -123,14 +123,14 @@ def sweep_command(
         Path | None,
         typer.Option(
             "--plot",
-            parser=path_value,
+            parser=file_path_value,
             help="PNG of the state map / fragility / thresholds (default: beside --out, .png).",
         ),
     ] = None,
     recording: Annotated[
         Path | None,
         typer.Option(
-            "--recording", parser=path_value, help="Rerun recording of the study (default: beside --out, .rrd)."
+            "--recording", parser=file_path_value, help="Rerun recording of the study (default: beside --out, .rrd)."
         ),
     ] = None,
     no_recording: Annotated[

@@ -280,6 +280,36 @@ OPTION_ROWS = [
         "--history f/h.npz: f is not a folder",
     ),
     ("out-is-folder", {**scen(), "d.rrd/x": ""}, (*RUN, "--out", "d.rrd"), 2, "--out d.rrd: is a folder"),
+    # Path("x.rrd/") is x.rrd: each of these wrote the file x.rrd (h.npz, …) without a word
+    ("out-trailing-slash", {**scen()}, (*RUN, "--out", "x.rrd/"), 2, 'x.rrd/: a path ending in "/" names a folder'),
+    ("out-trailing-dot", {**scen()}, (*RUN, "--out", "x.rrd/."), 2, 'x.rrd/.: a path ending in "/." names a folder'),
+    (
+        "history-trailing-slash",
+        {**scen()},
+        (*RUN, "--no-recording", "--history", "h.npz/"),
+        2,
+        "'--history': h.npz/: a path ending in \"/\" names a folder, not a file",
+    ),
+    ("check-out-trailing-slash", {**scen()}, ("check", "s.toml", "--out", "x.rrd/"), 2, "x.rrd/: a path ending in"),
+    ("build-out-trailing-slash", {}, ("build", "wall", "--out", "w.geojson/"), 2, "w.geojson/: a path ending in"),
+    ("limit-out-trailing-slash", {}, ("limit", "arch", "--out", "l.rrd/"), 2, "l.rrd/: a path ending in"),
+    ("sweep-out-trailing-slash", {}, ("sweep", "wall", "-p", "amp=0.1", "--out", "s.csv/"), 2, "s.csv/: a path ending"),
+    ("sweep-plot-trailing-slash", {}, ("sweep", "wall", "-p", "amp=0.1", "--plot", "p.png/"), 2, "'--plot': p.png/: a"),
+    (
+        "sweep-recording-trailing-slash",
+        {},
+        ("sweep", "wall", "-p", "amp=0.1", "--recording", "r.rrd/"),
+        2,
+        "'--recording': r.rrd/: a path ending in",
+    ),
+    # an existing folder keeps the message that names a file in it
+    (
+        "out-folder-with-slash",
+        {"d/x": ""},
+        (*WALL, "--out", "d/"),
+        2,
+        "--out d: is a folder (name a file in it: d/NAME",
+    ),
     (
         "check-out-exists",
         {**scen(), "r.rrd": "old"},
