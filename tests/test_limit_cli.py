@@ -125,6 +125,24 @@ def test_infeasible_structure_is_one_line_exit_2(tmp_path):
     assert_one_line_error(invoke("limit", path), "no equilibrium")
 
 
+def test_unsupported_blocks_and_a_frictionless_arch_say_why_there_is_no_equilibrium(tmp_path):
+    # each said "no equilibrium: the blocks cannot carry their own weight (the linear program is infeasible)"
+    square = lambda y0: f"polygon = [[0, {y0}], [1, {y0}], [1, {y0 + 1}], [0, {y0 + 1}]]\n"  # noqa: E731
+    ground = '[[support]]\nname = "ground"\npolygon = [[-1, -1], [2, -1], [2, 0], [-1, 0]]\n'
+    stack = tmp_path / "stack.toml"
+    stack.write_text(f'[[block]]\nname = "a"\n{square(0)}[[block]]\nname = "b"\n{square(1)}')
+    assert_one_line_error(invoke("limit", stack), "no support: nothing holds the 2 blocks up")
+    above = tmp_path / "above.toml"  # a stack of two hovering above a block on the ground
+    above.write_text(
+        f'[[block]]\nname = "a"\n{square(0)}[[block]]\nname = "b"\n{square(1.5)}[[block]]\nname = "c"\n{square(2.5)}'
+        + ground
+    )
+    assert_one_line_error(
+        invoke("limit", above), 'block 2 ("b") and the 1 block it touches rest on no support, so no equilibrium'
+    )
+    assert_one_line_error(invoke("limit", "arch", "--friction", "0"), "weight with friction 0 (the joints carry no")
+
+
 def test_a_refusal_a_warning_explains_is_one_line_with_it(tmp_path):
     # a block touching nothing was said twice (a warning, then the error in its words); under a gravity
     # pointing up "no equilibrium" came with no reason on its line

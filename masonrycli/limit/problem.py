@@ -27,6 +27,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 from scipy.optimize import linprog
+from scipy.sparse.csgraph import connected_components
 
 from geometry_library.checks import body_label
 from masonrycli.errors import InputError
@@ -169,14 +170,26 @@ def _row_scale(model: Model) -> np.ndarray:
 
 
 def _check_supported(model: Model, joints: Joints) -> None:
+    """Every group of touching blocks must touch a support, else no equilibrium exists: say which (the LP
+    said "the blocks cannot carry their own weight (the linear program is infeasible)", for a scenario with
+    no support at all too)."""
     n = model.block_count
-    touched = np.zeros(n, dtype=bool)
-    body = joints.contact_body.ravel()
-    touched[body[body < n]] = True
-    if not touched.all():
-        index = int(np.flatnonzero(~touched)[0])
+    if model.support_count == 0:
+        raise LimitError(f"no support: nothing holds the {n} block{'s' * (n != 1)} up, so no equilibrium exists")
+    # node n stands for every support: a group of blocks is held if it is connected to it
+    ends = np.minimum(joints.contact_body.reshape(-1, 2), n)
+    graph = sp.coo_matrix((np.ones(len(ends)), (ends[:, 0], ends[:, 1])), shape=(n + 1, n + 1))
+    _, group = connected_components(graph, directed=False)
+    loose = np.flatnonzero(group[:n] != group[n])
+    if loose.size:
+        index = int(loose[0])
+        others = int(np.count_nonzero(group[:n] == group[index])) - 1
+        label = body_label(index, model.block_name[index])
         raise LimitError(
-            f"{body_label(index, model.block_name[index])} touches nothing: it has no support, so no equilibrium exists"
+            f"{label} touches nothing: it has no support, so no equilibrium exists"
+            if others == 0
+            else f"{label} and the {others} block{'s' * (others != 1)} it touches rest on no support, so no "
+            "equilibrium exists"
         )
 
 
@@ -210,7 +223,8 @@ def solve_limit(
     res = linprog(cost, A_eq=a_eq, b_eq=b_eq, bounds=(0, None), method=method, options=options or {})
     elapsed = time.perf_counter() - t0
     if res.status != 0:
-        raise _status_error(res.status, res.message, "the blocks cannot carry their own weight")
+        shear = " with friction 0 (the joints carry no shear)" if model.friction == 0 else ""
+        raise _status_error(res.status, res.message, f"the blocks cannot carry their own weight{shear}")
     alpha = res.x[:-1].reshape(-1, 2) * weight
     mu = model.friction
     force = np.stack([alpha.sum(axis=1), mu * (alpha[:, 0] - alpha[:, 1])], axis=1)
