@@ -122,13 +122,17 @@ def legend_markdown(
     magnify: float | None,
     main_field: str = "cell_spherical_stress",
     paper_t: float | None = None,
+    arrow_cap: float | None = None,
 ) -> str:
-    """The legend shown under the structure views (and in the run document): the tabs' short names first."""
+    """The legend shown under the structure views (and in the run document): the tabs' short names first.
+    ``arrow_cap``: the longest arrow drawn, m (a larger force is drawn that long)."""
     scale = (
         "scale not fixed yet"
         if not force_scale
         else f"{block_height:.3g} m (a median block height) = {block_height / force_scale / 1e3:.4g} kN"
     )
+    if force_scale and arrow_cap:
+        scale += f"; at most {arrow_cap:.3g} m: a larger force ({arrow_cap / force_scale / 1e3:.4g} kN and up) is drawn that long, hover for its value"
     factor = "set when the run closes" if magnify is None else f"× {magnify:g}"
     return (
         f"{tabs_legend(main_field, paper_t)}\n"

@@ -19,6 +19,7 @@ ROBUST_PERCENTILE: Final = 98.0  # the glyph scales come from this percentile of
 GLYPH_HALF_LENGTH: Final = 0.45  # longest principal-axis half-length / median block's smaller side
 RESULTANT_LENGTH: Final = 1.5  # joint resultant of the first loaded frame's 95th percentile, in block heights
 RESULTANT_PERCENTILE: Final = 95.0
+RESULTANT_CAP: Final = 0.5  # a joint arrow is drawn at most this × the structure's size long (overlays.send_joints)
 INSET: Final = 0.002  # block fills are inset by this × the structure's size: the joints show as dark lines
 # but by no more than this × a median block's smaller side: on an 8-course wall 37.5 m long 0.002 × 37.5 m
 # inset 0.2 m high blocks by 7.5 cm a side, the fills were 5 cm high (about a pixel at first open) and every

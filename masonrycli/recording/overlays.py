@@ -55,9 +55,13 @@ def send_axes(
     )
 
 
-def send_joints(rec: rr.RecordingStream, idx: list, b: FrameBatch, force_scale: float | None) -> None:
+def send_joints(
+    rec: rr.RecordingStream, idx: list, b: FrameBatch, force_scale: float | None, max_length: float = np.inf
+) -> np.ndarray:
     """One arrow per loaded joint (the batch's "joint_point", "joint_force", "joint_state"), centred on its
-    point of application, ``force_scale`` m per N, coloured by state; the hinges ("hinge_point")."""
+    point of application, ``force_scale`` m per N but at most ``max_length`` m long, coloured by state; the
+    hinges ("hinge_point"). Returns the arrows' extent (xmin, ymin, xmax, ymax), m (inf, inf, -inf, -inf:
+    none), for the view to hold them (``static_content.log_plane``)."""
     points, lengths = b.concat("joint_point", (0, 2))
     forces, _ = b.concat("joint_force", (0, 2))
     state, _ = b.concat("joint_state", (0,))
@@ -65,13 +69,21 @@ def send_joints(rec: rr.RecordingStream, idx: list, b: FrameBatch, force_scale: 
     for value, rgba in _STATE_RGBA.items():
         colors[state == value] = rgba
     vectors = forces * (force_scale or 0.0)
+    # an impact's one-frame spike (a 64-course wall's toe: 12 m at 1.6 MN, the wall 12.8 m high) would set
+    # the view of every frame: drawn at the cap, its force on hover
+    length = np.hypot(vectors[:, 0], vectors[:, 1])
+    over = length > max_length
+    vectors[over] *= (max_length / length[over])[:, None]
     magnitude = 1e-3 * np.hypot(forces[:, 0], forces[:, 1]).astype(np.float32)
+    origins = points - 0.5 * vectors
+    ends = np.concatenate([origins, origins + vectors]) if len(points) else np.zeros((0, 2))
+    extent = np.r_[ends.min(axis=0), ends.max(axis=0)] if len(ends) else np.array([np.inf, np.inf, -np.inf, -np.inf])
     rec.send_columns(
         FORCES,
         indexes=idx,
         columns=[
             *rr.Arrows2D.columns(
-                origins=(points - 0.5 * vectors).astype(np.float32), colors=colors, vectors=vectors.astype(np.float32)
+                origins=origins.astype(np.float32), colors=colors, vectors=vectors.astype(np.float32)
             ).partition(lengths),
             *rr.AnyValues.columns(force_kN=pa.array(magnitude, type=pa.float32())).partition(lengths),
         ],
@@ -80,6 +92,7 @@ def send_joints(rec: rr.RecordingStream, idx: list, b: FrameBatch, force_scale: 
     rec.send_columns(
         HINGES, indexes=idx, columns=rr.Points2D.columns(positions=hinges.astype(np.float32)).partition(per_frame)
     )
+    return extent
 
 
 def frame_joint_resultants(frame, block_q: np.ndarray, support_q: np.ndarray):

@@ -63,6 +63,7 @@ from masonrycli.recording.layout import (
     LEGEND_BARS,
     LEGEND_LABELS,
     METADATA,
+    RESULTANT_CAP,
     RESULTANT_LENGTH,
     RESULTANT_PERCENTILE,
     ROBUST_PERCENTILE,
@@ -136,8 +137,9 @@ class Recorder:
         self._block_side = float(np.median(size.min(axis=1)))  # m: the glyphs' unit; caps the fills' inset
         # (N,) m: a block's farthest vertex from its centroid, for the reach of the run (_clear_the_legend)
         self._radius = np.maximum.reduceat(np.hypot(*loc.T), first) if n else np.zeros(0)
-        self._reach = -np.inf
-        self._reach_left = np.inf  # the smallest x: a collapse to the left widens the view that way
+        # (xmin, ymin, xmax, ymax) m of what the run drew: the blocks' x (a collapse either way), the joint
+        # arrows (_clear_the_legend widens the view to hold it)
+        self._extent = np.array([np.inf, np.inf, -np.inf, -np.inf])
         # steps with a residual, those a decade under the tolerance, the largest, the smallest of the others
         self._residuals = [0, 0, 0.0, np.inf]
         self._glyph_length = GLYPH_HALF_LENGTH * self._block_side
@@ -326,9 +328,10 @@ class Recorder:
             warnings.warn(f"recording flush failed while closing: {error!r}", RuntimeWarning, stacklevel=2)
 
     def _clear_the_legend(self) -> None:
-        """The colour bars and their labels moved right of the farthest x a block reached, the view widened
-        to hold them: they stood right of the structure as built, and a wall shaken 0.32 m to the right
-        and collapsing ('masonry simulate wall --amp 2 --freq 1') covered the bar and its title."""
+        """The colour bars and their labels moved right of the farthest x a block or arrow reached, the view
+        widened to hold them and every frame's arrows: they stood right of the structure as built, and a wall
+        shaken 0.32 m to the right and collapsing ('masonry simulate wall --amp 2 --freq 1') covered the bar
+        and its title (log_plane)."""
         if self._ref is None:
             return
         q, sq, _ = self._ref
@@ -338,8 +341,7 @@ class Recorder:
             self._supports,
             q,
             sq,
-            reach=self._reach,
-            reach_left=self._reach_left,
+            content=self._extent,
             block_side=self._block_side,
         )
         shift = rr.Transform3D(translation=[box[0] - self._legend_box[0], 0.0, 0.0])
@@ -380,8 +382,11 @@ class Recorder:
         idx = time_indexes(b)
         q = b.stack("block_q")  # (F, N, 3)
         if self._n:
-            self._reach = max(self._reach, float((q[..., 0] + self._radius).max()))
-            self._reach_left = min(self._reach_left, float((q[..., 0] - self._radius).min()))
+            e = self._extent
+            e[2], e[0] = (
+                max(e[2], float((q[..., 0] + self._radius).max())),
+                min(e[0], float((q[..., 0] - self._radius).min())),
+            )
         tensors = {key: b.stack(key) for key in TENSOR_KEYS}
         # A voussoir of a bare ring has no cell strain rate; its strain rate along the ring stands in.
         vsr = tensors["cell_volumetric_strain_rate"]
@@ -421,7 +426,8 @@ class Recorder:
             send_axes(self.rec, f"{XY}/{name}", idx, *args)
 
     def _send_joints(self, idx: list, b: FrameBatch) -> None:
-        send_joints(self.rec, idx, b, self.force_scale)
+        arrows = send_joints(self.rec, idx, b, self.force_scale, RESULTANT_CAP * self._size)
+        self._extent = np.r_[np.minimum(self._extent[:2], arrows[:2]), np.maximum(self._extent[2:], arrows[2:])]
 
     def _send_magnified(self) -> None:
         if self._poses is not None and self._poses.count and self._ref is not None:
@@ -459,7 +465,9 @@ class Recorder:
         )
         self.rec.log(METADATA, rr.TextDocument(viewer_safe_text(text), media_type="text/markdown"), static=True)
         paper_t = None if self.paper is None else self.paper[0]
-        legend = legend_markdown(self.force_scale, self.block_height, self.magnify, self._main_field, paper_t)
+        legend = legend_markdown(
+            self.force_scale, self.block_height, self.magnify, self._main_field, paper_t, RESULTANT_CAP * self._size
+        )
         self.rec.log(LEGEND, rr.TextDocument(viewer_safe_text(legend), media_type="text/markdown"), static=True)
 
 

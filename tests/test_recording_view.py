@@ -1,0 +1,63 @@
+"""What the structure views frame, read back from recordings: every frame's content inside the view."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from masonrycli.frame import CONTACT_STICK
+from masonrycli.recording import Recorder
+from masonrycli.recording.layout import FORCES, LEGEND, PLANE, RESULTANT_CAP
+
+import recording_fixtures as fx
+from recording_fixtures import strict_rerun, temporal_rows  # noqa: F401 (strict_rerun: autouse)
+
+
+def _view(path) -> tuple[float, float, float, float]:
+    """(xmin, ymin, xmax, ymax), m, of the structure views (1 image unit = 1 m; the image starts at x0, y0)."""
+    x0, y0, _ = fx.static_value(path, f"/{PLANE}", "Transform3D:translation")[0]
+    width, height = fx.static_value(path, f"/{PLANE}", "Pinhole:resolution")[0]
+    return x0, y0 - height, x0 + width, y0
+
+
+def test_the_view_holds_every_frames_joint_arrows(tmp_path):
+    """'masonry simulate wall --courses 64 --length 4.5' (the lab's h64): the wall rocks on its toes, whose
+    joint carries the weight of the wall (1.6 MN against 67 kN a block height at the run's fixed scale); the
+    arrow, centred on its point, ran 4 m below the view in 70 frames of 100 (Live, Sliding and Opening tabs).
+    The scale stays fixed for the run (the arrows compare across time); the view holds every frame's arrows,
+    and an arrow is at most RESULTANT_CAP x the structure's size long (an impact's one-frame spike: 12 m on
+    the 12.8 m wall), its force on hover."""
+    static, q0 = fx.wall()
+    n = len(q0)
+    frames = fx.frames(static, q0, 12)
+    toe = np.array([0.0, 0.05])  # the wall's left toe, on the ground (its top at y = 0)
+    force = 300.0 * (1.0 + np.arange(12.0))
+    force[-1] = 1e6  # the last frame: a spike
+    for f, fy in zip(frames, force):  # one joint (block 0 on the ground) carrying more and more
+        f.contact_body[(f.contact_body[:, 0] == 0) & (f.contact_body[:, 1] == n)] = (1, 2)
+        f.contact_body[0], f.contact_point[0], f.contact_normal[0] = (0, n), toe, (0.0, 1.0)
+        f.contact_status[0], f.contact_force[0] = CONTACT_STICK, (0.0, fy)
+    path = tmp_path / "toe.rrd"
+    with Recorder(path, static, fx.METADATA, batch_frames=4) as rec:
+        for f in frames:
+            rec.log_frame(f)
+    origins = temporal_rows(path, f"/{FORCES}", "Arrows2D:origins")
+    vectors = temporal_rows(path, f"/{FORCES}", "Arrows2D:vectors")
+    xmin, ymin, xmax, ymax = _view(path)
+    cap = RESULTANT_CAP * 4 * fx.BLOCK_W  # the structure's size: the wall is 1.2 m long, 0.8 m high
+    toe_lengths, lowest = [], np.inf
+    for f in frames:
+        o, v = np.array(origins[f.step]).reshape(-1, 2), np.array(vectors[f.step]).reshape(-1, 2)
+        ends = np.concatenate([o, o + v])
+        assert (ends[:, 0] > xmin).all() and (ends[:, 0] < xmax).all(), (f.step, ends[:, 0].min(), xmin, xmax)
+        assert (ends[:, 1] > ymin).all() and (ends[:, 1] < ymax).all(), (f.step, ends[:, 1].min(), ymin, ymax)
+        assert np.hypot(*v.T).max() <= cap * (1 + 1e-6)
+        at_toe = np.argmin(np.hypot(*(o + 0.5 * v - toe).T))
+        toe_lengths.append(np.hypot(*v[at_toe]))
+        lowest = min(lowest, ends[:, 1].min())
+    # the fixed scale: the toe arrow grows with its force until the cap (the spike)
+    np.testing.assert_allclose(toe_lengths, np.minimum(rec.force_scale * force, cap), rtol=1e-5)
+    # uncapped, the arrow before the spike reaches below the ground's underside (y = -0.1 m) by more than
+    # the margin of a view fitted to the structure (0.05 x its size)
+    assert rec.force_scale * force[-2] < cap and lowest < -0.1 - 0.05 * 1.2, (rec.force_scale, lowest)
+    legend = fx.static_value(path, f"/{LEGEND}", "TextDocument:text")[0]
+    assert f"at most {cap:.3g} m" in legend, legend
