@@ -359,6 +359,8 @@ def inspect_command(
     parameters, status, frames, time span, and each array's shape, dtype and unit)."""
     from masonrycli.history_inspect import inspect_history, is_history
 
+    if recording.is_file() and recording.stat().st_size == 0:  # rerun's "file too small to be an RRD", a zip error
+        raise InputError(f"{recording}: an empty file (0 bytes), not a recording or a history")
     if is_history(recording):
         from masonrycli.report import history_tables
 
@@ -375,6 +377,8 @@ def inspect_command(
         raise InputError(problem)
     try:
         info = inspect_recording(recording)
+    except ValueError as exc:  # the reader's own words: the file holds no complete recording
+        raise InputError(f"{recording}: not a readable Rerun recording: {exc}") from None
     except Exception as exc:  # a corrupt or foreign file: say so in one line
         raise InputError(f"{recording}: not a readable Rerun recording ({type(exc).__name__}: {exc})") from None
     console.print(recording_table(str(recording), info))

@@ -363,6 +363,17 @@ OPTION_ROWS = [
         2,
         "H.npz: not a readable history (.npz): BadZipFile: File is not a zip file",
     ),
+    # rerun's "Failed to decode frame: file too small to be an RRD" and a zip error; a recording cut before its
+    # first message said "(ValueError: cut.rrd: no recording in this file)"
+    ("inspect-empty-rrd", {"e.rrd": b""}, ("inspect", "e.rrd"), 2, "e.rrd: an empty file (0 bytes), not a recording"),
+    ("inspect-empty-npz", {"e.npz": b""}, ("inspect", "e.npz"), 2, "e.npz: an empty file (0 bytes), not a recording"),
+    (
+        "inspect-cut-before-a-message",
+        {"cut.rrd": bytes.fromhex("52524632002900000102000001000000000000005e000000")},
+        ("inspect", "cut.rrd"),
+        2,
+        "cut.rrd: not a readable Rerun recording: no complete recording in its 24 bytes (cut short, or damaged)",
+    ),
     (
         "inspect-scenario",
         {**scen()},

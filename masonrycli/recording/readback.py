@@ -183,7 +183,7 @@ def _open_reader(path: str, scratch: str) -> tuple[rr.chunk.RrdReader, bool]:
             with open(source, "rb") as src, open(shorter, "wb") as dst:
                 dst.write(src.read(end))
             source, truncated = shorter, True
-    raise ValueError(f"{path}: no complete message found")
+    raise ValueError("no complete message in it (cut short, or damaged)")
 
 
 @contextlib.contextmanager
@@ -215,7 +215,7 @@ def _summarise(reader: rr.chunk.RrdReader, truncated: bool, path) -> dict:
         warnings.simplefilter("ignore")
         recordings = reader.recordings()
     if not recordings:
-        raise ValueError(f"{path}: no recording in this file")
+        raise ValueError(f"no complete recording in its {os.path.getsize(path):,} bytes (cut short, or damaged)")
     entry = recordings[0]
     paths: set[str] = set()
     steps: set[int] = set()
