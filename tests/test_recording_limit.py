@@ -163,3 +163,37 @@ def test_many_hinges_are_smaller_dots(written, tmp_path, monkeypatch):
             if chunk.entity_path == f"/{HINGES}" and chunk.is_static:
                 radii[name] = chunk.to_record_batch().column("Points2D:radii").to_pylist()[-1]
     assert radii == {"few": [-4.0], "many": [-2.0]}
+
+
+def test_the_live_load_is_drawn_where_it_acts(written, tmp_path):
+    """The point load of 'masonry limit aqueduct --load point --block v15 --direction -y' was nowhere on
+    screen (the document alone named its block). An arrow whose tip is on the load's point, along it: the
+    loaded block's centroid for a point load; the blocks' centre of mass for body forces (their resultant)."""
+    from masonrycli.recording.limit import LOAD, LOAD_LENGTH
+
+    import recording_fixtures as fx
+
+    path, _ = written  # two 0.4 x 0.8 blocks stacked, a horizontal body force +x: the centre of mass (0.2, 0.8)
+    size = 1.6
+    for rrd, tip, direction in (
+        (path, (0.2, 0.8), (1.0, 0.0)),
+        (tmp_path / "point.rrd", (0.2, 1.2), (-1.0, 0.0)),  # block b1: centroid (0.2, 1.2)
+    ):
+        if rrd != path:
+            write_recording(analyse(column(2, 0.4, 0.8, 0.9), LiveLoad("point", "-x", "b1")), rrd)
+        origin = np.array(fx.static_value(rrd, f"/{LOAD}", "Arrows2D:origins"))
+        vector = np.array(fx.static_value(rrd, f"/{LOAD}", "Arrows2D:vectors"))
+        np.testing.assert_allclose(origin[0] + vector[0], tip, atol=1e-6)
+        np.testing.assert_allclose(vector[0], LOAD_LENGTH * size * np.array(direction), atol=1e-6)
+
+
+def test_the_document_lists_a_dozen_joints_and_says_how_many_more():
+    """The aqueduct's point load listed 40 of its 363 hinges and 40 of its 500 sliding joints beside the
+    view, a 30-line wall of names with no word that there were more."""
+    from masonrycli.limit.command import DOCUMENT_NAMES, _document_names
+
+    names = [f"j{k}" for k in range(363)]
+    text = _document_names(names)
+    assert text.startswith(", ".join(names[:DOCUMENT_NAMES])) and f"j{DOCUMENT_NAMES}," not in text
+    assert text.endswith(f"and {363 - DOCUMENT_NAMES} more (all in --json)")
+    assert _document_names(names[:3]) == "j0, j1, j2"

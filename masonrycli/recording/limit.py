@@ -53,11 +53,16 @@ OUTLINES: Final = f"{XY}/limit/outlines"
 HINGES: Final = f"{XY}/limit/hinges"
 SLIDING: Final = f"{XY}/limit/sliding"
 THRUST: Final = f"{XY}/limit/thrust"
+LOAD: Final = f"{XY}/limit/load"
+LOAD_RGBA: Final = 0x3C8CFFFF  # the live load's arrow (blue: no other mark is)
+LOAD_LENGTH: Final = 0.15  # × the structure's size: the arrow shows where and which way, the document how much
 SPEED_BAR: Final = "structure/limit/speed_bar"
 SPEED_LABELS: Final = f"{XY}/limit/speed_bar"
 SPEED_TITLE: Final = "Speed / fastest"
 DOCUMENT: Final = "limit/document"
-LIMIT_PATHS: Final = (PLANE, XY, FILL, SUPPORTS, OUTLINES, HINGES, SLIDING, THRUST, SPEED_BAR, SPEED_LABELS, DOCUMENT)
+LIMIT_PATHS: Final = (
+    *(PLANE, XY, FILL, SUPPORTS, OUTLINES, HINGES, SLIDING, THRUST, LOAD, SPEED_BAR, SPEED_LABELS, DOCUMENT),
+)
 _NAMESPACE: Final = uuid.UUID("2b8f0c57-64f1-4f0e-9a51-1f3c7d0e6a21")
 
 
@@ -93,6 +98,8 @@ class MechanismDrawing:
     """(P, 2) m: centres of pressure of the loaded joints."""
     document: str
     """Markdown shown beside the view (λ, load, hinges…)."""
+    load: tuple[np.ndarray, np.ndarray] | None = None
+    """(point, unit direction), m: where the live load acts and which way (drawn on the structure as built)."""
 
 
 def _block_speed(polys: Polygons, velocity: np.ndarray) -> np.ndarray:
@@ -171,7 +178,9 @@ def write_limit_recording(path: str | os.PathLike, drawing: MechanismDrawing) ->
     rec = rr.RecordingStream(APPLICATION_ID, recording_id=str(uuid.uuid5(_NAMESPACE, os.fspath(path))))
     view = rrb.Spatial2DView(
         origin=f"/{PLANE}",
-        contents=[f"+ /{p}" for p in (SUPPORTS, FILL, OUTLINES, THRUST, HINGES, SLIDING, SPEED_BAR, SPEED_LABELS)],
+        contents=[
+            f"+ /{p}" for p in (SUPPORTS, FILL, OUTLINES, THRUST, LOAD, HINGES, SLIDING, SPEED_BAR, SPEED_LABELS)
+        ],
         name="Collapse mechanism (right, magnified) and line of thrust",
     )
     blueprint = rrb.Blueprint(
@@ -205,6 +214,8 @@ def write_limit_recording(path: str | os.PathLike, drawing: MechanismDrawing) ->
             radius = MARKER_RADIUS[count > MANY_MARKERS]
             rec.log(path_, rr.Points2D.from_fields(radii=radius, colors=colour, draw_order=60.0), static=True)
         rec.log(THRUST, rr.Points2D(d.thrust_point, radii=-2.5, colors=THRUST_RGBA, draw_order=55.0), static=True)
+        if d.load is not None:  # the point load was nowhere on screen: the document alone named its block
+            _log_load(rec, d.load, LOAD_LENGTH * size)
         idx = [rr.TimeColumn("step", sequence=np.arange(frames))]
         rec.send_columns(
             FILL,
@@ -230,6 +241,24 @@ def write_limit_recording(path: str | os.PathLike, drawing: MechanismDrawing) ->
         wait_written(rec, path)
         rec.disconnect()
     check_complete(path)
+
+
+def _log_load(rec: rr.RecordingStream, load: tuple[np.ndarray, np.ndarray], length: float) -> None:
+    """The live load: an arrow ``length`` m long whose tip is on its point, along its direction. No label:
+    the viewer draws it on a grey box at the tip, which hid the loaded block (the document says blue arrow)."""
+    point, direction = (np.asarray(a, dtype=np.float64) for a in load)
+    vector = length * direction
+    rec.log(
+        LOAD,
+        rr.Arrows2D(
+            origins=[point - vector],
+            vectors=[vector],
+            colors=LOAD_RGBA,
+            radii=-2.5,
+            draw_order=70.0,
+        ),
+        static=True,
+    )
 
 
 def _log_speed_bar(rec: rr.RecordingStream, legend_box: tuple[float, float, float, float]) -> None:
