@@ -5,6 +5,7 @@ gives its row once, with the points a driver hands out on the way."""
 from __future__ import annotations
 
 import re
+import time
 
 import pytest
 
@@ -63,6 +64,42 @@ def test_an_explicit_limit_is_kept(client, monkeypatch):
         client, "s", Driver(40), lambda p, r: held.append(len(client.futures)), False, None, False, limit=3
     )
     assert len(held) == 40 and max(held) <= 4
+
+
+def test_a_cluster_without_workers_says_the_study_waits_and_again_when_one_joins(monkeypatch):
+    # every worker of a --scheduler killed: the study waited, silent, its bar still (walk-through
+    # 2026-11-29, 180 s without a word); it waits still (a worker may join), and says so
+    from distributed import Client, LocalCluster
+
+    def task(base, params, *args):  # long enough for the watch to see the worker that joined
+        time.sleep(0.3)
+        return dict(params)
+
+    monkeypatch.setattr(runner, "run_task", task)
+    monkeypatch.setattr(runner, "NO_WORKER_WAIT", 0.5)
+    monkeypatch.setattr(runner, "WATCH_EVERY", 0.1)
+    cluster = LocalCluster(n_workers=0, threads_per_worker=1, processes=False, dashboard_address=":0")
+    client = Client(cluster)
+    said, rows = [], []
+
+    def warn(line):
+        said.append(line)
+        if len(said) == 1:  # the study waits for a worker: one joins
+            cluster.scale(1)
+
+    try:
+        runner.run_on_cluster(
+            client, "s", Driver(3), lambda p, r: rows.append(r), False, None, False, warn=warn, where="X"
+        )
+    finally:
+        client.close()
+        cluster.close()
+    assert said == [
+        "X: no worker for 0.5 s, 3 runs waiting: the study goes on when a worker joins (Ctrl-C stops it, every "
+        "finished row written)",
+        "X: a worker joined: the study goes on",
+    ]
+    assert sorted(r["amp"] for r in rows) == [0.0, 1.0, 2.0]
 
 
 class Listener:

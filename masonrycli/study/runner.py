@@ -24,6 +24,7 @@ failed runs.
 
 from __future__ import annotations
 
+import contextlib
 import gc
 import logging
 import os
@@ -319,12 +320,66 @@ def in_flight_limit(client) -> int:
     return max(MIN_IN_FLIGHT, IN_FLIGHT_PER_THREAD * threads)
 
 
-def run_on_cluster(client, base, driver, on_row: Callable[[dict, dict], None], *task_args, limit=None) -> None:
+NO_WORKER_WAIT = 10.0
+"""s with runs pending and no worker on the scheduler before the study says it waits for one."""
+WATCH_EVERY = 1.0
+"""s between two looks at the scheduler's workers (:class:`_WorkerWatch`)."""
+
+
+class _WorkerWatch:
+    """A thread that says when the cluster has had no worker for :data:`NO_WORKER_WAIT` s while runs wait,
+    and when one joins again. Every worker of a ``--scheduler`` killed (``kill`` of the ``dask worker``
+    command, a preempted machine) left the study waiting, silent, its bar still, until a worker joined:
+    Dask keeps the tasks for the next worker, which is right (workers come back), but the user saw a hang
+    (walk-through 2026-11-29: 180 s without a word, then killed). ``warn`` takes the lines."""
+
+    def __init__(self, client, warn: Callable[[str], None], where: str, waiting: Callable[[], int]) -> None:
+        self.client, self.warn, self.where, self.waiting = client, warn, where, waiting
+        self.stop = threading.Event()
+        self.thread = threading.Thread(target=self._watch, name="masonry-worker-watch", daemon=True)
+
+    def __enter__(self):
+        self.thread.start()
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.stop.set()
+        self.thread.join(WATCH_EVERY + 1.0)  # a look held by a dying scheduler is left to end with the process
+
+    def _watch(self) -> None:
+        import time
+
+        since, said = None, False
+        while not self.stop.wait(WATCH_EVERY):
+            try:
+                workers = len(self.client.nthreads())
+            except Exception:  # noqa: BLE001 - a scheduler gone is the study's to report (SchedulerLost)
+                continue
+            if self.stop.is_set():
+                return
+            if workers:
+                if said:
+                    self.warn(f"{self.where}: a worker joined: the study goes on")
+                since, said = None, False
+                continue
+            since = since or time.monotonic()
+            if not said and time.monotonic() - since >= NO_WORKER_WAIT:
+                said = True
+                self.warn(
+                    f"{self.where}: no worker for {NO_WORKER_WAIT:g} s, {self.waiting()} runs waiting: the study "
+                    "goes on when a worker joins (Ctrl-C stops it, every finished row written)"
+                )
+
+
+def run_on_cluster(
+    client, base, driver, on_row: Callable[[dict, dict], None], *task_args, limit=None, warn=None, where=""
+) -> None:
     """Run ``driver``'s points on ``client`` until it hands out no more; ``on_row(params, row)`` for each.
     ``task_args``: :func:`run_task`'s arguments after the point (stop_at_collapse, history_dir, force,
     study).
     At most ``limit`` tasks (default :func:`in_flight_limit`) are submitted at a time, the next one as
-    each comes back."""
+    each comes back. ``warn`` (if given) is told when the cluster has no worker for a while (:class:`_WorkerWatch`;
+    ``where`` names the cluster)."""
     import cloudpickle
     from distributed import as_completed
 
@@ -350,22 +405,24 @@ def run_on_cluster(client, base, driver, on_row: Callable[[dict, dict], None], *
             completed.add(future)
 
     submit()
-    for future in completed:
-        params = pending.pop(future.key)
-        try:
-            answer, worker, row = future.result()
-        except Exception as exc:  # the task never returned (KilledWorker, a cluster failure)
-            if _scheduler_lost(client, exc):
-                raise SchedulerLost(
-                    f"lost the connection to the scheduler with {len(pending) + 1} runs pending"
-                ) from None
-            row = params | empty_result(f"{type(exc).__name__}: {exc}", 0.0)
-        else:
-            check_result(answer, worker, params, ours)  # another masonry's row is not kept
-        future.release()
-        waiting.extendleft(reversed(driver.feed(params, row)))  # a search's next step first: its row sooner
-        on_row(params, row)
-        submit()
+    watch = _WorkerWatch(client, warn, where, lambda: len(pending) + len(waiting)) if warn else contextlib.nullcontext()
+    with watch:
+        for future in completed:
+            params = pending.pop(future.key)
+            try:
+                answer, worker, row = future.result()
+            except Exception as exc:  # the task never returned (KilledWorker, a cluster failure)
+                if _scheduler_lost(client, exc):
+                    raise SchedulerLost(
+                        f"lost the connection to the scheduler with {len(pending) + 1} runs pending"
+                    ) from None
+                row = params | empty_result(f"{type(exc).__name__}: {exc}", 0.0)
+            else:
+                check_result(answer, worker, params, ours)  # another masonry's row is not kept
+            future.release()
+            waiting.extendleft(reversed(driver.feed(params, row)))  # a search's next step first: its row sooner
+            on_row(params, row)
+            submit()
 
 
 def run_serially(base, driver, on_row: Callable[[dict, dict], None], *task_args) -> None:

@@ -198,7 +198,8 @@ def run_study(base: StudyBase, request: StudyRequest, console: Console) -> Study
             if client is None:
                 run_serially(base, driver, on_row, *task_args)
             else:
-                run_on_cluster(client, base, driver, on_row, *task_args)
+                where = f"--scheduler {request.scheduler}" if request.scheduler else "the local cluster"
+                run_on_cluster(client, base, driver, on_row, *task_args, warn=request.warn, where=where)
     except (WorkerMismatch, SchedulerLost) as exc:  # the rows before it are kept (written below), resumable
         where = f"--scheduler {request.scheduler}" if request.scheduler else "the local cluster"
         once = "every worker runs this masonry" if isinstance(exc, WorkerMismatch) else "the scheduler is back"
