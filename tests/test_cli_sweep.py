@@ -56,6 +56,8 @@ def block(tmp_path) -> Path:
         (["-p", "amp=0.1", "--duration", "-1", "--dt", "0.01"], "--duration: duration = -1: must be > 0"),
         (["-p", "amp=0.1:1:4", "--find", "amp", "--rtol", "0"], "--rtol 0: must be in (0, 1)"),  # said 0.0
         (["-p", "amp=0.1:1:4", "--find", "amp", "--rtol", "1e0"], "--rtol 1e0: must be in (0, 1)"),
+        # a bracket with no float64 middle: the same point ran for ever
+        (["-p", "amp=0.1:1:4", "--find", "amp", "--rtol", "1e-300"], "--rtol 1e-300: must be >= 1e-09 (each halving"),
         (["-p", "amp=0.1", "--rtol", "0.010"], "--rtol 0.010: goes with --find"),
         (["-p", "amp=0.1,1e30"], "--param amp=1e+30: "),  # it ran, exit 0
         (["-p", "phase=0,1e300"], "--param phase: phase = 1e+300: must be within ±10000 rad"),  # it ran

@@ -48,6 +48,10 @@ class StudyPlan:
 
 MAX_WORKERS_PER_CORE = 4
 """``--workers`` beyond this many per core is refused as a likely typo (each worker is a process of ~200 MB)."""
+MIN_RTOL = 1e-9
+"""``--rtol`` below this is refused as a likely typo: each halving of a bracket is one more run per point (30 from
+a bracket as wide as its value down to 1e-9), and a bracket narrower than float64's 2.2e-16 of its value has no
+middle, so the bisection never ended (``--rtol 1e-300`` ran the same point over and over: no row after 4 min)."""
 
 
 def plan_study(
@@ -135,6 +139,10 @@ def plan_study(
     outcome, rtol = outcome or "collapse", 0.005 if rtol is None else rtol
     if not (0 < rtol < 1):
         raise InputError(f"--rtol {option_text(rtol)}: must be in (0, 1)")
+    if rtol < MIN_RTOL:
+        raise InputError(
+            f"--rtol {option_text(rtol)}: must be >= {MIN_RTOL:g} (each halving is one more run per point; a likely typo)"
+        )
     _check_out_reads_nothing(out, base)
     if no_recording and recording is not None:
         raise InputError(f"--recording {recording} with --no-recording: choose one")
