@@ -23,6 +23,7 @@ from rich.console import Console
 from rich.text import Text
 
 from masonrycli import SOURCE_DIGEST, __version__
+from masonrycli.engine import compile_ahead
 from masonrycli.errors import InputError
 from masonrycli.history import HistoryFile
 from masonrycli.interrupt import StopSignals
@@ -208,7 +209,7 @@ def execute(
     outputs are closed with status "failed" and renamed into place. ``signals``: a :class:`StopSignals`
     the caller entered and keeps installed after the run (its closing phase lasting through the summary);
     by default one of the run's own."""
-    with StopSignals() if signals is None else contextlib.nullcontext(signals) as signals:
+    with StopSignals() if signals is None else contextlib.nullcontext(signals) as signals, compile_ahead.ahead():
         sinks: dict[OutputFile, object] = {}
         try:
             for out in outputs.files():

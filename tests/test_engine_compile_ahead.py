@@ -1,0 +1,101 @@
+"""engine.compile_ahead: the child compiles exactly what a run calls, into the cache the run reads; it is
+started only when the cache lacks it and two CPUs are there, and never outlives the run."""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+
+import pytest
+
+from masonrycli.engine import compile_ahead
+
+from cli_helpers import invoke
+
+
+def test_a_run_calls_every_kernel_with_the_signature_the_child_compiles(tmp_path):
+    # The quick start's run: recorded frames (the joint and tensor kernels) and stalled steps (the
+    # body-order stage) included. A signature the run does not use would be compiled for nothing.
+    done = invoke("simulate", "wall", "--freq", 2, "--amp", 1, "--no-recording", "--history", tmp_path / "h.npz")
+    assert done.exit_code == 0, done.output
+    for name, text in compile_ahead.KERNELS:
+        assert compile_ahead.signature(text) in compile_ahead.dispatcher(name).signatures, name
+
+
+def test_the_notation_reads_as_numba_types():
+    import numba.types as nt
+
+    assert compile_ahead.signature("(i4[:, ::1], f8, b1[::1], f8[:, :, :, ::1],)") == (
+        nt.Array(nt.int32, 2, "C"),
+        nt.float64,
+        nt.Array(nt.boolean, 1, "C"),
+        nt.Array(nt.float64, 4, "C"),
+    )
+
+
+def _child_env(cache) -> dict:
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(cache), RERUN_ANALYTICS="0")
+    root = os.path.dirname(os.path.dirname(os.path.abspath(compile_ahead.__file__)))
+    env["PYTHONPATH"] = os.pathsep.join(p for p in (os.path.dirname(root), env.get("PYTHONPATH", "")) if p)
+    return env
+
+
+@pytest.mark.slow
+def test_what_the_child_compiles_a_run_loads_from_the_cache(tmp_path):
+    cache = tmp_path / "numba-cache"
+    cache.mkdir()
+    env = _child_env(cache)
+    check = (
+        "from masonrycli.engine import compile_ahead as c\n"
+        "print(c.needed())\n"
+        "for name, text in c.KERNELS:\n"
+        "    d = c.dispatcher(name); d.compile(c.signature(text))\n"
+        "    print(name, sum(d.stats.cache_hits.values()), sum(d.stats.cache_misses.values()))\n"
+    )
+    child = subprocess.run([sys.executable, "-m", "masonrycli.engine.compile_ahead"], env=env, timeout=600)
+    assert child.returncode == 0
+    done = subprocess.run([sys.executable, "-c", check], env=env, capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr
+    lines = done.stdout.splitlines()
+    # the cache now holds every kernel of a run's: no child needed, each loaded (a hit), none compiled
+    assert lines[0] == "False" or compile_ahead._cpus() < 2
+    assert lines[1:] == [f"{name} 1 0" for name, _ in compile_ahead.KERNELS]
+
+
+def test_no_child_where_it_cannot_help(monkeypatch):
+    monkeypatch.setattr(compile_ahead, "_cached", lambda name: False)
+    monkeypatch.setattr(compile_ahead, "_cpus", lambda: 2)
+    assert compile_ahead.needed()
+    monkeypatch.setenv("MASONRY_COMPILE_AHEAD", "0")
+    assert not compile_ahead.needed()
+    monkeypatch.delenv("MASONRY_COMPILE_AHEAD")
+    monkeypatch.setattr(compile_ahead, "_cpus", lambda: 1)
+    assert not compile_ahead.needed()
+    monkeypatch.setattr(compile_ahead, "_cpus", lambda: 2)
+    monkeypatch.setattr(compile_ahead, "_cached", lambda name: True)
+    assert not compile_ahead.needed()
+    with compile_ahead.ahead() as child:
+        assert child is None
+
+
+def test_the_stalled_stage_alone_starts_no_child(monkeypatch):
+    # a run that never stalls never caches the body-order stage: it must not start a child every time
+    monkeypatch.setattr(compile_ahead, "_cpus", lambda: 2)
+    monkeypatch.setattr(compile_ahead, "_cached", lambda name: name not in dict(compile_ahead.STALLED))
+    assert not compile_ahead.needed()
+
+
+def test_the_child_is_stopped_and_reaped_when_the_block_ends(monkeypatch):
+    monkeypatch.setattr(compile_ahead, "needed", lambda: True)
+    with pytest.raises(KeyboardInterrupt):
+        with compile_ahead.ahead() as child:
+            assert child is not None and child.poll() is None
+            raise KeyboardInterrupt  # a Ctrl-C in the run: the child goes too
+    assert child.returncode is not None
+
+
+def test_the_child_stops_when_its_parent_is_gone():
+    # started by a process that has exited: getppid() is no longer it, nothing is compiled
+    gone = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"], capture_output=True, text=True)
+    assert compile_ahead.compile_all(parent=int(gone.stdout)) == 0
