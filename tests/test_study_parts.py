@@ -124,6 +124,18 @@ def test_find_driver_bisects_an_outcome_that_comes_below_a_value():
     assert row["evaluations"] == 3 + math.ceil(math.log2((2.0 - 0.7) / (0.005 * 1.28)))
 
 
+def test_find_driver_ends_below_zero_and_around_zero():
+    # "× hi" never held for a bracket below 0: --find amp over amp=-1:-0.1:3 ran the same point for ever
+    driver = FindDriver([Axis("amp", (-1.0, -0.55, -0.1))], "amp", "sliding", 0.005, done={})
+    (row,) = _search(driver, lambda p: p["amp"] < -0.468)
+    assert row["holds"] == "below" and row["amp_lo"] < -0.468 <= row["amp_hi"]
+    assert row["amp_hi"] - row["amp_lo"] <= 0.005 * 0.469 and row["evaluations"] < 20
+    # a threshold at 0 exactly has no relative width to reach: it ends where float64 has no middle left
+    driver = FindDriver([Axis("amp", (-1.0, 1.0))], "amp", "sliding", 0.005, done={})
+    (row,) = _search(driver, lambda p: p["amp"] > 0.0)
+    assert row["amp_lo"] <= 0.0 < row["amp_hi"] and row["evaluations"] < 1200
+
+
 def test_find_driver_notes_an_outcome_at_both_ends_or_neither():
     axis = [Axis("friction", (0.1, 0.7, 2.0))]
     (row,) = _search(FindDriver(axis, "friction", "sliding", 0.005, done={}), lambda p: True)

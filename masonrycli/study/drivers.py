@@ -6,7 +6,7 @@ the Dask side and knows nothing of grids or bisection; the drivers know nothing 
 
 Threshold search (``--find amp``): for every point of the other axes, the values of the ``amp`` axis
 (``amp=LO:HI:N``) are run first, all at once; they bracket the threshold, which is then bisected until the
-bracket is narrower than ``rtol`` × its upper end. The threshold reported is the middle of the final bracket
+bracket is narrower than ``rtol`` × its larger end in size (its upper end, for a positive axis). The threshold reported is the middle of the final bracket
 (so it is within rtol / 2 of every value in the bracket). Which way the outcome goes is read from the ends
 of the range:
 
@@ -118,9 +118,14 @@ class FindDriver:
                 search.hi = value
             else:
                 search.lo = value
-        if search.hi - search.lo <= self.rtol * search.hi:
-            return self._finish(key, point, search)
-        return [point | {self.find: 0.5 * (search.lo + search.hi)}]
+        # × the larger end in size: "× hi" never held for a bracket below 0 (amp=-1:-0.1:3 ran for ever)
+        middle = 0.5 * (search.lo + search.hi)
+        if (
+            search.hi - search.lo <= self.rtol * max(abs(search.lo), abs(search.hi))
+            or not search.lo < middle < search.hi
+        ):
+            return self._finish(key, point, search)  # the second: a bracket around 0 ends where float64 does
+        return [point | {self.find: middle}]
 
     def _bracket(self, search: _Search) -> bool:
         """Bracket the threshold from the initial values (module doc); False, with a note, when the range
