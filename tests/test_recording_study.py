@@ -337,13 +337,15 @@ def test_the_state_map_labels_stand_clear_of_the_dots(tmp_path):
     chunks = list(rr.chunk.RrdReader(str(two_by_two(tmp_path))).stream())
     dots = [static_fields(chunks, e) for e in ("/study/state_map", "/study/state_map/key")]
     centres = np.concatenate([np.array(d["Points2D:positions"]) for d in dots])
-    radius = max(float(np.max(d["Points2D:radii"])) for d in dots)
+    radius = np.concatenate(  # each dot's (the key's are smaller)
+        [np.broadcast_to(np.array(d["Points2D:radii"], np.float64).ravel(), len(d["Points2D:positions"])) for d in dots]
+    )
     assert all(not any(d.get("Points2D:show_labels") or [False]) for d in dots)  # the dots draw no text
     labels = [static_fields(chunks, e) for e in ("/study/state_map/axes", "/study/state_map/key/names")]
     anchors = np.concatenate([np.array(t["Points2D:positions"]) for t in labels])
     assert sum(len(t["Points2D:labels"]) for t in labels) == 4 + 4  # two values per axis, four states
-    gap = np.linalg.norm(anchors[:, None, :] - centres[None, :, :], axis=-1).min()
-    assert gap >= radius + 0.1 * 1.0 - 1e-6  # the map is 1 (freq) by 0.5 (amp)
+    gap = np.linalg.norm(anchors[:, None, :] - centres[None, :, :], axis=-1) - radius[None, :]
+    assert gap.min() >= 0.1 * 1.0 - 1e-6  # the map is 1 (freq) by 0.5 (amp)
 
 
 def test_the_rows_are_the_terminals_with_units_under_the_table(tmp_path):
@@ -473,3 +475,15 @@ def test_the_state_map_labels_do_not_overlap_whatever_the_spacing(tmp_path, name
     assert drawn == shown
     if name in ("readme", "uneven"):
         assert len(drawn) == len(xs) + len(ys)
+
+
+def test_the_key_does_not_read_as_a_row_of_runs(tmp_path):
+    """'masonry sweep wall --param amp=0.2:1:3': the map is one row of three runs, and the key under it was
+    four dots of the same size, as far apart (intact, damaged, collapsed, failed): a second row of runs to
+    the eye. The key's dots are less than half the runs' size."""
+    import rerun as rr
+
+    chunks = list(rr.chunk.RrdReader(str(two_by_two(tmp_path))).stream())
+    runs = float(np.min(static_fields(chunks, "/study/state_map")["Points2D:radii"]))
+    key = float(np.max(static_fields(chunks, "/study/state_map/key")["Points2D:radii"]))
+    assert key < 0.5 * runs, (key, runs)

@@ -180,6 +180,9 @@ def _number(value) -> float:
 LABEL_CHAR_PX, LABEL_PAD_PX, LABEL_HEIGHT_PX, LABEL_GAP_PX = 8.0, 10.0, 24.0, 6.0
 MAP_VIEW_PX, MAP_FILL = (600.0, 1000.0), 0.55
 DOT_RADIUS = 0.25  # of the grid's cell
+# the key's dots, smaller: as large and as far apart as the runs', the key under a one-row map ('masonry
+# sweep wall --param amp=0.2:1:3') read as a second row of runs, of values intact, damaged, collapsed, failed
+KEY_RADIUS = 0.4 * DOT_RADIUS
 KEY_STATES = ("intact", "damaged", "collapsed", "")
 
 
@@ -244,9 +247,9 @@ def _map_labels(names: list[str], ticks: list[list[str]], n: tuple[int, int], px
     widths = [label_width_px(s or "failed") / px for s in KEY_STATES]
     steps = [max((w0 + w1) / 2.0 + gap, 4.0 * r) for w0, w1 in zip(widths, widths[1:])]
     spread = max(1.0, (n[0] - 1 - left) / sum(steps))
-    key_y = bottom - gap - r
+    key_y = bottom - gap - KEY_RADIUS
     key_at = [[left + spread * sum(steps[:i]), key_y] for i in range(len(KEY_STATES))]
-    key_names_at = [[x, key_y - clear - gap - h / 2.0] for x, _ in key_at]
+    key_names_at = [[x, key_y - max(KEY_RADIUS, h / 2.0) - gap - h / 2.0] for x, _ in key_at]
     return at, texts, title_at, titles, key_at, key_names_at
 
 
@@ -279,7 +282,7 @@ def _log_state_map(rec, rows: list[dict], names: list[str]) -> None:
         layout = _map_labels(names, ticks, n, px)
         key = np.array(layout[4])
         anchors = [np.array(a, dtype=np.float64).reshape(-1, 2) for a in (layout[0], layout[2], layout[5])]
-        if map_scale_px(np.concatenate([dots, *anchors, key - DOT_RADIUS, key + DOT_RADIUS])) >= px:
+        if map_scale_px(np.concatenate([dots, *anchors, key - KEY_RADIUS, key + KEY_RADIUS])) >= px:
             break
         px *= 0.9
     at, texts, title_at, titles, key_at, key_names_at = layout
@@ -294,7 +297,7 @@ def _log_state_map(rec, rows: list[dict], names: list[str]) -> None:
     rec.log("study/state_map/axes", drawn(at, texts), static=True)
     rec.log("study/state_map/axes/names", drawn(title_at, [viewer_safe_text(t) for t in titles]), static=True)
     key_colours = np.array([STATE_RGBA[s] for s in KEY_STATES], dtype=np.uint8)
-    key = rr.Points2D(np.array(key_at, np.float32), colors=key_colours, radii=DOT_RADIUS)
+    key = rr.Points2D(np.array(key_at, np.float32), colors=key_colours, radii=KEY_RADIUS)
     rec.log("study/state_map/key", key, static=True)
     rec.log("study/state_map/key/names", drawn(key_names_at, [s or "failed" for s in KEY_STATES]), static=True)
 
