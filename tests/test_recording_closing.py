@@ -175,6 +175,36 @@ def test_the_readback_helpers_read_a_cut_recording_as_inspect_does(wall, tmp_pat
     assert blueprint_views(cut) and recording_rows(cut)
 
 
+def test_a_cut_recording_counts_the_frames_whose_blocks_it_holds(wall, tmp_path):
+    """Walk-through 2026-11-29: the first tenth of an interrupted aqueduct's recording (its frames sent at
+    close, the colour bars' labels before the fill and the blocks) was read as "83 frames up to its last
+    complete chunk", steps 0 … 814, with no block drawn past the first. A frame counts once its blocks (their
+    hover values, read by field_frames) are in the file."""
+    from masonrycli.recording.readback import field_frames
+
+    static, q0 = wall
+    whole, cut = tmp_path / "whole.rrd", tmp_path / "cut.rrd"
+    with Recorder(whole, static, fx.METADATA, batch_frames=4, long_batch_frames=4) as rec:
+        for f in fx.frames(static, q0, 9):
+            rec.log_frame(f)
+    data = whole.read_bytes()
+    read, labels_only = 0, 0
+    for share in range(1, 101):
+        cut.write_bytes(data[: len(data) * share // 100])
+        try:
+            info = inspect_recording(cut)
+        except ValueError:  # not even the recording's first message
+            continue
+        read += 1
+        frames = field_frames(cut)
+        drawn = sorted(step for step, row in frames.items() if row["values"])
+        assert info["frames"] == len(drawn), (share, info["frames"], drawn, info["entity_paths"])
+        assert info["steps"] == ((drawn[0], drawn[-1]) if drawn else None)
+        labels_only += len(frames) > len(drawn)
+    assert read > 50 and labels_only  # some cuts hold a frame's labels without its blocks
+    assert info["frames"] == 9 and info["complete"]
+
+
 def test_the_colour_bars_stand_right_of_where_the_blocks_went(tmp_path):
     """The bars stood right of the structure as built: 'masonry simulate wall --amp 2 --freq 1
     --stop-at-collapse' shook the wall 0.32 m right and it fell over the bar and its title. At close, the

@@ -20,10 +20,13 @@ import rerun as rr
 
 from masonrycli.errors import BINARY_FILE, NOT_A_FILE, binary_under_text_suffix
 from masonrycli.outputs import being_written
-from masonrycli.recording.layout import BLOCKS, CHAIN_KEY, FIELDS, HOVER_VALUES, METADATA, PER_STEP_SERIES, SERIES
+from masonrycli.recording.layout import BLOCKS, CHAIN_KEY, FIELDS, FILL, HOVER_VALUES, METADATA, PER_STEP_SERIES, SERIES
 from masonrycli.recording.screenshot import _viewer_executable, screenshot_recording  # noqa: F401 (re-exported)
 
 _PER_STEP = frozenset(f"/{SERIES[k]}" for k in PER_STEP_SERIES)
+_RUN_FRAMES = frozenset(f"/{p}" for p in (FILL, BLOCKS, *SERIES.values(), *(f.labels for f in FIELDS)))
+"""Entities only a run's recording logs (a limit or a study recording has none): a file with one is a run's,
+whose frames are those of its blocks."""
 
 _TRUNCATED = re.compile(r"Message payload \(start (\d+), length \d+\) exceeds file size")
 _MESSAGE_HEADER_BYTES = 16  # an RRD message: kind (u64) and length (u64), then the payload
@@ -200,9 +203,9 @@ def inspect_recording(path: str | os.PathLike) -> dict:
     """Summary of a recording file; works without a footer too (a killed writer's file) and on a file cut
     in the middle of a message (read up to its last complete message).
 
-    Keys: application_id, recording_id, frames (distinct `step` values of the recorded frames; solver
-    health is logged for every step besides), steps (first, last frame) or None, time_span (first, last
-    frame's sim_time, s) or None, entity_paths (sorted, with the leading "/"), has_blueprint, complete
+    Keys: application_id, recording_id, frames (distinct `step` values of the recorded frames whose
+    blocks are in the file; solver health is logged for every step besides), steps (first, last frame) or
+    None, time_span (first, last frame's sim_time, s) or None, entity_paths (sorted, with the leading "/"), has_blueprint, complete
     (footer present), truncated (the writer did not finish: no footer, or cut in a message; what
     ``masonry inspect`` warns about), metadata (the run document's Markdown, or None).
     """
@@ -218,8 +221,12 @@ def _summarise(reader: rr.chunk.RrdReader, truncated: bool, path) -> dict:
         raise ValueError(f"no complete recording in its {os.path.getsize(path):,} bytes (cut short, or damaged)")
     entry = recordings[0]
     paths: set[str] = set()
-    steps: set[int] = set()
-    t_lo, t_hi = np.inf, -np.inf
+    # steps and sim_time span of every timed entity ("all") and of the blocks' ("blocks"): a run's frame is
+    # shown once its blocks are in the file. A batch sends the colour bars' labels, then the fill, then the
+    # blocks, so a file cut in between (an interrupted run's, written at close) held the labels of every frame
+    # and was said to hold them all ("83 frames up to its last complete chunk": a tenth of the file, no block
+    # drawn past step 0). A limit or study recording has no blocks: its frames are any entity's.
+    seen = {key: (set(), [np.inf, -np.inf]) for key in ("all", "blocks")}
     metadata: str | None = None
     for chunk in reader.stream(store=entry):
         paths.add(chunk.entity_path)
@@ -232,11 +239,14 @@ def _summarise(reader: rr.chunk.RrdReader, truncated: bool, path) -> dict:
             continue
         if chunk.entity_path in _PER_STEP:  # solver health, logged at every step: not frames
             continue
-        if "step" in names:
-            steps.update(batch.column("step").to_numpy().tolist())
-        if "sim_time" in names and batch.num_rows:
-            t = batch.column("sim_time").cast(pa.int64()).to_numpy() * 1e-9
-            t_lo, t_hi = min(t_lo, t.min()), max(t_hi, t.max())
+        for key in ("all", "blocks") if chunk.entity_path == f"/{BLOCKS}" else ("all",):
+            steps, span = seen[key]
+            if "step" in names:
+                steps.update(batch.column("step").to_numpy().tolist())
+            if "sim_time" in names and batch.num_rows:
+                t = batch.column("sim_time").cast(pa.int64()).to_numpy() * 1e-9
+                span[:] = min(span[0], t.min()), max(span[1], t.max())
+    steps, (t_lo, t_hi) = seen["blocks" if paths & _RUN_FRAMES else "all"]
     try:
         reader.store(store=entry)
         complete = True
