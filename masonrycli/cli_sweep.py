@@ -234,12 +234,27 @@ def _identity(path: Path) -> tuple | None:
 def _exit_for_failed_rows(result, err_console) -> None:
     """Exit 5 when rows failed, else 3 when runs diverged (as ``masonry simulate``), each with one line:
     a script saw exit 0 under "2 failed" (histories on a full disk). A collapse is an outcome, not this."""
+    from masonrycli.study.task import REFUSED
+
     total = _n(len(result.rows), "row")
     diverged = sum(1 for r in result.rows if r.get("status") == "diverged")
-    if result.failed:
+    refused = [r for r in result.rows if r.get("status") == "error" and str(r.get("error")).startswith(REFUSED)]
+    # The plot and the recording are written whole however many rows failed, so the same command again is
+    # refused ("--out's plot s.png: the file exists"): --force replaces them and reuses every finished row.
+    if refused:  # a retry refuses them again: "run the same command again to retry them" sent the user round
+        first = str(refused[0]["error"]).removeprefix(REFUSED)
         err_console.print(
-            f"error: {result.failed} of {total} failed (the reason is in their error column in {result.out}); "
-            "run the same command again to retry them",
+            f"error: {len(refused)} of {total} refused their parameters ({first}{'; …' if len(refused) > 1 else ''}): "
+            f"the same command refuses {'it' if len(refused) == 1 else 'them'} again; a grid without "
+            f"{'it' if len(refused) == 1 else 'them'}, with --force, reuses the finished rows (every reason is in the "
+            f"error column in {result.out})",
+            soft_wrap=True,
+        )
+    if result.failed > len(refused):
+        err_console.print(
+            f"error: {result.failed - len(refused)} of {total} failed (the reason is in their error column in "
+            f"{result.out}); run the same command again with --force to retry them (it reuses the finished rows, "
+            "and replaces the plot and the recording)",
             soft_wrap=True,
         )
     if diverged:

@@ -72,6 +72,9 @@ def block(tmp_path) -> Path:
         (["-p", "friction=0.5,-1,0.6"], "--param friction=-1: friction = -1.0: must be >= 0"),
         (["-p", "dt=0.002:0.004:3"], "--param dt=0.003: dt = 0.003: does not divide duration = 1.0"),
         (["-p", "amp=0.1,1e30,0.2", "-p", "freq=1,2"], "--param amp=1e+30 freq=1: "),
+        # a bad combination of values each good with the first point (30 Hz at dt = 0.02 s, aliased) ran into an
+        # error row: "1 of 4 rows failed …; run the same command again to retry them", refused again each time
+        (["-p", "freq=30,1", "-p", "dt=0.002,0.02"], 'block.toml: support "ground": frequency = 30 Hz is above'),
     ],
 )
 def test_sweep_errors_are_one_line(block, args, fragment, tmp_path, monkeypatch):
@@ -219,6 +222,10 @@ def test_failed_rows_give_exit_5_after_the_whole_table(block, tmp_path, monkeypa
     assert len(read_rows(out)) == 3 and (tmp_path / "s.png").exists()  # the table and the plot are whole
     said = words(result.output)
     assert f"error: 2 of 3 rows failed (the reason is in their error column in {out}); run the same" in said, said
+    # it said "run the same command again to retry them", which was refused: "--out's plot s.png: the file exists"
+    assert said.endswith("run the same command again with --force to retry them (it reuses the finished rows, and "
+                         "replaces the plot and the recording)"), said  # fmt: skip
+    assert "the file exists" in invoke("sweep", block, *args).output
     monkeypatch.setattr(run, "simulate", real)
     again = invoke("sweep", block, *args, "--force")  # --force: the plot exists
     # words, not lines: the console wraps the line with the table's path, where depends on the path's length
@@ -250,6 +257,31 @@ def test_diverged_rows_give_exit_3_as_simulate_does(block, tmp_path, monkeypatch
     said = words(result.output)
     assert f"error: 1 of 2 rows diverged (their error column in {out} says when); a smaller" in said
     assert [r["error"] for r in read_rows(out)] == ["", "diverged at t = 0.0100 s"]
+
+
+def test_a_point_refused_in_a_grid_too_large_to_check_is_a_row_the_closing_line_says_is_refused_again(
+    block, tmp_path, monkeypatch
+):
+    # a grid of more than MAX_CHECKED_POINTS is checked only along its axes: a bad combination there is refused
+    # by its run. It said "1 of 4 rows failed …; run the same command again to retry them", which refused it again.
+    monkeypatch.setattr("masonrycli.study.study.MAX_CHECKED_POINTS", 3)
+    out = tmp_path / "s.csv"
+    args = ["-p", "freq=30,1", "-p", "dt=0.002,0.02", "--duration", 0.02, "--workers", 0, "-o", out, "--no-recording"]
+    for again in ([], ["--force"]):  # --force: the plot exists
+        result = invoke("sweep", block, *args, *again)
+        assert result.exit_code == 5, result.output
+        rows = read_rows(out)
+        assert [r["status"] for r in rows] == ["completed", "error", "completed", "completed"]
+        why = f'--param freq=30 dt=0.02: {block}: support "ground": frequency = 30 Hz is above 1/(2 dt) = 25 Hz'
+        assert rows[1]["error"].startswith(f"refused: {why}")
+        said = words(result.output)
+        assert "retry" not in said, said
+        assert said.endswith(
+            f"error: 1 of 4 rows refused their parameters ({why}: steps of dt = 0.02 s sample it at aliased phases "
+            "(dt = 0.00167 s gives 20 steps a period)): the same command refuses it again; a grid without it, with "
+            f"--force, reuses the finished rows (every reason is in the error column in {out})"
+        ), said
+        assert ("1 run now, 3 rows already there" in said) == bool(again)
 
 
 def test_a_misspelt_parameter_is_said_before_the_outputs_that_exist(block, tmp_path, monkeypatch):

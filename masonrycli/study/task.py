@@ -41,6 +41,8 @@ RESULT_COLUMNS = (
     "error",
 )
 """The columns every row has after its parameters (units in ``docs/sweep.md``)."""
+REFUSED = "refused: "
+"""How the error of a row whose point was refused begins (its parameters cannot run: refused again on a retry)."""
 
 
 def run_task(
@@ -59,6 +61,7 @@ def run_task(
     replaced only with ``force`` or when an earlier run of the same ``study`` (its fingerprint and its
     table) wrote it (:func:`made_by_study`; the study checked them all before the first run).
     """
+    from masonrycli.errors import InputError
     from masonrycli.execute import run_metadata
     from masonrycli.history import HistoryFile
     from masonrycli.outputs import OutputFile, written_whole
@@ -84,6 +87,8 @@ def run_task(
             if sinks:
                 sinks[0].run_values |= {f"intensity_{k}": v for k, v in result.intensity.items()}
                 sinks[0].close(status=result.status, note=result.message)
+    except InputError as exc:  # the point's parameters refused (a grid too large to check whole: study.py)
+        return row | empty_result(f"{REFUSED}{exc}", time.perf_counter() - start)
     except Exception as exc:  # a failed task is reported in its row; the study goes on
         return row | empty_result(f"{type(exc).__name__}: {exc}", time.perf_counter() - start)
     out = result.outcome
