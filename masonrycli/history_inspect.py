@@ -160,7 +160,9 @@ def run_rows(info: dict) -> list[tuple[str, str]]:
         rows.append(("study point", ", ".join(f"{k} = {v}" for k, v in point.items())))
     status = info["status"]
     note = info["note"]
-    rows.append(("status", (f"{status}: {note}" if note else status) if status else NOT_RECORDED))
+    if status and note:  # "interrupted at t = …", "diverged at t = …" name their status already
+        status = note if note.startswith(status) else f"{status}: {note}"
+    rows.append(("status", status or NOT_RECORDED))
     solver, tol, cap = get("solver"), get("nlgs_tolerance"), get("nlgs_max_iterations")
     rows.append(("solver", str(solver) if solver is not None else NOT_RECORDED))
     rows.append(("tolerance", f"{tol:g} m/s (at most {cap} sweeps a step)" if given(tol, cap) else _or(tol, " m/s")))

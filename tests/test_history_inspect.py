@@ -94,7 +94,8 @@ def test_an_interrupted_history_says_where_it_stopped(tmp_path):
     assert (info["status"], info["frames"], info["steps"]) == ("interrupted", 2, (0, 1))
     shown = invoke("inspect", tmp_path / "i.npz")
     assert shown.exit_code == 0, shown.output
-    assert _rows(shown.output)["status"] == "interrupted: interrupted at t = 0.0010 s (step 1 of 20)"
+    # walk-through 2026-11-29: "interrupted: interrupted at t = …", the note naming its status again
+    assert _rows(shown.output)["status"] == "interrupted at t = 0.0010 s (step 1 of 20)"
 
 
 def test_a_sweep_history_names_its_study_point(history, tmp_path):
