@@ -1,10 +1,12 @@
 """Studies on real Dask clusters: a LocalCluster of 2 worker processes gives the rows of the same runs
 made one by one; a scheduler and a worker started as separate processes lose no finished row when the
-worker is killed mid-study, and the same command run again completes the study."""
+worker is killed mid-study, and the same command run again completes the study. Each of these tables equals
+the same study run with --workers 0, every column but the timings, bit for bit."""
 
 from __future__ import annotations
 
 import json
+import math
 import os
 import signal
 import subprocess
@@ -43,6 +45,9 @@ def test_local_cluster_rows_equal_the_runs_made_one_by_one(tmp_path):
     result = run_study(base, request, Console(quiet=True))
     rows = pq.read_table(tmp_path / "study.parquet").to_pylist()
     assert len(rows) == 4 and result.ran == 4
+    serial = StudyRequest(axes=axes, out=tmp_path / "serial.parquet", workers=0)  # --workers 0: in this process
+    run_study(base, serial, Console(quiet=True))
+    _assert_same_rows(rows, pq.read_table(tmp_path / "serial.parquet").to_pylist())  # every column, bit for bit
     for row in rows:
         alone = simulate(apply_point(base, {"amp": row["amp"], "freq": row["freq"]}), stop_at_collapse=True)
         assert row["status"] == alone.status == "completed"
@@ -59,6 +64,33 @@ def test_local_cluster_rows_equal_the_runs_made_one_by_one(tmp_path):
         "study",
         "source",
     }
+
+
+TIMINGS = {"wall_time", "cpu_time"}
+
+
+def _assert_same_rows(rows: list[dict], reference: list[dict]) -> None:
+    """Every column but the timings equal, bit for bit (NaN to NaN): runs are deterministic whatever made them."""
+    assert len(rows) == len(reference)
+    for row, ref in zip(rows, reference):
+        assert row.keys() == ref.keys()
+        for key in row.keys() - TIMINGS:
+            a, b = row[key], ref[key]
+            assert a == b or (isinstance(a, float) and isinstance(b, float) and math.isnan(a) and math.isnan(b)), (
+                key,
+                row,
+                ref,
+            )
+
+
+def _serially(sweep: list, out: Path, log: Path) -> list[dict]:
+    """The rows of ``sweep`` run again in the command's own process (--workers 0) into ``out``."""
+    cut = [i for i, a in enumerate(sweep) if str(a) in ("--workers", "--scheduler")]  # with their values
+    args = [str(a) for i, a in enumerate(sweep) if i not in cut and i - 1 not in cut]
+    args[args.index("--out") + 1] = str(out)
+    done = subprocess.run([*args, "--workers", "0"], stdout=open(log, "w"), stderr=subprocess.STDOUT, env=ENV)
+    assert done.returncode == 0, log.read_text()
+    return _read_csv(out)
 
 
 def _spawn(args, log: Path, terminal: bool = False):
@@ -141,6 +173,8 @@ def test_scheduler_and_worker_processes_kill_the_worker_and_resume(tmp_path):
             if r["amp"] in kept:
                 assert r["wall_time"] == kept[r["amp"]]
         assert f"{len(kept)} rows already there" in words((tmp_path / "sweep2.log").read_text())
+        # the rows of the two workers, one killed, are those of the same runs made in one process
+        _assert_same_rows(rows, _serially(sweep, tmp_path / "serial.csv", tmp_path / "serial.log"))
     finally:
         for proc in sweeps + workers + [scheduler]:
             _kill(proc)
@@ -300,7 +334,13 @@ def test_sigterm_on_a_study_writes_the_finished_rows_and_exits_143(tmp_path):
     lines = [ln for ln in log.read_text().splitlines() if ln.strip()]
     assert lines[-1].startswith("interrupted (SIGTERM): every finished row is in"), lines
     assert not any("semaphore" in ln or "Traceback" in ln for ln in lines), lines
-    assert 1 <= len(_read_csv(out)) < 6
+    kept = len(_read_csv(out))
+    assert 1 <= kept < 6
+    # the same command resumes: the finished rows reused, the table that of the study run in one go
+    again = subprocess.run(sweep, capture_output=True, text=True, env=ENV, timeout=300)
+    assert again.returncode == 0, again.stdout + again.stderr
+    assert f"({6 - kept} run{'s' if 6 - kept > 1 else ''} now, {kept} row" in words(again.stdout), again.stdout
+    _assert_same_rows(_read_csv(out), _serially(sweep, tmp_path / "serial.csv", tmp_path / "serial.log"))
 
 
 # The command, with a thread that signals once the first worker process exists: mid-start, that worker
