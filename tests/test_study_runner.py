@@ -225,6 +225,38 @@ def test_a_host_that_does_not_exist_is_refused_at_once():
     )
 
 
+def test_an_address_that_drops_the_connection_is_refused_after_the_probe(monkeypatch):
+    # a firewall that drops packets (or a host that is down) took Client's whole 20 s, 23 s in all: here a
+    # listener whose accept queue is full, so the kernel drops further SYNs as such a firewall would
+    import socket
+
+    from masonrycli.errors import InputError
+
+    monkeypatch.setattr(runner, "PROBE_TIMEOUT", 1.0)
+    with socket.socket() as listener:
+        listener.bind(("127.0.0.1", 0))
+        listener.listen(0)
+        port = listener.getsockname()[1]
+        queued = [socket.socket() for _ in range(4)]
+        for sock in queued:  # fill the queue: connects that never complete, then dropped ones
+            sock.setblocking(False)
+            sock.connect_ex(("127.0.0.1", port))
+        time.sleep(0.3)
+        try:
+            start = time.monotonic()
+            with pytest.raises(InputError) as raised:
+                runner.open_cluster(f"tcp://127.0.0.1:{port}", None)
+            took = time.monotonic() - start
+        finally:
+            for sock in queued:
+                sock.close()
+    assert took < 1.0 + 3.0
+    assert str(raised.value) == (
+        f"--scheduler tcp://127.0.0.1:{port}: cannot connect (no answer from 127.0.0.1:{port} within 1 s: the host "
+        "is down, or a firewall drops it)"
+    )
+
+
 def test_a_name_lookup_that_may_pass_on_a_retry_is_left_to_client(monkeypatch):
     # Only "no such name" is final: a resolver that did not answer in time (EAI_AGAIN) may answer
     # Client's retries within its CONNECT_TIMEOUT, so the scheduler is not refused as "no host named ...".

@@ -25,6 +25,7 @@ failed runs.
 from __future__ import annotations
 
 import contextlib
+import errno
 import gc
 import logging
 import os
@@ -246,6 +247,8 @@ def _connect(Client, scheduler: str):
             raise InputError(f"--scheduler {scheduler}: cannot connect ({type(error).__name__}: {error})") from None
         if isinstance(error, Exception):
             why = ": ".join([type(error).__name__, *str(error).splitlines()[:1]])
+            if isinstance(error, MemoryError):  # "Unable to allocate 3.07 EiB": its first bytes read as a size
+                why = "the service there spoke first, and Dask read its bytes as an absurd message size"
             raise InputError(
                 f"--scheduler {scheduler}: not a Dask scheduler (its answer is not Dask's protocol: {why})"
             )
@@ -257,17 +260,19 @@ def _connect(Client, scheduler: str):
         raise
 
 
-PROBE_TIMEOUT = 2.0
-"""s: how long :func:`_refused` waits for a plain TCP connection."""
+PROBE_TIMEOUT = 5.0
+"""s: how long :func:`_refused` waits for a plain TCP connection: a host's kernel answers one at once, however
+busy its scheduler, and a far one within a second; 5 s leaves room for two retries of a lost packet."""
 
 
 def _refused(scheduler: str) -> str:
     """Why nothing can answer at a ``tcp://`` scheduler address ("" if something may): a port where
     nothing listens refuses a plain TCP connection at once, while ``Client`` retried it for its whole
     ``CONNECT_TIMEOUT`` (a mistyped port waited 20 s for its one line); so did a host name the resolver
-    does not know (``nosuchhost.invalid:8786``). Any other address, scheme or failure (a TCP connection
-    not made within PROBE_TIMEOUT: a firewall, a far or busy host) is left to ``Client`` and its
-    ``CONNECT_TIMEOUT``, which says what it met."""
+    does not know (``nosuchhost.invalid:8786``), a host that does not answer within ``PROBE_TIMEOUT`` (a firewall
+    that drops the packets, a host that is down: 23 s, Client's 20 and the probe's) and one with no route to it.
+    Any other address, scheme or failure is left to ``Client`` and its ``CONNECT_TIMEOUT``, which says what
+    it met."""
     import socket
 
     from distributed.comm.addressing import parse_address, parse_host_port
@@ -287,7 +292,11 @@ def _refused(scheduler: str) -> str:
         if error.errno in (socket.EAI_NONAME, getattr(socket, "EAI_NODATA", socket.EAI_NONAME)):
             return f"no host named {host}: {error.strerror}"
         return ""  # EAI_AGAIN (a resolver that did not answer in time) and the like: may pass on a retry
-    except OSError:
+    except TimeoutError:
+        return f"no answer from {host}:{port} within {PROBE_TIMEOUT:g} s: the host is down, or a firewall drops it"
+    except OSError as error:
+        if error.errno in (errno.EHOSTUNREACH, errno.ENETUNREACH):
+            return f"{host}:{port}: {error.strerror}"
         return ""
     return ""
 
