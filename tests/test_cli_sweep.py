@@ -60,6 +60,7 @@ def block(tmp_path) -> Path:
         (["-p", "amp=0.1:1:4", "--find", "amp", "--rtol", "1e-300"], "--rtol 1e-300: must be >= 1e-09 (each halving"),
         (["-p", "amp=0.1", "--rtol", "0.010"], "--rtol 0.010: goes with --find"),
         (["-p", "amp=0.1,1e30"], "--param amp=1e+30: "),  # it ran, exit 0
+        (["-p", "amp=0.1", "--histories", "h.npz"], "--histories h.npz: names the folder for one history per run"),
         (["-p", "phase=0,1e300"], "--param phase: phase = 1e+300: must be within ±10000 rad"),  # it ran
         # both rows ran at 0.5 m/s, under the names amp=0.1 and amp=0.2
         (["-p", "amp=0.1,0.2", "-p", "ground.amp=0.5"], "--param ground.amp: sets the amplitude of support 'ground'"),

@@ -86,6 +86,11 @@ def check_histories(
         return
     if folder.exists() and not folder.is_dir():
         raise InputError(f"--histories {folder}: is not a folder")
+    if not folder.exists() and folder.suffix.lower() == ".npz":  # it was made: a folder h.npz of amp=0.1.npz, …
+        raise InputError(
+            f"--histories {folder}: names the folder for one history per run (e.g. --histories histories), "
+            "not a file: a name ending in .npz is a file's"
+        )
     names = dict.fromkeys(history_name(p | {find: _ANY} if find else p) for p in points)
     for name in names:
         if find:
