@@ -330,3 +330,25 @@ def test_a_reader_of_stdout_that_goes_away_leaves_the_plot_and_the_recording(tmp
     proc.wait(timeout=300)
     assert {p.name for p in tmp_path.iterdir()} >= {"s.csv", "s.png", "s.rrd"}
     assert len(read_rows(out)) == 2
+
+
+def test_a_scheduler_lost_before_the_first_row_says_nothing_was_written(block, tmp_path, monkeypatch):
+    # a scheduler killed before any row came back said "every finished row is in s.csv", and there was no s.csv
+    from masonrycli.study import runner
+
+    class Client:
+        def close(self):
+            pass
+
+    def lost(*args, **kwargs):
+        raise runner.SchedulerLost("lost the connection to the scheduler with 2 runs pending")
+
+    monkeypatch.setattr(runner, "open_cluster", lambda *args: (Client(), None))
+    monkeypatch.setattr(runner, "run_on_cluster", lost)
+    result = invoke("sweep", block, "-p", "amp=0.1,0.2", "--scheduler", "tcp://127.0.0.1:1", "-o", tmp_path / "s.csv")
+    assert result.exit_code == 2, result.output
+    assert words(result.output) == (
+        "error: --scheduler tcp://127.0.0.1:1: lost the connection to the scheduler with 2 runs pending; no row was "
+        "finished, nothing was written (the same command runs the study once the scheduler is back)"
+    )
+    assert [p.name for p in tmp_path.iterdir()] == ["block.toml"]

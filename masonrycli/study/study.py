@@ -211,9 +211,11 @@ def run_study(base: StudyBase, request: StudyRequest, console: Console) -> Study
     except (WorkerMismatch, SchedulerLost) as exc:  # the rows before it are kept (written below), resumable
         where = f"--scheduler {request.scheduler}" if request.scheduler else "the local cluster"
         once = "every worker runs this masonry" if isinstance(exc, WorkerMismatch) else "the scheduler is back"
-        raise InputError(
-            f"{where}: {exc}; every finished row is in {request.out} (the same command resumes the study once {once})"
-        ) from None
+        if driver.rows():
+            kept = f"every finished row is in {request.out} (the same command resumes the study once {once})"
+        else:  # it said "every finished row is in s.csv", and there was no s.csv (a scheduler lost before the first row)
+            kept = f"no row was finished, nothing was written (the same command runs the study once {once})"
+        raise InputError(f"{where}: {exc}; {kept}") from None
     finally:
         journal.close()
         rows = driver.rows()
