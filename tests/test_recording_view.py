@@ -3,10 +3,11 @@
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
 from masonrycli.frame import CONTACT_STICK
 from masonrycli.recording import Recorder
-from masonrycli.recording.layout import FORCES, LEGEND, PLANE, RESULTANT_CAP
+from masonrycli.recording.layout import FIELDS, FORCES, LEGEND, PLANE, RESULTANT_CAP
 
 import recording_fixtures as fx
 from recording_fixtures import strict_rerun, temporal_rows  # noqa: F401 (strict_rerun: autouse)
@@ -60,4 +61,35 @@ def test_the_view_holds_every_frames_joint_arrows(tmp_path):
     # the margin of a view fitted to the structure (0.05 x its size)
     assert rec.force_scale * force[-2] < cap and lowest < -0.1 - 0.05 * 1.2, (rec.force_scale, lowest)
     legend = fx.static_value(path, f"/{LEGEND}", "TextDocument:text")[0]
-    assert f"at most {cap:.3g} m" in legend, legend
+    assert f"at most {cap:.3g} m ({cap / rec.force_scale / 1e3:.4g} kN and up)" in legend, legend
+
+
+def test_the_magnified_tab_is_framed_on_the_structure_and_holds_the_magnified_shape(tmp_path):
+    """The magnified shape's tab has no colour bar, yet showed the view the other tabs share: the structure
+    in its left two thirds, the right third kept for a bar. It is framed on the view left of the bars. And
+    the view holds the magnified shape (blocks; supports in y): the arch's right foundation, settled 1 cm in
+    'masonry simulate arch --duration 1' and drawn x 25, touched the bottom edge (0.03 m from it)."""
+    from masonrycli.recording.layout import LEGEND_BARS, MAGNIFIED, MAGNIFIED_TAB
+    from masonrycli.recording.readback import blueprint_views
+
+    static, q0 = fx.wall()
+    frames = fx.frames(static, q0, 12)
+    for k, f in enumerate(frames):  # the blocks rise 5 mm a frame, drawn x 40: 2.2 m above the wall at the end
+        f.block_q[:, 1] += 0.005 * k
+    path = tmp_path / "magnified.rrd"
+    with Recorder(path, static, fx.METADATA, batch_frames=4, magnify=40.0) as rec:
+        for f in frames:
+            rec.log_frame(f)
+    xmin, ymin, xmax, ymax = _view(path)
+    strips = temporal_rows(path, f"/{MAGNIFIED}", "LineStrips2D:strips")
+    n = len(q0)
+    for step, rows in strips.items():
+        blocks = np.concatenate([np.array(r) for r in rows[:n]])
+        assert (blocks >= (xmin, ymin)).all() and (blocks <= (xmax, ymax)).all(), (step, blocks.max(axis=0), ymax)
+    (x_range, y_range) = blueprint_views(path)[MAGNIFIED_TAB]["bounds"]
+    dx = fx.static_value(path, f"/{LEGEND_BARS}", "Transform3D:translation")[0][0]
+    bar_left = min(np.array(fx.static_value(path, f"/{f.bar}", "Mesh3D:vertex_positions"))[:, 0].min() for f in FIELDS)
+    owner = np.repeat(np.arange(n), np.diff(static.block_vert_start))
+    right = max(float((f.block_q[owner, 0] + static.block_vert_local[:, 0]).max()) for f in frames)
+    assert x_range[0] == 0.0 and right - xmin < x_range[1] < bar_left + dx - xmin, (x_range, right, bar_left)
+    assert y_range == (0.0, pytest.approx(ymax - ymin))

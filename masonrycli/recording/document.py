@@ -125,21 +125,21 @@ def legend_markdown(
     arrow_cap: float | None = None,
 ) -> str:
     """The legend shown under the structure views (and in the run document): the tabs' short names first.
-    ``arrow_cap``: the longest arrow drawn, m (a larger force is drawn that long)."""
+    ``arrow_cap``: the longest arrow drawn, m (a larger force is drawn that long; its value on hover)."""
     scale = (
-        "scale not fixed yet"
+        "length proportional to the force, scale not fixed yet"
         if not force_scale
-        else f"{block_height:.3g} m (a median block height) = {block_height / force_scale / 1e3:.4g} kN"
+        else f"length {block_height:.3g} m (a median block height) per {block_height / force_scale / 1e3:.4g} kN"
     )
-    if force_scale and arrow_cap:
-        scale += f"; at most {arrow_cap:.3g} m: a larger force ({arrow_cap / force_scale / 1e3:.4g} kN and up) is drawn that long, hover for its value"
+    if force_scale and arrow_cap:  # kept short: three lines of it pushed the Magnified line out of the panel
+        scale += f", at most {arrow_cap:.3g} m ({arrow_cap / force_scale / 1e3:.4g} kN and up)"
     factor = "set when the run closes" if magnify is None else f"× {magnify:g}"
     return (
         f"{tabs_legend(main_field, paper_t)}\n"
         f"- **Joint forces** ({LIVE_TAB}, {FIELD_TABS['block_sliding_ratio']} and {FIELD_TABS['block_max_opening']} "
         "tabs): one arrow per joint, the resultant of its contact forces on the body above it, "
-        f"centred on its point of application (line of thrust); length proportional to the force, {scale}. Green = sticking, "
-        "orange = sliding, red = open at one end (turning about the other). Yellow dots: hinges.\n"
+        f"centred on its point of application (line of thrust); {scale}. Green = sticking, "
+        "orange = sliding, red = open at one end. Yellow dots: hinges.\n"
         "- **Fills**: colour bar beside the structure; grey = undefined (NaN), magenta = below the range, "
         "lime green = above it. Small dark dots: the blocks' centroids; hover one for the block's name and values.\n"
         f"- **{MAGNIFIED_TAB}** deformed shape: displacements and rotations {factor}; grey = as built."

@@ -251,9 +251,12 @@ def build_blueprint(
     main_field: str = "cell_spherical_stress",
     paper: tuple[float, tuple[str, ...]] | None = None,
     residual_range: tuple[float, float] | None = None,
+    structure_view: tuple[float, float] | None = None,
 ) -> rrb.Blueprint:
     """Structure tabs and the on-screen legend (left); time series and the run document (right).
     ``residual_range``: the residual plot's y range (log10 of m/s; None: the viewer's fit to the data).
+    ``structure_view``: (width, height) of the view left of the colour bars, image units from the view's
+    top left (``static_content.log_plane``): the magnified shape's tab, which has no bar, shows that part.
 
     Tabs: the live main view (forces, principal stress, ``main_field``), with ``paper`` = (t, figure
     numbers) the paper's four figures pinned to t, the four fields live, the magnified deformed shape,
@@ -279,6 +282,11 @@ def build_blueprint(
             origin=f"/{PLANE}",
             contents=[f"+ /{x}" for x in (UNDEFORMED, MAGNIFIED)],
             name=MAGNIFIED_TAB,  # its factor: the Legend (the tab's name had it, and was cut)
+            # framed on the structure: it stood in the left two thirds of the tab, the right third kept empty
+            # for the colour bar the other tabs have
+            visual_bounds=None
+            if structure_view is None
+            else rrb.VisualBounds2D(x_range=[0.0, structure_view[0]], y_range=[0.0, structure_view[1]]),
         ),
         _structure_view(FIELD_TABS[sliding.key], sliding, joints),
         _structure_view(FIELD_TABS[opening.key], opening, joints),

@@ -191,7 +191,7 @@ def write_limit_recording(path: str | os.PathLike, drawing: MechanismDrawing) ->
     )
     rec.save(os.fspath(path), default_blueprint=blueprint)
     try:
-        legend_box, _ = log_plane(rec, both, sup_both, poses[-1], sup_q)
+        legend_box, _, _ = log_plane(rec, both, sup_both, poses[-1], sup_q)
         _log_speed_bar(rec, legend_box)
         rec.log(DOCUMENT, rr.TextDocument(viewer_safe_text(d.document), media_type=rr.MediaType.MARKDOWN), static=True)
         rec.log(

@@ -92,9 +92,12 @@ def send_magnified(
     magnify: float | None,
     size: float,
     batch_frames: int,
-) -> float:
+) -> tuple[float, np.ndarray]:
     """Send the magnified outlines of the frames in ``poses`` about ``ref`` (the first block_q, support_q);
-    returns the factor used (``magnify``, or the default for ``size`` m)."""
+    returns the factor used (``magnify``, or the default for ``size`` m) and the extent drawn (xmin, ymin,
+    xmax, ymax), m: the blocks', the supports' in y only (a wide ground is shown only a little beyond the
+    blocks: ``static_content.log_plane``), for the view to hold it (the arch's right foundation, settled
+    1 cm in 1 s and drawn x 25, touched the view's bottom edge)."""
     ref_q, ref_sq = ref
     rigid = _supports_move_together(poses, ref_sq, size, batch_frames)
     if magnify is None:  # one pass over the file: the displacement of largest norm, as a (1, 2) array
@@ -108,15 +111,25 @@ def send_magnified(
         m = magnification(largest, size)
     else:
         m = float(magnify)
+    extent = np.array([np.inf, np.inf, -np.inf, -np.inf])
     for chunk in _chunks(poses, batch_frames):
         q, sq = chunk["q"].astype(np.float64), chunk["sq"].astype(np.float64)
         batch = FrameBatch(step=chunk["step"].tolist(), time=chunk["time"].tolist())
         n_frames = len(chunk)
         back = (m - 1.0) * _ground_shift(chunk, ref_sq, rigid)[:, None, :]  # the ground's travel, not magnified
-        sets = [blocks.outlines(blocks.world(ref_q + m * (q - ref_q) - back))]
+        verts = blocks.world(ref_q + m * (q - ref_q) - back)
+        sets = [blocks.outlines(verts)]
+        if verts.size:
+            lo, hi = verts.reshape(-1, 2).min(axis=0), verts.reshape(-1, 2).max(axis=0)
+            extent = np.r_[np.minimum(extent[:2], lo), np.maximum(extent[2:], hi)]
         count = blocks.count
         if supports.count:
-            sets.append(supports.outlines(supports.world(ref_sq + m * (sq - ref_sq) - back)))
+            verts = supports.world(ref_sq + m * (sq - ref_sq) - back)
+            sets.append(supports.outlines(verts))
+            extent[1], extent[3] = (
+                min(extent[1], float(verts[..., 1].min())),
+                max(extent[3], float(verts[..., 1].max())),
+            )
             count += supports.count
         # frame by frame: that frame's blocks, then its supports
         strips = [arr.slice(k * (len(arr) // n_frames), len(arr) // n_frames) for k in range(n_frames) for arr in sets]
@@ -127,7 +140,7 @@ def send_magnified(
                 partition_lengths(n_frames, count)
             ),
         )
-    return m
+    return m, extent
 
 
 def _supports_move_together(poses: PoseSpool, ref_sq: np.ndarray, size: float, batch_frames: int) -> bool:

@@ -287,7 +287,8 @@ def blueprint_views(path: str | os.PathLike) -> dict[str, dict]:
     """The views of the recording's last default blueprint (the one the viewer opens on; a run that ended
     before the paper's instant sends a second one without the pinned tabs): name -> {"kind", "origin",
     "pinned", "legend"}; ``pinned`` is (timeline, start s, end s) for a view whose visible time range is
-    fixed, else None; ``legend``: False for a plot whose legend is hidden, else None (the viewer's default); ``y_range``: a plot's fixed y range or None."""
+    fixed, else None; ``legend``: False for a plot whose legend is hidden, else None (the viewer's default); ``y_range``: a plot's fixed y range or None; ``bounds``: a 2-D view's
+    fixed framing ((x0, x1), (y0, y1)) or None (the viewer's fit)."""
     with _reading(path) as reader:
         chunks = list(reader.stream(store=_last_blueprint(reader)))
     by_id: dict[str, dict] = {}
@@ -296,7 +297,7 @@ def blueprint_views(path: str | os.PathLike) -> dict[str, dict]:
         parts = chunk.entity_path.strip("/").split("/")
         if parts[0] != "view" or len(parts) < 2:
             continue
-        view = by_id.setdefault(parts[1], {"pinned": None, "legend": None, "y_range": None})
+        view = by_id.setdefault(parts[1], {"pinned": None, "legend": None, "y_range": None, "bounds": None})
         names = batch.schema.names
         if "ViewBlueprint:display_name" in names:
             view["name"] = batch.column("ViewBlueprint:display_name").to_pylist()[-1][0]
@@ -304,6 +305,9 @@ def blueprint_views(path: str | os.PathLike) -> dict[str, dict]:
             view["origin"] = batch.column("ViewBlueprint:space_origin").to_pylist()[-1][0]
         if "ScalarAxis:range" in names:
             view["y_range"] = tuple(batch.column("ScalarAxis:range").to_pylist()[-1][0])
+        if "VisualBounds2D:range" in names:  # a 2-D view's framing: (x range, y range) in its origin's units
+            (r,) = batch.column("VisualBounds2D:range").to_pylist()[-1]
+            view["bounds"] = (tuple(r["x_range"]), tuple(r["y_range"]))
         if "PlotLegend:visible" in names:
             view["legend"] = batch.column("PlotLegend:visible").to_pylist()[-1][0]
         if "VisibleTimeRanges:ranges" in names:

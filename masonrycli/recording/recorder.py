@@ -153,6 +153,7 @@ class Recorder:
         self.axis_scale: dict[str, float] = {}
         self.magnify = magnify
         self._legend_box = (0.0, 0.0, 0.0, 0.0)
+        self._structure_view: tuple[float, float] | None = None  # the view left of the legend (log_plane)
         self._label_anchors = np.zeros((0, 2), np.float32)
         self._size = 1.0
         self._frames, self._last = 0, None  # frames logged; (step, time) of the last one
@@ -211,7 +212,7 @@ class Recorder:
         sq = np.asarray(frame.support_q, f64).reshape(-1, 3)
         if self._ref is None:
             self._ref = (q, sq, float(frame.energy_potential))
-            self._legend_box, self._size = log_plane(
+            self._legend_box, self._size, _ = log_plane(
                 self.rec, self._blocks, self._supports, q, sq, block_side=self._block_side
             )
             self._fill = Polygons(
@@ -335,7 +336,7 @@ class Recorder:
         if self._ref is None:
             return
         q, sq, _ = self._ref
-        box, _ = log_plane(
+        box, _, self._structure_view = log_plane(
             self.rec,
             self._blocks,
             self._supports,
@@ -374,7 +375,7 @@ class Recorder:
             reached = self._last is not None and self._last[1] >= self.paper[0] - 0.5 * self.static.dt
             if not reached:
                 self.paper = None
-        layout = build_blueprint(self._main_field, self.paper, self.residual_range())
+        layout = build_blueprint(self._main_field, self.paper, self.residual_range(), self._structure_view)
         self.rec.send_blueprint(layout, make_active=True, make_default=True)
 
     # ---- per-batch content
@@ -431,16 +432,9 @@ class Recorder:
 
     def _send_magnified(self) -> None:
         if self._poses is not None and self._poses.count and self._ref is not None:
-            self.magnify = send_magnified(
-                self.rec,
-                self._blocks,
-                self._supports,
-                self._poses,
-                self._ref[:2],
-                self.magnify,
-                self._size,
-                self.long_batch_frames,
-            )
+            args = (self._poses, self._ref[:2], self.magnify, self._size, self.long_batch_frames)
+            self.magnify, drawn = send_magnified(self.rec, self._blocks, self._supports, *args)
+            self._extent = np.r_[np.minimum(self._extent[:2], drawn[:2]), np.maximum(self._extent[2:], drawn[2:])]
 
     # ---- run document
     def _log_metadata(self, status: str, note: str) -> None:

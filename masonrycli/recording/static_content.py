@@ -180,9 +180,10 @@ def log_plane(
     support_q: np.ndarray,
     content: np.ndarray | None = None,
     block_side: float | None = None,
-) -> tuple[tuple[float, float, float, float], float]:
-    """Pinhole and y-up transform sized to the structure at the first frame; returns the legend box and
-    the structure's size (m). ``content``: (xmin, ymin, xmax, ymax), m, of what the run drew (the blocks'
+) -> tuple[tuple[float, float, float, float], float, tuple[float, float]]:
+    """Pinhole and y-up transform sized to the structure at the first frame; returns the legend box, the
+    structure's size (m) and the view's extent left of the legend (image units: width, height), for a tab
+    without a colour bar (the magnified shape's). ``content``: (xmin, ymin, xmax, ymax), m, of what the run drew (the blocks'
     x reach, the joint arrows; the recorder's close): the view widens to hold it and the legend box stands
     right of it (a wall shaken right covered the bar, one falling left left the view, and a 64-course wall's
     toe arrows ran off the bottom: 'masonry simulate wall --courses 64 --length 4.5', 70 frames of 100).
@@ -219,7 +220,7 @@ def log_plane(
     rec.log(XY, rr.Transform3D(translation=[-x0, y0, 0.0], scale=[1.0, -1.0, 1.0]), static=True)
     if block_side is not None:
         rec.log(BLOCKS, rr.Points2D.from_fields(radii=centroid_radius(resolution, block_side)), static=True)
-    return legend_box, size
+    return legend_box, size, (legend_box[0] - pad - x0, resolution[1])
 
 
 _PANEL_PX: Final = (1150.0, 840.0)  # the structure panel of a 1920 x 1080 window (docs' screenshots)
