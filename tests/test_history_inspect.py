@@ -155,6 +155,21 @@ def test_damaged_files_and_other_archives_are_one_line(history, tmp_path):
     assert_one_line_error(invoke("inspect", pickled), "pickled.npz: not a readable history (.npz)")
 
 
+def test_a_history_damaged_inside_an_array_is_refused(history, tmp_path):
+    # bytes changed inside block_q, an array inspect does not load: summarised as sound, exit 0
+    import zipfile
+
+    with zipfile.ZipFile(history) as zf:
+        info = zf.getinfo("block_q.npy")
+    data = bytearray(history.read_bytes())
+    at = info.header_offset + 30 + len(info.filename) + len(info.extra) + info.file_size // 2
+    data[at] ^= 0xFF
+    damaged = tmp_path / "damaged.npz"
+    damaged.write_bytes(bytes(data))
+    assert_one_line_error(invoke("inspect", damaged), ": a damaged history: the array block_q fails its checksum")
+    assert "not a readable" not in invoke("inspect", damaged).output
+
+
 def test_a_history_under_another_name_is_still_a_history(history, tmp_path):
     renamed = tmp_path / "h.data"
     renamed.write_bytes(history.read_bytes())
