@@ -9,7 +9,7 @@ per-task overhead of going through Dask. Run with ``.venv/bin/python benchmarks/
   (energy dissipated, state, drifts, IMs, NLGS sweeps): the speed-up is only claimed for identical
   results.
 * **per-task overhead** — ``--tiny`` one-step runs through the cluster vs in process, per task.
-* **CPU time per task** in process and on a worker (``time.process_time`` inside the task): on a machine
+* **CPU time per task** in process and on a worker (``time.thread_time`` inside the task): on a machine
   whose other processes take the cores, the wall-time speed-up says more about them than about the
   sweep; workers × (CPU time in process / CPU time on a worker) is the speed-up with a free core each.
 

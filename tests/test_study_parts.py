@@ -251,6 +251,34 @@ def test_failed_task_is_a_row(arch_base):
     assert math.isnan(row["pga"]) and row["state"] == ""
 
 
+def test_a_row_s_cpu_time_is_its_own_not_its_neighbour_s(arch_base, monkeypatch):
+    # a worker of two threads (`dask worker --nthreads 2`) runs two tasks at once: each row's cpu_time was the
+    # process's, the other task's CPU too (12 runs of the wall: 11.0 s in all, 5.7 s on 1-thread workers)
+    import hashlib
+    import threading
+    import time
+
+    from masonrycli import run
+
+    real, spent = run.simulate, []
+
+    def beside_a_busy_thread(*args, **kwargs):  # a task on the worker's other thread: fixed work, GIL released
+        data = bytes(20_000_000)
+        before = time.process_time()
+        other = threading.Thread(target=lambda: [hashlib.sha256(data).digest() for _ in range(40)])
+        other.start()
+        other.join()
+        spent.append(time.process_time() - before)
+        return real(*args, **kwargs)
+
+    alone = run_task(arch_base, {"amp": 0.5})["cpu_time"]
+    alone = min(alone, run_task(arch_base, {"amp": 0.5})["cpu_time"])  # the first may compile
+    monkeypatch.setattr(run, "simulate", beside_a_busy_thread)
+    row = run_task(arch_base, {"amp": 0.5})
+    assert row["status"] == "completed" and spent[0] > 0.2  # the neighbour's CPU, in the process's
+    assert row["cpu_time"] < alone + 0.5 * spent[0], (row["cpu_time"], alone, spent)
+
+
 def test_lognormal_fit_recovers_known_median_and_dispersion():
     rng = np.random.default_rng(7)
     theta, beta = 0.8, 0.4
