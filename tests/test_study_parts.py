@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import os
 
 import numpy as np
 import pytest
@@ -346,6 +347,29 @@ def test_a_run_whose_output_failed_is_an_error_row_with_its_message(arch_base, t
     row = run_task(arch_base, {"amp": 0.5}, history_dir=str(tmp_path))
     assert row["status"] == "error" and row["state"] == "" and row["amp"] == 0.5
     assert row["error"].startswith("failed: stopped at t = ") and "No space left on device" in row["error"]
+
+
+def test_a_history_written_whole_removes_what_killed_writers_of_it_left(arch_base, tmp_path):
+    # a --scheduler's worker killed inside a run left .amp=0.2_freq=3.npz.4718.part and its .rows folder (3 MB)
+    # in --histories for good: the point ran again elsewhere, and the command cleans up only its local workers'
+    import subprocess
+    import sys
+
+    gone = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"], capture_output=True, text=True)
+    dead, alive = int(gone.stdout), os.getppid()  # a writer that ended, and one running (another study's)
+    for pid in (dead, alive):
+        (tmp_path / f".amp=0.5.npz.{pid}.part").write_bytes(b"")
+        (tmp_path / f".amp=0.5.npz.{pid}.part.rows").mkdir()
+        (tmp_path / f".amp=0.5.npz.{pid}.part.rows" / "block_q.raw").write_bytes(b"0" * 1000)
+    (tmp_path / f".amp=0.75.npz.{dead}.part").write_bytes(b"")  # another point's: its own run removes it
+    row = run_task(arch_base, {"amp": 0.5}, history_dir=str(tmp_path))
+    assert row["status"] == "completed", row["error"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == [
+        f".amp=0.5.npz.{alive}.part",
+        f".amp=0.5.npz.{alive}.part.rows",
+        f".amp=0.75.npz.{dead}.part",
+        "amp=0.5.npz",
+    ]
 
 
 def test_a_history_of_the_same_study_is_replaced_another_is_kept(arch_base, tmp_path):

@@ -89,6 +89,8 @@ def run_task(
             if sinks:
                 sinks[0].run_values |= {f"intensity_{k}": v for k, v in result.intensity.items()}
                 sinks[0].close(status=result.status, note=result.message)
+        if history_dir:  # written whole: what a killed writer of the same point left is of no one now
+            remove_stale_parts(path)
     except InputError as exc:  # the point's parameters refused (a grid too large to check whole: study.py)
         return row | empty_result(f"{REFUSED}{exc}", time.perf_counter() - start)
     except Exception as exc:  # a failed task is reported in its row; the study goes on
@@ -128,6 +130,30 @@ def history_name(params: dict) -> str:
     run's history replacing the earlier one; 15 still writes linspace's 0.30000000000000004 as 0.3."""
     text = "_".join(f"{k}={v:.15g}" if isinstance(v, float) else f"{k}={v}" for k, v in params.items())
     return "".join(c if c.isalnum() or c in "=._-" else "-" for c in text) + ".npz"
+
+
+def remove_stale_parts(path: Path) -> None:
+    """Remove the temporary files of ``path`` (a history this process has just written whole) that writers no
+    longer running left: a worker killed inside a run leaves its ``.NAME.<pid>.part`` and the history's
+    ``.rows`` folder (3 MB for 3 s of the 51-block wall, growing with the run), and the scheduler runs the
+    point again elsewhere. The command removes those of its LocalCluster's workers at the end; on a
+    ``--scheduler``'s workers, whose pids mean nothing to it, they stayed for good (walk-through 2026-11-29).
+    A writer still running on this machine is left alone (another study writing the same folder)."""
+    import shutil
+
+    from masonrycli.outputs import glob_escape, part_writer
+
+    for part in path.parent.glob(f".{glob_escape(path.name)}.*.part*"):
+        writer = part.with_name(part.name.removesuffix(".rows"))
+        if not writer.name.endswith(".part") or part_writer(writer) is not None:
+            continue
+        try:
+            if part.is_dir():
+                shutil.rmtree(part, ignore_errors=True)
+            else:
+                part.unlink(missing_ok=True)
+        except OSError:  # another process removing it too, a read-only folder: left, as before
+            pass
 
 
 def made_by_study(path: Path, study: tuple[str, str] | None) -> bool:
