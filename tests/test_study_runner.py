@@ -164,6 +164,26 @@ def test_a_scheduler_address_where_no_dask_scheduler_answers_is_one_line(greetin
     assert "\n" not in str(raised.value) and "Dask scheduler" in str(raised.value)
 
 
+def test_a_listener_that_says_nothing_is_refused_after_the_probe(monkeypatch):
+    # the dashboard's port 8787 (HTTP, waiting for a request) held the command for Client's 20 s and the
+    # grace after it, 30 s; a scheduler greets as it accepts, so the probe's wait tells
+    from masonrycli.errors import InputError
+
+    monkeypatch.setattr(runner, "PROBE_TIMEOUT", 1.0)
+    listener = Listener(b"")
+    start = time.monotonic()
+    try:
+        with pytest.raises(InputError) as raised:
+            runner.open_cluster(listener.address, None)
+    finally:
+        listener.close()
+    assert time.monotonic() - start < 1.0 + 3.0
+    assert str(raised.value) == (
+        f"--scheduler {listener.address}: no Dask scheduler answered within 1 s (something listens there but does "
+        "not speak Dask: the dashboard's port, or another service?)"
+    )
+
+
 def test_a_client_that_failed_to_connect_is_collected_before_the_command_goes_on(monkeypatch):
     # A half-made Client left to a later garbage collection ran its finaliser inside the next LocalCluster's
     # start, under distributed's class-wide LoopRunner lock that the finaliser also takes: the process hung

@@ -199,7 +199,7 @@ def _connect(Client, scheduler: str):
     while waiting) is closed by the thread: nobody else would, and it was the process's default client."""
     refused = _refused(scheduler)
     if refused:
-        raise InputError(f"--scheduler {scheduler}: cannot connect ({refused})")
+        raise InputError(f"--scheduler {scheduler}: {refused}")
     made: dict = {}
     lock = threading.Lock()  # the thread hands its client over, or closes it once the command gave up
 
@@ -239,8 +239,7 @@ def _connect(Client, scheduler: str):
             waiting = "client" not in made and "error" not in made
         if waiting:  # the raise gives up (below): a client that arrives from now on is closed
             raise InputError(
-                f"--scheduler {scheduler}: no Dask scheduler answered within {CONNECT_TIMEOUT + CONNECT_GRACE:g} s "
-                "(something listens there but does not speak Dask: the dashboard's port, or another service?)"
+                f"--scheduler {scheduler}: " + SILENT.format(seconds=f"{CONNECT_TIMEOUT + CONNECT_GRACE:g}")
             )
         error = made.get("error")
         if isinstance(error, (OSError, TimeoutError)):
@@ -260,19 +259,24 @@ def _connect(Client, scheduler: str):
         raise
 
 
+SILENT = (
+    "no Dask scheduler answered within {seconds} s (something listens there but does not speak Dask: the "
+    "dashboard's port, or another service?)"
+)
 PROBE_TIMEOUT = 5.0
 """s: how long :func:`_refused` waits for a plain TCP connection: a host's kernel answers one at once, however
 busy its scheduler, and a far one within a second; 5 s leaves room for two retries of a lost packet."""
 
 
 def _refused(scheduler: str) -> str:
-    """Why nothing can answer at a ``tcp://`` scheduler address ("" if something may): a port where
+    """Why no scheduler can answer at a ``tcp://`` address, as the one line says it ("" if one may): a port where
     nothing listens refuses a plain TCP connection at once, while ``Client`` retried it for its whole
     ``CONNECT_TIMEOUT`` (a mistyped port waited 20 s for its one line); so did a host name the resolver
     does not know (``nosuchhost.invalid:8786``), a host that does not answer within ``PROBE_TIMEOUT`` (a firewall
-    that drops the packets, a host that is down: 23 s, Client's 20 and the probe's) and one with no route to it.
-    Any other address, scheme or failure is left to ``Client`` and its ``CONNECT_TIMEOUT``, which says what
-    it met."""
+    that drops the packets, a host that is down: 23 s, Client's 20 and the probe's), one with no route to it,
+    and a listener that says nothing for ``PROBE_TIMEOUT`` once connected (a scheduler greets at once). Any
+    other address, scheme or failure is left to ``Client`` and its ``CONNECT_TIMEOUT``, which says what it
+    met."""
     import socket
 
     from distributed.comm.addressing import parse_address, parse_host_port
@@ -285,19 +289,33 @@ def _refused(scheduler: str) -> str:
     if scheme != "tcp":
         return ""
     try:
-        socket.create_connection((host, port), timeout=PROBE_TIMEOUT).close()
+        sock = socket.create_connection((host, port), timeout=PROBE_TIMEOUT)
     except ConnectionRefusedError:
-        return f"nothing listens at {host}:{port}: connection refused"
+        return f"cannot connect (nothing listens at {host}:{port}: connection refused)"
     except socket.gaierror as error:  # Client retried the lookup for its 20 s: the name stays unknown
         if error.errno in (socket.EAI_NONAME, getattr(socket, "EAI_NODATA", socket.EAI_NONAME)):
-            return f"no host named {host}: {error.strerror}"
+            return f"cannot connect (no host named {host}: {error.strerror})"
         return ""  # EAI_AGAIN (a resolver that did not answer in time) and the like: may pass on a retry
     except TimeoutError:
-        return f"no answer from {host}:{port} within {PROBE_TIMEOUT:g} s: the host is down, or a firewall drops it"
+        return (
+            f"cannot connect (no answer from {host}:{port} within {PROBE_TIMEOUT:g} s: the host is down, or a "
+            "firewall drops it)"
+        )
     except OSError as error:
         if error.errno in (errno.EHOSTUNREACH, errno.ENETUNREACH):
-            return f"{host}:{port}: {error.strerror}"
+            return f"cannot connect ({host}:{port}: {error.strerror})"
         return ""
+    # A Dask scheduler speaks first: its handshake, as it accepts (distributed.comm.core, on_connection). A
+    # listener that says nothing (the dashboard's HTTP port 8787, waiting for a request) held Client for its
+    # CONNECT_TIMEOUT and the grace after it: 30 s before the line below, now PROBE_TIMEOUT.
+    with sock:
+        sock.settimeout(PROBE_TIMEOUT)
+        try:
+            sock.recv(1)
+        except TimeoutError:
+            return SILENT.format(seconds=f"{PROBE_TIMEOUT:g}")
+        except OSError:  # reset: Client says what it meets
+            pass
     return ""
 
 
