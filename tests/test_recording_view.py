@@ -93,3 +93,26 @@ def test_the_magnified_tab_is_framed_on_the_structure_and_holds_the_magnified_sh
     right = max(float((f.block_q[owner, 0] + static.block_vert_local[:, 0]).max()) for f in frames)
     assert x_range[0] == 0.0 and right - xmin < x_range[1] < bar_left + dx - xmin, (x_range, right, bar_left)
     assert y_range == (0.0, pytest.approx(ymax - ymin))
+
+
+def test_hinge_dots_stay_smaller_than_small_blocks(tmp_path):
+    """'masonry simulate wall --courses 64 --length 4.5': 729 hinge dots 4 ui points (8 px wide) on blocks
+    9 px high covered the Sliding and Opening tabs in yellow, the colour of a sliding ratio of 1 there. As
+    drawn at first open (the 1150 x 840 px structure panel fitted to the view) a hinge dot is now at most half
+    a block's smaller side wide, and grows with the blocks when zoomed; a small structure keeps 4 points."""
+    from masonrycli.recording.layout import HINGE_RADIUS, HINGES
+
+    def drawn(static, q0, name):  # (dot width, block's smaller side) at first open, px; the radius logged
+        path = tmp_path / name
+        with Recorder(path, static, fx.METADATA, batch_frames=4) as rec:
+            for f in fx.frames(static, q0, 3):
+                rec.log_frame(f)
+        w, h = fx.static_value(path, f"/{PLANE}", "Pinhole:resolution")[0]
+        px_per_m = min(1150.0 / w, 840.0 / h)
+        (r,) = fx.static_value(path, f"/{HINGES}", "Points2D:radii")
+        return (-2.0 * r if r < 0 else 2.0 * r * px_per_m), min(fx.BLOCK_W, fx.BLOCK_H) * px_per_m, r
+
+    dot, side, _ = drawn(*fx.wall(courses=64, per_course=15, ragged=False), "tall.rrd")  # 4.5 m x 12.8 m
+    assert dot <= 0.5 * side + 1e-6, (dot, side)
+    _, _, r = drawn(*fx.wall(), "small.rrd")  # 1.2 m x 0.8 m: blocks ~ 100 px
+    assert r == HINGE_RADIUS

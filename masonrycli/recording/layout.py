@@ -162,6 +162,7 @@ OPEN_RGBA: Final = 0xE03C31FF  # joint open at one end, turning about the other 
 MAGNIFIED_RGBA: Final = 0xE8E8E8FF
 UNDEFORMED_RGBA: Final = 0x6E6E6EFF
 HINGE_RGBA: Final = 0xFFD700FF
+HINGE_RADIUS: Final = -4.0  # ui points; a share of the blocks on a large structure (static_content.hinge_radius)
 COMPRESSION_RGBA: Final = 0x141414FF  # principal axis with a negative value (near black)
 TENSION_RGBA: Final = 0xDC00DCFF  # principal axis with a positive value (magenta)
 CENTROID_RGBA: Final = 0x282828FF  # the dot at each block's centroid, the hover target of its values

@@ -27,6 +27,7 @@ from masonrycli.recording.layout import (
     CENTROID_RGBA,
     FILL,
     FORCES,
+    HINGE_RADIUS,
     HINGE_RGBA,
     HINGES,
     LEGEND_TEXT_RGBA,
@@ -101,7 +102,7 @@ def log_static(rec: rr.RecordingStream, st: RecordingStatic, blocks: Polygons, s
     )
     rec.log(STRESS_AXES, rr.LineStrips2D.from_fields(radii=-1.25, draw_order=40.0), static=True)
     rec.log(FORCES, rr.Arrows2D.from_fields(radii=-1.5, draw_order=50.0), static=True)
-    rec.log(HINGES, rr.Points2D.from_fields(radii=-4.0, colors=HINGE_RGBA, draw_order=60.0), static=True)
+    rec.log(HINGES, rr.Points2D.from_fields(radii=HINGE_RADIUS, colors=HINGE_RGBA, draw_order=60.0), static=True)
     rec.log(MAGNIFIED, rr.LineStrips2D.from_fields(colors=MAGNIFIED_RGBA, radii=-1.0, draw_order=30.0), static=True)
     series_names = {
         "energy_kinetic": ["kinetic"],
@@ -188,7 +189,7 @@ def log_plane(
     right of it (a wall shaken right covered the bar, one falling left left the view, and a 64-course wall's
     toe arrows ran off the bottom: 'masonry simulate wall --courses 64 --length 4.5', 70 frames of 100).
     ``block_side``: a median block's smaller side (m); given, the centroid dots are sized to the blocks as
-    drawn in this view (:func:`centroid_radius`)."""
+    drawn in this view, and the hinge dots (:func:`centroid_radius`, :func:`hinge_radius`)."""
     sup = supports.world(support_q[None])[0]
     blk = blocks.world(block_q[None])[0] if blocks.count else sup
     lo, hi = blk.min(axis=0), blk.max(axis=0)
@@ -220,23 +221,34 @@ def log_plane(
     rec.log(XY, rr.Transform3D(translation=[-x0, y0, 0.0], scale=[1.0, -1.0, 1.0]), static=True)
     if block_side is not None:
         rec.log(BLOCKS, rr.Points2D.from_fields(radii=centroid_radius(resolution, block_side)), static=True)
+        rec.log(HINGES, rr.Points2D.from_fields(radii=hinge_radius(resolution, block_side)), static=True)
     return legend_box, size, (legend_box[0] - pad - x0, resolution[1])
 
 
 _PANEL_PX: Final = (1150.0, 840.0)  # the structure panel of a 1920 x 1080 window (docs' screenshots)
 
 
-def centroid_radius(resolution, block_side: float) -> float:
-    """The centroid dots' radius: CENTROID_RADIUS (ui points, negative), unless a dot that size would be more
-    than a quarter of a median block's smaller side wide as drawn at first open (``resolution``: the view's
-    extent, m, fitted to the structure panel); then an eighth of that side, in metres (positive): as small
-    at first open, and it grows with the blocks when the user zooms in to hover one. At 2.5 points a dot
-    was 5 px wide on the 4-5 px high blocks of an 8-course wall 37.5 m long and on the 11 px ones of a
-    64-course wall: the dots darkened every colour map."""
+def centroid_radius(resolution, block_side: float, points: float = -CENTROID_RADIUS, share: float = 0.125) -> float:
+    """A dot's radius: -``points`` (ui points, negative: the same size at every zoom), unless a dot that size
+    would be more than 2 ``share`` of a median block's smaller side wide as drawn at first open
+    (``resolution``: the view's extent, m, fitted to the structure panel); then ``share`` of that side, in
+    metres (positive): as small at first open, and it grows with the blocks when the user zooms in.
+
+    The centroid dots (2.5 points, an eighth of the side): 5 px wide on the 4-5 px high blocks of an
+    8-course wall 37.5 m long and on the 11 px ones of a 64-course wall, they darkened every colour map. The
+    hinges (:func:`hinge_radius`)."""
     px_per_m = min(_PANEL_PX[0] / float(resolution[0]), _PANEL_PX[1] / float(resolution[1]))
-    if 0.125 * block_side * px_per_m >= -CENTROID_RADIUS:
-        return CENTROID_RADIUS
-    return 0.125 * block_side
+    if share * block_side * px_per_m >= points:
+        return -points
+    return share * block_side
+
+
+def hinge_radius(resolution, block_side: float) -> float:
+    """The hinge dots' radius: 4 ui points, or a quarter of a median block's smaller side when such a dot
+    would be wider than half the side at first open (:func:`centroid_radius`). On the 64-course wall
+    ('masonry simulate wall --courses 64 --length 4.5') 729 hinges 8 px wide on 9 px high blocks covered
+    the Sliding and Opening tabs in yellow, the colour of a sliding ratio of 1 there."""
+    return centroid_radius(resolution, block_side, -HINGE_RADIUS, 0.25)
 
 
 LUTS: Final = {"signed": COOLWARM, "negative": BLUES, "positive": VIRIDIS}
