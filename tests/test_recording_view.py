@@ -116,3 +116,33 @@ def test_hinge_dots_stay_smaller_than_small_blocks(tmp_path):
     assert dot <= 0.5 * side + 1e-6, (dot, side)
     _, _, r = drawn(*fx.wall(), "small.rrd")  # 1.2 m x 0.8 m: blocks ~ 100 px
     assert r == HINGE_RADIUS
+
+
+def test_lines_over_the_blocks_stay_thinner_than_small_blocks(tmp_path):
+    """'masonry simulate wall --courses 8 --length 37.5': blocks 5.6 px high at first open, joint arrows
+    1.5 ui points (3 px thick), glyphs 1.25: every colour hidden under orange and green. At first open an
+    arrow is now at most a quarter of a block's smaller side thick, a glyph or magnified outline a fifth;
+    they thicken with the blocks when zoomed; a small structure keeps its ui points."""
+    from masonrycli.recording.layout import FORCES, MAGNIFIED, STRESS_AXES
+    from masonrycli.recording.static_content import LINE_POINTS
+
+    columns = {FORCES: "Arrows2D:radii", STRESS_AXES: "LineStrips2D:radii", MAGNIFIED: "LineStrips2D:radii"}
+    for static, q0, name, small in (
+        (*fx.wall(courses=2, per_course=100, ragged=False), "long.rrd", False),  # 30 m x 0.4 m
+        (*fx.wall(), "small.rrd", True),  # 1.2 m x 0.8 m: blocks ~ 100 px
+    ):
+        path = tmp_path / name
+        with Recorder(path, static, fx.METADATA, batch_frames=4) as rec:
+            for f in fx.frames(static, q0, 3):
+                rec.log_frame(f)
+        w, h = fx.static_value(path, f"/{PLANE}", "Pinhole:resolution")[0]
+        px_per_m = min(1150.0 / w, 840.0 / h)
+        side = min(fx.BLOCK_W, fx.BLOCK_H) * px_per_m
+        for entity, column in columns.items():
+            (r,) = fx.static_value(path, f"/{entity}", column)
+            points, share = LINE_POINTS[entity]
+            if small:
+                assert r == -points, (entity, r)
+            else:
+                assert 0 < r * px_per_m <= share * side + 1e-6, (entity, r, side)
+        assert small or side < 8.0  # the long wall's blocks are small at first open

@@ -141,7 +141,7 @@ def legend_markdown(
         f"centred on its point of application (line of thrust); {scale}. Green = sticking, "
         "orange = sliding, red = open at one end. Yellow dots: hinges.\n"
         "- **Fills**: colour bar beside the structure; grey = undefined (NaN), magenta = below the range, "
-        "lime green = above it. Small dark dots: the blocks' centroids; hover one for the block's name and values.\n"
+        "lime green = above it. Small dark dots: block centroids (hover one: its name and values).\n"
         f"- **{MAGNIFIED_TAB}** deformed shape: displacements and rotations {factor}; grey = as built."
     )
 
