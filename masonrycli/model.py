@@ -11,6 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from geometry_library.blocks import JOINT_SEPARATOR
 from geometry_library.mass import mass_properties
 from masonrycli.motion import support_velocity
 
@@ -76,6 +77,12 @@ class Model:
     @property
     def body_count(self) -> int:
         return self.block_count + self.support_count
+
+    def joint_names(self, joint_body) -> list[str]:
+        """``"a|b"`` for each row (a, b) of body indices (blocks, then supports): how hinge lists, the limit
+        analysis and its verification name a joint (body names may not contain the separator)."""
+        names = self.block_name + self.support_name
+        return [f"{names[a]}{JOINT_SEPARATOR}{names[b]}" for a, b in joint_body]
 
 
 @dataclass(eq=False)

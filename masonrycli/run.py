@@ -335,8 +335,7 @@ def simulate(
     if sim.last is not None and sim.joints.key.size:
         hinged, _ = sim.hinges()
         hinge_count = int(hinged.sum())
-        names = list(m.block_name) + list(m.support_name)
-        pairs = [f"{names[a]}|{names[b]}" for a, b in sim.joints.joint_body[hinged]]
+        pairs = m.joint_names(sim.joints.joint_body[hinged])
         shown = ", ".join(pairs[:8]) + (" …" if len(pairs) > 8 else "")
         extra["hinged joints (end)"] = f"{len(pairs)}" + (f": {shown}" if pairs else "")
     # Stopped by the user: measure what was applied (the whole run's loading can be 10⁸ samples, minutes

@@ -89,5 +89,4 @@ def find_joints(model: Model) -> Joints:
 
 def joint_names(model: Model, joints: Joints) -> list[str]:
     """``"a|b"`` for each joint, the two body names as the dynamic run's hinge report spells them."""
-    names = list(model.block_name) + list(model.support_name)
-    return [f"{names[a]}|{names[b]}" for a, b in joints.joint_body]
+    return model.joint_names(joints.joint_body)

@@ -124,8 +124,7 @@ def run_check(scenario, result: LimitResult, factor: float, duration: float = DU
     v = sim.state.body_v[:n]
     speed = float((np.hypot(v[:, 0], v[:, 1]) + np.abs(v[:, 2]) * radius).max()) if n else 0.0
     hinged, _ = sim.hinges() if sim.last is not None else (np.zeros(0, dtype=bool), None)
-    names = list(m.block_name) + list(m.support_name)
-    hinges = tuple(f"{names[a]}|{names[b]}" for a, b in sim.joints.joint_body[hinged])
+    hinges = tuple(m.joint_names(sim.joints.joint_body[hinged]))
     similarity = None
     if collapsed:
         moved = sim.state.body_q[:n] - q0
