@@ -523,3 +523,42 @@ def test_the_masonry_check_waits_60_s_at_most(tmp_path, monkeypatch):
         os.kill(pid, signal.SIGCONT)
         client.close()
         cluster.close()
+
+
+def test_a_point_that_kills_its_worker_is_an_error_row_saying_so_and_only_it(monkeypatch):
+    # the row said "KilledWorker: Attempted to run task 'run-21434d39-…' on 4 different workers, but all those
+    # workers died while running it. The last worker … Inspecting worker logs is often a good next step to diagnose
+    # what went wrong. Fo" (cut at 300 characters); and a point running beside it in the same worker process (a
+    # worker of 2 threads, as `dask worker` makes by default; or one whose result was not yet sent) died with it,
+    # four times over: an error row too, for a good point
+    from distributed import Client, LocalCluster
+
+    from masonrycli.study import runner
+
+    class Driver:
+        def start(self):
+            return [{"amp": 0.1}, {"amp": 0.2}]
+
+        def feed(self, params, row):
+            return []
+
+    def task(base, params, *args):  # the point 0.2 ends its worker process, as an out-of-memory kill would
+        time.sleep(0.2 if params["amp"] == 0.2 else 1.0)
+        if params["amp"] == 0.2:
+            os._exit(1)
+        return dict(params, status="completed", error="")
+
+    monkeypatch.setattr(runner, "run_task", task)  # sent to the workers by value (runner.make_task)
+    cluster = LocalCluster(n_workers=1, threads_per_worker=2, processes=True, dashboard_address=":0")
+    client = Client(cluster)
+    rows = []
+    try:
+        runner.run_on_cluster(client, "s", Driver(), lambda p, r: rows.append(r), False, None, False)
+    finally:
+        client.close()
+        cluster.close()
+    rows.sort(key=lambda r: r["amp"])
+    assert [(r["amp"], r["status"]) for r in rows] == [(0.1, "completed"), (0.2, "error")]
+    said = rows[1]["error"]
+    assert said.startswith("KilledWorker: the worker process running this point died, on each of the 4 workers ")
+    assert said.endswith(": out of memory, or a crash (the workers' logs say which)"), said

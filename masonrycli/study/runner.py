@@ -408,7 +408,7 @@ def run_on_cluster(
     each comes back. ``warn`` (if given) is told when the cluster has no worker for a while (:class:`_WorkerWatch`;
     ``where`` names the cluster)."""
     import cloudpickle
-    from distributed import as_completed
+    from distributed import KilledWorker, as_completed
 
     from masonrycli.study.versions import check_result, make_task, this_version
 
@@ -423,33 +423,71 @@ def run_on_cluster(
     waiting = deque(driver.start())
     pending = {}
     completed = as_completed()
+    # Points whose workers died under them (KilledWorker), run again one at a time once nothing else runs. A
+    # point that ends its worker process (out of memory, a crash) takes with it the tasks running beside it in
+    # that process (a worker of several threads, `dask worker`'s default) and those whose results the worker had
+    # not yet sent (it batches them every 2 ms); each such death counts against them as against it, and a good
+    # point that died with it four times was an error row too (every time with 2 threads, 1 run in 4 with one).
+    # Alone, a good point runs; the point that kills its workers does so again, and its row says so.
+    killed: deque = deque()
+    alone: set = set()  # keys of the tasks so run
 
-    def submit():
-        while waiting and len(pending) < limit:
-            params = waiting.popleft()
+    def submit(points=waiting, most=limit):
+        while points and len(pending) < most:
+            params = points.popleft()
             future = client.submit(run, ours, base_future, params, *task_args, pure=False)
             pending[future.key] = params
             completed.add(future)
+            if points is killed:
+                alone.add(future.key)
 
     submit()
-    watch = _WorkerWatch(client, warn, where, lambda: len(pending) + len(waiting)) if warn else contextlib.nullcontext()
+    watch = (
+        _WorkerWatch(client, warn, where, lambda: len(pending) + len(waiting) + len(killed))
+        if warn
+        else contextlib.nullcontext()
+    )
     with watch:
-        for future in completed:
-            params = pending.pop(future.key)
-            try:
-                answer, worker, row = future.result()
-            except Exception as exc:  # the task never returned (KilledWorker, a cluster failure)
-                if _scheduler_lost(client, exc):
-                    raise SchedulerLost(
-                        f"lost the connection to the scheduler with {len(pending) + 1} runs pending"
-                    ) from None
-                row = params | empty_result(f"{type(exc).__name__}: {exc}", 0.0)
-            else:
-                check_result(answer, worker, params, ours)  # another masonry's row is not kept
-            future.release()
-            waiting.extendleft(reversed(driver.feed(params, row)))  # a search's next step first: its row sooner
-            on_row(params, row)
-            submit()
+        while True:
+            for future in completed:
+                params = pending.pop(future.key)
+                try:
+                    answer, worker, row = future.result()
+                except Exception as exc:  # the task never returned (KilledWorker, a cluster failure)
+                    if _scheduler_lost(client, exc):
+                        raise SchedulerLost(
+                            f"lost the connection to the scheduler with {len(pending) + len(killed) + 1} runs pending"
+                        ) from None
+                    if isinstance(exc, KilledWorker) and future.key not in alone:
+                        killed.append(params)  # run again alone (above)
+                        future.release()
+                        submit()
+                        continue
+                    row = params | empty_result(task_error(exc), 0.0)
+                else:
+                    check_result(answer, worker, params, ours)  # another masonry's row is not kept
+                future.release()
+                waiting.extendleft(reversed(driver.feed(params, row)))  # a search's next step first: its row sooner
+                on_row(params, row)
+                submit()
+            if not killed:
+                return
+            submit(killed, 1)  # nothing else in flight: the next one alone
+
+
+def task_error(exc: Exception) -> str:
+    """What a row's error column says of a task that never returned. Dask's KilledWorker text (the task's key,
+    "Inspecting worker logs is often a good next step…", a URL) was cut at 300 characters before it said what
+    had happened to the point: the worker processes running it died, one after the other."""
+    from distributed import KilledWorker
+
+    if isinstance(exc, KilledWorker):
+        last = getattr(exc.last_worker, "address", exc.last_worker)
+        return (
+            f"KilledWorker: the worker process running this point died, on each of the {exc.allowed_failures + 1} "
+            f"workers that tried it (the last {last}): out of memory, or a crash (the workers' logs say which)"
+        )
+    return f"{type(exc).__name__}: {exc}"
 
 
 def run_serially(base, driver, on_row: Callable[[dict, dict], None], *task_args) -> None:
