@@ -211,6 +211,8 @@ def execute(
     by default one of the run's own."""
     with StopSignals() if signals is None else contextlib.nullcontext(signals) as signals, compile_ahead.ahead():
         sinks: dict[OutputFile, object] = {}
+        if note := compile_ahead.no_cache_note():  # a read-only install and no writable home or /tmp
+            print(note, file=sys.stderr)
         try:
             for out in outputs.files():
                 open_part(out)

@@ -3,8 +3,8 @@
 Every kernel of ``masonrycli.engine`` is decorated with :data:`njit` (never ``numba.njit`` directly), so
 that changing a flag changes it everywhere.
 
-- ``cache=True``: compiled machine code is cached next to the sources (``__pycache__``), so a second
-  start does not recompile.
+- ``cache=True``: compiled machine code is cached (next to the sources, ``__pycache__``, unless that
+  folder cannot be written: "Where" below), so a second start does not recompile.
 - ``no_cfunc_wrapper``: numba otherwise builds, optimises and compiles with every kernel a C-callable
   wrapper, used only when a kernel is passed as a first-class function value, which the engine never
   does: ~0.02 s of CPU a kernel, 5 % of a first run's compilation.
@@ -47,6 +47,17 @@ kernels it calls: ``fused._before_solve`` that of detection, integration and war
 that of ``nlgs._relative_velocity``, ``warmstart`` the packed columns of ``nlgs``. numba alone stamps a
 kernel with its own file only, so an edit of a callee in another file would leave its callers' cached
 code stale.
+
+Where: one folder for the whole engine, chosen at import (:func:`cache_dir`): ``NUMBA_CACHE_DIR`` when set
+and writable, else ``__pycache__`` beside the sources, else numba's user-wide folder (``~/.cache/numba``),
+else the user's own folder in the temporary folder (``/tmp/masonry-numba-<uid>``, 0700, refused if another
+user owns it or may write into it), else none: kernels are compiled in every run, uncached, and a run says
+so (:data:`NO_CACHE_NOTE`). A read-only install (a venv of root's used by another user, a Docker image
+built as root and run as a user) thus caches in the user's folder, stamped as above. Before, a kernel whose
+``__pycache__`` could not be written was left to numba's own locators: its user-wide cache was stamped
+with the kernel's own file only (an upgrade of a callee in place then loaded stale code), and with no
+writable home (``nobody``, a container's user) every engine import ended in numba's ``RuntimeError: cannot
+cache function …: no locator available``.
 """
 
 from __future__ import annotations
@@ -55,16 +66,16 @@ import functools
 import hashlib
 import os
 import re
+import stat
+import tempfile
 import types
 
 import numba
 from numba.core import caching, config
 from numba.core.registry import CPUDispatcher
+from numba.misc.appdirs import AppDirs
 
 config.SLP_VECTORIZE = 1  # module doc
-njit = functools.partial(numba.njit, cache=True, no_cfunc_wrapper=True)
-"""``numba.njit`` with the engine's flags. Use as ``@njit`` or ``@njit(...)``."""
-
 __all__ = ["kernel_only", "njit"]
 
 
@@ -144,14 +155,77 @@ class _EngineSources:
         return super().from_function(py_func, py_file)
 
 
-class _EngineUserDir(_EngineSources, caching.UserProvidedCacheLocator):
-    """``NUMBA_CACHE_DIR`` set: there."""
+class _EngineCache(_EngineSources, caching._SourceFileBackedLocatorMixin, caching._CacheLocator):
+    """In :data:`CACHE_DIR` (one folder for the whole engine, chosen at import)."""
+
+    def __init__(self, py_func, py_file):
+        self._py_file = py_file
+        self._lineno = py_func.__code__.co_firstlineno
+
+    def get_cache_path(self):
+        return CACHE_DIR
+
+    @classmethod
+    def from_function(cls, py_func, py_file):
+        return super().from_function(py_func, py_file) if CACHE_DIR else None
 
 
-class _EngineInTree(_EngineSources, caching.InTreeCacheLocator):
-    """Next to the sources (``__pycache__``)."""
+def _writable(path: str) -> bool:
+    """Whether ``path`` is (or can be made) a folder this process writes into: numba's own test."""
+    try:
+        os.makedirs(path, exist_ok=True)
+        tempfile.TemporaryFile(dir=path).close()
+    except OSError:
+        return False
+    return True
 
+
+def _own_folder(path: str) -> bool:
+    """Whether ``path`` is a folder (not a link) of this user that no one else may write into, made so if it
+    is not there. A shared temporary folder: another user could otherwise put a cache there first, and
+    numba's index is a pickle, run as it is read."""
+    try:
+        os.makedirs(path, mode=0o700, exist_ok=True)
+        st = os.lstat(path)
+    except OSError:
+        return False
+    return stat.S_ISDIR(st.st_mode) and st.st_uid == os.geteuid() and not st.st_mode & 0o022
+
+
+def candidates() -> list[str]:
+    """Where the engine's cache may go, in order: ``NUMBA_CACHE_DIR`` when set, next to the sources
+    (``__pycache__``), numba's user-wide folder (``~/.cache/numba``), then a folder of this user in the
+    temporary folder (``/tmp/masonry-numba-1000``). The first three are numba's own order and folders."""
+    sub = caching._CacheLocator.get_suitable_cache_subpath(os.path.join(_ENGINE, "_jit.py"))  # engine_<sha1>
+    found = [os.path.join(config.CACHE_DIR, sub)] if config.CACHE_DIR else []
+    found.append(os.path.join(_ENGINE, "__pycache__"))
+    found.append(os.path.join(AppDirs(appname="numba", appauthor=False).user_cache_dir, sub))
+    uid = os.geteuid() if hasattr(os, "geteuid") else os.getpid()
+    found.append(os.path.join(tempfile.gettempdir(), f"masonry-numba-{uid}", sub))
+    return found
+
+
+def cache_dir() -> str | None:
+    """The first of :func:`candidates` this process can write into, or None (module doc, "Where")."""
+    *usual, temporary = candidates()
+    for path in usual:
+        if _writable(path):
+            return path
+    return temporary if _own_folder(os.path.dirname(temporary)) and _writable(temporary) else None
+
+
+CACHE_DIR = cache_dir()
+"""The folder of the engine's compiled kernels, None when no folder can be written (then none is cached)."""
+
+NO_CACHE_NOTE = (
+    "note: no folder for the compiled numba kernels can be written ({}): every run compiles them again "
+    "(about 20 s of CPU); set NUMBA_CACHE_DIR to a writable folder to keep them"
+)
+"""Said at the start of a run when :data:`CACHE_DIR` is None (formatted with the folders tried)."""
+
+njit = functools.partial(numba.njit, cache=CACHE_DIR is not None, no_cfunc_wrapper=True)
+"""``numba.njit`` with the engine's flags. Use as ``@njit`` or ``@njit(...)``."""
 
 # numba ≥ 0.60 names it CacheImpl, earlier _CacheImpl; the first locator that accepts a function is used.
 _CACHE_IMPL = getattr(caching, "CacheImpl", None) or caching._CacheImpl
-_CACHE_IMPL._locator_classes[:0] = [_EngineUserDir, _EngineInTree]
+_CACHE_IMPL._locator_classes[:0] = [_EngineCache]

@@ -10,7 +10,9 @@ others; the run then loads them from the cache instead of compiling them. When t
 kernel the run compiles it too (the same machine code, so results are bit-identical either way).
 
 The child is started only when it can help: at least two CPUs for this process, and a cache that lacks
-a current entry for one of :data:`EVERY_RUN` (a warm start reads a few small index files, nothing more).
+a current entry for one of :data:`EVERY_RUN` (a warm start reads a few small index files, nothing more);
+never when no folder can hold the cache (``engine._jit``, "Where": a read-only install with no writable
+home or temporary folder), where what it compiled would be lost.
 It runs in its own session (a Ctrl-C at the terminal is the run's to handle), stops when its parent
 is gone, and is stopped when the run ends. numba writes each cache file under a temporary name and
 renames it, so a stopped child leaves no half-written entry.
@@ -103,12 +105,25 @@ def _cpus() -> int:
         return os.cpu_count() or 1
 
 
+def no_cache_note() -> str | None:
+    """The line a run says when no folder can hold the compiled kernels (engine._jit, "Where"), else None."""
+    from masonrycli.engine import _jit
+
+    if _jit.CACHE_DIR is not None:
+        return None
+    return _jit.NO_CACHE_NOTE.format(", ".join(_jit.candidates()))
+
+
 def needed() -> bool:
-    """Whether a child would help: two CPUs or more, JIT on, and a kernel of :data:`EVERY_RUN` not cached.
+    """Whether a child would help: two CPUs or more, JIT on, a cache, and a kernel of :data:`EVERY_RUN` not cached.
     :data:`STALLED` does not count: a run that never stalls would otherwise start a child every time."""
     from numba.core import config
 
+    from masonrycli.engine import _jit
+
     if _cpus() < 2 or config.DISABLE_JIT or os.environ.get("MASONRY_COMPILE_AHEAD", "1") == "0":
+        return False
+    if _jit.CACHE_DIR is None:  # nowhere to put what it compiles
         return False
     return not all(_cached(name) for name, _ in EVERY_RUN)
 
