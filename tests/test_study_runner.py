@@ -9,7 +9,7 @@ import time
 
 import pytest
 
-from masonrycli.study import runner
+from masonrycli.study import runner, watch
 
 
 @pytest.fixture(scope="module")
@@ -76,8 +76,8 @@ def test_a_cluster_without_workers_says_the_study_waits_and_again_when_one_joins
         return dict(params)
 
     monkeypatch.setattr(runner, "run_task", task)
-    monkeypatch.setattr(runner, "NO_WORKER_WAIT", 0.5)
-    monkeypatch.setattr(runner, "WATCH_EVERY", 0.1)
+    monkeypatch.setattr(watch, "NO_WORKER_WAIT", 0.5)
+    monkeypatch.setattr(watch, "WATCH_EVERY", 0.1)
     cluster = LocalCluster(n_workers=0, threads_per_worker=1, processes=False, dashboard_address=":0")
     client = Client(cluster)
     said, rows = [], []
