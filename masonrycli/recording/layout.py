@@ -252,12 +252,13 @@ def build_blueprint(
     main_field: str = "cell_spherical_stress",
     paper: tuple[float, tuple[str, ...]] | None = None,
     residual_range: tuple[float, float] | None = None,
-    structure_view: tuple[float, float] | None = None,
+    structure_view: tuple[tuple[float, float], tuple[float, float]] | None = None,
 ) -> rrb.Blueprint:
     """Structure tabs and the on-screen legend (left); time series and the run document (right).
     ``residual_range``: the residual plot's y range (log10 of m/s; None: the viewer's fit to the data).
-    ``structure_view``: (width, height) of the view left of the colour bars, image units from the view's
-    top left (``static_content.log_plane``): the magnified shape's tab, which has no bar, shows that part.
+    ``structure_view``: the part of the view that holds the structure and its magnified shape, image ranges
+    (u0, u1), (v0, v1) (``static_content.log_plane``): the magnified shape's tab, which has no bar nor
+    arrows, shows that part.
 
     Tabs: the live main view (forces, principal stress, ``main_field``), with ``paper`` = (t, figure
     numbers) the paper's four figures pinned to t, the four fields live, the magnified deformed shape,
@@ -287,7 +288,7 @@ def build_blueprint(
             # for the colour bar the other tabs have
             visual_bounds=None
             if structure_view is None
-            else rrb.VisualBounds2D(x_range=[0.0, structure_view[0]], y_range=[0.0, structure_view[1]]),
+            else rrb.VisualBounds2D(x_range=list(structure_view[0]), y_range=list(structure_view[1])),
         ),
         _structure_view(FIELD_TABS[sliding.key], sliding, joints),
         _structure_view(FIELD_TABS[opening.key], opening, joints),

@@ -137,9 +137,10 @@ class Recorder:
         self._block_side = float(np.median(size.min(axis=1)))  # m: the glyphs' unit; caps the fills' inset
         # (N,) m: a block's farthest vertex from its centroid, for the reach of the run (_clear_the_legend)
         self._radius = np.maximum.reduceat(np.hypot(*loc.T), first) if n else np.zeros(0)
-        # (xmin, ymin, xmax, ymax) m of what the run drew: the blocks' x (a collapse either way), the joint
-        # arrows (_clear_the_legend widens the view to hold it)
+        # (xmin, ymin, xmax, ymax) m of what the run drew: the blocks' x (a collapse either way), the magnified
+        # shape; with the arrows, the view widens to hold it (_clear_the_legend)
         self._extent = np.array([np.inf, np.inf, -np.inf, -np.inf])
+        self._arrows = self._extent.copy()  # the joint arrows' (the Magnified tab has none)
         # steps with a residual, those a decade under the tolerance, the largest, the smallest of the others
         self._residuals = [0, 0, 0.0, np.inf]
         self._glyph_length = GLYPH_HALF_LENGTH * self._block_side
@@ -153,7 +154,7 @@ class Recorder:
         self.axis_scale: dict[str, float] = {}
         self.magnify = magnify
         self._legend_box = (0.0, 0.0, 0.0, 0.0)
-        self._structure_view: tuple[float, float] | None = None  # the view left of the legend (log_plane)
+        self._structure_view = None  # the Magnified tab's part of the view (log_plane)
         self._label_anchors = np.zeros((0, 2), np.float32)
         self._size = 1.0
         self._frames, self._last = 0, None  # frames logged; (step, time) of the last one
@@ -342,8 +343,9 @@ class Recorder:
             self._supports,
             q,
             sq,
-            content=self._extent,
+            content=_union(self._extent, self._arrows),
             block_side=self._block_side,
+            shape=self._extent,
         )
         shift = rr.Transform3D(translation=[box[0] - self._legend_box[0], 0.0, 0.0])
         for path in (LEGEND_BARS, LEGEND_LABELS):
@@ -428,13 +430,13 @@ class Recorder:
 
     def _send_joints(self, idx: list, b: FrameBatch) -> None:
         arrows = send_joints(self.rec, idx, b, self.force_scale, RESULTANT_CAP * self._size)
-        self._extent = np.r_[np.minimum(self._extent[:2], arrows[:2]), np.maximum(self._extent[2:], arrows[2:])]
+        self._arrows = _union(self._arrows, arrows)
 
     def _send_magnified(self) -> None:
         if self._poses is not None and self._poses.count and self._ref is not None:
             args = (self._poses, self._ref[:2], self.magnify, self._size, self.long_batch_frames)
             self.magnify, drawn = send_magnified(self.rec, self._blocks, self._supports, *args)
-            self._extent = np.r_[np.minimum(self._extent[:2], drawn[:2]), np.maximum(self._extent[2:], drawn[2:])]
+            self._extent = _union(self._extent, drawn)
 
     # ---- run document
     def _log_metadata(self, status: str, note: str) -> None:
@@ -463,6 +465,11 @@ class Recorder:
             self.force_scale, self.block_height, self.magnify, self._main_field, paper_t, RESULTANT_CAP * self._size
         )
         self.rec.log(LEGEND, rr.TextDocument(viewer_safe_text(legend), media_type="text/markdown"), static=True)
+
+
+def _union(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """The box (xmin, ymin, xmax, ymax) holding boxes ``a`` and ``b``."""
+    return np.r_[np.minimum(a[:2], b[:2]), np.maximum(a[2:], b[2:])]
 
 
 def _tensor(tensors: dict, key: str, n: int) -> np.ndarray:

@@ -182,10 +182,12 @@ def log_plane(
     support_q: np.ndarray,
     content: np.ndarray | None = None,
     block_side: float | None = None,
-) -> tuple[tuple[float, float, float, float], float, tuple[float, float]]:
+    shape: np.ndarray | None = None,
+) -> tuple[tuple[float, float, float, float], float, tuple[tuple[float, float], tuple[float, float]]]:
     """Pinhole and y-up transform sized to the structure at the first frame; returns the legend box, the
-    structure's size (m) and the view's extent left of the legend (image units: width, height), for a tab
-    without a colour bar (the magnified shape's). ``content``: (xmin, ymin, xmax, ymax), m, of what the run drew (the blocks'
+    structure's size (m) and, for the tab without a colour bar nor arrows (the magnified shape's), the part
+    of the view that holds the structure and ``shape`` (xmin, ymin, xmax, ymax, m: what that tab draws),
+    as image ranges (u0, u1), (v0, v1). ``content``: (xmin, ymin, xmax, ymax), m, of what the run drew (the blocks'
     x reach, the joint arrows; the recorder's close): the view widens to hold it and the legend box stands
     right of it (a wall shaken right covered the bar, one falling left left the view, and a 64-course wall's
     toe arrows ran off the bottom: 'masonry simulate wall --courses 64 --length 4.5', 70 frames of 100).
@@ -193,13 +195,8 @@ def log_plane(
     drawn in this view, and the hinge dots (:func:`centroid_radius`, :func:`hinge_radius`)."""
     sup = supports.world(support_q[None])[0]
     blk = blocks.world(block_q[None])[0] if blocks.count else sup
-    lo, hi = blk.min(axis=0), blk.max(axis=0)
-    size = float(max(hi - lo)) or 1.0
-    if content is not None:
-        lo, hi = np.minimum(lo, content[:2]), np.maximum(hi, content[2:])
-    if len(sup):  # show the supports, but a wide ground only a little beyond the blocks
-        lo = np.minimum(lo, np.maximum(sup.min(axis=0), lo - _SUPPORT_MARGIN * size))
-        hi = np.maximum(hi, np.minimum(sup.max(axis=0), hi + _SUPPORT_MARGIN * size))
+    size = float(max(blk.max(axis=0) - blk.min(axis=0))) or 1.0
+    lo, hi = _held(blk, sup, size, content)
     pad, bar = 0.05 * size, 0.025 * size
     ya, yb = blk[:, 1].min(), blk[:, 1].max()
     room = 0.12 * (yb - ya)  # for the title above the bar and the over / under labels
@@ -229,7 +226,20 @@ def log_plane(
                 rr.Arrows2D.from_fields(radii=radius) if path == FORCES else rr.LineStrips2D.from_fields(radii=radius)
             )
             rec.log(path, style, static=True)
-    return legend_box, size, (legend_box[0] - pad - x0, resolution[1])
+    slo, shi = _held(blk, sup, size, shape)  # a 64-course wall's Magnified tab kept room for the toe arrows
+    return legend_box, size, ((slo[0] - pad - x0, shi[0] + pad - x0), (y0 - shi[1] - pad, y0 - slo[1] + pad))
+
+
+def _held(blk: np.ndarray, sup: np.ndarray, size: float, content: np.ndarray | None) -> tuple[np.ndarray, np.ndarray]:
+    """(lo, hi), m: the box a view holds: the blocks, ``content`` (xmin, ymin, xmax, ymax) and the supports,
+    but a wide ground only a little beyond the blocks."""
+    lo, hi = blk.min(axis=0), blk.max(axis=0)
+    if content is not None:
+        lo, hi = np.minimum(lo, content[:2]), np.maximum(hi, content[2:])
+    if len(sup):
+        lo = np.minimum(lo, np.maximum(sup.min(axis=0), lo - _SUPPORT_MARGIN * size))
+        hi = np.maximum(hi, np.minimum(sup.max(axis=0), hi + _SUPPORT_MARGIN * size))
+    return lo, hi
 
 
 LINE_POINTS: Final = {FORCES: (1.5, 0.125), STRESS_AXES: (1.25, 0.1), MAGNIFIED: (1.0, 0.1)}
