@@ -26,7 +26,13 @@ JOINT_SEPARATOR = "|"
 
 
 class GeometryError(ValueError):
-    """Bad geometry. The message is one line naming the block (index and name) and the problem."""
+    """Bad geometry. The message is one line naming the block (index and name) and the problem. ``keys``:
+    the builder options it is about, when a builder's check raised it (a caller names them as the user gave
+    them: ``--ring-thickness`` on the command line)."""
+
+    def __init__(self, message: str, *, keys: tuple[str, ...] = ()):
+        super().__init__(message)
+        self.keys = tuple(keys)
 
 
 LINE_BREAKING = ("Cc", "Zl", "Zp")

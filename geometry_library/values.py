@@ -268,7 +268,7 @@ def check_positive(label: str, **values) -> None:
         problem = number_problem(value, gt=0.0, unit=SETTING_UNITS.get(key))
         if problem is not None:
             what = problem.removeprefix("must be ") if isinstance(value, str) else "a positive number"
-            raise GeometryError(f"{label}: {key} must be {what}, got {shown(value)}")
+            raise GeometryError(f"{label}: {key} must be {what}, got {shown(value)}", keys=(key,))
 
 
 MATERIAL_RANGE = {"density": (1e-3, 1e5, "kg/m³"), "thickness": (1e-6, 1e3, "m")}
@@ -283,7 +283,9 @@ def check_material(label: str, **values) -> None:
     for key, value in values.items():
         lo, hi, unit = MATERIAL_RANGE[key]
         if not lo <= value <= hi:
-            raise GeometryError(f"{label}: {key} {_g(value)} {unit} is absurd (a likely typo: {lo:g} to {hi:g} {unit})")
+            raise GeometryError(
+                f"{label}: {key} {_g(value)} {unit} is absurd (a likely typo: {lo:g} to {hi:g} {unit})", keys=(key,)
+            )
 
 
 DIMENSION_RANGE = (1e-3, 1e3)
@@ -298,7 +300,9 @@ def check_dimensions(label: str, **values) -> None:
     lo, hi = DIMENSION_RANGE
     for key, value in values.items():
         if not lo <= value <= hi:
-            raise GeometryError(f"{label}: {key} {_g(value)} m is absurd (a likely typo: {lo:g} to {hi:g} m)")
+            raise GeometryError(
+                f"{label}: {key} {_g(value)} m is absurd (a likely typo: {lo:g} to {hi:g} m)", keys=(key,)
+            )
 
 
 MAX_BLOCKS = 100_000
@@ -306,16 +310,16 @@ MAX_BLOCKS = 100_000
 and fill the memory before anything was said). The largest benchmark wall has 3996 blocks."""
 
 
-def check_block_total(label: str, total: int, what: str = "", bound: bool = False) -> None:
-    """Raise a one-line GeometryError when ``what`` (the options, for the message) makes more than
-    :data:`MAX_BLOCKS` blocks (``bound``: ``total`` is an upper bound of the count, not the count)."""
+def check_block_total(label: str, total: int, what: str = "", bound: bool = False, keys: tuple[str, ...] = ()) -> None:
+    """Raise a one-line GeometryError when ``what`` (the options, for the message; ``keys``, their names)
+    makes more than :data:`MAX_BLOCKS` blocks (``bound``: ``total`` is an upper bound of the count)."""
     if total > MAX_BLOCKS:
         makes = f"{what} makes up to " if bound else f"{what} makes " if what else ""
-        raise GeometryError(f"{label}: {makes}{total} blocks, more than {MAX_BLOCKS} (a likely typo)")
+        raise GeometryError(f"{label}: {makes}{total} blocks, more than {MAX_BLOCKS} (a likely typo)", keys=keys)
 
 
 def check_count(label: str, minimum: int = 1, **values) -> None:
     """Raise a one-line GeometryError unless every value is an integer ≥ ``minimum``."""
     for key, value in values.items():
         if number_problem(value, integer=True, ge=minimum) is not None:
-            raise GeometryError(f"{label}: {key} must be an integer ≥ {minimum}, got {value!r}")
+            raise GeometryError(f"{label}: {key} must be an integer ≥ {minimum}, got {value!r}", keys=(key,))

@@ -40,6 +40,7 @@ from masonrycli.record_motion import Record, time_step_problem
 from masonrycli.record_text import NoTimeStep, TimeStepNotUsed
 from masonrycli.records import record_motion
 from masonrycli.scenario import MAX_DURATION, Material, RunConfig, Scenario, scenario_from_builder
+from masonrycli.structure import BuilderError, as_options
 from masonrycli.values import option_text
 
 DEFAULT_DURATION = {"wall": 1.0, "arch": 5.0, "aqueduct": 5.0}
@@ -311,14 +312,17 @@ def build_assembly(name: str, **overrides):
     ``density`` / ``thickness`` (None: not given), built and checked as ``simulate`` builds them
     (:func:`~masonrycli.structure.build_structure`): the same mistake gets the same line (build said
     "wall: block count …" where simulate and sweep said 'builder "wall": block count …')."""
-    from masonrycli.structure import build_structure
+    from masonrycli.structure import BuilderError, as_options, build_structure
 
     material = Material()
     for key in ("density", "thickness"):
         if overrides.get(key) is not None:
             material = _replace(material, f"--{key}", **{key: overrides[key]})
     given = {k: v for k, v in overrides.items() if v is not None and k not in ("density", "thickness")}
-    return build_structure(name, builder_options(name, given), material.density, material.thickness)
+    try:
+        return build_structure(name, builder_options(name, given), material.density, material.thickness)
+    except BuilderError as exc:  # named as typed, as simulate names them
+        raise as_options(exc, given) from None
 
 
 def builtin(name: str, **overrides) -> Scenario:
@@ -334,10 +338,12 @@ def builtin(name: str, **overrides) -> Scenario:
     loading = {k: overrides.get(k) for k in LOADING_OVERRIDES}
     motions = _loading(name, **loading)
     reserved = (*RUN_OVERRIDES, *MATERIAL_OVERRIDES, *LOADING_OVERRIDES)
-    options = {k: v for k, v in overrides.items() if k not in reserved and v is not None}
-    options = builder_options(name, options)
+    given = {k: v for k, v in overrides.items() if k not in reserved and v is not None}
     run = RunConfig(duration=_duration(name, motions, overrides))
-    scenario = scenario_from_builder(name, options, run, material, motions)
+    try:
+        scenario = scenario_from_builder(name, builder_options(name, given), run, material, motions)
+    except BuilderError as exc:  # named as typed: --ring-thickness, not the builder's ring_thickness
+        raise as_options(exc, given) from None
     return override_run(scenario, **_given(overrides, RUN_OVERRIDES))
 
 

@@ -23,7 +23,7 @@ from geometry_library.blocks import Assembly, Block, GeometryError
 from geometry_library.values import MATERIAL_RANGE
 from masonrycli.errors import InputContext, InputError, input_path
 from masonrycli.motion import Fixed, Motion
-from masonrycli.structure import build_structure, check_finite_tree, read_geometry, structure_warnings
+from masonrycli.structure import BuilderError, build_structure, check_finite_tree, read_geometry, structure_warnings
 from masonrycli.values import check_int, check_real, check_vector, field_error, quote_string, shorten
 
 MAX_DURATION = 1e5
@@ -324,12 +324,11 @@ def scenario_from_builder(
         try:
             check_finite_tree(key, value)
         except InputError as exc:
-            raise InputError(f"{where} {exc}") from None
+            raise BuilderError(builder, str(exc), (key,)) from None
     try:
         assembly = build_structure(builder, options, material.density, material.thickness)
-    except InputError as exc:
-        msg = str(exc)
-        raise InputError(msg if msg.startswith(f'builder "{builder}"') else f"{where} {msg}") from None
+    except InputError as exc:  # 'builder "wall": …', a BuilderError's keys kept (an unknown option has none)
+        raise BuilderError(builder, getattr(exc, "problem", str(exc)), getattr(exc, "keys", ())) from None
     known = [s.name for s in assembly.supports]
     for name, motion in motions_by_support.items():
         if name not in known:

@@ -26,7 +26,7 @@ from masonrycli.records import record_fields
 from masonrycli.scenario import Material, RunConfig, Scenario, block_speed_problem
 from masonrycli.scenario_warnings import idle_driven_supports
 from masonrycli.structure import build_structure, check_finite_tree, read_geometry, structure_warnings
-from masonrycli.toml_lines import with_line
+from masonrycli.toml_lines import key_line, with_line
 from masonrycli.values import (
     check_real,
     check_vector,
@@ -97,7 +97,11 @@ def loads_scenario(
     try:
         return _parse_document(doc, ctx, default_name)
     except InputError as exc:  # the line of the key it names, where the text shows it unambiguously
-        raise InputError(with_line(str(exc), ctx.fname, text)) from None
+        message = with_line(str(exc), ctx.fname, text)
+        keys = getattr(exc, "structure_keys", ())  # a builder's check: 'builder "arch": ring_thickness 0 m …'
+        if message == str(exc) and len(keys) == 1 and (line := key_line(text, ("structure",), keys[0])):
+            message = f"{ctx.fname}:{line}: {message[len(ctx.fname) + 2 :]}"
+        raise InputError(message) from None
 
 
 def _table(doc: dict, key: str, ctx: InputContext) -> dict:
@@ -185,7 +189,9 @@ def _parse_document(doc: dict, ctx: InputContext, default_name: str) -> Scenario
             try:
                 assembly = build_structure(builder, options, material.density, material.thickness)
             except InputError as exc:
-                raise ctx.error("[structure]", str(exc)) from None
+                error = ctx.error("[structure]", str(exc))
+                error.structure_keys = getattr(exc, "keys", ())  # its line, if one key (loads_scenario)
+                raise error from None
             structure_info = {"builder": builder, **options}
             what = f'builder "{builder}"'
         motions_by_support = {}

@@ -139,6 +139,33 @@ def _check_option_type(key: str, value, spec_field: dataclasses.Field):
     return value
 
 
+class BuilderError(InputError):
+    """``builder "arch": <problem>``, with the builder options the problem is about (``keys``, maybe none),
+    for a caller that names them as the user gave them (:func:`as_options`; a file adds its line)."""
+
+    def __init__(self, builder: str, problem: str, keys: tuple[str, ...] = (), named: bool = True):
+        super().__init__(f'builder "{builder}": {problem}' if named else problem)  # named: the builder's name first
+        self.builder, self.problem, self.keys, self.named = builder, problem, tuple(keys), named
+
+    def __reduce__(self):  # pickled with its fields (a sweep's worker sends it back): not as InputError(str)
+        return BuilderError, (self.builder, self.problem, self.keys, self.named)
+
+
+def as_options(exc: BuilderError, given: dict) -> InputError:
+    """``exc`` naming the command-line options it is about, when ``given`` (builder option -> value, from the
+    command line) holds them: ``--ring-thickness 0.0001 m is absurd (…)``, ``--blocks: block count must be
+    …``, ``--courses and --length: …`` ('builder "arch": ring_thickness 0.0001 m …' named a key the user
+    never typed). Else ``exc`` unchanged (a problem of no option, or of a default the user did not give)."""
+    keys = [k for k in exc.keys if k in given]
+    if not keys:
+        return exc
+    flags = " and ".join("--" + k.replace("_", "-") for k in keys)
+    key = keys[0]
+    if len(keys) == 1 and exc.problem.startswith(f"{key} ") and not exc.problem.startswith(f"{key} = "):
+        return InputError(f"{flags} {exc.problem[len(key) + 1 :]}")  # "ring_thickness 0.0001 m is absurd"
+    return InputError(f"{flags}: {exc.problem}")
+
+
 def build_structure(builder: str, options: dict, density: float, thickness: float) -> Assembly:
     """``BUILDERS[builder](**options).build()``; errors become InputError ``key = value: problem``.
 
@@ -156,7 +183,10 @@ def build_structure(builder: str, options: dict, density: float, thickness: floa
             close = difflib.get_close_matches(key, list(params), n=1)
             hint = f'did you mean "{close[0]}"?' if close else f"options: {', '.join(params) or 'none'}"
             raise InputError(f'unknown option {quote_string(key)} of builder "{builder}" ({hint})')
-        kwargs[key] = _check_option_type(key, _freeze(value), params[key])
+        try:
+            kwargs[key] = _check_option_type(key, _freeze(value), params[key])
+        except InputError as exc:
+            raise BuilderError(builder, str(exc), (key,), named=False) from None  # "[structure] key = …" in a file
     for key, value in (("density", density), ("thickness", thickness)):
         if key in params and key not in kwargs:
             kwargs[key] = value
@@ -165,7 +195,7 @@ def build_structure(builder: str, options: dict, density: float, thickness: floa
     except ValueError as exc:  # GeometryError, InputError, bad values; a TypeError is a bug: not hidden
         msg = one_line(exc)  # the builders' messages start with their name: not twice ('builder "wall": wall: …')
         msg = msg[len(builder) + 2 :] if msg.startswith(f"{builder}: ") else msg
-        raise InputError(f'builder "{builder}": {msg}') from None
+        raise BuilderError(builder, msg, getattr(exc, "keys", ())) from None
     if not isinstance(assembly, Assembly):
         raise InputError(f'builder "{builder}" returned {type(assembly).__name__}, not an Assembly')
     return assembly

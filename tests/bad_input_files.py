@@ -284,6 +284,14 @@ FILE_ROWS = [
         's.toml:2: [structure] builder = "tower"',
     ),
     (
+        # a builder's check names the key and its line (the option, given on the command line: bad_input_options)
+        "structure-builder-check",
+        {"s.toml": '# an arch\n[structure]\nbuilder = "arch"\nring_thickness = 0.0001\n'},
+        ("check", "s.toml"),
+        2,
+        's.toml:4: [structure] builder "arch": ring_thickness 0.0001 m is absurd (a likely typo: 0.001 to 1000 m)',
+    ),
+    (
         "structure-file-format",
         {"s.toml": '[structure]\nfile = "w.txt"\n', "w.txt": ""},
         ("check", "s.toml"),

@@ -267,7 +267,17 @@ def test_a_bad_target_is_named_in_one_line(target, message, tmp_path, monkeypatc
     [
         ({"blocks": 3, "density": -1.0}, "--density: density = -1.0: must be > 0"),
         ({"thickness": 1e9}, "--thickness: thickness = 1000000000.0: must be between 1e-06 and 1000 m (a likely typo)"),
-        ({"blocks": 0}, 'builder "wall": block count must be a positive integer, got 0'),
+        ({"blocks": 0}, "--blocks: block count must be a positive integer, got 0"),
+        (
+            {"blocks": 51, "courses": 5},
+            "--blocks and --courses: 51 blocks cannot be laid in running bond with 5 courses"
+            " (courses × full blocks per odd course: 1×51, 2×25, 6×8, 34×1)",
+        ),
+        (
+            {"courses": 5},
+            "--courses: 51 blocks cannot be laid in running bond with 5 courses"  # 51: the default
+            " (courses × full blocks per odd course: 1×51, 2×25, 6×8, 34×1)",
+        ),
     ],
 )
 def test_build_assembly_refuses_a_bad_option_in_one_line_naming_it(options, message):

@@ -212,7 +212,7 @@ def test_a_ctrl_c_while_the_arguments_are_read_is_one_line(argv, monkeypatch):
         # a float option's value as the user typed it: these said 0.0, 1000000000.0, -1.0 (typer had made
         # the text a float before the check)
         (("sweep", "wall", "-p", "amp=0.1:1:4", "--find", "amp", "--rtol", "0"), "--rtol 0: must be in (0, 1)"),
-        (RUN + ("--length", "0"), 'builder "wall": length must be a positive number, got 0'),
+        (RUN + ("--length", "0"), "--length must be a positive number, got 0"),
         (
             RUN + ("--density", "1e9"),
             "--density: density = 1e9: must be between 0.001 and 100000 kg/m³ (a likely typo)",
@@ -227,11 +227,11 @@ def test_a_ctrl_c_while_the_arguments_are_read_is_one_line(argv, monkeypatch):
         # a builder dimension's range check said "span 1e+09 m" (geometry's check_dimensions in %g)
         (
             ("simulate", "arch", "--span", "1e9", "--no-recording"),
-            'builder "arch": span 1e9 m is absurd (a likely typo: 0.001 to 1000 m)',
+            "--span 1e9 m is absurd (a likely typo: 0.001 to 1000 m)",
         ),
         (
             ("build", "wall", "--block-height", "1E-9", "--out", "x.geojson"),
-            'builder "wall": block_height 1E-9 m is absurd (a likely typo: 0.001 to 1000 m)',
+            "--block-height 1E-9 m is absurd (a likely typo: 0.001 to 1000 m)",
         ),
         # RunConfig's dt-against-duration checks echoed the floats: "dt = 2.0", "duration 100000.0"
         (("simulate", "wall", "--no-recording", "--dt", "2"), "--dt: dt = 2: must be <= duration (1.0)"),

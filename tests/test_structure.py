@@ -174,3 +174,24 @@ def test_validation_warnings_are_lines_and_its_errors_are_placed():
     overlapping = Assembly((Block(box(0, 0, 0.4, 0.2), "a"), Block(box(0.2, 0, 0.6, 0.2), "b")), (ground,))
     with pytest.raises(InputError, match=r'^s\.toml: blocks 1 \("a"\) and 2 \("b"\) overlap by 0\.04 m²'):
         structure_warnings(overlapping, CTX)
+
+
+@pytest.mark.parametrize(
+    "options, given, message",
+    [
+        ({"ring_thickness": 0.0001}, None, "--ring-thickness 0.0001 m is absurd (a likely typo: 0.001 to 1000 m)"),
+        ({"ring_thickness": 0.9, "pier_width": 0.5}, None, "--ring-thickness and --pier-width: ring_thickness 0.9 m"),
+        ({"ring_thickness": 0.9, "pier_width": 0.5}, {"pier_width": 0.5}, "--pier-width: ring_thickness 0.9 m"),
+        ({"voussoirs": 1}, {}, 'builder "arch": voussoirs must be an integer ≥ 2, got 1'),  # not given: as it was
+    ],
+)
+def test_a_builder_check_names_the_command_line_options_it_is_about(options, given, message):
+    import pickle
+
+    from masonrycli.structure import BuilderError, as_options
+
+    with pytest.raises(BuilderError) as info:
+        build_structure("arch", options, 2500.0, 1.0)
+    again = pickle.loads(pickle.dumps(info.value))  # a sweep's worker sends it back whole
+    assert (again.keys, again.problem, str(again)) == (info.value.keys, info.value.problem, str(info.value))
+    assert str(as_options(info.value, options if given is None else given)).startswith(message)

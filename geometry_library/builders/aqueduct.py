@@ -67,7 +67,8 @@ class AqueductSpec(ArchSpec):
         crown = geom.springing + geom.extrados_radius
         if top < crown:
             raise GeometryError(
-                f"aqueduct: the wall top ({top:g} m) is below the crown of the extrados ({crown:g} m); raise the wall courses (--wall-courses, or wall_courses in a scenario file)"
+                f"aqueduct: the wall top ({top:g} m) is below the crown of the extrados ({crown:g} m); raise the wall courses (--wall-courses, or wall_courses in a scenario file)",
+                keys=("wall_courses",),
             )
         # Bound the spandrel count before cutting it: every course spans the width between the piers'
         # outer faces, at most one block per block length plus the two ends.
@@ -77,6 +78,7 @@ class AqueductSpec(ArchSpec):
             len(blocks) + self.wall_courses * per_course,
             f"{self.wall_courses} wall courses of {self.block_length:g} m blocks over {2.0 * geom.half_width:g} m",
             bound=True,
+            keys=("wall_courses", "block_length"),
         )
         region = Polygon(geom.extrados)
         pieces = spandrel_blocks(

@@ -119,7 +119,12 @@ def arch_parts(spec: ArchSpec) -> tuple[list[Block], list[Support], ArchGeometry
     left_role, right_role = (r.strip().lower() if isinstance(r, str) else r for r in (spec.left_role, spec.right_role))
     check_count("arch", 2, voussoirs=voussoirs)
     check_count("arch", 1, pier_courses=pier_courses)
-    check_block_total("arch", voussoirs + 4 * pier_courses, f"{voussoirs} voussoirs and {pier_courses} pier courses")
+    check_block_total(
+        "arch",
+        voussoirs + 4 * pier_courses,
+        f"{voussoirs} voussoirs and {pier_courses} pier courses",
+        keys=("voussoirs", "pier_courses"),
+    )
     check_positive("arch", density=density, thickness=thickness)
     check_dimensions(
         "arch",
@@ -132,13 +137,16 @@ def arch_parts(spec: ArchSpec) -> tuple[list[Block], list[Support], ArchGeometry
     if ring_thickness > pier_width:
         raise GeometryError(
             f"arch: ring_thickness {ring_thickness:g} m is wider than the pier ({pier_width:g} m): "
-            "the pier top must carry the whole springing voussoir"
+            "the pier top must carry the whole springing voussoir",
+            keys=("ring_thickness", "pier_width"),
         )
     if foundation_margin < 0:
-        raise GeometryError(f"arch: foundation_margin must be ≥ 0, got {foundation_margin!r}")
+        raise GeometryError(
+            f"arch: foundation_margin must be ≥ 0, got {foundation_margin!r}", keys=("foundation_margin",)
+        )
     for key, role in (("left_role", left_role), ("right_role", right_role)):
         if role not in SUPPORT_ROLES:
-            raise GeometryError(f"arch: {key} must be one of {SUPPORT_ROLES}, got {role!r}")
+            raise GeometryError(f"arch: {key} must be one of {SUPPORT_ROLES}, got {role!r}", keys=(key,))
 
     r_in = 0.5 * span
     r_out = r_in + ring_thickness

@@ -88,8 +88,8 @@ class WallLayout:
 def wall_layouts(blocks: int) -> list[tuple[int, int]]:
     """Every (courses, full_per_course) with courses·n + ⌊courses/2⌋ == blocks, fewest courses first."""
     if number_problem(blocks, integer=True, ge=1) is not None:
-        raise GeometryError(f"wall: block count must be a positive integer, got {blocks!r}")
-    check_block_total("wall", blocks)
+        raise GeometryError(f"wall: block count must be a positive integer, got {blocks!r}", keys=("blocks",))
+    check_block_total("wall", blocks, keys=("blocks",))
     out = []
     for c in range(1, blocks + 1):
         rest = blocks - c // 2
@@ -127,15 +127,18 @@ def wall_layout(
             lo = max(1, math.floor(n_float))  # the lengths that fit on either side, to pick from
             fits = ", ".join(f"{k * block_length:g} m is {k}" for k in sorted({lo, math.floor(n_float) + 1}))
             raise GeometryError(
-                f"wall: length {length:g} m is not a whole number of {block_length:g} m blocks ({fits})"
+                f"wall: length {length:g} m is not a whole number of {block_length:g} m blocks ({fits})",
+                keys=("length",),
             )
     if courses is not None and number_problem(courses, integer=True, ge=1) is not None:
-        raise GeometryError(f"wall: courses must be a positive integer, got {courses!r}")
+        raise GeometryError(f"wall: courses must be a positive integer, got {courses!r}", keys=("courses",))
     if blocks is None:
         if courses is None or n_pinned is None:
-            raise GeometryError("wall: give a block count, or both courses and length")
+            raise GeometryError(
+                "wall: give a block count, or both courses and length", keys=("blocks", "courses", "length")
+            )
         blocks = courses * n_pinned + courses // 2
-        check_block_total("wall", blocks, f"{courses} courses of length {length:g} m")
+        check_block_total("wall", blocks, f"{courses} courses of length {length:g} m", keys=("courses", "length"))
     candidates = wall_layouts(blocks)
     if courses is not None:
         candidates = [(c, n) for c, n in candidates if c == courses]
@@ -154,7 +157,8 @@ def wall_layout(
         possible = ", ".join(f"{c}×{n}" for c, n in wall_layouts(blocks))
         raise GeometryError(
             f"wall: {blocks} blocks cannot be laid in running bond {why} "
-            f"(courses × full blocks per odd course: {possible})"
+            f"(courses × full blocks per odd course: {possible})",
+            keys=("blocks", *(["courses"] if courses is not None else []), *(["length"] if length is not None else [])),
         )
 
     def aspect(cn: tuple[int, int]) -> float:
@@ -202,7 +206,7 @@ class WallSpec:
         check_positive("wall", density=density, thickness=thickness)
         check_dimensions("wall", ground_depth=self.ground_depth)
         if self.ground_margin < 0:
-            raise GeometryError(f"wall: ground_margin must be ≥ 0, got {self.ground_margin!r}")
+            raise GeometryError(f"wall: ground_margin must be ≥ 0, got {self.ground_margin!r}", keys=("ground_margin",))
         x0 = -0.5 * layout.length
         cw = name_width(layout.courses)
         bw = name_width(layout.full_per_course + 1)
