@@ -99,3 +99,39 @@ def test_the_child_stops_when_its_parent_is_gone():
     # started by a process that has exited: getppid() is no longer it, nothing is compiled
     gone = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"], capture_output=True, text=True)
     assert compile_ahead.compile_all(parent=int(gone.stdout)) == 0
+
+
+class _Client:
+    def __init__(self, workers):
+        self.workers, self.submitted = workers, []
+
+    def scheduler_info(self):
+        return {"workers": {w: {} for w in self.workers}}
+
+    def submit(self, fn, **kw):
+        self.submitted.append((fn, kw))
+        return "future"
+
+
+def test_a_cluster_of_two_workers_or_more_compiles_on_its_last_one(monkeypatch):
+    monkeypatch.setattr(compile_ahead, "needed", lambda: True)
+    one, two = _Client(["tcp://a:1"]), _Client(["tcp://b:2", "tcp://a:1"])
+    assert compile_ahead.on_cluster(one) is None and not one.submitted
+    assert compile_ahead.on_cluster(two) == "future"
+    [(fn, kw)] = two.submitted
+    assert fn is compile_ahead.compile_quietly and kw["workers"] == ["tcp://b:2"] and not kw["allow_other_workers"]
+    monkeypatch.setattr(compile_ahead, "needed", lambda: False)
+    assert compile_ahead.on_cluster(_Client(["tcp://b:2", "tcp://a:1"])) is None
+
+
+@pytest.mark.slow
+def test_the_task_runs_on_a_real_local_cluster(monkeypatch):
+    # needed() is the study's process's answer; the worker compiles (here: loads from the warm cache) all
+    from distributed import Client, LocalCluster
+
+    monkeypatch.setattr(compile_ahead, "needed", lambda: True)
+    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=":0") as cluster:
+        with Client(cluster) as client:
+            future = compile_ahead.on_cluster(client)
+            assert future.result(timeout=600) == len(compile_ahead.KERNELS)
+            assert client.who_has(future)[future.key] == (max(client.scheduler_info()["workers"]),)

@@ -17,6 +17,9 @@ It runs in its own session (a Ctrl-C at the terminal is the run's to handle), st
 is gone, and is stopped when the run ends. numba writes each cache file under a temporary name and
 renames it, so a stopped child leaves no half-written entry.
 
+A study does the same: on ``--workers 0`` around its runs (:func:`ahead`), on a LocalCluster of two
+workers or more as the last worker's first task (:func:`on_cluster`), while the other workers start the runs.
+
     python -m masonrycli.engine.compile_ahead     # what the child runs (exit 0 whatever happens)
 """
 
@@ -160,6 +163,27 @@ def compile_all(parent: int | None = None) -> int:
         dispatcher(name).compile(signature(text))
         done += 1
     return done
+
+
+def compile_quietly() -> int:
+    """:func:`compile_all`, any error swallowed (-1): a helper never reports, the runs compile what it missed."""
+    try:
+        return compile_all()
+    except Exception:  # noqa: BLE001
+        return -1
+
+
+def on_cluster(client):
+    """The same on a study's LocalCluster: when :func:`needed` and the cluster has two workers or more, its
+    last worker compiles :data:`KERNELS` as its first task while the others start the runs, which then
+    load them (the workers share this process's cache). Returns the task's future (hold it until the
+    study ends: a released future is cancelled), or None."""
+    if not needed():
+        return None
+    workers = sorted(client.scheduler_info()["workers"])
+    if len(workers) < 2:
+        return None
+    return client.submit(compile_quietly, workers=workers[-1:], allow_other_workers=False, pure=False)
 
 
 def main(argv: list[str]) -> None:

@@ -116,6 +116,7 @@ def prepare(base: StudyBase, request: StudyRequest) -> str:
 
 def run_study(base: StudyBase, request: StudyRequest, console: Console) -> StudyResult:
     """Run every row of the study not already in ``request.out``; write the table (also on Ctrl-C)."""
+    from masonrycli.engine import compile_ahead
     from masonrycli.study.runner import SchedulerLost, open_cluster, run_on_cluster, run_serially
 
     study_id = prepare(base, request)
@@ -204,10 +205,13 @@ def run_study(base: StudyBase, request: StudyRequest, console: Console) -> Study
         task_args = (request.stop_at_collapse, histories, request.force, study)
         with progress:
             if client is None:
-                run_serially(base, driver, on_row, *task_args)
+                with compile_ahead.ahead():  # a first study on one core compiles on two (engine/compile_ahead.py)
+                    run_serially(base, driver, on_row, *task_args)
             else:
                 where = f"--scheduler {request.scheduler}" if request.scheduler else "the local cluster"
+                ahead = compile_ahead.on_cluster(client) if cluster is not None else None  # held to the end
                 run_on_cluster(client, base, driver, on_row, *task_args, warn=request.warn, where=where)
+                del ahead
     except (WorkerMismatch, SchedulerLost) as exc:  # the rows before it are kept (written below), resumable
         where = f"--scheduler {request.scheduler}" if request.scheduler else "the local cluster"
         once = "every worker runs this masonry" if isinstance(exc, WorkerMismatch) else "the scheduler is back"
