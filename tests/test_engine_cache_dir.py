@@ -32,11 +32,13 @@ out["locator"] = type(cache._impl.locator).__name__ if cache.cache_path else Non
 """
 
 
-def _run(tmp_path, blocked: list[str], more: str = "") -> dict:
+def _run(tmp_path, blocked: list[str], more: str = "", numba_cache_dir: str | None = None) -> dict:
     env = dict(os.environ, HOME=str(tmp_path / "home"), XDG_CACHE_HOME=str(tmp_path / "home" / ".cache"))
     env["TMPDIR"] = str(tmp_path / "tmp")
     env.pop("NUMBA_CACHE_DIR", None)
-    (tmp_path / "tmp").mkdir()
+    if numba_cache_dir:
+        env["NUMBA_CACHE_DIR"] = numba_cache_dir
+    (tmp_path / "tmp").mkdir(parents=True)
     code = _REFUSE + _RUN + more + "print(json.dumps(out))\n"
     done = subprocess.run([sys.executable, "-c", code, json.dumps(blocked)], env=env, capture_output=True, text=True)
     assert done.returncode == 0, done.stderr  # before: RuntimeError: cannot cache function …: no locator available
@@ -95,3 +97,36 @@ def test_numba_cache_dir_comes_first_and_the_sources_next(monkeypatch, tmp_path)
     assert _jit.cache_dir() == first
     monkeypatch.setattr(_jit.config, "CACHE_DIR", "")
     assert _jit.candidates()[0] == _engine_pycache()
+
+
+def test_a_read_only_install_s_own_cache_serves_its_user(tmp_path):
+    # the install's __pycache__ filled as its owner runs it (a Docker image's build step), then read-only
+    filled = tmp_path / "owner"
+    filled.mkdir()
+    assert _run(filled, [])["cache_dir"] == _engine_pycache()
+    more = 'out["hits"] = sum(joints._nan_max._python_twin.stats.cache_hits.values())\n'
+    out = _run(tmp_path / "user", [_engine_pycache()], more)
+    assert out["cache_dir"].startswith(str(tmp_path / "user" / "home" / ".cache" / "numba") + os.sep)
+    assert out["hits"] == 1  # loaded, not compiled again (before: 0, the user's empty cache)
+    # an empty NUMBA_CACHE_DIR stays empty (benchmarks/bench_cold.py measures a first run so)
+    cold = str(tmp_path / "cold")
+    out = _run(tmp_path / "bench", [_engine_pycache()], more, numba_cache_dir=cold)
+    assert out["cache_dir"].startswith(cold + os.sep) and out["hits"] == 0
+
+
+def test_seed_copies_what_the_target_lacks_or_holds_older(tmp_path):
+    source, target = tmp_path / "source", tmp_path / "target"
+    source.mkdir()
+    target.mkdir()
+    for name, text in [("m.f-3.py311.nbi", "index"), ("m.f-3.py311.1.nbc", "one"), ("m.f-3.py311.2.nbc", "two")]:
+        (source / name).write_text(text)
+    (source / "m.f-30.py311.1.nbc").write_text("another kernel's data, without its index")
+    assert _jit.seed(str(source), str(target)) == 1
+    assert sorted(p.name for p in target.iterdir()) == ["m.f-3.py311.1.nbc", "m.f-3.py311.2.nbc", "m.f-3.py311.nbi"]
+    assert (target / "m.f-3.py311.2.nbc").read_text() == "two"
+    (target / "m.f-3.py311.nbi").write_text("the user's, newer")
+    assert _jit.seed(str(source), str(target)) == 0  # not overwritten
+    os.utime(source / "m.f-3.py311.nbi", (2e9, 2e9))  # the install's cache filled again, later
+    assert _jit.seed(str(source), str(target)) == 1
+    assert (target / "m.f-3.py311.nbi").read_text() == "index"
+    assert _jit.seed(str(tmp_path / "none"), str(target)) == 0

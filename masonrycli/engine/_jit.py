@@ -53,7 +53,9 @@ and writable, else ``__pycache__`` beside the sources, else numba's user-wide fo
 else the user's own folder in the temporary folder (``/tmp/masonry-numba-<uid>``, 0700, refused if another
 user owns it or may write into it), else none: kernels are compiled in every run, uncached, and a run says
 so (:data:`NO_CACHE_NOTE`). A read-only install (a venv of root's used by another user, a Docker image
-built as root and run as a user) thus caches in the user's folder, stamped as above. Before, a kernel whose
+built as root and run as a user) thus caches in the user's folder, stamped as above, and that folder is
+first given what the install's own ``__pycache__`` holds (:func:`seed`: a cache filled when the image was
+built serves its users; not with ``NUMBA_CACHE_DIR``, which a cold-start benchmark sets empty). Before, a kernel whose
 ``__pycache__`` could not be written was left to numba's own locators: its user-wide cache was stamped
 with the kernel's own file only (an upgrade of a callee in place then loaded stale code), and with no
 writable home (``nobody``, a container's user) every engine import ended in numba's ``RuntimeError: cannot
@@ -62,10 +64,12 @@ cache function …: no locator available``.
 
 from __future__ import annotations
 
+import contextlib
 import functools
 import hashlib
 import os
 import re
+import shutil
 import stat
 import tempfile
 import types
@@ -214,8 +218,45 @@ def cache_dir() -> str | None:
     return temporary if _own_folder(os.path.dirname(temporary)) and _writable(temporary) else None
 
 
+def seed(source: str, target: str) -> int:
+    """Copy into ``target`` each kernel's cache files (its index ``*.nbi`` and the data ``*.N.nbc`` it names)
+    that ``source`` holds newer or ``target`` lacks; the number of kernels copied. A read-only install whose
+    ``__pycache__`` was filled when it was made (a Docker image's build step running masonry as root) thus
+    serves its user's cache, which started empty and compiled everything again (18.6 s of CPU). Data first,
+    the index last, each under a temporary name renamed into place (as numba writes them): a process
+    reading the target meanwhile (the compile-ahead child seeds it too) sees an old entry or a whole one. An
+    entry stamped for other sources reads as empty there, as it did here; nothing is copied on error."""
+    try:
+        names = os.listdir(source)
+        have = {n: os.stat(os.path.join(target, n)).st_mtime for n in os.listdir(target) if n.endswith(".nbi")}
+    except OSError:
+        return 0
+    copied = 0
+    for index in sorted(n for n in names if n.endswith(".nbi")):
+        base, part = index[: -len(".nbi")], None
+        try:
+            if index in have and os.stat(os.path.join(source, index)).st_mtime <= have[index]:
+                continue
+            data = [
+                n for n in names if n.startswith(base + ".") and n.endswith(".nbc") and n[len(base) + 1 : -4].isdigit()
+            ]
+            for name in [*data, index]:
+                part = os.path.join(target, f".{name}.{os.getpid()}.part")
+                shutil.copyfile(os.path.join(source, name), part)
+                os.replace(part, os.path.join(target, name))
+        except OSError:
+            with contextlib.suppress(OSError, TypeError):  # TypeError: no part yet
+                os.unlink(part)
+            continue
+        copied += 1
+    return copied
+
+
 CACHE_DIR = cache_dir()
 """The folder of the engine's compiled kernels, None when no folder can be written (then none is cached)."""
+
+if CACHE_DIR is not None and not config.CACHE_DIR and CACHE_DIR != os.path.join(_ENGINE, "__pycache__"):
+    seed(os.path.join(_ENGINE, "__pycache__"), CACHE_DIR)  # a read-only install's own cache, if it has one
 
 NO_CACHE_NOTE = (
     "note: no folder for the compiled numba kernels can be written ({}): every run compiles them again "
