@@ -239,3 +239,25 @@ def test_the_state_maps_cells_and_ticks_are_the_same_for_both_pictures():
     # ":g" keeps six significant digits: two values it would write alike are written exactly
     assert map_axis([{"amp": 0.1}, {"amp": 0.1000001}], "amp")[1] == ["0.1", "0.1000001"]
     assert map_axis([{"record": "b.AT2"}, {"record": "a.AT2"}], "record") == (["a.AT2", "b.AT2"], ["a.AT2", "b.AT2"])
+
+
+def test_a_user_whose_home_cannot_be_written_gets_no_matplotlib_warning(tmp_path):
+    # 'nobody', a container's user: matplotlib said on stderr at every sweep that it made a temporary folder
+    import os
+    import subprocess
+    import sys
+
+    home = tmp_path / "home"
+    home.write_text("a file: no folder can be made in it, whoever runs this")
+    env = {k: v for k, v in os.environ.items() if k not in ("MPLCONFIGDIR", "XDG_CONFIG_HOME", "XDG_CACHE_HOME")}
+    code = (
+        "from masonrycli.study import plots\n"
+        "plots.state_map([{'amp': 0.1, 'state': 'intact'}, {'amp': 0.2, 'state': 'collapsed', 'collapse_time': 0.5}],"
+        " 'amp', None, 'm.png', 'states')\n"
+    )
+    done = subprocess.run(
+        [sys.executable, "-c", code], env=dict(env, HOME=str(home)), cwd=tmp_path, capture_output=True
+    )
+    assert done.returncode == 0, done.stderr
+    assert done.stderr == b""  # before: 'mkdir -p failed for path …/.config/matplotlib' and 'Matplotlib created …'
+    assert (tmp_path / "m.png").stat().st_size > 0

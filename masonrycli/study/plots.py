@@ -30,11 +30,22 @@ _MARKERS = {"circle": "o", "tick": "|", "diamond": "D", "up": "^", "down": "v"}
 
 
 def _pyplot():
-    import matplotlib
+    """pyplot on Agg. Quiet about its folders: for a user whose home cannot be written (``nobody``, a
+    container's user) matplotlib said on stderr, at every sweep, that it made a temporary config folder
+    and that MPLCONFIGDIR should be set ('mkdir -p failed for path /nonexistent/.config/matplotlib …'):
+    the temporary folder serves, the fonts are few (0.4 s for import and a figure either way)."""
+    import logging
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    log = logging.getLogger("matplotlib")
+    level = log.level
+    log.setLevel(logging.ERROR)
+    try:
+        import matplotlib
 
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+    finally:
+        log.setLevel(level)
     return plt
 
 
@@ -46,9 +57,9 @@ def _save(fig, path: Path) -> Path:
 
 def state_map(rows: list[dict], x: str, y: str | None, path: Path, title: str) -> Path:
     """PNG of the states over parameters ``x`` (and ``y``): one coloured cell per run."""
+    plt = _pyplot()  # first: matplotlib imported quietly
     from matplotlib.patches import Patch
 
-    plt = _pyplot()
     xs, x_ticks = map_axis(rows, x)
     ys, y_ticks = map_axis(rows, y) if y else ([0], [])
     fig, ax = plt.subplots(figsize=(1.2 + 0.7 * len(xs), 1.2 + 0.55 * len(ys)))
