@@ -102,6 +102,22 @@ def test_a_cluster_without_workers_says_the_study_waits_and_again_when_one_joins
     assert sorted(r["amp"] for r in rows) == [0.0, 1.0, 2.0]
 
 
+def test_a_lost_scheduler_counts_every_run_not_made(client, monkeypatch):
+    # "with 2 runs pending" of a study with 5 runs to go: the points not yet submitted (at most a few per worker
+    # thread are) were left out, 64 pending of a 10 000-point grid
+    def task(base, params, *args):
+        if params["amp"] == 1.0:
+            raise OSError("the connection to the scheduler went with it")  # taken for the scheduler's loss below
+        return dict(params)
+
+    monkeypatch.setattr(runner, "run_task", task)
+    monkeypatch.setattr(runner, "_scheduler_lost", lambda client, exc: True)
+    rows = []
+    with pytest.raises(runner.SchedulerLost) as lost:
+        runner.run_on_cluster(client, "s", Driver(6), lambda p, r: rows.append(r), False, None, False, limit=2)
+    assert str(lost.value) == f"lost the connection to the scheduler with {6 - len(rows)} runs pending"
+
+
 class Listener:
     """A TCP service on a free local port that is not a Dask scheduler: it accepts and says ``greeting``
     (or nothing) and keeps the connection open."""

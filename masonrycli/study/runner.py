@@ -406,7 +406,8 @@ def run_on_cluster(
                 except Exception as exc:  # the task never returned (KilledWorker, a cluster failure)
                     if _scheduler_lost(client, exc):
                         raise SchedulerLost(
-                            f"lost the connection to the scheduler with {len(pending) + len(killed) + 1} runs pending"
+                            f"lost the connection to the scheduler with {len(pending) + len(waiting) + len(killed) + 1} runs "
+                            "pending"
                         ) from None
                     if isinstance(exc, KilledWorker) and future.key not in alone:
                         killed.append(params)  # run again alone (above)
