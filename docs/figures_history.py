@@ -239,10 +239,10 @@ def colour_ranges(run: Run, i: int) -> str:
         v = h[key][i]
         d = v[np.isfinite(v)]
         over = int(((d < r.lo) | (d > r.hi)).sum())
-        span = (min(d.max(), r.hi) - max(d.min(), r.lo)) / (r.hi - r.lo)
+        span = r.span(d)  # the use rule's: the 1 % most extreme cells at each end left out
         parts.append(
             f"{key.removeprefix('cell_')} {r.lo:.3g} … {r.hi:.3g} ({over} of {d.size} defined cells beyond, "
-            f"cells span {100 * span:.0f} % of it at t = {h['time'][i]:.2f} s)"
+            f"their bulk spans {100 * span:.0f} % of it at t = {h['time'][i]:.2f} s)"
         )
     return "Recording colour ranges at that frame (replayed from the history): " + "; ".join(parts)
 

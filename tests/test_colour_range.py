@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from masonrycli import colormap as cm
-from masonrycli.colour_range import MIN_SPAN, OUTSIDE_SHARE, ColourRange, RangeTracker, fit_range
+from masonrycli.colour_range import BULK_TRIM, MIN_SPAN, OUTSIDE_SHARE, ColourRange, RangeTracker, fit_range
 
 
 def outside_share(r: ColourRange, v: np.ndarray) -> float:
@@ -17,8 +17,11 @@ def outside_share(r: ColourRange, v: np.ndarray) -> float:
 
 
 def span_share(r: ColourRange, v: np.ndarray) -> float:
-    v = v[np.isfinite(v)]
-    return (min(v.max(), r.hi) - max(v.min(), r.lo)) / (r.hi - r.lo)
+    """The use rule's span, written out: the defined cells sorted, 1 % (rounded down) dropped at each end."""
+    v = np.sort(v[np.isfinite(v)])
+    k = int(0.01 * v.size)
+    assert BULK_TRIM == 0.01
+    return (min(v[v.size - 1 - k], r.hi) - max(v[k], r.lo)) / (r.hi - r.lo)
 
 
 @pytest.mark.parametrize("kind", ["signed", "negative", "positive"])
@@ -51,6 +54,43 @@ def test_a_range_is_kept_while_it_holds_and_ends_are_nice_numbers():
     assert tracker.update(np.linspace(0.1, 0.7, 51)) is r
     assert tracker.update(np.linspace(0.0, 0.3, 51)) is not r  # spans 30 %: refitted
     assert tracker.current.hi == pytest.approx(0.3)
+
+
+@pytest.mark.parametrize("kind", ["signed", "negative", "positive"])
+def test_one_extreme_cell_does_not_hold_a_range_the_other_cells_use_a_sliver_of(kind):
+    """After an impact: one cell stays at the range's end, the 299 others are 30× smaller. The min-to-max
+    span (the rule before 2026-11-29) was 100 % and kept the range; the bulk spans 3 %: refitted, and the
+    extreme cell is counted outside the new range (1 of 300, within the 2 %)."""
+    rng = np.random.default_rng(5)
+    sign = {"signed": 1.0, "negative": -1.0, "positive": 1.0}[kind]
+    violent = sign * rng.uniform(0.0, 1e6, 300)
+    if kind == "signed":
+        violent = rng.uniform(-1e6, 1e6, 300)
+    quiet = violent / 30.0
+    quiet[17] = violent[np.argmax(np.abs(violent))]  # the cell that stays extreme
+    for batch in (False, True):
+        tracker = RangeTracker(kind, floor=1.0)
+        first = tracker.follow(violent[None])[0][0] if batch else tracker.update(violent)
+        assert max(-first.lo, first.hi) >= 9e5
+        assert (min(quiet.max(), first.hi) - max(quiet.min(), first.lo)) / (first.hi - first.lo) >= MIN_SPAN
+        if batch:
+            ranges, below, above = tracker.follow(quiet[None])
+            r, outside = ranges[0], below[0] + above[0]
+        else:
+            r = tracker.update(quiet)
+            outside = sum(r.outside(quiet)[:2])
+        assert r is not first and tracker.changes == 2
+        assert max(-r.lo, r.hi) <= 1e6 / 30.0 * 1.5  # fitted to the quiet cells (nice rounding: ≤ 1.5×)
+        assert outside == 1 and span_share(r, quiet) >= MIN_SPAN
+
+
+def test_a_frame_under_100_cells_keeps_all_its_cells_in_the_span():
+    """Rounded down, 1 % of 99 cells is none: a small structure's ranges are as before (the 51-block wall)."""
+    tracker = RangeTracker("positive", floor=1e-6)
+    r = tracker.update(np.linspace(0.0, 1.0, 99))
+    quiet = np.r_[np.linspace(0.0, 0.02, 98), 0.9]
+    assert tracker.update(quiet) is r
+    assert tracker.update(np.r_[np.linspace(0.0, 0.02, 99), 0.9]) is not r  # 100 cells: the extreme one left out
 
 
 def test_small_frames_keep_every_cell_inside_and_the_floor_holds_noise_down():

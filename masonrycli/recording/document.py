@@ -16,7 +16,7 @@ import numpy as np
 import rerun as rr
 
 from masonrycli import __version__ as MASONRY_VERSION
-from masonrycli.colour_range import MIN_SPAN, OUTSIDE_SHARE
+from masonrycli.colour_range import BULK_TRIM, MIN_SPAN, OUTSIDE_SHARE
 from masonrycli.recording.layout import (
     AXES,
     FIELD_TABS,
@@ -94,7 +94,8 @@ def run_document(
         *(f"  - {n.replace('_', ' ')}: full length at |λ| = {_fmt_scale(axis_scale.get(n), '')}" for n in AXES),
         "- **Colour ranges follow the data**: each field's range is checked against every recorded frame "
         f"and refitted from that frame on only when more than {100 * OUTSIDE_SHARE:g} % of the cells fall "
-        f"outside it or the cells use less than {100 * MIN_SPAN:g} % of it; the colour bar always shows "
+        f"outside it or the cells, leaving out the {100 * BULK_TRIM:g} % most extreme at each end, span less "
+        f"than {100 * MIN_SPAN:g} % of it; the colour bar always shows "
         "the range in force (five ticks) and how many cells are beyond it.",
         "",
         "| field | colour map | last range | refits |",
