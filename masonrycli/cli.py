@@ -116,18 +116,23 @@ def _execute_and_report(scenario, opts: dict, hint, outputs, signals) -> None:
         )
         raise typer.Exit(EXIT_INTERNAL) from None
     result = outcome.result
-    print_summary(console, outcome, scenario, hint(result.time) if hint is not None and result is not None else "")
-    for error in outcome.errors:
-        say("error", "bold red", f"cannot write {error}")
-    if outcome.errors or result.status == FAILED:
-        raise typer.Exit(EXIT_OUTPUT_FAILED)
-    if signals.signum is not None:
-        if outcome.signum is None or result.status != INTERRUPTED:  # it came once the last step was over
+    try:
+        print_summary(console, outcome, scenario, hint(result.time) if hint is not None and result is not None else "")
+        for error in outcome.errors:
+            say("error", "bold red", f"cannot write {error}")
+        if signals.signum is not None and (outcome.signum is None or result.status != INTERRUPTED):
+            # it came once the last step was over
             say(
                 "note",
                 "yellow",
                 f"{signal_name(signals.signum)} after the last step: the run {result.status} and its files are whole",
             )
+    except OSError:  # the terminal is gone (SIGHUP: the files are closed, whole): the exit code still says how
+        if signals.signum is None:
+            raise
+    if outcome.errors or result.status == FAILED:
+        raise typer.Exit(EXIT_OUTPUT_FAILED)
+    if signals.signum is not None:
         raise typer.Exit(exit_code(signals.signum))
     if result.status == DIVERGED:
         raise typer.Exit(EXIT_DIVERGED)

@@ -217,7 +217,8 @@ def sweep_command(
                 missing = [str(f.path) for f in files if f is not None and f.path not in written]
                 again = "with --force (no run is made again)" if written else "(no run is made again)"
                 said = f"every row is in {out}, but not written: {', '.join(missing)}; run the same command {again}"
-            err_console.print(f"interrupted{how}: {said}", soft_wrap=True)
+            with contextlib.suppress(OSError):  # the terminal is gone (SIGHUP): the exit code still says how
+                err_console.print(f"interrupted{how}: {said}", soft_wrap=True)
             raise typer.Exit(exit_code(signum)) from None
 
 

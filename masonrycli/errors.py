@@ -5,7 +5,7 @@ Exit codes (README, "Troubleshooting"): 0 the run completed (or the command succ
 (an engine bug; ``MASONRY_DEBUG=1`` shows the traceback) · 2 bad input, including an output path that
 cannot be written, checked before step 1 · 3 the run diverged · 4 an output could not be written during
 the run (disk full, folder removed) · 5 a study (``masonry sweep``) finished with failed runs (rows with
-``status = error``: an engine error or an output that could not be written; the table is whole) · 128 + signal number when stopped by a signal (130 Ctrl-C, 143 SIGTERM).
+``status = error``: an engine error or an output that could not be written; the table is whole) · 128 + signal number when stopped by a signal (130 Ctrl-C, 143 SIGTERM, 129 SIGHUP: the terminal closed).
 """
 
 import os

@@ -1,4 +1,4 @@
-"""Ctrl-C (SIGINT) and SIGTERM, handled in one place for the whole run.
+"""Ctrl-C (SIGINT), SIGTERM and SIGHUP (the terminal closed), handled in one place for the whole run.
 
 Three phases, because what a signal may safely do depends on what is under way:
 
@@ -41,7 +41,10 @@ import signal
 import sys
 import threading
 
-SIGNALS = (signal.SIGINT, signal.SIGTERM)
+SIGNALS = (signal.SIGINT, signal.SIGTERM, *((signal.SIGHUP,) if hasattr(signal, "SIGHUP") else ()))
+"""Ctrl-C, ``kill``, and the terminal closing (an SSH session dropped: SIGHUP to the session's processes; before
+it was handled, a run killed so left only its ``.part`` files). SIGHUP is left alone when it is ignored as the
+run starts (``nohup``): the run then goes on, as the user asked."""
 
 
 class StopRun(BaseException):
@@ -79,6 +82,8 @@ class _Handlers:
             _INSTALLED.append(self)
             try:
                 for sig in SIGNALS:
+                    if _nohup(sig):
+                        continue
                     self._previous[sig] = signal.signal(sig, self._handle)
             except BaseException:  # a signal between two installs (StopRun): __exit__ will not run
                 self.__exit__()
@@ -249,10 +254,17 @@ def raise_dropped() -> None:
         raise handlers._raised
 
 
+def _nohup(sig: int) -> bool:
+    """SIGHUP ignored by whoever started the run (``nohup``, a service manager): it stays ignored."""
+    return sig == getattr(signal, "SIGHUP", None) and signal.getsignal(sig) == signal.SIG_IGN
+
+
 def already_stopping(signum: int) -> None:
     """What a repeated signal prints, once a stop is under way (on stderr, one line)."""
-    # os.write: no buffered I/O inside a signal handler (it may interrupt a print).
-    os.write(2, f"{signal_name(signum)}: already stopping — finishing the output files\n".encode())
+    # os.write: no buffered I/O inside a signal handler (it may interrupt a print). A closed terminal (SIGHUP)
+    # or pipe makes the write fail: an error raised here would land in the code finishing the files.
+    with contextlib.suppress(OSError):
+        os.write(2, f"{signal_name(signum)}: already stopping — finishing the output files\n".encode())
 
 
 def ignore_signals_while_exiting() -> None:

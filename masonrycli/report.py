@@ -3,6 +3,7 @@ tables of ``masonry check`` and ``masonry inspect``."""
 
 from __future__ import annotations
 
+import contextlib
 import sys
 import threading
 import time
@@ -72,8 +73,14 @@ def progress_bar(console: Console, n_steps: int):
             iters=stats.iterations,
         )
 
-    with progress:
+    progress.start()
+    try:
         yield on_progress
+    finally:
+        # its last refresh, with the terminal gone (SIGHUP: an SSH session dropped) fails; the run's files do
+        # not depend on it (it made the run "failed" where it was interrupted)
+        with contextlib.suppress(OSError):
+            progress.stop()
 
 
 SOLVER_NOTES = {

@@ -17,7 +17,7 @@ INTERRUPTED: Final = "interrupted"
 DIVERGED: Final = "diverged"
 FAILED: Final = "failed"
 STATUSES: Final = (RUNNING, COMPLETED, INTERRUPTED, DIVERGED, FAILED)
-"""running: not closed yet · completed: reached the end · interrupted: stopped by Ctrl-C or SIGTERM ·
+"""running: not closed yet · completed: reached the end · interrupted: stopped by Ctrl-C, SIGTERM or SIGHUP ·
 diverged: stopped on a non-physical state · failed: an engine error or an output that could not be written."""
 
 

@@ -173,6 +173,8 @@ def dask_setup(worker) -> None:
     Setting SIG_IGN also drops a Ctrl-C that waited, blocked, for this moment."""
     if threading.current_thread() is threading.main_thread():
         signal.signal(signal.SIGINT, signal.SIG_IGN)
+        if hasattr(signal, "SIGHUP"):  # the terminal closing is the command's to handle too (its rows written)
+            signal.signal(signal.SIGHUP, signal.SIG_IGN)
 
 
 def quiet_worker_logs() -> None:
