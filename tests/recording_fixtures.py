@@ -13,7 +13,7 @@ import rerun as rr
 from scipy.spatial import Delaunay
 
 from masonrycli.frame import CONTACT_OPEN, CONTACT_SLIP, CONTACT_STICK, Frame
-from masonrycli.recording import RecordingStatic
+from masonrycli.recording import Recorder, RecordingStatic
 
 BLOCK_W, BLOCK_H = 0.3, 0.2
 
@@ -181,3 +181,23 @@ def static_value(path, entity: str, column: str):
                     if v is not None and row_id > latest:  # row ids: big-endian, time first
                         value, latest = v, row_id
     return value
+
+
+def px_per_metre_at_first_open(path, static: RecordingStatic, q0: np.ndarray, count: int = 3) -> float:
+    """Record ``count`` frames of ``static`` at ``path``; the structure panel's pixels per metre as the recording
+    opens: the 1150 x 840 px panel of a 1920 x 1080 window fitted to the view's logged extent."""
+    from masonrycli.recording.layout import PLANE
+
+    with Recorder(path, static, METADATA, batch_frames=4) as rec:
+        for f in frames(static, q0, count):
+            rec.log_frame(f)
+    w, h = static_value(path, f"/{PLANE}", "Pinhole:resolution")[0]
+    return min(1150.0 / w, 840.0 / h)
+
+
+def dot_at_first_open(path, static: RecordingStatic, q0: np.ndarray, entity: str) -> tuple[float, float, float]:
+    """(a dot's width, a block's smaller side) in px as the recording at ``path`` opens, and the radius logged
+    for the points at ``entity`` (negative: ui points, a fixed size on screen)."""
+    px_per_m = px_per_metre_at_first_open(path, static, q0)
+    (r,) = static_value(path, f"/{entity}", "Points2D:radii")
+    return (-2.0 * r if r < 0 else 2.0 * r * px_per_m), min(BLOCK_W, BLOCK_H) * px_per_m, r

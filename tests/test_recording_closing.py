@@ -152,17 +152,23 @@ def test_interrupt_in_the_middle_of_a_flush_still_leaves_a_complete_file(wall, t
     assert all(len(set(r)) == len(r) for r in rows.values())  # no row sent twice (the batch again at close)
 
 
+def _nine_frames(wall, tmp_path):
+    """A whole recording of the fixture wall's 9 frames in batches of 4 (the last one's sent at close)."""
+    static, q0 = wall
+    whole = tmp_path / "whole.rrd"
+    with Recorder(whole, static, fx.METADATA, batch_frames=4, long_batch_frames=4) as rec:
+        for f in fx.frames(static, q0, 9):
+            rec.log_frame(f)
+    return whole
+
+
 def test_the_readback_helpers_read_a_cut_recording_as_inspect_does(wall, tmp_path):
     """A file cut in the middle of a message (a kill -9's .NAME.<pid>.part, a full disk): inspect read it up to
     its last whole message, field_frames, blueprint_views and recording_rows raised "Message payload (start …)
     exceeds file size"."""
     from masonrycli.recording.readback import blueprint_views, field_frames
 
-    static, q0 = wall
-    whole, cut = tmp_path / "whole.rrd", tmp_path / "cut.rrd"
-    with Recorder(whole, static, fx.METADATA, batch_frames=4, long_batch_frames=4) as rec:
-        for f in fx.frames(static, q0, 9):
-            rec.log_frame(f)
+    whole, cut = _nine_frames(wall, tmp_path), tmp_path / "cut.rrd"
     data = whole.read_bytes()
     for share in (0.8, 0.7, 0.6, 0.5, 0.4, 0.3):  # a cut inside the second batch of frames
         cut.write_bytes(data[: int(len(data) * share)])
@@ -182,11 +188,7 @@ def test_a_cut_recording_counts_the_frames_whose_blocks_it_holds(wall, tmp_path)
     hover values, read by field_frames) are in the file."""
     from masonrycli.recording.readback import field_frames
 
-    static, q0 = wall
-    whole, cut = tmp_path / "whole.rrd", tmp_path / "cut.rrd"
-    with Recorder(whole, static, fx.METADATA, batch_frames=4, long_batch_frames=4) as rec:
-        for f in fx.frames(static, q0, 9):
-            rec.log_frame(f)
+    whole, cut = _nine_frames(wall, tmp_path), tmp_path / "cut.rrd"
     data = whole.read_bytes()
     read, labels_only = 0, 0
     for share in range(1, 101):
@@ -310,17 +312,10 @@ def test_centroid_dots_stay_smaller_than_small_blocks(tmp_path):
     wall 37.5 m long the blocks are 4-5 px high at first open and the dots darkened every colour map. As
     drawn at first open (the structure panel of a 1920 x 1080 window, 1150 x 840 px, fitted to the view's
     extent) a dot is now at most a quarter of a block's smaller side wide; a small structure keeps 2.5."""
-    from masonrycli.recording.layout import BLOCKS, CENTROID_RADIUS, PLANE
+    from masonrycli.recording.layout import BLOCKS, CENTROID_RADIUS
 
-    def drawn(static, q0, name):  # (dot width, block's smaller side) at first open, px
-        path = tmp_path / name
-        with Recorder(path, static, fx.METADATA, batch_frames=4) as rec:
-            for f in fx.frames(static, q0, 3):
-                rec.log_frame(f)
-        w, h = fx.static_value(path, f"/{PLANE}", "Pinhole:resolution")[0]
-        px_per_m = min(1150.0 / w, 840.0 / h)
-        (r,) = fx.static_value(path, f"/{BLOCKS}", "Points2D:radii")
-        return (-2.0 * r if r < 0 else 2.0 * r * px_per_m), min(fx.BLOCK_W, fx.BLOCK_H) * px_per_m, r
+    def drawn(static, q0, name):  # (dot width, block's smaller side) at first open, px; the radius logged
+        return fx.dot_at_first_open(tmp_path / name, static, q0, BLOCKS)
 
     dot, side, _ = drawn(*fx.wall(courses=2, per_course=100, ragged=False), "long.rrd")  # 30 m x 0.4 m
     assert dot <= 0.25 * side + 1e-6, (dot, side)

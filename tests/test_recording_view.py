@@ -109,14 +109,7 @@ def test_hinge_dots_stay_smaller_than_small_blocks(tmp_path):
     from masonrycli.recording.layout import HINGE_RADIUS, HINGES
 
     def drawn(static, q0, name):  # (dot width, block's smaller side) at first open, px; the radius logged
-        path = tmp_path / name
-        with Recorder(path, static, fx.METADATA, batch_frames=4) as rec:
-            for f in fx.frames(static, q0, 3):
-                rec.log_frame(f)
-        w, h = fx.static_value(path, f"/{PLANE}", "Pinhole:resolution")[0]
-        px_per_m = min(1150.0 / w, 840.0 / h)
-        (r,) = fx.static_value(path, f"/{HINGES}", "Points2D:radii")
-        return (-2.0 * r if r < 0 else 2.0 * r * px_per_m), min(fx.BLOCK_W, fx.BLOCK_H) * px_per_m, r
+        return fx.dot_at_first_open(tmp_path / name, static, q0, HINGES)
 
     dot, side, _ = drawn(*fx.wall(courses=64, per_course=15, ragged=False), "tall.rrd")  # 4.5 m x 12.8 m
     assert dot <= 0.5 * side + 1e-6, (dot, side)
@@ -138,11 +131,7 @@ def test_lines_over_the_blocks_stay_thinner_than_small_blocks(tmp_path):
         (*fx.wall(), "small.rrd", True),  # 1.2 m x 0.8 m: blocks ~ 100 px
     ):
         path = tmp_path / name
-        with Recorder(path, static, fx.METADATA, batch_frames=4) as rec:
-            for f in fx.frames(static, q0, 3):
-                rec.log_frame(f)
-        w, h = fx.static_value(path, f"/{PLANE}", "Pinhole:resolution")[0]
-        px_per_m = min(1150.0 / w, 840.0 / h)
+        px_per_m = fx.px_per_metre_at_first_open(path, static, q0)
         side = min(fx.BLOCK_W, fx.BLOCK_H) * px_per_m
         for entity, column in columns.items():
             (r,) = fx.static_value(path, f"/{entity}", column)
