@@ -65,7 +65,7 @@ def signal_name(signum: int) -> str:
 
 
 class _Handlers:
-    """Installs :meth:`_handle` for :data:`SIGNALS` on entry (main thread only) and puts the previous
+    """Installs :meth:`_handle` (through :meth:`_dispatch`) for :data:`SIGNALS` on entry (main thread only) and puts the previous
     handlers back on exit."""
 
     def __init__(self) -> None:
@@ -84,7 +84,7 @@ class _Handlers:
                 for sig in SIGNALS:
                     if _nohup(sig):
                         continue
-                    self._previous[sig] = signal.signal(sig, self._handle)
+                    self._previous[sig] = signal.signal(sig, self._dispatch)
             except BaseException:  # a signal between two installs (StopRun): __exit__ will not run
                 self.__exit__()
                 raise
@@ -112,6 +112,11 @@ class _Handlers:
             self.dropped = True  # said by the command's own stop line, not by a traceback
             return
         self._hook(unraisable)
+
+    def _dispatch(self, signum, frame) -> None:
+        if signum == getattr(signal, "SIGHUP", None):
+            detach_hung_up_terminal()
+        self._handle(signum, frame)
 
     def _handle(self, signum, _frame) -> None:
         raise NotImplementedError
@@ -257,6 +262,41 @@ def raise_dropped() -> None:
 def _nohup(sig: int) -> bool:
     """SIGHUP ignored by whoever started the run (``nohup``, a service manager): it stays ignored."""
     return sig == getattr(signal, "SIGHUP", None) and signal.getsignal(sig) == signal.SIG_IGN
+
+
+def detach_hung_up_terminal() -> None:
+    """Point stdin, stdout and stderr that are a terminal hung up (closed: an SSH session dropped) at
+    /dev/null, so that every later message goes nowhere instead of failing.
+
+    Once the kernel has hung the terminal up (before it sends SIGHUP) every write to it fails with EIO: the
+    line of a stopped command (``masonry limit``'s "interrupted: …", ``masonry build``'s note, a study's
+    last progress line) raised there, and the error of the error line made the command exit 1 with a
+    traceback for nobody, where its files were whole (exit 129 said so). A hung-up terminal is told apart by
+    ``tcgetattr`` failing with EIO; a file or pipe (``--json > out.json``) fails with ENOTTY and is kept, so
+    is a live terminal (``kill -HUP``). Safe in a signal handler: no buffered I/O."""
+    import errno
+    import termios
+
+    null = None
+    try:
+        for fd in (0, 1, 2):
+            try:
+                termios.tcgetattr(fd)
+            except termios.error as exc:
+                if exc.args[0] != errno.EIO:
+                    continue
+            except OSError:  # closed, or no such descriptor
+                continue
+            else:
+                continue  # a live terminal
+            if null is None:
+                null = os.open(os.devnull, os.O_RDWR)
+            os.dup2(null, fd)
+    except OSError:
+        pass
+    finally:
+        if null is not None:
+            os.close(null)
 
 
 def already_stopping(signum: int) -> None:

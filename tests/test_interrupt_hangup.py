@@ -123,3 +123,72 @@ def test_a_closed_terminal_keeps_a_study_s_finished_rows(tmp_path):
     assert _hang_up(argv, tmp_path, lambda: journal.exists() and journal.stat().st_size > 0) == 129
     rows = store.read_rows(out)
     assert 1 <= len(rows) < 12 and all(r.get("state") in ("intact", "damaged", "collapsed") for r in rows)
+
+
+def _appears(pattern_folder: Path, pattern: str, after: float = 0.0):
+    """Once a file matching ``pattern`` is in ``pattern_folder``, and ``after`` seconds later."""
+    seen: list[float] = []
+
+    def ready() -> bool:
+        if not seen and any(pattern_folder.glob(pattern)):
+            seen.append(time.monotonic())
+        return bool(seen) and time.monotonic() >= seen[0] + after
+
+    return ready
+
+
+@pytest.mark.slow
+def test_a_closed_terminal_while_build_writes_leaves_the_file_whole(tmp_path):
+    """The terminal closing while 'masonry build' writes a big GeoJSON: the file whole, exit 129. Before, the
+    note saying so failed on the hung-up terminal (EIO) and the command exited 1."""
+    import json
+
+    argv = ["build", "wall", "--blocks", "20000", "--out", "w.geojson"]
+    assert _hang_up(argv, tmp_path, _appears(tmp_path, ".w.geojson.*.part")) == 129
+    assert len(json.loads((tmp_path / "w.geojson").read_text())["features"]) > 20000
+    assert [p.name for p in tmp_path.iterdir()] == ["w.geojson"]
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize(
+    "pattern, after", [(".m.rrd.*.part", 0.0), ("m.rrd", 1.0)], ids=["writing-the-recording", "verify"]
+)
+def test_a_closed_terminal_stops_limit_with_its_recording_whole(tmp_path, pattern, after):
+    """'masonry limit --verify --out' whose terminal closes while the recording is written or while --verify's
+    engine runs: the recording whole, exit 129. Before, its 'interrupted: …' line failed on the hung-up
+    terminal (EIO), and the error line for that failed too: exit 1."""
+    argv = ["limit", "aqueduct", "--verify", "--out", "m.rrd"]
+    assert _hang_up(argv, tmp_path, _appears(tmp_path, pattern, after)) == 129
+    assert frames_in_recording(tmp_path / "m.rrd") >= 1
+    assert [p.name for p in tmp_path.iterdir()] == ["m.rrd"]
+
+
+def test_a_hung_up_terminal_is_replaced_by_dev_null_and_nothing_else(tmp_path):
+    """In a child: stdout a pipe (kept), stderr a terminal whose master is closed (hung up: /dev/null after),
+    stdin a live terminal (kept)."""
+    import pty
+
+    from masonrycli.interrupt import detach_hung_up_terminal
+
+    read_end, write_end = os.pipe()
+    pid = os.fork()
+    if pid == 0:  # pragma: no cover - the child
+        code = 1
+        try:
+            live_master, live_slave = pty.openpty()
+            dead_master, dead_slave = pty.openpty()
+            os.dup2(live_slave, 0)
+            os.dup2(write_end, 1)
+            os.dup2(dead_slave, 2)
+            os.close(dead_master)  # hung up: writes to fd 2 fail with EIO
+            detach_hung_up_terminal()
+            os.write(2, b"goes nowhere\n")
+            os.write(1, b"kept\n")
+            code = 0 if os.isatty(0) and os.path.samestat(os.fstat(2), os.stat(os.devnull)) else 3
+        finally:
+            os._exit(code)
+    os.close(write_end)
+    _, status = os.waitpid(pid, 0)
+    assert os.waitstatus_to_exitcode(status) == 0
+    assert os.read(read_end, 100) == b"kept\n"
+    os.close(read_end)
