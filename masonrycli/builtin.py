@@ -40,7 +40,7 @@ from masonrycli.record_motion import Record, time_step_problem
 from masonrycli.record_text import NoTimeStep, TimeStepNotUsed
 from masonrycli.records import record_motion
 from masonrycli.scenario import MAX_DURATION, Material, RunConfig, Scenario, scenario_from_builder
-from masonrycli.structure import BuilderError, as_options
+from masonrycli.structure import GEOMETRY_SUFFIXES, BuilderError, as_options, build_structure
 from masonrycli.values import option_text
 
 DEFAULT_DURATION = {"wall": 1.0, "arch": 5.0, "aqueduct": 5.0}
@@ -177,7 +177,6 @@ def target_scenario(target: str | os.PathLike, built_in: Callable[[str], Scenari
     one-line :class:`InputError` from every command, naming it."""
     from masonrycli.scenario import scenario_from_geometry_file
     from masonrycli.scenario_toml import load_scenario
-    from masonrycli.structure import GEOMETRY_SUFFIXES
 
     target = os.fspath(target)
     if not target.strip():  # Path("") is the working folder: it said "error: : no such scenario …"
@@ -312,8 +311,6 @@ def build_assembly(name: str, **overrides):
     ``density`` / ``thickness`` (None: not given), built and checked as ``simulate`` builds them
     (:func:`~masonrycli.structure.build_structure`): the same mistake gets the same line (build said
     "wall: block count …" where simulate and sweep said 'builder "wall": block count …')."""
-    from masonrycli.structure import BuilderError, as_options, build_structure
-
     material = Material()
     for key in ("density", "thickness"):
         if overrides.get(key) is not None:

@@ -393,12 +393,11 @@ def run_on_cluster(
             if points is killed:
                 alone.add(future.key)
 
+    def not_made() -> int:  # the runs submitted, waiting, or to run again alone
+        return len(pending) + len(waiting) + len(killed)
+
     submit()
-    watch = (
-        WorkerWatch(client, warn, where, lambda: len(pending) + len(waiting) + len(killed))
-        if warn
-        else contextlib.nullcontext()
-    )
+    watch = WorkerWatch(client, warn, where, not_made) if warn else contextlib.nullcontext()
     with watch:
         while True:
             for future in completed:
@@ -408,8 +407,7 @@ def run_on_cluster(
                 except Exception as exc:  # the task never returned (KilledWorker, a cluster failure)
                     if _scheduler_lost(client, exc):
                         raise SchedulerLost(
-                            f"lost the connection to the scheduler with {len(pending) + len(waiting) + len(killed) + 1} runs "
-                            "pending"
+                            f"lost the connection to the scheduler with {not_made() + 1} runs pending"
                         ) from None
                     if isinstance(exc, KilledWorker) and future.key not in alone:
                         killed.append(params)  # run again alone (above)
