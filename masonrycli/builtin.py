@@ -154,7 +154,7 @@ def with_record(
         raise InputError(
             f"--record: {file} holds no motion (its supports are fixed); shake one in a scenario file: "
             f'[structure] file = "{file}" and a [[support]] name = "{scenario.assembly.supports[0].name}" with '
-            'motion = { kind = "record", file = ... } (docs/scenario-format.md)'
+            'motion = { kind = "record", file = ... } (masonry docs scenario-format)'
         )
     if not any(shaking):
         raise InputError(f"--record: {scenario.name} has no shaking support (give one a sine or record motion)")

@@ -401,6 +401,25 @@ def inspect_command(
         warn(f"{recording}: truncated ({why}) — {info['frames']} frames up to its last complete chunk")
 
 
+@app.command("docs")
+@user_errors
+def docs_command(
+    topic: Annotated[str | None, typer.Argument(help="A page's topic; without one, the list of topics.")] = None,
+    path: Annotated[bool, typer.Option("--path", help="Print the page's file name instead of the page.")] = False,
+) -> None:
+    """List the documentation's topics, or print one page (Markdown) or its file.
+
+    The pages ship with masonry: an install without the clone has them too."""
+    from masonrycli import user_docs
+
+    if topic is None:
+        for line in user_docs.listing():
+            console.print(line, soft_wrap=True)
+        return
+    page = user_docs.find(topic)
+    sys.stdout.write(f"{page.path}\n" if path else page.path.read_text(encoding="utf-8"))
+
+
 def _one_line_summaries(*typer_apps: typer.Typer) -> None:
     # The command lists (masonry --help, masonry simulate --help) showed a docstring with its source line
     # breaks ("run history (the run's" / "parameters, …" on two lines) and run's and check's had a copy to

@@ -221,7 +221,7 @@ STOP = {
         bool,
         typer.Option(
             "--stop-at-collapse",
-            help="End the run once the structure has collapsed (docs/collapse.md).",
+            help="End the run once the structure has collapsed (masonry docs collapse).",
             rich_help_panel="Run",
         ),
     ]

@@ -204,7 +204,7 @@ def run_rows(info: dict) -> list[tuple[str, str]]:
     ]
     rows.append(("bodies", ", ".join(bodies) or NOT_RECORDED))
     if not info["units_recorded"]:
-        rows.append(("units", f"{NOT_RECORDED} in this file (README, 'What a run writes', lists them)"))
+        rows.append(("units", f"{NOT_RECORDED} in this file (masonry docs readme, 'What a run writes', lists them)"))
     return rows
 
 

@@ -89,7 +89,7 @@ def test_record_on_a_geometry_file_says_how_to_shake_it(at2, tmp_path):
     assert words(result.output) == (
         "error: --record: wall.geojson holds no motion (its supports are fixed); shake one in a scenario file: "
         '[structure] file = "wall.geojson" and a [[support]] name = "ground" with motion = { kind = "record", '
-        "file = ... } (docs/scenario-format.md)"
+        "file = ... } (masonry docs scenario-format)"
     )
 
 

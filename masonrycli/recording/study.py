@@ -408,7 +408,7 @@ def _markdown(name: str, rows: list[dict], columns) -> str:
     for r in rows[:500]:
         lines.append("| " + " | ".join(c.cell(r).replace("|", "/") for c in columns) + " |")
     legend = [c.legend for c in columns if c.legend]
-    lines += ["", " · ".join(legend), "", "Every column, in SI units, is in the table file (docs/sweep.md)."]
+    lines += ["", " · ".join(legend), "", "Every column, in SI units, is in the table file (masonry docs sweep)."]
     if len(rows) > 500:
         lines.append(f"The first 500 of {len(rows)} rows.")
     return viewer_safe_text("\n".join(lines))
