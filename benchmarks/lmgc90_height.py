@@ -28,7 +28,7 @@ grow ~35×. This script measures the reference code's own growth on the same wal
   check that the two codes solve the same problem; summaries over the whole run and over the first
   ``--window`` seconds (default 0.3), so that walls run for different durations are compared like with like.
 
-``--budget`` caps the CPU seconds of each LMGC90 wall run: past it the run stops after the current step and
+``--budget`` (or a third field of ``--walls``, ``h64:0.3:1400``) caps the CPU seconds of each LMGC90 wall run: past it the run stops after the current step and
 our engine runs over the same steps. ``--codes lmgc,ours`` chooses what runs; one JSON document goes to stdout (and to ``--out``, per-step
 arrays included), progress to stderr. Figures: benchmarks/LMGC90.md, "Height series".
 """
@@ -226,7 +226,11 @@ def growth(doc: dict, window_s: float) -> dict:
 
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("--walls", default="h8:1.0,h16:1.0,h32:0.4,h64:0.3", help="name:duration, … (h8 h16 h32 h64)")
+    ap.add_argument(
+        "--walls",
+        default="h8:1.0,h16:1.0,h32:0.4,h64:0.3",
+        help="name:duration[:budget], … (h8 h16 h32 h64; budget: CPU s, default --budget)",
+    )
     ap.add_argument("--codes", default="lmgc,ours")
     ap.add_argument("--budget", type=float, default=1e9, help="CPU s: LMGC90 stops a wall's run past it")
     ap.add_argument("--cap", type=int, default=20000, help="LMGC90's iteration cap per step")
@@ -238,10 +242,10 @@ def main(argv=None):
     args = ap.parse_args(argv)
     walls = []
     for item in args.walls.split(","):
-        name, _, dur = item.partition(":")
-        if name not in ("h8", "h16", "h32", "h64") or not dur:
-            ap.error(f"--walls: {item!r} is not hN:seconds with N in 8, 16, 32, 64")
-        walls.append((name, int(name[1:]), float(dur)))
+        name, dur, *budget = item.split(":")
+        if name not in ("h8", "h16", "h32", "h64") or not dur or len(budget) > 1:
+            ap.error(f"--walls: {item!r} is not hN:seconds[:budget] with N in 8, 16, 32, 64")
+        walls.append((name, int(name[1:]), float(dur), float(budget[0]) if budget else args.budget))
     codes = args.codes.split(",")
     config = dict(CONFIGS["matched-check1"], tol=args.tol, gs_it2=args.cap)
 
@@ -260,10 +264,10 @@ def main(argv=None):
         if not lmgc.patchable:
             sys.exit(f"LMGC90's settings cannot be patched: {lmgc.why_not}")
         doc["results"]["lmgc90"] = {}
-    for name, courses, duration in walls:
+    for name, courses, duration, budget in walls:
         if "lmgc" in codes:
-            log(f"lmgc90 {name}, {duration} s, tol {args.tol:g}, cap {args.cap}")
-            run = run_lmgc(lmgc, courses, duration, config, args.budget)
+            log(f"lmgc90 {name}, {duration} s, tol {args.tol:g}, cap {args.cap}, budget {budget:g} s")
+            run = run_lmgc(lmgc, courses, duration, config, budget)
             duration = run["duration_s"]  # ours over the same steps
             run["summary"] = summarise(run, args.window)
             doc["results"]["lmgc90"][name] = run
@@ -279,6 +283,8 @@ def main(argv=None):
                 else:
                     log(f"ours {solver} {name}: {run['error']}\n{run['stderr_tail']}")
                 doc["results"].setdefault(f"ours {solver}", {})[name] = run
+        if args.out:  # after each wall: a late failure keeps the walls done
+            args.out.write_text(json.dumps(doc) + "\n")
     doc["growth"] = growth(doc, args.window)
     doc["loadavg_at_end"] = list(os.getloadavg())
     if args.out:
