@@ -124,7 +124,7 @@ def check_record_dt(record_dt: float | None) -> float | None:
 
 
 def record_motion_option(path: Path, scale: float | None, record_dt: float | None = None) -> Record:
-    """The ground motion of a ``--record`` file (.AT2 or CSV), multiplied by ``scale``; ``record_dt``: the
+    """The ground motion of a ``--record`` file (.AT2, ESM .ASC or CSV), multiplied by ``scale``; ``record_dt``: the
     spacing of a one-column CSV's samples, s."""
     check_record_dt(record_dt)
     try:

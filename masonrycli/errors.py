@@ -70,12 +70,13 @@ FILE_KINDS = {  # suffix: (what a file of it is, what to do with it), for an inp
     ".wkt": ("a geometry file (WKT)", "masonry run runs it"),
     ".csv": ("a CSV table", "a record goes in --record or a scenario's record motion"),
     ".at2": ("an earthquake record (.AT2)", "a record goes in --record or a scenario's record motion"),
+    ".asc": ("an earthquake record (ESM .ASC)", "a record goes in --record or a scenario's record motion"),
 }
 """Reading a recording as a scenario said "not a UTF-8 text file (byte 31)", a GeoJSON as a record
 "wall.geojson:2: not a number": the input's name says what it is."""
 
 
-TEXT_SUFFIXES = frozenset({".toml", ".geojson", ".json", ".wkt", ".csv", ".at2"})
+TEXT_SUFFIXES = frozenset({".toml", ".geojson", ".json", ".wkt", ".csv", ".at2", ".asc"})
 """Suffixes of text files: a binary file under one was named "a scenario file (TOML)" by inspect and --record."""
 BINARY_FILE = "not a text file (it holds NUL bytes: a binary file)"
 """What a binary file read as text is called (no encoding makes it text: saving it "as UTF-8" is no advice)."""

@@ -1,9 +1,11 @@
 """Reading ground-motion records from files into :class:`~masonrycli.record_motion.Record` motions.
 
-Two formats, chosen by the file's extension:
+Three formats, chosen by the file's extension:
 
 * ``.AT2`` (PEER NGA): acceleration in g, one component per file, a 4-line header whose last line
   gives ``NPTS`` and ``DT`` (see :func:`load_at2`); samples at t = 0, DT, 2 DT, ...
+* ``.ASC`` (ESM / ITACA): ``KEY: value`` header lines giving ``SAMPLING_INTERVAL_S``, ``NDATA`` and
+  ``UNITS`` (acceleration in cm/s², or velocity), then one sample a line (:mod:`masonrycli.record_esm`);
 * ``.VT2`` / ``.DT2`` (PEER's velocity and displacement series) are refused, naming the .AT2;
 * anything else is CSV: one sample per line, ``time,value`` or ``time,x,y``, or one ``value`` per line
   given a time step (samples at t = 0, dt, 2 dt, ...; see :func:`load_record_csv`).
@@ -31,6 +33,7 @@ from masonrycli.errors import (
     not_utf8,
     special_file,
 )
+from masonrycli.record_esm import esm_text, esm_vertical, is_esm, looks_like_esm
 from masonrycli.record_motion import Record, time_step_problem
 from masonrycli.record_text import NoTimeStep, TimeStepNotUsed, at2_text, csv_text, number
 from masonrycli.record_units import check_at2_header, check_csv_header, header_quantity, record_text
@@ -58,10 +61,16 @@ def load_record_csv(path, display: str | None = None, time_step: float | None = 
         return csv_text(text, name, time_step)
     except InputError:
         lines, _ = _head(text, 4)  # a PEER record saved as .txt said 'q.txt:2: not a number: "SYNTH"'
+        stem = os.path.splitext(os.path.basename(os.fspath(path)))[0]
         if len(lines) == 4 and (_AT2_NEW.search(lines[3]) or _AT2_OLD.search(lines[3])):
             raise InputError(
                 f"{name}: a PEER .AT2 record (its line 4 gives NPTS and DT) read as a CSV: the file's suffix "
-                f"chooses the format, name it {os.path.splitext(os.path.basename(os.fspath(path)))[0]}.AT2"
+                f"chooses the format, name it {stem}.AT2"
+            ) from None
+        if looks_like_esm(_head(text, 80)[0]):
+            raise InputError(
+                f"{name}: an ESM record (its header gives SAMPLING_INTERVAL_S and NDATA) read as a CSV: the "
+                f"file's suffix chooses the format, name it {stem}.ASC"
             ) from None
         raise
 
@@ -149,6 +158,13 @@ def is_at2(path) -> bool:
     return os.fspath(path).lower().endswith(".at2")
 
 
+def load_esm(path, display: str | None = None) -> tuple[float, np.ndarray, str]:
+    """Read an ESM / ITACA ``.ASC`` file: ``(dt s, samples in m/s² or m/s, quantity)``
+    (:func:`masonrycli.record_esm.esm_text`)."""
+    name = display if display is not None else str(path)
+    return esm_text(_read_text(path, name), name)
+
+
 _PEER_OTHER = {".vt2": "velocity (.VT2, cm/s)", ".dt2": "displacement (.DT2, cm)"}
 """PEER's other series of a component. Read as CSV they failed on their header's second line (`not a
 number: "Imperial Valley..."`), which said nothing of the format."""
@@ -156,9 +172,16 @@ number: "Imperial Valley..."`), which said nothing of the format."""
 
 def vertical_at2(path) -> bool:
     """An .AT2 file of a vertical component: PEER's file name ends in UP or DWN (RSN6_IMPVALL.I_I-ELCUP.AT2)
-    or its header's second line ends with the component ("…, EL CENTRO ARRAY #6, UP")."""
+    or its header's second line ends with the component ("…, EL CENTRO ARRAY #6, UP"); an ESM .ASC file
+    whose header says ``COMPONENT: Z`` (or a channel ``HNZ``)."""
     path = os.fspath(path)
     stem, suffix = os.path.splitext(os.path.basename(path))
+    if is_esm(path):
+        try:
+            with open(path, encoding="utf-8", errors="replace") as fh:
+                return esm_vertical([fh.readline() for _ in range(80)])
+        except OSError:
+            return False
     if suffix.lower() != ".at2":
         return False
     if stem.upper().endswith(("UP", "DWN")):
@@ -182,14 +205,18 @@ def check_not_peer_other(path, name: str) -> None:
         )
 
 
+RECORD_FILE = "a ground-motion record (a PEER .AT2 file, an ESM .ASC file or a CSV)"
+
+
 def read_record(path, display: str | None = None, time_step: float | None = None) -> tuple:
     """``(time (n,) s, value (n,) or (n, 2), quantity)`` of a record file: an .AT2 file gives its
-    acceleration in m/s² and quantity ``"acceleration"``; a CSV file gives its columns as they are and
-    quantity None (the caller says what the values are). ``time_step``: the CSV holds one value per
-    line at that spacing (s); an .AT2 file has its own (its header's DT) and is refused with one."""
+    acceleration in m/s² and quantity ``"acceleration"``, an ESM .ASC file its series in SI and its quantity;
+    a CSV file gives its columns as they are and quantity None (the caller says what the values are).
+    ``time_step``: the CSV holds one value per line at that spacing (s); an .AT2 or .ASC file has its own
+    (its header's DT, SAMPLING_INTERVAL_S) and is refused with one."""
     name = display if display is not None else str(path)
     check_not_peer_other(path, name)
-    other = file_kind(path, "a ground-motion record (a PEER .AT2 file or a CSV)", (".csv", ".at2"), name)
+    other = file_kind(path, RECORD_FILE, (".csv", ".at2", ".asc"), name)
     if other is not None and os.path.isfile(path):  # a missing one: the reader says so
         raise other
     if is_at2(path):
@@ -200,6 +227,15 @@ def read_record(path, display: str | None = None, time_step: float | None = None
             )
         dt, acc = load_at2(path, display)
         return np.arange(acc.size) * dt, acc * G_STANDARD, "acceleration"
+    if is_esm(path):
+        if time_step is not None:
+            raise TimeStepNotUsed(
+                display or str(path),
+                "an ESM .ASC file gives its own time step (SAMPLING_INTERVAL_S in its header): {key} goes with "
+                "a CSV of one value per line",
+            )
+        dt, samples, quantity = load_esm(path, display)
+        return np.arange(samples.size) * dt, samples, quantity
     time, value = load_record_csv(path, display, time_step)
     return time, value, None
 
@@ -227,7 +263,7 @@ def record_motion(
     display: str | None = None,
     time_step: float | None = None,
 ) -> Record:
-    """A :class:`~masonrycli.record_motion.Record` from a record file (.AT2 or CSV, see :func:`read_record`).
+    """A :class:`~masonrycli.record_motion.Record` from a record file (.AT2, .ASC or CSV, see :func:`read_record`).
 
     ``quantity`` defaults to "acceleration" for .AT2 files (the only one they hold) and, for CSV, to the
     quantity its header names (:func:`~masonrycli.record_units.header_quantity`), else "velocity". ``vertical`` is the file of the vertical component (the record then acts along x and y and
@@ -237,7 +273,8 @@ def record_motion(
     time_step = _time_step(time_step, "time_step")
     time, value, native = read_record(path, display, time_step)
     if native is not None and quantity not in (None, native):
-        raise InputError(f"{display or path}: an .AT2 file holds acceleration, not {quantity}")
+        kind = "an .AT2 file" if is_at2(path) else "this ESM file"
+        raise InputError(f"{display or path}: {kind} holds {native}, not {quantity}")
     quantity = quantity or native or header_quantity(path) or "velocity"  # a CSV: as its header says, else m/s
     if native is None:
         check_csv_header(path, display or str(path), quantity, scale)

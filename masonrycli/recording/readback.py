@@ -109,6 +109,7 @@ _OTHER_FILES = {  # suffix: what masonry writes or reads under it, for a file th
     ".csv": "a table (.csv)",
     ".png": "an image (.png)",
     ".at2": "a ground-motion record (PEER .AT2; simulate and run take it with --record)",
+    ".asc": "a ground-motion record (ESM .ASC; simulate and run take it with --record)",
 }
 
 

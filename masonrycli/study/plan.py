@@ -269,7 +269,7 @@ def _record_duration(scenario, motions: dict, whole: bool):
 
 
 def _records(entries: list[Path], out: Path, record_dt: float | None) -> tuple[dict, list[str]]:
-    """``(record motions by file name, warnings)``, from files and the .AT2 / .csv files of folders (but the
+    """``(record motions by file name, warnings)``, from files and the .AT2 / .ASC / .csv files of folders (but the
     study's table ``out``: kept in its records' folder, it was read as a record by the same command run again,
     "recs/ida.csv:2: not a number", so the study could not be resumed). ``record_dt`` (--record-dt, s):
     the spacing of the samples of the CSVs of one value per line; refused when no file is one. A folder's
@@ -288,7 +288,7 @@ def _records(entries: list[Path], out: Path, record_dt: float | None) -> tuple[d
                     raise InputError(said)
                 unread.append(said)
             if not found:
-                raise InputError(f"--records {entry}: no .AT2 or .csv record in it")
+                raise InputError(f"--records {entry}: no .AT2, .ASC or .csv record in it")
             files += found
         elif entry.is_file():
             files.append(entry)
@@ -304,7 +304,7 @@ def _records(entries: list[Path], out: Path, record_dt: float | None) -> tuple[d
         names = ", ".join(upright[:3]) + (" …" if len(upright) > 3 else "")
         unread.append(
             f"--records: {names} {'are vertical components' if len(upright) > 1 else 'is a vertical component'} "
-            "(PEER's UP / DWN), run along x as the others: leave them out of the set (a scenario file's "
+            "(PEER's UP / DWN, ESM's Z), run along x as the others: leave them out of the set (a scenario file's "
             "vertical = … applies one with its horizontal)"
         )
     if record_dt is not None and all(m.time_step is None for m in motions.values()):
@@ -317,7 +317,7 @@ def _records(entries: list[Path], out: Path, record_dt: float | None) -> tuple[d
 
 
 def _is_record_file(path: Path) -> bool:
-    return path.suffix.lower() in (".at2", ".csv") and path.is_file()
+    return path.suffix.lower() in (".at2", ".asc", ".csv") and path.is_file()
 
 
 def _record(path: Path, record_dt: float | None):

@@ -1,0 +1,162 @@
+"""ESM / ITACA ASCII records (``….ACC.ASC``): the reader's header keys and units against a hand-made file
+(tests/data/esm_acc.ASC: an ESM header, then a(t) = 100 sin(2π·2·t) cm/s² every 5 ms, 200 samples), errors
+naming file and line, and the file through ``check``, ``run``'s ``--record`` and a ``sweep --records`` folder."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from masonrycli.errors import InputError, RecordWarning
+from masonrycli.records import load_esm, record_motion
+from masonrycli.study.store import read_rows
+
+from cli_helpers import assert_one_line_error, invoke, words
+
+DATA = Path(__file__).parent / "data"
+ESM = DATA / "esm_acc.ASC"
+BLOCK = DATA / "block_on_ground.toml"  # a block on a sine-shaken ground, 1 s
+FIRST_SAMPLE_LINE = 61  # the header's 60 lines, then the samples
+
+
+def _edited(tmp_path: Path, old: str, new: str, name: str = "q.ASC") -> Path:
+    text = ESM.read_text()
+    assert old in text
+    path = tmp_path / name
+    path.write_text(text.replace(old, new, 1))
+    return path
+
+
+def test_the_reader_takes_interval_count_and_cm_s2_from_the_header():
+    dt, values, quantity = load_esm(ESM)
+    t = np.arange(200) * 0.005
+    assert dt == 0.005 and quantity == "acceleration" and values.shape == (200,)
+    # cm/s² -> m/s²: the file's 7 significant digits of 100 sin(2π·2·t) (within 5e-5 cm/s²), times 0.01
+    np.testing.assert_allclose(values, np.sin(2 * np.pi * 2 * t), rtol=0, atol=6e-7)
+
+
+def test_the_record_integrates_to_the_velocity_of_its_sine():
+    # a(t) = A sin(ωt) from rest integrates to v(t) = (A/ω)(1 - cos ωt): at the samples the trapezoid rule's
+    # error is (ω dt)²/12 of the amplitude, 0.08 % at 2 Hz and 5 ms
+    m = record_motion(ESM, baseline="none")
+    omega = 2 * np.pi * 2
+    t = np.arange(199) * 0.005
+    v = m.velocity_at(t)[:, 0]
+    np.testing.assert_allclose(v, (1 - np.cos(omega * t)) / omega, rtol=0, atol=2e-3 * (2 / omega))
+    assert m.quantity == "acceleration" and m.source == str(ESM.resolve())
+
+
+def test_a_velocity_file_is_read_as_velocity_in_m_s(tmp_path):
+    path = _edited(tmp_path, "UNITS: cm/s^2", "UNITS: cm/s")
+    path.write_text(path.read_text().replace("DATA_TYPE: ACCELERATION", "DATA_TYPE: VELOCITY"))
+    m = record_motion(path)
+    assert m.quantity == "velocity"
+    assert m.value[50] == pytest.approx(0.01 * 100 * math.sin(2 * math.pi * 2 * 50 * 0.005), abs=1e-8)
+
+
+@pytest.mark.parametrize(
+    ("old", "new", "message"),
+    [
+        (
+            "UNITS: cm/s^2",
+            "UNITS: cm",
+            "q.ASC:35: UNITS: cm: a displacement series: give the same component's acceleration",
+        ),
+        (
+            "DATA_TYPE: ACCELERATION",
+            "DATA_TYPE: DISPLACEMENT",
+            'q.ASC:52: DATA_TYPE: "DISPLACEMENT": a displacement series',
+        ),
+        (
+            "DATA_TYPE: ACCELERATION",
+            "DATA_TYPE: ACCELERATION RESPONSE SPECTRUM",
+            'q.ASC:52: DATA_TYPE: "ACCELERATION RESPONSE SPECTRUM": not an acceleration or velocity time series',
+        ),
+        ("UNITS: cm/s^2", "UNITS: counts", 'q.ASC:35: UNITS: "counts": not a unit masonry reads'),
+        (
+            "UNITS: cm/s^2",
+            "UNITS: cm/s",
+            "q.ASC:35: UNITS: cm/s is velocity, but DATA_TYPE (line 52) says ACCELERATION",
+        ),
+        (
+            "SAMPLING_INTERVAL_S: 0.005000",
+            "SAMPLING_INTERVAL: 0.005",
+            "q.ASC: not an ESM record: its header has no SAMPLING_INTERVAL_S",
+        ),
+        (
+            "SAMPLING_INTERVAL_S: 0.005000",
+            "SAMPLING_INTERVAL_S: 5",
+            'q.ASC:29: SAMPLING_INTERVAL_S = "5": must be within',
+        ),
+        ("SAMPLING_INTERVAL_S: 0.005000", "SAMPLING_INTERVAL_S: 5 ms", "q.ASC:29: SAMPLING_INTERVAL_S: not a number"),
+        ("NDATA: 200", "NDATA: 300", "q.ASC: header says NDATA = 300 but the file holds 200 samples"),
+        ("NDATA: 200", "NDATA: two hundred", "q.ASC:30: NDATA: not a whole number"),
+        ("6.279052e+00\n", "6.279052e+00\n1.2O3e+01\n", f'q.ASC:{FIRST_SAMPLE_LINE + 2}: not a number: "1.2O3e+01"'),
+        ("6.279052e+00\n", "6.279052e+00\nnan\n", f"q.ASC:{FIRST_SAMPLE_LINE + 2}: values must be finite"),
+    ],
+)
+def test_errors_name_the_file_the_line_and_the_key(tmp_path, old, new, message):
+    path = _edited(tmp_path, old, new)
+    with pytest.raises(InputError) as info:
+        load_esm(path, display="q.ASC")
+    assert message in str(info.value) and "\n" not in str(info.value)
+
+
+def test_more_samples_than_ndata_keeps_ndata_with_a_warning(tmp_path):
+    path = _edited(tmp_path, "NDATA: 200", "NDATA: 150")
+    with pytest.warns(RecordWarning, match="NDATA = 150 but the file holds 200 samples; the 50 after"):
+        dt, values, _ = load_esm(path)
+    assert values.size == 150
+
+
+def test_check_and_run_take_an_esm_file_as_record(tmp_path):
+    # before: 'esm_acc.ASC:2: not a number: "EVENT_ID:"' (read as a CSV), exit 2
+    result = invoke("check", BLOCK, "--record", ESM)
+    assert result.exit_code == 0, result.output
+    assert "record of acceleration (esm_acc.ASC, 200 samples" in words(result.output)
+    result = invoke("run", BLOCK, "--record", ESM, "--scale", 2, "--duration", 0.5, "--no-recording")
+    assert result.exit_code == 0, result.output
+    assert "completed" in result.output and "ground motion (ground) │ PGA" in words(result.output)
+
+
+def test_an_esm_file_refuses_a_time_step_and_is_named_under_another_suffix(tmp_path):
+    result = invoke("check", BLOCK, "--record", ESM, "--record-dt", 0.01)
+    assert_one_line_error(result, "esm_acc.ASC", "an ESM .ASC file gives its own time step", "--record-dt")
+    renamed = tmp_path / "norcia.txt"
+    renamed.write_text(ESM.read_text())
+    result = invoke("check", BLOCK, "--record", renamed)
+    assert_one_line_error(result, "norcia.txt: an ESM record", "name it norcia.ASC")
+
+
+def test_a_vertical_component_shaking_horizontally_is_warned(tmp_path):
+    path = _edited(tmp_path, "CHANNEL: HNE", "CHANNEL: HNZ", name="IT.NRC..HNZ.D.ACC.ASC")
+    path.write_text(path.read_text().replace("COMPONENT: E", "COMPONENT: Z"))
+    result = invoke("check", BLOCK, "--record", path)
+    assert result.exit_code == 0, result.output
+    assert "IT.NRC..HNZ.D.ACC.ASC is a vertical component" in words(result.output)
+
+
+def test_a_records_folder_sweeps_its_esm_files(tmp_path):
+    # before: the .ASC file of the folder was left out without a word (1 row, the CSV's)
+    folder = tmp_path / "recs"
+    folder.mkdir()
+    (folder / "IT.NRC..HNE.D.20161030.064017.C.ACC.ASC").write_text(ESM.read_text())
+    # the same samples in m/s², with their times
+    _, acc, _ = load_esm(ESM)
+    (folder / "same.csv").write_text(
+        "time (s),acc (m/s2)\n" + "".join(f"{i * 0.005!r},{float(a)!r}\n" for i, a in enumerate(acc))
+    )
+    out = tmp_path / "s.csv"
+    result = invoke(
+        "sweep", BLOCK, "--records", folder, "--scale", 1, "--duration", 0.5, "--workers", 0, "--out", out,
+        "--no-recording",
+    )  # fmt: skip
+    assert result.exit_code == 0, result.output
+    rows = {r["record"]: r for r in read_rows(out)}
+    assert sorted(rows) == ["IT.NRC..HNE.D.20161030.064017.C.ACC.ASC", "same.csv"]
+    esm, csv = rows["IT.NRC..HNE.D.20161030.064017.C.ACC.ASC"], rows["same.csv"]
+    for column in ("state", "pga", "pgv", "arias", "energy_dissipated", "peak_drift"):
+        assert repr(esm[column]) == repr(csv[column]), column  # the same record, read from either file
