@@ -144,6 +144,25 @@ def header_quantity(path) -> str | None:
     return "acceleration" if says_acc and not says_vel else "velocity" if says_vel and not says_acc else None
 
 
+_G = 9.80665
+"""m/s² per g, exact (records.G_STANDARD): the factor a header's g converts by (9.81 is the message's round figure)."""
+
+
+def header_factor(path, quantity: str) -> tuple[str, float] | None:
+    """``(unit, factor to SI)`` when the header of the CSV record at ``path`` gives ``quantity`` in a unit that
+    needs one (g, gal, cm/s², cm/s, mm/s, in/s, …), else None. How a ``sweep --records`` set reads such a file:
+    it has no scale of its own there (``--scale`` is the study's axis), so a record in g could not be swept at
+    all — refused, told "a scale of 9.81 converts them", which the set had no way to give."""
+    found = csv_header(path)
+    unit = _SCALED_UNIT.search(found[1]) if found else None
+    if unit is None:
+        return None
+    kind, factor = _SCALED[unit.group(1).lower()]
+    if kind != quantity:
+        return None
+    return unit.group(1), _G if unit.group(1).lower() == "g" else factor
+
+
 def check_csv_header(path, name: str, quantity, scale) -> None:
     """Raise :class:`InputError` if the header of the CSV record at ``path`` names units that disagree
     with reading it as ``quantity`` ("velocity" m/s or "acceleration" m/s²) times ``scale``, or gives

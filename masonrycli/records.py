@@ -36,7 +36,7 @@ from masonrycli.errors import (
 from masonrycli.record_esm import esm_text, esm_vertical, is_esm, looks_like_esm
 from masonrycli.record_motion import Record, time_step_problem
 from masonrycli.record_text import NoTimeStep, TimeStepNotUsed, at2_text, csv_text, number
-from masonrycli.record_units import check_at2_header, check_csv_header, header_quantity, record_text
+from masonrycli.record_units import check_at2_header, check_csv_header, header_factor, header_quantity, record_text
 from masonrycli.values import format_value, quote_string, shorten
 
 
@@ -262,13 +262,17 @@ def record_motion(
     baseline: str = "quadratic",
     display: str | None = None,
     time_step: float | None = None,
+    header_units: bool = False,
 ) -> Record:
     """A :class:`~masonrycli.record_motion.Record` from a record file (.AT2, .ASC or CSV, see :func:`read_record`).
 
     ``quantity`` defaults to "acceleration" for .AT2 files (the only one they hold) and, for CSV, to the
     quantity its header names (:func:`~masonrycli.record_units.header_quantity`), else "velocity". ``vertical`` is the file of the vertical component (the record then acts along x and y and
     ``direction`` is not used). ``source`` is the absolute path of the file. ``time_step`` (s): the
-    files hold one value per line at that spacing (checked before they are read).
+    files hold one value per line at that spacing (checked before they are read). ``header_units``: a CSV
+    whose header gives its unit (``acc (g)``, ``vel (cm/s)``) is converted by it to SI, ``scale`` then
+    multiplying the record as recorded, as an .AT2 file's g (a ``sweep --records`` set, whose scale is the
+    study's axis); without it such a file needs ``scale`` to be the conversion.
     """
     time_step = _time_step(time_step, "time_step")
     time, value, native = read_record(path, display, time_step)
@@ -277,7 +281,10 @@ def record_motion(
         raise InputError(f"{display or path}: {kind} holds {native}, not {quantity}")
     quantity = quantity or native or header_quantity(path) or "velocity"  # a CSV: as its header says, else m/s
     if native is None:
-        check_csv_header(path, display or str(path), quantity, scale)
+        unit = header_factor(path, quantity) if header_units else None
+        if unit is not None:
+            value = value * unit[1]
+        check_csv_header(path, display or str(path), quantity, scale if unit is None else unit[1])
     vertical_source = ""
     if vertical is not None:
         vtime, vvalue, vnative = read_record(vertical, time_step=time_step)

@@ -67,3 +67,33 @@ def test_a_set_of_csv_accelerograms_is_swept(tmp_path):
     assert {r["status"] for r in rows.values()} == {"completed"}
     assert rows[2.0]["pga"] == pytest.approx(2 * rows[1.0]["pga"], rel=1e-9)
     assert rows[1.0]["pga"] == pytest.approx(np.abs(a).max(), rel=0.05)  # the record's samples, baseline-corrected
+
+
+def test_a_csv_whose_header_gives_g_is_swept_in_g(tmp_path):
+    # a set has no scale per file (--scale is the axis): 'acc (g)' was refused, "a scale of 9.81 converts them",
+    # which the set could not give. Now it reads as an .AT2 file's g: the rows of the same samples in m/s².
+    t = (np.arange(41) * 0.005).tolist()
+    a_g = (0.3 * np.sin(2 * np.pi * 5 * np.array(t))).tolist()
+    folder = tmp_path / "records"
+    folder.mkdir()
+    (folder / "in_g.csv").write_text("time (s),acc (g)\n" + "".join(f"{x!r},{y!r}\n" for x, y in zip(t, a_g)))
+    si = "time (s),acc (m/s2)\n" + "".join(f"{x!r},{y * 9.80665!r}\n" for x, y in zip(t, a_g))
+    (folder / "in_si.csv").write_text(si)
+    (folder / "in_gal.csv").write_text(
+        "time (s),acc (gal)\n" + "".join(f"{x!r},{y * 980.665!r}\n" for x, y in zip(t, a_g))
+    )
+    out = tmp_path / "s.csv"
+    args = ["sweep", BLOCK, "--records", folder, "--duration", 0.2, "--out", out, "--no-recording", "--workers", 0]
+    result = invoke(*args, "--scale", "1,2")
+    assert result.exit_code == 0, result.output
+    rows = {(r["record"], r["scale"]): r for r in read_rows(out)}
+    same = [c for c in RESULT_COLUMNS if c not in ("wall_time", "cpu_time")]
+    for scale in (1.0, 2.0):
+        g, ref = rows["in_g.csv", scale], rows["in_si.csv", scale]
+        assert [repr(g[c]) for c in same] == [repr(ref[c]) for c in same], scale
+        assert rows["in_gal.csv", scale]["pga"] == pytest.approx(ref["pga"], rel=1e-12)
+    # the advice --record gives such a file, a scale of 9.81, would convert it twice: said
+    result = invoke(*args, "--scale", "1,9.81", "--force")
+    assert "--records: in_g.csv is read in g, as its header says, and converted to SI already; --scale 9.81" in words(
+        result.output
+    )

@@ -211,6 +211,23 @@ def _set_warnings(base: StudyBase, axes: list[Axis]) -> list[str]:
             run = dataclasses.replace(scenario.run, duration=max(scenario.run.duration, longest))  # not its length
             shown = record_warnings(dataclasses.replace(scenario, run=run), upright=False)  # the set names those
             said += [w for w in shown if w not in said]
+    return said + _converted_twice(base.records, scales)
+
+
+def _converted_twice(records: dict, scales: list[float]) -> list[str]:
+    """A scale that is the conversion of a CSV the set reads in its header's unit (``acc (g)`` at ``--scale
+    9.81``, the advice ``--record`` gives such a file): converted twice, 9.81 times too strong."""
+    from masonrycli.record_units import header_factor
+
+    said = []
+    for name, m in records.items():
+        unit = header_factor(m.source, m.quantity) if m.source.lower().endswith(".csv") else None
+        twice = [s for s in scales if unit and abs(abs(s) / unit[1] - 1) < 0.02]
+        if twice:
+            said.append(
+                f"--records: {name} is read in {unit[0]}, as its header says, and converted to SI already; "
+                f"--scale {twice[0]:g} converts it again (the scale multiplies the record, 1 is as recorded)"
+            )
     return said
 
 
@@ -324,16 +341,17 @@ def _record(path: Path, record_dt: float | None):
     """The motion of one file of a record set: a CSV of one value per line with its samples ``record_dt``
     apart, any other file with its own times (a mixed set: the time step is for its one-column files).
     The file's first sample says which: read without a time step, a one-column file is refused there,
-    before the rest of it is parsed, and read again with the time step."""
+    before the rest of it is parsed, and read again with the time step. A CSV whose header gives its unit
+    (g, gal, cm/s², cm/s, …) is read in it, converted to SI: a set has no scale of its own per file."""
     from masonrycli.record_text import NoTimeStep
     from masonrycli.records import record_motion
 
     try:
-        return record_motion(path, display=str(path))
+        return record_motion(path, display=str(path), header_units=True)
     except NoTimeStep as exc:
         if record_dt is None:
             raise exc.give("--record-dt SECONDS") from None
-        return record_motion(path, display=str(path), time_step=record_dt)
+        return record_motion(path, display=str(path), time_step=record_dt, header_units=True)
 
 
 def _same_file(a, b) -> bool:
