@@ -24,10 +24,15 @@ from masonrycli.recording import screenshot_recording
 SHOTS = {  # recording -> (instant s, image stem, tabs to keep: tab index -> suffix)
     "wall51": (0.1, "wall51-t0.1", {1: "fig-III.2", 2: "fig-III.3", 3: "fig-III.4", 4: "fig-III.5"}),
     "wall248": (0.1, "wall248-t0.1", {1: "fig-III.2", 2: "fig-III.3", 3: "fig-III.4", 4: "fig-III.5"}),
-    "arch": (5.0, "arch-t5", {1: "fig-III.7", 2: "fig-III.8", 3: "fig-III.9", 4: "fig-III.10", 9: "magnified"}),
-    "aqueduct": (5.0, "aqueduct-t5", {1: "fig-III.7", 2: "fig-III.8", 3: "fig-III.9", 4: "fig-III.10", 9: "magnified"}),
-    # a 1 s run has no paper-figure tabs: tab 1 is the live volumetric strain rate, 5 the magnified shape
-    "aqueduct-shaken": (1.0, "aqueduct-shaken-t1", {1: "volumetric-strain-rate", 5: "magnified"}),
+    "arch": (5.0, "arch-t5", {1: "fig-III.7", 2: "fig-III.8", 3: "fig-III.9", 4: "fig-III.10", 10: "magnified"}),
+    "aqueduct": (
+        5.0,
+        "aqueduct-t5",
+        {1: "fig-III.7", 2: "fig-III.8", 3: "fig-III.9", 4: "fig-III.10", 10: "magnified"},
+    ),
+    # a 1 s run has no paper-figure tabs: tab 1 is the live volumetric strain rate, 6 the magnified shape
+    # (after Stress p, p √ and Stress q)
+    "aqueduct-shaken": (1.0, "aqueduct-shaken-t1", {1: "volumetric-strain-rate", 6: "magnified"}),
 }
 STRUCTURE_PANEL = (
     0,

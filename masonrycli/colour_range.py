@@ -44,6 +44,7 @@ import numpy as np
 from masonrycli.colormap import nice_ceil
 
 ScaleKind = Literal["negative", "positive", "signed"]
+Scale = Literal["linear", "sqrt"]
 
 OUTSIDE_SHARE: Final = 0.02
 """Largest share of a frame's defined cells allowed outside the logged range."""
@@ -71,9 +72,12 @@ class ColourRange:
         """
         return positions(self.kind, values, self.lo, self.hi)
 
-    def ticks(self, count: int = 5) -> np.ndarray:
-        """``count`` (odd) tick values at evenly spaced colour positions, lo first; zero is one of them."""
+    def ticks(self, count: int = 5, scale: Scale = "linear") -> np.ndarray:
+        """``count`` (odd) tick values at evenly spaced colour positions on ``scale``, lo first; zero is one
+        of them (on the square-root scale the ticks of [−800, 0] kPa are −800, −450, −200, −50, 0)."""
         t = np.linspace(0.0, 1.0, count)
+        if scale == "sqrt":
+            t = sqrt_scale(self.kind, t, inverse=True)
         if self.kind == "signed":
             return np.where(t < 0.5, self.lo * (1.0 - 2.0 * t), self.hi * (2.0 * t - 1.0))
         return self.lo + t * (self.hi - self.lo)
@@ -117,6 +121,27 @@ def positions(kind: ScaleKind, values: np.ndarray, lo, hi) -> np.ndarray:
         with np.errstate(invalid="ignore"):
             return np.where(v < 0.0, 0.5 - 0.5 * v / lo, 0.5 + 0.5 * v / hi)
     return (v - lo) / (hi - lo)
+
+
+def _zero_position(kind: ScaleKind) -> tuple[float, float]:
+    """(the colour position of zero, the length of the map on one side of it) for a ``kind`` of scale."""
+    return {"negative": (1.0, 1.0), "positive": (0.0, 1.0), "signed": (0.5, 0.5)}[kind]
+
+
+def sqrt_scale(kind: ScaleKind, position: np.ndarray, inverse: bool = False) -> np.ndarray:
+    """Linear colour positions (:func:`positions`) → positions on the signed square-root scale, where a value
+    sits at √(|value| / |range end on its side|) of the map from zero, towards that end; ``inverse``: back.
+
+    Zero stays where it is (white on the blues, grey in the middle of the diverging map) and the ends stay
+    the range's ends; a value beyond an end stays beyond it (below 0 or above 1), NaN stays NaN. A stress field
+    with a few joints at MN and the bulk of the cells at tens of kPa (a tall wall after an impact) has its median
+    at 1/20 of the linear map, next to white; at √(1/20) ≈ 0.22 of this one.
+    """
+    zero, side = _zero_position(kind)
+    d = (np.asarray(position, dtype=np.float64) - zero) / side  # signed share of the side, ±1 at the ends
+    mapped = np.square(d) if inverse else np.sqrt(np.abs(d))
+    with np.errstate(invalid="ignore"):  # NaN keeps its NaN sign
+        return zero + side * np.sign(d) * mapped
 
 
 def nice_floor_negative(x: float) -> float:

@@ -12,7 +12,7 @@ from masonrycli import colormap as cm
 from masonrycli import recording as rec_mod
 from masonrycli.builtin import paper_loading
 from masonrycli.recording import Recorder, inspect_recording
-from masonrycli.recording.layout import FIELD_TABS, FILL, LIVE_TAB, MAGNIFIED_TAB, PLOT_NAMES
+from masonrycli.recording.layout import FIELD_TABS, FILL, LIVE_TAB, MAGNIFIED_TAB, PLOT_NAMES, SQRT_TABS
 from masonrycli.recording.readback import blueprint_views, field_frames
 
 import recording_fixtures as fx
@@ -26,7 +26,7 @@ def test_embedded_blueprint_has_the_views(written, wall, tmp_path):
     path, *_, rec = written
     views = blueprint_views(path)
     spatial = {n for n, v in views.items() if v["kind"] == "2D" and v["origin"] == "/structure/plane"}
-    assert {LIVE_TAB, MAGNIFIED_TAB, *FIELD_TABS.values()} == spatial
+    assert {LIVE_TAB, MAGNIFIED_TAB, *FIELD_TABS.values(), *SQRT_TABS.values()} == spatial
     # the magnified view's factor (set at close) is in the Legend: in the tab's name it was cut
     assert rec.magnify > 0 and f"× {rec.magnify:g}" in static_value(path, "/run/legend", "TextDocument:text")[0]
     assert sum(v["kind"] == "TimeSeries" for v in views.values()) == 9
@@ -153,7 +153,7 @@ def test_a_run_s_recording_opens_at_t0_on_the_structure_as_built(tmp_path):
 
 
 def test_every_tab_name_fits_its_tab_bar(written, wall, tmp_path):
-    """The quick start's structure panel has 12 tabs in ~1150 px of a 1920 px window: with names of up to 56
+    """The quick start's structure panel has 12 tabs (13 with p on the square-root scale) in ~1150 px of a 1920 px window: with names of up to 56
     characters ("Live: joint forces, principal stress, Spherical stress p") four were readable and the first
     was cut; the right column showed three of its six plot tabs. Measured in the headless viewer: about
     5.5 px a character and 33 px a tab besides (12 short tabs took 972 px); the tab bars leave ~70 px to
@@ -166,8 +166,8 @@ def test_every_tab_name_fits_its_tab_bar(written, wall, tmp_path):
     views = blueprint_views(tmp_path / "w.rrd")
     structure = [n for n, v in views.items() if v["kind"] == "2D"]
     plots = [n for n, v in views.items() if v["kind"] == "TimeSeries"]
-    assert len(structure) == 12 and len(plots) == 9  # distinct: a repeated name would merge two views here
-    assert 33 * 12 + 5.5 * sum(map(len, structure)) < 1080
+    assert len(structure) == 13 and len(plots) == 9  # distinct: a repeated name would merge two views here
+    assert 33 * 13 + 5.5 * sum(map(len, structure)) < 1080
     rows = ([PLOT_NAMES[k] for k in ("energy_kinetic", "energy_balance", "energy_large", "max_displacement")],
             [PLOT_NAMES[k] for k in ("support_velocity", "support_displacement", "residual", "iterations", "contacts")])  # fmt: skip
     assert set(plots) == {n for row in rows for n in row}

@@ -24,6 +24,8 @@ from masonrycli.recording.layout import (
     LIVE_TAB,
     MAGNIFIED_TAB,
     ROBUST_PERCENTILE,
+    SQRT_FIELDS,
+    SQRT_TABS,
     tabs_legend,
 )
 
@@ -97,6 +99,14 @@ def run_document(
         f"outside it or the cells, leaving out the {100 * BULK_TRIM:g} % most extreme at each end, span less "
         f"than {100 * MIN_SPAN:g} % of it; the colour bar always shows "
         "the range in force (five ticks) and how many cells are beyond it.",
+        *(
+            f"- **{SQRT_TABS[f.name]}** (not one of the paper's views): {f.title.split(',')[0].lower()} on a "
+            "square-root scale, with the range of its linear tab: a cell's colour stands at √(value / range end) "
+            "of the bar from its zero end, so the bulk of a field with a few extreme cells (a tall wall's joints "
+            "after an impact) is not pale; the ticks are the values at evenly spaced colours (0, 1/16, 1/4, 9/16 "
+            "and 1 × the range end)."
+            for f in SQRT_FIELDS
+        ),
         "",
         "| field | colour map | last range | refits |",
         "|---|---|---|---|",

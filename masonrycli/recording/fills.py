@@ -9,7 +9,7 @@ import rerun as rr
 
 from masonrycli.recording.arrays import Polygons, partition_lengths, z0
 from masonrycli.recording.field_colours import FieldColours
-from masonrycli.recording.layout import BLOCKS, FIELDS, FILL, HOVER_VALUES, SUPPORT_FILL, SUPPORT_OUTLINES
+from masonrycli.recording.layout import BLOCKS, COLOURED, FILL, HOVER_VALUES, SUPPORT_FILL, SUPPORT_OUTLINES
 from masonrycli.recording.static_content import TICKS
 
 
@@ -33,7 +33,7 @@ def send_blocks(
     per_vertex, per_block = partition_lengths(n_frames, n_vert), partition_lengths(n_frames, n_blocks)
     columns = [*rr.Mesh3D.columns(vertex_positions=z0(verts)).partition(per_vertex)]
     hover = [*rr.Points2D.columns(positions=q[..., :2].reshape(-1, 2).astype(np.float32)).partition(per_block)]
-    for f in FIELDS:
+    for f in COLOURED:  # the fields first: a square-root view takes its linear twin's ranges
         colors, labels, lo, hi = colours.colour(f, tensors[f.key], initial)
         archetype = f.colors.removesuffix(":colors")
         columns += rr.DynamicArchetype.columns(

@@ -13,7 +13,7 @@ import rerun.blueprint as rrb
 from rerun.blueprint.encodings import ComponentSourceKind, VisualizerComponentMapping
 
 from masonrycli.builtin import is_paper_loading, paper_instant_missed
-from masonrycli.colour_range import ScaleKind
+from masonrycli.colour_range import Scale, ScaleKind
 
 ROBUST_PERCENTILE: Final = 98.0  # the glyph scales come from this percentile of |value|
 GLYPH_HALF_LENGTH: Final = 0.45  # longest principal-axis half-length / median block's smaller side
@@ -36,10 +36,16 @@ class FieldSpec(NamedTuple):
     colors: str  # the fill mesh's colour component for this field ("<Name>:colors")
     bar: str  # entity paths: the colour bar and its labels
     labels: str
+    scale: Scale = "linear"  # "sqrt": the signed square-root scale (colour_range.sqrt_scale), SQRT_FIELDS
+
+    @property
+    def name(self) -> str:
+        """The view's field: ``key``, with "@sqrt" on the square-root scale (field_frames' ranges)."""
+        return self.key if self.scale == "linear" else f"{self.key}@{self.scale}"
 
 
-def _field(key: str, title: str, unit: str, kind: ScaleKind, floor: float) -> FieldSpec:
-    short = key.removeprefix("cell_").removeprefix("block_")
+def _field(key: str, title: str, unit: str, kind: ScaleKind, floor: float, scale: Scale = "linear") -> FieldSpec:
+    short = key.removeprefix("cell_").removeprefix("block_") + ("" if scale == "linear" else f"_{scale}")
     archetype = "".join(w.capitalize() for w in short.split("_"))
     return FieldSpec(
         key,
@@ -50,6 +56,7 @@ def _field(key: str, title: str, unit: str, kind: ScaleKind, floor: float) -> Fi
         f"{archetype}:colors",
         f"structure/legend/{short}",
         f"structure/plane/xy/legend/{short}",
+        scale,
     )
 
 
@@ -66,6 +73,13 @@ states. The volumetric strain rate of a block without a cell strain but in a one
 of a bare ring) is its ``chain_strain_rate``: the strain rate along the ring."""
 PAPER_FIELDS: Final = FIELDS[:4]
 FIELD_BY_KEY: Final = {f.key: f for f in FIELDS}
+SQRT_FIELDS: Final = (_field("cell_spherical_stress", "Spherical stress p, √ scale", "Pa", "negative", 100.0, "sqrt"),)
+"""Fields shown again on the signed square-root scale, in a tab of their own (not the paper's): a tall wall
+after an impact has a few joints at MN and the bulk of its cells at tens of kPa, pale on the linear map
+whatever its range. Each takes the range of its linear twin (one tracker: the same ends, refits and counts
+beyond them); the colour bar is the same gradient, its ticks at the values of evenly spaced colours."""
+COLOURED: Final = FIELDS + SQRT_FIELDS
+"""Every colour component of the fill, with its colour bar and labels: the fields, then the square-root views."""
 CHAIN_KEY: Final = "chain_strain_rate"
 HOVER_VALUES: Final = {  # per-block value shown when hovering a block -> Frame.tensors key
     "p": "cell_spherical_stress",
@@ -143,7 +157,7 @@ ENTITY_PATHS: Final = (
     SUPPORT_FILL,
     LEGEND_BARS,
     LEGEND_LABELS,
-    *(p for f in FIELDS for p in (f.bar, f.labels)),
+    *(p for f in COLOURED for p in (f.bar, f.labels)),
     *SERIES.values(),
     METADATA,
     LEGEND,
@@ -178,6 +192,8 @@ FIELD_TABS: Final = {
     "block_sliding_ratio": "Sliding",
     "block_max_opening": "Opening",
 }
+SQRT_TABS: Final = {"cell_spherical_stress@sqrt": "p √"}
+"""The square-root views' tabs (``FieldSpec.name`` -> tab), each right after its linear twin's."""
 MAGNIFIED_TAB: Final = "Magnified"
 """Tab names, short: the quick start's recording has 12 tabs in the structure panel (~1150 px of a 1920 px
 window), where names of up to 56 characters ("Live: joint forces, principal stress, Spherical stress p")
@@ -208,7 +224,11 @@ def tabs_legend(main_field: str = "cell_spherical_stress", paper_t: float | None
     """The Legend panel's line on the tabs: what each short name shows (``paper_t``: the paper's figures'
     instant, s, when the recording has their tabs)."""
     main = FIELD_BY_KEY[main_field].title
-    fields = ", ".join(f"{FIELD_TABS[f.key]} = {f.title.lower()}" for f in FIELDS)
+    names = []
+    for f in FIELDS:
+        names.append(f"{FIELD_TABS[f.key]} = {f.title.lower()}")
+        names += [f"{SQRT_TABS[s.name]} = the same on a square-root scale" for s in SQRT_FIELDS if s.key == f.key]
+    fields = ", ".join(names)
     return (
         f"- **Tabs**: {LIVE_TAB} = joint forces, principal stress axes and {main.lower()}; "
         + ("" if paper_t is None else f"Fig. = the paper's figures at t = {paper_t:g} s (pinned there); ")
@@ -261,7 +281,8 @@ def build_blueprint(
     arrows, shows that part.
 
     Tabs: the live main view (forces, principal stress, ``main_field``), with ``paper`` = (t, figure
-    numbers) the paper's four figures pinned to t, the four fields live, the magnified deformed shape,
+    numbers) the paper's four figures pinned to t, the four fields live (p also on the square-root scale,
+    ``SQRT_FIELDS``), the magnified deformed shape,
     the joint states (names: :data:`LIVE_TAB`, :func:`paper_tab`, :data:`FIELD_TABS`, :data:`MAGNIFIED_TAB`).
     Opens on ``sim_time`` following the end of the data: at the last frame of a finished run, and on the
     newest frame of a run still being written.
@@ -278,7 +299,9 @@ def build_blueprint(
         tabs += [
             _structure_view(paper_tab(fig), f, extras.get(f.key, ()), at=t) for fig, f in zip(figures, PAPER_FIELDS)
         ]
-    tabs += [_structure_view(FIELD_TABS[f.key], f, extras.get(f.key, ())) for f in PAPER_FIELDS]
+    for f in PAPER_FIELDS:  # each square-root view right after its linear twin
+        tabs += [_structure_view(FIELD_TABS[f.key], f, extras.get(f.key, ()))]
+        tabs += [_structure_view(SQRT_TABS[s.name], s, extras.get(s.key, ())) for s in SQRT_FIELDS if s.key == f.key]
     tabs += [
         rrb.Spatial2DView(
             origin=f"/{PLANE}",

@@ -20,11 +20,20 @@ import rerun as rr
 
 from masonrycli.errors import BINARY_FILE, NOT_A_FILE, binary_under_text_suffix
 from masonrycli.outputs import being_written
-from masonrycli.recording.layout import BLOCKS, CHAIN_KEY, FIELDS, FILL, HOVER_VALUES, METADATA, PER_STEP_SERIES, SERIES
+from masonrycli.recording.layout import (
+    BLOCKS,
+    CHAIN_KEY,
+    COLOURED,
+    FILL,
+    HOVER_VALUES,
+    METADATA,
+    PER_STEP_SERIES,
+    SERIES,
+)
 from masonrycli.recording.screenshot import _viewer_executable, screenshot_recording  # noqa: F401 (re-exported)
 
 _PER_STEP = frozenset(f"/{SERIES[k]}" for k in PER_STEP_SERIES)
-_RUN_FRAMES = frozenset(f"/{p}" for p in (FILL, BLOCKS, *SERIES.values(), *(f.labels for f in FIELDS)))
+_RUN_FRAMES = frozenset(f"/{p}" for p in (FILL, BLOCKS, *SERIES.values(), *(f.labels for f in COLOURED)))
 """Entities only a run's recording logs (a limit or a study recording has none): a file with one is a run's,
 whose frames are those of its blocks."""
 
@@ -337,11 +346,11 @@ def blueprint_time_panel(path: str | os.PathLike) -> dict:
 
 def field_frames(path: str | os.PathLike) -> dict[int, dict]:
     """Per recorded step: {"time": s, "values": hover values by field key (N,), "ranges": field key ->
-    the colour range logged for that frame}. The volumetric strain rate is the one the fill shows (the
-    chain strain rate where the cell has none)."""
+    the colour range logged for that frame; a square-root view's under ``FieldSpec.name``, "key@sqrt"}. The
+    volumetric strain rate is the one the fill shows (the chain strain rate where the cell has none)."""
     out: dict[int, dict] = {}
     hover = {name: key for name, key in HOVER_VALUES.items()}
-    labels = {f"/{f.labels}": f.key for f in FIELDS}
+    labels = {f"/{f.labels}": f.name for f in COLOURED}
     with _reading(path) as reader:
         chunks = list(reader.stream())
     for chunk in chunks:

@@ -11,8 +11,8 @@ cumulated strain, sliding ratio and openings 0. It takes the colour ranges of th
 does not count towards a batch's ``batch_frames`` nor fix a scale, so every later frame reads as before.
 
 What is logged per frame, once each: the block fill mesh's vertex positions (float32, inset so the
-joints show) with one colour component per field (each view maps its own, ``layout.FIELDS``); a hover
-point per block with its values (float32); the principal-axis glyphs; one resultant arrow per joint
+joints show) with one colour component per field and view (each view maps its own, ``layout.COLOURED``:
+the fields, and p again on a square-root scale); a hover point per block with its values (float32); the principal-axis glyphs; one resultant arrow per joint
 (``masonrycli.joint_forces``); hinges; each field's colour range and legend labels; the time series
 (energies, displacements, support motion: ``series``). Solver health (sweeps, residual, contacts) is
 logged for every step (``log_step``), sent with the frames or every ``batching.STEP_BATCH`` steps. The
@@ -54,6 +54,7 @@ from masonrycli.recording.fills import send_blocks, send_supports
 from masonrycli.recording.layout import (
     AXES,
     CHAIN_KEY,
+    COLOURED,
     FIELD_BY_KEY,
     FIELDS,
     GLYPH_HALF_LENGTH,
@@ -221,7 +222,7 @@ class Recorder:
                 inset_local(self.static.block_vert_start, self.static.block_vert_local, self.fill_inset()),
             )
             log_initial_shape(self.rec, self._blocks, self.static.triangles, q, sq, self._supports)
-            for f in FIELDS:
+            for f in COLOURED:
                 log_legend(self.rec, f, self._legend_box)
             self._label_anchors = legend_positions(self._legend_box).astype(np.float32)
             folder = os.path.dirname(os.path.abspath(self.path))
