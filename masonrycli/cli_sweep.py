@@ -288,13 +288,42 @@ def _no_fit(rows: list[dict], axes) -> str:
     return f"fragility: no fit — all {len(rows)} runs collapsed ({less})"
 
 
+def _fit_line(group, im: str, axes) -> str:
+    """The fragility line of one group of runs (``fragility.FitGroup``): its fit, or why there is none;
+    prefixed by the group's values when the study has several (``friction = 0.5: fragility (pga): …``)."""
+    from masonrycli.intensity import UNITS
+
+    fit, rows, unit = group.fit, group.rows, UNITS[im]
+    if fit is None:
+        line = _no_fit(rows, axes)
+    elif fit.separated is not None:
+        stood, fell = fit.separated
+        line = (
+            f"fragility ({im}): not resolved — every collapse ({im} ≥ {fell:.4g} {unit}) is above every run "
+            f"that stood (≤ {stood:.4g} {unit}): the median θ is anywhere between, the dispersion β → 0; more "
+            f"records or scales are needed ({fit.collapsed} of {fit.runs} runs collapsed{_at_zero(rows, im)})"
+        )
+    elif fit.unbounded:
+        line = (
+            f"fragility ({im}): not resolved — the collapses do not come at larger {im} than the runs that "
+            f"stood (the fit's dispersion β runs to its bound, {fit.dispersion:.3g}); more records or scales are "
+            f"needed ({fit.collapsed} of {fit.runs} runs collapsed{_at_zero(rows, im)})"
+        )
+    else:
+        line = (
+            f"fragility ({im}): median θ = {fit.median:.4g} {unit}, dispersion β = {fit.dispersion:.3f} "
+            f"({fit.collapsed} of {fit.runs} runs collapsed{_at_zero(rows, im)})"
+        )
+    return f"{group.label}: {line}" if group.label else line
+
+
 def _report(console, result, plan: StudyPlan, im: str, written: list, signals: FirstSignalStops) -> None:
     """The table on the terminal, the fit, the plot and the recording; ``written`` gets each file's path
     as it is renamed into place, a signal held between the two (:func:`_recorded`)."""
     from masonrycli.intensity import UNITS
     from masonrycli.outputs import written_whole
     from masonrycli.study.curves import searched_range
-    from masonrycli.study.fragility import fit_lognormal
+    from masonrycli.study.fragility import fit_by
     from masonrycli.study.plots import fragility_curve, state_map, threshold_curve
     from masonrycli.study.table import find_columns, grid_columns, study_table
 
@@ -303,7 +332,7 @@ def _report(console, result, plan: StudyPlan, im: str, written: list, signals: F
     keys = [a.name for a in axes if a.name != request.find]  # what a row is keyed by
     columns = find_columns(keys, request.find) if request.find else grid_columns(keys, im)
     names = [a.name for a in axes if a.name != request.find and len(a.values) > 1]
-    fit, good = None, []
+    fit, groups = None, []
     with written_whole(plot, around_commit=_recorded(signals, written, plot)) as part:
         if request.find:
             title = f"{name}: {request.outcome} threshold"
@@ -311,8 +340,11 @@ def _report(console, result, plan: StudyPlan, im: str, written: list, signals: F
             threshold_curve(rows, request.find, names[0] if names else None, part, title, searched)
         elif "record" in [a.name for a in axes]:
             good = [r for r in rows if r.get("status") != "error"]
-            fit = fit_lognormal([r[im] for r in good], [r["state"] == "collapsed" for r in good], im)
-            fragility_curve(good, im, fit, part, f"{name}: fragility ({len(good)} runs)", UNITS[im])
+            # one curve per value of the other swept parameters: pooled, two frictions made one curve of neither
+            groups = fit_by(good, im, [n for n in names if n not in ("record", "scale")])
+            fit = groups[0].fit if len(groups) == 1 else None
+            title = f"{name}: fragility ({len(good)} runs{f', {len(groups)} curves' if len(groups) > 1 else ''})"
+            fragility_curve(good, im, fit, part, title, UNITS[im], groups)
         else:
             x, y = names[0] if names else axes[0].name, names[1] if len(names) > 1 else None
             state_map(rows, x, y, part, name)
@@ -321,7 +353,7 @@ def _report(console, result, plan: StudyPlan, im: str, written: list, signals: F
 
         try:
             with written_whole(recording, around_commit=_recorded(signals, written, recording)) as part:
-                record_study(part, name, rows, request, fit, im, plot.path)
+                record_study(part, name, rows, request, fit, im, plot.path, groups)
         except OSError as exc:  # a full disk: the table and plot are written, the recording is not (exit 4)
             from masonrycli.cli_messages import fail
 
@@ -333,28 +365,8 @@ def _report(console, result, plan: StudyPlan, im: str, written: list, signals: F
         f"{_n(len(rows), 'row')} in {result.out} ({_n(result.ran, 'run')} now, {_n(result.skipped, 'row')} already "
         f"there, {result.failed} failed) in {result.wall_time:.1f} s"
     )
-    if "record" in [a.name for a in axes] and not request.find:
-        if fit is None:
-            console.print(_no_fit(good, request.axes))
-        elif fit.separated is not None:
-            stood, fell = fit.separated
-            unit = UNITS[im]
-            console.print(
-                f"fragility ({im}): not resolved — every collapse ({im} ≥ {fell:.4g} {unit}) is above every run "
-                f"that stood (≤ {stood:.4g} {unit}): the median θ is anywhere between, the dispersion β → 0; more "
-                f"records or scales are needed ({fit.collapsed} of {fit.runs} runs collapsed{_at_zero(good, im)})"
-            )
-        elif fit.unbounded:
-            console.print(
-                f"fragility ({im}): not resolved — the collapses do not come at larger {im} than the runs that "
-                f"stood (the fit's dispersion β runs to its bound, {fit.dispersion:.3g}); more records or scales are "
-                f"needed ({fit.collapsed} of {fit.runs} runs collapsed{_at_zero(good, im)})"
-            )
-        else:
-            console.print(
-                f"fragility ({im}): median θ = {fit.median:.4g} {UNITS[im]}, dispersion β = {fit.dispersion:.3f} "
-                f"({fit.collapsed} of {fit.runs} runs collapsed{_at_zero(good, im)})"
-            )
+    for group in groups:
+        console.print(_fit_line(group, im, request.axes))
     console.print(f"plot: {plot.path}")
     if recording is not None:
         console.print(f"recording: {recording.path}")

@@ -352,3 +352,25 @@ def test_a_scheduler_lost_before_the_first_row_says_nothing_was_written(block, t
         "finished, nothing was written (the same command runs the study once the scheduler is back)"
     )
     assert [p.name for p in tmp_path.iterdir()] == ["block.toml"]
+
+
+def test_a_record_study_over_friction_says_one_fragility_per_friction(block, tmp_path):
+    # 'masonry sweep rubble.toml --records recs --scale … --param friction=0.5,0.7' fitted one curve over the
+    # runs of both frictions, and said one line: the fragility of neither wall
+    folder = tmp_path / "records"
+    folder.mkdir()
+    for seed in range(2):
+        a = band_limited(1.0, 0.01, [1.0 + 0.4 * seed, 2.5], [0.03, 0.01], seed=seed)[3]
+        write_at2(folder / f"syn{seed}.AT2", a / G_STANDARD, 0.01)
+    out = tmp_path / "ida.csv"
+    args = ["sweep", block, "--records", folder, "--scale", "0.5:8:3", "--param", "friction=0.3,0.9"]
+    result = invoke(*args, "--workers", 0, "--out", out, "--no-recording")
+    assert result.exit_code == 0, result.output
+    said = words(result.output)
+    assert said.count("fragility") == said.count(": fragility") == 2, said  # one line a friction, none pooled
+    rows = read_rows(out)
+    for friction in (0.3, 0.9):  # each line counts its own runs
+        own = [r for r in rows if r["friction"] == friction]
+        fell = sum(r["state"] == "collapsed" for r in own)
+        line = said.split(f"friction = {friction:g}: fragility")[1].split("friction =")[0]
+        assert len(own) == 6 and (fell in (0, 6) or f"({fell} of 6 runs collapsed" in line), line

@@ -19,7 +19,7 @@ from masonrycli.colormap import unpack_rgba
 from masonrycli.recording.study import record_study
 from masonrycli.study import plots
 from masonrycli.study.curves import NOT_FOUND_COLOUR, STATE_COLOURS, rgb, threshold_series
-from masonrycli.study.fragility import fit_lognormal
+from masonrycli.study.fragility import fit_by, fit_lognormal
 
 # 12 runs of 3 records at 4 scales: collapses from pga 5.5 m/s² up but one (7.2) and one below (3.0),
 # so the lognormal fit is resolved
@@ -90,6 +90,44 @@ def test_the_fragility_curve_has_the_same_colours_and_legend_in_the_png_and_the_
         assert png[f"runs: {state}"] == rgb(STATE_COLOURS[state])
     assert len(set(png.values())) == len(png)  # no colour means two things
     assert fit.separated is None and f"lognormal: θ = {fit.median:.3g} m/s², β = {fit.dispersion:.2f}" in png
+
+
+def test_a_record_study_over_friction_fits_one_curve_per_friction_in_the_png_and_the_recording(png_figures, tmp_path):
+    # the 12 runs at friction 0.5, and the same runs at 0.7 collapsing from pga 7 m/s² up (but one, and one
+    # below): pooled, one curve of 24 runs was the fragility of neither wall
+    odd = (("r0", 3.0), ("r1", 4.0))
+    stiff = [
+        r
+        | {
+            "friction": 0.7,
+            "state": "collapsed" if (r["pga"] > 7.0) != ((r["record"], r["scale"]) in odd) else "damaged",
+        }
+        for r in FRAGILITY_ROWS
+    ]
+    rows = [r | {"friction": 0.5} for r in FRAGILITY_ROWS] + stiff
+    groups = fit_by(rows, "pga", ["friction"])
+    assert [g.label for g in groups] == ["friction = 0.5", "friction = 0.7"]
+    for g, friction in zip(groups, (0.5, 0.7)):
+        own = [r for r in rows if r["friction"] == friction]
+        alone = fit_lognormal([r["pga"] for r in own], [r["state"] == "collapsed" for r in own], "pga")
+        assert g.rows == own and (g.fit.median, g.fit.dispersion) == (alone.median, alone.dispersion)
+    assert groups[1].fit.median > 1.2 * groups[0].fit.median and all(g.fit.separated is None for g in groups)
+    plots.fragility_curve(rows, "pga", None, tmp_path / "f.png", "fragility", "m/s²", groups)
+    axes = [
+        SimpleNamespace(name="record", values=("r0", "r1", "r2")),
+        SimpleNamespace(name="friction", values=(0.5, 0.7)),
+    ]
+    request = SimpleNamespace(axes=axes, find=None)
+    rrd = record_study(tmp_path / "f.rrd", "s", rows, request, None, "pga", tmp_path / "f.png", groups)
+    png = png_figures[0]
+    drawn = {s["label"]: s["rgb"] for s in recorded_series(rrd, "study/fragility").values() if s["x"]}
+    assert png == drawn
+    colours = []
+    for g in groups:  # a group's fraction and curve in one colour, its own: no state's, no other group's
+        curve = png[f"{g.label}: lognormal: θ = {g.fit.median:.3g} m/s², β = {g.fit.dispersion:.2f}"]
+        assert png[f"{g.label}: fraction collapsed per scale"] == curve
+        colours.append(curve)
+    assert len(set(colours)) == 2 and not set(colours) & {rgb(c) for c in STATE_COLOURS.values()}
 
 
 def test_the_legend_hides_no_run_of_the_fragility_curve():

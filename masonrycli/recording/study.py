@@ -71,7 +71,7 @@ from masonrycli.study.table import find_columns, grid_columns
 STATE_RGBA = {state: (*rgb(colour), 255) for state, colour in STATE_COLOURS.items()}
 
 
-def record_study(path: Path, name: str, rows: list[dict], request, fit, im: str, plot: Path) -> Path:
+def record_study(path: Path, name: str, rows: list[dict], request, fit, im: str, plot: Path, groups=None) -> Path:
     """Write the study's ``.rrd`` at ``path`` (closed, with its blueprint); the caller writes it under
     a temporary name and renames it (``masonrycli.outputs.written_whole``)."""
     path = Path(path)
@@ -113,7 +113,7 @@ def record_study(path: Path, name: str, rows: list[dict], request, fit, im: str,
         # empty time panel with a "log_time" of its own, which meant nothing here (module doc)
         panels.append(rrb.TimePanel(state="hidden"))
     else:
-        timeline, end = _log_fragility(rec, rows, fit, im)
+        timeline, end = _log_fragility(rec, rows, fit, im, groups)
         legend = rrb.PlotLegend(corner="RightBottom")  # high IM, P = 0: where runs are fewest
         title = viewer_safe_text(f"fragility: P(collapse) against {x_scale(im, UNITS[im], 1000.0)[1]}")
         view, panel = _plot_view("study/fragility", title, timeline, (0, end), (-0.05, 1.05), legend)
@@ -351,12 +351,13 @@ def _points_style(c, label: str) -> rr.SeriesPoints:
     return rr.SeriesPoints(colors=[rgb(c.colour)], names=[label], markers=[marker], marker_sizes=[size])
 
 
-def _log_fragility(rec, rows: list[dict], fit, im: str) -> tuple[str, int]:
-    """Runs, fraction collapsed per scale and fitted curve as scalars on the IM's time line (module doc);
-    returns the time line's name and the end of the curve on it (1.2 × the largest IM, in its ticks)."""
+def _log_fragility(rec, rows: list[dict], fit, im: str, groups=None) -> tuple[str, int]:
+    """Runs, fraction collapsed per scale and fitted curve (of each of ``groups``) as scalars on the IM's time
+    line (module doc); returns the time line's name and the end of the curve on it (1.2 × the largest IM,
+    in its ticks)."""
     timeline = fragility_timeline(im)
     good = [r for r in rows if r.get("status") != "error"]
-    _send_curve(rec, "study/fragility", timeline, 1000.0, fragility_series(good, im, fit, UNITS[im]))
+    _send_curve(rec, "study/fragility", timeline, 1000.0, fragility_series(good, im, fit, UNITS[im], groups))
     x = np.array([_number(r.get(im)) for r in good], dtype=np.float64)
     top = np.nanmax(x) if np.isfinite(x).any() else 1.0
     return timeline, int(np.rint(1200.0 * top)) + 1

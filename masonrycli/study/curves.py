@@ -21,6 +21,8 @@ STATE_COLOURS = {"intact": "#2e9e5b", "damaged": "#f0a030", "collapsed": "#d0303
 """A run's state (``""``: failed) -> colour: the state map's cells, the fragility curve's runs."""
 FRACTION_COLOUR = "#9b59d0"  # purple: no state's colour (it was red, a collapsed run's colour, in the PNG)
 FIT_COLOUR = "#1f5fa8"
+GROUP_COLOURS = ("#1f5fa8", "#9b59d0", "#17a2b8", "#8c564b", "#e377c2", "#7f8c2a")
+"""The fit and fraction of each value of a record study's other parameter (``fit_by``): none a state's colour."""
 THRESHOLD_COLOUR = "#d03030"
 NOT_FOUND_COLOUR = "#8c8c8c"  # grey: no threshold in the searched range
 
@@ -90,30 +92,47 @@ def fit_label(fit, unit: str) -> str:
     return f"lognormal: θ = {fit.median:.3g} {unit}, β = {fit.dispersion:.2f}"
 
 
-def fragility_series(rows: list[dict], im: str, fit, unit: str) -> list[Series]:
+def fragility_series(rows: list[dict], im: str, fit, unit: str, groups=None) -> list[Series]:
     """The runs at 0 or 1 by state, the fraction collapsed per scale (at the scale's mean IM), the
-    fitted lognormal from IM = 0 to 1.2 × the largest (300 points); ``rows`` without the failed runs."""
+    fitted lognormal from IM = 0 to 1.2 × the largest (300 points); ``rows`` without the failed runs.
+    ``groups`` (``fragility.fit_by``, more than one): the fraction and the fit of each group instead, in its
+    colour, its label first (``friction = 0.5: lognormal: θ = …``); ``fit`` is then not used."""
     x = np.array([_number(r.get(im)) for r in rows], dtype=np.float64)
-    collapsed = np.array([r.get("state") == "collapsed" for r in rows], dtype=bool)
     out = []
     for state in ("intact", "damaged", "collapsed"):
         sel = np.array([r.get("state") == state for r in rows], dtype=bool) & np.isfinite(x)
         y = np.full(int(sel.sum()), 1.0 if state == "collapsed" else 0.0)
         out.append(Series(f"runs/{state}", f"runs: {state}", STATE_COLOURS[state], "tick", x[sel], y))
-    if rows and "scale" in rows[0]:
-        scales = sorted({r["scale"] for r in rows})
-        pick = [np.array([r["scale"] == s for r in rows]) for s in scales]
-        mean_x = np.array([np.nanmean(x[p]) if np.isfinite(x[p]).any() else np.nan for p in pick])
-        fraction = np.array([collapsed[p].mean() for p in pick])
-        ok = np.isfinite(mean_x)
-        out.append(
-            Series("fraction", "fraction collapsed per scale", FRACTION_COLOUR, "diamond", mean_x[ok], fraction[ok])
-        )
-    if fit is not None and np.isfinite(x).any():
-        # from IM = 0 in steps of 1/1000 of the unit (the recording's time line is in thousandths)
-        grid = np.unique(np.rint(np.linspace(0, np.nanmax(x) * 1.2, 300) * 1000.0)) / 1000.0
-        out.append(Series("fit", fit_label(fit, unit), FIT_COLOUR, "line", grid, fit.probability(grid)))
+    if not np.isfinite(x).any():
+        return out
+    # from IM = 0 in steps of 1/1000 of the unit (the recording's time line is in thousandths)
+    grid = np.unique(np.rint(np.linspace(0, np.nanmax(x) * 1.2, 300) * 1000.0)) / 1000.0
+    if groups is None or len(groups) < 2:
+        out += _fraction(rows, im, "fraction", "fraction collapsed per scale", FRACTION_COLOUR)
+        if fit is not None:
+            out.append(Series("fit", fit_label(fit, unit), FIT_COLOUR, "line", grid, fit.probability(grid)))
+        return out
+    for i, g in enumerate(groups):
+        colour = GROUP_COLOURS[i % len(GROUP_COLOURS)]
+        out += _fraction(g.rows, im, f"fraction/{i}", f"{g.label}: fraction collapsed per scale", colour)
+        if g.fit is not None:
+            label = f"{g.label}: {fit_label(g.fit, unit)}"
+            out.append(Series(f"fit/{i}", label, colour, "line", grid, g.fit.probability(grid)))
     return out
+
+
+def _fraction(rows: list[dict], im: str, key: str, label: str, colour: str) -> list[Series]:
+    """The fraction of ``rows`` collapsed at each scale, at the scale's mean IM (none without a scale)."""
+    if not rows or "scale" not in rows[0]:
+        return []
+    x = np.array([_number(r.get(im)) for r in rows], dtype=np.float64)
+    collapsed = np.array([r.get("state") == "collapsed" for r in rows], dtype=bool)
+    scales = sorted({r["scale"] for r in rows})
+    pick = [np.array([r["scale"] == s for r in rows]) for s in scales]
+    mean_x = np.array([np.nanmean(x[p]) if np.isfinite(x[p]).any() else np.nan for p in pick])
+    fraction = np.array([collapsed[p].mean() for p in pick])
+    ok = np.isfinite(mean_x)
+    return [Series(key, label, colour, "diamond", mean_x[ok], fraction[ok])]
 
 
 def threshold_series(

@@ -117,12 +117,12 @@ def _legend_beside(ax) -> None:
     ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8, frameon=False)
 
 
-def fragility_figure(rows: list[dict], im: str, fit, title: str, unit: str):
+def fragility_figure(rows: list[dict], im: str, fit, title: str, unit: str, groups=None):
     """The fragility curve's figure (``fragility_series``): runs at 0 / 1 by state, the fraction collapsed
-    per scale stripe, the fitted lognormal."""
+    per scale stripe, the fitted lognormal (one of each per group of ``groups``)."""
     plt = _pyplot()
     fig, ax = plt.subplots(figsize=(6.0, 4.0))
-    _draw(ax, fragility_series(rows, im, fit, unit))
+    _draw(ax, fragility_series(rows, im, fit, unit, groups))
     ax.set_xlabel(f"{im} ({unit})")
     ax.set_ylabel("P(collapse)")
     ax.set_ylim(-0.05, 1.05)
@@ -131,9 +131,9 @@ def fragility_figure(rows: list[dict], im: str, fit, title: str, unit: str):
     return fig
 
 
-def fragility_curve(rows: list[dict], im: str, fit, path: Path, title: str, unit: str) -> Path:
+def fragility_curve(rows: list[dict], im: str, fit, path: Path, title: str, unit: str, groups=None) -> Path:
     """PNG of :func:`fragility_figure`."""
-    fig = fragility_figure(rows, im, fit, title, unit)
+    fig = fragility_figure(rows, im, fit, title, unit, groups)
     try:
         return _save(fig, path)
     finally:
