@@ -374,3 +374,24 @@ def test_a_record_study_over_friction_says_one_fragility_per_friction(block, tmp
         fell = sum(r["state"] == "collapsed" for r in own)
         line = said.split(f"friction = {friction:g}: fragility")[1].split("friction =")[0]
         assert len(own) == 6 and (fell in (0, 6) or f"({fell} of 6 runs collapsed" in line), line
+
+
+def test_a_rows_run_replays_with_simulate_and_stop_at_collapse(tmp_path):
+    # docs/sweep.md "One run of a study, in the viewer": the row's point given to simulate, --stop-at-collapse
+    import numpy as np
+
+    out, folder = tmp_path / "s.csv", tmp_path / "h"
+    args = ["--param", "amp=1.25", "--param", "freq=2", "--duration", 2, "--histories", folder, "--out", out]
+    result = invoke("sweep", "wall", *args, "--workers", 0, "--no-recording")
+    assert result.exit_code == 0, result.output
+    (row,) = read_rows(out)
+    again = tmp_path / "r.npz"
+    result = invoke(
+        "simulate", "wall", "--amp", 1.25, "--freq", 2, "--duration", 2, "--stop-at-collapse", "--history", again,
+        "--no-recording",
+    )  # fmt: skip
+    assert result.exit_code == 0, result.output
+    study, replay = np.load(folder / "amp=1.25_freq=2.npz"), np.load(again)
+    assert row["state"] == "collapsed" and replay["time"][-1] == pytest.approx(row["collapse_time"])
+    for name in ("time", "block_q", "block_v", "energy_dissipated"):
+        assert np.array_equal(study[name], replay[name]), name
