@@ -17,8 +17,9 @@ It runs in its own session (a Ctrl-C at the terminal is the run's to handle), st
 is gone, and is stopped when the run ends. numba writes each cache file under a temporary name and
 renames it, so a stopped child leaves no half-written entry.
 
-A study does the same: on ``--workers 0`` around its runs (:func:`ahead`), on a LocalCluster of two
-workers or more as the last worker's first task (:func:`on_cluster`), while the other workers start the runs.
+A study does the same: on ``--workers 0`` around its runs (:func:`ahead`), on a cluster of two workers or
+more (a LocalCluster, or ``--scheduler``'s workers of one host) as the last worker's first task
+(:func:`on_cluster`), while the other workers start the runs.
 
     python -m masonrycli.engine.compile_ahead     # what the child runs (exit 0 whatever happens)
 """
@@ -173,17 +174,38 @@ def compile_quietly() -> int:
         return -1
 
 
-def on_cluster(client):
-    """The same on a study's LocalCluster: when :func:`needed` and the cluster has two workers or more, its
-    last worker compiles :data:`KERNELS` as its first task while the others start the runs, which then
-    load them (the workers share this process's cache). Returns the task's future (hold it until the
-    study ends: a released future is cancelled), or None."""
-    if not needed():
+def compile_if_needed() -> int:
+    """:func:`compile_quietly` where :func:`needed` says so, in the worker's own process (0 when not): an
+    external cluster's workers have their own cache, which the study's process cannot see."""
+    try:
+        return compile_quietly() if needed() else 0
+    except Exception:  # noqa: BLE001
+        return -1
+
+
+def on_cluster(client, external: bool = False):
+    """The same on a study's cluster: when the cluster has two workers or more that share a cache, the last
+    of them compiles :data:`KERNELS` as its first task while the others start the runs, which then load them.
+    Returns the task's future (hold it until the study ends: a released future is cancelled), or None.
+
+    A LocalCluster's workers share this process's cache, so :func:`needed` is asked here. An external
+    cluster's (``--scheduler``) are asked on the worker itself (:func:`compile_if_needed`), among the workers
+    of the host that has the most (those of one host share a cache, as a study's ``dask worker --nworkers N``
+    do): without it, N workers of an empty cache each compiled every kernel, one after the other."""
+    if not external and not needed():
         return None
-    workers = sorted(client.scheduler_info()["workers"])
-    if len(workers) < 2:
+    try:
+        workers = client.scheduler_info()["workers"]
+    except Exception:  # noqa: BLE001 - a helper never fails the study: its runs compile what they need
         return None
-    return client.submit(compile_quietly, workers=workers[-1:], allow_other_workers=False, pure=False)
+    hosts: dict = {}
+    for address, info in workers.items():
+        hosts.setdefault(info.get("host") if external else None, []).append(address)
+    group = sorted(max(hosts.values(), key=len, default=[]))
+    if len(group) < 2:
+        return None
+    task = compile_if_needed if external else compile_quietly
+    return client.submit(task, workers=group[-1:], allow_other_workers=False, pure=False)
 
 
 def main(argv: list[str]) -> None:
