@@ -146,21 +146,27 @@ def with_record(
         _record_options_alone(scale, record_dt)
         return scenario
     shaking = [m.kind in ("sine", "record") for m in scenario.motions]
-    if not any(shaking) and os.path.abspath(scenario.source or "") == scenario.structure.get("file"):
-        # a GeoJSON / WKT file run as it is: it has no place for a motion, "give one a sine" was no way out
-        file = os.path.basename(scenario.source)
-        if not scenario.assembly.supports:
-            raise InputError(f"--record: {file} has no support to shake (every body in it is a block)")
-        raise InputError(
-            f"--record: {file} holds no motion (its supports are fixed); shake one in a scenario file: "
-            f'[structure] file = "{file}" and a [[support]] name = "{scenario.assembly.supports[0].name}" with '
-            'motion = { kind = "record", file = ... } (masonry docs scenario-format)'
-        )
     if not any(shaking):
-        raise InputError(f"--record: {scenario.name} has no shaking support (give one a sine or record motion)")
+        raise no_shaking_support(scenario, "--record")
     motion = record_motion_option(record, scale, record_dt)
     motions = tuple(motion if shake else m for shake, m in zip(shaking, scenario.motions))
     return dataclasses.replace(scenario, motions=motions)
+
+
+def no_shaking_support(scenario: Scenario, option: str) -> InputError:
+    """The refusal of a record (``--record``, ``sweep --records``: ``option``) for a scenario none of whose
+    supports shakes. A GeoJSON / WKT file run as it is has no place for a motion: "give one a sine" was no
+    way out, so the message writes the scenario file that shakes it."""
+    if os.path.abspath(scenario.source or "") != scenario.structure.get("file"):
+        return InputError(f"{option}: {scenario.name} has no shaking support (give one a sine or record motion)")
+    file = os.path.basename(scenario.source)
+    if not scenario.assembly.supports:
+        return InputError(f"{option}: {file} has no support to shake (every body in it is a block)")
+    return InputError(
+        f"{option}: {file} holds no motion (its supports are fixed); shake one in a scenario file: "
+        f'[structure] file = "{file}" and a [[support]] name = "{scenario.assembly.supports[0].name}" with '
+        'motion = { kind = "record", file = ... } (masonry docs scenario-format)'
+    )
 
 
 def is_built_in(target: str | os.PathLike) -> bool:

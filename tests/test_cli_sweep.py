@@ -199,8 +199,17 @@ def test_records_run_whole_on_a_built_in_and_a_shorter_run_is_warned(block, tmp_
     fixed.write_text(BLOCK.replace('motion = { kind = "sine", amplitude = 0.1, frequency = 2.0 }', ""))
     result = invoke("sweep", fixed, "--records", folder, "--workers", 0, "--out", tmp_path / "f.csv")
     assert result.exit_code == 2 and result.output.strip().splitlines() == [
-        "error: record: fixed has no shaking support (give one a sine or record motion)"
+        "error: --records: fixed has no shaking support (give one a sine or record motion)"
     ]
+    # a geometry file swept as it is, over records: the scenario file that shakes it, as run --record says
+    geo = tmp_path / "wall.geojson"
+    assert invoke("build", "wall", "--blocks", 7, "--out", geo).exit_code == 0
+    result = invoke("sweep", geo, "--records", folder, "--workers", 0, "--out", tmp_path / "g.csv")
+    assert result.exit_code == 2 and words(result.output) == (
+        "error: --records: wall.geojson holds no motion (its supports are fixed); shake one in a scenario file: "
+        '[structure] file = "wall.geojson" and a [[support]] name = "ground" with motion = { kind = "record", '
+        "file = ... } (masonry docs scenario-format)"
+    )
 
 
 def test_failed_rows_give_exit_5_after_the_whole_table(block, tmp_path, monkeypatch):

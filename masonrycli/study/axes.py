@@ -179,7 +179,9 @@ def apply_point(base, params: dict):
         record = base.records[params["record"]]
         shaking = [j for j, m in enumerate(motions) if m.kind in ("sine", "record")]
         if not shaking:
-            raise InputError(f"record: {scenario.name} has no shaking support (give one a sine or record motion)")
+            from masonrycli.builtin import no_shaking_support
+
+            raise no_shaking_support(scenario, "--records")
         for j in shaking:
             motions[j] = record
     names = [s.name for s in scenario.assembly.supports]
