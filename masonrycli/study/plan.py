@@ -306,6 +306,7 @@ def _records(entries: list[Path], out: Path, record_dt: float | None) -> tuple[d
                 unread.append(said)
             if not found:
                 raise InputError(f"--records {entry}: no .AT2, .ASC or .csv record in it")
+            unread += _not_read(entry)
             files += found
         elif entry.is_file():
             files.append(entry)
@@ -331,6 +332,47 @@ def _records(entries: list[Path], out: Path, record_dt: float | None) -> tuple[d
             "with a time column keep their own times): leave it out"
         )
     return motions, unread
+
+
+_NOT_RECORDS = {
+    ".parquet",
+    ".png",
+    ".rrd",
+    ".npz",
+    ".jsonl",
+    ".vt2",
+    ".dt2",
+    ".toml",
+    ".geojson",
+    ".json",
+    ".wkt",
+    ".md",
+    ".pdf",
+}
+"""Suffixes a --records folder may hold beside its records without a word: masonry's own files (a study's
+table, picture, recording, journal; scenarios, geometry; notes) and PEER's velocity and displacement companions."""
+
+
+def _not_read(folder: Path) -> list[str]:
+    """The warning naming the files of a ``--records`` folder that are not read (no hidden file, none of
+    ``_NOT_RECORDS``): a folder of ESM's .ASC files beside its CSVs ran the CSVs alone, without a word, and a
+    K-NET .NS / .EW file or a .txt accelerogram would be left out alike."""
+    other = sorted(
+        p.name
+        for p in folder.iterdir()
+        if p.is_file()
+        and not p.name.startswith(".")
+        and not _is_record_file(p)
+        and p.suffix.lower() not in _NOT_RECORDS
+    )
+    if not other:
+        return []
+    names = ", ".join(other[:3]) + (" …" if len(other) > 3 else "")
+    count = f"{len(other)} file{'s' if len(other) > 1 else ''}"
+    return [
+        f"--records {folder}: {count} not read as records ({names}): a set reads PEER .AT2, ESM .ASC and .csv "
+        "files (convert the others to a CSV of time and acceleration)"
+    ]
 
 
 def _is_record_file(path: Path) -> bool:
