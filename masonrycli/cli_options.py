@@ -128,7 +128,7 @@ RECORD = {
     "record": _opt(
         Path,
         "Loading",
-        "Ground motion record shaking the ground/foundations instead of the sine: PEER .AT2 (g), ESM .ASC (its header's units) or CSV "
+        "Ground motion record shaking the ground/foundations instead of the sine: PEER .AT2 (g), ESM .ASC (its header's units), K-NET .NS/.EW/.UD or CSV "
         "(time, velocity). Baseline-corrected; window and vertical component in a scenario file.",
         "--record",
     ),

@@ -45,7 +45,7 @@ def sweep_command(
         typer.Option(
             "--records",
             parser=path_value,
-            help="Record files (PEER .AT2, ESM .ASC or CSV) or folders of them, repeatable: one axis 'record' over them.",
+            help="Record files (PEER .AT2, ESM .ASC, K-NET .NS/.EW/.UD or CSV) or folders of them, repeatable: one axis 'record' over them.",
         ),
     ] = None,
     record_dt: Annotated[

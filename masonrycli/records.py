@@ -1,11 +1,13 @@
 """Reading ground-motion records from files into :class:`~masonrycli.record_motion.Record` motions.
 
-Three formats, chosen by the file's extension:
+Four formats, chosen by the file's extension:
 
 * ``.AT2`` (PEER NGA): acceleration in g, one component per file, a 4-line header whose last line
   gives ``NPTS`` and ``DT`` (see :func:`load_at2`); samples at t = 0, DT, 2 DT, ...
 * ``.ASC`` (ESM / ITACA): ``KEY: value`` header lines giving ``SAMPLING_INTERVAL_S``, ``NDATA`` and
   ``UNITS`` (acceleration in cm/s², or velocity), then one sample a line (:mod:`masonrycli.record_esm`);
+* ``.NS`` / ``.EW`` / ``.UD`` (K-NET; ``.NS1`` … ``.UD2`` KiK-net): a 17-line header giving the sampling
+  frequency and the counts' scale factor, then the counts (:mod:`masonrycli.record_knet`);
 * ``.VT2`` / ``.DT2`` (PEER's velocity and displacement series) are refused, naming the .AT2;
 * anything else is CSV: one sample per line, ``time,value`` or ``time,x,y``, or one ``value`` per line
   given a time step (samples at t = 0, dt, 2 dt, ...; see :func:`load_record_csv`).
@@ -34,6 +36,7 @@ from masonrycli.errors import (
     special_file,
 )
 from masonrycli.record_esm import esm_text, esm_vertical, is_esm, looks_like_esm
+from masonrycli.record_knet import is_knet, knet_text, knet_vertical
 from masonrycli.record_motion import Record, time_step_problem
 from masonrycli.record_text import NoTimeStep, TimeStepNotUsed, at2_text, csv_text, number
 from masonrycli.record_units import check_at2_header, check_csv_header, header_factor, header_quantity, record_text
@@ -176,6 +179,8 @@ def vertical_at2(path) -> bool:
     whose header says ``COMPONENT: Z`` (or a channel ``HNZ``)."""
     path = os.fspath(path)
     stem, suffix = os.path.splitext(os.path.basename(path))
+    if is_knet(path):
+        return knet_vertical(path)
     if is_esm(path):
         try:
             with open(path, encoding="utf-8", errors="replace") as fh:
@@ -205,7 +210,7 @@ def check_not_peer_other(path, name: str) -> None:
         )
 
 
-RECORD_FILE = "a ground-motion record (a PEER .AT2 file, an ESM .ASC file or a CSV)"
+RECORD_FILE = "a ground-motion record (a PEER .AT2 file, an ESM .ASC file, a K-NET file or a CSV)"
 
 
 def read_record(path, display: str | None = None, time_step: float | None = None) -> tuple:
@@ -236,6 +241,15 @@ def read_record(path, display: str | None = None, time_step: float | None = None
             )
         dt, samples, quantity = load_esm(path, display)
         return np.arange(samples.size) * dt, samples, quantity
+    if is_knet(path):
+        if time_step is not None:
+            raise TimeStepNotUsed(
+                display or str(path),
+                "a K-NET file gives its own time step (Sampling Freq in its header): {key} goes with a CSV of one "
+                "value per line",
+            )
+        dt, acc = knet_text(_read_text(path, name), name)
+        return np.arange(acc.size) * dt, acc, "acceleration"
     time, value = load_record_csv(path, display, time_step)
     return time, value, None
 
@@ -277,7 +291,7 @@ def record_motion(
     time_step = _time_step(time_step, "time_step")
     time, value, native = read_record(path, display, time_step)
     if native is not None and quantity not in (None, native):
-        kind = "an .AT2 file" if is_at2(path) else "this ESM file"
+        kind = "an .AT2 file" if is_at2(path) else "a K-NET file" if is_knet(path) else "this ESM file"
         raise InputError(f"{display or path}: {kind} holds {native}, not {quantity}")
     quantity = quantity or native or header_quantity(path) or "velocity"  # a CSV: as its header says, else m/s
     if native is None:

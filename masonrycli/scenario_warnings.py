@@ -187,7 +187,7 @@ def record_warnings(scenario: Scenario, upright: bool = True) -> list[str]:
             for (name, first), names in numbered.items()
         ]
         + [
-            f"{who(names)}: the record {name} is a vertical component (PEER's UP / DWN, ESM's Z), applied horizontally: give "
+            f"{who(names)}: the record {name} is a vertical component (PEER's UP / DWN, ESM's Z, K-NET's UD), applied horizontally: give "
             "a horizontal one (H1 / H2), or this one as a scenario file's vertical = … beside its horizontal"
             for name, names in sideways.items()
         ]

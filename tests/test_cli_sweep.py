@@ -407,12 +407,12 @@ def test_a_rows_run_replays_with_simulate_and_stop_at_collapse(tmp_path):
 
 
 def test_a_records_folder_names_the_files_it_does_not_read(block, tmp_path):
-    # a K-NET file (.NS) and a one-column .txt accelerogram beside the set's .AT2 were left out without a word
+    # a COSMOS file (.V2) and a one-column .txt accelerogram beside the set's .AT2 were left out without a word
     folder = tmp_path / "records"
     folder.mkdir()
     a = band_limited(0.3, 0.01, [2.0], [0.01], seed=1)[3]
     write_at2(folder / "syn.AT2", a / G_STANDARD, 0.01)
-    (folder / "MYG0041103111446.NS").write_text("Origin Time       2011/03/11 14:46:00\n")
+    (folder / "CE13122.V2").write_text("Corrected accelerogram\n")
     (folder / "quake.txt").write_text("0.1\n0.2\n")
     for own in ("syn.AT2.vt2", "notes.md", ".hidden", "old.png"):  # companions, notes, masonry's files: no word
         (folder / own).write_text("x")
@@ -420,7 +420,7 @@ def test_a_records_folder_names_the_files_it_does_not_read(block, tmp_path):
     result = invoke("sweep", block, "--records", folder, "--workers", 0, "--out", out, "--no-recording")
     assert result.exit_code == 0, result.output
     assert (
-        f"warning: --records {folder}: 2 files not read as records (MYG0041103111446.NS, quake.txt): a set reads "
-        "PEER .AT2, ESM .ASC and .csv files" in words(result.output)
+        f"warning: --records {folder}: 2 files not read as records (CE13122.V2, quake.txt): a set reads "
+        "PEER .AT2, ESM .ASC, K-NET (.NS, .EW, .UD) and .csv files" in words(result.output)
     )
     assert [r["record"] for r in read_rows(out)] == ["syn.AT2"]

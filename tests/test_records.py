@@ -184,11 +184,11 @@ def test_a_peer_velocity_or_displacement_file_names_the_at2(tmp_path, suffix, wh
     [
         (
             "wall.geojson",
-            "a geometry file (GeoJSON), not a ground-motion record (a PEER .AT2 file, an ESM .ASC file or a CSV); masonry run runs it",
+            "a geometry file (GeoJSON), not a ground-motion record (a PEER .AT2 file, an ESM .ASC file, a K-NET file or a CSV); masonry run runs it",
         ),
         (
             "quake.xlsx",
-            "a spreadsheet (.xlsx), not a ground-motion record (a PEER .AT2 file, an ESM .ASC file or a CSV); save the sheet as CSV",
+            "a spreadsheet (.xlsx), not a ground-motion record (a PEER .AT2 file, an ESM .ASC file, a K-NET file or a CSV); save the sheet as CSV",
         ),
         ("run.rrd", "a Rerun recording (.rrd), not a ground-motion record"),
         ("wall.toml", "a scenario file (TOML), not a ground-motion record"),

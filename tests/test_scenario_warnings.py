@@ -234,7 +234,7 @@ def test_a_vertical_component_applied_horizontally_is_warned_about(tmp_path):
     up = "RSN6_IMPVALL.I_I-ELCUP.AT2"
     for motion, name in ((f'file = "{up}"', up), ('file = "q.AT2", direction = [1.0, 0.2]', "q.AT2")):
         assert said(motion) == [
-            f"support \"ground\": the record {name} is a vertical component (PEER's UP / DWN, ESM's Z), applied horizontally: "
+            f"support \"ground\": the record {name} is a vertical component (PEER's UP / DWN, ESM's Z, K-NET's UD), applied horizontally: "
             "give a horizontal one (H1 / H2), or this one as a scenario file's vertical = … beside its horizontal"
         ]
     assert said(f'file = "{up}", vertical = "RSN6_IMPVALL.I_I-ELC180.AT2"')  # the pair given the wrong way round

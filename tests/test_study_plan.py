@@ -179,7 +179,7 @@ def test_a_vertical_component_in_a_record_set_is_named(tmp_path):
     write_at2(folder / "q4.AT2", a / G_STANDARD, 0.01, title="IMPERIAL VALLEY 10/15/79 2316, EL CENTRO ARRAY #6, 230")
     said = plan_study("wall", records=[folder], out=Path("s.csv")).request.warnings
     assert said == (
-        "--records: RSN6_IMPVALL.I_I-ELCUP.AT2, q3.AT2 are vertical components (PEER's UP / DWN, ESM's Z), run along x as "
+        "--records: RSN6_IMPVALL.I_I-ELCUP.AT2, q3.AT2 are vertical components (PEER's UP / DWN, ESM's Z, K-NET's UD), run along x as "
         "the others: leave them out of the set (a scenario file's vertical = … applies one with its horizontal)",
     )
 

@@ -305,7 +305,7 @@ def _records(entries: list[Path], out: Path, record_dt: float | None) -> tuple[d
                     raise InputError(said)
                 unread.append(said)
             if not found:
-                raise InputError(f"--records {entry}: no .AT2, .ASC or .csv record in it")
+                raise InputError(f"--records {entry}: no .AT2, .ASC, K-NET or .csv record in it")
             unread += _not_read(entry)
             files += found
         elif entry.is_file():
@@ -322,7 +322,7 @@ def _records(entries: list[Path], out: Path, record_dt: float | None) -> tuple[d
         names = ", ".join(upright[:3]) + (" …" if len(upright) > 3 else "")
         unread.append(
             f"--records: {names} {'are vertical components' if len(upright) > 1 else 'is a vertical component'} "
-            "(PEER's UP / DWN, ESM's Z), run along x as the others: leave them out of the set (a scenario file's "
+            "(PEER's UP / DWN, ESM's Z, K-NET's UD), run along x as the others: leave them out of the set (a scenario file's "
             "vertical = … applies one with its horizontal)"
         )
     if record_dt is not None and all(m.time_step is None for m in motions.values()):
@@ -370,13 +370,15 @@ def _not_read(folder: Path) -> list[str]:
     names = ", ".join(other[:3]) + (" …" if len(other) > 3 else "")
     count = f"{len(other)} file{'s' if len(other) > 1 else ''}"
     return [
-        f"--records {folder}: {count} not read as records ({names}): a set reads PEER .AT2, ESM .ASC and .csv "
+        f"--records {folder}: {count} not read as records ({names}): a set reads PEER .AT2, ESM .ASC, K-NET (.NS, .EW, .UD) and .csv "
         "files (convert the others to a CSV of time and acceleration)"
     ]
 
 
 def _is_record_file(path: Path) -> bool:
-    return path.suffix.lower() in (".at2", ".asc", ".csv") and path.is_file()
+    from masonrycli.record_knet import KNET_SUFFIXES
+
+    return path.suffix.lower() in (".at2", ".asc", ".csv", *KNET_SUFFIXES) and path.is_file()
 
 
 def _record(path: Path, record_dt: float | None):
