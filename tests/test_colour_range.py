@@ -8,7 +8,15 @@ import numpy as np
 import pytest
 
 from masonrycli import colormap as cm
-from masonrycli.colour_range import BULK_TRIM, MIN_SPAN, OUTSIDE_SHARE, ColourRange, RangeTracker, fit_range
+from masonrycli.colour_range import (
+    BULK_TRIM,
+    HOLD_SPAN,
+    MIN_SPAN,
+    OUTSIDE_SHARE,
+    ColourRange,
+    RangeTracker,
+    fit_range,
+)
 
 
 def outside_share(r: ColourRange, v: np.ndarray) -> float:
@@ -27,10 +35,12 @@ def span_share(r: ColourRange, v: np.ndarray) -> float:
 @pytest.mark.parametrize("kind", ["signed", "negative", "positive"])
 def test_every_frame_keeps_both_rules_on_a_growing_then_calming_field(kind):
     """A field that grows 50× then calms down 50× (as a cumulated strain, a shaking): every frame has
-    at most 2 % of its cells outside the range in force and spans at least MIN_SPAN of it."""
+    at most 2 % of its cells outside the range in force and spans at least MIN_SPAN of it — on a signed
+    scale at least HOLD_SPAN, and MIN_SPAN again by the next frame (SHRINK_AFTER)."""
     rng = np.random.default_rng(1)
     tracker = RangeTracker(kind, floor=1e-9)
     amplitude = np.r_[np.geomspace(1.0, 50.0, 60), np.geomspace(50.0, 1.0, 60)]
+    short_before = False
     for a in amplitude:
         v = a * rng.standard_normal(300)
         v[rng.integers(0, 300, 3)] *= 30.0  # a few outliers (1 %)
@@ -38,7 +48,9 @@ def test_every_frame_keeps_both_rules_on_a_growing_then_calming_field(kind):
         v[5] = np.nan  # undefined cells do not count
         r = tracker.update(v)
         assert outside_share(r, v) <= OUTSIDE_SHARE
-        assert span_share(r, v) >= MIN_SPAN
+        short = span_share(r, v) < MIN_SPAN
+        assert not short or (kind == "signed" and span_share(r, v) >= HOLD_SPAN and not short_before)
+        short_before = short
         assert r.lo <= 0.0 <= r.hi
         if kind == "negative":
             assert r.hi == 0.0  # one-sided: the map ends at zero

@@ -149,3 +149,30 @@ def test_the_sqrt_tab_follows_its_twin_live_and_the_legend_says_what_it_is(tmp_p
     assert names.index(tab) == names.index(FIELD_TABS[sqrt_p.key]) + 1  # right after its linear twin
     legend = fx.static_value(path, "/run/legend", "TextDocument:text")[0]
     assert f"{tab} = the same on a square-root scale" in legend
+
+
+def test_the_recorded_strain_rate_ranges_hold_through_one_short_frame(tmp_path):
+    """Read back: the volumetric strain rate's ranges logged for a run whose rate dips for one frame, two in a
+    row, or deeply, are the plain reference's (test_colour_range_hold), which keeps the range through a single
+    short frame; batches of 5 frames cut the dips anywhere."""
+    from test_colour_range_hold import dipping_frames, reference
+
+    static, q0 = fx.wall(12, 10)
+    rates = 0.01 * dipping_frames("signed", count=60, seed=2)[:, : len(q0)]
+    rates[40] = 0.01  # dipping_frames' frame without a defined cell: a uniform one here (a cell is never NaN)
+    rng = np.random.default_rng(3)
+    frames = []
+    for k, v in enumerate(rates):
+        f = fx.frame(static, q0, 10 * (k + 1), rng)
+        f.tensors["cell_volumetric_strain_rate"] = v
+        frames.append(f)
+    path = tmp_path / "rates.rrd"
+    with Recorder(path, static, fx.METADATA, batch_frames=5) as rec:
+        for f in frames:
+            rec.log_frame(f)
+    spec = FIELD_BY_KEY["cell_volumetric_strain_rate"]
+    expected, why = reference("signed", spec.floor, rates, 2)
+    read = field_frames(path)
+    got = [read[f.step]["ranges"][spec.key] for f in frames]
+    assert got == [(r.lo, r.hi) for r in expected]
+    assert why.count("short kept") >= 2

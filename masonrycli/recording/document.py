@@ -16,7 +16,7 @@ import numpy as np
 import rerun as rr
 
 from masonrycli import __version__ as MASONRY_VERSION
-from masonrycli.colour_range import BULK_TRIM, MIN_SPAN, OUTSIDE_SHARE
+from masonrycli.colour_range import BULK_TRIM, HOLD_SPAN, MIN_SPAN, OUTSIDE_SHARE
 from masonrycli.recording.layout import (
     AXES,
     FIELD_TABS,
@@ -97,7 +97,8 @@ def run_document(
         "- **Colour ranges follow the data**: each field's range is checked against every recorded frame "
         f"and refitted from that frame on only when more than {100 * OUTSIDE_SHARE:g} % of the cells fall "
         f"outside it or the cells, leaving out the {100 * BULK_TRIM:g} % most extreme at each end, span less "
-        f"than {100 * MIN_SPAN:g} % of it; the colour bar always shows "
+        f"than {100 * MIN_SPAN:g} % of it (on the signed strain-rate scale: in two frames in a row, or less than "
+        f"{100 * HOLD_SPAN:g} % in one); the colour bar always shows "
         "the range in force (five ticks) and how many cells are beyond it.",
         *(
             f"- **{SQRT_TABS[f.name]}** (not one of the paper's views): {f.title.split(',')[0].lower()} on a "
