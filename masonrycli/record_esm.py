@@ -110,6 +110,22 @@ def esm_vertical(text_head: list[str]) -> bool:
     return False
 
 
+def esm_series(path) -> str:
+    """The ``DATA_TYPE`` an ESM file's header gives (upper case; "" when it gives none or cannot be read):
+    a ``--records`` folder of an ESM download holds each component's ACCELERATION, VELOCITY and
+    DISPLACEMENT files and spectra, and reads the first alone."""
+    try:
+        with open(path, encoding="utf-8", errors="replace") as fh:
+            head = [fh.readline() for _ in range(100)]
+    except OSError:
+        return ""
+    for line in head:
+        m = _KEY.match(line)
+        if m and m.group(1).upper() == "DATA_TYPE":
+            return m.group(2).strip().upper()
+    return ""
+
+
 def _header(text: str) -> tuple[dict[str, tuple[str, int]], int]:
     """``({KEY: (value, line)}, index of the first sample line's start)``: the ``KEY: value`` lines up to the
     first line that holds a number (the first key of a name wins)."""

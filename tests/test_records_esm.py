@@ -160,3 +160,37 @@ def test_a_records_folder_sweeps_its_esm_files(tmp_path):
     esm, csv = rows["IT.NRC..HNE.D.20161030.064017.C.ACC.ASC"], rows["same.csv"]
     for column in ("state", "pga", "pgv", "arias", "energy_dissipated", "peak_drift"):
         assert repr(esm[column]) == repr(csv[column]), column  # the same record, read from either file
+
+
+def test_a_records_folder_of_an_esm_download_takes_the_acceleration_files(tmp_path):
+    # an ESM zip holds each component's ACC, VEL and DIS files (and spectra): read all, a folder stopped at the
+    # DIS file, or ran the VEL file beside its ACC as a second record of the same shaking
+    folder = tmp_path / "recs"
+    folder.mkdir()
+    stem = "IT.NRC..HNE.D.20161030.064017.C"
+    (folder / f"{stem}.ACC.ASC").write_text(ESM.read_text())
+    velocity = (
+        ESM.read_text()
+        .replace("UNITS: cm/s^2", "UNITS: cm/s")
+        .replace("DATA_TYPE: ACCELERATION", "DATA_TYPE: VELOCITY")
+    )
+    (folder / f"{stem}.VEL.ASC").write_text(velocity)
+    (folder / f"{stem}.DIS.ASC").write_text(
+        velocity.replace("UNITS: cm/s", "UNITS: cm").replace("VELOCITY", "DISPLACEMENT")
+    )
+    spectrum = ESM.read_text().replace("DATA_TYPE: ACCELERATION", "DATA_TYPE: ACCELERATION RESPONSE SPECTRUM")
+    (folder / f"{stem}.SA.ASC").write_text(spectrum)
+    out = tmp_path / "s.csv"
+    args = ["sweep", BLOCK, "--records", folder, "--scale", 1, "--duration", 0.2, "--workers", 0, "--out", out]
+    result = invoke(*args, "--no-recording")
+    assert result.exit_code == 0, result.output
+    assert [r["record"] for r in read_rows(out)] == [f"{stem}.ACC.ASC"]
+    said = words(result.output)
+    assert (
+        f"--records {folder}: 3 ESM files of another series than acceleration left out ({stem}.DIS.ASC, "
+        f"{stem}.SA.ASC, {stem}.VEL.ASC): a set folder takes each component's acceleration" in said
+    )
+    assert "not read as records" not in said  # named once, by the line that says why
+    # given by name, the velocity file runs (as velocity, m/s)
+    result = invoke("check", BLOCK, "--record", folder / f"{stem}.VEL.ASC")
+    assert result.exit_code == 0 and "record of velocity" in words(result.output), result.output

@@ -306,7 +306,7 @@ def _records(entries: list[Path], out: Path, record_dt: float | None) -> tuple[d
                 unread.append(said)
             if not found:
                 raise InputError(f"--records {entry}: no .AT2, .ASC, K-NET or .csv record in it")
-            unread += _not_read(entry)
+            unread += _not_read(entry) + _esm_others(entry)
             files += found
         elif entry.is_file():
             files.append(entry)
@@ -364,6 +364,7 @@ def _not_read(folder: Path) -> list[str]:
         and not p.name.startswith(".")
         and not _is_record_file(p)
         and p.suffix.lower() not in _NOT_RECORDS
+        and not _esm_other(p)
     )
     if not other:
         return []
@@ -375,10 +376,36 @@ def _not_read(folder: Path) -> list[str]:
     ]
 
 
+def _esm_others(folder: Path) -> list[str]:
+    """The warning naming a folder's ESM files of another series than acceleration, left out: an ESM download
+    holds each component's ….ACC.ASC, ….VEL.ASC, ….DIS.ASC and spectra, and read all it ran each record twice
+    (its acceleration and its velocity, two rows of one shaking) or stopped at the first displacement file."""
+    other = sorted(p.name for p in folder.iterdir() if p.is_file() and _esm_other(p))
+    if not other:
+        return []
+    names = ", ".join(other[:3]) + (" …" if len(other) > 3 else "")
+    return [
+        f"--records {folder}: {len(other)} ESM file{'s' if len(other) > 1 else ''} of another series than "
+        f"acceleration left out ({names}): a set folder takes each component's acceleration (….ACC.ASC); give a "
+        "velocity file by its name to run it"
+    ]
+
+
+def _esm_other(path: Path) -> bool:
+    """An ESM .ASC file whose header says it is no acceleration series (VELOCITY, DISPLACEMENT, a spectrum)."""
+    from masonrycli.record_esm import esm_series
+
+    return path.suffix.lower() == ".asc" and esm_series(path) not in ("", "ACCELERATION")
+
+
 def _is_record_file(path: Path) -> bool:
+    """A file a --records folder reads: .AT2, .csv, K-NET, and ESM .ASC files of acceleration."""
     from masonrycli.record_knet import KNET_SUFFIXES
 
-    return path.suffix.lower() in (".at2", ".asc", ".csv", *KNET_SUFFIXES) and path.is_file()
+    suffix = path.suffix.lower()
+    if suffix not in (".at2", ".asc", ".csv", *KNET_SUFFIXES) or not path.is_file():
+        return False
+    return not _esm_other(path)
 
 
 def _record(path: Path, record_dt: float | None):
