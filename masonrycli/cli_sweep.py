@@ -337,7 +337,7 @@ def _report(console, result, plan: StudyPlan, im: str, written: list, signals: F
         if request.find:
             title = f"{name}: {request.outcome} threshold"
             searched = searched_range(request)
-            threshold_curve(rows, request.find, names[0] if names else None, part, title, searched)
+            threshold_curve(rows, request.find, names[0] if names else None, part, title, searched, tuple(names[1:]))
         elif "record" in [a.name for a in axes]:
             good = [r for r in rows if r.get("status") != "error"]
             # one curve per value of the other swept parameters: pooled, two frictions made one curve of neither

@@ -201,6 +201,36 @@ def test_thresholds_along_record_names_are_points_not_a_line(png_figures, tmp_pa
     assert [c.key for c in threshold_series(rows, "scale", np.arange(3.0), (0.5, 3.0))][:2] == ["line", "points"]
 
 
+def test_thresholds_over_records_and_friction_are_one_series_a_friction(png_figures, tmp_path):
+    """``--records DIR --find scale --param friction=0.5,0.7``: the two frictions' thresholds were one red
+    series, two points at each record, which was which unsaid. One series a friction, in its own colour, its
+    label first, in the PNG and the recording alike."""
+    thresholds = {0.5: (1.7, 2.3, 0.4), 0.7: (1.9, 2.5, 1.1)}
+    rows = [
+        {"record": name, "friction": mu, "scale_threshold": t, "scale_lo": t - 0.1, "scale_hi": t + 0.1}
+        | {"outcome": "collapse", "status": "completed", "note": ""}
+        for k, name in enumerate(("elcentro.AT2", "kobe.AT2", "norcia.ASC"))
+        for mu, t in ((mu, thresholds[mu][k]) for mu in (0.5, 0.7))
+    ]
+    args = (rows, "scale", "record", tmp_path / "t.png", "thresholds", (0.25, 4.0))
+    plots.threshold_curve(*args, ("friction",))
+    axes = [
+        SimpleNamespace(name="scale", values=(0.25, 4.0)),
+        SimpleNamespace(name="record", values=("elcentro.AT2", "kobe.AT2", "norcia.ASC")),
+        SimpleNamespace(name="friction", values=(0.5, 0.7)),
+    ]
+    request = SimpleNamespace(axes=axes, find="scale")
+    rrd = record_study(tmp_path / "t.rrd", "s", rows, request, None, "pga", tmp_path / "t.png")
+    series = recorded_series(rrd, "study/thresholds")
+    png = png_figures[0]
+    for g, mu in enumerate((0.5, 0.7)):
+        points = series[f"/study/thresholds/points/{g}"]
+        assert points["label"] == f"friction = {mu:g}: scale_threshold"
+        assert points["x"] == [0, 1, 2] and points["y"] == list(thresholds[mu])
+        assert png[points["label"]] == points["rgb"]
+    assert len(png) == 2 and len(set(png.values())) == 2
+
+
 def test_thresholds_along_record_names_draw_no_line_in_the_png(tmp_path, monkeypatch):
     import matplotlib.figure
 

@@ -380,7 +380,7 @@ def _log_thresholds(rec, rows: list[dict], find: str, names: list[str], searched
         whole = bool(np.all(at[np.isfinite(at)] == np.rint(at[np.isfinite(at)])))
         per_unit = 1.0 if whole else 1000.0
         timeline, against = x_scale(x or "point", unit, per_unit)
-    series = threshold_series(rows, find, at, searched, joined=by_name is None)
+    series = threshold_series(rows, find, at, searched, joined=by_name is None, by=names[1:])
     _send_curve(rec, "study/thresholds", timeline, per_unit, series)
     # Every swept point is in the view, found or not, with a margin beside the outermost: the range was
     # the found points' alone, so one found point (friction 0.6; none at 0.3) sat on the right edge, cut.

@@ -92,6 +92,18 @@ def fit_label(fit, unit: str) -> str:
     return f"lognormal: θ = {fit.median:.3g} {unit}, β = {fit.dispersion:.2f}"
 
 
+def point_groups(rows: list[dict], by: list[str]) -> list[tuple[str, list[int]]]:
+    """``(label, row indices)`` of each combination of the values of parameters ``by`` in ``rows``, in the rows'
+    order (``friction = 0.5``); one group ``("", every row)`` when ``by`` is empty."""
+    groups: dict[tuple, list[int]] = {}
+    for i, r in enumerate(rows):
+        groups.setdefault(tuple(r.get(k) for k in by), []).append(i)
+    return [
+        (", ".join(f"{k} = {v:g}" if isinstance(v, float) else f"{k} = {v}" for k, v in zip(by, values)), members)
+        for values, members in groups.items()
+    ]
+
+
 def fragility_series(rows: list[dict], im: str, fit, unit: str, groups=None) -> list[Series]:
     """The runs at 0 or 1 by state, the fraction collapsed per scale (at the scale's mean IM), the
     fitted lognormal from IM = 0 to 1.2 × the largest (300 points); ``rows`` without the failed runs.
@@ -136,7 +148,7 @@ def _fraction(rows: list[dict], im: str, key: str, label: str, colour: str) -> l
 
 
 def threshold_series(
-    rows: list[dict], find: str, at: np.ndarray, searched: tuple[float, float], joined: bool = True
+    rows: list[dict], find: str, at: np.ndarray, searched: tuple[float, float], joined: bool = True, by=()
 ) -> list[Series]:
     """``<find>_threshold`` at ``at`` (each row's position on the x axis) as a line with its points (points
     alone unless ``joined``: along record names, whose order is alphabetical, a line between two records
@@ -144,7 +156,9 @@ def threshold_series(
     the points where the search found none, marked at the searched range's top (``searched`` = the
     lowest and highest value tried first) when the outcome was not reached up to it, at its bottom when
     it was reached already there; a failed search (status error) is left out. The line's label says when
-    the outcome holds below the threshold (``holds``)."""
+    the outcome holds below the threshold (``holds``). ``by``: the other swept parameters than the x axis's
+    (``friction`` beside ``record``): one line a value of them, in its colour, its label first (two
+    frictions' thresholds were one red line, their points two at each record, which was which unsaid)."""
     at = np.asarray(at, dtype=np.float64)
     y = np.array([_number(r.get(f"{find}_threshold")) for r in rows], dtype=np.float64)
     hi = np.array([_number(r.get(f"{find}_hi")) for r in rows], dtype=np.float64)
@@ -152,7 +166,6 @@ def threshold_series(
     found = np.isfinite(y) & np.isfinite(at)
     none = ~np.isfinite(y) & np.isfinite(at) & searched_ok
     above, below = none & ~np.isfinite(hi), none & np.isfinite(hi)  # hi: the lowest value that reached it
-    order = np.argsort(at[found], kind="stable")
     label = f"{with_unit(find).replace(find, find + '_threshold', 1)}"
     outcome = next((r.get("outcome") for r in rows if r.get("outcome")), "outcome")
     sides = {r.get("holds") for r, f in zip(rows, found) if f}
@@ -161,11 +174,23 @@ def threshold_series(
     elif "below" in sides:
         label += f": {outcome} above it, below where holds = below"
     lo_v, hi_v = searched
-    x_found, y_found = at[found][order], y[found][order]
-    curve = [Series("line", label, THRESHOLD_COLOUR, "line", x_found, y_found)] if joined else []
+    groups = point_groups(rows, list(by))
+    curves = []
+    for g, (name, members) in enumerate(groups):
+        mine = np.zeros(len(rows), dtype=bool)
+        mine[members] = True
+        pick = found & mine
+        order = np.argsort(at[pick], kind="stable")
+        x_found, y_found = at[pick][order], y[pick][order]
+        key, colour = ("", THRESHOLD_COLOUR) if len(groups) == 1 else (f"/{g}", GROUP_COLOURS[g % len(GROUP_COLOURS)])
+        shown = f"{name}: {label}" if len(groups) > 1 else label
+        if joined:
+            curves.append(Series("line" + key, shown, colour, "line", x_found, y_found))
+        curves.append(
+            Series("points" + key, shown + (": points" if joined else ""), colour, "circle", x_found, y_found)
+        )
     return [
-        *curve,
-        Series("points", label + (": points" if joined else ""), THRESHOLD_COLOUR, "circle", x_found, y_found),
+        *curves,
         Series(
             "not_found/above",
             f"none found: no {outcome} up to {find} = {hi_v:g}",

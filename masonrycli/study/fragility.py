@@ -95,14 +95,13 @@ class FitGroup:
 def fit_by(rows: list[dict], im: str, by: list[str]) -> list[FitGroup]:
     """One :class:`FitGroup` per combination of the values of parameters ``by`` in ``rows`` (failed runs
     left out by the caller), in the rows' order; one group of every row when ``by`` is empty (or no row)."""
+    from masonrycli.study.curves import point_groups
+
     if not rows:
         return [FitGroup("", [], None)]
-    groups: dict[tuple, list[dict]] = {}
-    for r in rows:
-        groups.setdefault(tuple(r.get(k) for k in by), []).append(r)
     out = []
-    for values, members in groups.items():
-        label = ", ".join(f"{k} = {v:g}" if isinstance(v, float) else f"{k} = {v}" for k, v in zip(by, values))
+    for label, indices in point_groups(rows, by):
+        members = [rows[i] for i in indices]
         fit = fit_lognormal([r[im] for r in members], [r["state"] == "collapsed" for r in members], im)
         out.append(FitGroup(label, members, fit))
     return out

@@ -140,13 +140,16 @@ def fragility_curve(rows: list[dict], im: str, fit, path: Path, title: str, unit
         _pyplot().close(fig)  # also when saving fails: a long-lived process would keep every figure
 
 
-def threshold_figure(rows: list[dict], find: str, x: str | None, title: str, searched: tuple[float, float]):
-    """``<find>_threshold`` against parameter ``x`` (the points in order without one), the points where
-    none was found marked at the end of the searched range (``threshold_series``)."""
+def threshold_figure(
+    rows: list[dict], find: str, x: str | None, title: str, searched: tuple[float, float], by: tuple = ()
+):
+    """``<find>_threshold`` against parameter ``x`` (the points in order without one), one line a value of
+    the other swept parameters ``by``, the points where none was found marked at the end of the searched
+    range (``threshold_series``)."""
     plt = _pyplot()
     fig, ax = plt.subplots(figsize=(6.0, 4.0))
     at, names = axis_positions(rows, x)
-    _draw(ax, threshold_series(rows, find, at, searched, joined=names is None))
+    _draw(ax, threshold_series(rows, find, at, searched, joined=names is None, by=by))
     if names is not None:
         ax.set_xticks(range(len(names)), names, rotation=45)
     elif not x:  # the points in order, numbered from 1 (one point was ticked -0.04 … 0.04 around 0)
@@ -161,10 +164,10 @@ def threshold_figure(rows: list[dict], find: str, x: str | None, title: str, sea
 
 
 def threshold_curve(
-    rows: list[dict], find: str, x: str | None, path: Path, title: str, searched: tuple[float, float]
+    rows: list[dict], find: str, x: str | None, path: Path, title: str, searched: tuple[float, float], by: tuple = ()
 ) -> Path:
     """PNG of :func:`threshold_figure`."""
-    fig = threshold_figure(rows, find, x, title, searched)
+    fig = threshold_figure(rows, find, x, title, searched, by)
     try:
         return _save(fig, path)
     finally:
