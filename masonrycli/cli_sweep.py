@@ -347,7 +347,7 @@ def _report(console, result, plan: StudyPlan, im: str, written: list, signals: F
             fragility_curve(good, im, fit, part, title, UNITS[im], groups)
         else:
             x, y = names[0] if names else axes[0].name, names[1] if len(names) > 1 else None
-            state_map(rows, x, y, part, name)
+            state_map(rows, x, y, part, name, tuple(names[2:]))
     if recording is not None:
         from masonrycli.recording.study import record_study
 

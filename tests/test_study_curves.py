@@ -309,6 +309,49 @@ def test_the_state_maps_cells_and_ticks_are_the_same_for_both_pictures():
     assert map_axis([{"record": "b.AT2"}, {"record": "a.AT2"}], "record") == (["a.AT2", "b.AT2"], ["a.AT2", "b.AT2"])
 
 
+def test_a_grid_of_three_parameters_maps_each_value_of_the_third_apart(tmp_path, monkeypatch):
+    """``--param amp=0.5,1.5 --param freq=1,2 --param friction=0.3,0.7``: one map drew both frictions' runs in
+    each cell, the last one's state shown. One map a friction in the PNG, each cell its own run's colour; in the
+    recording the two runs of a cell side by side, their hover naming the friction."""
+    import matplotlib.figure
+
+    rows = [
+        {"amp": a, "freq": f, "friction": mu, "status": "completed", "collapse_time": math.nan}
+        | {"state": "collapsed" if a > 1 and mu < 0.5 else "damaged" if a > 1 else "intact"}
+        for a in (0.5, 1.5)
+        for f in (1.0, 2.0)
+        for mu in (0.3, 0.7)
+    ]
+    maps: dict[str, dict] = {}
+
+    def catch(fig, path, **kwargs):
+        for ax in fig.axes:
+            if ax.get_visible() and ax.patches:
+                cells = {(round(p.get_x() + 0.5), round(p.get_y() + 0.5)): p.get_facecolor()[:3] for p in ax.patches}
+                maps[ax.get_title()] = {k: tuple(round(255 * c) for c in v) for k, v in cells.items()}
+        with open(path, "wb") as fh:
+            fh.write(b"\x89PNG")
+
+    monkeypatch.setattr(matplotlib.figure.Figure, "savefig", catch)
+    plots.state_map(rows, "amp", "freq", tmp_path / "m.png", "wall", ("friction",))
+    assert sorted(maps) == ["friction = 0.3", "friction = 0.7"]
+    for r in rows:
+        cell = ([0.5, 1.5].index(r["amp"]), [1.0, 2.0].index(r["freq"]))
+        assert maps[f"friction = {r['friction']:g}"][cell] == rgb(STATE_COLOURS[r["state"]])
+    axes = [
+        SimpleNamespace(name=n, values=v)
+        for n, v in (("amp", (0.5, 1.5)), ("freq", (1.0, 2.0)), ("friction", (0.3, 0.7)))
+    ]
+    rrd = record_study(tmp_path / "m.rrd", "wall", rows, SimpleNamespace(axes=axes, find=None), None, "pga", None)
+    for ch in rr.chunk.RrdReader(str(rrd)).stream():
+        batch = ch.to_record_batch()
+        if ch.entity_path == "/study/state_map" and "Points2D:positions" in batch.schema.names:
+            positions = [tuple(p) for p in batch.column("Points2D:positions").to_pylist()[0]]
+            labels = batch.column("Points2D:labels").to_pylist()[0]
+    assert len(set(positions)) == 8  # every run its own dot
+    assert labels[0] == "amp=0.5 freq=1.0 friction=0.3: intact"
+
+
 def test_a_user_whose_home_cannot_be_written_gets_no_matplotlib_warning(tmp_path):
     # 'nobody', a container's user: matplotlib said on stderr at every sweep that it made a temporary folder
     import os

@@ -61,6 +61,7 @@ from masonrycli.study.curves import (
     axis_positions,
     fragility_series,
     map_axis,
+    point_groups,
     rgb,
     searched_range,
     threshold_series,
@@ -258,7 +259,7 @@ def _log_state_map(rec, rows: list[dict], names: list[str]) -> None:
     values: amp = 0.1, 0.2 beside freq = 1, 2 were dots 0.1 apart on a map 1 high, their labels drawn over
     each other, "amp=0.amp=0.2"), with the values, the axes' names and the key as labels laid out not to
     overlap at the view's estimated scale (:func:`map_scale_px`). The values are on hover."""
-    names = names[:2]
+    names, by = names[:2], names[2:]
     values, ticks = zip(*(map_axis(rows, name) for name in names)) if names else ((), ())
     index = [{v: i for i, v in enumerate(vs)} for vs in values]
     n = (len(values[0]) if names else 1, len(values[1]) if len(names) > 1 else 1)
@@ -266,11 +267,18 @@ def _log_state_map(rec, rows: list[dict], names: list[str]) -> None:
         [[index[k][r[name]] if k < len(names) else 0 for k, name in enumerate((*names, None, None)[:2])] for r in rows],
         dtype=np.float32,
     ).reshape(-1, 2)
+    # a third swept parameter's runs side by side in their cell (drawn at one place, the last hid the others),
+    # in the order of its values, smaller; the PNG draws one map a value
+    groups = point_groups(rows, by)
+    radius = DOT_RADIUS if len(groups) == 1 else min(DOT_RADIUS, 0.4 / len(groups))
+    for g, (_, members) in enumerate(groups):
+        pos[members, 0] += (g - (len(groups) - 1) / 2) * 2.2 * radius if len(groups) > 1 else 0.0
     colours = np.array([STATE_RGBA.get(r.get("state") or "", STATE_RGBA[""]) for r in rows], dtype=np.uint8)
     labels = [
-        viewer_safe_text(" ".join(f"{n}={r[n]}" for n in names) + f": {r.get('state') or 'failed'}") for r in rows
+        viewer_safe_text(" ".join(f"{n}={r[n]}" for n in (*names, *by)) + f": {r.get('state') or 'failed'}")
+        for r in rows
     ]
-    points = rr.Points2D(pos, colors=colours, labels=labels, radii=DOT_RADIUS, show_labels=False)
+    points = rr.Points2D(pos, colors=colours, labels=labels, radii=radius, show_labels=False)
     rec.log("study/state_map", points, static=True)
     ticks = [[viewer_safe_text(t) for t in texts] for texts in ticks]
     # The scale depends on the labels' extent, which depends on the scale (a label's size in map units is

@@ -22,6 +22,7 @@ from masonrycli.study.curves import (
     axis_positions,
     fragility_series,
     map_axis,
+    point_groups,
     threshold_series,
     with_unit,
 )
@@ -55,14 +56,39 @@ def _save(fig, path: Path) -> Path:
     return path
 
 
-def state_map(rows: list[dict], x: str, y: str | None, path: Path, title: str) -> Path:
-    """PNG of the states over parameters ``x`` (and ``y``): one coloured cell per run."""
+def state_map(rows: list[dict], x: str, y: str | None, path: Path, title: str, by: tuple = ()) -> Path:
+    """PNG of the states over parameters ``x`` (and ``y``): one coloured cell per run; one map a value of the
+    other swept parameters ``by``, side by side, each titled with it (``friction = 0.3``): in one map a third
+    axis's runs were drawn over each other, the last one's state shown for the cell."""
     plt = _pyplot()  # first: matplotlib imported quietly
     from matplotlib.patches import Patch
 
     xs, x_ticks = map_axis(rows, x)
     ys, y_ticks = map_axis(rows, y) if y else ([0], [])
-    fig, ax = plt.subplots(figsize=(1.2 + 0.7 * len(xs), 1.2 + 0.55 * len(ys)))
+    groups = point_groups(rows, list(by))
+    cols = min(len(groups), 4)
+    lines = -(-len(groups) // cols)
+    size = (1.2 + 0.7 * len(xs), 1.2 + 0.55 * len(ys))
+    figsize = size if cols == 1 else (size[0] * cols + 0.4 * (cols - 1), size[1] * lines + 0.3 * lines)
+    fig, grid = plt.subplots(lines, cols, figsize=figsize, squeeze=False, layout="constrained" if cols > 1 else None)
+    for ax, (label, members) in zip(grid.flat, groups):
+        _map_cells(ax, [rows[i] for i in members], x, y, xs, ys, x_ticks, y_ticks)
+        ax.set_title(label or title, fontsize=10)
+    for ax in list(grid.flat)[len(groups) :]:
+        ax.set_visible(False)
+    handles = [Patch(color=STATE_COLOURS[s], label=s) for s in ("intact", "damaged", "collapsed")]
+    grid.flat[cols - 1].legend(handles=handles, loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False)
+    if len(groups) > 1:
+        fig.suptitle(title, fontsize=10)
+    try:
+        return _save(fig, path)
+    finally:
+        plt.close(fig)  # also when saving fails: a long-lived process would keep every figure
+
+
+def _map_cells(ax, rows: list[dict], x: str, y: str | None, xs: list, ys: list, x_ticks, y_ticks) -> None:
+    """One state map: a coloured cell a run at its (x, y) values, the collapse time written in it."""
+    plt = _pyplot()
     for r in rows:
         i, j = xs.index(r[x]), ys.index(r[y]) if y else 0
         colour = STATE_COLOURS.get(r.get("state") or "", STATE_COLOURS[""])
@@ -79,13 +105,6 @@ def state_map(rows: list[dict], x: str, y: str | None, path: Path, title: str) -
         ax.set_ylabel(with_unit(y))
     else:
         ax.set_yticks([])
-    handles = [Patch(color=STATE_COLOURS[s], label=s) for s in ("intact", "damaged", "collapsed")]
-    ax.legend(handles=handles, loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False)
-    ax.set_title(title, fontsize=10)
-    try:
-        return _save(fig, path)
-    finally:
-        plt.close(fig)  # also when saving fails: a long-lived process would keep every figure
 
 
 def _draw(ax, series) -> None:
