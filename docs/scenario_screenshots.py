@@ -23,7 +23,8 @@ from masonrycli.recording import screenshot_recording
 
 SHOTS = {  # recording -> (instant s, image stem, tabs to keep: tab index -> suffix)
     "wall51": (0.1, "wall51-t0.1", {1: "fig-III.2", 2: "fig-III.3", 3: "fig-III.4", 4: "fig-III.5"}),
-    "wall248": (0.1, "wall248-t0.1", {1: "fig-III.2", 2: "fig-III.3", 3: "fig-III.4", 4: "fig-III.5"}),
+    # tab 8: the spherical stress on the square-root scale ("p √"), live, at the same instant
+    "wall248": (0.1, "wall248-t0.1", {1: "fig-III.2", 2: "fig-III.3", 3: "fig-III.4", 4: "fig-III.5", 8: "p-sqrt"}),
     "arch": (5.0, "arch-t5", {1: "fig-III.7", 2: "fig-III.8", 3: "fig-III.9", 4: "fig-III.10", 10: "magnified"}),
     "aqueduct": (
         5.0,
