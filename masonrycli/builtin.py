@@ -33,9 +33,10 @@ import math
 import os
 from collections.abc import Callable
 from pathlib import Path
+from types import SimpleNamespace
 
 from masonrycli.errors import NOT_A_FILE, InputError, file_kind, special_file
-from masonrycli.motion import Constant, Sine
+from masonrycli.motion import Constant, Fixed, Sine
 from masonrycli.record_motion import Record, time_step_problem
 from masonrycli.record_text import NoTimeStep, TimeStepNotUsed
 from masonrycli.records import record_motion
@@ -141,30 +142,60 @@ def record_motion_option(path: Path, scale: float | None, record_dt: float | Non
 def with_record(
     scenario: Scenario, record: Path | None, scale: float | None, record_dt: float | None = None
 ) -> Scenario:
-    """``scenario`` with every shaking support (sine or record motion) driven by the ``record`` file."""
+    """``scenario`` with the supports a record shakes (:func:`shaken_supports`) driven by the ``record`` file."""
     if record is None:
         _record_options_alone(scale, record_dt)
         return scenario
-    shaking = [m.kind in ("sine", "record") for m in scenario.motions]
-    if not any(shaking):
+    if not any(shaken_supports(scenario)):
         raise no_shaking_support(scenario, "--record")
-    motion = record_motion_option(record, scale, record_dt)
+    return shaken_by(scenario, record_motion_option(record, scale, record_dt))
+
+
+def _geometry_as_is(scenario: Scenario) -> bool:
+    """Whether ``scenario`` is a GeoJSON / WKT file run as it is (every support fixed, no scenario file)."""
+    return bool(scenario.source) and os.path.abspath(scenario.source) == scenario.structure.get("file")
+
+
+def shaken_supports(scenario: Scenario) -> list[bool]:
+    """Which supports a record (``--record``, ``sweep --records``) shakes: those with a sine or record motion.
+    A GeoJSON / WKT file run as it is has none (it holds no motion): there, its support when it has one —
+    ``masonry run wall.geojson --record q.AT2`` of a wall on its ground was refused, and a scenario file had to
+    be written to say the obvious; of several, which one is for a scenario file to say."""
+    shaking = [m.kind in ("sine", "record") for m in scenario.motions]
+    if any(shaking) or not _geometry_as_is(scenario):
+        return shaking
+    return [True] if len(shaking) == 1 else shaking
+
+
+def shaken_by(scenario: Scenario, motion) -> Scenario:
+    """``scenario`` with its :func:`shaken_supports` moved by ``motion``; a geometry file's warning that the
+    support it marks driven stays fixed (it has no motion) is left out: the record drives it now."""
+    from masonrycli.scenario_warnings import idle_driven_supports
+
+    shaking = shaken_supports(scenario)
     motions = tuple(motion if shake else m for shake, m in zip(shaking, scenario.motions))
-    return dataclasses.replace(scenario, motions=motions)
+    # the line the file's mark made (the scenario's roles follow its motions: the mark is not kept)
+    marked = [dataclasses.replace(s, role="driven") for s, shake in zip(scenario.assembly.supports, shaking) if shake]
+    stale = idle_driven_supports(SimpleNamespace(supports=marked), [Fixed()] * len(marked))
+    return dataclasses.replace(
+        scenario, motions=motions, warnings=tuple(w for w in scenario.warnings if w not in stale)
+    )
 
 
 def no_shaking_support(scenario: Scenario, option: str) -> InputError:
     """The refusal of a record (``--record``, ``sweep --records``: ``option``) for a scenario none of whose
-    supports shakes. A GeoJSON / WKT file run as it is has no place for a motion: "give one a sine" was no
-    way out, so the message writes the scenario file that shakes it."""
-    if os.path.abspath(scenario.source or "") != scenario.structure.get("file"):
+    supports shakes (:func:`shaken_supports`). A GeoJSON / WKT file of several supports holds no motion and no
+    way to say which one shakes ("give one a sine" was no way out): the message writes the scenario file."""
+    if not _geometry_as_is(scenario):
         return InputError(f"{option}: {scenario.name} has no shaking support (give one a sine or record motion)")
     file = os.path.basename(scenario.source)
-    if not scenario.assembly.supports:
+    supports = scenario.assembly.supports
+    if not supports:
         return InputError(f"{option}: {file} has no support to shake (every body in it is a block)")
+    names = ", ".join(s.name for s in supports[:4]) + (" …" if len(supports) > 4 else "")
     return InputError(
-        f"{option}: {file} holds no motion (its supports are fixed); shake one in a scenario file: "
-        f'[structure] file = "{file}" and a [[support]] name = "{scenario.assembly.supports[0].name}" with '
+        f"{option}: {file} holds no motion and {len(supports)} supports ({names}); say which the record shakes in "
+        f'a scenario file: [structure] file = "{file}" and a [[support]] name = "{supports[0].name}" with '
         'motion = { kind = "record", file = ... } (masonry docs scenario-format)'
     )
 

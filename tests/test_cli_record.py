@@ -79,17 +79,30 @@ def test_record_option_errors_are_one_line(at2, args, fragment):
     assert len(lines) == 1 and fragment in lines[0], result.output
 
 
-def test_record_on_a_geometry_file_says_how_to_shake_it(at2, tmp_path):
-    # `run wall.geojson --record q.AT2` said "wall has no shaking support (give one a sine or record motion)":
-    # a geometry file has no place for a motion (every support is fixed); a scenario file names its supports.
+def test_record_on_a_geometry_file_shakes_its_support_or_says_how_to_choose(at2, tmp_path):
+    # `run wall.geojson --record q.AT2` of a wall on its one ground was refused ("holds no motion … shake one in
+    # a scenario file"): the record shakes that ground. A file of several supports does not say which one shakes:
+    # a scenario file names it.
     geo = tmp_path / "wall.geojson"
     assert invoke("build", "wall", "--blocks", 7, "--out", geo).exit_code == 0
-    result = invoke("run", geo, "--record", at2)
+    # marked driven (QGIS attribute support_role): its warning "driven, but given no motion, so fixed" is not said
+    geo.write_text(geo.read_text().replace('"support_role": "fixed"', '"support_role": "driven"'))
+    assert "driven, but given no motion" in invoke("check", geo).output
+    result = invoke("check", geo, "--record", at2)
+    assert result.exit_code == 0, result.output
+    assert "loading │ ground: record of acceleration (quake.AT2" in words(result.output)
+    assert "driven, but given no motion" not in result.output
+    out = tmp_path / "s.csv"
+    result = invoke("sweep", geo, "--records", at2, "--scale", 1, "--duration", 0.1, "--workers", 0, "--out", out)
+    assert result.exit_code == 0 and "driven, but given no motion" not in result.output, result.output
+    arch = tmp_path / "arch.geojson"
+    assert invoke("build", "arch", "--out", arch).exit_code == 0
+    result = invoke("run", arch, "--record", at2)
     assert result.exit_code == 2
     assert words(result.output) == (
-        "error: --record: wall.geojson holds no motion (its supports are fixed); shake one in a scenario file: "
-        '[structure] file = "wall.geojson" and a [[support]] name = "ground" with motion = { kind = "record", '
-        "file = ... } (masonry docs scenario-format)"
+        "error: --record: arch.geojson holds no motion and 2 supports (left-foundation, right-foundation); say "
+        'which the record shakes in a scenario file: [structure] file = "arch.geojson" and a [[support]] name = '
+        '"left-foundation" with motion = { kind = "record", file = ... } (masonry docs scenario-format)'
     )
 
 

@@ -201,14 +201,15 @@ def test_records_run_whole_on_a_built_in_and_a_shorter_run_is_warned(block, tmp_
     assert result.exit_code == 2 and result.output.strip().splitlines() == [
         "error: --records: fixed has no shaking support (give one a sine or record motion)"
     ]
-    # a geometry file swept as it is, over records: the scenario file that shakes it, as run --record says
-    geo = tmp_path / "wall.geojson"
-    assert invoke("build", "wall", "--blocks", 7, "--out", geo).exit_code == 0
+    # a geometry file of several supports swept as it is, over records: the scenario file that says which one
+    # shakes, as run --record says (one of a single support shakes it: test_cli_record)
+    geo = tmp_path / "arch.geojson"
+    assert invoke("build", "arch", "--out", geo).exit_code == 0
     result = invoke("sweep", geo, "--records", folder, "--workers", 0, "--out", tmp_path / "g.csv")
     assert result.exit_code == 2 and words(result.output) == (
-        "error: --records: wall.geojson holds no motion (its supports are fixed); shake one in a scenario file: "
-        '[structure] file = "wall.geojson" and a [[support]] name = "ground" with motion = { kind = "record", '
-        "file = ... } (masonry docs scenario-format)"
+        "error: --records: arch.geojson holds no motion and 2 supports (left-foundation, right-foundation); say "
+        'which the record shakes in a scenario file: [structure] file = "arch.geojson" and a [[support]] name = '
+        '"left-foundation" with motion = { kind = "record", file = ... } (masonry docs scenario-format)'
     )
 
 

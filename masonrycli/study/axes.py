@@ -177,10 +177,10 @@ def apply_point(base, params: dict):
     motions = list(scenario.motions)
     if "record" in params:
         record = base.records[params["record"]]
-        shaking = [j for j, m in enumerate(motions) if m.kind in ("sine", "record")]
-        if not shaking:
-            from masonrycli.builtin import no_shaking_support
+        from masonrycli.builtin import no_shaking_support, shaken_supports
 
+        shaking = [j for j, shaken in enumerate(shaken_supports(scenario)) if shaken]
+        if not shaking:
             raise no_shaking_support(scenario, "--records")
         for j in shaking:
             motions[j] = record

@@ -166,7 +166,7 @@ def plan_study(
         stop_at_collapse=stop_at_collapse,
         histories=histories,
         force=force,
-        warnings=(*_scenario_warnings(base.scenario, records), *late, *_set_warnings(base, axes)),
+        warnings=(*_scenario_warnings(base.scenario, base.records), *late, *_set_warnings(base, axes)),
         warn=warn,
     )
     return StudyPlan(base, request, name, picture, recorded)
@@ -176,10 +176,13 @@ def _scenario_warnings(scenario, records) -> list[str]:
     """The warnings ``masonry run`` prints for the study's base scenario (a block touching nothing, a GeoJSON
     property not used, gravity pointing up: the sweep ran every point without a word); with ``--records``
     its own record is not run, so not its records' (the set's are in ``late``)."""
+    from masonrycli.builtin import shaken_by
     from masonrycli.scenario_warnings import record_warnings, scenario_warnings
 
-    said = scenario_warnings(scenario)
-    return [w for w in said if w not in record_warnings(scenario)] if records else said
+    if not records:
+        return scenario_warnings(scenario)
+    shaken = shaken_by(scenario, next(iter(records.values())))  # a file's driven supports: shaken, not idle
+    return [w for w in scenario_warnings(shaken) if w not in record_warnings(shaken)]
 
 
 def _set_warnings(base: StudyBase, axes: list[Axis]) -> list[str]:
