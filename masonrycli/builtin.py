@@ -152,8 +152,10 @@ def with_record(
 
 
 def _geometry_as_is(scenario: Scenario) -> bool:
-    """Whether ``scenario`` is a GeoJSON / WKT file run as it is (every support fixed, no scenario file)."""
-    return bool(scenario.source) and os.path.abspath(scenario.source) == scenario.structure.get("file")
+    """Whether ``scenario`` is a GeoJSON / WKT file run as it is (every support fixed, no scenario file). By
+    the suffix of its source, not its absolute path: a study's worker started in another folder resolved the
+    command's relative ``rubble.geojson`` elsewhere, and every row of a --scheduler study was refused."""
+    return Path(scenario.source or "").suffix.lower() in GEOMETRY_SUFFIXES and "file" in scenario.structure
 
 
 def shaken_supports(scenario: Scenario) -> list[bool]:

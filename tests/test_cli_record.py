@@ -283,3 +283,17 @@ def test_a_csv_accelerogram_is_read_as_its_header_says(tmp_path):
     assert record_motion(csv).quantity == "velocity"
     csv.write_text("0,0\n0.01,0.1\n")
     assert record_motion(csv).quantity == "velocity"
+
+
+def test_a_geometry_files_support_is_shaken_from_any_folder(tmp_path, monkeypatch):
+    # a --scheduler's worker started in another folder resolved the command's relative 'wall.geojson' there:
+    # every row of 'masonry sweep wall.geojson --records recs --scheduler …' was refused, "no shaking support"
+    from masonrycli.builtin import shaken_supports, target_scenario
+
+    (tmp_path / "study").mkdir()
+    (tmp_path / "worker").mkdir()
+    assert invoke("build", "wall", "--blocks", 7, "--out", tmp_path / "study" / "wall.geojson").exit_code == 0
+    monkeypatch.chdir(tmp_path / "study")
+    scenario = target_scenario("wall.geojson")
+    monkeypatch.chdir(tmp_path / "worker")
+    assert shaken_supports(scenario) == [True]
