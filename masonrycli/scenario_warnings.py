@@ -114,6 +114,7 @@ def record_warnings(scenario: Scenario, upright: bool = True) -> list[str]:
       1/(2 dt) comes back aliased (the record's counterpart of check_sampling's sine);
     * it peaks beyond 10 g as scaled (no earthquake comes near: a CSV in cm/s read as m/s, or a scale
       meant as a unit conversion applied twice, ran "completed … collapsed" without a word);
+    * it is an ESM or K-NET file (converted from cm/s² or gal on reading) scaled by 0.01: converted twice;
     * it is an .AT2 file (in g, converted on reading) scaled by g (9.81, or 981 for cm/s²): converted twice,
       a 0.3 g record ran at 2.9 g, under the 10 g line.
     * its times are 0, 1, 2, … s: a spreadsheet's sample numbers (a 1000-sample record ran as 1000 s at 1 Hz,
@@ -128,6 +129,7 @@ def record_warnings(scenario: Scenario, upright: bool = True) -> list[str]:
     fine: dict[tuple[str, float], list[str]] = {}
     strong: dict[tuple[str, float, float], list[str]] = {}
     twice: dict[tuple[str, float, float], list[str]] = {}
+    shrunk: dict[tuple[str, float, float], list[str]] = {}
     numbered: dict[tuple[str, float], list[str]] = {}
     sideways: dict[str, list[str]] = {}
     for support, m in zip(scenario.assembly.supports, scenario.motions):
@@ -144,6 +146,8 @@ def record_warnings(scenario: Scenario, upright: bool = True) -> list[str]:
             fine.setdefault((name, m.sample_interval), []).append(f'"{support.name}"')
         if name.lower().endswith(".at2") and any(abs(m.scale / g - 1.0) < 0.02 for g in (G_STANDARD, 100 * G_STANDARD)):
             twice.setdefault((name, m.peak_acceleration / G_STANDARD, m.scale), []).append(f'"{support.name}"')
+        elif _cm_file(name) and abs(m.scale / 0.01 - 1.0) < 0.02:
+            shrunk.setdefault((name, m.peak_acceleration, m.scale), []).append(f'"{support.name}"')
         elif m.peak_acceleration > MAX_AT2_G * G_STANDARD:
             strong.setdefault((name, m.peak_acceleration / G_STANDARD, m.scale), []).append(f'"{support.name}"')
         # along x (or as the horizontal of a vertical pair): an up component along y (direction [0, 1]) is meant
@@ -182,6 +186,12 @@ def record_warnings(scenario: Scenario, upright: bool = True) -> list[str]:
             for (name, peak, scale), names in twice.items()
         ]
         + [
+            f"{who(names)}: the record {name} is read in its header's units (cm/s², gal) and converted to m/s² "
+            f"already; scale {scale:g} converts it again ({peak:.3g} m/s² as applied, 100 times too weak; the scale "
+            "multiplies the record, 1 is as recorded)"
+            for (name, peak, scale), names in shrunk.items()
+        ]
+        + [
             f"{who(names)}: the record {name} has its samples at t = {first:g}, {first + 1:g}, {first + 2:g}, … s: "
             "sample numbers, not times? (give its times in s, or its values alone with --record-dt / time_step)"
             for (name, first), names in numbered.items()
@@ -192,6 +202,13 @@ def record_warnings(scenario: Scenario, upright: bool = True) -> list[str]:
             for name, names in sideways.items()
         ]
     )
+
+
+def _cm_file(name: str) -> bool:
+    """An ESM .ASC or K-NET file: read in its header's units (cm/s², gal) and converted to m/s² on reading."""
+    from masonrycli.record_knet import KNET_SUFFIXES
+
+    return name.lower().endswith((".asc", *KNET_SUFFIXES))
 
 
 def _numbered(time) -> bool:

@@ -194,3 +194,17 @@ def test_a_records_folder_of_an_esm_download_takes_the_acceleration_files(tmp_pa
     # given by name, the velocity file runs (as velocity, m/s)
     result = invoke("check", BLOCK, "--record", folder / f"{stem}.VEL.ASC")
     assert result.exit_code == 0 and "record of velocity" in words(result.output), result.output
+
+
+@pytest.mark.parametrize("record", [ESM, DATA / "knet.NS"])
+def test_a_scale_of_0_01_converting_cm_again_is_warned(record):
+    # the file is converted from cm/s² (gal) on reading: a scale of 0.01, meant as that conversion, ran the
+    # record 100 times too weak, "intact", without a word
+    result = invoke("check", BLOCK, "--record", record, "--scale", 0.01)
+    assert result.exit_code == 0, result.output
+    said = words(result.output)
+    assert (
+        f"the record {record.name} is read in its header's units (cm/s², gal) and converted to m/s² already; scale 0.01"
+        in said
+    )
+    assert "converts it again" not in words(invoke("check", BLOCK, "--record", record, "--scale", 0.5).output)

@@ -200,9 +200,10 @@ def _set_warnings(base: StudyBase, axes: list[Axis]) -> list[str]:
     by_name = {a.name: a.values for a in axes}
     scales = [s for s in by_name.get("scale", ()) if isinstance(s, float)]
     said: list[str] = []
-    # the largest scale (the 10 g line) and any scale of g (an .AT2 converted twice); a dt axis at its largest
+    # the largest scale (the 10 g line), any scale of g (an .AT2 converted twice) or of 0.01 (an ESM / K-NET file
+    # in cm/s² converted twice); a dt axis at its largest
     picked = ({max(scales, key=abs)} if scales else set()) | {
-        s for s in scales if any(abs(abs(s) / g - 1) < 0.02 for g in (G_STANDARD, 100 * G_STANDARD))
+        s for s in scales if any(abs(abs(s) / g - 1) < 0.02 for g in (G_STANDARD, 100 * G_STANDARD, 0.01))
     }
     dts = [d for d in by_name.get("dt", ()) if isinstance(d, float)]
     for name in base.records:
