@@ -62,8 +62,9 @@ def test_no_view_reports_visualizer_errors(screenshot):
     png, reports, tmp = screenshot
     assert reports == []
     assert png_size(png) == (1920, 1080)
-    # every tab was shown and checked: 8 structure tabs; tab0 too, as the solver row opens on its third tab
-    assert len(list((tmp / "tabs").glob("tab*.png"))) == 8
+    # every tab was shown and checked: 9 structure tabs (p √ too); tab0 too, as the solver row opens on its
+    # third tab
+    assert len(list((tmp / "tabs").glob("tab*.png"))) == 9
 
 
 def test_blocks_are_drawn_y_up_with_field_colours(screenshot):
@@ -166,7 +167,7 @@ def test_a_recording_of_static_data_alone_is_shown(tmp_path):
 def test_every_tab_of_a_paper_run_is_shown_the_live_one_too(tmp_path):
     """A paper run opens on its second tab (Fig. III.2); the tabs were shown from the second on, so the
     live tab (joint forces, principal stress: the one a user reaches first) was never drawn nor checked:
-    tab1..tab11 of its 12 tabs. Now every tab not on screen at open is shown."""
+    tab1..tab11 of its 12 tabs (13 since the p √ tab). Now every tab not on screen at open is shown."""
     static, q0 = fx.wall(5, 6)
     rrd = tmp_path / "wall.rrd"
     paper = {**fx.METADATA, "scenario": "wall", "duration_s": 0.14, "supports": paper_loading("wall")}
@@ -175,7 +176,7 @@ def test_every_tab_of_a_paper_run_is_shown_the_live_one_too(tmp_path):
             rec.log_frame(f)
     tabs = tmp_path / "tabs"
     assert screenshot_recording(rrd, tmp_path / "open.png", timeout=120, at_open=True, tabs_dir=tabs) == []
-    assert sorted(p.name for p in tabs.glob("tab*.png")) == sorted(f"tab{i}.png" for i in range(12))
+    assert sorted(p.name for p in tabs.glob("tab*.png")) == sorted(f"tab{i}.png" for i in range(13))
 
 
 def test_a_limit_recording_is_shown_at_its_last_step(tmp_path):
