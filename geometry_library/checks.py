@@ -454,7 +454,11 @@ def validate_assembly(
         bad.append((a, b, area, tol, overlaps[k]))
     if bad:
         a, b, area, tol, overlap = bad[0]
-        more = f" (and {len(bad) - 1} more overlapping pair(s))" if len(bad) > 1 else ""
+        # the other pairs named, so a drawing with a few slips is mended in one go (it was one per run of check,
+        # "and 4 more overlapping pair(s)" naming none); the pairs of blocks, names joined by "/"
+        others = [f"{names[p]}/{names[q]}" for p, q, *_ in bad[1:]]
+        shown = ", ".join(others[:5]) + (f", … ({len(others) - 5} more)" if len(others) > 5 else "")
+        more = f" (and {len(others)} more overlapping pair{'s' if len(others) > 1 else ''}: {shown})" if others else ""
         if b < n_blocks:
             what = f'blocks {a + 1} ("{names[a]}") and {b + 1} ("{names[b]}")'
         else:

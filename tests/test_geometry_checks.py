@@ -109,6 +109,22 @@ def test_overlapping_blocks_name_both_and_the_area():
     assert "0.1 m²" in text
 
 
+def test_every_overlapping_pair_is_named_in_the_one_line():
+    # a wall drawn in QGIS with a few slips: the line named the first pair and "(and 2 more overlapping
+    # pair(s))", one more run of check per slip; now the others by name
+    row = [box(i, 0, i + 1, 1) for i in range(4)]
+    row[1], row[3] = box(1, 0, 2.1, 1), box(2.95, 0, 4, 1)  # into b2, and b3 from the right
+    sunk = box(4.5, -0.01, 5, 1)  # into the ground
+    a = asm(*row, sunk, supports=[GROUND])
+    text = raises_one_line("overlap", validate_assembly, a)
+    assert text.startswith('blocks 2 ("b1") and 3 ("b2") overlap by 0.1 m²')
+    assert text.endswith("(and 2 more overlapping pairs: b2/b3, b4/ground)")
+    many = asm(*[box(0.9 * i, 0, 0.9 * i + 1, 1) for i in range(9)], supports=[GROUND])
+    assert raises_one_line("overlap", validate_assembly, many).endswith(
+        "(and 7 more overlapping pairs: b1/b2, b2/b3, b3/b4, b4/b5, b5/b6, … (2 more))"
+    )
+
+
 def test_block_sunk_into_a_support_is_an_overlap():
     a = asm(box(0, -0.01, 1, 1), supports=[GROUND], names=["sunk"])
     text = raises_one_line("overlap", validate_assembly, a)
