@@ -235,6 +235,15 @@ def _register_sweep() -> None:
 _register_sweep()
 
 
+def _register_export() -> None:
+    from masonrycli.cli_export import export_command
+
+    app.command("export")(user_errors(export_command))
+
+
+_register_export()
+
+
 @app.command("limit")
 @user_errors
 def limit_command(

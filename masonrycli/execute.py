@@ -25,7 +25,7 @@ from rich.text import Text
 from masonrycli import SOURCE_DIGEST, __version__
 from masonrycli.engine import compile_ahead
 from masonrycli.errors import InputError
-from masonrycli.history import HistoryFile
+from masonrycli.history import HistoryFile, block_constants
 from masonrycli.interrupt import StopSignals
 from masonrycli.outputs import OutputFile, check_distinct, check_output, check_space, default_recording_path, open_part
 from masonrycli.report import progress_bar, slow_start_notice, summary_table
@@ -259,6 +259,7 @@ def _open_sink(out: OutputFile, outputs: Outputs, scenario, sim: Simulation, mag
     if out is outputs.history:
         history = HistoryFile(out.part, sim.model.block_name, sim.model.support_name)
         history.run_info = run_metadata(scenario, sim)
+        history.run_values |= block_constants(sim.model)
         return history
     from masonrycli.recording import Recorder
 

@@ -10,6 +10,8 @@ Arrays (T frames, N blocks, S supports), block order = scenario order:
     support_work (T,) J (cumulated) · every per-block tensor field of masonrycli.tensors.TENSOR_FIELDS
     joint_body (J,2) body indices, blocks then supports (N + s: support s) · joint_hinged (T,J) bool ·
     hinge_count (T,)  (see masonrycli.mechanism)
+    block_mass (N,) kg · block_inertia (N,) kg m² · block_extent (N,4) m (bounding box as built; written by
+    the command line, :func:`block_constants`)
     block_name (N,) · support_name (S,) · status () str (masonrycli.sinks.STATUSES) · note () str
     intensity_pga, intensity_pgv, intensity_arias, intensity_d5_95, intensity_sa () — the ground motion as
     applied (masonrycli.intensity), when a support shakes
@@ -70,6 +72,9 @@ UNITS: dict[str, str] = {
     **{name: f"{unit}, {text}" for name, (_, unit, text) in (TENSOR_FIELDS | JOINT_FIELDS).items()},
     "joint_hinged": "(T,J) bool, joint hinged (one end carries all the normal force, the other is open)",
     "hinge_count": "hinged joints at the frame",
+    "block_mass": "(N,) kg, block mass (density x area x thickness)",
+    "block_inertia": "(N,) kg m2, polar moment of inertia about the centroid",
+    "block_extent": "(N,4) m, bounding box as built at t = 0: xmin, ymin, xmax, ymax",
     "block_name": "(N,) block names, the order of every block axis",
     "support_name": "(S,) support names",
     "joint_body": "(J,2) the two bodies of each joint: index into block_name, or N + s for support s",
@@ -102,6 +107,24 @@ def _row_arrays(frame: Frame):
     yield "hinge_count", np.asarray(int(hinged.sum()))
 
 
+def block_constants(model) -> dict[str, np.ndarray]:
+    """The blocks' mass, inertia and bounding box as built (``block_mass``, ``block_inertia``,
+    ``block_extent``): what ``masonry export`` needs besides the rows (the course of a block, the structure's
+    height for the drift ratio, the inertia forces for the overturning moment). Constant arrays of the run,
+    given to a history's ``run_values``."""
+    n = model.block_count
+    start = model.body_vert_start
+    extent = np.empty((n, 4))
+    for b in range(n):  # once per run, not in the time loop
+        xy = model.vert_local[start[b] : start[b + 1]] + model.body_q0[b, :2]
+        extent[b] = (*xy.min(axis=0), *xy.max(axis=0))
+    return {
+        "block_mass": np.array(model.body_mass[:n], dtype=float),
+        "block_inertia": np.array(model.body_inertia[:n], dtype=float),
+        "block_extent": extent,
+    }
+
+
 def frame_rows(frame: Frame) -> dict[str, np.ndarray]:
     """One history row per array name (copies: the engine reuses its buffers)."""
     return {name: np.array(value, copy=True) for name, value in _row_arrays(frame)}
@@ -115,8 +138,9 @@ class History:
         self.support_name = np.asarray(support_name, dtype=str)
         self._rows: dict[str, list] = {}
         self.joint_body = np.zeros((0, 2), dtype=np.int64)
-        self.run_values: dict[str, float] = {}
-        """One value per run (e.g. ``intensity_pga``), written as 0-d arrays."""
+        self.run_values: dict[str, float | np.ndarray] = {}
+        """One value per run (e.g. ``intensity_pga``, written as 0-d arrays) or constant array of the run
+        (:func:`block_constants`)."""
 
     def __len__(self) -> int:
         return len(self._rows.get("time", ()))
@@ -158,8 +182,9 @@ class HistoryFile:
         self.scratch.mkdir()
         self.frames = 0
         self.joint_body = np.zeros((0, 2), dtype=np.int64)
-        self.run_values: dict[str, float] = {}
-        """One value per run (e.g. ``intensity_pga``), written as 0-d arrays; set before :meth:`close`."""
+        self.run_values: dict[str, float | np.ndarray] = {}
+        """One value per run (e.g. ``intensity_pga``, written as 0-d arrays) or constant array of the run
+        (:func:`block_constants`); set before :meth:`close`."""
         self.run_info: dict = {}
         """The run's parameters (:func:`masonrycli.execute.run_metadata`), written as ``run`` (JSON)."""
         self._files: dict[str, tuple] = {}  # name -> (open raw file, dtype, row shape)

@@ -393,6 +393,13 @@ OPTION_ROWS = [
     # first message said "(ValueError: cut.rrd: no recording in this file)"
     ("inspect-empty-rrd", {"e.rrd": b""}, ("inspect", "e.rrd"), 2, "e.rrd: an empty file (0 bytes), not a recording"),
     ("inspect-empty-npz", {"e.npz": b""}, ("inspect", "e.npz"), 2, "e.npz: an empty file (0 bytes), not a recording"),
+    # -- export
+    ("export-missing", {}, ("export", "missing.npz"), 2, "missing.npz: no such history"),
+    ("export-empty", {"e.npz": b""}, ("export", "e.npz"), 2, "e.npz: not a readable history (.npz): BadZipFile"),
+    ("export-text", {"h.npz": "time,a\n"}, ("export", "h.npz"), 2, "h.npz: not a readable history (.npz)"),
+    ("export-out-suffix", {}, ("export", "missing.npz", "--out", "s.xlsx"), 2, "--out s.xlsx: the file name must end"),
+    ("export-out-exists", {"s.csv": "mine"}, ("export", "h.npz", "--out", "s.csv"), 2, "--out s.csv: the file exists"),
+    ("export-every-0", {}, ("export", "h.npz", "--every", "0"), 2, "--every 0: keep every K-th frame, K ≥ 1"),
     (
         "inspect-cut-before-a-message",
         {"cut.rrd": bytes.fromhex("52524632002900000102000001000000000000005e000000")},

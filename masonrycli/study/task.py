@@ -63,7 +63,7 @@ def run_task(
     """
     from masonrycli.errors import InputError
     from masonrycli.execute import run_metadata
-    from masonrycli.history import HistoryFile
+    from masonrycli.history import HistoryFile, block_constants
     from masonrycli.outputs import OutputFile, written_whole
     from masonrycli.run import Simulation, simulate
     from masonrycli.study.axes import apply_point
@@ -83,6 +83,7 @@ def run_task(
                 part = files.enter_context(written_whole(out))
                 sinks.append(HistoryFile(part, sim.model.block_name, sim.model.support_name))
                 sinks[0].run_info = run_metadata(scenario, sim) | {"study_point": params}
+                sinks[0].run_values |= block_constants(sim.model)
                 if study:
                     sinks[0].run_info |= {"study": study[0], "study_table": study[1]}
             result = simulate(scenario, sinks, sim=sim, stop_at_collapse=stop_at_collapse)

@@ -1,0 +1,100 @@
+"""``masonry export``: a run history as CSV. Thin: options -> :func:`masonrycli.history_export.export_table`
+-> the CSV written whole (:func:`masonrycli.outputs.written_whole`); registered on the app by :mod:`masonrycli.cli`.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+from masonrycli.cli_options import file_path_value, path_value, whole_value
+from masonrycli.errors import InputError
+
+
+def _names(values: list[str] | None) -> list[str]:
+    """``--blocks a,b --blocks c`` → [a, b, c]."""
+    return [name.strip() for value in values or () for name in value.split(",") if name.strip()]
+
+
+def _course_numbers(values: list[str] | None) -> list[int]:
+    out = []
+    for text in _names(values):
+        try:
+            out.append(int(text))
+        except ValueError:
+            raise InputError(f"--course {text}: not a course number (1 = the lowest course)") from None
+    return out
+
+
+def export_command(
+    history: Annotated[
+        Path, typer.Argument(help="A run history (--history H.npz).", metavar="H.npz", parser=path_value)
+    ],
+    out: Annotated[
+        Path | None,
+        typer.Option(
+            "--out",
+            "-o",
+            parser=file_path_value,
+            help="The CSV to write (default: H.csv beside H.npz).",
+            metavar="S.csv",
+        ),
+    ] = None,
+    blocks: Annotated[
+        list[str] | None,
+        typer.Option("--blocks", help="Blocks by name, comma-separated or repeated: their columns each."),
+    ] = None,
+    course: Annotated[
+        list[str] | None,
+        typer.Option("--course", help="A course's mean (1 = the lowest), comma-separated or repeated."),
+    ] = None,
+    top: Annotated[bool, typer.Option("--top", help="The top course's mean (the default without a target).")] = False,
+    ground: Annotated[
+        str | None,
+        typer.Option(
+            help="The support motions are measured from (default: the only one, or the first moving sideways)."
+        ),
+    ] = None,
+    absolute: Annotated[
+        bool,
+        typer.Option(
+            "--absolute", help="The targets' motion in the fixed frame (default: relative to the ground, ' rel')."
+        ),
+    ] = False,
+    every: Annotated[
+        int,
+        typer.Option(parser=whole_value, help="Keep every K-th recorded frame (after differentiating).", metavar="K"),
+    ] = 1,
+    force: Annotated[bool, typer.Option("--force", help="Replace the --out file if it exists.")] = False,
+) -> None:
+    """Write a run history as CSV (one row per frame, units in the header): the ground's motion, blocks' or
+    courses' displacement, velocity, acceleration (relative to the ground), drift ratio, base shear,
+    overturning moment, hinges, energies."""
+    from masonrycli.cli_messages import console, say
+    from masonrycli.history_export import export_table, write_csv
+    from masonrycli.outputs import check_output, written_whole
+
+    if every < 1:
+        raise InputError(f"--every {every}: keep every K-th frame, K ≥ 1")
+    target = check_output(out if out is not None else history.with_suffix(".csv"), "--out", ".csv", force)
+    table = export_table(
+        history,
+        blocks=_names(blocks),
+        course_numbers=_course_numbers(course),
+        top=top,
+        ground=ground,
+        relative=not absolute,
+        every=every,
+    )
+    with written_whole(target) as part:
+        write_csv(table, part)
+    for note in table.notes:
+        say("note", "yellow", note)
+    rows = len(table.values[0])
+    console.print(
+        f"{history}: {rows} row{'s' if rows != 1 else ''} × {len(table.names)} columns → {target.path}",
+        soft_wrap=True,
+        markup=False,
+    )
