@@ -167,6 +167,7 @@ def read_geojson(path, density: float = 2500.0, thickness: float = 1.0, unknown:
         raise GeometryError(f"{path}: FeatureCollection has no 'features' list")
     blocks: list[Block] = []
     supports: list[Support] = []
+    refused: list[tuple[str, str]] = []  # (message, body) of each polygon refused, said together at the end
     for k, feature in enumerate(features, start=1):  # numbered from 1, as the bodies are (body_label)
         feature_at = where = f"{path}: feature {k}"  # the body's label is added once its role is read
         if not isinstance(feature, dict) or feature.get("type") != "Feature":
@@ -219,7 +220,9 @@ def read_geojson(path, density: float = 2500.0, thickness: float = 1.0, unknown:
         try:
             polygon = polygon_from_coords(coords, index, name, role)
         except GeometryError as exc:
-            raise GeometryError(f"{feature_at}: {exc}") from None  # exc starts with the body's label
+            refused.append((f"{feature_at}: {exc}", body_label(index, name, role)))  # exc starts with the label
+            (blocks if role == "block" else supports).append(None)  # the next bodies keep their numbers
+            continue
         if role == "block":
             blocks.append(
                 Block(
@@ -235,7 +238,19 @@ def read_geojson(path, density: float = 2500.0, thickness: float = 1.0, unknown:
             if srole not in SUPPORT_ROLES:
                 raise GeometryError(f"{where}: support_role must be one of {SUPPORT_ROLES}, got {srole!r}")
             supports.append(Support(polygon, name, srole))
+    _raise_refused(refused)
     return Assembly(tuple(blocks), tuple(supports))
+
+
+def _raise_refused(refused: list[tuple[str, str]]) -> None:
+    """Raise the first refused polygon's error, the other refused bodies named after it: a drawing with
+    several stones not convex (or self-intersecting) was mended one run of ``masonry check`` per stone."""
+    if not refused:
+        return
+    others = [body for _, body in refused[1:]]
+    shown = ", ".join(others[:5]) + (f", … ({len(others) - 5} more)" if len(others) > 5 else "")
+    more = f" (and {len(others)} more polygon{'s' if len(others) > 1 else ''} refused: {shown})" if others else ""
+    raise GeometryError(refused[0][0] + more)
 
 
 def _ring_coords(polygon: Polygon) -> list[list[float]]:
@@ -339,6 +354,7 @@ def read_wkt(path, density: float = 2500.0, thickness: float = 1.0) -> Assembly:
                 entries.append((f"{path}: line {n}", None, None, None, line))
     blocks: list[Block] = []
     supports: list[Support] = []
+    refused: list[tuple[str, str]] = []
     for where, role, name, srole, text in entries:
         role = (role or ("support" if srole else "block")).lower()
         polys = _polygons_of(_parse_wkt(text, where), where)
@@ -355,11 +371,14 @@ def read_wkt(path, density: float = 2500.0, thickness: float = 1.0) -> Assembly:
             try:
                 polygon = polygon_from_coords(np.asarray(poly.exterior.coords)[:, :2], index, label, role)
             except GeometryError as exc:
-                raise GeometryError(f"{where}: {exc}") from None
+                refused.append((f"{where}: {exc}", body_label(index, label, role)))
+                (blocks if role == "block" else supports).append(None)  # the next bodies keep their numbers
+                continue
             if role == "block":
                 blocks.append(Block(polygon, label, float(density), float(thickness)))
             else:
                 supports.append(Support(polygon, label, (srole or "fixed").lower()))
+    _raise_refused(refused)
     return Assembly(tuple(blocks), tuple(supports))
 
 

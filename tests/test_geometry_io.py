@@ -399,3 +399,40 @@ def test_geojson_numbers_written_with_their_units(tmp_path):
         GeometryError, match=r"thickness must be a number, not a string \(it is read in m: convert 50 cm to m"
     ):
         read_geojson(path)
+
+
+def test_every_refused_polygon_is_named_in_the_one_line(tmp_path):
+    # a wall drawn with three dented stones: the line named the first and stopped, one run of check per stone
+    dent = [[0, 0], [1, 0], [1, 1], [0.5, 0.6], [0, 1]]  # reflex vertex at (0.5, 0.6)
+    bowtie = [[0, 0], [1, 1], [1, 0], [0, 1]]
+    square = [[0, 0], [1, 0], [1, 1], [0, 1]]
+
+    def shifted(ring, dx):
+        return [[x + dx, y] for x, y in ring] + [[ring[0][0] + dx, ring[0][1]]]
+
+    rings = [square, dent, square, bowtie, dent]
+    features = [
+        {
+            "type": "Feature",
+            "properties": {"name": f"s{i}"},
+            "geometry": {"type": "Polygon", "coordinates": [shifted(r, 2 * i)]},
+        }
+        for i, r in enumerate(rings)
+    ]
+    path = tmp_path / "wall.geojson"
+    path.write_text(json.dumps({"type": "FeatureCollection", "features": features}))
+    with pytest.raises(GeometryError) as info:
+        read_geojson(path)
+    text = str(info.value)
+    assert text.startswith(f'{path}: feature 2: block 2 ("s1"): polygon is not convex')
+    assert text.endswith('(and 2 more polygons refused: block 4 ("s3"), block 5 ("s4"))') and "\n" not in text
+    wkt = tmp_path / "wall.wkt"
+    wkt.write_text(
+        "\n".join(
+            f"s{i}: POLYGON (({', '.join(f'{x} {y}' for x, y in shifted(r, 2 * i))}))" for i, r in enumerate(rings)
+        )
+    )
+    with pytest.raises(GeometryError) as info:
+        read_wkt(wkt)
+    assert str(info.value).startswith(f'{wkt}: line 2: block 2 ("s1"): polygon is not convex')
+    assert str(info.value).endswith('(and 2 more polygons refused: block 4 ("s3"), block 5 ("s4"))')
