@@ -28,9 +28,45 @@ def _course_numbers(values: list[str] | None) -> list[int]:
     return out
 
 
+def _inputs(paths: list[Path]) -> list[Path]:
+    """The histories named: files as given, a folder's ``*.npz`` (a study's ``--histories``), sorted."""
+    out = []
+    for path in paths:
+        if path.is_dir():
+            found = sorted(p for p in path.glob("*.npz") if not p.name.startswith("."))
+            if not found:
+                raise InputError(f"{path}: a folder without histories (*.npz)")
+            out += found
+        else:
+            out.append(path)
+    return out
+
+
+def _targets(histories: list[Path], out: Path | None, force: bool, several: bool):
+    """The checked output of each history (:func:`masonrycli.outputs.check_output`): ``out`` for one history,
+    ``out``/NAME.csv (a folder) or NAME.csv beside each for several."""
+    from masonrycli.outputs import check_distinct, check_output
+
+    if several and out is not None and not out.is_dir():
+        raise InputError(f"--out {out}: several histories, one CSV each: --out names an existing folder for them")
+    targets = []
+    for history in histories:
+        path = history.with_suffix(".csv")
+        if out is not None:
+            path = out / path.name if several else out
+        targets.append(check_output(path, "--out", ".csv", force))
+    check_distinct(*targets)
+    return targets
+
+
 def export_command(
-    history: Annotated[
-        Path, typer.Argument(help="A run history (--history H.npz).", metavar="H.npz", parser=path_value)
+    histories: Annotated[
+        list[Path],
+        typer.Argument(
+            help="Run histories (--history H.npz), or a folder of them (a study's --histories).",
+            metavar="H.npz...|FOLDER",
+            parser=path_value,
+        ),
     ],
     out: Annotated[
         Path | None,
@@ -38,8 +74,8 @@ def export_command(
             "--out",
             "-o",
             parser=file_path_value,
-            help="The CSV to write (default: H.csv beside H.npz).",
-            metavar="S.csv",
+            help="The CSV to write (default: H.csv beside H.npz); for several histories, a folder.",
+            metavar="S.csv|FOLDER",
         ),
     ] = None,
     blocks: Annotated[
@@ -74,13 +110,17 @@ def export_command(
     overturning moment, hinges, energies."""
     from masonrycli.cli_messages import console, say
     from masonrycli.history_export import export_table, write_csv
-    from masonrycli.outputs import check_output, written_whole
+    from masonrycli.history_inspect import inspect_history
+    from masonrycli.outputs import written_whole
 
     if every < 1:
         raise InputError(f"--every {every}: keep every K-th frame, K ≥ 1")
-    target = check_output(out if out is not None else history.with_suffix(".csv"), "--out", ".csv", force)
-    table = export_table(
-        history,
+    inputs = _inputs(histories)
+    several = len(inputs) > 1 or any(path.is_dir() for path in histories)
+    targets = _targets(inputs, out, force, several)
+    for history in inputs:  # every file checked before the first CSV is written
+        inspect_history(history)
+    options = dict(
         blocks=_names(blocks),
         course_numbers=_course_numbers(course),
         top=top,
@@ -88,13 +128,12 @@ def export_command(
         relative=not absolute,
         every=every,
     )
-    with written_whole(target) as part:
-        write_csv(table, part)
-    for note in table.notes:
-        say("note", "yellow", note)
-    rows = len(table.values[0])
-    console.print(
-        f"{history}: {rows} row{'s' if rows != 1 else ''} × {len(table.names)} columns → {target.path}",
-        soft_wrap=True,
-        markup=False,
-    )
+    for history, target in zip(inputs, targets):
+        table = export_table(history, **options)
+        with written_whole(target) as part:
+            write_csv(table, part)
+        for note in table.notes:
+            say("note", "yellow", note)
+        rows = len(table.values[0])
+        line = f"{history}: {rows} row{'s' if rows != 1 else ''} × {len(table.names)} columns → {target.path}"
+        console.print(line, soft_wrap=True, markup=False)

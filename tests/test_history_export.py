@@ -217,3 +217,78 @@ def test_bad_input_is_one_line(run, tmp_path):
     assert_one_line_error(invoke("export", tmp_path / "text.npz"), "text.npz: not a readable history")
     np.savez(tmp_path / "bare.npz", time=np.zeros(2))
     assert_one_line_error(invoke("export", tmp_path / "bare.npz"), "bare.npz: a history without block_q")
+
+
+class SupportMoment:
+    """A frame sink: the moment about O of the support contacts' forces on the blocks, from the solver's
+    contact points and forces (what the export's Newton–Euler moment must reproduce without them)."""
+
+    def __init__(self, n: int, base: tuple[float, float]):
+        self.n, self.base, self.moments, self.q0 = n, np.array(base), [], None
+
+    def on_frame(self, frame) -> None:
+        if self.q0 is None:
+            self.q0 = frame.support_q[0, :2].copy()
+        origin = self.base + frame.support_q[0, :2] - self.q0
+        total = 0.0
+        for (a, b), point, force in zip(frame.contact_body, frame.contact_point, frame.contact_force):
+            if (a < self.n) == (b < self.n):
+                continue  # block against block (their forces cancel), or support against support
+            on_block = force if b < self.n else -force  # contact_force acts on body b
+            r = point - origin
+            total += r[0] * on_block[1] - r[1] * on_block[0]
+        self.moments.append(total)
+
+    def close(self, status: str = "completed", note: str = "") -> None:
+        pass
+
+
+def test_the_overturning_moment_is_that_of_the_support_contacts(tmp_path):
+    from masonrycli.builtin import builtin
+    from masonrycli.history import History, block_constants
+    from masonrycli.run import Simulation, simulate
+
+    scenario = builtin("wall", duration=0.02, record_every=1)
+    sim = Simulation(scenario)
+    constants = block_constants(sim.model)
+    extent = constants["block_extent"]
+    watch = SupportMoment(sim.model.block_count, (0.5 * (extent[:, 0].min() + extent[:, 2].max()), extent[:, 1].min()))
+    history = History(sim.model.block_name, sim.model.support_name)
+    simulate(scenario, [history, watch], sim=sim)
+    path = tmp_path / "h.npz"
+    np.savez(path, **(history.arrays() | constants))
+    table = export_table(path)
+    moment = dict(zip(table.names, table.values))["overturning moment (N m)"]
+    contacts = np.array(watch.moments)
+    # frame k's accelerations are means over steps k and k+1: so is the contacts' moment
+    mean = 0.5 * (contacts[1:-1] + contacts[2:])
+    assert np.abs(mean).min() > 2e4  # the wall, dragged at 12 m/s², leans on its ground: tens of kN m
+    # 3.4e-4 at most: the export's lever arms are the frame's, the step's impulses act mid-step
+    assert np.allclose(moment[1:-1], mean, rtol=1e-3), np.abs(moment[1:-1] / mean - 1).max()
+
+
+def test_a_folder_of_histories_gives_one_csv_each(tmp_path):
+    folder = tmp_path / "histories"
+    folder.mkdir()
+    hand_history(folder / "amp=0.5.npz")
+    hand_history(folder / "amp=1.npz", status="interrupted")
+    out = tmp_path / "csv"
+    out.mkdir()
+    result = invoke("export", folder, "--out", out, "--blocks", "c")
+    assert result.exit_code == 0, result.output
+    assert sorted(p.name for p in out.iterdir()) == ["amp=0.5.csv", "amp=1.csv"]
+    assert floats(read_csv(out / "amp=1.csv")["c ax rel (m/s2)"]) == pytest.approx([C] * 5)
+    assert "amp=1.npz: interrupted at t = 0.0350 s" in " ".join(result.output.split())
+    # nothing is written unless every CSV can be: one exists already
+    (out / "amp=0.5.csv").unlink()
+    assert_one_line_error(invoke("export", folder, "--out", out), "--out", "amp=1.csv: the file exists")
+    assert not (out / "amp=0.5.csv").exists()
+    assert_one_line_error(
+        invoke("export", folder / "amp=0.5.npz", folder / "amp=1.npz", "--out", tmp_path / "one.csv"),
+        "one.csv: several histories, one CSV each: --out names an existing folder",
+    )
+    assert invoke("export", folder / "amp=0.5.npz", folder / "amp=1.npz").exit_code == 0  # beside each
+    assert sorted(p.name for p in folder.glob("*.csv")) == ["amp=0.5.csv", "amp=1.csv"]
+    empty = tmp_path / "empty"
+    empty.mkdir()
+    assert_one_line_error(invoke("export", empty), "empty: a folder without histories (*.npz)")
