@@ -80,17 +80,20 @@ def export_command(
     ] = None,
     blocks: Annotated[
         list[str] | None,
-        typer.Option("--blocks", help="Blocks by name, comma-separated or repeated: their columns each."),
+        typer.Option(
+            "--blocks", help="Blocks by name, comma-separated or repeated: their columns each.", metavar="NAME,..."
+        ),
     ] = None,
     course: Annotated[
         list[str] | None,
-        typer.Option("--course", help="A course's mean (1 = the lowest), comma-separated or repeated."),
+        typer.Option("--course", help="A course's mean (1 = the lowest), comma-separated or repeated.", metavar="N"),
     ] = None,
     top: Annotated[bool, typer.Option("--top", help="The top course's mean (the default without a target).")] = False,
     ground: Annotated[
         str | None,
         typer.Option(
-            help="The support motions are measured from (default: the only one, or the first moving sideways)."
+            help="The support the targets' motion is measured from (default: the only one, or the first moving sideways).",
+            metavar="NAME",
         ),
     ] = None,
     absolute: Annotated[
