@@ -367,14 +367,28 @@ def build_aqueduct_command(**opts) -> None:
 @app.command("inspect")
 @user_errors
 def inspect_command(
-    recording: Annotated[Path, typer.Argument(help="Recording (.rrd) or run history (.npz).", metavar="REC.rrd|H.npz")],
+    recording: Annotated[
+        Path, typer.Argument(help="Recording (.rrd), run history (.npz) or study table.", metavar="REC.rrd|H.npz|S.csv")
+    ],
 ) -> None:
-    """Summarise a recording (scenario, frames, time span, entities) or a run history (the run's
-    parameters, status, frames, time span, and each array's shape, dtype and unit)."""
+    """Summarise a recording (scenario, frames, time span, entities), a run history (the run's
+    parameters, status, frames, time span, and each array's shape, dtype and unit) or a study's table
+    (rows, states, swept values, and each column's unit)."""
     from masonrycli.history_inspect import inspect_history, is_history
+    from masonrycli.study.inspect_table import is_study_table, study_summary
 
     if recording.is_file() and recording.stat().st_size == 0:  # rerun's "file too small to be an RRD", a zip error
         raise InputError(f"{recording}: an empty file (0 bytes), not a recording or a history")
+    if is_study_table(recording):
+        from masonrycli.report import columns_lines
+
+        table, lines = columns_lines(
+            f"{recording} — study table", *study_summary(recording), "column", "unit / meaning"
+        )
+        console.print(table)
+        for line in lines:
+            console.print(line, soft_wrap=True)
+        return
     if is_history(recording):
         from masonrycli.report import history_tables
 

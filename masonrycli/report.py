@@ -197,3 +197,14 @@ def history_tables(history: str, info: dict) -> tuple[Table, list[str]]:
     widths = [max(len(row[i]) for row in rows) for i in range(3)]
     lines = ["  ".join([*(cell.ljust(w) for cell, w in zip(row[:3], widths)), row[3]]) for row in rows]
     return table, lines
+
+
+def columns_lines(title: str, rows: list[tuple[str, str]], lines: list[tuple[str, str]], *heads: str):
+    """``(table, lines)``: a two-column table of ``rows`` under ``title``, then one aligned line per ``(name,
+    meaning)`` of ``lines`` under ``heads`` (``masonry inspect S.csv``: as a history's arrays, a line each,
+    never wrapped: grep-able)."""
+    table = _two_columns(title)
+    for label, value in rows:
+        table.add_row(label, value)
+    width = max(len(n) for n, _ in [heads, *lines])
+    return table, [f"{n.ljust(width)}  {m}" for n, m in [heads, *lines]]

@@ -12,7 +12,7 @@ import pytest
 from masonrycli.records import G_STANDARD
 from masonrycli.study.store import read_rows
 
-from cli_helpers import words
+from cli_helpers import assert_one_line_error, words
 from sweep_helpers import BLOCK, invoke, write_block
 from synthetic_records import band_limited, write_at2
 
@@ -425,3 +425,22 @@ def test_a_records_folder_names_the_files_it_does_not_read(block, tmp_path):
         "PEER .AT2, ESM .ASC, K-NET (.NS, .EW, .UD) and .csv files" in words(result.output)
     )
     assert [r["record"] for r in read_rows(out)] == ["syn.AT2"]
+
+
+def test_inspect_a_study_table_gives_its_rows_values_and_each_columns_unit(block, tmp_path):
+    # 'masonry inspect study.csv' said "a table (.csv), not a recording": the table's numbers had no unit anywhere
+    # but the docs (pga 1.70: m/s² or g?)
+    for suffix in (".csv", ".parquet"):
+        out = tmp_path / f"s_{suffix[1:]}{suffix}"  # its own plot beside it
+        args = ["--param", "amp=0.05,0.1", "--param", "friction=0.5", "--duration", 0.1, "--workers", 0]
+        assert invoke("sweep", block, *args, "--out", out, "--no-recording").exit_code == 0
+        result = invoke("inspect", out)
+        assert result.exit_code == 0, result.output
+        said = words(result.output)
+        assert "study table" in said and "rows │ 2 (" in said and "amp │ 0.05, 0.1 m/s" in said, said
+        lines = result.output.splitlines()
+        assert any(ln.split() == ["pga", "m/s²,", "peak", "ground", "acceleration", "as", "applied"] for ln in lines)
+        assert any(ln.startswith("max_opening") and "m, largest joint opening" in ln for ln in lines)
+    record = tmp_path / "q.csv"
+    record.write_text("time,velocity\n0,0\n1,1\n")
+    assert_one_line_error(invoke("inspect", record), "q.csv: not a study's table")
