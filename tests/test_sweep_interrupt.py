@@ -86,7 +86,7 @@ def test_a_signal_while_the_pictures_are_written_says_what_is_missing(block, tmp
     args = ["sweep", block, "-p", "amp=0.05,0.1", "--duration", 0.02, "--workers", 0, "-o", out]
     drawn = plots.state_map
 
-    def ctrl_c_in_the_plot(rows, x, y, path, title):
+    def ctrl_c_in_the_plot(rows, x, y, path, title, by=()):
         Path(path).write_bytes(b"half a PNG")
         raise KeyboardInterrupt
 
