@@ -39,6 +39,24 @@ def test_table_of_this_study_is_resumed_and_any_other_refused(tmp_path):
         open_table(out, "abc", False, ["amp"], POINTS)
 
 
+def test_a_record_sets_row_is_of_this_study_by_its_own_record_or_the_whole_set(tmp_path):
+    # rows written by record: "a:…" (a's fingerprint) or the set's "set" (tables written before) are kept;
+    # a row of b whose samples changed ("b:old") is another study's
+    out = tmp_path / "s.csv"
+    points = [{"record": r, "scale": 1.0} for r in ("a", "b", "c")]
+    rows = [{"record": "a", "scale": 1.0, "study": "a:1"}, {"record": "b", "scale": 1.0, "study": "set"}]
+    store.write_rows(open_table(out, "set", False, ["record", "scale"], points)[0], rows, ["record", "scale", "study"])
+    by_record = {"a": "a:1", "b": "b:1", "c": "c:1"}
+    table, ours = open_table(out, "set", False, ["record", "scale"], points, row_study=lambda r: by_record[r["record"]])
+    assert [r["record"] for r in ours] == ["a", "b"]
+    # a new set (c added): the set's fingerprint changes, the rows of a keep theirs
+    _, ours = open_table(out, "set+c", True, ["record", "scale"], points, row_study=lambda r: by_record[r["record"]])
+    assert [r["record"] for r in ours] == ["a"]
+    by_record["a"] = "a:edited"
+    with pytest.raises(InputError, match="the file exists"):
+        open_table(out, "set+c", False, ["record", "scale"], points, row_study=lambda r: by_record[r["record"]])
+
+
 def test_histories_to_write_are_checked_and_find_matches_any_value(tmp_path):
     folder = tmp_path / "h"
     check_histories(folder, POINTS, None, False)  # a folder still to make

@@ -43,11 +43,13 @@ def test_a_set_with_a_one_column_file_sweeps_on_worker_processes(tmp_path):
         one, two = rows["one.csv", scale], rows["two.csv", scale]
         assert [repr(one[c]) for c in same] == [repr(two[c]) for c in same], scale  # bit for bit, NaN as NaN
     assert rows["one.csv", 10.0]["pgv"] == pytest.approx(10 * max(abs(x) for x in v))
-    # the same time step makes the same study (its rows reused); another is another record, another study
+    # the same time step makes the same study (its rows reused); another is another record: its rows run again,
+    # those of the file with its own times are kept (a row is of its own record's study)
     again = invoke(*args, "--record-dt", 0.01, "--workers", 0, "--force")
     assert again.exit_code == 0 and "(0 runs now, 4 rows already there, 0 failed)" in words(again.output), again.output
     again = invoke(*args, "--record-dt", 0.02, "--workers", 0, "--force")
-    assert again.exit_code == 0 and "(4 runs now, 0 rows already there, 0 failed)" in words(again.output), again.output
+    assert again.exit_code == 0 and "(2 runs now, 2 rows already there, 0 failed)" in words(again.output), again.output
+    assert "--force replaces 2 rows over record, scale" in words(again.output)
 
 
 def test_a_set_of_csv_accelerograms_is_swept(tmp_path):
@@ -97,3 +99,30 @@ def test_a_csv_whose_header_gives_g_is_swept_in_g(tmp_path):
     assert "--records: in_g.csv is read in g, as its header says, and converted to SI already; --scale 9.81" in words(
         result.output
     )
+
+
+def test_a_record_added_to_the_set_keeps_the_finished_rows_of_the_others(tmp_path):
+    # a fragility study grows as records are downloaded: adding one to the folder made the whole study
+    # "another study" (every record's samples in one fingerprint), each finished row refused or run again
+    folder = tmp_path / "records"
+    folder.mkdir()
+    t = [i * 0.01 for i in range(21)]
+    for k, name in enumerate(("a.csv", "b.csv", "c.csv")):
+        v = band_limited(0.2, 0.01, [3.0 + k], [0.004], seed=k)[2].tolist()
+        text = "time,velocity\n" + "".join(f"{x!r},{y!r}\n" for x, y in zip(t, v))
+        (tmp_path / name).write_text(text)
+    for name in ("a.csv", "b.csv"):
+        (folder / name).write_text((tmp_path / name).read_text())
+    out = tmp_path / "s.csv"
+    args = ["sweep", BLOCK, "--records", folder, "--scale", "1,2", "--duration", 0.2, "--out", out, "--workers", 0]
+    result = invoke(*args, "--no-recording")
+    assert result.exit_code == 0 and "(4 runs now, 0 rows already there" in words(result.output), result.output
+    (folder / "c.csv").write_text((tmp_path / "c.csv").read_text())
+    result = invoke(*args, "--no-recording", "--force")  # --force: the plot exists
+    assert result.exit_code == 0 and "(2 runs now, 4 rows already there" in words(result.output), result.output
+    assert "--force replaces" not in result.output
+    # a record edited since: its rows are another study's, run again; the others kept
+    (folder / "a.csv").write_text((tmp_path / "a.csv").read_text().replace("0.0,", "0.0,0.001\n#", 1))
+    result = invoke(*args, "--no-recording", "--force")
+    assert result.exit_code == 0 and "(2 runs now, 4 rows already there" in words(result.output), result.output
+    assert "--force replaces 2 rows over record, scale" in words(result.output)

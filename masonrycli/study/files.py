@@ -33,10 +33,11 @@ def check_picture(path: Path | None, option: str, suffix: str, force: bool) -> O
 
 
 def open_table(
-    out: Path, study_id: str, force: bool, names: list[str], points: list[dict], warn=None
+    out: Path, study_id: str, force: bool, names: list[str], points: list[dict], warn=None, row_study=None
 ) -> tuple[OutputFile, list]:
     """Check the table ``out`` for the study ``study_id`` over ``points`` (rows keyed by ``names``):
-    ``(its OutputFile, the rows of this study already in it and its journal)``. Raises
+    ``(its OutputFile, the rows of this study already in it and its journal)``; a row whose ``study`` is
+    ``row_study(row)`` is this study's too (a record set's row, by its own record). Raises
     :class:`InputError` for a table that is not this study's unless ``force`` (see the module docstring);
     with ``force``, says through ``warn`` whose rows it replaces."""
     suffix = out.suffix.lower()
@@ -47,7 +48,8 @@ def open_table(
             raise InputError(f"--out {exc} (add --force to replace it)") from None
         rows = []
     keys = {store.row_key(p, names) for p in points}
-    ours = [r for r in rows if r.get("study") == study_id and store.row_key(r, names) in keys]
+    mine = (study_id,) if row_study is None else None
+    ours = [r for r in rows if r.get("study") in (mine or (study_id, row_study(r))) and store.row_key(r, names) in keys]
     foreign = len(ours) < len(rows)  # another study's rows, or points not in this grid: they would be lost
     if foreign and force and warn is not None:
         warn(f"--out {out}: --force replaces {_whose([r for r in rows if r not in ours])}")

@@ -96,9 +96,14 @@ def _samples_digest(record) -> str:
     return digest.hexdigest()
 
 
-def prepare(base: StudyBase, request: StudyRequest) -> str:
-    """Check the request against the base (a bad axis fails here, before any cluster starts) and
-    return the study's fingerprint."""
+def prepare(base: StudyBase, request: StudyRequest) -> tuple[str, dict[str, str]]:
+    """Check the request against the base (a bad axis fails here, before any cluster starts) and return
+    the study's fingerprint, and that of each record of a ``--records`` set: the study of its rows alone.
+
+    A row of a record set is of this study when its ``study`` is either: the fingerprint over every record
+    (the rows of tables written before), or its own record's. Adding a record to the set (a fragility study
+    grows as records are downloaded) changed the one fingerprint, and every finished row was "another
+    study's": refused, or run again with --force."""
     from masonrycli.scenario_toml import dump_scenario
 
     check_axes(request.axes)
@@ -109,9 +114,11 @@ def prepare(base: StudyBase, request: StudyRequest) -> str:
     # kept its rows ("0 runs now, 1 row already there", the old pgv)
     records = {name: (r.source, r.scale, _samples_digest(r)) for name, r in base.records.items()}
     settings = (request.find, request.outcome if request.find else None, request.rtol if request.find else None)
-    return store.fingerprint(
-        dump_scenario(base.scenario, inline_records=True), records, settings, request.stop_at_collapse
-    )
+    dumped = dump_scenario(base.scenario, inline_records=True)
+    by_record = {
+        name: store.fingerprint(dumped, {name: r}, settings, request.stop_at_collapse) for name, r in records.items()
+    }
+    return store.fingerprint(dumped, records, settings, request.stop_at_collapse), by_record
 
 
 def run_study(base: StudyBase, request: StudyRequest, console: Console) -> StudyResult:
@@ -119,10 +126,14 @@ def run_study(base: StudyBase, request: StudyRequest, console: Console) -> Study
     from masonrycli.engine import compile_ahead
     from masonrycli.study.runner import SchedulerLost, open_cluster, run_on_cluster, run_serially
 
-    study_id = prepare(base, request)
+    study_id, by_record = prepare(base, request)
+
+    def row_study(row: dict) -> str:  # the fingerprint a new row is written with: its record's, in a set
+        return by_record.get(row.get("record"), study_id)
+
     names = [a.name for a in request.axes if a.name != request.find]  # a row's key
     points = grid([a for a in request.axes if a.name != request.find])
-    table, ours = files.open_table(request.out, study_id, request.force, names, points, request.warn)
+    table, ours = files.open_table(request.out, study_id, request.force, names, points, request.warn, row_study)
     # run again: error rows, and "failed" ones (tables written before those became error rows)
     done = {store.row_key(r, names): r for r in ours if r.get("status") not in ("error", "failed")}
     if request.find:
@@ -191,7 +202,7 @@ def run_study(base: StudyBase, request: StudyRequest, console: Console) -> Study
         label = row.get("state") or "failed"
         counts[label] = counts.get(label, 0) + 1
         for finished in driver.finished:
-            finished["study"] = study_id
+            finished["study"] = row_study(finished)
             finished["source"] = source
             journal.append(finished)
             progress.advance(bar)
@@ -224,7 +235,7 @@ def run_study(base: StudyBase, request: StudyRequest, console: Console) -> Study
         journal.close()
         rows = driver.rows()
         for r in rows:
-            r.setdefault("study", study_id)
+            r.setdefault("study", row_study(r))
             r.setdefault("source", "")  # a row of a table written before rows named their source: unknown
         if rows:
             store.write_rows(table, rows, columns)
