@@ -371,9 +371,8 @@ def inspect_command(
         Path, typer.Argument(help="Recording (.rrd), run history (.npz) or study table.", metavar="REC.rrd|H.npz|S.csv")
     ],
 ) -> None:
-    """Summarise a recording (scenario, frames, time span, entities), a run history (the run's
-    parameters, status, frames, time span, and each array's shape, dtype and unit) or a study's table
-    (rows, states, swept values, and each column's unit)."""
+    """Summarise a recording (scenario, frames, time span, entities), a run history (its parameters,
+    status, frames and each array's unit) or a study's table (its rows and each column's unit)."""
     from masonrycli.history_inspect import inspect_history, is_history
     from masonrycli.study.inspect_table import is_study_table, study_summary
 

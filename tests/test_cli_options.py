@@ -59,8 +59,8 @@ def test_command_list_keeps_each_summary_on_one_line(group, commands):
         "run": "options given here override the file's values.",
         "check": "print a summary (blocks, supports, mass, bounding box, steps, the loading, outputs); nothing is "
         "computed or written.",
-        "inspect": "a run history (the run's parameters, status, frames, time span, and each array's shape, dtype "
-        "and unit).",
+        "inspect": "a run history (its parameters, status, frames and each array's unit) or a study's table (its rows "
+        "and each column's unit).",
     }
     for name, summary in rows.items():
         assert summary.endswith(said.get(name, ".")), summary
