@@ -119,7 +119,7 @@ def _heights(h: dict, y0: np.ndarray, notes: list[str], shown: str) -> tuple[flo
     height = float(np.median(gaps)) if gaps.size else 0.0
     notes.append(
         f"{shown}: no block_extent (a history of an older masonry): course height estimated from the centroids, "
-        f"{height:.4g} m; drift ratio over {np.ptp(y0) + height:.4g} m"
+        f"{height:.4g} m; drift ratio over {np.ptp(y0) + height:.4g} m; no overturning moment (no block masses)"
     )
     return height, float(np.ptp(y0) + height), float(y0.min() - height / 2), float("nan")
 

@@ -150,6 +150,8 @@ def test_an_old_history_without_block_extent_estimates_the_course_height(tmp_pat
     # centroids 0.1 and 0.3: course height 0.2, height 0.2 + 0.2
     assert np.allclose(col["drift ratio (-)"], (0.5 * C * TIMES**2 - D * TIMES) / 0.4)
     assert any("course height estimated from the centroids, 0.2 m" in note for note in table.notes)
+    # README: "the moment is left out, and a note says so"
+    assert any("no overturning moment (no block masses)" in note for note in table.notes)
 
 
 @pytest.fixture(scope="module")
