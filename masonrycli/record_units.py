@@ -61,37 +61,53 @@ def check_at2_sample(value: float, where: str) -> None:
 
 
 def _words(*alternatives: str) -> re.Pattern:
-    # whole words: not inside a longer run of letters ("_" and brackets are boundaries)
-    return re.compile(r"(?<![a-z])(" + "|".join(alternatives) + r")(?![a-z0-9^²])", re.IGNORECASE)
+    # whole words: not inside a longer run of letters ("_" and brackets are boundaries); a velocity unit is
+    # not the start of an acceleration's ("cm/s" of "cm/s/s", "cm/s2")
+    return re.compile(r"(?<![a-z])(" + "|".join(alternatives) + r")(?![a-z0-9^²]|/\s*s)", re.IGNORECASE)
 
 
+# a length over a time, and over a time squared: "cm/s", "cm/sec"; "cm/s2", "cm/s^2", "cm/s²", "cm/s/s",
+# "cm/sec^2". Before, "cm/s/s" and "in/s/s" were read as velocity in cm/s and in/s, and "cm/s²", "mm/s2"
+# and "cm/sec^2" named no unit, their samples read in m/s² (100x, 1000x too strong), without a word
+_PER_S = r"/\s*s(?:ec)?"
+
+
+def _speed(lengths: str) -> str:
+    return f"(?:{lengths}){_PER_S}"
+
+
+def _accel(lengths: str) -> str:
+    return f"(?:{lengths}){_PER_S}(?:\\^?2|²|{_PER_S})"
+
+
+_SPEED, _ACCEL = _speed("cm|mm|m|in|ft"), _accel("cm|mm|m|in|ft")
 _TIME_MS = _words("ms", "msec", "milliseconds?")
-_ACCELERATION = _words(
-    "acc", "accel", "accn", "accelerations?", r"m/s\^?2", "m/s²", "m/s/s", "gal", "g", r"cm/s\^?2",
-    r"in/s\^?2", "in/s²", r"ft/s\^?2", "ft/s²",
-)  # fmt: skip
-_VELOCITY = _words("vel", "velocity", "velocities", "speed", "m/s", "cm/s", "mm/s", "in/s", "ft/s")
+_ACCELERATION = _words("acc", "accel", "accn", "accelerations?", _ACCEL, "gal", "g")
+_VELOCITY = _words("vel", "velocity", "velocities", "speed", _SPEED)
 # a displacement series was read as velocity in m/s (a header "time (s),disp (m)"), with no word
 _DISPLACEMENT = _words("disp", "displ", "displacements?")
-# units that need a scale to be SI: unit -> (quantity, the factor to m/s or m/s²)
+# units that need a scale to be SI, in their canonical spelling (:func:`_unit_key`) -> (quantity, the factor
+# to m/s or m/s²)
 _SCALED = {
     "cm/s": ("velocity", 0.01),
     "mm/s": ("velocity", 0.001),
     "g": ("acceleration", 9.81),
     "gal": ("acceleration", 0.01),
     "cm/s2": ("acceleration", 0.01),
-    "cm/s^2": ("acceleration", 0.01),
+    "mm/s2": ("acceleration", 0.001),
     # US units: read as SI they were 39x (in) and 3.3x (ft) too large, without a word
     "in/s": ("velocity", 0.0254),
     "ft/s": ("velocity", 0.3048),
     "in/s2": ("acceleration", 0.0254),
-    "in/s^2": ("acceleration", 0.0254),
-    "in/s²": ("acceleration", 0.0254),
     "ft/s2": ("acceleration", 0.3048),
-    "ft/s^2": ("acceleration", 0.3048),
-    "ft/s²": ("acceleration", 0.3048),
 }
-_SCALED_UNIT = _words(*(re.escape(u) for u in _SCALED))
+_SCALED_UNIT = _words(_accel("cm|mm|in|ft"), _speed("cm|mm|in|ft"), "gal", "g")  # m/s, m/s² are SI already
+
+
+def _unit_key(unit: str) -> str:
+    """The :data:`_SCALED` key of a unit as written: ``CM/SEC^2``, ``cm/s/s``, ``cm/s²`` -> ``cm/s2``."""
+    key = re.sub(r"\s+", "", unit.lower()).replace("sec", "s")
+    return re.sub(r"/s(?:\^?2|²|/s)$", "/s2", key)
 
 
 def record_text(raw: bytes) -> str:
@@ -157,10 +173,10 @@ def header_factor(path, quantity: str) -> tuple[str, float] | None:
     unit = _SCALED_UNIT.search(found[1]) if found else None
     if unit is None:
         return None
-    kind, factor = _SCALED[unit.group(1).lower()]
+    kind, factor = _SCALED[_unit_key(unit.group(1))]
     if kind != quantity:
         return None
-    return unit.group(1), _G if unit.group(1).lower() == "g" else factor
+    return unit.group(1), _G if _unit_key(unit.group(1)) == "g" else factor
 
 
 def check_csv_header(path, name: str, quantity, scale) -> None:
@@ -189,7 +205,7 @@ def check_csv_header(path, name: str, quantity, scale) -> None:
         )
     unit = _SCALED_UNIT.search(text)
     if unit and isinstance(scale, (int, float)) and scale == 1.0:
-        kind, factor = _SCALED[unit.group(1).lower()]
+        kind, factor = _SCALED[_unit_key(unit.group(1))]
         if kind == quantity:
             raise InputError(
                 f"{where}: the header gives {kind} in {unit.group(1)} ({shown}) but the samples are read in "

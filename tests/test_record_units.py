@@ -5,7 +5,7 @@ from __future__ import annotations
 import pytest
 
 from masonrycli.errors import InputError
-from masonrycli.record_units import check_at2_header, check_csv_header, csv_header
+from masonrycli.record_units import check_at2_header, check_csv_header, csv_header, header_factor, header_quantity
 
 
 def check(tmp_path, text, quantity="velocity", scale=1.0):
@@ -41,6 +41,14 @@ SAMPLES = "0,0\n0.01,0.5\n0.02,0.1\n"
         ("time,acc (in/s^2)", "acceleration", 1.0, "acceleration in in/s^2"),
         ("time,a (ft/s2)", "acceleration", 1.0, "(a scale of 0.3048 converts them)"),
         ("time,acc (in/s2)", "velocity", 1.0, "the header says acceleration"),
+        # were read as velocity in cm/s / in/s ("/s/s"), or as m/s² without a word (², mm, sec)
+        ("time,a (cm/s/s)", "acceleration", 1.0, "acceleration in cm/s/s"),
+        ("time,a (cm/s/s)", "velocity", 1.0, "the header says acceleration"),
+        ("time,acc (in/s/s)", "acceleration", 1.0, "(a scale of 0.0254 converts them)"),
+        ("time,acc (cm/s²)", "acceleration", 1.0, "acceleration in cm/s² ("),
+        ("time,acc (mm/s2)", "acceleration", 1.0, "(a scale of 0.001 converts them)"),
+        ("time,acc (cm/sec^2)", "acceleration", 1.0, "acceleration in cm/sec^2"),
+        ("time,v (cm/sec)", "velocity", 1.0, "velocity in cm/sec"),
     ],
 )
 def test_header_disagreeing_with_the_reading_is_one_line(tmp_path, header, quantity, scale, expected):
@@ -63,10 +71,33 @@ def test_header_disagreeing_with_the_reading_is_one_line(tmp_path, header, quant
         ("time,items", "acceleration", 1.0),
         ("time,vel (in/s)", "velocity", 0.0254),
         ("time (s), position in s-curve", "velocity", 1.0),
+        ("time, a (m/s/s)", "acceleration", 1.0),
+        ("time,a (cm/s/s)", "acceleration", 0.01),
     ],
 )
 def test_header_that_agrees_or_names_nothing_is_read(tmp_path, header, quantity, scale):
     check(tmp_path, header + "\n" + SAMPLES, quantity, scale)
+
+
+@pytest.mark.parametrize(
+    "header, quantity, factor",
+    [
+        ("time (s),a (cm/s/s)", "acceleration", 0.01),
+        ("time (s),acceleration (in/s/s)", "acceleration", 0.0254),
+        ("time (s),acc (cm/s²)", "acceleration", 0.01),
+        ("time (s),acc (mm/s2)", "acceleration", 0.001),
+        ("time (s),acc (CM/SEC^2)", "acceleration", 0.01),
+        ("time (s),v (cm/sec)", "velocity", 0.01),
+        ("time (s),a (m/s/s)", "acceleration", None),
+    ],
+)
+def test_how_a_sets_csv_reads_its_headers_unit(tmp_path, header, quantity, factor):
+    # how a sweep --records set reads a CSV: the quantity and the factor to SI its header names
+    f = tmp_path / "q.csv"
+    f.write_text(header + "\n" + SAMPLES)
+    assert header_quantity(f) == quantity
+    found = header_factor(f, quantity)
+    assert (found and found[1]) == factor
 
 
 def test_csv_header_is_the_line_before_the_samples(tmp_path):
