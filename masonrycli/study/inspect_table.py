@@ -84,8 +84,8 @@ def study_summary(path) -> tuple[list[tuple[str, str]], list[tuple[str, str]]]:
     table = [
         ("rows", f"{len(rows)} ({', '.join(f'{n} {s}' for s, n in states.most_common())})"),
         *((p, _values(rows, p)) for p in params),
-        ("study", ", ".join(sorted({str(r.get("study")) for r in rows}))),
-        ("masonry source", ", ".join(sorted({str(r.get("source")) for r in rows}))),
+        ("study", _some(r.get("study") for r in rows)),
+        ("masonry source", _some(r.get("source") for r in rows)),
     ]
     if find:
         table.insert(1, ("search", f"--find {find}: {find}_threshold, {find}_lo, {find}_hi"))
@@ -101,6 +101,12 @@ def study_summary(path) -> tuple[list[tuple[str, str]], list[tuple[str, str]]]:
         else:
             lines.append((c, COLUMN_UNITS[c]))
     return table, lines
+
+
+def _some(values) -> str:
+    """The distinct ``values``, the first 3 and a count."""
+    found = sorted({str(v) for v in values})
+    return ", ".join(found[:3]) + (f", … ({len(found)})" if len(found) > 3 else "")
 
 
 def _values(rows: list[dict], name: str) -> str:
