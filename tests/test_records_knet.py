@@ -89,3 +89,26 @@ def test_check_run_and_sweep_take_a_knet_file(tmp_path):
     assert result.exit_code == 0, result.output
     assert sorted(r["record"] for r in read_rows(out)) == ["MYG0041103111446.NS", "MYG0041103111446.UD"]
     assert "MYG0041103111446.UD is a vertical component (PEER's UP / DWN, ESM's Z, K-NET's UD)" in words(result.output)
+
+
+def test_a_records_folder_of_a_kiknet_download_takes_the_surface_files(tmp_path):
+    # a KiK-net download holds each station's borehole (….NS1, .EW1, .UD1) and surface (….NS2 …) files: read
+    # all, the folder ran the borehole motion (at the sensor's depth) as a second record of the same shaking
+    folder = tmp_path / "recs"
+    folder.mkdir()
+    for suffix in ("NS1", "EW1", "NS2", "EW2"):
+        (folder / f"FKSH100304091446.{suffix}").write_text(KNET.read_text())
+    out = tmp_path / "s.csv"
+    args = ["sweep", BLOCK, "--records", folder, "--scale", 1, "--duration", 0.2, "--workers", 0, "--out", out]
+    result = invoke(*args, "--no-recording")
+    assert result.exit_code == 0, result.output
+    assert sorted(r["record"] for r in read_rows(out)) == ["FKSH100304091446.EW2", "FKSH100304091446.NS2"]
+    said = words(result.output)
+    assert (
+        f"--records {folder}: 2 KiK-net borehole files left out (FKSH100304091446.EW1, FKSH100304091446.NS1): the "
+        "motion at the sensor's depth" in said
+    )
+    assert "not read as records" not in said  # named once, by the line that says why
+    # given by name, a borehole file runs
+    result = invoke("check", BLOCK, "--record", folder / "FKSH100304091446.NS1")
+    assert result.exit_code == 0 and "record of acceleration (FKSH100304091446.NS1" in words(result.output)

@@ -310,7 +310,7 @@ def _records(entries: list[Path], out: Path, record_dt: float | None) -> tuple[d
                 unread.append(said)
             if not found:
                 raise InputError(f"--records {entry}: no .AT2, .ASC, K-NET or .csv record in it")
-            unread += _not_read(entry) + _esm_others(entry)
+            unread += _not_read(entry) + _esm_others(entry) + _boreholes(entry)
             files += found
         elif entry.is_file():
             files.append(entry)
@@ -369,6 +369,7 @@ def _not_read(folder: Path) -> list[str]:
         and not _is_record_file(p)
         and p.suffix.lower() not in _NOT_RECORDS
         and not _esm_other(p)
+        and not _kik_borehole(p)
     )
     if not other:
         return []
@@ -402,14 +403,36 @@ def _esm_other(path: Path) -> bool:
     return path.suffix.lower() == ".asc" and esm_series(path) not in ("", "ACCELERATION")
 
 
+def _boreholes(folder: Path) -> list[str]:
+    """The warning naming a folder's KiK-net borehole files, left out: a KiK-net download holds each station's
+    surface (….NS2, .EW2, .UD2) and borehole (….NS1, .EW1, .UD1: the motion at the sensor's depth, tens to
+    hundreds of metres down, not the ground a structure stands on) files; read all, each shaking ran twice,
+    once as its borehole record."""
+    other = sorted(p.name for p in folder.iterdir() if p.is_file() and _kik_borehole(p))
+    if not other:
+        return []
+    names = ", ".join(other[:3]) + (" …" if len(other) > 3 else "")
+    return [
+        f"--records {folder}: {len(other)} KiK-net borehole file{'s' if len(other) > 1 else ''} left out ({names}): "
+        "the motion at the sensor's depth, not at the ground surface; a set folder takes the surface ones (….NS2, "
+        ".EW2); give a borehole file by its name to run it"
+    ]
+
+
+def _kik_borehole(path: Path) -> bool:
+    """A KiK-net file of the borehole sensor (``.NS1``, ``.EW1``, ``.UD1``)."""
+    return path.suffix.lower() in (".ns1", ".ew1", ".ud1")
+
+
 def _is_record_file(path: Path) -> bool:
-    """A file a --records folder reads: .AT2, .csv, K-NET, and ESM .ASC files of acceleration."""
+    """A file a --records folder reads: .AT2, .csv, K-NET, KiK-net's surface files and ESM .ASC files of
+    acceleration."""
     from masonrycli.record_knet import KNET_SUFFIXES
 
     suffix = path.suffix.lower()
     if suffix not in (".at2", ".asc", ".csv", *KNET_SUFFIXES) or not path.is_file():
         return False
-    return not _esm_other(path)
+    return not _esm_other(path) and not _kik_borehole(path)
 
 
 def _record(path: Path, record_dt: float | None):
