@@ -284,8 +284,24 @@ def file_scenario(
 ) -> Scenario:
     """The scenario of a TOML, GeoJSON or WKT file (``masonry run`` / ``check``, :func:`target_scenario`:
     a built-in's name is told where it runs) driven by ``record`` times ``scale`` if given
-    (:func:`with_record`), with the run settings and the friction of ``overrides`` (:func:`override_run`)."""
-    return override_run(with_record(target_scenario(path), record, scale, record_dt), **overrides)
+    (:func:`with_record`), with the run settings and the friction of ``overrides`` (:func:`override_run`).
+    A geometry file has no run settings of its own: shaken by a record with no --duration it runs the whole
+    record, as ``simulate`` does (it ran the default 1 s: 'masonry run wall.geojson --record q.AT2' of an 8 s
+    record, its strong motion after 2 s, said "intact")."""
+    scenario = with_record(target_scenario(path), record, scale, record_dt)
+    if record is not None and _geometry_as_is(scenario) and overrides.get("duration") is None:
+        overrides = overrides | {"duration": whole_records(scenario.motions, overrides.get("dt"))}
+    return override_run(scenario, **overrides)
+
+
+def whole_records(motions, dt=None) -> float:
+    """s: the longest record of ``motions`` in whole steps of ``dt`` (default: the run's 1e-3 s), at most
+    ``MAX_DURATION``; a bad ``dt`` gives the default duration (:func:`override_run` names the option)."""
+    ends = [m.end_time for m in motions if m.kind == "record"]
+    dt = RunConfig.dt if dt is None else dt
+    if not ends or not (isinstance(dt, (int, float)) and 0.0 < dt < math.inf):
+        return RunConfig.duration
+    return min(max(1, math.ceil(max(ends) / dt - 1e-9)) * dt, MAX_DURATION)
 
 
 def _loading(name: str, amp, freq, settlement, record, scale, record_dt=None) -> dict:

@@ -10,6 +10,7 @@ from typer.testing import CliRunner
 
 from masonrycli.cli import app
 from masonrycli.records import G_STANDARD, record_motion
+from masonrycli.study.store import read_rows
 
 from cli_helpers import words
 from synthetic_records import band_limited, write_at2
@@ -297,3 +298,22 @@ def test_a_geometry_files_support_is_shaken_from_any_folder(tmp_path, monkeypatc
     scenario = target_scenario("wall.geojson")
     monkeypatch.chdir(tmp_path / "worker")
     assert shaken_supports(scenario) == [True]
+
+
+def test_a_geometry_file_shaken_by_a_record_runs_the_whole_record(at2, tmp_path):
+    # a geometry file has no run settings: 'run wall.geojson --record q.AT2' ran the default 1 s of a 2 s record
+    # (and a sweep over records likewise), where simulate runs the whole record
+    geo = tmp_path / "wall.geojson"
+    assert invoke("build", "wall", "--blocks", 7, "--out", geo).exit_code == 0
+    result = invoke("check", geo, "--record", at2)
+    assert result.exit_code == 0 and "time │ 2 s in 2000 steps of 0.001 s" in words(result.output), result.output
+    assert "not applied" not in result.output
+    result = invoke("check", geo, "--record", at2, "--dt", 0.003)  # whole steps of the dt given: 667 × 3 ms
+    assert result.exit_code == 0 and "time │ 2.001 s in 667 steps of 0.003 s" in words(result.output), result.output
+    result = invoke("check", geo, "--record", at2, "--duration", 0.5)  # a duration given stands
+    assert "time │ 0.5 s in 500 steps" in words(result.output)
+    out = tmp_path / "s.csv"
+    result = invoke("sweep", geo, "--records", at2, "--scale", 0.01, "--workers", 0, "--out", out, "--no-recording")
+    assert result.exit_code == 0, result.output
+    (row,) = read_rows(out)
+    assert row["steps"] == 2000 and "not applied" not in result.output

@@ -88,7 +88,8 @@ def plan_study(
 
     # a built-in swept over records runs as long as they last (below): its default duration is not the
     # runs', so a --dt need not divide it ('--records recs --dt 0.003' said "does not divide duration = 1.0")
-    lasting = bool(records) and duration is None and is_built_in(target)
+    # a geometry file has no [run] duration of its own either: swept over records, it runs them whole too
+    lasting = bool(records) and duration is None and (is_built_in(target) or _is_geometry(target))
     base = StudyBase(_base_scenario(target, duration, dt, lasting), {})
     name = base.scenario.name
     # the name reduced as recordings name it: "../../evil" made a folder "study-.." and wrote beside it
@@ -233,6 +234,12 @@ def _converted_twice(records: dict, scales: list[float]) -> list[str]:
                 f"--scale {twice[0]:g} converts it again (the scale multiplies the record, 1 is as recorded)"
             )
     return said
+
+
+def _is_geometry(target) -> bool:
+    from masonrycli.structure import GEOMETRY_SUFFIXES
+
+    return Path(target).suffix.lower() in GEOMETRY_SUFFIXES
 
 
 def _base_scenario(target: str, duration, dt, lasting: bool = False):
