@@ -113,7 +113,6 @@ def export_command(
     overturning moment, hinges, energies."""
     from masonrycli.cli_messages import console, say
     from masonrycli.history_export import export_table, write_csv
-    from masonrycli.history_inspect import inspect_history
     from masonrycli.outputs import written_whole
 
     if every < 1:
@@ -121,8 +120,6 @@ def export_command(
     inputs = _inputs(histories)
     several = len(inputs) > 1 or any(path.is_dir() for path in histories)
     targets = _targets(inputs, out, force, several)
-    for history in inputs:  # every file checked before the first CSV is written
-        inspect_history(history)
     options = dict(
         blocks=_names(blocks),
         course_numbers=_course_numbers(course),
@@ -131,8 +128,10 @@ def export_command(
         relative=not absolute,
         every=every,
     )
-    for history, target in zip(inputs, targets):
-        table = export_table(history, **options)
+    # every table made before the first CSV is written: a folder whose second history lacked a --blocks name or
+    # held no frame wrote the first CSV, then stopped (exit 2), and the same command again met "the file exists"
+    tables = [export_table(history, **options) for history in inputs]
+    for history, target, table in zip(inputs, targets, tables):
         with written_whole(target) as part:
             write_csv(table, part)
         for note in table.notes:

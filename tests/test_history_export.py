@@ -291,6 +291,15 @@ def test_a_folder_of_histories_gives_one_csv_each(tmp_path):
     )
     assert invoke("export", folder / "amp=0.5.npz", folder / "amp=1.npz").exit_code == 0  # beside each
     assert sorted(p.name for p in folder.glob("*.csv")) == ["amp=0.5.csv", "amp=1.csv"]
+    # nor when a later history cannot be exported: one without the --blocks name, one of no frame
+    mixed = tmp_path / "mixed"
+    mixed.mkdir()
+    hand_history(mixed / "a.npz")
+    hand_history(mixed / "b.npz", block_name=np.array(["x", "y", "z"]))
+    assert_one_line_error(invoke("export", mixed, "--blocks", "c"), "--blocks c: no such block in", "b.npz")
+    hand_history(mixed / "b.npz", time=TIMES[:0])
+    assert_one_line_error(invoke("export", mixed), "b.npz: a history of no frame")
+    assert list(mixed.glob("*.csv")) == []
     empty = tmp_path / "empty"
     empty.mkdir()
     assert_one_line_error(invoke("export", empty), "empty: a folder without histories (*.npz)")
