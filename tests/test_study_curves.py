@@ -349,6 +349,12 @@ def test_a_grid_of_three_parameters_maps_each_value_of_the_third_apart(tmp_path,
             positions = [tuple(p) for p in batch.column("Points2D:positions").to_pylist()[0]]
             labels = batch.column("Points2D:labels").to_pylist()[0]
     assert len(set(positions)) == 8  # every run its own dot
+    from masonrycli.recording.readback import blueprint_views
+
+    # the view's name says which dot of a cell is which friction
+    assert "state map: amp (m/s) right, freq (Hz) up; friction 0.3 | 0.7 left to right in a cell" in blueprint_views(
+        rrd
+    )
     assert labels[0] == "amp=0.5 freq=1.0 friction=0.3: intact"
 
 

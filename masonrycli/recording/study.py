@@ -108,7 +108,9 @@ def record_study(path: Path, name: str, rows: list[dict], request, fit, im: str,
         _log_state_map(rec, rows, names)
         rec.log("study/state_map", rr.Transform3D(scale=[1.0, -1.0, 1.0]), static=True)  # y up (module doc)
         axes = ", ".join(f"{_with_unit(n)} {way}" for n, way in zip(names, ("right", "up")))
-        title = viewer_safe_text(f"state map: {axes}" if axes else "state map")
+        # a third parameter's runs side by side in each cell (_log_state_map): which is which, left to right
+        beside = "; ".join(f"{n} {' | '.join(map_axis(rows, n)[1])} left to right in a cell" for n in names[2:])
+        title = viewer_safe_text(f"state map: {axes}{'; ' + beside if beside else ''}" if axes else "state map")
         views.insert(0, rrb.Spatial2DView(origin="study", contents=["+ /study/state_map/**"], name=title))
         # hidden: the map, the picture and the rows are static, on no time line, and the viewer fills an
         # empty time panel with a "log_time" of its own, which meant nothing here (module doc)
