@@ -81,9 +81,14 @@ def _accel(lengths: str) -> str:
 
 
 _SPEED, _ACCEL = _speed("cm|mm|m|in|ft"), _accel("cm|mm|m|in|ft")
+# g, the unit, but not a one-letter symbol's subscript: a_g, v_g, u_g are the ground's acceleration, velocity and
+# displacement (EC8's a_g, in m/s²; this project's v_g). "time,v_g" was read as acceleration in g: refused by
+# --record with "a scale of 9.81 converts them" (a velocity then run as an acceleration), converted by 9.81
+# without a word in a sweep --records set
+_G_UNIT = r"(?<!\b[a-z]_)g"
 _TIME_MS = _words("ms", "msec", "milliseconds?")
-_ACCELERATION = _words("acc", "accel", "accn", "accelerations?", _ACCEL, "gal", "g")
-_VELOCITY = _words("vel", "velocity", "velocities", "speed", _SPEED)
+_ACCELERATION = _words("acc", "accel", "accn", "accelerations?", "a_g", _ACCEL, "gal", _G_UNIT)
+_VELOCITY = _words("vel", "velocity", "velocities", "speed", "v_g", _SPEED)
 # a displacement series was read as velocity in m/s (a header "time (s),disp (m)"), with no word
 _DISPLACEMENT = _words("disp", "displ", "displacements?")
 # units that need a scale to be SI, in their canonical spelling (:func:`_unit_key`) -> (quantity, the factor
@@ -101,7 +106,7 @@ _SCALED = {
     "in/s2": ("acceleration", 0.0254),
     "ft/s2": ("acceleration", 0.3048),
 }
-_SCALED_UNIT = _words(_accel("cm|mm|in|ft"), _speed("cm|mm|in|ft"), "gal", "g")  # m/s, m/s² are SI already
+_SCALED_UNIT = _words(_accel("cm|mm|in|ft"), _speed("cm|mm|in|ft"), "gal", _G_UNIT)  # m/s, m/s² are SI already
 
 
 def _unit_key(unit: str) -> str:

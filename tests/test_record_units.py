@@ -73,6 +73,9 @@ def test_header_disagreeing_with_the_reading_is_one_line(tmp_path, header, quant
         ("time (s), position in s-curve", "velocity", 1.0),
         ("time, a (m/s/s)", "acceleration", 1.0),
         ("time,a (cm/s/s)", "acceleration", 0.01),
+        # a_g, v_g: the ground's acceleration and velocity, not a unit of g
+        ("time,a_g", "acceleration", 1.0),
+        ("time,v_g", "velocity", 1.0),
     ],
 )
 def test_header_that_agrees_or_names_nothing_is_read(tmp_path, header, quantity, scale):
@@ -89,6 +92,10 @@ def test_header_that_agrees_or_names_nothing_is_read(tmp_path, header, quantity,
         ("time (s),acc (CM/SEC^2)", "acceleration", 0.01),
         ("time (s),v (cm/sec)", "velocity", 0.01),
         ("time (s),a (m/s/s)", "acceleration", None),
+        ("time (s),v_g", "velocity", None),  # the ground's velocity (read as acceleration in g before)
+        ("time (s),a_g", "acceleration", None),
+        ("time (s),a_g (g)", "acceleration", 9.80665),
+        ("time (s),acc_g", "acceleration", 9.80665),
     ],
 )
 def test_how_a_sets_csv_reads_its_headers_unit(tmp_path, header, quantity, factor):
