@@ -144,6 +144,32 @@ def check_axes(axes: list[Axis]) -> None:
         raise InputError(f"--param: the grid has {runs} points ({sizes}), more than {MAX_RUNS} (a likely typo)")
 
 
+_OTHER_NAMES = {
+    "mu": "friction",
+    "μ": "friction",
+    "coulomb": "friction",
+    "friction_coefficient": "friction",
+    "amplitude": "amp",
+    "velocity": "amp",
+    "pga": "scale",
+    "pgv": "scale",
+    "intensity": "scale",
+    "factor": "scale",
+    "scale_factor": "scale",
+}
+"""Names an engineer gives a parameter -> masonry's (did_you_mean found none of them: ``--param mu=0.5,0.7``)."""
+
+
+def _also_called(key: str) -> str:
+    """' (the Coulomb coefficient is "friction")'-like hint for another name of a parameter, or ""."""
+    name = _OTHER_NAMES.get(key.rpartition(".")[2].lower())
+    if name is None:
+        return ""
+    if name == "scale":
+        return ' (records are scaled by "scale": --scale LO:HI:N; pga and pgv are in every row, as applied)'
+    return f' (did you mean "{name}"?)'
+
+
 def apply_point(base, params: dict):
     """The scenario of one grid point: ``base`` (a :class:`StudyBase`) changed by ``params``.
 
@@ -191,7 +217,7 @@ def apply_point(base, params: dict):
         if short not in MOTION_PARAMS:
             if key not in RUN_PARAMS and key not in ("friction", "record") and key not in options:
                 known = [*MOTION_PARAMS, *RUN_PARAMS, "friction", "record", *_builder_options(builder)]
-                hint = did_you_mean(key, known) or _not_built(builder, key)
+                hint = _also_called(key) or did_you_mean(key, known) or _not_built(builder, key)
                 raise InputError(f"--param {key}: unknown parameter{hint} (see masonry sweep --help)")
             continue
         kind, attr = MOTION_PARAMS[short]
