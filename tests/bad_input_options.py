@@ -438,4 +438,11 @@ OPTION_ROWS = [
         2,
         "q.AT2: a ground-motion record (PEER .AT2; simulate and run take it with --record), not a recording",
     ),
+    (  # said rerun's 'Not an RRD file: expected FourCC header "RRF2", got "Orig"'
+        "inspect-knet-record",
+        {"q.EW2": "Origin Time       2011/03/11 14:46:00\n"},
+        ("inspect", "q.EW2"),
+        2,
+        "q.EW2: a ground-motion record (K-NET .EW2; simulate and run take it with --record), not a recording",
+    ),
 ]
