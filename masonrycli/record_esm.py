@@ -22,6 +22,7 @@ Every refusal is one line naming the file and the line (``q.ASC:29: SAMPLING_INT
 from __future__ import annotations
 
 import math
+import os
 import re
 import warnings
 
@@ -60,8 +61,24 @@ _SERIES = ("ACCELERATION", "VELOCITY")
 
 
 def is_esm(path) -> bool:
-    """Whether ``path`` is named as an ESM / ITACA record (``….ASC``, any case)."""
-    return str(path).lower().endswith(ESM_SUFFIX)
+    """Whether ``path`` is an ESM / ITACA record: named ``….ASC`` (any case), its first line that is not blank a
+    ``KEY: value`` line (``EVENT_NAME: …``; a file that cannot be opened: by its name alone, the reader says why).
+
+    ``.asc`` is also a common name for a plain table of samples (columns of numbers, perhaps a header line), read
+    as a CSV before this reader: ``--record q.asc`` of time and acceleration became 'not an ESM record: its header
+    has no SAMPLING_INTERVAL_S line', and a one-column one refused --record-dt. Such a file is read as a CSV is."""
+    if not str(path).lower().endswith(ESM_SUFFIX):
+        return False
+    if not os.path.isfile(path):  # missing, a folder, a pipe: the reader says so
+        return True
+    try:
+        with open(path, encoding="utf-8", errors="replace") as fh:
+            for _, line in zip(range(50), fh):
+                if line.strip():
+                    return _KEY.match(line) is not None
+    except OSError:
+        return True
+    return True  # blank: the ESM reader says what it lacks
 
 
 def looks_like_esm(lines: list[str]) -> bool:

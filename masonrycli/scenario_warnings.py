@@ -146,7 +146,7 @@ def record_warnings(scenario: Scenario, upright: bool = True) -> list[str]:
             fine.setdefault((name, m.sample_interval), []).append(f'"{support.name}"')
         if name.lower().endswith(".at2") and any(abs(m.scale / g - 1.0) < 0.02 for g in (G_STANDARD, 100 * G_STANDARD)):
             twice.setdefault((name, m.peak_acceleration / G_STANDARD, m.scale), []).append(f'"{support.name}"')
-        elif _cm_file(name) and abs(m.scale / 0.01 - 1.0) < 0.02:
+        elif m.source and _cm_file(m.source) and abs(m.scale / 0.01 - 1.0) < 0.02:
             shrunk.setdefault((name, m.peak_acceleration, m.scale), []).append(f'"{support.name}"')
         elif m.peak_acceleration > MAX_AT2_G * G_STANDARD:
             strong.setdefault((name, m.peak_acceleration / G_STANDARD, m.scale), []).append(f'"{support.name}"')
@@ -204,11 +204,13 @@ def record_warnings(scenario: Scenario, upright: bool = True) -> list[str]:
     )
 
 
-def _cm_file(name: str) -> bool:
-    """An ESM .ASC or K-NET file: read in its header's units (cm/s², gal) and converted to m/s² on reading."""
-    from masonrycli.record_knet import KNET_SUFFIXES
+def _cm_file(path: str) -> bool:
+    """An ESM .ASC or K-NET file: read in its header's units (cm/s², gal) and converted to m/s² on reading (a
+    plain table named .asc is read as a CSV, in its own units: scale 0.01 converts its cm/s²)."""
+    from masonrycli.record_esm import is_esm
+    from masonrycli.record_knet import is_knet
 
-    return name.lower().endswith((".asc", *KNET_SUFFIXES))
+    return is_knet(path) or is_esm(path)
 
 
 def _numbered(time) -> bool:

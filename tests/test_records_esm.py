@@ -208,3 +208,21 @@ def test_a_scale_of_0_01_converting_cm_again_is_warned(record):
         in said
     )
     assert "converts it again" not in words(invoke("check", BLOCK, "--record", record, "--scale", 0.5).output)
+
+
+def test_a_plain_table_named_asc_is_read_as_a_csv(tmp_path):
+    # .asc is a common name for a table of samples: read as a CSV before the ESM reader, then refused ('not an
+    # ESM record: its header has no SAMPLING_INTERVAL_S line'), its one-column form refusing --record-dt
+    _, acc, _ = load_esm(ESM)
+    two = tmp_path / "table.asc"
+    two.write_text("".join(f"{i * 0.005!r} {float(a)!r}\n" for i, a in enumerate(acc)))
+    m = record_motion(two, quantity="acceleration", baseline="none")
+    np.testing.assert_array_equal(m.time, np.arange(200) * 0.005)
+    np.testing.assert_array_equal(m.value, acc)
+    one = tmp_path / "column.asc"
+    one.write_text("".join(f"{float(a)!r}\n" for a in acc))
+    result = invoke("check", BLOCK, "--record", one, "--record-dt", 0.005)
+    assert result.exit_code == 0 and "record of velocity (column.asc, 200 samples" in words(result.output)
+    # in cm/s², converted by a scale of 0.01 as a CSV's: not an ESM file's "converts it again"
+    result = invoke("check", BLOCK, "--record", two, "--scale", 0.01)
+    assert result.exit_code == 0 and "converts it again" not in words(result.output), result.output
