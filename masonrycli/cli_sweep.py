@@ -8,6 +8,7 @@ exit codes. Registered on the app by :mod:`masonrycli.cli`.
 from __future__ import annotations
 
 import contextlib
+import shlex
 import signal
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated
@@ -369,7 +370,15 @@ def _report(console, result, plan: StudyPlan, im: str, written: list, signals: F
         console.print(_fit_line(group, im, request.axes))
     console.print(f"plot: {plot.path}")
     if recording is not None:
-        console.print(f"recording: {recording.path}")
+        # as masonry run says it: 'recording: s.rrd' left a first user to find out what opens a .rrd
+        from rich.text import Text
+
+        from masonrycli.execute import rerun_command
+
+        command = f"{shlex.quote(rerun_command())} {shlex.quote(str(recording.path))}"
+        console.print(
+            Text.assemble("recording: ", str(recording.path), "  (open it: ", (command, "bold"), ")"), soft_wrap=True
+        )
 
 
 @contextlib.contextmanager

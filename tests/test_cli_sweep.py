@@ -448,3 +448,18 @@ def test_inspect_a_study_table_gives_its_rows_values_and_each_columns_unit(block
     record = tmp_path / "q.csv"
     record.write_text("time,velocity\n0,0\n1,1\n")
     assert_one_line_error(invoke("inspect", record), "q.csv: not a study's table")
+
+
+def test_the_study_recording_line_says_how_to_open_it(block, tmp_path):
+    # 'recording: s.rrd' left a first user to find out what opens a .rrd; masonry run says "Open the recording: rerun …"
+    import shlex
+
+    folder = tmp_path / "my runs"
+    folder.mkdir()
+    out = folder / "s.csv"
+    result = invoke("sweep", block, "-p", "amp=0.05,0.1", "--duration", 0.02, "--workers", 0, "--out", out)
+    assert result.exit_code == 0, result.output
+    last = words(result.output).split("recording: ")[-1]
+    assert last.startswith(f"{folder / 's.rrd'} (open it: ") and last.endswith(")"), last
+    command = shlex.split(last.split("(open it: ")[1].removesuffix(")"))  # quoted for the shell: one path
+    assert command[0].endswith("rerun") and command[1:] == [str(folder / "s.rrd")]
