@@ -63,21 +63,27 @@ def check_at2_sample(value: float, where: str) -> None:
 def _words(*alternatives: str) -> re.Pattern:
     # whole words: not inside a longer run of letters ("_" and brackets are boundaries); a velocity unit is
     # not the start of an acceleration's ("cm/s" of "cm/s/s", "cm/s2")
-    return re.compile(r"(?<![a-z])(" + "|".join(alternatives) + r")(?![a-z0-9^²]|/\s*s)", re.IGNORECASE)
+    return re.compile(r"(?<![a-z])(" + "|".join(alternatives) + r")(?![a-z0-9^²*]|/\s*s)", re.IGNORECASE)
 
 
-# a length over a time, and over a time squared: "cm/s", "cm/sec"; "cm/s2", "cm/s^2", "cm/s²", "cm/s/s",
-# "cm/sec^2". Before, "cm/s/s" and "in/s/s" were read as velocity in cm/s and in/s, and "cm/s²", "mm/s2"
-# and "cm/sec^2" named no unit, their samples read in m/s² (100x, 1000x too strong), without a word
+# a length over a time, and over a time squared: "cm/s", "cm/sec", "cm s-1"; "cm/s2", "cm/s^2", "cm/s²",
+# "cm/s**2", "cm/s/s", "cm/sec^2", "cm s-2", "cm s^-2". Before, "cm/s/s", "in/s/s" and "cm/s**2" were read as
+# velocity in cm/s and in/s, and "cm/s²", "mm/s2", "cm/sec^2" and "cm s-2" named no unit, their samples read
+# in m/s² (100x, 1000x too strong), without a word
 _PER_S = r"/\s*s(?:ec)?"
+_S = r"\s*s(?:ec)?"  # "cm s-1", "cm s^-2": a negative power of s after a blank, metric lengths only ("in s-1")
+
+
+def _metric(lengths: str) -> str:
+    return "|".join(unit for unit in lengths.split("|") if unit in ("cm", "mm", "m"))
 
 
 def _speed(lengths: str) -> str:
-    return f"(?:{lengths}){_PER_S}"
+    return f"(?:(?:{lengths}){_PER_S}|(?:{_metric(lengths)}){_S}(?:\\^?-1|⁻¹))"
 
 
 def _accel(lengths: str) -> str:
-    return f"(?:{lengths}){_PER_S}(?:\\^?2|²|{_PER_S})"
+    return f"(?:(?:{lengths}){_PER_S}(?:\\^?2|²|\\*\\*2|{_PER_S})|(?:{_metric(lengths)}){_S}(?:\\^?-2|⁻²))"
 
 
 _SPEED, _ACCEL = _speed("cm|mm|m|in|ft"), _accel("cm|mm|m|in|ft")
@@ -110,9 +116,14 @@ _SCALED_UNIT = _words(_accel("cm|mm|in|ft"), _speed("cm|mm|in|ft"), "gal", _G_UN
 
 
 def _unit_key(unit: str) -> str:
-    """The :data:`_SCALED` key of a unit as written: ``CM/SEC^2``, ``cm/s/s``, ``cm/s²`` -> ``cm/s2``."""
+    """The :data:`_SCALED` key of a unit as written: ``CM/SEC^2``, ``cm/s/s``, ``cm/s²``, ``cm s-2`` -> ``cm/s2``;
+    ``cm/sec``, ``cm s-1`` -> ``cm/s``; ``g``, ``gal`` as they are."""
     key = re.sub(r"\s+", "", unit.lower()).replace("sec", "s")
-    return re.sub(r"/s(?:\^?2|²|/s)$", "/s2", key)
+    length = re.fullmatch(r"(cm|mm|in|ft|m)/?s(.*)", key)
+    if length is None:
+        return key
+    squared = length.group(2) in ("2", "^2", "²", "**2", "/s", "-2", "^-2", "⁻²")
+    return f"{length.group(1)}/s{'2' if squared else ''}"
 
 
 def record_text(raw: bytes) -> str:
