@@ -74,8 +74,8 @@ def is_esm(path) -> bool:
     try:
         with open(path, encoding="utf-8", errors="replace") as fh:
             for _, line in zip(range(50), fh):
-                if line.strip():
-                    return _KEY.match(line) is not None
+                if line.strip("\ufeff \t\r\n"):  # a byte-order mark (a file saved again by Notepad) is no text
+                    return _KEY.match(line.lstrip("\ufeff")) is not None
     except OSError:
         return True
     return True  # blank: the ESM reader says what it lacks

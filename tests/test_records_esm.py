@@ -223,6 +223,10 @@ def test_a_plain_table_named_asc_is_read_as_a_csv(tmp_path):
     one.write_text("".join(f"{float(a)!r}\n" for a in acc))
     result = invoke("check", BLOCK, "--record", one, "--record-dt", 0.005)
     assert result.exit_code == 0 and "record of velocity (column.asc, 200 samples" in words(result.output)
+    # an ESM file saved again with a byte-order mark is still one
+    bom = tmp_path / "bom.ASC"
+    bom.write_text("\ufeff" + ESM.read_text(), encoding="utf-8")
+    assert record_motion(bom).quantity == "acceleration"
     # in cm/s², converted by a scale of 0.01 as a CSV's: not an ESM file's "converts it again"
     result = invoke("check", BLOCK, "--record", two, "--scale", 0.01)
     assert result.exit_code == 0 and "converts it again" not in words(result.output), result.output
