@@ -62,8 +62,8 @@ def check_at2_sample(value: float, where: str) -> None:
 
 def _words(*alternatives: str) -> re.Pattern:
     # whole words: not inside a longer run of letters ("_" and brackets are boundaries); a velocity unit is
-    # not the start of an acceleration's ("cm/s" of "cm/s/s", "cm/s2")
-    return re.compile(r"(?<![a-z])(" + "|".join(alternatives) + r")(?![a-z0-9^²*]|/\s*s)", re.IGNORECASE)
+    # not the start of an acceleration's ("cm/s" of "cm/s/s", "cm/s2", "cm/s**2")
+    return re.compile(r"(?<![a-z])(" + "|".join(alternatives) + r")(?![a-z0-9^²]|/\s*s|\*\*)", re.IGNORECASE)
 
 
 # a length over a time, and over a time squared: "cm/s", "cm/sec", "cm s-1"; "cm/s2", "cm/s^2", "cm/s²",

@@ -96,6 +96,7 @@ def test_header_that_agrees_or_names_nothing_is_read(tmp_path, header, quantity,
         ("time (s),acc (mm s^-2)", "acceleration", 0.001),
         ("time (s),acc (m s-2)", "acceleration", None),
         ("time (s),vel (cm s-1)", "velocity", 0.01),
+        ("time (s),acc*", "acceleration", None),  # a footnote's star
         ("time (s),a (m/s/s)", "acceleration", None),
         ("time (s),v_g", "velocity", None),  # the ground's velocity (read as acceleration in g before)
         ("time (s),a_g", "acceleration", None),
