@@ -191,6 +191,12 @@ def test_a_records_folder_of_an_esm_download_takes_the_acceleration_files(tmp_pa
         f"{stem}.SA.ASC, {stem}.VEL.ASC): a set folder takes each component's acceleration" in said
     )
     assert "not read as records" not in said  # named once, by the line that says why
+    # a folder of the other series alone says why none is read ("no .ASC record in it" before)
+    (folder / f"{stem}.ACC.ASC").unlink()
+    assert_one_line_error(
+        invoke(*args, "--no-recording", "--force"),
+        f"--records {folder}: no .AT2, .ASC, K-NET or .csv record in it; 3 ESM files of another series",
+    )
     # given by name, the velocity file runs (as velocity, m/s)
     result = invoke("check", BLOCK, "--record", folder / f"{stem}.VEL.ASC")
     assert result.exit_code == 0 and "record of velocity" in words(result.output), result.output

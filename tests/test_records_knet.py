@@ -109,6 +109,13 @@ def test_a_records_folder_of_a_kiknet_download_takes_the_surface_files(tmp_path)
         "motion at the sensor's depth" in said
     )
     assert "not read as records" not in said  # named once, by the line that says why
+    # a folder of borehole files alone says why none is read
+    for p in folder.glob("*2"):
+        p.unlink()
+    assert_one_line_error(
+        invoke(*args, "--no-recording", "--force"),
+        f"--records {folder}: no .AT2, .ASC, K-NET or .csv record in it; 2 KiK-net borehole files left out",
+    )
     # given by name, a borehole file runs
     result = invoke("check", BLOCK, "--record", folder / "FKSH100304091446.NS1")
     assert result.exit_code == 0 and "record of acceleration (FKSH100304091446.NS1" in words(result.output)

@@ -315,8 +315,10 @@ def _records(entries: list[Path], out: Path, record_dt: float | None) -> tuple[d
                 if not found:
                     raise InputError(said)
                 unread.append(said)
-            if not found:
-                raise InputError(f"--records {entry}: no .AT2, .ASC, K-NET or .csv record in it")
+            if not found:  # an ESM download's VEL files or KiK-net's borehole ones alone: said why, not "no .ASC"
+                left = [w.removeprefix(f"--records {entry}: ") for w in _esm_others(entry) + _boreholes(entry)]
+                said = "".join(f"; {w}" for w in left)
+                raise InputError(f"--records {entry}: no .AT2, .ASC, K-NET or .csv record in it{said}")
             unread += _not_read(entry) + _esm_others(entry) + _boreholes(entry)
             files += found
         elif entry.is_file():
