@@ -99,6 +99,10 @@ def test_a_csv_whose_header_gives_g_is_swept_in_g(tmp_path):
     assert "--records: in_g.csv is read in g, as its header says, and converted to SI already; --scale 9.81" in words(
         result.output
     )
+    # so is a plain table named .asc (read as a CSV is): it was left out of the warning (.csv alone)
+    (folder / "in_g.csv").rename(folder / "in_g.asc")
+    result = invoke(*args, "--scale", "1,9.81", "--force")
+    assert "--records: in_g.asc is read in g, as its header says, and converted to SI already" in words(result.output)
 
 
 def test_a_record_added_to_the_set_keeps_the_finished_rows_of_the_others(tmp_path):

@@ -222,11 +222,16 @@ def _set_warnings(base: StudyBase, axes: list[Axis]) -> list[str]:
 def _converted_twice(records: dict, scales: list[float]) -> list[str]:
     """A scale that is the conversion of a CSV the set reads in its header's unit (``acc (g)`` at ``--scale
     9.81``, the advice ``--record`` gives such a file): converted twice, 9.81 times too strong."""
+    from masonrycli.record_esm import is_esm
+    from masonrycli.record_knet import is_knet
     from masonrycli.record_units import header_factor
+    from masonrycli.records import is_at2
 
     said = []
     for name, m in records.items():
-        unit = header_factor(m.source, m.quantity) if m.source.lower().endswith(".csv") else None
+        # read as a CSV: a .csv, and a .txt or a plain table named .asc given by name or in the folder
+        as_csv = m.source and not (is_at2(m.source) or is_esm(m.source) or is_knet(m.source))
+        unit = header_factor(m.source, m.quantity) if as_csv else None
         twice = [s for s in scales if unit and abs(abs(s) / unit[1] - 1) < 0.02]
         if twice:
             said.append(
