@@ -20,7 +20,21 @@ def _terminated(signum, frame):
     raise _Terminated
 
 
+def _unencodable_characters_replaced() -> None:
+    """Terminals and pipes whose encoding lacks a character masonry writes (—, →, ≤, σ: a Windows console
+    in cp1252, ``PYTHONIOENCODING=cp1252``, a redirect under an ASCII locale) get ``?`` for it.
+
+    Without this, the first such character raised UnicodeEncodeError: ``masonry simulate wall`` ended with a
+    traceback and exit 1 at its summary ('→' in the energy row), after its files were written.
+    """
+    for stream in (sys.stdout, sys.stderr):
+        reconfigure = getattr(stream, "reconfigure", None)  # a TextIOWrapper; not a replaced stream (tests)
+        if reconfigure is not None and stream.errors == "strict":
+            reconfigure(errors="replace")
+
+
 def main() -> None:
+    _unencodable_characters_replaced()
     # SIGTERM before a command's own handling (masonrycli.interrupt) takes over — Python loading the command
     # line, the structure being built, the outputs checked — killed it without a word (exit -15), where a
     # Ctrl-C says one line; nothing is written in those phases. The commands' handlers put this one back.

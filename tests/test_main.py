@@ -2,6 +2,10 @@
 
 from __future__ import annotations
 
+import os
+import subprocess
+import sys
+
 import pytest
 
 
@@ -18,9 +22,23 @@ def test_ctrl_c_while_masonry_starts_is_one_line_and_exit_130(monkeypatch, capsy
             if name == "masonrycli.cli":
                 raise KeyboardInterrupt
 
-    monkeypatch.delitem(sys.modules, "masonrycli.cli")
+    monkeypatch.delitem(sys.modules, "masonrycli.cli", raising=False)  # imported or not by earlier tests
     monkeypatch.setattr(sys, "meta_path", [Interrupted(), *sys.meta_path])
     with pytest.raises(SystemExit) as exc:
         main()
     assert exc.value.code == 130
     assert capsys.readouterr().err == "error: Ctrl-C while masonry was starting: nothing was run\n"
+
+
+@pytest.mark.parametrize("args", [("simulate", "wall", "--duration", "0.01", "--no-recording"), ("docs", "collapse")])
+def test_a_terminal_without_unicode_gets_question_marks_not_a_traceback(args, tmp_path):
+    # PYTHONIOENCODING=cp1252 (a Windows console, or a redirect there): the summary's '→' raised
+    # UnicodeEncodeError — a traceback and exit 1 after the run; `masonry docs collapse` (σ, ≤) the same
+    env = dict(os.environ, PYTHONIOENCODING="cp1252", RERUN_ANALYTICS="0", COLUMNS="100")
+    done = subprocess.run(
+        [sys.executable, "-m", "masonrycli", *args], cwd=tmp_path, env=env, capture_output=True, timeout=300
+    )
+    assert done.returncode == 0, done.stderr.decode("cp1252")
+    assert b"Traceback" not in done.stderr
+    said = (done.stdout + done.stderr).decode("cp1252")
+    assert "?" in said  # the characters cp1252 lacks, replaced
