@@ -18,7 +18,7 @@ What each column is (README "Export a history"):
 * ``base shear (N)`` and ``base vertical (N)``: the horizontal and vertical force of all the supports on
   the blocks, −Σ ``support_force`` (the history holds the blocks' force on each support), for the blocks'
   thickness; at rest the vertical is the weight; the shear is positive when the base pushes the structure
-  towards +x (= Σ m a_x of the blocks);
+  towards +x (= Σ m a_x of the blocks); empty at t = 0 (step 0: no contact force solved yet);
 * ``overturning moment (N m)``: moment of the supports' forces on the blocks about the base point O (the
   blocks' lowest point as built, midway between their leftmost and rightmost, moving with the ground),
   counter-clockwise positive, from the blocks' inertia (Newton–Euler: Σ (r − O) × m (a − g) + I α, the
@@ -239,9 +239,12 @@ def export_table(
     top_blocks = np.flatnonzero(y0 >= y0.max() - height / 2)
     top_dx = (q[:, top_blocks, 0] - q[0, top_blocks, 0]).mean(axis=1) - ground_u[:, 0]
     table.add("drift ratio (-)", top_dx / structure_height if structure_height > 0 else np.full(len(time), np.nan))
-    force = h["support_force"].sum(axis=1)  # (T,2): the blocks' force on all the supports
-    table.add("base shear (N)", -force[:, 0])
-    table.add("base vertical (N)", -force[:, 1])
+    force = -h["support_force"].sum(axis=1)  # (T,2): all the supports' force on the blocks
+    # the frame of step 0 is before any contact force was solved: its 0 is no force, an empty cell says so
+    # (a 0 there drew a spike at the first row of every base-shear plot, the moment beside it non-zero)
+    force[h["step"] == 0] = np.nan
+    table.add("base shear (N)", force[:, 0])
+    table.add("base vertical (N)", force[:, 1])
     moment = overturning_moment(h, time, base_y, middle_x, ground_u)
     if moment is not None:
         table.add("overturning moment (N m)", moment)
