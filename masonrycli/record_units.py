@@ -1,18 +1,21 @@
 """What a record file's own header says about its units, checked against how it is read.
 
 A record's samples carry no units: an .AT2 file is read as acceleration in g, a CSV file as velocity
-in m/s (or what a scenario file's ``quantity`` and ``scale`` say), times in s. A header that says
-otherwise means the samples would be taken 100–1000× too large, or as the wrong quantity, and the run
-would still say "completed". So a header that *names* other units is refused with one line saying
-what and where; a header that names none is taken at its word (PEER's format is g, a CSV is SI):
+in m/s (or what a scenario file's ``quantity`` says) or in the unit its header gives, times in s. A header
+that says otherwise means the samples would be taken 100–1000× too large, or as the wrong quantity, and the
+run would still say "completed". So a header that *names* other units than the file can be read in is refused
+with one line saying what and where; a header that names none is taken at its word (PEER's format is g, a CSV
+is SI):
 
 * .AT2 (:func:`check_at2_header`): ``UNITS OF CM/S/S`` (anything but G), or a ``VELOCITY`` /
   ``DISPLACEMENT`` series (PEER's .VT2 / .DT2 files, renamed).
 * .AT2 samples (:func:`check_at2_sample`): beyond ``MAX_AT2_G`` (10 g) they are not g — cm/s² under a
   header that says g, or a header that names no unit.
 * CSV (:func:`check_csv_header`), the one text line allowed before the samples: times in ms; an
-  acceleration header read as velocity or the reverse; cm/s, mm/s, in/s, ft/s, g, gal, cm/s², in/s² or ft/s² values read with
-  scale 1 (a scale other than 1 is taken as the conversion).
+  acceleration header read as velocity or the reverse. A header giving cm/s, mm/s, in/s, ft/s, g, gal, cm/s²,
+  in/s² or ft/s² is read in that unit, converted to SI, wherever a record is read (``--record``, a scenario
+  file, a ``sweep --records`` set); a scale equal to that conversion (the old way to read such a file) is
+  refused, it would now convert twice.
 
 The patterns look for whole words, so ``time_ms`` and ``acc (g)`` match but ``rms`` and ``ground`` do not.
 """
@@ -182,9 +185,7 @@ _G = 9.80665
 
 def header_factor(path, quantity: str) -> tuple[str, float] | None:
     """``(unit, factor to SI)`` when the header of the CSV record at ``path`` gives ``quantity`` in a unit that
-    needs one (g, gal, cm/s², cm/s, mm/s, in/s, …), else None. How a ``sweep --records`` set reads such a file:
-    it has no scale of its own there (``--scale`` is the study's axis), so a record in g could not be swept at
-    all — refused, told "a scale of 9.81 converts them", which the set had no way to give."""
+    needs one (g, gal, cm/s², cm/s, mm/s, in/s, …), else None (:func:`check_csv_header` applies it)."""
     found = csv_header(path)
     unit = _SCALED_UNIT.search(found[1]) if found else None
     if unit is None:
@@ -195,13 +196,26 @@ def header_factor(path, quantity: str) -> tuple[str, float] | None:
     return unit.group(1), _G if _unit_key(unit.group(1)) == "g" else factor
 
 
-def check_csv_header(path, name: str, quantity, scale) -> None:
-    """Raise :class:`InputError` if the header of the CSV record at ``path`` names units that disagree
-    with reading it as ``quantity`` ("velocity" m/s or "acceleration" m/s²) times ``scale``, or gives
-    times in ms. Values that are not a known quantity or a number are left to the Record's own checks."""
+CONVERTED_AGAIN = 0.005
+"""Relative width around a CSV header's conversion (9.80665 for g, 0.01 for gal) within which a ``scale`` is
+taken for that conversion given a second time (9.81, 9.807, 9.8; 0.01): refused. Narrow: a scale of 10 on a
+record in g is a choice, not the conversion."""
+
+
+def check_csv_header(path, name: str, quantity, scale) -> float:
+    """The factor to SI of the CSV record at ``path`` read as ``quantity`` ("velocity" m/s or "acceleration"
+    m/s²): what its header's unit says (9.80665 for ``acc (g)``, 0.01 for ``vel (cm/s)``, 1 when it names none).
+    The samples are multiplied by it on reading, as an .AT2 file's g or an ESM file's cm/s² are, wherever a
+    record is read (``--record``, a scenario's record table, a ``sweep --records`` set, ``check``), and ``scale``
+    then multiplies the record as recorded.
+
+    Raises :class:`InputError` if the header names units that disagree with ``quantity``, gives times in ms,
+    or if ``scale`` is the conversion itself (:data:`CONVERTED_AGAIN`): before, such a file was read in SI and
+    its scale was the conversion, so ``scale = 9.81`` on a file in g was right, and now would make it 9.81 times
+    stronger without a word. Values that are not a known quantity or a number are left to the Record's checks."""
     found = csv_header(path)
     if found is None or quantity not in ("velocity", "acceleration"):
-        return
+        return 1.0
     lineno, text = found
     where, shown = f"{name}:{lineno}", shorten(text, 40)
     if _TIME_MS.search(text):
@@ -219,11 +233,19 @@ def check_csv_header(path, name: str, quantity, scale) -> None:
             f"{where}: the header says {other} ({shown}) but the samples are read as {quantity}, {unit} "
             f'(a scenario file\'s record motion takes quantity = "{other}")'
         )
-    unit = _SCALED_UNIT.search(text)
-    if unit and isinstance(scale, (int, float)) and scale == 1.0:
-        kind, factor = _SCALED[_unit_key(unit.group(1))]
-        if kind == quantity:
-            raise InputError(
-                f"{where}: the header gives {kind} in {unit.group(1)} ({shown}) but the samples are read in "
-                f"{'m/s' if kind == 'velocity' else 'm/s²'} (a scale of {factor:g} converts them)"
-            )
+    unit = header_factor(path, quantity)
+    if unit is None:
+        return 1.0
+    factor = unit[1]
+    if (
+        isinstance(scale, (int, float))
+        and not isinstance(scale, bool)
+        and abs(abs(scale) / factor - 1) < CONVERTED_AGAIN
+    ):
+        si = "m/s" if quantity == "velocity" else "m/s²"
+        times = f"{1 / factor:.3g} times too weak" if factor < 1 else f"{factor:.3g} times too strong"
+        raise InputError(
+            f"{where}: the header gives {quantity} in {unit[0]} ({shown}), converted to {si} on reading: scale "
+            f"{scale:g} would convert it again ({times}); drop the scale (it multiplies the record as recorded)"
+        )
+    return factor

@@ -39,7 +39,7 @@ from masonrycli.record_esm import esm_text, esm_vertical, is_esm, looks_like_esm
 from masonrycli.record_knet import is_knet, knet_text, knet_vertical
 from masonrycli.record_motion import Record, time_step_problem
 from masonrycli.record_text import NoTimeStep, TimeStepNotUsed, at2_text, csv_text, number
-from masonrycli.record_units import check_at2_header, check_csv_header, header_factor, header_quantity, record_text
+from masonrycli.record_units import check_at2_header, check_csv_header, header_quantity, record_text
 from masonrycli.values import format_value, quote_string, shorten
 
 
@@ -276,17 +276,16 @@ def record_motion(
     baseline: str = "quadratic",
     display: str | None = None,
     time_step: float | None = None,
-    header_units: bool = False,
 ) -> Record:
     """A :class:`~masonrycli.record_motion.Record` from a record file (.AT2, .ASC or CSV, see :func:`read_record`).
 
     ``quantity`` defaults to "acceleration" for .AT2 files (the only one they hold) and, for CSV, to the
     quantity its header names (:func:`~masonrycli.record_units.header_quantity`), else "velocity". ``vertical`` is the file of the vertical component (the record then acts along x and y and
     ``direction`` is not used). ``source`` is the absolute path of the file. ``time_step`` (s): the
-    files hold one value per line at that spacing (checked before they are read). ``header_units``: a CSV
-    whose header gives its unit (``acc (g)``, ``vel (cm/s)``) is converted by it to SI, ``scale`` then
-    multiplying the record as recorded, as an .AT2 file's g (a ``sweep --records`` set, whose scale is the
-    study's axis); without it such a file needs ``scale`` to be the conversion.
+    files hold one value per line at that spacing (checked before they are read). A CSV whose header gives its
+    unit (``acc (g)``, ``vel (cm/s)``) is converted by it to SI, as an .AT2 file's g, ``scale`` multiplying the
+    record as recorded (:func:`~masonrycli.record_units.check_csv_header`; a scale equal to the conversion is
+    refused).
     """
     time_step = _time_step(time_step, "time_step")
     time, value, native = read_record(path, display, time_step)
@@ -295,15 +294,12 @@ def record_motion(
         raise InputError(f"{display or path}: {kind} holds {native}, not {quantity}")
     quantity = quantity or native or header_quantity(path) or "velocity"  # a CSV: as its header says, else m/s
     if native is None:
-        unit = header_factor(path, quantity) if header_units else None
-        if unit is not None:
-            value = value * unit[1]
-        check_csv_header(path, display or str(path), quantity, scale if unit is None else unit[1])
+        value = _in_si(value, check_csv_header(path, display or str(path), quantity, scale))
     vertical_source = ""
     if vertical is not None:
         vtime, vvalue, vnative = read_record(vertical, time_step=time_step)
         if vnative is None:
-            check_csv_header(vertical, str(vertical), quantity, scale)
+            vvalue = _in_si(vvalue, check_csv_header(vertical, str(vertical), quantity, scale))
         if vnative != native:
             raise InputError(f"{vertical}: the vertical component must be in the same format as {path}")
         time, value = combine_vertical(time, value, vtime, vvalue, str(path), str(vertical))
@@ -320,6 +316,12 @@ def record_motion(
         vertical_source=vertical_source,
         time_step=time_step,
     )
+
+
+def _in_si(value: np.ndarray, factor: float) -> np.ndarray:
+    """A CSV's samples in SI: times the factor its header's unit gives (the same array when it names none, so a
+    file in SI is read bit for bit as before)."""
+    return value if factor == 1.0 else value * factor
 
 
 def _time_step(value, key: str) -> float | None:
@@ -388,8 +390,10 @@ def _table_file(table: dict, key: str, base_dir: str, time_step: float | None):
         raise InputError(f"motion.{key} = {quote_string(file)}: {not_a_file(resolved)} (looked for {resolved})")
     try:
         time, value, native = read_record(resolved, display=file, time_step=time_step)
-        if native is None:
-            check_csv_header(resolved, file, table.get("quantity", "velocity"), table.get("scale", 1.0))
+        if native is None:  # in the unit its header gives, converted to SI
+            value = _in_si(
+                value, check_csv_header(resolved, file, table.get("quantity", "velocity"), table.get("scale", 1.0))
+            )
     except NoTimeStep as exc:  # --record-dt goes with --record, not with the scenario's own record file
         raise InputError(f"motion.{key}: {exc.give('time_step = SECONDS in the record table')}") from None
     except InputError as exc:

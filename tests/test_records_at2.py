@@ -181,9 +181,12 @@ def test_scenario_record_errors(tmp_path, motion, expected):
 def test_csv_header_units_reach_record_motion_and_scenario_files(tmp_path):
     f = tmp_path / "q.csv"
     f.write_text("time,v (cm/s)\n0,0\n0.1,5\n")
-    with pytest.raises(InputError, match=r"^q.csv:1: the header gives velocity in cm/s"):
-        record_motion(f, display="q.csv")
-    assert record_motion(f, scale=0.01).velocity_at([0.1])[0, 0] == pytest.approx(0.05)
-    with pytest.raises(InputError, match=r"^motion.file: q.csv:1: the header gives velocity in cm/s"):
-        record_fields({"file": "q.csv"}, str(tmp_path))
-    assert record_fields({"file": "q.csv", "scale": 0.01}, str(tmp_path))["time"].tolist() == [0.0, 0.1]
+    # read in cm/s, converted to m/s, by --record and a scenario's record table alike; the scale of 0.01 that
+    # converted it before (read in m/s) would convert it twice: refused
+    assert record_motion(f, display="q.csv").velocity_at([0.1])[0, 0] == pytest.approx(0.05)
+    assert record_motion(f, scale=2.0).velocity_at([0.1])[0, 0] == pytest.approx(0.1)
+    with pytest.raises(InputError, match=r"^q.csv:1: the header gives velocity in cm/s .* scale 0.01 would convert"):
+        record_motion(f, display="q.csv", scale=0.01)
+    assert record_fields({"file": "q.csv"}, str(tmp_path))["value"].tolist() == [0.0, 0.05]
+    with pytest.raises(InputError, match=r"^motion.file: q.csv:1: the header gives velocity in cm/s .* drop the sc"):
+        record_fields({"file": "q.csv", "scale": 0.01}, str(tmp_path))

@@ -94,7 +94,7 @@ def test_a_csv_whose_header_gives_g_is_swept_in_g(tmp_path):
         g, ref = rows["in_g.csv", scale], rows["in_si.csv", scale]
         assert [repr(g[c]) for c in same] == [repr(ref[c]) for c in same], scale
         assert rows["in_gal.csv", scale]["pga"] == pytest.approx(ref["pga"], rel=1e-12)
-    # the advice --record gives such a file, a scale of 9.81, would convert it twice: said
+    # the old way to read such a file (--record refuses it now), a scale of 9.81, would convert it twice: said
     result = invoke(*args, "--scale", "1,9.81", "--force")
     assert "--records: in_g.csv is read in g, as its header says, and converted to SI already; --scale 9.81" in words(
         result.output

@@ -454,16 +454,17 @@ def _record(path: Path, record_dt: float | None):
     apart, any other file with its own times (a mixed set: the time step is for its one-column files).
     The file's first sample says which: read without a time step, a one-column file is refused there,
     before the rest of it is parsed, and read again with the time step. A CSV whose header gives its unit
-    (g, gal, cm/s², cm/s, …) is read in it, converted to SI: a set has no scale of its own per file."""
+    (g, gal, cm/s², cm/s, …) is read in it, converted to SI, as ``--record`` reads it (the axis's scale then
+    multiplies the record as recorded, and a row replays with ``run --record FILE --scale`` the row's scale)."""
     from masonrycli.record_text import NoTimeStep
     from masonrycli.records import record_motion
 
     try:
-        return record_motion(path, display=str(path), header_units=True)
+        return record_motion(path, display=str(path))
     except NoTimeStep as exc:
         if record_dt is None:
             raise exc.give("--record-dt SECONDS") from None
-        return record_motion(path, display=str(path), time_step=record_dt, header_units=True)
+        return record_motion(path, display=str(path), time_step=record_dt)
 
 
 def _same_file(a, b) -> bool:
