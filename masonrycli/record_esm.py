@@ -131,15 +131,30 @@ def esm_series(path) -> str:
     """The ``DATA_TYPE`` an ESM file's header gives (upper case; "" when it gives none or cannot be read):
     a ``--records`` folder of an ESM download holds each component's ACCELERATION, VELOCITY and
     DISPLACEMENT files and spectra, and reads the first alone."""
+    return _header_value(path, "DATA_TYPE").upper()
+
+
+def esm_units(path) -> tuple[str, float] | None:
+    """The ``UNITS`` an ESM file's header gives, as written (``cm/s^2``, ``cm/s``), and the factor its samples
+    were multiplied by on reading (0.01 for cm/s² or cm/s); None when it gives none masonry reads. A warning
+    about a scale that converts the file a second time names the file's own unit (a velocity file is in cm/s,
+    not in gal)."""
+    units = _header_value(path, "UNITS")
+    known = _UNITS.get("".join(units.split()).lower())
+    return (units, known[1]) if known else None
+
+
+def _header_value(path, key: str) -> str:
+    """The value of ``KEY:`` in an ESM file's first 100 lines ("" when it has none or cannot be read)."""
     try:
         with open(path, encoding="utf-8", errors="replace") as fh:
             head = [fh.readline() for _ in range(100)]
     except OSError:
         return ""
     for line in head:
-        m = _KEY.match(line)
-        if m and m.group(1).upper() == "DATA_TYPE":
-            return m.group(2).strip().upper()
+        m = _KEY.match(line.lstrip("\ufeff"))
+        if m and m.group(1).upper() == key:
+            return m.group(2).strip()
     return ""
 
 

@@ -114,7 +114,8 @@ def record_warnings(scenario: Scenario, upright: bool = True) -> list[str]:
       1/(2 dt) comes back aliased (the record's counterpart of check_sampling's sine);
     * it peaks beyond 10 g as scaled (no earthquake comes near: a CSV in cm/s read as m/s, or a scale
       meant as a unit conversion applied twice, ran "completed … collapsed" without a word);
-    * it is an ESM or K-NET file (converted from cm/s² or gal on reading) scaled by 0.01: converted twice;
+    * it is an ESM or K-NET file (converted from its header's cm/s², gal or cm/s on reading) scaled by 0.01:
+      converted twice (the warning names the file's own unit);
     * it is an .AT2 file (in g, converted on reading) scaled by g (9.81, or 981 for cm/s²): converted twice,
       a 0.3 g record ran at 2.9 g, under the 10 g line.
     * its times are 0, 1, 2, … s: a spreadsheet's sample numbers (a 1000-sample record ran as 1000 s at 1 Hz,
@@ -146,8 +147,9 @@ def record_warnings(scenario: Scenario, upright: bool = True) -> list[str]:
             fine.setdefault((name, m.sample_interval), []).append(f'"{support.name}"')
         if name.lower().endswith(".at2") and any(abs(m.scale / g - 1.0) < 0.02 for g in (G_STANDARD, 100 * G_STANDARD)):
             twice.setdefault((name, m.peak_acceleration / G_STANDARD, m.scale), []).append(f'"{support.name}"')
-        elif m.source and _cm_file(m.source) and abs(m.scale / 0.01 - 1.0) < 0.02:
-            shrunk.setdefault((name, m.peak_acceleration, m.scale), []).append(f'"{support.name}"')
+        elif abs(m.scale / 0.01 - 1.0) < 0.02 and (unit := _cm_unit(m.source)):
+            peak = m.peak_acceleration if m.quantity == "acceleration" else m.peak_speed(m.end_time)
+            shrunk.setdefault((name, unit, m.quantity, peak, m.scale), []).append(f'"{support.name}"')
         elif m.peak_acceleration > MAX_AT2_G * G_STANDARD:
             strong.setdefault((name, m.peak_acceleration / G_STANDARD, m.scale), []).append(f'"{support.name}"')
         # along x (or as the horizontal of a vertical pair): an up component along y (direction [0, 1]) is meant
@@ -186,10 +188,10 @@ def record_warnings(scenario: Scenario, upright: bool = True) -> list[str]:
             for (name, peak, scale), names in twice.items()
         ]
         + [
-            f"{who(names)}: the record {name} is read in its header's units (cm/s², gal) and converted to m/s² "
-            f"already; scale {scale:g} converts it again ({peak:.3g} m/s² as applied, 100 times too weak; the scale "
-            "multiplies the record, 1 is as recorded)"
-            for (name, peak, scale), names in shrunk.items()
+            f"{who(names)}: the record {name} is read in its header's unit ({unit}) and converted to {_SI[quantity]} "
+            f"already; scale {scale:g} converts it again ({peak:.3g} {_SI[quantity]} as applied, 100 times too weak; "
+            "the scale multiplies the record, 1 is as recorded)"
+            for (name, unit, quantity, peak, scale), names in shrunk.items()
         ]
         + [
             f"{who(names)}: the record {name} has its samples at t = {first:g}, {first + 1:g}, {first + 2:g}, … s: "
@@ -204,13 +206,23 @@ def record_warnings(scenario: Scenario, upright: bool = True) -> list[str]:
     )
 
 
-def _cm_file(path: str) -> bool:
-    """An ESM .ASC or K-NET file: read in its header's units (cm/s², gal) and converted to m/s² on reading (a
-    plain table named .asc is read as a CSV, in its own units: scale 0.01 converts its cm/s²)."""
-    from masonrycli.record_esm import is_esm
+_SI = {"acceleration": "m/s²", "velocity": "m/s"}
+
+
+def _cm_unit(source: str) -> str:
+    """The unit an ESM or K-NET file's header gives when its samples were converted from centimetres on reading
+    (an ESM file's UNITS as written: cm/s^2, gal, cm/s; gal for K-NET), "" for any other file: a CSV (a plain
+    table named .asc too) is read in its own units, scale 0.01 converting its cm/s²; an ESM file in m/s² or mm/s
+    is not converted twice by 0.01."""
+    from masonrycli.record_esm import esm_units, is_esm
     from masonrycli.record_knet import is_knet
 
-    return is_knet(path) or is_esm(path)
+    if not source:
+        return ""
+    if is_knet(source):
+        return "gal"
+    units = esm_units(source) if is_esm(source) else None
+    return units[0] if units and units[1] == 0.01 else ""
 
 
 def _numbered(time) -> bool:

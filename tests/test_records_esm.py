@@ -202,18 +202,42 @@ def test_a_records_folder_of_an_esm_download_takes_the_acceleration_files(tmp_pa
     assert result.exit_code == 0 and "record of velocity" in words(result.output), result.output
 
 
-@pytest.mark.parametrize("record", [ESM, DATA / "knet.NS"])
-def test_a_scale_of_0_01_converting_cm_again_is_warned(record):
+@pytest.mark.parametrize("record, unit, peak", [(ESM, "cm/s^2", "0.01"), (DATA / "knet.NS", "gal", "0.00499")])
+def test_a_scale_of_0_01_converting_cm_again_is_warned(record, unit, peak):
     # the file is converted from cm/s² (gal) on reading: a scale of 0.01, meant as that conversion, ran the
     # record 100 times too weak, "intact", without a word
     result = invoke("check", BLOCK, "--record", record, "--scale", 0.01)
     assert result.exit_code == 0, result.output
     said = words(result.output)
     assert (
-        f"the record {record.name} is read in its header's units (cm/s², gal) and converted to m/s² already; scale 0.01"
-        in said
+        f"the record {record.name} is read in its header's unit ({unit}) and converted to m/s² already; scale 0.01 "
+        f"converts it again ({peak} m/s² as applied, 100 times too weak" in said
     )
     assert "converts it again" not in words(invoke("check", BLOCK, "--record", record, "--scale", 0.5).output)
+
+
+def test_the_scale_of_0_01_warning_names_a_velocity_files_own_unit(tmp_path):
+    # an ESM VEL file is in cm/s: the warning said "(cm/s², gal) and converted to m/s²" of it, and gave its
+    # peak as an acceleration; the samples are 100 sin(2π·2·t) cm/s, 1 m/s at their peak, 0.01 m/s scaled
+    velocity = tmp_path / "IT.NRC..HNE.D.20161030.064017.C.VEL.ASC"
+    velocity.write_text(
+        ESM.read_text()
+        .replace("UNITS: cm/s^2", "UNITS: cm/s")
+        .replace("DATA_TYPE: ACCELERATION", "DATA_TYPE: VELOCITY")
+    )
+    result = invoke("check", BLOCK, "--record", velocity, "--scale", 0.01)
+    assert result.exit_code == 0, result.output
+    said = words(result.output)
+    assert (
+        f"the record {velocity.name} is read in its header's unit (cm/s) and converted to m/s already; scale 0.01 "
+        "converts it again (0.01 m/s as applied, 100 times too weak" in said
+    ), said
+    assert "cm/s²" not in said and "gal" not in said
+    # an ESM file in m/s² is not converted from centimetres: a scale of 0.01 converts nothing twice
+    metres = tmp_path / "m.ASC"
+    metres.write_text(ESM.read_text().replace("UNITS: cm/s^2", "UNITS: m/s^2"))
+    result = invoke("check", BLOCK, "--record", metres, "--scale", 0.01)
+    assert result.exit_code == 0 and "converts it again" not in words(result.output), result.output
 
 
 def test_a_plain_table_named_asc_is_read_as_a_csv(tmp_path):
