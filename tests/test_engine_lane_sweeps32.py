@@ -347,11 +347,10 @@ class _Model:
 
 
 @pytest.mark.parametrize("name", ["columns4x16x64", "columns4x16x62", "stack39"])
-def test_the_first_stage_ends_on_a_float64_sweep_from_the_float32_impulses(name, monkeypatch):
+def test_the_first_stage_ends_on_a_float64_sweep_from_the_float32_impulses(name):
     body, pack, v0, r0, mu = _problem(name)
     count = body.shape[0]
-    model = type("M", (_Model,), {"friction": mu})
-    monkeypatch.setattr(nlgs, "FLOAT32", True)
+    model = type("M", (_Model,), {"friction": mu, "solver": "nlgs-accel32"})
     v, r, st = v0.copy(), r0.copy(), np.zeros(count, np.int8)
     its, res = nlgs.solve(body, pack, count, model, v, r, st)
     # by hand: the float32 sweeps to the tolerance, then the float64 lane sweeps from their impulses
@@ -365,13 +364,13 @@ def test_the_first_stage_ends_on_a_float64_sweep_from_the_float32_impulses(name,
     assert np.abs(v.ravel() - (v0.ravel() + m_inv @ h @ r.ravel())).max() < 1e-12
 
 
-def test_without_a_tolerance_or_float32_the_first_stage_is_the_float64_lane_sweeps(monkeypatch):
-    # tolerance 0 runs exactly the cap (nlgs.py doc): in float64 only; FLOAT32 off: the lane sweeps alone
+def test_without_a_tolerance_or_float32_the_first_stage_is_the_float64_lane_sweeps():
+    # tolerance 0 runs exactly the cap (nlgs.py doc): in float64 only, even for "nlgs-accel32"; solver
+    # "nlgs-accel": the lane sweeps alone
     body, pack, v0, r0, mu = _problem("stack39")
     count = body.shape[0]
-    for flag, tolerance in ((True, 0.0), (False, 1e-6)):
-        monkeypatch.setattr(nlgs, "FLOAT32", flag)
-        model = type("M", (_Model,), {"friction": mu, "tolerance": tolerance, "max_iterations": 50})
+    for solver, tolerance in (("nlgs-accel32", 0.0), ("nlgs-accel", 1e-6)):
+        model = type("M", (_Model,), {"friction": mu, "tolerance": tolerance, "max_iterations": 50, "solver": solver})
         v, r, st = v0.copy(), r0.copy(), np.zeros(count, np.int8)
         out = nlgs.solve(body, pack, count, model, v, r, st)
         v2, r2, st2 = v0.copy(), r0.copy(), np.zeros(count, np.int8)
@@ -388,12 +387,11 @@ def test_float32_sweeps_run_to_run_and_without_contacts():
 
 
 @pytest.mark.parametrize("name", ["columns4x16x62", "stack39"])
-def test_solver_nlgs_accel32_is_the_float32_first_stage_and_nlgs_accel_is_not(name, monkeypatch):
-    # solver "nlgs-accel32" runs lane_sweeps32.first_stage with FLOAT32 off; "nlgs-accel" (FLOAT32 off, the
-    # default) the float64 lane sweeps alone: each against the first stage called by hand
+def test_solver_nlgs_accel32_is_the_float32_first_stage_and_nlgs_accel_is_not(name):
+    # solver "nlgs-accel32" runs lane_sweeps32.first_stage; "nlgs-accel" the float64 lane sweeps alone:
+    # each against the first stage called by hand
     body, pack, v0, r0, mu = _problem(name)
     count = body.shape[0]
-    monkeypatch.setattr(nlgs, "FLOAT32", False)
     for solver, first in (("nlgs-accel32", lane_sweeps32.first_stage), ("nlgs-accel", lane_sweeps._lane_sweeps)):
         model = type("M", (_Model,), {"friction": mu, "solver": solver})
         v, r, st = v0.copy(), r0.copy(), np.zeros(count, np.int8)

@@ -246,11 +246,10 @@ def test_lane_sweeps_run_to_run_and_without_contacts():
 
 def test_the_default_solve_starts_with_the_lane_sweeps(monkeypatch):
     # nlgs.solve's first stage (nlgs-accel, tolerance > 0) is the lane sweeps while LANES, the 4-run
-    # scalar momentum sweep (interleaved._accelerated) without: the same converged step by both. FLOAT32
-    # off: the float64 lane sweeps alone (with it, test_engine_lane_sweeps32).
+    # scalar momentum sweep (interleaved._accelerated) without: the same converged step by both. Solver
+    # "nlgs-accel": the float64 lane sweeps alone ("nlgs-accel32": test_engine_lane_sweeps32).
     body, pack, v0, r0, mu = _problem(39)
     count = body.shape[0]
-    monkeypatch.setattr(nlgs, "FLOAT32", False)
 
     class Model:
         friction, tolerance, max_iterations, solver = mu, 1e-6, 10_000, "nlgs-accel"

@@ -1,7 +1,7 @@
 """The start of the default solver's first stage in single precision: :mod:`masonrycli.engine.lane_sweeps`'s
 momentum sweeps in float32, 16 contacts visited at once on ``<16 x float>`` vectors
 (:mod:`masonrycli.engine._vector32`), then the float64 lane sweeps from their impulses (iterative
-refinement: the step ends on a float64 sweep and the float64 stopping test, nlgs.FLOAT32):
+refinement: the step ends on a float64 sweep and the float64 stopping test; solver "nlgs-accel32", chosen in nlgs.solve):
 
     groups: 16 runs of ⌈C/16⌉ contacts of detection order; group j's lane q holds contact
             q·run + (j + s_q) mod run, s_q = run/2 for odd q in the staggered layout, 0 in the plain one
@@ -74,10 +74,6 @@ STALL32 = 200
 the first stage's own stall window)."""
 RESYNC = 32
 """Sweeps between the float32 stage's re-derivations of the velocities from the impulses (_resync)."""
-TOL_FACTOR = 1.0
-"""The float32 stage stops at TOL_FACTOR × the step's tolerance, the float64 sweeps finish to the tolerance.
-A lab lever (benchmarks/JOURNAL.md "Why float32 sweeps make tall walls' runs dearer"): 10 made h32's
-ensemble neutral (units 1.045) and took wall-248's gain away (CPU 0.99); 1 is what shipped."""
 
 
 @njit(inline="always")
@@ -439,7 +435,7 @@ def first_stage(contact_body, pack, count, mu, tolerance, max_iterations, v, r, 
     Returns (iterations, residual): the sweeps of both, the float64 sweep's residual."""
     # max_iterations − 1: the float64 sweep the step ends on stays within the run's cap
     its32, _ = lane_sweeps32(
-        contact_body, pack, count, mu, tolerance * TOL_FACTOR, max(max_iterations - 1, 0), v, r, status,
+        contact_body, pack, count, mu, tolerance, max(max_iterations - 1, 0), v, r, status,
         min(stall_after, STALL32), -1, RESYNC,
     )  # fmt: skip
     its, residual = lane_sweeps._lane_sweeps(

@@ -293,8 +293,6 @@ LANES = True
 """The accelerated solve's first stage by :mod:`masonrycli.engine.lane_sweeps` (8 runs, 8 contacts visited
 at once in vectors); False: by the scalar sweep in INTERLEAVE runs (interleaved._accelerated), the
 default until the lane sweeps replaced it (benchmarks/JOURNAL.md, explicit vectors addendum)."""
-FLOAT32 = False
-"""The lab's switch: "nlgs-accel" starts as "nlgs-accel32" does (lane_sweeps32.first_stage)."""
 ACCELERATED = ("nlgs-accel", "nlgs-accel32")  # momentum's first stage, stalled steps by stalled.py
 
 
@@ -366,8 +364,9 @@ def solve(contact_body, pack, count, model, v, r, status) -> tuple[int, float]:
     (module doc). Another method plugged in beside this one keeps the signature, reports its work in
     sweep equivalents (contact visits / C) and the same residual, so that the history and the
     unconverged count mean the same thing. A solve that stalls continues by faces (module doc); its
-    iterations are then the point sweeps plus the faces' sweep units. With solver "nlgs-accel" a stalled
-    solve goes on by the methods of :mod:`masonrycli.engine.stalled`, and its iterations add up all of them."""
+    iterations are then the point sweeps plus the faces' sweep units. With an accelerated solver
+    ("nlgs-accel32", "nlgs-accel") a stalled solve goes on by the methods of
+    :mod:`masonrycli.engine.stalled`, and its iterations add up all of them."""
     mu, tolerance, cap = model.friction, model.tolerance, model.max_iterations
     accelerated = model.solver in ACCELERATED
     if not accelerated or tolerance <= 0.0:
@@ -382,7 +381,7 @@ def solve(contact_body, pack, count, model, v, r, status) -> tuple[int, float]:
         iterations, residual = interleaved._shrinking(
             contact_body, pack, count, mu, tolerance, cap, v, r, status, momentum.STALL_SWEEPS, shrink.CHECK_EVERY
         )
-    elif (model.solver == "nlgs-accel32" or FLOAT32) and LANES:  # the one place float32 is chosen
+    elif model.solver == "nlgs-accel32" and LANES:  # the one place float32 is chosen
         iterations, residual = lane_sweeps32.first_stage(
             contact_body, pack, count, mu, tolerance, cap, v, r, status, momentum.STALL_SWEEPS,
             momentum.stall_near(model),
