@@ -450,6 +450,35 @@ def test_inspect_a_study_table_gives_its_rows_values_and_each_columns_unit(block
     assert_one_line_error(invoke("inspect", record), "q.csv: not a study's table")
 
 
+def test_inspect_a_study_table_with_its_header_and_no_rows_says_none_yet(block, tmp_path):
+    # its header has the study and status columns, yet inspect said "not a study's table (no study and status
+    # columns)"; a table with its rows filtered away in a spreadsheet (or pandas) and saved again is one
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    out = tmp_path / "s.csv"
+    args = ["--param", "amp=0.05,0.1", "--duration", 0.1, "--workers", 0]
+    assert invoke("sweep", block, *args, "--out", out, "--no-recording").exit_code == 0
+    header = out.read_text().splitlines()[0]
+    empty_csv = tmp_path / "e.csv"
+    empty_csv.write_text(header + "\n")
+    empty_parquet = tmp_path / "e.parquet"
+    pq.write_table(pa.table({c: pa.array([], pa.float64()) for c in header.split(",")}), empty_parquet)
+    for table in (empty_csv, empty_parquet):
+        result = invoke("inspect", table)
+        assert result.exit_code == 0, result.output
+        said = words(result.output.replace("│", " "))  # the table's cells, wrapped within their column
+        assert "not a study's table" not in said
+        assert "rows 0 — no rows yet: masonry sweep writes its rows here when the study ends or is stopped" in said
+        assert f"kept in the journal {table.name}.journal.jsonl meanwhile" in said, said
+        assert "amp no value yet" in said
+        assert any(ln.startswith("pga") and "m/s²" in ln for ln in result.output.splitlines())
+    # a study under way: its finished rows are in the journal
+    (tmp_path / "e.csv.journal.jsonl").write_text('{"amp": 0.05}\n{"amp": 0.1}\n')
+    said = words(invoke("inspect", empty_csv).output.replace("│", " "))
+    assert "2 finished rows wait in e.csv.journal.jsonl, written here when the study ends" in said, said
+
+
 def test_the_study_recording_line_says_how_to_open_it(block, tmp_path):
     # 'recording: s.rrd' left a first user to find out what opens a .rrd; masonry run says "Open the recording: rerun …"
     import shlex

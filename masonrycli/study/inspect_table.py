@@ -67,8 +67,8 @@ def study_summary(path) -> tuple[list[tuple[str, str]], list[tuple[str, str]]]:
     if not path.is_file():
         raise InputError(f"{path}: no such file")
     rows = _read_table(path)
-    columns = list(rows[0]) if rows else []
-    if not rows or "study" not in columns or "status" not in columns:
+    columns = list(rows[0]) if rows else _header(path)
+    if "study" not in columns or "status" not in columns:
         raise InputError(
             f"{path}: not a study's table (no study and status columns); inspect reads the .rrd recordings, the .npz "
             "histories and the tables of masonry sweep"
@@ -82,10 +82,16 @@ def study_summary(path) -> tuple[list[tuple[str, str]], list[tuple[str, str]]]:
             for r in rows
         )
     table = [
-        ("rows", f"{len(rows)} ({', '.join(f'{n} {s}' for s, n in states.most_common())})"),
-        *((p, _values(rows, p)) for p in params),
-        ("study", _some(r.get("study") for r in rows)),
-        ("masonry source", _some(r.get("source") for r in rows)),
+        (
+            "rows",
+            f"{len(rows)} ({', '.join(f'{n} {s}' for s, n in states.most_common())})" if rows else _none_yet(path),
+        ),
+        *((p, _values(rows, p) if rows else "no value yet") for p in params),
+        *(
+            [("study", _some(r.get("study") for r in rows)), ("masonry source", _some(r.get("source") for r in rows))]
+            if rows
+            else []
+        ),
     ]
     if find:
         table.insert(1, ("search", f"--find {find}: {find}_threshold, {find}_lo, {find}_hi"))
@@ -101,6 +107,41 @@ def study_summary(path) -> tuple[list[tuple[str, str]], list[tuple[str, str]]]:
         else:
             lines.append((c, COLUMN_UNITS[c]))
     return table, lines
+
+
+def _header(path: Path) -> list[str]:
+    """The column names of a table with no row (its header alone; a .parquet file's schema)."""
+    import csv
+
+    try:
+        if path.suffix.lower() == ".parquet":
+            import pyarrow.parquet as pq
+
+            return list(pq.read_schema(path).names)
+        with open(path, newline="") as fh:
+            return next(csv.reader(fh), [])
+    except Exception:  # _read_table read it: a header it cannot give is no study's
+        return []
+
+
+def _none_yet(path: Path) -> str:
+    """The rows line of a study's table with its header and no row: ``inspect`` said "not a study's table (no
+    study and status columns)" of it, though its header has both. masonry sweep writes the table whole when the
+    study ends or is stopped, with every finished row, and none when stopped before its first (a header-only
+    table comes from elsewhere: a spreadsheet's rows deleted, a filter that kept none); finished rows wait in
+    the journal beside it meanwhile."""
+    from masonrycli.study.store import journal_path
+
+    journal = journal_path(path)
+    waiting = ""
+    if journal.is_file():
+        with open(journal, errors="replace") as fh:
+            n = sum(1 for line in fh if line.strip())
+        waiting = f"; {n} finished row{'s' if n != 1 else ''} wait in {journal.name}, written here when the study ends"
+    return (
+        "0 — no rows yet: masonry sweep writes its rows here when the study ends or is stopped (Ctrl-C), each "
+        f"finished row kept in the journal {journal.name} meanwhile{waiting}"
+    )
 
 
 def _some(values) -> str:
