@@ -160,12 +160,15 @@ def _geometry_as_is(scenario: Scenario) -> bool:
 
 def shaken_supports(scenario: Scenario) -> list[bool]:
     """Which supports a record (``--record``, ``sweep --records``) shakes: those with a sine or record motion.
-    A GeoJSON / WKT file run as it is has none (it holds no motion): there, its support when it has one —
-    ``masonry run wall.geojson --record q.AT2`` of a wall on its ground was refused, and a scenario file had to
-    be written to say the obvious; of several, which one is for a scenario file to say."""
+    A GeoJSON / WKT file run as it is has none (it holds no motion): there, the supports it marks driven
+    (``"support_role": "driven"``, WKT ``support NAME driven:``), the others staying fixed, else its support when
+    it has one — ``masonry run wall.geojson --record q.AT2`` of a wall on its ground was refused, and a scenario
+    file had to be written to say the obvious; of several unmarked, none (refused: which one is not obvious)."""
     shaking = [m.kind in ("sine", "record") for m in scenario.motions]
     if any(shaking) or not _geometry_as_is(scenario):
         return shaking
+    if scenario.marked_driven:
+        return [s.name in scenario.marked_driven for s in scenario.assembly.supports]
     return [True] if len(shaking) == 1 else shaking
 
 
@@ -196,9 +199,10 @@ def no_shaking_support(scenario: Scenario, option: str) -> InputError:
         return InputError(f"{option}: {file} has no support to shake (every body in it is a block)")
     names = ", ".join(s.name for s in supports[:4]) + (" …" if len(supports) > 4 else "")
     return InputError(
-        f"{option}: {file} holds no motion and {len(supports)} supports ({names}); say which the record shakes in "
-        f'a scenario file: [structure] file = "{file}" and a [[support]] name = "{supports[0].name}" with '
-        'motion = { kind = "record", file = ... } (masonry docs scenario-format)'
+        f"{option}: {file} holds no motion and {len(supports)} supports ({names}); say which the record shakes: "
+        'mark them "support_role": "driven" in the file (WKT: support NAME driven: …), or write a scenario file '
+        f'[structure] file = "{file}" with a [[support]] name = "{supports[0].name}" and motion = {{ kind = "record", '
+        "file = ... } (masonry docs scenario-format)"
     )
 
 

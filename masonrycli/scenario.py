@@ -181,6 +181,8 @@ class Scenario:
     source : scenario file path, or ``"builder:<name>"``.
     structure : ``{"builder": name, **options}`` for builder scenarios, else ``{}``.
     warnings : non-fatal remarks from ``geometry_library.checks.validate_assembly``.
+    marked_driven : names of the supports a geometry file run as it is marks ``"driven"`` (``support_role``): a
+        record given on the command line shakes them (:func:`masonrycli.builtin.shaken_supports`).
 
     Each support's ``role`` is made consistent with its motion (``"driven"`` unless the motion is fixed).
     """
@@ -193,6 +195,7 @@ class Scenario:
     source: str = ""
     structure: dict = field(default_factory=dict)
     warnings: tuple[str, ...] = ()
+    marked_driven: tuple[str, ...] = ()
 
     def __post_init__(self):
         motions = tuple(self.motions)
@@ -352,11 +355,8 @@ def scenario_from_builder(
 
 
 def scenario_from_geometry_file(path) -> Scenario:
-    """A scenario with default run and material settings for a GeoJSON / WKT file: every support fixed.
-
-    ``masonry run my-wall.geojson`` uses it; for motions or other settings, write a scenario file with
-    ``[structure] file = "my-wall.geojson"``.
-    """
+    """A scenario with default run and material settings for a GeoJSON / WKT file, every support fixed (``masonry
+    run my-wall.geojson``; for motions or settings: a scenario file, ``[structure] file = "my-wall.geojson"``)."""
     path = os.fspath(path)
     ctx = InputContext(path, os.path.dirname(os.path.abspath(path)))
     material = Material()
@@ -375,6 +375,7 @@ def scenario_from_geometry_file(path) -> Scenario:
         source=path,
         structure={"file": os.path.abspath(path)},
         warnings=warnings,
+        marked_driven=tuple(s.name for s in assembly.supports if s.role == "driven"),  # before roles follow motions
     )
 
 

@@ -102,8 +102,9 @@ def test_record_on_a_geometry_file_shakes_its_support_or_says_how_to_choose(at2,
     assert result.exit_code == 2
     assert words(result.output) == (
         "error: --record: arch.geojson holds no motion and 2 supports (left-foundation, right-foundation); say "
-        'which the record shakes in a scenario file: [structure] file = "arch.geojson" and a [[support]] name = '
-        '"left-foundation" with motion = { kind = "record", file = ... } (masonry docs scenario-format)'
+        'which the record shakes: mark them "support_role": "driven" in the file (WKT: support NAME driven: …), or '
+        'write a scenario file [structure] file = "arch.geojson" with a [[support]] name = "left-foundation" and '
+        'motion = { kind = "record", file = ... } (masonry docs scenario-format)'
     )
 
 
@@ -317,3 +318,51 @@ def test_a_geometry_file_shaken_by_a_record_runs_the_whole_record(at2, tmp_path)
     assert result.exit_code == 0, result.output
     (row,) = read_rows(out)
     assert row["steps"] == 2000 and "not applied" not in result.output
+
+
+TWO_SUPPORTS = """{"type": "FeatureCollection", "features": [
+ {"type": "Feature", "properties": {"role": "block", "name": "lintel"},
+  "geometry": {"type": "Polygon", "coordinates": [[[-0.4, 0], [0.4, 0], [0.4, 0.2], [-0.4, 0.2], [-0.4, 0]]]}},
+ {"type": "Feature", "properties": {"role": "support", "name": "left", "support_role": "driven"},
+  "geometry": {"type": "Polygon", "coordinates": [[[-1, -0.5], [-0.05, -0.5], [-0.05, 0], [-1, 0], [-1, -0.5]]]}},
+ {"type": "Feature", "properties": {"role": "support", "name": "right"},
+  "geometry": {"type": "Polygon", "coordinates": [[[0.05, -0.5], [1, -0.5], [1, 0], [0.05, 0], [0.05, -0.5]]]}}
+]}"""
+
+
+def test_record_on_a_geometry_file_shakes_the_supports_it_marks_driven(tmp_path):
+    # a lintel on two pads, the left one marked "support_role": "driven": --record shakes it, the right one stays
+    # fixed (a file of several supports was refused: only a scenario file could say which one shakes)
+    from masonrycli.builtin import target_scenario, with_record
+
+    geo = tmp_path / "two.geojson"
+    geo.write_text(TWO_SUPPORTS)
+    rec = tmp_path / "v.csv"
+    rec.write_text("time (s),vel (m/s)\n0,0\n0.05,0.1\n0.1,0\n")
+    result = invoke("check", geo, "--record", rec)
+    assert result.exit_code == 0, result.output
+    said = words(result.output)
+    assert "loading │ left: record of velocity (v.csv, 3 samples" in said and "right:" not in said
+    assert "driven, but given no motion" not in said
+    scenario = with_record(target_scenario(geo), rec, None)
+    assert [m.kind for m in scenario.motions] == ["record", "fixed"]
+    assert [s.role for s in scenario.assembly.supports] == ["driven", "fixed"]
+    t = np.array([0.0, 0.025, 0.05, 0.2])
+    np.testing.assert_array_equal(scenario.motions[0].velocity_at(t)[:, 0], [0.0, 0.05, 0.1, 0.0])  # linear
+    np.testing.assert_array_equal(scenario.motions[1].velocity_at(t), np.zeros((4, 2)))
+    # both marked: both shake; a sweep over records does the same
+    both = tmp_path / "both.geojson"
+    both.write_text(TWO_SUPPORTS.replace('"name": "right"', '"name": "right", "support_role": "Driven"'))
+    assert [m.kind for m in with_record(target_scenario(both), rec, None).motions] == ["record", "record"]
+    out = tmp_path / "s.csv"
+    result = invoke("sweep", geo, "--records", rec, "--scale", "1,2", "--duration", 0.1, "--workers", 0, "--out", out)
+    assert result.exit_code == 0 and "driven, but given no motion" not in result.output, result.output
+    assert len(read_rows(out)) == 2
+    # a role that is neither: one line naming the feature and the support
+    bad = tmp_path / "bad.geojson"
+    bad.write_text(TWO_SUPPORTS.replace('"support_role": "driven"', '"support_role": "shaken"'))
+    result = invoke("run", bad, "--record", rec)
+    assert result.exit_code == 2 and "Traceback" not in result.output
+    assert words(result.output) == (
+        f"error: {bad}: feature 2: support 1 (\"left\"): support_role must be one of ('fixed', 'driven'), got 'shaken'"
+    )

@@ -212,8 +212,9 @@ def test_records_run_whole_on_a_built_in_and_a_shorter_run_is_warned(block, tmp_
     result = invoke("sweep", geo, "--records", folder, "--workers", 0, "--out", tmp_path / "g.csv")
     assert result.exit_code == 2 and words(result.output) == (
         "error: --records: arch.geojson holds no motion and 2 supports (left-foundation, right-foundation); say "
-        'which the record shakes in a scenario file: [structure] file = "arch.geojson" and a [[support]] name = '
-        '"left-foundation" with motion = { kind = "record", file = ... } (masonry docs scenario-format)'
+        'which the record shakes: mark them "support_role": "driven" in the file (WKT: support NAME driven: …), or '
+        'write a scenario file [structure] file = "arch.geojson" with a [[support]] name = "left-foundation" and '
+        'motion = { kind = "record", file = ... } (masonry docs scenario-format)'
     )
 
 
