@@ -22,7 +22,9 @@ What each column is (README "Export a history"):
 * ``overturning moment (N m)``: moment of the supports' forces on the blocks about the base point O (the
   blocks' lowest point as built, midway between their leftmost and rightmost, moving with the ground),
   counter-clockwise positive, from the blocks' inertia (Newton–Euler: Σ (r − O) × m (a − g) + I α, the
-  accelerations by the rule below) — the history keeps the support's resultant, not where it acts;
+  accelerations by the rule below) — the history keeps the support's resultant, not where it acts; empty at
+  t = 0 as the shear is (the same reaction, not yet solved: the inertia's one-sided difference there is the
+  first interval's mean, and a moment-against-shear plot would take the row as a point without its shear);
 * ``hinges (-)``, ``energy kinetic / potential / dissipated (J)``, ``support work (J)``.
 
 **Accelerations** are finite differences of the recorded velocities: at frame k, (v[k+1] − v[k−1]) /
@@ -247,6 +249,10 @@ def export_table(
     table.add("base vertical (N)", force[:, 1])
     moment = overturning_moment(h, time, base_y, middle_x, ground_u)
     if moment is not None:
+        # the moment of the same base reaction, empty where the shear is: the blocks' inertia gives a number at
+        # step 0 (a one-sided difference, the first interval's mean put at t = 0), but no support force acts
+        # yet, and a moment-against-shear (M-V) plot took that row as a half point (a blank x is 0 in Excel)
+        moment[h["step"] == 0] = np.nan
         table.add("overturning moment (N m)", moment)
     for name, column in SCALARS:
         if name in h:
