@@ -236,6 +236,10 @@ class PairBuffers:
         Candidate pairs (a, b), a < b, sorted by (a, b); rows ``[:pair_count]`` are valid.
     pair_count : int
         Number of valid rows of ``pair_body`` after the last call.
+    pair_scratch : (P_cap, 2) int32
+        Work array of the two counting-sort passes that order ``pair_body``.
+    body_counter : (B + 1,) int64
+        Work array of those passes: pairs per body, then each body's first row.
     body_order : (B,) int64
         Bodies sorted along the sweep axis (kept between calls: the next sort starts from it).
     axis : int

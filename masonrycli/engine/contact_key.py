@@ -43,6 +43,7 @@ KEY_LIMIT_VERTICES = 256
 
 @kernel_only
 def _make_key(a, b, owner_is_b, vertex, edge):
+    # The bit layout of the module doc; the fields' limits (check_topology) keep them from overlapping.
     return (
         (np.int64(a) << 40)
         | (np.int64(b) << 17)

@@ -95,11 +95,10 @@ def before_solve(solver, state, support_v_next) -> tuple[int, int, float] | None
 def after_solve(solver, state, count: int) -> tuple[float, float]:
     """End ``solver``'s step after the solve: q_n+1 in ``state``, the impulses kept for the next warm start.
     Returns (top block speed m/s, NaN if a block's q or v is not finite; largest penetration m, ≥ 0)."""
-    m, bf, warm = solver.model, solver.buffers, solver._warm
-    warm.reserve(count)
+    m, bf = solver.model, solver.buffers
+    keep_key, keep_r = solver._warm.reserve(count)  # what the next step's warm start reads
     speed, depth = _after_solve(
         state.body_q, solver._v_old, state.body_v, m.dt, m.theta, m.block_count,
-        bf.contact_key, solver._r, bf.contact_gap, count, warm._key, warm._r,
+        bf.contact_key, solver._r, bf.contact_gap, count, keep_key, keep_r,
     )  # fmt: skip
-    warm._count = count
     return speed, depth

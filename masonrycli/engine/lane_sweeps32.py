@@ -137,6 +137,7 @@ def _contact(count, run, q, j, stagger):
 
 @njit(inline="always")
 def _moves(Q, base, side):
+    # lanes._moves on this module's 16-lane rows: the lane moves body a (side 0) or b (side 1).
     if side == 0:
         return Q[base + P_IMA * W] > 0.0 or Q[base + P_IIA * W] > 0.0
     return Q[base + P_IMB * W] > 0.0 or Q[base + P_IIB * W] > 0.0

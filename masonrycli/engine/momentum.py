@@ -70,7 +70,7 @@ STALL_SWEEPS = 200
 """Accelerated sweeps without a new lowest residual after which nlgs.solve hands the step to stalled.py
 (module doc, last paragraph)."""
 NEAR = 3.0
-"""× the tolerance: a first stage whose lowest residual is this close waits stall_near(C) sweeps without a new
+"""× the tolerance: a first stage whose lowest residual is this close waits stall_near(model) sweeps without a new
 low instead of STALL_SWEEPS before it hands the step over (module doc, "Near the tolerance")."""
 STALL_NEAR = 25.0
 """The first stage's stall window once its lowest residual is within NEAR × the tolerance, in sweeps per block

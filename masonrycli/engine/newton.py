@@ -1,4 +1,5 @@
-"""Alart–Curnier semismooth Newton on one step's contact problem: the fifth method of a stalled solve.
+"""Alart–Curnier semismooth Newton on one step's contact problem: the first of the round-robin's methods
+in a stalled solve (stalled.METHODS).
 
 Unknowns: the impulses r (C, 2); v(r) = v_free + M⁻¹ H r, u = Hᵀ v(r) (nlgs's notation). Per contact, with
 W = W_αα's diagonal entries (W_tt, W_nn; 1/W is Alart–Curnier's step ρ) and the Signorini bias b,
@@ -81,6 +82,7 @@ from masonrycli.engine.nlgs import P_BIAS, P_IIA, P_IIB, P_IMA, P_IMB, P_NA, P_N
 LAMBDA = 1e-3
 """Levenberg–Marquardt shift λ (× diag W): the lowest; × 10 after a rejected step, ÷ 4 after a full one."""
 LAMBDA_MAX = 1.0
+"""The largest shift λ: rejected steps raise it no further."""
 SIGMA = 1e-4
 """Armijo's sufficient-decrease constant."""
 ALPHA_MIN = 2.0**-10

@@ -288,7 +288,7 @@ def _nlgs(contact_body, pack, count, mu, tolerance, max_iterations, v, r, status
 
 
 INTERLEAVE = 4
-"""The sweep visits the contacts in this many interleaved runs of detection order (see _nlgs_interleaved)."""
+"""The scalar sweeps visit the contacts in this many interleaved runs of detection order (:mod:`.interleaved`)."""
 LANES = True
 """The accelerated solve's first stage by :mod:`masonrycli.engine.lane_sweeps` (8 runs, 8 contacts visited
 at once in vectors); False: by the scalar sweep in INTERLEAVE runs (interleaved._accelerated), the

@@ -1,7 +1,7 @@
 """Contact forces and power of a solved step, and the contacts' tangential velocities (for joint states).
 
 Split from :mod:`masonrycli.engine.nlgs` (module size): the same kernels on the same packed rows
-(``nlgs.pack``), using the sweeps' one compiled ``_relative_velocity`` so the values are the sweeps' own.
+(``nlgs.prepare_contacts``), using the sweeps' one compiled ``_relative_velocity`` so the values are the sweeps' own.
 """
 
 from __future__ import annotations

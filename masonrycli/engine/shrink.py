@@ -47,7 +47,7 @@ sweep full: momentum's kernel)."""
 
 @njit(inline="always")
 def _sweep(body, pack, rr, status, n, v, beta, mu):
-    # One accelerated sweep over rows [0, n): momentum._nlgs_accelerated's contact loop (flip omitted),
+    # One accelerated sweep over rows [0, n): momentum._momentum_sweeps's contact loop (flip omitted),
     # the same operations in the same order. Returns Σ |e_α|².
     sum_e2 = 0.0
     for k in range(n):
@@ -108,6 +108,7 @@ def _compact(active, count, contact_body, pack, rr, status):
 
 @njit(inline="always")
 def _write_back(rows, rr_a, status_a, rr, status):
+    # _compact's inverse for what the sweeps change: rr and status of row rows[i] ← the copies' row i.
     for i in range(rows.shape[0]):
         c = rows[i]
         for j in range(4):
@@ -131,7 +132,7 @@ def _check(active, count, contact_body, pack, v):
 
 @njit
 def _nlgs_shrinking(contact_body, pack, count, mu, tolerance, max_iterations, v, r, status, stall_after, check_every):
-    # momentum._nlgs_accelerated (flip omitted) with the left-out contacts of the module doc:
+    # momentum._momentum_sweeps (flip omitted) with the left-out contacts of the module doc:
     #   v ← v_free + M⁻¹ H r_warm ; β = 0 ; sweep 1 over every contact (momentum's first sweep)
     #   active ← contacts not quiet after it (r_n or r_prev,n ≠ 0); compact copies of their rows
     #   repeat:

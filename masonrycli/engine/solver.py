@@ -88,18 +88,26 @@ class Solver:
         self.body_q_m = np.empty((b, 3))
         """(B, 3) configuration at which the last step detected its contacts."""
         self._v_old = np.empty((b, 3))
+        """(B, 3) m/s, rad/s: v_n, the velocities the step began with (θ-method update, contact power)."""
         self._warm = warmstart.WarmStart(self.buffers.contact_capacity)
         self._count = 0
+        """C: contacts of the last step (rows [:C] of the contact arrays are valid)."""
         self._alloc(self.buffers.contact_capacity)
         self._v_free = np.empty((b, 3))
+        """(B, 3) m/s, rad/s: a step at rest's free velocities, from which _settle solves on."""
         self._top_speed = None
         """m/s: top block speed at the end of the last step (None before the first)."""
 
     def _alloc(self, capacity: int) -> None:
+        # Capacity rows (the contact buffers' capacity), rows [:C] valid after a step.
         self._pack = np.zeros((capacity, nlgs.PACK_WIDTH))
+        """(C_cap, PACK_WIDTH) the contacts' packed constants (nlgs.prepare_contacts; units per column)."""
         self._r = np.zeros((capacity, 2))
+        """(C_cap, 2) N·s: impulses (r_t, r_n) on body b; the warm start in, the solution out."""
         self._status = np.zeros(capacity, dtype=np.int8)
+        """(C_cap,) int8: ContactStatus of each contact after the solve."""
         self._force = np.zeros((capacity, 2))
+        """(C_cap, 2) N: world force on body b of each contact, r / dt (power.contact_power)."""
         self.support_force = np.zeros((self.model.support_count, 2))
         """(S, 2) N: total force the blocks exert on each support during the last step."""
 
@@ -116,7 +124,7 @@ class Solver:
 
     @property
     def contact_normal(self) -> np.ndarray:
-        """(C, 2) unit normals from body a to body b."""
+        """(C, 2) unit normals [-] from body a to body b."""
         return self.buffers.contact_normal[: self._count]
 
     @property

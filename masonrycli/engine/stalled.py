@@ -196,8 +196,10 @@ NEWTON_AHEAD = 1
 
 
 class _State:
-    """One method's iterate: velocities (None until first run), impulses, statuses, last residual and the
-    lowest residual it ended a round with (m/s)."""
+    """One method's iterate: velocities ``v`` (B, 3; None until its first run), impulses ``r`` (C, 2) N·s,
+    ``status`` (C,), its last ``residual`` and the lowest residual it ended a round with, ``low`` (m/s);
+    newton's alone: its Newton ``iterate`` (C, 2) N·s, its regularisation ``shift`` ([λ], newton.py) and
+    its ``resumes``."""
 
     __slots__ = ("v", "r", "status", "residual", "low", "iterate", "shift", "resumes")
 
@@ -293,11 +295,11 @@ def continue_stalled(
                 if stage.residual <= tolerance:
                     _adopt(stage, v, r, status, count)
                     return iterations, stage.residual
-            if name == "newton":  # its sweeps' stall or residual says little of its Newton iterate, which
-                pass  # goes on at the next resume: it leaves after NEWTON_LAST_ROUND only
-            elif done < units:  # stalled inside its budget: its own stall window says it will not get there
-                active.remove(name)
-            elif state.residual >= state.low:  # a whole budget, doubled, without a new low: it cycles
+            # The drop rules (module doc). Not newton's: its sweeps' stall or residual says little of its
+            # Newton iterate, which goes on at the next resume; it leaves after NEWTON_LAST_ROUND only.
+            #   done < units: stalled inside its budget, its own stall window says it will not get there
+            #   residual ≥ low: a whole budget, doubled, without a new low: it cycles
+            if name != "newton" and (done < units or state.residual >= state.low):
                 active.remove(name)
             state.low = min(state.low, state.residual)
         budget *= 2

@@ -214,8 +214,11 @@ class WarmStart:
 
     def __init__(self, capacity: int):
         self._key = np.empty(capacity, np.int64)
+        """(≥ C_prev,) int64: the previous step's contact keys, sorted (rows [:C_prev])."""
         self._r = np.empty((capacity, 2))
+        """(≥ C_prev, 2) N·s: their final impulses (r_t, r_n), in key order."""
         self._count = 0
+        """C_prev: contacts of the previous step."""
 
     @property
     def key(self) -> np.ndarray:
@@ -224,7 +227,7 @@ class WarmStart:
 
     @property
     def r(self) -> np.ndarray:
-        """(≥ C_prev, 2) their final impulses (rows ``[:C_prev]``)."""
+        """(≥ C_prev, 2) N·s their final impulses (rows ``[:C_prev]``)."""
         return self._r
 
     def start(self, key: np.ndarray, count: int, r: np.ndarray) -> int:
