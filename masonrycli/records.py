@@ -350,10 +350,12 @@ def record_fields(table: dict, base_dir: str) -> dict:
         raise InputError("motion.time_step: goes with file, a CSV of one value per line (inline samples give time)")
     if has_file:
         time_step = _time_step(table.get("time_step"), "motion.time_step")
-        time, value, native, source = _table_file(table, "file", base_dir, time_step)
+        time, value, native, source, quantity = _table_file(table, "file", base_dir, time_step)
         out = {"source": source, "time_step": time_step}
+        if native is None and "quantity" not in table:
+            out["quantity"] = quantity  # a CSV: as its header says, as --record reads it, else velocity
         if "vertical" in table:
-            vtime, vvalue, vnative, vsource = _table_file(table, "vertical", base_dir, time_step)
+            vtime, vvalue, vnative, vsource, _ = _table_file(table, "vertical", base_dir, time_step, quantity)
             if vnative != native:
                 raise InputError(f"motion.vertical: must be in the same format as {table['file']}")
             try:
@@ -381,7 +383,9 @@ def record_fields(table: dict, base_dir: str) -> dict:
     return {"time": table["time"], "value": value}
 
 
-def _table_file(table: dict, key: str, base_dir: str, time_step: float | None):
+def _table_file(table: dict, key: str, base_dir: str, time_step: float | None, quantity: str | None = None):
+    """``(time, value, native quantity or None, resolved path, quantity)`` of the record table's ``key`` file: a
+    CSV in SI, read as ``quantity`` (default: the table's, else as its header says, else velocity)."""
     file = table[key]
     if not isinstance(file, str) or not file:
         raise InputError(f"motion.{key} = {format_value(file)[:40]}: must be a file name")
@@ -391,11 +395,10 @@ def _table_file(table: dict, key: str, base_dir: str, time_step: float | None):
     try:
         time, value, native = read_record(resolved, display=file, time_step=time_step)
         if native is None:  # in the unit its header gives, converted to SI
-            value = _in_si(
-                value, check_csv_header(resolved, file, table.get("quantity", "velocity"), table.get("scale", 1.0))
-            )
+            quantity = quantity or table.get("quantity") or header_quantity(resolved) or "velocity"
+            value = _in_si(value, check_csv_header(resolved, file, quantity, table.get("scale", 1.0)))
     except NoTimeStep as exc:  # --record-dt goes with --record, not with the scenario's own record file
         raise InputError(f"motion.{key}: {exc.give('time_step = SECONDS in the record table')}") from None
     except InputError as exc:
         raise InputError(f"motion.{key}: {exc}") from None
-    return time, value, native, resolved
+    return time, value, native, resolved, quantity
