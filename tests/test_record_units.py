@@ -10,6 +10,7 @@ import pytest
 
 from masonrycli.errors import InputError
 from masonrycli.record_units import check_at2_header, check_csv_header, csv_header, header_factor, header_quantity
+from masonrycli.study.store import read_rows
 
 from cli_helpers import assert_one_line_error, invoke, words
 
@@ -188,6 +189,17 @@ def test_a_csv_in_g_shakes_the_same_through_run_a_scenario_and_a_set(tmp_path):
     np.testing.assert_allclose(v, exact, rtol=0, atol=2 * trapezoid * np.abs(exact).max())
     for other in (by_set, by_file):
         np.testing.assert_array_equal(other.velocity_at(t), by_run.velocity_at(t))  # bit for bit
+    # through the command: the set's row at scale 2 applies 2 × 0.3 g (its pga as applied, m/s², of the
+    # baseline-corrected samples: within 1e-4 of the exact peak here; 9.81x off if read as m/s² or converted twice)
+    folder = tmp_path / "set"
+    folder.mkdir()
+    _g_csv(folder / "q.csv")
+    out = tmp_path / "rows.csv"
+    args = ("sweep", BLOCK, "--records", folder, "--scale", 2, "--duration", 0.02, "--workers", 0, "--out", out)
+    result = invoke(*args, "--no-recording")
+    assert result.exit_code == 0, result.output
+    (row,) = read_rows(out)
+    assert row["pga"] == pytest.approx(2 * A_G * 9.80665, rel=1e-4)
 
 
 @pytest.mark.parametrize("command, target", [("check", BLOCK), ("run", BLOCK), ("simulate", "wall")])

@@ -220,8 +220,10 @@ def _set_warnings(base: StudyBase, axes: list[Axis]) -> list[str]:
 
 
 def _converted_twice(records: dict, scales: list[float]) -> list[str]:
-    """A scale that is the conversion of a CSV the set reads in its header's unit (``acc (g)`` at ``--scale
-    9.81``, the advice ``--record`` gives such a file): converted twice, 9.81 times too strong."""
+    """A scale that is the conversion of a CSV read in its header's unit (``acc (g)`` at ``--scale 9.81``, how
+    ``--record`` read such a file before it converted it too): converted twice, 9.81 times too strong. A warning
+    here, where ``--record`` refuses it (:func:`~masonrycli.record_units.check_csv_header`): an axis may hold the
+    value among others (``--scale 1,9.81,20``), and no study read such a file that way (a set refused it)."""
     from masonrycli.record_esm import is_esm
     from masonrycli.record_knet import is_knet
     from masonrycli.record_units import header_factor
