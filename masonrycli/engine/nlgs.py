@@ -356,14 +356,15 @@ def solve(contact_body, pack, count, model, v, r, status) -> tuple[int, float]:
     """Solve one step's contact problem by NLGS: the engine's one entry point for a contact solver.
 
     In: ``contact_body`` (C, 2) bodies a < b, ``pack`` (C, PACK_WIDTH) from :func:`prepare_contacts`,
-    ``model`` (friction, tolerance m/s, max_iterations, solver "nlgs-accel", "nlgs-accel32" or "nlgs"). ``v`` (B, 3): v_free
+    ``model`` (friction, tolerance m/s, max_iterations, solver "nlgs-accel", "nlgs-accel32" or "nlgs", and
+    block_depth for "nlgs-accel32"'s stall window, momentum.stall_near). ``v`` (B, 3): v_free
     in, v_n+1 out. ``r`` (C, 2): starting impulses in, (r_t, r_n) N·s out. ``status`` (C,) int8 out
     (:class:`~masonrycli.engine.contact.ContactStatus`).
 
     Returns (iterations, residual): sweeps done, and the last sweep's RMS contact-law violation in m/s
     (module doc). Another method plugged in beside this one keeps the signature, reports its work in
     sweep equivalents (contact visits / C) and the same residual, so that the history and the
-    unconverged count mean the same thing. A solve that stalls continues by faces (module doc); its
+    unconverged count mean the same thing. A plain ("nlgs") solve that stalls continues by faces (module doc); its
     iterations are then the point sweeps plus the faces' sweep units. With an accelerated solver
     ("nlgs-accel32", "nlgs-accel") a stalled solve goes on by the methods of
     :mod:`masonrycli.engine.stalled`, and its iterations add up all of them."""

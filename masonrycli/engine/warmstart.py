@@ -86,7 +86,7 @@ def _warm_start(key, count, prev_key, prev_r, r):
 
 @njit(inline="always")
 def _remember(key, r, count, out_key, out_r):
-    # Keys sorted (stable) with their impulses, for the next step's binary searches.
+    # Keys sorted (stable) with their impulses, for the next step's searches (_warm_start).
     # Insertion sort: detection emits the contacts sorted by body pair, the keys' leading bits, so only
     # the one or two contacts of a pair can be out of order: ~linear, and no allocation.
     for i in range(count):
