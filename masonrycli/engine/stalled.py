@@ -1,5 +1,20 @@
 """What a stalled accelerated solve does: momentum in body order, then five methods taken in turn.
 
+    continue_stalled (the step's first stage stopped at its stall window above the tolerance):
+        stage: momentum in body order (bodies.py) from the warm start, ≤ BODIES_UNITS sweep units;
+               done if it meets the tolerance; handed over early when its residual cycles
+               ("Hand-over", "Sooner" below)
+        round-robin, round k = 0, 1, …: each method of METHODS still active (newton, turning,
+        alternating, momentum, faces) resumes from its own iterate for FIRST_BUDGET · 2^k units
+        (newton: NEWTON_BUDGET × that, its second resume right after its first, none after
+        NEWTON_LAST_ROUND); done when one meets the tolerance; after BODIES_REENTER resumes a
+        handed-over stage goes on once ("Re-entry"); a method that stalls inside its budget or ends a
+        round no lower than an earlier one is dropped (newton excepted)
+        at the cap: the round-robin's state of lowest residual, the step counted unconverged
+
+The paragraphs below are the why, each with its measurements, in the order the rules were added; the
+round-robin's own case ("Gauss–Seidel with momentum … converges most steps") comes after the stage's.
+
 First, from the step's warm start, momentum sweeps that visit the contacts body by body
 (:mod:`masonrycli.engine.bodies`) for at most BODIES_UNITS sweep units (stall window BODIES_STALL sweeps;
 they hand over to the round-robin earlier when their residual cycles, "Hand-over" below).
