@@ -1,7 +1,8 @@
 """The sweeps of a step in interleaved order: the contacts copied into K runs visited in turn, swept by
-momentum (:mod:`masonrycli.engine.momentum`, solver "nlgs-accel") or plainly (``nlgs._nlgs``), copied back.
-The default solver's first stage uses 8 runs and vectors instead (:mod:`masonrycli.engine.lanes`,
-:mod:`masonrycli.engine.lane_sweeps`); stalled.py's sweeps and plain "nlgs" use these.
+momentum (:mod:`masonrycli.engine.momentum`) or plainly (``nlgs._nlgs``), copied back. The accelerated
+solvers' first stage uses 8 runs and vectors instead (:mod:`masonrycli.engine.lanes`,
+:mod:`masonrycli.engine.lane_sweeps`); plain "nlgs", stalled.py's and newton.py's sweeps use these (and
+the first stage with the lab's ``nlgs.LANES`` off).
 
 Detection order puts a pair's two or three contact points, and the pairs of one block, next to each
 other: each visit then reads the velocities the visit before has just written, and the sweep runs at

@@ -1,4 +1,5 @@
-"""The first stage of solver "nlgs-accel": momentum's sweeps with 8 contacts visited at once, in vectors.
+"""The first stage of solver "nlgs-accel" (and the float64 end of "nlgs-accel32"'s, lane_sweeps32.first_stage):
+momentum's sweeps with 8 contacts visited at once, in vectors.
 
 The sweeps of :mod:`masonrycli.engine.momentum` (Nesterov extrapolation, adaptive restart, the stall
 window after which nlgs.solve hands the step to :mod:`masonrycli.engine.stalled`) in the lane groups of
