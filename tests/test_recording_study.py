@@ -70,6 +70,38 @@ def test_records_sweep_fits_a_fragility_curve_and_records_the_study(block, tmp_p
     assert twice.exit_code == 2 and "two records named syn0.AT2" in twice.output
 
 
+def test_each_groups_fraction_and_fit_share_one_legend_entry_of_one_line(block, tmp_path):
+    # 5 frictions' curves: the viewer's legend had 13 entries (each group's fraction and fit), 5 wrapped on two
+    # lines, and "runs: intact / damaged / collapsed" were cut off below the view (headless screenshot,
+    # 1920 x 1080); the viewer lists same-named series once: one entry a group, one line each
+    import rerun as rr
+
+    folder = tmp_path / "records"
+    folder.mkdir()
+    for seed in range(3):
+        t, u, v, a = band_limited(1.0, 0.01, [1.0 + 0.4 * seed, 2.5], [0.03, 0.01], seed=seed)
+        write_at2(folder / f"syn{seed}.AT2", a / G_STANDARD, 0.01)
+    out, rrd = tmp_path / "s.csv", tmp_path / "s.rrd"
+    args = ["--records", folder, "--scale", "5:80:4", "--param", "friction=0.4:0.8:5", "--duration", 0.2]
+    result = invoke("sweep", block, *args, "--workers", 0, "--out", out, "--recording", rrd)
+    assert result.exit_code == 0, result.output
+    names = {}
+    for chunk in rr.chunk.RrdReader(str(rrd)).stream():
+        if chunk.is_static and chunk.entity_path.startswith("/study/fragility/"):
+            batch = chunk.to_record_batch()
+            (column,) = [n for n in batch.schema.names if n.endswith(":names")]
+            names[chunk.entity_path.removeprefix("/study/fragility/")] = batch.column(column).to_pylist()[0][0]
+    groups = [f"friction = {f:g}" for f in (0.4, 0.5, 0.6, 0.7, 0.8)]
+    assert {f"fit/{i}" for i in range(5)} <= set(names)  # every group fitted: a curve each
+    for i, group in enumerate(groups):
+        assert names[f"fraction/{i}"] == names[f"fit/{i}"] and names[f"fit/{i}"].startswith(f"{group}: "), names
+    entries = set(names.values())
+    assert len(entries) == 8 and {"runs: intact", "runs: damaged", "runs: collapsed"} <= entries, entries
+    # one line of the legend: 46 characters wrapped ("friction = 0.4: lognormal: θ = 39.5 m/s², β =" was its first)
+    assert max(map(len, entries)) <= 42, entries
+    assert names["fit/0"].startswith("friction = 0.4: θ = ") and " m/s², β = " in names["fit/0"], names["fit/0"]
+
+
 def check_fragility_reads_as_a_plot(rrd: Path, rows: list[dict]) -> None:
     """The fragility curve opens as a plot with its own axes: P(collapse) 0-1 against the IM from 0 to
     past the largest run (in a 2-D view with one scale for both it read as a flat line 60 m/s² long and

@@ -28,7 +28,9 @@ a sequence time line in thousandths of the intensity's unit (``pga (mm/s²)``: a
 so 1 mm/s² is its resolution), y the probability fixed at [−0.05, 1.05]; the runs are points at 0 or 1
 coloured by state, the fraction collapsed at each scale and the fitted lognormal: the series, colours
 and legend labels of the PNG (``masonrycli.study.curves``; red was a collapsed run here and the fraction
-per scale there).
+per scale there). With a curve per value of another swept parameter, a group's fraction and fit share one
+legend entry, one line long (:func:`_one_entry_a_group`): 5 groups' 13 entries ran off the view's bottom,
+the runs' own with them.
 
 The threshold curve read flat the same way (``amp_threshold`` 0.08–0.23 m/s against ``blocks`` 12–48
 or ``friction`` 0.1–0.3): it is plotted the same way, against the other swept parameter's own time line
@@ -43,6 +45,7 @@ m/s²)", "friction × 1000 (#1000 = 1)" (:func:`x_scale`); before, only "(mm/s²
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import uuid
 from pathlib import Path
@@ -64,6 +67,7 @@ from masonrycli.study.curves import (
     point_groups,
     rgb,
     searched_range,
+    short_fit_label,
     threshold_series,
 )
 from masonrycli.study.curves import UNITS as PARAM_UNITS
@@ -367,10 +371,27 @@ def _log_fragility(rec, rows: list[dict], fit, im: str, groups=None) -> tuple[st
     in its ticks)."""
     timeline = fragility_timeline(im)
     good = [r for r in rows if r.get("status") != "error"]
-    _send_curve(rec, "study/fragility", timeline, 1000.0, fragility_series(good, im, fit, UNITS[im], groups))
+    series = _one_entry_a_group(fragility_series(good, im, fit, UNITS[im], groups), groups, UNITS[im])
+    _send_curve(rec, "study/fragility", timeline, 1000.0, series)
     x = np.array([_number(r.get(im)) for r in good], dtype=np.float64)
     top = np.nanmax(x) if np.isfinite(x).any() else 1.0
     return timeline, int(np.rint(1200.0 * top)) + 1
+
+
+def _one_entry_a_group(series, groups, unit: str) -> list:
+    """The fragility ``series`` with each group's fraction and fit under one name, ``friction = 0.5: θ = 3.09
+    m/s², β = 0.31`` (:func:`~masonrycli.study.curves.short_fit_label`): the viewer's legend lists series of
+    the same name once, in their colour. With 5 groups (``--param friction=0.4:0.8:5``) it had 13 entries, 5
+    of them wrapped on two lines, and the runs' 3 (``runs: intact / damaged / collapsed``) were cut off below
+    the view (a headless screenshot at 1920 x 1080); now 8, each one line. The PNG keeps its own entries."""
+    if not groups or len(groups) < 2:
+        return list(series)
+    names = {str(i): f"{g.label}: {short_fit_label(g.fit, unit)}" for i, g in enumerate(groups)}
+    out = []
+    for c in series:
+        kind, _, i = c.key.partition("/")
+        out.append(dataclasses.replace(c, label=names[i]) if kind in ("fraction", "fit") and i in names else c)
+    return out
 
 
 def _log_thresholds(rec, rows: list[dict], find: str, names: list[str], searched) -> tuple[str, str, int, int, tuple]:

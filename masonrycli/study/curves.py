@@ -92,6 +92,18 @@ def fit_label(fit, unit: str) -> str:
     return f"lognormal: θ = {fit.median:.3g} {unit}, β = {fit.dispersion:.2f}"
 
 
+def short_fit_label(fit, unit: str) -> str:
+    """:func:`fit_label` in one line of the viewer's legend beside a group's name (``friction = 0.5: θ = 3.09
+    m/s², β = 0.31``): the group's fraction and fit share that one entry (``masonrycli.recording.study``)."""
+    if fit is None:
+        return "fraction collapsed per scale"
+    if fit.separated:
+        return "not resolved (β → 0)"
+    if getattr(fit, "unbounded", False):
+        return "not resolved (β → ∞)"
+    return f"θ = {fit.median:.3g} {unit}, β = {fit.dispersion:.2f}"
+
+
 def point_groups(rows: list[dict], by: list[str]) -> list[tuple[str, list[int]]]:
     """``(label, row indices)`` of each combination of the values of parameters ``by`` in ``rows``, in the rows'
     order (``friction = 0.5``); one group ``("", every row)`` when ``by`` is empty."""
