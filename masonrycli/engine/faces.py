@@ -1,4 +1,5 @@
-"""Gauss–Seidel by faces: what a stalled NLGS solve continues with.
+"""Gauss–Seidel by faces: what a stalled plain "nlgs" solve continues with, and the last of stalled.py's
+methods for the accelerated solvers.
 
 Two blocks in contact along a face touch at two points (three for a point inside a face) that the
 detection emits next to each other, with the same body pair. Point-by-point Gauss–Seidel visits them
