@@ -190,3 +190,37 @@ def test_a_limit_recording_is_shown_at_its_last_step(tmp_path):
     rrd = tmp_path / "mechanism.rrd"
     write_recording(analyse(column(2, 0.4, 0.8, 0.9), LiveLoad("horizontal")), rrd)
     assert screenshot_recording(rrd, tmp_path / "last.png", timeout=120) == []
+
+
+def test_a_fragility_legend_of_five_groups_shows_the_runs_entries(tmp_path):
+    # 'masonry sweep … --records recs --param friction=0.4:0.8:5': the plot's legend lost "runs: intact" and
+    # "runs: damaged" (13 entries, 5 of them two lines long, ran off the view's bottom); their dots are the only
+    # green and orange right of the runs themselves (intact at pga 3-4 m/s², damaged up to 43 of a 74 m/s² axis)
+    import PIL.Image as image_module
+
+    from masonrycli.records import G_STANDARD
+    from masonrycli.study.curves import STATE_COLOURS, rgb
+
+    from sweep_helpers import invoke, write_block
+    from synthetic_records import band_limited, write_at2
+
+    folder = tmp_path / "records"
+    folder.mkdir()
+    for seed in range(3):
+        t, u, v, a = band_limited(1.0, 0.01, [1.0 + 0.4 * seed, 2.5], [0.03, 0.01], seed=seed)
+        write_at2(folder / f"syn{seed}.AT2", a / G_STANDARD, 0.01)
+    rrd = tmp_path / "s.rrd"
+    args = ["--records", folder, "--scale", "5:80:4", "--param", "friction=0.4:0.8:5", "--duration", 0.2]
+    result = invoke(
+        "sweep", write_block(tmp_path), *args, "--workers", 0, "--out", tmp_path / "s.csv", "--recording", rrd
+    )
+    assert result.exit_code == 0, result.output
+    png = tmp_path / "s.png.shot.png"
+    assert screenshot_recording(rrd, png, at_open=True, timeout=120) == []
+    image = np.asarray(image_module.open(png).convert("RGB"))
+    width, height = png_size(png)
+    legend_side = image[
+        int(0.05 * height) : int(0.97 * height), int(0.18 * width) : width // 3
+    ]  # the plot's right half
+    for state in ("intact", "damaged", "collapsed"):
+        assert near(legend_side, np.array([rgb(STATE_COLOURS[state])] * 4), tol=40).sum() > 20, state
