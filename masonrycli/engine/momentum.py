@@ -8,53 +8,37 @@ Each sweep of :mod:`masonrycli.engine.nlgs` starts from a Nesterov extrapolation
 impulses and velocities; the momentum is dropped whenever a sweep's residual grows by more than
 RESTART_GROWTH (adaptive restart). The contact law, the local solve, the residual and the stopping test
 are nlgs's, and a step still ends on a sweep, so what a converged step satisfies is unchanged; only the
-path is shorter. Measured on captured steps (benchmarks/JOURNAL.md): 2.5–4.6× fewer sweeps on walls of
-8–32 courses, 2.4× on the arch, 5.9× on the aqueduct, at the same distance from a 1e-9 m/s reference;
-one accelerated sweep costs ~1.2× a plain one (the extrapolation reads and writes r and v once more). A
-restart growth of 1.3 or more diverges on the 248-block wall; 1.05–1.2 all converge.
+path is shorter (pseudo-code above _momentum_sweeps):
+
+    repeat: (r, v) ← (r, v) + β (r − r_prev, v − v_prev);  the sweep of nlgs from there
+            stop at the tolerance, or after STALL_SWEEPS sweeps without a new lowest residual
+            a residual > RESTART_GROWTH × the last: j = 1;  β = (j − 1)/(j + 2), j += 1
 
 Why momentum works here: Gauss–Seidel moves load through a stack of hyperstatic joints about one course
 per sweep, so on a wall of N courses its error decays like a diffusion, ~N² sweeps per decade. Nesterov's
 extrapolation turns that into ~N on linear problems; the restart keeps it safe where the nonsmooth law
 switches a contact between open, stick and slip (a sweep whose residual jumps has just crossed one).
+Measured on captured steps: 2.5–4.6× fewer sweeps on walls of 8–32 courses at the same distance from a
+1e-9 m/s reference, one accelerated sweep costing ~1.2× a plain one (benchmarks/JOURNAL.md, "nlgs-accel:
+Gauss–Seidel with Nesterov momentum").
 
-Where it fails: on tall sliding walls momentum can drive a step into a stick/slip cycle that plain sweeps
-do not leave either (the 32-course wall's steps 84–88: the residual wanders at 5e-5–9e-5 m/s for 60 000
-sweeps, where plain sweeps from the same warm start converge in 1219–1539 on two of them). Left to the
-plain solve's 10 000-sweep stall window, such steps made the default slower than plain Gauss–Seidel over
-the first 0.2 s of the 32- and 64-course walls (96 against 79 and 318 against 164 CPU s per simulated s).
-So a solve of this solver stops after STALL_SWEEPS accelerated sweeps without a new lowest residual, and
-nlgs.solve hands the step to :mod:`masonrycli.engine.stalled`: this momentum with its sweep
-direction turning at every restart (``flip``), alternating-direction sweeps, this momentum resumed, and
-faces, in turn with doubling budgets (that module's doc has the figures). The fixed chain it replaced
-(faces for at most 5000 sweep units, plain sweeps from the warm start, faces to the cap) took
-17 816–23 714 sweep units on the 32-course wall's sliding steps.
+Stall window: on tall sliding walls momentum can drive a step into a stick/slip cycle where its residual
+wanders above the tolerance. So a solve stops after STALL_SWEEPS accelerated sweeps without a new lowest
+residual, and nlgs.solve hands the step to :mod:`masonrycli.engine.stalled` (whose body-order stage
+finishes almost every such step from the warm start). 200 rather than 500 gets the step there sooner:
+ensembles of 48 runs, mean sweep units a step 0.614× on the 32-course wall ("Momentum's stall window and
+the round-robin's order").
 
-The window was 500 sweeps until stalled.py put momentum in body order ahead of its round-robin, a stage
-that finishes almost every stalled step of the tall walls from the warm start: momentum's 500-sweep
-plateau was then 23–45 % of their hard steps' units (benchmarks/JOURNAL.md, "Momentum's stall window").
-With 200 the stage gets them sooner. Ensembles of 48 runs a wall against 500: mean sweep units a step
-0.614× [90 %: 0.535, 0.707] on the 32-course wall, 0.878× [0.807, 0.960] on the 64-course wall, 0.969×
-[0.923, 1.013] on the 248-block wall; unconverged steps 7 → 1, 2 → 4, 3 → 0. 100 costs the 248-block
-wall 4 % (its steps with plateaus that momentum finishes go to the stage, which costs more on them).
-
-Near the tolerance (since 2026-11-28). A step handed over is solved again from its warm start, so a first
-stage that stalls just above the tolerance throws its progress away. On the 64-course wall that is most
-hard steps: of the 177 steps of ≥ 2500 units of its benchmark run (1 m/s, 2 Hz, 1 s), 91 stalled below
-3 × the tolerance, and the body-order stage then spent ~6800 units on each where the first stage, left
-to go on, finished in ~3200. So once its lowest residual is within NEAR × the tolerance, the float64 part
-of the default's first stage (lane_sweeps32.first_stage: lane_sweeps._lane_sweeps after the float32
-sweeps) waits stall_near(model) = max(STALL_SWEEPS, STALL_NEAR × Model.block_depth) sweeps for a new low:
-the plateaus of momentum are longer on deeper structures, as load moves about one block a sweep. 1600 on
-the 64-course wall, 400 on the 248-block wall, 200 (unchanged) on walls of 8 courses or fewer. Replayed
-(captured steps through nlgs.solve) with fixed windows: the 64-course wall's 177 steps 1 319 183 units at
-200, 987 505 at 1000, 915 518 at 2000 (all converged from 1000 on; one at the cap at 200); the 32-course
-wall's 79 steps 0.968× at 1000; the 248-block wall's 194 steps of ≥ 400 units 1.026× at 400–600, 1.16× at
-3000. A window of ½ × the contact count instead of the depth (9050127) made the long 8-course walls dearer
-(1004 blocks: 1.20× the units over 3 runs): they have the 64-course wall's contacts, not its depth.
+Near the tolerance: a step handed over is solved again from its warm start, so a first stage that stalls
+just above the tolerance throws its progress away. So once its lowest residual is within NEAR × the
+tolerance, the float64 part of the default's first stage (lane_sweeps32.first_stage: lane_sweeps._lane_sweeps
+after the float32 sweeps) waits stall_near(model) = max(STALL_SWEEPS, STALL_NEAR × Model.block_depth) sweeps
+for a new low: the plateaus of momentum are longer on deeper structures, as load moves about one block a
+sweep (the depth, not the contact count: long low walls have the contacts of tall ones). Replayed, the
+64-course wall's 177 steps of ≥ 2500 units: 1 319 183 units at window 200, 915 518 at 2000 ("Near the
+tolerance: the first stage waits longer").
 "nlgs-accel" (the float64 path) and the lab levers nlgs.LANES = False and shrink.CHECK_EVERY > 0 keep the
-plain window. Ensembles of one-second runs against the rule off: benchmarks/JOURNAL.md, "Near the
-tolerance".
+plain window.
 """
 
 from __future__ import annotations
@@ -65,10 +49,11 @@ from masonrycli.engine._jit import kernel_only, njit
 from masonrycli.engine.nlgs import P_WNN, P_WTN, P_WTT, _local_solve, _push, _relative_velocity
 
 RESTART_GROWTH = 1.1
-"""The accelerated sweep drops its momentum when a sweep's residual exceeds the previous one by this factor."""
+"""The accelerated sweep drops its momentum when a sweep's residual exceeds the previous one by this factor
+(1.3 or more diverges on the 248-block wall; 1.05–1.2 all converge)."""
 STALL_SWEEPS = 200
 """Accelerated sweeps without a new lowest residual after which nlgs.solve hands the step to stalled.py
-(module doc, last paragraph)."""
+(module doc, "Stall window")."""
 NEAR = 3.0
 """× the tolerance: a first stage whose lowest residual is this close waits stall_near(model) sweeps without a new
 low instead of STALL_SWEEPS before it hands the step over (module doc, "Near the tolerance")."""
