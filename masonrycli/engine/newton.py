@@ -35,40 +35,23 @@ One resume for a budget of U sweep units (stalled.py; the iterate r and λ carry
     module doc), their (v, r, status) the state the method reports (consistent), while the next resume
     goes on from the Newton iterate r
 
-Newton alone converges linearly near the solution (λ held, short steps): on the 32-course wall's step
-that turning needs 21 377 units for, its own RMS of F falls from 3e-3 to 1e-5 in ~25 steps, while turning
-sweeps from its iterate after 10 steps finish in ~1000 units; hence 10 Newton steps a first resume
-(NEWTON_SHARES[0] of stalled.py's 2 × 2000 units) and sweeps from there; a step still not solved gets
-40 in the next resume (NEWTON_SHARES[1]), the iterate going on: of 5 steps that ended unconverged in
-ensemble runs (all five methods dropped or the cap), 3 then converge in 12 643–13 455 units (with 20
-Newton steps again, 1 of them; with 66, 3; with 106, 4), while the 98-step replay below takes 212 312
-units instead of 194 066 (one step, h32's 25 446-unit one: 37 446 instead of 19 678).
+Why: Newton alone converges only linearly near the solution (λ held, short steps), but it gets a stalled
+step out of its stick/slip cycle: on the 32-course wall's step that turning sweeps need 21 377 units for,
+turning sweeps from the iterate of 10 Newton steps finish in ~1000. Hence 10 Newton steps in a first resume
+(NEWTON_SHARES[0] of stalled.py's 2 × 2000 units) and sweeps from there, 40 in the next (NEWTON_SHARES[1]),
+the iterate going on. First in stalled.py's order, it takes the 98 stalled steps of the 32- and 64-course
+walls' first 0.2 s from 408 422 sweep units to 212 312 (0.52×; benchmarks/JOURNAL.md, "Alart–Curnier in the
+engine, as a fifth stalled-step method"). It starts from the warm start: from momentum's stalled iterate it
+does worse ("Alart–Curnier: globalised semismooth Newton on the full law").
 
-Units. A Newton step costs 46–60 turning sweeps of the same step in CPU (the banded assembly, LU and solve:
-1.2–1.8 ms at 497 bodies, 3.2–4.4 ms at 993, against 30–36 µs and 64–87 µs a sweep; six captured stalled
-steps of the 32- and 64-course walls, CPU minimum of 15 on a loaded machine), plus ~4 evaluations of F in
-its line search at ~1 sweep each: NEWTON_UNITS = 60, a constant so that sweep counts stay deterministic.
-scipy's splu of the same matrix (COO assembly, MMD ordering) took 100–150 sweeps a step, counted as 200.
+Not on ordinary steps (those momentum converges without stalling): 1.06–4.4× momentum's units on the
+248-block wall's, at best 0.985× (noise) on the tall walls' ("Newton-type steps on ordinary steps"): a wall's
+solution set is a continuum of self-stresses, and the sweeps' work there is choosing one inside the cone,
+which F's Newton step does not do.
 
-On the 98 stalled steps of the 32- and 64-course walls' first 0.2 s (captured from main's runs, each
-replayed through stalled.continue_stalled): 408 422 units without this method, 291 118 with it second in
-the order at 200 units a step (splu), 260 206 at 60 units (banded), 256 810 with the polish's stall window,
-233 323 also in the second round, 194 066 (0.48×) first in the order: 10 Newton steps and their sweeps
-then finish 92 of the 98 steps; 212 312 (0.52×) with 40 Newton steps in the second resume (above).
-Chunked sweeps between groups of Newton steps (20, 40, 80 … sweeps every 5 or 10 steps) took
-264 842–272 864 at 60 units.
-
-Lab figures (variant ``ac-aug-l3``, from the step's warm start, alone): 8 of 9 captured stalled steps of
-the 32- and 64-course walls converged in 0.14–0.93× the engine's units (h64-108 7041 against 51 926,
-h32-99 6709 against 27 240, h32-106 2839 against 13 238); h32-87 not converged. From momentum's stalled
-iterate instead of the warm start it does worse, hence stalled.py starts it from r_warm.
-
-Not on ordinary steps (those momentum converges without stalling): one direction from the warm start or
-from momentum's iterate after 10–200 sweeps, λ 1e-6–1e-1, with or without the line search or the active
-set frozen from the sweeps' statuses, then sweeps, takes 1.06–4.4× momentum's units on the 248-block
-wall's and at best 0.985× (noise) on the 32- and 64-course walls' (benchmarks/JOURNAL.md, "Newton-type
-steps on ordinary steps"): a wall's solution set is a continuum of self-stresses, and the sweeps' work
-there is choosing one inside the cone, which F's Newton step does not do.
+Units. A Newton step costs 46–60 turning sweeps of the same step in CPU (the banded assembly, LU and solve),
+plus ~4 evaluations of F in its line search at ~1 sweep each: NEWTON_UNITS = 60, a constant so that sweep
+counts stay deterministic.
 """
 
 from __future__ import annotations
