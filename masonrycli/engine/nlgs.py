@@ -29,17 +29,13 @@ one course per sweep, and a slow mode can keep velocities 1e-4 m/s off while eac
 
 Stagnation. On tall walls that slide (32 courses and more, shaken at 1 m/s) Gauss–Seidel can cycle: at
 step 74 of the 32-course wall the residual wanders between 7.7e-5 and 2.3e-4 m/s for 50 000 sweeps while
-hundreds of sliding bed-joint corners change status (benchmarks/JOURNAL.md, "Sweep order"). Such a step never meets the
-tolerance, and sweeping it to the cap cost half of that wall's run time. So when a solve with a
-tolerance > 0 goes STALL_SWEEPS sweeps without a new lowest residual, it continues by faces
-(:mod:`masonrycli.engine.faces`: the points of each face solved together, which does not cycle there)
-until the tolerance, the cap (counted in sweep units), or the faces stall in turn; a step that still
-misses the tolerance is counted unconverged as at the cap. Over 1 s of the 32-course wall this leaves
-no unconverged step (5 before, each 50 000 sweeps; the two longest steps now take 21 388 and 29 436
-sweep units). A slowly converging step is not handed over, since its residual keeps reaching new lows:
-the aqueduct's first 0.2 s, with steps of up to 33 292 sweeps that end just under 1e-5 m/s, and every
-golden history are bit-identical (a 2000-sweep window changed them and left one step of the 32-course
-wall unconverged). Tolerance 0 runs exactly the cap.
+hundreds of sliding bed-joint corners change status (benchmarks/JOURNAL.md, "Sweep order"), and sweeping
+such steps to the cap cost half of that wall's run time. So when a solve with a tolerance > 0 goes
+STALL_SWEEPS sweeps without a new lowest residual, it continues by faces (:mod:`masonrycli.engine.faces`:
+the points of each face solved together, which does not cycle there) until the tolerance, the cap (counted
+in sweep units), or the faces stall in turn; a step that still misses the tolerance is counted unconverged
+as at the cap. A slowly converging step keeps reaching new lows and is not handed over. Tolerance 0 runs
+exactly the cap.
 
 Acceleration (solvers "nlgs-accel32", the default, and "nlgs-accel"; "nlgs" is the plain sweep): the
 same sweep started from a Nesterov extrapolation of the last two sweeps (:mod:`masonrycli.engine.momentum`),
@@ -59,7 +55,7 @@ from masonrycli.engine.contact import ContactStatus
 
 STALL_SWEEPS = 10_000
 """Point sweeps without a new lowest residual after which a solve with a tolerance > 0 continues by faces
-(module doc, "Stagnation")."""
+(module doc, "Stagnation"); 2000 handed over slowly converging steps (golden histories changed)."""
 
 # Plain ints for the kernels (the enum is for readers).
 STATUS_OPEN, STATUS_STICK, STATUS_SLIP = int(ContactStatus.OPEN), int(ContactStatus.STICK), int(ContactStatus.SLIP)
