@@ -11,22 +11,18 @@ restarted when the residual grows by more than momentum.RESTART_GROWTH, as in
 start, so v stays v_free + M⁻¹ H r).
 
 Why: on the hard steps of the 32- and 64-course walls (tall walls sliding on their base, where momentum in
-detection order cycles between stick and slip and stalled.py's other methods take thousands of sweep
-units), measured alone from the step's warm start on 64 steps captured from 24 ensemble runs
-(benchmarks/JOURNAL.md, "New methods on hard steps"; tolerance 1e-5 m/s, cap 50 000): this converges all
-64 in 150 139 sweep units, where the engine took 956 975 (geometric mean of the per-step ratio 0.14;
-on the 41 steps of ≥ 10 000 engine units 0.11), and the best of stalled.py's methods alone converge 54
-(faces, 977 723 units, not converged counted at the cap; Alart–Curnier Newton 54, 923 744). The same
-sweeps without momentum converge 62 in 625 858. What matters is the second visit: detection order is
-already sorted by each contact's lower body, so momentum in detection order is this body order with each
-contact visited once, from its lower body, and it converges 19 (the engine's interleaved order 18).
-On ordinary steps (those momentum converges without stalling; 30 of the 32-course wall, 26 of the
-64-course wall) it takes 1.42× / 1.36× momentum's units, at 1.3–1.4× the CPU per unit (the indirect
-visit order): it is for stalled steps only. It can stop on a step where it cycles (the 248-block wall's
-hard steps): after a few windows of sweeps whose residual level stays well above its lowest residual
-(_cycling_windows; stalled.py's module doc, "Hand-over"; sooner when the stage stays far from the tolerance
-or its level far above its low: "Sooner"), and go on later from where
-it stopped, as one long run would (Stage: stalled.py's "Re-entry").
+detection order cycles between stick and slip), alone from the step's warm start, this converges all 64
+captured steps in 150 139 sweep units, where the engine took 956 975 and the best of stalled.py's methods
+alone converge 54 (benchmarks/JOURNAL.md, "New methods on hard steps"). What matters is the second visit:
+detection order is already sorted by each contact's lower body, so momentum in detection order is this body
+order with each contact visited once, from its lower body, and it converges 19. On ordinary steps it takes
+1.36–1.42× momentum's units at 1.3–1.4× the CPU per unit (the indirect visit order): it is for stalled
+steps only.
+
+It can stop on a step where it cycles (the 248-block wall's hard steps): after a few windows of sweeps whose
+residual level stays well above its lowest residual (_cycling_windows; stalled.py's module doc, "Hand-over";
+sooner when the stage stays far from the tolerance or its level far above its low: "Sooner"), and go on
+later from where it stopped, as one long run would (Stage: stalled.py's "Re-entry").
 
 The residual is the engine's (nlgs module doc): RMS over the contacts of |W_αα Δr_α| at the contact's
 first visit in the sweep. Work is counted in sweep units, contact visits / C (a sweep is ~1.9 units on a
