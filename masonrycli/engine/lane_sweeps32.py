@@ -14,14 +14,11 @@ refinement: the step ends on a float64 sweep and the float64 stopping test; solv
     first_stage: then lane_sweeps._lane_sweeps from r (v = v_free + M⁻¹ H r re-derived in float64)
 
 Why: a float32 visit does the same operations as a float64 one on twice the lanes of a zmm register,
-and the body rows it gathers are 16 bytes instead of 32. Measured on captured steps of the 248-block
-wall (benchmarks/JOURNAL.md, "Float32 first stage"): 2.5–2.7 ns per contact·sweep against 4.0–4.1; on
-every step of its 1 s run, the float32 sweeps to 1e-5 m/s took 160 a step (the float64 ones 157) and the
-float64 sweeps after them 3.8 (0 to 554): the first stage 1.4–1.5× cheaper, and 1.279 → 0.919 CPU s per
-simulated s in bench_solver. Rounding is not what limits it there: the float32 sweeps alone reach
-1.7e-6–7.6e-6 m/s before they stall. On taller walls they stall higher (4.6e-5–6.8e-5 m/s on the
-32-course wall's captured steps: a sweep's rounding, ~1e-7 m/s, accumulates in the slow modes over
-hundreds of sweeps), and the float64 sweeps take over from there: h32's first stage cost the same.
+and the body rows it gathers are 16 bytes instead of 32: 2.5–2.7 ns per contact·sweep against 4.0–4.1 on
+captured steps of the 248-block wall, and 1.279 → 0.919 CPU s per simulated s in bench_solver
+(benchmarks/JOURNAL.md, "The float32 first stage"). Rounding does not decide the result: the float32 sweeps
+stall where a sweep's rounding (~1e-7 m/s) accumulates in the slow modes (higher on taller walls), and the
+float64 sweeps after them end the step on the float64 stopping test.
 
 Why the staggered layout: with 16 runs on a wall of 16 courses a run is about a course, and lane q and
 q + 1 (the same place in neighbouring courses) meet on the block between them: every group of the
