@@ -31,7 +31,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._jit import kernel_only
+from ._jit import kernel_only, njit
 
 __all__ = ["KEY_LIMIT_BODIES", "KEY_LIMIT_VERTICES", "check_topology", "decode_contact_key"]
 
@@ -80,6 +80,31 @@ def _end_label(side, t0, ivtx, e, e2, k, length, snap, ref_is_b):
     if side >= 0:
         return (1 if ref_is_b else 0), rv, k
     return (0 if ref_is_b else 1), ivtx, e
+
+
+@njit(inline="always")
+def first_at_least(key, n, k, lo):
+    # The first row i ≥ lo of the sorted key[:n] with key[i] ≥ k, or n (what np.searchsorted finds when
+    # every row before lo is < k): the search of warmstart._warm_start and joints._key_row, whose keys come
+    # almost in order, so i is usually within a row or two of lo:
+    #   gallop from lo: probe lo, lo + 1, lo + 3, lo + 7 … until a key ≥ k (or the end); then bisect
+    #   between the last probe below and that one
+    # Written out, not np.searchsorted: numba compiled its generic comparisons for ~0.5 s of CPU.
+    hi = lo
+    step = 1
+    while hi < n and key[hi] < k:  # every row ≤ hi is < k
+        lo = hi + 1
+        hi = lo + step - 1
+        step *= 2
+    if hi > n:
+        hi = n
+    while lo < hi:  # rows < lo are < k; row hi is ≥ k, or hi = n
+        mid = (lo + hi) >> 1
+        if key[mid] < k:
+            lo = mid + 1
+        else:
+            hi = mid
+    return lo
 
 
 def check_topology(body_vert_start) -> None:

@@ -20,6 +20,7 @@ import numpy as np
 
 from masonrycli.engine._jit import kernel_only, njit
 from masonrycli.engine.contact import ContactStatus
+from masonrycli.engine.contact_key import first_at_least
 
 _OPEN, _STICK, _SLIP = int(ContactStatus.OPEN), int(ContactStatus.STICK), int(ContactStatus.SLIP)
 
@@ -60,23 +61,12 @@ def _nan_max(x, y):
 @kernel_only
 def _key_row(key, k, hint):
     # the row of k in the sorted, distinct keys `key`, or −1. The contacts come sorted by pair, so the next
-    # contact's key is at or just after the row found for the last one (`hint`): gallop forward from there
-    # (rows hint, hint+1, hint+3, hint+7, ... while key ≤ k), then search the last stride only; from row 0
-    # when key[hint] > k. A contact costs a few comparisons instead of a search over all the joints.
-    # Written out, not np.searchsorted: numba's compiled its generic comparisons for ~0.5 s of CPU.
+    # contact's key is at or just after the row found for the last one (`hint`): contact_key.first_at_least
+    # (a gallop, then a bisection; the warm start's search) from there, from row 0 when key[hint] > k.
+    # Distinct keys: the first row ≥ k is k's row if any. A contact costs a few comparisons instead of a
+    # search over all the joints.
     n = key.shape[0]
-    lo = hint if hint < n and key[hint] <= k else 0
-    step = 1
-    while lo + step < n and key[lo + step] <= k:
-        lo += step
-        step *= 2
-    hi = min(lo + step, n)  # key[lo] ≤ k (or lo = 0) and key[hi] > k (or hi = n): bisect [lo, hi)
-    while hi - lo > 1:
-        mid = (lo + hi) // 2
-        if key[mid] <= k:
-            lo = mid
-        else:
-            hi = mid
+    lo = first_at_least(key, n, k, hint if hint < n and key[hint] <= k else 0)
     return lo if lo < n and key[lo] == k else -1
 
 

@@ -63,6 +63,7 @@ V = _vector  # short name in the kernels (imported by module name: _jit stamps t
 
 @njit(inline="always")
 def _local_solve_v(ut, un, bias, wtt, wtn, wnn, itt, itn, inn, isp, ism, mu):
+    # lane_sweeps32._local_solve32 is its copy on <16 x float>: numba cannot take the vector module as an argument.
     # nlgs._local_solve in every lane without branches: all candidates computed, then the first valid one
     # in _local_solve's order (open; stick; slide in the free direction s0 = sign u_t; the other way; the
     # projected fallback). The same operations on the same operands as _local_solve, so the same bits.
@@ -110,6 +111,7 @@ def _local_solve_v(ut, un, bias, wtt, wtn, wnn, itt, itn, inn, isp, ism, mu):
 
 @njit(inline="always")
 def _group(j, act, Q, IA, IB, v4, beta, mu, full):
+    # lane_sweeps32._group32 is its copy on <16 x float>: numba cannot take the vector module as an argument.
     # The visit of group j's lanes in mask act (module doc), on the AoSoA rows Q and the padded v4.
     #   read: one 256-bit row a body and lane (gather_rows; an absent lane reads body 0, offset 0, and
     #         its zero rows make it open: nothing computed from it is stored)

@@ -33,6 +33,7 @@ import numpy as np
 
 from masonrycli.engine import _vector32, lane_sweeps, momentum
 from masonrycli.engine._jit import njit
+from masonrycli.engine.lanes import colour_lane
 from masonrycli.engine.nlgs import (
     P_BIAS,
     P_IIA,
@@ -133,16 +134,9 @@ def _contact(count, run, q, j, stagger):
 
 
 @njit(inline="always")
-def _moves(Q, base, side):
-    # lanes._moves on this module's 16-lane rows: the lane moves body a (side 0) or b (side 1).
-    if side == 0:
-        return Q[base + P_IMA * W] > 0.0 or Q[base + P_IIA * W] > 0.0
-    return Q[base + P_IMB * W] > 0.0 or Q[base + P_IIB * W] > 0.0
-
-
-@njit(inline="always")
 def _clashing_groups(contact_body, pack, count, run, stagger, seen):
     # The groups of a layout in which two lanes move the same body (seen: -1 for every body on entry).
+    # lanes._moves' test on the pack's rows, not Q's: the layout is chosen before Q exists.
     n = 0
     for j in range(run):
         clash = 0
@@ -186,6 +180,8 @@ def pack_lanes32(contact_body, pack, count, v, r, stagger):
     # IA, IB [j·16 + q] = 4a, 4b (0 in absent lanes); lanes[j·16 + q] = c or -1
     # sub[j, k], nsub[j]: group j's clash-free sub-groups, greedy in lane order (lanes._sub_groups)
     # v4[4b … 4b + 2] = float32(v_free + M⁻¹ H r_warm), the pushes in float64 (v is not written)
+    # Its own copy of lanes.pack_lanes but for colour_lane: float32 rows, the staggered layout, and the
+    # pushes in contact order from the pack (lanes': in lane order from Q), so one kernel would change bits.
     run = (count + W - 1) // W
     Q = np.empty(run * ROWS * W, np.float32)
     for i in range(Q.shape[0]):
@@ -218,28 +214,8 @@ def pack_lanes32(contact_body, pack, count, v, r, stagger):
     for j in range(run):
         n = 0
         for q in range(W):
-            if lanes[j * W + q] < 0:
-                continue
-            base = j * ROWS * W + q
-            busy = 0
-            for side in range(2):
-                b = (IA[j * W + q] if side == 0 else IB[j * W + q]) >> 2
-                if _moves(Q, base, side) and seen[b] == j:
-                    busy |= held[b]
-            k = 0
-            while busy >> k & 1:
-                k += 1
-            if k == n:
-                sub[j, k] = 0
-                n += 1
-            sub[j, k] |= 1 << q
-            for side in range(2):
-                b = (IA[j * W + q] if side == 0 else IB[j * W + q]) >> 2
-                if _moves(Q, base, side):
-                    if seen[b] != j:
-                        seen[b] = j
-                        held[b] = 0
-                    held[b] |= 1 << k
+            if lanes[j * W + q] >= 0:
+                n = colour_lane(Q, IA, IB, j, q, W, n, seen, held, sub)
         nsub[j] = n
     v64 = v.copy()
     for c in range(count):
@@ -256,6 +232,7 @@ def pack_lanes32(contact_body, pack, count, v, r, stagger):
 @njit(inline="always")
 def _group32(j, act, Q, IA, IB, v4, beta, mu, full):
     # lane_sweeps._group in float32 on 16 lanes; returns the lanes' |e_α|² (0 in lanes outside act)
+    # A copy, not shared: numba cannot take the vector module (_vector32, <16 x float>) as an argument.
     q0 = j * ROWS * W
     at = j * W
     vax, vay, waa = V.gather_rows(v4, IA, at)

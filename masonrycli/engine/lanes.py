@@ -48,19 +48,48 @@ TILE = 16
 
 
 @njit(inline="always")
-def _moves(Q, base, side):
-    # The lane at Q[base] (a group's rows, offset by its lane) moves its body a (side 0) or b (side 1): a
-    # support has zero inverse mass and inertia.
+def _moves(Q, base, side, w):
+    # The lane at Q[base] (a group's rows of w lanes, offset by its lane) moves its body a (side 0) or b
+    # (side 1): a support has zero inverse mass and inertia. w: 8 here, 16 in lane_sweeps32 (its caller
+    # passes its own constant, so the inlined copy indexes with a constant as before).
     if side == 0:
-        return Q[base + P_IMA * W] > 0.0 or Q[base + P_IIA * W] > 0.0
-    return Q[base + P_IMB * W] > 0.0 or Q[base + P_IIB * W] > 0.0
+        return Q[base + P_IMA * w] > 0.0 or Q[base + P_IIA * w] > 0.0
+    return Q[base + P_IMB * w] > 0.0 or Q[base + P_IIB * w] > 0.0
+
+
+@njit(inline="always")
+def colour_lane(Q, IA, IB, j, q, w, n, seen, held, sub):
+    # Lane q of group j (groups of w lanes) joins the lowest of the group's n sub-groups that holds none of
+    # the bodies it moves, or a new one; returns the group's sub-group count. One step of _sub_groups'
+    # greedy colouring, shared with lane_sweeps32.pack_lanes32 (16 lanes, its own layout; the same ROWS).
+    base = j * ROWS * w + q
+    busy = 0
+    for side in range(2):
+        b = (IA[j * w + q] if side == 0 else IB[j * w + q]) >> 2
+        if _moves(Q, base, side, w) and seen[b] == j:
+            busy |= held[b]
+    k = 0
+    while busy >> k & 1:
+        k += 1
+    if k == n:
+        sub[j, k] = 0
+        n += 1
+    sub[j, k] |= 1 << q
+    for side in range(2):
+        b = (IA[j * w + q] if side == 0 else IB[j * w + q]) >> 2
+        if _moves(Q, base, side, w):
+            if seen[b] != j:
+                seen[b] = j
+                held[b] = 0
+            held[b] |= 1 << k
+    return n
 
 
 @njit(inline="always")
 def _sub_groups(Q, IA, IB, count, run, j, seen, held, sub):
     # Group j's sub-groups (module doc): sub[j, k] = lane mask of sub-group k; returns their number.
     #   held[body] = the sub-groups of group j holding a lane that moves body (valid while seen[body] = j)
-    #   for each lane q present (contact q·run + j < C), in lane order:
+    #   for each lane q present (contact q·run + j < C), in lane order (colour_lane):
     #       k = the lowest sub-group holding none of the bodies q moves (greedy colouring; k = 0 unless
     #           the group clashes); sub[j, k] |= bit q; held[each body q moves] |= bit k
     # Bitmasks per body rather than comparing the 28 pairs of lanes: the pairs took 145 µs a step on the
@@ -69,26 +98,7 @@ def _sub_groups(Q, IA, IB, count, run, j, seen, held, sub):
     for q in range(W):
         if q * run + j >= count:
             break
-        base = j * ROWS * W + q
-        busy = 0
-        for side in range(2):
-            b = (IA[j * W + q] if side == 0 else IB[j * W + q]) >> 2
-            if _moves(Q, base, side) and seen[b] == j:
-                busy |= held[b]
-        k = 0
-        while busy >> k & 1:
-            k += 1
-        if k == n:
-            sub[j, k] = 0
-            n += 1
-        sub[j, k] |= 1 << q
-        for side in range(2):
-            b = (IA[j * W + q] if side == 0 else IB[j * W + q]) >> 2
-            if _moves(Q, base, side):
-                if seen[b] != j:
-                    seen[b] = j
-                    held[b] = 0
-                held[b] |= 1 << k
+        n = colour_lane(Q, IA, IB, j, q, W, n, seen, held, sub)
     return n
 
 
@@ -124,6 +134,8 @@ def pack_lanes(contact_body, pack, count, v, r):
     # Q is filled TILE groups at a time, and the sub-groups and pushes read Q, not the pack: pack rows
     # q·run + j of one group lie C/8 rows apart, and reading them group by group took 44 µs a step on the
     # 248-block wall against 31 (benchmarks/JOURNAL.md, "Where a wall-248 step goes at the lane sweeps").
+    # Not shared with lane_sweeps32.pack_lanes32 (only colour_lane is): its pushes go in contact order from
+    # the pack in float64, these in lane order from Q, so one kernel would change one path's bits.
     run = (count + W - 1) // W
     # np.empty and a fill, not np.zeros (_jit's rule): np.zeros compiled 2 signatures and a fill of its own,
     # 0.1 s of a first run's CPU (benchmarks/JOURNAL.md, "Cold start"); absent lanes keep these zeros
