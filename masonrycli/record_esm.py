@@ -21,7 +21,6 @@ Every refusal is one line naming the file and the line (``q.ASC:29: SAMPLING_INT
 
 from __future__ import annotations
 
-import math
 import os
 import re
 import warnings
@@ -30,6 +29,7 @@ import numpy as np
 
 from masonrycli.errors import InputError, RecordWarning
 from masonrycli.record_motion import time_step_problem
+from masonrycli.record_text import free_numbers
 from masonrycli.values import shorten
 
 ESM_SUFFIX = ".asc"
@@ -244,19 +244,4 @@ def _ndata(header: dict, name: str) -> int:
 
 def _samples(text: str, first: int, name: str) -> np.ndarray:
     """The numbers of ``text[first:]`` (white-space separated, several a line allowed); a field that is no finite number is refused at its line."""
-    body = text[first:]
-    try:
-        values = np.array(list(map(float, body.split())), dtype=np.float64)
-    except ValueError:
-        values = None
-    if values is None or not np.isfinite(values).all():
-        start = text.count("\n", 0, first) + 1
-        for lineno, line in enumerate(body.splitlines(), start=start):
-            for field in line.split():
-                try:
-                    x = float(field)
-                except ValueError:
-                    raise InputError(f"{name}:{lineno}: not a number: {shorten(field, 40)}") from None
-                if not math.isfinite(x):
-                    raise InputError(f"{name}:{lineno}: values must be finite, got {shorten(field, 40)}")
-    return values
+    return free_numbers(text[first:].splitlines(), text.count("\n", 0, first) + 1, name)

@@ -25,6 +25,7 @@ import numpy as np
 
 from masonrycli.errors import InputError
 from masonrycli.record_motion import time_step_problem
+from masonrycli.record_text import free_numbers
 from masonrycli.values import shorten
 
 KNET_SUFFIXES = (".ns", ".ew", ".ud", ".ns1", ".ew1", ".ud1", ".ns2", ".ew2", ".ud2")
@@ -102,19 +103,7 @@ def _factor(found: tuple[str, int], name: str) -> float:
 def _samples(lines: list[str], first: int, name: str) -> np.ndarray:
     """The numbers of ``lines`` (the first being line ``first`` of the file), white-space separated; a field
     that is no finite number is refused at its line; at least 2."""
-    try:
-        values = np.array(list(map(float, " ".join(lines).split())), dtype=np.float64)
-    except ValueError:
-        values = None
-    if values is None or not np.isfinite(values).all():
-        for lineno, line in enumerate(lines, start=first):
-            for field in line.split():
-                try:
-                    x = float(field)
-                except ValueError:
-                    raise InputError(f"{name}:{lineno}: not a number: {shorten(field, 40)}") from None
-                if not math.isfinite(x):
-                    raise InputError(f"{name}:{lineno}: values must be finite, got {shorten(field, 40)}")
+    values = free_numbers(lines, first, name)
     if values.size < 2:
         raise InputError(f"{name}: a record needs at least 2 samples, found {values.size}")
     return values

@@ -351,3 +351,23 @@ def _is_float(text: str) -> bool:
     except ValueError:
         return False
     return True
+
+
+def free_numbers(lines: list[str], first: int, name: str) -> np.ndarray:
+    """The numbers of ``lines`` (the first being line ``first`` of the file), white-space separated, any count
+    a line (the sample blocks of ESM and K-NET files); a field that is no finite number is refused at its
+    line. Read by numpy at once; only a text it refuses is walked line by line, to name the line."""
+    try:
+        values = np.array(list(map(float, " ".join(lines).split())), dtype=np.float64)
+    except ValueError:
+        values = None
+    if values is None or not np.isfinite(values).all():
+        for lineno, line in enumerate(lines, start=first):
+            for field in line.split():
+                try:
+                    x = float(field)
+                except ValueError:
+                    raise InputError(f"{name}:{lineno}: not a number: {shorten(field, 40)}") from None
+                if not math.isfinite(x):
+                    raise InputError(f"{name}:{lineno}: values must be finite, got {shorten(field, 40)}")
+    return values
