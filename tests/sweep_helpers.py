@@ -1,4 +1,5 @@
-"""Driving ``masonry sweep`` in tests: a sine-shaken block scenario, a velocity record, invoke at a wide terminal."""
+"""Driving ``masonry sweep`` in tests: a sine-shaken block scenario, a velocity record, invoke at a wide terminal;
+reading a study recording's static fields back."""
 
 from __future__ import annotations
 
@@ -38,3 +39,12 @@ def velocity_csv(path: Path) -> Path:
     """``path``: a 2-column velocity record, 30 samples 0.01 s apart alternating 0 and 0.05 m/s."""
     path.write_text("time,v\n" + "".join(f"{0.01 * i:.2f},{0.05 * (i % 2):.2f}\n" for i in range(30)))
     return path
+
+
+def static_fields(chunks, entity: str) -> dict:
+    out = {}
+    for ch in chunks:
+        if ch.entity_path == entity:
+            batch = ch.to_record_batch()
+            out |= {n: batch.column(n).to_pylist()[0] for n in batch.schema.names if ":" in n}
+    return out
