@@ -42,7 +42,7 @@ from types import SimpleNamespace
 import numpy as np
 
 from benchmarks.solver_lab.problems import DATA
-from masonrycli.engine import bodies, lane_sweeps32, momentum, newton, nlgs, shrink, stalled
+from masonrycli.engine import bodies, lane_sweeps32, momentum, newton, nlgs, stalled
 
 HARD = DATA / "hard"
 BIG = 10_000
@@ -179,7 +179,6 @@ def _set(overrides: dict[str, object]) -> dict[str, object]:
         "stalled": stalled,
         "nlgs": nlgs,
         "bodies": bodies,
-        "shrink": shrink,
         "lane_sweeps32": lane_sweeps32,
     }
     old = {}

@@ -25,7 +25,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from masonrycli.engine import momentum, shrink
+from masonrycli.engine import momentum
 from masonrycli.engine._jit import njit
 from masonrycli.engine.nlgs import INTERLEAVE, PACK_WIDTH, _nlgs
 
@@ -76,18 +76,6 @@ def _accelerated(contact_body, pack, count, mu, tolerance, max_iterations, v, v_
     order, body_o, pack_o, r_o, status_o = _in_order(contact_body, pack, count, r, status)
     iterations, residual = momentum._momentum_sweeps(
         body_o, pack_o, count, mu, tolerance, max_iterations, v, v_flat, r_o, status_o, stall, flip
-    )
-    _back(order, count, r_o, status_o, r, status)
-    return iterations, residual
-
-
-@njit
-def _shrinking(contact_body, pack, count, mu, tolerance, max_iterations, v, r, status, stall, check_every):
-    # in order → shrink._nlgs_shrinking(stall window ``stall``, a check every ``check_every`` sweeps) → back.
-    # Returns (iterations, residual).
-    order, body_o, pack_o, r_o, status_o = _in_order(contact_body, pack, count, r, status)
-    iterations, residual = shrink._nlgs_shrinking(
-        body_o, pack_o, count, mu, tolerance, max_iterations, v, r_o, status_o, stall, check_every
     )
     _back(order, count, r_o, status_o, r, status)
     return iterations, residual

@@ -37,7 +37,7 @@ for a new low: the plateaus of momentum are longer on deeper structures, as load
 sweep (the depth, not the contact count: long low walls have the contacts of tall ones). Replayed, the
 64-course wall's 177 steps of ≥ 2500 units: 1 319 183 units at window 200, 915 518 at 2000 ("Near the
 tolerance: the first stage waits longer").
-"nlgs-accel" (the float64 path) and the lab levers nlgs.LANES = False and shrink.CHECK_EVERY > 0 keep the
+"nlgs-accel" (the float64 path) and the lab lever nlgs.LANES = False keep the
 plain window.
 """
 

@@ -374,11 +374,7 @@ def solve(contact_body, pack, count, model, v, r, status) -> tuple[int, float]:
     # Accelerated: momentum (the lane sweeps, LANES) until its stall window; a stalled step goes on by the
     # methods of stalled.py.
     v_free, r_warm = v.copy(), r[:count].copy()
-    if shrink.CHECK_EVERY > 0:  # the first stage only: stalled.py's methods keep their sweeps
-        iterations, residual = interleaved._shrinking(
-            contact_body, pack, count, mu, tolerance, cap, v, r, status, momentum.STALL_SWEEPS, shrink.CHECK_EVERY
-        )
-    elif model.solver == "nlgs-accel32" and LANES:  # the one place float32 is chosen
+    if model.solver == "nlgs-accel32" and LANES:  # the one place float32 is chosen
         iterations, residual = lane_sweeps32.first_stage(
             contact_body, pack, count, mu, tolerance, cap, v, r, status, momentum.STALL_SWEEPS,
             momentum.stall_near(model),
@@ -403,4 +399,4 @@ def _faces_if_stalled(contact_body, pack, count, mu, tolerance, cap, v, r, statu
 
 # At the end: faces, momentum and stalled build on this module's sweep primitives (a stalled solve()
 # continues by faces or by stalled's methods; the accelerated sweep is momentum's).
-from masonrycli.engine import faces, interleaved, lane_sweeps, lane_sweeps32, momentum, shrink, stalled  # noqa: E402
+from masonrycli.engine import faces, interleaved, lane_sweeps, lane_sweeps32, momentum, stalled  # noqa: E402
