@@ -35,8 +35,20 @@ from masonrycli.cli_options import (
 )
 from masonrycli.errors import EXIT_DIVERGED, EXIT_INTERNAL, EXIT_OUTPUT_FAILED, InputError
 
+
+class _InTheOrderUsersMeetThem(OneLineUsageErrors):
+    """``masonry --help`` lists the commands in the order a user meets them — the quick start's ``simulate``
+    first — instead of typer's (commands, then groups: ``simulate`` and ``build`` came last, under ``docs``)."""
+
+    ORDER = ("simulate", "run", "check", "build", "inspect", "export", "limit", "sweep", "docs")
+
+    def list_commands(self, ctx) -> list[str]:
+        rank = {name: k for k, name in enumerate(self.ORDER)}
+        return sorted(super().list_commands(ctx), key=lambda name: rank.get(name, len(rank)))
+
+
 app = typer.Typer(
-    cls=OneLineUsageErrors,
+    cls=_InTheOrderUsersMeetThem,
     rich_markup_mode="rich",
     no_args_is_help=True,
     add_completion=False,
@@ -218,8 +230,8 @@ def _load(scenario_file: str, opts: dict):
 @user_errors
 @with_options(RUN_FROM_FILE, STOP, FRICTION_FROM_FILE, OUTPUT, FORCE, RECORD)
 def run_command(scenario_file: ScenarioFile, **opts) -> None:
-    """Run any scenario file (or a GeoJSON / WKT geometry file, supports fixed); options given here
-    override the file's values."""
+    """Run any scenario file, or a GeoJSON / WKT geometry file (supports fixed, or shaken by --record: the one
+    support, or those marked driven); options given here override the file's values."""
     scenario = _load(scenario_file, opts)
     _execute(scenario, opts)
 

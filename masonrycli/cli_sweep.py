@@ -28,7 +28,7 @@ def sweep_command(
     target: Annotated[
         str,
         typer.Argument(
-            help="wall, arch, aqueduct, a scenario file (TOML) or a GeoJSON / WKT geometry (supports fixed).",
+            help="wall, arch, aqueduct, a scenario file (TOML) or a GeoJSON / WKT geometry (--records shakes its one support or those marked driven).",
             metavar="TARGET",
         ),
     ],
