@@ -209,16 +209,7 @@ def export_table(
     ground_a = frame_rate(sv, time)
 
     table.add("time (s)", time)
-    g = str(h["support_name"][s])
-    for col, unit, value in (
-        ("ux", "m", ground_u[:, 0]),
-        ("uy", "m", ground_u[:, 1]),
-        ("vx", "m/s", sv[:, 0]),
-        ("vy", "m/s", sv[:, 1]),
-        ("ax", "m/s2", ground_a[:, 0]),
-        ("ay", "m/s2", ground_a[:, 1]),
-    ):
-        table.add(f"{g} {col} ({unit})", value)
+    _add_motion(table, str(h["support_name"][s]), "", ground_u, sv, ground_a, rotation=False)
     rel = " rel" if relative else ""
     for label, members in targets:
         u = (q[:, members] - q[0, members]).mean(axis=1)  # (T,3) mean displacement and rotation
@@ -228,16 +219,7 @@ def export_table(
             u = u - ground_u
             vel = vel[:, :2] - sv
             acc = acc[:, :2] - ground_a
-        for col, unit, value in (
-            ("ux", "m", u[:, 0]),
-            ("uy", "m", u[:, 1]),
-            ("rot", "rad", u[:, 2]),
-            ("vx", "m/s", vel[:, 0]),
-            ("vy", "m/s", vel[:, 1]),
-            ("ax", "m/s2", acc[:, 0]),
-            ("ay", "m/s2", acc[:, 1]),
-        ):
-            table.add(f"{label} {col}{'' if col == 'rot' else rel} ({unit})", value)
+        _add_motion(table, label, rel, u, vel, acc, rotation=True)
     top_blocks = np.flatnonzero(y0 >= y0.max() - height / 2)
     top_dx = (q[:, top_blocks, 0] - q[0, top_blocks, 0]).mean(axis=1) - ground_u[:, 0]
     table.add("drift ratio (-)", top_dx / structure_height if structure_height > 0 else np.full(len(time), np.nan))
@@ -260,6 +242,22 @@ def export_table(
     if every > 1:
         table.values = [value[::every] for value in table.values]
     return table
+
+
+def _add_motion(table: Table, label: str, rel: str, u, vel, acc, rotation: bool) -> None:
+    """The columns of one target's (or the ground's) motion: ux, uy, [rot], vx, vy, ax, ay; ``rel`` (" rel" or
+    "") marks the relative ones (a rotation is the same either way)."""
+    columns = [("ux", "m", u[:, 0]), ("uy", "m", u[:, 1])]
+    if rotation:
+        columns.append(("rot", "rad", u[:, 2]))
+    columns += [
+        ("vx", "m/s", vel[:, 0]),
+        ("vy", "m/s", vel[:, 1]),
+        ("ax", "m/s2", acc[:, 0]),
+        ("ay", "m/s2", acc[:, 1]),
+    ]
+    for col, unit, value in columns:
+        table.add(f"{label} {col}{'' if col == 'rot' else rel} ({unit})", value)
 
 
 def overturning_moment(h: dict, time: np.ndarray, base_y: float, middle_x: float, ground_u: np.ndarray):

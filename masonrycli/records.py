@@ -210,6 +210,30 @@ def check_not_peer_other(path, name: str) -> None:
         )
 
 
+def _read_at2(path, display, name) -> tuple:
+    dt, acc = load_at2(path, display)
+    return np.arange(acc.size) * dt, acc * G_STANDARD, "acceleration"
+
+
+def _read_esm(path, display, name) -> tuple:
+    dt, samples, quantity = load_esm(path, display)
+    return np.arange(samples.size) * dt, samples, quantity
+
+
+def _read_knet(path, display, name) -> tuple:
+    dt, acc = knet_text(_read_text(path, name), name)
+    return np.arange(acc.size) * dt, acc, "acceleration"
+
+
+_HEADED_FORMATS = (
+    (is_at2, "an .AT2 file", "DT", _read_at2),
+    (is_esm, "an ESM .ASC file", "SAMPLING_INTERVAL_S", _read_esm),
+    (is_knet, "a K-NET file", "Sampling Freq", _read_knet),
+)
+"""The record formats whose header gives the time step: (is it one, its name, the header's field, its reader
+giving ``(time, value, quantity)``)."""
+
+
 RECORD_FILE = "a ground-motion record (a PEER .AT2 file, an ESM .ASC file, a K-NET file or a CSV)"
 
 
@@ -224,32 +248,15 @@ def read_record(path, display: str | None = None, time_step: float | None = None
     other = file_kind(path, RECORD_FILE, (".csv", ".at2", ".asc"), name)
     if other is not None and os.path.isfile(path):  # a missing one: the reader says so
         raise other
-    if is_at2(path):
-        if time_step is not None:
-            raise TimeStepNotUsed(
-                display or str(path),
-                "an .AT2 file gives its own time step (DT in its header): {key} goes with a CSV of one value per line",
-            )
-        dt, acc = load_at2(path, display)
-        return np.arange(acc.size) * dt, acc * G_STANDARD, "acceleration"
-    if is_esm(path):
-        if time_step is not None:
-            raise TimeStepNotUsed(
-                display or str(path),
-                "an ESM .ASC file gives its own time step (SAMPLING_INTERVAL_S in its header): {key} goes with "
-                "a CSV of one value per line",
-            )
-        dt, samples, quantity = load_esm(path, display)
-        return np.arange(samples.size) * dt, samples, quantity
-    if is_knet(path):
-        if time_step is not None:
-            raise TimeStepNotUsed(
-                display or str(path),
-                "a K-NET file gives its own time step (Sampling Freq in its header): {key} goes with a CSV of one "
-                "value per line",
-            )
-        dt, acc = knet_text(_read_text(path, name), name)
-        return np.arange(acc.size) * dt, acc, "acceleration"
+    for is_kind, kind, field, read in _HEADED_FORMATS:
+        if is_kind(path):
+            if time_step is not None:
+                raise TimeStepNotUsed(
+                    display or str(path),
+                    f"{kind} gives its own time step ({field} in its header): {{key}} goes with a CSV of one value "
+                    "per line",
+                )
+            return read(path, display, name)
     time, value = load_record_csv(path, display, time_step)
     return time, value, None
 

@@ -7,6 +7,8 @@ closed form, the ground starts and ends at rest, and it ends where it started (â
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 
 
@@ -44,3 +46,11 @@ def write_at2(path, acc_g, dt: float, title: str = "SYNTHETIC 11/23/26, TEST STA
         lines.append("".join(f"{x:15.7E}" for x in acc_g[i : i + 5]))
     with open(path, "w") as fh:
         fh.write("\n".join(lines) + "\n")
+
+
+def edited_copy(source: Path, target: Path, old: str, new: str) -> Path:
+    """``source``'s text with its first ``old`` replaced by ``new``, written at ``target`` (a damaged record)."""
+    text = source.read_text()
+    assert old in text
+    target.write_text(text.replace(old, new, 1))
+    return target

@@ -15,6 +15,7 @@ from masonrycli.records import load_esm, record_motion
 from masonrycli.study.store import read_rows
 
 from cli_helpers import assert_one_line_error, invoke, words
+from synthetic_records import edited_copy
 
 DATA = Path(__file__).parent / "data"
 ESM = DATA / "esm_acc.ASC"
@@ -23,11 +24,7 @@ FIRST_SAMPLE_LINE = 61  # the header's 60 lines, then the samples
 
 
 def _edited(tmp_path: Path, old: str, new: str, name: str = "q.ASC") -> Path:
-    text = ESM.read_text()
-    assert old in text
-    path = tmp_path / name
-    path.write_text(text.replace(old, new, 1))
-    return path
+    return edited_copy(ESM, tmp_path / name, old, new)
 
 
 def test_the_reader_takes_interval_count_and_cm_s2_from_the_header():

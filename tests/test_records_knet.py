@@ -15,6 +15,7 @@ from masonrycli.records import read_record, record_motion
 from masonrycli.study.store import read_rows
 
 from cli_helpers import assert_one_line_error, invoke, words
+from synthetic_records import edited_copy
 
 DATA = Path(__file__).parent / "data"
 KNET = DATA / "knet.NS"
@@ -23,11 +24,7 @@ COUNT = 0.01 * 3920 / 6182761  # m/s² a count
 
 
 def _edited(tmp_path: Path, old: str, new: str, name: str = "q.NS") -> Path:
-    text = KNET.read_text()
-    assert old in text
-    path = tmp_path / name
-    path.write_text(text.replace(old, new, 1))
-    return path
+    return edited_copy(KNET, tmp_path / name, old, new)
 
 
 def test_the_reader_scales_the_counts_and_removes_the_offset():
