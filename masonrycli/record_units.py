@@ -201,6 +201,16 @@ CONVERTED_AGAIN = 0.005
 taken for that conversion given a second time (9.81, 9.807, 9.8; 0.01): refused. Narrow: a scale of 10 on a
 record in g is a choice, not the conversion."""
 
+NEAR_CONVERSION = 0.02
+"""Relative width within which a scale reads as a unit conversion given again, where it is only warned about:
+a ``sweep --scale`` axis value, an ESM / K-NET file's 0.01, an .AT2 file's 9.81."""
+
+
+def converts_again(scale: float, factor: float, width: float = CONVERTED_AGAIN) -> bool:
+    """Whether ``scale`` is, within ``width`` (relative, either sign), the conversion ``factor`` a record was
+    already read with: the same conversion applied a second time."""
+    return abs(abs(scale) / factor - 1) < width
+
 
 def check_csv_header(path, name: str, quantity, scale) -> float:
     """The factor to SI of the CSV record at ``path`` read as ``quantity`` ("velocity" m/s or "acceleration"
@@ -237,11 +247,7 @@ def check_csv_header(path, name: str, quantity, scale) -> float:
     if unit is None:
         return 1.0
     factor = unit[1]
-    if (
-        isinstance(scale, (int, float))
-        and not isinstance(scale, bool)
-        and abs(abs(scale) / factor - 1) < CONVERTED_AGAIN
-    ):
+    if isinstance(scale, (int, float)) and not isinstance(scale, bool) and converts_again(scale, factor):
         si = "m/s" if quantity == "velocity" else "m/s²"
         times = f"{1 / factor:.3g} times too weak" if factor < 1 else f"{factor:.3g} times too strong"
         raise InputError(

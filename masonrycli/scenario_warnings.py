@@ -22,7 +22,7 @@ import os
 
 import numpy as np
 
-from masonrycli.record_units import MAX_AT2_G
+from masonrycli.record_units import MAX_AT2_G, NEAR_CONVERSION
 from masonrycli.records import G_STANDARD, vertical_at2
 from masonrycli.scenario import Scenario
 from masonrycli.values import quote_string
@@ -145,9 +145,11 @@ def record_warnings(scenario: Scenario, upright: bool = True) -> list[str]:
             late.setdefault((name, m.end_time), []).append(f'"{support.name}"')
         if m.sample_interval < run.dt * (1.0 - 1e-9):
             fine.setdefault((name, m.sample_interval), []).append(f'"{support.name}"')
-        if name.lower().endswith(".at2") and any(abs(m.scale / g - 1.0) < 0.02 for g in (G_STANDARD, 100 * G_STANDARD)):
+        if name.lower().endswith(".at2") and any(
+            abs(m.scale / g - 1.0) < NEAR_CONVERSION for g in (G_STANDARD, 100 * G_STANDARD)
+        ):
             twice.setdefault((name, m.peak_acceleration / G_STANDARD, m.scale), []).append(f'"{support.name}"')
-        elif abs(m.scale / 0.01 - 1.0) < 0.02 and (unit := _cm_unit(m.source)):
+        elif abs(m.scale / 0.01 - 1.0) < NEAR_CONVERSION and (unit := _cm_unit(m.source)):
             peak = m.peak_acceleration if m.quantity == "acceleration" else m.peak_speed(m.end_time)
             shrunk.setdefault((name, unit, m.quantity, peak, m.scale), []).append(f'"{support.name}"')
         elif m.peak_acceleration > MAX_AT2_G * G_STANDARD:

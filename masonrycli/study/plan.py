@@ -226,7 +226,7 @@ def _converted_twice(records: dict, scales: list[float]) -> list[str]:
     value among others (``--scale 1,9.81,20``), and no study read such a file that way (a set refused it)."""
     from masonrycli.record_esm import is_esm
     from masonrycli.record_knet import is_knet
-    from masonrycli.record_units import header_factor
+    from masonrycli.record_units import NEAR_CONVERSION, converts_again, header_factor
     from masonrycli.records import is_at2
 
     said = []
@@ -234,7 +234,7 @@ def _converted_twice(records: dict, scales: list[float]) -> list[str]:
         # read as a CSV: a .csv, and a .txt or a plain table named .asc given by name or in the folder
         as_csv = m.source and not (is_at2(m.source) or is_esm(m.source) or is_knet(m.source))
         unit = header_factor(m.source, m.quantity) if as_csv else None
-        twice = [s for s in scales if unit and abs(abs(s) / unit[1] - 1) < 0.02]
+        twice = [s for s in scales if unit and converts_again(s, unit[1], NEAR_CONVERSION)]
         if twice:
             said.append(
                 f"--records: {name} is read in {unit[0]}, as its header says, and converted to SI already; "
