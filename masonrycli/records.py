@@ -234,6 +234,12 @@ _HEADED_FORMATS = (
 giving ``(time, value, quantity)``)."""
 
 
+def read_as_csv(path) -> bool:
+    """Whether :func:`read_record` reads ``path`` as a CSV: none of the formats whose header gives the time
+    step (a .csv, a .txt, a plain table named .asc)."""
+    return not any(is_kind(path) for is_kind, *_ in _HEADED_FORMATS)
+
+
 RECORD_FILE = "a ground-motion record (a PEER .AT2 file, an ESM .ASC file, a K-NET file or a CSV)"
 
 

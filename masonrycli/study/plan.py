@@ -224,15 +224,13 @@ def _converted_twice(records: dict, scales: list[float]) -> list[str]:
     ``--record`` read such a file before it converted it too): converted twice, 9.81 times too strong. A warning
     here, where ``--record`` refuses it (:func:`~masonrycli.record_units.check_csv_header`): an axis may hold the
     value among others (``--scale 1,9.81,20``), and no study read such a file that way (a set refused it)."""
-    from masonrycli.record_esm import is_esm
-    from masonrycli.record_knet import is_knet
     from masonrycli.record_units import NEAR_CONVERSION, converts_again, header_factor
-    from masonrycli.records import is_at2
+    from masonrycli.records import read_as_csv
 
     said = []
     for name, m in records.items():
         # read as a CSV: a .csv, and a .txt or a plain table named .asc given by name or in the folder
-        as_csv = m.source and not (is_at2(m.source) or is_esm(m.source) or is_knet(m.source))
+        as_csv = m.source and read_as_csv(m.source)
         unit = header_factor(m.source, m.quantity) if as_csv else None
         twice = [s for s in scales if unit and converts_again(s, unit[1], NEAR_CONVERSION)]
         if twice:
