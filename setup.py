@@ -1,6 +1,6 @@
 """Packaging hook; everything else is in pyproject.toml. The wheel carries the documentation pages (docs/*.md
 and README.md) as masonrycli/docs/, so ``masonry docs`` and the messages that name a topic work in an
-install without the clone (masonrycli/user_docs.py). MANIFEST.in puts the pages in the sdist, which
+install without the clone (masonrycli/cli/docs.py). MANIFEST.in puts the pages in the sdist, which
 ``python -m build`` makes the wheel from. An editable install reads them from the clone instead."""
 
 from pathlib import Path

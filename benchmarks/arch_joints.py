@@ -27,7 +27,7 @@ from typing import NamedTuple
 import numpy as np
 
 OPENING = 1e-4
-"""m: an end opened by more than this is open (0.1 mm, as masonrycli.mechanism.OPENING)."""
+"""m: an end opened by more than this is open (0.1 mm, as masonrycli.analysis.mechanism.OPENING)."""
 
 
 class Joints(NamedTuple):

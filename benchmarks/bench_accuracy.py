@@ -36,7 +36,7 @@ ROOT = Path(__file__).resolve().parent.parent
 
 from benchmarks.solver_cases import CASES  # noqa: E402
 from benchmarks.solver_reference import SECOND, TIGHT, errors_pct, parse_spec, run, spec_of  # noqa: E402
-from masonrycli.scenario import SOLVERS  # noqa: E402
+from masonrycli.scenario.scenario import SOLVERS  # noqa: E402
 
 BENCH_REFERENCE = spec_of(TIGHT)
 """bench_solver's tight solve as a spec: the first reference by default."""

@@ -32,9 +32,9 @@ os.environ.setdefault("RERUN_ANALYTICS", "0")
 
 from masonrycli.engine import nlgs  # noqa: E402
 from masonrycli.engine import solver as solver_module  # noqa: E402
-from masonrycli.motion import Constant, Sine  # noqa: E402
 from masonrycli.run import Simulation, simulate  # noqa: E402
-from masonrycli.scenario import Material, RunConfig, scenario_from_builder  # noqa: E402
+from masonrycli.scenario.motion import Constant, Sine  # noqa: E402
+from masonrycli.scenario.scenario import Material, RunConfig, scenario_from_builder  # noqa: E402
 
 SINE = Sine(direction=(1.0, 0.0), amplitude=1.0, frequency=2.0)
 CASES = {

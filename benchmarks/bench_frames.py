@@ -45,11 +45,12 @@ PARTS = ("frame", "frame.tensors", "frame.joints", "history", "record", "record.
 def worker(package_root: str, out: str, command: list[str]) -> None:
     """In a fresh process: the command, once to warm up, then timed (JSON on the last line)."""
     sys.path[:0] = [package_root, str(ROOT)]
-    from masonrycli import history, run
-    from masonrycli.cli import app
-    from masonrycli.mechanism import JointTracker
+    from masonrycli import run
+    from masonrycli.analysis.mechanism import JointTracker
+    from masonrycli.analysis.tensors import TensorComputer
+    from masonrycli.cli.app import app
+    from masonrycli.outputs import history
     from masonrycli.recording import overlays, recorder
-    from masonrycli.tensors import TensorComputer
 
     assert Path(run.__file__).is_relative_to(package_root), run.__file__
     totals: dict[str, float] = {}

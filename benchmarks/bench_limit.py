@@ -32,7 +32,7 @@ from masonrycli.limit import LiveLoad, analyse_model  # noqa: E402
 from masonrycli.limit.joints import find_joints  # noqa: E402
 from masonrycli.limit.problem import load_vectors, solve_limit  # noqa: E402
 from masonrycli.model import build_model  # noqa: E402
-from masonrycli.scenario import Material, RunConfig, scenario_from_builder  # noqa: E402
+from masonrycli.scenario.scenario import Material, RunConfig, scenario_from_builder  # noqa: E402
 
 CASES = ("wall", "arch", "aqueduct")
 TIGHT = {"primal_feasibility_tolerance": 1e-10, "dual_feasibility_tolerance": 1e-10}

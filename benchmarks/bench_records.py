@@ -23,7 +23,7 @@ import warnings
 
 import numpy as np
 
-from masonrycli.records import load_at2, load_record_csv
+from masonrycli.records.read import load_at2, load_record_csv
 
 TIME_STEP = 0.005
 """s, the samples' spacing (the one-column file is read with it)."""

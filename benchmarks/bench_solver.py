@@ -10,7 +10,7 @@ One command (from the repository root, in the project venv; ``pip install -e ".[
 Cases: benchmarks/solver_cases.py (the paper's 51- and 248-block walls, an 8 × 6 wall, the arch and the
 aqueduct; walls of 8, 16, 32, 64 courses × 15 blocks; 8-course walls of ~500 to ~4000 blocks).
 
-Solvers (``--solvers``, default: every one of ``masonrycli.scenario.SOLVERS``, the default first): each
+Solvers (``--solvers``, default: every one of ``masonrycli.scenario.scenario.SOLVERS``, the default first): each
 case runs with each solver in the same benchmark run, interleaved (repeat 1: case A with solver 1,
 solver 2, pymunk, case B …; then repeat 2 …), so a ratio compares runs made under the same load. For each
 case and solver:
@@ -90,7 +90,7 @@ from benchmarks.solver_reference import (  # noqa: E402
 from benchmarks.solver_reference import run as run_reference  # noqa: E402
 from masonrycli.engine import nlgs  # noqa: E402
 from masonrycli.run import Simulation, simulate  # noqa: E402
-from masonrycli.scenario import SOLVERS  # noqa: E402
+from masonrycli.scenario.scenario import SOLVERS  # noqa: E402
 
 SUITES = {
     "paper": ["wall-51", "wall-52", "wall-248", "arch", "aqueduct"],

@@ -29,8 +29,8 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 os.environ.setdefault("RERUN_ANALYTICS", "0")
 
-from masonrycli.motion import Sine  # noqa: E402
-from masonrycli.scenario import Material, RunConfig, scenario_from_builder  # noqa: E402
+from masonrycli.scenario.motion import Sine  # noqa: E402
+from masonrycli.scenario.scenario import Material, RunConfig, scenario_from_builder  # noqa: E402
 from masonrycli.study.axes import StudyBase, grid, parse_axis  # noqa: E402
 from masonrycli.study.drivers import GridDriver  # noqa: E402
 from masonrycli.study.runner import open_cluster, run_on_cluster, run_serially  # noqa: E402

@@ -158,8 +158,8 @@ def lmgc_snapshot(lmgc, k, c0, f0) -> dict:
 def run_ours(times, settlement: float, tolerance: float | None, structure: str = "arch", mu: float = MU) -> dict:
     import numpy as np
 
-    from masonrycli.builtin import builtin
     from masonrycli.run import Simulation
+    from masonrycli.scenario.builtin import builtin
 
     wanted = steps_of(times)
     extra = {} if tolerance is None else {"tolerance": tolerance}

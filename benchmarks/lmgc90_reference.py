@@ -256,9 +256,9 @@ OURS = r"""
 import json, statistics, sys, time
 sys.path.insert(0, ROOT)
 import numpy as np
-from masonrycli.motion import Sine
+from masonrycli.scenario.motion import Sine
 from masonrycli.run import Simulation, simulate
-from masonrycli.scenario import Material, RunConfig, scenario_from_builder
+from masonrycli.scenario.scenario import Material, RunConfig, scenario_from_builder
 
 def scenario():
     motion = Sine(direction=(1.0, 0.0), amplitude=AMPLITUDE, frequency=FREQUENCY)

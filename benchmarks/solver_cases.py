@@ -19,8 +19,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from masonrycli.motion import Constant, Sine
-from masonrycli.scenario import Material, RunConfig, scenario_from_builder
+from masonrycli.scenario.motion import Constant, Sine
+from masonrycli.scenario.scenario import Material, RunConfig, scenario_from_builder
 
 SINE = Sine(amplitude=1.0, frequency=2.0)
 SETTLE = {"right-foundation": Constant(velocity=(0.0, -0.01))}

@@ -20,7 +20,7 @@ import numpy as np
 
 from benchmarks.solver_cases import course_of, is_wall, make_scenario, slips
 from masonrycli.run import Simulation, simulate
-from masonrycli.scenario import SOLVERS
+from masonrycli.scenario.scenario import SOLVERS
 
 SAMPLES = (100, 200)
 """Steps (dt = 1e-3) at which the accuracy is read: 0.1 and 0.2 s."""

@@ -19,8 +19,8 @@ import sys
 
 import numpy as np
 
-from masonrycli.builtin import builtin
 from masonrycli.run import simulate
+from masonrycli.scenario.builtin import builtin
 
 SOLVER = "nlgs"
 """The page's solver (docs/scenarios.md, "Which solver"). With today's default the figures move a little: the 51-block

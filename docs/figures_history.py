@@ -183,7 +183,7 @@ def single_point_contacts(run: Run, kind: str) -> str:
     (``masonrycli.run.Simulation`` set-up, no time step), classified by where the contact point lies on
     each body (a corner or inside a face); ``block_max_opening`` leaves them out (joints only)."""
     from masonrycli.run import Simulation
-    from masonrycli.scenario import Material, RunConfig, scenario_from_builder
+    from masonrycli.scenario.scenario import Material, RunConfig, scenario_from_builder
 
     options = {"blocks": run.n} if kind == "wall" else {}
     tracker = Simulation(scenario_from_builder(kind, options, RunConfig(duration=0.001), Material(), {})).joints
@@ -216,10 +216,10 @@ RECORDED_FIELDS = (
 
 def recorded_ranges(h: dict, key: str) -> list:
     """The colour range of ``key`` at every frame, as ``masonrycli.recording`` logs it: a
-    ``masonrycli.colour_range.RangeTracker`` fed the frames from the first computed one on; the initial
+    ``masonrycli.recording.colour_range.RangeTracker`` fed the frames from the first computed one on; the initial
     state (entry 0, t = 0) takes the range of the frame after it. The volumetric strain rate falls back
     on the chain strain rate."""
-    from masonrycli.colour_range import RangeTracker
+    from masonrycli.recording.colour_range import RangeTracker
     from masonrycli.recording.layout import CHAIN_KEY, FIELD_BY_KEY
 
     spec = FIELD_BY_KEY[key]

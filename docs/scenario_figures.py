@@ -12,9 +12,9 @@ Any subset of the options works; each prints its tables (plain text, numbers as 
 
 Joint states are read from the history: ``block_max_opening`` (the widest opening of the block's initial
 face joints — body pairs with two initial contact points — followed kinematically by
-``masonrycli.mechanism``; single corner contacts are left out), ``block_sliding_ratio`` (share of the block's
+``masonrycli.analysis.mechanism``; single corner contacts are left out), ``block_sliding_ratio`` (share of the block's
 normal contact load carried by sliding contacts: at the friction limit *and* sliding faster than
-``masonrycli.mechanism.SLIP_SPEED``, 1 mm/s) and ``joint_hinged``. Two things the history does not hold
+``masonrycli.analysis.mechanism.SLIP_SPEED``, 1 mm/s) and ``joint_hinged``. Two things the history does not hold
 per joint — which end of a joint is open (intrados / extrados) and how far its faces have slid — are
 measured geometrically, which also gives an independent cross-check of the openings and hinges: the
 structure is rebuilt with the project's builder (defaults, ``blocks`` = N for a wall; checked against the
@@ -24,7 +24,7 @@ motions of ``block_q`` / ``support_q``. Positive = open, negative = interpenetra
 far the widest geometric opening of each block is from ``block_max_opening``.
 
 The colour ranges of the recording are replayed from the history the way the recorder follows the data
-(``masonrycli.colour_range.RangeTracker`` over every frame after the initial one).
+(``masonrycli.recording.colour_range.RangeTracker`` over every frame after the initial one).
 
 This script is the command line; the tables come from its sibling modules: figures_history.py (loading,
 joint geometry, tables, cross-checks), figures_wall.py, figures_arch.py and figures_arch_response.py.

@@ -6,7 +6,7 @@ words its message in its own style around it:
 
 - geometry_library (builders, checks, geometry files): :func:`check_positive` and :func:`check_count`
   raise ``GeometryError("<label>: <key> must be a positive number, got <value>")``;
-- masonrycli (scenario files, options, motions): ``masonrycli.values.check_real`` / ``check_int`` raise
+- masonrycli (scenario files, options, motions): ``masonrycli.scenario.values.check_real`` / ``check_int`` raise
   ``InputError("<key> = <value>: <reason>")``.
 
 A number written as a string with its unit (``"1 s"``, ``"2500 kg/m3"``) is told the number to write and
@@ -49,7 +49,7 @@ class TypedNumber(float):
 def shown(value, otherwise: Callable[[Any], str] = repr) -> str:
     """``value`` for a message: as typed when it is a :class:`TypedNumber` ("--rtol 0", not "0.0"), else
     ``otherwise(value)``, the caller's format for any other value (repr here). The one place that rule lives:
-    ``masonrycli.values.shorten`` and ``option_text`` call it with their formats."""
+    ``masonrycli.scenario.values.shorten`` and ``option_text`` call it with their formats."""
     return value.text if isinstance(value, TypedNumber) else otherwise(value)
 
 

@@ -1,6 +1,6 @@
 """``python -m masonrycli`` and the ``masonry`` command (the entry point in pyproject.toml).
 
-The command line lives in :mod:`masonrycli.cli`; it is imported here, inside ``main``, so that a Ctrl-C
+The command line lives in :mod:`masonrycli.cli.app`; it is imported here, inside ``main``, so that a Ctrl-C
 while Python loads it (typer, rich, numpy: the first half second) ends in one line and exit 130 instead
 of a KeyboardInterrupt traceback.
 """
@@ -41,7 +41,7 @@ def main() -> None:
     if threading.current_thread() is threading.main_thread():
         signal.signal(signal.SIGTERM, _terminated)
     try:
-        from masonrycli.cli import main as cli_main
+        from masonrycli.cli.app import main as cli_main
         from masonrycli.interrupt import ignore_signals_while_exiting
     except KeyboardInterrupt:
         sys.stderr.write("error: Ctrl-C while masonry was starting: nothing was run\n")

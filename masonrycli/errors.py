@@ -21,7 +21,7 @@ EXIT_ROWS_FAILED = 5
 
 class RecordWarning(UserWarning):
     """An input read with a remark (an .AT2 file with samples beyond its NPTS); the command line prints it
-    as one ``warning: …`` line (:func:`masonrycli.cli_messages.user_errors`)."""
+    as one ``warning: …`` line (:func:`masonrycli.cli.messages.user_errors`)."""
 
 
 class InputError(ValueError):

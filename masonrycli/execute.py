@@ -1,6 +1,6 @@
 """Run a scenario with its outputs: output checks, history file, Rerun recording, progress bar, summary.
 
-Before step 1 every output path is checked and its temporary file created (:mod:`masonrycli.outputs`),
+Before step 1 every output path is checked and its temporary file created (:mod:`masonrycli.outputs.files`),
 and a run whose outputs would not fit on the disk is refused. The outputs are then closed whatever
 happens — normal end, divergence, a signal, an engine error, a failed write — and each one that closed
 is renamed into place, so what was computed is kept and a path never holds half a file.
@@ -25,14 +25,21 @@ from rich.text import Text
 from masonrycli import SOURCE_DIGEST, __version__
 from masonrycli.engine import compile_ahead
 from masonrycli.errors import InputError
-from masonrycli.history import HistoryFile, block_constants
 from masonrycli.interrupt import StopSignals
-from masonrycli.outputs import OutputFile, check_distinct, check_output, check_space, default_recording_path, open_part
-from masonrycli.report import progress_bar, slow_start_notice, summary_table
+from masonrycli.outputs.files import (
+    OutputFile,
+    check_distinct,
+    check_output,
+    check_space,
+    default_recording_path,
+    open_part,
+)
+from masonrycli.outputs.history import HistoryFile, block_constants
+from masonrycli.outputs.report import progress_bar, slow_start_notice, summary_table
+from masonrycli.outputs.sinks import COMPLETED, FAILED
 from masonrycli.run import RunResult, Simulation, simulate
-from masonrycli.sinks import COMPLETED, FAILED
+from masonrycli.scenario.values import option_text
 from masonrycli.source_digest import source_commit
-from masonrycli.values import option_text
 
 HISTORY_BYTES_PER_BLOCK = 500
 """Upper estimate of one block's share of a history row (measured: 326 B for the walls, 420 B for an arch of
@@ -76,7 +83,7 @@ def check_run(
 ) -> Outputs:
     """Everything checked before a run (what ``masonry check`` stops after): the time step against the
     supports' motions, ``--magnify``, then the outputs (:func:`plan_outputs`). Raises InputError."""
-    from masonrycli.scenario import check_sampling
+    from masonrycli.scenario.scenario import check_sampling
 
     check_sampling(scenario)
     check_magnify(magnify, no_recording)
@@ -205,7 +212,7 @@ def execute(
     signals: StopSignals | None = None,
 ) -> Outcome:
     """Run ``scenario`` writing ``outputs``; ``stop_at_collapse`` ends the run when the structure
-    collapses (:mod:`masonrycli.collapse`); ``magnify``: the recording's magnified-shape factor (None:
+    collapses (:mod:`masonrycli.analysis.collapse`); ``magnify``: the recording's magnified-shape factor (None:
     chosen from the run). Signals: :mod:`masonrycli.interrupt` (a stop before step 1
     raises its ``StopRun`` after removing the temporary files); an engine error is re-raised after the
     outputs are closed with status "failed" and renamed into place. ``signals``: a :class:`StopSignals`

@@ -1,6 +1,6 @@
 """Model (what does not change during a run) and State (what does), as flat arrays.
 
-``build_model`` turns a :class:`~masonrycli.scenario.Scenario` into a :class:`Model` once; the time loop
+``build_model`` turns a :class:`~masonrycli.scenario.scenario.Scenario` into a :class:`Model` once; the time loop
 then only touches arrays. Bodies are the blocks (0..N-1, scenario order) followed by the supports
 (N..N+S-1). Supports have zero inverse mass: they move with their imposed velocity and ignore impulses.
 """
@@ -13,7 +13,7 @@ import numpy as np
 
 from geometry_library.blocks import JOINT_SEPARATOR
 from geometry_library.mass import mass_properties
-from masonrycli.motion import support_velocity
+from masonrycli.scenario.motion import support_velocity
 
 
 @dataclass(frozen=True, eq=False)

@@ -1,7 +1,7 @@
 """The one time loop: motion → detect → solve → tensors → record → progress.
 
-``simulate`` owns no I/O format: it hands each recorded :class:`~masonrycli.frame.Frame` to the sinks it
-is given (:class:`~masonrycli.sinks.FrameSink`: a history, a recorder); the caller closes them. It stops
+``simulate`` owns no I/O format: it hands each recorded :class:`~masonrycli.outputs.frame.Frame` to the sinks it
+is given (:class:`~masonrycli.outputs.sinks.FrameSink`: a history, a recorder); the caller closes them. It stops
 early when ``stop()`` says so (a signal, see :mod:`masonrycli.interrupt`), when the state diverges, or
 when a sink cannot write (``OSError``: the result says which sink and why).
 """
@@ -15,16 +15,16 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from masonrycli.collapse import CollapseMonitor, rule_for
+from masonrycli.analysis.collapse import CollapseMonitor, rule_for
+from masonrycli.analysis.mechanism import JointTracker, contact_states
+from masonrycli.analysis.tensors import TensorComputer, build_triangles, chain_neighbours
 from masonrycli.engine import integrate
 from masonrycli.engine.solver import Solver, StepStats
-from masonrycli.frame import Frame
-from masonrycli.intensity import describe as describe_intensity
-from masonrycli.intensity import intensity_measures, shaking_support
-from masonrycli.mechanism import JointTracker, contact_states
 from masonrycli.model import Model, State, build_model, initial_state
-from masonrycli.sinks import COMPLETED, DIVERGED, FAILED, INTERRUPTED
-from masonrycli.tensors import TensorComputer, build_triangles, chain_neighbours
+from masonrycli.outputs.frame import Frame
+from masonrycli.outputs.sinks import COMPLETED, DIVERGED, FAILED, INTERRUPTED
+from masonrycli.records.intensity import describe as describe_intensity
+from masonrycli.records.intensity import intensity_measures, shaking_support
 
 DIVERGENCE_SPEED = 1e3
 """m/s: a block faster than this (or a non-finite state) stops the run as diverged."""
@@ -85,7 +85,7 @@ class RunResult:
     """What happened, for the summary table."""
 
     status: str
-    """One of :data:`masonrycli.sinks.STATUSES` but "running": "completed", "interrupted", "diverged" or "failed"."""
+    """One of :data:`masonrycli.outputs.sinks.STATUSES` but "running": "completed", "interrupted", "diverged" or "failed"."""
     message: str
     """One line on how the run stopped ("" when it ran all its steps)."""
     steps: int
@@ -115,7 +115,7 @@ class RunResult:
     extra: dict = field(default_factory=dict)
     """Further summary rows, label → text (e.g. the hinged joints at the end)."""
     intensity: dict = field(default_factory=dict)
-    """Intensity measures of the shaking support's motion as applied (:mod:`masonrycli.intensity`), or {}."""
+    """Intensity measures of the shaking support's motion as applied (:mod:`masonrycli.records.intensity`), or {}."""
     outcome: dict = field(default_factory=dict)
     """What happened to the structure (:func:`run_outcome`): state, collapse time, drifts, hinges, ..."""
     failed_sink: object = None
@@ -268,7 +268,7 @@ def simulate(
     every step; when it is true the run ends "interrupted" after recording the state it reached. Pass
     ``sim`` to run an already built :class:`Simulation` (the caller needed its model or triangles first).
     ``stop_at_collapse`` ends the run at the first step where the structure has collapsed
-    (:mod:`masonrycli.collapse`); the status stays "completed" and the message says so.
+    (:mod:`masonrycli.analysis.collapse`); the status stays "completed" and the message says so.
     """
     t0 = _time.perf_counter()
     sim = Simulation(scenario) if sim is None else sim
@@ -368,7 +368,7 @@ def simulate(
 
 
 def run_outcome(sim: Simulation, hinges: int) -> dict:
-    """The structure's state and the indicators behind it (:mod:`masonrycli.collapse`): ``state``,
+    """The structure's state and the indicators behind it (:mod:`masonrycli.analysis.collapse`): ``state``,
     ``collapse_time`` (s, NaN if none), ``collapse_reason``, ``residual_drift`` and ``peak_drift``
     (× height), ``max_opening`` (m), ``max_displacement`` (m, the largest block's relative to the
     shaking ground: damage beyond 5 mm), ``hinges``, ``slide_time`` / ``rock_time`` (s, NaN if none),

@@ -8,7 +8,7 @@ import time
 
 from typer.testing import CliRunner
 
-from masonrycli.cli import app
+from masonrycli.cli.app import app
 
 runner = CliRunner()
 

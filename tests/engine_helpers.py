@@ -7,9 +7,9 @@ from pathlib import Path
 
 import numpy as np
 
-from masonrycli.history import History
+from masonrycli.outputs.history import History
 from masonrycli.run import simulate
-from masonrycli.scenario_toml import load_scenario
+from masonrycli.scenario.toml_file import load_scenario
 
 DATA = Path(__file__).parent / "data"
 

@@ -6,8 +6,8 @@ import numpy as np
 from shapely.geometry import Polygon, box
 
 from geometry_library.blocks import Assembly, Block, Support
-from masonrycli.motion import Fixed
-from masonrycli.scenario import Material, RunConfig, Scenario
+from masonrycli.scenario.motion import Fixed
+from masonrycli.scenario.scenario import Material, RunConfig, Scenario
 
 DENSITY = 2000.0
 

@@ -2,7 +2,7 @@
 
 A running-bond wall of rectangles (one block of the top course is a pentagon, so the polygons are
 ragged), a ground support, a centroid triangulation, and frames with a swaying wall, random contacts
-and tensor fields named as in masonrycli.tensors; reading rows back, and rerun's strict mode.
+and tensor fields named as in masonrycli.analysis.tensors; reading rows back, and rerun's strict mode.
 """
 
 from __future__ import annotations
@@ -12,7 +12,7 @@ import pytest
 import rerun as rr
 from scipy.spatial import Delaunay
 
-from masonrycli.frame import CONTACT_OPEN, CONTACT_SLIP, CONTACT_STICK, Frame
+from masonrycli.outputs.frame import CONTACT_OPEN, CONTACT_SLIP, CONTACT_STICK, Frame
 from masonrycli.recording import Recorder, RecordingStatic
 
 BLOCK_W, BLOCK_H = 0.3, 0.2
@@ -73,7 +73,7 @@ GROUND_Q0 = np.array([[2 * BLOCK_W, -0.05, 0.0]])
 
 
 def tensor_fields(n: int, rng: np.random.Generator, t: float) -> dict[str, np.ndarray]:
-    """Per-block fields with the names masonrycli.tensors produces; block 1 has no triangle (NaN)."""
+    """Per-block fields with the names masonrycli.analysis.tensors produces; block 1 has no triangle (NaN)."""
     p1 = rng.normal(-2e3, 1e3, n)
     p2 = p1 - np.abs(rng.normal(1e3, 500.0, n))
     e1 = rng.normal(0.0, 0.05, n) * (1 + t)

@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 
 from masonrycli.errors import InputError
-from masonrycli.scenario import Scenario
-from masonrycli.scenario_toml import load_scenario
+from masonrycli.scenario.scenario import Scenario
+from masonrycli.scenario.toml_file import load_scenario
 
 DATA = Path(__file__).parent / "data"
 

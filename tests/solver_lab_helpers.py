@@ -6,7 +6,7 @@ import numpy as np
 
 from benchmarks.solver_lab.capture import SINE, capture_run, reference
 from masonrycli.run import Simulation
-from masonrycli.scenario import Material, RunConfig, scenario_from_builder
+from masonrycli.scenario.scenario import Material, RunConfig, scenario_from_builder
 
 
 def tiny_cold_problem():

@@ -7,7 +7,7 @@ from pathlib import Path
 
 from typer.testing import CliRunner
 
-from masonrycli.cli import app
+from masonrycli.cli.app import app
 
 runner = CliRunner()
 BLOCK = """

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 from shapely.geometry import box
 
-from masonrycli import tensors as T
+from masonrycli.analysis import tensors as T
 
 from naive_collision import course_edges
 

@@ -14,7 +14,7 @@ from bad_input_files import FILE_ROWS
 from bad_input_options import OPTION_ROWS
 from typer.testing import CliRunner
 
-from masonrycli.cli import app
+from masonrycli.cli.app import app
 
 # (id, files, argv, exit code, fragment of the one line)
 CATALOGUE = FILE_ROWS + OPTION_ROWS

@@ -7,7 +7,7 @@ from __future__ import annotations
 import os
 
 from benchmarks import bench_frames
-from masonrycli.cli import app
+from masonrycli.cli.app import app
 
 os.environ.setdefault("RERUN_ANALYTICS", "0")
 

@@ -6,7 +6,7 @@ import pytest
 from benchmarks import bench_solver
 from benchmarks.solver_cases import make_scenario
 from masonrycli.run import simulate
-from masonrycli.scenario import SOLVERS
+from masonrycli.scenario.scenario import SOLVERS
 
 
 def _run(cpu: float, top: float, mean: float, sweeps: float = 10.0) -> dict:

@@ -7,7 +7,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from masonrycli.builtin import (
+from masonrycli.errors import InputError
+from masonrycli.records.read import record_motion
+from masonrycli.scenario.builtin import (
     PAPER_INSTANT,
     build_assembly,
     builtin,
@@ -17,10 +19,8 @@ from masonrycli.builtin import (
     paper_instant_hint,
     target_scenario,
 )
-from masonrycli.errors import InputError
-from masonrycli.motion import Constant, Fixed, Sine
-from masonrycli.records import record_motion
-from masonrycli.scenario import RunConfig
+from masonrycli.scenario.motion import Constant, Fixed, Sine
+from masonrycli.scenario.scenario import RunConfig
 
 RECORD = Path(__file__).parent / "data" / "quake_velocity.csv"
 

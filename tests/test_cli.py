@@ -1,4 +1,4 @@
-"""The commands of masonrycli/cli.py as a user drives them: simulate, run, check, build and inspect on short
+"""The commands of masonrycli/cli/app.py as a user drives them: simulate, run, check, build and inspect on short
 runs, and their bad input as one line. Options and --help: test_cli_options.py; messages, a closed stdout
 and Ctrl-C: test_cli_messages.py; a run's outcomes (diverged, failed, unconverged): test_execute.py."""
 

@@ -1,4 +1,4 @@
-"""One-line usage errors (masonrycli/cli_messages.py): a numeric option given text, or a number with its
+"""One-line usage errors (masonrycli/cli/messages.py): a numeric option given text, or a number with its
 unit, says what to write and in which unit the option is read (the units of docs/scenario-format.md and of
 the options' help), never converting; a closed stdout and a Ctrl-C before the run (user_errors)."""
 
@@ -154,7 +154,7 @@ def test_every_numeric_option_has_a_known_unit():
     import typer
 
     from geometry_library.values import unit_of
-    from masonrycli.cli import app
+    from masonrycli.cli.app import app
 
     commands = typer.main.get_command(app).commands
     numeric = [
@@ -274,7 +274,7 @@ def test_an_option_of_one_value_given_twice_is_refused(args, line, tmp_path, mon
 
 
 def test_options_given_many_times_on_purpose_and_flags_are_taken():
-    from masonrycli.cli import app
+    from masonrycli.cli.app import app
 
     assert app_group(app)._repeated_option(["sweep", "wall", "-p", "amp=0.1", "-p", "freq=2"]) is None
     assert app_group(app)._repeated_option(["simulate", "wall", "--force", "--force"]) is None
@@ -304,12 +304,12 @@ def test_a_closed_stdout_is_not_bad_input(tmp_path):
 
 def test_ctrl_c_before_the_run_is_one_line_and_exit_130(monkeypatch):
     # a Ctrl-C while the structure is built (before the run's own signal handling) exited 130 without a word
-    import masonrycli.builtin
+    import masonrycli.scenario.builtin
 
     def interrupted(*args, **kwargs):
         raise KeyboardInterrupt
 
-    monkeypatch.setattr(masonrycli.builtin, "builtin", interrupted)
+    monkeypatch.setattr(masonrycli.scenario.builtin, "builtin", interrupted)
     result = invoke("simulate", "wall", "--duration", 0.01, "--no-recording")
     assert result.exit_code == 130
     assert result.output.strip() == "error: Ctrl-C: stopped before any output was written"

@@ -1,4 +1,4 @@
-"""The options of every command (masonrycli/cli_options.py): what --help says of them (their defaults, only
+"""The options of every command (masonrycli/cli/options.py): what --help says of them (their defaults, only
 those a structure takes, -h as --help), choices in any case, and paths with a ~ the shell left."""
 
 from __future__ import annotations
@@ -48,7 +48,7 @@ def test_command_list_keeps_each_summary_on_one_line(group, commands):
     # "override the file's values." on two lines of a 120-column terminal); their fix, a copy of each
     # docstring, left inspect's broken ("run history (the run's" / "parameters, …", walk-through 2026-11-29)
     # and check's copy without "the loading".
-    from masonrycli.cli import app
+    from masonrycli.cli.app import app
 
     from cli_helpers import runner
 
@@ -73,7 +73,7 @@ def test_command_list_keeps_each_summary_on_one_line(group, commands):
 
 def _option_help(command: list[str]) -> dict[str, str]:
     """Each option of ``masonry COMMAND --help`` with its help text (joined over wrapped lines)."""
-    from masonrycli.cli import app
+    from masonrycli.cli.app import app
 
     from cli_helpers import runner
 

@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 from typer.testing import CliRunner
 
-from masonrycli.cli import app
-from masonrycli.records import G_STANDARD, record_motion
+from masonrycli.cli.app import app
+from masonrycli.records.read import G_STANDARD, record_motion
 from masonrycli.study.store import read_rows
 
 from cli_helpers import words
@@ -134,9 +134,9 @@ motion = { kind = "sine", amplitude = 0.5, frequency = 2.0 }
 
 def test_run_document_holds_the_baseline_correction(at2):
     from masonrycli.execute import run_metadata
-    from masonrycli.motion import Sine
     from masonrycli.run import Simulation
-    from masonrycli.scenario import Material, RunConfig, scenario_from_builder
+    from masonrycli.scenario.motion import Sine
+    from masonrycli.scenario.scenario import Material, RunConfig, scenario_from_builder
 
     motion = record_motion(at2, scale=0.5)
     motions = {"left-foundation": motion, "right-foundation": Sine(amplitude=0.1, frequency=2.0)}
@@ -290,7 +290,7 @@ def test_a_csv_accelerogram_is_read_as_its_header_says(tmp_path):
 def test_a_geometry_files_support_is_shaken_from_any_folder(tmp_path, monkeypatch):
     # a --scheduler's worker started in another folder resolved the command's relative 'wall.geojson' there:
     # every row of 'masonry sweep wall.geojson --records recs --scheduler …' was refused, "no shaking support"
-    from masonrycli.builtin import shaken_supports, target_scenario
+    from masonrycli.scenario.builtin import shaken_supports, target_scenario
 
     (tmp_path / "study").mkdir()
     (tmp_path / "worker").mkdir()
@@ -333,7 +333,7 @@ TWO_SUPPORTS = """{"type": "FeatureCollection", "features": [
 def test_record_on_a_geometry_file_shakes_the_supports_it_marks_driven(tmp_path):
     # a lintel on two pads, the left one marked "support_role": "driven": --record shakes it, the right one stays
     # fixed (a file of several supports was refused: only a scenario file could say which one shakes)
-    from masonrycli.builtin import target_scenario, with_record
+    from masonrycli.scenario.builtin import target_scenario, with_record
 
     geo = tmp_path / "two.geojson"
     geo.write_text(TWO_SUPPORTS)

@@ -9,7 +9,7 @@ from pathlib import Path
 
 import pytest
 
-from masonrycli.records import G_STANDARD
+from masonrycli.records.read import G_STANDARD
 from masonrycli.study.store import read_rows
 
 from cli_helpers import assert_one_line_error, words

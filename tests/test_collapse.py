@@ -10,9 +10,9 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from masonrycli.collapse import RULES, CollapseMonitor, CollapseRule
+from masonrycli.analysis.collapse import RULES, CollapseMonitor, CollapseRule
 from masonrycli.run import Simulation, simulate
-from masonrycli.scenario_toml import loads_scenario
+from masonrycli.scenario.toml_file import loads_scenario
 
 from engine_helpers import PerStep
 

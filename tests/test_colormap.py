@@ -1,11 +1,11 @@
-"""masonrycli.colormap: lookup tables, NaN colour, nice ceilings and robust maxima."""
+"""masonrycli.recording.colormap: lookup tables, NaN colour, nice ceilings and robust maxima."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
-from masonrycli import colormap as cm
+from masonrycli.recording import colormap as cm
 
 
 def test_colormap_lookup():

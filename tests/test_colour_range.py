@@ -1,4 +1,4 @@
-"""masonrycli.colour_range: the two rules (coverage, use) on every frame, the three kinds, the floor."""
+"""masonrycli.recording.colour_range: the two rules (coverage, use) on every frame, the three kinds, the floor."""
 
 from __future__ import annotations
 
@@ -7,8 +7,8 @@ import math
 import numpy as np
 import pytest
 
-from masonrycli import colormap as cm
-from masonrycli.colour_range import (
+from masonrycli.recording import colormap as cm
+from masonrycli.recording.colour_range import (
     BULK_TRIM,
     HOLD_SPAN,
     MIN_SPAN,

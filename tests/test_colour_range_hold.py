@@ -9,7 +9,7 @@ import math
 import numpy as np
 import pytest
 
-from masonrycli.colour_range import HOLD_SPAN, MIN_SPAN, SHRINK_AFTER, RangeTracker, fit_range
+from masonrycli.recording.colour_range import HOLD_SPAN, MIN_SPAN, SHRINK_AFTER, RangeTracker, fit_range
 
 
 def reference(kind: str, floor: float, frames: np.ndarray, shrink_after: int) -> tuple[list, list[str]]:

@@ -5,10 +5,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from masonrycli.history import History
-from masonrycli.motion import Sine
+from masonrycli.outputs.history import History
 from masonrycli.run import simulate
-from masonrycli.scenario import Material, RunConfig, scenario_from_builder
+from masonrycli.scenario.motion import Sine
+from masonrycli.scenario.scenario import Material, RunConfig, scenario_from_builder
 
 
 def _wall_history(duration: float) -> np.ndarray:

@@ -122,7 +122,7 @@ def test_free_flight_energy(theta, tmp_path):
     )
     from dataclasses import replace
 
-    from masonrycli.scenario_toml import load_scenario
+    from masonrycli.scenario.toml_file import load_scenario
 
     sc = load_scenario(path)
     sc = replace(sc, run=replace(sc.run, theta=theta))
@@ -142,7 +142,7 @@ def test_block_on_ground_does_not_creep_or_sink(tmp_path):
         .replace("duration = 1.0", "duration = 10.0")
         .replace("record_every = 1", "record_every = 100")
     )
-    from masonrycli.scenario_toml import load_scenario
+    from masonrycli.scenario.toml_file import load_scenario
 
     h, result = run_history(load_scenario(path))
     dq = h["block_q"][:, 0, :2] - h["block_q"][0, 0, :2]
@@ -158,9 +158,9 @@ def test_arch_at_rest_does_not_wander(solver):
     # T × tolerance, the distance one contact violating its law by the tolerance for the whole run
     # travels. The solve stopped at the tolerance alone let the arch wander by 0.14 mm in 2 s (7× that
     # bound; engine/solver.py, "At rest").
-    from masonrycli.builtin import builtin
     from masonrycli.engine.solver import Solver
     from masonrycli.model import build_model, initial_state
+    from masonrycli.scenario.builtin import builtin
 
     duration = 2.0
     m = build_model(builtin("arch", settlement=0.0, duration=duration, solver=solver))
@@ -178,9 +178,9 @@ def test_arch_at_rest_keeps_the_sweep_cap():
     # A step at rest is solved on past the tolerance (engine/solver.py, "At rest"), but --max-iterations
     # caps a step's sweeps whatever they are spent on: the extra sweeps once took steps the ordinary solve
     # had converged to 1001-1013 sweep units under a cap of 50 and reported them capped and unconverged.
-    from masonrycli.builtin import builtin
     from masonrycli.engine.solver import Solver
     from masonrycli.model import build_model, initial_state
+    from masonrycli.scenario.builtin import builtin
 
     cap = 50
     m = build_model(builtin("arch", settlement=0.0, duration=0.2, max_iterations=cap))
@@ -205,7 +205,7 @@ polygon = [[0.0, {height}], [0.4, {height}], [0.4, {top}], [0.0, {top}]]
 name = "ground"
 polygon = [[-2.0, -0.5], [2.0, -0.5], [2.0, 0.0], [-2.0, 0.0]]
 """)
-    from masonrycli.scenario_toml import load_scenario
+    from masonrycli.scenario.toml_file import load_scenario
 
     h, result = run_history(load_scenario(path))
     y = h["block_q"][:, 0, 1]

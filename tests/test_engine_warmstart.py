@@ -57,7 +57,7 @@ def test_each_key_finds_the_row_a_binary_search_finds():
 
 def _wall_at_rest(alert: float, solver: str = "nlgs-accel"):
     from masonrycli.run import Simulation
-    from masonrycli.scenario import Material, RunConfig, scenario_from_builder
+    from masonrycli.scenario.scenario import Material, RunConfig, scenario_from_builder
 
     run = RunConfig(duration=0.05, alert_distance=alert, solver=solver)
     return Simulation(scenario_from_builder("wall", {}, run, Material(), {}))

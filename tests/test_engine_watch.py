@@ -5,9 +5,9 @@ from __future__ import annotations
 import numpy as np
 
 from masonrycli.engine.watch import watch_step
-from masonrycli.motion import Sine
 from masonrycli.run import Simulation
-from masonrycli.scenario import Material, RunConfig, scenario_from_builder
+from masonrycli.scenario.motion import Sine
+from masonrycli.scenario.scenario import Material, RunConfig, scenario_from_builder
 
 
 def test_watch_matches_numpy():

@@ -26,11 +26,11 @@ from masonrycli import execute as execute_module
 from masonrycli.errors import InputError
 from masonrycli.execute import check_run, execute, plan_outputs, unconverged_warning
 from masonrycli.interrupt import StopRun
-from masonrycli.motion import Sine
-from masonrycli.outputs import OutputFile
+from masonrycli.outputs.files import OutputFile
 from masonrycli.recording import inspect_recording
 from masonrycli.run import Simulation
-from masonrycli.scenario import SOLVERS, Material, RunConfig, Scenario
+from masonrycli.scenario.motion import Sine
+from masonrycli.scenario.scenario import SOLVERS, Material, RunConfig, Scenario
 from masonrycli.source_digest import source_commit
 
 from cli_helpers import invoke, signal_inside_a_ctypes_callback, words
@@ -207,8 +207,8 @@ def test_check_run_refuses_a_step_too_long_for_the_motion(tmp_path):
 def test_the_size_estimate_is_an_upper_bound(args, tmp_path):
     """The estimate left out the recording's static part: the 51-block wall's 0.1 s was let start on a 1 MB
     disk (estimate ~0.6 MB; it wrote 0.63 MB of recording + its history) and failed there, exit 4."""
-    from masonrycli.builtin import builtin
     from masonrycli.execute import output_sizes
+    from masonrycli.scenario.builtin import builtin
 
     rrd, npz = tmp_path / "r.rrd", tmp_path / "h.npz"
     result = invoke(*args, "--out", rrd, "--history", npz)

@@ -17,7 +17,7 @@ from geometry_library.values import (
     same_unit,
 )
 from masonrycli.errors import InputError
-from masonrycli.values import check_int, check_real
+from masonrycli.scenario.values import check_int, check_real
 
 
 @pytest.mark.parametrize(
@@ -189,7 +189,7 @@ def test_a_typed_number_writes_and_hashes_as_the_float_it_is():
     import json
     import pickle
 
-    from masonrycli.values import format_value
+    from masonrycli.scenario.values import format_value
 
     for text in ("0.1", "1e9", "2e-3", "-0", "3"):
         typed, plain = TypedNumber(float(text), text), float(text)

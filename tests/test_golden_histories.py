@@ -29,10 +29,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from masonrycli.history import History
-from masonrycli.motion import Constant, Sine
+from masonrycli.outputs.history import History
 from masonrycli.run import simulate
-from masonrycli.scenario import Material, RunConfig, scenario_from_builder
+from masonrycli.scenario.motion import Constant, Sine
+from masonrycli.scenario.scenario import Material, RunConfig, scenario_from_builder
 
 GOLDEN = Path(__file__).parent / "data" / "golden_histories.json"
 

@@ -8,9 +8,9 @@ import tracemalloc
 
 import numpy as np
 
-from masonrycli.history import History, HistoryFile
+from masonrycli.outputs.history import History, HistoryFile
 from masonrycli.run import Simulation, simulate
-from masonrycli.scenario import Material, RunConfig, scenario_from_builder
+from masonrycli.scenario.scenario import Material, RunConfig, scenario_from_builder
 
 
 def wall(duration: float, record_every: int = 1):
@@ -77,7 +77,7 @@ def test_history_file_memory_is_flat_in_the_frame_count(tmp_path):
 def test_support_velocities_are_not_tabulated_for_the_whole_run():
     """Finding 6: a 10⁹-step run allocated its support-velocity table before step 1 (gigabytes)."""
     from masonrycli.model import SupportVelocity, build_model
-    from masonrycli.motion import Sine, support_velocity
+    from masonrycli.scenario.motion import Sine, support_velocity
 
     sc = scenario_from_builder(
         "wall",

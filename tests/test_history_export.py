@@ -10,7 +10,7 @@ import json
 import numpy as np
 import pytest
 
-from masonrycli.history_export import export_table, frame_rate
+from masonrycli.outputs.export import export_table, frame_rate
 
 from cli_helpers import assert_one_line_error, invoke
 
@@ -254,9 +254,9 @@ class SupportMoment:
 
 
 def test_the_overturning_moment_is_that_of_the_support_contacts(tmp_path):
-    from masonrycli.builtin import builtin
-    from masonrycli.history import History, block_constants
+    from masonrycli.outputs.history import History, block_constants
     from masonrycli.run import Simulation, simulate
+    from masonrycli.scenario.builtin import builtin
 
     scenario = builtin("wall", duration=0.02, record_every=1)
     sim = Simulation(scenario)

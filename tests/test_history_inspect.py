@@ -1,4 +1,4 @@
-"""``masonry inspect H.npz`` (masonrycli/history_inspect.py): a run history summarised from the file alone —
+"""``masonry inspect H.npz`` (masonrycli/outputs/inspect_history.py): a run history summarised from the file alone —
 the run's parameters and status, frames and time span, one line per array with its shape, dtype and unit —
 for a real run's history, an interrupted one, a sweep's, one written before histories described themselves;
 a damaged file or an archive that is no history is one line and exit code 2. Before: every .npz was
@@ -13,12 +13,12 @@ import re
 import numpy as np
 import pytest
 
-from masonrycli.builtin import builtin
 from masonrycli.execute import run_metadata
-from masonrycli.history import HistoryFile
-from masonrycli.history_inspect import NOT_RECORDED, inspect_history, is_history
+from masonrycli.outputs.history import HistoryFile
+from masonrycli.outputs.inspect_history import NOT_RECORDED, inspect_history, is_history
 from masonrycli.run import Simulation, simulate
-from masonrycli.scenario import SOLVERS
+from masonrycli.scenario.builtin import builtin
+from masonrycli.scenario.scenario import SOLVERS
 
 from cli_helpers import assert_one_line_error, invoke
 

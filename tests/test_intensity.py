@@ -6,9 +6,9 @@ import numpy as np
 import pytest
 from scipy import signal
 
-from masonrycli.intensity import SA_DAMPING, describe, intensity_measures, shaking_support
-from masonrycli.motion import Constant, Fixed, Sine
-from masonrycli.record_motion import Record
+from masonrycli.records.intensity import SA_DAMPING, describe, intensity_measures, shaking_support
+from masonrycli.records.motion import Record
+from masonrycli.scenario.motion import Constant, Fixed, Sine
 
 from cli_helpers import invoke, words
 

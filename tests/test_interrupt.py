@@ -397,7 +397,7 @@ def test_a_ctrl_c_as_build_says_what_it_wrote_keeps_the_file(tmp_path, monkeypat
     naming it) said "Ctrl-C: stopped before any output was written" of the file it had just written."""
     from typer.testing import CliRunner
 
-    import masonrycli.cli as cli
+    import masonrycli.cli.app as cli
 
     out = tmp_path / "w.geojson"
     said = cli.console.print
@@ -437,7 +437,7 @@ main()
 @pytest.mark.parametrize(
     "module, said",
     [
-        ("masonrycli.cli", "error: SIGTERM while masonry was starting: nothing was run"),
+        ("masonrycli.cli.app", "error: SIGTERM while masonry was starting: nothing was run"),
         ("masonrycli.execute", "error: SIGTERM: stopped before any output was written"),
     ],
     ids=["starting", "setting-up"],

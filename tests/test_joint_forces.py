@@ -1,12 +1,12 @@
-"""masonrycli.joint_forces against hand-computed resultants and an independent moment balance."""
+"""masonrycli.analysis.joint_forces against hand-computed resultants and an independent moment balance."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
-from masonrycli.frame import CONTACT_OPEN, CONTACT_SLIP, CONTACT_STICK
-from masonrycli.joint_forces import JOINT_OPEN, JOINT_SLIP, JOINT_STICK, joint_resultants, magnification
+from masonrycli.analysis.joint_forces import JOINT_OPEN, JOINT_SLIP, JOINT_STICK, joint_resultants, magnification
+from masonrycli.outputs.frame import CONTACT_OPEN, CONTACT_SLIP, CONTACT_STICK
 
 
 def test_a_bed_joint_under_an_eccentric_load():

@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 
 from masonrycli import SOURCE_DIGEST
-from masonrycli.cli import app
-from masonrycli.scenario_toml import dump_scenario
+from masonrycli.cli.app import app
+from masonrycli.scenario.toml_file import dump_scenario
 
 from cli_helpers import assert_one_line_error, invoke, runner, signal_inside_a_ctypes_callback, words
 from limit_helpers import column
@@ -194,7 +194,7 @@ else:
         raise AssertionError("not stopped")
     verify.run_check = run_check
 sys.argv = ["masonry", *sys.argv[2:]]
-from masonrycli.cli import main
+from masonrycli.cli.app import main
 main()
 """
 
@@ -251,9 +251,9 @@ def test_a_long_hinge_list_shows_the_fastest_turning_joints_first():
     # The aqueduct under a point load on v15 hinges 363 joints (|Δω| × length above 1e-4 of the fastest
     # point: the spandrel's running bond follows the arch). The table showed the first 8 in body order
     # (left-pier-c16-b1|left-pier-c17-b1, …), turning at 0.01–1 % of the crown hinge v15|v16, not shown.
-    from masonrycli.builtin import builtin
     from masonrycli.limit.analysis import analyse
     from masonrycli.limit.problem import LiveLoad
+    from masonrycli.scenario.builtin import builtin
 
     result = analyse(builtin("aqueduct"), LiveLoad("point", "-y", "v15"))
     u, j, m = result.solution.block_velocity, result.joints, result.model

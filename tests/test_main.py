@@ -19,10 +19,10 @@ def test_ctrl_c_while_masonry_starts_is_one_line_and_exit_130(monkeypatch, capsy
 
     class Interrupted(importlib.abc.MetaPathFinder):
         def find_spec(self, name, path=None, target=None):
-            if name == "masonrycli.cli":
+            if name == "masonrycli.cli.app":
                 raise KeyboardInterrupt
 
-    monkeypatch.delitem(sys.modules, "masonrycli.cli", raising=False)  # imported or not by earlier tests
+    monkeypatch.delitem(sys.modules, "masonrycli.cli.app", raising=False)  # imported or not by earlier tests
     monkeypatch.setattr(sys, "meta_path", [Interrupted(), *sys.meta_path])
     with pytest.raises(SystemExit) as exc:
         main()

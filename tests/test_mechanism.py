@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from masonrycli.frame import CONTACT_OPEN, CONTACT_SLIP, CONTACT_STICK
-from masonrycli.mechanism import OPENING, JointTracker, mobilised_friction
+from masonrycli.analysis.mechanism import OPENING, JointTracker, mobilised_friction
+from masonrycli.outputs.frame import CONTACT_OPEN, CONTACT_SLIP, CONTACT_STICK
 
 # Block 0: unit square on [0,1]x[0,1]; block 1: unit square on [0,1]x[1,2]; body 2: a support below.
 Q0 = np.array([[0.5, 0.5, 0.0], [0.5, 1.5, 0.0], [0.5, -0.5, 0.0]])
@@ -88,7 +88,7 @@ def test_no_joints(n_blocks):
 
 
 def test_reported_status_keeps_slip_only_when_sliding():
-    from masonrycli.mechanism import SLIP_SPEED, reported_status
+    from masonrycli.analysis.mechanism import SLIP_SPEED, reported_status
 
     status = np.array([CONTACT_SLIP, CONTACT_SLIP, CONTACT_STICK, CONTACT_OPEN], np.int8)
     ut = np.array([0.5 * SLIP_SPEED, -2 * SLIP_SPEED, 5.0, 5.0])
@@ -122,7 +122,7 @@ def test_blocks_facing_across_a_gap_are_not_a_joint():
     # A raised alert distance also detects block 1's top face against a block 2 hanging 0.15 m above it:
     # two initial "contacts" with gap 0.15 m. They were a joint opened by 150 mm from the start (a wall at
     # rest reported damaged); only contacts within JOINT_GAP are joint ends.
-    from masonrycli.mechanism import JOINT_GAP
+    from masonrycli.analysis.mechanism import JOINT_GAP
 
     q0 = np.vstack([Q0, [[0.5, 2.65, 0.0]]])
     body = np.vstack([BODY, [[1, 3], [1, 3]]])

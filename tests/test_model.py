@@ -11,8 +11,8 @@ from shapely.geometry import Polygon, box
 
 from geometry_library.blocks import Assembly, Block, Support
 from masonrycli.model import build_model, initial_state
-from masonrycli.motion import Sine
-from masonrycli.scenario import Material, RunConfig, Scenario
+from masonrycli.scenario.motion import Sine
+from masonrycli.scenario.scenario import Material, RunConfig, Scenario
 
 AMP, FREQ, DT = 0.3, 2.0, 1e-3
 SHAKE = Sine(amplitude=AMP, frequency=FREQ, phase=math.pi / 2)  # v(0) = AMP along x
@@ -87,7 +87,7 @@ def test_block_depth_is_the_vertical_extent_over_the_median_block_height():
     # rect 0 … 0.2 m high, tri 0.2 … 0.5 (0.3 high): extent 0.5 m over the median height 0.25 m = 2
     assert _model().block_depth == pytest.approx(2.0)
     # a built running-bond wall: its courses, whatever its length
-    from masonrycli.scenario import scenario_from_builder
+    from masonrycli.scenario.scenario import scenario_from_builder
 
     for courses, length in ((5, 2.1), (5, 6.0), (12, 2.1)):
         options = {"blocks": None, "courses": courses, "length": length}

@@ -12,8 +12,8 @@ import numpy as np
 import pytest
 from typer.testing import CliRunner
 
-from masonrycli.cli import app
-from masonrycli.outputs import (
+from masonrycli.cli.app import app
+from masonrycli.outputs.files import (
     OutputFile,
     being_written,
     default_recording_path,
@@ -115,7 +115,7 @@ def test_default_names_of_the_same_second_differ(tmp_path):
 
 
 def test_two_runs_in_the_same_second_keep_both_recordings(tmp_path, monkeypatch):
-    import masonrycli.outputs as outputs
+    import masonrycli.outputs.files as outputs
 
     class Frozen:
         @staticmethod
@@ -191,7 +191,7 @@ def test_unwritable_history_is_found_before_any_computing(tmp_path, monkeypatch)
 
 def test_unwritable_folder_found_when_the_temporary_file_is_created(tmp_path, monkeypatch):
     """Permissions are checked by creating the temporary file (root passes os.access checks)."""
-    import masonrycli.outputs as outputs
+    import masonrycli.outputs.files as outputs
 
     def denied(*args, **kwargs):
         raise PermissionError(errno.EACCES, "Permission denied")
@@ -266,7 +266,7 @@ def test_outputs_that_would_not_fit_are_refused(tmp_path, monkeypatch):
     """Finding 6: a run whose outputs cannot fit on the disk is refused before it starts, with the estimate."""
     import shutil
 
-    import masonrycli.outputs as outputs
+    import masonrycli.outputs.files as outputs
 
     monkeypatch.setattr(outputs.shutil, "disk_usage", lambda p: shutil._ntuple_diskusage(10**9, 10**9 - 10**6, 10**6))
     result = invoke("simulate", "wall", "--duration", 20, "--record-every", 1, "--history", tmp_path / "h.npz")
@@ -278,7 +278,7 @@ def test_outputs_that_would_not_fit_are_refused(tmp_path, monkeypatch):
 def test_history_write_failure_stops_the_run(tmp_path, monkeypatch):
     """Finding 3 (history side): disk full on the history exited 1 and left h.npz.tmp.npz behind. Now: exit
     4, one line naming the file and the cause, never "completed", no temporary file, the recording kept."""
-    from masonrycli.history import HistoryFile
+    from masonrycli.outputs.history import HistoryFile
 
     original = HistoryFile.on_frame
 
@@ -301,7 +301,7 @@ def test_history_write_failure_stops_the_run(tmp_path, monkeypatch):
 def test_an_output_may_accept_several_suffixes(tmp_path):
     # build --out w.json was refused although `run` reads .json as GeoJSON
     from masonrycli.errors import InputError
-    from masonrycli.outputs import check_output
+    from masonrycli.outputs.files import check_output
 
     for name in ("w.geojson", "w.JSON"):
         assert check_output(tmp_path / name, "--out", (".geojson", ".json"), False).path == tmp_path / name
@@ -312,7 +312,7 @@ def test_an_output_may_accept_several_suffixes(tmp_path):
 def test_a_folder_given_as_the_output_says_so_first(tmp_path):
     # --out recordings/ said "the file name must end in .rrd", as if a name were wrong, not a folder given
     from masonrycli.errors import InputError
-    from masonrycli.outputs import check_output
+    from masonrycli.outputs.files import check_output
 
     with pytest.raises(InputError) as info:
         check_output(tmp_path, "--out", ".rrd", False)

@@ -15,7 +15,7 @@ import pytest
 import rerun as rr
 from typer.testing import CliRunner
 
-from masonrycli.cli import app
+from masonrycli.cli.app import app
 from masonrycli.recording import FIELDS
 from masonrycli.recording.layout import FIELD_BY_KEY, PAPER_FIELDS
 from masonrycli.recording.readback import blueprint_views, field_frames

@@ -11,10 +11,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from masonrycli.history import History
-from masonrycli.motion import Constant, Sine
+from masonrycli.outputs.history import History
 from masonrycli.run import simulate
-from masonrycli.scenario import Material, RunConfig, scenario_from_builder
+from masonrycli.scenario.motion import Constant, Sine
+from masonrycli.scenario.scenario import Material, RunConfig, scenario_from_builder
 
 pytestmark = pytest.mark.slow
 
@@ -72,7 +72,7 @@ def _face_ends(pa, pb, tol=1e-9):
 
 def test_arch_hinges_are_in_the_ring_or_at_its_springings(arch_settlement):
     """The ring (voussoir joints and the two springings) turns only at hinges, and the detector reports
-    exactly those. Reference, independent of masonrycli.mechanism: the two ends of each joint face taken
+    exactly those. Reference, independent of masonrycli.analysis.mechanism: the two ends of each joint face taken
     from the builder's polygons and carried with the block poses — a hinge has one end closed (|opening|
     < 0.05 mm) and the other open by more than 0.1 mm; the ring is rigid between the hinges."""
     h, _ = arch_settlement

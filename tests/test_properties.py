@@ -14,11 +14,11 @@ from typer.testing import CliRunner
 
 from geometry_library.blocks import GeometryError
 from geometry_library.checks import polygon_from_coords
-from masonrycli.cli import app
+from masonrycli.cli.app import app
 from masonrycli.errors import InputError
-from masonrycli.scenario_toml import loads_scenario
-from masonrycli.toml_lines import message_key
-from masonrycli.values import format_value, quote_key
+from masonrycli.scenario.toml_file import loads_scenario
+from masonrycli.scenario.toml_lines import message_key
+from masonrycli.scenario.values import format_value, quote_key
 
 SETTINGS = settings(max_examples=30, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
 
@@ -86,7 +86,7 @@ def test_random_toml_is_a_scenario_or_one_line(text):
         message = str(exc)
         where = re.match(r"r\.toml(?::([1-9][0-9]*))?: ", message)
         assert len(message.splitlines()) == 1 and where, message
-        if where.group(1):  # a key's line (masonrycli/toml_lines.py): the key the message names is on it
+        if where.group(1):  # a key's line (masonrycli/scenario/toml_lines.py): the key the message names is on it
             path, key = message_key(message[where.end() :])
             assert key in text.split("\n")[int(where.group(1)) - 1], (message, text)
 

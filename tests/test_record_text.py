@@ -9,9 +9,9 @@ import random
 import numpy as np
 import pytest
 
-import masonrycli.record_text as rt
+import masonrycli.records.text as rt
 from masonrycli.errors import InputError
-from masonrycli.records import load_at2, load_record_csv
+from masonrycli.records.read import load_at2, load_record_csv
 
 from synthetic_records import write_at2
 

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from masonrycli.errors import InputError
-from masonrycli.record_units import check_at2_header, check_csv_header, csv_header, header_factor, header_quantity
+from masonrycli.records.units import check_at2_header, check_csv_header, csv_header, header_factor, header_quantity
 from masonrycli.study.store import read_rows
 
 from cli_helpers import assert_one_line_error, invoke, words
@@ -145,7 +145,7 @@ def test_at2_header_units():
 
 
 def test_at2_samples_beyond_ten_g_are_not_g():
-    from masonrycli.record_units import MAX_AT2_G, check_at2_sample
+    from masonrycli.records.units import MAX_AT2_G, check_at2_sample
 
     check_at2_sample(-MAX_AT2_G, "a.AT2:5")
     with pytest.raises(InputError, match=r"^a.AT2:7: sample 294.2 g is beyond 10 g: the samples are not in g"):
@@ -168,8 +168,8 @@ def _g_csv(path, header="time (s),acc (g)"):
 def test_a_csv_in_g_shakes_the_same_through_run_a_scenario_and_a_set(tmp_path):
     # the header's g is converted on reading by run/simulate/check --record, a scenario's record table and a
     # sweep --records set alike; --record refused such a file at scale 1 ("a scale of 9.81 converts them")
-    from masonrycli.builtin import record_motion_option
-    from masonrycli.scenario_toml import loads_scenario
+    from masonrycli.scenario.builtin import record_motion_option
+    from masonrycli.scenario.toml_file import loads_scenario
     from masonrycli.study.plan import _record
 
     f = _g_csv(tmp_path / "q.csv")

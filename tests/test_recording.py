@@ -6,11 +6,11 @@ import numpy as np
 import pytest
 import rerun as rr
 
-from masonrycli import colormap as cm
 from masonrycli import recording as rec_mod
-from masonrycli.colour_range import MIN_SPAN, OUTSIDE_SHARE
-from masonrycli.joint_forces import joint_resultants
+from masonrycli.analysis.joint_forces import joint_resultants
 from masonrycli.recording import ENTITY_PATHS, FIELDS, Recorder, inspect_recording
+from masonrycli.recording import colormap as cm
+from masonrycli.recording.colour_range import MIN_SPAN, OUTSIDE_SHARE
 from masonrycli.recording.layout import FILL, INSET, PLOT_NAMES
 from masonrycli.recording.readback import blueprint_views, field_frames
 

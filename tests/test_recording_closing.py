@@ -10,9 +10,9 @@ import textwrap
 import numpy as np
 import pytest
 
-from masonrycli import colormap as cm
 from masonrycli import recording as rec_mod
 from masonrycli.recording import Recorder, inspect_recording
+from masonrycli.recording import colormap as cm
 from masonrycli.recording.layout import FILL
 from masonrycli.recording.readback import recording_rows
 

@@ -8,12 +8,12 @@ import numpy as np
 import pytest
 import test_recording
 
-from masonrycli import colormap as cm
 from masonrycli import recording as rec_mod
-from masonrycli.builtin import paper_loading
 from masonrycli.recording import Recorder, inspect_recording
+from masonrycli.recording import colormap as cm
 from masonrycli.recording.layout import FIELD_TABS, FILL, LIVE_TAB, MAGNIFIED_TAB, PLOT_NAMES, SQRT_TABS
 from masonrycli.recording.readback import blueprint_views, field_frames
+from masonrycli.scenario.builtin import paper_loading
 
 import recording_fixtures as fx
 from recording_fixtures import strict_rerun, temporal_rows  # noqa: F401 (strict_rerun: autouse)

@@ -6,10 +6,10 @@ import numpy as np
 import pytest
 import rerun as rr
 
-from masonrycli.colormap import VIRIDIS
 from masonrycli.limit import LiveLoad, analyse
 from masonrycli.limit.command import write_recording
 from masonrycli.recording import inspect_recording
+from masonrycli.recording.colormap import VIRIDIS
 from masonrycli.recording.limit import (
     FILL,
     HINGES,

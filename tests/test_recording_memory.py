@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 import masonrycli.recording.batching as batching
-from masonrycli.joint_forces import magnification
+from masonrycli.analysis.joint_forces import magnification
 from masonrycli.recording import Recorder
 from masonrycli.recording.readback import recording_rows
 

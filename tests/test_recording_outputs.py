@@ -12,7 +12,7 @@ import pytest
 from typer.testing import CliRunner
 
 import masonrycli.recording.batching as batching
-from masonrycli.cli import app
+from masonrycli.cli.app import app
 from masonrycli.recording.readback import check_complete, inspect_recording
 
 from cli_helpers import words

@@ -8,12 +8,12 @@ import math
 import numpy as np
 import pytest
 
-from masonrycli import colormap as cm
-from masonrycli.builtin import paper_loading
-from masonrycli.colour_range import ColourRange, positions, sqrt_scale
 from masonrycli.recording import Recorder
+from masonrycli.recording import colormap as cm
+from masonrycli.recording.colour_range import ColourRange, positions, sqrt_scale
 from masonrycli.recording.layout import FIELD_BY_KEY, FIELD_TABS, FILL, SQRT_FIELDS, SQRT_TABS, build_blueprint
 from masonrycli.recording.readback import blueprint_views, field_frames
+from masonrycli.scenario.builtin import paper_loading
 
 import recording_fixtures as fx
 from recording_fixtures import strict_rerun, temporal_rows  # noqa: F401 (strict_rerun: autouse)

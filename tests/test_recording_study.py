@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from masonrycli.records import G_STANDARD
+from masonrycli.records.read import G_STANDARD
 from masonrycli.study.store import read_rows
 
 from cli_helpers import words
@@ -289,7 +289,7 @@ def test_grid_sweep_state_map_and_histories(block, tmp_path):
         if ch.entity_path == "/study/state_map/key":
             batch = ch.to_record_batch()
             key |= {n: batch.column(n).to_pylist() for n in batch.schema.names if ":" in n}
-    from masonrycli.colormap import unpack_rgba
+    from masonrycli.recording.colormap import unpack_rgba
     from masonrycli.study.curves import STATE_COLOURS, rgb
 
     names = static_fields(chunks, "/study/state_map/key/names")

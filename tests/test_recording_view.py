@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from masonrycli.frame import CONTACT_STICK
+from masonrycli.outputs.frame import CONTACT_STICK
 from masonrycli.recording import Recorder
 from masonrycli.recording.layout import FIELDS, FORCES, LEGEND, PLANE, RESULTANT_CAP
 

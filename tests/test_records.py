@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from masonrycli.errors import InputError
-from masonrycli.records import load_at2, load_record_csv, record_motion
+from masonrycli.records.read import load_at2, load_record_csv, record_motion
 
 from synthetic_records import band_limited, write_at2
 
@@ -291,7 +291,7 @@ def test_one_column_files_with_a_vertical_component(tmp_path):
 
 
 def test_a_one_column_file_in_a_scenario_reads_and_writes_back(tmp_path):
-    from masonrycli.scenario_toml import dump_scenario, loads_scenario
+    from masonrycli.scenario.toml_file import dump_scenario, loads_scenario
 
     values = np.random.default_rng(6).normal(scale=0.1, size=300).tolist()
     one, two = one_and_two_columns(tmp_path, values, 0.01, "q")
@@ -355,7 +355,7 @@ def test_a_one_column_file_in_a_scenario_reads_and_writes_back(tmp_path):
     ],
 )
 def test_one_column_errors_in_a_scenario(tmp_path, motion, expected):
-    from masonrycli.scenario_toml import loads_scenario
+    from masonrycli.scenario.toml_file import loads_scenario
 
     write_at2(tmp_path / "h.AT2", [0.0, 0.1, 0.2], 0.01)
     (tmp_path / "one.csv").write_text("0.1\n0.2\n0.3\n")

@@ -10,7 +10,7 @@ import pytest
 from test_records import SCENARIO, one_line
 
 from masonrycli.errors import InputError, RecordWarning
-from masonrycli.records import G_STANDARD, load_at2, record_fields, record_motion
+from masonrycli.records.read import G_STANDARD, load_at2, record_fields, record_motion
 
 from synthetic_records import band_limited, closed_form, write_at2
 
@@ -126,7 +126,7 @@ def test_vertical_component_and_window(tmp_path):
 
 def test_a_scenario_record_file_under_the_home_folder(tmp_path, monkeypatch):
     # file = "~/records/q.AT2" was looked for as <scenario folder>/~/records/q.AT2, "no such file"
-    from masonrycli.scenario_toml import loads_scenario
+    from masonrycli.scenario.toml_file import loads_scenario
 
     monkeypatch.setenv("HOME", str(tmp_path / "home"))
     (tmp_path / "home" / "records").mkdir(parents=True)
@@ -137,7 +137,7 @@ def test_a_scenario_record_file_under_the_home_folder(tmp_path, monkeypatch):
 
 
 def test_scenario_record_with_at2_vertical_window_and_round_trip(tmp_path):
-    from masonrycli.scenario_toml import dump_scenario, loads_scenario
+    from masonrycli.scenario.toml_file import dump_scenario, loads_scenario
 
     write_at2(tmp_path / "h.AT2", [0.0, 0.1, 0.2, 0.3, 0.4, 0.5], 0.01)
     write_at2(tmp_path / "v.AT2", [0.0, -0.1, -0.2, -0.3, -0.4, -0.5], 0.01)
@@ -169,7 +169,7 @@ def test_scenario_record_with_at2_vertical_window_and_round_trip(tmp_path):
     ],
 )
 def test_scenario_record_errors(tmp_path, motion, expected):
-    from masonrycli.scenario_toml import loads_scenario
+    from masonrycli.scenario.toml_file import loads_scenario
 
     write_at2(tmp_path / "h.AT2", [0.0, 0.1, 0.2], 0.01)
     (tmp_path / "q.csv").write_text("0,0\n1,1\n")

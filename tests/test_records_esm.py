@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from masonrycli.errors import InputError, RecordWarning
-from masonrycli.records import load_esm, record_motion
+from masonrycli.records.read import load_esm, record_motion
 from masonrycli.study.store import read_rows
 
 from cli_helpers import assert_one_line_error, invoke, words

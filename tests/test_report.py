@@ -1,4 +1,4 @@
-"""The terminal tables (masonrycli/report.py): the summary names the solver that ran; inspect's rows."""
+"""The terminal tables (masonrycli/outputs/report.py): the summary names the solver that ran; inspect's rows."""
 
 import io
 import time
@@ -6,9 +6,9 @@ import time
 import pytest
 from rich.console import Console
 
-from masonrycli.report import SLOW_START, SOLVER_NOTES, recording_table, slow_start_notice, summary_table
+from masonrycli.outputs.report import SLOW_START, SOLVER_NOTES, recording_table, slow_start_notice, summary_table
 from masonrycli.run import simulate
-from masonrycli.scenario import SOLVERS
+from masonrycli.scenario.scenario import SOLVERS
 from tests.engine_helpers import scenario
 
 

@@ -12,9 +12,9 @@ import numpy as np
 import pytest
 from test_collapse import block_scenario
 
-from masonrycli.motion import Sine
 from masonrycli.run import SolverTally, simulate
-from masonrycli.scenario import Material, RunConfig, scenario_from_builder
+from masonrycli.scenario.motion import Sine
+from masonrycli.scenario.scenario import Material, RunConfig, scenario_from_builder
 
 from cli_helpers import invoke
 from engine_helpers import PerStep
@@ -78,7 +78,7 @@ def test_a_block_displaced_without_drift_or_opening_says_why_it_is_damaged():
     # "damaged (residual drift 0 % of the height, 0 hinges, largest opening 0 mm)": damaged by the block's
     # displacement (> 5 mm, docs/collapse.md), which the line did not show.
     from masonrycli.run import describe_outcome
-    from masonrycli.scenario_toml import loads_scenario
+    from masonrycli.scenario.toml_file import loads_scenario
 
     sc = loads_scenario(
         """

@@ -11,13 +11,13 @@ from scenario_helpers import BLOCK, DATA, GROUND, write
 
 from geometry_library.blocks import Assembly, Block, Support
 from masonrycli.errors import InputError
-from masonrycli.motion import Constant, Fixed, Sine
-from masonrycli.scenario import (
+from masonrycli.scenario.motion import Constant, Fixed, Sine
+from masonrycli.scenario.scenario import (
     Material,
     RunConfig,
     scenario_summary,
 )
-from masonrycli.scenario_toml import load_scenario, loads_scenario
+from masonrycli.scenario.toml_file import load_scenario, loads_scenario
 
 # ------------------------------------------------------------------------------------------- loading
 
@@ -118,7 +118,7 @@ def test_a_hand_made_block_is_simulated_as_validate_assembly_checked_it():
 
     from geometry_library import validate_assembly
     from masonrycli.run import Simulation
-    from masonrycli.scenario import Scenario
+    from masonrycli.scenario.scenario import Scenario
 
     def scenario(dent):
         block = Block(Polygon([(0, 0), (0.15, dent), (0.3, 0), (0.3, 0.2), (0, 0.2)]), "dented")
@@ -138,7 +138,7 @@ def test_a_hand_made_block_is_simulated_as_validate_assembly_checked_it():
 
 
 def test_check_sampling_refuses_a_sine_above_half_the_step_rate():
-    from masonrycli.scenario import check_sampling
+    from masonrycli.scenario.scenario import check_sampling
 
     scenario = load_scenario(DATA / "block_on_ground.toml")  # 2 Hz, dt = 1e-3 s
     check_sampling(scenario)
@@ -161,9 +161,9 @@ def test_check_sampling_refuses_a_support_faster_than_a_diverged_block():
     # --amp 1e30 ran (exit 0, "collapsed at t = 0.001 s"), --settlement 1e9 too, and a CSV record of
     # 1e300 m/s printed numpy's overflow warnings: a support that fast is a typo, refused like the others
     from masonrycli import run as run_module
-    from masonrycli.motion import Ramp
-    from masonrycli.record_motion import Record
-    from masonrycli.scenario import MAX_SUPPORT_SPEED, check_sampling
+    from masonrycli.records.motion import Record
+    from masonrycli.scenario.motion import Ramp
+    from masonrycli.scenario.scenario import MAX_SUPPORT_SPEED, check_sampling
 
     scenario = load_scenario(DATA / "block_on_ground.toml")  # 1 m/s sine, 1 s
     assert MAX_SUPPORT_SPEED == run_module.DIVERGENCE_SPEED  # what the run itself calls diverged
@@ -195,7 +195,7 @@ def test_an_initial_velocity_faster_than_a_diverged_block_is_refused(tmp_path):
     # velocity = [1e9, 0, 0] ran and ended as exit 3, "diverged at step 1": refused like a support that fast,
     # by the speed of the block's fastest point |v| + |ω|·r (r: farthest vertex from the centroid)
     from masonrycli import run as run_module
-    from masonrycli.scenario import MAX_BLOCK_SPEED, scenario_from_geometry_file
+    from masonrycli.scenario.scenario import MAX_BLOCK_SPEED, scenario_from_geometry_file
 
     assert MAX_BLOCK_SPEED == run_module.DIVERGENCE_SPEED
     r = math.hypot(0.2, 0.1)  # the 0.4 m × 0.2 m block: centroid (0.2, 0.1), a corner at r from it

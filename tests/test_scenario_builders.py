@@ -12,14 +12,14 @@ from scenario_helpers import BLOCK, DATA, GROUND, assert_same_scenario, load_err
 import geometry_library.builders as builders_pkg
 from geometry_library.blocks import Assembly, Block, GeometryError, Support
 from masonrycli.errors import InputError
-from masonrycli.motion import Constant, Fixed, Sine
-from masonrycli.scenario import (
+from masonrycli.scenario.motion import Constant, Fixed, Sine
+from masonrycli.scenario.scenario import (
     Material,
     RunConfig,
     scenario_from_builder,
     scenario_summary,
 )
-from masonrycli.scenario_toml import dump_scenario, load_scenario, loads_scenario
+from masonrycli.scenario.toml_file import dump_scenario, load_scenario, loads_scenario
 
 # ----------------------------------------------------------------------------------------- builders
 

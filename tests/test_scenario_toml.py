@@ -11,14 +11,14 @@ from scenario_helpers import BLOCK, DATA, GROUND, XY_CSV, assert_same_scenario, 
 
 from geometry_library.blocks import Assembly, Support
 from masonrycli.errors import InputError
-from masonrycli.motion import Fixed
-from masonrycli.records import record_motion
-from masonrycli.scenario import (
+from masonrycli.records.read import record_motion
+from masonrycli.scenario.motion import Fixed
+from masonrycli.scenario.scenario import (
     Material,
     RunConfig,
     Scenario,
 )
-from masonrycli.scenario_toml import dump_scenario, load_scenario, loads_scenario
+from masonrycli.scenario.toml_file import dump_scenario, load_scenario, loads_scenario
 
 # ----------------------------------------------------------------------------------------- round trip
 

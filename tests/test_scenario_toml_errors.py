@@ -7,10 +7,10 @@ from scenario_helpers import BLOCK, BLOCK2, DATA, GROUND, XY_CSV, load_error, wr
 
 from geometry_library.blocks import GeometryError
 from masonrycli.errors import InputError
-from masonrycli.scenario import (
+from masonrycli.scenario.scenario import (
     scenario_summary,
 )
-from masonrycli.scenario_toml import load_scenario
+from masonrycli.scenario.toml_file import load_scenario
 
 # ------------------------------------------------------------------------------------------- errors
 
@@ -393,7 +393,7 @@ def test_an_aliased_sine_names_the_line_of_its_frequency(tmp_path, text, extra):
     frequency key, as the file's other errors do (it gave the file alone)."""
     from typer.testing import CliRunner
 
-    from masonrycli.cli import app
+    from masonrycli.cli.app import app
 
     path = write(tmp_path, text, "s.toml")
     line = next(i for i, ln in enumerate(text.split("\n"), start=1) if "frequency = 2.0" in ln)
@@ -425,7 +425,7 @@ def test_a_support_too_fast_names_the_line_of_its_speed(tmp_path, text, value):
     (it gave the file alone)."""
     from typer.testing import CliRunner
 
-    from masonrycli.cli import app
+    from masonrycli.cli.app import app
 
     path = write(tmp_path, text, "s.toml")
     line = next(i for i, ln in enumerate(text.split("\n"), start=1) if value in ln and "name" not in ln)
@@ -452,7 +452,7 @@ def test_a_record_too_fast_names_the_line_of_its_file(tmp_path, text, value):
     its inline ``value``), as the sine's amplitude gives its own (it gave the file alone: ``s.toml: …``)."""
     from typer.testing import CliRunner
 
-    from masonrycli.cli import app
+    from masonrycli.cli.app import app
 
     (tmp_path / "recs").mkdir()
     (tmp_path / "recs" / "fast.csv").write_text(FAST_RECORD)
@@ -470,7 +470,7 @@ def test_a_record_too_fast_from_a_sweep_record_set_names_no_line(tmp_path):
     ``file`` line would point at a record that is not the one run."""
     from typer.testing import CliRunner
 
-    from masonrycli.cli import app
+    from masonrycli.cli.app import app
 
     (tmp_path / "recs").mkdir()
     (tmp_path / "recs" / "fast.csv").write_text(FAST_RECORD)
@@ -488,7 +488,7 @@ def test_a_support_too_fast_by_a_sweep_value_names_no_line(tmp_path):
     mislead, so the message gives the file alone."""
     from typer.testing import CliRunner
 
-    from masonrycli.cli import app
+    from masonrycli.cli.app import app
 
     path = write(tmp_path, f"[run]\nduration = 1.0\n\n{BLOCK}\n{GROUND}{SINE}", "s.toml")
     result = CliRunner().invoke(app, ["sweep", str(path), "-p", "amp=1e30", "-o", str(tmp_path / "x.parquet")])

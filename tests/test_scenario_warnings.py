@@ -1,4 +1,4 @@
-"""What a valid scenario may still have wrong (masonrycli.scenario_warnings): records the run does not follow
+"""What a valid scenario may still have wrong (masonrycli.scenario.caveats): records the run does not follow
 whole, a gravity pointing up or in other units, densities in t/m³; and that every command prints them."""
 
 from __future__ import annotations
@@ -8,8 +8,8 @@ import dataclasses
 import pytest
 from scenario_helpers import BLOCK, DATA, GROUND
 
-from masonrycli.scenario_toml import load_scenario, loads_scenario
-from masonrycli.scenario_warnings import record_warnings, scenario_warnings, setting_warnings
+from masonrycli.scenario.caveats import record_warnings, scenario_warnings, setting_warnings
+from masonrycli.scenario.toml_file import load_scenario, loads_scenario
 
 from cli_helpers import invoke, words
 
@@ -64,7 +64,7 @@ def test_record_warnings_name_a_record_beyond_10_g_as_scaled(tmp_path):
     ]
     gentle = dataclasses.replace(scenario, motions=(dataclasses.replace(scenario.motions[-1], scale=1.0),))
     assert not any("peaks" in w for w in record_warnings(gentle))  # 5.1 g: strong, not absurd
-    from masonrycli.record_motion import Record
+    from masonrycli.records.motion import Record
 
     accel = Record(
         time=(0.0, 0.1, 0.2), value=((0.0, 0.0), (3.0, 4.0), (-1.0, 0.0)), quantity="acceleration", scale=2.0
@@ -157,7 +157,7 @@ def test_a_drawing_in_millimetres_is_warned_about(tmp_path):
         "coordinates, or --block-length / --block-height, by 1000)"
     ]
     assert setting_warnings(_scenario(tmp_path)) == []  # 0.4 × 0.2 m
-    from masonrycli.builtin import builtin
+    from masonrycli.scenario.builtin import builtin
 
     assert any("300 × 200 m" in w for w in setting_warnings(builtin("wall", block_length=300.0, block_height=200.0)))
 
@@ -184,7 +184,7 @@ def test_a_driven_support_without_a_motion_is_warned_about(tmp_path):
     # support_role = "driven" in a GeoJSON run as it is: the support stayed fixed, "loading: none", no word
     import json
 
-    from masonrycli.scenario import scenario_from_geometry_file
+    from masonrycli.scenario.scenario import scenario_from_geometry_file
 
     ring = [[-2, -0.5], [2, -0.5], [2, 0], [-2, 0], [-2, -0.5]]
     block = {

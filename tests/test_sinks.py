@@ -1,4 +1,4 @@
-"""masonrycli.sinks: the status words, and the one sink contract that the history and the recorder meet."""
+"""masonrycli.outputs.sinks: the status words, and the one sink contract that the history and the recorder meet."""
 
 from __future__ import annotations
 
@@ -7,8 +7,8 @@ from pathlib import Path
 
 import numpy as np
 
-from masonrycli.history import History, HistoryFile
-from masonrycli.sinks import COMPLETED, DIVERGED, FAILED, INTERRUPTED, RUNNING, STATUSES, FrameSink
+from masonrycli.outputs.history import History, HistoryFile
+from masonrycli.outputs.sinks import COMPLETED, DIVERGED, FAILED, INTERRUPTED, RUNNING, STATUSES, FrameSink
 
 README = Path(__file__).parent.parent / "README.md"
 
@@ -55,7 +55,7 @@ def test_a_frames_arrays_are_its_own():
     """FrameSink: sinks keep a frame's arrays without copying, so no two frames share memory (the engine
     reuses its buffers) and a frame is unchanged by the steps after it."""
     from masonrycli.run import Simulation
-    from masonrycli.scenario import Material, RunConfig, scenario_from_builder
+    from masonrycli.scenario.scenario import Material, RunConfig, scenario_from_builder
 
     sim = Simulation(scenario_from_builder("wall", {"blocks": 51}, RunConfig(duration=0.02), Material(), {}))
     for _ in range(3):

@@ -7,9 +7,9 @@ import numpy as np
 import pytest
 from typer.testing import CliRunner
 
-from masonrycli.cli import app
-from masonrycli.colormap import BLUES, COOLWARM, unpack_rgba
+from masonrycli.cli.app import app
 from masonrycli.recording import inspect_recording, screenshot_recording
+from masonrycli.recording.colormap import BLUES, COOLWARM, unpack_rgba
 
 pytestmark = pytest.mark.slow
 

@@ -14,7 +14,7 @@ from benchmarks.solver_lab.outcome import Context
 from benchmarks.solver_lab.problems import REF_RESIDUAL, Problem
 from masonrycli.engine import nlgs as N
 from masonrycli.run import Simulation
-from masonrycli.scenario import Material, RunConfig, scenario_from_builder
+from masonrycli.scenario.scenario import Material, RunConfig, scenario_from_builder
 
 
 def _captured(tmp_path):
@@ -154,7 +154,7 @@ def test_accelerated_method_takes_the_engine_default_and_stops_on_the_law(tmp_pa
     # nlgs-accel is the engine's default solve: at the count it found, the lab's law residual is at the
     # target and the impulses are those of nlgs.solve with the engine's default solver from r_warm
     from benchmarks.solver_lab.methods import accelerated
-    from masonrycli.scenario import RunConfig
+    from masonrycli.scenario.scenario import RunConfig
 
     p = _captured(tmp_path)
     ctx = Context(p)

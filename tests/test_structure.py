@@ -1,4 +1,4 @@
-"""masonrycli.structure: builder options checked against the spec and the material's defaults, geometry
+"""masonrycli.scenario.structure: builder options checked against the spec and the material's defaults, geometry
 files read with the material's defaults, validation warnings on one line and errors at their place.
 (The TOML spellings of the option errors are in test_scenario_builders.py; these are the module's own rules.)"""
 
@@ -14,7 +14,7 @@ import geometry_library.builders as builders_pkg
 from geometry_library.blocks import Assembly, Block, GeometryError, Support
 from geometry_library.mass import mass_properties
 from masonrycli.errors import InputContext, InputError
-from masonrycli.structure import build_structure, check_finite_tree, read_geometry, structure_warnings
+from masonrycli.scenario.structure import build_structure, check_finite_tree, read_geometry, structure_warnings
 
 CTX = InputContext("s.toml", ".")
 
@@ -188,7 +188,7 @@ def test_validation_warnings_are_lines_and_its_errors_are_placed():
 def test_a_builder_check_names_the_command_line_options_it_is_about(options, given, message):
     import pickle
 
-    from masonrycli.structure import BuilderError, as_options
+    from masonrycli.scenario.structure import BuilderError, as_options
 
     with pytest.raises(BuilderError) as info:
         build_structure("arch", options, 2500.0, 1.0)

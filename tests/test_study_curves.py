@@ -15,7 +15,7 @@ import pytest
 import rerun as rr
 from matplotlib.colors import to_rgb
 
-from masonrycli.colormap import unpack_rgba
+from masonrycli.recording.colormap import unpack_rgba
 from masonrycli.recording.study import record_study
 from masonrycli.study import plots
 from masonrycli.study.curves import NOT_FOUND_COLOUR, STATE_COLOURS, rgb, threshold_series

@@ -10,10 +10,10 @@ import pytest
 from scipy.stats import norm
 
 from masonrycli.errors import InputError
-from masonrycli.motion import Constant, Sine
-from masonrycli.outputs import OutputFile
-from masonrycli.records import record_motion
-from masonrycli.scenario import Material, RunConfig, scenario_from_builder
+from masonrycli.outputs.files import OutputFile
+from masonrycli.records.read import record_motion
+from masonrycli.scenario.motion import Constant, Sine
+from masonrycli.scenario.scenario import Material, RunConfig, scenario_from_builder
 from masonrycli.study import store
 from masonrycli.study.axes import Axis, StudyBase, apply_point, check_axes, grid, parse_axis
 from masonrycli.study.curves import fit_label
@@ -338,7 +338,7 @@ def test_closing_the_cluster_silences_its_teardown_logs(capfd):
 def test_a_run_whose_output_failed_is_an_error_row_with_its_message(arch_base, tmp_path, monkeypatch):
     """simulate returns status "failed" (no exception) when a history write fails mid-run: the row said
     status "failed" with an empty error column, was not counted as failed and not run again on resume."""
-    from masonrycli.history import HistoryFile
+    from masonrycli.outputs.history import HistoryFile
 
     def disk_full(self, frame):
         raise OSError(28, "No space left on device")
@@ -392,7 +392,7 @@ def test_a_history_of_the_same_study_is_replaced_another_is_kept(arch_base, tmp_
 
 def test_the_fragility_line_counts_the_runs_at_zero_intensity_it_leaves_out():
     # '--scale 0:6:3' printed "(1 of 4 runs collapsed)" under a table of 6 rows: the 2 at pga 0 left out unsaid
-    from masonrycli.cli_sweep import _at_zero
+    from masonrycli.cli.sweep import _at_zero
 
     rows = [{"pga": 0.0}, {"pga": 0.0}, {"pga": 21.9}, {"pga": math.nan}]
     assert _at_zero(rows, "pga") == "; 3 runs at pga = 0 left out"

@@ -10,7 +10,7 @@ from pathlib import Path
 import pytest
 
 from masonrycli.errors import InputError
-from masonrycli.records import G_STANDARD
+from masonrycli.records.read import G_STANDARD
 from masonrycli.study.plan import plan_study
 
 from synthetic_records import band_limited, write_at2

@@ -18,9 +18,9 @@ import pyarrow.parquet as pq
 import pytest
 from rich.console import Console
 
-from masonrycli.motion import Sine
 from masonrycli.run import simulate
-from masonrycli.scenario import Material, RunConfig, scenario_from_builder
+from masonrycli.scenario.motion import Sine
+from masonrycli.scenario.scenario import Material, RunConfig, scenario_from_builder
 from masonrycli.study.axes import StudyBase, apply_point, parse_axis
 from masonrycli.study.study import StudyRequest, run_study
 from masonrycli.study.task import RESULT_COLUMNS

@@ -16,7 +16,7 @@ import pyarrow.parquet as pq
 import pytest
 from typer.testing import CliRunner
 
-from masonrycli.cli import app
+from masonrycli.cli.app import app
 
 from cli_helpers import words
 

@@ -34,7 +34,7 @@ def test_ctrl_c_while_the_scheduler_is_reached_says_nothing_was_written(block, t
 
 
 def test_ctrl_c_leaves_no_partial_file_and_the_same_command_resumes(block, tmp_path, monkeypatch):
-    from masonrycli.history import HistoryFile
+    from masonrycli.outputs.history import HistoryFile
 
     out, h = tmp_path / "s.parquet", tmp_path / "h"
     args = ["-p", "amp=0.05,0.1,0.2", "--duration", 0.02, "--workers", 0, "-o", out, "--histories", h]
@@ -200,7 +200,7 @@ def test_a_signal_just_after_the_plot_is_renamed_does_not_call_it_missing(block,
     import signal
     import time
 
-    from masonrycli.outputs import OutputFile
+    from masonrycli.outputs.files import OutputFile
 
     out = tmp_path / "s.csv"
     commit = OutputFile.commit
@@ -230,7 +230,7 @@ def test_a_signal_held_while_the_plot_s_rename_fails_reports_the_error(block, tm
     import signal
     import time
 
-    from masonrycli.outputs import OutputFile
+    from masonrycli.outputs.files import OutputFile
 
     out = tmp_path / "s.csv"
     commit = OutputFile.commit

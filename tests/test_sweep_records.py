@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 from typer.testing import CliRunner
 
-from masonrycli.cli import app
+from masonrycli.cli.app import app
 from masonrycli.study.store import read_rows
 from masonrycli.study.task import RESULT_COLUMNS
 

@@ -1,4 +1,4 @@
-"""masonrycli.tensors: DESIGN §6 cases 3–5 with exact references and the TensorComputer."""
+"""masonrycli.analysis.tensors: DESIGN §6 cases 3–5 with exact references and the TensorComputer."""
 
 from __future__ import annotations
 
@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 from tensor_helpers import deformed, star, star_is_closed, state_arrays, triangulated_wall
 
-from masonrycli import tensors as T
+from masonrycli.analysis import tensors as T
 
 RHO, G = 2000.0, 9.81
 

@@ -8,9 +8,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from masonrycli.history import History
+from masonrycli.outputs.history import History
 from masonrycli.run import simulate
-from masonrycli.scenario import Material, RunConfig, scenario_from_builder
+from masonrycli.scenario.scenario import Material, RunConfig, scenario_from_builder
 
 from engine_helpers import run_history, scenario
 
@@ -93,8 +93,8 @@ def test_cells_cover_piers_spandrels_and_end_voussoirs(builder):
 def test_affine_velocity_is_exact_on_cells_with_non_touching_triangles(builder):
     """v = L x + c gives sym(L) in every cell, the cells whose fan joins two blocks that do not touch
     included (there are some: the springing voussoirs' and the pier blocks' beside them)."""
+    from masonrycli.analysis.tensors import cell_strain_rate
     from masonrycli.run import Simulation
-    from masonrycli.tensors import cell_strain_rate
 
     sc = scenario_from_builder(builder, {}, RunConfig(duration=0.01), Material(), {})
     sim = Simulation(sc)

@@ -1,4 +1,4 @@
-"""masonrycli.tensors triangulation: cell fans over the contact neighbours, chain neighbours, isolated blocks."""
+"""masonrycli.analysis.tensors triangulation: cell fans over the contact neighbours, chain neighbours, isolated blocks."""
 
 from __future__ import annotations
 
@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 from tensor_helpers import running_bond, star, star_is_closed, state_arrays, triangulated_wall
 
-from masonrycli import tensors as T
+from masonrycli.analysis import tensors as T
 
 
 @pytest.fixture(scope="module")

@@ -1,4 +1,4 @@
-"""The line of a scenario error (masonrycli/toml_lines.py): ``s.toml:4: [run] duration = "1 s": …`` where the
+"""The line of a scenario error (masonrycli/scenario/toml_lines.py): ``s.toml:4: [run] duration = "1 s": …`` where the
 key is found unambiguously — proved by tomllib on a renamed copy — and no line at all otherwise. Dotted keys,
 inline tables, arrays of tables, look-alikes in strings and comments never give a wrong line."""
 
@@ -10,8 +10,8 @@ import time
 import pytest
 
 from masonrycli.errors import InputError
-from masonrycli.scenario_toml import load_scenario
-from masonrycli.toml_lines import key_line, message_key
+from masonrycli.scenario.toml_file import load_scenario
+from masonrycli.scenario.toml_lines import key_line, message_key
 
 SQUARE = "[[0.0, 0.0], [0.4, 0.0], [0.4, 0.2], [0.0, 0.2]]"
 GROUND = "[[-5.0, -0.5], [5.0, -0.5], [5.0, 0.0], [-5.0, 0.0]]"
@@ -197,7 +197,7 @@ def test_file_key_line_only_where_the_file_gives_the_value(tmp_path):
     """The line of a value checked after the command line applied its own (``--dt``, ``--param freq=``):
     the key's line where the file gives the value the run has, None elsewhere (the file's other value's
     line would mislead); an [[support]] entry found by its name."""
-    from masonrycli.toml_lines import file_key_line
+    from masonrycli.scenario.toml_lines import file_key_line
 
     text = (
         '[run]\ndt = 1e-3\n\n[[support]]\nname = "left"\nmotion = { kind = "sine", frequency = 3.0 }\n'

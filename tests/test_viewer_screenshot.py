@@ -10,11 +10,11 @@ import ctypes.util
 import numpy as np
 import pytest
 
-from masonrycli.builtin import paper_loading
-from masonrycli.colormap import BLUES, unpack_rgba
 from masonrycli.recording import Recorder, screenshot_recording
+from masonrycli.recording.colormap import BLUES, unpack_rgba
 from masonrycli.recording.layout import SUPPORT_FILL_RGBA
 from masonrycli.recording.readback import _viewer_executable
+from masonrycli.scenario.builtin import paper_loading
 
 import recording_fixtures as fx
 
@@ -198,7 +198,7 @@ def test_a_fragility_legend_of_five_groups_shows_the_runs_entries(tmp_path):
     # green and orange right of the runs themselves (intact at pga 3-4 m/s², damaged up to 43 of a 74 m/s² axis)
     import PIL.Image as image_module
 
-    from masonrycli.records import G_STANDARD
+    from masonrycli.records.read import G_STANDARD
     from masonrycli.study.curves import STATE_COLOURS, rgb
 
     from sweep_helpers import invoke, write_block

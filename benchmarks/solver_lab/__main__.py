@@ -15,7 +15,7 @@ os.environ.setdefault("RERUN_ANALYTICS", "0")
 def main() -> None:
     from benchmarks.solver_lab import ensemble, handover, hard_methods, hard_steps, tall_steps
     from benchmarks.solver_lab.capture import CASES
-    from masonrycli.scenario import SOLVERS
+    from masonrycli.scenario.scenario import SOLVERS
 
     ap = argparse.ArgumentParser(prog="python -m benchmarks.solver_lab", description=__doc__)
     sub = ap.add_subparsers(dest="command", required=True)

@@ -20,9 +20,9 @@ import numpy as np
 from benchmarks.solver_lab import law
 from benchmarks.solver_lab.problems import DATA, REF_CAP, REF_RESIDUAL, Problem
 from masonrycli.engine import nlgs
-from masonrycli.motion import Constant, Sine
 from masonrycli.run import Simulation
-from masonrycli.scenario import Material, RunConfig, scenario_from_builder
+from masonrycli.scenario.motion import Constant, Sine
+from masonrycli.scenario.scenario import Material, RunConfig, scenario_from_builder
 
 SINE = Sine(direction=(1.0, 0.0), amplitude=1.0, frequency=2.0)
 SETTLE = Constant(velocity=(0.0, -0.01))

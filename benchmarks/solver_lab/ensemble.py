@@ -91,9 +91,9 @@ def engine_commit() -> dict:
 def run_one(case: str, motion: tuple[float, float, float], duration: float, jitter: float = 0.0, copy: int = 0) -> dict:
     """One unrecorded run of ``case`` shaken by ``motion``, amplitude × (1 + jitter + copy · COPY_STEP)."""
     from benchmarks.solver_cases import CASES
-    from masonrycli.motion import Sine
     from masonrycli.run import Simulation
-    from masonrycli.scenario import Material, RunConfig, scenario_from_builder
+    from masonrycli.scenario.motion import Sine
+    from masonrycli.scenario.scenario import Material, RunConfig, scenario_from_builder
 
     builder, options, _, motions = CASES[case]
     if list(motions) != ["ground"]:

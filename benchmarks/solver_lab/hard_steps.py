@@ -130,9 +130,9 @@ def _capture_cases(cases, copy, min_units, motions, duration, directory, overrid
 def _capture_run(case, motion, copy, min_units, duration, directory, solver) -> tuple[dict, list[int]]:
     from benchmarks.solver_cases import CASES
     from benchmarks.solver_lab.ensemble import COPY_STEP
-    from masonrycli.motion import Sine
     from masonrycli.run import Simulation
-    from masonrycli.scenario import Material, RunConfig, scenario_from_builder
+    from masonrycli.scenario.motion import Sine
+    from masonrycli.scenario.scenario import Material, RunConfig, scenario_from_builder
 
     builder, options, _, _ = CASES[case]
     amplitude, frequency, phase = motion

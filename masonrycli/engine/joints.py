@@ -1,5 +1,5 @@
-"""Kernels of the joint states (:mod:`masonrycli.mechanism`): openings, hinge flags, per-block fields; and
-the sums behind the recording's joint resultants (:mod:`masonrycli.joint_forces`).
+"""Kernels of the joint states (:mod:`masonrycli.analysis.mechanism`): openings, hinge flags, per-block fields; and
+the sums behind the recording's joint resultants (:mod:`masonrycli.analysis.joint_forces`).
 
 They are computed for every recorded frame. In numpy each was a dozen small array operations (fancy
 indexing, ``ufunc.at``, ``bincount``), ~200 µs a frame on the 51-block wall; one pass here does the
@@ -7,7 +7,7 @@ same arithmetic in the same order, so the results are the same bits: ``(0 + p₀
 ``einsum`` sums a two-term dot product, bins start at 0 and add their weights in contact order as
 ``bincount`` does, and maxima propagate NaN as ``np.maximum``.
 
-Conventions as in :mod:`masonrycli.mechanism`: a joint *end* is an initial contact point followed with
+Conventions as in :mod:`masonrycli.analysis.mechanism`: a joint *end* is an initial contact point followed with
 its two bodies; ``end_joint[e]`` is the joint of end e (−1 for a single corner contact); joint keys are
 ``a·B + b`` (B bodies), sorted.
 """

@@ -1,6 +1,6 @@
 """Kernels for the cell stress and strain tensors of Chetouane et al. (2003), eqs. 1–12.
 
-Private kernels only; the documented launchers are in ``masonrycli.tensors``. Index and sign conventions
+Private kernels only; the documented launchers are in ``masonrycli.analysis.tensors``. Index and sign conventions
 follow ``docs/architecture.md``: blocks 0..N-1 then supports N..; ``contact_force`` is the force on
 body b of ``contact_body[c] = (a, b)`` in world coordinates, body a gets the opposite. A tensor
 ``t[i, j]`` is stored row-major, ``(GI ⊗ F)_ij = GI_i F_j`` and ``L_ij = ∂v_i/∂x_j``.
@@ -22,7 +22,7 @@ ISOTROPY_TOLERANCE = 1e-14
 (c = (a+d)/2) is treated as isotropic: its principal angle is reported as 0 instead of a direction
 that would only reflect round-off (and flicker from one step to the next)."""
 
-# Rows of the packed outputs of ``_strain_step`` / ``_stress_step`` (see ``masonrycli.tensors.TensorComputer``).
+# Rows of the packed outputs of ``_strain_step`` / ``_stress_step`` (see ``masonrycli.analysis.tensors.TensorComputer``).
 T_BLOCK_STRESS, T_CELL_STRESS, T_CELL_STRAIN_RATE, T_CELL_STRAIN = 0, 1, 2, 3
 TENSOR_ROWS = 4
 P_STRESS, P_STRAIN_RATE, P_STRAIN = 0, 1, 2

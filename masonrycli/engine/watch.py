@@ -1,4 +1,4 @@
-"""Per-step collapse indicators in one pass over blocks and contacts (read by :mod:`masonrycli.collapse`).
+"""Per-step collapse indicators in one pass over blocks and contacts (read by :mod:`masonrycli.analysis.collapse`).
 
 After each step the collapse monitor needs a handful of maxima: the fastest turning block, the
 fastest sliding closed contact, the deepest fall and the largest turn relative to each block's own

@@ -23,7 +23,7 @@ from masonrycli.errors import EXIT_OUTPUT_FAILED, InputError
 from masonrycli.interrupt import StopRun, StopSignals, exit_code, signal_name
 from masonrycli.limit.analysis import LimitResult, analyse
 from masonrycli.limit.problem import DIRECTIONS, LimitError, LiveLoad
-from masonrycli.outputs import check_output, written_whole
+from masonrycli.outputs.files import check_output, written_whole
 from masonrycli.source_digest import source_commit
 
 SHOWN = 8
@@ -34,9 +34,9 @@ THRUST_SHOWN = 0.02
 
 def resolve_structure(structure: str, friction: float | None):
     """A scenario from a built-in name (the builder's defaults, no motion), a scenario file or a geometry
-    file (:func:`~masonrycli.builtin.target_scenario`); ``friction`` overrides μ."""
-    from masonrycli.builtin import override_run, target_scenario
-    from masonrycli.scenario import Material, RunConfig, scenario_from_builder
+    file (:func:`~masonrycli.scenario.builtin.target_scenario`); ``friction`` overrides μ."""
+    from masonrycli.scenario.builtin import override_run, target_scenario
+    from masonrycli.scenario.scenario import Material, RunConfig, scenario_from_builder
 
     scenario = target_scenario(structure, lambda name: scenario_from_builder(name, {}, RunConfig(), Material(), {}))
     return override_run(scenario, friction=friction)
@@ -272,7 +272,7 @@ class _Done:
 def _analyse(structure, live, friction, verify, out, force, done: _Done, signals, *, console, err_console):
     """The work of :func:`run_limit`, filling ``done`` as it goes; returns the --verify checks. ``console``:
     where the result table goes before --verify runs (None with --json)."""
-    from masonrycli.scenario_warnings import setting_warnings
+    from masonrycli.scenario.caveats import setting_warnings
 
     target = None if out is None else check_output(out, "--out", ".rrd", force)
     scenario = resolve_structure(structure, friction)
@@ -293,7 +293,7 @@ def _analyse(structure, live, friction, verify, out, force, done: _Done, signals
                 with written_whole(target) as part:  # under a temporary name, renamed when complete
                     write_recording(done.result, part)
             except OSError as exc:  # a full disk: as simulate's outputs, exit 4 (it said "completed", exit 0)
-                from masonrycli.cli_messages import fail
+                from masonrycli.cli.messages import fail
 
                 fail(f"cannot write {target.option} {target.path}: {exc.strerror or exc}", EXIT_OUTPUT_FAILED)
             done.out = target.path

@@ -2,7 +2,7 @@
 
 The contact points come from :func:`masonrycli.engine.collision.detect_contacts` — the very detection the
 time loop runs — in the initial configuration, within the model's alert distance but at most
-:data:`~masonrycli.mechanism.JOINT_GAP` (1 mm, the default alert distance). So every assembly the engine
+:data:`~masonrycli.analysis.mechanism.JOINT_GAP` (1 mm, the default alert distance). So every assembly the engine
 can run can also be analysed, and a joint here is a joint there. The cap: with ``[run] alert_distance =
 0.5`` the 51-block wall had "joints" between blocks 0.2 m apart (and with 1e9 between its two ends),
 which carried the LP's forces across the gaps: λ 0.544 / 0.569 instead of 0.464, with hinges such as
@@ -20,8 +20,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from masonrycli.analysis.mechanism import JOINT_GAP
 from masonrycli.engine.collision import ContactBuffers, detect_contacts
-from masonrycli.mechanism import JOINT_GAP
 from masonrycli.model import Model
 
 

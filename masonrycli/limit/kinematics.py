@@ -8,7 +8,7 @@ block point moves at 1. At a contact point p of joint (a, b) the relative veloci
 split into opening Δv·n (≥ 0 by the flow rule) and sliding Δv·t. Along a straight joint the sliding
 rate is the same at every point, and the opening varies linearly with the relative rotation Δω.
 
-The words are those of the dynamic run (``masonrycli.mechanism``): a joint is named by its two bodies
+The words are those of the dynamic run (``masonrycli.analysis.mechanism``): a joint is named by its two bodies
 ``"a|b"``; it is **hinged** when its faces turn relative to each other (|Δω| × joint length above the
 tolerance) — a face joint rotating about one end, the end that stays closed being the hinge; it is
 **sliding** when its faces move along each other. A joint may do both. Single-point (corner) contacts

@@ -13,7 +13,7 @@ there, and its displacement field is compared with the LP's mechanism:
     similarity = Σ_i d_i · u_i / (|d| |u|),   d_i = (Δx_i, Δy_i, Δθ_i r_i),  u_i = (vx_i, vy_i, ω_i r_i)
 
 (r_i: block radius, so rotations weigh like the motion they give a block's corners), together with the
-hinged joints of the dynamic run (``masonrycli.mechanism``) found at that instant.
+hinged joints of the dynamic run (``masonrycli.analysis.mechanism``) found at that instant.
 """
 
 from __future__ import annotations
@@ -27,8 +27,8 @@ import numpy as np
 
 from masonrycli.errors import InputError
 from masonrycli.limit.analysis import LimitResult
-from masonrycli.motion import Fixed
 from masonrycli.run import Simulation
+from masonrycli.scenario.motion import Fixed
 
 FACTORS = (0.95, 1.05)
 """Multiples of λ the engine is run at."""

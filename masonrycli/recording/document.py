@@ -16,7 +16,7 @@ import numpy as np
 import rerun as rr
 
 from masonrycli import __version__ as MASONRY_VERSION
-from masonrycli.colour_range import BULK_TRIM, HOLD_SPAN, MIN_SPAN, OUTSIDE_SHARE
+from masonrycli.recording.colour_range import BULK_TRIM, HOLD_SPAN, MIN_SPAN, OUTSIDE_SHARE
 from masonrycli.recording.layout import (
     AXES,
     FIELD_TABS,

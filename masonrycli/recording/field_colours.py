@@ -1,6 +1,6 @@
 """The colour of each tensor field: its range followed frame by frame, block colours, legend labels.
 
-One :class:`FieldColours` per recording. A field's range (``masonrycli.colour_range.RangeTracker``) is refitted
+One :class:`FieldColours` per recording. A field's range (``masonrycli.recording.colour_range.RangeTracker``) is refitted
 when the data leave it or shrink well inside it; each range's tick labels are made once, since a range
 holds for many frames. No rerun here: the recorder sends what this computes.
 """
@@ -9,8 +9,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from masonrycli.colormap import map_positions, tick_label
-from masonrycli.colour_range import RangeTracker, positions, sqrt_scale
+from masonrycli.recording.colormap import map_positions, tick_label
+from masonrycli.recording.colour_range import RangeTracker, positions, sqrt_scale
 from masonrycli.recording.document import viewer_safe_text
 from masonrycli.recording.layout import FieldSpec
 from masonrycli.recording.static_content import LUTS, TICKS

@@ -12,8 +12,8 @@ import rerun as rr
 import rerun.blueprint as rrb
 from rerun.blueprint.encodings import ComponentSourceKind, VisualizerComponentMapping
 
-from masonrycli.builtin import is_paper_loading, paper_instant_missed
-from masonrycli.colour_range import Scale, ScaleKind
+from masonrycli.recording.colour_range import Scale, ScaleKind
+from masonrycli.scenario.builtin import is_paper_loading, paper_instant_missed
 
 ROBUST_PERCENTILE: Final = 98.0  # the glyph scales come from this percentile of |value|
 GLYPH_HALF_LENGTH: Final = 0.45  # longest principal-axis half-length / median block's smaller side

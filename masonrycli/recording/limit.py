@@ -23,8 +23,8 @@ import numpy as np
 import rerun as rr
 import rerun.blueprint as rrb
 
-from masonrycli.colormap import VIRIDIS, colorbar_mesh, map_scalars
 from masonrycli.recording.arrays import Polygons, z0
+from masonrycli.recording.colormap import VIRIDIS, colorbar_mesh, map_scalars
 from masonrycli.recording.document import viewer_safe_text
 from masonrycli.recording.layout import (
     HINGE_RGBA,

@@ -4,9 +4,9 @@ relative to it is magnified instead, on the ground where it is: x0 + g + m (x �
 The shaken wall's view magnified the ground's rigid travel: ``masonry simulate wall --amp 0.3 --duration 0.5``
 (the ground travels 4.8 cm) was drawn × 2.5, wall and ground sliding 12 cm to and fro, its own largest
 displacement (0.036 mm, the summary's, relative to the ground) not seen; now × 3000. The same reference as the
-summary's "largest block displacement" and masonrycli.collapse.
+summary's "largest block displacement" and masonrycli.analysis.collapse.
 
-Logged when the recorder closes: the default factor m (``masonrycli.joint_forces.magnification``) needs
+Logged when the recorder closes: the default factor m (``masonrycli.analysis.joint_forces.magnification``) needs
 the largest displacement of the run. Only outlines (line strips), the initial frame (t = 0), every
 ``MAGNIFIED_EVERY``-th computed frame and the last: the mechanism reads as well at half the frame rate, for
 half the bytes.
@@ -25,7 +25,7 @@ import numpy as np
 import pyarrow as pa
 import rerun as rr
 
-from masonrycli.joint_forces import magnification
+from masonrycli.analysis.joint_forces import magnification
 from masonrycli.recording.arrays import FrameBatch, Polygons, partition_lengths, time_indexes
 from masonrycli.recording.layout import MAGNIFIED
 

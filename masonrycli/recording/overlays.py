@@ -8,7 +8,7 @@ import numpy as np
 import pyarrow as pa
 import rerun as rr
 
-from masonrycli.joint_forces import JOINT_OPEN, JOINT_SLIP, JOINT_STICK, joint_resultants
+from masonrycli.analysis.joint_forces import JOINT_OPEN, JOINT_SLIP, JOINT_STICK, joint_resultants
 from masonrycli.recording.arrays import FrameBatch, partition_lengths, uniform_strips
 from masonrycli.recording.layout import (
     COMPRESSION_RGBA,

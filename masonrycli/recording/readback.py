@@ -19,7 +19,7 @@ import pyarrow as pa
 import rerun as rr
 
 from masonrycli.errors import BINARY_FILE, NOT_A_FILE, binary_under_text_suffix
-from masonrycli.outputs import being_written
+from masonrycli.outputs.files import being_written
 from masonrycli.recording.layout import (
     BLOCKS,
     CHAIN_KEY,

@@ -13,7 +13,7 @@ does not count towards a batch's ``batch_frames`` nor fix a scale, so every late
 What is logged per frame, once each: the block fill mesh's vertex positions (float32, inset so the
 joints show) with one colour component per field and view (each view maps its own, ``layout.COLOURED``:
 the fields, and p again on a square-root scale); a hover point per block with its values (float32); the principal-axis glyphs; one resultant arrow per joint
-(``masonrycli.joint_forces``); hinges; each field's colour range and legend labels; the time series
+(``masonrycli.analysis.joint_forces``); hinges; each field's colour range and legend labels; the time series
 (energies, displacements, support motion: ``series``). Solver health (sweeps, residual, contacts) is
 logged for every step (``log_step``), sent with the frames or every ``batching.STEP_BATCH`` steps. The
 magnified deformed shape is logged when the recorder closes, when the largest displacement of the run is
@@ -24,7 +24,7 @@ sent).
 Batches: ``batch_frames`` (100) frames until the scales are fixed, then ``long_batch_frames``; also every
 ``FLUSH_SECONDS`` once the scales are fixed (the rules and their reasons: ``batching``).
 
-Scales: colour ranges follow the data (``masonrycli.colour_range.RangeTracker``, checked every frame);
+Scales: colour ranges follow the data (``masonrycli.recording.colour_range.RangeTracker``, checked every frame);
 the joint-resultant scale (``RESULTANT_LENGTH`` block heights for the 95th percentile resultant of the
 first loaded frame) and the glyph scales (98th percentile of the first batch) are fixed once per run so
 lengths compare across time.
@@ -44,10 +44,11 @@ from typing import Final
 import numpy as np
 import rerun as rr
 
-from masonrycli.colormap import nice_ceil, robust_max_abs
-from masonrycli.frame import Frame
+from masonrycli.outputs.frame import Frame
+from masonrycli.outputs.sinks import COMPLETED, FAILED, INTERRUPTED, RUNNING
 from masonrycli.recording.arrays import FrameBatch, Polygons, time_indexes
 from masonrycli.recording.batching import Batching, initial_frames, io_errors, steps_due
+from masonrycli.recording.colormap import nice_ceil, robust_max_abs
 from masonrycli.recording.document import legend_markdown, run_document, viewer_safe_text
 from masonrycli.recording.field_colours import FieldColours
 from masonrycli.recording.fills import send_blocks, send_supports
@@ -87,7 +88,6 @@ from masonrycli.recording.static_content import (
     log_plane,
     log_static,
 )
-from masonrycli.sinks import COMPLETED, FAILED, INTERRUPTED, RUNNING
 
 APPLICATION_ID: Final = "masonry"
 _RECORDING_NAMESPACE: Final = uuid.UUID("6f1c4f5e-9b0e-4c51-a0a6-3f0d6c1e2a77")
@@ -105,7 +105,7 @@ class Recorder:
     ``batch_frames``: frames a batch until the scales are fixed; ``long_batch_frames`` after (None:
     ``batching.LONG_BATCH_BLOCK_FRAMES`` over the block count; at least ``batch_frames``). ``magnify``: the
     magnified view's factor (None: the largest displacement of the run drawn as 5 % of the structure's size,
-    ``masonrycli.joint_forces.magnification``). The paper-figure tabs are added for the scenarios of
+    ``masonrycli.analysis.joint_forces.magnification``). The paper-figure tabs are added for the scenarios of
     ``layout.PAPER_FIGURES`` under the paper's loading whose ``duration_s`` reaches the paper's instant
     (``paper_figures``).
     """
@@ -205,7 +205,7 @@ class Recorder:
                 send_steps(self.rec, s, self._log10_tolerance)
 
     def on_frame(self, frame: Frame) -> None:
-        """Buffer one frame (the :class:`~masonrycli.sinks.FrameSink` method); sends the buffer when it is
+        """Buffer one frame (the :class:`~masonrycli.outputs.sinks.FrameSink` method); sends the buffer when it is
         due (``batching.Batching.frames_due``)."""
         if self._closed:
             raise RuntimeError("Recorder is closed")
@@ -289,7 +289,7 @@ class Recorder:
         (readback.wait_written: stopped by a full disk, ``OSError``, no disconnect) and disconnect (which
         writes the footer), then read the footer back (a full disk may show only there: ``OSError``).
 
-        ``status``: one of :data:`masonrycli.sinks.STATUSES`; ``note``: one line, e.g.
+        ``status``: one of :data:`masonrycli.outputs.sinks.STATUSES`; ``note``: one line, e.g.
         "interrupted at t = 0.412 s (step 412)" (without a note, the last frame's time is given).
         """
         if self._closed:

@@ -18,8 +18,8 @@ import numpy as np
 import pyarrow as pa
 import rerun as rr
 
-from masonrycli.colormap import BLUES, COOLWARM, OVER_RGBA, UNDER_RGBA, VIRIDIS, colorbar_mesh
 from masonrycli.recording.arrays import Polygons, uniform_strips, z0
+from masonrycli.recording.colormap import BLUES, COOLWARM, OVER_RGBA, UNDER_RGBA, VIRIDIS, colorbar_mesh
 from masonrycli.recording.document import viewer_safe_text
 from masonrycli.recording.layout import (
     BLOCKS,

@@ -55,10 +55,10 @@ import pyarrow as pa
 import rerun as rr
 import rerun.blueprint as rrb
 
-from masonrycli.intensity import UNITS
 from masonrycli.recording.document import viewer_safe_text
 from masonrycli.recording.readback import check_complete, wait_written
 from masonrycli.recording.recorder import APPLICATION_ID
+from masonrycli.records.intensity import UNITS
 from masonrycli.study.curves import (
     STATE_COLOURS,
     axis_positions,
@@ -78,7 +78,7 @@ STATE_RGBA = {state: (*rgb(colour), 255) for state, colour in STATE_COLOURS.item
 
 def record_study(path: Path, name: str, rows: list[dict], request, fit, im: str, plot: Path, groups=None) -> Path:
     """Write the study's ``.rrd`` at ``path`` (closed, with its blueprint); the caller writes it under
-    a temporary name and renames it (``masonrycli.outputs.written_whole``)."""
+    a temporary name and renames it (``masonrycli.outputs.files.written_whole``)."""
     path = Path(path)
     rec = rr.RecordingStream(APPLICATION_ID, recording_id=str(uuid.uuid4()))
     # to the file from the start, the blueprint sent at the end: a save at the end handed rerun's writer the

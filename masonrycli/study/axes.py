@@ -10,7 +10,7 @@ An axis is written ``name=LO:HI:N`` (N values evenly spaced from LO to HI), ``na
 ``record``                          the record file (``--records DIR`` makes this axis): every
                                     shaking support (sine or record) is driven by it
 ``friction``                        the Coulomb coefficient of every contact
-``duration``, ``dt``, ``theta``,    the run settings of :class:`~masonrycli.scenario.RunConfig`
+``duration``, ``dt``, ``theta``,    the run settings of :class:`~masonrycli.scenario.scenario.RunConfig`
 ``tolerance``, ``max_iterations``
 a builder option (``blocks``, ...)  the structure is rebuilt (builder scenarios only)
 =================================== ===========================================================
@@ -27,7 +27,7 @@ import numpy as np
 
 from geometry_library.values import unit_hint, unit_of
 from masonrycli.errors import InputError
-from masonrycli.values import did_you_mean
+from masonrycli.scenario.values import did_you_mean
 
 MOTION_PARAMS = {"amp": ("sine", "amplitude"), "freq": ("sine", "frequency"), "phase": ("sine", "phase")}
 MOTION_PARAMS["scale"] = ("record", "scale")
@@ -176,7 +176,7 @@ def apply_point(base, params: dict):
     Order: builder options (rebuild), run and material settings, the record, then motion parameters
     (so ``scale`` applies to the record chosen on the same point). Raises :class:`InputError`.
     """
-    from masonrycli.scenario import check_sampling, scenario_from_builder
+    from masonrycli.scenario.scenario import check_sampling, scenario_from_builder
 
     scenario = base.scenario
     builder = scenario.structure.get("builder")
@@ -203,7 +203,7 @@ def apply_point(base, params: dict):
     motions = list(scenario.motions)
     if "record" in params:
         record = base.records[params["record"]]
-        from masonrycli.builtin import no_shaking_support, shaken_supports
+        from masonrycli.scenario.builtin import no_shaking_support, shaken_supports
 
         shaking = [j for j, shaken in enumerate(shaken_supports(scenario)) if shaken]
         if not shaking:

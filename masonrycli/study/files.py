@@ -1,4 +1,4 @@
-"""The files a study writes, under the policy of :mod:`masonrycli.outputs`, all checked before any run.
+"""The files a study writes, under the policy of :mod:`masonrycli.outputs.files`, all checked before any run.
 
 - The table (``--out``) is the study's state: an existing table whose rows are all of this study (same
   ``study`` fingerprint, points of this grid) is resumed — its rows are kept and the new ones added, so
@@ -9,7 +9,7 @@
   follow ``simulate``: an existing file is refused unless ``--force``. The histories checked are those
   of the runs still to make (for ``--find``, any value of the bisected parameter at an unfinished point).
 - Every file is written as ``.NAME.<pid>.part`` and renamed into place when complete
-  (:func:`masonrycli.outputs.written_whole`), so Ctrl-C, a killed process or a failed write leaves the
+  (:func:`masonrycli.outputs.files.written_whole`), so Ctrl-C, a killed process or a failed write leaves the
   previous file or a complete new one, never half a file.
 """
 
@@ -19,7 +19,7 @@ import shutil
 from pathlib import Path
 
 from masonrycli.errors import InputError
-from masonrycli.outputs import OutputFile, check_output, glob_escape, part_writer
+from masonrycli.outputs.files import OutputFile, check_output, glob_escape, part_writer
 from masonrycli.study import store
 from masonrycli.study.task import history_name, made_by_study
 

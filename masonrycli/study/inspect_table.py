@@ -13,7 +13,7 @@ from collections import Counter
 from pathlib import Path
 
 from masonrycli.errors import InputError
-from masonrycli.intensity import UNITS as IM_UNITS
+from masonrycli.records.intensity import UNITS as IM_UNITS
 from masonrycli.study.curves import UNITS as PARAM_UNITS
 
 COLUMN_UNITS = {

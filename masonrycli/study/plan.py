@@ -5,7 +5,7 @@ before anything runs or is written: the axes (``--param``, ``--records``, ``--sc
 only go together (``--outcome`` / ``--rtol`` with ``--find``, ``--workers`` without ``--scheduler``,
 ``--recording`` without ``--no-recording``), and the files beside the table. A bad option raises a one-line
 :class:`~masonrycli.errors.InputError` (exit 2) naming it. What it returns is what
-:func:`~masonrycli.study.study.run_study` and the report of :mod:`masonrycli.cli_sweep` take; the table and
+:func:`~masonrycli.study.study.run_study` and the report of :mod:`masonrycli.cli.sweep` take; the table and
 the histories are checked by ``run_study``, which knows which rows are this study's and which runs are
 still to make.
 """
@@ -17,15 +17,15 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
-from masonrycli.builtin import check_record_dt, is_built_in, override_run, target_scenario
 from masonrycli.errors import NOT_A_FILE, InputError
-from masonrycli.outputs import OutputFile, safe_name
-from masonrycli.records import vertical_at2
+from masonrycli.outputs.files import OutputFile, safe_name
+from masonrycli.records.read import vertical_at2
+from masonrycli.scenario.builtin import check_record_dt, is_built_in, override_run, target_scenario
+from masonrycli.scenario.values import option_text
 from masonrycli.study import store
 from masonrycli.study.axes import Axis, StudyBase, apply_point, check_axes, check_find, parse_axis
 from masonrycli.study.files import check_picture
 from masonrycli.study.study import StudyRequest, points_to_check
-from masonrycli.values import option_text
 
 SWEEP_DURATION = {"wall": 1.0, "arch": 2.0, "aqueduct": 2.0}
 """s: default simulated time of a built-in structure in a study."""
@@ -82,7 +82,7 @@ def plan_study(
     ``masonry sweep`` runs with these options, each named as the command line names it; ``warn`` gets
     the warnings (runs shorter than records) once ``run_study`` has checked the table. Raises
     :class:`InputError`, the first problem in one line, before any run or file."""
-    from masonrycli.intensity import INTENSITY_MEASURES
+    from masonrycli.records.intensity import INTENSITY_MEASURES
     from masonrycli.study.runner import check_scheduler
     from masonrycli.study.task import check_outcome
 
@@ -177,8 +177,8 @@ def _scenario_warnings(scenario, records) -> list[str]:
     """The warnings ``masonry run`` prints for the study's base scenario (a block touching nothing, a GeoJSON
     property not used, gravity pointing up: the sweep ran every point without a word); with ``--records``
     its own record is not run, so not its records' (the set's are in ``late``)."""
-    from masonrycli.builtin import shaken_by
-    from masonrycli.scenario_warnings import record_warnings, scenario_warnings
+    from masonrycli.scenario.builtin import shaken_by
+    from masonrycli.scenario.caveats import record_warnings, scenario_warnings
 
     if not records:
         return scenario_warnings(scenario)
@@ -193,8 +193,8 @@ def _set_warnings(base: StudyBase, axes: list[Axis]) -> list[str]:
     where 'simulate --record' says each. Its length is said by ``_record_duration`` (in one line)."""
     import dataclasses
 
-    from masonrycli.records import G_STANDARD
-    from masonrycli.scenario_warnings import record_warnings
+    from masonrycli.records.read import G_STANDARD
+    from masonrycli.scenario.caveats import record_warnings
 
     if not base.records:
         return []
@@ -222,10 +222,10 @@ def _set_warnings(base: StudyBase, axes: list[Axis]) -> list[str]:
 def _converted_twice(records: dict, scales: list[float]) -> list[str]:
     """A scale that is the conversion of a CSV read in its header's unit (``acc (g)`` at ``--scale 9.81``, how
     ``--record`` read such a file before it converted it too): converted twice, 9.81 times too strong. A warning
-    here, where ``--record`` refuses it (:func:`~masonrycli.record_units.check_csv_header`): an axis may hold the
+    here, where ``--record`` refuses it (:func:`~masonrycli.records.units.check_csv_header`): an axis may hold the
     value among others (``--scale 1,9.81,20``), and no study read such a file that way (a set refused it)."""
-    from masonrycli.record_units import NEAR_CONVERSION, converts_again, header_factor
-    from masonrycli.records import read_as_csv
+    from masonrycli.records.read import read_as_csv
+    from masonrycli.records.units import NEAR_CONVERSION, converts_again, header_factor
 
     said = []
     for name, m in records.items():
@@ -242,7 +242,7 @@ def _converted_twice(records: dict, scales: list[float]) -> list[str]:
 
 
 def _is_geometry(target) -> bool:
-    from masonrycli.structure import GEOMETRY_SUFFIXES
+    from masonrycli.scenario.structure import GEOMETRY_SUFFIXES
 
     return Path(target).suffix.lower() in GEOMETRY_SUFFIXES
 
@@ -265,8 +265,8 @@ def _base_scenario(target: str, duration, dt, lasting: bool = False):
 def _shaken(name: str):
     """The built-in structure ``name`` of a study: 1 m/s at 2 Hz on the ground (wall) or both foundations
     (arch, aqueduct), for ``SWEEP_DURATION``."""
-    from masonrycli.motion import Sine
-    from masonrycli.scenario import Material, RunConfig, scenario_from_builder
+    from masonrycli.scenario.motion import Sine
+    from masonrycli.scenario.scenario import Material, RunConfig, scenario_from_builder
 
     shaken = ("ground",) if name == "wall" else ("left-foundation", "right-foundation")
     motions = {s: Sine(amplitude=1.0, frequency=2.0) for s in shaken}
@@ -282,7 +282,7 @@ def _record_duration(scenario, motions: dict, whole: bool):
     import dataclasses
     import math
 
-    from masonrycli.scenario import MAX_DURATION
+    from masonrycli.scenario.scenario import MAX_DURATION
 
     run = scenario.run
     # named by the longest: the first late record ("longest 3 s, quake1.csv" for a 2 s quake1.csv) misled
@@ -412,7 +412,7 @@ def _esm_others(folder: Path) -> list[str]:
 
 def _esm_other(path: Path) -> bool:
     """An ESM .ASC file whose header says it is no acceleration series (VELOCITY, DISPLACEMENT, a spectrum)."""
-    from masonrycli.record_esm import esm_series
+    from masonrycli.records.esm import esm_series
 
     return path.suffix.lower() == ".asc" and esm_series(path) not in ("", "ACCELERATION")
 
@@ -441,7 +441,7 @@ def _kik_borehole(path: Path) -> bool:
 def _is_record_file(path: Path) -> bool:
     """A file a --records folder reads: .AT2, .csv, K-NET, KiK-net's surface files and ESM .ASC files of
     acceleration."""
-    from masonrycli.record_knet import KNET_SUFFIXES
+    from masonrycli.records.knet import KNET_SUFFIXES
 
     suffix = path.suffix.lower()
     if suffix not in (".at2", ".asc", ".csv", *KNET_SUFFIXES) or not path.is_file():
@@ -456,8 +456,8 @@ def _record(path: Path, record_dt: float | None):
     before the rest of it is parsed, and read again with the time step. A CSV whose header gives its unit
     (g, gal, cm/s², cm/s, …) is read in it, converted to SI, as ``--record`` reads it (the axis's scale then
     multiplies the record as recorded, and a row replays with ``run --record FILE --scale`` the row's scale)."""
-    from masonrycli.record_text import NoTimeStep
-    from masonrycli.records import record_motion
+    from masonrycli.records.read import record_motion
+    from masonrycli.records.text import NoTimeStep
 
     try:
         return record_motion(path, display=str(path))

@@ -51,7 +51,7 @@ def _pyplot():
 
 
 def _save(fig, path: Path) -> Path:
-    # PNG whatever the name: the caller writes a temporary ".part" file (masonrycli.outputs.written_whole)
+    # PNG whatever the name: the caller writes a temporary ".part" file (masonrycli.outputs.files.written_whole)
     fig.savefig(path, format="png", dpi=120, bbox_inches="tight")
     return path
 

@@ -2,7 +2,7 @@
 
 Finished rows are never lost: each row is appended to a journal (``<out>.journal.jsonl``, one JSON
 object per line, flushed) the moment it arrives; the table itself is rewritten whole (temporary file,
-then rename: :mod:`masonrycli.outputs`) at the end of the study and when it is interrupted, after which
+then rename: :mod:`masonrycli.outputs.files`) at the end of the study and when it is interrupted, after which
 the journal goes. Which existing table may be rewritten: :mod:`masonrycli.study.files`.
 Re-running the same study reads both and skips the rows already finished (resume). Rows carry a
 ``study`` column, a fingerprint of everything but the grid, so a different study never reuses them.
@@ -17,7 +17,7 @@ import math
 from pathlib import Path
 
 from masonrycli.errors import InputError
-from masonrycli.outputs import OutputFile, check_folder, written_whole
+from masonrycli.outputs.files import OutputFile, check_folder, written_whole
 
 SUFFIXES = (".parquet", ".csv")
 TEXT_COLUMNS = frozenset({"study", "source", "state", "status", "error", "note", "outcome", "holds", "record"})
@@ -106,7 +106,7 @@ def _plain(value):
 
 def write_rows(out: OutputFile, rows: list[dict], columns: list[str]) -> Path:
     """Write ``rows`` (every key of ``columns``, in that order) to ``out`` whole (temporary file renamed
-    into place, :func:`masonrycli.outputs.written_whole`), then drop the journal; returns where it went."""
+    into place, :func:`masonrycli.outputs.files.written_whole`), then drop the journal; returns where it went."""
     table = [{c: _plain(r.get(c)) if hasattr(r.get(c), "item") else r.get(c) for c in columns} for r in rows]
     journal = journal_path(out.path)
     with written_whole(out) as part:

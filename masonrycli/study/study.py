@@ -2,7 +2,7 @@
 
 :func:`run_study` is what ``masonry sweep`` does once :mod:`masonrycli.study.plan` has checked its
 options; the outputs around it (terminal table, PNG, Rerun recording) are made by
-:mod:`masonrycli.cli_sweep`; which files may be written: :mod:`masonrycli.study.files`.
+:mod:`masonrycli.cli.sweep`; which files may be written: :mod:`masonrycli.study.files`.
 """
 
 from __future__ import annotations
@@ -104,7 +104,7 @@ def prepare(base: StudyBase, request: StudyRequest) -> tuple[str, dict[str, str]
     (the rows of tables written before), or its own record's. Adding a record to the set (a fragility study
     grows as records are downloaded) changed the one fingerprint, and every finished row was "another
     study's": refused, or run again with --force."""
-    from masonrycli.scenario_toml import dump_scenario
+    from masonrycli.scenario.toml_file import dump_scenario
 
     check_axes(request.axes)
     check_find(request.axes, request.find)

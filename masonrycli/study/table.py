@@ -19,7 +19,7 @@ from rich.measure import Measurement
 from rich.table import Table
 from rich.text import Text
 
-from masonrycli.intensity import UNITS as IM_UNITS
+from masonrycli.records.intensity import UNITS as IM_UNITS
 from masonrycli.study.curves import UNITS as PARAM_UNITS
 
 SHOWN_ROWS = 40

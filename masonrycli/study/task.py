@@ -14,7 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
-from masonrycli.intensity import INTENSITY_MEASURES
+from masonrycli.records.intensity import INTENSITY_MEASURES
 
 OUTCOMES = ("collapse", "sliding", "rocking")
 """Outcomes ``--find`` can bisect for, besides ``drift:X`` (peak top drift beyond X × the height)."""
@@ -55,16 +55,16 @@ def run_task(
 ) -> dict:
     """Run the grid point ``params`` of ``base`` (:class:`~masonrycli.study.axes.StudyBase`): its row.
 
-    With ``history_dir`` the run's history (:mod:`masonrycli.history`) is written there as
+    With ``history_dir`` the run's history (:mod:`masonrycli.outputs.history`) is written there as
     :func:`history_name` of the point (on the worker's file system), under the policy of
-    :mod:`masonrycli.outputs`: a temporary file renamed into place when complete, an existing file
+    :mod:`masonrycli.outputs.files`: a temporary file renamed into place when complete, an existing file
     replaced only with ``force`` or when an earlier run of the same ``study`` (its fingerprint and its
     table) wrote it (:func:`made_by_study`; the study checked them all before the first run).
     """
     from masonrycli.errors import InputError
     from masonrycli.execute import run_metadata
-    from masonrycli.history import HistoryFile, block_constants
-    from masonrycli.outputs import OutputFile, written_whole
+    from masonrycli.outputs.files import OutputFile, written_whole
+    from masonrycli.outputs.history import HistoryFile, block_constants
     from masonrycli.run import Simulation, simulate
     from masonrycli.study.axes import apply_point
 
@@ -142,7 +142,7 @@ def remove_stale_parts(path: Path) -> None:
     A writer still running on this machine is left alone (another study writing the same folder)."""
     import shutil
 
-    from masonrycli.outputs import glob_escape, part_writer
+    from masonrycli.outputs.files import glob_escape, part_writer
 
     for part in path.parent.glob(f".{glob_escape(path.name)}.*.part*"):
         writer = part.with_name(part.name.removesuffix(".rows"))

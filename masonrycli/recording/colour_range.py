@@ -51,7 +51,7 @@ from typing import Final, Literal
 
 import numpy as np
 
-from masonrycli.colormap import nice_ceil
+from masonrycli.recording.colormap import nice_ceil
 
 ScaleKind = Literal["negative", "positive", "signed"]
 Scale = Literal["linear", "sqrt"]

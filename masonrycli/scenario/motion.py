@@ -4,7 +4,7 @@ A support (ground, foundation pad) translates with an imposed velocity. Each mot
 its velocity history (:meth:`velocity_at`, vectorised over time), a one-line description
 (:meth:`describe`) and its TOML spelling (``TOML_KEYS``, ``TOML_REQUIRED``, :meth:`toml_fields`);
 :func:`support_velocity` evaluates all supports of a scenario at many instants at once. The TOML
-``kind`` -> class table is ``masonrycli.scenario_toml.MOTION_KINDS``.
+``kind`` -> class table is ``masonrycli.scenario.toml_file.MOTION_KINDS``.
 
 Kinds
 -----
@@ -17,8 +17,8 @@ Kinds
 :class:`Ramp` (``ramp``)
     v(t) = ``acceleration`` · clip(t, 0, ``until``): constant acceleration from rest, then constant
     velocity after ``until`` (an acceleration pulse; ``until = inf`` by default).
-:class:`~masonrycli.record_motion.Record` (``record``)
-    A tabulated velocity or acceleration history (earthquake record), in :mod:`masonrycli.record_motion`.
+:class:`~masonrycli.records.motion.Record` (``record``)
+    A tabulated velocity or acceleration history (earthquake record), in :mod:`masonrycli.records.motion`.
 
 Units: m/s, m/s², s, Hz, rad.
 """
@@ -32,7 +32,7 @@ from typing import ClassVar
 
 import numpy as np
 
-from masonrycli.values import check_real, check_vector, field_error
+from masonrycli.scenario.values import check_real, check_vector, field_error
 
 MAX_PHASE = 1e4
 """rad — a sine's phase beyond ±this is refused as a likely typo: the sine repeats every 2π, so any phase can

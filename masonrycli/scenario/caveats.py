@@ -22,10 +22,10 @@ import os
 
 import numpy as np
 
-from masonrycli.record_units import MAX_AT2_G, NEAR_CONVERSION
-from masonrycli.records import G_STANDARD, vertical_at2
-from masonrycli.scenario import Scenario
-from masonrycli.values import quote_string
+from masonrycli.records.read import G_STANDARD, vertical_at2
+from masonrycli.records.units import MAX_AT2_G, NEAR_CONVERSION
+from masonrycli.scenario.scenario import Scenario
+from masonrycli.scenario.values import quote_string
 
 MIN_DENSITY = 100.0
 """kg/m³: lighter blocks are warned about (masonry units weigh 1200–3000 kg/m³, timber 400–700): a density in
@@ -216,8 +216,8 @@ def _cm_unit(source: str) -> str:
     (an ESM file's UNITS as written: cm/s^2, gal, cm/s; gal for K-NET), "" for any other file: a CSV (a plain
     table named .asc too) is read in its own units, scale 0.01 converting its cm/s²; an ESM file in m/s² or mm/s
     is not converted twice by 0.01."""
-    from masonrycli.record_esm import esm_units, is_esm
-    from masonrycli.record_knet import is_knet
+    from masonrycli.records.esm import esm_units, is_esm
+    from masonrycli.records.knet import is_knet
 
     if not source:
         return ""

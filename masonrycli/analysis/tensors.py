@@ -36,7 +36,7 @@ Definitions (DESIGN §3; paper eqs. 1–12)
   tensor (r ≤ 1e-14 (|c| + r)) gets φ = 0. Stress: spherical p = (σ1+σ2)/2, deviatoric
   q = (σ1−σ2)/2, skew |σ_xy − σ_yx|/2. Strain (rate): volumetric = trace = ε1+ε2, deviatoric
   (ε1−ε2)/2. Compression and contraction are negative.
-* The joint states (sliding ratio, joint opening, hinges) are in ``masonrycli.mechanism``.
+* The joint states (sliding ratio, joint opening, hinges) are in ``masonrycli.analysis.mechanism``.
 
 Units: SI. Forces in N acting on the block's whole thickness (as the solver's, m = ρ·A·e); with the
 default e = 1 m these are N/m and σ is in Pa either way.

@@ -1,6 +1,6 @@
 """``masonry inspect H.npz``: what a run history holds, read from the file alone.
 
-A history (:mod:`masonrycli.history`) describes itself: ``run`` (the JSON of the run's parameters),
+A history (:mod:`masonrycli.outputs.history`) describes itself: ``run`` (the JSON of the run's parameters),
 ``units`` (each array's unit / meaning), ``status`` and ``note``. Histories written before those existed
 are summarised too, their missing parts said "not recorded". Only the arrays' headers are read (shape and
 dtype), and the few small arrays the summary shows (``time``, ``step``, ``run``, ``units``, ``status``,
@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from masonrycli.errors import NOT_A_FILE, InputError, one_line
-from masonrycli.outputs import being_written
+from masonrycli.outputs.files import being_written
 
 NOT_RECORDED = "not recorded"
 _ZIP_MAGIC = b"PK\x03\x04"

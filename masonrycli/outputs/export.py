@@ -51,7 +51,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from masonrycli.errors import InputError
-from masonrycli.history_inspect import inspect_history
+from masonrycli.outputs.inspect_history import inspect_history
 
 NEEDED = ("time", "block_q", "block_v", "block_name", "support_q", "support_v", "support_force", "support_name")
 SCALARS = (

@@ -88,7 +88,7 @@ SOLVER_NOTES = {
     "nlgs-accel32": "Gauss–Seidel with momentum, first sweeps in float32; plain: --solver nlgs",
     "nlgs": "plain Gauss–Seidel, the reference",
 }
-"""What the summary says after a solver's name (masonrycli.scenario.SOLVERS)."""
+"""What the summary says after a solver's name (masonrycli.scenario.scenario.SOLVERS)."""
 
 
 def summary_table(result, recording: str | None, history: str | None) -> Table:
@@ -144,8 +144,8 @@ def _two_columns(title: str) -> Table:
 
 
 def check_table(scenario_file: str, info: dict, output_files) -> Table:
-    """``masonry check``'s table: ``info`` of :func:`masonrycli.scenario.scenario_summary`, the files a run
-    would write (:class:`masonrycli.outputs.OutputFile`)."""
+    """``masonry check``'s table: ``info`` of :func:`masonrycli.scenario.scenario.scenario_summary`, the files a run
+    would write (:class:`masonrycli.outputs.files.OutputFile`)."""
     table = _two_columns(f"{scenario_file} — valid")
     xmin, ymin, xmax, ymax = info["bounding_box"]
     table.add_row("scenario", str(info["name"]))
@@ -183,11 +183,11 @@ def recording_table(recording: str, info: dict) -> Table:
 
 
 def history_tables(history: str, info: dict) -> tuple[Table, list[str]]:
-    """``masonry inspect H.npz``: a table of the run (:func:`masonrycli.history_inspect.run_rows`, as a
+    """``masonry inspect H.npz``: a table of the run (:func:`masonrycli.outputs.inspect_history.run_rows`, as a
     recording's rows), then one line per array (name, shape, dtype, unit / meaning) in aligned columns — a
     line each, never wrapped into a box (a table of 49 arrays cut names and folded meanings over 3-5
     lines at 80 columns), so ``masonry inspect H.npz | grep stress`` finds an array."""
-    from masonrycli.history_inspect import array_rows, run_rows
+    from masonrycli.outputs.inspect_history import array_rows, run_rows
 
     table = _two_columns(f"{history} — run history")
     for label, value in run_rows(info):

@@ -17,7 +17,7 @@ from pathlib import Path
 from geometry_library.blocks import Assembly, GeometryError
 from geometry_library.values import SETTING_UNITS, TypedNumber, number_problem
 from masonrycli.errors import InputContext, InputError, not_a_file, one_line
-from masonrycli.values import did_you_mean, field_error, quote_string
+from masonrycli.scenario.values import did_you_mean, field_error, quote_string
 
 GEOMETRY_SUFFIXES = (".geojson", ".json", ".wkt")
 

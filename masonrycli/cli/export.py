@@ -1,5 +1,5 @@
-"""``masonry export``: a run history as CSV. Thin: options -> :func:`masonrycli.history_export.export_table`
--> the CSV written whole (:func:`masonrycli.outputs.written_whole`); registered on the app by :mod:`masonrycli.cli`.
+"""``masonry export``: a run history as CSV. Thin: options -> :func:`masonrycli.outputs.export.export_table`
+-> the CSV written whole (:func:`masonrycli.outputs.files.written_whole`); registered on the app by :mod:`masonrycli.cli.app`.
 """
 
 from __future__ import annotations
@@ -9,7 +9,7 @@ from typing import Annotated
 
 import typer
 
-from masonrycli.cli_options import file_path_value, path_value, whole_value
+from masonrycli.cli.options import file_path_value, path_value, whole_value
 from masonrycli.errors import InputError
 
 
@@ -43,9 +43,9 @@ def _inputs(paths: list[Path]) -> list[Path]:
 
 
 def _targets(histories: list[Path], out: Path | None, force: bool, several: bool):
-    """The checked output of each history (:func:`masonrycli.outputs.check_output`): ``out`` for one history,
+    """The checked output of each history (:func:`masonrycli.outputs.files.check_output`): ``out`` for one history,
     ``out``/NAME.csv (a folder) or NAME.csv beside each for several."""
-    from masonrycli.outputs import check_distinct, check_output
+    from masonrycli.outputs.files import check_distinct, check_output
 
     if several and out is not None and not out.is_dir():
         raise InputError(f"--out {out}: several histories, one CSV each: --out names an existing folder for them")
@@ -111,9 +111,9 @@ def export_command(
     """Write a run history as CSV (one row per frame, units in the header): the ground's motion, blocks' or
     courses' displacement, velocity, acceleration (relative to the ground), drift ratio, base shear,
     overturning moment, hinges, energies."""
-    from masonrycli.cli_messages import console, say
-    from masonrycli.history_export import export_table, write_csv
-    from masonrycli.outputs import written_whole
+    from masonrycli.cli.messages import console, say
+    from masonrycli.outputs.export import export_table, write_csv
+    from masonrycli.outputs.files import written_whole
 
     if every < 1:
         raise InputError(f"--every {every}: keep every K-th frame, K ≥ 1")

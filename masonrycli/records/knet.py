@@ -24,9 +24,9 @@ import re
 import numpy as np
 
 from masonrycli.errors import InputError
-from masonrycli.record_motion import time_step_problem
-from masonrycli.record_text import free_numbers
-from masonrycli.values import shorten
+from masonrycli.records.motion import time_step_problem
+from masonrycli.records.text import free_numbers
+from masonrycli.scenario.values import shorten
 
 KNET_SUFFIXES = (".ns", ".ew", ".ud", ".ns1", ".ew1", ".ud1", ".ns2", ".ew2", ".ud2")
 _HEADER_LINES = 17  # the last one "Memo."; a file cut before it is no K-NET record

@@ -20,14 +20,14 @@ import numpy as np
 
 from geometry_library.blocks import Assembly, Block, GeometryError, Support, name_problem
 from masonrycli.errors import NOT_A_FILE, InputContext, InputError, input_path, not_utf8, one_line, special_file
-from masonrycli.motion import Constant, Fixed, Motion, Ramp, Sine
-from masonrycli.record_motion import Record
-from masonrycli.records import record_fields
-from masonrycli.scenario import Material, RunConfig, Scenario, block_speed_problem
-from masonrycli.scenario_warnings import idle_driven_supports
-from masonrycli.structure import build_structure, check_finite_tree, read_geometry, structure_warnings
-from masonrycli.toml_lines import key_line, with_line
-from masonrycli.values import (
+from masonrycli.records.motion import Record
+from masonrycli.records.read import record_fields
+from masonrycli.scenario.caveats import idle_driven_supports
+from masonrycli.scenario.motion import Constant, Fixed, Motion, Ramp, Sine
+from masonrycli.scenario.scenario import Material, RunConfig, Scenario, block_speed_problem
+from masonrycli.scenario.structure import build_structure, check_finite_tree, read_geometry, structure_warnings
+from masonrycli.scenario.toml_lines import key_line, with_line
+from masonrycli.scenario.values import (
     check_real,
     check_vector,
     field_error,
@@ -404,7 +404,7 @@ def dump_scenario(scenario: Scenario, *, inline_records: bool = False) -> str:
     ``inline_records`` is true or the record has no file. A builder scenario is written as its blocks
     (the builder and options are noted in a comment).
     """
-    out = ["# masonry scenario (written by masonrycli.scenario_toml.dump_scenario)"]
+    out = ["# masonry scenario (written by masonrycli.scenario.toml_file.dump_scenario)"]
     if scenario.structure:
         opts = ", ".join(
             f"{quote_key(str(k))} = {format_value(v)}" for k, v in scenario.structure.items() if k != "builder"

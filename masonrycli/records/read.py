@@ -1,13 +1,13 @@
-"""Reading ground-motion records from files into :class:`~masonrycli.record_motion.Record` motions.
+"""Reading ground-motion records from files into :class:`~masonrycli.records.motion.Record` motions.
 
 Four formats, chosen by the file's extension:
 
 * ``.AT2`` (PEER NGA): acceleration in g, one component per file, a 4-line header whose last line
   gives ``NPTS`` and ``DT`` (see :func:`load_at2`); samples at t = 0, DT, 2 DT, ...
 * ``.ASC`` (ESM / ITACA): ``KEY: value`` header lines giving ``SAMPLING_INTERVAL_S``, ``NDATA`` and
-  ``UNITS`` (acceleration in cm/s², or velocity), then one sample a line (:mod:`masonrycli.record_esm`);
+  ``UNITS`` (acceleration in cm/s², or velocity), then one sample a line (:mod:`masonrycli.records.esm`);
 * ``.NS`` / ``.EW`` / ``.UD`` (K-NET; ``.NS1`` … ``.UD2`` KiK-net): a 17-line header giving the sampling
-  frequency and the counts' scale factor, then the counts (:mod:`masonrycli.record_knet`);
+  frequency and the counts' scale factor, then the counts (:mod:`masonrycli.records.knet`);
 * ``.VT2`` / ``.DT2`` (PEER's velocity and displacement series) are refused, naming the .AT2;
 * anything else is CSV: one sample per line, ``time,value`` or ``time,x,y``, or one ``value`` per line
   given a time step (samples at t = 0, dt, 2 dt, ...; see :func:`load_record_csv`).
@@ -35,12 +35,12 @@ from masonrycli.errors import (
     not_utf8,
     special_file,
 )
-from masonrycli.record_esm import esm_text, esm_vertical, is_esm, looks_like_esm
-from masonrycli.record_knet import is_knet, knet_text, knet_vertical
-from masonrycli.record_motion import Record, time_step_problem
-from masonrycli.record_text import NoTimeStep, TimeStepNotUsed, at2_text, csv_text, number
-from masonrycli.record_units import check_at2_header, check_csv_header, header_quantity, record_text
-from masonrycli.values import format_value, quote_string, shorten
+from masonrycli.records.esm import esm_text, esm_vertical, is_esm, looks_like_esm
+from masonrycli.records.knet import is_knet, knet_text, knet_vertical
+from masonrycli.records.motion import Record, time_step_problem
+from masonrycli.records.text import NoTimeStep, TimeStepNotUsed, at2_text, csv_text, number
+from masonrycli.records.units import check_at2_header, check_csv_header, header_quantity, record_text
+from masonrycli.scenario.values import format_value, quote_string, shorten
 
 
 def load_record_csv(path, display: str | None = None, time_step: float | None = None):
@@ -163,7 +163,7 @@ def is_at2(path) -> bool:
 
 def load_esm(path, display: str | None = None) -> tuple[float, np.ndarray, str]:
     """Read an ESM / ITACA ``.ASC`` file: ``(dt s, samples in m/s² or m/s, quantity)``
-    (:func:`masonrycli.record_esm.esm_text`)."""
+    (:func:`masonrycli.records.esm.esm_text`)."""
     name = display if display is not None else str(path)
     return esm_text(_read_text(path, name), name)
 
@@ -290,14 +290,14 @@ def record_motion(
     display: str | None = None,
     time_step: float | None = None,
 ) -> Record:
-    """A :class:`~masonrycli.record_motion.Record` from a record file (.AT2, .ASC or CSV, see :func:`read_record`).
+    """A :class:`~masonrycli.records.motion.Record` from a record file (.AT2, .ASC or CSV, see :func:`read_record`).
 
     ``quantity`` defaults to "acceleration" for .AT2 files (the only one they hold) and, for CSV, to the
-    quantity its header names (:func:`~masonrycli.record_units.header_quantity`), else "velocity". ``vertical`` is the file of the vertical component (the record then acts along x and y and
+    quantity its header names (:func:`~masonrycli.records.units.header_quantity`), else "velocity". ``vertical`` is the file of the vertical component (the record then acts along x and y and
     ``direction`` is not used). ``source`` is the absolute path of the file. ``time_step`` (s): the
     files hold one value per line at that spacing (checked before they are read). A CSV whose header gives its
     unit (``acc (g)``, ``vel (cm/s)``) is converted by it to SI, as an .AT2 file's g, ``scale`` multiplying the
-    record as recorded (:func:`~masonrycli.record_units.check_csv_header`; a scale equal to the conversion is
+    record as recorded (:func:`~masonrycli.records.units.check_csv_header`; a scale equal to the conversion is
     refused).
     """
     time_step = _time_step(time_step, "time_step")
@@ -348,7 +348,7 @@ def _time_step(value, key: str) -> float | None:
 
 
 def record_fields(table: dict, base_dir: str) -> dict:
-    """The :class:`~masonrycli.record_motion.Record` arguments for the data of a scenario's record table:
+    """The :class:`~masonrycli.records.motion.Record` arguments for the data of a scenario's record table:
     ``file`` (and ``vertical``) read relative to ``base_dir``, or inline ``time`` and ``value``.
 
     Raises :class:`InputError` with a message naming the key (``motion.file = "q.csv": no such file ...``).

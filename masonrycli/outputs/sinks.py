@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from typing import Final, Protocol, runtime_checkable
 
-from masonrycli.frame import Frame
+from masonrycli.outputs.frame import Frame
 
 RUNNING: Final = "running"
 COMPLETED: Final = "completed"

@@ -1,11 +1,11 @@
-"""A ground-motion record as a support motion: :class:`Record`, the ``record`` kind of :mod:`masonrycli.motion`.
+"""A ground-motion record as a support motion: :class:`Record`, the ``record`` kind of :mod:`masonrycli.scenario.motion`.
 
 A tabulated velocity or acceleration history (earthquake record). ``time`` (n,) s; ``value`` either n
 numbers applied along d̂ (``direction``) or n (x, y) pairs, kept as read-only float64 arrays (a 3-million-
 sample record as Python tuples cost 0.7 s of start-up). Values are multiplied by ``scale``; ``quantity``
 says whether they are velocities (interpolated linearly) or accelerations (integrated exactly,
 ``baseline`` drift-corrected); ``window = [a, b]`` uses only the samples with a <= t <= b, moved to start
-at t = 0. How: :mod:`masonrycli.record_velocity`. Record files are read in :mod:`masonrycli.records`;
+at t = 0. How: :mod:`masonrycli.records.velocity`. Record files are read in :mod:`masonrycli.records.read`;
 :func:`time_step_problem` checks a one-column file's time step (there and for ``--record-dt``).
 
 What sets it apart from the closed-form kinds: its samples are checked (an error names the sample),
@@ -27,9 +27,9 @@ from typing import ClassVar
 import numpy as np
 
 from geometry_library.values import number_problem
-from masonrycli.motion import Motion, _Directed, _direction, _g, _put, _time_column, _vec
-from masonrycli.record_velocity import RecordArrays, record_arrays, record_velocity
-from masonrycli.values import check_real, check_samples, check_vector, field_error, format_value
+from masonrycli.records.velocity import RecordArrays, record_arrays, record_velocity
+from masonrycli.scenario.motion import Motion, _Directed, _direction, _g, _put, _time_column, _vec
+from masonrycli.scenario.values import check_real, check_samples, check_vector, field_error, format_value
 
 RECORD_QUANTITIES = ("velocity", "acceleration")
 BASELINES = ("quadratic", "none")
@@ -53,7 +53,7 @@ def time_step_problem(value) -> str | None:
 
 @dataclass(frozen=True, kw_only=True, eq=False)
 class Record(_Directed, Motion):
-    """A tabulated velocity or acceleration history (see :mod:`masonrycli.record_velocity`).
+    """A tabulated velocity or acceleration history (see :mod:`masonrycli.records.velocity`).
 
     time : (n,) s, strictly increasing, n >= 2; kept as a read-only float64 array.
     value : n floats (along ``direction``) or n (x, y) pairs, m/s or m/s² (before ``scale``); kept as a
@@ -210,7 +210,7 @@ class Record(_Directed, Motion):
     @property
     def baseline_correction(self) -> dict:
         """What the baseline correction subtracted, for the run document: ``{"baseline": "quadratic",
-        "c1": [x, y], "c2": [x, y], "length": T}`` (m/s, s; see :mod:`masonrycli.record_velocity`), or
+        "c1": [x, y], "c2": [x, y], "length": T}`` (m/s, s; see :mod:`masonrycli.records.velocity`), or
         ``{"baseline": "none"}``."""
         if not self.corrected:
             return {"baseline": "none"}

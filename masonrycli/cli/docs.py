@@ -14,7 +14,7 @@ from pathlib import Path
 
 from masonrycli.errors import InputError
 
-_PACKAGE = Path(__file__).resolve().parent
+_PACKAGE = Path(__file__).resolve().parent.parent  # masonrycli/, where the wheel puts docs/
 README_TOPIC = "readme"
 
 

@@ -49,7 +49,7 @@ class Frame:
     contact_mobilised: np.ndarray
     """(C,) |r_t| / (mu r_n), 0 for open contacts."""
     tensors: dict
-    """Per-block tensor fields, name -> array (see masonrycli.tensors.TENSOR_FIELDS)."""
+    """Per-block tensor fields, name -> array (see masonrycli.analysis.tensors.TENSOR_FIELDS)."""
     energy_kinetic: float
     """J (per block thickness)."""
     energy_potential: float
@@ -65,7 +65,7 @@ class Frame:
     contact_count: int
     """C, the step's contacts (the length of the ``contact_*`` arrays)."""
     joint_body: np.ndarray = field(default_factory=lambda: np.zeros((0, 2), dtype=np.int64))
-    """(J, 2) bodies of each joint (pairs touching along a face initially; see masonrycli.mechanism)."""
+    """(J, 2) bodies of each joint (pairs touching along a face initially; see masonrycli.analysis.mechanism)."""
     joint_hinged: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=bool))
     """(J,) True where the joint is hinged: one end carries all the normal force, the other is open."""
     hinge_point: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)))

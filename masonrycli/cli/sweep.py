@@ -2,7 +2,7 @@
 
 Thin: options -> :func:`~masonrycli.study.plan.plan_study` (every check, the base scenario and the
 :class:`~masonrycli.study.study.StudyRequest`) -> run_study -> table, PNG, Rerun recording; messages and
-exit codes. Registered on the app by :mod:`masonrycli.cli`.
+exit codes. Registered on the app by :mod:`masonrycli.cli.app`.
 """
 
 from __future__ import annotations
@@ -15,10 +15,10 @@ from typing import TYPE_CHECKING, Annotated
 
 import typer
 
-from masonrycli.cli_options import choice_value, file_path_value, number_value, path_value, whole_value
+from masonrycli.cli.options import choice_value, file_path_value, number_value, path_value, whole_value
 from masonrycli.errors import EXIT_DIVERGED, EXIT_OUTPUT_FAILED, EXIT_ROWS_FAILED
 from masonrycli.interrupt import FirstSignalStops, exit_code, signal_name
-from masonrycli.outputs import OutputFile
+from masonrycli.outputs.files import OutputFile
 
 if TYPE_CHECKING:
     from masonrycli.study.plan import StudyPlan
@@ -154,7 +154,7 @@ def sweep_command(
 
     [bold]masonry sweep wall --param amp=0.1:1.0:10 --param freq=0.5:4:8 --out study.parquet[/bold]
     """
-    from masonrycli.cli import console, err_console
+    from masonrycli.cli.app import console, err_console
     from masonrycli.study import store
     from masonrycli.study.plan import plan_study
     from masonrycli.study.study import run_study
@@ -292,7 +292,7 @@ def _no_fit(rows: list[dict], axes) -> str:
 def _fit_line(group, im: str, axes) -> str:
     """The fragility line of one group of runs (``fragility.FitGroup``): its fit, or why there is none;
     prefixed by the group's values when the study has several (``friction = 0.5: fragility (pga): …``)."""
-    from masonrycli.intensity import UNITS
+    from masonrycli.records.intensity import UNITS
 
     fit, rows, unit = group.fit, group.rows, UNITS[im]
     if fit is None:
@@ -321,8 +321,8 @@ def _fit_line(group, im: str, axes) -> str:
 def _report(console, result, plan: StudyPlan, im: str, written: list, signals: FirstSignalStops) -> None:
     """The table on the terminal, the fit, the plot and the recording; ``written`` gets each file's path
     as it is renamed into place, a signal held between the two (:func:`_recorded`)."""
-    from masonrycli.intensity import UNITS
-    from masonrycli.outputs import written_whole
+    from masonrycli.outputs.files import written_whole
+    from masonrycli.records.intensity import UNITS
     from masonrycli.study.curves import searched_range
     from masonrycli.study.fragility import fit_by
     from masonrycli.study.plots import fragility_curve, state_map, threshold_curve
@@ -356,7 +356,7 @@ def _report(console, result, plan: StudyPlan, im: str, written: list, signals: F
             with written_whole(recording, around_commit=_recorded(signals, written, recording)) as part:
                 record_study(part, name, rows, request, fit, im, plot.path, groups)
         except OSError as exc:  # a full disk: the table and plot are written, the recording is not (exit 4)
-            from masonrycli.cli_messages import fail
+            from masonrycli.cli.messages import fail
 
             fail(f"cannot write {recording.option} {recording.path}: {exc.strerror or exc}", EXIT_OUTPUT_FAILED)
     # said once both are written: a reader of stdout that goes away (`masonry sweep … | head`) broke the pipe

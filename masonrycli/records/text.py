@@ -29,8 +29,8 @@ import re
 import numpy as np
 
 from masonrycli.errors import InputError
-from masonrycli.record_units import MAX_AT2_G, check_at2_sample
-from masonrycli.values import format_value, shorten
+from masonrycli.records.units import MAX_AT2_G, check_at2_sample
+from masonrycli.scenario.values import format_value, shorten
 
 _SPLIT = re.compile(r"\s*[,;]\s*|\s+")
 CHUNK_CHARS = 1 << 20
@@ -95,7 +95,7 @@ class TimeStepNotUsed(InputError):
 
 def csv_lines(lines, first: int, name: str, state: CsvState) -> tuple[list, list]:
     """``(times, values)`` of CSV ``lines``, the first being line ``first`` of the file (the reference
-    reading; see :func:`masonrycli.records.load_record_csv` for the format). Raises :class:`InputError`."""
+    reading; see :func:`masonrycli.records.read.load_record_csv` for the format). Raises :class:`InputError`."""
     times: list[float] = []
     values: list = []
     for lineno, line in enumerate(lines, start=first):

@@ -28,9 +28,9 @@ import warnings
 import numpy as np
 
 from masonrycli.errors import InputError, RecordWarning
-from masonrycli.record_motion import time_step_problem
-from masonrycli.record_text import free_numbers
-from masonrycli.values import shorten
+from masonrycli.records.motion import time_step_problem
+from masonrycli.records.text import free_numbers
+from masonrycli.scenario.values import shorten
 
 ESM_SUFFIX = ".asc"
 G_STANDARD = 9.80665

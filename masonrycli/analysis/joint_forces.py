@@ -57,7 +57,7 @@ def joint_resultants(
     Args:
         contact_body: (C, 2) int bodies (a, b) of each contact; contact_point (C, 2) m; contact_normal
             (C, 2) unit, from a to b; contact_force (C, 2) N on body b; contact_status (C,) int
-            (``masonrycli.frame`` CONTACT_*).
+            (``masonrycli.outputs.frame`` CONTACT_*).
         contact_frame: (C,) int ≥ 0, optional: the frame of each contact, for the contacts of several
             frames at once (a recording's batch). The joints are then those of (frame, a, b), rows sorted
             by (frame, a, b), ``frame`` says which; each frame's rows are what it alone would give.

@@ -26,7 +26,7 @@ import io
 import re
 
 from masonrycli.errors import InputError
-from masonrycli.values import shorten
+from masonrycli.scenario.values import shorten
 
 _AT2_UNITS = re.compile(r"UNITS\s+OF\s+([^\s,;]+)", re.IGNORECASE)
 _AT2_OTHER_SERIES = re.compile(r"\b(VELOCITY|DISPLACEMENT)\b", re.IGNORECASE)

@@ -36,13 +36,13 @@ from pathlib import Path
 from types import SimpleNamespace
 
 from masonrycli.errors import NOT_A_FILE, InputError, file_kind, special_file
-from masonrycli.motion import Constant, Fixed, Sine
-from masonrycli.record_motion import Record, time_step_problem
-from masonrycli.record_text import NoTimeStep, TimeStepNotUsed
-from masonrycli.records import record_motion
-from masonrycli.scenario import MAX_DURATION, Material, RunConfig, Scenario, scenario_from_builder
-from masonrycli.structure import GEOMETRY_SUFFIXES, BuilderError, as_options, build_structure
-from masonrycli.values import option_text
+from masonrycli.records.motion import Record, time_step_problem
+from masonrycli.records.read import record_motion
+from masonrycli.records.text import NoTimeStep, TimeStepNotUsed
+from masonrycli.scenario.motion import Constant, Fixed, Sine
+from masonrycli.scenario.scenario import MAX_DURATION, Material, RunConfig, Scenario, scenario_from_builder
+from masonrycli.scenario.structure import GEOMETRY_SUFFIXES, BuilderError, as_options, build_structure
+from masonrycli.scenario.values import option_text
 
 DEFAULT_DURATION = {"wall": 1.0, "arch": 5.0, "aqueduct": 5.0}
 """s, simulated time of each built-in scenario."""
@@ -175,7 +175,7 @@ def shaken_supports(scenario: Scenario) -> list[bool]:
 def shaken_by(scenario: Scenario, motion) -> Scenario:
     """``scenario`` with its :func:`shaken_supports` moved by ``motion``; a geometry file's warning that the
     support it marks driven stays fixed (it has no motion) is left out: the record drives it now."""
-    from masonrycli.scenario_warnings import idle_driven_supports
+    from masonrycli.scenario.caveats import idle_driven_supports
 
     shaking = shaken_supports(scenario)
     motions = tuple(motion if shake else m for shake, m in zip(shaking, scenario.motions))
@@ -218,8 +218,8 @@ def target_scenario(target: str | os.PathLike, built_in: Callable[[str], Scenari
     takes files only, and the message says where the built-ins run), else a scenario file (TOML) or a
     geometry file (GeoJSON / WKT, every support fixed). A target that is none of them raises the same
     one-line :class:`InputError` from every command, naming it."""
-    from masonrycli.scenario import scenario_from_geometry_file
-    from masonrycli.scenario_toml import load_scenario
+    from masonrycli.scenario.scenario import scenario_from_geometry_file
+    from masonrycli.scenario.toml_file import load_scenario
 
     target = os.fspath(target)
     if not target.strip():  # Path("") is the working folder: it said "error: : no such scenario …"
@@ -368,7 +368,7 @@ def builder_options(name: str, options: dict) -> dict:
 def build_assembly(name: str, **overrides):
     """The assembly of builder ``name`` that ``masonry build`` writes, from the builder's options and
     ``density`` / ``thickness`` (None: not given), built and checked as ``simulate`` builds them
-    (:func:`~masonrycli.structure.build_structure`): the same mistake gets the same line (build said
+    (:func:`~masonrycli.scenario.structure.build_structure`): the same mistake gets the same line (build said
     "wall: block count …" where simulate and sweep said 'builder "wall": block count …')."""
     material = Material()
     for key in ("density", "thickness"):

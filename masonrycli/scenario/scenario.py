@@ -1,14 +1,10 @@
 """Scenarios: what to simulate (structure, material, support motions) and how (time stepping, solver).
 
-This module holds the data classes and the constructors that do not read TOML: a :class:`Scenario`
-from a named builder of ``geometry_library.builders`` (:func:`scenario_from_builder`, used by
-``masonry simulate wall ...``) or from a geometry file (:func:`scenario_from_geometry_file`).
-:mod:`masonrycli.scenario_toml` reads a TOML scenario file (``load_scenario``, format in
-``docs/scenario-format.md``) and writes one back (``dump_scenario``); :func:`scenario_summary` gives the
-numbers ``masonry check`` prints.
-
-Every problem with the input raises :class:`masonrycli.errors.InputError` with a one-line message naming
-the file and the key, e.g. ``wall.toml: [run] dt = -0.001: must be > 0``.
+The data classes and the constructors that do not read TOML: from a builder of ``geometry_library.builders``
+(:func:`scenario_from_builder`: ``masonry simulate wall ...``) or a geometry file (:func:`scenario_from_geometry_file`).
+:mod:`masonrycli.scenario.toml_file` reads and writes scenario files; :func:`scenario_summary` gives what
+``masonry check`` prints. A problem with the input raises :class:`masonrycli.errors.InputError`, one line naming
+the file and the key: ``wall.toml: [run] dt = -0.001: must be > 0``.
 """
 
 from __future__ import annotations
@@ -22,9 +18,15 @@ from pathlib import Path
 from geometry_library.blocks import Assembly, Block, GeometryError
 from geometry_library.values import MATERIAL_RANGE
 from masonrycli.errors import InputContext, InputError, input_path
-from masonrycli.motion import Fixed, Motion
-from masonrycli.structure import BuilderError, build_structure, check_finite_tree, read_geometry, structure_warnings
-from masonrycli.values import check_int, check_real, check_vector, field_error, quote_string, shorten
+from masonrycli.scenario.motion import Fixed, Motion
+from masonrycli.scenario.structure import (
+    BuilderError,
+    build_structure,
+    check_finite_tree,
+    read_geometry,
+    structure_warnings,
+)
+from masonrycli.scenario.values import check_int, check_real, check_vector, field_error, quote_string, shorten
 
 MAX_DURATION = 1e5
 """s — longer runs are refused as a likely typo."""
@@ -55,8 +57,7 @@ from the centroid) is refused as a likely typo: run.py calls a block that fast d
 SOLVERS = ("nlgs-accel32", "nlgs-accel", "nlgs")
 """Contact solvers a run can select (RunConfig.solver); the first is the default."""
 
-# --------------------------------------------------------------------------------------------------
-# configuration dataclasses
+# configuration dataclasses ----------------------------------------------------------------------
 
 
 @dataclass(frozen=True)
@@ -177,12 +178,12 @@ class Scenario:
     name : label of the run (recording names, summaries).
     run : :class:`RunConfig`.  material : :class:`Material`.
     assembly : blocks and supports (``geometry_library.blocks.Assembly``).
-    motions : one :class:`~masonrycli.motion.Motion` per support, in ``assembly.supports`` order.
+    motions : one :class:`~masonrycli.scenario.motion.Motion` per support, in ``assembly.supports`` order.
     source : scenario file path, or ``"builder:<name>"``.
     structure : ``{"builder": name, **options}`` for builder scenarios, else ``{}``.
     warnings : non-fatal remarks from ``geometry_library.checks.validate_assembly``.
     marked_driven : names of the supports a geometry file run as it is marks ``"driven"`` (``support_role``): a
-        record given on the command line shakes them (:func:`masonrycli.builtin.shaken_supports`).
+        record given on the command line shakes them (:func:`masonrycli.scenario.builtin.shaken_supports`).
 
     Each support's ``role`` is made consistent with its motion (``"driven"`` unless the motion is fixed).
     """
@@ -308,8 +309,7 @@ def _check_alert_distance(alert_distance: float, assembly: Assembly, where: str)
         )
 
 
-# --------------------------------------------------------------------------------------------------
-# constructors
+# constructors -----------------------------------------------------------------------------------
 
 
 def scenario_from_builder(
@@ -362,7 +362,7 @@ def scenario_from_geometry_file(path) -> Scenario:
     material = Material()
     notes: list[str] = []
     assembly = read_geometry(path, material.density, material.thickness, ctx, where="", notes=notes)
-    from masonrycli.scenario_warnings import idle_driven_supports
+    from masonrycli.scenario.caveats import idle_driven_supports
 
     motions = tuple(Fixed() for _ in assembly.supports)
     warnings = (*notes, *idle_driven_supports(assembly, motions), *structure_warnings(assembly, ctx))
@@ -379,8 +379,7 @@ def scenario_from_geometry_file(path) -> Scenario:
     )
 
 
-# --------------------------------------------------------------------------------------------------
-# summary
+# summary ----------------------------------------------------------------------------------------
 
 
 def _block_mass(block: Block) -> float:
@@ -465,7 +464,7 @@ def _file_where(source: str, *candidates) -> str:
     """``<file>:<line>: `` of the first (table path, key, value) the file gives with the value the run has
     (``--dt`` or a sweep's ``--param`` may have replaced it: toml_lines.file_key_line); ``<file>: `` when
     none is found (a geometry file, a key not written in the file)."""
-    from masonrycli.toml_lines import file_key_line
+    from masonrycli.scenario.toml_lines import file_key_line
 
     for path, key, value in candidates:
         line = file_key_line(source, path, key, value)

@@ -1,6 +1,6 @@
 """The velocity history a tabulated record defines: its samples prepared once, then evaluated at any times.
 
-:class:`~masonrycli.record_motion.Record` holds the samples as read (``time`` (n,) s; ``value`` (n,) along a
+:class:`~masonrycli.records.motion.Record` holds the samples as read (``time`` (n,) s; ``value`` (n,) along a
 direction or (n, 2)); :func:`record_arrays` prepares them (direction, scale, window, the nodal
 velocities of an acceleration record, its baseline correction) and :func:`record_velocity` evaluates
 the velocity at many instants at once.

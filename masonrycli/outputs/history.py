@@ -7,14 +7,14 @@ Arrays (T frames, N blocks, S supports), block order = scenario order:
     contact_count (T,) · nlgs_iterations (T,) sweeps · nlgs_residual (T,) m/s (of the step ending at the frame)
     nlgs_unconverged (T,) steps since t = 0 that ended unconverged (residual > tolerance or at the cap)
     energy_kinetic (T,) J · energy_potential (T,) J · energy_dissipated (T,) J (cumulated)
-    support_work (T,) J (cumulated) · every per-block tensor field of masonrycli.tensors.TENSOR_FIELDS
+    support_work (T,) J (cumulated) · every per-block tensor field of masonrycli.analysis.tensors.TENSOR_FIELDS
     joint_body (J,2) body indices, blocks then supports (N + s: support s) · joint_hinged (T,J) bool ·
-    hinge_count (T,)  (see masonrycli.mechanism)
+    hinge_count (T,)  (see masonrycli.analysis.mechanism)
     block_mass (N,) kg · block_inertia (N,) kg m² · block_extent (N,4) m (bounding box as built; written by
     the command line, :func:`block_constants`)
-    block_name (N,) · support_name (S,) · status () str (masonrycli.sinks.STATUSES) · note () str
+    block_name (N,) · support_name (S,) · status () str (masonrycli.outputs.sinks.STATUSES) · note () str
     intensity_pga, intensity_pgv, intensity_arias, intensity_d5_95, intensity_sa () — the ground motion as
-    applied (masonrycli.intensity), when a support shakes
+    applied (masonrycli.records.intensity), when a support shakes
 
 :class:`HistoryFile` (the command line's sink) streams every row to disk as it comes, so memory stays
 flat however long the run; :class:`History` keeps the rows in memory for tests and scripts.
@@ -35,10 +35,10 @@ from pathlib import Path
 
 import numpy as np
 
-from masonrycli.frame import Frame
-from masonrycli.mechanism import JOINT_FIELDS
-from masonrycli.sinks import COMPLETED
-from masonrycli.tensors import TENSOR_FIELDS
+from masonrycli.analysis.mechanism import JOINT_FIELDS
+from masonrycli.analysis.tensors import TENSOR_FIELDS
+from masonrycli.outputs.frame import Frame
+from masonrycli.outputs.sinks import COMPLETED
 
 _SCALARS = (
     "time",
@@ -166,7 +166,7 @@ class History:
 
 
 class HistoryFile:
-    """A :class:`~masonrycli.sinks.FrameSink` writing the history ``.npz`` at ``path`` without holding it.
+    """A :class:`~masonrycli.outputs.sinks.FrameSink` writing the history ``.npz`` at ``path`` without holding it.
 
     Each frame's rows are appended to one raw file per array in the scratch folder ``<path>.rows``;
     :meth:`close` writes the ``.npz`` from them (a stored zip of ``.npy`` members, read by ``np.load``)

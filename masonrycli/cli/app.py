@@ -12,8 +12,8 @@ import typer
 
 from geometry_library.blocks import GeometryError
 from masonrycli import __version__
-from masonrycli.cli_messages import OneLineUsageErrors, console, err_console, fail, say, user_errors, warn
-from masonrycli.cli_options import (
+from masonrycli.cli.messages import OneLineUsageErrors, console, err_console, fail, say, user_errors, warn
+from masonrycli.cli.options import (
     AQUEDUCT,
     ARCH,
     BLOCK_MATERIAL,
@@ -86,7 +86,7 @@ def _execute(scenario, opts: dict, hint=None) -> None:
     """Check the outputs (``opts``: the OUTPUT, FORCE and STOP options), run, print the summary; exit with
     the code of how the run ended. ``hint``: the line under the summary, given the time the run reached."""
     from masonrycli.interrupt import StopSignals
-    from masonrycli.scenario_warnings import scenario_warnings
+    from masonrycli.scenario.caveats import scenario_warnings
 
     outputs = _check_run(scenario, opts)
     for warning in scenario_warnings(scenario):
@@ -102,7 +102,7 @@ def _execute_and_report(scenario, opts: dict, hint, outputs, signals) -> None:
     """:func:`_execute`'s run and summary, under ``signals``."""
     from masonrycli.execute import execute, print_summary
     from masonrycli.interrupt import StopRun, exit_code, signal_name
-    from masonrycli.sinks import DIVERGED, FAILED, INTERRUPTED
+    from masonrycli.outputs.sinks import DIVERGED, FAILED, INTERRUPTED
 
     try:
         outcome = execute(
@@ -173,7 +173,7 @@ def _pop(opts: dict, *groups: dict) -> dict:
 
 
 def _simulate(name: str, opts: dict) -> None:
-    from masonrycli.builtin import builtin, paper_instant_hint
+    from masonrycli.scenario.builtin import builtin, paper_instant_hint
 
     outputs = _pop(opts, OUTPUT, FORCE, STOP)
     scenario = builtin(name, **opts)
@@ -221,7 +221,7 @@ RUN_FROM_FILE, FRICTION_FROM_FILE = file_defaults(RUN), file_defaults(FRICTION) 
 def _load(scenario_file: str, opts: dict):
     """The scenario of a TOML, GeoJSON or WKT file with the command line's record and run options
     (taken out of ``opts``) applied."""
-    from masonrycli.builtin import file_scenario
+    from masonrycli.scenario.builtin import file_scenario
 
     return file_scenario(scenario_file, **_pop(opts, RECORD, RUN, FRICTION))
 
@@ -239,7 +239,7 @@ def run_command(scenario_file: ScenarioFile, **opts) -> None:
 def _register_sweep() -> None:
     # the sweep command lives in its own module (it is as long as a small CLI); registered here so
     # that `masonry --help` lists it with the others
-    from masonrycli.cli_sweep import sweep_command
+    from masonrycli.cli.sweep import sweep_command
 
     app.command("sweep")(user_errors(sweep_command))
 
@@ -248,7 +248,7 @@ _register_sweep()
 
 
 def _register_export() -> None:
-    from masonrycli.cli_export import export_command
+    from masonrycli.cli.export import export_command
 
     app.command("export")(user_errors(export_command))
 
@@ -311,9 +311,9 @@ def limit_command(
 def check_command(scenario_file: ScenarioFile, **opts) -> None:
     """Validate what `masonry run` would run, with the same arguments, and print a summary (blocks,
     supports, mass, bounding box, steps, the loading, outputs); nothing is computed or written."""
-    from masonrycli.report import check_table
-    from masonrycli.scenario import scenario_summary
-    from masonrycli.scenario_warnings import scenario_warnings
+    from masonrycli.outputs.report import check_table
+    from masonrycli.scenario.caveats import scenario_warnings
+    from masonrycli.scenario.scenario import scenario_summary
 
     scenario = _load(scenario_file, opts)
     outputs = _check_run(scenario, opts)
@@ -326,8 +326,8 @@ def _write_assembly(builder: str, opts: dict) -> None:
     """Build, check and write the GeoJSON under a temporary name, renamed onto ``--out`` when complete."""
     from geometry_library.checks import validate_assembly
     from geometry_library.io import write_geojson
-    from masonrycli.builtin import build_assembly
-    from masonrycli.outputs import check_output, written_whole
+    from masonrycli.outputs.files import check_output, written_whole
+    from masonrycli.scenario.builtin import build_assembly
 
     # .json too: `masonry run` reads a .json file as GeoJSON (GEOMETRY_SUFFIXES), build refused to write one
     target = check_output(opts.pop("out"), "--out", (".geojson", ".json"), opts.pop("force"))
@@ -385,13 +385,13 @@ def inspect_command(
 ) -> None:
     """Summarise a recording (scenario, frames, time span, entities), a run history (its parameters,
     status, frames and each array's unit) or a study's table (its rows and each column's unit)."""
-    from masonrycli.history_inspect import inspect_history, is_history
+    from masonrycli.outputs.inspect_history import inspect_history, is_history
     from masonrycli.study.inspect_table import is_study_table, study_summary
 
     if recording.is_file() and recording.stat().st_size == 0:  # rerun's "file too small to be an RRD", a zip error
         raise InputError(f"{recording}: an empty file (0 bytes), not a recording or a history")
     if is_study_table(recording):
-        from masonrycli.report import columns_lines
+        from masonrycli.outputs.report import columns_lines
 
         table, lines = columns_lines(
             f"{recording} — study table", *study_summary(recording), "column", "unit / meaning"
@@ -401,15 +401,15 @@ def inspect_command(
             console.print(line, soft_wrap=True)
         return
     if is_history(recording):
-        from masonrycli.report import history_tables
+        from masonrycli.outputs.report import history_tables
 
         table, lines = history_tables(str(recording), inspect_history(recording))
         console.print(table)
         for line in lines:
             console.print(line, soft_wrap=True)
         return
+    from masonrycli.outputs.report import recording_table
     from masonrycli.recording import inspect_recording, recording_path_problem
-    from masonrycli.report import recording_table
 
     problem = recording_path_problem(recording)
     if problem:
@@ -424,7 +424,7 @@ def inspect_command(
     if info.get("metadata"):
         console.print(info["metadata"])
     if info["truncated"]:
-        from masonrycli.outputs import part_writer
+        from masonrycli.outputs.files import part_writer
 
         pid = part_writer(recording)
         why = (
@@ -444,7 +444,7 @@ def docs_command(
     """List the documentation's topics, or print one page (Markdown) or its file.
 
     The pages ship with masonry: an install without the clone has them too."""
-    from masonrycli import user_docs
+    from masonrycli.cli import docs as user_docs
 
     if topic is None:
         for line in user_docs.listing():
