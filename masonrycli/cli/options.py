@@ -51,7 +51,7 @@ def _no_underscore(text: str, kind: str) -> None:
 def number_value(text: str) -> TypedNumber:
     """A float option's value that remembers how it was typed, for the messages that echo it ("--rtol 0:
     must be in (0, 1)", was "0.0"). Parsed as typer parses a float (pydantic's lax float), so a value that
-    is not a number fails as before (cli_messages: "--dt 20ms: must be a number ..."), except digits with
+    is not a number fails as before (cli/messages.py: "--dt 20ms: must be a number ..."), except digits with
     underscores (:func:`_no_underscore`)."""
     _no_underscore(text, "float_parsing")
     return TypedNumber(_FLOAT.validate_python(text), str(text))

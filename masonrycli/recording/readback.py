@@ -119,7 +119,7 @@ _OTHER_FILES = {  # suffix: what masonry writes or reads under it, for a file th
     ".png": "an image (.png)",
     ".at2": "a ground-motion record (PEER .AT2; simulate and run take it with --record)",
     ".asc": "a ground-motion record (ESM .ASC; simulate and run take it with --record)",
-    **{  # K-NET / KiK-net's (record_knet.KNET_SUFFIXES): 'Not an RRD file: expected FourCC header "RRF2", got "Orig"'
+    **{  # K-NET / KiK-net's (records.knet.KNET_SUFFIXES): 'Not an RRD file: expected FourCC header "RRF2", got "Orig"'
         f".{c}{n}": f"a ground-motion record (K-NET .{c.upper()}{n}; simulate and run take it with --record)"
         for c in ("ns", "ew", "ud")
         for n in ("", "1", "2")
