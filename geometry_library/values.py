@@ -103,6 +103,7 @@ SETTING_UNITS: dict[str, str] = {
             "ground_margin",
             "ground_depth",
             "span",
+            "rise",
             "ring_thickness",
             "pier_width",
             "pier_course_height",

@@ -61,6 +61,12 @@ class AqueductSpec(ArchSpec):
         Raises GeometryError (one line) for invalid parameters, or a wall top below the crown.
         """
         check_count("aqueduct", 1, wall_courses=self.wall_courses)
+        if self.rise is not None and self.rise != 0.5 * self.span:  # the spandrel is cut to a semicircle's extrados
+            raise GeometryError(
+                f"aqueduct: rise {self.rise:g} m: the aqueduct's arch is semicircular (a segmental arch is the arch "
+                "builder's: masonry build arch --rise)",
+                keys=("rise",),
+            )
         check_dimensions("aqueduct", block_length=self.block_length, block_height=self.block_height)
         blocks, supports, geom = arch_parts(self)
         top = geom.springing + self.wall_courses * self.block_height

@@ -1,4 +1,4 @@
-"""Semicircular voussoir arch on two running-bond piers (the paper's 98-block arch).
+"""Semicircular or segmental voussoir arch on two running-bond piers (the paper's 98-block arch).
 
 Geometry (defaults)
 -------------------
@@ -18,7 +18,15 @@ Geometry (defaults)
 - Springing line at y = 3.40 m, crown intrados at 5.20 m and extrados at 5.55 m; arch centre at
   x = 0. Overall 5.40 m wide (piers' outer faces).
 
-Block count: 2 × 17 × 2 + 30 = 98. Order: left pier (bottom up, left to right), voussoirs (left to
+Segmental arch (``rise`` below span / 2): the intrados is the circular arc through both springings
+and the crown, radius R_i = (span²/4 + rise²) / (2 rise), centre R_i − rise below the springing line;
+the voussoirs divide its embrace 2α (sin α = span / (2 R_i)) into equal angles, joints radial. The
+springing joints are then inclined, so each pier carries a skewback stone (``left-skewback``,
+``right-skewback``) across its whole width: from the intrados springing point up the radial joint to the
+extrados springing point, t·cos α above the pier top, then level to the pier's outer face. These two
+blocks come right after the left pier and right before the right pier.
+
+Block count: 2 × 17 × 2 + 30 = 98 (+ 2 skewbacks for a segmental arch). Order: left pier (bottom up, left to right), voussoirs (left to
 right, ``v01`` … ``v30``), right pier. Names: ``left-pier-c01-b1`` …, ``v01`` …, ``right-pier-c17-b2``.
 """
 
@@ -56,6 +64,21 @@ class ArchGeometry:
     extrados: np.ndarray
 
 
+def _unit_segment(n: int, half_angle: float) -> np.ndarray:
+    """(n+1, 2) points (cos φ_k, sin φ_k) from φ_0 = π/2 + α to φ_n = π/2 − α in equal steps, exactly
+    mirror-symmetric about x = 0 (α = ``half_angle`` < π/2: a segmental arch's embrace is 2α)."""
+    out = np.empty((n + 1, 2))
+    for k in range(n + 1):
+        j = min(k, n - k)
+        if 2 * j == n:
+            c, s = 0.0, 1.0
+        else:
+            phi = 0.5 * math.pi - half_angle + 2.0 * half_angle * j / n  # from the right springing up
+            c, s = math.cos(phi), math.sin(phi)
+        out[k] = (-c, s) if k == j else (c, s)
+    return out
+
+
 def _unit_half_circle(n: int) -> np.ndarray:
     """(n+1, 2) points (cos φ_k, sin φ_k), φ_k = π − πk/n, exactly mirror-symmetric about x = 0."""
     out = np.empty((n + 1, 2))
@@ -74,7 +97,7 @@ def _unit_half_circle(n: int) -> np.ndarray:
 
 @dataclass(frozen=True)
 class ArchSpec:
-    """Parameters of a semicircular arch on two running-bond piers (the TOML ``[structure]`` options).
+    """Parameters of a semicircular or segmental arch on two running-bond piers (the TOML ``[structure]`` options).
 
     Attributes
     ----------
@@ -82,6 +105,8 @@ class ArchSpec:
     pier_courses : int — courses per pier, 2 blocks each (default 17 → 34 blocks per pier).
     span : float, m — clear span between the piers = intrados diameter (default 3.6).
     ring_thickness : float, m — extrados radius − intrados radius (default 0.35), ≤ pier_width.
+    rise : float, m, or None — height of the intrados crown above the springing line; None or span / 2 is
+        the semicircle, less a segmental arch with a skewback on each pier (module docstring).
     pier_width : float, m (default 0.90; blocks 0.60 + 0.30). pier_course_height : m (0.20).
     density : kg/m³. thickness : m, out of plane.
     foundation_margin, foundation_depth : m — foundation pads under each pier.
@@ -100,10 +125,11 @@ class ArchSpec:
     foundation_depth: float = 0.50
     left_role: str = "fixed"
     right_role: str = "fixed"
+    rise: float | None = None
 
     def build(self) -> Assembly:
-        """The arch: 2·2·pier_courses + voussoirs blocks (98 by default) and two supports. See the
-        module docstring for the layout, names and order."""
+        """The arch: 2·2·pier_courses + voussoirs blocks (98 by default; + 2 skewbacks when segmental)
+        and two supports. See the module docstring for the layout, names and order."""
         blocks, supports, _ = arch_parts(self)
         return Assembly(tuple(blocks), tuple(supports))
 
@@ -148,15 +174,23 @@ def arch_parts(spec: ArchSpec) -> tuple[list[Block], list[Support], ArchGeometry
         if role not in SUPPORT_ROLES:
             raise GeometryError(f"arch: {key} must be one of {SUPPORT_ROLES}, got {role!r}", keys=(key,))
 
-    r_in = 0.5 * span
-    r_out = r_in + ring_thickness
-    outer = r_in + pier_width
     y_spring = pier_courses * pier_course_height
-    unit = _unit_half_circle(voussoirs)
-    intrados = unit * r_in + (0.0, y_spring)
-    extrados = unit * r_out + (0.0, y_spring)
-    intrados[:, 1][[0, -1]] = y_spring
-    extrados[:, 1][[0, -1]] = y_spring
+    half_angle = _half_angle(span, spec.rise)
+    if half_angle is None:  # the semicircle, as it always was built (bit for bit)
+        r_in = 0.5 * span
+        centre_y = y_spring
+        unit = _unit_half_circle(voussoirs)
+    else:
+        r_in = 0.5 * span / math.sin(half_angle)
+        centre_y = y_spring - r_in * math.cos(half_angle)
+        unit = _unit_segment(voussoirs, half_angle)
+    r_out = r_in + ring_thickness
+    outer = 0.5 * span + pier_width
+    intrados = unit * r_in + (0.0, centre_y)
+    extrados = unit * r_out + (0.0, centre_y)
+    intrados[[0, -1]] = [(-0.5 * span, y_spring), (0.5 * span, y_spring)]  # the springings, exactly
+    if half_angle is None:
+        extrados[:, 1][[0, -1]] = y_spring
 
     def pier(side: str, x_in: float, x_out: float) -> list[Block]:
         sign = 1.0 if x_out > x_in else -1.0
@@ -184,23 +218,38 @@ def arch_parts(spec: ArchSpec) -> tuple[list[Block], list[Support], ArchGeometry
         )
         for k in range(voussoirs)
     ]
-    blocks = pier("left", -r_in, -outer) + ring + pier("right", r_in, outer)
+    skewbacks: tuple[list[Block], list[Block]] = ([], [])
+    if half_angle is not None:  # the inclined springing joint rests on a stone across the pier top
+        y_top = extrados[0, 1]
+        skewbacks = tuple(
+            [
+                make_block(
+                    np.array([intrados[k], (side * outer, y_spring), (side * outer, y_top), extrados[k]]),
+                    f"{name}-skewback",
+                    density,
+                    thickness,
+                )
+            ]
+            for k, side, name in ((0, -1.0, "left"), (-1, 1.0, "right"))
+        )
+    half = 0.5 * span
+    blocks = pier("left", -half, -outer) + skewbacks[0] + ring + skewbacks[1] + pier("right", half, outer)
 
     inner_margin = min(foundation_margin, 0.25 * span)
     supports = [
         make_support(
-            box(-outer - foundation_margin, -foundation_depth, -r_in + inner_margin, 0.0),
+            box(-outer - foundation_margin, -foundation_depth, -half + inner_margin, 0.0),
             "left-foundation",
             left_role,
         ),
         make_support(
-            box(r_in - inner_margin, -foundation_depth, outer + foundation_margin, 0.0),
+            box(half - inner_margin, -foundation_depth, outer + foundation_margin, 0.0),
             "right-foundation",
             right_role,
         ),
     ]
     geometry = ArchGeometry(
-        centre=np.array([0.0, y_spring]),
+        centre=np.array([0.0, centre_y]),
         intrados_radius=r_in,
         extrados_radius=r_out,
         springing=y_spring,
@@ -208,6 +257,24 @@ def arch_parts(spec: ArchSpec) -> tuple[list[Block], list[Support], ArchGeometry
         extrados=extrados,
     )
     return blocks, supports, geometry
+
+
+def _half_angle(span: float, rise: float | None) -> float | None:
+    """α, half the embrace of a segmental arch of this span and intrados rise; None for the semicircle
+    (rise None or span / 2). A rise above span / 2 (a horseshoe or a stilted arch) is refused."""
+    if rise is None:
+        return None
+    check_dimensions("arch", rise=rise)
+    if rise > 0.5 * span * (1.0 + 1e-12):
+        raise GeometryError(
+            f"arch: rise {rise:g} m is more than half the span ({0.5 * span:g} m): a segmental arch rises at most "
+            "to a semicircle (leave rise out, or give span / 2, for the semicircle)",
+            keys=("rise", "span"),
+        )
+    if rise >= 0.5 * span * (1.0 - 1e-12):
+        return None
+    radius = (0.25 * span * span + rise * rise) / (2.0 * rise)
+    return math.asin(min(1.0, 0.5 * span / radius))
 
 
 def build_arch(**options) -> Assembly:

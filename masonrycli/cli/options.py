@@ -102,7 +102,17 @@ ARCH = {
     "ring_thickness": _opt(float, "Structure", "Arch ring thickness, m (default 0.35)."),
     "pier_width": _opt(float, "Structure", "Pier width, m (default 0.90)."),
 }
+# the aqueduct's spandrel is cut to a semicircle: --rise is the bare arch's
 AQUEDUCT = {**ARCH, "wall_courses": _opt(int, "Structure", "Courses of the spandrel walls (default 18).")}
+ARCH = {
+    **ARCH,
+    "rise": _opt(
+        float,
+        "Structure",
+        "Rise of the intrados crown above the springings, m (default: span / 2, the semicircle; less: a "
+        "segmental arch, with a skewback stone on each pier).",
+    ),
+}
 # The wall stands on one ground, shaken by default; the arch and the aqueduct settle their right
 # foundation by default and are shaken with --settlement 0 --amp A. One group for both listed --settlement
 # under `simulate wall --help` (always refused there) and no loading default anywhere.

@@ -1,0 +1,101 @@
+"""An independent slow reference for the collapse load of a voussoir ring on two rigid springers: the
+least load factor over every kinematically admissible four-hinge mechanism (the upper-bound theorem of
+limit analysis for a no-tension ring that cannot slide; Heyman, *The Masonry Arch*, 1982, ch. 4;
+Oppenheim 1992 and Ochsendorf 2002 for the arch under horizontal acceleration).
+
+It shares nothing with ``masonrycli.limit``: no LP, no contact detection. The ring is given by its joints —
+joint j has an intrados point I_j and an extrados point E_j; voussoir k lies between joints k and k+1 — and
+the voussoirs' masses and centroids. A mechanism hinges at joints a < b < c < d, each hinge at I or E:
+
+    body 1 = voussoirs a … b−1 turns (ω1 = 1) about the hinge H_a on the left springer's side
+    body 3 = voussoirs c … d−1 turns (ω3) about H_d
+    body 2 = voussoirs b … c−1 turns (ω2) about I2 = line(H_a, H_b) ∩ line(H_d, H_c)
+    ω2 from the common velocity of H_b, ω3 from that of H_c; the other voussoirs stay still.
+
+It is admissible when every hinge opens its joint at the other end (relative rotation of the right body
+with respect to the left one, read at the joint's far end, moves it away along the joint's normal), for ω1
+or for −ω1; then λ = −P(dead) / P(live), with P the power of the loads, taken with the sign making
+P(live) > 0. The collapse factor is the least λ over all admissible mechanisms (every 4-hinge choice and
+all 16 intrados/extrados patterns, vectorised with prefix sums: P of a body turning ω about O is
+ω (Σ (c × f) − O × Σ f)).
+"""
+
+from __future__ import annotations
+
+import itertools
+
+import numpy as np
+
+
+def _cross(ax, ay, bx, by):
+    return ax * by - ay * bx
+
+
+def _power(prefix_sums, bodies) -> np.ndarray:
+    """Power of one load on the three turning bodies (ω, first voussoir, end, centre of rotation) of each mechanism."""
+    fx, fy, m = prefix_sums
+    total = 0.0
+    for omega, lo, hi, centre in bodies:
+        sfx, sfy, sm = fx[hi] - fx[lo], fy[hi] - fy[lo], m[hi] - m[lo]
+        total = total + omega * (sm - _cross(centre[:, 0], centre[:, 1], sfx, sfy))
+    return total
+
+
+def least_load_factor(
+    intrados: np.ndarray, extrados: np.ndarray, centroid: np.ndarray, dead: np.ndarray, live: np.ndarray
+) -> tuple[float, tuple]:
+    """(λ, (joints a b c d, sides)) of the weakest admissible four-hinge mechanism.
+
+    intrados, extrados : (n+1, 2) joint end points, left to right; centroid : (n, 2) voussoir centroids;
+    dead, live : (n, 2) forces on each voussoir (the live one multiplied by λ).
+    """
+    n = len(centroid)
+    radial = extrados - intrados
+    radial /= np.hypot(radial[:, 0], radial[:, 1])[:, None]
+    normal = np.stack([radial[:, 1], -radial[:, 0]], axis=1)  # along the ring, left to right
+
+    def prefix(forces):
+        m = _cross(centroid[:, 0], centroid[:, 1], forces[:, 0], forces[:, 1])
+        return [np.concatenate([[0.0], np.cumsum(v)]) for v in (forces[:, 0], forces[:, 1], m)]
+
+    sums = {"dead": prefix(dead), "live": prefix(live)}
+    combos = np.array(list(itertools.combinations(range(n + 1), 4)))
+    a, b, c, d = combos.T
+    best = (np.inf, None)
+    for sides in itertools.product((0, 1), repeat=4):  # 0: hinge on the intrados, 1: on the extrados
+        ends = [(intrados, extrados) if s == 0 else (extrados, intrados) for s in sides]
+        h = [ends[i][0][j] for i, j in enumerate((a, b, c, d))]  # hinge points
+        far = [ends[i][1][j] for i, j in enumerate((a, b, c, d))]  # the joints' other ends
+        # I2: H_a + s (H_b − H_a) on the line through H_d and H_c
+        u, w = h[1] - h[0], h[2] - h[3]
+        den = _cross(u[:, 0], u[:, 1], w[:, 0], w[:, 1])
+        ok = np.abs(den) > 1e-12
+        den = np.where(ok, den, 1.0)
+        r = h[3] - h[0]
+        s = _cross(r[:, 0], r[:, 1], w[:, 0], w[:, 1]) / den
+        centre2 = h[0] + s[:, None] * u
+        hb, hc = h[1] - centre2, h[2] - centre2
+        w2 = np.einsum("ij,ij->i", u, hb) / np.maximum(np.einsum("ij,ij->i", hb, hb), 1e-300)
+        hd = h[2] - h[3]
+        w3 = w2 * np.einsum("ij,ij->i", hc, hd) / np.maximum(np.einsum("ij,ij->i", hd, hd), 1e-300)
+        ok &= (np.einsum("ij,ij->i", hb, hb) > 1e-18) & (np.einsum("ij,ij->i", hd, hd) > 1e-18)
+        omega = [np.ones_like(w2), w2, w3]  # bodies 1, 2, 3; the springers' sides are still (0)
+        turn = [omega[0], omega[1] - omega[0], omega[2] - omega[1], -omega[2]]  # right minus left, per hinge
+        opening = []
+        for k, j in enumerate((a, b, c, d)):
+            arm = far[k] - h[k]
+            rel = turn[k][:, None] * np.stack([-arm[:, 1], arm[:, 0]], axis=1)
+            opening.append(np.einsum("ij,ij->i", rel, normal[j]))
+        opening = np.array(opening)
+        forward, backward = np.all(opening > 1e-12, axis=0), np.all(opening < -1e-12, axis=0)
+        sign = np.where(forward, 1.0, np.where(backward, -1.0, 0.0))
+        ok &= sign != 0.0
+
+        bodies = ((omega[0], a, b, h[0]), (omega[1], b, c, centre2), (omega[2], c, d, h[3]))
+        p_dead, p_live = (sign * _power(sums[kind], bodies) for kind in ("dead", "live"))
+        ok &= p_live > 1e-12 * np.abs(p_dead).max()
+        lam = np.where(ok, -p_dead / np.where(ok, p_live, 1.0), np.inf)
+        k = int(np.argmin(lam))
+        if lam[k] < best[0]:
+            best = (float(lam[k]), (tuple(int(x) for x in combos[k]), sides))
+    return best
