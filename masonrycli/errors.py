@@ -40,10 +40,23 @@ def input_path(base_dir: str, given: str) -> str:
     return os.path.abspath(os.path.join(base_dir, os.path.expanduser(given)))
 
 
+ESCAPED_PATH = (
+    "a \\ between double quotes starts an escape (\\t, \\n, \\U…): write the path with / "
+    "(\"C:/Users/ana/quake.AT2\") or between single quotes ('C:\\Users\\ana\\quake.AT2')"
+)
+"""What to do about a Windows path written between a TOML file's double quotes."""
+
+
 def not_a_file(path) -> str:
     """Why ``path`` is no regular file to read: "is a directory" (a folder was called a device, a pipe or a
     socket), NOT_A_FILE, or "no such file"."""
-    return "is a directory" if os.path.isdir(path) else NOT_A_FILE if os.path.exists(path) else "no such file"
+    if os.path.isdir(path):
+        return "is a directory"
+    if os.path.exists(path):
+        return NOT_A_FILE
+    if any(c in os.fspath(path) for c in "\t\n\r\f\b\v"):  # "C:\temp\new.csv" in a TOML "…" string
+        return f"no such file: its name holds a tab or a line break, {ESCAPED_PATH}"
+    return "no such file"
 
 
 def special_file(path) -> bool:
@@ -110,12 +123,22 @@ def file_kind(path, expected: str, skip: tuple[str, ...] = (), name: str | None 
     )
 
 
-def not_utf8(name: str, raw: bytes, exc: UnicodeDecodeError) -> InputError:
+def _utf16_without_mark(head: bytes) -> bool:
+    """Latin text in UTF-16 with no byte-order mark: a 0 at (nearly) every even or every odd byte, the others
+    not 0 (a binary file has zeros at both)."""
+    half = len(head) // 2
+    even, odd = head[0::2].count(0), head[1::2].count(0)
+    return half >= 4 and max(even, odd) >= 0.9 * half and min(even, odd) <= 0.1 * half
+
+
+def not_utf8(name: str, raw: bytes, exc: UnicodeDecodeError | None = None) -> InputError:
     """The error for a text input that is not UTF-8: a UTF-16 file (Excel's "Unicode Text", Notepad's
     "Unicode") is named as such, where "not a UTF-8 text file (byte 0)" left the user to guess."""
     if raw[:2] in (b"\xff\xfe", b"\xfe\xff"):
         return InputError(f"{name}: a UTF-16 text file (it starts with UTF-16's byte-order mark); save it as UTF-8")
-    if b"\x00" in raw:  # no text in any encoding: saving it "as UTF-8" is no advice
+    if _utf16_without_mark(raw[:400]):
+        return InputError(f"{name}: a UTF-16 text file (a 0 byte beside every character); save it as UTF-8")
+    if b"\x00" in raw or exc is None:  # no text in any encoding: saving it "as UTF-8" is no advice
         return InputError(f"{name}: {BINARY_FILE}")
     # the line, and what to do: "not a UTF-8 text file (byte 18)" left a user to count bytes for a "è" typed
     # in a comment by an editor saving in the Windows code page

@@ -289,7 +289,7 @@ def test_three_column_record_file_rejects_direction(tmp_path):
         ("support = [1, 2]\n" + BLOCK, "support: must be an array of tables [[support]]"),
         ("name = 3\n" + BLOCK, "name = 3: must be a string"),
         ("[run]\ndt = 0.01\n", "no blocks: add [[block]] tables or a [structure] builder"),
-        ("", "no blocks: add [[block]] tables or a [structure] builder"),
+        ("", "the file is empty (or only comments): a scenario needs [[block]] tables or a [structure] builder"),
         (BLOCK + GROUND + "mass = 3\n", '[[support]] #1 ("ground"): unknown key "mass"'),
         (BLOCK + '[[support]]\nname = "g"\n', '[[support]] #1 ("g"): polygon: missing'),
     ],

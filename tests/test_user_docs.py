@@ -110,8 +110,10 @@ def test_an_install_from_a_wheel_has_every_page_a_message_names(tmp_path):
     # (added after the install, so pip never sees this venv's masonry)
     venv = tmp_path / "venv"
     subprocess.run([sys.executable, "-m", "venv", "--without-pip", venv], check=True)
+    # without PYTHONPATH: a worktree's on it finds the clone's masonry.egg-info, and pip installs nothing
+    env = {k: v for k, v in os.environ.items() if k != "PYTHONPATH"} | {"RERUN_ANALYTICS": "0"}
     install = [sys.executable, "-m", "pip", "--python", venv / "bin" / "python", "install", "-q", "--no-deps"]
-    subprocess.run([*install, "--no-index", "--no-cache-dir", wheel], check=True, capture_output=True)
+    subprocess.run([*install, "--no-index", "--no-cache-dir", wheel], check=True, capture_output=True, env=env)
     site = subprocess.run(
         [venv / "bin" / "python", "-c", "import sysconfig; print(sysconfig.get_paths()['purelib'])"],
         capture_output=True, text=True, check=True,
@@ -119,7 +121,6 @@ def test_an_install_from_a_wheel_has_every_page_a_message_names(tmp_path):
     Path(site, "dependencies.pth").write_text(sysconfig.get_paths()["purelib"] + "\n")
     elsewhere = tmp_path / "elsewhere"
     elsewhere.mkdir()
-    env = {k: v for k, v in os.environ.items() if k != "PYTHONPATH"} | {"RERUN_ANALYTICS": "0"}
 
     def masonry(*args):
         done = subprocess.run([venv / "bin" / "masonry", *args], cwd=elsewhere, env=env, capture_output=True, text=True)

@@ -27,6 +27,7 @@ from masonrycli.scenario.motion import Constant, Fixed, Motion, Ramp, Sine
 from masonrycli.scenario.scenario import Material, RunConfig, Scenario, block_speed_problem
 from masonrycli.scenario.structure import build_structure, check_finite_tree, read_geometry, structure_warnings
 from masonrycli.scenario.toml_lines import key_line, with_line
+from masonrycli.scenario.toml_syntax import hint as syntax_hint
 from masonrycli.scenario.values import (
     check_real,
     check_vector,
@@ -78,6 +79,8 @@ def load_scenario(path) -> Scenario:
         text = raw.decode("utf-8-sig")  # tolerate the byte-order mark some Windows editors add
     except UnicodeDecodeError as exc:
         raise not_utf8(fname, raw, exc) from None
+    if "\x00" in text:  # valid UTF-8 all the same: UTF-16 saved without its byte-order mark, or not text
+        raise not_utf8(fname, raw)
     base_dir = os.path.dirname(os.path.abspath(fname))
     return loads_scenario(text, source=fname, base_dir=base_dir, default_name=Path(fname).stem)
 
@@ -91,7 +94,8 @@ def loads_scenario(
     try:
         doc = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
-        raise ctx.error("", f"TOML syntax error: {exc}") from None
+        fix = syntax_hint(text, str(exc))
+        raise ctx.error("", f"TOML syntax error: {exc}" + (f"; {fix}" if fix else "")) from None
     except RecursionError:  # thousands of nested [[[…]]]: tomllib recurses (a traceback, exit 1)
         raise ctx.error("", "TOML nested too deeply (arrays or inline tables within each other)") from None
     try:
@@ -102,6 +106,14 @@ def loads_scenario(
         if message == str(exc) and len(keys) == 1 and (line := key_line(text, ("structure",), keys[0])):
             message = f"{ctx.fname}:{line}: {message[len(ctx.fname) + 2 :]}"
         raise InputError(message) from None
+
+
+def _misplaced(key: str) -> str:
+    """A [run] or [material] setting written at the top, before any table (its header forgotten)."""
+    for section, cls in (("run", RunConfig), ("material", Material)):
+        if key in (f.name for f in dataclasses.fields(cls)):
+            return f"unknown key {quote_string(key)} at the top of the file (a [{section}] setting: write it below a [{section}] line)"
+    return ""
 
 
 def _table(doc: dict, key: str, ctx: InputContext) -> dict:
@@ -140,9 +152,14 @@ def _config(cls, table: dict, ctx: InputContext, section: str):
 
 
 def _parse_document(doc: dict, ctx: InputContext, default_name: str) -> Scenario:
+    if not doc:  # an empty file (saved before it was typed, or another file than the one written)
+        raise ctx.error(
+            "",
+            "the file is empty (or only comments): a scenario needs [[block]] tables or a [structure] builder (masonry docs scenario-format)",
+        )
     for key in doc:
         if key not in TOP_LEVEL_KEYS:
-            raise ctx.error("", unknown_key(key, TOP_LEVEL_KEYS))
+            raise ctx.error("", _misplaced(key) or unknown_key(key, TOP_LEVEL_KEYS))
     try:
         name = _check_name("name", doc["name"]) if "name" in doc else default_name
     except InputError as exc:
