@@ -400,6 +400,42 @@ OPTION_ROWS = [
     ("export-out-suffix", {}, ("export", "missing.npz", "--out", "s.xlsx"), 2, "--out s.xlsx: the file name must end"),
     ("export-out-exists", {"s.csv": "mine"}, ("export", "h.npz", "--out", "s.csv"), 2, "--out s.csv: the file exists"),
     ("export-every-0", {}, ("export", "h.npz", "--every", "0"), 2, "--every 0: keep every K-th frame, K ≥ 1"),
+    # -- export --times: the lab's file is read before the histories
+    (
+        "export-times-no-time",
+        {"lab.csv": "a,b (mm)\n0,1\n"},
+        ("export", "h.npz", "--times", "lab.csv"),
+        2,
+        "lab.csv:1: no time column",
+    ),
+    (
+        "export-times-back",
+        {"lab.csv": "time (s),x\n0.1,1\n0.05,2\n"},
+        ("export", "h.npz", "--times", "lab.csv"),
+        2,
+        "lab.csv:3: time 0.05 is not after the previous sample's 0.1",
+    ),
+    (
+        "export-times-nan",
+        {"lab.csv": "t (ms),x\n0,1\nNaN,2\n"},
+        ("export", "h.npz", "--times", "lab.csv"),
+        2,
+        "lab.csv:3: time NaN is not a finite",
+    ),
+    (
+        "export-times-xlsx",
+        {"lab.xlsx": b"PK\x03\x04" + bytes(40)},
+        ("export", "h.npz", "--times", "lab.xlsx"),
+        2,
+        "lab.xlsx: a zip file (an Excel workbook?), not a CSV",
+    ),
+    (
+        "export-combined-no-out",
+        {},
+        ("export", "a.npz", "b.npz", "--combined"),
+        2,
+        "--combined: name the table with --out",
+    ),
     (
         "inspect-cut-before-a-message",
         {"cut.rrd": bytes.fromhex("52524632002900000102000001000000000000005e000000")},

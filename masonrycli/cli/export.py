@@ -59,6 +59,19 @@ def _targets(histories: list[Path], out: Path | None, force: bool, several: bool
     return targets
 
 
+def _combined_target(histories: list[Path], out: Path | None, force: bool):
+    """The checked output of ``--combined``: ``--out``, else FOLDER.csv beside the one folder given."""
+    from masonrycli.outputs.files import check_output
+
+    if out is None:
+        if len(histories) != 1 or not histories[0].is_dir():
+            raise InputError("--combined: name the table with --out S.csv (FOLDER.csv by default, for one folder)")
+        out = histories[0].parent / f"{histories[0].resolve().name}.csv"
+    elif out.is_dir():
+        raise InputError(f"--out {out}: --combined writes one table: name a file (--out {out / 'study.csv'})")
+    return check_output(out, "--out", ".csv", force)
+
+
 def export_command(
     histories: Annotated[
         list[Path],
@@ -106,6 +119,36 @@ def export_command(
         int,
         typer.Option(parser=whole_value, help="Keep every K-th recorded frame (after differentiating).", metavar="K"),
     ] = 1,
+    times: Annotated[
+        Path | None,
+        typer.Option(
+            "--times",
+            parser=path_value,
+            help="A lab's CSV (header row, a time column): every column at its sample times, beside its own columns.",
+            metavar="LAB.csv",
+        ),
+    ] = None,
+    time_column: Annotated[
+        str | None,
+        typer.Option(help="The --times file's time column (default: the one named time or t).", metavar="NAME"),
+    ] = None,
+    compare: Annotated[
+        list[str] | None,
+        typer.Option(
+            "--compare",
+            help="A --times column against the first target's ux (or =MASONRY COLUMN): peak, RMS error, "
+            "correlation, Sprague–Geers.",
+            metavar="LAB COLUMN[=COLUMN]",
+        ),
+    ] = None,
+    combined: Annotated[
+        bool,
+        typer.Option(
+            "--combined",
+            help="Several histories as one long CSV: a row per run × frame, with the history's name and its study "
+            "point's values (default --out: FOLDER.csv beside the folder).",
+        ),
+    ] = False,
     force: Annotated[bool, typer.Option("--force", help="Replace the --out file if it exists.")] = False,
 ) -> None:
     """Write a run history as CSV (one row per frame, units in the header): the ground's motion, blocks' or
@@ -117,9 +160,21 @@ def export_command(
 
     if every < 1:
         raise InputError(f"--every {every}: keep every K-th frame, K ≥ 1")
+    if times is None and (compare or time_column is not None):
+        raise InputError(
+            f"{'--compare' if compare else '--time-column'}: a column of the --times file: give --times LAB.csv"
+        )
+    if times is not None and every > 1:
+        raise InputError(f"--every {every} and --times: the rows are the lab's samples, give one or the other")
     inputs = _inputs(histories)
     several = len(inputs) > 1 or any(path.is_dir() for path in histories)
-    targets = _targets(inputs, out, force, several)
+    if combined:
+        targets = [_combined_target(histories, out, force)]
+    else:
+        targets = _targets(inputs, out, force, several)
+    for target in targets:  # --force must not replace the lab's own file with the export of it
+        if times is not None and times.exists() and target.path.exists() and target.path.samefile(times):
+            raise InputError(f"{target.option} {target.path}: is the --times file (name another CSV to write)")
     options = dict(
         blocks=_names(blocks),
         course_numbers=_course_numbers(course),
@@ -130,8 +185,29 @@ def export_command(
     )
     # every table made before the first CSV is written: a folder whose second history lacked a --blocks name or
     # held no frame wrote the first CSV, then stopped (exit 2), and the same command again met "the file exists"
+    lab = None
+    if times is not None:  # before the histories: a lab file's error is said however they are
+        from masonrycli.outputs.lab_file import read_lab_file
+
+        lab = read_lab_file(times, time_column)
     tables = [export_table(history, **options) for history in inputs]
-    for history, target, table in zip(inputs, targets, tables):
+    measures = [[] for _ in tables]
+    if lab is not None:
+        from masonrycli.outputs.agreement import compare as measure
+        from masonrycli.outputs.resample import resample
+
+        tables = [resample(table, lab, str(history)) for history, table in zip(inputs, tables)]
+        for history, table, lines in zip(inputs, tables, measures):
+            for spec in compare or ():
+                found = measure(table, spec, lab.path, lab.lines, lab.time)
+                lines += [f"{history}: {found[0]}", *found[1:]] if combined else found  # one table: say whose
+    shown = [str(history) for history in inputs]
+    if combined:
+        from masonrycli.outputs.export import long_table
+
+        tables = [long_table(tables, [history.stem for history in inputs], shown)]
+        shown, measures = [", ".join(shown) if len(shown) < 4 else f"{len(shown)} histories"], [sum(measures, [])]
+    for history, target, table, lines in zip(shown, targets, tables, measures):
         with written_whole(target) as part:
             write_csv(table, part)
         for note in table.notes:
@@ -139,3 +215,5 @@ def export_command(
         rows = len(table.values[0])
         line = f"{history}: {rows} row{'s' if rows != 1 else ''} × {len(table.names)} columns → {target.path}"
         console.print(line, soft_wrap=True, markup=False)
+        for text in lines:
+            console.print(text, soft_wrap=True, markup=False)

@@ -71,6 +71,10 @@ class Table:
     names: list[str] = field(default_factory=list)
     values: list[np.ndarray] = field(default_factory=list)
     notes: list[str] = field(default_factory=list)
+    main: str = ""
+    """The first target's horizontal displacement column (``top ux rel (m)``): what ``--compare`` compares with."""
+    point: dict = field(default_factory=dict)
+    """The run's study point (``masonry sweep --histories``: its swept values, ``record``), else empty."""
 
     def add(self, name: str, value) -> None:
         value = np.asarray(value)
@@ -187,7 +191,7 @@ def export_table(
     """The table of the history at ``path`` (module docstring); without targets, the top."""
     shown = os.fspath(path)
     h = read_history(path)
-    table = Table()
+    table = Table(point=_run(h).get("study_point") or {})
     time = np.asarray(h["time"], dtype=float)
     q, v = h["block_q"], h["block_v"]
     if len(time) == 0:
@@ -212,6 +216,7 @@ def export_table(
     _add_motion(table, str(h["support_name"][s]), "", ground_u, sv, ground_a, rotation=False)
     rel = " rel" if relative else ""
     for label, members in targets:
+        table.main = table.main or f"{label} ux{rel} (m)"
         u = (q[:, members] - q[0, members]).mean(axis=1)  # (T,3) mean displacement and rotation
         vel = v[:, members].mean(axis=1)
         acc = frame_rate(vel, time)
@@ -276,21 +281,64 @@ def overturning_moment(h: dict, time: np.ndarray, base_y: float, middle_x: float
     return (rx * fy - ry * fx + inertia * acc[:, :, 2]).sum(axis=1)
 
 
-def _gravity(h: dict) -> np.ndarray:
-    """The run's gravity (m/s²) from its parameters, else (0, −9.81)."""
+def _run(h: dict) -> dict:
+    """The run's parameters (the history's ``run`` JSON), empty when it has none or they do not read."""
     import json
 
     try:
         run = json.loads(str(h["run"])) if "run" in h else {}
-        return np.asarray(run.get("gravity_m_s2", (0.0, -9.81)), dtype=float)
+    except ValueError:
+        return {}
+    return run if isinstance(run, dict) else {}
+
+
+def _gravity(h: dict) -> np.ndarray:
+    """The run's gravity (m/s²) from its parameters, else (0, −9.81)."""
+    try:
+        return np.asarray(_run(h).get("gravity_m_s2", (0.0, -9.81)), dtype=float)
     except (ValueError, TypeError):
         return np.array([0.0, -9.81])
 
 
+def long_table(tables: list[Table], names: list[str], shown: list[str]) -> Table:
+    """One table of several runs' (a study's ``--histories``), one row per run × row: ``history`` (``names``,
+    the file's stem), the swept values of each run's study point (an empty cell where a run has none), then
+    the runs' columns, which must be the same. :class:`InputError` naming the first run whose columns differ."""
+    first = tables[0]
+    for table, where in zip(tables[1:], shown[1:]):
+        if table.names != first.names:
+            other = next((n for n in table.names if n not in first.names), None) or next(
+                n for n in first.names if n not in table.names
+            )
+            raise InputError(
+                f"--combined: {where} has other columns than {shown[0]} ({other}): one table needs the same "
+                "columns (the same structure, targets and --times), export them apart"
+            )
+    out = Table(notes=[note for table in tables for note in table.notes], main=first.main)
+    sizes = [len(table.values[0]) for table in tables]
+    out.names.append("history")
+    out.values.append(np.repeat(np.array(names, dtype=object), sizes))
+    keys = list(dict.fromkeys(key for table in tables for key in table.point))
+    for key in keys:
+        values = [table.point.get(key) for table in tables]
+        if all(v is None or (isinstance(v, int | float) and not isinstance(v, bool)) for v in values):
+            whole = all(isinstance(v, int) for v in values)  # None (a run without the key) is an empty cell
+            column = np.array([np.nan if v is None else v for v in values], dtype=np.int64 if whole else float)
+            column = np.repeat(column, sizes)
+        else:
+            column = np.repeat(np.array(["" if v is None else str(v) for v in values], dtype=object), sizes)
+        out.names.append(f"study {key}" if key in first.names or key == "history" else key)  # a lab's column "amp"
+        out.values.append(column)
+    for i, name in enumerate(first.names):
+        out.names.append(name)
+        out.values.append(np.concatenate([table.values[i] for table in tables]))
+    return out
+
+
 def number(x) -> str:
     """A cell: an integer as it is, a float as the shortest text that reads back as the same float
-    (``repr``); NaN an empty cell (Excel and pandas read it as missing)."""
-    if isinstance(x, int):
+    (``repr``); NaN an empty cell (Excel and pandas read it as missing); text (a lab file's cell) as it is."""
+    if isinstance(x, int | str):
         return str(x)
     return repr(x) if np.isfinite(x) else ""
 
