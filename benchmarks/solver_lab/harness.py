@@ -56,6 +56,7 @@ def _register_optional():
         anderson,
         cluster,
         cpg,
+        galerkin,
         ipm,
         ipm_lcp,
         ipm_shift,
@@ -81,6 +82,7 @@ def _register_optional():
         ipm_shift,
         cpg,
         lines,
+        galerkin,
     ):
         METHODS.update(module.METHODS)
 
