@@ -39,6 +39,9 @@ within h/2 of the highest centroid (collapse.py's top). A history written before
 (masonry before 2026-11-29) has no block heights: h is then the median spacing of the distinct centroid
 heights (a wall's course height), the height the centroids' extent plus h, and the overturning moment is
 left out (no masses); :func:`export_table` says so in its notes.
+
+At a lab's sample times: :mod:`masonrycli.outputs.resample` (``--times``); several histories as one long table:
+:func:`long_table` (``--combined``).
 """
 
 from __future__ import annotations
