@@ -9,9 +9,11 @@ is renamed into place, so what was computed is kept and a path never holds half 
 from __future__ import annotations
 
 import contextlib
+import os
 import platform
 import shlex
 import shutil
+import subprocess
 import sys
 import warnings
 from dataclasses import dataclass, field
@@ -351,14 +353,31 @@ def print_summary(console: Console, outcome: Outcome, scenario, hint: str = "") 
     if hint and "--out" in paths:
         console.print(hint, soft_wrap=True)
     if "--out" in paths:
-        # quoted for the shell: "rerun my runs/w.rrd" opened "my" and "runs/w.rrd"
-        command = f"{shlex.quote(rerun_command())} {shlex.quote(paths['--out'])}"
+        command = open_command(paths["--out"])
         console.print(Text.assemble("Open the recording:  ", (command, "bold")), soft_wrap=True)
 
 
-def rerun_command() -> str:
-    """How to start the viewer from here: ``rerun`` if it is on PATH, else the one beside this Python."""
+def open_command(recording, *, windows: bool = os.name == "nt") -> str:
+    """The line that opens ``recording`` in the viewer, quoted for this system's shell ("rerun my runs/w.rrd"
+    opened "my" and "runs/w.rrd"). On Windows with double quotes: shlex's '…' (taken for a backslash, so
+    every default path 'recordings\\wall-….rrd') are no quotes to cmd.exe."""
+    quote = subprocess.list2cmdline if windows else shlex.join
+    return quote([rerun_command(windows=windows), os.fspath(recording)])
+
+
+def rerun_command(*, windows: bool = os.name == "nt") -> str:
+    """How to start the viewer from here: ``rerun`` if it is on PATH, else the one beside this Python (on
+    Windows ``Scripts\\rerun.exe``: a ``rerun`` there does not exist, and "rerun" alone is not found in a
+    venv not activated), relative to the working folder when it is below it (``.venv/bin/rerun``)."""
     if shutil.which("rerun"):
         return "rerun"
-    beside = Path(sys.executable).parent / "rerun"
-    return str(beside) if beside.exists() else "rerun"
+    beside = Path(sys.executable).parent / ("rerun.exe" if windows else "rerun")
+    if not beside.exists():
+        return "rerun"
+    try:
+        below = os.path.relpath(beside)
+    except ValueError:  # on another drive
+        return str(beside)
+    if below.startswith(os.pardir):
+        return str(beside)
+    return os.path.join(os.curdir, below) if windows or os.sep not in below else below  # PowerShell: .\x.exe

@@ -243,6 +243,31 @@ def test_the_last_line_is_a_command_the_shell_runs(tmp_path):
     assert words[0].endswith("rerun") and words[1:] == [str(rrd)], last
 
 
+def test_the_open_command_runs_where_the_student_is(tmp_path, monkeypatch):
+    """A class on Windows, the venv not activated: the last line said "rerun 'recordings\\wall-….rrd'" — no
+    rerun on PATH, and '…' are no quotes to cmd.exe (shlex quoted every default path for its backslash);
+    its viewer is Scripts\\rerun.exe. On any system the viewer below the working folder is named from there."""
+    monkeypatch.setattr(execute_module.shutil, "which", lambda name: None)
+    for system, folder, viewer in ((True, "Scripts", "rerun.exe"), (False, "bin", "rerun")):
+        scripts = tmp_path / "class" / ".venv" / folder
+        scripts.mkdir(parents=True)
+        (scripts / viewer).touch()
+        monkeypatch.setattr(execute_module.sys, "executable", str(scripts / "python"))
+        monkeypatch.chdir(tmp_path / "class")
+        rrd = os.path.join("recordings", "wall-20261129-082048.rrd")
+        command = execute_module.open_command(rrd, windows=system)
+        shown = os.path.join(os.curdir, ".venv", folder, viewer) if system else os.path.join(".venv", folder, viewer)
+        assert command == f"{shown} {rrd}"
+        assert execute_module.open_command("my runs/w.rrd", windows=system).endswith(
+            ' "my runs/w.rrd"' if system else " 'my runs/w.rrd'"
+        )
+        monkeypatch.chdir(tmp_path)  # elsewhere: the viewer's whole path
+        elsewhere = tmp_path / "elsewhere"
+        elsewhere.mkdir(exist_ok=True)
+        monkeypatch.chdir(elsewhere)
+        assert execute_module.open_command("w.rrd", windows=system) == f"{scripts / viewer} w.rrd"
+
+
 def test_the_unconverged_warning_names_only_the_causes_there_were():
     # "20 at the 2-sweep cap, the others stalled: every method … gave up" when none had stalled.
     run = RunConfig(max_iterations=2, tolerance=1e-5)

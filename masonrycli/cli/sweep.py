@@ -8,7 +8,6 @@ exit codes. Registered on the app by :mod:`masonrycli.cli.app`.
 from __future__ import annotations
 
 import contextlib
-import shlex
 import signal
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated
@@ -373,9 +372,9 @@ def _report(console, result, plan: StudyPlan, im: str, written: list, signals: F
         # as masonry run says it: 'recording: s.rrd' left a first user to find out what opens a .rrd
         from rich.text import Text
 
-        from masonrycli.execute import rerun_command
+        from masonrycli.execute import open_command
 
-        command = f"{shlex.quote(rerun_command())} {shlex.quote(str(recording.path))}"
+        command = open_command(recording.path)
         console.print(
             Text.assemble("recording: ", str(recording.path), "  (open it: ", (command, "bold"), ")"), soft_wrap=True
         )
