@@ -286,3 +286,42 @@ def test_an_empty_out_is_said_to_be_empty():
     from cli_helpers import assert_one_line_error, invoke
 
     assert_one_line_error(invoke("limit", "wall", "--out", ""), "--out", "the path is empty")
+
+
+def test_a_built_in_takes_the_structure_options_of_masonry_build(tmp_path):
+    """`masonry limit arch --span 8 --rise 2 …` analyses the arch `masonry build arch` writes with the same
+    options (it said "No such option: --span": a bridge had to go through a GeoJSON file first)."""
+    shape = ["--span", "8", "--rise", "2", "--ring-thickness", "0.5", "--pier-width", "3", "--pier-courses", "5"]
+    geo = tmp_path / "bridge.geojson"
+    assert invoke("build", "arch", *shape, "--out", geo).exit_code == 0
+    direct = invoke("limit", "arch", *shape, "--json")
+    assert direct.exit_code == 0, direct.output
+    via_file = json.loads(invoke("limit", geo, "--json").stdout)
+    default = json.loads(invoke("limit", "arch", "--json").stdout)
+    data = json.loads(direct.stdout)
+    assert data["blocks"] == via_file["blocks"] == 4 * 5 + 30 + 2
+    assert data["load_factor"] == pytest.approx(via_file["load_factor"], rel=1e-9)
+    assert data["hinges"] == via_file["hinges"] and data["load_factor"] != pytest.approx(default["load_factor"])
+    thick = json.loads(invoke("limit", "arch", *shape, "--thickness", "4", "--json").stdout)
+    assert thick["collapse_load_N"] == pytest.approx(4 * data["collapse_load_N"], rel=1e-9)
+
+
+@pytest.mark.parametrize(
+    "args, fragments",
+    [
+        (["arch", "--blocks", "3"], ["--blocks: not an option of the arch (its options: --density, --pier-courses"]),
+        (["aqueduct", "--rise", "1"], ["--rise: not an option of the aqueduct"]),
+        (["wall", "--span", "8"], ["--span: not an option of the wall"]),
+        (["arch", "--rise", "9"], ["--rise 9 m is more than half the span (1.8 m)"]),
+    ],
+)
+def test_a_structure_option_the_built_in_does_not_take_is_one_line(args, fragments):
+    assert_one_line_error(invoke("limit", *args), *fragments)
+
+
+def test_structure_options_on_a_file_are_refused(column_file):
+    assert_one_line_error(
+        invoke("limit", column_file, "--span", "3"),
+        "--span: structure options shape a built-in structure",
+        "is a file, which gives its own geometry",
+    )

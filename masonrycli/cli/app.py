@@ -14,6 +14,7 @@ from geometry_library.blocks import GeometryError
 from masonrycli import __version__
 from masonrycli.cli.messages import OneLineUsageErrors, console, err_console, fail, say, user_errors, warn
 from masonrycli.cli.options import (
+    ANY_STRUCTURE,
     AQUEDUCT,
     ARCH,
     BLOCK_MATERIAL,
@@ -258,6 +259,7 @@ _register_export()
 
 @app.command("limit")
 @user_errors
+@with_options(ANY_STRUCTURE, BLOCK_MATERIAL)
 def limit_command(
     structure: Annotated[
         str,
@@ -286,8 +288,13 @@ def limit_command(
         ),
     ] = None,
     force: Annotated[bool, typer.Option("--force", help="Replace the --out file if it exists.")] = False,
+    **structure_options,
 ) -> None:
-    """The collapse load factor λ and mechanism of a block assembly (rigid-block limit analysis, one LP)."""
+    """The collapse load factor λ and mechanism of a block assembly (rigid-block limit analysis, one LP).
+
+    A built-in takes the structure options of [bold]masonry build NAME[/bold]:
+    [bold]masonry limit arch --span 8 --rise 2 --ring-thickness 0.5[/bold].
+    """
     from masonrycli.limit.command import run_limit
 
     run_limit(
@@ -302,6 +309,7 @@ def limit_command(
         console=console,
         err_console=err_console,
         force=force,
+        structure_options=structure_options,
     )
 
 
@@ -364,7 +372,7 @@ def build_wall_command(**opts) -> None:
 @user_errors
 @with_options(GEO_OUT, ARCH, BLOCK_MATERIAL, FORCE)
 def build_arch_command(**opts) -> None:
-    """A semicircular arch on two piers, each on its foundation."""
+    """A semicircular arch on two piers, each on its foundation; segmental with --rise below span / 2."""
     _write_assembly("arch", opts)
 
 

@@ -113,6 +113,9 @@ ARCH = {
         "segmental arch, with a skewback stone on each pier).",
     ),
 }
+STRUCTURE_OPTIONS = {"wall": WALL, "arch": ARCH, "aqueduct": AQUEDUCT}
+"""The structure options of each built-in: ``masonry limit NAME`` takes their union and refuses the others'."""
+ANY_STRUCTURE = {k: v for group in STRUCTURE_OPTIONS.values() for k, v in group.items()}
 # The wall stands on one ground, shaken by default; the arch and the aqueduct settle their right
 # foundation by default and are shaken with --settlement 0 --amp A. One group for both listed --settlement
 # under `simulate wall --help` (always refused there) and no loading default anywhere.

@@ -32,13 +32,36 @@ THRUST_SHOWN = 0.02
 """The recording's line of thrust shows joints carrying at least this share of the largest joint force."""
 
 
-def resolve_structure(structure: str, friction: float | None):
-    """A scenario from a built-in name (the builder's defaults, no motion), a scenario file or a geometry
-    file (:func:`~masonrycli.scenario.builtin.target_scenario`); ``friction`` overrides μ."""
-    from masonrycli.scenario.builtin import override_run, target_scenario
+def resolve_structure(structure: str, friction: float | None, options: dict | None = None):
+    """A scenario from a built-in name (the builder's defaults, or ``options``: the structure options of
+    ``masonry build NAME`` and --density / --thickness, no motion), a scenario file or a geometry file
+    (:func:`~masonrycli.scenario.builtin.target_scenario`); ``friction`` overrides μ."""
+    from masonrycli.cli.options import BLOCK_MATERIAL, STRUCTURE_OPTIONS
+    from masonrycli.scenario.builtin import builtin, is_built_in, override_run, target_scenario
     from masonrycli.scenario.scenario import Material, RunConfig, scenario_from_builder
 
-    scenario = target_scenario(structure, lambda name: scenario_from_builder(name, {}, RunConfig(), Material(), {}))
+    given = {k: v for k, v in (options or {}).items() if v is not None}
+    flags = ", ".join(f"--{k.replace('_', '-')}" for k in given)
+    if given and not is_built_in(structure):
+        raise InputError(
+            f"{flags}: structure options shape a built-in structure (masonry limit wall|arch|aqueduct …); "
+            f"{structure} is a file, which gives its own geometry"
+        )
+    if given and is_built_in(structure):
+        allowed = {*STRUCTURE_OPTIONS[structure], *BLOCK_MATERIAL}
+        foreign = [k for k in given if k not in allowed]
+        if foreign:
+            names = ", ".join(f"--{k.replace('_', '-')}" for k in sorted(allowed))
+            raise InputError(
+                f"--{foreign[0].replace('_', '-')}: not an option of the {structure} (its options: {names})"
+            )
+
+    def built_in(name: str):
+        if given:  # the scenario simulate would run, its loading left out: limit's supports are fixed
+            return builtin(name, **given)
+        return scenario_from_builder(name, {}, RunConfig(), Material(), {})
+
+    scenario = target_scenario(structure, built_in)
     return override_run(scenario, friction=friction)
 
 
@@ -195,6 +218,7 @@ def run_limit(
     console: Console,
     err_console: Console,
     force: bool = False,
+    structure_options: dict | None = None,
 ) -> None:
     """``masonry limit``: analyse, optionally record and verify, then print a table or one JSON object.
 
@@ -217,6 +241,7 @@ def run_limit(
                     signals,
                     console=None if as_json else console,
                     err_console=err_console,
+                    structure_options=structure_options,
                 )
         except StopRun as stop:
             how = "" if stop.signum == signal.SIGINT else f" ({signal_name(stop.signum)})"  # as `masonry sweep`
@@ -269,13 +294,15 @@ class _Done:
         return said + "; --verify did not finish" if self.verifying else said
 
 
-def _analyse(structure, live, friction, verify, out, force, done: _Done, signals, *, console, err_console):
+def _analyse(
+    structure, live, friction, verify, out, force, done: _Done, signals, *, console, err_console, structure_options
+):
     """The work of :func:`run_limit`, filling ``done`` as it goes; returns the --verify checks. ``console``:
     where the result table goes before --verify runs (None with --json)."""
     from masonrycli.scenario.caveats import setting_warnings
 
     target = None if out is None else check_output(out, "--out", ".rrd", force)
-    scenario = resolve_structure(structure, friction)
+    scenario = resolve_structure(structure, friction, structure_options)
     if verify and live.kind == "point":
         raise InputError("--verify: the engine has no point loads; verify a horizontal or tilt load")
     settings = setting_warnings(scenario)  # not its records': it has no time
