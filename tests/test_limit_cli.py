@@ -47,7 +47,8 @@ def test_no_friction_gives_zero_not_minus_zero(column_file):
     # A frictionless column slides at once: λ = 0, which HiGHS returns as -0.0 ("λ = -0.0000 (tilt ψ =
     # -0.00°)", "collapse load -0 N", "load_factor": -0.0 in the JSON)
     table = invoke("limit", column_file, "--friction", "0")
-    assert table.exit_code == 0 and "0.0000  (tilt ψ = 0.00°)" in table.output and "-0" not in table.output
+    assert table.exit_code == 0 and "0.0000  (a horizontal acceleration of 0 g" in table.output
+    assert "tilt ψ = 0.00°)" in table.output and "-0" not in table.output
     data = json.loads(invoke("limit", column_file, "--friction", "0", "--json").stdout)
     assert str(data["load_factor"]) == "0.0" and str(data["collapse_load_N"]) == "0.0"
 
@@ -325,3 +326,17 @@ def test_structure_options_on_a_file_are_refused(column_file):
         "--span: structure options shape a built-in structure",
         "is a file, which gives its own geometry",
     )
+
+
+def test_the_table_reads_lambda_as_an_acceleration_and_names_the_thickness_of_its_newtons(monkeypatch):
+    """A horizontal body force λ × weight is a horizontal acceleration of λ g (what an engineer compares with
+    a design PGA); the newtons are for the blocks' out-of-plane thickness (a 4 m wide bridge: 4 × a 1 m one)."""
+    monkeypatch.setenv("COLUMNS", "250")  # one line a row
+    data = json.loads(invoke("limit", "arch", "--json").stdout)
+    lam = data["load_factor"]
+    table = words(runner.invoke(app, ["limit", "arch", "--thickness", "4"], env={"COLUMNS": "250"}).output)
+    assert f"a horizontal acceleration of {lam:.3g} g = {lam * 9.81:.3g} m/s²" in table
+    assert "for blocks 4 m thick (out of plane)" in table and data["thickness_m"] == 1.0
+    point = runner.invoke(app, ["limit", "arch", "--load", "point", "--block", "v10", "--direction", "-y"])
+    point = words(point.output)
+    assert "horizontal acceleration" not in point and "for blocks 1 m thick" in point

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -34,6 +34,9 @@ class LimitResult:
     """N: the live load at λ = 1 (total weight, or the loaded block's weight)."""
     analysis_time: float
     """s: joints + assembly + solve + reading (model building excluded)."""
+    thickness: float | None = None
+    """m: the blocks' out-of-plane thickness, which the newtons are for (None: not one for every block, or
+    a model analysed without its scenario)."""
 
     @property
     def load_factor(self) -> float:
@@ -93,6 +96,7 @@ class LimitResult:
             "tilt_angle_deg": self.tilt_angle(),
             "collapse_load_N": self.load_factor * self.reference_force,
             "reference_load_N": self.reference_force,
+            "thickness_m": self.thickness,
             "friction": m.friction,
             "blocks": m.block_count,
             "supports": m.support_count,
@@ -158,4 +162,6 @@ def analyse_model(model: Model, load: LiveLoad, scenario_name: str = "") -> Limi
 
 def analyse(scenario, load: LiveLoad) -> LimitResult:
     """Limit analysis of ``scenario`` (its blocks, supports, material and gravity) under ``load``."""
-    return analyse_model(build_model(scenario), load, scenario.name)
+    result = analyse_model(build_model(scenario), load, scenario.name)
+    thicknesses = {b.thickness for b in scenario.assembly.blocks}
+    return replace(result, thickness=thicknesses.pop()) if len(thicknesses) == 1 else result

@@ -86,10 +86,17 @@ def result_table(result: LimitResult, out: Path | None) -> Table:
     table.add_row("joints", f"{s['joints']} ({s['contact_points']} contact points, from the engine's detection)")
     table.add_row("live load", result.load.describe())
     lam = Text(f"{result.load_factor:.4f}", style="bold")  # Text: the consoles parse no markup
+    reading = []
+    if result.load.kind == "horizontal":  # a body force λ × weight is a horizontal acceleration of λ g
+        g = float(np.hypot(*result.model.gravity))
+        reading.append(f"a horizontal acceleration of {result.load_factor:.3g} g = {result.load_factor * g:.3g} m/s²")
     if result.tilt_angle() is not None:
-        lam.append(f"  (tilt ψ = {result.tilt_angle():.2f}°)")
+        reading.append(f"tilt ψ = {result.tilt_angle():.2f}°")
+    if reading:
+        lam.append(f"  ({'; '.join(reading)})")
     table.add_row("load factor λ", lam)
-    table.add_row("collapse load", f"{s['collapse_load_N']:.4g} N (λ × {s['reference_load_N']:.4g} N)")
+    depth = "" if result.thickness is None else f", for blocks {result.thickness:g} m thick (out of plane)"
+    table.add_row("collapse load", f"{s['collapse_load_N']:.4g} N (λ × {s['reference_load_N']:.4g} N){depth}")
     table.add_row("hinges", _names(result.hinges_largest_first()))
     table.add_row("sliding joints", _names(result.sliding_largest_first()))
     table.add_row("blocks in the mechanism", f"{len(result.moving_blocks)} of {s['blocks']}")
