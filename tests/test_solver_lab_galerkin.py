@@ -165,3 +165,23 @@ def test_solve_reaches_the_target_and_the_reference(cold):
         np.testing.assert_allclose(out.v, v, atol=1e-9)
         assert out.converged and ctx.residual(v, out.r) <= 1e-8, name
         assert law.velocity_error(p, v) < 1e-5, name
+
+
+def test_layer_rigid_share(cold):
+    # A rigid motion of each course (own translation and rotation about any point) is all "layer-rigid";
+    # one block of a course moving alone is not.
+    p = cold
+    lay = G.layers(p)
+    rng = np.random.default_rng(5)
+    e = np.zeros((lay.size, 3))
+    for k in range(1, lay.max() + 1):
+        s = lay == k
+        vx, vy, w = rng.normal(size=3)
+        x0, y0 = rng.normal(size=2)
+        e[s, 0] = vx - w * (p.q_m[s, 1] - y0)
+        e[s, 1] = vy + w * (p.q_m[s, 0] - x0)
+        e[s, 2] = w
+    assert G.layer_rigid_share(p, e, lay) == pytest.approx(1.0, abs=1e-12)
+    one = np.zeros_like(e)
+    one[np.flatnonzero(lay == 2)[0], 0] = 1.0
+    assert 0.0 < G.layer_rigid_share(p, one, lay) < 0.5
