@@ -6,7 +6,7 @@ from pathlib import Path
 
 import pytest
 
-from cli_helpers import assert_one_line_error, invoke
+from cli_helpers import assert_one_line_error, invoke, runner
 
 DATA = Path(__file__).parent / "data"
 RUN = ("simulate", "wall", "--duration", "0.01", "--no-recording")
@@ -313,3 +313,28 @@ def test_ctrl_c_before_the_run_is_one_line_and_exit_130(monkeypatch):
     result = invoke("simulate", "wall", "--duration", 0.01, "--no-recording")
     assert result.exit_code == 130
     assert result.output.strip() == "error: Ctrl-C: stopped before any output was written"
+
+
+@pytest.mark.parametrize(
+    "args, said",
+    [
+        # a folder with a space (a student's "C:\Users\Ana Silva\…"): "Got unexpected extra argument(s) (wall.toml)"
+        (("run", "my", "wall.toml"), 'a name with spaces goes between quotes: masonry run "my wall.toml"'),
+        (("check", "C:/Users/Ana", "Silva/w.toml"), 'masonry check "C:/Users/Ana Silva/w.toml"'),
+        (("inspect", "my", "runs/w.rrd"), 'masonry inspect "my runs/w.rrd"'),
+        (("simulate", "wall", "--amp", "1.5", "m/s"), "(m/s): a number goes alone, without its unit"),
+        (("run", "w.toml", "--duration", "1", "s"), "(s): a number goes alone, without its unit"),
+    ],
+)
+def test_an_extra_word_says_what_it_likely_is(args, said):
+    from masonrycli.cli.app import app
+
+    result = runner.invoke(app, list(args), prog_name="masonry")
+    assert_one_line_error(result, "Got unexpected extra argument(s)", said)
+
+
+def test_an_extra_word_of_no_known_kind_keeps_the_parsers_line():
+    from masonrycli.cli.app import app
+
+    result = runner.invoke(app, ["simulate", "wall", "extra"], prog_name="masonry")
+    assert_one_line_error(result, "(extra) (masonry simulate wall --help lists the options)")

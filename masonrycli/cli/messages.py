@@ -4,6 +4,7 @@ decorator that turns bad input into exit code 2, and click's usage errors as one
 from __future__ import annotations
 
 import functools
+import os
 import sys
 import warnings
 
@@ -95,7 +96,11 @@ class OneLineUsageErrors(typer.core.TyperGroup):
         except click_errors.UsageError as exc:
             command = exc.ctx.command_path if exc.ctx is not None else self._path_of(args)
             listed = "commands" if exc.format_message().startswith("No such command") else "options"
-            said = _number_with_unit(exc) or f"{exc.format_message()} ({command} --help lists the {listed})"
+            said = (
+                _number_with_unit(exc)
+                or _split_word(exc, command)
+                or f"{exc.format_message()} ({command} --help lists the {listed})"
+            )
             say("error", "bold red", said)
             sys.exit(exc.exit_code)
         except click_errors.ClickException as exc:
@@ -184,3 +189,24 @@ def _number_with_unit(exc) -> str | None:
     if not shown.isprintable():  # "--dt $'1\nx'" printed two lines
         shown = shown.encode("unicode_escape").decode("ascii")
     return f"{max(param.opts, key=len)} {shown}: must be {kind}{hint}"
+
+
+_UNIT_WORDS = frozenset("s ms min m mm cm m/s m/s2 m/s² cm/s mm/s g gal hz Hz kg kg/m3 kg/m³ rad deg ° %".split())
+
+
+def _split_word(exc, command: str) -> str | None:
+    """What an extra word on the command line most likely is: a unit after a number (``--amp 1.5 m/s``) or the
+    rest of a file name with a space (``masonry run my wall.toml``: "C:\\Users\\Ana Silva\\…" on a student's
+    laptop), which said only "Got unexpected extra argument(s) (wall.toml)"; None for anything else."""
+    message = exc.format_message()
+    extra = message.removeprefix("Got unexpected extra argument").removeprefix("s").removeprefix("(s)").strip()
+    if extra == message.strip() or not (extra.startswith("(") and extra.endswith(")")) or exc.ctx is None:
+        return None
+    words = extra[1:-1]
+    if words.split()[0] in _UNIT_WORDS:
+        return f"{message}: a number goes alone, without its unit (the options are in SI units: {command} --help)"
+    named = [p for p in exc.ctx.command.params if p.param_type_name == "argument"]
+    given = exc.ctx.params.get(named[0].name) if named else None
+    if isinstance(given, (str, os.PathLike)):
+        return f'{message}: a name with spaces goes between quotes: {command} "{os.fspath(given)} {words}"'
+    return None
