@@ -63,9 +63,9 @@ class Probe:
         original_solve = self._solve
         probe = self
 
-        def timed_solve(contact_body, pack, count, model, v, r, status):
+        def timed_solve(contact_body, pack, count, model, v, r, status, *tuning):
             t = time.perf_counter()
-            its, res = original_solve(contact_body, pack, count, model, v, r, status)
+            its, res = original_solve(contact_body, pack, count, model, v, r, status, *tuning)
             probe.nlgs_s += time.perf_counter() - t
             probe.contact_sweeps += its * count
             return its, res

@@ -147,11 +147,11 @@ def measure(case: str, duration: float) -> dict:
     tally = np.zeros((3 + 2 * len(KS), 3), np.int64)
     kernel, calls = nlgs._nlgs_interleaved, [0]
 
-    def counted(contact_body, pack, count, mu, tolerance, cap, v, r, status, accelerate, stall, alternate=False):
+    def counted(contact_body, pack, count, mu, tolerance, cap, v, r, status, accelerate, stall, alternate=False, **kw):
         if accelerate and not alternate:
             v2, r2, s2 = v.copy(), r.copy(), status.copy()
             out2 = _counted(contact_body, pack, count, mu, tolerance, cap, v2, r2, s2, stall, ks, tally)
-        out = kernel(contact_body, pack, count, mu, tolerance, cap, v, r, status, accelerate, stall, alternate)
+        out = kernel(contact_body, pack, count, mu, tolerance, cap, v, r, status, accelerate, stall, alternate, **kw)
         if accelerate and not alternate:
             same = out2 == out and np.array_equal(v2, v) and np.array_equal(r2[:count], r[:count])
             assert same, "the counted copy left the engine's path"

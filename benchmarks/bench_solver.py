@@ -109,9 +109,9 @@ class _SolveTimer:
         self._solve = nlgs.solve
 
     def __enter__(self):
-        def timed(contact_body, pack, count, model, v, r, status):
+        def timed(contact_body, pack, count, model, v, r, status, *tuning):
             t = time.process_time()
-            its, res = self._solve(contact_body, pack, count, model, v, r, status)
+            its, res = self._solve(contact_body, pack, count, model, v, r, status, *tuning)
             self.cpu += time.process_time() - t
             self.contact_sweeps += its * count
             return its, res
@@ -123,10 +123,12 @@ class _SolveTimer:
         nlgs.solve = self._solve
 
 
-def run_masonry(case: str, duration: float | None, record: bool, **run_options) -> dict:
-    """One run of ``case``; CPU time of ``simulate`` only (scenario and model built before)."""
+def run_masonry(case: str, duration: float | None, record: bool, tuning=None, **run_options) -> dict:
+    """One run of ``case``; CPU time of ``simulate`` only (scenario and model built before). ``tuning``: the
+    engine's Tuning (engine/tuning.py) if not the shipped one; None keeps Simulation's call as older engines
+    take it (bench_phases runs this module against other revisions)."""
     sc = make_scenario(case, duration, **run_options)
-    sim = Simulation(sc)
+    sim = Simulation(sc) if tuning is None else Simulation(sc, tuning=tuning)
     sampler = Sampler(sim, case)
     sinks: list = [sampler]
     recorder = tmp = None

@@ -20,6 +20,7 @@ from masonrycli.analysis.mechanism import JointTracker, contact_states
 from masonrycli.analysis.tensors import TensorComputer, build_triangles, chain_neighbours
 from masonrycli.engine import integrate
 from masonrycli.engine.solver import Solver, StepStats
+from masonrycli.engine.tuning import TUNING, Tuning
 from masonrycli.model import Model, State, build_model, initial_state
 from masonrycli.outputs.frame import Frame
 from masonrycli.outputs.sinks import COMPLETED, DIVERGED, FAILED, INTERRUPTED
@@ -125,11 +126,12 @@ class RunResult:
 class Simulation:
     """Model, state, solver and tensor computer of one scenario, advanced step by step."""
 
-    def __init__(self, scenario, model: Model | None = None):
+    def __init__(self, scenario, model: Model | None = None, tuning: Tuning = TUNING):
+        # tuning: the contact solve's numbers (engine/tuning.py); the solver lab passes others
         self.scenario = scenario
         self.model = model if model is not None else build_model(scenario)
         self.state: State = initial_state(self.model)
-        self.solver = Solver(self.model)
+        self.solver = Solver(self.model, tuning)
         m = self.model
         n = m.block_count
         # Cells and triangles come from the blocks touching in the initial configuration.

@@ -20,6 +20,7 @@ from test_engine_nlgs import _dense_h, _stack_problem
 from masonrycli.engine import _vector32 as V
 from masonrycli.engine import lane_sweeps, lane_sweeps32, momentum, nlgs
 from masonrycli.engine._jit import njit
+from masonrycli.engine.tuning import TUNING
 
 N = nlgs
 F = np.float32
@@ -309,7 +310,7 @@ def _lane(count, c):
     return c // -(-count // W)
 
 
-def _run32(body, pack, v0, r0, mu, tolerance, cap, stall=momentum.STALL_SWEEPS, resync=lane_sweeps32.RESYNC):
+def _run32(body, pack, v0, r0, mu, tolerance, cap, stall=TUNING.first_stall, resync=lane_sweeps32.RESYNC):
     count = body.shape[0]
     v, r, st = v0.copy(), r0.copy(), np.full(count, -1, np.int8)
     its, res = lane_sweeps32.lane_sweeps32(body, pack, count, mu, tolerance, cap, v, r, st, stall, -1, resync)
@@ -374,7 +375,7 @@ def test_without_a_tolerance_or_float32_the_first_stage_is_the_float64_lane_swee
         v, r, st = v0.copy(), r0.copy(), np.zeros(count, np.int8)
         out = nlgs.solve(body, pack, count, model, v, r, st)
         v2, r2, st2 = v0.copy(), r0.copy(), np.zeros(count, np.int8)
-        ref = lane_sweeps._lane_sweeps(body, pack, count, mu, tolerance, 50, v2, r2, st2, momentum.STALL_SWEEPS)
+        ref = lane_sweeps._lane_sweeps(body, pack, count, mu, tolerance, 50, v2, r2, st2, TUNING.first_stall)
         assert out == ref and _same_bits(v, v2) and _same_bits(r, r2)
 
 
@@ -397,7 +398,7 @@ def test_solver_nlgs_accel32_is_the_float32_first_stage_and_nlgs_accel_is_not(na
         v, r, st = v0.copy(), r0.copy(), np.zeros(count, np.int8)
         out = nlgs.solve(body, pack, count, model, v, r, st)
         v2, r2, st2 = v0.copy(), r0.copy(), np.zeros(count, np.int8)
-        ref = first(body, pack, count, mu, 1e-6, 10_000, v2, r2, st2, momentum.STALL_SWEEPS)
+        ref = first(body, pack, count, mu, 1e-6, 10_000, v2, r2, st2, TUNING.first_stall)
         assert out == ref and out[1] <= 1e-6 and _same_bits(v, v2) and _same_bits(r, r2)
 
 
@@ -414,7 +415,7 @@ def test_the_first_stage_waits_near_the_tolerance_by_the_structures_depth(monkey
         return first(*args)
 
     monkeypatch.setattr(lane_sweeps32, "first_stage", spy)
-    for depth, window in ((0.0, momentum.STALL_SWEEPS), (6.0, momentum.STALL_SWEEPS), (64.0, 1600)):
+    for depth, window in ((0.0, TUNING.first_stall), (6.0, TUNING.first_stall), (64.0, 1600)):
         model = type("M", (_Model,), {"friction": mu, "solver": "nlgs-accel32", "block_depth": depth})
         assert momentum.stall_near(model) == window
         nlgs.solve(body, pack, count, model, v0.copy(), r0.copy(), np.zeros(count, np.int8))

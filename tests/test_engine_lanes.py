@@ -11,6 +11,7 @@ import math
 import os
 import subprocess
 import sys
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -19,6 +20,7 @@ from test_engine_nlgs import _stack_problem
 
 from masonrycli.engine import lane_sweeps, lanes, momentum, nlgs
 from masonrycli.engine.nlgs import STATUS_OPEN, STATUS_SLIP, STATUS_STICK
+from masonrycli.engine.tuning import TUNING
 
 ROOT = Path(__file__).resolve().parent.parent
 N = nlgs
@@ -163,7 +165,7 @@ def _same_bits(a, b):
     return np.array_equal(np.asarray(a, np.float64).view(np.int64), np.asarray(b, np.float64).view(np.int64))
 
 
-def _run(body, pack, v0, r0, mu, tolerance, cap, stall=momentum.STALL_SWEEPS):
+def _run(body, pack, v0, r0, mu, tolerance, cap, stall=TUNING.first_stall):
     count = body.shape[0]
     v, r, st = v0.copy(), r0.copy(), np.full(count, -1, np.int8)
     its, res = lane_sweeps._lane_sweeps(body, pack, count, mu, tolerance, cap, v, r, st, stall)
@@ -244,8 +246,8 @@ def test_lane_sweeps_run_to_run_and_without_contacts():
     assert _same_bits(v, v0)
 
 
-def test_the_default_solve_starts_with_the_lane_sweeps(monkeypatch):
-    # nlgs.solve's first stage (nlgs-accel, tolerance > 0) is the lane sweeps while LANES, the 4-run
+def test_the_default_solve_starts_with_the_lane_sweeps():
+    # nlgs.solve's first stage (nlgs-accel, tolerance > 0) is the lane sweeps while Tuning.lanes, the 4-run
     # scalar momentum sweep (interleaved._accelerated) without: the same converged step by both. Solver
     # "nlgs-accel": the float64 lane sweeps alone ("nlgs-accel32": test_engine_lane_sweeps32).
     body, pack, v0, r0, mu = _problem(39)
@@ -256,9 +258,8 @@ def test_the_default_solve_starts_with_the_lane_sweeps(monkeypatch):
 
     out = {}
     for flag in (True, False):
-        monkeypatch.setattr(nlgs, "LANES", flag)
         v, r, st = v0.copy(), r0.copy(), np.zeros(count, np.int8)
-        out[flag] = (*nlgs.solve(body, pack, count, Model, v, r, st), v, r)
+        out[flag] = (*nlgs.solve(body, pack, count, Model, v, r, st, replace(TUNING, lanes=flag)), v, r)
     its, res, v, r, _ = _run(body, pack, v0, r0, mu, 1e-6, 10_000)
     assert res <= 1e-6 and out[True][:2] == (its, res) and _same_bits(out[True][2], v) and _same_bits(out[True][3], r)
     assert out[False][0] != its and out[False][1] <= 1e-6  # another order, another path to the tolerance

@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 
 from masonrycli.engine import momentum, nlgs, power
+from masonrycli.engine.tuning import TUNING
 
 RNG = np.random.default_rng(20261121)
 
@@ -370,9 +371,7 @@ def test_accelerated_sweeps_match_a_slow_dense_implementation(problem, sweeps, t
         body, w_blocks, h, m_inv, v0, r0.copy(), mu, bias, sweeps, momentum.RESTART_GROWTH, turning
     )
     v, r, status = v0.copy(), r0.copy(), np.zeros(count, dtype=np.int8)
-    its, res = momentum._nlgs_accelerated(
-        body, pack, count, mu, 0.0, sweeps, v, r, status, momentum.STALL_SWEEPS, turning
-    )
+    its, res = momentum._nlgs_accelerated(body, pack, count, mu, 0.0, sweeps, v, r, status, TUNING.first_stall, turning)
     assert its == its_ref
     assert res == pytest.approx(res_ref, rel=1e-8, abs=1e-15)
     np.testing.assert_allclose(r, r_ref, rtol=1e-8, atol=1e-13)
@@ -389,7 +388,7 @@ def test_accelerated_solve_converges_to_the_contact_law_and_the_unique_velocitie
     status = np.zeros(count, dtype=np.int8)
     v_acc, r_acc = v0.copy(), r0.copy()
     its_acc, res_acc = momentum._nlgs_accelerated(
-        body, pack, count, mu, 1e-13, 200000, v_acc, r_acc, status, momentum.STALL_SWEEPS
+        body, pack, count, mu, 1e-13, 200000, v_acc, r_acc, status, TUNING.first_stall
     )
     v_gs, r_gs = v0.copy(), r0.copy()
     its_gs, _ = nlgs._nlgs(body, pack, count, mu, 1e-13, 200000, v_gs, r_gs, status)

@@ -97,13 +97,11 @@ def test_shifted_copies_pair_an_engine_with_itself(tmp_path):
 
 
 def test_set_changes_the_engine_for_these_runs_only(tmp_path):
-    from masonrycli.engine import momentum
-
-    window = momentum.STALL_SWEEPS
     plain = ensemble.run(["h8"], [(1.0, 2.0, 0.0)], 0.003, tmp_path / "a.json")
-    varied = ensemble.run(["h8"], [(1.0, 2.0, 0.0)], 0.003, tmp_path / "b.json", override="momentum.STALL_SWEEPS=1")
-    assert momentum.STALL_SWEEPS == window  # restored
-    assert varied["engine"]["override"] == "momentum.STALL_SWEEPS=1" and "override" not in plain["engine"]
-    assert json.loads((tmp_path / "b.json").read_text())["engine"]["override"] == "momentum.STALL_SWEEPS=1"
+    varied = ensemble.run(["h8"], [(1.0, 2.0, 0.0)], 0.003, tmp_path / "b.json", override="first_stall=1")
+    again = ensemble.run(["h8"], [(1.0, 2.0, 0.0)], 0.003, tmp_path / "c.json")
+    assert again["runs"][0]["units"] == plain["runs"][0]["units"]  # these runs only
+    assert varied["engine"]["override"] == "first_stall=1" and "override" not in plain["engine"]
+    assert json.loads((tmp_path / "b.json").read_text())["engine"]["override"] == "first_stall=1"
     # a one-sweep window sends the cold first step to stalled.py at once: other sweep units
     assert varied["runs"][0]["units"] != plain["runs"][0]["units"]

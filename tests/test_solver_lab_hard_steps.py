@@ -19,8 +19,8 @@ def test_capture_into_a_directory_replays_from_it(tmp_path):
     # A momentum window of 1 sweep hands every step that does not converge in momentum's first sweeps to
     # stalled.py: such a step records where momentum stalled, and one its body-order stage finishes is
     # labelled "bodies", not "momentum0" (momentum's own solve).
-    forced = hard_steps.replay(["momentum.STALL_SWEEPS=1"], 1, None, None, directory=tmp_path)
-    steps = forced["variants"]["momentum.STALL_SWEEPS=1"]["steps"].values()
+    forced = hard_steps.replay(["first_stall=1"], 1, None, None, directory=tmp_path)
+    steps = forced["variants"]["first_stall=1"]["steps"].values()
     handed = [s for s in steps if s["stalled_at"] is not None]
     assert handed and all(s["by"] != "momentum0" for s in handed)
     assert all(s["by"] == "momentum0" for s in steps if s["stalled_at"] is None and s["converged"])
@@ -29,13 +29,11 @@ def test_capture_into_a_directory_replays_from_it(tmp_path):
 
 def test_capture_with_constants_set_replays_under_the_same_variant(tmp_path):
     # A capture with --set runs the variant's trajectory: its steps replayed under that variant get the
-    # units the capture run spent on them, each entry names the override, and the constant is restored.
-    from masonrycli.engine import momentum
-
-    before = momentum.STALL_SWEEPS
+    # units the capture run spent on them, and each entry names the override. The JOURNAL's old spelling of
+    # a field (the module constant it replaced) still names it.
     variant = "momentum.STALL_SWEEPS=1"
+    assert hard_steps.tuning_of(hard_steps._parse(variant)).first_stall == 1
     hard_steps.capture(["h8"], 0, 1, [(1.0, 2.0, 0.0)], 0.004, tmp_path, override=variant)
-    assert momentum.STALL_SWEEPS == before
     index = json.loads((tmp_path / "index-h8-c0.json").read_text())
     assert len(index) == 4 and all(e["override"] == variant for e in index.values())
     doc = hard_steps.replay([variant], 1, None, None, directory=tmp_path)
@@ -44,15 +42,16 @@ def test_capture_with_constants_set_replays_under_the_same_variant(tmp_path):
     }
 
 
-def test_stages_split_each_step_into_the_units_the_engine_spent(tmp_path, monkeypatch):
+def test_stages_split_each_step_into_the_units_the_engine_spent(tmp_path):
     # hard stages: momentum's units, the body-order stage's calls and the round-robin's resumes add up to the
     # units nlgs.solve spends on the step; momentum's history is one residual a sweep, ending on the residual
     # its own solve stopped at (the first stage re-run with caps 1, 2, …). A 1-sweep window hands steps over.
-    from masonrycli.engine import momentum
+    from dataclasses import replace
+
+    from masonrycli.engine.tuning import TUNING
 
     hard_steps.capture(["h8"], 0, 1, motions=[(1.0, 2.0, 0.0)], duration=0.004, directory=tmp_path)
-    monkeypatch.setattr(momentum, "STALL_SWEEPS", 1)
-    doc = hard_steps.stages(1, None, tmp_path)
+    doc = hard_steps.stages(1, None, tmp_path, replace(TUNING, first_stall=1))
     assert len(doc) == 4
     for s in doc.values():
         m = s["momentum"]

@@ -1,8 +1,10 @@
 """The lab's trajectory sample and first-stage variants (benchmarks/solver_lab/trajectory.py, ordinary.py,
 ordinary_runs.py): with the engine's parameters the lab kernel must be the engine's accelerated solve, or
 none of the variants' figures compare with the engine. The lab kernel is the scalar first stage in 4 runs
-(momentum.py), the engine's until the lane sweeps replaced it: the engine runs here with nlgs.LANES off."""
+(momentum.py), the engine's until the lane sweeps replaced it: the engine runs here with Tuning.lanes off
+(SCALAR)."""
 
+from dataclasses import replace
 from types import SimpleNamespace
 
 import numpy as np
@@ -10,12 +12,14 @@ import numpy as np
 from benchmarks.bench_solver import run_masonry
 from benchmarks.solver_lab import ordinary, ordinary_runs, trajectory
 from masonrycli.engine import nlgs
+from masonrycli.engine.tuning import TUNING
+
+SCALAR = replace(TUNING, lanes=False)
 
 
 def _sample(tmp_path, monkeypatch):
-    monkeypatch.setattr(nlgs, "LANES", False)
     monkeypatch.setattr(trajectory, "TRAJECTORY", tmp_path)
-    trajectory.capture("wall-51", every=4, duration=0.03)
+    trajectory.capture("wall-51", every=4, duration=0.03, tuning=SCALAR)
     return [ordinary.Step(p) for p in sorted((tmp_path / "wall-51").glob("step-*.npz"))]
 
 
@@ -31,7 +35,7 @@ def test_lab_kernel_with_engine_parameters_is_the_engine(tmp_path, monkeypatch):
         model = SimpleNamespace(
             friction=s.mu, tolerance=ordinary.TOLERANCE, max_iterations=ordinary.CAP, solver="nlgs-accel"
         )
-        its_e, _ = nlgs.solve(d["body"], d["pack"], s.count, model, v_e, r_e, np.zeros(s.count, np.int8))
+        its_e, _ = nlgs.solve(d["body"], d["pack"], s.count, model, v_e, r_e, np.zeros(s.count, np.int8), SCALAR)
         assert its_e == its
         np.testing.assert_array_equal(v, v_e)
         o = ordinary._order("engine", d["point"], d["body"])
@@ -56,9 +60,8 @@ def test_check_stops_on_the_iterate_residual(tmp_path, monkeypatch):
         assert its - history[-1] <= plain and res <= ordinary.TOLERANCE
 
 
-def test_engine_variant_in_a_whole_run_is_the_engine_run(monkeypatch):
-    monkeypatch.setattr(nlgs, "LANES", False)
-    engine = run_masonry("wall-51", 0.05, record=False)
+def test_engine_variant_in_a_whole_run_is_the_engine_run():
+    engine = run_masonry("wall-51", 0.05, record=False, tuning=SCALAR)
     lab = ordinary_runs.run_variant("wall-51", {}, 0.05)
     assert lab["sweeps_mean"] == engine["sweeps_mean"] and lab["sweeps_max"] == engine["sweeps_max"]
     assert lab["unconverged"] == engine["unconverged"] == 0

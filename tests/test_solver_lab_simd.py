@@ -14,6 +14,7 @@ from test_engine_nlgs import _packed_row, _random_problem, _stack_problem
 from benchmarks.solver_lab import law, simd_sweep
 from benchmarks.solver_lab.outcome import Context
 from masonrycli.engine import lanes, momentum, nlgs
+from masonrycli.engine.tuning import TUNING
 
 
 @pytest.fixture(scope="module")
@@ -102,7 +103,7 @@ def test_level_schedule_replays_the_engines_sweep_bit_for_bit(problem):
     v2, r2 = problem.v_free.copy(), problem.r_warm.copy()
     s2 = np.zeros(problem.count, np.int8)
     sweeps2, residual2 = nlgs._nlgs_interleaved(problem.body, problem.pack(), problem.count, problem.mu, tol,
-                                                200_000, v2, r2, s2, True, momentum.STALL_SWEEPS, False)  # fmt: skip
+                                                200_000, v2, r2, s2, True, TUNING.first_stall, False)  # fmt: skip
     assert sweeps == sweeps2 and residual == residual2
     assert np.array_equal(v, v2) and np.array_equal(r, r2)
 
@@ -208,7 +209,7 @@ def test_coloured_sweeps_are_momentum_gauss_seidel_in_colour_order(problem, swee
     its, res, _ = simd_sweep.solve(body, pack, count, mu, 0.0, sweeps, v, r, status, sweeps)
     v_s, r_s, st_s = v0.copy(), r0[order].copy(), np.zeros(count, np.int8)
     its_s, res_s = momentum._nlgs_accelerated(np.ascontiguousarray(body[order]), np.ascontiguousarray(pack[order]),
-                                              count, mu, 0.0, sweeps, v_s, r_s, st_s, momentum.STALL_SWEEPS)  # fmt: skip
+                                              count, mu, 0.0, sweeps, v_s, r_s, st_s, TUNING.first_stall)  # fmt: skip
     assert its == its_s == sweeps
     assert res == pytest.approx(res_s, rel=1e-12, abs=1e-18)  # only the residual's summation order differs
     np.testing.assert_allclose(v, v_s, rtol=1e-12, atol=1e-15)

@@ -2,20 +2,21 @@
 the engine's own stopping test would stop, and its "own" count is where an independent numpy law residual
 (benchmarks/solver_lab/law.py) of the iterate first meets the tolerance."""
 
+from dataclasses import replace
 from types import SimpleNamespace
 
 import numpy as np
 
 from benchmarks.solver_lab import law, ordinary, tail, trajectory
-from masonrycli.engine import momentum, nlgs
+from masonrycli.engine import momentum
+from masonrycli.engine.tuning import TUNING
 
 
 def _steps(tmp_path, monkeypatch):
-    monkeypatch.setattr(nlgs, "LANES", False)
     monkeypatch.setattr(trajectory, "TRAJECTORY", tmp_path)
     monkeypatch.setattr(ordinary, "TRAJECTORY", tmp_path)
     monkeypatch.setattr(tail, "TRAJECTORY", tmp_path)
-    trajectory.capture("wall-51", every=4, duration=0.03)
+    trajectory.capture("wall-51", every=4, duration=0.03, tuning=replace(TUNING, lanes=False))
     steps = [ordinary.Step(p) for p in sorted((tmp_path / "wall-51").glob("step-*.npz"))]
     ordinary.references("wall-51", steps)
     return steps

@@ -1,7 +1,7 @@
 """Ensembles of short runs: a solver change judged on many trajectories at once, as a distribution.
 
     python -m benchmarks.solver_lab ensemble run --cases h32 h64 [--duration 0.15] [--motions A,F[,PHASE] …]
-                                                 [--copies K] [--jitter EPS] [--set MOD.NAME=VALUE[+…]]
+                                                 [--copies K] [--jitter EPS] [--set FIELD=VALUE[+…]]
                                                  --out FILE.json
     python -m benchmarks.solver_lab ensemble compare A.json[,A2.json …] B.json[,…] [--shift-copy K]
 
@@ -88,8 +88,11 @@ def engine_commit() -> dict:
     }
 
 
-def run_one(case: str, motion: tuple[float, float, float], duration: float, jitter: float = 0.0, copy: int = 0) -> dict:
-    """One unrecorded run of ``case`` shaken by ``motion``, amplitude × (1 + jitter + copy · COPY_STEP)."""
+def run_one(
+    case: str, motion: tuple[float, float, float], duration: float, jitter: float = 0.0, copy: int = 0, tuning=None
+) -> dict:
+    """One unrecorded run of ``case`` shaken by ``motion``, amplitude × (1 + jitter + copy · COPY_STEP), with the
+    engine's ``tuning`` (engine/tuning.py; None: the shipped one)."""
     from benchmarks.solver_cases import CASES
     from masonrycli.run import Simulation
     from masonrycli.scenario.motion import Sine
@@ -101,7 +104,7 @@ def run_one(case: str, motion: tuple[float, float, float], duration: float, jitt
     amplitude, frequency, phase = motion
     ground = Sine(amplitude=amplitude * (1.0 + jitter + copy * COPY_STEP), frequency=frequency, phase=phase)
     scenario = scenario_from_builder(builder, options, RunConfig(duration=duration), Material(), {"ground": ground})
-    sim = Simulation(scenario)
+    sim = Simulation(scenario) if tuning is None else Simulation(scenario, tuning=tuning)
     units = []
     t = time.process_time()
     for _ in range(sim.model.n_steps):  # simulate()'s loop without frames or sinks
@@ -140,21 +143,18 @@ def run(
 ) -> dict:
     """Run every case under every motion; print a line a run and each case's spread; write ``out``.
 
-    ``override`` (``"momentum.STALL_SWEEPS=200+stalled.BODIES_CYCLING=4"``, as ``hard replay``'s variants)
-    sets engine constants for these runs only and is kept in the JSON as ``engine["override"]``: a rule
-    change is judged on ensembles before it is written into the engine."""
+    ``override`` (``"first_stall=200+bodies_cycling=4"``, as ``hard replay``'s variants: fields of the engine's
+    Tuning, engine/tuning.py) changes the engine's tuning for these runs only and is kept in the JSON as
+    ``engine["override"]``: a rule change is judged on ensembles before it is written into the engine."""
+    tuning = None
     if override:
-        from benchmarks.solver_lab.hard_steps import _parse, _set
+        from benchmarks.solver_lab.hard_steps import _parse, tuning_of
 
-        old = _set(_parse(override))
-        try:
-            return _run(cases, motions, duration, out, jitter, copies, override)
-        finally:
-            _set(old)
-    return _run(cases, motions, duration, out, jitter, copies, override)
+        tuning = tuning_of(_parse(override))
+    return _run(cases, motions, duration, out, jitter, copies, override, tuning)
 
 
-def _run(cases, motions, duration, out, jitter, copies, override) -> dict:
+def _run(cases, motions, duration, out, jitter, copies, override, tuning) -> dict:
     from benchmarks.solver_cases import make_scenario
     from masonrycli.run import simulate
 
@@ -170,12 +170,12 @@ def _run(cases, motions, duration, out, jitter, copies, override) -> dict:
     doc = {"engine": engine, "duration": duration, "jitter": jitter, "runs": runs}
     if override:
         engine["override"] = override
-        print(f"engine constants set for these runs: {override}", flush=True)
+        print(f"engine tuning for these runs: {override}", flush=True)
     for case in cases:
         print(f"\n{case}\n| A m/s | f Hz | φ | copy | mean units | max | unconverged | CPU s |\n" + "|---" * 8 + "|")
         for motion in motions:
             for copy in copies:
-                r = run_one(case, motion, duration, jitter, copy)
+                r = run_one(case, motion, duration, jitter, copy, tuning)
                 runs.append(r)
                 if out is not None:  # after every run: an ensemble stopped halfway keeps what it ran
                     out.write_text(json.dumps(doc, indent=1))
@@ -290,7 +290,9 @@ def add_arguments(sub) -> None:
     r.add_argument("--copies", type=int, default=1, help="runs a motion, amplitude × (1 + k·1e-6), k = 0 …")
     r.add_argument("--first-copy", type=int, default=0, help="k of the first copy (to extend an ensemble)")
     r.add_argument("--out", type=Path, default=None)
-    r.add_argument("--set", default="", metavar="MOD.NAME=VALUE[+…]", help="engine constants for these runs")
+    r.add_argument(
+        "--set", default="", metavar="FIELD=VALUE[+…]", help="engine Tuning fields for these runs (engine/tuning.py)"
+    )
     c = act.add_parser("compare", help="B against A, runs paired by motion")
     c.add_argument("a", help="A's JSON (several: comma-separated, runs pooled)")
     c.add_argument("b", help="B's JSON (several: comma-separated, runs pooled)")

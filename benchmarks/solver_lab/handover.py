@@ -14,17 +14,18 @@ costs does not depend on when the stage stopped. So a step's units under any han
 and a rule that decides from the stage's residual history alone can be judged offline from three
 recordings a step: ``record`` replays each kept step (``hard_steps``' capture, ``data/hard``) through
 ``nlgs.solve`` and, at the hand-over, runs the stage alone for up to RECORD_UNITS sweep units with no stall
-window, keeping every sweep's residual, and then the round-robin alone (``stalled.BODIES_UNITS = 0``). Per
+window, keeping every sweep's residual, and then the round-robin alone (``Tuning.bodies_units = 0``). Per
 step: momentum's units and its residual at the stall, the stage's units a sweep (body-order visits / C),
 its history, the round-robin's units and residual. ``table`` evaluates rules (``RULES``) on the
 recordings, the cap ignored (100 000: only a step that already fails reaches it). The stage's re-entry
-(``stalled.BODIES_REENTER``) is not modelled: the units are those of the engine with it 0.
+(``Tuning.bodies_reenter``) is not modelled: the units are those of the engine with it 0.
 """
 
 from __future__ import annotations
 
 import json
 import time
+from dataclasses import replace
 from pathlib import Path
 from types import SimpleNamespace
 
@@ -32,9 +33,10 @@ import numpy as np
 
 from benchmarks.solver_lab.hard_steps import HARD
 from masonrycli.engine import bodies, nlgs, stalled
+from masonrycli.engine.tuning import TUNING, Tuning
 
 RECORD_UNITS = 32_000
-"""Sweep units the stage gets in a recording: twice the engine's BODIES_UNITS, to see what more would buy."""
+"""Sweep units the stage gets in a recording: twice the engine's Tuning.bodies_units, to see what more would buy."""
 
 
 def _names(cases, min_units, max_units, directory=None) -> list[str]:
@@ -47,9 +49,10 @@ def _names(cases, min_units, max_units, directory=None) -> list[str]:
     )
 
 
-def record_step(name: str, directory=None) -> dict | None:
+def record_step(name: str, directory=None, tuning: Tuning = TUNING) -> dict | None:
     """One kept step (of ``directory``, default data/hard): momentum until its stall, then the stage alone
-    (history) and the round-robin alone. None if momentum converges the step (no hand-over)."""
+    (history) and the round-robin alone, the engine's ``tuning`` otherwise. None if momentum converges the step
+    (no hand-over)."""
     z = np.load((directory or HARD) / f"{name}.npz")
     body, pack, count = z["body"].astype(np.int32), z["pack"], z["body"].shape[0]
     v, r, status = z["v_free"].copy(), z["r_warm"].copy(), z["status"].copy()
@@ -59,7 +62,9 @@ def record_step(name: str, directory=None) -> dict | None:
     out: dict = {}
     finish = stalled.continue_stalled
 
-    def entered(contact_body, pack, count, mu, tolerance, cap, v, r, status, v_free, r_warm, iterations, residual):
+    def entered(
+        contact_body, pack, count, mu, tolerance, cap, v, r, status, v_free, r_warm, iterations, residual, tuning=TUNING
+    ):
         out["momentum_units"], out["momentum_residual"] = int(iterations), float(residual)
         start, members = bodies._body_lists(contact_body, pack, count, v.shape[0])
         out["units_per_sweep"] = members.shape[0] / count
@@ -72,20 +77,16 @@ def record_step(name: str, directory=None) -> dict | None:
         out["stage_cpu_s"] = time.process_time() - t
         out["history"] = history[~np.isnan(history)]
         out["stage_units"], out["stage_residual"] = int(done), float(res)
-        units = stalled.BODIES_UNITS
-        stalled.BODIES_UNITS = 0
-        try:
-            total, res = finish(
-                contact_body, pack, count, mu, tolerance, cap, v, r, status, v_free, r_warm, iterations, residual
-            )
-        finally:
-            stalled.BODIES_UNITS = units
+        robin = replace(tuning, bodies_units=0)  # the round-robin alone
+        total, res = finish(
+            contact_body, pack, count, mu, tolerance, cap, v, r, status, v_free, r_warm, iterations, residual, robin
+        )
         out["robin_units"], out["robin_residual"] = int(total - iterations), float(res)
         return total, res
 
     stalled.continue_stalled = entered
     try:
-        nlgs.solve(body, pack, count, model, v, r, status)
+        nlgs.solve(body, pack, count, model, v, r, status, tuning)
     finally:
         stalled.continue_stalled = finish
     if not out:
@@ -94,14 +95,16 @@ def record_step(name: str, directory=None) -> dict | None:
     return out
 
 
-def record(cases: list[str], min_units: int, max_units: int | None, out: Path, directory=None) -> None:
+def record(
+    cases: list[str], min_units: int, max_units: int | None, out: Path, directory=None, tuning: Tuning = TUNING
+) -> None:
     """Record every kept step of ``cases`` (module doc; of the captured set ``directory``, default data/hard)
     into ``out`` (.npz: one array per field and step)."""
     names = _names(cases, min_units, max_units, directory)
     arrays: dict[str, np.ndarray] = {}
     t = time.process_time()
     for i, name in enumerate(names):
-        rec = record_step(name, directory)
+        rec = record_step(name, directory, tuning)
         if rec is None:
             continue
         for key, value in rec.items():

@@ -49,6 +49,7 @@ from benchmarks.solver_lab import sweep_variants as sv
 from benchmarks.solver_lab.problems import DATA
 from benchmarks.solver_lab.stalled_steps import _method as existing_method
 from masonrycli.engine import stalled
+from masonrycli.engine.tuning import TUNING
 
 HARD = DATA / "hard"
 TOLERANCE, CAP, STALL, BIG = 1e-5, 50_000, 10_000, 10_000
@@ -238,6 +239,7 @@ def _round_robin(
     r_warm,
     its,
     res,
+    tuning=TUNING,
 ):
     # stalled.continue_stalled with ``methods`` in its order, where "bodies" is body_sweeps with ``rounds``
     # inner rounds from the warm start (v rebuilt from v_free at each resume, its budget as stall window),
@@ -265,13 +267,13 @@ def _round_robin(
         "faces": stalled._State(v.copy(), r[:count].copy(), status[:count].copy(), res),
     }
     active = list(methods)
-    budget, round_ = stalled.FIRST_BUDGET, 0
+    budget, round_ = TUNING.first_budget, 0
     while its < cap and active:
         for name in list(active):
-            if (name == "newton" and round_ > stalled.NEWTON_LAST_ROUND) or (name == "bodies" and round_ > last):
+            if (name == "newton" and round_ > TUNING.newton_last_round) or (name == "bodies" and round_ > last):
                 active.remove(name)
                 continue
-            share = stalled.NEWTON_BUDGET if name == "newton" else factor if name == "bodies" else 1
+            share = TUNING.newton_budget if name == "newton" else factor if name == "bodies" else 1
             units = min(budget * share, cap - its)
             if units <= 0:
                 break
@@ -295,7 +297,9 @@ def _round_robin(
                     accelerate,
                 )
             else:
-                done = stalled._resume(name, state, contact_body, pack, count, mu, tolerance, units, v_free, cap - its)
+                done = stalled._resume(
+                    name, state, contact_body, pack, count, mu, tolerance, units, v_free, cap - its, tuning
+                )
             its += done
             if state.residual <= tolerance:
                 stalled._adopt(state, v, r, status, count)
@@ -310,8 +314,8 @@ def _round_robin(
     return its, best.residual
 
 
-_FIRST = ("bodies",) + stalled.METHODS
-_SECOND = stalled.METHODS[:1] + ("bodies",) + stalled.METHODS[1:]
+_FIRST = ("bodies",) + TUNING.methods
+_SECOND = TUNING.methods[:1] + ("bodies",) + TUNING.methods[1:]
 REPLAYS = {
     "main": None,
     "bodies-first": (_FIRST, 1, 1, 99, False, None),
@@ -320,11 +324,11 @@ REPLAYS = {
     "mom-bodies-first-x2": (_FIRST, 1, 2, 99, True, None),
     "mom-bodies-first-x4": (_FIRST, 1, 4, 99, True, None),
     "mom-bodies-second": (_SECOND, 1, 1, 99, True, None),
-    "mom-bodies-ahead-16k-s2000": (stalled.METHODS, 1, 1, 99, True, (16000, 2000)),
-    "mom-bodies-ahead-30k-s2000": (stalled.METHODS, 1, 1, 99, True, (30000, 2000)),
-    "mom-bodies-ahead-16k-s1000": (stalled.METHODS, 1, 1, 99, True, (16000, 1000)),
-    "mom-bodies-ahead-16k-s8000": (stalled.METHODS, 1, 1, 99, True, (16000, 8000)),
-    "mom-bodies-ahead-25k-s10000": (stalled.METHODS, 1, 1, 99, True, (25000, 10000)),
+    "mom-bodies-ahead-16k-s2000": (TUNING.methods, 1, 1, 99, True, (16000, 2000)),
+    "mom-bodies-ahead-30k-s2000": (TUNING.methods, 1, 1, 99, True, (30000, 2000)),
+    "mom-bodies-ahead-16k-s1000": (TUNING.methods, 1, 1, 99, True, (16000, 1000)),
+    "mom-bodies-ahead-16k-s8000": (TUNING.methods, 1, 1, 99, True, (16000, 8000)),
+    "mom-bodies-ahead-25k-s10000": (TUNING.methods, 1, 1, 99, True, (25000, 10000)),
 }
 """Replay variants: None is stalled.py as it is; else (the round-robin's methods in order, bodies' inner rounds,
 bodies' budget in units of the others', the last round (0-based) bodies takes part in, bodies with momentum,

@@ -1,7 +1,7 @@
 """Hard steps: capture the steps that cost the engine most in ensemble runs, and replay rule variants on them.
 
     python -m benchmarks.solver_lab hard capture [--cases h32 h64] [--copy 0] [--min-units 1000]
-                                                 [--motions A,F …] [--duration S] [--dir DIR] [--set MOD.NAME=V+…]
+                                                 [--motions A,F …] [--duration S] [--dir DIR] [--set FIELD=V+…]
     python -m benchmarks.solver_lab hard replay --variants main ns-… [--min-units 2500] [--out FILE.json] [--dir DIR]
     python -m benchmarks.solver_lab hard table FILE.json [FILE.json …]
     python -m benchmarks.solver_lab hard stages [--dir DIR] [--min-units 400] --out FILE.json
@@ -16,12 +16,12 @@ cap) in ``data/hard/<case>-a<A>-f<F>-c<copy>-<step>.npz``, with the units and re
 checked against an ensemble file of the same engine (the same motion and copy give the same units).
 ``--dir`` captures into (and replays from) another directory than ``data/hard``: a set per engine, since a
 capture describes the engine that ran it (``data/hard`` is that of 88c12c6 for h32 / h64). ``--set`` runs the
-capture with module constants set as a replay variant's (``MOD.NAME=VALUE[+…]``, kept in the index as
+capture with the engine's Tuning changed as a replay variant's (``FIELD=VALUE[+…]``, kept in the index as
 ``override``): the steps of a variant's trajectory, which leaves main's at its first changed step.
 
 ``replay`` solves each kept step with ``--min-units`` or more by nlgs.solve from its warm start, once per
-variant: a variant is a set of module constants of momentum.py, stalled.py and newton.py set for the
-replay (VARIANTS below), restored after. Per step: units, converged, and the method that finished it
+variant: a variant is a set of fields of the engine's Tuning (engine/tuning.py) changed for the replay
+(VARIANTS below; the old module-constant names of LEGACY still accepted), handed to nlgs.solve. Per step: units, converged, and the method that finished it
 (the last one stalled.py resumed; "momentum0" for momentum's own first solve, "bodies" for stalled.py's
 body-order stage ahead of its round-robin). ``table`` prints, per
 variant: total units, steps converged, steps above 10 000 units, ratio to the first file's total, and
@@ -36,13 +36,15 @@ from __future__ import annotations
 
 import json
 import time
+from dataclasses import replace
 from pathlib import Path
 from types import SimpleNamespace
 
 import numpy as np
 
 from benchmarks.solver_lab.problems import DATA
-from masonrycli.engine import bodies, lane_sweeps32, momentum, newton, nlgs, stalled
+from masonrycli.engine import bodies, nlgs, stalled
+from masonrycli.engine.tuning import TUNING, Tuning
 
 HARD = DATA / "hard"
 BIG = 10_000
@@ -50,34 +52,44 @@ BIG = 10_000
 
 VARIANTS: dict[str, dict[str, object]] = {
     "main": {},
-    "stall300": {"momentum.STALL_SWEEPS": 300},
-    "stall200": {"momentum.STALL_SWEEPS": 200},
-    "stall1000": {"momentum.STALL_SWEEPS": 1000},
-    "lambda3e-4": {"newton.LAMBDA": 3e-4},
-    "lambda1e-4": {"newton.LAMBDA": 1e-4},
-    "lambda3e-3": {"newton.LAMBDA": 3e-3},
-    "shares.1-.3": {"newton.NEWTON_SHARES": (0.1, 0.3)},
-    "shares.25-.3": {"newton.NEWTON_SHARES": (0.25, 0.3)},
-    "shares.15-.5": {"newton.NEWTON_SHARES": (0.15, 0.5)},
-    "shares.15-.15": {"newton.NEWTON_SHARES": (0.15, 0.15)},
-    "nlast0": {"stalled.NEWTON_LAST_ROUND": 0},
-    "nlast2": {"stalled.NEWTON_LAST_ROUND": 2},
-    "nbudget1": {"stalled.NEWTON_BUDGET": 1},
-    "nbudget3": {"stalled.NEWTON_BUDGET": 3},
-    "polish500": {"newton.POLISH_STALL": 500},
-    "polish2000": {"newton.POLISH_STALL": 2000},
-    "first1000": {"stalled.FIRST_BUDGET": 1000},
-    "first4000": {"stalled.FIRST_BUDGET": 4000},
-    "order-tfam": {"stalled.METHODS": ("newton", "turning", "faces", "alternating", "momentum")},
-    "order-tn": {"stalled.METHODS": ("turning", "newton", "alternating", "momentum", "faces")},
-    "no-momentum": {"stalled.METHODS": ("newton", "turning", "alternating", "faces")},
-    "ahead1": {"stalled.NEWTON_AHEAD": 1},
-    "ahead1-nlast2": {"stalled.NEWTON_AHEAD": 1, "stalled.NEWTON_LAST_ROUND": 2},
-    "ahead2-nlast2": {"stalled.NEWTON_AHEAD": 2, "stalled.NEWTON_LAST_ROUND": 2},
-    "first1000-nb4": {"stalled.FIRST_BUDGET": 1000, "stalled.NEWTON_BUDGET": 4},
-    "first500-nb8": {"stalled.FIRST_BUDGET": 500, "stalled.NEWTON_BUDGET": 8},
-    "no-alternating": {"stalled.METHODS": ("newton", "turning", "momentum", "faces")},
+    "stall300": {"first_stall": 300},
+    "stall200": {"first_stall": 200},
+    "stall1000": {"first_stall": 1000},
+    "shares.1-.3": {"newton_shares": (0.1, 0.3)},
+    "shares.25-.3": {"newton_shares": (0.25, 0.3)},
+    "shares.15-.5": {"newton_shares": (0.15, 0.5)},
+    "shares.15-.15": {"newton_shares": (0.15, 0.15)},
+    "nlast0": {"newton_last_round": 0},
+    "nlast2": {"newton_last_round": 2},
+    "nbudget1": {"newton_budget": 1},
+    "nbudget3": {"newton_budget": 3},
+    "first1000": {"first_budget": 1000},
+    "first4000": {"first_budget": 4000},
+    "order-tfam": {"methods": ("newton", "turning", "faces", "alternating", "momentum")},
+    "order-tn": {"methods": ("turning", "newton", "alternating", "momentum", "faces")},
+    "no-momentum": {"methods": ("newton", "turning", "alternating", "faces")},
+    "ahead1": {"newton_ahead": 1},
+    "ahead1-nlast2": {"newton_ahead": 1, "newton_last_round": 2},
+    "ahead2-nlast2": {"newton_ahead": 2, "newton_last_round": 2},
+    "first1000-nb4": {"first_budget": 1000, "newton_budget": 4},
+    "first500-nb8": {"first_budget": 500, "newton_budget": 8},
+    "no-alternating": {"methods": ("newton", "turning", "momentum", "faces")},
 }
+"""Named replay variants: fields of the engine's Tuning and their values (the λ and polish-window variants of
+"Hard steps" set newton.py module constants, which nothing sets any more: not replayable by name)."""
+
+LEGACY = {
+    "momentum.STALL_SWEEPS": "first_stall",
+    "nlgs.LANES": "lanes",
+    "newton.NEWTON_SHARES": "newton_shares",
+    **{f"stalled.{f.upper()}": f for f in (
+        "bodies_units", "bodies_stall", "bodies_window", "bodies_level", "bodies_cycling", "bodies_far",
+        "bodies_strong", "bodies_cycling_far", "bodies_reenter", "first_budget", "methods", "newton_budget",
+        "newton_last_round", "newton_ahead",
+    )},
+}  # fmt: skip
+"""The module constants the JOURNAL's commands set (``--set momentum.STALL_SWEEPS=200``), by the Tuning field that
+replaced each: those commands still run."""
 
 
 def _key(case: str, motion, copy: int, step: int) -> str:
@@ -95,25 +107,24 @@ def capture(
     solver: str = "nlgs-accel",
 ) -> None:
     """Run ``cases`` under the ensemble's motions; keep the steps of ``min_units`` or more (module doc), with
-    the constants of ``override`` (``MOD.NAME=VALUE[+…]``) set for the capture, by ``solver`` (kept with each
+    the Tuning fields of ``override`` (``FIELD=VALUE[+…]``) changed for the capture, by ``solver`` (kept with each
     step: its replay runs the same path)."""
     directory = directory or HARD  # read at the call: tests point HARD elsewhere
     directory.mkdir(parents=True, exist_ok=True)
-    old = _set(_parse(override)) if override else {}
-    try:
-        _capture_cases(cases, copy, min_units, motions, duration, directory, override, solver)
-    finally:
-        _set(old)
+    tuning = tuning_of(_parse(override)) if override else TUNING
+    _capture_cases(cases, copy, min_units, motions, duration, directory, override, solver, tuning)
 
 
-def _capture_cases(cases, copy, min_units, motions, duration, directory, override, solver) -> None:
+def _capture_cases(cases, copy, min_units, motions, duration, directory, override, solver, tuning) -> None:
     from benchmarks.solver_lab import ensemble
 
     for case in cases:
         index_path = directory / f"index-{case}-c{copy}.json"  # one a capture process: cases run in parallel
         index = json.loads(index_path.read_text()) if index_path.exists() else {}
         for motion in motions or ensemble.MOTIONS:
-            kept, units = _capture_run(case, motion, copy, min_units, duration or ensemble.DURATION, directory, solver)
+            kept, units = _capture_run(
+                case, motion, copy, min_units, duration or ensemble.DURATION, directory, solver, tuning
+            )
             if override:
                 for entry in kept.values():
                     entry["override"] = override
@@ -127,7 +138,7 @@ def _capture_cases(cases, copy, min_units, motions, duration, directory, overrid
             )
 
 
-def _capture_run(case, motion, copy, min_units, duration, directory, solver) -> tuple[dict, list[int]]:
+def _capture_run(case, motion, copy, min_units, duration, directory, solver, tuning) -> tuple[dict, list[int]]:
     from benchmarks.solver_cases import CASES
     from benchmarks.solver_lab.ensemble import COPY_STEP
     from masonrycli.run import Simulation
@@ -140,11 +151,11 @@ def _capture_run(case, motion, copy, min_units, duration, directory, solver) -> 
     scenario = scenario_from_builder(
         builder, options, RunConfig(duration=duration, solver=solver), Material(), {"ground": ground}
     )
-    sim = Simulation(scenario)
+    sim = Simulation(scenario, tuning=tuning)
     solve = nlgs.solve
     step, kept, units = [0], {}, []
 
-    def watched(contact_body, pack, count, model, v, r, status):
+    def watched(contact_body, pack, count, model, v, r, status, tuning=TUNING):
         inputs = {
             "body": contact_body[:count].copy(),
             "pack": pack[:count].copy(),
@@ -152,7 +163,7 @@ def _capture_run(case, motion, copy, min_units, duration, directory, solver) -> 
             "r_warm": r[:count].copy(),
             "status": status[:count].copy(),
         }
-        out = solve(contact_body, pack, count, model, v, r, status)
+        out = solve(contact_body, pack, count, model, v, r, status, tuning)
         if out[0] >= min_units:
             name = _key(case, motion, copy, step[0])
             params = {"mu": model.friction, "tolerance": model.tolerance, "cap": model.max_iterations}
@@ -172,21 +183,10 @@ def _capture_run(case, motion, copy, min_units, duration, directory, solver) -> 
     return kept, units
 
 
-def _set(overrides: dict[str, object]) -> dict[str, object]:
-    modules = {
-        "momentum": momentum,
-        "newton": newton,
-        "stalled": stalled,
-        "nlgs": nlgs,
-        "bodies": bodies,
-        "lane_sweeps32": lane_sweeps32,
-    }
-    old = {}
-    for name, value in overrides.items():
-        module, attr = name.split(".")
-        old[name] = getattr(modules[module], attr)
-        setattr(modules[module], attr, value)
-    return old
+def tuning_of(overrides: dict[str, object]) -> Tuning:
+    """The shipped tuning with ``overrides`` (field → value; a LEGACY name for its field); an unknown name is a
+    TypeError of dataclasses.replace."""
+    return replace(TUNING, **{LEGACY.get(name, name): value for name, value in overrides.items()})
 
 
 def _model(z) -> SimpleNamespace:
@@ -200,8 +200,9 @@ def _model(z) -> SimpleNamespace:
     )  # fmt: skip
 
 
-def replay_step(name: str, directory=None) -> dict:
-    """One kept step through nlgs.solve from its warm start: units, residual, the method that finished."""
+def replay_step(name: str, directory=None, tuning: Tuning = TUNING) -> dict:
+    """One kept step through nlgs.solve with ``tuning`` from its warm start: units, residual, the method that
+    finished."""
     z = np.load((directory or HARD) / f"{name}.npz")
     body, pack, count = z["body"].astype(np.int32), z["pack"], z["body"].shape[0]
     v, r, status = z["v_free"].copy(), z["r_warm"].copy(), z["status"].copy()
@@ -224,7 +225,7 @@ def replay_step(name: str, directory=None) -> dict:
     stalled._resume, stalled.continue_stalled = logged, entered
     try:
         t = time.process_time()
-        units, residual = nlgs.solve(body, pack, count, model, v, r, status)
+        units, residual = nlgs.solve(body, pack, count, model, v, r, status, tuning)
         cpu = time.process_time() - t
     finally:
         stalled._resume, stalled.continue_stalled = resume, finish
@@ -265,14 +266,11 @@ def replay(
     }
     for variant in variants:
         overrides = VARIANTS[variant] if variant in VARIANTS else _parse(variant)
-        old = _set(overrides)
-        try:
-            results = {}
-            t = time.process_time()
-            for name in names:
-                results[name] = replay_step(name, directory)
-        finally:
-            _set(old)
+        tuning = tuning_of(overrides)
+        results = {}
+        t = time.process_time()
+        for name in names:
+            results[name] = replay_step(name, directory, tuning)
         doc["variants"][variant] = {"overrides": {k: str(v) for k, v in overrides.items()}, "steps": results}
         print(summary_line(variant, results, doc["engine"]) + f" ({time.process_time() - t:.0f} CPU s)", flush=True)
         if out is not None:
@@ -281,7 +279,7 @@ def replay(
 
 
 def _parse(text: str) -> dict[str, object]:
-    """``"newton.LAMBDA=3e-4+stalled.FIRST_BUDGET=1000"`` → overrides (values by Python's literal syntax)."""
+    """``"first_stall=300+first_budget=1000"`` → overrides (values by Python's literal syntax)."""
     import ast
 
     overrides = {}
@@ -329,8 +327,9 @@ def _first_below(history: np.ndarray, level: float) -> int | None:
     return int(k[0]) + 1 if k.size else None
 
 
-def stage_split(name: str, directory=None) -> dict:
-    """One kept step: units and residual history per stage of the chain (module doc, ``stages``)."""
+def stage_split(name: str, directory=None, tuning: Tuning = TUNING) -> dict:
+    """One kept step: units and residual history per stage of the chain (module doc, ``stages``), with the
+    engine's ``tuning``."""
     from masonrycli.engine import lane_sweeps
 
     z = np.load((directory or HARD) / f"{name}.npz")
@@ -339,7 +338,7 @@ def stage_split(name: str, directory=None) -> dict:
 
     def first_stage(sweeps):
         v, r, st = z["v_free"].copy(), z["r_warm"].copy(), z["status"].copy()
-        return lane_sweeps._lane_sweeps(body, pack, count, mu, tol, sweeps, v, r, st, momentum.STALL_SWEEPS)
+        return lane_sweeps._lane_sweeps(body, pack, count, mu, tol, sweeps, v, r, st, tuning.first_stall)
 
     sweeps = first_stage(cap)[0]
     h = np.array([first_stage(k)[1] for k in range(1, sweeps + 1)])
@@ -363,7 +362,7 @@ def stage_split(name: str, directory=None) -> dict:
     bodies.body_order_sweeps, stalled._resume = recorded, logged
     try:
         v, r, st = z["v_free"].copy(), z["r_warm"].copy(), z["status"].copy()
-        out["units"], out["residual"] = (float(x) for x in nlgs.solve(body, pack, count, _model(z), v, r, st))
+        out["units"], out["residual"] = (float(x) for x in nlgs.solve(body, pack, count, _model(z), v, r, st, tuning))
     finally:
         bodies.body_order_sweeps, stalled._resume = order, resume
     for part, hist in [(out["momentum"], h)] + [(c, c["history"]) for c in calls]:
@@ -374,14 +373,14 @@ def stage_split(name: str, directory=None) -> dict:
     return out
 
 
-def stages(min_units: int, out: Path | None, directory=None) -> dict:
+def stages(min_units: int, out: Path | None, directory=None, tuning: Tuning = TUNING) -> dict:
     """``stage_split`` of every kept step of ≥ ``min_units``, dearest first; one line each, JSON to ``out``."""
     directory = directory or HARD
     index = {n: e for path in sorted(directory.glob("index-*.json")) for n, e in json.loads(path.read_text()).items()}
     names = sorted((n for n, e in index.items() if e["units"] >= min_units), key=lambda n: -index[n]["units"])
     doc = {}
     for name in names:
-        doc[name] = s = stage_split(name, directory)
+        doc[name] = s = stage_split(name, directory, tuning)
         tol, m = s["tolerance"], s["momentum"]
         line = f"{name}: {s['units']:.0f} units | momentum {m['units']} (low {m['low'] / tol:.2f}× at {m['low_at']}, ≤ 2× at {m['within2']})"
         for c in s["stage"]:
@@ -406,11 +405,16 @@ def add_arguments(sub) -> None:
     c.add_argument("--motions", nargs="+", default=None, help="A,F[,PHASE] … (default: the ensemble's 12)")
     c.add_argument("--duration", type=float, default=None, help="s (default: the ensemble's)")
     c.add_argument("--dir", type=Path, default=None, help="where the steps go (default data/hard)")
-    c.add_argument("--set", default=None, metavar="MOD.NAME=VALUE[+…]", help="engine constants for the capture")
+    c.add_argument(
+        "--set", default=None, metavar="FIELD=VALUE[+…]", help="Tuning fields for the capture (engine/tuning.py)"
+    )
     c.add_argument("--solver", default="nlgs-accel", help="the run's solver (default nlgs-accel, the float64 path)")
     r = act.add_parser("replay")
     r.add_argument(
-        "--variants", nargs="+", default=["main"], help=f"names ({', '.join(VARIANTS)}) or MOD.NAME=VALUE[+…]"
+        "--variants",
+        nargs="+",
+        default=["main"],
+        help=f"names ({', '.join(VARIANTS)}) or FIELD=VALUE[+…] of engine/tuning.py",
     )
     r.add_argument("--min-units", type=int, default=2500)
     r.add_argument("--max-units", type=int, default=None)

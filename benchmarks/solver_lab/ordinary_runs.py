@@ -24,6 +24,7 @@ from benchmarks.solver_lab.capture import _align
 from benchmarks.solver_lab.ordinary import ENGINE, STALL, VARIANTS, _accelerated, _interleave, kernel_args
 from benchmarks.solver_lab.trajectory import TRAJECTORY
 from masonrycli.engine import nlgs, stalled
+from masonrycli.engine.tuning import TUNING
 
 
 def _tight(case: str, duration: float) -> dict:
@@ -43,7 +44,7 @@ def run_variant(case: str, params: dict, duration: float) -> dict:
     hist = [(np.empty(0, np.int64), np.empty((0, 2)))] * 2
     sims = []
 
-    def solve(contact_body, pack, count, model, v, r, status):
+    def solve(contact_body, pack, count, model, v, r, status, tuning=TUNING):
         o = _interleave(count)
         body = np.ascontiguousarray(contact_body[:count][o].astype(np.uint32))
         pk = np.ascontiguousarray(pack[:count][o])
@@ -78,6 +79,7 @@ def run_variant(case: str, params: dict, duration: float) -> dict:
                 r_warm,
                 its,
                 res,
+                tuning,
             )
         if q["gamma"]:
             order = np.argsort(key, kind="stable")

@@ -8,7 +8,7 @@
 
 The steps: the inputs of every ``--every``-th accelerated first-stage call that ``nlgs.solve`` makes on
 ``--case`` (bench_kernel.capture). On each, the engine's ``nlgs._nlgs_interleaved`` (momentum; the lane
-sweeps while ``nlgs.LANES``, the default, else the 4-run interleaved order) and each coloured variant run
+sweeps while ``Tuning.lanes``, the default, else the 4-run interleaved order) and each coloured variant run
 from the same inputs to the engine's tolerance, stall window 200.
 Timing: ``--rounds`` rounds, each running the engine and then every variant over all steps (the order
 rotated from round to round), CPU time (``time.process_time``) per pass; the minimum over rounds.
@@ -17,8 +17,8 @@ the first stage, steps ending above the tolerance (stalled: the engine would han
 and with ``--reference`` the distance of v from a tight solve of the same step (momentum to 1e-9 m/s with
 no stall window, cap TIGHT_CAP; plain NLGS if that misses it, the closer of the two kept): RMS over the
 step's bodies and components, then mean and max over steps. ``--asm``: what LLVM made of each phase.
-``--whole-run``: whole runs with the engine's first stage by its lane sweeps (``nlgs.LANES``, the default)
-and by the 4-run scalar sweep (``LANES`` False); "lanes+vec" in ``--variants`` is the lane sweeps alone.
+``--whole-run``: whole runs with the engine's first stage by its lane sweeps (``Tuning.lanes``, the default)
+and by the 4-run scalar sweep (``lanes`` False); "lanes+vec" in ``--variants`` is the lane sweeps alone.
 """
 
 from __future__ import annotations
@@ -27,6 +27,7 @@ import argparse
 import contextlib
 import re
 import time
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -34,6 +35,7 @@ import numpy as np
 from benchmarks.bench_kernel import capture
 from benchmarks.solver_lab import simd_sweep
 from masonrycli.engine import nlgs
+from masonrycli.engine.tuning import TUNING
 
 TIGHT = 1e-9
 TIGHT_CAP = 50_000
@@ -127,23 +129,23 @@ def run(case, duration, every, rounds, variants, reference):
 
 
 @contextlib.contextmanager
-def first_stage_by_lanes(lanes=True):
-    """While open, ``nlgs.LANES`` is ``lanes``: ``nlgs.solve``'s first stage (its first call of
-    ``_nlgs_interleaved``: momentum to the stall window) is the engine's lane sweeps (engine/lane_sweeps.py,
-    the default) or, False, the 4-run scalar sweep (interleaved._accelerated, the default before them);
-    stalled steps go on by stalled.py either way. Yields a tally: first-stage CPU s and sweeps, steps handed
-    to stalled.py."""
+def first_stage_timed():
+    """While open, ``nlgs.solve``'s first stage (its first call of ``_nlgs_interleaved``: momentum to the stall
+    window) is timed: the engine's lane sweeps (engine/lane_sweeps.py, the default) or, with the runs'
+    Tuning.lanes False, the 4-run scalar sweep (interleaved._accelerated, the default before them); stalled
+    steps go on by stalled.py either way. Yields a tally: first-stage CPU s and sweeps, steps handed to
+    stalled.py."""
     from masonrycli.engine import stalled
 
-    kernel, solve, cont, flag = nlgs._nlgs_interleaved, nlgs.solve, stalled.continue_stalled, nlgs.LANES
+    kernel, solve, cont = nlgs._nlgs_interleaved, nlgs.solve, stalled.continue_stalled
     first, tally = [False], {"first_cpu": 0.0, "first_sweeps": 0, "stalled": 0}
 
-    def first_stage(contact_body, pack, count, mu, tolerance, cap, v, r, status, accelerate, stall, *rest):
+    def first_stage(contact_body, pack, count, mu, tolerance, cap, v, r, status, accelerate, stall, *rest, **kw):
         if not (first[0] and accelerate and not rest):
-            return kernel(contact_body, pack, count, mu, tolerance, cap, v, r, status, accelerate, stall, *rest)
+            return kernel(contact_body, pack, count, mu, tolerance, cap, v, r, status, accelerate, stall, *rest, **kw)
         first[0] = False
         t = time.process_time()
-        out = kernel(contact_body, pack, count, mu, tolerance, cap, v, r, status, accelerate, stall)
+        out = kernel(contact_body, pack, count, mu, tolerance, cap, v, r, status, accelerate, stall, **kw)
         tally["first_cpu"] += time.process_time() - t
         tally["first_sweeps"] += out[0]
         return out
@@ -159,24 +161,24 @@ def first_stage_by_lanes(lanes=True):
         tally["stalled"] += 1
         return cont(*args)
 
-    nlgs._nlgs_interleaved, nlgs.solve, stalled.continue_stalled, nlgs.LANES = first_stage, solve_first, counted, lanes
+    nlgs._nlgs_interleaved, nlgs.solve, stalled.continue_stalled = first_stage, solve_first, counted
     try:
         yield tally
     finally:
-        nlgs._nlgs_interleaved, nlgs.solve, stalled.continue_stalled, nlgs.LANES = kernel, solve, cont, flag
+        nlgs._nlgs_interleaved, nlgs.solve, stalled.continue_stalled = kernel, solve, cont
 
 
 def whole_runs(case, duration, rounds):
-    """Whole runs of ``case`` with the engine's first stage by the 4-run scalar sweep (``nlgs.LANES``
-    False) and by the lane sweeps (True, the default): first_stage_by_lanes. Rounds interleaved, CPU
+    """Whole runs of ``case`` with the engine's first stage by the 4-run scalar sweep (``Tuning.lanes``
+    False) and by the lane sweeps (True, the default), timed by first_stage_timed. Rounds interleaved, CPU
     minimum; top-course / mean slip at 0.1 and 0.2 s against a tight solve (plain NLGS at 1e-7 m/s,
     bench_solver's TIGHT)."""
     from benchmarks.bench_solver import run_masonry
     from benchmarks.solver_reference import TIGHT, errors_pct
 
     def one(lanes, seconds):
-        with first_stage_by_lanes(lanes) as tally:
-            row = run_masonry(case, seconds, False)
+        with first_stage_timed() as tally:
+            row = run_masonry(case, seconds, False, tuning=replace(TUNING, lanes=lanes))
         return row | tally
 
     one(True, 0.003)  # compile both
@@ -190,7 +192,7 @@ def whole_runs(case, duration, rounds):
         best = min(rows_, key=lambda x: x["cpu_s"])
         errs = "  ".join(f"{int(k) / 1000:g} s {t:+.2f} / {m:+.2f} %" for k, (t, m) in
                          errors_pct(best["samples"], reference).items())  # fmt: skip
-        name = "LANES=True (lane sweeps)" if lanes else "LANES=False (4-run scalar)"
+        name = "lanes=True (lane sweeps)" if lanes else "lanes=False (4-run scalar)"
         print(f"{case} {name}: {best['cpu_s'] / best['sim_s']:.3f} CPU s per sim s (solve {best['nlgs_share']:.0%}), "
               f"{best['sweeps_mean']:.1f} sweeps a step (max {best['sweeps_max']}), unconverged "
               f"{best['unconverged']}, handed to stalled.py {best['stalled']}; first stage "
@@ -201,14 +203,13 @@ def whole_runs(case, duration, rounds):
 
 def ensembles(cases, duration, copies, out):
     """solver_lab.ensemble's runs (12 ground motions × ``copies``) with the 4-run scalar first stage
-    (``nlgs.LANES`` False), written to OUT-scalar.json, and with the lane sweeps (True), to OUT-lanes.json;
+    (``Tuning.lanes`` False), written to OUT-scalar.json, and with the lane sweeps (True), to OUT-lanes.json;
     then ``ensemble compare`` of the two."""
     from benchmarks.solver_lab import ensemble
 
     paths = [Path(f"{out}-scalar.json"), Path(f"{out}-lanes.json")]
     for lanes, path in zip((False, True), paths):
-        with first_stage_by_lanes(lanes):
-            ensemble.run(cases, ensemble.MOTIONS, duration, path, copies=range(copies))
+        ensemble.run(cases, ensemble.MOTIONS, duration, path, copies=range(copies), override=f"lanes={lanes}")
     return ensemble.compare(*paths)
 
 
@@ -257,7 +258,7 @@ def main(argv=None):
     parser.add_argument("--variants", nargs="*", default=["split", "fused"])
     parser.add_argument("--reference", action="store_true")
     parser.add_argument("--asm", action="store_true", help="only print what LLVM made of each phase")
-    parser.add_argument("--whole-run", action="store_true", help="whole runs, nlgs.LANES True and False (whole_runs)")
+    parser.add_argument("--whole-run", action="store_true", help="whole runs, Tuning.lanes True and False (whole_runs)")
     parser.add_argument("--ensemble", metavar="OUT", help="with --whole-run: ensembles of short runs (ensembles)")
     parser.add_argument("--copies", type=int, default=2, help="--ensemble: runs a motion")
     args = parser.parse_args(argv)

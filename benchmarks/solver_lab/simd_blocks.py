@@ -26,6 +26,7 @@ from benchmarks.solver_lab.simd_sweep import _PACK_OF_K, K_ROWS, _local_solve_bf
 from masonrycli.engine import momentum, nlgs
 from masonrycli.engine._jit import njit
 from masonrycli.engine.nlgs import P_IIA, P_IIB, P_IMA, P_IMB
+from masonrycli.engine.tuning import TUNING
 
 LANES = 8
 """Contacts a block: one AVX-512 vector of doubles."""
@@ -220,6 +221,6 @@ def block_sweeps(contact_body, pack, count, mu, tolerance, max_iterations, v, v_
     return iterations, residual, n_colours
 
 
-def solve(contact_body, pack, count, mu, tolerance, cap, v, r, status, stall_after=momentum.STALL_SWEEPS):
+def solve(contact_body, pack, count, mu, tolerance, cap, v, r, status, stall_after=TUNING.first_stall):
     """The block-coloured first stage on one step's arrays (as nlgs._nlgs_interleaved takes them)."""
     return block_sweeps(contact_body, pack, count, mu, tolerance, cap, v, v.reshape(-1), r, status, stall_after)

@@ -50,6 +50,7 @@ from masonrycli.engine.nlgs import (
     STATUS_SLIP,
     STATUS_STICK,
 )
+from masonrycli.engine.tuning import TUNING
 
 RESTART_GROWTH = momentum.RESTART_GROWTH
 
@@ -404,9 +405,7 @@ def _engine_lanes(contact_body, pack, count, mu, tolerance, cap, v, r, status, s
     return its, residual, int(nsub.sum())
 
 
-def solve(
-    contact_body, pack, count, mu, tolerance, cap, v, r, status, stall_after=momentum.STALL_SWEEPS, variant="split"
-):
+def solve(contact_body, pack, count, mu, tolerance, cap, v, r, status, stall_after=TUNING.first_stall, variant="split"):
     """The coloured first stage on one step's arrays (as nlgs._nlgs_interleaved takes them).
     Returns (iterations, residual, colours). Variant "blocks": simd_blocks.py's layout in 8-contact blocks;
     "lanes+vec": the engine's lane sweeps (engine/lane_sweeps.py, the default's first stage; the lab's

@@ -35,29 +35,31 @@ import numpy as np
 
 from benchmarks.solver_cases import make_scenario
 from benchmarks.solver_lab.problems import DATA, Problem
-from masonrycli.engine import faces, momentum, nlgs, stalled
+from masonrycli.engine import faces, nlgs, stalled
+from masonrycli.engine.tuning import TUNING, Tuning
 from masonrycli.run import Simulation, simulate
 
 STALLED = DATA / "stalled"
 TOLERANCE, CAP = 1e-5, 50_000
 
 
-def capture(cases: list[str], duration: float) -> None:
-    """Run ``cases`` for ``duration`` simulated s; write the input of each step stalled.py finished."""
+def capture(cases: list[str], duration: float, tuning: Tuning = TUNING) -> None:
+    """Run ``cases`` for ``duration`` simulated s with the engine's ``tuning``; write the input of each step
+    stalled.py finished."""
     STALLED.mkdir(parents=True, exist_ok=True)
     for case in cases:
-        steps, kept = _capture_case(case, duration)
+        steps, kept = _capture_case(case, duration, tuning)
         print(f"{case}: {steps} steps, {len(kept)} stalled: {' '.join(kept)}", flush=True)
 
 
-def _capture_case(case: str, duration: float) -> tuple[int, list[str]]:
+def _capture_case(case: str, duration: float, tuning: Tuning = TUNING) -> tuple[int, list[str]]:
     solve, finish = nlgs.solve, stalled.continue_stalled
     step, pending, kept = [0], {}, []
 
-    def watched(contact_body, pack, count, model, v, r, status):
+    def watched(contact_body, pack, count, model, v, r, status, tuning=TUNING):
         pending.update(body=contact_body[:count].copy(), pack=pack[:count].copy(), v_free=v.copy())
         pending.update(r_warm=r[:count].copy(), mu=model.friction, stalled=False)
-        out = solve(contact_body, pack, count, model, v, r, status)
+        out = solve(contact_body, pack, count, model, v, r, status, tuning)
         if pending["stalled"]:
             path = STALLED / f"{case}-{step[0]}.npz"
             np.savez(path, **{k: val for k, val in pending.items() if k != "stalled"})
@@ -72,7 +74,7 @@ def _capture_case(case: str, duration: float) -> tuple[int, list[str]]:
     nlgs.solve, stalled.continue_stalled = watched, marked
     try:
         sc = make_scenario(case, duration)
-        simulate(sc, [], sim=Simulation(sc))
+        simulate(sc, [], sim=Simulation(sc, tuning=tuning))
     finally:
         nlgs.solve, stalled.continue_stalled = solve, finish
     return step[0], kept
@@ -84,9 +86,7 @@ def _method(name, p, v, r, status, cap=CAP):
         model = SimpleNamespace(friction=mu, tolerance=TOLERANCE, max_iterations=cap, solver="nlgs-accel")
         return nlgs.solve(body, pack, count, model, v, r, status)
     if name == "faces":
-        its, res = nlgs._nlgs_interleaved(
-            body, pack, count, mu, TOLERANCE, cap, v, r, status, True, momentum.STALL_SWEEPS
-        )
+        its, res = nlgs._nlgs_interleaved(body, pack, count, mu, TOLERANCE, cap, v, r, status, True, TUNING.first_stall)
         if res <= TOLERANCE:
             return its, res
         units, res = faces.face_sweeps(body, pack, count, mu, TOLERANCE, cap - its, v, r, status)
@@ -95,7 +95,7 @@ def _method(name, p, v, r, status, cap=CAP):
         return nlgs._nlgs_interleaved(body, pack, count, mu, TOLERANCE, cap, v, r, status, False, cap)
     # turning, momentum, alternating, newton: stalled.py's own resume, from the warm start, with the whole cap
     state = stalled._State(None, r, status, np.inf)
-    its = stalled._resume(name, state, body, pack, count, mu, TOLERANCE, cap, v.copy(), cap)
+    its = stalled._resume(name, state, body, pack, count, mu, TOLERANCE, cap, v.copy(), cap, TUNING)
     v[:] = state.v
     return its, state.residual
 

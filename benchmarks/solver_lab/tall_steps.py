@@ -16,7 +16,7 @@ steps of ≥ 2500 units, at df779f6). Each is solved from its warm start:
     ipm-pred-close4   the same predictor, ipm-newton to 1e-4 m/s, then accelerated sweeps
     cpg-mono          methods/cpg.py's monotone CPG (s ← μ|u_t| each iteration)
     ipm-pred-bodies   ipm-pred with the engine's body-order momentum (bodies.py, stalled.py's stage, stall
-                      window stalled.BODIES_STALL, no hand-over) as its closing sweeps (new here)
+                      window TUNING.bodies_stall, no hand-over) as its closing sweeps (new here)
 
 Units, deterministic and at the compiled floor (so favourable to the lab methods): an engine accelerated
 sweep 1 (as the engine counts them); an IPM factorisation FACTOR_UNITS[kind][case] (LAPACK's banded Cholesky
@@ -44,7 +44,8 @@ from benchmarks.solver_lab.methods import cpg, ipm, ipm_shift
 from benchmarks.solver_lab.outcome import Clock, Context
 from benchmarks.solver_lab.problems import DATA
 from benchmarks.solver_lab.stalled_steps import as_problem
-from masonrycli.engine import bodies, nlgs, stalled
+from masonrycli.engine import bodies, nlgs
+from masonrycli.engine.tuning import TUNING
 
 TOLERANCE, ENGINE_CAP, CAP = 1e-5, 100_000, 50_000
 BUDGET, MIN_BUDGET = 2.0, 5000
@@ -115,7 +116,7 @@ def _closing(ctx, r, budget, body_order=False) -> tuple[int, float, np.ndarray]:
     budget = max(budget, 1)
     if body_order:
         n, res = bodies.body_order_sweeps(
-            p.body, ctx.pack, p.count, p.mu, TOLERANCE, budget, v, r, status, stalled.BODIES_STALL
+            p.body, ctx.pack, p.count, p.mu, TOLERANCE, budget, v, r, status, TUNING.bodies_stall
         )
     else:
         n, res = nlgs._nlgs_interleaved(p.body, ctx.pack, p.count, p.mu, TOLERANCE, budget, v, r, status, True, budget)

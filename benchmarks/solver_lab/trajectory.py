@@ -29,18 +29,20 @@ from benchmarks.solver_cases import make_scenario
 from benchmarks.solver_lab.capture import _align
 from benchmarks.solver_lab.problems import DATA
 from masonrycli.engine import nlgs, stalled
+from masonrycli.engine.tuning import TUNING, Tuning
 from masonrycli.run import Simulation
 
 TRAJECTORY = DATA / "trajectory"
 
 
-def capture(case: str, every: int, duration: float | None, name: str | None = None) -> None:
-    """Run ``case`` and keep every ``every``-th step (module doc) in ``data/trajectory/<name or case>``."""
+def capture(case: str, every: int, duration: float | None, name: str | None = None, tuning: Tuning = TUNING) -> None:
+    """Run ``case`` with the engine's ``tuning`` and keep every ``every``-th step (module doc) in
+    ``data/trajectory/<name or case>``."""
     out = TRAJECTORY / (name or case)
     out.mkdir(parents=True, exist_ok=True)
     for old in out.glob("step-*.npz"):
         old.unlink()
-    sim = Simulation(make_scenario(case, duration))
+    sim = Simulation(make_scenario(case, duration), tuning=tuning)
     solver = sim.solver
     solve, finish = nlgs.solve, stalled.continue_stalled
     # The sorted keys and impulses of the last two steps: hist[1] the warm start's step, hist[0] the one before.
@@ -52,7 +54,7 @@ def capture(case: str, every: int, duration: float | None, name: str | None = No
         flag[0] = True
         return finish(*args, **kwargs)
 
-    def watched(contact_body, pack, count, model, v, r, status):
+    def watched(contact_body, pack, count, model, v, r, status, tuning=TUNING):
         step = len(steps) + 1
         keep = step % every == 0 or step == 1
         if keep:
@@ -69,7 +71,7 @@ def capture(case: str, every: int, duration: float | None, name: str | None = No
                 point=solver.buffers.contact_point[:count].copy(),
             )
         flag[0] = False
-        its, res = solve(contact_body, pack, count, model, v, r, status)
+        its, res = solve(contact_body, pack, count, model, v, r, status, tuning)
         steps.append((int(its), flag[0]))
         if keep:
             np.savez(out / f"step-{step:04d}.npz", step=step, sweeps=its, stalled=flag[0], **kept)

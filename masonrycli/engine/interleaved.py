@@ -2,7 +2,7 @@
 momentum (:mod:`masonrycli.engine.momentum`) or plainly (``nlgs._nlgs``), copied back. The accelerated
 solvers' first stage uses 8 runs and vectors instead (:mod:`masonrycli.engine.lanes`,
 :mod:`masonrycli.engine.lane_sweeps`); plain "nlgs", stalled.py's and newton.py's sweeps use these (and
-the first stage with the lab's ``nlgs.LANES`` off).
+the first stage with the lab's ``Tuning.lanes`` off).
 
 Detection order puts a pair's two or three contact points, and the pairs of one block, next to each
 other: each visit then reads the velocities the visit before has just written, and the sweep runs at

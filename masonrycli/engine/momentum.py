@@ -2,7 +2,7 @@
 
 This module's kernel is the scalar sweep in the engine's interleaved order (4 runs): stalled.py's momentum
 stages use it, and the first stage did until :mod:`masonrycli.engine.lane_sweeps` (the same rule, 8 runs,
-8 contacts visited at once in vectors) replaced it there (``nlgs.LANES``).
+8 contacts visited at once in vectors) replaced it there (``Tuning.lanes``).
 
 Each sweep of :mod:`masonrycli.engine.nlgs` starts from a Nesterov extrapolation of the last two sweeps'
 impulses and velocities; the momentum is dropped whenever a sweep's residual grows by more than
@@ -11,7 +11,7 @@ are nlgs's, and a step still ends on a sweep, so what a converged step satisfies
 path is shorter (pseudo-code above _momentum_sweeps):
 
     repeat: (r, v) ← (r, v) + β (r − r_prev, v − v_prev);  the sweep of nlgs from there
-            stop at the tolerance, or after STALL_SWEEPS sweeps without a new lowest residual
+            stop at the tolerance, or after stall_after sweeps without a new lowest residual
             a residual > RESTART_GROWTH × the last: j = 1;  β = (j − 1)/(j + 2), j += 1
 
 Why momentum works here: Gauss–Seidel moves load through a stack of hyperstatic joints about one course
@@ -23,7 +23,7 @@ Measured on captured steps: 2.5–4.6× fewer sweeps on walls of 8–32 courses 
 Gauss–Seidel with Nesterov momentum").
 
 Stall window: on tall sliding walls momentum can drive a step into a stick/slip cycle where its residual
-wanders above the tolerance. So a solve stops after STALL_SWEEPS accelerated sweeps without a new lowest
+wanders above the tolerance. So a solve stops after Tuning.first_stall accelerated sweeps without a new lowest
 residual, and nlgs.solve hands the step to :mod:`masonrycli.engine.stalled` (whose body-order stage
 finishes almost every such step from the warm start). 200 rather than 500 gets the step there sooner:
 ensembles of 48 runs, mean sweep units a step 0.614× on the 32-course wall ("Momentum's stall window and
@@ -32,12 +32,12 @@ the round-robin's order").
 Near the tolerance: a step handed over is solved again from its warm start, so a first stage that stalls
 just above the tolerance throws its progress away. So once its lowest residual is within NEAR × the
 tolerance, the float64 part of the default's first stage (lane_sweeps32.first_stage: lane_sweeps._lane_sweeps
-after the float32 sweeps) waits stall_near(model) = max(STALL_SWEEPS, STALL_NEAR × Model.block_depth) sweeps
+after the float32 sweeps) waits stall_near(model, tuning) = max(Tuning.first_stall, STALL_NEAR × Model.block_depth) sweeps
 for a new low: the plateaus of momentum are longer on deeper structures, as load moves about one block a
 sweep (the depth, not the contact count: long low walls have the contacts of tall ones). Replayed, the
 64-course wall's 177 steps of ≥ 2500 units: 1 319 183 units at window 200, 915 518 at 2000 ("Near the
 tolerance: the first stage waits longer").
-"nlgs-accel" (the float64 path) and the lab lever nlgs.LANES = False keep the
+"nlgs-accel" (the float64 path) and the lab lever Tuning.lanes = False keep the
 plain window.
 """
 
@@ -47,26 +47,24 @@ import numpy as np
 
 from masonrycli.engine._jit import kernel_only, njit
 from masonrycli.engine.nlgs import P_WNN, P_WTN, P_WTT, _local_solve, _push, _relative_velocity
+from masonrycli.engine.tuning import TUNING
 
 RESTART_GROWTH = 1.1
 """The accelerated sweep drops its momentum when a sweep's residual exceeds the previous one by this factor
 (1.3 or more diverges on the 248-block wall; 1.05–1.2 all converge)."""
-STALL_SWEEPS = 200
-"""Accelerated sweeps without a new lowest residual after which nlgs.solve hands the step to stalled.py
-(module doc, "Stall window")."""
 NEAR = 3.0
 """× the tolerance: a first stage whose lowest residual is this close waits stall_near(model) sweeps without a new
-low instead of STALL_SWEEPS before it hands the step over (module doc, "Near the tolerance")."""
+low instead of Tuning.first_stall before it hands the step over (module doc, "Near the tolerance")."""
 STALL_NEAR = 25.0
 """The first stage's stall window once its lowest residual is within NEAR × the tolerance, in sweeps per block
-of the structure's depth (Model.block_depth, at least STALL_SWEEPS): 400 sweeps on the 16-course 248-block
+of the structure's depth (Model.block_depth, at least Tuning.first_stall): 400 sweeps on the 16-course 248-block
 wall, 1600 on the 64-course wall; 200, as before, on walls of 8 courses or fewer however long."""
 
 
-def stall_near(model) -> int:
+def stall_near(model, tuning=TUNING) -> int:
     """Sweeps the first stage waits for a new low once it is within NEAR × the tolerance (module doc); a model
-    without ``block_depth`` (the lab's replays of older captures) keeps STALL_SWEEPS."""
-    return max(STALL_SWEEPS, int(STALL_NEAR * getattr(model, "block_depth", 0.0)))
+    without ``block_depth`` (the lab's replays of older captures) keeps ``tuning.first_stall``."""
+    return max(tuning.first_stall, int(STALL_NEAR * getattr(model, "block_depth", 0.0)))
 
 
 @kernel_only

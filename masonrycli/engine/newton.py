@@ -1,5 +1,5 @@
 """Alart–Curnier semismooth Newton on one step's contact problem: the first of the round-robin's methods
-in a stalled solve (stalled.METHODS).
+in a stalled solve (Tuning.methods, stalled.py).
 
 Unknowns: the impulses r (C, 2); v(r) = v_free + M⁻¹ H r, u = Hᵀ v(r) (nlgs's notation). Per contact, with
 W = W_αα's diagonal entries (W_tt, W_nn; 1/W is Alart–Curnier's step ρ) and the Signorini bias b,
@@ -25,7 +25,8 @@ the 3B velocity system, banded when bodies are numbered by position (one banded 
 
 One resume for a budget of U sweep units (stalled.py; the iterate r and λ carry over between resumes):
 
-    while units < NEWTON_SHARES[k] · U:               (k: this resume's number, the last share after)
+    while units < newton_shares[k] · U:               (k: this resume's number, the last share after;
+                                                       Tuning.newton_shares)
         F = F(r);  K, rhs = the system above, into the band;  dr from its LU   (NEWTON_UNITS)
         α = 1, ½, ¼ … ≥ ALPHA_MIN: accept the first with ½|F(r + α dr)|² ≤ (1 − 2σα) ½|F(r)|²  (Armijo)
         accepted: r += α dr;  λ = max(λ / 4, LAMBDA) if α = 1
@@ -38,7 +39,7 @@ One resume for a budget of U sweep units (stalled.py; the iterate r and λ carry
 Why: Newton alone converges only linearly near the solution (λ held, short steps), but it gets a stalled
 step out of its stick/slip cycle: on the 32-course wall's step that turning sweeps need 21 377 units for,
 turning sweeps from the iterate of 10 Newton steps finish in ~1000. Hence 10 Newton steps in a first resume
-(NEWTON_SHARES[0] of stalled.py's 2 × 2000 units) and sweeps from there, 40 in the next (NEWTON_SHARES[1]),
+(newton_shares[0] of stalled.py's 2 × 2000 units) and sweeps from there, 40 in the next (newton_shares[1]),
 the iterate going on. First in stalled.py's order, it takes the 98 stalled steps of the 32- and 64-course
 walls' first 0.2 s from 408 422 sweep units to 212 312 (0.52×; benchmarks/JOURNAL.md, "Alart–Curnier in the
 engine, as a fifth stalled-step method"). It starts from the warm start: from momentum's stalled iterate it
@@ -61,6 +62,7 @@ import numpy as np
 from masonrycli.engine import banded, nlgs
 from masonrycli.engine._jit import njit
 from masonrycli.engine.nlgs import P_BIAS, P_IIA, P_IIB, P_IMA, P_IMB, P_NA, P_NB, P_NX, P_NY, P_TA, P_TB, P_WNN, P_WTT
+from masonrycli.engine.tuning import TUNING
 
 LAMBDA = 1e-3
 """Levenberg–Marquardt shift λ (× diag W): the lowest; × 10 after a rejected step, ÷ 4 after a full one."""
@@ -74,10 +76,6 @@ WATCHDOG = 20
 """Plain engine sweeps after a rejected Newton step."""
 NEWTON_UNITS = 60
 """Sweep units one Newton step counts (module doc, "Units")."""
-NEWTON_SHARES = (0.15, 0.3)
-"""Share of the budget spent on Newton steps in the first resume (10 steps of stalled.py's first 4000 units)
-and in later ones (40 of its 8000: a step that gets there needs more of them); the rest goes to the sweeps
-from the Newton iterate."""
 POLISH_STALL = 1000
 """Sweeps from the Newton iterate without a new lowest residual after which the resume ends (the method is
 then dropped by stalled.py's rule, the budget left to the others)."""
@@ -292,7 +290,20 @@ def _newton_step(contact_body, pack, count, mu, v_free, r, status, shift, band, 
 
 
 def newton_steps(
-    contact_body, pack, count, mu, tolerance, units, limit, v_free, r, r_out, v, status, shift, share=NEWTON_SHARES[0]
+    contact_body,
+    pack,
+    count,
+    mu,
+    tolerance,
+    units,
+    limit,
+    v_free,
+    r,
+    r_out,
+    v,
+    status,
+    shift,
+    share=TUNING.newton_shares[0],
 ) -> tuple[int, float]:
     """One resume of the method (module doc) for a budget of ``units`` sweep units, never beyond ``limit``
     (the step's cap): Newton steps from the iterate ``r`` (C, 2, updated in place) for ``share`` of the

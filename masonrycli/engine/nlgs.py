@@ -40,7 +40,7 @@ exactly the cap.
 Acceleration (solvers "nlgs-accel32", the default, and "nlgs-accel"; "nlgs" is the plain sweep): the
 same sweep started from a Nesterov extrapolation of the last two sweeps (:mod:`masonrycli.engine.momentum`),
 its first stage visiting the contacts in 8 interleaved runs, 8 contacts at once in vectors
-(:mod:`masonrycli.engine.lane_sweeps`; ``LANES``). A stalled accelerated solve goes on by the methods of :mod:`masonrycli.engine.stalled` (momentum turning
+(:mod:`masonrycli.engine.lane_sweeps`; ``Tuning.lanes``). A stalled accelerated solve goes on by the methods of :mod:`masonrycli.engine.stalled` (momentum turning
 its direction at restarts, alternating-direction sweeps, momentum resumed, faces, in turn with doubling
 budgets). Its iterations count accelerated sweeps (each ~1.1–1.6× the time of a plain one) plus the later
 methods' sweep units.
@@ -52,6 +52,7 @@ import numpy as np
 
 from masonrycli.engine._jit import kernel_only, njit
 from masonrycli.engine.contact import ContactStatus
+from masonrycli.engine.tuning import TUNING
 
 STALL_SWEEPS = 10_000
 """Point sweeps without a new lowest residual after which a solve with a tolerance > 0 continues by faces
@@ -285,10 +286,6 @@ def _nlgs(contact_body, pack, count, mu, tolerance, max_iterations, v, r, status
 
 INTERLEAVE = 4
 """The scalar sweeps visit the contacts in this many interleaved runs of detection order (:mod:`.interleaved`)."""
-LANES = True
-"""The accelerated solve's first stage by :mod:`masonrycli.engine.lane_sweeps` (8 runs, 8 contacts visited
-at once in vectors); False: by the scalar sweep in INTERLEAVE runs (interleaved._accelerated), the
-default until the lane sweeps replaced it (benchmarks/JOURNAL.md, explicit vectors addendum)."""
 ACCELERATED = ("nlgs-accel", "nlgs-accel32")  # momentum's first stage, stalled steps by stalled.py
 
 
@@ -305,15 +302,16 @@ def _nlgs_interleaved(
     accelerate,
     accelerated_stall,
     alternate=None,
+    lanes=True,
 ):
     """The sweeps in interleaved order (:mod:`masonrycli.engine.interleaved`): momentum's
     (``accelerate``, stall window ``accelerated_stall``) or the plain ones; ``alternate`` as in
     stalled.py. ``alternate`` omitted with ``accelerate``: the first stage of :func:`solve`, by the lane
-    sweeps when LANES (the benchmarks that capture the first stage hook this function's 11-argument
+    sweeps when ``lanes`` (Tuning.lanes; the benchmarks that capture the first stage hook this function's 11-argument
     calls); stalled.py's and newton.py's sweeps pass it. Returns (iterations, residual). Two kernels rather
     than one with the flag as an argument: a run compiles only the sweep it uses (the plain one cost 1.5 s
     of the first run's compilation)."""
-    if accelerate and alternate is None and LANES:
+    if accelerate and alternate is None and lanes:
         return lane_sweeps._lane_sweeps(
             contact_body, pack, count, mu, tolerance, max_iterations, v, r, status, accelerated_stall
         )
@@ -348,14 +346,15 @@ def prepare_contacts(contact_body, contact_point, contact_normal, contact_gap, c
     )
 
 
-def solve(contact_body, pack, count, model, v, r, status) -> tuple[int, float]:
+def solve(contact_body, pack, count, model, v, r, status, tuning=TUNING) -> tuple[int, float]:
     """Solve one step's contact problem by NLGS: the engine's one entry point for a contact solver.
 
     In: ``contact_body`` (C, 2) bodies a < b, ``pack`` (C, PACK_WIDTH) from :func:`prepare_contacts`,
     ``model`` (friction, tolerance m/s, max_iterations, solver "nlgs-accel", "nlgs-accel32" or "nlgs", and
     block_depth for "nlgs-accel32"'s stall window, momentum.stall_near). ``v`` (B, 3): v_free
     in, v_n+1 out. ``r`` (C, 2): starting impulses in, (r_t, r_n) N·s out. ``status`` (C,) int8 out
-    (:class:`~masonrycli.engine.contact.ContactStatus`).
+    (:class:`~masonrycli.engine.contact.ContactStatus`). ``tuning``: the first stage's and the stalled-step
+    methods' numbers (:class:`~masonrycli.engine.tuning.Tuning`; the Solver's, the shipped ones by default).
 
     Returns (iterations, residual): sweeps done, and the last sweep's RMS contact-law violation in m/s
     (module doc). Another method plugged in beside this one keeps the signature, reports its work in
@@ -368,25 +367,27 @@ def solve(contact_body, pack, count, model, v, r, status) -> tuple[int, float]:
     accelerated = model.solver in ACCELERATED
     if not accelerated or tolerance <= 0.0:
         iterations, residual = _nlgs_interleaved(
-            contact_body, pack, count, mu, tolerance, cap, v, r, status, accelerated, STALL_SWEEPS
-        )
+            contact_body, pack, count, mu, tolerance, cap, v, r, status, accelerated, STALL_SWEEPS,
+            lanes=tuning.lanes,
+        )  # fmt: skip
         return _faces_if_stalled(contact_body, pack, count, mu, tolerance, cap, v, r, status, iterations, residual)
-    # Accelerated: momentum (the lane sweeps, LANES) until its stall window; a stalled step goes on by the
-    # methods of stalled.py.
+    # Accelerated: momentum (the lane sweeps, Tuning.lanes) until its stall window; a stalled step goes on by
+    # the methods of stalled.py.
     v_free, r_warm = v.copy(), r[:count].copy()
-    if model.solver == "nlgs-accel32" and LANES:  # the one place float32 is chosen
+    if model.solver == "nlgs-accel32" and tuning.lanes:  # the one place float32 is chosen
         iterations, residual = lane_sweeps32.first_stage(
-            contact_body, pack, count, mu, tolerance, cap, v, r, status, momentum.STALL_SWEEPS,
-            momentum.stall_near(model),
+            contact_body, pack, count, mu, tolerance, cap, v, r, status, tuning.first_stall,
+            momentum.stall_near(model, tuning),
         )  # fmt: skip
     else:
         iterations, residual = _nlgs_interleaved(
-            contact_body, pack, count, mu, tolerance, cap, v, r, status, True, momentum.STALL_SWEEPS
-        )
+            contact_body, pack, count, mu, tolerance, cap, v, r, status, True, tuning.first_stall,
+            lanes=tuning.lanes,
+        )  # fmt: skip
     if residual <= tolerance or iterations >= cap:
         return iterations, residual
     return stalled.continue_stalled(
-        contact_body, pack, count, mu, tolerance, cap, v, r, status, v_free, r_warm, iterations, residual
+        contact_body, pack, count, mu, tolerance, cap, v, r, status, v_free, r_warm, iterations, residual, tuning
     )
 
 

@@ -41,6 +41,7 @@ import numpy as np
 
 from masonrycli.engine import fused, integrate, nlgs, power, warmstart
 from masonrycli.engine.collision import ContactBuffers, detect_contacts
+from masonrycli.engine.tuning import TUNING, Tuning
 
 REST_SPEED = 1e-3
 """m/s: a step is at rest when every block ended the previous step slower than this and no support moves.
@@ -76,13 +77,17 @@ class StepStats:
 
 
 class Solver:
-    """Owns the per-step work buffers of one model. ``step(state)`` advances ``state`` in place.
+    """Owns the per-step work buffers of one model. ``step(state)`` advances ``state`` in place. ``tuning``:
+    the contact solve's numbers (:class:`~masonrycli.engine.tuning.Tuning`; the shipped ones by default).
 
     After a step, the ``contact_*`` properties hold the step's contacts (views of length C).
     """
 
-    def __init__(self, model):
+    def __init__(self, model, tuning: Tuning = TUNING):
         self.model = model
+        self.tuning = tuning
+        """The contact solve's first-stage and stalled-step numbers (engine/tuning.py), handed to nlgs.solve
+        every step: the shipped ones, or the solver lab's (a frozen value, set at construction)."""
         b = model.body_count
         self.buffers = ContactBuffers(model.body_vert_start)
         self.body_q_m = np.empty((b, 3))
@@ -197,7 +202,7 @@ class Solver:
         if rest:
             np.copyto(self._v_free, state.body_v)
             m = _in_float64(m)
-        iterations, residual = nlgs.solve(body, self._pack, count, m, state.body_v, self._r, self._status)
+        iterations, residual = nlgs.solve(body, self._pack, count, m, state.body_v, self._r, self._status, self.tuning)
         # The continuation stays below the run's sweep cap: a step whose ordinary solve met the tolerance
         # must not be reported capped or unconverged for the extra sweeps (nor spend more than the cap).
         budget = min(REST_BUDGET, m.max_iterations - 1 - iterations)
@@ -250,7 +255,7 @@ class Solver:
         kept = v.copy(), r.copy(), status.copy()
         np.copyto(v, self._v_free)
         bf = self.buffers
-        more, settled = nlgs.solve(bf.contact_body, self._pack, count, tight, v, self._r, self._status)
+        more, settled = nlgs.solve(bf.contact_body, self._pack, count, tight, v, self._r, self._status, self.tuning)
         if settled > residual:  # the continuation ended worse: back to the ordinary solve's result
             np.copyto(v, kept[0])
             np.copyto(r, kept[1])

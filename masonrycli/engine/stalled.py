@@ -1,13 +1,13 @@
 """What a stalled accelerated solve does: momentum in body order, then five methods taken in turn.
 
     continue_stalled (the step's first stage stopped at its stall window above the tolerance):
-        stage: momentum in body order (bodies.py) from the warm start, ≤ BODIES_UNITS sweep units;
+        stage: momentum in body order (bodies.py) from the warm start, ≤ bodies_units sweep units;
                done if it meets the tolerance; handed over early when its residual cycles
                ("Hand-over", "Sooner" below)
-        round-robin, round k = 0, 1, …: each method of METHODS still active (newton, turning,
-        alternating, momentum, faces) resumes from its own iterate for FIRST_BUDGET · 2^k units
-        (newton: NEWTON_BUDGET × that, its second resume right after its first, none after
-        NEWTON_LAST_ROUND); done when one meets the tolerance; after BODIES_REENTER resumes a
+        round-robin, round k = 0, 1, …: each method of methods still active (newton, turning,
+        alternating, momentum, faces) resumes from its own iterate for first_budget · 2^k units
+        (newton: newton_budget × that, its second resume right after its first, none after
+        newton_last_round); done when one meets the tolerance; after bodies_reenter resumes a
         handed-over stage goes on once ("Re-entry"); a method that stalls inside its budget or ends a
         round no lower than an earlier one is dropped (newton excepted)
         at the cap: the round-robin's state of lowest residual, the step counted unconverged
@@ -22,8 +22,8 @@ of the 32- and 64-course walls, 159 597 sweep units for all 35, where each metho
 costs at most about 4 × 2U plus the first stage, whichever method that is. The methods:
 
 * "newton" (:mod:`masonrycli.engine.newton`): Alart–Curnier Newton steps from the warm start, then turning
-  sweeps from its iterate. First, with NEWTON_BUDGET × the others' budget, and its second resume right
-  after its first (NEWTON_AHEAD), in round 0 only; the drop rules leave it alone (each resume's sweeps start
+  sweeps from its iterate. First, with newton_budget × the others' budget, and its second resume right
+  after its first (newton_ahead), in round 0 only; the drop rules leave it alone (each resume's sweeps start
   from a new Newton iterate, so their stall says little of it). On 98 stalled steps of the 32- and
   64-course walls it takes the round-robin from 408 422 units to 212 312 ("Alart–Curnier in the engine").
 * "turning": momentum whose sweep direction turns at every restart (a one-way sweep can repeat the
@@ -40,33 +40,37 @@ them it takes 27 240 units. A step that needs 10 000 units of the one method tha
 
 The stage ahead of the round-robin: momentum in body order (:mod:`masonrycli.engine.bodies`) from the warm
 start converges all 64 hard steps of the 32- and 64-course walls' ensemble runs in 150 139 units, where the
-round-robin took 956 975 ("New methods on hard steps"). Momentum's stall window (momentum.STALL_SWEEPS)
+round-robin took 956 975 ("New methods on hard steps"). Momentum's stall window (first_stall)
 decides how soon a hard step reaches it.
 
 Hand-over: where the stage fails (the 248-block wall's hard steps) its residual cycles at a level well above
 its lowest, reached in an early dip, while the round-robin then finishes in ~600 units (newton's first
-resume). So every BODIES_WINDOW sweeps the window's level (geometric mean of its residuals) is compared with
-BODIES_LEVEL × the lowest residual so far, and BODIES_CYCLING such windows in a row hand the step over
+resume). So every bodies_window sweeps the window's level (geometric mean of its residuals) is compared with
+bodies_level × the lowest residual so far, and bodies_cycling such windows in a row hand the step over
 (bodies._cycling_windows). The round-robin starts from the warm start, not from the stage's iterate, so a
 step the stage would not have finished ends with the same solution in fewer units: wall-248's 45 hard steps
 955 083 → 671 907 units ("The hand-over, again"). A quicker trigger (4 windows at 1.4) also handed over
 steps the stage finishes slowly, and newton's solution of those, though within the tolerance too, differs
 from the stage's: runs left main's path.
 
-Sooner: BODIES_CYCLING_FAR cycling windows in a row hand over when the stage's lowest residual is above
-BODIES_FAR × the tolerance or each window's level above BODIES_STRONG × its low, far from anything the
+Sooner: bodies_cycling_far cycling windows in a row hand over when the stage's lowest residual is above
+bodies_far × the tolerance or each window's level above bodies_strong × its low, far from anything the
 stage finishes: the benchmark's wall-248 run's 58 steps of ≥ 400 units 51 875 → 45 952 ("Where the dear
 steps of the benchmark's wall-248 run go").
 
-Re-entry: a handed-over stage keeps its run (bodies.Stage) and, after BODIES_REENTER of the round-robin's
+Re-entry: a handed-over stage keeps its run (bodies.Stage) and, after bodies_reenter of the round-robin's
 resumes, goes on once for the units it had left, as one long run would; also when the round-robin ends
 first. A step that cycles for a while and then converges otherwise paid a round-robin 10× dearer (the
 64-course wall's step 128: 98 160 units with the hand-over alone, 15 142 with re-entry; "A way back to the
 stage"). At the cap the round-robin's lowest residual is adopted, never the stage's.
 
 Newton ahead: a step newton finishes in its second resume used to pay the four other methods' round 0
-first; with NEWTON_AHEAD, 342 replayed steps of ≥ 2500 units 3 291 823 → 2 769 636 units (0.84×), as many
+first; with newton_ahead, 342 replayed steps of ≥ 2500 units 3 291 823 → 2 769 636 units (0.84×), as many
 converged ("Hard steps: the costliest steps").
+
+The numbers named here in lower case (bodies_units, first_budget, methods, newton_ahead, …) are the fields of
+:class:`masonrycli.engine.tuning.Tuning`, documented there with their units and sources; continue_stalled gets
+them from nlgs.solve, which gets them from the Solver.
 """
 
 from __future__ import annotations
@@ -74,50 +78,7 @@ from __future__ import annotations
 import numpy as np
 
 from masonrycli.engine import bodies, faces, newton, nlgs
-
-BODIES_UNITS = 16_000
-"""Sweep units that momentum in body order (:mod:`masonrycli.engine.bodies`) gets alone, before the round-robin."""
-BODIES_STALL = 8000
-"""Its sweeps without a new lowest residual after which the round-robin takes over."""
-BODIES_WINDOW = 500
-"""Sweeps over which the hand-over rule takes the stage's residual level (module doc, "Hand-over")."""
-BODIES_LEVEL = 1.8
-"""A window whose level (geometric mean of its residuals) is above this × the stage's lowest residual cycles."""
-BODIES_CYCLING = 8
-"""Cycling windows in a row after which the stage hands over to the round-robin (0: never, and no re-entry;
-8: not before sweep 4000; module doc, "Hand-over")."""
-
-BODIES_FAR = 2.0
-"""A stage whose lowest residual is still above this × the tolerance hands over after BODIES_CYCLING_FAR cycling
-windows in a row instead of BODIES_CYCLING (module doc, "Sooner")."""
-BODIES_STRONG = 3.0
-"""So does a stage whose windows' level is above this × its lowest residual, BODIES_CYCLING_FAR windows in a row."""
-BODIES_CYCLING_FAR = 2
-"""Windows in a row of the sooner hand-over (0: off; 2: not before sweep 1000; module doc, "Sooner")."""
-
-BODIES_REENTER = 2
-"""After a hand-over, the round-robin's resumes (in its order, newton's ahead counted) after which the stage
-goes on from where it stopped, once, for the rest of its BODIES_UNITS (module doc, "Re-entry"); it does
-also if the round-robin ends first. 0: never."""
-
-FIRST_BUDGET = 2000
-"""Sweep units each method gets in the first round; doubled every round."""
-
-METHODS = ("newton", "turning", "alternating", "momentum", "faces")
-"""The order in which a round visits the methods (module doc, "Why"): the one that finishes most stalled steps
-first."""
-
-
-NEWTON_BUDGET = 2
-"""newton's budget in a round, in units of the others'."""
-
-NEWTON_LAST_ROUND = 1
-"""The last resume (0-based) "newton" makes, its k-th with the budget of round k: it finishes most steps it
-finishes in its first two budgets."""
-
-NEWTON_AHEAD = 1
-"""Further resumes "newton" makes right after its first, in round 0, before the other methods start
-(module doc, "Newton ahead")."""
+from masonrycli.engine.tuning import TUNING
 
 
 class _State:
@@ -136,7 +97,7 @@ class _State:
 
 
 def continue_stalled(
-    contact_body, pack, count, mu, tolerance, cap, v, r, status, v_free, r_warm, iterations, residual
+    contact_body, pack, count, mu, tolerance, cap, v, r, status, v_free, r_warm, iterations, residual, tuning=TUNING
 ) -> tuple[int, float]:
     """Finish a step whose accelerated solve stalled.
 
@@ -144,14 +105,14 @@ def continue_stalled(
     iterate, consistent; ``status`` (C,)), ``v_free`` (B, 3) the free velocities and ``r_warm`` (C, 2) the
     warm start, ``iterations`` (sweep units) and ``residual`` (m/s) of the momentum solve so far. Out:
     ``v``, ``r``, ``status`` of the method that met ``tolerance`` (or, at ``cap``, of the lowest residual).
-    Returns (iterations including the earlier ones, residual)."""
+    ``tuning``: the stage's and the round-robin's numbers (:class:`~masonrycli.engine.tuning.Tuning`). Returns (iterations including the earlier ones, residual)."""
     # First momentum in body order from the warm start, alone (bodies module doc: it converges the hard
     # steps in a fraction of the round-robin's units); the round-robin below only if it does not.
     stage = None  # the stage's iterate, kept with its run when the hand-over rule stops it (it may re-enter)
     run, stage_left = None, 0
-    if BODIES_UNITS > 0:
+    if tuning.bodies_units > 0:
         v_b, r_b, status_b = v_free.copy(), r_warm[:count].copy(), status[:count].copy()
-        units = min(BODIES_UNITS, cap - iterations)
+        units = min(tuning.bodies_units, cap - iterations)
         run = bodies.new_stage(count, v.shape[0])
         done, residual_b = bodies.body_order_sweeps(
             contact_body,
@@ -163,14 +124,14 @@ def continue_stalled(
             v_b,
             r_b,
             status_b,
-            BODIES_STALL,
-            BODIES_WINDOW,
-            BODIES_LEVEL,
-            BODIES_CYCLING,
+            tuning.bodies_stall,
+            tuning.bodies_window,
+            tuning.bodies_level,
+            tuning.bodies_cycling,
             stage=run,
-            far=BODIES_FAR,
-            far_cycling=BODIES_CYCLING_FAR,
-            strong=BODIES_STRONG,
+            far=tuning.bodies_far,
+            far_cycling=tuning.bodies_cycling_far,
+            strong=tuning.bodies_strong,
         )
         iterations += done
         if residual_b <= tolerance or (iterations >= cap and residual_b < residual):
@@ -178,8 +139,8 @@ def continue_stalled(
             return iterations, residual_b
         if iterations >= cap:
             return iterations, residual
-        if BODIES_REENTER > 0 and run.carry[bodies.C_REASON] == bodies.STOP_CYCLING:
-            stage, stage_left = _State(v_b, r_b, status_b, residual_b), BODIES_UNITS - done
+        if tuning.bodies_reenter > 0 and run.carry[bodies.C_REASON] == bodies.STOP_CYCLING:
+            stage, stage_left = _State(v_b, r_b, status_b, residual_b), tuning.bodies_units - done
     states = {
         "newton": _State(None, r_warm[:count].copy(), status[:count].copy(), np.inf),
         "turning": _State(None, r_warm[:count].copy(), status[:count].copy(), np.inf),
@@ -187,41 +148,43 @@ def continue_stalled(
         "momentum": _State(v.copy(), r[:count].copy(), status[:count].copy(), residual),  # goes on
         "faces": _State(v.copy(), r[:count].copy(), status[:count].copy(), residual),
     }
-    active = list(METHODS)
-    budget = FIRST_BUDGET
+    active = list(tuning.methods)
+    budget = tuning.first_budget
     round_ = 0
     newton_resumes = 0
     resumes = 0  # the round-robin's, for the stage's re-entry
     while iterations < cap and active:
-        # newton makes NEWTON_AHEAD more resumes right after its first, in round 0 (module doc)
-        for name in [m for m in active for _ in range(1 + NEWTON_AHEAD if m == "newton" and round_ == 0 else 1)]:
+        # newton makes tuning.newton_ahead more resumes right after its first, in round 0 (module doc)
+        for name in [m for m in active for _ in range(1 + tuning.newton_ahead if m == "newton" and round_ == 0 else 1)]:
             state = states[name]
-            if name == "newton" and newton_resumes > NEWTON_LAST_ROUND:
+            if name == "newton" and newton_resumes > tuning.newton_last_round:
                 if name in active:
                     active.remove(name)
                 continue
             if name == "newton":  # its k-th resume gets the budget of round k, ahead or not
-                units = min(FIRST_BUDGET * 2**newton_resumes * NEWTON_BUDGET, cap - iterations)
+                units = min(tuning.first_budget * 2**newton_resumes * tuning.newton_budget, cap - iterations)
                 newton_resumes += 1
             else:
                 units = min(budget, cap - iterations)
             if units <= 0:
                 break
-            done = _resume(name, state, contact_body, pack, count, mu, tolerance, units, v_free, cap - iterations)
+            done = _resume(
+                name, state, contact_body, pack, count, mu, tolerance, units, v_free, cap - iterations, tuning
+            )
             iterations += done
             if state.residual <= tolerance:
                 _adopt(state, v, r, status, count)
                 return iterations, state.residual
             resumes += 1
-            if stage is not None and resumes == BODIES_REENTER:
+            if stage is not None and resumes == tuning.bodies_reenter:
                 iterations += _reenter(
-                    stage, run, min(stage_left, cap - iterations), contact_body, pack, count, mu, tolerance
+                    stage, run, min(stage_left, cap - iterations), contact_body, pack, count, mu, tolerance, tuning
                 )
                 if stage.residual <= tolerance:
                     _adopt(stage, v, r, status, count)
                     return iterations, stage.residual
             # The drop rules (module doc). Not newton's: its sweeps' stall or residual says little of its
-            # Newton iterate, which goes on at the next resume; it leaves after NEWTON_LAST_ROUND only.
+            # Newton iterate, which goes on at the next resume; it leaves after tuning.newton_last_round only.
             #   done < units: stalled inside its budget, its own stall window says it will not get there
             #   residual ≥ low: a whole budget, doubled, without a new low: it cycles
             if name != "newton" and (done < units or state.residual >= state.low):
@@ -229,8 +192,10 @@ def continue_stalled(
             state.low = min(state.low, state.residual)
         budget *= 2
         round_ += 1
-    if stage is not None and resumes < BODIES_REENTER:  # the round-robin ended first: the stage's turn
-        iterations += _reenter(stage, run, min(stage_left, cap - iterations), contact_body, pack, count, mu, tolerance)
+    if stage is not None and resumes < tuning.bodies_reenter:  # the round-robin ended first: the stage's turn
+        iterations += _reenter(
+            stage, run, min(stage_left, cap - iterations), contact_body, pack, count, mu, tolerance, tuning
+        )
         if stage.residual <= tolerance:
             _adopt(stage, v, r, status, count)
             return iterations, stage.residual
@@ -241,16 +206,16 @@ def continue_stalled(
     return iterations, best.residual
 
 
-def _reenter(stage, run, units, contact_body, pack, count, mu, tolerance) -> int:
+def _reenter(stage, run, units, contact_body, pack, count, mu, tolerance, tuning) -> int:
     # The stage goes on from where its hand-over stopped it, as one long run would (bodies.Stage), for the
     # units it had left, without the hand-over rule (it already handed over) and with its stall window.
     done, stage.residual = bodies.body_order_sweeps(
-        contact_body, pack, count, mu, tolerance, units, stage.v, stage.r, stage.status, BODIES_STALL, stage=run
+        contact_body, pack, count, mu, tolerance, units, stage.v, stage.r, stage.status, tuning.bodies_stall, stage=run
     )
     return done
 
 
-def _resume(name, state, contact_body, pack, count, mu, tolerance, units, v_free, limit) -> int:
+def _resume(name, state, contact_body, pack, count, mu, tolerance, units, v_free, limit, tuning) -> int:
     # Each method goes on from its own iterate. The sweeps of nlgs rebuild v from v_free and r on entry
     # (v = v_free + M⁻¹ H r), so their state is r alone; faces carry v along with r. Momentum, turning or
     # not, restarts its extrapolation (β = 0, forward) at every resume and gets the whole budget as its
@@ -274,7 +239,7 @@ def _resume(name, state, contact_body, pack, count, mu, tolerance, units, v_free
             state.v,
             state.status,
             state.shift,
-            newton.NEWTON_SHARES[min(state.resumes, len(newton.NEWTON_SHARES) - 1)],
+            tuning.newton_shares[min(state.resumes, len(tuning.newton_shares) - 1)],
         )
         state.resumes += 1
         return done
