@@ -31,6 +31,12 @@ def test_the_summary_names_the_solver_that_ran(solver):
     assert _rows(result)["solver"] == f"{solver} ({SOLVER_NOTES[solver]})"
 
 
+def test_the_run_time_is_not_called_wall_time():
+    # "wall time 25.62 s" in the summary of `masonry simulate wall` read, to a class, as a time of the wall
+    rows = _rows(simulate(scenario("column5.toml", duration=0.01)))
+    assert "wall time" not in rows and rows["run time"].endswith(" steps/s)")
+
+
 def test_a_dissipation_below_zero_at_round_off_is_said_to_be_zero():
     # walk-through 2026-11-28: `masonry run tests/data/validation/column5.toml` (five blocks at rest) printed
     # "dissipated at contacts  -6.394e-14 J"; a real value is printed as it is

@@ -40,7 +40,7 @@ def test_at_80_columns_every_row_is_one_line_within_the_width():
     assert "7.75" in body[4] and "0.00 " in body[0]  # drift in % of height; -1e-9 is not "-0.00"
     legend = words(" ".join(lines[len(body) + 5 :]))
     assert "collapse: time of collapse, s" in legend and "drift: residual, % of height" in legend
-    assert "not shown at this width: hinges, wall, peak, sweeps" in legend and "every column in ida.parquet" in legend
+    assert "not shown at this width: hinges, took, peak, sweeps" in legend and "every column in ida.parquet" in legend
     # the file's drifts are fractions of the height, its openings metres (before: only the terminal's % and mm named)
     assert "in SI units (drifts × height, openings m)" in legend
     assert "failed: record=synthetic-record-2.AT2 scale=1.75: ValueError: a long reason" in legend
@@ -62,8 +62,10 @@ def test_a_long_record_name_leaves_room_for_the_state(tmp_path):
 def test_a_wide_console_shows_every_column_and_the_units():
     lines = _render(ROWS, grid_columns(["record", "scale"], "pga"), ["record", "scale"], 200)
     header = next(line for line in lines if "record" in line and "state" in line)
-    for name in ("collapse", "drift", "pga", "open", "hinges", "wall", "peak", "sweeps"):
+    for name in ("collapse", "drift", "pga", "open", "hinges", "took", "peak", "sweeps"):
         assert f" {name} " in header
+    # a student's study of the wall read a column "wall" (the run time, s) as something of the wall
+    assert " wall " not in header and "took: run time, s" in " ".join(lines)
     said = " ".join(lines)
     assert "not shown" not in said and "pga m/s²" in said and "open: largest opening, mm" in said
     assert " 30.2 " in lines[7] and " 1.23 " in lines[7] and " 12.3 " in lines[7]  # mm, % of height, s

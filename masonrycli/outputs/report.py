@@ -98,7 +98,7 @@ def summary_table(result, recording: str | None, history: str | None) -> Table:
     table.add_column("value")
     tally = result.tally
     table.add_row("steps", f"{result.steps} (t = {result.time:.4f} s)")
-    table.add_row("wall time", f"{result.wall_time:.2f} s ({result.steps / max(result.wall_time, 1e-9):.0f} steps/s)")
+    table.add_row("run time", f"{result.wall_time:.2f} s ({result.steps / max(result.wall_time, 1e-9):.0f} steps/s)")
     if result.solver:
         note = SOLVER_NOTES.get(result.solver)
         table.add_row("solver", f"{result.solver} ({note})" if note else result.solver)
