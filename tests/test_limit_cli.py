@@ -66,7 +66,9 @@ def test_verify_at_zero_lambda_says_there_is_nothing_to_verify(column_file):
 
 
 def test_point_load_on_a_named_block(column_file):
-    result = runner.invoke(app, ["limit", str(column_file), "--load", "point", "--block", "b2", "--json"])
+    result = runner.invoke(
+        app, ["limit", str(column_file), "--load", "point", "--block", "b2", "--direction", "+x", "--json"]
+    )
     data = json.loads(result.stdout)
     # Top block of 3: overturning of the whole column 3B/(5H) = 1.2 > μ = 0.9, so the top block slides.
     assert data["load_factor"] == pytest.approx(0.9, rel=5e-3)
@@ -340,3 +342,33 @@ def test_the_table_reads_lambda_as_an_acceleration_and_names_the_thickness_of_it
     point = runner.invoke(app, ["limit", "arch", "--load", "point", "--block", "v10", "--direction", "-y"])
     point = words(point.output)
     assert "horizontal acceleration" not in point and "for blocks 1 m thick" in point
+
+
+def test_a_point_load_placed_by_abscissa_loads_the_voussoir_over_it_and_points_down():
+    """`--at X`: the top block over x = X (a deck load at the quarter span), found here from the ring's
+    definition (R = (s²/4 + f²)/(2f), equal angles); a point load's default direction is down (it was +x)."""
+    span, rise, ring, n = 8.0, 2.0, 0.5, 30
+    shape = ["--span", "8", "--rise", "2", "--ring-thickness", "0.5", "--pier-width", "3", "--pier-courses", "5"]
+    radius = (span**2 / 4 + rise**2) / (2 * rise)
+    alpha = np.arcsin(span / (2 * radius))
+    extrados_x = -(radius + ring) * np.sin(alpha - 2 * alpha * np.arange(n + 1) / n)
+    k = int(np.searchsorted(extrados_x, -span / 4)) - 1  # the voussoir whose extrados spans x = -2
+    data = json.loads(invoke("limit", "arch", *shape, "--load", "point", "--at", "-2", "--json").stdout)
+    assert data["load"] == {"kind": "point", "direction": "-y", "block": f"v{k + 1:02d}", "at_m": -2.0}
+    named = json.loads(invoke("limit", "arch", *shape, "--load", "point", "--block", f"v{k + 1:02d}", "--json").stdout)
+    down = invoke("limit", "arch", *shape, "--load", "point", "--block", f"v{k + 1:02d}", "--direction", "-y", "--json")
+    assert named["load_factor"] == data["load_factor"] == json.loads(down.stdout)["load_factor"]
+    table = runner.invoke(app, ["limit", "arch", *shape, "--load", "point", "--at", "-2"], env={"COLUMNS": "250"})
+    assert f"point load on v{k + 1:02d} (the top block over x = -2 m), -y" in table.output
+
+
+@pytest.mark.parametrize(
+    "args, fragment",
+    [
+        (["--at", "-1"], "--at -1: only a point load acts at one place (use --load point)"),
+        (["--load", "point", "--at", "-1", "--block", "v05"], "--block v05 and --at -1: give the loaded block one way"),
+        (["--load", "point", "--at", "50"], "--at 50: no block over x = 50 m (the blocks span x = -2.7 … 2.7 m)"),
+    ],
+)
+def test_a_bad_at_is_one_line(args, fragment):
+    assert_one_line_error(invoke("limit", "arch", *args), fragment)

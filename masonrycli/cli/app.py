@@ -28,6 +28,8 @@ from masonrycli.cli.options import (
     STOP,
     WALL,
     WALL_LOADING,
+    AtOption,
+    DirectionOption,
     Friction,
     choice_value,
     file_defaults,
@@ -275,7 +277,8 @@ def limit_command(
         ),
     ] = "horizontal",
     block: Annotated[str | None, typer.Option(help="Block carrying the point load (λ × its weight).")] = None,
-    direction: Annotated[str, typer.Option(parser=choice_value, help="+x or -x (a point load also +y or -y).")] = "+x",
+    at: AtOption = None,
+    direction: DirectionOption = None,
     friction: Friction = None,
     as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object on stdout, nothing else.")] = False,
     verify: Annotated[
@@ -310,6 +313,7 @@ def limit_command(
         err_console=err_console,
         force=force,
         structure_options=structure_options,
+        at=at,
     )
 
 

@@ -181,6 +181,23 @@ RUN = {
     ),
 }
 Friction = _opt(float, "Material", "Coulomb coefficient of every contact (default 0.6).")
+# masonry limit's load options
+AtOption = Annotated[
+    float | None,
+    typer.Option(
+        "--at",
+        parser=number_value,
+        metavar="X",
+        help="Point load on the top block over x = X m instead of --block (a deck load at that abscissa).",
+    ),
+]
+DirectionOption = Annotated[
+    str | None,
+    typer.Option(
+        parser=choice_value,
+        help="+x or -x (default +x); a point load also +y or -y (default -y: down, as a load on a deck).",
+    ),
+]
 FRICTION = {"friction": Friction}
 
 _BUILT_IN_DEFAULT = re.compile(r"\(default ([^;)]*)")

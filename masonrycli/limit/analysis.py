@@ -12,6 +12,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from masonrycli.errors import InputError
 from masonrycli.limit.joints import Joints, find_joints, joint_names
 from masonrycli.limit.kinematics import JointMotion, joint_motion
 from masonrycli.limit.problem import LimitError, LiveLoad, LPSolution, load_vectors, solve_limit
@@ -91,7 +92,12 @@ class LimitResult:
         ]
         return {
             "scenario": self.scenario_name,
-            "load": {"kind": self.load.kind, "direction": self.load.direction, "block": self.load.block},
+            "load": {
+                "kind": self.load.kind,
+                "direction": self.load.direction,
+                "block": self.load.block,
+                "at_m": self.load.at,
+            },
             "load_factor": self.load_factor,
             "tilt_angle_deg": self.tilt_angle(),
             "collapse_load_N": self.load_factor * self.reference_force,
@@ -160,8 +166,36 @@ def analyse_model(model: Model, load: LiveLoad, scenario_name: str = "") -> Limi
     )
 
 
+def block_over(blocks, x: float) -> str:
+    """The name of the block whose upper boundary is highest over abscissa ``x`` (m): where a load placed on
+    the structure's top surface at ``x`` bears (a bridge's deck load at the quarter span → the voussoir
+    there). On a joint's vertical line the first such block in order is taken."""
+    best, name = -math.inf, None
+    for block in blocks:
+        xy = np.asarray(block.vertices, dtype=float)
+        p, q = xy, np.roll(xy, -1, axis=0)
+        lo, hi = np.minimum(p[:, 0], q[:, 0]), np.maximum(p[:, 0], q[:, 0])
+        over = (lo <= x) & (x <= hi)
+        if not over.any():
+            continue
+        dx = q[:, 0] - p[:, 0]
+        # an edge's height at x; a vertical edge at x counts with its higher end
+        t = np.where(dx != 0, (x - p[:, 0]) / np.where(dx != 0, dx, 1.0), 1.0)
+        y = np.where(dx != 0, p[:, 1] + t * (q[:, 1] - p[:, 1]), np.maximum(p[:, 1], q[:, 1]))
+        top = float(y[over].max())
+        if top > best + 1e-12:
+            best, name = top, block.name
+    if name is None:
+        xs = np.concatenate([np.asarray(b.vertices)[:, 0] for b in blocks])
+        raise InputError(f"--at {x:g}: no block over x = {x:g} m (the blocks span x = {xs.min():g} … {xs.max():g} m)")
+    return name
+
+
 def analyse(scenario, load: LiveLoad) -> LimitResult:
-    """Limit analysis of ``scenario`` (its blocks, supports, material and gravity) under ``load``."""
+    """Limit analysis of ``scenario`` (its blocks, supports, material and gravity) under ``load``; a point
+    load given by its place (``load.at``) is put on :func:`block_over` that place."""
+    if load.kind == "point" and load.at is not None and not load.resolved:
+        load = replace(load, block=block_over(scenario.assembly.blocks, load.at), resolved=True)
     result = analyse_model(build_model(scenario), load, scenario.name)
     thicknesses = {b.thickness for b in scenario.assembly.blocks}
     return replace(result, thickness=thicknesses.pop()) if len(thicknesses) == 1 else result

@@ -216,7 +216,7 @@ def run_limit(
     structure: str,
     *,
     load: str,
-    direction: str,
+    direction: str | None,
     block: str | None,
     friction: float | None,
     as_json: bool,
@@ -226,6 +226,7 @@ def run_limit(
     err_console: Console,
     force: bool = False,
     structure_options: dict | None = None,
+    at: float | None = None,
 ) -> None:
     """``masonry limit``: analyse, optionally record and verify, then print a table or one JSON object.
 
@@ -239,7 +240,7 @@ def run_limit(
             with signals.setup_work():  # the analysis and --verify compile numba kernels on a first run
                 checks = _analyse(
                     structure,
-                    LiveLoad(load, direction, block),
+                    LiveLoad(load, direction, block, at),
                     friction,
                     verify,
                     out,

@@ -21,6 +21,7 @@ scaled back after it, so the tolerances of HiGHS mean the same thing for a pebbl
 from __future__ import annotations
 
 import difflib
+import math
 import time
 from dataclasses import dataclass
 
@@ -54,30 +55,46 @@ class LiveLoad:
     kind : ``"horizontal"`` — a body force λ·m·|g| on every block (quasi-static earthquake);
         ``"tilt"`` — the same program read as a tilting table, tan ψ = λ;
         ``"point"`` — a force λ·m_B·|g| at the centroid of block ``block`` (its own weight times λ).
-    direction : ``"+x"`` or ``"-x"`` (and ``"+y"``/``"-y"`` for a point load).
+    direction : ``"+x"`` or ``"-x"`` (and ``"+y"``/``"-y"`` for a point load); None: ``"+x"`` for a body force,
+        ``"-y"`` (down, as a live load on a deck) for a point load.
     block : name of the loaded block (point load only).
+    at : m, or None — a point load on the topmost block over x = ``at`` instead of a named one (a load on
+        the deck at that abscissa: "the quarter span"); :func:`~masonrycli.limit.analysis.analyse` names the
+        block (``block``) from the structure.
     """
 
     kind: str = "horizontal"
-    direction: str = "+x"
+    direction: str | None = None
     block: str | None = None
+    at: float | None = None
+    resolved: bool = False
+    """True once ``block`` was found from ``at`` (the two then go together)."""
 
     def __post_init__(self):
         if self.kind not in LOAD_KINDS:
             raise InputError(f"--load {self.kind}: expected one of {', '.join(LOAD_KINDS)}")
+        if self.direction is None:  # a point load pushed sideways by default surprised a bridge's engineer
+            object.__setattr__(self, "direction", "-y" if self.kind == "point" else "+x")
         allowed = tuple(DIRECTIONS) if self.kind == "point" else ("+x", "-x")
         if self.direction not in allowed:
             raise InputError(
                 f"--direction {self.direction}: expected one of {', '.join(allowed)} for a {self.kind} load"
             )
-        if self.kind == "point" and not self.block:
-            raise InputError("--load point: name the loaded block with --block NAME")
+        if self.at is not None and not math.isfinite(self.at):
+            raise InputError(f"--at {self.at}: the abscissa must be a finite number of metres")
+        if self.kind == "point" and self.block and self.at is not None and not self.resolved:
+            raise InputError(f"--block {self.block} and --at {self.at:g}: give the loaded block one way")
+        if self.kind == "point" and not self.block and self.at is None:
+            raise InputError("--load point: name the loaded block with --block NAME, or give its place with --at X (m)")
         if self.kind != "point" and self.block:
             raise InputError(f"--block {self.block}: only a point load acts on one block (use --load point)")
+        if self.kind != "point" and self.at is not None:
+            raise InputError(f"--at {self.at:g}: only a point load acts at one place (use --load point)")
 
     def describe(self) -> str:
         if self.kind == "point":
-            return f"point load on {self.block}, {self.direction} (λ × its weight)"
+            where = "" if self.at is None else f" (the top block over x = {self.at:g} m)"
+            return f"point load on {self.block}{where}, {self.direction} (λ × its weight)"
         what = "tilting table (tan ψ = λ)" if self.kind == "tilt" else "horizontal body force (λ × weight)"
         return f"{what}, {self.direction}"
 
