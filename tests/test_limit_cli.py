@@ -13,7 +13,7 @@ from masonrycli.cli.app import app
 from masonrycli.scenario.toml_file import dump_scenario
 
 from cli_helpers import assert_one_line_error, invoke, runner, signal_inside_a_ctypes_callback, words
-from limit_helpers import column
+from limit_helpers import column, semicircular_arch
 
 
 @pytest.fixture(scope="module")
@@ -239,7 +239,7 @@ def test_ctrl_c_inside_numbas_compiler_is_the_interrupted_line(column_file, monk
 
     import masonrycli.limit.command as command
 
-    def compile_interrupted(scenario, live):
+    def compile_interrupted(scenario, live, **options):
         signal_inside_a_ctypes_callback(signal.SIGINT)
         raise RuntimeError("no compiled object yet for <Library '_narrowphase'>")
 
@@ -372,3 +372,21 @@ def test_a_point_load_placed_by_abscissa_loads_the_voussoir_over_it_and_points_d
 )
 def test_a_bad_at_is_one_line(args, fragment):
     assert_one_line_error(invoke("limit", "arch", *args), fragment)
+
+
+def test_thrust_gives_each_abutments_least_and_greatest_thrust_of_the_classical_arch(tmp_path):
+    """`--thrust`: the semicircle of t/R = 0.15 on rigid springers against the classical statics of the
+    continuous arch (tests/test_limit_arch.py: H_min/W = 0.175873 with the supports spreading, H_max/W =
+    0.226976 pushed together; Heyman 1982, Ochsendorf 2006), each springer pushed outward."""
+    path = tmp_path / "semicircle.toml"
+    path.write_text(dump_scenario(semicircular_arch(0.15, 60, friction=2.0)))
+    data = json.loads(invoke("limit", path, "--thrust", "--json").stdout)
+    weight = data["reference_load_N"]  # the horizontal load's reference: the arch's weight
+    by_support = {t["support"]: t for t in data["support_thrust"]}
+    assert by_support["right-springer"]["direction"] == "+x" and by_support["left-springer"]["direction"] == "-x"
+    for t in by_support.values():
+        assert t["least_N"] / weight == pytest.approx(0.175873, rel=5e-3)
+        assert t["greatest_N"] / weight == pytest.approx(0.226976, rel=5e-3)
+    table = words(runner.invoke(app, ["limit", str(path), "--thrust"], env={"COLUMNS": "250"}).output)
+    assert f"thrust on left-springer │ {by_support['left-springer']['least_N']:.4g} …" in table
+    assert json.loads(invoke("limit", path, "--json").stdout)["support_thrust"] is None  # only when asked

@@ -31,6 +31,7 @@ from masonrycli.cli.options import (
     AtOption,
     DirectionOption,
     Friction,
+    ThrustOption,
     choice_value,
     file_defaults,
     file_path_value,
@@ -281,6 +282,7 @@ def limit_command(
     direction: DirectionOption = None,
     friction: Friction = None,
     as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object on stdout, nothing else.")] = False,
+    thrust: ThrustOption = False,
     verify: Annotated[
         bool, typer.Option("--verify", help="Run the NSCD engine at 0.95 λ and 1.05 λ (tilted gravity) and compare.")
     ] = False,
@@ -314,6 +316,7 @@ def limit_command(
         force=force,
         structure_options=structure_options,
         at=at,
+        thrust=thrust,
     )
 
 

@@ -191,6 +191,14 @@ AtOption = Annotated[
         help="Point load on the top block over x = X m instead of --block (a deck load at that abscissa).",
     ),
 ]
+ThrustOption = Annotated[
+    bool,
+    typer.Option(
+        "--thrust",
+        help="Also the least and greatest horizontal thrust on each support under the dead load alone (an "
+        "arch's abutments spreading / pushed together).",
+    ),
+]
 DirectionOption = Annotated[
     str | None,
     typer.Option(

@@ -15,7 +15,7 @@ import numpy as np
 from masonrycli.errors import InputError
 from masonrycli.limit.joints import Joints, find_joints, joint_names
 from masonrycli.limit.kinematics import JointMotion, joint_motion
-from masonrycli.limit.problem import LimitError, LiveLoad, LPSolution, load_vectors, solve_limit
+from masonrycli.limit.problem import LimitError, LiveLoad, LPSolution, load_vectors, solve_limit, support_thrust_range
 from masonrycli.limit.thrust import ThrustLine, thrust_line
 from masonrycli.model import Model, build_model
 
@@ -38,6 +38,9 @@ class LimitResult:
     thickness: float | None = None
     """m: the blocks' out-of-plane thickness, which the newtons are for (None: not one for every block, or
     a model analysed without its scenario)."""
+    support_thrust: tuple[tuple[str, str, float, float], ...] | None = None
+    """(support, outward direction, least N, greatest N) of each support under the dead load alone
+    (:func:`support_thrusts`); None unless asked for (``masonry limit --thrust``)."""
 
     @property
     def load_factor(self) -> float:
@@ -103,6 +106,12 @@ class LimitResult:
             "collapse_load_N": self.load_factor * self.reference_force,
             "reference_load_N": self.reference_force,
             "thickness_m": self.thickness,
+            "support_thrust": None
+            if self.support_thrust is None
+            else [
+                {"support": name, "direction": d, "least_N": lo, "greatest_N": hi}
+                for name, d, lo, hi in self.support_thrust
+            ],
             "friction": m.friction,
             "blocks": m.block_count,
             "supports": m.support_count,
@@ -191,11 +200,31 @@ def block_over(blocks, x: float) -> str:
     return name
 
 
-def analyse(scenario, load: LiveLoad) -> LimitResult:
+def support_thrusts(model: Model, joints: Joints) -> tuple[tuple[str, str, float, float], ...]:
+    """(support name, "+x"/"-x", least, greatest) horizontal force in N that the blocks can push on each
+    support, outward (away from the blocks' centre of mass), under their own weight alone over every
+    admissible set of joint forces: an arch's thrust on its abutments, least when they spread, greatest
+    when they are pushed together (Heyman's active and passive states)."""
+    dead, _, _ = load_vectors(model, LiveLoad())
+    n = model.block_count
+    mass = model.body_mass[:n]
+    centre = float(np.sum(mass * model.body_q0[:n, 0]) / mass.sum())
+    out = []
+    for s, name in enumerate(model.support_name):
+        outward = 1.0 if model.body_q0[n + s, 0] >= centre else -1.0
+        least, greatest = support_thrust_range(model, joints, dead, s, (outward, 0.0))
+        out.append((str(name), "+x" if outward > 0 else "-x", least, greatest))
+    return tuple(out)
+
+
+def analyse(scenario, load: LiveLoad, thrust: bool = False) -> LimitResult:
     """Limit analysis of ``scenario`` (its blocks, supports, material and gravity) under ``load``; a point
-    load given by its place (``load.at``) is put on :func:`block_over` that place."""
+    load given by its place (``load.at``) is put on :func:`block_over` that place; ``thrust``: with
+    :func:`support_thrusts` too."""
     if load.kind == "point" and load.at is not None and not load.resolved:
         load = replace(load, block=block_over(scenario.assembly.blocks, load.at), resolved=True)
     result = analyse_model(build_model(scenario), load, scenario.name)
     thicknesses = {b.thickness for b in scenario.assembly.blocks}
-    return replace(result, thickness=thicknesses.pop()) if len(thicknesses) == 1 else result
+    if len(thicknesses) == 1:
+        result = replace(result, thickness=thicknesses.pop())
+    return replace(result, support_thrust=support_thrusts(result.model, result.joints)) if thrust else result

@@ -97,6 +97,12 @@ def result_table(result: LimitResult, out: Path | None) -> Table:
     table.add_row("load factor λ", lam)
     depth = "" if result.thickness is None else f", for blocks {result.thickness:g} m thick (out of plane)"
     table.add_row("collapse load", f"{s['collapse_load_N']:.4g} N (λ × {s['reference_load_N']:.4g} N){depth}")
+    for name, direction, least, greatest in result.support_thrust or ():
+        table.add_row(
+            f"thrust on {name}",
+            f"{least:.4g} … {greatest:.4g} N towards {direction}, under the dead load alone (least: the supports "
+            "spreading; greatest: pushed together)",
+        )
     table.add_row("hinges", _names(result.hinges_largest_first()))
     table.add_row("sliding joints", _names(result.sliding_largest_first()))
     table.add_row("blocks in the mechanism", f"{len(result.moving_blocks)} of {s['blocks']}")
@@ -227,6 +233,7 @@ def run_limit(
     force: bool = False,
     structure_options: dict | None = None,
     at: float | None = None,
+    thrust: bool = False,
 ) -> None:
     """``masonry limit``: analyse, optionally record and verify, then print a table or one JSON object.
 
@@ -250,6 +257,7 @@ def run_limit(
                     console=None if as_json else console,
                     err_console=err_console,
                     structure_options=structure_options,
+                    thrust=thrust,
                 )
         except StopRun as stop:
             how = "" if stop.signum == signal.SIGINT else f" ({signal_name(stop.signum)})"  # as `masonry sweep`
@@ -302,20 +310,18 @@ class _Done:
         return said + "; --verify did not finish" if self.verifying else said
 
 
-def _analyse(
-    structure, live, friction, verify, out, force, done: _Done, signals, *, console, err_console, structure_options
-):
+def _analyse(structure, live, friction, verify, out, force, done: _Done, signals, *, console, err_console, **options):
     """The work of :func:`run_limit`, filling ``done`` as it goes; returns the --verify checks. ``console``:
     where the result table goes before --verify runs (None with --json)."""
     from masonrycli.scenario.caveats import setting_warnings
 
     target = None if out is None else check_output(out, "--out", ".rrd", force)
-    scenario = resolve_structure(structure, friction, structure_options)
+    scenario = resolve_structure(structure, friction, options["structure_options"])
     if verify and live.kind == "point":
         raise InputError("--verify: the engine has no point loads; verify a horizontal or tilt load")
     settings = setting_warnings(scenario)  # not its records': it has no time
     try:
-        done.result = analyse(scenario, live)
+        done.result = analyse(scenario, live, thrust=options["thrust"])
     except LimitError as exc:
         # one line, as any refusal: a block touching nothing was said twice (a warning, then the error in the
         # same words); a setting's warning is the reason ("no equilibrium" under a gravity pointing up)
