@@ -390,3 +390,17 @@ def test_thrust_gives_each_abutments_least_and_greatest_thrust_of_the_classical_
     table = words(runner.invoke(app, ["limit", str(path), "--thrust"], env={"COLUMNS": "250"}).output)
     assert f"thrust on left-springer │ {by_support['left-springer']['least_N']:.4g} …" in table
     assert json.loads(invoke("limit", path, "--json").stdout)["support_thrust"] is None  # only when asked
+
+
+def test_the_recordings_panel_reads_lambda_as_the_table_does():
+    from masonrycli.limit import LiveLoad, analyse
+    from masonrycli.limit.command import mechanism_document, resolve_structure
+
+    result = analyse(resolve_structure("arch", None, {"thickness": 4.0}), LiveLoad("horizontal"))
+    text = mechanism_document(result)
+    lam = result.load_factor
+    assert (
+        f"**load factor λ = {lam:.4f}** (a horizontal acceleration of {lam:.3g} g = {lam * 9.81:.3g} m/s²; tilt ψ"
+        in text
+    )
+    assert "N, for blocks 4 m thick (out of plane) (the resultant of the body forces" in text

@@ -74,6 +74,22 @@ def _names(names: list[str]) -> str:
     return f"{len(names)}" + (f": {', '.join(names)}" if names else "")
 
 
+def lambda_reading(result: LimitResult) -> str:
+    """λ in an engineer's words: a body force λ × weight is a horizontal acceleration of λ g; the tilt."""
+    reading = []
+    if result.load.kind == "horizontal":
+        g = float(np.hypot(*result.model.gravity))
+        reading.append(f"a horizontal acceleration of {result.load_factor:.3g} g = {result.load_factor * g:.3g} m/s²")
+    if result.tilt_angle() is not None:
+        reading.append(f"tilt ψ = {result.tilt_angle():.2f}°")
+    return "; ".join(reading)
+
+
+def _depth(result: LimitResult) -> str:
+    """Which out-of-plane thickness the newtons are for."""
+    return "" if result.thickness is None else f", for blocks {result.thickness:g} m thick (out of plane)"
+
+
 def result_table(result: LimitResult, out: Path | None) -> Table:
     s = result.summary()
     table = Table(title=f"masonry limit — {result.scenario_name}", show_header=False, title_justify="left")
@@ -86,17 +102,11 @@ def result_table(result: LimitResult, out: Path | None) -> Table:
     table.add_row("joints", f"{s['joints']} ({s['contact_points']} contact points, from the engine's detection)")
     table.add_row("live load", result.load.describe())
     lam = Text(f"{result.load_factor:.4f}", style="bold")  # Text: the consoles parse no markup
-    reading = []
-    if result.load.kind == "horizontal":  # a body force λ × weight is a horizontal acceleration of λ g
-        g = float(np.hypot(*result.model.gravity))
-        reading.append(f"a horizontal acceleration of {result.load_factor:.3g} g = {result.load_factor * g:.3g} m/s²")
-    if result.tilt_angle() is not None:
-        reading.append(f"tilt ψ = {result.tilt_angle():.2f}°")
+    reading = lambda_reading(result)
     if reading:
-        lam.append(f"  ({'; '.join(reading)})")
+        lam.append(f"  ({reading})")
     table.add_row("load factor λ", lam)
-    depth = "" if result.thickness is None else f", for blocks {result.thickness:g} m thick (out of plane)"
-    table.add_row("collapse load", f"{s['collapse_load_N']:.4g} N (λ × {s['reference_load_N']:.4g} N){depth}")
+    table.add_row("collapse load", f"{s['collapse_load_N']:.4g} N (λ × {s['reference_load_N']:.4g} N){_depth(result)}")
     for name, direction, least, greatest in result.support_thrust or ():
         table.add_row(
             f"thrust on {name}",
@@ -137,10 +147,10 @@ def verify_table(checks) -> Table:
 
 def mechanism_document(result: LimitResult) -> str:
     """Markdown for the recording's side panel."""
-    tilt = result.tilt_angle()
+    reading = lambda_reading(result)
     lines = [
         f"# masonry limit: {result.scenario_name}",
-        f"**load factor λ = {result.load_factor:.4f}**" + (f" (tilt {tilt:.2f}°)" if tilt is not None else ""),
+        f"**load factor λ = {result.load_factor:.4f}**" + (f" ({reading})" if reading else ""),
         "",
         f"live load: {result.load.describe()}; friction {result.model.friction:g}",
         "",
@@ -149,6 +159,7 @@ def mechanism_document(result: LimitResult) -> str:
         "yellow: hinges; orange: sliding joints. Play the timeline to grow the mechanism.",
         "",
         f"Blue arrow (left): the live load at collapse, {result.load_factor * result.reference_force:.4g} N"
+        + _depth(result)
         + (" (the resultant of the body forces, at the centre of mass)." if result.load.kind != "point" else "."),
         "",
         f"hinges ({len(result.hinges)}, the fastest first): " + _document_names(result.hinges_largest_first()),
