@@ -234,6 +234,14 @@ OPTION_ROWS = [
     # it was ignored without a word (the magnified shape is drawn in the recording only)
     ("sim-magnify-no-recording", {}, (*WALL, "--magnify", "5", "--no-recording"), 2, "--magnify 5 with --no-recording"),
     ("sim-scale-alone", {}, (*WALL, "--scale", "2", "--no-recording"), 2, "--scale: goes with --record"),
+    ("sim-baseline-alone", {}, (*WALL, "--baseline", "none", "--no-recording"), 2, "--baseline: goes with --record"),
+    (
+        "sim-baseline-word",
+        {"a.csv": "time (s),acc (m/s2)\n0,0\n0.01,1\n"},
+        (*WALL, "--record", "a.csv", "--baseline", "off", "--no-recording"),
+        2,
+        'error: --baseline off: must be "quadratic" or "none"',
+    ),
     # an absurd support speed ran to exit 0 ("collapsed at t = 0.001 s"; the CSV with numpy's overflow warnings)
     ("sim-amp-absurd", {}, (*WALL, "--amp", "1e30", "--no-recording"), 2, 'support "ground": sine 1e+30 m/s'),
     ("sim-settlement-absurd", {}, (*ARCH, "--settlement", "1e9", "--no-recording"), 2, "up to 1e+09 m/s, more than"),

@@ -123,6 +123,11 @@ def test_every_command_prints_the_warnings(tmp_path):
     assert said.startswith("error: no equilibrium") and "([run] gravity = [0, 9.81] points up" in said
 
 
+def others(warnings: list[str]) -> list[str]:
+    """The warnings but the baseline correction's: these tests' few-sample pulses do not end at rest."""
+    return [w for w in warnings if "does not start and end at rest" not in w]
+
+
 @pytest.mark.parametrize("scale", [9.81, 9.80665, 981.0])
 def test_an_at2_record_scaled_by_g_is_warned_about(tmp_path, scale):
     # --scale 9.81 "to convert g" on an .AT2 (converted on reading): a 0.3 g record ran at 2.9 g, no word
@@ -137,12 +142,12 @@ def test_an_at2_record_scaled_by_g_is_warned_about(tmp_path, scale):
     )
     scenario = loads_scenario(text, source=str(tmp_path / "s.toml"), base_dir=tmp_path)
     peak = 0.3 * scale
-    assert record_warnings(scenario) == [
+    assert others(record_warnings(scenario)) == [
         f'support "ground": the record q.AT2 is read in g and converted to m/s² already; scale {scale:g} converts it '
         f"again ({peak:.3g} g as applied; the scale multiplies the record, 1 is as recorded)"
     ]
     text = text.replace(f"scale = {scale}", "scale = 2.0")  # a scale, not a unit
-    assert record_warnings(loads_scenario(text, source=str(tmp_path / "s.toml"), base_dir=tmp_path)) == []
+    assert others(record_warnings(loads_scenario(text, source=str(tmp_path / "s.toml"), base_dir=tmp_path))) == []
 
 
 def test_a_drawing_in_millimetres_is_warned_about(tmp_path):
@@ -171,7 +176,7 @@ def test_sample_numbers_taken_for_times_are_warned_about(tmp_path, first):
     motion = 'motion = { kind = "record", file = "idx.csv", quantity = "acceleration" }\n'
     text = "[run]\nduration = 0.5\n" + BLOCK + GROUND + motion
     scenario = loads_scenario(text, source=str(tmp_path / "s.toml"), base_dir=tmp_path)
-    assert record_warnings(scenario) == [
+    assert others(record_warnings(scenario)) == [
         f'support "ground": the record idx.csv has its samples at t = {first}, {first + 1}, {first + 2}, … s: sample '
         "numbers, not times? (give its times in s, or its values alone with --record-dt / time_step)"
     ]
@@ -229,7 +234,7 @@ def test_a_vertical_component_applied_horizontally_is_warned_about(tmp_path):
 
     def said(motion: str) -> list[str]:
         text = "[run]\nduration = 0.03\n" + BLOCK + GROUND + f'motion = {{ kind = "record", {motion} }}\n'
-        return record_warnings(loads_scenario(text, source=str(tmp_path / "s.toml"), base_dir=tmp_path))
+        return others(record_warnings(loads_scenario(text, source=str(tmp_path / "s.toml"), base_dir=tmp_path)))
 
     up = "RSN6_IMPVALL.I_I-ELCUP.AT2"
     for motion, name in ((f'file = "{up}"', up), ('file = "q.AT2", direction = [1.0, 0.2]', "q.AT2")):

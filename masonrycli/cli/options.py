@@ -30,7 +30,7 @@ def _opt(kind: type, panel: str, help: str, *decls: str, parser=None):
 
 
 def choice_value(text: str) -> str:
-    """A choice option's value (--im, --outcome, --solver, --load, --direction) in lower case, the
+    """A choice option's value (--im, --outcome, --solver, --load, --direction, --baseline) in lower case, the
     spelling its help lists: "--im PGV" said "expected one of pga, pgv, arias, sa"."""
     return str(text).strip().lower()
 
@@ -142,10 +142,18 @@ RECORD = {
         Path,
         "Loading",
         "Ground motion record shaking the ground/foundations instead of the sine: PEER .AT2 (g), ESM .ASC (its header's units), K-NET .NS/.EW/.UD or CSV "
-        "(time, velocity). Baseline-corrected; window and vertical component in a scenario file.",
+        "(time, velocity). Baseline-corrected (--baseline); window and vertical component in a scenario file.",
         "--record",
     ),
     "scale": _opt(float, "Loading", "Multiplies the --record (default 1).", "--scale"),
+    "baseline": _opt(
+        str,
+        "Loading",
+        "Drift correction of an acceleration --record, as a scenario file's baseline: quadratic (default; the "
+        "ground ends at rest where it started) or none (the samples as given: a shake table's own input).",
+        "--baseline",
+        parser=choice_value,
+    ),
     "record_dt": _opt(
         float,
         "Loading",

@@ -57,6 +57,15 @@ def sweep_command(
             "the other files keep their own times.",
         ),
     ] = None,
+    baseline: Annotated[
+        str | None,
+        typer.Option(
+            "--baseline",
+            parser=choice_value,
+            help="Drift correction of the --records of acceleration, as a scenario file's baseline: quadratic "
+            "(default) or none (the samples as given).",
+        ),
+    ] = None,
     scale: Annotated[
         str | None, typer.Option("--scale", help="Record scale axis, e.g. 0.25:2:8 (= --param scale=...).")
     ] = None,
@@ -163,6 +172,7 @@ def sweep_command(
         params=param,
         records=records,
         record_dt=record_dt,
+        baseline=baseline,
         scale=scale,
         find=find,
         outcome=outcome,

@@ -27,12 +27,14 @@ from typing import ClassVar
 import numpy as np
 
 from geometry_library.values import number_problem
-from masonrycli.records.velocity import RecordArrays, record_arrays, record_velocity
+from masonrycli.records.velocity import RecordArrays, correction_acceleration, record_arrays, record_velocity
 from masonrycli.scenario.motion import Motion, _Directed, _direction, _g, _put, _time_column, _vec
 from masonrycli.scenario.values import check_real, check_samples, check_vector, field_error, format_value
 
 RECORD_QUANTITIES = ("velocity", "acceleration")
 BASELINES = ("quadratic", "none")
+BASELINE_PROBLEM = 'must be "quadratic" or "none"'
+"""Why a ``baseline`` is refused: the scenario file's key and ``--baseline`` say it alike."""
 
 
 MIN_TIME_STEP, MAX_TIME_STEP = 1e-6, 1.0
@@ -103,7 +105,7 @@ class Record(_Directed, Motion):
             raise field_error("quantity", self.quantity, 'must be "velocity" or "acceleration"')
         _put(self, "scale", check_real("scale", self.scale))
         if self.baseline not in BASELINES:
-            raise field_error("baseline", self.baseline, 'must be "quadratic" or "none"')
+            raise field_error("baseline", self.baseline, BASELINE_PROBLEM)
         for key in ("source", "vertical_source"):
             if not isinstance(getattr(self, key), str):
                 raise field_error(key, getattr(self, key), "must be a string")
@@ -201,6 +203,17 @@ class Record(_Directed, Motion):
         if self.quantity != "acceleration":
             return float(np.hypot(*(np.diff(a.value, axis=0) / np.diff(a.time)[:, None]).T).max())
         return float(np.hypot(*a.value.T).max())
+
+    @property
+    def baseline_change(self) -> tuple[float, float]:
+        """m/s²: ``(applied peak, largest change)`` of the acceleration the baseline correction makes — the
+        peak of the samples used, scaled, minus the correction's straight line, and that line's largest
+        size (at an end of the record); ``(peak_acceleration, 0)`` when not corrected."""
+        if not self.corrected:
+            return self.peak_acceleration, 0.0
+        a = self._arrays
+        change = correction_acceleration(a)
+        return float(np.hypot(*(a.value - change).T).max()), float(np.hypot(*change.T).max())
 
     @property
     def sample_interval(self) -> float:

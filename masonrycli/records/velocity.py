@@ -82,6 +82,16 @@ def record_arrays(time, value, unit_direction, scale: float, window, quantity: s
     return RecordArrays(time, value, nodal_v, coefficients)
 
 
+def correction_acceleration(arrays: RecordArrays) -> np.ndarray:
+    """(n, 2) m/s²: what the baseline correction subtracts from the acceleration at the samples, the
+    straight line (c₁ + 2 c₂ s)/T (the derivative of c₁ s + c₂ s²); zero when not corrected. The applied
+    acceleration is the linear interpolation of ``value`` minus this line, so its peak is at a sample."""
+    time, baseline = arrays.time, arrays.baseline
+    length = time[-1] - time[0]
+    s = ((time - time[0]) / length)[:, None]
+    return (baseline[0] + 2.0 * baseline[1] * s) / length
+
+
 def record_velocity(t: np.ndarray, arrays: RecordArrays, quantity: str, corrected: bool) -> np.ndarray:
     """Velocity (T, 2) m/s at times ``t`` (T,) s of a record prepared by :func:`record_arrays`."""
     time, value, nodal_v, baseline = arrays

@@ -36,7 +36,7 @@ from pathlib import Path
 from types import SimpleNamespace
 
 from masonrycli.errors import NOT_A_FILE, InputError, file_kind, special_file
-from masonrycli.records.motion import Record, time_step_problem
+from masonrycli.records.motion import BASELINE_PROBLEM, BASELINES, Record, time_step_problem
 from masonrycli.records.read import record_motion
 from masonrycli.records.text import NoTimeStep, TimeStepNotUsed
 from masonrycli.scenario.motion import Constant, Fixed, Sine
@@ -57,7 +57,7 @@ PAPER_INSTANT = {"wall": ("III.2–III.5", 0.1), "arch": ("III.7–III.10", 5.0)
 
 RUN_OVERRIDES = ("duration", "dt", "theta", "record_every", "tolerance", "max_iterations", "solver")
 MATERIAL_OVERRIDES = ("density", "thickness", "friction")
-LOADING_OVERRIDES = ("freq", "amp", "settlement", "record", "scale", "record_dt")
+LOADING_OVERRIDES = ("freq", "amp", "settlement", "record", "scale", "record_dt", "baseline")
 
 
 def _given(values: dict, keys) -> dict:
@@ -124,12 +124,28 @@ def check_record_dt(record_dt: float | None) -> float | None:
     return record_dt
 
 
-def record_motion_option(path: Path, scale: float | None, record_dt: float | None = None) -> Record:
+def check_baseline(baseline: str | None) -> str | None:
+    """``--baseline`` (simulate, run, check, sweep) checked as a record table's ``baseline``; None: not given."""
+    if baseline is not None and baseline not in BASELINES:
+        raise InputError(f"--baseline {baseline}: {BASELINE_PROBLEM}")
+    return baseline
+
+
+def record_motion_option(
+    path: Path, scale: float | None, record_dt: float | None = None, baseline: str | None = None
+) -> Record:
     """The ground motion of a ``--record`` file (.AT2, ESM .ASC or CSV), multiplied by ``scale``; ``record_dt``: the
-    spacing of a one-column CSV's samples, s."""
+    spacing of a one-column CSV's samples, s; ``baseline``: the drift correction of an acceleration record."""
     check_record_dt(record_dt)
+    check_baseline(baseline)
     try:
-        return record_motion(path, scale=1.0 if scale is None else scale, display=str(path), time_step=record_dt)
+        return record_motion(
+            path,
+            scale=1.0 if scale is None else scale,
+            display=str(path),
+            time_step=record_dt,
+            baseline=baseline or "quadratic",
+        )
     except NoTimeStep as exc:
         raise exc.give("--record-dt SECONDS") from None
     except TimeStepNotUsed as exc:  # the message named time_step, a scenario's key, not the option given
@@ -140,15 +156,19 @@ def record_motion_option(path: Path, scale: float | None, record_dt: float | Non
 
 
 def with_record(
-    scenario: Scenario, record: Path | None, scale: float | None, record_dt: float | None = None
+    scenario: Scenario,
+    record: Path | None,
+    scale: float | None,
+    record_dt: float | None = None,
+    baseline: str | None = None,
 ) -> Scenario:
     """``scenario`` with the supports a record shakes (:func:`shaken_supports`) driven by the ``record`` file."""
     if record is None:
-        _record_options_alone(scale, record_dt)
+        _record_options_alone(scale, record_dt, baseline)
         return scenario
     if not any(shaken_supports(scenario)):
         raise no_shaking_support(scenario, "--record")
-    return shaken_by(scenario, record_motion_option(record, scale, record_dt))
+    return shaken_by(scenario, record_motion_option(record, scale, record_dt, baseline))
 
 
 def _geometry_as_is(scenario: Scenario) -> bool:
@@ -270,12 +290,16 @@ def _target_problem(target: str) -> str:
     return ""
 
 
-def _record_options_alone(scale: float | None, record_dt: float | None) -> None:
-    """Refuse --scale and --record-dt given without --record."""
+def _record_options_alone(scale: float | None, record_dt: float | None, baseline: str | None = None) -> None:
+    """Refuse --scale, --record-dt and --baseline given without --record."""
     if scale is not None:
         raise InputError("--scale: goes with --record (it multiplies the record)")
     if record_dt is not None:
         raise InputError("--record-dt: goes with --record (the time between the samples of a one-column file)")
+    if baseline is not None:
+        raise InputError(
+            '--baseline: goes with --record (a scenario file\'s own record takes baseline = "none" in its table)'
+        )
 
 
 def file_scenario(
@@ -284,6 +308,7 @@ def file_scenario(
     record: Path | None = None,
     scale: float | None = None,
     record_dt: float | None = None,
+    baseline: str | None = None,
     **overrides,
 ) -> Scenario:
     """The scenario of a TOML, GeoJSON or WKT file (``masonry run`` / ``check``, :func:`target_scenario`:
@@ -292,7 +317,7 @@ def file_scenario(
     A geometry file has no run settings of its own: shaken by a record with no --duration it runs the whole
     record, as ``simulate`` does (it ran the default 1 s: 'masonry run wall.geojson --record q.AT2' of an 8 s
     record, its strong motion after 2 s, said "intact")."""
-    scenario = with_record(target_scenario(path), record, scale, record_dt)
+    scenario = with_record(target_scenario(path), record, scale, record_dt, baseline)
     if record is not None and _geometry_as_is(scenario) and overrides.get("duration") is None:
         overrides = overrides | {"duration": whole_records(scenario.motions, overrides.get("dt"))}
     return override_run(scenario, **overrides)
@@ -308,7 +333,7 @@ def whole_records(motions, dt=None) -> float:
     return min(max(1, math.ceil(max(ends) / dt - 1e-9)) * dt, MAX_DURATION)
 
 
-def _loading(name: str, amp, freq, settlement, record, scale, record_dt=None) -> dict:
+def _loading(name: str, amp, freq, settlement, record, scale, record_dt=None, baseline=None) -> dict:
     """Support name -> motion of the built-in loading, with the loading overrides applied."""
     if record is not None:
         if amp is not None or freq is not None or settlement:
@@ -317,9 +342,9 @@ def _loading(name: str, amp, freq, settlement, record, scale, record_dt=None) ->
             why = "shakes both foundations instead" if given == "--settlement" else "replaces the sine"
             raise InputError(f"--record with {given}: choose one loading (the record {why})")
         shaken = ("ground",) if name == "wall" else ("left-foundation", "right-foundation")
-        motion = record_motion_option(record, scale, record_dt)
+        motion = record_motion_option(record, scale, record_dt, baseline)
         return {support: motion for support in shaken}
-    _record_options_alone(scale, record_dt)
+    _record_options_alone(scale, record_dt, baseline)
     loading_freq, freq = freq, SHAKE_FREQUENCY if freq is None else freq
     if name == "wall":
         if settlement:

@@ -2,7 +2,8 @@
 ``limit`` and ``sweep`` to print before anything runs.
 
 * :func:`record_warnings`: a record the run does not follow whole (it starts after the run ends, goes on
-  after it, is sampled finer than dt, or peaks beyond 10 g as scaled).
+  after it, is sampled finer than dt, or peaks beyond 10 g as scaled), or not as its file gives it (the
+  baseline correction changes its acceleration by more than ``BASELINE_CHANGE`` of its peak).
 * :func:`setting_warnings`: settings in the wrong units or sign — a gravity pointing up (the blocks fly
   off, or limit analysis finds "no equilibrium") or far from 9.81 m/s² (cm/s², or g), a density below
   any masonry unit's (t/m³ or g/cm³: stresses and forces 1000× too small, the motion unchanged), a block
@@ -39,6 +40,16 @@ NUMBERED_SAMPLES = 50
 GRAVITY_RANGE = (0.5 * G_STANDARD, 2.0 * G_STANDARD)
 """m/s²: a gravity of another size is warned about: cm/s² (981) or g (1) — but not one below 0.01 g, which is
 no gravity on purpose (limit analysis refuses it in its own line)."""
+BASELINE_CHANGE = 0.15
+"""A record whose baseline correction changes its acceleration, at some instant, by more than this fraction of
+its peak is warned about: it does not start and end at rest (a shake table's sine from rest, 0.8 g at 2 Hz for
+1 s: the correction adds up to 48 % of the peak, the peak becomes 0.8977 g). Acceleration, not velocity: the
+structure feels the ground's acceleration (a uniform velocity is not felt), and bringing a drifting velocity
+back is what the correction is for (an unprocessed noise burst's PGV changes by 30 % and more). The figures,
+``python -m benchmarks.baseline_shapes`` (docs/scenario-format.md, "baseline correction"): a sine from rest of n
+cycles 95 %/n (warned up to 6 cycles); the test suite's tapered synthetic records ≤ 4e-5; 1500 decaying noise
+bursts of each kind: white ≤ 4.4 %, Kanai–Tajimi-filtered (never processed, rich in drift) ≤ 11.8 %,
+Clough–Penzien ≤ 2.3 %: none warns."""
 
 
 def scenario_warnings(scenario: Scenario) -> list[str]:
@@ -133,6 +144,7 @@ def record_warnings(scenario: Scenario, upright: bool = True) -> list[str]:
     shrunk: dict[tuple[str, float, float], list[str]] = {}
     numbered: dict[tuple[str, float], list[str]] = {}
     sideways: dict[str, list[str]] = {}
+    changed: dict[tuple[str, float, float, float], list[str]] = {}
     for support, m in zip(scenario.assembly.supports, scenario.motions):
         if m.kind != "record":
             continue
@@ -154,6 +166,9 @@ def record_warnings(scenario: Scenario, upright: bool = True) -> list[str]:
             shrunk.setdefault((name, unit, m.quantity, peak, m.scale), []).append(f'"{support.name}"')
         elif m.peak_acceleration > MAX_AT2_G * G_STANDARD:
             strong.setdefault((name, m.peak_acceleration / G_STANDARD, m.scale), []).append(f'"{support.name}"')
+        applied, change = m.baseline_change
+        if change > BASELINE_CHANGE * m.peak_acceleration:
+            changed.setdefault((name, m.peak_acceleration, applied, change), []).append(f'"{support.name}"')
         # along x (or as the horizontal of a vertical pair): an up component along y (direction [0, 1]) is meant
         horizontal = m.vertical_source or abs(m.direction[0]) >= abs(m.direction[1])
         if upright and m.source and horizontal and vertical_at2(m.source):
@@ -204,6 +219,13 @@ def record_warnings(scenario: Scenario, upright: bool = True) -> list[str]:
             f"{who(names)}: the record {name} is a vertical component (PEER's UP / DWN, ESM's Z, K-NET's UD), applied horizontally: give "
             "a horizontal one (H1 / H2), or this one as a scenario file's vertical = … beside its horizontal"
             for name, names in sideways.items()
+        ]
+        + [
+            f"{who(names)}: the record {name} does not start and end at rest: its baseline correction changes the "
+            f"acceleration by up to {change / G_STANDARD:.3g} g ({100 * change / peak:.0f} % of its peak): its peak "
+            f"{peak / G_STANDARD:.4g} g becomes {applied / G_STANDARD:.4g} g as applied (×{applied / peak:.4g}); "
+            '--baseline none (a scenario file\'s baseline = "none") applies it as given'
+            for (name, peak, applied, change), names in changed.items()
         ]
     )
 

@@ -20,7 +20,7 @@ from pathlib import Path
 from masonrycli.errors import NOT_A_FILE, InputError
 from masonrycli.outputs.files import OutputFile, safe_name
 from masonrycli.records.read import vertical_at2
-from masonrycli.scenario.builtin import check_record_dt, is_built_in, override_run, target_scenario
+from masonrycli.scenario.builtin import check_baseline, check_record_dt, is_built_in, override_run, target_scenario
 from masonrycli.scenario.values import option_text
 from masonrycli.study import store
 from masonrycli.study.axes import Axis, StudyBase, apply_point, check_axes, check_find, parse_axis
@@ -60,6 +60,7 @@ def plan_study(
     params: list[str] | None = None,
     records: list[Path] | None = None,
     record_dt: float | None = None,
+    baseline: str | None = None,
     scale: str | None = None,
     find: str | None = None,
     outcome: str | None = None,
@@ -98,8 +99,10 @@ def plan_study(
     late: list[str] = []  # warnings about records longer than the runs
     if check_record_dt(record_dt) is not None and not records:
         raise InputError("--record-dt: goes with --records (the time between the samples of its one-column files)")
+    if check_baseline(baseline) is not None and not records:  # a scenario file's record has its table's baseline
+        raise InputError('--baseline: goes with --records (a scenario file\'s own record takes baseline = "none")')
     if records:
-        motions, unread = _records(records, out, record_dt)
+        motions, unread = _records(records, out, record_dt, baseline or "quadratic")
         scenario, late = _record_duration(base.scenario, motions, lasting)  # a file's [run] duration stands
         late = [*unread, *late]
         base = StudyBase(scenario, motions)
@@ -301,7 +304,7 @@ def _record_duration(scenario, motions: dict, whole: bool):
     ]
 
 
-def _records(entries: list[Path], out: Path, record_dt: float | None) -> tuple[dict, list[str]]:
+def _records(entries: list[Path], out: Path, record_dt: float | None, baseline: str) -> tuple[dict, list[str]]:
     """``(record motions by file name, warnings)``, from files and the .AT2 / .ASC / .csv files of folders (but the
     study's table ``out``: kept in its records' folder, it was read as a record by the same command run again,
     "recs/ida.csv:2: not a number", so the study could not be resumed). ``record_dt`` (--record-dt, s):
@@ -334,7 +337,7 @@ def _records(entries: list[Path], out: Path, record_dt: float | None) -> tuple[d
     twice = sorted({n for n in names if names.count(n) > 1})
     if twice:
         raise InputError(f"--records: two records named {twice[0]} (rows are keyed by the file name)")
-    motions = {p.name: _record(p, record_dt) for p in files}
+    motions = {p.name: _record(p, record_dt, baseline) for p in files}
     upright = [p.name for p in files if vertical_at2(p)]
     if upright:  # an unzipped NGA-West2 search holds each recording's H1, H2 and UP files, all .AT2
         names = ", ".join(upright[:3]) + (" …" if len(upright) > 3 else "")
@@ -449,7 +452,7 @@ def _is_record_file(path: Path) -> bool:
     return not _esm_other(path) and not _kik_borehole(path)
 
 
-def _record(path: Path, record_dt: float | None):
+def _record(path: Path, record_dt: float | None, baseline: str = "quadratic"):
     """The motion of one file of a record set: a CSV of one value per line with its samples ``record_dt``
     apart, any other file with its own times (a mixed set: the time step is for its one-column files).
     The file's first sample says which: read without a time step, a one-column file is refused there,
@@ -460,11 +463,11 @@ def _record(path: Path, record_dt: float | None):
     from masonrycli.records.text import NoTimeStep
 
     try:
-        return record_motion(path, display=str(path))
+        return record_motion(path, display=str(path), baseline=baseline)
     except NoTimeStep as exc:
         if record_dt is None:
             raise exc.give("--record-dt SECONDS") from None
-        return record_motion(path, display=str(path), time_step=record_dt)
+        return record_motion(path, display=str(path), time_step=record_dt, baseline=baseline)
 
 
 def _same_file(a, b) -> bool:
