@@ -332,3 +332,23 @@ def test_a_study_recording_that_cannot_be_written_whole_is_exit_4_the_table_kept
         assert done.returncode == 4 and len(lines) == 1, (share, done.stdout[-1000:], done.stderr[-1000:])
         assert lines[0].startswith("error: cannot write --out's recording s.rrd: "), lines[0]
         assert sorted(p.name for p in run.iterdir()) == ["s.parquet", "s.png"]
+
+
+def test_a_search_of_one_point_keeps_its_time_line_from_0(block, tmp_path):
+    """`masonry sweep block.toml --param amp=0.05:1.0:3 --find amp`: one point, at index 0 with a margin at -1.
+    The viewer opens with the cursor at the time line's start, and Rerun 0.41 draws no static image below 0:
+    the picture's view said "No data available" (test_viewer_screenshot). The point is numbered 1, as in the
+    PNG, and the time line starts at 0."""
+    import rerun as rr
+
+    out, rrd = tmp_path / "find.csv", tmp_path / "find.rrd"
+    args = ["-p", "amp=0.02:0.4:3", "--find", "amp", "--outcome", "sliding", "--duration", 0.3, "--workers", 0]
+    assert invoke("sweep", block, *args, "--out", out, "--recording", rrd).exit_code == 0
+    extent = [
+        ch.to_record_batch().column("point").to_pylist()
+        for ch in rr.chunk.RrdReader(str(rrd)).stream()
+        if ch.entity_path == "/study/extent"
+    ]
+    assert extent == [[0, 2]]
+    view = blueprint_layout(rrd)["TimeAxis:view_range"]
+    assert (view["start"], view["end"]) == (0, 2)

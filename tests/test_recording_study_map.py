@@ -59,7 +59,7 @@ def test_the_rows_are_the_terminals_with_units_under_the_table(tmp_path):
     text = static_fields(chunks, "/study/rows")["TextDocument:text"][0]
     lines = text.splitlines()
     header = [h.strip() for h in lines[2].strip("|").split("|")]
-    assert header == ["freq", "amp", "state", "collapse", "drift", "pga", "open", "hinges", "wall", "peak", "sweeps"]
+    assert header == ["freq", "amp", "state", "collapse", "drift", "pga", "open", "hinges", "took", "peak", "sweeps"]
     first, last = ([c.strip() for c in ln.strip("|").split("|")] for ln in (lines[4], lines[7]))
     assert first[3] == "" and last[3] == "0.40"  # no collapse: blank; collapse at 0.4 s
     assert first[4] == "1.23" and first[6] == "0.7"  # drift in % of height, opening in mm

@@ -199,7 +199,8 @@ def test_thresholds_along_record_names_are_points_not_a_line(png_figures, tmp_pa
     series = recorded_series(rrd, "study/thresholds")
     assert "/study/thresholds/line" not in series
     points = series["/study/thresholds/points"]
-    assert points["x"] == [0, 1, 2] and points["y"] == [1.5, 0.8, 1.1] and points["label"] == "scale_threshold"
+    # numbered from 1 on the recording's time line (a cursor below 0 hid the picture: test_recording_study)
+    assert points["x"] == [1, 2, 3] and points["y"] == [1.5, 0.8, 1.1] and points["label"] == "scale_threshold"
     assert list(png_figures[0]) == ["scale_threshold"]
     # numeric x keeps its line (a threshold against friction is a curve)
     assert [c.key for c in threshold_series(rows, "scale", np.arange(3.0), (0.5, 3.0))][:2] == ["line", "points"]
@@ -230,7 +231,7 @@ def test_thresholds_over_records_and_friction_are_one_series_a_friction(png_figu
     for g, mu in enumerate((0.5, 0.7)):
         points = series[f"/study/thresholds/points/{g}"]
         assert points["label"] == f"friction = {mu:g}: scale_threshold"
-        assert points["x"] == [0, 1, 2] and points["y"] == list(thresholds[mu])
+        assert points["x"] == [1, 2, 3] and points["y"] == list(thresholds[mu])
         assert png[points["label"]] == points["rgb"]
     assert len(png) == 2 and len(set(png.values())) == 2
 

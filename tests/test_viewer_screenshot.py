@@ -224,3 +224,23 @@ def test_a_fragility_legend_of_five_groups_shows_the_runs_entries(tmp_path):
     ]  # the plot's right half
     for state in ("intact", "damaged", "collapsed"):
         assert near(legend_side, np.array([rgb(STATE_COLOURS[state])] * 4), tol=40).sum() > 20, state
+
+
+def test_the_picture_of_a_one_point_search_is_drawn_at_open(tmp_path):
+    # A class's first threshold search, `masonry sweep block.toml --param amp=0.05:1.0:3 --find amp`: its
+    # recording opened with the picture's view empty ("No data available"): the cursor at the time line's
+    # start, -1, and Rerun 0.41 draws no static image below 0. The picture is the middle third of the window.
+    import PIL.Image as image_module
+
+    from sweep_helpers import invoke, write_block
+
+    rrd = tmp_path / "find.rrd"
+    args = ["-p", "amp=0.02:0.4:3", "--find", "amp", "--outcome", "sliding", "--duration", 0.3, "--workers", 0]
+    result = invoke("sweep", write_block(tmp_path), *args, "--out", tmp_path / "find.csv", "--recording", rrd)
+    assert result.exit_code == 0, result.output
+    png = tmp_path / "open.png"
+    assert screenshot_recording(rrd, png, at_open=True, timeout=120) == []
+    image = np.asarray(image_module.open(png).convert("RGB")).astype(np.int32)
+    width, height = png_size(png)
+    middle = image[height // 10 : 9 * height // 10, width // 3 + 20 : 2 * width // 3 - 20]
+    assert (middle.sum(axis=-1) > 600).mean() > 0.1  # the PNG's white background (was 0.0002)

@@ -403,6 +403,8 @@ def _log_thresholds(rec, rows: list[dict], find: str, names: list[str], searched
     the y range."""
     x = names[0] if names else None
     at, by_name = axis_positions(rows, x)
+    if by_name is not None or x is None:  # an index: from 1, as the PNG numbers the points (and see below)
+        at = at + 1.0
     if by_name is not None:
         timeline, per_unit = f"{x} (index)", 1.0
         against = timeline
@@ -419,6 +421,11 @@ def _log_thresholds(rec, rows: list[dict], find: str, names: list[str], searched
     ticks = np.rint(at[swept] * per_unit) if swept.any() else np.zeros(1)
     span = max(float(ticks.max() - ticks.min()), 0.1 * float(np.abs(ticks).max()), 1.0)
     x_range = (int(np.floor(min(0.0, ticks.min() - 0.05 * span))), int(np.ceil(ticks.max() + 0.05 * span)))
+    if ticks.min() >= 0:
+        # The viewer opens with the time cursor at the time line's start, and Rerun 0.41 draws no static image
+        # while the cursor is below 0: a search of one point (index 0, its margin at -1) opened on the
+        # picture's view saying "No data available" (headless screenshot, 2026-11-29)
+        x_range = (max(x_range[0], 0), x_range[1])
     # the y range holds the found thresholds and the marks of the points without one
     shown = np.concatenate([c.y for c in series if c.marker != "line"])
     shown = shown[np.isfinite(shown)]
