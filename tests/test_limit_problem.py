@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from shapely.geometry import box
+from shapely.geometry import Polygon, box
 
 from masonrycli.errors import InputError
 from masonrycli.limit import LimitError, LiveLoad, analyse
@@ -120,6 +120,20 @@ def test_a_block_that_cannot_stand_is_infeasible():
     sc = scenario([("overhang", box(0, 0, 1, 1))], [("ground", box(-1, -1, 0.3, 0))], 0.6)
     with pytest.raises(LimitError, match="no equilibrium"):
         analyse(sc, LiveLoad())
+
+
+def test_no_equilibrium_names_what_gives_way_under_the_dead_load():
+    """The Farkas mechanism of an infeasible structure, against statics: a block whose centroid (x = 0.5) lies
+    beyond the ground's edge (x = 0.3) tips about that edge; one on a 30° slope with μ = 0.3 < tan 30° and a
+    base wider than tall slides down it (it said only "no equilibrium", whatever failed)."""
+    tipping = scenario([("overhang", box(0, 0, 1, 1))], [("ground", box(-1, -1, 0.3, 0))], 0.6)
+    with pytest.raises(LimitError, match=r"under its own weight 1 of 1 blocks give way — hinges overhang\|ground$"):
+        analyse(tipping, LiveLoad())
+    c, s = np.cos(np.pi / 6), np.sin(np.pi / 6)
+    slope = Polygon([(0, 0), (4 * c, -4 * s), (4 * c, -3), (0, -3)])
+    block = Polygon([(x * c + y * s, -x * s + y * c) for x, y in [(1, 0), (2, 0), (2, 0.4), (1, 0.4)]])
+    with pytest.raises(LimitError, match=r"1 of 1 blocks give way — sliding (block\|slope|slope\|block)$"):
+        analyse(scenario([("block", block)], [("slope", slope)], 0.3), LiveLoad())
 
 
 def test_a_load_no_mechanism_can_follow_is_unbounded():

@@ -15,7 +15,16 @@ import numpy as np
 from masonrycli.errors import InputError
 from masonrycli.limit.joints import Joints, find_joints, joint_names
 from masonrycli.limit.kinematics import JointMotion, joint_motion
-from masonrycli.limit.problem import LimitError, LiveLoad, LPSolution, load_vectors, solve_limit, support_thrust_range
+from masonrycli.limit.problem import (
+    LimitError,
+    LiveLoad,
+    LPSolution,
+    NoEquilibrium,
+    gravity_mechanism,
+    load_vectors,
+    solve_limit,
+    support_thrust_range,
+)
 from masonrycli.limit.thrust import ThrustLine, thrust_line
 from masonrycli.model import Model, build_model
 
@@ -145,6 +154,28 @@ MIN_GRAVITY = 1e-6
 """m/s²: below this the blocks' weight is taken as zero (a microgravity experiment has ~1e-5)."""
 
 
+def _falls(model: Model, joints: Joints, dead: np.ndarray, shown: int = 4) -> str:
+    """What gives way under the dead load alone (:func:`gravity_mechanism`), for the "no equilibrium" line:
+    which blocks move, the fastest hinges and sliding joints (an abutment tipped by an arch's thrust)."""
+    motion = joint_motion(model, joints, gravity_mechanism(model, joints, dead))
+    moving = int(np.count_nonzero(motion.block_moving))
+    if not moving:
+        return ""
+    names = joint_names(model, joints)
+
+    def fastest(rate, chosen):
+        order = [k for k in np.argsort(-rate, kind="stable") if chosen[k]]
+        more = f" and {len(order) - shown} more" if len(order) > shown else ""
+        return ", ".join(names[k] for k in order[:shown]) + more
+
+    parts = []
+    if motion.joint_hinged.any():
+        parts.append(f"hinges {fastest(motion.joint_turn, motion.joint_hinged)}")
+    if motion.joint_sliding.any():
+        parts.append(f"sliding {fastest(motion.joint_slide, motion.joint_sliding)}")
+    return f"; under its own weight {moving} of {model.block_count} blocks give way — " + "; ".join(parts)
+
+
 def analyse_model(model: Model, load: LiveLoad, scenario_name: str = "") -> LimitResult:
     """Limit analysis of a built model (supports are rigid and fixed whatever their motion in a run)."""
     t0 = time.perf_counter()
@@ -158,7 +189,10 @@ def analyse_model(model: Model, load: LiveLoad, scenario_name: str = "") -> Limi
         )
     joints = find_joints(model)
     dead, live, reference = load_vectors(model, load)
-    solution = solve_limit(model, joints, dead, live)
+    try:
+        solution = solve_limit(model, joints, dead, live)
+    except NoEquilibrium as exc:
+        raise NoEquilibrium(f"{exc}{_falls(model, joints, dead)}") from None
     motion = joint_motion(model, joints, solution.block_velocity)
     weight = float(np.mean(model.body_mass[: model.block_count]) * np.hypot(*model.gravity))
     thrust = thrust_line(joints, solution.contact_force, loaded=1e-9 * weight)

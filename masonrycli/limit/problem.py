@@ -48,6 +48,10 @@ class LimitError(InputError):
     """No collapse load exists (infeasible or unbounded program); the message is one line."""
 
 
+class NoEquilibrium(LimitError):
+    """The blocks cannot carry their own weight (the program is infeasible)."""
+
+
 @dataclass(frozen=True)
 class LiveLoad:
     """The load that grows with λ.
@@ -212,7 +216,7 @@ def _check_supported(model: Model, joints: Joints) -> None:
 
 def _status_error(status: int, message: str, what: str) -> LimitError:
     if status == 2:
-        return LimitError(f"no equilibrium: {what} (the linear program is infeasible)")
+        return NoEquilibrium(f"no equilibrium: {what} (the linear program is infeasible)")
     if status == 3:
         return LimitError(
             "no collapse: the joints resist the live load at any factor (the linear program is unbounded) — "
@@ -254,6 +258,25 @@ def solve_limit(
         solve_time=elapsed,
         iterations=int(getattr(res, "nit", 0)),
     )
+
+
+def gravity_mechanism(model: Model, joints: Joints, dead: np.ndarray) -> np.ndarray:
+    """(N, 3) block velocities of a mechanism the dead load drives on its own, for a structure with no
+    equilibrium, normalised so the fastest block point moves at 1.
+
+    Farkas: {A f = b, f ≥ 0} has no solution iff some u has Aᵀu ≥ 0 (every cone edge does non-negative
+    power: the joints open or slide and dilate, as a collapse mechanism's) and bᵀu < 0 (the dead load does
+    positive work). Minimise bᵀu over the box |u| ≤ 1: one vertex, the mechanism that frees the most work.
+    """
+    weight, _ = _scales(model)
+    scale = _row_scale(model)
+    a = sp.diags(scale) @ equilibrium_matrix(model, joints)
+    b = -scale * dead / weight
+    res = linprog(b, A_ub=-a.T.tocsc(), b_ub=np.zeros(a.shape[1]), bounds=(-1.0, 1.0), method=METHOD)
+    if res.status != 0 or res.fun >= 0:
+        return np.zeros((model.block_count, 3))
+    velocity = (res.x * scale).reshape(-1, 3)
+    return velocity / max(_fastest_point(model, velocity), 1e-300)
 
 
 def _fastest_point(model: Model, velocity: np.ndarray) -> float:
