@@ -172,3 +172,29 @@ def test_a_raised_alert_distance_adds_no_joint_across_a_gap(alert):
     joints = find_joints(build_model(sc))
     assert [tuple(b) for b in joints.joint_body] == [(0, 1), (0, 4), (1, 2), (2, 3)]
     assert analyse(sc, LiveLoad("horizontal")).load_factor == pytest.approx(0.3, rel=REL)
+
+
+def test_thrust_without_bound_is_said_and_lambda_still_found():
+    """`--thrust` on a panel jammed between two supports: they can squeeze it with any force (a self-stress
+    of the two blocks against each other), so its greatest thrust has no bound, while the free columns on
+    either side still collapse at λ = B/H = 0.25. The unbounded LP made the whole analysis fail with "no collapse:
+    the joints resist the live load at any factor". A lone column pushes nothing sideways on its ground:
+    0 … 0 exactly (it printed -4e-10 … -7e-12 N, the LP's rounding)."""
+    jammed = scenario(
+        [
+            ("a", box(-0.2, 0.0, 0.0, 0.4)),
+            ("b", box(0.0, 0.0, 0.2, 0.4)),
+            ("c", box(2.0, 0.0, 2.2, 0.8)),
+            ("d", box(-2.2, 0.0, -2.0, 0.8)),
+        ],
+        [("left", box(-0.5, 0.0, -0.2, 1.0)), ("right", box(0.2, 0.0, 0.5, 1.0)), ("ground", box(-4, -0.5, 4, 0))],
+        friction=0.6,
+    )
+    result = analyse(jammed, LiveLoad(), thrust=True)
+    assert result.load_factor == pytest.approx(0.25, rel=REL)
+    thrusts = {name: (way, least, greatest) for name, way, least, greatest in result.support_thrust}
+    assert thrusts["left"] == ("-x", 0.0, np.inf) and thrusts["right"] == ("+x", 0.0, np.inf)
+    data = result.summary()["support_thrust"]
+    assert [t["greatest_N"] for t in data if t["support"] != "ground"] == [None, None]  # JSON has no infinity
+    lone = analyse(column(1, 0.4, 0.8, friction=0.6), LiveLoad(), thrust=True)
+    assert lone.support_thrust[0][2:] == (0.0, 0.0)

@@ -49,7 +49,7 @@ class LimitResult:
     a model analysed without its scenario)."""
     support_thrust: tuple[tuple[str, str, float, float], ...] | None = None
     """(support, outward direction, least N, greatest N) of each support under the dead load alone
-    (:func:`support_thrusts`); None unless asked for (``masonry limit --thrust``)."""
+    (:func:`support_thrusts`; ±inf: no bound, null in JSON); None unless asked for (``masonry limit --thrust``)."""
 
     @property
     def load_factor(self) -> float:
@@ -118,7 +118,7 @@ class LimitResult:
             "support_thrust": None
             if self.support_thrust is None
             else [
-                {"support": name, "direction": d, "least_N": lo, "greatest_N": hi}
+                {"support": name, "direction": d, "least_N": _finite(lo), "greatest_N": _finite(hi)}
                 for name, d, lo, hi in self.support_thrust
             ],
             "friction": m.friction,

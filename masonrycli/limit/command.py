@@ -8,6 +8,7 @@ prints exactly one JSON object on stdout and nothing else (warnings go to stderr
 from __future__ import annotations
 
 import json
+import math
 import signal
 from dataclasses import dataclass
 from pathlib import Path
@@ -108,9 +109,11 @@ def result_table(result: LimitResult, out: Path | None) -> Table:
     table.add_row("load factor λ", lam)
     table.add_row("collapse load", f"{s['collapse_load_N']:.4g} N (λ × {s['reference_load_N']:.4g} N){_depth(result)}")
     for name, direction, least, greatest in result.support_thrust or ():
+        bound = f"{greatest:.4g} N" if math.isfinite(greatest) else "no bound (blocks jammed between supports)"
+        lower = f"{least:.4g}" if math.isfinite(least) else "no bound"
         table.add_row(
             f"thrust on {name}",
-            f"{least:.4g} … {greatest:.4g} N towards {direction}, under the dead load alone (least: the supports "
+            f"{lower} … {bound} towards {direction}, under the dead load alone (least: the supports "
             "spreading; greatest: pushed together)",
         )
     table.add_row("hinges", _names(result.hinges_largest_first()))

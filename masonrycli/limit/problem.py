@@ -298,7 +298,10 @@ def support_thrust_range(
     under their own weight alone, over every admissible set of joint forces.
 
     For an arch on two supports this is the range of its horizontal thrust: the minimum when the supports
-    spread, the maximum when they are pushed together (Heyman's active and passive states).
+    spread, the maximum when they are pushed together (Heyman's active and passive states). A bound is
+    ±inf where there is none (blocks jammed between two supports: any self-stress of theirs is admissible;
+    the unbounded LP failed the whole analysis as "no collapse"), and 0 within the LP's rounding of it
+    (a lone column's ground: −4e-10 N).
     """
     _check_supported(model, joints)
     weight, _ = _scales(model)
@@ -311,7 +314,11 @@ def support_thrust_range(
     out = []
     for sign in (1.0, -1.0):
         res = linprog(sign * cost, A_eq=a_eq, b_eq=b_eq, bounds=(0, None), method=METHOD)
+        if res.status == 3:
+            out.append(-sign * np.inf)
+            continue
         if res.status != 0:
             raise _status_error(res.status, res.message, "the blocks cannot carry their own weight")
-        out.append(sign * res.fun * weight)
+        force = sign * res.fun * weight
+        out.append(0.0 if abs(force) < 1e-9 * weight else force)
     return out[0], out[1]
