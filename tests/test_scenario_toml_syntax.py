@@ -32,9 +32,14 @@ TYPOS = [  # what a student writes -> the fix the message gives
     ("phase = -.5", "write -0.5"),
     ("duration = 5.", "a decimal point needs a digit after it: write 5.0"),
     ("density = 2 500", "no spaces within a number: write 2500"),
+    ("max_iterations = 1 000 000", "no spaces within a number: write 1000000"),  # it said 1000: a wrong number
+    ("density = 2 500.5", "write 2500.5"),
     ('motion = { kind = "sine", amplitude = 1 m/s, frequency = 2 }', "without m/s:"),
     ('motion = { kind = "sine", amplitude = 0,5, frequency = 2 }', "the decimal separator is a point: write 0.5"),
     ("name = wall", 'a text goes between quotes: "wall"'),
+    ("name = my wall  # the first", 'a text goes between quotes: "my wall"'),  # it said "my"
+    ("name = 3rd-wall", 'a text goes between quotes: "3rd-wall"'),  # it said "without rd-wall", a unit
+    ("file = C:\\Users\\Ana Silva\\q.AT2", "quotes: 'C:\\Users\\Ana Silva\\q.AT2'"),  # it said 'C:\\Users\\Ana'
     ("file = C:\\q.AT2", "a file name goes between quotes: 'C:\\q.AT2' (single quotes keep its \\ as they are)"),
     ("file = records/q.AT2", "a file name goes between quotes: 'records/q.AT2'"),
     ('file = "C:\\Users\\ana\\q.AT2"', 'write the path with / ("C:/Users/ana/quake.AT2") or between single quotes'),
@@ -49,7 +54,9 @@ def test_a_syntax_error_says_the_likely_fix(line, fix):
     assert fix in hint(f"[run]\n{line}\n", str(exc.value))
 
 
-@pytest.mark.parametrize("text", ['name = "abc', "[run\ndt = 1", "x = = 1", "a = 1\na = 2", "dt = \n", "dt ="])
+@pytest.mark.parametrize(
+    "text", ["duration = 0.5.", 'name = "abc', "[run\ndt = 1", "x = = 1", "a = 1\na = 2", "dt = \n", "dt ="]
+)
 def test_no_guess_where_the_mistake_is_none_of_those(text):
     with pytest.raises(tomllib.TOMLDecodeError) as exc:
         tomllib.loads(text)

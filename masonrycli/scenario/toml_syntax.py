@@ -21,6 +21,17 @@ _DIGITS_BEFORE = re.compile(r"(?:^|[=\[,{]\s*)([-+]?\d+)$")
 _WORD = re.compile(r"[^\s,\]}#]+")
 _COMMA_NUMBER = re.compile(r"=\s*([-+]?\d+),(\d+)\b")
 _UNIT_START = re.compile(r"[A-Za-zµ°%'\"/]")
+_UNIT_WORD = re.compile(r"[A-Za-zµ°%'\"/²³^*·.\d]{1,8}")  # s, ms, m/s, kg/m3, m/s^2, Hz; not "rd-wall"
+_SPACED_NUMBER = re.compile(r"[-+]?\d+(?: +\d+)*(?:\.\d+)?(?:[eE][-+]?\d+)?")
+_KEY_EQUALS = re.compile(r"^\s*[\w.\"'-]+\s*=\s*")
+
+
+def _value_text(line: str, start: int) -> str:
+    """The unquoted value from ``start``: the rest of a ``key = value`` line (up to a comment: a name or a
+    path may hold spaces), else (in an array or inline table) up to the next space, comma or bracket."""
+    if _KEY_EQUALS.fullmatch(line[:start]):
+        return line[start:].split("#")[0].strip()
+    return _WORD.match(line, start).group()
 
 
 def hint(text: str, message: str) -> str:
@@ -42,18 +53,29 @@ def hint(text: str, message: str) -> str:
         decimals = re.match(r"\d+", after).group()
         return f"the decimal separator is a point: write {digits.group(1)}.{decimals}"
     number = _NUMBER_BEFORE.search(before)
-    if number and at.isdigit() and before.endswith(" "):  # "1 000"
-        return f"no spaces within a number: write {number.group(1)}{_WORD.match(line, column - 1).group()}"
-    if number and at == "." and not after[:1].isdigit():  # "5."
-        return f"a decimal point needs a digit after it: write {number.group(1)}.0"
+    if number and at.isdigit() and before.endswith(" "):  # "1 000", "1 000 000" (every group, not 1000)
+        whole = _SPACED_NUMBER.match(line, number.start(1)).group()
+        return f"no spaces within a number: write {whole.replace(' ', '')}"
+    if number and at == "." and not after[:1].isdigit():  # "5." (not "0.5.": no fix to guess)
+        return (
+            ""
+            if re.search(r"[.eE]", number.group(1))
+            else f"a decimal point needs a digit after it: write {number.group(1)}.0"
+        )
     if number and _UNIT_START.match(at):
         unit = _WORD.match(line, column - 1).group()
-        return f"write the number alone, without {unit}: a scenario's numbers are in SI units (m, s, kg, m/s, Hz, rad)"
+        if _UNIT_WORD.fullmatch(unit):
+            return (
+                f"write the number alone, without {unit}: a scenario's numbers are in SI units (m, s, kg, m/s, Hz, rad)"
+            )
+        if _KEY_EQUALS.fullmatch(line[: number.start(1)]):  # "name = 3rd-wall": a text
+            return f'a text goes between quotes: "{_value_text(line, number.start(1))}"'
+        return ""
     bare = re.match(r"([-+]?)\.(\d+)", line[column - 1 :])
     if bare and re.search(r"[=\[,{]\s*$", before):  # ".5", "-.5"
         return f"a number starts with a digit: write {bare.group(1)}0.{bare.group(2)}"
     if message.startswith("Invalid value") and re.search(r"=\s*$", before) and at and (at.isalpha() or at in "/~."):
-        word = _WORD.match(line, column - 1).group()
+        word = _value_text(line, column - 1)
         if "\\" in word or "/" in word or re.match(r"[A-Za-z]:", word):
             keep = " (single quotes keep its \\ as they are)" if "\\" in word else ""
             return f"a file name goes between quotes: '{word}'{keep}"
