@@ -31,6 +31,7 @@ from masonrycli.cli.options import (
     AtOption,
     DirectionOption,
     Friction,
+    MinThicknessOption,
     ThrustOption,
     choice_value,
     file_defaults,
@@ -283,6 +284,7 @@ def limit_command(
     friction: Friction = None,
     as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object on stdout, nothing else.")] = False,
     thrust: ThrustOption = False,
+    min_thickness: MinThicknessOption = False,
     verify: Annotated[
         bool, typer.Option("--verify", help="Run the NSCD engine at 0.95 λ and 1.05 λ (tilted gravity) and compare.")
     ] = False,
@@ -317,6 +319,7 @@ def limit_command(
         structure_options=structure_options,
         at=at,
         thrust=thrust,
+        min_thickness=min_thickness,
     )
 
 

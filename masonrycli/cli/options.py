@@ -199,6 +199,14 @@ AtOption = Annotated[
         help="Point load on the top block over x = X m instead of --block (a deck load at that abscissa).",
     ),
 ]
+MinThicknessOption = Annotated[
+    bool,
+    typer.Option(
+        "--min-thickness",
+        help="The arch only: the least ring thickness that carries its own weight on the same piers, and "
+        "Heyman's geometric factor of safety (the ring's thickness over it).",
+    ),
+]
 ThrustOption = Annotated[
     bool,
     typer.Option(

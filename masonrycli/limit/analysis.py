@@ -47,6 +47,9 @@ class LimitResult:
     thickness: float | None = None
     """m: the blocks' out-of-plane thickness, which the newtons are for (None: not one for every block, or
     a model analysed without its scenario)."""
+    ring: tuple[float, float] | None = None
+    """m: (ring thickness, least ring thickness that carries its own weight) of a built-in arch
+    (:mod:`masonrycli.limit.thickness`); None unless asked for (``masonry limit --min-thickness``)."""
     support_thrust: tuple[tuple[str, str, float, float], ...] | None = None
     """(support, outward direction, least N, greatest N) of each support under the dead load alone
     (:func:`support_thrusts`; ±inf: no bound, null in JSON); None unless asked for (``masonry limit --thrust``)."""
@@ -115,6 +118,9 @@ class LimitResult:
             "collapse_load_N": self.load_factor * self.reference_force,
             "reference_load_N": self.reference_force,
             "thickness_m": self.thickness,
+            "ring_thickness_m": None if self.ring is None else self.ring[0],
+            "least_ring_thickness_m": None if self.ring is None else self.ring[1],
+            "geometric_factor": None if self.ring is None else self.ring[0] / self.ring[1],
             "support_thrust": None
             if self.support_thrust is None
             else [

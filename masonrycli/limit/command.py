@@ -10,7 +10,7 @@ from __future__ import annotations
 import json
 import math
 import signal
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -108,6 +108,12 @@ def result_table(result: LimitResult, out: Path | None) -> Table:
         lam.append(f"  ({reading})")
     table.add_row("load factor λ", lam)
     table.add_row("collapse load", f"{s['collapse_load_N']:.4g} N (λ × {s['reference_load_N']:.4g} N){_depth(result)}")
+    if result.ring is not None:
+        table.add_row(
+            "least ring thickness",
+            f"{result.ring[1]:.4g} m for a ring of {result.ring[0]:g} m: geometric factor of safety "
+            f"{result.ring[0] / result.ring[1]:.2f} (Heyman)",
+        )
     for name, direction, least, greatest in result.support_thrust or ():
         bound = f"{greatest:.4g} N" if math.isfinite(greatest) else "no bound (blocks jammed between supports)"
         lower = f"{least:.4g}" if math.isfinite(least) else "no bound"
@@ -248,6 +254,7 @@ def run_limit(
     structure_options: dict | None = None,
     at: float | None = None,
     thrust: bool = False,
+    min_thickness: bool = False,
 ) -> None:
     """``masonry limit``: analyse, optionally record and verify, then print a table or one JSON object.
 
@@ -272,6 +279,7 @@ def run_limit(
                     err_console=err_console,
                     structure_options=structure_options,
                     thrust=thrust,
+                    min_thickness=min_thickness,
                 )
         except StopRun as stop:
             how = "" if stop.signum == signal.SIGINT else f" ({signal_name(stop.signum)})"  # as `masonry sweep`
@@ -324,6 +332,26 @@ class _Done:
         return said + "; --verify did not finish" if self.verifying else said
 
 
+def _least_ring(structure: str, friction: float | None, structure_options: dict | None) -> tuple[float, float]:
+    """(ring thickness, least ring thickness) of the built-in arch ``structure`` with its options."""
+    from geometry_library.builders import ArchSpec
+    from masonrycli.limit.thickness import least_ring_thickness
+    from masonrycli.scenario.builtin import builtin, override_run
+
+    if structure != "arch":
+        raise InputError(
+            f"--min-thickness: the arch's ring only (masonry limit arch …); {structure} is not the arch built-in"
+        )
+    given = {k: v for k, v in (structure_options or {}).items() if v is not None}
+    thickness = float(given.pop("ring_thickness", ArchSpec.ring_thickness))
+
+    def build(t: float):
+        return override_run(builtin("arch", ring_thickness=t, **given), friction=friction)
+
+    found = least_ring_thickness(build, thickness)
+    return found.thickness, found.least
+
+
 def _analyse(structure, live, friction, verify, out, force, done: _Done, signals, *, console, err_console, **options):
     """The work of :func:`run_limit`, filling ``done`` as it goes; returns the --verify checks. ``console``:
     where the result table goes before --verify runs (None with --json)."""
@@ -336,6 +364,8 @@ def _analyse(structure, live, friction, verify, out, force, done: _Done, signals
     settings = setting_warnings(scenario)  # not its records': it has no time
     try:
         done.result = analyse(scenario, live, thrust=options["thrust"])
+        if options["min_thickness"]:
+            done.result = replace(done.result, ring=_least_ring(structure, friction, options["structure_options"]))
     except LimitError as exc:
         # one line, as any refusal: a block touching nothing was said twice (a warning, then the error in the
         # same words); a setting's warning is the reason ("no equilibrium" under a gravity pointing up)
