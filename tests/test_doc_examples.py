@@ -33,6 +33,7 @@ PLACEHOLDER = re.compile(r"…|\.\.\.|\\\||\[-|\b[A-Z]+\.\w+\b|\b(?:SCENARIO|FIL
 FRAGMENTS = {  # in a sentence, not a command line
     "sweep --find amp --outcome sliding",  # collapse.md: the option, named
     "build wall",  # README: "the same 51-block wall (`masonry build wall`)", the builder named
+    "build arch",  # limit.md: "the segmental arch that `masonry build arch` writes with those options"
 }
 NOT_RUN = {  # example -> why it is parsed only
     "export h.npz --times lab.csv --compare 'LVDT top (mm)' --out lab-vs-masonry.csv": "a laboratory's measurements",
@@ -44,6 +45,7 @@ NOT_RUN = {  # example -> why it is parsed only
     "export h/ --combined": "the README's history folder: test_history_export",
     "export h --combined": "the README's history folder: test_history_export",
     "export h.npz --blocks c06-b05 --course 3 --top": "the README's h.npz: test_history_export",
+    "export h.npz --blocks v08,v15 --top": "limit.md's h.npz, of a run written as 'simulate arch …'",
 }
 
 
@@ -67,13 +69,18 @@ def _pages_examples() -> list[tuple[str, str]]:
 
 
 def _help_examples() -> list[tuple[str, str]]:
+    """The command lines of the --help texts: as they show them in bold (a sentence's full stop after one is
+    not part of it), or a line of their own."""
     group = typer.main.get_command(app)
-    return [
-        (f"masonry {name} --help", m.group(1))
-        for name, command in group.commands.items()
-        for line in re.sub(r"\[/?bold\]", "", command.help or "").splitlines()  # rich markup
-        if (m := COMMAND.match(line.strip()))
-    ]
+    found = []
+    for name, command in group.commands.items():
+        text = command.help or ""
+        lines = [m.group(1) for line in text.splitlines() if (m := COMMAND.match(line.strip()))]
+        bold = re.findall(r"\[bold\]masonry ([^\[]+)\[/bold\]", text)
+        for example in bold or lines:
+            if not PLACEHOLDER.search(example):
+                found.append((f"masonry {name} --help", example))
+    return found
 
 
 def _parse(command: str) -> None:
@@ -119,10 +126,31 @@ motion = { kind = "sine", direction = [1.0, 0.0], amplitude = 1.0, frequency = 2
 """
 
 
+def _pages_files() -> dict[str, str]:
+    """The files a page tells the reader to save: a ```toml block after a paragraph saying "save `NAME.toml`"."""
+    files = {}
+    for page in PAGES:
+        for before, text in re.findall(r"((?:[^\n]+\n)+)\n```toml\n(.*?)```", page.read_text(), re.S):
+            if named := re.search(r"[Ss]ave (?:this as )?`([\w.-]+\.toml)`", before):
+                files[named.group(1)] = text
+    return files
+
+
+def test_the_files_a_page_says_to_save_are_valid_scenarios(tmp_path):
+    files = _pages_files()
+    assert {"block.toml", "slender.toml"} <= set(files)  # class.md
+    for name, text in files.items():
+        (tmp_path / name).write_text(text)
+        result = invoke("check", tmp_path / name)
+        assert result.exit_code == 0, f"{name}: {result.output}"
+
+
 def _seed(folder: Path) -> None:
     """The files the examples name, in ``folder``."""
     for name in ("block.toml", "wall.toml", "rubble.toml"):
         (folder / name).write_text(BLOCK_TOML)
+    for name, text in _pages_files().items():  # "Save this as `block.toml`:" and its TOML (class.md)
+        (folder / name).write_text(text)
     (folder / "my-arch.toml").write_text((ROOT / "tests" / "data" / "arch_settlement.toml").read_text())
     for name, structure in (("wall", "wall"), ("my-wall", "wall"), ("rubble", "wall"), ("arch", "arch")):
         assert invoke("build", structure, "--out", folder / f"{name}.geojson").exit_code == 0
@@ -137,6 +165,7 @@ def _seed(folder: Path) -> None:
         if feature["properties"]["role"] == "support":
             feature["properties"]["support_role"] = "driven"
     (folder / "arch.geojson").write_text(json.dumps(arch))
+    (folder / "my wall.toml").write_text(BLOCK_TOML)  # class.md: a name with a space, between quotes
     (folder / "recordings").mkdir()  # made by README's quick start, before its other examples
 
 

@@ -300,7 +300,7 @@ def limit_command(
     """The collapse load factor λ and mechanism of a block assembly (rigid-block limit analysis, one LP).
 
     A built-in takes the structure options of [bold]masonry build NAME[/bold]:
-    [bold]masonry limit arch --span 8 --rise 2 --ring-thickness 0.5[/bold].
+    [bold]masonry limit arch --span 4[/bold].
     """
     from masonrycli.limit.command import run_limit
 
