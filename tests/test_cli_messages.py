@@ -322,6 +322,12 @@ def test_ctrl_c_before_the_run_is_one_line_and_exit_130(monkeypatch):
         (("run", "my", "wall.toml"), 'a name with spaces goes between quotes: masonry run "my wall.toml"'),
         (("check", "C:/Users/Ana", "Silva/w.toml"), 'masonry check "C:/Users/Ana Silva/w.toml"'),
         (("inspect", "my", "runs/w.rrd"), 'masonry inspect "my runs/w.rrd"'),
+        # "wall" is whole: a record without --record (it said 'a name with spaces …: masonry run "wall quake.AT2"')
+        (
+            ("run", "wall", "quake.AT2"),
+            "(quake.AT2): masonry run takes one structure; a record goes after --record: "
+            "masonry run wall --record quake.AT2",
+        ),
         (("simulate", "wall", "--amp", "1.5", "m/s"), "(m/s): a number goes alone, without its unit"),
         (("run", "w.toml", "--duration", "1", "s"), "(s): a number goes alone, without its unit"),
     ],
@@ -333,8 +339,13 @@ def test_an_extra_word_says_what_it_likely_is(args, said):
     assert_one_line_error(result, "Got unexpected extra argument(s)", said)
 
 
-def test_an_extra_word_of_no_known_kind_keeps_the_parsers_line():
+def test_an_extra_word_of_no_known_kind_keeps_the_parsers_line(tmp_path, monkeypatch):
     from masonrycli.cli.app import app
 
     result = runner.invoke(app, ["simulate", "wall", "extra"], prog_name="masonry")
     assert_one_line_error(result, "(extra) (masonry simulate wall --help lists the options)")
+    # a file that exists is a whole name too: no guess of a space in it (it said 'check "w.toml extra.png"')
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "w.toml").write_text("")
+    result = runner.invoke(app, ["check", "w.toml", "extra.png"], prog_name="masonry")
+    assert_one_line_error(result, "(extra.png) (masonry check --help lists the options)")

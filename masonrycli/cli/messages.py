@@ -191,6 +191,7 @@ def _number_with_unit(exc) -> str | None:
     return f"{max(param.opts, key=len)} {shown}: must be {kind}{hint}"
 
 
+_RECORD_SUFFIXES = (".at2", ".csv", ".txt", ".asc", ".dat")  # what --record reads (records/read.py)
 _UNIT_WORDS = frozenset("s ms min m mm cm m/s m/s2 m/s² cm/s mm/s g gal hz Hz kg kg/m3 kg/m³ rad deg ° %".split())
 
 
@@ -207,6 +208,17 @@ def _split_word(exc, command: str) -> str | None:
         return f"{message}: a number goes alone, without its unit (the options are in SI units: {command} --help)"
     named = [p for p in exc.ctx.command.params if p.param_type_name == "argument"]
     given = exc.ctx.params.get(named[0].name) if named else None
-    if isinstance(given, (str, os.PathLike)):
-        return f'{message}: a name with spaces goes between quotes: {command} "{os.fspath(given)} {words}"'
+    if not isinstance(given, (str, os.PathLike)):
+        return None
+    from masonrycli.records.knet import KNET_SUFFIXES
+    from masonrycli.scenario.builtin import is_built_in
+
+    given = os.fspath(given)
+    joined = f"{given} {words}"
+    # "masonry run wall quake.AT2" (a record without --record): "wall" is whole, no name cut at a space
+    if os.path.exists(joined) or not (os.path.exists(given) or is_built_in(given)):
+        return f'{message}: a name with spaces goes between quotes: {command} "{joined}"'
+    record = os.path.splitext(words)[1].lower() in _RECORD_SUFFIXES or words.lower().endswith(KNET_SUFFIXES)
+    if record and " " not in words and any("--record" in p.opts for p in exc.ctx.command.params):
+        return f"{message}: {command} takes one structure; a record goes after --record: {command} {given} --record {words}"
     return None
