@@ -349,3 +349,11 @@ def test_an_extra_word_of_no_known_kind_keeps_the_parsers_line(tmp_path, monkeyp
     (tmp_path / "w.toml").write_text("")
     result = runner.invoke(app, ["check", "w.toml", "extra.png"], prog_name="masonry")
     assert_one_line_error(result, "(extra.png) (masonry check --help lists the options)")
+
+
+def test_a_value_given_to_a_flag_says_it_takes_none():
+    # --help shows "--no-recording <bool>": "--no-recording true" said only "Got unexpected extra argument(s)"
+    from masonrycli.cli.app import app
+
+    result = runner.invoke(app, ["simulate", "wall", "--no-recording", "true"], prog_name="masonry")
+    assert_one_line_error(result, "(true): an on/off option (--no-recording, --force) takes no value")

@@ -192,6 +192,7 @@ def _number_with_unit(exc) -> str | None:
 
 
 _RECORD_SUFFIXES = (".at2", ".csv", ".txt", ".asc", ".dat")  # what --record reads (records/read.py)
+_FLAG_VALUES = frozenset("true false yes no on off 1 0".split())
 _UNIT_WORDS = frozenset("s ms min m mm cm m/s m/s2 m/s² cm/s mm/s g gal hz Hz kg kg/m3 kg/m³ rad deg ° %".split())
 
 
@@ -206,6 +207,8 @@ def _split_word(exc, command: str) -> str | None:
     words = extra[1:-1]
     if words.split()[0] in _UNIT_WORDS:
         return f"{message}: a number goes alone, without its unit (the options are in SI units: {command} --help)"
+    if words.split()[0].lower() in _FLAG_VALUES:  # --help shows a flag as "--no-recording <bool>"
+        return f"{message}: an on/off option (--no-recording, --force) takes no value: give it alone, or leave it out"
     named = [p for p in exc.ctx.command.params if p.param_type_name == "argument"]
     given = exc.ctx.params.get(named[0].name) if named else None
     if not isinstance(given, (str, os.PathLike)):
