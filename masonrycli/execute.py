@@ -343,7 +343,7 @@ def print_summary(console: Console, outcome: Outcome, scenario, hint: str = "") 
     """The summary table, the optional ``hint``, and last the command that opens the recording."""
     result = outcome.result
     paths = {o.option: str(o.path) for o in outcome.written}
-    console.print(summary_table(result, paths.get("--out"), paths.get("--history")))
+    console.print(summary_table(result, paths.get("--out"), paths.get("--history"), scenario.name))
     if result is not None and result.unconverged:
         run = scenario.run
         tally = result.tally

@@ -78,3 +78,14 @@ def test_a_slow_start_on_a_terminal_says_why():
         time.sleep(0.2)
     assert slow.getvalue() == SLOW_START + "\n" and "compiles the numba kernels" in SLOW_START
     assert fast.getvalue() == "" and piped.getvalue() == ""  # quick, or not a terminal: nothing
+
+
+def test_the_summary_is_titled_with_the_scenario_not_masonry_run(tmp_path, monkeypatch):
+    # `masonry simulate arch …` ended under "masonry run — completed" (a bridge engineer's report)
+    from tests.cli_helpers import invoke
+
+    monkeypatch.chdir(tmp_path)
+    result = invoke("simulate", "arch", "--duration", "0.002", "--no-recording")
+    assert result.exit_code == 0, result.output
+    assert "masonry run —" not in result.output
+    assert "arch — completed" in result.output

@@ -91,9 +91,11 @@ SOLVER_NOTES = {
 """What the summary says after a solver's name (masonrycli.scenario.scenario.SOLVERS)."""
 
 
-def summary_table(result, recording: str | None, history: str | None) -> Table:
-    """The end-of-run table: steps, contacts, solver and its effort, penetration, energy, outputs."""
-    table = Table(title=f"masonry run — {result.status}", show_header=False, title_justify="left")
+def summary_table(result, recording: str | None, history: str | None, name: str = "") -> Table:
+    """The end-of-run table: steps, contacts, solver and its effort, penetration, energy, outputs. Its title
+    is the scenario's ``name`` and how the run ended ("wall — completed"; it said "masonry run" after a
+    ``masonry simulate`` too)."""
+    table = Table(title=f"{name or 'run'} — {result.status}", show_header=False, title_justify="left")
     table.add_column("quantity", style="bold")
     table.add_column("value")
     tally = result.tally
