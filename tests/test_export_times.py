@@ -135,9 +135,12 @@ def test_bad_lab_files_are_one_line_and_write_nothing(tmp_path):
     (tmp_path / "book.xlsx").write_bytes(b"PK\x03\x04" + bytes(100))
     assert_one_line_error(invoke("export", h, "--times", tmp_path / "book.xlsx"), "book.xlsx: a zip file (an Excel")
     assert_one_line_error(invoke("export", h, "--times", h), "h.npz: an .npz archive (a history?), not a CSV")
-    (tmp_path / "bin.csv").write_bytes(b"\xff\xfet\x00i\x00")
+    # Excel's "Unicode Text" is UTF-16: it was called "not a text file"; now named, with the fix, as a record is
+    (tmp_path / "u16.csv").write_bytes("time (s)\tx\n0\t1\n".encode("utf-16"))
+    assert_one_line_error(invoke("export", h, "--times", tmp_path / "u16.csv"), "u16.csv: a UTF-16 text file", "UTF-8")
+    (tmp_path / "bin.csv").write_bytes(b"\x89PNG\r\n\x1a\n\x00\x00")
     assert_one_line_error(invoke("export", h, "--times", tmp_path / "bin.csv"), "bin.csv: not a text file")
-    assert_one_line_error(invoke("export", h, "--times", tmp_path / "none.csv"), "none.csv: no such file")
+    assert_one_line_error(invoke("export", h, "--times", tmp_path / "none.csv"), "none.csv: cannot read: No such file")
     assert_one_line_error(invoke("export", h, "--times", tmp_path), "is a folder, not a CSV")
     lab = write_lab(tmp_path / "lab.csv", LAB_TIMES)
     assert_one_line_error(invoke("export", h, "--times", lab, "--time-column", "x"), "--time-column x: no such column")
@@ -226,3 +229,29 @@ def test_a_real_table_run_at_its_own_frame_times_is_the_plain_export(tmp_path):
     on = [0, 1, 3, 6]
     assert [lab["top ux rel (m)"][i] for i in on] == [plain["top ux rel (m)"][k] for k in (0, 3, 8, 20)]
     assert np.allclose(base, by_definition(frames, top, at), rtol=1e-12, atol=1e-18)
+
+
+def test_a_pipe_as_the_lab_file_is_refused_not_waited_on(tmp_path):
+    """A named pipe (or /dev/zero) given as --times: reading it never ended, as a record's did before it was
+    refused (records.read and lab_file now read an input file alike: records.units.input_text)."""
+    import os
+    import threading
+
+    from masonrycli.errors import InputError
+    from masonrycli.outputs.lab_file import read_lab_file
+
+    pipe = tmp_path / "lab.csv"
+    os.mkfifo(pipe)
+    said = []
+
+    def read():
+        try:
+            read_lab_file(pipe)
+        except InputError as exc:
+            said.append(str(exc))
+
+    reader = threading.Thread(target=read, daemon=True)
+    reader.start()
+    reader.join(10.0)
+    assert not reader.is_alive(), "reading the pipe did not end"
+    assert said == [f"{pipe}: cannot read: not a regular file (a device, a pipe or a socket)"]

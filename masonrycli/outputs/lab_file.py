@@ -26,7 +26,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from masonrycli.errors import InputError
-from masonrycli.records.units import record_text
+from masonrycli.records.units import decoded, input_bytes
 from masonrycli.scenario.values import shorten
 
 _TIME_NAME = re.compile(
@@ -50,23 +50,14 @@ class LabFile:
 
 
 def _text(path, shown: str) -> str:
-    """The file's text, or one line saying why it is no CSV (missing, a folder, a workbook, binary)."""
+    """The file's text, or one line saying why it is no CSV (missing, a folder, a pipe, a workbook, UTF-16)."""
     if os.path.isdir(path):
         raise InputError(f"{shown}: is a folder, not a CSV")
-    try:
-        with open(path, "rb") as fh:
-            raw = fh.read()
-    except FileNotFoundError:
-        raise InputError(f"{shown}: no such file") from None
-    except OSError as exc:
-        raise InputError(f"{shown}: cannot read: {exc.strerror or exc}") from None
+    raw = input_bytes(path, shown, "cannot read")
     if raw.startswith(b"PK\x03\x04"):  # a zip: an .xlsx workbook, or an .npz history
         what = "an .npz archive (a history?)" if b".npy" in raw[:4096] else "a zip file (an Excel workbook?)"
         raise InputError(f"{shown}: {what}, not a CSV (save the sheet as CSV: a header row, then one row a sample)")
-    try:
-        return record_text(raw)
-    except UnicodeDecodeError:
-        raise InputError(f"{shown}: not a text file (a CSV: a header row, then one row a sample)") from None
+    return decoded(raw, shown)
 
 
 def _split(line: str, separator: str) -> list[str]:

@@ -26,20 +26,17 @@ import warnings
 import numpy as np
 
 from masonrycli.errors import (
-    NOT_A_FILE,
     InputError,
     RecordWarning,
     file_kind,
     input_path,
     not_a_file,
-    not_utf8,
-    special_file,
 )
 from masonrycli.records.esm import esm_text, esm_vertical, is_esm, looks_like_esm
 from masonrycli.records.knet import is_knet, knet_text, knet_vertical
 from masonrycli.records.motion import Record, time_step_problem
 from masonrycli.records.text import NoTimeStep, TimeStepNotUsed, at2_text, csv_text, number
-from masonrycli.records.units import check_at2_header, check_csv_header, header_quantity, record_text
+from masonrycli.records.units import check_at2_header, check_csv_header, header_quantity, input_text
 from masonrycli.scenario.values import format_value, quote_string, shorten
 
 
@@ -79,23 +76,7 @@ def load_record_csv(path, display: str | None = None, time_step: float | None = 
 
 
 def _read_text(path, name: str) -> str:
-    if special_file(path):
-        raise InputError(f"{name}: cannot read record: {NOT_A_FILE}")
-    try:
-        with open(path, "rb") as fh:
-            raw = fh.read()
-    except IsADirectoryError:
-        raise InputError(f"{name}: cannot read record: is a directory") from None
-    except OSError as exc:
-        raise InputError(f"{name}: cannot read record: {exc.strerror or exc}") from None
-    try:
-        text = record_text(raw)  # UTF-8, else the Windows code page (a spreadsheet's CSV)
-    except UnicodeDecodeError as exc:
-        raise not_utf8(name, raw, exc) from None
-    if "\r" in text and text.count("\r") == text.count("\r\n"):
-        # Windows line ends: the same lines to splitlines, and chunks numpy can read (record_text)
-        text = text.replace("\r\n", "\n")
-    return text
+    return input_text(path, name, "cannot read record")
 
 
 # "NPTS=  3930, DT=   .0100 SEC" (NGA-West2) or "3930   0.0100   NPTS, DT" (older NGA files)

@@ -25,7 +25,7 @@ from __future__ import annotations
 import io
 import re
 
-from masonrycli.errors import InputError
+from masonrycli.errors import NOT_A_FILE, InputError, not_utf8, special_file
 from masonrycli.scenario.values import shorten
 
 _AT2_UNITS = re.compile(r"UNITS\s+OF\s+([^\s,;]+)", re.IGNORECASE)
@@ -146,6 +146,38 @@ def record_text(raw: bytes) -> str:
         return raw.decode("cp1252")
     except UnicodeDecodeError:
         return raw.decode("latin-1")
+
+
+def input_text(path, name: str, cannot: str) -> str:
+    """The text of an input file a user names (a record, a lab's CSV): one line, ``NAME: CANNOT: why``, for a
+    device or a pipe (reading ``/dev/zero`` or a named pipe never ended), a folder or an unreadable file; a
+    UTF-16 or binary file named as such (:func:`masonrycli.errors.not_utf8`); Windows line ends as ``\n``."""
+    return decoded(input_bytes(path, name, cannot), name)
+
+
+def input_bytes(path, name: str, cannot: str) -> bytes:
+    """The bytes of the input file at ``path`` (:func:`input_text`, undecoded)."""
+    if special_file(path):
+        raise InputError(f"{name}: {cannot}: {NOT_A_FILE}")
+    try:
+        with open(path, "rb") as fh:
+            return fh.read()
+    except IsADirectoryError:
+        raise InputError(f"{name}: {cannot}: is a directory") from None
+    except OSError as exc:
+        raise InputError(f"{name}: {cannot}: {exc.strerror or exc}") from None
+
+
+def decoded(raw: bytes, name: str) -> str:
+    """:func:`record_text` of an input's bytes, or one line (UTF-16, binary, the line of a bad byte)."""
+    try:
+        text = record_text(raw)  # UTF-8, else the Windows code page (a spreadsheet's CSV)
+    except UnicodeDecodeError as exc:
+        raise not_utf8(name, raw, exc) from None
+    if "\r" in text and text.count("\r") == text.count("\r\n"):
+        # Windows line ends: the same lines to splitlines, and chunks numpy can read (record_text)
+        text = text.replace("\r\n", "\n")
+    return text
 
 
 def csv_header(path) -> tuple[int, str] | None:
