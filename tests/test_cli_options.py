@@ -9,7 +9,7 @@ import pytest
 
 from masonrycli import __version__
 
-from cli_helpers import invoke
+from cli_helpers import invoke, runner
 
 
 def test_help_and_version():
@@ -151,3 +151,14 @@ def test_a_tilde_the_shell_left_is_the_home_folder(tmp_path, monkeypatch):
     assert invoke("build", "wall", "--out=~/runs/w.geojson").exit_code == 0
     assert sorted(p.name for p in (home / "runs").iterdir()) == ["w.geojson", "w.npz", "w.rrd"]
     assert list(work.iterdir()) == []
+
+
+@pytest.mark.parametrize("command", [("simulate", "wall"), ("run",), ("sweep",), ("limit",), ("export",)])
+def test_help_shows_no_type_on_an_on_off_option(command):
+    # "--no-recording <bool>", "--force <bool>" (typer 0.29): a class read them as taking a value, true or false
+    from masonrycli.cli.app import app
+
+    result = runner.invoke(app, [*command, "--help"], prog_name="masonry", env={"COLUMNS": "120"})
+    assert result.exit_code == 0, result.output
+    flags = [line for line in result.output.splitlines() if "--force" in line or "--no-recording" in line]
+    assert flags and not any("<bool>" in line for line in flags), flags
