@@ -70,7 +70,7 @@ def run_document(
         "",
         f"**Status:** {line}",
         "",
-        f"**Wall time:** {wall_time:.2f} s · **frames:** {frames} · "
+        f"**Run time:** {wall_time:.2f} s · **frames:** {frames} · "
         f"**dt:** {dt:g} s · **friction:** {friction:g} · "
         f"**blocks:** {blocks} · **supports:** {supports}",
         "",

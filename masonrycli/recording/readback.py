@@ -386,7 +386,7 @@ def field_frames(path: str | os.PathLike) -> dict[int, dict]:
     return out
 
 
-_RUN_CLOCK = re.compile(r"(\*\*Wall time:\*\* )[0-9.]+( s)|(\| (?:started|commit|source_digest) \| )[^|]*")
+_RUN_CLOCK = re.compile(r"(\*\*Run time:\*\* )[0-9.]+( s)|(\| (?:started|commit|source_digest) \| )[^|]*")
 """What differs between two runs of one command: the clock, and the code (two revisions compared)."""
 _RUN_CODE = re.compile(r"(, commit )[^,]*(, source )[0-9a-z ]+")
 """The code in the run document's heading (``**masonry** 0.1.0, commit f935f83, source 4583eaac5ced``)."""
