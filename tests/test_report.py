@@ -76,7 +76,7 @@ def test_a_slow_start_on_a_terminal_says_why():
         pass
     with slow_start_notice(after=0.01, stream=piped):
         time.sleep(0.2)
-    assert slow.getvalue() == SLOW_START + "\n" and "compiles the numba kernels" in SLOW_START
+    assert slow.getvalue() == SLOW_START + "\n" and "translates the solver to machine code" in SLOW_START
     assert fast.getvalue() == "" and piped.getvalue() == ""  # quick, or not a terminal: nothing
 
 

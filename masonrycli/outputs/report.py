@@ -14,9 +14,9 @@ from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
 from rich.table import Table
 from rich.text import Text
 
-SLOW_START = (
-    "starting: building the model (a first run, or the first after an update, also compiles the numba "
-    "kernels: about 20 s of CPU; later runs of a small structure start in about a second)"
+SLOW_START = (  # said "compiles the numba kernels": words a class new to Python's tools did not know
+    "starting: building the model; a first run (or the first after an update) also translates the solver "
+    "to machine code (numba), about 20 s of CPU, once: later runs of a small structure start in about a second"
 )
 
 
