@@ -185,6 +185,24 @@ def test_measures_of_agreement_against_their_closed_forms():
     assert column_unit("comment") is None
 
 
+@pytest.mark.parametrize(
+    "name, quantity, factor",
+    [  # the spellings --record reads in the same lab file's header (records/units.py), --compare did not
+        ("acc (cm/sec^2)", "acceleration", 0.01),
+        ("acc (m/s/s)", "acceleration", 1.0),
+        ("a (m s-2)", "acceleration", 1.0),
+        ("acc (ft/s2)", "acceleration", 0.3048),
+        ("v (in/s)", "velocity", 0.0254),
+        ("v (cm/sec)", "velocity", 0.01),
+        ("acc (G)", "acceleration", 9.80665),
+        ("t (ms)", None, None),  # milliseconds, not m/s
+    ],
+)
+def test_compare_reads_the_units_a_record_header_is_read_in(name, quantity, factor):
+    found = column_unit(name)
+    assert (found[1:] if found else (None, None)) == (quantity, factor)
+
+
 def test_compare_converts_the_lab_unit(tmp_path):
     h = hand_history(tmp_path / "h.npz")
     at = TIMES  # on the frames: masonry's columns exactly the formula

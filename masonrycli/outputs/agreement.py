@@ -22,13 +22,17 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from masonrycli.records.units import G_STANDARD, SCALED_UNITS, unit_key
+
 UNITS = {
+    **{unit: (kind, G_STANDARD if unit == "g" else factor) for unit, (kind, factor) in SCALED_UNITS.items()},
     "m": ("length", 1.0),
     "cm": ("length", 1e-2),
     "mm": ("length", 1e-3),
     "um": ("length", 1e-6),
     "µm": ("length", 1e-6),
     "in": ("length", 0.0254),
+    "ft": ("length", 0.3048),
     "m/s": ("velocity", 1.0),
     "cm/s": ("velocity", 1e-2),
     "mm/s": ("velocity", 1e-3),
@@ -50,7 +54,9 @@ UNITS = {
     "-": ("ratio", 1.0),
     "%": ("ratio", 1e-2),
 }
-"""Unit (as written in a column's name, lower case, ``^2`` written ``2``) → (quantity, factor to SI)."""
+"""Unit (as written in a column's name, lower case, ``^2`` written ``2``) → (quantity, factor to SI): the
+velocities and accelerations a record's header is read in (:data:`masonrycli.records.units.SCALED_UNITS`:
+in/s, ft/s², …), and lengths, angles, forces and moments."""
 
 _UNIT = re.compile(r"[\(\[]\s*([^\(\)\[\]]+?)\s*[\)\]]\s*$")
 
@@ -62,6 +68,8 @@ def column_unit(name: str) -> tuple[str, str, float] | None:
         return None
     key = re.sub(r"\s+", " ", found.group(1).lower()).replace("^2", "2").replace("**2", "2").replace("·", " ")
     key = key.replace("nm", "n m") if key in ("nm", "knm") else key
+    if key not in UNITS and ("/" in key or "-" in key):  # cm/sec^2, m/s/s, m s-2 as --record reads them; not ms
+        key = unit_key(key)
     if key not in UNITS:
         return None
     return (found.group(1), *UNITS[key])

@@ -30,10 +30,10 @@ import numpy as np
 from masonrycli.errors import InputError, RecordWarning
 from masonrycli.records.motion import time_step_problem
 from masonrycli.records.text import free_numbers
+from masonrycli.records.units import G_STANDARD
 from masonrycli.scenario.values import shorten
 
 ESM_SUFFIX = ".asc"
-G_STANDARD = 9.80665
 
 _KEY = re.compile(r"^\s*([A-Za-z][A-Za-z0-9_/^.()\-]*)\s*:(.*)$")
 # UNITS as written, lower case and without blanks -> (series, factor to m/s² or m/s)

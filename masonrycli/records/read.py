@@ -36,7 +36,7 @@ from masonrycli.records.esm import esm_text, esm_vertical, is_esm, looks_like_es
 from masonrycli.records.knet import is_knet, knet_text, knet_vertical
 from masonrycli.records.motion import Record, time_step_problem
 from masonrycli.records.text import NoTimeStep, TimeStepNotUsed, at2_text, csv_text, number
-from masonrycli.records.units import check_at2_header, check_csv_header, header_quantity, input_text
+from masonrycli.records.units import G_STANDARD, check_at2_header, check_csv_header, header_quantity, input_text
 from masonrycli.scenario.values import format_value, quote_string, shorten
 
 
@@ -134,7 +134,6 @@ def _head(text: str, n: int) -> tuple[list[str], int | None]:
     return [p.splitlines()[0] for p in parts[:n]], sum(len(p) for p in parts[:n])
 
 
-G_STANDARD = 9.80665
 """m/s² per g: .AT2 accelerations are in units of standard gravity."""
 
 

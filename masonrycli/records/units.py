@@ -100,9 +100,9 @@ _ACCELERATION = _words("acc", "accel", "accn", "accelerations?", "a_g", _ACCEL, 
 _VELOCITY = _words("vel", "velocity", "velocities", "speed", "v_g", _SPEED)
 # a displacement series was read as velocity in m/s (a header "time (s),disp (m)"), with no word
 _DISPLACEMENT = _words("disp", "displ", "displacements?")
-# units that need a scale to be SI, in their canonical spelling (:func:`_unit_key`) -> (quantity, the factor
+# units that need a scale to be SI, in their canonical spelling (:func:`unit_key`) -> (quantity, the factor
 # to m/s or m/s²)
-_SCALED = {
+SCALED_UNITS = {
     "cm/s": ("velocity", 0.01),
     "mm/s": ("velocity", 0.001),
     "g": ("acceleration", 9.81),
@@ -118,8 +118,8 @@ _SCALED = {
 _SCALED_UNIT = _words(_accel("cm|mm|in|ft"), _speed("cm|mm|in|ft"), "gal", _G_UNIT)  # m/s, m/s² are SI already
 
 
-def _unit_key(unit: str) -> str:
-    """The :data:`_SCALED` key of a unit as written: ``CM/SEC^2``, ``cm/s/s``, ``cm/s²``, ``cm s-2`` -> ``cm/s2``;
+def unit_key(unit: str) -> str:
+    """The :data:`SCALED_UNITS` key of a unit as written: ``CM/SEC^2``, ``cm/s/s``, ``cm/s²``, ``cm s-2`` -> ``cm/s2``;
     ``cm/sec``, ``cm s-1`` -> ``cm/s``; ``g``, ``gal`` as they are."""
     key = re.sub(r"\s+", "", unit.lower()).replace("sec", "s")
     length = re.fullmatch(r"(cm|mm|in|ft|m)/?s(.*)", key)
@@ -211,8 +211,9 @@ def header_quantity(path) -> str | None:
     return "acceleration" if says_acc and not says_vel else "velocity" if says_vel and not says_acc else None
 
 
-_G = 9.80665
-"""m/s² per g, exact (records.G_STANDARD): the factor a header's g converts by (9.81 is the message's round figure)."""
+G_STANDARD = 9.80665
+"""m/s² per g, exact: the factor a header's g converts by (9.81 is the message's round figure), as an .AT2
+file's and an ESM file's g."""
 
 
 def header_factor(path, quantity: str) -> tuple[str, float] | None:
@@ -222,10 +223,10 @@ def header_factor(path, quantity: str) -> tuple[str, float] | None:
     unit = _SCALED_UNIT.search(found[1]) if found else None
     if unit is None:
         return None
-    kind, factor = _SCALED[_unit_key(unit.group(1))]
+    kind, factor = SCALED_UNITS[unit_key(unit.group(1))]
     if kind != quantity:
         return None
-    return unit.group(1), _G if _unit_key(unit.group(1)) == "g" else factor
+    return unit.group(1), G_STANDARD if unit_key(unit.group(1)) == "g" else factor
 
 
 CONVERTED_AGAIN = 0.005
