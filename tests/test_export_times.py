@@ -93,6 +93,8 @@ def test_lab_files_as_spreadsheets_write_them(tmp_path):
         ("eu.csv", "# test 12\nTime [s];x (mm)\n0;1\n0,012;2\n0,03;3\n", ()),
         ("named.csv", "Zeit,x (mm)\n0,1\n0.012,2\n0.03,3\n", ("--time-column", "Zeit")),
         ("tab.csv", "time_s\tx (mm)\n0\t1\n0.012\t2\n0.03\t3\n", ()),
+        # Excel's "Text (tab-delimited)" in a decimal-comma locale: "time 0,012 is not a number"
+        ("eutab.csv", "time (s)\tx (mm)\n0\t1\n0,012\t2\n0,03\t3\n", ()),
     ]
     for name, text, extra in cases:
         (tmp_path / name).write_text(text)

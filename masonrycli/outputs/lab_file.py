@@ -7,8 +7,8 @@ and the time column as numbers in seconds:
 
 * the time column is the one whose name is ``time`` or ``t`` (any case, ``Time [s]``, ``time_ms``, ``t (ms)``),
   or the one ``--time-column`` names; its unit s (also when it names none) or ms;
-* separators: a comma; a semicolon when the header has one (its decimal commas read as points, a European
-  spreadsheet's CSV); a tab when the header has a tab and no comma. Blank lines and ``#`` lines are skipped,
+* separators: a comma; a semicolon when the header has one; a tab when the header has a tab and no comma
+  (with a semicolon or a tab, decimal commas read as points: a European spreadsheet's CSV or text file). Blank lines and ``#`` lines are skipped,
   before the header and after it;
 * every time a finite number, strictly increasing; at least one sample.
 
@@ -63,7 +63,7 @@ def _text(path, shown: str) -> str:
 def _split(line: str, separator: str) -> list[str]:
     cells = next(csv.reader([line], delimiter=separator))
     cells = [c.strip() for c in cells]
-    if separator == ";":  # decimal commas: "0,5" is 0.5
+    if separator != ",":  # decimal commas (a semicolon or tab file has no comma between cells): "0,5" is 0.5
         cells = [
             c.replace(",", ".") if re.fullmatch(r"[-+]?\d*,\d*(e[-+]?\d+)?", c, re.IGNORECASE) else c for c in cells
         ]
