@@ -90,6 +90,20 @@ def test_a_rise_beyond_the_semicircle_or_absurd_is_refused(kwargs, match):
         build_arch(**kwargs)
 
 
+def test_a_rise_leaving_a_sliver_of_a_skewback_is_refused():
+    """Rise 1.7999999 m on the default 3.6 m span: springing joints all but vertical, skewbacks 2e-8 m thick
+    (the engine hit its sweep cap at 6 steps/s). The skewback is t cos α with cos α = (R − F)/R; at the
+    largest rise the message gives, 0.1 mm or a little more."""
+    with pytest.raises(GeometryError, match=r"rise 1.7999999 m leaves skewbacks 1.9e-05 mm thick .* at most 1.7994 m"):
+        build_arch(rise=1.7999999)
+    for rise in (1.7994, 1.79):
+        a = build_arch(rise=rise)
+        radius = (1.8**2 + rise**2) / (2 * rise)
+        skew = a.blocks[34].vertices[:, 1]
+        assert skew.max() - skew.min() == pytest.approx(0.35 * (radius - rise) / radius, rel=1e-9)
+        assert skew.max() - skew.min() >= 1e-4
+
+
 def test_the_aqueduct_refuses_a_segmental_arch():
     with pytest.raises(GeometryError, match="the aqueduct's arch is semicircular"):
         AqueductSpec(rise=1.0).build()
