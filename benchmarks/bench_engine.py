@@ -30,8 +30,7 @@ sys.path.insert(0, str(ROOT))
 os.environ.setdefault("RERUN_ANALYTICS", "0")
 
 
-from masonrycli.engine import nlgs  # noqa: E402
-from masonrycli.engine import solver as solver_module  # noqa: E402
+from masonrycli.engine import dispatch  # noqa: E402
 from masonrycli.run import Simulation, simulate  # noqa: E402
 from masonrycli.scenario.motion import Constant, Sine  # noqa: E402
 from masonrycli.scenario.scenario import Material, RunConfig, scenario_from_builder  # noqa: E402
@@ -57,7 +56,7 @@ class Probe:
         self.nlgs_s = 0.0
         self.tensor_s = 0.0
         self.contact_sweeps = 0
-        self._solve = nlgs.solve
+        self._solve = dispatch.solve
 
     def install(self, sim: Simulation) -> None:
         original_solve = self._solve
@@ -70,7 +69,7 @@ class Probe:
             probe.contact_sweeps += its * count
             return its, res
 
-        solver_module.nlgs.solve = timed_solve
+        dispatch.solve = timed_solve
         original_tensors = sim.tensors.step
 
         def timed_tensors(*args):
@@ -81,7 +80,7 @@ class Probe:
         sim.tensors.step = timed_tensors
 
     def uninstall(self) -> None:
-        solver_module.nlgs.solve = self._solve
+        dispatch.solve = self._solve
 
 
 def run_once(case: str, record: bool) -> dict:

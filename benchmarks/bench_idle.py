@@ -3,8 +3,9 @@
     .venv/bin/python -m benchmarks.bench_idle [--case wall-248] [--duration 1] [--json PATH]
 
 Runs ``--case`` (benchmarks.solver_cases, the solver benchmark's trajectory) with the engine's default
-solver and, for every first-stage call of the accelerated sweep (``nlgs._nlgs_interleaved`` with
-``accelerate`` and no ``alternate``: the sweeps of every step until momentum converges or stalls), solves
+solver and, for every call of the scalar accelerated sweep (``interleaved.sweeps`` with ``accelerate`` and
+no ``alternate``: the sweeps of every step until momentum converges or stalls, its first stage run by that
+sweep rather than by the lane sweeps, and stalled.py's "momentum" resumes), solves
 the same input again with the lab copy below, which is ``momentum._nlgs_accelerated`` with counters (its
 sweeps, residual, v and r are checked equal to the engine's, bit for bit). Per visit of a contact:
 
@@ -33,7 +34,7 @@ os.environ.setdefault("RERUN_ANALYTICS", "0")
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
-from masonrycli.engine import interleaved, momentum, nlgs  # noqa: E402
+from masonrycli.engine import dispatch, interleaved, momentum  # noqa: E402
 from masonrycli.engine._jit import njit  # noqa: E402
 from masonrycli.engine.nlgs import P_WNN, P_WTN, P_WTT, _local_solve, _push, _relative_velocity  # noqa: E402
 
@@ -145,25 +146,29 @@ def measure(case: str, duration: float) -> dict:
 
     ks = np.array(KS, np.int64)
     tally = np.zeros((3 + 2 * len(KS), 3), np.int64)
-    kernel, calls = nlgs._nlgs_interleaved, [0]
+    kernel, first, calls = interleaved.sweeps, dispatch.first_stage, [0]
 
-    def counted(contact_body, pack, count, mu, tolerance, cap, v, r, status, accelerate, stall, alternate=False, **kw):
+    def counted(contact_body, pack, count, mu, tolerance, cap, v, r, status, accelerate, stall, alternate=False):
         if accelerate and not alternate:
             v2, r2, s2 = v.copy(), r.copy(), status.copy()
             out2 = _counted(contact_body, pack, count, mu, tolerance, cap, v2, r2, s2, stall, ks, tally)
-        out = kernel(contact_body, pack, count, mu, tolerance, cap, v, r, status, accelerate, stall, alternate, **kw)
+        out = kernel(contact_body, pack, count, mu, tolerance, cap, v, r, status, accelerate, stall, alternate)
         if accelerate and not alternate:
             same = out2 == out and np.array_equal(v2, v) and np.array_equal(r2[:count], r[:count])
             assert same, "the counted copy left the engine's path"
             calls[0] += 1
         return out
 
-    nlgs._nlgs_interleaved = counted
+    def scalar_first_stage(contact_body, pack, count, mu, tolerance, cap, v, r, status, stall, lanes=True):
+        # by interleaved.sweeps, which the lab copy follows
+        return first(contact_body, pack, count, mu, tolerance, cap, v, r, status, stall, False)
+
+    interleaved.sweeps, dispatch.first_stage = counted, scalar_first_stage
     try:
         scenario = make_scenario(case, duration, solver=FLOAT64)  # the float64 first stage it times
         simulate(scenario, [], sim=Simulation(scenario))
     finally:
-        nlgs._nlgs_interleaved = kernel
+        interleaved.sweeps, dispatch.first_stage = kernel, first
     visits = int(tally[0].sum())
     row = {"case": case, "duration": duration, "calls": calls[0], "visits": visits, "sweeps": int(tally[-1, 2])}
     row["by_status"] = {

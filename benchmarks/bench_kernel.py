@@ -5,8 +5,9 @@ same captured steps, and whether both give the same bits.
         [--every 10] [--rounds 5] [--json PATH]
 
 1. The working tree runs ``--case`` for ``--duration`` simulated seconds and keeps the inputs of every
-   ``--every``-th call that ``nlgs.solve`` makes to ``nlgs._nlgs_interleaved`` (the accelerated solve of
-   each step with the default solver), then the outputs the working tree gives for them.
+   ``--every``-th call that ``dispatch.solve`` makes to ``dispatch.first_stage`` (the float64 first stage of
+   each step's accelerated solve), then the outputs the working tree gives for them. A revision older than
+   engine/dispatch.py runs the same calls as ``nlgs._nlgs_interleaved``'s 11-argument form (:func:`first_stage`).
 2. Each revision (``git archive`` of its ``masonrycli``; ``--new`` defaults to the working tree) is
    timed in a fresh process of its own, with its own numba flags and a numba cache of its own (the working
    tree's own cache, as in bench_frames: :func:`worker_env`): every captured call once (compile, and the
@@ -46,31 +47,45 @@ PASSES = 3
 
 
 def capture(case: str, duration: float, every: int) -> list[tuple]:
-    """Inputs of every ``every``-th call of ``nlgs._nlgs_interleaved`` made by ``nlgs.solve`` on ``case``."""
+    """Inputs of every ``every``-th call of ``dispatch.first_stage`` made by ``dispatch.solve`` on ``case``, in
+    the 11-argument form (…, status, True, stall window) that ``nlgs._nlgs_interleaved`` took."""
     sys.path.insert(0, str(ROOT))
     from benchmarks.solver_cases import FLOAT64, make_scenario
-    from masonrycli.engine import nlgs
+    from masonrycli.engine import dispatch
     from masonrycli.run import Simulation, simulate
 
-    kernel, calls, seen = nlgs._nlgs_interleaved, [], [0]
+    kernel, calls, seen = dispatch.first_stage, [], [0]
 
-    def keep(contact_body, pack, count, *rest, **options):
-        # the 11 arguments every revision takes (the lane sweeps, which solve() asks for by lanes=True)
-        plain_form = set(options) <= {"lanes"} and options.get("lanes", True) and len(rest) == 8
-        if plain_form and seen[0] % every == 0:
-            mu, tolerance, cap, v, r, status = rest[:6]
+    def keep(contact_body, pack, count, mu, tolerance, cap, v, r, status, stall, lanes=True):
+        if lanes and seen[0] % every == 0:  # the lane sweeps, as every revision runs the first stage
             calls.append((contact_body[:count].copy(), pack[:count].copy(), count, mu, tolerance, cap)
-                         + (v.copy(), r[:count].copy(), status[:count].copy()) + tuple(rest[6:]))  # fmt: skip
-        seen[0] += plain_form
-        return kernel(contact_body, pack, count, *rest, **options)
+                         + (v.copy(), r[:count].copy(), status[:count].copy(), True, stall))  # fmt: skip
+        seen[0] += lanes
+        return kernel(contact_body, pack, count, mu, tolerance, cap, v, r, status, stall, lanes)
 
-    nlgs._nlgs_interleaved = keep
+    dispatch.first_stage = keep
     try:
         scenario = make_scenario(case, duration, solver=FLOAT64)  # the float64 first stage it times
         simulate(scenario, [], sim=Simulation(scenario))
     finally:
-        nlgs._nlgs_interleaved = kernel
+        dispatch.first_stage = kernel
     return calls
+
+
+def first_stage():
+    """The first stage of the ``masonrycli`` imported, taking a captured call's 11 arguments: dispatch.first_stage,
+    or ``nlgs._nlgs_interleaved`` in a revision older than engine/dispatch.py."""
+    try:
+        from masonrycli.engine import dispatch
+    except ImportError:
+        from masonrycli.engine import nlgs
+
+        return nlgs._nlgs_interleaved
+
+    def kernel(contact_body, pack, count, mu, tolerance, cap, v, r, status, accelerate, stall):
+        return dispatch.first_stage(contact_body, pack, count, mu, tolerance, cap, v, r, status, stall)
+
+    return kernel
 
 
 def run_calls(kernel, calls) -> tuple[list, str]:
@@ -93,12 +108,13 @@ def worker(package_root: str, capture_file: str) -> None:
     assert Path(nlgs.__file__).is_relative_to(package_root), nlgs.__file__
     with open(capture_file, "rb") as f:
         calls = pickle.load(f)
-    _, digest = run_calls(nlgs._nlgs_interleaved, calls)
+    kernel = first_stage()
+    _, digest = run_calls(kernel, calls)
     work = 0
     for contact_body, pack, count, mu, tolerance, cap, v, r, status, *rest in calls:
-        work += count * nlgs._nlgs_interleaved(contact_body, pack, count, mu, tolerance, cap, v.copy(), r.copy(),
-                                               status.copy(), *rest)[0]  # fmt: skip
-    best = min(sum(run_calls(nlgs._nlgs_interleaved, calls)[0]) for _ in range(PASSES))
+        work += count * kernel(contact_body, pack, count, mu, tolerance, cap, v.copy(), r.copy(), status.copy(),
+                               *rest)[0]  # fmt: skip
+    best = min(sum(run_calls(kernel, calls)[0]) for _ in range(PASSES))
     print(json.dumps({"cpu_s": best, "contact_sweeps": int(work), "digest": digest}))
 
 

@@ -12,8 +12,9 @@ steps unless ``--no-record``), after a 0.02 s warm-up run, with the step's launc
 their CPU time (``time.process_time``, ~0.7 µs a call on this machine):
 
 * ``before_solve`` (fused.before_solve: q_m, detection, warm start, v_free), ``prepare``
-  (nlgs.prepare_contacts), ``solve`` (nlgs.solve; within it ``solve.sweeps``, the interleaved sweep
-  kernel, and ``solve.stalled``, stalled.py's methods), ``contact_power``, ``after_solve``;
+  (nlgs.prepare_contacts), ``solve`` (dispatch.solve; within it ``solve.sweeps``, the float64 first stage
+  and the interleaved sweeps: dispatch.first_stage and interleaved.sweeps, or nlgs._nlgs_interleaved in a
+  revision before engine/dispatch.py, and ``solve.stalled``, stalled.py's methods), ``contact_power``, ``after_solve``;
 * outside the solver: ``tensors`` (TensorComputer.step), ``monitor`` (CollapseMonitor.update),
   ``frame`` (Simulation.frame, every recorded frame), ``record`` (Recorder.on_frame and close);
 * ``rest``: the run's CPU time minus all of the above (the loop, the statistics, Python between calls).
@@ -65,14 +66,19 @@ def worker(package_root: str, case: str, duration: float, record: bool) -> None:
     import numpy as np
 
     from benchmarks import bench_solver
-    from masonrycli.engine import fused, nlgs, power, stalled
+    from masonrycli.engine import fused, interleaved, nlgs, power, stalled
     from masonrycli.recording import Recorder
 
+    try:  # solve() and the first stage: engine/dispatch.py; nlgs.solve and nlgs._nlgs_interleaved before it
+        from masonrycli.engine import dispatch
+    except ImportError:
+        dispatch = nlgs
     assert Path(nlgs.__file__).is_relative_to(package_root), nlgs.__file__
     totals: dict[str, float] = {}
     for owner, name, key in (
-        (fused, "before_solve", "before_solve"), (nlgs, "prepare_contacts", "prepare"), (nlgs, "solve", "solve"),
-        (nlgs, "_nlgs_interleaved", "solve.sweeps"), (stalled, "continue_stalled", "solve.stalled"),
+        (fused, "before_solve", "before_solve"), (nlgs, "prepare_contacts", "prepare"), (dispatch, "solve", "solve"),
+        (nlgs, "_nlgs_interleaved", "solve.sweeps"), (dispatch, "first_stage", "solve.sweeps"),
+        (interleaved, "sweeps", "solve.sweeps"), (stalled, "continue_stalled", "solve.stalled"),
         (power, "contact_power", "contact_power"), (fused, "after_solve", "after_solve"),
         (Recorder, "on_frame", "record"), (Recorder, "close", "record"),
     ):  # fmt: skip

@@ -21,7 +21,7 @@ case and solver:
   times faster the default is than plain Gauss–Seidel);
 * sweeps per step (mean, max; the solver's ``iterations``, in Gauss–Seidel sweep units), unconverged steps
   (residual > tolerance or at the cap), contacts per step, ns per contact per sweep (CPU time inside
-  ``nlgs.solve`` / Σ contacts × sweeps);
+  ``dispatch.solve`` / Σ contacts × sweeps);
 * accuracy: slip of the top course and mean slip at 0.1 and 0.2 s (solver_cases.slips) against one tight
   solve of the same case in the same run — **plain** ``nlgs`` at tolerance 1e-7 m/s, cap 20000 sweeps,
   whatever the solvers compared — in % (for the arch and the aqueduct, the mean block displacement
@@ -89,6 +89,11 @@ from benchmarks.solver_reference import (  # noqa: E402
 )
 from benchmarks.solver_reference import run as run_reference  # noqa: E402
 from masonrycli.engine import nlgs  # noqa: E402
+
+try:  # the module whose solve() the Solver calls: engine/dispatch.py; nlgs.py in older revisions (bench_phases)
+    from masonrycli.engine import dispatch as solve_home  # noqa: E402
+except ImportError:
+    solve_home = nlgs
 from masonrycli.run import Simulation, simulate  # noqa: E402
 from masonrycli.scenario.scenario import SOLVERS  # noqa: E402
 
@@ -101,12 +106,12 @@ DEFAULT = SOLVERS[0]
 
 
 class _SolveTimer:
-    """Wraps nlgs.solve (as the solver module calls it) to sum CPU time and contact·sweeps."""
+    """Wraps dispatch.solve (as the solver module calls it) to sum CPU time and contact·sweeps."""
 
     def __init__(self):
         self.cpu = 0.0
         self.contact_sweeps = 0
-        self._solve = nlgs.solve
+        self._solve = solve_home.solve
 
     def __enter__(self):
         def timed(contact_body, pack, count, model, v, r, status, *tuning):
@@ -116,11 +121,11 @@ class _SolveTimer:
             self.contact_sweeps += its * count
             return its, res
 
-        nlgs.solve = timed
+        solve_home.solve = timed
         return self
 
     def __exit__(self, *exc):
-        nlgs.solve = self._solve
+        solve_home.solve = self._solve
 
 
 def run_masonry(case: str, duration: float | None, record: bool, tuning=None, **run_options) -> dict:

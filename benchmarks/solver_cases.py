@@ -48,7 +48,7 @@ for _blocks, _length in LENGTH_SERIES.items():
 
 FLOAT64 = "nlgs-accel"
 """The accelerated solver in double precision: the tools that time or instrument the float64 first stage
-(``nlgs._nlgs_interleaved``, the lane sweeps) run it by name since the default, "nlgs-accel32", starts in
+(``dispatch.first_stage``, the lane sweeps) run it by name since the default, "nlgs-accel32", starts in
 float32."""
 
 

@@ -62,7 +62,7 @@ class Model:
     max_iterations: int
     """NLGS sweep cap."""
     solver: str
-    """Contact solver (RunConfig.solver): "nlgs-accel", "nlgs-accel32" or "nlgs" (masonrycli.engine.nlgs.solve)."""
+    """Contact solver (RunConfig.solver): "nlgs-accel", "nlgs-accel32" or "nlgs" (masonrycli.engine.dispatch.solve)."""
     alert_distance: float
     """Contacts whose gap is below this are kept, m."""
     n_steps: int

@@ -18,7 +18,7 @@ from test_engine_lanes import _local_solve, _moves, _same_bits
 from test_engine_nlgs import _dense_h, _stack_problem
 
 from masonrycli.engine import _vector32 as V
-from masonrycli.engine import lane_sweeps, lane_sweeps32, momentum, nlgs
+from masonrycli.engine import dispatch, lane_sweeps, lane_sweeps32, momentum, nlgs
 from masonrycli.engine._jit import njit
 from masonrycli.engine.tuning import TUNING
 
@@ -353,7 +353,7 @@ def test_the_first_stage_ends_on_a_float64_sweep_from_the_float32_impulses(name)
     count = body.shape[0]
     model = type("M", (_Model,), {"friction": mu, "solver": "nlgs-accel32"})
     v, r, st = v0.copy(), r0.copy(), np.zeros(count, np.int8)
-    its, res = nlgs.solve(body, pack, count, model, v, r, st)
+    its, res = dispatch.solve(body, pack, count, model, v, r, st)
     # by hand: the float32 sweeps to the tolerance, then the float64 lane sweeps from their impulses
     its32, _, r32, _ = _run32(body, pack, v0, r0, mu, 1e-6, 10_000)
     v2, r2, st2 = v0.copy(), r32.copy(), np.zeros(count, np.int8)
@@ -373,7 +373,7 @@ def test_without_a_tolerance_or_float32_the_first_stage_is_the_float64_lane_swee
     for solver, tolerance in (("nlgs-accel32", 0.0), ("nlgs-accel", 1e-6)):
         model = type("M", (_Model,), {"friction": mu, "tolerance": tolerance, "max_iterations": 50, "solver": solver})
         v, r, st = v0.copy(), r0.copy(), np.zeros(count, np.int8)
-        out = nlgs.solve(body, pack, count, model, v, r, st)
+        out = dispatch.solve(body, pack, count, model, v, r, st)
         v2, r2, st2 = v0.copy(), r0.copy(), np.zeros(count, np.int8)
         ref = lane_sweeps._lane_sweeps(body, pack, count, mu, tolerance, 50, v2, r2, st2, TUNING.first_stall)
         assert out == ref and _same_bits(v, v2) and _same_bits(r, r2)
@@ -396,14 +396,14 @@ def test_solver_nlgs_accel32_is_the_float32_first_stage_and_nlgs_accel_is_not(na
     for solver, first in (("nlgs-accel32", lane_sweeps32.first_stage), ("nlgs-accel", lane_sweeps._lane_sweeps)):
         model = type("M", (_Model,), {"friction": mu, "solver": solver})
         v, r, st = v0.copy(), r0.copy(), np.zeros(count, np.int8)
-        out = nlgs.solve(body, pack, count, model, v, r, st)
+        out = dispatch.solve(body, pack, count, model, v, r, st)
         v2, r2, st2 = v0.copy(), r0.copy(), np.zeros(count, np.int8)
         ref = first(body, pack, count, mu, 1e-6, 10_000, v2, r2, st2, TUNING.first_stall)
         assert out == ref and out[1] <= 1e-6 and _same_bits(v, v2) and _same_bits(r, r2)
 
 
 def test_the_first_stage_waits_near_the_tolerance_by_the_structures_depth(monkeypatch):
-    # nlgs.solve hands lane_sweeps32.first_stage momentum.stall_near(model): 25 sweeps a block of depth, at
+    # dispatch.solve hands lane_sweeps32.first_stage momentum.stall_near(model): 25 sweeps a block of depth, at
     # least STALL_SWEEPS; first_stage's float64 part is _lane_sweeps with that window within NEAR × tol
     body, pack, v0, r0, mu = _problem("stack39")
     count = body.shape[0]
@@ -418,7 +418,7 @@ def test_the_first_stage_waits_near_the_tolerance_by_the_structures_depth(monkey
     for depth, window in ((0.0, TUNING.first_stall), (6.0, TUNING.first_stall), (64.0, 1600)):
         model = type("M", (_Model,), {"friction": mu, "solver": "nlgs-accel32", "block_depth": depth})
         assert momentum.stall_near(model) == window
-        nlgs.solve(body, pack, count, model, v0.copy(), r0.copy(), np.zeros(count, np.int8))
+        dispatch.solve(body, pack, count, model, v0.copy(), r0.copy(), np.zeros(count, np.int8))
         assert seen[-1] == window
     # by hand, on a step that stalls near its tolerance: the float32 stage, then the float64 one with both windows
     stalled = first(body, pack, count, mu, 1e-30, 5000, v0.copy(), r0.copy(), np.zeros(count, np.int8), 3, 3)

@@ -18,7 +18,7 @@ import numpy as np
 import pytest
 from test_engine_nlgs import _stack_problem
 
-from masonrycli.engine import lane_sweeps, lanes, momentum, nlgs
+from masonrycli.engine import dispatch, lane_sweeps, lanes, momentum, nlgs
 from masonrycli.engine.nlgs import STATUS_OPEN, STATUS_SLIP, STATUS_STICK
 from masonrycli.engine.tuning import TUNING
 
@@ -247,7 +247,7 @@ def test_lane_sweeps_run_to_run_and_without_contacts():
 
 
 def test_the_default_solve_starts_with_the_lane_sweeps():
-    # nlgs.solve's first stage (nlgs-accel, tolerance > 0) is the lane sweeps while Tuning.lanes, the 4-run
+    # dispatch.solve's first stage (nlgs-accel, tolerance > 0) is the lane sweeps while Tuning.lanes, the 4-run
     # scalar momentum sweep (interleaved._accelerated) without: the same converged step by both. Solver
     # "nlgs-accel": the float64 lane sweeps alone ("nlgs-accel32": test_engine_lane_sweeps32).
     body, pack, v0, r0, mu = _problem(39)
@@ -259,7 +259,7 @@ def test_the_default_solve_starts_with_the_lane_sweeps():
     out = {}
     for flag in (True, False):
         v, r, st = v0.copy(), r0.copy(), np.zeros(count, np.int8)
-        out[flag] = (*nlgs.solve(body, pack, count, Model, v, r, st, replace(TUNING, lanes=flag)), v, r)
+        out[flag] = (*dispatch.solve(body, pack, count, Model, v, r, st, replace(TUNING, lanes=flag)), v, r)
     its, res, v, r, _ = _run(body, pack, v0, r0, mu, 1e-6, 10_000)
     assert res <= 1e-6 and out[True][:2] == (its, res) and _same_bits(out[True][2], v) and _same_bits(out[True][3], r)
     assert out[False][0] != its and out[False][1] <= 1e-6  # another order, another path to the tolerance

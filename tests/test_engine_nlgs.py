@@ -178,7 +178,7 @@ def test_contact_power_matches_dense_definitions():
 def _slow_sweep(body, w_blocks, h, m_inv, v, r, mu, bias, order=None):
     """One Gauss–Seidel sweep written out with the dense H and M⁻¹ (numpy, one contact at a time, in
     ``order`` or in index order), updating the flat v and r in place; returns its RMS of |W_αα Δr_α| (m/s),
-    the stopping quantity of nlgs.solve."""
+    the stopping quantity of dispatch.solve."""
     e2 = 0.0
     for c in range(body.shape[0]) if order is None else order:
         w = w_blocks[c]
@@ -423,7 +423,7 @@ def test_momentum_carries_load_down_a_stack_in_far_fewer_sweeps():
 
 def test_an_accelerated_solve_that_stops_improving_ends_its_window_after_its_lowest_residual():
     # As for plain sweeps (test above), with the accelerated solve's own window: the solve stops
-    # ``stall_after`` sweeps after its last new low when the tolerance is out of reach, so that nlgs.solve
+    # ``stall_after`` sweeps after its last new low when the tolerance is out of reach, so that dispatch.solve
     # can go on by faces; tolerance 0 runs the cap exactly.
     body, pack, h, m_inv, w_blocks, v0, r0, mu, bias = _random_problem(1)  # wanders at ~1e-16 m/s from sweep ~170
     count = body.shape[0]

@@ -8,7 +8,7 @@ from types import SimpleNamespace
 
 import numpy as np
 
-from masonrycli.engine import bodies, faces, nlgs, stalled
+from masonrycli.engine import bodies, dispatch, faces, stalled
 from masonrycli.engine.tuning import TUNING
 from tests.test_engine_nlgs import _stack_problem
 
@@ -22,7 +22,7 @@ def _solve(problem, solver, tolerance, cap=100000, tuning=ROBIN):
     count = body.shape[0]
     model = SimpleNamespace(friction=mu, tolerance=tolerance, max_iterations=cap, solver=solver)
     v, r, status = v0.copy(), r0.copy(), np.zeros(count, dtype=np.int8)
-    its, res = nlgs.solve(body, pack, count, model, v, r, status, tuning)
+    its, res = dispatch.solve(body, pack, count, model, v, r, status, tuning)
     return v, r, its, res
 
 

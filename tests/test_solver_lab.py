@@ -12,6 +12,7 @@ from benchmarks.solver_lab.capture import SINE, capture_run, reference
 from benchmarks.solver_lab.methods import gauss_seidel
 from benchmarks.solver_lab.outcome import Context
 from benchmarks.solver_lab.problems import REF_RESIDUAL, Problem
+from masonrycli.engine import dispatch
 from masonrycli.engine import nlgs as N
 from masonrycli.run import Simulation
 from masonrycli.scenario.scenario import Material, RunConfig, scenario_from_builder
@@ -152,7 +153,7 @@ def test_linear_correction_keeps_a_solution(tmp_path):
 
 def test_accelerated_method_takes_the_engine_default_and_stops_on_the_law(tmp_path):
     # nlgs-accel is the engine's default solve: at the count it found, the lab's law residual is at the
-    # target and the impulses are those of nlgs.solve with the engine's default solver from r_warm
+    # target and the impulses are those of dispatch.solve with the engine's default solver from r_warm
     from benchmarks.solver_lab.methods import accelerated
     from masonrycli.scenario.scenario import RunConfig
 
@@ -164,7 +165,7 @@ def test_accelerated_method_takes_the_engine_default_and_stops_on_the_law(tmp_pa
     v = law.velocity_from_impulse(p, ctx.H, out.r)
     assert ctx.residual(v, out.r) <= 1e-6 and law.velocity_error(p, v) < 1e-4
     r = p.r_warm.copy()
-    N.solve(
+    dispatch.solve(
         p.body,
         ctx.pack,
         p.count,

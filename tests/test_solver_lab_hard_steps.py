@@ -44,7 +44,7 @@ def test_capture_with_constants_set_replays_under_the_same_variant(tmp_path):
 
 def test_stages_split_each_step_into_the_units_the_engine_spent(tmp_path):
     # hard stages: momentum's units, the body-order stage's calls and the round-robin's resumes add up to the
-    # units nlgs.solve spends on the step; momentum's history is one residual a sweep, ending on the residual
+    # units dispatch.solve spends on the step; momentum's history is one residual a sweep, ending on the residual
     # its own solve stopped at (the first stage re-run with caps 1, 2, …). A 1-sweep window hands steps over.
     from dataclasses import replace
 

@@ -11,7 +11,7 @@ import numpy as np
 
 from benchmarks.bench_solver import run_masonry
 from benchmarks.solver_lab import ordinary, ordinary_runs, trajectory
-from masonrycli.engine import nlgs
+from masonrycli.engine import dispatch
 from masonrycli.engine.tuning import TUNING
 
 SCALAR = replace(TUNING, lanes=False)
@@ -35,7 +35,7 @@ def test_lab_kernel_with_engine_parameters_is_the_engine(tmp_path, monkeypatch):
         model = SimpleNamespace(
             friction=s.mu, tolerance=ordinary.TOLERANCE, max_iterations=ordinary.CAP, solver="nlgs-accel"
         )
-        its_e, _ = nlgs.solve(d["body"], d["pack"], s.count, model, v_e, r_e, np.zeros(s.count, np.int8), SCALAR)
+        its_e, _ = dispatch.solve(d["body"], d["pack"], s.count, model, v_e, r_e, np.zeros(s.count, np.int8), SCALAR)
         assert its_e == its
         np.testing.assert_array_equal(v, v_e)
         o = ordinary._order("engine", d["point"], d["body"])

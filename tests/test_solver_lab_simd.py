@@ -1,6 +1,6 @@
 """The coloured SIMD sweeps of the solver lab (benchmarks/solver_lab/simd_sweep.py).
 
-References: the engine's own local solve and sweep (nlgs._local_solve, nlgs._nlgs_interleaved), the
+References: the engine's own local solve and sweep (nlgs._local_solve, dispatch.first_stage), the
 colouring's definition checked by brute force, and the tight solve the lab's capture keeps per problem.
 """
 
@@ -13,7 +13,7 @@ from test_engine_nlgs import _packed_row, _random_problem, _stack_problem
 
 from benchmarks.solver_lab import law, simd_sweep
 from benchmarks.solver_lab.outcome import Context
-from masonrycli.engine import lanes, momentum, nlgs
+from masonrycli.engine import interleaved, lanes, momentum, nlgs
 from masonrycli.engine.tuning import TUNING
 
 
@@ -102,8 +102,8 @@ def test_level_schedule_replays_the_engines_sweep_bit_for_bit(problem):
     (sweeps, residual, _), v, r = _solve(problem, "levels", tol)
     v2, r2 = problem.v_free.copy(), problem.r_warm.copy()
     s2 = np.zeros(problem.count, np.int8)
-    sweeps2, residual2 = nlgs._nlgs_interleaved(problem.body, problem.pack(), problem.count, problem.mu, tol,
-                                                200_000, v2, r2, s2, True, TUNING.first_stall, False)  # fmt: skip
+    sweeps2, residual2 = interleaved.sweeps(problem.body, problem.pack(), problem.count, problem.mu, tol,
+                                            200_000, v2, r2, s2, True, TUNING.first_stall, False)  # fmt: skip
     assert sweeps == sweeps2 and residual == residual2
     assert np.array_equal(v, v2) and np.array_equal(r, r2)
 

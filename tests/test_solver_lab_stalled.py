@@ -7,15 +7,15 @@ import numpy as np
 
 from benchmarks.solver_lab import law, stalled_steps
 from benchmarks.solver_lab.outcome import Context
-from masonrycli.engine import nlgs, stalled
+from masonrycli.engine import dispatch, stalled
 from masonrycli.engine.tuning import TUNING
 
 
 def test_capture_keeps_the_stalled_steps_and_the_table_solves_them(tmp_path, monkeypatch, capsys):
     monkeypatch.setattr(stalled_steps, "STALLED", tmp_path)
-    solve, finish = nlgs.solve, stalled.continue_stalled
+    solve, finish = dispatch.solve, stalled.continue_stalled
     steps, kept = stalled_steps._capture_case("wall-51", 0.005, replace(TUNING, first_stall=1))
-    assert (nlgs.solve, stalled.continue_stalled) == (solve, finish)  # the run's wrappers are undone
+    assert (dispatch.solve, stalled.continue_stalled) == (solve, finish)  # the run's wrappers are undone
     assert steps == 5 and kept and all((tmp_path / name).exists() for name in kept)
     stalled_steps.table(sorted(tmp_path.glob("*.npz")), repeat=1)
     out = capsys.readouterr().out

@@ -7,7 +7,7 @@
 
 The run uses the engine's default solver unless ``--solver`` says otherwise (then the problems' names end
 in ``-<solver>``): its trajectory, and its hardest step, are that solver's. The run is driven from
-outside: ``nlgs.solve`` is wrapped and the problem copied just before the solve (see ``problems.py``).
+outside: ``dispatch.solve`` is wrapped and the problem copied just before the solve (see ``problems.py``).
 Then each kept problem gets its tight reference solution and is written to ``data/<name>.npz``.
 """
 
@@ -19,7 +19,7 @@ import numpy as np
 
 from benchmarks.solver_lab import law
 from benchmarks.solver_lab.problems import DATA, REF_CAP, REF_RESIDUAL, Problem
-from masonrycli.engine import nlgs
+from masonrycli.engine import dispatch
 from masonrycli.run import Simulation
 from masonrycli.scenario.motion import Constant, Sine
 from masonrycli.scenario.scenario import Material, RunConfig, scenario_from_builder
@@ -71,7 +71,7 @@ def reference(problem: Problem) -> None:
     sweeps, chunk = 0, 500
     while True:
         v = problem.v_free.copy()
-        its, _ = nlgs.solve(problem.body, pack, c, problem.shim(0.0, chunk), v, r, status)
+        its, _ = dispatch.solve(problem.body, pack, c, problem.shim(0.0, chunk), v, r, status)
         sweeps += its
         res = float(law.law_residual(problem, pack, H, v, r).max(initial=0.0))
         if res <= REF_RESIDUAL or sweeps >= REF_CAP:
@@ -94,14 +94,14 @@ def capture_case(case: str, solver: str = DEFAULT_SOLVER) -> tuple[list[Problem]
 
 
 def capture_run(sim: Simulation, typical_step: int) -> tuple[dict[str, Problem], int]:
-    """Step ``sim`` to its end with ``nlgs.solve`` wrapped; ({"cold", "typical", "hard"} → problem, the number
+    """Step ``sim`` to its end with ``dispatch.solve`` wrapped; ({"cold", "typical", "hard"} → problem, the number
     of steps whose solve ended above its tolerance)."""
     solver, m = sim.solver, sim.model
     hist = [(np.empty(0, np.int64), np.empty((0, 2))), (np.empty(0, np.int64), np.empty((0, 2)))]
     kept: dict[str, Problem] = {}
     hard_sweeps = -1
     unconverged = 0
-    original = nlgs.solve
+    original = dispatch.solve
 
     def snapshot(count, v, r) -> Problem:
         bf = solver.buffers
@@ -152,12 +152,12 @@ def capture_run(sim: Simulation, typical_step: int) -> tuple[dict[str, Problem],
         hist[0], hist[1] = hist[1], (key[order].copy(), r[:count][order].copy())
         return its, res
 
-    nlgs.solve = hooked
+    dispatch.solve = hooked
     try:
         for _ in range(m.n_steps):
             solver.step(sim.state)
     finally:
-        nlgs.solve = original
+        dispatch.solve = original
     return kept, unconverged
 
 

@@ -13,7 +13,7 @@ costs does not depend on when the stage stopped. So a step's units under any han
 
 and a rule that decides from the stage's residual history alone can be judged offline from three
 recordings a step: ``record`` replays each kept step (``hard_steps``' capture, ``data/hard``) through
-``nlgs.solve`` and, at the hand-over, runs the stage alone for up to RECORD_UNITS sweep units with no stall
+``dispatch.solve`` and, at the hand-over, runs the stage alone for up to RECORD_UNITS sweep units with no stall
 window, keeping every sweep's residual, and then the round-robin alone (``Tuning.bodies_units = 0``). Per
 step: momentum's units and its residual at the stall, the stage's units a sweep (body-order visits / C),
 its history, the round-robin's units and residual. ``table`` evaluates rules (``RULES``) on the
@@ -32,7 +32,7 @@ from types import SimpleNamespace
 import numpy as np
 
 from benchmarks.solver_lab.hard_steps import HARD
-from masonrycli.engine import bodies, nlgs, stalled
+from masonrycli.engine import bodies, dispatch, stalled
 from masonrycli.engine.tuning import TUNING, Tuning
 
 RECORD_UNITS = 32_000
@@ -86,7 +86,7 @@ def record_step(name: str, directory=None, tuning: Tuning = TUNING) -> dict | No
 
     stalled.continue_stalled = entered
     try:
-        nlgs.solve(body, pack, count, model, v, r, status, tuning)
+        dispatch.solve(body, pack, count, model, v, r, status, tuning)
     finally:
         stalled.continue_stalled = finish
     if not out:

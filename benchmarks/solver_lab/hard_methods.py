@@ -4,7 +4,7 @@
     python -m benchmarks.solver_lab hard-methods table FILE.json [FILE.json …]
 
 The hard steps are those the hard capture kept (``data/hard``, benchmarks/solver_lab/hard_steps.py on the
-``hard`` branch: nlgs.solve's input at every step of ≥ 1000 sweep units of 12 + 12 ensemble runs of the
+``hard`` branch: dispatch.solve's input at every step of ≥ 1000 sweep units of 12 + 12 ensemble runs of the
 32- and 64-course walls, with the engine's units in ``index-<case>-c<copy>.json``). The sample
 (:func:`sample`): per case, the steps of ≥ 10 000 engine units sorted by units (largest first), every
 ``big_every``-th from the first; and of those with 2500–10 000, every ``mid_every``-th. Deterministic.
@@ -48,7 +48,7 @@ import numpy as np
 from benchmarks.solver_lab import sweep_variants as sv
 from benchmarks.solver_lab.problems import DATA
 from benchmarks.solver_lab.stalled_steps import _method as existing_method
-from masonrycli.engine import stalled
+from masonrycli.engine import dispatch, stalled
 from masonrycli.engine.tuning import TUNING
 
 HARD = DATA / "hard"
@@ -216,7 +216,7 @@ def main(args) -> None:
         table(args.files)
 
 
-# Replay: the round-robin of stalled.py with body-wise sweeps as one more method, through nlgs.solve.
+# Replay: the round-robin of stalled.py with body-wise sweeps as one more method, through dispatch.solve.
 
 
 def _round_robin(
@@ -336,11 +336,9 @@ bodies' budget in units of the others', the last round (0-based) bodies takes pa
 
 
 def replay(variants: list[str], names: list[str], out: Path) -> None:
-    """Each step of ``names`` through nlgs.solve from its warm start, stalled.continue_stalled replaced by
+    """Each step of ``names`` through dispatch.solve from its warm start, stalled.continue_stalled replaced by
     the variant's round-robin; units, residual per step to ``out``."""
     from types import SimpleNamespace
-
-    from masonrycli.engine import nlgs
 
     index = _index()
     doc = json.loads(out.read_text()) if out.exists() else {"replays": {}}
@@ -363,7 +361,7 @@ def replay(variants: list[str], names: list[str], out: Path) -> None:
                     max_iterations=int(z["cap"]),
                     solver="nlgs-accel",
                 )
-                units, residual = nlgs.solve(body, pack, count, model, v, r, status)
+                units, residual = dispatch.solve(body, pack, count, model, v, r, status)
                 res[name] = {
                     "units": int(units),
                     "residual": float(residual),

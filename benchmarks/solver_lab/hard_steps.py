@@ -7,9 +7,9 @@
     python -m benchmarks.solver_lab hard stages [--dir DIR] [--min-units 400] --out FILE.json
 
 A whole run is chaotic (an amplitude changed by 1e-6 gives another trajectory, ensemble.py), so a change of
-the stalled-step rules cannot be judged on one run; replaying the same captured steps through ``nlgs.solve``
+the stalled-step rules cannot be judged on one run; replaying the same captured steps through ``dispatch.solve``
 is deterministic. ``capture`` runs each case under the ensemble's motions (ensemble.MOTIONS, copy ``--copy``,
-ensemble.DURATION) with the engine as it is, and keeps the input nlgs.solve got at every step that took
+ensemble.DURATION) with the engine as it is, and keeps the input dispatch.solve got at every step that took
 ``--min-units`` sweep units or more (body pairs, packed rows, v_free, warm start r, status, μ, tolerance,
 cap) in ``data/hard/<case>-a<A>-f<F>-c<copy>-<step>.npz``, with the units and residual the engine spent on it
 (``index-<case>-c<copy>.json``). The per-step units of the run are printed beside the run's total so that they can be
@@ -19,9 +19,9 @@ capture describes the engine that ran it (``data/hard`` is that of 88c12c6 for h
 capture with the engine's Tuning changed as a replay variant's (``FIELD=VALUE[+…]``, kept in the index as
 ``override``): the steps of a variant's trajectory, which leaves main's at its first changed step.
 
-``replay`` solves each kept step with ``--min-units`` or more by nlgs.solve from its warm start, once per
+``replay`` solves each kept step with ``--min-units`` or more by dispatch.solve from its warm start, once per
 variant: a variant is a set of fields of the engine's Tuning (engine/tuning.py) changed for the replay
-(VARIANTS below; the old module-constant names of LEGACY still accepted), handed to nlgs.solve. Per step: units, converged, and the method that finished it
+(VARIANTS below; the old module-constant names of LEGACY still accepted), handed to dispatch.solve. Per step: units, converged, and the method that finished it
 (the last one stalled.py resumed; "momentum0" for momentum's own first solve, "bodies" for stalled.py's
 body-order stage ahead of its round-robin). ``table`` prints, per
 variant: total units, steps converged, steps above 10 000 units, ratio to the first file's total, and
@@ -43,7 +43,7 @@ from types import SimpleNamespace
 import numpy as np
 
 from benchmarks.solver_lab.problems import DATA
-from masonrycli.engine import bodies, nlgs, stalled
+from masonrycli.engine import bodies, dispatch, stalled
 from masonrycli.engine.tuning import TUNING, Tuning
 
 HARD = DATA / "hard"
@@ -152,7 +152,7 @@ def _capture_run(case, motion, copy, min_units, duration, directory, solver, tun
         builder, options, RunConfig(duration=duration, solver=solver), Material(), {"ground": ground}
     )
     sim = Simulation(scenario, tuning=tuning)
-    solve = nlgs.solve
+    solve = dispatch.solve
     step, kept, units = [0], {}, []
 
     def watched(contact_body, pack, count, model, v, r, status, tuning=TUNING):
@@ -173,13 +173,13 @@ def _capture_run(case, motion, copy, min_units, duration, directory, solver, tun
             kept[name].update(params, contacts=int(count), bodies=int(v.shape[0]), solver=model.solver)
         return out
 
-    nlgs.solve = watched
+    dispatch.solve = watched
     try:
         for _ in range(sim.model.n_steps):
             units.append(int(sim.step().iterations))
             step[0] += 1
     finally:
-        nlgs.solve = solve
+        dispatch.solve = solve
     return kept, units
 
 
@@ -190,7 +190,7 @@ def tuning_of(overrides: dict[str, object]) -> Tuning:
 
 
 def _model(z) -> SimpleNamespace:
-    """The model fields nlgs.solve reads, as the step was captured: μ, tolerance, cap, solver and the
+    """The model fields dispatch.solve reads, as the step was captured: μ, tolerance, cap, solver and the
     structure's depth (sets captured before 28 Nov carry no solver: ``nlgs-accel``; none before the depth: 0,
     the plain stall window)."""
     return SimpleNamespace(
@@ -201,7 +201,7 @@ def _model(z) -> SimpleNamespace:
 
 
 def replay_step(name: str, directory=None, tuning: Tuning = TUNING) -> dict:
-    """One kept step through nlgs.solve with ``tuning`` from its warm start: units, residual, the method that
+    """One kept step through dispatch.solve with ``tuning`` from its warm start: units, residual, the method that
     finished."""
     z = np.load((directory or HARD) / f"{name}.npz")
     body, pack, count = z["body"].astype(np.int32), z["pack"], z["body"].shape[0]
@@ -225,7 +225,7 @@ def replay_step(name: str, directory=None, tuning: Tuning = TUNING) -> dict:
     stalled._resume, stalled.continue_stalled = logged, entered
     try:
         t = time.process_time()
-        units, residual = nlgs.solve(body, pack, count, model, v, r, status, tuning)
+        units, residual = dispatch.solve(body, pack, count, model, v, r, status, tuning)
         cpu = time.process_time() - t
     finally:
         stalled._resume, stalled.continue_stalled = resume, finish
@@ -362,7 +362,9 @@ def stage_split(name: str, directory=None, tuning: Tuning = TUNING) -> dict:
     bodies.body_order_sweeps, stalled._resume = recorded, logged
     try:
         v, r, st = z["v_free"].copy(), z["r_warm"].copy(), z["status"].copy()
-        out["units"], out["residual"] = (float(x) for x in nlgs.solve(body, pack, count, _model(z), v, r, st, tuning))
+        out["units"], out["residual"] = (
+            float(x) for x in dispatch.solve(body, pack, count, _model(z), v, r, st, tuning)
+        )
     finally:
         bodies.body_order_sweeps, stalled._resume = order, resume
     for part, hist in [(out["momentum"], h)] + [(c, c["history"]) for c in calls]:

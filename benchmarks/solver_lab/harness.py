@@ -25,7 +25,7 @@ from benchmarks.solver_lab import law
 from benchmarks.solver_lab.methods import gauss_seidel
 from benchmarks.solver_lab.outcome import Context
 from benchmarks.solver_lab.problems import load_all
-from masonrycli.engine import nlgs
+from masonrycli.engine import dispatch
 
 METHODS = dict(gauss_seidel.METHODS)
 DEFAULT_METHODS = [
@@ -97,7 +97,9 @@ def sweep_seconds(ctx: Context, repeat: int, n: int = 200) -> dict[str, float]:
         for solver in best:
             r, v = p.r_warm.copy(), p.v_free.copy()
             t = time.process_time()
-            done, _ = nlgs.solve(p.body, ctx.pack, p.count, p.shim(0.0, n, solver), v, r, np.zeros(p.count, np.int8))
+            done, _ = dispatch.solve(
+                p.body, ctx.pack, p.count, p.shim(0.0, n, solver), v, r, np.zeros(p.count, np.int8)
+            )
             best[solver] = min(best[solver], (time.process_time() - t) / max(done, 1))
     return best
 

@@ -4,14 +4,14 @@
 
 On each ordinary step (momentum converged it without stalling) of a trajectory sample (``trajectory.py``),
 from the step's warm start: ``ipm-newton`` (methods/ipm.py) until the lab's RMS law residual ≤ LOOSE, then
-the engine's accelerated sweeps (``nlgs._nlgs_interleaved``, stall window 500, cap 20 000 — as
+the engine's accelerated sweeps (``dispatch.first_stage``, stall window 500, cap 20 000 — as
 newton_ordinary.py) to the engine's test (in-sweep RMS ≤ 1e-5 m/s). Against momentum alone from the same
 warm start (the engine; its sweeps equal the run's on ordinary steps). Reported per LOOSE: IPM iterations
 and closing sweeps (sum, mean, median, largest), steps whose closing sweeps stalled, and the CPU time of the
 IPM part and of the closing sweeps over momentum's (one timed pass after an untimed one; the operators'
 one-off numpy setup is left out as in ipm.py).
 
-A trajectory step stores the contacts as the engine's ``nlgs.solve`` got them (``pack``), not the geometry,
+A trajectory step stores the contacts as the engine's ``dispatch.solve`` got them (``pack``), not the geometry,
 so the lab's Problem is rebuilt from the pack: masses and inertias from its per-contact inverse masses
 (P_IMA…); no reference velocity (v_ref = v_free, unused: the table reports counts and CPU only).
 """

@@ -6,7 +6,7 @@
 Every ordinary step of ``data/trajectory/SAMPLE`` (the engine's momentum converged it without stalling) is
 solved from its warm start by
 
-    engine           the engine's accelerated solve (``nlgs._nlgs_interleaved``, momentum alone, its in-sweep
+    engine           the engine's accelerated solve (``dispatch.first_stage``, momentum alone, its in-sweep
                      test at 1e-5 m/s): the run's sweep counts
     pointwise-accel  methods/joint.py's kernel, one point per joint: momentum on point sweeps in detection
                      order, stopped when the lab's law residual of the iterate (law.py) ≤ 1e-5 m/s
@@ -31,7 +31,7 @@ import numpy as np
 from benchmarks.solver_lab.methods import joint
 from benchmarks.solver_lab.newton_ordinary import Step
 from benchmarks.solver_lab.trajectory import TRAJECTORY
-from masonrycli.engine import nlgs
+from masonrycli.engine import dispatch
 
 TOLERANCE = 1e-5
 CAP = 20_000
@@ -47,7 +47,7 @@ def _engine(s: Step, n: int | None = None):
     """The engine's momentum from the warm start (n: exactly n sweeps, else to its own test): (sweeps, v)."""
     v, r, status = s.v_free.copy(), s.r_warm.copy(), np.zeros(s.count, np.int8)
     tol = 0.0 if n is not None else TOLERANCE
-    its, _ = nlgs._nlgs_interleaved(s.body, s.pack, s.count, s.mu, tol, n or CAP, v, r, status, True, CAP)
+    its, _ = dispatch.first_stage(s.body, s.pack, s.count, s.mu, tol, n or CAP, v, r, status, CAP)
     return int(its), v
 
 

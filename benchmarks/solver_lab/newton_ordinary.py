@@ -5,7 +5,7 @@
 
 On the ordinary steps of a trajectory sample (``trajectory.py``: the engine's momentum converged them
 without stalling), from each step's warm start, every variant ends on the engine's accelerated sweeps
-(``nlgs._nlgs_interleaved``, stall window 500, cap 20 000) until the engine's stopping test (in-sweep RMS
+(``dispatch.first_stage``, stall window 500, cap 20 000) until the engine's stopping test (in-sweep RMS
 residual ≤ 1e-5 m/s) holds: what a variant adds must make those sweeps fewer than momentum's alone. Units:
 sweeps, plus ``newton.NEWTON_UNITS`` (60) per Newton direction; oracle variants count their sweeps only.
 
@@ -47,7 +47,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spl
 
 from benchmarks.solver_lab.trajectory import TRAJECTORY
-from masonrycli.engine import newton, nlgs
+from masonrycli.engine import dispatch, newton, nlgs
 from masonrycli.engine.nlgs import P_BIAS, P_IIA, P_IIB, P_IMA, P_IMB, P_WNN, P_WTT
 
 TOLERANCE = 1e-5
@@ -95,9 +95,7 @@ class Step:
     def sweeps(self, r0, cap=CAP, stall=STALL, tolerance=TOLERANCE):
         """The engine's accelerated sweeps from impulses r0: (sweeps, residual, v, r, status)."""
         v, r, status = self.v_free.copy(), r0.copy(), np.zeros(self.count, np.int8)
-        its, res = nlgs._nlgs_interleaved(
-            self.body, self.pack, self.count, self.mu, tolerance, cap, v, r, status, True, stall
-        )
+        its, res = dispatch.first_stage(self.body, self.pack, self.count, self.mu, tolerance, cap, v, r, status, stall)
         return its, res, v, r, status
 
     def velocity(self, r):

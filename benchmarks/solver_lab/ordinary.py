@@ -253,7 +253,7 @@ def _accelerated(
 
 
 def _interleave(count: int) -> np.ndarray:
-    """The engine's visiting order (nlgs._nlgs_interleaved)."""
+    """The engine's visiting order (dispatch.first_stage)."""
     k = nlgs.INTERLEAVE
     run = (count + k - 1) // k
     return np.array([q * run + j for j in range(run) for q in range(k) if q * run + j < count], dtype=np.int64)

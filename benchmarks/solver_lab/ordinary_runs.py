@@ -5,10 +5,10 @@ warm starts follow.
 
 A kept step (``ordinary.py``) starts from the warm start of the engine's own run; a variant that stops its
 steps at another iterate hands the next step another warm start, and moves the trajectory. So each variant
-also runs the whole case: ``nlgs.solve`` is replaced by the lab kernel of ``ordinary.py`` with the variant's
+also runs the whole case: ``dispatch.solve`` is replaced by the lab kernel of ``ordinary.py`` with the variant's
 parameters on the engine's interleaved order (the engine's parameters give the engine's run, checked by
 the "engine" row), and a step it leaves stalled goes on by the engine's ``stalled.continue_stalled`` as in
-``nlgs.solve``. Reported: total sweep units, mean and max per step, unconverged steps, and the top-course /
+``dispatch.solve``. Reported: total sweep units, mean and max per step, unconverged steps, and the top-course /
 mean slip at 0.1 and 0.2 s against the tight solve of ``bench_solver`` (plain NLGS at 1e-7 m/s, cap 20 000;
 computed once and kept in ``data/trajectory/<case>/tight.json``).
 """
@@ -23,7 +23,7 @@ from benchmarks.bench_solver import TIGHT, errors_pct, run_masonry
 from benchmarks.solver_lab.capture import _align
 from benchmarks.solver_lab.ordinary import ENGINE, STALL, VARIANTS, _accelerated, _interleave, kernel_args
 from benchmarks.solver_lab.trajectory import TRAJECTORY
-from masonrycli.engine import nlgs, stalled
+from masonrycli.engine import dispatch, stalled
 from masonrycli.engine.tuning import TUNING
 
 
@@ -40,7 +40,7 @@ def _tight(case: str, duration: float) -> dict:
 def run_variant(case: str, params: dict, duration: float) -> dict:
     """One whole run of ``case`` with the first stage of every step replaced by the lab kernel (module doc)."""
     q = ENGINE | params
-    original = nlgs.solve
+    original = dispatch.solve
     hist = [(np.empty(0, np.int64), np.empty((0, 2)))] * 2
     sims = []
 
@@ -64,7 +64,7 @@ def run_variant(case: str, params: dict, duration: float) -> dict:
         its, res = _accelerated(body, pk, count, mu, tol, cap, v, r_o, st_o, STALL, *kernel_args(params), np.zeros(0))
         r[o] = r_o
         status[o] = st_o
-        if res > model.tolerance and its < model.max_iterations:  # stalled: as nlgs.solve
+        if res > model.tolerance and its < model.max_iterations:  # stalled: as dispatch.solve
             its, res = stalled.continue_stalled(
                 contact_body,
                 pack,
@@ -97,11 +97,11 @@ def run_variant(case: str, params: dict, duration: float) -> dict:
         return sim
 
     bench_solver.Simulation = catching
-    nlgs.solve = solve
+    dispatch.solve = solve
     try:
         return run_masonry(case, duration, record=False)
     finally:
-        nlgs.solve = original
+        dispatch.solve = original
         bench_solver.Simulation = made
 
 

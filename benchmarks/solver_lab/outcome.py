@@ -8,7 +8,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from benchmarks.solver_lab import law
-from masonrycli.engine import nlgs
+from masonrycli.engine import dispatch
 
 
 @dataclass
@@ -70,7 +70,7 @@ class Context:
         p = self.p
         v = p.v_free.copy()
         status = np.zeros(p.count, dtype=np.int8)
-        nlgs.solve(p.body, self.pack, p.count, p.shim(0.0, n, solver=solver), v, r, status)
+        dispatch.solve(p.body, self.pack, p.count, p.shim(0.0, n, solver=solver), v, r, status)
         return v, status
 
     def residual(self, v: np.ndarray, r: np.ndarray) -> float:

@@ -1,7 +1,7 @@
 """Per-step contact problems captured from real runs, stored compactly, with a tight reference solution.
 
 A problem is everything that defines one step's NLGS input, taken from OUTSIDE the engine: the engine's
-``nlgs.solve`` launcher is wrapped while a :class:`~masonrycli.run.Simulation` steps, and just before the
+``dispatch.solve`` launcher is wrapped while a :class:`~masonrycli.run.Simulation` steps, and just before the
 solve we copy
 
     contacts:  body pair (a < b), point, unit normal a → b, gap g_m, stable key

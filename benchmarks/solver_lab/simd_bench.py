@@ -6,8 +6,8 @@
     python -m benchmarks.solver_lab.simd_bench --whole-run [--case wall-248] [--duration 1] [--rounds 3]
         [--ensemble OUT [--copies 2]]
 
-The steps: the inputs of every ``--every``-th accelerated first-stage call that ``nlgs.solve`` makes on
-``--case`` (bench_kernel.capture). On each, the engine's ``nlgs._nlgs_interleaved`` (momentum; the lane
+The steps: the inputs of every ``--every``-th accelerated first-stage call that ``dispatch.solve`` makes on
+``--case`` (bench_kernel.capture). On each, the engine's ``dispatch.first_stage`` (momentum; the lane
 sweeps while ``Tuning.lanes``, the default, else the 4-run interleaved order) and each coloured variant run
 from the same inputs to the engine's tolerance, stall window 200.
 Timing: ``--rounds`` rounds, each running the engine and then every variant over all steps (the order
@@ -34,7 +34,7 @@ import numpy as np
 
 from benchmarks.bench_kernel import capture
 from benchmarks.solver_lab import simd_sweep
-from masonrycli.engine import nlgs
+from masonrycli.engine import dispatch, interleaved, nlgs
 from masonrycli.engine.tuning import TUNING
 
 TIGHT = 1e-9
@@ -44,8 +44,7 @@ TIGHT_CAP = 50_000
 def _engine(call):
     contact_body, pack, count, mu, tolerance, cap, v, r, status, accelerate, stall = call
     v, r, status = v.copy(), r.copy(), status.copy()
-    sweeps, residual = nlgs._nlgs_interleaved(contact_body, pack, count, mu, tolerance, cap, v, r, status,
-                                              accelerate, stall)  # fmt: skip
+    sweeps, residual = dispatch.first_stage(contact_body, pack, count, mu, tolerance, cap, v, r, status, stall)
     return sweeps, residual, v
 
 
@@ -62,12 +61,11 @@ def _tight(call):
     # still misses it. Returns (v, residual).
     contact_body, pack, count, mu, tolerance, cap, v, r, status, accelerate, stall = call
     v1, r1, s1 = v.copy(), r.copy(), status.copy()
-    _, residual = nlgs._nlgs_interleaved(contact_body, pack, count, mu, TIGHT, TIGHT_CAP, v1, r1, s1, True,
-                                         TIGHT_CAP)  # fmt: skip
+    _, residual = dispatch.first_stage(contact_body, pack, count, mu, TIGHT, TIGHT_CAP, v1, r1, s1, TIGHT_CAP)
     if residual > TIGHT:
         v2, r2, s2 = v.copy(), r.copy(), status.copy()
-        _, res2 = nlgs._nlgs_interleaved(contact_body, pack, count, mu, TIGHT, TIGHT_CAP, v2, r2, s2, False,
-                                         nlgs.STALL_SWEEPS)  # fmt: skip
+        _, res2 = interleaved.sweeps(contact_body, pack, count, mu, TIGHT, TIGHT_CAP, v2, r2, s2, False,
+                                     nlgs.STALL_SWEEPS)  # fmt: skip
         if res2 < residual:
             v1, residual = v2, res2
     return v1, residual
@@ -130,42 +128,32 @@ def run(case, duration, every, rounds, variants, reference):
 
 @contextlib.contextmanager
 def first_stage_timed():
-    """While open, ``nlgs.solve``'s first stage (its first call of ``_nlgs_interleaved``: momentum to the stall
+    """While open, ``dispatch.solve``'s float64 first stage (``dispatch.first_stage``: momentum to the stall
     window) is timed: the engine's lane sweeps (engine/lane_sweeps.py, the default) or, with the runs'
     Tuning.lanes False, the 4-run scalar sweep (interleaved._accelerated, the default before them); stalled
     steps go on by stalled.py either way. Yields a tally: first-stage CPU s and sweeps, steps handed to
     stalled.py."""
     from masonrycli.engine import stalled
 
-    kernel, solve, cont = nlgs._nlgs_interleaved, nlgs.solve, stalled.continue_stalled
-    first, tally = [False], {"first_cpu": 0.0, "first_sweeps": 0, "stalled": 0}
+    kernel, cont = dispatch.first_stage, stalled.continue_stalled
+    tally = {"first_cpu": 0.0, "first_sweeps": 0, "stalled": 0}
 
-    def first_stage(contact_body, pack, count, mu, tolerance, cap, v, r, status, accelerate, stall, *rest, **kw):
-        if not (first[0] and accelerate and not rest):
-            return kernel(contact_body, pack, count, mu, tolerance, cap, v, r, status, accelerate, stall, *rest, **kw)
-        first[0] = False
+    def first_stage(*args, **kw):  # dispatch.solve calls it once a step, for the first stage alone
         t = time.process_time()
-        out = kernel(contact_body, pack, count, mu, tolerance, cap, v, r, status, accelerate, stall, **kw)
+        out = kernel(*args, **kw)
         tally["first_cpu"] += time.process_time() - t
         tally["first_sweeps"] += out[0]
         return out
-
-    def solve_first(*args):
-        first[0] = True
-        try:
-            return solve(*args)
-        finally:
-            first[0] = False
 
     def counted(*args):
         tally["stalled"] += 1
         return cont(*args)
 
-    nlgs._nlgs_interleaved, nlgs.solve, stalled.continue_stalled = first_stage, solve_first, counted
+    dispatch.first_stage, stalled.continue_stalled = first_stage, counted
     try:
         yield tally
     finally:
-        nlgs._nlgs_interleaved, nlgs.solve, stalled.continue_stalled = kernel, solve, cont
+        dispatch.first_stage, stalled.continue_stalled = kernel, cont
 
 
 def whole_runs(case, duration, rounds):

@@ -222,5 +222,5 @@ def block_sweeps(contact_body, pack, count, mu, tolerance, max_iterations, v, v_
 
 
 def solve(contact_body, pack, count, mu, tolerance, cap, v, r, status, stall_after=TUNING.first_stall):
-    """The block-coloured first stage on one step's arrays (as nlgs._nlgs_interleaved takes them)."""
+    """The block-coloured first stage on one step's arrays (as dispatch.first_stage takes them)."""
     return block_sweeps(contact_body, pack, count, mu, tolerance, cap, v, v.reshape(-1), r, status, stall_after)

@@ -406,7 +406,7 @@ def _engine_lanes(contact_body, pack, count, mu, tolerance, cap, v, r, status, s
 
 
 def solve(contact_body, pack, count, mu, tolerance, cap, v, r, status, stall_after=TUNING.first_stall, variant="split"):
-    """The coloured first stage on one step's arrays (as nlgs._nlgs_interleaved takes them).
+    """The coloured first stage on one step's arrays (as dispatch.first_stage takes them).
     Returns (iterations, residual, colours). Variant "blocks": simd_blocks.py's layout in 8-contact blocks;
     "lanes+vec": the engine's lane sweeps (engine/lane_sweeps.py, the default's first stage; the lab's
     explicit-vector prototype, simd_lanes.py, became them), the lane groups' visits (sub-groups of a

@@ -4,13 +4,13 @@
     python -m benchmarks.solver_lab stalled table
 
 ``capture`` runs each case of :mod:`benchmarks.solver_cases` with the default solver and keeps the input
-of every step that :mod:`masonrycli.engine.stalled` had to finish (nlgs.solve's arguments as the engine
+of every step that :mod:`masonrycli.engine.stalled` had to finish (dispatch.solve's arguments as the engine
 passed them: body pairs, packed rows, v_free, warm start), in ``data/stalled/<case>-<step>.npz``.
-``table`` solves each kept step from its warm start with the engine's ``nlgs.solve`` and with each
+``table`` solves each kept step from its warm start with the engine's ``dispatch.solve`` and with each
 method alone, to the engine's tolerance and cap, and prints sweep units, CPU ms (minimum of --repeat) and
 whether the tolerance was met:
 
-    engine        nlgs.solve as shipped (momentum, then stalled.py's round-robin)
+    engine        dispatch.solve as shipped (momentum, then stalled.py's round-robin)
     turning       accelerated sweeps whose direction turns at every restart, no stall window
     momentum      accelerated sweeps with no stall window
     alternating   plain sweeps, every second one in reverse order (10 000-sweep stall window)
@@ -35,7 +35,7 @@ import numpy as np
 
 from benchmarks.solver_cases import make_scenario
 from benchmarks.solver_lab.problems import DATA, Problem
-from masonrycli.engine import faces, nlgs, stalled
+from masonrycli.engine import dispatch, faces, interleaved, nlgs, stalled
 from masonrycli.engine.tuning import TUNING, Tuning
 from masonrycli.run import Simulation, simulate
 
@@ -53,7 +53,7 @@ def capture(cases: list[str], duration: float, tuning: Tuning = TUNING) -> None:
 
 
 def _capture_case(case: str, duration: float, tuning: Tuning = TUNING) -> tuple[int, list[str]]:
-    solve, finish = nlgs.solve, stalled.continue_stalled
+    solve, finish = dispatch.solve, stalled.continue_stalled
     step, pending, kept = [0], {}, []
 
     def watched(contact_body, pack, count, model, v, r, status, tuning=TUNING):
@@ -71,12 +71,12 @@ def _capture_case(case: str, duration: float, tuning: Tuning = TUNING) -> tuple[
         pending["stalled"] = True
         return finish(*args)
 
-    nlgs.solve, stalled.continue_stalled = watched, marked
+    dispatch.solve, stalled.continue_stalled = watched, marked
     try:
         sc = make_scenario(case, duration)
         simulate(sc, [], sim=Simulation(sc, tuning=tuning))
     finally:
-        nlgs.solve, stalled.continue_stalled = solve, finish
+        dispatch.solve, stalled.continue_stalled = solve, finish
     return step[0], kept
 
 
@@ -84,15 +84,15 @@ def _method(name, p, v, r, status, cap=CAP):
     body, pack, mu, count = p["body"], p["pack"], float(p["mu"]), p["body"].shape[0]
     if name == "engine":
         model = SimpleNamespace(friction=mu, tolerance=TOLERANCE, max_iterations=cap, solver="nlgs-accel")
-        return nlgs.solve(body, pack, count, model, v, r, status)
+        return dispatch.solve(body, pack, count, model, v, r, status)
     if name == "faces":
-        its, res = nlgs._nlgs_interleaved(body, pack, count, mu, TOLERANCE, cap, v, r, status, True, TUNING.first_stall)
+        its, res = dispatch.first_stage(body, pack, count, mu, TOLERANCE, cap, v, r, status, TUNING.first_stall)
         if res <= TOLERANCE:
             return its, res
         units, res = faces.face_sweeps(body, pack, count, mu, TOLERANCE, cap - its, v, r, status)
         return its + units, res
     if name == "plain":
-        return nlgs._nlgs_interleaved(body, pack, count, mu, TOLERANCE, cap, v, r, status, False, cap)
+        return interleaved.sweeps(body, pack, count, mu, TOLERANCE, cap, v, r, status, False, cap)
     # turning, momentum, alternating, newton: stalled.py's own resume, from the warm start, with the whole cap
     state = stalled._State(None, r, status, np.inf)
     its = stalled._resume(name, state, body, pack, count, mu, TOLERANCE, cap, v.copy(), cap, TUNING)

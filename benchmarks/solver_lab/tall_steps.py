@@ -9,7 +9,7 @@ of the first 0.2 s, at cbefb3a: the steps whose momentum stalled then) and in ``
 ``hard-paper-h64`` (hard_steps.py's capture of the benchmark's trajectory, the paper's 1 m/s 2 Hz shake, 0.2 s,
 steps of ≥ 2500 units, at df779f6). Each is solved from its warm start:
 
-    engine            nlgs.solve as it runs today (momentum, stalled.py's body-order stage, round-robin),
+    engine            dispatch.solve as it runs today (momentum, stalled.py's body-order stage, round-robin),
                       tolerance 1e-5 m/s, cap 100 000 units; its own unit count
     ipm-pred          methods/ipm_shift.py's: 100 accelerated sweeps, s frozen at μ|u_t| of their velocities,
                       one frozen-shift IPM (ipm.run_ipm "frozen"), then accelerated sweeps to the tolerance
@@ -44,7 +44,7 @@ from benchmarks.solver_lab.methods import cpg, ipm, ipm_shift
 from benchmarks.solver_lab.outcome import Clock, Context
 from benchmarks.solver_lab.problems import DATA
 from benchmarks.solver_lab.stalled_steps import as_problem
-from masonrycli.engine import bodies, nlgs
+from masonrycli.engine import bodies, dispatch
 from masonrycli.engine.tuning import TUNING
 
 TOLERANCE, ENGINE_CAP, CAP = 1e-5, 100_000, 50_000
@@ -81,7 +81,7 @@ def engine(z) -> dict:
         friction=float(z["mu"]), tolerance=TOLERANCE, max_iterations=ENGINE_CAP, solver="nlgs-accel"
     )
     t = time.process_time()
-    units, res = nlgs.solve(body, pack, count, model, v, r, status)
+    units, res = dispatch.solve(body, pack, count, model, v, r, status)
     return {"units": int(units), "residual": float(res), "cpu_s": time.process_time() - t, "v": v, "r": r}
 
 
@@ -119,7 +119,7 @@ def _closing(ctx, r, budget, body_order=False) -> tuple[int, float, np.ndarray]:
             p.body, ctx.pack, p.count, p.mu, TOLERANCE, budget, v, r, status, TUNING.bodies_stall
         )
     else:
-        n, res = nlgs._nlgs_interleaved(p.body, ctx.pack, p.count, p.mu, TOLERANCE, budget, v, r, status, True, budget)
+        n, res = dispatch.first_stage(p.body, ctx.pack, p.count, p.mu, TOLERANCE, budget, v, r, status, budget)
     return int(n), float(res), v
 
 

@@ -3,10 +3,10 @@
     python -m benchmarks.solver_lab trajectory --case wall-248 [--every 5] [--duration 1] [--name DIR]
 
 Runs a case of :mod:`benchmarks.solver_cases` with the engine's default solver and, from outside the
-engine (``nlgs.solve`` wrapped, as ``capture.py``), keeps the input of every ``every``-th step in
+engine (``dispatch.solve`` wrapped, as ``capture.py``), keeps the input of every ``every``-th step in
 ``data/trajectory/<case>/step-NNNN.npz`` (``--name``: another directory than the case's):
 
-    body (C, 2), pack (C, PACK_WIDTH)   the contacts as nlgs.solve got them
+    body (C, 2), pack (C, PACK_WIDTH)   the contacts as dispatch.solve got them
     v_free (B, 3), r_warm (C, 2), mu    the step's free velocities, warm start, friction
     r_prev2 (C, 2), has_prev2 (C,)      the impulses of the step before the warm start's, by contact key
                                         (0 / False where the contact did not exist then): for predictions
@@ -28,7 +28,7 @@ import numpy as np
 from benchmarks.solver_cases import make_scenario
 from benchmarks.solver_lab.capture import _align
 from benchmarks.solver_lab.problems import DATA
-from masonrycli.engine import nlgs, stalled
+from masonrycli.engine import dispatch, stalled
 from masonrycli.engine.tuning import TUNING, Tuning
 from masonrycli.run import Simulation
 
@@ -44,7 +44,7 @@ def capture(case: str, every: int, duration: float | None, name: str | None = No
         old.unlink()
     sim = Simulation(make_scenario(case, duration), tuning=tuning)
     solver = sim.solver
-    solve, finish = nlgs.solve, stalled.continue_stalled
+    solve, finish = dispatch.solve, stalled.continue_stalled
     # The sorted keys and impulses of the last two steps: hist[1] the warm start's step, hist[0] the one before.
     hist = [(np.empty(0, np.int64), np.empty((0, 2))), (np.empty(0, np.int64), np.empty((0, 2)))]
     steps: list[tuple[int, bool]] = []
@@ -80,13 +80,13 @@ def capture(case: str, every: int, duration: float | None, name: str | None = No
         hist[0], hist[1] = hist[1], (key[order].copy(), r[:count][order].copy())
         return its, res
 
-    nlgs.solve, stalled.continue_stalled = watched, watched_finish
+    dispatch.solve, stalled.continue_stalled = watched, watched_finish
     t = time.process_time()
     try:
         for _ in range(sim.model.n_steps):
             solver.step(sim.state)
     finally:
-        nlgs.solve, stalled.continue_stalled = solve, finish
+        dispatch.solve, stalled.continue_stalled = solve, finish
     took = time.process_time() - t
     sweeps = np.array([s for s, _ in steps])
     stalls = [i + 1 for i, (_, st) in enumerate(steps) if st]

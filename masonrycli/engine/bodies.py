@@ -1,6 +1,6 @@
 """Gauss–Seidel in body order with momentum: the first method of a stalled solve.
 
-The engine's sweeps visit the contacts in detection order (interleaved, nlgs._nlgs_interleaved). Here a
+The engine's sweeps visit the contacts in detection order (interleaved.py; lanes.py). Here a
 sweep goes through the bodies in turn and visits, for each body with mass, every contact of that body:
 a contact between two blocks is visited twice in a sweep (once from each block), a contact with a
 support once. So each block's corners are solved one after the other with the block's velocity fresh,

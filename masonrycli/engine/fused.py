@@ -4,9 +4,9 @@ On the 51-block wall a step outside the solve made a dozen launcher calls of 1â€
 unboxing, shape checks, the Python between them) around kernels of a few Âµs: the calls cost more than
 the work. The kernels are the same (:mod:`.integrate`, :mod:`.collision`, :mod:`.warmstart`), called in
 the same order on the same arrays, so a step's numbers do not change. The contact constants, the solve
-and the contact powers keep their own launchers (:mod:`.nlgs`). Whatever the fused call does not handle
-(the first detection, a capacity exceeded, a pose not finite) it hands back, and the step goes through
-the launchers one by one as before (:meth:`masonrycli.engine.solver.Solver.step`).
+and the contact powers keep their own launchers (nlgs.prepare_contacts, dispatch.solve,
+power.contact_power). Whatever the fused call does not handle (the first detection, a capacity exceeded, a
+pose not finite) it hands back, and the step goes through the launchers one by one as before (:meth:`masonrycli.engine.solver.Solver.step`).
 """
 
 from __future__ import annotations

@@ -1,8 +1,8 @@
 """The sweeps of a step in interleaved order: the contacts copied into K runs visited in turn, swept by
-momentum (:mod:`masonrycli.engine.momentum`) or plainly (``nlgs._nlgs``), copied back. The accelerated
-solvers' first stage uses 8 runs and vectors instead (:mod:`masonrycli.engine.lanes`,
-:mod:`masonrycli.engine.lane_sweeps`); plain "nlgs", stalled.py's and newton.py's sweeps use these (and
-the first stage with the lab's ``Tuning.lanes`` off).
+momentum (:mod:`masonrycli.engine.momentum`) or plainly (``nlgs._nlgs``), copied back; :func:`sweeps`
+launches them. The accelerated solvers' first stage uses 8 runs and vectors instead
+(:mod:`masonrycli.engine.lanes`, :mod:`masonrycli.engine.lane_sweeps`; dispatch.first_stage); plain "nlgs",
+stalled.py's and newton.py's sweeps use these (and the first stage with the lab's ``Tuning.lanes`` off).
 
 Detection order puts a pair's two or three contact points, and the pairs of one block, next to each
 other: each visit then reads the velocities the visit before has just written, and the sweep runs at
@@ -16,7 +16,7 @@ walls, 8- and 32-course walls, arch and aqueduct). The rows are copied into that
 reads memory in sequence), solved, and r, status copied back.
 
 One kernel per sweep (:func:`_accelerated`, :func:`_plain`), chosen by the launcher
-``nlgs._nlgs_interleaved``: a kernel holds the machine code of every sweep it may call, so one kernel
+:func:`sweeps`: a kernel holds the machine code of every sweep it may call, so one kernel
 taking the choice as an argument compiled both (the plain sweep is 1.5 s of CPU the default solver's
 first run does not need).
 """
@@ -88,3 +88,34 @@ def _plain(contact_body, pack, count, mu, tolerance, max_iterations, v, r, statu
     iterations, residual = _nlgs(body_o, pack_o, count, mu, tolerance, max_iterations, v, r_o, status_o, alternate)
     _back(order, count, r_o, status_o, r, status)
     return iterations, residual
+
+
+def sweeps(
+    contact_body,
+    pack,
+    count,
+    mu,
+    tolerance,
+    max_iterations,
+    v,
+    r,
+    status,
+    accelerate,
+    accelerated_stall,
+    alternate=False,
+):
+    """The sweeps in interleaved order: momentum's (``accelerate``, stall window ``accelerated_stall``) or the
+    plain ones; ``alternate`` as in stalled.py (momentum turning at restarts, plain sweeps alternating their
+    direction). Returns (iterations, residual). Two kernels rather than one with the flag as an argument: a
+    run compiles only the sweep it uses (the plain one cost 1.5 s of the first run's compilation)."""
+    if accelerate:
+        if not v.flags.c_contiguous:  # v.reshape would copy: the sweep's flat view of v must be v
+            raise ValueError("the body velocities v must be a C-contiguous array")
+        args = (contact_body, pack, count, mu, tolerance, max_iterations, v, v.reshape(-1), r, status)
+        if alternate:
+            return _accelerated(*args, accelerated_stall, True)
+        return _accelerated(*args, accelerated_stall)  # flip omitted: compiled out
+    args = (contact_body, pack, count, mu, tolerance, max_iterations, v, r, status)
+    if alternate:
+        return _plain(*args, True)
+    return _plain(*args)

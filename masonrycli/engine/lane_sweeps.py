@@ -2,7 +2,7 @@
 momentum's sweeps with 8 contacts visited at once, in vectors.
 
 The sweeps of :mod:`masonrycli.engine.momentum` (Nesterov extrapolation, adaptive restart, the stall
-window after which nlgs.solve hands the step to :mod:`masonrycli.engine.stalled`) in the lane groups of
+window after which dispatch.solve hands the step to :mod:`masonrycli.engine.stalled`) in the lane groups of
 :mod:`masonrycli.engine.lanes`: the interleaved order with 8 runs, a group's 8 contacts visited side by
 side on ``<8 x double>`` vectors (:mod:`masonrycli.engine._vector`), one lane a contact:
 

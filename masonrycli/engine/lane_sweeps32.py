@@ -1,7 +1,7 @@
 """The start of the default solver's first stage in single precision: :mod:`masonrycli.engine.lane_sweeps`'s
 momentum sweeps in float32, 16 contacts visited at once on ``<16 x float>`` vectors
 (:mod:`masonrycli.engine._vector32`), then the float64 lane sweeps from their impulses (iterative
-refinement: the step ends on a float64 sweep and the float64 stopping test; solver "nlgs-accel32", chosen in nlgs.solve):
+refinement: the step ends on a float64 sweep and the float64 stopping test; solver "nlgs-accel32", chosen in dispatch.solve):
 
     groups: 16 runs of ⌈C/16⌉ contacts of detection order; group j's lane q holds contact
             q·run + (j + s_q) mod run, s_q = run/2 for odd q in the staggered layout, 0 in the plain one

@@ -24,7 +24,7 @@ Gauss–Seidel with Nesterov momentum").
 
 Stall window: on tall sliding walls momentum can drive a step into a stick/slip cycle where its residual
 wanders above the tolerance. So a solve stops after Tuning.first_stall accelerated sweeps without a new lowest
-residual, and nlgs.solve hands the step to :mod:`masonrycli.engine.stalled` (whose body-order stage
+residual, and dispatch.solve hands the step to :mod:`masonrycli.engine.stalled` (whose body-order stage
 finishes almost every such step from the warm start). 200 rather than 500 gets the step there sooner:
 ensembles of 48 runs, mean sweep units a step 0.614× on the 32-course wall ("Momentum's stall window and
 the round-robin's order").
@@ -106,7 +106,7 @@ def _momentum_sweeps(
     #       for α in order: r_y = r_α + β (r_α − r_prev,α), r_prev,α ← r_α
     #                       the visit of _nlgs from r_y (e_α = W_αα (r_α' − r_y))
     #       residual and stopping as in _nlgs, the stall rule with a window of stall_after sweeps (then
-    #       nlgs.solve hands the step to stalled.py); then j, β from the restart rule, and with flip the
+    #       dispatch.solve hands the step to stalled.py); then j, β from the restart rule, and with flip the
     #       sweep order reverses at each restart (stalled.py's "turning" method)
     for c in range(count):
         # c unsigned as in the sweep below: one compiled _push serves both

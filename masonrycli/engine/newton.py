@@ -59,7 +59,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from masonrycli.engine import banded, nlgs
+from masonrycli.engine import banded, interleaved, nlgs
 from masonrycli.engine._jit import njit
 from masonrycli.engine.nlgs import P_BIAS, P_IIA, P_IIB, P_IMA, P_IMB, P_NA, P_NB, P_NX, P_NY, P_TA, P_TB, P_WNN, P_WTT
 from masonrycli.engine.tuning import TUNING
@@ -285,7 +285,7 @@ def _newton_step(contact_body, pack, count, mu, v_free, r, status, shift, band, 
     # a poor model: shift more, and let plain sweeps move r where the line search could not
     shift[0] = min(10.0 * shift[0], LAMBDA_MAX)
     work[:] = v_free
-    nlgs._nlgs_interleaved(contact_body, pack, count, mu, 0.0, WATCHDOG, work, r, status, False, 0)
+    interleaved.sweeps(contact_body, pack, count, mu, 0.0, WATCHDOG, work, r, status, False, 0)
     return NEWTON_UNITS + WATCHDOG
 
 
@@ -324,7 +324,7 @@ def newton_steps(
     if sweeps > 0:
         r_out[:] = r
         v[:] = v_free
-        d, residual = nlgs._nlgs_interleaved(
+        d, residual = interleaved.sweeps(
             contact_body, pack, count, mu, tolerance, sweeps, v, r_out, status, True, POLISH_STALL, True
         )
         done += d

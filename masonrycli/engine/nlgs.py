@@ -31,19 +31,15 @@ Stagnation. On tall walls that slide (32 courses and more, shaken at 1 m/s) Gaus
 step 74 of the 32-course wall the residual wanders between 7.7e-5 and 2.3e-4 m/s for 50 000 sweeps while
 hundreds of sliding bed-joint corners change status (benchmarks/JOURNAL.md, "Sweep order"), and sweeping
 such steps to the cap cost half of that wall's run time. So when a solve with a tolerance > 0 goes
-STALL_SWEEPS sweeps without a new lowest residual, it continues by faces (:mod:`masonrycli.engine.faces`:
+STALL_SWEEPS sweeps without a new lowest residual, dispatch.solve continues it by faces (:mod:`masonrycli.engine.faces`:
 the points of each face solved together, which does not cycle there) until the tolerance, the cap (counted
 in sweep units), or the faces stall in turn; a step that still misses the tolerance is counted unconverged
 as at the cap. A slowly converging step keeps reaching new lows and is not handed over. Tolerance 0 runs
 exactly the cap.
 
-Acceleration (solvers "nlgs-accel32", the default, and "nlgs-accel"; "nlgs" is the plain sweep): the
-same sweep started from a Nesterov extrapolation of the last two sweeps (:mod:`masonrycli.engine.momentum`),
-its first stage visiting the contacts in 8 interleaved runs, 8 contacts at once in vectors
-(:mod:`masonrycli.engine.lane_sweeps`; ``Tuning.lanes``). A stalled accelerated solve goes on by the methods of :mod:`masonrycli.engine.stalled` (momentum turning
-its direction at restarts, alternating-direction sweeps, momentum resumed, faces, in turn with doubling
-budgets). Its iterations count accelerated sweeps (each ~1.1–1.6× the time of a plain one) plus the later
-methods' sweep units.
+The solve of a step (which sweeps, the faces after a stall, the accelerated solvers' first stage and
+stalled steps) is :func:`masonrycli.engine.dispatch.solve`; this module holds the primitives every sweep is
+made of (the packed constants, the local solve, one contact's visit) and the plain sweep.
 """
 
 from __future__ import annotations
@@ -52,7 +48,6 @@ import numpy as np
 
 from masonrycli.engine._jit import kernel_only, njit
 from masonrycli.engine.contact import ContactStatus
-from masonrycli.engine.tuning import TUNING
 
 STALL_SWEEPS = 10_000
 """Point sweeps without a new lowest residual after which a solve with a tolerance > 0 continues by faces
@@ -234,7 +229,7 @@ def _nlgs(contact_body, pack, count, mu, tolerance, max_iterations, v, r, status
     #                       v += M⁻¹ H_α (r_α' − r_α)
     #       residual = sqrt(Σ_α |e_α|² / C)
     #   until residual ≤ tolerance, or the cap, or (tolerance > 0) STALL_SWEEPS sweeps in a row without
-    #   a new lowest residual: sweeping on would only cycle (module doc), solve() goes on by faces.
+    #   a new lowest residual: sweeping on would only cycle (module doc), dispatch.solve goes on by faces.
     for c in range(count):
         # c unsigned as in the sweep below: one compiled _push serves both
         _push(v, contact_body[c, 0], contact_body[c, 1], pack, np.uint64(c), r[c, 0], r[c, 1])
@@ -286,46 +281,6 @@ def _nlgs(contact_body, pack, count, mu, tolerance, max_iterations, v, r, status
 
 INTERLEAVE = 4
 """The scalar sweeps visit the contacts in this many interleaved runs of detection order (:mod:`.interleaved`)."""
-ACCELERATED = ("nlgs-accel", "nlgs-accel32")  # momentum's first stage, stalled steps by stalled.py
-
-
-def _nlgs_interleaved(
-    contact_body,
-    pack,
-    count,
-    mu,
-    tolerance,
-    max_iterations,
-    v,
-    r,
-    status,
-    accelerate,
-    accelerated_stall,
-    alternate=None,
-    lanes=True,
-):
-    """The sweeps in interleaved order (:mod:`masonrycli.engine.interleaved`): momentum's
-    (``accelerate``, stall window ``accelerated_stall``) or the plain ones; ``alternate`` as in
-    stalled.py. ``alternate`` omitted with ``accelerate``: the first stage of :func:`solve`, by the lane
-    sweeps when ``lanes`` (Tuning.lanes; the benchmarks that capture the first stage hook this function's 11-argument
-    calls); stalled.py's and newton.py's sweeps pass it. Returns (iterations, residual). Two kernels rather
-    than one with the flag as an argument: a run compiles only the sweep it uses (the plain one cost 1.5 s
-    of the first run's compilation)."""
-    if accelerate and alternate is None and lanes:
-        return lane_sweeps._lane_sweeps(
-            contact_body, pack, count, mu, tolerance, max_iterations, v, r, status, accelerated_stall
-        )
-    if accelerate:
-        if not v.flags.c_contiguous:  # v.reshape would copy: the sweep's flat view of v must be v
-            raise ValueError("the body velocities v must be a C-contiguous array")
-        args = (contact_body, pack, count, mu, tolerance, max_iterations, v, v.reshape(-1), r, status)
-        if alternate:
-            return interleaved._accelerated(*args, accelerated_stall, True)
-        return interleaved._accelerated(*args, accelerated_stall)  # flip omitted: compiled out
-    args = (contact_body, pack, count, mu, tolerance, max_iterations, v, r, status)
-    if alternate:
-        return interleaved._plain(*args, True)
-    return interleaved._plain(*args)
 
 
 def prepare_contacts(contact_body, contact_point, contact_normal, contact_gap, count, body_q, model, out_pack) -> None:
@@ -344,60 +299,3 @@ def prepare_contacts(contact_body, contact_point, contact_normal, contact_gap, c
         model.dt,
         out_pack,
     )
-
-
-def solve(contact_body, pack, count, model, v, r, status, tuning=TUNING) -> tuple[int, float]:
-    """Solve one step's contact problem by NLGS: the engine's one entry point for a contact solver.
-
-    In: ``contact_body`` (C, 2) bodies a < b, ``pack`` (C, PACK_WIDTH) from :func:`prepare_contacts`,
-    ``model`` (friction, tolerance m/s, max_iterations, solver "nlgs-accel", "nlgs-accel32" or "nlgs", and
-    block_depth for "nlgs-accel32"'s stall window, momentum.stall_near). ``v`` (B, 3): v_free
-    in, v_n+1 out. ``r`` (C, 2): starting impulses in, (r_t, r_n) N·s out. ``status`` (C,) int8 out
-    (:class:`~masonrycli.engine.contact.ContactStatus`). ``tuning``: the first stage's and the stalled-step
-    methods' numbers (:class:`~masonrycli.engine.tuning.Tuning`; the Solver's, the shipped ones by default).
-
-    Returns (iterations, residual): sweeps done, and the last sweep's RMS contact-law violation in m/s
-    (module doc). Another method plugged in beside this one keeps the signature, reports its work in
-    sweep equivalents (contact visits / C) and the same residual, so that the history and the
-    unconverged count mean the same thing. A plain ("nlgs") solve that stalls continues by faces (module doc); its
-    iterations are then the point sweeps plus the faces' sweep units. With an accelerated solver
-    ("nlgs-accel32", "nlgs-accel") a stalled solve goes on by the methods of
-    :mod:`masonrycli.engine.stalled`, and its iterations add up all of them."""
-    mu, tolerance, cap = model.friction, model.tolerance, model.max_iterations
-    accelerated = model.solver in ACCELERATED
-    if not accelerated or tolerance <= 0.0:
-        iterations, residual = _nlgs_interleaved(
-            contact_body, pack, count, mu, tolerance, cap, v, r, status, accelerated, STALL_SWEEPS,
-            lanes=tuning.lanes,
-        )  # fmt: skip
-        return _faces_if_stalled(contact_body, pack, count, mu, tolerance, cap, v, r, status, iterations, residual)
-    # Accelerated: momentum (the lane sweeps, Tuning.lanes) until its stall window; a stalled step goes on by
-    # the methods of stalled.py.
-    v_free, r_warm = v.copy(), r[:count].copy()
-    if model.solver == "nlgs-accel32" and tuning.lanes:  # the one place float32 is chosen
-        iterations, residual = lane_sweeps32.first_stage(
-            contact_body, pack, count, mu, tolerance, cap, v, r, status, tuning.first_stall,
-            momentum.stall_near(model, tuning),
-        )  # fmt: skip
-    else:
-        iterations, residual = _nlgs_interleaved(
-            contact_body, pack, count, mu, tolerance, cap, v, r, status, True, tuning.first_stall,
-            lanes=tuning.lanes,
-        )  # fmt: skip
-    if residual <= tolerance or iterations >= cap:
-        return iterations, residual
-    return stalled.continue_stalled(
-        contact_body, pack, count, mu, tolerance, cap, v, r, status, v_free, r_warm, iterations, residual, tuning
-    )
-
-
-def _faces_if_stalled(contact_body, pack, count, mu, tolerance, cap, v, r, status, iterations, residual):
-    if tolerance > 0.0 and residual > tolerance and iterations < cap:  # stalled, not capped
-        units, residual = faces.face_sweeps(contact_body, pack, count, mu, tolerance, cap - iterations, v, r, status)
-        iterations += units
-    return iterations, residual
-
-
-# At the end: faces, momentum and stalled build on this module's sweep primitives (a stalled solve()
-# continues by faces or by stalled's methods; the accelerated sweep is momentum's).
-from masonrycli.engine import faces, interleaved, lane_sweeps, lane_sweeps32, momentum, stalled  # noqa: E402

@@ -6,7 +6,7 @@
 4. v_free = v_n + dt g ; supports get v(t_n+1)         integrate.free_velocity
 5. lever arms, W_αα, Signorini bias                    nlgs.prepare_contacts
    no contact warm-started (first step): static guess  warmstart.static_guess
-6. NLGS → r, v_n+1                                     nlgs.solve
+6. NLGS → r, v_n+1                                     dispatch.solve
    a structure at rest: the solve continued to a tighter tolerance   Solver._settle
 7. contact forces, dissipation, support work           power.contact_power
 8. q_n+1 = q_n + dt (θ v_n+1 + (1 − θ) v_n)            integrate.update_q
@@ -39,7 +39,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from masonrycli.engine import fused, integrate, nlgs, power, warmstart
+from masonrycli.engine import dispatch, fused, integrate, nlgs, power, warmstart
 from masonrycli.engine.collision import ContactBuffers, detect_contacts
 from masonrycli.engine.tuning import TUNING, Tuning
 
@@ -61,7 +61,7 @@ class StepStats:
     contact_count: int
     """C, contacts detected at the step's configuration."""
     iterations: int
-    """Sweep units the contact solver spent (masonrycli.engine.nlgs.solve)."""
+    """Sweep units the contact solver spent (masonrycli.engine.dispatch.solve)."""
     residual: float
     """m/s: RMS contact-law violation of the last sweep, the quantity compared with the tolerance."""
     dissipated: float
@@ -73,7 +73,7 @@ class StepStats:
     max_block_speed: float
     """Top block speed |v| at the end of the step, m/s; NaN if a block's q or v is not finite."""
     converged: bool
-    """The solver met its stopping test: residual ≤ tolerance before the sweep cap (nlgs.solve)."""
+    """The solver met its stopping test: residual ≤ tolerance before the sweep cap (dispatch.solve)."""
 
 
 class Solver:
@@ -86,7 +86,7 @@ class Solver:
     def __init__(self, model, tuning: Tuning = TUNING):
         self.model = model
         self.tuning = tuning
-        """The contact solve's first-stage and stalled-step numbers (engine/tuning.py), handed to nlgs.solve
+        """The contact solve's first-stage and stalled-step numbers (engine/tuning.py), handed to dispatch.solve
         every step: the shipped ones, or the solver lab's (a frozen value, set at construction)."""
         b = model.body_count
         self.buffers = ContactBuffers(model.body_vert_start)
@@ -202,7 +202,9 @@ class Solver:
         if rest:
             np.copyto(self._v_free, state.body_v)
             m = _in_float64(m)
-        iterations, residual = nlgs.solve(body, self._pack, count, m, state.body_v, self._r, self._status, self.tuning)
+        iterations, residual = dispatch.solve(
+            body, self._pack, count, m, state.body_v, self._r, self._status, self.tuning
+        )
         # The continuation stays below the run's sweep cap: a step whose ordinary solve met the tolerance
         # must not be reported capped or unconverged for the extra sweeps (nor spend more than the cap).
         budget = min(REST_BUDGET, m.max_iterations - 1 - iterations)
@@ -255,7 +257,7 @@ class Solver:
         kept = v.copy(), r.copy(), status.copy()
         np.copyto(v, self._v_free)
         bf = self.buffers
-        more, settled = nlgs.solve(bf.contact_body, self._pack, count, tight, v, self._r, self._status, self.tuning)
+        more, settled = dispatch.solve(bf.contact_body, self._pack, count, tight, v, self._r, self._status, self.tuning)
         if settled > residual:  # the continuation ended worse: back to the ordinary solve's result
             np.copyto(v, kept[0])
             np.copyto(r, kept[1])

@@ -70,14 +70,14 @@ converged ("Hard steps: the costliest steps").
 
 The numbers named here in lower case (bodies_units, first_budget, methods, newton_ahead, …) are the fields of
 :class:`masonrycli.engine.tuning.Tuning`, documented there with their units and sources; continue_stalled gets
-them from nlgs.solve, which gets them from the Solver.
+them from dispatch.solve, which gets them from the Solver.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from masonrycli.engine import bodies, faces, newton, nlgs
+from masonrycli.engine import bodies, faces, interleaved, newton
 from masonrycli.engine.tuning import TUNING
 
 
@@ -101,7 +101,7 @@ def continue_stalled(
 ) -> tuple[int, float]:
     """Finish a step whose accelerated solve stalled.
 
-    In: the step's arrays as nlgs.solve has them (``v`` (B, 3) m/s and ``r`` (C, 2) N·s: momentum's stalled
+    In: the step's arrays as dispatch.solve has them (``v`` (B, 3) m/s and ``r`` (C, 2) N·s: momentum's stalled
     iterate, consistent; ``status`` (C,)), ``v_free`` (B, 3) the free velocities and ``r_warm`` (C, 2) the
     warm start, ``iterations`` (sweep units) and ``residual`` (m/s) of the momentum solve so far. Out:
     ``v``, ``r``, ``status`` of the method that met ``tolerance`` (or, at ``cap``, of the lowest residual).
@@ -250,7 +250,7 @@ def _resume(name, state, contact_body, pack, count, mu, tolerance, units, v_free
         return done
     state.v = v_free.copy()
     accelerate = name != "alternating"
-    done, state.residual = nlgs._nlgs_interleaved(
+    done, state.residual = interleaved.sweeps(
         contact_body,
         pack,
         count,

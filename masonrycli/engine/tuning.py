@@ -1,7 +1,7 @@
 """The contact solve's tuning: how a step's first stage runs and how a stalled step is finished.
 
 One frozen value, :data:`TUNING` (the shipped numbers), handed down from the :class:`~masonrycli.engine.solver.Solver`
-to ``nlgs.solve`` and on to :func:`masonrycli.engine.stalled.continue_stalled`; nothing in the engine reads a
+to ``dispatch.solve`` and on to :func:`masonrycli.engine.stalled.continue_stalled`; nothing in the engine reads a
 module global for these. The solver lab and the tests try other values by passing another instance
 (``dataclasses.replace(TUNING, bodies_cycling=4)``), never by patching a module. Each field says what it counts,
 in which units, and the benchmarks/JOURNAL.md section its value came from; the methods themselves are described

@@ -59,7 +59,7 @@ class Frame:
     support_work: float
     """J, cumulated work done by the supports on the blocks since t = 0."""
     nlgs_iterations: int
-    """Sweeps of the step that ended at this frame (masonrycli.engine.nlgs.solve)."""
+    """Sweeps of the step that ended at this frame (masonrycli.engine.dispatch.solve)."""
     nlgs_residual: float
     """m/s: RMS contact-law violation of that step's last sweep, the quantity compared with the tolerance."""
     contact_count: int

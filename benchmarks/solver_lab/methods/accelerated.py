@@ -1,6 +1,6 @@
 """Gauss–Seidel with Nesterov momentum: the engine's default solver "nlgs-accel" (engine/momentum.py) in the lab.
 
-nlgs-accel      the engine's accelerated solve (``nlgs.solve`` with ``solver = "nlgs-accel"``) from r_warm,
+nlgs-accel      the engine's accelerated solve (``dispatch.solve`` with ``solver = "nlgs-accel"``) from r_warm,
                 stopped when the lab's RMS contact-law residual ≤ target, like nlgs-law: the count is found
                 at sweep counts ≤ 10 % apart, then re-run in one kernel call and timed. The momentum cannot
                 be resumed between kernel calls, so every count tried is a fresh solve from r_warm.

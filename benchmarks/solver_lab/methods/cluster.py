@@ -38,7 +38,7 @@ from scipy.sparse.csgraph import connected_components
 from benchmarks.solver_lab import law
 from benchmarks.solver_lab.outcome import Clock, Outcome, sweeps_with_corrections
 from benchmarks.solver_lab.problems import pack_contacts
-from masonrycli.engine import nlgs
+from masonrycli.engine import dispatch, nlgs
 
 SWEEPS = 20
 """Fine sweeps between coarse corrections."""
@@ -115,7 +115,7 @@ def coarse_step(ctx, v, r, clock):
         vc = (vbar - mc_inv * (Hc.T @ r_in.ravel())).reshape(-1, 3)
     with clock("coarse"):
         rc = r_in.copy()
-        nlgs.solve(cbody, cpack, n_in, shim, vc, rc, np.zeros(n_in, dtype=np.int8))
+        dispatch.solve(cbody, cpack, n_in, shim, vc, rc, np.zeros(n_in, dtype=np.int8))
     with clock("intra"):
         dV = vc.ravel() - vbar
         dr_in = rc - r_in

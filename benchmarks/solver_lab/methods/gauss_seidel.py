@@ -1,4 +1,4 @@
-"""Gauss–Seidel variants, all on the engine's own NLGS kernel (``nlgs.solve``).
+"""Gauss–Seidel variants, all on the engine's own NLGS kernel (``dispatch.solve``).
 
 nlgs          the engine as shipped: its own stopping test and cap, warm start r_warm.
 nlgs-law      the same sweeps, stopped when the contact-law residual ≤ target (checked by the lab in
@@ -19,7 +19,7 @@ import numpy as np
 
 from benchmarks.solver_lab import law
 from benchmarks.solver_lab.outcome import Clock, Outcome, project_cone
-from masonrycli.engine import nlgs
+from masonrycli.engine import dispatch
 
 CAP = 50_000
 ORACLE_ERROR = 1e-4
@@ -55,7 +55,7 @@ def engine_default(ctx, target) -> Outcome:
     v = p.v_free.copy()
     status = np.zeros(p.count, dtype=np.int8)
     with clock("sweeps"):
-        its, _ = nlgs.solve(p.body, ctx.pack, p.count, p.shim(), v, r, status)
+        its, _ = dispatch.solve(p.body, ctx.pack, p.count, p.shim(), v, r, status)
     return Outcome(v, r, int(its), float(its), clock.phases, converged=its < p.shim().max_iterations)
 
 

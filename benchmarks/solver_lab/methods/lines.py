@@ -18,7 +18,7 @@ not yet continued — zigzag columns in running bond, one block of each course.
         SWEEPS_BETWEEN plain engine sweeps on the joints between lines
     until the contact-law residual (law.py, RMS over all contacts) ≤ target, or ROUNDS rounds
 
-Each line is solved by the engine's kernel (``nlgs.solve`` on the line's contacts): an oracle of an exact
+Each line is solved by the engine's kernel (``dispatch.solve`` on the line's contacts): an oracle of an exact
 line solve, whose own cost is not the question. The question is whether the outer rounds stay flat with
 height; ``detail`` gives the rounds and the contact visits in sweep equivalents (visits / C) so the inner
 work can be read too. The harness's sweep units are CPU-based and include Python's per-line overhead.
@@ -32,7 +32,7 @@ import numpy as np
 
 from benchmarks.solver_lab import law
 from benchmarks.solver_lab.outcome import Outcome
-from masonrycli.engine import nlgs
+from masonrycli.engine import dispatch, nlgs
 
 INNER_TOL = 1e-8
 """m/s: a line's solve stops here (1000× below the lab's target: near exact)."""
@@ -92,7 +92,7 @@ def _solve_subset(ctx, v, r, status, idx, tolerance, cap, solver) -> int:
     s_sub = status[idx].copy()
     shim = p.shim(tolerance, cap, solver=solver)
     body, pack = np.ascontiguousarray(p.body[idx]), np.ascontiguousarray(ctx.pack[idx])
-    sweeps, _ = nlgs.solve(body, pack, idx.size, shim, v_free, r_sub, s_sub)
+    sweeps, _ = dispatch.solve(body, pack, idx.size, shim, v_free, r_sub, s_sub)
     v[:], r[idx], status[idx] = v_free, r_sub, s_sub
     return int(sweeps)
 
