@@ -3,8 +3,7 @@
     .venv/bin/python -m benchmarks.bench_idle [--case wall-248] [--duration 1] [--json PATH]
 
 Runs ``--case`` (benchmarks.solver_cases, the solver benchmark's trajectory) with the engine's default
-solver and, for every call of the scalar accelerated sweep (``interleaved.sweeps`` with ``accelerate`` and
-no ``alternate``: the sweeps of every step until momentum converges or stalls, its first stage run by that
+solver and, for every call of the scalar accelerated sweep (``interleaved.sweeps`` in its MOMENTUM mode: the sweeps of every step until momentum converges or stalls, its first stage run by that
 sweep rather than by the lane sweeps, and stalled.py's "momentum" resumes), solves
 the same input again with the lab copy below, which is ``momentum._nlgs_accelerated`` with counters (its
 sweeps, residual, v and r are checked equal to the engine's, bit for bit). Per visit of a contact:
@@ -148,12 +147,12 @@ def measure(case: str, duration: float) -> dict:
     tally = np.zeros((3 + 2 * len(KS), 3), np.int64)
     kernel, first, calls = interleaved.sweeps, dispatch.first_stage, [0]
 
-    def counted(contact_body, pack, count, mu, tolerance, cap, v, r, status, accelerate, stall, alternate=False):
-        if accelerate and not alternate:
+    def counted(contact_body, pack, count, mu, tolerance, cap, v, r, status, mode, stall=0):
+        if mode == interleaved.MOMENTUM:
             v2, r2, s2 = v.copy(), r.copy(), status.copy()
             out2 = _counted(contact_body, pack, count, mu, tolerance, cap, v2, r2, s2, stall, ks, tally)
-        out = kernel(contact_body, pack, count, mu, tolerance, cap, v, r, status, accelerate, stall, alternate)
-        if accelerate and not alternate:
+        out = kernel(contact_body, pack, count, mu, tolerance, cap, v, r, status, mode, stall)
+        if mode == interleaved.MOMENTUM:
             same = out2 == out and np.array_equal(v2, v) and np.array_equal(r2[:count], r[:count])
             assert same, "the counted copy left the engine's path"
             calls[0] += 1

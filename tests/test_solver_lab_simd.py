@@ -103,7 +103,7 @@ def test_level_schedule_replays_the_engines_sweep_bit_for_bit(problem):
     v2, r2 = problem.v_free.copy(), problem.r_warm.copy()
     s2 = np.zeros(problem.count, np.int8)
     sweeps2, residual2 = interleaved.sweeps(problem.body, problem.pack(), problem.count, problem.mu, tol,
-                                            200_000, v2, r2, s2, True, TUNING.first_stall, False)  # fmt: skip
+                                            200_000, v2, r2, s2, interleaved.MOMENTUM, TUNING.first_stall)  # fmt: skip
     assert sweeps == sweeps2 and residual == residual2
     assert np.array_equal(v, v2) and np.array_equal(r, r2)
 

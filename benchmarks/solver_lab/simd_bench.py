@@ -64,8 +64,7 @@ def _tight(call):
     _, residual = dispatch.first_stage(contact_body, pack, count, mu, TIGHT, TIGHT_CAP, v1, r1, s1, TIGHT_CAP)
     if residual > TIGHT:
         v2, r2, s2 = v.copy(), r.copy(), status.copy()
-        _, res2 = interleaved.sweeps(contact_body, pack, count, mu, TIGHT, TIGHT_CAP, v2, r2, s2, False,
-                                     nlgs.STALL_SWEEPS)  # fmt: skip
+        _, res2 = interleaved.sweeps(contact_body, pack, count, mu, TIGHT, TIGHT_CAP, v2, r2, s2, interleaved.PLAIN)
         if res2 < residual:
             v1, residual = v2, res2
     return v1, residual

@@ -92,7 +92,7 @@ def _method(name, p, v, r, status, cap=CAP):
         units, res = faces.face_sweeps(body, pack, count, mu, TOLERANCE, cap - its, v, r, status)
         return its + units, res
     if name == "plain":
-        return interleaved.sweeps(body, pack, count, mu, TOLERANCE, cap, v, r, status, False, cap)
+        return interleaved.sweeps(body, pack, count, mu, TOLERANCE, cap, v, r, status, interleaved.PLAIN)
     # turning, momentum, alternating, newton: stalled.py's own resume, from the warm start, with the whole cap
     state = stalled._State(None, r, status, np.inf)
     its = stalled._resume(name, state, body, pack, count, mu, TOLERANCE, cap, v.copy(), cap, TUNING)

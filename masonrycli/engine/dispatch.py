@@ -1,8 +1,9 @@
 """The one entry point of a step's contact solve: which sweeps solve it, and where a stalled step goes on.
 
     solve(model, tuning):
-        "nlgs" (or tolerance 0): plain sweeps in interleaved order (interleaved.sweeps) to the tolerance, the
-            cap or their stall window (nlgs.STALL_SWEEPS); a stalled step goes on by faces (faces.py)
+        "nlgs": plain sweeps in interleaved order (interleaved.sweeps, PLAIN) to the tolerance, the cap or
+            their stall window (nlgs.STALL_SWEEPS); a stalled step goes on by faces (faces.py); tolerance 0:
+            the solver's sweeps (the accelerated ones: first_stage), exactly the cap
         "nlgs-accel32": first stage lane_sweeps32.first_stage (float32 lane sweeps, then float64 ones)
         "nlgs-accel":   first stage :func:`first_stage` (the float64 lane sweeps; the 4-run scalar momentum
                         sweep with Tuning.lanes off), to the tolerance, the cap or Tuning.first_stall sweeps
@@ -58,7 +59,7 @@ def solve(contact_body, pack, count, model, v, r, status, tuning=TUNING) -> tupl
             )
         else:
             iterations, residual = interleaved.sweeps(
-                contact_body, pack, count, mu, tolerance, cap, v, r, status, False, STALL_SWEEPS
+                contact_body, pack, count, mu, tolerance, cap, v, r, status, interleaved.PLAIN
             )
         return _faces_if_stalled(contact_body, pack, count, mu, tolerance, cap, v, r, status, iterations, residual)
     # Accelerated: momentum (the lane sweeps, Tuning.lanes) until its stall window; a stalled step goes on by
@@ -88,7 +89,9 @@ def first_stage(contact_body, pack, count, mu, tolerance, max_iterations, v, r, 
     (bench_kernel, bench_idle). Returns (iterations, residual)."""
     if lanes:
         return lane_sweeps._lane_sweeps(contact_body, pack, count, mu, tolerance, max_iterations, v, r, status, stall)
-    return interleaved.sweeps(contact_body, pack, count, mu, tolerance, max_iterations, v, r, status, True, stall)
+    return interleaved.sweeps(
+        contact_body, pack, count, mu, tolerance, max_iterations, v, r, status, interleaved.MOMENTUM, stall
+    )
 
 
 def _faces_if_stalled(contact_body, pack, count, mu, tolerance, cap, v, r, status, iterations, residual):

@@ -90,32 +90,29 @@ def _plain(contact_body, pack, count, mu, tolerance, max_iterations, v, r, statu
     return iterations, residual
 
 
-def sweeps(
-    contact_body,
-    pack,
-    count,
-    mu,
-    tolerance,
-    max_iterations,
-    v,
-    r,
-    status,
-    accelerate,
-    accelerated_stall,
-    alternate=False,
-):
-    """The sweeps in interleaved order: momentum's (``accelerate``, stall window ``accelerated_stall``) or the
-    plain ones; ``alternate`` as in stalled.py (momentum turning at restarts, plain sweeps alternating their
-    direction). Returns (iterations, residual). Two kernels rather than one with the flag as an argument: a
-    run compiles only the sweep it uses (the plain one cost 1.5 s of the first run's compilation)."""
-    if accelerate:
+MOMENTUM, TURNING, PLAIN, ALTERNATING = "momentum", "turning", "plain", "alternating"
+"""The sweeps :func:`sweeps` runs (``mode``; the first three are stalled.py's method names):
+MOMENTUM: Gauss–Seidel with momentum (momentum.py), every sweep forward;
+TURNING: the same, its direction turning at every restart (a one-way sweep can repeat a stick/slip cycle);
+PLAIN: plain Gauss–Seidel, every sweep forward; ALTERNATING: plain, forward, backward, forward, …."""
+
+
+def sweeps(contact_body, pack, count, mu, tolerance, max_iterations, v, r, status, mode, stall=0):
+    """The sweeps of ``mode`` (MOMENTUM, TURNING, PLAIN, ALTERNATING) in interleaved order, until
+    ``tolerance``, ``max_iterations`` or a stall: ``stall`` sweeps without a new lowest residual for the
+    momentum modes, nlgs.STALL_SWEEPS (compiled in) for the plain ones, which take no ``stall``. Returns
+    (iterations, residual). Two kernels rather than one with the choice as an argument: a run compiles only
+    the sweep it uses (the plain one cost 1.5 s of the first run's compilation)."""
+    if mode == MOMENTUM or mode == TURNING:
         if not v.flags.c_contiguous:  # v.reshape would copy: the sweep's flat view of v must be v
             raise ValueError("the body velocities v must be a C-contiguous array")
         args = (contact_body, pack, count, mu, tolerance, max_iterations, v, v.reshape(-1), r, status)
-        if alternate:
-            return _accelerated(*args, accelerated_stall, True)
-        return _accelerated(*args, accelerated_stall)  # flip omitted: compiled out
+        if mode == TURNING:
+            return _accelerated(*args, stall, True)
+        return _accelerated(*args, stall)  # flip omitted: compiled out
     args = (contact_body, pack, count, mu, tolerance, max_iterations, v, r, status)
-    if alternate:
+    if mode == ALTERNATING:
         return _plain(*args, True)
-    return _plain(*args)
+    if mode == PLAIN:
+        return _plain(*args)
+    raise ValueError(f"interleaved.sweeps: no sweep mode {mode!r} (momentum, turning, plain, alternating)")

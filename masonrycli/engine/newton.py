@@ -285,7 +285,7 @@ def _newton_step(contact_body, pack, count, mu, v_free, r, status, shift, band, 
     # a poor model: shift more, and let plain sweeps move r where the line search could not
     shift[0] = min(10.0 * shift[0], LAMBDA_MAX)
     work[:] = v_free
-    interleaved.sweeps(contact_body, pack, count, mu, 0.0, WATCHDOG, work, r, status, False, 0)
+    interleaved.sweeps(contact_body, pack, count, mu, 0.0, WATCHDOG, work, r, status, interleaved.PLAIN)
     return NEWTON_UNITS + WATCHDOG
 
 
@@ -325,7 +325,7 @@ def newton_steps(
         r_out[:] = r
         v[:] = v_free
         d, residual = interleaved.sweeps(
-            contact_body, pack, count, mu, tolerance, sweeps, v, r_out, status, True, POLISH_STALL, True
+            contact_body, pack, count, mu, tolerance, sweeps, v, r_out, status, interleaved.TURNING, POLISH_STALL
         )
         done += d
     return done, residual

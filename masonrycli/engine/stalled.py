@@ -249,20 +249,9 @@ def _resume(name, state, contact_body, pack, count, mu, tolerance, units, v_free
         )
         return done
     state.v = v_free.copy()
-    accelerate = name != "alternating"
+    # turning, alternating, momentum: the sweep modes of the same names
     done, state.residual = interleaved.sweeps(
-        contact_body,
-        pack,
-        count,
-        mu,
-        tolerance,
-        units,
-        state.v,
-        state.r,
-        state.status,
-        accelerate,
-        units,
-        name != "momentum",
+        contact_body, pack, count, mu, tolerance, units, state.v, state.r, state.status, name, units
     )
     return done
 
