@@ -404,7 +404,7 @@ def test_solver_nlgs_accel32_is_the_float32_first_stage_and_nlgs_accel_is_not(na
 
 def test_the_first_stage_waits_near_the_tolerance_by_the_structures_depth(monkeypatch):
     # dispatch.solve hands lane_sweeps32.first_stage momentum.stall_near(model): 25 sweeps a block of depth, at
-    # least STALL_SWEEPS; first_stage's float64 part is _lane_sweeps with that window within NEAR × tol
+    # least Tuning.first_stall; first_stage's float64 part is _lane_sweeps with that window within NEAR × tol
     body, pack, v0, r0, mu = _problem("stack39")
     count = body.shape[0]
     seen = []

@@ -295,4 +295,4 @@ def test_group_layout_puts_each_contact_in_its_lane():
     assert (its, res) == (0, 0.0) and _same_bits(r, r0) and np.all(st == 0)
     ref = slow_lane_sweeps(body, pack, count, mu, 1e-9, 0, v0, r0, 200)
     assert _same_bits(v, ref[2])
-    assert lanes.ROWS == nlgs.PACK_WIDTH + 5 and lanes.W == 8
+    assert lanes.ROWS == nlgs.PACK_WIDTH + 5 and lanes.LANES == 8

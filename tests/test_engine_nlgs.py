@@ -258,7 +258,7 @@ def test_alternating_sweeps_match_the_dense_sweep_forward_then_backward(sweeps):
 def test_a_solve_that_stops_improving_ends_stall_sweeps_after_its_lowest_residual():
     # These contacts converge to the floating-point floor within 8 sweeps; after that the residual only
     # wanders around 1e-16 m/s. With a tolerance the floor never meets, the solve must stop
-    # STALL_SWEEPS sweeps after its last new low (unconverged, as at the cap) instead of running to the
+    # PLAIN_STALL sweeps after its last new low (unconverged, as at the cap) instead of running to the
     # cap; with tolerance 0 it runs the cap exactly.
     q, inv_mass, inv_inertia, body, point, normal, gap = _random_contacts(seed=3)
     mu, dt, count = 0.5, 1e-3, body.shape[0]
@@ -278,10 +278,10 @@ def test_a_solve_that_stops_improving_ends_stall_sweeps_after_its_lowest_residua
     assert 0.0 < lows[last_low] < 1e-14
     v, r = v0.copy(), r0.copy()
     its, res = nlgs._nlgs(body, pack, count, mu, 1e-300, 10**6, v, r, status)
-    assert its == last_low + 1 + nlgs.STALL_SWEEPS and res > 1e-300
+    assert its == last_low + 1 + nlgs.PLAIN_STALL and res > 1e-300
     v, r = v0.copy(), r0.copy()
-    its, _ = nlgs._nlgs(body, pack, count, mu, 0.0, 3 * nlgs.STALL_SWEEPS, v, r, status)
-    assert its == 3 * nlgs.STALL_SWEEPS
+    its, _ = nlgs._nlgs(body, pack, count, mu, 0.0, 3 * nlgs.PLAIN_STALL, v, r, status)
+    assert its == 3 * nlgs.PLAIN_STALL
 
 
 # --- The accelerated sweep (solver "nlgs-accel"), against a slow dense implementation ------------------

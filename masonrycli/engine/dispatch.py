@@ -2,7 +2,7 @@
 
     solve(model, tuning):
         "nlgs": plain sweeps in interleaved order (interleaved.sweeps, PLAIN) to the tolerance, the cap or
-            their stall window (nlgs.STALL_SWEEPS); a stalled step goes on by faces (faces.py); tolerance 0:
+            their stall window (nlgs.PLAIN_STALL); a stalled step goes on by faces (faces.py); tolerance 0:
             the solver's sweeps (the accelerated ones: first_stage), exactly the cap
         "nlgs-accel32": first stage lane_sweeps32.first_stage (float32 lane sweeps, then float64 ones)
         "nlgs-accel":   first stage :func:`first_stage` (the float64 lane sweeps; the 4-run scalar momentum
@@ -26,7 +26,6 @@ primitives.
 from __future__ import annotations
 
 from masonrycli.engine import faces, interleaved, lane_sweeps, lane_sweeps32, momentum, stalled
-from masonrycli.engine.nlgs import STALL_SWEEPS
 from masonrycli.engine.tuning import TUNING
 
 ACCELERATED = ("nlgs-accel", "nlgs-accel32")
@@ -53,9 +52,9 @@ def solve(contact_body, pack, count, model, v, r, status, tuning=TUNING) -> tupl
     mu, tolerance, cap = model.friction, model.tolerance, model.max_iterations
     accelerated = model.solver in ACCELERATED
     if not accelerated or tolerance <= 0.0:
-        if accelerated:  # tolerance 0: the first stage's sweeps, exactly the cap
+        if accelerated:  # tolerance 0: the first stage's sweeps, exactly the cap (no stall rule at tolerance 0)
             iterations, residual = first_stage(
-                contact_body, pack, count, mu, tolerance, cap, v, r, status, STALL_SWEEPS, tuning.lanes
+                contact_body, pack, count, mu, tolerance, cap, v, r, status, tuning.first_stall, tuning.lanes
             )
         else:
             iterations, residual = interleaved.sweeps(

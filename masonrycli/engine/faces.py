@@ -27,7 +27,7 @@ import numpy as np
 from masonrycli.engine._jit import njit
 from masonrycli.engine.nlgs import P_WNN, P_WTN, P_WTT, _local_solve, _push, _relative_velocity
 
-STALL_SWEEPS = 10_000
+FACES_STALL = 10_000
 """Face sweeps without a new lowest residual after which the solve gives up (the step is unconverged)."""
 INNER_ROUNDS = 10
 """Most rounds over one face's points per sweep."""
@@ -43,7 +43,7 @@ def _face_sweeps(contact_body, pack, count, mu, tolerance, max_units, v, r, stat
     #   repeat (one sweep):
     #       for each face: round 1 visits its points (their |W Δr|² make the residual);
     #                      more rounds while a round moves > INNER_DROP × round 1 (≤ INNER_ROUNDS)
-    #   until residual ≤ tolerance, the work cap (sweep units), or STALL_SWEEPS sweeps without a new low.
+    #   until residual ≤ tolerance, the work cap (sweep units), or FACES_STALL sweeps without a new low.
     # A visit is the arithmetic of nlgs._nlgs's contact loop, written out here once (one call site):
     # calling a shared visit function cost 47–57 ns per visit against 8.7 ns inline (captured steps of
     # the 248-block wall; likely the reference counting of the arrays numba passes to a call it does not
@@ -107,7 +107,7 @@ def _face_sweeps(contact_body, pack, count, mu, tolerance, max_units, v, r, stat
         if residual < best:
             best = residual
             best_at = sweep
-        elif sweep - best_at >= STALL_SWEEPS:
+        elif sweep - best_at >= FACES_STALL:
             break
         sweep += 1
     return (visits + count - 1) // count, residual

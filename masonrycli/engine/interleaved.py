@@ -100,7 +100,7 @@ PLAIN: plain Gauss–Seidel, every sweep forward; ALTERNATING: plain, forward, b
 def sweeps(contact_body, pack, count, mu, tolerance, max_iterations, v, r, status, mode, stall=0):
     """The sweeps of ``mode`` (MOMENTUM, TURNING, PLAIN, ALTERNATING) in interleaved order, until
     ``tolerance``, ``max_iterations`` or a stall: ``stall`` sweeps without a new lowest residual for the
-    momentum modes, nlgs.STALL_SWEEPS (compiled in) for the plain ones, which take no ``stall``. Returns
+    momentum modes, nlgs.PLAIN_STALL (compiled in) for the plain ones, which take no ``stall``. Returns
     (iterations, residual). Two kernels rather than one with the choice as an argument: a run compiles only
     the sweep it uses (the plain one cost 1.5 s of the first run's compilation)."""
     if mode == MOMENTUM or mode == TURNING:

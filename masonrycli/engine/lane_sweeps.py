@@ -32,7 +32,7 @@ import numpy as np
 
 from masonrycli.engine import _vector, momentum
 from masonrycli.engine._jit import njit
-from masonrycli.engine.lanes import FULL, R_PN, R_PT, R_ST, R_XN, R_XT, ROWS, W, pack_lanes, unpack_lanes
+from masonrycli.engine.lanes import FULL, LANES, R_PN, R_PT, R_ST, R_XN, R_XT, ROWS, pack_lanes, unpack_lanes
 from masonrycli.engine.nlgs import (
     P_BIAS,
     P_IIA,
@@ -120,47 +120,47 @@ def _group(j, act, Q, IA, IB, v4, beta, mu, full):
     #         act only, by scalar stores in lane order (on Zen 5 the masked hardware scatters cost more:
     #         benchmarks/JOURNAL.md, explicit vectors addendum).
     # Returns the group's Σ|e_α|², its lanes added in lane order.
-    q0 = j * ROWS * W
-    at = j * W
+    q0 = j * ROWS * LANES
+    at = j * LANES
     vax, vay, waa = V.gather_rows(v4, IA, at)
     vbx, vby, wbb = V.gather_rows(v4, IB, at)
-    nx = V.load(Q, q0 + P_NX * W)
-    ny = V.load(Q, q0 + P_NY * W)
-    ta = V.load(Q, q0 + P_TA * W)
-    na = V.load(Q, q0 + P_NA * W)
-    tb = V.load(Q, q0 + P_TB * W)
-    nb = V.load(Q, q0 + P_NB * W)
+    nx = V.load(Q, q0 + P_NX * LANES)
+    ny = V.load(Q, q0 + P_NY * LANES)
+    ta = V.load(Q, q0 + P_TA * LANES)
+    na = V.load(Q, q0 + P_NA * LANES)
+    tb = V.load(Q, q0 + P_TB * LANES)
+    nb = V.load(Q, q0 + P_NB * LANES)
     dvx = vbx - vax  # u = H_αᵀ v as nlgs._relative_velocity
     dvy = vby - vay
     ut = dvx * ny - dvy * nx + wbb * tb - waa * ta
     un = dvx * nx + dvy * ny + wbb * nb - waa * na
-    xt = V.load(Q, q0 + R_XT * W)  # the extrapolated start as momentum._momentum_sweeps
-    xn = V.load(Q, q0 + R_XN * W)
-    rt0 = xt + beta * (xt - V.load(Q, q0 + R_PT * W))
-    rn0 = xn + beta * (xn - V.load(Q, q0 + R_PN * W))
-    V.masked_store(Q, q0 + R_PT * W, xt, act)
-    V.masked_store(Q, q0 + R_PN * W, xn, act)
-    wtt = V.load(Q, q0 + P_WTT * W)
-    wtn = V.load(Q, q0 + P_WTN * W)
-    wnn = V.load(Q, q0 + P_WNN * W)
+    xt = V.load(Q, q0 + R_XT * LANES)  # the extrapolated start as momentum._momentum_sweeps
+    xn = V.load(Q, q0 + R_XN * LANES)
+    rt0 = xt + beta * (xt - V.load(Q, q0 + R_PT * LANES))
+    rn0 = xn + beta * (xn - V.load(Q, q0 + R_PN * LANES))
+    V.masked_store(Q, q0 + R_PT * LANES, xt, act)
+    V.masked_store(Q, q0 + R_PN * LANES, xn, act)
+    wtt = V.load(Q, q0 + P_WTT * LANES)
+    wtn = V.load(Q, q0 + P_WTN * LANES)
+    wnn = V.load(Q, q0 + P_WNN * LANES)
     ut = ut - (wtt * rt0 + wtn * rn0)
     un = un - (wtn * rt0 + wnn * rn0)
-    rt, rn, st = _local_solve_v(ut, un, V.load(Q, q0 + P_BIAS * W), wtt, wtn, wnn, V.load(Q, q0 + P_ITT * W),
-                                V.load(Q, q0 + P_ITN * W), V.load(Q, q0 + P_INN * W), V.load(Q, q0 + P_ISP * W),
-                                V.load(Q, q0 + P_ISM * W), mu)  # fmt: skip
-    V.masked_store(Q, q0 + R_ST * W, st, act)
-    V.masked_store(Q, q0 + R_XT * W, rt, act)
-    V.masked_store(Q, q0 + R_XN * W, rn, act)
+    rt, rn, st = _local_solve_v(ut, un, V.load(Q, q0 + P_BIAS * LANES), wtt, wtn, wnn, V.load(Q, q0 + P_ITT * LANES),
+                                V.load(Q, q0 + P_ITN * LANES), V.load(Q, q0 + P_INN * LANES), V.load(Q, q0 + P_ISP * LANES),
+                                V.load(Q, q0 + P_ISM * LANES), mu)  # fmt: skip
+    V.masked_store(Q, q0 + R_ST * LANES, st, act)
+    V.masked_store(Q, q0 + R_XT * LANES, rt, act)
+    V.masked_store(Q, q0 + R_XN * LANES, rn, act)
     drt = rt - rt0
     drn = rn - rn0
     zero = V.splat(0.0)
     moved = act & ((drt != zero) | (drn != zero))
     px = drt * ny + drn * nx  # the push as nlgs._push
     py = -drt * nx + drn * ny
-    ima = V.load(Q, q0 + P_IMA * W)
-    iia = V.load(Q, q0 + P_IIA * W)
-    imb = V.load(Q, q0 + P_IMB * W)
-    iib = V.load(Q, q0 + P_IIB * W)
+    ima = V.load(Q, q0 + P_IMA * LANES)
+    iia = V.load(Q, q0 + P_IIA * LANES)
+    imb = V.load(Q, q0 + P_IMB * LANES)
+    iib = V.load(Q, q0 + P_IIB * LANES)
     push_a = moved & ((ima > zero) | (iia > zero))  # movable bodies only: a support is never written
     push_b = moved & ((imb > zero) | (iib > zero))
     nax = vax - ima * px
@@ -175,7 +175,7 @@ def _group(j, act, Q, IA, IB, v4, beta, mu, full):
     else:
         pa = V.bits_of(push_a)
         pb = V.bits_of(push_b)
-        for q in range(W):
+        for q in range(LANES):
             if pa >> q & 1:
                 o = IA[at + q]
                 v4[o] = V.lane(nax, q)
@@ -190,7 +190,7 @@ def _group(j, act, Q, IA, IB, v4, beta, mu, full):
     en = wtn * drt + wnn * drn
     e2 = V.select(act, et * et + en * en, zero)  # an absent lane's is +0: adding it changes no bit
     s = 0.0
-    for q in range(W):
+    for q in range(LANES):
         s += V.lane(e2, q)
     return s
 

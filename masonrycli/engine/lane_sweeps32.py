@@ -62,11 +62,11 @@ from masonrycli.engine.nlgs import (
 )
 
 V = _vector32
-W = 16
-"""Lanes: contacts of a group."""
+LANES32 = 16
+"""Lanes: contacts of a float32 group (``_vector32.WIDTH``)."""
 R_XT, R_XN, R_PT, R_PN, R_ST = PACK_WIDTH, PACK_WIDTH + 1, PACK_WIDTH + 2, PACK_WIDTH + 3, PACK_WIDTH + 4
 ROWS = PACK_WIDTH + 5
-FULL = (1 << W) - 1
+FULL = (1 << LANES32) - 1
 STALL32 = 200
 """Sweeps without a new low after which the float32 stage hands the step to the float64 sweeps (at most
 the first stage's own stall window)."""
@@ -140,7 +140,7 @@ def _clashing_groups(contact_body, pack, count, run, stagger, seen):
     n = 0
     for j in range(run):
         clash = 0
-        for q in range(W):
+        for q in range(LANES32):
             c = _contact(count, run, q, j, stagger)
             if c < 0:
                 continue
@@ -162,7 +162,7 @@ def _clashing_groups(contact_body, pack, count, run, stagger, seen):
 def _choose_layout(contact_body, pack, count, bodies):
     # 1 (staggered) when it has fewer clashing groups than the plain layout, else 0. The plain layout is
     # kept unless more than an eighth of its groups clash.
-    run = (count + W - 1) // W
+    run = (count + LANES32 - 1) // LANES32
     seen = np.empty(bodies, np.int64)
     for b in range(bodies):
         seen[b] = -1
@@ -182,30 +182,30 @@ def pack_lanes32(contact_body, pack, count, v, r, stagger):
     # v4[4b … 4b + 2] = float32(v_free + M⁻¹ H r_warm), the pushes in float64 (v is not written)
     # Its own copy of lanes.pack_lanes but for colour_lane: float32 rows, the staggered layout, and the
     # pushes in contact order from the pack (lanes': in lane order from Q), so one kernel would change bits.
-    run = (count + W - 1) // W
-    Q = np.empty(run * ROWS * W, np.float32)
+    run = (count + LANES32 - 1) // LANES32
+    Q = np.empty(run * ROWS * LANES32, np.float32)
     for i in range(Q.shape[0]):
         Q[i] = 0.0
-    IA = np.empty(run * W, np.int64)
-    IB = np.empty(run * W, np.int64)
-    lanes = np.empty(run * W, np.int64)
+    IA = np.empty(run * LANES32, np.int64)
+    IB = np.empty(run * LANES32, np.int64)
+    lanes = np.empty(run * LANES32, np.int64)
     for j in range(run):
-        for q in range(W):
+        for q in range(LANES32):
             c = _contact(count, run, q, j, stagger)
-            lanes[j * W + q] = c
-            IA[j * W + q] = 0
-            IB[j * W + q] = 0
+            lanes[j * LANES32 + q] = c
+            IA[j * LANES32 + q] = 0
+            IB[j * LANES32 + q] = 0
             if c < 0:
                 continue
-            base = j * ROWS * W + q
+            base = j * ROWS * LANES32 + q
             for row in range(PACK_WIDTH):
-                Q[base + row * W] = np.float32(pack[c, row])
-            Q[base + R_XT * W] = Q[base + R_PT * W] = np.float32(r[c, 0])
-            Q[base + R_XN * W] = Q[base + R_PN * W] = np.float32(r[c, 1])
-            IA[j * W + q] = 4 * contact_body[c, 0]
-            IB[j * W + q] = 4 * contact_body[c, 1]
+                Q[base + row * LANES32] = np.float32(pack[c, row])
+            Q[base + R_XT * LANES32] = Q[base + R_PT * LANES32] = np.float32(r[c, 0])
+            Q[base + R_XN * LANES32] = Q[base + R_PN * LANES32] = np.float32(r[c, 1])
+            IA[j * LANES32 + q] = 4 * contact_body[c, 0]
+            IB[j * LANES32 + q] = 4 * contact_body[c, 1]
     bodies = v.shape[0]
-    sub = np.empty((run, W), np.int64)
+    sub = np.empty((run, LANES32), np.int64)
     nsub = np.empty(run, np.int64)
     seen = np.empty(bodies, np.int64)
     held = np.empty(bodies, np.int64)
@@ -213,9 +213,9 @@ def pack_lanes32(contact_body, pack, count, v, r, stagger):
         seen[b] = -1
     for j in range(run):
         n = 0
-        for q in range(W):
-            if lanes[j * W + q] >= 0:
-                n = colour_lane(Q, IA, IB, j, q, W, n, seen, held, sub)
+        for q in range(LANES32):
+            if lanes[j * LANES32 + q] >= 0:
+                n = colour_lane(Q, IA, IB, j, q, LANES32, n, seen, held, sub)
         nsub[j] = n
     v64 = v.copy()
     for c in range(count):
@@ -233,47 +233,47 @@ def pack_lanes32(contact_body, pack, count, v, r, stagger):
 def _group32(j, act, Q, IA, IB, v4, beta, mu, full):
     # lane_sweeps._group in float32 on 16 lanes; returns the lanes' |e_α|² (0 in lanes outside act)
     # A copy, not shared: numba cannot take the vector module (_vector32, <16 x float>) as an argument.
-    q0 = j * ROWS * W
-    at = j * W
+    q0 = j * ROWS * LANES32
+    at = j * LANES32
     vax, vay, waa = V.gather_rows(v4, IA, at)
     vbx, vby, wbb = V.gather_rows(v4, IB, at)
-    nx = V.load(Q, q0 + P_NX * W)
-    ny = V.load(Q, q0 + P_NY * W)
-    ta = V.load(Q, q0 + P_TA * W)
-    na = V.load(Q, q0 + P_NA * W)
-    tb = V.load(Q, q0 + P_TB * W)
-    nb = V.load(Q, q0 + P_NB * W)
+    nx = V.load(Q, q0 + P_NX * LANES32)
+    ny = V.load(Q, q0 + P_NY * LANES32)
+    ta = V.load(Q, q0 + P_TA * LANES32)
+    na = V.load(Q, q0 + P_NA * LANES32)
+    tb = V.load(Q, q0 + P_TB * LANES32)
+    nb = V.load(Q, q0 + P_NB * LANES32)
     dvx = vbx - vax
     dvy = vby - vay
     ut = dvx * ny - dvy * nx + wbb * tb - waa * ta
     un = dvx * nx + dvy * ny + wbb * nb - waa * na
-    xt = V.load(Q, q0 + R_XT * W)
-    xn = V.load(Q, q0 + R_XN * W)
-    rt0 = xt + beta * (xt - V.load(Q, q0 + R_PT * W))
-    rn0 = xn + beta * (xn - V.load(Q, q0 + R_PN * W))
-    V.masked_store(Q, q0 + R_PT * W, xt, act)
-    V.masked_store(Q, q0 + R_PN * W, xn, act)
-    wtt = V.load(Q, q0 + P_WTT * W)
-    wtn = V.load(Q, q0 + P_WTN * W)
-    wnn = V.load(Q, q0 + P_WNN * W)
+    xt = V.load(Q, q0 + R_XT * LANES32)
+    xn = V.load(Q, q0 + R_XN * LANES32)
+    rt0 = xt + beta * (xt - V.load(Q, q0 + R_PT * LANES32))
+    rn0 = xn + beta * (xn - V.load(Q, q0 + R_PN * LANES32))
+    V.masked_store(Q, q0 + R_PT * LANES32, xt, act)
+    V.masked_store(Q, q0 + R_PN * LANES32, xn, act)
+    wtt = V.load(Q, q0 + P_WTT * LANES32)
+    wtn = V.load(Q, q0 + P_WTN * LANES32)
+    wnn = V.load(Q, q0 + P_WNN * LANES32)
     ut = ut - (wtt * rt0 + wtn * rn0)
     un = un - (wtn * rt0 + wnn * rn0)
-    rt, rn, st = _local_solve32(ut, un, V.load(Q, q0 + P_BIAS * W), wtt, wtn, wnn, V.load(Q, q0 + P_ITT * W),
-                                V.load(Q, q0 + P_ITN * W), V.load(Q, q0 + P_INN * W), V.load(Q, q0 + P_ISP * W),
-                                V.load(Q, q0 + P_ISM * W), mu)  # fmt: skip
-    V.masked_store(Q, q0 + R_ST * W, st, act)
-    V.masked_store(Q, q0 + R_XT * W, rt, act)
-    V.masked_store(Q, q0 + R_XN * W, rn, act)
+    rt, rn, st = _local_solve32(ut, un, V.load(Q, q0 + P_BIAS * LANES32), wtt, wtn, wnn, V.load(Q, q0 + P_ITT * LANES32),
+                                V.load(Q, q0 + P_ITN * LANES32), V.load(Q, q0 + P_INN * LANES32), V.load(Q, q0 + P_ISP * LANES32),
+                                V.load(Q, q0 + P_ISM * LANES32), mu)  # fmt: skip
+    V.masked_store(Q, q0 + R_ST * LANES32, st, act)
+    V.masked_store(Q, q0 + R_XT * LANES32, rt, act)
+    V.masked_store(Q, q0 + R_XN * LANES32, rn, act)
     drt = rt - rt0
     drn = rn - rn0
     zero = V.splat(0.0)
     moved = act & ((drt != zero) | (drn != zero))
     px = drt * ny + drn * nx
     py = -drt * nx + drn * ny
-    ima = V.load(Q, q0 + P_IMA * W)
-    iia = V.load(Q, q0 + P_IIA * W)
-    imb = V.load(Q, q0 + P_IMB * W)
-    iib = V.load(Q, q0 + P_IIB * W)
+    ima = V.load(Q, q0 + P_IMA * LANES32)
+    iia = V.load(Q, q0 + P_IIA * LANES32)
+    imb = V.load(Q, q0 + P_IMB * LANES32)
+    iib = V.load(Q, q0 + P_IIB * LANES32)
     push_a = moved & ((ima > zero) | (iia > zero))
     push_b = moved & ((imb > zero) | (iib > zero))
     nax = vax - ima * px
@@ -288,7 +288,7 @@ def _group32(j, act, Q, IA, IB, v4, beta, mu, full):
     else:
         pa = V.bits_of(push_a)
         pb = V.bits_of(push_b)
-        for q in range(W):
+        for q in range(LANES32):
             if pa >> q & 1:
                 o = IA[at + q]
                 v4[o] = np.float32(V.lane(nax, q))
@@ -318,12 +318,12 @@ def _resync(contact_body, pack, Q, lanes, v_free, v64, vp64, v4, v_prev):
         c = lanes[i]
         if c < 0:
             continue
-        base = (i // W) * ROWS * W + i % W
+        base = (i // LANES32) * ROWS * LANES32 + i % LANES32
         a = contact_body[c, 0]
         b = contact_body[c, 1]
         cc = np.uint64(c)
-        _push(v64, a, b, pack, cc, np.float64(Q[base + R_XT * W]), np.float64(Q[base + R_XN * W]))
-        _push(vp64, a, b, pack, cc, np.float64(Q[base + R_PT * W]), np.float64(Q[base + R_PN * W]))
+        _push(v64, a, b, pack, cc, np.float64(Q[base + R_XT * LANES32]), np.float64(Q[base + R_XN * LANES32]))
+        _push(vp64, a, b, pack, cc, np.float64(Q[base + R_PT * LANES32]), np.float64(Q[base + R_PN * LANES32]))
     for b in range(v_free.shape[0]):
         for k in range(3):
             v4[4 * b + k] = np.float32(v64[b, k])
@@ -376,7 +376,7 @@ def lane_sweeps32(
             for k in range(nsub[j]):
                 acc = acc + _group32(j, V.mask_bits(sub[j, k]), Q, IA, IB, v4, vbeta, vmu, False)
         sum_e2 = 0.0
-        for q in range(W):
+        for q in range(LANES32):
             sum_e2 += V.lane(acc, q)
         residual = np.sqrt(sum_e2 / count)
         if residual <= tolerance:
@@ -392,13 +392,13 @@ def lane_sweeps32(
         beta = (j_restart - 1.0) / (j_restart + 2.0)
         j_restart += 1
     for j in range(run):
-        for q in range(W):
-            c = lanes[j * W + q]
+        for q in range(LANES32):
+            c = lanes[j * LANES32 + q]
             if c >= 0:
-                base = j * ROWS * W + q
-                r[c, 0] = np.float64(Q[base + R_XT * W])
-                r[c, 1] = np.float64(Q[base + R_XN * W])
-                status[c] = np.int8(Q[base + R_ST * W])
+                base = j * ROWS * LANES32 + q
+                r[c, 0] = np.float64(Q[base + R_XT * LANES32])
+                r[c, 1] = np.float64(Q[base + R_XN * LANES32])
+                status[c] = np.int8(Q[base + R_ST * LANES32])
     return iterations, residual
 
 

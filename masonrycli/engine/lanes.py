@@ -36,12 +36,12 @@ import numpy as np
 from masonrycli.engine._jit import njit
 from masonrycli.engine.nlgs import P_IIA, P_IIB, P_IMA, P_IMB, P_NA, P_NB, P_NX, P_NY, P_TA, P_TB, PACK_WIDTH
 
-W = 8
-"""Lanes: contacts of a group (``_vector.WIDTH``)."""
+LANES = 8
+"""Lanes: contacts of a group (``_vector.WIDTH``). (W in these modules' comments is the Delassus block W_αα.)"""
 R_XT, R_XN, R_PT, R_PN, R_ST = PACK_WIDTH, PACK_WIDTH + 1, PACK_WIDTH + 2, PACK_WIDTH + 3, PACK_WIDTH + 4
 ROWS = PACK_WIDTH + 5
 """Rows of a group: the packed constants, r_t, r_n, r_prev,t, r_prev,n, status."""
-FULL = (1 << W) - 1
+FULL = (1 << LANES) - 1
 """The lane mask of a group with all 8 lanes."""
 TILE = 16
 """Groups whose rows pack_lanes fills at once (16 × 1.5 kB of rows, and 8 runs of 16 pack rows, in L1)."""
@@ -95,10 +95,10 @@ def _sub_groups(Q, IA, IB, count, run, j, seen, held, sub):
     # Bitmasks per body rather than comparing the 28 pairs of lanes: the pairs took 145 µs a step on the
     # 248-block wall (whose sweeps take ~600 µs a step), the masks ~5.
     n = 0
-    for q in range(W):
+    for q in range(LANES):
         if q * run + j >= count:
             break
-        n = colour_lane(Q, IA, IB, j, q, W, n, seen, held, sub)
+        n = colour_lane(Q, IA, IB, j, q, LANES, n, seen, held, sub)
     return n
 
 
@@ -106,20 +106,20 @@ def _sub_groups(Q, IA, IB, count, run, j, seen, held, sub):
 def _push_lane(v, Q, base, a, b):
     # v ← v + M⁻¹ H r of the lane at Q[base] (its r in rows R_XT, R_XN): nlgs._push's operations on the same
     # values (the rows are copies of the pack), so the same bits; a support gets ±0.
-    drt = Q[base + R_XT * W]
-    drn = Q[base + R_XN * W]
-    nx = Q[base + P_NX * W]
-    ny = Q[base + P_NY * W]
+    drt = Q[base + R_XT * LANES]
+    drn = Q[base + R_XN * LANES]
+    nx = Q[base + P_NX * LANES]
+    ny = Q[base + P_NY * LANES]
     px = drt * ny + drn * nx
     py = -drt * nx + drn * ny
-    ima = Q[base + P_IMA * W]
+    ima = Q[base + P_IMA * LANES]
     v[a, 0] -= ima * px
     v[a, 1] -= ima * py
-    v[a, 2] -= Q[base + P_IIA * W] * (Q[base + P_TA * W] * drt + Q[base + P_NA * W] * drn)
-    imb = Q[base + P_IMB * W]
+    v[a, 2] -= Q[base + P_IIA * LANES] * (Q[base + P_TA * LANES] * drt + Q[base + P_NA * LANES] * drn)
+    imb = Q[base + P_IMB * LANES]
     v[b, 0] += imb * px
     v[b, 1] += imb * py
-    v[b, 2] += Q[base + P_IIB * W] * (Q[base + P_TB * W] * drt + Q[base + P_NB * W] * drn)
+    v[b, 2] += Q[base + P_IIB * LANES] * (Q[base + P_TB * LANES] * drt + Q[base + P_NB * LANES] * drn)
 
 
 @njit(inline="always")
@@ -136,12 +136,12 @@ def pack_lanes(contact_body, pack, count, v, r):
     # 248-block wall against 31 (benchmarks/JOURNAL.md, "Where a wall-248 step goes at the lane sweeps").
     # Not shared with lane_sweeps32.pack_lanes32 (only colour_lane is): its pushes go in contact order from
     # the pack in float64, these in lane order from Q, so one kernel would change one path's bits.
-    run = (count + W - 1) // W
+    run = (count + LANES - 1) // LANES
     # np.empty and a fill, not np.zeros (_jit's rule): np.zeros compiled 2 signatures and a fill of its own,
     # 0.1 s of a first run's CPU (benchmarks/JOURNAL.md, "Cold start"); absent lanes keep these zeros
-    Q = np.empty(run * ROWS * W, np.float64)
-    IA = np.empty(run * W, np.int64)
-    IB = np.empty(run * W, np.int64)
+    Q = np.empty(run * ROWS * LANES, np.float64)
+    IA = np.empty(run * LANES, np.int64)
+    IB = np.empty(run * LANES, np.int64)
     for i in range(Q.shape[0]):
         Q[i] = 0.0
     for i in range(IA.shape[0]):
@@ -149,21 +149,21 @@ def pack_lanes(contact_body, pack, count, v, r):
         IB[i] = 0
     for j0 in range(0, run, TILE):
         j1 = min(j0 + TILE, run)
-        for q in range(W):
+        for q in range(LANES):
             for j in range(j0, j1):
                 c = q * run + j
                 if c >= count:
                     break
-                base = j * ROWS * W + q
+                base = j * ROWS * LANES + q
                 for row in range(PACK_WIDTH):
-                    Q[base + row * W] = pack[c, row]
-                Q[base + R_XT * W] = r[c, 0]
-                Q[base + R_PT * W] = r[c, 0]
-                Q[base + R_XN * W] = r[c, 1]
-                Q[base + R_PN * W] = r[c, 1]
-                IA[j * W + q] = 4 * contact_body[c, 0]
-                IB[j * W + q] = 4 * contact_body[c, 1]
-    sub = np.empty((run, W), np.int64)
+                    Q[base + row * LANES] = pack[c, row]
+                Q[base + R_XT * LANES] = r[c, 0]
+                Q[base + R_PT * LANES] = r[c, 0]
+                Q[base + R_XN * LANES] = r[c, 1]
+                Q[base + R_PN * LANES] = r[c, 1]
+                IA[j * LANES + q] = 4 * contact_body[c, 0]
+                IB[j * LANES + q] = 4 * contact_body[c, 1]
+    sub = np.empty((run, LANES), np.int64)
     nsub = np.empty(run, np.int64)
     bodies = v.shape[0]
     seen = np.empty(bodies, np.int64)
@@ -172,10 +172,10 @@ def pack_lanes(contact_body, pack, count, v, r):
         seen[b] = -1
     for j in range(run):  # group by group in lane order: the solver lab's "lanes+split" order, whose bits these are
         nsub[j] = _sub_groups(Q, IA, IB, count, run, j, seen, held, sub)
-        for q in range(W):
+        for q in range(LANES):
             if q * run + j >= count:
                 break
-            _push_lane(v, Q, j * ROWS * W + q, IA[j * W + q] >> 2, IB[j * W + q] >> 2)
+            _push_lane(v, Q, j * ROWS * LANES + q, IA[j * LANES + q] >> 2, IB[j * LANES + q] >> 2)
     v4 = np.empty(4 * bodies, np.float64)
     for b in range(bodies):
         v4[4 * b] = v[b, 0]
@@ -188,17 +188,17 @@ def pack_lanes(contact_body, pack, count, v, r):
 @njit(inline="always")
 def unpack_lanes(Q, count, v4, v, r, status):
     # Back from group order: v[b] ← v4[4b … 4b + 2]; r, status of contact c ← its lane's rows.
-    run = (count + W - 1) // W
+    run = (count + LANES - 1) // LANES
     for b in range(v.shape[0]):
         v[b, 0] = v4[4 * b]
         v[b, 1] = v4[4 * b + 1]
         v[b, 2] = v4[4 * b + 2]
     for j in range(run):  # group by group: Q read where it lies (c in order took 2.5 µs more a step)
-        for q in range(W):
+        for q in range(LANES):
             c = q * run + j
             if c >= count:
                 break
-            base = j * ROWS * W + q
-            r[c, 0] = Q[base + R_XT * W]
-            r[c, 1] = Q[base + R_XN * W]
-            status[c] = np.int8(Q[base + R_ST * W])
+            base = j * ROWS * LANES + q
+            r[c, 0] = Q[base + R_XT * LANES]
+            r[c, 1] = Q[base + R_XN * LANES]
+            status[c] = np.int8(Q[base + R_ST * LANES])

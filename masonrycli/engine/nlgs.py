@@ -31,7 +31,7 @@ Stagnation. On tall walls that slide (32 courses and more, shaken at 1 m/s) Gaus
 step 74 of the 32-course wall the residual wanders between 7.7e-5 and 2.3e-4 m/s for 50 000 sweeps while
 hundreds of sliding bed-joint corners change status (benchmarks/JOURNAL.md, "Sweep order"), and sweeping
 such steps to the cap cost half of that wall's run time. So when a solve with a tolerance > 0 goes
-STALL_SWEEPS sweeps without a new lowest residual, dispatch.solve continues it by faces (:mod:`masonrycli.engine.faces`:
+PLAIN_STALL sweeps without a new lowest residual, dispatch.solve continues it by faces (:mod:`masonrycli.engine.faces`:
 the points of each face solved together, which does not cycle there) until the tolerance, the cap (counted
 in sweep units), or the faces stall in turn; a step that still misses the tolerance is counted unconverged
 as at the cap. A slowly converging step keeps reaching new lows and is not handed over. Tolerance 0 runs
@@ -49,7 +49,7 @@ import numpy as np
 from masonrycli.engine._jit import kernel_only, njit
 from masonrycli.engine.contact import ContactStatus
 
-STALL_SWEEPS = 10_000
+PLAIN_STALL = 10_000
 """Point sweeps without a new lowest residual after which a solve with a tolerance > 0 continues by faces
 (module doc, "Stagnation"); 2000 handed over slowly converging steps (golden histories changed)."""
 
@@ -228,7 +228,7 @@ def _nlgs(contact_body, pack, count, mu, tolerance, max_iterations, v, r, status
     #                       e_α = W_αα (r_α' − r_α)      (m/s: α's violation of its law at the visit)
     #                       v += M⁻¹ H_α (r_α' − r_α)
     #       residual = sqrt(Σ_α |e_α|² / C)
-    #   until residual ≤ tolerance, or the cap, or (tolerance > 0) STALL_SWEEPS sweeps in a row without
+    #   until residual ≤ tolerance, or the cap, or (tolerance > 0) PLAIN_STALL sweeps in a row without
     #   a new lowest residual: sweeping on would only cycle (module doc), dispatch.solve goes on by faces.
     for c in range(count):
         # c unsigned as in the sweep below: one compiled _push serves both
@@ -274,7 +274,7 @@ def _nlgs(contact_body, pack, count, mu, tolerance, max_iterations, v, r, status
         if residual < best:
             best = residual
             best_at = it
-        elif tolerance > 0.0 and it - best_at >= STALL_SWEEPS:
+        elif tolerance > 0.0 and it - best_at >= PLAIN_STALL:
             break
     return iterations, residual
 
