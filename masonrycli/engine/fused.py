@@ -67,23 +67,26 @@ def _after_solve(body_q, v_old, body_v, dt, theta, block_count, contact_key, r, 
     return speed, depth if depth > 0.0 else 0.0
 
 
-def before_solve(solver, state, support_v_next) -> tuple[int, int, float] | None:
-    """Begin ``solver``'s step on ``state`` up to the solve: q_m, contacts, warm start, v_free. Returns
-    (contacts, warm-started contacts, detection distance), or None when the launchers must detect (the
-    first detection, new arrays, a capacity exceeded, a pose not finite): q_m is then written and the
-    distance is ``solver.detection_distance`` of it."""
-    m, bf, warm = solver.model, solver.buffers, solver._warm
+def before_solve(m, bf, warm, state, support_v_next, q_m, v_old, r) -> tuple[int, int, float] | None:
+    """Begin a step of model ``m`` on ``state`` up to the solve: q_m, contacts, warm start, v_free.
+
+    In: the Solver's arrays — ``bf`` its ContactBuffers (contacts written, count set), ``warm`` its
+    warmstart.WarmStart (the previous step's keys and impulses), ``q_m`` (B, 3) out: the detection
+    configuration, ``v_old`` (B, 3) out: v_n, ``r`` (C_cap, 2) N·s out: the warm start. Returns (contacts,
+    warm-started contacts, detection distance), or None when the launchers must detect (the first
+    detection, new arrays, a capacity exceeded, a pose not finite): q_m is then written and the distance is
+    Solver.detection_distance of it."""
     if not bf.checked_for(m.vert_local, m.body_dynamic, m.body_vert_start):
         return None
     pairs = bf.pairs
     pair_count, count, hits, distance = _before_solve(
         state.body_q, state.body_v, m.body_radius, m.dt, m.theta, m.gravity, m.alert_distance,
         m.body_vert_start, m.vert_local, m.body_dynamic, support_v_next, m.block_count,
-        solver.body_q_m, solver._v_old,
+        q_m, v_old,
         bf.vert_world, bf.body_aabb, pairs.axis, pairs.body_order, pairs.pair_body, pairs.pair_scratch,
         pairs.body_counter, bf.edge_normal, bf.body_size,
         bf.contact_body, bf.contact_point, bf.contact_normal, bf.contact_gap, bf.contact_key,
-        warm.key, warm.r, solver._r,
+        warm.key, warm.r, r,
     )  # fmt: skip
     if count < 0:
         return None
@@ -92,13 +95,13 @@ def before_solve(solver, state, support_v_next) -> tuple[int, int, float] | None
     return count, hits, distance
 
 
-def after_solve(solver, state, count: int) -> tuple[float, float]:
-    """End ``solver``'s step after the solve: q_n+1 in ``state``, the impulses kept for the next warm start.
-    Returns (top block speed m/s, NaN if a block's q or v is not finite; largest penetration m, ≥ 0)."""
-    m, bf = solver.model, solver.buffers
-    keep_key, keep_r = solver._warm.reserve(count)  # what the next step's warm start reads
+def after_solve(m, bf, warm, state, count: int, v_old, r) -> tuple[float, float]:
+    """End a step of model ``m`` after the solve: q_n+1 in ``state`` (θ-method from ``v_old``, v_n), the
+    ``count`` contacts' keys (``bf``) and impulses ``r`` kept in ``warm`` for the next warm start. Returns (top
+    block speed m/s, NaN if a block's q or v is not finite; largest penetration m, ≥ 0)."""
+    keep_key, keep_r = warm.reserve(count)  # what the next step's warm start reads
     speed, depth = _after_solve(
-        state.body_q, solver._v_old, state.body_v, m.dt, m.theta, m.block_count,
-        bf.contact_key, solver._r, bf.contact_gap, count, keep_key, keep_r,
+        state.body_q, v_old, state.body_v, m.dt, m.theta, m.block_count,
+        bf.contact_key, r, bf.contact_gap, count, keep_key, keep_r,
     )  # fmt: skip
     return speed, depth

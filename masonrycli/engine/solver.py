@@ -182,8 +182,10 @@ class Solver:
         m = self.model
         k = state.step
         support_v_next = m.support_velocity[k + 1]
-        begun = fused.before_solve(self, state, support_v_next)  # steps 1–4 in one call
         bf = self.buffers
+        begun = fused.before_solve(  # steps 1–4 in one call
+            m, bf, self._warm, state, support_v_next, self.body_q_m, self._v_old, self._r
+        )
         if begun is None:  # first detection, capacities exceeded, a pose not finite: one by one
             top_speed = integrate.begin_step(m, state.body_q, state.body_v, self.body_q_m, self._v_old)
             count = self.detect(self.body_q_m, self.detection_distance(top_speed))
@@ -214,7 +216,9 @@ class Solver:
         dissipated, work = power.contact_power(
             body, self._pack, self._r, count, self._v_old, state.body_v, m, self._force, self.support_force
         )
-        block_speed, penetration = fused.after_solve(self, state, count)  # steps 8–9
+        block_speed, penetration = fused.after_solve(  # steps 8–9
+            self.model, bf, self._warm, state, count, self._v_old, self._r
+        )
         self._top_speed = block_speed
         state.step = k + 1
         state.time = state.step * m.dt
