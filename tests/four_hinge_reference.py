@@ -42,23 +42,29 @@ def _power(prefix_sums, bodies) -> np.ndarray:
 
 
 def least_load_factor(
-    intrados: np.ndarray, extrados: np.ndarray, centroid: np.ndarray, dead: np.ndarray, live: np.ndarray
+    intrados: np.ndarray,
+    extrados: np.ndarray,
+    centroid: np.ndarray,
+    dead: np.ndarray,
+    live: np.ndarray,
+    live_at: np.ndarray | None = None,
 ) -> tuple[float, tuple]:
     """(λ, (joints a b c d, sides)) of the weakest admissible four-hinge mechanism.
 
     intrados, extrados : (n+1, 2) joint end points, left to right; centroid : (n, 2) voussoir centroids;
-    dead, live : (n, 2) forces on each voussoir (the live one multiplied by λ).
+    dead, live : (n, 2) forces on each voussoir (the live one multiplied by λ); live_at : (n, 2) where each
+    live force acts (default: the centroids; a deck load acts on the extrados).
     """
     n = len(centroid)
     radial = extrados - intrados
     radial /= np.hypot(radial[:, 0], radial[:, 1])[:, None]
     normal = np.stack([radial[:, 1], -radial[:, 0]], axis=1)  # along the ring, left to right
 
-    def prefix(forces):
-        m = _cross(centroid[:, 0], centroid[:, 1], forces[:, 0], forces[:, 1])
+    def prefix(forces, at):
+        m = _cross(at[:, 0], at[:, 1], forces[:, 0], forces[:, 1])
         return [np.concatenate([[0.0], np.cumsum(v)]) for v in (forces[:, 0], forces[:, 1], m)]
 
-    sums = {"dead": prefix(dead), "live": prefix(live)}
+    sums = {"dead": prefix(dead, centroid), "live": prefix(live, centroid if live_at is None else live_at)}
     combos = np.array(list(itertools.combinations(range(n + 1), 4)))
     a, b, c, d = combos.T
     best = (np.inf, None)

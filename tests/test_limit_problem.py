@@ -198,3 +198,22 @@ def test_thrust_without_bound_is_said_and_lambda_still_found():
     assert [t["greatest_N"] for t in data if t["support"] != "ground"] == [None, None]  # JSON has no infinity
     lone = analyse(column(1, 0.4, 0.8, friction=0.6), LiveLoad(), thrust=True)
     assert lone.support_thrust[0][2:] == (0.0, 0.0)
+
+
+def test_a_point_load_given_by_its_place_acts_there_not_at_the_blocks_centroid():
+    """`--at X` is a load on the deck at x = X: its line of action passes there, on the block's top. Statics
+    of one block: a beam 2 m × 0.2 m on a support under x ∈ [0, 1.2] (centroid x = 1 over it) tips about the
+    support's edge x = 1.2 under a load P down at x = X > 1.2 when P (X − 1.2) = W (1.2 − 1): λ = 0.2 / (X − 1.2);
+    at the centroid (--block) it never tips. A push +x at the top of a B × H block on the ground tips it at
+    λ = B / (2H), at the centroid at B / H. Before, --at loaded the centroid: 'no collapse' (unbounded) for
+    the beam, whatever X."""
+    beam = scenario([("beam", box(0.0, 0.0, 2.0, 0.2))], [("ground", box(-1.0, -0.5, 1.2, 0.0))], friction=2.0)
+    for x in (1.5, 1.9):
+        result = analyse(beam, LiveLoad("point", at=x))
+        assert result.load.block == "beam"
+        assert result.load_factor == pytest.approx(0.2 / (x - 1.2), rel=REL)
+    with pytest.raises(LimitError, match="no collapse"):
+        analyse(beam, LiveLoad("point", block="beam"))
+    block = column(1, 0.4, 0.8, 2.0)
+    assert analyse(block, LiveLoad("point", "+x", at=0.2)).load_factor == pytest.approx(0.25, rel=REL)
+    assert analyse(block, LiveLoad("point", "+x", block="b0")).load_factor == pytest.approx(0.5, rel=REL)

@@ -132,3 +132,29 @@ def test_segmental_arch_horizontal_acceleration_and_quarter_span_load_match_the_
     assert _unordered(r.hinges) == hinge_names(hinged)
     weight = voussoir_loads(i, e)[1][quarter] * 2000.0 * G  # the helper's density
     assert r.load_factor * weight == pytest.approx(r.summary()["collapse_load_N"], rel=1e-9)
+
+
+@pytest.mark.parametrize("x", [-2.0, -1.3])
+def test_a_deck_load_at_x_acts_on_the_extrados_there(x):
+    """`--at X`: the point load down on the voussoir whose extrados spans x = X, acting at (X, its extrados
+    there), against the reference with that force's moment taken there (not at the centroid: --at -2 gave
+    λ = 8.6225 of the centroid load on the bridge, the load at -2 on the deck 8.3903)."""
+    voussoirs = 20
+    sc = segmental_ring_scenario(voussoirs)
+    i, e = segmental_reference_ring(voussoirs)
+    i, e = i + (0, 3.4), e + (0, 3.4)
+    k = int(np.searchsorted(e[:, 0], x)) - 1  # the voussoir whose extrados chord spans x
+    w = (x - e[k, 0]) / (e[k + 1, 0] - e[k, 0])
+    point = (1 - w) * e[k] + w * e[k + 1]
+    centroid, weight = voussoir_loads(i, e)
+    dead = np.stack([0 * weight, -weight], axis=1)
+    live = np.zeros_like(dead)
+    live[k] = (0.0, -weight[k])
+    at = centroid.copy()
+    at[k] = point
+    expected, (hinged, _) = least_load_factor(i, e, centroid, dead, live, live_at=at)
+    centred, _ = least_load_factor(i, e, centroid, dead, live)
+    assert abs(expected / centred - 1) > 1e-3  # where the load acts matters here
+    r = analyse(sc, LiveLoad("point", at=x))
+    assert r.load.block == f"v{k + 1:02d}"
+    assert r.load_factor == pytest.approx(expected, rel=1e-6)

@@ -215,10 +215,10 @@ def analyse_model(model: Model, load: LiveLoad, scenario_name: str = "") -> Limi
     )
 
 
-def block_over(blocks, x: float) -> str:
-    """The name of the block whose upper boundary is highest over abscissa ``x`` (m): where a load placed on
-    the structure's top surface at ``x`` bears (a bridge's deck load at the quarter span → the voussoir
-    there). On a joint's vertical line the first such block in order is taken."""
+def block_over(blocks, x: float) -> tuple[str, float]:
+    """The name of the block whose upper boundary is highest over abscissa ``x`` (m), and that height (m):
+    where a load placed on the structure's top surface at ``x`` bears (a bridge's deck load at the quarter
+    span → the voussoir there). On a joint's vertical line the first such block in order is taken."""
     best, name = -math.inf, None
     for block in blocks:
         xy = np.asarray(block.vertices, dtype=float)
@@ -237,7 +237,7 @@ def block_over(blocks, x: float) -> str:
     if name is None:
         xs = np.concatenate([np.asarray(b.vertices)[:, 0] for b in blocks])
         raise InputError(f"--at {x:g}: no block over x = {x:g} m (the blocks span x = {xs.min():g} … {xs.max():g} m)")
-    return name
+    return name, best
 
 
 def support_thrusts(model: Model, joints: Joints) -> tuple[tuple[str, str, float, float], ...]:
@@ -262,7 +262,8 @@ def analyse(scenario, load: LiveLoad, thrust: bool = False) -> LimitResult:
     load given by its place (``load.at``) is put on :func:`block_over` that place; ``thrust``: with
     :func:`support_thrusts` too."""
     if load.kind == "point" and load.at is not None and not load.resolved:
-        load = replace(load, block=block_over(scenario.assembly.blocks, load.at), resolved=True)
+        block, top = block_over(scenario.assembly.blocks, load.at)
+        load = replace(load, block=block, resolved=True, top=top)
     result = analyse_model(build_model(scenario), load, scenario.name)
     thicknesses = {b.thickness for b in scenario.assembly.blocks}
     if len(thicknesses) == 1:

@@ -192,11 +192,13 @@ def _document_names(names: list[str]) -> str:
 
 
 def load_arrow(result: LimitResult) -> tuple[np.ndarray, np.ndarray]:
-    """(point, unit direction), m: where the live load acts (the loaded block's centroid, or the blocks'
-    centre of mass for body forces: their resultant) and which way."""
+    """(point, unit direction), m: where the live load acts (``--at``'s place on the loaded block's top, the
+    loaded block's centroid, or the blocks' centre of mass for body forces: their resultant) and which way."""
     m = result.model
     n = m.block_count
     direction = np.asarray(DIRECTIONS[result.load.direction], dtype=np.float64)
+    if result.load.kind == "point" and result.load.top is not None:
+        return np.array([result.load.at, result.load.top]), direction
     if result.load.kind == "point":
         return m.body_q0[list(m.block_name).index(result.load.block), :2].copy(), direction
     mass = m.body_mass[:n]

@@ -63,8 +63,9 @@ class LiveLoad:
         ``"-y"`` (down, as a live load on a deck) for a point load.
     block : name of the loaded block (point load only).
     at : m, or None — a point load on the topmost block over x = ``at`` instead of a named one (a load on
-        the deck at that abscissa: "the quarter span"); :func:`~masonrycli.limit.analysis.analyse` names the
-        block (``block``) from the structure.
+        the deck at that abscissa: "the quarter span"), acting at (``at``, ``top``), on the block's upper
+        boundary, not at its centroid; :func:`~masonrycli.limit.analysis.analyse` names the block (``block``)
+        and finds ``top`` from the structure.
     """
 
     kind: str = "horizontal"
@@ -73,6 +74,8 @@ class LiveLoad:
     at: float | None = None
     resolved: bool = False
     """True once ``block`` was found from ``at`` (the two then go together)."""
+    top: float | None = None
+    """m: the height of the loaded block's upper boundary over ``at`` (set with ``resolved``)."""
 
     def __post_init__(self):
         if self.kind not in LOAD_KINDS:
@@ -97,7 +100,7 @@ class LiveLoad:
 
     def describe(self) -> str:
         if self.kind == "point":
-            where = "" if self.at is None else f" (the top block over x = {self.at:g} m)"
+            where = "" if self.at is None else f" (the top block over x = {self.at:g} m, loaded there)"
             return f"point load on {self.block}{where}, {self.direction} (λ × its weight)"
         what = "tilting table (tan ψ = λ)" if self.kind == "tilt" else "horizontal body force (λ × weight)"
         return f"{what}, {self.direction}"
@@ -127,6 +130,9 @@ def load_vectors(model: Model, load: LiveLoad) -> tuple[np.ndarray, np.ndarray, 
             raise InputError(f"--block {load.block}: no such block{hint}")
         i = names.index(load.block)
         live[i, :2] = mass[i] * g * direction
+        if load.at is not None and load.top is not None:  # acting at (at, top): its moment about the centroid
+            arm = np.array([load.at, load.top]) - model.body_q0[i, :2]
+            live[i, 2] = arm[0] * live[i, 1] - arm[1] * live[i, 0]
         reference = float(mass[i] * g)
     else:
         live[:, :2] = (mass * g)[:, None] * direction[None, :]
