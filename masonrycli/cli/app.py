@@ -51,20 +51,6 @@ class _InTheOrderUsersMeetThem(OneLineUsageErrors):
         rank = {name: k for k, name in enumerate(self.ORDER)}
         return sorted(super().list_commands(ctx), key=lambda name: rank.get(name, len(rank)))
 
-    def main(self, *args, **kwargs):
-        _no_type_on_flags(self)
-        return super().main(*args, **kwargs)
-
-
-def _no_type_on_flags(command) -> None:
-    """--help showed every on/off option with a type, "--no-recording <bool>" (typer 0.29), and a class
-    typed "--no-recording true": a flag takes no value, so it shows none."""
-    for param in getattr(command, "params", []):
-        if getattr(param, "is_flag", False) and param.metavar is None:
-            param.metavar = ""
-    for sub in getattr(command, "commands", {}).values():
-        _no_type_on_flags(sub)
-
 
 app = typer.Typer(
     cls=_InTheOrderUsersMeetThem,

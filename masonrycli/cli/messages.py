@@ -77,11 +77,22 @@ def _show_warning(previous):
     return show
 
 
+def _no_type_on_flags(command) -> None:
+    """--help showed every on/off option with a type, "--no-recording <bool>" (typer 0.29), and a class
+    typed "--no-recording true": a flag takes no value, so it shows none."""
+    for param in getattr(command, "params", []):
+        if getattr(param, "is_flag", False) and param.metavar is None:
+            param.metavar = ""
+    for sub in getattr(command, "commands", {}).values():
+        _no_type_on_flags(sub)
+
+
 class OneLineUsageErrors(typer.core.TyperGroup):
     """Click's usage errors (``--dt abc``, an unknown option) as one line and exit code 2, like every
     other bad input, instead of a framed panel."""
 
     def main(self, args=None, prog_name=None, complete_var=None, standalone_mode=True, **extra):
+        _no_type_on_flags(self)
         if not standalone_mode:
             return super().main(args, prog_name, complete_var, standalone_mode=False, **extra)
         repeated = self._repeated_option(sys.argv[1:] if args is None else list(args))
