@@ -41,3 +41,25 @@ def signal_inside_a_ctypes_callback(signum: int) -> None:
         time.sleep(0.2)  # the handler runs here
 
     ctypes.CFUNCTYPE(None)(callback)()
+
+
+def refusals_within(read, path, seconds: float = 10.0) -> list[str]:
+    """The InputError messages of ``read(path)``, run in a thread so that a read that never ends (a named
+    pipe, /dev/zero) fails the test after ``seconds`` instead of stopping the suite."""
+    import threading
+
+    from masonrycli.errors import InputError
+
+    said = []
+
+    def run():
+        try:
+            read(path)
+        except InputError as exc:
+            said.append(str(exc))
+
+    reader = threading.Thread(target=run, daemon=True)
+    reader.start()
+    reader.join(seconds)
+    assert not reader.is_alive(), f"reading {path} did not end"
+    return said

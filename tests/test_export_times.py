@@ -255,23 +255,12 @@ def test_a_pipe_as_the_lab_file_is_refused_not_waited_on(tmp_path):
     """A named pipe (or /dev/zero) given as --times: reading it never ended, as a record's did before it was
     refused (records.read and lab_file now read an input file alike: records.units.input_text)."""
     import os
-    import threading
 
-    from masonrycli.errors import InputError
     from masonrycli.outputs.lab_file import read_lab_file
+
+    from cli_helpers import refusals_within
 
     pipe = tmp_path / "lab.csv"
     os.mkfifo(pipe)
-    said = []
-
-    def read():
-        try:
-            read_lab_file(pipe)
-        except InputError as exc:
-            said.append(str(exc))
-
-    reader = threading.Thread(target=read, daemon=True)
-    reader.start()
-    reader.join(10.0)
-    assert not reader.is_alive(), "reading the pipe did not end"
+    said = refusals_within(read_lab_file, pipe)
     assert said == [f"{pipe}: cannot read: not a regular file (a device, a pipe or a socket)"]

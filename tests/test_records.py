@@ -220,23 +220,13 @@ def test_a_pipe_or_a_device_is_refused_without_reading_it(tmp_path):
     # writer: the command hung before its first line. The read runs in a thread so that the old hang fails
     # the test instead of stopping the suite.
     import os
-    import threading
+
+    from cli_helpers import refusals_within
 
     pipe = tmp_path / "pipe.csv"
     os.mkfifo(pipe)
     for path in (pipe, Path("/dev/zero")):
-        said = []
-
-        def read(path=path, said=said):
-            try:
-                load_record_csv(path)
-            except InputError as exc:
-                said.append(str(exc))
-
-        reader = threading.Thread(target=read, daemon=True)
-        reader.start()
-        reader.join(10.0)
-        assert not reader.is_alive(), f"reading {path} did not end"
+        said = refusals_within(load_record_csv, path)
         assert said == [f"{path}: cannot read record: not a regular file (a device, a pipe or a socket)"]
 
 
