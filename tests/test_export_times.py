@@ -154,6 +154,10 @@ def test_bad_lab_files_are_one_line_and_write_nothing(tmp_path):
         invoke("export", h, "--times", lab, "--compare", "LVDT top (mm)=hinges (-)"), "'LVDT top (mm)' is a length"
     )
     assert_one_line_error(
+        invoke("export", h, "--times", lab, "--compare", "LVDT top (mm)=ground ax (m/s2)"),
+        "'LVDT top (mm)' is a length, 'ground ax (m/s2)' an acceleration",  # it said 'a acceleration'
+    )
+    assert_one_line_error(
         invoke("export", h, "--times", lab, "--compare", "LVDT top (mm)=LVDT top (mm)"), "among masonry's columns"
     )
     # --force never replaces the lab's own file with the export of it

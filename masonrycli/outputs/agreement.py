@@ -149,6 +149,11 @@ def describe(a: Agreement, measured: str, computed: str, unit: str) -> list[str]
     ]
 
 
+def _a(quantity: str) -> str:
+    """'a length', 'an acceleration' (it said 'a acceleration', 'a angle')."""
+    return f"{'an' if quantity[0] in 'aeiou' else 'a'} {quantity}"
+
+
 def compare(table, spec: str, lab_path: str, lab_lines: list[int], time: np.ndarray) -> list[str]:
     """The measures of ``--compare spec`` on a resampled ``table`` (:func:`masonrycli.outputs.resample.resample`):
     ``LAB COLUMN`` against the table's first target (``table.main``), or ``LAB COLUMN=MASONRY COLUMN``.
@@ -171,8 +176,8 @@ def compare(table, spec: str, lab_path: str, lab_lines: list[int], time: np.ndar
             f"one: '{measured} (mm)'; {', '.join(k for k in UNITS if k.isascii())})"
         )
     if theirs is None or theirs[1] != lab_unit[1]:
-        what = theirs[1] if theirs else "no known unit"
-        raise InputError(f"--compare {spec}: '{measured}' is a {lab_unit[1]}, '{computed}' a {what}")
+        what = _a(theirs[1]) if theirs else "no known unit"
+        raise InputError(f"--compare {spec}: '{measured}' is {_a(lab_unit[1])}, '{computed}' {what}")
     cells = columns[measured]
     values = np.full(len(cells), np.nan)
     for i, cell in enumerate(cells):
