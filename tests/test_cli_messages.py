@@ -357,3 +357,14 @@ def test_a_value_given_to_a_flag_says_it_takes_none():
 
     result = runner.invoke(app, ["simulate", "wall", "--no-recording", "true"], prog_name="masonry")
     assert_one_line_error(result, "(true): an on/off option (--no-recording, --force) takes no value")
+
+
+def test_a_list_cut_at_the_space_after_a_comma_says_so():
+    # "--param amp=0.5, 1" (a space after the comma, as in prose): it said "(1): an on/off option … takes no
+    # value", with no on/off option on the line
+    from masonrycli.cli.app import app
+
+    result = runner.invoke(app, ["sweep", "wall", "--param", "amp=0.5,", "1", "--workers", "0"], prog_name="masonry")
+    assert_one_line_error(result, "(1): a list goes without spaces after its commas: amp=0.5,1")
+    result = runner.invoke(app, ["simulate", "wall", "--duration", "1", "0"], prog_name="masonry")
+    assert "on/off" not in result.output  # no flag given: "0" is no flag's value

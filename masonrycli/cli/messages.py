@@ -218,7 +218,14 @@ def _split_word(exc, command: str) -> str | None:
     words = extra[1:-1]
     if words.split()[0] in _UNIT_WORDS:
         return f"{message}: a number goes alone, without its unit (the options are in SI units: {command} --help)"
-    if words.split()[0].lower() in _FLAG_VALUES:  # --help shows a flag as "--no-recording <bool>"
+    # "--param amp=0.5, 1": a list cut at the space after its comma (it was read as a flag's value, "1")
+    values = [v for value in exc.ctx.params.values() for v in (value if isinstance(value, list | tuple) else [value])]
+    cut = [v for v in values if isinstance(v, str) and v.endswith(",")]
+    if cut:
+        return f"{message}: a list goes without spaces after its commas: {cut[-1]}{words.replace(' ', '')}"
+    flags = [p for p in exc.ctx.command.params if getattr(p, "is_flag", False) and p.name in exc.ctx.params]
+    given_flag = any(exc.ctx.params[p.name] != p.default for p in flags)
+    if given_flag and words.split()[0].lower() in _FLAG_VALUES:  # --help showed "--no-recording <bool>"
         return f"{message}: an on/off option (--no-recording, --force) takes no value: give it alone, or leave it out"
     named = [p for p in exc.ctx.command.params if p.param_type_name == "argument"]
     given = exc.ctx.params.get(named[0].name) if named else None
