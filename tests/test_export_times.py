@@ -268,3 +268,11 @@ def test_a_pipe_as_the_lab_file_is_refused_not_waited_on(tmp_path):
     os.mkfifo(pipe)
     said = refusals_within(read_lab_file, pipe)
     assert said == [f"{pipe}: cannot read: not a regular file (a device, a pipe or a socket)"]
+
+
+def test_a_list_cut_at_a_space_is_said_not_taken_for_a_history(tmp_path):
+    """`--blocks a, c`: the shell hands `c` over as a second history; it said only 'c: no such history'."""
+    h = hand_history(tmp_path / "h.npz")
+    result = invoke("export", h, "--blocks", "a,", "c", "--out", tmp_path / "o.csv")
+    assert_one_line_error(result, "--blocks a, c: a list goes without spaces after its commas: --blocks a,c")
+    assert not (tmp_path / "o.csv").exists()

@@ -28,6 +28,19 @@ def _course_numbers(values: list[str] | None) -> list[int]:
     return out
 
 
+def _check_cut_lists(lists: dict, histories: list[Path]) -> None:
+    """``--blocks c01-b01, c01-b02``: the shell cut the list at its space and the rest became a history,
+    which said only "c01-b02: no such history"."""
+    for option, values in lists.items():
+        cut = [value for value in values or () if value.endswith(",")]
+        rest = [path for path in histories if not path.exists()]
+        if cut and rest:
+            raise InputError(
+                f"{option} {cut[-1]} {rest[0]}: a list goes without spaces after its commas: "
+                f"{option} {cut[-1]}{rest[0]}"
+            )
+
+
 def _inputs(paths: list[Path]) -> list[Path]:
     """The histories named: files as given, a folder's ``*.npz`` (a study's ``--histories``), sorted."""
     out = []
@@ -166,6 +179,7 @@ def export_command(
         )
     if times is not None and every > 1:
         raise InputError(f"--every {every} and --times: the rows are the lab's samples, give one or the other")
+    _check_cut_lists({"--blocks": blocks, "--course": course}, histories)
     inputs = _inputs(histories)
     several = len(inputs) > 1 or any(path.is_dir() for path in histories)
     if combined:
