@@ -71,7 +71,7 @@ def test_baseline_none_applies_the_samples_as_given(tmp_path):
             "--no-recording", "--history", npz,
         )  # fmt: skip
         assert result.exit_code == 0, result.output
-        assert "does not start and end at rest" not in result.output
+        assert "does not end at rest where it started" not in result.output
         h = np.load(npz)
         np.testing.assert_array_equal(h["time"], np.arange(1001) * 1e-3)
         np.testing.assert_allclose(h["support_v"][:, 0, 0], given, rtol=1e-12, atol=1e-12)
@@ -97,6 +97,8 @@ def test_the_warning_names_both_peaks_the_ratio_and_the_option(table):
         lines[0],
     )
     assert numbers and lines[0].startswith('warning: support "ground": the record table.csv'), lines[0]
+    # the sine from rest is at rest at both ends (v = a/ω (1 − cos ωt), whole cycles): it ends elsewhere
+    assert "the record table.csv does not end at rest where it started:" in lines[0]  # the words the other tests seek
     change, percent, peak, applied, ratio = map(float, numbers.groups())
     # the closed form (module docstring), its peak on a fine grid
     omega, amp = 2 * np.pi * FREQ, PEAK_G
@@ -115,7 +117,7 @@ def test_the_warning_names_both_peaks_the_ratio_and_the_option(table):
 def test_no_warning_for_a_record_that_starts_and_ends_at_rest(at_rest):
     result = invoke("check", BLOCK, "--record", at_rest)
     assert result.exit_code == 0, result.output
-    assert "does not start and end at rest" not in result.output and "baseline-corrected" in result.output
+    assert "does not end at rest where it started" not in result.output and "baseline-corrected" in result.output
 
 
 def test_a_scenario_files_record_warns_and_its_baseline_none_does_not(tmp_path):
@@ -129,9 +131,9 @@ def test_a_scenario_files_record_warns_and_its_baseline_none_does_not(tmp_path):
         )
         path = tmp_path / "s.toml"
         path.write_text(text.replace(motion, record))
-        said = [w for w in record_warnings(load_scenario(path)) if "does not start and end at rest" in w]
+        said = [w for w in record_warnings(load_scenario(path)) if "does not end at rest where it started" in w]
         assert len(said) == int(warned), said
-        assert not said or "the record (inline) does not start" in said[0]
+        assert not said or "the record (inline) does not end at rest where it started" in said[0]
 
 
 @pytest.mark.parametrize("kind", BURSTS)
@@ -167,8 +169,10 @@ def test_a_bad_baseline_is_one_line_exit_2(table, tmp_path, monkeypatch, args, m
 
 def test_sweep_records_take_the_baseline(table, tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
-    warned = [w for w in plan_study("wall", records=[table]).request.warnings if "does not start and end" in w]
+    warned = [
+        w for w in plan_study("wall", records=[table]).request.warnings if "does not end at rest where it started" in w
+    ]
     assert len(warned) == 1 and "--baseline none" in warned[0]
     plan = plan_study("wall", records=[table], baseline="none", out=Path("b.parquet"))
     assert [m.baseline for m in plan.base.records.values()] == ["none"]
-    assert not [w for w in plan.request.warnings if "does not start and end" in w]
+    assert not [w for w in plan.request.warnings if "does not end at rest where it started" in w]

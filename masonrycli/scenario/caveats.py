@@ -42,7 +42,7 @@ GRAVITY_RANGE = (0.5 * G_STANDARD, 2.0 * G_STANDARD)
 no gravity on purpose (limit analysis refuses it in its own line)."""
 BASELINE_CHANGE = 0.15
 """A record whose baseline correction changes its acceleration, at some instant, by more than this fraction of
-its peak is warned about: it does not start and end at rest (a shake table's sine from rest, 0.8 g at 2 Hz for
+its peak is warned about: it does not end at rest where it started (a shake table's sine from rest, 0.8 g at 2 Hz for
 1 s: the correction adds up to 48 % of the peak, the peak becomes 0.8977 g). Acceleration, not velocity: the
 structure feels the ground's acceleration (a uniform velocity is not felt), and bringing a drifting velocity
 back is what the correction is for (an unprocessed noise burst's PGV changes by 30 % and more). The figures,
@@ -221,7 +221,7 @@ def record_warnings(scenario: Scenario, upright: bool = True) -> list[str]:
             for name, names in sideways.items()
         ]
         + [
-            f"{who(names)}: the record {name} does not start and end at rest: its baseline correction changes the "
+            f"{who(names)}: the record {name} does not end at rest where it started: its baseline correction changes the "
             f"acceleration by up to {change / G_STANDARD:.3g} g ({100 * change / peak:.0f} % of its peak): its peak "
             f"{peak / G_STANDARD:.4g} g becomes {applied / G_STANDARD:.4g} g as applied (×{applied / peak:.4g}); "
             '--baseline none (a scenario file\'s baseline = "none") applies it as given'
