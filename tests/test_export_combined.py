@@ -41,6 +41,18 @@ def test_a_folder_as_one_long_table(tmp_path):
     assert [float(x) for x in table["time (s)"][n : 2 * n]] == pytest.approx(TIMES * 2)
 
 
+def test_the_working_folder_s_table_goes_beside_it(tmp_path, monkeypatch):
+    """`masonry export . --combined` inside the histories' folder: FOLDER.csv beside it, as for `h/` (it was
+    written into the folder itself, ./h.csv)."""
+    folder = tmp_path / "h"
+    folder.mkdir()
+    study_history(folder / "amp=1.npz", {"amp": 1.0})
+    monkeypatch.chdir(folder)
+    result = invoke("export", ".", "--combined", "--blocks", "c")
+    assert result.exit_code == 0, result.output
+    assert (tmp_path / "h.csv").exists() and not (folder / "h.csv").exists()
+
+
 def test_combined_with_lab_times_and_integer_points(tmp_path):
     folder = tmp_path / "h"
     folder.mkdir()

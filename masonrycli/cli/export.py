@@ -79,7 +79,8 @@ def _combined_target(histories: list[Path], out: Path | None, force: bool):
     if out is None:
         if len(histories) != 1 or not histories[0].is_dir():
             raise InputError("--combined: name the table with --out S.csv (FOLDER.csv by default, for one folder)")
-        out = histories[0].parent / f"{histories[0].resolve().name}.csv"
+        folder = histories[0].resolve()  # "." is the working folder: its table goes beside it, not in it
+        out = folder.parent / f"{folder.name}.csv"
     elif out.is_dir():
         raise InputError(f"--out {out}: --combined writes one table: name a file (--out {out / 'study.csv'})")
     return check_output(out, "--out", ".csv", force)
