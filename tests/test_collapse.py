@@ -115,12 +115,11 @@ def test_block_at_rest_is_intact():
 
 
 class _Watch:
-    """Stands in for the solver in CollapseMonitor.update: no contacts."""
+    """Stands in for the solver in CollapseMonitor.update: no contacts (its public views, as watch_step reads)."""
 
-    _count = 0
-    _pack = np.zeros((1, 1))
-    _status = np.zeros(1, dtype=np.int8)
-    buffers = SimpleNamespace(contact_body=np.zeros((1, 2), dtype=np.int32))
+    contact_body = np.zeros((0, 2), dtype=np.int32)
+    contact_pack = np.zeros((0, 1))
+    contact_status = np.zeros(0, dtype=np.int8)
 
 
 def test_a_sliver_riding_a_settling_support_has_not_fallen():

@@ -35,3 +35,15 @@ def test_watch_matches_numpy():
     assert fall == np.max((q0[:n, 1] - st.body_q[:n, 1]) / height)
     assert turn == np.abs(st.body_q[:n, 2]).max()
     assert top_dx == np.mean(st.body_q[top, 0] - q0[top, 0])
+
+
+def test_the_step_kernels_read_no_private_attribute_of_the_solver():
+    # fused.py and watch.py get the Solver's arrays as arguments or through its documented public views
+    # (contact_body, contact_pack, contact_status), never through its private attributes.
+    import inspect
+    import re
+
+    from masonrycli.engine import fused, watch
+
+    for module in (fused, watch):
+        assert not re.findall(r"solver\._\w+", inspect.getsource(module)), module.__name__

@@ -148,6 +148,12 @@ class Solver:
         return self._force[: self._count]
 
     @property
+    def contact_pack(self) -> np.ndarray:
+        """(C, PACK_WIDTH) the contacts' packed constants at the step's detection configuration (nlgs.py's
+        columns: frame, lever arms m, W_αα 1/kg, Signorini bias m/s, inverse masses)."""
+        return self._pack[: self._count]
+
+    @property
     def contact_status(self) -> np.ndarray:
         """(C,) int8: 0 open, 1 stick, 2 slip."""
         return self._status[: self._count]

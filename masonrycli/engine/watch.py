@@ -49,17 +49,6 @@ def watch_step(solver, body_q, body_v, q0, height, top) -> tuple[float, float, f
     Returns (max |ω| rad/s, max |u_t| of closed contacts m/s, max fall / height, max |θ| rad,
     mean x displacement of the top blocks m).
     """
-    c = solver._count
-    bf = solver.buffers
-    return _watch(
-        body_q,
-        body_v,
-        q0,
-        height,
-        height.shape[0],
-        top,
-        bf.contact_body,
-        solver._pack,
-        solver._status,
-        c,
-    )
+    # the step's contacts through the Solver's public views (rows [:C], C-contiguous: the kernel's types)
+    body, pack, status = solver.contact_body, solver.contact_pack, solver.contact_status
+    return _watch(body_q, body_v, q0, height, height.shape[0], top, body, pack, status, status.shape[0])
