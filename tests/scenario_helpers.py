@@ -33,7 +33,9 @@ def load_error(tmp_path: Path, text: str, name: str = "wall.toml") -> str:
         load_scenario(path)
     msg = str(exc.value)
     assert "\n" not in msg and msg == msg.strip()
-    where = re.match(rf"{re.escape(str(path))}(:[1-9][0-9]*)?: ", msg)  # the key's line: tests/test_toml_lines.py
+    where = re.match(
+        rf"{re.escape(str(path))}(:[1-9][0-9]*)?: ", msg
+    )  # the key's line: tests/test_scenario_toml_lines.py
     assert where, msg
     return msg[where.end() :]  # the part after "<file>: " or "<file>:<line>: "
 

@@ -8,7 +8,7 @@ import json
 
 import numpy as np
 import pytest
-from test_history_export import TIMES, hand_history, read_csv
+from test_outputs_export import TIMES, hand_history, read_csv
 
 from cli_helpers import assert_one_line_error, invoke
 

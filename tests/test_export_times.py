@@ -11,7 +11,7 @@ import re
 
 import numpy as np
 import pytest
-from test_history_export import TIMES, floats, hand_history, read_csv
+from test_outputs_export import TIMES, floats, hand_history, read_csv
 
 from masonrycli.outputs.agreement import agreement, column_unit
 from masonrycli.outputs.export import export_table

@@ -267,7 +267,7 @@ def test_fill_colours_follow_the_field_with_ranges_that_follow_the_data(tmp_path
 def test_colour_bar_end_caps_stand_apart_from_the_bar(written):
     """Each field's bar as recorded: the below / above caps (the last 6 vertices) are far from every colour
     of the bar (the spherical-stress bar's top, 0 kPa, and its white "above" cap read as one)."""
-    from test_colormap import min_distances
+    from test_recording_colormap import min_distances
 
     path = written[0]
     for f in FIELDS:

@@ -155,7 +155,7 @@ def test_the_recorded_strain_rate_ranges_hold_through_one_short_frame(tmp_path):
     """Read back: the volumetric strain rate's ranges logged for a run whose rate dips for one frame, two in a
     row, or deeply, are the plain reference's (test_colour_range_hold), which keeps the range through a single
     short frame; batches of 5 frames cut the dips anywhere."""
-    from test_colour_range_hold import dipping_frames, reference
+    from test_recording_colour_range_hold import dipping_frames, reference
 
     static, q0 = fx.wall(12, 10)
     rates = 0.01 * dipping_frames("signed", count=60, seed=2)[:, : len(q0)]

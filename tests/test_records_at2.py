@@ -1,5 +1,5 @@
 """PEER NGA .AT2 records: the reader's formats and units, errors naming file and line, the vertical component and
-its window, and .AT2 files in scenario files (tests/test_records.py holds the CSV formats and one-column files)."""
+its window, and .AT2 files in scenario files (tests/test_records_read.py holds the CSV formats and one-column files)."""
 
 from __future__ import annotations
 
@@ -7,7 +7,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from test_records import SCENARIO, one_line
+from test_records_read import SCENARIO, one_line
 
 from masonrycli.errors import InputError, RecordWarning
 from masonrycli.records.read import G_STANDARD, load_at2, record_fields, record_motion

@@ -10,7 +10,7 @@ from types import SimpleNamespace
 
 import numpy as np
 import pytest
-from test_collapse import block_scenario
+from test_analysis_collapse import block_scenario
 
 from masonrycli.run import SolverTally, simulate
 from masonrycli.scenario.motion import Sine

@@ -354,7 +354,7 @@ def test_one_column_errors_in_a_scenario(tmp_path, motion, expected):
     with pytest.raises(InputError) as exc:
         loads_scenario(SCENARIO.replace("MOTION", motion), source="s.toml", base_dir=tmp_path)
     message = one_line(exc)
-    # the line of the motion (SCENARIO's 9th: its motion = { … } inline table, tests/test_toml_lines.py)
+    # the line of the motion (SCENARIO's 9th: its motion = { … } inline table, tests/test_scenario_toml_lines.py)
     assert message.startswith('s.toml:9: [[support]] #1 ("ground"): ' + expected), message
 
 
