@@ -26,6 +26,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from masonrycli.errors import InputError
+from masonrycli.records.text import is_float
 from masonrycli.records.units import decoded, input_bytes
 from masonrycli.scenario.values import shorten
 
@@ -107,7 +108,7 @@ def read_lab_file(path, time_column: str | None = None) -> LabFile:
     head_line, head = lines[0]
     separator = ";" if ";" in head else "\t" if "\t" in head and "," not in head else ","
     header = _split(head, separator)
-    if all(_is_number(cell) for cell in header):
+    if all(is_float(cell) for cell in header):
         raise InputError(f"{shown}:{head_line}: no header row (the first row names the columns: time (s), …)")
     index, factor = _time_column(header, time_column, f"{shown}:{head_line}")
     rows, numbers, where, previous = [], [], [], ""
@@ -136,11 +137,3 @@ def read_lab_file(path, time_column: str | None = None) -> LabFile:
     if not rows:
         raise InputError(f"{shown}: a header and no sample")
     return LabFile(shown, header, rows, index, np.array(numbers), where)
-
-
-def _is_number(text: str) -> bool:
-    try:
-        float(text)
-    except ValueError:
-        return False
-    return True

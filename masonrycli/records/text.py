@@ -109,7 +109,7 @@ def csv_lines(lines, first: int, name: str, state: CsvState) -> tuple[list, list
             if state.ncol == 0 and not state.header_seen:
                 state.header_seen = True
                 continue
-            bad = next(f for f in fields if not _is_float(f))
+            bad = next(f for f in fields if not is_float(f))
             raise InputError(f"{name}:{lineno}: not a number: {shorten(bad, 40)}") from None
         if state.ncol == 0:
             _first_columns(len(nums), f"{name}:{lineno}", state.one_column)
@@ -345,7 +345,8 @@ def number(text: str, where: str) -> float:
         raise InputError(f"{where}: not a number: {shorten(text, 40)}") from None
 
 
-def _is_float(text: str) -> bool:
+def is_float(text: str) -> bool:
+    """Whether ``float`` reads ``text`` (a record's field, a lab file's header cell)."""
     try:
         float(text)
     except ValueError:
