@@ -12,7 +12,8 @@ import typer
 import typer.core
 from rich.console import Console
 from rich.text import Text
-from typer._click import exceptions as click_errors  # typer 0.29 vendors click; no public name
+from typer._click import core as click_core  # typer 0.29 vendors click; no public name
+from typer._click import exceptions as click_errors
 
 from geometry_library.blocks import GeometryError
 from geometry_library.values import unit_hint, unit_of
@@ -77,14 +78,17 @@ def _show_warning(previous):
     return show
 
 
-def _no_type_on_flags(command) -> None:
+def _no_type_on_flags(command, help_names: list[str]) -> None:
     """--help showed every on/off option with a type, "--no-recording <bool>" (typer 0.29), and a class
-    typed "--no-recording true": a flag takes no value, so it shows none."""
-    for param in getattr(command, "params", []):
+    typed "--no-recording true": a flag takes no value, so it shows none. The help option too ("--help -h
+    <bool>" on every page): click makes it only when a page is shown, so it is made here, once per command,
+    with the names the command line uses (click keeps the first one made)."""
+    help_option = command.get_help_option(click_core.Context(command, help_option_names=help_names))
+    for param in [*getattr(command, "params", []), *([help_option] if help_option is not None else [])]:
         if getattr(param, "is_flag", False) and param.metavar is None:
             param.metavar = ""
     for sub in getattr(command, "commands", {}).values():
-        _no_type_on_flags(sub)
+        _no_type_on_flags(sub, help_names)
 
 
 class OneLineUsageErrors(typer.core.TyperGroup):
@@ -92,7 +96,7 @@ class OneLineUsageErrors(typer.core.TyperGroup):
     other bad input, instead of a framed panel."""
 
     def main(self, args=None, prog_name=None, complete_var=None, standalone_mode=True, **extra):
-        _no_type_on_flags(self)
+        _no_type_on_flags(self, self.context_settings.get("help_option_names", ["--help"]))
         if not standalone_mode:
             return super().main(args, prog_name, complete_var, standalone_mode=False, **extra)
         repeated = self._repeated_option(sys.argv[1:] if args is None else list(args))
