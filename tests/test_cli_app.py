@@ -103,13 +103,53 @@ def test_geojson_properties_not_used_are_warned_by_run_and_check(tmp_path):
         assert '"densty" (did you mean "density"?) first on feature 2, block 1 ("B1")' in line and "fid" not in line
 
 
-@pytest.mark.parametrize(("command", "name"), [("check", "wall"), ("run", "arch")])
-def test_a_built_in_name_given_as_scenario_file_points_to_simulate(command, name, tmp_path, monkeypatch):
-    """QA: `masonry check wall` said "wall: cannot read scenario: No such file or directory"."""
+@pytest.mark.parametrize("name", ["wall", "arch"])
+def test_a_built_in_name_given_to_run_points_to_simulate(name, tmp_path, monkeypatch):
+    """QA: `masonry run wall` said "wall: cannot read scenario: No such file or directory"."""
     monkeypatch.chdir(tmp_path)  # no file called `wall` here
-    result = invoke(command, name)
+    result = invoke("run", name)
     assert_one_line_error(result, f"{name}: not a file", f"masonry simulate {name}")
     assert "No such file" not in result.output
+
+
+def _rows(output: str) -> dict[str, str]:
+    """The check table's rows, name -> value."""
+    cells = [[c.strip() for c in line.strip().strip("│").split("│")] for line in output.splitlines()]
+    return {c[0]: c[1] for c in cells if len(c) == 2 and c[0]}
+
+
+def test_check_takes_the_options_simulate_takes_for_a_built_in(tmp_path, monkeypatch):
+    # a user checking what `simulate arch --span 8 --rise 2` would run could not: check took files only
+    # ("arch: not a file") and no --span ("No such option"). Reference: the same structure written by
+    # `build` and read back as a geometry file.
+    monkeypatch.chdir(tmp_path)
+    assert invoke("build", "arch", "--span", 8, "--rise", 2, "--out", "a.geojson").exit_code == 0
+    built = _rows(invoke("check", "a.geojson").output)
+    result = invoke("check", "arch", "--span", 8, "--rise", 2)
+    assert result.exit_code == 0, result.output
+    rows = _rows(result.output)
+    for row in ("blocks", "supports", "total mass", "bounding box"):
+        assert rows[row] == built[row], row
+    assert rows["bounding box"] != _rows(invoke("check", "arch").output)["bounding box"]  # the span is taken
+    # the loading and time of `simulate arch` (DESIGN: right foundation settles at 1 cm/s for 5 s)
+    assert rows["loading"] == "right-foundation: constant velocity (0, -0.01) m/s"
+    assert rows["time"].startswith("5 s in 5000 steps")
+    wall = _rows(invoke("check", "wall", "--courses", 3, "--length", 3, "--amp", 0.5, "--freq", 3).output)
+    # 3 m of 0.30 m blocks: 10 in courses 1 and 3, 9 and two halves in course 2 (running bond)
+    assert wall["blocks"] == "31" and "0.5" in wall["loading"] and "3 Hz" in wall["loading"], wall
+
+
+@pytest.mark.parametrize(
+    "args, fragments",
+    [
+        (("wall", "--span", 8), ["--span: not an option of the wall", "masonry simulate wall --help"]),
+        (("arch", "--blocks", 8), ["--blocks: not an option of the arch"]),
+        (("wall", "--settlement", 0.1), ["--settlement", "the wall stands on one ground"]),
+        ((DATA / "arch_settlement.toml", "--rise", 1, "--amp", 2), ["--rise, --amp: shape a built-in", "is a file"]),
+    ],
+)
+def test_check_refuses_the_builtin_options_that_cannot_apply(args, fragments):
+    assert_one_line_error(invoke("check", *args), *fragments)
 
 
 @pytest.mark.parametrize(

@@ -220,7 +220,7 @@ ScenarioFile = Annotated[
 ]
 
 
-RUN_FROM_FILE, FRICTION_FROM_FILE = file_defaults(RUN), file_defaults(FRICTION)  # run and check: the file's values
+RUN_FROM_FILE, FRICTION_FROM_FILE = file_defaults(RUN), file_defaults(FRICTION)  # run's: the file's values
 
 
 def _load(scenario_file: str, opts: dict):
@@ -250,6 +250,15 @@ def _register_sweep() -> None:
 
 
 _register_sweep()
+
+
+def _register_check() -> None:
+    from masonrycli.cli.check import check_command
+
+    app.command("check")(user_errors(check_command))
+
+
+_register_check()
 
 
 def _register_export() -> None:
@@ -321,23 +330,6 @@ def limit_command(
         thrust=thrust,
         min_thickness=min_thickness,
     )
-
-
-@app.command("check")
-@user_errors
-@with_options(RUN_FROM_FILE, STOP, FRICTION_FROM_FILE, OUTPUT, FORCE, RECORD)
-def check_command(scenario_file: ScenarioFile, **opts) -> None:
-    """Validate what `masonry run` would run, with the same arguments, and print a summary (blocks,
-    supports, mass, bounding box, steps, the loading, outputs); nothing is computed or written."""
-    from masonrycli.outputs.report import check_table
-    from masonrycli.scenario.caveats import scenario_warnings
-    from masonrycli.scenario.scenario import scenario_summary
-
-    scenario = _load(scenario_file, opts)
-    outputs = _check_run(scenario, opts)
-    console.print(check_table(str(Path(scenario_file)), scenario_summary(scenario), outputs.files()))
-    for warning in scenario_warnings(scenario):
-        warn(warning)
 
 
 def _write_assembly(builder: str, opts: dict) -> None:

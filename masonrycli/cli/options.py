@@ -137,6 +137,22 @@ SETTLED_LOADING = {
         float, "Loading", "Downward velocity of the right foundation, m/s (default 0.01; 0 with --amp: shaking)."
     ),
 }
+BUILT_IN_LOADING = {
+    "freq": _opt(
+        float, "Loading", "A built-in's sine: velocity frequency, Hz (default 2), as simulate's --freq.", "--freq"
+    ),
+    "amp": _opt(
+        float,
+        "Loading",
+        "A built-in's sine: horizontal velocity amplitude, m/s, as simulate's --amp (the wall's default 1; the "
+        "arch and the aqueduct with --settlement 0).",
+        "--amp",
+    ),
+    "settlement": _opt(
+        float, "Loading", "The arch's or the aqueduct's: downward velocity of the right foundation, m/s (default 0.01)."
+    ),
+}
+"""``masonry check NAME``'s loading options: those of ``simulate wall`` and ``simulate arch`` together."""
 RECORD = {
     "record": _opt(
         Path,

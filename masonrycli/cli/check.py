@@ -1,0 +1,90 @@
+"""``masonry check``: what ``run`` (a file) or ``simulate`` (a built-in name) would run, with the same
+options, summarised and checked; nothing computed or written. Registered on the app by :mod:`masonrycli.cli.app`.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+from masonrycli.cli.messages import console, warn
+from masonrycli.cli.options import (
+    ANY_STRUCTURE,
+    BLOCK_MATERIAL,
+    BUILT_IN_LOADING,
+    FORCE,
+    FRICTION,
+    OUTPUT,
+    RECORD,
+    RUN,
+    STOP,
+    STRUCTURE_OPTIONS,
+    file_defaults,
+    with_options,
+)
+from masonrycli.errors import InputError
+
+BUILT_IN_ONLY = {**ANY_STRUCTURE, **BUILT_IN_LOADING, **BLOCK_MATERIAL}
+"""The options that shape a built-in structure and its loading (``simulate NAME``'s); a file gives its own."""
+
+
+def _flags(names) -> str:
+    return ", ".join(f"--{name.replace('_', '-')}" for name in names)
+
+
+def _scenario(target: str, opts: dict):
+    """The scenario ``run TARGET`` (a file) or ``simulate TARGET`` (a built-in name) would run with ``opts``
+    (taken out of ``opts``): the built-in's structure, loading and material options refused for a file, and
+    another built-in's structure options for a built-in, in one line."""
+    from masonrycli.scenario.builtin import builtin, file_scenario, is_built_in
+
+    shaping = {name: value for name in BUILT_IN_ONLY if (value := opts.pop(name)) is not None}
+    settings = {name: opts.pop(name) for group in (RECORD, RUN, FRICTION) for name in group}
+    if not is_built_in(target):
+        if shaping:
+            raise InputError(
+                f"{_flags(shaping)}: shape a built-in structure (masonry check wall|arch|aqueduct …); {target} is "
+                "a file, which gives its own geometry and loading"
+            )
+        return file_scenario(target, **settings)
+    allowed = {*STRUCTURE_OPTIONS[target], *BUILT_IN_LOADING, *BLOCK_MATERIAL}
+    foreign = [name for name in shaping if name not in allowed]
+    if foreign:  # simulate NAME does not take them ("No such option"): the same run cannot be checked
+        raise InputError(f"{_flags(foreign[:1])}: not an option of the {target} (masonry simulate {target} --help)")
+    return builtin(target, **shaping, **settings)
+
+
+@with_options(file_defaults(RUN), STOP, file_defaults(FRICTION), OUTPUT, FORCE, RECORD, BUILT_IN_ONLY)
+def check_command(
+    target: Annotated[
+        str,
+        typer.Argument(
+            help="Scenario file (TOML), or a GeoJSON / WKT geometry, as run takes it; or wall, arch or aqueduct, "
+            "as simulate takes it (with its structure and loading options).",
+            metavar="SCENARIO|wall|arch|aqueduct",
+        ),
+    ],
+    **opts,
+) -> None:
+    """Validate what `masonry run` (a file) or `masonry simulate NAME` (a built-in) would run, with the same
+    arguments, and print a summary (blocks, supports, mass, bounding box, steps, the loading, outputs); nothing
+    is computed or written."""
+    from masonrycli.execute import check_run
+    from masonrycli.outputs.report import check_table
+    from masonrycli.scenario.caveats import scenario_warnings
+    from masonrycli.scenario.scenario import scenario_summary
+
+    scenario = _scenario(target, opts)
+    outputs = check_run(
+        scenario,
+        opts["out"],
+        opts["history"],
+        no_recording=opts["no_recording"],
+        force=opts["force"],
+        magnify=opts["magnify"],
+    )
+    console.print(check_table(str(Path(target)), scenario_summary(scenario), outputs.files()))
+    for warning in scenario_warnings(scenario):
+        warn(warning)
