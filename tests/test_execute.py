@@ -351,3 +351,54 @@ def test_unconverged_steps_are_counted_and_warned(tmp_path):
     assert r.exit_code == 0 and "unconverged" in r.output and "warning" not in r.output, r.output
     h = np.load(npz)
     assert h["nlgs_unconverged"][-1] == 0 and np.all(h["nlgs_residual"] <= 1e-5)
+
+
+POWERSHELL_MODULES = (
+    r"C:\Users\Ana Silva\Documents\WindowsPowerShell\Modules;C:\Program Files\WindowsPowerShell\Modules"
+)
+MACHINE_MODULES = r"C:\Program Files\WindowsPowerShell\Modules;C:\WINDOWS\system32\WindowsPowerShell\v1.0\Modules"
+
+
+@pytest.mark.parametrize(
+    "modules, call",
+    [
+        (POWERSHELL_MODULES, "& "),  # Windows PowerShell 5.1: its own user folder first
+        (r"c:\users\ana silva\Documents\PowerShell\Modules;" + MACHINE_MODULES, "& "),  # pwsh 7, any case
+        (MACHINE_MODULES, ""),  # cmd.exe from the Start menu: the machine's value only
+        (None, ""),
+    ],
+)
+def test_the_open_command_calls_a_quoted_viewer_in_powershell(tmp_path, monkeypatch, modules, call):
+    """A student in "C:\\Users\\Ana Silva" whose venv is not below the working folder: the line was
+    '"C:\\…\\Scripts\\rerun.exe" "my runs\\w.rrd"', right in cmd.exe, but in PowerShell a quoted path is a
+    string ("Unexpected token"): it runs after the call operator, '& "…\\rerun.exe" "…"', which cmd.exe refuses."""
+    monkeypatch.setattr(execute_module.shutil, "which", lambda name: None)
+    scripts = tmp_path / "Ana Silva" / ".venv" / "Scripts"
+    scripts.mkdir(parents=True)
+    (scripts / "rerun.exe").touch()
+    monkeypatch.setattr(execute_module.sys, "executable", str(scripts / "python.exe"))
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setenv("USERPROFILE", r"C:\Users\Ana Silva")
+    if modules is None:
+        monkeypatch.delenv("PSModulePath", raising=False)
+    else:
+        monkeypatch.setenv("PSModulePath", modules)
+    viewer = os.path.join(os.curdir, "Ana Silva", ".venv", "Scripts", "rerun.exe")
+    rrd = r"recordings\wall-20261129-082048.rrd"
+    assert execute_module.open_command(rrd, windows=True) == f'{call}"{viewer}" {rrd}'
+    assert execute_module.open_command(r"my runs\w.rrd", windows=True) == f'{call}"{viewer}" "my runs\\w.rrd"'
+    # a viewer that needs no quotes needs no operator: the line runs in either shell
+    monkeypatch.chdir(tmp_path / "Ana Silva")
+    assert (
+        execute_module.open_command(rrd, windows=True)
+        == f"{os.path.join(os.curdir, '.venv', 'Scripts', 'rerun.exe')} {rrd}"
+    )
+
+
+def test_the_open_command_quotes_what_either_windows_shell_would_read_otherwise(monkeypatch):
+    # list2cmdline quoted only spaces: "rerun it's.rrd" is an unclosed string to PowerShell, "rerun a&b.rrd"
+    # two commands to cmd.exe
+    monkeypatch.setattr(execute_module.shutil, "which", lambda name: "rerun")
+    for name in ("it's.rrd", "a&b.rrd", "w (2).rrd", "x;y.rrd"):
+        assert execute_module.open_command(name, windows=True) == f'rerun "{name}"'
+    assert execute_module.open_command(r"C:\runs\w-1_a.rrd", windows=True) == r"rerun C:\runs\w-1_a.rrd"
