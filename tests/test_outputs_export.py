@@ -295,8 +295,11 @@ def test_a_folder_of_histories_gives_one_csv_each(tmp_path):
     assert not (out / "amp=0.5.csv").exists()
     assert_one_line_error(
         invoke("export", folder / "amp=0.5.npz", folder / "amp=1.npz", "--out", tmp_path / "one.csv"),
-        "one.csv: several histories, one CSV each: --out names an existing folder",
+        "one.csv: several histories, one CSV each: --out names a folder for them",
     )
+    made = tmp_path / "made" / "csv"  # a folder not there yet is made, as one file's folder is
+    assert invoke("export", folder / "amp=0.5.npz", folder / "amp=1.npz", "--out", made).exit_code == 0
+    assert sorted(p.name for p in made.iterdir()) == ["amp=0.5.csv", "amp=1.csv"]
     assert invoke("export", folder / "amp=0.5.npz", folder / "amp=1.npz").exit_code == 0  # beside each
     assert sorted(p.name for p in folder.glob("*.csv")) == ["amp=0.5.csv", "amp=1.csv"]
     # nor when a later history cannot be exported: one without the --blocks name, one of no frame

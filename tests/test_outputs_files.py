@@ -351,20 +351,26 @@ def test_a_read_only_file_system_is_named(tmp_path, monkeypatch):
     assert result.exit_code == 2 and result.output.strip() == said, result.output
 
 
-def test_an_output_in_a_missing_folder_is_refused(tmp_path, monkeypatch):
-    # '--out /nonexist/a.rrd' made the folder /nonexist and wrote there (a typo, '--out reslts/w.rrd', left a
-    # new folder and the file where no one looked); build --out and --history alike. The default recording's
-    # recordings/ is still made.
+def test_an_output_in_a_missing_folder_is_written_there(tmp_path, monkeypatch):
+    # '--out recordings/x.rrd' was refused ("there is no folder recordings (make it first)") where the default
+    # recording's recordings/ is made; --history, build --out, export --out and sweep's outputs alike. Made
+    # when the file is opened, after every check: check makes nothing, and a refused run leaves no folder.
     monkeypatch.chdir(tmp_path)
-    for args, option, path in (
-        (("run", COLUMN, "--duration", 0.01, "--out", "reslts/w.rrd"), "--out", "reslts/w.rrd"),
-        (("run", COLUMN, "--duration", 0.01, "--no-recording", "--history", "a/b/h.npz"), "--history", "a/b/h.npz"),
-        (("build", "wall", "--out", "x/w.geojson"), "--out", "x/w.geojson"),
-    ):
-        result = invoke(*args)
-        folder = str(Path(path).parent)
-        assert result.exit_code == 2, result.output
-        assert result.output.strip() == f"error: {option} {path}: there is no folder {folder} (make it first)"
-    assert sorted(p.name for p in tmp_path.iterdir()) == []
-    assert invoke("run", COLUMN, "--duration", 0.01).exit_code == 0
-    assert [p.name for p in tmp_path.iterdir()] == ["recordings"]
+    assert invoke("check", COLUMN, "--out", "new/w.rrd", "--history", "new/h.npz").exit_code == 0
+    refused = invoke("run", COLUMN, "--duration", -1, "--out", "new/w.rrd")
+    assert refused.exit_code == 2 and list(tmp_path.iterdir()) == [], refused.output
+    result = invoke("run", COLUMN, "--duration", 0.01, "--out", "recordings/x.rrd", "--history", "a/b/h.npz")
+    assert result.exit_code == 0, result.output
+    assert invoke("build", "wall", "--out", "x/w.geojson").exit_code == 0
+    assert invoke("export", "a/b/h.npz", "--out", "e/f/h.csv").exit_code == 0
+    sweep = ("sweep", COLUMN, "-p", "friction=0.5", "--duration", 0.01, "--workers", 0, "--out", "s/t.csv")
+    outputs = ("--plot", "p/t.png", "--recording", "r/t.rrd", "--histories", "hh/runs")
+    result = invoke(*sweep, *outputs)
+    assert result.exit_code == 0, result.output
+    made = ["a/b/h.npz", "e/f/h.csv", "hh/runs/friction=0.5.npz", "p/t.png", "r/t.rrd", "recordings/x.rrd"]
+    made += ["s/t.csv", "x/w.geojson"]
+    assert sorted(p.relative_to(tmp_path).as_posix() for p in tmp_path.rglob("*") if p.is_file()) == made
+    assert leftovers(tmp_path) == []
+    # a file where a folder is named is still refused, whole
+    result = invoke("run", COLUMN, "--duration", 0.01, "--out", "x/w.geojson/y.rrd")
+    assert result.exit_code == 2 and "x/w.geojson is not a folder" in result.output, result.output

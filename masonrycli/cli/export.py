@@ -60,8 +60,8 @@ def _targets(histories: list[Path], out: Path | None, force: bool, several: bool
     ``out``/NAME.csv (a folder) or NAME.csv beside each for several."""
     from masonrycli.outputs.files import check_distinct, check_output
 
-    if several and out is not None and not out.is_dir():
-        raise InputError(f"--out {out}: several histories, one CSV each: --out names an existing folder for them")
+    if several and out is not None and (out.suffix.lower() == ".csv" or (out.exists() and not out.is_dir())):
+        raise InputError(f"--out {out}: several histories, one CSV each: --out names a folder for them")
     targets = []
     for history in histories:
         path = history.with_suffix(".csv")

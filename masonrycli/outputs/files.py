@@ -3,7 +3,9 @@
 The policy (README, "Outputs and overwriting"):
 
 - An explicit path (``--out``, ``--history``, ``build --out``) that already exists is refused, exit 2,
-  unless ``--force`` is given. Two outputs naming the same file are refused.
+  unless ``--force`` is given. Two outputs naming the same file are refused. Its missing folders are made,
+  as the default recording's ``recordings/`` is (``--out runs/w.rrd`` was refused for want of ``runs/``);
+  a typed folder name shows in the summary's path.
 - Default recording names ``recordings/<name>-<YYYYmmdd-HHMMSS>.rrd`` never collide: a name already on
   disk, or being written by another run, takes ``-2``, ``-3``… Scenario names are reduced to
   letters, digits and ``._-`` so they cannot leave ``recordings/``.
@@ -149,11 +151,10 @@ def check_output(
     force: bool,
     *,
     default_name: bool = False,
-    make_folder: bool = False,
 ) -> OutputFile:
     """Check ``path`` before anything is computed: suffix (one, or a tuple of accepted ones), not a folder,
-    not existing (unless ``force``), its folder existing (or creatable: the default name's recordings/, a
-    ``make_folder`` option's own folder) and writable. Raises :class:`InputError` naming the option and the
+    not existing (unless ``force``), its folder existing or creatable (:func:`check_folder`; made when the
+    file is opened, :func:`open_part`) and writable. Raises :class:`InputError` naming the option and the
     path."""
     where = f"{option} {path}"
     suffixes = (suffix,) if isinstance(suffix, str) else suffix
@@ -167,7 +168,7 @@ def check_output(
         raise InputError(f"{where}: the file exists{broken} (add --force to replace it)")
     if path.exists() and not os.access(path, os.W_OK):
         raise InputError(f"{where}: the file exists and is read-only")
-    check_folder(path, where, make=default_name or make_folder)
+    check_folder(path, where)
     return OutputFile(path, option, force=force, default_name=default_name)
 
 
@@ -192,16 +193,13 @@ def _check_name_length(path: Path, where: str) -> None:
         )
 
 
-def check_folder(path: Path, where: str, make: bool = False) -> None:
-    """Raise :class:`InputError` (``where: problem``) unless ``path``'s folder exists (or, with ``make``, can
-    be made) and is writable, on a disk. A missing folder was made without a word: a typo (``--out
-    reslts/w.rrd``) left a new folder and the file where no one looked."""
+def check_folder(path: Path, where: str) -> None:
+    """Raise :class:`InputError` (``where: problem``) unless ``path``'s folder exists or can be made (its
+    nearest existing folder is one, and writable) on a disk. Nothing is made here: ``check`` writes nothing."""
     folder = path.parent
     existing = next((p for p in (folder, *folder.parents) if p.exists()), Path("."))
     if not existing.is_dir():
         raise InputError(f"{where}: {existing} is not a folder")
-    if not make and existing != folder:
-        raise InputError(f"{where}: there is no folder {folder} (make it first)")
     if not os.access(existing, os.W_OK | os.X_OK):
         raise InputError(f"{where}: cannot write in {existing} ({_why_not_writable(existing)})")
     if shutil.disk_usage(existing).total == 0:  # /proc, /sys: writable to root, yet no file can be made there

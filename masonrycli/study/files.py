@@ -99,7 +99,7 @@ def check_histories(
             taken = sorted(folder.glob(glob_escape(name).replace(_ANY, "*"))) if folder.is_dir() else []
             name = taken[0].name if taken else name.replace(_ANY, "0")
         made = made_by_study(folder / name, study)
-        check_output(folder / name, "--histories", ".npz", force or made, make_folder=True)  # the study makes it
+        check_output(folder / name, "--histories", ".npz", force or made)  # the study makes the folder
 
 
 def remove_abandoned_parts(folder: Path | None) -> None:
