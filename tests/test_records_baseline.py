@@ -17,6 +17,7 @@ from typer.testing import CliRunner
 
 from benchmarks.baseline_shapes import BURSTS, bursts
 from masonrycli.cli.app import app
+from masonrycli.errors import RecordWarning
 from masonrycli.records.motion import Record
 from masonrycli.records.read import G_STANDARD
 from masonrycli.scenario.caveats import BASELINE_CHANGE, record_warnings
@@ -176,3 +177,52 @@ def test_sweep_records_take_the_baseline(table, tmp_path, monkeypatch):
     plan = plan_study("wall", records=[table], baseline="none", out=Path("b.parquet"))
     assert [m.baseline for m in plan.base.records.values()] == ["none"]
     assert not [w for w in plan.request.warnings if "does not end at rest where it started" in w]
+
+
+@pytest.mark.parametrize("command", [("check", BLOCK), ("simulate", "wall", "--no-recording", "--duration", 0.01)])
+def test_a_baseline_on_a_velocity_record_says_it_does_not_apply(command, tmp_path):
+    # "--baseline quadratic" on a velocity record did nothing, without a word: a velocity record is not
+    # integrated, never corrected (its samples as given: the reference, np.interp of the file, below)
+    velocity = DATA / "quake_velocity.csv"
+    result = invoke(*command, "--record", velocity, "--baseline", "quadratic")
+    assert result.exit_code == 2, result.output
+    assert result.output.strip() == (
+        f"error: --baseline quadratic: {velocity} is a velocity record, used as given: the drift correction is of "
+        "acceleration records, which are integrated (leave --baseline out)"
+    )
+    result = invoke(*command, "--record", velocity, "--baseline", "none")
+    assert result.exit_code == 0, result.output
+    said = [ln for ln in result.output.splitlines() if ln.startswith("warning: --baseline")]
+    assert said == [
+        f"warning: --baseline none: {velocity} is a velocity record, used as given whatever --baseline says (it "
+        "applies to acceleration records)"
+    ], result.output
+    assert invoke(*command, "--record", velocity).exit_code == 0  # not given: no word
+
+
+def test_a_velocity_record_is_used_as_given():
+    from masonrycli.scenario.builtin import record_motion_option
+
+    velocity = DATA / "quake_velocity.csv"
+    t, v = np.loadtxt(velocity, delimiter=",", skiprows=2, unpack=True)
+    at = np.linspace(t[0], t[-1], 101)
+    with pytest.warns(RecordWarning):
+        applied = record_motion_option(velocity, None, baseline="none").velocity_at(at)
+    assert applied[:, 0] == pytest.approx(np.interp(at, t, v), abs=1e-12) and not applied[:, 1].any()
+
+
+def test_sweep_records_say_which_velocity_records_a_baseline_leaves(table, tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    velocity = tmp_path / "v.csv"
+    velocity.write_text((DATA / "quake_velocity.csv").read_text())
+    with pytest.raises(Exception, match=r"^--baseline quadratic: v.csv is a velocity record, used as given: "):
+        plan_study("wall", records=[velocity], baseline="quadratic", out=Path("a.parquet"))
+    mixed = plan_study("wall", records=[table, velocity], baseline="quadratic", out=Path("b.parquet"))
+    said = [w for w in mixed.request.warnings if w.startswith("--baseline")]
+    assert said == [
+        "--baseline quadratic: v.csv is a velocity record, used as given; it corrects the acceleration records"
+    ]
+    as_given = plan_study("wall", records=[table, velocity], baseline="none", out=Path("c.parquet"))
+    assert not [w for w in as_given.request.warnings if w.startswith("--baseline")]
+    alone = plan_study("wall", records=[velocity], baseline="none", out=Path("d.parquet")).request.warnings
+    assert [w for w in alone if w.startswith("--baseline none: v.csv is a velocity record")], alone

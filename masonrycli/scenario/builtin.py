@@ -31,12 +31,13 @@ import dataclasses
 import difflib
 import math
 import os
+import warnings
 from collections.abc import Callable
 from pathlib import Path
 from types import SimpleNamespace
 
-from masonrycli.errors import NOT_A_FILE, InputError, file_kind, special_file
-from masonrycli.records.motion import BASELINE_PROBLEM, BASELINES, Record, time_step_problem
+from masonrycli.errors import NOT_A_FILE, InputError, RecordWarning, file_kind, special_file
+from masonrycli.records.motion import BASELINE_PROBLEM, BASELINES, Record, time_step_problem, unused_baseline
 from masonrycli.records.read import record_motion
 from masonrycli.records.text import NoTimeStep, TimeStepNotUsed
 from masonrycli.scenario.motion import Constant, Fixed, Sine
@@ -139,7 +140,7 @@ def record_motion_option(
     check_record_dt(record_dt)
     check_baseline(baseline)
     try:
-        return record_motion(
+        motion = record_motion(
             path,
             scale=1.0 if scale is None else scale,
             display=str(path),
@@ -153,6 +154,9 @@ def record_motion_option(
     except InputError as exc:
         msg = str(exc)
         raise InputError(msg if msg.startswith(str(path)) else f"--record {path}: {msg}") from None
+    for line in unused_baseline(baseline, {str(path): motion}):
+        warnings.warn(RecordWarning(line), stacklevel=2)
+    return motion
 
 
 def with_record(

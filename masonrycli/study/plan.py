@@ -19,6 +19,7 @@ from pathlib import Path
 
 from masonrycli.errors import NOT_A_FILE, InputError
 from masonrycli.outputs.files import OutputFile, safe_name
+from masonrycli.records.motion import unused_baseline
 from masonrycli.records.read import vertical_at2
 from masonrycli.scenario.builtin import check_baseline, check_record_dt, is_built_in, override_run, target_scenario
 from masonrycli.scenario.values import option_text
@@ -103,6 +104,7 @@ def plan_study(
         raise InputError('--baseline: goes with --records (a scenario file\'s own record takes baseline = "none")')
     if records:
         motions, unread = _records(records, out, record_dt, baseline or "quadratic")
+        unread += unused_baseline(baseline, motions)
         scenario, late = _record_duration(base.scenario, motions, lasting)  # a file's [run] duration stands
         late = [*unread, *late]
         base = StudyBase(scenario, motions)
