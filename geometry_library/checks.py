@@ -108,6 +108,11 @@ CONTACT_DISTANCE = 1e-3
 _NORMALISED: weakref.WeakValueDictionary[int, Polygon] = weakref.WeakValueDictionary()
 
 
+class NotConvexError(GeometryError):
+    """A polygon refused as not convex (and nothing else): a reader may take its convex hull instead
+    (:mod:`geometry_library.survey`)."""
+
+
 def body_label(index: int, name: str, kind: str = "block") -> str:
     """``block 7 ("c03-b02")`` for ``blocks[6]`` — how every message names a body: ``index`` is its
     0-based position among the bodies of its kind, shown from 1 as the user counts them in the file (the
@@ -281,7 +286,7 @@ def normalise_coords(coords, label: str) -> np.ndarray:
         h = shape_tolerance(xy)
     reflex = np.flatnonzero(depth <= h)  # inside the neighbours' line by more than h (or a spike's tip)
     if reflex.size:
-        raise GeometryError(
+        raise NotConvexError(
             f"{label}: polygon is not convex (reflex vertex at {_fmt(xy[reflex[0]])}){float32_hint(given, h)}"
         )
     return np.ascontiguousarray(xy)

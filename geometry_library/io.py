@@ -62,7 +62,8 @@ import shapely.wkt
 from shapely.geometry import GeometryCollection, MultiPolygon, Polygon
 
 from .blocks import SUPPORT_ROLES, Assembly, Block, GeometryError, Support, name_problem, quoted_name
-from .checks import body_label, polygon_from_coords
+from .checks import NotConvexError, body_label, polygon_from_coords
+from .survey import Frame, Survey, frame_of, hull_note, hull_of, survey_notes, trim_overlaps, units_hint
 from .values import check_positive, is_real
 
 _LABEL = re.compile(
@@ -129,7 +130,14 @@ def _velocity(value, where: str) -> tuple[float, float, float]:
     return v
 
 
-def read_geojson(path, density: float = 2500.0, thickness: float = 1.0, unknown: dict | None = None) -> Assembly:
+def read_geojson(
+    path,
+    density: float = 2500.0,
+    thickness: float = 1.0,
+    unknown: dict | None = None,
+    survey: Survey | None = None,
+    notes: list | None = None,
+) -> Assembly:
     """Read an assembly from a GeoJSON FeatureCollection (format in the module docstring).
 
     Parameters
@@ -138,6 +146,9 @@ def read_geojson(path, density: float = 2500.0, thickness: float = 1.0, unknown:
     density : kg/m³, thickness : m — defaults for blocks without those properties.
     unknown : a dict given receives each property key the reader does not use (not in GEOJSON_PROPERTIES nor
         GIS_ID_COLUMNS) → the first body carrying it (``feature 2, block 2 ("B2")``), in file order.
+    survey : how to read a surveyed file (units, y down, convex hulls, overlaps trimmed:
+        :mod:`geometry_library.survey`); a file far from the origin is moved near it in any case.
+    notes : a list given receives the one-line notes of that reading (the shift, hulls, trims, hints).
 
     Raises
     ------
@@ -168,6 +179,7 @@ def read_geojson(path, density: float = 2500.0, thickness: float = 1.0, unknown:
     blocks: list[Block] = []
     supports: list[Support] = []
     refused: list[tuple[str, str]] = []  # (message, body) of each polygon refused, said together at the end
+    pending = []  # (feature_at, where, role, index, name, props, coords): made once every ring is read
     for k, feature in enumerate(features, start=1):  # numbered from 1, as the bodies are (body_label)
         feature_at = where = f"{path}: feature {k}"  # the body's label is added once its role is read
         if not isinstance(feature, dict) or feature.get("type") != "Feature":
@@ -217,32 +229,69 @@ def read_geojson(path, density: float = 2500.0, thickness: float = 1.0, unknown:
             coords = np.array([[_real(c) for c in xy[:2]] for xy in rings[0]], dtype=np.float64)
         except (TypeError, ValueError, IndexError):
             raise GeometryError(f"{where}: coordinates must be [x, y] number pairs") from None
+        (blocks if role == "block" else supports).append(None)  # numbered now, made once the frame is known
+        pending.append((feature_at, where, role, index, name, props, coords))
+    survey = survey or Survey()
+    frame = frame_of([entry[-1] for entry in pending], survey)
+    hulls: list[tuple[str, float]] = []
+    for feature_at, where, role, index, name, props, coords in pending:
         try:
-            polygon = polygon_from_coords(coords, index, name, role)
+            polygon = _surveyed_polygon(frame.local(coords), index, name, role, survey, hulls)
         except GeometryError as exc:
             refused.append((f"{feature_at}: {exc}", body_label(index, name, role)))  # exc starts with the label
-            (blocks if role == "block" else supports).append(None)  # the next bodies keep their numbers
             continue
         if role == "block":
-            blocks.append(
-                Block(
-                    polygon,
-                    name,
-                    _number(props.get("density", density), "density", where),
-                    _number(props.get("thickness", thickness), "thickness", where),
-                    _velocity(props.get("velocity", (0.0, 0.0, 0.0)), where),
-                )
+            blocks[index] = Block(
+                polygon,
+                name,
+                _number(props.get("density", density), "density", where),
+                _number(props.get("thickness", thickness), "thickness", where),
+                _velocity(props.get("velocity", (0.0, 0.0, 0.0)), where),
             )
         else:
             srole = _word(props.get("support_role", "fixed"))
             if srole not in SUPPORT_ROLES:
                 raise GeometryError(f"{where}: support_role must be one of {SUPPORT_ROLES}, got {srole!r}")
-            supports.append(Support(polygon, name, srole))
-    _raise_refused(refused)
-    return Assembly(tuple(blocks), tuple(supports))
+            supports[index] = Support(polygon, name, srole)
+    return _surveyed(path, refused, blocks, supports, frame, survey, hulls, notes)
 
 
-def _raise_refused(refused: list[tuple[str, str]]) -> None:
+def _surveyed_polygon(xy, index: int, name: str, role: str, survey: Survey, hulls: list) -> Polygon:
+    """The checked polygon of a body (``polygon_from_coords``), or with ``survey.convex_hull`` that of its hull
+    when it is not convex (``hulls`` receives its label and the area the hull adds)."""
+    try:
+        return polygon_from_coords(xy, index, name, role)
+    except NotConvexError:
+        if not survey.convex_hull:
+            raise
+    label = body_label(index, name, role)
+    hull, gain = hull_of(xy, label)
+    hulls.append((label, gain))
+    return polygon_from_coords(hull, index, name, role)
+
+
+def _surveyed(path, refused, blocks, supports, frame: Frame, survey: Survey, hulls, notes) -> Assembly:
+    """The assembly read (refusals raised, with where the coordinates they quote are on the map and a units
+    hint), overlaps trimmed when ``survey`` says so; ``notes`` (if a list) receives what was done."""
+    read = [p.polygon for p in blocks if p is not None]
+    hint = units_hint(read, survey) if refused else ""
+    _raise_refused(refused, frame.where() + (f"; {hint}" if hint else ""))
+    assembly = Assembly(tuple(blocks), tuple(supports))
+    said = survey_notes(path, frame, survey, read, [s.polygon for s in supports])
+    if hulls:
+        said.append(hull_note(path, hulls))
+    if survey.trim_overlaps > 0.0 and assembly.block_count:
+        try:
+            assembly, trimmed = trim_overlaps(assembly, survey.trim_overlaps)
+        except GeometryError as exc:
+            raise GeometryError(f"{path}: {exc}{frame.where()}") from None
+        said += [f"{path}: {trimmed}"] if trimmed else []
+    if notes is not None:
+        notes.extend(said)
+    return assembly
+
+
+def _raise_refused(refused: list[tuple[str, str]], end: str = "") -> None:
     """Raise the first refused polygon's error, the other refused bodies named after it: a drawing with
     several stones not convex (or self-intersecting) was mended one run of ``masonry check`` per stone."""
     if not refused:
@@ -250,7 +299,7 @@ def _raise_refused(refused: list[tuple[str, str]]) -> None:
     others = [body for _, body in refused[1:]]
     shown = ", ".join(others[:5]) + (f", … ({len(others) - 5} more)" if len(others) > 5 else "")
     more = f" (and {len(others)} more polygon{'s' if len(others) > 1 else ''} refused: {shown})" if others else ""
-    raise GeometryError(refused[0][0] + more)
+    raise GeometryError(refused[0][0] + end + more)
 
 
 def _ring_coords(polygon: Polygon) -> list[list[float]]:
@@ -312,8 +361,11 @@ def _parse_wkt(text: str, where: str):
         raise GeometryError(f"{where}: cannot parse WKT ({msg})") from None
 
 
-def read_wkt(path, density: float = 2500.0, thickness: float = 1.0) -> Assembly:
-    """Read an assembly from a WKT file (format in the module docstring).
+def read_wkt(
+    path, density: float = 2500.0, thickness: float = 1.0, survey: Survey | None = None, notes: list | None = None
+) -> Assembly:
+    """Read an assembly from a WKT file (format in the module docstring); ``survey`` and ``notes`` as
+    :func:`read_geojson`'s.
 
     Raises
     ------
@@ -355,6 +407,7 @@ def read_wkt(path, density: float = 2500.0, thickness: float = 1.0) -> Assembly:
     blocks: list[Block] = []
     supports: list[Support] = []
     refused: list[tuple[str, str]] = []
+    pending = []  # (where, role, index, label, srole, coords): made once every ring is read
     for where, role, name, srole, text in entries:
         role = (role or ("support" if srole else "block")).lower()
         polys = _polygons_of(_parse_wkt(text, where), where)
@@ -368,18 +421,22 @@ def read_wkt(path, density: float = 2500.0, thickness: float = 1.0) -> Assembly:
                 raise GeometryError(f"{where}: {body_label(index, label, role)}: polygon is empty")
             if poly.interiors:
                 raise GeometryError(f"{where}: {body_label(index, label, role)}: polygon has holes; blocks are solid")
-            try:
-                polygon = polygon_from_coords(np.asarray(poly.exterior.coords)[:, :2], index, label, role)
-            except GeometryError as exc:
-                refused.append((f"{where}: {exc}", body_label(index, label, role)))
-                (blocks if role == "block" else supports).append(None)  # the next bodies keep their numbers
-                continue
-            if role == "block":
-                blocks.append(Block(polygon, label, float(density), float(thickness)))
-            else:
-                supports.append(Support(polygon, label, (srole or "fixed").lower()))
-    _raise_refused(refused)
-    return Assembly(tuple(blocks), tuple(supports))
+            (blocks if role == "block" else supports).append(None)  # numbered now, made once the frame is known
+            pending.append((where, role, index, label, srole, np.asarray(poly.exterior.coords)[:, :2]))
+    survey = survey or Survey()
+    frame = frame_of([entry[-1] for entry in pending], survey)
+    hulls: list[tuple[str, float]] = []
+    for where, role, index, label, srole, coords in pending:
+        try:
+            polygon = _surveyed_polygon(frame.local(coords), index, label, role, survey, hulls)
+        except GeometryError as exc:
+            refused.append((f"{where}: {exc}", body_label(index, label, role)))
+            continue
+        if role == "block":
+            blocks[index] = Block(polygon, label, float(density), float(thickness))
+        else:
+            supports[index] = Support(polygon, label, (srole or "fixed").lower())
+    return _surveyed(path, refused, blocks, supports, frame, survey, hulls, notes)
 
 
 _NO_COLON = re.compile(r"\s*(?P<label>[^\s(:][^(:]*?)\s+(?P<kind>POLYGON|MULTIPOLYGON|GEOMETRYCOLLECTION)\b", re.I)

@@ -19,6 +19,7 @@ from pathlib import Path
 import click
 import numpy as np
 import pytest
+import surveyed_wall
 import typer
 
 from masonrycli.cli.app import app
@@ -36,6 +37,7 @@ FRAGMENTS = {  # in a sentence, not a command line
     "build arch",  # limit.md: "the segmental arch that `masonry build arch` writes with those options"
 }
 NOT_RUN = {  # example -> why it is parsed only
+    "check traced-wall.geojson": "refused on purpose: the page shows its refusals (test_cli_survey)",
     "export h.npz --times lab.csv --compare 'LVDT top (mm)' --out lab-vs-masonry.csv": "a laboratory's measurements",
     "docs collapse": "prints a page: test_user_docs",
     "limit aqueduct --verify": "30 s, run with --out mech.rrd on the same page",
@@ -166,6 +168,8 @@ def _seed(folder: Path) -> None:
             feature["properties"]["support_role"] = "driven"
     (folder / "arch.geojson").write_text(json.dumps(arch))
     (folder / "my wall.toml").write_text(BLOCK_TOML)  # class.md: a name with a space, between quotes
+    # scenario-format.md: a wall traced in QGIS (Lambert-93, mm slips, 4 stones dented)
+    surveyed_wall.write(folder / "traced-wall.geojson", offset=surveyed_wall.LAMBERT93, dent=2e-3, dents=4)
     (folder / "recordings").mkdir()  # made by README's quick start, before its other examples
 
 

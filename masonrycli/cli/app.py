@@ -26,6 +26,7 @@ from masonrycli.cli.options import (
     RUN,
     SETTLED_LOADING,
     STOP,
+    SURVEY,
     WALL,
     WALL_LOADING,
     AtOption,
@@ -228,12 +229,12 @@ def _load(scenario_file: str, opts: dict):
     (taken out of ``opts``) applied."""
     from masonrycli.scenario.builtin import file_scenario
 
-    return file_scenario(scenario_file, **_pop(opts, RECORD, RUN, FRICTION))
+    return file_scenario(scenario_file, survey=_pop(opts, SURVEY), **_pop(opts, RECORD, RUN, FRICTION))
 
 
 @app.command("run")
 @user_errors
-@with_options(RUN_FROM_FILE, STOP, FRICTION_FROM_FILE, OUTPUT, FORCE, RECORD)
+@with_options(RUN_FROM_FILE, STOP, FRICTION_FROM_FILE, OUTPUT, FORCE, RECORD, SURVEY)
 def run_command(scenario_file: ScenarioFile, **opts) -> None:
     """Run any scenario file, or a GeoJSON / WKT geometry file (supports fixed, or shaken by --record: the one
     support, or those marked driven); options given here override the file's values."""
@@ -272,7 +273,7 @@ _register_export()
 
 @app.command("limit")
 @user_errors
-@with_options(ANY_STRUCTURE, BLOCK_MATERIAL)
+@with_options(ANY_STRUCTURE, BLOCK_MATERIAL, SURVEY)
 def limit_command(
     structure: Annotated[
         str,

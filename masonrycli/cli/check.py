@@ -21,6 +21,7 @@ from masonrycli.cli.options import (
     RUN,
     STOP,
     STRUCTURE_OPTIONS,
+    SURVEY,
     file_defaults,
     with_options,
 )
@@ -39,16 +40,19 @@ def _scenario(target: str, opts: dict):
     (taken out of ``opts``): the built-in's structure, loading and material options refused for a file, and
     another built-in's structure options for a built-in, in one line."""
     from masonrycli.scenario.builtin import builtin, file_scenario, is_built_in
+    from masonrycli.scenario.structure import survey_of
 
     shaping = {name: value for name in BUILT_IN_ONLY if (value := opts.pop(name)) is not None}
     settings = {name: opts.pop(name) for group in (RECORD, RUN, FRICTION) for name in group}
+    survey = {name: opts.pop(name) for name in SURVEY}  # how a geometry file is read: refused for a built-in
     if not is_built_in(target):
         if shaping:
             raise InputError(
                 f"{_flags(shaping)}: shape a built-in structure (masonry check wall|arch|aqueduct …); {target} is "
                 "a file, which gives its own geometry and loading"
             )
-        return file_scenario(target, **settings)
+        return file_scenario(target, survey=survey, **settings)
+    survey_of(survey, target)
     allowed = {*STRUCTURE_OPTIONS[target], *BUILT_IN_LOADING, *BLOCK_MATERIAL}
     foreign = [name for name in shaping if name not in allowed]
     if foreign:  # simulate NAME does not take them ("No such option"): the same run cannot be checked
@@ -56,7 +60,7 @@ def _scenario(target: str, opts: dict):
     return builtin(target, **shaping, **settings)
 
 
-@with_options(file_defaults(RUN), STOP, file_defaults(FRICTION), OUTPUT, FORCE, RECORD, BUILT_IN_ONLY)
+@with_options(file_defaults(RUN), STOP, file_defaults(FRICTION), OUTPUT, FORCE, RECORD, BUILT_IN_ONLY, SURVEY)
 def check_command(
     target: Annotated[
         str,

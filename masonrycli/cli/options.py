@@ -239,6 +239,37 @@ DirectionOption = Annotated[
     ),
 ]
 FRICTION = {"friction": Friction}
+SURVEY = {  # how a GeoJSON / WKT file is read (geometry_library/survey.py): a surveyed wall's
+    "units": _opt(
+        str,
+        "Geometry file",
+        "Unit of a GeoJSON / WKT file's coordinates: m (default), cm or mm.",
+        "--units",
+        parser=choice_value,
+    ),
+    "flip_y": Annotated[
+        bool,
+        typer.Option(
+            "--flip-y",
+            help="The file's y axis points down (image rows): read it pointing up.",
+            rich_help_panel="Geometry file",
+        ),
+    ],
+    "convex_hull": Annotated[
+        bool,
+        typer.Option(
+            "--convex-hull",
+            help="Read a slightly non-convex stone as its convex hull (at most 5 % more area; the area added is said).",
+            rich_help_panel="Geometry file",
+        ),
+    ],
+    "trim_overlaps": _opt(
+        float,
+        "Geometry file",
+        "Cut neighbours overlapping by a tracing slip up to this deep, m (0.003), along the middle of their overlap.",
+        "--trim-overlaps",
+    ),
+}
 
 _BUILT_IN_DEFAULT = re.compile(r"\(default ([^;)]*)")
 """The "(default 1e-3" of a help text: the built-in value, which a scenario file's replaces."""

@@ -37,11 +37,13 @@ def resolve_structure(structure: str, friction: float | None, options: dict | No
     """A scenario from a built-in name (the builder's defaults, or ``options``: the structure options of
     ``masonry build NAME`` and --density / --thickness, no motion), a scenario file or a geometry file
     (:func:`~masonrycli.scenario.builtin.target_scenario`); ``friction`` overrides μ."""
-    from masonrycli.cli.options import BLOCK_MATERIAL, STRUCTURE_OPTIONS
+    from masonrycli.cli.options import BLOCK_MATERIAL, STRUCTURE_OPTIONS, SURVEY
     from masonrycli.scenario.builtin import builtin, is_built_in, override_run, target_scenario
     from masonrycli.scenario.scenario import Material, RunConfig, scenario_from_builder
 
-    given = {k: v for k, v in (options or {}).items() if v is not None}
+    options = dict(options or {})
+    survey = {k: options.pop(k) for k in SURVEY if k in options}  # a geometry file's reading (target_scenario)
+    given = {k: v for k, v in options.items() if v is not None}
     flags = ", ".join(f"--{k.replace('_', '-')}" for k in given)
     if given and not is_built_in(structure):
         raise InputError(
@@ -62,7 +64,7 @@ def resolve_structure(structure: str, friction: float | None, options: dict | No
             return builtin(name, **given)
         return scenario_from_builder(name, {}, RunConfig(), Material(), {})
 
-    scenario = target_scenario(structure, built_in)
+    scenario = target_scenario(structure, built_in, survey)
     return override_run(scenario, friction=friction)
 
 
@@ -344,7 +346,9 @@ def _least_ring(structure: str, friction: float | None, structure_options: dict 
         raise InputError(
             f"--min-thickness: the arch's ring only (masonry limit arch …); {structure} is not the arch built-in"
         )
-    given = {k: v for k, v in (structure_options or {}).items() if v is not None}
+    from masonrycli.cli.options import SURVEY
+
+    given = {k: v for k, v in (structure_options or {}).items() if v is not None and k not in SURVEY}
     thickness = float(given.pop("ring_thickness", ArchSpec.ring_thickness))
 
     def build(t: float):

@@ -42,7 +42,7 @@ from masonrycli.records.read import record_motion
 from masonrycli.records.text import NoTimeStep, TimeStepNotUsed
 from masonrycli.scenario.motion import Constant, Fixed, Sine
 from masonrycli.scenario.scenario import MAX_DURATION, Material, RunConfig, Scenario, scenario_from_builder
-from masonrycli.scenario.structure import GEOMETRY_SUFFIXES, BuilderError, as_options, build_structure
+from masonrycli.scenario.structure import GEOMETRY_SUFFIXES, BuilderError, as_options, build_structure, survey_of
 from masonrycli.scenario.values import option_text
 
 DEFAULT_DURATION = {"wall": 1.0, "arch": 5.0, "aqueduct": 5.0}
@@ -237,15 +237,16 @@ def is_built_in(target: str | os.PathLike) -> bool:
     return os.fspath(target) in DEFAULT_DURATION and not os.path.isfile(target)
 
 
-def target_scenario(target: str | os.PathLike, built_in: Callable[[str], Scenario] | None = None) -> Scenario:
+def target_scenario(target: str | os.PathLike, built_in: Callable[[str], Scenario] | None = None, survey=None):
     """The scenario a command's TARGET names: ``built_in(name)`` for a built-in name (None: the command
     takes files only, and the message says where the built-ins run), else a scenario file (TOML) or a
     geometry file (GeoJSON / WKT, every support fixed). A target that is none of them raises the same
-    one-line :class:`InputError` from every command, naming it."""
+    one-line :class:`InputError` from every command, naming it. ``survey``: a geometry file's reading (survey_of)."""
     from masonrycli.scenario.scenario import scenario_from_geometry_file
     from masonrycli.scenario.toml_file import load_scenario
 
     target = os.fspath(target)
+    survey = survey_of(survey or {}, target)
     if not target.strip():  # Path("") is the working folder: it said "error: : no such scenario …"
         raise InputError(f"the structure argument is empty ({target!r}): give wall, arch, aqueduct or a scenario file")
     if is_built_in(target):
@@ -259,7 +260,7 @@ def target_scenario(target: str | os.PathLike, built_in: Callable[[str], Scenari
         raise InputError(f"{target}: {problem}")
     path = Path(target)  # as the commands read it before: "./s.toml" is the scenario "s.toml"
     if path.suffix.lower() in GEOMETRY_SUFFIXES:
-        return scenario_from_geometry_file(path)
+        return scenario_from_geometry_file(path, survey)
     try:
         return load_scenario(path)
     except InputError as exc:
@@ -313,6 +314,7 @@ def file_scenario(
     scale: float | None = None,
     record_dt: float | None = None,
     baseline: str | None = None,
+    survey: dict | None = None,
     **overrides,
 ) -> Scenario:
     """The scenario of a TOML, GeoJSON or WKT file (``masonry run`` / ``check``, :func:`target_scenario`:
@@ -321,7 +323,7 @@ def file_scenario(
     A geometry file has no run settings of its own: shaken by a record with no --duration it runs the whole
     record, as ``simulate`` does (it ran the default 1 s: 'masonry run wall.geojson --record q.AT2' of an 8 s
     record, its strong motion after 2 s, said "intact")."""
-    scenario = with_record(target_scenario(path), record, scale, record_dt, baseline)
+    scenario = with_record(target_scenario(path, survey=survey), record, scale, record_dt, baseline)
     if record is not None and _geometry_as_is(scenario) and overrides.get("duration") is None:
         overrides = overrides | {"duration": whole_records(scenario.motions, overrides.get("dt"))}
     return override_run(scenario, **overrides)

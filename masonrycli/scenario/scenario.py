@@ -354,18 +354,18 @@ def scenario_from_builder(
     )
 
 
-def scenario_from_geometry_file(path) -> Scenario:
+def scenario_from_geometry_file(path, survey=None) -> Scenario:
     """A scenario with default run and material settings for a GeoJSON / WKT file, every support fixed (``masonry
     run my-wall.geojson``; for motions or settings: a scenario file, ``[structure] file = "my-wall.geojson"``)."""
     path = os.fspath(path)
     ctx = InputContext(path, os.path.dirname(os.path.abspath(path)))
     material = Material()
     notes: list[str] = []
-    assembly = read_geometry(path, material.density, material.thickness, ctx, where="", notes=notes)
+    assembly = read_geometry(path, material.density, material.thickness, ctx, where="", notes=notes, survey=survey)
     from masonrycli.scenario.caveats import idle_driven_supports
 
     motions = tuple(Fixed() for _ in assembly.supports)
-    warnings = (*notes, *idle_driven_supports(assembly, motions), *structure_warnings(assembly, ctx))
+    warnings = (*notes, *idle_driven_supports(assembly, motions), *structure_warnings(assembly, ctx, as_run=True))
     return Scenario(
         name=Path(path).stem,
         run=RunConfig(),

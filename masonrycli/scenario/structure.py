@@ -23,12 +23,19 @@ GEOMETRY_SUFFIXES = (".geojson", ".json", ".wkt")
 
 
 def read_geometry(
-    path: str, density: float, thickness: float, ctx: InputContext, where: str = "[structure]", notes=None
+    path: str,
+    density: float,
+    thickness: float,
+    ctx: InputContext,
+    where: str = "[structure]",
+    notes=None,
+    survey=None,
 ) -> Assembly:
     """Blocks and supports of a GeoJSON or WKT file (``geometry_library.io``), with ``density`` and
     ``thickness`` (the material's) as defaults. ``where`` is the table naming the file ("" when the file
     is the scenario itself: ``masonry run wall.geojson``). ``notes``: a list given receives the one-line
-    warning of :func:`unread_properties_warning`, if any."""
+    warning of :func:`unread_properties_warning`, if any, and the reader's notes (a map grid's coordinates moved
+    near the origin, ``survey``'s hulls and trims: :mod:`geometry_library.survey`)."""
     from geometry_library import io as geo_io
 
     suffix = Path(path).suffix.lower()
@@ -41,18 +48,55 @@ def read_geometry(
         missing = not_a_file(path)
         raise ctx.error(where, f"file = {quote_string(path)}: {missing}" if where else missing)
     unknown: dict = {}
+    said: list[str] = []
     try:
         if suffix == ".wkt":
-            return geo_io.read_wkt(path, density=density, thickness=thickness)
-        assembly = geo_io.read_geojson(path, density=density, thickness=thickness, unknown=unknown)
+            assembly = geo_io.read_wkt(path, density=density, thickness=thickness, survey=survey, notes=said)
+        else:
+            assembly = geo_io.read_geojson(
+                path, density=density, thickness=thickness, unknown=unknown, survey=survey, notes=said
+            )
         if unknown and notes is not None:
             notes.append(unread_properties_warning(path, unknown, geo_io.GEOJSON_PROPERTIES))
+        if notes is not None:
+            notes.extend(said)
         return assembly
     except (GeometryError, ValueError) as exc:
         msg = one_line(exc)
+        if not where and "not convex" in msg and not getattr(survey, "convex_hull", False):
+            msg += HULL_HINT  # a file run as it is: the option is on this command line
         if not where and msg.startswith(f"{path}:"):  # the reader named the file already
             raise InputError(msg) from None
         raise ctx.error(where, msg) from None
+
+
+SURVEY_FLAGS = {
+    "units": "--units",
+    "flip_y": "--flip-y",
+    "convex_hull": "--convex-hull",
+    "trim_overlaps": "--trim-overlaps",
+}
+
+
+def survey_of(options: dict, target: str):
+    """The :class:`geometry_library.survey.Survey` of the command line's options reading a geometry file
+    (None when none is given); given for a target that is no GeoJSON / WKT file, they are refused."""
+    from geometry_library.survey import UNITS, Survey
+
+    given = {k: v for k, v in options.items() if v is not None and v is not False}
+    if not given:
+        return None
+    flags = " and ".join(SURVEY_FLAGS[k] for k in given)
+    if Path(target).suffix.lower() not in GEOMETRY_SUFFIXES:
+        raise InputError(f"{flags}: read{'s' if len(given) == 1 else ''} a GeoJSON / WKT file; {target} is not one")
+    if given.get("units", "m") not in UNITS:
+        raise InputError(f"--units {given['units']}: expected one of {', '.join(UNITS)}")
+    depth = given.get("trim_overlaps")
+    if depth is not None and not (math.isfinite(depth) and 0.0 < depth <= 0.1):
+        raise InputError(
+            f"--trim-overlaps {depth:g}: must be in (0, 0.1] m, the deepest overlap a tracing slip makes (0.003: 3 mm)"
+        )
+    return Survey(**given)
 
 
 _MISPLACED = {  # a property read on the other role's bodies (geometry_library.io): why it was not read here
@@ -76,14 +120,20 @@ def unread_properties_warning(path: str, unknown: dict, known) -> str:
     return f"{path}: properties not used, ignored (used: {', '.join(known)}): {'; '.join(items)}"
 
 
-def structure_warnings(assembly: Assembly, ctx: InputContext) -> tuple[str, ...]:
-    """``validate_assembly``: its errors raised at ``ctx``, its warnings on one line each."""
+TRIM_HINT = "; a slip of the tracing? --trim-overlaps 0.003 cuts neighbours overlapping up to 3 mm along the middle"
+HULL_HINT = "; --convex-hull reads a slightly non-convex stone as its convex hull"
+
+
+def structure_warnings(assembly: Assembly, ctx: InputContext, as_run: bool = False) -> tuple[str, ...]:
+    """``validate_assembly``: its errors raised at ``ctx``, its warnings on one line each. ``as_run``: a
+    geometry file run as it is, whose overlap is refused with the option that trims a tracing slip."""
     from geometry_library.checks import validate_assembly
 
     try:
         warnings = validate_assembly(assembly)
     except GeometryError as exc:
-        raise ctx.error("", str(exc)) from None
+        hint = TRIM_HINT if as_run and " overlap by " in str(exc) else ""
+        raise ctx.error("", str(exc) + hint) from None
     return tuple(one_line(w) for w in (warnings or ()))
 
 

@@ -1,0 +1,274 @@
+"""A surveyed wall as a GIS hands it over: a map grid's coordinates, other units, y pointing down, stones
+traced by hand. What the readers (:mod:`geometry_library.io`) do to such a file before the checks.
+
+A heritage survey traces each stone of a wall's face on an orthophoto. Its file differs from a drawn one in
+ways that each stopped a run:
+
+- **a map grid** (Lambert-93: x ≈ 651 234 m, y ≈ 6 861 210 m) — beyond ``MAX_COORDINATE`` every vertex was
+  refused. Coordinates beyond ``RECENTRE_BEYOND`` (10 km) are read moved by whole kilometres to near the
+  origin (always, no option: the mechanics do not depend on where the wall stands, and float32 — the
+  recording's positions, the engine's first sweeps — keeps 0.5 m at 6.9e6 m). The shift is said, and added
+  to a refusal's coordinates, so a stone is found again on the map;
+- **other units** (``units``: ``"mm"``, ``"cm"``): read into metres. A wall in millimetres read as metres
+  has stones hundreds of metres across; with no ``units`` given, stones whose median size exceeds
+  ``HUGE_STONE`` (20 m) are said to be likely millimetres;
+- **y pointing down** (image rows, ``flip_y``): read with y negated, so gravity pulls the wall towards its
+  foot. Without it, a support lying above half the blocks is said to be likely upside down;
+- **slightly non-convex stones** (``convex_hull``, opt-in): a stone refused as not convex is read as its
+  convex hull, if that adds at most ``MAX_HULL_GAIN`` (5 %) of its area — the area added is said; more
+  is a stone of another shape, still refused (split it in QGIS);
+- **neighbours overlapping by a tracing slip** (``trim_overlaps`` = the deepest overlap to trim, m, opt-in):
+  each overlapping pair is cut along a line through the middle of their overlap (:func:`trim_overlaps`).
+
+Trimming, in pseudo-code::
+
+    for each pair (A, B) of bodies whose overlap O has an area (not two supports):
+        refuse if depth(O) > trim depth                 (a real overlap, not a slip)
+        line L through O's centroid along O's longest direction (principal axis of O's vertices)
+        refuse if A's and B's centroids are on the same side of L
+        A keeps its side of L, B the other                   (collected first, cut after: order-free)
+    each body = its polygon clipped by all its half-planes   (a convex polygon stays convex)
+
+After the cuts A and B meet along L exactly: they touch, as the stones do. A half-plane cut keeps a body
+convex and only removes area; the area removed is said (largest fraction of a body).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import numpy as np
+import shapely
+from shapely.geometry import Polygon
+from shapely.strtree import STRtree
+
+from .blocks import Assembly, GeometryError
+from .checks import body_label, normalised_polygon, overlap_depth, signed_area
+
+RECENTRE_BEYOND = 1e4
+"""m: coordinates farther than this from the origin are moved near it."""
+RECENTRE_STEP = 1e3
+"""m: the shift is a whole number of these (the local coordinates keep the survey's last digits)."""
+UNITS = {"m": 1.0, "cm": 0.01, "mm": 0.001}
+"""Metres per unit of a file's coordinates."""
+MAX_HULL_GAIN = 0.05
+"""The most area (fraction of the stone's) a convex hull may add: more is no tracing slip."""
+HUGE_STONE = 20.0
+"""m: a median stone larger than this across is a wall in millimetres or centimetres read as metres."""
+
+
+@dataclasses.dataclass(frozen=True)
+class Survey:
+    """How to read a surveyed file (module docstring). The default reads a file as it is, moved near the
+    origin when it is far."""
+
+    units: str = "m"
+    flip_y: bool = False
+    convex_hull: bool = False
+    trim_overlaps: float = 0.0
+    """m: the deepest overlap of two bodies trimmed (0: none trimmed, an overlap is refused by the checks)."""
+
+    def __post_init__(self):
+        if self.units not in UNITS:
+            raise GeometryError(f"units must be one of {', '.join(UNITS)}, got {self.units!r}")
+        if not (math.isfinite(self.trim_overlaps) and 0.0 <= self.trim_overlaps <= 0.1):
+            raise GeometryError(f"trim depth must be between 0 and 0.1 m (a tracing slip), got {self.trim_overlaps!r}")
+
+
+@dataclasses.dataclass(frozen=True)
+class Frame:
+    """File coordinates → metres near the origin: ``(xy × scale) × (1, ±1) − shift``."""
+
+    scale: float = 1.0
+    flip_y: bool = False
+    shift: tuple[float, float] = (0.0, 0.0)
+
+    def local(self, xy: np.ndarray) -> np.ndarray:
+        out = np.asarray(xy, dtype=np.float64) * self.scale
+        if self.flip_y:
+            out = out * np.array([1.0, -1.0])
+        return out - np.array(self.shift)
+
+    def where(self) -> str:
+        """The end of a message quoting local coordinates: how to find them on the map ("" if not moved)."""
+        if self.shift == (0.0, 0.0):
+            return ""
+        return f" (coordinates read moved by ({-self.shift[0]:.0f}, {-self.shift[1]:.0f}) m: add {_pair(self.shift)} for the map's)"
+
+
+def _pair(p) -> str:
+    return f"({p[0]:.0f}, {p[1]:.0f})"
+
+
+def frame_of(rings: list, survey: Survey) -> Frame:
+    """The frame of a file's rings (each (k, 2) as given): units, flip, and the shift of whole kilometres that
+    brings the lowest, leftmost corner of their bounding box near the origin when it is farther than
+    ``RECENTRE_BEYOND`` (not when the rings span more than 1000 km: the checks refuse such a file as it is)."""
+    scale = UNITS[survey.units]
+    frame = Frame(scale, survey.flip_y)
+    xy = [np.asarray(r, dtype=np.float64).reshape(-1, 2) for r in rings if np.size(r)]
+    xy = frame.local(np.vstack(xy)) if xy else np.zeros((0, 2))
+    xy = xy[np.all(np.isfinite(xy), axis=1)]
+    if not len(xy):
+        return frame
+    low, high = xy.min(axis=0), xy.max(axis=0)
+    if np.abs(xy).max() <= RECENTRE_BEYOND or np.any(high - low > 1e6):
+        return frame
+    shift = np.floor(low / RECENTRE_STEP) * RECENTRE_STEP
+    shift = np.where(np.maximum(np.abs(low), np.abs(high)) > RECENTRE_BEYOND, shift, 0.0)
+    return dataclasses.replace(frame, shift=(float(shift[0]), float(shift[1])))
+
+
+def survey_notes(path, frame: Frame, survey: Survey, blocks: list, supports: list) -> list[str]:
+    """One-line notes on a surveyed file once read: the shift, and the likely units or y-axis slips."""
+    notes = []
+    if frame.shift != (0.0, 0.0):
+        notes.append(
+            f"{path}: coordinates {_far(frame) / 1e3:,.0f} km from the origin (a map grid's) read moved by "
+            f"({-frame.shift[0]:.0f}, {-frame.shift[1]:.0f}) m, near it: add {_pair(frame.shift)} to map a "
+            "result back onto the survey"
+        )
+    hint = units_hint(blocks, survey)
+    if hint:
+        notes.append(f"{path}: {hint}")
+    if supports and blocks and not survey.flip_y:
+        feet = np.median([p.bounds[1] for p in blocks])
+        above = [k for k, s in enumerate(supports) if s.bounds[1] >= feet]
+        if len(above) == len(supports):
+            what = "the supports lie" if len(supports) > 1 else "the support lies"
+            notes.append(
+                f"{path}: {what} above half the blocks: is the y axis pointing down (image rows)? --flip-y reads "
+                "it pointing up"
+            )
+    return notes
+
+
+def _far(frame: Frame) -> float:
+    return float(np.hypot(*frame.shift))
+
+
+def units_hint(blocks: list, survey: Survey) -> str:
+    """A sentence when the median block (shapely polygons, m) is more than ``HUGE_STONE`` across and no
+    ``units`` were given ("" otherwise)."""
+    if not blocks or survey.units != "m":
+        return ""
+    sizes = [math.hypot(x1 - x0, y1 - y0) for x0, y0, x1, y1 in (p.bounds for p in blocks)]
+    median = float(np.median(sizes))
+    if median <= HUGE_STONE:
+        return ""
+    return (
+        f"the blocks are {min(sizes):.3g}–{max(sizes):.3g} m across (median {median:.3g} m): are the coordinates "
+        "millimetres? --units mm reads them so (--units cm: centimetres)"
+    )
+
+
+def hull_of(xy: np.ndarray, label: str) -> tuple[np.ndarray, float]:
+    """The convex hull of a ring (k, 2) refused as not convex, and the fraction of its area it adds; raises
+    when that is more than ``MAX_HULL_GAIN`` (or the ring self-intersects: no area to compare)."""
+    ring = Polygon(xy)
+    area = abs(signed_area(np.asarray(xy, dtype=np.float64)))
+    hull = shapely.convex_hull(ring)
+    gain = hull.area / area - 1.0 if ring.is_valid and area > 0.0 else math.inf
+    if not gain <= MAX_HULL_GAIN:
+        raise GeometryError(
+            f"{label}: polygon is not convex, and its convex hull would add {gain:.1%} of its area, more than "
+            f"--convex-hull takes ({MAX_HULL_GAIN:.0%}: a tracing slip): split it into convex stones"
+        )
+    return np.asarray(hull.exterior.coords)[:-1], gain
+
+
+def hull_note(path, hulls: list[tuple[str, float]]) -> str:
+    """The note of the stones read as their hulls (``hulls``: label, area added)."""
+    label, most = max(hulls, key=lambda h: h[1])
+    least = min(g for _, g in hulls)
+    return (
+        f"{path}: {len(hulls)} non-convex polygon{'s' if len(hulls) > 1 else ''} read as {'their' if len(hulls) > 1 else 'its'} "
+        f"convex hull{'s' if len(hulls) > 1 else ''} (--convex-hull), adding {least:.2%}–{most:.2%} of the area (most: {label})"
+    )
+
+
+def _labels(assembly: Assembly) -> list[str]:
+    return [body_label(i, b.name) for i, b in enumerate(assembly.blocks)] + [
+        body_label(j, s.name, "support") for j, s in enumerate(assembly.supports)
+    ]
+
+
+def trim_overlaps(assembly: Assembly, depth: float) -> tuple[Assembly, str]:
+    """``assembly`` with each pair of overlapping bodies (not two supports) cut along the middle of their
+    overlap (module docstring), and a one-line note of what was trimmed ("" when nothing overlapped).
+    Raises when an overlap is deeper than ``depth`` m (listing the pairs) or cannot be split."""
+    bodies = [*assembly.blocks, *assembly.supports]
+    n_blocks = assembly.block_count
+    polys = np.array([b.polygon for b in bodies], dtype=object)
+    labels = _labels(assembly)
+    left, right = STRtree(polys).query(polys, predicate="intersects")
+    keep = (left < right) & (left < n_blocks)
+    left, right = left[keep], right[keep]
+    overlaps = shapely.intersection(polys[left], polys[right])
+    cuts: list[list[tuple[np.ndarray, float]]] = [[] for _ in bodies]  # per body: (n, c) keeping n·x >= c
+    deep, deepest = [], 0.0
+    for a, b, overlap in zip(left.tolist(), right.tolist(), overlaps):
+        if overlap.area <= 1e-12 * min(polys[a].area, polys[b].area):
+            continue  # touching along an edge or at a point
+        d = overlap_depth(overlap)
+        if d > depth:
+            deep.append((a, b, d))
+            continue
+        deepest = max(deepest, d)
+        xy = shapely.get_coordinates(overlap)[:-1]
+        centre = np.asarray(overlap.centroid.coords[0])
+        axis = np.linalg.svd(xy - centre, full_matrices=False)[2][0]  # the overlap's longest direction
+        normal = np.array([-axis[1], axis[0]])
+        side_a = float(normal @ (np.asarray(polys[a].centroid.coords[0]) - centre))
+        side_b = float(normal @ (np.asarray(polys[b].centroid.coords[0]) - centre))
+        if side_a * side_b >= 0.0:
+            raise GeometryError(f"{labels[a]} and {labels[b]} overlap in a way no straight cut separates")
+        normal = normal if side_a > 0.0 else -normal
+        cuts[a].append((normal, float(normal @ centre)))
+        cuts[b].append((-normal, float(-normal @ centre)))
+    if deep:
+        a, b, d = deep[0]
+        others = [f"{bodies[p].name}/{bodies[q].name}" for p, q, _ in deep[1:6]]
+        more = (
+            f" (and {len(deep) - 1} more: {', '.join(others)}{', …' if len(deep) > 6 else ''})" if len(deep) > 1 else ""
+        )
+        raise GeometryError(
+            f"{labels[a]} and {labels[b]} overlap {d * 1e3:.3g} mm deep, more than the {depth * 1e3:.3g} mm trimmed "
+            f"(a slip of the tracing that deep: a larger depth trims it; else redraw them){more}"
+        )
+    pairs = sum(len(c) for c in cuts) // 2
+    if not pairs:
+        return assembly, ""
+    new, worst = [], (0.0, "")
+    for k, (body, body_cuts) in enumerate(zip(bodies, cuts)):
+        if not body_cuts:
+            new.append(body)
+            continue
+        xy = np.asarray(body.polygon.exterior.coords)[:-1]
+        for normal, c in body_cuts:
+            xy = _clip(xy, normal, c)
+        polygon = normalised_polygon(xy, labels[k])
+        lost = 1.0 - polygon.area / body.polygon.area
+        worst = max(worst, (lost, labels[k]))
+        new.append(dataclasses.replace(body, polygon=polygon))
+    trimmed = Assembly(tuple(new[:n_blocks]), tuple(new[n_blocks:]))
+    note = (
+        f"{pairs} overlapping pair{'s' if pairs > 1 else ''} trimmed along the middle of their overlap "
+        f"(--trim-overlaps; deepest {deepest * 1e3:.2g} mm, at most {worst[0]:.2%} of a body's area: {worst[1]})"
+    )
+    return trimmed, note
+
+
+def _clip(xy: np.ndarray, normal: np.ndarray, c: float) -> np.ndarray:
+    """The convex ring ``xy`` (k, 2) clipped to the half-plane n·x ≥ c (Sutherland–Hodgman, one edge)."""
+    s = xy @ normal - c
+    out = []
+    for i in range(len(xy)):
+        j = (i + 1) % len(xy)
+        if s[i] >= 0.0:
+            out.append(xy[i])
+        if (s[i] >= 0.0) != (s[j] >= 0.0):
+            t = s[i] / (s[i] - s[j])
+            out.append(xy[i] + t * (xy[j] - xy[i]))
+    return np.array(out)

@@ -1,0 +1,68 @@
+"""A heritage researcher's traced wall on the command line: check, limit and run a GeoJSON in Lambert-93 with
+slightly non-convex stones and tracing slips (--convex-hull, --trim-overlaps, --units, --flip-y)."""
+
+import json
+
+import pytest
+import surveyed_wall
+
+from cli_helpers import assert_one_line_error, invoke, words
+
+
+@pytest.fixture
+def traced(tmp_path):
+    """72 stones traced to the mm in Lambert-93, slips of up to 1 mm a vertex, 4 stones dented 2 mm."""
+    path = tmp_path / "wall.geojson"
+    surveyed_wall.write(path, offset=surveyed_wall.LAMBERT93, dent=2e-3, dents=4)
+    return path
+
+
+def test_check_a_traced_wall_reads_it_with_the_options_it_names(traced):
+    result = invoke("check", traced)  # each refusal names the option that mends it
+    assert_one_line_error(
+        result, 'block 4 ("block-4"): polygon is not convex', "add (651000, 6861000)", "--convex-hull"
+    )
+    result = invoke("check", traced, "--convex-hull")
+    assert_one_line_error(result, "overlap by", "--trim-overlaps 0.003")
+    result = invoke("check", traced, "--convex-hull", "--trim-overlaps", "0.003")
+    assert result.exit_code == 0, result.output
+    said = words(result.output)
+    assert "wall.geojson — valid" in said and "72" in said
+    assert "read moved by (-651000, -6861000) m" in said
+    assert "4 non-convex polygons read as their convex hulls (--convex-hull)" in said
+    assert "overlapping pairs trimmed along the middle of their overlap" in said
+
+
+def test_the_reading_options_are_refused_for_what_is_no_geometry_file(tmp_path):
+    assert_one_line_error(
+        invoke("check", "wall", "--units", "mm"), "--units: reads a GeoJSON / WKT file; wall is not one"
+    )
+    assert_one_line_error(invoke("limit", "arch", "--flip-y"), "--flip-y: reads a GeoJSON / WKT file")
+    assert_one_line_error(
+        invoke("check", tmp_path / "w.geojson", "--units", "ft"), "--units ft: expected one of m, cm, mm"
+    )
+    assert_one_line_error(
+        invoke("run", "x.geojson", "--trim-overlaps", "0.5"), "--trim-overlaps 0.5: must be in (0, 0.1]"
+    )
+
+
+def test_limit_of_a_wall_in_lambert93_is_that_of_the_wall_at_the_origin(tmp_path):
+    # the same stones (exact, no slip) at the origin and 6 861 km north: the same joints, the same λ
+    exact = dict(slip=0.0, ndigits=9)
+    surveyed_wall.write(tmp_path / "local.geojson", **exact)
+    surveyed_wall.write(tmp_path / "l93.geojson", offset=surveyed_wall.LAMBERT93, **exact)
+    local = invoke("limit", tmp_path / "local.geojson", "--json")
+    far = invoke("limit", tmp_path / "l93.geojson", "--json")
+    assert local.exit_code == 0 and far.exit_code == 0, far.output
+    lam = [json.loads(r.stdout)["load_factor"] for r in (local, far)]
+    assert lam[1] == pytest.approx(lam[0], rel=1e-6)  # the LP solved to its tolerance at 234 m, not 0
+
+
+def test_a_wall_in_millimetres_with_y_down_checks_as_in_metres_with_y_up(tmp_path):
+    surveyed_wall.write(tmp_path / "m.geojson", slip=0.0, ndigits=9)
+    surveyed_wall.write(tmp_path / "mm.geojson", slip=0.0, ndigits=6, scale=1000.0, flip_y=True)
+    result = invoke("check", tmp_path / "mm.geojson", "--units", "mm", "--flip-y")
+    metres = invoke("check", tmp_path / "m.geojson")
+    assert result.exit_code == 0 and metres.exit_code == 0, result.output
+    mass = [next(ln for ln in r.output.splitlines() if "mass" in ln).split("│")[2] for r in (result, metres)]
+    assert mass[0] == mass[1]

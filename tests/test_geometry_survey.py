@@ -1,0 +1,162 @@
+"""Reading a surveyed wall (geometry_library/survey.py): a map grid's coordinates moved near the origin, units,
+y pointing down, convex hulls and overlaps trimmed — each against the same wall drawn in metres near the origin
+or a figure worked out by hand."""
+
+import json
+
+import numpy as np
+import pytest
+import surveyed_wall
+from shapely.geometry import Polygon, box
+
+from geometry_library import Assembly, Block, GeometryError, Support, read_geojson, read_wkt, validate_assembly
+from geometry_library.survey import Survey, trim_overlaps
+
+EXACT = dict(slip=0.0, ndigits=9)  # the stones as they tile the face, to a nanometre
+
+
+def wall_file(tmp_path, name, **options):
+    path = tmp_path / name
+    surveyed_wall.write(path, **options)
+    return path
+
+
+def vertices(assembly):
+    return [b.vertices for b in (*assembly.blocks, *assembly.supports)]
+
+
+def test_a_wall_in_lambert93_is_read_moved_by_whole_kilometres(tmp_path):
+    # every vertex was refused: "more than 1e+06 m from the origin (… move a map grid's … to a local origin)"
+    local = read_geojson(wall_file(tmp_path, "local.geojson", **EXACT))
+    notes = []
+    far = read_geojson(wall_file(tmp_path, "l93.geojson", offset=surveyed_wall.LAMBERT93, **EXACT), notes=notes)
+    assert far.block_count == local.block_count == 72 and far.support_count == 1
+    # x − 651 000, y − 6 861 000: the local wall plus the offset's last (234.12, 210.55) m
+    for a, b in zip(vertices(far), vertices(local)):
+        np.testing.assert_allclose(a, b + [234.12, 210.55], rtol=0, atol=1e-8)
+    assert validate_assembly(far) == []  # float64 keeps the survey's nanometres there
+    assert any("read moved by (-651000, -6861000) m" in n and "add (651000, 6861000)" in n for n in notes), notes
+
+
+def test_a_refusal_in_a_moved_file_says_how_to_find_its_coordinates_on_the_map(tmp_path):
+    path = wall_file(tmp_path, "l93.geojson", offset=surveyed_wall.LAMBERT93, dent=3e-3, dents=1, ndigits=6)
+    with pytest.raises(GeometryError, match=r"not convex .* add \(651000, 6861000\) for the map's"):
+        read_geojson(path)
+
+
+def test_a_wall_near_the_origin_is_read_as_it_is(tmp_path):
+    # 9 km east: not moved (RECENTRE_BEYOND is 10 km), no note
+    notes = []
+    near = read_geojson(wall_file(tmp_path, "near.geojson", offset=(9000.0, 0.0), **EXACT), notes=notes)
+    assert near.bounds()[0] == pytest.approx(8999.7) and notes == []
+
+
+def test_millimetres_read_with_their_unit_and_said_when_not(tmp_path):
+    local = read_geojson(wall_file(tmp_path, "m.geojson", **EXACT))
+    mm = wall_file(tmp_path, "mm.geojson", scale=1000.0, **EXACT)
+    for a, b in zip(vertices(read_geojson(mm, survey=Survey(units="mm"))), vertices(local)):
+        np.testing.assert_allclose(a, b, rtol=0, atol=1e-9)
+    # read as metres the foundation's 1.38e6 m² is refused as absurd: the refusal says why
+    with pytest.raises(GeometryError, match=r"median \d+ m\): are the coordinates millimetres\? --units mm"):
+        read_geojson(mm)
+
+
+def test_y_pointing_down_is_read_up_and_said_when_not(tmp_path):
+    local = read_geojson(wall_file(tmp_path, "up.geojson", **EXACT))
+    down = wall_file(tmp_path, "down.geojson", flip_y=True, **EXACT)
+    for a, b in zip(vertices(read_geojson(down, survey=Survey(flip_y=True))), vertices(local)):
+        np.testing.assert_allclose(a, b, rtol=0, atol=1e-12)
+    notes = []
+    read_geojson(down, notes=notes)  # the ground above the stones: gravity would pull the wall off it
+    assert any("the support lies above half the blocks" in n and "--flip-y" in n for n in notes), notes
+
+
+def square_feature(ring, name):
+    closed = [*ring, ring[0]]
+    return {"type": "Feature", "properties": {"name": name}, "geometry": {"type": "Polygon", "coordinates": [closed]}}
+
+
+def test_a_dented_stone_is_read_as_its_hull_with_the_area_it_adds(tmp_path):
+    # a 0.4 × 0.2 m stone whose bottom edge is pushed 2 mm in at its middle: the hull adds the triangle
+    # 0.4 × 0.002 / 2 = 4e-4 m² to 0.08 − 4e-4 m², i.e. 0.503 %
+    dented = [[0, 0], [0.2, 0.002], [0.4, 0], [0.4, 0.2], [0, 0.2]]
+    path = tmp_path / "dent.geojson"
+    path.write_text(json.dumps({"type": "FeatureCollection", "features": [square_feature(dented, "S1")]}))
+    with pytest.raises(GeometryError, match="not convex"):
+        read_geojson(path)
+    notes = []
+    hulled = read_geojson(path, survey=Survey(convex_hull=True), notes=notes)
+    assert hulled.blocks[0].polygon.equals(box(0, 0, 0.4, 0.2))
+    assert any(f"adding {4e-4 / (0.08 - 4e-4):.2%}" in n and 'block 1 ("S1")' in n for n in notes), notes
+
+
+def test_a_stone_of_another_shape_is_not_hulled():
+    # an L of three 0.2 m squares: its hull adds half a square, 16.7 % — no tracing slip
+    from geometry_library.survey import hull_of
+
+    ell = np.array([[0, 0], [0.4, 0], [0.4, 0.2], [0.2, 0.2], [0.2, 0.4], [0, 0.4]])
+    with pytest.raises(GeometryError, match=r"would add 16.7% of its area.*split it into convex stones"):
+        hull_of(ell, "block 1")
+
+
+def two_stones(overlap: float, ground: bool = False) -> Assembly:
+    """Two 1 × 0.5 m stones side by side, the right one drawn ``overlap`` m into the left one."""
+    blocks = (Block(box(0, 0, 1, 0.5), "L"), Block(box(1 - overlap, 0, 2 - overlap, 0.5), "R"))
+    supports = (Support(box(-1, -0.5, 3, 0.0), "ground"),) if ground else ()
+    return Assembly(blocks, supports)
+
+
+def test_overlapping_neighbours_are_cut_along_the_middle_of_their_overlap():
+    # R 2 mm into L: each gives up 1 mm of its 0.5 m face, 5e-4 m² = 0.1 % of its area; they then meet at x = 0.999
+    trimmed, note = trim_overlaps(two_stones(0.002, ground=True), 0.003)
+    left, right = trimmed.blocks
+    assert left.polygon.bounds == pytest.approx((0, 0, 0.999, 0.5), abs=1e-12)
+    assert right.polygon.bounds == pytest.approx((0.999, 0, 1.998, 0.5), abs=1e-12)
+    assert left.polygon.intersection(right.polygon).area == pytest.approx(0.0, abs=1e-15)
+    assert left.polygon.distance(right.polygon) == pytest.approx(0.0, abs=1e-12)  # they touch: a contact
+    assert trimmed.supports[0].polygon.equals(box(-1, -0.5, 3, 0.0))  # touching the ground is no overlap
+    assert validate_assembly(trimmed) == []
+    assert note.startswith("1 overlapping pair trimmed") and "deepest 2 mm" in note and "0.10% of a body's area" in note
+
+
+def test_a_corner_sunk_into_the_ground_is_cut_and_both_stay_convex():
+    # a stone tilted 1° with its left corner 1 mm into the ground (a triangle 1 mm deep, 5.7 cm long)
+    c, s = np.cos(np.radians(1)), -np.sin(np.radians(1))  # turned 1° anticlockwise
+    ring = np.array([[0, 0], [0.4, 0], [0.4, 0.2], [0, 0.2]]) @ np.array([[c, s], [-s, c]]).T + [0, -0.001]
+    stone = Assembly((Block(Polygon(ring), "S"),), (Support(box(-1, -0.5, 1, 0.0), "ground"),))
+    trimmed, _ = trim_overlaps(stone, 0.003)
+    after = [trimmed.blocks[0].polygon, trimmed.supports[0].polygon]
+    assert after[0].intersection(after[1]).area == pytest.approx(0.0, abs=1e-15)
+    assert all(p.equals(p.convex_hull) for p in after)
+    assert validate_assembly(trimmed) == []
+
+
+def test_an_overlap_deeper_than_the_depth_given_is_refused_naming_the_pair():
+    with pytest.raises(
+        GeometryError, match=r'block 1 \("L"\) and block 2 \("R"\) overlap 5 mm deep, more than the 3 mm'
+    ):
+        trim_overlaps(two_stones(0.005), 0.003)
+
+
+def test_the_traced_wall_is_trimmed_whatever_the_order_of_its_features(tmp_path):
+    # the cuts are all found before any is made: reversing the features gives the same stones (to rounding:
+    # an intersection's vertices come in another order)
+    data = surveyed_wall.write(tmp_path / "a.geojson", dent=2e-3, dents=4)
+    data["features"] = data["features"][::-1]
+    (tmp_path / "b.geojson").write_text(json.dumps(data))
+    survey = Survey(convex_hull=True, trim_overlaps=0.003)
+    a = read_geojson(tmp_path / "a.geojson", survey=survey)
+    b = read_geojson(tmp_path / "b.geojson", survey=survey)
+    assert validate_assembly(a) == [] and validate_assembly(b) == []
+    for x, y in zip(a.blocks, b.blocks[::-1]):
+        assert x.polygon.hausdorff_distance(y.polygon) < 1e-12
+
+
+def test_wkt_is_read_the_same_way(tmp_path):
+    path = tmp_path / "w.wkt"
+    x, y = surveyed_wall.LAMBERT93
+    path.write_text(f"S1: POLYGON (({x} {y}, {x + 0.4} {y}, {x + 0.4} {y + 0.2}, {x} {y + 0.2}, {x} {y}))\n")
+    notes = []
+    stone = read_wkt(path, survey=Survey(), notes=notes).blocks[0]
+    assert stone.polygon.bounds == pytest.approx((234.12, 210.55, 234.52, 210.75), abs=1e-8)
+    assert "read moved by (-651000, -6861000) m" in notes[0]
