@@ -158,6 +158,38 @@ def test_find_driver_notes_an_outcome_at_both_ends_or_neither():
     )
 
 
+def test_find_driver_says_when_its_runs_are_not_monotone():
+    # the wall at 2 Hz collapses at 1.25 m/s and stands at 1.5 m/s: --find amp gave one threshold as if it
+    # were the only one. The runs that show it are named, in the row's note and a warning line.
+    axes = [Axis("amp", (0.25, 0.5, 0.75, 1.0, 1.25, 1.5)), Axis("freq", (2.0,))]
+    driver = FindDriver(axes, "amp", "collapse", 0.005, done={})
+    (row,) = _search(driver, lambda p: 0.9 < p["amp"] < 1.4)
+    assert row["holds"] == "above" and 0.75 < row["amp_threshold"] < 1.0
+    assert row["note"] == "not monotone: collapse at amp = 1.25, not at amp = 1.5"
+    assert driver.warnings == [
+        f"--find amp (freq = 2): collapse at amp = 1.25, not at amp = 1.5: not monotone in amp, so the threshold "
+        f"{row['amp_threshold']:g} is one of several — a grid over the range shows where it holds"
+    ]
+    # mirrored: sliding below a friction, then again above a friction that does not slide
+    driver = FindDriver([Axis("friction", (0.1, 0.4, 0.7, 1.0))], "friction", "sliding", 0.005, done={})
+    (row,) = _search(driver, lambda p: p["friction"] < 0.3 or 0.6 < p["friction"] < 0.8)
+    assert row["holds"] == "below" and row["note"] == "not monotone: sliding at friction = 0.7, not at friction = 0.4"
+    assert len(driver.warnings) == 1 and "sliding at friction = 0.7, not at friction = 0.4: not" in driver.warnings[0]
+    # the range's ends both reached, not between: the note says it already; the warning line too
+    driver = FindDriver([Axis("friction", (0.1, 0.7, 2.0))], "friction", "sliding", 0.005, done={})
+    (row,) = _search(driver, lambda p: p["friction"] != 0.7)
+    assert row["note"].endswith("it comes and goes over the range (a grid shows where it holds)")
+    assert driver.warnings == [
+        "--find friction: sliding at friction = 0.1, not at friction = 0.7: not monotone in friction, so no "
+        "threshold — a grid over the range shows where it holds"
+    ]
+    # monotone searches say nothing
+    for outcome_at in (lambda p: p["amp"] > 0.6, lambda p: True, lambda p: False):
+        driver = FindDriver(axes, "amp", "collapse", 0.005, done={})
+        (row,) = _search(driver, outcome_at)
+        assert driver.warnings == [] and not row["note"].startswith("not monotone")
+
+
 def test_find_driver_searches_again_a_row_that_said_the_outcome_comes_below():
     # a table written before the downward search: its row had no threshold and that note; resumed, it is run
     # again (and an upward row of then is kept, marked as found upwards)

@@ -95,3 +95,24 @@ def test_find_friction_finds_the_friction_below_which_the_block_slides(tmp_path)
     # the terminal says which side too: the holds column and its legend
     line = next(line for line in result.output.splitlines() if f"{row['friction_threshold']:.4g}" in line)
     assert "below" in line and "holds: the outcome above / below the threshold" in words(result.output)
+
+
+def test_find_says_in_one_line_when_its_runs_are_not_monotone(tmp_path, monkeypatch):
+    # at 2 Hz the wall collapses at 1.25 m/s and stands at 1.5 m/s: --find amp gave a threshold as if it were
+    # the only one. The runs here are real; which of them reach the outcome is set (as the wall's would be).
+    from masonrycli.study import drivers
+
+    monkeypatch.setattr(drivers, "reached", lambda row, outcome: 0.12 < row["amp"] < 0.22)
+    out = tmp_path / "find.csv"
+    args = [str(block_file(tmp_path, 0.8, 0.4, 0.6)), "--param", "amp=0.05:0.25:5", "--find", "amp"]
+    args += ["--outcome", "sliding", "--workers", "0", "--out", str(out), "--no-recording"]
+    result = runner.invoke(app, ["sweep", *args], terminal_width=200)
+    assert result.exit_code == 0, result.output
+    with open(out, newline="") as fh:
+        (row,) = list(csv.DictReader(fh))
+    assert row["note"] == "not monotone: sliding at amp = 0.2, not at amp = 0.25"
+    said = [line for line in result.output.splitlines() if line.startswith("warning: --find")]
+    assert said == [
+        f"warning: --find amp: sliding at amp = 0.2, not at amp = 0.25: not monotone in amp, so the threshold "
+        f"{float(row['amp_threshold']):g} is one of several — a grid over the range shows where it holds"
+    ], result.output

@@ -206,6 +206,8 @@ def sweep_command(
         try:
             result = run_study(plan.base, plan.request, console)
             _report(console, result, plan, im, written, signals)
+            for line in result.warnings:
+                err_console.print(f"warning: {line}", soft_wrap=True)
             _exit_for_failed_rows(result, err_console)
         except (KeyboardInterrupt, Exception) as exc:
             if not isinstance(exc, KeyboardInterrupt) and not signals.raised():

@@ -19,6 +19,11 @@ of the range:
 A point where no value produces the outcome, or LO already does and so does HI, has no threshold in the
 range: NaN, ``holds`` empty, and the note says which (``<find>_hi`` is LO when LO already produces it: the
 threshold curve marks the point there).
+
+Bisection assumes the outcome, once reached, stays reached further on (above the threshold, or below it).
+When the runs of a point show otherwise — the wall at 2 Hz collapses at 1.25 m/s and stands at 1.5 m/s —
+the threshold is one of several: the row's note and a warning line (:attr:`FindDriver.warnings`) name the
+two values, a run reaching the outcome and one beyond it that does not.
 """
 
 from __future__ import annotations
@@ -88,6 +93,8 @@ class FindDriver:
         self.skipped = len(self._rows)
         self.total = len(self.points)
         self.finished: list[dict] = []
+        self.warnings: list[str] = []
+        """One line per point whose runs show the outcome is not monotone in ``find`` (module doc)."""
 
     def start(self) -> list[dict]:
         return [
@@ -158,6 +165,18 @@ class FindDriver:
 
     def _finish(self, key, point: dict, search: _Search) -> list[dict]:
         threshold = 0.5 * (search.lo + search.hi)
+        pair = _not_monotone(search.results, search.holds == "below")
+        if pair is not None:
+            find, outcome = self.find, self.outcome
+            seen = f"{outcome} at {find} = {pair[0]:g}, not at {find} = {pair[1]:g}"
+            if search.holds:  # a bracketed threshold; the note of one not found says it comes and goes
+                search.note = f"not monotone: {seen}"
+            at = ", ".join(f"{k} = {v:g}" if isinstance(v, float) else f"{k} = {v}" for k, v in point.items())
+            found = f"the threshold {threshold:g} is one of several" if math.isfinite(threshold) else "no threshold"
+            self.warnings.append(
+                f"--find {find}{f' ({at})' if at else ''}: {seen}: not monotone in {find}, so {found} — a grid "
+                "over the range shows where it holds"
+            )
         self._rows[key] = point | {
             f"{self.find}_threshold": threshold,
             f"{self.find}_lo": search.lo,
@@ -175,6 +194,20 @@ class FindDriver:
 
     def rows(self) -> list[dict]:
         return [self._rows[k] for k in (row_key(p, self.names) for p in self.points) if k in self._rows]
+
+
+def _not_monotone(results: dict[float, bool], below: bool) -> tuple[float, float] | None:
+    """``(reached, not reached)``: two values of a search's runs that bisection's assumption rules out — the
+    outcome reached at one and not at a value beyond it (above it; below it when the outcome comes ``below``
+    a value), the run beyond as far out as any and the one reaching it the nearest to it; None if none."""
+    order = sorted(results, reverse=below)  # the outcome's side last
+    for k in range(len(order) - 1, 0, -1):
+        beyond = order[k]
+        if not results[beyond]:
+            reaching = [v for v in order[:k] if results[v]]
+            if reaching:
+                return reaching[-1], beyond
+    return None
 
 
 def _stale(row: dict) -> bool:

@@ -46,7 +46,7 @@ COLUMN_UNITS = {
     "holds": "above / below: the outcome holds above or below the threshold",
     "outcome": "what --find looked for",
     "evaluations": "runs the search made",
-    "note": "why no threshold was found",
+    "note": "why no threshold was found, or the two runs showing the outcome is not monotone",
 }
 """Each column of a study's table after its parameters: unit, then meaning (docs/sweep.md, "Rows")."""
 _SEARCH = ("_threshold", "_lo", "_hi")

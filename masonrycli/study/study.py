@@ -62,6 +62,8 @@ class StudyResult:
     failed: int = 0
     out: Path | None = None
     """Where the table went."""
+    warnings: tuple[str, ...] = ()
+    """Lines for the user once the table is shown (a search whose runs are not monotone: drivers.py)."""
 
 
 MAX_CHECKED_VALUES = 1000
@@ -246,7 +248,8 @@ def run_study(base: StudyBase, request: StudyRequest, console: Console) -> Study
         if request.scheduler is None:  # its workers are gone: what they left half-written is of no one
             files.remove_abandoned_parts(request.histories)
     failed = sum(1 for r in rows if r.get("status") == "error")
-    return StudyResult(rows, columns, driver.skipped, ran, time.perf_counter() - start, failed, table.path)
+    found = tuple(getattr(driver, "warnings", ()))
+    return StudyResult(rows, columns, driver.skipped, ran, time.perf_counter() - start, failed, table.path, found)
 
 
 def _rows(n: int) -> str:
