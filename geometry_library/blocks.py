@@ -80,6 +80,11 @@ class Block:
     density : float, kg/m³.
     thickness : float, m — out-of-plane depth; mass = density · area · thickness.
     velocity : (vx, vy, omega) — initial velocity, m/s and rad/s.
+    carried_mass : float, kg — a dead mass the block carries (the fill over a bridge's voussoir,
+        :mod:`geometry_library.fill`), for the block's thickness; 0: none.
+    carried_at : (x, y), m — where that mass is lumped (the fill column's centroid); None without one.
+        It moves with the block: :func:`masonrycli.model.build_model` adds it to the block's mass, moves
+        the centre of mass and adds its parallel-axis inertia (a point mass: no rotary inertia of its own).
     """
 
     polygon: Polygon
@@ -87,6 +92,8 @@ class Block:
     density: float = 2500.0
     thickness: float = 1.0
     velocity: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    carried_mass: float = 0.0
+    carried_at: tuple[float, float] | None = None
 
     @property
     def vertices(self) -> np.ndarray:

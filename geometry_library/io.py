@@ -13,6 +13,8 @@ only; a ``MultiPolygon`` of one part, as QGIS saves polygon layers, is that poly
 ``thickness``      m, blocks only (default: the reader's ``thickness`` argument)
 ``velocity``       [vx, vy, ω] initial velocity, blocks only (default [0, 0, 0])
 ``support_role``   ``"fixed"`` (default) or ``"driven"``, supports only
+``carried_mass``   kg ≥ 0, blocks only: a dead mass the block carries (a bridge's fill), with
+``carried_at``     [x, y] m, where it is lumped (``Block.carried_mass``; default none)
 =================  =========================================================================
 
 Other properties, and a block's on a support or a support's on a block, are not read: ``read_geojson`` lists
@@ -79,9 +81,9 @@ def _word(value):
     return value.strip().lower() if isinstance(value, str) else value
 
 
-GEOJSON_PROPERTIES = ("role", "name", "density", "thickness", "velocity", "support_role")
+GEOJSON_PROPERTIES = ("role", "name", "density", "thickness", "velocity", "support_role", "carried_mass", "carried_at")
 """The feature properties the reader uses."""
-BLOCK_PROPERTIES = ("density", "thickness", "velocity")
+BLOCK_PROPERTIES = ("density", "thickness", "velocity", "carried_mass", "carried_at")
 """The properties read on blocks only: on a support they are not used (listed in ``unknown``)."""
 SUPPORT_PROPERTIES = ("support_role",)
 """The properties read on supports only: on a block they are not used (listed in ``unknown``)."""
@@ -118,6 +120,22 @@ def _real(value) -> float:
         return float(value)
     except OverflowError:  # a 400-digit integer: "int too large to convert to float" was a traceback
         return math.inf
+
+
+def _carried(props: dict, where: str, frame) -> dict:
+    """A block's ``carried_mass`` and ``carried_at`` (both or neither), the point in the polygons' ``frame``."""
+    mass, at = props.get("carried_mass"), props.get("carried_at")
+    if mass is None and at is None:
+        return {}
+    try:
+        m, point = _real(mass), frame.local(np.array([_real(x) for x in at], dtype=np.float64))
+    except (TypeError, ValueError):
+        m, point = math.nan, ()
+    if len(point) != 2 or not (np.all(np.isfinite(point)) and math.isfinite(m) and m >= 0.0):
+        raise GeometryError(
+            f"{where}: carried_mass (kg ≥ 0) and carried_at ([x, y] m) go together, got {mass!r}, {at!r}"
+        )
+    return {"carried_mass": m, "carried_at": (float(point[0]), float(point[1]))}
 
 
 def _velocity(value, where: str) -> tuple[float, float, float]:
@@ -247,6 +265,7 @@ def read_geojson(
                 _number(props.get("density", density), "density", where),
                 _number(props.get("thickness", thickness), "thickness", where),
                 _velocity(props.get("velocity", (0.0, 0.0, 0.0)), where),
+                **_carried(props, where, frame),
             )
         else:
             srole = _word(props.get("support_role", "fixed"))
@@ -316,6 +335,9 @@ def write_geojson(assembly: Assembly, path) -> Path:
         props = {"role": "block", "name": block.name, "density": block.density, "thickness": block.thickness}
         if any(v != 0.0 for v in block.velocity):
             props["velocity"] = [float(v) for v in block.velocity]
+        if block.carried_mass > 0.0:
+            props["carried_mass"] = float(block.carried_mass)
+            props["carried_at"] = [float(x) for x in block.carried_at]
         features.append(_feature(block.polygon, props))
     for support in assembly.supports:
         props = {"role": "support", "name": support.name, "support_role": support.role}
@@ -463,7 +485,7 @@ def _wkt_polygon(polygon: Polygon) -> str:
 
 
 def write_wkt(assembly: Assembly, path) -> Path:
-    """Write ``assembly`` as labelled WKT lines (full precision; density/thickness are not kept)."""
+    """Write ``assembly`` as labelled WKT lines (full precision; density, thickness and a carried fill are not kept)."""
     path = Path(path)
     for body in (*assembly.blocks, *assembly.supports):
         if not body.name or re.search(r"[\s:]", body.name):

@@ -110,9 +110,12 @@ SETTING_UNITS: dict[str, str] = {
             "foundation_margin",
             "foundation_depth",
             "min_thickness",
+            "fill_to",
+            "fill_cover",
         ),
         "m",
     ),
+    "fill_density": "kg/m³",
     **dict.fromkeys(("blocks", "courses", "voussoirs", "pier_courses", "wall_courses", "min_fraction"), ""),
 }
 """The unit each numeric setting is read in, as docs/scenario-format.md documents it ("": a plain number,

@@ -73,6 +73,9 @@ class Model:
     """(N,) str: the blocks' names, scenario order."""
     support_name: tuple
     """(S,) str: the supports' names, scenario order."""
+    block_carried_mass: np.ndarray
+    """(N,) kg: the part of each block's mass that is a dead mass it carries (a bridge's fill over a voussoir,
+    ``Block.carried_mass``); body_mass, body_q0 and body_inertia include it."""
 
     @property
     def body_count(self) -> int:
@@ -110,6 +113,7 @@ def build_model(scenario) -> Model:
     mass = np.empty(n + s)
     inertia = np.empty(n + s)
     volume = np.empty(n)
+    carried = np.zeros(n)
     q0 = np.zeros((n + s, 3))
     v0 = np.zeros((n + s, 3))
     starts = [0]
@@ -118,9 +122,17 @@ def build_model(scenario) -> Model:
         xy = block.vertices
         props = mass_properties(xy, block.density, block.thickness)
         mass[i], inertia[i], volume[i] = props.mass, props.inertia, props.area * block.thickness
-        q0[i, :2] = props.centroid
+        centre = props.centroid
+        carried[i] = block.carried_mass
+        if carried[i] > 0.0:  # a point mass riding on the block: the body's centre of mass moves towards it
+            at = np.asarray(block.carried_at, dtype=np.float64)
+            total = mass[i] + carried[i]
+            centre = (mass[i] * props.centroid + carried[i] * at) / total
+            inertia[i] += mass[i] * _squared(props.centroid - centre) + carried[i] * _squared(at - centre)
+            mass[i] = total
+        q0[i, :2] = centre
         v0[i] = block.velocity
-        local.append(xy - props.centroid)
+        local.append(xy - centre)
         starts.append(starts[-1] + len(xy))
     for j, support in enumerate(supports):
         xy = support.vertices
@@ -162,7 +174,12 @@ def build_model(scenario) -> Model:
         support_velocity=table,
         block_name=tuple(b.name for b in blocks),
         support_name=tuple(sp.name for sp in supports),
+        block_carried_mass=carried,
     )
+
+
+def _squared(d: np.ndarray) -> float:
+    return float(d[0] * d[0] + d[1] * d[1])
 
 
 class SupportVelocity:

@@ -48,12 +48,15 @@ def least_load_factor(
     dead: np.ndarray,
     live: np.ndarray,
     live_at: np.ndarray | None = None,
+    extra: tuple = (),
 ) -> tuple[float, tuple]:
     """(λ, (joints a b c d, sides)) of the weakest admissible four-hinge mechanism.
 
     intrados, extrados : (n+1, 2) joint end points, left to right; centroid : (n, 2) voussoir centroids;
     dead, live : (n, 2) forces on each voussoir (the live one multiplied by λ); live_at : (n, 2) where each
-    live force acts (default: the centroids; a deck load acts on the extrados).
+    live force acts (default: the centroids; a deck load acts on the extrados). extra : more loads on the
+    voussoirs, each (kind, forces (n, 2), at (n, 2)) with kind "dead" or "live": a bridge's fill, whose
+    weight (dead) and, under a horizontal acceleration, inertia (live) act at the fill column's centroid.
     """
     n = len(centroid)
     radial = extrados - intrados
@@ -65,6 +68,8 @@ def least_load_factor(
         return [np.concatenate([[0.0], np.cumsum(v)]) for v in (forces[:, 0], forces[:, 1], m)]
 
     sums = {"dead": prefix(dead, centroid), "live": prefix(live, centroid if live_at is None else live_at)}
+    for kind, forces, at in extra:  # loads add: so do their prefix sums
+        sums[kind] = [a + b for a, b in zip(sums[kind], prefix(np.asarray(forces), np.asarray(at)))]
     combos = np.array(list(itertools.combinations(range(n + 1), 4)))
     a, b, c, d = combos.T
     best = (np.inf, None)

@@ -312,7 +312,12 @@ def test_a_built_in_takes_the_structure_options_of_masonry_build(tmp_path):
 @pytest.mark.parametrize(
     "args, fragments",
     [
-        (["arch", "--blocks", "3"], ["--blocks: not an option of the arch (its options: --density, --pier-courses"]),
+        (
+            ["arch", "--blocks", "3"],
+            [
+                "--blocks: not an option of the arch (its options: --density, --fill-cover, --fill-density, --fill-to, --pier-courses"
+            ],
+        ),
         (["aqueduct", "--rise", "1"], ["--rise: not an option of the aqueduct"]),
         (["wall", "--span", "8"], ["--span: not an option of the wall"]),
         (["arch", "--rise", "9"], ["--rise 9 m is more than half the span (1.8 m)"]),

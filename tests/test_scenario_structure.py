@@ -121,7 +121,7 @@ def test_geojson_properties_not_used_give_one_warning_with_near_misses(tmp_path)
     read_geometry(path, 2500.0, 1.0, CTX, notes=notes)
     (note,) = notes
     assert note == (
-        f"{path}: properties not used, ignored (used: role, name, density, thickness, velocity, support_role): "
+        f"{path}: properties not used, ignored (used: role, name, density, thickness, velocity, support_role, carried_mass, carried_at): "
         '"densty" (did you mean "density"?) first on feature 1, block 1 ("a"); '
         '"friction" (friction is the scenario file\'s [material] friction, one for every contact) first on '
         'feature 1, block 1 ("a"); "colour" first on feature 1, block 1 ("a")'
@@ -138,7 +138,7 @@ def test_a_property_of_the_other_role_is_warned_about_with_why(tmp_path):
     notes: list[str] = []
     read_geometry(path, 2500.0, 1.0, CTX, notes=notes)
     assert notes == [
-        f"{path}: properties not used, ignored (used: role, name, density, thickness, velocity, support_role): "
+        f"{path}: properties not used, ignored (used: role, name, density, thickness, velocity, support_role, carried_mass, carried_at): "
         '"support_role" (read on supports only) first on feature 1, block 1 ("a"); "velocity" (read on blocks '
         'only: a support moves by a scenario file\'s [[support]] motion) first on feature 2, support 1 ("g"); '
         '"thickness" (read on blocks only: a support has no mass) first on feature 2, support 1 ("g")'

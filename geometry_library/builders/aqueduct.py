@@ -67,6 +67,13 @@ class AqueductSpec(ArchSpec):
                 "builder's: masonry build arch --rise)",
                 keys=("rise",),
             )
+        given = [k for k in ("fill_to", "fill_cover", "fill_density") if getattr(self, k) is not None]
+        if given:  # its spandrel walls are blocks, not fill
+            raise GeometryError(
+                f"aqueduct: {given[0]}: the aqueduct's spandrel is masonry walls, not fill (fill is the arch "
+                "builder's: masonry build arch --fill-to)",
+                keys=tuple(given),
+            )
         check_dimensions("aqueduct", block_length=self.block_length, block_height=self.block_height)
         blocks, supports, geom = arch_parts(self)
         top = geom.springing + self.wall_courses * self.block_height

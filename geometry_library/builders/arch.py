@@ -39,7 +39,16 @@ import numpy as np
 from shapely.geometry import box
 
 from ..blocks import SUPPORT_ROLES, Assembly, Block, GeometryError, Support
-from ..values import check_block_total, check_count, check_dimensions, check_positive
+from ..fill import with_fill
+from ..values import (
+    DIMENSION_RANGE,
+    MATERIAL_RANGE,
+    check_block_total,
+    check_count,
+    check_dimensions,
+    check_positive,
+    number_problem,
+)
 from ._common import make_block, make_support, name_width
 
 
@@ -111,6 +120,12 @@ class ArchSpec:
     density : kg/m³. thickness : m, out of plane.
     foundation_margin, foundation_depth : m — foundation pads under each pier.
     left_role, right_role : support roles of "left-foundation" / "right-foundation".
+    fill_to : float, m, or None — fill over the arch up to this height above the springing line, between
+        the piers' outer faces (a bridge's fill, dead load only: :mod:`geometry_library.fill`); below the
+        crown the ring stands proud of it.
+    fill_cover : float, m, or None — the same, its level given as the depth over the ring's top (≥ 0);
+        give one of fill_to and fill_cover.
+    fill_density : kg/m³ — the fill's (default 2000 when a fill is given).
     """
 
     voussoirs: int = 30
@@ -126,12 +141,58 @@ class ArchSpec:
     left_role: str = "fixed"
     right_role: str = "fixed"
     rise: float | None = None
+    fill_to: float | None = None
+    fill_cover: float | None = None
+    fill_density: float | None = None
 
     def build(self) -> Assembly:
         """The arch: 2·2·pier_courses + voussoirs blocks (98 by default; + 2 skewbacks when segmental)
-        and two supports. See the module docstring for the layout, names and order."""
-        blocks, supports, _ = arch_parts(self)
+        and two supports. See the module docstring for the layout, names and order. With a fill, the
+        blocks under it carry its weight (:func:`fill_level`)."""
+        blocks, supports, geometry = arch_parts(self)
+        level = fill_level(self, geometry)
+        if level is not None:
+            density = FILL_DENSITY if self.fill_density is None else self.fill_density
+            blocks = with_fill(blocks, level, density, -geometry.half_width, geometry.half_width)
         return Assembly(tuple(blocks), tuple(supports))
+
+
+FILL_DENSITY = 2000.0
+"""kg/m³: a bridge's fill when none is given (granular fill weighs 18–22 kN/m³)."""
+
+
+def fill_level(spec: ArchSpec, geometry: ArchGeometry) -> float | None:
+    """y (m) of the fill's surface of ``spec`` (None: no fill), its options checked."""
+    to, cover, density = spec.fill_to, spec.fill_cover, spec.fill_density
+    if to is None and cover is None:
+        if density is not None:
+            raise GeometryError(
+                "arch: fill_density without fill_to or fill_cover: give the fill's level (a height or a cover)",
+                keys=("fill_density",),
+            )
+        return None
+    if to is not None and cover is not None:
+        raise GeometryError(
+            "arch: the fill's level is given twice (a height and a cover): give one", keys=("fill_to", "fill_cover")
+        )
+    if density is not None:  # the sensible range of a block's density
+        check_positive("arch", fill_density=density)
+        lo, hi, unit = MATERIAL_RANGE["density"]
+        if not lo <= density <= hi:
+            raise GeometryError(
+                f"arch: fill_density {density:g} {unit} is absurd (a likely typo: {lo:g} to {hi:g} {unit})",
+                keys=("fill_density",),
+            )
+    crown = float(geometry.extrados[:, 1].max())
+    if to is not None:
+        check_dimensions("arch", fill_to=to)
+        return geometry.springing + to
+    problem = number_problem(cover, ge=0.0, le=DIMENSION_RANGE[1])
+    if problem is not None:
+        below = isinstance(cover, float | int) and cover < 0
+        why = " (a cover is measured up from the ring's top: a fill below the crown is fill_to's)" if below else ""
+        raise GeometryError(f"arch: fill_cover {cover:g} m {problem}{why}", keys=("fill_cover",))
+    return crown + cover
 
 
 def arch_parts(spec: ArchSpec) -> tuple[list[Block], list[Support], ArchGeometry]:

@@ -112,6 +112,15 @@ ARCH = {
         "Rise of the intrados crown above the springings, m (default: span / 2, the semicircle; less: a "
         "segmental arch, with a skewback stone on each pier).",
     ),
+    # a bridge's fill: dead load on the blocks under it (geometry_library/fill.py)
+    "fill_to": _opt(
+        float,
+        "Structure",
+        "Fill over the arch up to this height above the springings, m, between the piers' outer faces: its "
+        "weight rides on the blocks under it (dead load only: no strength, no side pressure).",
+    ),
+    "fill_cover": _opt(float, "Structure", "The same fill, its level given as the depth over the ring's top, m."),
+    "fill_density": _opt(float, "Structure", "Density of the fill, kg/m³ (default 2000)."),
 }
 STRUCTURE_OPTIONS = {"wall": WALL, "arch": ARCH, "aqueduct": AQUEDUCT}
 """The structure options of each built-in: ``masonry limit NAME`` takes their union and refuses the others'."""

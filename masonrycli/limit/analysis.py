@@ -128,6 +128,7 @@ class LimitResult:
                 for name, d, lo, hi in self.support_thrust
             ],
             "friction": m.friction,
+            "fill_load_N": float(m.block_carried_mass.sum() * np.hypot(*m.gravity)),  # weight riding on the blocks
             "blocks": m.block_count,
             "supports": m.support_count,
             "joints": j.joint_count,

@@ -102,6 +102,8 @@ def result_table(result: LimitResult, out: Path | None) -> Table:
         f"{n} {what}{'s' if n != 1 else ''}" for n, what in ((s["blocks"], "block"), (s["supports"], "support"))
     )
     table.add_row("structure", f"{counts}, friction μ = {s['friction']:g}")
+    if s["fill_load_N"]:
+        table.add_row("fill", f"{s['fill_load_N']:.4g} N{_depth(result)}, dead load on the blocks under it")
     table.add_row("joints", f"{s['joints']} ({s['contact_points']} contact points, from the engine's detection)")
     table.add_row("live load", result.load.describe())
     lam = Text(f"{result.load_factor:.4f}", style="bold")  # Text: the consoles parse no markup

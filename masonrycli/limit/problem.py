@@ -31,6 +31,7 @@ from scipy.optimize import linprog
 from scipy.sparse.csgraph import connected_components
 
 from geometry_library.checks import body_label
+from geometry_library.mass import mass_properties
 from masonrycli.errors import InputError
 from masonrycli.limit.joints import Joints
 from masonrycli.model import Model
@@ -129,11 +130,17 @@ def load_vectors(model: Model, load: LiveLoad) -> tuple[np.ndarray, np.ndarray, 
             hint = f" (did you mean {', '.join(close)}?)" if close else f" ({count}, e.g. {', '.join(names[:3])})"
             raise InputError(f"--block {load.block}: no such block{hint}")
         i = names.index(load.block)
-        live[i, :2] = mass[i] * g * direction
+        own = mass[i] - model.block_carried_mass[i]  # the block's own weight: not the fill it carries
+        live[i, :2] = own * g * direction
         if load.at is not None and load.top is not None:  # acting at (at, top): its moment about the centroid
             arm = np.array([load.at, load.top]) - model.body_q0[i, :2]
-            live[i, 2] = arm[0] * live[i, 1] - arm[1] * live[i, 0]
-        reference = float(mass[i] * g)
+        elif model.block_carried_mass[i] > 0.0:  # at the block's own centroid: a carried fill moved the body's
+            vertices = model.vert_local[model.body_vert_start[i] : model.body_vert_start[i + 1]]  # centre of mass
+            arm = mass_properties(vertices).centroid
+        else:
+            arm = np.zeros(2)
+        live[i, 2] = arm[0] * live[i, 1] - arm[1] * live[i, 0]
+        reference = float(own * g)
     else:
         live[:, :2] = (mass * g)[:, None] * direction[None, :]
         reference = float(mass.sum() * g)

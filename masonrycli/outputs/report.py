@@ -154,6 +154,8 @@ def check_table(scenario_file: str, info: dict, output_files) -> Table:
     table.add_row("blocks", str(info["blocks"]))
     table.add_row("supports", str(info["supports"]))
     table.add_row("total mass", f"{info['total_mass']:.6g} kg")
+    if info.get("fill_mass"):  # dead load riding on the blocks (an arch's --fill-to), not in the blocks' mass
+        table.add_row("fill", f"{info['fill_mass']:.6g} kg carried by the blocks under it (dead load only)")
     table.add_row("bounding box", f"x {xmin:.4g} … {xmax:.4g} m, y {ymin:.4g} … {ymax:.4g} m")
     table.add_row("friction", f"{info['friction']:g}")
     table.add_row(

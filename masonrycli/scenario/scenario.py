@@ -487,6 +487,7 @@ def scenario_summary(scenario: Scenario) -> dict:
             {"name": s.name, "role": s.role, "motion": m.describe()} for s, m in zip(asm.supports, scenario.motions)
         ],
         "total_mass": float(sum(masses)),
+        "fill_mass": float(sum(b.carried_mass for b in asm.blocks)),  # a bridge's fill riding on the blocks, kg
         "total_area": float(sum(float(b.polygon.area) for b in asm.blocks)),
         "bounding_box": tuple(float(x) for x in asm.bounds()),
         "friction": scenario.material.friction,

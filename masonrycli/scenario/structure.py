@@ -104,6 +104,8 @@ _MISPLACED = {  # a property read on the other role's bodies (geometry_library.i
     "thickness": " (read on blocks only: a support has no mass)",
     "velocity": " (read on blocks only: a support moves by a scenario file's [[support]] motion)",
     "support_role": " (read on supports only)",
+    "carried_mass": " (read on blocks only: a support carries nothing)",
+    "carried_at": " (read on blocks only: a support carries nothing)",
 }
 
 

@@ -39,7 +39,7 @@ from masonrycli.scenario.values import (
 )
 
 TOP_LEVEL_KEYS = ("name", "run", "material", "structure", "block", "support")
-BLOCK_KEYS = ("name", "polygon", "density", "thickness", "velocity")
+BLOCK_KEYS = ("name", "polygon", "density", "thickness", "velocity", "carried_mass", "carried_at")
 SUPPORT_KEYS = ("name", "polygon", "motion")
 BUILDER_SUPPORT_KEYS = ("name", "motion")
 
@@ -318,11 +318,15 @@ def _parse_block(i: int, table: dict, material: Material, ctx: InputContext, nam
         density = check_real("density", table.get("density", material.density), gt=0.0)
         thickness = check_real("thickness", table.get("thickness", material.thickness), gt=0.0)
         velocity = check_vector("velocity", table.get("velocity", (0.0, 0.0, 0.0)), size=3)
+        carried = {}  # a fill's dead mass riding on the block (Block.carried_mass): both keys or neither
+        if "carried_mass" in table or "carried_at" in table:
+            carried["carried_mass"] = check_real("carried_mass", table.get("carried_mass", 0.0), ge=0.0)
+            carried["carried_at"] = check_vector("carried_at", table.get("carried_at"))
     except InputError as exc:
         raise ctx.error(loc, str(exc)) from None
     _check_unique(name, loc, names, ctx)
     polygon = _polygon(coords, i - 1, name, "block", ctx, loc)
-    block = Block(polygon=polygon, name=name, density=density, thickness=thickness, velocity=velocity)
+    block = Block(polygon=polygon, name=name, density=density, thickness=thickness, velocity=velocity, **carried)
     problem = block_speed_problem(block)
     if problem:  # velocity = [1e9, 0, 0] ran and ended as exit 3, "diverged at step 1"
         raise ctx.error(loc, problem)
@@ -452,6 +456,9 @@ def dump_scenario(scenario: Scenario, *, inline_records: bool = False) -> str:
         velocity = [float(v) for v in block.velocity]
         if any(v != 0.0 for v in velocity):
             out.append(f"velocity = {format_value(velocity)}")
+        if block.carried_mass > 0.0:
+            out.append(f"carried_mass = {format_value(float(block.carried_mass))}")
+            out.append(f"carried_at = {format_value([float(x) for x in block.carried_at])}")
     for support, motion in zip(scenario.assembly.supports, scenario.motions):
         out += [
             "",

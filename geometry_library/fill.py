@@ -1,0 +1,113 @@
+"""Fill over a structure: the dead weight of soil up to a level, carried by the blocks beneath it.
+
+A masonry bridge's fill is assessed, in Heyman's conservative way, as dead load only: its weight bears
+vertically on the ring, it has no strength of its own and pushes nothing sideways. Each vertical column
+of fill, from the structure's top surface up to the fill level, bears on the block whose upper boundary
+is highest under it.
+
+The top surface is piecewise linear, with breaks only at the blocks' vertices. Between two consecutive
+vertex abscissae one block is topmost and its top edge is one straight line, so the fill over that piece
+is a trapezoid (cut where the top rises above the level: a ring standing proud of a haunch fill):
+
+    for each piece [a, b] of the top surface within [x_lo, x_hi]:
+        block, y(x) = the topmost block at (a + b) / 2 and its top edge there
+        clip [a, b] to where y(x) < level
+        add the trapezoid (a, y(a)), (b, y(b)), (b, level), (a, level) to that block's fill
+
+A block's fill is the sum of its trapezoids (area, centroid); where no block is under a piece (a gap
+between piers), no fill is counted (it would fall through).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+
+from .blocks import Block
+
+
+@dataclasses.dataclass(frozen=True, eq=False)
+class Fill:
+    """The fill over each block: ``area`` (N,) m² and ``centroid`` (N, 2) m (nan where the area is 0)."""
+
+    area: np.ndarray
+    centroid: np.ndarray
+
+
+def _edges(blocks) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(E, 2) start and end points and (E,) owner of every block edge."""
+    starts, ends, owner = [], [], []
+    for i, block in enumerate(blocks):
+        xy = np.asarray(block.vertices, dtype=np.float64)
+        starts.append(xy)
+        ends.append(np.roll(xy, -1, axis=0))
+        owner.append(np.full(len(xy), i))
+    return np.concatenate(starts), np.concatenate(ends), np.concatenate(owner)
+
+
+def _trapezoid(a: float, b: float, ya: float, yb: float, level: float) -> tuple[float, float, float]:
+    """(area, first moment about y = 0 … as Σ x·A, Σ y·A) of {a ≤ x ≤ b, line(ya, yb) ≤ y ≤ level}, the line
+    assumed below the level over [a, b] (a corner may touch it)."""
+    ha, hb = level - ya, level - yb  # heights of the two vertical sides, ≥ 0
+    width = b - a
+    area = 0.5 * width * (ha + hb)
+    if area <= 0.0:
+        return 0.0, 0.0, 0.0
+    # centroid of a trapezoid with parallel vertical sides: x from a by w (ha + 2 hb) / (3 (ha + hb));
+    # y: the mean over the strip of the column's mid-height, weighted by its height
+    cx = a + width * (ha + 2.0 * hb) / (3.0 * (ha + hb))
+    # ∫ h(x) (level − h(x)/2) dx / ∫ h(x) dx with h linear: level − (ha² + ha hb + hb²) / (3 (ha + hb))
+    cy = level - (ha * ha + ha * hb + hb * hb) / (3.0 * (ha + hb))
+    return area, cx * area, cy * area
+
+
+def fill_over(blocks, level: float, x_lo: float, x_hi: float) -> Fill:
+    """The fill up to ``level`` (m) over the blocks' top surface between ``x_lo`` and ``x_hi`` (m), per block
+    (module docstring)."""
+    n = len(blocks)
+    p, q, owner = _edges(blocks)
+    xs = np.unique(np.concatenate([p[:, 0], [x_lo, x_hi]]))
+    xs = xs[(xs >= x_lo) & (xs <= x_hi)]
+    lo, hi = np.minimum(p[:, 0], q[:, 0]), np.maximum(p[:, 0], q[:, 0])
+    sums = np.zeros((n, 3))
+    for a, b in zip(xs[:-1], xs[1:]):
+        if not b > a:
+            continue
+        mid = 0.5 * (a + b)
+        spans = np.flatnonzero((lo < mid) & (mid < hi))  # no vertex lies strictly inside (a, b)
+        if spans.size == 0:
+            continue
+        t = (mid - p[spans, 0]) / (q[spans, 0] - p[spans, 0])
+        k = spans[int(np.argmax(p[spans, 1] + t * (q[spans, 1] - p[spans, 1])))]
+        slope = (q[k, 1] - p[k, 1]) / (q[k, 0] - p[k, 0])
+        line = lambda x, k=k, slope=slope: p[k, 1] + slope * (x - p[k, 0])  # noqa: E731
+        ya, yb = line(a), line(b)
+        if ya >= level and yb >= level:
+            continue
+        if ya > level or yb > level:  # the top crosses the level inside: keep the part below it
+            cross = p[k, 0] + (level - p[k, 1]) / slope
+            a, b = (a, cross) if ya < level else (cross, b)
+            ya, yb = min(line(a), level), min(line(b), level)
+        sums[owner[k]] += _trapezoid(a, b, ya, yb, level)
+    area = sums[:, 0]
+    with np.errstate(invalid="ignore", divide="ignore"):
+        centroid = np.where(area[:, None] > 0.0, sums[:, 1:] / area[:, None], np.nan)
+    return Fill(area=area, centroid=centroid)
+
+
+def with_fill(blocks, level: float, density: float, x_lo: float, x_hi: float) -> list[Block]:
+    """``blocks`` each carrying the mass of its fill (:func:`fill_over`; density kg/m³ × area × the block's
+    thickness) lumped at the fill's centroid, added to any mass it carried before."""
+    fill = fill_over(blocks, level, x_lo, x_hi)
+    out = []
+    for block, area, centre in zip(blocks, fill.area, fill.centroid):
+        if area <= 0.0:
+            out.append(block)
+            continue
+        mass = density * area * block.thickness
+        total = block.carried_mass + mass
+        before = np.asarray(block.carried_at if block.carried_at is not None else centre, dtype=np.float64)
+        at = (block.carried_mass * before + mass * centre) / total
+        out.append(dataclasses.replace(block, carried_mass=float(total), carried_at=(float(at[0]), float(at[1]))))
+    return out

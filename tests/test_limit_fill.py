@@ -1,0 +1,131 @@
+"""A bridge's fill (dead load only) over the segmental ring: `masonry limit` against the four-hinge reference
+(tests/four_hinge_reference.py, the fill's weight computed here from its definition: the quadrilateral
+between each voussoir's extrados chord and the fill level, by the shoelace formula), and the closed forms a
+fill has: its total weight, and a symmetric fill's symmetric thrust.
+
+Both sides solve the same discrete ring with the fill's weight on each voussoir at its column's centroid
+(no sliding: μ = 10), so they agree to rounding, hinge for hinge, as the bare ring does.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from four_hinge_reference import least_load_factor
+from test_limit_ring_mechanisms import (
+    MU,
+    RING,
+    _joint,
+    _unordered,
+    segmental_reference_ring,
+    voussoir_loads,
+)
+
+from geometry_library.blocks import Assembly
+from geometry_library.builders import build_arch
+from masonrycli.limit import LiveLoad, analyse
+from masonrycli.limit.analysis import support_thrusts
+from masonrycli.scenario.motion import Fixed
+from masonrycli.scenario.scenario import Material, RunConfig, Scenario
+
+G = 9.81
+SPRINGING = 3.4  # the builder's default piers: 17 courses of 0.20 m
+COVER = 0.3  # m of fill over the crown
+FILL_DENSITY = 1900.0
+STONE = 2500.0  # the builder's block density
+
+
+def filled_ring_scenario(voussoirs: int) -> Scenario:
+    """The builder's segmental ring under COVER of fill, its voussoirs (carrying their fill) on its two
+    skewbacks held fixed (rigid abutments, which carry the fill over them)."""
+    assembly = build_arch(
+        span=8.0,
+        rise=2.0,
+        ring_thickness=RING,
+        voussoirs=voussoirs,
+        pier_width=1.0,
+        fill_cover=COVER,
+        fill_density=FILL_DENSITY,
+    )
+    from geometry_library.blocks import Support
+
+    ring = tuple(b for b in assembly.blocks if b.name.startswith("v"))
+    springers = tuple(Support(b.polygon, b.name) for b in assembly.blocks if b.name.endswith("skewback"))
+    return Scenario(
+        name="filled",
+        run=RunConfig(),
+        material=Material(density=STONE, friction=MU),
+        assembly=Assembly(blocks=ring, supports=springers),
+        motions=tuple(Fixed() for _ in springers),
+    )
+
+
+def reference_fill(extrados: np.ndarray, level: float) -> tuple[np.ndarray, np.ndarray]:
+    """Centroids and areas of the quadrilaterals E_k, E_k+1, (x_k+1, level), (x_k, level) over each chord."""
+    top_left = np.stack([extrados[:-1, 0], np.full(len(extrados) - 1, level)], axis=1)
+    top_right = np.stack([extrados[1:, 0], np.full(len(extrados) - 1, level)], axis=1)
+    # voussoir_loads takes (intrados, extrados) chains and shoelaces I_k, I_k+1, E_k+1, E_k: pass the chord as
+    # the "intrados" and the level as the "extrados" (a chain of two points each quad)
+    centroids, areas = [], []
+    for k in range(len(extrados) - 1):
+        c, a = voussoir_loads(extrados[k : k + 2], np.stack([top_left[k], top_right[k]]))
+        centroids.append(c[0])
+        areas.append(a[0])
+    return np.array(centroids), np.array(areas)
+
+
+@pytest.mark.parametrize("voussoirs", [20, 31])
+def test_filled_ring_matches_the_four_hinge_reference(voussoirs):
+    """Horizontal acceleration (the fill's mass accelerated with the ring: its inertia at its centroid) and a
+    point load over the quarter span (λ × the voussoir's own weight, the fill's weight dead)."""
+    sc = filled_ring_scenario(voussoirs)
+    i, e = segmental_reference_ring(voussoirs)
+    i, e = i + (0, SPRINGING), e + (0, SPRINGING)
+    level = e[:, 1].max() + COVER
+    centroid, area = voussoir_loads(i, e)
+    weight = STONE * G * area
+    fill_at, fill_area = reference_fill(e, level)
+    fill = FILL_DENSITY * G * fill_area
+    dead = np.stack([0 * weight, -weight], axis=1)
+    fill_dead = np.stack([0 * fill, -fill], axis=1)
+    vw = max(2, len(str(voussoirs)))
+    name = lambda k: f"v{k + 1:0{vw}d}"  # noqa: E731
+    hinge_names = lambda ks: {_joint(k, voussoirs, "left-skewback", "right-skewback", name) for k in ks}  # noqa: E731
+
+    # the builder's fill on each voussoir is the reference's, to rounding
+    carried = np.array([b.carried_mass for b in sc.assembly.blocks])
+    np.testing.assert_allclose(carried * G, fill, rtol=1e-9)
+    np.testing.assert_allclose([b.carried_at for b in sc.assembly.blocks], fill_at, atol=1e-9)
+
+    live = np.stack([weight, 0 * weight], axis=1)
+    extra = (("dead", fill_dead, fill_at), ("live", np.stack([fill, 0 * fill], axis=1), fill_at))
+    expected, (hinged, _) = least_load_factor(i, e, centroid, dead, live, extra=extra)
+    r = analyse(sc, LiveLoad("horizontal"))
+    assert r.load_factor == pytest.approx(expected, rel=1e-6)
+    assert _unordered(r.hinges) == hinge_names(hinged)
+    bare, _ = least_load_factor(i, e, centroid, dead, live)
+    assert abs(expected / bare - 1) > 0.05  # the fill changes the answer: the test would see it missing
+
+    quarter = int(np.searchsorted(i[:, 0], -2.0)) - 1
+    live = np.zeros_like(dead)
+    live[quarter] = (0.0, -weight[quarter])
+    expected, (hinged, _) = least_load_factor(i, e, centroid, dead, live, extra=(("dead", fill_dead, fill_at),))
+    r = analyse(sc, LiveLoad("point", "-y", block=name(quarter)))
+    assert r.load_factor == pytest.approx(expected, rel=1e-6)
+    assert _unordered(r.hinges) == hinge_names(hinged)
+    assert r.reference_force == pytest.approx(weight[quarter], rel=1e-9)  # its own weight, not its fill's
+
+
+def test_a_symmetric_fill_gives_a_symmetric_thrust_and_more_of_it():
+    """The filled bridge's least and greatest abutment thrust, left equal to right; the fill adds to both."""
+    options = dict(span=8.0, rise=2.0, ring_thickness=0.5, pier_width=3.0, pier_courses=5)
+    from masonrycli.scenario.builtin import builtin
+
+    def thrusts(**fill):
+        r = analyse(builtin("arch", **options, **fill), LiveLoad(), thrust=True)
+        return {name: (lo, hi) for name, _, lo, hi in support_thrusts(r.model, r.joints)}
+
+    bare, filled = thrusts(), thrusts(fill_cover=0.5)
+    left, right = filled["left-foundation"], filled["right-foundation"]
+    np.testing.assert_allclose(left, right, rtol=1e-6)
+    assert left[0] > 1.5 * bare["left-foundation"][0]
