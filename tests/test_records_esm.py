@@ -257,3 +257,43 @@ def test_a_plain_table_named_asc_is_read_as_a_csv(tmp_path):
     # in cm/s², converted by a scale of 0.01 as a CSV's: not an ESM file's "converts it again"
     result = invoke("check", BLOCK, "--record", two, "--scale", 0.01)
     assert result.exit_code == 0 and "converts it again" not in words(result.output), result.output
+
+
+# the spellings the ESM reader's own table held, with their factors from the units' definitions
+ESM_SPELLINGS = {
+    **dict.fromkeys(("cm/s^2", "cm/s2", "cm/s/s", "cm/s²", "cm/sec^2", "gal"), ("acceleration", 0.01)),
+    **dict.fromkeys(("m/s^2", "m/s2", "m/s/s", "m/s²"), ("acceleration", 1.0)),
+    **dict.fromkeys(("mm/s^2", "mm/s2"), ("acceleration", 0.001)),
+    "g": ("acceleration", 9.80665),
+    **dict.fromkeys(("cm/s", "cm/sec"), ("velocity", 0.01)),
+    "m/s": ("velocity", 1.0),
+    "mm/s": ("velocity", 0.001),
+}
+
+
+@pytest.mark.parametrize("unit", sorted(ESM_SPELLINGS))
+def test_an_esm_file_reads_every_unit_it_read_before(tmp_path, unit):
+    # the reader's unit table was a copy of records/units.py's; it reads through that one now, unchanged
+    quantity, factor = ESM_SPELLINGS[unit]
+    path = _edited(tmp_path, "UNITS: cm/s^2", f"UNITS: {unit.upper() if unit != 'g' else unit}")
+    path.write_text(path.read_text().replace("DATA_TYPE: ACCELERATION", f"DATA_TYPE: {quantity.upper()}"))
+    dt, values, read_as = load_esm(path)
+    raw = np.loadtxt(ESM, skiprows=FIRST_SAMPLE_LINE - 1)  # the file's numbers as written
+    assert read_as == quantity and np.array_equal(values, raw * factor)
+
+
+@pytest.mark.parametrize("unit", ["cm s-2", "cm/s**2", "in/s2", "ft/s2", "in/s", "gal", "g", "mm/s"])
+def test_an_esm_header_and_a_csv_header_read_a_unit_alike(tmp_path, unit):
+    # one table: an ESM file named "cm s-2" or "in/s2" was refused ("not a unit masonry reads") where a CSV
+    # header giving the same unit was read in it
+    from masonrycli.records.units import header_factor
+
+    quantity = "velocity" if unit in ("in/s", "mm/s") else "acceleration"
+    csv_file = tmp_path / "q.csv"
+    csv_file.write_text(f"time (s),{'vel' if quantity == 'velocity' else 'acc'} ({unit})\n0,0\n0.01,1\n")
+    path = _edited(tmp_path, "UNITS: cm/s^2", f"UNITS: {unit}")
+    path.write_text(path.read_text().replace("DATA_TYPE: ACCELERATION", f"DATA_TYPE: {quantity.upper()}"))
+    _, values, read_as = load_esm(path)
+    factor = header_factor(csv_file, quantity)[1]
+    raw = np.loadtxt(ESM, skiprows=FIRST_SAMPLE_LINE - 1)
+    assert read_as == quantity and np.array_equal(values, raw * factor)

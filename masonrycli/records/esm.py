@@ -11,7 +11,8 @@ files), then ``NDATA`` samples, one a line, ``SAMPLING_INTERVAL_S`` apart from t
     header  = the "KEY: value" lines up to the first line that is a number (other text lines are skipped)
     dt      = SAMPLING_INTERVAL_S (s, a record's time step: 1e-6 to 1 s); n = NDATA (an integer >= 2)
     series  = DATA_TYPE when given: ACCELERATION or VELOCITY (DISPLACEMENT, spectra: refused, naming why)
-    factor  = UNITS to SI: cm/s^2 (ESM's), gal, m/s^2, mm/s^2, g -> acceleration; cm/s, m/s, mm/s -> velocity;
+    factor  = UNITS to SI: cm/s^2 (ESM's), gal, m/s^2, mm/s^2, g -> acceleration; cm/s, m/s, mm/s -> velocity,
+              by the unit table a CSV header is read by (records/units.py, unit_factor);
               a unit of the other series than DATA_TYPE's, a length or an unknown unit: refused
     samples = the numbers after the header, each finite, n of them (fewer: refused; more: a warning, the
               first n kept, as an .AT2 file's NPTS), times 0, dt, 2 dt, ...; values x factor
@@ -30,32 +31,12 @@ import numpy as np
 from masonrycli.errors import InputError, RecordWarning
 from masonrycli.records.motion import time_step_problem
 from masonrycli.records.text import free_numbers
-from masonrycli.records.units import G_STANDARD
+from masonrycli.records.units import unit_factor
 from masonrycli.scenario.values import shorten
 
 ESM_SUFFIX = ".asc"
 
 _KEY = re.compile(r"^\s*([A-Za-z][A-Za-z0-9_/^.()\-]*)\s*:(.*)$")
-# UNITS as written, lower case and without blanks -> (series, factor to m/s² or m/s)
-_UNITS = {
-    "cm/s^2": ("acceleration", 0.01),
-    "cm/s2": ("acceleration", 0.01),
-    "cm/s/s": ("acceleration", 0.01),
-    "cm/s²": ("acceleration", 0.01),
-    "cm/sec^2": ("acceleration", 0.01),
-    "gal": ("acceleration", 0.01),
-    "m/s^2": ("acceleration", 1.0),
-    "m/s2": ("acceleration", 1.0),
-    "m/s/s": ("acceleration", 1.0),
-    "m/s²": ("acceleration", 1.0),
-    "mm/s^2": ("acceleration", 0.001),
-    "mm/s2": ("acceleration", 0.001),
-    "g": ("acceleration", G_STANDARD),
-    "cm/s": ("velocity", 0.01),
-    "cm/sec": ("velocity", 0.01),
-    "m/s": ("velocity", 1.0),
-    "mm/s": ("velocity", 0.001),
-}
 _LENGTHS = {"cm", "m", "mm"}
 _SERIES = ("ACCELERATION", "VELOCITY")
 
@@ -140,7 +121,7 @@ def esm_units(path) -> tuple[str, float] | None:
     about a scale that converts the file a second time names the file's own unit (a velocity file is in cm/s,
     not in gal)."""
     units = _header_value(path, "UNITS")
-    known = _UNITS.get("".join(units.split()).lower())
+    known = unit_factor(units)
     return (units, known[1]) if known else None
 
 
@@ -207,11 +188,12 @@ def _series(header: dict, name: str) -> tuple[str, float]:
             f"{name}:{line}: UNITS: {units}: a displacement series: give the same component's acceleration "
             "file (….ACC.ASC), which masonry integrates"
         )
-    if unit not in _UNITS:
+    known = unit_factor(units)
+    if known is None:
         raise InputError(
             f"{name}:{line}: UNITS: {shorten(units, 30)}: not a unit masonry reads (cm/s^2, gal, m/s^2, g; cm/s, m/s)"
         )
-    series, factor = _UNITS[unit]
+    series, factor = known
     if kind and kind.lower() != series:
         raise InputError(
             f"{name}:{line}: UNITS: {units} is {series}, but DATA_TYPE (line {type_line}) says {data_type}"

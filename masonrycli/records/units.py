@@ -229,6 +229,23 @@ def header_factor(path, quantity: str) -> tuple[str, float] | None:
     return unit.group(1), G_STANDARD if unit_key(unit.group(1)) == "g" else factor
 
 
+def unit_factor(unit: str) -> tuple[str, float] | None:
+    """``(quantity, factor to SI)`` of a unit written alone, as an ESM header's ``UNITS`` gives it (``cm/s^2``,
+    ``gal``, ``g``, ``m/s``; blanks and case aside), by the spellings and the table a CSV header is read by
+    (:data:`SCALED_UNITS`, m/s and m/s² as they are); None for anything else (a length, "counts")."""
+    text = "".join(unit.split())
+    if not (_SI_OR_SCALED.fullmatch(text) or text.lower() in ("g", "gal")):
+        return None
+    key = unit_key(text)
+    if key in ("m/s", "m/s2"):
+        return ("velocity" if key == "m/s" else "acceleration"), 1.0
+    quantity, factor = SCALED_UNITS[key]
+    return quantity, G_STANDARD if key == "g" else factor
+
+
+_SI_OR_SCALED = re.compile(f"{_ACCEL}|{_SPEED}", re.IGNORECASE)
+
+
 CONVERTED_AGAIN = 0.005
 """Relative width around a CSV header's conversion (9.80665 for g, 0.01 for gal) within which a ``scale`` is
 taken for that conversion given a second time (9.81, 9.807, 9.8; 0.01): refused. Narrow: a scale of 10 on a
