@@ -18,19 +18,23 @@ ways that each stopped a run:
   convex hull, if that adds at most ``MAX_HULL_GAIN`` (5 %) of its area — the area added is said; more
   is a stone of another shape, still refused (split it in QGIS);
 - **neighbours overlapping by a tracing slip** (``trim_overlaps`` = the deepest overlap to trim, m, opt-in):
-  each overlapping pair is cut along a line through the middle of their overlap (:func:`trim_overlaps`).
+  each overlapping pair is cut along the chord of their overlap, where their outlines cross (:func:`trim_overlaps`).
 
 Trimming, in pseudo-code::
 
     for each pair (A, B) of bodies whose overlap O has an area (not two supports):
         refuse if depth(O) > trim depth                 (a real overlap, not a slip)
-        line L through O's centroid along O's longest direction (principal axis of O's vertices)
+        line L through P and Q, the two points where the outlines of A and B cross
         refuse if A's and B's centroids are on the same side of L
         A keeps its side of L, B the other                   (collected first, cut after: order-free)
     each body = its polygon clipped by all its half-planes   (a convex polygon stays convex)
 
-After the cuts A and B meet along L exactly: they touch, as the stones do. A half-plane cut keeps a body
-convex and only removes area; the area removed is said (largest fraction of a body).
+The chord PQ splits O in two: the part of A beyond it is the cap of O between PQ and A's outline inside B,
+and B's is the other cap, so each body gives up a part of the overlap and nothing else — a wide ground
+under a stone sunk 1 mm into it at one end and lifted at the other is not touched (its outline inside the
+stone is the chord), where a cut through the overlap's middle, tilted, lowered it metres away. After the cuts
+A and B meet along PQ: they touch, as the stones do. A half-plane cut keeps a body convex and only removes
+area; the area removed is said (largest fraction of a body).
 """
 
 from __future__ import annotations
@@ -195,7 +199,7 @@ def _labels(assembly: Assembly) -> list[str]:
 
 
 def trim_overlaps(assembly: Assembly, depth: float) -> tuple[Assembly, str]:
-    """``assembly`` with each pair of overlapping bodies (not two supports) cut along the middle of their
+    """``assembly`` with each pair of overlapping bodies (not two supports) cut along the chord of their
     overlap (module docstring), and a one-line note of what was trimmed ("" when nothing overlapped).
     Raises when an overlap is deeper than ``depth`` m (listing the pairs) or cannot be split."""
     bodies = [*assembly.blocks, *assembly.supports]
@@ -216,17 +220,14 @@ def trim_overlaps(assembly: Assembly, depth: float) -> tuple[Assembly, str]:
             deep.append((a, b, d))
             continue
         deepest = max(deepest, d)
-        xy = shapely.get_coordinates(overlap)[:-1]
-        centre = np.asarray(overlap.centroid.coords[0])
-        axis = np.linalg.svd(xy - centre, full_matrices=False)[2][0]  # the overlap's longest direction
-        normal = np.array([-axis[1], axis[0]])
-        side_a = float(normal @ (np.asarray(polys[a].centroid.coords[0]) - centre))
-        side_b = float(normal @ (np.asarray(polys[b].centroid.coords[0]) - centre))
+        start, normal = _chord(polys[a], polys[b])
+        side_a = float(normal @ (np.asarray(polys[a].centroid.coords[0]) - start))
+        side_b = float(normal @ (np.asarray(polys[b].centroid.coords[0]) - start))
         if side_a * side_b >= 0.0:
             raise GeometryError(f"{labels[a]} and {labels[b]} overlap in a way no straight cut separates")
         normal = normal if side_a > 0.0 else -normal
-        cuts[a].append((normal, float(normal @ centre)))
-        cuts[b].append((-normal, float(-normal @ centre)))
+        cuts[a].append((normal, float(normal @ start)))
+        cuts[b].append((-normal, float(-normal @ start)))
     if deep:
         a, b, d = deep[0]
         others = [f"{bodies[p].name}/{bodies[q].name}" for p, q, _ in deep[1:6]]
@@ -254,10 +255,27 @@ def trim_overlaps(assembly: Assembly, depth: float) -> tuple[Assembly, str]:
         new.append(dataclasses.replace(body, polygon=polygon))
     trimmed = Assembly(tuple(new[:n_blocks]), tuple(new[n_blocks:]))
     note = (
-        f"{pairs} overlapping pair{'s' if pairs > 1 else ''} trimmed along the middle of their overlap "
+        f"{pairs} overlapping pair{'s' if pairs > 1 else ''} trimmed along the chord of their overlap "
         f"(--trim-overlaps; deepest {deepest * 1e3:.2g} mm, at most {worst[0]:.2%} of a body's area: {worst[1]})"
     )
     return trimmed, note
+
+
+def _chord(a: Polygon, b: Polygon) -> tuple[np.ndarray, np.ndarray]:
+    """A point and a unit normal of the line through the two points where the outlines of the overlapping
+    convex bodies ``a`` and ``b`` cross. Edges lying along each other (two squares side by side, one 2 mm
+    into the other: their tops and bottoms overlap 2 mm) give a stretch of points at each end of the chord:
+    each end is the middle of its stretch (the farthest two points made a diagonal cut)."""
+    crossing = shapely.get_coordinates(shapely.intersection(a.exterior, b.exterior))
+    if len(crossing) < 2:
+        return crossing[0] if len(crossing) else np.zeros(2), np.array([1.0, 0.0])  # refused: no cut
+    centre = crossing.mean(axis=0)
+    along = np.linalg.svd(crossing - centre, full_matrices=False)[2][0]  # the chord's direction
+    t = (crossing - centre) @ along
+    end = t > 0.5 * (t.min() + t.max())
+    p, q = crossing[~end].mean(axis=0), crossing[end].mean(axis=0)
+    along = (q - p) / np.hypot(*(q - p))
+    return p, np.array([-along[1], along[0]])
 
 
 def _clip(xy: np.ndarray, normal: np.ndarray, c: float) -> np.ndarray:

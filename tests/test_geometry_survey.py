@@ -106,7 +106,7 @@ def two_stones(overlap: float, ground: bool = False) -> Assembly:
     return Assembly(blocks, supports)
 
 
-def test_overlapping_neighbours_are_cut_along_the_middle_of_their_overlap():
+def test_overlapping_neighbours_are_cut_along_the_chord_of_their_overlap():
     # R 2 mm into L: each gives up 1 mm of its 0.5 m face, 5e-4 m² = 0.1 % of its area; they then meet at x = 0.999
     trimmed, note = trim_overlaps(two_stones(0.002, ground=True), 0.003)
     left, right = trimmed.blocks
@@ -129,6 +129,21 @@ def test_a_corner_sunk_into_the_ground_is_cut_and_both_stay_convex():
     assert after[0].intersection(after[1]).area == pytest.approx(0.0, abs=1e-15)
     assert all(p.equals(p.convex_hull) for p in after)
     assert validate_assembly(trimmed) == []
+
+
+def test_a_wide_ground_under_a_stone_sunk_at_one_end_is_left_as_it_is():
+    # the stone's bottom crosses the ground's top 5.7 cm from its left corner, 1 mm deep there: the chord is the
+    # ground's top, so the stone is cut flat on it and the ground keeps its 4 m top (a cut through the overlap's
+    # middle, tilted 0.5°, lowered the ground's far end by 17 mm: the stones there were left in the air)
+    c, s = np.cos(np.radians(1)), -np.sin(np.radians(1))
+    ring = np.array([[0, 0], [0.4, 0], [0.4, 0.2], [0, 0.2]]) @ np.array([[c, s], [-s, c]]).T + [0, -0.001]
+    ground = box(-2, -0.5, 2, 0.0)
+    trimmed, _ = trim_overlaps(Assembly((Block(Polygon(ring), "S"),), (Support(ground, "ground"),)), 0.003)
+    assert trimmed.supports[0].polygon.hausdorff_distance(ground) < 1e-12
+    assert trimmed.blocks[0].polygon.bounds[1] == pytest.approx(0.0, abs=1e-12)
+    assert trimmed.blocks[0].polygon.area == pytest.approx(
+        Polygon(ring).area - 0.5 * 0.001 * 0.001 / np.tan(np.radians(1)), rel=1e-6
+    )
 
 
 def test_an_overlap_deeper_than_the_depth_given_is_refused_naming_the_pair():

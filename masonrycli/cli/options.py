@@ -275,7 +275,7 @@ SURVEY = {  # how a GeoJSON / WKT file is read (geometry_library/survey.py): a s
     "trim_overlaps": _opt(
         float,
         "Geometry file",
-        "Cut neighbours overlapping by a tracing slip up to this deep, m (0.003), along the middle of their overlap.",
+        "Cut neighbours overlapping by a tracing slip up to this deep, m (0.003), along the chord where their outlines cross.",
         "--trim-overlaps",
     ),
 }

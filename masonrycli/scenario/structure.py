@@ -122,7 +122,9 @@ def unread_properties_warning(path: str, unknown: dict, known) -> str:
     return f"{path}: properties not used, ignored (used: {', '.join(known)}): {'; '.join(items)}"
 
 
-TRIM_HINT = "; a slip of the tracing? --trim-overlaps 0.003 cuts neighbours overlapping up to 3 mm along the middle"
+TRIM_HINT = (
+    "; a slip of the tracing? --trim-overlaps 0.003 cuts neighbours overlapping up to 3 mm where their outlines cross"
+)
 HULL_HINT = "; --convex-hull reads a slightly non-convex stone as its convex hull"
 
 
