@@ -226,3 +226,31 @@ def test_sweep_records_say_which_velocity_records_a_baseline_leaves(table, tmp_p
     assert not [w for w in as_given.request.warnings if w.startswith("--baseline")]
     alone = plan_study("wall", records=[velocity], baseline="none", out=Path("d.parquet")).request.warnings
     assert [w for w in alone if w.startswith("--baseline none: v.csv is a velocity record")], alone
+
+
+def test_a_scenario_files_baseline_on_a_velocity_record_says_it_does_not_apply(tmp_path):
+    # a record table's baseline = "quadratic" on a velocity record was taken without a word, as --baseline was
+    (tmp_path / "q.csv").write_text((DATA / "quake_velocity.csv").read_text())
+    lines = [
+        "[[block]]",
+        "polygon = [[0, 0], [0.4, 0], [0.4, 0.2], [0, 0.2]]",
+        "[[support]]",
+        'name = "ground"',
+        "polygon = [[-1, -0.2], [1, -0.2], [1, 0], [-1, 0]]",
+        'motion = { kind = "record", file = "q.csv"BASELINE }',
+    ]
+    said = {}
+    for baseline in ("quadratic", "none", ""):
+        path = tmp_path / f"s{baseline}.toml"
+        path.write_text("\n".join(lines).replace("BASELINE", f', baseline = "{baseline}"' if baseline else "") + "\n")
+        said[baseline] = invoke("check", path, "--duration", 0.4)
+    assert said["quadratic"].exit_code == 2 and said["quadratic"].output.strip() == (
+        f'error: {tmp_path / "squadratic.toml"}:6: [[support]] #1 ("ground"): motion.baseline = "quadratic": q.csv is '
+        "a velocity record, used as given: the drift correction is of acceleration records, which are integrated "
+        "(leave baseline out)"
+    )
+    assert said["none"].exit_code == 0 and (
+        'motion.baseline = "none": q.csv is a velocity record, used as given whatever baseline says'
+        in said["none"].output
+    )
+    assert said[""].exit_code == 0 and "baseline =" not in said[""].output

@@ -38,32 +38,31 @@ BASELINE_PROBLEM = 'must be "quadratic" or "none"'
 """Why a ``baseline`` is refused: the scenario file's key and ``--baseline`` say it alike."""
 
 
-def unused_baseline(baseline: str | None, records: dict, option: str = "--baseline") -> list[str]:
+def unused_baseline(baseline: str | None, records: dict, option: str = "--baseline", given: str = "") -> list[str]:
     """The warnings for an explicit ``baseline`` (None: not given) over ``records`` (name -> :class:`Record`)
     of which some are velocity records: their samples are used as given, never corrected (the drift the
     correction takes out is the integration's, and a velocity record is not integrated; one that does not
     end at rest is its own motion, a shake table's). It did nothing there without a word. ``quadratic``
     with no acceleration record among them asks for what cannot be made: :class:`InputError` (exit 2),
     rather than a run of a motion other than the one asked for; ``none`` runs as asked, with a line saying
-    the option had no bearing; over a mixed set ``quadratic`` names the velocity records it leaves as given."""
+    the option had no bearing; over a mixed set ``quadratic`` names the velocity records it leaves as given.
+    ``given``: how the lines name the setting (default ``--baseline quadratic``; a scenario file's
+    ``baseline = "quadratic"``)."""
     velocity = [name for name, record in records.items() if record.quantity == "velocity"]
     if baseline is None or not velocity:
         return []
+    given = given or f"{option} {baseline}"
     names = ", ".join(velocity[:3]) + (" …" if len(velocity) > 3 else "")
     plural = len(velocity) > 1
     kind = f"{'are velocity records' if plural else 'is a velocity record'}, used as given"
     if len(velocity) < len(records):  # none: every record as given, as asked
-        return (
-            [f"{option} quadratic: {names} {kind}; it corrects the acceleration records"]
-            if baseline == "quadratic"
-            else []
-        )
+        return [f"{given}: {names} {kind}; it corrects the acceleration records"] if baseline == "quadratic" else []
     if baseline == "quadratic":
         raise InputError(
-            f"{option} quadratic: {names} {kind}: the drift correction is of acceleration records, which are "
+            f"{given}: {names} {kind}: the drift correction is of acceleration records, which are "
             f"integrated (leave {option} out)"
         )
-    return [f"{option} none: {names} {kind} whatever {option} says (it applies to acceleration records)"]
+    return [f"{given}: {names} {kind} whatever {option} says (it applies to acceleration records)"]
 
 
 MIN_TIME_STEP, MAX_TIME_STEP = 1e-6, 1.0

@@ -14,13 +14,23 @@ import dataclasses
 import math
 import os
 import tomllib
+import warnings
 from pathlib import Path
 
 import numpy as np
 
 from geometry_library.blocks import Assembly, Block, GeometryError, Support, name_problem
-from masonrycli.errors import NOT_A_FILE, InputContext, InputError, input_path, not_utf8, one_line, special_file
-from masonrycli.records.motion import Record
+from masonrycli.errors import (
+    NOT_A_FILE,
+    InputContext,
+    InputError,
+    RecordWarning,
+    input_path,
+    not_utf8,
+    one_line,
+    special_file,
+)
+from masonrycli.records.motion import Record, unused_baseline
 from masonrycli.records.read import record_fields
 from masonrycli.scenario.caveats import idle_driven_supports
 from masonrycli.scenario.motion import Constant, Fixed, Motion, Ramp, Sine
@@ -394,6 +404,14 @@ def _parse_motion(table, ctx: InputContext, loc: str) -> Motion:
         motion = cls(**args)
     except InputError as exc:
         raise ctx.error(loc, f"motion.{exc}") from None
+    if kind == "record" and "baseline" in table:  # a velocity record's is never applied: said (records/motion.py)
+        name = os.path.basename(motion.source) if motion.source else "the inline record"
+        try:
+            said = unused_baseline(motion.baseline, {name: motion}, "baseline", f'baseline = "{motion.baseline}"')
+        except InputError as exc:
+            raise ctx.error(loc, f"motion.{exc}") from None
+        for line in said:
+            warnings.warn(RecordWarning(str(ctx.error(loc, f"motion.{line}"))), stacklevel=2)
     if kind == "sine" and motion.frequency == 0.0 and motion.amplitude and abs(math.sin(motion.phase)) < 1e-12:
         # it ran: amplitude · sin(0) = 0, the ground never moved ("intact"); --freq 0 --amp 1 was refused
         raise ctx.error(
