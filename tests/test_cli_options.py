@@ -102,15 +102,17 @@ def test_simulate_help_lists_only_what_the_structure_takes_with_its_defaults():
 
 
 def test_run_and_check_help_give_the_scenario_files_values_as_defaults():
-    # `run --help` said "(default 1e-3)" for --dt, although a file's [run] dt is what runs
-    for command in (["run"], ["check"]):
+    # `run --help` said "(default 1e-3)" for --dt, although a file's [run] dt is what runs; check takes a
+    # built-in too, whose values are the default there (it said "the scenario file's value" only)
+    for command, value in (
+        (["run"], "the scenario file's value"),
+        (["check"], "the scenario file's or the built-in's value"),
+    ):
         options = _option_help(command)
-        assert "(default: the scenario file's value, else 1e-3)" in options["--dt"]
-        assert "(default: the scenario file's value, else 0.5)" in options["--theta"]
-        assert "(default: the scenario file's value, else 0.6)" in options["--friction"]
-        assert (
-            "(default: the scenario file's value)" in options["--duration"] and "simulate" not in options["--duration"]
-        )
+        assert f"(default: {value}, else 1e-3)" in options["--dt"]
+        assert f"(default: {value}, else 0.5)" in options["--theta"]
+        assert f"(default: {value}, else 0.6)" in options["--friction"]
+        assert f"(default: {value})" in options["--duration"] and "simulate" not in options["--duration"]
     simulate = _option_help(["simulate", "wall"])
     assert "(default 1e-3)" in simulate["--dt"] and "(default 0.6)" in simulate["--friction"]
 

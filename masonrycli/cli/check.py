@@ -60,7 +60,11 @@ def _scenario(target: str, opts: dict):
     return builtin(target, **shaping, **settings)
 
 
-@with_options(file_defaults(RUN), STOP, file_defaults(FRICTION), OUTPUT, FORCE, RECORD, BUILT_IN_ONLY, SURVEY)
+FILE_OR_BUILT_IN = "the scenario file's or the built-in's value"  # the run options' default: "the file's" was half
+RUN_FROM_EITHER, FRICTION_FROM_EITHER = file_defaults(RUN, FILE_OR_BUILT_IN), file_defaults(FRICTION, FILE_OR_BUILT_IN)
+
+
+@with_options(RUN_FROM_EITHER, STOP, FRICTION_FROM_EITHER, OUTPUT, FORCE, RECORD, BUILT_IN_ONLY, SURVEY)
 def check_command(
     target: Annotated[
         str,

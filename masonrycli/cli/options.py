@@ -284,17 +284,16 @@ _BUILT_IN_DEFAULT = re.compile(r"\(default ([^;)]*)")
 """The "(default 1e-3" of a help text: the built-in value, which a scenario file's replaces."""
 
 
-def file_defaults(group: dict) -> dict:
+def file_defaults(group: dict, value: str = "the scenario file's value") -> dict:
     """``group`` with each "(default …)" of its help texts saying the scenario file's value is the default:
-    ``run --help`` said "(default 1e-3)" for --dt although a file's [run] dt = 2e-4 is what runs."""
+    ``run --help`` said "(default 1e-3)" for --dt although a file's [run] dt = 2e-4 is what runs. ``value``:
+    how that default is named (``check``, which takes a built-in too: the file's or the built-in's)."""
     out = {}
     for name, annotation in group.items():
         kind, info = typing.get_args(annotation)
         info = copy.copy(info)
-        info.help = _BUILT_IN_DEFAULT.sub(r"(default: the scenario file's value, else \1", info.help, count=1)
-        info.help = info.help.replace(
-            "the built-in's or the file's; simulate --record: the whole record", "the scenario file's value"
-        )
+        info.help = _BUILT_IN_DEFAULT.sub(rf"(default: {value}, else \1", info.help, count=1)
+        info.help = info.help.replace("the built-in's or the file's; simulate --record: the whole record", value)
         out[name] = Annotated[kind, info]
     return out
 
