@@ -185,7 +185,8 @@ OPTION_UNITS: dict[str, str] = {
     "workers": "",
     "magnify": "",
     "at": "m",  # limit --at X: the abscissa of a point load
-    "trim_overlaps": "m",  # the deepest overlap of a surveyed file's neighbours trimmed
+    "trim_overlaps": "m",
+    "settle": "s",  # limit --settle: seconds of settling under gravity  # the deepest overlap of a surveyed file's neighbours trimmed
 }
 """The unit of each numeric option with no scenario setting (their help: --rtol a relative width,
 --workers a count, --magnify a factor): the one place they are added. (limit's --block is a block's

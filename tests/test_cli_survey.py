@@ -79,3 +79,45 @@ def test_limit_of_a_traced_wall_trimmed_is_near_that_of_the_exact_stones(tmp_pat
     assert exact.exit_code == 0 and traced.exit_code == 0, traced.output
     lam = [json.loads(r.stdout)["load_factor"] for r in (exact, traced)]
     assert lam[1] == pytest.approx(lam[0], rel=0.03)
+
+
+def block_above_ground(tmp_path, gap: float):
+    """A 0.4 × 0.8 m block drawn ``gap`` m above a fixed ground, as a GeoJSON file."""
+    block = [[0, gap], [0.4, gap], [0.4, 0.8 + gap], [0, 0.8 + gap], [0, gap]]
+    ground = [[-1, -0.5], [1.4, -0.5], [1.4, 0], [-1, 0], [-1, -0.5]]
+    features = [
+        {"type": "Feature", "properties": {"name": "B"}, "geometry": {"type": "Polygon", "coordinates": [block]}},
+        {
+            "type": "Feature",
+            "properties": {"role": "support"},
+            "geometry": {"type": "Polygon", "coordinates": [ground]},
+        },
+    ]
+    path = tmp_path / "gap.geojson"
+    path.write_text(json.dumps({"type": "FeatureCollection", "features": features}))
+    return path
+
+
+@pytest.mark.slow
+def test_limit_settle_lets_a_block_drawn_apart_come_to_rest_first(tmp_path):
+    # 2 mm above its ground: no joint within the engine's 1 mm, nothing holds it, and the refusal names the
+    # option; settled, it stands on the ground and tips about its toe at λ = B / H = 0.5 (μ = 0.6: no sliding)
+    path = block_above_ground(tmp_path, 0.002)
+    assert_one_line_error(invoke("limit", path), "no equilibrium", "--settle 0.5")
+    result = invoke("limit", path, "--settle", "0.2", "--json")
+    assert result.exit_code == 0, result.output
+    answer = json.loads(result.stdout)
+    assert answer["load_factor"] == pytest.approx(0.5, rel=1e-3)
+    assert answer["settled"]["block"] == "B" and answer["settled"]["largest_move"] == pytest.approx(0.002, rel=0.05)
+    table = invoke("limit", path, "--settle", "0.2").output
+    assert "settled" in table and "0.2 s under its own weight (--settle)" in table and "touches nothing" not in table
+
+
+@pytest.mark.slow
+def test_limit_settle_refuses_a_wall_that_does_not_stand_as_drawn(tmp_path):
+    # 0.3 m above the ground the block falls 0.3 m: far beyond --verify's collapse threshold (0.1 × its radius)
+    path = block_above_ground(tmp_path, 0.3)
+    result = invoke("limit", path, "--settle", "0.5", "--out", tmp_path / "m.rrd")
+    assert_one_line_error(result, "the wall does not stand as drawn", "B moved more than")
+    assert not (tmp_path / "m.rrd").exists()
+    assert_one_line_error(invoke("limit", path, "--settle", "20"), "--settle 20: must be in (0, 10] s")

@@ -33,6 +33,7 @@ from masonrycli.cli.options import (
     DirectionOption,
     Friction,
     MinThicknessOption,
+    SettleOption,
     ThrustOption,
     choice_value,
     file_defaults,
@@ -294,6 +295,7 @@ def limit_command(
     friction: Friction = None,
     as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object on stdout, nothing else.")] = False,
     thrust: ThrustOption = False,
+    settle: SettleOption = None,
     min_thickness: MinThicknessOption = False,
     verify: Annotated[
         bool, typer.Option("--verify", help="Run the NSCD engine at 0.95 λ and 1.05 λ (tilted gravity) and compare.")
@@ -330,6 +332,7 @@ def limit_command(
         at=at,
         thrust=thrust,
         min_thickness=min_thickness,
+        settle=settle,
     )
 
 

@@ -232,6 +232,15 @@ MinThicknessOption = Annotated[
         "Heyman's geometric factor of safety (the ring's thickness over it).",
     ),
 ]
+SettleOption = Annotated[
+    float | None,
+    typer.Option(
+        "--settle",
+        parser=number_value,
+        help="First let the structure come to rest under its own weight for this many seconds (the engine, supports "
+        "fixed), and analyse it there: a traced wall's gaps closed (0.5).",
+    ),
+]
 ThrustOption = Annotated[
     bool,
     typer.Option(

@@ -50,6 +50,9 @@ class LimitResult:
     ring: tuple[float, float] | None = None
     """m: (ring thickness, least ring thickness that carries its own weight) of a built-in arch
     (:mod:`masonrycli.limit.thickness`); None unless asked for (``masonry limit --min-thickness``)."""
+    settled: object | None = None
+    """The :class:`~masonrycli.limit.settle.Settling` of ``masonry limit --settle`` (the wall analysed where the
+    engine let it come to rest), None without it."""
     support_thrust: tuple[tuple[str, str, float, float], ...] | None = None
     """(support, outward direction, least N, greatest N) of each support under the dead load alone
     (:func:`support_thrusts`; ±inf: no bound, null in JSON); None unless asked for (``masonry limit --thrust``)."""
@@ -132,6 +135,7 @@ class LimitResult:
             "blocks": m.block_count,
             "supports": m.support_count,
             "joints": j.joint_count,
+            "settled": None if self.settled is None else self.settled.summary(),
             "contact_points": j.contact_count,
             "hinges": self.hinges,
             "hinge_points": [[float(x), float(y)] for x, y in self.motion.hinge_point],

@@ -23,7 +23,7 @@ from masonrycli import SOURCE_DIGEST, __version__
 from masonrycli.errors import EXIT_OUTPUT_FAILED, InputError
 from masonrycli.interrupt import StopRun, StopSignals, exit_code, signal_name
 from masonrycli.limit.analysis import LimitResult, analyse
-from masonrycli.limit.problem import DIRECTIONS, LimitError, LiveLoad
+from masonrycli.limit.problem import DIRECTIONS, LimitError, LiveLoad, NoEquilibrium
 from masonrycli.outputs.files import check_output, written_whole
 from masonrycli.source_digest import source_commit
 
@@ -104,6 +104,8 @@ def result_table(result: LimitResult, out: Path | None) -> Table:
     table.add_row("structure", f"{counts}, friction μ = {s['friction']:g}")
     if s["fill_load_N"]:
         table.add_row("fill", f"{s['fill_load_N']:.4g} N{_depth(result)}, dead load on the blocks under it")
+    if result.settled is not None:
+        table.add_row("settled", result.settled.describe())
     table.add_row("joints", f"{s['joints']} ({s['contact_points']} contact points, from the engine's detection)")
     table.add_row("live load", result.load.describe())
     lam = Text(f"{result.load_factor:.4f}", style="bold")  # Text: the consoles parse no markup
@@ -261,8 +263,10 @@ def run_limit(
     at: float | None = None,
     thrust: bool = False,
     min_thickness: bool = False,
+    settle: float | None = None,
 ) -> None:
     """``masonry limit``: analyse, optionally record and verify, then print a table or one JSON object.
+    ``settle``: s the wall is first let come to rest under its own weight (:mod:`masonrycli.limit.settle`).
 
     Ctrl-C or SIGTERM stops it (:mod:`masonrycli.interrupt`) with one line on stderr and exit 130 / 143, as
     ``simulate`` and ``sweep`` do (SIGTERM killed it before: exit -15, no word); one that arrives while the
@@ -286,6 +290,7 @@ def run_limit(
                     structure_options=structure_options,
                     thrust=thrust,
                     min_thickness=min_thickness,
+                    settle=settle,
                 )
         except StopRun as stop:
             how = "" if stop.signum == signal.SIGINT else f" ({signal_name(stop.signum)})"  # as `masonry sweep`
@@ -370,14 +375,22 @@ def _analyse(structure, live, friction, verify, out, force, done: _Done, signals
     if verify and live.kind == "point":
         raise InputError("--verify: the engine has no point loads; verify a horizontal or tilt load")
     settings = setting_warnings(scenario)  # not its records': it has no time
+    settling = None
+    if options["settle"] is not None:  # the engine first: a traced wall's gaps closed under its own weight
+        from masonrycli.limit.settle import settle
+
+        scenario, settling = settle(scenario, options["settle"])
     try:
-        done.result = analyse(scenario, live, thrust=options["thrust"])
+        done.result = replace(analyse(scenario, live, thrust=options["thrust"]), settled=settling)
         if options["min_thickness"]:
             done.result = replace(done.result, ring=_least_ring(structure, friction, options["structure_options"]))
     except LimitError as exc:
         # one line, as any refusal: a block touching nothing was said twice (a warning, then the error in the
         # same words); a setting's warning is the reason ("no equilibrium" under a gravity pointing up)
-        raise LimitError(f"{exc} ({'; '.join(settings)})" if settings else str(exc)) from None
+        said = f"{exc} ({'; '.join(settings)})" if settings else str(exc)
+        if isinstance(exc, NoEquilibrium) and settling is None:  # a traced wall: stones a tracing's gap apart
+            said += "; stones drawn apart (a traced wall's gaps)? --settle 0.5 lets them come to rest first"
+        raise LimitError(said) from None
     for warning in (*scenario.warnings, *settings):
         err_console.print(Text.assemble(("warning:", "yellow"), f" {warning}"))
     if target is not None:

@@ -219,7 +219,7 @@ def _check_supported(model: Model, joints: Joints) -> None:
         index = int(loose[0])
         others = int(np.count_nonzero(group[:n] == group[index])) - 1
         label = body_label(index, model.block_name[index])
-        raise LimitError(
+        raise NoEquilibrium(  # a stone drawn a gap above the others: settling may close it (limit --settle)
             f"{label} touches nothing: it has no support, so no equilibrium exists"
             if others == 0
             else f"{label} and the {others} block{'s' * (others != 1)} it touches rest on no support, so no "
