@@ -148,6 +148,28 @@ def survey_notes(path, frame: Frame, survey: Survey, blocks: list, supports: lis
     return notes
 
 
+def ground_hint(assembly: Assembly) -> str:
+    """With no support, the block that looks like the ground or a foundation — the lowest, spanning at least
+    ``GROUND_SPAN`` of the blocks' width — named ("" if none): a QGIS layer's ``layer = "foundation"`` column is
+    not read, and the no-support warning left the user to find which feature to mark."""
+    blocks = assembly.blocks
+    if assembly.support_count or len(blocks) < 2:
+        return ""
+    bounds = np.array([b.polygon.bounds for b in blocks])
+    lowest = int(np.argmin(bounds[:, 1]))
+    width = bounds[:, 2].max() - bounds[:, 0].min()
+    if bounds[lowest, 2] - bounds[lowest, 0] < GROUND_SPAN * width:
+        return ""
+    return (
+        f"{body_label(lowest, blocks[lowest].name)} lies lowest and spans the structure: if it is the ground or a "
+        'foundation, give it "role": "support" (in QGIS, a text field role valued support)'
+    )
+
+
+GROUND_SPAN = 0.8
+"""The share of the blocks' width a block must span to be named as the likely ground."""
+
+
 def _far(frame: Frame) -> float:
     return float(np.hypot(*frame.shift))
 

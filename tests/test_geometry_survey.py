@@ -175,3 +175,16 @@ def test_wkt_is_read_the_same_way(tmp_path):
     stone = read_wkt(path, survey=Survey(), notes=notes).blocks[0]
     assert stone.polygon.bounds == pytest.approx((234.12, 210.55, 234.52, 210.75), abs=1e-8)
     assert "read moved by (-651000, -6861000) m" in notes[0]
+
+
+def test_an_unmarked_foundation_is_named(tmp_path):
+    # the foundation polygon of a QGIS layer, layer = "foundation" and no "role": 73 blocks and no support
+    notes = []
+    wall = read_geojson(wall_file(tmp_path, "w.geojson", mark_ground=False, **EXACT), notes=notes)
+    assert wall.support_count == 0 and wall.block_count == 73
+    assert any(
+        'block 73 ("block-73") lies lowest and spans the structure' in n and '"role": "support"' in n for n in notes
+    )
+    notes = []
+    read_geojson(wall_file(tmp_path, "m.geojson", **EXACT), notes=notes)  # marked: nothing to say
+    assert not any("lies lowest" in n for n in notes)
