@@ -65,17 +65,7 @@ from shapely.geometry import GeometryCollection, MultiPolygon, Polygon
 
 from .blocks import SUPPORT_ROLES, Assembly, Block, GeometryError, Support, name_problem, quoted_name
 from .checks import NotConvexError, body_label, polygon_from_coords
-from .survey import (
-    Frame,
-    Survey,
-    frame_of,
-    ground_hint,
-    hull_note,
-    hull_of,
-    survey_notes,
-    trim_overlaps,
-    units_hint,
-)
+from .survey import Frame, Survey, frame_of, hull_note, hull_of, survey_notes, trim_overlaps, units_hint
 from .values import check_positive, is_real
 
 _LABEL = re.compile(
@@ -306,8 +296,7 @@ def _surveyed(path, refused, blocks, supports, frame: Frame, survey: Survey, hul
     hint = units_hint(read, survey) if refused else ""
     _raise_refused(refused, frame.where() + (f"; {hint}" if hint else ""))
     assembly = Assembly(tuple(blocks), tuple(supports))
-    said = survey_notes(path, frame, survey, read, [s.polygon for s in supports])
-    said += [f"{path}: {hint}"] if (hint := ground_hint(assembly)) else []
+    said = survey_notes(path, frame, survey, assembly)
     if hulls:
         said.append(hull_note(path, hulls))
     if survey.trim_overlaps > 0.0 and assembly.block_count:

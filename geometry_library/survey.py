@@ -124,8 +124,11 @@ def frame_of(rings: list, survey: Survey) -> Frame:
     return dataclasses.replace(frame, shift=(float(shift[0]), float(shift[1])))
 
 
-def survey_notes(path, frame: Frame, survey: Survey, blocks: list, supports: list) -> list[str]:
-    """One-line notes on a surveyed file once read: the shift, and the likely units or y-axis slips."""
+def survey_notes(path, frame: Frame, survey: Survey, assembly: Assembly) -> list[str]:
+    """One-line notes on a surveyed file once read: the shift, the likely units or y-axis slips, the likely
+    ground of a file with no support."""
+    blocks = [b.polygon for b in assembly.blocks]
+    supports = [s.polygon for s in assembly.supports]
     notes = []
     if frame.shift != (0.0, 0.0):
         notes.append(
@@ -145,7 +148,8 @@ def survey_notes(path, frame: Frame, survey: Survey, blocks: list, supports: lis
                 f"{path}: {what} above half the blocks: is the y axis pointing down (image rows)? --flip-y reads "
                 "it pointing up"
             )
-    return notes
+    hint = ground_hint(assembly)
+    return notes + ([f"{path}: {hint}"] if hint else [])
 
 
 def ground_hint(assembly: Assembly) -> str:
