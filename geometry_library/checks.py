@@ -84,7 +84,7 @@ from shapely.strtree import STRtree
 from .blocks import SUPPORT_ROLES, Assembly, GeometryError, name_problem, quoted_name
 from .float32 import FLOAT32_RTOL, float32_hint, float32_resolution
 from .union_screen import union_screen
-from .values import check_material
+from .values import check_carried, check_material
 
 COLLINEAR_RTOL = 1e-9
 # Shape tolerance h = SHAPE_RTOL × width of the block (module docstring, Tolerances).
@@ -365,7 +365,7 @@ def validate_assembly(
 
     Errors (GeometryError, one line naming the body): not a polygon / holes / NaN / fewer than 3
     vertices / self-intersection / zero or absurd area / non-convex; non-positive density or
-    thickness; unknown support role; duplicate names; no blocks; a block overlapping another block
+    thickness; an absurd carried mass (:func:`~geometry_library.values.check_carried`); unknown support role; duplicate names; no blocks; a block overlapping another block
     or a support by more than ``OVERLAP_RTOL`` × the smaller one's area (module docstring, Tolerances),
     or by more than ``overlap_tolerance`` m² if given, or more than ``OVERLAP_MAX_DEPTH`` deep (either way).
 
@@ -392,6 +392,7 @@ def validate_assembly(
         label = body_label(i, block.name)
         polys.append(normalise_polygon(block.polygon, i, block.name))
         check_material(label, density=block.density, thickness=block.thickness)
+        check_carried(label, block, block.density * polys[-1].area * block.thickness, polys[-1].centroid.coords[0])
         labels.append(label)
     for j, support in enumerate(assembly.supports):
         label = body_label(j, support.name, "support")

@@ -330,3 +330,35 @@ def check_count(label: str, minimum: int = 1, **values) -> None:
     for key, value in values.items():
         if number_problem(value, integer=True, ge=minimum) is not None:
             raise GeometryError(f"{label}: {key} must be an integer ≥ {minimum}, got {value!r}", keys=(key,))
+
+
+MAX_CARRIED = 1e6
+"""The most mass a block may carry (``Block.carried_mass``), in times its own: a fill 20 m deep over a 0.2 m
+voussoir is 80 times. Beyond, a likely typo: a 1 m block carrying 1e300 kg ran and was reported "collapsed at
+t = 0.001 s", and ``limit`` said "no collapse: unbounded"."""
+
+
+def check_carried(label: str, block, own_mass: float, centroid) -> None:
+    """Raise a one-line GeometryError unless ``block``'s carried mass is at most :data:`MAX_CARRIED` times
+    ``own_mass`` (kg) and lumped within ``DIMENSION_RANGE[1]`` of its ``centroid`` (a fill column stands over
+    its block: ``carried_at`` at 1e9 m lumped a mass a million km away, tipping the block, without a word)."""
+    mass, at = block.carried_mass, block.carried_at
+    if number_problem(mass, ge=0.0) is not None or not mass <= MAX_CARRIED * own_mass:
+        raise GeometryError(
+            f"{label}: carried_mass {_g(mass)} kg is absurd (a likely typo: at most {MAX_CARRIED:g} times the "
+            f"block's own {own_mass:.4g} kg)",
+            keys=("carried_mass",),
+        )
+    if mass == 0.0:
+        return
+    if at is None:
+        raise GeometryError(
+            f"{label}: carried_mass {_g(mass)} kg without carried_at (where it rides)", keys=("carried_at",)
+        )
+    reach = math.hypot(float(at[0]) - float(centroid[0]), float(at[1]) - float(centroid[1]))
+    if not reach <= DIMENSION_RANGE[1]:
+        raise GeometryError(
+            f"{label}: carried_at ({_g(at[0])}, {_g(at[1])}) m is {reach:.3g} m from the block's centroid, absurd "
+            f"(a likely typo: a carried fill rides within {DIMENSION_RANGE[1]:g} m of its block)",
+            keys=("carried_at",),
+        )

@@ -147,3 +147,38 @@ def test_the_fill_survives_geojson_and_a_scenario_file(tmp_path):
     assert [(b.carried_mass, b.carried_at) for b in back.blocks] == want
     again = loads_scenario(dump_scenario(scenario))
     assert [(b.carried_mass, b.carried_at) for b in again.assembly.blocks] == want
+
+
+@pytest.mark.parametrize(
+    "carried, said",
+    [
+        ({"carried_mass": 1e300, "carried_at": [0.5, 1.5]}, "carried_mass 1e+300 kg is absurd"),
+        ({"carried_mass": 500.0, "carried_at": [1e9, 1.5]}, "is 1e+09 m from the block's centroid, absurd"),
+    ],
+)
+def test_an_absurd_carried_fill_in_a_file_is_refused_in_one_line(tmp_path, carried, said):
+    """A 1 m block carrying 1e300 kg ran and was 'collapsed at t = 0.001 s'; one carrying 500 kg a million km
+    away, 'no equilibrium' in limit: a typo in a GeoJSON's properties or a [[block]] table, refused naming it."""
+    import json
+
+    from cli_helpers import assert_one_line_error, invoke
+
+    square = [[0, 0], [1, 0], [1, 1], [0, 1], [0, 0]]
+    ground = [[-1, -1], [2, -1], [2, 0], [-1, 0], [-1, -1]]
+    features = [
+        {
+            "type": "Feature",
+            "properties": {"role": r, "name": n, **p},
+            "geometry": {"type": "Polygon", "coordinates": [c]},
+        }
+        for r, n, p, c in (("block", "b", carried, square), ("support", "g", {}, ground))
+    ]
+    path = tmp_path / "w.geojson"
+    path.write_text(json.dumps({"type": "FeatureCollection", "features": features}))
+    assert_one_line_error(invoke("check", path), 'block 1 ("b"): carried_', said)
+    toml = tmp_path / "w.toml"
+    toml.write_text(
+        f"[[block]]\nname = 'b'\npolygon = {square[:-1]}\ncarried_mass = {carried['carried_mass']!r}\n"
+        f"carried_at = {carried['carried_at']!r}\n[[support]]\nname = 'g'\npolygon = {ground[:-1]}\n"
+    )
+    assert_one_line_error(invoke("check", toml), said)
