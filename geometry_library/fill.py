@@ -62,34 +62,61 @@ def _trapezoid(a: float, b: float, ya: float, yb: float, level: float) -> tuple[
     return area, cx * area, cy * area
 
 
-def fill_over(blocks, level: float, x_lo: float, x_hi: float) -> Fill:
-    """The fill up to ``level`` (m) over the blocks' top surface between ``x_lo`` and ``x_hi`` (m), per block
-    (module docstring)."""
-    n = len(blocks)
+@dataclasses.dataclass(frozen=True, eq=False)
+class TopPiece:
+    """A piece [a, b] (m) of the blocks' top surface over which block ``block`` (index) is topmost, its top
+    the straight line y(x) = y_a + slope (x − a)."""
+
+    a: float
+    b: float
+    block: int
+    y_a: float
+    slope: float
+
+    def y(self, x: float) -> float:
+        return self.y_a + self.slope * (x - self.a)
+
+
+def top_surface(blocks, x_lo: float, x_hi: float) -> list[TopPiece]:
+    """The blocks' top surface between ``x_lo`` and ``x_hi`` (m), left to right (module docstring): one piece
+    per stretch on one straight top edge of one block (consecutive stretches of the same edge merged); none
+    where no block is."""
     p, q, owner = _edges(blocks)
     xs = np.unique(np.concatenate([p[:, 0], [x_lo, x_hi]]))
     xs = xs[(xs >= x_lo) & (xs <= x_hi)]
     lo, hi = np.minimum(p[:, 0], q[:, 0]), np.maximum(p[:, 0], q[:, 0])
-    sums = np.zeros((n, 3))
+    pieces: list[TopPiece] = []
+    edge_of: list[int] = []
     for a, b in zip(xs[:-1], xs[1:]):
-        if not b > a:
-            continue
         mid = 0.5 * (a + b)
         spans = np.flatnonzero((lo < mid) & (mid < hi))  # no vertex lies strictly inside (a, b)
         if spans.size == 0:
             continue
         t = (mid - p[spans, 0]) / (q[spans, 0] - p[spans, 0])
-        k = spans[int(np.argmax(p[spans, 1] + t * (q[spans, 1] - p[spans, 1])))]
-        slope = (q[k, 1] - p[k, 1]) / (q[k, 0] - p[k, 0])
-        line = lambda x, k=k, slope=slope: p[k, 1] + slope * (x - p[k, 0])  # noqa: E731
-        ya, yb = line(a), line(b)
+        k = int(spans[int(np.argmax(p[spans, 1] + t * (q[spans, 1] - p[spans, 1])))])
+        slope = float((q[k, 1] - p[k, 1]) / (q[k, 0] - p[k, 0]))
+        if pieces and edge_of[-1] == k and pieces[-1].b == a:  # the same straight edge goes on
+            pieces[-1] = dataclasses.replace(pieces[-1], b=float(b))
+            continue
+        pieces.append(TopPiece(float(a), float(b), int(owner[k]), float(p[k, 1] + slope * (a - p[k, 0])), slope))
+        edge_of.append(k)
+    return pieces
+
+
+def fill_over(blocks, level: float, x_lo: float, x_hi: float) -> Fill:
+    """The fill up to ``level`` (m) over the blocks' top surface between ``x_lo`` and ``x_hi`` (m), per block
+    (module docstring)."""
+    sums = np.zeros((len(blocks), 3))
+    for piece in top_surface(blocks, x_lo, x_hi):
+        a, b = piece.a, piece.b
+        ya, yb = piece.y(a), piece.y(b)
         if ya >= level and yb >= level:
             continue
         if ya > level or yb > level:  # the top crosses the level inside: keep the part below it
-            cross = p[k, 0] + (level - p[k, 1]) / slope
+            cross = a + (level - ya) / piece.slope
             a, b = (a, cross) if ya < level else (cross, b)
-            ya, yb = min(line(a), level), min(line(b), level)
-        sums[owner[k]] += _trapezoid(a, b, ya, yb, level)
+            ya, yb = min(piece.y(a), level), min(piece.y(b), level)
+        sums[piece.block] += _trapezoid(a, b, ya, yb, level)
     area = sums[:, 0]
     with np.errstate(invalid="ignore", divide="ignore"):
         centroid = np.where(area[:, None] > 0.0, sums[:, 1:] / area[:, None], np.nan)

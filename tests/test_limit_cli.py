@@ -359,7 +359,14 @@ def test_a_point_load_placed_by_abscissa_loads_the_voussoir_over_it_and_points_d
     extrados_x = -(radius + ring) * np.sin(alpha - 2 * alpha * np.arange(n + 1) / n)
     k = int(np.searchsorted(extrados_x, -span / 4)) - 1  # the voussoir whose extrados spans x = -2
     data = json.loads(invoke("limit", "arch", *shape, "--load", "point", "--at", "-2", "--json").stdout)
-    assert data["load"] == {"kind": "point", "direction": "-y", "block": f"v{k + 1:02d}", "at_m": -2.0}
+    assert data["load"] == {
+        "kind": "point",
+        "direction": "-y",
+        "block": f"v{k + 1:02d}",
+        "at_m": -2.0,
+        "force_N": None,
+        "worst": False,
+    }
     named = json.loads(invoke("limit", "arch", *shape, "--load", "point", "--block", f"v{k + 1:02d}", "--json").stdout)
     down = invoke("limit", "arch", *shape, "--load", "point", "--block", f"v{k + 1:02d}", "--direction", "-y", "--json")
     assert named["load_factor"] == json.loads(down.stdout)["load_factor"]  # --block: down, at its centroid

@@ -33,8 +33,10 @@ from masonrycli.cli.options import (
     DirectionOption,
     Friction,
     MinThicknessOption,
+    PointForceOption,
     SettleOption,
     ThrustOption,
+    WorstOption,
     choice_value,
     file_defaults,
     file_path_value,
@@ -291,6 +293,8 @@ def limit_command(
     ] = "horizontal",
     block: Annotated[str | None, typer.Option(help="Block carrying the point load (λ × its weight).")] = None,
     at: AtOption = None,
+    worst: WorstOption = False,
+    point_force: PointForceOption = None,
     direction: DirectionOption = None,
     friction: Friction = None,
     as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object on stdout, nothing else.")] = False,
@@ -333,6 +337,8 @@ def limit_command(
         thrust=thrust,
         min_thickness=min_thickness,
         settle=settle,
+        worst=worst,
+        point_force=point_force,
     )
 
 

@@ -224,6 +224,23 @@ AtOption = Annotated[
         help="Point load on the top block over x = X m instead of --block (a deck load at that abscissa).",
     ),
 ]
+WorstOption = Annotated[
+    bool,
+    typer.Option(
+        "--worst",
+        help="With --load point: try the load at every place on the structure's top (both ends of each "
+        "straight stretch, where λ is least) and report the worst.",
+    ),
+]
+PointForceOption = Annotated[
+    str | None,
+    typer.Option(
+        "--point-force",
+        metavar="F",
+        help="The point load's size with its unit, e.g. 100kN (N, kN, MN), for the blocks' out-of-plane "
+        "thickness: λ multiplies it (default: the loaded block's own weight).",
+    ),
+]
 MinThicknessOption = Annotated[
     bool,
     typer.Option(

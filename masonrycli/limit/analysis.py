@@ -53,6 +53,9 @@ class LimitResult:
     settled: object | None = None
     """The :class:`~masonrycli.limit.settle.Settling` of ``masonry limit --settle`` (the wall analysed where the
     engine let it come to rest), None without it."""
+    places: tuple | None = None
+    """The places a ``--worst`` point load was tried at (:class:`masonrycli.limit.worst.Place`), left to right;
+    None without ``--worst``."""
     support_thrust: tuple[tuple[str, str, float, float], ...] | None = None
     """(support, outward direction, least N, greatest N) of each support under the dead load alone
     (:func:`support_thrusts`; ±inf: no bound, null in JSON); None unless asked for (``masonry limit --thrust``)."""
@@ -115,7 +118,12 @@ class LimitResult:
                 "direction": self.load.direction,
                 "block": self.load.block,
                 "at_m": self.load.at,
+                "force_N": self.load.force,
+                "worst": self.load.worst,
             },
+            "places": None
+            if self.places is None
+            else [{"at_m": p.at, "block": p.block, "load_factor": p.load_factor} for p in self.places],
             "load_factor": self.load_factor,
             "tilt_angle_deg": self.tilt_angle(),
             "collapse_load_N": self.load_factor * self.reference_force,
@@ -264,12 +272,18 @@ def support_thrusts(model: Model, joints: Joints) -> tuple[tuple[str, str, float
 
 def analyse(scenario, load: LiveLoad, thrust: bool = False) -> LimitResult:
     """Limit analysis of ``scenario`` (its blocks, supports, material and gravity) under ``load``; a point
-    load given by its place (``load.at``) is put on :func:`block_over` that place; ``thrust``: with
+    load given by its place (``load.at``) is put on :func:`block_over` that place, a ``--worst`` one where its
+    λ is least (:mod:`masonrycli.limit.worst`); ``thrust``: with
     :func:`support_thrusts` too."""
+    places = None
+    if load.worst and not load.resolved:
+        from masonrycli.limit.worst import worst_load
+
+        load, places = worst_load(scenario, load)
     if load.kind == "point" and load.at is not None and not load.resolved:
         block, top = block_over(scenario.assembly.blocks, load.at)
         load = replace(load, block=block, resolved=True, top=top)
-    result = analyse_model(build_model(scenario), load, scenario.name)
+    result = replace(analyse_model(build_model(scenario), load, scenario.name), places=places)
     thicknesses = {b.thickness for b in scenario.assembly.blocks}
     if len(thicknesses) == 1:
         result = replace(result, thickness=thicknesses.pop())

@@ -23,7 +23,7 @@ from masonrycli import SOURCE_DIGEST, __version__
 from masonrycli.errors import EXIT_OUTPUT_FAILED, InputError
 from masonrycli.interrupt import StopRun, StopSignals, exit_code, signal_name
 from masonrycli.limit.analysis import LimitResult, analyse
-from masonrycli.limit.problem import DIRECTIONS, LimitError, LiveLoad, NoEquilibrium
+from masonrycli.limit.problem import DIRECTIONS, LimitError, LiveLoad, NoEquilibrium, parse_force
 from masonrycli.outputs.files import check_output, written_whole
 from masonrycli.source_digest import source_commit
 
@@ -93,6 +93,22 @@ def _depth(result: LimitResult) -> str:
     return "" if result.thickness is None else f", for blocks {result.thickness:g} m thick (out of plane)"
 
 
+def _worst_text(result: LimitResult) -> str:
+    """The --worst row: where, among how many places, and the next-worst places elsewhere."""
+    found = sorted((p for p in result.places if p.load_factor is not None), key=lambda p: p.load_factor)
+    skipped = len(result.places) - len(found)
+    said = f"x = {result.load.at:.4g} m on {result.load.block}, the least λ of {len(result.places)} places tried"
+    said += " (both ends of each straight stretch of the blocks' top: λ is least at one of them)"
+    others, seen = [], {round(result.load.at, 9)}
+    for p in found:  # the next-worst elsewhere: a joint's other side is the same place
+        if round(p.at, 9) not in seen and len(others) < 3:
+            others.append(p)
+            seen.add(round(p.at, 9))
+    if others:
+        said += "; next: " + ", ".join(f"λ = {p.load_factor:.4g} at x = {p.at:.4g} m on {p.block}" for p in others)
+    return said + (f"; {skipped} with no mechanism that follows the load" if skipped else "")
+
+
 def result_table(result: LimitResult, out: Path | None) -> Table:
     s = result.summary()
     table = Table(title=f"masonry limit — {result.scenario_name}", show_header=False, title_justify="left")
@@ -108,6 +124,8 @@ def result_table(result: LimitResult, out: Path | None) -> Table:
         table.add_row("settled", result.settled.describe())
     table.add_row("joints", f"{s['joints']} ({s['contact_points']} contact points, from the engine's detection)")
     table.add_row("live load", result.load.describe())
+    if result.places is not None:
+        table.add_row("worst place", _worst_text(result))
     lam = Text(f"{result.load_factor:.4f}", style="bold")  # Text: the consoles parse no markup
     reading = lambda_reading(result)
     if reading:
@@ -264,6 +282,8 @@ def run_limit(
     thrust: bool = False,
     min_thickness: bool = False,
     settle: float | None = None,
+    worst: bool = False,
+    point_force: str | None = None,
 ) -> None:
     """``masonry limit``: analyse, optionally record and verify, then print a table or one JSON object.
     ``settle``: s the wall is first let come to rest under its own weight (:mod:`masonrycli.limit.settle`).
@@ -278,7 +298,14 @@ def run_limit(
             with signals.setup_work():  # the analysis and --verify compile numba kernels on a first run
                 checks = _analyse(
                     structure,
-                    LiveLoad(load, direction, block, at),
+                    LiveLoad(
+                        load,
+                        direction,
+                        block,
+                        at,
+                        worst=worst,
+                        force=None if point_force is None else parse_force(point_force),
+                    ),
                     friction,
                     verify,
                     out,

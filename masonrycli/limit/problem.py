@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import difflib
 import math
+import re
 import time
 from dataclasses import dataclass
 
@@ -77,6 +78,12 @@ class LiveLoad:
     """True once ``block`` was found from ``at`` (the two then go together)."""
     top: float | None = None
     """m: the height of the loaded block's upper boundary over ``at`` (set with ``resolved``)."""
+    worst: bool = False
+    """A point load at the place of least λ over the structure's top (:mod:`masonrycli.limit.worst` finds it
+    and sets ``block``, ``at``, ``top`` and ``resolved``)."""
+    force: float | None = None
+    """N: a point load's size (``--point-force 100kN``: an axle, for the blocks' thickness); λ multiplies it.
+    None: the loaded block's own weight."""
 
     def __post_init__(self):
         if self.kind not in LOAD_KINDS:
@@ -90,21 +97,64 @@ class LiveLoad:
             )
         if self.at is not None and not math.isfinite(self.at):
             raise InputError(f"--at {self.at}: the abscissa must be a finite number of metres")
+        if self.worst and self.kind != "point":
+            raise InputError("--worst: the worst place of a point load (use --load point)")
+        if self.worst and not self.resolved and (self.block or self.at is not None):
+            given = f"--block {self.block}" if self.block else f"--at {self.at:g}"
+            raise InputError(f"--worst and {given}: --worst finds the place itself; give one")
         if self.kind == "point" and self.block and self.at is not None and not self.resolved:
             raise InputError(f"--block {self.block} and --at {self.at:g}: give the loaded block one way")
-        if self.kind == "point" and not self.block and self.at is None:
-            raise InputError("--load point: name the loaded block with --block NAME, or give its place with --at X (m)")
+        if self.kind == "point" and not self.block and self.at is None and not self.worst:
+            raise InputError(
+                "--load point: name the loaded block with --block NAME, give its place with --at X (m), or find the "
+                "worst place with --worst"
+            )
         if self.kind != "point" and self.block:
             raise InputError(f"--block {self.block}: only a point load acts on one block (use --load point)")
         if self.kind != "point" and self.at is not None:
             raise InputError(f"--at {self.at:g}: only a point load acts at one place (use --load point)")
+        if self.force is not None and self.kind != "point":
+            raise InputError(f"--point-force {self.force:g} N: only a point load has a size (use --load point)")
+        if self.force is not None and not (math.isfinite(self.force) and self.force > 0):
+            raise InputError(f"--point-force {self.force:g} N: must be a force > 0")
 
     def describe(self) -> str:
         if self.kind == "point":
             where = "" if self.at is None else f" (the top block over x = {self.at:g} m, loaded there)"
-            return f"point load on {self.block}{where}, {self.direction} (λ × its weight)"
+            where = f" at x = {self.at:g} m (the worst place on the top)" if self.worst else where
+            size = "its weight" if self.force is None else force_text(self.force)
+            what = "point load" if self.force is None else f"point load of {force_text(self.force)}"
+            return f"{what} on {self.block}{where}, {self.direction} (λ × {size})"
         what = "tilting table (tan ψ = λ)" if self.kind == "tilt" else "horizontal body force (λ × weight)"
         return f"{what}, {self.direction}"
+
+
+FORCE_UNITS = {"n": 1.0, "kn": 1e3, "mn": 1e6}
+_FORCE = re.compile(r"\s*([+-]?(?:\d+(?:\.\d*)?|\.\d+)(?:[eE][+-]?\d+)?)\s*([A-Za-zµ/·*^0-9]*)\s*")
+
+
+def parse_force(text: str) -> float:
+    """N of ``--point-force`` as typed: a number and its unit, N, kN or MN ("100kN", "100 kN", "2.5e5 N"). A
+    bare number is refused (100 what? an axle is quoted in kN, a block's weight in N), so is another unit."""
+    match = _FORCE.fullmatch(str(text))
+    if match is None:
+        raise InputError(f"--point-force {text}: expected a force with its unit, e.g. 100kN (N, kN or MN)")
+    number, unit = float(match.group(1)), match.group(2)
+    if not unit:
+        raise InputError(f"--point-force {text}: give its unit, e.g. {text}kN or {text}N (N, kN or MN)")
+    if unit.lower() not in FORCE_UNITS:
+        tonnes = {"kg": 1e-3, "t": 1.0}.get(unit.lower())
+        hint = f": a mass; {text} weighs {number * tonnes * 9.81:g} kN" if tonnes else ""
+        raise InputError(f"--point-force {text}: {unit} is not a unit of force (N, kN or MN){hint}")
+    return number * FORCE_UNITS[unit.lower()]
+
+
+def force_text(newtons: float) -> str:
+    """100 kN, 2.5 MN, 850 N: a force as an engineer writes it."""
+    for unit, size in (("MN", 1e6), ("kN", 1e3)):
+        if abs(newtons) >= size:
+            return f"{newtons / size:.4g} {unit}"
+    return f"{newtons:.4g} N"
 
 
 def load_vectors(model: Model, load: LiveLoad) -> tuple[np.ndarray, np.ndarray, float]:
@@ -131,7 +181,8 @@ def load_vectors(model: Model, load: LiveLoad) -> tuple[np.ndarray, np.ndarray, 
             raise InputError(f"--block {load.block}: no such block{hint}")
         i = names.index(load.block)
         own = mass[i] - model.block_carried_mass[i]  # the block's own weight: not the fill it carries
-        live[i, :2] = own * g * direction
+        size = own * g if load.force is None else load.force
+        live[i, :2] = size * direction
         if load.at is not None and load.top is not None:  # acting at (at, top): its moment about the centroid
             arm = np.array([load.at, load.top]) - model.body_q0[i, :2]
         elif model.block_carried_mass[i] > 0.0:  # at the block's own centroid: a carried fill moved the body's
@@ -140,7 +191,7 @@ def load_vectors(model: Model, load: LiveLoad) -> tuple[np.ndarray, np.ndarray, 
         else:
             arm = np.zeros(2)
         live[i, 2] = arm[0] * live[i, 1] - arm[1] * live[i, 0]
-        reference = float(own * g)
+        reference = float(size)
     else:
         live[:, :2] = (mass * g)[:, None] * direction[None, :]
         reference = float(mass.sum() * g)
