@@ -54,3 +54,25 @@ def test_default_arch_stands_at_095_and_collapses_at_105_lambda_like_the_lp():
     # The engine's hinges at collapse are hinges of the LP's mechanism.
     assert high.hinges and set(high.shared_hinges) == set(high.hinges)
     assert np.isfinite(high.max_displacement)
+
+
+def test_a_point_load_is_verified_as_a_weight_where_it_acts():
+    """--verify of an axle on the filled ring (rigid skewbacks, no sliding): the load becomes a mass f·λ·F/g the
+    loaded voussoir carries at (X, its extrados) under plain gravity; the engine stands at 0.95 λ and
+    collapses at 1.05 λ on the LP's hinges (λ itself checked against the four-hinge reference in
+    tests/test_limit_fill.py and test_limit_worst.py)."""
+    from test_limit_fill import filled_ring_scenario
+
+    sc = filled_ring_scenario(20)
+    result = analyse(sc, LiveLoad("point", at=-2.0, force=100e3))
+    weighted = tilted_scenario(sc, result, 1.05, duration=0.5)
+    assert tuple(weighted.run.gravity) == tuple(sc.run.gravity)
+    i = [b.name for b in sc.assembly.blocks].index(result.load.block)
+    before, after = sc.assembly.blocks[i], weighted.assembly.blocks[i]
+    added = 1.05 * result.load_factor * 100e3 / 9.81
+    assert after.carried_mass == pytest.approx(before.carried_mass + added, rel=1e-12)
+    moment = after.carried_mass * after.carried_at[0] - before.carried_mass * before.carried_at[0]
+    assert moment / added == pytest.approx(-2.0, abs=1e-9)  # the added mass sits on x = −2
+    low, high = verify(sc, result)
+    assert not low.collapsed and high.collapsed
+    assert low.tilt_deg is None and set(high.hinges) <= set(result.hinges) and len(high.shared_hinges) >= 3

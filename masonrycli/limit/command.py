@@ -158,7 +158,9 @@ def result_table(result: LimitResult, out: Path | None) -> Table:
 
 
 def verify_table(checks) -> Table:
-    table = Table(title="--verify: the NSCD engine under gravity tilted to atan(f·λ)", title_justify="left")
+    weight = bool(checks) and checks[0].tilt_deg is None  # a point load: a weight f·λ·F on its block
+    title = "the point load as a weight f·λ·F on its block" if weight else "gravity tilted to atan(f·λ)"
+    table = Table(title=f"--verify: the NSCD engine under {title}", title_justify="left")
     # Short header words, each column at least as wide as its longest word: at 80 columns rich cut
     # "max displacement" and "mechanism similarity" to "displacem…" and "similari…".
     for col in ("f", "tilt", "engine", "predicted", "largest move", "similarity", "hinges shared"):
@@ -166,7 +168,7 @@ def verify_table(checks) -> Table:
     for c in checks:
         table.add_row(
             f"{c.factor:g}",
-            f"{c.tilt_deg:.2f}°",
+            "weight" if c.tilt_deg is None else f"{c.tilt_deg:.2f}°",
             f"collapses at t = {c.time:.3f} s"
             if c.collapsed
             else f"stands for {c.time:.2f} s (end speed {c.max_speed * 1e3:.2g} mm/s)",
@@ -399,8 +401,10 @@ def _analyse(structure, live, friction, verify, out, force, done: _Done, signals
 
     target = None if out is None else check_output(out, "--out", ".rrd", force)
     scenario = resolve_structure(structure, friction, options["structure_options"])
-    if verify and live.kind == "point":
-        raise InputError("--verify: the engine has no point loads; verify a horizontal or tilt load")
+    if verify:  # before the analysis: a point load the engine cannot carry is refused at once
+        from masonrycli.limit.verify import check_verifiable
+
+        check_verifiable(live)
     settings = setting_warnings(scenario)  # not its records': it has no time
     settling = None
     if options["settle"] is not None:  # the engine first: a traced wall's gaps closed under its own weight

@@ -48,7 +48,8 @@ class DynamicCheck:
     """One engine run at f·λ."""
 
     factor: float
-    tilt_deg: float
+    tilt_deg: float | None
+    """Gravity's tilt, or None for a point load (a weight: gravity as it is)."""
     collapsed: bool
     time: float
     """s: when the collapse threshold was crossed, or the end of the run."""
@@ -74,14 +75,44 @@ class DynamicCheck:
         return dataclasses.asdict(self) | {"as_predicted": self.as_predicted}
 
 
-def tilted_scenario(scenario, result: LimitResult, factor: float, duration: float):
-    """``scenario`` with gravity tilted to atan(factor·λ) towards the live load, fixed supports, ``duration``."""
-    if result.load.kind == "point":
-        raise InputError("--verify: the engine has no point loads; verify a horizontal or tilt load")
+def check_verifiable(load) -> None:
+    """InputError for a live load the engine cannot be given: a point load other than down."""
+    if load.kind == "point" and load.direction != "-y":
+        raise InputError(
+            f"--verify: a point load is verified as a weight on its block, so down only (--direction -y), not "
+            f"{load.direction}; the engine's only force is gravity"
+        )
+
+
+def weighted_scenario(scenario, result: LimitResult, factor: float):
+    """``scenario`` with the point load at ``factor`` × its collapse value as a mass the loaded block carries
+    where the load acts (``Block.carried_mass``): a weight of f·λ·F, moving with the block."""
+    load = result.load
+    check_verifiable(load)
     g = float(np.hypot(*scenario.run.gravity))
-    side = 1.0 if result.load.direction == "+x" else -1.0
-    psi = math.atan(factor * result.load_factor)
-    gravity = (side * g * math.sin(psi), -g * math.cos(psi))
+    blocks = list(scenario.assembly.blocks)
+    i = [b.name for b in blocks].index(load.block)
+    block = blocks[i]
+    at = (load.at, load.top) if load.at is not None else tuple(block.polygon.centroid.coords[0])
+    mass = factor * result.load_factor * result.reference_force / g
+    before = block.carried_at if block.carried_mass > 0 else at
+    total = block.carried_mass + mass
+    centre = tuple((block.carried_mass * np.asarray(before) + mass * np.asarray(at)) / total)
+    blocks[i] = dataclasses.replace(block, carried_mass=total, carried_at=(float(centre[0]), float(centre[1])))
+    return dataclasses.replace(scenario, assembly=dataclasses.replace(scenario.assembly, blocks=tuple(blocks)))
+
+
+def tilted_scenario(scenario, result: LimitResult, factor: float, duration: float):
+    """``scenario`` with gravity tilted to atan(factor·λ) towards the live load (a point load: as a weight,
+    :func:`weighted_scenario`, gravity as it is), fixed supports, ``duration``."""
+    if result.load.kind == "point":
+        scenario = weighted_scenario(scenario, result, factor)
+        gravity = tuple(scenario.run.gravity)
+    else:
+        g = float(np.hypot(*scenario.run.gravity))
+        side = 1.0 if result.load.direction == "+x" else -1.0
+        psi = math.atan(factor * result.load_factor)
+        gravity = (side * g * math.sin(psi), -g * math.cos(psi))
     run = dataclasses.replace(
         scenario.run,
         gravity=gravity,
@@ -132,7 +163,7 @@ def run_check(scenario, result: LimitResult, factor: float, duration: float = DU
     lp_hinges = set(result.hinges)
     return DynamicCheck(
         factor=factor,
-        tilt_deg=math.degrees(math.atan(factor * result.load_factor)),
+        tilt_deg=None if result.load.kind == "point" else math.degrees(math.atan(factor * result.load_factor)),
         collapsed=collapsed,
         time=sim.state.time,
         max_displacement=largest,
