@@ -419,3 +419,23 @@ def test_the_recordings_panel_reads_lambda_as_the_table_does():
         in text
     )
     assert "N, for blocks 4 m thick (out of plane) (the resultant of the body forces" in text
+
+
+def test_the_settle_hint_is_not_given_where_settling_cannot_mend_it(tmp_path):
+    # a built-in's stones are laid exact and a setting's warning gives its own reason: the hint that a traced
+    # wall's stones may be drawn apart ('--settle 0.5') ended 'limit arch --friction 0' and a gravity pointing up
+    arch = invoke("limit", "arch", "--friction", "0")
+    assert_one_line_error(arch, "with friction 0 (the joints carry no shear)")
+    up = tmp_path / "up.toml"
+    up.write_text(
+        "[run]\ngravity = [0.0, 9.81]\n[[block]]\npolygon = [[0, 0], [1, 0], [1, 1], [0, 1]]\n"
+        '[[support]]\nname = "ground"\npolygon = [[-1, -1], [2, -1], [2, 0], [-1, 0]]\n'
+    )
+    for result in (arch, invoke("limit", up)):
+        assert "--settle" not in result.output, result.output
+    thin = tmp_path / "thin.toml"  # drawn by hand: the hint stays
+    thin.write_text(
+        '[material]\nfriction = 2.0\n[[block]]\nname = "leaning"\npolygon = [[0, 0], [1, 0], [1, 1], [0, 1]]\n'
+        '[[support]]\nname = "ground"\npolygon = [[-1, -1], [0.3, -1], [0.3, 0], [-1, 0]]\n'
+    )
+    assert_one_line_error(invoke("limit", thin), "no equilibrium", "--settle 0.5")

@@ -419,7 +419,10 @@ def _analyse(structure, live, friction, verify, out, force, done: _Done, signals
         # one line, as any refusal: a block touching nothing was said twice (a warning, then the error in the
         # same words); a setting's warning is the reason ("no equilibrium" under a gravity pointing up)
         said = f"{exc} ({'; '.join(settings)})" if settings else str(exc)
-        if isinstance(exc, NoEquilibrium) and settling is None:  # a traced wall: stones a tracing's gap apart
+        # a traced wall: stones a tracing's gap apart. Not a built-in's (its stones are laid exact: a thin ring, no
+        # friction), nor one a setting's warning explains: --settle would not mend them
+        drawn = "builder" not in scenario.structure and not settings
+        if isinstance(exc, NoEquilibrium) and settling is None and drawn:
             said += "; stones drawn apart (a traced wall's gaps)? --settle 0.5 lets them come to rest first"
         raise LimitError(said) from None
     for warning in (*scenario.warnings, *settings):
