@@ -158,8 +158,8 @@ def measure(case: str, duration: float) -> dict:
             calls[0] += 1
         return out
 
-    def scalar_first_stage(contact_body, pack, count, mu, tolerance, cap, v, r, status, stall, lanes=True):
-        # by interleaved.sweeps, which the lab copy follows
+    def scalar_first_stage(contact_body, pack, count, mu, tolerance, cap, v, r, status, stall, lanes=True, *growth):
+        # by interleaved.sweeps, which the lab copy follows (at momentum.RESTART_GROWTH: growth not passed)
         return first(contact_body, pack, count, mu, tolerance, cap, v, r, status, stall, False)
 
     interleaved.sweeps, dispatch.first_stage = counted, scalar_first_stage

@@ -42,3 +42,24 @@ def test_the_working_tree_against_itself_on_the_small_wall_is_bit_identical():
     assert row["calls"] == 10 and row["bit_identical"]
     assert row["base"]["contact_sweeps"] == row["new"]["contact_sweeps"] > 0
     assert row["new_over_base"] > 0.0
+
+
+def test_a_side_s_environment_is_parsed_and_set_last_and_a_bad_pair_refused(tmp_path, capsys):
+    assert bench_kernel.parse_env(["NUMBA_CPU_NAME=znver5", "X=a=b"]) == {"NUMBA_CPU_NAME": "znver5", "X": "a=b"}
+    assert bench_kernel.parse_env(None) == {}
+    env = bench_kernel.worker_env(str(tmp_path), tmp_path, {"NUMBA_CACHE_DIR": "/elsewhere"})
+    assert env["NUMBA_CACHE_DIR"] == "/elsewhere"  # the side's own value wins over the checkout's cache
+    with pytest.raises(SystemExit) as exit_:
+        bench_kernel.parse_env(["NUMBA_CPU_NAME"])
+    assert exit_.value.code == 2 and "expected KEY=VALUE" in capsys.readouterr().err
+
+
+@pytest.mark.slow
+def test_the_float32_stage_under_another_cpu_name_is_bit_identical():
+    # The same source compiled with another CPU's tuning (instruction scheduling only, the host's features):
+    # each side's workers got their own environment, and the float32 stage's outputs are the same bits.
+    row = bench_kernel.compare(bench_kernel.WORKTREE, bench_kernel.WORKTREE, "wall-51", 0.01, 1, 1, "float32",
+                               {"new": {"NUMBA_CPU_NAME": "x86-64-v3"}})  # fmt: skip
+    assert row["stage"] == "float32" and row["calls"] == 10 and row["bit_identical"]
+    assert row["new"]["env"] == {"NUMBA_CPU_NAME": "x86-64-v3"} and row["base"]["env"] == {}
+    assert row["base"]["contact_sweeps"] == row["new"]["contact_sweeps"] > 0

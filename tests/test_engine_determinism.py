@@ -49,7 +49,7 @@ def test_a_step_gives_the_same_bits_fused_or_through_the_launchers(monkeypatch):
     for _ in range(fast.model.n_steps):
         s = fast.solver
         support_v_next = fast.model.support_velocity[fast.state.step + 1]
-        begun = before_solve(s.model, s.buffers, s._warm, fast.state, support_v_next, s.body_q_m, s._v_old, s._r)
+        begun = before_solve(s.model, s.buffers, s._warm, fast.state, support_v_next, s.body_q_m, s.body_v_n, s._r)
         fused_calls += begun is not None
         fast.state.body_v[:] = slow.state.body_v  # undo its v_free: step() begins the step again
         fast.step()

@@ -411,7 +411,8 @@ def test_the_first_stage_waits_near_the_tolerance_by_the_structures_depth(monkey
     first = lane_sweeps32.first_stage
 
     def spy(*args):
-        seen.append(args[-1])
+        seen.append(args[10])  # stall_near (args[11]: Tuning.lane_growth)
+        assert args[11] == TUNING.lane_growth
         return first(*args)
 
     monkeypatch.setattr(lane_sweeps32, "first_stage", spy)

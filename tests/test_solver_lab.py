@@ -5,7 +5,6 @@ by the engine's NLGS must satisfy the lab's contact law and reproduce v = v_free
 """
 
 import numpy as np
-import pytest
 
 from benchmarks.solver_lab import law
 from benchmarks.solver_lab.capture import SINE, capture_run, reference
@@ -18,10 +17,14 @@ from masonrycli.run import Simulation
 from masonrycli.scenario.scenario import Material, RunConfig, scenario_from_builder
 
 
-def _captured(tmp_path):
-    sc = scenario_from_builder(
+def _tiny_wall():
+    return scenario_from_builder(
         "wall", {"blocks": 7, "courses": 2}, RunConfig(duration=0.03, solver="nlgs-accel"), Material(), {"ground": SINE}
     )
+
+
+def _captured(tmp_path):
+    sc = _tiny_wall()
     # Step 15: on this run (default solver nlgs-accel) steps 18-28 each have a contact sitting exactly on
     # its friction limit, where the reference's Gauss–Seidel settles into a stick/slip cycle at 2-3e-9 m/s,
     # above REF_RESIDUAL; step 15 has none (its reference converges in 500 sweeps).
@@ -44,6 +47,20 @@ def test_reference_satisfies_the_lab_law_and_momentum(tmp_path):
     # the warm start alone is not a solution: the residual measures something
     v_warm = law.velocity_from_impulse(p, ctx.H, p.r_warm)
     assert ctx.residual(v_warm, p.r_warm) > 1e3 * REF_RESIDUAL
+
+
+def test_a_captured_v_n_is_the_velocity_its_step_began_with_as_the_solver_s_public_array(tmp_path):
+    # capture reads Solver.body_v_n (public) in the hooked solve; the reference: the state's velocities
+    # before that step, from a second run of the same scenario stepped to it
+    p = _captured(tmp_path)
+    sim = Simulation(_tiny_wall())
+    for _ in range(p.step - 1):
+        sim.step()
+    before = sim.state.body_v.copy()
+    np.testing.assert_array_equal(p.v_n, before)
+    sim.step()
+    np.testing.assert_array_equal(sim.solver.body_v_n, before)
+    assert not np.array_equal(sim.state.body_v, before)  # the step moved the blocks: the array is v_n, not v
 
 
 def test_local_solve_open_stick_slide():
@@ -177,19 +194,20 @@ def test_accelerated_method_takes_the_engine_default_and_stops_on_the_law(tmp_pa
     np.testing.assert_array_equal(r, out.r)
 
 
-@pytest.mark.slow
-def test_accelerated_variants_differ_only_by_restart_growth(tmp_path):
-    # A variant's worker compiles the engine afresh with another RESTART_GROWTH (numba freezes globals):
-    # at the engine's own growth it reproduces the in-process solve bit for bit; at a growth that restarts
-    # less often it does not (the change really reached the compiled kernel).
+def test_accelerated_variants_differ_only_by_restart_growth():
+    # A variant hands dispatch.solve a Tuning with another lane_growth (a kernel argument, in this process):
+    # at the engine's own growth it reproduces the shipped solve bit for bit; at a growth that restarts
+    # less often it does not (the value really reached the compiled kernel).
     from benchmarks.solver_lab.methods import accelerated
     from masonrycli.engine import momentum
+    from masonrycli.engine.tuning import TUNING
     from tests.solver_lab_helpers import tiny_cold_problem
 
     ctx = Context(tiny_cold_problem())
     ctx.accel_cost = 1.0
+    assert TUNING.lane_growth == momentum.RESTART_GROWTH == 1.1
     base = accelerated.accelerated(ctx, 1e-7)
-    same = accelerated.variant(momentum.RESTART_GROWTH)(ctx, 1e-7)
+    same = accelerated.variant(TUNING.lane_growth)(ctx, 1e-7)
     assert same.iterations == base.iterations
     np.testing.assert_array_equal(same.r, base.r)
     other = accelerated.variant(2.0)(ctx, 1e-7)

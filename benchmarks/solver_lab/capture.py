@@ -120,7 +120,7 @@ def capture_run(sim: Simulation, typical_step: int) -> tuple[dict[str, Problem],
             inv_inertia=m.body_inv_inertia.copy(),
             radius=m.body_radius.copy(),
             v_free=v.copy(),
-            v_n=solver._v_old.copy(),  # v_n: the solver keeps it for the θ-update
+            v_n=solver.body_v_n.copy(),  # v_n: the velocities the step began with (θ-update)
             r_warm=r[:count].copy(),
             r_prev2=r_prev2,
             has_prev2=has2,

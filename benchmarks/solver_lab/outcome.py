@@ -9,6 +9,7 @@ import numpy as np
 
 from benchmarks.solver_lab import law
 from masonrycli.engine import dispatch
+from masonrycli.engine.tuning import TUNING
 
 
 @dataclass
@@ -64,13 +65,13 @@ class Context:
         self.accel_cost = np.nan
         """CPU time of one accelerated sweep (solver "nlgs-accel") over one plain sweep (measured by the harness)."""
 
-    def sweep(self, r: np.ndarray, n: int, solver: str = "nlgs") -> tuple[np.ndarray, np.ndarray]:
-        """``n`` engine NLGS sweeps (``solver``: plain or "nlgs-accel") from impulses ``r`` (updated in place);
-        returns (v, status)."""
+    def sweep(self, r: np.ndarray, n: int, solver: str = "nlgs", tuning=TUNING) -> tuple[np.ndarray, np.ndarray]:
+        """``n`` engine NLGS sweeps (``solver``: plain or "nlgs-accel"; ``tuning``: the engine's Tuning, the
+        shipped one by default) from impulses ``r`` (updated in place); returns (v, status)."""
         p = self.p
         v = p.v_free.copy()
         status = np.zeros(p.count, dtype=np.int8)
-        dispatch.solve(p.body, self.pack, p.count, p.shim(0.0, n, solver=solver), v, r, status)
+        dispatch.solve(p.body, self.pack, p.count, p.shim(0.0, n, solver=solver), v, r, status, tuning)
         return v, status
 
     def residual(self, v: np.ndarray, r: np.ndarray) -> float:

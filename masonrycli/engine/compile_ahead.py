@@ -40,7 +40,7 @@ EVERY_RUN: tuple[tuple[str, str], ...] = (
     #  that a run calls each with exactly this signature (tests/test_engine_compile_ahead.py).
     (
         "lane_sweeps._lane_sweeps",
-        "(i4[:, ::1], f8[:, ::1], i8, f8, f8, i8, f8[:, ::1], f8[:, ::1], i1[::1], i8, f8, i8,)",
+        "(i4[:, ::1], f8[:, ::1], i8, f8, f8, i8, f8[:, ::1], f8[:, ::1], i1[::1], i8, f8, i8, f8,)",
     ),
     (
         "power._contact_power",

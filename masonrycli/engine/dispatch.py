@@ -54,8 +54,9 @@ def solve(contact_body, pack, count, model, v, r, status, tuning=TUNING) -> tupl
     if not accelerated or tolerance <= 0.0:
         if accelerated:  # tolerance 0: the first stage's sweeps, exactly the cap (no stall rule at tolerance 0)
             iterations, residual = first_stage(
-                contact_body, pack, count, mu, tolerance, cap, v, r, status, tuning.first_stall, tuning.lanes
-            )
+                contact_body, pack, count, mu, tolerance, cap, v, r, status, tuning.first_stall, tuning.lanes,
+                tuning.lane_growth,
+            )  # fmt: skip
         else:
             iterations, residual = interleaved.sweeps(
                 contact_body, pack, count, mu, tolerance, cap, v, r, status, interleaved.PLAIN
@@ -67,12 +68,13 @@ def solve(contact_body, pack, count, model, v, r, status, tuning=TUNING) -> tupl
     if model.solver == "nlgs-accel32" and tuning.lanes:  # the one place float32 is chosen
         iterations, residual = lane_sweeps32.first_stage(
             contact_body, pack, count, mu, tolerance, cap, v, r, status, tuning.first_stall,
-            momentum.stall_near(model, tuning),
+            momentum.stall_near(model, tuning), tuning.lane_growth,
         )  # fmt: skip
     else:
         iterations, residual = first_stage(
-            contact_body, pack, count, mu, tolerance, cap, v, r, status, tuning.first_stall, tuning.lanes
-        )
+            contact_body, pack, count, mu, tolerance, cap, v, r, status, tuning.first_stall, tuning.lanes,
+            tuning.lane_growth,
+        )  # fmt: skip
     if residual <= tolerance or iterations >= cap:
         return iterations, residual
     return stalled.continue_stalled(
@@ -80,14 +82,20 @@ def solve(contact_body, pack, count, model, v, r, status, tuning=TUNING) -> tupl
     )
 
 
-def first_stage(contact_body, pack, count, mu, tolerance, max_iterations, v, r, status, stall, lanes=True):
+def first_stage(
+    contact_body, pack, count, mu, tolerance, max_iterations, v, r, status, stall, lanes=True,
+    growth=TUNING.lane_growth,
+):  # fmt: skip
     """The float64 first stage of an accelerated solve: momentum from the warm start (``v`` enters as v_free)
     until ``tolerance``, ``max_iterations`` or ``stall`` sweeps without a new lowest residual; by the lane
-    sweeps (lane_sweeps._lane_sweeps) or, ``lanes`` False (the lab's Tuning.lanes), by the 4-run scalar
-    momentum sweep (interleaved.sweeps). The benchmarks that capture the first stage hook this function
-    (bench_kernel, bench_idle). Returns (iterations, residual)."""
-    if lanes:
-        return lane_sweeps._lane_sweeps(contact_body, pack, count, mu, tolerance, max_iterations, v, r, status, stall)
+    sweeps (lane_sweeps._lane_sweeps, restarting at ``growth``: Tuning.lane_growth) or, ``lanes`` False (the
+    lab's Tuning.lanes), by the 4-run scalar momentum sweep (interleaved.sweeps, momentum.RESTART_GROWTH). The
+    benchmarks that capture the first stage hook this function (bench_kernel, bench_idle). Returns
+    (iterations, residual)."""
+    if lanes:  # no near-tolerance window here (near_level 0: the same stops as with it omitted)
+        return lane_sweeps._lane_sweeps(
+            contact_body, pack, count, mu, tolerance, max_iterations, v, r, status, stall, 0.0, 0, growth
+        )
     return interleaved.sweeps(
         contact_body, pack, count, mu, tolerance, max_iterations, v, r, status, interleaved.MOMENTUM, stall
     )

@@ -197,14 +197,27 @@ def _group(j, act, Q, IA, IB, v4, beta, mu, full):
 
 @njit
 def _lane_sweeps(
-    contact_body, pack, count, mu, tolerance, max_iterations, v, r, status, stall_after, near_level=0.0, stall_near=0
+    contact_body,
+    pack,
+    count,
+    mu,
+    tolerance,
+    max_iterations,
+    v,
+    r,
+    status,
+    stall_after,
+    near_level=0.0,
+    stall_near=0,
+    growth=momentum.RESTART_GROWTH,
 ):
     # v: v_free in, v_n+1 out; r: warm start in, impulses out (as momentum._momentum_sweeps, flip omitted).
     #   Q, IA, IB, groups, v4 ← lanes.pack_lanes (v ← v_free + M⁻¹ H r_warm on the way)
     #   repeat: _extrapolate(v4); for each group: _group on each of its sub-groups (one unless it clashes)
     #           residual = sqrt(Σ|e_α|² / C); stop at the tolerance, the cap or the stall window
     #           (stall_after sweeps without a new low; stall_near once the low is ≤ near_level m/s);
-    #           restart (j = 1) when the residual grew by more than RESTART_GROWTH; β = (j − 1)/(j + 2)
+    #           restart (j = 1) when the residual grew by more than ``growth`` (Tuning.lane_growth; the
+    #           shipped one by default); β = (j − 1)/(j + 2)
     #   v, r, status ← lanes.unpack_lanes
     # Returns (iterations, residual).
     if count == 0:
@@ -244,7 +257,7 @@ def _lane_sweeps(
             best_at = it
         elif tolerance > 0.0 and it - best_at >= (stall_near if best <= near_level else stall_after):
             break
-        if residual > momentum.RESTART_GROWTH * last:
+        if residual > growth * last:
             j_restart = 1
         last = residual
         beta = (j_restart - 1.0) / (j_restart + 2.0)

@@ -63,7 +63,9 @@ from masonrycli.engine.nlgs import (
 
 V = _vector32
 LANES32 = 16
-"""Lanes: contacts of a float32 group (``_vector32.WIDTH``)."""
+"""Lanes: contacts of a float32 group (``_vector32.WIDTH``). 16 on every CPU: on Zen 4, which runs a zmm
+operation as two 256-bit halves, 8 lanes cost 1.04× per contact·sweep (another order: other bits), 4 lanes
+1.64×, the 16 split into ymm halves 1.008× (benchmarks/JOURNAL.md, "Issue 10's aim on a Zen 4 CPU")."""
 R_XT, R_XN, R_PT, R_PN, R_ST = PACK_WIDTH, PACK_WIDTH + 1, PACK_WIDTH + 2, PACK_WIDTH + 3, PACK_WIDTH + 4
 ROWS = PACK_WIDTH + 5
 FULL = (1 << LANES32) - 1
@@ -341,10 +343,22 @@ def _extrapolate32(x, x_prev, beta):
 
 @njit
 def lane_sweeps32(
-    contact_body, pack, count, mu, tolerance, max_iterations, v, r, status, stall_after, stagger, resync=0
+    contact_body,
+    pack,
+    count,
+    mu,
+    tolerance,
+    max_iterations,
+    v,
+    r,
+    status,
+    stall_after,
+    stagger,
+    resync=0,
+    growth=momentum.RESTART_GROWTH,
 ):
     # The float32 stage (module doc). v: v_free, read only; r: warm start in, float64 of the float32
-    # impulses out; status out. Returns (iterations, residual).
+    # impulses out; status out; growth: the restart's factor (Tuning.lane_growth). Returns (iterations, residual).
     if count == 0:
         return 0, 0.0
     if stagger < 0:
@@ -386,7 +400,7 @@ def lane_sweeps32(
             best_at = it
         elif tolerance > 0.0 and it - best_at >= stall_after:
             break
-        if residual > momentum.RESTART_GROWTH * last:
+        if residual > growth * last:
             j_restart = 1
         last = residual
         beta = (j_restart - 1.0) / (j_restart + 2.0)
@@ -402,19 +416,32 @@ def lane_sweeps32(
     return iterations, residual
 
 
-def first_stage(contact_body, pack, count, mu, tolerance, max_iterations, v, r, status, stall_after, stall_near=0):
+def first_stage(
+    contact_body,
+    pack,
+    count,
+    mu,
+    tolerance,
+    max_iterations,
+    v,
+    r,
+    status,
+    stall_after,
+    stall_near=0,
+    growth=momentum.RESTART_GROWTH,
+):
     """The accelerated solve's first stage with a float32 start (module doc): :func:`lane_sweeps32` to
     ``tolerance`` (its own float32 test), then lane_sweeps._lane_sweeps from its impulses in float64 (v
     re-derived from v_free, at least one sweep: the step ends on a float64 sweep and test), whose stall
-    window is ``stall_near`` once within momentum.NEAR × the tolerance (momentum.py, "Near the tolerance").
-    Returns (iterations, residual): the sweeps of both, the float64 sweep's residual."""
+    window is ``stall_near`` once within momentum.NEAR × the tolerance (momentum.py, "Near the tolerance");
+    both restart at ``growth`` (Tuning.lane_growth). Returns (iterations, residual): the sweeps of both, the float64 sweep's residual."""
     # max_iterations − 1: the float64 sweep the step ends on stays within the run's cap
     its32, _ = lane_sweeps32(
         contact_body, pack, count, mu, tolerance, max(max_iterations - 1, 0), v, r, status,
-        min(stall_after, STALL32), -1, RESYNC,
+        min(stall_after, STALL32), -1, RESYNC, growth,
     )  # fmt: skip
     its, residual = lane_sweeps._lane_sweeps(
         contact_body, pack, count, mu, tolerance, max(max_iterations - its32, 1), v, r, status, stall_after,
-        momentum.NEAR * tolerance, max(stall_near, stall_after),
+        momentum.NEAR * tolerance, max(stall_near, stall_after), growth,
     )  # fmt: skip
     return its32 + its, residual

@@ -49,9 +49,10 @@ from masonrycli.engine._jit import kernel_only, njit
 from masonrycli.engine.nlgs import P_WNN, P_WTN, P_WTT, _local_solve, _push, _relative_velocity
 from masonrycli.engine.tuning import TUNING
 
-RESTART_GROWTH = 1.1
+RESTART_GROWTH = TUNING.lane_growth
 """The accelerated sweep drops its momentum when a sweep's residual exceeds the previous one by this factor
-(1.3 or more diverges on the 248-block wall; 1.05–1.2 all converge)."""
+(1.3 or more diverges on the 248-block wall; 1.05–1.2 all converge): the shipped Tuning.lane_growth, compiled
+into this module's sweep and the body-order stage's (the lane sweeps take Tuning.lane_growth as an argument)."""
 NEAR = 3.0
 """× the tolerance: a first stage whose lowest residual is this close waits stall_near(model) sweeps without a new
 low instead of Tuning.first_stall before it hands the step over (module doc, "Near the tolerance")."""

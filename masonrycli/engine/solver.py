@@ -92,8 +92,10 @@ class Solver:
         self.buffers = ContactBuffers(model.body_vert_start)
         self.body_q_m = np.empty((b, 3))
         """(B, 3) configuration at which the last step detected its contacts."""
-        self._v_old = np.empty((b, 3))
-        """(B, 3) m/s, rad/s: v_n, the velocities the step began with (θ-method update, contact power)."""
+        self.body_v_n = np.empty((b, 3))
+        """(B, 3) m/s, rad/s: v_n, the velocities the last step began with (θ-method update, contact power);
+        written at the start of a step, so during the contact solve it holds that step's v_n (the solver
+        lab's capture reads it there)."""
         self._warm = warmstart.WarmStart(self.buffers.contact_capacity)
         self._count = 0
         """C: contacts of the last step (rows [:C] of the contact arrays are valid)."""
@@ -190,13 +192,13 @@ class Solver:
         support_v_next = m.support_velocity[k + 1]
         bf = self.buffers
         begun = fused.before_solve(  # steps 1–4 in one call
-            m, bf, self._warm, state, support_v_next, self.body_q_m, self._v_old, self._r
+            m, bf, self._warm, state, support_v_next, self.body_q_m, self.body_v_n, self._r
         )
         if begun is None:  # first detection, capacities exceeded, a pose not finite: one by one
-            top_speed = integrate.begin_step(m, state.body_q, state.body_v, self.body_q_m, self._v_old)
+            top_speed = integrate.begin_step(m, state.body_q, state.body_v, self.body_q_m, self.body_v_n)
             count = self.detect(self.body_q_m, self.detection_distance(top_speed))
             warm = self._warm.start(bf.contact_key, count, self._r)
-            integrate.free_velocity(m, self._v_old, support_v_next, state.body_v)
+            integrate.free_velocity(m, self.body_v_n, support_v_next, state.body_v)
         else:
             count, warm, _ = begun
             self._count = count
@@ -220,10 +222,10 @@ class Solver:
             more, residual = self._settle(state, count, residual, budget)
             iterations += more
         dissipated, work = power.contact_power(
-            body, self._pack, self._r, count, self._v_old, state.body_v, m, self._force, self.support_force
+            body, self._pack, self._r, count, self.body_v_n, state.body_v, m, self._force, self.support_force
         )
         block_speed, penetration = fused.after_solve(  # steps 8–9
-            self.model, bf, self._warm, state, count, self._v_old, self._r
+            self.model, bf, self._warm, state, count, self.body_v_n, self._r
         )
         self._top_speed = block_speed
         state.step = k + 1
@@ -250,10 +252,10 @@ class Solver:
         n = m.block_count
         top = self._top_speed
         if top is None:  # first step: the initial velocities
-            top = float(np.hypot(self._v_old[:n, 0], self._v_old[:n, 1]).max()) if n else 0.0
+            top = float(np.hypot(self.body_v_n[:n, 0], self.body_v_n[:n, 1]).max()) if n else 0.0
         if not top < REST_SPEED:
             return False
-        return not (np.any(support_v_next) or np.any(self._v_old[n:]))
+        return not (np.any(support_v_next) or np.any(self.body_v_n[n:]))
 
     def _settle(self, state, count: int, residual: float, budget: int) -> tuple[int, float]:
         """Solve a step at rest on from its solution (r, status of the ordinary solve; v from v_free) to

@@ -27,6 +27,14 @@ class Tuning:
     nlgs.INTERLEAVE runs (interleaved._accelerated), the default until the lane sweeps replaced it
     (benchmarks/JOURNAL.md, explicit vectors addendum)."""
 
+    lane_growth: float = 1.1
+    """Adaptive restart of the lane sweeps (the first stage with ``lanes``, float32 and float64): a sweep whose
+    residual exceeds the last one's by more than this factor drops the momentum (β = 0; momentum module doc).
+    The scalar momentum sweeps and the body-order stage compile in momentum.RESTART_GROWTH, this default
+    (1.3 or more diverged on the 248-block wall, 1.05–1.2 all converged: "nlgs-accel: Gauss–Seidel with
+    Nesterov momentum"). A kernel argument, so the lab tries other values in process ("Issue 10's aim on a
+    Zen 4 CPU")."""
+
     first_stall: int = 200
     """Accelerated sweeps without a new lowest residual after which the first stage hands the step to
     stalled.py (momentum module doc, "Stall window"): 200 rather than 500, mean sweep units a step 0.614× on the
