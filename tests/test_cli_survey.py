@@ -121,3 +121,23 @@ def test_limit_settle_refuses_a_wall_that_does_not_stand_as_drawn(tmp_path):
     assert_one_line_error(result, "the wall does not stand as drawn", "B moved more than")
     assert not (tmp_path / "m.rrd").exists()
     assert_one_line_error(invoke("limit", path, "--settle", "20"), "--settle 20: must be in (0, 10] s")
+
+
+@pytest.mark.slow
+def test_a_carried_fill_settles_with_its_block(tmp_path):
+    # --settle moved each block's polygon and left a carried fill's point where it was drawn: the 0.4 × 0.8 block
+    # drawn 2 mm above its ground, carrying its own mass lumped 0.1 m above its top, comes down 2 mm with it
+    from geometry_library.io import read_geojson
+    from masonrycli.limit.settle import settle
+    from masonrycli.scenario.builtin import target_scenario
+
+    path = block_above_ground(tmp_path, 0.002)
+    data = json.loads(path.read_text())
+    data["features"][0]["properties"].update(carried_mass=800.0, carried_at=[0.2, 0.902])
+    path.write_text(json.dumps(data))
+    assert read_geojson(path).blocks[0].carried_at == (0.2, 0.902)
+    settled, how = settle(target_scenario(path), 0.2)
+    block = settled.assembly.blocks[0]
+    drop = 0.002 - block.polygon.bounds[1]  # how far the polygon came down (to its contact with the ground)
+    assert drop == pytest.approx(0.002, abs=2e-4) and how.largest_move == pytest.approx(0.002, rel=0.05)
+    assert block.carried_at == pytest.approx((0.2, 0.902 - drop), abs=1e-6)

@@ -103,9 +103,14 @@ def settle(scenario, duration: float):
         turn = q[i, 2] - q0[i, 2]
         c, s = math.cos(turn), math.sin(turn)
         # vert_local is the body frame at q0 (θ0 = the initial angle): turn it by θ − θ0 and place it at q
-        xy = local @ np.array([[c, s], [-s, c]]) + q[i, :2]
+        turned = np.array([[c, s], [-s, c]])
+        xy = local @ turned + q[i, :2]
         polygon = normalised_polygon(xy, f'block {i + 1} ("{block.name}")')
-        moved_blocks.append(dataclasses.replace(block, polygon=polygon))
+        moved = {"polygon": polygon}
+        if block.carried_at is not None:  # a carried fill rides with its block: it moves as the polygon does
+            at = (np.asarray(block.carried_at, dtype=np.float64) - q0[i, :2]) @ turned + q[i, :2]
+            moved["carried_at"] = (float(at[0]), float(at[1]))
+        moved_blocks.append(dataclasses.replace(block, **moved))
     assembly = dataclasses.replace(scenario.assembly, blocks=tuple(moved_blocks))
     # "touches nothing … it will fall freely" was of the wall as drawn: settled, it rests (or was refused above)
     warnings = tuple(w for w in scenario.warnings if " touches nothing " not in w)
