@@ -3,6 +3,7 @@ slightly non-convex stones and tracing slips (--convex-hull, --trim-overlaps, --
 
 import json
 
+import numpy as np
 import pytest
 import surveyed_wall
 
@@ -128,7 +129,7 @@ def test_a_carried_fill_settles_with_its_block(tmp_path):
     # --settle moved each block's polygon and left a carried fill's point where it was drawn: the 0.4 × 0.8 block
     # drawn 2 mm above its ground, carrying its own mass lumped 0.1 m above its top, comes down 2 mm with it
     from geometry_library.io import read_geojson
-    from masonrycli.limit.settle import settle
+    from masonrycli.settle import settle
     from masonrycli.scenario.builtin import target_scenario
 
     path = block_above_ground(tmp_path, 0.002)
@@ -141,3 +142,35 @@ def test_a_carried_fill_settles_with_its_block(tmp_path):
     drop = 0.002 - block.polygon.bounds[1]  # how far the polygon came down (to its contact with the ground)
     assert drop == pytest.approx(0.002, abs=2e-4) and how.largest_move == pytest.approx(0.002, rel=0.05)
     assert block.carried_at == pytest.approx((0.2, 0.902 - drop), abs=1e-6)
+
+
+def test_a_settled_traced_wall_at_rest_is_intact(traced, tmp_path):
+    # settled, the stones rest on one end of many joints, the other end drawn up to 1 mm open: nothing moves
+    # at rest (largest block displacement under 1e-3 mm), so no joint has hinged — it said "damaged, 37 hinges"
+    history = tmp_path / "h.npz"
+    result = invoke(
+        "run", traced, "--convex-hull", "--trim-overlaps", "0.003", "--settle", "0.5",
+        "--duration", "0.2", "--no-recording", "--history", history,
+    )  # fmt: skip
+    assert result.exit_code == 0, result.output
+    assert "settled 0.5 s under its own weight (--settle)" in words(result.output)
+    assert "intact" in result.output and "damaged" not in result.output
+    saved = np.load(history)
+    assert np.abs(saved["block_q"][-1, :, :2] - saved["block_q"][0, :, :2]).max() < 1e-6
+    assert saved["hinge_count"].max() == 0
+
+
+def test_check_takes_run_s_settle_and_checks_its_value(traced):
+    assert_one_line_error(invoke("check", traced, "--settle", "20"), "--settle 20: must be in (0, 10] s")
+    result = invoke("check", traced, "--convex-hull", "--trim-overlaps", "0.003", "--settle", "0.5")
+    assert result.exit_code == 0, result.output
+
+
+@pytest.mark.slow
+def test_sweep_reads_a_traced_wall_as_run_does(traced, tmp_path):
+    out = tmp_path / "s.csv"
+    args = ["--param", "friction=0.5,0.7", "--duration", "0.05", "--workers", "0", "--no-recording", "--out", out]
+    assert_one_line_error(invoke("sweep", traced, *args), "not convex", "--convex-hull")
+    result = invoke("sweep", traced, *args, "--convex-hull", "--trim-overlaps", "0.003", "--settle", "0.2")
+    assert result.exit_code == 0, result.output
+    assert "settled 0.2 s under its own weight" in words(result.output) and out.exists()

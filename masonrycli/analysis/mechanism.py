@@ -24,8 +24,9 @@ Per contact, ``mobilised_friction`` is the share of the available friction in us
 the friction limit, 0 on open contacts (and where μ r_n ≤ 0, where no friction is available).
 
 A joint is **hinged** when exactly one of its current contact points carries normal force (r_n > 0),
-its other end has opened by more than ``OPENING``, and it carries at least ``LOAD_FRACTION`` × the
-mean block weight (nearly unloaded joints are not reported).
+its other end has opened by more than ``OPENING`` since the start (beyond its initial gap g₀ when that is
+positive: a joint drawn open at one end is no hinge until it opens further), and it carries at least
+``LOAD_FRACTION`` × the mean block weight (nearly unloaded joints are not reported).
 
 The loops over ends, joints and contacts are the kernels of :mod:`masonrycli.engine.joints`.
 """
@@ -144,9 +145,12 @@ class JointTracker:
         if self.key.size == 0:
             return np.zeros(0, dtype=bool)
         opening = self.opening(body_q) if opening is None else opening
+        # opened since the start: an end drawn apart (a traced wall's faces meet at one end, the other 0.1-1 mm
+        # off) is no hinge at rest — a settled traced wall was "damaged", 37 hinges, with nothing moving
+        opened = np.ascontiguousarray(opening - np.maximum(self._gap0, 0.0))
         body = np.ascontiguousarray(contact_body, dtype=np.int64).reshape(-1, 2)
         return _kernels.hinged(
-            opening, self._end_joint, self.key, self.body_count, body, contact_rn, dt, OPENING, self.min_force
+            opened, self._end_joint, self.key, self.body_count, body, contact_rn, dt, OPENING, self.min_force
         )
 
     def hinge_points(self, contact_body, contact_point, contact_rn, hinged) -> np.ndarray:

@@ -24,6 +24,7 @@ from masonrycli.cli.options import (
     OUTPUT,
     RECORD,
     RUN,
+    SETTLE,
     SETTLED_LOADING,
     STOP,
     SURVEY,
@@ -231,13 +232,15 @@ def _load(scenario_file: str, opts: dict):
     """The scenario of a TOML, GeoJSON or WKT file with the command line's record and run options
     (taken out of ``opts``) applied."""
     from masonrycli.scenario.builtin import file_scenario
+    from masonrycli.settle import settled_scenario
 
-    return file_scenario(scenario_file, survey=_pop(opts, SURVEY), **_pop(opts, RECORD, RUN, FRICTION))
+    scenario = file_scenario(scenario_file, survey=_pop(opts, SURVEY), **_pop(opts, RECORD, RUN, FRICTION))
+    return settled_scenario(scenario, opts.pop("settle"))  # the engine: before the run, not part of it
 
 
 @app.command("run")
 @user_errors
-@with_options(RUN_FROM_FILE, STOP, FRICTION_FROM_FILE, OUTPUT, FORCE, RECORD, SURVEY)
+@with_options(RUN_FROM_FILE, STOP, FRICTION_FROM_FILE, OUTPUT, FORCE, RECORD, SURVEY, SETTLE)
 def run_command(scenario_file: ScenarioFile, **opts) -> None:
     """Run any scenario file, or a GeoJSON / WKT geometry file (supports fixed, or shaken by --record: the one
     support, or those marked driven); options given here override the file's values."""

@@ -19,6 +19,7 @@ from masonrycli.cli.options import (
     OUTPUT,
     RECORD,
     RUN,
+    SETTLE,
     STOP,
     STRUCTURE_OPTIONS,
     SURVEY,
@@ -45,6 +46,10 @@ def _scenario(target: str, opts: dict):
     shaping = {name: value for name in BUILT_IN_ONLY if (value := opts.pop(name)) is not None}
     settings = {name: opts.pop(name) for group in (RECORD, RUN, FRICTION) for name in group}
     survey = {name: opts.pop(name) for name in SURVEY}  # how a geometry file is read: refused for a built-in
+    if (settle := opts.pop("settle")) is not None:  # run's --settle runs the engine: here only its value is checked
+        from masonrycli.settle import check_settle
+
+        check_settle(settle)
     if not is_built_in(target):
         if shaping:
             raise InputError(
@@ -64,7 +69,7 @@ FILE_OR_BUILT_IN = "the scenario file's or the built-in's value"  # the run opti
 RUN_FROM_EITHER, FRICTION_FROM_EITHER = file_defaults(RUN, FILE_OR_BUILT_IN), file_defaults(FRICTION, FILE_OR_BUILT_IN)
 
 
-@with_options(RUN_FROM_EITHER, STOP, FRICTION_FROM_EITHER, OUTPUT, FORCE, RECORD, BUILT_IN_ONLY, SURVEY)
+@with_options(RUN_FROM_EITHER, STOP, FRICTION_FROM_EITHER, OUTPUT, FORCE, RECORD, BUILT_IN_ONLY, SURVEY, SETTLE)
 def check_command(
     target: Annotated[
         str,

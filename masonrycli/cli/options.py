@@ -258,6 +258,15 @@ SettleOption = Annotated[
         "fixed), and analyse it there: a traced wall's gaps closed (0.5).",
     ),
 ]
+SETTLE = {  # run, check, sweep: the structure let come to rest before it is shaken (masonrycli/settle.py)
+    "settle": _opt(
+        float,
+        "Geometry file",
+        "First let the structure come to rest under its own weight for this many seconds (the engine, supports "
+        "fixed) and shake it from there: a traced wall's gaps closed (0.5).",
+        "--settle",
+    )
+}
 ThrustOption = Annotated[
     bool,
     typer.Option(

@@ -14,7 +14,16 @@ from typing import TYPE_CHECKING, Annotated
 
 import typer
 
-from masonrycli.cli.options import choice_value, file_path_value, number_value, path_value, whole_value
+from masonrycli.cli.options import (
+    SETTLE,
+    SURVEY,
+    choice_value,
+    file_path_value,
+    number_value,
+    path_value,
+    whole_value,
+    with_options,
+)
 from masonrycli.errors import EXIT_DIVERGED, EXIT_OUTPUT_FAILED, EXIT_ROWS_FAILED
 from masonrycli.interrupt import FirstSignalStops, exit_code, signal_name
 from masonrycli.outputs.files import OutputFile
@@ -23,6 +32,7 @@ if TYPE_CHECKING:
     from masonrycli.study.plan import StudyPlan
 
 
+@with_options(SURVEY, SETTLE)
 def sweep_command(
     target: Annotated[
         str,
@@ -157,6 +167,7 @@ def sweep_command(
             "--force", help="Replace existing output files (finished rows of the same study are still reused)."
         ),
     ] = False,
+    **survey,
 ) -> None:
     """Run a structure over a grid of parameters or a set of records on Dask; one row per run.
 
@@ -189,6 +200,8 @@ def sweep_command(
         no_recording=no_recording,
         histories=histories,
         force=force,
+        survey={k: v for k, v in survey.items() if k != "settle"},
+        settle=survey["settle"],
         warn=lambda line: err_console.print(f"warning: {line}", soft_wrap=True),
     )
     # SIGTERM (kill, a batch system's time limit) takes Ctrl-C's way out: the finished rows are written and

@@ -51,7 +51,7 @@ class LimitResult:
     """m: (ring thickness, least ring thickness that carries its own weight) of a built-in arch
     (:mod:`masonrycli.limit.thickness`); None unless asked for (``masonry limit --min-thickness``)."""
     settled: object | None = None
-    """The :class:`~masonrycli.limit.settle.Settling` of ``masonry limit --settle`` (the wall analysed where the
+    """The :class:`~masonrycli.settle.Settling` of ``masonry limit --settle`` (the wall analysed where the
     engine let it come to rest), None without it."""
     places: tuple | None = None
     """The places a ``--worst`` point load was tried at (:class:`masonrycli.limit.worst.Place`), left to right;

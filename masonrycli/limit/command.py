@@ -288,7 +288,7 @@ def run_limit(
     point_force: str | None = None,
 ) -> None:
     """``masonry limit``: analyse, optionally record and verify, then print a table or one JSON object.
-    ``settle``: s the wall is first let come to rest under its own weight (:mod:`masonrycli.limit.settle`).
+    ``settle``: s the wall is first let come to rest under its own weight (:mod:`masonrycli.settle`).
 
     Ctrl-C or SIGTERM stops it (:mod:`masonrycli.interrupt`) with one line on stderr and exit 130 / 143, as
     ``simulate`` and ``sweep`` do (SIGTERM killed it before: exit -15, no word); one that arrives while the
@@ -408,7 +408,7 @@ def _analyse(structure, live, friction, verify, out, force, done: _Done, signals
     settings = setting_warnings(scenario)  # not its records': it has no time
     settling = None
     if options["settle"] is not None:  # the engine first: a traced wall's gaps closed under its own weight
-        from masonrycli.limit.settle import settle
+        from masonrycli.settle import settle
 
         scenario, settling = settle(scenario, options["settle"])
     try:

@@ -79,11 +79,15 @@ def plan_study(
     histories: Path | None = None,
     force: bool = False,
     warn: Callable[[str], None] | None = None,
+    survey: dict | None = None,
+    settle: float | None = None,
 ) -> StudyPlan:
     """The study of ``target`` (``wall``, ``arch``, ``aqueduct``, a scenario file or a geometry file) that
     ``masonry sweep`` runs with these options, each named as the command line names it; ``warn`` gets
     the warnings (runs shorter than records) once ``run_study`` has checked the table. Raises
-    :class:`InputError`, the first problem in one line, before any run or file."""
+    :class:`InputError`, the first problem in one line, before any run or file. ``survey``: how a geometry
+    file is read (--units, --flip-y, --convex-hull, --trim-overlaps, as ``masonry run`` reads it); ``settle``: s
+    the structure comes to rest under its own weight first, once for every run (:mod:`masonrycli.settle`)."""
     from masonrycli.records.intensity import INTENSITY_MEASURES
     from masonrycli.study.runner import check_scheduler
     from masonrycli.study.task import check_outcome
@@ -92,7 +96,7 @@ def plan_study(
     # runs', so a --dt need not divide it ('--records recs --dt 0.003' said "does not divide duration = 1.0")
     # a geometry file has no [run] duration of its own either: swept over records, it runs them whole too
     lasting = bool(records) and duration is None and (is_built_in(target) or _is_geometry(target))
-    base = StudyBase(_base_scenario(target, duration, dt, lasting), {})
+    base = StudyBase(_base_scenario(target, duration, dt, lasting, survey, settle), {})
     name = base.scenario.name
     # the name reduced as recordings name it: "../../evil" made a folder "study-.." and wrote beside it
     out = store.check_out(out or Path(f"study-{safe_name(name)}.parquet"))
@@ -252,10 +256,13 @@ def _is_geometry(target) -> bool:
     return Path(target).suffix.lower() in GEOMETRY_SUFFIXES
 
 
-def _base_scenario(target: str, duration, dt, lasting: bool = False):
+def _base_scenario(target: str, duration, dt, lasting: bool = False, survey: dict | None = None, settle=None):
     """The study's scenario before its axes; ``lasting``: its duration is set later (by the records), so
     a ``dt`` is applied with a duration it divides."""
-    scenario = target_scenario(target, _shaken)  # a GeoJSON / WKT file as `masonry run` takes it
+    from masonrycli.settle import settled_scenario
+
+    scenario = target_scenario(target, _shaken, survey)  # a GeoJSON / WKT file as `masonry run` takes it
+    scenario = settled_scenario(scenario, settle)  # once, before the axes: every run starts from it at rest
     if lasting and dt is not None and dt > 0:
         import math
 
