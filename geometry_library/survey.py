@@ -9,7 +9,8 @@ ways that each stopped a run:
   origin (always, no option: the mechanics do not depend on where the wall stands, and float32 — the
   recording's positions, the engine's first sweeps — keeps 0.5 m at 6.9e6 m). The shift is said, and added
   to a refusal's coordinates, so a stone is found again on the map;
-- **other units** (``units``: ``"mm"``, ``"cm"``): read into metres. A wall in millimetres read as metres
+- **other units** (``units``: ``"mm"``, ``"cm"``, or metres per unit: ``"0.002"`` for a photograph's pixels
+  of 2 mm, traced in an image tool): read into metres. A wall in millimetres read as metres
   has stones hundreds of metres across; with no ``units`` given, stones whose median size exceeds
   ``HUGE_STONE`` (20 m) are said to be likely millimetres;
 - **y pointing down** (image rows, ``flip_y``): read with y negated, so gravity pulls the wall towards its
@@ -74,8 +75,10 @@ class Survey:
     """m: the deepest overlap of two bodies trimmed (0: none trimmed, an overlap is refused by the checks)."""
 
     def __post_init__(self):
-        if self.units not in UNITS:
-            raise GeometryError(f"units must be one of {', '.join(UNITS)}, got {self.units!r}")
+        if unit_scale(self.units) is None:
+            raise GeometryError(
+                f"units must be one of {', '.join(UNITS)} or metres per unit (0.002: pixels of 2 mm), got {self.units!r}"
+            )
         if not (math.isfinite(self.trim_overlaps) and 0.0 <= self.trim_overlaps <= 0.1):
             raise GeometryError(f"trim depth must be between 0 and 0.1 m (a tracing slip), got {self.trim_overlaps!r}")
 
@@ -109,7 +112,7 @@ def frame_of(rings: list, survey: Survey) -> Frame:
     """The frame of a file's rings (each (k, 2) as given): units, flip, and the shift of whole kilometres that
     brings the lowest, leftmost corner of their bounding box near the origin when it is farther than
     ``RECENTRE_BEYOND`` (not when the rings span more than 1000 km: the checks refuse such a file as it is)."""
-    scale = UNITS[survey.units]
+    scale = unit_scale(survey.units)
     frame = Frame(scale, survey.flip_y)
     xy = [np.asarray(r, dtype=np.float64).reshape(-1, 2) for r in rings if np.size(r)]
     xy = frame.local(np.vstack(xy)) if xy else np.zeros((0, 2))
@@ -122,6 +125,17 @@ def frame_of(rings: list, survey: Survey) -> Frame:
     shift = np.floor(low / RECENTRE_STEP) * RECENTRE_STEP
     shift = np.where(np.maximum(np.abs(low), np.abs(high)) > RECENTRE_BEYOND, shift, 0.0)
     return dataclasses.replace(frame, shift=(float(shift[0]), float(shift[1])))
+
+
+def unit_scale(units: str) -> float | None:
+    """Metres per unit of ``units`` (a name of ``UNITS`` or a number of metres, in (0, 1000]); None if neither."""
+    if units in UNITS:
+        return UNITS[units]
+    try:
+        scale = float(units)
+    except (TypeError, ValueError):
+        return None
+    return scale if math.isfinite(scale) and 0.0 < scale <= 1e3 else None
 
 
 def survey_notes(path, frame: Frame, survey: Survey, assembly: Assembly) -> list[str]:

@@ -188,3 +188,14 @@ def test_an_unmarked_foundation_is_named(tmp_path):
     notes = []
     read_geojson(wall_file(tmp_path, "m.geojson", **EXACT), notes=notes)  # marked: nothing to say
     assert not any("lies lowest" in n for n in notes)
+
+
+def test_pixels_of_a_photograph_read_with_their_size(tmp_path):
+    # traced on an image in pixels of 2.5 mm, rows counting down: --units 0.0025 --flip-y gives the metres back
+    local = read_geojson(wall_file(tmp_path, "m.geojson", **EXACT))
+    pixels = wall_file(tmp_path, "px.geojson", scale=400.0, flip_y=True, slip=0.0, ndigits=9)
+    for a, b in zip(vertices(read_geojson(pixels, survey=Survey(units="0.0025", flip_y=True))), vertices(local)):
+        np.testing.assert_allclose(a, b, rtol=0, atol=1e-9)
+    for bad in ("0", "-1", "nan", "ft", "2000"):
+        with pytest.raises(GeometryError, match="units must be one of m, cm, mm or metres per unit"):
+            Survey(units=bad)

@@ -287,7 +287,7 @@ SURVEY = {  # how a GeoJSON / WKT file is read (geometry_library/survey.py): a s
     "units": _opt(
         str,
         "Geometry file",
-        "Unit of a GeoJSON / WKT file's coordinates: m (default), cm or mm.",
+        "Unit of a GeoJSON / WKT file's coordinates: m (default), cm, mm, or metres per unit (0.002: pixels of 2 mm).",
         "--units",
         parser=choice_value,
     ),

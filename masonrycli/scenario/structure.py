@@ -81,7 +81,7 @@ SURVEY_FLAGS = {
 def survey_of(options: dict, target: str):
     """The :class:`geometry_library.survey.Survey` of the command line's options reading a geometry file
     (None when none is given); given for a target that is no GeoJSON / WKT file, they are refused."""
-    from geometry_library.survey import UNITS, Survey
+    from geometry_library.survey import UNITS, Survey, unit_scale
 
     given = {k: v for k, v in options.items() if v is not None and v is not False}
     if not given:
@@ -89,8 +89,11 @@ def survey_of(options: dict, target: str):
     flags = " and ".join(SURVEY_FLAGS[k] for k in given)
     if Path(target).suffix.lower() not in GEOMETRY_SUFFIXES:
         raise InputError(f"{flags}: read{'s' if len(given) == 1 else ''} a GeoJSON / WKT file; {target} is not one")
-    if given.get("units", "m") not in UNITS:
-        raise InputError(f"--units {given['units']}: expected one of {', '.join(UNITS)}")
+    if unit_scale(given.get("units", "m")) is None:
+        raise InputError(
+            f"--units {given['units']}: expected one of {', '.join(UNITS)} or metres per unit in (0, 1000] (a "
+            "photograph's pixels of 2 mm: 0.002)"
+        )
     depth = given.get("trim_overlaps")
     if depth is not None and not (math.isfinite(depth) and 0.0 < depth <= 0.1):
         raise InputError(
