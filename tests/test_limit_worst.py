@@ -61,13 +61,15 @@ def test_the_worst_place_of_an_axle_matches_the_reference_over_every_point_of_th
         assert p.load_factor is None if np.isinf(expected) else p.load_factor == pytest.approx(expected, rel=1e-6)
 
 
-def test_a_force_scales_lambda_and_leaves_the_collapse_load():
-    """λ × F is the collapse load whatever F: the same place, 100 kN or the block's own weight."""
+@pytest.mark.parametrize("force", [1e-3, AXLE, 1e12, 1e15, 1e21])
+def test_a_force_scales_lambda_and_leaves_the_collapse_load(force):
+    """λ × F is the collapse load whatever F: the same place, F or the block's own weight. The LP took F as
+    given: at 1e15 N a collapse load of a fifth, at 1e21 N a negative one, at 1 mN 'unbounded'."""
     sc = filled_ring_scenario(20)
     own = analyse(sc, LiveLoad("point", at=-2.0))
-    axle = analyse(sc, LiveLoad("point", at=-2.0, force=AXLE))
-    assert axle.reference_force == AXLE
-    assert axle.load_factor * AXLE == pytest.approx(own.load_factor * own.reference_force, rel=1e-9)
+    axle = analyse(sc, LiveLoad("point", at=-2.0, force=force))
+    assert axle.reference_force == force
+    assert axle.load_factor * force == pytest.approx(own.load_factor * own.reference_force, rel=1e-9)
 
 
 @pytest.mark.parametrize(

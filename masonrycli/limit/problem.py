@@ -300,8 +300,14 @@ def solve_limit(
     weight, _ = _scales(model)
     scale = _row_scale(model)
     a = sp.diags(scale) @ equilibrium_matrix(model, joints)  # unknowns α / weight: O(1)
-    a_eq = sp.hstack([a, sp.csc_matrix((scale * live / weight)[:, None])], format="csc")
     b_eq = -scale * dead / weight
+    # λ's column is brought to the dead load's size by a power of two (exact), λ scaled back: a point force is the
+    # user's (--point-force 1e15N gave a collapse load of 1.7 kN for 9.0 kN, 1e-3N 'unbounded'); a body force is a
+    # weight as the dead load is, its factor 1
+    column = scale * live / weight
+    size, dead_size = float(np.abs(column).max()), float(np.abs(b_eq).max())
+    factor = 2.0 ** round(math.log2(dead_size / size)) if size > 0.0 and dead_size > 0.0 else 1.0
+    a_eq = sp.hstack([a, sp.csc_matrix(factor * column[:, None])], format="csc")
     cost = np.zeros(a_eq.shape[1])
     cost[-1] = -1.0
     t0 = time.perf_counter()
@@ -316,7 +322,7 @@ def solve_limit(
     # Dual of  min −λ, A z = b:  y with Aᵀy ≤ c. The mechanism is u = −y, back in unscaled rows.
     velocity = (-res.eqlin.marginals * scale).reshape(-1, 3)
     return LPSolution(
-        load_factor=float(res.x[-1]) + 0.0,  # HiGHS's λ at its bound 0 is -0.0 (shown as λ = -0.0000, -0 N)
+        load_factor=float(res.x[-1]) * factor + 0.0,  # HiGHS's λ at its bound 0 is -0.0 (shown as λ = -0.0000, -0 N)
         contact_force=force,
         block_velocity=velocity / max(_fastest_point(model, velocity), 1e-300),
         solve_time=elapsed,
