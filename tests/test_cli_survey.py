@@ -174,3 +174,26 @@ def test_sweep_reads_a_traced_wall_as_run_does(traced, tmp_path):
     result = invoke("sweep", traced, *args, "--convex-hull", "--trim-overlaps", "0.003", "--settle", "0.2")
     assert result.exit_code == 0, result.output
     assert "settled 0.2 s under its own weight" in words(result.output) and out.exists()
+
+
+def test_a_scenario_file_reads_a_traced_wall_with_its_structure_keys(traced, tmp_path):
+    # a scenario file gives the foundation its own motion: [structure] takes the options' keys beside file
+    scenario = tmp_path / "s.toml"
+    head = f'[structure]\nfile = "{traced.name}"\n'
+    motion = '[[support]]\nname = "support-1"\nmotion = { kind = "sine", amplitude = 0.3, frequency = 2.0 }\n'
+    scenario.write_text(head + motion)
+    assert_one_line_error(invoke("check", scenario), "not convex", "convex_hull = true (in [structure])")
+    scenario.write_text(head + "convex_hull = true\ntrim_overlaps = 0.003\n" + motion)
+    result = invoke("check", scenario)
+    assert result.exit_code == 0, result.output
+    said = words(result.output)
+    assert "4 non-convex polygons read as their convex hulls" in said and "overlapping pairs trimmed" in said
+    for bad, message in (
+        ("flip_y = 1", "flip_y = 1: must be true or false"),
+        ('units = "ft"', "units = 'ft': must be m, cm, mm or metres per unit"),
+        ("trim_overlaps = 0.5", "trim_overlaps = 0.5: must be a number in (0, 0.1] m"),
+        ("thickness = 2", "thickness: not allowed with file = ... (a geometry file brings its own blocks and supports; "
+         "how it is read: units, flip_y, convex_hull, trim_overlaps)"),
+    ):  # fmt: skip
+        scenario.write_text(head + bad + "\n" + motion)
+        assert_one_line_error(invoke("check", scenario), message)

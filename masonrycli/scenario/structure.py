@@ -63,8 +63,8 @@ def read_geometry(
         return assembly
     except (GeometryError, ValueError) as exc:
         msg = one_line(exc)
-        if not where and "not convex" in msg and not getattr(survey, "convex_hull", False):
-            msg += HULL_HINT  # a file run as it is: the option is on this command line
+        if "not convex" in msg and not getattr(survey, "convex_hull", False):  # the option, or the scenario's key
+            msg += HULL_HINT if not where else "; convex_hull = true (in [structure]) reads it as its convex hull"
         if not where and msg.startswith(f"{path}:"):  # the reader named the file already
             raise InputError(msg) from None
         raise ctx.error(where, msg) from None
@@ -76,6 +76,26 @@ SURVEY_FLAGS = {
     "convex_hull": "--convex-hull",
     "trim_overlaps": "--trim-overlaps",
 }
+
+
+def survey_keys(table: dict, ctx: InputContext):
+    """The :class:`~geometry_library.survey.Survey` of a scenario file's ``[structure]`` keys beside ``file``
+    (``units``, ``flip_y``, ``convex_hull``, ``trim_overlaps``: the command line's options, which read a file run
+    as it is), None when none is given; a wrong value is refused naming its key."""
+    from geometry_library.survey import Survey, unit_scale
+
+    given = {k: table[k] for k in SURVEY_FLAGS if k in table}
+    for key in ("flip_y", "convex_hull"):
+        if key in given and not isinstance(given[key], bool):
+            raise ctx.error("[structure]", f"{key} = {given[key]!r}: must be true or false")
+    if "units" in given:
+        given["units"] = str(given["units"]) if not isinstance(given["units"], bool) else ""
+        if unit_scale(given["units"]) is None:
+            raise ctx.error("[structure]", f"units = {table['units']!r}: must be m, cm, mm or metres per unit (0.002)")
+    depth = given.get("trim_overlaps")
+    if depth is not None and (isinstance(depth, bool) or not isinstance(depth, (int, float)) or not 0 < depth <= 0.1):
+        raise ctx.error("[structure]", f"trim_overlaps = {depth!r}: must be a number in (0, 0.1] m (0.003: 3 mm)")
+    return Survey(**given) if given else None
 
 
 def survey_of(options: dict, target: str):

@@ -35,7 +35,14 @@ from masonrycli.records.read import record_fields
 from masonrycli.scenario.caveats import idle_driven_supports
 from masonrycli.scenario.motion import Constant, Fixed, Motion, Ramp, Sine
 from masonrycli.scenario.scenario import Material, RunConfig, Scenario, block_speed_problem
-from masonrycli.scenario.structure import build_structure, check_finite_tree, read_geometry, structure_warnings
+from masonrycli.scenario.structure import (
+    SURVEY_FLAGS,
+    build_structure,
+    check_finite_tree,
+    read_geometry,
+    structure_warnings,
+    survey_keys,
+)
 from masonrycli.scenario.toml_lines import key_line, with_line
 from masonrycli.scenario.toml_syntax import hint as syntax_hint
 from masonrycli.scenario.values import (
@@ -188,17 +195,19 @@ def _parse_document(doc: dict, ctx: InputContext, default_name: str) -> Scenario
                 "not allowed together with a [structure] builder or file (use either explicit blocks or a [structure])",
             )
         if "file" in structure:
-            extra = [k for k in structure if k != "file"]
+            extra = [k for k in structure if k != "file" and k not in SURVEY_FLAGS]  # how it is read: survey_keys
             if extra:
                 raise ctx.error(
                     "[structure]",
-                    f"{extra[0]}: not allowed with file = ... (a geometry file brings its own blocks and supports)",
+                    f"{extra[0]}: not allowed with file = ... (a geometry file brings its own blocks and supports; "
+                    f"how it is read: {', '.join(SURVEY_FLAGS)})",
                 )
             file = structure["file"]
             if not isinstance(file, str):
                 raise ctx.error("[structure]", f"file = {format_value(file)[:40]}: must be a string")
             path = input_path(ctx.base_dir, file)  # "~/w.geojson" too
-            assembly = read_geometry(path, material.density, material.thickness, ctx, notes=notes)
+            survey = survey_keys(structure, ctx)
+            assembly = read_geometry(path, material.density, material.thickness, ctx, notes=notes, survey=survey)
             what = f"file {quote_string(file)}"
             structure_info = {"file": path}
         else:
