@@ -315,7 +315,7 @@ def test_a_built_in_takes_the_structure_options_of_masonry_build(tmp_path):
         (
             ["arch", "--blocks", "3"],
             [
-                "--blocks: not an option of the arch (its options: --density, --fill-cover, --fill-density, --fill-to, --pier-courses"
+                "--blocks: not an option of the arch (its options: --abutments, --density, --fill-cover, --fill-density, --fill-to, --pier-courses"
             ],
         ),
         (["aqueduct", "--rise", "1"], ["--rise: not an option of the aqueduct"]),

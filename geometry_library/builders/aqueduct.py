@@ -67,6 +67,12 @@ class AqueductSpec(ArchSpec):
                 "builder's: masonry build arch --rise)",
                 keys=("rise",),
             )
+        if self.abutments != "courses":  # its spandrel walls stand on the piers' courses
+            raise GeometryError(
+                f"aqueduct: abutments {self.abutments!r}: the aqueduct's piers are courses under its spandrel walls "
+                "(solid or fixed abutments are the arch builder's)",
+                keys=("abutments",),
+            )
         given = [k for k in ("fill_to", "fill_cover", "fill_density") if getattr(self, k) is not None]
         if given:  # its spandrel walls are blocks, not fill
             raise GeometryError(

@@ -37,6 +37,7 @@ from dataclasses import dataclass
 
 import numpy as np
 from shapely.geometry import box
+from shapely.ops import unary_union
 
 from ..blocks import SUPPORT_ROLES, Assembly, Block, GeometryError, Support
 from ..fill import with_fill
@@ -126,6 +127,10 @@ class ArchSpec:
     fill_cover : float, m, or None — the same, its level given as the depth over the ring's top (≥ 0);
         give one of fill_to and fill_cover.
     fill_density : kg/m³ — the fill's (default 2000 when a fill is given).
+    abutments : str — "courses" (default: each pier in running-bond courses, a skewback stone on top when
+        segmental), "solid" (each pier and its skewback one block, ``left-abutment`` / ``right-abutment``: a
+        massive abutment, bonded through) or "fixed" (that block rigid: it is the foundation support
+        ``left-foundation`` / ``right-foundation`` itself, moving as the foundation's motion says).
     """
 
     voussoirs: int = 30
@@ -144,17 +149,46 @@ class ArchSpec:
     fill_to: float | None = None
     fill_cover: float | None = None
     fill_density: float | None = None
+    abutments: str = "courses"
 
     def build(self) -> Assembly:
         """The arch: 2·2·pier_courses + voussoirs blocks (98 by default; + 2 skewbacks when segmental)
         and two supports. See the module docstring for the layout, names and order. With a fill, the
         blocks under it carry its weight (:func:`fill_level`)."""
         blocks, supports, geometry = arch_parts(self)
+        blocks, supports = solid_abutments(self, blocks, supports)
         level = fill_level(self, geometry)
         if level is not None:
             density = FILL_DENSITY if self.fill_density is None else self.fill_density
             blocks = with_fill(blocks, level, density, -geometry.half_width, geometry.half_width)
         return Assembly(tuple(blocks), tuple(supports))
+
+
+ABUTMENTS = ("courses", "solid", "fixed")
+
+
+def solid_abutments(spec: ArchSpec, blocks: list[Block], supports: list[Support]):
+    """``blocks`` and ``supports`` with each pier and its skewback made one block (``spec.abutments`` "solid")
+    or the foundation support itself ("fixed"); unchanged for "courses". The pier's courses and its skewback
+    fill a convex polygon (a box, and the skewback's trapezoid across its whole top), which replaces them."""
+    kind = spec.abutments.strip().lower() if isinstance(spec.abutments, str) else spec.abutments
+    if kind not in ABUTMENTS:
+        raise GeometryError(f"arch: abutments must be one of {', '.join(ABUTMENTS)}, got {kind!r}", keys=("abutments",))
+    if kind == "courses":
+        return blocks, supports
+    out_blocks, out_supports = list(blocks), list(supports)
+    for side in ("left", "right"):
+        parts = [b for b in blocks if b.name.startswith(f"{side}-pier-") or b.name == f"{side}-skewback"]
+        polygon = unary_union([b.polygon for b in parts]).convex_hull  # their union: convex already
+        first = out_blocks.index(parts[0])
+        out_blocks = [b for b in out_blocks if b not in parts]
+        name = f"{side}-foundation"
+        if kind == "solid":
+            out_blocks.insert(first, make_block(polygon, f"{side}-abutment", spec.density, spec.thickness))
+        else:  # the abutment is the support: rigid, where the foundation pad was
+            k = [sp.name for sp in out_supports].index(name)
+            out_supports[k] = make_support(polygon, name, out_supports[k].role)
+    return out_blocks, out_supports
 
 
 FILL_DENSITY = 2000.0

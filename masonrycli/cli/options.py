@@ -121,6 +121,13 @@ ARCH = {
     ),
     "fill_cover": _opt(float, "Structure", "The same fill, its level given as the depth over the ring's top, m."),
     "fill_density": _opt(float, "Structure", "Density of the fill, kg/m³ (default 2000)."),
+    "abutments": _opt(
+        str,
+        "Structure",
+        "courses (default: piers of two blocks a course), solid (each pier and its skewback one block) or "
+        "fixed (that block the rigid foundation).",
+        parser=choice_value,
+    ),
 }
 STRUCTURE_OPTIONS = {"wall": WALL, "arch": ARCH, "aqueduct": AQUEDUCT}
 """The structure options of each built-in: ``masonry limit NAME`` takes their union and refuses the others'."""
