@@ -129,3 +129,26 @@ def test_a_symmetric_fill_gives_a_symmetric_thrust_and_more_of_it():
     left, right = filled["left-foundation"], filled["right-foundation"]
     np.testing.assert_allclose(left, right, rtol=1e-6)
     assert left[0] > 1.5 * bare["left-foundation"][0]
+
+
+def test_the_recording_of_a_filled_bridge_says_its_fill_and_puts_a_block_load_where_it_acts():
+    """The mechanism recording draws the blocks, not the fill: its panel said nothing of the 421.6 kN/m a
+    filled bridge carries. And its arrow of a point load on a block stood at the body's centre of mass, which
+    the fill moves up: the load acts at the block's own centroid (the shoelace of its polygon)."""
+    from geometry_library.mass import mass_properties
+    from masonrycli.limit.command import load_arrow, mechanism_document
+
+    scenario = filled_ring_scenario(20)
+    fill = sum(b.carried_mass for b in scenario.assembly.blocks) * G
+    result = analyse(scenario, LiveLoad("point", block="v05"))
+    said = mechanism_document(result)
+    assert f"{fill:.4g} N of fill" in said, said
+    point, _ = load_arrow(result)
+    block = next(b for b in scenario.assembly.blocks if b.name == "v05")
+    assert point == pytest.approx(mass_properties(block.vertices).centroid, abs=1e-9)
+    import dataclasses
+
+    blocks = tuple(dataclasses.replace(b, carried_mass=0.0, carried_at=None) for b in scenario.assembly.blocks)
+    bare_ring = dataclasses.replace(scenario, assembly=dataclasses.replace(scenario.assembly, blocks=blocks))
+    bare = analyse(bare_ring, LiveLoad("point", block="v05"))
+    assert "of fill" not in mechanism_document(bare)

@@ -19,6 +19,7 @@ from rich.console import Console
 from rich.table import Table
 from rich.text import Text
 
+from geometry_library.mass import mass_properties
 from masonrycli import SOURCE_DIGEST, __version__
 from masonrycli.errors import EXIT_OUTPUT_FAILED, InputError
 from masonrycli.interrupt import StopRun, StopSignals, exit_code, signal_name
@@ -189,6 +190,7 @@ def mechanism_document(result: LimitResult) -> str:
         "",
         f"live load: {result.load.describe()}; friction {result.model.friction:g}",
         "",
+        *_fill_lines(result),
         "Left: the structure as built; red dots: the line of thrust (centre of pressure of each loaded joint).",
         "Right: the collapse mechanism, magnified, blocks coloured by their speed in it (grey: still);",
         "yellow: hinges; orange: sliding joints. Play the timeline to grow the mechanism.",
@@ -203,6 +205,14 @@ def mechanism_document(result: LimitResult) -> str:
         + _document_names(result.sliding_largest_first()),
     ]
     return "\n".join(lines)
+
+
+def _fill_lines(result: LimitResult) -> list[str]:
+    """The panel's word on a fill, which the view does not draw: a filled bridge's recording showed a bare ring."""
+    fill = result.summary()["fill_load_N"]
+    if not fill:
+        return []
+    return [f"dead load: the blocks' weight and {fill:.4g} N of fill{_depth(result)}, borne by the blocks under it", ""]
 
 
 DOCUMENT_NAMES = 12
@@ -225,8 +235,10 @@ def load_arrow(result: LimitResult) -> tuple[np.ndarray, np.ndarray]:
     direction = np.asarray(DIRECTIONS[result.load.direction], dtype=np.float64)
     if result.load.kind == "point" and result.load.top is not None:
         return np.array([result.load.at, result.load.top]), direction
-    if result.load.kind == "point":
-        return m.body_q0[list(m.block_name).index(result.load.block), :2].copy(), direction
+    if result.load.kind == "point":  # at the block's own centroid: a carried fill moved the body's centre of mass
+        i = list(m.block_name).index(result.load.block)
+        own = mass_properties(m.vert_local[m.body_vert_start[i] : m.body_vert_start[i + 1]]).centroid
+        return m.body_q0[i, :2] + own, direction
     mass = m.body_mass[:n]
     return (mass[:, None] * m.body_q0[:n, :2]).sum(axis=0) / mass.sum(), direction
 
