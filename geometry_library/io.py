@@ -3,7 +3,8 @@
 GeoJSON
 -------
 A ``FeatureCollection`` with one ``Polygon`` feature per body (coordinates in metres, exterior ring
-only; a ``MultiPolygon`` of one part, as QGIS saves polygon layers, is that polygon). Feature properties
+only; a ``MultiPolygon`` of one part, as QGIS saves polygon layers, is that polygon; a ``LineString``, or a
+``MultiLineString`` of one part, is a ground line: the support under it, ``survey.ground_from_line``). Feature properties
 (a ``null`` one is not given: its default applies):
 
 =================  =========================================================================
@@ -64,9 +65,11 @@ import shapely.wkt
 from shapely.geometry import GeometryCollection, MultiPolygon, Polygon
 
 from .blocks import SUPPORT_ROLES, Assembly, Block, GeometryError, Support, name_problem, quoted_name
-from .checks import NotConvexError, body_label, polygon_from_coords
-from .survey import Frame, Survey, frame_of, hull_note, hull_of, survey_notes, trim_overlaps, units_hint
+from .checks import body_label
+from .survey import GROUND_DEPTH, Survey, finish_reading, frame_of, ground_from_line, surveyed_polygon
 from .values import check_positive, is_real
+
+LINES = ("LineString", "MultiLineString")
 
 _LABEL = re.compile(
     r"^\s*(?:(?P<role>block|support)\s+)?(?P<name>[^\s:]+)(?:\s+(?P<srole>fixed|driven))?\s*:\s*(?P<wkt>.+)$",
@@ -198,6 +201,7 @@ def read_geojson(
     supports: list[Support] = []
     refused: list[tuple[str, str]] = []  # (message, body) of each polygon refused, said together at the end
     pending = []  # (feature_at, where, role, index, name, props, coords): made once every ring is read
+    survey, said = survey or Survey(), []  # said: the ground lines read
     for k, feature in enumerate(features, start=1):  # numbered from 1, as the bodies are (body_label)
         feature_at = where = f"{path}: feature {k}"  # the body's label is added once its role is read
         if not isinstance(feature, dict) or feature.get("type") != "Feature":
@@ -208,13 +212,17 @@ def read_geojson(
         # null is not given (a GIS writes an empty attribute cell as null): a block was named "None" and a
         # null density refused ("must be a positive number, got None")
         props = {key: value for key, value in props.items() if value is not None}
-        role = _word(props.get("role", "block"))  # "Support" was "role must be 'block' or 'support'"
-        if role not in ("block", "support"):
-            raise GeometryError(f"{where}: role must be 'block' or 'support', got {role!r}")
+        geometry = feature.get("geometry")
+        gtype = geometry.get("type") if isinstance(geometry, dict) else None
+        line = gtype in ("LineString", "MultiLineString")  # a ground line traced along the foot: a support
+        role = _word(props.get("role", "support" if line else "block"))  # "Support": "role must be 'block' or …"
+        if role not in ("block", "support") or (line and role == "block"):
+            allowed = "'support' (a line is the ground under it)" if line else "'block' or 'support'"
+            raise GeometryError(f"{where}: role must be {allowed}, got {role!r}")
         index = len(blocks) if role == "block" else len(supports)
         name = props.get("name", "")
         if isinstance(name, str) and not name.strip():  # an empty attribute cell, as null: not given
-            name = f"{role}-{index + 1}"  # block-1 first, as in a TOML file
+            name = "ground" if line else f"{role}-{index + 1}"  # block-1 first, as in a TOML file
         if isinstance(name, (bool, list, dict)):  # a number is a GIS id column's (5 -> "5"); these were named
             raise GeometryError(f"{where}: name must be a string, got {name!r}")  # "{'a': 1}", "True"
         name = str(name)
@@ -226,10 +234,20 @@ def read_geojson(
             for key in props:
                 if key in elsewhere or (key not in GEOJSON_PROPERTIES and str(key).lower() not in GIS_ID_COLUMNS):
                     unknown.setdefault(key, f"feature {k}, {body_label(index, name, role)}")
-        geometry = feature.get("geometry")
-        gtype = geometry.get("type") if isinstance(geometry, dict) else None
-        rings = geometry.get("coordinates") if gtype in ("Polygon", "MultiPolygon") else None
-        if gtype == "MultiPolygon":  # QGIS saves a polygon layer as MultiPolygons, most of one part
+        rings = geometry.get("coordinates") if gtype in ("Polygon", "MultiPolygon", *LINES) else None
+        if line:  # [[x, y], …] (a MultiLineString of one part, as QGIS saves a line layer): the ground under it
+            rings = rings[0] if gtype == "MultiLineString" and isinstance(rings, list) and len(rings) == 1 else rings
+            try:
+                ring, dip = ground_from_line([[_real(c) for c in xy[:2]] for xy in rings], survey, where)
+            except (TypeError, ValueError, IndexError) as exc:  # GeometryError is a ValueError: said as it is
+                bad = f"{where}: a ground line is [[x, y], …] (a MultiLineString of one part)"
+                raise GeometryError(str(exc) if isinstance(exc, GeometryError) else bad) from None
+            said.append(
+                f"{feature_at}: a {gtype} read as the ground under it, {GROUND_DEPTH:g} m deep (its upper hull: "
+                f"dips up to {dip * 1e3:.2g} mm bridged)"
+            )
+            rings = [ring.tolist()]
+        elif gtype == "MultiPolygon":  # QGIS saves a polygon layer as MultiPolygons, most of one part
             if not isinstance(rings, list) or len(rings) != 1:
                 parts = len(rings) if isinstance(rings, list) else 0
                 raise GeometryError(
@@ -238,7 +256,7 @@ def read_geojson(
                 )
             rings = rings[0]
         elif gtype != "Polygon":
-            raise GeometryError(f"{where}: geometry must be a Polygon, got {gtype!r}")
+            raise GeometryError(f"{where}: geometry must be a Polygon, got {gtype!r} (a LineString: a ground line)")
         if not isinstance(rings, list) or not rings:
             raise GeometryError(f"{where}: Polygon has no coordinates")
         if len(rings) > 1:
@@ -249,12 +267,12 @@ def read_geojson(
             raise GeometryError(f"{where}: coordinates must be [x, y] number pairs") from None
         (blocks if role == "block" else supports).append(None)  # numbered now, made once the frame is known
         pending.append((feature_at, where, role, index, name, props, coords))
-    survey = survey or Survey()
     frame = frame_of([entry[-1] for entry in pending], survey)
     hulls: list[tuple[str, float]] = []
+    (notes if notes is not None else []).extend(said)
     for feature_at, where, role, index, name, props, coords in pending:
         try:
-            polygon = _surveyed_polygon(frame.local(coords), index, name, role, survey, hulls)
+            polygon = surveyed_polygon(frame.local(coords), index, name, role, survey, hulls)
         except GeometryError as exc:
             refused.append((f"{feature_at}: {exc}", body_label(index, name, role)))  # exc starts with the label
             continue
@@ -272,53 +290,7 @@ def read_geojson(
             if srole not in SUPPORT_ROLES:
                 raise GeometryError(f"{where}: support_role must be one of {SUPPORT_ROLES}, got {srole!r}")
             supports[index] = Support(polygon, name, srole)
-    return _surveyed(path, refused, blocks, supports, frame, survey, hulls, notes)
-
-
-def _surveyed_polygon(xy, index: int, name: str, role: str, survey: Survey, hulls: list) -> Polygon:
-    """The checked polygon of a body (``polygon_from_coords``), or with ``survey.convex_hull`` that of its hull
-    when it is not convex (``hulls`` receives its label and the area the hull adds)."""
-    try:
-        return polygon_from_coords(xy, index, name, role)
-    except NotConvexError:
-        if not survey.convex_hull:
-            raise
-    label = body_label(index, name, role)
-    hull, gain = hull_of(xy, label)
-    hulls.append((label, gain))
-    return polygon_from_coords(hull, index, name, role)
-
-
-def _surveyed(path, refused, blocks, supports, frame: Frame, survey: Survey, hulls, notes) -> Assembly:
-    """The assembly read (refusals raised, with where the coordinates they quote are on the map and a units
-    hint), overlaps trimmed when ``survey`` says so; ``notes`` (if a list) receives what was done."""
-    read = [p.polygon for p in blocks if p is not None]
-    hint = units_hint(read, survey) if refused else ""
-    _raise_refused(refused, frame.where() + (f"; {hint}" if hint else ""))
-    assembly = Assembly(tuple(blocks), tuple(supports))
-    said = survey_notes(path, frame, survey, assembly)
-    if hulls:
-        said.append(hull_note(path, hulls))
-    if survey.trim_overlaps > 0.0 and assembly.block_count:
-        try:
-            assembly, trimmed = trim_overlaps(assembly, survey.trim_overlaps)
-        except GeometryError as exc:
-            raise GeometryError(f"{path}: {exc}{frame.where()}") from None
-        said += [f"{path}: {trimmed}"] if trimmed else []
-    if notes is not None:
-        notes.extend(said)
-    return assembly
-
-
-def _raise_refused(refused: list[tuple[str, str]], end: str = "") -> None:
-    """Raise the first refused polygon's error, the other refused bodies named after it: a drawing with
-    several stones not convex (or self-intersecting) was mended one run of ``masonry check`` per stone."""
-    if not refused:
-        return
-    others = [body for _, body in refused[1:]]
-    shown = ", ".join(others[:5]) + (f", … ({len(others) - 5} more)" if len(others) > 5 else "")
-    more = f" (and {len(others)} more polygon{'s' if len(others) > 1 else ''} refused: {shown})" if others else ""
-    raise GeometryError(refused[0][0] + end + more)
+    return finish_reading(path, refused, blocks, supports, frame, survey, hulls, notes)
 
 
 def _ring_coords(polygon: Polygon) -> list[list[float]]:
@@ -450,7 +422,7 @@ def read_wkt(
     hulls: list[tuple[str, float]] = []
     for where, role, index, label, srole, coords in pending:
         try:
-            polygon = _surveyed_polygon(frame.local(coords), index, label, role, survey, hulls)
+            polygon = surveyed_polygon(frame.local(coords), index, label, role, survey, hulls)
         except GeometryError as exc:
             refused.append((f"{where}: {exc}", body_label(index, label, role)))
             continue
@@ -458,7 +430,7 @@ def read_wkt(
             blocks[index] = Block(polygon, label, float(density), float(thickness))
         else:
             supports[index] = Support(polygon, label, (srole or "fixed").lower())
-    return _surveyed(path, refused, blocks, supports, frame, survey, hulls, notes)
+    return finish_reading(path, refused, blocks, supports, frame, survey, hulls, notes)
 
 
 _NO_COLON = re.compile(r"\s*(?P<label>[^\s(:][^(:]*?)\s+(?P<kind>POLYGON|MULTIPOLYGON|GEOMETRYCOLLECTION)\b", re.I)

@@ -18,6 +18,8 @@ ways that each stopped a run:
 - **slightly non-convex stones** (``convex_hull``, opt-in): a stone refused as not convex is read as its
   convex hull, if that adds at most ``MAX_HULL_GAIN`` (5 %) of its area — the area added is said; more
   is a stone of another shape, still refused (split it in QGIS);
+- **a ground traced as a line** along the wall's foot (a GeoJSON ``LineString``): the support under it
+  (:func:`ground_from_line`: one convex body, its top the line's upper hull, refused over a step);
 - **neighbours overlapping by a tracing slip** (``trim_overlaps`` = the deepest overlap to trim, m, opt-in):
   each overlapping pair is cut along the chord of their overlap, where their outlines cross (:func:`trim_overlaps`).
 
@@ -49,7 +51,7 @@ from shapely.geometry import Polygon
 from shapely.strtree import STRtree
 
 from .blocks import Assembly, GeometryError
-from .checks import body_label, normalised_polygon, overlap_depth, signed_area
+from .checks import NotConvexError, body_label, normalised_polygon, overlap_depth, polygon_from_coords, signed_area
 
 RECENTRE_BEYOND = 1e4
 """m: coordinates farther than this from the origin are moved near it."""
@@ -125,6 +127,34 @@ def frame_of(rings: list, survey: Survey) -> Frame:
     shift = np.floor(low / RECENTRE_STEP) * RECENTRE_STEP
     shift = np.where(np.maximum(np.abs(low), np.abs(high)) > RECENTRE_BEYOND, shift, 0.0)
     return dataclasses.replace(frame, shift=(float(shift[0]), float(shift[1])))
+
+
+GROUND_DEPTH = 0.5
+"""m: how far below a ground line's lowest point the ground read from it reaches."""
+GROUND_DIP = 0.01
+"""m: the deepest dip of a ground line its upper hull may bridge (deeper: a step to draw as polygons)."""
+
+
+def ground_from_line(xy, survey: Survey, where: str) -> tuple[np.ndarray, float]:
+    """The ring (file coordinates) of the ground under a traced ground line ``xy`` (k, 2): the convex hull of the
+    line and of two points ``GROUND_DEPTH`` below its lowest one (below: y down with ``flip_y``), one convex
+    support whose top is the line's upper hull; and the deepest dip of the line that hull bridges, m. Raises
+    when that dip exceeds ``GROUND_DIP`` (a step: draw the ground as convex polygons)."""
+    xy = np.asarray(xy, dtype=np.float64)
+    if xy.ndim != 2 or len(xy) < 2 or not np.all(np.isfinite(xy)):
+        raise GeometryError(f"{where}: a ground line needs two or more finite [x, y] points")
+    scale = unit_scale(survey.units)
+    down = 1.0 if survey.flip_y else -1.0
+    base = (xy[:, 1].max() if survey.flip_y else xy[:, 1].min()) + down * GROUND_DEPTH / scale
+    hull = shapely.convex_hull(shapely.multipoints([*xy, [xy[:, 0].min(), base], [xy[:, 0].max(), base]]))
+    dip = float(shapely.distance(hull.exterior, shapely.points(xy)).max()) * scale
+    if dip > GROUND_DIP:
+        raise GeometryError(
+            f"{where}: the ground line dips {dip * 1e3:.3g} mm below the straight line over its dip, more than "
+            f"{GROUND_DIP * 1e3:g} mm (the ground read from a line is one convex support): draw the ground as convex "
+            "polygons"
+        )
+    return np.asarray(hull.exterior.coords)[:-1], dip
 
 
 def unit_scale(units: str) -> float | None:
@@ -330,3 +360,49 @@ def _clip(xy: np.ndarray, normal: np.ndarray, c: float) -> np.ndarray:
             t = s[i] / (s[i] - s[j])
             out.append(xy[i] + t * (xy[j] - xy[i]))
     return np.array(out)
+
+
+def surveyed_polygon(xy, index: int, name: str, role: str, survey: Survey, hulls: list) -> Polygon:
+    """The checked polygon of a body (``polygon_from_coords``), or with ``survey.convex_hull`` that of its hull
+    when it is not convex (``hulls`` receives its label and the area the hull adds)."""
+    try:
+        return polygon_from_coords(xy, index, name, role)
+    except NotConvexError:
+        if not survey.convex_hull:
+            raise
+    label = body_label(index, name, role)
+    hull, gain = hull_of(xy, label)
+    hulls.append((label, gain))
+    return polygon_from_coords(hull, index, name, role)
+
+
+def finish_reading(path, refused, blocks, supports, frame: Frame, survey: Survey, hulls, notes) -> Assembly:
+    """The assembly read (refusals raised, with where the coordinates they quote are on the map and a units
+    hint), overlaps trimmed when ``survey`` says so; ``notes`` (if a list) receives what was done."""
+    read = [p.polygon for p in blocks if p is not None]
+    hint = units_hint(read, survey) if refused else ""
+    raise_refused(refused, frame.where() + (f"; {hint}" if hint else ""))
+    assembly = Assembly(tuple(blocks), tuple(supports))
+    said = survey_notes(path, frame, survey, assembly)
+    if hulls:
+        said.append(hull_note(path, hulls))
+    if survey.trim_overlaps > 0.0 and assembly.block_count:
+        try:
+            assembly, trimmed = trim_overlaps(assembly, survey.trim_overlaps)
+        except GeometryError as exc:
+            raise GeometryError(f"{path}: {exc}{frame.where()}") from None
+        said += [f"{path}: {trimmed}"] if trimmed else []
+    if notes is not None:
+        notes.extend(said)
+    return assembly
+
+
+def raise_refused(refused: list[tuple[str, str]], end: str = "") -> None:
+    """Raise the first refused polygon's error, the other refused bodies named after it: a drawing with
+    several stones not convex (or self-intersecting) was mended one run of ``masonry check`` per stone."""
+    if not refused:
+        return
+    others = [body for _, body in refused[1:]]
+    shown = ", ".join(others[:5]) + (f", … ({len(others) - 5} more)" if len(others) > 5 else "")
+    more = f" (and {len(others)} more polygon{'s' if len(others) > 1 else ''} refused: {shown})" if others else ""
+    raise GeometryError(refused[0][0] + end + more)

@@ -80,10 +80,19 @@ def traced(rings, slip=1e-3, dent=0.0, dents=0, seed=1):
 
 
 def feature_collection(
-    rings, ground, offset=(0.0, 0.0), scale=1.0, flip_y=False, mark_ground=True, multipolygon=True, ndigits=3
+    rings,
+    ground,
+    offset=(0.0, 0.0),
+    scale=1.0,
+    flip_y=False,
+    mark_ground=True,
+    multipolygon=True,
+    ndigits=3,
+    ground_line=False,
 ):
     """A GeoJSON FeatureCollection (dict) of the stones then the foundation, in a GIS's coordinates:
-    ``(x + offset) × scale``, y as an image's rows when ``flip_y``; rounded to ``ndigits`` (mm in metres)."""
+    ``(x + offset) × scale``, y as an image's rows when ``flip_y``; rounded to ``ndigits`` (mm in metres). With
+    ``ground_line`` the foundation is the line along its top (a LineString traced along the wall's foot)."""
 
     def coords(ring):
         xy = np.asarray(ring, dtype=float)
@@ -110,7 +119,14 @@ def feature_collection(
     props = {"id": len(rings) + 1, "stone_type": None, "layer": "foundation"}
     if mark_ground:
         props["role"] = "support"
-    features.append({"type": "Feature", "properties": props, "geometry": geometry(ground)})
+    if ground_line:  # the foundation's top, from left to right, with a vertex under every metre
+        top = np.array([[x, 0.0] for x in np.linspace(ground[0, 0], ground[1, 0], 6)])
+        line = coords(top)[:-1]
+        features.append(
+            {"type": "Feature", "properties": props, "geometry": {"type": "LineString", "coordinates": line}}
+        )
+    else:
+        features.append({"type": "Feature", "properties": props, "geometry": geometry(ground)})
     crs = {"type": "name", "properties": {"name": "urn:ogc:def:crs:EPSG::2154"}}
     return {"type": "FeatureCollection", "name": "wall", "crs": crs, "features": features}
 

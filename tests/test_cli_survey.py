@@ -197,3 +197,13 @@ def test_a_scenario_file_reads_a_traced_wall_with_its_structure_keys(traced, tmp
     ):  # fmt: skip
         scenario.write_text(head + bad + "\n" + motion)
         assert_one_line_error(invoke("check", scenario), message)
+
+
+def test_limit_on_a_ground_line_is_that_on_the_foundation_polygon(tmp_path):
+    # the exact stones on their foundation polygon, and on the line along its top: the same joints, the same λ
+    surveyed_wall.write(tmp_path / "polygon.geojson", slip=0.0, ndigits=9)
+    surveyed_wall.write(tmp_path / "line.geojson", slip=0.0, ndigits=9, ground_line=True, mark_ground=False)
+    answers = [invoke("limit", tmp_path / f"{name}.geojson", "--json") for name in ("polygon", "line")]
+    assert all(a.exit_code == 0 for a in answers), answers[1].output
+    lam = [json.loads(a.stdout)["load_factor"] for a in answers]
+    assert lam[1] == pytest.approx(lam[0], rel=1e-9)

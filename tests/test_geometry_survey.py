@@ -199,3 +199,28 @@ def test_pixels_of_a_photograph_read_with_their_size(tmp_path):
     for bad in ("0", "-1", "nan", "ft", "2000"):
         with pytest.raises(GeometryError, match="units must be one of m, cm, mm or metres per unit"):
             Survey(units=bad)
+
+
+def test_a_ground_line_is_the_ground_under_it(tmp_path):
+    # the foundation traced as a LineString along the wall's foot (y = 0, 6 vertices): one convex support, the
+    # rectangle down to 0.5 m below the line; no role needed (a line is no block)
+    notes = []
+    wall = read_geojson(wall_file(tmp_path, "w.geojson", ground_line=True, mark_ground=False, **EXACT), notes=notes)
+    assert wall.block_count == 72 and wall.support_count == 1 and wall.supports[0].name == "ground"
+    assert wall.supports[0].polygon.equals(box(-0.3, -0.5, 4.3, 0.0))
+    assert any("feature 73: a LineString read as the ground under it, 0.5 m deep" in n for n in notes), notes
+    assert validate_assembly(wall) == []
+
+
+def test_a_ground_line_with_a_step_is_refused(tmp_path):
+    # a 3 cm step down in the middle: the hull over it would bury the stones on the lower side
+    line = [[0, 0], [1, 0], [1.01, -0.03], [2, -0.03]]
+    feature = {"type": "Feature", "properties": {}, "geometry": {"type": "LineString", "coordinates": line}}
+    path = tmp_path / "step.geojson"
+    path.write_text(json.dumps({"type": "FeatureCollection", "features": [feature]}))
+    with pytest.raises(GeometryError, match=r"feature 1: support 1 \(\"ground\"\): the ground line dips 29.7 mm"):
+        read_geojson(path)
+    feature["properties"]["role"] = "block"
+    path.write_text(json.dumps({"type": "FeatureCollection", "features": [feature]}))
+    with pytest.raises(GeometryError, match="role must be 'support' \\(a line is the ground under it\\)"):
+        read_geojson(path)
