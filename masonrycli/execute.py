@@ -37,7 +37,7 @@ from masonrycli.outputs.files import (
     default_recording_path,
     open_part,
 )
-from masonrycli.outputs.history import HistoryFile, block_constants
+from masonrycli.outputs.history import History, HistoryFile, block_constants
 from masonrycli.outputs.report import progress_bar, slow_start_notice, summary_table
 from masonrycli.outputs.sinks import COMPLETED, FAILED
 from masonrycli.run import RunResult, Simulation, simulate
@@ -148,6 +148,9 @@ class Outcome:
     written: list[OutputFile] = field(default_factory=list)
     errors: list[str] = field(default_factory=list)
     """One line per output that could not be written: "--history h.npz: No space left on device"."""
+    history: History | None = None
+    """The history kept in memory (``execute(keep_history=True)``: the Python API), closed: the arrays the
+    ``--history`` file holds."""
 
 
 def run_metadata(scenario, sim: Simulation) -> dict:
@@ -213,6 +216,8 @@ def execute(
     stop_at_collapse: bool = False,
     magnify: float | None = None,
     signals: StopSignals | None = None,
+    keep_history: bool = False,
+    sinks_also=(),
 ) -> Outcome:
     """Run ``scenario`` writing ``outputs``; ``stop_at_collapse`` ends the run when the structure
     collapses (:mod:`masonrycli.analysis.collapse`); ``magnify``: the recording's magnified-shape factor (None:
@@ -220,7 +225,9 @@ def execute(
     raises its ``StopRun`` after removing the temporary files); an engine error is re-raised after the
     outputs are closed with status "failed" and renamed into place. ``signals``: a :class:`StopSignals`
     the caller entered and keeps installed after the run (its closing phase lasting through the summary);
-    by default one of the run's own."""
+    by default one of the run's own. ``keep_history``: also keep the history in memory, as the ``--history``
+    file would hold it (:attr:`Outcome.history`); ``sinks_also``: further frame sinks (the API's ``on_frame``),
+    handed every frame after the outputs and closed by their owner."""
     with StopSignals() if signals is None else contextlib.nullcontext(signals) as signals, compile_ahead.ahead():
         sinks: dict[OutputFile, object] = {}
         if note := compile_ahead.no_cache_note():  # a read-only install and no writable home or /tmp
@@ -236,6 +243,7 @@ def execute(
                     sinks[out] = _open_sink(out, outputs, scenario, sim, magnify)
                 except OSError as exc:
                     raise InputError(f"{out.option} {out.path}: cannot write: {exc.strerror or exc}") from None
+            kept = _history(History, scenario, sim) if keep_history else None
         except BaseException:
             for sink in sinks.values():
                 _quietly_close(sink)
@@ -249,31 +257,40 @@ def execute(
             with progress_bar(console, sim.model.n_steps) as on_progress:
                 result = simulate(
                     scenario,
-                    list(sinks.values()),
+                    [*sinks.values(), *([kept] if kept is not None else []), *sinks_also],
                     on_progress=on_progress,
                     sim=sim,
                     stop=signals.requested,
                     stop_at_collapse=stop_at_collapse,
                 )
             status, note = result.status, result.message
-            if outputs.history is not None:
-                sinks[outputs.history].run_values |= {f"intensity_{k}": v for k, v in result.intensity.items()}
+            for history in (sinks.get(outputs.history), kept):
+                if history is not None:
+                    history.run_values |= {f"intensity_{k}": v for k, v in result.intensity.items()}
         finally:
             signals.closing()
             written, errors = _close_all(sinks, status, note, result)
-    return Outcome(result, signals.signum, written, errors)
+            if kept is not None:  # as the file was closed: "failed" once an output failed
+                kept.close(*((result.status, result.message) if result is not None else (status, note)))
+    return Outcome(result, signals.signum, written, errors, kept)
 
 
 def _open_sink(out: OutputFile, outputs: Outputs, scenario, sim: Simulation, magnify: float | None = None):
     """The history or the recorder writing ``out``'s temporary file."""
     if out is outputs.history:
-        history = HistoryFile(out.part, sim.model.block_name, sim.model.support_name)
-        history.run_info = run_metadata(scenario, sim)
-        history.run_values |= block_constants(sim.model)
-        return history
+        return _history(HistoryFile, scenario, sim, out.part)
     from masonrycli.recording import Recorder
 
     return Recorder(out.part, recording_static(sim), run_metadata(scenario, sim), magnify=magnify)
+
+
+def _history(kind, scenario, sim: Simulation, *path):
+    """A history (``kind``: :class:`HistoryFile` writing ``path``, or :class:`History` in memory) given what
+    the rows do not hold: the run's parameters and the blocks' constants."""
+    history = kind(*path, sim.model.block_name, sim.model.support_name)
+    history.run_info = run_metadata(scenario, sim)
+    history.run_values |= block_constants(sim.model)
+    return history
 
 
 def _quietly_close(sink) -> None:

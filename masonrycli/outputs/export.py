@@ -191,9 +191,10 @@ def export_table(
     relative: bool = True,
     every: int = 1,
 ) -> Table:
-    """The table of the history at ``path`` (module docstring); without targets, the top."""
-    shown = os.fspath(path)
-    h = read_history(path)
+    """The table of the history at ``path`` (module docstring); without targets, the top. ``path`` may also
+    be the history's arrays (a dict: the Python API's run in memory), named "the run" in the messages."""
+    shown = "the run" if isinstance(path, dict) else os.fspath(path)
+    h = path if isinstance(path, dict) else read_history(path)
     table = Table(point=_run(h).get("study_point") or {})
     time = np.asarray(h["time"], dtype=float)
     q, v = h["block_q"], h["block_v"]

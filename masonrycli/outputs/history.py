@@ -141,6 +141,9 @@ class History:
         self.run_values: dict[str, float | np.ndarray] = {}
         """One value per run (e.g. ``intensity_pga``, written as 0-d arrays) or constant array of the run
         (:func:`block_constants`)."""
+        self.run_info: dict = {}
+        """The run's parameters, as :class:`HistoryFile`'s (``run``, once closed)."""
+        self._closing: dict[str, np.ndarray] = {}
 
     def __len__(self) -> int:
         return len(self._rows.get("time", ()))
@@ -153,16 +156,30 @@ class History:
     append = on_frame
 
     def close(self, status: str = COMPLETED, note: str = "") -> None:
-        """Nothing to finish: the rows stay in memory."""
+        """The rows stay in memory; from now on :meth:`arrays` also holds what a closed :class:`HistoryFile`
+        adds: ``status``, ``note``, ``run`` and ``units`` (the Python API's run has every array of the file)."""
+        self._closing = {"status": np.asarray(status), "note": np.asarray(note)}
+        self._closing["run"] = np.asarray(json.dumps(self.run_info, default=str, ensure_ascii=False))
 
     def arrays(self) -> dict[str, np.ndarray]:
         out = {name: np.asarray(values) for name, values in self._rows.items()}
         out["block_name"] = self.block_name
         out["support_name"] = self.support_name
-        out |= {name: np.asarray(value) for name, value in self.run_values.items()}
-        if self._rows:
+        if self._rows or self._closing:
             out["joint_body"] = np.asarray(self.joint_body)
+        # closed: in the order HistoryFile.close writes them, so that ``units`` lists them alike
+        closing = dict(self._closing)
+        out |= {name: closing.pop(name) for name in ("status", "note") if name in closing}
+        out |= {name: np.asarray(value) for name, value in self.run_values.items()}
+        if closing:
+            out |= closing
+            out["units"] = units_table([*out, "units"])
         return out
+
+
+def units_table(names) -> np.ndarray:
+    """(K, 2) str: each array name and its unit / meaning (:data:`UNITS`), the history's ``units``."""
+    return np.array([[n, UNITS.get(n, "")] for n in names], dtype=str)
 
 
 class HistoryFile:
@@ -223,7 +240,7 @@ class HistoryFile:
             } | {name: np.asarray(value) for name, value in self.run_values.items()}
             constants["run"] = np.asarray(json.dumps(self.run_info, default=str, ensure_ascii=False))
             names = [*self._files, *constants, "units"]
-            constants["units"] = np.array([[n, UNITS.get(n, "")] for n in names], dtype=str)
+            constants["units"] = units_table(names)
             with zipfile.ZipFile(self.path, "w", zipfile.ZIP_STORED, allowZip64=True) as zf:
                 for name, (_, dtype, shape) in self._files.items():
                     with zf.open(f"{name}.npy", "w", force_zip64=True) as member:

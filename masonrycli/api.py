@@ -1,0 +1,308 @@
+"""masonry from Python (a notebook, a script): :func:`scenario`, :func:`simulate`, :func:`read_history`, :func:`view`.
+
+Each is the command line's own code called as the commands call it, not a second implementation:
+
+==============================================  ===============================================================
+Python                                          the command line's code
+==============================================  ===============================================================
+``scenario("wall", amp=0.5, blocks=248)``       ``masonry check wall --amp 0.5 --blocks 248`` (builtin.builtin)
+``scenario("my.toml", dt=2e-4)``                ``masonry run my.toml --dt 2e-4`` (builtin.file_scenario)
+``simulate(s, history="h.npz")``                ``masonry simulate / run … --history h.npz`` (execute.check_run,
+                                                execute.execute)
+``read_history("h.npz")``                       ``masonry inspect h.npz``'s checks, then every array
+``Run.table(top=True)``                         ``masonry export h.npz --top`` (outputs.export.export_table)
+==============================================  ===============================================================
+
+So a bad value raises :class:`masonrycli.errors.InputError` carrying the line the command prints before its exit
+code 2, which names the option as the command line spells it (``amp=float("nan")``: "--amp: amplitude = nan: must
+be a finite number"), and a run's arrays are bit for bit those of the history ``masonry simulate … --history``
+writes. The keywords are the commands' options under their Python names (``--record-every`` is
+``record_every=``). Nothing is written unless asked: ``recording=`` and ``history=`` name the files (the
+command line's rules: an existing file is refused without ``force=True``), so a loop over parameters leaves no
+files behind. No state is kept between calls.
+
+Why a module of its own and not names in ``masonrycli/__init__.py``: that package is imported by every
+``masonry`` command, sweep worker and the compile-ahead process, and these functions import the engine (numba);
+``from masonrycli import api`` costs that only to those who use it.
+"""
+
+from __future__ import annotations
+
+import difflib
+import io
+import os
+import warnings
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from masonrycli.errors import InputError
+
+_SIMULATE_GROUPS = {  # the option groups of `masonry simulate NAME` (cli/app.py), by built-in
+    "wall": ("WALL", "WALL_LOADING"),
+    "arch": ("ARCH", "SETTLED_LOADING"),
+    "aqueduct": ("AQUEDUCT", "SETTLED_LOADING"),
+}
+
+
+def _option_names(target) -> list[str]:
+    """The keywords ``target`` takes: the options of ``masonry simulate NAME`` for a built-in, of ``masonry run``
+    for a file, and of the run settings and record for a :class:`Scenario` already made."""
+    from masonrycli.cli import options
+    from masonrycli.scenario.builtin import is_built_in
+
+    groups = ["RECORD", "RUN", "FRICTION"]
+    if isinstance(target, (str, os.PathLike)) and is_built_in(target):
+        groups += [*_SIMULATE_GROUPS[os.fspath(target)], "BLOCK_MATERIAL"]
+    elif isinstance(target, (str, os.PathLike)):
+        groups.append("SURVEY")
+    return [name for group in groups for name in getattr(options, group)]
+
+
+def _check_names(target, given: dict) -> None:
+    """Refuse a keyword the command does not take, as its command line refuses the option (one line)."""
+    known = _option_names(target)
+    for key in given:
+        if key not in known:
+            close = difflib.get_close_matches(key, known, n=3)
+            what = os.fspath(target) if isinstance(target, (str, os.PathLike)) else "a Scenario already made"
+            hint = f"did you mean {', '.join(close)}?" if close else f"its options: {', '.join(known)}"
+            raise InputError(f"no such option: {key}= for {what} ({hint})")
+
+
+def _path(value, option: str) -> Path:
+    """A path keyword as the command line reads its option: ``~`` expanded, an empty one refused."""
+    if not isinstance(value, (str, os.PathLike)):
+        raise InputError(f"{option} {value!r}: a path (str or pathlib.Path), not a {type(value).__name__}")
+    if not os.fspath(value).strip():
+        raise InputError(f"{option}: the path is empty")
+    return Path(os.path.expanduser(os.fspath(value)))
+
+
+def scenario(target, **options):
+    """The :class:`~masonrycli.scenario.scenario.Scenario` that :func:`simulate` would run: ``target`` is a
+    built-in's name (``"wall"``, ``"arch"``, ``"aqueduct"``, with ``masonry simulate NAME``'s options:
+    ``blocks=248, amp=0.5, freq=2``), a scenario or geometry file (``masonry run``'s options), or a Scenario
+    already made (its run settings, friction and record replaced). Raises :class:`InputError` (one line)."""
+    from geometry_library.blocks import GeometryError
+    from masonrycli.scenario.builtin import builtin, file_scenario, is_built_in, override_run, with_record
+    from masonrycli.scenario.scenario import Scenario
+
+    if not isinstance(target, (str, os.PathLike, Scenario)):
+        raise InputError(
+            f"{target!r}: give wall, arch, aqueduct, a scenario / geometry file's path or a Scenario, not a "
+            f"{type(target).__name__}"
+        )
+    _check_names(target, options)
+    options = {k: v for k, v in options.items() if v is not None}
+    if "record" in options:
+        options["record"] = _path(options["record"], "--record")
+    try:
+        if isinstance(target, Scenario):
+            record = {k: options.pop(k, None) for k in ("record", "scale", "record_dt", "baseline")}
+            return override_run(with_record(target, **record), **options)
+        if is_built_in(target):
+            return builtin(os.fspath(target), **options)
+        survey = {k: options.pop(k) for k in ("units", "flip_y", "convex_hull", "trim_overlaps") if k in options}
+        return file_scenario(target, survey=survey, **options)
+    except GeometryError as exc:  # the command line's one line, as the one error type of bad input
+        raise InputError(str(exc).splitlines()[0] if str(exc) else type(exc).__name__) from None
+
+
+class _FrameCallback:
+    """``simulate(on_frame=f)``: ``f(frame)`` for every recorded :class:`~masonrycli.outputs.frame.Frame`."""
+
+    def __init__(self, function):
+        self.on_frame = function
+
+    def close(self, status: str, note: str = "") -> None:
+        """Nothing to close: the function's owner keeps what it gathered."""
+
+
+def simulate(
+    target,
+    *,
+    recording=None,
+    history=None,
+    force: bool = False,
+    stop_at_collapse: bool = False,
+    magnify: float | None = None,
+    on_frame=None,
+    **options,
+) -> Run:
+    """Run ``target`` (as :func:`scenario` takes it, with its ``options``) and return its :class:`Run`: every
+    array of the history in memory. ``recording``: a ``.rrd`` path to write, or True for the command line's
+    default name (``recordings/<name>-<time>.rrd``); ``history``: a ``.npz`` path to write. By default nothing is
+    written. ``on_frame(frame)`` is called with every recorded frame (the contacts' points, normals and forces,
+    which the history does not keep). The run's own warnings (a record cut short, a setting's caveat) are Python
+    warnings; Ctrl-C (a notebook's "interrupt") ends the run "interrupted" with the frames it reached."""
+    from rich.console import Console
+
+    from masonrycli.execute import check_run, execute
+    from masonrycli.interrupt import StopRun
+    from masonrycli.outputs.report import summary_table
+    from masonrycli.scenario.caveats import scenario_warnings
+
+    sc = scenario(target, **options)
+    out = _path(recording, "--out") if recording not in (None, False, True) else None
+    hist = _path(history, "--history") if history is not None else None
+    outputs = check_run(sc, out, hist, no_recording=recording in (None, False), force=force, magnify=magnify)
+    for warning in scenario_warnings(sc):
+        warnings.warn(warning, UserWarning, stacklevel=2)
+    quiet = Console(file=io.StringIO(), quiet=True)
+    sinks = [_FrameCallback(on_frame)] if on_frame is not None else []
+    try:
+        outcome = execute(
+            sc,
+            outputs,
+            console=quiet,
+            stop_at_collapse=stop_at_collapse,
+            magnify=magnify,
+            keep_history=True,
+            sinks_also=sinks,
+        )
+    except StopRun:  # a signal before the first step: nothing was written
+        raise KeyboardInterrupt from None
+    for error in outcome.errors:
+        warnings.warn(f"cannot write {error}", RuntimeWarning, stacklevel=2)
+    paths = {o.option: o.path for o in outcome.written}
+    text = Console(file=io.StringIO(), width=100, record=True)
+    shown = {k: str(v) for k, v in paths.items()}
+    text.print(summary_table(outcome.result, shown.get("--out"), shown.get("--history"), sc.name))
+    return Run(
+        outcome.history.arrays(),
+        outcome=dict(outcome.result.outcome),
+        recording=paths.get("--out"),
+        history=paths.get("--history"),
+        summary=text.export_text(),
+    )
+
+
+def read_history(path) -> Run:
+    """The :class:`Run` of a history file (``--history``, ``simulate(history=…)``, ``masonry sweep
+    --histories``), checked as ``masonry inspect`` checks it. Its ``outcome`` is None: the file keeps the rows,
+    not the run's verdict (``masonry inspect`` and the study's table have it)."""
+    from masonrycli.outputs.inspect_history import inspect_history
+
+    path = _path(path, "history")
+    inspect_history(path)  # one line for a missing, damaged or foreign file
+    with np.load(path, allow_pickle=False) as npz:
+        arrays = {name: npz[name] for name in npz.files}
+    return Run(arrays, history=path)
+
+
+def view(recording):
+    """Open ``recording`` (a ``.rrd``) in the Rerun viewer, as the line a run's summary ends with does; returns
+    the viewer's process (:class:`subprocess.Popen`)."""
+    import subprocess
+
+    from masonrycli.execute import rerun_command
+    from masonrycli.recording import recording_path_problem
+
+    path = _path(recording, "recording")
+    problem = recording_path_problem(path)
+    if problem:
+        raise InputError(problem)
+    return subprocess.Popen([rerun_command(), os.fspath(path)])
+
+
+@dataclass(frozen=True, eq=False)
+class Run:
+    """A run's history: ``run["block_q"]`` is the array of that name in the ``.npz`` (T frames, N blocks, S
+    supports, J joints; ``run.unit(name)`` its unit), and a few views of them."""
+
+    arrays: dict
+    """Every array of the history, by name, as the ``.npz`` holds them (``units`` and ``run`` too)."""
+    outcome: dict | None = None
+    """The structure's state (``state``: intact, damaged or collapsed; ``collapse_time`` s, NaN if none;
+    ``peak_drift``, ``residual_drift`` × height; ``hinges``; ``max_opening`` m; …: docs/collapse.md), or None
+    for a history read from a file."""
+    recording: Path | None = None
+    """The recording written, or None."""
+    history: Path | None = None
+    """The history file written (or read), or None."""
+    summary: str = field(default="", repr=False)
+    """The command line's end-of-run table, as text ("" for a history read from a file)."""
+
+    def __getitem__(self, name: str) -> np.ndarray:
+        if name not in self.arrays:
+            close = difflib.get_close_matches(name, list(self.arrays), n=3)
+            raise KeyError(f"{name!r}: no such array" + (f" (did you mean {', '.join(close)}?)" if close else ""))
+        return self.arrays[name]
+
+    def __repr__(self) -> str:
+        state = f", {self.outcome['state']}" if self.outcome else ""
+        return (
+            f"<masonry Run: {self.status}{state}, {len(self.block_names)} blocks, {len(self.time)} frames to "
+            f"t = {self.time[-1] if len(self.time) else 0:g} s>"
+        )
+
+    def unit(self, name: str) -> str:
+        """The unit / meaning of array ``name`` (the history's ``units`` table)."""
+        self[name]  # noqa: B018 (an unknown name is a KeyError that says so)
+        return self.units.get(name, "")
+
+    @property
+    def units(self) -> dict[str, str]:
+        return {str(k): str(v) for k, v in self.arrays.get("units", np.zeros((0, 2), dtype=str))}
+
+    @property
+    def time(self) -> np.ndarray:
+        """(T,) s, the recorded frames' times."""
+        return self.arrays["time"]
+
+    @property
+    def status(self) -> str:
+        """completed, interrupted, diverged or failed."""
+        return str(self.arrays.get("status", ""))
+
+    @property
+    def note(self) -> str:
+        """Where and why the run stopped ("" when it ran all its steps)."""
+        return str(self.arrays.get("note", ""))
+
+    @property
+    def block_names(self) -> list[str]:
+        return [str(n) for n in self.arrays["block_name"]]
+
+    @property
+    def support_names(self) -> list[str]:
+        return [str(n) for n in self.arrays["support_name"]]
+
+    @property
+    def displacement(self) -> np.ndarray:
+        """(T, N, 3) each block's centroid displacement from t = 0, x and y (m), and rotation (rad, CCW)."""
+        q = self.arrays["block_q"]
+        return q - q[:1]
+
+    def block(self, name: str) -> int:
+        """The index of block ``name`` on every block axis."""
+        names = self.block_names
+        if name not in names:
+            close = difflib.get_close_matches(name, names, n=3)
+            raise InputError(f"no block {name!r}" + (f" (did you mean {', '.join(close)}?)" if close else ""))
+        return names.index(name)
+
+    def hinged_joints(self, frame: int = -1) -> list[str]:
+        """The joints hinged at ``frame`` (default the last), named ``"a|b"`` as the run's summary names them."""
+        from masonrycli.model import JOINT_SEPARATOR
+
+        names = self.block_names + self.support_names
+        body = self.arrays["joint_body"][self.arrays["joint_hinged"][frame]]
+        return [f"{names[a]}{JOINT_SEPARATOR}{names[b]}" for a, b in body]
+
+    def table(self, *, blocks=(), courses=(), top: bool = False, ground: str | None = None, relative: bool = True):
+        """``masonry export``'s columns, name (with its unit) → (T,) array: the ground's motion, each target's
+        (a block by name, a course by number from the bottom, the top course) displacement, velocity and
+        acceleration relative to the ground (``relative=False``: absolute), ``drift ratio (-)``, base shear,
+        overturning moment, hinges, energies (``masonry docs readme``, "Export a history as CSV"). Without
+        targets, the top course. ``pandas.DataFrame(run.table())`` makes it a frame."""
+        from masonrycli.outputs.export import export_table
+
+        table = export_table(
+            self.arrays, blocks=list(blocks), course_numbers=list(courses), top=top, ground=ground, relative=relative
+        )
+        for note in table.notes:
+            warnings.warn(note, UserWarning, stacklevel=2)
+        return dict(zip(table.names, table.values))

@@ -1,0 +1,193 @@
+"""The Python API (masonrycli/api.py, docs/python.md): the command line's own code from Python. A run's arrays
+are those of the history ``masonry simulate|run … --history`` writes, bit for bit; a bad value is refused with
+the line the command prints before its exit 2; nothing is written unless asked; the page's code blocks run."""
+
+from __future__ import annotations
+
+import json
+import re
+import subprocess
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from masonrycli import api
+from masonrycli.errors import InputError
+
+from cli_helpers import invoke, words
+from synthetic_records import band_limited, write_at2
+
+ROOT = Path(__file__).resolve().parent.parent
+DATA = ROOT / "tests" / "data"
+
+
+def _same_arrays(mine: dict, theirs, *, same_start: bool = False) -> None:
+    """Every array equal in dtype, shape and bits; ``run`` (the JSON of the parameters) equal but for the time
+    each run started."""
+    assert set(mine) == set(theirs.files if hasattr(theirs, "files") else theirs)
+    for name, value in mine.items():
+        other = theirs[name]
+        if name == "run":
+            first, second = json.loads(str(value)), json.loads(str(other))
+            if not same_start:
+                first.pop("started"), second.pop("started")
+            assert first == second
+            continue
+        assert value.dtype == other.dtype and value.shape == other.shape, name
+        assert np.array_equal(value, other, equal_nan=value.dtype.kind == "f"), name
+
+
+def _quake(tmp_path) -> Path:
+    path = tmp_path / "q.AT2"
+    _, _, _, acc = band_limited(0.2, 0.005, [4.0, 7.0], [0.002, 0.001])
+    write_at2(path, acc / 9.81, 0.005)
+    return path
+
+
+CASES = {
+    "sine": (
+        ("simulate", "wall", "--amp", "0.5", "--freq", "3", "--record-every", "5"),
+        "wall",
+        {"amp": 0.5, "freq": 3.0, "record_every": 5},
+    ),
+    "record": (
+        ("simulate", "wall", "--record", "{quake}", "--scale", "0.5"),
+        "wall",
+        {"record": "{quake}", "scale": 0.5},
+    ),
+    "file": (
+        ("run", str(DATA / "wall_shaken.toml"), "--friction", "0.5"),
+        str(DATA / "wall_shaken.toml"),
+        {"friction": 0.5},
+    ),
+}
+
+
+@pytest.mark.parametrize("case", CASES)
+def test_a_run_s_arrays_are_the_command_line_s_history_bit_for_bit(case, tmp_path):
+    # the same values through `masonry simulate|run … --history` and api.simulate: every array of the file,
+    # its units table and the run's parameters too (but for the second it started)
+    args, target, options = CASES[case]
+    quake = str(_quake(tmp_path))
+    args = [a.format(quake=quake) for a in args]
+    options = {k: v.format(quake=quake) if isinstance(v, str) else v for k, v in options.items()}
+    h = tmp_path / "h.npz"
+    result = invoke(*args, "--duration", "0.05", "--no-recording", "--history", h)
+    assert result.exit_code == 0, result.output
+    run = api.simulate(target, duration=0.05, **options)
+    with np.load(h) as written:
+        _same_arrays(run.arrays, written)
+    assert run.status == "completed" and run.time[-1] == pytest.approx(0.05)
+
+
+# (API keywords, the command line's options): each refused alike
+REFUSED = [
+    ({"amp": float("nan")}, ["--amp", "nan"]),
+    ({"dt": 0.3}, ["--dt", "0.3"]),
+    ({"blocks": -3}, ["--blocks", "-3"]),
+    ({"settlement": 0.01}, ["--settlement", "0.01"]),
+    ({"freq": 0.0}, ["--freq", "0"]),
+    ({"scale": 2}, ["--scale", "2"]),
+    ({"record": "missing.AT2"}, ["--record", "missing.AT2"]),
+    ({"duration": -1}, ["--duration", "-1"]),
+    ({"friction": -0.2}, ["--friction", "-0.2"]),
+    ({"solver": "gauss"}, ["--solver", "gauss"]),
+    ({"history": "h.npz"}, ["--history", "h.npz"]),  # exists: refused without force
+    ({"history": "h.txt"}, ["--history", "h.txt"]),
+    ({"recording": "w.rrd", "history": "w.rrd"}, ["--out", "w.rrd", "--history", "w.rrd"]),
+]
+
+
+@pytest.mark.parametrize("options, args", REFUSED, ids=lambda v: " ".join(map(str, v)) if isinstance(v, list) else None)
+def test_a_bad_value_is_refused_with_the_command_line_s_line(options, args, tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "h.npz").write_bytes(b"")
+    cli_args = args if "--out" in args else [*args, "--no-recording"]
+    result = invoke("simulate", "wall", *cli_args)
+    assert result.exit_code == 2, result.output
+    with pytest.raises(InputError) as refused:
+        api.simulate("wall", **options)
+    assert words(result.output) == f"error: {refused.value}"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["h.npz"]  # neither wrote anything
+
+
+def test_an_option_the_command_does_not_take_is_one_line_naming_the_close_ones(tmp_path):
+    with pytest.raises(InputError, match=r"^no such option: blok= for wall \(did you mean blocks\?\)$"):
+        api.scenario("wall", blok=3)
+    with pytest.raises(InputError, match="no such option: span= for wall"):
+        api.scenario("wall", span=4.0)  # the arch's: `masonry simulate wall --span 4` has no such option
+    wall = api.scenario("wall", duration=0.05)
+    with pytest.raises(InputError, match="no such option: amp= for a Scenario already made"):
+        api.simulate(wall, amp=0.5)  # the loading goes with the structure: api.scenario("wall", amp=0.5)
+    with pytest.raises(InputError, match="give wall, arch, aqueduct"):
+        api.scenario(51)
+
+
+def test_nothing_is_written_unless_asked_and_runs_keep_no_state(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    first = api.simulate("wall", duration=0.02, amp=0.5, record_every=1)
+    other = api.simulate("wall", duration=0.02, amp=1.0, record_every=1)
+    again = api.simulate("wall", duration=0.02, amp=0.5, record_every=1)
+    assert list(tmp_path.iterdir()) == []  # no recordings/ folder, no history
+    assert first.recording is None and first.history is None
+    _same_arrays(first.arrays, again.arrays)
+    assert not np.array_equal(first["block_q"], other["block_q"])
+
+
+def test_files_asked_for_are_written_read_back_and_viewed(tmp_path, monkeypatch):
+    h, rec = tmp_path / "runs" / "w.npz", tmp_path / "runs" / "w.rrd"
+    run = api.simulate("wall", duration=0.02, amp=0.5, history=h, recording=rec)
+    assert run.history == h and run.recording == rec and rec.stat().st_size > 0
+    back = api.read_history(h)
+    _same_arrays(run.arrays, back.arrays)
+    assert back.outcome is None and back.status == "completed" and back.unit("time") == "s, time of the frame"
+    with pytest.raises(InputError, match="--history .*exists"):
+        api.simulate("wall", duration=0.02, history=h)  # never overwritten without force
+    api.simulate("wall", duration=0.02, history=h, force=True)
+    started = []
+    monkeypatch.setattr(subprocess, "Popen", lambda args: started.append(args) or "viewer")
+    assert api.view(rec) == "viewer" and started[0][1:] == [str(rec)]
+    with pytest.raises(InputError, match="no such history"):
+        api.read_history(tmp_path / "none.npz")
+
+
+def test_the_views_of_the_arrays(tmp_path):
+    frames = []
+    run = api.simulate("wall", duration=0.05, amp=0.5, on_frame=frames.append)
+    assert [f.time for f in frames] == list(run.time)  # every recorded frame, the history's
+    assert all(f.contact_force.shape == f.contact_point.shape == (len(f.contact_body), 2) for f in frames)
+    u = run.displacement
+    assert u.shape == (len(run.time), 51, 3) and not u[0].any()
+    assert run.block("c01-b01") == run.block_names.index("c01-b01")
+    with pytest.raises(InputError, match="did you mean c01-b01"):
+        run.block("c1-b01")
+    hinged = run.hinged_joints()
+    assert len(hinged) == run["hinge_count"][-1] == run.outcome["hinges"]
+    assert all("|" in name for name in hinged)
+    table = run.table()
+    # the top course's drift at the end is the summary's residual drift (the same definition, collapse.md)
+    assert table["drift ratio (-)"][-1] == pytest.approx(run.outcome["residual_drift"], rel=1e-9, abs=1e-15)
+    assert run.unit("cell_spherical_stress").startswith("Pa")
+    with pytest.raises(KeyError, match="did you mean energy_kinetic"):
+        run["energy_kinetc"]
+
+
+def _page_blocks() -> list[str]:
+    return re.findall(r"```python\n(.*?)```", (ROOT / "docs" / "python.md").read_text(), flags=re.S)
+
+
+def test_the_python_page_runs_as_a_notebook(tmp_path, monkeypatch):
+    # its blocks one after the other in one namespace, as a notebook's cells, in an empty folder
+    import matplotlib
+
+    matplotlib.use("Agg")
+    monkeypatch.chdir(tmp_path)
+    blocks = _page_blocks()
+    assert len(blocks) >= 8
+    namespace: dict = {}
+    for k, code in enumerate(blocks):
+        exec(compile(code, f"docs/python.md block {k + 1}", "exec"), namespace)
+    assert (tmp_path / "wall-drift.png").stat().st_size > 0 and (tmp_path / "runs" / "wall.npz").is_file()
+    assert namespace["run"].outcome["state"] == "damaged"
+    assert namespace["message"] == "--amp: amplitude = nan: must be a finite number"
