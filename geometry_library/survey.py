@@ -147,6 +147,10 @@ def ground_from_line(xy, survey: Survey, where: str) -> tuple[np.ndarray, float]
     down = 1.0 if survey.flip_y else -1.0
     base = (xy[:, 1].max() if survey.flip_y else xy[:, 1].min()) + down * GROUND_DEPTH / scale
     hull = shapely.convex_hull(shapely.multipoints([*xy, [xy[:, 0].min(), base], [xy[:, 0].max(), base]]))
+    if (
+        hull.geom_type != "Polygon"
+    ):  # a vertical line, or one point repeated: a hull of no area (it said AttributeError)
+        raise GeometryError(f"{where}: a ground line runs along the wall's foot: its points span no width in x")
     dip = float(shapely.distance(hull.exterior, shapely.points(xy)).max()) * scale
     if dip > GROUND_DIP:
         raise GeometryError(

@@ -224,3 +224,19 @@ def test_a_ground_line_with_a_step_is_refused(tmp_path):
     path.write_text(json.dumps({"type": "FeatureCollection", "features": [feature]}))
     with pytest.raises(GeometryError, match="role must be 'support' \\(a line is the ground under it\\)"):
         read_geojson(path)
+
+
+@pytest.mark.parametrize("line", [[[0, 0], [0, 1]], [[0.2, 0], [0.2, 0]]])
+def test_a_ground_line_of_no_width_is_refused_in_one_line(tmp_path, line):
+    # a vertical line, or one point given twice: their hull has no area ('check' ended in an AttributeError
+    # traceback: 'LineString' object has no attribute 'exterior')
+    from cli_helpers import assert_one_line_error, invoke
+
+    block = [[0, 0], [0.4, 0], [0.4, 0.8], [0, 0.8], [0, 0]]
+    features = [
+        {"type": "Feature", "properties": {"name": "B"}, "geometry": {"type": "Polygon", "coordinates": [block]}},
+        {"type": "Feature", "properties": {}, "geometry": {"type": "LineString", "coordinates": line}},
+    ]
+    path = tmp_path / "line.geojson"
+    path.write_text(json.dumps({"type": "FeatureCollection", "features": features}))
+    assert_one_line_error(invoke("check", path), 'feature 2: support 1 ("ground"): a ground line', "span no width")
