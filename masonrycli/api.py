@@ -60,6 +60,16 @@ def _option_names(target) -> list[str]:
     return [name for group in groups for name in getattr(options, group)]
 
 
+_OUTPUTS = {  # the command line's output options, which simulate() names otherwise
+    "out": "the recording is simulate(recording=PATH)",
+    "no_recording": "simulate() writes no recording unless recording= names one",
+    "force": "force= is simulate()'s, with recording= or history=",
+    "history": "history= is simulate()'s",
+    "magnify": "magnify= is simulate()'s, with recording=",
+    "stop_at_collapse": "stop_at_collapse= is simulate()'s",
+}
+
+
 def _check_names(target, given: dict) -> None:
     """Refuse a keyword the command does not take, as its command line refuses the option (one line)."""
     known = _option_names(target)
@@ -68,6 +78,7 @@ def _check_names(target, given: dict) -> None:
             close = difflib.get_close_matches(key, known, n=3)
             what = os.fspath(target) if isinstance(target, (str, os.PathLike)) else "a Scenario already made"
             hint = f"did you mean {', '.join(close)}?" if close else f"its options: {', '.join(known)}"
+            hint = _OUTPUTS.get(key, hint)
             raise InputError(f"no such option: {key}= for {what} ({hint})")
 
 

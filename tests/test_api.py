@@ -5,7 +5,9 @@ the line the command prints before its exit 2; nothing is written unless asked; 
 from __future__ import annotations
 
 import json
+import os
 import re
+import signal
 import subprocess
 from pathlib import Path
 
@@ -40,7 +42,7 @@ def _same_arrays(mine: dict, theirs, *, same_start: bool = False) -> None:
 
 def _quake(tmp_path) -> Path:
     path = tmp_path / "q.AT2"
-    _, _, _, acc = band_limited(0.2, 0.005, [4.0, 7.0], [0.002, 0.001])
+    _, _, _, acc = band_limited(0.05, 0.005, [20.0, 35.0], [0.0005, 0.0002])
     write_at2(path, acc / 9.81, 0.005)
     return path
 
@@ -122,6 +124,26 @@ def test_an_option_the_command_does_not_take_is_one_line_naming_the_close_ones(t
         api.simulate(wall, amp=0.5)  # the loading goes with the structure: api.scenario("wall", amp=0.5)
     with pytest.raises(InputError, match="give wall, arch, aqueduct"):
         api.scenario(51)
+    with pytest.raises(
+        InputError, match=r"no such option: out= for wall \(the recording is simulate\(recording=PATH\)\)"
+    ):
+        api.simulate("wall", out="w.rrd")  # the command line's --out
+
+
+def test_ctrl_c_ends_the_run_interrupted_with_its_frames(tmp_path):
+    # a notebook's "interrupt the kernel" is a SIGINT: the run ends after the step under way and returns what it
+    # reached (files whole), as the command line does; Python's own handler is back afterwards
+    def interrupt(frame):
+        if frame.step == 20:
+            os.kill(os.getpid(), signal.SIGINT)
+
+    h = tmp_path / "h.npz"
+    run = api.simulate("wall", duration=0.1, record_every=10, on_frame=interrupt, history=h)
+    assert run.status == "interrupted" and run.note == "interrupted at t = 0.0200 s (step 20 of 100)"
+    assert list(run["step"]) == [0, 10, 20]
+    with np.load(h) as written:
+        assert str(written["status"]) == "interrupted" and list(written["step"]) == [0, 10, 20]
+    assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
 
 
 def test_nothing_is_written_unless_asked_and_runs_keep_no_state(tmp_path, monkeypatch):
