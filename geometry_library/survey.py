@@ -55,6 +55,9 @@ from .checks import NotConvexError, body_label, normalised_polygon, overlap_dept
 
 RECENTRE_BEYOND = 1e4
 """m: coordinates farther than this from the origin are moved near it."""
+RECENTRE_UP_TO = 1e8
+"""m: coordinates farther than this are not moved (float64 keeps 1.5e-8 m there; any map grid is nearer, Web
+Mercator's 2e7 m included): the checks refuse them as they are, beyond ``MAX_COORDINATE``."""
 RECENTRE_STEP = 1e3
 """m: the shift is a whole number of these (the local coordinates keep the survey's last digits)."""
 UNITS = {"m": 1.0, "cm": 0.01, "mm": 0.001}
@@ -122,7 +125,9 @@ def frame_of(rings: list, survey: Survey) -> Frame:
     if not len(xy):
         return frame
     low, high = xy.min(axis=0), xy.max(axis=0)
-    if np.abs(xy).max() <= RECENTRE_BEYOND or np.any(high - low > 1e6):
+    far = np.abs(xy).max()
+    # beyond RECENTRE_UP_TO float64 itself has lost the millimetres (1e12 m: ±0.1 mm): refused as it is
+    if far <= RECENTRE_BEYOND or far > RECENTRE_UP_TO or np.any(high - low > 1e6):
         return frame
     shift = np.floor(low / RECENTRE_STEP) * RECENTRE_STEP
     shift = np.where(np.maximum(np.abs(low), np.abs(high)) > RECENTRE_BEYOND, shift, 0.0)

@@ -240,3 +240,14 @@ def test_a_ground_line_of_no_width_is_refused_in_one_line(tmp_path, line):
     path = tmp_path / "line.geojson"
     path.write_text(json.dumps({"type": "FeatureCollection", "features": features}))
     assert_one_line_error(invoke("check", path), 'feature 2: support 1 ("ground"): a ground line', "span no width")
+
+
+def test_coordinates_beyond_any_map_grid_are_refused_as_before(tmp_path):
+    # 1e12 m out float64 keeps only ±0.1 mm: not moved, refused naming the vertex (as every far file was)
+    x = 1e12
+    ring = [[x, 0], [x + 0.4, 0], [x + 0.4, 0.2], [x, 0.2], [x, 0]]
+    feature = {"type": "Feature", "properties": {}, "geometry": {"type": "Polygon", "coordinates": [ring]}}
+    path = tmp_path / "far.geojson"
+    path.write_text(json.dumps({"type": "FeatureCollection", "features": [feature]}))
+    with pytest.raises(GeometryError, match=r"vertex 0 at \(1e\+12, 0\) is more than 1e\+06 m from the origin"):
+        read_geojson(path)
