@@ -138,3 +138,33 @@ def with_fill(blocks, level: float, density: float, x_lo: float, x_hi: float) ->
         at = (block.carried_mass * before + mass * centre) / total
         out.append(dataclasses.replace(block, carried_mass=float(total), carried_at=(float(at[0]), float(at[1]))))
     return out
+
+
+def spread_load(blocks, x: float, level: float, angle_deg: float) -> list[tuple[int, float, float, float]]:
+    """A load at abscissa ``x`` on the fill's surface (``level``, m), spread down through the fill at
+    ``angle_deg`` from the vertical onto the blocks' top (a wheel's load through a bridge's fill): uniform
+    over x − h … x + h, h = d tan(angle), d the fill's depth over the top at x. Returns (block index, x, y,
+    share) of each piece of the top it covers: the resultant of its part, at the middle of the part (a
+    uniform load on a straight edge), shares summing to 1 (less a part past the structure's ends). No depth (the top at or above the level): all at x.
+    """
+    pieces = top_surface(blocks, *_extent(blocks))
+    under = [p for p in pieces if p.a <= x <= p.b]
+    if not under:
+        return []
+    depth = level - max(p.y(x) for p in under)
+    half = depth * np.tan(np.radians(angle_deg)) if depth > 0 else 0.0
+    if half <= 0.0:
+        piece = max(under, key=lambda p: p.y(x))
+        return [(piece.block, x, piece.y(x), 1.0)]
+    out = []
+    for p in pieces:  # a part of the strip past the structure's ends bears on the ground there: not counted
+        lo, hi = max(p.a, x - half), min(p.b, x + half)
+        if hi > lo:
+            mid = 0.5 * (lo + hi)
+            out.append((p.block, mid, p.y(mid), (hi - lo) / (2.0 * half)))
+    return out
+
+
+def _extent(blocks) -> tuple[float, float]:
+    xs = np.concatenate([np.asarray(b.vertices)[:, 0] for b in blocks])
+    return float(xs.min()), float(xs.max())

@@ -366,6 +366,8 @@ def test_a_point_load_placed_by_abscissa_loads_the_voussoir_over_it_and_points_d
         "at_m": -2.0,
         "force_N": None,
         "worst": False,
+        "spread_deg": None,
+        "spread_onto": None,
     }
     named = json.loads(invoke("limit", "arch", *shape, "--load", "point", "--block", f"v{k + 1:02d}", "--json").stdout)
     down = invoke("limit", "arch", *shape, "--load", "point", "--block", f"v{k + 1:02d}", "--direction", "-y", "--json")

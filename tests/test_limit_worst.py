@@ -103,6 +103,9 @@ def test_a_force_without_its_unit_or_with_another_is_refused(text, said):
         (["--worst"], "--worst: the worst place of a point load (use --load point)"),
         (["--load", "point", "--worst", "--at", "-2"], "--worst and --at -2: --worst finds the place itself"),
         (["--load", "point", "--at", "40"], "--at 40: no block over x = 40 m"),
+        (["--load", "point", "--at", "-2", "--spread", "30"], "--spread 30: no fill to spread through"),
+        (["--load", "point", "--at", "-2", "--spread", "95", "--fill-cover", "0.3"], "0 to 90 degrees"),
+        (["--spread", "30", "--fill-cover", "0.3"], "--spread 30: a point load down on the fill's surface spreads"),
     ],
 )
 def test_bad_point_load_options_are_one_line_exit_2(args, said):
@@ -110,3 +113,61 @@ def test_bad_point_load_options_are_one_line_exit_2(args, said):
     assert result.exit_code == 2, result.output
     lines = result.output.strip().splitlines()
     assert len(lines) == 1 and said in lines[0], result.output
+
+
+@pytest.mark.parametrize("x, angle", [(-2.0, 30.0), (0.4, 26.6)])
+def test_an_axle_spread_through_the_fill_matches_the_reference(x, angle):
+    """`--spread DEG`: the axle on the fill's surface at x bears uniformly on the extrados over x ± d tan(DEG),
+    d the fill's depth over the extrados at x; on each voussoir its part acts at the middle of the part of
+    its chord (the resultant of a uniform load on a straight edge). The reference builds the same from the
+    ring's chords and the level, and enumerates the four-hinge mechanisms."""
+    import dataclasses
+
+    voussoirs = 20
+    sc = filled_ring_scenario(voussoirs)
+    options = dict(span=8.0, rise=2.0, ring_thickness=0.5, voussoirs=voussoirs, pier_width=1.0, fill_cover=COVER)
+    sc = dataclasses.replace(sc, structure={"builder": "arch", **options})  # where the fill's level comes from
+    i, e = segmental_reference_ring(voussoirs)
+    i, e = i + (0, SPRINGING), e + (0, SPRINGING)
+    level = e[:, 1].max() + COVER
+    centroid, area = voussoir_loads(i, e)
+    weight = STONE * G * area
+    fill_at, fill_area = reference_fill(e, level)
+    fill = FILL_DENSITY * G * fill_area
+    dead = np.stack([0 * weight, -weight], axis=1)
+    k = int(np.searchsorted(e[:, 0], x)) - 1
+    chord = lambda k, u: e[k, 1] + (u - e[k, 0]) * (e[k + 1, 1] - e[k, 1]) / (e[k + 1, 0] - e[k, 0])  # noqa: E731
+    half = (level - chord(k, x)) * np.tan(np.radians(angle))
+    live, at = np.zeros_like(dead), centroid.copy()
+    for j in range(voussoirs):
+        lo, hi = max(e[j, 0], x - half), min(e[j + 1, 0], x + half)
+        if hi > lo:
+            live[j] = (0.0, -AXLE * (hi - lo) / (2 * half))
+            at[j] = (0.5 * (lo + hi), chord(j, 0.5 * (lo + hi)))
+    assert np.count_nonzero(live[:, 1]) >= 2  # spread over more than one voussoir
+    extra = (("dead", np.stack([0 * fill, -fill], axis=1), fill_at),)
+    expected, _ = least_load_factor(i, e, centroid, dead, live, live_at=at, extra=extra)
+    r = analyse(sc, LiveLoad("point", at=x, force=AXLE, spread=angle))
+    assert r.load_factor == pytest.approx(expected, rel=1e-6)
+    point, _ = least_load_factor(
+        i,
+        e,
+        centroid,
+        dead,
+        np.where(np.arange(voussoirs)[:, None] == k, [0, -AXLE], 0.0),
+        live_at=np.where(np.arange(voussoirs)[:, None] == k, [x, chord(k, x)], centroid),
+        extra=extra,
+    )
+    assert abs(expected / point - 1) > 0.01  # the spread matters
+    # --verify gives the engine the same strip: each part a weight on its voussoir, f·λ·F in all
+    from masonrycli.limit.verify import tilted_scenario
+
+    weighted = tilted_scenario(sc, r, 1.05, duration=0.5)
+    added = [a.carried_mass - b.carried_mass for a, b in zip(weighted.assembly.blocks, sc.assembly.blocks)]
+    assert np.count_nonzero(added) == np.count_nonzero(live[:, 1])
+    assert sum(added) == pytest.approx(1.05 * r.load_factor * AXLE / 9.81, rel=1e-12)
+
+
+def test_spread_needs_a_fill_to_spread_through():
+    with pytest.raises(InputError, match="no fill to spread through"):
+        analyse(filled_ring_scenario(20), LiveLoad("point", at=-2.0, spread=30.0))

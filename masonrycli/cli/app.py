@@ -33,14 +33,16 @@ from masonrycli.cli.options import (
     AtOption,
     DirectionOption,
     Friction,
+    MechanismOutOption,
     MinThicknessOption,
     PointForceOption,
     SettleOption,
+    SpreadOption,
     ThrustOption,
+    VerifyOption,
     WorstOption,
     choice_value,
     file_defaults,
-    file_path_value,
     with_options,
 )
 from masonrycli.errors import EXIT_DIVERGED, EXIT_INTERNAL, EXIT_OUTPUT_FAILED, InputError
@@ -298,21 +300,15 @@ def limit_command(
     at: AtOption = None,
     worst: WorstOption = False,
     point_force: PointForceOption = None,
+    spread: SpreadOption = None,
     direction: DirectionOption = None,
     friction: Friction = None,
     as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object on stdout, nothing else.")] = False,
     thrust: ThrustOption = False,
     settle: SettleOption = None,
     min_thickness: MinThicknessOption = False,
-    verify: Annotated[
-        bool, typer.Option("--verify", help="Run the NSCD engine at 0.95 λ and 1.05 λ (tilted gravity) and compare.")
-    ] = False,
-    out: Annotated[
-        Path | None,
-        typer.Option(
-            "--out", "-o", parser=file_path_value, help="Write the mechanism recording (.rrd).", metavar="REC.rrd"
-        ),
-    ] = None,
+    verify: VerifyOption = False,
+    out: MechanismOutOption = None,
     force: Annotated[bool, typer.Option("--force", help="Replace the --out file if it exists.")] = False,
     **structure_options,
 ) -> None:
@@ -342,6 +338,7 @@ def limit_command(
         settle=settle,
         worst=worst,
         point_force=point_force,
+        spread=spread,
     )
 
 

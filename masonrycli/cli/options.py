@@ -248,6 +248,29 @@ PointForceOption = Annotated[
         "thickness: λ multiplies it (default: the loaded block's own weight).",
     ),
 ]
+VerifyOption = Annotated[
+    bool,
+    typer.Option(
+        "--verify",
+        help="Run the NSCD engine at 0.95 λ and 1.05 λ (tilted gravity; a point load as a weight) and compare.",
+    ),
+]
+MechanismOutOption = Annotated[
+    Path | None,
+    typer.Option(
+        "--out", "-o", parser=file_path_value, help="Write the mechanism recording (.rrd).", metavar="REC.rrd"
+    ),
+]
+SpreadOption = Annotated[
+    float | None,
+    typer.Option(
+        "--spread",
+        parser=number_value,
+        metavar="DEG",
+        help="A point load on the fill's surface spreads down through the fill at DEG from the vertical onto "
+        "the blocks' top (e.g. 26.6: 2 down for 1 across each side); needs --fill-to or --fill-cover.",
+    ),
+]
 MinThicknessOption = Annotated[
     bool,
     typer.Option(

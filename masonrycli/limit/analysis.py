@@ -119,6 +119,10 @@ class LimitResult:
                 "block": self.load.block,
                 "at_m": self.load.at,
                 "force_N": self.load.force,
+                "spread_deg": self.load.spread,
+                "spread_onto": None
+                if self.load.patches is None
+                else [{"block": b, "point": [x, y], "share": w} for b, x, y, w in self.load.patches],
                 "worst": self.load.worst,
             },
             "places": None
@@ -283,6 +287,10 @@ def analyse(scenario, load: LiveLoad, thrust: bool = False) -> LimitResult:
     if load.kind == "point" and load.at is not None and not load.resolved:
         block, top = block_over(scenario.assembly.blocks, load.at)
         load = replace(load, block=block, resolved=True, top=top)
+        if load.spread is not None:  # through the fill onto the blocks around
+            from masonrycli.limit.worst import fill_surface, placed
+
+            load = placed(load, scenario.assembly.blocks, load.at, block, top, fill_surface(scenario))
     result = replace(analyse_model(build_model(scenario), load, scenario.name), places=places)
     thicknesses = {b.thickness for b in scenario.assembly.blocks}
     if len(thicknesses) == 1:

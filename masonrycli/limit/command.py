@@ -298,6 +298,7 @@ def run_limit(
     settle: float | None = None,
     worst: bool = False,
     point_force: str | None = None,
+    spread: float | None = None,
 ) -> None:
     """``masonry limit``: analyse, optionally record and verify, then print a table or one JSON object.
     ``settle``: s the wall is first let come to rest under its own weight (:mod:`masonrycli.settle`).
@@ -319,6 +320,7 @@ def run_limit(
                         at,
                         worst=worst,
                         force=None if point_force is None else parse_force(point_force),
+                        spread=spread,
                     ),
                     friction,
                     verify,

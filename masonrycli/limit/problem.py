@@ -81,6 +81,11 @@ class LiveLoad:
     worst: bool = False
     """A point load at the place of least λ over the structure's top (:mod:`masonrycli.limit.worst` finds it
     and sets ``block``, ``at``, ``top`` and ``resolved``)."""
+    spread: float | None = None
+    """Degrees from the vertical: a point load on the fill's surface spreads through the fill onto the blocks'
+    top (``geometry_library.fill.spread_load``); None: it bears where it is put."""
+    patches: tuple | None = None
+    """((block name, x, y, share), ...): where a spread load bears, set with ``resolved``."""
     force: float | None = None
     """N: a point load's size (``--point-force 100kN``: an axle, for the blocks' thickness); λ multiplies it.
     None: the loaded block's own weight."""
@@ -113,6 +118,15 @@ class LiveLoad:
             raise InputError(f"--block {self.block}: only a point load acts on one block (use --load point)")
         if self.kind != "point" and self.at is not None:
             raise InputError(f"--at {self.at:g}: only a point load acts at one place (use --load point)")
+        if self.spread is not None and (
+            self.kind != "point" or self.direction != "-y" or self.block and not self.resolved
+        ):
+            raise InputError(
+                f"--spread {self.spread:g}: a point load down on the fill's surface spreads (--load point with "
+                "--at X or --worst)"
+            )
+        if self.spread is not None and not (math.isfinite(self.spread) and 0.0 <= self.spread < 90.0):
+            raise InputError(f"--spread {self.spread:g}: an angle from the vertical, 0 to 90 degrees (not 90)")
         if self.force is not None and self.kind != "point":
             raise InputError(f"--point-force {self.force:g} N: only a point load has a size (use --load point)")
         if self.force is not None and not (math.isfinite(self.force) and self.force > 0):
@@ -122,6 +136,8 @@ class LiveLoad:
         if self.kind == "point":
             where = "" if self.at is None else f" (the top block over x = {self.at:g} m, loaded there)"
             where = f" at x = {self.at:g} m (the worst place on the top)" if self.worst else where
+            if self.spread is not None:
+                where += f", spread through the fill at {self.spread:g}° onto {len(self.patches or ())} stretches"
             size = "its weight" if self.force is None else force_text(self.force)
             what = "point load" if self.force is None else f"point load of {force_text(self.force)}"
             return f"{what} on {self.block}{where}, {self.direction} (λ × {size})"
@@ -192,6 +208,13 @@ def load_vectors(model: Model, load: LiveLoad) -> tuple[np.ndarray, np.ndarray, 
             arm = np.zeros(2)
         live[i, 2] = arm[0] * live[i, 1] - arm[1] * live[i, 0]
         reference = float(size)
+        if load.patches:  # spread through the fill: each part at its place on its block, instead
+            live[i] = 0.0
+            for name, x, y, share in load.patches:
+                k = names.index(name)
+                force = share * size * direction
+                arm = np.array([x, y]) - model.body_q0[k, :2]
+                live[k] += (force[0], force[1], arm[0] * force[1] - arm[1] * force[0])
     else:
         live[:, :2] = (mass * g)[:, None] * direction[None, :]
         reference = float(mass.sum() * g)

@@ -91,14 +91,17 @@ def weighted_scenario(scenario, result: LimitResult, factor: float):
     check_verifiable(load)
     g = float(np.hypot(*scenario.run.gravity))
     blocks = list(scenario.assembly.blocks)
-    i = [b.name for b in blocks].index(load.block)
-    block = blocks[i]
+    names = [b.name for b in blocks]
+    block = blocks[names.index(load.block)]
     at = (load.at, load.top) if load.at is not None else tuple(block.polygon.centroid.coords[0])
     mass = factor * result.load_factor * result.reference_force / g
-    before = block.carried_at if block.carried_mass > 0 else at
-    total = block.carried_mass + mass
-    centre = tuple((block.carried_mass * np.asarray(before) + mass * np.asarray(at)) / total)
-    blocks[i] = dataclasses.replace(block, carried_mass=total, carried_at=(float(centre[0]), float(centre[1])))
+    for name, x, y, share in load.patches or ((load.block, *at, 1.0),):  # a spread load: each part where it bears
+        i = names.index(name)
+        block, part = blocks[i], share * mass
+        before = block.carried_at if block.carried_mass > 0 else (x, y)
+        total = block.carried_mass + part
+        centre = (block.carried_mass * np.asarray(before) + part * np.asarray((x, y))) / total
+        blocks[i] = dataclasses.replace(block, carried_mass=total, carried_at=(float(centre[0]), float(centre[1])))
     return dataclasses.replace(scenario, assembly=dataclasses.replace(scenario.assembly, blocks=tuple(blocks)))
 
 

@@ -12,15 +12,21 @@ block the stretch belongs to — at a joint, once on each side of it:
         for x in (stretch.a, stretch.b): λ(x) = the LP with the load at (x, y(x)) on stretch.block
     worst = the least λ (the leftmost on a tie)
 
+A load spread through the fill (``--spread``) is no longer linear along a stretch (its strip's edges move
+over the blocks): λ has kinks where the strip's centre or an edge passes a stretch's end, and the scan tries
+those and the midpoints between them — close, not exact.
+
 A place where no mechanism follows the load (the LP is unbounded: a pier's top pressed down onto its
 foundation) has no λ and is skipped; a structure that cannot carry its own weight fails the whole scan.
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, replace
 
-from geometry_library.fill import top_surface
+from geometry_library.fill import spread_load, top_surface
+from masonrycli.errors import InputError
 from masonrycli.limit.joints import find_joints
 from masonrycli.limit.problem import LimitError, LiveLoad, NoEquilibrium, load_vectors, solve_limit
 from masonrycli.model import build_model
@@ -37,22 +43,78 @@ class Place:
     load_factor: float | None
 
 
+def fill_surface(scenario) -> float | None:
+    """m: the level of the fill of an arch built with one (``--fill-to`` / ``--fill-cover``), else None."""
+    from geometry_library.builders.arch import ArchSpec, arch_parts, fill_level
+
+    options = {k: v for k, v in scenario.structure.items() if k != "builder"}
+    if scenario.structure.get("builder") != "arch":
+        return None
+    spec = ArchSpec(**options)
+    return fill_level(spec, arch_parts(spec)[2])
+
+
+def placed(load: LiveLoad, blocks, at: float, block: str, top: float, level: float | None) -> LiveLoad:
+    """``load`` at abscissa ``at`` on ``block`` (its top there at ``top``), spread through the fill up to
+    ``level`` when ``load.spread`` says so (``geometry_library.fill.spread_load``)."""
+    resolved = replace(load, block=block, at=at, resolved=True, top=top)
+    if load.spread is None:
+        return resolved
+    if level is None:
+        raise _no_fill(load)
+    parts = spread_load(blocks, at, level, load.spread)
+    return replace(resolved, patches=tuple((blocks[b].name, x, y, share) for b, x, y, share in parts))
+
+
+def _no_fill(load: LiveLoad) -> InputError:
+    return InputError(
+        f"--spread {load.spread:g}: no fill to spread through (an arch built with --fill-to or --fill-cover)"
+    )
+
+
+def _spread_places(pieces, level: float, angle: float) -> list[float]:
+    """Where a spread load's λ has its kinks (the strip's centre or an edge on a stretch's end: b ± h(x)),
+    and the midpoints between them: λ between them is not checked (module docstring)."""
+    ends = sorted({p.a for p in pieces} | {p.b for p in pieces})
+    tan = math.tan(math.radians(angle))
+
+    def half(x):
+        under = [p.y(x) for p in pieces if p.a <= x <= p.b]
+        return max(level - max(under), 0.0) * tan if under else 0.0
+
+    xs = set(ends)
+    for b in ends:
+        for side in (-1.0, 1.0):
+            x = b
+            for _ in range(20):  # x + side·h(x) = b, h varying slowly with x: a fixed point
+                x = b - side * half(x)
+            xs.add(x)
+    xs = sorted(x for x in xs if ends[0] <= x <= ends[-1])
+    return sorted(set(xs) | {0.5 * (a + b) for a, b in zip(xs[:-1], xs[1:])})
+
+
 def scan_places(scenario, load: LiveLoad) -> tuple[Place, ...]:
     """λ of ``load`` (a point load, its place not given) at both ends of every stretch of the top surface of
-    ``scenario``'s blocks, left to right (module docstring)."""
+    ``scenario``'s blocks, left to right (module docstring); a spread load at :func:`_spread_places`."""
     blocks = scenario.assembly.blocks
     lo = min(float(b.polygon.bounds[0]) for b in blocks)
     hi = max(float(b.polygon.bounds[2]) for b in blocks)
     model = build_model(scenario)
     joints = find_joints(model)
+    pieces = top_surface(blocks, lo, hi)
+    level = fill_surface(scenario) if load.spread is not None else None
+    if load.spread is None:
+        tried = [(x, p) for p in pieces for x in (p.a, p.b)]
+    else:
+        if level is None:
+            raise _no_fill(load)
+        tried = [(x, next(p for p in pieces if p.a <= x <= p.b)) for x in _spread_places(pieces, level, load.spread)]
     places, seen = [], set()
-    for piece in top_surface(blocks, lo, hi):
+    for x, piece in tried:
         name = blocks[piece.block].name
-        for x in (piece.a, piece.b):
-            if (x, name) in seen:
-                continue
+        if (x, name) not in seen:
             seen.add((x, name))
-            at = replace(load, block=name, at=x, resolved=True, top=piece.y(x))
+            at = placed(load, blocks, x, name, piece.y(x), level)
             dead, live, _ = load_vectors(model, at)
             try:
                 lam = solve_limit(model, joints, dead, live).load_factor
@@ -71,4 +133,5 @@ def worst_load(scenario, load: LiveLoad) -> tuple[LiveLoad, tuple[Place, ...]]:
     if not found:
         raise LimitError("--worst: no place on the structure's top where a mechanism follows the load")
     worst = min(found, key=lambda p: p.load_factor)  # min keeps the first (leftmost) of equal ones
-    return replace(load, block=worst.block, at=worst.at, resolved=True, top=worst.top), places
+    level = fill_surface(scenario) if load.spread is not None else None
+    return placed(load, scenario.assembly.blocks, worst.at, worst.block, worst.top, level), places
