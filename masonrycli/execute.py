@@ -161,6 +161,8 @@ def run_metadata(scenario, sim: Simulation) -> dict:
         "source": scenario.source,
         "structure": dict(scenario.structure),
         "blocks": sim.model.block_count,
+        # a carried fill is not drawn: the recording's parameters say it (only when there is one)
+        **({"fill_mass_kg": fill} if (fill := float(sim.model.block_carried_mass.sum())) > 0.0 else {}),
         "supports": {s.name: m.describe() for s, m in zip(scenario.assembly.supports, scenario.motions)},
         "baseline_corrections": {
             s.name: m.baseline_correction

@@ -182,3 +182,17 @@ def test_an_absurd_carried_fill_in_a_file_is_refused_in_one_line(tmp_path, carri
         f"carried_at = {carried['carried_at']!r}\n[[support]]\nname = 'g'\npolygon = {ground[:-1]}\n"
     )
     assert_one_line_error(invoke("check", toml), said)
+
+
+def test_a_runs_parameters_say_the_fill_the_view_does_not_draw():
+    """The recording draws the blocks, not their fill: a filled bridge's Parameters said a builder option at
+    most ('fill_cover', nothing for a GeoJSON of one), not the mass it carries. Now fill_mass_kg, the blocks'
+    carried masses; none without a fill."""
+    from masonrycli.execute import run_metadata
+    from masonrycli.run import Simulation
+
+    filled = builtin("arch", **BRIDGE, fill_cover=0.3)
+    meta = run_metadata(filled, Simulation(filled))
+    assert meta["fill_mass_kg"] == pytest.approx(sum(b.carried_mass for b in filled.assembly.blocks), rel=1e-12)
+    bare = builtin("arch", **BRIDGE)
+    assert "fill_mass_kg" not in run_metadata(bare, Simulation(bare))
