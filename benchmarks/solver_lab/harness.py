@@ -64,6 +64,7 @@ def _register_optional():
         linear,
         lines,
         newton,
+        schwarz,
         tnnmg,
     )
 
@@ -83,6 +84,7 @@ def _register_optional():
         cpg,
         lines,
         galerkin,
+        schwarz,
     ):
         METHODS.update(module.METHODS)
 

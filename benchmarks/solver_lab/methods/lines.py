@@ -80,10 +80,11 @@ def build_lines(p, pack) -> tuple[list[list[int]], list[np.ndarray], np.ndarray]
     return lines, [np.flatnonzero(owner == k) for k in range(len(lines))], np.flatnonzero(owner < 0)
 
 
-def _solve_subset(ctx, v, r, status, idx, tolerance, cap, solver) -> int:
-    """The engine's NLGS on contacts ``idx`` alone, all other impulses held: updates v, r, status; sweeps."""
+def solve_subset(ctx, v, r, status, idx, tolerance, cap, solver) -> tuple[int, float]:
+    """The engine's NLGS on contacts ``idx`` alone, all other impulses held: updates v, r, status; returns
+    (sweeps, the engine's last RMS law residual over ``idx``, m/s)."""
     if idx.size == 0:
-        return 0
+        return 0, 0.0
     p = ctx.p
     rows = np.empty(2 * idx.size, np.int64)
     rows[0::2], rows[1::2] = 2 * idx, 2 * idx + 1
@@ -92,9 +93,9 @@ def _solve_subset(ctx, v, r, status, idx, tolerance, cap, solver) -> int:
     s_sub = status[idx].copy()
     shim = p.shim(tolerance, cap, solver=solver)
     body, pack = np.ascontiguousarray(p.body[idx]), np.ascontiguousarray(ctx.pack[idx])
-    sweeps, _ = dispatch.solve(body, pack, idx.size, shim, v_free, r_sub, s_sub)
+    sweeps, residual = dispatch.solve(body, pack, idx.size, shim, v_free, r_sub, s_sub)
     v[:], r[idx], status[idx] = v_free, r_sub, s_sub
-    return int(sweeps)
+    return int(sweeps), float(residual)
 
 
 def _method(sweeps_between: int):
@@ -110,8 +111,8 @@ def _method(sweeps_between: int):
         while rounds < ROUNDS and residual > target:
             rounds += 1
             for g in groups:
-                visits += g.size * _solve_subset(ctx, v, r, status, g, INNER_TOL, INNER_CAP, "nlgs-accel")
-            visits += between.size * _solve_subset(ctx, v, r, status, between, 0.0, sweeps_between, "nlgs")
+                visits += g.size * solve_subset(ctx, v, r, status, g, INNER_TOL, INNER_CAP, "nlgs-accel")[0]
+            visits += between.size * solve_subset(ctx, v, r, status, between, 0.0, sweeps_between, "nlgs")[0]
             residual = ctx.residual(v, r)
         sizes = [len(line) for line in lines]
         detail = (
