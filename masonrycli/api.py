@@ -82,13 +82,19 @@ def _check_names(target, given: dict) -> None:
             raise InputError(f"no such option: {key}= for {what} ({hint})")
 
 
-def _path(value, option: str) -> Path:
-    """A path keyword as the command line reads its option: ``~`` expanded, an empty one refused."""
+def _path(value, option: str, *, output: bool = False) -> Path:
+    """A path keyword read by the command line's own parser of ``option`` (``~`` expanded, an empty one refused;
+    an output's "x.rrd/" names a folder, where Path("x.rrd/") would have written the file x.rrd)."""
+    import typer
+
+    from masonrycli.cli.options import file_path_value, path_value
+
     if not isinstance(value, (str, os.PathLike)):
         raise InputError(f"{option} {value!r}: a path (str or pathlib.Path), not a {type(value).__name__}")
-    if not os.fspath(value).strip():
-        raise InputError(f"{option}: the path is empty")
-    return Path(os.path.expanduser(os.fspath(value)))
+    try:
+        return (file_path_value if output else path_value)(os.fspath(value))
+    except typer.BadParameter as exc:
+        raise InputError(f"{option}: {exc.message}") from None
 
 
 def scenario(target, **options):
@@ -156,8 +162,8 @@ def simulate(
     from masonrycli.scenario.caveats import scenario_warnings
 
     sc = scenario(target, **options)
-    out = _path(recording, "--out") if recording not in (None, False, True) else None
-    hist = _path(history, "--history") if history is not None else None
+    out = _path(recording, "--out", output=True) if recording not in (None, False, True) else None
+    hist = _path(history, "--history", output=True) if history is not None else None
     outputs = check_run(sc, out, hist, no_recording=recording in (None, False), force=force, magnify=magnify)
     for warning in scenario_warnings(sc):
         warnings.warn(warning, UserWarning, stacklevel=2)

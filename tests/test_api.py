@@ -114,6 +114,24 @@ def test_a_bad_value_is_refused_with_the_command_line_s_line(options, args, tmp_
     assert sorted(p.name for p in tmp_path.iterdir()) == ["h.npz"]  # neither wrote anything
 
 
+@pytest.mark.parametrize(
+    "options, args, said",
+    [
+        ({"recording": "x.rrd/"}, ["--out", "x.rrd/"], 'x.rrd/: a path ending in "/" names a folder, not a file'),
+        ({"history": "h.npz/."}, ["--history", "h.npz/."], 'h.npz/.: a path ending in "/." names a folder'),
+        ({"record": ""}, ["--record", ""], "the path is empty"),
+    ],
+)
+def test_a_path_is_read_by_the_command_line_s_parser(options, args, said, tmp_path, monkeypatch):
+    # the parser's refusals are the command line's own words around the same reason ("Invalid value for
+    # '--out' / '-o': …"); Path("x.rrd/") is x.rrd, which the API wrote without a word
+    monkeypatch.chdir(tmp_path)
+    assert said in words(invoke("simulate", "wall", *args).output)
+    with pytest.raises(InputError, match=re.escape(f"{args[0]}: {said}")):
+        api.simulate("wall", duration=0.01, **options)
+    assert list(tmp_path.iterdir()) == []
+
+
 def test_an_option_the_command_does_not_take_is_one_line_naming_the_close_ones(tmp_path):
     with pytest.raises(InputError, match=r"^no such option: blok= for wall \(did you mean blocks\?\)$"):
         api.scenario("wall", blok=3)

@@ -1,0 +1,90 @@
+"""Every refusal of the bad-input catalogue (tests/bad_input_files.py, bad_input_options.py) that ``masonry
+simulate``, ``run`` or ``check`` makes with exit 2 is the Python API's too, in the same words: each row's options,
+as the command line converts them, given to :func:`masonrycli.api.simulate` raise the
+:class:`~masonrycli.errors.InputError` whose text is the command's line (a row the command line's parser refuses,
+"--dt abc", has no Python counterpart: a number is a number there)."""
+
+from __future__ import annotations
+
+import ast
+import re
+
+import click
+import pytest
+import typer
+from bad_input_files import FILE_ROWS
+from bad_input_options import OPTION_ROWS
+from test_bad_input_catalogue import write_files
+
+from geometry_library.values import TypedNumber
+from masonrycli import api
+from masonrycli.cli.app import app
+from masonrycli.errors import InputError
+
+from cli_helpers import invoke, words
+
+ROWS = [row for row in FILE_ROWS + OPTION_ROWS if row[2][0] in ("simulate", "run", "check") and row[3] == 2]
+TARGET = {"run": "scenario_file", "check": "target"}
+
+
+def _keywords(argv: list[str]):
+    """(target, keywords) of a command line as its command parses them, or None if the parser refuses it."""
+    group = typer.main.get_command(app)
+    root = click.Context(group, info_name="masonry")
+    name, *rest = argv
+    command = group.get_command(root, name)
+    target = None
+    if name == "simulate":
+        command, target, rest = command.get_command(root, rest[0]), rest[0], rest[1:]
+        if command is None:
+            return None
+    try:
+        params = command.make_context(name, list(rest), parent=root).params
+    except Exception:  # noqa: BLE001 (typer's own click's errors: a parse error, a --help)
+        return None
+    target = params.pop(TARGET[name]) if target is None else target
+    given = {k: _typed(v) for k, v in params.items() if v is not None and v is not False}
+    given.pop("no_recording", None)  # the API's default
+    if "out" in given:
+        given["recording"] = given.pop("out")
+    return target, given
+
+
+def _typed(value):
+    """A number as a Python user would type it: the literal of its text on the command line ("-1" an int)."""
+    if isinstance(value, TypedNumber):
+        try:
+            return ast.literal_eval(value.text)
+        except (ValueError, SyntaxError):  # "nan", "inf": float() reads them, Python needs float("nan")
+            return float(value)
+    return value
+
+
+_NUMBER = re.compile(r"-?\d+(?:\.\d*)?(?:e[-+]?\d+)?")
+
+
+def _numbers_alike(text: str) -> str:
+    """``text`` with every number in one spelling: "duration 1e5" and "duration 100000.0" say the same."""
+    return _NUMBER.sub(lambda m: repr(float(m.group())), text)
+
+
+PARSED = [row for row in ROWS if _keywords(list(row[2])) is not None]
+"""The rows the command line's parser takes (it refuses "--dt abc", "--bogus", a missing value: no Python
+counterpart, those are left out here)."""
+
+
+def test_most_rows_have_a_python_counterpart():
+    assert len(ROWS) >= 130 and len(PARSED) >= len(ROWS) - 12
+
+
+@pytest.mark.parametrize("name, files, argv, code, fragment", PARSED, ids=[row[0] for row in PARSED])
+def test_the_api_refuses_as_the_command_line(name, files, argv, code, fragment, tmp_path, monkeypatch):
+    write_files(tmp_path, files)
+    monkeypatch.chdir(tmp_path)
+    argv = [a.format(d=tmp_path) for a in argv]
+    parsed = _keywords(argv)
+    said = words(invoke(*argv).output)
+    target, keywords = parsed
+    with pytest.raises(InputError) as refused:
+        api.simulate(target, **keywords)
+    assert _numbers_alike(f"error: {words(str(refused.value))}") == _numbers_alike(said)
