@@ -52,6 +52,7 @@ from shapely.strtree import STRtree
 
 from .blocks import Assembly, GeometryError
 from .checks import NotConvexError, body_label, normalised_polygon, overlap_depth, polygon_from_coords, signed_area
+from .float32 import float32_resolution
 
 RECENTRE_BEYOND = 1e4
 """m: coordinates farther than this from the origin are moved near it."""
@@ -95,6 +96,9 @@ class Frame:
     scale: float = 1.0
     flip_y: bool = False
     shift: tuple[float, float] = (0.0, 0.0)
+    rounding: float | None = None
+    """m: how far a float32 export's rounding may have moved the file's coordinates as given (None: not a
+    float32 export) — once moved, the checks see coordinates that are no float32 values and cannot tell."""
 
     def local(self, xy: np.ndarray) -> np.ndarray:
         out = np.asarray(xy, dtype=np.float64) * self.scale
@@ -131,7 +135,11 @@ def frame_of(rings: list, survey: Survey) -> Frame:
         return frame
     shift = np.floor(low / RECENTRE_STEP) * RECENTRE_STEP
     shift = np.where(np.maximum(np.abs(low), np.abs(high)) > RECENTRE_BEYOND, shift, 0.0)
-    return dataclasses.replace(frame, shift=(float(shift[0]), float(shift[1])))
+    rounding = float32_resolution(
+        np.vstack([np.asarray(r, dtype=np.float64).reshape(-1, 2) for r in rings if np.size(r)])
+    )
+    rounding = None if rounding is None else rounding * scale
+    return dataclasses.replace(frame, shift=(float(shift[0]), float(shift[1])), rounding=rounding)
 
 
 GROUND_DEPTH = 0.5
@@ -188,6 +196,11 @@ def survey_notes(path, frame: Frame, survey: Survey, assembly: Assembly) -> list
             f"{path}: coordinates {_far(frame) / 1e3:,.0f} km from the origin (a map grid's) read moved by "
             f"({-frame.shift[0]:.0f}, {-frame.shift[1]:.0f}) m, near it: add {_pair(frame.shift)} to map a "
             "result back onto the survey"
+        )
+    if frame.rounding is not None and frame.rounding >= 1e-5:
+        notes.append(
+            f"{path}: its coordinates are float32 values, exact only to ±{frame.rounding:.2g} m that far from the "
+            "origin: every outline is rounded by that much; export them in float64 (QGIS: a GeoJSON's default)"
         )
     hint = units_hint(blocks, survey)
     if hint:
@@ -390,6 +403,11 @@ def finish_reading(path, refused, blocks, supports, frame: Frame, survey: Survey
     hint), overlaps trimmed when ``survey`` says so; ``notes`` (if a list) receives what was done."""
     read = [p.polygon for p in blocks if p is not None]
     hint = units_hint(read, survey) if refused else ""
+    if refused and frame.rounding is not None and frame.rounding >= 1e-5:  # the likely cause, said with it
+        hint = (
+            f"{hint}; " * bool(hint)
+            + f"its coordinates are float32 values, exact only to ±{frame.rounding:.2g} m there"
+        )
     raise_refused(refused, frame.where() + (f"; {hint}" if hint else ""))
     assembly = Assembly(tuple(blocks), tuple(supports))
     said = survey_notes(path, frame, survey, assembly)

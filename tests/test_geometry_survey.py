@@ -251,3 +251,21 @@ def test_coordinates_beyond_any_map_grid_are_refused_as_before(tmp_path):
     path.write_text(json.dumps({"type": "FeatureCollection", "features": [feature]}))
     with pytest.raises(GeometryError, match=r"vertex 0 at \(1e\+12, 0\) is more than 1e\+06 m from the origin"):
         read_geojson(path)
+
+
+def test_a_float32_export_far_away_is_said_once_moved(tmp_path):
+    # 12 km out a float32 keeps ±0.7 mm: moved near the origin the coordinates are no float32 values any more,
+    # so the checks' float32 warning could not fire — the reader says it, and with a refusal
+    data = surveyed_wall.write(tmp_path / "w.geojson", offset=(12000.0, 5000.0), slip=0.0, ndigits=9)
+    for feature in data["features"]:
+        rings = feature["geometry"]["coordinates"][0]
+        rings[0] = [[float(np.float32(x)), float(np.float32(y))] for x, y in rings[0]]
+    (tmp_path / "f32.geojson").write_text(json.dumps(data))
+    notes = []
+    read_geojson(tmp_path / "f32.geojson", survey=Survey(trim_overlaps=0.003), notes=notes)
+    assert any("float32 values, exact only to ±0.00072 m that far" in n for n in notes), notes
+    with pytest.raises(GeometryError, match="float32 values, exact only to ±0.00072 m there"):
+        feature = data["features"][0]["geometry"]["coordinates"][0][0]
+        feature.insert(2, [float(np.float32(12000.2)), float(np.float32(5000.01))])  # a dent: refused
+        (tmp_path / "f32.geojson").write_text(json.dumps(data))
+        read_geojson(tmp_path / "f32.geojson")
