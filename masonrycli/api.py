@@ -56,7 +56,7 @@ def _option_names(target) -> list[str]:
     if isinstance(target, (str, os.PathLike)) and is_built_in(target):
         groups += [*_SIMULATE_GROUPS[os.fspath(target)], "BLOCK_MATERIAL"]
     elif isinstance(target, (str, os.PathLike)):
-        groups.append("SURVEY")
+        groups += ["SURVEY", "SETTLE"]
     return [name for group in groups for name in getattr(options, group)]
 
 
@@ -105,6 +105,7 @@ def scenario(target, **options):
     from geometry_library.blocks import GeometryError
     from masonrycli.scenario.builtin import builtin, file_scenario, is_built_in, override_run, with_record
     from masonrycli.scenario.scenario import Scenario
+    from masonrycli.settle import settled_scenario
 
     if not isinstance(target, (str, os.PathLike, Scenario)):
         raise InputError(
@@ -122,7 +123,8 @@ def scenario(target, **options):
         if is_built_in(target):
             return builtin(os.fspath(target), **options)
         survey = {k: options.pop(k) for k in ("units", "flip_y", "convex_hull", "trim_overlaps") if k in options}
-        return file_scenario(target, survey=survey, **options)
+        settle = options.pop("settle", None)
+        return settled_scenario(file_scenario(target, survey=survey, **options), settle)  # as `masonry run` loads it
     except GeometryError as exc:  # the command line's one line, as the one error type of bad input
         raise InputError(str(exc).splitlines()[0] if str(exc) else type(exc).__name__) from None
 
