@@ -472,8 +472,9 @@ def validate_assembly(
         hint = float32_hint(coords, h_min, "their")
         depth = overlap_depth(overlap)
         depth = f"{depth * 1e3:.2g} mm deep" if depth < 0.1 else f"{depth:.3g} m deep"
+        twice = " — one covers the other: the same stone drawn twice?" * bool(area >= 0.9 * body_areas[[a, b]].min())
         raise GeometryError(
-            f"{what} overlap by {area:.3g} m², {depth} (tolerance {tol:.3g} m², "
+            f"{what} overlap by {area:.3g} m², {depth}{twice} (tolerance {tol:.3g} m², "
             f"{OVERLAP_MAX_DEPTH * 1e3:g} mm deep){more}{hint}"
         )
 

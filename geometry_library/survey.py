@@ -309,7 +309,7 @@ def trim_overlaps(assembly: Assembly, depth: float) -> tuple[Assembly, str]:
             continue  # touching along an edge or at a point
         d = overlap_depth(overlap)
         if d > depth:
-            deep.append((a, b, d))
+            deep.append((a, b, d, overlap.area >= 0.9 * min(polys[a].area, polys[b].area)))
             continue
         deepest = max(deepest, d)
         start, normal = _chord(polys[a], polys[b])
@@ -321,14 +321,19 @@ def trim_overlaps(assembly: Assembly, depth: float) -> tuple[Assembly, str]:
         cuts[a].append((normal, float(normal @ start)))
         cuts[b].append((-normal, float(-normal @ start)))
     if deep:
-        a, b, d = deep[0]
-        others = [f"{bodies[p].name}/{bodies[q].name}" for p, q, _ in deep[1:6]]
+        a, b, d, twice = deep[0]
+        others = [f"{bodies[p].name}/{bodies[q].name}" for p, q, *_ in deep[1:6]]
         more = (
             f" (and {len(deep) - 1} more: {', '.join(others)}{', …' if len(deep) > 6 else ''})" if len(deep) > 1 else ""
         )
         raise GeometryError(
             f"{labels[a]} and {labels[b]} overlap {d * 1e3:.3g} mm deep, more than the {depth * 1e3:.3g} mm trimmed "
-            f"(a slip of the tracing that deep: a larger depth trims it; else redraw them){more}"
+            + (
+                "(one covers the other: the same stone drawn twice?)"
+                if twice
+                else "(a slip of the tracing that deep: a larger depth trims it; else redraw them)"
+            )
+            + more
         )
     pairs = sum(len(c) for c in cuts) // 2
     if not pairs:

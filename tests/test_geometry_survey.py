@@ -269,3 +269,17 @@ def test_a_float32_export_far_away_is_said_once_moved(tmp_path):
         feature.insert(2, [float(np.float32(12000.2)), float(np.float32(5000.01))])  # a dent: refused
         (tmp_path / "f32.geojson").write_text(json.dumps(data))
         read_geojson(tmp_path / "f32.geojson")
+
+
+def test_a_stone_drawn_twice_is_named_so(tmp_path):
+    # a QGIS slip: the same stone digitised twice (a copy 1 mm off): not a tracing overlap, said so either way
+    stones = (Block(box(0, 0, 0.4, 0.2), "S1"), Block(box(0.001, 0, 0.401, 0.2), "S1-copy"))
+    twice = Assembly(stones, (Support(box(-1, -0.5, 1, 0.0), "ground"),))
+    with pytest.raises(
+        GeometryError, match="200 mm deep, more than the 3 mm trimmed \\(one covers the other: the same"
+    ):
+        trim_overlaps(twice, 0.003)
+    with pytest.raises(GeometryError, match=r"0\.2 m deep — one covers the other: the same stone drawn twice\?"):
+        validate_assembly(twice)
+    with pytest.raises(GeometryError, match=r"overlap by 0\.0002 m², 1 mm deep \(tolerance"):  # a slip: not said
+        validate_assembly(Assembly((stones[0], Block(box(0.399, 0, 0.8, 0.2), "S2")), twice.supports))
