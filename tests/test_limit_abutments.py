@@ -62,3 +62,52 @@ def test_bad_abutments_are_one_line():
         build_arch(abutments="hollow")
     with pytest.raises(GeometryError, match="the aqueduct's piers are courses"):
         build_aqueduct(abutments="solid")
+
+
+def test_the_filled_rings_least_thickness_is_the_four_hinge_references():
+    """`--min-thickness` with a fill to a fixed level (2.6 m over the springing line: over the crown of any ring
+    tried) on fixed abutments: the thickness at which the enumeration's least λ under a vanishing horizontal
+    load reaches 0, the fill's weight and inertia on each voussoir from its chord up to the level (shoelace,
+    as in tests/test_limit_fill.py)."""
+    import json
+    import math
+
+    from four_hinge_reference import least_load_factor
+    from scipy.optimize import brentq
+    from test_limit_fill import reference_fill
+    from test_limit_ring_mechanisms import ring, voussoir_loads
+
+    from cli_helpers import invoke
+
+    radius, alpha, level = 5.0, math.asin(0.8), 2.6  # the springing line at y = 0 here
+
+    def lam(t, filled=True):
+        i, e = ring(radius, t, alpha, 30, centre_y=-3.0)
+        centroid, area = voussoir_loads(i, e)
+        at, fill = reference_fill(e, level)
+        fill = fill * (2000.0 / 2500.0) * filled  # per the blocks' ρ g: dead and live are in areas × ρ_stone
+        extra = (
+            ("dead", np.stack([0 * fill, -fill], axis=1), at),
+            ("live", np.stack([fill, 0 * fill], axis=1), at),
+        )
+        dead, live = np.stack([0 * area, -area], axis=1), np.stack([area, 0 * area], axis=1)
+        return least_load_factor(i, e, centroid, dead, live, extra=extra)[0]
+
+    expected = brentq(lam, 0.02, 0.3, xtol=1e-8)
+    assert abs(expected / brentq(lambda t: lam(t, False), 0.02, 0.3, xtol=1e-8) - 1) > 0.05  # the fill matters
+    shape = ["--span", "8", "--rise", "2", "--ring-thickness", "0.5", "--pier-width", "3", "--pier-courses", "5"]
+    result = invoke(
+        "limit",
+        "arch",
+        *shape,
+        "--abutments",
+        "fixed",
+        "--fill-to",
+        "2.6",
+        "--friction",
+        "10",
+        "--min-thickness",
+        "--json",
+    )
+    assert result.exit_code == 0, result.output
+    assert json.loads(result.stdout)["least_ring_thickness_m"] == pytest.approx(expected, rel=2e-4)

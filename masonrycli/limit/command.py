@@ -124,7 +124,8 @@ def result_table(result: LimitResult, out: Path | None) -> Table:
     if result.settled is not None:
         table.add_row("settled", result.settled.describe())
     table.add_row("joints", f"{s['joints']} ({s['contact_points']} contact points, from the engine's detection)")
-    table.add_row("live load", result.load.describe())
+    fill_too = "; the fill's mass too" if s["fill_load_N"] and result.load.kind != "point" else ""
+    table.add_row("live load", result.load.describe() + fill_too)
     if result.places is not None:
         table.add_row("worst place", _worst_text(result))
     lam = Text(f"{result.load_factor:.4f}", style="bold")  # Text: the consoles parse no markup
