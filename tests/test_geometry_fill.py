@@ -196,3 +196,16 @@ def test_a_runs_parameters_say_the_fill_the_view_does_not_draw():
     assert meta["fill_mass_kg"] == pytest.approx(sum(b.carried_mass for b in filled.assembly.blocks), rel=1e-12)
     bare = builtin("arch", **BRIDGE)
     assert "fill_mass_kg" not in run_metadata(bare, Simulation(bare))
+
+
+def test_check_names_the_fill_it_would_run_with(tmp_path):
+    """`masonry check` on a scenario file of the filled bridge: a `fill` row with the mass its blocks carry."""
+    from cli_helpers import invoke, words
+
+    path = tmp_path / "bridge.toml"
+    options = "".join(f"{k} = {v}\n" for k, v in BRIDGE.items())
+    path.write_text(f'name = "bridge"\n[structure]\nbuilder = "arch"\n{options}fill_cover = 0.3\n')
+    result = invoke("check", str(path), "--no-recording")
+    assert result.exit_code == 0, result.output
+    fill = sum(b.carried_mass for b in builtin("arch", **BRIDGE, fill_cover=0.3).assembly.blocks)
+    assert f"fill {fill:.6g} kg carried by the blocks under it" in words(result.output.replace("│", " "))
