@@ -193,6 +193,9 @@ def test_files_asked_for_are_written_read_back_and_viewed(tmp_path, monkeypatch)
     with pytest.raises(InputError, match="--history .*exists"):
         api.simulate("wall", duration=0.02, history=h)  # never overwritten without force
     api.simulate("wall", duration=0.02, history=h, force=True)
+    monkeypatch.chdir(tmp_path)
+    default = api.simulate("wall", duration=0.02, recording=True)  # the command line's default name
+    assert default.recording.parent == Path("recordings") and default.recording.name.startswith("wall-")
     started = []
     monkeypatch.setattr(subprocess, "Popen", lambda args: started.append(args) or "viewer")
     assert api.view(rec) == "viewer" and started[0][1:] == [str(rec)]
