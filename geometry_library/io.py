@@ -9,7 +9,8 @@ only; a ``MultiPolygon`` of one part, as QGIS saves polygon layers, is that poly
 
 =================  =========================================================================
 ``role``           ``"block"`` (default) or ``"support"``
-``name``           unique label (default ``block-<i>`` / ``support-<j>``)
+``name``           unique label (default ``<column>-<value>`` of a GIS id column, ``id-17``, when those differ
+                   (:func:`id_names`); else ``block-<i>`` / ``support-<j>``)
 ``density``        kg/m³, blocks only (default: the reader's ``density`` argument)
 ``thickness``      m, blocks only (default: the reader's ``thickness`` argument)
 ``velocity``       [vx, vy, ω] initial velocity, blocks only (default [0, 0, 0])
@@ -201,6 +202,7 @@ def read_geojson(
     supports: list[Support] = []
     refused: list[tuple[str, str]] = []  # (message, body) of each polygon refused, said together at the end
     pending = []  # (feature_at, where, role, index, name, props, coords): made once every ring is read
+    by_id = id_names(features)  # feature number -> "id-17": a GIS layer's own numbering names its stones
     survey, said = survey or Survey(), []  # said: the ground lines read
     for k, feature in enumerate(features, start=1):  # numbered from 1, as the bodies are (body_label)
         feature_at = where = f"{path}: feature {k}"  # the body's label is added once its role is read
@@ -222,7 +224,7 @@ def read_geojson(
         index = len(blocks) if role == "block" else len(supports)
         name = props.get("name", "")
         if isinstance(name, str) and not name.strip():  # an empty attribute cell, as null: not given
-            name = "ground" if line else f"{role}-{index + 1}"  # block-1 first, as in a TOML file
+            name = by_id.get(k) or ("ground" if line else f"{role}-{index + 1}")  # block-1 first, as in TOML
         if isinstance(name, (bool, list, dict)):  # a number is a GIS id column's (5 -> "5"); these were named
             raise GeometryError(f"{where}: name must be a string, got {name!r}")  # "{'a': 1}", "True"
         name = str(name)
@@ -291,6 +293,28 @@ def read_geojson(
                 raise GeometryError(f"{where}: support_role must be one of {SUPPORT_ROLES}, got {srole!r}")
             supports[index] = Support(polygon, name, srole)
     return finish_reading(path, refused, blocks, supports, frame, survey, hulls, notes)
+
+
+def id_names(features: list) -> dict[int, str]:
+    """Feature number (from 1) → ``"<column>-<value>"`` (``id-17``) for the features with no ``name`` but a GIS
+    id column (``GIS_ID_COLUMNS``, a whole number or a word), when those names all differ from each other and
+    from the names given ({} otherwise: every body keeps its default name). A stone refused or overlapping was
+    ``block 4 ("block-4")``, which a QGIS attribute table does not show (block 4 is feature 5 when the
+    foundation comes first); its id is there."""
+    named, found = set(), {}
+    for k, feature in enumerate(features, start=1):
+        props = (feature.get("properties") if isinstance(feature, dict) else None) or {}
+        props = props if isinstance(props, dict) else {}
+        if isinstance(props.get("name"), str) and props["name"].strip():
+            named.add(props["name"])
+            continue
+        for key, value in props.items():
+            if str(key).lower() in GIS_ID_COLUMNS and isinstance(value, (int, str)) and not isinstance(value, bool):
+                found[k] = f"{key}-{value}"
+                break
+    names = list(found.values())
+    unique = len(set(names)) == len(names) and not named.intersection(names)
+    return found if unique and all(name_problem(n) is None for n in names) else {}
 
 
 def _ring_coords(polygon: Polygon) -> list[list[float]]:

@@ -20,9 +20,7 @@ def traced(tmp_path):
 
 def test_check_a_traced_wall_reads_it_with_the_options_it_names(traced):
     result = invoke("check", traced)  # each refusal names the option that mends it
-    assert_one_line_error(
-        result, 'block 4 ("block-4"): polygon is not convex', "add (651000, 6861000)", "--convex-hull"
-    )
+    assert_one_line_error(result, 'block 4 ("id-4"): polygon is not convex', "add (651000, 6861000)", "--convex-hull")
     result = invoke("check", traced, "--convex-hull")
     assert_one_line_error(result, "overlap by", "--trim-overlaps 0.003")
     result = invoke("check", traced, "--convex-hull", "--trim-overlaps", "0.003")
@@ -180,7 +178,7 @@ def test_a_scenario_file_reads_a_traced_wall_with_its_structure_keys(traced, tmp
     # a scenario file gives the foundation its own motion: [structure] takes the options' keys beside file
     scenario = tmp_path / "s.toml"
     head = f'[structure]\nfile = "{traced.name}"\n'
-    motion = '[[support]]\nname = "support-1"\nmotion = { kind = "sine", amplitude = 0.3, frequency = 2.0 }\n'
+    motion = '[[support]]\nname = "id-73"\nmotion = { kind = "sine", amplitude = 0.3, frequency = 2.0 }\n'
     scenario.write_text(head + motion)
     assert_one_line_error(invoke("check", scenario), "not convex", "convex_hull = true (in [structure])")
     scenario.write_text(head + "convex_hull = true\ntrim_overlaps = 0.003\n" + motion)

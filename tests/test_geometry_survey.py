@@ -183,7 +183,7 @@ def test_an_unmarked_foundation_is_named(tmp_path):
     wall = read_geojson(wall_file(tmp_path, "w.geojson", mark_ground=False, **EXACT), notes=notes)
     assert wall.support_count == 0 and wall.block_count == 73
     assert any(
-        'block 73 ("block-73") lies lowest and spans the structure' in n and '"role": "support"' in n for n in notes
+        'block 73 ("id-73") lies lowest and spans the structure' in n and '"role": "support"' in n for n in notes
     )
     notes = []
     read_geojson(wall_file(tmp_path, "m.geojson", **EXACT), notes=notes)  # marked: nothing to say
@@ -206,7 +206,9 @@ def test_a_ground_line_is_the_ground_under_it(tmp_path):
     # rectangle down to 0.5 m below the line; no role needed (a line is no block)
     notes = []
     wall = read_geojson(wall_file(tmp_path, "w.geojson", ground_line=True, mark_ground=False, **EXACT), notes=notes)
-    assert wall.block_count == 72 and wall.support_count == 1 and wall.supports[0].name == "ground"
+    assert (
+        wall.block_count == 72 and wall.support_count == 1 and wall.supports[0].name == "id-73"
+    )  # its id column; "ground" without
     assert wall.supports[0].polygon.equals(box(-0.3, -0.5, 4.3, 0.0))
     assert any("feature 73: a LineString read as the ground under it, 0.5 m deep" in n for n in notes), notes
     assert validate_assembly(wall) == []
@@ -283,3 +285,18 @@ def test_a_stone_drawn_twice_is_named_so(tmp_path):
         validate_assembly(twice)
     with pytest.raises(GeometryError, match=r"overlap by 0\.0002 m², 1 mm deep \(tolerance"):  # a slip: not said
         validate_assembly(Assembly((stones[0], Block(box(0.399, 0, 0.8, 0.2), "S2")), twice.supports))
+
+
+def test_stones_are_named_by_their_id_column(tmp_path):
+    # the layer's id column names the stones (block 4 of a file whose foundation comes first is feature 5):
+    # the foundation first, so block k is feature k + 1 and id k
+    data = surveyed_wall.write(tmp_path / "w.geojson", **EXACT)
+    data["features"] = data["features"][-1:] + data["features"][:-1]
+    data["features"][3]["geometry"]["coordinates"][0][0].insert(2, [0.95, 0.05])  # stone id 3 dented: refused
+    (tmp_path / "f.geojson").write_text(json.dumps(data))
+    with pytest.raises(GeometryError, match=r'feature 4: block 3 \("id-3"\): polygon is not convex'):
+        read_geojson(tmp_path / "f.geojson")
+    data["features"][5]["properties"]["id"] = 3  # two stones with id 3: no names from ids, the defaults
+    (tmp_path / "f.geojson").write_text(json.dumps(data))
+    with pytest.raises(GeometryError, match=r'feature 4: block 3 \("block-3"\): polygon is not convex'):
+        read_geojson(tmp_path / "f.geojson")
