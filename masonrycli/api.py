@@ -169,7 +169,9 @@ def simulate(
     outputs = check_run(sc, out, hist, no_recording=recording in (None, False), force=force, magnify=magnify)
     for warning in scenario_warnings(sc):
         warnings.warn(warning, UserWarning, stacklevel=2)
-    quiet = Console(file=io.StringIO(), quiet=True)
+    # force_jupyter=False: in a notebook rich shows every console's output under the cell whatever its file (the
+    # summary table, which goes to Run.summary, was shown after every run of a loop)
+    quiet = Console(file=io.StringIO(), quiet=True, force_jupyter=False)
     sinks = [_FrameCallback(on_frame)] if on_frame is not None else []
     try:
         outcome = execute(
@@ -186,7 +188,7 @@ def simulate(
     for error in outcome.errors:
         warnings.warn(f"cannot write {error}", RuntimeWarning, stacklevel=2)
     paths = {o.option: o.path for o in outcome.written}
-    text = Console(file=io.StringIO(), width=100, record=True)
+    text = Console(file=io.StringIO(), width=100, record=True, force_jupyter=False)
     shown = {k: str(v) for k, v in paths.items()}
     text.print(summary_table(outcome.result, shown.get("--out"), shown.get("--history"), sc.name))
     return Run(

@@ -224,6 +224,20 @@ def test_the_views_of_the_arrays(tmp_path):
         run["energy_kinetc"]
 
 
+def test_a_notebook_shows_nothing_but_what_the_user_prints(monkeypatch, capsys):
+    # in Jupyter rich displays a console's output under the cell whatever its file: every api.simulate showed the
+    # summary table (found running docs/python.md's cells in an ipykernel). Here rich is made to believe it is in
+    # Jupyter, and what it would display is counted.
+    import rich.console
+    import rich.jupyter
+
+    shown = []
+    monkeypatch.setattr(rich.console, "_is_jupyter", lambda: True)
+    monkeypatch.setattr(rich.jupyter, "display", lambda segments, text: shown.append(text))
+    run = api.simulate("wall", duration=0.02, amp=0.5)
+    assert shown == [] and capsys.readouterr() == ("", "") and run.summary.startswith("wall — completed")
+
+
 def _page_blocks() -> list[str]:
     return re.findall(r"```python\n(.*?)```", (ROOT / "docs" / "python.md").read_text(), flags=re.S)
 
