@@ -10,6 +10,7 @@ import os
 import re
 import signal
 import subprocess
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -236,6 +237,16 @@ def test_a_notebook_shows_nothing_but_what_the_user_prints(monkeypatch, capsys):
     monkeypatch.setattr(rich.jupyter, "display", lambda segments, text: shown.append(text))
     run = api.simulate("wall", duration=0.02, amp=0.5)
     assert shown == [] and capsys.readouterr() == ("", "") and run.summary.startswith("wall — completed")
+
+
+def test_import_masonrycli_names_the_api_and_does_not_load_it():
+    # the first thing a student tries; the package stays light for the commands (no engine, no numba)
+    code = (
+        "import sys, masonrycli; assert 'from masonrycli import api' in masonrycli.__doc__; "
+        "assert 'masonrycli.api' not in sys.modules and 'numba' not in sys.modules; "
+        "assert masonrycli.api.simulate is sys.modules['masonrycli.api'].simulate"
+    )
+    subprocess.run([sys.executable, "-c", code], check=True, cwd=ROOT, env={**os.environ, "PYTHONPATH": str(ROOT)})
 
 
 def _page_blocks() -> list[str]:
