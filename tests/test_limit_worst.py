@@ -171,3 +171,21 @@ def test_an_axle_spread_through_the_fill_matches_the_reference(x, angle):
 def test_spread_needs_a_fill_to_spread_through():
     with pytest.raises(InputError, match="no fill to spread through"):
         analyse(filled_ring_scenario(20), LiveLoad("point", at=-2.0, spread=30.0))
+
+
+def test_the_table_says_whether_the_axle_is_carried():
+    """λ ≥ 1 carries the given force, λ < 1 does not: an axle of half and of twice the bridge's collapse load
+    over its quarter span."""
+    from masonrycli.scenario.builtin import builtin
+
+    from cli_helpers import words
+
+    shape = dict(span=8.0, rise=2.0, ring_thickness=0.5, pier_width=3.0, pier_courses=5)
+    collapse = analyse(builtin("arch", **shape), LiveLoad("point", at=-2.0, force=AXLE)).load_factor * AXLE
+    options = [f"--{k.replace('_', '-')}={v:g}" for k, v in shape.items()]
+    for factor, verdict in ((0.5, "carries it"), (2.0, "does not carry it")):
+        force = factor * collapse
+        result = invoke("limit", "arch", *options, "--load", "point", "--at", "-2", "--point-force", f"{force:.17g}N")
+        assert result.exit_code == 0, result.output
+        size = f"{force / 1e3:.4g} kN"
+        assert f"({verdict}: collapse at {1 / factor:.3g} × {size})" in words(result.output.replace("│", " "))

@@ -24,7 +24,7 @@ from masonrycli import SOURCE_DIGEST, __version__
 from masonrycli.errors import EXIT_OUTPUT_FAILED, InputError
 from masonrycli.interrupt import StopRun, StopSignals, exit_code, signal_name
 from masonrycli.limit.analysis import LimitResult, analyse
-from masonrycli.limit.problem import DIRECTIONS, LimitError, LiveLoad, NoEquilibrium, parse_force
+from masonrycli.limit.problem import DIRECTIONS, LimitError, LiveLoad, NoEquilibrium, force_text, parse_force
 from masonrycli.outputs.files import check_output, written_whole
 from masonrycli.source_digest import source_commit
 
@@ -86,6 +86,10 @@ def lambda_reading(result: LimitResult) -> str:
         reading.append(f"a horizontal acceleration of {result.load_factor:.3g} g = {result.load_factor * g:.3g} m/s²")
     if result.tilt_angle() is not None:
         reading.append(f"tilt ψ = {result.tilt_angle():.2f}°")
+    if result.load.force is not None:  # an axle's verdict: carried, or by how much it is not
+        size = force_text(result.load.force)
+        verdict = "carries it" if result.load_factor >= 1.0 else "does not carry it"
+        reading.append(f"{verdict}: collapse at {result.load_factor:.3g} × {size}")
     return "; ".join(reading)
 
 
