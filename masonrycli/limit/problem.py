@@ -137,7 +137,8 @@ class LiveLoad:
             where = "" if self.at is None else f" (the top block over x = {self.at:g} m, loaded there)"
             where = f" at x = {self.at:g} m (the worst place on the top)" if self.worst else where
             if self.spread is not None:
-                where += f", spread through the fill at {self.spread:g}° onto {len(self.patches or ())} stretches"
+                n = len(self.patches or ())
+                where += f", spread through the fill at {self.spread:g}° onto {n} stretch{'es' * (n != 1)} of the top"
             size = "its weight" if self.force is None else force_text(self.force)
             what = "point load" if self.force is None else f"point load of {force_text(self.force)}"
             return f"{what} on {self.block}{where}, {self.direction} (λ × {size})"
