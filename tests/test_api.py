@@ -209,6 +209,7 @@ def test_the_views_of_the_arrays(tmp_path):
     run = api.simulate("wall", duration=0.05, amp=0.5, on_frame=frames.append)
     assert [f.time for f in frames] == list(run.time)  # every recorded frame, the history's
     assert all(f.contact_force.shape == f.contact_point.shape == (len(f.contact_body), 2) for f in frames)
+    assert [b.name for b in api.scenario("wall").assembly.blocks] == run.block_names  # docs/python.md draws so
     u = run.displacement
     assert u.shape == (len(run.time), 51, 3) and not u[0].any()
     assert run.block("c01-b01") == run.block_names.index("c01-b01")
@@ -264,6 +265,10 @@ def test_the_python_page_runs_as_a_notebook(tmp_path, monkeypatch):
     namespace: dict = {}
     for k, code in enumerate(blocks):
         exec(compile(code, f"docs/python.md block {k + 1}", "exec"), namespace)
-    assert (tmp_path / "wall-drift.png").stat().st_size > 0 and (tmp_path / "runs" / "wall.npz").is_file()
+    assert (
+        (tmp_path / "wall-drift.png").stat().st_size > 0
+        and (tmp_path / "wall-end.png").stat().st_size > 0
+        and (tmp_path / "runs" / "wall.npz").is_file()
+    )
     assert namespace["run"].outcome["state"] == "damaged"
     assert namespace["message"] == "--amp: amplitude = nan: must be a finite number"
