@@ -204,6 +204,23 @@ def test_files_asked_for_are_written_read_back_and_viewed(tmp_path, monkeypatch)
         api.read_history(tmp_path / "none.npz")
 
 
+@pytest.mark.parametrize(
+    "name, said",
+    [
+        ("w.rrd", "w.rrd: a Rerun recording (.rrd), not a history (.npz); masonry inspect summarises it"),
+        ("s.toml", "s.toml: a scenario file (TOML), not a history (.npz); masonry run runs it"),
+    ],
+)
+def test_a_file_of_another_kind_is_named_as_such(name, said, tmp_path, monkeypatch):
+    # read_history and masonry export said "w.rrd: not a readable history (.npz): BadZipFile: File is not a zip file"
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / name).write_text("x")
+    with pytest.raises(InputError) as refused:
+        api.read_history(name)
+    assert str(refused.value) == said
+    assert words(invoke("export", name).output) == f"error: {said}"
+
+
 def test_the_views_of_the_arrays(tmp_path):
     frames = []
     run = api.simulate("wall", duration=0.05, amp=0.5, on_frame=frames.append)

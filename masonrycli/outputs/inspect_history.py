@@ -16,7 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
-from masonrycli.errors import NOT_A_FILE, InputError, one_line
+from masonrycli.errors import NOT_A_FILE, InputError, file_kind, one_line
 from masonrycli.outputs.files import being_written
 
 NOT_RECORDED = "not recorded"
@@ -79,6 +79,9 @@ def inspect_history(path: str | os.PathLike) -> dict:
         if live is not None:  # streamed as raw rows, made an .npz at the end: nothing to read before it
             raise InputError(f"{shown}: not there yet: a run still going (pid {live[1]}) writes it, whole at its end")
         raise InputError(f"{shown}: no such history")
+    other = file_kind(path, "a history (.npz)", skip=(".npz",))
+    if other is not None:  # export or read_history given a recording said "not a readable history: BadZipFile"
+        raise other
     try:
         with zipfile.ZipFile(path) as zf:
             # every array's checksum first: a file damaged inside an array inspect does not load was summarised
