@@ -103,10 +103,9 @@ def top_surface(blocks, x_lo: float, x_hi: float) -> list[TopPiece]:
     return pieces
 
 
-def fill_over(blocks, level: float, x_lo: float, x_hi: float) -> Fill:
-    """The fill up to ``level`` (m) over the blocks' top surface between ``x_lo`` and ``x_hi`` (m), per block
-    (module docstring)."""
-    sums = np.zeros((len(blocks), 3))
+def _under_level(blocks, level: float, x_lo: float, x_hi: float):
+    """(block, a, b, y(a), y(b)) of each piece of the top surface below ``level``, left to right, clipped where
+    the top crosses the level (module docstring)."""
     for piece in top_surface(blocks, x_lo, x_hi):
         a, b = piece.a, piece.b
         ya, yb = piece.y(a), piece.y(b)
@@ -116,11 +115,54 @@ def fill_over(blocks, level: float, x_lo: float, x_hi: float) -> Fill:
             cross = a + (level - ya) / piece.slope
             a, b = (a, cross) if ya < level else (cross, b)
             ya, yb = min(piece.y(a), level), min(piece.y(b), level)
-        sums[piece.block] += _trapezoid(a, b, ya, yb, level)
+        yield piece.block, a, b, ya, yb
+
+
+def fill_over(blocks, level: float, x_lo: float, x_hi: float) -> Fill:
+    """The fill up to ``level`` (m) over the blocks' top surface between ``x_lo`` and ``x_hi`` (m), per block
+    (module docstring)."""
+    sums = np.zeros((len(blocks), 3))
+    for block, a, b, ya, yb in _under_level(blocks, level, x_lo, x_hi):
+        sums[block] += _trapezoid(a, b, ya, yb, level)
     area = sums[:, 0]
     with np.errstate(invalid="ignore", divide="ignore"):
         centroid = np.where(area[:, None] > 0.0, sums[:, 1:] / area[:, None], np.nan)
     return Fill(area=area, centroid=centroid)
+
+
+@dataclasses.dataclass(frozen=True, eq=False)
+class FillColumns:
+    """The fill's columns as drawn: one polygon per run of the top surface that one block carries (one per
+    block under the fill when, as over a ring, each block's top is one stretch). Polygon k belongs to block
+    ``block[k]``; its vertices ``vertices[start[k]:start[k + 1]]`` (m, counter-clockwise) are the top surface
+    left to right, p_0 … p_n, then the same abscissae on the level right to left, so that piece i of the
+    column is the trapezoid p_i, p_i+1, t_i+1, t_i (t the points on the level): an exact triangulation
+    where a fan would cross a peaked top."""
+
+    block: np.ndarray
+    """(P,) int64."""
+    start: np.ndarray
+    """(P+1,) int64."""
+    vertices: np.ndarray
+    """(V, 2) float64, m."""
+
+
+def fill_columns(blocks, level: float, x_lo: float, x_hi: float) -> FillColumns:
+    """The fill of :func:`fill_over` as polygons, per block (:class:`FillColumns`): the same pieces, each
+    block's consecutive pieces joined into one column, so their areas sum to ``fill_over``'s."""
+    runs: list[tuple[int, list[tuple[float, float]]]] = []  # (block, bottom points left to right)
+    for block, a, b, ya, yb in _under_level(blocks, level, x_lo, x_hi):
+        if runs and runs[-1][0] == block and runs[-1][1][-1][0] == a:  # the same block goes on
+            runs[-1][1].append((b, yb))
+        else:
+            runs.append((block, [(a, ya), (b, yb)]))
+    polygons = [np.array(bottom + [(x, level) for x, _ in reversed(bottom)]) for _, bottom in runs]
+    sizes = np.array([len(p) for p in polygons], dtype=np.int64)
+    return FillColumns(
+        block=np.array([b for b, _ in runs], dtype=np.int64),
+        start=np.r_[0, np.cumsum(sizes)].astype(np.int64),
+        vertices=np.concatenate(polygons) if polygons else np.zeros((0, 2)),
+    )
 
 
 def with_fill(blocks, level: float, density: float, x_lo: float, x_hi: float) -> list[Block]:

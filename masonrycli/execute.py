@@ -161,7 +161,7 @@ def run_metadata(scenario, sim: Simulation) -> dict:
         "source": scenario.source,
         "structure": dict(scenario.structure),
         "blocks": sim.model.block_count,
-        # a carried fill is not drawn: the recording's parameters say it (only when there is one)
+        # a carried fill, said in the parameters (only when there is one); a built-in's is also drawn
         **({"fill_mass_kg": fill} if (fill := float(sim.model.block_carried_mass.sum())) > 0.0 else {}),
         "supports": {s.name: m.describe() for s, m in zip(scenario.assembly.supports, scenario.motions)},
         "baseline_corrections": {
@@ -190,14 +190,20 @@ def run_metadata(scenario, sim: Simulation) -> dict:
     }
 
 
-def recording_static(sim: Simulation):
-    """Geometry the recorder logs once: block and support polygons, triangulation."""
+def recording_static(sim: Simulation, scenario=None):
+    """Geometry the recorder logs once: block and support polygons, triangulation; the columns of a built-in
+    bridge's fill (``scenario``'s, moved to their blocks' frames)."""
     from masonrycli.recording import RecordingStatic
+    from masonrycli.scenario.fill import columns_on_blocks
 
     m = sim.model
     n = m.block_count
     start = m.body_vert_start
+    cols = None if scenario is None else columns_on_blocks(scenario, m.body_q0[:n, :2])
+    fill = {} if cols is None else dict(zip(("fill_block", "fill_vert_start", "fill_vert_local"), cols))
     return RecordingStatic(
+        **fill,
+        fill_load_n=float(m.block_carried_mass.sum() * np.hypot(*m.gravity)),
         block_name=np.asarray(m.block_name, dtype=str),
         block_vert_start=start[: n + 1].copy(),
         block_vert_local=m.vert_local[: start[n]].copy(),
@@ -283,7 +289,7 @@ def _open_sink(out: OutputFile, outputs: Outputs, scenario, sim: Simulation, mag
         return _history(HistoryFile, scenario, sim, out.part)
     from masonrycli.recording import Recorder
 
-    return Recorder(out.part, recording_static(sim), run_metadata(scenario, sim), magnify=magnify)
+    return Recorder(out.part, recording_static(sim, scenario), run_metadata(scenario, sim), magnify=magnify)
 
 
 def _history(kind, scenario, sim: Simulation, *path):

@@ -213,11 +213,13 @@ def mechanism_document(result: LimitResult) -> str:
 
 
 def _fill_lines(result: LimitResult) -> list[str]:
-    """The panel's word on a fill, which the view does not draw: a filled bridge's recording showed a bare ring."""
+    """The panel's word on a fill: a filled bridge's recording showed a bare ring (the view draws a built-in's
+    columns now; a GeoJSON's carried masses have no level to draw them to)."""
     fill = result.summary()["fill_load_N"]
     if not fill:
         return []
-    return [f"dead load: the blocks' weight and {fill:.4g} N of fill{_depth(result)}, borne by the blocks under it", ""]
+    said = f"dead load: the blocks' weight and {fill:.4g} N of fill{_depth(result)}, borne by the blocks under it"
+    return [said + " (sand: a built-in bridge's fill, each column over its block, carried along the mechanism)", ""]
 
 
 DOCUMENT_NAMES = 12
@@ -248,9 +250,11 @@ def load_arrow(result: LimitResult) -> tuple[np.ndarray, np.ndarray]:
     return (mass[:, None] * m.body_q0[:n, :2]).sum(axis=0) / mass.sum(), direction
 
 
-def write_recording(result: LimitResult, out: Path) -> None:
-    """The mechanism recording (``masonrycli.recording.limit``) of ``result``."""
+def write_recording(result: LimitResult, out: Path, scenario=None) -> None:
+    """The mechanism recording (``masonrycli.recording.limit``) of ``result``; ``scenario``'s fill drawn."""
+    from masonrycli.recording.carried_fill import ColumnArrays
     from masonrycli.recording.limit import MechanismDrawing, write_limit_recording
+    from masonrycli.scenario.fill import columns_on_blocks
 
     m, j, mo = result.model, result.joints, result.motion
     n = m.block_count
@@ -278,6 +282,9 @@ def write_recording(result: LimitResult, out: Path) -> None:
         thrust_point=thrust[np.isfinite(thrust).all(axis=1)],
         document=mechanism_document(result),
         load=load_arrow(result),
+        fill=None
+        if (cols := columns_on_blocks(scenario, m.body_q0[:n, :2]) if scenario else None) is None
+        else ColumnArrays(*cols),
     )
     out.parent.mkdir(parents=True, exist_ok=True)
     write_limit_recording(out, drawing)
@@ -450,7 +457,7 @@ def _analyse(structure, live, friction, verify, out, force, done: _Done, signals
         with signals.held():  # a signal now waits until the recording is whole and in place
             try:
                 with written_whole(target) as part:  # under a temporary name, renamed when complete
-                    write_recording(done.result, part)
+                    write_recording(done.result, part, scenario)
             except OSError as exc:  # a full disk: as simulate's outputs, exit 4 (it said "completed", exit 0)
                 from masonrycli.cli.messages import fail
 

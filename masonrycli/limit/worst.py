@@ -30,6 +30,7 @@ from masonrycli.errors import InputError
 from masonrycli.limit.joints import find_joints
 from masonrycli.limit.problem import LimitError, LiveLoad, NoEquilibrium, load_vectors, solve_limit
 from masonrycli.model import build_model
+from masonrycli.scenario.fill import fill_surface
 
 
 @dataclass(frozen=True)
@@ -41,17 +42,6 @@ class Place:
     block: str
     top: float
     load_factor: float | None
-
-
-def fill_surface(scenario) -> float | None:
-    """m: the level of the fill of an arch built with one (``--fill-to`` / ``--fill-cover``), else None."""
-    from geometry_library.builders.arch import ArchSpec, arch_parts, fill_level
-
-    options = {k: v for k, v in scenario.structure.items() if k != "builder"}
-    if scenario.structure.get("builder") != "arch":
-        return None
-    spec = ArchSpec(**options)
-    return fill_level(spec, arch_parts(spec)[2])
 
 
 def placed(load: LiveLoad, blocks, at: float, block: str, top: float, level: float | None) -> LiveLoad:

@@ -8,6 +8,7 @@
 - ``static_content``: ``RecordingStatic`` and what is logged once (styles, drawing plane, colour bars).
 - ``arrays``: posed polygons, Arrow line strips and the frame buffer behind ``send_columns``.
 - ``fills`` and ``overlays``: what a batch of frames draws (the coloured block fills; glyphs, arrows, hinges).
+- ``carried_fill``: a bridge's fill (soil, dead load) drawn over the blocks carrying it, moving with them.
 - ``readback``: ``inspect_recording`` (summary of a file), ``recording_path_problem`` (another file, a missing path or a
   folder, in one line) and ``screenshot_recording`` (headless viewer).
 - ``_rerun_private``: the only use of rerun's private API, kept small and explained there.

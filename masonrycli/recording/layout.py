@@ -117,6 +117,7 @@ STRESS_AXES: Final = f"{XY}/stress_axes"
 MAGNIFIED: Final = f"{XY}/magnified"
 UNDEFORMED: Final = f"{XY}/undeformed"
 SUPPORT_FILL: Final = "structure/supports"
+CARRIED_FILL: Final = ("structure/carried_fill", f"{XY}/carried_fill")  # a bridge's fill: mesh, outlines
 LEGEND_BARS: Final = "structure/legend"  # parent of the colour bars: moved right of where the blocks went
 LEGEND_LABELS: Final = f"{XY}/legend"  # parent of their labels, moved with them
 METADATA: Final = "run/metadata"
@@ -254,7 +255,7 @@ def _fill_colours(f: FieldSpec) -> dict:
 def _structure_view(name: str, f: FieldSpec, extra: tuple[str, ...] = (), at: float | None = None) -> rrb.Spatial2DView:
     """A tab of the structure coloured by field ``f``; ``at``: pinned to that sim_time (s), else live.
     Hover points (block values) in the tabs of the paper's fields."""
-    paths = (SUPPORT_FILL, FILL, f.bar, BLOCKS, SUPPORT_OUTLINES, f.labels, *extra)
+    paths = (SUPPORT_FILL, FILL, *CARRIED_FILL, f.bar, BLOCKS, SUPPORT_OUTLINES, f.labels, *extra)
     pinned = None
     if at is not None:
         moment = rrb.TimeRangeBoundary.absolute(seconds=at)

@@ -24,6 +24,7 @@ import rerun as rr
 import rerun.blueprint as rrb
 
 from masonrycli.recording.arrays import Polygons, z0
+from masonrycli.recording.carried_fill import CARRIED_FILL, CarriedFill, ColumnArrays, no_columns
 from masonrycli.recording.colormap import VIRIDIS, colorbar_mesh, map_scalars
 from masonrycli.recording.document import viewer_safe_text
 from masonrycli.recording.layout import (
@@ -100,6 +101,8 @@ class MechanismDrawing:
     """Markdown shown beside the view (λ, load, hinges…)."""
     load: tuple[np.ndarray, np.ndarray] | None = None
     """(point, unit direction), m: where the live load acts and which way (drawn on the structure as built)."""
+    fill: ColumnArrays | None = None
+    """The columns of fill the blocks carry (``carried_fill``), drawn on both copies; None: no fill."""
 
 
 def _block_speed(polys: Polygons, velocity: np.ndarray) -> np.ndarray:
@@ -179,7 +182,8 @@ def write_limit_recording(path: str | os.PathLike, drawing: MechanismDrawing) ->
     view = rrb.Spatial2DView(
         origin=f"/{PLANE}",
         contents=[
-            f"+ /{p}" for p in (SUPPORTS, FILL, OUTLINES, THRUST, LOAD, HINGES, SLIDING, SPEED_BAR, SPEED_LABELS)
+            f"+ /{p}"
+            for p in (SUPPORTS, FILL, *CARRIED_FILL, OUTLINES, THRUST, LOAD, HINGES, SLIDING, SPEED_BAR, SPEED_LABELS)
         ],
         name="Collapse mechanism (right, magnified) and line of thrust",
     )
@@ -217,6 +221,9 @@ def write_limit_recording(path: str | os.PathLike, drawing: MechanismDrawing) ->
         if d.load is not None:  # the point load was nowhere on screen: the document alone named its block
             _log_load(rec, d.load, LOAD_LENGTH * size)
         idx = [rr.TimeColumn("step", sequence=np.arange(frames))]
+        carried = CarriedFill(no_columns() if d.fill is None else d.fill, copies=2, blocks=n)
+        carried.log_static(rec)
+        carried.send(rec, idx, poses)  # each column on its block in both copies: carried along the mechanism
         rec.send_columns(
             FILL,
             indexes=idx,

@@ -48,6 +48,7 @@ from masonrycli.outputs.frame import Frame
 from masonrycli.outputs.sinks import COMPLETED, FAILED, INTERRUPTED, RUNNING
 from masonrycli.recording.arrays import FrameBatch, Polygons, time_indexes
 from masonrycli.recording.batching import Batching, initial_frames, io_errors, steps_due
+from masonrycli.recording.carried_fill import CarriedFill, ColumnArrays, fill_legend
 from masonrycli.recording.colormap import nice_ceil, robust_max_abs
 from masonrycli.recording.document import legend_markdown, run_document, viewer_safe_text
 from masonrycli.recording.field_colours import FieldColours
@@ -128,6 +129,7 @@ class Recorder:
         self._t0, self._closed, self._stopped = time.perf_counter(), False, False
         self._blocks = Polygons(static.block_vert_start, static.block_vert_local)
         self._supports = Polygons(static.support_vert_start, static.support_vert_local)
+        self._carried = CarriedFill(ColumnArrays(static.fill_block, static.fill_vert_start, static.fill_vert_local))
         self._fill: Polygons | None = None  # inset blocks, once the structure's size is known
         self._n = n = self._blocks.count
         self.batching = Batching(batch_frames, n, long_batch_frames)
@@ -171,6 +173,7 @@ class Recorder:
             self._main_field = main_field
             self.rec.save(self.path, default_blueprint=build_blueprint(main_field, self.paper))
             log_static(self.rec, static, self._blocks, self._supports)
+            self._carried.log_static(self.rec)
             tolerance = self.metadata.get("nlgs_tolerance")
             self._log10_tolerance = float(np.log10(tolerance)) if tolerance else np.nan
             self._log_metadata(RUNNING, "")
@@ -402,6 +405,7 @@ class Recorder:
             self.rec, idx, self._fill, self._blocks.owner, self._colours, self._label_anchors, q, tensors, initial
         )
         send_supports(self.rec, idx, self._supports, b.stack("support_q"))
+        self._carried.send(self.rec, idx, q)
         self._send_axes(idx, q, tensors)
         self._send_joints(idx, b)
         send_series(self.rec, idx, b, q, self._ref, self._n)
@@ -465,6 +469,7 @@ class Recorder:
         legend = legend_markdown(
             self.force_scale, self.block_height, self.magnify, self._main_field, paper_t, RESULTANT_CAP * self._size
         )
+        legend += fill_legend(self.static.fill_load_n, self.metadata.get("thickness_m"), self._carried.count > 0)
         self.rec.log(LEGEND, rr.TextDocument(viewer_safe_text(legend), media_type="text/markdown"), static=True)
 
 

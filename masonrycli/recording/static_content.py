@@ -11,7 +11,7 @@ would hide.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Final
 
 import numpy as np
@@ -74,6 +74,14 @@ class RecordingStatic:
     friction: float
     dt: float
     """s."""
+    fill_block: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
+    """(P,) int64: the block carrying each column of fill (``carried_fill``; none without a fill)."""
+    fill_vert_start: np.ndarray = field(default_factory=lambda: np.zeros(1, np.int64))
+    """(P+1,) int64."""
+    fill_vert_local: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)))
+    """(Vf, 2) m, relative to the carrying block's centre (as block_vert_local)."""
+    fill_load_n: float = 0.0
+    """N: the weight the blocks carry (for their thickness), said in the legend."""
 
 
 def log_static(rec: rr.RecordingStream, st: RecordingStatic, blocks: Polygons, supports: Polygons) -> None:

@@ -1,0 +1,48 @@
+"""The fill a built-in bridge carries: its level and its columns, for whatever draws or loads it.
+
+A block knows only the mass it carries and where (``Block.carried_mass`` at ``carried_at``); the fill's level
+and extent are the builder's (``ArchSpec``: ``--fill-to`` / ``--fill-cover`` between the piers' outer faces).
+They are read again from the scenario's structure options, and the columns recomputed over the scenario's own
+blocks (``geometry_library.fill.fill_columns``, the pieces ``with_fill`` weighed). A GeoJSON or a scenario
+file with carried masses has no level: nothing here (its recording says the mass, draws no column).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from geometry_library.fill import FillColumns, fill_columns
+
+
+def _fill_of(scenario) -> tuple[float, float, float] | None:
+    """(level, x_lo, x_hi), m, of an arch built with a fill; None otherwise."""
+    from geometry_library.builders.arch import ArchSpec, arch_parts, fill_level
+
+    if scenario.structure.get("builder") != "arch":
+        return None
+    spec = ArchSpec(**{k: v for k, v in scenario.structure.items() if k != "builder"})
+    geometry = arch_parts(spec)[2]
+    level = fill_level(spec, geometry)
+    return None if level is None else (level, -geometry.half_width, geometry.half_width)
+
+
+def fill_surface(scenario) -> float | None:
+    """m: the level of the fill of an arch built with one (``--fill-to`` / ``--fill-cover``), else None."""
+    fill = _fill_of(scenario)
+    return None if fill is None else fill[0]
+
+
+def carried_columns(scenario) -> FillColumns | None:
+    """The fill's columns over the scenario's blocks (world coordinates as built), None without a fill."""
+    fill = _fill_of(scenario)
+    return None if fill is None else fill_columns(scenario.assembly.blocks, *fill)
+
+
+def columns_on_blocks(scenario, centre: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+    """(block (P,), start (P+1,), vertices (V, 2) m relative to their block's ``centre`` (N, 2)) of the fill's
+    columns (:func:`carried_columns`): as the recording poses them, on their blocks; None without a fill."""
+    columns = carried_columns(scenario)
+    if columns is None or not len(columns.block):
+        return None
+    owner = np.repeat(columns.block, np.diff(columns.start))
+    return columns.block, columns.start, columns.vertices - np.asarray(centre)[owner]

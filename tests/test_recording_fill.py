@@ -1,0 +1,175 @@
+"""A bridge's fill is drawn in its recordings: one column per block that carries fill, over that block and
+moving with it, their areas the fill's (a reference computed here with shapely from the builder's outline:
+the box up to the fill level less the blocks' downward shadow); none in a bare arch's recording."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import rerun as rr
+import shapely
+from shapely.geometry import MultiPoint, box
+from typer.testing import CliRunner
+
+from geometry_library.builders import build_arch
+from masonrycli.cli.app import app
+from masonrycli.recording import inspect_recording, screenshot_recording
+from masonrycli.recording.carried_fill import FILL_MESH, FILL_OUTLINES, strip_triangles
+from masonrycli.recording.limit import OUTLINES, STEPS
+
+import recording_fixtures as fx
+
+BRIDGE = {"span": 8.0, "rise": 2.0, "ring_thickness": 0.5, "pier_width": 3.0, "pier_courses": 5}
+COVER, DENSITY = 0.3, 1900.0
+OPTIONS = [f"--{k.replace('_', '-')}={v:g}" for k, v in BRIDGE.items()]
+FILL = [f"--fill-cover={COVER:g}", f"--fill-density={DENSITY:g}"]
+runner = CliRunner()
+
+
+def invoke(*args):
+    result = runner.invoke(app, [str(a) for a in args], terminal_width=200)
+    assert result.exit_code == 0, result.output
+    return result
+
+
+def strips(path, entity: str) -> dict[int, list[np.ndarray]]:
+    """step -> the closed strips logged at ``entity`` then."""
+    out = {}
+    for chunk in rr.chunk.RrdReader(str(path)).stream():
+        if chunk.entity_path == f"/{entity}" and not chunk.is_static:
+            batch = chunk.to_record_batch()
+            for step, value in zip(batch.column("step").to_pylist(), batch.column("LineStrips2D:strips").to_pylist()):
+                out[step] = [np.array(s, dtype=float) for s in value]
+    return out
+
+
+def shoelace(ring: np.ndarray) -> float:
+    x, y = ring[:-1].T  # closed: the first point repeated
+    return 0.5 * float(np.sum(x * np.roll(y, -1) - np.roll(x, -1) * y))
+
+
+def centroid(ring: np.ndarray) -> np.ndarray:
+    return np.asarray(shapely.Polygon(ring).centroid.coords[0])
+
+
+def reference_fill_area() -> float:
+    """The fill's area from its definition: between the piers' outer faces, under the level (COVER over the
+    highest stone), above every block (a block's shadow: its hull with itself moved far down)."""
+    blocks = build_arch(**BRIDGE).blocks
+    xy = np.concatenate([b.vertices for b in blocks])
+    low, level, half = xy[:, 1].min(), xy[:, 1].max() + COVER, np.abs(xy[:, 0]).max()
+    shadows = [MultiPoint(np.r_[b.vertices, b.vertices - [0.0, 100.0]]).convex_hull for b in blocks]
+    return box(-half, low, half, level).difference(shapely.union_all(shadows)).area
+
+
+@pytest.fixture(scope="module")
+def bridge(tmp_path_factory):
+    tmp = tmp_path_factory.mktemp("bridge")
+    rrd, npz = tmp / "bridge.rrd", tmp / "bridge.npz"
+    invoke("simulate", "arch", *OPTIONS, *FILL, "--settlement", 0.02, "--duration", 0.05, "--dt", 1e-3,
+           "--record-every", 25, "--out", rrd, "--history", npz)  # fmt: skip
+    return rrd, np.load(npz), build_arch(**BRIDGE, fill_cover=COVER, fill_density=DENSITY).blocks
+
+
+def test_one_column_over_each_block_that_carries_fill_their_area_the_fills(bridge):
+    rrd, _, blocks = bridge
+    first = strips(rrd, FILL_OUTLINES)[0]
+    carrying = [b for b in blocks if b.carried_mass > 0]
+    assert len(first) == len(carrying) > 20  # the voussoirs and the piers' top courses
+    areas = np.array([shoelace(s) for s in first])
+    assert (areas > 0).all()  # counter-clockwise, none empty
+    assert areas.sum() == pytest.approx(reference_fill_area(), rel=1e-6)  # float32 vertices
+    # each column over the block that carries it: its centroid is where that block's fill is lumped, and its
+    # mass that block's carried mass
+    at = np.array([b.carried_at for b in carrying])
+    for ring, area in zip(first, areas):
+        k = int(np.argmin(np.hypot(*(at - centroid(ring)).T)))
+        assert np.hypot(*(at[k] - centroid(ring))) < 1e-5
+        assert DENSITY * area * carrying[k].thickness == pytest.approx(carrying[k].carried_mass, rel=1e-5)
+
+
+def test_the_columns_move_with_their_blocks(bridge):
+    rrd, history, blocks = bridge
+    drawn = strips(rrd, FILL_OUTLINES)
+    last = max(drawn)
+    q0, q = history["block_q"][0], history["block_q"][list(history["step"]).index(last)]
+    assert np.abs(q - q0).max() > 1e-4  # the settlement moved the blocks
+    at = np.array([b.carried_at if b.carried_mass > 0 else (np.inf, np.inf) for b in blocks])
+    for before, after in zip(drawn[0], drawn[last]):
+        b = int(np.argmin(np.hypot(*(at - centroid(before)).T)))
+        c, s = np.cos(q[b, 2] - q0[b, 2]), np.sin(q[b, 2] - q0[b, 2])
+        moved = (before - q0[b, :2]) @ np.array([[c, s], [-s, c]]) + q[b, :2]
+        np.testing.assert_allclose(after, moved, atol=2e-5)
+
+
+def test_the_legend_says_the_fill_and_its_load(bridge):
+    rrd, _, blocks = bridge
+    legend = fx.static_value(rrd, "/run/legend", "TextDocument:text")[0]
+    load = sum(b.carried_mass for b in blocks) * 9.81 / 1e3
+    assert "**Fill**" in legend and "dead load only" in legend and f"{load:.4g} kN per metre of width" in legend
+
+
+def test_a_bare_arch_records_no_fill(tmp_path):
+    rrd = tmp_path / "bare.rrd"
+    invoke("simulate", "arch", *OPTIONS, "--duration", 0.002, "--dt", 1e-3, "--out", rrd)
+    paths = set(inspect_recording(rrd)["entity_paths"])
+    assert f"/{FILL_OUTLINES}" not in paths and f"/{FILL_MESH}" not in paths
+    assert "**Fill**" not in fx.static_value(rrd, "/run/legend", "TextDocument:text")[0]
+
+
+def test_limit_draws_the_fill_on_both_copies_carried_by_the_mechanism(tmp_path):
+    rrd = tmp_path / "limit.rrd"
+    invoke("limit", "arch", *OPTIONS, *FILL, "--out", rrd)
+    columns, blocks = strips(rrd, FILL_OUTLINES), strips(rrd, OUTLINES)
+    n = len(blocks[0]) // 2
+    assert len(columns[0]) % 2 == 0
+    half = len(columns[0]) // 2
+    assert sum(shoelace(s) for s in columns[0][:half]) == pytest.approx(reference_fill_area(), rel=1e-6)
+    # rigid: each column of the mechanism copy keeps its distances to some block's vertices (its carrier's)
+    moved = 0
+    for k in range(half, 2 * half):
+        a0, a1 = columns[0][k], columns[STEPS][k]
+        keeps = [
+            np.allclose(np.hypot(*(a0[:, None] - b0[None]).T), np.hypot(*(a1[:, None] - b1[None]).T), atol=1e-4)
+            for b0, b1 in zip(blocks[0][n:], blocks[STEPS][n:])
+            if np.abs(b1 - b0).max() > 1e-3  # a block that moves in the mechanism
+        ]
+        moved += any(keeps)
+        np.testing.assert_allclose(columns[0][k - half], columns[STEPS][k - half])  # the structure as built
+    assert moved > 5
+
+
+def test_limit_of_a_bare_arch_draws_no_fill(tmp_path):
+    rrd = tmp_path / "bare.rrd"
+    invoke("limit", "arch", *OPTIONS, "--out", rrd)
+    assert f"/{FILL_OUTLINES}" not in set(inspect_recording(rrd)["entity_paths"])
+
+
+def test_each_column_is_triangulated_piece_by_piece():
+    """A column over a peaked top (two pieces): a fan from its first corner would cross the peak."""
+    column = np.array([(0, 0), (1, 0.9), (2, 0), (2, 1), (1, 1), (0, 1)], dtype=float)
+    tri = strip_triangles(np.array([0, 6]))
+    (ux, uy), (vx, vy) = (column[tri[:, 1]] - column[tri[:, 0]]).T, (column[tri[:, 2]] - column[tri[:, 0]]).T
+    area = float(np.sum(np.abs(ux * vy - uy * vx)) / 2)
+    assert len(tri) == 4 and area == pytest.approx(shapely.Polygon(column).area)
+
+
+SAND_SHOWN = (141, 127, 99)
+"""The fill's colour as the headless viewer renders it (FILL_RGBA, translucent, over the dark background), measured."""
+
+
+@pytest.mark.slow  # starts the viewer twice: needs mesa-vulkan-drivers libvulkan1 (test_viewer_screenshot)
+def test_the_viewer_shows_the_fill_over_the_ring(bridge, tmp_path):
+    from PIL import Image
+
+    bare = tmp_path / "bare.rrd"
+    invoke("simulate", "arch", *OPTIONS, "--duration", 0.05, "--dt", 1e-3, "--record-every", 25, "--out", bare)
+    sand = {}
+    for name, rrd in (("filled", bridge[0]), ("bare", bare)):
+        png = tmp_path / f"{name}.png"
+        assert screenshot_recording(rrd, png, time_s=0.05, timeout=120) == []
+        rgb = np.asarray(Image.open(png).convert("RGB"), dtype=np.int32)
+        sand[name] = np.abs(rgb - SAND_SHOWN).sum(axis=-1) < 12
+    rows = np.flatnonzero(sand["filled"].any(axis=1))
+    assert sand["filled"].sum() > 50_000 and sand["bare"].sum() < 100  # 1920 x 1080: ~120 000 of sand
+    assert rows.max() - rows.min() > 100  # a band over the ring, not a line
