@@ -48,15 +48,16 @@ _SIMULATE_GROUPS = {  # the option groups of `masonry simulate NAME` (cli/app.py
 
 def _option_names(target) -> list[str]:
     """The keywords ``target`` takes: the options of ``masonry simulate NAME`` for a built-in, of ``masonry run``
-    for a file, and of the run settings and record for a :class:`Scenario` already made."""
+    for a file, and the run settings and friction for a :class:`Scenario` already made (its loading is made with
+    it: a record given to it would run for its duration, where ``simulate("wall", record=…)`` runs the record)."""
     from masonrycli.cli import options
     from masonrycli.scenario.builtin import is_built_in
 
-    groups = ["RECORD", "RUN", "FRICTION"]
+    groups = ["RUN", "FRICTION"]
     if isinstance(target, (str, os.PathLike)) and is_built_in(target):
-        groups += [*_SIMULATE_GROUPS[os.fspath(target)], "BLOCK_MATERIAL"]
+        groups += ["RECORD", *_SIMULATE_GROUPS[os.fspath(target)], "BLOCK_MATERIAL"]
     elif isinstance(target, (str, os.PathLike)):
-        groups += ["SURVEY", "SETTLE"]
+        groups += ["RECORD", "SURVEY", "SETTLE"]
     return [name for group in groups for name in getattr(options, group)]
 
 
@@ -78,6 +79,8 @@ def _check_names(target, given: dict) -> None:
             close = difflib.get_close_matches(key, known, n=3)
             what = os.fspath(target) if isinstance(target, (str, os.PathLike)) else "a Scenario already made"
             hint = f"did you mean {', '.join(close)}?" if close else f"its options: {', '.join(known)}"
+            if not isinstance(target, (str, os.PathLike)):
+                hint = "it takes run settings and friction; its structure and loading are given to api.scenario()"
             hint = _OUTPUTS.get(key, hint)
             raise InputError(f"no such option: {key}= for {what} ({hint})")
 
@@ -101,9 +104,9 @@ def scenario(target, **options):
     """The :class:`~masonrycli.scenario.scenario.Scenario` that :func:`simulate` would run: ``target`` is a
     built-in's name (``"wall"``, ``"arch"``, ``"aqueduct"``, with ``masonry simulate NAME``'s options:
     ``blocks=248, amp=0.5, freq=2``), a scenario or geometry file (``masonry run``'s options), or a Scenario
-    already made (its run settings, friction and record replaced). Raises :class:`InputError` (one line)."""
+    already made (its run settings and friction replaced). Raises :class:`InputError` (one line)."""
     from geometry_library.blocks import GeometryError
-    from masonrycli.scenario.builtin import builtin, file_scenario, is_built_in, override_run, with_record
+    from masonrycli.scenario.builtin import builtin, file_scenario, is_built_in, override_run
     from masonrycli.scenario.scenario import Scenario
     from masonrycli.settle import settled_scenario
 
@@ -118,8 +121,7 @@ def scenario(target, **options):
         options["record"] = _path(options["record"], "--record")
     try:
         if isinstance(target, Scenario):
-            record = {k: options.pop(k, None) for k in ("record", "scale", "record_dt", "baseline")}
-            return override_run(with_record(target, **record), **options)
+            return override_run(target, **options)
         if is_built_in(target):
             return builtin(os.fspath(target), **options)
         survey = {k: options.pop(k) for k in ("units", "flip_y", "convex_hull", "trim_overlaps") if k in options}

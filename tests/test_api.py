@@ -147,8 +147,11 @@ def test_an_option_the_command_does_not_take_is_one_line_naming_the_close_ones(t
     with pytest.raises(InputError, match="no such option: span= for wall"):
         api.scenario("wall", span=4.0)  # the arch's: `masonry simulate wall --span 4` has no such option
     wall = api.scenario("wall", duration=0.05)
-    with pytest.raises(InputError, match="no such option: amp= for a Scenario already made"):
+    with pytest.raises(InputError, match="no such option: amp= for a Scenario already made .*api.scenario"):
         api.simulate(wall, amp=0.5)  # the loading goes with the structure: api.scenario("wall", amp=0.5)
+    with pytest.raises(InputError, match="no such option: record= for a Scenario already made"):
+        api.simulate(wall, record="q.AT2")  # it would run the wall's 1 s, not the record's length
+    assert api.scenario(wall, dt=5e-4, friction=0.5).run.dt == 5e-4
     with pytest.raises(InputError, match="give wall, arch, aqueduct"):
         api.scenario(51)
     with pytest.raises(
