@@ -270,7 +270,7 @@ def read_geojson(
         (blocks if role == "block" else supports).append(None)  # numbered now, made once the frame is known
         pending.append((feature_at, where, role, index, name, props, coords))
     frame = frame_of([entry[-1] for entry in pending], survey)
-    hulls: list[tuple[str, float]] = []
+    hulls: list[tuple[str, float, float]] = []
     (notes if notes is not None else []).extend(said)
     for feature_at, where, role, index, name, props, coords in pending:
         try:
@@ -443,7 +443,7 @@ def read_wkt(
             pending.append((where, role, index, label, srole, np.asarray(poly.exterior.coords)[:, :2]))
     survey = survey or Survey()
     frame = frame_of([entry[-1] for entry in pending], survey)
-    hulls: list[tuple[str, float]] = []
+    hulls: list[tuple[str, float, float]] = []
     for where, role, index, label, srole, coords in pending:
         try:
             polygon = surveyed_polygon(frame.local(coords), index, label, role, survey, hulls)

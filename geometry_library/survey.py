@@ -79,6 +79,9 @@ class Survey:
     convex_hull: bool = False
     trim_overlaps: float = 0.0
     """m: the deepest overlap of two bodies trimmed (0: none trimmed, an overlap is refused by the checks)."""
+    done: dict = dataclasses.field(default_factory=dict, compare=False, repr=False)
+    """What the last file read with it was read as (:func:`reading_record`), filled by :func:`finish_reading`: a
+    run's parameters record it, so a history says which reading of its file it is of."""
 
     def __post_init__(self):
         if unit_scale(self.units) is None:
@@ -274,10 +277,10 @@ def hull_of(xy: np.ndarray, label: str) -> tuple[np.ndarray, float]:
     return np.asarray(hull.exterior.coords)[:-1], gain
 
 
-def hull_note(path, hulls: list[tuple[str, float]]) -> str:
-    """The note of the stones read as their hulls (``hulls``: label, area added)."""
-    label, most = max(hulls, key=lambda h: h[1])
-    least = min(g for _, g in hulls)
+def hull_note(path, hulls: list[tuple[str, float, float]]) -> str:
+    """The note of the stones read as their hulls (``hulls``: label, fraction of its area added, m² added)."""
+    label, most, _ = max(hulls, key=lambda h: h[1])
+    least = min(h[1] for h in hulls)
     return (
         f"{path}: {len(hulls)} non-convex polygon{'s' if len(hulls) > 1 else ''} read as {'their' if len(hulls) > 1 else 'its'} "
         f"convex hull{'s' if len(hulls) > 1 else ''} (--convex-hull), adding {least:.2%}–{most:.2%} of the area (most: {label})"
@@ -290,10 +293,11 @@ def _labels(assembly: Assembly) -> list[str]:
     ]
 
 
-def trim_overlaps(assembly: Assembly, depth: float) -> tuple[Assembly, str]:
+def trim_overlaps(assembly: Assembly, depth: float, counts: dict | None = None) -> tuple[Assembly, str]:
     """``assembly`` with each pair of overlapping bodies (not two supports) cut along the chord of their
     overlap (module docstring), and a one-line note of what was trimmed ("" when nothing overlapped).
-    Raises when an overlap is deeper than ``depth`` m (listing the pairs) or cannot be split."""
+    Raises when an overlap is deeper than ``depth`` m (listing the pairs) or cannot be split. ``counts`` (a
+    dict given) receives ``pairs`` trimmed and the ``deepest_m`` of their overlaps."""
     bodies = [*assembly.blocks, *assembly.supports]
     n_blocks = assembly.block_count
     polys = np.array([b.polygon for b in bodies], dtype=object)
@@ -336,6 +340,8 @@ def trim_overlaps(assembly: Assembly, depth: float) -> tuple[Assembly, str]:
             + more
         )
     pairs = sum(len(c) for c in cuts) // 2
+    if counts is not None:
+        counts.update(pairs=pairs, deepest_m=deepest)
     if not pairs:
         return assembly, ""
     new, worst = [], (0.0, "")
@@ -399,8 +405,9 @@ def surveyed_polygon(xy, index: int, name: str, role: str, survey: Survey, hulls
             raise
     label = body_label(index, name, role)
     hull, gain = hull_of(xy, label)
-    hulls.append((label, gain))
-    return polygon_from_coords(hull, index, name, role)
+    polygon = polygon_from_coords(hull, index, name, role)
+    hulls.append((label, gain, polygon.area * gain / (1.0 + gain)))
+    return polygon
 
 
 def finish_reading(path, refused, blocks, supports, frame: Frame, survey: Survey, hulls, notes) -> Assembly:
@@ -418,15 +425,37 @@ def finish_reading(path, refused, blocks, supports, frame: Frame, survey: Survey
     said = survey_notes(path, frame, survey, assembly)
     if hulls:
         said.append(hull_note(path, hulls))
+    counts = {"pairs": 0, "deepest_m": 0.0}
     if survey.trim_overlaps > 0.0 and assembly.block_count:
         try:
-            assembly, trimmed = trim_overlaps(assembly, survey.trim_overlaps)
+            assembly, trimmed = trim_overlaps(assembly, survey.trim_overlaps, counts)
         except GeometryError as exc:
             raise GeometryError(f"{path}: {exc}{frame.where()}") from None
         said += [f"{path}: {trimmed}"] if trimmed else []
     if notes is not None:
         notes.extend(said)
+    survey.done.clear()
+    survey.done.update(reading_record(frame, survey, hulls, counts))
     return assembly
+
+
+def reading_record(frame: Frame, survey: Survey, hulls: list, counts: dict) -> dict:
+    """What a file was read as, only what applies (a file in metres near the origin, read as it is: {}):
+    ``map_origin_m`` (the map coordinates of the origin read: add them to a result's, as the shift's note and a
+    refusal say), ``units`` and ``metres_per_unit``, ``flip_y``, ``convex_hull`` (stones hulled, m² added),
+    ``trim_overlaps`` (depth, pairs trimmed, deepest overlap)."""
+    record: dict = {}
+    if frame.shift != (0.0, 0.0):
+        record["map_origin_m"] = [frame.shift[0], frame.shift[1]]
+    if survey.units != "m":
+        record |= {"units": survey.units, "metres_per_unit": frame.scale}
+    if survey.flip_y:
+        record["flip_y"] = True
+    if survey.convex_hull:
+        record["convex_hull"] = {"stones": len(hulls), "area_added_m2": float(sum(h[2] for h in hulls))}
+    if survey.trim_overlaps > 0.0:
+        record["trim_overlaps"] = {"depth_m": survey.trim_overlaps, **counts}
+    return record
 
 
 def raise_refused(refused: list[tuple[str, str]], end: str = "") -> None:

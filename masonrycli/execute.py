@@ -163,6 +163,8 @@ def run_metadata(scenario, sim: Simulation) -> dict:
         "blocks": sim.model.block_count,
         # a carried fill, said in the parameters (only when there is one); a built-in's is also drawn
         **({"fill_mass_kg": fill} if (fill := float(sim.model.block_carried_mass.sum())) > 0.0 else {}),
+        # how its file was read (map shift, units, hulls, trims) and settled: the view shows only the result
+        **({"reading": dict(scenario.reading)} if scenario.reading else {}),
         "supports": {s.name: m.describe() for s, m in zip(scenario.assembly.supports, scenario.motions)},
         "baseline_corrections": {
             s.name: m.baseline_correction

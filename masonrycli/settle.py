@@ -73,7 +73,8 @@ def settled_scenario(scenario, duration: float | None):
         return scenario
     settled, settling = settle(scenario, duration)
     said = f"settled {settling.describe()} before the run: it starts there, at rest"
-    return dataclasses.replace(settled, warnings=(*settled.warnings, said))
+    reading = {**settled.reading, "settle_s": float(duration)}  # the run's parameters say it (execute.run_metadata)
+    return dataclasses.replace(settled, warnings=(*settled.warnings, said), reading=reading)
 
 
 def settle(scenario, duration: float):

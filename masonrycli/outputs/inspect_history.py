@@ -142,6 +142,27 @@ def inspect_history(path: str | os.PathLike) -> dict:
     }
 
 
+def reading_text(reading: dict) -> str:
+    """One line of how a run's geometry file was read (``run["reading"]``: geometry_library.survey's record, and
+    ``settle_s``): the command line's option for each, with what it did."""
+    said = []
+    if (origin := reading.get("map_origin_m")) is not None:
+        said.append(f"moved near the origin: add ({origin[0]:.0f}, {origin[1]:.0f}) m for the map's coordinates")
+    if "units" in reading:
+        said.append(f"--units {reading['units']} ({reading.get('metres_per_unit', float('nan')):g} m per unit)")
+    if reading.get("flip_y"):
+        said.append("--flip-y")
+    if isinstance(hull := reading.get("convex_hull"), dict):
+        said.append(
+            f"--convex-hull: {hull.get('stones')} stones read as their hulls (+{hull.get('area_added_m2', 0):.3g} m²)"
+        )
+    if isinstance(trim := reading.get("trim_overlaps"), dict):
+        said.append(f"--trim-overlaps {trim.get('depth_m', 0):g}: {trim.get('pairs')} overlapping pairs trimmed")
+    if "settle_s" in reading:
+        said.append(f"--settle {reading['settle_s']:g}: settled before the run")
+    return "; ".join(said)
+
+
 def _dtype_name(dtype: np.dtype) -> str:
     return "str" if dtype.kind == "U" else dtype.name
 
@@ -163,6 +184,9 @@ def run_rows(info: dict) -> list[tuple[str, str]]:
 
     scenario, source = get("scenario"), get("source")
     rows.append(("scenario", f"{scenario} ({source})" if given(scenario, source) else str(scenario or NOT_RECORDED)))
+    reading = get("reading")
+    if isinstance(reading, dict) and reading:  # how its geometry file was read: the history is of that reading
+        rows.append(("reading", reading_text(reading)))
     point = get("study_point")
     if isinstance(point, dict):  # a history of masonry sweep --histories
         rows.append(("study point", ", ".join(f"{k} = {v}" for k, v in point.items())))

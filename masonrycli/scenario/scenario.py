@@ -184,6 +184,7 @@ class Scenario:
     warnings : non-fatal remarks from ``geometry_library.checks.validate_assembly``.
     marked_driven : names of the supports a geometry file run as it is marks ``"driven"`` (``support_role``): a
         record given on the command line shakes them (:func:`masonrycli.scenario.builtin.shaken_supports`).
+    reading : how its file was read and settled (map shift, units, hulls, trims, ``settle_s``): run parameters.
 
     Each support's ``role`` is made consistent with its motion (``"driven"`` unless the motion is fixed).
     """
@@ -197,6 +198,7 @@ class Scenario:
     structure: dict = field(default_factory=dict)
     warnings: tuple[str, ...] = ()
     marked_driven: tuple[str, ...] = ()
+    reading: dict = field(default_factory=dict)
 
     def __post_init__(self):
         motions = tuple(self.motions)
@@ -246,14 +248,8 @@ def block_speed_problem(block: Block) -> str | None:
     speed = math.hypot(vx, vy) + abs(omega) * max(math.hypot(*(p - centroid)) for p in xy)
     if speed <= MAX_BLOCK_SPEED:
         return None
-    return str(
-        field_error(
-            "velocity",
-            list(block.velocity),
-            f"a point of the block would move at {speed:.3g} m/s, more than {MAX_BLOCK_SPEED:g} m/s "
-            "(a likely typo: a block that fast is a diverged run)",
-        )
-    )
+    why = f"a point of the block would move at {speed:.3g} m/s, more than {MAX_BLOCK_SPEED:g} m/s (a likely typo"
+    return str(field_error("velocity", list(block.velocity), why + ": a block that fast is a diverged run)"))
 
 
 def _cleaned_assembly(assembly: Assembly, where: str) -> Assembly:
@@ -361,7 +357,8 @@ def scenario_from_geometry_file(path, survey=None) -> Scenario:
     ctx = InputContext(path, os.path.dirname(os.path.abspath(path)))
     material = Material()
     notes: list[str] = []
-    assembly = read_geometry(path, material.density, material.thickness, ctx, where="", notes=notes, survey=survey)
+    reading: dict = {}
+    assembly = read_geometry(path, material.density, material.thickness, ctx, "", notes, survey, reading)
     from masonrycli.scenario.caveats import idle_driven_supports
 
     motions = tuple(Fixed() for _ in assembly.supports)
@@ -376,6 +373,7 @@ def scenario_from_geometry_file(path, survey=None) -> Scenario:
         structure={"file": os.path.abspath(path)},
         warnings=warnings,
         marked_driven=tuple(s.name for s in assembly.supports if s.role == "driven"),  # before roles follow motions
+        reading=reading,
     )
 
 

@@ -30,13 +30,19 @@ def read_geometry(
     where: str = "[structure]",
     notes=None,
     survey=None,
+    reading: dict | None = None,
 ) -> Assembly:
     """Blocks and supports of a GeoJSON or WKT file (``geometry_library.io``), with ``density`` and
     ``thickness`` (the material's) as defaults. ``where`` is the table naming the file ("" when the file
     is the scenario itself: ``masonry run wall.geojson``). ``notes``: a list given receives the one-line
     warning of :func:`unread_properties_warning`, if any, and the reader's notes (a map grid's coordinates moved
-    near the origin, ``survey``'s hulls and trims: :mod:`geometry_library.survey`)."""
+    near the origin, ``survey``'s hulls and trims: :mod:`geometry_library.survey`). ``reading``: a dict given
+    receives what the file was read as (``survey.reading_record``: the map shift, units, hulls, trims), which a
+    run's parameters record."""
     from geometry_library import io as geo_io
+    from geometry_library.survey import Survey
+
+    survey = Survey() if survey is None else survey  # the default reading too: a map grid's file is moved
 
     suffix = Path(path).suffix.lower()
     if suffix not in GEOMETRY_SUFFIXES:
@@ -60,6 +66,8 @@ def read_geometry(
             notes.append(unread_properties_warning(path, unknown, geo_io.GEOJSON_PROPERTIES))
         if notes is not None:
             notes.extend(said)
+        if reading is not None:
+            reading.update(survey.done)
         return assembly
     except (GeometryError, ValueError) as exc:
         msg = one_line(exc)
@@ -81,7 +89,7 @@ SURVEY_FLAGS = {
 def survey_keys(table: dict, ctx: InputContext):
     """The :class:`~geometry_library.survey.Survey` of a scenario file's ``[structure]`` keys beside ``file``
     (``units``, ``flip_y``, ``convex_hull``, ``trim_overlaps``: the command line's options, which read a file run
-    as it is), None when none is given; a wrong value is refused naming its key."""
+    as it is), the default one when none is given; a wrong value is refused naming its key."""
     from geometry_library.survey import Survey, unit_scale
 
     given = {k: table[k] for k in SURVEY_FLAGS if k in table}
@@ -95,7 +103,7 @@ def survey_keys(table: dict, ctx: InputContext):
     depth = given.get("trim_overlaps")
     if depth is not None and (isinstance(depth, bool) or not isinstance(depth, (int, float)) or not 0 < depth <= 0.1):
         raise ctx.error("[structure]", f"trim_overlaps = {depth!r}: must be a number in (0, 0.1] m (0.003: 3 mm)")
-    return Survey(**given) if given else None
+    return Survey(**given)
 
 
 def survey_of(options: dict, target: str):

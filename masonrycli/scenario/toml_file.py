@@ -185,7 +185,7 @@ def _parse_document(doc: dict, ctx: InputContext, default_name: str) -> Scenario
     material = _config(Material, _table(doc, "material", ctx), ctx, "material")
     block_tables = _array_of_tables(doc, "block", ctx)
     support_tables = _array_of_tables(doc, "support", ctx)
-    notes: list[str] = []  # warnings of a geometry file (its properties not used)
+    notes, reading = [], {}  # a geometry file's warnings (its properties not used); what it was read as
 
     if "structure" in doc:
         structure = _table(doc, "structure", ctx)
@@ -209,7 +209,7 @@ def _parse_document(doc: dict, ctx: InputContext, default_name: str) -> Scenario
             survey = survey_keys(structure, ctx)
             assembly = read_geometry(path, material.density, material.thickness, ctx, notes=notes, survey=survey)
             what = f"file {quote_string(file)}"
-            structure_info = {"file": path}
+            structure_info, reading = {"file": path}, dict(survey.done)  # read_geometry filled it
         else:
             if "builder" not in structure:
                 raise ctx.error("[structure]", 'builder: missing (e.g. builder = "wall", or file = "my-wall.geojson")')
@@ -272,7 +272,6 @@ def _parse_document(doc: dict, ctx: InputContext, default_name: str) -> Scenario
         assembly = Assembly(blocks=tuple(blocks), supports=tuple(supports))
         motions = tuple(motions_list)
         structure_info = {}
-
     warnings = (*notes, *structure_warnings(assembly, ctx))
     return Scenario(
         name=name,
@@ -283,6 +282,7 @@ def _parse_document(doc: dict, ctx: InputContext, default_name: str) -> Scenario
         source=ctx.fname,
         structure=structure_info,
         warnings=warnings,
+        reading=reading,
     )
 
 
