@@ -15,6 +15,7 @@ from geometry_library.builders import build_arch
 from masonrycli.cli.app import app
 from masonrycli.recording import inspect_recording, screenshot_recording
 from masonrycli.recording.carried_fill import FILL_MESH, FILL_OUTLINES, strip_triangles
+from masonrycli.recording.layout import BLOCKS
 from masonrycli.recording.limit import OUTLINES, STEPS
 
 import recording_fixtures as fx
@@ -100,6 +101,36 @@ def test_the_columns_move_with_their_blocks(bridge):
         c, s = np.cos(q[b, 2] - q0[b, 2]), np.sin(q[b, 2] - q0[b, 2])
         moved = (before - q0[b, :2]) @ np.array([[c, s], [-s, c]]) + q[b, :2]
         np.testing.assert_allclose(after, moved, atol=2e-5)
+
+
+def points(path, entity: str) -> dict[int, np.ndarray]:
+    out = {}
+    for chunk in rr.chunk.RrdReader(str(path)).stream():
+        if chunk.entity_path == f"/{entity}" and not chunk.is_static:
+            batch = chunk.to_record_batch()
+            if "Points2D:positions" in batch.schema.names:
+                for step, value in zip(
+                    batch.column("step").to_pylist(), batch.column("Points2D:positions").to_pylist()
+                ):
+                    out[step] = np.array(value, dtype=float)
+    return out
+
+
+def test_the_centroid_dots_and_glyphs_stay_on_their_blocks(bridge):
+    """Found with the fill drawn: the dots (hover targets) and stress glyphs of the filled voussoirs stood in
+    the fill, at the body's centre of mass, which v01's fill (2.5 times its own mass) pulls far above it."""
+    rrd, history, blocks = bridge
+    dots = points(rrd, BLOCKS)
+    own = np.array([b.polygon.centroid.coords[0] for b in blocks])
+    np.testing.assert_allclose(dots[0], own, atol=1e-5)
+    last = max(dots)
+    q0, q = history["block_q"][0], history["block_q"][list(history["step"]).index(last)]
+    c, s = np.cos(q[:, 2] - q0[:, 2]), np.sin(q[:, 2] - q0[:, 2])
+    rel = own - q0[:, :2]
+    moved = q[:, :2] + np.stack([c * rel[:, 0] - s * rel[:, 1], s * rel[:, 0] + c * rel[:, 1]], axis=1)
+    np.testing.assert_allclose(dots[last], moved, atol=2e-5)
+    glyphs = strips(rrd, "structure/plane/xy/stress_axes")[0]  # two segments a block, centred on it
+    np.testing.assert_allclose([g.mean(axis=0) for g in glyphs[::2]], own, atol=1e-5)
 
 
 def test_the_legend_says_the_fill_and_its_load(bridge):

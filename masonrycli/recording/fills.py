@@ -23,16 +23,22 @@ def send_blocks(
     q: np.ndarray,
     tensors: dict[str, np.ndarray],
     initial: int = 0,
+    at: np.ndarray | None = None,
 ) -> None:
     """The fill (positions once, a colour component per field), legends, hover points and values of the
     frames ``q`` (F, N, 3); ``owner``: the block of each fill vertex; the ``initial`` first frames (the
-    state as built) take the colour range of the frame after them."""
+    state as built) take the colour range of the frame after them; ``at`` (F, N, 2): the hover points (the
+    blocks' own centroids; default their poses)."""
     n_frames, n_blocks = len(q), q.shape[1]
     verts = fill.world(q)  # (F, V, 2)
     n_vert = verts.shape[1]
     per_vertex, per_block = partition_lengths(n_frames, n_vert), partition_lengths(n_frames, n_blocks)
     columns = [*rr.Mesh3D.columns(vertex_positions=z0(verts)).partition(per_vertex)]
-    hover = [*rr.Points2D.columns(positions=q[..., :2].reshape(-1, 2).astype(np.float32)).partition(per_block)]
+    hover = [
+        *rr.Points2D.columns(positions=(q[..., :2] if at is None else at).reshape(-1, 2).astype(np.float32)).partition(
+            per_block
+        )
+    ]
     for f in COLOURED:  # the fields first: a square-root view takes its linear twin's ranges
         colors, labels, lo, hi = colours.colour(f, tensors[f.key], initial)
         archetype = f.colors.removesuffix(":colors")

@@ -46,7 +46,7 @@ import rerun as rr
 
 from masonrycli.outputs.frame import Frame
 from masonrycli.outputs.sinks import COMPLETED, FAILED, INTERRUPTED, RUNNING
-from masonrycli.recording.arrays import FrameBatch, Polygons, time_indexes
+from masonrycli.recording.arrays import FrameBatch, Polygons, own_centroids, posed_points, time_indexes
 from masonrycli.recording.batching import Batching, initial_frames, io_errors, steps_due
 from masonrycli.recording.carried_fill import CarriedFill, ColumnArrays, fill_legend
 from masonrycli.recording.colormap import nice_ceil, robust_max_abs
@@ -128,6 +128,7 @@ class Recorder:
         self.path, self.static, self.metadata = os.fspath(path), static, dict(metadata)
         self._t0, self._closed, self._stopped = time.perf_counter(), False, False
         self._blocks = Polygons(static.block_vert_start, static.block_vert_local)
+        self._own = own_centroids(static.block_vert_start, static.block_vert_local)  # (N, 2): posed_points
         self._supports = Polygons(static.support_vert_start, static.support_vert_local)
         self._carried = CarriedFill(ColumnArrays(static.fill_block, static.fill_vert_start, static.fill_vert_local))
         self._fill: Polygons | None = None  # inset blocks, once the structure's size is known
@@ -401,12 +402,13 @@ class Recorder:
         initial = initial_frames(b)  # the state as built: no scale from it (module doc)
         if self._fix_scales({k: v[initial:] for k, v in tensors.items()}, b):
             self._log_metadata(RUNNING, "")
-        send_blocks(
-            self.rec, idx, self._fill, self._blocks.owner, self._colours, self._label_anchors, q, tensors, initial
-        )
+        # dots and glyphs on each block's own centroid: a carried fill pulls the body's centre up into it
+        own = posed_points(q, self._own)
+        args = (self._fill, self._blocks.owner, self._colours, self._label_anchors, q, tensors, initial)
+        send_blocks(self.rec, idx, *args, at=own)
         send_supports(self.rec, idx, self._supports, b.stack("support_q"))
         self._carried.send(self.rec, idx, q)
-        self._send_axes(idx, q, tensors)
+        self._send_axes(idx, np.concatenate([own, q[..., 2:]], axis=-1), tensors)
         self._send_joints(idx, b)
         send_series(self.rec, idx, b, q, self._ref, self._n)
 
