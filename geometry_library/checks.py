@@ -266,10 +266,7 @@ def normalise_coords(coords, label: str) -> np.ndarray:
         # block is then 3e-6 "m" wide, and the message said only "too small"
         on_globe = bool(np.all(np.abs(xy[:, 0]) <= 180.0) and np.all(np.abs(xy[:, 1]) <= 90.0))
         degrees = on_globe and 0.0 < size < 1e-3 and float(np.abs(xy).max()) > 1e3 * size
-        hint = (
-            " (longitude / latitude in degrees? coordinates are metres: export in a projected CRS)" if degrees else ""
-        )
-        raise GeometryError(f"{label}: polygon area {abs(area):.3g} m² is zero or too small{hint}")
+        raise GeometryError(f"{label}: polygon area {abs(area):.3g} m² is zero or too small{DEGREES_HINT * degrees}")
     if abs(area) > MAX_AREA:
         raise GeometryError(f"{label}: polygon area {abs(area):.3g} m² is absurd (coordinates must be metres)")
     if area < 0.0:
@@ -290,6 +287,9 @@ def normalise_coords(coords, label: str) -> np.ndarray:
             f"{label}: polygon is not convex (reflex vertex at {_fmt(xy[reflex[0]])}){float32_hint(given, h)}"
         )
     return np.ascontiguousarray(xy)
+
+
+DEGREES_HINT = " (longitude / latitude in degrees? coordinates are metres: export in a projected CRS)"  # no --units
 
 
 def polygon_from_coords(coords, index: int, name: str, kind: str = "block") -> Polygon:

@@ -67,6 +67,8 @@ MAX_HULL_GAIN = 0.05
 """The most area (fraction of the stone's) a convex hull may add: more is no tracing slip."""
 HUGE_STONE = 20.0
 """m: a median stone larger than this across is a wall in millimetres or centimetres read as metres."""
+TINY_STONE = 0.01
+"""m: a median stone smaller than this across (read with ``units``) is a wall in other units: refused."""
 
 
 @dataclasses.dataclass(frozen=True)
@@ -248,18 +250,29 @@ def _far(frame: Frame) -> float:
 
 
 def units_hint(blocks: list, survey: Survey) -> str:
-    """A sentence when the median block (shapely polygons, m) is more than ``HUGE_STONE`` across and no
-    ``units`` were given ("" otherwise)."""
-    if not blocks or survey.units != "m":
+    """A sentence when the median block (shapely polygons, m) is more than ``HUGE_STONE`` across, or read with
+    ``units`` less than ``TINY_STONE``, naming the units that make it a stone's size ("" otherwise)."""
+    if not blocks:
         return ""
     sizes = [math.hypot(x1 - x0, y1 - y0) for x0, y0, x1, y1 in (p.bounds for p in blocks)]
     median = float(np.median(sizes))
-    if median <= HUGE_STONE:
+    given = survey.units != "m"
+    if median <= HUGE_STONE and (median >= TINY_STONE or not given):
         return ""
-    return (
-        f"the blocks are {min(sizes):.3g}–{max(sizes):.3g} m across (median {median:.3g} m): are the coordinates "
-        "millimetres? --units mm reads them so (--units cm: centimetres)"
-    )
+    as_read = f" read with --units {survey.units}" if given else ""
+    as_file = median / unit_scale(survey.units)  # the median stone in the file's own numbers
+    fits = [u for u in UNITS if TINY_STONE <= as_file * UNITS[u] <= HUGE_STONE]
+    fits.sort(key=lambda u: abs(math.log(as_file * UNITS[u] / 0.4)))  # the nearest to a stone's 0.4 m
+    word = {"m": "metres? without --units they are read so", "cm": "centimetres? --units cm reads them so"}
+    word["mm"] = "millimetres? --units mm reads them so (--units cm: centimetres)"
+    guess = f"are the coordinates {word[fits[0]]}" if fits else "which unit are they? --units 0.002: 2 mm per unit"
+    return f"the blocks are {_lengths(min(sizes), max(sizes))} across{as_read} (median {_lengths(median)}): {guess}"
+
+
+def _lengths(*metres: float) -> str:
+    """Lengths as "321–718 m", or "0.32–0.716 mm" when the largest is under 0.1 m."""
+    unit, factor = ("m", 1.0) if max(metres) >= 0.1 else ("mm", 1e3)
+    return "–".join(f"{m * factor:.3g}" for m in metres) + f" {unit}"
 
 
 def hull_of(xy: np.ndarray, label: str) -> tuple[np.ndarray, float]:
@@ -403,6 +416,14 @@ def surveyed_polygon(xy, index: int, name: str, role: str, survey: Survey, hulls
     except NotConvexError:
         if not survey.convex_hull:
             raise
+    except GeometryError as exc:  # a stone too small read with --units: the unit, not degrees, is what is wrong
+        if survey.units == "m" or "is zero or too small" not in str(exc):
+            raise
+        from .checks import DEGREES_HINT
+
+        size = float(np.hypot(*np.ptp(np.asarray(xy, dtype=np.float64), axis=0)))
+        said = f" (a stone {size:.2g} m across read with --units {survey.units}: is that the coordinates' unit?)"
+        raise GeometryError(str(exc).replace(DEGREES_HINT, "") + said) from None
     label = body_label(index, name, role)
     hull, gain = hull_of(xy, label)
     polygon = polygon_from_coords(hull, index, name, role)
@@ -421,6 +442,9 @@ def finish_reading(path, refused, blocks, supports, frame: Frame, survey: Survey
             + f"its coordinates are float32 values, exact only to ±{frame.rounding:.2g} m there"
         )
     raise_refused(refused, frame.where() + (f"; {hint}" if hint else ""))
+    hint = units_hint(read, survey)
+    if survey.units != "m" and hint:  # stones of a mm read with --units: no wall; its overlaps were refused next
+        raise GeometryError(f"{path}: {hint}")
     assembly = Assembly(tuple(blocks), tuple(supports))
     said = survey_notes(path, frame, survey, assembly)
     if hulls:

@@ -300,3 +300,21 @@ def test_stones_are_named_by_their_id_column(tmp_path):
     (tmp_path / "f.geojson").write_text(json.dumps(data))
     with pytest.raises(GeometryError, match=r'feature 4: block 3 \("block-3"\): polygon is not convex'):
         read_geojson(tmp_path / "f.geojson")
+
+
+def test_units_that_make_no_stone_are_said_as_such(tmp_path):
+    """A wall in metres read with --units mm has stones half a millimetre across: it was refused for overlaps
+    0.0007 mm deep, with no word of the units; --units 1e-12 on a map grid's file was asked whether it was in
+    degrees. Both now say the unit read with, and the one that makes stones of them."""
+    metres = wall_file(tmp_path, "m.geojson", **EXACT)
+    with pytest.raises(GeometryError, match=r"0\.32–0\.716 mm across read with --units mm \(median 0\.47 mm\): are the "
+                       r"coordinates metres\? without --units they are read so$"):  # fmt: skip
+        read_geojson(metres, survey=Survey(units="mm"))
+    with pytest.raises(GeometryError, match=r"read with --units 0\.0025 .*are the coordinates metres"):
+        read_geojson(metres, survey=Survey(units="0.0025"))
+    far = wall_file(tmp_path, "l93.geojson", offset=surveyed_wall.LAMBERT93, **EXACT)
+    with pytest.raises(
+        GeometryError, match=r"too small \(a stone 4\.8e-13 m across read with --units 1e-12: is"
+    ) as err:
+        read_geojson(far, survey=Survey(units="1e-12"))
+    assert "longitude" not in str(err.value) and "\n" not in str(err.value)
