@@ -31,6 +31,7 @@ from geometry_library.checks import normalised_polygon
 from masonrycli.errors import InputError
 from masonrycli.limit.verify import COLLAPSE_SHARE, MAX_ITERATIONS, TOLERANCE
 from masonrycli.scenario.motion import Fixed
+from masonrycli.scenario.values import option_text
 
 MAX_SETTLE = 10.0
 """s: the longest settling asked for (a wall that has not come to rest in 10 s does not stand)."""
@@ -63,7 +64,7 @@ def check_settle(duration) -> None:
     """Refuse a settling time out of (0, ``MAX_SETTLE``] s (as ``check`` does, without running it)."""
     if not (math.isfinite(duration) and 0.0 < duration <= MAX_SETTLE):
         raise InputError(
-            f"--settle {duration:g}: must be in (0, {MAX_SETTLE:g}] s (0.5 lets a traced wall's gaps close)"
+            f"--settle {option_text(duration)}: must be in (0, {MAX_SETTLE:g}] s (0.5 lets a traced wall's gaps close)"
         )
 
 

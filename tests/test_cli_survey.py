@@ -205,3 +205,7 @@ def test_limit_on_a_ground_line_is_that_on_the_foundation_polygon(tmp_path):
     assert all(a.exit_code == 0 for a in answers), answers[1].output
     lam = [json.loads(a.stdout)["load_factor"] for a in answers]
     assert lam[1] == pytest.approx(lam[0], rel=1e-9)
+
+
+def test_settle_out_of_range_is_echoed_as_typed(traced):
+    assert_one_line_error(invoke("check", traced, "--settle", "1e9"), "--settle 1e9: must be in (0, 10] s")

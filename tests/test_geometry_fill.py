@@ -209,3 +209,22 @@ def test_check_names_the_fill_it_would_run_with(tmp_path):
     assert result.exit_code == 0, result.output
     fill = sum(b.carried_mass for b in builtin("arch", **BRIDGE, fill_cover=0.3).assembly.blocks)
     assert f"fill {fill:.6g} kg carried by the blocks under it" in words(result.output.replace("│", " "))
+
+
+def test_fill_slips_are_said_in_the_words_the_user_typed(tmp_path):
+    """--fill-density alone said 'without fill_to or fill_cover' (a file's keys) on the command line; a
+    [[block]] with carried_at and no carried_mass ran as carrying nothing, without a word."""
+    from cli_helpers import assert_one_line_error, invoke
+
+    assert_one_line_error(
+        invoke("simulate", "arch", "--fill-density", "1800"), "--fill-density without --fill-to or --fill-cover: give"
+    )
+    scenario = tmp_path / "s.toml"
+    scenario.write_text("[structure]\nbuilder = 'arch'\nfill_density = 1800.0\n")
+    assert_one_line_error(invoke("check", scenario), "fill_density without fill_to or fill_cover")  # keys in a file
+    square = [[0, 0], [1, 0], [1, 1], [0, 1]]
+    scenario.write_text(
+        f"[[block]]\nname = 'b'\npolygon = {square}\ncarried_at = [0.5, 1.5]\n"
+        "[[support]]\nname = 'g'\npolygon = [[-1, -1], [2, -1], [2, 0], [-1, 0]]\n"
+    )
+    assert_one_line_error(invoke("check", scenario), "[[block]] #1", "carried_at without carried_mass: give the mass")

@@ -12,6 +12,7 @@ import dataclasses
 import difflib
 import math
 import os
+import re
 from pathlib import Path
 
 from geometry_library.blocks import Assembly, GeometryError
@@ -247,8 +248,17 @@ def as_options(exc: BuilderError, given: dict) -> InputError:
     flags = " and ".join("--" + k.replace("_", "-") for k in keys)
     key = keys[0]
     if len(keys) == 1 and exc.problem.startswith(f"{key} ") and not exc.problem.startswith(f"{key} = "):
-        return InputError(f"{flags} {exc.problem[len(key) + 1 :]}")  # "ring_thickness 0.0001 m is absurd"
-    return InputError(f"{flags}: {exc.problem}")
+        return InputError(f"{flags} {_flags(exc, exc.problem[len(key) + 1 :])}")  # "ring_thickness 0.0001 m is absurd"
+    return InputError(f"{flags}: {_flags(exc, exc.problem)}")
+
+
+def _flags(exc: BuilderError, text: str) -> str:
+    """``text`` with the builder's other option keys it names as options: '--fill-density without --fill-to or
+    --fill-cover' (it said 'without fill_to or fill_cover', the file's keys, on the command line)."""
+    from geometry_library.builders import BUILDERS
+
+    names = {f.name for f in dataclasses.fields(BUILDERS[exc.builder])} if exc.builder in BUILDERS else set()
+    return re.sub(r"\b[a-z]+(?:_[a-z]+)+\b", lambda m: "--" + m[0].replace("_", "-") if m[0] in names else m[0], text)
 
 
 def build_structure(builder: str, options: dict, density: float, thickness: float) -> Assembly:

@@ -326,9 +326,8 @@ def _check_unique(name: str, loc: str, names: dict, ctx: InputContext):
 def _parse_block(i: int, table: dict, material: Material, ctx: InputContext, names: dict) -> Block:
     default_name = f"block-{i}"
     loc = _locator("block", i, table, default_name)
-    for key in table:
-        if key not in BLOCK_KEYS:
-            raise ctx.error(loc, unknown_key(key, BLOCK_KEYS))
+    if unknown := [key for key in table if key not in BLOCK_KEYS]:
+        raise ctx.error(loc, unknown_key(unknown[0], BLOCK_KEYS))
     try:
         name = _check_name("name", table.get("name", default_name))
         if "polygon" not in table:
@@ -338,6 +337,8 @@ def _parse_block(i: int, table: dict, material: Material, ctx: InputContext, nam
         thickness = check_real("thickness", table.get("thickness", material.thickness), gt=0.0)
         velocity = check_vector("velocity", table.get("velocity", (0.0, 0.0, 0.0)), size=3)
         carried = {}  # a fill's dead mass riding on the block (Block.carried_mass): both keys or neither
+        if "carried_at" in table and "carried_mass" not in table:  # a point carrying nothing: it ran as no fill
+            raise InputError("carried_at without carried_mass: give the mass it carries (kg), or leave carried_at out")
         if "carried_mass" in table or "carried_at" in table:
             carried["carried_mass"] = check_real("carried_mass", table.get("carried_mass", 0.0), ge=0.0)
             carried["carried_at"] = check_vector("carried_at", table.get("carried_at"))
@@ -346,8 +347,7 @@ def _parse_block(i: int, table: dict, material: Material, ctx: InputContext, nam
     _check_unique(name, loc, names, ctx)
     polygon = _polygon(coords, i - 1, name, "block", ctx, loc)
     block = Block(polygon=polygon, name=name, density=density, thickness=thickness, velocity=velocity, **carried)
-    problem = block_speed_problem(block)
-    if problem:  # velocity = [1e9, 0, 0] ran and ended as exit 3, "diverged at step 1"
+    if problem := block_speed_problem(block):  # velocity = [1e9, 0, 0] ran and ended as exit 3, "diverged at step 1"
         raise ctx.error(loc, problem)
     return block
 
