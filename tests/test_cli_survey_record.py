@@ -78,3 +78,17 @@ def test_a_file_read_as_it_is_and_a_builder_record_no_reading(tmp_path):
     surveyed_wall.write(tmp_path / "exact.geojson", slip=0.0, ndigits=9)
     for scenario in (target_scenario(tmp_path / "exact.geojson"), builtin("wall")):
         assert "reading" not in run_metadata(scenario, Simulation(scenario))
+
+
+def test_a_scenario_files_structure_keys_are_recorded_as_the_options_are(tmp_path):
+    from masonrycli.execute import run_metadata
+    from masonrycli.run import Simulation
+    from masonrycli.scenario.toml_file import load_scenario
+
+    surveyed_wall.write(tmp_path / "l93.geojson", offset=surveyed_wall.LAMBERT93, slip=0.0, ndigits=9)
+    (tmp_path / "s.toml").write_text('[structure]\nfile = "l93.geojson"\nconvex_hull = true\n')
+    scenario = load_scenario(tmp_path / "s.toml")
+    assert run_metadata(scenario, Simulation(scenario))["reading"] == {
+        "map_origin_m": [651000.0, 6861000.0],
+        "convex_hull": {"stones": 0, "area_added_m2": 0.0},
+    }
