@@ -55,7 +55,7 @@ def _option_names(target) -> list[str]:
 
     groups = ["RUN", "FRICTION"]
     if isinstance(target, (str, os.PathLike)) and is_built_in(target):
-        groups += ["RECORD", *_SIMULATE_GROUPS[os.fspath(target)], "BLOCK_MATERIAL"]
+        groups += ["RECORD", *_SIMULATE_GROUPS[os.fspath(target)], "BLOCK_MATERIAL", "SIMULATE_SETTLE"]
     elif isinstance(target, (str, os.PathLike)):
         groups += ["RECORD", "SURVEY", "SETTLE"]
     return [name for group in groups for name in getattr(options, group)]
@@ -122,10 +122,10 @@ def scenario(target, **options):
     try:
         if isinstance(target, Scenario):
             return override_run(target, **options)
+        settle = options.pop("settle", None)  # the engine, as the command line: `masonry simulate` / `run --settle`
         if is_built_in(target):
-            return builtin(os.fspath(target), **options)
+            return settled_scenario(builtin(os.fspath(target), **options), settle)
         survey = {k: options.pop(k) for k in ("units", "flip_y", "convex_hull", "trim_overlaps") if k in options}
-        settle = options.pop("settle", None)
         return settled_scenario(file_scenario(target, survey=survey, **options), settle)  # as `masonry run` loads it
     except GeometryError as exc:  # the command line's one line, as the one error type of bad input
         raise InputError(str(exc).splitlines()[0] if str(exc) else type(exc).__name__) from None

@@ -92,3 +92,15 @@ def test_a_scenario_files_structure_keys_are_recorded_as_the_options_are(tmp_pat
         "map_origin_m": [651000.0, 6861000.0],
         "convex_hull": {"stones": 0, "area_added_m2": 0.0},
     }
+
+
+def test_simulate_settles_a_built_in_as_run_does(tmp_path):
+    # `masonry simulate` had no --settle ('No such option') where run, check, sweep and limit take it
+    history = tmp_path / "h.npz"
+    result = invoke(
+        "simulate", "wall", "--settle", "0.05", "--duration", "0.01", "--history", history, "--no-recording"
+    )
+    assert result.exit_code == 0, result.output
+    assert "settled 0.05 s under its own weight" in words(result.output)
+    assert json.loads(str(np.load(history)["run"]))["reading"] == {"settle_s": 0.05}
+    assert_one_line_error(invoke("simulate", "arch", "--settle", "0"), "--settle 0: must be in (0, ")

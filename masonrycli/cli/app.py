@@ -26,6 +26,7 @@ from masonrycli.cli.options import (
     RUN,
     SETTLE,
     SETTLED_LOADING,
+    SIMULATE_SETTLE,
     STOP,
     SURVEY,
     WALL,
@@ -186,16 +187,17 @@ def _pop(opts: dict, *groups: dict) -> dict:
 
 def _simulate(name: str, opts: dict) -> None:
     from masonrycli.scenario.builtin import builtin, paper_instant_hint
+    from masonrycli.settle import settled_scenario
 
-    outputs = _pop(opts, OUTPUT, FORCE, STOP)
-    scenario = builtin(name, **opts)
+    outputs, settle = _pop(opts, OUTPUT, FORCE, STOP), opts.pop("settle")
+    scenario = settled_scenario(builtin(name, **opts), settle)  # as run's _load: before the run, not part of it
     supports = {s.name: m.describe() for s, m in zip(scenario.assembly.supports, scenario.motions)}
     _execute(scenario, outputs, lambda reached: paper_instant_hint(name, scenario.run, supports, reached))
 
 
 @simulate_app.command("wall")
 @user_errors
-@with_options(WALL, WALL_LOADING, RECORD, RUN, STOP, FRICTION, BLOCK_MATERIAL, OUTPUT, FORCE)
+@with_options(WALL, WALL_LOADING, RECORD, RUN, SIMULATE_SETTLE, STOP, FRICTION, BLOCK_MATERIAL, OUTPUT, FORCE)
 def simulate_wall(**opts) -> None:
     """The paper's running-bond wall on a shaken ground (default 51 blocks, 1 m/s at 2 Hz for 1 s)."""
     _simulate("wall", opts)
@@ -203,7 +205,7 @@ def simulate_wall(**opts) -> None:
 
 @simulate_app.command("arch")
 @user_errors
-@with_options(ARCH, SETTLED_LOADING, RECORD, RUN, STOP, FRICTION, BLOCK_MATERIAL, OUTPUT, FORCE)
+@with_options(ARCH, SETTLED_LOADING, RECORD, RUN, SIMULATE_SETTLE, STOP, FRICTION, BLOCK_MATERIAL, OUTPUT, FORCE)
 def simulate_arch(**opts) -> None:
     """The paper's 98-block arch on two piers; default: right foundation settles at 1 cm/s for 5 s."""
     _simulate("arch", opts)
@@ -211,7 +213,7 @@ def simulate_arch(**opts) -> None:
 
 @simulate_app.command("aqueduct")
 @user_errors
-@with_options(AQUEDUCT, SETTLED_LOADING, RECORD, RUN, STOP, FRICTION, BLOCK_MATERIAL, OUTPUT, FORCE)
+@with_options(AQUEDUCT, SETTLED_LOADING, RECORD, RUN, SIMULATE_SETTLE, STOP, FRICTION, BLOCK_MATERIAL, OUTPUT, FORCE)
 def simulate_aqueduct(**opts) -> None:
     """A segment of the Arles aqueduct (98 arch + 248 wall blocks); default: settlement 1 cm/s for 5 s.
 

@@ -297,6 +297,15 @@ SETTLE = {  # run, check, sweep: the structure let come to rest before it is sha
         "--settle",
     )
 }
+SIMULATE_SETTLE = {  # simulate: a built-in let come to rest before it is loaded, as run --settle (settle.py)
+    "settle": _opt(
+        float,
+        "Run",
+        "First let the structure come to rest under its own weight for this many seconds (the engine, supports "
+        "fixed), then load it from there; the run's parameters say so (reading.settle_s).",
+        "--settle",
+    )
+}
 ThrustOption = Annotated[
     bool,
     typer.Option(
