@@ -197,3 +197,29 @@ def test_the_document_lists_a_dozen_joints_and_says_how_many_more():
     assert text.startswith(", ".join(names[:DOCUMENT_NAMES])) and f"j{DOCUMENT_NAMES}," not in text
     assert text.endswith(f"and {363 - DOCUMENT_NAMES} more (all in --json)")
     assert _document_names(names[:3]) == "j0, j1, j2"
+
+
+def test_a_surveyed_walls_recording_says_how_its_file_was_read(tmp_path):
+    """limit --out of a traced wall said nothing of its reading (map shift, units, settling), where a run's
+    Parameters table does (39a60e9): the side panel has the same rows."""
+    import json
+
+    import surveyed_wall
+
+    from masonrycli.recording.limit import DOCUMENT
+
+    import recording_fixtures as fx
+    from cli_helpers import invoke
+
+    surveyed_wall.write(tmp_path / "l93.geojson", offset=surveyed_wall.LAMBERT93, scale=1000.0, slip=0.0, ndigits=6)
+    rrd = tmp_path / "l.rrd"
+    result = invoke("limit", tmp_path / "l93.geojson", "--units", "mm", "--settle", "0.02", "--out", rrd, "--json")
+    assert result.exit_code == 0, result.output
+    panel = fx.static_value(rrd, f"/{DOCUMENT}", "TextDocument:text")[0]
+    table = panel.split("## How the file was read")[1]
+    assert "| reading.map_origin_m | [651000.0, 6861000.0] |" in table
+    assert "| reading.units | mm |" in table and "| reading.metres_per_unit | 0.001 |" in table
+    assert "| reading.settle_s | 0.02 |" in table
+    assert json.loads(result.stdout)["load_factor"] > 0.0
+    write_recording(analyse(column(2, 0.4, 0.8, 0.9), LiveLoad("horizontal")), tmp_path / "bare.rrd")
+    assert "How the file was read" not in fx.static_value(tmp_path / "bare.rrd", f"/{DOCUMENT}", "TextDocument:text")[0]

@@ -285,6 +285,11 @@ def write_recording(result: LimitResult, out: Path, scenario=None) -> None:
         fill=None
         if (cols := columns_on_blocks(scenario, m.body_q0[:n, :2]) if scenario else None) is None
         else ColumnArrays(*cols),
+        # as run's parameters: settle() leaves settle_s to settled_scenario, which limit does not call
+        reading={
+            **getattr(scenario, "reading", {}),
+            **({"settle_s": float(result.settled.duration)} if result.settled else {}),
+        },
     )
     out.parent.mkdir(parents=True, exist_ok=True)
     write_limit_recording(out, drawing)

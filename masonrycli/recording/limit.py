@@ -26,7 +26,7 @@ import rerun.blueprint as rrb
 from masonrycli.recording.arrays import Polygons, z0
 from masonrycli.recording.carried_fill import CARRIED_FILL, CarriedFill, ColumnArrays, no_columns
 from masonrycli.recording.colormap import VIRIDIS, colorbar_mesh, map_scalars
-from masonrycli.recording.document import viewer_safe_text
+from masonrycli.recording.document import _flatten, viewer_safe_text
 from masonrycli.recording.layout import (
     HINGE_RGBA,
     LEGEND_TEXT_RGBA,
@@ -103,6 +103,9 @@ class MechanismDrawing:
     """(point, unit direction), m: where the live load acts and which way (drawn on the structure as built)."""
     fill: ColumnArrays | None = None
     """The columns of fill the blocks carry (``carried_fill``), drawn on both copies; None: no fill."""
+    reading: dict | None = None
+    """How a surveyed file was read and settled (``Scenario.reading``, as a run's parameters say it: map_origin_m,
+    units, hulls, trims, settle_s); None or empty: read as it is, or a built-in."""
 
 
 def _block_speed(polys: Polygons, velocity: np.ndarray) -> np.ndarray:
@@ -197,7 +200,9 @@ def write_limit_recording(path: str | os.PathLike, drawing: MechanismDrawing) ->
     try:
         legend_box, _, _ = log_plane(rec, both, sup_both, poses[-1], sup_q)
         _log_speed_bar(rec, legend_box)
-        rec.log(DOCUMENT, rr.TextDocument(viewer_safe_text(d.document), media_type=rr.MediaType.MARKDOWN), static=True)
+        rec.log(
+            DOCUMENT, rr.TextDocument(viewer_safe_text(_document(d)), media_type=rr.MediaType.MARKDOWN), static=True
+        )
         rec.log(
             SUPPORTS,
             rr.Mesh3D(
@@ -248,6 +253,15 @@ def write_limit_recording(path: str | os.PathLike, drawing: MechanismDrawing) ->
         wait_written(rec, path)
         rec.disconnect()
     check_complete(path)
+
+
+def _document(d: MechanismDrawing) -> str:
+    """The side panel: the analysis's document, then how its file was read as a run's Parameters table says it
+    (a limit recording of the Lambert-93 wall read in mm, hulled and settled said none of it)."""
+    if not d.reading:
+        return d.document
+    rows = (f"| {k} | {v} |" for k, v in _flatten({"reading": d.reading}))
+    return "\n".join([d.document, "", "## How the file was read", "", "| parameter | value |", "|---|---|", *rows])
 
 
 def _log_load(rec: rr.RecordingStream, load: tuple[np.ndarray, np.ndarray], length: float) -> None:
