@@ -128,6 +128,7 @@ _SPELLINGS = {  # a unit -> how users write it, compared after _spelled (lower c
     "m/s": ("m/s", "ms-1", "m.s-1", "m·s-1", "m/sec"),
     "Hz": ("hz", "hertz", "1/s", "s-1", "/s", "cps"),
     "rad": ("rad", "radian", "radians"),
+    "°": ("°", "deg", "degs", "degree", "degrees"),
 }
 _DECIMAL_COMMA = re.compile(r"\s*([+-]?\d+),(\d+)\s*")
 _PERCENT = re.compile(r"\s*([+-]?(?:\d+(?:\.\d*)?|\.\d+))\s*%\s*")
@@ -185,8 +186,9 @@ OPTION_UNITS: dict[str, str] = {
     "workers": "",
     "magnify": "",
     "at": "m",  # limit --at X: the abscissa of a point load
-    "trim_overlaps": "m",
-    "settle": "s",  # limit --settle: seconds of settling under gravity  # the deepest overlap of a surveyed file's neighbours trimmed
+    "trim_overlaps": "m",  # the deepest overlap of a surveyed file's neighbours trimmed
+    "settle": "s",  # --settle: seconds of settling under gravity
+    "spread": "°",  # limit --spread: a point load's spread through the fill, from the vertical
 }
 """The unit of each numeric option with no scenario setting (their help: --rtol a relative width,
 --workers a count, --magnify a factor): the one place they are added. (limit's --block is a block's

@@ -75,6 +75,10 @@ def test_a_number_option_given_text_says_what_to_write(option, value, message):
             "--settlement 1cm/s: must be a number (it is read in m/s: convert 1 cm/s",
         ),
         (
+            ("limit", "arch", "--load", "point", "--at", "-2", "--spread", "30deg"),
+            "--spread 30deg: must be a number (write 30, in °, without the unit)",
+        ),
+        (
             ("build", "arch", "--span", "2m", "--out", "x.geojson"),
             "--span 2m: must be a number (write 2, in m, without the unit)",
         ),

@@ -180,8 +180,8 @@ def test_validation_warnings_are_lines_and_its_errors_are_placed():
     "options, given, message",
     [
         ({"ring_thickness": 0.0001}, None, "--ring-thickness 0.0001 m is absurd (a likely typo: 0.001 to 1000 m)"),
-        ({"ring_thickness": 0.9, "pier_width": 0.5}, None, "--ring-thickness and --pier-width: ring_thickness 0.9 m"),
-        ({"ring_thickness": 0.9, "pier_width": 0.5}, {"pier_width": 0.5}, "--pier-width: ring_thickness 0.9 m"),
+        ({"ring_thickness": 0.9, "pier_width": 0.5}, None, "--ring-thickness and --pier-width: --ring-thickness 0.9 m"),
+        ({"ring_thickness": 0.9, "pier_width": 0.5}, {"pier_width": 0.5}, "--pier-width: --ring-thickness 0.9 m"),
         ({"voussoirs": 1}, {}, 'builder "arch": voussoirs must be an integer ≥ 2, got 1'),  # not given: as it was
     ],
 )
