@@ -15,7 +15,7 @@ from geometry_library.builders import build_arch
 from masonrycli.cli.app import app
 from masonrycli.recording import inspect_recording, screenshot_recording
 from masonrycli.recording.carried_fill import FILL_MESH, FILL_OUTLINES, strip_triangles
-from masonrycli.recording.layout import BLOCKS
+from masonrycli.recording.layout import BLOCKS, MAGNIFIED, MAGNIFIED_FILL
 from masonrycli.recording.limit import OUTLINES, STEPS
 
 import recording_fixtures as fx
@@ -103,6 +103,25 @@ def test_the_columns_move_with_their_blocks(bridge):
         np.testing.assert_allclose(after, moved, atol=2e-5)
 
 
+def test_the_magnified_tab_draws_the_columns_on_its_magnified_blocks(bridge):
+    """The Magnified tab showed the bare ring of a filled bridge: each column now goes with its block there too,
+    rigidly, at the magnified pose (turned m θ, moved m times), where the Live view's is at the computed one."""
+    rrd, _, blocks = bridge
+    columns, ring, live = strips(rrd, MAGNIFIED_FILL), strips(rrd, MAGNIFIED), strips(rrd, FILL_OUTLINES)
+    last = max(columns)
+    assert sorted(columns) == sorted(ring) and last == max(live)
+    for drawn, built in zip(columns[0], live[0]):  # as built at step 0, to the float32 poses' rounding × m (0.13 mm)
+        np.testing.assert_allclose(drawn, built, atol=1e-3)
+    at = np.array([b.carried_at if b.carried_mass > 0 else (np.inf, np.inf) for b in blocks])
+    for before, after, seen in zip(columns[0], columns[last], live[last]):
+        b = int(np.argmin(np.hypot(*(at - centroid(before)).T)))
+        (p0, q0), (p1, q1) = ring[0][b][:2], ring[last][b][:2]  # the block's first edge, as built and magnified
+        turn = np.arctan2(*(q1 - p1)[::-1]) - np.arctan2(*(q0 - p0)[::-1])
+        c, s = np.cos(turn), np.sin(turn)
+        np.testing.assert_allclose(after, (before - p0) @ np.array([[c, s], [-s, c]]) + p1, atol=2e-5)
+        assert np.abs(after - before).max() > 3 * np.abs(seen - before).max()  # magnified, not the Live pose
+
+
 def points(path, entity: str) -> dict[int, np.ndarray]:
     out = {}
     for chunk in rr.chunk.RrdReader(str(path)).stream():
@@ -144,7 +163,7 @@ def test_a_bare_arch_records_no_fill(tmp_path):
     rrd = tmp_path / "bare.rrd"
     invoke("simulate", "arch", *OPTIONS, "--duration", 0.002, "--dt", 1e-3, "--out", rrd)
     paths = set(inspect_recording(rrd)["entity_paths"])
-    assert f"/{FILL_OUTLINES}" not in paths and f"/{FILL_MESH}" not in paths
+    assert f"/{FILL_OUTLINES}" not in paths and f"/{FILL_MESH}" not in paths and f"/{MAGNIFIED_FILL}" not in paths
     assert "**Fill**" not in fx.static_value(rrd, "/run/legend", "TextDocument:text")[0]
 
 

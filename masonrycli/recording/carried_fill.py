@@ -4,7 +4,8 @@ The fill is dead load only (``geometry_library.fill``): the engine and the limit
 riding on each block under it (``Block.carried_mass``). A view of the bare ring hid 421.6 kN/m of it, so
 each column is drawn where its block carries it: a translucent sand mesh with a faint outline, placed by its
 block's pose every frame (it is carried: when the ring deforms, its columns go with their voussoirs and may
-overlap or part, as a fill with no strength of its own would not, which the legend says).
+overlap or part, as a fill with no strength of its own would not, which the legend says). The Magnified tab
+outlines them on its magnified blocks (``magnified.send_magnified``): it showed the bare ring.
 
 Columns arrive as plain arrays (``geometry_library.fill.FillColumns``: bottom points left to right, then the
 level right to left), vertices relative to their block's body centre at θ = 0 as the blocks' own. Each
@@ -21,7 +22,7 @@ import numpy as np
 import rerun as rr
 
 from masonrycli.recording.arrays import Polygons, partition_lengths, z0
-from masonrycli.recording.layout import CARRIED_FILL
+from masonrycli.recording.layout import CARRIED_FILL, MAGNIFIED_FILL
 
 FILL_MESH, FILL_OUTLINES = CARRIED_FILL  # only in the recording of a structure that carries a fill
 FILL_RGBA: Final = 0xD9C49A60  # sand, translucent: the fill is load, not masonry
@@ -69,12 +70,15 @@ class CarriedFill:
         self.block = np.concatenate([columns.block + c * blocks for c in range(copies)])
         self.triangles = strip_triangles(np.concatenate(starts))
 
-    def log_static(self, rec: rr.RecordingStream) -> None:
+    def log_static(self, rec: rr.RecordingStream, magnified: bool = True) -> None:
+        """Style and triangles; ``magnified``: the Magnified tab's outlines too (a run's, not limit's)."""
         if not self.count:
             return
         rec.log(FILL_MESH, rr.Mesh3D.from_fields(triangle_indices=self.triangles, albedo_factor=FILL_RGBA), static=True)
         style = rr.LineStrips2D.from_fields(colors=FILL_LINE_RGBA, radii=-FILL_LINE_POINTS, draw_order=20.0)
         rec.log(FILL_OUTLINES, style, static=True)
+        if magnified:
+            rec.log(MAGNIFIED_FILL, style, static=True)
 
     def send(self, rec: rr.RecordingStream, idx: list, q: np.ndarray) -> None:
         """The columns at the block poses ``q`` (F, N, 3) of the frames ``idx``."""
@@ -87,11 +91,19 @@ class CarriedFill:
             indexes=idx,
             columns=rr.Mesh3D.columns(vertex_positions=z0(verts)).partition(partition_lengths(frames, verts.shape[1])),
         )
+        self.send_outlines(rec, idx, q, FILL_OUTLINES, verts)
+
+    def send_outlines(self, rec: rr.RecordingStream, idx: list, q: np.ndarray, path: str, verts=None) -> None:
+        """The columns' outlines at the block poses ``q`` (F, N, 3) to ``path``: the Live view's, and the Magnified
+        tab's (``magnified``: posed as its magnified blocks, the bare ring was drawn there)."""
+        if not self.count:
+            return
+        verts = self.polygons.world(q[:, self.block]) if verts is None else verts
         rec.send_columns(
-            FILL_OUTLINES,
+            path,
             indexes=idx,
             columns=rr.LineStrips2D.columns(strips=self.polygons.outlines(verts)).partition(
-                partition_lengths(frames, self.count)
+                partition_lengths(len(q), self.count)
             ),
         )
 

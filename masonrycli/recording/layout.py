@@ -118,6 +118,7 @@ MAGNIFIED: Final = f"{XY}/magnified"
 UNDEFORMED: Final = f"{XY}/undeformed"
 SUPPORT_FILL: Final = "structure/supports"
 CARRIED_FILL: Final = ("structure/carried_fill", f"{XY}/carried_fill")  # a bridge's fill: mesh, outlines
+MAGNIFIED_FILL: Final = f"{XY}/magnified_fill"  # its columns' outlines on the magnified shape
 LEGEND_BARS: Final = "structure/legend"  # parent of the colour bars: moved right of where the blocks went
 LEGEND_LABELS: Final = f"{XY}/legend"  # parent of their labels, moved with them
 METADATA: Final = "run/metadata"
@@ -306,7 +307,7 @@ def build_blueprint(
     tabs += [
         rrb.Spatial2DView(
             origin=f"/{PLANE}",
-            contents=[f"+ /{x}" for x in (UNDEFORMED, MAGNIFIED)],
+            contents=[f"+ /{x}" for x in (UNDEFORMED, MAGNIFIED, MAGNIFIED_FILL)],
             name=MAGNIFIED_TAB,  # its factor: the Legend (the tab's name had it, and was cut)
             # framed on the structure: it stood in the left two thirds of the tab, the right third kept empty
             # for the colour bar the other tabs have

@@ -227,7 +227,7 @@ def write_limit_recording(path: str | os.PathLike, drawing: MechanismDrawing) ->
             _log_load(rec, d.load, LOAD_LENGTH * size)
         idx = [rr.TimeColumn("step", sequence=np.arange(frames))]
         carried = CarriedFill(no_columns() if d.fill is None else d.fill, copies=2, blocks=n)
-        carried.log_static(rec)
+        carried.log_static(rec, magnified=False)
         carried.send(rec, idx, poses)  # each column on its block in both copies: carried along the mechanism
         rec.send_columns(
             FILL,

@@ -27,7 +27,7 @@ import rerun as rr
 
 from masonrycli.analysis.joint_forces import magnification
 from masonrycli.recording.arrays import FrameBatch, Polygons, partition_lengths, time_indexes
-from masonrycli.recording.layout import MAGNIFIED
+from masonrycli.recording.layout import MAGNIFIED, MAGNIFIED_FILL
 
 MAGNIFIED_EVERY: Final = 2
 
@@ -92,12 +92,14 @@ def send_magnified(
     magnify: float | None,
     size: float,
     batch_frames: int,
+    fill=None,
 ) -> tuple[float, np.ndarray]:
     """Send the magnified outlines of the frames in ``poses`` about ``ref`` (the first block_q, support_q);
     returns the factor used (``magnify``, or the default for ``size`` m) and the extent drawn (xmin, ymin,
     xmax, ymax), m: the blocks', the supports' in y only (a wide ground is shown only a little beyond the
     blocks: ``static_content.log_plane``), for the view to hold it (the arch's right foundation, settled
-    1 cm in 1 s and drawn x 25, touched the view's bottom edge)."""
+    1 cm in 1 s and drawn x 25, touched the view's bottom edge). ``fill``: a bridge's ``CarriedFill``, its columns'
+    outlines posed on the magnified blocks."""
     ref_q, ref_sq = ref
     rigid = _supports_move_together(poses, ref_sq, size, batch_frames)
     if magnify is None:  # one pass over the file: the displacement of largest norm, as a (1, 2) array
@@ -117,7 +119,10 @@ def send_magnified(
         batch = FrameBatch(step=chunk["step"].tolist(), time=chunk["time"].tolist())
         n_frames = len(chunk)
         back = (m - 1.0) * _ground_shift(chunk, ref_sq, rigid)[:, None, :]  # the ground's travel, not magnified
-        verts = blocks.world(ref_q + m * (q - ref_q) - back)
+        magnified = ref_q + m * (q - ref_q) - back
+        verts = blocks.world(magnified)
+        if fill is not None:
+            fill.send_outlines(rec, time_indexes(batch), magnified, MAGNIFIED_FILL)
         sets = [blocks.outlines(verts)]
         if verts.size:
             lo, hi = verts.reshape(-1, 2).min(axis=0), verts.reshape(-1, 2).max(axis=0)

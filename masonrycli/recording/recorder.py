@@ -442,7 +442,7 @@ class Recorder:
     def _send_magnified(self) -> None:
         if self._poses is not None and self._poses.count and self._ref is not None:
             args = (self._poses, self._ref[:2], self.magnify, self._size, self.long_batch_frames)
-            self.magnify, drawn = send_magnified(self.rec, self._blocks, self._supports, *args)
+            self.magnify, drawn = send_magnified(self.rec, self._blocks, self._supports, *args, self._carried)
             self._extent = _union(self._extent, drawn)
 
     # ---- run document
