@@ -42,6 +42,7 @@ from masonrycli.cli.options import (
     ThrustOption,
     VerifyOption,
     WorstOption,
+    checked_outputs,
     choice_value,
     file_defaults,
     with_options,
@@ -101,7 +102,7 @@ def _execute(scenario, opts: dict, hint=None) -> None:
     from masonrycli.interrupt import StopSignals
     from masonrycli.scenario.caveats import scenario_warnings
 
-    outputs = _check_run(scenario, opts)
+    outputs = checked_outputs(scenario, opts)
     for warning in scenario_warnings(scenario):
         warn(warning)
     # The run's handlers stay installed through the summary: once execute() had put Python's back, a Ctrl-C
@@ -161,20 +162,6 @@ def _execute_and_report(scenario, opts: dict, hint, outputs, signals) -> None:
         raise typer.Exit(exit_code(signals.signum))
     if result.status == DIVERGED:
         raise typer.Exit(EXIT_DIVERGED)
-
-
-def _check_run(scenario, opts: dict):
-    """The checked outputs of ``scenario`` (``opts``: the OUTPUT and FORCE options)."""
-    from masonrycli.execute import check_run
-
-    return check_run(
-        scenario,
-        opts["out"],
-        opts["history"],
-        no_recording=opts["no_recording"],
-        force=opts["force"],
-        magnify=opts["magnify"],
-    )
 
 
 def _pop(opts: dict, *groups: dict) -> dict:

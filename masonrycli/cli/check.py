@@ -23,6 +23,7 @@ from masonrycli.cli.options import (
     STOP,
     STRUCTURE_OPTIONS,
     SURVEY,
+    checked_outputs,
     file_defaults,
     with_options,
 )
@@ -84,20 +85,12 @@ def check_command(
     """Validate what `masonry run` (a file) or `masonry simulate NAME` (a built-in) would run, with the same
     arguments, and print a summary (blocks, supports, mass, bounding box, steps, the loading, outputs); nothing
     is computed or written."""
-    from masonrycli.execute import check_run
     from masonrycli.outputs.report import check_table
     from masonrycli.scenario.caveats import scenario_warnings
     from masonrycli.scenario.scenario import scenario_summary
 
     scenario = _scenario(target, opts)
-    outputs = check_run(
-        scenario,
-        opts["out"],
-        opts["history"],
-        no_recording=opts["no_recording"],
-        force=opts["force"],
-        magnify=opts["magnify"],
-    )
+    outputs = checked_outputs(scenario, opts)
     console.print(check_table(str(Path(target)), scenario_summary(scenario), outputs.files()))
     for warning in scenario_warnings(scenario):
         warn(warning)

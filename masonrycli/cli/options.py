@@ -417,6 +417,23 @@ FORCE = {
         ),
     ]
 }
+
+
+def checked_outputs(scenario, opts: dict):
+    """The outputs a run of ``scenario`` would write, checked (``opts``: the OUTPUT and FORCE options), as
+    run, simulate and check all ask: :func:`masonrycli.execute.check_run`."""
+    from masonrycli.execute import check_run
+
+    return check_run(
+        scenario,
+        opts["out"],
+        opts["history"],
+        no_recording=opts["no_recording"],
+        force=opts["force"],
+        magnify=opts["magnify"],
+    )
+
+
 GEO_OUT = {
     "out": Annotated[
         Path, typer.Option("--out", "-o", parser=file_path_value, help="GeoJSON file to write (.geojson or .json).")
