@@ -74,11 +74,10 @@ def reference_fill(extrados: np.ndarray, level: float) -> tuple[np.ndarray, np.n
     return np.array(centroids), np.array(areas)
 
 
-@pytest.mark.parametrize("voussoirs", [20, 31])
-def test_filled_ring_matches_the_four_hinge_reference(voussoirs):
-    """Horizontal acceleration (the fill's mass accelerated with the ring: its inertia at its centroid) and a
-    point load over the quarter span (λ × the voussoir's own weight, the fill's weight dead)."""
-    sc = filled_ring_scenario(voussoirs)
+def filled_ring_reference(voussoirs: int):
+    """The reference's filled ring, built apart from the builder: intrados and extrados chains on the springing
+    line, the fill level, each voussoir's centroid and own weight (N), its fill's point and weight (N), and the
+    own weights as dead loads (x, y)."""
     i, e = segmental_reference_ring(voussoirs)
     i, e = i + (0, SPRINGING), e + (0, SPRINGING)
     level = e[:, 1].max() + COVER
@@ -87,6 +86,15 @@ def test_filled_ring_matches_the_four_hinge_reference(voussoirs):
     fill_at, fill_area = reference_fill(e, level)
     fill = FILL_DENSITY * G * fill_area
     dead = np.stack([0 * weight, -weight], axis=1)
+    return i, e, level, centroid, weight, fill_at, fill, dead
+
+
+@pytest.mark.parametrize("voussoirs", [20, 31])
+def test_filled_ring_matches_the_four_hinge_reference(voussoirs):
+    """Horizontal acceleration (the fill's mass accelerated with the ring: its inertia at its centroid) and a
+    point load over the quarter span (λ × the voussoir's own weight, the fill's weight dead)."""
+    sc = filled_ring_scenario(voussoirs)
+    i, e, _, centroid, weight, fill_at, fill, dead = filled_ring_reference(voussoirs)
     fill_dead = np.stack([0 * fill, -fill], axis=1)
     vw = max(2, len(str(voussoirs)))
     name = lambda k: f"v{k + 1:0{vw}d}"  # noqa: E731

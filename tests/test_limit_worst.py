@@ -10,8 +10,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from four_hinge_reference import least_load_factor
-from test_limit_fill import COVER, FILL_DENSITY, SPRINGING, STONE, G, filled_ring_scenario, reference_fill
-from test_limit_ring_mechanisms import segmental_reference_ring, voussoir_loads
+from test_limit_fill import COVER, filled_ring_reference, filled_ring_scenario
 
 from masonrycli.errors import InputError
 from masonrycli.limit import LiveLoad, analyse
@@ -24,13 +23,7 @@ AXLE = 100e3  # N
 
 def test_the_worst_place_of_an_axle_matches_the_reference_over_every_point_of_the_extrados():
     voussoirs = 20
-    i, e = segmental_reference_ring(voussoirs)
-    i, e = i + (0, SPRINGING), e + (0, SPRINGING)
-    centroid, area = voussoir_loads(i, e)
-    weight = STONE * G * area
-    fill_at, fill_area = reference_fill(e, e[:, 1].max() + COVER)
-    fill = FILL_DENSITY * G * fill_area
-    dead = np.stack([0 * weight, -weight], axis=1)
+    i, e, _, centroid, _, fill_at, fill, dead = filled_ring_reference(voussoirs)
     extra = (("dead", np.stack([0 * fill, -fill], axis=1), fill_at),)
     tried = []  # (λ, x, voussoir)
     for k in range(voussoirs):
@@ -127,14 +120,7 @@ def test_an_axle_spread_through_the_fill_matches_the_reference(x, angle):
     sc = filled_ring_scenario(voussoirs)
     options = dict(span=8.0, rise=2.0, ring_thickness=0.5, voussoirs=voussoirs, pier_width=1.0, fill_cover=COVER)
     sc = dataclasses.replace(sc, structure={"builder": "arch", **options})  # where the fill's level comes from
-    i, e = segmental_reference_ring(voussoirs)
-    i, e = i + (0, SPRINGING), e + (0, SPRINGING)
-    level = e[:, 1].max() + COVER
-    centroid, area = voussoir_loads(i, e)
-    weight = STONE * G * area
-    fill_at, fill_area = reference_fill(e, level)
-    fill = FILL_DENSITY * G * fill_area
-    dead = np.stack([0 * weight, -weight], axis=1)
+    i, e, level, centroid, _, fill_at, fill, dead = filled_ring_reference(voussoirs)
     k = int(np.searchsorted(e[:, 0], x)) - 1
     chord = lambda k, u: e[k, 1] + (u - e[k, 0]) * (e[k + 1, 1] - e[k, 1]) / (e[k + 1, 0] - e[k, 0])  # noqa: E731
     half = (level - chord(k, x)) * np.tan(np.radians(angle))
