@@ -411,7 +411,8 @@ def test_thrust_gives_each_abutments_least_and_greatest_thrust_of_the_classical_
 
 def test_the_recordings_panel_reads_lambda_as_the_table_does():
     from masonrycli.limit import LiveLoad, analyse
-    from masonrycli.limit.command import mechanism_document, resolve_structure
+    from masonrycli.limit.command import resolve_structure
+    from masonrycli.limit.drawing import mechanism_document
 
     result = analyse(resolve_structure("arch", None, {"thickness": 4.0}), LiveLoad("horizontal"))
     text = mechanism_document(result)

@@ -144,7 +144,7 @@ def test_the_recording_of_a_filled_bridge_says_its_fill_and_puts_a_block_load_wh
     filled bridge carries. And its arrow of a point load on a block stood at the body's centre of mass, which
     the fill moves up: the load acts at the block's own centroid (the shoelace of its polygon)."""
     from geometry_library.mass import mass_properties
-    from masonrycli.limit.command import load_arrow, mechanism_document
+    from masonrycli.limit.drawing import load_arrow, mechanism_document
 
     scenario = filled_ring_scenario(20)
     fill = sum(b.carried_mass for b in scenario.assembly.blocks) * G

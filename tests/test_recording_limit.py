@@ -7,7 +7,7 @@ import pytest
 import rerun as rr
 
 from masonrycli.limit import LiveLoad, analyse
-from masonrycli.limit.command import write_recording
+from masonrycli.limit.drawing import write_recording
 from masonrycli.recording import inspect_recording
 from masonrycli.recording.colormap import VIRIDIS
 from masonrycli.recording.limit import (
@@ -190,7 +190,7 @@ def test_the_live_load_is_drawn_where_it_acts(written, tmp_path):
 def test_the_document_lists_a_dozen_joints_and_says_how_many_more():
     """The aqueduct's point load listed 40 of its 363 hinges and 40 of its 500 sliding joints beside the
     view, a 30-line wall of names with no word that there were more."""
-    from masonrycli.limit.command import DOCUMENT_NAMES, _document_names
+    from masonrycli.limit.drawing import DOCUMENT_NAMES, _document_names
 
     names = [f"j{k}" for k in range(363)]
     text = _document_names(names)

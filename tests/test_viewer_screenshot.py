@@ -183,7 +183,7 @@ def test_a_limit_recording_is_shown_at_its_last_step(tmp_path):
     """A limit analysis records the mechanism on a `step` time line alone: the screenshot at the last
     frame asked for `sim_time` and failed (ConnectionError: no timeline "sim_time")."""
     from masonrycli.limit import LiveLoad, analyse
-    from masonrycli.limit.command import write_recording
+    from masonrycli.limit.drawing import write_recording
 
     from limit_helpers import column
 
