@@ -211,6 +211,6 @@ def test_the_ground_is_taken_out_only_when_every_support_moves_with_it(tmp_path)
         for k in range(5):
             sq = ref_sq.copy()
             sq[:, 0 if together else 1] += np.array(moves) * k
-            spool.append(10 * k, 0.01 * k, np.zeros((1, 3)), sq)
+            spool.append(10 * k, 0.01 * k, np.zeros((1, 3)), sq - ref_sq)  # the spool holds displacements
         assert _supports_move_together(spool, ref_sq, 4.0, batch_frames=2) is together
         spool.close()

@@ -244,7 +244,8 @@ class Recorder:
         b.add("hinge_point", np.asarray(getattr(frame, "hinge_point", np.zeros((0, 2))), f64).reshape(-1, 2))
         for key in TENSOR_KEYS:
             b.add(key, _tensor(frame.tensors, key, self._n))
-        self._poses.append(int(frame.step), float(frame.time), q, sq)  # float32 on disk, as they were kept
+        q0, sq0, _ = self._ref  # displacements in float64, then float32 on disk: step 0's exactly 0 (magnified doc)
+        self._poses.append(int(frame.step), float(frame.time), q - q0, sq - sq0)
         self._last = (int(frame.step), float(frame.time))
         self._frames += 1
         if self.batching.frames_due(b, self._scales_fixed()):
