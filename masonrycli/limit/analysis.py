@@ -47,9 +47,10 @@ class LimitResult:
     thickness: float | None = None
     """m: the blocks' out-of-plane thickness, which the newtons are for (None: not one for every block, or
     a model analysed without its scenario)."""
-    ring: tuple[float, float] | None = None
-    """m: (ring thickness, least ring thickness that carries its own weight) of a built-in arch
-    (:mod:`masonrycli.limit.thickness`); None unless asked for (``masonry limit --min-thickness``)."""
+    ring: object | None = None
+    """The :class:`~masonrycli.limit.thickness.LeastThickness` of a built-in arch (its ring thickness, the least
+    that carries its own weight, whether the builder bounded the search); None unless asked for (``masonry
+    limit --min-thickness``)."""
     settled: object | None = None
     """The :class:`~masonrycli.settle.Settling` of ``masonry limit --settle`` (the wall analysed where the
     engine let it come to rest), None without it."""
@@ -133,9 +134,11 @@ class LimitResult:
             "collapse_load_N": self.load_factor * self.reference_force,
             "reference_load_N": self.reference_force,
             "thickness_m": self.thickness,
-            "ring_thickness_m": None if self.ring is None else self.ring[0],
-            "least_ring_thickness_m": None if self.ring is None else self.ring[1],
-            "geometric_factor": None if self.ring is None else self.ring[0] / self.ring[1],
+            "ring_thickness_m": None if self.ring is None else self.ring.thickness,
+            "least_ring_thickness_m": None if self.ring is None else self.ring.least,
+            "geometric_factor": None if self.ring is None else self.ring.factor,
+            # why least_ring_thickness_m is only an upper bound (the ring still stood there), or null
+            "least_ring_thickness_bounded_by": None if self.ring is None else self.ring.bounded_by,
             "support_thrust": None
             if self.support_thrust is None
             else [

@@ -138,11 +138,7 @@ def result_table(result: LimitResult, out: Path | None) -> Table:
         "collapse load", f"{s['collapse_load_N']:.4g} N (λ × {s['reference_load_N']:.4g} N){depth_text(result)}"
     )
     if result.ring is not None:
-        table.add_row(
-            "least ring thickness",
-            f"{result.ring[1]:.4g} m for a ring of {result.ring[0]:g} m: geometric factor of safety "
-            f"{result.ring[0] / result.ring[1]:.2f} (Heyman)",
-        )
+        table.add_row("least ring thickness", result.ring.describe())
     for name, direction, least, greatest in result.support_thrust or ():
         bound = f"{greatest:.4g} N" if math.isfinite(greatest) else "no bound (blocks jammed between supports)"
         lower = f"{least:.4g}" if math.isfinite(least) else "no bound"
@@ -293,28 +289,6 @@ class _Done:
         return said + "; --verify did not finish" if self.verifying else said
 
 
-def _least_ring(structure: str, friction: float | None, structure_options: dict | None) -> tuple[float, float]:
-    """(ring thickness, least ring thickness) of the built-in arch ``structure`` with its options."""
-    from geometry_library.builders import ArchSpec
-    from masonrycli.limit.thickness import least_ring_thickness
-    from masonrycli.scenario.builtin import builtin, override_run
-
-    if structure != "arch":
-        raise InputError(
-            f"--min-thickness: the arch's ring only (masonry limit arch …); {structure} is not the arch built-in"
-        )
-    from masonrycli.cli.options import SURVEY
-
-    given = {k: v for k, v in (structure_options or {}).items() if v is not None and k not in SURVEY}
-    thickness = float(given.pop("ring_thickness", ArchSpec.ring_thickness))
-
-    def build(t: float):
-        return override_run(builtin("arch", ring_thickness=t, **given), friction=friction)
-
-    found = least_ring_thickness(build, thickness)
-    return found.thickness, found.least
-
-
 def _analyse(structure, live, friction, verify, out, force, done: _Done, signals, *, console, err_console, **options):
     """The work of :func:`run_limit`, filling ``done`` as it goes; returns the --verify checks. ``console``:
     where the result table goes before --verify runs (None with --json)."""
@@ -335,7 +309,11 @@ def _analyse(structure, live, friction, verify, out, force, done: _Done, signals
     try:
         done.result = replace(analyse(scenario, live, thrust=options["thrust"]), settled=settling)
         if options["min_thickness"]:
-            done.result = replace(done.result, ring=_least_ring(structure, friction, options["structure_options"]))
+            from masonrycli.limit.thickness import builtin_least_ring
+
+            done.result = replace(
+                done.result, ring=builtin_least_ring(structure, friction, options["structure_options"])
+            )
     except LimitError as exc:
         # one line, as any refusal: a block touching nothing was said twice (a warning, then the error in the
         # same words); a setting's warning is the reason ("no equilibrium" under a gravity pointing up)
