@@ -159,6 +159,16 @@ def test_the_legend_says_the_fill_and_its_load(bridge):
     assert "**Fill**" in legend and "dead load only" in legend and f"{load:.4g} kN per metre of width" in legend
 
 
+def test_the_magnified_line_of_the_legend_says_the_fill(bridge):
+    """The Magnified tab drew the columns' outlines, its legend line said nothing of them, and the Fill line
+    under it was cut off the panel in that tab (headless screenshot): the Magnified line says the fill."""
+    rrd, _, blocks = bridge
+    legend = fx.static_value(rrd, "/run/legend", "TextDocument:text")[0]
+    (line,) = [x for x in legend.splitlines() if x.startswith("- **Magnified**")]
+    load = sum(b.carried_mass for b in blocks) * 9.81 / 1e3
+    assert f"sand outlines = the fill (dead load only, {load:.4g} kN)" in line, line
+
+
 def test_a_bare_arch_records_no_fill(tmp_path):
     rrd = tmp_path / "bare.rrd"
     invoke("simulate", "arch", *OPTIONS, "--duration", 0.002, "--dt", 1e-3, "--out", rrd)

@@ -108,6 +108,19 @@ class CarriedFill:
         )
 
 
+def magnified_fill_note(fill_load_n: float, drawn: bool) -> str:
+    """The Magnified line's words on a carried fill ('' without one), ending that line: the tab shows the
+    columns' outlines and the legend's Fill line, under it, was cut off the panel there."""
+    if not fill_load_n:
+        return ""
+    load = f"dead load only, {fill_load_n / 1e3:.4g} kN"
+    return (
+        f"; sand outlines = the fill ({load}), each column on its magnified block"
+        if drawn
+        else (f"; the fill ({load}) is not drawn")
+    )
+
+
 def fill_legend(fill_load_n: float, thickness: float | None, drawn: bool) -> str:
     """The legend's line for a carried fill ('' without one); ``fill_load_n``: its weight, N, for the blocks'
     ``thickness`` (m; None: not known); ``drawn``: its columns are (a built-in bridge's, not a GeoJSON's)."""

@@ -135,9 +135,11 @@ def legend_markdown(
     main_field: str = "cell_spherical_stress",
     paper_t: float | None = None,
     arrow_cap: float | None = None,
+    magnified_fill: str = "",
 ) -> str:
     """The legend shown under the structure views (and in the run document): the tabs' short names first.
-    ``arrow_cap``: the longest arrow drawn, m (a larger force is drawn that long; its value on hover)."""
+    ``arrow_cap``: the longest arrow drawn, m (a larger force is drawn that long; its value on hover).
+    ``magnified_fill``: what the Magnified line says of a carried fill (``carried_fill.magnified_fill_note``)."""
     scale = (
         "length proportional to the force, scale not fixed yet"
         if not force_scale
@@ -154,7 +156,7 @@ def legend_markdown(
         "orange = sliding, red = open at one end. Yellow dots: hinges.\n"
         "- **Fills**: colour bar beside the structure; grey = undefined (NaN), magenta = below the range, "
         "lime green = above it. Small dark dots: block centroids (hover one: its name and values).\n"
-        f"- **{MAGNIFIED_TAB}** deformed shape: displacements and rotations {factor}; grey = as built."
+        f"- **{MAGNIFIED_TAB}** deformed shape: displacements and rotations {factor}; grey = as built{magnified_fill}."
     )
 
 

@@ -48,7 +48,7 @@ from masonrycli.outputs.frame import Frame
 from masonrycli.outputs.sinks import COMPLETED, FAILED, INTERRUPTED, RUNNING
 from masonrycli.recording.arrays import FrameBatch, Polygons, own_centroids, posed_points, time_indexes
 from masonrycli.recording.batching import Batching, initial_frames, io_errors, steps_due
-from masonrycli.recording.carried_fill import CarriedFill, ColumnArrays, fill_legend
+from masonrycli.recording.carried_fill import CarriedFill, ColumnArrays, fill_legend, magnified_fill_note
 from masonrycli.recording.colormap import nice_ceil, robust_max_abs
 from masonrycli.recording.document import legend_markdown, run_document, viewer_safe_text
 from masonrycli.recording.field_colours import FieldColours
@@ -79,6 +79,7 @@ from masonrycli.recording.layout import (
 from masonrycli.recording.magnified import PoseSpool, send_magnified
 from masonrycli.recording.overlays import frame_joint_resultants, send_axes, send_joints
 from masonrycli.recording.readback import check_complete, wait_written
+from masonrycli.recording.residual_range import ResidualRange
 from masonrycli.recording.series import send_series, send_steps
 from masonrycli.recording.static_content import (
     RecordingStatic,
@@ -145,8 +146,6 @@ class Recorder:
         # shape; with the arrows, the view widens to hold it (_clear_the_legend)
         self._extent = np.array([np.inf, np.inf, -np.inf, -np.inf])
         self._arrows = self._extent.copy()  # the joint arrows' (the Magnified tab has none)
-        # steps with a residual, those a decade under the tolerance, the largest, the smallest of the others
-        self._residuals = [0, 0, 0.0, np.inf]
         self._glyph_length = GLYPH_HALF_LENGTH * self._block_side
         # (N,) m: a glyph never reaches out of its own block (thin cut spandrel blocks of the aqueduct)
         self._glyph_cap = np.minimum(self._glyph_length, GLYPH_HALF_LENGTH * size.min(axis=1))[: self._n]
@@ -175,8 +174,8 @@ class Recorder:
             self.rec.save(self.path, default_blueprint=build_blueprint(main_field, self.paper))
             log_static(self.rec, static, self._blocks, self._supports)
             self._carried.log_static(self.rec)
-            tolerance = self.metadata.get("nlgs_tolerance")
-            self._log10_tolerance = float(np.log10(tolerance)) if tolerance else np.nan
+            self._residuals = ResidualRange(self.metadata.get("nlgs_tolerance"))  # the residual plot's range
+            self._log10_tolerance = self._residuals.log10_tolerance
             self._log_metadata(RUNNING, "")
 
     def __enter__(self) -> Recorder:
@@ -196,13 +195,7 @@ class Recorder:
         s.add("step", int(step))
         s.add("time", float(time_s))
         s.add("values", (float(stats.iterations), float(stats.residual), float(stats.contact_count)))
-        r = float(stats.residual)
-        if np.isfinite(r) and r > 0:  # for the residual plot's range (residual_range)
-            low = bool(np.log10(r) < self._log10_tolerance - 1.0)
-            self._residuals[0] += 1
-            self._residuals[1] += low
-            self._residuals[2] = max(self._residuals[2], r)
-            self._residuals[3] = self._residuals[3] if low else min(self._residuals[3], r)
+        self._residuals.add(stats.residual)
         if steps_due(s):
             self._steps = FrameBatch()
             with io_errors(self.path):
@@ -363,16 +356,8 @@ class Recorder:
         return min(INSET * self._size, INSET_BLOCK_CAP * self._block_side)
 
     def residual_range(self) -> tuple[float, float] | None:
-        """The residual plot's y range, log10 of m/s: from the smallest residual but those more than a decade
-        under the tolerance to the largest (at least the tolerance), when at most 5 % of the steps lie that
-        low; else None (the viewer's fit). A record run converged its first steps far below the tolerance (1e-7.5 m/s under 1e-5): the
-        plot spanned 2.5 decades for them, the rest of the run a flat line on the tolerance's."""
-        steps, low, worst, best = self._residuals
-        if not steps or not np.isfinite(self._log10_tolerance) or low > 0.05 * steps or not np.isfinite(best):
-            return None
-        lo, hi = float(np.log10(best)), max(self._log10_tolerance, float(np.log10(worst)))
-        margin = 0.05 * (hi - lo)
-        return (lo - margin, hi + margin)
+        """The residual plot's y range, log10 of m/s, or None (``residual_range.ResidualRange``)."""
+        return self._residuals.range()
 
     def _send_final_layout(self) -> None:
         """The layout again, the last default wins: with the magnified view's factor in its tab's name (the
@@ -469,10 +454,17 @@ class Recorder:
         )
         self.rec.log(METADATA, rr.TextDocument(viewer_safe_text(text), media_type="text/markdown"), static=True)
         paper_t = None if self.paper is None else self.paper[0]
-        legend = legend_markdown(
-            self.force_scale, self.block_height, self.magnify, self._main_field, paper_t, RESULTANT_CAP * self._size
+        fill, drawn = self.static.fill_load_n, self._carried.count > 0
+        args = (
+            self.force_scale,
+            self.block_height,
+            self.magnify,
+            self._main_field,
+            paper_t,
+            RESULTANT_CAP * self._size,
         )
-        legend += fill_legend(self.static.fill_load_n, self.metadata.get("thickness_m"), self._carried.count > 0)
+        legend = legend_markdown(*args, magnified_fill_note(fill, drawn))
+        legend += fill_legend(fill, self.metadata.get("thickness_m"), drawn)
         self.rec.log(LEGEND, rr.TextDocument(viewer_safe_text(legend), media_type="text/markdown"), static=True)
 
 
