@@ -110,3 +110,55 @@ def least_load_factor(
         if lam[k] < best[0]:
             best = (float(lam[k]), (tuple(int(x) for x in combos[k]), sides))
     return best
+
+
+def right_support_thrust(
+    intrados: np.ndarray, extrados: np.ndarray, centroid: np.ndarray, dead: np.ndarray
+) -> tuple[float, float]:
+    """(least, greatest) horizontal force the ring pushes on its right springer towards +x (outward), under
+    ``dead`` alone, from the three-hinge mechanisms of a springer that moves (Heyman's spreading supports).
+
+    The right springer moves by u = (s, 0), s = +1 (spreading) or −1 (pushed together); hinges at joints
+    a < b < c: voussoirs a … b−1 turn ω1 about H_a, b … c−1 turn ω2 about H_b's velocity, c … n−1 move with the
+    springer, so ω1 k×(H_b − H_a) + ω2 k×(H_c − H_b) = u. Each hinge must open its joint (as above). The
+    joints' forces do no positive power on an opening mechanism, so the power of the dead load P and of the
+    springer's reaction −H x̂ satisfy P − s H ≤ 0 for every admissible one: H ≥ P (s = 1) and H ≤ −P (s = −1).
+    The least thrust is the largest such P, the greatest the least −P (the lower- and upper-bound theorems
+    meet at a three-hinge mechanism).
+    """
+    n = len(centroid)
+    radial = extrados - intrados
+    radial /= np.hypot(radial[:, 0], radial[:, 1])[:, None]
+    normal = np.stack([radial[:, 1], -radial[:, 0]], axis=1)
+    m = _cross(centroid[:, 0], centroid[:, 1], dead[:, 0], dead[:, 1])
+    fx, fy, mm = (np.concatenate([[0.0], np.cumsum(v)]) for v in (dead[:, 0], dead[:, 1], m))
+    combos = np.array(list(itertools.combinations(range(n + 1), 3)))
+    a, b, c = combos.T
+    bounds = []
+    for s in (1.0, -1.0):
+        best = -np.inf
+        for sides in itertools.product((0, 1), repeat=3):
+            ends = [(intrados, extrados) if side == 0 else (extrados, intrados) for side in sides]
+            h = [ends[i][0][j] for i, j in enumerate((a, b, c))]
+            far = [ends[i][1][j] for i, j in enumerate((a, b, c))]
+            r1, r2 = h[1] - h[0], h[2] - h[1]
+            det = _cross(-r1[:, 1], r1[:, 0], -r2[:, 1], r2[:, 0])  # columns k×r1, k×r2
+            ok = np.abs(det) > 1e-12
+            det = np.where(ok, det, 1.0)
+            w1 = _cross(s, 0.0, -r2[:, 1], r2[:, 0]) / det  # Cramer on [k×r1 k×r2] (ω1, ω2) = (s, 0)
+            w2 = _cross(-r1[:, 1], r1[:, 0], s, 0.0) / det
+            turn = [w1, w2 - w1, -w2]  # right minus left at each hinge (the springer's part does not turn)
+            opens = ok
+            for k, j in enumerate((a, b, c)):
+                arm = far[k] - h[k]
+                rel = turn[k][:, None] * np.stack([-arm[:, 1], arm[:, 0]], axis=1)
+                opens = opens & (np.einsum("ij,ij->i", rel, normal[j]) > 1e-12)
+            v_b = w1[:, None] * np.stack([-r1[:, 1], r1[:, 0]], axis=1)  # velocity of H_b
+            p1 = w1 * ((mm[b] - mm[a]) - _cross(h[0][:, 0], h[0][:, 1], fx[b] - fx[a], fy[b] - fy[a]))
+            f2x, f2y = fx[c] - fx[b], fy[c] - fy[b]
+            p2 = v_b[:, 0] * f2x + v_b[:, 1] * f2y + w2 * ((mm[c] - mm[b]) - _cross(h[1][:, 0], h[1][:, 1], f2x, f2y))
+            p3 = s * (fx[n] - fx[c])
+            power = p1 + p2 + p3  # P: the bound is H ≥ P (s = 1) or −H ≥ P (s = −1)
+            best = max(best, float(np.max(np.where(opens, power, -np.inf))))
+        bounds.append(s * best)
+    return bounds[0], bounds[1]
