@@ -154,15 +154,17 @@ class Outcome:
 
 
 def run_metadata(scenario, sim: Simulation) -> dict:
-    """Scenario and parameters for the recording's metadata document."""
+    """Scenario and parameters for the recording's metadata document (its Parameters table, a history's ``run``);
+    ``sim``: the :class:`Simulation`, or only its Model (``masonry limit --out``: the same table, no time loop)."""
     run, mat = scenario.run, scenario.material
+    model = getattr(sim, "model", sim)
     return {
         "scenario": scenario.name,
         "source": scenario.source,
         "structure": dict(scenario.structure),
-        "blocks": sim.model.block_count,
+        "blocks": model.block_count,
         # a carried fill, said in the parameters (only when there is one); a built-in's is also drawn
-        **({"fill_mass_kg": fill} if (fill := float(sim.model.block_carried_mass.sum())) > 0.0 else {}),
+        **({"fill_mass_kg": fill} if (fill := float(model.block_carried_mass.sum())) > 0.0 else {}),
         # how its file was read (map shift, units, hulls, trims) and settled: the view shows only the result
         **({"reading": dict(scenario.reading)} if scenario.reading else {}),
         "supports": {s.name: m.describe() for s, m in zip(scenario.assembly.supports, scenario.motions)},

@@ -216,10 +216,40 @@ def test_a_surveyed_walls_recording_says_how_its_file_was_read(tmp_path):
     result = invoke("limit", tmp_path / "l93.geojson", "--units", "mm", "--settle", "0.02", "--out", rrd, "--json")
     assert result.exit_code == 0, result.output
     panel = fx.static_value(rrd, f"/{DOCUMENT}", "TextDocument:text")[0]
-    table = panel.split("## How the file was read")[1]
+    table = panel.split("## Parameters")[1]
     assert "| reading.map_origin_m | [651000.0, 6861000.0] |" in table
     assert "| reading.units | mm |" in table and "| reading.metres_per_unit | 0.001 |" in table
     assert "| reading.settle_s | 0.02 |" in table
     assert json.loads(result.stdout)["load_factor"] > 0.0
     write_recording(analyse(column(2, 0.4, 0.8, 0.9), LiveLoad("horizontal")), tmp_path / "bare.rrd")
-    assert "How the file was read" not in fx.static_value(tmp_path / "bare.rrd", f"/{DOCUMENT}", "TextDocument:text")[0]
+    assert "## Parameters" not in fx.static_value(tmp_path / "bare.rrd", f"/{DOCUMENT}", "TextDocument:text")[0]
+
+
+def _parameters(text: str) -> dict[str, str]:
+    """The rows of a document's Parameters table, key -> value."""
+    table = text.split("## Parameters")[1].split("\n## ")[0]
+    return dict(line.strip("| ").split(" | ", 1) for line in table.splitlines() if line.startswith("| "))
+
+
+def test_the_parameters_table_is_simulates(tmp_path):
+    """limit --out's panel had no Parameters table (the bridge's span, cover, fill mass nowhere; a traced wall's
+    'reading' rows alone since e7f9366): it is built as simulate's, from execute.run_metadata, the same rows,
+    but every support fixed (the analysis holds them so; the built-in's loading was a settling foundation)."""
+    from masonrycli.recording.layout import METADATA
+    from masonrycli.recording.limit import DOCUMENT
+
+    import recording_fixtures as fx
+    from cli_helpers import invoke
+
+    bridge = ["arch", "--span", 8, "--rise", 2, "--ring-thickness", 0.5, "--pier-width", 3, "--pier-courses", 5]
+    bridge += ["--fill-cover", 0.3]
+    limit, run = tmp_path / "limit.rrd", tmp_path / "run.rrd"
+    assert invoke("limit", *bridge, "--out", limit).exit_code == 0
+    assert invoke("simulate", *bridge, "--duration", 0.001, "--dt", 0.001, "--out", run).exit_code == 0
+    shown = _parameters(fx.static_value(limit, f"/{DOCUMENT}", "TextDocument:text")[0])
+    ran = _parameters(fx.static_value(run, f"/{METADATA}", "TextDocument:text")[0])
+    assert list(shown) == list(ran)  # the same rows, in order
+    for key in ("structure.span", "structure.fill_cover", "fill_mass_kg", "blocks", "friction", "source"):
+        assert shown[key] == ran[key], key
+    assert float(shown["fill_mass_kg"]) > 4e4  # 421.6 kN / 9.81
+    assert ran["supports.right-foundation"] != "fixed" and shown["supports.right-foundation"] == "fixed"

@@ -4,6 +4,7 @@ itself is :mod:`masonrycli.recording.limit`'s (Rerun lives in the recording pack
 
 from __future__ import annotations
 
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -81,6 +82,19 @@ def load_arrow(result: LimitResult) -> tuple[np.ndarray, np.ndarray]:
     return (mass[:, None] * m.body_q0[:n, :2]).sum(axis=0) / mass.sum(), direction
 
 
+def _parameters(scenario, result: LimitResult) -> dict:
+    """The Parameters table's rows from the source simulate's recording takes them from (execute.run_metadata),
+    ``settle_s`` in its ``reading`` as run's: settle() leaves it to settled_scenario, which limit does not call.
+    Every support is said fixed, as the analysis holds it: a built-in's rows carried the loading simulate would
+    apply ('masonry limit arch --fill-cover 0.3': right-foundation, constant velocity (0, -0.01) m/s)."""
+    from masonrycli.execute import run_metadata
+
+    if result.settled is not None:
+        scenario = replace(scenario, reading={**scenario.reading, "settle_s": float(result.settled.duration)})
+    parameters = run_metadata(scenario, result.model)
+    return {**parameters, "supports": dict.fromkeys(parameters["supports"], "fixed")}
+
+
 def write_recording(result: LimitResult, out: Path, scenario=None) -> None:
     """The mechanism recording (``masonrycli.recording.limit``) of ``result``; ``scenario``'s fill drawn."""
     from masonrycli.recording.carried_fill import ColumnArrays
@@ -116,11 +130,7 @@ def write_recording(result: LimitResult, out: Path, scenario=None) -> None:
         fill=None
         if (cols := columns_on_blocks(scenario, m.body_q0[:n, :2]) if scenario else None) is None
         else ColumnArrays(*cols),
-        # as run's parameters: settle() leaves settle_s to settled_scenario, which limit does not call
-        reading={
-            **getattr(scenario, "reading", {}),
-            **({"settle_s": float(result.settled.duration)} if result.settled else {}),
-        },
+        parameters=None if scenario is None else _parameters(scenario, result),
     )
     out.parent.mkdir(parents=True, exist_ok=True)
     write_limit_recording(out, drawing)

@@ -78,11 +78,7 @@ def run_document(
         f"**solver:** {metadata.get('solver', '—')} · **masonry** {metadata.get('masonry', '—')}, "
         f"commit {metadata.get('commit', '—')}, source {metadata.get('source_digest', '—')}",
         "",
-        "## Parameters",
-        "",
-        "| parameter | value |",
-        "|---|---|",
-        *(f"| {k} | {v} |" for k, v in _flatten(metadata)),
+        *parameters_markdown(metadata),
         "",
         "## How to read the views",
         "",
@@ -126,6 +122,12 @@ def run_document(
         *(f"| {k} | {v} |" for k, v in _versions().items()),
     ]
     return "\n".join(lines) + "\n"
+
+
+def parameters_markdown(metadata: dict) -> list[str]:
+    """The Parameters table's lines (a run's document, a limit recording's panel): one row per dotted key."""
+    rows = (f"| {k} | {v} |" for k, v in _flatten(metadata))
+    return ["## Parameters", "", "| parameter | value |", "|---|---|", *rows]
 
 
 def legend_markdown(

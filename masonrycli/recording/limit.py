@@ -26,7 +26,7 @@ import rerun.blueprint as rrb
 from masonrycli.recording.arrays import Polygons, z0
 from masonrycli.recording.carried_fill import CARRIED_FILL, CarriedFill, ColumnArrays, no_columns
 from masonrycli.recording.colormap import VIRIDIS, colorbar_mesh, map_scalars
-from masonrycli.recording.document import _flatten, viewer_safe_text
+from masonrycli.recording.document import parameters_markdown, viewer_safe_text
 from masonrycli.recording.layout import (
     HINGE_RGBA,
     LEGEND_TEXT_RGBA,
@@ -103,9 +103,10 @@ class MechanismDrawing:
     """(point, unit direction), m: where the live load acts and which way (drawn on the structure as built)."""
     fill: ColumnArrays | None = None
     """The columns of fill the blocks carry (``carried_fill``), drawn on both copies; None: no fill."""
-    reading: dict | None = None
-    """How a surveyed file was read and settled (``Scenario.reading``, as a run's parameters say it: map_origin_m,
-    units, hulls, trims, settle_s); None or empty: read as it is, or a built-in."""
+    parameters: dict | None = None
+    """The run's parameters, as a simulate recording's Parameters table has them (``execute.run_metadata``:
+    the structure's options, the fill, how a surveyed file was read and settled, friction, versions); None:
+    no scenario (a limit analysis made in Python)."""
 
 
 def _block_speed(polys: Polygons, velocity: np.ndarray) -> np.ndarray:
@@ -256,12 +257,11 @@ def write_limit_recording(path: str | os.PathLike, drawing: MechanismDrawing) ->
 
 
 def _document(d: MechanismDrawing) -> str:
-    """The side panel: the analysis's document, then how its file was read as a run's Parameters table says it
-    (a limit recording of the Lambert-93 wall read in mm, hulled and settled said none of it)."""
-    if not d.reading:
+    """The side panel: the analysis's document, then the run's Parameters table as simulate's recording has it
+    (the bridge's said neither its span nor its fill cover; e7f9366 gave it the 'reading' rows alone)."""
+    if not d.parameters:
         return d.document
-    rows = (f"| {k} | {v} |" for k, v in _flatten({"reading": d.reading}))
-    return "\n".join([d.document, "", "## How the file was read", "", "| parameter | value |", "|---|---|", *rows])
+    return "\n".join([d.document, "", *parameters_markdown(d.parameters)])
 
 
 def _log_load(rec: rr.RecordingStream, load: tuple[np.ndarray, np.ndarray], length: float) -> None:
