@@ -106,6 +106,7 @@ def scenario(target, **options):
     ``blocks=248, amp=0.5, freq=2``), a scenario or geometry file (``masonry run``'s options), or a Scenario
     already made (its run settings and friction replaced). Raises :class:`InputError` (one line)."""
     from geometry_library.blocks import GeometryError
+    from masonrycli.records.pga import with_pga
     from masonrycli.scenario.builtin import builtin, file_scenario, is_built_in, override_run
     from masonrycli.scenario.scenario import Scenario
     from masonrycli.settle import settled_scenario
@@ -123,12 +124,27 @@ def scenario(target, **options):
         if isinstance(target, Scenario):
             return override_run(target, **options)
         settle = options.pop("settle", None)  # the engine, as the command line: `masonry simulate` / `run --settle`
+        pga = _pga(options.pop("pga", None))  # the record's scale, once the scenario is built
         if is_built_in(target):
-            return settled_scenario(builtin(os.fspath(target), **options), settle)
-        survey = {k: options.pop(k) for k in ("units", "flip_y", "convex_hull", "trim_overlaps") if k in options}
-        return settled_scenario(file_scenario(target, survey=survey, **options), settle)  # as `masonry run` loads it
+            made = builtin(os.fspath(target), **options)
+        else:
+            survey = {k: options.pop(k) for k in ("units", "flip_y", "convex_hull", "trim_overlaps") if k in options}
+            made = file_scenario(target, survey=survey, **options)  # as `masonry run` loads it
+        return settled_scenario(with_pga(made, pga, options.get("scale")), settle)
     except GeometryError as exc:  # the command line's one line, as the one error type of bad input
         raise InputError(str(exc).splitlines()[0] if str(exc) else type(exc).__name__) from None
+
+
+def _pga(value) -> float | None:
+    """``pga=``: a number in g, or a string as ``--pga`` takes it ("0.25g", "2.45m/s2"); None: not given."""
+    from masonrycli.records.pga import pga_in_g
+
+    if value is None:
+        return None
+    try:
+        return pga_in_g(value)
+    except InputError as exc:
+        raise InputError(f"--pga {exc}") from None
 
 
 class _FrameCallback:

@@ -173,11 +173,13 @@ def _pop(opts: dict, *groups: dict) -> dict:
 
 
 def _simulate(name: str, opts: dict) -> None:
+    from masonrycli.records.pga import with_pga
     from masonrycli.scenario.builtin import builtin, paper_instant_hint
     from masonrycli.settle import settled_scenario
 
-    outputs, settle = _pop(opts, OUTPUT, FORCE, STOP), opts.pop("settle")
-    scenario = settled_scenario(builtin(name, **opts), settle)  # as run's _load: before the run, not part of it
+    outputs, settle, pga = _pop(opts, OUTPUT, FORCE, STOP), opts.pop("settle"), opts.pop("pga")
+    scenario = with_pga(builtin(name, **opts), pga, opts["scale"])
+    scenario = settled_scenario(scenario, settle)  # as run's _load: before the run, not part of it
     supports = {s.name: m.describe() for s, m in zip(scenario.assembly.supports, scenario.motions)}
     _execute(scenario, outputs, lambda reached: paper_instant_hint(name, scenario.run, supports, reached))
 
@@ -222,10 +224,13 @@ RUN_FROM_FILE, FRICTION_FROM_FILE = file_defaults(RUN), file_defaults(FRICTION) 
 def _load(scenario_file: str, opts: dict):
     """The scenario of a TOML, GeoJSON or WKT file with the command line's record and run options
     (taken out of ``opts``) applied."""
+    from masonrycli.records.pga import with_pga
     from masonrycli.scenario.builtin import file_scenario
     from masonrycli.settle import settled_scenario
 
-    scenario = file_scenario(scenario_file, survey=_pop(opts, SURVEY), **_pop(opts, RECORD, RUN, FRICTION))
+    settings = _pop(opts, RECORD, RUN, FRICTION)
+    pga = settings.pop("pga")
+    scenario = with_pga(file_scenario(scenario_file, survey=_pop(opts, SURVEY), **settings), pga, settings["scale"])
     return settled_scenario(scenario, opts.pop("settle"))  # the engine: before the run, not part of it
 
 

@@ -41,11 +41,13 @@ def _scenario(target: str, opts: dict):
     """The scenario ``run TARGET`` (a file) or ``simulate TARGET`` (a built-in name) would run with ``opts``
     (taken out of ``opts``): the built-in's structure, loading and material options refused for a file, and
     another built-in's structure options for a built-in, in one line."""
+    from masonrycli.records.pga import with_pga
     from masonrycli.scenario.builtin import builtin, file_scenario, is_built_in
     from masonrycli.scenario.structure import survey_of
 
     shaping = {name: value for name in BUILT_IN_ONLY if (value := opts.pop(name)) is not None}
-    settings = {name: opts.pop(name) for group in (RECORD, RUN, FRICTION) for name in group}
+    pga = opts.pop("pga")  # the record's scale, found once the scenario is built (records/pga.py)
+    settings = {name: opts.pop(name) for group in (RECORD, RUN, FRICTION) for name in group if name != "pga"}
     survey = {name: opts.pop(name) for name in SURVEY}  # how a geometry file is read: refused for a built-in
     if (settle := opts.pop("settle")) is not None:  # run's --settle runs the engine: here only its value is checked
         from masonrycli.settle import check_settle
@@ -57,13 +59,13 @@ def _scenario(target: str, opts: dict):
                 f"{_flags(shaping)}: shape a built-in structure (masonry check wall|arch|aqueduct …); {target} is "
                 "a file, which gives its own geometry and loading"
             )
-        return file_scenario(target, survey=survey, **settings)
+        return with_pga(file_scenario(target, survey=survey, **settings), pga, settings["scale"])
     survey_of(survey, target)
     allowed = {*STRUCTURE_OPTIONS[target], *BUILT_IN_LOADING, *BLOCK_MATERIAL}
     foreign = [name for name in shaping if name not in allowed]
     if foreign:  # simulate NAME does not take them ("No such option"): the same run cannot be checked
         raise InputError(f"{_flags(foreign[:1])}: not an option of the {target} (masonry simulate {target} --help)")
-    return builtin(target, **shaping, **settings)
+    return with_pga(builtin(target, **shaping, **settings), pga, settings["scale"])
 
 
 FILE_OR_BUILT_IN = "the scenario file's or the built-in's value"  # the run options' default: "the file's" was half

@@ -57,6 +57,17 @@ def number_value(text: str) -> TypedNumber:
     return TypedNumber(_FLOAT.validate_python(text), str(text))
 
 
+def pga_value(text: str) -> float:
+    """``--pga``'s value in g, a unit converted (:func:`masonrycli.records.pga.pga_in_g`)."""
+    from masonrycli.errors import InputError
+    from masonrycli.records.pga import pga_in_g
+
+    try:
+        return TypedNumber(pga_in_g(text), str(text))
+    except InputError as exc:
+        raise typer.BadParameter(str(exc)) from None
+
+
 def whole_value(text: str) -> int:
     """An int option's value, parsed as typer parses an int (pydantic's lax int), without underscores."""
     _no_underscore(text, "int_parsing")
@@ -178,6 +189,14 @@ RECORD = {
         "--record",
     ),
     "scale": _opt(float, "Loading", "Multiplies the --record (default 1).", "--scale"),
+    "pga": _opt(
+        float,
+        "Loading",
+        "Scale the --record so that the ground motion as applied peaks at this acceleration, in g (0.25), or "
+        "with its unit (2.45m/s2, 245gal); instead of --scale.",
+        "--pga",
+        parser=pga_value,
+    ),
     "baseline": _opt(
         str,
         "Loading",

@@ -1,0 +1,77 @@
+"""``--pga``: a record scaled so that the ground motion as applied peaks at a site's design PGA."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from masonrycli import api
+from masonrycli.records.read import G_STANDARD, record_motion
+
+from cli_helpers import assert_one_line_error, invoke
+from synthetic_records import band_limited, write_at2
+
+
+@pytest.fixture
+def at2(tmp_path):
+    t, u, v, a = band_limited(1.0, 0.005, [2.0, 4.5], [0.004, 0.001], seed=5)
+    # not at rest at its end (a record cut short): the baseline correction moves its peak
+    write_at2(tmp_path / "quake.AT2", a[: len(a) * 3 // 4] / G_STANDARD, 0.005)
+    return tmp_path / "quake.AT2"
+
+
+def applied_peak(record, steps: int, dt: float) -> float:
+    """m/s²: the largest step-to-step change of the record's x velocity over the run, per dt (slow: a loop)."""
+    v = [float(record.velocity_at(np.array([k * dt]))[0, 0]) for k in range(steps + 1)]
+    return max(abs(v[k + 1] - v[k]) for k in range(steps)) / dt
+
+
+@pytest.mark.parametrize("given", ["0.3", "0.3g", "2.941995m/s2", "294.1995gal"])
+def test_a_record_scaled_to_a_pga_is_applied_at_that_peak(at2, tmp_path, given):
+    npz = tmp_path / "h.npz"
+    result = invoke(
+        "simulate", "wall", "--blocks", 12, "--record", at2, "--pga", given, "--no-recording", "--history", npz,
+    )  # fmt: skip
+    assert result.exit_code == 0, result.output
+    h = np.load(npz)
+    steps = int(h["step"][-1])
+    # the scale that makes it: the record's own peak as applied (baseline-corrected, at the run's steps)
+    scale = 0.3 * G_STANDARD / applied_peak(record_motion(at2), steps, 1e-3)
+    assert scale != pytest.approx(0.3 * G_STANDARD / record_motion(at2).peak_acceleration, rel=1e-3)
+    np.testing.assert_allclose(
+        h["support_v"][:, 0, :], record_motion(at2, scale=scale).velocity_at(h["time"]), rtol=1e-12, atol=1e-15
+    )
+    assert float(h["intensity_pga"]) == pytest.approx(0.3 * G_STANDARD, rel=1e-12)
+    assert "(0.3 g)" in result.output
+
+
+def test_check_and_the_api_take_the_pga_and_check_says_the_scale(at2):
+    steps = round(record_motion(at2).end_time / 1e-3)  # simulate runs the whole record
+    scale = 0.25 * G_STANDARD / applied_peak(record_motion(at2), steps, 1e-3)
+    result = invoke("check", "wall", "--blocks", 12, "--record", at2, "--pga", "0.25")
+    assert result.exit_code == 0, result.output
+    assert f"× {scale:.6g}" in result.output
+    made = api.scenario("wall", blocks=12, record=at2, pga="2.4516625 m/s2")
+    assert made.motions[0].scale == pytest.approx(scale, rel=1e-12)
+    assert api.scenario("wall", blocks=12, record=at2, pga=0.25).motions[0].scale == made.motions[0].scale
+
+
+@pytest.mark.parametrize(
+    "args, said",
+    [
+        (("--pga", "0.25", "--scale", "2"), "--pga with --scale: give one"),
+        (("--pga", "0.25x"), "--pga': 0.25x: x is not a unit of acceleration"),
+        (("--pga", "3kN"), "3kN: kN is not a unit of acceleration"),
+        (("--pga", "0"), "0: must be a peak acceleration above 0 and at most 10 g"),
+        (("--pga", "25"), "25: must be a peak acceleration above 0 and at most 10 g"),
+    ],
+)
+def test_a_bad_pga_is_one_line(at2, args, said):
+    assert_one_line_error(invoke("check", "wall", "--record", at2, *args), said)
+    assert_one_line_error(invoke("simulate", "wall", "--record", at2, "--no-recording", *args), said)
+
+
+def test_a_pga_without_a_record_says_it_scales_one():
+    said = "--pga: scales a ground-motion record, and its sine motion is not a record (give --record FILE)"
+    assert_one_line_error(invoke("simulate", "wall", "--pga", "0.25", "--no-recording"), said)
+    assert_one_line_error(invoke("check", "arch", "--pga", "0.25"), "nothing shakes it")
