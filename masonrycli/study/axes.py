@@ -184,6 +184,7 @@ def apply_point(base, params: dict):
     if options:
         names = [s.name for s in scenario.assembly.supports]
         structure = {k: v for k, v in scenario.structure.items() if k != "builder"}
+        structure = _count_follows(builder, structure, options)
         try:
             scenario = scenario_from_builder(
                 builder, structure | options, scenario.run, scenario.material, dict(zip(names, scenario.motions))
@@ -257,6 +258,18 @@ def apply_point(base, params: dict):
 
 def _point(params: dict) -> str:
     return " ".join(f"{k}={v:g}" if isinstance(v, float) else f"{k}={v}" for k, v in params.items())
+
+
+def _count_follows(builder, structure: dict, options: dict) -> dict:
+    """The wall's ``structure`` without its block count when a point gives ``courses`` or ``length`` and not
+    ``blocks``, and both are then known: the count follows from them, as ``simulate wall --courses 15 --length
+    0.6`` builds it (37 blocks). The study's wall kept the built-in's 51 blocks, and every such point was
+    refused: '51 blocks cannot be laid in running bond with 15 courses and length 0.6 m'."""
+    if builder != "wall" or "blocks" in options or not options.keys() & {"courses", "length"}:
+        return structure
+    if not {"courses", "length"} <= (structure | options).keys():
+        return structure
+    return {k: v for k, v in structure.items() if k != "blocks"} | {"blocks": None}
 
 
 def _builder_option(builder, name: str) -> bool:
