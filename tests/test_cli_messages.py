@@ -372,3 +372,12 @@ def test_a_list_cut_at_the_space_after_a_comma_says_so():
     assert_one_line_error(result, "(1): a list goes without spaces after its commas: amp=0.5,1")
     result = runner.invoke(app, ["simulate", "wall", "--duration", "1", "0"], prog_name="masonry")
     assert "on/off" not in result.output  # no flag given: "0" is no flag's value
+
+
+@pytest.mark.parametrize("option, value", [("--courses", "15"), ("--friction", "0.5"), ("--density", "2200")])
+def test_a_run_option_given_to_a_study_names_its_axis(option, value):
+    # 'sweep wall --courses 15' said "No such option: --courses (Possible options: --force, --records)"
+    key = option[2:]
+    said = f"{option}: a study takes it as an axis: --param {key}=VALUE (one value: every run"
+    assert_one_line_error(invoke("sweep", "wall", option, value), said)
+    assert_one_line_error(invoke("sweep", "wall", "--bogus", value), "No such option: --bogus")

@@ -7,6 +7,7 @@ import functools
 import os
 import sys
 import warnings
+from dataclasses import fields
 
 import typer
 import typer.core
@@ -113,6 +114,7 @@ class OneLineUsageErrors(typer.core.TyperGroup):
             listed = "commands" if exc.format_message().startswith("No such command") else "options"
             said = (
                 _number_with_unit(exc)
+                or _sweep_axis(exc, command)
                 or _split_word(exc, command)
                 or f"{exc.format_message()} ({command} --help lists the {listed})"
             )
@@ -209,6 +211,26 @@ def _number_with_unit(exc) -> str | None:
 _RECORD_SUFFIXES = (".at2", ".csv", ".txt", ".asc", ".dat")  # what --record reads (records/read.py)
 _FLAG_VALUES = frozenset("true false yes no on off 1 0".split())
 _UNIT_WORDS = frozenset("s ms min m mm cm m/s m/s2 m/s² cm/s mm/s g gal hz Hz kg kg/m3 kg/m³ rad deg ° %".split())
+
+
+def _sweep_axis(exc, command: str) -> str | None:
+    """``masonry sweep wall --courses 15``: a setting simulate takes as an option is an axis of a study, given by
+    ``--param`` (one value, the same for every run). It said "No such option: --courses (Possible options:
+    --force, --records)", which pointed away from it. None for any other error or option."""
+    name = getattr(exc, "option_name", None) or ""
+    if not (command.split()[-1:] == ["sweep"] and name.startswith("--")):
+        return None
+    from geometry_library.builders import BUILDERS
+    from masonrycli.study.axes import MOTION_PARAMS, RUN_PARAMS
+
+    key = name[2:].replace("-", "_")
+    axes = {*MOTION_PARAMS, *RUN_PARAMS, "friction"} | {f.name for b in BUILDERS.values() for f in fields(b)}
+    if key not in axes:
+        return None
+    return (
+        f"{name}: a study takes it as an axis: --param {key}=VALUE (one value: every run; LO:HI:N or a,b,c: a "
+        f"value a run; {command} --help)"
+    )
 
 
 def _split_word(exc, command: str) -> str | None:
