@@ -76,6 +76,10 @@ class Model:
     block_carried_mass: np.ndarray
     """(N,) kg: the part of each block's mass that is a dead mass it carries (a bridge's fill over a voussoir,
     ``Block.carried_mass``); body_mass, body_q0 and body_inertia include it."""
+    block_centroid: np.ndarray
+    """(N, 2) m: each block's own (polygon's) centroid relative to its body's centre at θ = 0: exactly 0 but for
+    a block that carries a mass, whose body's centre of mass it pulls away (the cells' points,
+    ``masonrycli.analysis.tensors``)."""
 
     @property
     def body_count(self) -> int:
@@ -114,6 +118,7 @@ def build_model(scenario) -> Model:
     inertia = np.empty(n + s)
     volume = np.empty(n)
     carried = np.zeros(n)
+    own = np.zeros((n, 2))
     q0 = np.zeros((n + s, 3))
     v0 = np.zeros((n + s, 3))
     starts = [0]
@@ -130,6 +135,7 @@ def build_model(scenario) -> Model:
             centre = (mass[i] * props.centroid + carried[i] * at) / total
             inertia[i] += mass[i] * _squared(props.centroid - centre) + carried[i] * _squared(at - centre)
             mass[i] = total
+            own[i] = props.centroid - centre
         q0[i, :2] = centre
         v0[i] = block.velocity
         local.append(xy - centre)
@@ -175,6 +181,7 @@ def build_model(scenario) -> Model:
         block_name=tuple(b.name for b in blocks),
         support_name=tuple(sp.name for sp in supports),
         block_carried_mass=carried,
+        block_centroid=own,
     )
 
 

@@ -138,12 +138,15 @@ class Simulation:
         count = self.solver.detect(self.state.body_q)
         body = self.solver.contact_body[:count]
         blocks_only = body[(body[:, 0] < n) & (body[:, 1] < n)]
-        self.triangles = build_triangles(m.body_q0[:n, :2], blocks_only)
+        # on the blocks' own centroids (a carried fill moves the bodies' centres: tensors.py "Which point")
+        own = m.body_q0[:n, :2] + m.block_centroid if m.block_centroid.any() else m.body_q0[:n, :2]
+        self.triangles = build_triangles(own, blocks_only)
         weight = float(np.mean(m.body_mass[:n]) * np.hypot(*m.gravity)) if n else 0.0
         s = self.solver
         self.joints = JointTracker(body, s.contact_point, s.contact_normal, s.contact_gap, m.body_q0, n, weight)
+        chain = chain_neighbours(n, body)
         self.tensors = TensorComputer(
-            n, m.block_volume, self.triangles, centroids0=m.body_q0[:n, :2], chain=chain_neighbours(n, body)
+            n, m.block_volume, self.triangles, centroids0=own, chain=chain, centroid_offset=m.block_centroid
         )
         self.energy_dissipated = 0.0
         self.support_work = 0.0

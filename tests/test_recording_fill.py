@@ -15,7 +15,7 @@ from geometry_library.builders import build_arch
 from masonrycli.cli.app import app
 from masonrycli.recording import inspect_recording, screenshot_recording
 from masonrycli.recording.carried_fill import FILL_MESH, FILL_OUTLINES, strip_triangles
-from masonrycli.recording.layout import BLOCKS, MAGNIFIED, MAGNIFIED_FILL
+from masonrycli.recording.layout import BLOCKS, MAGNIFIED, MAGNIFIED_FILL, TRIANGULATION
 from masonrycli.recording.limit import OUTLINES, STEPS
 
 import recording_fixtures as fx
@@ -150,6 +150,9 @@ def test_the_centroid_dots_and_glyphs_stay_on_their_blocks(bridge):
     np.testing.assert_allclose(dots[last], moved, atol=2e-5)
     glyphs = strips(rrd, "structure/plane/xy/stress_axes")[0]  # two segments a block, centred on it
     np.testing.assert_allclose([g.mean(axis=0) for g in glyphs[::2]], own, atol=1e-5)
+    # the cells' triangles (Strain rate tab) join the same centroids: they joined the centres of mass, in the fill
+    corners = np.concatenate(fx.static_value(rrd, f"/{TRIANGULATION}", "LineStrips2D:strips"))
+    assert np.hypot(*(corners[:, None] - own[None]).T).min(axis=0).max() < 1e-5
 
 
 def test_the_legend_says_the_fill_and_its_load(bridge):

@@ -37,6 +37,14 @@ Definitions (DESIGN §3; paper eqs. 1–12)
   q = (σ1−σ2)/2, skew |σ_xy − σ_yx|/2. Strain (rate): volumetric = trace = ε1+ε2, deviatoric
   (ε1−ε2)/2. Compression and contraction are negative.
 * The joint states (sliding ratio, joint opening, hinges) are in ``masonrycli.analysis.mechanism``.
+* **Which point of a block**: the strain rate, the cumulated strain, the chain strain rate and the
+  triangulation take each block's own centroid (its polygon's, ``centroid_offset`` from the body's centre),
+  the paper's G: a bridge's fill, carried as a mass on the blocks under it (``Block.carried_mass``), pulls
+  the body's centre of mass up to 1.2 m into the fill, and fans between those points were not the
+  masonry's cells. The block stress keeps the body's centre of mass as G: about it the inertia and the
+  weight (the fill's included) have no moment, so the stress of a block at rest is symmetric (the filled
+  bridge's voussoirs: skew ≤ 7e-4 |p|); about the stone's own centroid the contacts' moment of the fill's
+  weight showed as a skew part up to 0.25 |p| (8.6 kPa). For a block that carries nothing the two agree.
 
 Units: SI. Forces in N acting on the block's whole thickness (as the solver's, m = ρ·A·e); with the
 default e = 1 m these are N/m and σ is in Pa either way.
@@ -315,6 +323,9 @@ class TensorComputer:
             configuration.
         centroids0: (N, 2) m, optional: the initial centroids, for the folded-fan floor.
         chain: (N, 2) int, optional: ``chain_neighbours`` (default: no block in a chain).
+        centroid_offset: (N, 2) m, optional: each block's own centroid relative to its body's centre at
+            θ = 0 (a carried fill's blocks'; module doc "Which point of a block"); None or all zero: the
+            body's centre is the centroid, and ``step`` hands the kernels the arrays it is given.
     """
 
     def __init__(
@@ -324,6 +335,7 @@ class TensorComputer:
         triangles: np.ndarray,
         centroids0: np.ndarray | None = None,
         chain: np.ndarray | None = None,
+        centroid_offset: np.ndarray | None = None,
     ):
         n = int(block_count)
         if n < 0:
@@ -360,6 +372,9 @@ class TensorComputer:
         self._buffers = {"tensor": self._tensor, "pair": self._pair, "scalar": self._scalar, "chain": self._chain_rate}
         self._invariants_stale = False
         self._stress_inputs: tuple | None = None  # the last step's arrays until fields() reads them
+        offset = None if centroid_offset is None else np.asarray(centroid_offset, dtype=np.float64).reshape(n, 2)
+        self.centroid_offset = None if offset is None or not offset.any() else offset
+        """(N, 2) m, or None: every block's centroid is its body's centre (no carried mass)."""
         self.reset_strain()
 
     def reset_strain(self) -> None:
@@ -400,10 +415,26 @@ class TensorComputer:
                 f"contact_body {contact_body.shape}, contact_point {contact_point.shape}, "
                 f"contact_force {contact_force.shape}"
             )
-        _k._strain_step(n, block_q, block_v, self.triangles, self.min_star_area, float(dt), self._tensor)
+        point_q, point_v = self.centroids(block_q, block_v)
+        _k._strain_step(n, point_q, point_v, self.triangles, self.min_star_area, float(dt), self._tensor)
         # Stress and chain strain rate are read at recorded frames only: computed then (fields).
-        self._stress_inputs = (block_q, block_v, contact_body, contact_point, contact_force)
+        self._stress_inputs = (block_q, point_q, point_v, contact_body, contact_point, contact_force)
         self._invariants_stale = True
+
+    def centroids(self, block_q: np.ndarray, block_v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(N, 3) the blocks' own centroids (x, y, θ) and their velocities (vx, vy, ω) from the bodies' poses
+        and velocities; the arrays given when no block carries a mass (``centroid_offset`` None)."""
+        if self.centroid_offset is None:
+            return block_q, block_v
+        # r = R(θ) offset;  x_c = x + r;  v_c = v + ω × r = (vx − ω r_y, vy + ω r_x)
+        n = self.block_count
+        q, v = block_q[:n], block_v[:n]
+        c, s = np.cos(q[:, 2]), np.sin(q[:, 2])
+        ox, oy = self.centroid_offset.T
+        rx, ry = c * ox - s * oy, s * ox + c * oy
+        point_q = np.stack([q[:, 0] + rx, q[:, 1] + ry, q[:, 2]], axis=1)
+        point_v = np.stack([v[:, 0] - v[:, 2] * ry, v[:, 1] + v[:, 2] * rx, v[:, 2]], axis=1)
+        return point_q, point_v
 
     def fields(self) -> dict[str, np.ndarray]:
         """Copies of all ``TENSOR_FIELDS``, name → (N, *shape) float64 C-contiguous array, in ``TENSOR_FIELDS``
@@ -414,11 +445,12 @@ class TensorComputer:
         every ``step`` — the values are the same, and steps that are not recorded skip ~20 µs.
         """
         if self._stress_inputs is not None:
-            q, v, body, point, force = self._stress_inputs
+            q, point_q, point_v, body, point, force = self._stress_inputs
             _k._stress_step(
                 self.block_count,
                 q,
-                v,
+                point_q,
+                point_v,
                 self.block_volume,
                 self.chain,
                 body,

@@ -291,12 +291,14 @@ def _strain_step(block_count, block_q, block_v, triangles, min_area, dt, tensor_
 
 
 # block stress → cell neighbours → cell stress, chain strain rate: only when the fields are read (the
-# step's own inputs; nothing carries over from one step to the next).
+# step's own inputs; nothing carries over from one step to the next). The stress about block_q (the bodies'
+# centres of mass), the chain's links between point_q with velocities point_v (the blocks' own centroids).
 @njit
 def _stress_step(
     block_count,
     block_q,
-    block_v,
+    point_q,
+    point_v,
     block_volume,
     chain,
     contact_body,
@@ -311,7 +313,7 @@ def _stress_step(
     _block_stress(n, block_q, block_volume, contact_body, contact_point, contact_force, block_stress)
     start, neighbour = _cell_neighbours(n, contact_body)
     _cell_average(n, start, neighbour, block_volume, block_stress, tensor_out[T_CELL_STRESS])
-    _chain_strain_rate(n, block_q, block_v, chain, chain_out)
+    _chain_strain_rate(n, point_q, point_v, chain, chain_out)
 
 
 # cell stress: skew |t_xy − t_yx|/2, principal values/angle, p = (σ1+σ2)/2, q = (σ1−σ2)/2

@@ -218,7 +218,8 @@ class Recorder:
                 self.static.block_vert_start,
                 inset_local(self.static.block_vert_start, self.static.block_vert_local, self.fill_inset()),
             )
-            log_initial_shape(self.rec, self._blocks, self.static.triangles, q, sq, self._supports)
+            own = posed_points(q[None], self._own)[0]  # the cells' points (analysis.tensors), not the fill's pull
+            log_initial_shape(self.rec, self._blocks, self.static.triangles, q, sq, self._supports, own)
             for f in COLOURED:
                 log_legend(self.rec, f, self._legend_box)
             self._label_anchors = legend_positions(self._legend_box).astype(np.float32)

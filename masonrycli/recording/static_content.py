@@ -135,8 +135,10 @@ def log_initial_shape(
     block_q: np.ndarray,
     support_q: np.ndarray,
     supports: Polygons,
+    centroids: np.ndarray | None = None,
 ) -> None:
-    """The as-built outlines (the magnified view's ghost) and the cells' triangles as built."""
+    """The as-built outlines (the magnified view's ghost) and the cells' triangles as built, between the blocks'
+    ``centroids`` (N, 2) m (None: their poses' x, y), their own, as the cells are (analysis.tensors)."""
     verts = blocks.world(block_q[None])
     ghost = [blocks.outlines(verts)]
     if supports.count:
@@ -146,7 +148,8 @@ def log_initial_shape(
         rr.LineStrips2D(pa.concat_arrays(ghost), colors=UNDEFORMED_RGBA, radii=-0.75, draw_order=20.0),
         static=True,
     )
-    closed = block_q[np.asarray(triangles, dtype=np.intp).reshape(-1, 3)[:, [0, 1, 2, 0]], :2]
+    points = block_q[:, :2] if centroids is None else np.asarray(centroids, dtype=np.float64)
+    closed = points[np.asarray(triangles, dtype=np.intp).reshape(-1, 3)[:, [0, 1, 2, 0]]]
     rec.log(
         TRIANGULATION,
         rr.LineStrips2D(uniform_strips(closed), colors=TRIANGULATION_RGBA, radii=-0.5, draw_order=31.0),
