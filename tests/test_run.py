@@ -16,7 +16,7 @@ from masonrycli.run import SolverTally, simulate
 from masonrycli.scenario.motion import Sine
 from masonrycli.scenario.scenario import Material, RunConfig, scenario_from_builder
 
-from cli_helpers import invoke
+from cli_helpers import invoke, words
 from engine_helpers import PerStep
 
 
@@ -115,3 +115,38 @@ def test_solver_option_runs_either_solver_to_the_same_motion(tmp_path):
     np.testing.assert_array_equal(q[None], q["nlgs-accel32"])  # the default
     for solver in ("nlgs-accel32", "nlgs-accel"):
         assert np.abs(q["nlgs"][..., :2] - q[solver][..., :2]).max() < 5e-4  # m, after 0.1 s of shaking
+
+
+def test_the_summary_gives_the_peak_drift_a_history_of_every_step_shows(tmp_path):
+    # an intact wall's state line gave its residual drift (~0) and no word of how far it swung meanwhile
+    npz = tmp_path / "h.npz"
+    args = (
+        "--courses",
+        4,
+        "--length",
+        1.2,
+        "--amp",
+        1,
+        "--duration",
+        0.3,
+        "--record-every",
+        1,
+        "--no-recording",
+        "--history",
+        npz,
+    )
+    result = invoke("simulate", "wall", *args)
+    assert result.exit_code == 0, result.output
+    h = np.load(npz)
+    # the top course (centroids within half a block height of the highest) relative to the ground, over the
+    # blocks' vertical extent, at every step: a plain loop over the history
+    q0, ext = h["block_q"][0], h["block_extent"]
+    height = ext[:, 3].max() - ext[:, 1].min()
+    top = [i for i in range(len(q0)) if q0[i, 1] >= q0[:, 1].max() - 0.5 * 0.2]
+    peak = 0.0
+    for k in range(len(h["time"])):
+        top_dx = sum(h["block_q"][k, i, 0] - q0[i, 0] for i in top) / len(top)
+        peak = max(peak, abs(top_dx - (h["support_q"][k, 0, 0] - h["support_q"][0, 0, 0])) / height)
+    assert peak > 1e-4
+    said = words(result.output.replace("│", " "))  # a row's wrapped lines joined
+    assert f"peak drift {100 * peak:.3g} % of the height ({1000 * peak * height:.3g} mm over {height:.3g} m)" in said
