@@ -103,10 +103,10 @@ def top_surface(blocks, x_lo: float, x_hi: float) -> list[TopPiece]:
     return pieces
 
 
-def _under_level(blocks, level: float, x_lo: float, x_hi: float):
+def _under_level(blocks, level: float, x_lo: float, x_hi: float, pieces: list[TopPiece] | None = None):
     """(block, a, b, y(a), y(b)) of each piece of the top surface below ``level``, left to right, clipped where
-    the top crosses the level (module docstring)."""
-    for piece in top_surface(blocks, x_lo, x_hi):
+    the top crosses the level (module docstring); ``pieces``: ``top_surface(blocks, x_lo, x_hi)`` if known."""
+    for piece in top_surface(blocks, x_lo, x_hi) if pieces is None else pieces:
         a, b = piece.a, piece.b
         ya, yb = piece.y(a), piece.y(b)
         if ya >= level and yb >= level:
@@ -118,11 +118,11 @@ def _under_level(blocks, level: float, x_lo: float, x_hi: float):
         yield piece.block, a, b, ya, yb
 
 
-def fill_over(blocks, level: float, x_lo: float, x_hi: float) -> Fill:
+def fill_over(blocks, level: float, x_lo: float, x_hi: float, pieces: list[TopPiece] | None = None) -> Fill:
     """The fill up to ``level`` (m) over the blocks' top surface between ``x_lo`` and ``x_hi`` (m), per block
-    (module docstring)."""
+    (module docstring); ``pieces``: that top surface, if known."""
     sums = np.zeros((len(blocks), 3))
-    for block, a, b, ya, yb in _under_level(blocks, level, x_lo, x_hi):
+    for block, a, b, ya, yb in _under_level(blocks, level, x_lo, x_hi, pieces):
         sums[block] += _trapezoid(a, b, ya, yb, level)
     area = sums[:, 0]
     with np.errstate(invalid="ignore", divide="ignore"):
@@ -180,6 +180,62 @@ def with_fill(blocks, level: float, density: float, x_lo: float, x_hi: float) ->
         at = (block.carried_mass * before + mass * centre) / total
         out.append(dataclasses.replace(block, carried_mass=float(total), carried_at=(float(at[0]), float(at[1]))))
     return out
+
+
+LEVEL_TOLERANCE = 1e-6
+"""A fill read back from its carried masses (:func:`level_from_carried`) is one when every block's fill
+centroid lies within this × the structure's size (at least 1 m) of its ``carried_at``, and every block's
+mass over its fill's area and thickness within this fraction of one density."""
+
+
+def level_from_carried(blocks) -> tuple[float, float, float] | None:
+    """(level, x_lo, x_hi), m, of the fill whose weight the blocks carry (``Block.carried_mass`` at
+    ``carried_at``), when it is one: a fill of one density up to one level over the blocks' top surface
+    between the structure's ends, as :func:`with_fill` lays it (a built-in bridge's written to GeoJSON or to
+    a scenario file's [[block]] tables). None for any other set of carried masses: nothing says their outline.
+
+        Y = Σ w_i y_i / Σ w_i, w_i = carried_mass_i / thickness_i  (∝ the fill's area over block i)
+        g(level) = the centroid y of fill_over(level), strictly increasing in the level (each layer added
+            lies above the fill under it), below Y at the highest carried_at (every column's centroid is
+            under the level), above it at 2 Y − the lowest vertex (a column's centroid is at least halfway up)
+        level = the root of g − Y (bisection to the last bit); then check every block, as LEVEL_TOLERANCE says
+    """
+    mass = np.array([b.carried_mass for b in blocks], dtype=np.float64)
+    if not blocks or not (mass > 0.0).any():
+        return None
+    carrying = mass > 0.0
+    at = np.array([b.carried_at if m > 0.0 else (np.nan, np.nan) for b, m in zip(blocks, mass)], dtype=np.float64)
+    thickness = np.array([b.thickness for b in blocks], dtype=np.float64)
+    weight = mass / thickness
+    target = float(np.sum(weight[carrying] * at[carrying, 1]) / weight.sum())
+    x_lo, x_hi = _extent(blocks)
+    pieces = top_surface(blocks, x_lo, x_hi)
+    bottom = min(float(np.asarray(b.vertices)[:, 1].min()) for b in blocks)
+
+    def centre(level: float) -> float:
+        fill = fill_over(blocks, level, x_lo, x_hi, pieces)
+        area = fill.area.sum()
+        return -np.inf if area <= 0.0 else float(np.nansum(fill.area * fill.centroid[:, 1]) / area)
+
+    lo, hi = float(at[carrying, 1].max()), 2.0 * target - bottom
+    if not lo < hi:
+        return None
+    for _ in range(200):  # halves the bracket until it holds no float between its ends
+        mid = 0.5 * (lo + hi)
+        if not lo < mid < hi:
+            break
+        lo, hi = (mid, hi) if centre(mid) < target else (lo, mid)
+    level = 0.5 * (lo + hi)
+    fill = fill_over(blocks, level, x_lo, x_hi, pieces)
+    size = max(1.0, x_hi - x_lo, level - bottom)
+    if not np.array_equal(fill.area > 0.0, carrying):
+        return None
+    if np.hypot(*(fill.centroid[carrying] - at[carrying]).T).max() > LEVEL_TOLERANCE * size:
+        return None
+    density = mass[carrying] / (fill.area[carrying] * thickness[carrying])
+    if np.abs(density / np.median(density) - 1.0).max() > LEVEL_TOLERANCE:
+        return None
+    return level, x_lo, x_hi
 
 
 def spread_load(blocks, x: float, level: float, angle_deg: float) -> list[tuple[int, float, float, float]]:

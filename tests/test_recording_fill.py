@@ -172,6 +172,30 @@ def test_the_magnified_line_of_the_legend_says_the_fill(bridge):
     assert f"sand outlines = the fill (dead load only, {load:.4g} kN)" in line, line
 
 
+def test_a_bridge_read_from_geojson_draws_its_fill_as_the_built_in(bridge, tmp_path):
+    """'masonry run b.geojson' of the bridge written by 'masonry build arch ... --out b.geojson' drew no fill (the
+    file keeps the carried masses, not the level): their level is found again (one fill, one density), and the
+    columns are the built-in's. Masses that are not one fill's stay undrawn, the legend says so."""
+    import json
+
+    geojson = tmp_path / "b.geojson"
+    invoke("build", "arch", *OPTIONS, *FILL, "--out", geojson)
+    rrd = tmp_path / "file.rrd"
+    invoke("run", geojson, "--duration", 0.001, "--dt", 1e-3, "--out", rrd)
+    drawn, built = strips(rrd, FILL_OUTLINES)[0], strips(bridge[0], FILL_OUTLINES)[0]
+    assert len(drawn) == len(built) > 20
+    for a, b in zip(drawn, built):
+        np.testing.assert_allclose(a, b, atol=1e-6)
+    data = json.loads(geojson.read_text())
+    carrying = [f for f in data["features"] if f["properties"].get("carried_mass")]
+    carrying[3]["properties"]["carried_mass"] *= 1.01  # one voussoir's fill 1 % denser: not one fill
+    geojson.write_text(json.dumps(data))
+    rrd = tmp_path / "other.rrd"
+    invoke("run", geojson, "--duration", 0.001, "--dt", 1e-3, "--out", rrd)
+    assert f"/{FILL_OUTLINES}" not in set(inspect_recording(rrd)["entity_paths"])
+    assert "not drawn" in fx.static_value(rrd, "/run/legend", "TextDocument:text")[0]
+
+
 def test_a_bare_arch_records_no_fill(tmp_path):
     rrd = tmp_path / "bare.rrd"
     invoke("simulate", "arch", *OPTIONS, "--duration", 0.002, "--dt", 1e-3, "--out", rrd)

@@ -18,8 +18,8 @@ THRUST_SHOWN = 0.02
 """The recording's line of thrust shows joints carrying at least this share of the largest joint force."""
 
 
-def mechanism_document(result: LimitResult) -> str:
-    """Markdown for the recording's side panel."""
+def mechanism_document(result: LimitResult, fill_drawn: bool = True) -> str:
+    """Markdown for the recording's side panel; ``fill_drawn``: the fill's columns are drawn (a carried fill's)."""
     reading = lambda_reading(result)
     lines = [
         f"# masonry limit: {result.scenario_name}",
@@ -27,7 +27,7 @@ def mechanism_document(result: LimitResult) -> str:
         "",
         f"live load: {result.load.describe()}; friction {result.model.friction:g}",
         "",
-        *_fill_lines(result),
+        *_fill_lines(result, fill_drawn),
         "Left: the structure as built; red dots: the line of thrust (centre of pressure of each loaded joint).",
         "Right: the collapse mechanism, magnified, blocks coloured by their speed in it (grey: still);",
         "yellow: hinges; orange: sliding joints. Play the timeline to grow the mechanism.",
@@ -44,14 +44,19 @@ def mechanism_document(result: LimitResult) -> str:
     return "\n".join(lines)
 
 
-def _fill_lines(result: LimitResult) -> list[str]:
-    """The panel's word on a fill: a filled bridge's recording showed a bare ring (the view draws a built-in's
-    columns now; a GeoJSON's carried masses have no level to draw them to)."""
+def _fill_lines(result: LimitResult, drawn: bool) -> list[str]:
+    """The panel's word on a fill: a filled bridge's recording showed a bare ring (the view draws its columns
+    now, a file's too when its carried masses are one fill's: ``scenario.fill``; other masses are not drawn)."""
     fill = result.summary()["fill_load_N"]
     if not fill:
         return []
     said = f"dead load: the blocks' weight and {fill:.4g} N of fill{depth_text(result)}, borne by the blocks under it"
-    return [said + " (sand: a built-in bridge's fill, each column over its block, carried along the mechanism)", ""]
+    how = (
+        " (sand: each column over its block, carried along the mechanism)"
+        if drawn
+        else " (not drawn: the carried masses are not those of one fill up to one level)"
+    )
+    return [said + how, ""]
 
 
 DOCUMENT_NAMES = 12
@@ -111,6 +116,7 @@ def write_recording(result: LimitResult, out: Path, scenario=None) -> None:
     # Centres of pressure of the joints that carry load (lightly loaded head joints only clutter the line).
     normal = result.thrust.joint_normal_force
     thrust = result.thrust.joint_point[normal >= THRUST_SHOWN * normal.max(initial=0.0)]
+    cols = columns_on_blocks(scenario, m.body_q0[:n, :2]) if scenario else None
     drawing = MechanismDrawing(
         block_vert_start=start[: n + 1].copy(),
         block_vert_local=m.vert_local[: start[n]].copy(),
@@ -125,11 +131,9 @@ def write_recording(result: LimitResult, out: Path, scenario=None) -> None:
         sliding_point=middle[mo.joint_sliding],
         sliding_block=carrier[mo.joint_sliding],
         thrust_point=thrust[np.isfinite(thrust).all(axis=1)],
-        document=mechanism_document(result),
+        document=mechanism_document(result, fill_drawn=cols is not None),
         load=load_arrow(result),
-        fill=None
-        if (cols := columns_on_blocks(scenario, m.body_q0[:n, :2]) if scenario else None) is None
-        else ColumnArrays(*cols),
+        fill=None if cols is None else ColumnArrays(*cols),
         parameters=None if scenario is None else _parameters(scenario, result),
     )
     out.parent.mkdir(parents=True, exist_ok=True)

@@ -132,6 +132,6 @@ def fill_legend(fill_load_n: float, thickness: float | None, drawn: bool) -> str
     where = (
         "drawn over the blocks that carry it, each column moving with its block"
         if drawn
-        else "carried by the blocks under it, not drawn (its level is not known)"
+        else "carried by the blocks under it, not drawn (the carried masses are not those of one fill up to one level)"
     )
     return f"\n- **Fill** (sand, translucent): dead load only, {load}, {where}."

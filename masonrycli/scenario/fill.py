@@ -4,14 +4,18 @@ A block knows only the mass it carries and where (``Block.carried_mass`` at ``ca
 and extent are the builder's (``ArchSpec``: ``--fill-to`` / ``--fill-cover`` between the piers' outer faces).
 They are read again from the scenario's structure options, and the columns recomputed over the scenario's own
 blocks (``geometry_library.fill.fill_columns``, the pieces ``with_fill`` weighed). A GeoJSON or a scenario
-file with carried masses has no level: nothing here (its recording says the mass, draws no column).
+file has only the carried masses: their columns are drawn when the masses are one fill's, of one density up to
+one level (a built-in bridge's written to a file: ``geometry_library.fill.level_from_carried`` finds that
+level and checks every block against it); other carried masses have no outline to draw (the recording says
+the mass and that it is not drawn). The fill's level for a load spread through it stays a built-in's
+(:func:`fill_surface`).
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from geometry_library.fill import FillColumns, fill_columns
+from geometry_library.fill import FillColumns, fill_columns, level_from_carried
 
 
 def _fill_of(scenario) -> tuple[float, float, float] | None:
@@ -33,8 +37,10 @@ def fill_surface(scenario) -> float | None:
 
 
 def carried_columns(scenario) -> FillColumns | None:
-    """The fill's columns over the scenario's blocks (world coordinates as built), None without a fill."""
-    fill = _fill_of(scenario)
+    """The fill's columns over the scenario's blocks (world coordinates as built), None without a fill or when
+    a file's carried masses are not one fill's (module doc)."""
+    built_in = scenario.structure.get("builder") == "arch"
+    fill = _fill_of(scenario) if built_in else level_from_carried(scenario.assembly.blocks)
     return None if fill is None else fill_columns(scenario.assembly.blocks, *fill)
 
 
