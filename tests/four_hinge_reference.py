@@ -58,10 +58,6 @@ def least_load_factor(
     voussoirs, each (kind, forces (n, 2), at (n, 2)) with kind "dead" or "live": a bridge's fill, whose
     weight (dead) and, under a horizontal acceleration, inertia (live) act at the fill column's centroid.
     """
-    n = len(centroid)
-    radial = extrados - intrados
-    radial /= np.hypot(radial[:, 0], radial[:, 1])[:, None]
-    normal = np.stack([radial[:, 1], -radial[:, 0]], axis=1)  # along the ring, left to right
 
     def prefix(forces, at):
         m = _cross(at[:, 0], at[:, 1], forces[:, 0], forces[:, 1])
@@ -70,9 +66,27 @@ def least_load_factor(
     sums = {"dead": prefix(dead, centroid), "live": prefix(live, centroid if live_at is None else live_at)}
     for kind, forces, at in extra:  # loads add: so do their prefix sums
         sums[kind] = [a + b for a, b in zip(sums[kind], prefix(np.asarray(forces), np.asarray(at)))]
+    best = (np.inf, None)
+    for combos, sides, ok, bodies, _ in _four_hinge_mechanisms(intrados, extrados):
+        p_dead, p_live = (_power(sums[kind], bodies) for kind in ("dead", "live"))
+        ok = ok & (p_live > 1e-12 * np.abs(p_dead).max())
+        lam = np.where(ok, -p_dead / np.where(ok, p_live, 1.0), np.inf)
+        k = int(np.argmin(lam))
+        if lam[k] < best[0]:
+            best = (float(lam[k]), (tuple(int(x) for x in combos[k]), sides))
+    return best
+
+
+def _four_hinge_mechanisms(intrados: np.ndarray, extrados: np.ndarray):
+    """For each intrados/extrados pattern of the hinges: (joints (M, 4), sides, admissible (M,), the three
+    bodies (ω, first voussoir, end, centre of rotation) turned the way that opens every hinge, the far-end
+    opening rate of each hinge (4, M))."""
+    n = len(intrados) - 1
+    radial = extrados - intrados
+    radial /= np.hypot(radial[:, 0], radial[:, 1])[:, None]
+    normal = np.stack([radial[:, 1], -radial[:, 0]], axis=1)  # along the ring, left to right
     combos = np.array(list(itertools.combinations(range(n + 1), 4)))
     a, b, c, d = combos.T
-    best = (np.inf, None)
     for sides in itertools.product((0, 1), repeat=4):  # 0: hinge on the intrados, 1: on the extrados
         ends = [(intrados, extrados) if s == 0 else (extrados, intrados) for s in sides]
         h = [ends[i][0][j] for i, j in enumerate((a, b, c, d))]  # hinge points
@@ -101,14 +115,27 @@ def least_load_factor(
         forward, backward = np.all(opening > 1e-12, axis=0), np.all(opening < -1e-12, axis=0)
         sign = np.where(forward, 1.0, np.where(backward, -1.0, 0.0))
         ok &= sign != 0.0
+        bodies = ((sign * omega[0], a, b, h[0]), (sign * omega[1], b, c, centre2), (sign * omega[2], c, d, h[3]))
+        yield combos, sides, ok, bodies, sign * opening
 
-        bodies = ((omega[0], a, b, h[0]), (omega[1], b, c, centre2), (omega[2], c, d, h[3]))
-        p_dead, p_live = (sign * _power(sums[kind], bodies) for kind in ("dead", "live"))
-        ok &= p_live > 1e-12 * np.abs(p_dead).max()
-        lam = np.where(ok, -p_dead / np.where(ok, p_live, 1.0), np.inf)
-        k = int(np.argmin(lam))
-        if lam[k] < best[0]:
-            best = (float(lam[k]), (tuple(int(x) for x in combos[k]), sides))
+
+def least_opening_mechanism(
+    intrados: np.ndarray, extrados: np.ndarray, centroid: np.ndarray, dead: np.ndarray
+) -> tuple[float, tuple]:
+    """(opening per work, (joints a b c d, sides)) of the four-hinge mechanism that the dead load drives with the
+    least opening of its joints for the work it does: min Σ_hinges (far-end opening rate) / P(dead) over the
+    admissible mechanisms with P(dead) > 0 (a ring that cannot stand has some). The far-end opening of a hinge
+    is its joint's whole opening: the hinge end stays shut."""
+    m = _cross(centroid[:, 0], centroid[:, 1], dead[:, 0], dead[:, 1])
+    sums = [np.concatenate([[0.0], np.cumsum(v)]) for v in (dead[:, 0], dead[:, 1], m)]
+    best = (np.inf, None)
+    for combos, sides, ok, bodies, opening in _four_hinge_mechanisms(intrados, extrados):
+        work = _power(sums, bodies)
+        ok = ok & (work > 1e-12)
+        ratio = np.where(ok, opening.sum(axis=0) / np.where(ok, work, 1.0), np.inf)
+        k = int(np.argmin(ratio))
+        if ratio[k] < best[0]:
+            best = (float(ratio[k]), (tuple(int(x) for x in combos[k]), sides))
     return best
 
 

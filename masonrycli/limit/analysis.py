@@ -14,7 +14,7 @@ import numpy as np
 
 from masonrycli.errors import InputError
 from masonrycli.limit.joints import Joints, find_joints, joint_names
-from masonrycli.limit.kinematics import JointMotion, joint_motion
+from masonrycli.limit.kinematics import JointMotion, joint_motion, rigid_parts
 from masonrycli.limit.problem import (
     LimitError,
     LiveLoad,
@@ -83,6 +83,12 @@ class LimitResult:
         names = self.names
         return [names[k] for k in order if self.motion.joint_hinged[k]]
 
+    def opening_largest_first(self) -> list[str]:
+        """The joints whose faces turn as they part all along (no end in contact), the fastest first."""
+        order = np.argsort(-self.motion.joint_turn, kind="stable")
+        names = self.names
+        return [names[k] for k in order if self.motion.joint_opening[k]]
+
     def sliding_largest_first(self) -> list[str]:
         """The sliding joints, the fastest-sliding first."""
         order = np.argsort(-self.motion.joint_slide, kind="stable")
@@ -92,6 +98,16 @@ class LimitResult:
     @property
     def moving_blocks(self) -> list[str]:
         return [n for n, m in zip(self.model.block_name, self.motion.block_moving) if m]
+
+    @property
+    def part_indices(self) -> list[np.ndarray]:
+        """The moving blocks (indices) as the mechanism's rigid parts, largest first (:func:`rigid_parts`)."""
+        return rigid_parts(self.model, self.joints, self.motion)
+
+    @property
+    def rigid_parts(self) -> list[list[str]]:
+        """:attr:`part_indices` by name."""
+        return [[str(self.model.block_name[k]) for k in p] for p in self.part_indices]
 
     def tilt_angle(self) -> float | None:
         """Degrees: the tilting table's critical angle atan(λ) (body-force loads only)."""
@@ -155,7 +171,9 @@ class LimitResult:
             "hinges": self.hinges,
             "hinge_points": [[float(x), float(y)] for x, y in self.motion.hinge_point],
             "sliding_joints": self.sliding_joints,
+            "opening_joints": self.opening_largest_first(),
             "moving_blocks": self.moving_blocks,
+            "rigid_parts": self.rigid_parts,
             "mechanism": {
                 name: [float(v) for v in vel]
                 for name, vel, moving in zip(m.block_name, self.solution.block_velocity, self.motion.block_moving)
@@ -182,7 +200,8 @@ MIN_GRAVITY = 1e-6
 
 def _falls(model: Model, joints: Joints, dead: np.ndarray, shown: int = 4) -> str:
     """What gives way under the dead load alone (:func:`gravity_mechanism`), for the "no equilibrium" line:
-    which blocks move, the fastest hinges and sliding joints (an abutment tipped by an arch's thrust)."""
+    which blocks move, as which rigid parts, its hinges and sliding joints (an abutment tipped by an arch's
+    thrust)."""
     motion = joint_motion(model, joints, gravity_mechanism(model, joints, dead))
     moving = int(np.count_nonzero(motion.block_moving))
     if not moving:
@@ -195,11 +214,39 @@ def _falls(model: Model, joints: Joints, dead: np.ndarray, shown: int = 4) -> st
         return ", ".join(names[k] for k in order[:shown]) + more
 
     parts = []
-    if motion.joint_hinged.any():
-        parts.append(f"hinges {fastest(motion.joint_turn, motion.joint_hinged)}")
-    if motion.joint_sliding.any():
-        parts.append(f"sliding {fastest(motion.joint_slide, motion.joint_sliding)}")
-    return f"; under its own weight {moving} of {model.block_count} blocks give way — " + "; ".join(parts)
+    for word, rate, chosen in (
+        ("hinges", motion.joint_turn, motion.joint_hinged),
+        ("sliding", motion.joint_slide, motion.joint_sliding),
+        ("opening", motion.joint_turn, motion.joint_opening),
+    ):
+        if chosen.any():
+            parts.append(f"{word} {fastest(rate, chosen)}")
+    return (
+        f"; under its own weight {moving} of {model.block_count} blocks give way{parts_text(model.block_name, rigid_parts(model, joints, motion))} — "
+        + "; ".join(parts)
+    )
+
+
+def parts_text(names, parts: list[np.ndarray], shown: int = 4) -> str:
+    """ ", as 3 rigid parts (v01 … v05, 5 blocks; …)" of the rigid parts ``parts`` (block indices, largest first):
+    a part of consecutive blocks by its first and last, another by its first two; "" when each moving block is
+    a part of its own (nothing to group)."""
+    if all(p.size == 1 for p in parts):
+        return ""
+
+    def part(p):
+        if p.size == 1:
+            return str(names[p[0]])
+        if p.size == 2 or np.all(np.diff(p) == 1):
+            return f"{names[p[0]]} {'…' if p.size > 2 else 'and'} {names[p[-1]]}" + (
+                f", {p.size} blocks" if p.size > 2 else ""
+            )
+        return f"{names[p[0]]}, {names[p[1]]} and {p.size - 2} more"
+
+    if len(parts) == 1:
+        return f", as one rigid part ({part(parts[0])})"
+    more = f"; and {len(parts) - shown} more" if len(parts) > shown else ""
+    return f", as {len(parts)} rigid parts ({'; '.join(part(p) for p in parts[:shown])}{more})"
 
 
 def analyse_model(model: Model, load: LiveLoad, scenario_name: str = "") -> LimitResult:

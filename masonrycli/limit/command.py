@@ -22,7 +22,7 @@ from rich.text import Text
 from masonrycli import SOURCE_DIGEST, __version__
 from masonrycli.errors import EXIT_OUTPUT_FAILED, InputError
 from masonrycli.interrupt import StopRun, StopSignals, exit_code, signal_name
-from masonrycli.limit.analysis import LimitResult, analyse
+from masonrycli.limit.analysis import LimitResult, analyse, parts_text
 from masonrycli.limit.problem import LimitError, LiveLoad, NoEquilibrium, force_text, parse_force
 from masonrycli.outputs.files import check_output, written_whole
 from masonrycli.source_digest import source_commit
@@ -149,7 +149,12 @@ def result_table(result: LimitResult, out: Path | None) -> Table:
         )
     table.add_row("hinges", _names(result.hinges_largest_first()))
     table.add_row("sliding joints", _names(result.sliding_largest_first()))
-    table.add_row("blocks in the mechanism", f"{len(result.moving_blocks)} of {s['blocks']}")
+    if result.motion.joint_opening.any():  # parting all along: not hinges (the wall's wedge had "10 hinges")
+        table.add_row("joints opening", _names(result.opening_largest_first()))
+    table.add_row(
+        "blocks in the mechanism",
+        f"{len(result.moving_blocks)} of {s['blocks']}{parts_text(result.model.block_name, result.part_indices)}",
+    )
     table.add_row(
         "solve time", f"{s['solve_time_s'] * 1e3:.0f} ms HiGHS, {s['analysis_time_s'] * 1e3:.0f} ms analysis in all"
     )

@@ -10,8 +10,12 @@ rate is the same at every point, and the opening varies linearly with the relati
 
 The words are those of the dynamic run (``masonrycli.analysis.mechanism``): a joint is named by its two bodies
 ``"a|b"``; it is **hinged** when its faces turn relative to each other (|Δω| × joint length above the
-tolerance) — a face joint rotating about one end, the end that stays closed being the hinge; it is
-**sliding** when its faces move along each other. A joint may do both. Single-point (corner) contacts
+tolerance) about an end that stays in contact — the hinge; it is **sliding** when its faces move along each
+other. A joint may do both. One whose faces turn as they part all along (no end in contact: the inner
+column of a pier tipping about its outer toe, the joints of a wedge of a wall turning on one pivot) is
+**opening**, not a hinge: listed as hinges, they made a wedge of 9 wall blocks turning about one point
+"10 hinges". An end stays in contact when its opening is at most the dilation of its sliding (μ |Δv·t|:
+the flow rule's, where the contact force may act) plus the tolerance. Single-point (corner) contacts
 are never hinges (a point has no face to open), as in the dynamic detector; they may slide.
 """
 
@@ -38,7 +42,9 @@ class JointMotion:
     contact_sliding: np.ndarray
     """(C,) sliding rate Δv·t at each contact point [-]."""
     joint_hinged: np.ndarray
-    """(J,) bool: the joint's faces turn about one of its ends."""
+    """(J,) bool: the joint's faces turn about one of its ends, which stays in contact."""
+    joint_opening: np.ndarray
+    """(J,) bool: the joint's faces turn as they part all along (no end in contact; not sliding)."""
     joint_sliding: np.ndarray
     """(J,) bool: the joint's faces slide along each other."""
     joint_turn: np.ndarray
@@ -77,10 +83,12 @@ def joint_motion(model: Model, joints: Joints, block_velocity: np.ndarray, tol: 
     length = np.hypot(*(point[last] - point[first]).T)
     face = joints.joint_points >= 2
     turn_rate = np.where(face, np.abs(turn) * length, 0.0)
-    hinged = turn_rate > tol
     j = joints.contact_joint
     slide = np.zeros(joints.joint_count)
     np.maximum.at(slide, j, np.abs(sliding))
+    in_contact = opening <= model.friction * np.abs(sliding) + tol
+    turning = turn_rate > tol
+    hinged = turning & (in_contact[first] | in_contact[last])
     # The hinge is the end that opens least: the closed end of a rotation about a joint end.
     closed = np.where(opening[first] <= opening[last], first, last)
     speed = np.hypot(*block_velocity[:, :2].T) + np.abs(block_velocity[:, 2]) * model.body_radius[:n]
@@ -88,9 +96,33 @@ def joint_motion(model: Model, joints: Joints, block_velocity: np.ndarray, tol: 
         contact_opening=opening,
         contact_sliding=sliding,
         joint_hinged=hinged,
+        joint_opening=turning & ~hinged & ~(slide > tol),
         joint_sliding=slide > tol,
         joint_turn=turn_rate,
         joint_slide=slide,
         hinge_point=point[closed[hinged]].copy(),
         block_moving=speed > tol,
     )
+
+
+def rigid_parts(model: Model, joints: Joints, motion: JointMotion, tol: float = MOTION_TOL) -> list[np.ndarray]:
+    """The moving blocks grouped into the rigid parts of the mechanism, largest first (ties: by first block):
+    blocks joined by a face joint whose faces do not move relative to each other (both its contact points'
+    opening and sliding below ``tol``) move as one body. A corner contact ties nothing: two blocks may turn
+    about it (the bridge on slender piers has v01 touching the pier's top course at its hinge, which put the
+    pier and half the ring in one part). A still block belongs to no part."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    n = model.block_count
+    rel = np.maximum(np.abs(motion.contact_opening), np.abs(motion.contact_sliding))
+    joint_rel = np.zeros(joints.joint_count)
+    np.maximum.at(joint_rel, joints.contact_joint, rel)
+    a, b = joints.joint_body.T
+    tied = (
+        (joint_rel <= tol) & (joints.joint_points >= 2) & (a < n) & (b < n) & motion.block_moving[np.minimum(a, n - 1)]
+    )
+    graph = coo_matrix((np.ones(int(tied.sum())), (a[tied], b[tied])), shape=(n, n))
+    _, label = connected_components(graph, directed=False)
+    parts = [np.flatnonzero((label == k) & motion.block_moving) for k in np.unique(label[motion.block_moving])]
+    return sorted(parts, key=lambda p: (-p.size, p[0]))
