@@ -64,11 +64,15 @@ def test_bad_abutments_are_one_line():
         build_aqueduct(abutments="solid")
 
 
-def test_the_filled_rings_least_thickness_is_the_four_hinge_references():
-    """`--min-thickness` with a fill to a fixed level (2.6 m over the springing line: over the crown of any ring
-    tried) on fixed abutments: the thickness at which the enumeration's least λ under a vanishing horizontal
-    load reaches 0, the fill's weight and inertia on each voussoir from its chord up to the level (shoelace,
-    as in tests/test_limit_fill.py)."""
+@pytest.mark.parametrize("level", [2.6, 1.5])
+def test_the_filled_rings_least_thickness_is_the_four_hinge_references(level):
+    """`--min-thickness` with a fill to a fixed level on fixed abutments: the thickness at which the
+    enumeration's least λ under a vanishing horizontal load reaches 0, the fill's weight and inertia on each
+    voussoir from its chord up to the level (tests/test_limit_fill.py's reference_fill, clipped at the level).
+    2.6 m over the springing line is over the crown of any ring tried (least ring 0.0399 m, 0.0720 bare); 1.5 m
+    fills the haunches only, its level crossing the chords near the crown (0.1236 m: a haunch fill with none
+    over the crown bends the thrust line away from the ring's shape; unchecked before, the reference's
+    quadrilateral of a crossing chord being a bow tie)."""
     import json
     import math
 
@@ -79,7 +83,7 @@ def test_the_filled_rings_least_thickness_is_the_four_hinge_references():
 
     from cli_helpers import invoke
 
-    radius, alpha, level = 5.0, math.asin(0.8), 2.6  # the springing line at y = 0 here
+    radius, alpha = 5.0, math.asin(0.8)  # the springing line at y = 0 here
 
     def lam(t, filled=True):
         i, e = ring(radius, t, alpha, 30, centre_y=-3.0)
@@ -103,7 +107,7 @@ def test_the_filled_rings_least_thickness_is_the_four_hinge_references():
         "--abutments",
         "fixed",
         "--fill-to",
-        "2.6",
+        str(level),
         "--friction",
         "10",
         "--min-thickness",
@@ -111,3 +115,26 @@ def test_the_filled_rings_least_thickness_is_the_four_hinge_references():
     )
     assert result.exit_code == 0, result.output
     assert json.loads(result.stdout)["least_ring_thickness_m"] == pytest.approx(expected, rel=2e-4)
+
+
+def test_the_references_fill_over_a_chord_crossing_the_level_is_shapelys_region_under_it():
+    """reference_fill against shapely: over each extrados chord, the part of its vertical strip above the chord
+    and below the level (the 0.1236 m ring under fill to 1.5 m: chords under, across and over the level)."""
+    import math
+
+    from shapely.geometry import Polygon, box
+    from test_limit_fill import reference_fill
+    from test_limit_ring_mechanisms import ring
+
+    _, e = ring(5.0, 0.1236, math.asin(0.8), 30, centre_y=-3.0)
+    level = 1.5
+    centroid, area = reference_fill(e, level)
+    below, above = e[:, 1] < level, e[:, 1] > level
+    crossing = below[:-1] != below[1:]
+    assert crossing.sum() == 2 and (above[:-1] & above[1:]).any() and (below[:-1] & below[1:]).any()
+    for k in range(len(e) - 1):
+        strip = Polygon([e[k], e[k + 1], (e[k + 1, 0], 10.0), (e[k, 0], 10.0)])
+        region = strip.intersection(box(e[:, 0].min() - 1, -10.0, e[:, 0].max() + 1, level))
+        assert area[k] == pytest.approx(region.area, abs=1e-12)
+        if region.area > 0:
+            np.testing.assert_allclose(centroid[k], region.centroid.coords[0], atol=1e-9)

@@ -61,16 +61,31 @@ def filled_ring_scenario(voussoirs: int) -> Scenario:
 
 
 def reference_fill(extrados: np.ndarray, level: float) -> tuple[np.ndarray, np.ndarray]:
-    """Centroids and areas of the quadrilaterals E_k, E_k+1, (x_k+1, level), (x_k, level) over each chord."""
-    top_left = np.stack([extrados[:-1, 0], np.full(len(extrados) - 1, level)], axis=1)
-    top_right = np.stack([extrados[1:, 0], np.full(len(extrados) - 1, level)], axis=1)
-    # voussoir_loads takes (intrados, extrados) chains and shoelaces I_k, I_k+1, E_k+1, E_k: pass the chord as
-    # the "intrados" and the level as the "extrados" (a chain of two points each quad)
+    """Centroids and areas of the fill over each extrados chord E_k E_k+1 up to ``level``: the quadrilateral
+    E_k, E_k+1, (x_k+1, level), (x_k, level) clipped to y ≤ level (Sutherland–Hodgman on one half-plane), so a
+    chord crossing the level carries the triangle under it and a chord above the level nothing. Unclipped,
+    the quadrilateral of a crossing chord is a bow tie whose shoelace subtracts the part above the level (a
+    haunch fill below the crown)."""
     centroids, areas = [], []
     for k in range(len(extrados) - 1):
-        c, a = voussoir_loads(extrados[k : k + 2], np.stack([top_left[k], top_right[k]]))
-        centroids.append(c[0])
-        areas.append(a[0])
+        quad = [extrados[k], extrados[k + 1], (extrados[k + 1, 0], level), (extrados[k, 0], level)]
+        clipped = []
+        for p, q in zip(quad, quad[1:] + quad[:1]):
+            (px, py), (qx, qy) = p, q
+            if py <= level:
+                clipped.append((px, py))
+            if (py - level) * (qy - level) < 0:  # the edge crosses the level: keep where it does
+                clipped.append((px + (level - py) / (qy - py) * (qx - px), level))
+        x, y = np.array(clipped).T
+        xn, yn = np.roll(x, -1), np.roll(y, -1)
+        cr = x * yn - xn * y
+        area = 0.5 * cr.sum()
+        if abs(area) < 1e-15:  # a chord above the level: no fill
+            centroids.append(extrados[k])
+            areas.append(0.0)
+            continue
+        centroids.append((((x + xn) * cr).sum() / (6 * area), ((y + yn) * cr).sum() / (6 * area)))
+        areas.append(abs(area))
     return np.array(centroids), np.array(areas)
 
 
