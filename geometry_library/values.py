@@ -190,6 +190,7 @@ OPTION_UNITS: dict[str, str] = {
     "settle": "s",  # --settle: seconds of settling under gravity
     "spread": "°",  # limit --spread: a point load's spread through the fill, from the vertical
     "pga": "g",  # --pga: the peak ground acceleration a record is scaled to (a unit may be written: 2.45m/s2)
+    "pga_g": "g",  # sweep --param pga_g=…: the same, an axis
 }
 """The unit of each numeric option with no scenario setting (their help: --rtol a relative width,
 --workers a count, --magnify a factor): the one place they are added. (limit's --block is a block's

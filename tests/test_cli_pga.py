@@ -7,6 +7,7 @@ import pytest
 
 from masonrycli import api
 from masonrycli.records.read import G_STANDARD, record_motion
+from masonrycli.study.store import read_rows
 
 from cli_helpers import assert_one_line_error, invoke
 from synthetic_records import band_limited, write_at2
@@ -75,3 +76,47 @@ def test_a_pga_without_a_record_says_it_scales_one():
     said = "--pga: scales a ground-motion record, and its sine motion is not a record (give --record FILE)"
     assert_one_line_error(invoke("simulate", "wall", "--pga", "0.25", "--no-recording"), said)
     assert_one_line_error(invoke("check", "arch", "--pga", "0.25"), "nothing shakes it")
+
+
+def test_a_study_scales_each_record_to_its_points_pga(at2, tmp_path):
+    # a study over PGA was --scale values worked out by hand per record; the rows' pga (as applied) then missed
+    # the values meant by the baseline correction's change of the peak
+    other = tmp_path / "other.AT2"
+    t, u, v, a = band_limited(0.6, 0.005, [3.0], [0.002], seed=9)
+    write_at2(other, a / G_STANDARD, 0.005)
+    out, histories = tmp_path / "s.csv", tmp_path / "h"
+    result = invoke(
+        "sweep", "wall", "--param", "blocks=12", "--records", at2, "--records", other, "--param", "pga_g=0.1,0.3",
+        "--duration", 0.4, "--workers", 0, "--no-recording", "--out", out, "--histories", histories,
+    )  # fmt: skip
+    assert result.exit_code == 0, result.output
+    rows = read_rows(out)
+    pairs = [("other.AT2", 0.1), ("other.AT2", 0.3), ("quake.AT2", 0.1), ("quake.AT2", 0.3)]
+    assert sorted((r["record"], r["pga_g"]) for r in rows) == pairs
+    for row in rows:
+        assert row["pga"] == pytest.approx(row["pga_g"] * G_STANDARD, rel=1e-12)
+        record = record_motion(tmp_path / row["record"])
+        scale = row["pga_g"] * G_STANDARD / applied_peak(record, 400, 1e-3)
+        h = np.load(next(histories.glob(f"*{row['record']}*pga_g={row['pga_g']:g}*.npz")))
+        np.testing.assert_allclose(
+            h["support_v"][:, 0, :], record_motion(tmp_path / row["record"], scale=scale).velocity_at(h["time"]),
+            rtol=1e-12, atol=1e-15,
+        )  # fmt: skip
+
+
+@pytest.mark.parametrize(
+    "args, said",
+    [
+        (("--param", "pga_g=0.25", "--scale", "1"), "--param pga_g: sets each record's scale, which --scale sets too"),
+        (("--param", "pga_g=0,0.25"), "--param pga_g=0.0: a peak ground acceleration in g, above 0 and at most 10"),
+        (("--param", "pga=0.25"), '--param pga: unknown parameter (records are scaled to a PGA in g by "pga_g"'),
+        (("--pga", "0.25"), "--pga: a study takes it as an axis: --param pga_g=VALUE"),
+    ],
+)
+def test_a_bad_pga_axis_is_one_line(at2, args, said):
+    assert_one_line_error(invoke("sweep", "wall", "--records", at2, *args), said)
+
+
+def test_a_pga_axis_on_a_sine_says_it_scales_records():
+    said = "--param pga_g=0.25: scales a ground-motion record, and its sine motion is not a record (give --records"
+    assert_one_line_error(invoke("sweep", "wall", "--param", "pga_g=0.25", "--workers", 0), said)

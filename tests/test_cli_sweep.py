@@ -29,7 +29,10 @@ def block(tmp_path) -> Path:
         # an engineer's names for them: "mu" said "unknown parameter" and no more
         (["-p", "mu=0.5,0.7"], '--param mu: unknown parameter (did you mean "friction"?)'),
         (["-p", "amplitude=1"], '--param amplitude: unknown parameter (did you mean "amp"?)'),
-        (["-p", "pga=1"], '--param pga: unknown parameter (records are scaled by "scale": --scale LO:HI:N'),
+        (
+            ["-p", "pga=1"],
+            '--param pga: unknown parameter (records are scaled to a PGA in g by "pga_g": --param pga_g=',
+        ),
         (["-p", "amp=1:2"], "--param amp=1:2: a range is LO:HI:N"),
         # a repeated value ran twice, into two rows of one key
         (["-p", "amp=0.1,0.2,0.1"], "--param amp: the value 0.1 is given twice (each point runs once)"),

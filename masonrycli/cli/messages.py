@@ -221,10 +221,10 @@ def _sweep_axis(exc, command: str) -> str | None:
     if not (command.split()[-1:] == ["sweep"] and name.startswith("--")):
         return None
     from geometry_library.builders import BUILDERS
-    from masonrycli.study.axes import MOTION_PARAMS, RUN_PARAMS
+    from masonrycli.study.axes import MOTION_PARAMS, PGA_PARAM, RUN_PARAMS
 
-    key = name[2:].replace("-", "_")
-    axes = {*MOTION_PARAMS, *RUN_PARAMS, "friction"} | {f.name for b in BUILDERS.values() for f in fields(b)}
+    key = {"pga": PGA_PARAM}.get(name[2:].replace("-", "_"), name[2:].replace("-", "_"))  # simulate --pga: in g
+    axes = {*MOTION_PARAMS, *RUN_PARAMS, "friction", PGA_PARAM} | {f.name for b in BUILDERS.values() for f in fields(b)}
     if key not in axes:
         return None
     return (

@@ -303,13 +303,15 @@ def _no_fit(rows: list[dict], axes) -> str:
     """Why a record study has no fragility curve, and what gives one: 'no fit (every run collapsed, or none
     did)' left the user to count which, and which way to move the scales."""
     fell = sum(r.get("state") == "collapsed" for r in rows)
-    scaled = "scale" in [a.name for a in axes]
+    names = [a.name for a in axes]
+    by = "--param pga_g" if "pga_g" in names else "--scale"  # the axis that scales the records
+    scaled = by != "--scale" or "scale" in names
     if len(rows) < 2:
         return f"fragility: no fit ({_n(len(rows), 'run')}; a fit needs at least 2)"
     if fell == 0:
-        more = "larger --scale values reach it" if scaled else "a --scale range reaches it"
+        more = f"larger {by} values reach it" if scaled else "a --scale range reaches it"
         return f"fragility: no fit — none of the {len(rows)} runs collapsed ({more})"
-    less = "smaller --scale values find where it stands" if scaled else "a --scale range finds where it stands"
+    less = f"smaller {by} values find where it stands" if scaled else "a --scale range finds where it stands"
     return f"fragility: no fit — all {len(rows)} runs collapsed ({less})"
 
 
@@ -366,7 +368,7 @@ def _report(console, result, plan: StudyPlan, im: str, written: list, signals: F
         elif "record" in [a.name for a in axes]:
             good = [r for r in rows if r.get("status") != "error"]
             # one curve per value of the other swept parameters: pooled, two frictions made one curve of neither
-            groups = fit_by(good, im, [n for n in names if n not in ("record", "scale")])
+            groups = fit_by(good, im, [n for n in names if n not in ("record", "scale", "pga_g")])
             fit = groups[0].fit if len(groups) == 1 else None
             title = f"{name}: fragility ({len(good)} runs{f', {len(groups)} curves' if len(groups) > 1 else ''})"
             fragility_curve(good, im, fit, part, title, UNITS[im], groups)

@@ -59,16 +59,17 @@ def with_pga(scenario, pga: float | None, scale: float | None = None):
     return scaled_to_pga(scenario, pga)
 
 
-def scaled_to_pga(scenario, pga: float, option: str = "--pga"):
+def scaled_to_pga(scenario, pga: float, option: str = "--pga", give: str = "--record FILE"):
     """``scenario`` with every record motion's scale multiplied so that its ground motion as applied (the
-    shaking support's, over the run's steps) peaks at ``pga`` g; ``option`` names the setting in errors.
-    Raises :class:`InputError` when no record shakes the structure, or when it never accelerates."""
+    shaking support's, over the run's steps) peaks at ``pga`` g; ``option`` names the setting in errors,
+    ``give`` how a record is given where it is. Raises :class:`InputError` when no record shakes the
+    structure, or when it never accelerates."""
     from masonrycli.records.intensity import shaking_support
 
     j = shaking_support(scenario.motions)
     if j is None or scenario.motions[j].kind != "record":
         what = "nothing shakes it" if j is None else f"its {scenario.motions[j].kind} motion is not a record"
-        raise InputError(f"{option}: scales a ground-motion record, and {what} (give --record FILE)")
+        raise InputError(f"{option}: scales a ground-motion record, and {what} (give {give})")
     run = scenario.run
     velocity = scenario.motions[j].velocity_at(np.arange(run.n_steps + 1, dtype=np.float64) * run.dt)[:, 0]
     peak = float(np.abs(np.diff(velocity)).max()) / run.dt if velocity.size > 1 else 0.0

@@ -9,6 +9,8 @@ An axis is written ``name=LO:HI:N`` (N values evenly spaced from LO to HI), ``na
 ``scale``                           the scale of every record motion (``ground.scale`` for one)
 ``record``                          the record file (``--records DIR`` makes this axis): every
                                     shaking support (sine or record) is driven by it
+``pga_g``                           every record scaled so the ground motion as applied peaks at this
+                                    PGA, in g (:mod:`masonrycli.records.pga`; instead of ``scale``)
 ``friction``                        the Coulomb coefficient of every contact
 ``duration``, ``dt``, ``theta``,    the run settings of :class:`~masonrycli.scenario.scenario.RunConfig`
 ``tolerance``, ``max_iterations``
@@ -33,6 +35,8 @@ MOTION_PARAMS = {"amp": ("sine", "amplitude"), "freq": ("sine", "frequency"), "p
 MOTION_PARAMS["scale"] = ("record", "scale")
 RUN_PARAMS = ("duration", "dt", "theta", "tolerance", "max_iterations")
 INT_PARAMS = ("max_iterations",)
+PGA_PARAM = "pga_g"
+"""The PGA a point's records are scaled to, in g: its own name, as the rows hold ``pga``, the PGA as applied (m/s²)."""
 MAX_RUNS = 10**6
 """Most values on an axis, and most runs in a grid: more is a likely typo (``amp=0:1:1000000000``
 used to allocate the values for minutes before anything was said)."""
@@ -132,6 +136,17 @@ def check_axes(axes: list[Axis]) -> None:
     dup = {n for n in names if names.count(n) > 1}
     if dup:
         raise InputError(f"--param {sorted(dup)[0]}: given twice")
+    if PGA_PARAM in names:
+        from masonrycli.records.pga import MAX_PGA_G
+
+        if any(n.rpartition(".")[2] == "scale" for n in names):
+            raise InputError(f"--param {PGA_PARAM}: sets each record's scale, which --scale sets too (give one)")
+        values = axes[names.index(PGA_PARAM)].values
+        bad = [v for v in values if isinstance(v, str) or not 0.0 < v <= MAX_PGA_G]
+        if bad:
+            raise InputError(
+                f"--param {PGA_PARAM}={bad[0]}: a peak ground acceleration in g, above 0 and at most {MAX_PGA_G:g}"
+            )
     for axis in axes:  # each point runs once: a repeated value ran twice into two rows of one key
         seen = set()
         for v in axis.values:  # a set: an axis may hold a million values
@@ -151,7 +166,7 @@ _OTHER_NAMES = {
     "friction_coefficient": "friction",
     "amplitude": "amp",
     "velocity": "amp",
-    "pga": "scale",
+    "pga": PGA_PARAM,
     "pgv": "scale",
     "intensity": "scale",
     "factor": "scale",
@@ -167,6 +182,8 @@ def _also_called(key: str) -> str:
         return ""
     if name == "scale":
         return ' (records are scaled by "scale": --scale LO:HI:N; pga and pgv are in every row, as applied)'
+    if name == PGA_PARAM:  # the row's "pga" is the PGA as applied, m/s²: the axis has its own name
+        return f' (records are scaled to a PGA in g by "{PGA_PARAM}": --param {PGA_PARAM}=0.1:0.4:7)'
     return f' (did you mean "{name}"?)'
 
 
@@ -216,8 +233,8 @@ def apply_point(base, params: dict):
     for key, value in params.items():
         support, _, short = key.rpartition(".")
         if short not in MOTION_PARAMS:
-            if key not in RUN_PARAMS and key not in ("friction", "record") and key not in options:
-                known = [*MOTION_PARAMS, *RUN_PARAMS, "friction", "record", *_builder_options(builder)]
+            if key not in RUN_PARAMS and key not in ("friction", "record", PGA_PARAM) and key not in options:
+                known = [*MOTION_PARAMS, *RUN_PARAMS, "friction", "record", PGA_PARAM, *_builder_options(builder)]
                 hint = _also_called(key) or did_you_mean(key, known) or _not_built(builder, key)
                 raise InputError(f"--param {key}: unknown parameter{hint} (see masonry sweep --help)")
             continue
@@ -249,6 +266,15 @@ def apply_point(base, params: dict):
                 "nothing moves (amp=0 is the point without shaking)"
             )
     scenario = dataclasses.replace(scenario, motions=tuple(motions))
+    if PGA_PARAM in params:  # once the point's record, dt and duration are set: the PGA as its run applies it
+        from masonrycli.records.pga import scaled_to_pga
+
+        scenario = scaled_to_pga(
+            scenario,
+            params[PGA_PARAM],
+            option=f"--param {_point({PGA_PARAM: params[PGA_PARAM]})}",
+            give="--records FILE",
+        )
     try:
         check_sampling(scenario)
     except InputError as exc:  # the point, not only the support: "--param amp=1e+30: support ..."

@@ -146,13 +146,15 @@ def fragility_series(rows: list[dict], im: str, fit, unit: str, groups=None) -> 
 
 
 def _fraction(rows: list[dict], im: str, key: str, label: str, colour: str) -> list[Series]:
-    """The fraction of ``rows`` collapsed at each scale, at the scale's mean IM (none without a scale)."""
-    if not rows or "scale" not in rows[0]:
+    """The fraction of ``rows`` collapsed at each scale (or PGA the records were scaled to, ``pga_g``), at its
+    mean IM (none without either)."""
+    by = next((k for k in ("scale", "pga_g") if rows and k in rows[0]), None)
+    if by is None:
         return []
     x = np.array([_number(r.get(im)) for r in rows], dtype=np.float64)
     collapsed = np.array([r.get("state") == "collapsed" for r in rows], dtype=bool)
-    scales = sorted({r["scale"] for r in rows})
-    pick = [np.array([r["scale"] == s for r in rows]) for s in scales]
+    scales = sorted({r[by] for r in rows})
+    pick = [np.array([r[by] == s for r in rows]) for s in scales]
     mean_x = np.array([np.nanmean(x[p]) if np.isfinite(x[p]).any() else np.nan for p in pick])
     fraction = np.array([collapsed[p].mean() for p in pick])
     ok = np.isfinite(mean_x)
