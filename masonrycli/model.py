@@ -7,7 +7,7 @@ then only touches arrays. Bodies are the blocks (0..N-1, scenario order) followe
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -80,6 +80,10 @@ class Model:
     """(N, 2) m: each block's own (polygon's) centroid relative to its body's centre at θ = 0: exactly 0 but for
     a block that carries a mass, whose body's centre of mass it pulls away (the cells' points,
     ``masonrycli.analysis.tensors``)."""
+    block_applied: np.ndarray = field(default_factory=lambda: np.zeros((0, 6)))
+    """(N, 6) or no rows: a force applied at a point of each block, as the engine's free velocity reads it —
+    Fx/m, Fy/m (m/s²), the point relative to the body's centre at θ = 0 (m), Fx/I, Fy/I (1/(m·s²)). Only
+    ``masonry limit --verify`` gives one (a point load along ±x or up, :func:`applied_forces`)."""
 
     @property
     def body_count(self) -> int:
@@ -237,3 +241,28 @@ def _radii(start: np.ndarray, local: np.ndarray) -> np.ndarray:
 
 def initial_state(model: Model) -> State:
     return State(model.body_q0.copy(), model.body_v0.copy(), 0, 0.0)
+
+
+def applied_forces(model: Model, forces) -> Model:
+    """``model`` with forces applied at points of its blocks: ``forces`` is [(block index, (Fx, Fy) N, (x, y) m
+    the point at θ = 0)]; several on one block (a spread load's parts) must be parallel: their resultant acts
+    at their force-weighted mean point."""
+    import dataclasses
+
+    n = model.block_count
+    applied = np.zeros((n, 6))
+    total = np.zeros((n, 2))
+    point = np.zeros((n, 2))
+    weight = np.zeros(n)
+    for b, force, at in forces:
+        f, p = np.asarray(force, dtype=np.float64), np.asarray(at, dtype=np.float64)
+        size = float(np.hypot(*f))
+        total[b] += f
+        point[b] += size * (p - model.body_q0[b, :2])
+        weight[b] += size
+    loaded = weight > 0
+    point[loaded] /= weight[loaded, None]
+    applied[:, 0:2] = total / model.body_mass[:n, None]
+    applied[:, 2:4] = point
+    applied[:, 4:6] = total / model.body_inertia[:n, None]
+    return dataclasses.replace(model, block_applied=applied)

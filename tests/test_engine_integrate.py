@@ -102,3 +102,28 @@ def test_tangential_velocity_is_the_relative_velocity_of_the_material_points_on_
     du = material_velocity(body[:, 1]) - material_velocity(body[:, 0])
     tangent = np.column_stack([normal[:, 1], -normal[:, 0]])  # contact.py: t = (n_y, −n_x)
     _close(power.tangential_velocity(body, pack, count, v), np.sum(du * tangent, axis=1))
+
+
+def test_an_applied_force_adds_its_impulse_and_its_moment_about_the_turned_point():
+    """v_free = v_n + dt (g + F/m), ω_free = ω_n + dt (R(θ) r0 × F) / I, on blocks with a force (limit
+    --verify's point load along ±x or up); the others as before, bit for bit."""
+    rng = np.random.default_rng(7)
+    m = _model(rng, 0.5)
+    force = np.zeros((BLOCKS, 2))
+    force[2] = (40.0, -15.0)
+    r0 = rng.normal(size=(BLOCKS, 2))
+    applied = np.zeros((BLOCKS, 6))
+    applied[:, 0:2] = force / m.body_mass[:BLOCKS, None]
+    applied[:, 2:4] = r0
+    applied[:, 4:6] = force / m.body_inertia[:BLOCKS, None]
+    q, v = rng.normal(size=(BODIES, 3)), rng.normal(size=(BODIES, 3))
+    support_v = rng.normal(size=(SUPPORTS, 2))
+    plain, pushed = np.full((BODIES, 3), np.nan), np.full((BODIES, 3), np.nan)
+    integrate.free_velocity(m, v, support_v, plain, q)
+    integrate.free_velocity(SimpleNamespace(**vars(m), block_applied=applied), v, support_v, pushed, q)
+    c, s = np.cos(q[2, 2]), np.sin(q[2, 2])
+    r = (c * r0[2, 0] - s * r0[2, 1], s * r0[2, 0] + c * r0[2, 1])
+    _close(pushed[2, :2], v[2, :2] + m.dt * (m.gravity + force[2] / m.body_mass[2]))
+    _close(pushed[2, 2], v[2, 2] + m.dt * (r[0] * force[2, 1] - r[1] * force[2, 0]) / m.body_inertia[2])
+    others = np.arange(BODIES) != 2
+    assert np.array_equal(pushed[others], plain[others])

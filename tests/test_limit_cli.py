@@ -106,7 +106,6 @@ def test_built_in_arch_by_name():
         # the LP called the wall unable to carry its own weight at μ = 1e8 ("no equilibrium ..."): refused
         (["wall", "--friction", "1e8"], ["--friction: friction = 1e8: must be <= 1000"]),
         (["arch", "--out", "x.png"], ["--out x.png", ".rrd"]),
-        (["arch", "--load", "point", "--block", "v01", "--direction", "+x", "--verify"], ["--verify", "down only"]),
     ],
 )
 def test_bad_input_is_one_line(args, fragments):

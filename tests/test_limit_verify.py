@@ -76,3 +76,50 @@ def test_a_point_load_is_verified_as_a_weight_where_it_acts():
     low, high = verify(sc, result)
     assert not low.collapsed and high.collapsed
     assert low.tilt_deg is None and set(high.hinges) <= set(result.hinges) and len(high.shared_hinges) >= 3
+
+
+G = 9.81
+
+
+def _threshold(sc, high):
+    """m: the collapse threshold d, 0.1 × the block's radius; it is crossed at d = ½ a t² under a net
+    acceleration a (a rigid block lifting or sliding from rest)."""
+    from masonrycli.model import build_model
+
+    m = build_model(sc)
+    threshold = 0.1 * float(np.median(m.body_radius[: m.block_count]))
+    assert high.threshold == pytest.approx(threshold, rel=1e-12)
+    return threshold
+
+
+def test_a_point_load_up_is_an_applied_force_the_block_rises_under_past_its_weight():
+    """A 0.4 × 0.8 m block pulled up at its centroid: the LP lifts it at λ = 1 (× its weight); the engine, given
+    the load as a force (no weight can pull up; it was refused, exit 2), holds it at 0.95 and lifts it at 1.05
+    with a net 0.05 g: the threshold d reached at t = √(2 d / 0.05 g)."""
+    sc = column(1, 0.4, 0.8, 0.6)
+    result = analyse(sc, LiveLoad("point", "+y", block="b0"))
+    assert result.load_factor == pytest.approx(1.0, rel=1e-9)
+    low, high = verify(sc, result, duration=1.5)
+    assert not low.collapsed and low.max_displacement < 1e-6
+    assert high.collapsed and high.applied == "force" and high.tilt_deg is None
+    d = _threshold(sc, high)
+    assert high.time == pytest.approx(math.sqrt(2 * d / (0.05 * G)), rel=0.02)
+    # (no similarity: at λ = 1 the load cancels the weight, so every lifting motion is a mechanism of the LP's,
+    # a toe's rotation as well as a straight lift)
+
+
+@pytest.mark.parametrize(("mu", "mode"), [(0.9, "overturns"), (0.3, "slides")])
+def test_a_point_load_along_x_is_an_applied_force_at_its_point(mu, mode):
+    """The same block pushed along +x at its centroid: the LP's λ = min(μ, B / H = 0.5); the engine stands at
+    0.95 λ and overturns about its toe, or slides with a net (1.05 − 1) μ g: t = √(2 d / (0.05 μ g))."""
+    sc = column(1, 0.4, 0.8, mu)
+    result = analyse(sc, LiveLoad("point", "+x", block="b0"))
+    assert result.load_factor == pytest.approx(min(mu, 0.5), rel=1e-9)
+    low, high = verify(sc, result, duration=2.0)
+    assert not low.collapsed and low.max_displacement < 1e-3 and low.max_speed < 1e-3
+    assert high.collapsed and high.applied == "force"
+    if mode == "overturns":
+        assert high.similarity > 0.99 and high.hinges == ("b0|ground",) == high.shared_hinges
+    else:
+        d = _threshold(sc, high)
+        assert high.time == pytest.approx(math.sqrt(2 * d / (0.05 * mu * G)), rel=0.02)

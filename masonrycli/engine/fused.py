@@ -20,7 +20,7 @@ from masonrycli.engine.warmstart import _remember, _warm_start
 @njit
 def _before_solve(
     body_q, body_v, body_radius, dt, theta, gravity, alert, body_vert_start, vert_local, body_dynamic,
-    support_v_next, block_count, q_m, v_old,
+    support_v_next, block_count, q_m, v_old, applied,
     vert_world, body_aabb, axis, body_order, pair_body, pair_scratch, counter, edge_normal, body_size,
     contact_body, contact_point, contact_normal, contact_gap, contact_key,
     prev_key, prev_r, r,
@@ -42,7 +42,7 @@ def _before_solve(
     if count < 0 or count > r.shape[0]:
         return pairs, -1, 0, distance
     hits = _warm_start(contact_key, count, prev_key, prev_r, r)
-    _free_velocity(v_old, body_dynamic, gravity, dt, support_v_next, block_count, body_v)
+    _free_velocity(v_old, body_dynamic, gravity, dt, support_v_next, block_count, body_v, body_q, applied)
     return pairs, count, hits, distance
 
 
@@ -82,7 +82,7 @@ def before_solve(m, bf, warm, state, support_v_next, q_m, v_old, r) -> tuple[int
     pair_count, count, hits, distance = _before_solve(
         state.body_q, state.body_v, m.body_radius, m.dt, m.theta, m.gravity, m.alert_distance,
         m.body_vert_start, m.vert_local, m.body_dynamic, support_v_next, m.block_count,
-        q_m, v_old,
+        q_m, v_old, m.block_applied,
         bf.vert_world, bf.body_aabb, pairs.axis, pairs.body_order, pairs.pair_body, pairs.pair_scratch,
         pairs.body_counter, bf.edge_normal, bf.body_size,
         bf.contact_body, bf.contact_point, bf.contact_normal, bf.contact_gap, bf.contact_key,

@@ -1,6 +1,7 @@
 """Moreau–Jean θ-method: free velocity, intermediate configuration, position update, energies.
 
-    v_free = v_n + dt · g                     (blocks; gravity is the only external force)
+    v_free = v_n + dt · (g + F_b / m_b)       (blocks; F_b: a force applied at a point of block b, which
+                                               only limit --verify gives, a point load along ±x or up)
     q_m    = q_n + (1 − θ) · dt · v_n         (contacts are detected here)
     q_n+1  = q_n + dt · (θ · v_n+1 + (1 − θ) · v_n)
 
@@ -32,13 +33,23 @@ def _begin_step(body_q, body_v, body_radius, dt, theta, out_q, out_v_old):
 
 
 @njit(inline="always")
-def _free_velocity(body_v, body_dynamic, gravity, dt, support_v_next, block_count, out_v):
+def _free_velocity(body_v, body_dynamic, gravity, dt, support_v_next, block_count, out_v, body_q, applied):
     # Blocks: v_free = v_n + dt·g. Supports: their imposed velocity at t_n+1 (no rotation).
+    # Applied forces (rows of ``applied``, block b: Fx/m, Fy/m, r0x, r0y, Fx/I, Fy/I; none when it has no
+    # rows): v_free += dt·F/m, ω_free += dt·(r × F)/I with r = R(θ_n)·r0 the point of application as the
+    # block has turned (a fixed direction, as a weight's).
     for b in range(body_v.shape[0]):
         if body_dynamic[b]:
             out_v[b, 0] = body_v[b, 0] + dt * gravity[0]
             out_v[b, 1] = body_v[b, 1] + dt * gravity[1]
             out_v[b, 2] = body_v[b, 2]
+            if b < applied.shape[0]:
+                cos, sin = np.cos(body_q[b, 2]), np.sin(body_q[b, 2])
+                rx = cos * applied[b, 2] - sin * applied[b, 3]
+                ry = sin * applied[b, 2] + cos * applied[b, 3]
+                out_v[b, 0] += dt * applied[b, 0]
+                out_v[b, 1] += dt * applied[b, 1]
+                out_v[b, 2] += dt * (rx * applied[b, 5] - ry * applied[b, 4])
         else:
             s = b - block_count
             out_v[b, 0] = support_v_next[s, 0]
@@ -83,9 +94,18 @@ def begin_step(model, body_q: np.ndarray, body_v: np.ndarray, out_q: np.ndarray,
     return _begin_step(body_q, body_v, model.body_radius, model.dt, model.theta, out_q, out_v_old)
 
 
-def free_velocity(model, body_v: np.ndarray, support_v_next: np.ndarray, out: np.ndarray) -> None:
-    """Write v_free (B, 3): blocks get gravity over dt, supports their imposed velocity at t_n+1."""
-    _free_velocity(body_v, model.body_dynamic, model.gravity, model.dt, support_v_next, model.block_count, out)
+NO_FORCE = np.zeros((0, 6))
+"""No block has an applied force (a model without ``block_applied``)."""
+
+
+def free_velocity(model, body_v: np.ndarray, support_v_next: np.ndarray, out: np.ndarray, body_q=None) -> None:
+    """Write v_free (B, 3): blocks get gravity (and their applied force, ``model.block_applied``, its point
+    turned by ``body_q``'s θ) over dt, supports their imposed velocity at t_n+1."""
+    applied = getattr(model, "block_applied", NO_FORCE)
+    q = np.zeros_like(body_v) if body_q is None else body_q
+    _free_velocity(
+        body_v, model.body_dynamic, model.gravity, model.dt, support_v_next, model.block_count, out, q, applied
+    )
 
 
 def update_q(model, body_q: np.ndarray, v_old: np.ndarray, v_new: np.ndarray) -> float:

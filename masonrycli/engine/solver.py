@@ -198,7 +198,7 @@ class Solver:
             top_speed = integrate.begin_step(m, state.body_q, state.body_v, self.body_q_m, self.body_v_n)
             count = self.detect(self.body_q_m, self.detection_distance(top_speed))
             warm = self._warm.start(bf.contact_key, count, self._r)
-            integrate.free_velocity(m, self.body_v_n, support_v_next, state.body_v)
+            integrate.free_velocity(m, self.body_v_n, support_v_next, state.body_v, state.body_q)
         else:
             count, warm, _ = begun
             self._count = count

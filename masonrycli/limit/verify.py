@@ -25,7 +25,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from masonrycli.errors import InputError
 from masonrycli.limit.analysis import LimitResult
 from masonrycli.run import Simulation
 from masonrycli.scenario.motion import Fixed
@@ -49,7 +48,7 @@ class DynamicCheck:
 
     factor: float
     tilt_deg: float | None
-    """Gravity's tilt, or None for a point load (a weight: gravity as it is)."""
+    """Gravity's tilt, or None for a point load (gravity as it is)."""
     collapsed: bool
     time: float
     """s: when the collapse threshold was crossed, or the end of the run."""
@@ -66,6 +65,9 @@ class DynamicCheck:
     shared_hinges: tuple[str, ...]
     """Of those, the ones the LP's mechanism hinges too."""
     wall_time: float
+    applied: str = "tilt"
+    """How the engine was given the live load: "tilt" (gravity tilted), "weight" (a point load down, a mass its
+    block carries) or "force" (a point load along ±x or up, applied at its point)."""
 
     @property
     def as_predicted(self) -> bool:
@@ -75,25 +77,44 @@ class DynamicCheck:
         return dataclasses.asdict(self) | {"as_predicted": self.as_predicted}
 
 
-def check_verifiable(load) -> None:
-    """InputError for a live load the engine cannot be given: a point load other than down."""
-    if load.kind == "point" and load.direction != "-y":
-        raise InputError(
-            f"--verify: a point load is verified as a weight on its block, so down only (--direction -y), not "
-            f"{load.direction}; the engine's only force is gravity"
-        )
+def load_point(scenario, load) -> tuple[float, float]:
+    """m: where a point load acts: ``--at``'s place on the block's top, or the loaded block's own centroid."""
+    if load.at is not None:
+        return (load.at, load.top)
+    block = next(b for b in scenario.assembly.blocks if b.name == load.block)
+    return tuple(block.polygon.centroid.coords[0])
+
+
+def applied_model(scenario, result: LimitResult, factor: float):
+    """The model of ``scenario`` with the point load at ``factor`` × its collapse value as a force applied where
+    it acts (each part of a spread load where it bears), along its direction: a point load along ±x or up,
+    which no weight can be. No mass: a braking force or an uplift has no vehicle's inertia."""
+    from masonrycli.limit.problem import DIRECTIONS
+    from masonrycli.model import applied_forces, build_model
+
+    load = result.load
+    model = build_model(scenario)
+    names = list(model.block_name)
+    size = factor * result.load_factor * result.reference_force
+    unit = np.asarray(DIRECTIONS[load.direction], dtype=np.float64)
+    parts = load.patches or ((load.block, *load_point(scenario, load), 1.0),)
+    return applied_forces(model, [(names.index(name), share * size * unit, (x, y)) for name, x, y, share in parts])
+
+
+def as_weight(load) -> bool:
+    """A point load down is verified as a weight its block carries (a vehicle's mass, inertia too); along
+    ±x or up, as a force applied at its point (:func:`applied_model`)."""
+    return load.kind == "point" and load.direction == "-y"
 
 
 def weighted_scenario(scenario, result: LimitResult, factor: float):
     """``scenario`` with the point load at ``factor`` × its collapse value as a mass the loaded block carries
     where the load acts (``Block.carried_mass``): a weight of f·λ·F, moving with the block."""
     load = result.load
-    check_verifiable(load)
     g = float(np.hypot(*scenario.run.gravity))
     blocks = list(scenario.assembly.blocks)
     names = [b.name for b in blocks]
-    block = blocks[names.index(load.block)]
-    at = (load.at, load.top) if load.at is not None else tuple(block.polygon.centroid.coords[0])
+    at = load_point(scenario, load)
     mass = factor * result.load_factor * result.reference_force / g
     for name, x, y, share in load.patches or ((load.block, *at, 1.0),):  # a spread load: each part where it bears
         i = names.index(name)
@@ -106,10 +127,12 @@ def weighted_scenario(scenario, result: LimitResult, factor: float):
 
 
 def tilted_scenario(scenario, result: LimitResult, factor: float, duration: float):
-    """``scenario`` with gravity tilted to atan(factor·λ) towards the live load (a point load: as a weight,
-    :func:`weighted_scenario`, gravity as it is), fixed supports, ``duration``."""
+    """``scenario`` with gravity tilted to atan(factor·λ) towards the live load (a point load down: as a
+    weight, :func:`weighted_scenario`; along ±x or up: gravity as it is, the force applied by
+    :func:`applied_model`), fixed supports, ``duration``."""
     if result.load.kind == "point":
-        scenario = weighted_scenario(scenario, result, factor)
+        if as_weight(result.load):
+            scenario = weighted_scenario(scenario, result, factor)
         gravity = tuple(scenario.run.gravity)
     else:
         g = float(np.hypot(*scenario.run.gravity))
@@ -137,7 +160,9 @@ def _similarity(displacement: np.ndarray, velocity: np.ndarray, radius: np.ndarr
 def run_check(scenario, result: LimitResult, factor: float, duration: float = DURATION) -> DynamicCheck:
     """Run the engine at ``factor`` × λ until it collapses or ``duration`` ends."""
     t0 = time.perf_counter()
-    sim = Simulation(tilted_scenario(scenario, result, factor, duration))
+    run = tilted_scenario(scenario, result, factor, duration)
+    pushed = result.load.kind == "point" and not as_weight(result.load)
+    sim = Simulation(run, model=applied_model(run, result, factor) if pushed else None)
     m = sim.model
     n = m.block_count
     threshold = COLLAPSE_SHARE * float(np.median(m.body_radius[:n]))
@@ -176,6 +201,7 @@ def run_check(scenario, result: LimitResult, factor: float, duration: float = DU
         hinges=hinges,
         shared_hinges=tuple(h for h in hinges if h in lp_hinges),
         wall_time=time.perf_counter() - t0,
+        applied="force" if pushed else "weight" if result.load.kind == "point" else "tilt",
     )
 
 
