@@ -9,7 +9,7 @@ from masonrycli import api
 from masonrycli.records.read import G_STANDARD, record_motion
 from masonrycli.study.store import read_rows
 
-from cli_helpers import assert_one_line_error, invoke
+from cli_helpers import assert_one_line_error, invoke, words
 from synthetic_records import band_limited, write_at2
 
 
@@ -120,3 +120,25 @@ def test_a_bad_pga_axis_is_one_line(at2, args, said):
 def test_a_pga_axis_on_a_sine_says_it_scales_records():
     said = "--param pga_g=0.25: scales a ground-motion record, and its sine motion is not a record (give --records"
     assert_one_line_error(invoke("sweep", "wall", "--param", "pga_g=0.25", "--workers", 0), said)
+
+
+def test_check_gives_the_ground_motion_the_run_will_apply(at2, tmp_path):
+    # check showed "× 0.25" and no PGA: a --scale 0.25 read as "PGA 0.25 g" (0.0775 g applied on the 20 s record
+    # it was found with) was seen only after the run
+    result = invoke("check", "wall", "--blocks", 12, "--record", at2, "--scale", 0.25, "--duration", 0.5)
+    assert result.exit_code == 0, result.output
+    npz = tmp_path / "h.npz"
+    args = ("--blocks", 12, "--record", at2, "--scale", 0.25, "--duration", 0.5, "--no-recording", "--history", npz)
+    assert invoke("simulate", "wall", *args).exit_code == 0
+    h = np.load(npz)
+    pga = 0.25 * applied_peak(record_motion(at2), 500, 1e-3)
+    assert float(h["intensity_pga"]) == pytest.approx(pga, rel=1e-12)
+    said = words(result.output.replace("│", " "))
+    assert (
+        f"intensity ground: PGA {pga:.3g} m/s² ({pga / G_STANDARD:.3g} g), PGV {float(h['intensity_pgv']):.3g} m/s, "
+        f"Arias {float(h['intensity_arias']):.3g} m/s, D5–95 {float(h['intensity_d5_95']):.3g} s, "
+        f"Sa(0.5 s) {float(h['intensity_sa']):.3g} m/s²"
+    ) in said
+    # the default wall's sine, 1 m/s at 2 Hz: 2π·2·1 = 12.6 m/s², 1.28 g
+    assert "PGA 12.6 m/s² (1.28 g), PGV 1 m/s" in words(invoke("check", "wall").output.replace("│", " "))
+    assert "intensity" not in invoke("check", "arch").output  # a settling foundation shakes nothing

@@ -88,11 +88,15 @@ def check_command(
     arguments, and print a summary (blocks, supports, mass, bounding box, steps, the loading, outputs); nothing
     is computed or written."""
     from masonrycli.outputs.report import check_table
+    from masonrycli.records.intensity import describe, loading_intensity
     from masonrycli.scenario.caveats import scenario_warnings
     from masonrycli.scenario.scenario import scenario_summary
 
     scenario = _scenario(target, opts)
     outputs = checked_outputs(scenario, opts)
-    console.print(check_table(str(Path(target)), scenario_summary(scenario), outputs.files()))
+    measured = loading_intensity(scenario)
+    # "intensity", no longer than the other labels: a wider label column re-wrapped every loading line
+    ground = None if measured is None else ("intensity", f"{measured[0]}: {describe(measured[1])}")
+    console.print(check_table(str(Path(target)), scenario_summary(scenario), outputs.files(), ground))
     for warning in scenario_warnings(scenario):
         warn(warning)

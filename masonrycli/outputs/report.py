@@ -145,9 +145,10 @@ def _two_columns(title: str) -> Table:
     return table
 
 
-def check_table(scenario_file: str, info: dict, output_files) -> Table:
+def check_table(scenario_file: str, info: dict, output_files, ground: tuple[str, str] | None = None) -> Table:
     """``masonry check``'s table: ``info`` of :func:`masonrycli.scenario.scenario.scenario_summary`, the files a run
-    would write (:class:`masonrycli.outputs.files.OutputFile`)."""
+    would write (:class:`masonrycli.outputs.files.OutputFile`); ``ground``: the row the run's summary gives the
+    ground motion as applied, (label, text), or None."""
     table = _two_columns(f"{scenario_file} — valid")
     xmin, ymin, xmax, ymax = info["bounding_box"]
     table.add_row("scenario", str(info["name"]))
@@ -164,6 +165,8 @@ def check_table(scenario_file: str, info: dict, output_files) -> Table:
     # the loading, as run will apply it (a --record and its --scale included): it was not shown at all
     driven = [f"{m['name']}: {m['motion']}" for m in info["support_motions"] if m["role"] != "fixed"]
     table.add_row("loading", "\n".join(driven) or "none (every support fixed)")
+    if ground is not None:  # its PGA: a --scale read as a PGA in g, or a sine's 1.28 g, seen before it runs
+        table.add_row(*ground)
     for out_file in output_files:
         table.add_row("recording" if out_file.option == "--out" else "history", str(out_file.path))
     return table

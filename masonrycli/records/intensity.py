@@ -63,6 +63,23 @@ def shaking_support(motions) -> int | None:
     return None
 
 
+MAX_CHECK_STEPS = 2_000_000
+"""Most steps ``masonry check`` measures the loading over (16 MB of velocities; a 10⁸-step run would take 800 MB)."""
+
+
+def loading_intensity(scenario) -> tuple[str, dict[str, float]] | None:
+    """``(support name, measures)`` of the ground motion a run of ``scenario`` would apply — what its summary's
+    ``ground motion`` row will say, before it runs (``masonry check``) — or None when no support shakes or the
+    run has more than :data:`MAX_CHECK_STEPS` steps."""
+    from masonrycli.scenario.motion import support_velocity
+
+    j, run = shaking_support(scenario.motions), scenario.run
+    if j is None or run.n_steps < 2 or run.n_steps > MAX_CHECK_STEPS:
+        return None
+    v = support_velocity(scenario.motions[j : j + 1], np.arange(run.n_steps + 1, dtype=np.float64) * run.dt)
+    return scenario.assembly.supports[j].name, intensity_measures(v[:, 0, 0], run.dt)
+
+
 def describe(ims: dict[str, float], sa_period: float = SA_PERIOD) -> str:
     """One summary line, e.g. ``PGA 3.14 m/s² (0.32 g), PGV 0.5 m/s, Arias 1.2 m/s, D5–95 4.1 s, Sa(0.5 s) 5 m/s²``."""
     return (
