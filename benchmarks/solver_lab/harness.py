@@ -65,6 +65,7 @@ def _register_optional():
         lines,
         newton,
         schwarz,
+        slip,
         tnnmg,
     )
 
@@ -85,6 +86,7 @@ def _register_optional():
         lines,
         galerkin,
         schwarz,
+        slip,
     ):
         METHODS.update(module.METHODS)
 
