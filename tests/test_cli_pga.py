@@ -61,6 +61,7 @@ def test_check_and_the_api_take_the_pga_and_check_says_the_scale(at2):
     "args, said",
     [
         (("--pga", "0.25", "--scale", "2"), "--pga with --scale: give one"),
+        (("--pga", "0.25", "g"), "(g): --pga takes its unit joined to the number (--pga 0.25g), or the number alone"),
         (("--pga", "0.25x"), "--pga': 0.25x: x is not a unit of acceleration"),
         (("--pga", "3kN"), "3kN: kN is not a unit of acceleration"),
         (("--pga", "0"), "0: must be a peak acceleration above 0 and at most 10 g"),

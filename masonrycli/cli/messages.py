@@ -242,6 +242,10 @@ def _split_word(exc, command: str) -> str | None:
     if extra == message.strip() or not (extra.startswith("(") and extra.endswith(")")) or exc.ctx is None:
         return None
     words = extra[1:-1]
+    pga = exc.ctx.params.get("pga")
+    if pga is not None and words.split()[0].lower() in ("g", "gal", "m/s2", "m/s²", "cm/s2", "cm/s²"):
+        # "--pga 0.25 g": --pga is in g, and reads a unit joined to its number; "the options are in SI" was wrong
+        return f"{message}: --pga takes its unit joined to the number (--pga {getattr(pga, 'text', pga)}{words.split()[0]}), or the number alone in g"
     if words.split()[0] in _UNIT_WORDS:
         return f"{message}: a number goes alone, without its unit (the options are in SI units: {command} --help)"
     # "--param amp=0.5, 1": a list cut at the space after its comma (it was read as a flag's value, "1")
