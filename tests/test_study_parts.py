@@ -22,6 +22,16 @@ from masonrycli.study.fragility import fit_lognormal
 from masonrycli.study.task import check_outcome, empty_result, reached, run_task
 
 
+def test_a_range_s_values_are_the_decimals_it_names():
+    # np.linspace(0.4, 0.8, 5) holds 0.6000000000000001 and 0.7000000000000001: a study's rows and CSV had them
+    assert parse_axis("friction=0.4:0.8:5").values == (0.4, 0.5, 0.6, 0.7, 0.8)
+    assert parse_axis("amp=0.1:1.0:10").values == tuple(k / 10 for k in range(1, 11))
+    assert parse_axis("pga_g=0.1:1.0:10").values[2] == 0.3  # not 0.30000000000000004
+    third = parse_axis("scale=0.32:1.6:10").values[1]  # not a short decimal: kept to 15 digits
+    assert third == float(f"{0.32 + 1.28 / 9:.15g}") and abs(third - (0.32 + 1.28 / 9)) < 1e-15
+    assert parse_axis("x=0.123456789012345:0.2:2").values[0] == 0.123456789012345  # LO as typed
+
+
 def test_parse_axis_forms_and_errors():
     assert parse_axis("amp=0.1:1.0:4").values == pytest.approx((0.1, 0.4, 0.7, 1.0))
     assert parse_axis("ground.amp=0.2,0.8").values == (0.2, 0.8)

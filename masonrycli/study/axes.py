@@ -80,7 +80,9 @@ def parse_axis(text: str, where: str = "") -> Axis:
             raise InputError(f"{where}: HI must be >= LO")
         if n > MAX_RUNS:
             raise InputError(f"{where}: N = {n} values, more than {MAX_RUNS} (a likely typo)")
-        values = tuple(float(v) for v in np.linspace(lo, hi, n))
+        # to 15 significant digits, which a value typed with up to 15 keeps: linspace's 0.6000000000000001 (of
+        # friction=0.4:0.8:5) was the table's and the CSV's value, so df[df.friction == 0.6] found no row
+        values = tuple(float(f"{v:.15g}") for v in np.linspace(lo, hi, n))
     else:
         values = tuple(_number(p, where, name) for p in spec.split(","))
     if name.split(".")[-1] in INT_PARAMS or _is_builder_int(name):
