@@ -480,7 +480,9 @@ OPTION_ROWS = [
         {"q.AT2": "PEER NGA STRONG MOTION DATABASE RECORD\n"},
         ("inspect", "q.AT2"),
         2,
-        "q.AT2: a ground-motion record (PEER .AT2; simulate and run take it with --record), not a recording",
+        "q.AT2: a ground-motion record (PEER .AT2; simulate and run take it with --record), not a recording; inspect "
+        "reads the .rrd recordings that --out writes (its PGA, PGV, Arias and length as a run applies it: masonry "
+        "check wall --record q.AT2)",
     ),
     (  # said rerun's 'Not an RRD file: expected FourCC header "RRF2", got "Orig"'
         "inspect-knet-record",

@@ -140,9 +140,12 @@ def _foreign_file(path: str | os.PathLike) -> str | None:
                 return None
     except OSError:  # unreadable: the reader says why
         return None
+    record = ""
     if binary_under_text_suffix(path):  # a binary file under a text suffix is none of those kinds
         kind = BINARY_FILE
-    return f"{os.fspath(path)}: {kind}, not a recording; inspect reads the .rrd recordings that --out writes"
+    elif kind.startswith("a ground-motion record"):  # what one inspecting it wants: its PGA, its length
+        record = f" (its PGA, PGV, Arias and length as a run applies it: masonry check wall --record {os.fspath(path)})"
+    return f"{os.fspath(path)}: {kind}, not a recording; inspect reads the .rrd recordings that --out writes{record}"
 
 
 def recording_path_problem(path: str | os.PathLike) -> str | None:
