@@ -143,3 +143,17 @@ def test_check_gives_the_ground_motion_the_run_will_apply(at2, tmp_path):
     # the default wall's sine, 1 m/s at 2 Hz: 2π·2·1 = 12.6 m/s², 1.28 g
     assert "PGA 12.6 m/s² (1.28 g), PGV 1 m/s" in words(invoke("check", "wall").output.replace("│", " "))
     assert "intensity" not in invoke("check", "arch").output  # a settling foundation shakes nothing
+
+
+def test_a_fragility_over_pga_levels_counts_its_collapses_per_pga():
+    from masonrycli.study.curves import fragility_series
+
+    rows = [
+        {"record": r, "pga_g": p, "pga": p * G_STANDARD * (1 + 1e-15), "state": "collapsed" if p > 0.3 else "intact"}
+        for r in ("a.AT2", "b.AT2")
+        for p in (0.2, 0.4)
+    ]
+    fraction = [s for s in fragility_series(rows, "pga", None, "m/s²") if s.key == "fraction"][0]
+    assert fraction.label == "fraction collapsed per PGA"  # it said "per scale" of a study with no scale
+    np.testing.assert_allclose(fraction.x, [0.2 * G_STANDARD, 0.4 * G_STANDARD], rtol=1e-12)
+    assert list(fraction.y) == [0.0, 1.0]

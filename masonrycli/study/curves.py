@@ -131,14 +131,15 @@ def fragility_series(rows: list[dict], im: str, fit, unit: str, groups=None) -> 
         return out
     # from IM = 0 in steps of 1/1000 of the unit (the recording's time line is in thousandths)
     grid = np.unique(np.rint(np.linspace(0, np.nanmax(x) * 1.2, 300) * 1000.0)) / 1000.0
+    per = "per PGA" if rows and "pga_g" in rows[0] else "per scale"  # the records scaled to each pga_g, or by scale
     if groups is None or len(groups) < 2:
-        out += _fraction(rows, im, "fraction", "fraction collapsed per scale", FRACTION_COLOUR)
+        out += _fraction(rows, im, "fraction", f"fraction collapsed {per}", FRACTION_COLOUR)
         if fit is not None:
             out.append(Series("fit", fit_label(fit, unit), FIT_COLOUR, "line", grid, fit.probability(grid)))
         return out
     for i, g in enumerate(groups):
         colour = GROUP_COLOURS[i % len(GROUP_COLOURS)]
-        out += _fraction(g.rows, im, f"fraction/{i}", f"{g.label}: fraction collapsed per scale", colour)
+        out += _fraction(g.rows, im, f"fraction/{i}", f"{g.label}: fraction collapsed {per}", colour)
         if g.fit is not None:
             label = f"{g.label}: {fit_label(g.fit, unit)}"
             out.append(Series(f"fit/{i}", label, colour, "line", grid, g.fit.probability(grid)))
