@@ -439,3 +439,24 @@ def test_the_fragility_line_counts_the_runs_at_zero_intensity_it_leaves_out():
     rows = [{"pga": 0.0}, {"pga": 0.0}, {"pga": 21.9}, {"pga": math.nan}]
     assert _at_zero(rows, "pga") == "; 3 runs at pga = 0 left out"
     assert _at_zero([{"pga": 1.0}], "pga") == ""
+
+
+def test_a_swept_parameter_has_the_unit_it_is_read_in(tmp_path):
+    """The axes' units come from geometry_library.values (OPTION_UNITS, SETTING_UNITS): a dict of five names in
+    study/curves.py left a study over pga_g (g) or length (m) with bare plot axes and inspect columns."""
+    from masonrycli.study.curves import with_unit
+    from masonrycli.study.inspect_table import study_summary
+
+    table = tmp_path / "s.csv"
+    table.write_text(
+        "record,length,pga_g,friction,state,pga,status,study,source\n"
+        "q.AT2,0.9,0.1,0.6,intact,0.98,completed,abc,def\n"
+        "q.AT2,0.9,0.2,0.6,intact,1.96,completed,abc,def\n"
+    )
+    rows, columns = study_summary(table)
+    assert dict(columns)["pga_g"] == "g, swept" and dict(columns)["length"] == "m, swept"
+    assert dict(columns)["friction"] == "swept parameter"  # no unit
+    assert dict(rows)["pga_g"] == "0.1, 0.2 g"
+    assert [with_unit(n) for n in ("pga_g", "ground.amp", "length", "friction")] == [
+        "pga_g (g)", "ground.amp (m/s)", "length (m)", "friction"
+    ]  # fmt: skip

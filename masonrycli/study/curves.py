@@ -26,8 +26,20 @@ GROUP_COLOURS = ("#1f5fa8", "#9b59d0", "#17a2b8", "#8c564b", "#e377c2", "#7f8c2a
 THRESHOLD_COLOUR = "#d03030"
 NOT_FOUND_COLOUR = "#8c8c8c"  # grey: no threshold in the searched range
 
-UNITS = {"amp": "m/s", "freq": "Hz", "phase": "rad", "duration": "s", "dt": "s"}
-"""A swept parameter's unit, by its last dotted part."""
+
+class _ParamUnits:
+    """A swept parameter's unit, by its last dotted part: ``UNITS.get(name, default)``, the unit
+    geometry_library.values.unit_of reads it in (the one registry), ``default`` when it has none. A dict of
+    five names here left the others bare: a study over ``pga_g`` (g), ``length`` (m) or ``density`` (kg/m³)
+    had axes and ``masonry inspect`` columns without their unit."""
+
+    def get(self, name: str, default: str | None = None) -> str | None:
+        from geometry_library.values import unit_of
+
+        return unit_of(name) or default
+
+
+UNITS = _ParamUnits()
 
 
 @dataclass(frozen=True)
