@@ -88,7 +88,7 @@ def test_a_study_scales_each_record_to_its_points_pga(at2, tmp_path):
     out, histories = tmp_path / "s.csv", tmp_path / "h"
     result = invoke(
         "sweep", "wall", "--param", "blocks=12", "--records", at2, "--records", other, "--param", "pga_g=0.1,0.3",
-        "--duration", 0.4, "--workers", 0, "--no-recording", "--out", out, "--histories", histories,
+        "--duration", 0.75, "--workers", 0, "--no-recording", "--out", out, "--histories", histories,
     )  # fmt: skip
     assert result.exit_code == 0, result.output
     rows = read_rows(out)
@@ -97,7 +97,7 @@ def test_a_study_scales_each_record_to_its_points_pga(at2, tmp_path):
     for row in rows:
         assert row["pga"] == pytest.approx(row["pga_g"] * G_STANDARD, rel=1e-12)
         record = record_motion(tmp_path / row["record"])
-        scale = row["pga_g"] * G_STANDARD / applied_peak(record, 400, 1e-3)
+        scale = row["pga_g"] * G_STANDARD / applied_peak(record, 750, 1e-3)
         h = np.load(next(histories.glob(f"*{row['record']}*pga_g={row['pga_g']:g}*.npz")))
         np.testing.assert_allclose(
             h["support_v"][:, 0, :], record_motion(tmp_path / row["record"], scale=scale).velocity_at(h["time"]),
@@ -157,3 +157,23 @@ def test_a_fragility_over_pga_levels_counts_its_collapses_per_pga():
     assert fraction.label == "fraction collapsed per PGA"  # it said "per scale" of a study with no scale
     np.testing.assert_allclose(fraction.x, [0.2 * G_STANDARD, 0.4 * G_STANDARD], rtol=1e-12)
     assert list(fraction.y) == [0.0, 1.0]
+
+
+def test_a_run_cut_short_applies_the_whole_record_so_scaled(at2, tmp_path):
+    # --pga scaled the part of the record the run reached: a run cut before the record's peak ran it stronger
+    # than the record scaled to that PGA (x1.12 for --duration 3 on a 20 s record peaking at 3.4 s)
+    record = record_motion(at2)
+    whole = applied_peak(record, round(record.end_time / 1e-3), 1e-3)
+    early = applied_peak(record, 200, 1e-3)
+    assert early < 0.9 * whole  # the record peaks after 0.2 s
+    npz = tmp_path / "h.npz"
+    args = ("--blocks", 12, "--record", at2, "--pga", 0.3, "--duration", 0.2, "--no-recording", "--history", npz)
+    result = invoke("simulate", "wall", *args)
+    assert result.exit_code == 0, result.output
+    assert "its shaking after t = 0.2 s is not applied" in words(result.output)
+    h = np.load(npz)
+    scale = 0.3 * G_STANDARD / whole
+    np.testing.assert_allclose(
+        h["support_v"][:, 0, :], record_motion(at2, scale=scale).velocity_at(h["time"]), rtol=1e-12
+    )
+    assert float(h["intensity_pga"]) == pytest.approx(scale * early, rel=1e-12)

@@ -6,11 +6,13 @@ as recorded. The run reports the PGA of the motion *as applied* (baseline-correc
 synthetic record: 0.25 / 0.312 g gave 0.248 g). So the scale is found from the motion as applied. The
 support velocity is linear in the scale (the integration and the least-squares baseline are linear maps), so
 
-    v   = the shaking support's x velocity at t_k = k dt, k = 0 … n_steps, with the records as read
+    v   = the shaking support's x velocity at t_k = k dt, k = 0 … n, with the records as read
+          (n: the run's steps, or the record's end in steps when it is longer: the whole record)
     a   = max_k |v[k+1] − v[k]| / dt                 (the PGA as records/intensity.py measures it)
     every record's scale  ×=  PGA / a
 
-makes the run's PGA the one asked for, to round-off.
+makes the run's PGA the one asked for, to round-off, when the run reaches the record's peak; a run cut
+before it applies the record so scaled up to its end (a warning says it is cut).
 """
 
 from __future__ import annotations
@@ -94,9 +96,13 @@ def scaled_to_pga(scenario, pga: float, option: str = "--pga", give: str = "--re
     if j is None or scenario.motions[j].kind != "record":
         what = "nothing shakes it" if j is None else f"its {scenario.motions[j].kind} motion is not a record"
         raise InputError(f"{option}: scales a ground-motion record, and {what} (give {give})")
-    peak = applied_peak(scenario.motions[j], scenario.run.n_steps, scenario.run.dt)
+    # over the whole record at the run's steps, whatever the run's length: a run cut before the record's peak
+    # applies the record so scaled up to its end (and is warned it is cut), where scaling the part it runs to
+    # the PGA inflated the record (--duration 3 on a 20 s synthetic record peaking at 3.4 s: ×1.12)
+    record, dt = scenario.motions[j], scenario.run.dt
+    peak = applied_peak(record, max(scenario.run.n_steps, math.ceil(record.end_time / dt) + 2), dt)
     if not peak > 0.0:
-        raise InputError(f"{option}: the record never accelerates the ground along x within the run")
+        raise InputError(f"{option}: the record never accelerates the ground along x")
     factor = pga * G_STANDARD / peak
     motions = tuple(
         dataclasses.replace(m, scale=m.scale * factor) if m.kind == "record" else m for m in scenario.motions
