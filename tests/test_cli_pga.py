@@ -177,3 +177,12 @@ def test_a_run_cut_short_applies_the_whole_record_so_scaled(at2, tmp_path):
         h["support_v"][:, 0, :], record_motion(at2, scale=scale).velocity_at(h["time"]), rtol=1e-12
     )
     assert float(h["intensity_pga"]) == pytest.approx(scale * early, rel=1e-12)
+
+
+def test_a_record_of_zeros_in_a_set_is_named(at2, tmp_path):
+    # a record of zeros among a study's files said '--param pga_g=0.4: the record never accelerates …': which one?
+    write_at2(tmp_path / "flat.AT2", np.zeros(50), 0.01)
+    said = "--param pga_g=0.4: flat.AT2 never accelerates the ground along x"
+    assert_one_line_error(invoke("sweep", "wall", "--records", tmp_path, "--param", "pga_g=0.4", "--workers", 0), said)
+    said = "--pga: flat.AT2 never accelerates the ground along x"
+    assert_one_line_error(invoke("simulate", "wall", "--record", tmp_path / "flat.AT2", "--pga", "0.4"), said)

@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import os
 import re
 
 import numpy as np
@@ -101,8 +102,9 @@ def scaled_to_pga(scenario, pga: float, option: str = "--pga", give: str = "--re
     # the PGA inflated the record (--duration 3 on a 20 s synthetic record peaking at 3.4 s: ×1.12)
     record, dt = scenario.motions[j], scenario.run.dt
     peak = applied_peak(record, max(scenario.run.n_steps, math.ceil(record.end_time / dt) + 2), dt)
-    if not peak > 0.0:
-        raise InputError(f"{option}: the record never accelerates the ground along x")
+    if not peak > 0.0:  # named: in a set of records, '--param pga_g=0.4: the record never …' left which to find
+        name = os.path.basename(record.source) if record.source else "the record"
+        raise InputError(f"{option}: {name} never accelerates the ground along x")
     factor = pga * G_STANDARD / peak
     motions = tuple(
         dataclasses.replace(m, scale=m.scale * factor) if m.kind == "record" else m for m in scenario.motions

@@ -338,6 +338,8 @@ def scenario_from_builder(
             raise InputError(f"{where} motion of support {quote_string(name)} must be a Motion")
     motions = tuple(motions_by_support.get(s.name, Fixed()) for s in assembly.supports)
     warnings = structure_warnings(assembly, InputContext(f'builder "{builder}"', "."))
+    # the builder's density, thickness (--param density) are the blocks': said by the run's document, not 2500
+    material = dataclasses.replace(material, **{k: options[k] for k in ("density", "thickness") if options.get(k)})
     return Scenario(
         name=builder,
         run=run,
