@@ -186,3 +186,13 @@ def test_a_history_under_another_name_is_still_a_history(history, tmp_path):
     assert_one_line_error(invoke("inspect", tmp_path / "d.npz"), "d.npz: a folder, not a history")
     shown = invoke("inspect", renamed)
     assert shown.exit_code == 0 and _rows(shown.output)["scenario"] == "wall (builder:wall)", shown.output
+
+
+def test_a_built_in_s_size_is_named(tmp_path):
+    # "scenario │ wall (builder:wall)" was all a colleague handed the history saw of a 3 m x 0.6 m section
+    path = tmp_path / "h.npz"
+    args = ("--courses", 4, "--length", 0.6, "--block-height", 0.25, "--duration", 0.01, "--no-recording")
+    assert invoke("simulate", "wall", *args, "--history", path).exit_code == 0
+    said = invoke("inspect", path).output
+    assert re.search(r"structure\s+│ wall: courses 4, length 0\.6, block_height 0\.25\s", said), said
+    assert np.load(path)["block_extent"][:, 3].max() == pytest.approx(1.0)  # 4 courses of 0.25 m, as named

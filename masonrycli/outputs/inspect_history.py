@@ -184,6 +184,14 @@ def run_rows(info: dict) -> list[tuple[str, str]]:
 
     scenario, source = get("scenario"), get("source")
     rows.append(("scenario", f"{scenario} ({source})" if given(scenario, source) else str(scenario or NOT_RECORDED)))
+    structure = get("structure")
+    if isinstance(structure, dict) and structure.get("builder"):  # its size: "wall (builder:wall)" said none
+        options = [
+            f"{k} {v:g}" if isinstance(v, float) else f"{k} {v}"
+            for k, v in structure.items()
+            if k != "builder" and v is not None
+        ]
+        rows.append(("structure", f"{structure['builder']}: {', '.join(options) or 'as built by default'}"))
     reading = get("reading")
     if isinstance(reading, dict) and reading:  # how its geometry file was read: the history is of that reading
         rows.append(("reading", reading_text(reading)))
