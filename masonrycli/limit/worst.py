@@ -58,7 +58,8 @@ def placed(load: LiveLoad, blocks, at: float, block: str, top: float, level: flo
 
 def _no_fill(load: LiveLoad) -> InputError:
     return InputError(
-        f"--spread {load.spread:g}: no fill to spread through (an arch built with --fill-to or --fill-cover)"
+        f"--spread {load.spread:g}: no fill to spread through (an arch built with --fill-to or --fill-cover, or "
+        "a file whose blocks' carried masses are one fill's)"
     )
 
 

@@ -7,8 +7,8 @@ blocks (``geometry_library.fill.fill_columns``, the pieces ``with_fill`` weighed
 file has only the carried masses: their columns are drawn when the masses are one fill's, of one density up to
 one level (a built-in bridge's written to a file: ``geometry_library.fill.level_from_carried`` finds that
 level and checks every block against it); other carried masses have no outline to draw (the recording says
-the mass and that it is not drawn). The fill's level for a load spread through it stays a built-in's
-(:func:`fill_surface`).
+the mass and that it is not drawn). A load spread through the fill (``limit --spread``) takes the same
+level (:func:`fill_surface`): a file's fill was drawn, and the spread refused as "no fill".
 """
 
 from __future__ import annotations
@@ -30,17 +30,25 @@ def _fill_of(scenario) -> tuple[float, float, float] | None:
     return None if level is None else (level, -geometry.half_width, geometry.half_width)
 
 
+def _fill(scenario) -> tuple[float, float, float] | None:
+    """(level, x_lo, x_hi), m, of the scenario's fill: the builder's for the arch built-in, else the one fill
+    its blocks' carried masses are (a file's, :func:`level_from_carried`); None when there is none."""
+    if scenario.structure.get("builder") == "arch":
+        return _fill_of(scenario)
+    return level_from_carried(scenario.assembly.blocks)
+
+
 def fill_surface(scenario) -> float | None:
-    """m: the level of the fill of an arch built with one (``--fill-to`` / ``--fill-cover``), else None."""
-    fill = _fill_of(scenario)
+    """m: the level of the scenario's fill (:func:`_fill`: an arch built with ``--fill-to`` / ``--fill-cover``,
+    or a file whose carried masses are one fill's), else None."""
+    fill = _fill(scenario)
     return None if fill is None else fill[0]
 
 
 def carried_columns(scenario) -> FillColumns | None:
     """The fill's columns over the scenario's blocks (world coordinates as built), None without a fill or when
     a file's carried masses are not one fill's (module doc)."""
-    built_in = scenario.structure.get("builder") == "arch"
-    fill = _fill_of(scenario) if built_in else level_from_carried(scenario.assembly.blocks)
+    fill = _fill(scenario)
     return None if fill is None else fill_columns(scenario.assembly.blocks, *fill)
 
 
