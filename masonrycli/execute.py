@@ -279,6 +279,9 @@ def execute(
             for history in (sinks.get(outputs.history), kept):
                 if history is not None:
                     history.run_values |= {f"intensity_{k}": v for k, v in result.intensity.items()}
+            recorder = sinks.get(outputs.recording) if outputs.recording is not None else None
+            if recorder is not None:  # its closing document says what the summary does: state, peak drift, PGA
+                recorder.metadata["result"] = dict(result.extra)
         finally:
             signals.closing()
             written, errors = _close_all(sinks, status, note, result)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+import re
 import subprocess
 import sys
 import textwrap
@@ -322,3 +323,18 @@ def test_centroid_dots_stay_smaller_than_small_blocks(tmp_path):
     assert dot <= 0.25 * side + 1e-6, (dot, side)
     _, _, r = drawn(*fx.wall(), "small.rrd")  # 1.2 m x 0.8 m: blocks ~ 100 px
     assert r == CENTROID_RADIUS
+
+
+def test_the_closing_document_gives_the_runs_result(tmp_path):
+    # a recording handed to a colleague said "completed" and the parameters, not whether the wall stood: the
+    # state, its peak drift and the ground motion were in the terminal's summary only
+    out = tmp_path / "w.rrd"
+    result = invoke("simulate", "wall", "--courses", 4, "--length", 1.2, "--duration", 0.1, "--out", out)
+    assert result.exit_code == 0, result.output
+    doc = words(inspect_recording(out)["metadata"])
+    summary = words(result.output.replace("│", " "))
+    for label in ("state", "peak drift", "ground motion (ground)", "hinged joints (end)"):
+        row = re.search(rf"\| result\.{re.escape(label)} \| (.*?) \|\n", inspect_recording(out)["metadata"])
+        assert row is not None, doc
+        assert f"{label} {words(row.group(1).replace(chr(92) + '|', '|'))}" in summary
+    assert "| result.state | damaged (residual drift" in doc
