@@ -17,12 +17,12 @@ from pathlib import Path
 
 import numpy as np
 from rich.console import Console
-from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 
 from masonrycli.errors import InputError
 from masonrycli.study import files, store
 from masonrycli.study.axes import Axis, StudyBase, apply_point, check_axes, check_find, grid
 from masonrycli.study.drivers import FindDriver, GridDriver
+from masonrycli.study.progress import StudyProgress
 from masonrycli.study.task import RESULT_COLUMNS
 from masonrycli.study.versions import WorkerMismatch, this_version
 
@@ -184,16 +184,7 @@ def run_study(base: StudyBase, request: StudyRequest, console: Console) -> Study
     except BaseException:
         _close(client, cluster)
         raise
-    progress = Progress(
-        TextColumn("[bold]sweep"),
-        BarColumn(),
-        MofNCompleteColumn(),
-        TextColumn("{task.fields[states]}"),
-        TimeElapsedColumn(),
-        console=console,
-        disable=not console.is_terminal,
-    )
-    bar = progress.add_task("rows", total=driver.total, completed=driver.skipped, states="")
+    progress = StudyProgress(console, driver.total, driver.skipped)  # a bar, or lines off a terminal
     counts: dict[str, int] = {}
     ran = 0
 
@@ -207,9 +198,11 @@ def run_study(base: StudyBase, request: StudyRequest, console: Console) -> Study
             finished["study"] = row_study(finished)
             finished["source"] = source
             journal.append(finished)
-            progress.advance(bar)
+            progress.advance()
         driver.finished.clear()
-        progress.update(bar, states=f"{ran} runs: " + ", ".join(f"{k} {v}" for k, v in sorted(counts.items())))
+        progress.states(
+            f"{ran} run{'' if ran == 1 else 's'}: " + ", ".join(f"{k} {v}" for k, v in sorted(counts.items()))
+        )
 
     try:
         histories = None
