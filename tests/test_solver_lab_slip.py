@@ -197,3 +197,29 @@ def test_solve_reaches_the_target_and_the_reference(cold):
             assert law.velocity_error(p, v) < law.velocity_error(p, v_alone) + 1e-5, name
         else:
             assert law.velocity_error(p, v) < 1e-5, name
+
+
+def test_course_rigid_fit(cold):
+    # a rigid motion of each course (own translation and rotation about any point) is its own fit; one block
+    # moving alone is not
+    p = cold
+    chain = S.build_chain(p, Context(p).pack)
+    rng = np.random.default_rng(3)
+    e = np.zeros((p.inv_mass.size, 3))
+    for c in range(chain.n):
+        s = chain.course == c
+        vx, vy, w = rng.normal(size=3)
+        x0, y0 = rng.normal(size=2)
+        e[s] = np.stack([vx - w * (p.q_m[s, 1] - y0), vy + w * (p.q_m[s, 0] - x0), np.full(s.sum(), w)], axis=1)
+    np.testing.assert_allclose(S.course_rigid_fit(p, chain, e), e, atol=1e-12)
+    one = np.zeros_like(e)
+    one[np.flatnonzero(chain.course == 1)[0], 0] = 1.0
+    assert np.abs(S.course_rigid_fit(p, chain, one) - one).max() > 0.5
+
+
+def test_oracle_counts_sweeps_to_the_target(cold):
+    ctx = Context(cold)
+    for kind in ("rigid", "full"):
+        o = S.oracle(ctx, kind, sweeps=5, target=1e-8, steps=3)
+        assert 0 < o["alone"] < S.CAP and 5 <= o["once"] < S.CAP and 0 < o["repeated"] < S.CAP
+        assert o["steps"] <= 3

@@ -96,10 +96,11 @@ def balance_normals(ctx, joint, r, dr) -> np.ndarray:
     return out
 
 
-def min_norm(ctx, course, joint, r, sliding, du, raw: list | None = None) -> np.ndarray:
+def min_norm(ctx, course, joint, r, sliding, du, raw: list | None = None, dv=None) -> np.ndarray:
     """Δr (C, 2) of the "min-norm" realisation of the courses' translation ``du`` (module doc). ``course`` (B,),
     ``joint`` (C,): slip.Chain's; ``sliding`` (C,): the joint contacts at their friction limit (slip.State's
-    classes 0 and 2). ``raw`` (a list): gets the least-norm Δr before the final clip, for the diagnostic."""
+    classes 0 and 2). ``raw`` (a list): gets the least-norm Δr before the final clip, for the diagnostic.
+    ``dv`` (B, 3): realise this velocity change instead (the oracle diagnostic of slip.oracle_rounds)."""
     p = ctx.p
     touching = (r[:, 1] > 0.0) | (ctx.pack[:, N.P_BIAS] <= 0.0)
     edge = touching & sliding & (joint >= 0)  # moved along the cone's edge: Δr_t = σ μ (r_n + Δr_n) − r_t
@@ -108,8 +109,11 @@ def min_norm(ctx, course, joint, r, sliding, du, raw: list | None = None) -> np.
     dyn = np.flatnonzero(p.inv_mass > 0)
     keep = np.stack([3 * dyn, 3 * dyn + 1, 3 * dyn + 2], axis=1).ravel()
     f = np.zeros((p.inv_mass.size, 3))
-    s = course >= 0
-    f[s, 0] = du[course[s]] / p.inv_mass[s]
+    if dv is None:
+        s = course >= 0
+        f[s, 0] = du[course[s]] / p.inv_mass[s]
+    else:
+        f[dyn] = dv[dyn] / np.stack([p.inv_mass, p.inv_mass, p.inv_inertia], axis=1)[dyn]
     f = f.ravel()
     fixed = np.zeros(p.count, bool)
     dr = np.zeros_like(r)
