@@ -138,3 +138,19 @@ def test_an_end_sliding_with_the_flow_rules_dilation_stays_in_contact():
     motion = joint_motion(model, joints, u)
     between = [sorted(p) for p in joints.joint_body.tolist()].index([0, 1])
     assert motion.joint_hinged[between] and motion.joint_sliding[between] and not motion.joint_opening[between]
+
+
+def test_the_recordings_panel_names_the_opening_joints_and_rigid_parts_as_the_table():
+    """The aqueduct's mechanism has 3 joints opening (no end in contact, 234b679): the table and --json listed
+    them, the recording's side panel did not (they were among its hinges before), nor the rigid parts."""
+    from masonrycli.limit.command import resolve_structure
+    from masonrycli.limit.drawing import mechanism_document
+
+    result = analyse(resolve_structure("aqueduct", None, {}), LiveLoad("horizontal"))
+    opening = result.opening_largest_first()
+    assert opening, "the aqueduct's mechanism has joints opening"
+    said = mechanism_document(result)
+    assert f"joints opening ({len(opening)}, the fastest first): {', '.join(opening)}" in said, said
+    table = words(invoke("limit", "aqueduct").output.replace("│", " "))
+    moving = re.search(r"blocks in the mechanism (\d+ of \d+, as \d+ rigid parts \([^)]*\))", table).group(1)
+    assert f"blocks in the mechanism: {moving}" in said, said

@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 
 from geometry_library.mass import mass_properties
-from masonrycli.limit.analysis import LimitResult
+from masonrycli.limit.analysis import LimitResult, parts_text
 from masonrycli.limit.command import depth_text, lambda_reading
 from masonrycli.limit.problem import DIRECTIONS
 
@@ -41,6 +41,12 @@ def mechanism_document(result: LimitResult, fill_drawn: bool = True) -> str:
         f"sliding joints ({len(result.sliding_joints)}, the fastest first): "
         + _document_names(result.sliding_largest_first()),
     ]
+    opening = result.opening_largest_first()
+    if opening:  # turning as they part all along: the table's 'joints opening' row, listed as hinges before
+        lines += ["", f"joints opening ({len(opening)}, the fastest first): " + _document_names(opening)]
+    moving = len(result.moving_blocks)
+    parts = parts_text(result.model.block_name, result.part_indices)
+    lines += ["", f"blocks in the mechanism: {moving} of {result.model.block_count}{parts}"]
     return "\n".join(lines)
 
 
