@@ -99,3 +99,22 @@ def test_the_title_counts_the_rows_in_the_singular_and_plural():
     columns, names = grid_columns(["record", "scale"], "pga"), ["record", "scale"]
     assert _render(ROWS[:1], columns, names, 80)[0].strip() == "study (1 row)"
     assert _render(ROWS, columns, names, 80)[0].strip() == f"study ({len(ROWS)} rows)"
+
+
+def test_a_parameter_of_one_value_is_said_once_not_a_column_a_row(tmp_path):
+    # 'sweep wall --param courses=6 --param length=0.6 --param density=2200 --records recs/ --param pga_g=… --param
+    # friction=…' at 80 columns: courses, length and density took 3 of its 7 columns, the same value on every row,
+    # and collapse and drift were left out
+    from typer.testing import CliRunner
+
+    from masonrycli.cli.app import app
+
+    args = ["sweep", "wall", "--param", "courses=4", "--param", "length=0.6", "--param", "density=2200"]
+    args += ["--param", "amp=0.1,0.2", "--param", "freq=1,2", "--duration", "0.01", "--workers", "0"]
+    result = CliRunner().invoke(app, [*args, "--no-recording", "--out", str(tmp_path / "s.csv")], terminal_width=80)
+    assert result.exit_code == 0, result.output
+    header = next(line for line in result.output.splitlines() if line.startswith("┃"))
+    assert [h.strip() for h in header.strip("┃").split("┃")][:5] == ["amp", "freq", "state", "collapse", "drift"]
+    assert "every row: courses = 4, length = 0.6, density = 2200 · " in words(result.output)
+    lines = _render(ROWS, grid_columns(["scale"], "pga"), ["record", "scale"], 80)  # a failed row keeps its point
+    assert "failed: record=synthetic-record-2.AT2 scale=1.75: ValueError" in words("\n".join(lines))

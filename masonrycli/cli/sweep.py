@@ -357,8 +357,12 @@ def _report(console, result, plan: StudyPlan, im: str, written: list, signals: F
     request, name, plot, recording = plan.request, plan.name, plan.picture, plan.recording
     rows, axes = result.rows, request.axes
     keys = [a.name for a in axes if a.name != request.find]  # what a row is keyed by
-    columns = find_columns(keys, request.find) if request.find else grid_columns(keys, im)
     names = [a.name for a in axes if a.name != request.find and len(a.values) > 1]
+    # an axis of one value is said once under the table, not in a column a row: the wall's courses, length and
+    # density took 3 of an 80-column terminal's 7 columns, and the pga and collapse columns were left out
+    fixed = {a.name: a.values[0] for a in axes if a.name != request.find and len(a.values) == 1 and names}
+    shown = [k for k in keys if k not in fixed]
+    columns = find_columns(shown, request.find) if request.find else grid_columns(shown, im)
     fit, groups = None, []
     with written_whole(plot, around_commit=_recorded(signals, written, plot)) as part:
         if request.find:
@@ -387,7 +391,7 @@ def _report(console, result, plan: StudyPlan, im: str, written: list, signals: F
             fail(f"cannot write {recording.option} {recording.path}: {exc.strerror or exc}", EXIT_OUTPUT_FAILED)
     # said once both are written: a reader of stdout that goes away (`masonry sweep … | head`) broke the pipe
     # at the first line after the table, and the plot and the recording were never written
-    console.print(study_table(rows, columns, keys, console, result.out))
+    console.print(study_table(rows, columns, keys, console, result.out, fixed))
     console.print(
         f"{_n(len(rows), 'row')} in {result.out} ({_n(result.ran, 'run')} now, {_n(result.skipped, 'row')} already "
         f"there, {result.failed} failed) in {result.wall_time:.1f} s"

@@ -4,7 +4,8 @@ Headers are short (``collapse``, ``drift``, ``open``) and every value is in the 
 with a fixed number of decimals, so a row stays on one line. When the columns do not fit the console,
 the least needed ones go first (``sweeps``, ``peak``, ``wall``, ``hinges``, ``open``, the intensity
 measure, ``drift``, ``collapse``; the parameters and the state always stay) and the legend says which
-are not shown; a cell still too wide ends in "…". Failed rows are listed under the table with their
+are not shown; a cell still too wide ends in "…". A parameter of one value over the study has no column: the legend
+says it once. Failed rows are listed under the table with their
 error. Every column is in the table file whatever the terminal shows.
 """
 
@@ -111,9 +112,12 @@ def find_columns(names: list[str], find: str) -> list[Column]:
     ]
 
 
-def study_table(rows: list[dict], columns: list[Column], names: list[str], console: Console, where) -> Group:
+def study_table(
+    rows: list[dict], columns: list[Column], names: list[str], console: Console, where, fixed: dict | None = None
+) -> Group:
     """The table (as many ``columns`` as ``console.width`` holds), its legend, and the failed rows (their
-    point: the parameters ``names``); ``where``: the table file."""
+    point: the parameters ``names``); ``where``: the table file; ``fixed``: the parameters of one value over
+    the study (no column of their own: the legend says them once, ``every row: courses = 6, length = 0.6``)."""
     shown = list(columns)
     table = _table(rows, shown)
     while _natural_width(console, table) > console.width and max(c.drop for c in shown) > 0:
@@ -121,6 +125,8 @@ def study_table(rows: list[dict], columns: list[Column], names: list[str], conso
         shown = [c for c in shown if c.drop != last]
         table = _table(rows, shown)
     legend = [c.legend for c in shown if c.legend]
+    if fixed:
+        legend.insert(0, "every row: " + ", ".join(f"{k} = {_param(v)}" for k, v in fixed.items()))
     headers = {c.header for c in columns}
     hidden = [c.header for c in columns if c not in shown]
     if hidden:
