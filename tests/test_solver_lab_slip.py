@@ -15,9 +15,11 @@ from scipy.optimize import minimize
 from benchmarks.solver_lab import law
 from benchmarks.solver_lab.capture import SINE, capture_run, reference
 from benchmarks.solver_lab.methods import slip as S
+from benchmarks.solver_lab.methods import slip_oracle as O
 from benchmarks.solver_lab.methods import slip_realise as R
 from benchmarks.solver_lab.methods.accelerated import accelerated
 from benchmarks.solver_lab.outcome import Context
+from masonrycli.engine import nlgs as N
 from masonrycli.run import Simulation
 from masonrycli.scenario.scenario import Material, RunConfig, scenario_from_builder
 
@@ -211,15 +213,34 @@ def test_course_rigid_fit(cold):
         vx, vy, w = rng.normal(size=3)
         x0, y0 = rng.normal(size=2)
         e[s] = np.stack([vx - w * (p.q_m[s, 1] - y0), vy + w * (p.q_m[s, 0] - x0), np.full(s.sum(), w)], axis=1)
-    np.testing.assert_allclose(S.course_rigid_fit(p, chain, e), e, atol=1e-12)
+    np.testing.assert_allclose(O.course_rigid_fit(p, chain, e), e, atol=1e-12)
     one = np.zeros_like(e)
     one[np.flatnonzero(chain.course == 1)[0], 0] = 1.0
-    assert np.abs(S.course_rigid_fit(p, chain, one) - one).max() > 0.5
+    assert np.abs(O.course_rigid_fit(p, chain, one) - one).max() > 0.5
 
 
 def test_oracle_counts_sweeps_to_the_target(cold):
     ctx = Context(cold)
-    for kind in ("rigid", "full"):
-        o = S.oracle(ctx, kind, sweeps=5, target=1e-8, steps=3)
+    for kind in ("rigid", "full", "joint-NMT"):
+        o = O.oracle(ctx, kind, sweeps=5, target=1e-8, steps=3)
         assert 0 < o["alone"] < S.CAP and 5 <= o["once"] < S.CAP and 0 < o["repeated"] < S.CAP
         assert o["steps"] <= 3
+
+
+def test_with_resultants_sets_each_bed_joints_resultants(cold):
+    # where nothing is clipped, N, the moment about the contacts' mean x and the friction total of every bed joint
+    # are the reference's, and nothing else changes
+    p = cold
+    ctx = Context(p)
+    chain = S.build_chain(p, ctx.pack)
+    inj = chain.joint >= 0
+    r = p.r_ref.copy()
+    touching = (r[:, 1] > 0) | (ctx.pack[:, N.P_BIAS] <= 0)
+    r[touching, 1] += 1.0  # 1 N·s more on every touching contact: the change back is uniform, nothing clipped
+    r[:, 0] *= 0.5
+    out = O.with_resultants(ctx, chain, r, "NMT")
+    k, x = chain.joint[inj], p.point[inj, 0]
+    xi = x - (np.bincount(k, x) / np.bincount(k))[k]
+    for q in (lambda z: z[inj, 1], lambda z: z[inj, 1] * xi, lambda z: chain.tau[inj] * z[inj, 0]):
+        np.testing.assert_allclose(np.bincount(k, q(out)), np.bincount(k, q(p.r_ref)), atol=1e-9)
+    np.testing.assert_array_equal(out[~inj], r[~inj])

@@ -42,7 +42,7 @@ scipy) over one engine sweep's. The residual checks after the sweeps are not cou
 the sweep), as in galerkin.py. Diagnostics (``python -m benchmarks.solver_lab.methods.slip PROBLEM …``):
 :func:`projection` gives the best correction the space allows (the M-orthogonal projection of the true error
 onto course x-translations) against what one step does; :func:`rounds` (``--rounds K``) follows K rounds;
-:func:`oracle` (``--oracle rigid full``) bounds every velocity-space coarse step by handing it the true error.
+:mod:`slip_oracle` (``--oracle rigid full joint-NM …``) bounds coarse steps by handing them the true answer.
 """
 
 from __future__ import annotations
@@ -359,66 +359,14 @@ def rounds(ctx, sweeps: int, count: int, realise: str = "min-norm") -> list[tupl
     return out
 
 
-def course_rigid_fit(p, chain: Chain, e: np.ndarray) -> np.ndarray:
-    """(B, 3): each course's mass-weighted rigid-body fit (translation and rotation about its centroid) of ``e``."""
-    out = np.zeros_like(e)
-    m = np.where(p.inv_mass > 0, 1.0 / np.where(p.inv_mass > 0, p.inv_mass, 1.0), 0.0)
-    inertia = np.where(p.inv_inertia > 0, 1.0 / np.where(p.inv_inertia > 0, p.inv_inertia, 1.0), 0.0)
-    for c in range(chain.n):
-        s = chain.course == c
-        d = p.q_m[s, :2] - (m[s, None] * p.q_m[s, :2]).sum(0) / m[s].sum()
-        V = (m[s, None] * e[s, :2]).sum(0) / m[s].sum()
-        L = (inertia[s] * e[s, 2] + m[s] * (d[:, 0] * e[s, 1] - d[:, 1] * e[s, 0])).sum()
-        w = L / (inertia[s] + m[s] * (d * d).sum(1)).sum()
-        out[s] = np.stack([V[0] - w * d[:, 1], V[1] + w * d[:, 0], np.full(d.shape[0], w)], axis=1)
-    return out
-
-
-def oracle(ctx, kind: str, sweeps: int = SWEEPS, target: float = 1e-5, steps: int = 200, cap: int = CAP) -> dict:
-    """What any coarse step in velocity space could do at best: the true error v_ref − v (``kind`` "full") or its
-    per-course rigid fit ("rigid": modes u, v, ω of every course) realised by the least-norm active set of
-    slip_realise.min_norm. Fine sweeps to the RMS law residual ``target``: from the warm start alone, after one
-    oracle step at ``sweeps`` sweeps, and with an oracle step every ``sweeps`` sweeps (at most ``steps``). Counts
-    alone and after one step in chunks ≥ 10 % apart (as nlgs-law), the repeated one exactly."""
-    p = ctx.p
-    chain = build_chain(p, ctx.pack)
-
-    def step(v, r):
-        e = p.v_ref - v
-        dv = e if kind == "full" else course_rigid_fit(p, chain, e)
-        sliding = joint_state(ctx, chain, v, r).cls != 1
-        return r + R.min_norm(ctx, chain.course, chain.joint, r, sliding, None, dv=dv)
-
-    def count(r, done=0):
-        while done < cap:
-            k = max(10, done // 10)
-            v, _ = ctx.sweep(r, k)
-            done += k
-            if ctx.residual(v, r) <= target:
-                break
-        return done
-
-    alone = count(p.r_warm.copy())
-    r = p.r_warm.copy()
-    v, _ = ctx.sweep(r, sweeps)
-    once = count(step(v, r), sweeps)
-    r, done, taken = p.r_warm.copy(), 0, 0
-    while done < cap:
-        v, _ = ctx.sweep(r, sweeps)
-        done += sweeps
-        if ctx.residual(v, r) <= target:
-            break
-        if taken < steps:
-            r, taken = step(v, r), taken + 1
-    return {"alone": alone, "once": once, "repeated": done, "steps": taken}
-
-
 def _projection_table(names, sweeps, smoother: str, realise: str, count: int, oracle_kinds=()) -> None:
     from benchmarks.solver_lab.outcome import Context
     from benchmarks.solver_lab.problems import load_all
 
     probs = load_all(names)
     if oracle_kinds:
+        from benchmarks.solver_lab.methods.slip_oracle import oracle
+
         print("| problem | oracle | fine sweeps to 1e-5 m/s: alone / one step / a step every SWEEPS (steps) |")
         print("|---|---|---|")
         for prob in probs:
@@ -463,6 +411,7 @@ if __name__ == "__main__":
     ap.add_argument("--smoother", default="nlgs", choices=["nlgs", "nlgs-accel"])
     ap.add_argument("--realise", default="min-norm", choices=["tangential", "balance", "min-norm"])
     ap.add_argument("--rounds", type=int, default=0, help="instead: this many rounds of sweeps + step (rounds())")
-    ap.add_argument("--oracle", nargs="*", default=[], choices=["rigid", "full"], help="instead: oracle()")
+    kinds = ["rigid", "full", "joint-N", "joint-NM", "joint-NMT"]
+    ap.add_argument("--oracle", nargs="*", default=[], choices=kinds, help="instead: slip_oracle.oracle()")
     a = ap.parse_args()
     _projection_table(a.problems, a.sweeps, a.smoother, a.realise, a.rounds, a.oracle)
