@@ -244,3 +244,13 @@ def test_a_run_setting_given_as_option_and_axis_is_refused(block, tmp_path, args
     line = f"error: {said}: the axis sets every run's {name}; give one"
     assert result.exit_code == 2 and words(result.output) == line, result.output
     assert sorted(p.name for p in tmp_path.iterdir()) == ["block.toml"]
+
+
+def test_the_summary_says_where_the_histories_are(block, tmp_path):
+    # it named the table, the plot and the recording, not the folder of the runs' histories
+    h = tmp_path / "h"
+    grid = ["-p", "amp=0.05,0.1", "--duration", 0.02, "--workers", 0, "--no-recording", "-o", tmp_path / "s.csv"]
+    result = invoke("sweep", block, *grid, "--histories", h)
+    assert result.exit_code == 0, result.output
+    assert f"histories: {h} (2 histories, one a run; as CSV: masonry export {h} --top)" in words(result.output)
+    assert sorted(p.name for p in h.iterdir()) == ["amp=0.05.npz", "amp=0.1.npz"]

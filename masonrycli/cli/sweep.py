@@ -399,6 +399,11 @@ def _report(console, result, plan: StudyPlan, im: str, written: list, signals: F
     for group in groups:
         console.print(_fit_line(group, im, request.axes))
     console.print(f"plot: {plot.path}")
+    if request.histories is not None:  # the summary named the table, plot and recording, not the runs' histories
+        # counted where this command runs (a remote cluster's workers write them where they run)
+        found = sum(1 for _ in request.histories.glob("*.npz")) if request.histories.is_dir() else 0
+        each = f"{found} {'history' if found == 1 else 'histories'}, one a run" if found else "one history a run"
+        console.print(f"histories: {request.histories} ({each}; as CSV: masonry export {request.histories} --top)")
     if recording is not None:
         # as masonry run says it: 'recording: s.rrd' left a first user to find out what opens a .rrd
         from rich.text import Text
