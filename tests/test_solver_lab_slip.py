@@ -244,3 +244,21 @@ def test_with_resultants_sets_each_bed_joints_resultants(cold):
     for q in (lambda z: z[inj, 1], lambda z: z[inj, 1] * xi, lambda z: chain.tau[inj] * z[inj, 0]):
         np.testing.assert_allclose(np.bincount(k, q(out)), np.bincount(k, q(p.r_ref)), atol=1e-9)
     np.testing.assert_array_equal(out[~inj], r[~inj])
+
+
+def test_with_resultants_per_pair(cold):
+    # the same for every body pair, head joints included: N, the moment along the pair's tangent and Σ r_t
+    p = cold
+    ctx = Context(p)
+    chain = S.build_chain(p, ctx.pack)
+    r = p.r_ref.copy()
+    touching = (r[:, 1] > 0) | (ctx.pack[:, N.P_BIAS] <= 0)
+    r[touching, 1] += 1.0
+    r[:, 0] *= 0.5
+    out = O.with_resultants(ctx, chain, r, "NMT", pairs=True)
+    pair = np.unique(p.body[:, 0] * 1000 + p.body[:, 1], return_inverse=True)[1].ravel()
+    t = np.stack([p.normal[:, 1], -p.normal[:, 0]], axis=1)
+    mean = np.stack([np.bincount(pair, p.point[:, j]) / np.bincount(pair) for j in (0, 1)], axis=1)
+    xi = ((p.point - mean[pair]) * t).sum(1)
+    for q in (lambda z: z[:, 1], lambda z: z[:, 1] * xi, lambda z: z[:, 0]):
+        np.testing.assert_allclose(np.bincount(pair, q(out)), np.bincount(pair, q(p.r_ref)), atol=1e-9)

@@ -8,7 +8,9 @@ do the rest (the lab's solver_lab JOURNAL, "nlgs-slip", table 4 and after).
                     normal resultant N_k = Σ r_n (a uniform change over the joint's touching contacts), with
                     "M" its moment about the contacts' mean x (a linear change, Navier's distribution), with "T"
                     its x-friction total (spread by room, slip_realise.spread); r_n clipped at 0 and r_t into the
-                    new cones (with_resultants).
+                    new cones (with_resultants). "pair-N", "pair-NM", "pair-NMT": the same for every body pair
+                    (all its contacts, head joints too: the Galerkin "joint" space's resultants). "pair-NM+joint-T": the
+                    pairs' N and M, then the bed joints' friction totals.
 
     oracle: sweeps to the target from the warm start alone; with one oracle step after SWEEPS sweeps; with one
             every SWEEPS sweeps (at most ``steps``).
@@ -23,18 +25,31 @@ from benchmarks.solver_lab.methods import slip_realise as R
 from masonrycli.engine import nlgs as N
 
 
-def with_resultants(ctx, chain: S.Chain, r, what: str) -> np.ndarray:
-    """r with every bed joint's N (and M if "M" in ``what``, T if "T") set to the reference's (module doc)."""
+def with_resultants(ctx, chain: S.Chain, r, what: str, pairs: bool = False) -> np.ndarray:
+    """r with every bed joint's N, M, T (those whose letter is in ``what``) set to the reference's (module doc);
+    ``pairs``: every body pair's instead (all contacts, head joints too; M about the pair's mean point along its
+    contacts' tangent, T the sum of r_t)."""
     p = ctx.p
-    inj = chain.joint >= 0
+    if pairs:
+        a_, b_ = p.body[:, 0].astype(np.int64), p.body[:, 1].astype(np.int64)
+        inj = np.ones(p.count, bool)
+        k = np.unique(a_ * p.inv_mass.size + b_, return_inverse=True)[1].ravel()
+        tau = np.ones(p.count)
+        t = np.stack([ctx.pack[:, N.P_NY], -ctx.pack[:, N.P_NX]], axis=1)
+    else:
+        inj = chain.joint >= 0
+        k = chain.joint[inj]
+        tau = chain.tau[inj]
+        t = np.tile([1.0, 0.0], (k.size, 1))
     rows = np.flatnonzero(inj)
-    k = chain.joint[inj]
-    n = chain.n
-    x = p.point[inj, 0]
-    xi = x - (np.bincount(k, x, n) / np.maximum(np.bincount(k, minlength=n), 1))[k]
+    n = int(k.max(initial=-1)) + 1
+    x = p.point[inj]
+    cnt = np.maximum(np.bincount(k, minlength=n), 1)
+    mean = np.stack([np.bincount(k, x[:, j], n) for j in (0, 1)], axis=1) / cnt[:, None]
+    xi = ((x - mean[k]) * t).sum(1)
     w = ((r[inj, 1] > 0) | (ctx.pack[inj, N.P_BIAS] <= 0)).astype(float)
     s0, s1, s2 = (np.bincount(k, w * xi**j, n) for j in range(3))
-    dN = np.bincount(k, p.r_ref[inj, 1] - r[inj, 1], n)
+    dN = np.bincount(k, p.r_ref[inj, 1] - r[inj, 1], n) if "N" in what else np.zeros(n)
     dM = np.bincount(k, (p.r_ref[inj, 1] - r[inj, 1]) * xi, n) if "M" in what else np.zeros(n)
     det = s0 * s2 - s1 * s1
     det = np.where(np.abs(det) > 1e-12 * np.maximum(s0 * s2, 1e-300), det, np.inf)  # one point: N only
@@ -42,12 +57,12 @@ def with_resultants(ctx, chain: S.Chain, r, what: str) -> np.ndarray:
     b = np.where(np.isfinite(det), (s0 * dM - s1 * dN) / det, 0.0)
     out = r.copy()
     out[rows, 1] = np.maximum(r[inj, 1] + w * (a[k] + b[k] * xi), 0.0)
-    lam = p.mu * out[rows, 1] * np.abs(chain.tau[inj])
-    xt = np.clip(chain.tau[inj] * r[inj, 0], -lam, lam)
+    lam = p.mu * out[rows, 1] * np.abs(tau)
+    xt = np.clip(tau * r[inj, 0], -lam, lam)
     if "T" in what:
         total = np.bincount(k, lam, n)
-        xt = R.spread(lam, xt, k, np.clip(np.bincount(k, chain.tau[inj] * p.r_ref[inj, 0], n), -total, total))
-    out[rows, 0] = xt / chain.tau[inj]
+        xt = R.spread(lam, xt, k, np.clip(np.bincount(k, tau * p.r_ref[inj, 0], n), -total, total))
+    out[rows, 0] = xt / tau
     return out
 
 
@@ -67,16 +82,19 @@ def course_rigid_fit(p, chain: S.Chain, e: np.ndarray) -> np.ndarray:
 
 
 def oracle(ctx, kind: str, sweeps: int = S.SWEEPS, target: float = 1e-5, steps: int = 200, cap: int = S.CAP) -> dict:
-    """What a coarse step could do at best (module doc): ``kind`` "full", "rigid", "joint-N", "joint-NM" or
-    "joint-NMT". Fine sweeps to the RMS law residual ``target``: from the warm start alone, after one
+    """What a coarse step could do at best (module doc): ``kind`` "full", "rigid", "joint-…" or "pair-…" (N, NM,
+    NMT). Fine sweeps to the RMS law residual ``target``: from the warm start alone, after one
     oracle step at ``sweeps`` sweeps, and with an oracle step every ``sweeps`` sweeps (at most ``steps``). Counts
     alone and after one step in chunks ≥ 10 % apart (as nlgs-law), the repeated one exactly."""
     p = ctx.p
     chain = S.build_chain(p, ctx.pack)
 
     def step(v, r):
-        if kind.startswith("joint-"):
-            return with_resultants(ctx, chain, r, kind[len("joint-") :])
+        if kind.startswith(("joint-", "pair-")):
+            for part in kind.split("+"):  # "pair-NM+joint-T": the pairs' normals, then the joints' friction
+                group, what = part.split("-")
+                r = with_resultants(ctx, chain, r, what, group == "pair")
+            return r
         e = p.v_ref - v
         dv = e if kind == "full" else course_rigid_fit(p, chain, e)
         sliding = S.joint_state(ctx, chain, v, r).cls != 1
