@@ -221,7 +221,7 @@ def test_course_rigid_fit(cold):
 
 def test_oracle_counts_sweeps_to_the_target(cold):
     ctx = Context(cold)
-    for kind in ("rigid", "full", "joint-NMT"):
+    for kind in ("rigid", "full", "joint-NMT", "pair-NM+slip-tangential"):
         o = O.oracle(ctx, kind, sweeps=5, target=1e-8, steps=3)
         assert 0 < o["alone"] < S.CAP and 5 <= o["once"] < S.CAP and 0 < o["repeated"] < S.CAP
         assert o["steps"] <= 3

@@ -411,7 +411,9 @@ if __name__ == "__main__":
     ap.add_argument("--smoother", default="nlgs", choices=["nlgs", "nlgs-accel"])
     ap.add_argument("--realise", default="min-norm", choices=["tangential", "balance", "min-norm"])
     ap.add_argument("--rounds", type=int, default=0, help="instead: this many rounds of sweeps + step (rounds())")
-    kinds = ["rigid", "full", "pair-NM+joint-T"] + [f"{g}-{w}" for g in ("joint", "pair") for w in ("N", "NM", "NMT")]
+    kinds = ["rigid", "full", "pair-NM+joint-T", "pair-NM+slip-tangential", "pair-NM+slip-min-norm"] + [
+        f"{g}-{w}" for g in ("joint", "pair") for w in ("N", "NM", "NMT")
+    ]
     ap.add_argument("--oracle", nargs="*", default=[], choices=kinds, help="instead: slip_oracle.oracle()")
     a = ap.parse_args()
     _projection_table(a.problems, a.sweeps, a.smoother, a.realise, a.rounds, a.oracle)

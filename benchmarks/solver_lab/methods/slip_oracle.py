@@ -10,7 +10,8 @@ do the rest (the lab's solver_lab JOURNAL, "nlgs-slip", table 4 and after).
                     its x-friction total (spread by room, slip_realise.spread); r_n clipped at 0 and r_t into the
                     new cones (with_resultants). "pair-N", "pair-NM", "pair-NMT": the same for every body pair
                     (all its contacts, head joints too: the Galerkin "joint" space's resultants). "pair-NM+joint-T": the
-                    pairs' N and M, then the bed joints' friction totals.
+                    pairs' N and M, then the bed joints' friction totals; "pair-NM+slip-R": the pairs' N and M,
+                    then one slip coarse step (realisation R: tangential, balance, min-norm) from there.
 
     oracle: sweeps to the target from the warm start alone; with one oracle step after SWEEPS sweeps; with one
             every SWEEPS sweeps (at most ``steps``).
@@ -20,6 +21,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from benchmarks.solver_lab import law
 from benchmarks.solver_lab.methods import slip as S
 from benchmarks.solver_lab.methods import slip_realise as R
 from masonrycli.engine import nlgs as N
@@ -92,6 +94,10 @@ def oracle(ctx, kind: str, sweeps: int = S.SWEEPS, target: float = 1e-5, steps: 
     def step(v, r):
         if kind.startswith(("joint-", "pair-")):
             for part in kind.split("+"):  # "pair-NM+joint-T": the pairs' normals, then the joints' friction
+                if part.startswith("slip-"):  # the slip step itself, from the iterate with the normals given
+                    v = law.velocity_from_impulse(p, ctx.H, r)
+                    r = S.coarse_step(ctx, chain, v, r, part[len("slip-") :])[0]
+                    continue
                 group, what = part.split("-")
                 r = with_resultants(ctx, chain, r, what, group == "pair")
             return r
