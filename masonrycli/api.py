@@ -11,6 +11,7 @@ Python                                          the command line's code
                                                 execute.execute)
 ``read_history("h.npz")``                       ``masonry inspect h.npz``'s checks, then every array
 ``Run.table(top=True)``                         ``masonry export h.npz --top`` (outputs.export.export_table)
+``Run.report()``                                ``masonry report h.npz`` (outputs.run_report.report_markdown)
 ==============================================  ===============================================================
 
 So a bad value raises :class:`masonrycli.errors.InputError` carrying the line the command prints before its exit
@@ -345,3 +346,17 @@ class Run:
         for note in table.notes:
             warnings.warn(note, UserWarning, stacklevel=2)
         return dict(zip(table.names, table.values))
+
+    def report(self, out=None, *, force: bool = False) -> str:
+        """``masonry report``'s one-page Markdown of the run (what was run, the ground motion as applied, the
+        state, peak and residual drift, hinged joints, unconverged steps: the summary's numbers). ``out``: a
+        ``.md`` path to write it to, with its figure beside it (``.png``), refused if it exists unless
+        ``force=True``, as ``masonry report H.npz --out R.md``."""
+        from masonrycli.outputs.run_report import check_outputs, report_markdown, write_report
+
+        shown = str(self.history) if self.history is not None else "the run"
+        if out is None:
+            return report_markdown(self.arrays, shown)
+        page, picture = check_outputs(_path(out, "--out", output=True), force)
+        write_report(self.arrays, shown, page, picture)
+        return page.path.read_text(encoding="utf-8")

@@ -37,7 +37,7 @@ from masonrycli.outputs.files import (
     default_recording_path,
     open_part,
 )
-from masonrycli.outputs.history import History, HistoryFile, block_constants
+from masonrycli.outputs.history import History, HistoryFile, block_constants, result_values
 from masonrycli.outputs.report import progress_bar, slow_start_notice, summary_table
 from masonrycli.outputs.sinks import COMPLETED, FAILED
 from masonrycli.run import RunResult, Simulation, simulate
@@ -47,8 +47,9 @@ from masonrycli.source_digest import source_commit
 HISTORY_BYTES_PER_BLOCK = 500
 """Upper estimate of one block's share of a history row (measured: 326 B for the walls, 420 B for an arch of
 60 voussoirs, whose blocks have more joints)."""
-HISTORY_STATIC_BYTES = 20_000
-"""... and of what a history holds however short (names, joints, intensity measures)."""
+HISTORY_STATIC_BYTES = 60_000
+"""... and of what a history holds however short (names, joints, intensity measures, the run's result; its
+``units`` table alone is 43 kB: 61 rows of two 89-character UTF-32 cells, measured 2026-11-29)."""
 RECORDING_BYTES_PER_BLOCK = 500
 """Upper estimate of one block's share of a recorded frame (measured: 405 B for the walls)."""
 FRAME_OVERHEAD_BYTES = 2000
@@ -279,6 +280,7 @@ def execute(
             for history in (sinks.get(outputs.history), kept):
                 if history is not None:
                     history.run_values |= {f"intensity_{k}": v for k, v in result.intensity.items()}
+                    history.run_values |= result_values(result.outcome, sim.monitor.height)
             recorder = sinks.get(outputs.recording) if outputs.recording is not None else None
             if recorder is not None:  # its closing document says what the summary does: state, peak drift, PGA
                 recorder.metadata["result"] = dict(result.extra)

@@ -340,9 +340,7 @@ def simulate(
     if sim.last is not None and sim.joints.key.size:
         hinged, _ = sim.hinges()
         hinge_count = int(hinged.sum())
-        pairs = m.joint_names(sim.joints.joint_body[hinged])
-        shown = ", ".join(pairs[:8]) + (" …" if len(pairs) > 8 else "")
-        extra["hinged joints (end)"] = f"{len(pairs)}" + (f": {shown}" if pairs else "")
+        extra["hinged joints (end)"] = describe_hinges(m.joint_names(sim.joints.joint_body[hinged]))
     # Stopped by the user: measure what was applied (the whole run's loading can be 10⁸ samples, minutes
     # of work after a Ctrl-C that should end the run at once).
     ims = applied_intensity(scenario, m, done if status == INTERRUPTED else None)
@@ -411,6 +409,13 @@ def describe_outcome(outcome: dict) -> str:
     if outcome["state"] == "collapsed":
         return f"collapsed at t = {outcome['collapse_time']:.3f} s ({outcome['collapse_reason']})"
     return f"{outcome['state']} ({tail})"
+
+
+def describe_hinges(pairs: list[str]) -> str:
+    """``12: c01-b01|c02-b01, …``: how many joints are hinged, and the first 8 by name (the summary's row and
+    ``masonry report``'s)."""
+    shown = ", ".join(pairs[:8]) + (" …" if len(pairs) > 8 else "")
+    return f"{len(pairs)}" + (f": {shown}" if pairs else "")
 
 
 def describe_peak_drift(ratio: float, height: float) -> str:

@@ -450,4 +450,25 @@ FILE_ROWS = [
     ("csv-decreasing", record("0,0\n1,0\n0.5,0\n"), ("check", "s.toml"), 2, "q.csv:3:"),
     ("csv-infinite", record("0,0\n1,inf\n"), ("check", "s.toml"), 2, "q.csv:2:"),
     ("csv-one-sample", record("0,0\n"), ("check", "s.toml"), 2, "q.csv"),
+    # -- report: the history read as export reads it, --out checked first (export's rule: never overwritten)
+    ("report-missing", {}, ("report", "missing.npz"), 2, "missing.npz: no such history"),
+    (
+        "report-recording",
+        {"w.rrd": b"RRF2" + bytes(60)},
+        ("report", "w.rrd"),
+        2,
+        "w.rrd: a Rerun recording (.rrd), not",
+    ),
+    ("report-study-table", {"s.csv": "amp,state\n0.1,intact\n"}, ("report", "s.csv"), 2, "s.csv: a CSV table, not a"),
+    ("report-text", {"h.npz": "time,a\n"}, ("report", "h.npz"), 2, "h.npz: not a readable history (.npz)"),
+    ("report-folder", {"d/x": ""}, ("report", "d"), 2, "d: a folder, not a history"),
+    ("report-out-exists", {"r.md": "mine"}, ("report", "h.npz", "--out", "r.md"), 2, "--out r.md: the file exists"),
+    (
+        "report-figure-exists",
+        {"r.png": "mine"},
+        ("report", "h.npz", "--out", "r.md"),
+        2,
+        "--out r.md's figure r.png: the file exists (add --force",
+    ),
+    ("report-out-suffix", {}, ("report", "h.npz", "--out", "r.txt"), 2, "--out r.txt: the file name must end in .md"),
 ]

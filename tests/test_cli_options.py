@@ -19,7 +19,9 @@ def test_help_and_version():
         assert command in result.output
     # listed in the order a user meets them, the quick start's command first (simulate and build came last)
     listed = re.findall(r"^│ ([a-z]+) ", result.output, flags=re.MULTILINE)  # a command's row, not its wrapped text
-    assert listed == ["simulate", "run", "check", "build", "inspect", "export", "limit", "sweep", "docs"], listed
+    assert listed == ["simulate", "run", "check", "build", "inspect", "export", "report", "limit", "sweep", "docs"], (
+        listed
+    )
     result = invoke("--version")
     assert result.exit_code == 0 and __version__ in result.output
     result = invoke("simulate", "wall", "--help")

@@ -54,7 +54,7 @@ class _InTheOrderUsersMeetThem(OneLineUsageErrors):
     """``masonry --help`` lists the commands in the order a user meets them — the quick start's ``simulate``
     first — instead of typer's (commands, then groups: ``simulate`` and ``build`` came last, under ``docs``)."""
 
-    ORDER = ("simulate", "run", "check", "build", "inspect", "export", "limit", "sweep", "docs")
+    ORDER = ("simulate", "run", "check", "build", "inspect", "export", "report", "limit", "sweep", "docs")
 
     def list_commands(self, ctx) -> list[str]:
         rank = {name: k for k, name in enumerate(self.ORDER)}
@@ -266,8 +266,10 @@ _register_check()
 
 def _register_export() -> None:
     from masonrycli.cli.export import export_command
+    from masonrycli.cli.report import report_command
 
     app.command("export")(user_errors(export_command))
+    app.command("report")(user_errors(report_command))
 
 
 _register_export()

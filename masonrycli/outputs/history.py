@@ -15,6 +15,9 @@ Arrays (T frames, N blocks, S supports), block order = scenario order:
     block_name (N,) · support_name (S,) · status () str (masonrycli.outputs.sinks.STATUSES) · note () str
     intensity_pga, intensity_pgv, intensity_arias, intensity_d5_95, intensity_sa () — the ground motion as
     applied (masonrycli.records.intensity), when a support shakes
+    result_state () str, result_collapse_time, result_collapse_reason () str, result_peak_drift,
+    result_residual_drift, result_max_opening, result_max_displacement, result_hinges, result_height () — the
+    run's verdict as its summary gives it (masonrycli.run.run_outcome, measured every step, not every frame)
 
 :class:`HistoryFile` (the command line's sink) streams every row to disk as it comes, so memory stays
 flat however long the run; :class:`History` keeps the rows in memory for tests and scripts.
@@ -85,6 +88,15 @@ UNITS: dict[str, str] = {
     "intensity_arias": "m/s, Arias intensity",
     "intensity_d5_95": "s, significant duration D5-95",
     "intensity_sa": "m/s2, spectral acceleration at 0.5 s, 5 % damping",
+    "result_state": "intact, damaged or collapsed, as the run's summary (masonry docs collapse)",
+    "result_collapse_time": "s, time of collapse (NaN: none)",
+    "result_collapse_reason": "why the structure collapsed (empty: it did not)",
+    "result_peak_drift": "x height, the top's largest drift relative to the ground, over every step",
+    "result_residual_drift": "x height, the top's drift relative to the ground at the end",
+    "result_max_opening": "m, the largest joint opening at the end",
+    "result_max_displacement": "m, the largest block displacement relative to the ground at the end",
+    "result_hinges": "hinged joints at the end",
+    "result_height": "m, the structure's height the drifts are ratios of (the blocks' vertical extent)",
     "units": "(K,2) this table: array name, unit / meaning",
     "run": "JSON of the run's parameters (scenario, dt, solver, commit, ...)",
 }
@@ -123,6 +135,19 @@ def block_constants(model) -> dict[str, np.ndarray]:
         "block_inertia": np.array(model.body_inertia[:n], dtype=float),
         "block_extent": extent,
     }
+
+
+RESULT_KEYS = ("state", "collapse_time", "collapse_reason", "peak_drift", "residual_drift", "max_opening")
+RESULT_KEYS += ("max_displacement", "hinges")
+"""The keys of :func:`masonrycli.run.run_outcome` a history keeps (``result_<key>``): what the summary's
+state and peak drift rows say, which the frames alone cannot give again (the peak is watched every step)."""
+
+
+def result_values(outcome: dict, height: float) -> dict[str, np.ndarray]:
+    """The run's verdict as history arrays (``result_*``, 0-d), from its outcome and the structure's height:
+    ``masonry report`` reads them back (it said 'the history does not store the state or peak drift')."""
+    values = {f"result_{key}": np.asarray(outcome[key]) for key in RESULT_KEYS if key in outcome}
+    return values | {"result_height": np.asarray(float(height))}
 
 
 def frame_rows(frame: Frame) -> dict[str, np.ndarray]:

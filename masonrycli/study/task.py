@@ -64,7 +64,7 @@ def run_task(
     from masonrycli.errors import InputError
     from masonrycli.execute import run_metadata
     from masonrycli.outputs.files import OutputFile, written_whole
-    from masonrycli.outputs.history import HistoryFile, block_constants
+    from masonrycli.outputs.history import HistoryFile, block_constants, result_values
     from masonrycli.run import Simulation, simulate
     from masonrycli.study.axes import apply_point
 
@@ -89,6 +89,7 @@ def run_task(
             result = simulate(scenario, sinks, sim=sim, stop_at_collapse=stop_at_collapse)
             if sinks:
                 sinks[0].run_values |= {f"intensity_{k}": v for k, v in result.intensity.items()}
+                sinks[0].run_values |= result_values(result.outcome, sim.monitor.height)
                 sinks[0].close(status=result.status, note=result.message)
         if history_dir:  # written whole: what a killed writer of the same point left is of no one now
             remove_stale_parts(path)
