@@ -64,6 +64,7 @@ def _register_optional():
         linear,
         lines,
         newton,
+        normal_slip,
         schwarz,
         slip,
         tnnmg,
@@ -87,6 +88,7 @@ def _register_optional():
         galerkin,
         schwarz,
         slip,
+        normal_slip,
     ):
         METHODS.update(module.METHODS)
 
