@@ -248,7 +248,10 @@ def test_the_parameters_table_is_simulates(tmp_path):
     assert invoke("simulate", *bridge, "--duration", 0.001, "--dt", 0.001, "--out", run).exit_code == 0
     shown = _parameters(fx.static_value(limit, f"/{DOCUMENT}", "TextDocument:text")[0])
     ran = _parameters(fx.static_value(run, f"/{METADATA}", "TextDocument:text")[0])
-    assert list(shown) == list(ran)  # the same rows, in order
+    # the same rows, in order, but the run's result (result.state, result.peak drift, …: 8592083), which a
+    # limit analysis has not run
+    assert any(k.startswith("result.") for k in ran) and not any(k.startswith("result.") for k in shown)
+    assert list(shown) == [k for k in ran if not k.startswith("result.")]
     for key in ("structure.span", "structure.fill_cover", "fill_mass_kg", "blocks", "friction", "source"):
         assert shown[key] == ran[key], key
     assert float(shown["fill_mass_kg"]) > 4e4  # 421.6 kN / 9.81
