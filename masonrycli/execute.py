@@ -301,11 +301,20 @@ def _open_sink(out: OutputFile, outputs: Outputs, scenario, sim: Simulation, mag
     return Recorder(out.part, recording_static(sim, scenario), run_metadata(scenario, sim), magnify=magnify)
 
 
+def command_line() -> dict:
+    """``{"command": "masonry simulate wall --record site.AT2 …"}`` when the ``masonry`` command (its entry point,
+    or ``python -m masonrycli``) runs this process, else ``{}`` (the Python API, a test's in-process runner): the
+    history keeps how it was made, which ``masonry report`` puts first (an engineer's summary named no command)."""
+    first = Path(sys.argv[0]) if sys.argv and sys.argv[0] else None
+    ours = first is not None and (first.name == "masonry" or first.parts[-2:] == ("masonrycli", "__main__.py"))
+    return {"command": shlex.join(["masonry", *sys.argv[1:]])} if ours else {}
+
+
 def _history(kind, scenario, sim: Simulation, *path):
     """A history (``kind``: :class:`HistoryFile` writing ``path``, or :class:`History` in memory) given what
-    the rows do not hold: the run's parameters and the blocks' constants."""
+    the rows do not hold: the run's parameters (and the command line that ran it) and the blocks' constants."""
     history = kind(*path, sim.model.block_name, sim.model.support_name)
-    history.run_info = run_metadata(scenario, sim)
+    history.run_info = run_metadata(scenario, sim) | command_line()
     history.run_values |= block_constants(sim.model)
     return history
 

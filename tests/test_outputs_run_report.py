@@ -142,3 +142,17 @@ def test_a_history_written_before_the_verdict_was_kept_says_so(shaken, tmp_path)
     assert page["state"].startswith("not recorded")
     drift = export_column(older, tmp_path, "drift ratio (-)")
     assert page["peak drift"].startswith(f"{100 * np.abs(drift).max():.3g} % of the height over the recorded frames")
+
+
+def test_the_command_that_made_the_history_comes_first(tmp_path, monkeypatch):
+    npz = tmp_path / "w.npz"
+    args = ("simulate", "wall", "--blocks", 12, "--duration", 0.01, "--no-recording", "--history", npz)
+    assert invoke(*args).exit_code == 0  # run in-process by a test: no command of masonry's to name
+    assert "command" not in rows(invoke("report", npz).output)
+    monkeypatch.setattr("sys.argv", ["/venv/bin/masonry", *map(str, args), "--force"])
+    assert invoke(*args, "--force").exit_code == 0
+    page = invoke("report", npz).output
+    assert (
+        page.split("\n")[6]
+        == f"| command | masonry simulate wall --blocks 12 --duration 0.01 --no-recording --history {npz} --force |"
+    )
