@@ -299,6 +299,21 @@ def _at_zero(rows: list[dict], im: str) -> str:
     return f"; {_n(zero, 'run')} at {im} = 0 left out" if zero else ""
 
 
+def _collapsed_line(group) -> str | None:
+    """How many runs of a fragility curve collapsed at each level (``friction = 0.5: collapsed per pga_g (g):
+    0.2 0/7, …, 1.6 4/7``): the paper's table, shown by the PNG's diamonds only; None without levels."""
+    from masonrycli.study.curves import UNITS, collapsed_per_level
+
+    found = collapsed_per_level(group.rows)
+    if found is None:
+        return None
+    by, levels = found
+    unit = UNITS.get(by)
+    head = f"collapsed per {by}" + (f" ({unit})" if unit else "")
+    counts = ", ".join(f"{level:g} {fell}/{runs}" for level, fell, runs in levels)
+    return f"{group.label + ': ' if group.label else ''}{head}: {counts}"
+
+
 def _no_fit(rows: list[dict], axes) -> str:
     """Why a record study has no fragility curve, and what gives one: 'no fit (every run collapsed, or none
     did)' left the user to count which, and which way to move the scales."""
@@ -398,6 +413,8 @@ def _report(console, result, plan: StudyPlan, im: str, written: list, signals: F
     )
     for group in groups:
         console.print(_fit_line(group, im, request.axes))
+        if (line := _collapsed_line(group)) is not None:
+            console.print(line)
     console.print(f"plot: {plot.path}")
     if request.histories is not None:  # the summary named the table, plot and recording, not the runs' histories
         # counted where this command runs (a remote cluster's workers write them where they run)

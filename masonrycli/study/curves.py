@@ -174,6 +174,17 @@ def _fraction(rows: list[dict], im: str, key: str, label: str, colour: str) -> l
     return [Series(key, label, colour, "diamond", mean_x[ok], fraction[ok])]
 
 
+def collapsed_per_level(rows: list[dict]) -> tuple[str, list[tuple[float, int, int]]] | None:
+    """``(by, [(level, collapsed, runs), …])``: how many of ``rows`` collapsed at each scale, or PGA the records
+    were scaled to (``by``: ``scale`` or ``pga_g``), levels increasing; None without either. The fraction
+    collapsed per level of the fragility plot, as counts for the summary."""
+    by = next((k for k in ("scale", "pga_g") if rows and k in rows[0]), None)
+    if by is None:
+        return None
+    at = {level: [r for r in rows if r[by] == level] for level in sorted({r[by] for r in rows})}
+    return by, [(level, sum(r.get("state") == "collapsed" for r in runs), len(runs)) for level, runs in at.items()]
+
+
 def threshold_series(
     rows: list[dict], find: str, at: np.ndarray, searched: tuple[float, float], joined: bool = True, by=()
 ) -> list[Series]:
