@@ -86,6 +86,38 @@ def test_normal_solve_matches_an_independent_qp(stack, cones):
     assert np.abs((rn - low) * w).max() <= 1e-7 * rn.max()
 
 
+def test_tangential_solve_matches_an_independent_qp(sliding):
+    # Tresca with g = μ r_n held, in impulse space: min ½ r_tᵀ W_tt r_t + r_tᵀ H_t v° subject to |r_t| ≤ g
+    # (W_tt = H_t M⁻¹ H_tᵀ dense from the lab's H, v° = v_free + M⁻¹ H_nᵀ r_n), by L-BFGS-B; the velocities
+    # v° + M⁻¹ H_tᵀ r_t are unique (W_tt is singular: r_t is not), so they are compared
+    p = sliding
+    ctx = Context(p)
+    ops = I.Operators(ctx)
+    r = _held(ctx, 5)
+    g = p.mu * r[:, 1]
+    assert (g > 0).sum() > 4
+    rt, its = NS.tangential_solve(ops, r)
+    assert its < NS.NORMAL_CAP
+    assert (np.abs(rt) <= g * (1 + 1e-12) + 1e-15).all()
+    H = law.h_matrix(p, ctx.pack).toarray()
+    minv = law.inv_mass_diag(p)
+    ht, hn = H[0::2], H[1::2]
+    v0 = p.v_free.ravel() + minv * (hn.T @ r[:, 1])
+    W = ht @ (minv[:, None] * ht.T)
+    q = ht @ v0
+    res = minimize(
+        lambda y: 0.5 * y @ W @ y + q @ y,
+        np.zeros(p.count),
+        jac=lambda y: W @ y + q,
+        bounds=list(zip(-g, g, strict=True)),
+        method="L-BFGS-B",
+        options={"ftol": 1e-16, "gtol": 1e-13, "maxiter": 20000},
+    )
+    want = v0 + minv * (ht.T @ res.x)
+    v = law.velocity_from_impulse(p, ctx.H, np.stack([rt, r[:, 1]], 1)).ravel()
+    np.testing.assert_allclose(v, want, atol=1e-6 * np.abs(want).max())
+
+
 def test_normal_solve_is_a_fixed_point_at_the_reference(sliding):
     # with the reference's tangentials held (cone bound on), the reference's velocities solve the normal problem
     p = sliding
@@ -96,13 +128,13 @@ def test_normal_solve_is_a_fixed_point_at_the_reference(sliding):
     np.testing.assert_array_equal(r[:, 0], p.r_ref[:, 0])  # no tangential clipped
 
 
-@pytest.mark.parametrize("k", [5, 20])
-def test_alternation_reaches_the_target_and_the_reference(sliding, k):
+@pytest.mark.parametrize("k, slip", [(5, "guard"), (20, "guard"), (20, "tresca")])
+def test_alternation_reaches_the_target_and_the_reference(sliding, k, slip):
     p = sliding
     ctx = Context(p)
     ctx.sweep_s = 1e-6
     trace = []
-    out = NS.alternate(ctx, 1e-8, k, trace, slip="guard")
+    out = NS.alternate(ctx, 1e-8, k, trace, slip=slip)
     v = law.velocity_from_impulse(p, ctx.H, out.r)
     np.testing.assert_allclose(out.v, v, atol=1e-9)
     assert out.converged and ctx.residual(v, out.r) <= 1e-8

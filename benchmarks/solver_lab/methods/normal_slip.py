@@ -49,6 +49,8 @@ NORMAL_TOL = 1e-8
 """m/s: the normal solve stops when the RMS primal residual and RMS min(z, W_nn r_n) are both below this (1e-3 ×
 the lab's target; the factor's rounding stalls it near 1e-9 on wall-8-cold), or when its step falls below STALL."""
 STALL = 1e-6
+SIGMA = 0.1
+"""The tangential solve's centring parameter."""
 NORMAL_CAP = 100
 """Interior-point iterations a normal solve."""
 ROUND_CAP = 400
@@ -121,6 +123,75 @@ def normal_solve(
     return low + lam, its
 
 
+def tangential_solve(ops: I.Operators, r: np.ndarray, tol: float = NORMAL_TOL) -> tuple[np.ndarray, int]:
+    """(r_t (C,), factorisations): the Tresca sub-problem with r's normal impulses held, g = μ r_n,
+
+        min ½ (x − x°)ᵀ M (x − x°) + Σ_α g_α |u_t,α(x)|,   x° = x_free + M⁻¹ H_nᵀ r_n,
+
+    as min ½ |x − x°|²_M + gᵀw s.t. s1 = w − u_t ≥ 0, s2 = w + u_t ≥ 0 with multipliers a, b ≥ 0 (a ⟂ s1, b ⟂ s2,
+    a + b = g, r_t = b − a, x = x° + M⁻¹ H_tᵀ r_t), by a primal–dual interior point (σ = SIGMA); w eliminated,
+    each iteration factors K = M + H_tᵀ diag(4 d1 d2 / (d1 + d2)) H_t (d1 = a / s1, d2 = b / s2). Contacts with
+    g ≤ OPEN × the largest g keep r_t = 0. Cold: r_t = 0 (module code says why)."""
+    c = r.shape[0]
+    g = ops.mu * np.maximum(r[:, 1], 0.0)
+    on = g > OPEN * max(float(g.max(initial=0.0)), 1e-300)  # a bound ~1e-16 of the largest stalls the steps at 1e-14
+    ht = ops.Hd[0::2][on]
+    htT = ht.T.tocsr()
+    ct = ops.u_const[on, 0]
+    x0 = ops.x_free + ops.minv * (ops.HdT @ np.stack([np.zeros(c), r[:, 1]], 1).ravel())
+    gg = g[on]
+    # start at the box's centre (r_t = 0) with every product a s1 = b s2 equal: the warm r_t's near-bound a or b
+    # stalled the steps at 1e-14 (wall-64-cold after 20 sweeps)
+    a = 0.5 * gg.copy()
+    b = 0.5 * gg.copy()
+
+    def velocity(a, b):
+        return x0 + ops.minv * (htT @ (b - a))
+
+    x = velocity(a, b)
+    u = ht @ x + ct
+    scale = max(float(np.abs(u).max(initial=0.0)), 1e-3)
+    s1 = scale * gg.mean() / gg
+    s2 = s1.copy()
+    w = np.abs(u) + scale
+    zero = np.zeros(c)
+    its = 0
+    while its < NORMAL_CAP and gg.size:
+        p1, p2 = w - u - s1, w + u - s2
+        rw = a + b - gg
+        mu_c = float(a @ s1 + b @ s2) / (2 * gg.size)
+        worst = max(np.abs(p1).max(), np.abs(p2).max())
+        comp = np.maximum(np.minimum(s1, a * ops.wnn[on]), np.minimum(s2, b * ops.wnn[on]))  # both pairs
+        if worst <= tol and np.sqrt((comp * comp).mean()) <= tol and np.abs(rw).max() <= 1e-9 * gg.max():
+            break
+        its += 1
+        d1, d2 = a / s1, b / s2
+        D = d1 + d2
+        e1, e2 = SIGMA * mu_c / s1 - a, SIGMA * mu_c / s2 - b
+        f = rw + e1 + e2 - d1 * p1 - d2 * p2
+        h = e1 - e2 - d1 * p1 + d2 * p2
+        gt = zero.copy()
+        gt[on] = 4 * d1 * d2 / D
+        fac = ops.factor_blocks(np.concatenate([gt, zero, zero, zero]))
+        dx = ops.solve(fac, -(htT @ (h + (d2 - d1) * f / D)))
+        du = ht @ dx
+        dw = (f + (d1 - d2) * du) / D
+        ds1, ds2 = dw - du + p1, dw + du + p2
+        da, db = e1 - d1 * ds1, e2 - d2 * ds2
+        alpha = min(
+            1.0,
+            I.STEP_FRACTION * min(I._max_step(a, da), I._max_step(b, db), I._max_step(s1, ds1), I._max_step(s2, ds2)),
+        )
+        a, b, s1, s2, w = a + alpha * da, b + alpha * db, s1 + alpha * ds1, s2 + alpha * ds2, w + alpha * dw
+        x = velocity(a, b)
+        u = ht @ x + ct
+        if alpha < STALL:
+            break
+    out = np.zeros(c)
+    out[on] = np.clip(b - a, -gg, gg)
+    return out, its
+
+
 def with_normals(ctx, r: np.ndarray, rn: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """(r', v'): r's normals replaced by ``rn``, its tangentials clipped into the new cones; v' = v(r')."""
     out = r.copy()
@@ -140,6 +211,13 @@ def outer_round(ctx, ops, chain, r, clock, slip="always") -> tuple[np.ndarray, n
         res_a = ctx.residual(v, r)
     if slip == "none":
         return r, v, its, res_a
+    if slip == "tresca":  # (b) replaced by the exact tangential sub-solve: a two-block exact alternation
+        with clock("slip"):
+            rt, its_t = tangential_solve(ops, r)
+            r = np.stack([rt, r[:, 1]], 1)
+            v = law.velocity_from_impulse(ctx.p, ctx.H, r)
+        ctx.slip_kept = getattr(ctx, "slip_kept", 0) + 1
+        return r, v, its + its_t, res_a
     with clock("slip"):
         r2, v2, _ = S.coarse_step(ctx, chain, v, r, "tangential")
     if slip == "guard":
@@ -237,7 +315,7 @@ def quartiles(ctx, v, r) -> list[float]:
     return list(np.bincount(q, e, 4) / max(e.sum(), 1e-300))
 
 
-def _table(names, ks, target, slip) -> None:
+def _table(names, ks, target, slip, rounds_cap=ROUND_CAP) -> None:
     from benchmarks.solver_lab.outcome import Context
     from benchmarks.solver_lab.problems import load_all
 
@@ -259,15 +337,17 @@ def _table(names, ks, target, slip) -> None:
                 )
                 continue
             trace: list = []
-            out = alternate(ctx, target, k, trace, slip=slip)
+            out = alternate(ctx, target, k, trace, rounds_cap, slip)
             last = trace[-1]
             quart = quartiles(ctx, out.v, out.r)
+            hist = ", ".join(f"{i}: {trace[i - 1][3]:.1e}" for i in (10, 30, 100, 300) if i <= len(trace))
             flips = [t[5] for t in trace]
             print(
                 f"| {prob.name} | {k} | {out.iterations}{'' if out.converged else '*'} | {trace[-1][0]} |"
                 f" {out.detail.split(', ')[1].split()[0]} ({ctx.slip_kept}) | {last[3]:.1e} | {last[4]:.1e} |"
                 f" {last[1]:.1e} / {last[2]:.1e} / {last[3]:.1e}, flips {flips[-1]} (max {max(flips)}),"
-                f" head {last[6]:.2f}, by height quarter {' / '.join(f'{q:.2f}' for q in quart)} |",
+                f" head {last[6]:.2f}, by height quarter {' / '.join(f'{q:.2f}' for q in quart)};"
+                f" residual at rounds {hist} |",
                 flush=True,
             )
 
@@ -279,6 +359,7 @@ if __name__ == "__main__":
     ap.add_argument("problems", nargs="+")
     ap.add_argument("--k", nargs="+", type=int, default=[0, 5, 20], help="engine sweeps a round; -1: 'once'")
     ap.add_argument("--target", type=float, default=1e-5)
-    ap.add_argument("--slip", default="guard", choices=["always", "guard", "none"])
+    ap.add_argument("--slip", default="guard", choices=["always", "guard", "none", "tresca"])
+    ap.add_argument("--rounds", type=int, default=ROUND_CAP, help="outer rounds at most")
     a = ap.parse_args()
-    _table(a.problems, a.k, a.target, a.slip)
+    _table(a.problems, a.k, a.target, a.slip, a.rounds)
