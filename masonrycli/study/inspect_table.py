@@ -64,6 +64,13 @@ def study_summary(path) -> tuple[list[tuple[str, str]], list[tuple[str, str]]]:
     from masonrycli.study.store import _read_table
 
     path = Path(path)
+    waiting = _journal_rows(path)
+    if not path.is_file() and waiting:  # killed (kill -9, out of memory) before it wrote its table: it said
+        # "no such file", as if the finished runs were lost
+        raise InputError(
+            f"{path}: not written yet — {_rows(waiting)} finished, in {path.name}.journal.jsonl (a study still "
+            "running, or killed before it wrote its table): the same masonry sweep command writes it and runs the rest"
+        )
     if not path.is_file():
         raise InputError(f"{path}: no such file")
     rows = _read_table(path)
@@ -93,6 +100,9 @@ def study_summary(path) -> tuple[list[tuple[str, str]], list[tuple[str, str]]]:
             else []
         ),
     ]
+    if rows and waiting:  # a resumed study still running, or killed: the table is of its last stop
+        more = f"{_rows(waiting)} finished since this table was written, in {path.name}.journal.jsonl"
+        table.insert(1, ("journal", f"{more} (the study still running, or killed: the same command adds them)"))
     if find:
         table.insert(1, ("search", f"--find {find}: {find}_threshold, {find}_lo, {find}_hi"))
     lines = []
@@ -122,6 +132,21 @@ def _header(path: Path) -> list[str]:
             return next(csv.reader(fh), [])
     except Exception:  # _read_table read it: a header it cannot give is no study's
         return []
+
+
+def _journal_rows(path: Path) -> int:
+    """Finished rows in the journal beside the table ``path`` (whole lines: a kill -9 may cut the last)."""
+    from masonrycli.study.store import journal_path
+
+    journal = journal_path(path)
+    if not journal.is_file():
+        return 0
+    with open(journal, errors="replace") as fh:
+        return sum(1 for line in fh if line.rstrip().endswith("}"))
+
+
+def _rows(n: int) -> str:
+    return f"{n} row{'s' if n != 1 else ''}"
 
 
 def _none_yet(path: Path) -> str:
