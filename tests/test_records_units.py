@@ -170,7 +170,7 @@ def test_a_csv_in_g_shakes_the_same_through_run_a_scenario_and_a_set(tmp_path):
     # sweep --records set alike; --record refused such a file at scale 1 ("a scale of 9.81 converts them")
     from masonrycli.scenario.builtin import record_motion_option
     from masonrycli.scenario.toml_file import loads_scenario
-    from masonrycli.study.plan import _record
+    from masonrycli.study.record_set import _record
 
     f = _g_csv(tmp_path / "q.csv")
     by_run = record_motion_option(f, 2.0)  # masonry run … --record q.csv --scale 2
