@@ -156,6 +156,9 @@ def _seed(folder: Path) -> None:
     (folder / "my-arch.toml").write_text((ROOT / "tests" / "data" / "arch_settlement.toml").read_text())
     for name, structure in (("wall", "wall"), ("my-wall", "wall"), ("rubble", "wall"), ("arch", "arch")):
         assert invoke("build", structure, "--out", folder / f"{name}.geojson").exit_code == 0
+    # limit.md's b.geojson: the filled bridge as 'masonry build arch … --fill-cover 0.3 --out b.geojson' writes it
+    bridge = ("--span", 8, "--rise", 2, "--ring-thickness", 0.5, "--pier-width", 3, "--pier-courses", 5)
+    assert invoke("build", "arch", *bridge, "--fill-cover", 0.3, "--out", folder / "b.geojson").exit_code == 0
     t, _, v, a = band_limited(1.0, 0.01, [1.0, 2.5], [0.01, 0.004])
     np.savetxt(folder / "table.csv", np.column_stack([t, v]), delimiter=",", header="time (s),vel (m/s)", comments="")
     write_at2(folder / "quake.AT2", a / 9.81, 0.01)
