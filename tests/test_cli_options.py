@@ -128,6 +128,16 @@ def test_sweep_help_gives_the_default_file_names():
     assert "(default: beside --out, .rrd)" in options["--recording"]
 
 
+def test_sweep_help_names_every_axis_a_study_takes():
+    # --param's help named amp, freq, phase, scale, friction, duration, dt and builder options, not pga_g
+    # (records scaled to a site's PGA), which the study has understood since 12380ab
+    from masonrycli.study import axes
+
+    names = [*axes.MOTION_PARAMS, axes.PGA_PARAM, "friction", "duration", "dt"]
+    param = _option_help(["sweep"])["--param"]
+    assert all(name in param for name in names), (names, param)
+
+
 def test_choice_options_take_any_case_and_help_lists_the_lower_case(tmp_path):
     # "sweep --im PGV" said "--im PGV: expected one of pga, pgv, arias, sa"; "limit --load Tilt",
     # "--direction -X", "--outcome Sliding" and "--solver NLGS" likewise

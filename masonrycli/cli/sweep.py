@@ -47,7 +47,8 @@ def sweep_command(
             "--param",
             "-p",
             help="An axis: NAME=LO:HI:N, NAME=a,b,c or NAME=value. Names: amp, freq, phase (the sine of the "
-            "moving supports; ground.amp for one), scale (records), friction, duration, dt, builder options.",
+            "moving supports; ground.amp for one), scale (records), pga_g (records scaled to peak at this PGA, in "
+            "g), friction, duration, dt, builder options.",
         ),
     ] = None,
     records: Annotated[
