@@ -1,6 +1,11 @@
 import os
 
 os.environ.setdefault("RERUN_ANALYTICS", "0")
+# The tests set the console's width themselves (COLUMNS in a CliRunner's env, or none: 80). One inherited from
+# the caller was read by rich when cli/messages.py made its Console at import and then fixed: a pytest-xdist
+# worker starts with COLUMNS=80 LINES=24 (readline sets them) and test_limit_cli's 250-column tables wrapped.
+for _name in ("COLUMNS", "LINES"):
+    os.environ.pop(_name, None)
 
 
 import signal  # noqa: E402

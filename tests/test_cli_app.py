@@ -11,7 +11,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from cli_helpers import assert_one_line_error, invoke, words
+from masonrycli.cli.app import app
+
+from cli_helpers import assert_one_line_error, invoke, runner, words
+
+WIDE = {"COLUMNS": "250"}
 
 DATA = Path(__file__).parent / "data"
 
@@ -215,7 +219,9 @@ def test_geometry_file_errors_are_one_line(tmp_path):
 
 def test_build_says_one_block_in_the_singular(tmp_path):
     # "wall: 1 blocks and 1 support → w.geojson"
-    result = invoke("build", "wall", "--blocks", 1, "--out", tmp_path / "w.geojson")
+    # a console wide enough for the path: at 80 columns one longer than the line is cut anywhere ("w.geojs on"),
+    # as under pytest-xdist, whose tmp_path is 10 characters longer (popen-gw0/)
+    result = runner.invoke(app, ["build", "wall", "--blocks", "1", "--out", str(tmp_path / "w.geojson")], env=WIDE)
     said = words(result.output)  # the console wraps a long path
     assert result.exit_code == 0 and f"wall: 1 block and 1 support → {tmp_path / 'w.geojson'}" in said
 
