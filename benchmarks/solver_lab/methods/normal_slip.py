@@ -24,7 +24,8 @@ centre of the solution set (every closed contact of a pair shares the load).
                 JOURNAL "nlgs-slip" measured from the reference's normals: 133 / 372 / 1400 / 3296 fine sweeps to
                 1e-5 m/s on the cold steps of 8 / 16 / 32 / 64 courses); "guard" (the METHODS): undone when it
                 raises the residual above (a)'s; "always": kept (k = 0 then diverges on wall-8-cold, residual 1e12
-                after 40 rounds); "none": skipped
+                after 40 rounds); "none": skipped; "tresca": replaced by the exact tangential sub-problem with the
+                normals held (tangential_solve: the two-block exact alternation)
             (c) k engine sweeps (plain Gauss–Seidel), k = 0, 5 or 20
     solve:  r = r_warm; repeat rounds until the RMS law residual of (v(r), r) ≤ target, ROUND_CAP rounds or CAP fine
             sweeps.
@@ -38,6 +39,8 @@ fine sweeps + the numpy / scipy CPU of (a) and (b) over one engine sweep's (not 
 
 from __future__ import annotations
 
+import sys
+
 import numpy as np
 
 from benchmarks.solver_lab import law
@@ -49,6 +52,8 @@ NORMAL_TOL = 1e-8
 """m/s: the normal solve stops when the RMS primal residual and RMS min(z, W_nn r_n) are both below this (1e-3 ×
 the lab's target; the factor's rounding stalls it near 1e-9 on wall-8-cold), or when its step falls below STALL."""
 STALL = 1e-6
+PROGRESS = 0
+"""CLI --progress: a line on stderr every this many rounds (0: none)."""
 SIGMA = 0.1
 """The tangential solve's centring parameter."""
 NORMAL_CAP = 100
@@ -263,6 +268,8 @@ def alternate(
         if trace is not None:
             share = float((e[head] ** 2).sum() / max((e * e).sum(), 1e-300))
             trace.append((done, res_a, res_b, res, law.velocity_error(p, v), flips, share))
+            if PROGRESS and rounds % PROGRESS == 0:
+                print(f"  {p.name} round {rounds}: residual {res:.2e} m/s, flips {flips}", file=sys.stderr, flush=True)
         if res <= target:
             ok = True
             break
@@ -361,5 +368,7 @@ if __name__ == "__main__":
     ap.add_argument("--target", type=float, default=1e-5)
     ap.add_argument("--slip", default="guard", choices=["always", "guard", "none", "tresca"])
     ap.add_argument("--rounds", type=int, default=ROUND_CAP, help="outer rounds at most")
+    ap.add_argument("--progress", type=int, default=0, help="a line on stderr every this many rounds")
     a = ap.parse_args()
+    PROGRESS = a.progress
     _table(a.problems, a.k, a.target, a.slip, a.rounds)
