@@ -12,6 +12,7 @@ import math
 import time as _time
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from datetime import datetime
 
 import numpy as np
 
@@ -129,6 +130,8 @@ class Simulation:
     def __init__(self, scenario, model: Model | None = None, tuning: Tuning = TUNING):
         # tuning: the contact solve's numbers (engine/tuning.py); the solver lab passes others
         self.scenario = scenario
+        # when the run started (its history, recording and in-memory run say the same second)
+        self.started = datetime.now().isoformat(timespec="seconds")
         self.model = model if model is not None else build_model(scenario)
         self.state: State = initial_state(self.model)
         self.solver = Solver(self.model, tuning)

@@ -156,3 +156,28 @@ def test_the_command_that_made_the_history_comes_first(tmp_path, monkeypatch):
         page.split("\n")[6]
         == f"| command | masonry simulate wall --blocks 12 --duration 0.01 --no-recording --history {npz} --force |"
     )
+
+
+def test_a_runs_outputs_say_one_start(tmp_path, monkeypatch):
+    # each output asked the clock when it was opened (execute.run_metadata): the history, the recording and the
+    # in-memory run could name seconds apart, and the page of the file differed from the run's own page (seen
+    # in CI: 'started' 15:45:15 against 15:45:14). A clock that moves a second at every question shows it.
+    import datetime as real
+    import json
+
+    from masonrycli import execute
+
+    class Ticking(real.datetime):
+        calls = 0
+
+        @classmethod
+        def now(cls, tz=None):
+            cls.calls += 1
+            return real.datetime(2026, 11, 29, 12, 0, cls.calls)
+
+    monkeypatch.setattr(execute, "datetime", Ticking)
+    npz, rrd = tmp_path / "w.npz", tmp_path / "w.rrd"
+    run = api.simulate("wall", duration=0.01, blocks=12, history=npz, recording=rrd)
+    with np.load(npz) as h:
+        started = json.loads(str(h["run"]))["started"]
+    assert rows(run.report())["started"] == started == rows(invoke("report", npz).output)["started"]
