@@ -12,13 +12,10 @@ import pytest
 from scipy.optimize import minimize
 
 from benchmarks.solver_lab import law
-from benchmarks.solver_lab.capture import SINE, capture_run, reference
 from benchmarks.solver_lab.methods import ipm as I
 from benchmarks.solver_lab.methods import normal_slip as NS
 from benchmarks.solver_lab.outcome import Context
 from masonrycli.engine import nlgs as N
-from masonrycli.run import Simulation
-from masonrycli.scenario.scenario import Material, RunConfig, scenario_from_builder
 from tests.solver_lab_helpers import tiny_cold_problem
 
 
@@ -29,14 +26,7 @@ def stack():
 
 @pytest.fixture(scope="module")
 def sliding():
-    sc = scenario_from_builder(
-        "wall", {"blocks": 7, "courses": 3}, RunConfig(duration=0.002), Material(), {"ground": SINE}
-    )
-    p = capture_run(Simulation(sc), typical_step=1)[0]["cold"]
-    p.name = "tiny-normal-slip"
-    reference(p)
-    assert p.ref_residual <= 1e-9
-    return p
+    return tiny_cold_problem(courses=3, name="tiny-normal-slip")
 
 
 def _held(ctx, sweeps=3):

@@ -13,15 +13,13 @@ import pytest
 from scipy.optimize import minimize
 
 from benchmarks.solver_lab import law
-from benchmarks.solver_lab.capture import SINE, capture_run, reference
 from benchmarks.solver_lab.methods import slip as S
 from benchmarks.solver_lab.methods import slip_oracle as O
 from benchmarks.solver_lab.methods import slip_realise as R
 from benchmarks.solver_lab.methods.accelerated import accelerated
 from benchmarks.solver_lab.outcome import Context
 from masonrycli.engine import nlgs as N
-from masonrycli.run import Simulation
-from masonrycli.scenario.scenario import Material, RunConfig, scenario_from_builder
+from tests.solver_lab_helpers import tiny_cold_problem
 
 
 def _random_chain(rng, n):
@@ -97,14 +95,7 @@ def test_chain_dual_is_the_dual_of_the_course_problem():
 
 @pytest.fixture(scope="module")
 def cold():
-    sc = scenario_from_builder(
-        "wall", {"blocks": 7, "courses": 3}, RunConfig(duration=0.002), Material(), {"ground": SINE}
-    )
-    p = capture_run(Simulation(sc), typical_step=1)[0]["cold"]
-    p.name = "tiny-slip"
-    reference(p)
-    assert p.ref_residual <= 1e-9
-    return p
+    return tiny_cold_problem(courses=3, name="tiny-slip")
 
 
 def test_courses_and_bed_joints(cold):

@@ -288,13 +288,7 @@ def once(ctx, target: float, sweeps: int = SWEEPS) -> dict:
     ctx.sweep(r, sweeps)
     r, v, its, res_a = outer_round(ctx, ops, chain, r, Clock())
     res_b = ctx.residual(v, r)
-    done = sweeps
-    while done < CAP:
-        n = max(10, done // 10)
-        v, _ = ctx.sweep(r, n)
-        done += n
-        if ctx.residual(v, r) <= target:
-            break
+    done, v = S.sweeps_to(ctx, r, target, CAP, sweeps, v)
     return {
         "fine": done,
         "factorisations": its,

@@ -80,6 +80,19 @@ class Chain:
     n: int
 
 
+def sweeps_to(ctx, r, target: float, cap: int = CAP, done: int = 0, v=None):
+    """Engine sweeps on ``r`` (in place) in chunks of max(10, a tenth of those done), so that the count is
+    within 10 % of the fewest that reach ``target`` (RMS law residual), until then or ``cap``:
+    (sweeps done in all, the last v; ``v`` if none was run)."""
+    while done < cap:
+        k = max(10, done // 10)
+        v, _ = ctx.sweep(r, k)
+        done += k
+        if ctx.residual(v, r) <= target:
+            break
+    return done, v
+
+
 def build_chain(p, pack) -> Chain:
     """Courses from the layers, joints from the contacts between consecutive layers (module doc, "chain")."""
     lay = layers(p)

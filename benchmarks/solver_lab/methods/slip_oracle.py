@@ -107,13 +107,7 @@ def oracle(ctx, kind: str, sweeps: int = S.SWEEPS, target: float = 1e-5, steps: 
         return r + R.min_norm(ctx, chain.course, chain.joint, r, sliding, None, dv=dv)
 
     def count(r, done=0):
-        while done < cap:
-            k = max(10, done // 10)
-            v, _ = ctx.sweep(r, k)
-            done += k
-            if ctx.residual(v, r) <= target:
-                break
-        return done
+        return S.sweeps_to(ctx, r, target, cap, done)[0]
 
     alone = count(p.r_warm.copy())
     r = p.r_warm.copy()
