@@ -30,6 +30,7 @@ def _model(rng, theta):
         body_inv_mass=np.where(dynamic, 1.0 / mass, 0.0),
         body_inv_inertia=np.where(dynamic, 1.0 / inertia, 0.0),
         friction=0.6,
+        block_applied=np.zeros((0, 6)),  # no applied force, as a built Model
     )
 
 
@@ -51,7 +52,7 @@ def test_a_step_of_the_theta_method_is_its_definition(theta):
 
     support_v = rng.normal(size=(SUPPORTS, 2))
     v_free = np.full((BODIES, 3), np.nan)
-    integrate.free_velocity(m, v, support_v, v_free)
+    integrate.free_velocity(m, v, support_v, v_free, q)
     _close(v_free[:BLOCKS, :2], v[:BLOCKS, :2] + m.dt * m.gravity)
     assert np.array_equal(v_free[:BLOCKS, 2], v[:BLOCKS, 2])
     assert np.array_equal(v_free[BLOCKS:, :2], support_v) and not v_free[BLOCKS:, 2].any()
@@ -120,7 +121,7 @@ def test_an_applied_force_adds_its_impulse_and_its_moment_about_the_turned_point
     support_v = rng.normal(size=(SUPPORTS, 2))
     plain, pushed = np.full((BODIES, 3), np.nan), np.full((BODIES, 3), np.nan)
     integrate.free_velocity(m, v, support_v, plain, q)
-    integrate.free_velocity(SimpleNamespace(**vars(m), block_applied=applied), v, support_v, pushed, q)
+    integrate.free_velocity(SimpleNamespace(**(vars(m) | {"block_applied": applied})), v, support_v, pushed, q)
     c, s = np.cos(q[2, 2]), np.sin(q[2, 2])
     r = (c * r0[2, 0] - s * r0[2, 1], s * r0[2, 0] + c * r0[2, 1])
     _close(pushed[2, :2], v[2, :2] + m.dt * (m.gravity + force[2] / m.body_mass[2]))

@@ -94,17 +94,19 @@ def begin_step(model, body_q: np.ndarray, body_v: np.ndarray, out_q: np.ndarray,
     return _begin_step(body_q, body_v, model.body_radius, model.dt, model.theta, out_q, out_v_old)
 
 
-NO_FORCE = np.zeros((0, 6))
-"""No block has an applied force (a model without ``block_applied``)."""
-
-
-def free_velocity(model, body_v: np.ndarray, support_v_next: np.ndarray, out: np.ndarray, body_q=None) -> None:
+def free_velocity(model, body_v: np.ndarray, support_v_next: np.ndarray, out: np.ndarray, body_q: np.ndarray) -> None:
     """Write v_free (B, 3): blocks get gravity (and their applied force, ``model.block_applied``, its point
     turned by ``body_q``'s θ) over dt, supports their imposed velocity at t_n+1."""
-    applied = getattr(model, "block_applied", NO_FORCE)
-    q = np.zeros_like(body_v) if body_q is None else body_q
     _free_velocity(
-        body_v, model.body_dynamic, model.gravity, model.dt, support_v_next, model.block_count, out, q, applied
+        body_v,
+        model.body_dynamic,
+        model.gravity,
+        model.dt,
+        support_v_next,
+        model.block_count,
+        out,
+        body_q,
+        model.block_applied,
     )
 
 
