@@ -91,7 +91,7 @@ def _path(value, option: str, *, output: bool = False) -> Path:
     an output's "x.rrd/" names a folder, where Path("x.rrd/") would have written the file x.rrd)."""
     import typer
 
-    from masonrycli.cli.options import file_path_value, path_value
+    from masonrycli.cli.option_values import file_path_value, path_value
 
     if not isinstance(value, (str, os.PathLike)):
         raise InputError(f"{option} {value!r}: a path (str or pathlib.Path), not a {type(value).__name__}")

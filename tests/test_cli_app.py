@@ -1,6 +1,7 @@
-"""The commands of masonrycli/cli/app.py as a user drives them: simulate, run, check, build and inspect on short
-runs, and their bad input as one line. Options and --help: test_cli_options.py; messages, a closed stdout
-and Ctrl-C: test_cli_messages.py; a run's outcomes (diverged, failed, unconverged): test_execute.py."""
+"""The commands of masonrycli/cli/app.py as a user drives them: simulate, run and check on short runs, and their
+bad input as one line. build: test_cli_build.py; inspect: test_cli_inspect_file.py; options and --help:
+test_cli_options.py; messages, a closed stdout and Ctrl-C: test_cli_messages.py; a run's outcomes (diverged,
+failed, unconverged): test_execute.py."""
 
 from __future__ import annotations
 
@@ -11,9 +12,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from masonrycli.cli.app import app
-
-from cli_helpers import assert_one_line_error, invoke, runner, words
+from cli_helpers import assert_one_line_error, invoke, words
 
 WIDE = {"COLUMNS": "250"}
 
@@ -217,58 +216,6 @@ def test_geometry_file_errors_are_one_line(tmp_path):
     assert_one_line_error(invoke("check", scen), "missing.geojson", "no such file")
 
 
-def test_build_says_one_block_in_the_singular(tmp_path):
-    # "wall: 1 blocks and 1 support → w.geojson"
-    # a console wide enough for the path: at 80 columns one longer than the line is cut anywhere ("w.geojs on"),
-    # as under pytest-xdist, whose tmp_path is 10 characters longer (popen-gw0/)
-    result = runner.invoke(app, ["build", "wall", "--blocks", "1", "--out", str(tmp_path / "w.geojson")], env=WIDE)
-    said = words(result.output)  # the console wraps a long path
-    assert result.exit_code == 0 and f"wall: 1 block and 1 support → {tmp_path / 'w.geojson'}" in said
-
-
-@pytest.mark.parametrize(
-    "builder, args, blocks, supports",
-    [
-        ("wall", ["--blocks", "51"], 51, 1),
-        ("wall", ["--blocks", "248"], 248, 1),
-        ("arch", [], 98, 2),
-    ],
-)
-def test_build_writes_geojson_that_runs(builder, args, blocks, supports, tmp_path):
-    """`masonry build` output: the right counts, convex, non-overlapping (checked with shapely), and the
-    same format runs directly and from a scenario file that gives its support a motion."""
-    from shapely.geometry import shape
-    from shapely.strtree import STRtree
-
-    out = tmp_path / f"{builder}.{'json' if supports == 2 else 'geojson'}"  # .json: `run` reads it as GeoJSON
-    result = invoke("build", builder, *args, "--out", out)
-    assert result.exit_code == 0, result.output
-    features = json.loads(out.read_text())["features"]
-    polys = [shape(f["geometry"]) for f in features if f["properties"]["role"] == "block"]
-    assert len(polys) == blocks
-    assert sum(f["properties"]["role"] == "support" for f in features) == supports
-    for p in polys:
-        assert p.convex_hull.area - p.area < 1e-12
-    tree = STRtree(polys)
-    for i, p in enumerate(polys):
-        for j in tree.query(p):
-            if j > i:
-                assert p.intersection(polys[j]).area < 1e-9
-    if builder == "wall" and blocks == 51:
-        npz = tmp_path / "direct.npz"
-        result = invoke("run", out, "--duration", 0.01, "--no-recording", "--history", npz)
-        assert result.exit_code == 0, result.output
-        assert np.load(npz)["block_q"].shape[1] == 51
-        scen = tmp_path / "shaken.toml"
-        scen.write_text(
-            f'[run]\nduration = 0.02\n[structure]\nfile = "{out.name}"\n[[support]]\nname = "ground"\n'
-            'motion = { kind = "sine", amplitude = 1.0, frequency = 2.0 }\n'
-        )
-        result = invoke("run", scen, "--no-recording", "--history", npz, "--force")
-        assert result.exit_code == 0, result.output
-        assert np.load(npz)["support_v"][-1, 0, 0] == pytest.approx(np.sin(2 * np.pi * 2 * 0.02))
-
-
 def test_a_float32_geojson_with_split_joints_runs(tmp_path):
     """The built-in aqueduct exported by a GIS / CAD tool in float32, a vertex in the middle of every edge: it
     was refused (exit 2: a rounded mid-edge vertex "not convex", or blocks 36 and 106 overlapping by 8e-9 m²);
@@ -285,16 +232,3 @@ def test_a_float32_geojson_with_split_joints_runs(tmp_path):
     result = invoke("run", out, "--duration", 0.05, "--no-recording")
     assert result.exit_code == 0, result.output
     assert "warning" not in result.output.lower(), result.output
-
-
-def test_inspect_summarises_a_recording(tmp_path):
-    rrd = tmp_path / "w.rrd"
-    assert invoke("simulate", "wall", "--duration", 0.03, "--out", rrd).exit_code == 0
-    result = invoke("inspect", rrd)
-    assert result.exit_code == 0, result.output
-    assert "masonry" in result.output and "/structure/plane/xy/blocks" in result.output
-    assert "steps          │ 0 … 30" in result.output  # from the initial frame (it began at 10)
-    bad = tmp_path / "bad.rrd"
-    bad.write_bytes(b"not a recording")
-    assert_one_line_error(invoke("inspect", bad), "bad.rrd")
-    assert_one_line_error(invoke("inspect", tmp_path / "missing.rrd"), "missing.rrd")

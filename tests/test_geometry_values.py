@@ -184,7 +184,7 @@ def test_material_outside_its_range_is_absurd():
 
 
 def test_a_typed_number_writes_and_hashes_as_the_float_it_is():
-    # An option's value keeps its text for messages only (cli_options.number_value): every value written
+    # An option's value keeps its text for messages only (cli.option_values.number_value): every value written
     # or digested from a scenario must be the plain float's, and a Dask worker's copy keeps the text.
     import json
     import pickle

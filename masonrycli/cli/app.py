@@ -3,16 +3,17 @@
 from __future__ import annotations
 
 import inspect
-import os
 import sys
-from pathlib import Path
 from typing import Annotated
 
 import typer
 
-from geometry_library.blocks import GeometryError
 from masonrycli import __version__
-from masonrycli.cli.messages import OneLineUsageErrors, console, err_console, fail, say, user_errors, warn
+from masonrycli.cli.build import build_app
+from masonrycli.cli.execution import execute_and_exit
+from masonrycli.cli.inspect_file import inspect_command
+from masonrycli.cli.messages import OneLineUsageErrors, console, err_console, user_errors
+from masonrycli.cli.option_values import choice_value
 from masonrycli.cli.options import (
     ANY_STRUCTURE,
     AQUEDUCT,
@@ -20,7 +21,6 @@ from masonrycli.cli.options import (
     BLOCK_MATERIAL,
     FORCE,
     FRICTION,
-    GEO_OUT,
     OUTPUT,
     RECORD,
     RUN,
@@ -42,12 +42,9 @@ from masonrycli.cli.options import (
     ThrustOption,
     VerifyOption,
     WorstOption,
-    checked_outputs,
-    choice_value,
     file_defaults,
     with_options,
 )
-from masonrycli.errors import EXIT_DIVERGED, EXIT_INTERNAL, EXIT_OUTPUT_FAILED, InputError
 
 
 class _InTheOrderUsersMeetThem(OneLineUsageErrors):
@@ -71,7 +68,6 @@ app = typer.Typer(
     "the cell stress and strain tensors of Chetouane et al. (2003), Rerun recordings.",
 )
 simulate_app = typer.Typer(no_args_is_help=True, help="Build a structure, load it and record the run.")
-build_app = typer.Typer(no_args_is_help=True, help="Build a structure and write it as GeoJSON.")
 app.add_typer(simulate_app, name="simulate")
 app.add_typer(build_app, name="build")
 
@@ -91,79 +87,6 @@ def main_callback(
     """masonry: rigid-block dynamics of dry-stone masonry."""
 
 
-# -- shared options -------------------------------------------------------------------------------
-# Each group maps a parameter name to its option; ``with_options`` adds groups to a command, so the
-# commands that share them declare each option once.
-
-
-def _execute(scenario, opts: dict, hint=None) -> None:
-    """Check the outputs (``opts``: the OUTPUT, FORCE and STOP options), run, print the summary; exit with
-    the code of how the run ended. ``hint``: the line under the summary, given the time the run reached."""
-    from masonrycli.interrupt import StopSignals
-    from masonrycli.scenario.caveats import scenario_warnings
-
-    outputs = checked_outputs(scenario, opts)
-    for warning in scenario_warnings(scenario):
-        warn(warning)
-    # The run's handlers stay installed through the summary: once execute() had put Python's back, a Ctrl-C
-    # while the summary was printed said "Ctrl-C: stopped before any output was written" (exit 130) of a
-    # run whose files had just been renamed into place, and a SIGTERM killed the process mid-table (-15).
-    with StopSignals() as signals:
-        _execute_and_report(scenario, opts, hint, outputs, signals)
-
-
-def _execute_and_report(scenario, opts: dict, hint, outputs, signals) -> None:
-    """:func:`_execute`'s run and summary, under ``signals``."""
-    from masonrycli.execute import execute, print_summary
-    from masonrycli.interrupt import StopRun, exit_code, signal_name
-    from masonrycli.outputs.sinks import DIVERGED, FAILED, INTERRUPTED
-
-    try:
-        outcome = execute(
-            scenario,
-            outputs,
-            console=console,
-            stop_at_collapse=opts["stop_at_collapse"],
-            magnify=opts["magnify"],
-            signals=signals,
-        )
-    except StopRun as stop:
-        fail(f"{signal_name(stop.signum)} before the first step: nothing was written", exit_code(stop.signum))
-    except (InputError, GeometryError):
-        raise
-    except Exception as exc:  # an engine bug: say so in one line, keep what was computed
-        if os.environ.get("MASONRY_DEBUG"):
-            raise
-        say(
-            "internal error",
-            "bold red",
-            f"{type(exc).__name__}: {exc} — the recording and history hold every frame computed before it"
-            " (MASONRY_DEBUG=1 shows the traceback)",
-        )
-        raise typer.Exit(EXIT_INTERNAL) from None
-    result = outcome.result
-    try:
-        print_summary(console, outcome, scenario, hint(result.time) if hint is not None and result is not None else "")
-        for error in outcome.errors:
-            say("error", "bold red", f"cannot write {error}")
-        if signals.signum is not None and (outcome.signum is None or result.status != INTERRUPTED):
-            # it came once the last step was over
-            say(
-                "note",
-                "yellow",
-                f"{signal_name(signals.signum)} after the last step: the run {result.status} and its files are whole",
-            )
-    except OSError:  # the terminal is gone (SIGHUP: the files are closed, whole): the exit code still says how
-        if signals.signum is None:
-            raise
-    if outcome.errors or result.status == FAILED:
-        raise typer.Exit(EXIT_OUTPUT_FAILED)
-    if signals.signum is not None:
-        raise typer.Exit(exit_code(signals.signum))
-    if result.status == DIVERGED:
-        raise typer.Exit(EXIT_DIVERGED)
-
-
 def _pop(opts: dict, *groups: dict) -> dict:
     """The options of ``groups`` taken out of ``opts``."""
     return {k: opts.pop(k) for group in groups for k in group}
@@ -181,7 +104,7 @@ def _simulate(name: str, opts: dict) -> None:
     scenario = with_pga(builtin(name, **opts), pga, opts["scale"])
     scenario = settled_scenario(scenario, settle)  # as run's _load: before the run, not part of it
     supports = {s.name: m.describe() for s, m in zip(scenario.assembly.supports, scenario.motions)}
-    _execute(scenario, outputs, lambda reached: paper_instant_hint(name, scenario.run, supports, reached))
+    execute_and_exit(scenario, outputs, lambda reached: paper_instant_hint(name, scenario.run, supports, reached))
 
 
 @simulate_app.command("wall")
@@ -241,7 +164,7 @@ def run_command(scenario_file: ScenarioFile, **opts) -> None:
     """Run any scenario file, or a GeoJSON / WKT geometry file (supports fixed, or shaken by --record: the one
     support, or those marked driven); options given here override the file's values."""
     scenario = _load(scenario_file, opts)
-    _execute(scenario, opts)
+    execute_and_exit(scenario, opts)
 
 
 def _register_sweep() -> None:
@@ -273,6 +196,7 @@ def _register_export() -> None:
 
 
 _register_export()
+app.command("inspect")(user_errors(inspect_command))
 
 
 @app.command("limit")
@@ -336,119 +260,6 @@ def limit_command(
         point_force=point_force,
         spread=spread,
     )
-
-
-def _write_assembly(builder: str, opts: dict) -> None:
-    """Build, check and write the GeoJSON under a temporary name, renamed onto ``--out`` when complete."""
-    from geometry_library.checks import validate_assembly
-    from geometry_library.io import write_geojson
-    from masonrycli.outputs.files import check_output, written_whole
-    from masonrycli.scenario.builtin import build_assembly
-
-    # .json too: `masonry run` reads a .json file as GeoJSON (GEOMETRY_SUFFIXES), build refused to write one
-    target = check_output(opts.pop("out"), "--out", (".geojson", ".json"), opts.pop("force"))
-    assembly = build_assembly(builder, **opts)
-    for warning in validate_assembly(assembly):
-        warn(warning)
-    from masonrycli.interrupt import StopSignals, exit_code, signal_name
-
-    out = target.path
-    # A signal waits until the file is whole and said: a Ctrl-C just after the rename said "Ctrl-C: stopped
-    # before any output was written" of the file written, a SIGTERM there killed the command (-15).
-    with StopSignals() as signals:
-        signals.closing()
-        with written_whole(target) as part:
-            write_geojson(assembly, part)
-        console.print(
-            f"{builder}: {assembly.block_count} block{'s' if assembly.block_count != 1 else ''} and "
-            f"{assembly.support_count} support{'s' if assembly.support_count != 1 else ''} → {out}"
-        )
-    if signals.signum is not None:
-        say("note", "yellow", f"{signal_name(signals.signum)} while {out} was written: it is whole")
-        raise typer.Exit(exit_code(signals.signum))
-
-
-@build_app.command("wall")
-@user_errors
-@with_options(GEO_OUT, WALL, BLOCK_MATERIAL, FORCE)
-def build_wall_command(**opts) -> None:
-    """A running-bond wall on its ground."""
-    _write_assembly("wall", opts)
-
-
-@build_app.command("arch")
-@user_errors
-@with_options(GEO_OUT, ARCH, BLOCK_MATERIAL, FORCE)
-def build_arch_command(**opts) -> None:
-    """A semicircular arch on two piers, each on its foundation; segmental with --rise below span / 2."""
-    _write_assembly("arch", opts)
-
-
-@build_app.command("aqueduct")
-@user_errors
-@with_options(GEO_OUT, AQUEDUCT, BLOCK_MATERIAL, FORCE)
-def build_aqueduct_command(**opts) -> None:
-    """The arch plus spandrel walls in running bond up to a level top."""
-    _write_assembly("aqueduct", opts)
-
-
-@app.command("inspect")
-@user_errors
-def inspect_command(
-    recording: Annotated[
-        Path, typer.Argument(help="Recording (.rrd), run history (.npz) or study table.", metavar="REC.rrd|H.npz|S.csv")
-    ],
-) -> None:
-    """Summarise a recording (scenario, frames, time span, entities), a run history (its parameters,
-    status, frames and each array's unit) or a study's table (its rows and each column's unit)."""
-    from masonrycli.outputs.inspect_history import inspect_history, is_history
-    from masonrycli.study.inspect_table import is_study_table, study_summary
-
-    if recording.is_file() and recording.stat().st_size == 0:  # rerun's "file too small to be an RRD", a zip error
-        raise InputError(f"{recording}: an empty file (0 bytes), not a recording or a history")
-    if is_study_table(recording):
-        from masonrycli.outputs.report import columns_lines
-
-        table, lines = columns_lines(
-            f"{recording} — study table", *study_summary(recording), "column", "unit / meaning"
-        )
-        console.print(table)
-        for line in lines:
-            console.print(line, soft_wrap=True)
-        return
-    if is_history(recording):
-        from masonrycli.outputs.report import history_tables
-
-        table, lines = history_tables(str(recording), inspect_history(recording))
-        console.print(table)
-        for line in lines:
-            console.print(line, soft_wrap=True)
-        return
-    from masonrycli.outputs.report import recording_table
-    from masonrycli.recording import inspect_recording, recording_path_problem
-
-    problem = recording_path_problem(recording)
-    if problem:
-        raise InputError(problem)
-    try:
-        info = inspect_recording(recording)
-    except ValueError as exc:  # the reader's own words: the file holds no complete recording
-        raise InputError(f"{recording}: not a readable Rerun recording: {exc}") from None
-    except Exception as exc:  # a corrupt or foreign file: say so in one line
-        raise InputError(f"{recording}: not a readable Rerun recording ({type(exc).__name__}: {exc})") from None
-    console.print(recording_table(str(recording), info))
-    if info.get("metadata"):
-        console.print(info["metadata"])
-    if info["truncated"]:
-        from masonrycli.outputs.files import part_writer
-
-        pid = part_writer(recording)
-        why = (
-            f"a run still going (pid {pid}) writes it"
-            if pid
-            else "its writer did not finish: killed, or the disk was full"
-        )
-        warn(f"{recording}: truncated ({why}) — {info['frames']} frames up to its last complete chunk")
 
 
 @app.command("docs")

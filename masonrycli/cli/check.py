@@ -9,6 +9,7 @@ from typing import Annotated
 
 import typer
 
+from masonrycli.cli.execution import checked_outputs
 from masonrycli.cli.messages import console, warn
 from masonrycli.cli.options import (
     ANY_STRUCTURE,
@@ -23,7 +24,6 @@ from masonrycli.cli.options import (
     STOP,
     STRUCTURE_OPTIONS,
     SURVEY,
-    checked_outputs,
     file_defaults,
     with_options,
 )

@@ -9,7 +9,7 @@ from typing import Annotated
 
 import typer
 
-from masonrycli.cli.options import file_path_value, path_value
+from masonrycli.cli.option_values import file_path_value, path_value
 
 
 def report_command(

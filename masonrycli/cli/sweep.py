@@ -14,14 +14,10 @@ from typing import TYPE_CHECKING, Annotated
 
 import typer
 
+from masonrycli.cli.option_values import choice_value, file_path_value, number_value, path_value, whole_value
 from masonrycli.cli.options import (
     SETTLE,
     SURVEY,
-    choice_value,
-    file_path_value,
-    number_value,
-    path_value,
-    whole_value,
     with_options,
 )
 from masonrycli.errors import EXIT_DIVERGED, EXIT_OUTPUT_FAILED, EXIT_ROWS_FAILED
