@@ -87,7 +87,7 @@ def check_run(
 ) -> Outputs:
     """Everything checked before a run (what ``masonry check`` stops after): the time step against the
     supports' motions, ``--magnify``, then the outputs (:func:`plan_outputs`). Raises InputError."""
-    from masonrycli.scenario.scenario import check_sampling
+    from masonrycli.scenario.sampling import check_sampling
 
     check_sampling(scenario)
     check_magnify(magnify, no_recording)

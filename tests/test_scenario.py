@@ -1,4 +1,5 @@
-"""Scenario data classes and constructors: loading the example files, defaults, config checks, sampling."""
+"""Scenario data classes and constructors: loading the example files, defaults, config checks. The sampling
+check (too fast a sine or a support): test_scenario_sampling.py."""
 
 from __future__ import annotations
 
@@ -11,7 +12,7 @@ from scenario_helpers import BLOCK, DATA, GROUND, write
 
 from geometry_library.blocks import Assembly, Block, Support
 from masonrycli.errors import InputError
-from masonrycli.scenario.motion import Constant, Fixed, Sine
+from masonrycli.scenario.motion import Fixed, Sine
 from masonrycli.scenario.scenario import (
     Material,
     RunConfig,
@@ -135,60 +136,6 @@ def test_a_hand_made_block_is_simulated_as_validate_assembly_checked_it():
         InputError, match=r'^block 1 \("dented"\): polygon is not convex \(reflex vertex at \(0.15, 0.001\)\)$'
     ):
         scenario(1e-3)
-
-
-def test_check_sampling_refuses_a_sine_above_half_the_step_rate():
-    from masonrycli.scenario.scenario import check_sampling
-
-    scenario = load_scenario(DATA / "block_on_ground.toml")  # 2 Hz, dt = 1e-3 s
-    check_sampling(scenario)
-    fast = dataclasses.replace(scenario, run=dataclasses.replace(scenario.run, dt=0.2))  # 2 Hz × 0.2 s = 0.4
-    check_sampling(fast)  # 2.5 steps a period: still followed
-    # two steps a period sample sin(π·k) = 0: the wall's ground never moved (PGA 3e-15 m/s², exit 0)
-    at_limit = dataclasses.replace(scenario, run=dataclasses.replace(scenario.run, dt=0.25))
-    with pytest.raises(InputError, match=r'support "ground": frequency = 2 Hz is at 1/\(2 dt\) = 2 Hz: steps of'):
-        check_sampling(at_limit)
-    too_fast = dataclasses.replace(scenario, run=dataclasses.replace(scenario.run, dt=0.5))
-    with pytest.raises(
-        InputError, match=r'block_on_ground.toml:26: support "ground": frequency = 2 Hz is above 1/\(2 dt\) = 1 Hz'
-    ):
-        check_sampling(too_fast)
-    still = dataclasses.replace(too_fast, motions=(dataclasses.replace(too_fast.motions[0], amplitude=0.0),))
-    check_sampling(still)  # a sine of zero amplitude moves nothing: any frequency
-
-
-def test_check_sampling_refuses_a_support_faster_than_a_diverged_block():
-    # --amp 1e30 ran (exit 0, "collapsed at t = 0.001 s"), --settlement 1e9 too, and a CSV record of
-    # 1e300 m/s printed numpy's overflow warnings: a support that fast is a typo, refused like the others
-    from masonrycli import run as run_module
-    from masonrycli.records.motion import Record
-    from masonrycli.scenario.motion import Ramp
-    from masonrycli.scenario.scenario import MAX_SUPPORT_SPEED, check_sampling
-
-    scenario = load_scenario(DATA / "block_on_ground.toml")  # 1 m/s sine, 1 s
-    assert MAX_SUPPORT_SPEED == run_module.DIVERGENCE_SPEED  # what the run itself calls diverged
-
-    def moving(motion):
-        return dataclasses.replace(scenario, motions=(motion,))
-
-    check_sampling(moving(dataclasses.replace(scenario.motions[0], amplitude=-1000.0)))  # at the limit
-    with pytest.raises(InputError) as info:
-        check_sampling(moving(dataclasses.replace(scenario.motions[0], amplitude=1e30)))
-    assert str(info.value) == (
-        f'{scenario.source}: support "ground": sine 1e+30 m/s · sin(2π·2 Hz·t) along (1, 0) moves at up to '
-        "1e+30 m/s, more than 1000 m/s (a likely typo: a block that fast is a diverged run)"
-    )
-    with pytest.raises(InputError, match=r"constant velocity \(0, -1e\+09\) m/s moves at up to 1e\+09 m/s"):
-        check_sampling(moving(Constant(velocity=(0.0, -1e9))))
-    # a ramp reaches a·min(until, duration): 2000 m/s² for the run's 1 s is too fast, for 0.4 s not
-    with pytest.raises(InputError, match=r"moves at up to 2e\+03 m/s"):
-        check_sampling(moving(Ramp(acceleration=(2000.0, 0.0))))
-    check_sampling(moving(Ramp(acceleration=(2000.0, 0.0), until=0.4)))
-    # a record: what it reaches within the run (its samples after the run's end do not count)
-    fast_late = Record(time=(0.0, 1.0, 2.0, 3.0), value=(0.0, 1.0, 1.0, 1e300), quantity="velocity")
-    check_sampling(moving(fast_late))
-    with pytest.raises(InputError, match=r"record of velocity \(inline, 4 samples, 0–3 s\).* up to 1e\+300 m/s"):
-        check_sampling(dataclasses.replace(moving(fast_late), run=dataclasses.replace(scenario.run, duration=3.0)))
 
 
 def test_an_initial_velocity_faster_than_a_diverged_block_is_refused(tmp_path):

@@ -195,7 +195,8 @@ def apply_point(base, params: dict):
     Order: builder options (rebuild), run and material settings, the record, then motion parameters
     (so ``scale`` applies to the record chosen on the same point). Raises :class:`InputError`.
     """
-    from masonrycli.scenario.scenario import check_sampling, scenario_from_builder
+    from masonrycli.scenario.sampling import check_sampling
+    from masonrycli.scenario.scenario import scenario_from_builder
 
     scenario = base.scenario
     builder = scenario.structure.get("builder")
