@@ -8,11 +8,13 @@ from __future__ import annotations
 import dataclasses
 
 import pytest
+from shapely.geometry import box
 
+from geometry_library.blocks import Block, GeometryError
 from geometry_library.builders import build_arch
 from geometry_library.builders.arch import ArchSpec, arch_parts, fill_level
 from geometry_library.builders.wall import WallSpec
-from geometry_library.fill import level_from_carried
+from geometry_library.fill import fill_over, level_from_carried
 from geometry_library.io import read_geojson, write_geojson
 
 BRIDGE = {"span": 8.0, "rise": 2.0, "ring_thickness": 0.5, "pier_width": 3.0, "pier_courses": 5}
@@ -51,3 +53,26 @@ def test_carried_masses_that_are_not_one_fill_give_none():
     centre = wall[top].polygon.centroid
     # a point mass on one stone of a wall (a statue): no fill of any level has its centroid there
     assert level_from_carried(_with(wall, top, carried_mass=500.0, carried_at=(centre.x, centre.y + 0.5))) is None
+
+
+def test_a_fill_level_at_the_skewbacks_top_is_no_fill_and_says_so():
+    """'masonry build arch --span 8 --rise 2 ... --fill-to 0.3' levels the fill with the skewbacks' top, which the
+    builder computes as 1.2999999999999994 m: each skewback carried a column 6e-16 m high (3.5e-12 kg), a file of
+    it was no fill ('--spread: no fill to spread through') and the run's table said a 7e-12 kg fill. The skewbacks'
+    top is 0.3 m above the springing line (R = 5 m, the springing joint's normal at 53.13° from the vertical, a
+    0.5 m ring: 0.5 cos 53.13° = 0.3) and the ring rises from there, so that level carries no fill at all: refused,
+    naming that height. Just above it the skewbacks carry their columns (a 2.6 m wide top under 1 cm: 52 kg)."""
+    with pytest.raises(GeometryError, match=r"fill_to 0.3 m .*lowest top .* is 0.3 m above the springing line"):
+        ArchSpec(**BRIDGE, fill_to=0.3).build()
+    blocks = ArchSpec(**BRIDGE, fill_to=0.31).build().blocks
+    skewback = next(b for b in blocks if b.name == "left-skewback")
+    assert skewback.carried_mass == pytest.approx(2000.0 * 2.6 * 0.01, rel=1e-9)
+    assert min(b.carried_mass for b in blocks if b.carried_mass > 0.0) > 1e-3  # kg: no round-off columns
+
+
+def test_a_top_at_the_level_but_for_round_off_carries_nothing():
+    """A block whose top is the fill's level less 6e-16 m (as the builder's skewbacks were) carries no column."""
+    low = Block(box(0.0, 0.0, 1.0, 1.2999999999999994), "low")
+    high = Block(box(1.0, 0.0, 2.0, 1.0), "high")
+    fill = fill_over([low, high], 1.3, 0.0, 2.0)
+    assert fill.area[0] == 0.0 and fill.area[1] == pytest.approx(0.3, rel=1e-12)

@@ -40,7 +40,7 @@ from shapely.geometry import box
 from shapely.ops import unary_union
 
 from ..blocks import SUPPORT_ROLES, Assembly, Block, GeometryError, Support
-from ..fill import with_fill
+from ..fill import top_surface, with_fill
 from ..values import (
     DIMENSION_RANGE,
     MATERIAL_RANGE,
@@ -161,7 +161,20 @@ class ArchSpec:
         if level is not None:
             density = FILL_DENSITY if self.fill_density is None else self.fill_density
             blocks = with_fill(blocks, level, density, -geometry.half_width, geometry.half_width)
+            if not any(b.carried_mass > 0.0 for b in blocks):  # only fill_to can: a cover is over the crown
+                raise GeometryError(
+                    f"arch: fill_to {self.fill_to:g} m puts the fill's surface at or below the blocks' top "
+                    f"everywhere (their lowest top between the piers' outer faces is {_lowest_top(blocks, geometry):.4g} m "
+                    "above the springing line): there is no fill; give a higher fill_to",
+                    keys=("fill_to",),
+                )
         return Assembly(tuple(blocks), tuple(supports))
+
+
+def _lowest_top(blocks, geometry: ArchGeometry) -> float:
+    """m above the springing line: the lowest point of the blocks' top surface between the piers' outer faces."""
+    pieces = top_surface(blocks, -geometry.half_width, geometry.half_width)
+    return min(min(p.y(p.a), p.y(p.b)) for p in pieces) - geometry.springing
 
 
 ABUTMENTS = ("courses", "solid", "fixed")
