@@ -94,7 +94,7 @@ def test_scenario_format_tables_list_every_key_the_reader_takes():
     import dataclasses
 
     from masonrycli.scenario.scenario import Material, RunConfig
-    from masonrycli.scenario.toml_file import BLOCK_KEYS, SUPPORT_KEYS
+    from masonrycli.scenario.toml_bodies import BLOCK_KEYS, SUPPORT_KEYS
 
     text = (ROOT / "docs" / "scenario-format.md").read_text()
     assert _table_keys(text, "## `[run]`") == {f.name for f in dataclasses.fields(RunConfig)}

@@ -15,7 +15,7 @@ from masonrycli.errors import InputError
 from masonrycli.records.motion import Record
 from masonrycli.records.read import record_motion
 from masonrycli.scenario.motion import Constant, Fixed, Ramp, Sine, support_velocity
-from masonrycli.scenario.toml_file import MOTION_KINDS
+from masonrycli.scenario.toml_bodies import MOTION_KINDS
 
 DATA = Path(__file__).parent / "data"
 T = np.linspace(-0.5, 3.0, 1401)

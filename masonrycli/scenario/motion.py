@@ -4,7 +4,7 @@ A support (ground, foundation pad) translates with an imposed velocity. Each mot
 its velocity history (:meth:`velocity_at`, vectorised over time), a one-line description
 (:meth:`describe`) and its TOML spelling (``TOML_KEYS``, ``TOML_REQUIRED``, :meth:`toml_fields`);
 :func:`support_velocity` evaluates all supports of a scenario at many instants at once. The TOML
-``kind`` -> class table is ``masonrycli.scenario.toml_file.MOTION_KINDS``.
+``kind`` -> class table is ``masonrycli.scenario.toml_bodies.MOTION_KINDS``.
 
 Kinds
 -----

@@ -189,3 +189,13 @@ def check_samples(key: str, seq, pairs: bool = False) -> np.ndarray:
         checked = np.array([check(f"{key}[{i}]", x) for i, x in enumerate(items)], dtype=np.float64)
     checked.setflags(write=False)
     return checked
+
+
+WORD_KEYS = frozenset({"solver", "quantity", "baseline"})
+"""Keys whose value is a word of a fixed list, read in any case as a motion's ``kind`` and the command line's
+``--solver NLGS`` (``solver = "NLGS"`` was refused)."""
+
+
+def lower_words(table: dict) -> dict:
+    """``table`` with the values of :data:`WORD_KEYS` stripped and in lower case."""
+    return {k: v.strip().lower() if k in WORD_KEYS and isinstance(v, str) else v for k, v in table.items()}
