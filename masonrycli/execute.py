@@ -154,6 +154,14 @@ class Outcome:
     ``--history`` file holds."""
 
 
+def _one_or_range(values: list[float], default: float) -> float | list[float]:
+    """The blocks' one value, or [least, greatest] when they differ; ``default`` for no block."""
+    if not values:
+        return float(default)
+    lo, hi = float(min(values)), float(max(values))
+    return lo if lo == hi else [lo, hi]
+
+
 def run_metadata(scenario, sim: Simulation) -> dict:
     """Scenario and parameters for the recording's metadata document (its Parameters table, a history's ``run``);
     ``sim``: the :class:`Simulation`, or only its Model (``masonry limit --out``: the same table, no time loop)."""
@@ -184,8 +192,9 @@ def run_metadata(scenario, sim: Simulation) -> dict:
         "record_every": run.record_every,
         "alert_distance_m": run.alert_distance,
         "friction": mat.friction,
-        "density_kg_m3": mat.density,
-        "thickness_m": mat.thickness,
+        # the blocks' own (a file's per-stone density column; the report said the default 2500 of a 2300 survey)
+        "density_kg_m3": _one_or_range([b.density for b in scenario.assembly.blocks], mat.density),
+        "thickness_m": _one_or_range([b.thickness for b in scenario.assembly.blocks], mat.thickness),
         "masonry": __version__,
         "commit": source_commit(),
         "source_digest": SOURCE_DIGEST,

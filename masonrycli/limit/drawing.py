@@ -102,8 +102,23 @@ def _parameters(scenario, result: LimitResult) -> dict:
 
     if result.settled is not None:
         scenario = replace(scenario, reading={**scenario.reading, "settle_s": float(result.settled.duration)})
-    parameters = run_metadata(scenario, result.model)
+    parameters = {k: v for k, v in run_metadata(scenario, result.model).items() if k not in TIME_LOOP}
     return {**parameters, "supports": dict.fromkeys(parameters["supports"], "fixed")}
+
+
+TIME_LOOP = (
+    "duration_s",
+    "dt_s",
+    "theta",
+    "nlgs_tolerance",
+    "nlgs_max_iterations",
+    "solver",
+    "record_every",
+    "baseline_corrections",
+)
+"""run_metadata's keys of the time loop, left out of a limit recording's Parameters table: one LP runs no time
+step, no Gauss–Seidel, records no frame and applies no record ('masonry limit arch --out' said dt 0.001, duration
+5 s, solver nlgs-accel32, a tolerance; --settle and --verify run the engine at their own settings, said apart)."""
 
 
 def write_recording(result: LimitResult, out: Path, scenario=None) -> None:

@@ -216,7 +216,7 @@ def run_rows(info: dict) -> list[tuple[str, str]]:
         rows.append(("loading", "\n".join(f"{name}: {motion}" for name, motion in loading.items())))
     mu, rho, thick = get("friction"), get("density_kg_m3"), get("thickness_m")
     if given(mu, rho, thick):
-        rows.append(("material", f"friction {mu:g}, density {rho:g} kg/m³, thickness {thick:g} m"))
+        rows.append(("material", f"friction {mu:g}, density {_value(rho)} kg/m³, thickness {_value(thick)} m"))
     version, commit, digest = get("masonry"), get("commit"), get("source_digest")
     rows.append(
         (
@@ -241,6 +241,13 @@ def run_rows(info: dict) -> list[tuple[str, str]]:
     if not info["units_recorded"]:
         rows.append(("units", f"{NOT_RECORDED} in this file (masonry docs readme, 'What a run writes', lists them)"))
     return rows
+
+
+def _value(value) -> str:
+    """A material value: one number, or the blocks' [least, greatest] when they differ ("2300–2700 (per block)")."""
+    if isinstance(value, (list, tuple)) and len(value) == 2:
+        return f"{value[0]:g}–{value[1]:g} (per block)"
+    return f"{value:g}"
 
 
 def _or(value, unit: str) -> str:
