@@ -33,6 +33,7 @@ import difflib
 import io
 import os
 import warnings
+import weakref
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -119,11 +120,12 @@ def scenario(target, **options):
         )
     _check_names(target, options)
     options = {k: v for k, v in options.items() if v is not None}
+    call = _call("scenario", target, options)  # as given: the record's path before it is read as a path
     if "record" in options:
         options["record"] = _path(options["record"], "--record")
     try:
         if isinstance(target, Scenario):
-            return override_run(target, **options)
+            return _made(override_run(target, **options), call)
         settle = options.pop("settle", None)  # the engine, as the command line: `masonry simulate` / `run --settle`
         pga = _pga(options.pop("pga", None))  # the record's scale, once the scenario is built
         if is_built_in(target):
@@ -131,9 +133,44 @@ def scenario(target, **options):
         else:
             survey = {k: options.pop(k) for k in ("units", "flip_y", "convex_hull", "trim_overlaps") if k in options}
             made = file_scenario(target, survey=survey, **options)  # as `masonry run` loads it
-        return settled_scenario(with_pga(made, pga, options.get("scale")), settle)
+        return _made(settled_scenario(with_pga(made, pga, options.get("scale")), settle), call)
     except GeometryError as exc:  # the command line's one line, as the one error type of bad input
         raise InputError(str(exc).splitlines()[0] if str(exc) else type(exc).__name__) from None
+
+
+_CALLS: dict[int, tuple[weakref.ref, str]] = {}
+"""id(Scenario) -> (the Scenario, weakly; the ``api.scenario(…)`` call that made it): what a run of it names."""
+
+
+def _made(made, call: str):
+    """``made``, remembered as made by ``call`` (its entry removed with it)."""
+    key = id(made)
+    _CALLS[key] = (weakref.ref(made, lambda _, key=key: _CALLS.pop(key, None)), call)
+    return made
+
+
+def _argument(value) -> str:
+    """A keyword's value as the call's text: a path as its string, a numpy number as the number, a function by
+    its name (its repr holds an address, another every run), a Scenario by the call that made it."""
+    from masonrycli.scenario.scenario import Scenario
+
+    if isinstance(value, os.PathLike):
+        return repr(os.fspath(value))
+    if isinstance(value, np.generic):
+        return repr(value.item())
+    if isinstance(value, Scenario):
+        entry = _CALLS.get(id(value))
+        return entry[1] if entry is not None and entry[0]() is value else f"<Scenario {value.name!r}>"
+    if callable(value):
+        return f"<function {getattr(value, '__name__', type(value).__name__)}>"
+    return repr(value)
+
+
+def _call(function: str, target, options: dict) -> str:
+    """``api.simulate('wall', amp=0.5, freq=2.0)``: the call as its arguments were given (None ones left out), what
+    a history of it keeps as its ``command`` (a command line's keeps the ``masonry …`` line)."""
+    given = [f"{k}={_argument(v)}" for k, v in options.items() if v is not None]
+    return f"api.{function}({', '.join([_argument(target), *given])})"
 
 
 def _pga(value) -> float | None:
@@ -183,6 +220,9 @@ def simulate(
     from masonrycli.scenario.caveats import scenario_warnings
 
     sc = scenario(target, **options)
+    asked = {"recording": recording, "history": history, "force": force or None, "stop_at_collapse": stop_at_collapse}
+    asked |= {"magnify": magnify, "on_frame": on_frame}
+    call = _call("simulate", target, options | {k: v for k, v in asked.items() if v not in (None, False)})
     out = _path(recording, "--out", output=True) if recording not in (None, False, True) else None
     hist = _path(history, "--history", output=True) if history is not None else None
     outputs = check_run(sc, out, hist, no_recording=recording in (None, False), force=force, magnify=magnify)
@@ -201,6 +241,7 @@ def simulate(
             magnify=magnify,
             keep_history=True,
             sinks_also=sinks,
+            command=call,
         )
     except StopRun:  # a signal before the first step: nothing was written
         raise KeyboardInterrupt from None

@@ -241,6 +241,7 @@ def execute(
     signals: StopSignals | None = None,
     keep_history: bool = False,
     sinks_also=(),
+    command: str | None = None,
 ) -> Outcome:
     """Run ``scenario`` writing ``outputs``; ``stop_at_collapse`` ends the run when the structure
     collapses (:mod:`masonrycli.analysis.collapse`); ``magnify``: the recording's magnified-shape factor (None:
@@ -250,7 +251,9 @@ def execute(
     the caller entered and keeps installed after the run (its closing phase lasting through the summary);
     by default one of the run's own. ``keep_history``: also keep the history in memory, as the ``--history``
     file would hold it (:attr:`Outcome.history`); ``sinks_also``: further frame sinks (the API's ``on_frame``),
-    handed every frame after the outputs and closed by their owner."""
+    handed every frame after the outputs and closed by their owner. ``command``: what made the run, kept in its
+    histories' ``run`` (the Python API's call); by default the ``masonry`` command line (:func:`command_line`)."""
+    made_by = {"command": command} if command else command_line()
     with StopSignals() if signals is None else contextlib.nullcontext(signals) as signals, compile_ahead.ahead():
         sinks: dict[OutputFile, object] = {}
         if note := compile_ahead.no_cache_note():  # a read-only install and no writable home or /tmp
@@ -263,10 +266,10 @@ def execute(
                     sim = Simulation(scenario)
             for out in outputs.files():
                 try:
-                    sinks[out] = _open_sink(out, outputs, scenario, sim, magnify)
+                    sinks[out] = _open_sink(out, outputs, scenario, sim, magnify, made_by)
                 except OSError as exc:
                     raise InputError(f"{out.option} {out.path}: cannot write: {exc.strerror or exc}") from None
-            kept = _history(History, scenario, sim) if keep_history else None
+            kept = _history(History, scenario, sim, made_by) if keep_history else None
         except BaseException:
             for sink in sinks.values():
                 _quietly_close(sink)
@@ -302,10 +305,10 @@ def execute(
     return Outcome(result, signals.signum, written, errors, kept)
 
 
-def _open_sink(out: OutputFile, outputs: Outputs, scenario, sim: Simulation, magnify: float | None = None):
-    """The history or the recorder writing ``out``'s temporary file."""
+def _open_sink(out: OutputFile, outputs: Outputs, scenario, sim: Simulation, magnify=None, made_by=None):
+    """The history or the recorder writing ``out``'s temporary file; ``made_by``: the history's ``command``."""
     if out is outputs.history:
-        return _history(HistoryFile, scenario, sim, out.part)
+        return _history(HistoryFile, scenario, sim, made_by or {}, out.part)
     from masonrycli.recording import Recorder
 
     return Recorder(out.part, recording_static(sim, scenario), run_metadata(scenario, sim), magnify=magnify)
@@ -320,11 +323,12 @@ def command_line() -> dict:
     return {"command": shlex.join(["masonry", *sys.argv[1:]])} if ours else {}
 
 
-def _history(kind, scenario, sim: Simulation, *path):
+def _history(kind, scenario, sim: Simulation, made_by: dict, *path):
     """A history (``kind``: :class:`HistoryFile` writing ``path``, or :class:`History` in memory) given what
-    the rows do not hold: the run's parameters (and the command line that ran it) and the blocks' constants."""
+    the rows do not hold: the run's parameters (and ``made_by``: the command that ran it) and the blocks'
+    constants."""
     history = kind(*path, sim.model.block_name, sim.model.support_name)
-    history.run_info = run_metadata(scenario, sim) | command_line()
+    history.run_info = run_metadata(scenario, sim) | made_by
     history.run_values |= block_constants(sim.model)
     return history
 

@@ -79,7 +79,7 @@ def _whose(rows: list[dict]) -> str:
 
 
 def check_histories(
-    folder: Path | None, points: list[dict], find: str | None, force: bool, study: tuple[str, str] | None = None
+    folder: Path | None, points: list[dict], find: str | None, force: bool, study: tuple[str, ...] | None = None
 ) -> None:
     """Refuse (unless ``force``) the history files the runs of ``points`` would write in ``folder``
     that exist already, but for those an earlier run of the same ``study`` wrote (:func:`made_by_study`);

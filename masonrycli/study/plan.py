@@ -88,6 +88,7 @@ def plan_study(
     :class:`InputError`, the first problem in one line, before any run or file. ``survey``: how a geometry
     file is read (--units, --flip-y, --convex-hull, --trim-overlaps, as ``masonry run`` reads it); ``settle``: s
     the structure comes to rest under its own weight first, once for every run (:mod:`masonrycli.settle`)."""
+    from masonrycli.execute import command_line
     from masonrycli.records.intensity import INTENSITY_MEASURES
     from masonrycli.study.runner import check_scheduler
     from masonrycli.study.task import check_outcome
@@ -178,6 +179,7 @@ def plan_study(
         force=force,
         warnings=(*_scenario_warnings(base.scenario, base.records), *late, *_set_warnings(base, axes)),
         warn=warn,
+        command=command_line().get("command", ""),  # each history names it (masonry report: what was run)
     )
     return StudyPlan(base, request, name, picture, recorded)
 

@@ -48,6 +48,8 @@ class StudyRequest:
     came out beside the one-line error of a bad request)."""
     warn: Callable[[str], None] | None = None
     """Where ``warnings`` go (the command line's stderr)."""
+    command: str = ""
+    """The ``masonry sweep …`` line that asked for the study ("" from elsewhere): each history names it."""
 
 
 @dataclass(frozen=True)
@@ -150,7 +152,8 @@ def run_study(base: StudyBase, request: StudyRequest, console: Console) -> Study
     # two solvers without a word.
     source = this_version()[1]
     other = [r for r in done.values() if r.get("source") != source]
-    study = (study_id, str(request.out.resolve()))  # whose histories may be replaced (study/task.py)
+    # whose histories may be replaced (study/task.py), and the command each names (`masonry report` says it)
+    study = (study_id, str(request.out.resolve()), request.command)
     files.check_histories(request.histories, driver.start(), request.find, request.force, study)
     unknown = [r for r in other if not r.get("source")]
     if len(other) > len(unknown) and request.warn is not None:

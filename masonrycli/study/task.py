@@ -51,7 +51,7 @@ def run_task(
     stop_at_collapse: bool = True,
     history_dir: str | None = None,
     force: bool = False,
-    study: tuple[str, str] | None = None,
+    study: tuple[str, str, str] | None = None,
 ) -> dict:
     """Run the grid point ``params`` of ``base`` (:class:`~masonrycli.study.axes.StudyBase`): its row.
 
@@ -59,7 +59,8 @@ def run_task(
     :func:`history_name` of the point (on the worker's file system), under the policy of
     :mod:`masonrycli.outputs.files`: a temporary file renamed into place when complete, an existing file
     replaced only with ``force`` or when an earlier run of the same ``study`` (its fingerprint and its
-    table) wrote it (:func:`made_by_study`; the study checked them all before the first run).
+    table) wrote it (:func:`made_by_study`; the study checked them all before the first run). The history
+    names its study, its table, its point and the ``masonry sweep`` command (``study``'s third, if any).
     """
     from masonrycli.errors import InputError
     from masonrycli.execute import run_metadata
@@ -86,6 +87,7 @@ def run_task(
                 sinks[0].run_values |= block_constants(sim.model)
                 if study:
                     sinks[0].run_info |= {"study": study[0], "study_table": study[1]}
+                    sinks[0].run_info |= {"command": study[2]} if study[2:] and study[2] else {}
             result = simulate(scenario, sinks, sim=sim, stop_at_collapse=stop_at_collapse)
             if sinks:
                 sinks[0].run_values |= {f"intensity_{k}": v for k, v in result.intensity.items()}
@@ -158,8 +160,9 @@ def remove_stale_parts(path: Path) -> None:
             pass
 
 
-def made_by_study(path: Path, study: tuple[str, str] | None) -> bool:
-    """Whether ``path`` is a history that a run of ``study`` (its fingerprint, its table) wrote. A study
+def made_by_study(path: Path, study: tuple[str, ...] | None) -> bool:
+    """Whether ``path`` is a history that a run of ``study`` (its fingerprint, its table; not the command's
+    words) wrote. A study
     stopped by Ctrl-C (or killed) leaves the histories of its runs in flight, which the workers finish,
     without their rows: the same command then refused to resume ("--histories …/amp=1.10909.npz: the file
     exists"). Such a file is made again and may be replaced; any other needs ``--force`` (the same study
@@ -171,7 +174,7 @@ def made_by_study(path: Path, study: tuple[str, str] | None) -> bool:
             run = json.loads(str(history["run"]))
     except Exception:  # not a history
         return False
-    return (run.get("study"), run.get("study_table")) == tuple(study)
+    return (run.get("study"), run.get("study_table")) == tuple(study)[:2]
 
 
 def empty_result(error: str, wall_time: float) -> dict:
