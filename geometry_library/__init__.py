@@ -25,8 +25,9 @@ from .builders import (
     wall_layouts,
 )
 from .checks import body_label, is_convex, normalise_polygon, polygon_from_coords, validate_assembly
-from .io import read_geojson, read_wkt, write_geojson, write_wkt
+from .io import read_geojson, write_geojson
 from .mass import MassProperties, mass_properties
+from .wkt import read_wkt, write_wkt
 
 __all__ = [
     "BUILDERS",

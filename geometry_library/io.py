@@ -1,4 +1,4 @@
-"""Reading and writing assemblies: GeoJSON and WKT.
+"""Reading and writing assemblies: GeoJSON (WKT: :mod:`geometry_library.wkt`).
 
 GeoJSON
 -------
@@ -27,20 +27,7 @@ adds to every layer.
 Blocks keep the order of their features, supports too. :func:`write_geojson` writes the same
 format with full float precision, so ``read_geojson(write_geojson(a))`` gives back ``a``.
 
-WKT
----
-One body per line; blank lines and lines starting with ``#`` are ignored. A line is a WKT
-geometry, optionally preceded by a label and a colon::
-
-    POLYGON ((0 0, 0.3 0, 0.3 0.2, 0 0.2, 0 0))            # block "block-<i>"
-    c01-b01: POLYGON ((...))                                # block "c01-b01"
-    block c01-b02: POLYGON ((...))
-    support ground fixed: POLYGON ((...))                   # support, role fixed or driven
-    support: POLYGON ((...))                                # support "support-<j>", fixed
-
-A ``MULTIPOLYGON`` or ``GEOMETRYCOLLECTION`` of polygons gives one block per member (named
-``<label>-<k>`` when labelled); the whole file may also be one such geometry spread over lines.
-WKT carries no density or thickness: the reader's arguments apply to every block.
+WKT: :mod:`geometry_library.wkt`.
 
 Errors are one-line :class:`GeometryError` messages naming the file, the feature / line and, once known,
 the body as every message names one (:func:`~geometry_library.checks.body_label`), in one format::
@@ -56,14 +43,11 @@ from __future__ import annotations
 
 import json
 import math
-import re
-import warnings
 from pathlib import Path
 
 import numpy as np
 import shapely
-import shapely.wkt
-from shapely.geometry import GeometryCollection, MultiPolygon, Polygon
+from shapely.geometry import Polygon
 
 from .blocks import SUPPORT_ROLES, Assembly, Block, GeometryError, Support, name_problem, quoted_name
 from .checks import body_label
@@ -71,13 +55,6 @@ from .survey import GROUND_DEPTH, Survey, finish_reading, frame_of, ground_from_
 from .values import check_positive, is_real
 
 LINES = ("LineString", "MultiLineString")
-
-_LABEL = re.compile(
-    r"^\s*(?:(?P<role>block|support)\s+)?(?P<name>[^\s:]+)(?:\s+(?P<srole>fixed|driven))?\s*:\s*(?P<wkt>.+)$",
-    re.IGNORECASE,
-)
-_ROLE_ONLY = re.compile(r"^\s*(?P<role>block|support)(?:\s+(?P<srole>fixed|driven))?\s*:\s*(?P<wkt>.+)$", re.IGNORECASE)
-"""A role with no name (``support : POLYGON …``): _LABEL read its role word as the name of a block."""
 
 
 def _word(value):
@@ -352,145 +329,3 @@ def _feature(polygon: Polygon, props: dict) -> dict:
         "properties": props,
         "geometry": {"type": "Polygon", "coordinates": [_ring_coords(polygon)]},
     }
-
-
-def _polygons_of(geom, where: str) -> list[Polygon]:
-    if isinstance(geom, Polygon):
-        return [geom]
-    if isinstance(geom, (MultiPolygon, GeometryCollection)):
-        out = []
-        for member in geom.geoms:
-            if not isinstance(member, Polygon):
-                raise GeometryError(f"{where}: collection member must be a POLYGON, got {member.geom_type}")
-            out.append(member)
-        return out
-    raise GeometryError(
-        f"{where}: geometry must be a POLYGON, MULTIPOLYGON or GEOMETRYCOLLECTION, got {geom.geom_type}"
-    )
-
-
-def _parse_wkt(text: str, where: str):
-    try:
-        with warnings.catch_warnings():  # GEOS warns on NaN coordinates; the vertex check reports them
-            warnings.simplefilter("ignore", RuntimeWarning)
-            return shapely.wkt.loads(text)
-    except Exception as exc:  # shapely raises GEOSException / ValueError variants
-        msg = str(exc).splitlines()[0] if str(exc) else exc.__class__.__name__
-        raise GeometryError(f"{where}: cannot parse WKT ({msg})") from None
-
-
-def read_wkt(
-    path, density: float = 2500.0, thickness: float = 1.0, survey: Survey | None = None, notes: list | None = None
-) -> Assembly:
-    """Read an assembly from a WKT file (format in the module docstring); ``survey`` and ``notes`` as
-    :func:`read_geojson`'s.
-
-    Raises
-    ------
-    GeometryError — unreadable file, unparsable WKT, wrong geometry type, holes, or a polygon failing
-    the checks of :func:`~geometry_library.checks.polygon_from_coords` (named by file, line, body).
-    """
-    path = Path(path)
-    _number(density, "density", str(path))
-    _number(thickness, "thickness", str(path))
-    lines = [
-        (n, line.strip())
-        for n, line in enumerate(_read_text(path).splitlines(), start=1)
-        if line.strip() and not line.lstrip().startswith("#")
-    ]
-    if not lines:
-        raise GeometryError(f"{path}: no geometry in file")
-    entries: list[tuple[str, str | None, str | None, str | None, str]] = []  # where, role, name, srole, wkt
-    first = lines[0][1].upper()
-    if first.startswith(("GEOMETRYCOLLECTION", "MULTIPOLYGON")) and len(lines) > 1 and not _complete(lines[0][1]):
-        entries.append((f"{path}: line {lines[0][0]}", None, None, None, " ".join(t for _, t in lines)))
-    else:
-        for n, line in lines:
-            m = _ROLE_ONLY.match(line)
-            if m and m["srole"] and m["role"].lower() == "block":
-                m = None  # "block fixed: …" is a block named "fixed" (a block has no support role): write_wkt's
-            m = m or _LABEL.match(line)
-            if m:  # a name before a colon (WKT has none): "polygon1: POLYGON …" is the block polygon1
-                name = m.groupdict().get("name")
-                entries.append((f"{path}: line {n}", m["role"], name, m["srole"], m["wkt"]))
-            elif ":" in line:  # WKT has no colon: a label the patterns refused (": POLYGON …" said "Unknown type: ':'")
-                raise _bad_label(f"{path}: line {n}", line.split(":", 1)[0])
-            elif (unlabelled := _NO_COLON.match(line)) is not None:  # "support g POLYGON …": "Unknown type: 'SUPPORT'"
-                raise GeometryError(
-                    f"{path}: line {n}: {unlabelled['label']!r} before {unlabelled['kind'].upper()}: a label ends "
-                    f"with a colon ('{unlabelled['label']}: {unlabelled['kind'].upper()} ((…))')"
-                )
-            else:
-                entries.append((f"{path}: line {n}", None, None, None, line))
-    blocks: list[Block] = []
-    supports: list[Support] = []
-    refused: list[tuple[str, str]] = []
-    pending = []  # (where, role, index, label, srole, coords): made once every ring is read
-    for where, role, name, srole, text in entries:
-        role = (role or ("support" if srole else "block")).lower()
-        polys = _polygons_of(_parse_wkt(text, where), where)
-        if role == "support" and len(polys) != 1:
-            raise GeometryError(f"{where}: a support must be a single POLYGON")
-        for k, poly in enumerate(polys):
-            index = len(blocks) if role == "block" else len(supports)
-            label = name if len(polys) == 1 or name is None else f"{name}-{k + 1}"
-            label = label or f"{role}-{index + 1}"
-            if poly.is_empty:
-                raise GeometryError(f"{where}: {body_label(index, label, role)}: polygon is empty")
-            if poly.interiors:
-                raise GeometryError(f"{where}: {body_label(index, label, role)}: polygon has holes; blocks are solid")
-            (blocks if role == "block" else supports).append(None)  # numbered now, made once the frame is known
-            pending.append((where, role, index, label, srole, np.asarray(poly.exterior.coords)[:, :2]))
-    survey = survey or Survey()
-    frame = frame_of([entry[-1] for entry in pending], survey)
-    hulls: list[tuple[str, float, float]] = []
-    for where, role, index, label, srole, coords in pending:
-        try:
-            polygon = surveyed_polygon(frame.local(coords), index, label, role, survey, hulls)
-        except GeometryError as exc:
-            refused.append((f"{where}: {exc}", body_label(index, label, role)))
-            continue
-        if role == "block":
-            blocks[index] = Block(polygon, label, float(density), float(thickness))
-        else:
-            supports[index] = Support(polygon, label, (srole or "fixed").lower())
-    return finish_reading(path, refused, blocks, supports, frame, survey, hulls, notes)
-
-
-_NO_COLON = re.compile(r"\s*(?P<label>[^\s(:][^(:]*?)\s+(?P<kind>POLYGON|MULTIPOLYGON|GEOMETRYCOLLECTION)\b", re.I)
-"""Words before the WKT with no colon after them: a label missing its colon."""
-
-
-def _bad_label(where: str, label: str) -> GeometryError:
-    """The error for a line whose text before its colon is not a label."""
-    what = "nothing before the colon" if not label.strip() else f"{label.strip()!r} before the colon is not a label"
-    return GeometryError(
-        f"{where}: {what}; expected 'NAME: POLYGON ((…))', 'block NAME: …', 'support [NAME] [fixed|driven]: …' "
-        "or the WKT alone (a name has no spaces or colons)"
-    )
-
-
-def _complete(text: str) -> bool:
-    """True if the parentheses of a WKT text are balanced (one complete geometry on the line)."""
-    return text.count("(") == text.count(")") and "(" in text
-
-
-def _wkt_polygon(polygon: Polygon) -> str:
-    ring = ", ".join(f"{x!r} {y!r}" for x, y in _ring_coords(polygon))
-    return f"POLYGON (({ring}))"
-
-
-def write_wkt(assembly: Assembly, path) -> Path:
-    """Write ``assembly`` as labelled WKT lines (full precision; density, thickness and a carried fill are not kept)."""
-    path = Path(path)
-    for body in (*assembly.blocks, *assembly.supports):
-        if not body.name or re.search(r"[\s:]", body.name):
-            raise GeometryError(f'{path}: name "{body.name}" cannot be written to WKT (spaces or colons)')
-    lines = ["# masonry assembly: one body per line, '<role> <name> [support role]: <WKT>'"]
-    lines += [f"block {b.name}: {_wkt_polygon(b.polygon)}" for b in assembly.blocks]
-    lines += [f"support {s.name} {s.role}: {_wkt_polygon(s.polygon)}" for s in assembly.supports]
-    try:
-        path.write_text("\n".join(lines) + "\n", encoding="utf-8")
-    except OSError as exc:
-        raise GeometryError(f"{path}: cannot write file ({exc})") from None
-    return path

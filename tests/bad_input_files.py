@@ -424,7 +424,14 @@ FILE_ROWS = [
         'n.wkt: line 1: block 1 ("block-1"): vertex 1 has a NaN or infinite coordinate',
     ),
     ("wkt-garbage", {"n.wkt": "POLYGON ((0 0, 1 0\n"}, ("check", "n.wkt"), 2, "n.wkt: line 1"),
-    ("wkt-linestring", {"n.wkt": "LINESTRING (0 0, 1 1)\n"}, ("check", "n.wkt"), 2, "n.wkt: line 1"),
+    # a LINESTRING is a ground line (the support under it); one of two parts is no line
+    (
+        "wkt-linestring",
+        {"n.wkt": "MULTILINESTRING ((0 0, 1 0), (2 0, 3 0))\n"},
+        ("check", "n.wkt"),
+        2,
+        "n.wkt: line 1: a MULTI",
+    ),
     # -- motion CSV records
     (
         "csv-not-a-number",

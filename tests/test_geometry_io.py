@@ -283,7 +283,7 @@ def test_wkt_errors_name_file_and_line(tmp_path):
     path.write_text("POLYGON ((0 0, 1 0, 1 1, 0 1, 0 0))\nPOLYGON ((0 0, 1 0\n")
     text = one_line_error(read_wkt, path)
     assert "bad.wkt: line 2: cannot parse WKT" in text
-    path.write_text("POLYGON ((0 0, 1 0, 1 1, 0 1, 0 0))\nLINESTRING (0 0, 1 1)\n")
+    path.write_text("POLYGON ((0 0, 1 0, 1 1, 0 1, 0 0))\nPOINT (0.5 2)\n")
     assert "line 2" in one_line_error(read_wkt, path)
     path.write_text("a: POLYGON ((0 0, 1 0, 1 1, 0 1, 0 0))\nc3-b2: POLYGON ((0 0, 2 0, 2 2, 1 0.5, 0 2, 0 0))\n")
     assert 'line 2: block 2 ("c3-b2"): polygon is not convex' in one_line_error(read_wkt, path)

@@ -243,7 +243,7 @@ def test_wkt_nan_prints_no_warning(tmp_path):
     import warnings
 
     from geometry_library.blocks import GeometryError
-    from geometry_library.io import read_wkt
+    from geometry_library.wkt import read_wkt
 
     path = tmp_path / "n.wkt"
     path.write_text("POLYGON ((0 0, nan 0, 1 1, 0 1, 0 0))\n")

@@ -41,6 +41,7 @@ def read_geometry(
     receives what the file was read as (``survey.reading_record``: the map shift, units, hulls, trims), which a
     run's parameters record."""
     from geometry_library import io as geo_io
+    from geometry_library import wkt as geo_wkt
     from geometry_library.survey import Survey
 
     survey = Survey() if survey is None else survey  # the default reading too: a map grid's file is moved
@@ -58,7 +59,7 @@ def read_geometry(
     said: list[str] = []
     try:
         if suffix == ".wkt":
-            assembly = geo_io.read_wkt(path, density=density, thickness=thickness, survey=survey, notes=said)
+            assembly = geo_wkt.read_wkt(path, density=density, thickness=thickness, survey=survey, notes=said)
         else:
             assembly = geo_io.read_geojson(
                 path, density=density, thickness=thickness, unknown=unknown, survey=survey, notes=said
