@@ -6,7 +6,7 @@ Each is the command line's own code called as the commands call it, not a second
 Python                                          the command line's code
 ==============================================  ===============================================================
 ``scenario("wall", amp=0.5, blocks=248)``       ``masonry check wall --amp 0.5 --blocks 248`` (builtin.builtin)
-``scenario("my.toml", dt=2e-4)``                ``masonry run my.toml --dt 2e-4`` (builtin.file_scenario)
+``scenario("my.toml", dt=2e-4)``                ``masonry run my.toml --dt 2e-4`` (target.file_scenario)
 ``simulate(s, history="h.npz")``                ``masonry simulate / run … --history h.npz`` (execute.check_run,
                                                 execute.execute)
 ``read_history("h.npz")``                       ``masonry inspect h.npz``'s checks, then every array
@@ -53,7 +53,7 @@ def _option_names(target) -> list[str]:
     for a file, and the run settings and friction for a :class:`Scenario` already made (its loading is made with
     it: a record given to it would run for its duration, where ``simulate("wall", record=…)`` runs the record)."""
     from masonrycli.cli import options
-    from masonrycli.scenario.builtin import is_built_in
+    from masonrycli.scenario.target import is_built_in
 
     groups = ["RUN", "FRICTION"]
     if isinstance(target, (str, os.PathLike)) and is_built_in(target):
@@ -109,8 +109,9 @@ def scenario(target, **options):
     already made (its run settings and friction replaced). Raises :class:`InputError` (one line)."""
     from geometry_library.blocks import GeometryError
     from masonrycli.records.pga import with_pga
-    from masonrycli.scenario.builtin import builtin, file_scenario, is_built_in, override_run
+    from masonrycli.scenario.builtin import builtin, override_run
     from masonrycli.scenario.scenario import Scenario
+    from masonrycli.scenario.target import file_scenario, is_built_in
     from masonrycli.settle import settled_scenario
 
     if not isinstance(target, (str, os.PathLike, Scenario)):

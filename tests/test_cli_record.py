@@ -291,7 +291,8 @@ def test_a_csv_accelerogram_is_read_as_its_header_says(tmp_path):
 def test_a_geometry_files_support_is_shaken_from_any_folder(tmp_path, monkeypatch):
     # a --scheduler's worker started in another folder resolved the command's relative 'wall.geojson' there:
     # every row of 'masonry sweep wall.geojson --records recs --scheduler …' was refused, "no shaking support"
-    from masonrycli.scenario.builtin import shaken_supports, target_scenario
+    from masonrycli.scenario.record_option import shaken_supports
+    from masonrycli.scenario.target import target_scenario
 
     (tmp_path / "study").mkdir()
     (tmp_path / "worker").mkdir()
@@ -334,7 +335,8 @@ TWO_SUPPORTS = """{"type": "FeatureCollection", "features": [
 def test_record_on_a_geometry_file_shakes_the_supports_it_marks_driven(tmp_path):
     # a lintel on two pads, the left one marked "support_role": "driven": --record shakes it, the right one stays
     # fixed (a file of several supports was refused: only a scenario file could say which one shakes)
-    from masonrycli.scenario.builtin import target_scenario, with_record
+    from masonrycli.scenario.record_option import with_record
+    from masonrycli.scenario.target import target_scenario
 
     geo = tmp_path / "two.geojson"
     geo.write_text(TWO_SUPPORTS)

@@ -127,7 +127,7 @@ def test_a_carried_fill_settles_with_its_block(tmp_path):
     # --settle moved each block's polygon and left a carried fill's point where it was drawn: the 0.4 × 0.8 block
     # drawn 2 mm above its ground, carrying its own mass lumped 0.1 m above its top, comes down 2 mm with it
     from geometry_library.io import read_geojson
-    from masonrycli.scenario.builtin import target_scenario
+    from masonrycli.scenario.target import target_scenario
     from masonrycli.settle import settle
 
     path = block_above_ground(tmp_path, 0.002)

@@ -73,7 +73,8 @@ def test_a_runs_history_and_recording_say_how_its_file_was_read(traced_mm, tmp_p
 def test_a_file_read_as_it_is_and_a_builder_record_no_reading(tmp_path):
     from masonrycli.execute import run_metadata
     from masonrycli.run import Simulation
-    from masonrycli.scenario.builtin import builtin, target_scenario
+    from masonrycli.scenario.builtin import builtin
+    from masonrycli.scenario.target import target_scenario
 
     surveyed_wall.write(tmp_path / "exact.geojson", slip=0.0, ndigits=9)
     for scenario in (target_scenario(tmp_path / "exact.geojson"), builtin("wall")):

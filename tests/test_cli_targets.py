@@ -55,7 +55,7 @@ def here(tmp_path, monkeypatch):
                 raise PermissionError(13, "Permission denied", "locked.toml")
             return real_open(file, *args, **kwargs)
 
-        monkeypatch.setattr("masonrycli.scenario.builtin.open", refusing_open, raising=False)
+        monkeypatch.setattr("masonrycli.scenario.target.open", refusing_open, raising=False)
     monkeypatch.chdir(tmp_path)
     yield tmp_path
     locked.chmod(0o644)

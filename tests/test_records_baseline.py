@@ -201,7 +201,7 @@ def test_a_baseline_on_a_velocity_record_says_it_does_not_apply(command, tmp_pat
 
 
 def test_a_velocity_record_is_used_as_given():
-    from masonrycli.scenario.builtin import record_motion_option
+    from masonrycli.scenario.record_option import record_motion_option
 
     velocity = DATA / "quake_velocity.csv"
     t, v = np.loadtxt(velocity, delimiter=",", skiprows=2, unpack=True)

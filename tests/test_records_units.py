@@ -168,7 +168,7 @@ def _g_csv(path, header="time (s),acc (g)"):
 def test_a_csv_in_g_shakes_the_same_through_run_a_scenario_and_a_set(tmp_path):
     # the header's g is converted on reading by run/simulate/check --record, a scenario's record table and a
     # sweep --records set alike; --record refused such a file at scale 1 ("a scale of 9.81 converts them")
-    from masonrycli.scenario.builtin import record_motion_option
+    from masonrycli.scenario.record_option import record_motion_option
     from masonrycli.scenario.toml_file import loads_scenario
     from masonrycli.study.record_set import _record
 

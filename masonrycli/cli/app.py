@@ -134,7 +134,7 @@ def simulate_aqueduct(**opts) -> None:
     _simulate("aqueduct", opts)
 
 
-# a str, checked by builtin.target_scenario as sweep's and limit's targets are: click's Path said of an
+# a str, checked by target.target_scenario as sweep's and limit's targets are: click's Path said of an
 # unreadable file "Invalid value for 'SCENARIO.toml': path 's.toml' is not readable", and made "" the folder "."
 ScenarioFile = Annotated[
     str, typer.Argument(help="Scenario file (TOML), or a GeoJSON / WKT geometry.", metavar="SCENARIO.toml")
@@ -148,7 +148,7 @@ def _load(scenario_file: str, opts: dict):
     """The scenario of a TOML, GeoJSON or WKT file with the command line's record and run options
     (taken out of ``opts``) applied."""
     from masonrycli.records.pga import with_pga
-    from masonrycli.scenario.builtin import file_scenario
+    from masonrycli.scenario.target import file_scenario
     from masonrycli.settle import settled_scenario
 
     settings = _pop(opts, RECORD, RUN, FRICTION)

@@ -42,8 +42,9 @@ def _scenario(target: str, opts: dict):
     (taken out of ``opts``): the built-in's structure, loading and material options refused for a file, and
     another built-in's structure options for a built-in, in one line."""
     from masonrycli.records.pga import with_pga
-    from masonrycli.scenario.builtin import builtin, file_scenario, is_built_in
+    from masonrycli.scenario.builtin import builtin
     from masonrycli.scenario.structure import survey_of
+    from masonrycli.scenario.target import file_scenario, is_built_in
 
     shaping = {name: value for name in BUILT_IN_ONLY if (value := opts.pop(name)) is not None}
     pga = opts.pop("pga")  # the record's scale, found once the scenario is built (records/pga.py)

@@ -262,7 +262,7 @@ def _split_word(exc, command: str) -> str | None:
     if not isinstance(given, (str, os.PathLike)):
         return None
     from masonrycli.records.knet import KNET_SUFFIXES
-    from masonrycli.scenario.builtin import is_built_in
+    from masonrycli.scenario.target import is_built_in
 
     given = os.fspath(given)
     joined = f"{given} {words}"

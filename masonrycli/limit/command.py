@@ -34,10 +34,11 @@ SHOWN = 8
 def resolve_structure(structure: str, friction: float | None, options: dict | None = None):
     """A scenario from a built-in name (the builder's defaults, or ``options``: the structure options of
     ``masonry build NAME`` and --density / --thickness, no motion), a scenario file or a geometry file
-    (:func:`~masonrycli.scenario.builtin.target_scenario`); ``friction`` overrides μ."""
+    (:func:`~masonrycli.scenario.target.target_scenario`); ``friction`` overrides μ."""
     from masonrycli.cli.options import BLOCK_MATERIAL, STRUCTURE_OPTIONS, SURVEY
-    from masonrycli.scenario.builtin import builtin, is_built_in, override_run, target_scenario
+    from masonrycli.scenario.builtin import builtin, override_run
     from masonrycli.scenario.scenario import Material, RunConfig, scenario_from_builder
+    from masonrycli.scenario.target import is_built_in, target_scenario
 
     options = dict(options or {})
     survey = {k: options.pop(k) for k in SURVEY if k in options}  # a geometry file's reading (target_scenario)

@@ -16,33 +16,22 @@ builder's own options (``blocks``, ``voussoirs``...), the loading (``amp`` m/s, 
 (``duration``, ``dt``, ``theta``, ``record_every``, ``tolerance``, ``max_iterations``, ``solver``). Errors name them
 as the command line spells them (``--settlement -1: must be >= 0 ...``).
 
-The same overrides serve the other commands' structures: :func:`file_scenario` (a scenario or geometry
-file, ``masonry run`` / ``check``) and :func:`build_assembly` (the builders' assemblies, ``masonry build``).
-
-:func:`target_scenario` resolves the TARGET of ``run`` / ``check``, ``sweep`` and ``limit`` (a built-in
-name, a scenario TOML or a GeoJSON / WKT file): a target that is none of them gets the same one line from
-every command (they said "no such scenario file", "no such scenario or geometry file" or "cannot read
-scenario: No such file or directory" for one missing file).
+The same overrides serve the other commands' structures: :func:`masonrycli.scenario.target.file_scenario` (a
+scenario or geometry file, ``masonry run`` / ``check``) and :func:`build_assembly` (the builders' assemblies,
+``masonry build``). A ``--record`` option's record: :mod:`masonrycli.scenario.record_option`; a command's
+TARGET (a built-in name or a file): :mod:`masonrycli.scenario.target`.
 """
 
 from __future__ import annotations
 
 import dataclasses
-import difflib
 import math
-import os
-import warnings
-from collections.abc import Callable
-from pathlib import Path
-from types import SimpleNamespace
 
-from masonrycli.errors import NOT_A_FILE, InputError, RecordWarning, file_kind, special_file
-from masonrycli.records.motion import BASELINE_PROBLEM, BASELINES, Record, time_step_problem, unused_baseline
-from masonrycli.records.read import record_motion
-from masonrycli.records.text import NoTimeStep, TimeStepNotUsed
-from masonrycli.scenario.motion import Constant, Fixed, Sine
+from masonrycli.errors import InputError
+from masonrycli.scenario.motion import Constant, Sine
+from masonrycli.scenario.record_option import record_motion_option, record_options_alone
 from masonrycli.scenario.scenario import MAX_DURATION, Material, RunConfig, Scenario, scenario_from_builder
-from masonrycli.scenario.structure import GEOMETRY_SUFFIXES, BuilderError, as_options, build_structure, survey_of
+from masonrycli.scenario.structure import BuilderError, as_options, build_structure
 from masonrycli.scenario.values import option_text
 
 DEFAULT_DURATION = {"wall": 1.0, "arch": 5.0, "aqueduct": 5.0}
@@ -116,229 +105,6 @@ def _sine(amp: float, freq: float) -> Sine:
     return sine
 
 
-def check_record_dt(record_dt: float | None) -> float | None:
-    """``--record-dt`` (simulate, run, check, sweep) checked as a record's time step; None: not given."""
-    if record_dt is not None:
-        problem = time_step_problem(record_dt)
-        if problem:
-            raise InputError(f"--record-dt {option_text(record_dt)}: {problem}")
-    return record_dt
-
-
-def check_baseline(baseline: str | None) -> str | None:
-    """``--baseline`` (simulate, run, check, sweep) checked as a record table's ``baseline``; None: not given."""
-    if baseline is not None and baseline not in BASELINES:
-        raise InputError(f"--baseline {baseline}: {BASELINE_PROBLEM}")
-    return baseline
-
-
-def record_motion_option(
-    path: Path, scale: float | None, record_dt: float | None = None, baseline: str | None = None
-) -> Record:
-    """The ground motion of a ``--record`` file (.AT2, ESM .ASC or CSV), multiplied by ``scale``; ``record_dt``: the
-    spacing of a one-column CSV's samples, s; ``baseline``: the drift correction of an acceleration record."""
-    check_record_dt(record_dt)
-    check_baseline(baseline)
-    try:
-        motion = record_motion(
-            path,
-            scale=1.0 if scale is None else scale,
-            display=str(path),
-            time_step=record_dt,
-            baseline=baseline or "quadratic",
-        )
-    except NoTimeStep as exc:
-        raise exc.give("--record-dt SECONDS") from None
-    except TimeStepNotUsed as exc:  # the message named time_step, a scenario's key, not the option given
-        raise exc.named("--record-dt") from None
-    except InputError as exc:
-        msg = str(exc)
-        raise InputError(msg if msg.startswith(str(path)) else f"--record {path}: {msg}") from None
-    for line in unused_baseline(baseline, {str(path): motion}):
-        warnings.warn(RecordWarning(line), stacklevel=2)
-    return motion
-
-
-def with_record(
-    scenario: Scenario,
-    record: Path | None,
-    scale: float | None,
-    record_dt: float | None = None,
-    baseline: str | None = None,
-) -> Scenario:
-    """``scenario`` with the supports a record shakes (:func:`shaken_supports`) driven by the ``record`` file."""
-    if record is None:
-        _record_options_alone(scale, record_dt, baseline)
-        return scenario
-    if not any(shaken_supports(scenario)):
-        raise no_shaking_support(scenario, "--record")
-    return shaken_by(scenario, record_motion_option(record, scale, record_dt, baseline))
-
-
-def _geometry_as_is(scenario: Scenario) -> bool:
-    """Whether ``scenario`` is a GeoJSON / WKT file run as it is (every support fixed, no scenario file). By
-    the suffix of its source, not its absolute path: a study's worker started in another folder resolved the
-    command's relative ``rubble.geojson`` elsewhere, and every row of a --scheduler study was refused."""
-    return Path(scenario.source or "").suffix.lower() in GEOMETRY_SUFFIXES and "file" in scenario.structure
-
-
-def shaken_supports(scenario: Scenario) -> list[bool]:
-    """Which supports a record (``--record``, ``sweep --records``) shakes: those with a sine or record motion.
-    A GeoJSON / WKT file run as it is has none (it holds no motion): there, the supports it marks driven
-    (``"support_role": "driven"``, WKT ``support NAME driven:``), the others staying fixed, else its support when
-    it has one — ``masonry run wall.geojson --record q.AT2`` of a wall on its ground was refused, and a scenario
-    file had to be written to say the obvious; of several unmarked, none (refused: which one is not obvious)."""
-    shaking = [m.kind in ("sine", "record") for m in scenario.motions]
-    if any(shaking) or not _geometry_as_is(scenario):
-        return shaking
-    if scenario.marked_driven:
-        return [s.name in scenario.marked_driven for s in scenario.assembly.supports]
-    return [True] if len(shaking) == 1 else shaking
-
-
-def shaken_by(scenario: Scenario, motion) -> Scenario:
-    """``scenario`` with its :func:`shaken_supports` moved by ``motion``; a geometry file's warning that the
-    support it marks driven stays fixed (it has no motion) is left out: the record drives it now."""
-    from masonrycli.scenario.caveats import idle_driven_supports
-
-    shaking = shaken_supports(scenario)
-    motions = tuple(motion if shake else m for shake, m in zip(shaking, scenario.motions))
-    # the line the file's mark made (the scenario's roles follow its motions: the mark is not kept)
-    marked = [dataclasses.replace(s, role="driven") for s, shake in zip(scenario.assembly.supports, shaking) if shake]
-    stale = idle_driven_supports(SimpleNamespace(supports=marked), [Fixed()] * len(marked))
-    return dataclasses.replace(
-        scenario, motions=motions, warnings=tuple(w for w in scenario.warnings if w not in stale)
-    )
-
-
-def no_shaking_support(scenario: Scenario, option: str) -> InputError:
-    """The refusal of a record (``--record``, ``sweep --records``: ``option``) for a scenario none of whose
-    supports shakes (:func:`shaken_supports`). A GeoJSON / WKT file of several supports holds no motion and no
-    way to say which one shakes ("give one a sine" was no way out): the message writes the scenario file."""
-    if not _geometry_as_is(scenario):
-        return InputError(f"{option}: {scenario.name} has no shaking support (give one a sine or record motion)")
-    file = os.path.basename(scenario.source)
-    supports = scenario.assembly.supports
-    if not supports:
-        return InputError(f"{option}: {file} has no support to shake (every body in it is a block)")
-    names = ", ".join(s.name for s in supports[:4]) + (" …" if len(supports) > 4 else "")
-    return InputError(
-        f"{option}: {file} holds no motion and {len(supports)} supports ({names}); say which the record shakes: "
-        'mark them "support_role": "driven" in the file (WKT: support NAME driven: …), or write a scenario file '
-        f'[structure] file = "{file}" with a [[support]] name = "{supports[0].name}" and motion = {{ kind = "record", '
-        "file = ... } (masonry docs scenario-format)"
-    )
-
-
-def is_built_in(target: str | os.PathLike) -> bool:
-    """Whether a command's TARGET names a built-in structure: its name, unless a file of that name is
-    here (a folder ``wall/`` of recordings is no scenario: ``masonry limit wall`` said "no such scenario
-    or geometry file")."""
-    return os.fspath(target) in DEFAULT_DURATION and not os.path.isfile(target)
-
-
-def target_scenario(target: str | os.PathLike, built_in: Callable[[str], Scenario] | None = None, survey=None):
-    """The scenario a command's TARGET names: ``built_in(name)`` for a built-in name (None: the command
-    takes files only, and the message says where the built-ins run), else a scenario file (TOML) or a
-    geometry file (GeoJSON / WKT, every support fixed). A target that is none of them raises the same
-    one-line :class:`InputError` from every command, naming it. ``survey``: a geometry file's reading (survey_of)."""
-    from masonrycli.scenario.scenario import scenario_from_geometry_file
-    from masonrycli.scenario.toml_file import load_scenario
-
-    target = os.fspath(target)
-    survey = survey_of(survey or {}, target)
-    if not target.strip():  # Path("") is the working folder: it said "error: : no such scenario …"
-        raise InputError(f"the structure argument is empty ({target!r}): give wall, arch, aqueduct or a scenario file")
-    if is_built_in(target):
-        if built_in is None:
-            raise InputError(f"{target}: not a file; the built-in structures are run with `masonry simulate {target}`")
-        return built_in(target)
-    if target.startswith("~"):  # quoted, the shell left it ('masonry run "~/w.toml"'): as --out and a file key
-        target = os.path.expanduser(target)
-    problem = _target_problem(target)
-    if problem:
-        raise InputError(f"{target}: {problem}")
-    path = Path(target)  # as the commands read it before: "./s.toml" is the scenario "s.toml"
-    if path.suffix.lower() in GEOMETRY_SUFFIXES:
-        return scenario_from_geometry_file(path, survey)
-    try:
-        return load_scenario(path)
-    except InputError as exc:
-        if path.suffix.lower() == ".toml":
-            raise
-        other = file_kind(path, "a scenario (TOML) or a geometry file (GeoJSON / WKT)")
-        if other is not None:
-            raise other from None
-        # "notes.txt: TOML syntax error …" left a user who meant a geometry file guessing why TOML
-        raise InputError(
-            f"{exc} (read as a scenario TOML: a geometry file's name ends in {', '.join(GEOMETRY_SUFFIXES)})"
-        ) from None
-
-
-def _target_problem(target: str) -> str:
-    """Why ``target`` is no file to read ("" if it is one), checked before a reader opens it: each reader
-    said it its own way ("cannot read scenario: is a directory", a folder named .geojson "not a regular
-    file", an unreadable one "cannot read file (PermissionError: [Errno 13] …)")."""
-    if special_file(target):  # checked without opening it: opening a named pipe waits for a writer
-        return NOT_A_FILE
-    if os.path.isdir(target):
-        return "is a directory, not a scenario or geometry file"
-    if not os.path.exists(target):
-        bare = os.sep not in target and not Path(target).suffix  # "wal", not "wal.toml" or "runs/wal"
-        close = difflib.get_close_matches(target.lower(), BUILT_IN, n=1) if bare else []
-        hint = f"did you mean {close[0]}?" if close else f"built-in structures: {', '.join(BUILT_IN)}"
-        return f"no such scenario or geometry file ({hint})"
-    try:
-        open(target, "rb").close()
-    except OSError as exc:
-        return f"cannot read file: {exc.strerror or exc}"
-    return ""
-
-
-def _record_options_alone(scale: float | None, record_dt: float | None, baseline: str | None = None) -> None:
-    """Refuse --scale, --record-dt and --baseline given without --record."""
-    if scale is not None:
-        raise InputError("--scale: goes with --record (it multiplies the record)")
-    if record_dt is not None:
-        raise InputError("--record-dt: goes with --record (the time between the samples of a one-column file)")
-    if baseline is not None:
-        raise InputError(
-            '--baseline: goes with --record (a scenario file\'s own record takes baseline = "none" in its table)'
-        )
-
-
-def file_scenario(
-    path: str | os.PathLike,
-    *,
-    record: Path | None = None,
-    scale: float | None = None,
-    record_dt: float | None = None,
-    baseline: str | None = None,
-    survey: dict | None = None,
-    **overrides,
-) -> Scenario:
-    """The scenario of a TOML, GeoJSON or WKT file (``masonry run`` / ``check``, :func:`target_scenario`:
-    a built-in's name is told where it runs) driven by ``record`` times ``scale`` if given
-    (:func:`with_record`), with the run settings and the friction of ``overrides`` (:func:`override_run`).
-    A geometry file has no run settings of its own: shaken by a record with no --duration it runs the whole
-    record, as ``simulate`` does (it ran the default 1 s: 'masonry run wall.geojson --record q.AT2' of an 8 s
-    record, its strong motion after 2 s, said "intact")."""
-    scenario = with_record(target_scenario(path, survey=survey), record, scale, record_dt, baseline)
-    if record is not None and _geometry_as_is(scenario) and overrides.get("duration") is None:
-        overrides = overrides | {"duration": whole_records(scenario.motions, overrides.get("dt"))}
-    return override_run(scenario, **overrides)
-
-
-def whole_records(motions, dt=None) -> float:
-    """s: the longest record of ``motions`` in whole steps of ``dt`` (default: the run's 1e-3 s), at most
-    ``MAX_DURATION``; a bad ``dt`` gives the default duration (:func:`override_run` names the option)."""
-    ends = [m.end_time for m in motions if m.kind == "record"]
-    dt = RunConfig.dt if dt is None else dt
-    if not ends or not (isinstance(dt, (int, float)) and 0.0 < dt < math.inf):
-        return RunConfig.duration
-    return min(max(1, math.ceil(max(ends) / dt - 1e-9)) * dt, MAX_DURATION)
-
-
 def _loading(name: str, amp, freq, settlement, record, scale, record_dt=None, baseline=None) -> dict:
     """Support name -> motion of the built-in loading, with the loading overrides applied."""
     if record is not None:
@@ -350,7 +116,7 @@ def _loading(name: str, amp, freq, settlement, record, scale, record_dt=None, ba
         shaken = ("ground",) if name == "wall" else ("left-foundation", "right-foundation")
         motion = record_motion_option(record, scale, record_dt, baseline)
         return {support: motion for support in shaken}
-    _record_options_alone(scale, record_dt, baseline)
+    record_options_alone(scale, record_dt, baseline)
     loading_freq, freq = freq, SHAKE_FREQUENCY if freq is None else freq
     if name == "wall":
         if settlement:

@@ -183,7 +183,7 @@ class Scenario:
     structure : ``{"builder": name, **options}`` for builder scenarios, else ``{}``.
     warnings : non-fatal remarks from ``geometry_library.checks.validate_assembly``.
     marked_driven : names of the supports a geometry file run as it is marks ``"driven"`` (``support_role``): a
-        record given on the command line shakes them (:func:`masonrycli.scenario.builtin.shaken_supports`).
+        record given on the command line shakes them (:func:`masonrycli.scenario.record_option.shaken_supports`).
     reading : how its file was read and settled (map shift, units, hulls, trims, ``settle_s``): run parameters.
 
     Each support's ``role`` is made consistent with its motion (``"driven"`` unless the motion is fixed).

@@ -224,7 +224,7 @@ def apply_point(base, params: dict):
     motions = list(scenario.motions)
     if "record" in params:
         record = base.records[params["record"]]
-        from masonrycli.scenario.builtin import no_shaking_support, shaken_supports
+        from masonrycli.scenario.record_option import no_shaking_support, shaken_supports
 
         shaking = [j for j, shaken in enumerate(shaken_supports(scenario)) if shaken]
         if not shaking:

@@ -20,7 +20,9 @@ from pathlib import Path
 from masonrycli.errors import InputError
 from masonrycli.outputs.files import OutputFile, safe_name
 from masonrycli.records.motion import unused_baseline
-from masonrycli.scenario.builtin import check_baseline, check_record_dt, is_built_in, override_run, target_scenario
+from masonrycli.scenario.builtin import override_run
+from masonrycli.scenario.record_option import check_baseline, check_record_dt
+from masonrycli.scenario.target import is_built_in, target_scenario
 from masonrycli.scenario.values import option_text
 from masonrycli.study import store
 from masonrycli.study.axes import Axis, StudyBase, apply_point, check_axes, check_find, parse_axis
@@ -188,8 +190,8 @@ def _scenario_warnings(scenario, records) -> list[str]:
     """The warnings ``masonry run`` prints for the study's base scenario (a block touching nothing, a GeoJSON
     property not used, gravity pointing up: the sweep ran every point without a word); with ``--records``
     its own record is not run, so not its records' (the set's are in ``late``)."""
-    from masonrycli.scenario.builtin import shaken_by
     from masonrycli.scenario.caveats import record_warnings, scenario_warnings
+    from masonrycli.scenario.record_option import shaken_by
 
     if not records:
         return scenario_warnings(scenario)
