@@ -25,6 +25,7 @@ from masonrycli.engine.tuning import TUNING, Tuning
 from masonrycli.model import Model, State, build_model, initial_state
 from masonrycli.outputs.frame import Frame
 from masonrycli.outputs.sinks import COMPLETED, DIVERGED, FAILED, INTERRUPTED
+from masonrycli.outputs.verdict import describe_hinges, describe_outcome, describe_peak_drift  # noqa: F401 (theirs)
 from masonrycli.records.intensity import describe as describe_intensity
 from masonrycli.records.intensity import intensity_measures, shaking_support
 
@@ -399,42 +400,6 @@ def run_outcome(sim: Simulation, hinges: int) -> dict:
         "max_slide_speed": mon.max_slide_speed,
         "max_rock_speed": mon.max_rock_speed,
     }
-
-
-def describe_outcome(outcome: dict) -> str:
-    """``collapsed at t = 0.53 s (a block fell ...)``, ``damaged (residual drift 0.31 %, 2 hinges, ...)``."""
-    tail = (
-        f"residual drift {_shown(100 * outcome['residual_drift'])} % of the height, {outcome['hinges']} hinges, "
-        f"largest opening {_shown(1000 * outcome['max_opening'])} mm"
-    )
-    if "max_displacement" in outcome:  # a block moved off its place damages too: the line shows by how much
-        tail += f", largest block displacement {_shown(1000 * outcome['max_displacement'])} mm"
-    if outcome["state"] == "collapsed":
-        return f"collapsed at t = {outcome['collapse_time']:.3f} s ({outcome['collapse_reason']})"
-    return f"{outcome['state']} ({tail})"
-
-
-def describe_hinges(pairs: list[str]) -> str:
-    """``12: c01-b01|c02-b01, …``: how many joints are hinged, and the first 8 by name (the summary's row and
-    ``masonry report``'s)."""
-    shown = ", ".join(pairs[:8]) + (" …" if len(pairs) > 8 else "")
-    return f"{len(pairs)}" + (f": {shown}" if pairs else "")
-
-
-def describe_peak_drift(ratio: float, height: float) -> str:
-    """``0.0627 % of the height (1.88 mm over 3 m), the top's largest horizontal move relative to the ground
-    during the run``: an intact wall's residual drift is ~0 whatever it went through (a 3 m section at 0.25 g
-    ended at 0.00396 % having swung to 0.063 %)."""
-    return (
-        f"{_shown(100 * ratio)} % of the height ({_shown(1000 * ratio * height)} mm over {height:.3g} m), the top's "
-        "largest horizontal move relative to the ground during the run"
-    )
-
-
-def _shown(value: float) -> str:
-    """3 significant digits, and 0 below 1e-6 (% or mm): a wall at rest read 'residual drift 2.16e-17 % ...,
-    largest opening 1.67e-32 mm', round-off dressed as a measurement."""
-    return "0" if abs(value) < 1e-6 else f"{value:.3g}"
 
 
 def applied_intensity(scenario, model: Model, steps: int | None = None) -> dict[str, float]:

@@ -229,3 +229,28 @@ def test_the_material_row_is_the_blocks_own_density(tmp_path, densities, said):
     assert said in _rows(invoke("inspect", h).stdout)["material"]
     assert said in invoke("report", h).stdout
     assert np.load(h)["block_mass"].sum() == pytest.approx(0.08 * sum(densities), rel=1e-12)
+
+
+def test_the_run_s_verdict_and_its_words_are_rows(tmp_path):
+    # the history kept result_* (4364b33) but inspect showed them as bare array lines, the words ones with no
+    # value at all ('result_state  ()  str'): its table now says the state, peak and residual drift as the run's
+    # summary said them, and a 0-d word is shown quoted
+    h = tmp_path / "h.npz"
+    ran = invoke("simulate", "wall", "--blocks", 12, "--amp", 0.5, "--duration", 0.05, "--history", h, "--no-recording")
+    assert ran.exit_code == 0, ran.output
+    summary, result = _rows(ran.output), invoke("inspect", h)
+    rows, arrays = _rows(result.output), _array_lines(result.output)
+    for label in ("state", "peak drift"):
+        assert rows[label] == summary[label]
+    with np.load(h) as npz:
+        ratio, height, state = (
+            float(npz["result_residual_drift"]),
+            float(npz["result_height"]),
+            str(npz["result_state"]),
+        )
+    assert rows["residual drift"].startswith(f"{100 * ratio:.3g} % of the height ({1000 * ratio * height:.3g} mm)")
+    assert arrays["result_state"].startswith(f"() = {state!r} ") and arrays["result_collapse_reason"].startswith(
+        "() = ''"
+    )
+    assert arrays["run"].split()[:2] == ["()", "str"]  # the run's JSON: its rows above, not a line of 2 kB
+    assert list(rows)[:2] == ["scenario", "structure"]  # an in-process command: no command to name

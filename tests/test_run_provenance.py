@@ -52,3 +52,14 @@ def test_a_sweep_s_histories_name_the_sweep(tmp_path, monkeypatch):
         assert _command(tmp_path / "h" / f"{point}.npz") == line
         page = rows(invoke("report", f"h/{point}.npz").output)
         assert page["command"] == line and page["study point"] == point.replace("=", " = ").replace("_", ", ")
+
+
+def test_inspect_shows_the_command_first_and_the_report_once(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    api.simulate("wall", blocks=12, duration=0.01, history="w.npz")
+    call = "api.simulate('wall', blocks=12, duration=0.01, history='w.npz')"
+    table = invoke("inspect", "w.npz").output
+    first = next(line for line in table.splitlines() if line.startswith("│"))
+    assert first.split("│")[1].strip() == "command" and call.startswith(first.split("│")[2].strip())
+    page = invoke("report", "w.npz").output
+    assert page.count("| command |") == 1 and page.count("| state |") == 1  # inspect's rows, taken once each

@@ -104,7 +104,7 @@ def inspect_history(path: str | os.PathLike) -> dict:
             small = {
                 name: npz[name]
                 for name, (shape, dtype) in headers.items()
-                if name in ("time", "step", *_SMALL) or (shape == () and dtype.kind in "biuf")
+                if name in ("time", "step", *_SMALL) or (shape == () and dtype.kind in "biufU")
             }
     except (OSError, zipfile.BadZipFile, ValueError, EOFError) as exc:
         raise _unreadable(path, exc) from None
@@ -118,7 +118,7 @@ def inspect_history(path: str | os.PathLike) -> dict:
     frames = int(time.shape[0]) if time.ndim else 0
     arrays = []
     for name, (shape, dtype) in headers.items():
-        value = small.get(name) if shape == () and dtype.kind in "biuf" else None
+        value = small.get(name) if shape == () and dtype.kind in "biufU" else None
         arrays.append((name, shape, _dtype_name(dtype), units.get(name), None if value is None else value.item()))
 
     def text(name):
@@ -179,6 +179,9 @@ def run_rows(info: dict) -> list[tuple[str, str]]:
     def get(key):
         return None if run is None else run.get(key)
 
+    if get("command"):  # the masonry command line, the Python API's call or the sweep that made it
+        rows.append(("command", str(get("command"))))
+
     def given(*values) -> bool:
         return all(v is not None for v in values)
 
@@ -203,6 +206,7 @@ def run_rows(info: dict) -> list[tuple[str, str]]:
     if status and note:  # "interrupted at t = …", "diverged at t = …" name their status already
         status = note if note.startswith(status) else f"{status}: {note}"
     rows.append(("status", status or NOT_RECORDED))
+    rows += verdict_rows({name: value for name, _, _, _, value in info.get("arrays", ())})
     solver, tol, cap = get("solver"), get("nlgs_tolerance"), get("nlgs_max_iterations")
     rows.append(("solver", str(solver) if solver is not None else NOT_RECORDED))
     rows.append(("tolerance", f"{tol:g} m/s (at most {cap} sweeps a step)" if given(tol, cap) else _or(tol, " m/s")))
@@ -250,6 +254,23 @@ def _value(value) -> str:
     return f"{value:g}"
 
 
+def verdict_rows(values: dict) -> list[tuple[str, str]]:
+    """The run's verdict from its ``result_*`` numbers (``values``: name -> the 0-d array's value), in the
+    summary's words: state, peak drift, residual drift; none for a history written before it was kept."""
+    from masonrycli.outputs.history import RESULT_KEYS
+    from masonrycli.outputs.verdict import describe_outcome, describe_peak_drift, describe_residual_drift
+
+    out = {key: values.get(f"result_{key}") for key in RESULT_KEYS}
+    height = values.get("result_height")
+    if height is None or any(v is None for v in out.values()):
+        return []
+    return [
+        ("state", describe_outcome(out)),
+        ("peak drift", describe_peak_drift(out["peak_drift"], height)),
+        ("residual drift", describe_residual_drift(out["residual_drift"], height)),
+    ]
+
+
 def _or(value, unit: str) -> str:
     return f"{value:g}{unit}" if isinstance(value, (int, float)) else NOT_RECORDED
 
@@ -259,6 +280,8 @@ def array_rows(info: dict) -> list[tuple[str, str, str, str]]:
     rows = []
     for name, shape, dtype, meaning, value in info["arrays"]:
         shape_text = "(" + ", ".join(map(str, shape)) + ("," if len(shape) == 1 else "") + ")"
+        if isinstance(value, str):  # a word (a state, a status) quoted, '' shown; the run's JSON is its table
+            value = repr(value) if len(value) <= 40 and "\n" not in value else None
         if value is not None:
             shape_text += f" = {value:.4g}" if isinstance(value, float) else f" = {value}"
         rows.append((name, shape_text, dtype, meaning if meaning else NOT_RECORDED))

@@ -78,7 +78,18 @@ def _info(arrays) -> dict:
     }
 
 
-RUN_ROWS = ("scenario", "structure", "reading", "study point", "material", "loading", "dt", "solver", "tolerance")
+RUN_ROWS = (
+    "command",
+    "scenario",
+    "structure",
+    "reading",
+    "study point",
+    "material",
+    "loading",
+    "dt",
+    "solver",
+    "tolerance",
+)
 """The rows of ``masonry inspect`` the page's 'what was run' gives, in this order (then masonry's own)."""
 
 
@@ -88,8 +99,6 @@ def _what_was_run(arrays, shown: str) -> list[tuple[str, str]]:
     rows = dict(run_rows(_info(arrays)))
     out = [(label, rows[label]) for label in RUN_ROWS if label in rows]
     run = _run(arrays)
-    if run.get("command"):
-        out.insert(0, ("command", str(run["command"])))
     out += [("masonry", rows["masonry"]), ("history", shown)]
     if run.get("started"):
         out.append(("started", str(run["started"])))
@@ -143,7 +152,13 @@ def unconverged(arrays) -> tuple[int, int] | None:
 
 def _result_rows(arrays, table) -> list[tuple[str, str]]:
     from masonrycli.outputs.inspect_history import run_rows
-    from masonrycli.run import _shown, describe_hinges, describe_outcome, describe_peak_drift
+    from masonrycli.outputs.verdict import (
+        describe_hinges,
+        describe_outcome,
+        describe_peak_drift,
+        describe_residual_drift,
+        shown,
+    )
 
     rows = [("status", dict(run_rows(_info(arrays)))["status"])]
     found = outcome(arrays)
@@ -151,14 +166,13 @@ def _result_rows(arrays, table) -> list[tuple[str, str]]:
         out, height = found
         rows.append(("state", describe_outcome(out)))
         rows.append(("peak drift", describe_peak_drift(out["peak_drift"], height)))
-        ratio = out["residual_drift"]
-        rows.append(("residual drift", f"{_shown(100 * ratio)} % of the height ({_shown(1000 * ratio * height)} mm)"))
+        rows.append(("residual drift", describe_residual_drift(out["residual_drift"], height)))
     else:
         drift = column(table, "drift ratio (-)")
         peak = float(np.nanmax(np.abs(drift))) if len(drift) else math.nan
         rows.append(("state", "not recorded: a history written before masonry kept the run's verdict (run it again)"))
-        rows.append(("peak drift", f"{_shown(100 * peak)} % of the height over the recorded frames (not every step)"))
-        rows.append(("residual drift", f"{_shown(100 * float(drift[-1]))} % of the height (the last frame)"))
+        rows.append(("peak drift", f"{shown(100 * peak)} % of the height over the recorded frames (not every step)"))
+        rows.append(("residual drift", f"{shown(100 * float(drift[-1]))} % of the height (the last frame)"))
     if "joint_hinged" in arrays:
         rows.append(("hinged joints (end)", describe_hinges(hinged_joints(arrays))))
     counts = unconverged(arrays)
