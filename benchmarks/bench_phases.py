@@ -14,7 +14,9 @@ their CPU time (``time.process_time``, ~0.7 µs a call on this machine):
 * ``before_solve`` (fused.before_solve: q_m, detection, warm start, v_free), ``prepare``
   (nlgs.prepare_contacts), ``solve`` (dispatch.solve; within it ``solve.sweeps``, the float64 first stage
   and the interleaved sweeps: dispatch.first_stage and interleaved.sweeps, or nlgs._nlgs_interleaved in a
-  revision before engine/dispatch.py, and ``solve.stalled``, stalled.py's methods), ``contact_power``, ``after_solve``;
+  revision before engine/dispatch.py; the default's lane_sweeps32.first_stage, within it ``solve.sweeps32``,
+  its float32 sweeps with their set-up, and ``solve.polish64``, the float64 lane sweeps after them, set-up
+  included; and ``solve.stalled``, stalled.py's methods), ``contact_power``, ``after_solve``;
 * outside the solver: ``tensors`` (TensorComputer.step), ``monitor`` (CollapseMonitor.update),
   ``frame`` (Simulation.frame, every recorded frame), ``record`` (Recorder.on_frame and close);
 * ``rest``: the run's CPU time minus all of the above (the loop, the statistics, Python between calls).
@@ -39,7 +41,8 @@ from pathlib import Path
 os.environ.setdefault("RERUN_ANALYTICS", "0")
 ROOT = Path(__file__).resolve().parent.parent
 PHASES = (
-    "before_solve", "prepare", "solve", "solve.sweeps", "solve.stalled", "contact_power", "after_solve",
+    "before_solve", "prepare", "solve", "solve.sweeps", "solve.sweeps32", "solve.polish64", "solve.stalled",
+    "contact_power", "after_solve",
     "tensors", "monitor", "frame", "record", "rest",
 )  # fmt: skip
 
@@ -67,6 +70,11 @@ def worker(package_root: str, case: str, duration: float, record: bool) -> None:
 
     from benchmarks import bench_solver
     from masonrycli.engine import fused, interleaved, nlgs, power, stalled
+
+    try:  # the float32 first stage (solver nlgs-accel32, the default since 878c068)
+        from masonrycli.engine import lane_sweeps, lane_sweeps32
+    except ImportError:
+        lane_sweeps = lane_sweeps32 = None
     from masonrycli.recording import Recorder
 
     try:  # solve() and the first stage: engine/dispatch.py; nlgs.solve and nlgs._nlgs_interleaved before it
@@ -78,7 +86,9 @@ def worker(package_root: str, case: str, duration: float, record: bool) -> None:
     for owner, name, key in (
         (fused, "before_solve", "before_solve"), (nlgs, "prepare_contacts", "prepare"), (dispatch, "solve", "solve"),
         (nlgs, "_nlgs_interleaved", "solve.sweeps"), (dispatch, "first_stage", "solve.sweeps"),
-        (interleaved, "sweeps", "solve.sweeps"), (stalled, "continue_stalled", "solve.stalled"),
+        (interleaved, "sweeps", "solve.sweeps"), (lane_sweeps32, "first_stage", "solve.sweeps"),
+        (lane_sweeps32, "lane_sweeps32", "solve.sweeps32"), (lane_sweeps, "_lane_sweeps", "solve.polish64"),
+        (stalled, "continue_stalled", "solve.stalled"),
         (power, "contact_power", "contact_power"), (fused, "after_solve", "after_solve"),
         (Recorder, "on_frame", "record"), (Recorder, "close", "record"),
     ):  # fmt: skip

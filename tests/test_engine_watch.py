@@ -37,6 +37,29 @@ def test_watch_matches_numpy():
     assert top_dx == np.mean(st.body_q[top, 0] - q0[top, 0])
 
 
+def test_watch_measures_the_fall_below_the_supports_settlement():
+    # The settlement (max over the supports of y0 - y, at least 0) lowers the blocks' reference: numpy's
+    # formula of CollapseMonitor.update before the kernel took it over; a NaN support's counts as none.
+    scenario = scenario_from_builder("wall", {"blocks": 12}, RunConfig(duration=0.05), Material(friction=0.6), {})
+    sim = Simulation(scenario)
+    for _ in range(20):
+        sim.step()
+    s, m = sim.solver, sim.model
+    n = m.block_count
+    assert m.body_q0.shape[0] > n  # the ground is a support
+    height = np.array([np.ptp(b.vertices[:, 1]) for b in scenario.assembly.blocks])
+    top = np.array([0, 5], dtype=np.int64)
+    q0 = m.body_q0
+    for drop, support_drop in ((0.0, 0.0), (0.05, 0.03), (0.05, -0.03), (0.05, np.nan)):
+        q = sim.state.body_q.copy()
+        q[:n, 1] -= drop
+        q[n:, 1] -= support_drop
+        settlement = max(0.0, float(np.max(q0[n:, 1] - q[n:, 1])))
+        lowered = q0[:n, 1] - settlement
+        _, _, fall, _, _ = watch_step(s, q, sim.state.body_v, q0, height, top)
+        assert fall == np.max((lowered - q[:n, 1]) / height)
+
+
 def test_the_step_kernels_read_no_private_attribute_of_the_solver():
     # fused.py and watch.py get the Solver's arrays as arguments or through its documented public views
     # (contact_body, contact_pack, contact_status), never through its private attributes.

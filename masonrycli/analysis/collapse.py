@@ -108,9 +108,6 @@ class CollapseMonitor:
         heights = np.array([np.ptp(v[:, 1]) for v in vertices_by_block]) if n else np.zeros(0)
         # The fall is measured in units of at least a median block: a sliver's own height is no scale.
         self.block_height = np.maximum(heights, float(np.median(heights))) if n else heights
-        self._q0_fall = q0.copy()
-        """q0 with the blocks' y lowered by the current settlement (what ``watch_step`` measures falls from)."""
-        self._settlement = 0.0
         ys = np.concatenate([v[:, 1] for v in vertices_by_block]) if n else np.zeros(1)
         self.height = float(np.ptp(ys)) or 1.0
         top_y = q0[:n, 1].max() if n else 0.0
@@ -140,12 +137,8 @@ class CollapseMonitor:
         """One step: ``body_q``/``body_v`` (B, 3) after ``solver``'s step."""
         if not self.n:
             return
-        n = self.n
-        settlement = max(0.0, float(np.max(self.q0[n:, 1] - body_q[n:, 1]))) if body_q.shape[0] > n else 0.0
-        if settlement != self._settlement:
-            self._settlement = settlement
-            self._q0_fall[:n, 1] = self.q0[:n, 1] - settlement
-        rock, slide, fall, turn, top_dx = watch_step(solver, body_q, body_v, self._q0_fall, self.block_height, self.top)
+        # the fall below the supports' settlement: watch_step's (a block riding a settling support has not fallen)
+        rock, slide, fall, turn, top_dx = watch_step(solver, body_q, body_v, self.q0, self.block_height, self.top)
         before, drift = self.collapse_time, top_dx - self._ground_dx(body_q)
         self.observe(time, rock, slide, fall, turn, drift)
         if before is None and self.collapse_time is not None and self.collapse_reason.startswith(DRIFTED):

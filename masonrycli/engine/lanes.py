@@ -137,16 +137,21 @@ def pack_lanes(contact_body, pack, count, v, r):
     # Not shared with lane_sweeps32.pack_lanes32 (only colour_lane is): its pushes go in contact order from
     # the pack in float64, these in lane order from Q, so one kernel would change one path's bits.
     run = (count + LANES - 1) // LANES
-    # np.empty and a fill, not np.zeros (_jit's rule): np.zeros compiled 2 signatures and a fill of its own,
-    # 0.1 s of a first run's CPU (benchmarks/JOURNAL.md, "Cold start"); absent lanes keep these zeros
+    # np.empty, not np.zeros (_jit's rule): np.zeros compiled 2 signatures and a fill of its own, 0.1 s of a
+    # first run's CPU (benchmarks/JOURNAL.md, "Cold start")
+    # (every element of Q written once: an absent lane's rows and IA, IB and a present lane's status 0, the
+    # zeros a fill of the whole of Q gave them before its rows were copied over it)
     Q = np.empty(run * ROWS * LANES, np.float64)
     IA = np.empty(run * LANES, np.int64)
     IB = np.empty(run * LANES, np.int64)
-    for i in range(Q.shape[0]):
-        Q[i] = 0.0
-    for i in range(IA.shape[0]):
-        IA[i] = 0
-        IB[i] = 0
+    for j in range(run):  # absent lanes: q·run + j ≥ C, in the last groups only
+        for q in range(LANES):
+            if q * run + j >= count:
+                base = j * ROWS * LANES + q
+                for row in range(ROWS):
+                    Q[base + row * LANES] = 0.0
+                IA[j * LANES + q] = 0
+                IB[j * LANES + q] = 0
     for j0 in range(0, run, TILE):
         j1 = min(j0 + TILE, run)
         for q in range(LANES):
@@ -161,6 +166,7 @@ def pack_lanes(contact_body, pack, count, v, r):
                 Q[base + R_PT * LANES] = r[c, 0]
                 Q[base + R_XN * LANES] = r[c, 1]
                 Q[base + R_PN * LANES] = r[c, 1]
+                Q[base + R_ST * LANES] = 0.0
                 IA[j * LANES + q] = 4 * contact_body[c, 0]
                 IB[j * LANES + q] = 4 * contact_body[c, 1]
     sub = np.empty((run, LANES), np.int64)
