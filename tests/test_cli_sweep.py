@@ -1,7 +1,8 @@
 """``masonry sweep`` as a user drives it (in process, --workers 0): its options checked into one-line errors,
-the counts line and the terminal table, what it sweeps (a scenario, a geometry file, records on a built-in),
-and its exit codes (3: some runs diverged, 5: some failed). The recording and pictures are in
-test_recording_study.py, the files it writes in test_sweep_outputs.py, signals in test_sweep_interrupt.py."""
+the counts line and the terminal table, what it sweeps (a scenario, a geometry file),
+and its exit codes (3: some runs diverged, 5: some failed). Over records: test_cli_sweep_records.py; inspect of
+its table: test_cli_inspect_file.py. The recording and pictures are in test_recording_study.py, the files it
+writes in test_sweep_outputs.py, signals in test_sweep_interrupt.py."""
 
 from __future__ import annotations
 
@@ -9,12 +10,10 @@ from pathlib import Path
 
 import pytest
 
-from masonrycli.records.read import G_STANDARD
 from masonrycli.study.store import read_rows
 
 from cli_helpers import assert_one_line_error, words
-from sweep_helpers import BLOCK, invoke, write_block
-from synthetic_records import band_limited, write_at2
+from sweep_helpers import invoke, write_block
 
 
 @pytest.fixture
@@ -98,7 +97,7 @@ def test_sweep_errors_are_one_line(block, args, fragment, tmp_path, monkeypatch)
 @pytest.mark.parametrize("option", ["--out", "--plot", "--recording", "--histories", "--records"])
 def test_an_empty_path_is_said_to_be_empty(option):
     # Path("") is ".": sweep took --out "" as the folder "."
-    from cli_helpers import assert_one_line_error, invoke
+    from cli_helpers import invoke
 
     assert_one_line_error(invoke("sweep", "wall", "--param", "amp=0.1", option, ""), option, "the path is empty")
 
@@ -145,21 +144,6 @@ def test_a_geometry_file_is_swept_as_run_runs_it(tmp_path):
     assert [r["friction"] for r in read_rows(out)] == [0.5, 0.6]
 
 
-def test_a_record_study_without_a_fit_says_which_side_and_what_to_change(tmp_path):
-    # 'fragility: no fit (every run collapsed, or none did)' left the user to count which, and which way to go
-    folder = tmp_path / "records"
-    folder.mkdir()
-    t, u, v, a = band_limited(0.2, 0.01, [2.0], [0.001], seed=0)
-    write_at2(folder / "weak.AT2", a / G_STANDARD, 0.01)
-    args = ["sweep", "wall", "--records", folder, "--workers", 0, "--no-recording", "--param", "blocks=12"]
-    result = invoke(*args, "--scale", "0.5,1", "--out", tmp_path / "a.csv")
-    assert result.exit_code == 0, result.output
-    said = words(result.output)
-    assert "fragility: no fit — none of the 2 runs collapsed (larger --scale values reach it)" in said, said
-    result = invoke(*args, "--out", tmp_path / "b.csv")
-    assert "fragility: no fit (1 run; a fit needs at least 2)" in words(result.output), result.output
-
-
 def test_rows_name_the_masonry_that_made_them_and_a_resume_says_when_it_differs(block, tmp_path):
     # the study's fingerprint is of its inputs, not of the code: resumed after an upgrade, a table mixed the
     # rows of two solvers without a word, and no row said which masonry had made it
@@ -179,46 +163,6 @@ def test_rows_name_the_masonry_that_made_them_and_a_resume_says_when_it_differs(
         "not run again" in words(result.output)
     ), result.output
     assert [r["source"] for r in read_rows(out)] == ["0123456789ab", ours, ours]
-
-
-def test_records_run_whole_on_a_built_in_and_a_shorter_run_is_warned(block, tmp_path):
-    # the built-in wall's 1 s cut every record to its first second: without --duration the runs last the
-    # longest record; a scenario file keeps its [run] duration, and a record longer than the runs is named
-    folder = tmp_path / "records"
-    folder.mkdir()
-    t, u, v, a = band_limited(1.5, 0.01, [1.0, 2.5], [0.003, 0.001], seed=0)
-    write_at2(folder / "long.AT2", a / G_STANDARD, 0.01)
-    (folder / "short.csv").write_text("time,velocity\n0,0\n0.2,0.01\n0.4,0\n")
-    out = tmp_path / "whole.csv"
-    result = invoke("sweep", "wall", "--records", folder, "--workers", 0, "--out", out, "--no-recording")
-    assert result.exit_code == 0, result.output
-    assert {(r["record"], r["steps"]) for r in read_rows(out)} == {("long.AT2", 1500), ("short.csv", 1500)}
-    assert "warning" not in result.output
-    result = invoke("sweep", block, "--records", folder, "--workers", 0, "--out", tmp_path / "b.csv", "--no-recording")
-    assert result.exit_code == 0, result.output
-    assert {r["steps"] for r in read_rows(tmp_path / "b.csv")} == {500}  # the file's 1 s at dt = 2e-3
-    assert (
-        "warning: the runs' 1 s are shorter than 1 of 2 records (longest 1.5 s, long.AT2): their shaking after "
-        "t = 1 s is not applied" in words(result.output)
-    )
-    # bad input stays one line: the warning comes once the request is checked, not beside its error
-    fixed = tmp_path / "fixed.toml"
-    fixed.write_text(BLOCK.replace('motion = { kind = "sine", amplitude = 0.1, frequency = 2.0 }', ""))
-    result = invoke("sweep", fixed, "--records", folder, "--workers", 0, "--out", tmp_path / "f.csv")
-    assert result.exit_code == 2 and result.output.strip().splitlines() == [
-        "error: --records: fixed has no shaking support (give one a sine or record motion)"
-    ]
-    # a geometry file of several supports swept as it is, over records: the scenario file that says which one
-    # shakes, as run --record says (one of a single support shakes it: test_cli_record)
-    geo = tmp_path / "arch.geojson"
-    assert invoke("build", "arch", "--out", geo).exit_code == 0
-    result = invoke("sweep", geo, "--records", folder, "--workers", 0, "--out", tmp_path / "g.csv")
-    assert result.exit_code == 2 and words(result.output) == (
-        "error: --records: arch.geojson holds no motion and 2 supports (left-foundation, right-foundation); say "
-        'which the record shakes: mark them "support_role": "driven" in the file (WKT: support NAME driven: …), or '
-        'write a scenario file [structure] file = "arch.geojson" with a [[support]] name = "left-foundation" and '
-        'motion = { kind = "record", file = ... } (masonry docs scenario-format)'
-    )
 
 
 def test_failed_rows_give_exit_5_after_the_whole_table(block, tmp_path, monkeypatch):
@@ -372,28 +316,6 @@ def test_a_scheduler_lost_before_the_first_row_says_nothing_was_written(block, t
     assert [p.name for p in tmp_path.iterdir()] == ["block.toml"]
 
 
-def test_a_record_study_over_friction_says_one_fragility_per_friction(block, tmp_path):
-    # 'masonry sweep rubble.toml --records recs --scale … --param friction=0.5,0.7' fitted one curve over the
-    # runs of both frictions, and said one line: the fragility of neither wall
-    folder = tmp_path / "records"
-    folder.mkdir()
-    for seed in range(2):
-        a = band_limited(1.0, 0.01, [1.0 + 0.4 * seed, 2.5], [0.03, 0.01], seed=seed)[3]
-        write_at2(folder / f"syn{seed}.AT2", a / G_STANDARD, 0.01)
-    out = tmp_path / "ida.csv"
-    args = ["sweep", block, "--records", folder, "--scale", "0.5:8:3", "--param", "friction=0.3,0.9"]
-    result = invoke(*args, "--workers", 0, "--out", out, "--no-recording")
-    assert result.exit_code == 0, result.output
-    said = words(result.output)
-    assert said.count("fragility") == said.count(": fragility") == 2, said  # one line a friction, none pooled
-    rows = read_rows(out)
-    for friction in (0.3, 0.9):  # each line counts its own runs
-        own = [r for r in rows if r["friction"] == friction]
-        fell = sum(r["state"] == "collapsed" for r in own)
-        line = said.split(f"friction = {friction:g}: fragility")[1].split("friction =")[0]
-        assert len(own) == 6 and (fell in (0, 6) or f"({fell} of 6 runs collapsed" in line), line
-
-
 def test_a_rows_run_replays_with_simulate_and_stop_at_collapse(tmp_path):
     # docs/sweep.md "One run of a study, in the viewer": the row's point given to simulate, --stop-at-collapse
     import numpy as np
@@ -413,74 +335,6 @@ def test_a_rows_run_replays_with_simulate_and_stop_at_collapse(tmp_path):
     assert row["state"] == "collapsed" and replay["time"][-1] == pytest.approx(row["collapse_time"])
     for name in ("time", "block_q", "block_v", "energy_dissipated"):
         assert np.array_equal(study[name], replay[name]), name
-
-
-def test_a_records_folder_names_the_files_it_does_not_read(block, tmp_path):
-    # a COSMOS file (.V2) and a one-column .txt accelerogram beside the set's .AT2 were left out without a word
-    folder = tmp_path / "records"
-    folder.mkdir()
-    a = band_limited(0.3, 0.01, [2.0], [0.01], seed=1)[3]
-    write_at2(folder / "syn.AT2", a / G_STANDARD, 0.01)
-    (folder / "CE13122.V2").write_text("Corrected accelerogram\n")
-    (folder / "quake.txt").write_text("0.1\n0.2\n")
-    for own in ("syn.AT2.vt2", "notes.md", ".hidden", "old.png"):  # companions, notes, masonry's files: no word
-        (folder / own).write_text("x")
-    out = tmp_path / "s.csv"
-    result = invoke("sweep", block, "--records", folder, "--workers", 0, "--out", out, "--no-recording")
-    assert result.exit_code == 0, result.output
-    assert (
-        f"warning: --records {folder}: 2 files not read as records (CE13122.V2, quake.txt): a set reads "
-        "PEER .AT2, ESM .ASC, K-NET (.NS, .EW, .UD) and .csv files" in words(result.output)
-    )
-    assert [r["record"] for r in read_rows(out)] == ["syn.AT2"]
-
-
-def test_inspect_a_study_table_gives_its_rows_values_and_each_columns_unit(block, tmp_path):
-    # 'masonry inspect study.csv' said "a table (.csv), not a recording": the table's numbers had no unit anywhere
-    # but the docs (pga 1.70: m/s² or g?)
-    for suffix in (".csv", ".parquet"):
-        out = tmp_path / f"s_{suffix[1:]}{suffix}"  # its own plot beside it
-        args = ["--param", "amp=0.05,0.1", "--param", "friction=0.5", "--duration", 0.1, "--workers", 0]
-        assert invoke("sweep", block, *args, "--out", out, "--no-recording").exit_code == 0
-        result = invoke("inspect", out)
-        assert result.exit_code == 0, result.output
-        said = words(result.output)
-        assert "study table" in said and "rows │ 2 (" in said and "amp │ 0.05, 0.1 m/s" in said, said
-        lines = result.output.splitlines()
-        assert any(ln.split() == ["pga", "m/s²,", "peak", "ground", "acceleration", "as", "applied"] for ln in lines)
-        assert any(ln.startswith("max_opening") and "m, largest joint opening" in ln for ln in lines)
-    record = tmp_path / "q.csv"
-    record.write_text("time,velocity\n0,0\n1,1\n")
-    assert_one_line_error(invoke("inspect", record), "q.csv: not a study's table")
-
-
-def test_inspect_a_study_table_with_its_header_and_no_rows_says_none_yet(block, tmp_path):
-    # its header has the study and status columns, yet inspect said "not a study's table (no study and status
-    # columns)"; a table with its rows filtered away in a spreadsheet (or pandas) and saved again is one
-    import pyarrow as pa
-    import pyarrow.parquet as pq
-
-    out = tmp_path / "s.csv"
-    args = ["--param", "amp=0.05,0.1", "--duration", 0.1, "--workers", 0]
-    assert invoke("sweep", block, *args, "--out", out, "--no-recording").exit_code == 0
-    header = out.read_text().splitlines()[0]
-    empty_csv = tmp_path / "e.csv"
-    empty_csv.write_text(header + "\n")
-    empty_parquet = tmp_path / "e.parquet"
-    pq.write_table(pa.table({c: pa.array([], pa.float64()) for c in header.split(",")}), empty_parquet)
-    for table in (empty_csv, empty_parquet):
-        result = invoke("inspect", table)
-        assert result.exit_code == 0, result.output
-        said = words(result.output.replace("│", " "))  # the table's cells, wrapped within their column
-        assert "not a study's table" not in said
-        assert "rows 0 — no rows yet: masonry sweep writes its rows here when the study ends or is stopped" in said
-        assert f"kept in the journal {table.name}.journal.jsonl meanwhile" in said, said
-        assert "amp no value yet" in said
-        assert any(ln.startswith("pga") and "m/s²" in ln for ln in result.output.splitlines())
-    # a study under way: its finished rows are in the journal
-    (tmp_path / "e.csv.journal.jsonl").write_text('{"amp": 0.05}\n{"amp": 0.1}\n')
-    said = words(invoke("inspect", empty_csv).output.replace("│", " "))
-    assert "2 finished rows wait in e.csv.journal.jsonl, written here when the study ends" in said, said
 
 
 def test_the_study_recording_line_says_how_to_open_it(block, tmp_path):
