@@ -1,4 +1,5 @@
-"""Every refusal of the bad-input catalogue (tests/bad_input_files.py, bad_input_options.py) that ``masonry
+"""Every refusal of the bad-input catalogue (tests/bad_input_files.py, bad_input_geometry.py,
+bad_input_options.py, bad_input_paths.py) that ``masonry
 simulate``, ``run`` or ``check`` makes with exit 2 is the Python API's too, in the same words: each row's options,
 as the command line converts them, given to :func:`masonrycli.api.simulate` raise the
 :class:`~masonrycli.errors.InputError` whose text is the command's line (a row the command line's parser refuses,
@@ -13,7 +14,9 @@ import click
 import pytest
 import typer
 from bad_input_files import FILE_ROWS
+from bad_input_geometry import GEOMETRY_ROWS
 from bad_input_options import OPTION_ROWS
+from bad_input_paths import PATH_ROWS
 from test_bad_input_catalogue import write_files
 
 from geometry_library.values import TypedNumber
@@ -24,7 +27,11 @@ from masonrycli.scenario.builtin import BUILT_IN
 
 from cli_helpers import invoke, words
 
-ROWS = [row for row in FILE_ROWS + OPTION_ROWS if row[2][0] in ("simulate", "run", "check") and row[3] == 2]
+ROWS = [
+    row
+    for row in FILE_ROWS + GEOMETRY_ROWS + OPTION_ROWS + PATH_ROWS
+    if row[2][0] in ("simulate", "run", "check") and row[3] == 2
+]
 TARGET = {"run": "scenario_file", "check": "target"}
 
 

@@ -11,13 +11,15 @@ import os
 
 import pytest
 from bad_input_files import FILE_ROWS
+from bad_input_geometry import GEOMETRY_ROWS
 from bad_input_options import OPTION_ROWS
+from bad_input_paths import PATH_ROWS
 from typer.testing import CliRunner
 
 from masonrycli.cli.app import app
 
 # (id, files, argv, exit code, fragment of the one line)
-CATALOGUE = FILE_ROWS + OPTION_ROWS
+CATALOGUE = FILE_ROWS + GEOMETRY_ROWS + OPTION_ROWS + PATH_ROWS
 
 
 def write_files(folder, files: dict) -> None:

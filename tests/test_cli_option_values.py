@@ -1,5 +1,5 @@
 """masonrycli/cli/option_values.py as a user meets it: choices in any case, a "~" the shell left. Numbers
-and paths refused as bad input: bad_input_options.py."""
+and paths refused as bad input: bad_input_options.py, bad_input_paths.py."""
 
 from __future__ import annotations
 
