@@ -16,6 +16,10 @@ is a trapezoid (cut where the top rises above the level: a ring standing proud o
 
 A block's fill is the sum of its trapezoids (area, centroid); where no block is under a piece (a gap
 between piers), no fill is counted (it would fall through).
+
+A fill traced as an outline (a surveyed bridge's: :func:`traced_fill_over`) is read the same way, from the top
+surface of the blocks and the supports up to the outline's top, each column bearing on the body topmost under it;
+its surface need not be level, and the columns over a support (the ground beyond an abutment) rest on it.
 """
 
 from __future__ import annotations
@@ -23,8 +27,13 @@ from __future__ import annotations
 import dataclasses
 
 import numpy as np
+from shapely import unary_union
+from shapely.geometry import Polygon
 
 from .blocks import Block
+
+FILL_DENSITY = 2000.0
+"""kg/m³: a bridge's fill when none is given (granular fill weighs 18–22 kN/m³)."""
 
 
 @dataclasses.dataclass(frozen=True, eq=False)
@@ -175,18 +184,7 @@ def fill_columns(blocks, level: float, x_lo: float, x_hi: float) -> FillColumns:
 def with_fill(blocks, level: float, density: float, x_lo: float, x_hi: float) -> list[Block]:
     """``blocks`` each carrying the mass of its fill (:func:`fill_over`; density kg/m³ × area × the block's
     thickness) lumped at the fill's centroid, added to any mass it carried before."""
-    fill = fill_over(blocks, level, x_lo, x_hi)
-    out = []
-    for block, area, centre in zip(blocks, fill.area, fill.centroid):
-        if area <= 0.0:
-            out.append(block)
-            continue
-        mass = density * area * block.thickness
-        total = block.carried_mass + mass
-        before = np.asarray(block.carried_at if block.carried_at is not None else centre, dtype=np.float64)
-        at = (block.carried_mass * before + mass * centre) / total
-        out.append(dataclasses.replace(block, carried_mass=float(total), carried_at=(float(at[0]), float(at[1]))))
-    return out
+    return carry(blocks, fill_over(blocks, level, x_lo, x_hi), density)
 
 
 LEVEL_TOLERANCE = 1e-6
@@ -273,3 +271,68 @@ def spread_load(blocks, x: float, level: float, angle_deg: float) -> list[tuple[
 def _extent(blocks) -> tuple[float, float]:
     xs = np.concatenate([np.asarray(b.vertices)[:, 0] for b in blocks])
     return float(xs.min()), float(xs.max())
+
+
+@dataclasses.dataclass(frozen=True, eq=False)
+class TracedFill:
+    """A traced fill's outline read over the structure: ``fill`` per block (area m², centroid m), and the areas
+    (m²) over a support (resting on it) and of the outline not above the bodies' top (drawn into the stones, or
+    over no body: no column to bear on)."""
+
+    fill: Fill
+    on_supports: float
+    not_above: float
+
+
+def traced_fill_over(blocks, supports, outline: Polygon) -> TracedFill:
+    """The fill of a traced ``outline`` (m), per block: from the top surface of the blocks and the supports up to
+    the outline's top, each column on the body topmost under it (module docstring; supports carry nothing). The
+    outline's top is the fill's surface and the fill reaches down to the stones (a tracing's lower edge along the
+    extrados, a few mm off the stones' chords, leaves no void under it), so a level outline between the
+    structure's ends is fill_over's fill to that level.
+
+        shadow = the outline swept down (its union with each edge's quadrilateral down to below every body)
+        for each piece [a, b] of the bodies' top surface under the outline (top_surface over blocks + supports):
+            part = shadow ∩ {a ≤ x ≤ b, y ≥ the piece's top line}
+            add its area and first moments to the piece's block, or to on_supports
+    """
+    bodies = [*blocks, *supports]
+    x_lo, _, x_hi, y_hi = outline.bounds
+    floor = min([outline.bounds[1], *(b.polygon.bounds[1] for b in bodies)]) - 1.0
+    xy = np.asarray(outline.exterior.coords)
+    sweeps = [Polygon([p, q, (q[0], floor), (p[0], floor)]) for p, q in zip(xy[:-1], xy[1:]) if p[0] != q[0]]
+    shadow = unary_union([outline, *sweeps])
+    sums = np.zeros((len(blocks), 3))
+    on_supports = outline_above = 0.0
+    for piece in top_surface(bodies, x_lo, x_hi) if bodies else []:
+        a, b = piece.a, piece.b
+        column = Polygon([(a, piece.y(a)), (b, piece.y(b)), (b, y_hi + 1.0), (a, y_hi + 1.0)])
+        outline_above += outline.intersection(column).area
+        part = shadow.intersection(column)
+        if part.is_empty or part.area <= 0.0:
+            continue
+        if piece.block >= len(blocks):
+            on_supports += part.area
+            continue
+        centre = part.centroid
+        sums[piece.block] += (part.area, centre.x * part.area, centre.y * part.area)
+    area = sums[:, 0]
+    with np.errstate(invalid="ignore", divide="ignore"):
+        centroid = np.where(area[:, None] > 0.0, sums[:, 1:] / area[:, None], np.nan)
+    return TracedFill(Fill(area=area, centroid=centroid), on_supports, max(0.0, outline.area - outline_above))
+
+
+def carry(blocks, fill: Fill, density: float) -> list[Block]:
+    """``blocks`` each carrying the mass of its ``fill`` (density kg/m³ × area × the block's thickness) at the
+    fill's centroid, added to any mass it carried before."""
+    out = []
+    for block, area, centre in zip(blocks, fill.area, fill.centroid):
+        if area <= 0.0:
+            out.append(block)
+            continue
+        mass = density * area * block.thickness
+        total = block.carried_mass + mass
+        before = np.asarray(block.carried_at if block.carried_at is not None else centre, dtype=np.float64)
+        at = (block.carried_mass * before + mass * centre) / total
+        out.append(dataclasses.replace(block, carried_mass=float(total), carried_at=(float(at[0]), float(at[1]))))
+    return out

@@ -51,7 +51,9 @@ from shapely.geometry import Polygon
 
 from .blocks import SUPPORT_ROLES, Assembly, Block, GeometryError, Support, name_problem, quoted_name
 from .checks import body_label
+from .fill import FILL_DENSITY
 from .survey import GROUND_DEPTH, Survey, finish_reading, frame_of, ground_from_line, surveyed_polygon
+from .traced_fill import carry_fills, fill_outline
 from .values import check_positive, is_real
 
 LINES = ("LineString", "MultiLineString")
@@ -68,6 +70,8 @@ BLOCK_PROPERTIES = ("density", "thickness", "velocity", "carried_mass", "carried
 """The properties read on blocks only: on a support they are not used (listed in ``unknown``)."""
 SUPPORT_PROPERTIES = ("support_role",)
 """The properties read on supports only: on a block they are not used (listed in ``unknown``)."""
+NOT_FILL_PROPERTIES = tuple(k for k in GEOJSON_PROPERTIES if k not in ("role", "name", "density"))
+"""The properties a traced fill (``"role": "fill"``) does not use (listed in ``unknown``)."""
 GIS_ID_COLUMNS = ("id", "fid", "ogc_fid", "objectid")
 """Feature ids a GIS export adds to every layer (compared lower-case): not read, not reported."""
 
@@ -179,6 +183,7 @@ def read_geojson(
     supports: list[Support] = []
     refused: list[tuple[str, str]] = []  # (message, body) of each polygon refused, said together at the end
     pending = []  # (feature_at, where, role, index, name, props, coords): made once every ring is read
+    fills = []  # (where, name, density, coords) of each traced fill: its weight goes to the blocks under it
     by_id = id_names(features)  # feature number -> "id-17": a GIS layer's own numbering names its stones
     survey, said = survey or Survey(), []  # said: the ground lines read
     for k, feature in enumerate(features, start=1):  # numbered from 1, as the bodies are (body_label)
@@ -195,10 +200,10 @@ def read_geojson(
         gtype = geometry.get("type") if isinstance(geometry, dict) else None
         line = gtype in ("LineString", "MultiLineString")  # a ground line traced along the foot: a support
         role = _word(props.get("role", "support" if line else "block"))  # "Support": "role must be 'block' or …"
-        if role not in ("block", "support") or (line and role == "block"):
-            allowed = "'support' (a line is the ground under it)" if line else "'block' or 'support'"
+        if role not in ("block", "support", "fill") or (line and role != "support"):
+            allowed = "'support' (a line is the ground under it)" if line else "'block', 'support' or 'fill'"
             raise GeometryError(f"{where}: role must be {allowed}, got {role!r}")
-        index = len(blocks) if role == "block" else len(supports)
+        index = {"block": len(blocks), "support": len(supports), "fill": len(fills)}[role]
         name = props.get("name", "")
         if isinstance(name, str) and not name.strip():  # an empty attribute cell, as null: not given
             name = by_id.get(k) or ("ground" if line else f"{role}-{index + 1}")  # block-1 first, as in TOML
@@ -209,7 +214,7 @@ def read_geojson(
             raise GeometryError(f"{where}: name {quoted_name(name)} {name_problem(name)}")
         where = f"{feature_at}: {body_label(index, name, role)}"
         if unknown is not None:  # a support's velocity (or density) was not read either, without a word
-            elsewhere = SUPPORT_PROPERTIES if role == "block" else BLOCK_PROPERTIES
+            elsewhere = {"block": SUPPORT_PROPERTIES, "support": BLOCK_PROPERTIES, "fill": NOT_FILL_PROPERTIES}[role]
             for key in props:
                 if key in elsewhere or (key not in GEOJSON_PROPERTIES and str(key).lower() not in GIS_ID_COLUMNS):
                     unknown.setdefault(key, f"feature {k}, {body_label(index, name, role)}")
@@ -244,6 +249,9 @@ def read_geojson(
             coords = np.array([[_real(c) for c in xy[:2]] for xy in rings[0]], dtype=np.float64)
         except (TypeError, ValueError, IndexError):
             raise GeometryError(f"{where}: coordinates must be [x, y] number pairs") from None
+        if role == "fill":  # no body: the blocks under it carry its weight (traced_fill.carry_fills)
+            fills.append((where, name, _number(props.get("density", FILL_DENSITY), "density", where), coords))
+            continue
         (blocks if role == "block" else supports).append(None)  # numbered now, made once the frame is known
         pending.append((feature_at, where, role, index, name, props, coords))
     frame = frame_of([entry[-1] for entry in pending], survey)
@@ -269,7 +277,8 @@ def read_geojson(
             if srole not in SUPPORT_ROLES:
                 raise GeometryError(f"{where}: support_role must be one of {SUPPORT_ROLES}, got {srole!r}")
             supports[index] = Support(polygon, name, srole)
-    return finish_reading(path, refused, blocks, supports, frame, survey, hulls, notes)
+    outlines = [(where, name, rho, fill_outline(frame.local(xy), where)) for where, name, rho, xy in fills]
+    return carry_fills(finish_reading(path, refused, blocks, supports, frame, survey, hulls, notes), outlines, notes)
 
 
 def id_names(features: list) -> dict[int, str]:

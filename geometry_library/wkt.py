@@ -33,14 +33,18 @@ from shapely.geometry import GeometryCollection, LineString, MultiLineString, Mu
 
 from .blocks import Assembly, Block, GeometryError, Support
 from .checks import body_label
+from .fill import FILL_DENSITY
 from .io import _number, _read_text, _ring_coords
 from .survey import GROUND_DEPTH, Survey, finish_reading, frame_of, ground_from_line, surveyed_polygon
+from .traced_fill import carry_fills, fill_outline
 
 _LABEL = re.compile(
-    r"^\s*(?:(?P<role>block|support)\s+)?(?P<name>[^\s:]+)(?:\s+(?P<srole>fixed|driven))?\s*:\s*(?P<wkt>.+)$",
+    r"^\s*(?:(?P<role>block|support|fill)\s+)?(?P<name>[^\s:]+)(?:\s+(?P<srole>fixed|driven))?\s*:\s*(?P<wkt>.+)$",
     re.IGNORECASE,
 )
-_ROLE_ONLY = re.compile(r"^\s*(?P<role>block|support)(?:\s+(?P<srole>fixed|driven))?\s*:\s*(?P<wkt>.+)$", re.IGNORECASE)
+_ROLE_ONLY = re.compile(
+    r"^\s*(?P<role>block|support|fill)(?:\s+(?P<srole>fixed|driven))?\s*:\s*(?P<wkt>.+)$", re.IGNORECASE
+)
 """A role with no name (``support : POLYGON …``): _LABEL read its role word as the name of a block."""
 
 
@@ -137,9 +141,14 @@ def read_wkt(
     refused: list[tuple[str, str]] = []
     pending = []  # (where, role, index, label, srole, coords): made once every ring is read
     survey, said = survey or Survey(), []  # said: the ground lines read
+    fills = []  # (where, name, density, ring) of each traced fill
     for where, role, name, srole, text in entries:
         geom = _parse_wkt(text, where)
         line = isinstance(geom, (LineString, MultiLineString))  # a ground line traced along the foot
+        if not line and (role or "").lower() == "fill":  # no body: the blocks under it carry its weight
+            name = name or f"fill-{len(fills) + 1}"
+            fills.append(_fill_entry(geom, f"{where}: {body_label(len(fills), name, 'fill')}", srole, name))
+            continue
         if line:
             body = f"{where}: {body_label(len(supports), name or 'ground', 'support')}"
             polys = [_ground_polygon(geom, (role or "support").lower(), where, body, survey, said)]
@@ -161,6 +170,7 @@ def read_wkt(
             pending.append((where, role, index, label, srole, np.asarray(poly.exterior.coords)[:, :2]))
     frame = frame_of([entry[-1] for entry in pending], survey)
     (notes if notes is not None else []).extend(said)
+    outlines = [(where, name, rho, fill_outline(frame.local(xy), where)) for where, name, rho, xy in fills]
     hulls: list[tuple[str, float, float]] = []
     for where, role, index, label, srole, coords in pending:
         try:
@@ -172,7 +182,18 @@ def read_wkt(
             blocks[index] = Block(polygon, label, float(density), float(thickness))
         else:
             supports[index] = Support(polygon, label, (srole or "fixed").lower())
-    return finish_reading(path, refused, blocks, supports, frame, survey, hulls, notes)
+    return carry_fills(finish_reading(path, refused, blocks, supports, frame, survey, hulls, notes), outlines, notes)
+
+
+def _fill_entry(geom, where: str, srole: str | None, name: str) -> tuple[str, str, float, np.ndarray]:
+    """(where, name, density, ring) of a traced fill's line (``fill NAME: POLYGON ((…))``; WKT has no density:
+    FILL_DENSITY's)."""
+    if srole:
+        raise GeometryError(f"{where}: a fill has no support role ({srole!r}): 'fill NAME: POLYGON ((…))'")
+    polys = _polygons_of(geom, where)
+    if len(polys) != 1 or polys[0].interiors:
+        raise GeometryError(f"{where}: a fill is one POLYGON, without holes")
+    return where, name, FILL_DENSITY, np.asarray(polys[0].exterior.coords)[:, :2]
 
 
 _NO_COLON = re.compile(

@@ -188,7 +188,7 @@ def test_geojson_errors_name_file_and_feature(tmp_path):
 _BAD_FEATURES = [  # (feature 2 of a file whose feature 1 is a good block, the body named or None, message)
     ("not a feature", {"type": "Point"}, None, "not a GeoJSON Feature"),
     ("properties", {"type": "Feature", "properties": [1], "geometry": None}, None, "'properties' must be an object"),
-    ("role", feature(SQ, role="roof", name="B12"), None, "role must be 'block' or 'support', got 'roof'"),
+    ("role", feature(SQ, role="roof", name="B12"), None, "role must be 'block', 'support' or 'fill', got 'roof'"),
     (
         "point",
         {"type": "Feature", "properties": {"name": "B12"}, "geometry": {"type": "Point"}},

@@ -40,7 +40,7 @@ from shapely.geometry import box
 from shapely.ops import unary_union
 
 from ..blocks import SUPPORT_ROLES, Assembly, Block, GeometryError, Support
-from ..fill import top_surface, with_fill
+from ..fill import FILL_DENSITY, top_surface, with_fill
 from ..values import (
     DIMENSION_RANGE,
     MATERIAL_RANGE,
@@ -202,10 +202,6 @@ def solid_abutments(spec: ArchSpec, blocks: list[Block], supports: list[Support]
             k = [sp.name for sp in out_supports].index(name)
             out_supports[k] = make_support(polygon, name, out_supports[k].role)
     return out_blocks, out_supports
-
-
-FILL_DENSITY = 2000.0
-"""kg/m³: a bridge's fill when none is given (granular fill weighs 18–22 kN/m³)."""
 
 
 def fill_level(spec: ArchSpec, geometry: ArchGeometry) -> float | None:
