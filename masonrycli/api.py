@@ -205,6 +205,7 @@ def simulate(
     stop_at_collapse: bool = False,
     magnify: float | None = None,
     on_frame=None,
+    progress: bool = False,
     **options,
 ) -> Run:
     """Run ``target`` (as :func:`scenario` takes it, with its ``options``) and return its :class:`Run`: every
@@ -212,11 +213,14 @@ def simulate(
     default name (``recordings/<name>-<time>.rrd``); ``history``: a ``.npz`` path to write. By default nothing is
     written. ``on_frame(frame)`` is called with every recorded frame (the contacts' points, normals and forces,
     which the history does not keep). The run's own warnings (a record cut short, a setting's caveat) are Python
-    warnings; Ctrl-C (a notebook's "interrupt") ends the run "interrupted" with the frames it reached."""
+    warnings; Ctrl-C (a notebook's "interrupt") ends the run "interrupted" with the frames it reached.
+    ``progress=True`` shows the run's progress as one line changing in place (:mod:`masonrycli.outputs.live_line`:
+    in a notebook a display under the cell; else stderr), first saying why a first run waits."""
     from rich.console import Console
 
     from masonrycli.execute import check_run, execute
     from masonrycli.interrupt import StopRun
+    from masonrycli.outputs.live_line import LiveLine
     from masonrycli.outputs.report import summary_table
     from masonrycli.scenario.caveats import scenario_warnings
 
@@ -233,6 +237,9 @@ def simulate(
     # summary table, which goes to Run.summary, was shown after every run of a loop)
     quiet = Console(file=io.StringIO(), quiet=True, force_jupyter=False)
     sinks = [_FrameCallback(on_frame)] if on_frame is not None else []
+    live = LiveLine(sc.name) if progress else None
+    if live is not None:
+        live.start()
     try:
         outcome = execute(
             sc,
@@ -243,9 +250,13 @@ def simulate(
             keep_history=True,
             sinks_also=sinks,
             command=call,
+            on_progress=live.on_progress if live is not None else None,
         )
     except StopRun:  # a signal before the first step: nothing was written
         raise KeyboardInterrupt from None
+    if live is not None:
+        result = outcome.result
+        live.end(result.status, result.steps, result.time, (result.outcome or {}).get("state", ""))
     for error in outcome.errors:
         warnings.warn(f"cannot write {error}", RuntimeWarning, stacklevel=2)
     paths = {o.option: o.path for o in outcome.written}

@@ -242,6 +242,7 @@ def execute(
     keep_history: bool = False,
     sinks_also=(),
     command: str | None = None,
+    on_progress=None,
 ) -> Outcome:
     """Run ``scenario`` writing ``outputs``; ``stop_at_collapse`` ends the run when the structure
     collapses (:mod:`masonrycli.analysis.collapse`); ``magnify``: the recording's magnified-shape factor (None:
@@ -252,7 +253,8 @@ def execute(
     by default one of the run's own. ``keep_history``: also keep the history in memory, as the ``--history``
     file would hold it (:attr:`Outcome.history`); ``sinks_also``: further frame sinks (the API's ``on_frame``),
     handed every frame after the outputs and closed by their owner. ``command``: what made the run, kept in its
-    histories' ``run`` (the Python API's call); by default the ``masonry`` command line (:func:`command_line`)."""
+    histories' ``run`` (the Python API's call); by default the ``masonry`` command line (:func:`command_line`).
+    ``on_progress(sim, stats)``: the run's progress, in place of the console's bar (the API's live line)."""
     made_by = {"command": command} if command else command_line()
     with StopSignals() if signals is None else contextlib.nullcontext(signals) as signals, compile_ahead.ahead():
         sinks: dict[OutputFile, object] = {}
@@ -280,11 +282,11 @@ def execute(
         result = None
         try:
             signals.stepping()
-            with progress_bar(console, sim.model.n_steps) as on_progress:
+            with progress_bar(console, sim.model.n_steps) as bar:
                 result = simulate(
                     scenario,
                     [*sinks.values(), *([kept] if kept is not None else []), *sinks_also],
-                    on_progress=on_progress,
+                    on_progress=on_progress or bar,
                     sim=sim,
                     stop=signals.requested,
                     stop_at_collapse=stop_at_collapse,

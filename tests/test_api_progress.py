@@ -1,0 +1,51 @@
+"""``api.simulate(progress=True)`` (masonrycli/outputs/live_line.py): in a notebook, one display under the cell
+updated in place — first why a first run waits, then the step, last how it ended — and nothing on stdout or
+stderr; in a script, stderr's start and end lines off a terminal. Before, a run in Jupyter showed nothing
+(the API's console is quiet) for the ~20 s a first run compiles, and ``progress=`` was refused."""
+
+from __future__ import annotations
+
+import re
+
+import pytest
+
+from masonrycli import api
+from masonrycli.outputs import live_line
+
+
+class FakeDisplay:
+    """What a notebook's display would show, update by update."""
+
+    def __init__(self):
+        self.shown = []
+
+    def show(self, text: str, final: bool = False) -> None:
+        self.shown.append(text)
+
+
+def test_a_notebook_gets_one_line_updated_in_place(monkeypatch, capsys):
+    display = FakeDisplay()
+    monkeypatch.setattr(live_line, "in_notebook", lambda: True)
+    monkeypatch.setattr(live_line, "_NotebookLine", lambda: display)
+    monkeypatch.setattr(live_line, "EVERY", 0.0)  # every progress call shown (every 10 steps)
+    run = api.simulate("wall", blocks=12, amp=0.5, duration=0.05, progress=True)
+    assert capsys.readouterr() == ("", "")  # no stream text: the display alone
+    first, *steps, last = display.shown
+    assert first == f"wall: {live_line.STARTING}"
+    said = [int(m.group(1)) for text in steps if (m := re.match(r"wall: step (\d+) of 50, t = ", text))]
+    assert said == list(range(10, 51, 10))  # the run's steps, in order, as the run reached them
+    assert re.fullmatch(rf"wall: completed, {run.outcome['state']}, 50 steps to t = 0.05 s in \d+\.\d s", last)
+
+
+def test_off_a_terminal_a_script_gets_its_start_and_end(monkeypatch, capsys):
+    monkeypatch.setattr(live_line, "in_notebook", lambda: False)
+    api.simulate("wall", blocks=12, duration=0.02, progress=True)
+    out, err = capsys.readouterr()
+    lines = err.splitlines()
+    assert out == "" and len(lines) == 2 and lines[0].startswith("wall: starting") and "completed" in lines[1]
+
+
+def test_without_progress_nothing_is_shown(monkeypatch, capsys):
+    monkeypatch.setattr(live_line, "in_notebook", lambda: pytest.fail("asked for no progress: no line made"))
+    api.simulate("wall", blocks=12, duration=0.02)
+    assert capsys.readouterr() == ("", "")
