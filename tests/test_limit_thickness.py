@@ -45,6 +45,10 @@ def test_the_segmental_arch_least_thickness_is_the_four_hinge_references():
             ["arch", "--span", "8", "--rise", "2", "--ring-thickness", "0.5", "--min-thickness"],
             "no equilibrium",  # on the default slender piers it does not stand at all: the analysis says so first
         ),
+        # --settle settled the ring analysed and the search went over the builder's rings unsettled, as drawn,
+        # without a word (the table's 'settled' row over a least thickness of rings that never were)
+        (["arch", "--settle", "0.5", "--min-thickness"], "--min-thickness with --settle 0.5: the least thickness is"),
+        (["wall", "--settle", "0.5", "--min-thickness"], "--min-thickness: the arch's ring only"),
     ],
 )
 def test_min_thickness_refusals_are_one_line(args, fragment):

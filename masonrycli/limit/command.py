@@ -304,6 +304,10 @@ def _analyse(structure, live, friction, verify, out, force, done: _Done, signals
     from masonrycli.scenario.caveats import setting_warnings
 
     target = None if out is None else check_output(out, "--out", ".rrd", force)
+    if options["min_thickness"]:  # before anything runs: --settle would have run the engine for nothing
+        from masonrycli.limit.thickness import check_min_thickness
+
+        check_min_thickness(structure, options["settle"])
     scenario = resolve_structure(structure, friction, options["structure_options"])
     settings = setting_warnings(scenario)  # not its records': it has no time
     settling = None

@@ -133,10 +133,7 @@ def builtin_least_ring(structure: str, friction: float | None, structure_options
     from geometry_library.builders import ArchSpec
     from masonrycli.scenario.builtin import builtin, override_run
 
-    if structure != "arch":
-        raise InputError(
-            f"--min-thickness: the arch's ring only (masonry limit arch …); {structure} is not the arch built-in"
-        )
+    check_min_thickness(structure, None)
     from masonrycli.cli.options import SURVEY
 
     given = {k: v for k, v in (structure_options or {}).items() if v is not None and k not in SURVEY}
@@ -146,3 +143,18 @@ def builtin_least_ring(structure: str, friction: float | None, structure_options
         return override_run(builtin("arch", ring_thickness=t, **given), friction=friction)
 
     return least_ring_thickness(build, thickness)
+
+
+def check_min_thickness(structure: str, settle: float | None) -> None:
+    """Refuse ``--min-thickness`` on anything but the arch built-in, and with ``--settle``: the search builds
+    the builder's rings, laid exact, where settling moves nothing, and a ring settled near its least thickness
+    would be the engine's slow creep, not the ring. It searched the unsettled rings under the settled table."""
+    if structure != "arch":
+        raise InputError(
+            f"--min-thickness: the arch's ring only (masonry limit arch …); {structure} is not the arch built-in"
+        )
+    if settle is not None:
+        raise InputError(
+            f"--min-thickness with --settle {settle:g}: the least thickness is searched over the builder's rings, "
+            "laid exact, with nothing to settle (--settle is for a traced file's gaps); drop --settle"
+        )
