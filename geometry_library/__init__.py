@@ -10,6 +10,7 @@ The only package of masonry that imports shapely. It knows nothing about dynamic
 150.0
 """
 
+from .assembly_checks import validate_assembly
 from .blocks import SUPPORT_ROLES, Assembly, Block, GeometryError, Support, ccw_vertices
 from .builders import (
     BUILDERS,
@@ -24,7 +25,7 @@ from .builders import (
     wall_layout,
     wall_layouts,
 )
-from .checks import body_label, is_convex, normalise_polygon, polygon_from_coords, validate_assembly
+from .checks import body_label, is_convex, normalise_polygon, polygon_from_coords
 from .io import read_geojson, write_geojson
 from .mass import MassProperties, mass_properties
 from .wkt import read_wkt, write_wkt

@@ -50,8 +50,9 @@ import shapely
 from shapely.geometry import Polygon
 from shapely.strtree import STRtree
 
+from .assembly_checks import overlap_depth
 from .blocks import Assembly, GeometryError
-from .checks import NotConvexError, body_label, normalised_polygon, overlap_depth, polygon_from_coords, signed_area
+from .checks import NotConvexError, body_label, normalised_polygon, polygon_from_coords, signed_area
 from .float32 import float32_resolution
 
 RECENTRE_BEYOND = 1e4

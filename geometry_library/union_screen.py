@@ -1,6 +1,6 @@
 """A screen for the assembly checks that stays linear in the number of blocks: one union of all bodies.
 
-Why. :func:`geometry_library.checks.validate_assembly` looks for overlapping pairs and for blocks that
+Why. :func:`geometry_library.assembly_checks.validate_assembly` looks for overlapping pairs and for blocks that
 touch nothing with a shapely STRtree. A tree filters by bounding boxes, and the voussoirs of a fine arch
 are slivers (0.35 m long, 2π·1.9 m / N wide) whose boxes, at 45° on the ring, are 0.25 m squares: each
 box meets ~N/25 others, so the exact tests ran on ~N²/20 pairs (3.2 million at N = 8000: 0.9 s of

@@ -13,7 +13,7 @@ from shapely import affinity
 from shapely.geometry import box
 from shapely.strtree import STRtree
 
-import geometry_library.checks as checks
+import geometry_library.assembly_checks as checks
 from geometry_library import Assembly, Block, GeometryError, Support, build_aqueduct, build_arch, validate_assembly
 from geometry_library.union_screen import union_screen
 

@@ -109,7 +109,7 @@ def test_overlapping_blocks_are_numbered_as_the_reader_numbers_them(tmp_path):
 
 
 def test_validate_assembly_errors_and_warnings(tmp_path, monkeypatch):
-    import geometry_library.checks as checks
+    import geometry_library.assembly_checks as checks
 
     def overlapping(assembly):
         raise GeometryError('block 1 ("b1") overlaps block 2 ("b2")')

@@ -13,7 +13,7 @@ build_app = typer.Typer(no_args_is_help=True, help="Build a structure and write 
 
 def _write_assembly(builder: str, opts: dict) -> None:
     """Build, check and write the GeoJSON under a temporary name, renamed onto ``--out`` when complete."""
-    from geometry_library.checks import validate_assembly
+    from geometry_library.assembly_checks import validate_assembly
     from geometry_library.io import write_geojson
     from masonrycli.outputs.files import check_output, written_whole
     from masonrycli.scenario.builtin import build_assembly

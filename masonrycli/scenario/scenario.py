@@ -181,7 +181,7 @@ class Scenario:
     motions : one :class:`~masonrycli.scenario.motion.Motion` per support, in ``assembly.supports`` order.
     source : scenario file path, or ``"builder:<name>"``.
     structure : ``{"builder": name, **options}`` for builder scenarios, else ``{}``.
-    warnings : non-fatal remarks from ``geometry_library.checks.validate_assembly``.
+    warnings : non-fatal remarks from ``geometry_library.assembly_checks.validate_assembly``.
     marked_driven : names of the supports a geometry file run as it is marks ``"driven"`` (``support_role``): a
         record given on the command line shakes them (:func:`masonrycli.scenario.record_option.shaken_supports`).
     reading : how its file was read and settled (map shift, units, hulls, trims, ``settle_s``): run parameters.

@@ -2,7 +2,7 @@
 
 ``build_structure`` checks TOML / command-line options against the builder's spec dataclass
 (``geometry_library.builders.BUILDERS``) and builds it; ``read_geometry`` reads a GeoJSON or WKT file;
-``structure_warnings`` runs ``geometry_library.checks.validate_assembly``. Problems raise a one-line
+``structure_warnings`` runs ``geometry_library.assembly_checks.validate_assembly``. Problems raise a one-line
 :class:`~masonrycli.errors.InputError`.
 """
 
@@ -164,7 +164,7 @@ HULL_HINT = "; --convex-hull reads a slightly non-convex stone as its convex hul
 def structure_warnings(assembly: Assembly, ctx: InputContext, as_run: bool = False) -> tuple[str, ...]:
     """``validate_assembly``: its errors raised at ``ctx``, its warnings on one line each. ``as_run``: a
     geometry file run as it is, whose overlap is refused with the option that trims a tracing slip."""
-    from geometry_library.checks import validate_assembly
+    from geometry_library.assembly_checks import validate_assembly
 
     try:
         warnings = validate_assembly(assembly)
