@@ -102,3 +102,16 @@ def test_check_and_limit_run_a_wkt_file_with_a_ground_line(tmp_path):
     assert result.exit_code == 0, result.output
     data = json.loads(invoke("limit", path, "--load", "tilt", "--json").stdout)
     assert data["load_factor"] == pytest.approx(0.6, rel=1e-9)
+
+
+def test_a_wkt_surveys_density_is_said_where_it_goes(tmp_path):
+    """WKT has no density column and --density is refused on a file: the refusal said only 'a file, which gives its
+    own geometry', and the researcher with a 2300 kg/m³ survey found no way in. It now names the way, which
+    gives 2 stones × 0.08 m² × 2300 kg/m³."""
+    path = _wkt(tmp_path, "LINESTRING (-1 0, 0.2 0, 1.4 0)")
+    for command in ("check", "limit"):
+        assert_one_line_error(invoke(command, path, "--density", 2300), "[material] density")
+    (tmp_path / "s.toml").write_text(f'[structure]\nfile = "{path.name}"\n\n[material]\ndensity = 2300\n')
+    result = invoke("check", tmp_path / "s.toml")
+    assert result.exit_code == 0, result.output
+    assert f"{2 * 0.08 * 2300:g} kg" in result.stdout

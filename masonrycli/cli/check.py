@@ -33,6 +33,17 @@ BUILT_IN_ONLY = {**ANY_STRUCTURE, **BUILT_IN_LOADING, **BLOCK_MATERIAL}
 """The options that shape a built-in structure and its loading (``simulate NAME``'s); a file gives its own."""
 
 
+def material_hint(given) -> str:
+    """What a refused --density / --thickness on a file is said with: where a file's stones get theirs (WKT has no
+    column for it: a researcher with a 2300 kg/m³ survey found no way in)."""
+    if not {"density", "thickness"} & set(given):
+        return ""
+    return (
+        "; its stones' density and thickness: the file's density / thickness columns (GeoJSON), or a scenario file "
+        "naming it ([structure] file = …) with [material] density / thickness (masonry docs scenario-format)"
+    )
+
+
 def _flags(names) -> str:
     return ", ".join(f"--{name.replace('_', '-')}" for name in names)
 
@@ -58,7 +69,7 @@ def _scenario(target: str, opts: dict):
         if shaping:
             raise InputError(
                 f"{_flags(shaping)}: shape a built-in structure (masonry check wall|arch|aqueduct …); {target} is "
-                "a file, which gives its own geometry and loading"
+                f"a file, which gives its own geometry and loading{material_hint(shaping)}"
             )
         return with_pga(file_scenario(target, survey=survey, **settings), pga, settings["scale"])
     survey_of(survey, target)

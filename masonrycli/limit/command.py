@@ -35,6 +35,7 @@ def resolve_structure(structure: str, friction: float | None, options: dict | No
     """A scenario from a built-in name (the builder's defaults, or ``options``: the structure options of
     ``masonry build NAME`` and --density / --thickness, no motion), a scenario file or a geometry file
     (:func:`~masonrycli.scenario.target.target_scenario`); ``friction`` overrides μ."""
+    from masonrycli.cli.check import material_hint
     from masonrycli.cli.options import BLOCK_MATERIAL, STRUCTURE_OPTIONS, SURVEY
     from masonrycli.scenario.builtin import builtin, override_run
     from masonrycli.scenario.scenario import Material, RunConfig, scenario_from_builder
@@ -47,7 +48,7 @@ def resolve_structure(structure: str, friction: float | None, options: dict | No
     if given and not is_built_in(structure):
         raise InputError(
             f"{flags}: structure options shape a built-in structure (masonry limit wall|arch|aqueduct …); "
-            f"{structure} is a file, which gives its own geometry"
+            f"{structure} is a file, which gives its own geometry{material_hint(given)}"
         )
     if given and is_built_in(structure):
         allowed = {*STRUCTURE_OPTIONS[structure], *BLOCK_MATERIAL}
