@@ -18,7 +18,8 @@ import numpy as np
 
 from masonrycli.analysis.collapse import CollapseMonitor, rule_for
 from masonrycli.analysis.mechanism import JointTracker, contact_states
-from masonrycli.analysis.tensors import TensorComputer, build_triangles, chain_neighbours
+from masonrycli.analysis.tensors import TensorComputer
+from masonrycli.analysis.triangulation import build_triangles, chain_neighbours
 from masonrycli.engine import integrate
 from masonrycli.engine.solver import Solver, StepStats
 from masonrycli.engine.tuning import TUNING, Tuning

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 from shapely.geometry import box
 
-from masonrycli.analysis import tensors as T
+from masonrycli.analysis import triangulation
 
 from naive_collision import course_edges
 
@@ -63,5 +63,5 @@ def deformed(centroids, seed, amount=0.02):
 def triangulated_wall():
     """A 5-course running bond of 5 blocks a course and its triangles: (centroids, areas, pairs, triangles)."""
     boxes, centroids, areas, pairs = running_bond(5, 5)
-    triangles = T.build_triangles(centroids, pairs)
+    triangles = triangulation.build_triangles(centroids, pairs)
     return centroids, areas, pairs, triangles

@@ -9,6 +9,7 @@ import pytest
 from tensor_helpers import deformed, star, star_is_closed, state_arrays, triangulated_wall
 
 from masonrycli.analysis import tensors as T
+from masonrycli.analysis import triangulation
 
 RHO, G = 2000.0, 9.81
 
@@ -120,7 +121,7 @@ def column_of_five():
 def test_case3_column_block_and_cell_stress():
     centroids, volume, body, point, force = column_of_five()
     n = len(centroids)
-    triangles = T.build_triangles(centroids, body)  # collinear centroids: no triangle
+    triangles = triangulation.build_triangles(centroids, body)  # collinear centroids: no triangle
     assert triangles.shape == (0, 3)
     tc = T.TensorComputer(n, volume, triangles)
     q, v = state_arrays(centroids)

@@ -1,4 +1,5 @@
-"""masonrycli.analysis.tensors triangulation: cell fans over the contact neighbours, chain neighbours, isolated blocks."""
+"""masonrycli.analysis.triangulation: cell fans over the contact neighbours, chain neighbours (and the chain strain
+rate of tensors over them), isolated blocks."""
 
 from __future__ import annotations
 
@@ -9,6 +10,7 @@ import pytest
 from tensor_helpers import running_bond, star, star_is_closed, state_arrays, triangulated_wall
 
 from masonrycli.analysis import tensors as T
+from masonrycli.analysis import triangulation
 
 
 @pytest.fixture(scope="module")
@@ -59,7 +61,7 @@ def test_build_triangles_is_deterministic_and_ignores_pair_order_repeats_and_sup
     rng = np.random.default_rng(0)
     messy = np.concatenate([pairs[:, ::-1], pairs, [[0, n], [n + 1, 3]]])
     messy = messy[rng.permutation(len(messy))]
-    np.testing.assert_array_equal(T.build_triangles(centroids, messy), triangles)
+    np.testing.assert_array_equal(triangulation.build_triangles(centroids, messy), triangles)
 
 
 def test_build_triangles_fans_over_consecutive_neighbours_and_drops_slivers():
@@ -67,29 +69,29 @@ def test_build_triangles_fans_over_consecutive_neighbours_and_drops_slivers():
     # neighbours (they need not touch each other, Fig. I.1); a gap of 180° or more is a free edge
     c = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
     sides = np.array([[0, 1], [1, 2], [2, 3], [3, 0]])
-    assert T.build_triangles(c, sides).tolist() == [[0, 1, 3], [1, 2, 0], [2, 3, 1], [3, 0, 2]]
+    assert triangulation.build_triangles(c, sides).tolist() == [[0, 1, 3], [1, 2, 0], [2, 3, 1], [3, 0, 2]]
     # collinear, fewer than 3, no pairs
     line = np.array([[0.0, 0.0], [1.0, 0.0], [2.0, 0.0]])
-    assert T.build_triangles(line, [[0, 1], [1, 2], [0, 2]]).shape == (0, 3)
-    assert T.build_triangles(c[:2], [[0, 1]]).shape == (0, 3)
-    assert T.build_triangles(c, np.zeros((0, 2))).shape == (0, 3)
+    assert triangulation.build_triangles(line, [[0, 1], [1, 2], [0, 2]]).shape == (0, 3)
+    assert triangulation.build_triangles(c[:2], [[0, 1]]).shape == (0, 3)
+    assert triangulation.build_triangles(c, np.zeros((0, 2))).shape == (0, 3)
     # a ring: each voussoir touches its two neighbours only; the fan over them is a sliver (smallest
     # angle 6° here) and is dropped, while a 12° triangle is kept
     for half_angle, kept in ((6.0, 0), (12.0, 1)):
         a = math.radians(half_angle)
         ring = np.array([[-math.cos(a), -math.sin(a)], [0.0, 0.0], [math.cos(a), -math.sin(a)]])
-        assert len(T.build_triangles(ring, [[0, 1], [1, 2]])) == kept
+        assert len(triangulation.build_triangles(ring, [[0, 1], [1, 2]])) == kept
 
 
 def test_fan_triangle_angles_are_at_least_the_minimum_in_the_paper_structures():
     """Every kept triangle's smallest angle (measured with numpy.linalg, independently) ≥ MIN_ANGLE."""
     boxes, centroids, _, pairs = running_bond(6, 5)
-    tri = T.build_triangles(centroids, pairs)
+    tri = triangulation.build_triangles(centroids, pairs)
     p = centroids[tri]
     for k in range(3):
         u, w = p[:, (k + 1) % 3] - p[:, k], p[:, (k + 2) % 3] - p[:, k]
         cos = (u * w).sum(1) / np.linalg.norm(u, axis=1) / np.linalg.norm(w, axis=1)
-        assert np.all(np.arccos(cos) >= T.MIN_ANGLE - 1e-12)
+        assert np.all(np.arccos(cos) >= triangulation.MIN_ANGLE - 1e-12)
 
 
 def test_chain_neighbours_and_chain_strain_rate_of_an_affine_field():
@@ -99,7 +101,7 @@ def test_chain_neighbours_and_chain_strain_rate_of_an_affine_field():
     x = np.array([[0.0, 0.0], [1.0, 0.1], [2.0, 0.3], [2.8, 0.9], [3.0, 2.0]])
     n = len(x)
     pairs = np.array([[0, 1], [1, 2], [2, 3], [3, 4], [0, n]])  # block 0 rests on support n
-    chain = T.chain_neighbours(n, pairs)
+    chain = triangulation.chain_neighbours(n, pairs)
     assert chain[0].tolist() == [-1, -1] and chain[4].tolist() == [-1, -1]  # support / one neighbour
     assert [sorted(c) for c in chain[1:4].tolist()] == [[0, 2], [1, 3], [2, 4]]
     l0, c0 = rng.normal(size=(2, 2)), rng.normal(size=2)
@@ -117,14 +119,16 @@ def test_chain_neighbours_and_chain_strain_rate_of_an_affine_field():
     q, v = state_arrays(straight)
     v[:3, :2] = straight @ l0.T
     u = np.array([1.0, 1.0]) / math.sqrt(2.0)
-    assert T.chain_strain_rate(3, q, v, T.chain_neighbours(3, [[0, 1], [1, 2]]))[1] == pytest.approx(u @ l0 @ u)
+    assert T.chain_strain_rate(3, q, v, triangulation.chain_neighbours(3, [[0, 1], [1, 2]]))[1] == pytest.approx(
+        u @ l0 @ u
+    )
 
 
 def test_isolated_block_gets_nan_strain(wall):
     centroids, areas, pairs, _ = wall
     n = len(centroids)
     far = np.concatenate([centroids, [[10.0, 0.1]]])  # block n touches nothing
-    triangles = T.build_triangles(far, pairs)
+    triangles = triangulation.build_triangles(far, pairs)
     assert not np.isin(n, triangles)
     tc = T.TensorComputer(n + 1, np.append(areas, 0.06), triangles)
     assert not tc.has_triangle[n] and tc.has_triangle[:n].any()
