@@ -294,3 +294,6 @@ def test_the_python_page_runs_as_a_notebook(tmp_path, monkeypatch):
     )
     assert namespace["run"].outcome["state"] == "damaged"
     assert namespace["message"] == "--amp: amplitude = nan: must be a finite number"
+    # the study run from the notebook's Python: its 4 rows, and a history naming the sweep that made it
+    assert [row["state"] for row in namespace["rows"]] == ["damaged"] * 4
+    assert "| command | masonry sweep wall --param freq=1,2 " in namespace["point"].report()

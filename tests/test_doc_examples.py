@@ -221,3 +221,38 @@ def test_the_pages_examples_run(page, commands, tmp_path, monkeypatch):
         if result.exit_code != 0:
             failed.append(f"masonry {command}: exit {result.exit_code}: {result.output.strip()[-400:]}")
     assert not failed, "\n".join(failed)
+
+
+def _python_blocks() -> list[tuple[str, int, str]]:
+    """(page, number, code) of the ```python blocks of every page but docs/python.md (test_api runs that one as a
+    notebook): README's first steps from Python, scenario-format.md's loading and building."""
+    found = []
+    for page in PAGES:
+        if page.name != "python.md":
+            for k, code in enumerate(re.findall(r"```python\n(.*?)```", page.read_text(), flags=re.S)):
+                found.append((page.name, k + 1, code))
+    return found
+
+
+def test_the_python_blocks_are_found():
+    pages = {page for page, _, _ in _python_blocks()}
+    assert {"README.md", "scenario-format.md"} <= pages
+
+
+@pytest.mark.parametrize("page, number, code", _python_blocks(), ids=lambda v: str(v)[:20])
+def test_the_pages_python_blocks_run(page, number, code, tmp_path, monkeypatch):
+    # each as a reader pastes it into a notebook, in a folder holding the files it names (wall.toml); only their
+    # imports were checked (test_docs), so a block whose call or keyword had changed still 'passed'
+    _seed(tmp_path)
+    monkeypatch.chdir(tmp_path)
+    namespace: dict = {}
+    exec(compile(code, f"{page} python block {number}", "exec"), namespace)
+    if "dump_scenario" in code:  # 'TOML text that loads back to the same scenario': written again, the same text
+        (tmp_path / "again.toml").write_text(namespace["text"])
+        again = namespace["dump_scenario"](namespace["load_scenario"](tmp_path / "again.toml"))
+        assert _but_source(again) == _but_source(namespace["text"]) and "[[block]]" in again
+
+
+def _but_source(text: str) -> str:
+    """A dumped scenario without its '# from FILE' line (the file it was read from)."""
+    return "\n".join(line for line in text.splitlines() if not line.startswith("# from "))
