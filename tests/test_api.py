@@ -297,3 +297,10 @@ def test_the_python_page_runs_as_a_notebook(tmp_path, monkeypatch):
     # the study run from the notebook's Python: its 4 rows, and a history naming the sweep that made it
     assert [row["state"] for row in namespace["rows"]] == ["damaged"] * 4
     assert "| command | masonry sweep wall --param freq=1,2 " in namespace["point"].report()
+
+
+def test_a_scenario_shown_in_a_notebook_is_a_few_lines():
+    # a cell ending in api.scenario("aqueduct") showed its repr: every block's polygon, 70 kB (14 kB for the wall)
+    shown = repr(api.scenario("aqueduct"))
+    assert len(shown) < 1000 and "Assembly(346 blocks (" in shown and "2 supports (left-foundation … " in shown
+    assert repr(api.scenario("wall").assembly) == "Assembly(51 blocks (c01-b01 … c06-b09), 1 support (ground))"
