@@ -396,12 +396,37 @@ def test_the_masonry_check_waits_60_s_at_most(tmp_path, monkeypatch):
         cluster.close()
 
 
+def _within(seconds: float, call, on_hang=lambda: None):
+    """``call()``'s result, made in a thread of its own; a failed test (``on_hang`` called first, to free the
+    thread) if it has not returned within ``seconds``: a study that hangs fails its test, it does not hang it."""
+    import threading
+
+    box: dict = {}
+
+    def target():
+        try:
+            box["value"] = call()
+        except BaseException as exc:  # noqa: BLE001 - raised again in the test's thread
+            box["error"] = exc
+
+    thread = threading.Thread(target=target, name="study-under-test", daemon=True)
+    thread.start()
+    thread.join(seconds)
+    if thread.is_alive():
+        on_hang()
+        pytest.fail(f"the study hung: no end within {seconds:g} s")
+    if "error" in box:
+        raise box["error"]
+    return box.get("value")
+
+
 def test_a_point_that_kills_its_worker_is_an_error_row_saying_so_and_only_it(monkeypatch):
     # the row said "KilledWorker: Attempted to run task 'run-21434d39-…' on 4 different workers, but all those
     # workers died while running it. The last worker … Inspecting worker logs is often a good next step to diagnose
     # what went wrong. Fo" (cut at 300 characters); and a point running beside it in the same worker process (a
     # worker of 2 threads, as `dask worker` makes by default; or one whose result was not yet sent) died with it,
     # four times over: an error row too, for a good point
+    import dask
     from distributed import Client, LocalCluster
 
     from masonrycli.study import runner
@@ -420,11 +445,20 @@ def test_a_point_that_kills_its_worker_is_an_error_row_saying_so_and_only_it(mon
         return dict(params, status="completed", error="")
 
     monkeypatch.setattr(runner, "run_task", task)  # sent to the workers by value (runner.make_task)
+    # Dask drops a worker not back 15 s after a loss (distributed.deploy.lost-worker-timeout), timed from that
+    # loss, and none replaces it (runner's WorkerWatch): on a loaded machine a worker restarting then was lost,
+    # and the study waited forever (3 runs in 4 beside three busy loops). At 0.1 s each death drops it.
+    monkeypatch.setitem(dask.config.config["distributed"]["deploy"], "lost-worker-timeout", "0.1s")
     cluster = LocalCluster(n_workers=1, threads_per_worker=2, processes=True, dashboard_address=":0")
     client = Client(cluster)
     rows = []
     try:
-        runner.run_on_cluster(client, "s", Driver(), lambda p, r: rows.append(r), False, None, False)
+        _within(
+            300,
+            lambda: runner.run_on_cluster(
+                client, "s", Driver(), lambda p, r: rows.append(r), False, None, False, cluster=cluster
+            ),
+        )
     finally:
         client.close()
         cluster.close()

@@ -24,7 +24,6 @@ failed runs.
 
 from __future__ import annotations
 
-import contextlib
 import errno
 import gc
 import logging
@@ -350,19 +349,30 @@ def in_flight_limit(client) -> int:
 
 
 def run_on_cluster(
-    client, base, driver, on_row: Callable[[dict, dict], None], *task_args, limit=None, warn=None, where=""
+    client,
+    base,
+    driver,
+    on_row: Callable[[dict, dict], None],
+    *task_args,
+    limit=None,
+    warn=None,
+    where="",
+    cluster=None,
 ) -> None:
     """Run ``driver``'s points on ``client`` until it hands out no more; ``on_row(params, row)`` for each.
     ``task_args``: :func:`run_task`'s arguments after the point (stop_at_collapse, history_dir, force,
     study).
     At most ``limit`` tasks (default :func:`in_flight_limit`) are submitted at a time, the next one as
     each comes back. ``warn`` (if given) is told when the cluster has no worker for a while (:class:`~masonrycli.study.watch.WorkerWatch`;
-    ``where`` names the cluster)."""
+    ``where`` names the cluster). ``cluster``: the LocalCluster the study owns, whose workers the watch starts
+    again; left without any for ``NO_WORKER_LIMIT`` s, the runs not made are error rows saying why."""
+    from concurrent.futures import CancelledError
+
     import cloudpickle
     from distributed import KilledWorker, as_completed
 
+    from masonrycli.study import watch as watching
     from masonrycli.study.versions import check_result, make_task, this_version
-    from masonrycli.study.watch import WorkerWatch
 
     limit = limit or in_flight_limit(client)
     ours = this_version()
@@ -373,7 +383,7 @@ def run_on_cluster(
     # worker once its masonry is known to be this one.
     base_future = client.submit(keep, cloudpickle.dumps((run_task, base)), pure=False)
     waiting = deque(driver.start())
-    pending = {}
+    pending = {}  # key -> (params, future)
     completed = as_completed()
     # Points whose workers died under them (KilledWorker), run again one at a time once nothing else runs. A
     # point that ends its worker process (out of memory, a crash) takes with it the tasks running beside it in
@@ -383,44 +393,72 @@ def run_on_cluster(
     # Alone, a good point runs; the point that kills its workers does so again, and its row says so.
     killed: deque = deque()
     alone: set = set()  # keys of the tasks so run
+    suspects: list = []  # the points whose workers died under them, for the reason below
+    lock = threading.Lock()  # pending and gave_up, shared with the watch's give_up
+    gave_up: list = []  # why the runs not made are error rows: the cluster was left without a worker
 
     def submit(points=waiting, most=limit):
-        while points and len(pending) < most:
-            params = points.popleft()
-            future = client.submit(run, ours, base_future, params, *task_args, pure=False)
-            pending[future.key] = params
-            completed.add(future)
-            if points is killed:
-                alone.add(future.key)
+        with lock:
+            while points and len(pending) < most and not gave_up:
+                params = points.popleft()
+                future = client.submit(run, ours, base_future, params, *task_args, pure=False)
+                pending[future.key] = params, future
+                completed.add(future)
+                if points is killed:
+                    alone.add(future.key)
 
     def not_made() -> int:  # the runs submitted, waiting, or to run again alone
         return len(pending) + len(waiting) + len(killed)
 
+    def give_up(deaths: int) -> None:  # from the watch's thread: the tasks in flight cancelled, the rest unsent
+        named = "; ".join(", ".join(f"{k}={v}" for k, v in p.items()) for p in suspects[:3])
+        named = f" (those running when they died: {named}{'; …' if len(suspects) > 3 else ''})" if suspects else ""
+        times = "once" if deaths == 1 else f"{deaths} times"
+        died = f" after its workers died {times}{named}" if deaths else ""
+        why = f"no worker left: the local cluster had none for {watching.NO_WORKER_LIMIT:g} s{died}; not run"
+        with lock:
+            gave_up.append(why)
+            cancel = [future for _, future in pending.values()]
+        client.cancel(cancel, reason="no worker left")
+
     submit()
-    watch = WorkerWatch(client, warn, where, not_made) if warn else contextlib.nullcontext()
-    with watch:
+    with watching.WorkerWatch(client, warn, where, not_made, cluster, give_up if cluster is not None else None):
         while True:
             for future in completed:
-                params = pending.pop(future.key)
+                with lock:
+                    params, _ = pending.pop(future.key)
                 try:
                     answer, worker, row = future.result()
                 except Exception as exc:  # the task never returned (KilledWorker, a cluster failure)
-                    if _scheduler_lost(client, exc):
+                    if gave_up and isinstance(exc, CancelledError):
+                        row = params | empty_result(gave_up[0], 0.0)
+                    elif _scheduler_lost(client, exc):
                         raise SchedulerLost(
                             f"lost the connection to the scheduler with {not_made() + 1} runs pending"
                         ) from None
-                    if isinstance(exc, KilledWorker) and future.key not in alone:
+                    elif isinstance(exc, KilledWorker) and future.key not in alone:
                         killed.append(params)  # run again alone (above)
+                        suspects.append(params)
                         future.release()
                         submit()
                         continue
-                    row = params | empty_result(task_error(exc), 0.0)
+                    else:
+                        row = params | empty_result(task_error(exc), 0.0)
                 else:
                     check_result(answer, worker, params, ours)  # another masonry's row is not kept
+                    if params in suspects:  # it ran alone: not the point that killed them
+                        suspects.remove(params)
                 future.release()
                 waiting.extendleft(reversed(driver.feed(params, row)))  # a search's next step first: its row sooner
                 on_row(params, row)
                 submit()
+            if gave_up:  # every run not made says why, each fed to the driver (a search ends at an error)
+                while killed or waiting:
+                    params = (killed or waiting).popleft()
+                    row = params | empty_result(gave_up[0], 0.0)
+                    waiting.extendleft(reversed(driver.feed(params, row)))
+                    on_row(params, row)
+                return
             if not killed:
                 return
             submit(killed, 1)  # nothing else in flight: the next one alone

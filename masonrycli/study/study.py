@@ -219,7 +219,9 @@ def run_study(base: StudyBase, request: StudyRequest, console: Console) -> Study
             else:
                 where = f"--scheduler {request.scheduler}" if request.scheduler else "the local cluster"
                 ahead = compile_ahead.on_cluster(client, external=cluster is None)  # held to the end
-                run_on_cluster(client, base, driver, on_row, *task_args, warn=request.warn, where=where)
+                run_on_cluster(
+                    client, base, driver, on_row, *task_args, warn=request.warn, where=where, cluster=cluster
+                )
                 del ahead
     except (WorkerMismatch, SchedulerLost) as exc:  # the rows before it are kept (written below), resumable
         where = f"--scheduler {request.scheduler}" if request.scheduler else "the local cluster"

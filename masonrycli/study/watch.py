@@ -1,6 +1,7 @@
 """Whether a study's cluster still has a worker and a scheduler that answers: :class:`WorkerWatch`, a thread
 beside the study's loop (:func:`masonrycli.study.runner.run_on_cluster`) that says when every worker has gone or
-the scheduler has stopped answering, and when that ends."""
+the scheduler has stopped answering, and when that ends. On the LocalCluster the study owns it also starts again
+a worker Dask dropped, and gives the runs up when no worker comes back: the study ends, it never hangs."""
 
 from __future__ import annotations
 
@@ -16,6 +17,12 @@ ASK_TIMEOUT = 5.0
 """s a look waits for the scheduler's answer."""
 NO_ANSWER_WAIT = 30.0
 """s without an answer from the scheduler before the study says so."""
+NO_WORKER_LIMIT = 60.0
+"""s the study's own LocalCluster may have no worker, runs waiting, before the study gives them up (error rows
+that the same command runs again). A worker process started again in 1.3 s on a quiet machine and in up to 7.1 s
+beside three busy loops on 2 cores (tests/test_sweep_cluster_lost_workers.py's scenario, 2026-11-29): 60 s is
+eight times that, and a minute is as long as a user should wait without an answer. A ``--scheduler``'s workers
+are someone else's to start (a batch queue may take an hour): there the study waits, and says so."""
 
 
 class WorkerWatch:
@@ -23,10 +30,20 @@ class WorkerWatch:
     and when one joins again. Every worker of a ``--scheduler`` killed (``kill`` of the ``dask worker``
     command, a preempted machine) left the study waiting, silent, its bar still, until a worker joined:
     Dask keeps the tasks for the next worker, which is right (workers come back), but the user saw a hang
-    (walk-through 2026-11-29: 180 s without a word, then killed). ``warn`` takes the lines."""
+    (walk-through 2026-11-29: 180 s without a word, then killed). ``warn`` takes the lines (None: unsaid).
 
-    def __init__(self, client, warn: Callable[[str], None], where: str, waiting: Callable[[], int]) -> None:
-        self.client, self.warn, self.where, self.waiting = client, warn, where, waiting
+    ``cluster``: the LocalCluster the study owns. Dask's own SpecCluster drops a worker for good when it is
+    not back ``distributed.deploy.lost-worker-timeout`` (15 s) after *a* loss, timed from that loss: a worker
+    that died again meanwhile and was restarting then is closed, its nanny with it, and none replaces it. On a
+    loaded machine (three busy loops on 2 cores) a point that killed its worker left the cluster without any,
+    after its 3rd or 4th death, 22-40 s in, in 3 runs of 3, and the study waited forever. The watch starts such
+    a worker again (``cluster.scale`` to its own size) at its next look; and if the cluster still has no worker
+    :data:`NO_WORKER_LIMIT` s on, it calls ``give_up(deaths)`` once (the workers seen to go) and stops."""
+
+    def __init__(self, client, warn, where: str, waiting: Callable[[], int], cluster=None, give_up=None) -> None:
+        self.client, self.where, self.waiting = client, where, waiting
+        self.warn = warn or (lambda line: None)
+        self.cluster, self.give_up = cluster, give_up
         self.stop = threading.Event()
         self.thread = threading.Thread(target=self._watch, name="masonry-worker-watch", daemon=True)
 
@@ -41,9 +58,11 @@ class WorkerWatch:
     def _watch(self) -> None:
         since = silent = None
         said = quiet = False
+        seen: set = set()
+        deaths = 0
         while not self.stop.wait(WATCH_EVERY):
             try:
-                workers = len(self.client.nthreads(callback_timeout=ASK_TIMEOUT))
+                workers = set(self.client.nthreads(callback_timeout=ASK_TIMEOUT))
             except TimeoutError:
                 # a scheduler stopped (SIGSTOP, a suspended laptop) or cut off without a word (a firewall, a
                 # cable): its connection stays open, nothing comes, and the study waited silent for as long
@@ -61,6 +80,10 @@ class WorkerWatch:
                 continue
             if self.stop.is_set():
                 return
+            deaths += len(seen - workers)  # those that lived between two looks are not counted
+            seen = workers
+            if self.cluster is not None:
+                self._restore()
             if quiet:
                 self.warn(f"{self.where}: the scheduler answers again: the study goes on")
             silent, quiet = None, False
@@ -73,6 +96,27 @@ class WorkerWatch:
             if not said and time.monotonic() - since >= NO_WORKER_WAIT:
                 said = True
                 self.warn(
-                    f"{self.where}: no worker for {NO_WORKER_WAIT:g} s, {self.waiting()} runs waiting: the study "
-                    "goes on when a worker joins (Ctrl-C stops it, every finished row written)"
+                    f"{self.where}: no worker for {NO_WORKER_WAIT:g} s, {self.waiting()} runs waiting: " + self._plan()
                 )
+            if self.give_up is not None and time.monotonic() - since >= NO_WORKER_LIMIT and self.waiting():
+                self.give_up(deaths)
+                return
+
+    def _plan(self) -> str:
+        if self.cluster is None:  # someone else's workers: one may join at any time
+            start = ""
+            if self.where.startswith("--scheduler "):
+                start = f"`dask worker {self.where.removeprefix('--scheduler ')}` starts one; "
+            return f"the study goes on when a worker joins ({start}Ctrl-C stops it, every finished row written)"
+        return (
+            f"if none starts within {NO_WORKER_LIMIT:g} s, they are given up (error rows, which the same command "
+            "runs again)"
+        )
+
+    def _restore(self) -> None:
+        """Start again each worker of the study's LocalCluster that Dask dropped (class doc): one asked of
+        its ``worker_spec`` and missing from its ``workers``. Asked again while it starts, ``scale`` waits
+        for the start before it (Dask's lock) and then finds it there."""
+        wanted = len(self.cluster.worker_spec)
+        if len(self.cluster.workers) < wanted and not self.stop.is_set():
+            self.cluster.scale(wanted)
