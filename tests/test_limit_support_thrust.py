@@ -75,3 +75,25 @@ def test_the_segmental_bridge_on_fixed_abutments_pushes_them_apart_as_the_refere
     for s in by_support.values():
         assert s["least_N"] == pytest.approx(least, rel=1e-6) and s["greatest_N"] == pytest.approx(greatest, rel=1e-6)
     assert 0 < least < greatest and math.isfinite(greatest)
+
+
+def test_one_support_under_every_block_has_no_thrust_to_give(tmp_path):
+    """A surveyed bridge on one traced ground: 'thrust on ground: 0 … 0 N towards -x' (equilibrium: the dead load has
+    no horizontal part, so neither has the one support's reaction) read as an arch pushing nothing. The table says
+    why there is none, and where an abutment's thrust comes from; --json keeps the 0 … 0."""
+    from cli_helpers import invoke
+
+    geo = tmp_path / "one.geojson"
+    ring = [[-1, -0.5], [2, -0.5], [2, 0], [-1, 0], [-1, -0.5]]
+    stone = [[0, 0], [0.4, 0], [0.4, 0.2], [0, 0.2], [0, 0]]
+    features = [
+        {"type": "Feature", "properties": {"name": "s"}, "geometry": {"type": "Polygon", "coordinates": [stone]}},
+        {"type": "Feature", "properties": {"role": "support"}, "geometry": {"type": "Polygon", "coordinates": [ring]}},
+    ]
+    geo.write_text(json.dumps({"type": "FeatureCollection", "features": features}))
+    table = invoke("limit", geo, "--thrust")
+    assert table.exit_code == 0, table.output
+    assert "none to give: one support carries every block" in " ".join(table.stdout.split())
+    assert "0 … 0" not in table.stdout
+    data = json.loads(invoke("limit", geo, "--thrust", "--json").stdout)
+    assert [(t["least_N"], t["greatest_N"]) for t in data["support_thrust"]] == [(0.0, 0.0)]

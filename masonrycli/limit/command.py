@@ -141,7 +141,14 @@ def result_table(result: LimitResult, out: Path | None) -> Table:
     )
     if result.ring is not None:
         table.add_row("least ring thickness", result.ring.describe())
-    for name, direction, least, greatest in result.support_thrust or ():
+    if result.support_thrust and result.model.support_count == 1:  # "0 … 0 N towards -x" said nothing
+        table.add_row(
+            f"thrust on {result.support_thrust[0][0]}",
+            "none to give: one support carries every block, so the horizontal forces on it balance; an arch's "
+            "thrust on its abutments needs each on its own support (a file: each abutment's foundation traced as "
+            "a support)",
+        )
+    for name, direction, least, greatest in (result.support_thrust or ()) if result.model.support_count > 1 else ():
         bound = f"{greatest:.4g} N" if math.isfinite(greatest) else "no bound (blocks jammed between supports)"
         lower = f"{least:.4g}" if math.isfinite(least) else "no bound"
         table.add_row(
