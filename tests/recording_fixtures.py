@@ -201,3 +201,28 @@ def dot_at_first_open(path, static: RecordingStatic, q0: np.ndarray, entity: str
     px_per_m = px_per_metre_at_first_open(path, static, q0)
     (r,) = static_value(path, f"/{entity}", "Points2D:radii")
     return (-2.0 * r if r < 0 else 2.0 * r * px_per_m), min(BLOCK_W, BLOCK_H) * px_per_m, r
+
+
+N_FRAMES, BATCH = 25, 10  # the written recording's frames: three flushes, the last one partial
+
+
+@pytest.fixture(scope="module", name="wall")
+def wall_fixture():
+    """The synthetic wall (:func:`wall`): (static, q0)."""
+    return wall()
+
+
+@pytest.fixture(scope="module", name="written")
+def written_fixture(wall, tmp_path_factory):
+    """``N_FRAMES`` frames of the wall recorded, ``BATCH`` a batch, in rerun's strict mode: (path, static,
+    frames, the closed recorder)."""
+    static, q0 = wall
+    frames_ = frames(static, q0, N_FRAMES)
+    path = tmp_path_factory.mktemp("rec") / "run.rrd"
+    before = rr.strict_mode()
+    rr.set_strict_mode(True)
+    with Recorder(path, static, METADATA, batch_frames=BATCH) as rec:
+        for f in frames_:
+            rec.log_frame(f)
+    rr.set_strict_mode(before)
+    return path, static, frames_, rec

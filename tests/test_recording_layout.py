@@ -1,12 +1,11 @@
 """The recording's layout, read back: the embedded blueprint's views and tabs, the paper-figure tabs (only under
 the paper's loading, structure and instant), where the viewer opens (sim_time followed, t = 0 as built), and
-every tab name fitting its tab bar (tests/test_recording.py holds the file's frames, colours and series)."""
+every tab name fitting its tab bar (tests/test_recording.py holds the file's frames and colours, test_recording_series.py its plots)."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
-import test_recording
 
 from masonrycli import recording as rec_mod
 from masonrycli.recording import Recorder, inspect_recording
@@ -16,10 +15,14 @@ from masonrycli.recording.readback import blueprint_views, field_frames
 from masonrycli.scenario.builtin import paper_loading
 
 import recording_fixtures as fx
-from recording_fixtures import strict_rerun, temporal_rows  # noqa: F401 (strict_rerun: autouse)
+from recording_fixtures import (  # noqa: F401 (fixtures: strict_rerun autouse, wall, written)
+    strict_rerun,
+    temporal_rows,
+    wall_fixture,
+    written_fixture,
+)
 
 static_value = fx.static_value
-wall, written = test_recording.wall, test_recording.written  # its module fixtures: one recording for both files
 
 
 def test_embedded_blueprint_has_the_views(written, wall, tmp_path):
