@@ -44,7 +44,10 @@ def test_embedded_blueprint_has_the_views(written, wall, tmp_path):
     views = blueprint_views(tmp_path / "w.rrd")
     pinned = {n: v["pinned"] for n, v in views.items() if v["pinned"]}
     assert sorted(pinned) == ["Fig. III.2", "Fig. III.3", "Fig. III.4", "Fig. III.5"]
-    assert "the paper's figures at t = 0.1 s" in static_value(tmp_path / "w.rrd", "/run/legend", "TextDocument:text")[0]
+    assert (
+        "the paper's figures, pinned at t = 0.1 s"
+        in static_value(tmp_path / "w.rrd", "/run/legend", "TextDocument:text")[0]
+    )
     assert set(pinned.values()) == {("sim_time", 0.1, 0.1)}
 
 

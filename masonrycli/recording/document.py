@@ -16,6 +16,7 @@ import numpy as np
 import rerun as rr
 
 from masonrycli import __version__ as MASONRY_VERSION
+from masonrycli.recording.colormap import tick_label
 from masonrycli.recording.colour_range import BULK_TRIM, HOLD_SPAN, MIN_SPAN, OUTSIDE_SHARE
 from masonrycli.recording.layout import (
     AXES,
@@ -70,6 +71,9 @@ def run_document(
         "",
         f"**Status:** {line}",
         "",
+        # the verdict on the first lines the Run panel shows: a collapsed wall's panel said "Status: completed"
+        # and its parameters, the state 30 rows down the table (result.state), under the panel's fold
+        *_verdict_lines(metadata.get("result")),
         f"**Run time:** {wall_time:.2f} s · **frames:** {frames} · "
         f"**dt:** {dt:g} s · **friction:** {friction:g} · "
         f"**blocks:** {blocks} · **supports:** {supports}",
@@ -124,6 +128,32 @@ def run_document(
     return "\n".join(lines) + "\n"
 
 
+def _axes_legend(axes: tuple[float, float | None] | None) -> str:
+    """The legend's line on the principal stress axes (the Live tab opens on them: the crosses in every block
+    were explained in the Run panel alone, 40 rows down), empty without ``axes``."""
+    if axes is None:
+        return ""
+    length, stress = axes
+    scale = (
+        "scale not fixed yet"
+        if not stress
+        else f"half-length {length:.3g} m at {tick_label(stress, 'Pa', stress, False)} (longer ones clipped)"
+    )
+    return (
+        f"- **Principal stress axes** ({LIVE_TAB} and p tabs): a cross per block along the principal directions, "
+        f"black = compression, magenta = tension; {scale}.\n"
+    )
+
+
+def _verdict_lines(result: object) -> list[str]:
+    """The run's state and peak drift as the summary words them (``metadata["result"]``, set before the
+    closing document), each a line; none before the run has ended or without them."""
+    if not isinstance(result, dict):
+        return []
+    rows = (("State", result.get("state")), ("Peak drift", result.get("peak drift")))
+    return [line for label, value in rows if value for line in (f"**{label}:** {value}", "")]
+
+
 def parameters_markdown(metadata: dict) -> list[str]:
     """The Parameters table's lines (a run's document, a limit recording's panel): one row per dotted key."""
     rows = (f"| {k} | {v} |" for k, v in _flatten(metadata))
@@ -138,10 +168,13 @@ def legend_markdown(
     paper_t: float | None = None,
     arrow_cap: float | None = None,
     magnified_fill: str = "",
+    axes: tuple[float, float | None] | None = None,
 ) -> str:
     """The legend shown under the structure views (and in the run document): the tabs' short names first.
     ``arrow_cap``: the longest arrow drawn, m (a larger force is drawn that long; its value on hover).
-    ``magnified_fill``: what the Magnified line says of a carried fill (``carried_fill.magnified_fill_note``)."""
+    ``magnified_fill``: what the Magnified line says of a carried fill (``carried_fill.magnified_fill_note``).
+    ``axes``: (half-length, m, of a principal stress axis at full length; |stress| there, Pa, None before
+    the first loaded batch): given, a line on the principal stress axes the Live tab opens on."""
     scale = (
         "length proportional to the force, scale not fixed yet"
         if not force_scale
@@ -156,6 +189,7 @@ def legend_markdown(
         "tabs): one arrow per joint, the resultant of its contact forces on the body above it, "
         f"centred on its point of application (line of thrust); {scale}. Green = sticking, "
         "orange = sliding, red = open at one end. Yellow dots: hinges.\n"
+        f"{_axes_legend(axes)}"
         "- **Fills**: colour bar beside the structure; grey = undefined (NaN), magenta = below the range, "
         "lime green = above it. Small dark dots: block centroids (hover one: its name and values).\n"
         f"- **{MAGNIFIED_TAB}** deformed shape: displacements and rotations {factor}; grey = as built{magnified_fill}."

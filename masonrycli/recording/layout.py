@@ -231,13 +231,11 @@ def tabs_legend(main_field: str = "cell_spherical_stress", paper_t: float | None
         names.append(f"{FIELD_TABS[f.key]} = {f.title.lower()}")
         names += [f"{SQRT_TABS[s.name]} = the same on a square-root scale" for s in SQRT_FIELDS if s.key == f.key]
     fields = ", ".join(names)
-    return (
-        f"- **Tabs**: {LIVE_TAB} = joint forces, principal stress axes and {main.lower()}; "
-        + ("" if paper_t is None else f"Fig. = the paper's figures at t = {paper_t:g} s (pinned there); ")
-        + f"{fields} (the last two with joint forces and hinges); "
-        f"{MAGNIFIED_TAB} = the magnified deformed shape."
-        + ("" if paper_t is None else " All but the Fig. tabs follow the time cursor.")
-    )
+    # one bullet of two lines at 1920 px: the Legend panel holds seven, and the principal stress axes' line
+    # (legend_markdown) pushed the Magnified one out. Left to the other bullets: the Magnified tab (its own
+    # line) and which tabs draw the joint forces (theirs)
+    pinned = "" if paper_t is None else f"Fig. = the paper's figures, pinned at t = {paper_t:g} s; "
+    return f"- **Tabs**: {LIVE_TAB} = joint forces, principal stress axes and {main.lower()}; " + pinned + f"{fields}."
 
 
 def _fill_colours(f: FieldSpec) -> dict:

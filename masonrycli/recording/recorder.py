@@ -464,7 +464,8 @@ class Recorder:
             paper_t,
             RESULTANT_CAP * self._size,
         )
-        legend = legend_markdown(*args, magnified_fill_note(fill, drawn))
+        axes = (self._glyph_length, self.axis_scale.get("stress_axes"))
+        legend = legend_markdown(*args, magnified_fill_note(fill, drawn), axes=axes)
         legend += fill_legend(fill, self.metadata.get("thickness_m"), drawn)
         self.rec.log(LEGEND, rr.TextDocument(viewer_safe_text(legend), media_type="text/markdown"), static=True)
 
