@@ -141,3 +141,28 @@ def test_lines_over_the_blocks_stay_thinner_than_small_blocks(tmp_path):
             else:
                 assert 0 < r * px_per_m <= share * side + 1e-6, (entity, r, side)
         assert small or side < 8.0  # the long wall's blocks are small at first open
+
+
+def test_a_block_falling_for_ever_does_not_shrink_the_structure_to_a_dot(tmp_path):
+    """A collapsed aqueduct run on after its collapse: blocks off the foundations' edge fell ~120 m in 5 s (nothing
+    under them), the view widened to hold them and the 7 m structure was a dot at its top. The view holds the
+    structure and what the run drew within CONTENT_REACH × its size of it: a block 1000 m down leaves it, the top
+    course moved one wall height aside stays in."""
+    from masonrycli.recording.static_content import CONTENT_REACH
+
+    static, q0 = fx.wall()
+    frames = fx.frames(static, q0, 8)
+    size = 4 * fx.BLOCK_W  # the wall is 1.2 m long, 0.8 m high
+    top = q0[:, 1] > q0[:, 1].max() - 0.5 * fx.BLOCK_H
+    for k, f in enumerate(frames):
+        f.block_q[top, 0] += 0.8 * k / 7  # the top course slides off by the wall's height
+        f.block_q[0, 1] -= 1000.0 * (k / 7) ** 2  # block 0 falls 1000 m
+    path = tmp_path / "falling.rrd"
+    with Recorder(path, static, fx.METADATA, batch_frames=4) as rec:
+        for f in frames:
+            rec.log_frame(f)
+    xmin, ymin, xmax, ymax = _view(path)
+    assert ymin > -(CONTENT_REACH + 0.2) * size and ymax - ymin < (CONTENT_REACH + 3) * size, (ymin, ymax)
+    owner = np.repeat(np.arange(len(q0)), np.diff(static.block_vert_start))
+    slid = frames[-1].block_q[owner, 0] + static.block_vert_local[:, 0]
+    assert slid[top[owner]].max() < xmax  # the slid course is in the view
