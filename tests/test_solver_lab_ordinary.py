@@ -10,7 +10,7 @@ from types import SimpleNamespace
 import numpy as np
 
 from benchmarks.bench_solver import run_masonry
-from benchmarks.solver_lab import ordinary, ordinary_runs, trajectory
+from benchmarks.solver_lab import ordinary, ordinary_runs, sweep_orders, trajectory
 from masonrycli.engine import dispatch
 from masonrycli.engine.tuning import TUNING
 
@@ -38,7 +38,7 @@ def test_lab_kernel_with_engine_parameters_is_the_engine(tmp_path, monkeypatch):
         its_e, _ = dispatch.solve(d["body"], d["pack"], s.count, model, v_e, r_e, np.zeros(s.count, np.int8), SCALAR)
         assert its_e == its
         np.testing.assert_array_equal(v, v_e)
-        o = ordinary._order("engine", d["point"], d["body"])
+        o = sweep_orders.sweep_order("engine", d["point"], d["body"])
         np.testing.assert_array_equal(r, r_e[o])
 
 

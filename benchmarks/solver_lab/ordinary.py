@@ -28,9 +28,9 @@ the contacts in the engine's interleaved order: with the engine's parameters it 
                  counted as one sweep unit. ("check-low": only at a new lowest in-sweep residual)
     gamma        warm start extrapolated along persistent contacts, r0 = r_{n−1} + γ (r_{n−1} − r_{n−2}),
                  clipped into the cone (γ = 0: the engine's warm start)
-    order        the sweep order (ORDERS)
+    order        the sweep order (sweep_orders.ORDERS)
 
-``solve_skipping`` measures another idea, leaving contacts open by a margin out of the sweeps.
+``skipping.solve_skipping`` measures another idea, leaving contacts open by a margin out of the sweeps.
 
 Reported per variant, over the sample: total sweeps (deterministic; all steps and the ordinary ones,
 i.e. those the engine's momentum converged without stalling), the geometric mean of the per-step ratio
@@ -48,6 +48,7 @@ import time
 
 import numpy as np
 
+from benchmarks.solver_lab.sweep_orders import ORDERS, sweep_order
 from benchmarks.solver_lab.trajectory import TRAJECTORY
 from masonrycli.engine import nlgs
 from masonrycli.engine._jit import njit
@@ -85,10 +86,6 @@ VARIANTS |= {f"a-{a:g}-check-1.2": {"a": a, "check": 1.2} for a in (0.0, -0.5)}
 VARIANTS |= {f"a-0-growth-{g:g}": {"a": 0.0, "growth": g} for g in (1.05, 1.15)}
 VARIANTS |= {f"a-0-cap-{c:g}": {"a": 0.0, "beta_cap": c} for c in (0.9, 0.95, 0.98)}
 VARIANTS |= {"a-1-gamma-0.25": {"a": 1.0, "gamma": 0.25}}
-ORDERS = ("engine", "detection", "reverse", "up", "down", "up-pure", "down-pure", "random", "by-b", "by-b-pure")
-"""Sweep orders: the engine's (detection order, 4 interleaved runs), detection order alone, the engine's
-reversed; by contact height (point y, ties by x) up or down, with the engine's interleaving or pure; random;
-by the higher body of the pair first (by-b: a block's contacts with the blocks below and left of it together)."""
 VARIANTS |= {f"order-{o}": {"order": o} for o in ORDERS[1:]}
 
 
@@ -252,31 +249,6 @@ def _accelerated(
     return iterations + checks, residual  # a check counted as one sweep unit (it reads what a sweep reads)
 
 
-def _interleave(count: int) -> np.ndarray:
-    """The engine's visiting order (dispatch.first_stage)."""
-    k = nlgs.INTERLEAVE
-    run = (count + k - 1) // k
-    return np.array([q * run + j for j in range(run) for q in range(k) if q * run + j < count], dtype=np.int64)
-
-
-def _order(name: str, point: np.ndarray, body: np.ndarray) -> np.ndarray:
-    c = point.shape[0]
-    if name.startswith("by-b"):
-        o = np.lexsort((body[:, 0], body[:, 1]))
-        return o if name.endswith("pure") else o[_interleave(c)]
-    if name in ("engine", "reverse"):
-        o = _interleave(c)
-        return o[::-1].copy() if name == "reverse" else o
-    if name == "detection":
-        return np.arange(c)
-    if name == "random":
-        return np.random.default_rng(0).permutation(c)
-    by_y = np.lexsort((point[:, 0], point[:, 1]))
-    if name.startswith("down"):
-        by_y = by_y[::-1]
-    return by_y if name.endswith("pure") else by_y[_interleave(c)]
-
-
 KERNEL_PARAMETERS = (
     "a",
     "beta_cap",
@@ -317,7 +289,7 @@ class Step:
 
     def arrays(self, order: str):
         if order not in self._by_order:
-            o = _order(order, self.raw["point"], self.raw["body"])
+            o = sweep_order(order, self.raw["point"], self.raw["body"])
             d = {k: np.ascontiguousarray(a[o]) for k, a in self.raw.items()}
             d["body"] = d["body"].astype(np.uint32)
             self._by_order[order] = d
@@ -354,55 +326,6 @@ class Step:
             np.zeros(0) if history is None else history,
         )
         return its, res, v, r
-
-
-def _normal_margin(v, body, pack):
-    """u_n + max(g, 0)/dt of each contact at velocities v (m/s): > 0 open."""
-    b = body.astype(np.int64)
-    dv = v[b[:, 1]] - v[b[:, 0]]
-    un = (
-        dv[:, 0] * pack[:, nlgs.P_NX]
-        + dv[:, 1] * pack[:, nlgs.P_NY]
-        + v[b[:, 1], 2] * pack[:, nlgs.P_NB]
-        - v[b[:, 0], 2] * pack[:, nlgs.P_NA]
-    )
-    return un + pack[:, nlgs.P_BIAS]
-
-
-def solve_skipping(step: Step, margin: float, clock=None):
-    """The engine's accelerated solve on the contacts that can act: a contact with no warm impulse that is
-    open by more than ``margin`` m/s at the warm start is left out of the sweeps (visiting it would find it
-    open and change nothing, as long as it stays open); the RMS still divides by all C contacts. At the end
-    every left-out contact must be open at the final velocities, else the step goes on with all contacts
-    (counted in ``fallback``). Returns (sweeps, residual, v, r, left out, fallback); ``clock`` (a list) gets
-    the CPU seconds of the kernel calls and the final test."""
-    d = step.arrays("engine")
-    st = np.zeros(step.count, dtype=np.int8)
-    v0 = step.v_free.copy()
-    args = kernel_args({})
-    _accelerated(
-        d["body"], d["pack"], step.count, step.mu, TOLERANCE, 0, v0, d["r_warm"].copy(), st, STALL, *args, np.zeros(0)
-    )
-    act = (d["r_warm"] != 0).any(axis=1) | (_normal_margin(v0, d["body"], d["pack"]) <= margin)
-    idx = np.flatnonzero(act)
-    body, pack, r = np.ascontiguousarray(d["body"][idx]), np.ascontiguousarray(d["pack"][idx]), d["r_warm"][idx].copy()
-    v = step.v_free.copy()
-    t = time.process_time()
-    its, res = _accelerated(
-        body, pack, idx.size, step.mu, TOLERANCE, CAP, v, r, st[idx], STALL, *args, np.zeros(0), step.count
-    )
-    out = d["r_warm"].copy() * 0.0
-    out[idx] = r
-    ok = bool((_normal_margin(v, d["body"][~act], d["pack"][~act]) >= 0.0).all())
-    if clock is not None:
-        clock.append(time.process_time() - t)
-    if not ok:
-        v = step.v_free.copy()
-        its2, res = _accelerated(
-            d["body"], d["pack"], step.count, step.mu, TOLERANCE, CAP, v, out, st, STALL, *args, np.zeros(0)
-        )
-        its += its2
-    return its, res, v, out, step.count - idx.size, not ok
 
 
 def _blocks(step: Step) -> np.ndarray:

@@ -21,7 +21,8 @@ import numpy as np
 
 from benchmarks.bench_solver import TIGHT, errors_pct, run_masonry
 from benchmarks.solver_lab.capture import _align
-from benchmarks.solver_lab.ordinary import ENGINE, STALL, VARIANTS, _accelerated, _interleave, kernel_args
+from benchmarks.solver_lab.ordinary import ENGINE, STALL, VARIANTS, _accelerated, kernel_args
+from benchmarks.solver_lab.sweep_orders import interleave
 from benchmarks.solver_lab.trajectory import TRAJECTORY
 from masonrycli.engine import dispatch, stalled
 from masonrycli.engine.tuning import TUNING
@@ -45,7 +46,7 @@ def run_variant(case: str, params: dict, duration: float) -> dict:
     sims = []
 
     def solve(contact_body, pack, count, model, v, r, status, tuning=TUNING):
-        o = _interleave(count)
+        o = interleave(count)
         body = np.ascontiguousarray(contact_body[:count][o].astype(np.uint32))
         pk = np.ascontiguousarray(pack[:count][o])
         r_o = r[:count][o].copy()
