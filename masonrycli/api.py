@@ -218,7 +218,7 @@ def simulate(
     in a notebook a display under the cell; else stderr), first saying why a first run waits."""
     from rich.console import Console
 
-    from masonrycli.execute import check_run, execute
+    from masonrycli.execute import check_run, execute, result_warning
     from masonrycli.interrupt import StopRun
     from masonrycli.outputs.live_line import LiveLine
     from masonrycli.outputs.report import summary_table
@@ -259,6 +259,8 @@ def simulate(
         live.end(result.status, result.steps, result.time, (result.outcome or {}).get("state", ""))
     for error in outcome.errors:
         warnings.warn(f"cannot write {error}", RuntimeWarning, stacklevel=2)
+    if (unconverged := result_warning(outcome.result, sc.run)) is not None:  # the command line's warning line
+        warnings.warn(unconverged, RuntimeWarning, stacklevel=2)
     paths = {o.option: o.path for o in outcome.written}
     text = Console(file=io.StringIO(), width=100, record=True, force_jupyter=False)
     shown = {k: str(v) for k, v in paths.items()}

@@ -399,16 +399,22 @@ def unconverged_warning(unconverged: int, steps: int, capped: int, run, worst: t
     )
 
 
+def result_warning(result, run) -> str | None:
+    """The warning a run's ``result`` gets after its summary (``run``: its RunConfig): how many steps ended
+    unconverged, or None when every step converged. The command line prints it; the Python API warns it."""
+    if result is None or not result.unconverged:
+        return None
+    tally = result.tally
+    worst = (tally.residual_max, tally.residual_max_step)
+    return unconverged_warning(result.unconverged, result.steps, tally.capped, run, worst)
+
+
 def print_summary(console: Console, outcome: Outcome, scenario, hint: str = "") -> None:
     """The summary table, the optional ``hint``, and last the command that opens the recording."""
     result = outcome.result
     paths = {o.option: str(o.path) for o in outcome.written}
     console.print(summary_table(result, paths.get("--out"), paths.get("--history"), scenario.name))
-    if result is not None and result.unconverged:
-        run = scenario.run
-        tally = result.tally
-        worst = (tally.residual_max, tally.residual_max_step)
-        text = unconverged_warning(result.unconverged, result.steps, tally.capped, run, worst)
+    if (text := result_warning(result, scenario.run)) is not None:
         console.print(Text.assemble(("warning: ", "bold red"), text), soft_wrap=True)
     if hint and "--out" in paths:
         console.print(hint, soft_wrap=True)

@@ -304,3 +304,14 @@ def test_a_scenario_shown_in_a_notebook_is_a_few_lines():
     shown = repr(api.scenario("aqueduct"))
     assert len(shown) < 1000 and "Assembly(346 blocks (" in shown and "2 supports (left-foundation … " in shown
     assert repr(api.scenario("wall").assembly) == "Assembly(51 blocks (c01-b01 … c06-b09), 1 support (ground))"
+
+
+def test_unconverged_steps_are_warned_as_the_command_line_warns_them():
+    # the command line prints 'warning: 100 of 100 steps ended unconverged …' after its summary; the API's run
+    # said nothing (its status 'completed', the count in Run.summary's table only)
+    result = invoke("simulate", "wall", "--amp", 1, "--duration", 0.02, "--max-iterations", 5, "--no-recording")
+    line = " ".join(result.output.split("warning: ", 1)[1].split())
+    with pytest.warns(RuntimeWarning) as said:
+        run = api.simulate("wall", amp=1.0, duration=0.02, max_iterations=5)
+    assert [str(w.message) for w in said] == [line] and line.startswith("20 of 20 steps ended unconverged")
+    assert run.status == "completed" and run["nlgs_unconverged"][-1] == 20
