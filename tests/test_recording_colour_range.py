@@ -155,3 +155,23 @@ def test_follow_gives_the_ranges_and_counts_of_update_frame_by_frame(kind):
     assert list(zip(below, above)) == counts
     assert batch.changes == one.changes >= 3
     assert batch.current == one.current
+
+
+def test_bulk_ends_are_the_sorted_rows_ranks_with_or_without_undefined_cells():
+    # a batch whose cells are all defined takes the two ranks by np.partition: the same values as a sort
+    from masonrycli.recording.colour_range import BULK_TRIM, bulk_ends
+
+    rng = np.random.default_rng(11)
+    for cells in (1, 2, 7, 248):
+        frames = np.round(rng.normal(size=(30, cells)), 1)  # ties
+        for holes in (False, True):
+            v = frames.copy()
+            if holes:
+                v[rng.random(v.shape) < 0.2] = np.nan
+                v[0, 0] = np.inf
+            bottom, top, defined = bulk_ends(v)
+            for row, d, lo, hi in zip(v, defined, bottom, top):
+                ordered = np.sort(row[np.isfinite(row)])
+                assert d == ordered.size
+                trim = int(np.floor(BULK_TRIM * d))
+                assert (lo, hi) == ((ordered[trim], ordered[max(d - 1 - trim, 0)]) if d else (np.inf, -np.inf))

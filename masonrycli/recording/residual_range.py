@@ -10,28 +10,49 @@ from __future__ import annotations
 
 import numpy as np
 
+CHUNK = 1024
+"""Residuals kept before they are counted, all at once (ResidualRange.add)."""
+
 
 class ResidualRange:
     """Counts the steps with a residual, those a decade under the tolerance, the largest residual and the
-    smallest of the others; ``tolerance``: m/s (None or 0: no range is ever given)."""
+    smallest of the others; ``tolerance``: m/s (None or 0: no range is ever given).
+
+    The residuals are counted CHUNK at a time, by array operations: one step's by numpy scalar calls
+    (np.isfinite, np.log10) took 14 ms of a recorded second of the 248-block wall (1000 steps), 1 % of its run.
+    np.log10 gives an array's elements as it gives each alone (numpy's one loop: tested); math.log10 does not
+    (another log10, other last bits, and a residual at a decade's edge counted otherwise)."""
 
     def __init__(self, tolerance: float | None) -> None:
         self.log10_tolerance = float(np.log10(tolerance)) if tolerance else np.nan
         self._steps, self._low, self._worst, self._best = 0, 0, 0.0, np.inf
+        self._kept = np.empty(CHUNK)
+        self._count = 0
 
     def add(self, residual: float) -> None:
         """One step's residual, m/s (not finite or not positive: not counted)."""
-        r = float(residual)
-        if not (np.isfinite(r) and r > 0):
+        self._kept[self._count] = residual
+        self._count += 1
+        if self._count == CHUNK:
+            self._fold()
+
+    def _fold(self) -> None:
+        """Count the residuals kept: finite and positive ones; low ones (log10 a decade under the tolerance's)."""
+        r = self._kept[: self._count]
+        self._count = 0
+        r = r[np.isfinite(r) & (r > 0)]
+        if not r.size:
             return
-        low = bool(np.log10(r) < self.log10_tolerance - 1.0)
-        self._steps += 1
-        self._low += low
-        self._worst = max(self._worst, r)
-        self._best = self._best if low else min(self._best, r)
+        low = np.log10(r) < self.log10_tolerance - 1.0
+        self._steps += int(r.size)
+        self._low += int(low.sum())
+        self._worst = max(self._worst, float(r.max()))
+        if not low.all():
+            self._best = min(self._best, float(r[~low].min()))
 
     def range(self) -> tuple[float, float] | None:
         """(low, high), log10 of m/s, with a 5 % margin each side; None: the viewer's fit (module doc)."""
+        self._fold()
         if not self._steps or not np.isfinite(self.log10_tolerance) or self._low > 0.05 * self._steps:
             return None
         if not np.isfinite(self._best):
