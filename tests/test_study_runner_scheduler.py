@@ -1,4 +1,4 @@
-"""``--scheduler ADDRESS`` (masonrycli/study/runner.py): an address where no Dask scheduler answers (silent,
+"""``--scheduler ADDRESS`` (masonrycli/study/scheduler.py): an address where no Dask scheduler answers (silent,
 talking another protocol, dropping the connection, nothing listening, no such host) is refused in one line
 after a short probe, a lookup that may pass on a retry is left to the client, and a client that connects
 after the command gave up (or a Ctrl-C) is closed, one in time returned open."""
@@ -10,7 +10,7 @@ import time
 
 import pytest
 
-from masonrycli.study import runner
+from masonrycli.study import runner, scheduler
 
 
 class Listener:
@@ -58,8 +58,8 @@ def test_a_scheduler_address_where_no_dask_scheduler_answers_is_one_line(greetin
 
     from masonrycli.errors import InputError
 
-    monkeypatch.setattr(runner, "CONNECT_TIMEOUT", 2.0)
-    monkeypatch.setattr(runner, "CONNECT_GRACE", 1.0)
+    monkeypatch.setattr(scheduler, "CONNECT_TIMEOUT", 2.0)
+    monkeypatch.setattr(scheduler, "CONNECT_GRACE", 1.0)
     listener = Listener(greeting)
     start = time.monotonic()
     try:
@@ -71,7 +71,7 @@ def test_a_scheduler_address_where_no_dask_scheduler_answers_is_one_line(greetin
     for thread in threading.enumerate():  # the given-up connect ends with the listener: not in a later test
         if thread.name == "masonry-scheduler-connect":
             thread.join(10.0)
-    assert took < 2.0 + runner.CONNECT_GRACE + 5.0
+    assert took < 2.0 + scheduler.CONNECT_GRACE + 5.0
     assert "\n" not in str(raised.value) and "Dask scheduler" in str(raised.value)
 
 
@@ -80,7 +80,7 @@ def test_a_listener_that_says_nothing_is_refused_after_the_probe(monkeypatch):
     # grace after it, 30 s; a scheduler greets as it accepts, so the probe's wait tells
     from masonrycli.errors import InputError
 
-    monkeypatch.setattr(runner, "PROBE_TIMEOUT", 1.0)
+    monkeypatch.setattr(scheduler, "PROBE_TIMEOUT", 1.0)
     listener = Listener(b"")
     start = time.monotonic()
     try:
@@ -105,7 +105,7 @@ def test_a_client_that_failed_to_connect_is_collected_before_the_command_goes_on
 
     from masonrycli.errors import InputError
 
-    monkeypatch.setattr(runner, "CONNECT_TIMEOUT", 2.0)
+    monkeypatch.setattr(scheduler, "CONNECT_TIMEOUT", 2.0)
     listener = Listener(b"SSH-2.0-OpenSSH_9.2\r\n" * 4)  # Client fails on its answer
     gc.collect()
     gc.disable()  # only the command's own collection counts
@@ -133,7 +133,7 @@ def test_a_port_where_nothing_listens_is_refused_at_once():
     start = time.monotonic()
     with pytest.raises(InputError) as raised:
         runner.open_cluster(f"tcp://127.0.0.1:{port}", None)
-    assert time.monotonic() - start < runner.PROBE_TIMEOUT
+    assert time.monotonic() - start < scheduler.PROBE_TIMEOUT
     assert str(raised.value) == (
         f"--scheduler tcp://127.0.0.1:{port}: cannot connect (nothing listens at 127.0.0.1:{port}: connection refused)"
     )
@@ -149,7 +149,7 @@ def test_a_host_that_does_not_exist_is_refused_at_once():
     start = time.monotonic()
     with pytest.raises(InputError) as raised:
         runner.open_cluster("nosuchhost.invalid:8786", None)
-    assert time.monotonic() - start < runner.CONNECT_TIMEOUT / 2
+    assert time.monotonic() - start < scheduler.CONNECT_TIMEOUT / 2
     assert re.fullmatch(
         r"--scheduler nosuchhost\.invalid:8786: cannot connect \(no host named nosuchhost\.invalid: [^\n]+\)",
         str(raised.value),
@@ -163,7 +163,7 @@ def test_an_address_that_drops_the_connection_is_refused_after_the_probe(monkeyp
 
     from masonrycli.errors import InputError
 
-    monkeypatch.setattr(runner, "PROBE_TIMEOUT", 1.0)
+    monkeypatch.setattr(scheduler, "PROBE_TIMEOUT", 1.0)
     with socket.socket() as listener:
         listener.bind(("127.0.0.1", 0))
         listener.listen(0)
@@ -197,7 +197,7 @@ def test_a_name_lookup_that_may_pass_on_a_retry_is_left_to_client(monkeypatch):
         raise socket.gaierror(socket.EAI_AGAIN, "Temporary failure in name resolution")
 
     monkeypatch.setattr(socket, "create_connection", lookup_fails)
-    assert runner._refused("tcp://scheduler.example:8786") == ""
+    assert scheduler._refused("tcp://scheduler.example:8786") == ""
 
 
 class SlowClient:
@@ -240,20 +240,20 @@ def test_a_client_that_connects_after_the_command_gave_up_is_closed(interrupt, m
     # open, the process's default client, in a long-lived process (a notebook) until it ended.
     from masonrycli.errors import InputError
 
-    monkeypatch.setattr(runner, "CONNECT_TIMEOUT", 0.1)
-    monkeypatch.setattr(runner, "CONNECT_GRACE", 0.1)
-    monkeypatch.setattr(runner, "_refused", lambda scheduler: "")  # the fake client's port 1 is closed
+    monkeypatch.setattr(scheduler, "CONNECT_TIMEOUT", 0.1)
+    monkeypatch.setattr(scheduler, "CONNECT_GRACE", 0.1)
+    monkeypatch.setattr(scheduler, "_refused", lambda scheduler: "")  # the fake client's port 1 is closed
     monkeypatch.setattr(SlowClient, "made", [])
     monkeypatch.setattr(SlowClient, "interrupt", interrupt)
     with pytest.raises(KeyboardInterrupt if interrupt else InputError):
-        runner._connect(SlowClient, "tcp://127.0.0.1:1")
+        scheduler.connect(SlowClient, "tcp://127.0.0.1:1")
     made = _wait_for_made()
     assert len(made) == 1 and made[0].closed
 
 
 def test_a_client_that_connects_in_time_is_returned_open(monkeypatch):
-    monkeypatch.setattr(runner, "_refused", lambda scheduler: "")
+    monkeypatch.setattr(scheduler, "_refused", lambda scheduler: "")
     monkeypatch.setattr(SlowClient, "made", [])
     monkeypatch.setattr(SlowClient, "delay", 0.05)
-    client = runner._connect(SlowClient, "tcp://127.0.0.1:1")
+    client = scheduler.connect(SlowClient, "tcp://127.0.0.1:1")
     assert client is SlowClient.made[0] and not client.closed

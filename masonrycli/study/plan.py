@@ -92,7 +92,7 @@ def plan_study(
     the structure comes to rest under its own weight first, once for every run (:mod:`masonrycli.settle`)."""
     from masonrycli.execute import command_line
     from masonrycli.records.intensity import INTENSITY_MEASURES
-    from masonrycli.study.runner import check_scheduler
+    from masonrycli.study.scheduler import check_scheduler
     from masonrycli.study.task import check_outcome
 
     # a built-in swept over records runs as long as they last (below): its default duration is not the
