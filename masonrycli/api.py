@@ -276,15 +276,18 @@ def simulate(
 
 def read_history(path) -> Run:
     """The :class:`Run` of a history file (``--history``, ``simulate(history=…)``, ``masonry sweep
-    --histories``), checked as ``masonry inspect`` checks it. Its ``outcome`` is None: the file keeps the rows,
-    not the run's verdict (``masonry inspect`` and the study's table have it)."""
+    --histories``), checked as ``masonry inspect`` checks it. Its ``outcome`` is the verdict the file keeps
+    (``result_*``: state, collapse_time, collapse_reason, peak_drift, residual_drift, max_opening,
+    max_displacement, hinges), or None for a history written before it kept them (2026-11-29)."""
     from masonrycli.outputs.inspect_history import inspect_history
+    from masonrycli.outputs.run_report import outcome
 
     path = _path(path, "history")
     inspect_history(path)  # one line for a missing, damaged or foreign file
     with np.load(path, allow_pickle=False) as npz:
         arrays = {name: npz[name] for name in npz.files}
-    return Run(arrays, history=path)
+    kept = outcome(arrays)  # it said None whatever the file held: r.outcome["state"] was a TypeError
+    return Run(arrays, outcome=kept[0] if kept is not None else None, history=path)
 
 
 def view(recording):
@@ -311,8 +314,8 @@ class Run:
     """Every array of the history, by name, as the ``.npz`` holds them (``units`` and ``run`` too)."""
     outcome: dict | None = None
     """The structure's state (``state``: intact, damaged or collapsed; ``collapse_time`` s, NaN if none;
-    ``peak_drift``, ``residual_drift`` × height; ``hinges``; ``max_opening`` m; …: docs/collapse.md), or None
-    for a history read from a file."""
+    ``peak_drift``, ``residual_drift`` × height; ``hinges``; ``max_opening`` m; …: docs/collapse.md); of a
+    history read from a file, the keys it keeps (:func:`read_history`), or None for an older file."""
     recording: Path | None = None
     """The recording written, or None."""
     history: Path | None = None

@@ -18,6 +18,7 @@ import pytest
 
 from masonrycli import api
 from masonrycli.errors import InputError
+from masonrycli.outputs.history import RESULT_KEYS
 
 from cli_helpers import invoke, words
 from synthetic_records import band_limited, write_at2
@@ -195,7 +196,15 @@ def test_files_asked_for_are_written_read_back_and_viewed(tmp_path, monkeypatch)
     assert run.history == h and run.recording == rec and rec.stat().st_size > 0
     back = api.read_history(h)
     _same_arrays(run.arrays, back.arrays)
-    assert back.outcome is None and back.status == "completed" and back.unit("time") == "s, time of the frame"
+    assert back.status == "completed" and back.unit("time") == "s, time of the frame"
+    # the verdict the file keeps (result_*) is the run's: read_history said None whatever the file held
+    assert set(back.outcome) == set(RESULT_KEYS) and back.outcome["state"] == run.outcome["state"]
+    for key in RESULT_KEYS:
+        assert back.outcome[key] == run.outcome[key] or np.isnan(back.outcome[key]) and np.isnan(run.outcome[key])
+    with np.load(h) as npz:  # a history written before histories kept the verdict: None
+        older = {k: npz[k] for k in npz.files if not k.startswith("result_")}
+    np.savez(tmp_path / "older.npz", **older)
+    assert api.read_history(tmp_path / "older.npz").outcome is None
     with pytest.raises(InputError, match="--history .*exists"):
         api.simulate("wall", duration=0.02, history=h)  # never overwritten without force
     api.simulate("wall", duration=0.02, history=h, force=True)
