@@ -125,3 +125,24 @@ def test_limit_spreads_a_load_through_a_traced_fill(tmp_path):
     assert traced.exit_code == 0, traced.output
     built = invoke("limit", "arch", "--fill-to", CROWN + 0.3, *args)
     assert json.loads(traced.stdout)["load_factor"] == pytest.approx(json.loads(built.stdout)["load_factor"], rel=1e-6)
+
+
+def test_a_point_load_placed_by_its_map_abscissa(tmp_path):
+    """A bridge traced in Lambert-93 is read moved by whole km (by -650 000 m: x = 651 001.9 is 1001.9); its
+    researcher gives --at on the map: it said 'no block over x = 651002 m (the blocks span x = 997.1 … 1002.5 m)'.
+    A map abscissa is moved as the file was, with a note, and loads the same voussoir with the same λ."""
+    east, north = 651000.0, 6861000.0
+    features = [_feature(_ring(b.polygon), name=b.name) for b in build_arch().blocks]
+    features += [_feature(_ring(s.polygon), role="support", name=s.name) for s in build_arch().supports]
+    for f in features:  # the crown at x = 651 001.8 m
+        f["geometry"]["coordinates"] = [[[x + east + 1.8, y + north] for x, y in f["geometry"]["coordinates"][0]]]
+    path = tmp_path / "l93.geojson"
+    path.write_text(json.dumps({"type": "FeatureCollection", "features": features}))
+    local = invoke("limit", path, "--load", "point", "--at", 1001.9, "--json")
+    mapped = invoke("limit", path, "--load", "point", "--at", east + 1.9, "--json")
+    assert local.exit_code == 0 and mapped.exit_code == 0, mapped.stderr
+    said = " ".join(mapped.stderr.split())
+    assert "--at 651001.9 is the map's abscissa: x = 1001.9 m in the file as read (moved by -650000 m)" in said
+    a, b = json.loads(local.stdout), json.loads(mapped.stdout)
+    assert a["load"]["block"] == b["load"]["block"] == "v16"
+    assert b["load_factor"] == pytest.approx(a["load_factor"], rel=1e-9)

@@ -68,6 +68,28 @@ def resolve_structure(structure: str, friction: float | None, options: dict | No
     return override_run(scenario, friction=friction)
 
 
+MAP_ABSCISSA = 1e4
+"""m: an --at this far from the origin, on a file read moved from a map grid, is the map's abscissa (the file as
+read lies within this of the origin: geometry_library.survey)."""
+
+
+def _on_the_file(live: LiveLoad, scenario, err_console) -> LiveLoad:
+    """``live`` with an --at given in the map's coordinates (a Lambert-93 abscissa, 651233.5) moved as the file was
+    read (to 233.5): it said 'no block over x = 651233 m (the blocks span x = 228.8 … 239.2 m)'."""
+    origin = (scenario.reading or {}).get("map_origin_m")
+    if live.at is None or origin is None or abs(live.at) < MAP_ABSCISSA:
+        return live
+    x = live.at - origin[0]
+    err_console.print(
+        Text.assemble(
+            ("note:", "cyan"),
+            f" --at {live.at:.12g} is the map's abscissa: x = {x:.12g} m in the file as read (moved by {-origin[0]:.0f} m)",
+        ),
+        soft_wrap=True,
+    )
+    return replace(live, at=x)
+
+
 def _names(names: list[str]) -> str:
     """``names`` come fastest first: a long list shows the mechanism's main joints, not the first names
     in body order (the aqueduct's point load listed 8 pier and spandrel joints turning at 0.01–1 % of its
@@ -323,6 +345,7 @@ def _analyse(structure, live, friction, verify, out, force, done: _Done, signals
         from masonrycli.settle import settle
 
         scenario, settling = settle(scenario, options["settle"])
+    live = _on_the_file(live, scenario, err_console)
     try:
         done.result = replace(analyse(scenario, live, thrust=options["thrust"]), settled=settling)
         if options["min_thickness"]:
