@@ -237,7 +237,9 @@ def simulate(
     # summary table, which goes to Run.summary, was shown after every run of a loop)
     quiet = Console(file=io.StringIO(), quiet=True, force_jupyter=False)
     sinks = [_FrameCallback(on_frame)] if on_frame is not None else []
-    live = LiveLine(sc.name) if progress else None
+    # which run of a loop the line is: the scenario and the options given ('wall (freq=2.0, friction=0.8)')
+    given = ", ".join(f"{k}={_argument(v)}" for k, v in options.items() if v is not None)
+    live = LiveLine(f"{sc.name} ({given})" if given else sc.name) if progress else None
     if live is not None:
         live.start()
     try:

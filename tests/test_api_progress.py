@@ -31,10 +31,11 @@ def test_a_notebook_gets_one_line_updated_in_place(monkeypatch, capsys):
     run = api.simulate("wall", blocks=12, amp=0.5, duration=0.05, progress=True)
     assert capsys.readouterr() == ("", "")  # no stream text: the display alone
     first, *steps, last = display.shown
-    assert first == f"wall: {live_line.STARTING}"
-    said = [int(m.group(1)) for text in steps if (m := re.match(r"wall: step (\d+) of 50, t = ", text))]
+    run_of = re.escape("wall (blocks=12, amp=0.5, duration=0.05)")  # which run of a loop: the options given
+    assert first == f"wall (blocks=12, amp=0.5, duration=0.05): {live_line.STARTING}"
+    said = [int(m.group(1)) for text in steps if (m := re.match(rf"{run_of}: step (\d+) of 50, t = ", text))]
     assert said == list(range(10, 51, 10))  # the run's steps, in order, as the run reached them
-    assert re.fullmatch(rf"wall: completed, {run.outcome['state']}, 50 steps to t = 0.05 s in \d+\.\d s", last)
+    assert re.fullmatch(rf"{run_of}: completed, {run.outcome['state']}, 50 steps to t = 0.05 s in \d+\.\d s", last)
 
 
 def test_off_a_terminal_a_script_gets_its_start_and_end(monkeypatch, capsys):
@@ -42,7 +43,8 @@ def test_off_a_terminal_a_script_gets_its_start_and_end(monkeypatch, capsys):
     api.simulate("wall", blocks=12, duration=0.02, progress=True)
     out, err = capsys.readouterr()
     lines = err.splitlines()
-    assert out == "" and len(lines) == 2 and lines[0].startswith("wall: starting") and "completed" in lines[1]
+    assert out == "" and len(lines) == 2 and lines[0].startswith("wall (blocks=12, duration=0.02): starting")
+    assert lines[1].startswith("wall (blocks=12, duration=0.02): completed")
 
 
 def test_without_progress_nothing_is_shown(monkeypatch, capsys):
