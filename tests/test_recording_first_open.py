@@ -86,3 +86,25 @@ def test_the_legend_stays_seven_lines_at_1920_px(tmp_path):
     bullets = [ln.replace("**", "") for ln in legend.splitlines() if ln.startswith("- ")]
     assert len(bullets) == 5 and bullets[-1].startswith("- Magnified")
     assert sum(math.ceil(len(b) / 185) for b in bullets) <= 7, [len(b) for b in bullets]
+
+
+def test_the_plots_open_on_what_moved_the_structure(tmp_path):
+    """An arch shaken by a .AT2 record opened its second row of plots on the solver's log10 residual, its
+    ground's velocity a click away: the support's velocity shows at open when a support moved, the residual
+    when none did."""
+    from masonrycli.recording.layout import PLOT_NAMES
+    from masonrycli.recording.readback import blueprint_tabs
+
+    static, q0 = fx.wall()
+    shaken = fx.frames(static, q0, 3)  # the ground shaken at 2 Hz
+    still = [type(f)(**{**f.__dict__, "support_v": np.zeros_like(f.support_v)}) for f in shaken]
+    opened = {}
+    for name, frames in (("shaken", shaken), ("still", still)):
+        with Recorder(tmp_path / f"{name}.rrd", static, fx.METADATA, batch_frames=4) as rec:
+            for f in frames:
+                rec.log_frame(f)
+        (plots,) = [
+            shown for names, shown in blueprint_tabs(tmp_path / f"{name}.rrd") if PLOT_NAMES["residual"] in names
+        ]
+        opened[name] = plots
+    assert opened == {"shaken": PLOT_NAMES["support_velocity"], "still": PLOT_NAMES["residual"]}

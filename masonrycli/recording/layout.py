@@ -273,12 +273,14 @@ def build_blueprint(
     paper: tuple[float, tuple[str, ...]] | None = None,
     residual_range: tuple[float, float] | None = None,
     structure_view: tuple[tuple[float, float], tuple[float, float]] | None = None,
+    supports_move: bool = False,
 ) -> rrb.Blueprint:
     """Structure tabs and the on-screen legend (left); time series and the run document (right).
     ``residual_range``: the residual plot's y range (log10 of m/s; None: the viewer's fit to the data).
     ``structure_view``: the part of the view that holds the structure and its magnified shape, image ranges
     (u0, u1), (v0, v1) (``static_content.log_plane``): the magnified shape's tab, which has no bar nor
-    arrows, shows that part.
+    arrows, shows that part. ``supports_move``: a support moved during the run (a shaken ground, a settling
+    foundation): the second row of plots opens on its velocity, else on the solver's residual.
 
     Tabs: the live main view (forces, principal stress, ``main_field``), with ``paper`` = (t, figure
     numbers) the paper's four figures pinned to t, the four fields live (p also on the square-root scale,
@@ -355,7 +357,10 @@ def build_blueprint(
             plot("residual", residual_axis),
             plot("iterations"),
             plot("contacts"),
-            active_tab=2,  # the residual, shown at first open as before the supports joined this row
+            # what moved the structure, at first open: the shaking ground, the settling foundation (an arch
+            # shaken by a .AT2 record opened on the solver's log10 residual, which a newcomer cannot read,
+            # its ground motion one click away); the residual when no support moves
+            active_tab=0 if supports_move else 2,
         ),
         rrb.TextDocumentView(origin=f"/{METADATA}", name="Run"),
         row_shares=[2, 2, 3],

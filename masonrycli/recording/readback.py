@@ -334,6 +334,30 @@ def blueprint_views(path: str | os.PathLike) -> dict[str, dict]:
     return {v["name"]: v for v in by_id.values() if "name" in v}
 
 
+def blueprint_tabs(path: str | os.PathLike) -> list[tuple[list[str], str]]:
+    """Every tab container of the recording's last default blueprint: (its views' names in order, the one
+    shown at open: its active tab, else the first)."""
+    with _reading(path) as reader:
+        chunks = list(reader.stream(store=_last_blueprint(reader)))
+    names: dict[str, str] = {}
+    tabs: list[tuple[list[str], str | None]] = []
+    for chunk in chunks:
+        batch = chunk.to_record_batch()
+        cols = batch.schema.names
+        if "ViewBlueprint:display_name" in cols:
+            names[chunk.entity_path.strip("/")] = batch.column("ViewBlueprint:display_name").to_pylist()[-1][0]
+        if "ContainerBlueprint:container_kind" in cols and batch.column(
+            "ContainerBlueprint:container_kind"
+        ).to_pylist()[-1] == [1]:  # rerun.blueprint.components.ContainerKind.Tabs
+            active = (
+                batch.column("ContainerBlueprint:active_tab").to_pylist()[-1]
+                if "ContainerBlueprint:active_tab" in cols
+                else None
+            )
+            tabs.append((batch.column("ContainerBlueprint:contents").to_pylist()[-1], active[0] if active else None))
+    return [([names[c] for c in contents], names[active or contents[0]]) for contents, active in tabs]
+
+
 def blueprint_time_panel(path: str | os.PathLike) -> dict:
     """The embedded blueprint's time panel: {"timeline": name or None, "play_state": "paused", "playing",
     "following" or None} (None: not set, the viewer's default)."""

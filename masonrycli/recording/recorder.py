@@ -158,6 +158,7 @@ class Recorder:
         self.magnify = magnify
         self._legend_box = (0.0, 0.0, 0.0, 0.0)
         self._structure_view = None  # the Magnified tab's part of the view (log_plane)
+        self._supports_moved = False  # a support's velocity was not 0 at a frame: its plot shows at open
         self._label_anchors = np.zeros((0, 2), np.float32)
         self._size = 1.0
         self._frames, self._last = 0, None  # frames logged; (step, time) of the last one
@@ -369,7 +370,9 @@ class Recorder:
             reached = self._last is not None and self._last[1] >= self.paper[0] - 0.5 * self.static.dt
             if not reached:
                 self.paper = None
-        layout = build_blueprint(self._main_field, self.paper, self.residual_range(), self._structure_view)
+        layout = build_blueprint(
+            self._main_field, self.paper, self.residual_range(), self._structure_view, self._supports_moved
+        )
         self.rec.send_blueprint(layout, make_active=True, make_default=True)
 
     # ---- per-batch content
@@ -394,6 +397,7 @@ class Recorder:
         args = (self._fill, self._blocks.owner, self._colours, self._label_anchors, q, tensors, initial)
         send_blocks(self.rec, idx, *args, at=own)
         send_supports(self.rec, idx, self._supports, b.stack("support_q"))
+        self._supports_moved = self._supports_moved or bool(np.any(b.stack("support_v")))
         self._carried.send(self.rec, idx, q)
         self._send_axes(idx, np.concatenate([own, q[..., 2:]], axis=-1), tensors)
         self._send_joints(idx, b)
