@@ -254,3 +254,19 @@ def test_the_run_s_verdict_and_its_words_are_rows(tmp_path):
     )
     assert arrays["run"].split()[:2] == ["()", "str"]  # the run's JSON: its rows above, not a line of 2 kB
     assert list(rows)[:2] == ["scenario", "structure"]  # an in-process command: no command to name
+
+
+def test_a_bridges_fill_is_a_row_of_inspect_and_of_the_report(tmp_path):
+    """A filled bridge's history: inspect and masonry report said friction, density and thickness, not the fill
+    the blocks carried (the 37-stone surveyed bridge's 42.7 t, more than its stones' 31.9 t). The default
+    semicircle filled to its crown at 1800 kg/m³: 1800 × (5.4 × 2.15 − 30 × ½ × 2.15² sin 6°) kg."""
+    import math
+
+    h = tmp_path / "h.npz"
+    args = ["arch", "--fill-to", 2.15, "--fill-density", 1800, "--settlement", 0, "--duration", 0.002, "--dt", 0.001]
+    result = invoke("simulate", *args, "--history", h, "--no-recording")
+    assert result.exit_code == 0, result.output
+    mass = 1800.0 * (5.4 * 2.15 - 30 * 0.5 * 2.15**2 * math.sin(math.radians(6.0)))
+    said = f"{mass:.6g} kg carried by the blocks under it (dead load only)"
+    assert _rows(invoke("inspect", h).stdout)["fill"] == said
+    assert f"| fill | {said} |" in invoke("report", h).stdout

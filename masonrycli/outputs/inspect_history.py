@@ -221,6 +221,8 @@ def run_rows(info: dict) -> list[tuple[str, str]]:
     mu, rho, thick = get("friction"), get("density_kg_m3"), get("thickness_m")
     if given(mu, rho, thick):
         rows.append(("material", f"friction {mu:g}, density {_value(rho)} kg/m³, thickness {_value(thick)} m"))
+    if (fill := get("fill_mass_kg")) is not None:  # a bridge's fill, often heavier than its stones: said by neither
+        rows.append(("fill", f"{fill:.6g} kg carried by the blocks under it (dead load only)"))
     version, commit, digest = get("masonry"), get("commit"), get("source_digest")
     rows.append(
         (

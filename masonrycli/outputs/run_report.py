@@ -7,7 +7,7 @@ what the user saw:
 on the page                from
 =========================  ==============================================================================
 what was run               ``masonry inspect H.npz``'s rows (:func:`inspect_history.run_rows`): scenario,
-                           structure and its size, material, loading, run settings, masonry's version,
+                           structure and its size, material, a bridge's fill, loading, run settings, masonry's version,
                            commit and source digest
 ground motion as applied   the history's ``intensity_*`` (measured by the run with
                            :func:`masonrycli.records.intensity.intensity_measures`, as ``check``'s
@@ -85,6 +85,7 @@ RUN_ROWS = (
     "reading",
     "study point",
     "material",
+    "fill",
     "loading",
     "dt",
     "solver",
