@@ -146,3 +146,15 @@ def test_a_point_load_placed_by_its_map_abscissa(tmp_path):
     a, b = json.loads(local.stdout), json.loads(mapped.stdout)
     assert a["load"]["block"] == b["load"]["block"] == "v16"
     assert b["load_factor"] == pytest.approx(a["load_factor"], rel=1e-9)
+
+
+def test_a_fills_unused_property_is_said_as_a_fills(tmp_path):
+    """A fill's 'velocity' was reported '(read on blocks only: a support moves by a scenario file's [[support]]
+    motion)', a support's reason."""
+    stone = _feature([[0, 0], [2, 0], [2, 1], [0, 1], [0, 0]], name="stone")
+    ground = _feature([[-2, -0.5], [3, -0.5], [3, 0], [-2, 0], [-2, -0.5]], role="support")
+    fill = _feature([[0, 1], [2, 1], [2, 2], [0, 2], [0, 1]], role="fill", velocity=[0, 0, 0])
+    path = tmp_path / "v.geojson"
+    path.write_text(json.dumps({"type": "FeatureCollection", "features": [stone, ground, fill]}))
+    said = " ".join(invoke("check", path).stderr.split())
+    assert '"velocity" (a fill takes role, name and density only) first on feature 3, fill 1' in said, said

@@ -149,6 +149,8 @@ def unread_properties_warning(path: str, unknown: dict, known) -> str:
     items = []
     for key, first in unknown.items():
         hint = _MISPLACED.get(key) or did_you_mean(key, known)
+        if ", fill " in first and key in _MISPLACED:  # a traced fill's: not a support's reason
+            hint = " (a fill takes role, name and density only)"
         if not hint and str(key).lower() == "friction":  # one coefficient for every contact, not a block's
             hint = " (friction is the scenario file's [material] friction, one for every contact)"
         items.append(f"{quote_string(str(key))}{hint} first on {first}")
