@@ -55,6 +55,18 @@ def test_min_thickness_refusals_are_one_line(args, fragment):
     assert_one_line_error(invoke("limit", *args), fragment)
 
 
+def test_min_thickness_on_a_file_names_the_built_in_to_ask(tmp_path):
+    """A surveyed bridge's researcher asking --min-thickness of her file was told only 'the arch's ring only': the
+    way to her ring's factor is the built-in of its dimensions, which the line now gives."""
+    from geometry_library.builders import build_arch
+    from geometry_library.io import write_geojson
+
+    path = write_geojson(build_arch(), tmp_path / "b.geojson")
+    assert_one_line_error(
+        invoke("limit", path, "--min-thickness"), "a surveyed ring's: the arch built-in of its span, rise and ring"
+    )
+
+
 def test_a_ring_standing_at_the_builders_thinnest_is_an_upper_bound_not_the_least():
     """A segmental arch of rise 3.9995 m on an 8 m span: its skewbacks are t·cos α thick, and the builder refuses
     them under 0.1 mm, i.e. every ring under 1e-4 / cos α = 0.80 m. The search read that refusal as "does not

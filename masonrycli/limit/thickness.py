@@ -150,8 +150,16 @@ def check_min_thickness(structure: str, settle: float | None) -> None:
     the builder's rings, laid exact, where settling moves nothing, and a ring settled near its least thickness
     would be the engine's slow creep, not the ring. It searched the unsettled rings under the settled table."""
     if structure != "arch":
+        from masonrycli.scenario.target import is_built_in
+
+        survey = (
+            ""
+            if is_built_in(structure)
+            else "; a surveyed ring's: the arch built-in of its span, rise and ring (masonry limit arch --span S "
+            "--rise F --ring-thickness T --pier-width W --min-thickness), its voussoirs equal"
+        )
         raise InputError(
-            f"--min-thickness: the arch's ring only (masonry limit arch …); {structure} is not the arch built-in"
+            f"--min-thickness: the arch's ring only (masonry limit arch …); {structure} is not the arch built-in{survey}"
         )
     if settle is not None:
         raise InputError(
