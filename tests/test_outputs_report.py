@@ -89,3 +89,11 @@ def test_the_summary_is_titled_with_the_scenario_not_masonry_run(tmp_path, monke
     assert result.exit_code == 0, result.output
     assert "masonry run —" not in result.output
     assert "arch — completed" in result.output
+
+
+def test_the_energy_row_says_its_change():
+    """A file read moved from a map grid stands hundreds of metres up: its summary said '2.475e+08 J → 2.475e+08 J'
+    and the few joules its stones lost (the balance: support work = change + dissipated) could not be read."""
+    result = simulate(scenario("column5.toml", duration=0.01))
+    result.energy_initial, result.energy_final = 2.475123e8, 2.475123e8 - 2.1
+    assert _rows(result)["energy (kinetic + potential)"] == "2.475e+08 J → 2.475e+08 J (change -2.1 J)"

@@ -114,7 +114,13 @@ def summary_table(result, recording: str | None, history: str | None, name: str 
         )
         table.add_row("NLGS residual (m/s)", f"max {tally.residual_max:.2e}, last {tally.residual_last:.2e}")
     table.add_row("max penetration", f"{result.max_penetration:.3e} m")
-    table.add_row("energy (kinetic + potential)", f"{result.energy_initial:.4g} J → {result.energy_final:.4g} J")
+    # its change said apart: a file read moved from a map grid stands hundreds of metres up, and its 2.475e+08 J →
+    # 2.475e+08 J hid the 2 J its stones lost (the balance: support work = change + dissipated)
+    change = result.energy_final - result.energy_initial
+    table.add_row(
+        "energy (kinetic + potential)",
+        f"{result.energy_initial:.4g} J → {result.energy_final:.4g} J (change {change:+.4g} J)",
+    )
     table.add_row("dissipated at contacts", _dissipated(result))
     table.add_row("work of the supports", f"{result.support_work:.4g} J")
     for key, value in result.extra.items():
