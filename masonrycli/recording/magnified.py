@@ -103,7 +103,7 @@ def send_magnified(
     """Send the magnified outlines of the frames in ``poses`` (displacements) about ``ref`` (the first block_q,
     support_q);
     returns the factor used (``magnify``, or the default for ``size`` m) and the extent drawn (xmin, ymin,
-    xmax, ymax), m: the blocks', the supports' in y only (a wide ground is shown only a little beyond the
+    xmax, ymax), m: the blocks' above the supports' lowest point (one fallen below it is left out), the supports' in y only (a wide ground is shown only a little beyond the
     blocks: ``static_content.log_plane``), for the view to hold it (the arch's right foundation, settled
     1 cm in 1 s and drawn x 25, touched the view's bottom edge). ``fill``: a bridge's ``CarriedFill``, its columns'
     outlines posed on the magnified blocks."""
@@ -131,18 +131,23 @@ def send_magnified(
         if fill is not None:
             fill.send_outlines(rec, time_indexes(batch), magnified, MAGNIFIED_FILL)
         sets = [blocks.outlines(verts)]
-        if verts.size:
-            lo, hi = verts.reshape(-1, 2).min(axis=0), verts.reshape(-1, 2).max(axis=0)
-            extent = np.r_[np.minimum(extent[:2], lo), np.maximum(extent[2:], hi)]
-        count = blocks.count
+        count, held = blocks.count, verts.reshape(-1, 2)
         if supports.count:
-            verts = supports.world(ref_sq + (m * dsq - back))
-            sets.append(supports.outlines(verts))
+            sverts = supports.world(ref_sq + (m * dsq - back))
+            sets.append(supports.outlines(sverts))
             extent[1], extent[3] = (
-                min(extent[1], float(verts[..., 1].min())),
-                max(extent[3], float(verts[..., 1].max())),
+                min(extent[1], float(sverts[..., 1].min())),
+                max(extent[3], float(sverts[..., 1].max())),
             )
             count += supports.count
+            # a block fallen off its supports (below the lowest one's bottom, in free fall) is not held in the
+            # view: a wall whose end blocks fell off its shaken ground ('masonry simulate wall --amp 3 --freq
+            # 0.8 --duration 3') was framed down to their last pose, metres under the ground, the structure
+            # and its colour bar squeezed into the top third of the panel
+            held = verts[verts[..., 1] >= sverts[..., 1].min(axis=1)[:, None]]
+        if held.size:
+            lo, hi = held.min(axis=0), held.max(axis=0)
+            extent = np.r_[np.minimum(extent[:2], lo), np.maximum(extent[2:], hi)]
         # frame by frame: that frame's blocks, then its supports
         strips = [arr.slice(k * (len(arr) // n_frames), len(arr) // n_frames) for k in range(n_frames) for arr in sets]
         rec.send_columns(

@@ -379,12 +379,14 @@ class Recorder:
     def _send_batch(self, b: FrameBatch) -> None:
         idx = time_indexes(b)
         q = b.stack("block_q")  # (F, N, 3)
-        if self._n:
-            e = self._extent
-            e[2], e[0] = (
-                max(e[2], float((q[..., 0] + self._radius).max())),
-                min(e[0], float((q[..., 0] - self._radius).min())),
-            )
+        if self._n:  # the blocks' x reach, but of a block fallen off the supports (magnified.send_magnified)
+            x, r = q[..., 0], np.broadcast_to(self._radius, q.shape[:2])
+            if self._supports.count:
+                on = q[..., 1] + r >= self._supports.world(b.stack("support_q"))[..., 1].min(axis=1)[:, None]
+                x, r = x[on], r[on]
+            if x.size:
+                e = self._extent
+                e[2], e[0] = max(e[2], float((x + r).max())), min(e[0], float((x - r).min()))
         tensors = {key: b.stack(key) for key in TENSOR_KEYS}
         # A voussoir of a bare ring has no cell strain rate; its strain rate along the ring stands in.
         vsr = tensors["cell_volumetric_strain_rate"]
