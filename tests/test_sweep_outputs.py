@@ -254,3 +254,17 @@ def test_the_summary_says_where_the_histories_are(block, tmp_path):
     assert result.exit_code == 0, result.output
     assert f"histories: {h} (2 histories, one a run; as CSV: masonry export {h} --top)" in words(result.output)
     assert sorted(p.name for p in h.iterdir()) == ["amp=0.05.npz", "amp=0.1.npz"]
+
+
+def test_the_summary_s_paths_and_commands_are_never_broken_over_lines(block, tmp_path):
+    # off a terminal (a pipe, a log, a notebook's subprocess) the console is 80 columns wide: the histories line
+    # of a long folder was wrapped inside its path and its 'masonry export … --top' command
+    deep = tmp_path / "course-2026" / "assignment-3-friction-and-frequency" / "histories-of-every-run"
+    out = deep.parent / "study-of-the-wall-at-several-frequencies.csv"
+    grid = ["-p", "amp=0.05,0.1", "--duration", 0.02, "--workers", 0, "--no-recording", "-o", out]
+    result = invoke("sweep", block, *grid, "--histories", deep)
+    assert result.exit_code == 0, result.output
+    lines = result.output.splitlines()
+    assert f"histories: {deep} (2 histories, one a run; as CSV: masonry export {deep} --top)" in lines
+    assert f"plot: {out.with_suffix('.png')}" in lines
+    assert any(line.startswith(f"2 rows in {out} (2 runs now, 0 rows already there, 0 failed) in ") for line in lines)

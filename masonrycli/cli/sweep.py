@@ -404,20 +404,25 @@ def _report(console, result, plan: StudyPlan, im: str, written: list, signals: F
     # said once both are written: a reader of stdout that goes away (`masonry sweep … | head`) broke the pipe
     # at the first line after the table, and the plot and the recording were never written
     console.print(study_table(rows, columns, keys, console, result.out, fixed))
+    # each on a line of its own however long its paths (soft_wrap): at a pipe's 80 columns, a notebook's capture or
+    # a log, 'histories: … (…; as CSV: masonry export h --top)' broke its path and command over two lines
     console.print(
         f"{_n(len(rows), 'row')} in {result.out} ({_n(result.ran, 'run')} now, {_n(result.skipped, 'row')} already "
-        f"there, {result.failed} failed) in {result.wall_time:.1f} s"
+        f"there, {result.failed} failed) in {result.wall_time:.1f} s",
+        soft_wrap=True,
     )
     for group in groups:
         console.print(_fit_line(group, im, request.axes))
         if (line := _collapsed_line(group)) is not None:
             console.print(line)
-    console.print(f"plot: {plot.path}")
+    console.print(f"plot: {plot.path}", soft_wrap=True)
     if request.histories is not None:  # the summary named the table, plot and recording, not the runs' histories
         # counted where this command runs (a remote cluster's workers write them where they run)
         found = sum(1 for _ in request.histories.glob("*.npz")) if request.histories.is_dir() else 0
         each = f"{found} {'history' if found == 1 else 'histories'}, one a run" if found else "one history a run"
-        console.print(f"histories: {request.histories} ({each}; as CSV: masonry export {request.histories} --top)")
+        console.print(
+            f"histories: {request.histories} ({each}; as CSV: masonry export {request.histories} --top)", soft_wrap=True
+        )
     if recording is not None:
         # as masonry run says it: 'recording: s.rrd' left a first user to find out what opens a .rrd
         from rich.text import Text
