@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import json
 import math
+import re
 
 import pytest
 from shapely.geometry import Point, box
@@ -146,6 +147,11 @@ def test_a_point_load_placed_by_its_map_abscissa(tmp_path):
     a, b = json.loads(local.stdout), json.loads(mapped.stdout)
     assert a["load"]["block"] == b["load"]["block"] == "v16"
     assert b["load_factor"] == pytest.approx(a["load_factor"], rel=1e-9)
+    assert b["map_origin_m"] == [650000.0, 6860000.0]
+    # and the worst place is said on the map too (it was the file's 1001.8 m alone)
+    worst = " ".join(invoke("limit", path, "--load", "point", "--worst").stdout.split())
+    x, on_map = re.search(r"x = (\S+) m \((\S+) on the map\)", worst).groups()
+    assert float(on_map) - 650000.0 == pytest.approx(float(x), abs=0.05)  # x said to 4 digits
 
 
 def test_a_fills_unused_property_is_said_as_a_fills(tmp_path):

@@ -57,6 +57,9 @@ class LimitResult:
     places: tuple | None = None
     """The places a ``--worst`` point load was tried at (:class:`masonrycli.limit.worst.Place`), left to right;
     None without ``--worst``."""
+    map_origin: tuple[float, float] | None = None
+    """m: the map coordinates of the origin a file was read moved to (its reading's ``map_origin_m``), so that a
+    place is also said on the survey; None for a file read as it is, or a built-in."""
     support_thrust: tuple[tuple[str, str, float, float], ...] | None = None
     """(support, outward direction, least N, greatest N) of each support under the dead load alone
     (:func:`support_thrusts`; ±inf: no bound, null in JSON); None unless asked for (``masonry limit --thrust``)."""
@@ -167,6 +170,7 @@ class LimitResult:
             "supports": m.support_count,
             "joints": j.joint_count,
             "settled": None if self.settled is None else self.settled.summary(),
+            "map_origin_m": None if self.map_origin is None else list(self.map_origin),
             "contact_points": j.contact_count,
             "hinges": self.hinges,
             "hinge_points": [[float(x), float(y)] for x, y in self.motion.hinge_point],

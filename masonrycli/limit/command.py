@@ -123,7 +123,10 @@ def _worst_text(result: LimitResult) -> str:
     """The --worst row: where, among how many places, and the next-worst places elsewhere."""
     found = sorted((p for p in result.places if p.load_factor is not None), key=lambda p: p.load_factor)
     skipped = len(result.places) - len(found)
-    said = f"x = {result.load.at:.4g} m on {result.load.block}, the least λ of {len(result.places)} places tried"
+    on_map = "" if result.map_origin is None else f" ({result.load.at + result.map_origin[0]:.12g} on the map)"
+    said = (
+        f"x = {result.load.at:.4g} m{on_map} on {result.load.block}, the least λ of {len(result.places)} places tried"
+    )
     said += " (both ends of each straight stretch of the blocks' top: λ is least at one of them)"
     others, seen = [], {round(result.load.at, 9)}
     for p in found:  # the next-worst elsewhere: a joint's other side is the same place
@@ -347,7 +350,12 @@ def _analyse(structure, live, friction, verify, out, force, done: _Done, signals
         scenario, settling = settle(scenario, options["settle"])
     live = _on_the_file(live, scenario, err_console)
     try:
-        done.result = replace(analyse(scenario, live, thrust=options["thrust"]), settled=settling)
+        origin = (scenario.reading or {}).get("map_origin_m")
+        done.result = replace(
+            analyse(scenario, live, thrust=options["thrust"]),
+            settled=settling,
+            map_origin=None if origin is None else (float(origin[0]), float(origin[1])),
+        )
         if options["min_thickness"]:
             from masonrycli.limit.thickness import builtin_least_ring
 
