@@ -97,3 +97,19 @@ def test_the_energy_row_says_its_change():
     result = simulate(scenario("column5.toml", duration=0.01))
     result.energy_initial, result.energy_final = 2.475123e8, 2.475123e8 - 2.1
     assert _rows(result)["energy (kinetic + potential)"] == "2.475e+08 J → 2.475e+08 J (change -2.1 J)"
+
+
+def test_a_long_path_is_whole_in_the_summary_and_build_s_line(tmp_path):
+    # off a terminal (80 columns) the summary's history row read '/tmp/…/course-2026/assignment-3-frict…': cut,
+    # the file it names lost; build's '→ PATH' line was broken in two inside the path
+    from cli_helpers import invoke
+
+    deep = tmp_path / "course-2026" / "assignment-3-friction-and-frequency" / "histories-of-every-run-of-the-wall"
+    result = invoke("simulate", "wall", "--duration", 0.01, "--no-recording", "--history", deep / "h.npz")
+    assert result.exit_code == 0, result.output
+    lines = result.output.splitlines()
+    start = next(i for i, line in enumerate(lines) if line.startswith("│ history "))
+    folded = "".join(line.split("│")[2].strip() for line in lines[start:] if line.startswith("│ ") and "│" in line[2:])
+    assert folded.startswith(str(deep / "h.npz")) and "…" not in folded
+    built = invoke("build", "wall", "--out", deep / "w.geojson")
+    assert f"wall: 51 blocks and 1 support → {deep / 'w.geojson'}" in built.output.splitlines()

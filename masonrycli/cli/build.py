@@ -34,7 +34,9 @@ def _write_assembly(builder: str, opts: dict) -> None:
             write_geojson(assembly, part)
         console.print(
             f"{builder}: {assembly.block_count} block{'s' if assembly.block_count != 1 else ''} and "
-            f"{assembly.support_count} support{'s' if assembly.support_count != 1 else ''} → {out}"
+            f"{assembly.support_count} support{'s' if assembly.support_count != 1 else ''} → {out}",
+            soft_wrap=True,  # the path whole on its line (at 80 columns off a terminal it was cut in two)
+            markup=False,
         )
     if signals.signum is not None:
         say("note", "yellow", f"{signal_name(signals.signum)} while {out} was written: it is whole")

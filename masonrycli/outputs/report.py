@@ -97,7 +97,8 @@ def summary_table(result, recording: str | None, history: str | None, name: str 
     ``masonry simulate`` too)."""
     table = Table(title=f"{name or 'run'} — {result.status}", show_header=False, title_justify="left")
     table.add_column("quantity", style="bold")
-    table.add_column("value")
+    # a path longer than the column folds onto the next lines: it was cut to 'runs/course-2026/assignm…'
+    table.add_column("value", overflow="fold")
     tally = result.tally
     table.add_row("steps", f"{result.steps} (t = {result.time:.4f} s)")
     table.add_row("run time", f"{result.wall_time:.2f} s ({result.steps / max(result.wall_time, 1e-9):.0f} steps/s)")
@@ -147,7 +148,7 @@ def _dissipated(result) -> str:
 def _two_columns(title: str) -> Table:
     table = Table(title=title, show_header=False, title_justify="left")
     table.add_column("", style="bold")
-    table.add_column("")
+    table.add_column("", overflow="fold")  # a long path or command whole, folded, not cut with '…'
     return table
 
 
