@@ -165,11 +165,15 @@ def worker(package_root: str, capture_file: str, stage: str = "float64") -> None
 
 
 def checkout(revision: str, into: Path) -> str:
-    """Directory holding ``masonrycli`` as it is at ``revision`` (the working tree for WORKTREE)."""
+    """Directory holding ``masonrycli`` and ``geometry_library`` as they are at ``revision`` (the working tree for
+    WORKTREE). The revision's own geometry_library, not the working tree's: the base's masonrycli imports the
+    names it had then (geometry_library.checks.validate_assembly before 41d2532 moved it: the base worker failed
+    with ImportError), and a built-in's blocks are the ones its revision built."""
     if revision == WORKTREE:
         return str(ROOT)
     into.mkdir()
-    archive = subprocess.run(["git", "-C", str(ROOT), "archive", revision, "masonrycli"], capture_output=True)
+    packages = ["masonrycli", "geometry_library"]
+    archive = subprocess.run(["git", "-C", str(ROOT), "archive", revision, *packages], capture_output=True)
     if archive.returncode:
         raise SystemExit(f"bench_kernel: git archive {revision}: {archive.stderr.decode().strip()}")
     with tarfile.open(fileobj=io.BytesIO(archive.stdout)) as tar:

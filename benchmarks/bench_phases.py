@@ -65,7 +65,7 @@ def _timed(owner, name: str, key: str, totals: dict) -> None:
 
 def worker(package_root: str, case: str, duration: float, record: bool) -> None:
     """In a fresh process: one timed run of ``case`` with the ``masonrycli`` under ``package_root`` (JSON out)."""
-    sys.path[:0] = [package_root, str(ROOT)]  # masonrycli from package_root; benchmarks, geometry_library here
+    sys.path[:0] = [package_root, str(ROOT)]  # masonrycli, geometry_library from package_root; benchmarks here
     import numpy as np
 
     from benchmarks import bench_solver

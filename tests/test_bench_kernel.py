@@ -63,3 +63,15 @@ def test_the_float32_stage_under_another_cpu_name_is_bit_identical():
     assert row["stage"] == "float32" and row["calls"] == 10 and row["bit_identical"]
     assert row["new"]["env"] == {"NUMBA_CPU_NAME": "x86-64-v3"} and row["base"]["env"] == {}
     assert row["base"]["contact_sweeps"] == row["new"]["contact_sweeps"] > 0
+
+
+def test_a_revision_s_checkout_holds_its_own_geometry_library(tmp_path):
+    # the base's masonrycli with the working tree's geometry_library: a base before 41d2532 (checks.py split)
+    # failed with 'cannot import name validate_assembly from geometry_library.checks' in bench_phases' worker
+    import subprocess
+    from pathlib import Path
+
+    root = Path(bench_kernel.checkout("HEAD", tmp_path / "head"))
+    for path in ("geometry_library/checks.py", "masonrycli/run.py"):
+        kept = subprocess.run(["git", "-C", str(bench_kernel.ROOT), "show", f"HEAD:{path}"], capture_output=True)
+        assert (root / path).read_bytes() == kept.stdout, path
