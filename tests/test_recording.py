@@ -288,7 +288,8 @@ def test_legend_labels_per_frame_and_run_document(written):
         assert f"{lo:.4g} … {hi:.4g}" in doc
         labels = temporal_rows(path, f"/{f.labels}", "Points2D:labels")
         last = labels[frames[-1].step]
-        assert last[5] == f.title  # five ticks, the title, then the below / above counts there are
+        # five ticks, the title with the frame's instant, then the below / above counts there are
+        assert last[5] == f"{f.title}, t = {frames[-1].time:.3f} s"
         # an empty count is no label at all: its point drew an empty box beside the bar
         for frame in frames:
             assert all(labels[frame.step])

@@ -108,3 +108,27 @@ def test_the_plots_open_on_what_moved_the_structure(tmp_path):
         ]
         opened[name] = plots
     assert opened == {"shaken": PLOT_NAMES["support_velocity"], "still": PLOT_NAMES["residual"]}
+
+
+def test_each_colour_bar_says_the_instant_its_view_shows(tmp_path):
+    """The quick start opens on "Fig. III.2", pinned at t = 0.1 s, its time line at 1.000 s: nothing on the
+    view said which instant it showed. Each frame's bar title carries its time, so the pinned tab reads
+    0.100 s and a live tab the cursor's time."""
+    from masonrycli.recording.layout import FIELD_BY_KEY
+    from masonrycli.recording.readback import blueprint_views
+    from masonrycli.scenario.builtin import paper_loading
+
+    static, q0 = fx.wall()
+    frames = fx.frames(static, q0, 13)  # to step 120: the paper's instant, then two frames more
+    paper = {**fx.METADATA, "scenario": "wall", "duration_s": 1.0, "supports": paper_loading("wall")}
+    path = tmp_path / "w.rrd"
+    with Recorder(path, static, paper, batch_frames=4) as rec:
+        for f in frames:
+            rec.log_frame(f)
+    (pinned,) = {v["pinned"] for v in blueprint_views(path).values() if v["pinned"]}
+    assert pinned == ("sim_time", 0.1, 0.1)
+    f = FIELD_BY_KEY["cell_volumetric_strain_rate"]  # Fig. III.2's field
+    labels = fx.temporal_rows(path, f"/{f.labels}", "Points2D:labels")
+    at = {round(fr.time, 9): fr.step for fr in frames}
+    assert f"{f.title}, t = 0.100 s" in labels[at[0.1]]
+    assert f"{f.title}, t = 0.120 s" in labels[frames[-1].step]

@@ -120,7 +120,11 @@ def test_the_sqrt_tab_colours_p_on_the_square_root_map_of_the_linear_range(tmp_p
                                       lin[~np.isnan(values)])  # fmt: skip
         span = max(-lo, hi)
         ticks = [cm.tick_label(lo * (1.0 - t) ** 2 + 0.0, "Pa", span, False) for t in (0.0, 0.25, 0.5, 0.75)]
-        assert labels[f.step][:6] == [*ticks, cm.tick_label(0.0, "Pa", span, False), "Spherical stress p, √ scale"]
+        assert labels[f.step][:6] == [
+            *ticks,
+            cm.tick_label(0.0, "Pa", span, False),
+            f"Spherical stress p, √ scale, t = {f.time:.3f} s",
+        ]
         below, above = int((values < lo).sum()), int((values > hi).sum())
         assert above == 1 and labels[f.step][6:] == [
             f"{n} {way}" for n, way in ((below, "below"), (above, "above")) if n

@@ -190,3 +190,29 @@ def test_a_block_fallen_off_the_supports_leaves_the_view_to_the_structure(tmp_pa
     # the ground's underside is at y = -0.1 m; the block ends 19 m under it and 4 m right of the wall
     np.testing.assert_allclose(views["fell"], views["stood"], atol=1e-9)
     assert views["fell"][1] > -0.1 - 0.1 * 1.2 and views["fell"][2] < 1.2 + 1.5, views["fell"]
+
+
+def test_the_bar_s_title_has_room_right_of_the_bar_on_a_wide_view(tmp_path):
+    """The bar's title is centred on the bar and says the frame's time ("Spherical stress p, t = 3.000 s",
+    ~180 px at 1920 x 1080). A wall strewn 2 m to the right of its 1.2 m (its reach widens the view, its size
+    does not) left the title ~80 px right of the bar's centre, its end cut by the panel's edge; at first open
+    (the 1150 x 840 px structure panel fitted to the view) 125 px are kept."""
+    from masonrycli.recording.layout import LEGEND_BARS
+    from masonrycli.recording.static_content import _PANEL_PX, _TITLE_HALF_PX
+
+    static, q0 = fx.wall()
+    frames = fx.frames(static, q0, 8)
+    for k, f in enumerate(frames):  # the wall slides 0.3 m a frame along its ground, 2.1 m in all
+        f.block_q[:, 0] += 0.3 * k
+        f.contact_point[:] = np.clip(f.contact_point, (0.0, 0.0), (1.2, 0.8))
+    path = tmp_path / "wide.rrd"
+    with Recorder(path, static, fx.METADATA, batch_frames=4) as rec:
+        for f in frames:
+            rec.log_frame(f)
+    xmin, ymin, xmax, ymax = _view(path)
+    px_per_m = min(_PANEL_PX[0] / (xmax - xmin), _PANEL_PX[1] / (ymax - ymin))
+    dx = fx.static_value(path, f"/{LEGEND_BARS}", "Transform3D:translation")[0][0]
+    bar = np.array(fx.static_value(path, f"/{FIELDS[0].bar}", "Mesh3D:vertex_positions"))[:, 0]
+    centre = 0.5 * (bar.min() + bar.max()) + dx
+    assert xmax - xmin > 3.0  # the view widened for the slide
+    assert (xmax - centre) * px_per_m >= _TITLE_HALF_PX - 1e-6, ((xmax - centre) * px_per_m, xmax, centre)

@@ -30,8 +30,12 @@ class FieldColours:
         """How often each field's range was refitted."""
         return {k: t.changes for k, t in self._trackers.items()}
 
-    def colour(self, f: FieldSpec, values: np.ndarray, initial: int = 0):
+    def colour(self, f: FieldSpec, values: np.ndarray, initial: int = 0, times=None):
         """Per frame: the range (tracked), block colours (F, N), legend labels, range ends (F,) each.
+
+        ``times`` (F,) s: the bar's title says the frame's instant ("Spherical stress p, t = 0.100 s"): the
+        quick start opens on the paper's Fig. III.2 pinned at 0.1 s, its time line at 1.000 s, and nothing on
+        the view said which instant it showed (the Legend, below, did); a live tab's title runs with the time.
 
         The ``initial`` first frames (the state as built, before the first step: NaN stresses, zero strains)
         take the range of the frame after them and are not shown to the tracker: fitted to them, the range
@@ -52,13 +56,14 @@ class FieldColours:
             position = sqrt_scale(f.kind, position)
         colors = map_positions(position, LUTS[f.kind])
         title = viewer_safe_text(f.title)
+        titles = [title] * len(ranges) if times is None else [f"{title}, t = {t:.3f} s" for t in times]
         labels: list[str] = []
         ticks, last = [], None
-        for r, n_below, n_above in zip(ranges, below.tolist(), above.tolist()):
+        for r, n_below, n_above, name in zip(ranges, below.tolist(), above.tolist(), titles):
             if r is not last:  # a range holds for many frames
                 ticks, last = self._tick_labels(f, r), r
             labels += ticks
-            labels += [title, f"{n_below} below" if n_below else "", f"{n_above} above" if n_above else ""]
+            labels += [name, f"{n_below} below" if n_below else "", f"{n_above} above" if n_above else ""]
         if f.scale == "linear":
             self.field_ranges[f.key] = (float(lo[-1]), float(hi[-1]))
         return colors, labels, lo, hi

@@ -24,11 +24,13 @@ def send_blocks(
     tensors: dict[str, np.ndarray],
     initial: int = 0,
     at: np.ndarray | None = None,
+    times: np.ndarray | None = None,
 ) -> None:
     """The fill (positions once, a colour component per field), legends, hover points and values of the
     frames ``q`` (F, N, 3); ``owner``: the block of each fill vertex; the ``initial`` first frames (the
     state as built) take the colour range of the frame after them; ``at`` (F, N, 2): the hover points (the
-    blocks' own centroids; default their poses)."""
+    blocks' own centroids; default their poses); ``times`` (F,) s: each frame's instant, in its colour bars'
+    titles."""
     n_frames, n_blocks = len(q), q.shape[1]
     verts = fill.world(q)  # (F, V, 2)
     n_vert = verts.shape[1]
@@ -40,7 +42,7 @@ def send_blocks(
         )
     ]
     for f in COLOURED:  # the fields first: a square-root view takes its linear twin's ranges
-        colors, labels, lo, hi = colours.colour(f, tensors[f.key], initial)
+        colors, labels, lo, hi = colours.colour(f, tensors[f.key], initial, times)
         archetype = f.colors.removesuffix(":colors")
         columns += rr.DynamicArchetype.columns(
             archetype, components={"colors": rr.components.ColorBatch(colors[:, owner].reshape(-1))}

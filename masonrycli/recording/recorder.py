@@ -397,7 +397,7 @@ class Recorder:
         # dots and glyphs on each block's own centroid: a carried fill pulls the body's centre up into it
         own = posed_points(q, self._own)
         args = (self._fill, self._blocks.owner, self._colours, self._label_anchors, q, tensors, initial)
-        send_blocks(self.rec, idx, *args, at=own)
+        send_blocks(self.rec, idx, *args, at=own, times=b["time"])
         send_supports(self.rec, idx, self._supports, b.stack("support_q"))
         self._supports_moved = self._supports_moved or bool(np.any(b.stack("support_v")))
         self._carried.send(self.rec, idx, q)

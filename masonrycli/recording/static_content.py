@@ -220,7 +220,12 @@ def log_plane(
     legend_box = (hi[0] + 2 * pad, ya + room, hi[0] + 2 * pad + bar, ya + room + span)
     hi[1] = max(hi[1], legend_box[3] + 0.14 * span + bar)
     x0, y0 = lo[0] - pad, hi[1] + pad
-    resolution = [hi[0] + 3 * pad + bar + 0.2 * size - x0, y0 - lo[1] + pad]
+    # room for half the bar's title right of the bar's centre as drawn at first open: the view's right margin
+    # m >= T / px_per_m - c, px_per_m = min(Pw / (w0 + m), Ph / height), solved for m (2 % spare: float32)
+    height, w0, c = y0 - lo[1] + pad, hi[0] + 3 * pad + bar - x0, pad + 0.5 * bar
+    t = 1.02 * _TITLE_HALF_PX
+    right = max(0.2 * size, t * height / _PANEL_PX[1] - c, (t * w0 / _PANEL_PX[0] - c) / (1.0 - t / _PANEL_PX[0]))
+    resolution = [w0 + right, height]
     rec.log(
         PLANE,
         rr.Pinhole(focal_length=_CAMERA_HEIGHT, principal_point=[0.0, 0.0], resolution=resolution),
@@ -269,6 +274,11 @@ keep to when that is smaller at first open (:func:`centroid_radius`): on an 8-co
 simulate wall --courses 8 --length 37.5', 5.6 px high blocks) the joint arrows 3 px thick (1.5 points) and
 the glyphs hid every colour under orange and green."""
 _PANEL_PX: Final = (1150.0, 840.0)  # the structure panel of a 1920 x 1080 window (docs' screenshots)
+_TITLE_HALF_PX: Final = 125.0
+"""Half the widest colour-bar title at 1920 x 1080, px ("Deviatoric cumulated strain, t = 10.000 s": ~5.7 px a
+character, its box's padding): the title is centred on the bar and says the frame's time; on a wide view (a
+collapsed wall strewn along its ground, 'masonry simulate wall --amp 3 --freq 0.8 --duration 3') the 0.2 x
+the structure's size right of the ticks left ~80 px, and "Spherical stress p, t = 3.000 s" lost its end."""
 
 
 def centroid_radius(resolution, block_side: float, points: float = -CENTROID_RADIUS, share: float = 0.125) -> float:
