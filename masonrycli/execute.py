@@ -313,7 +313,9 @@ def _open_sink(out: OutputFile, outputs: Outputs, scenario, sim: Simulation, mag
         return _history(HistoryFile, scenario, sim, made_by or {}, out.part)
     from masonrycli.recording import Recorder
 
-    return Recorder(out.part, recording_static(sim, scenario), run_metadata(scenario, sim), magnify=magnify)
+    # the recording's Parameters name the command as the history does (a viewer of a colleague's run had no way to it)
+    metadata = run_metadata(scenario, sim) | (made_by or {})
+    return Recorder(out.part, recording_static(sim, scenario), metadata, magnify=magnify)
 
 
 def command_line() -> dict:

@@ -63,3 +63,21 @@ def test_inspect_shows_the_command_first_and_the_report_once(tmp_path, monkeypat
     assert first.split("│")[1].strip() == "command" and call.startswith(first.split("│")[2].strip())
     page = invoke("report", "w.npz").output
     assert page.count("| command |") == 1 and page.count("| state |") == 1  # inspect's rows, taken once each
+
+
+def test_a_recording_s_parameters_name_the_command(tmp_path, monkeypatch):
+    # the history named its command, the recording (what a colleague opens in the viewer) did not
+    from masonrycli.recording.readback import recording_rows
+
+    monkeypatch.chdir(tmp_path)
+    args = ["simulate", "wall", "--blocks", "12", "--duration", "0.01", "--out", "c.rrd"]
+    monkeypatch.setattr("sys.argv", ["/venv/bin/masonry", *args])
+    assert invoke(*args).exit_code == 0
+    api.simulate("wall", blocks=12, duration=0.01, recording="a.rrd")
+    for rrd, command in (("c.rrd", "masonry " + " ".join(args)), ("a.rrd", _call("recording='a.rrd'"))):
+        (document,) = recording_rows(rrd)["static /run/metadata"]
+        assert f"| command | {command} |" in document.encode().decode("unicode_escape")
+
+
+def _call(output: str) -> str:
+    return f"api.simulate('wall', blocks=12, duration=0.01, {output})"

@@ -98,12 +98,12 @@ def _parameters(scenario, result: LimitResult) -> dict:
     ``settle_s`` in its ``reading`` as run's: settle() leaves it to settled_scenario, which limit does not call.
     Every support is said fixed, as the analysis holds it: a built-in's rows carried the loading simulate would
     apply ('masonry limit arch --fill-cover 0.3': right-foundation, constant velocity (0, -0.01) m/s)."""
-    from masonrycli.execute import run_metadata
+    from masonrycli.execute import command_line, run_metadata
 
     if result.settled is not None:
         scenario = replace(scenario, reading={**scenario.reading, "settle_s": float(result.settled.duration)})
     parameters = {k: v for k, v in run_metadata(scenario, result.model).items() if k not in TIME_LOOP}
-    return {**parameters, "supports": dict.fromkeys(parameters["supports"], "fixed")}
+    return {**parameters, "supports": dict.fromkeys(parameters["supports"], "fixed")} | command_line()
 
 
 TIME_LOOP = (
