@@ -270,3 +270,25 @@ def test_a_bridges_fill_is_a_row_of_inspect_and_of_the_report(tmp_path):
     said = f"{mass:.6g} kg carried by the blocks under it (dead load only)"
     assert _rows(invoke("inspect", h).stdout)["fill"] == said
     assert f"| fill | {said} |" in invoke("report", h).stdout
+
+
+@pytest.mark.parametrize("command", ["inspect", "report"])
+def test_reading_a_history_does_not_load_the_engine(history, command):
+    # 5d01658 moved the verdict's words out of masonrycli.run so that inspect need not load numba (a second of
+    # import), then took RESULT_KEYS from outputs.history, which imports the engine's kernels: numba again
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    code = (
+        "import runpy, sys\n"
+        f"sys.argv = ['masonry', {command!r}, {str(history)!r}]\n"
+        "try:\n    runpy.run_module('masonrycli', run_name='__main__')\nexcept SystemExit as exc:\n    assert not exc.code\n"
+        "print('loaded:', [m for m in ('numba', 'masonrycli.engine', 'masonrycli.run') if m in sys.modules], "
+        "file=sys.stderr)\n"
+    )
+    root = Path(__file__).resolve().parent.parent
+    env = {**os.environ, "PYTHONPATH": str(root), "RERUN_ANALYTICS": "0"}
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, timeout=120)
+    assert done.returncode == 0, done.stderr
+    assert done.stderr.splitlines()[-1] == "loaded: []", done.stderr

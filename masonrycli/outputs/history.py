@@ -42,6 +42,7 @@ from masonrycli.analysis.mechanism import JOINT_FIELDS
 from masonrycli.analysis.tensors import TENSOR_FIELDS
 from masonrycli.outputs.frame import Frame
 from masonrycli.outputs.sinks import COMPLETED
+from masonrycli.outputs.verdict import RESULT_KEYS
 
 _SCALARS = (
     "time",
@@ -135,12 +136,6 @@ def block_constants(model) -> dict[str, np.ndarray]:
         "block_inertia": np.array(model.body_inertia[:n], dtype=float),
         "block_extent": extent,
     }
-
-
-RESULT_KEYS = ("state", "collapse_time", "collapse_reason", "peak_drift", "residual_drift", "max_opening")
-RESULT_KEYS += ("max_displacement", "hinges")
-"""The keys of :func:`masonrycli.run.run_outcome` a history keeps (``result_<key>``): what the summary's
-state and peak drift rows say, which the frames alone cannot give again (the peak is watched every step)."""
 
 
 def result_values(outcome: dict, height: float) -> dict[str, np.ndarray]:

@@ -259,8 +259,7 @@ def _value(value) -> str:
 def verdict_rows(values: dict) -> list[tuple[str, str]]:
     """The run's verdict from its ``result_*`` numbers (``values``: name -> the 0-d array's value), in the
     summary's words: state, peak drift, residual drift; none for a history written before it was kept."""
-    from masonrycli.outputs.history import RESULT_KEYS
-    from masonrycli.outputs.verdict import describe_outcome, describe_peak_drift, describe_residual_drift
+    from masonrycli.outputs.verdict import RESULT_KEYS, describe_outcome, describe_peak_drift, describe_residual_drift
 
     out = {key: values.get(f"result_{key}") for key in RESULT_KEYS}
     height = values.get("result_height")

@@ -125,7 +125,7 @@ def _ground_rows(ims: dict[str, float]) -> list[tuple[str, str]]:
 def outcome(arrays) -> tuple[dict, float] | None:
     """The run's outcome (:func:`masonrycli.run.run_outcome`'s keys) and the structure's height (m) the drifts
     are ratios of, as the history keeps them (``result_*``), or None for a history without them."""
-    from masonrycli.outputs.history import RESULT_KEYS
+    from masonrycli.outputs.verdict import RESULT_KEYS
 
     if not all(f"result_{k}" in arrays for k in (*RESULT_KEYS, "height")):
         return None

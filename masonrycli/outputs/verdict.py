@@ -7,6 +7,12 @@ second and must not load numba to word a row (importing :mod:`masonrycli.run` co
 
 from __future__ import annotations
 
+RESULT_KEYS = ("state", "collapse_time", "collapse_reason", "peak_drift", "residual_drift", "max_opening")
+RESULT_KEYS += ("max_displacement", "hinges")
+"""The keys of :func:`masonrycli.run.run_outcome` a history keeps (``result_<key>``): what the summary's
+state and peak drift rows say, which the frames alone cannot give again (the peak is watched every step).
+Here, not in :mod:`masonrycli.outputs.history` (which imports the engine's kernels, numba): inspect reads them."""
+
 
 def describe_outcome(outcome: dict) -> str:
     """``collapsed at t = 0.53 s (a block fell ...)``, ``damaged (residual drift 0.31 %, 2 hinges, ...)``."""
