@@ -260,3 +260,28 @@ def test_the_viewer_shows_the_fill_over_the_ring(bridge, tmp_path):
     rows = np.flatnonzero(sand["filled"].any(axis=1))
     assert sand["filled"].sum() > 50_000 and sand["bare"].sum() < 100  # 1920 x 1080: ~120 000 of sand
     assert rows.max() - rows.min() > 100  # a band over the ring, not a line
+
+
+def test_a_fill_on_blocks_of_two_thicknesses_is_recorded(tmp_path):
+    """A survey whose stones carry a thickness column (1 m and 0.8 m) under a traced fill: the run's
+    thickness_m is [0.8, 1.0] (9a0e0e6), which the legend's 'kN per metre of width' divided by: 'internal
+    error: TypeError' at close, exit 1. The Fill line says the load, 1800 kg/m³ × 0.5 m² a stone × (1 + 0.8) m,
+    without a per-metre figure that no single thickness gives."""
+    import json
+
+    def feature(ring, **props):
+        return {"type": "Feature", "properties": props, "geometry": {"type": "Polygon", "coordinates": [ring]}}
+
+    features = [
+        feature([[0, 0], [1, 0], [1, 0.5], [0, 0.5], [0, 0]], name="a", thickness=1.0),
+        feature([[1, 0], [2, 0], [2, 0.5], [1, 0.5], [1, 0]], name="b", thickness=0.8),
+        feature([[-2, -0.5], [4, -0.5], [4, 0], [-2, 0], [-2, -0.5]], role="support"),
+        feature([[0, 0.5], [2, 0.5], [2, 1], [0, 1], [0, 0.5]], role="fill", density=1800),
+    ]
+    path, rrd = tmp_path / "two.geojson", tmp_path / "two.rrd"
+    path.write_text(json.dumps({"type": "FeatureCollection", "features": features}))
+    invoke("run", path, "--duration", 0.001, "--dt", 1e-3, "--out", rrd)
+    legend = fx.static_value(rrd, "/run/legend", "TextDocument:text")[0]
+    load = 1800 * 0.5 * (1.0 + 0.8) * 9.81 / 1e3
+    (line,) = [x for x in legend.splitlines() if x.startswith("- **Fill**")]
+    assert f"{load:.4g} kN," in line and "per metre" not in line, line

@@ -472,7 +472,10 @@ class Recorder:
         )
         axes = (self._glyph_length, self.axis_scale.get("stress_axes"))
         legend = legend_markdown(*args, magnified_fill_note(fill, drawn), axes=axes)
-        legend += fill_legend(fill, self.metadata.get("thickness_m"), drawn)
+        # the blocks' one thickness; a file's blocks of several give [least, greatest] (execute.run_metadata), for
+        # which no "per metre of width" holds: none said (a list here ended the run in a TypeError at close)
+        thickness = self.metadata.get("thickness_m")
+        legend += fill_legend(fill, thickness if isinstance(thickness, (int, float)) else None, drawn)
         self.rec.log(LEGEND, rr.TextDocument(viewer_safe_text(legend), media_type="text/markdown"), static=True)
 
 
