@@ -20,6 +20,7 @@ import click
 import numpy as np
 import pytest
 import surveyed_wall
+import traced_bridge
 import typer
 
 from masonrycli.cli.app import app
@@ -173,6 +174,8 @@ def _seed(folder: Path) -> None:
     (folder / "my wall.toml").write_text(BLOCK_TOML)  # class.md: a name with a space, between quotes
     # scenario-format.md: a wall traced in QGIS (Lambert-93, mm slips, 4 stones dented)
     surveyed_wall.write(folder / "traced-wall.geojson", offset=surveyed_wall.LAMBERT93, dent=2e-3, dents=4)
+    # README's and scenario-format.md's bridge.geojson: a rubble bridge traced in Lambert-93 to the mm, with its fill
+    traced_bridge.write(folder / "bridge.geojson", offset=surveyed_wall.LAMBERT93, ndigits=3)
     (folder / "recordings").mkdir()  # made by README's quick start, before its other examples
 
 

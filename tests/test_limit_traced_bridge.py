@@ -7,71 +7,19 @@ and the fill's columns over its extrados chords computed here by the shoelace fo
 from __future__ import annotations
 
 import json
-import math
 
 import numpy as np
 import pytest
 from four_hinge_reference import least_load_factor, right_support_thrust
+from traced_bridge import FILL, ROAD, SPRING, STONE, G, R, T, joint_angles, write
 
 from cli_helpers import invoke
-
-R, T, SPRING, ROAD = 3.0, 0.5, 2.0, 6.0  # intrados radius, ring, springing line, road (m)
-STONE, FILL, G = 2300.0, 1900.0, 9.81
-ABUTMENT = 2.2  # m wide, 4 courses of 0.5 m
-
-
-def _joint_angles() -> np.ndarray:
-    rng = np.random.default_rng(7)
-    w = rng.uniform(7.0, 14.0, 17)
-    return np.radians(np.r_[0.0, np.cumsum(w / w.sum() * 180.0)])
-
-
-def _polygon(ring, **props) -> dict:
-    ring = [list(map(float, p)) for p in ring]
-    return {"type": "Feature", "properties": props, "geometry": {"type": "Polygon", "coordinates": [ring + [ring[0]]]}}
-
-
-def _line(points, **props) -> dict:
-    return {"type": "Feature", "properties": props, "geometry": {"type": "LineString", "coordinates": points}}
-
-
-def _bridge(path) -> None:
-    a = _joint_angles()
-    features = []
-    for k in range(17):
-        ring = [
-            (r * math.cos(t), SPRING + r * math.sin(t))
-            for r, t in ((R, a[k]), (R + T, a[k]), (R + T, a[k + 1]), (R, a[k + 1]))
-        ]
-        features.append(_polygon(ring, name=f"v{k + 1:02d}", density=STONE))
-    for side in (1.0, -1.0):  # courses bonded: joints at 0.9 / 0.6 + 1.5 m from the springing
-        for c in range(4):
-            cuts = (
-                [R, R + (0.9 if c % 2 == 0 else 0.6), R + ABUTMENT]
-                if c % 2 == 0
-                else [R, R + 0.6, R + 1.5, R + ABUTMENT]
-            )
-            for b, (xa, xb) in enumerate(zip(cuts[:-1], cuts[1:])):
-                ring = [
-                    (side * xa, 0.5 * c),
-                    (side * xb, 0.5 * c),
-                    (side * xb, 0.5 * c + 0.5),
-                    (side * xa, 0.5 * c + 0.5),
-                ]
-                ring = ring if side > 0 else ring[::-1]
-                features.append(_polygon(ring, name=f"{'RL'[side < 0]}-c{c + 1}-s{b + 1}", density=STONE))
-    arc = [((R + T) * math.cos(t), SPRING + (R + T) * math.sin(t)) for t in np.linspace(0.0, math.pi, 200)]
-    outline = [(R + ABUTMENT, SPRING), *arc, (-R - ABUTMENT, SPRING), (-R - ABUTMENT, ROAD), (R + ABUTMENT, ROAD)]
-    features.append(_polygon(outline, role="fill", name="fill", density=FILL))
-    features.append(_line([[-R - ABUTMENT - 1, 0.0], [-R + 0.5, 0.0]], name="left-ground"))
-    features.append(_line([[R - 0.5, 0.0], [R + ABUTMENT + 1, 0.0]], name="right-ground"))
-    path.write_text(json.dumps({"type": "FeatureCollection", "features": features}))
 
 
 def _ring_loads():
     """Joints left to right, and each voussoir's weight with its fill's, at their common centre of mass (only the
     abscissa of a vertical load matters); the fill's column over a chord: the quadrilateral up to the road."""
-    t = _joint_angles()[::-1]
+    t = joint_angles()[::-1]
     intrados = np.stack([R * np.cos(t), SPRING + R * np.sin(t)], axis=1)
     extrados = np.stack([(R + T) * np.cos(t), SPRING + (R + T) * np.sin(t)], axis=1)
 
@@ -92,7 +40,7 @@ def _ring_loads():
 @pytest.fixture(scope="module")
 def bridge(tmp_path_factory):
     path = tmp_path_factory.mktemp("bridge") / "bridge.geojson"
-    _bridge(path)
+    write(path)
     return path
 
 
