@@ -4,7 +4,7 @@ the same recording and history.
     .venv/bin/python -m benchmarks.bench_frames --base REV [--new REV] [--rounds 3] [--json PATH]
         [-- simulate wall --blocks 248 --duration 0.2 --record-every 1]
 
-Each revision (``git archive`` of its ``masonrycli``, as benchmarks/bench_kernel.py does; ``--new``
+Each revision (``git archive`` of its ``masonrycli`` and ``geometry_library``, as benchmarks/bench_kernel.py does; ``--new``
 defaults to the working tree) runs the ``masonry`` command given (default above; ``--out``, ``--history``
 and ``--force`` are added) in fresh processes of its own, with a numba cache of its own, rounds
 alternating the order (base, new; new, base; …), each after the same run once to warm up (every kernel

@@ -9,7 +9,7 @@ same captured steps, and whether both give the same bits.
    ``--every``-th call that ``dispatch.solve`` makes to ``dispatch.first_stage`` (the float64 first stage of
    each step's accelerated solve), then the outputs the working tree gives for them. A revision older than
    engine/dispatch.py runs the same calls as ``nlgs._nlgs_interleaved``'s 11-argument form (:func:`first_stage`).
-2. Each revision (``git archive`` of its ``masonrycli``; ``--new`` defaults to the working tree) is
+2. Each revision (``git archive`` of its ``masonrycli`` and ``geometry_library``; ``--new`` defaults to the working tree) is
    timed in a fresh process of its own, with its own numba flags and a numba cache of its own (the working
    tree's own cache, as in bench_frames: :func:`worker_env`): every captured call once (compile, and the
    bits of v, r, status, sweeps and residual), then the whole set ``PASSES`` times, CPU time

@@ -4,7 +4,7 @@ the same bits.
     .venv/bin/python -m benchmarks.bench_phases --base REV [--new REV] [--case wall-248] [--duration 1]
         [--rounds 3] [--no-record] [--json PATH]
 
-Each revision (``git archive`` of its ``masonrycli``, as benchmarks/bench_kernel.py does; ``--new``
+Each revision (``git archive`` of its ``masonrycli`` and ``geometry_library``, as benchmarks/bench_kernel.py does; ``--new``
 defaults to the working tree) runs ``--case`` in fresh processes of its own, with a numba cache of its
 own (bench_kernel.worker_env), rounds alternating the order (base, new; new, base; …). A run is the solver benchmark's
 (bench_solver.run_masonry: the scenario built first, then ``simulate`` timed, a Rerun recording every 10
