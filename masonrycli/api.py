@@ -87,6 +87,20 @@ def _check_names(target, given: dict) -> None:
             raise InputError(f"no such option: {key}= for {what} ({hint})")
 
 
+def _one_value_each(options: dict) -> None:
+    """Refuse several values for one keyword (``freq=[1, 2, 3]``: a run takes one), saying how to run them all:
+    it said "--freq: frequency = [1, 2, 3]: must be a number", and a student took it for a wrong type."""
+    for key, value in options.items():
+        if isinstance(value, (list, tuple, range, np.ndarray)) and np.size(value) > 1:
+            values = [f"{v:g}" if isinstance(v, float) else str(v) for v in np.ravel(value)]
+            listed = ",".join(values[:3]) + (",…" if len(values) > 3 else "")
+            raise InputError(
+                f"{key}: {len(values)} values ({listed}): one run takes one value; loop over them (for {key} in …: "
+                f"api.simulate(…, {key}={key})) or run a study, masonry sweep --param {key}={listed} (masonry docs "
+                "python, 'Looping over parameters')"
+            )
+
+
 def _path(value, option: str, *, output: bool = False) -> Path:
     """A path keyword read by the command line's own parser of ``option`` (``~`` expanded, an empty one refused;
     an output's "x.rrd/" names a folder, where Path("x.rrd/") would have written the file x.rrd)."""
@@ -120,6 +134,7 @@ def scenario(target, **options):
             f"{type(target).__name__}"
         )
     _check_names(target, options)
+    _one_value_each(options)
     options = {k: v for k, v in options.items() if v is not None}
     call = _call("scenario", target, options)  # as given: the record's path before it is read as a path
     if "record" in options:

@@ -111,3 +111,19 @@ def test_the_api_takes_the_options_of_its_command_and_no_other(target):
     expected = {p.name for p in command.params} - OUTPUTS - {"scenario_file"}
     assert set(api._option_names(target)) == expected
     assert OUTPUTS - {"out", "no_recording"} <= set(api.simulate.__kwdefaults__)
+
+
+@pytest.mark.parametrize(
+    "given, said",
+    [
+        ({"freq": [1, 2, 3]}, "freq: 3 values (1,2,3): one run takes one value; loop over them"),
+        ({"friction": (0.4, 0.6)}, "friction: 2 values (0.4,0.6): one run takes one value"),
+    ],
+)
+def test_several_values_for_one_keyword_say_how_to_run_them(given, said):
+    # a student passed freq=[1, 2, 3] expecting three runs: 'must be a number' read as a wrong type
+    with pytest.raises(InputError) as refused:
+        api.simulate("wall", duration=0.01, **given)
+    key, values = next(iter(given.items()))
+    assert str(refused.value).startswith(said)
+    assert f"masonry sweep --param {key}={','.join(map(str, values))} " in str(refused.value)
