@@ -258,3 +258,22 @@ def test_the_parameters_table_is_simulates(tmp_path):
         assert shown[key] == ran[key], key
     assert float(shown["fill_mass_kg"]) > 4e4  # 421.6 kN / 9.81
     assert ran["supports.right-foundation"] != "fixed" and shown["supports.right-foundation"] == "fixed"
+
+
+def test_the_mechanism_says_by_how_much_it_is_magnified(written):
+    """'masonry limit arch --out l.rrd' drew the mechanism "magnified" and never said by how much. The view's
+    name and the side panel give the distance its fastest block point travels at the last step, which the test
+    measures on the drawn outlines (the column's top corner turning about the toe: a chord 0.06 % under it)."""
+    from masonrycli.recording.limit import DOCUMENT
+    from masonrycli.recording.readback import blueprint_views
+
+    path, _ = written
+    strips = rows(path, OUTLINES, "LineStrips2D:strips")
+    first, last = (np.array(strips[k], dtype=float) for k in (0, STEPS))
+    moved = np.hypot(*(last[2:] - first[2:]).reshape(-1, 2).T).max()  # the mechanism copy's vertices
+    stated = f"{MAGNIFIED_SHARE * 1.6:.3g} m"  # the column is 1.6 m high, 0.4 m wide
+    assert float(stated.split()[0]) == pytest.approx(moved, rel=1e-3), (stated, moved)
+    (document,) = static_column(path, DOCUMENT, "TextDocument:text")
+    assert f"fastest block point travels {stated} ({MAGNIFIED_SHARE:.0%} of the structure's 1.6 m)" in document
+    (name,) = [v for v in blueprint_views(path) if v.startswith("Collapse mechanism")]
+    assert f"fastest point moved {stated}" in name, name

@@ -18,8 +18,9 @@ THRUST_SHOWN = 0.02
 """The recording's line of thrust shows joints carrying at least this share of the largest joint force."""
 
 
-def mechanism_document(result: LimitResult, fill_drawn: bool = True) -> str:
-    """Markdown for the recording's side panel; ``fill_drawn``: the fill's columns are drawn (a carried fill's)."""
+def mechanism_document(result: LimitResult, fill_drawn: bool = True, magnified: str = "magnified") -> str:
+    """Markdown for the recording's side panel; ``fill_drawn``: the fill's columns are drawn (a carried fill's);
+    ``magnified``: how much the mechanism is magnified (``recording.limit.magnified_words``)."""
     reading = lambda_reading(result)
     lines = [
         f"# masonry limit: {result.scenario_name}",
@@ -29,7 +30,7 @@ def mechanism_document(result: LimitResult, fill_drawn: bool = True) -> str:
         "",
         *_fill_lines(result, fill_drawn),
         "Left: the structure as built; red dots: the line of thrust (centre of pressure of each loaded joint).",
-        "Right: the collapse mechanism, magnified, blocks coloured by their speed in it (grey: still);",
+        f"Right: the collapse mechanism, {magnified}; blocks coloured by their speed in it (grey: still);",
         "yellow: hinges; orange: sliding joints. Play the timeline to grow the mechanism.",
         "",
         f"Blue arrow (left): the live load at collapse, {result.load_factor * result.reference_force:.4g} N"
@@ -124,7 +125,7 @@ step, no Gauss–Seidel, records no frame and applies no record ('masonry limit 
 def write_recording(result: LimitResult, out: Path, scenario=None) -> None:
     """The mechanism recording (``masonrycli.recording.limit``) of ``result``; ``scenario``'s fill drawn."""
     from masonrycli.recording.carried_fill import ColumnArrays
-    from masonrycli.recording.limit import MechanismDrawing, write_limit_recording
+    from masonrycli.recording.limit import MechanismDrawing, magnification, magnified_words, write_limit_recording
     from masonrycli.scenario.fill import columns_on_blocks
 
     m, j, mo = result.model, result.joints, result.motion
@@ -138,6 +139,7 @@ def write_recording(result: LimitResult, out: Path, scenario=None) -> None:
     normal = result.thrust.joint_normal_force
     thrust = result.thrust.joint_point[normal >= THRUST_SHOWN * normal.max(initial=0.0)]
     cols = columns_on_blocks(scenario, m.body_q0[:n, :2]) if scenario else None
+    _, size = magnification(start[: n + 1], m.vert_local[: start[n]], m.body_q0[:n], result.solution.block_velocity)
     drawing = MechanismDrawing(
         block_vert_start=start[: n + 1].copy(),
         block_vert_local=m.vert_local[: start[n]].copy(),
@@ -152,7 +154,7 @@ def write_recording(result: LimitResult, out: Path, scenario=None) -> None:
         sliding_point=middle[mo.joint_sliding],
         sliding_block=carrier[mo.joint_sliding],
         thrust_point=thrust[np.isfinite(thrust).all(axis=1)],
-        document=mechanism_document(result, fill_drawn=cols is not None),
+        document=mechanism_document(result, fill_drawn=cols is not None, magnified=magnified_words(size)),
         load=load_arrow(result),
         fill=None if cols is None else ColumnArrays(*cols),
         parameters=None if scenario is None else _parameters(scenario, result),

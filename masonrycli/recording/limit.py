@@ -151,6 +151,28 @@ def _doubled(start: np.ndarray, local: np.ndarray) -> Polygons:
     return Polygons(np.r_[start, start[1:] + start[-1]], np.concatenate([local, local]))
 
 
+def magnification(start: np.ndarray, local: np.ndarray, q0: np.ndarray, velocity: np.ndarray) -> tuple[float, float]:
+    """(amplitude, size): the factor the mechanism's velocities (N, 3) are drawn times at the last step, and the
+    structure's size, m (the larger side of the blocks' box as built). The fastest block point moves
+    ``MAGNIFIED_SHARE`` × size; amplitude 0 when no block moves."""
+    blocks = Polygons(start, local)
+    verts = blocks.world(q0[None])[0]
+    size = float(max(verts.max(axis=0) - verts.min(axis=0))) or 1.0
+    speed = _block_speed(blocks, velocity)
+    fastest = float(speed.max(initial=0.0))
+    return (MAGNIFIED_SHARE * size / fastest if fastest > 0 else 0.0), size
+
+
+def magnified_words(size: float) -> str:
+    """What the mechanism copy's magnification is, said where it is drawn: the recording said "magnified" and
+    not by how much ('masonry limit arch --out l.rrd'). A mechanism is a velocity field, its size arbitrary:
+    the drawing moves its fastest block point ``MAGNIFIED_SHARE`` × the structure's size."""
+    return (
+        f"magnified so that its fastest block point travels {MAGNIFIED_SHARE * size:.3g} m "
+        f"({MAGNIFIED_SHARE:.0%} of the structure's {size:.3g} m) at the last step"
+    )
+
+
 def write_limit_recording(path: str | os.PathLike, drawing: MechanismDrawing) -> None:
     """Write the mechanism recording ``path`` (.rrd, complete with its footer and default blueprint)."""
     d = drawing
@@ -162,10 +184,9 @@ def write_limit_recording(path: str | os.PathLike, drawing: MechanismDrawing) ->
     )
     verts0 = blocks.world(d.block_q0[None])[0]
     lo, hi = verts0.min(axis=0), verts0.max(axis=0)
-    size = float(max(hi - lo)) or 1.0
+    amplitude, size = magnification(d.block_vert_start, d.block_vert_local, d.block_q0, d.block_velocity)
     shift = np.array([1.15 * (hi[0] - lo[0]) + 0.05 * size, 0.0, 0.0])
     speed = _block_speed(blocks, d.block_velocity)
-    amplitude = MAGNIFIED_SHARE * size / speed.max() if speed.size and speed.max() > 0 else 0.0
     colours = np.where(
         d.block_moving, map_scalars(speed, 0.0, float(speed.max(initial=0.0)) or 1.0, VIRIDIS), STILL_RGBA
     )
@@ -189,7 +210,8 @@ def write_limit_recording(path: str | os.PathLike, drawing: MechanismDrawing) ->
             f"+ /{p}"
             for p in (SUPPORTS, FILL, *CARRIED_FILL, OUTLINES, THRUST, LOAD, HINGES, SLIDING, SPEED_BAR, SPEED_LABELS)
         ],
-        name="Collapse mechanism (right, magnified) and line of thrust",
+        # its magnification in its name, as the document says it (the Legend of this recording)
+        name=f"Collapse mechanism (right, fastest point moved {MAGNIFIED_SHARE * size:.3g} m) and line of thrust",
     )
     blueprint = rrb.Blueprint(
         rrb.Horizontal(view, rrb.TextDocumentView(origin=f"/{DOCUMENT}", name="Limit analysis"), column_shares=[3, 1]),
