@@ -270,7 +270,13 @@ def simulate(
             on_progress=live.on_progress if live is not None else None,
         )
     except StopRun:  # a signal before the first step: nothing was written
+        if live is not None:
+            live.stopped("interrupted before its first step, nothing written")
         raise KeyboardInterrupt from None
+    except BaseException as exc:  # the line said 'starting: …' under the cell's traceback, as if still going
+        if live is not None:
+            live.stopped(f"stopped: {type(exc).__name__}: {exc}".split("\n")[0])
+        raise
     if live is not None:
         result = outcome.result
         live.end(result.status, result.steps, result.time, (result.outcome or {}).get("state", ""))

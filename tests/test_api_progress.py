@@ -51,3 +51,18 @@ def test_without_progress_nothing_is_shown(monkeypatch, capsys):
     monkeypatch.setattr(live_line, "in_notebook", lambda: pytest.fail("asked for no progress: no line made"))
     api.simulate("wall", blocks=12, duration=0.02)
     assert capsys.readouterr() == ("", "")
+
+
+def test_a_run_that_raises_ends_its_line_saying_so(monkeypatch):
+    # the display kept 'starting: building the model …' under the cell's traceback, as if the run still went on
+    display = FakeDisplay()
+    monkeypatch.setattr(live_line, "in_notebook", lambda: True)
+    monkeypatch.setattr(live_line, "_NotebookLine", lambda: display)
+
+    def broken(scenario):
+        raise RuntimeError("the engine failed\nsecond line")
+
+    monkeypatch.setattr("masonrycli.execute.Simulation", broken)
+    with pytest.raises(RuntimeError, match="the engine failed"):
+        api.simulate("wall", blocks=12, duration=0.02, progress=True)
+    assert display.shown[-1] == "wall (blocks=12, duration=0.02): stopped: RuntimeError: the engine failed"

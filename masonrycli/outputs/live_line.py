@@ -96,3 +96,7 @@ class LiveLine:
         took = self.clock() - self.started
         ended = f"{status}, {state}" if state else status
         self.line.show(f"{self.name}: {ended}, {steps} steps to t = {t:g} s in {took:.1f} s", final=True)
+
+    def stopped(self, why: str) -> None:
+        """The last line of a run that raised before it ended (``why``), in place of the line it had reached."""
+        self.line.show(f"{self.name}: {why}", final=True)
