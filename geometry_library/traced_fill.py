@@ -3,9 +3,10 @@
 A surveyed bridge's fill (the soil or rubble between the spandrel walls, over the ring up to the road) is no
 block: it has no strength of its own and is read, as the arch builder's ``--fill-to``, as dead load only
 (:mod:`geometry_library.fill`). In a GeoJSON file it is a feature with ``"role": "fill"`` (an optional
-``density``, kg/m³, default :data:`~geometry_library.fill.FILL_DENSITY`); in WKT a line ``fill NAME: POLYGON
-((…))``. Its outline may be any simple polygon (not convex: the fill over a ring's extrados never is), drawn
-down onto the stones or a little into them, and its top need not be level (a cambered road):
+``density``, kg/m³, default :data:`~geometry_library.fill.FILL_DENSITY`); in WKT a line
+``fill NAME DENSITY: POLYGON ((…))`` (its density optional). Its outline may be any simple polygon (not convex: the
+fill over a ring's extrados never is), drawn down onto the stones or a little into them, and its top need not be
+level (a cambered road):
 
     for each fill outline:
         the fill is each column from the top surface of the blocks and supports up to the outline's top, bearing

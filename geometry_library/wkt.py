@@ -120,6 +120,9 @@ def read_wkt(
         entries.append((f"{path}: line {lines[0][0]}", None, None, None, " ".join(t for _, t in lines)))
     else:
         for n, line in lines:
+            if fill := _FILL.match(line):  # "fill road 1900: POLYGON …": a traced fill, its density after its name
+                entries.append((f"{path}: line {n}", "fill", fill["name"], fill["density"], fill["wkt"]))
+                continue
             m = _ROLE_ONLY.match(line)
             if m and m["srole"] and m["role"].lower() == "block":
                 m = None  # "block fixed: …" is a block named "fixed" (a block has no support role): write_wkt's
@@ -185,16 +188,29 @@ def read_wkt(
     return carry_fills(finish_reading(path, refused, blocks, supports, frame, survey, hulls, notes), outlines, notes)
 
 
-def _fill_entry(geom, where: str, srole: str | None, name: str) -> tuple[str, str, float, np.ndarray]:
-    """(where, name, density, ring) of a traced fill's line (``fill NAME: POLYGON ((…))``; WKT has no density:
-    FILL_DENSITY's)."""
-    if srole:
-        raise GeometryError(f"{where}: a fill has no support role ({srole!r}): 'fill NAME: POLYGON ((…))'")
+def _fill_entry(geom, where: str, density: str | None, name: str) -> tuple[str, str, float, np.ndarray]:
+    """(where, name, density kg/m³, ring) of a traced fill's line (``fill NAME [DENSITY]: POLYGON ((…))``; no
+    density: FILL_DENSITY)."""
+    rho = FILL_DENSITY if density is None else _number(_float(density, where), "density", where)
     polys = _polygons_of(geom, where)
     if len(polys) != 1 or polys[0].interiors:
         raise GeometryError(f"{where}: a fill is one POLYGON, without holes")
-    return where, name, FILL_DENSITY, np.asarray(polys[0].exterior.coords)[:, :2]
+    return where, name, rho, np.asarray(polys[0].exterior.coords)[:, :2]
 
+
+def _float(text: str, where: str) -> float:
+    try:
+        return float(text)
+    except ValueError:
+        raise GeometryError(
+            f"{where}: the fill's density {text!r} is not a number (kg/m³: 'fill NAME 1900: …')"
+        ) from None
+
+
+_FILL = re.compile(
+    r"^\s*fill(?:\s+(?P<name>[^\s:]+))?(?:\s+(?P<density>[-+]?[0-9][^\s:]*))?\s*:\s*(?P<wkt>.+)$", re.IGNORECASE
+)
+"""A traced fill's label: ``fill``, its name, then its density (kg/m³; FILL_DENSITY without one)."""
 
 _NO_COLON = re.compile(
     r"\s*(?P<label>[^\s(:][^(:]*?)\s+(?P<kind>POLYGON|MULTIPOLYGON|GEOMETRYCOLLECTION|LINESTRING|MULTILINESTRING)\b",

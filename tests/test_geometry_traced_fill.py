@@ -68,16 +68,21 @@ def test_a_traced_fill_to_the_crown_is_the_closed_form_and_the_builders(tmp_path
 
 def test_a_haunch_fill_under_the_crown_as_wkt(tmp_path):
     """Fill to 1.5 m over the springing line, below the crown (the ring stands proud of it): the builder's
-    --fill-to 1.5, at WKT's default 2000 kg/m³: two outlines in WKT, each with a fill label."""
+    --fill-to 1.5 at 1800 kg/m³: two outlines in WKT, each labelled 'fill NAME 1800:' (WKT has no density column:
+    it was 2000 kg/m³, always)."""
     outline = _traced_to(1.5)
     assert outline.geom_type == "MultiPolygon" and len(outline.geoms) == 2
     lines = [f"block {b.name}: {b.polygon.wkt}" for b in build_arch().blocks]
     lines += [f"support {s.name}: {s.polygon.wkt}" for s in build_arch().supports]
-    lines += [f"fill haunch-{k}: {part.wkt}" for k, part in enumerate(outline.geoms)]  # one line a haunch
+    lines += [f"fill haunch-{k} 1800: {part.wkt}" for k, part in enumerate(outline.geoms)]  # a line a haunch
     (tmp_path / "b.wkt").write_text("\n".join(lines) + "\n")
     read = read_wkt(tmp_path / "b.wkt")
-    for got, want in zip(read.blocks, build_arch(fill_to=1.5).blocks, strict=True):
+    for got, want in zip(read.blocks, build_arch(fill_to=1.5, fill_density=1800.0).blocks, strict=True):
         assert got.carried_mass == pytest.approx(want.carried_mass, rel=1e-9, abs=1e-9), got.name
+    lines[-1] = lines[-1].replace("haunch-1 1800:", "haunch-1 18OO:")  # a letter O for a zero: one line
+    (tmp_path / "bad.wkt").write_text("\n".join(lines) + "\n")
+    with pytest.raises(GeometryError, match=r'line 102: fill 2 \("haunch-1"\): the fill.s density .18OO. is not a n'):
+        read_wkt(tmp_path / "bad.wkt")
 
 
 def test_a_cambered_fill_partly_over_the_ground(tmp_path):
