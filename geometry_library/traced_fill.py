@@ -25,6 +25,7 @@ from shapely.geometry import Polygon
 
 from .blocks import Assembly, GeometryError
 from .fill import carry, traced_fill_over
+from .values import check_material
 
 
 def fill_outline(xy: np.ndarray, where: str) -> Polygon:
@@ -46,6 +47,7 @@ def carry_fills(assembly: Assembly, outlines: list, notes: list | None) -> Assem
     carries is refused: it would be no load at all."""
     blocks = list(assembly.blocks)
     for where, _name, density, outline in outlines:
+        check_material(where, density=density)  # the builder's --fill-density range: 1e9 kg/m³ ran, a typo
         traced = traced_fill_over(blocks, assembly.supports, outline)
         area = traced.fill.area
         if not (area > 0.0).any():

@@ -121,6 +121,11 @@ def read_wkt(
     else:
         for n, line in lines:
             if fill := _FILL.match(line):  # "fill road 1900: POLYGON …": a traced fill, its density after its name
+                if fill["density"] is None and _is_number(fill["name"]):  # 'fill 1800:' ran at 2000, named "1800"
+                    raise GeometryError(
+                        f"{path}: line {n}: 'fill {fill['name']}:' reads {fill['name']} as the fill's name; its "
+                        f"density goes after a name: 'fill NAME {fill['name']}: POLYGON ((…))'"
+                    )
                 entries.append((f"{path}: line {n}", "fill", fill["name"], fill["density"], fill["wkt"]))
                 continue
             m = _ROLE_ONLY.match(line)
@@ -198,6 +203,14 @@ def _fill_entry(geom, where: str, density: str | None, name: str) -> tuple[str, 
     return where, name, rho, np.asarray(polys[0].exterior.coords)[:, :2]
 
 
+def _is_number(text: str | None) -> bool:
+    try:
+        float(text or "")
+    except ValueError:
+        return False
+    return True
+
+
 def _float(text: str, where: str) -> float:
     try:
         return float(text)
@@ -223,8 +236,8 @@ def _bad_label(where: str, label: str) -> GeometryError:
     """The error for a line whose text before its colon is not a label."""
     what = "nothing before the colon" if not label.strip() else f"{label.strip()!r} before the colon is not a label"
     return GeometryError(
-        f"{where}: {what}; expected 'NAME: POLYGON ((…))', 'block NAME: …', 'support [NAME] [fixed|driven]: …' "
-        "or the WKT alone (a name has no spaces or colons)"
+        f"{where}: {what}; expected 'NAME: POLYGON ((…))', 'block NAME: …', 'support [NAME] [fixed|driven]: …', "
+        "'fill NAME [DENSITY]: …' or the WKT alone (a name has no spaces or colons)"
     )
 
 

@@ -307,7 +307,7 @@ def test_wkt_a_line_whose_label_is_not_one_says_what_is_expected(line, what, tmp
     path.write_text("support ground: POLYGON ((-2 -1, 3 -1, 3 0, -2 0, -2 -1))\n" + line + "\n")
     assert one_line_error(read_wkt, path) == (
         f"{path}: line 2: {what}; expected 'NAME: POLYGON ((…))', 'block NAME: …', 'support [NAME] [fixed|driven]: "
-        "…' or the WKT alone (a name has no spaces or colons)"
+        "…', 'fill NAME [DENSITY]: …' or the WKT alone (a name has no spaces or colons)"
     )
 
 

@@ -169,3 +169,37 @@ def test_a_fills_unused_property_is_said_as_a_fills(tmp_path):
     path.write_text(json.dumps({"type": "FeatureCollection", "features": [stone, ground, fill]}))
     said = " ".join(invoke("check", path).stderr.split())
     assert '"velocity" (a fill takes role, name and density only) first on feature 3, fill 1' in said, said
+
+
+STONE_ON_GROUND = (
+    "block a: POLYGON ((0 0, 2 0, 2 1, 0 1, 0 0))\nsupport g: POLYGON ((-2 -0.5, 3 -0.5, 3 0, -2 0, -2 -0.5))\n"
+)
+
+
+@pytest.mark.parametrize(
+    ("label", "said"),
+    [
+        # 'fill 1800:' was a fill named "1800" at 2000 kg/m³, without a word: 11 % more dead load than meant
+        ("fill 1800", "line 3: 'fill 1800:' reads 1800 as the fill's name; its density goes after a name: 'fill NAME"),
+        # the builder's --fill-density 1e9 is refused as a typo; a traced fill of 1e9 kg/m³ ran (2e9 kg on a stone)
+        ("fill road 1e9", 'line 3: fill 1 ("road"): density 1e+09 kg/m³ is absurd (a likely typo: 0.001 to 100000'),
+        # a label that is none listed every form but the fill's
+        (
+            "road 1800",
+            "expected 'NAME: POLYGON ((…))', 'block NAME: …', 'support [NAME] [fixed|driven]: …', 'fill NAME",
+        ),
+    ],
+)
+def test_a_wkt_fill_s_density_is_read_as_meant_or_refused(tmp_path, label, said):
+    path = tmp_path / "f.wkt"
+    path.write_text(STONE_ON_GROUND + f"{label}: POLYGON ((0 1, 2 1, 2 2, 0 2, 0 1))\n")
+    assert_one_line_error(invoke("check", path), said)
+
+
+def test_a_geojson_fill_s_absurd_density_is_refused(tmp_path):
+    stone = _feature([[0, 0], [2, 0], [2, 1], [0, 1], [0, 0]], name="stone")
+    ground = _feature([[-2, -0.5], [3, -0.5], [3, 0], [-2, 0], [-2, -0.5]], role="support")
+    fill = _feature([[0, 1], [2, 1], [2, 2], [0, 2], [0, 1]], role="fill", density=1e9)
+    path = tmp_path / "f.geojson"
+    path.write_text(json.dumps({"type": "FeatureCollection", "features": [stone, ground, fill]}))
+    assert_one_line_error(invoke("check", path), 'feature 3: fill 1 ("fill-1"): density 1e+09 kg/m³ is absurd')
