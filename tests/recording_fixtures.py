@@ -226,3 +226,16 @@ def written_fixture(wall, tmp_path_factory):
             rec.log_frame(f)
     rr.set_strict_mode(before)
     return path, static, frames_, rec
+
+
+def legend_points(path, points) -> np.ndarray:
+    """(K, 2) ``points`` (x, y, m) of the colour bars or their labels as drawn: moved and stretched by their
+    parent's transform at close (static_content.legend_move: translation after scale; none: as logged)."""
+    from masonrycli.recording.layout import LEGEND_BARS
+
+    p = np.array(points, dtype=np.float64).reshape(-1, np.shape(points)[-1])[:, :2]
+    t = static_value(path, f"/{LEGEND_BARS}", "Transform3D:translation")
+    s = static_value(path, f"/{LEGEND_BARS}", "Transform3D:scale")
+    scale = np.ones(2) if s is None else np.array(s[0][:2])
+    shift = np.zeros(2) if t is None else np.array(t[0][:2])
+    return p * scale + shift

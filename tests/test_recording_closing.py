@@ -219,12 +219,11 @@ def test_the_colour_bars_stand_right_of_where_the_blocks_went(tmp_path):
     owner = np.repeat(np.arange(len(q0)), np.diff(start))
     # unrotated outlines: the frames turn the blocks by 0.01 rad at most, under a millimetre here
     reach = max(float((f.block_q[owner, 0] + static.block_vert_local[:, 0]).max()) for f in frames)
-    from masonrycli.recording.layout import LEGEND_BARS, PLANE
+    from masonrycli.recording.layout import PLANE
     from masonrycli.recording.static_content import legend_positions
 
-    dx = last_static(path, f"/{LEGEND_BARS}", "Transform3D:translation")[0][0]
     for f in rec_mod.FIELDS:
-        bar = np.array(last_static(path, f"/{f.bar}", "Mesh3D:vertex_positions"))[:, 0] + dx
+        bar = fx.legend_points(path, last_static(path, f"/{f.bar}", "Mesh3D:vertex_positions"))[:, 0]
         assert bar.min() > reach + 0.01, (f.key, bar.min(), reach)
     # the view holds the bar and its tick labels (1 image unit = 1 m; the pinhole's image starts at x0)
     x0 = last_static(path, f"/{PLANE}", "Transform3D:translation")[0][0]
@@ -242,14 +241,12 @@ def test_the_view_holds_a_structure_that_went_left(tmp_path):
     owner = np.repeat(np.arange(len(q0)), np.diff(start))
     left = min(float((f.block_q[owner, 0] + static.block_vert_local[:, 0]).min()) for f in frames)
     reach = max(float((f.block_q[owner, 0] + static.block_vert_local[:, 0]).max()) for f in frames)
-    from masonrycli.recording.layout import LEGEND_BARS, PLANE
+    from masonrycli.recording.layout import PLANE
 
     x0 = last_static(path, f"/{PLANE}", "Transform3D:translation")[0][0]
     assert x0 < left - 0.01, (x0, left)
-    dx = last_static(path, f"/{LEGEND_BARS}", "Transform3D:translation")
-    dx = dx[0][0] if dx is not None else 0.0
     for f in rec_mod.FIELDS:
-        bar = np.array(last_static(path, f"/{f.bar}", "Mesh3D:vertex_positions"))[:, 0] + dx
+        bar = fx.legend_points(path, last_static(path, f"/{f.bar}", "Mesh3D:vertex_positions"))[:, 0]
         assert bar.min() > reach + 0.01, (f.key, bar.min(), reach)
 
 

@@ -285,3 +285,19 @@ def test_a_fill_on_blocks_of_two_thicknesses_is_recorded(tmp_path):
     load = 1800 * 0.5 * (1.0 + 0.8) * 9.81 / 1e3
     (line,) = [x for x in legend.splitlines() if x.startswith("- **Fill**")]
     assert f"{load:.4g} kN," in line and "per metre" not in line, line
+
+
+def test_the_legend_panel_shows_a_bridge_s_fill_line(bridge):
+    """A filled bridge's Legend has a Fill line more than a bare arch's: eight lines at 1920 x 1080 where the
+    panel under the structure tabs (5 : 1 of the ~1000 px column, a 24 px title bar, ~20 px a line) shows
+    seven, the Fill line below its fold (9 lines here: the Magnified line wraps too). The panel's share grows to hold the Legend's lines."""
+    import math
+
+    from masonrycli.recording.readback import blueprint_row_shares
+
+    rrd, _, _ = bridge
+    legend = fx.static_value(rrd, "/run/legend", "TextDocument:text")[0]
+    lines = sum(math.ceil(len(x.replace("**", "")) / 185) for x in legend.splitlines() if x.strip())
+    assert lines >= 8, legend  # 9 here: the Magnified line, saying the fill too, wraps
+    (tabs, panel), *_ = [s for s in blueprint_row_shares(rrd) if len(s) == 2 and s[0] == 5.0]
+    assert 1000.0 * panel / (tabs + panel) >= 24.0 + 20.0 * lines - 1e-3, (tabs, panel)  # float32 shares

@@ -132,3 +132,26 @@ def test_each_colour_bar_says_the_instant_its_view_shows(tmp_path):
     at = {round(fr.time, 9): fr.step for fr in frames}
     assert f"{f.title}, t = 0.100 s" in labels[at[0.1]]
     assert f"{f.title}, t = 0.120 s" in labels[frames[-1].step]
+
+
+def test_the_support_velocity_plot_keeps_its_lines_off_its_edges_and_its_legend(tmp_path):
+    """A settling arch's Support v plot ran from -0.01 to 0 m/s (the viewer's fit): the still supports' lines
+    lay on its top edge, the settling vy on its bottom edge, and the legend (bottom left) hid the start of that
+    line. The plot's range leaves a margin above and below the lines and, under them, room for the legend's
+    rows (about 23 px each of the ~240 px plot at 1920 x 1080)."""
+    from masonrycli.recording.layout import PLOT_NAMES
+    from masonrycli.recording.readback import blueprint_views
+
+    static, q0 = fx.wall()
+    frames = fx.frames(static, q0, 6)
+    settling = [type(f)(**{**f.__dict__, "support_v": np.array([[0.0, -0.01]])}) for f in frames]
+    path = tmp_path / "settling.rrd"
+    with Recorder(path, static, fx.METADATA, batch_frames=4) as rec:
+        for f in settling:
+            rec.log_frame(f)
+    low, high = blueprint_views(path)[PLOT_NAMES["support_velocity"]]["y_range"]
+    height = high - low
+    assert (high - 0.0) / height >= 0.05, (low, high)  # vx and the still lines off the top edge
+    rows = 2  # the ground's vx and vy in the legend
+    assert (-0.01 - low) / height >= 0.05 + rows * 23 / 240, (low, high)  # the legend under the vy line
+    assert 0.01 / height >= 0.3, (low, high)  # the lines still use a good part of the plot

@@ -74,7 +74,7 @@ def test_the_magnified_tab_is_framed_on_the_structure_and_holds_the_magnified_sh
     in its left two thirds, the right third kept for a bar. It is framed on the view left of the bars. And
     the view holds the magnified shape (blocks; supports in y): the arch's right foundation, settled 1 cm in
     'masonry simulate arch --duration 1' and drawn x 25, touched the bottom edge (0.03 m from it)."""
-    from masonrycli.recording.layout import LEGEND_BARS, MAGNIFIED, MAGNIFIED_TAB
+    from masonrycli.recording.layout import MAGNIFIED, MAGNIFIED_TAB
     from masonrycli.recording.readback import blueprint_views
 
     static, q0 = fx.wall()
@@ -92,11 +92,13 @@ def test_the_magnified_tab_is_framed_on_the_structure_and_holds_the_magnified_sh
         blocks = np.concatenate([np.array(r) for r in rows[:n]])
         assert (blocks >= (xmin, ymin)).all() and (blocks <= (xmax, ymax)).all(), (step, blocks.max(axis=0), ymax)
     (x_range, y_range) = blueprint_views(path)[MAGNIFIED_TAB]["bounds"]
-    dx = fx.static_value(path, f"/{LEGEND_BARS}", "Transform3D:translation")[0][0]
-    bar_left = min(np.array(fx.static_value(path, f"/{f.bar}", "Mesh3D:vertex_positions"))[:, 0].min() for f in FIELDS)
+    bar_left = min(
+        fx.legend_points(path, fx.static_value(path, f"/{f.bar}", "Mesh3D:vertex_positions"))[:, 0].min()
+        for f in FIELDS
+    )
     owner = np.repeat(np.arange(n), np.diff(static.block_vert_start))
     right = max(float((f.block_q[owner, 0] + static.block_vert_local[:, 0]).max()) for f in frames)
-    assert 0.0 <= x_range[0] and right - xmin < x_range[1] < bar_left + dx - xmin, (x_range, right, bar_left)
+    assert 0.0 <= x_range[0] and right - xmin < x_range[1] < bar_left - xmin, (x_range, right, bar_left)
     top = max(np.concatenate([np.array(r) for r in rows[:n]])[:, 1].max() for rows in strips.values())
     assert 0.0 <= y_range[0] < ymax - top and y_range[1] <= ymax - ymin + 1e-6, (y_range, top, ymax)
 
@@ -197,7 +199,6 @@ def test_the_bar_s_title_has_room_right_of_the_bar_on_a_wide_view(tmp_path):
     ~180 px at 1920 x 1080). A wall strewn 2 m to the right of its 1.2 m (its reach widens the view, its size
     does not) left the title ~80 px right of the bar's centre, its end cut by the panel's edge; at first open
     (the 1150 x 840 px structure panel fitted to the view) 125 px are kept."""
-    from masonrycli.recording.layout import LEGEND_BARS
     from masonrycli.recording.static_content import _PANEL_PX, _TITLE_HALF_PX
 
     static, q0 = fx.wall()
@@ -211,8 +212,46 @@ def test_the_bar_s_title_has_room_right_of_the_bar_on_a_wide_view(tmp_path):
             rec.log_frame(f)
     xmin, ymin, xmax, ymax = _view(path)
     px_per_m = min(_PANEL_PX[0] / (xmax - xmin), _PANEL_PX[1] / (ymax - ymin))
-    dx = fx.static_value(path, f"/{LEGEND_BARS}", "Transform3D:translation")[0][0]
-    bar = np.array(fx.static_value(path, f"/{FIELDS[0].bar}", "Mesh3D:vertex_positions"))[:, 0]
-    centre = 0.5 * (bar.min() + bar.max()) + dx
+    bar = fx.legend_points(path, fx.static_value(path, f"/{FIELDS[0].bar}", "Mesh3D:vertex_positions"))[:, 0]
+    centre = 0.5 * (bar.min() + bar.max())
     assert xmax - xmin > 3.0  # the view widened for the slide
     assert (xmax - centre) * px_per_m >= _TITLE_HALF_PX - 1e-6, ((xmax - centre) * px_per_m, xmax, centre)
+
+
+def test_the_colour_bar_keeps_its_size_and_its_ticks_clear_of_it_on_a_wide_view(tmp_path):
+    """'masonry simulate wall --amp 3 --freq 0.8 --duration 3': the bar was sized and its tick labels placed at
+    the first frame, on the wall as built; the view widened at close to hold the collapse strewn along its ground
+    and the bar opened ~7 px wide, its tick labels (~50-80 px wide, centred 3 bar widths right of it) over it.
+    At close the bar is sized to the view that holds the run: as wide on screen as on a wall that stood, its
+    ticks' labels clear of it."""
+    from masonrycli.recording.layout import LEGEND_LABELS
+    from masonrycli.recording.static_content import _PANEL_PX, TICKS
+
+    static, q0 = fx.wall()
+    frames = fx.frames(static, q0, 8)
+    for f in frames:
+        f.contact_point[:] = np.clip(f.contact_point, (0.0, 0.0), (1.2, 0.8))
+    strewn = [type(f)(**{**f.__dict__, "block_q": f.block_q.copy()}) for f in frames]
+    for k, f in enumerate(strewn):  # the wall slides 0.6 m a frame along its ground, 4.2 m in all
+        f.block_q[:, 0] += 0.6 * k
+    shown = {}
+    for name, run in (("stood", frames), ("strewn", strewn)):
+        path = tmp_path / f"{name}.rrd"
+        with Recorder(path, static, fx.METADATA, batch_frames=4) as rec:
+            for f in run:
+                rec.log_frame(f)
+        xmin, ymin, xmax, ymax = _view(path)
+        px_per_m = min(_PANEL_PX[0] / (xmax - xmin), _PANEL_PX[1] / (ymax - ymin))
+        bar = fx.legend_points(path, fx.static_value(path, f"/{FIELDS[0].bar}", "Mesh3D:vertex_positions"))
+        anchors = fx.legend_points(
+            path, temporal_rows(path, f"/{FIELDS[0].labels}", "Points2D:positions")[frames[-1].step]
+        )
+        ticks = anchors[:TICKS, 0]
+        shown[name] = (px_per_m * (bar[:, 0].max() - bar[:, 0].min()), px_per_m * (ticks.min() - bar[:, 0].max()))
+        assert xmax - xmin > (4.0 if name == "strewn" else 0.0)
+        assert (ticks < xmax).all() and bar[:, 1].max() < ymax, (name, ticks, xmax)
+        assert fx.static_value(path, f"/{LEGEND_LABELS}", "Transform3D:translation") is not None
+    stood_width, _ = shown["stood"]
+    width, gap = shown["strewn"]
+    assert width >= 0.7 * stood_width and width >= 15.0, shown  # px
+    assert gap >= 40.0, shown  # a label's half width: clear of the bar

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import functools
 import importlib.metadata
+import math
 import platform
 import re
 from typing import Final
@@ -194,6 +195,16 @@ def legend_markdown(
         "lime green = above it. Small dark dots: block centroids (hover one: its name and values).\n"
         f"- **{MAGNIFIED_TAB}** deformed shape: displacements and rotations {factor}; grey = as built{magnified_fill}."
     )
+
+
+LEGEND_LINE_CHARS: Final = 185
+"""Characters of one line of the Legend panel at 1920 x 1080 (the structure column's 1150 px)."""
+
+
+def legend_lines(legend: str) -> int:
+    """Lines the Legend panel takes for ``legend`` at 1920 x 1080: each bullet wraps at LEGEND_LINE_CHARS."""
+    bullets = [line.replace("**", "") for line in legend.splitlines() if line.strip()]
+    return sum(math.ceil(len(b) / LEGEND_LINE_CHARS) for b in bullets)
 
 
 _SAFE_EXTRA: Final = "–—‘’“”…·•×−≤≥≈°±²³µ√∞→✓∑ΔΣ"

@@ -268,12 +268,28 @@ def _structure_view(name: str, f: FieldSpec, extra: tuple[str, ...] = (), at: fl
     )
 
 
+LEGEND_PX: Final = (24.0, 20.0, 1000.0)
+"""The Legend panel at 1920 x 1080: its title bar and one line of text, px, and the structure column's height
+(tab bar to time panel) that the tabs and the Legend share 5 : 1 (seven lines at 1)."""
+
+
+def legend_share(lines: int) -> float:
+    """The Legend panel's row share (the structure tabs' 5) for ``lines`` of legend at 1920 x 1080
+    (``document.legend_lines``): at least 1; more when the lines need it. A bridge's Fill line was the eighth,
+    below the panel's fold (seven show at 1)."""
+    title, line, column = LEGEND_PX
+    need = title + line * lines
+    return max(1.0, 5.0 * need / (column - need)) if need < 0.5 * column else 5.0
+
+
 def build_blueprint(
     main_field: str = "cell_spherical_stress",
     paper: tuple[float, tuple[str, ...]] | None = None,
     residual_range: tuple[float, float] | None = None,
     structure_view: tuple[tuple[float, float], tuple[float, float]] | None = None,
     supports_move: bool = False,
+    support_v_range: tuple[float, float] | None = None,
+    legend_lines: int = 7,
 ) -> rrb.Blueprint:
     """Structure tabs and the on-screen legend (left); time series and the run document (right).
     ``residual_range``: the residual plot's y range (log10 of m/s; None: the viewer's fit to the data).
@@ -281,6 +297,8 @@ def build_blueprint(
     (u0, u1), (v0, v1) (``static_content.log_plane``): the magnified shape's tab, which has no bar nor
     arrows, shows that part. ``supports_move``: a support moved during the run (a shaken ground, a settling
     foundation): the second row of plots opens on its velocity, else on the solver's residual.
+    ``support_v_range``: the Support v plot's y range (m/s, ``series.support_velocity_range``; None: the fit).
+    ``legend_lines``: the Legend's lines at 1920 x 1080 (:func:`legend_share`).
 
     Tabs: the live main view (forces, principal stress, ``main_field``), with ``paper`` = (t, figure
     numbers) the paper's four figures pinned to t, the four fields live (p also on the square-root scale,
@@ -321,16 +339,18 @@ def build_blueprint(
     structure = rrb.Vertical(
         rrb.Tabs(*tabs, active_tab=1 if paper is not None else 0),
         rrb.TextDocumentView(origin=f"/{LEGEND}", name="Legend"),
-        row_shares=[5, 1],
+        row_shares=[5, legend_share(legend_lines)],
     )
     whole_run = rrb.TimeAxis(
         view_range=rrb.TimeRange(rrb.TimeRangeBoundary.infinite(), rrb.TimeRangeBoundary.infinite())
     )
 
-    def plot(key: str, axis_y: rrb.ScalarAxis | None = None) -> rrb.TimeSeriesView:
+    def plot(
+        key: str, axis_y: rrb.ScalarAxis | None = None, legend: rrb.PlotLegend | None = None
+    ) -> rrb.TimeSeriesView:
         # a plot of one series whose name says it has no legend: the legend box (bottom left) hid the
         # start of the curve and repeated the name ("kinetic" under "Kinetic energy (J)")
-        legend = rrb.PlotLegend(visible=False) if key in SINGLE_SERIES else None
+        legend = rrb.PlotLegend(visible=False) if key in SINGLE_SERIES else legend
         return rrb.TimeSeriesView(
             origin=f"/{SERIES[key]}", name=PLOT_NAMES[key], axis_x=whole_run, axis_y=axis_y, plot_legend=legend
         )
@@ -350,7 +370,12 @@ def build_blueprint(
         rrb.Tabs(
             # the supports (what moves the structure) beside the solver's health: six tabs in one row did
             # not fit the column
-            plot("support_velocity"),
+            # its range leaves the bottom left to the legend (series.support_velocity_range)
+            plot(
+                "support_velocity",
+                None if support_v_range is None else rrb.ScalarAxis(range=support_v_range),
+                None if support_v_range is None else rrb.PlotLegend(corner="LeftBottom"),
+            ),
             plot("support_displacement"),
             # the residual's unit (the RMS contact-law violation of a sweep, m/s, as --tolerance): the plot's
             # ticks read -5 .. -5.3 with no unit anywhere on screen

@@ -358,6 +358,20 @@ def blueprint_tabs(path: str | os.PathLike) -> list[tuple[list[str], str]]:
     return [([names[c] for c in contents], names[active or contents[0]]) for contents, active in tabs]
 
 
+def blueprint_row_shares(path: str | os.PathLike) -> list[list[float]]:
+    """The row shares of every vertical container of the recording's last default blueprint (those set)."""
+    with _reading(path) as reader:
+        chunks = list(reader.stream(store=_last_blueprint(reader)))
+    out = []
+    for chunk in chunks:
+        batch = chunk.to_record_batch()
+        if "ContainerBlueprint:row_shares" in batch.schema.names:
+            shares = batch.column("ContainerBlueprint:row_shares").to_pylist()[-1]
+            if shares:
+                out.append([float(x) for x in shares])
+    return out
+
+
 def blueprint_time_panel(path: str | os.PathLike) -> dict:
     """The embedded blueprint's time panel: {"timeline": name or None, "play_state": "paused", "playing",
     "following" or None} (None: not set, the viewer's default)."""

@@ -50,7 +50,7 @@ from masonrycli.recording.arrays import FrameBatch, Polygons, own_centroids, pos
 from masonrycli.recording.batching import Batching, initial_frames, io_errors, steps_due
 from masonrycli.recording.carried_fill import CarriedFill, ColumnArrays, fill_legend, magnified_fill_note
 from masonrycli.recording.colormap import nice_ceil, robust_max_abs
-from masonrycli.recording.document import legend_markdown, run_document, viewer_safe_text
+from masonrycli.recording.document import legend_lines, legend_markdown, run_document, viewer_safe_text
 from masonrycli.recording.field_colours import FieldColours
 from masonrycli.recording.fills import send_blocks, send_supports
 from masonrycli.recording.layout import (
@@ -80,10 +80,11 @@ from masonrycli.recording.magnified import PoseSpool, send_magnified
 from masonrycli.recording.overlays import frame_joint_resultants, send_axes, send_joints
 from masonrycli.recording.readback import check_complete, wait_written
 from masonrycli.recording.residual_range import ResidualRange
-from masonrycli.recording.series import send_series, send_steps
+from masonrycli.recording.series import send_series, send_steps, support_velocity_range
 from masonrycli.recording.static_content import (
     RecordingStatic,
     inset_local,
+    legend_move,
     legend_positions,
     log_initial_shape,
     log_legend,
@@ -158,7 +159,8 @@ class Recorder:
         self.magnify = magnify
         self._legend_box = (0.0, 0.0, 0.0, 0.0)
         self._structure_view = None  # the Magnified tab's part of the view (log_plane)
-        self._supports_moved = False  # a support's velocity was not 0 at a frame: its plot shows at open
+        self._legend_lines = 7  # the Legend's lines at 1920 x 1080 (_log_metadata)
+        self._support_v = (0.0, 0.0)  # m/s, the lowest and highest support velocity component recorded, 0 in
         self._label_anchors = np.zeros((0, 2), np.float32)
         self._size = 1.0
         self._frames, self._last = 0, None  # frames logged; (step, time) of the last one
@@ -348,7 +350,7 @@ class Recorder:
             block_side=self._block_side,
             shape=self._extent,
         )
-        shift = rr.Transform3D(translation=[box[0] - self._legend_box[0], 0.0, 0.0])
+        shift = legend_move(self._legend_box, box)  # the bar sized to the view at close (log_plane)
         for path in (LEGEND_BARS, LEGEND_LABELS):
             self.rec.log(path, shift, static=True)
 
@@ -370,9 +372,9 @@ class Recorder:
             reached = self._last is not None and self._last[1] >= self.paper[0] - 0.5 * self.static.dt
             if not reached:
                 self.paper = None
-        layout = build_blueprint(
-            self._main_field, self.paper, self.residual_range(), self._structure_view, self._supports_moved
-        )
+        v_range = support_velocity_range(*self._support_v, 2 * self._supports.count)  # None: no support moved
+        args = (self._main_field, self.paper, self.residual_range(), self._structure_view, v_range is not None)
+        layout = build_blueprint(*args, support_v_range=v_range, legend_lines=self._legend_lines)
         self.rec.send_blueprint(layout, make_active=True, make_default=True)
 
     # ---- per-batch content
@@ -399,7 +401,11 @@ class Recorder:
         args = (self._fill, self._blocks.owner, self._colours, self._label_anchors, q, tensors, initial)
         send_blocks(self.rec, idx, *args, at=own, times=b["time"])
         send_supports(self.rec, idx, self._supports, b.stack("support_q"))
-        self._supports_moved = self._supports_moved or bool(np.any(b.stack("support_v")))
+        sv = b.stack("support_v")  # a support that moved: its plot shows at open (build_blueprint)
+        self._support_v = (
+            min(self._support_v[0], float(sv.min(initial=0.0))),
+            max(self._support_v[1], float(sv.max(initial=0.0))),
+        )
         self._carried.send(self.rec, idx, q)
         self._send_axes(idx, np.concatenate([own, q[..., 2:]], axis=-1), tensors)
         self._send_joints(idx, b)
@@ -476,6 +482,7 @@ class Recorder:
         # which no "per metre of width" holds: none said (a list here ended the run in a TypeError at close)
         thickness = self.metadata.get("thickness_m")
         legend += fill_legend(fill, thickness if isinstance(thickness, (int, float)) else None, drawn)
+        self._legend_lines = legend_lines(legend)  # the Legend panel's height at close (layout.legend_share)
         self.rec.log(LEGEND, rr.TextDocument(viewer_safe_text(legend), media_type="text/markdown"), static=True)
 
 

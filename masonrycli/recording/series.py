@@ -10,6 +10,8 @@ log10 of the residual beside log10 of the tolerance, and the contact count.
 
 from __future__ import annotations
 
+from typing import Final
+
 import numpy as np
 import rerun as rr
 
@@ -60,6 +62,26 @@ def balance_log10(kinetic, potential_change, dissipated, work) -> np.ndarray:
     with np.errstate(divide="ignore", invalid="ignore"):
         share = np.where(scale > 0.0, error / scale, 0.0)
     return np.log10(np.maximum(share, BALANCE_FLOOR))
+
+
+PLOT_PAD: Final = 0.08
+"""Share of a plot's height left empty above and below its lines: a settling arch's supports (vx, vy = 0 and
+vy = -0.01 m/s) drew lines on the plot's top and bottom edges, the viewer's fit to the data."""
+LEGEND_ROW_SHARE: Final = 0.1
+"""Share of a plot's height one legend row takes at 1920 x 1080 (~23 of the ~240 px of the support plots), kept
+free of lines under them: the legend (bottom left) hid the start of a settling foundation's vy line."""
+
+
+def support_velocity_range(low: float, high: float, rows: int) -> tuple[float, float] | None:
+    """The Support v plot's y range, m/s, for velocities from ``low`` to ``high`` (0 included) and ``rows``
+    series in its legend: PLOT_PAD above and below the lines, and under them room for the legend (its rows,
+    at most 60 % of the plot). None when no support moved (the viewer's fit)."""
+    low, high = min(low, 0.0), max(high, 0.0)
+    if not np.isfinite(low) or not np.isfinite(high) or high - low <= 0.0:
+        return None
+    legend = min(0.6, LEGEND_ROW_SHARE * rows)
+    height = (high - low) / (1.0 - 2.0 * PLOT_PAD - legend)
+    return low - (PLOT_PAD + legend) * height, high + PLOT_PAD * height
 
 
 def _common_travel(sq: np.ndarray, ref_sq: np.ndarray) -> np.ndarray:

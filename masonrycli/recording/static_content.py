@@ -208,7 +208,10 @@ def log_plane(
     blk = blocks.world(block_q[None])[0] if blocks.count else sup
     size = float(max(blk.max(axis=0) - blk.min(axis=0))) or 1.0
     lo, hi = _held(blk, sup, size, content)
-    pad, bar = 0.05 * size, 0.025 * size
+    # the bar's width: 2.5 % of the structure's size, or of the box the view holds when what the run drew widens
+    # it beyond the supports' margin: a collapse strewn along its ground ('masonry simulate wall --amp 3 --freq
+    # 0.8 --duration 3') drew a bar 7 px wide at close, its tick labels (3 widths right of it) over it
+    pad, bar = 0.05 * size, 0.025 * max(size, float(max(hi - lo)) / (1.0 + 2.0 * _SUPPORT_MARGIN))
     ya, yb = blk[:, 1].min(), blk[:, 1].max()
     room = 0.12 * (yb - ya)  # for the title above the bar and the over / under labels
     # a low structure got a bar as short as itself: an 8-course wall 37.5 m long ('simulate wall
@@ -244,6 +247,14 @@ def log_plane(
             rec.log(path, style, static=True)
     slo, shi = _held(blk, sup, size, shape)  # a 64-course wall's Magnified tab kept room for the toe arrows
     return legend_box, size, ((slo[0] - pad - x0, shi[0] + pad - x0), (y0 - shi[1] - pad, y0 - slo[1] + pad))
+
+
+def legend_move(old: tuple[float, float, float, float], new: tuple[float, float, float, float]) -> rr.Transform3D:
+    """The transform (on the colour bars' and their labels' parents) that takes what was drawn in legend box
+    ``old`` (the first frame's, ``log_plane``) to box ``new`` (the view at close): moved and stretched, the
+    labels' anchors (``legend_positions``) with it, so the ticks keep their distance to the bar."""
+    kx, ky = (new[2] - new[0]) / (old[2] - old[0]), (new[3] - new[1]) / (old[3] - old[1])
+    return rr.Transform3D(translation=[new[0] - kx * old[0], new[1] - ky * old[1], 0.0], scale=[kx, ky, 1.0])
 
 
 CONTENT_REACH: Final = 2.0
