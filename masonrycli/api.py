@@ -15,8 +15,8 @@ Python                                          the command line's code
 ==============================================  ===============================================================
 
 So a bad value raises :class:`masonrycli.errors.InputError` carrying the line the command prints before its exit
-code 2, which names the option as the command line spells it (``amp=float("nan")``: "--amp: amplitude = nan: must
-be a finite number"), and a run's arrays are bit for bit those of the history ``masonry simulate … --history``
+code 2, its options named by the keywords typed here (``amp=float("nan")``: "amp=: amplitude = nan: must be a
+finite number", where the command line says "--amp: …"; :mod:`masonrycli.option_spelling`; warnings too), and a run's arrays are bit for bit those of the history ``masonry simulate … --history``
 writes. The keywords are the commands' options under their Python names (``--record-every`` is
 ``record_every=``). Nothing is written unless asked: ``recording=`` and ``history=`` name the files (the
 command line's rules: an existing file is refused without ``force=True``), so a loop over parameters leaves no
@@ -30,6 +30,7 @@ Why a module of its own and not names in ``masonrycli/__init__.py``: that packag
 from __future__ import annotations
 
 import difflib
+import functools
 import io
 import os
 import warnings
@@ -61,6 +62,39 @@ def _option_names(target) -> list[str]:
     elif isinstance(target, (str, os.PathLike)):
         groups += ["RECORD", "SURVEY", "SETTLE"]
     return [name for group in groups for name in getattr(options, group)]
+
+
+@functools.cache
+def _keywords() -> frozenset[str]:
+    """Every keyword of :func:`scenario` and :func:`simulate`, whatever the target: the options the messages name."""
+    from masonrycli.cli import options
+
+    groups = ["RUN", "FRICTION", "RECORD", "SURVEY", "SETTLE", "BLOCK_MATERIAL", "WALL", "WALL_LOADING", "ARCH"]
+    groups += ["SETTLED_LOADING", "AQUEDUCT", "SIMULATE_SETTLE"]
+    names = {name for group in groups for name in getattr(options, group)}
+    return frozenset(names | set(_OUTPUTS) | {"recording"})
+
+
+def _python_spelled(function):
+    """``function`` with the options its errors and warnings name spelled as its keywords (``duration=``, where
+    the command line says ``--duration``): the same messages (:mod:`masonrycli.option_spelling`). Its warnings
+    are said as it returns or raises, from the caller's line."""
+    from masonrycli.option_spelling import python_spelling
+
+    @functools.wraps(function)
+    def spelled(*args, **kwargs):
+        caught: list = []
+        try:
+            with warnings.catch_warnings(record=True) as caught:
+                warnings.simplefilter("always")  # the caller's filters apply as they are said again below
+                return function(*args, **kwargs)
+        except InputError as exc:
+            raise InputError(python_spelling(str(exc), _keywords())) from None
+        finally:
+            for said in caught:
+                warnings.warn(python_spelling(str(said.message), _keywords()), said.category, stacklevel=2)
+
+    return spelled
 
 
 _OUTPUTS = {  # the command line's output options, which simulate() names otherwise
@@ -116,6 +150,7 @@ def _path(value, option: str, *, output: bool = False) -> Path:
         raise InputError(f"{option}: {exc.message}") from None
 
 
+@_python_spelled
 def scenario(target, **options):
     """The :class:`~masonrycli.scenario.scenario.Scenario` that :func:`simulate` would run: ``target`` is a
     built-in's name (``"wall"``, ``"arch"``, ``"aqueduct"``, with ``masonry simulate NAME``'s options:
@@ -211,6 +246,7 @@ class _FrameCallback:
         """Nothing to close: the function's owner keeps what it gathered."""
 
 
+@_python_spelled
 def simulate(
     target,
     *,
@@ -297,6 +333,7 @@ def simulate(
     )
 
 
+@_python_spelled
 def read_history(path) -> Run:
     """The :class:`Run` of a history file (``--history``, ``simulate(history=…)``, ``masonry sweep
     --histories``), checked as ``masonry inspect`` checks it. Its ``outcome`` is the verdict the file keeps
@@ -313,6 +350,7 @@ def read_history(path) -> Run:
     return Run(arrays, outcome=kept[0] if kept is not None else None, history=path)
 
 
+@_python_spelled
 def view(recording):
     """Open ``recording`` (a ``.rrd``) in the Rerun viewer, as the line a run's summary ends with does; returns
     the viewer's process (:class:`subprocess.Popen`)."""
@@ -438,6 +476,6 @@ class Run:
         shown = str(self.history) if self.history is not None else "the run"
         if out is None:
             return report_markdown(self.arrays, shown)
-        page, picture = check_outputs(_path(out, "--out", output=True), force)
+        page, picture = check_outputs(_path(out, "out=", output=True), force)
         write_report(self.arrays, shown, page, picture)
         return page.path.read_text(encoding="utf-8")

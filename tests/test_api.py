@@ -18,6 +18,7 @@ import pytest
 
 from masonrycli import api
 from masonrycli.errors import InputError
+from masonrycli.option_spelling import python_spelling
 from masonrycli.outputs.history import RESULT_KEYS
 
 from cli_helpers import invoke, words
@@ -122,7 +123,8 @@ def test_a_bad_value_is_refused_with_the_command_line_s_line(options, args, tmp_
     assert result.exit_code == 2, result.output
     with pytest.raises(InputError) as refused:
         api.simulate("wall", **options)
-    assert words(result.output) == f"error: {refused.value}"
+    # the same line, its options named by the keywords given (duration=, not --duration)
+    assert python_spelling(words(result.output), api._keywords()) == f"error: {refused.value}"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["h.npz"]  # neither wrote anything
 
 
@@ -139,7 +141,8 @@ def test_a_path_is_read_by_the_command_line_s_parser(options, args, said, tmp_pa
     # '--out' / '-o': …"); Path("x.rrd/") is x.rrd, which the API wrote without a word
     monkeypatch.chdir(tmp_path)
     assert said in words(invoke("simulate", "wall", *args).output)
-    with pytest.raises(InputError, match=re.escape(f"{args[0]}: {said}")):
+    keyword = {"--out": "recording"}.get(args[0], args[0][2:])
+    with pytest.raises(InputError, match=re.escape(f"{keyword}=: {said}")):
         api.simulate("wall", duration=0.01, **options)
     assert list(tmp_path.iterdir()) == []
 
@@ -205,7 +208,7 @@ def test_files_asked_for_are_written_read_back_and_viewed(tmp_path, monkeypatch)
         older = {k: npz[k] for k in npz.files if not k.startswith("result_")}
     np.savez(tmp_path / "older.npz", **older)
     assert api.read_history(tmp_path / "older.npz").outcome is None
-    with pytest.raises(InputError, match="--history .*exists"):
+    with pytest.raises(InputError, match="history=.*exists.*add force="):
         api.simulate("wall", duration=0.02, history=h)  # never overwritten without force
     api.simulate("wall", duration=0.02, history=h, force=True)
     monkeypatch.chdir(tmp_path)
@@ -302,7 +305,7 @@ def test_the_python_page_runs_as_a_notebook(tmp_path, monkeypatch):
         and (tmp_path / "runs" / "wall.npz").is_file()
     )
     assert namespace["run"].outcome["state"] == "damaged"
-    assert namespace["message"] == "--amp: amplitude = nan: must be a finite number"
+    assert namespace["message"] == "amp=nan (amplitude): must be a finite number"
     # the study run from the notebook's Python: its 4 rows, and a history naming the sweep that made it
     assert [row["state"] for row in namespace["rows"]] == ["damaged"] * 4
     assert "| command | masonry sweep wall --param freq=1,2 " in namespace["point"].report()
@@ -322,5 +325,8 @@ def test_unconverged_steps_are_warned_as_the_command_line_warns_them():
     line = " ".join(result.output.split("warning: ", 1)[1].split())
     with pytest.warns(RuntimeWarning) as said:
         run = api.simulate("wall", amp=1.0, duration=0.02, max_iterations=5)
-    assert [str(w.message) for w in said] == [line] and line.startswith("20 of 20 steps ended unconverged")
+    # the command line's line, its options spelled as the keywords given (tolerance=, max_iterations=)
+    assert [str(w.message) for w in said] == [python_spelling(line, api._keywords())]
+    assert line.startswith("20 of 20 steps ended unconverged") and "--tolerance" in line
+    assert "above tolerance=1e-05 m/s" in str(said[0].message)
     assert run.status == "completed" and run["nlgs_unconverged"][-1] == 20

@@ -2,12 +2,14 @@
 bad_input_options.py, bad_input_paths.py) that ``masonry
 simulate``, ``run`` or ``check`` makes with exit 2 is the Python API's too, in the same words: each row's options,
 as the command line converts them, given to :func:`masonrycli.api.simulate` raise the
-:class:`~masonrycli.errors.InputError` whose text is the command's line (a row the command line's parser refuses,
+:class:`~masonrycli.errors.InputError` whose text is the command's line with its options spelled as the API's
+keywords (``duration=``, not ``--duration``: :mod:`masonrycli.option_spelling`) (a row the command line's parser refuses,
 "--dt abc", has no Python counterpart: a number is a number there)."""
 
 from __future__ import annotations
 
 import ast
+import inspect
 import re
 
 import click
@@ -23,6 +25,7 @@ from geometry_library.values import TypedNumber
 from masonrycli import api
 from masonrycli.cli.app import app
 from masonrycli.errors import InputError
+from masonrycli.option_spelling import python_spelling
 from masonrycli.scenario.builtin import BUILT_IN
 
 from cli_helpers import invoke, words
@@ -95,7 +98,60 @@ def test_the_api_refuses_as_the_command_line(name, files, argv, code, fragment, 
     target, keywords = parsed
     with pytest.raises(InputError) as refused:
         api.simulate(target, **keywords)
-    assert _numbers_alike(f"error: {words(str(refused.value))}") == _numbers_alike(said)
+    spelled = python_spelling(said, api._keywords())
+    assert _numbers_alike(f"error: {words(str(refused.value))}") == _numbers_alike(spelled)
+    assert not re.search(rf"--({'|'.join(k.replace('_', '-') for k in keywords)})\b", str(refused.value))
+
+
+BAD_CALLS = [  # (keywords, the keyword the message names first): every keyword a value of which can be refused
+    ({"duration": -1}, "duration=-1"),
+    ({"duration": 4.99, "dt": 0.02}, "duration="),
+    ({"dt": 0}, "dt=0"),
+    ({"theta": 2}, "theta=2"),
+    ({"tolerance": 1e-300}, "tolerance=1e-300"),
+    ({"max_iterations": 0}, "max_iterations=0"),
+    ({"record_every": 0}, "record_every=0"),
+    ({"solver": "x"}, "solver="),
+    ({"friction": -1}, "friction=-1"),
+    ({"amp": float("nan")}, "amp=nan"),
+    ({"freq": 0, "amp": 1}, "freq=0"),
+    ({"blocks": 3.5}, "blocks=3.5"),
+    ({"courses": 0}, "courses="),
+    ({"length": 0.45}, "length=0.45"),
+    ({"block_length": -1}, "block_length="),
+    ({"block_height": -1}, "block_height="),
+    ({"density": -1}, "density=-1"),
+    ({"thickness": 0}, "thickness=0"),
+    ({"settle": -1}, "settle=-1"),
+    ({"pga": "x"}, "pga=x"),
+    ({"scale": 2}, "scale="),
+    ({"record_dt": 0.01}, "record_dt="),
+    ({"baseline": "none"}, "baseline="),
+    ({"recording": 3}, "recording=3"),
+    ({"history": 3}, "history=3"),
+    ({"magnify": -1}, "magnify=-1"),
+]
+
+
+@pytest.mark.parametrize("given, named", BAD_CALLS, ids=[" ".join(g) for g, _ in BAD_CALLS])
+def test_a_bad_call_names_the_keyword_as_typed(given, named):
+    # a notebook user read '--tolerance', '--duration 4.99' and looked for flags the API does not have
+    with pytest.raises(InputError) as refused:
+        api.simulate("wall", **({"duration": 0.01} | given))
+    said = str(refused.value)
+    assert named in said and "--" not in said.split(" masonry ")[0], said
+
+
+def test_the_unconverged_warning_names_the_keywords():
+    with pytest.warns(RuntimeWarning) as caught:
+        api.simulate("wall", duration=0.01, max_iterations=2)
+    said = str(caught[0].message)
+    assert "above tolerance=1e-05 m/s" in said and "Raise max_iterations= " in said and "--" not in said
+
+
+def test_the_command_line_keeps_its_flags():
+    said = words(invoke("simulate", "wall", "--duration", "-1", "--no-recording").output)
+    assert said == "error: --duration: duration = -1: must be > 0"
 
 
 OUTPUTS = {"out", "no_recording", "history", "force", "magnify", "stop_at_collapse"}
@@ -110,7 +166,7 @@ def test_the_api_takes_the_options_of_its_command_and_no_other(target):
     command = group.commands["simulate"].commands[target] if target in BUILT_IN else group.commands["run"]
     expected = {p.name for p in command.params} - OUTPUTS - {"scenario_file"}
     assert set(api._option_names(target)) == expected
-    assert OUTPUTS - {"out", "no_recording"} <= set(api.simulate.__kwdefaults__)
+    assert OUTPUTS - {"out", "no_recording"} <= set(inspect.signature(api.simulate).parameters)
 
 
 @pytest.mark.parametrize(
