@@ -308,6 +308,8 @@ def test_the_python_page_runs_as_a_notebook(tmp_path, monkeypatch):
     assert namespace["message"] == "amp=nan (amplitude): must be a finite number"
     # the study run from the notebook's Python: its 4 rows, and a history naming the sweep that made it
     assert [row["state"] for row in namespace["rows"]] == ["damaged"] * 4
+    # the table names the sweep too, as the page's `python -m masonrycli sweep` ran it (a CSV column)
+    assert {row["command"] for row in namespace["rows"]} == {f"masonry {' '.join(namespace['study'][3:])}"}
     assert "| command | masonry sweep wall --param freq=1,2 " in namespace["point"].report()
 
 

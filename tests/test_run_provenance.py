@@ -1,9 +1,10 @@
 """What made a history: a command line's run keeps its ``masonry …`` line (test_outputs_run_report), a Python API
 run its ``api.simulate(…)`` call, a sweep's history the ``masonry sweep …`` line; ``masonry report`` names it
-first and ``masonry inspect`` shows it."""
+first and ``masonry inspect`` shows it. A sweep's table keeps it in a ``command`` column, row by row."""
 
 from __future__ import annotations
 
+import csv
 import json
 from pathlib import Path
 
@@ -12,7 +13,8 @@ from test_outputs_run_report import rows
 
 from masonrycli import api
 
-from cli_helpers import invoke
+from cli_helpers import invoke, words
+from sweep_helpers import invoke as invoke_wide
 
 
 def _command(npz: Path) -> str | None:
@@ -81,3 +83,47 @@ def test_a_recording_s_parameters_name_the_command(tmp_path, monkeypatch):
 
 def _call(output: str) -> str:
     return f"api.simulate('wall', blocks=12, duration=0.01, {output})"
+
+
+def _sweep(monkeypatch, *args):
+    args = ["sweep", "wall", "-p", "blocks=12", *args, "--duration", "0.01", "--workers", "0", "--no-recording"]
+    monkeypatch.setattr("sys.argv", ["/venv/bin/masonry", *args])  # as the masonry entry point runs it
+    result = invoke(*args)
+    assert result.exit_code == 0, result.output
+    return "masonry " + " ".join(args)
+
+
+def test_a_sweep_s_table_names_the_sweep_row_by_row_and_inspect_shows_it(tmp_path, monkeypatch):
+    # only the histories named the sweep; the table (what a colleague is sent) did not say what made it
+    monkeypatch.chdir(tmp_path)
+    first = _sweep(monkeypatch, "-p", "amp=0.1", "-o", "s.csv")
+    # resumed (its plot replaced: --force), the first row kept, one more run
+    resumed = _sweep(monkeypatch, "-p", "amp=0.1,0.2", "-o", "s.csv", "--force")
+    with open("s.csv", newline="") as fh:  # a plain CSV reader: the header first, one column more
+        rows = list(csv.DictReader(fh))
+    assert [(r["amp"], r["command"]) for r in rows] == [("0.1", first), ("0.2", resumed)]
+    cells = _cells(invoke_wide("inspect", "s.csv").output)
+    assert list(cells)[:2] == ["command", "rows"] and cells["rows"] == "2 (2 intact)"
+    assert cells["command"] == f"{first} {resumed}"  # one a line, wrapped at spaces
+    # a table written before rows named their command resumes; its rows say so
+    with open("s.csv", newline="") as fh:
+        old = [{k: v for k, v in r.items() if k != "command"} for r in csv.DictReader(fh)]
+    with open("s.csv", "w", newline="") as fh:
+        writer = csv.DictWriter(fh, fieldnames=list(old[0]))
+        writer.writeheader()
+        writer.writerows(old)
+    again = _sweep(monkeypatch, "-p", "amp=0.1,0.2,0.3", "-o", "s.csv", "--force")
+    with open("s.csv", newline="") as fh:
+        assert [r["command"] for r in csv.DictReader(fh)] == ["", "", again]
+    assert _cells(invoke_wide("inspect", "s.csv").output)["command"] == f"{again} 2 rows: not recorded"
+
+
+def _cells(output: str) -> dict[str, str]:
+    """The rows of inspect's table, name → its cell's words (the lines a cell wraps to joined by spaces)."""
+    cells: dict[str, str] = {}
+    for line in output.splitlines():
+        if line.startswith("│"):
+            name, cell = (part.strip() for part in line.split("│")[1:3])
+            key = name or list(cells)[-1]
+            cells[key] = words(f"{cells.get(key, '')} {cell}")
+    return cells

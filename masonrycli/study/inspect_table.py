@@ -43,6 +43,7 @@ COLUMN_UNITS = {
     "error": "why the task failed (empty if it did not)",
     "study": "fingerprint of the base scenario and settings",
     "source": "digest of the masonry source that made the row",
+    "command": "the masonry sweep line that made the row (its histories name it too; empty: not recorded)",
     "holds": "above / below: the outcome holds above or below the threshold",
     "outcome": "what --find looked for",
     "evaluations": "runs the search made",
@@ -100,6 +101,8 @@ def study_summary(path) -> tuple[list[tuple[str, str]], list[tuple[str, str]]]:
             else []
         ),
     ]
+    if "command" in columns and rows:  # first, as inspect H.npz shows what made a history
+        table.insert(0, ("command", _commands(rows)))
     if rows and waiting:  # a resumed study still running, or killed: the table is of its last stop
         more = f"{_rows(waiting)} finished since this table was written, in {path.name}.journal.jsonl"
         table.insert(1, ("journal", f"{more} (the study still running, or killed: the same command adds them)"))
@@ -117,6 +120,17 @@ def study_summary(path) -> tuple[list[tuple[str, str]], list[tuple[str, str]]]:
         else:
             lines.append((c, COLUMN_UNITS[c]))
     return table, lines
+
+
+def _commands(rows: list[dict]) -> str:
+    """The lines that made ``rows``, each once in the rows' order (a resume's after the first run's), one a line,
+    and how many rows say none (written before rows named their command, or by a study run from elsewhere)."""
+    made = [str(r.get("command") or "") for r in rows]
+    lines = [c for c in dict.fromkeys(made) if c]
+    unknown = made.count("")
+    if unknown:
+        lines.append(f"{_rows(unknown)}: not recorded" if lines else "not recorded")
+    return "\n".join(lines)
 
 
 def _header(path: Path) -> list[str]:

@@ -20,7 +20,9 @@ from masonrycli.errors import InputError
 from masonrycli.outputs.files import OutputFile, check_folder, written_whole
 
 SUFFIXES = (".parquet", ".csv")
-TEXT_COLUMNS = frozenset({"study", "source", "state", "status", "error", "note", "outcome", "holds", "record"})
+TEXT_COLUMNS = frozenset(
+    {"study", "source", "command", "state", "status", "error", "note", "outcome", "holds", "record"}
+)
 """CSV columns read back as text even when they look like numbers (a fingerprint "1234e5...")."""
 
 

@@ -144,9 +144,10 @@ def run_study(base: StudyBase, request: StudyRequest, console: Console) -> Study
         driver = FindDriver(request.axes, request.find, request.outcome, request.rtol, done)
         columns = names + [f"{request.find}_{s}" for s in ("threshold", "lo", "hi")]
         columns += ["holds", "outcome", "evaluations", "status", "wall_time", "note", "error", "study", "source"]
+        columns += ["command"]
     else:
         driver = GridDriver(request.axes, done)
-        columns = names + list(RESULT_COLUMNS) + ["study", "source"]
+        columns = names + list(RESULT_COLUMNS) + ["study", "source", "command"]
     # Each row names the masonry source that made it (every run's is the command's: versions.py). The
     # fingerprint is of the study's inputs, not of the code: resumed after an upgrade, a table mixed rows of
     # two solvers without a word.
@@ -200,6 +201,9 @@ def run_study(base: StudyBase, request: StudyRequest, console: Console) -> Study
         for finished in driver.finished:
             finished["study"] = row_study(finished)
             finished["source"] = source
+            # the line that made the row, as its history keeps it: a column, which every CSV reader takes (a
+            # "# command" line above the header broke csv.DictReader and pandas; the table has no other place)
+            finished["command"] = request.command
             journal.append(finished)
             progress.advance()
         driver.finished.clear()
@@ -237,6 +241,7 @@ def run_study(base: StudyBase, request: StudyRequest, console: Console) -> Study
         for r in rows:
             r.setdefault("study", row_study(r))
             r.setdefault("source", "")  # a row of a table written before rows named their source: unknown
+            r.setdefault("command", "")  # or their command
         if rows:
             store.write_rows(table, rows, columns)
         else:  # stopped before any row: a header-only table held nothing, yet the same command refused it;
