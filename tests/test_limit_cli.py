@@ -263,9 +263,11 @@ def test_a_long_hinge_list_shows_the_fastest_turning_joints_first():
     first, last = j.joint_start[:-1], j.joint_start[1:] - 1
     length = np.hypot(*(j.contact_point[last] - j.contact_point[first]).T)
     turn = np.abs(omega[j.joint_body[:, 1]] - omega[j.joint_body[:, 0]]) * length * (j.joint_points >= 2)
-    fastest = [result.names[k] for k in np.argsort(-turn)[:2]]
+    turn = turn * result.motion.joint_hinged  # a face turning as it opens all along is no hinge (not listed)
+    fastest = [result.names[k] for k in np.argsort(-turn, kind="stable")[:2]]
     assert fastest[0] == "v15|v16"  # the crown hinge under the load, as on the bare arch
-    shown = words(invoke("limit", "aqueduct", "--load", "point", "--block", "v15", "--direction", "-y").output)
+    table = invoke("limit", "aqueduct", "--load", "point", "--block", "v15", "--direction", "-y").output
+    shown = words(table.replace("│", " "))  # the list wraps within its cell
     assert f"{len(result.hinges)}, the 8 fastest: {', '.join(fastest)}" in shown, shown
 
 

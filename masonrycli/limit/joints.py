@@ -21,7 +21,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from masonrycli.analysis.mechanism import JOINT_GAP
-from masonrycli.engine.collision import ContactBuffers, detect_contacts
+from masonrycli.engine.collision import ContactBuffers, detect_contacts, world_vertices
+from masonrycli.limit.corners import rounded_corner_normal
 from masonrycli.model import Model
 
 
@@ -41,6 +42,15 @@ class Joints:
     """(J, 2) int64: the two bodies of each joint."""
     joint_start: np.ndarray
     """(J+1,) int64: contacts of joint j are rows joint_start[j]:joint_start[j+1]."""
+    contact_grip: np.ndarray | None = None
+    """(C,) share of μ each contact carries: 0 at a corner on a corner, rising to 1 over the rounding radius
+    along a face from its rounded end (:mod:`masonrycli.limit.corners`); None: 1 everywhere."""
+
+    def contact_friction(self, mu: float) -> np.ndarray:
+        """(C,) Coulomb coefficient of each contact: ``mu`` × its grip."""
+        if self.contact_grip is None:
+            return np.full(self.contact_count, float(mu))
+        return float(mu) * self.contact_grip
 
     @property
     def contact_count(self) -> int:
@@ -77,14 +87,39 @@ def find_joints(model: Model) -> Joints:
     first = np.ones(key.size, dtype=bool)
     first[1:] = key[1:] != key[:-1]
     starts = np.flatnonzero(first)
+    normal = np.array(c.contact_normal[:count][order], dtype=np.float64)
+    single = starts[np.diff(np.append(starts, key.size)) == 1]
+    grip = _round_corners(model, body, normal, single)
     return Joints(
         contact_body=body,
         contact_point=np.array(c.contact_point[:count][order], dtype=np.float64),
-        contact_normal=np.array(c.contact_normal[:count][order], dtype=np.float64),
+        contact_normal=normal,
         contact_joint=np.cumsum(first) - 1,
         joint_body=body[starts].copy(),
         joint_start=np.append(starts, key.size).astype(np.int64),
+        contact_grip=grip,
     )
+
+
+def _round_corners(model: Model, body: np.ndarray, normal: np.ndarray, rows: np.ndarray) -> np.ndarray:
+    """(C,) grip of every contact (the share of μ it carries); the single-point contacts ``rows`` that touch
+    within the rounding of a corner (:mod:`masonrycli.limit.corners`) take the normal of the rounded corners (in
+    place) and grip < 1: a corner on a corner's detected normal turned by up to 90° with a survey's last digit.
+    A corner on a face away from its ends keeps its detected normal bit for bit, and grip 1; one on a sliver of
+    a face (3.5 mm long on the aqueduct, whose direction a millimetre's rounding turns by 18°) takes the normal of
+    the face the rounding leaves."""
+    grip = np.ones(normal.shape[0])
+    if rows.size == 0:
+        return grip
+    verts = world_vertices(model.body_q0, model.body_vert_start, model.vert_local)
+    start = model.body_vert_start
+    for r in rows:
+        a, b = int(body[r, 0]), int(body[r, 1])
+        found = rounded_corner_normal(verts[start[a] : start[a + 1]], verts[start[b] : start[b + 1]])
+        # a normal within ~1e-6 rad of the detected one is that face's: kept bit for bit
+        if found is not None and (found[1] < 1.0 or float(found[0] @ normal[r]) < 1.0 - 1e-12):
+            normal[r], grip[r] = found
+    return grip
 
 
 def joint_names(model: Model, joints: Joints) -> list[str]:

@@ -86,7 +86,7 @@ def joint_motion(model: Model, joints: Joints, block_velocity: np.ndarray, tol: 
     j = joints.contact_joint
     slide = np.zeros(joints.joint_count)
     np.maximum.at(slide, j, np.abs(sliding))
-    in_contact = opening <= model.friction * np.abs(sliding) + tol
+    in_contact = opening <= joints.contact_friction(model.friction) * np.abs(sliding) + tol
     turning = turn_rate > tol
     hinged = turning & (in_contact[first] | in_contact[last])
     # The hinge is the end that opens least: the closed end of a rotation about a joint end.

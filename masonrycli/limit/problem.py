@@ -223,8 +223,9 @@ def load_vectors(model: Model, load: LiveLoad) -> tuple[np.ndarray, np.ndarray, 
 
 
 def _cone_edges(model: Model, joints: Joints) -> np.ndarray:
-    """(2C, 2): the cone edges g⁺ = n + μt, g⁻ = n − μt of every contact, interleaved."""
-    mu = model.friction
+    """(2C, 2): the cone edges g⁺ = n + μt, g⁻ = n − μt of every contact, interleaved (μ = 0 at a corner on a
+    corner: :mod:`masonrycli.limit.corners`)."""
+    mu = joints.contact_friction(model.friction)[:, None]
     normal, tangent = joints.contact_normal, joints.contact_tangent
     return np.stack([normal + mu * tangent, normal - mu * tangent], axis=1).reshape(-1, 2)
 
@@ -341,7 +342,7 @@ def solve_limit(
         shear = " with friction 0 (the joints carry no shear)" if model.friction == 0 else ""
         raise _status_error(res.status, res.message, f"the blocks cannot carry their own weight{shear}")
     alpha = res.x[:-1].reshape(-1, 2) * weight
-    mu = model.friction
+    mu = joints.contact_friction(model.friction)
     force = np.stack([alpha.sum(axis=1), mu * (alpha[:, 0] - alpha[:, 1])], axis=1)
     # Dual of  min −λ, A z = b:  y with Aᵀy ≤ c. The mechanism is u = −y, back in unscaled rows.
     velocity = (-res.eqlin.marginals * scale).reshape(-1, 3)
