@@ -3,6 +3,14 @@
 Plain arrays (struct of arrays). Index conventions: blocks 0..N-1 in scenario order, supports 0..S-1,
 contacts 0..C-1 (C varies per frame). Body indices in ``contact_body`` run over blocks first, then
 supports (body N + s is support s).
+
+Two configurations: the blocks' ``block_q`` / ``block_v`` are the state at the end of the step (``time``); the
+``contact_*`` arrays are the contacts of that step, detected and solved in the step's intermediate configuration
+of the Moreau–Jean scheme, q_m = q_n + (1 − θ)·dt·v_n = ``block_q − θ·dt·block_v`` (engine/integrate.py,
+engine/solver.py), and the block stress of ``tensors`` takes its centroids G there (run.py gives the tensors
+``body_q_m``). A block's stress computed from the contacts with G = ``block_q[:, :2] − θ·dt·block_v[:, :2]`` is
+the engine's to rounding (2e-15 relative); with the end-of-step ``block_q`` it is off by ~1e-4 relative on a
+shaken wall (tests/test_frame_configuration.py).
 """
 
 from __future__ import annotations
@@ -25,7 +33,8 @@ class Frame:
     time: float
     """Simulated time, s."""
     block_q: np.ndarray
-    """(N, 3) centroid x, y (m) and rotation from the initial orientation (rad, counter-clockwise)."""
+    """(N, 3) centroid x, y (m) and rotation from the initial orientation (rad, counter-clockwise), at the end of
+    the step; the contacts are at ``block_q − θ·dt·block_v`` (module doc)."""
     block_v: np.ndarray
     """(N, 3) centroid velocity vx, vy (m/s) and angular velocity (rad/s)."""
     support_q: np.ndarray
@@ -37,7 +46,8 @@ class Frame:
     contact_body: np.ndarray
     """(C, 2) int: bodies a, b of each contact (normal points from a to b)."""
     contact_point: np.ndarray
-    """(C, 2) contact point in world coordinates, m."""
+    """(C, 2) contact point in world coordinates, m, in the step's intermediate configuration q_m (module doc),
+    not at ``block_q``."""
     contact_normal: np.ndarray
     """(C, 2) unit normal from body a to body b."""
     contact_force: np.ndarray
