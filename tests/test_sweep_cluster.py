@@ -463,7 +463,7 @@ def test_a_point_that_kills_its_worker_is_an_error_row_saying_so_and_only_it(mon
         client.close()
         cluster.close()
     rows.sort(key=lambda r: r["amp"])
-    assert [(r["amp"], r["status"]) for r in rows] == [(0.1, "completed"), (0.2, "error")]
+    assert [(r["amp"], r["status"]) for r in rows] == [(0.1, "completed"), (0.2, "error")], [r["error"] for r in rows]
     said = rows[1]["error"]
     assert said.startswith("KilledWorker: the worker process running this point died, on each of the 4 workers ")
     assert said.endswith(": out of memory, or a crash (the workers' logs say which)"), said

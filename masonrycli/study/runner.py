@@ -267,8 +267,9 @@ def run_on_cluster(
     with watching.WorkerWatch(client, warn, where, not_made, cluster, give_up if cluster is not None else None):
         while True:
             for future in completed:
-                with lock:
-                    params, _ = pending.pop(future.key)
+                params = pending[future.key][0]
+                # pending until fetched: a result lost with its worker is made again inside result() ("Couldn't
+                # gather keys"), and with no worker left the study waited there, past give_up (CLI, 2026-11-29)
                 try:
                     answer, worker, row = future.result()
                 except Exception as exc:  # the task never returned (KilledWorker, a cluster failure)
@@ -276,9 +277,11 @@ def run_on_cluster(
                         row = params | empty_result(gave_up[0], 0.0)
                     elif _scheduler_lost(client, exc):
                         raise SchedulerLost(
-                            f"lost the connection to the scheduler with {not_made() + 1} runs pending"
+                            f"lost the connection to the scheduler with {not_made()} runs pending"
                         ) from None
-                    elif isinstance(exc, KilledWorker) and future.key not in alone:
+                    elif isinstance(exc, KilledWorker) and future.key not in alone and not gave_up:
+                        with lock:
+                            del pending[future.key]
                         killed.append(params)  # run again alone (above)
                         suspects.append(params)
                         future.release()
@@ -290,6 +293,8 @@ def run_on_cluster(
                     check_result(answer, worker, params, ours)  # another masonry's row is not kept
                     if params in suspects:  # it ran alone: not the point that killed them
                         suspects.remove(params)
+                with lock:
+                    del pending[future.key]
                 future.release()
                 waiting.extendleft(reversed(driver.feed(params, row)))  # a search's next step first: its row sooner
                 on_row(params, row)
