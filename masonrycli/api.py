@@ -75,11 +75,20 @@ def _keywords() -> frozenset[str]:
     return frozenset(names | set(_OUTPUTS) | {"recording"})
 
 
-def _python_spelled(function):
+def _python_spelled(function=None, *, keywords=None, renamed=None):
     """``function`` with the options its errors and warnings name spelled as its keywords (``duration=``, where
     the command line says ``--duration``): the same messages (:mod:`masonrycli.option_spelling`). Its warnings
-    are said as it returns or raises, from the caller's line."""
-    from masonrycli.option_spelling import python_spelling
+    are said as it returns or raises, from the caller's line. ``keywords`` / ``renamed``: a method's own (default:
+    scenario's and simulate's, ``--out`` as ``recording=``)."""
+    from masonrycli.option_spelling import RENAMED, python_spelling
+
+    if function is None:
+        return functools.partial(_python_spelled, keywords=keywords, renamed=renamed)
+
+    def spell(text: str) -> str:
+        return python_spelling(
+            text, _keywords() if keywords is None else keywords, RENAMED if renamed is None else renamed
+        )
 
     @functools.wraps(function)
     def spelled(*args, **kwargs):
@@ -89,10 +98,10 @@ def _python_spelled(function):
                 warnings.simplefilter("always")  # the caller's filters apply as they are said again below
                 return function(*args, **kwargs)
         except InputError as exc:
-            raise InputError(python_spelling(str(exc), _keywords())) from None
+            raise InputError(spell(str(exc))) from None
         finally:
             for said in caught:
-                warnings.warn(python_spelling(str(said.message), _keywords()), said.category, stacklevel=2)
+                warnings.warn(spell(str(said.message)), said.category, stacklevel=2)
 
     return spelled
 
@@ -451,6 +460,10 @@ class Run:
         body = self.arrays["joint_body"][self.arrays["joint_hinged"][frame]]
         return [f"{names[a]}{JOINT_SEPARATOR}{names[b]}" for a, b in body]
 
+    @_python_spelled(
+        keywords={"blocks", "courses", "top", "ground", "relative"},
+        renamed={"course": "courses", "absolute": "relative"},
+    )
     def table(self, *, blocks=(), courses=(), top: bool = False, ground: str | None = None, relative: bool = True):
         """``masonry export``'s columns, name (with its unit) → (T,) array: the ground's motion, each target's
         (a block by name, a course by number from the bottom, the top course) displacement, velocity and
@@ -466,6 +479,7 @@ class Run:
             warnings.warn(note, UserWarning, stacklevel=2)
         return dict(zip(table.names, table.values))
 
+    @_python_spelled(keywords={"out", "force"}, renamed={})
     def report(self, out=None, *, force: bool = False) -> str:
         """``masonry report``'s one-page Markdown of the run (what was run, the ground motion as applied, the
         state, peak and residual drift, hinged joints, unconverged steps: the summary's numbers). ``out``: a
@@ -476,6 +490,6 @@ class Run:
         shown = str(self.history) if self.history is not None else "the run"
         if out is None:
             return report_markdown(self.arrays, shown)
-        page, picture = check_outputs(_path(out, "out=", output=True), force)
+        page, picture = check_outputs(_path(out, "--out", output=True), force)
         write_report(self.arrays, shown, page, picture)
         return page.path.read_text(encoding="utf-8")

@@ -28,9 +28,9 @@ _VALUE = re.compile(r" (?P<value>(?:[-+]?[\d.]|nan\b|inf\b)\S*?|[\w~/.-]*[/.][\w
 word the message ends with a colon ("--pga x: must be a number")."""
 
 
-def python_spelling(text: str, keywords: Iterable[str]) -> str:
+def python_spelling(text: str, keywords: Iterable[str], renamed: dict[str, str] = RENAMED) -> str:
     """``text`` with each ``--name`` of a ``keywords`` entry spelled ``name=`` (``--record-every`` →
-    ``record_every=``, ``--out`` → ``recording=``), its value joined to it (``--duration 4.99`` →
+    ``record_every=``; ``renamed``: the options whose keyword is another word, ``--out`` → ``recording=``), its value joined to it (``--duration 4.99`` →
     ``duration=4.99``), and an option followed by its setting's value as the keyword's (``--dt: dt = 0.02:`` →
     ``dt=0.02:``, ``--amp: amplitude = nan:`` → ``amp=nan (amplitude):``)."""
     keywords = set(keywords)
@@ -38,7 +38,7 @@ def python_spelling(text: str, keywords: Iterable[str]) -> str:
     out, at = [], 0
     for match in _FLAG.finditer(text):
         name = match["name"].replace("-", "_")
-        keyword = RENAMED.get(name, name)
+        keyword = renamed.get(name, name)
         if keyword not in keywords or any(lo <= match.start() < hi for lo, hi in commands):
             continue
         end = match.end()

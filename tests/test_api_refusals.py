@@ -183,3 +183,33 @@ def test_several_values_for_one_keyword_say_how_to_run_them(given, said):
     key, values = next(iter(given.items()))
     assert str(refused.value).startswith(said)
     assert f"masonry sweep --param {key}={','.join(map(str, values))} " in str(refused.value)
+
+
+@pytest.fixture(scope="module")
+def run():
+    return api.simulate("wall", blocks=12, duration=0.01)
+
+
+@pytest.mark.parametrize(
+    "method, given, said",
+    [
+        ("table", {"blocks": ["nope"]}, "blocks=nope: no such block in the run"),
+        ("table", {"courses": [99]}, "courses=99: the run has 1 courses"),
+        ("table", {"ground": "x"}, "ground=x: no such support in the run"),
+        ("report", {"out": "r.txt"}, "out=r.txt: the file name must end in .md"),
+        ("report", {"out": 3}, "out=3: a path"),
+    ],
+)
+def test_a_run_s_methods_name_their_keywords(run, method, given, said, tmp_path, monkeypatch):
+    # Run.table(courses=[99]) said '--course 99: …', a flag of masonry export the method does not have
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(InputError) as refused:
+        getattr(run, method)(**given)
+    assert str(refused.value).startswith(said) and "--" not in str(refused.value), refused.value
+
+
+def test_a_report_that_exists_says_force_as_the_method_takes_it(run, tmp_path):
+    run.report(tmp_path / "r.md")
+    with pytest.raises(InputError, match=r"r\.md: the file exists \(add force= to replace it\)") as refused:
+        run.report(tmp_path / "r.md")
+    assert str(refused.value).startswith("out=")
