@@ -94,8 +94,9 @@ def _python_spelled(function=None, *, keywords=None, renamed=None):
     def spelled(*args, **kwargs):
         caught: list = []
         try:
+            # the caller's filters kept: what they hide (a library's DeprecationWarning) is not said again below,
+            # from the caller's line, where Python shows a DeprecationWarning of __main__
             with warnings.catch_warnings(record=True) as caught:
-                warnings.simplefilter("always")  # the caller's filters apply as they are said again below
                 return function(*args, **kwargs)
         except InputError as exc:
             raise InputError(spell(str(exc))) from None

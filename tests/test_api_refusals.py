@@ -213,3 +213,24 @@ def test_a_report_that_exists_says_force_as_the_method_takes_it(run, tmp_path):
     with pytest.raises(InputError, match=r"r\.md: the file exists \(add force= to replace it\)") as refused:
         run.report(tmp_path / "r.md")
     assert str(refused.value).startswith("out=")
+
+
+def test_a_warning_the_caller_s_filters_hide_stays_hidden(monkeypatch):
+    # the warnings said again from the caller's line must be those the caller's filters let through: a library's
+    # DeprecationWarning, hidden by Python's defaults, came out as one of the notebook's own (its __main__)
+    import warnings
+
+    from masonrycli import execute
+
+    check_run = execute.check_run
+
+    def with_a_library_warning(*args, **kwargs):
+        warnings.warn_explicit("a library's deprecation", DeprecationWarning, "somelib.py", 1, module="somelib")
+        return check_run(*args, **kwargs)
+
+    monkeypatch.setattr(execute, "check_run", with_a_library_warning)
+    with warnings.catch_warnings(record=True) as said:
+        warnings.simplefilter("ignore", DeprecationWarning)  # Python's defaults: shown for __main__ only
+        warnings.filterwarnings("default", category=DeprecationWarning, module=__name__)
+        api.simulate("wall", blocks=12, duration=0.002)
+    assert [str(w.message) for w in said if w.category is DeprecationWarning] == []
