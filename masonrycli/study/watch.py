@@ -18,6 +18,10 @@ ASK_TIMEOUT = 5.0
 """s a look waits for the scheduler's answer."""
 NO_ANSWER_WAIT = 30.0
 """s without an answer from the scheduler before the study says so."""
+STARTING_WAIT = 15.0
+"""s a worker this watch started again counts as still starting: twice the slowest start measured (7.1 s beside
+three busy loops, :data:`NO_WORKER_LIMIT`). One Dask drops again before any look sees it is then replaced at the
+first look after it (it would otherwise stay "starting" for ever, and the study give up at the limit)."""
 NO_WORKER_LIMIT = 60.0
 """s the study's own LocalCluster may have no worker, runs waiting, before the study gives them up (error rows
 that the same command runs again). A worker process started again in 1.3 s on a quiet machine and in up to 7.1 s
@@ -47,7 +51,7 @@ class WorkerWatch:
         self.warn = warn or (lambda line: None)
         self.cluster, self.give_up = cluster, give_up
         self.size = len(cluster.worker_spec) if cluster is not None else 0  # the workers the study asked for
-        self.asked: set = set()  # names of the workers this watch started again, until Dask lists them
+        self.asked: dict = {}  # name -> time.monotonic() this watch started it again, until Dask lists it
         self.restarts = 0
         self.joined = self.left = 0  # workers the scheduler said joined, left (:meth:`_event`)
         self.stop = threading.Event()
@@ -144,7 +148,8 @@ class WorkerWatch:
 
         cluster = self.cluster
         workers = dict(cluster.workers)
-        self.asked -= set(workers)
+        now = time.monotonic()
+        self.asked = {n: t for n, t in self.asked.items() if n not in workers and now - t < STARTING_WAIT}
         gone = [
             name
             for name in list(cluster.worker_spec)
@@ -153,27 +158,13 @@ class WorkerWatch:
         ]
         if not gone or self.stop.is_set():
             return
-        names = set()
         for name in gone:
             self.restarts += 1
             cluster.worker_spec.pop(name, None)
             cluster.worker_spec[f"again-{self.restarts}"] = cluster.new_spec  # as SpecCluster.new_worker_spec
-            names.add(f"again-{self.restarts}")
-        self.asked |= names
-        # Dask's loop closes the nannies no longer asked for and starts the new ones; one that fails to start is
-        # closed, and replaced at the next look. Its error is the watch's, not a traceback on the command's stderr.
-        cluster.loop.add_callback(_correct_state, cluster, self.asked, names)
-
-
-async def _correct_state(cluster, asked: set, names: set) -> None:
-    """The cluster's workers made those of its spec (what ``SpecCluster.scale`` asks its loop for), an
-    error kept quiet: the loop logged it ("Exception in callback … Nanny failed to start", a traceback).
-    ``names`` leave ``asked`` once their start has ended, however: one started and dropped again by Dask
-    between two looks (its worker died as it started: 3 runs of 4 of test_sweep_cluster's kill test, quiet)
-    was never seen, stayed asked for, and was never replaced; the cluster gave up at 60 s."""
-    try:
-        await cluster._correct_state()
-    except Exception:  # noqa: BLE001 - a worker that did not start: _restore sees its nanny closed
-        pass
-    finally:
-        asked -= names
+            self.asked[f"again-{self.restarts}"] = now
+        # Dask's loop closes the nannies no longer asked for and starts the new ones (``scale`` to the spec's own
+        # size adds and removes nothing: it is the public way to ask for that correction; distributed's private
+        # ``_correct_state`` is free to change in any release); one that fails to start is closed, and replaced
+        # at a later look.
+        cluster.scale(len(cluster.worker_spec))
