@@ -9,6 +9,7 @@ counted and named, so that a set of several damaged files is mended in one go.
 from __future__ import annotations
 
 import os
+from collections.abc import Callable
 from pathlib import Path
 
 from masonrycli.errors import NOT_A_FILE, InputError
@@ -125,15 +126,21 @@ def _esm_others(folder: Path) -> list[str]:
     """The warning naming a folder's ESM files of another series than acceleration, left out: an ESM download
     holds each component's ….ACC.ASC, ….VEL.ASC, ….DIS.ASC and spectra, and read all it ran each record twice
     (its acceleration and its velocity, two rows of one shaking) or stopped at the first displacement file."""
-    other = sorted(p.name for p in folder.iterdir() if p.is_file() and _esm_other(p))
+    other, names = _left_out(folder, _esm_other)
     if not other:
         return []
-    names = ", ".join(other[:3]) + (" …" if len(other) > 3 else "")
     return [
         f"--records {folder}: {len(other)} ESM file{'s' if len(other) > 1 else ''} of another series than "
         f"acceleration left out ({names}): a set folder takes each component's acceleration (….ACC.ASC); give a "
         "velocity file by its name to run it"
     ]
+
+
+def _left_out(folder: Path, left: Callable[[Path], bool]) -> tuple[list[str], str]:
+    """The names of a folder's files that ``left`` leaves out of a set, sorted, and the first three of them for a
+    warning ("a, b, c …")."""
+    other = sorted(p.name for p in folder.iterdir() if p.is_file() and left(p))
+    return other, ", ".join(other[:3]) + (" …" if len(other) > 3 else "")
 
 
 def _esm_other(path: Path) -> bool:
@@ -148,10 +155,9 @@ def _boreholes(folder: Path) -> list[str]:
     surface (….NS2, .EW2, .UD2) and borehole (….NS1, .EW1, .UD1: the motion at the sensor's depth, tens to
     hundreds of metres down, not the ground a structure stands on) files; read all, each shaking ran twice,
     once as its borehole record."""
-    other = sorted(p.name for p in folder.iterdir() if p.is_file() and _kik_borehole(p))
+    other, names = _left_out(folder, _kik_borehole)
     if not other:
         return []
-    names = ", ".join(other[:3]) + (" …" if len(other) > 3 else "")
     return [
         f"--records {folder}: {len(other)} KiK-net borehole file{'s' if len(other) > 1 else ''} left out ({names}): "
         "the motion at the sensor's depth, not at the ground surface; a set folder takes the surface ones (….NS2, "
