@@ -97,7 +97,7 @@ def trim_overlaps(assembly: Assembly, depth: float, counts: dict | None = None) 
             continue
         xy = np.asarray(body.polygon.exterior.coords)[:-1]
         for normal, c in body_cuts:
-            xy = _clip(xy, normal, c)
+            xy = clip_half_plane(xy, normal, c)
         polygon = normalised_polygon(xy, labels[k])
         lost = 1.0 - polygon.area / body.polygon.area
         worst = max(worst, (lost, labels[k]))
@@ -127,7 +127,7 @@ def _chord(a: Polygon, b: Polygon) -> tuple[np.ndarray, np.ndarray]:
     return p, np.array([-along[1], along[0]])
 
 
-def _clip(xy: np.ndarray, normal: np.ndarray, c: float) -> np.ndarray:
+def clip_half_plane(xy: np.ndarray, normal: np.ndarray, c: float) -> np.ndarray:
     """The convex ring ``xy`` (k, 2) clipped to the half-plane n·x ≥ c (Sutherland–Hodgman, one edge)."""
     s = xy @ normal - c
     out = []

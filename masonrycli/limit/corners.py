@@ -39,6 +39,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from geometry_library.trim import clip_half_plane
+
 CORNER_RADIUS = 0.02
 """m: the rounding radius of a block's corners (a chipped arris of a dressed stone; UDEC's rounding length is
 of this order, ~1 % of a block's size). A survey's 1 mm error then turns a corner-to-corner normal by ≲ 3°."""
@@ -57,17 +59,7 @@ def eroded(vertices: np.ndarray, radius: float) -> np.ndarray:
     for n, c in zip(normal, offset):
         if out.shape[0] == 0:
             break
-        s = out @ n - c  # > 0: outside the shifted half-plane
-        nxt = np.roll(out, -1, axis=0)
-        s_next = np.roll(s, -1)
-        points = []
-        for k in range(out.shape[0]):
-            if s[k] <= 0.0:
-                points.append(out[k])
-            if (s[k] <= 0.0) != (s_next[k] <= 0.0):
-                t = s[k] / (s[k] - s_next[k])
-                points.append(out[k] + t * (nxt[k] - out[k]))
-        out = np.array(points, dtype=np.float64).reshape(-1, 2)
+        out = clip_half_plane(out, -n, -c).reshape(-1, 2)  # keep n·x ≤ c: inside the shifted edge
     return out
 
 
