@@ -9,6 +9,10 @@ For each recording found in RUN_DIR: the whole window at the paper's instant (th
 first paper-figure tab), the structure panel of each of the four paper-figure tabs (pinned to the paper's
 instant), the magnified deformed shape and the joint states at the last frame. Prints the views' error
 reports (``[]`` when healthy) and the files written.
+
+A limit analysis's recording (``masonry limit arch --out limit-arch.rrd``, run in RUN_DIR) gives
+docs/images/limit-arch.png (README, docs/limit.md): the whole window as the recording opens (the mechanism
+beside the arch, its colour bar and the Limit analysis panel), what a reader sees first.
 """
 
 from __future__ import annotations
@@ -44,9 +48,22 @@ STRUCTURE_PANEL = (
 WINDOW_WIDTH = 1440  # the whole-window images are downscaled to this width
 
 
+def _window(rrd: Path, target: Path, **where) -> None:
+    """The whole window of ``rrd`` (``screenshot_recording``'s ``where``: an instant, or at open), downscaled to
+    WINDOW_WIDTH, saved as ``target``; the views' reports printed."""
+    with tempfile.TemporaryDirectory() as tmp:
+        window = Path(tmp) / "window.png"
+        print(f"{rrd}: {screenshot_recording(rrd, window, timeout=300, tabs_dir=tmp, **where)}")
+        image = Image.open(window).convert("RGB")
+        image.resize((WINDOW_WIDTH, round(image.height * WINDOW_WIDTH / image.width))).save(target, optimize=True)
+        print(f"  {target}")
+
+
 def main(run_dir: str, out_dir: str) -> None:
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
+    if (Path(run_dir) / "limit-arch.rrd").exists():  # a limit analysis opens on its one view: shown at open
+        _window(Path(run_dir) / "limit-arch.rrd", out / "limit-arch.png", at_open=True)
     for name, (instant, stem, tabs) in SHOTS.items():
         rrd = Path(run_dir) / f"{name}.rrd"
         if not rrd.exists():
