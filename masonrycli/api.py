@@ -29,135 +29,22 @@ Why a module of its own and not names in ``masonrycli/__init__.py``: that packag
 
 from __future__ import annotations
 
-import difflib
-import functools
 import io
 import os
 import warnings
 import weakref
-from dataclasses import dataclass, field
-from pathlib import Path
 
 import numpy as np
 
+from masonrycli.api_keywords import all_keywords as _keywords  # noqa: F401 (tests read them as api._keywords)
+from masonrycli.api_keywords import check_names as _check_names
+from masonrycli.api_keywords import one_value_each as _one_value_each
+from masonrycli.api_keywords import option_names as _option_names  # noqa: F401 (and api._option_names)
+from masonrycli.api_keywords import path_value as _path
+from masonrycli.api_keywords import pga_value as _pga
+from masonrycli.api_keywords import python_spelled as _python_spelled
+from masonrycli.api_run import Run  # api.Run: what simulate returns
 from masonrycli.errors import InputError
-
-_SIMULATE_GROUPS = {  # the option groups of `masonry simulate NAME` (cli/app.py), by built-in
-    "wall": ("WALL", "WALL_LOADING"),
-    "arch": ("ARCH", "SETTLED_LOADING"),
-    "aqueduct": ("AQUEDUCT", "SETTLED_LOADING"),
-}
-
-
-def _option_names(target) -> list[str]:
-    """The keywords ``target`` takes: the options of ``masonry simulate NAME`` for a built-in, of ``masonry run``
-    for a file, and the run settings and friction for a :class:`Scenario` already made (its loading is made with
-    it: a record given to it would run for its duration, where ``simulate("wall", record=…)`` runs the record)."""
-    from masonrycli.cli import options
-    from masonrycli.scenario.target import is_built_in
-
-    groups = ["RUN", "FRICTION"]
-    if isinstance(target, (str, os.PathLike)) and is_built_in(target):
-        groups += ["RECORD", *_SIMULATE_GROUPS[os.fspath(target)], "BLOCK_MATERIAL", "SIMULATE_SETTLE"]
-    elif isinstance(target, (str, os.PathLike)):
-        groups += ["RECORD", "SURVEY", "SETTLE"]
-    return [name for group in groups for name in getattr(options, group)]
-
-
-@functools.cache
-def _keywords() -> frozenset[str]:
-    """Every keyword of :func:`scenario` and :func:`simulate`, whatever the target: the options the messages name."""
-    from masonrycli.cli import options
-
-    groups = ["RUN", "FRICTION", "RECORD", "SURVEY", "SETTLE", "BLOCK_MATERIAL", "WALL", "WALL_LOADING", "ARCH"]
-    groups += ["SETTLED_LOADING", "AQUEDUCT", "SIMULATE_SETTLE"]
-    names = {name for group in groups for name in getattr(options, group)}
-    return frozenset(names | set(_OUTPUTS) | {"recording"})
-
-
-def _python_spelled(function=None, *, keywords=None, renamed=None):
-    """``function`` with the options its errors and warnings name spelled as its keywords (``duration=``, where
-    the command line says ``--duration``): the same messages (:mod:`masonrycli.option_spelling`). Its warnings
-    are said as it returns or raises, from the caller's line. ``keywords`` / ``renamed``: a method's own (default:
-    scenario's and simulate's, ``--out`` as ``recording=``)."""
-    from masonrycli.option_spelling import RENAMED, python_spelling
-
-    if function is None:
-        return functools.partial(_python_spelled, keywords=keywords, renamed=renamed)
-
-    def spell(text: str) -> str:
-        return python_spelling(
-            text, _keywords() if keywords is None else keywords, RENAMED if renamed is None else renamed
-        )
-
-    @functools.wraps(function)
-    def spelled(*args, **kwargs):
-        caught: list = []
-        try:
-            # the caller's filters kept: what they hide (a library's DeprecationWarning) is not said again below,
-            # from the caller's line, where Python shows a DeprecationWarning of __main__
-            with warnings.catch_warnings(record=True) as caught:
-                return function(*args, **kwargs)
-        except InputError as exc:
-            raise InputError(spell(str(exc))) from None
-        finally:
-            for said in caught:
-                warnings.warn(spell(str(said.message)), said.category, stacklevel=2)
-
-    return spelled
-
-
-_OUTPUTS = {  # the command line's output options, which simulate() names otherwise
-    "out": "the recording is simulate(recording=PATH)",
-    "no_recording": "simulate() writes no recording unless recording= names one",
-    "force": "force= is simulate()'s, with recording= or history=",
-    "history": "history= is simulate()'s",
-    "magnify": "magnify= is simulate()'s, with recording=",
-    "stop_at_collapse": "stop_at_collapse= is simulate()'s",
-}
-
-
-def _check_names(target, given: dict) -> None:
-    """Refuse a keyword the command does not take, as its command line refuses the option (one line)."""
-    known = _option_names(target)
-    for key in given:
-        if key not in known:
-            close = difflib.get_close_matches(key, known, n=3)
-            what = os.fspath(target) if isinstance(target, (str, os.PathLike)) else "a Scenario already made"
-            hint = f"did you mean {', '.join(close)}?" if close else f"its options: {', '.join(known)}"
-            if not isinstance(target, (str, os.PathLike)):
-                hint = "it takes run settings and friction; its structure and loading are given to api.scenario()"
-            hint = _OUTPUTS.get(key, hint)
-            raise InputError(f"no such option: {key}= for {what} ({hint})")
-
-
-def _one_value_each(options: dict) -> None:
-    """Refuse several values for one keyword (``freq=[1, 2, 3]``: a run takes one), saying how to run them all:
-    it said "--freq: frequency = [1, 2, 3]: must be a number", and a student took it for a wrong type."""
-    for key, value in options.items():
-        if isinstance(value, (list, tuple, range, np.ndarray)) and np.size(value) > 1:
-            values = [f"{v:g}" if isinstance(v, float) else str(v) for v in np.ravel(value)]
-            listed = ",".join(values[:3]) + (",…" if len(values) > 3 else "")
-            raise InputError(
-                f"{key}: {len(values)} values ({listed}): one run takes one value; loop over them (for {key} in …: "
-                f"api.simulate(…, {key}={key})) or run a study, masonry sweep --param {key}={listed} (masonry docs "
-                "python, 'Looping over parameters')"
-            )
-
-
-def _path(value, option: str, *, output: bool = False) -> Path:
-    """A path keyword read by the command line's own parser of ``option`` (``~`` expanded, an empty one refused;
-    an output's "x.rrd/" names a folder, where Path("x.rrd/") would have written the file x.rrd)."""
-    import typer
-
-    from masonrycli.cli.option_values import file_path_value, path_value
-
-    if not isinstance(value, (str, os.PathLike)):
-        raise InputError(f"{option} {value!r}: a path (str or pathlib.Path), not a {type(value).__name__}")
-    try:
-        return (file_path_value if output else path_value)(os.fspath(value))
-    except typer.BadParameter as exc:
-        raise InputError(f"{option}: {exc.message}") from None
 
 
 @_python_spelled
@@ -232,18 +119,6 @@ def _call(function: str, target, options: dict) -> str:
     a history of it keeps as its ``command`` (a command line's keeps the ``masonry …`` line)."""
     given = [f"{k}={_argument(v)}" for k, v in options.items() if v is not None]
     return f"api.{function}({', '.join([_argument(target), *given])})"
-
-
-def _pga(value) -> float | None:
-    """``pga=``: a number in g, or a string as ``--pga`` takes it ("0.25g", "2.45m/s2"); None: not given."""
-    from masonrycli.records.pga import pga_in_g
-
-    if value is None:
-        return None
-    try:
-        return pga_in_g(value)
-    except InputError as exc:
-        raise InputError(f"--pga {exc}") from None
 
 
 class _FrameCallback:
@@ -374,123 +249,3 @@ def view(recording):
     if problem:
         raise InputError(problem)
     return subprocess.Popen([rerun_command(), os.fspath(path)])
-
-
-@dataclass(frozen=True, eq=False)
-class Run:
-    """A run's history: ``run["block_q"]`` is the array of that name in the ``.npz`` (T frames, N blocks, S
-    supports, J joints; ``run.unit(name)`` its unit), and a few views of them."""
-
-    arrays: dict
-    """Every array of the history, by name, as the ``.npz`` holds them (``units`` and ``run`` too)."""
-    outcome: dict | None = None
-    """The structure's state (``state``: intact, damaged or collapsed; ``collapse_time`` s, NaN if none;
-    ``peak_drift``, ``residual_drift`` × height; ``hinges``; ``max_opening`` m; …: docs/collapse.md); of a
-    history read from a file, the keys it keeps (:func:`read_history`), or None for an older file."""
-    recording: Path | None = None
-    """The recording written, or None."""
-    history: Path | None = None
-    """The history file written (or read), or None."""
-    summary: str = field(default="", repr=False)
-    """The command line's end-of-run table, as text ("" for a history read from a file)."""
-
-    def __getitem__(self, name: str) -> np.ndarray:
-        if name not in self.arrays:
-            close = difflib.get_close_matches(name, list(self.arrays), n=3)
-            raise KeyError(f"{name!r}: no such array" + (f" (did you mean {', '.join(close)}?)" if close else ""))
-        return self.arrays[name]
-
-    def __repr__(self) -> str:
-        state = f", {self.outcome['state']}" if self.outcome else ""
-        return (
-            f"<masonry Run: {self.status}{state}, {len(self.block_names)} blocks, {len(self.time)} frames to "
-            f"t = {self.time[-1] if len(self.time) else 0:g} s>"
-        )
-
-    def unit(self, name: str) -> str:
-        """The unit / meaning of array ``name`` (the history's ``units`` table)."""
-        self[name]  # noqa: B018 (an unknown name is a KeyError that says so)
-        return self.units.get(name, "")
-
-    @property
-    def units(self) -> dict[str, str]:
-        return {str(k): str(v) for k, v in self.arrays.get("units", np.zeros((0, 2), dtype=str))}
-
-    @property
-    def time(self) -> np.ndarray:
-        """(T,) s, the recorded frames' times."""
-        return self.arrays["time"]
-
-    @property
-    def status(self) -> str:
-        """completed, interrupted, diverged or failed."""
-        return str(self.arrays.get("status", ""))
-
-    @property
-    def note(self) -> str:
-        """Where and why the run stopped ("" when it ran all its steps)."""
-        return str(self.arrays.get("note", ""))
-
-    @property
-    def block_names(self) -> list[str]:
-        return [str(n) for n in self.arrays["block_name"]]
-
-    @property
-    def support_names(self) -> list[str]:
-        return [str(n) for n in self.arrays["support_name"]]
-
-    @property
-    def displacement(self) -> np.ndarray:
-        """(T, N, 3) each block's centroid displacement from t = 0, x and y (m), and rotation (rad, CCW)."""
-        q = self.arrays["block_q"]
-        return q - q[:1]
-
-    def block(self, name: str) -> int:
-        """The index of block ``name`` on every block axis."""
-        names = self.block_names
-        if name not in names:
-            close = difflib.get_close_matches(name, names, n=3)
-            raise InputError(f"no block {name!r}" + (f" (did you mean {', '.join(close)}?)" if close else ""))
-        return names.index(name)
-
-    def hinged_joints(self, frame: int = -1) -> list[str]:
-        """The joints hinged at ``frame`` (default the last), named ``"a|b"`` as the run's summary names them."""
-        from masonrycli.model import JOINT_SEPARATOR
-
-        names = self.block_names + self.support_names
-        body = self.arrays["joint_body"][self.arrays["joint_hinged"][frame]]
-        return [f"{names[a]}{JOINT_SEPARATOR}{names[b]}" for a, b in body]
-
-    @_python_spelled(
-        keywords={"blocks", "courses", "top", "ground", "relative"},
-        renamed={"course": "courses", "absolute": "relative"},
-    )
-    def table(self, *, blocks=(), courses=(), top: bool = False, ground: str | None = None, relative: bool = True):
-        """``masonry export``'s columns, name (with its unit) → (T,) array: the ground's motion, each target's
-        (a block by name, a course by number from the bottom, the top course) displacement, velocity and
-        acceleration relative to the ground (``relative=False``: absolute), ``drift ratio (-)``, base shear,
-        overturning moment, hinges, energies (``masonry docs readme``, "Export a history as CSV"). Without
-        targets, the top course. ``pandas.DataFrame(run.table())`` makes it a frame."""
-        from masonrycli.outputs.export import export_table
-
-        table = export_table(
-            self.arrays, blocks=list(blocks), course_numbers=list(courses), top=top, ground=ground, relative=relative
-        )
-        for note in table.notes:
-            warnings.warn(note, UserWarning, stacklevel=2)
-        return dict(zip(table.names, table.values))
-
-    @_python_spelled(keywords={"out", "force"}, renamed={})
-    def report(self, out=None, *, force: bool = False) -> str:
-        """``masonry report``'s one-page Markdown of the run (what was run, the ground motion as applied, the
-        state, peak and residual drift, hinged joints, unconverged steps: the summary's numbers). ``out``: a
-        ``.md`` path to write it to, with its figure beside it (``.png``), refused if it exists unless
-        ``force=True``, as ``masonry report H.npz --out R.md``."""
-        from masonrycli.outputs.run_report import check_outputs, report_markdown, write_report
-
-        shown = str(self.history) if self.history is not None else "the run"
-        if out is None:
-            return report_markdown(self.arrays, shown)
-        page, picture = check_outputs(_path(out, "--out", output=True), force)
-        write_report(self.arrays, shown, page, picture)
-        return page.path.read_text(encoding="utf-8")

@@ -9,12 +9,8 @@ is renamed into place, so what was computed is kept and a path never holds half 
 from __future__ import annotations
 
 import contextlib
-import ntpath
-import os
 import platform
-import re
 import shlex
-import shutil
 import sys
 import warnings
 from dataclasses import dataclass, field
@@ -23,121 +19,30 @@ from pathlib import Path
 
 import numpy as np
 from rich.console import Console
-from rich.text import Text
 
 from masonrycli import SOURCE_DIGEST, __version__
 from masonrycli.engine import compile_ahead
 from masonrycli.errors import InputError
 from masonrycli.interrupt import StopSignals
-from masonrycli.outputs.files import (
-    OutputFile,
-    check_distinct,
-    check_output,
-    check_space,
-    default_recording_path,
-    open_part,
+
+# what execute.py held before (the callers and tests import them from here): the outputs planned before a run,
+# what the command line says at its end, the viewer's line
+from masonrycli.output_plan import (  # noqa: F401
+    MAX_MAGNIFY,
+    Outputs,
+    check_magnify,
+    check_run,
+    output_sizes,
+    plan_outputs,
 )
+from masonrycli.outputs.files import OutputFile, open_part
 from masonrycli.outputs.history import History, HistoryFile, block_constants, result_values
-from masonrycli.outputs.report import progress_bar, slow_start_notice, summary_table
+from masonrycli.outputs.report import progress_bar, slow_start_notice
 from masonrycli.outputs.sinks import COMPLETED, FAILED
 from masonrycli.run import RunResult, Simulation, simulate
-from masonrycli.scenario.values import option_text
+from masonrycli.run_summary import print_summary, result_warning, unconverged_warning  # noqa: F401
 from masonrycli.source_digest import source_commit
-
-HISTORY_BYTES_PER_BLOCK = 500
-"""Upper estimate of one block's share of a history row (measured: 326 B for the walls, 420 B for an arch of
-60 voussoirs, whose blocks have more joints)."""
-HISTORY_STATIC_BYTES = 60_000
-"""... and of what a history holds however short (names, joints, intensity measures, the run's result; its
-``units`` table alone is 43 kB: 61 rows of two 89-character UTF-32 cells, measured 2026-11-29)."""
-RECORDING_BYTES_PER_BLOCK = 500
-"""Upper estimate of one block's share of a recorded frame (measured: 405 B for the walls)."""
-FRAME_OVERHEAD_BYTES = 2000
-RECORDING_STATIC_BYTES = 750_000
-"""Upper estimate of what a recording holds however short: blueprint, legends, document, static geometry
-(measured: 452 kB for the 51-block wall's 10 steps, 548 kB for the aqueduct's 2; without it a 0.1 s run
-was let start on a disk it then filled, exit 4). Re-measured 2026-11-29 (c5b6ab5): 678 kB for the wall's 2
-steps, 763 kB for the aqueduct's; the wall's 0.3 s at --record-every 100 wrote 815–835 kB against the 600 kB
-constant's estimate of 813 kB (test_execute's size test failed in CI)."""
-RECORDING_STATIC_BYTES_PER_BLOCK = 300
-"""... and its share per block (measured: 703 kB for 1004 blocks and 2 steps, one frame of ~400 kB in it)."""
-RECORDING_BYTES_PER_STEP = 200
-"""Upper estimate of the per-step series (solver sweeps, residual, contacts: measured ~150 B a step for
-the wall at --record-every 1000, 603 kB for 1000 steps)."""
-
-
-@dataclass
-class Outputs:
-    """The run's output files, checked (see :func:`plan_outputs`); None where not written."""
-
-    recording: OutputFile | None = None
-    history: OutputFile | None = None
-
-    def files(self) -> list[OutputFile]:
-        return [o for o in (self.recording, self.history) if o is not None]
-
-
-MAX_MAGNIFY = 1e6
-"""Largest --magnify: beyond it a millimetre is drawn a kilometre long (1e300 overflowed the recording's
-float32 coordinates to inf, with a RuntimeWarning)."""
-
-
-def check_run(
-    scenario, out: Path | None, history: Path | None, *, no_recording: bool, force: bool, magnify: float | None
-) -> Outputs:
-    """Everything checked before a run (what ``masonry check`` stops after): the time step against the
-    supports' motions, ``--magnify``, then the outputs (:func:`plan_outputs`). Raises InputError."""
-    from masonrycli.scenario.sampling import check_sampling
-
-    check_sampling(scenario)
-    check_magnify(magnify, no_recording)
-    return plan_outputs(scenario, out, history, no_recording=no_recording, force=force)
-
-
-def check_magnify(magnify: float | None, no_recording: bool) -> None:
-    if magnify is not None and not 1.0 <= magnify <= MAX_MAGNIFY:
-        raise InputError(f"--magnify {option_text(magnify)}: must be between 1 and {MAX_MAGNIFY:g}")
-    if magnify is not None and no_recording:  # it was ignored, as --out was: nothing draws the shape
-        raise InputError(
-            f"--magnify {option_text(magnify)} with --no-recording: choose one (it draws in the recording)"
-        )
-
-
-def plan_outputs(scenario, out: Path | None, history: Path | None, *, no_recording: bool, force: bool) -> Outputs:
-    """Check the output paths and the free space before anything is computed (raises InputError)."""
-    if no_recording and out is not None:  # it was ignored: the recording asked for was silently not written
-        raise InputError(f"--out {out} with --no-recording: choose one")
-    rec = None
-    if not no_recording:
-        if out is None:
-            # checked as --out is: a file named "recordings" here gave "internal error: NotADirectoryError"
-            path = default_recording_path(scenario.name)
-            try:
-                rec = check_output(path, "--out", ".rrd", False, default_name=True)
-            except InputError as exc:
-                problem = str(exc).removeprefix(f"--out {path}: ")
-                raise InputError(
-                    f"the default recording {path}: {problem} (give --out R.rrd, or --no-recording)"
-                ) from None
-        else:
-            rec = check_output(out, "--out", ".rrd", force)
-    hist = check_output(history, "--history", ".npz", force) if history is not None else None
-    check_distinct(rec, hist)
-    check_space([(o, size) for o, size in zip((rec, hist), output_sizes(scenario)) if o is not None])
-    return Outputs(rec, hist)
-
-
-def output_sizes(scenario) -> tuple[int, int]:
-    """Upper estimates of the recording's and the history's sizes, bytes (what check_space compares)."""
-    steps, n = scenario.run.n_steps, scenario.assembly.block_count
-    frames = steps // scenario.run.record_every + 2
-    recording = (
-        RECORDING_STATIC_BYTES
-        + RECORDING_STATIC_BYTES_PER_BLOCK * n
-        + RECORDING_BYTES_PER_STEP * steps
-        + frames * (RECORDING_BYTES_PER_BLOCK * n + FRAME_OVERHEAD_BYTES)
-    )
-    return recording, HISTORY_STATIC_BYTES + frames * (HISTORY_BYTES_PER_BLOCK * n + FRAME_OVERHEAD_BYTES)
+from masonrycli.viewer_command import in_powershell, open_command, rerun_command  # noqa: F401
 
 
 @dataclass
@@ -369,111 +274,3 @@ def _close_all(sinks: dict, status: str, note: str, result) -> tuple[list[Output
     if errors and result is not None and result.status == COMPLETED:
         result.status, result.message = FAILED, f"output failed: {errors[0]}"
     return written, errors
-
-
-_STALLED = {
-    "nlgs": "no lower residual in 10 000 sweeps by faces",
-    "nlgs-accel": "every method of the stalled-step round-robin gave up above it",
-    "nlgs-accel32": "every method of the stalled-step round-robin gave up above it",
-}
-"""What a step that ends unconverged below the cap went through, by solver (engine/nlgs.py, stalled.py)."""
-
-
-def unconverged_warning(unconverged: int, steps: int, capped: int, run, worst: tuple[float, int] | None = None) -> str:
-    """The warning's text for ``unconverged`` of ``steps`` steps, ``capped`` of them at the sweep cap of
-    ``run`` (a RunConfig); the rest stalled. It said "20 at the 2-sweep cap, the others stalled: every method
-    … gave up" when there were no others. ``worst``: the largest residual (m/s) and its step (1-based), said
-    with its time and its multiple of the tolerance, so that a user knows how far off and where to look."""
-    stalled = unconverged - capped
-    why = [f"{capped} at the {run.max_iterations}-sweep cap"] if capped else []
-    if stalled:
-        why.append(f"{'the other ' if capped else ''}{stalled} stalled: {_STALLED[run.solver]}")
-    if worst is not None and worst[1] > 0 and worst[0] == worst[0]:  # not before a step, not NaN
-        residual, step = worst
-        ratio = residual / run.tolerance
-        times = f"{ratio:.2g}" if ratio < 10 else f"{ratio:.0f}"  # 1.4×, 64×, 637× (not 6.4e+02×)
-        why.append(f"the worst {residual:.3g} m/s ({times}× the tolerance) at t = {step * run.dt:g} s")
-    advice = "Raise --max-iterations for capped steps, or check" if capped else "Check"
-    return (
-        f"{unconverged} of {steps} steps ended unconverged (contact-law residual above --tolerance "
-        f"{run.tolerance:g} m/s; {', '.join(why)}); their impulses and motion are approximate. "
-        f"{advice} the history's nlgs_residual."
-    )
-
-
-def result_warning(result, run) -> str | None:
-    """The warning a run's ``result`` gets after its summary (``run``: its RunConfig): how many steps ended
-    unconverged, or None when every step converged. The command line prints it; the Python API warns it."""
-    if result is None or not result.unconverged:
-        return None
-    tally = result.tally
-    worst = (tally.residual_max, tally.residual_max_step)
-    return unconverged_warning(result.unconverged, result.steps, tally.capped, run, worst)
-
-
-def print_summary(console: Console, outcome: Outcome, scenario, hint: str = "") -> None:
-    """The summary table, the optional ``hint``, and last the command that opens the recording."""
-    result = outcome.result
-    paths = {o.option: str(o.path) for o in outcome.written}
-    console.print(summary_table(result, paths.get("--out"), paths.get("--history"), scenario.name))
-    if (text := result_warning(result, scenario.run)) is not None:
-        console.print(Text.assemble(("warning: ", "bold red"), text), soft_wrap=True)
-    if hint and "--out" in paths:
-        console.print(hint, soft_wrap=True)
-    if "--out" in paths:
-        command = open_command(paths["--out"])
-        console.print(Text.assemble("Open the recording:  ", (command, "bold")), soft_wrap=True)
-
-
-def open_command(recording, *, windows: bool = os.name == "nt", environ=os.environ) -> str:
-    """The line that opens ``recording`` in the viewer, quoted for this system's shell ("rerun my runs/w.rrd"
-    opened "my" and "runs/w.rrd"). On Windows with double quotes, which cmd.exe and PowerShell both read
-    (shlex's '…', taken for a backslash, so every default path 'recordings\\wall-….rrd', are no quotes to
-    cmd.exe); a quoted viewer ("C:\\Users\\Ana Silva\\…\\rerun.exe") is a string to PowerShell, run only
-    after its call operator &, which cmd.exe refuses: in PowerShell (:func:`in_powershell`) the line starts
-    with "& ". An unquoted viewer needs no operator, so that line runs in either."""
-    if not windows:
-        return shlex.join([rerun_command(windows=windows), os.fspath(recording)])
-    viewer, path = (_windows_word(text) for text in (rerun_command(windows=windows), os.fspath(recording)))
-    call = "& " if viewer.startswith('"') and in_powershell(environ) else ""
-    return f"{call}{viewer} {path}"
-
-
-_PLAIN_WORD = re.compile(r"[\w.:\\/+=~-]+")
-"""What cmd.exe and PowerShell both read as one literal word; anything else goes between double quotes
-(a space, and the characters either shell gives a meaning outside quotes: ' & ( ) ; , @ { } ^ < > |)."""
-
-
-def _windows_word(text: str) -> str:
-    return text if _PLAIN_WORD.fullmatch(text) else f'"{text}"'
-
-
-def in_powershell(environ=os.environ) -> bool:
-    """Whether this process most likely runs in a PowerShell window: PowerShell (5.1 and 7) adds the user's
-    own module folder (under %USERPROFILE%, Documents\\WindowsPowerShell\\Modules or
-    Documents\\PowerShell\\Modules) to PSModulePath at start, which the machine's value, the one cmd.exe
-    started from the Start menu gets, does not hold. A cmd.exe started from PowerShell inherits it: the
-    line is then PowerShell's."""
-    home = environ.get("USERPROFILE", "").rstrip("\\/")
-    if not home:
-        return False
-    home = ntpath.normcase(home) + "\\"
-    return any(ntpath.normcase(p).startswith(home) for p in environ.get("PSModulePath", "").split(";") if p)
-
-
-def rerun_command(*, windows: bool = os.name == "nt") -> str:
-    """How to start the viewer from here: ``rerun`` if it is on PATH, else the one beside this Python (on
-    Windows ``Scripts\\rerun.exe``: a ``rerun`` there does not exist, and "rerun" alone is not found in a
-    venv not activated), relative to the working folder when it is below it (``.venv/bin/rerun``)."""
-    if shutil.which("rerun"):
-        return "rerun"
-    beside = Path(sys.executable).parent / ("rerun.exe" if windows else "rerun")
-    if not beside.exists():
-        return "rerun"
-    try:
-        below = os.path.relpath(beside)
-    except ValueError:  # on another drive
-        return str(beside)
-    if below.startswith(os.pardir):
-        return str(beside)
-    return os.path.join(os.curdir, below) if windows or os.sep not in below else below  # PowerShell: .\x.exe

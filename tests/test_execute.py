@@ -21,7 +21,7 @@ from rich.console import Console
 from shapely.geometry import box
 
 from geometry_library.blocks import Assembly, Block, Support
-from masonrycli import SOURCE_DIGEST
+from masonrycli import SOURCE_DIGEST, viewer_command
 from masonrycli import execute as execute_module
 from masonrycli.errors import InputError
 from masonrycli.execute import check_run, execute, plan_outputs, unconverged_warning
@@ -247,12 +247,12 @@ def test_the_open_command_runs_where_the_student_is(tmp_path, monkeypatch):
     """A class on Windows, the venv not activated: the last line said "rerun 'recordings\\wall-….rrd'" — no
     rerun on PATH, and '…' are no quotes to cmd.exe (shlex quoted every default path for its backslash);
     its viewer is Scripts\\rerun.exe. On any system the viewer below the working folder is named from there."""
-    monkeypatch.setattr(execute_module.shutil, "which", lambda name: None)
+    monkeypatch.setattr(viewer_command.shutil, "which", lambda name: None)
     for system, folder, viewer in ((True, "Scripts", "rerun.exe"), (False, "bin", "rerun")):
         scripts = tmp_path / "class" / ".venv" / folder
         scripts.mkdir(parents=True)
         (scripts / viewer).touch()
-        monkeypatch.setattr(execute_module.sys, "executable", str(scripts / "python"))
+        monkeypatch.setattr(viewer_command.sys, "executable", str(scripts / "python"))
         monkeypatch.chdir(tmp_path / "class")
         rrd = os.path.join("recordings", "wall-20261129-082048.rrd")
         command = execute_module.open_command(rrd, windows=system)
@@ -372,11 +372,11 @@ def test_the_open_command_calls_a_quoted_viewer_in_powershell(tmp_path, monkeypa
     """A student in "C:\\Users\\Ana Silva" whose venv is not below the working folder: the line was
     '"C:\\…\\Scripts\\rerun.exe" "my runs\\w.rrd"', right in cmd.exe, but in PowerShell a quoted path is a
     string ("Unexpected token"): it runs after the call operator, '& "…\\rerun.exe" "…"', which cmd.exe refuses."""
-    monkeypatch.setattr(execute_module.shutil, "which", lambda name: None)
+    monkeypatch.setattr(viewer_command.shutil, "which", lambda name: None)
     scripts = tmp_path / "Ana Silva" / ".venv" / "Scripts"
     scripts.mkdir(parents=True)
     (scripts / "rerun.exe").touch()
-    monkeypatch.setattr(execute_module.sys, "executable", str(scripts / "python.exe"))
+    monkeypatch.setattr(viewer_command.sys, "executable", str(scripts / "python.exe"))
     monkeypatch.chdir(tmp_path)
     monkeypatch.setenv("USERPROFILE", r"C:\Users\Ana Silva")
     if modules is None:
@@ -398,7 +398,7 @@ def test_the_open_command_calls_a_quoted_viewer_in_powershell(tmp_path, monkeypa
 def test_the_open_command_quotes_what_either_windows_shell_would_read_otherwise(monkeypatch):
     # list2cmdline quoted only spaces: "rerun it's.rrd" is an unclosed string to PowerShell, "rerun a&b.rrd"
     # two commands to cmd.exe
-    monkeypatch.setattr(execute_module.shutil, "which", lambda name: "rerun")
+    monkeypatch.setattr(viewer_command.shutil, "which", lambda name: "rerun")
     for name in ("it's.rrd", "a&b.rrd", "w (2).rrd", "x;y.rrd"):
         assert execute_module.open_command(name, windows=True) == f'rerun "{name}"'
     assert execute_module.open_command(r"C:\runs\w-1_a.rrd", windows=True) == r"rerun C:\runs\w-1_a.rrd"
