@@ -1,6 +1,8 @@
 """Rerun recording of a run: the only package that imports rerun.
 
 - ``recorder``: ``Recorder`` writes one run's ``.rrd`` from its frames; ``RecordingStatic`` is its input.
+- ``scales`` (joint-resultant and glyph scales fixed once a run), ``reach`` (how far the drawing reached: the
+  view at close) and ``run_panels`` (the Run panel and the Legend logged): the recorder's parts.
 - ``batching``: when the recorder sends what it buffered (batch sizes, every second, steps' health).
 - ``layout``: entity paths, field specs, colours, scale constants, the default blueprint, the paper's tabs.
 - ``field_colours``: each field's colour range followed frame by frame, block colours and legend labels.

@@ -48,9 +48,7 @@ from masonrycli.outputs.frame import Frame
 from masonrycli.outputs.sinks import COMPLETED, FAILED, INTERRUPTED, RUNNING
 from masonrycli.recording.arrays import FrameBatch, Polygons, own_centroids, posed_points, time_indexes
 from masonrycli.recording.batching import Batching, initial_frames, io_errors, steps_due
-from masonrycli.recording.carried_fill import CarriedFill, ColumnArrays, fill_legend, magnified_fill_note
-from masonrycli.recording.colormap import nice_ceil, robust_max_abs
-from masonrycli.recording.document import legend_lines, legend_markdown, run_document, viewer_safe_text
+from masonrycli.recording.carried_fill import CarriedFill, ColumnArrays
 from masonrycli.recording.field_colours import FieldColours
 from masonrycli.recording.fills import send_blocks, send_supports
 from masonrycli.recording.layout import (
@@ -62,14 +60,9 @@ from masonrycli.recording.layout import (
     GLYPH_HALF_LENGTH,
     INSET,
     INSET_BLOCK_CAP,
-    LEGEND,
     LEGEND_BARS,
     LEGEND_LABELS,
-    METADATA,
     RESULTANT_CAP,
-    RESULTANT_LENGTH,
-    RESULTANT_PERCENTILE,
-    ROBUST_PERCENTILE,
     SCALARS,
     TENSOR_KEYS,
     XY,
@@ -78,8 +71,11 @@ from masonrycli.recording.layout import (
 )
 from masonrycli.recording.magnified import PoseSpool, send_magnified
 from masonrycli.recording.overlays import frame_joint_resultants, send_axes, send_joints
+from masonrycli.recording.reach import Reach
 from masonrycli.recording.readback import check_complete, wait_written
 from masonrycli.recording.residual_range import ResidualRange
+from masonrycli.recording.run_panels import PanelFacts, log_run_panels
+from masonrycli.recording.scales import fix_scales
 from masonrycli.recording.series import send_series, send_steps, support_velocity_range
 from masonrycli.recording.static_content import (
     RecordingStatic,
@@ -141,12 +137,9 @@ class Recorder:
         size = (np.maximum.reduceat(loc, first) - np.minimum.reduceat(loc, first)) if n else np.ones((1, 2))
         self.block_height = float(np.median(size[:, 1]))  # m, median block height: the force-arrow unit
         self._block_side = float(np.median(size.min(axis=1)))  # m: the glyphs' unit; caps the fills' inset
-        # (N,) m: a block's farthest vertex from its centroid, for the reach of the run (_clear_the_legend)
-        self._radius = np.maximum.reduceat(np.hypot(*loc.T), first) if n else np.zeros(0)
-        # (xmin, ymin, xmax, ymax) m of what the run drew: the blocks' x (a collapse either way), the magnified
-        # shape; with the arrows, the view widens to hold it (_clear_the_legend)
-        self._extent = np.array([np.inf, np.inf, -np.inf, -np.inf])
-        self._arrows = self._extent.copy()  # the joint arrows' (the Magnified tab has none)
+        # what the run drew, from each block's farthest vertex from its centroid: the view widens to hold it
+        # (_clear_the_legend)
+        self._reach = Reach(np.maximum.reduceat(np.hypot(*loc.T), first) if n else np.zeros(0))
         self._glyph_length = GLYPH_HALF_LENGTH * self._block_side
         # (N,) m: a glyph never reaches out of its own block (thin cut spandrel blocks of the aqueduct)
         self._glyph_cap = np.minimum(self._glyph_length, GLYPH_HALF_LENGTH * size.min(axis=1))[: self._n]
@@ -346,9 +339,9 @@ class Recorder:
             self._supports,
             q,
             sq,
-            content=_union(self._extent, self._arrows),
+            content=self._reach.content(),
             block_side=self._block_side,
-            shape=self._extent,
+            shape=self._reach.extent,
         )
         shift = legend_move(self._legend_box, box)  # the bar sized to the view at close (log_plane)
         for path in (LEGEND_BARS, LEGEND_LABELS):
@@ -381,14 +374,8 @@ class Recorder:
     def _send_batch(self, b: FrameBatch) -> None:
         idx = time_indexes(b)
         q = b.stack("block_q")  # (F, N, 3)
-        if self._n:  # the blocks' x reach, but of a block fallen off the supports (magnified.send_magnified)
-            x, r = q[..., 0], np.broadcast_to(self._radius, q.shape[:2])
-            if self._supports.count:
-                on = q[..., 1] + r >= self._supports.world(b.stack("support_q"))[..., 1].min(axis=1)[:, None]
-                x, r = x[on], r[on]
-            if x.size:
-                e = self._extent
-                e[2], e[0] = max(e[2], float((x + r).max())), min(e[0], float((x - r).min()))
+        floor = self._supports.world(b.stack("support_q"))[..., 1].min(axis=1) if self._supports.count else None
+        self._reach.add_blocks(q, floor)
         tensors = {key: b.stack(key) for key in TENSOR_KEYS}
         # A voussoir of a bare ring has no cell strain rate; its strain rate along the ring stands in.
         vsr = tensors["cell_volumetric_strain_rate"]
@@ -413,20 +400,7 @@ class Recorder:
 
     def _fix_scales(self, tensors: dict[str, np.ndarray], b: FrameBatch) -> bool:
         """Fix the force and glyph scales not fixed yet from this batch if it has data; True if any was."""
-        fixed = False
-        if self.force_scale is None:
-            forces, lengths = b.concat("joint_force", (0, 2))
-            loaded = np.nonzero(lengths)[0]
-            if loaded.size:  # the first frame with a loaded joint
-                start = int(lengths[: loaded[0]].sum())
-                first = forces[start : start + lengths[loaded[0]]]
-                m = nice_ceil(float(np.percentile(np.hypot(first[:, 0], first[:, 1]), RESULTANT_PERCENTILE)))
-                if m > 0.0:
-                    self.force_scale, fixed = RESULTANT_LENGTH * self.block_height / m, True
-        for name, (values_key, _) in AXES.items():
-            m = nice_ceil(robust_max_abs(tensors[values_key], ROBUST_PERCENTILE))
-            if name not in self.axis_scale and m > 0.0:
-                self.axis_scale[name], fixed = m, True
+        self.force_scale, fixed = fix_scales(self.force_scale, self.axis_scale, tensors, b, self.block_height)
         return fixed
 
     def _send_axes(self, idx: list, q: np.ndarray, tensors: dict[str, np.ndarray]) -> None:
@@ -436,20 +410,17 @@ class Recorder:
 
     def _send_joints(self, idx: list, b: FrameBatch) -> None:
         arrows = send_joints(self.rec, idx, b, self.force_scale, RESULTANT_CAP * self._size)
-        self._arrows = _union(self._arrows, arrows)
+        self._reach.add_arrows(arrows)
 
     def _send_magnified(self) -> None:
         if self._poses is not None and self._poses.count and self._ref is not None:
             args = (self._poses, self._ref[:2], self.magnify, self._size, self.long_batch_frames)
             self.magnify, drawn = send_magnified(self.rec, self._blocks, self._supports, *args, self._carried)
-            self._extent = _union(self._extent, drawn)
+            self._reach.add_drawn(drawn)
 
     # ---- run document
     def _log_metadata(self, status: str, note: str) -> None:
-        text = run_document(
-            self.metadata,
-            status,
-            note,
+        facts = PanelFacts(
             last=self._last,
             wall_time=time.perf_counter() - self._t0,
             frames=self._frames,
@@ -464,31 +435,13 @@ class Recorder:
             field_ranges=self.field_ranges,
             range_changes=self._colours.range_changes(),
             magnify=self.magnify,
+            main_field=self._main_field,
+            paper_t=None if self.paper is None else self.paper[0],
+            resultant_cap=RESULTANT_CAP * self._size,
+            fill_load_n=self.static.fill_load_n,
+            fill_drawn=self._carried.count > 0,
         )
-        self.rec.log(METADATA, rr.TextDocument(viewer_safe_text(text), media_type="text/markdown"), static=True)
-        paper_t = None if self.paper is None else self.paper[0]
-        fill, drawn = self.static.fill_load_n, self._carried.count > 0
-        args = (
-            self.force_scale,
-            self.block_height,
-            self.magnify,
-            self._main_field,
-            paper_t,
-            RESULTANT_CAP * self._size,
-        )
-        axes = (self._glyph_length, self.axis_scale.get("stress_axes"))
-        legend = legend_markdown(*args, magnified_fill_note(fill, drawn), axes=axes)
-        # the blocks' one thickness; a file's blocks of several give [least, greatest] (execute.run_metadata), for
-        # which no "per metre of width" holds: none said (a list here ended the run in a TypeError at close)
-        thickness = self.metadata.get("thickness_m")
-        legend += fill_legend(fill, thickness if isinstance(thickness, (int, float)) else None, drawn)
-        self._legend_lines = legend_lines(legend)  # the Legend panel's height at close (layout.legend_share)
-        self.rec.log(LEGEND, rr.TextDocument(viewer_safe_text(legend), media_type="text/markdown"), static=True)
-
-
-def _union(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """The box (xmin, ymin, xmax, ymax) holding boxes ``a`` and ``b``."""
-    return np.r_[np.minimum(a[:2], b[:2]), np.maximum(a[2:], b[2:])]
+        self._legend_lines = log_run_panels(self.rec, self.metadata, status, note, facts)
 
 
 def _tensor(tensors: dict, key: str, n: int) -> np.ndarray:
