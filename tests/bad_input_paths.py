@@ -149,6 +149,16 @@ PATH_ROWS = [
     ("export-out-suffix", {}, ("export", "missing.npz", "--out", "s.xlsx"), 2, "--out s.xlsx: the file name must end"),
     ("export-out-exists", {"s.csv": "mine"}, ("export", "h.npz", "--out", "s.csv"), 2, "--out s.csv: the file exists"),
     ("export-every-0", {}, ("export", "h.npz", "--every", "0"), 2, "--every 0: keep every K-th frame, K ≥ 1"),
+    # a history named twice said "--out and --out name the same file h.csv" (no --out given); --combined took it twice
+    ("export-history-twice", {}, ("export", "h.npz", "h.npz"), 2, "h.npz: named twice (each history is exported once)"),
+    (
+        "export-combined-twice",
+        {},
+        ("export", "h.npz", "./h.npz", "--combined", "--out", "c.csv"),
+        2,
+        "h.npz: named twice",
+    ),
+    ("export-one-csv-two-runs", {}, ("export", "a/h.npz", "b/h.npz", "--out", "o"), 2, "a/h.npz and b/h.npz: both"),
     # -- export --times: the lab's file is read before the histories
     (
         "export-times-no-time",

@@ -4,6 +4,7 @@
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 from typing import Annotated
 
@@ -52,7 +53,19 @@ def _inputs(paths: list[Path]) -> list[Path]:
             out += found
         else:
             out.append(path)
+    _named_once(out)
     return out
+
+
+def _named_once(histories: list[Path]) -> None:
+    """``export w.npz w.npz`` (or ``w.npz .``) said "--out and --out name the same file w.csv", of an --out not
+    given; with --combined the run was in the table twice."""
+    seen: dict[str, Path] = {}
+    for path in histories:
+        first = seen.setdefault(os.path.realpath(path), path)
+        if first is not path:
+            same = "named twice" if str(first) == str(path) else f"the same history as {first}"
+            raise InputError(f"{path}: {same} (each history is exported once)")
 
 
 def _targets(histories: list[Path], out: Path | None, force: bool, several: bool):
@@ -67,6 +80,12 @@ def _targets(histories: list[Path], out: Path | None, force: bool, several: bool
         path = history.with_suffix(".csv")
         if out is not None:
             path = out / path.name if several else out
+        for earlier, target in zip(histories, targets):  # a/w.npz and b/w.npz --out runs/: both runs/w.csv
+            if os.path.realpath(target.path) == os.path.realpath(path):
+                raise InputError(
+                    f"{earlier} and {history}: both would be written to {path} (one CSV each: export them to "
+                    "two folders)"
+                )
         targets.append(check_output(path, "--out", ".csv", force))
     check_distinct(*targets)
     return targets
