@@ -242,6 +242,8 @@ def _split_word(exc, command: str) -> str | None:
     if extra == message.strip() or not (extra.startswith("(") and extra.endswith(")")) or exc.ctx is None:
         return None
     words = extra[1:-1]
+    if not words.strip():  # "masonry simulate wall ''" (an unset "$OPTS" quoted) was an IndexError, exit 1
+        return f"{message}: an empty word — a shell variable with nothing in it? ({command} --help)"
     pga = exc.ctx.params.get("pga")
     if pga is not None and words.split()[0].lower() in ("g", "gal", "m/s2", "m/s²", "cm/s2", "cm/s²"):
         # "--pga 0.25 g": --pga is in g, and reads a unit joined to its number; "the options are in SI" was wrong
