@@ -269,6 +269,8 @@ OPTION_ROWS = [
     ("limit-direction", {}, ("limit", "arch", "--direction", "up"), 2, "--direction up: expected one of +x, -x"),
     ("limit-point-no-block", {}, ("limit", "arch", "--load", "point"), 2, "--load point: name the loaded block"),
     ("limit-friction", {}, ("limit", "arch", "--friction", "-1"), 2, "--friction: friction = -1: must be >= 0"),
+    # --block '' was taken as no block: a horizontal load ran as if it was not given (--block v01 is refused)
+    ("limit-block-empty", {}, ("limit", "arch", "--block", ""), 2, "--block '': an empty name"),
     # an empty extra word (a quoted shell variable with nothing in it) was an IndexError, exit 1, a traceback
     ("simulate-empty-word", {}, ("simulate", "wall", ""), 2, "extra argument(s) (): an empty word"),
     ("limit-empty-word", {}, ("limit", "wall", ""), 2, "extra argument(s) (): an empty word"),
