@@ -288,7 +288,7 @@ def build_blueprint(
     residual_range: tuple[float, float] | None = None,
     structure_view: tuple[tuple[float, float], tuple[float, float]] | None = None,
     supports_move: bool = False,
-    support_v_range: tuple[float, float] | None = None,
+    plot_ranges: dict[str, tuple[float, float] | None] | None = None,
     legend_lines: int = 7,
 ) -> rrb.Blueprint:
     """Structure tabs and the on-screen legend (left); time series and the run document (right).
@@ -297,7 +297,8 @@ def build_blueprint(
     (u0, u1), (v0, v1) (``static_content.log_plane``): the magnified shape's tab, which has no bar nor
     arrows, shows that part. ``supports_move``: a support moved during the run (a shaken ground, a settling
     foundation): the second row of plots opens on its velocity, else on the solver's residual.
-    ``support_v_range``: the Support v plot's y range (m/s, ``series.support_velocity_range``; None: the fit).
+    ``plot_ranges``: the y range of plots (``PLOT_NAMES`` keys: Energies, Support v, Support u), in their units,
+    each with its legend bottom left (``series.plot_range``); a plot not given or None: the viewer's fit.
     ``legend_lines``: the Legend's lines at 1920 x 1080 (:func:`legend_share`).
 
     Tabs: the live main view (forces, principal stress, ``main_field``), with ``paper`` = (t, figure
@@ -345,12 +346,15 @@ def build_blueprint(
         view_range=rrb.TimeRange(rrb.TimeRangeBoundary.infinite(), rrb.TimeRangeBoundary.infinite())
     )
 
-    def plot(
-        key: str, axis_y: rrb.ScalarAxis | None = None, legend: rrb.PlotLegend | None = None
-    ) -> rrb.TimeSeriesView:
+    ranges = plot_ranges or {}
+
+    def plot(key: str, axis_y: rrb.ScalarAxis | None = None) -> rrb.TimeSeriesView:
         # a plot of one series whose name says it has no legend: the legend box (bottom left) hid the
-        # start of the curve and repeated the name ("kinetic" under "Kinetic energy (J)")
-        legend = rrb.PlotLegend(visible=False) if key in SINGLE_SERIES else legend
+        # start of the curve and repeated the name ("kinetic" under "Kinetic energy (J)"); a ranged plot
+        # leaves the bottom left to its legend (series.plot_range)
+        legend = rrb.PlotLegend(visible=False) if key in SINGLE_SERIES else None
+        if ranges.get(key) is not None:
+            axis_y, legend = rrb.ScalarAxis(range=ranges[key]), rrb.PlotLegend(corner="LeftBottom")
         return rrb.TimeSeriesView(
             origin=f"/{SERIES[key]}", name=PLOT_NAMES[key], axis_x=whole_run, axis_y=axis_y, plot_legend=legend
         )
@@ -370,12 +374,7 @@ def build_blueprint(
         rrb.Tabs(
             # the supports (what moves the structure) beside the solver's health: six tabs in one row did
             # not fit the column
-            # its range leaves the bottom left to the legend (series.support_velocity_range)
-            plot(
-                "support_velocity",
-                None if support_v_range is None else rrb.ScalarAxis(range=support_v_range),
-                None if support_v_range is None else rrb.PlotLegend(corner="LeftBottom"),
-            ),
+            plot("support_velocity"),
             plot("support_displacement"),
             # the residual's unit (the RMS contact-law violation of a sweep, m/s, as --tolerance): the plot's
             # ticks read -5 .. -5.3 with no unit anywhere on screen

@@ -76,7 +76,7 @@ from masonrycli.recording.readback import check_complete, wait_written
 from masonrycli.recording.residual_range import ResidualRange
 from masonrycli.recording.run_panels import PanelFacts, log_run_panels
 from masonrycli.recording.scales import fix_scales
-from masonrycli.recording.series import send_series, send_steps, support_velocity_range
+from masonrycli.recording.series import RANGED, plot_range, send_series, send_steps
 from masonrycli.recording.static_content import (
     RecordingStatic,
     inset_local,
@@ -153,7 +153,7 @@ class Recorder:
         self._legend_box = (0.0, 0.0, 0.0, 0.0)
         self._structure_view = None  # the Magnified tab's part of the view (log_plane)
         self._legend_lines = 7  # the Legend's lines at 1920 x 1080 (_log_metadata)
-        self._support_v = (0.0, 0.0)  # m/s, the lowest and highest support velocity component recorded, 0 in
+        self._spans = dict.fromkeys(RANGED, (0.0, 0.0))  # each ranged plot's lowest and highest value, 0 in
         self._label_anchors = np.zeros((0, 2), np.float32)
         self._size = 1.0
         self._frames, self._last = 0, None  # frames logged; (step, time) of the last one
@@ -365,9 +365,12 @@ class Recorder:
             reached = self._last is not None and self._last[1] >= self.paper[0] - 0.5 * self.static.dt
             if not reached:
                 self.paper = None
-        v_range = support_velocity_range(*self._support_v, 2 * self._supports.count)  # None: no support moved
-        args = (self._main_field, self.paper, self.residual_range(), self._structure_view, v_range is not None)
-        layout = build_blueprint(*args, support_v_range=v_range, legend_lines=self._legend_lines)
+        rows = {"energy_large": 3, "support_velocity": 2 * self._supports.count}
+        rows["support_displacement"] = rows["support_velocity"]
+        ranges = {key: plot_range(*self._spans[key], rows[key]) for key in RANGED}  # None: all 0
+        moved = ranges["support_velocity"] is not None  # a support that moved: its plot shows at open
+        args = (self._main_field, self.paper, self.residual_range(), self._structure_view, moved)
+        layout = build_blueprint(*args, plot_ranges=ranges, legend_lines=self._legend_lines)
         self.rec.send_blueprint(layout, make_active=True, make_default=True)
 
     # ---- per-batch content
@@ -388,15 +391,12 @@ class Recorder:
         args = (self._fill, self._blocks.owner, self._colours, self._label_anchors, q, tensors, initial)
         send_blocks(self.rec, idx, *args, at=own, times=b["time"])
         send_supports(self.rec, idx, self._supports, b.stack("support_q"))
-        sv = b.stack("support_v")  # a support that moved: its plot shows at open (build_blueprint)
-        self._support_v = (
-            min(self._support_v[0], float(sv.min(initial=0.0))),
-            max(self._support_v[1], float(sv.max(initial=0.0))),
-        )
         self._carried.send(self.rec, idx, q)
         self._send_axes(idx, np.concatenate([own, q[..., 2:]], axis=-1), tensors)
         self._send_joints(idx, b)
-        send_series(self.rec, idx, b, q, self._ref, self._n)
+        spans = send_series(self.rec, idx, b, q, self._ref, self._n)
+        for key, (low, high) in spans.items():
+            self._spans[key] = (min(self._spans[key][0], low), max(self._spans[key][1], high))
 
     def _fix_scales(self, tensors: dict[str, np.ndarray], b: FrameBatch) -> bool:
         """Fix the force and glyph scales not fixed yet from this batch if it has data; True if any was."""

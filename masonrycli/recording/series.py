@@ -26,9 +26,10 @@ def send_series(
     q: np.ndarray,
     ref: tuple[np.ndarray, np.ndarray, float],
     n_blocks: int,
-) -> None:
+) -> dict[str, tuple[float, float]]:
     """The per-frame series of a batch ``b`` (``q`` (F, N, 3) its block poses); ``ref``: the as-built block
-    and support poses and potential energy."""
+    and support poses and potential energy. Returns the lowest and highest finite value of each
+    :data:`RANGED` plot in the batch (0 included)."""
     n_frames = len(q)
     ref_q, ref_sq, ref_pot = ref
     kinetic, potential, dissipated, work = np.array(b["scalars"]).T  # SCALARS order
@@ -43,6 +44,14 @@ def send_series(
         "support_displacement": sq[..., :2] - ref_sq[None, :, :2],
     }
     _send_scalars(rec, idx, series)
+    return {key: _span(series[key]) for key in RANGED}
+
+
+def _span(values: np.ndarray) -> tuple[float, float]:
+    """(lowest, highest) finite value of ``values`` with 0: a plot's lines and its 0."""
+    v = np.asarray(values, dtype=np.float64)
+    v = v[np.isfinite(v)]
+    return float(v.min(initial=0.0)), float(v.max(initial=0.0))
 
 
 BALANCE_FLOOR = 1e-16
@@ -70,18 +79,43 @@ vy = -0.01 m/s) drew lines on the plot's top and bottom edges, the viewer's fit 
 LEGEND_ROW_SHARE: Final = 0.1
 """Share of a plot's height one legend row takes at 1920 x 1080 (~23 of the ~240 px of the support plots), kept
 free of lines under them: the legend (bottom left) hid the start of a settling foundation's vy line."""
+RANGED: Final = ("energy_large", "support_velocity", "support_displacement")
+"""The plots of several series, with a legend, whose y range the recording sets (:func:`plot_range`). Support
+v alone was: Support u's lines ran along its top and bottom edges and under its legend (a record's ground ux
+dipped behind it), and in Energies the legend hid the start of the support work and the two lines at 0."""
 
 
-def support_velocity_range(low: float, high: float, rows: int) -> tuple[float, float] | None:
-    """The Support v plot's y range, m/s, for velocities from ``low`` to ``high`` (0 included) and ``rows``
-    series in its legend: PLOT_PAD above and below the lines, and under them room for the legend (its rows,
-    at most 60 % of the plot). None when no support moved (the viewer's fit)."""
+def plot_range(low: float, high: float, rows: int) -> tuple[float, float] | None:
+    """A plot's y range for values from ``low`` to ``high`` (0 included) and ``rows`` series in its legend:
+    PLOT_PAD above and below the lines, and under them room for the legend (its rows, at most 60 % of the
+    plot). None when every value is 0 (a still support: the viewer's fit)."""
     low, high = min(low, 0.0), max(high, 0.0)
     if not np.isfinite(low) or not np.isfinite(high) or high - low <= 0.0:
         return None
     legend = min(0.6, LEGEND_ROW_SHARE * rows)
     height = (high - low) / (1.0 - 2.0 * PLOT_PAD - legend)
     return low - (PLOT_PAD + legend) * height, high + PLOT_PAD * height
+
+
+SUPPORT_PALETTE: Final = (
+    0xFF9F40FF,  # orange
+    0x5FA8FFFF,  # blue
+    0x59C36AFF,  # green
+    0xE15759FF,  # red
+    0xB07AE0FF,  # purple
+    0xEDC948FF,  # yellow
+    0x76D7D1FF,  # cyan
+    0xFF8FC8FF,  # pink
+)
+"""The support plots' series colours, RGBA, in order (support 0 x, support 0 y, support 1 x, ...): left to the
+viewer, a settling arch's left-foundation vy and right-foundation vy were both pink (which foundation settles
+could not be read), and the same component had another colour in Support v and in Support u."""
+
+
+def support_series_colours(supports: int) -> np.ndarray:
+    """(2 S,) uint32 RGBA of each series of the Support v and Support u plots (x, y a support), the same in both
+    (uint32: rerun reads 4 plain ints as one colour's R, G, B, A)."""
+    return np.array([SUPPORT_PALETTE[k % len(SUPPORT_PALETTE)] for k in range(2 * supports)], dtype=np.uint32)
 
 
 def _common_travel(sq: np.ndarray, ref_sq: np.ndarray) -> np.ndarray:

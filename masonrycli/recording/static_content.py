@@ -47,6 +47,7 @@ from masonrycli.recording.layout import (
     XY,
     FieldSpec,
 )
+from masonrycli.recording.series import support_series_colours
 
 _CAMERA_HEIGHT: Final = 1.0e4  # m, drawing-plane camera above z = 0
 _SUPPORT_MARGIN: Final = 0.15  # initial view: supports up to this × the structure's size beyond blocks
@@ -124,8 +125,13 @@ def log_static(rec: rr.RecordingStream, st: RecordingStatic, blocks: Polygons, s
         "residual": ["log10 NLGS residual", "log10 tolerance"],
         "contacts": ["contacts"],
     }
+    colours = support_series_colours(len(names))  # the same component, the same colour in both plots
     for key, path in SERIES.items():
-        rec.log(path, rr.SeriesLines(names=[viewer_safe_text(n) for n in series_names[key]]), static=True)
+        lines = [viewer_safe_text(n) for n in series_names[key]]
+        if key in ("support_velocity", "support_displacement") and lines:
+            rec.log(path, rr.SeriesLines(names=lines, colors=colours), static=True)
+        else:
+            rec.log(path, rr.SeriesLines(names=lines), static=True)
 
 
 def log_initial_shape(
