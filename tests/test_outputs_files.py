@@ -214,6 +214,58 @@ def test_commit_replaces_only_with_force(tmp_path):
     assert free_name(target) == tmp_path / "a-2.npz"
 
 
+def _spy_on_the_disk(monkeypatch, fail_on: str | None = None) -> list:
+    """Log the fsyncs (of what), renames and links in order; an fsync of a path ending in ``fail_on`` says the
+    disk is full, as NFS, quotas and delayed allocation do only when the data is flushed."""
+    log, real_fsync, real_replace, real_link = [], os.fsync, os.replace, os.link
+
+    def fsync(fd):
+        path = os.readlink(f"/proc/self/fd/{fd}")
+        log.append(("fsync", path))
+        if fail_on and path.endswith(fail_on):
+            raise OSError(errno.ENOSPC, "No space left on device")
+        real_fsync(fd)
+
+    def replace(src, dst, *args, **kwargs):
+        log.append(("rename", str(src), str(dst)))
+        real_replace(src, dst, *args, **kwargs)
+
+    def link(src, dst, *args, **kwargs):
+        log.append(("rename", str(src), str(dst)))
+        real_link(src, dst, *args, **kwargs)
+
+    monkeypatch.setattr(os, "fsync", fsync)
+    monkeypatch.setattr(os, "replace", replace)
+    monkeypatch.setattr(os, "link", link)
+    return log
+
+
+@pytest.mark.parametrize("force", [True, False])
+def test_a_file_is_on_the_disk_before_its_name_points_at_it(force, tmp_path, monkeypatch):
+    """Renamed unflushed, a file could reach the disk after its new name (XFS, btrfs, ext4 without
+    auto_da_alloc): a power cut then left an empty file where the previous one was. The part is flushed
+    first, the folder's rename after."""
+    target = tmp_path / "a.npz"
+    out = OutputFile(target, "--history", force=force)
+    open_part(out)
+    out.part.write_bytes(b"new")
+    log = _spy_on_the_disk(monkeypatch)
+    assert out.commit() == target and target.read_bytes() == b"new"
+    assert log == [("fsync", str(part_path(target))), ("rename", str(out.part), str(target)), ("fsync", str(tmp_path))]
+
+
+def test_a_disk_full_only_the_flush_reports_keeps_the_previous_file(tmp_path, monkeypatch):
+    """A history whose flush failed (ENOSPC at fsync) was renamed onto the previous one all the same."""
+    npz = tmp_path / "h.npz"
+    npz.write_bytes(b"the previous history")
+    _spy_on_the_disk(monkeypatch, fail_on=".part")
+    result = invoke("simulate", "wall", "--duration", 0.01, "--no-recording", "--history", npz, "--force")
+    assert result.exit_code == 4, result.output
+    assert "No space left on device" in result.output and "completed" not in result.output
+    assert npz.read_bytes() == b"the previous history"
+    assert leftovers(tmp_path) == []
+
+
 def test_courses_and_length_choose_the_wall(tmp_path):
     """Finding 8: --courses/--length without --blocks always failed ("51 blocks cannot be laid…")."""
     npz = tmp_path / "h.npz"

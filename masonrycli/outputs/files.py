@@ -85,6 +85,24 @@ def _numbered(path: Path, k: int) -> Path:
     return path if k == 1 else path.with_name(f"{path.stem}-{k}{path.suffix}")
 
 
+def _to_disk(path: Path, folder: bool = False) -> None:
+    """fsync ``path``: a file's data, or a folder's entries (a rename in it). A folder's fsync some file
+    systems refuse (EINVAL) or cannot open is skipped: the rename is made, only its durability unsure."""
+    try:
+        fd = os.open(path, os.O_RDONLY | (getattr(os, "O_DIRECTORY", 0) if folder else 0))
+    except OSError:
+        if folder:
+            return
+        raise
+    try:
+        os.fsync(fd)
+    except OSError:
+        if not folder:
+            raise
+    finally:
+        os.close(fd)
+
+
 def free_name(path: Path) -> Path:
     """``path``, or the first ``stem-k.suffix`` (k = 2, 3…) that neither exists nor is being written."""
     k = 1
@@ -114,7 +132,17 @@ class OutputFile:
         return part_path(self.path)
 
     def commit(self) -> Path:
-        """Rename the complete ``part`` file onto ``path`` (see the module docstring); returns where it went."""
+        """Rename the complete ``part`` file onto ``path`` (see the module docstring); returns where it went.
+        The part's bytes reach the disk before the name points at them, and the rename after it: a rename
+        may be written before the data it names (XFS, btrfs, ext4 without auto_da_alloc), and a power cut then
+        left an empty or partial file where the previous one was. A disk full that only the flush reports
+        (NFS, quotas, delayed allocation) is an OSError here, before the rename: the previous file stays."""
+        _to_disk(self.part)
+        target = self._rename()
+        _to_disk(target.parent, folder=True)
+        return target
+
+    def _rename(self) -> Path:
         if self.force:
             os.replace(self.part, self.path)
             return self.path
