@@ -99,6 +99,9 @@ MAX_AREA = 1e6
 # m: a vertex farther than this from the origin is refused. Products of larger coordinates (areas, cross
 # products) overflow or lose all precision in float64, so the convexity test could no longer be trusted.
 MAX_COORDINATE = 1e6
+# vertices of one outline as given: the clean-up removes them one at a time (about n² work): 10 000 took
+# 0.7 s of CPU, a 100 000-vertex circle over 60 s before any word. A stone traced at every pixel of a scan.
+MAX_VERTICES = 10_000
 CONTACT_DISTANCE = 1e-3
 
 # id -> polygon made by normalised_polygon; the entry goes when the polygon does, so an id is never
@@ -227,6 +230,11 @@ def normalise_coords(coords, label: str) -> np.ndarray:
         raise GeometryError(f"{label}: coordinates are not numbers ({exc})") from None
     if xy.ndim != 2 or xy.shape[1] != 2 or xy.shape[0] == 0:
         raise GeometryError(f"{label}: expected (k, 2) vertex coordinates, got shape {xy.shape}")
+    if len(xy) > MAX_VERTICES:
+        raise GeometryError(
+            f"{label}: {len(xy)} vertices, more than {MAX_VERTICES} (an outline traced at every pixel? "
+            "simplify it to about 1 mm: QGIS's Vector > Geometry Tools > Simplify)"
+        )
     if not np.all(np.isfinite(xy)):
         bad = int(np.flatnonzero(~np.all(np.isfinite(xy), axis=1))[0])
         raise GeometryError(f"{label}: vertex {bad} has a NaN or infinite coordinate")

@@ -4,6 +4,8 @@
 
 from __future__ import annotations
 
+import math
+
 from bad_input_files import BLOCK, scen
 
 
@@ -20,6 +22,9 @@ def feature(coords, role: str = "block", name: str = "a", gtype: str = "Polygon"
 
 
 SQUARE = [[[0, 0], [1, 0], [1, 1], [0, 1], [0, 0]]]
+CIRCLE = [
+    [round(math.cos(2 * math.pi * k / 10001), 9), round(2 + math.sin(2 * math.pi * k / 10001), 9)] for k in range(10001)
+]
 
 # (id, files, argv, exit code, fragment of the one line)
 GEOMETRY_ROWS = [
@@ -56,6 +61,15 @@ GEOMETRY_ROWS = [
         "g.geojson: ",
     ),
     ("geojson-missing", {}, ("run", "nope.geojson"), 2, "nope.geojson: no such scenario or geometry file"),
+    # a 100 000-vertex circle was cleaned one vertex at a time for minutes before a word: now at most 10 000
+    (
+        "toml-too-many-vertices",
+        scen(block=f'name = "disc"\npolygon = {CIRCLE}\n'),
+        ("check", "s.toml"),
+        2,
+        '[[block]] #1 ("disc"): 10001 vertices, more than 10000 (an outline traced at every pixel?',
+    ),
+    ("geojson-too-many-vertices", {"g.geojson": feature([CIRCLE])}, ("check", "g.geojson"), 2, "10001 vertices"),
     # integers too large for a float (TOML and JSON read any size): "OverflowError: int too large to convert
     # to float", a traceback; and a JSON true read as the coordinate 1.0 without a word
     (
