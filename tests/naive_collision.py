@@ -21,6 +21,7 @@ import math
 
 import numpy as np
 import shapely
+import shapely.ops
 from shapely.geometry import LineString, Point, Polygon
 
 REF_TOL_ABS = 1e-9
@@ -274,6 +275,19 @@ def closest_is_vertex_face(A, B, d, tol=1e-12):
 
 def distance(A, B):
     return polygon(A).distance(polygon(B))
+
+
+def rounded_normal(A, B, radius):
+    """Unit direction from A to B between the closest points of A and B eroded by ``radius`` (the rounded
+    corners of engine/rounded.py), or None when the eroded polygons touch or one vanishes. shapely does the
+    work: a mitred inward buffer of a convex polygon moves each edge inwards by ``radius``."""
+    ea = polygon(A).buffer(-radius, join_style="mitre")
+    eb = polygon(B).buffer(-radius, join_style="mitre")
+    if ea.is_empty or eb.is_empty or ea.area <= 0.0 or eb.area <= 0.0 or ea.distance(eb) <= 0.0:
+        return None
+    p, q = shapely.ops.nearest_points(ea, eb)
+    v = np.array([q.x - p.x, q.y - p.y])
+    return v / np.hypot(*v)
 
 
 def point_distance(P, p):

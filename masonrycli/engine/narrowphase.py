@@ -25,6 +25,10 @@ For a candidate pair (a, b) of convex counter-clockwise polygons:
 Two blocks sharing a joint give exactly the two ends of the overlapping segment with gap 0; a block
 on a wide ground gives its two bottom corners; a corner on a face gives one point.
 
+6. **Rounded corners.** A pair with a single contact takes the normal of the two blocks' corners rounded by
+   2 cm (:mod:`.rounded`): a corner on a corner's normal no longer turns with a survey's last millimetre; a
+   corner on a face keeps step 5's normal bit for bit.
+
 Each contact carries a key naming the touching features (vertex of one body against edge of the other),
 the same from one step to the next: see :mod:`.contact_key`.
 
@@ -49,6 +53,7 @@ import numpy as np
 from ._arrays import check_array, check_vertices
 from ._jit import kernel_only, njit
 from .contact_key import _end_label, _make_key, check_topology
+from .rounded import SCRATCH_ROWS, _round_single, scratch_polygons
 
 __all__ = ["REF_TOL_ABS", "REF_TOL_REL", "collide_polygons", "edge_normals", "narrowphase"]
 
@@ -362,20 +367,25 @@ def _narrowphase(
     vert_world, edge_normal, body_size, body_vert_start, pair_body, pair_count, alert,
     contact_body, contact_point, contact_normal, contact_gap, contact_key,
 ):  # fmt: skip
-    # for each candidate pair p (in the given order): append its 0..2 contacts (see _collide_pair).
+    # for each candidate pair p (in the given order): append its 0..2 contacts (see _collide_pair);
+    # one contact: its normal is the rounded corners' (step 6, .rounded._round_single).
     # Contacts beyond the capacity are counted, not written. Returns the number of contacts.
     c = np.int64(0)  # not 0: numba would compile _collide_pair for the literal 0 as well (broadphase.py)
+    scratch = np.empty((4, SCRATCH_ROWS, 2), np.float64)
     for p in range(pair_count):
         a = pair_body[p, 0]
         b = pair_body[p, 1]
         sa = body_vert_start[a]
         sb = body_vert_start[b]
-        c = _collide_pair(
-            vert_world, edge_normal, body_size[a], body_size[b],
-            sa, body_vert_start[a + 1] - sa, sb, body_vert_start[b + 1] - sb,
-            a, b, alert, c,
+        na = body_vert_start[a + 1] - sa
+        nb = body_vert_start[b + 1] - sb
+        after = _collide_pair(
+            vert_world, edge_normal, body_size[a], body_size[b], sa, na, sb, nb, a, b, alert, c,
             contact_body, contact_point, contact_normal, contact_gap, contact_key,
         )  # fmt: skip
+        if after == c + 1 and c < contact_gap.shape[0]:
+            _round_single(vert_world, edge_normal, sa, na, sb, nb, c, contact_normal, scratch)
+        c = after
     return c
 
 
@@ -475,4 +485,6 @@ def collide_polygons(verts_a, verts_b, alert, a: int = 0, b: int = 1):
         vert, normal, size[0], size[1], 0, len(verts_a), len(verts_a), len(verts_b), a, b, float(alert), 0,
         contact_body, contact_point, contact_normal, contact_gap, contact_key,
     )  # fmt: skip
+    if c == 1:
+        _round_single(vert, normal, 0, len(verts_a), len(verts_a), len(verts_b), 0, contact_normal, scratch_polygons())
     return contact_point[:c].copy(), contact_normal[:c].copy(), contact_gap[:c].copy(), contact_key[:c].copy()
