@@ -80,6 +80,14 @@ def test_at2_reader_formats_and_units(tmp_path):
         ("a\nb\nc\nNPTS= 3, DT= 0.01 SEC\n0.1 x 0.3\n", 'bad.AT2:5: not a number: "x"'),
         ("a\nb\nc\nNPTS= 4, DT= 0.01 SEC\n0.1 0.2 0.3\n", "bad.AT2: header says NPTS = 4 but the file holds 3"),
         ("a\nb\nc\nNPTS= 3, DT= 0 SEC\n0.1 0.2 0.3\n", "bad.AT2:4: DT must be > 0"),
+        # an absurd DT was read as given: DT = 10 made 3 samples a record of 20 s, with no word on its time step
+        ("a\nb\nc\nNPTS= 3, DT= 10 SEC\n0.1 0.2 0.3\n", "bad.AT2:4: DT = 10: must be within 1e-06–1 s, likely a typo"),
+        (
+            "a\nb\nc\nNPTS= 3, DT= 0.2 SEC\n0.1 0.2 0.3\n",
+            "bad.AT2:4: DT = 0.2: an acceleration record sampled every 0.2 s holds nothing above 2.5 Hz, where "
+            "earthquakes shake and walls rock (accelerographs sample every 5–20 ms): at most 0.1 s, so a typo or a "
+            "damaged header",
+        ),
         ("a\nb\n", "bad.AT2: not a PEER .AT2 file"),
         # the header's own word on units and quantity (samples would be read as g: 100-1000x off)
         (
@@ -104,6 +112,13 @@ def test_at2_errors_name_file_and_line(tmp_path, text, expected):
     with pytest.raises(InputError) as exc:
         load_at2(tmp_path / "bad.AT2", display="bad.AT2")
     assert expected in one_line(exc)
+
+
+def test_an_at2_sampled_at_0_1_s_or_finer_is_read(tmp_path):
+    # the bound is above the coarsest accelerogram (old digitised films: 0.04 s), not a real record's DT
+    for dt in (0.1, 0.04, 0.005):
+        write_at2(tmp_path / "ok.AT2", [0.0, 0.1, 0.0], dt)
+        assert load_at2(tmp_path / "ok.AT2")[0] == dt
 
 
 def test_vertical_component_and_window(tmp_path):

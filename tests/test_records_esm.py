@@ -88,6 +88,11 @@ def test_a_velocity_file_is_read_as_velocity_in_m_s(tmp_path):
             "SAMPLING_INTERVAL_S: 5",
             'q.ASC:29: SAMPLING_INTERVAL_S = "5": must be within',
         ),
+        (
+            "SAMPLING_INTERVAL_S: 0.005000",
+            "SAMPLING_INTERVAL_S: 0.5",
+            'q.ASC:29: SAMPLING_INTERVAL_S = "0.5": an acceleration record sampled every 0.5 s holds nothing above 1 Hz',
+        ),
         ("SAMPLING_INTERVAL_S: 0.005000", "SAMPLING_INTERVAL_S: 5 ms", "q.ASC:29: SAMPLING_INTERVAL_S: not a number"),
         ("NDATA: 200", "NDATA: 300", "q.ASC: header says NDATA = 300 but the file holds 200 samples"),
         ("NDATA: 200", "NDATA: two hundred", "q.ASC:30: NDATA: not a whole number"),

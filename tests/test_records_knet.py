@@ -54,7 +54,13 @@ def test_the_record_integrates_to_the_velocity_of_its_sine():
         (
             "Sampling Freq(Hz) 100Hz",
             "Sampling Freq(Hz) 0.1Hz",
-            'q.NS:11: Sampling Freq(Hz) = "0.1Hz": a time step of 10 s must be within',
+            'q.NS:11: Sampling Freq(Hz) = "0.1Hz": a time step of 10 s: must be within',
+        ),
+        (
+            "Sampling Freq(Hz) 100Hz",
+            "Sampling Freq(Hz) 5Hz",
+            'q.NS:11: Sampling Freq(Hz) = "5Hz": a time step of 0.2 s: an acceleration record sampled every 0.2 s holds '
+            "nothing above 2.5 Hz",
         ),
         ("Sampling Freq(Hz) 100Hz", "Sampling Rate     100Hz", "q.NS: the K-NET header has no 'Sampling Freq' line"),
         ("3920(gal)/6182761", "3920/6182761", 'q.NS:14: Scale Factor: "3920/6182761": expected A(gal)/B'),

@@ -135,10 +135,15 @@ def test_local_cluster_workers_log_nothing_below_critical():
     client, cluster = runner.open_cluster(None, 1)
     try:
         levels = client.run(_distributed_log_level)
+        # a worker started again (its process died under a point) was not: it logged at INFO (its preload now
+        # quiets it, as it starts)
+        client.restart()
+        again = client.run(_distributed_log_level)
     finally:
         client.close()
         cluster.close()
     assert levels and all(level >= logging.CRITICAL for level in levels.values()), levels
+    assert again and all(level >= logging.CRITICAL for level in again.values()), again
 
 
 def test_local_cluster_has_no_more_workers_than_runs():
@@ -230,11 +235,56 @@ def test_a_signal_while_the_local_cluster_starts_stops_once_it_is_up_and_closes_
 def test_a_worker_process_ignores_sigint_from_its_start():
     # dask_setup runs in each worker process of a study's LocalCluster (a preload): a terminal's Ctrl-C
     # reaches them too, and is the command's to act on
+    import logging
     import signal
 
     before = signal.getsignal(signal.SIGINT)
+    hangup = signal.getsignal(signal.SIGHUP)
+    level = logging.getLogger("distributed").level  # dask_setup quiets the worker's logs: this process's here
     try:
         runner.dask_setup(None)
         assert signal.getsignal(signal.SIGINT) == signal.SIG_IGN
     finally:
         signal.signal(signal.SIGINT, before)
+        signal.signal(signal.SIGHUP, hangup)
+        logging.getLogger("distributed").setLevel(level)
+
+
+def test_a_run_stays_pending_until_its_result_is_fetched(client, monkeypatch):
+    # 361c8d0: a result lost with its worker is made again inside future.result() ("Couldn't gather keys"); the loop
+    # had taken the run out of `pending` before fetching it, so while result() waited the watch counted no run
+    # waiting, and the give-up (no worker left) did not cancel it: the CLI waited there for good. Here the fetch of
+    # the one run finds the watch giving up (as its thread would, 60 s without a worker): the run counts as waiting,
+    # is cancelled, and its row says why; before, the fetch returned the row as made, and no run was waiting.
+    import distributed
+
+    monkeypatch.setattr(runner, "run_task", lambda base, params, *args: dict(params, status="completed", error=""))
+    watched = {}
+
+    class Watch:  # the WorkerWatch's place: keeps what the loop gives it (its count of runs waiting, give_up)
+        def __init__(self, client, warn, where, waiting, cluster=None, give_up=None):
+            watched.update(waiting=waiting, give_up=give_up)
+
+        def __enter__(self):
+            return self
+
+        def __exit__(self, *exc):
+            return None
+
+    fetched, seen = distributed.Future.result, []
+
+    def result(future, *args, **kwargs):  # the fetch: the worker holding the result is gone, none comes back
+        seen.append(watched["waiting"]())
+        watched["give_up"](2)
+        return fetched(future, *args, **kwargs)
+
+    monkeypatch.setattr(watch, "WorkerWatch", Watch)
+    monkeypatch.setattr(distributed.Future, "result", result)
+    rows = []
+    runner.run_on_cluster(client, "s", Driver(1), lambda p, r: rows.append(r), False, None, False, cluster=object())
+    assert seen == [1]  # the run being fetched is waiting (0 before)
+    assert [(r["amp"], r["status"]) for r in rows] == [(0.0, "error")], rows
+    assert rows[0]["error"] == (
+        f"no worker left: the local cluster had none for {watch.NO_WORKER_LIMIT:g} s after its workers died 2 times; "
+        "not run"
+    )

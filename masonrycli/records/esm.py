@@ -9,7 +9,7 @@ Layout (the "DYNA 1.2" header of ESM and ITACA): header lines ``KEY: value`` (64
 files), then ``NDATA`` samples, one a line, ``SAMPLING_INTERVAL_S`` apart from t = 0, in ``UNITS``. Read:
 
     header  = the "KEY: value" lines up to the first line that is a number (other text lines are skipped)
-    dt      = SAMPLING_INTERVAL_S (s, a record's time step: 1e-6 to 1 s); n = NDATA (an integer >= 2)
+    dt      = SAMPLING_INTERVAL_S (s, a record's time step: 1e-6 to 1 s, at most 0.1 s for acceleration); n = NDATA (an integer >= 2)
     series  = DATA_TYPE when given: ACCELERATION or VELOCITY (DISPLACEMENT, spectra: refused, naming why)
     factor  = UNITS to SI: cm/s^2 (ESM's), gal, m/s^2, mm/s^2, g -> acceleration; cm/s, m/s, mm/s -> velocity,
               by the unit table a CSV header is read by (records/units.py, unit_factor);
@@ -80,7 +80,7 @@ def esm_text(text: str, name: str) -> tuple[float, np.ndarray, str]:
             "KEY: value lines, SAMPLING_INTERVAL_S and NDATA among them, then one sample a line)"
         )
     series, factor = _series(header, name)
-    dt = _dt(header, name)
+    dt = _dt(header, name, series == "acceleration")
     npts = _ndata(header, name)
     values = _samples(text, first, name)
     if values.size < npts:
@@ -201,13 +201,13 @@ def _series(header: dict, name: str) -> tuple[str, float]:
     return series, factor
 
 
-def _dt(header: dict, name: str) -> float:
+def _dt(header: dict, name: str, acceleration: bool) -> float:
     text, line = header["SAMPLING_INTERVAL_S"]
     try:
         dt = float(text)
     except ValueError:
         raise InputError(f"{name}:{line}: SAMPLING_INTERVAL_S: not a number: {shorten(text, 40)}") from None
-    problem = time_step_problem(dt)
+    problem = time_step_problem(dt, acceleration)
     if problem:
         raise InputError(f"{name}:{line}: SAMPLING_INTERVAL_S = {shorten(text, 40)}: {problem}")
     return dt

@@ -6,7 +6,7 @@ Layout: 17 header lines, a key in the first 18 columns and its value after it (`
 samples, integers (the digitiser's counts), 8 a line. Read:
 
     header  = the lines up to and with "Memo." (keys matched by their start, any case and spacing)
-    dt      = 1 / Sampling Freq (Hz; "100Hz"), a record's time step (1e-6 to 1 s)
+    dt      = 1 / Sampling Freq (Hz; "100Hz"), a record's time step (1e-6 to 0.1 s: an accelerogram)
     factor  = Scale Factor "A(gal)/B": A/B gal a count, 0.01 A/B m/s²
     samples = the numbers after the header, each finite, at least 2; times 0, dt, 2 dt, ...
     values  = (samples - their mean) x factor: NIED's files carry the instrument's offset, which its
@@ -83,9 +83,9 @@ def _dt(found: tuple[str, int], name: str) -> float:
         raise InputError(f"{name}:{line}: Sampling Freq(Hz): not a frequency: {shorten(text, 30)} (e.g. 100Hz)")
     freq = float(match.group(1))
     dt = 1.0 / freq if freq > 0 else math.inf
-    problem = time_step_problem(dt)
+    problem = time_step_problem(dt, acceleration=True)  # K-NET files are accelerograms
     if problem:
-        raise InputError(f"{name}:{line}: Sampling Freq(Hz) = {shorten(text, 30)}: a time step of {dt:g} s {problem}")
+        raise InputError(f"{name}:{line}: Sampling Freq(Hz) = {shorten(text, 30)}: a time step of {dt:g} s: {problem}")
     return dt
 
 

@@ -70,13 +70,30 @@ MIN_TIME_STEP, MAX_TIME_STEP = 1e-6, 1.0
 a likely typo (10 for 10 ms stretched the record 1000-fold), below 1 µs no accelerogram."""
 
 
-def time_step_problem(value) -> str | None:
-    """What is wrong with ``value`` as the time step of a one-column record (s), or None."""
+MAX_ACCELEROGRAM_STEP = 0.1
+"""s: the coarsest sample spacing of an acceleration record whose header gives it (an .AT2 file's DT, K-NET's
+Sampling Freq, ESM's SAMPLING_INTERVAL_S). Sampled every 0.1 s, a record holds nothing above 5 Hz (its Nyquist
+frequency), where the ground acceleration of an earthquake carries much of its energy (up to 10-25 Hz) and a
+wall's rocking and a stone's impacts lie: accelerographs sample at 50-200 Hz (DT 0.005-0.02 s; 0.04 s in the
+oldest digitised records). An .AT2 file's DT of 10 s was read as a record of 70 s whose peaks a run of 0.5 s
+interpolated linearly, with a warning about its length only: a typo or a damaged header, never a record."""
+
+
+def time_step_problem(value, acceleration: bool = False) -> str | None:
+    """What is wrong with ``value`` as the time step of a record (s), or None: a one-column record's
+    (``--record-dt``, a velocity or an acceleration), or with ``acceleration`` that of an accelerogram's header
+    (at most :data:`MAX_ACCELEROGRAM_STEP`)."""
     problem = number_problem(value, gt=0.0, unit="s")
     if problem is None and not MIN_TIME_STEP <= float(value) <= MAX_TIME_STEP:
         problem = (
             f"must be within {MIN_TIME_STEP:g}–{MAX_TIME_STEP:g} s, likely a typo (accelerographs sample every "
             "1–20 ms; 10 for 10 ms would stretch the record 1000-fold)"
+        )
+    if problem is None and acceleration and float(value) > MAX_ACCELEROGRAM_STEP:
+        problem = (
+            f"an acceleration record sampled every {float(value):g} s holds nothing above {0.5 / float(value):.3g} Hz, "
+            f"where earthquakes shake and walls rock (accelerographs sample every 5–20 ms): at most "
+            f"{MAX_ACCELEROGRAM_STEP:g} s, so a typo or a damaged header"
         )
     return problem
 

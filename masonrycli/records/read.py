@@ -104,6 +104,9 @@ def load_at2(path, display: str | None = None) -> tuple[float, np.ndarray]:
     npts, dt = int(match.group(1)), number(match.group(2), f"{name}:4")
     if not (math.isfinite(dt) and dt > 0.0) or npts < 2:
         raise InputError(f"{name}:4: DT must be > 0 and NPTS >= 2, got DT = {format_value(dt)}, NPTS = {npts}")
+    problem = time_step_problem(dt, acceleration=True)  # DT = 10 was read as a record of 70 s, without a word
+    if problem:
+        raise InputError(f"{name}:4: DT = {dt:g}: {problem}")
     values = at2_text(text, pos, name, npts)
     if len(values) < npts:
         raise InputError(f"{name}: header says NPTS = {npts} but the file holds {len(values)} samples")

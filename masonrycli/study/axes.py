@@ -221,6 +221,9 @@ def apply_point(base, params: dict):
         scenario = dataclasses.replace(
             scenario, material=_replace(scenario.material, friction, where=f"--param {_point(friction)}")
         )
+    if base.settle is not None:  # each variant of the structure comes to rest as itself (settled_variant)
+        friction = {"friction": params["friction"]} if "friction" in params else {}
+        scenario = settled_variant(base, scenario, options | run_changes | friction)
     motions = list(scenario.motions)
     if "record" in params:
         record = base.records[params["record"]]
@@ -334,7 +337,31 @@ def _replace(obj, changes: dict, where: str = ""):
 
 @dataclass(frozen=True)
 class StudyBase:
-    """What every task of a study starts from: the base scenario and the records it may use (by name)."""
+    """What every task of a study starts from: the base scenario and the records it may use (by name).
+
+    ``settle``: s each variant of the structure comes to rest under its own weight before its runs (``--settle``;
+    :func:`settled_variant`), the scenario being then as drawn; ``settled`` keeps each variant settled, by its
+    point's structural values: filled while the command checks the points, it travels with the base to the
+    workers, which settle only a variant it lacks (once a process)."""
 
     scenario: object
     records: dict = dataclasses.field(default_factory=dict)
+    settle: float | None = None
+    settled: dict = dataclasses.field(default_factory=dict, compare=False, repr=False)
+
+
+def settled_variant(base: StudyBase, scenario, changes: dict):
+    """``scenario`` (the base changed by a point's structural values ``changes``: builder options, run settings,
+    friction) settled for ``base.settle`` s, kept in ``base.settled``. Settling the base alone started a point of
+    another geometry or friction unsettled, its gaps closing under the shaking (a traced wall "damaged" at rest:
+    masonrycli/settle.py), or from the base's resting place. A variant that does not stand is refused naming
+    its point. The motions (amplitude, record, scale) do not change where a structure rests: not in the key."""
+    from masonrycli.settle import settled_scenario
+
+    key = tuple(sorted(changes.items()))
+    if key not in base.settled:
+        try:
+            base.settled[key] = settled_scenario(scenario, base.settle)
+        except InputError as exc:
+            raise InputError(f"--param {_point(changes)}: {exc}" if changes else str(exc)) from None
+    return base.settled[key]

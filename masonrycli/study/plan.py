@@ -89,7 +89,7 @@ def plan_study(
     the warnings (runs shorter than records) once ``run_study`` has checked the table. Raises
     :class:`InputError`, the first problem in one line, before any run or file. ``survey``: how a geometry
     file is read (--units, --flip-y, --convex-hull, --trim-overlaps, as ``masonry run`` reads it); ``settle``: s
-    the structure comes to rest under its own weight first, once for every run (:mod:`masonrycli.settle`)."""
+    each variant of the structure comes to rest under its own weight first (:func:`~masonrycli.study.axes.settled_variant`)."""
     from masonrycli.execute import command_line
     from masonrycli.records.intensity import INTENSITY_MEASURES
     from masonrycli.study.scheduler import check_scheduler
@@ -99,7 +99,7 @@ def plan_study(
     # runs', so a --dt need not divide it ('--records recs --dt 0.003' said "does not divide duration = 1.0")
     # a geometry file has no [run] duration of its own either: swept over records, it runs them whole too
     lasting = bool(records) and duration is None and (is_built_in(target) or _is_geometry(target))
-    base = StudyBase(_base_scenario(target, duration, dt, lasting, survey, settle), {})
+    base = StudyBase(_base_scenario(target, duration, dt, lasting, survey), {}, settle)  # each variant settled (axes)
     name = base.scenario.name
     # the name reduced as recordings name it: "../../evil" made a folder "study-.." and wrote beside it
     out = store.check_out(out or Path(f"study-{safe_name(name)}.parquet"))
@@ -114,7 +114,7 @@ def plan_study(
         unread += unused_baseline(baseline, motions)
         scenario, late = _record_duration(base.scenario, motions, lasting)  # a file's [run] duration stands
         late = [*unread, *late]
-        base = StudyBase(scenario, motions)
+        base = StudyBase(scenario, motions, settle)
         axes.insert(0, Axis("record", tuple(motions)))
     if scale is not None:
         axes.append(parse_axis(f"scale={scale}", where=f"--scale {scale}"))  # it said "--param scale=..."
@@ -179,7 +179,12 @@ def plan_study(
         stop_at_collapse=stop_at_collapse,
         histories=histories,
         force=force,
-        warnings=(*_scenario_warnings(base.scenario, base.records), *late, *_set_warnings(base, axes)),
+        warnings=(
+            *_scenario_warnings(base.scenario, base.records),
+            *_settled_lines(base),
+            *late,
+            *_set_warnings(base, axes),
+        ),
         warn=warn,
         command=command_line().get("command", ""),  # each history names it (masonry report: what was run)
     )
@@ -260,13 +265,25 @@ def _is_geometry(target) -> bool:
     return Path(target).suffix.lower() in GEOMETRY_SUFFIXES
 
 
-def _base_scenario(target: str, duration, dt, lasting: bool = False, survey: dict | None = None, settle=None):
-    """The study's scenario before its axes; ``lasting``: its duration is set later (by the records), so
-    a ``dt`` is applied with a duration it divides."""
-    from masonrycli.settle import settled_scenario
+def _settled_lines(base) -> list[str]:
+    """What ``--settle`` did: the line ``masonry run --settle`` says, one a variant of the structure the points
+    checked settled (its values first: ``blocks=20: settled 0.5 s …``), at most :data:`SETTLED_LINES`."""
+    lines = [
+        (f"{' '.join(f'{k}={v:g}' if isinstance(v, float) else f'{k}={v}' for k, v in key)}: " if key else "")
+        + scenario.warnings[-1].replace("before the run: it starts", "before its runs: each starts")
+        for key, scenario in base.settled.items()
+    ]
+    more = len(lines) - SETTLED_LINES
+    return lines[:SETTLED_LINES] + ([f"… and {more} more variants settled so (--settle)"] if more > 0 else [])
 
+
+SETTLED_LINES = 5
+
+
+def _base_scenario(target: str, duration, dt, lasting: bool = False, survey: dict | None = None):
+    """The study's scenario before its axes, as drawn (``--settle`` settles each variant: axes.settled_variant);
+    ``lasting``: its duration is set later (by the records), so a ``dt`` is applied with a duration it divides."""
     scenario = target_scenario(target, _shaken, survey)  # a GeoJSON / WKT file as `masonry run` takes it
-    scenario = settled_scenario(scenario, settle)  # once, before the axes: every run starts from it at rest
     if lasting and dt is not None and dt > 0:
         import math
 

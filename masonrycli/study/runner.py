@@ -41,13 +41,8 @@ def open_cluster(scheduler: str | None, workers: int | None, runs: int | None = 
     """``(client, cluster)``: a client of ``scheduler``, or of a new LocalCluster (then also returned,
     to be closed by the caller) with ``workers`` processes (default: one per core), at most ``runs`` (the
     runs that can go at once): "-p amp=0.1,0.2 --workers 4" started 4 processes of ~200 MB, 2 of them idle."""
-    # distributed's first import defines its dataclasses by exec(): a KeyboardInterrupt raised inside one,
-    # even caught, made `python -m masonrycli` exit -2 after the stop line (CPython 3.11 flags it as unhandled;
-    # 2 in 24 Ctrl-Cs 0.45-0.6 s in). Held over the import, the signal is raised after it.
-    importing = _WhileWorkersStart(spawning=False)
-    with importing:
-        from distributed import Client, LocalCluster
-    importing.deliver()
+    import_distributed()
+    from distributed import Client, LocalCluster
 
     if scheduler:
         from masonrycli.study.versions import check_workers
@@ -94,6 +89,18 @@ def open_cluster(scheduler: str | None, workers: int | None, runs: int | None = 
             cluster.close()
         raise
     return client, cluster
+
+
+def import_distributed() -> None:
+    """Import distributed, a Ctrl-C or SIGTERM of the import raised once it is done.
+
+    distributed's first import defines its dataclasses by exec(): a KeyboardInterrupt raised inside one,
+    even caught, made `python -m masonrycli` exit -2 after the stop line (CPython 3.11 flags it as unhandled;
+    2 in 24 Ctrl-Cs 0.45-0.6 s in). Held over the import, the signal is raised after it."""
+    importing = _WhileWorkersStart(spawning=False)
+    with importing:
+        import distributed  # noqa: F401
+    importing.deliver()
 
 
 class _WhileWorkersStart:
@@ -149,7 +156,9 @@ class _WhileWorkersStart:
 def dask_setup(worker) -> None:
     """Run by each worker process of a study's LocalCluster as it starts (a Dask preload): SIGINT ignored,
     so a Ctrl-C in the terminal is left to the command, which closes the cluster (:func:`open_cluster`).
-    Setting SIG_IGN also drops a Ctrl-C that waited, blocked, for this moment."""
+    Setting SIG_IGN also drops a Ctrl-C that waited, blocked, for this moment. Its logs go quiet here too: a
+    worker started again after a death (Dask's nanny, or the study's watch) missed :func:`open_cluster`'s call."""
+    quiet_worker_logs()
     if threading.current_thread() is threading.main_thread():
         signal.signal(signal.SIGINT, signal.SIG_IGN)
         if hasattr(signal, "SIGHUP"):  # the terminal closing is the command's to handle too (its rows written)

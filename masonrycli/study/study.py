@@ -7,6 +7,7 @@ options; the outputs around it (terminal table, PNG, Rerun recording) are made b
 
 from __future__ import annotations
 
+import dataclasses
 import hashlib
 import logging
 import math
@@ -118,6 +119,8 @@ def prepare(base: StudyBase, request: StudyRequest) -> tuple[str, dict[str, str]
     # kept its rows ("0 runs now, 1 row already there", the old pgv)
     records = {name: (r.source, r.scale, _samples_digest(r)) for name, r in base.records.items()}
     settings = (request.find, request.outcome if request.find else None, request.rtol if request.find else None)
+    if base.settle is not None:  # the scenario is as drawn: each variant's runs start settled (tables before: no key)
+        settings = (*settings, ("settle", base.settle))
     dumped = dump_scenario(base.scenario, inline_records=True)
     by_record = {
         name: store.fingerprint(dumped, {name: r}, settings, request.stop_at_collapse) for name, r in records.items()
@@ -126,7 +129,26 @@ def prepare(base: StudyBase, request: StudyRequest) -> tuple[str, dict[str, str]
 
 
 def run_study(base: StudyBase, request: StudyRequest, console: Console) -> StudyResult:
-    """Run every row of the study not already in ``request.out``; write the table (also on Ctrl-C)."""
+    """Run every row of the study not already in ``request.out``; write the table (also on Ctrl-C).
+    On Dask, Dask's own log lines go to ``<out>.dask.log``, and one line says so (:mod:`masonrycli.study.dask_log`)."""
+    if request.workers == 0:  # no Dask
+        return _run_study(base, request, console)
+    from masonrycli.study.dask_log import DaskLog, log_path
+
+    result = None
+    with DaskLog(log_path(request.out)) as log:
+        try:
+            result = _run_study(base, request, console)
+        finally:  # stopped (Ctrl-C, a lost scheduler) as well: the line comes before the stop's
+            said = log.said()
+            if said is not None and result is None and request.warn is not None:
+                request.warn(said)
+    if said is not None:  # shown once the table is
+        result = dataclasses.replace(result, warnings=(*result.warnings, said))
+    return result
+
+
+def _run_study(base: StudyBase, request: StudyRequest, console: Console) -> StudyResult:
     from masonrycli.engine import compile_ahead
     from masonrycli.study.runner import SchedulerLost, open_cluster, run_on_cluster, run_serially
 
