@@ -103,11 +103,14 @@ class Block:
 
 @dataclass(frozen=True, eq=False)
 class Support:
-    """A body with imposed motion (ground, foundation). ``role`` is ``"fixed"`` or ``"driven"``."""
+    """A body with imposed motion (ground, foundation). ``role`` is ``"fixed"`` or ``"driven"``. ``line``: the
+    ground line it was read from (m, as read: ``survey.ground_from_line`` of it is ``polygon``), written back as
+    that line; None for a support drawn as a polygon."""
 
     polygon: Polygon
     name: str
     role: str = "fixed"
+    line: tuple[tuple[float, float], ...] | None = None
 
     @property
     def vertices(self) -> np.ndarray:
@@ -116,11 +119,37 @@ class Support:
 
 
 @dataclass(frozen=True, eq=False)
+class TracedFill:
+    """A fill traced as an outline in a surveyed file (:mod:`geometry_library.traced_fill`), as read: its blocks
+    carry its weight; the writers write it back as the outline."""
+
+    name: str
+    density: float
+    """kg/m³."""
+    outline: Polygon
+    """m, as read (near the origin)."""
+
+
+@dataclass(frozen=True, eq=False)
 class Assembly:
-    """Blocks and supports, in a fixed order (block index = position in ``blocks``)."""
+    """Blocks and supports, in a fixed order (block index = position in ``blocks``). ``fills``: the traced fills
+    a file gave (their weight is in the blocks' ``carried_mass``), and ``uncarried`` the blocks before they carried
+    them, so that a writer writes the outlines and not their weight twice (both empty without traced fills)."""
 
     blocks: tuple[Block, ...]
     supports: tuple[Support, ...] = field(default_factory=tuple)
+    fills: tuple[TracedFill, ...] = ()
+    uncarried: tuple[Block, ...] = ()
+
+    def traced_fills(self) -> tuple[tuple[Block, ...], tuple[TracedFill, ...]]:
+        """(the blocks as written, the fills as written): the blocks before their traced fills and those fills,
+        or the blocks as they are and no fill when the assembly's blocks are no longer those the fills were
+        carried by (moved, trimmed, rebuilt after reading: their carried masses are then all a writer has)."""
+        same = len(self.uncarried) == len(self.blocks) and all(
+            u.polygon is b.polygon and u.name == b.name and u.thickness == b.thickness
+            for u, b in zip(self.uncarried, self.blocks)
+        )
+        return (self.uncarried, self.fills) if self.fills and same else (self.blocks, ())
 
     @property
     def block_count(self) -> int:

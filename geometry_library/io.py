@@ -49,8 +49,8 @@ import numpy as np
 import shapely
 from shapely.geometry import Polygon
 
-from .blocks import SUPPORT_ROLES, Assembly, Block, GeometryError, Support, name_problem, quoted_name
-from .checks import body_label
+from .blocks import SUPPORT_ROLES, Assembly, Block, GeometryError, Support, ccw_vertices, name_problem, quoted_name
+from .checks import body_label, polygon_from_coords
 from .fill import FILL_DENSITY
 from .survey import GROUND_DEPTH, Survey, finish_reading, frame_of, ground_from_line, surveyed_polygon
 from .traced_fill import carry_fills, fill_outline
@@ -184,6 +184,7 @@ def read_geojson(
     refused: list[tuple[str, str]] = []  # (message, body) of each polygon refused, said together at the end
     pending = []  # (feature_at, where, role, index, name, props, coords): made once every ring is read
     fills = []  # (where, name, density, coords) of each traced fill: its weight goes to the blocks under it
+    lines: dict[int, np.ndarray] = {}  # pending's index -> a ground line's points as given
     by_id = id_names(features)  # feature number -> "id-17": a GIS layer's own numbering names its stones
     survey, said = survey or Survey(), []  # said: the ground lines read
     for k, feature in enumerate(features, start=1):  # numbered from 1, as the bodies are (body_label)
@@ -222,7 +223,8 @@ def read_geojson(
         if line:  # [[x, y], …] (a MultiLineString of one part, as QGIS saves a line layer): the ground under it
             rings = rings[0] if gtype == "MultiLineString" and isinstance(rings, list) and len(rings) == 1 else rings
             try:
-                ring, dip = ground_from_line([[_real(c) for c in xy[:2]] for xy in rings], survey, where)
+                traced = np.array([[_real(c) for c in xy[:2]] for xy in rings], dtype=np.float64)
+                ring, dip = ground_from_line(traced, survey, where)
             except (TypeError, ValueError, IndexError) as exc:  # GeometryError is a ValueError: said as it is
                 bad = f"{where}: a ground line is [[x, y], …] (a MultiLineString of one part)"
                 raise GeometryError(str(exc) if isinstance(exc, GeometryError) else bad) from None
@@ -253,13 +255,17 @@ def read_geojson(
             fills.append((where, name, _number(props.get("density", FILL_DENSITY), "density", where), coords))
             continue
         (blocks if role == "block" else supports).append(None)  # numbered now, made once the frame is known
+        if line:
+            lines[len(pending)] = traced
         pending.append((feature_at, where, role, index, name, props, coords))
     frame = frame_of([entry[-1] for entry in pending], survey)
     hulls: list[tuple[str, float, float]] = []
     (notes if notes is not None else []).extend(said)
-    for feature_at, where, role, index, name, props, coords in pending:
+    for k, (feature_at, where, role, index, name, props, coords) in enumerate(pending):
+        line = frame.local(lines[k]) if k in lines else None  # the ground made again from it as read: written so
+        coords = frame.local(coords) if line is None else ground_from_line(line, Survey(), where)[0]
         try:
-            polygon = surveyed_polygon(frame.local(coords), index, name, role, survey, hulls)
+            polygon = surveyed_polygon(coords, index, name, role, survey, hulls)
         except GeometryError as exc:
             refused.append((f"{feature_at}: {exc}", body_label(index, name, role)))  # exc starts with the label
             continue
@@ -276,9 +282,14 @@ def read_geojson(
             srole = _word(props.get("support_role", "fixed"))
             if srole not in SUPPORT_ROLES:
                 raise GeometryError(f"{where}: support_role must be one of {SUPPORT_ROLES}, got {srole!r}")
-            supports[index] = Support(polygon, name, srole)
+            supports[index] = Support(polygon, name, srole, _line_of(line))
     outlines = [(where, name, rho, fill_outline(frame.local(xy), where)) for where, name, rho, xy in fills]
     return carry_fills(finish_reading(path, refused, blocks, supports, frame, survey, hulls, notes), outlines, notes)
+
+
+def _line_of(xy) -> tuple[tuple[float, float], ...] | None:
+    """A ground line's points (m, as read) as ``Support.line`` keeps them; None for no line."""
+    return None if xy is None else tuple((float(x), float(y)) for x, y in np.asarray(xy))
 
 
 def id_names(features: list) -> dict[int, str]:
@@ -309,11 +320,28 @@ def _ring_coords(polygon: Polygon) -> list[list[float]]:
     return [[float(x), float(y)] for x, y in np.asarray(xy)[:, :2]]
 
 
+def ground_line(support: Support) -> list[tuple[float, float]] | None:
+    """The ground line ``support`` was read from, when the ground made from it again is its polygon to the bit
+    (None otherwise: a support drawn as a polygon, or one trimmed since: its polygon is what it is)."""
+    if support.line is None:
+        return None
+    try:
+        ring, _ = ground_from_line(np.asarray(support.line, dtype=np.float64), Survey(), support.name)
+        made = polygon_from_coords(ring, 0, support.name, "support")
+    except GeometryError:
+        return None
+    return list(support.line) if np.array_equal(ccw_vertices(made), support.vertices) else None
+
+
 def write_geojson(assembly: Assembly, path) -> Path:
-    """Write ``assembly`` as a GeoJSON FeatureCollection (full precision); returns the path."""
+    """Write ``assembly`` as a GeoJSON FeatureCollection (full precision); returns the path. A surveyed file's
+    traced fills are written as their outlines (``"role": "fill"``, the blocks without their weight) and its ground
+    lines as lines, so that reading the file written gives the same assembly (in the coordinates read: near the
+    origin, in metres)."""
     path = Path(path)
     features = []
-    for block in assembly.blocks:
+    blocks, fills = assembly.traced_fills()
+    for block in blocks:
         props = {"role": "block", "name": block.name, "density": block.density, "thickness": block.thickness}
         if any(v != 0.0 for v in block.velocity):
             props["velocity"] = [float(v) for v in block.velocity]
@@ -321,9 +349,16 @@ def write_geojson(assembly: Assembly, path) -> Path:
             props["carried_mass"] = float(block.carried_mass)
             props["carried_at"] = [float(x) for x in block.carried_at]
         features.append(_feature(block.polygon, props))
+    for fill in fills:
+        features.append(_feature(fill.outline, {"role": "fill", "name": fill.name, "density": fill.density}))
     for support in assembly.supports:
         props = {"role": "support", "name": support.name, "support_role": support.role}
-        features.append(_feature(support.polygon, props))
+        line = ground_line(support)
+        if line is None:
+            features.append(_feature(support.polygon, props))
+        else:
+            geometry = {"type": "LineString", "coordinates": [[x, y] for x, y in line]}
+            features.append({"type": "Feature", "properties": props, "geometry": geometry})
     data = {"type": "FeatureCollection", "features": features}
     try:
         path.write_text(json.dumps(data, indent=1) + "\n", encoding="utf-8")

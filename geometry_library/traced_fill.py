@@ -21,9 +21,10 @@ The reading says what it did, one note per outline (its mass, the blocks carryin
 from __future__ import annotations
 
 import numpy as np
+import shapely
 from shapely.geometry import Polygon
 
-from .blocks import Assembly, GeometryError
+from .blocks import Assembly, GeometryError, TracedFill
 from .fill import carry, traced_fill_over
 from .values import check_material
 
@@ -33,7 +34,7 @@ def fill_outline(xy: np.ndarray, where: str) -> Polygon:
     xy = np.asarray(xy, dtype=np.float64)
     if len(xy) < 3 or not np.all(np.isfinite(xy)):
         raise GeometryError(f"{where}: a fill's outline needs three or more finite [x, y] points")
-    outline = Polygon(xy)
+    outline = shapely.geometry.polygon.orient(Polygon(xy), sign=1.0)  # CCW as written back: a round trip is exact
     if not outline.is_valid:
         raise GeometryError(f"{where}: the fill's outline crosses itself: trace it as one simple polygon")
     if outline.area <= 0.0:
@@ -46,6 +47,8 @@ def carry_fills(assembly: Assembly, outlines: list, notes: list | None) -> Assem
     outline) each: module docstring); ``notes`` (if a list) receives one line per fill. A fill that no block
     carries is refused: it would be no load at all."""
     blocks = list(assembly.blocks)
+    if not outlines:
+        return assembly
     for where, _name, density, outline in outlines:
         check_material(where, density=density)  # the builder's --fill-density range: 1e9 kg/m³ ran, a typo
         traced = traced_fill_over(blocks, assembly.supports, outline)
@@ -72,4 +75,5 @@ def carry_fills(assembly: Assembly, outlines: list, notes: list | None) -> Assem
                 f"by the {int((area > 0.0).sum())} blocks under it (no strength, no side pressure)"
                 + "".join(f"; {text}" for text in left)
             )
-    return Assembly(tuple(blocks), assembly.supports)
+    fills = tuple(TracedFill(name, float(density), outline) for _, name, density, outline in outlines)
+    return Assembly(tuple(blocks), assembly.supports, fills, assembly.blocks)

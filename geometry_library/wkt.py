@@ -34,7 +34,7 @@ from shapely.geometry import GeometryCollection, LineString, MultiLineString, Mu
 from .blocks import Assembly, Block, GeometryError, Support
 from .checks import body_label
 from .fill import FILL_DENSITY
-from .io import _number, _read_text, _ring_coords
+from .io import _line_of, _number, _read_text, _ring_coords, ground_line
 from .survey import GROUND_DEPTH, Survey, finish_reading, frame_of, ground_from_line, surveyed_polygon
 from .traced_fill import carry_fills, fill_outline
 
@@ -64,10 +64,12 @@ def _polygons_of(geom, where: str) -> list[Polygon]:
     )
 
 
-def _ground_polygon(geom, role: str, where: str, body: str, survey: Survey, said: list[str]) -> Polygon:
+def _ground_polygon(
+    geom, role: str, where: str, body: str, survey: Survey, said: list[str]
+) -> tuple[Polygon, np.ndarray]:
     """The ground under a traced ground line (``survey.ground_from_line``, as a GeoJSON ``LineString``'s), in the
-    file's coordinates; the line said in ``said``. A line labelled ``block``, or of several parts, is refused;
-    ``body``: ``where`` with the support's label, for the line's own faults."""
+    file's coordinates, its line's points as ``traced``; the line said in ``said``. A line labelled ``block``, or of
+    several parts, is refused; ``body``: ``where`` with the support's label, for the line's own faults."""
     kind = geom.geom_type.upper()
     if role != "support":
         raise GeometryError(f"{where}: a {kind} is the ground under it: label it 'support NAME:' (or not at all)")
@@ -75,12 +77,13 @@ def _ground_polygon(geom, role: str, where: str, body: str, survey: Survey, said
         if len(geom.geoms) != 1:
             raise GeometryError(f"{where}: a MULTILINESTRING of {len(geom.geoms)} parts; a ground line is one line")
         geom = geom.geoms[0]
-    ring, dip = ground_from_line(np.asarray(geom.coords, dtype=np.float64)[:, :2], survey, body)
+    traced = np.asarray(geom.coords, dtype=np.float64)[:, :2]
+    ring, dip = ground_from_line(traced, survey, body)
     said.append(
         f"{where}: a {kind} read as the ground under it, {GROUND_DEPTH:g} m deep (its upper hull: dips up to "
         f"{dip * 1e3:.2g} mm bridged)"
     )
-    return Polygon(ring)
+    return Polygon(ring), traced
 
 
 def _parse_wkt(text: str, where: str):
@@ -150,6 +153,7 @@ def read_wkt(
     pending = []  # (where, role, index, label, srole, coords): made once every ring is read
     survey, said = survey or Survey(), []  # said: the ground lines read
     fills = []  # (where, name, density, ring) of each traced fill
+    lines: dict[int, np.ndarray] = {}  # pending's index -> a ground line's points as given
     for where, role, name, srole, text in entries:
         geom = _parse_wkt(text, where)
         line = isinstance(geom, (LineString, MultiLineString))  # a ground line traced along the foot
@@ -159,7 +163,8 @@ def read_wkt(
             continue
         if line:
             body = f"{where}: {body_label(len(supports), name or 'ground', 'support')}"
-            polys = [_ground_polygon(geom, (role or "support").lower(), where, body, survey, said)]
+            ground, lines[len(pending)] = _ground_polygon(geom, (role or "support").lower(), where, body, survey, said)
+            polys = [ground]
             role, name = "support", name or "ground"
         else:
             role = (role or ("support" if srole else "block")).lower()
@@ -180,16 +185,18 @@ def read_wkt(
     (notes if notes is not None else []).extend(said)
     outlines = [(where, name, rho, fill_outline(frame.local(xy), where)) for where, name, rho, xy in fills]
     hulls: list[tuple[str, float, float]] = []
-    for where, role, index, label, srole, coords in pending:
+    for k, (where, role, index, label, srole, coords) in enumerate(pending):
+        line = frame.local(lines[k]) if k in lines else None  # the ground made again from it as read: written so
+        coords = frame.local(coords) if line is None else ground_from_line(line, Survey(), where)[0]
         try:
-            polygon = surveyed_polygon(frame.local(coords), index, label, role, survey, hulls)
+            polygon = surveyed_polygon(coords, index, label, role, survey, hulls)
         except GeometryError as exc:
             refused.append((f"{where}: {exc}", body_label(index, label, role)))
             continue
         if role == "block":
             blocks[index] = Block(polygon, label, float(density), float(thickness))
         else:
-            supports[index] = Support(polygon, label, (srole or "fixed").lower())
+            supports[index] = Support(polygon, label, (srole or "fixed").lower(), _line_of(line))
     return carry_fills(finish_reading(path, refused, blocks, supports, frame, survey, hulls, notes), outlines, notes)
 
 
@@ -252,14 +259,30 @@ def _wkt_polygon(polygon: Polygon) -> str:
 
 
 def write_wkt(assembly: Assembly, path) -> Path:
-    """Write ``assembly`` as labelled WKT lines (full precision; density, thickness and a carried fill are not kept)."""
+    """Write ``assembly`` as labelled WKT lines (full precision): its traced fills as ``fill NAME DENSITY:``
+    outlines, its ground lines as LINESTRINGs, so that reading the file gives the same assembly (coordinates as
+    read: near the origin, in metres). Density and thickness are not kept (the reader's arguments give them); a
+    block carrying a mass that is no traced fill's (the builder's ``fill_to``) is refused: WKT cannot hold it."""
     path = Path(path)
-    for body in (*assembly.blocks, *assembly.supports):
+    blocks, fills = assembly.traced_fills()
+    for body in (*blocks, *assembly.supports, *fills):
         if not body.name or re.search(r"[\s:]", body.name):
             raise GeometryError(f'{path}: name "{body.name}" cannot be written to WKT (spaces or colons)')
-    lines = ["# masonry assembly: one body per line, '<role> <name> [support role]: <WKT>'"]
-    lines += [f"block {b.name}: {_wkt_polygon(b.polygon)}" for b in assembly.blocks]
-    lines += [f"support {s.name} {s.role}: {_wkt_polygon(s.polygon)}" for s in assembly.supports]
+    for index, block in enumerate(blocks):
+        if block.carried_mass > 0.0:
+            raise GeometryError(
+                f"{path}: {body_label(index, block.name)} carries {block.carried_mass:.4g} kg (a fill's weight), which "
+                "WKT cannot hold: write GeoJSON (write_geojson keeps it as carried_mass)"
+            )
+    lines = ["# masonry assembly: one body per line, '<role> <name> [support role]: <WKT>', 'fill <name> <kg/m3>: …'"]
+    lines += [f"block {b.name}: {_wkt_polygon(b.polygon)}" for b in blocks]
+    lines += [f"fill {f.name} {f.density!r}: {_wkt_polygon(f.outline)}" for f in fills]
+    for s in assembly.supports:
+        line = ground_line(s)
+        shape = (
+            _wkt_polygon(s.polygon) if line is None else f"LINESTRING ({', '.join(f'{x!r} {y!r}' for x, y in line)})"
+        )
+        lines.append(f"support {s.name} {s.role}: {shape}")
     try:
         path.write_text("\n".join(lines) + "\n", encoding="utf-8")
     except OSError as exc:

@@ -357,11 +357,15 @@ def _analyse(structure, live, friction, verify, out, force, done: _Done, signals
             map_origin=None if origin is None else (float(origin[0]), float(origin[1])),
         )
         if options["min_thickness"]:
-            from masonrycli.limit.thickness import builtin_least_ring
+            from masonrycli.limit.thickness import builtin_least_ring, traced_least_ring
+            from masonrycli.scenario.target import is_built_in
 
-            done.result = replace(
-                done.result, ring=builtin_least_ring(structure, friction, options["structure_options"])
+            ring = (
+                builtin_least_ring(structure, friction, options["structure_options"])
+                if is_built_in(structure)
+                else traced_least_ring(scenario)
             )
+            done.result = replace(done.result, ring=ring)
     except LimitError as exc:
         # one line, as any refusal: a block touching nothing was said twice (a warning, then the error in the
         # same words); a setting's warning is the reason ("no equilibrium" under a gravity pointing up)

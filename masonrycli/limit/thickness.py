@@ -1,4 +1,5 @@
-"""The least ring thickness of a built-in arch and its geometric factor of safety (``masonry limit --min-thickness``).
+"""The least ring thickness of an arch and its geometric factor of safety (``masonry limit --min-thickness``): the
+built-in arch's, or a surveyed ring's (a geometry file's: thinned about its centre line, :mod:`geometry_library.ring`).
 
 Heyman's geometric factor of safety of a masonry arch is its ring thickness over the least thickness whose
 ring, on the same supports, can still carry its own weight (at the least one the thrust line touches the
@@ -21,6 +22,7 @@ reach the builder's 0.1 mm there, where the semicircle beside it needs 0.454 m).
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 
 from masonrycli.errors import InputError
@@ -46,6 +48,9 @@ class LeastThickness:
     """Why no thinner ring was tried (the builder's refusal of one, in its words), when the ring still stands
     at the thinnest tried: ``least`` is then an upper bound and the factor a lower bound. None: the search
     found where the ring stops standing."""
+    traced: str | None = None
+    """A surveyed ring's voussoirs ("v01 … v17, 17 voussoirs"), whose thickness is its joints' mean length; None:
+    the built-in arch's ring."""
 
     @property
     def factor(self) -> float:
@@ -55,10 +60,12 @@ class LeastThickness:
     def describe(self) -> str:
         """The table's line."""
         if self.bounded_by is None:
-            return (
-                f"{self.least:.4g} m for a ring of {self.thickness:g} m: geometric factor of safety "
-                f"{self.factor:.2f} (Heyman)"
+            ring = (
+                f"{self.thickness:g} m"
+                if self.traced is None
+                else f"{self.thickness:.4g} m ({self.traced}, thinned about its centre line)"
             )
+            return f"{self.least:.4g} m for a ring of {ring}: geometric factor of safety {self.factor:.2f} (Heyman)"
         return (
             f"at most {self.least:.4g} m for a ring of {self.thickness:g} m: it still stands at the thinnest "
             f"tried ({self.bounded_by}); geometric factor of safety at least "
@@ -145,24 +152,49 @@ def builtin_least_ring(structure: str, friction: float | None, structure_options
     return least_ring_thickness(build, thickness)
 
 
-def check_min_thickness(structure: str, settle: float | None) -> None:
-    """Refuse ``--min-thickness`` on anything but the arch built-in, and with ``--settle``: the search builds
-    the builder's rings, laid exact, where settling moves nothing, and a ring settled near its least thickness
-    would be the engine's slow creep, not the ring. It searched the unsettled rings under the settled table."""
-    if structure != "arch":
-        from masonrycli.scenario.target import is_built_in
+MIN_FACTOR = 1e-3
+"""The thinnest a traced ring is made, over its thickness as traced (a 0.5 m ring: 0.5 mm)."""
 
-        survey = (
-            ""
-            if is_built_in(structure)
-            else "; a surveyed ring's: the arch built-in of its span, rise and ring (masonry limit arch --span S "
-            "--rise F --ring-thickness T --pier-width W --min-thickness), its voussoirs equal"
-        )
+
+def traced_least_ring(scenario) -> LeastThickness:
+    """The :class:`LeastThickness` of the ring traced in a geometry file's ``scenario`` (:mod:`geometry_library.ring`:
+    its voussoirs thinned about the ring's centre line, its traced fills carried again); InputError, one line, when
+    it has none."""
+    from geometry_library.blocks import GeometryError
+    from geometry_library.ring import find_ring, thinner
+
+    try:
+        ring = find_ring(scenario.assembly)
+    except GeometryError as exc:
+        raise InputError(f"--min-thickness: {scenario.source}: {exc}") from None
+
+    def build(t: float):
+        factor = t / ring.thickness
+        if factor < MIN_FACTOR:
+            raise InputError(f"a ring under {MIN_FACTOR:g} of its traced thickness is made no thinner")
+        try:
+            return dataclasses.replace(scenario, assembly=thinner(scenario.assembly, ring, factor))
+        except GeometryError as exc:
+            raise InputError(str(exc)) from None
+
+    found = least_ring_thickness(build, ring.thickness)
+    return dataclasses.replace(found, traced=ring.describe(scenario.assembly))
+
+
+def check_min_thickness(structure: str, settle: float | None) -> None:
+    """Refuse ``--min-thickness`` on the wall and aqueduct built-ins, and with ``--settle``: the search builds the
+    rings, laid exact (the builder's) or as traced, and a ring settled near its least thickness would be the
+    engine's slow creep, not the ring. It searched the unsettled rings under the settled table."""
+    from masonrycli.scenario.target import is_built_in
+
+    if structure != "arch" and is_built_in(structure):
         raise InputError(
-            f"--min-thickness: the arch's ring only (masonry limit arch …); {structure} is not the arch built-in{survey}"
+            f"--min-thickness: an arch's ring only (masonry limit arch …, or a surveyed arch's file); {structure} has "
+            "no ring of its own to thin"
         )
     if settle is not None:
+        rings = "the builder's rings, laid exact" if structure == "arch" else "the ring as traced, thinned"
         raise InputError(
-            f"--min-thickness with --settle {settle:g}: the least thickness is searched over the builder's rings, "
-            "laid exact, with nothing to settle (--settle is for a traced file's gaps); drop --settle"
+            f"--min-thickness with --settle {settle:g}: the least thickness is searched over {rings}, not over a "
+            "settled ring; drop --settle"
         )

@@ -216,7 +216,7 @@ class Scenario:
                 s if s.role == m.role else dataclasses.replace(s, role=m.role)
                 for s, m in zip(self.assembly.supports, motions)
             )
-            object.__setattr__(self, "assembly", Assembly(blocks=self.assembly.blocks, supports=supports))
+            object.__setattr__(self, "assembly", dataclasses.replace(self.assembly, supports=supports))  # fills kept
         where = "" if self.source.startswith("builder:") or not self.source else f"{self.source}: "
         object.__setattr__(self, "assembly", _cleaned_assembly(self.assembly, where))
         _check_initial_velocities(self.assembly, where)
@@ -275,7 +275,7 @@ def _cleaned_assembly(assembly: Assembly, where: str) -> Assembly:
     supports = tuple(cleaned(s, j, "support") for j, s in enumerate(assembly.supports))
     if all(a is b for a, b in zip(blocks + supports, (*assembly.blocks, *assembly.supports))):
         return assembly
-    return Assembly(blocks=blocks, supports=supports)
+    return dataclasses.replace(assembly, blocks=blocks, supports=supports)  # traced fills kept (traced_fills checks)
 
 
 def _check_initial_velocities(assembly: Assembly, where: str) -> None:
