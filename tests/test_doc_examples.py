@@ -166,6 +166,12 @@ def _seed(folder: Path) -> None:
     for records in ("records", "recs"):
         (folder / records).mkdir()
         write_at2(folder / records / "RSN6_IMPVALL.I_I-ELC180.AT2", a / 9.81, 0.01)
+    write_at2(folder / "recs" / "RSN900_SYN-0.AT2", a / 9.81, 0.01)  # sweep.md's fragility study, a row replayed
+    (folder / "frag.csv").write_text(  # and its table, read by the page's Python (two rows a study makes)
+        "record,blocks,pga_g,friction,state,peak_drift,status,error,study,source,command\n"
+        "RSN900_SYN-0.AT2,12,2.25,0.5,collapsed,0.25,completed,,abc,def,masonry sweep …\n"
+        "RSN900_SYN-0.AT2,12,2.25,0.6,damaged,0.12,completed,,abc,def,masonry sweep …\n"
+    )
     arch = json.loads((folder / "arch.geojson").read_text())  # scenario-format.md: "those marked driven shake"
     for feature in arch["features"]:
         if feature["properties"]["role"] == "support":

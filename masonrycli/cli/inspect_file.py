@@ -32,6 +32,7 @@ def inspect_command(
             f"{recording} — study table", *study_summary(recording), "column", "unit / meaning"
         )
         console.print(table)
+        _print_levels(recording)
         for line in lines:
             console.print(line, soft_wrap=True)
         return
@@ -68,3 +69,25 @@ def inspect_command(
             else "its writer did not finish: killed, or the disk was full"
         )
         warn(f"{recording}: truncated ({why}) — {info['frames']} frames up to its last complete chunk")
+
+
+def _print_levels(path: Path) -> None:
+    """A record study's collapsed fraction per level (``pga_g`` or ``scale``), under its table: the counts the
+    sweep printed at its end, from the table (masonrycli/study/levels.py)."""
+    from rich import box
+    from rich.table import Table
+
+    from masonrycli.study.inspect_table import level_table
+
+    found = level_table(path)
+    if found is None:
+        return
+    title, heads, cells, note = found
+    table = Table(title=title, title_justify="left", box=box.SIMPLE_HEAD)
+    for i, head in enumerate(heads):
+        table.add_column(head, justify="left" if i == 0 else "right", no_wrap=True)
+    for line in cells:
+        table.add_row(*line)
+    console.print(table)
+    if note:
+        console.print(note, soft_wrap=True)

@@ -81,8 +81,7 @@ def study_summary(path) -> tuple[list[tuple[str, str]], list[tuple[str, str]]]:
             f"{path}: not a study's table (no study and status columns); inspect reads the .rrd recordings, the .npz "
             "histories and the tables of masonry sweep"
         )
-    find = next((c[: -len("_threshold")] for c in columns if c.endswith("_threshold")), None)
-    params = [c for c in columns if c not in COLUMN_UNITS and not (find and c.startswith(find) and c.endswith(_SEARCH))]
+    find, params = _params(columns)
     states = Counter(r.get("state") or "failed" for r in rows) if "state" in columns else Counter()
     if find:  # a search's rows: found or not
         states = Counter(
@@ -120,6 +119,25 @@ def study_summary(path) -> tuple[list[tuple[str, str]], list[tuple[str, str]]]:
         else:
             lines.append((c, COLUMN_UNITS[c]))
     return table, lines
+
+
+def level_table(path):
+    """The collapsed fraction per level of a record study's table at ``path`` (:func:`masonrycli.study.levels.
+    collapsed_table`: title, heads, cells, note), or None (no level axis, a search's table, no row)."""
+    from masonrycli.study.levels import collapsed_table
+    from masonrycli.study.store import _read_table
+
+    rows = _read_table(Path(path))
+    find, params = _params(list(rows[0]) if rows else [])
+    return None if find else collapsed_table(rows, params)
+
+
+def _params(columns: list[str]) -> tuple[str | None, list[str]]:
+    """``(the --find parameter or None, the swept parameters)`` of a table's ``columns``."""
+    find = next((c[: -len("_threshold")] for c in columns if c.endswith("_threshold")), None)
+    return find, [
+        c for c in columns if c not in COLUMN_UNITS and not (find and c.startswith(find) and c.endswith(_SEARCH))
+    ]
 
 
 def _commands(rows: list[dict]) -> str:
