@@ -121,6 +121,27 @@ def _call(function: str, target, options: dict) -> str:
     return f"api.{function}({', '.join([_argument(target), *given])})"
 
 
+class _FirstUnconverged:
+    """Warns of the run's first unconverged step as it ends (a RuntimeWarning): the count came only with the run's
+    end, minutes later in a long run. The end's warning still says how many and the worst."""
+
+    def __init__(self, run):
+        self.run, self.said = run, False
+
+    def on_frame(self, frame) -> None:
+        """Frames are not its business (a sink's ``log_step`` is)."""
+
+    def log_step(self, step: int, time: float, stats) -> None:
+        if not stats.converged and not self.said:
+            from masonrycli.run_summary import first_unconverged_warning
+
+            self.said = True
+            warnings.warn(first_unconverged_warning(step, time, stats.residual, self.run), RuntimeWarning, stacklevel=2)
+
+    def close(self, status: str, note: str = "") -> None:
+        """Nothing to close."""
+
+
 class _FrameCallback:
     """``simulate(on_frame=f)``: ``f(frame)`` for every recorded :class:`~masonrycli.outputs.frame.Frame`."""
 
@@ -172,7 +193,7 @@ def simulate(
     # force_jupyter=False: in a notebook rich shows every console's output under the cell whatever its file (the
     # summary table, which goes to Run.summary, was shown after every run of a loop)
     quiet = Console(file=io.StringIO(), quiet=True, force_jupyter=False)
-    sinks = [_FrameCallback(on_frame)] if on_frame is not None else []
+    sinks = [_FirstUnconverged(sc.run), *([_FrameCallback(on_frame)] if on_frame is not None else [])]
     # which run of a loop the line is: the scenario and the options given ('wall (freq=2.0, friction=0.8)')
     given = ", ".join(f"{k}={_argument(v)}" for k, v in options.items() if v is not None)
     live = LiveLine(f"{sc.name} ({given})" if given else sc.name) if progress else None

@@ -7,6 +7,7 @@ from __future__ import annotations
 import difflib
 import functools
 import os
+import sys
 import warnings
 from pathlib import Path
 
@@ -50,7 +51,8 @@ def all_keywords() -> frozenset[str]:
 def python_spelled(function=None, *, keywords=None, renamed=None):
     """``function`` with the options its errors and warnings name spelled as its keywords (``duration=``, where
     the command line says ``--duration``): the same messages (:mod:`masonrycli.option_spelling`). Its warnings
-    are said as it returns or raises, from the caller's line. ``keywords`` / ``renamed``: a method's own (default:
+    are said as they happen, from the caller's line (they were held until the call returned: a record's warning
+    came minutes later, at the end of the run). ``keywords`` / ``renamed``: a method's own (default:
     scenario's and simulate's, ``--out`` as ``recording=``)."""
     from masonrycli.option_spelling import RENAMED, python_spelling
 
@@ -64,19 +66,35 @@ def python_spelled(function=None, *, keywords=None, renamed=None):
 
     @functools.wraps(function)
     def spelled(*args, **kwargs):
-        caught: list = []
-        try:
-            # the caller's filters kept: what they hide (a library's DeprecationWarning) is not said again below,
-            # from the caller's line, where Python shows a DeprecationWarning of __main__
-            with warnings.catch_warnings(record=True) as caught:
+        caller = sys._getframe(1)  # the notebook's line, which the warnings name
+        # the caller's filters kept: what they hide (a library's DeprecationWarning) reaches no showwarning, so
+        # is not said again from the caller's line, where Python shows a DeprecationWarning of __main__
+        with warnings.catch_warnings():  # showwarning restored on the way out
+            warnings.showwarning = _said_from(caller, warnings.showwarning, spell)
+            try:
                 return function(*args, **kwargs)
-        except InputError as exc:
-            raise InputError(spell(str(exc))) from None
-        finally:
-            for said in caught:
-                warnings.warn(spell(str(said.message)), said.category, stacklevel=2)
+            except InputError as exc:
+                raise InputError(spell(str(exc))) from None
 
     return spelled
+
+
+def _said_from(caller, show, spell):
+    """A ``warnings.showwarning`` that says a warning again now, spelled, as if warned at ``caller``'s line
+    (through the caller's filters, shown by ``show``: the caller's own showwarning)."""
+
+    def say(message, category, filename, lineno, file=None, line=None):
+        mine = warnings.showwarning
+        warnings.showwarning = show  # its own showing: not this one again
+        try:
+            module = caller.f_globals.get("__name__", "__main__")
+            registry = caller.f_globals.setdefault("__warningregistry__", {})
+            text = spell(str(message))
+            warnings.warn_explicit(text, category, caller.f_code.co_filename, caller.f_lineno, module, registry)
+        finally:
+            warnings.showwarning = mine
+
+    return say
 
 
 OUTPUTS = {  # the command line's output options, which simulate() names otherwise

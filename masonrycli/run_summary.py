@@ -44,6 +44,17 @@ def unconverged_warning(unconverged: int, steps: int, capped: int, run, worst: t
     )
 
 
+def first_unconverged_warning(step: int, time: float, residual: float, run) -> str:
+    """What the Python API warns as the first step of ``run`` (a RunConfig) ends unconverged, during the run:
+    the step, its residual and the tolerance (the end's :func:`unconverged_warning` counts them all)."""
+    ratio = residual / run.tolerance if residual == residual else float("nan")
+    times = f"{ratio:.2g}" if ratio < 10 else f"{ratio:.0f}"
+    return (
+        f"step {step} (t = {time:g} s) ended unconverged: contact-law residual {residual:.3g} m/s, {times}× "
+        f"--tolerance {run.tolerance:g} m/s; the run goes on, and its end says how many steps did"
+    )
+
+
 def result_warning(result, run) -> str | None:
     """The warning a run's ``result`` gets after its summary (``run``: its RunConfig): how many steps ended
     unconverged, or None when every step converged. The command line prints it; the Python API warns it."""

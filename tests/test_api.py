@@ -328,7 +328,8 @@ def test_unconverged_steps_are_warned_as_the_command_line_warns_them():
     with pytest.warns(RuntimeWarning) as said:
         run = api.simulate("wall", amp=1.0, duration=0.02, max_iterations=5)
     # the command line's line, its options spelled as the keywords given (tolerance=, max_iterations=)
-    assert [str(w.message) for w in said] == [python_spelling(line, api._keywords())]
+    # after the first unconverged step's own warning, said as it ended (tests/test_api_warnings.py)
+    assert [str(w.message) for w in said][1:] == [python_spelling(line, api._keywords())]
     assert line.startswith("20 of 20 steps ended unconverged") and "--tolerance" in line
-    assert "above tolerance=1e-05 m/s" in str(said[0].message)
+    assert "above tolerance=1e-05 m/s" in str(said[-1].message)
     assert run.status == "completed" and run["nlgs_unconverged"][-1] == 20
