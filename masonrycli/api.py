@@ -175,7 +175,7 @@ def simulate(
     in a notebook a display under the cell; else stderr), first saying why a first run waits."""
     from rich.console import Console
 
-    from masonrycli.execute import check_run, execute, result_warning
+    from masonrycli.execute import check_magnify, check_run, execute, result_warning
     from masonrycli.interrupt import StopRun
     from masonrycli.outputs.live_line import LiveLine
     from masonrycli.outputs.report import summary_table
@@ -187,6 +187,9 @@ def simulate(
     call = _call("simulate", target, options | {k: v for k, v in asked.items() if v not in (None, False)})
     out = _path(recording, "--out", output=True) if recording not in (None, False, True) else None
     hist = _path(history, "--history", output=True) if history is not None else None
+    if magnify is not None and recording in (None, False):  # the command line's "--magnify 5 with --no-recording"
+        check_magnify(magnify, no_recording=False)  # its range first, as the command line's
+        raise InputError(f"magnify={_argument(magnify)} draws in the recording: give recording= too (a path, or True)")
     outputs = check_run(sc, out, hist, no_recording=recording in (None, False), force=force, magnify=magnify)
     for warning in scenario_warnings(sc):
         warnings.warn(warning, UserWarning, stacklevel=2)

@@ -59,14 +59,15 @@ def python_spelled(function=None, *, keywords=None, renamed=None):
     if function is None:
         return functools.partial(python_spelled, keywords=keywords, renamed=renamed)
 
-    def spell(text: str) -> str:
-        return python_spelling(
-            text, all_keywords() if keywords is None else keywords, RENAMED if renamed is None else renamed
-        )
-
     @functools.wraps(function)
     def spelled(*args, **kwargs):
         caller = sys._getframe(1)  # the notebook's line, which the warnings name
+        given = {k: v for k, v in kwargs.items() if v is not None}  # "--blocks and --courses:" said no values
+
+        def spell(text: str) -> str:
+            known = all_keywords() if keywords is None else keywords
+            return python_spelling(text, known, RENAMED if renamed is None else renamed, given)
+
         # the caller's filters kept: what they hide (a library's DeprecationWarning) reaches no showwarning, so
         # is not said again from the caller's line, where Python shows a DeprecationWarning of __main__
         with warnings.catch_warnings():  # showwarning restored on the way out
@@ -143,11 +144,15 @@ def path_value(value, option: str, *, output: bool = False) -> Path:
     from masonrycli.cli.option_values import file_path_value, path_value
 
     if not isinstance(value, (str, os.PathLike)):
-        raise InputError(f"{option} {value!r}: a path (str or pathlib.Path), not a {type(value).__name__}")
+        kind = type(value).__name__
+        raise InputError(
+            f"{option} {value!r}: a path (str or pathlib.Path), not {'an' if kind[0] in 'aeiou' else 'a'} {kind}"
+        )
     try:
         return (file_path_value if output else path_value)(os.fspath(value))
     except typer.BadParameter as exc:
-        raise InputError(f"{option}: {exc.message}") from None
+        said = exc.message  # "x.rrd/: a path ending in "/" …": the value once, the keyword's (recording=x.rrd/: …)
+        raise InputError(f"{option} {said}" if said.startswith(f"{value}: ") else f"{option}: {said}") from None
 
 
 def pga_value(value) -> float | None:

@@ -162,7 +162,7 @@ def test_check_refuses_the_builtin_options_that_cannot_apply(args, fragments):
         (("run", DATA / "validation" / "column5.toml", "--dt", -1), ["dt"]),
         (("run", DATA / "validation" / "column5.toml", "--theta", 0.2), ["theta"]),
         (("run", DATA / "validation" / "column5.toml", "--friction", "nan"), ["friction"]),
-        (("simulate", "wall", "--blocks", 0, "--duration", 0.01), ["block count", "0"]),
+        (("simulate", "wall", "--blocks", 0, "--duration", 0.01), ["--blocks 0", "positive integer"]),
         (("simulate", "wall", "--density", -5, "--duration", 0.01), ["density"]),
         (("simulate", "arch", "--settlement", -1, "--duration", 0.01), ["--settlement"]),
         # a sine the steps alias (1e9 Hz at dt = 1e-3 s sampled 0 at every step: the ground never moved)

@@ -216,7 +216,7 @@ def test_a_ctrl_c_while_the_arguments_are_read_is_one_line(argv, monkeypatch):
         # a float option's value as the user typed it: these said 0.0, 1000000000.0, -1.0 (typer had made
         # the text a float before the check)
         (("sweep", "wall", "-p", "amp=0.1:1:4", "--find", "amp", "--rtol", "0"), "--rtol 0: must be in (0, 1)"),
-        (RUN + ("--length", "0"), "--length must be a positive number, got 0"),
+        (RUN + ("--length", "0"), "--length 0: must be a positive number"),
         (
             RUN + ("--density", "1e9"),
             "--density: density = 1e9: must be between 0.001 and 100000 kg/m³ (a likely typo)",
@@ -241,11 +241,11 @@ def test_a_ctrl_c_while_the_arguments_are_read_is_one_line(argv, monkeypatch):
         (("simulate", "wall", "--no-recording", "--dt", "2"), "--dt: dt = 2: must be <= duration (1.0)"),
         (
             ("simulate", "wall", "--no-recording", "--duration", "1e5", "--dt", "1e-4"),
-            "--duration and --dt: dt = 1e-4: gives 1,000,000,000 steps for duration 1e5 (at most 100,000,000)",
+            "--duration and --dt: duration = 1e5 at dt = 1e-4 is 1,000,000,000 steps (at most 100,000,000)",
         ),
         (
             ("simulate", "wall", "--no-recording", "--duration", "0.50", "--dt", "0.3"),
-            "--duration and --dt: dt = 0.3: does not divide duration = 0.50"
+            "--duration and --dt: duration = 0.50 is not a whole number of steps of dt = 0.3"
             " (1.66667 steps); use dt = 0.25 (2 steps) or change the duration",
         ),  # fmt: skip
     ],

@@ -65,11 +65,14 @@ def test_arch_record_shakes_both_foundations_and_run_overrides_scenario_motion(a
 @pytest.mark.parametrize(
     "args, fragment",
     [
-        (["simulate", "wall", "--record", "RECORD", "--amp", 1], "--record with --amp: choose one loading"),
-        (["simulate", "arch", "--record", "RECORD", "--settlement", 0.01], "--record with --settlement"),
-        (["simulate", "wall", "--scale", 2], "--scale: goes with --record"),
+        (["simulate", "wall", "--record", "RECORD", "--amp", 1], "--amp 1: choose one loading"),
+        (
+            ["simulate", "arch", "--record", "RECORD", "--settlement", 0.01],
+            "with --settlement 0.01: choose one loading",
+        ),
+        (["simulate", "wall", "--scale", 2], "--scale 2 goes with --record"),
         (["simulate", "wall", "--record", "nope.AT2"], "nope.AT2: cannot read record"),
-        (["run", DATA / "block_on_ground.toml", "--scale", 2], "--scale: goes with --record"),
+        (["run", DATA / "block_on_ground.toml", "--scale", 2], "--scale 2 goes with --record"),
         (["run", DATA / "column_5.toml", "--record", "RECORD"], "has no shaking support"),
     ],
 )
@@ -243,7 +246,7 @@ def test_record_dt_reads_a_one_column_record_on_simulate_run_and_check(one_colum
         ),
         (
             ["--record-dt", 0.01],
-            "error: --record-dt: goes with --record (the time between the samples of a one-column file)",
+            "error: --record-dt 0.01 goes with --record (the time between the samples of a one-column file)",
         ),
         (["--record", "ONE", "--record-dt", 0], "error: --record-dt 0: must be > 0"),
         (["--record", "ONE", "--record-dt", -0.01], "error: --record-dt -0.01: must be > 0"),

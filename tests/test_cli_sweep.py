@@ -77,7 +77,7 @@ def block(tmp_path) -> Path:
         # a bad value inside an axis (only its ends were checked) ran into an error row, and the study said
         # "3 rows ... 1 failed"
         (["-p", "friction=0.5,-1,0.6"], "--param friction=-1: friction = -1.0: must be >= 0"),
-        (["-p", "dt=0.002:0.004:3"], "--param dt=0.003: dt = 0.003: does not divide duration = 1.0"),
+        (["-p", "dt=0.002:0.004:3"], "--param dt=0.003: duration = 1.0 is not a whole number of steps of dt = 0.003"),
         (["-p", "amp=0.1,1e30,0.2", "-p", "freq=1,2"], "--param amp=1e+30 freq=1: "),
         # a bad combination of values each good with the first point (30 Hz at dt = 0.02 s, aliased) ran into an
         # error row: "1 of 4 rows failed …; run the same command again to retry them", refused again each time

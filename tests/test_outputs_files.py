@@ -310,7 +310,10 @@ def test_dt_not_dividing_the_duration_is_reported():
     """Finding 11: --dt 0.3 --duration 1 silently ran 3 steps and stopped at t = 0.9 s."""
     result = invoke("run", COLUMN, "--duration", 1, "--dt", 0.3, "--no-recording")
     assert result.exit_code == 2
-    assert "dt = 0.3: does not divide duration = 1 (" in result.output and "0.333333 (3 steps)" in result.output
+    assert (
+        "duration = 1 is not a whole number of steps of dt = 0.3 (" in result.output
+        and "0.333333 (3 steps)" in result.output
+    )
     assert invoke("run", COLUMN, "--duration", 0.9, "--dt", 0.3, "--no-recording").exit_code == 0
 
 

@@ -154,8 +154,8 @@ def test_earthquake_like_records_do_not_warn(kind):
     [
         (("check", BLOCK, "--record", "TABLE", "--baseline", "linear"), '--baseline linear: must be "quadratic" or "none"'),
         (("simulate", "wall", "--record", "TABLE", "--baseline", "no"), '--baseline no: must be "quadratic" or "none"'),
-        (("run", BLOCK, "--baseline", "none"), '--baseline: goes with --record (a scenario file\'s own record takes baseline = "none" in its table)'),
-        (("simulate", "wall", "--baseline", "quadratic"), "--baseline: goes with --record"),
+        (("run", BLOCK, "--baseline", "none"), '--baseline none goes with --record (a scenario file\'s own record takes baseline = "none" in its table)'),
+        (("simulate", "wall", "--baseline", "quadratic"), "--baseline quadratic goes with --record"),
         (("sweep", "wall", "--records", "TABLE", "--baseline", "linear"), '--baseline linear: must be "quadratic" or "none"'),
         (("sweep", "wall", "--param", "amp=0.1,0.2", "--baseline", "none"), "--baseline: goes with --records"),
     ],

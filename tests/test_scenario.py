@@ -206,4 +206,4 @@ def test_too_many_steps_says_how_many_exactly():
     # 1.001e8 steps was "gives 1e+08 steps ... (at most 1e+08)": the refusal read like a contradiction
     with pytest.raises(InputError) as exc:
         RunConfig(duration=1001.0, dt=1e-5)
-    assert str(exc.value) == "dt = 1e-05: gives 100,100,000 steps for duration 1001.0 (at most 100,000,000)"
+    assert str(exc.value) == "duration = 1001.0 at dt = 1e-05 is 100,100,000 steps (at most 100,000,000)"

@@ -59,9 +59,13 @@ def test_overrides_reach_structure_loading_material_and_run():
 @pytest.mark.parametrize(
     "name, overrides, message",
     [
-        ("wall", {"settlement": 0.01}, "--settlement: the wall stands on one ground; settlement applies to arch"),
+        ("wall", {"settlement": 0.01}, "--settlement 0.01: the wall stands on one ground; settlement applies to arch"),
         ("arch", {"settlement": -1.0}, "--settlement -1: must be >= 0 (a downward velocity, m/s)"),
-        ("arch", {"settlement": 0.01, "amp": 1.0}, "--settlement with --amp: choose one loading (settle or shake)"),
+        (
+            "arch",
+            {"settlement": 0.01, "amp": 1.0},
+            "--settlement 0.01 with --amp 1: choose one loading (settle or shake)",
+        ),
         ("arch", {"amp": 1.0}, "--amp 1: the arch settles its right foundation by default; shake both"),
         ("aqueduct", {"freq": 3.0}, "--freq 3: the aqueduct settles its right foundation by default; shake"),
         ("arch", {"settlement": 0.0, "freq": 3.0}, "--freq 3 without --amp: nothing shakes the arch"),
@@ -75,12 +79,12 @@ def test_overrides_reach_structure_loading_material_and_run():
         ("wall", {"duration": 0.01, "dt": 0.02}, "--duration and --dt: dt = 0.02: must be <= duration (0.01)"),
         ("wall", {"blockz": 3}, 'builder "wall": unknown option "blockz" of builder "wall" (did you mean "blocks"?)'),
         ("tower", {}, "unknown built-in scenario 'tower' (expected one of wall, arch, aqueduct)"),
-        ("wall", {"scale": 2.0}, "--scale: goes with --record (it multiplies the record)"),
+        ("wall", {"scale": 2.0}, "--scale 2 goes with --record (it multiplies the record)"),
         # it said "(the record replaces the sine)": the arch settles by default, it has no sine
         (
             "arch",
             {"record": RECORD, "settlement": 0.01},
-            "--record with --settlement: choose one loading (the record shakes both foundations instead)",
+            f"--record {RECORD} with --settlement 0.01: choose one loading (the record shakes both foundations instead)",
         ),
     ],
 )
@@ -113,7 +117,7 @@ def test_override_run_names_the_values_the_run_would_have():
     with pytest.raises(InputError) as info:
         override_run(s, dt=1e-9, duration=0.5)
     assert str(info.value) == (
-        "--duration and --dt: dt = 1e-09: gives 500,000,000 steps for duration 0.5 (at most 100,000,000)"
+        "--duration and --dt: duration = 0.5 at dt = 1e-09 is 500,000,000 steps (at most 100,000,000)"
     )
     with pytest.raises(InputError, match=r"^--dt: dt = 0\.0: must be > 0$"):
         override_run(s, duration=0.02, dt=0.0)  # wrong on its own: named alone
@@ -216,7 +220,7 @@ def test_a_record_without_duration_runs_whole_in_steps_of_dt():
     [
         ({"blocks": 3, "density": -1.0}, "--density: density = -1.0: must be > 0"),
         ({"thickness": 1e9}, "--thickness: thickness = 1000000000.0: must be between 1e-06 and 1000 m (a likely typo)"),
-        ({"blocks": 0}, "--blocks: block count must be a positive integer, got 0"),
+        ({"blocks": 0}, "--blocks 0: must be a positive integer"),
         (
             {"blocks": 51, "courses": 5},
             "--blocks and --courses: 51 blocks cannot be laid in running bond with 5 courses"
@@ -240,7 +244,7 @@ def test_build_assembly_refuses_a_bad_option_in_one_line_naming_it(options, mess
 )
 def test_build_assembly_refuses_a_bad_builder_option_as_simulate_does(name, options):
     """`masonry build wall --blocks 0` said "wall: block count …", `masonry simulate wall --blocks 0` (and
-    sweep's --param) 'builder "wall": block count …': one mistake, one line."""
+    sweep's --param) 'builder "wall": block count …': one mistake, one line (now "--blocks 0: must be …")."""
     with pytest.raises(InputError) as built:
         build_assembly(name, **options)
     with pytest.raises(InputError) as simulated:

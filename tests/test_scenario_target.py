@@ -24,7 +24,7 @@ def test_a_file_scenario_takes_the_record_and_the_run_overrides(tmp_path, monkey
     assert motions_by_name(s) == {"ground": record_motion(RECORD, scale=2.0, display=str(RECORD))}
     with pytest.raises(InputError) as info:
         file_scenario(path, scale=2.0)
-    assert str(info.value) == "--scale: goes with --record (it multiplies the record)"
+    assert str(info.value) == "--scale 2 goes with --record (it multiplies the record)"
     monkeypatch.chdir(tmp_path)  # no file named wall here
     with pytest.raises(InputError) as info:
         file_scenario(Path("wall"))

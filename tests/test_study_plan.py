@@ -155,7 +155,9 @@ def test_a_dt_need_not_divide_the_built_in_s_duration_when_the_records_set_it(tm
     assert run.dt == 0.003 and round(run.duration / run.dt) == 500 and run.duration == pytest.approx(1.5)
     # a dt wrong on its own is still refused as the option, and a --duration still has to fit
     assert _refused("wall", records=[folder], dt=0.0, out=Path("s.csv")) == "--dt: dt = 0.0: must be > 0"
-    assert "does not divide duration = 1.0" in _refused("wall", records=[folder], dt=0.003, duration=1.0)
+    assert "duration = 1.0 is not a whole number of steps of dt = 0.003" in _refused(
+        "wall", records=[folder], dt=0.003, duration=1.0
+    )
 
 
 def test_a_sine_axis_over_records_says_their_axis_is_scale(tmp_path):

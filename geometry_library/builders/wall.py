@@ -88,7 +88,7 @@ class WallLayout:
 def wall_layouts(blocks: int) -> list[tuple[int, int]]:
     """Every (courses, full_per_course) with courses·n + ⌊courses/2⌋ == blocks, fewest courses first."""
     if number_problem(blocks, integer=True, ge=1) is not None:
-        raise GeometryError(f"wall: block count must be a positive integer, got {blocks!r}", keys=("blocks",))
+        raise GeometryError(f"wall: blocks must be a positive integer, got {blocks!r}", keys=("blocks",))
     check_block_total("wall", blocks, keys=("blocks",))
     out = []
     for c in range(1, blocks + 1):

@@ -110,9 +110,10 @@ def _loading(name: str, amp, freq, settlement, record, scale, record_dt=None, ba
     if record is not None:
         if amp is not None or freq is not None or settlement:
             given = "--amp" if amp is not None else "--freq" if freq is not None else "--settlement"
+            value = option_text(amp if amp is not None else freq if freq is not None else settlement)
             # a settlement is no sine: "(the record replaces the sine)" said of --settlement read wrong
             why = "shakes both foundations instead" if given == "--settlement" else "replaces the sine"
-            raise InputError(f"--record with {given}: choose one loading (the record {why})")
+            raise InputError(f"--record {record} with {given} {value}: choose one loading (the record {why})")
         shaken = ("ground",) if name == "wall" else ("left-foundation", "right-foundation")
         motion = record_motion_option(record, scale, record_dt, baseline)
         return {support: motion for support in shaken}
@@ -120,7 +121,10 @@ def _loading(name: str, amp, freq, settlement, record, scale, record_dt=None, ba
     loading_freq, freq = freq, SHAKE_FREQUENCY if freq is None else freq
     if name == "wall":
         if settlement:
-            raise InputError("--settlement: the wall stands on one ground; settlement applies to arch and aqueduct")
+            raise InputError(
+                f"--settlement {option_text(settlement)}: the wall stands on one ground; settlement applies to arch "
+                "and aqueduct"
+            )
         amp = SHAKE_AMPLITUDE if amp is None else amp
         return {"ground": _sine(amp, freq)} if amp else {}
     if settlement is not None and not math.isfinite(settlement):
@@ -134,7 +138,10 @@ def _loading(name: str, amp, freq, settlement, record, scale, record_dt=None, ba
     if settlement is None and amp:
         raise InputError(f"--amp {amp:g}: {settles}; shake both foundations with --settlement 0 --amp {amp:g}")
     if settlement and amp:
-        raise InputError("--settlement with --amp: choose one loading (settle or shake)")
+        raise InputError(
+            f"--settlement {option_text(settlement)} with --amp {option_text(amp)}: choose one loading (settle or "
+            "shake)"
+        )
     if amp is None and loading_freq is not None:
         if settlement == 0:
             raise InputError(f"--freq {freq:g} without --amp: nothing shakes the {name} (give --amp A)")

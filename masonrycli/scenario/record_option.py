@@ -136,12 +136,17 @@ def no_shaking_support(scenario: Scenario, option: str) -> InputError:
 
 
 def record_options_alone(scale: float | None, record_dt: float | None, baseline: str | None = None) -> None:
-    """Refuse --scale, --record-dt and --baseline given without --record."""
+    """Refuse --scale, --record-dt and --baseline given without --record (each named with its value: the API
+    says "scale=2 goes with record=", where "--scale: goes with" read "scale=: goes with")."""
     if scale is not None:
-        raise InputError("--scale: goes with --record (it multiplies the record)")
+        raise InputError(f"--scale {option_text(scale)} goes with --record (it multiplies the record)")
     if record_dt is not None:
-        raise InputError("--record-dt: goes with --record (the time between the samples of a one-column file)")
+        raise InputError(
+            f"--record-dt {option_text(record_dt)} goes with --record (the time between the samples of a one-column "
+            "file)"
+        )
     if baseline is not None:
         raise InputError(
-            '--baseline: goes with --record (a scenario file\'s own record takes baseline = "none" in its table)'
+            f'--baseline {baseline} goes with --record (a scenario file\'s own record takes baseline = "none" in its '
+            "table)"
         )

@@ -99,20 +99,20 @@ class RunConfig:
         put("dt", check_real("dt", self.dt, gt=0.0))
         if self.dt > self.duration:
             raise field_error("dt", dt, f"must be <= duration ({duration})")
-        if self.duration / self.dt > MAX_STEPS:
-            raise field_error(
-                "dt", dt, f"gives {self.duration / self.dt:,.0f} steps for duration {duration} (at most {MAX_STEPS:,})"
+        # of both: a sentence naming both (the API respells each); a dt of 1e-310 is not 'inf steps': below
+        if MAX_STEPS < self.duration / self.dt < math.inf:
+            raise InputError(
+                f"duration = {duration} at dt = {shorten(dt)} is {self.duration / self.dt:,.0f} steps (at most "
+                f"{MAX_STEPS:,})"
             )
         if self.dt < MIN_DT:  # after the steps' check, which says more of a dt too small for its duration
             raise field_error("dt", dt, f"must be >= {MIN_DT:g} s (a likely typo)")
         steps = self.duration / self.dt
         if abs(steps - round(steps)) > 1e-6 * max(1.0, steps):
             n = max(1, round(steps))
-            raise field_error(
-                "dt",
-                dt,
-                f"does not divide duration = {duration} ({steps:.6g} steps); "
-                f"use dt = {self.duration / n:.6g} ({n} steps) or change the duration",
+            raise InputError(
+                f"duration = {duration} is not a whole number of steps of dt = {shorten(dt)} ({steps:.6g} steps); "
+                f"use dt = {self.duration / n:.6g} ({n} steps) or change the duration"
             )
         put("theta", check_real("theta", self.theta, ge=0.5, le=1.0))
         put("gravity", check_vector("gravity", self.gravity))

@@ -18,7 +18,7 @@ from pathlib import Path
 from geometry_library.blocks import Assembly, GeometryError
 from geometry_library.values import SETTING_UNITS, TypedNumber, number_problem
 from masonrycli.errors import InputContext, InputError, not_a_file, one_line
-from masonrycli.scenario.values import did_you_mean, field_error, quote_string
+from masonrycli.scenario.values import did_you_mean, field_error, option_text, quote_string
 
 GEOMETRY_SUFFIXES = (".geojson", ".json", ".wkt")
 
@@ -242,16 +242,21 @@ class BuilderError(InputError):
 
 def as_options(exc: BuilderError, given: dict) -> InputError:
     """``exc`` naming the command-line options it is about, when ``given`` (builder option -> value, from the
-    command line) holds them: ``--ring-thickness 0.0001 m is absurd (…)``, ``--blocks: block count must be
-    …``, ``--courses and --length: …`` ('builder "arch": ring_thickness 0.0001 m …' named a key the user
+    command line) holds them: ``--ring-thickness 0.0001 m is absurd (…)``, ``--blocks 0: must be a positive
+    integer``, ``--courses and --length: …`` ('builder "arch": ring_thickness 0.0001 m …' named a key the user
     never typed). Else ``exc`` unchanged (a problem of no option, or of a default the user did not give)."""
     keys = [k for k in exc.keys if k in given]
     if not keys:
         return exc
-    flags = " and ".join("--" + k.replace("_", "-") for k in keys)
     key = keys[0]
+    flag = "--" + key.replace("_", "-")
+    # a value's problem as the options' ("--courses 0: must be a positive integer"; it said "--courses must be a
+    # positive integer, got 0", which the API spelled "courses= must be …")
+    if len(keys) == 1 and (bad := re.fullmatch(rf"(?:[a-z]+: )?{key} (must be .+), got .+", exc.problem)):  # "arch: "
+        return InputError(f"{flag} {option_text(given[key])}: {bad[1]}")
     if len(keys) == 1 and exc.problem.startswith(f"{key} ") and not exc.problem.startswith(f"{key} = "):
-        return InputError(f"{flags} {_flags(exc, exc.problem[len(key) + 1 :])}")  # "ring_thickness 0.0001 m is absurd"
+        return InputError(f"{flag} {_flags(exc, exc.problem[len(key) + 1 :])}")  # "ring_thickness 0.0001 m is absurd"
+    flags = " and ".join("--" + k.replace("_", "-") for k in keys)
     return InputError(f"{flags}: {_flags(exc, exc.problem)}")
 
 
