@@ -47,7 +47,14 @@ def slow_start_notice(after: float = 5.0, stream=None):
 
 @contextmanager
 def progress_bar(console: Console, n_steps: int):
-    """Yield an ``on_progress(sim, stats)`` callback drawing steps/s, simulated time and NLGS sweeps."""
+    """Yield an ``on_progress(sim, stats)`` callback drawing steps/s, simulated time and NLGS sweeps; from a
+    notebook's cell a line at each tenth of the run instead (:mod:`masonrycli.outputs.cell_output`: the
+    notebook stored every redraw of the bar)."""
+    from masonrycli.outputs.cell_output import StepLines, notebook_cell
+
+    if console.is_terminal and notebook_cell():
+        yield StepLines(console, n_steps)
+        return
     progress = Progress(
         TextColumn("[bold]simulating"),
         BarColumn(),

@@ -21,6 +21,8 @@ import time
 from rich.console import Console
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 
+from masonrycli.outputs.cell_output import notebook_cell
+
 LINE_EVERY_FRACTION = 0.1
 """Of the rows to make (those not already in the table): a line each time this many more have finished."""
 LINE_EVERY_S = 60.0
@@ -33,7 +35,7 @@ class StudyProgress:
 
     def __init__(self, console: Console, total: int, skipped: int) -> None:
         self.total, self.done, self.skipped = total, skipped, skipped
-        self.terminal = console.is_terminal
+        self.terminal = console.is_terminal and not notebook_cell()  # a cell stored each redraw: lines there
         self.lines = None if self.terminal else Console(stderr=True, markup=False, highlight=False)
         self.bar = Progress(
             TextColumn("[bold]sweep"),
