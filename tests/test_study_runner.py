@@ -115,7 +115,8 @@ def test_a_lost_scheduler_counts_every_run_not_made(client, monkeypatch):
     rows = []
     with pytest.raises(runner.SchedulerLost) as lost:
         runner.run_on_cluster(client, "s", Driver(6), lambda p, r: rows.append(r), False, None, False, limit=2)
-    assert str(lost.value) == f"lost the connection to the scheduler with {6 - len(rows)} runs pending"
+    left = 6 - len(rows)
+    assert str(lost.value) == f"lost the connection to the scheduler with {left} run{'' if left == 1 else 's'} pending"
 
 
 def _distributed_log_level() -> int:

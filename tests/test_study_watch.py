@@ -46,3 +46,16 @@ def test_a_scheduler_that_answers_is_not_said_to_be_silent(monkeypatch):
     with watch.WorkerWatch(SilentThenAnswering(0), said.append, "X", lambda: 3):
         time.sleep(0.3)
     assert said == []
+
+
+def test_one_run_waiting_is_one_run(monkeypatch):
+    # "… 1 runs waiting" when the last point was left
+    monkeypatch.setattr(watch, "WATCH_EVERY", 0.02)
+    monkeypatch.setattr(watch, "ASK_TIMEOUT", 0.1)
+    monkeypatch.setattr(watch, "NO_ANSWER_WAIT", 0.3)
+    said: list[str] = []
+    with watch.WorkerWatch(SilentThenAnswering(8), said.append, "X", lambda: 1):
+        end = time.monotonic() + 10
+        while len(said) < 1 and time.monotonic() < end:
+            time.sleep(0.02)
+    assert ", 1 run waiting: the study goes on when it answers" in said[0], said

@@ -286,7 +286,7 @@ def run_on_cluster(
                         row = params | empty_result(gave_up[0], 0.0)
                     elif _scheduler_lost(client, exc):
                         raise SchedulerLost(
-                            f"lost the connection to the scheduler with {not_made()} runs pending"
+                            f"lost the connection to the scheduler with {watching.runs(not_made())} pending"
                         ) from None
                     elif isinstance(exc, KilledWorker) and future.key not in alone and not gave_up:
                         with lock:

@@ -98,7 +98,7 @@ class WorkerWatch:
                     quiet = True
                     self.warn(
                         f"{self.where}: the scheduler has not answered for {NO_ANSWER_WAIT:g} s (stopped, its "
-                        f"machine overloaded or cut off?), {_runs(self.waiting())} waiting: the study goes on when it "
+                        f"machine overloaded or cut off?), {runs(self.waiting())} waiting: the study goes on when it "
                         "answers (Ctrl-C stops it, every finished row written)"
                     )
                 continue
@@ -121,8 +121,7 @@ class WorkerWatch:
             if not said and time.monotonic() - since >= NO_WORKER_WAIT:
                 said = True
                 self.warn(
-                    f"{self.where}: no worker for {NO_WORKER_WAIT:g} s, {_runs(self.waiting())} waiting: "
-                    + self._plan()
+                    f"{self.where}: no worker for {NO_WORKER_WAIT:g} s, {runs(self.waiting())} waiting: " + self._plan()
                 )
             if self.give_up is not None and time.monotonic() - since >= NO_WORKER_LIMIT and self.waiting():
                 self.give_up(self.left)
@@ -171,6 +170,6 @@ class WorkerWatch:
         cluster.scale(len(cluster.worker_spec))
 
 
-def _runs(n: int) -> str:
-    """'1 run', '8 runs' ("1 runs waiting" was said when one point was left)."""
+def runs(n: int) -> str:
+    """'1 run', '8 runs' ("1 runs waiting", "with 1 runs pending" were said when one point was left)."""
     return f"{n} run{'' if n == 1 else 's'}"
