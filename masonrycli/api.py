@@ -202,6 +202,7 @@ def simulate(
     live = LiveLine(f"{sc.name} ({given})" if given else sc.name) if progress else None
     if live is not None:
         live.start()
+        warnings.showwarning = live.under(warnings.showwarning)  # python_spelled's catch_warnings restores it
     try:
         outcome = execute(
             sc,

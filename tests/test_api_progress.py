@@ -5,7 +5,10 @@ stderr; in a script, stderr's start and end lines off a terminal. Before, a run 
 
 from __future__ import annotations
 
+import io
 import re
+import sys
+import warnings
 
 import pytest
 
@@ -66,3 +69,26 @@ def test_a_run_that_raises_ends_its_line_saying_so(monkeypatch):
     with pytest.raises(RuntimeError, match="the engine failed"):
         api.simulate("wall", blocks=12, duration=0.02, progress=True)
     assert display.shown[-1] == "wall (blocks=12, duration=0.02): stopped: RuntimeError: the engine failed"
+
+
+class _Terminal(io.StringIO):
+    def isatty(self) -> bool:
+        return True
+
+
+def test_a_warning_during_the_run_starts_a_line_of_its_own_on_a_terminal(monkeypatch):
+    # the first unconverged step's warning, said as it happens, was written at the end of the progress line
+    # ('… ~20 s, once)/tmp/x.py:2: RuntimeWarning: step 1 …')
+    terminal = _Terminal()
+    monkeypatch.setattr(sys, "stderr", terminal)
+    monkeypatch.setattr(live_line, "in_notebook", lambda: False)
+    with warnings.catch_warnings():
+        warnings.simplefilter("always")
+        # Python's own showing, on stderr (pytest's keeps a list)
+        warnings.showwarning = lambda m, c, f, n, file=None, line=None: sys.stderr.write(
+            warnings.formatwarning(m, c, f, n, line)
+        )
+        api.simulate("wall", blocks=12, duration=0.02, max_iterations=2, progress=True)
+    text = terminal.getvalue()
+    said = [m.start() for m in re.finditer(r"\S+:\d+: RuntimeWarning: ", text)]
+    assert len(said) == 2 and all(text[at - 1] == "\n" for at in said), text

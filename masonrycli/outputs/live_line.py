@@ -53,14 +53,23 @@ class _StreamLine:
         self.stream = stream
         self.tty = stream.isatty()
         self.said = False
+        self.open = False  # a terminal's line written without its end
 
     def show(self, text: str, final: bool = False) -> None:
         if self.tty:
             self.stream.write("\r\x1b[2K" + text + ("\n" if final else ""))
+            self.open = not final
         elif final or not self.said:
             self.stream.write(text + "\n")
         self.said = True
         self.stream.flush()
+
+    def end_line(self) -> None:
+        """End the line where it is, so that what the stream says next (a warning) starts a line of its own."""
+        if self.open:
+            self.stream.write("\n")
+            self.stream.flush()
+            self.open = False
 
 
 class LiveLine:
@@ -96,6 +105,16 @@ class LiveLine:
         took = self.clock() - self.started
         ended = f"{status}, {state}" if state else status
         self.line.show(f"{self.name}: {ended}, {steps} steps to t = {t:g} s in {took:.1f} s", final=True)
+
+    def under(self, showwarning):
+        """``showwarning`` ending the line first: a warning said during the run (its first unconverged step) was
+        written at the end of the terminal's line, after 'starting: …'. The next update starts a new line."""
+
+        def show(*args, **kwargs):
+            getattr(self.line, "end_line", lambda: None)()  # a notebook's display is not the warnings' stream
+            showwarning(*args, **kwargs)
+
+        return show
 
     def stopped(self, why: str) -> None:
         """The last line of a run that raised before it ended (``why``), in place of the line it had reached."""
