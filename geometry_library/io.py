@@ -362,8 +362,8 @@ def write_geojson(assembly: Assembly, path) -> Path:
     data = {"type": "FeatureCollection", "features": features}
     try:
         path.write_text(json.dumps(data, indent=1) + "\n", encoding="utf-8")
-    except OSError as exc:
-        raise GeometryError(f"{path}: cannot write file ({exc})") from None
+    except OSError as exc:  # its cause kept: masonry build names its --out, not this temporary file
+        raise GeometryError(f"{path}: cannot write file ({exc})") from exc
     return path
 
 

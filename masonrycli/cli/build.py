@@ -14,6 +14,7 @@ build_app = typer.Typer(no_args_is_help=True, help="Build a structure and write 
 def _write_assembly(builder: str, opts: dict) -> None:
     """Build, check and write the GeoJSON under a temporary name, renamed onto ``--out`` when complete."""
     from geometry_library.assembly_checks import validate_assembly
+    from geometry_library.blocks import GeometryError
     from geometry_library.io import write_geojson
     from masonrycli.outputs.files import check_output, written_whole
     from masonrycli.scenario.builtin import build_assembly
@@ -31,7 +32,10 @@ def _write_assembly(builder: str, opts: dict) -> None:
     with StopSignals() as signals:
         signals.closing()
         with written_whole(target) as part:
-            write_geojson(assembly, part)
+            try:
+                write_geojson(assembly, part)
+            except GeometryError as exc:  # a full disk said ".b.geojson.123.part: cannot write file", exit 2
+                raise exc.__cause__ if isinstance(exc.__cause__, OSError) else exc from None
         console.print(
             f"{builder}: {assembly.block_count} block{'s' if assembly.block_count != 1 else ''} and "
             f"{assembly.support_count} support{'s' if assembly.support_count != 1 else ''} → {out}",

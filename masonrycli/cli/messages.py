@@ -18,7 +18,7 @@ from typer._click import exceptions as click_errors
 
 from geometry_library.blocks import GeometryError
 from geometry_library.values import unit_hint, unit_of
-from masonrycli.errors import EXIT_BAD_INPUT, InputError, RecordWarning
+from masonrycli.errors import EXIT_BAD_INPUT, EXIT_OUTPUT_FAILED, InputError, RecordWarning
 
 # No markup and no highlighting: file names, TOML tables ("[run]") and values ("[inf, 0, 0]") print as given.
 console = Console(markup=False, highlight=False)
@@ -57,6 +57,8 @@ def user_errors(func):
             # click stops quietly with exit 1, as it does when the pipe breaks outside a command
             raise
         except OSError as exc:
+            if getattr(exc, "output", None):  # an output being written (outputs.files.written_whole)
+                fail(f"cannot write {exc.output}: {exc.strerror or exc}", EXIT_OUTPUT_FAILED)
             fail(f"{exc.filename or ''}: {exc.strerror or exc}".lstrip(": "))
         except KeyboardInterrupt:
             # Ctrl-C before a command's own handling takes over (building the structure, reading a record,

@@ -279,8 +279,12 @@ def written_whole(out: OutputFile, around_commit=None):
         yield out.part
         with around_commit if around_commit is not None else contextlib.nullcontext():
             out.commit()
-    except BaseException:  # the rename too: a failed one left the hidden part file beside the path
+    except BaseException as exc:  # the rename too: a failed one left the hidden part file beside the path
         out.discard()
+        if isinstance(exc, OSError) and not hasattr(exc, "output"):
+            # a disk full while it was written said only "error: No space left on device", exit 2 (bad input):
+            # the command line names the output (cli.messages.user_errors, exit 4 as simulate's)
+            exc.output = f"{out.option} {out.path}"
         raise
 
 

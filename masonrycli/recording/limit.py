@@ -24,6 +24,7 @@ import rerun as rr
 import rerun.blueprint as rrb
 
 from masonrycli.recording.arrays import Polygons, z0
+from masonrycli.recording.batching import io_errors
 from masonrycli.recording.carried_fill import CARRIED_FILL, CarriedFill, ColumnArrays, no_columns
 from masonrycli.recording.colormap import VIRIDIS, colorbar_mesh, map_scalars
 from masonrycli.recording.document import parameters_markdown, viewer_safe_text
@@ -219,7 +220,8 @@ def write_limit_recording(path: str | os.PathLike, drawing: MechanismDrawing) ->
         rrb.SelectionPanel(state="collapsed"),
         rrb.TimePanel(state="collapsed"),
     )
-    rec.save(os.fspath(path), default_blueprint=blueprint)
+    with io_errors(os.fspath(path)):  # a full disk here was rerun's RuntimeError: a traceback, exit 1
+        rec.save(os.fspath(path), default_blueprint=blueprint)
     try:
         legend_box, _, _ = log_plane(rec, both, sup_both, poses[-1], sup_q)
         _log_speed_bar(rec, legend_box)
