@@ -255,3 +255,29 @@ def test_the_colour_bar_keeps_its_size_and_its_ticks_clear_of_it_on_a_wide_view(
     width, gap = shown["strewn"]
     assert width >= 0.7 * stood_width and width >= 15.0, shown  # px
     assert gap >= 40.0, shown  # a label's half width: clear of the bar
+
+
+def test_the_bar_s_title_has_room_left_of_the_bar_on_a_tall_structure(tmp_path):
+    """The aqueduct, 7 m high and narrower, opens with the view fitted to its height: the bar stood 2 pads
+    (0.1 x its size) right of the structure, ~78 px at first open, and its title, centred on the bar
+    ("Volumetric strain rate, t = 5.000 s", ~210 px), covered the wall's top right blocks. The bar's centre now
+    stands at least half a title (125 px) right of every block and support as built at the title's height."""
+    from masonrycli.recording.layout import UNDEFORMED
+    from masonrycli.recording.static_content import _PANEL_PX, _TITLE_HALF_PX, TICKS
+
+    from cli_helpers import invoke
+
+    path = tmp_path / "aqueduct.rrd"
+    result = invoke("simulate", "aqueduct", "--duration", 0.02, "--out", path)
+    assert result.exit_code == 0, result.output
+    xmin, ymin, xmax, ymax = _view(path)
+    px_per_m = min(_PANEL_PX[0] / (xmax - xmin), _PANEL_PX[1] / (ymax - ymin))
+    strips = [np.array(s) for s in fx.static_value(path, f"/{UNDEFORMED}", "LineStrips2D:strips")]
+    for f in FIELDS:
+        rows = temporal_rows(path, f"/{f.labels}", "Points2D:positions")
+        title_x, title_y = fx.legend_points(path, rows[max(rows)])[TICKS]
+        band = 10.0 / px_per_m  # half a title's box, ~20 px high
+        beside = [s[:, 0].max() for s in strips if s[:, 1].max() >= title_y - band and s[:, 1].min() <= title_y + band]
+        assert beside, (title_y, f.key)  # the title stands beside the wall's top
+        assert (title_x - max(beside)) * px_per_m >= _TITLE_HALF_PX, (f.key, (title_x - max(beside)) * px_per_m)
+        assert (xmax - title_x) * px_per_m >= _TITLE_HALF_PX - 1e-6, (f.key, (xmax - title_x) * px_per_m)

@@ -226,15 +226,38 @@ def log_plane(
     # ~60 px apart), standing on the same base and rising above the structure, the view made taller to hold
     # it and its title (at 0.14 of the bar's height above it)
     span = max(yb - ya - 2 * room, _MIN_BAR_RATIO * bar)
-    legend_box = (hi[0] + 2 * pad, ya + room, hi[0] + 2 * pad + bar, ya + room + span)
-    hi[1] = max(hi[1], legend_box[3] + 0.14 * span + bar)
+    hi[1] = max(hi[1], ya + room + span + 0.14 * span + bar)
     x0, y0 = lo[0] - pad, hi[1] + pad
-    # room for half the bar's title right of the bar's centre as drawn at first open: the view's right margin
-    # m >= T / px_per_m - c, px_per_m = min(Pw / (w0 + m), Ph / height), solved for m (2 % spare: float32)
-    height, w0, c = y0 - lo[1] + pad, hi[0] + 3 * pad + bar - x0, pad + 0.5 * bar
-    t = 1.02 * _TITLE_HALF_PX
-    right = max(0.2 * size, t * height / _PANEL_PX[1] - c, (t * w0 / _PANEL_PX[0] - c) / (1.0 - t / _PANEL_PX[0]))
-    resolution = [w0 + right, height]
+    height, t = y0 - lo[1] + pad, 1.02 * _TITLE_HALF_PX
+
+    def resolution_for(gap: float) -> list[float]:
+        # room for half the bar's title right of the bar's centre as drawn at first open: the view's right
+        # margin m >= T / px_per_m - c, px_per_m = min(Pw / (w0 + m), Ph / height), solved for m (2 % spare)
+        w0, c = hi[0] + gap + pad + bar - x0, pad + 0.5 * bar
+        right = max(0.2 * size, t * height / _PANEL_PX[1] - c, (t * w0 / _PANEL_PX[0] - c) / (1.0 - t / _PANEL_PX[0]))
+        return [w0 + right, height]
+
+    # and left of it, clear of the blocks and supports as built at the title's height: the aqueduct's title
+    # ("Volumetric strain rate, t = 5.000 s", centred on a bar 2 pads right of its foundation) covered the
+    # wall's top right blocks. A wider gap widens the view (fewer px a metre): a few rounds of gap = what
+    # reaches the title's height + T / px_per_m - bar / 2 settle (T < Pw / 9)
+    title_y = ya + room + 1.14 * span  # legend_positions' title anchor
+    parts = [_boxes(p, v) for p, v in ((blocks, blk), (supports, sup)) if p.count]
+    low, high, right_end = (np.concatenate(c) for c in zip(*parts)) if parts else (np.zeros(0),) * 3
+    gap = 2 * pad
+    for _ in range(8):
+        resolution = resolution_for(gap)
+        px_per_m = min(_PANEL_PX[0] / resolution[0], _PANEL_PX[1] / resolution[1])
+        band = _TITLE_BAND_PX / px_per_m
+        beside = (high >= title_y - band) & (low <= title_y + band)
+        if not beside.any():
+            break
+        need = float(right_end[beside].max()) + (t + _TITLE_SPARE_PX) / px_per_m - 0.5 * bar - hi[0]
+        if gap >= need:
+            break
+        gap = need
+    resolution = resolution_for(gap)
+    legend_box = (hi[0] + gap, ya + room, hi[0] + gap + bar, ya + room + span)
     rec.log(
         PLANE,
         rr.Pinhole(focal_length=_CAMERA_HEIGHT, principal_point=[0.0, 0.0], resolution=resolution),
@@ -296,6 +319,19 @@ _TITLE_HALF_PX: Final = 125.0
 character, its box's padding): the title is centred on the bar and says the frame's time; on a wide view (a
 collapsed wall strewn along its ground, 'masonry simulate wall --amp 3 --freq 0.8 --duration 3') the 0.2 x
 the structure's size right of the ticks left ~80 px, and "Spherical stress p, t = 3.000 s" lost its end."""
+
+
+_TITLE_SPARE_PX: Final = 8.0
+"""px kept between the structure and the left end of a colour-bar title (``log_plane``)."""
+_TITLE_BAND_PX: Final = 14.0
+"""Half the height of a colour-bar title's box and a spare, px: the blocks within it are beside the title."""
+
+
+def _boxes(polygons: Polygons, verts: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Each polygon's lowest y, highest y and rightmost x (m) from its world vertices ``verts`` (V, 2)."""
+    first = np.flatnonzero(np.r_[True, polygons.owner[1:] != polygons.owner[:-1]])
+    y, x = verts[:, 1], verts[:, 0]
+    return np.minimum.reduceat(y, first), np.maximum.reduceat(y, first), np.maximum.reduceat(x, first)
 
 
 def centroid_radius(resolution, block_side: float, points: float = -CENTROID_RADIUS, share: float = 0.125) -> float:
