@@ -1,13 +1,19 @@
-"""Small assemblies for the limit-analysis tests: rectangles on a ground, a semicircular arch on springers."""
+"""Small assemblies for the limit-analysis tests: rectangles on a ground, a semicircular arch on springers; the
+built-in aqueduct as a survey would give it (moved, rounded to the millimetre)."""
 
 from __future__ import annotations
+
+import json
 
 import numpy as np
 from shapely.geometry import Polygon, box
 
 from geometry_library.blocks import Assembly, Block, Support
+from masonrycli.limit.command import resolve_structure
 from masonrycli.scenario.motion import Fixed
 from masonrycli.scenario.scenario import Material, RunConfig, Scenario
+
+from cli_helpers import invoke
 
 DENSITY = 2000.0
 
@@ -53,3 +59,23 @@ def semicircular_arch(thickness: float, voussoirs: int, friction: float, radius:
         ("left-springer", box(-re - 0.2, -0.5, -ri + 0.2, 0.0)),
     ]
     return scenario(blocks, springers, friction, name="semicircle")
+
+
+def surveyed_aqueduct(tmp_path, name: str, digits: int, dx: float = 0.0, dy: float = 0.0):
+    """The aqueduct's GeoJSON (``masonry build aqueduct``) moved by (dx, dy) and rounded to ``digits`` decimals,
+    read as ``masonry limit`` reads it with --trim-overlaps 0.002 (the rounding overlaps 36 pairs by up to 0.4 mm)."""
+    exact = tmp_path / "aqueduct.geojson"
+    if not exact.exists():
+        assert invoke("build", "aqueduct", "-o", str(exact)).exit_code == 0
+    doc = json.loads(exact.read_text())
+
+    def move(c):
+        if isinstance(c[0], (int, float)):
+            return [round(c[0] + dx, digits), round(c[1] + dy, digits)]
+        return [move(x) for x in c]
+
+    for feature in doc["features"]:
+        feature["geometry"]["coordinates"] = move(feature["geometry"]["coordinates"])
+    path = tmp_path / f"{name}.geojson"
+    path.write_text(json.dumps(doc))
+    return resolve_structure(str(path), None, {"trim_overlaps": 0.002})

@@ -7,7 +7,6 @@ in 2 s) and the one rounded to 1 mm collapsed at t = 1.20 s (0.195 s rounded in 
 
 from __future__ import annotations
 
-import json
 import math
 
 import numpy as np
@@ -18,7 +17,7 @@ from masonrycli.engine.narrowphase import collide_polygons
 from masonrycli.engine.rounded import CORNER_RADIUS, rounded_normal
 
 import naive_collision as nv
-from cli_helpers import invoke
+from limit_helpers import surveyed_aqueduct
 
 SQUARE = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
 POST = SQUARE - 1.0  # [-1, 0]²: its top-right corner (0, 0) under the square's bottom-left corner
@@ -107,28 +106,6 @@ def test_a_block_thinner_than_two_radii_keeps_the_detected_normal():
     assert rounded_normal(sliver, POST) is None
     _, normal, _, _ = collide_polygons(POST, sliver + np.array([0.0, 1e-4]), 1e-3)
     assert abs(float(normal[0] @ np.array([math.sqrt(0.5)] * 2))) < 0.99  # a face's normal, as detected
-
-
-def surveyed_aqueduct(tmp_path, name: str, digits: int, dx: float = 0.0, dy: float = 0.0):
-    """The aqueduct's GeoJSON moved by (dx, dy), rounded to ``digits`` decimals, read with --trim-overlaps 0.002
-    (as tests/test_limit_corners.py reads it)."""
-    from masonrycli.limit.command import resolve_structure
-
-    exact = tmp_path / "aqueduct.geojson"
-    if not exact.exists():
-        assert invoke("build", "aqueduct", "-o", str(exact)).exit_code == 0
-    doc = json.loads(exact.read_text())
-
-    def move(c):
-        if isinstance(c[0], (int, float)):
-            return [round(c[0] + dx, digits), round(c[1] + dy, digits)]
-        return [move(x) for x in c]
-
-    for feature in doc["features"]:
-        feature["geometry"]["coordinates"] = move(feature["geometry"]["coordinates"])
-    path = tmp_path / f"{name}.geojson"
-    path.write_text(json.dumps(doc))
-    return resolve_structure(str(path), None, {"trim_overlaps": 0.002})
 
 
 @pytest.mark.slow

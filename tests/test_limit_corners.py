@@ -7,7 +7,6 @@ block's corner took whichever edge's normal the detection's last digit picked, a
 
 from __future__ import annotations
 
-import json
 import math
 
 import numpy as np
@@ -15,14 +14,12 @@ import pytest
 from shapely.geometry import box
 
 from masonrycli.limit.analysis import analyse
-from masonrycli.limit.command import resolve_structure
 from masonrycli.limit.corners import CORNER_RADIUS, rounded_corner_normal
 from masonrycli.limit.joints import find_joints
 from masonrycli.limit.problem import LiveLoad
 from masonrycli.model import build_model
 
-from cli_helpers import invoke
-from limit_helpers import scenario
+from limit_helpers import scenario, surveyed_aqueduct
 
 
 def block_on_a_corner(friction: float = 0.6):
@@ -72,24 +69,9 @@ def test_a_corner_on_a_face_keeps_the_faces_normal_and_friction():
     np.testing.assert_array_equal(joints.contact_friction(0.6), [0.6, 0.6])
 
 
-def _surveyed(tmp_path, name: str, digits: int, dx: float = 0.0, dy: float = 0.0):
-    """The aqueduct's GeoJSON with its coordinates moved by (dx, dy) and rounded to ``digits`` decimals, as read
-    with --trim-overlaps 0.002 (the rounding overlaps 36 pairs by up to 0.4 mm)."""
-    exact = tmp_path / "aqueduct.geojson"
-    if not exact.exists():
-        assert invoke("build", "aqueduct", "-o", str(exact)).exit_code == 0
-    doc = json.loads(exact.read_text())
-
-    def move(c):
-        if isinstance(c[0], (int, float)):
-            return [round(c[0] + dx, digits), round(c[1] + dy, digits)]
-        return [move(x) for x in c]
-
-    for feature in doc["features"]:
-        feature["geometry"]["coordinates"] = move(feature["geometry"]["coordinates"])
-    path = tmp_path / f"{name}.geojson"
-    path.write_text(json.dumps(doc))
-    return analyse(resolve_structure(str(path), None, {"trim_overlaps": 0.002}), LiveLoad()).load_factor
+def _surveyed(tmp_path, name: str, digits: int, dx: float = 0.0, dy: float = 0.0) -> float:
+    """λ of the aqueduct moved by (dx, dy) and rounded to ``digits`` decimals (limit_helpers.surveyed_aqueduct)."""
+    return analyse(surveyed_aqueduct(tmp_path, name, digits, dx, dy), LiveLoad()).load_factor
 
 
 @pytest.mark.slow
