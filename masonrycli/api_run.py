@@ -4,6 +4,7 @@ command line's views of them (``masonry export``'s table, ``masonry report``'s p
 from __future__ import annotations
 
 import difflib
+import json
 import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -53,6 +54,15 @@ class Run:
     @property
     def units(self) -> dict[str, str]:
         return {str(k): str(v) for k, v in self.arrays.get("units", np.zeros((0, 2), dtype=str))}
+
+    @property
+    def parameters(self) -> dict:
+        """The run's parameters, as its history keeps them (the ``run`` array, JSON): ``scenario``, ``dt_s``,
+        ``solver``, ``friction``, …, the ``command`` that ran it, and for a run of a study its ``study_point``
+        (``{"freq": 2.0}``) and ``study_table``; {} for a history that keeps none. A teacher reading a study's
+        histories had to ``json.loads(str(run["run"]))`` to learn which point each was."""
+        text = str(self.arrays.get("run", ""))
+        return json.loads(text) if text else {}
 
     @property
     def time(self) -> np.ndarray:

@@ -313,6 +313,7 @@ def test_the_python_page_runs_as_a_notebook(tmp_path, monkeypatch):
     # the table names the sweep too, as the page's `python -m masonrycli sweep` ran it (a CSV column)
     assert {row["command"] for row in namespace["rows"]} == {f"masonry {' '.join(namespace['study'][3:])}"}
     assert "| command | masonry sweep wall --param freq=1,2 " in namespace["point"].report()
+    assert namespace["point"].parameters["study_point"] == {"freq": 2.0, "friction": 0.7}  # the page's comment
 
 
 def test_a_scenario_shown_in_a_notebook_is_a_few_lines():
