@@ -76,6 +76,8 @@ def python_spelled(function=None, *, keywords=None, renamed=None):
                 return function(*args, **kwargs)
             except InputError as exc:
                 raise InputError(spell(str(exc))) from None
+            except Warning as exc:  # a warning the caller's filters make an error ("error"): spelled as warned
+                raise type(exc)(spell(str(exc))) from None
 
     return spelled
 

@@ -7,6 +7,8 @@ from __future__ import annotations
 
 import warnings
 
+import pytest
+
 from masonrycli import api
 
 
@@ -42,3 +44,13 @@ def test_the_first_unconverged_step_is_said_as_it_ends_and_the_count_at_the_end(
 def test_a_converged_run_says_nothing():
     said, _ = _run_watching()
     assert [str(w.message) for w in said] == []
+
+
+def test_a_warning_made_an_error_by_the_caller_s_filters_names_the_keywords():
+    # simplefilter("error") raised the first unconverged step's warning in masonry's words ('--tolerance')
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", RuntimeWarning)
+        with pytest.raises(RuntimeWarning) as raised:
+            api.simulate("wall", blocks=12, duration=0.02, max_iterations=2)
+    said = str(raised.value)
+    assert said.startswith("step 1 (t = 0.001 s) ended unconverged") and "tolerance=1e-05" in said and "--" not in said
