@@ -388,7 +388,22 @@ def test_a_run_whose_output_failed_is_an_error_row_with_its_message(arch_base, t
     monkeypatch.setattr(HistoryFile, "on_frame", disk_full)
     row = run_task(arch_base, {"amp": 0.5}, history_dir=str(tmp_path))
     assert row["status"] == "error" and row["state"] == "" and row["amp"] == 0.5
-    assert row["error"].startswith("failed: stopped at t = ") and "No space left on device" in row["error"]
+    assert row["error"].startswith("failed: cannot write --histories ") and "No space left on device" in row["error"]
+    assert f"{tmp_path / 'amp=0.5.npz'}: stopped at t = " in row["error"]  # which file
+
+
+def test_a_history_that_cannot_be_finished_names_its_file(arch_base, tmp_path, monkeypatch):
+    """A full disk as the history was assembled (its close) said "OSError: [Errno 28] No space left on device"."""
+    from masonrycli.outputs.history import HistoryFile
+
+    def disk_full(self, *args, **kwargs):
+        raise OSError(28, "No space left on device")
+
+    monkeypatch.setattr(HistoryFile, "close", disk_full)
+    row = run_task(arch_base, {"amp": 0.5}, history_dir=str(tmp_path))
+    assert row["status"] == "error" and row["amp"] == 0.5
+    assert row["error"] == f"cannot write --histories {tmp_path / 'amp=0.5.npz'}: No space left on device"
+    assert os.listdir(tmp_path) == []
 
 
 def test_a_history_written_whole_removes_what_killed_writers_of_it_left(arch_base, tmp_path):

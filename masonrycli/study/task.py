@@ -73,6 +73,7 @@ def run_task(
     # process a machine by default) runs two tasks at once, and each row counted the other's CPU too
     start, cpu_start = time.perf_counter(), time.thread_time()
     row = dict(params)
+    out_file = None  # the history's, with history_dir
     try:
         scenario = apply_point(base, params)
         sim = Simulation(scenario)
@@ -80,8 +81,8 @@ def run_task(
             sinks = []
             if history_dir:
                 path = Path(history_dir) / history_name(params)
-                out = OutputFile(path, "--histories", force=force or made_by_study(path, study))
-                part = files.enter_context(written_whole(out))
+                out_file = OutputFile(path, "--histories", force=force or made_by_study(path, study))
+                part = files.enter_context(written_whole(out_file))
                 sinks.append(HistoryFile(part, sim.model.block_name, sim.model.support_name))
                 sinks[0].run_info = run_metadata(scenario, sim) | {"study_point": params}
                 sinks[0].run_values |= block_constants(sim.model)
@@ -98,7 +99,9 @@ def run_task(
     except InputError as exc:  # the point's parameters refused (a grid too large to check whole: study.py)
         return row | empty_result(f"{REFUSED}{exc}", time.perf_counter() - start)
     except Exception as exc:  # a failed task is reported in its row; the study goes on
-        return row | empty_result(f"{type(exc).__name__}: {exc}", time.perf_counter() - start)
+        # an output's (outputs.files.written_whole): "OSError: [Errno 28] No space left on device" named no file
+        said = f"cannot write {exc.output}: {exc.strerror or exc}" if getattr(exc, "output", None) else None
+        return row | empty_result(said or f"{type(exc).__name__}: {exc}", time.perf_counter() - start)
     out = result.outcome
     tally = result.tally
     # a run that stopped early without raising (status "failed": an output's write failed mid-run;
@@ -121,7 +124,7 @@ def run_task(
         "capped_steps": tally.capped,
         "last_residual": tally.residual_last,
         "max_penetration": result.max_penetration,
-        "error": f"{result.status}: {result.message}"
+        "error": f"{result.status}: {_written(result, out_file)}{result.message}"
         if failed
         else (result.message if result.status == "diverged" else ""),
     }
@@ -232,3 +235,9 @@ def check_outcome(outcome: str) -> str:
             f"the ratio is a fraction, drift:{limit / 100:g} is {limit:g} %)"
         )
     return outcome
+
+
+def _written(result, out) -> str:
+    """``cannot write --histories h/amp=0.5.npz: `` when the run stopped because its history could not be
+    written (the row said only "failed: stopped at t = 0.03 s (step 30): No space left on device")."""
+    return f"cannot write {out.option} {out.path}: " if out and result.failed_sink is not None else ""
