@@ -122,6 +122,8 @@ PATH_ROWS = [
     ("limit-empty-name", {}, ("limit", ""), 2, "the structure argument is empty (''): give wall, arch, aqueduct or"),
     # -- inspect
     ("inspect-missing", {}, ("inspect", "missing.rrd"), 2, "missing.rrd: no such recording"),
+    # "" was read as "." (the working folder: "a folder, not a recording"), as --out "" once was
+    ("inspect-empty-path", {"w.rrd": "x"}, ("inspect", ""), 2, "'REC.rrd|H.npz|S.csv': the path is empty"),
     (
         "inspect-not-rrd",
         {"bad.rrd": "not a recording"},

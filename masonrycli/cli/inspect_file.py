@@ -10,12 +10,18 @@ from typing import Annotated
 import typer
 
 from masonrycli.cli.messages import console, warn
+from masonrycli.cli.option_values import path_value
 from masonrycli.errors import InputError
 
 
 def inspect_command(
     recording: Annotated[
-        Path, typer.Argument(help="Recording (.rrd), run history (.npz) or study table.", metavar="REC.rrd|H.npz|S.csv")
+        Path,
+        typer.Argument(
+            help="Recording (.rrd), run history (.npz) or study table.",
+            metavar="REC.rrd|H.npz|S.csv",
+            parser=path_value,  # "" was read as "." (the working folder's recordings listed), "~" not expanded
+        ),
     ],
 ) -> None:
     """Summarise a recording (scenario, frames, time span, entities), a run history (its parameters,
