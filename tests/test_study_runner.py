@@ -115,8 +115,24 @@ def test_a_lost_scheduler_counts_every_run_not_made(client, monkeypatch):
     rows = []
     with pytest.raises(runner.SchedulerLost) as lost:
         runner.run_on_cluster(client, "s", Driver(6), lambda p, r: rows.append(r), False, None, False, limit=2)
-    left = 6 - len(rows)
-    assert str(lost.value) == f"lost the connection to the scheduler with {left} run{'' if left == 1 else 's'} pending"
+    assert str(lost.value) == f"lost the connection to the scheduler with {6 - len(rows)} runs pending"
+
+
+def test_a_lost_scheduler_with_one_run_left_says_one_run(client, monkeypatch):
+    # "with 1 runs pending" when the last point's run found the scheduler gone (9a2001f's fix): one point at a
+    # time (limit=1), the first gives its row, the second is the one run left
+    def task(base, params, *args):
+        if params["amp"] == 1.0:
+            raise OSError("the connection to the scheduler went with it")
+        return dict(params)
+
+    monkeypatch.setattr(runner, "run_task", task)
+    monkeypatch.setattr(runner, "_scheduler_lost", lambda client, exc: True)
+    rows = []
+    with pytest.raises(runner.SchedulerLost) as lost:
+        runner.run_on_cluster(client, "s", Driver(2), lambda p, r: rows.append(r), False, None, False, limit=1)
+    assert len(rows) == 1
+    assert str(lost.value) == "lost the connection to the scheduler with 1 run pending"
 
 
 def _distributed_log_level() -> int:
