@@ -89,6 +89,8 @@ class Frame:
     rounding: float | None = None
     """m: how far a float32 export's rounding may have moved the file's coordinates as given (None: not a
     float32 export) — once moved, the checks see coordinates that are no float32 values and cannot tell."""
+    far: float = 0.0
+    """m: the farthest a coordinate lies from the origin, read in its units (before any shift)."""
 
     def local(self, xy: np.ndarray) -> np.ndarray:
         out = np.asarray(xy, dtype=np.float64) * self.scale
@@ -120,6 +122,7 @@ def frame_of(rings: list, survey: Survey) -> Frame:
         return frame
     low, high = xy.min(axis=0), xy.max(axis=0)
     far = np.abs(xy).max()
+    frame = dataclasses.replace(frame, far=float(far))
     # beyond RECENTRE_UP_TO float64 itself has lost the millimetres (1e12 m: ±0.1 mm): refused as it is
     if far <= RECENTRE_BEYOND or far > RECENTRE_UP_TO or np.any(high - low > 1e6):
         return frame
@@ -313,6 +316,11 @@ def finish_reading(path, refused, blocks, supports, frame: Frame, survey: Survey
     hint), overlaps trimmed when ``survey`` says so; ``notes`` (if a list) receives what was done."""
     read = [p.polygon for p in blocks if p is not None]
     hint = units_hint(read, survey) if refused else ""
+    if refused and not hint and survey.units == "m" and RECENTRE_UP_TO < frame.far <= RECENTRE_UP_TO / UNITS["mm"]:
+        # a map grid's millimetres (Lambert-93 × 1000): refused as far, with no word of the unit that reads them
+        hint = (
+            f"coordinates up to {frame.far:.3g} from the origin: a map grid's in millimetres? --units mm reads them so"
+        )
     if refused and frame.rounding is not None and frame.rounding >= 1e-5:  # the likely cause, said with it
         hint = (
             f"{hint}; " * bool(hint)
@@ -320,7 +328,8 @@ def finish_reading(path, refused, blocks, supports, frame: Frame, survey: Survey
         )
     raise_refused(refused, frame.where() + (f"; {hint}" if hint else ""))
     hint = units_hint(read, survey)
-    if survey.units != "m" and hint:  # stones of a mm read with --units: no wall; its overlaps were refused next
+    if hint:  # stones of a km (a survey in mm read as metres), or of a mm read with --units: no masonry. The
+        # first ran with a warning, and a bridge's traced fill was refused as "carried_at … absurd (a likely typo)"
         raise GeometryError(f"{path}: {hint}")
     assembly = Assembly(tuple(blocks), tuple(supports))
     said = survey_notes(path, frame, survey, assembly)

@@ -25,6 +25,7 @@ import shapely
 from shapely.geometry import Polygon
 
 from .blocks import Assembly, GeometryError, TracedFill
+from .checks import body_label
 from .fill import carry, traced_fill_over
 from .values import check_material
 
@@ -40,6 +41,33 @@ def fill_outline(xy: np.ndarray, where: str) -> Polygon:
     if outline.area <= 0.0:
         raise GeometryError(f"{where}: the fill's outline has no area")
     return outline
+
+
+def _stones_inside(blocks, outline: Polygon) -> str:
+    """Where a fill's outline reaches into the stones deeper than a tracing's slip (``INSIDE_DEPTH``): how many, the
+    deepest named ("" if none). Its part there is no fill (the fill reaches down to their top), so the weight is
+    right; the words let a researcher find an outline drawn over the ring, or a stone traced as fill."""
+    polys = np.array([b.polygon for b in blocks], dtype=object)
+    overlaps = shapely.intersection(polys, outline)
+    depth = np.array([_depth(o) for o in overlaps])
+    deep = np.flatnonzero(depth > INSIDE_DEPTH)
+    if not len(deep):
+        return ""
+    k = int(deep[np.argmax(depth[deep])])
+    many = f"{len(deep)} stones, the deepest" if len(deep) > 1 else "a stone,"
+    return (
+        f"it reaches into {many} {body_label(k, blocks[k].name)} about {depth[k] * 1e3:.3g} mm deep (its part "
+        "inside them is not fill: is its lower edge drawn over the stones?)"
+    )
+
+
+INSIDE_DEPTH = 0.01
+"""m: an outline reaching deeper into a stone than this is said (a few mm is a tracing's slip)."""
+
+
+def _depth(overlap) -> float:
+    """m: how deep an overlap is (twice its area over its perimeter: a thin strip's width); 0 for none."""
+    return 0.0 if overlap.is_empty or overlap.area <= 0.0 else 2.0 * overlap.area / overlap.length
 
 
 def carry_fills(assembly: Assembly, outlines: list, notes: list | None) -> Assembly:
@@ -69,6 +97,9 @@ def carry_fills(assembly: Assembly, outlines: list, notes: list | None) -> Assem
             )
             if a > 1e-9 * outline.area
         ]
+        inside = _stones_inside(blocks, outline)
+        if inside:
+            left.append(inside)
         if notes is not None:
             notes.append(
                 f"{where}: a fill of {density:g} kg/m³, read as dead load: {area.sum():.4g} m², {mass:.4g} kg carried "

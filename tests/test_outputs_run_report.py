@@ -4,6 +4,7 @@ export's and an independent reading of the history's arrays; its files are writt
 from __future__ import annotations
 
 import csv
+import json
 import re
 
 import numpy as np
@@ -181,3 +182,23 @@ def test_a_runs_outputs_say_one_start(tmp_path, monkeypatch):
     with np.load(npz) as h:
         started = json.loads(str(h["run"]))["started"]
     assert rows(run.report())["started"] == started == rows(invoke("report", npz).output)["started"]
+
+
+def test_the_page_says_where_the_joints_open_most_on_the_map_too(at2, tmp_path):
+    """A wall traced in Lambert-93 shaken at 1.5 g: the state's line gives the largest opening, the page now names
+    the block whose joints open most and where it stands, in the run's coordinates and on the survey's map."""
+    import surveyed_wall
+
+    wall = tmp_path / "l93.geojson"
+    surveyed_wall.write(wall, offset=surveyed_wall.LAMBERT93, slip=0.0, ndigits=6)
+    npz = tmp_path / "h.npz"
+    args = ("--record", at2, "--pga", 1.5, "--duration", 0.5, "--settle", 0.2)
+    result = invoke("run", wall, *args, "--no-recording", "--history", npz)
+    assert result.exit_code == 0, result.output
+    h = np.load(npz, allow_pickle=False)
+    k = int(np.argmax(h["block_max_opening"][-1]))
+    x, y = h["block_q"][-1][k, :2]
+    origin = json.loads(str(h["run"]))["reading"]["map_origin_m"]
+    said = rows(invoke("report", npz).stdout)["most open (end)"]
+    assert said.startswith(f"{h['block_name'][k]}'s joints, {1000 * h['block_max_opening'][-1][k]:.3g} mm; ")
+    assert f"its centroid at ({x:.3f}, {y:.3f}) m (on the map ({x + origin[0]:.3f}, {y + origin[1]:.3f}))" in said

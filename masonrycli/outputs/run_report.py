@@ -144,6 +144,20 @@ def hinged_joints(arrays) -> list[str]:
     return [f"{names[a]}{JOINT_SEPARATOR}{names[b]}" for a, b in body]
 
 
+def most_open(arrays) -> tuple[str, float, tuple[float, float]] | None:
+    """The block whose joints open most at the last frame (``block_max_opening``), that opening (m) and where its
+    centroid is then (m, in the coordinates the run read: near the origin for a map grid's file), or None when
+    nothing opens or it is not recorded. The state's line gives the largest opening; a researcher asks where."""
+    if "block_max_opening" not in arrays or not len(arrays["time"]) or not len(arrays["block_name"]):
+        return None
+    last = np.asarray(arrays["block_max_opening"][-1], dtype=np.float64)
+    k = int(np.argmax(last))
+    if not last[k] > 0.0:
+        return None
+    x, y = (float(v) for v in np.asarray(arrays["block_q"][-1])[k, :2])
+    return str(arrays["block_name"][k]), float(last[k]), (x, y)
+
+
 def unconverged(arrays) -> tuple[int, int] | None:
     """(steps that ended unconverged, steps run), from the last frame, or None: not recorded."""
     if "nlgs_unconverged" not in arrays or "step" not in arrays or not len(arrays["step"]):
@@ -155,6 +169,7 @@ def _result_rows(arrays, table) -> list[tuple[str, str]]:
     from masonrycli.outputs.inspect_history import run_rows
     from masonrycli.outputs.verdict import (
         describe_hinges,
+        describe_most_open,
         describe_outcome,
         describe_peak_drift,
         describe_residual_drift,
@@ -176,6 +191,10 @@ def _result_rows(arrays, table) -> list[tuple[str, str]]:
         rows.append(("residual drift", f"{shown(100 * float(drift[-1]))} % of the height (the last frame)"))
     if "joint_hinged" in arrays:
         rows.append(("hinged joints (end)", describe_hinges(hinged_joints(arrays))))
+    if (found := most_open(arrays)) is not None:
+        rows.append(
+            ("most open (end)", describe_most_open(*found, _run(arrays).get("reading", {}).get("map_origin_m")))
+        )
     counts = unconverged(arrays)
     if counts is not None:
         bad, steps = counts

@@ -27,6 +27,15 @@ def describe_outcome(outcome: dict) -> str:
     return f"{outcome['state']} ({tail})"
 
 
+def describe_most_open(name: str, opening: float, at: tuple[float, float], origin=None) -> str:
+    """``v05's joints, 3.88 mm; its centroid at (2.31, 5.02) m (on the map (650002.31, 6861005.02))``: where the
+    largest opening is, on the survey too when its file was read moved from a map grid (``origin``, m)."""
+    text = f"{name}'s joints, {shown(1000 * opening)} mm; its centroid at ({at[0]:.3f}, {at[1]:.3f}) m"
+    if origin is not None:
+        text += f" (on the map ({at[0] + origin[0]:.3f}, {at[1] + origin[1]:.3f}))"
+    return text
+
+
 def describe_hinges(pairs: list[str]) -> str:
     """``12: c01-b01|c02-b01, …``: how many joints are hinged, and the first 8 by name (the summary's row and
     ``masonry report``'s)."""
