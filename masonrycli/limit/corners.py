@@ -23,7 +23,7 @@ at the origin, 0.1053 rounded in Lambert-93.
   may slide past each other either way. A corner landing on a face within r of its rounded end keeps the share
   inset / r of μ (0 at the end, μ at r in), so that μ does not jump where a millimetre moves the point off the
   end. On the aqueduct λ is then 0.0995 exact and 0.0994 rounded, at origin or
-  in Lambert-93, against the engine's collapse between 0.095 and 0.0975 (docs/limit.md).
+  in Lambert-93, against the engine's collapse near 0.095 (docs/limit.md).
 
 Pseudo-code for one single-point joint (a, b)::
 
