@@ -353,4 +353,26 @@ FILE_ROWS = [
         "--out r.md's figure r.png: the file exists (add --force",
     ),
     ("report-out-suffix", {}, ("report", "h.npz", "--out", "r.txt"), 2, "--out r.txt: the file name must end in .md"),
+    # an accelerogram's time step over 0.1 s: DT = 10 ran, read as a record of 70 s (a warning on its length only)
+    (
+        "at2-dt-absurd",
+        {"q.AT2": "PEER\nx\nACCELERATION TIME SERIES IN UNITS OF G\nNPTS= 3, DT= 10 SEC\n0.0 0.1 0.0\n"},
+        ("check", "wall", "--record", "q.AT2"),
+        2,
+        "q.AT2:4: DT = 10: must be within 1e-06–1 s",
+    ),
+    (
+        "at2-dt-coarse",
+        {"q.AT2": "PEER\nx\nACCELERATION TIME SERIES IN UNITS OF G\nNPTS= 3, DT= 0.5 SEC\n0.0 0.1 0.0\n"},
+        ("sweep", "wall", "--records", "q.AT2", "--scale", "1,2", "--workers", "0"),
+        2,
+        "q.AT2:4: DT = 0.5: an acceleration record sampled every 0.5 s holds nothing above 1 Hz",
+    ),
+    (
+        "one-column-acceleration-coarse",
+        {"q.csv": "acc (g)\n0\n0.1\n0\n"},
+        ("check", "wall", "--record", "q.csv", "--record-dt", "0.5"),
+        2,
+        "q.csv: acceleration samples 0.5 s apart (the time step given) hold nothing above 1 Hz",
+    ),
 ]

@@ -342,6 +342,13 @@ def test_a_one_column_file_in_a_scenario_reads_and_writes_back(tmp_path):
             "10 for 10 ms would stretch the record 1000-fold)",
         ),
         ('{ kind = "record", file = "one.csv", time_step = 1e-9 }', "motion.time_step = 1e-09: must be within"),
+        # acceleration one a line 0.5 s apart (the header says acc): as an .AT2 of DT = 0.5, refused
+        (
+            '{ kind = "record", file = "acc.csv", time_step = 0.5 }',
+            "motion.file: acc.csv: acceleration samples 0.5 s apart (the time step given) hold nothing above 1 Hz, "
+            "where earthquakes shake and walls rock (accelerographs sample every 5–20 ms): an acceleration record's "
+            "time step is at most 0.1 s",
+        ),
     ],
 )
 def test_one_column_errors_in_a_scenario(tmp_path, motion, expected):
@@ -351,6 +358,7 @@ def test_one_column_errors_in_a_scenario(tmp_path, motion, expected):
     (tmp_path / "one.csv").write_text("0.1\n0.2\n0.3\n")
     (tmp_path / "two.csv").write_text("0,0.1\n0.01,0.2\n")
     (tmp_path / "three.csv").write_text("t,x,y\n0,0.1,0.2\n")
+    (tmp_path / "acc.csv").write_text("acc (g)\n0\n0.1\n0\n")
     with pytest.raises(InputError) as exc:
         loads_scenario(SCENARIO.replace("MOTION", motion), source="s.toml", base_dir=tmp_path)
     message = one_line(exc)
@@ -372,3 +380,16 @@ def test_a_binary_file_under_a_text_suffix_is_not_named_by_its_suffix(tmp_path):
     text.write_text('name = "s"\n')
     with pytest.raises(InputError, match=r"s\.toml: a scenario file \(TOML\), not a ground-motion record"):
         record_motion(text)
+
+
+def test_one_column_acceleration_takes_a_time_step_up_to_0_1_s_and_velocity_up_to_1_s(tmp_path):
+    # the bound of an accelerogram's header (motion.MAX_ACCELEROGRAM_STEP) holds for acceleration given one value a
+    # line; a velocity so given keeps the one-column bound, 1 s (a shake table's smooth input)
+    from masonrycli.records.read import record_motion
+
+    (tmp_path / "acc.csv").write_text("acc (g)\n0\n0.1\n0\n")
+    (tmp_path / "vel.csv").write_text("0\n0.1\n0\n")
+    assert record_motion(tmp_path / "acc.csv", time_step=0.1).time[-1] == pytest.approx(0.2)
+    with pytest.raises(InputError, match=r"acc.csv: acceleration samples 0.2 s apart \(the time step given\)"):
+        record_motion(tmp_path / "acc.csv", time_step=0.2, display="acc.csv")
+    assert record_motion(tmp_path / "vel.csv", time_step=0.5).quantity == "velocity"

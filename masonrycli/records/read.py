@@ -34,7 +34,7 @@ from masonrycli.errors import (
 )
 from masonrycli.records.esm import esm_text, esm_vertical, is_esm, looks_like_esm
 from masonrycli.records.knet import is_knet, knet_text, knet_vertical
-from masonrycli.records.motion import Record, time_step_problem
+from masonrycli.records.motion import MAX_ACCELEROGRAM_STEP, Record, time_step_problem
 from masonrycli.records.text import NoTimeStep, TimeStepNotUsed, at2_text, csv_text, number
 from masonrycli.records.units import G_STANDARD, check_at2_header, check_csv_header, header_quantity, input_text
 from masonrycli.scenario.values import format_value, quote_string, shorten
@@ -289,6 +289,7 @@ def record_motion(
         kind = "an .AT2 file" if is_at2(path) else "a K-NET file" if is_knet(path) else "this ESM file"
         raise InputError(f"{display or path}: {kind} holds {native}, not {quantity}")
     quantity = quantity or native or header_quantity(path) or "velocity"  # a CSV: as its header says, else m/s
+    _coarse_acceleration(display or str(path), time_step, quantity)
     if native is None:
         value = _in_si(value, check_csv_header(path, display or str(path), quantity, scale))
     vertical_source = ""
@@ -318,6 +319,17 @@ def _in_si(value: np.ndarray, factor: float) -> np.ndarray:
     """A CSV's samples in SI: times the factor its header's unit gives (the same array when it names none, so a
     file in SI is read bit for bit as before)."""
     return value if factor == 1.0 else value * factor
+
+
+def _coarse_acceleration(name: str, time_step: float | None, quantity: str) -> None:
+    """Refuse acceleration samples one a line given a time step over :data:`MAX_ACCELEROGRAM_STEP` (an .AT2's DT
+    is held to it as well): ``--record-dt 0.5`` on an ``acc (g)`` column ran, 2 samples a second."""
+    if time_step is not None and quantity == "acceleration" and time_step > MAX_ACCELEROGRAM_STEP:
+        raise InputError(
+            f"{name}: acceleration samples {time_step:g} s apart (the time step given) hold nothing above "
+            f"{0.5 / time_step:.3g} Hz, where earthquakes shake and walls rock (accelerographs sample every 5–20 ms): "
+            f"an acceleration record's time step is at most {MAX_ACCELEROGRAM_STEP:g} s"
+        )
 
 
 def _time_step(value, key: str) -> float | None:
@@ -392,6 +404,7 @@ def _table_file(table: dict, key: str, base_dir: str, time_step: float | None, q
         time, value, native = read_record(resolved, display=file, time_step=time_step)
         if native is None:  # in the unit its header gives, converted to SI
             quantity = quantity or table.get("quantity") or header_quantity(resolved) or "velocity"
+            _coarse_acceleration(file, time_step, quantity)
             value = _in_si(value, check_csv_header(resolved, file, quantity, table.get("scale", 1.0)))
     except NoTimeStep as exc:  # --record-dt goes with --record, not with the scenario's own record file
         raise InputError(f"motion.{key}: {exc.give('time_step = SECONDS in the record table')}") from None
