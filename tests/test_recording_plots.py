@@ -59,3 +59,18 @@ def test_each_support_component_has_its_own_colour_the_same_in_both_support_plot
     assert velocity is not None and len(velocity) == 4, velocity
     assert len(set(velocity)) == 4, velocity  # the two vy lines told apart
     assert displacement == velocity  # ux has vx's colour, uy vy's
+
+
+def test_the_residual_plot_keeps_its_tolerance_off_its_top_edge_and_its_residuals_out_of_its_legend(arch):
+    """The residual plot's range had a 5 % margin each side: the tolerance's line (the top of the plot when
+    every step converges) lay on the top edge, and the legend's two rows (bottom left) over the lowest
+    residuals. Residuals more than a decade under the tolerance may lie below (residual_range's module doc)."""
+    values = _values(arch, "residual")
+    tolerance = values.max()  # log10 of the tolerance: every step at or under it
+    values = values[np.isfinite(values) & (values >= tolerance - 1.0)]
+    y_range = blueprint_views(arch)[PLOT_NAMES["residual"]]["y_range"]
+    assert y_range is not None
+    low, high = y_range
+    height = high - low
+    assert (high - values.max()) / height >= PAD, (y_range, values.max())
+    assert (values.min() - low) / height >= PAD + 2 * LEGEND_ROW, (y_range, values.min())

@@ -346,7 +346,7 @@ def build_blueprint(
         view_range=rrb.TimeRange(rrb.TimeRangeBoundary.infinite(), rrb.TimeRangeBoundary.infinite())
     )
 
-    ranges = plot_ranges or {}
+    ranges = {**(plot_ranges or {}), "residual": residual_range}
 
     def plot(key: str, axis_y: rrb.ScalarAxis | None = None) -> rrb.TimeSeriesView:
         # a plot of one series whose name says it has no legend: the legend box (bottom left) hid the
@@ -358,8 +358,6 @@ def build_blueprint(
         return rrb.TimeSeriesView(
             origin=f"/{SERIES[key]}", name=PLOT_NAMES[key], axis_x=whole_run, axis_y=axis_y, plot_legend=legend
         )
-
-    residual_axis = rrb.ScalarAxis(range=residual_range) if residual_range is not None else None
 
     right = rrb.Vertical(
         rrb.Tabs(
@@ -378,7 +376,7 @@ def build_blueprint(
             plot("support_displacement"),
             # the residual's unit (the RMS contact-law violation of a sweep, m/s, as --tolerance): the plot's
             # ticks read -5 .. -5.3 with no unit anywhere on screen
-            plot("residual", residual_axis),
+            plot("residual"),
             plot("iterations"),
             plot("contacts"),
             # what moved the structure, at first open: the shaking ground, the settling foundation (an arch

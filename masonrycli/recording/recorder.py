@@ -71,12 +71,13 @@ from masonrycli.recording.layout import (
 )
 from masonrycli.recording.magnified import PoseSpool, send_magnified
 from masonrycli.recording.overlays import frame_joint_resultants, send_axes, send_joints
+from masonrycli.recording.plot_range import plot_range
 from masonrycli.recording.reach import Reach
 from masonrycli.recording.readback import check_complete, wait_written
 from masonrycli.recording.residual_range import ResidualRange
 from masonrycli.recording.run_panels import PanelFacts, log_run_panels
 from masonrycli.recording.scales import fix_scales
-from masonrycli.recording.series import RANGED, plot_range, send_series, send_steps
+from masonrycli.recording.series import RANGED, send_series, send_steps
 from masonrycli.recording.static_content import (
     RecordingStatic,
     inset_local,

@@ -3,12 +3,15 @@
 A record run converged its first steps far below the tolerance (1e-7.5 m/s under 1e-5): the plot spanned
 2.5 decades for them, the rest of the run a flat line on the tolerance's. So the range runs from the
 smallest residual but those more than a decade under the tolerance to the largest (at least the tolerance),
-when at most 5 % of the steps lie that low; else the viewer fits the data.
+when at most 5 % of the steps lie that low, with margins and room for the legend (``plot_range``); else the
+viewer fits the data.
 """
 
 from __future__ import annotations
 
 import numpy as np
+
+from masonrycli.recording.plot_range import plot_range
 
 CHUNK = 1024
 """Residuals kept before they are counted, all at once (ResidualRange.add)."""
@@ -50,13 +53,15 @@ class ResidualRange:
         if not low.all():
             self._best = min(self._best, float(r[~low].min()))
 
-    def range(self) -> tuple[float, float] | None:
-        """(low, high), log10 of m/s, with a 5 % margin each side; None: the viewer's fit (module doc)."""
+    def range(self, rows: int = 2) -> tuple[float, float] | None:
+        """(low, high), log10 of m/s, with a margin above the lines and, under them, room for the legend's
+        ``rows`` (``plot_range``); None: the viewer's fit (module doc)."""
         self._fold()
         if not self._steps or not np.isfinite(self.log10_tolerance) or self._low > 0.05 * self._steps:
             return None
         if not np.isfinite(self._best):
             return None
         lo, hi = float(np.log10(self._best)), max(self.log10_tolerance, float(np.log10(self._worst)))
-        margin = 0.05 * (hi - lo)
-        return (lo - margin, hi + margin)
+        # the tolerance's line lay on the top edge, under the frame, and the legend (bottom left) over the
+        # lowest residuals of the run's first steps, with a 5 % margin each side
+        return plot_range(lo, hi, rows, with_zero=False)

@@ -73,28 +73,10 @@ def balance_log10(kinetic, potential_change, dissipated, work) -> np.ndarray:
     return np.log10(np.maximum(share, BALANCE_FLOOR))
 
 
-PLOT_PAD: Final = 0.08
-"""Share of a plot's height left empty above and below its lines: a settling arch's supports (vx, vy = 0 and
-vy = -0.01 m/s) drew lines on the plot's top and bottom edges, the viewer's fit to the data."""
-LEGEND_ROW_SHARE: Final = 0.1
-"""Share of a plot's height one legend row takes at 1920 x 1080 (~23 of the ~240 px of the support plots), kept
-free of lines under them: the legend (bottom left) hid the start of a settling foundation's vy line."""
 RANGED: Final = ("energy_large", "support_velocity", "support_displacement")
-"""The plots of several series, with a legend, whose y range the recording sets (:func:`plot_range`). Support
+"""The plots of several series, with a legend, whose y range the recording sets (``plot_range``). Support
 v alone was: Support u's lines ran along its top and bottom edges and under its legend (a record's ground ux
 dipped behind it), and in Energies the legend hid the start of the support work and the two lines at 0."""
-
-
-def plot_range(low: float, high: float, rows: int) -> tuple[float, float] | None:
-    """A plot's y range for values from ``low`` to ``high`` (0 included) and ``rows`` series in its legend:
-    PLOT_PAD above and below the lines, and under them room for the legend (its rows, at most 60 % of the
-    plot). None when every value is 0 (a still support: the viewer's fit)."""
-    low, high = min(low, 0.0), max(high, 0.0)
-    if not np.isfinite(low) or not np.isfinite(high) or high - low <= 0.0:
-        return None
-    legend = min(0.6, LEGEND_ROW_SHARE * rows)
-    height = (high - low) / (1.0 - 2.0 * PLOT_PAD - legend)
-    return low - (PLOT_PAD + legend) * height, high + PLOT_PAD * height
 
 
 SUPPORT_PALETTE: Final = (
