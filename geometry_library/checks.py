@@ -230,9 +230,10 @@ def normalise_coords(coords, label: str) -> np.ndarray:
         raise GeometryError(f"{label}: coordinates are not numbers ({exc})") from None
     if xy.ndim != 2 or xy.shape[1] != 2 or xy.shape[0] == 0:
         raise GeometryError(f"{label}: expected (k, 2) vertex coordinates, got shape {xy.shape}")
-    if len(xy) > MAX_VERTICES:
+    given = len(xy) - int(len(xy) > 1 and bool(np.all(xy[0] == xy[-1])))  # a closed ring's repeat not counted
+    if given > MAX_VERTICES:
         raise GeometryError(
-            f"{label}: {len(xy)} vertices, more than {MAX_VERTICES} (an outline traced at every pixel? "
+            f"{label}: {given} vertices, more than {MAX_VERTICES} (an outline traced at every pixel? "
             "simplify it to about 1 mm: QGIS's Vector > Geometry Tools > Simplify)"
         )
     if not np.all(np.isfinite(xy)):

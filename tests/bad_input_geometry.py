@@ -70,6 +70,15 @@ GEOMETRY_ROWS = [
         '[[block]] #1 ("disc"): 10001 vertices, more than 10000 (an outline traced at every pixel?',
     ),
     ("geojson-too-many-vertices", {"g.geojson": feature([CIRCLE])}, ("check", "g.geojson"), 2, "10001 vertices"),
+    # a closed ring (as GeoJSON and WKT write every ring) counts its distinct vertices: 10 001 and its repeated
+    # first one were said '10002 vertices', and 10 000 closed were refused as 10 001
+    (
+        "geojson-closed-ring-vertices",
+        {"g.geojson": feature([CIRCLE + CIRCLE[:1]])},
+        ("check", "g.geojson"),
+        2,
+        ": 10001 vertices, more than 10000",
+    ),
     # integers too large for a float (TOML and JSON read any size): "OverflowError: int too large to convert
     # to float", a traceback; and a JSON true read as the coordinate 1.0 without a word
     (
