@@ -157,7 +157,8 @@ def validate_assembly(
             what = f"{labels[a]} and {labels[b]}"
         hint = float32_hint(coords, h_min, "their")
         depth = overlap_depth(overlap)
-        depth = f"{depth * 1e3:.2g} mm deep" if depth < 0.1 else f"{depth:.3g} m deep"
+        # two digits, written out: 99.7 mm said '1e+02 mm deep' (a stone traced 10 cm into another)
+        depth = f"{float(f'{depth * 1e3:.2g}'):g} mm deep" if depth < 0.1 else f"{depth:.3g} m deep"
         twice = " — one covers the other: the same stone drawn twice?" * bool(area >= 0.9 * body_areas[[a, b]].min())
         raise GeometryError(
             f"{what} overlap by {area:.3g} m², {depth}{twice} (tolerance {tol:.3g} m², "

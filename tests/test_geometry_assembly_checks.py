@@ -136,3 +136,11 @@ def test_a_corner_7_mm_inside_the_ground_is_refused_though_its_area_is_within_to
     assert "0.6 mm deep" in raises_one_line("overlap", validate_assembly, corner_in(6e-4))
     assert validate_assembly(corner_in(4e-4)) == []
     assert overlap_depth(box(0, 0, 0.3, 1e-4)) == pytest.approx(1e-4)  # a face sunk 0.1 mm: 0.1 mm
+
+
+def test_an_overlap_just_under_a_decimetre_is_said_in_millimetres_written_out():
+    # a stone traced 99.7 mm into its neighbour said "1e+02 mm deep"
+    a = Block(box(0, 0, 0.3, 0.2), "a")
+    deep = asm(a.polygon, box(0.2003, 0, 0.5003, 0.2), supports=[GROUND], names=["a", "b"])
+    said = raises_one_line("overlap", validate_assembly, deep)
+    assert ", 100 mm deep (tolerance" in said and "e+" not in said, said
