@@ -102,9 +102,10 @@ def test_a_cluster_without_workers_says_the_study_waits_and_again_when_one_joins
     assert sorted(r["amp"] for r in rows) == [0.0, 1.0, 2.0]
 
 
-def test_a_lost_scheduler_counts_every_run_not_made(client, monkeypatch):
-    # "with 2 runs pending" of a study with 5 runs to go: the points not yet submitted (at most a few per worker
-    # thread are) were left out, 64 pending of a 10 000-point grid
+def _lose_the_scheduler(client, monkeypatch, points: int, limit: int) -> tuple[list, str]:
+    """A study of ``points`` points, ``limit`` at a time, whose point amp = 1 finds the scheduler gone: (the rows
+    made, the SchedulerLost message)."""
+
     def task(base, params, *args):
         if params["amp"] == 1.0:
             raise OSError("the connection to the scheduler went with it")  # taken for the scheduler's loss below
@@ -114,25 +115,22 @@ def test_a_lost_scheduler_counts_every_run_not_made(client, monkeypatch):
     monkeypatch.setattr(runner, "_scheduler_lost", lambda client, exc: True)
     rows = []
     with pytest.raises(runner.SchedulerLost) as lost:
-        runner.run_on_cluster(client, "s", Driver(6), lambda p, r: rows.append(r), False, None, False, limit=2)
-    assert str(lost.value) == f"lost the connection to the scheduler with {6 - len(rows)} runs pending"
+        runner.run_on_cluster(client, "s", Driver(points), lambda p, r: rows.append(r), False, None, False, limit=limit)
+    return rows, str(lost.value)
+
+
+def test_a_lost_scheduler_counts_every_run_not_made(client, monkeypatch):
+    # "with 2 runs pending" of a study with 5 runs to go: the points not yet submitted (at most a few per worker
+    # thread are) were left out, 64 pending of a 10 000-point grid
+    rows, said = _lose_the_scheduler(client, monkeypatch, 6, 2)
+    assert said == f"lost the connection to the scheduler with {6 - len(rows)} runs pending"
 
 
 def test_a_lost_scheduler_with_one_run_left_says_one_run(client, monkeypatch):
     # "with 1 runs pending" when the last point's run found the scheduler gone (9a2001f's fix): one point at a
     # time (limit=1), the first gives its row, the second is the one run left
-    def task(base, params, *args):
-        if params["amp"] == 1.0:
-            raise OSError("the connection to the scheduler went with it")
-        return dict(params)
-
-    monkeypatch.setattr(runner, "run_task", task)
-    monkeypatch.setattr(runner, "_scheduler_lost", lambda client, exc: True)
-    rows = []
-    with pytest.raises(runner.SchedulerLost) as lost:
-        runner.run_on_cluster(client, "s", Driver(2), lambda p, r: rows.append(r), False, None, False, limit=1)
-    assert len(rows) == 1
-    assert str(lost.value) == "lost the connection to the scheduler with 1 run pending"
+    rows, said = _lose_the_scheduler(client, monkeypatch, 2, 1)
+    assert len(rows) == 1 and said == "lost the connection to the scheduler with 1 run pending"
 
 
 def _distributed_log_level() -> int:

@@ -22,17 +22,24 @@ class SilentThenAnswering:
         return {"tcp://10.0.0.7:40213": 1}
 
 
+def _said_by_a_silent_scheduler(where: str, waiting: int, lines: int) -> list[str]:
+    """The watch's first ``lines`` lines (10 s at most) over a scheduler silent for its first 8 looks, with
+    ``waiting`` runs waiting."""
+    said: list[str] = []
+    with watch.WorkerWatch(SilentThenAnswering(8), said.append, where, lambda: waiting):
+        end = time.monotonic() + 10
+        while len(said) < lines and time.monotonic() < end:
+            time.sleep(0.02)
+    return said
+
+
 def test_a_scheduler_that_stops_answering_is_said_and_again_when_it_answers(monkeypatch):
     # a scheduler stopped (kill -STOP) mid-study: its connection stayed open, and the study waited 60 s without
     # a line, then went on when it was continued
     monkeypatch.setattr(watch, "WATCH_EVERY", 0.02)
     monkeypatch.setattr(watch, "ASK_TIMEOUT", 0.1)
     monkeypatch.setattr(watch, "NO_ANSWER_WAIT", 0.3)
-    said: list[str] = []
-    with watch.WorkerWatch(SilentThenAnswering(8), said.append, "--scheduler tcp://h:8786", lambda: 3):
-        end = time.monotonic() + 10
-        while len(said) < 2 and time.monotonic() < end:
-            time.sleep(0.02)
+    said = _said_by_a_silent_scheduler("--scheduler tcp://h:8786", waiting=3, lines=2)
     assert said == [
         "--scheduler tcp://h:8786: the scheduler has not answered for 0.3 s (stopped, its machine overloaded or cut "
         "off?), 3 runs waiting: the study goes on when it answers (Ctrl-C stops it, every finished row written)",
@@ -53,9 +60,5 @@ def test_one_run_waiting_is_one_run(monkeypatch):
     monkeypatch.setattr(watch, "WATCH_EVERY", 0.02)
     monkeypatch.setattr(watch, "ASK_TIMEOUT", 0.1)
     monkeypatch.setattr(watch, "NO_ANSWER_WAIT", 0.3)
-    said: list[str] = []
-    with watch.WorkerWatch(SilentThenAnswering(8), said.append, "X", lambda: 1):
-        end = time.monotonic() + 10
-        while len(said) < 1 and time.monotonic() < end:
-            time.sleep(0.02)
+    said = _said_by_a_silent_scheduler("X", waiting=1, lines=1)
     assert ", 1 run waiting: the study goes on when it answers" in said[0], said
