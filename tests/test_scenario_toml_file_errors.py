@@ -19,7 +19,7 @@ RUN_ERRORS = [
     ("dt = -0.001", "[run] dt = -0.001: must be > 0"),
     ("dt = 0", "[run] dt = 0: must be > 0"),
     ("dt = 2.0", "[run] dt = 2.0: must be <= duration (1.0)"),
-    ("dt = 1e-12", "[run] dt = 1e-12: gives 1,000,000,000,000 steps"),
+    ("dt = 1e-12", "[run] duration = 1.0 at dt = 1e-12 is 1,000,000,000,000 steps (at most 100,000,000)"),
     ("duration = 0.0", "[run] duration = 0.0: must be > 0"),
     ("duration = -1", "[run] duration = -1: must be > 0"),
     ("duration = 1e6", "[run] duration = 1000000.0: must be <= 100000"),
