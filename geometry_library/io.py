@@ -81,8 +81,14 @@ def _read_text(path: Path) -> str:
         raw = path.read_bytes()
     except OSError as exc:
         raise GeometryError(f"{path}: cannot read file ({exc.__class__.__name__}: {exc})") from None
+    # Notepad's "UTF-8 with BOM" was "invalid JSON (Unexpected UTF-8 BOM …)" (a scenario file reads it); a UTF-16
+    # file was "byte 0, 0xff: … such as Windows-1252", a binary one named a line of its bytes
+    if raw[:2] in (b"\xff\xfe", b"\xfe\xff"):
+        raise GeometryError(f"{path}: a UTF-16 text file (it starts with UTF-16's byte-order mark); save it as UTF-8")
+    if b"\x00" in raw:
+        raise GeometryError(f"{path}: not a text file (it holds NUL bytes: a binary file)")
     try:
-        return raw.decode("utf-8")
+        return raw.decode("utf-8-sig")
     except UnicodeDecodeError as exc:  # it said "(UnicodeDecodeError: 'utf-8' codec can't decode byte 0xe9 …)"
         line = raw.count(b"\n", 0, exc.start) + 1
         raise GeometryError(

@@ -61,6 +61,14 @@ GEOMETRY_ROWS = [
         "g.geojson: ",
     ),
     ("geojson-missing", {}, ("run", "nope.geojson"), 2, "nope.geojson: no such scenario or geometry file"),
+    # it said "g.geojson:1: not a UTF-8 text file (byte 0, 0xff: … such as Windows-1252)"
+    (
+        "geojson-utf16",
+        {"g.geojson": feature(SQUARE).encode("utf-16")},
+        ("check", "g.geojson"),
+        2,
+        "g.geojson: a UTF-16 text file (it starts with UTF-16's byte-order mark); save it as UTF-8",
+    ),
     # a 100 000-vertex circle was cleaned one vertex at a time for minutes before a word: now at most 10 000
     (
         "toml-too-many-vertices",

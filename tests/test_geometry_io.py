@@ -140,6 +140,34 @@ def one_line_error(fn, *args):
     return text
 
 
+def test_a_utf8_byte_order_mark_is_read_utf16_and_binary_files_named(tmp_path):
+    """Notepad's "UTF-8 with BOM": a GeoJSON was "invalid JSON (Unexpected UTF-8 BOM …)", a WKT file's first label
+    "'\\ufeffblock a' … is not a label" (a scenario file reads it). A UTF-16 file was "byte 0, 0xff: a character
+    saved in another encoding, such as Windows-1252", a binary one "not a UTF-8 text file" at some line."""
+    from geometry_library.wkt import read_wkt
+
+    wkt = "block a: POLYGON ((0 0, 1 0, 1 1, 0 1, 0 0))\nsupport g: POLYGON ((-5 -1, 5 -1, 5 0, -5 0, -5 -1))\n"
+    (tmp_path / "plain.wkt").write_text(wkt, encoding="utf-8")
+    (tmp_path / "bom.wkt").write_text(wkt, encoding="utf-8-sig")
+    plain = read_wkt(tmp_path / "plain.wkt")
+    marked = read_wkt(tmp_path / "bom.wkt")
+    assert [b.name for b in marked.blocks] == ["a"] and marked.blocks[0].polygon.equals(plain.blocks[0].polygon)
+    text = write_geojson(plain, tmp_path / "plain.geojson").read_text(encoding="utf-8")
+    (tmp_path / "bom.geojson").write_text(text, encoding="utf-8-sig")
+    marked = read_geojson(tmp_path / "bom.geojson")
+    assert [b.name for b in marked.blocks] == ["a"] and marked.blocks[0].polygon.equals(plain.blocks[0].polygon)
+    for name in ("u16.geojson", "u16.wkt"):
+        (tmp_path / name).write_text(wkt, encoding="utf-16")
+    assert one_line_error(read_geojson, tmp_path / "u16.geojson") == (
+        f"{tmp_path / 'u16.geojson'}: a UTF-16 text file (it starts with UTF-16's byte-order mark); save it as UTF-8"
+    )
+    assert "u16.wkt: a UTF-16 text file" in one_line_error(read_wkt, tmp_path / "u16.wkt")
+    (tmp_path / "bin.geojson").write_bytes(bytes(range(256)))
+    assert one_line_error(read_geojson, tmp_path / "bin.geojson").endswith(
+        "bin.geojson: not a text file (it holds NUL bytes: a binary file)"
+    )
+
+
 def test_geojson_errors_name_file_and_feature(tmp_path):
     missing = one_line_error(read_geojson, tmp_path / "nope.geojson")
     assert "nope.geojson: cannot read file" in missing
