@@ -160,6 +160,9 @@ PATH_ROWS = [
         2,
         "h.npz: named twice",
     ),
+    # an empty --blocks / --course (an unset "$BLOCKS") exported the top course without a word
+    ("export-blocks-empty", {}, ("export", "h.npz", "--blocks", ""), 2, "--blocks '': an empty list (block names"),
+    ("export-course-empty", {}, ("export", "h.npz", "--course", " "), 2, "--course ' ': an empty list (course numbers"),
     ("export-one-csv-two-runs", {}, ("export", "a/h.npz", "b/h.npz", "--out", "o"), 2, "a/h.npz and b/h.npz: both"),
     # -- export --times: the lab's file is read before the histories
     (

@@ -14,14 +14,18 @@ from masonrycli.cli.option_values import file_path_value, path_value, whole_valu
 from masonrycli.errors import InputError
 
 
-def _names(values: list[str] | None) -> list[str]:
-    """``--blocks a,b --blocks c`` → [a, b, c]."""
+def _names(values: list[str] | None, option: str = "--blocks", what: str = "block names") -> list[str]:
+    """``--blocks a,b --blocks c`` → [a, b, c]. An empty value (an unset "$BLOCKS") is refused: it exported the
+    default target (the top course) without a word."""
+    for value in values or ():
+        if not value.replace(",", "").strip():
+            raise InputError(f"{option} {value!r}: an empty list ({what}, comma-separated)")
     return [name.strip() for value in values or () for name in value.split(",") if name.strip()]
 
 
 def _course_numbers(values: list[str] | None) -> list[int]:
     out = []
-    for text in _names(values):
+    for text in _names(values, "--course", "course numbers"):
         try:
             out.append(int(text))
         except ValueError:
