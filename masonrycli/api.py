@@ -7,7 +7,7 @@ Python                                          the command line's code
 ==============================================  ===============================================================
 ``scenario("wall", amp=0.5, blocks=248)``       ``masonry check wall --amp 0.5 --blocks 248`` (builtin.builtin)
 ``scenario("my.toml", dt=2e-4)``                ``masonry run my.toml --dt 2e-4`` (target.file_scenario)
-``simulate(s, history="h.npz")``                ``masonry simulate / run … --history h.npz`` (execute.check_run,
+``simulate(s, history="h.npz")``                ``masonry simulate / run … --history h.npz`` (output_plan.check_run,
                                                 execute.execute)
 ``read_history("h.npz")``                       ``masonry inspect h.npz``'s checks, then every array
 ``Run.table(top=True)``                         ``masonry export h.npz --top`` (outputs.export.export_table)
@@ -175,10 +175,12 @@ def simulate(
     in a notebook a display under the cell; else stderr), first saying why a first run waits."""
     from rich.console import Console
 
-    from masonrycli.execute import check_magnify, check_run, execute, result_warning
+    from masonrycli.execute import execute
     from masonrycli.interrupt import StopRun
+    from masonrycli.output_plan import check_magnify, check_run
     from masonrycli.outputs.live_line import LiveLine
     from masonrycli.outputs.report import summary_table
+    from masonrycli.run_summary import result_warning
     from masonrycli.scenario.caveats import scenario_warnings
 
     sc = scenario(target, **options)
@@ -266,8 +268,8 @@ def view(recording):
     the viewer's process (:class:`subprocess.Popen`)."""
     import subprocess
 
-    from masonrycli.execute import rerun_command
     from masonrycli.recording import recording_path_problem
+    from masonrycli.viewer_command import rerun_command
 
     path = _path(recording, "recording")
     problem = recording_path_problem(path)

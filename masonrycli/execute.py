@@ -24,25 +24,13 @@ from masonrycli import SOURCE_DIGEST, __version__
 from masonrycli.engine import compile_ahead
 from masonrycli.errors import InputError
 from masonrycli.interrupt import StopSignals
-
-# what execute.py held before (the callers and tests import them from here): the outputs planned before a run,
-# what the command line says at its end, the viewer's line
-from masonrycli.output_plan import (  # noqa: F401
-    MAX_MAGNIFY,
-    Outputs,
-    check_magnify,
-    check_run,
-    output_sizes,
-    plan_outputs,
-)
+from masonrycli.output_plan import Outputs
 from masonrycli.outputs.files import OutputFile, open_part
 from masonrycli.outputs.history import History, HistoryFile, block_constants, result_values
 from masonrycli.outputs.report import progress_bar, slow_start_notice
 from masonrycli.outputs.sinks import COMPLETED, FAILED
 from masonrycli.run import RunResult, Simulation, simulate
-from masonrycli.run_summary import print_summary, result_warning, unconverged_warning  # noqa: F401
 from masonrycli.source_digest import source_commit
-from masonrycli.viewer_command import in_powershell, open_command, rerun_command  # noqa: F401
 
 
 @dataclass

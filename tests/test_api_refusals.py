@@ -306,15 +306,15 @@ def test_a_warning_the_caller_s_filters_hide_stays_hidden(monkeypatch):
     # DeprecationWarning, hidden by Python's defaults, came out as one of the notebook's own (its __main__)
     import warnings
 
-    from masonrycli import execute
+    from masonrycli import output_plan
 
-    check_run = execute.check_run
+    check_run = output_plan.check_run
 
     def with_a_library_warning(*args, **kwargs):
         warnings.warn_explicit("a library's deprecation", DeprecationWarning, "somelib.py", 1, module="somelib")
         return check_run(*args, **kwargs)
 
-    monkeypatch.setattr(execute, "check_run", with_a_library_warning)
+    monkeypatch.setattr(output_plan, "check_run", with_a_library_warning)
     with warnings.catch_warnings(record=True) as said:
         warnings.simplefilter("ignore", DeprecationWarning)  # Python's defaults: shown for __main__ only
         warnings.filterwarnings("default", category=DeprecationWarning, module=__name__)

@@ -24,11 +24,13 @@ from geometry_library.blocks import Assembly, Block, Support
 from masonrycli import SOURCE_DIGEST, viewer_command
 from masonrycli import execute as execute_module
 from masonrycli.errors import InputError
-from masonrycli.execute import check_run, execute, plan_outputs, unconverged_warning
+from masonrycli.execute import execute
 from masonrycli.interrupt import StopRun
+from masonrycli.output_plan import check_run, output_sizes, plan_outputs
 from masonrycli.outputs.files import OutputFile
 from masonrycli.recording import inspect_recording
 from masonrycli.run import Simulation
+from masonrycli.run_summary import unconverged_warning
 from masonrycli.scenario.motion import Sine
 from masonrycli.scenario.scenario import SOLVERS, Material, RunConfig, Scenario
 from masonrycli.source_digest import source_commit
@@ -207,7 +209,6 @@ def test_check_run_refuses_a_step_too_long_for_the_motion(tmp_path):
 def test_the_size_estimate_is_an_upper_bound(args, tmp_path):
     """The estimate left out the recording's static part: the 51-block wall's 0.1 s was let start on a 1 MB
     disk (estimate ~0.6 MB; it wrote 0.63 MB of recording + its history) and failed there, exit 4."""
-    from masonrycli.execute import output_sizes
     from masonrycli.scenario.builtin import builtin
 
     rrd, npz = tmp_path / "r.rrd", tmp_path / "h.npz"
@@ -255,17 +256,17 @@ def test_the_open_command_runs_where_the_student_is(tmp_path, monkeypatch):
         monkeypatch.setattr(viewer_command.sys, "executable", str(scripts / "python"))
         monkeypatch.chdir(tmp_path / "class")
         rrd = os.path.join("recordings", "wall-20261129-082048.rrd")
-        command = execute_module.open_command(rrd, windows=system)
+        command = viewer_command.open_command(rrd, windows=system)
         shown = os.path.join(os.curdir, ".venv", folder, viewer) if system else os.path.join(".venv", folder, viewer)
         assert command == f"{shown} {rrd}"
-        assert execute_module.open_command("my runs/w.rrd", windows=system).endswith(
+        assert viewer_command.open_command("my runs/w.rrd", windows=system).endswith(
             ' "my runs/w.rrd"' if system else " 'my runs/w.rrd'"
         )
         monkeypatch.chdir(tmp_path)  # elsewhere: the viewer's whole path
         elsewhere = tmp_path / "elsewhere"
         elsewhere.mkdir(exist_ok=True)
         monkeypatch.chdir(elsewhere)
-        assert execute_module.open_command("w.rrd", windows=system) == f"{scripts / viewer} w.rrd"
+        assert viewer_command.open_command("w.rrd", windows=system) == f"{scripts / viewer} w.rrd"
 
 
 def test_the_unconverged_warning_names_only_the_causes_there_were():
@@ -385,12 +386,12 @@ def test_the_open_command_calls_a_quoted_viewer_in_powershell(tmp_path, monkeypa
         monkeypatch.setenv("PSModulePath", modules)
     viewer = os.path.join(os.curdir, "Ana Silva", ".venv", "Scripts", "rerun.exe")
     rrd = r"recordings\wall-20261129-082048.rrd"
-    assert execute_module.open_command(rrd, windows=True) == f'{call}"{viewer}" {rrd}'
-    assert execute_module.open_command(r"my runs\w.rrd", windows=True) == f'{call}"{viewer}" "my runs\\w.rrd"'
+    assert viewer_command.open_command(rrd, windows=True) == f'{call}"{viewer}" {rrd}'
+    assert viewer_command.open_command(r"my runs\w.rrd", windows=True) == f'{call}"{viewer}" "my runs\\w.rrd"'
     # a viewer that needs no quotes needs no operator: the line runs in either shell
     monkeypatch.chdir(tmp_path / "Ana Silva")
     assert (
-        execute_module.open_command(rrd, windows=True)
+        viewer_command.open_command(rrd, windows=True)
         == f"{os.path.join(os.curdir, '.venv', 'Scripts', 'rerun.exe')} {rrd}"
     )
 
@@ -400,5 +401,5 @@ def test_the_open_command_quotes_what_either_windows_shell_would_read_otherwise(
     # two commands to cmd.exe
     monkeypatch.setattr(viewer_command.shutil, "which", lambda name: "rerun")
     for name in ("it's.rrd", "a&b.rrd", "w (2).rrd", "x;y.rrd"):
-        assert execute_module.open_command(name, windows=True) == f'rerun "{name}"'
-    assert execute_module.open_command(r"C:\runs\w-1_a.rrd", windows=True) == r"rerun C:\runs\w-1_a.rrd"
+        assert viewer_command.open_command(name, windows=True) == f'rerun "{name}"'
+    assert viewer_command.open_command(r"C:\runs\w-1_a.rrd", windows=True) == r"rerun C:\runs\w-1_a.rrd"

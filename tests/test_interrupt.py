@@ -313,16 +313,16 @@ def test_a_stopped_context_never_puts_pythons_handler_back_on_its_way_out(monkey
 
 SIGNAL_IN_SUMMARY = """
 import os, signal, sys, time
-import masonrycli.execute as execute
+import masonrycli.run_summary as run_summary
 
-print_summary = execute.print_summary
+print_summary = run_summary.print_summary
 
 def signalled_summary(*args, **kwargs):  # the run is over, its files renamed into place
     os.kill(os.getpid(), int(os.environ["SIGNAL"]))
     time.sleep(0.2)  # a Python handler runs here
     print_summary(*args, **kwargs)
 
-execute.print_summary = signalled_summary
+run_summary.print_summary = signalled_summary
 sys.argv = ["masonry", *sys.argv[1:]]
 from masonrycli.__main__ import main
 main()

@@ -15,8 +15,8 @@ from masonrycli.errors import EXIT_DIVERGED, EXIT_INTERNAL, EXIT_OUTPUT_FAILED, 
 
 def checked_outputs(scenario, opts: dict):
     """The outputs a run of ``scenario`` would write, checked (``opts``: the OUTPUT and FORCE options), as
-    run, simulate and check all ask: :func:`masonrycli.execute.check_run`."""
-    from masonrycli.execute import check_run
+    run, simulate and check all ask: :func:`masonrycli.output_plan.check_run`."""
+    from masonrycli.output_plan import check_run
 
     return check_run(
         scenario,
@@ -31,6 +31,9 @@ def checked_outputs(scenario, opts: dict):
 def execute_and_exit(scenario, opts: dict, hint=None) -> None:
     """Check the outputs (``opts``: the OUTPUT, FORCE and STOP options), run, print the summary; exit with
     the code of how the run ended. ``hint``: the line under the summary, given the time the run reached."""
+    # the run's module (the engine, the outputs) loaded before the run's handlers: a signal while it loads is
+    # "stopped before any output was written", not a traceback out of the handlers below
+    from masonrycli.execute import execute
     from masonrycli.interrupt import StopSignals
     from masonrycli.scenario.caveats import scenario_warnings
 
@@ -41,14 +44,15 @@ def execute_and_exit(scenario, opts: dict, hint=None) -> None:
     # while the summary was printed said "Ctrl-C: stopped before any output was written" (exit 130) of a
     # run whose files had just been renamed into place, and a SIGTERM killed the process mid-table (-15).
     with StopSignals() as signals:
-        _execute_and_report(scenario, opts, hint, outputs, signals)
+        _execute_and_report(execute, scenario, opts, hint, outputs, signals)
 
 
-def _execute_and_report(scenario, opts: dict, hint, outputs, signals) -> None:
-    """:func:`execute_and_exit`'s run and summary, under ``signals``."""
-    from masonrycli.execute import execute, print_summary
+def _execute_and_report(execute, scenario, opts: dict, hint, outputs, signals) -> None:
+    """:func:`execute_and_exit`'s run (``execute``: :func:`masonrycli.execute.execute`) and summary, under
+    ``signals``."""
     from masonrycli.interrupt import StopRun, exit_code, signal_name
     from masonrycli.outputs.sinks import DIVERGED, FAILED, INTERRUPTED
+    from masonrycli.run_summary import print_summary
 
     try:
         outcome = execute(

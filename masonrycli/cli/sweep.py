@@ -427,7 +427,7 @@ def _report(console, result, plan: StudyPlan, im: str, written: list, signals: F
         # as masonry run says it: 'recording: s.rrd' left a first user to find out what opens a .rrd
         from rich.text import Text
 
-        from masonrycli.execute import open_command
+        from masonrycli.viewer_command import open_command
 
         command = open_command(recording.path)
         console.print(
