@@ -74,3 +74,14 @@ def test_the_residual_plot_keeps_its_tolerance_off_its_top_edge_and_its_residual
     height = high - low
     assert (high - values.max()) / height >= PAD, (y_range, values.max())
     assert (values.min() - low) / height >= PAD + 2 * LEGEND_ROW, (y_range, values.min())
+
+
+def test_the_sweeps_plot_runs_from_0(arch):
+    """Fitted to its data, the Sweeps per step plot of the ESM record's wall (2 to 22 sweeps a step) had one
+    tick, "10", and no 0: how many sweeps a step took could not be read. Its range runs from 0 now."""
+    values = _values(arch, "iterations")
+    y_range = blueprint_views(arch)[PLOT_NAMES["iterations"]]["y_range"]
+    assert y_range is not None
+    low, high = y_range
+    assert low <= 0.0 and (high - values.max()) / (high - low) >= PAD, (y_range, values.max())
+    assert blueprint_views(arch)[PLOT_NAMES["iterations"]]["legend"] is False  # one series: no legend

@@ -297,8 +297,9 @@ def build_blueprint(
     (u0, u1), (v0, v1) (``static_content.log_plane``): the magnified shape's tab, which has no bar nor
     arrows, shows that part. ``supports_move``: a support moved during the run (a shaken ground, a settling
     foundation): the second row of plots opens on its velocity, else on the solver's residual.
-    ``plot_ranges``: the y range of plots (``PLOT_NAMES`` keys: Energies, Support v, Support u), in their units,
-    each with its legend bottom left (``series.plot_range``); a plot not given or None: the viewer's fit.
+    ``plot_ranges``: the y range of plots (``PLOT_NAMES`` keys: Energies, Support v, Support u, Sweeps), in their
+    units, each with its legend bottom left if it has one (``plot_range``); a plot not given or None: the
+    viewer's fit.
     ``legend_lines``: the Legend's lines at 1920 x 1080 (:func:`legend_share`).
 
     Tabs: the live main view (forces, principal stress, ``main_field``), with ``paper`` = (t, figure
@@ -354,7 +355,7 @@ def build_blueprint(
         # leaves the bottom left to its legend (series.plot_range)
         legend = rrb.PlotLegend(visible=False) if key in SINGLE_SERIES else None
         if ranges.get(key) is not None:
-            axis_y, legend = rrb.ScalarAxis(range=ranges[key]), rrb.PlotLegend(corner="LeftBottom")
+            axis_y, legend = rrb.ScalarAxis(range=ranges[key]), legend or rrb.PlotLegend(corner="LeftBottom")
         return rrb.TimeSeriesView(
             origin=f"/{SERIES[key]}", name=PLOT_NAMES[key], axis_x=whole_run, axis_y=axis_y, plot_legend=legend
         )

@@ -155,6 +155,7 @@ class Recorder:
         self._structure_view = None  # the Magnified tab's part of the view (log_plane)
         self._legend_lines = 7  # the Legend's lines at 1920 x 1080 (_log_metadata)
         self._spans = dict.fromkeys(RANGED, (0.0, 0.0))  # each ranged plot's lowest and highest value, 0 in
+        self._most_sweeps = 0.0  # the most sweeps a step took: the Sweeps plot's range, from 0
         self._label_anchors = np.zeros((0, 2), np.float32)
         self._size = 1.0
         self._frames, self._last = 0, None  # frames logged; (step, time) of the last one
@@ -193,6 +194,7 @@ class Recorder:
         s.add("time", float(time_s))
         s.add("values", (float(stats.iterations), float(stats.residual), float(stats.contact_count)))
         self._residuals.add(stats.residual)
+        self._most_sweeps = max(self._most_sweeps, float(stats.iterations))
         if steps_due(s):
             self._steps = FrameBatch()
             with io_errors(self.path):
@@ -369,6 +371,8 @@ class Recorder:
         rows = {"energy_large": 3, "support_velocity": 2 * self._supports.count}
         rows["support_displacement"] = rows["support_velocity"]
         ranges = {key: plot_range(*self._spans[key], rows[key]) for key in RANGED}  # None: all 0
+        # from 0: fitted to its data, the plot of a run whose steps took 2 to 22 sweeps had one tick, "10"
+        ranges["iterations"] = plot_range(0.0, self._most_sweeps, 0)
         moved = ranges["support_velocity"] is not None  # a support that moved: its plot shows at open
         args = (self._main_field, self.paper, self.residual_range(), self._structure_view, moved)
         layout = build_blueprint(*args, plot_ranges=ranges, legend_lines=self._legend_lines)
