@@ -43,6 +43,17 @@ def test_table_names_lambda_and_mechanism(column_file, tmp_path):
     assert out.stat().st_size > 0
 
 
+def test_a_mechanism_that_slides_is_said_to_overstate_lambda_maybe(column_file, tmp_path):
+    """The LP's slide dilates (associative flow), the engine's does not: a column of 3 blocks 0.4 × 0.2 m on μ =
+    0.2 slides at λ = μ (it would rock at B/H = 0.667) and the table says λ may overstate; rocking at μ = 0.9
+    it does not say so."""
+    sliding = tmp_path / "sliding.toml"
+    sliding.write_text(dump_scenario(column(3, 0.4, 0.2, 0.2)))
+    said = invoke("limit", sliding).output
+    assert "0.2000" in said and "λ, as it slides" in said and "may overstate" in said
+    assert "as it slides" not in invoke("limit", column_file).output
+
+
 def test_no_friction_gives_zero_not_minus_zero(column_file):
     # A frictionless column slides at once: λ = 0, which HiGHS returns as -0.0 ("λ = -0.0000 (tilt ψ =
     # -0.00°)", "collapse load -0 N", "load_factor": -0.0 in the JSON)

@@ -138,6 +138,14 @@ def _worst_text(result: LimitResult) -> str:
     return said + (f"; {skipped} with no mechanism that follows the load" if skipped else "")
 
 
+SLIDING_CAVEAT = (
+    "may overstate: the LP's joints dilate as they slide (by μ × the slip: associative flow), the stones' and the "
+    "engine's do not, so the structure may collapse below λ (the built-in wall at 0.90–0.95 λ); --verify runs "
+    "the engine at 0.95 and 1.05 λ"
+)
+"""The row said under a mechanism with sliding joints (docs/limit.md, *The caveat*)."""
+
+
 def result_table(result: LimitResult, out: Path | None) -> Table:
     s = result.summary()
     table = Table(title=f"masonry limit — {result.scenario_name}", show_header=False, title_justify="left")
@@ -183,6 +191,8 @@ def result_table(result: LimitResult, out: Path | None) -> Table:
         )
     table.add_row("hinges", _names(result.hinges_largest_first()))
     table.add_row("sliding joints", _names(result.sliding_largest_first()))
+    if result.sliding_joints:
+        table.add_row("λ, as it slides", SLIDING_CAVEAT)
     if result.motion.joint_opening.any():  # parting all along: not hinges (the wall's wedge had "10 hinges")
         table.add_row("joints opening", _names(result.opening_largest_first()))
     table.add_row(

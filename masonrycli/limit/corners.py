@@ -24,6 +24,12 @@ at the origin, 0.1053 rounded in Lambert-93.
   inset / r of μ (0 at the end, μ at r in), so that μ does not jump where a millimetre moves the point off the
   end. On the aqueduct λ is then 0.0995 exact and 0.0994 rounded, at origin or
   in Lambert-93, against the engine's collapse near 0.095 (docs/limit.md).
+  Keeping μ there (the engine's contact model) was measured against the engine and lost: with μ kept the LP's
+  associative sliding makes a corner dilate by μ × its slip to pass the other, nearly a pin at μ = 10, where the
+  engine's corner slips past: λ 0.1328 on the aqueduct (the engine falls at 0.95 λ), 0.9192 on the segmental
+  bridge at μ = 10 (falls at 0.95 λ) and its ring's least thickness 0.0587 m at μ = 10 against the four-hinge
+  reference's 0.07195 (the engine brings 0.065 m down). The rule's cost: on that bridge at μ = 0.6, whose
+  voussoirs' corners sit on the piers' corners, λ = 0.0955 where the engine carries 0.95 × 0.1739 (safe side).
 
 Pseudo-code for one single-point joint (a, b)::
 
