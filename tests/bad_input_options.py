@@ -283,6 +283,8 @@ OPTION_ROWS = [
     ("limit-friction", {}, ("limit", "arch", "--friction", "-1"), 2, "--friction: friction = -1: must be >= 0"),
     # --block '' was taken as no block: a horizontal load ran as if it was not given (--block v01 is refused)
     ("limit-block-empty", {}, ("limit", "arch", "--block", ""), 2, "--block '': an empty name"),
+    # a blank name was said '--block  : only a point load acts on one block' ('--block  : no such block' with --load point)
+    ("limit-block-blank", {}, ("limit", "arch", "--load", "point", "--block", " "), 2, "--block ' ': an empty name"),
     # an empty extra word (a quoted shell variable with nothing in it) was an IndexError, exit 1, a traceback
     ("simulate-empty-word", {}, ("simulate", "wall", ""), 2, "extra argument(s) (): an empty word"),
     ("limit-empty-word", {}, ("limit", "wall", ""), 2, "extra argument(s) (): an empty word"),

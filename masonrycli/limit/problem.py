@@ -91,8 +91,10 @@ class LiveLoad:
     None: the loaded block's own weight."""
 
     def __post_init__(self):
-        if self.block is not None and not self.block:  # was taken as not given: "--load point: name the …"
-            raise InputError("--block '': an empty name (the loaded block's name, as masonry check lists them)")
+        if self.block is not None and not self.block.strip():  # '': taken as not given; ' ': "--block  : no such …"
+            raise InputError(
+                f"--block {self.block!r}: an empty name (the loaded block's name, as masonry check lists them)"
+            )
         if self.kind not in LOAD_KINDS:
             raise InputError(f"--load {self.kind}: expected one of {', '.join(LOAD_KINDS)}")
         if self.direction is None:  # a point load pushed sideways by default surprised a bridge's engineer
