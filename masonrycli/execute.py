@@ -22,6 +22,7 @@ from rich.console import Console
 
 from masonrycli import SOURCE_DIGEST, __version__
 from masonrycli.engine import compile_ahead
+from masonrycli.engine.compile_log import watched_compiles
 from masonrycli.errors import InputError
 from masonrycli.interrupt import StopSignals
 from masonrycli.output_plan import Outputs
@@ -149,7 +150,11 @@ def execute(
     histories' ``run`` (the Python API's call); by default the ``masonry`` command line (:func:`command_line`).
     ``on_progress(sim, stats)``: the run's progress, in place of the console's bar (the API's live line)."""
     made_by = {"command": command} if command else command_line()
-    with StopSignals() if signals is None else contextlib.nullcontext(signals) as signals, compile_ahead.ahead():
+    with (
+        StopSignals() if signals is None else contextlib.nullcontext(signals) as signals,
+        compile_ahead.ahead(),
+        contextlib.ExitStack() as watch,
+    ):
         sinks: dict[OutputFile, object] = {}
         if note := compile_ahead.no_cache_note():  # a read-only install and no writable home or /tmp
             print(note, file=sys.stderr)
@@ -174,7 +179,9 @@ def execute(
         status, note = FAILED, "the run stopped on an unexpected error"
         result = None
         try:
-            signals.stepping()
+            # a signal during a step's numba compilation stops the run at once, not minutes later (interrupt.py)
+            compiling = watch.enter_context(watched_compiles())
+            signals.stepping(compiling)
             with progress_bar(console, sim.model.n_steps) as bar:
                 result = simulate(
                     scenario,

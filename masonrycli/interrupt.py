@@ -5,7 +5,9 @@ Three phases, because what a signal may safely do depends on what is under way:
 - **setup** (model, first numba compile, output files opened): nothing is computed yet, so the signal
   raises :class:`StopRun` at once — the caller removes its temporary files and exits;
 - **stepping**: the signal only sets :attr:`StopSignals.signum`; the time loop polls :meth:`requested`
-  after each step, so the step in progress finishes and every frame handed to the sinks is whole;
+  after each step, so the step in progress finishes and every frame handed to the sinks is whole — unless
+  that step is compiling numba kernels (a first run compiles some in step 1, others in the first step
+  that stalls): the signal then raises :class:`StopStep` and the loop ends at the step before (below);
 - **closing** (files being finished and renamed): further signals are counted and acknowledged on stderr,
   never raised, so a second Ctrl-C or a ``kill`` during shutdown cannot lose a file.
 
@@ -19,6 +21,15 @@ internal error with exit 1 instead of the stop. So while the handlers are instal
 theirs is not printed but noted (:attr:`dropped`), and :meth:`StopSignals.setup_work` raises the stop
 instead of the error it caused; :func:`raise_dropped` does so for code that catches errors itself (``masonry
 sweep --workers 0`` made that error a failed row, went on, and took every later Ctrl-C for a repeat).
+
+A compilation inside a step is why a stop cannot always wait for the step to end: with an empty cache and a
+loaded machine it lasts minutes (a SIGTERM of ``timeout 120`` at load 23 was acknowledged, "already
+stopping", and the run went on compiling for 10 more minutes until SIGKILLed; at load 8 the compilations of
+step 1 and of the first stalled step took 16 s and 23 s). So :meth:`StopSignals.stepping` is given a
+``compiling()`` test (``engine.compile_log.watched_compiles``), and a signal while it is true inside the loop's
+:func:`abandonable` work (a step, a frame being built) — the first signal or a repeat — raises
+:class:`StopStep` out of the compilation; the time loop puts the state back as it was before the step and
+ends there (``run.simulate``). Elsewhere (the summary's last kernels) a compilation is waited for.
 
 :class:`FirstSignalStops` is the same rule for a command that stops by ``KeyboardInterrupt`` (``masonry
 sweep``): the first signal raises it, later ones are acknowledged and ignored (after the context too,
@@ -49,6 +60,15 @@ run starts (``nohup``): the run then goes on, as the user asked."""
 
 class StopRun(BaseException):
     """A stop signal arrived before the first step (not an ``Exception``: nothing should swallow it)."""
+
+    def __init__(self, signum: int):
+        super().__init__(signal.Signals(signum).name)
+        self.signum = signum
+
+
+class StopStep(BaseException):
+    """A stop signal arrived while the step in progress was compiling numba kernels (module doc): the step
+    is abandoned, the run ends at the step before it."""
 
     def __init__(self, signum: int):
         super().__init__(signal.Signals(signum).name)
@@ -130,14 +150,18 @@ class StopSignals(_Handlers):
         self.signum: int | None = None
         self.phase = "setup"
         self.repeats = 0
+        self._compiling = None
 
-    def stepping(self) -> None:
-        """From now on a signal asks the time loop to stop after its current step."""
+    def stepping(self, compiling=None) -> None:
+        """From now on a signal asks the time loop to stop after its current step; ``compiling()``: whether
+        numba is compiling in this thread now, when a signal raises :class:`StopStep` instead (module doc)."""
         self.phase = "stepping"
+        self._compiling = compiling
 
     def closing(self) -> None:
         """From now on signals are acknowledged and otherwise ignored until the files are closed."""
         self.phase = "closing"
+        self._compiling = None
 
     @contextlib.contextmanager
     def held(self):
@@ -169,13 +193,17 @@ class StopSignals(_Handlers):
             raise StopRun(self.signum)
 
     def _handle(self, signum, _frame) -> None:
-        if self.signum is None:
+        first = self.signum is None
+        if first:
             self.signum = signum
-            if self.phase == "setup":
-                self._raise(StopRun(signum))
-            return
-        self.repeats += 1
-        already_stopping(signum)
+        else:
+            self.repeats += 1
+            already_stopping(signum)
+        if first and self.phase == "setup":
+            self._raise(StopRun(signum))
+        # a repeat too: the first one's StopStep may have been dropped inside the compiler (module doc)
+        if self.phase == "stepping" and _ABANDONABLE and self._compiling is not None and self._compiling():
+            self._raise(StopStep(self.signum))
 
 
 class FirstSignalStops(_Handlers):
@@ -244,6 +272,21 @@ class FirstSignalStops(_Handlers):
             self._deferred = True
             return
         self._raise(KeyboardInterrupt())
+
+
+_ABANDONABLE: list[bool] = []
+"""Non-empty inside :func:`abandonable`."""
+
+
+@contextlib.contextmanager
+def abandonable():
+    """Work the time loop can abandon (a step, a frame being built): a signal while it compiles numba kernels
+    raises :class:`StopStep` (module doc); the caller puts back what the block changed."""
+    _ABANDONABLE.append(True)
+    try:
+        yield
+    finally:
+        _ABANDONABLE.pop()
 
 
 _INSTALLED: list[_Handlers] = []

@@ -23,6 +23,7 @@ from masonrycli.analysis.triangulation import build_triangles, chain_neighbours
 from masonrycli.engine import integrate
 from masonrycli.engine.solver import Solver, StepStats
 from masonrycli.engine.tuning import TUNING, Tuning
+from masonrycli.interrupt import StopStep, abandonable, raise_dropped
 from masonrycli.model import Model, State, build_model, initial_state
 from masonrycli.outputs.frame import Frame
 from masonrycli.outputs.sinks import COMPLETED, DIVERGED, FAILED, INTERRUPTED
@@ -291,13 +292,18 @@ def simulate(
     frames = 0
 
     failed_sink = None
+    abandoned = False
 
     def emit() -> bool:
-        """Hand the current frame to every sink; False (and ``failed_sink`` set) if one cannot write."""
-        nonlocal frames, failed_sink
+        """Hand the current frame to every sink; False (and ``failed_sink`` set) if one cannot write, False
+        and ``abandoned`` when a stop signal came while the frame's kernels compiled (none is handed on)."""
+        nonlocal frames, failed_sink, abandoned
         if not sinks:  # a frame costs contact copies, tensors and joint states: build it only for a reader
             return True
-        frame = sim.frame()
+        frame = _abandonable(sim.frame)
+        if frame is None:
+            abandoned = True
+            return False
         for sink in sinks:
             try:
                 sink.on_frame(frame)
@@ -310,9 +316,13 @@ def simulate(
     per_step = [sink.log_step for sink in sinks if hasattr(sink, "log_step")]
     status, message = COMPLETED, ""
     done = 0
+    before = sim.state.copy()
     ok = emit()
     for k in range(n_steps if ok else 0):
-        stats = sim.step()
+        stats = _step(sim, before)
+        if stats is None:  # a stop signal during the step's numba compilation (interrupt.py): the step before
+            abandoned = True
+            break
         tally.add(stats)
         max_pen = max(max_pen, stats.max_penetration)
         done = k + 1
@@ -337,12 +347,23 @@ def simulate(
             status, message = INTERRUPTED, f"interrupted at t = {sim.state.time:.4f} s (step {done} of {n_steps})"
             ok = recorded or emit()
             break
-    if not ok:
+    if abandoned and status == DIVERGED:
+        pass  # said so; its last frame is the one before
+    elif abandoned:
+        status, message = (
+            INTERRUPTED,
+            (
+                f"interrupted at t = {sim.state.time:.4f} s (step {done} of {n_steps}) while numba compiled the run's"
+                " kernels"
+            ),
+        )
+    elif not ok:
         sink, exc = failed_sink
         status, message = FAILED, f"stopped at t = {sim.state.time:.4f} s (step {done}): {exc.strerror or exc}"
     extra: dict[str, str] = {}
     hinge_count = 0
-    if sim.last is not None and sim.joints.key.size:
+    # an abandoned step may have overwritten the contacts the hinges are read from
+    if sim.last is not None and sim.joints.key.size and not abandoned:
         hinged, _ = sim.hinges()
         hinge_count = int(hinged.sum())
         extra["hinged joints (end)"] = describe_hinges(m.joint_names(sim.joints.joint_body[hinged]))
@@ -375,6 +396,35 @@ def simulate(
         outcome=outcome,
         failed_sink=failed_sink[0] if failed_sink else None,
     )
+
+
+def _step(sim: Simulation, before) -> StepStats | None:
+    """``sim.step()``, or None when a stop signal abandoned it (:class:`~masonrycli.interrupt.StopStep`): the
+    state is then put back as it was before the step (``before``: a :class:`State` the size of the
+    state's, overwritten here), so the run's last state is one the solver reached whole. Copying two (B, 3)
+    arrays costs ~1 µs a step, against the ~0.5 ms of a step of the 51-block wall."""
+    np.copyto(before.body_q, sim.state.body_q)
+    np.copyto(before.body_v, sim.state.body_v)
+    before.step, before.time = sim.state.step, sim.state.time
+    stats = _abandonable(sim.step)
+    if stats is None:
+        np.copyto(sim.state.body_q, before.body_q)
+        np.copyto(sim.state.body_v, before.body_v)
+        sim.state.step, sim.state.time = before.step, before.time
+    return stats
+
+
+def _abandonable(work):
+    """``work()``, or None when a stop signal abandoned it while numba compiled (interrupt.StopStep)."""
+    try:
+        with abandonable():
+            try:
+                return work()
+            except Exception:
+                raise_dropped()  # the StopStep that Python dropped inside numba's compiler caused this error
+                raise
+    except StopStep:
+        return None
 
 
 def run_outcome(sim: Simulation, hinges: int) -> dict:

@@ -10,6 +10,7 @@ compiled, so not recorded.
 
 from __future__ import annotations
 
+import threading
 import time
 from contextlib import contextmanager
 from typing import NamedTuple
@@ -59,5 +60,34 @@ def recorded_compiles():
     ev.register("numba:compile", listener)
     try:
         yield out
+    finally:
+        ev.unregister("numba:compile", listener)
+
+
+class _Depth(ev.Listener):
+    """How many compilations of this thread are under way (nested: a kernel's callees)."""
+
+    def __init__(self):
+        self.thread = threading.get_ident()
+        self.depth = 0
+
+    def on_start(self, event):
+        if threading.get_ident() == self.thread:
+            self.depth += 1
+
+    def on_end(self, event):
+        if threading.get_ident() == self.thread:
+            self.depth = max(0, self.depth - 1)
+
+
+@contextmanager
+def watched_compiles():
+    """Yield ``compiling()``: whether numba is compiling for this thread now (a step's first call of a
+    kernel; a kernel loaded from the cache does not count). A stop signal cannot wait for a compilation to
+    end (:mod:`masonrycli.interrupt`); other threads' compilations are theirs."""
+    listener = _Depth()
+    ev.register("numba:compile", listener)
+    try:
+        yield lambda: listener.depth > 0
     finally:
         ev.unregister("numba:compile", listener)
