@@ -245,8 +245,8 @@ def test_a_signal_held_while_the_plot_s_rename_fails_reports_the_error(block, tm
     monkeypatch.setattr(OutputFile, "commit", ctrl_c_then_a_failed_rename)
     result = invoke("sweep", block, "-p", "amp=0.05,0.1", "--duration", 0.02, "--workers", 0, "-o", out)
     said = words(result.output)
-    assert result.exit_code == 2, result.output
-    assert f"error: {tmp_path / 's.png'}: Permission denied" in said
+    assert result.exit_code == 4, result.output  # an output failed (0c388ba: exit 4 and the output named)
+    assert f"error: cannot write --out's plot {tmp_path / 's.png'}: Permission denied" in said
     assert "interrupted" not in said and "Traceback" not in said
     assert len(read_rows(out)) == 2
     assert sorted(p.name for p in tmp_path.iterdir()) == ["block.toml", "s.csv"]  # no .s.png.<pid>.part
