@@ -180,7 +180,7 @@ def execute(
         result = None
         try:
             # a signal during a step's numba compilation stops the run at once, not minutes later (interrupt.py)
-            compiling = watch.enter_context(watched_compiles())
+            compiling = watch.enter_context(watched_compiles(signals.compile_event))
             signals.stepping(compiling)
             with progress_bar(console, sim.model.n_steps) as bar:
                 result = simulate(

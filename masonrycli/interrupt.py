@@ -29,7 +29,9 @@ step 1 and of the first stalled step took 16 s and 23 s). So :meth:`StopSignals.
 ``compiling()`` test (``engine.compile_log.watched_compiles``), and a signal while it is true inside the loop's
 :func:`abandonable` work (a step, a frame being built) — the first signal or a repeat — raises
 :class:`StopStep` out of the compilation; the time loop puts the state back as it was before the step and
-ends there (``run.simulate``). Elsewhere (the summary's last kernels) a compilation is waited for.
+ends there (``run.simulate``). That raise, too, can be dropped inside the compiler; then the next start or end
+of a compilation raises it (:meth:`StopSignals.compile_event`, from numba's own Python code). Elsewhere (the
+summary's last kernels) a compilation is waited for.
 
 :class:`FirstSignalStops` is the same rule for a command that stops by ``KeyboardInterrupt`` (``masonry
 sweep``): the first signal raises it, later ones are acknowledged and ignored (after the context too,
@@ -191,6 +193,14 @@ class StopSignals(_Handlers):
             raise
         if self.dropped:
             raise StopRun(self.signum)
+
+    def compile_event(self) -> None:
+        """A numba compilation of the stepping thread starts or ends: once a stop is asked, inside the loop's
+        :func:`abandonable` work, raise :class:`StopStep` from there — the handler's own raise is often dropped
+        inside the compiler (module doc; measured: a SIGTERM in the first frame's compilation was dropped, and
+        step 1 then compiled for 10 s before the loop stopped)."""
+        if self.signum is not None and self.phase == "stepping" and _ABANDONABLE:
+            self._raise(StopStep(self.signum))
 
     def _handle(self, signum, _frame) -> None:
         first = self.signum is None

@@ -294,13 +294,14 @@ def simulate(
     failed_sink = None
     abandoned = False
 
-    def emit() -> bool:
+    def emit(first: bool = False) -> bool:
         """Hand the current frame to every sink; False (and ``failed_sink`` set) if one cannot write, False
-        and ``abandoned`` when a stop signal came while the frame's kernels compiled (none is handed on)."""
+        and ``abandoned`` when a stop signal came while the frame's kernels compiled (none is handed on).
+        The ``first`` frame (t = 0) is never abandoned: a history without one is no history."""
         nonlocal frames, failed_sink, abandoned
         if not sinks:  # a frame costs contact copies, tensors and joint states: build it only for a reader
             return True
-        frame = _abandonable(sim.frame)
+        frame = sim.frame() if first else _abandonable(sim.frame)
         if frame is None:
             abandoned = True
             return False
@@ -317,7 +318,7 @@ def simulate(
     status, message = COMPLETED, ""
     done = 0
     before = sim.state.copy()
-    ok = emit()
+    ok = emit(first=True)
     for k in range(n_steps if ok else 0):
         stats = _step(sim, before)
         if stats is None:  # a stop signal during the step's numba compilation (interrupt.py): the step before

@@ -27,16 +27,26 @@ import masonrycli.run as run
 step = run.Simulation.step
 WHERE = os.environ["WHERE"]
 
-def compiling(sim):
+def compile_for(seconds):
+    end = time.monotonic() + seconds
+    while time.monotonic() < end:
+        time.sleep(0.01)
+
+def compiling(sim, seconds=60):
     # numba compiling a kernel the run calls first here, for a minute (a loaded machine, an empty cache)
     with ev.trigger_event("numba:compile", data={"dispatcher": None, "args": ()}):
+        if os.environ.get("DROPPED"):  # the handler's raise lands in llvmlite's ctypes callback: dropped
+            sys.path.insert(0, os.environ["TESTS"])
+            from cli_helpers import signal_inside_a_ctypes_callback
+            signal_inside_a_ctypes_callback(int(os.environ["SIGNAL"]))
+            compile_for(2)
+            with ev.trigger_event("numba:compile", data={"dispatcher": None, "args": ()}):  # a callee's
+                compile_for(seconds)
         os.kill(os.getpid(), int(os.environ["SIGNAL"]))
         if os.environ.get("REPEAT"):
             time.sleep(0.5)
             os.kill(os.getpid(), int(os.environ["SIGNAL"]))
-        end = time.monotonic() + 60
-        while time.monotonic() < end:
-            time.sleep(0.01)
+        compile_for(seconds)
 
 def slow_step(sim):
     if WHERE == "step" and sim.state.step == 25:
@@ -49,6 +59,8 @@ frame = run.Simulation.frame
 def slow_frame(sim):
     if WHERE == "frame" and sim.state.step == 30:
         compiling(sim)
+    if WHERE == "first" and sim.state.step == 0:
+        compiling(sim, 3)  # the first frame is waited for: a history holds at least t = 0
     return frame(sim)
 
 run.Simulation.step = slow_step
@@ -59,10 +71,11 @@ main()
 """
 
 
-def _run(tmp_path, sig, where: str, repeat: bool = False):
+def _run(tmp_path, sig, where: str, repeat: bool = False, dropped: bool = False):
     rrd, npz = tmp_path / "w.rrd", tmp_path / "w.npz"
     argv = ["simulate", "wall", "--duration", "100", "--out", str(rrd), "--history", str(npz)]
     env = dict(os.environ, RERUN_ANALYTICS="0", SIGNAL=str(int(sig)), WHERE=where, REPEAT="1" if repeat else "")
+    env |= {"DROPPED": "1" if dropped else "", "TESTS": os.path.dirname(__file__)}
     t0 = time.monotonic()
     proc = subprocess.run(
         [sys.executable, "-c", COMPILING_STEP, *argv], env=env, capture_output=True, text=True, timeout=240
@@ -98,3 +111,26 @@ def test_a_signal_while_a_step_compiles_stops_the_run_at_once(sig, code, where, 
     assert change and abs(float(change[1])) < 1000, proc.stdout
     assert frames_in_recording(rrd) == len(h["time"])
     assert sorted(p.name for p in tmp_path.iterdir()) == ["w.npz", "w.rrd"]
+
+
+@pytest.mark.slow
+def test_a_stop_dropped_inside_the_compiler_stops_the_step_at_the_next_compilation(tmp_path):
+    """The handler's raise landed in llvmlite's ctypes callback and was dropped (measured: a SIGTERM in a cold
+    run's first compilations, and step 1 compiled 10 s more): the next kernel's compilation raises it."""
+    proc, took, rrd, npz = _run(tmp_path, signal.SIGTERM, "step", dropped=True)
+    assert proc.returncode == 143, proc.stdout + proc.stderr
+    assert took < 45, f"{took:.0f} s: the run waited for the compilation"
+    assert "Traceback" not in proc.stderr and "Exception ignored" not in proc.stderr, proc.stderr
+    h = np.load(npz)
+    assert "(step 25 of 100000) while numba compiled" in str(h["note"]), h["note"]
+    assert frames_in_recording(rrd) == len(h["time"]) == 3
+
+
+@pytest.mark.slow
+def test_a_signal_while_the_first_frame_compiles_keeps_it(tmp_path):
+    """The frame at t = 0 is waited for (a history without one cannot be read); the run stops after step 1."""
+    proc, took, rrd, npz = _run(tmp_path, signal.SIGTERM, "first")
+    assert proc.returncode == 143, proc.stdout + proc.stderr
+    h = np.load(npz)
+    assert str(h["status"]) == "interrupted" and h["time"][0] == 0.0, h["note"]
+    assert frames_in_recording(rrd) == len(h["time"])

@@ -65,27 +65,36 @@ def recorded_compiles():
 
 
 class _Depth(ev.Listener):
-    """How many compilations of this thread are under way (nested: a kernel's callees)."""
+    """How many compilations of this thread are under way (nested: a kernel's callees); ``on_event()`` at
+    each start and end of one."""
 
-    def __init__(self):
+    def __init__(self, on_event=None):
         self.thread = threading.get_ident()
         self.depth = 0
+        self.on_event = on_event
 
     def on_start(self, event):
         if threading.get_ident() == self.thread:
             self.depth += 1
+            if self.on_event is not None:
+                self.on_event()
 
     def on_end(self, event):
         if threading.get_ident() == self.thread:
             self.depth = max(0, self.depth - 1)
+            if self.on_event is not None:
+                self.on_event()
 
 
 @contextmanager
-def watched_compiles():
+def watched_compiles(on_event=None):
     """Yield ``compiling()``: whether numba is compiling for this thread now (a step's first call of a
     kernel; a kernel loaded from the cache does not count). A stop signal cannot wait for a compilation to
-    end (:mod:`masonrycli.interrupt`); other threads' compilations are theirs."""
-    listener = _Depth()
+    end (:mod:`masonrycli.interrupt`); other threads' compilations are theirs. ``on_event()`` is called at
+    the start and the end of each compilation of this thread, from numba's Python code: an exception it
+    raises stops the compilation (a signal handler's raise may land inside a ctypes callback instead, where
+    Python drops it)."""
+    listener = _Depth(on_event)
     ev.register("numba:compile", listener)
     try:
         yield lambda: listener.depth > 0
