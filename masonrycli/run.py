@@ -370,7 +370,9 @@ def simulate(
         extra["hinged joints (end)"] = describe_hinges(m.joint_names(sim.joints.joint_body[hinged]))
     # Stopped by the user: measure what was applied (the whole run's loading can be 10⁸ samples, minutes
     # of work after a Ctrl-C that should end the run at once).
-    ims = applied_intensity(scenario, m, done if status == INTERRUPTED else None)
+    # Ended early otherwise (diverged: 'simulate wall --duration 1e5' at step 243 406 of 10⁸, then over
+    # 10 minutes of eqsig's per-sample loop, deaf to signals), the same: what was applied up to the end.
+    ims = applied_intensity(scenario, m, done if status in (INTERRUPTED, DIVERGED, FAILED) else None)
     if ims:
         extra[f"ground motion ({m.support_name[shaking_support(scenario.motions)]})"] = describe_intensity(ims)
     outcome = run_outcome(sim, hinge_count)
@@ -458,7 +460,7 @@ def applied_intensity(scenario, model: Model, steps: int | None = None) -> dict[
     """Intensity measures of the shaking support's horizontal velocity over the run's duration (the
     loading as applied: scaled, windowed, corrected, cut at the duration — whether or not the run
     stopped early, so the measure belongs to the loading, not to the response), or {} when no
-    support shakes. ``steps``: over the first ``steps`` steps only (a run interrupted by the user)."""
+    support shakes. ``steps``: over the first ``steps`` steps only (a run that ended early: stopped, diverged, failed)."""
     j = shaking_support(scenario.motions)
     steps = model.n_steps if steps is None else steps
     if j is None or steps < 2:

@@ -150,3 +150,20 @@ def test_the_summary_gives_the_peak_drift_a_history_of_every_step_shows(tmp_path
     assert peak > 1e-4
     said = words(result.output.replace("│", " "))  # a row's wrapped lines joined
     assert f"peak drift {100 * peak:.3g} % of the height ({1000 * peak * height:.3g} mm over {height:.3g} m)" in said
+
+
+def test_a_run_ended_early_measures_the_loading_over_the_steps_it_ran(monkeypatch):
+    """'simulate wall --duration 1e5' diverged at t = 243 s (step 243 406 of 10⁸), and its summary then measured
+    the intensity over all 10⁸ steps (eqsig's Nigam–Jennings, a Python loop a sample: over 10 minutes, during
+    which a SIGTERM said "already stopping" and changed nothing). A run that diverged, failed or was stopped
+    measures the steps it ran; a completed one (at collapse too) its whole loading."""
+    import masonrycli.run as run
+    from masonrycli.scenario.builtin import builtin
+
+    asked = []
+    measure = run.applied_intensity
+    monkeypatch.setattr(run, "applied_intensity", lambda sc, m, steps=None: asked.append(steps) or measure(sc, m, 50))
+    monkeypatch.setattr(run.Simulation, "diverged", lambda sim: "a test" if sim.state.step == 40 else "")
+    result = simulate(builtin("wall", duration=1000.0))
+    assert result.status == "diverged" and result.steps == 40
+    assert asked == [40]
