@@ -23,6 +23,7 @@ from masonrycli.cli.options import (
 from masonrycli.errors import EXIT_DIVERGED, EXIT_OUTPUT_FAILED, EXIT_ROWS_FAILED
 from masonrycli.interrupt import FirstSignalStops, exit_code, signal_name
 from masonrycli.outputs.files import OutputFile
+from masonrycli.outputs.verdict import counted
 
 if TYPE_CHECKING:
     from masonrycli.study.plan import StudyPlan
@@ -259,7 +260,7 @@ def _exit_for_failed_rows(result, err_console) -> None:
     a script saw exit 0 under "2 failed" (histories on a full disk). A collapse is an outcome, not this."""
     from masonrycli.study.task import REFUSED
 
-    total = _n(len(result.rows), "row")
+    total = counted(len(result.rows), "row")
     diverged = sum(1 for r in result.rows if r.get("status") == "diverged")
     refused = [r for r in result.rows if r.get("status") == "error" and str(r.get("error")).startswith(REFUSED)]
     # The plot and the recording are written whole however many rows failed, so the same command again is
@@ -293,7 +294,7 @@ def _exit_for_failed_rows(result, err_console) -> None:
 def _at_zero(rows: list[dict], im: str) -> str:
     """The runs the fit leaves out, at an IM of 0 (--scale 0:6:3): "1 of 4 runs collapsed" of 6 rows."""
     zero = sum(1 for r in rows if not (isinstance(r.get(im), (int, float)) and r[im] > 0))
-    return f"; {_n(zero, 'run')} at {im} = 0 left out" if zero else ""
+    return f"; {counted(zero, 'run')} at {im} = 0 left out" if zero else ""
 
 
 def _collapsed_line(group) -> str | None:
@@ -319,7 +320,7 @@ def _no_fit(rows: list[dict], axes) -> str:
     by = "--param pga_g" if "pga_g" in names else "--scale"  # the axis that scales the records
     scaled = by != "--scale" or "scale" in names
     if len(rows) < 2:
-        return f"fragility: no fit ({_n(len(rows), 'run')}; a fit needs at least 2)"
+        return f"fragility: no fit ({counted(len(rows), 'run')}; a fit needs at least 2)"
     if fell == 0:
         more = f"larger {by} values reach it" if scaled else "a --scale range reaches it"
         return f"fragility: no fit — none of the {len(rows)} runs collapsed ({more})"
@@ -407,7 +408,7 @@ def _report(console, result, plan: StudyPlan, im: str, written: list, signals: F
     # each on a line of its own however long its paths (soft_wrap): at a pipe's 80 columns, a notebook's capture or
     # a log, 'histories: … (…; as CSV: masonry export h --top)' broke its path and command over two lines
     console.print(
-        f"{_n(len(rows), 'row')} in {result.out} ({_n(result.ran, 'run')} now, {_n(result.skipped, 'row')} already "
+        f"{counted(len(rows), 'row')} in {result.out} ({counted(result.ran, 'run')} now, {counted(result.skipped, 'row')} already "
         f"there, {result.failed} failed) in {result.wall_time:.1f} s",
         soft_wrap=True,
     )
@@ -442,8 +443,3 @@ def _recorded(signals: FirstSignalStops, written: list, out: OutputFile):
     with signals.held():
         yield
         written.append(out.path)
-
-
-def _n(count: int, word: str) -> str:
-    """``1 row``, ``2 rows``, ``0 rows`` (it said "1 rows in s.csv (1 runs now, ...)")."""
-    return f"{count} {word}{'' if count == 1 else 's'}"

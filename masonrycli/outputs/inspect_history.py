@@ -18,6 +18,7 @@ import numpy as np
 
 from masonrycli.errors import NOT_A_FILE, InputError, file_kind, one_line
 from masonrycli.outputs.files import being_written
+from masonrycli.outputs.verdict import counted
 
 NOT_RECORDED = "not recorded"
 _ZIP_MAGIC = b"PK\x03\x04"
@@ -167,10 +168,6 @@ def _dtype_name(dtype: np.dtype) -> str:
     return "str" if dtype.kind == "U" else dtype.name
 
 
-def _plural(n: int, word: str) -> str:
-    return f"{n} {word}{'' if n == 1 else 's'}"
-
-
 def run_rows(info: dict) -> list[tuple[str, str]]:
     """The summary's rows (label, value) before the arrays: the run's metadata, what the file spans."""
     run = info["run"]
@@ -239,7 +236,7 @@ def run_rows(info: dict) -> list[tuple[str, str]]:
     span = info["time_span"]
     rows.append(("time_span", f"{span[0]:g} … {span[1]:g} s" if span else "—"))
     bodies = [
-        _plural(n, word)
+        counted(n, word)
         for n, word in ((info["blocks"], "block"), (info["supports"], "support"), (info["joints"], "joint"))
         if n is not None
     ]

@@ -62,3 +62,8 @@ def shown(value: float) -> str:
     """3 significant digits, and 0 below 1e-6 (% or mm): a wall at rest read 'residual drift 2.16e-17 % ...,
     largest opening 1.67e-32 mm', round-off dressed as a measurement."""
     return "0" if abs(value) < 1e-6 else f"{value:.3g}"
+
+
+def counted(n: int, word: str) -> str:
+    """``1 run``, ``2 runs``, ``0 rows``: a count and its noun, plural unless one ("1 runs" was said)."""
+    return f"{n} {word}{'' if n == 1 else 's'}"

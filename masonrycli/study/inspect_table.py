@@ -13,6 +13,7 @@ from collections import Counter
 from pathlib import Path
 
 from masonrycli.errors import InputError
+from masonrycli.outputs.verdict import counted
 from masonrycli.records.intensity import UNITS as IM_UNITS
 from masonrycli.study.curves import UNITS as PARAM_UNITS
 
@@ -69,7 +70,7 @@ def study_summary(path) -> tuple[list[tuple[str, str]], list[tuple[str, str]]]:
     if not path.is_file() and waiting:  # killed (kill -9, out of memory) before it wrote its table: it said
         # "no such file", as if the finished runs were lost
         raise InputError(
-            f"{path}: not written yet — {_rows(waiting)} finished, in {path.name}.journal.jsonl (a study still "
+            f"{path}: not written yet — {counted(waiting, 'row')} finished, in {path.name}.journal.jsonl (a study still "
             "running, or killed before it wrote its table): the same masonry sweep command writes it and runs the rest"
         )
     if not path.is_file():
@@ -103,7 +104,7 @@ def study_summary(path) -> tuple[list[tuple[str, str]], list[tuple[str, str]]]:
     if "command" in columns and rows:  # first, as inspect H.npz shows what made a history
         table.insert(0, ("command", _commands(rows)))
     if rows and waiting:  # a resumed study still running, or killed: the table is of its last stop
-        more = f"{_rows(waiting)} finished since this table was written, in {path.name}.journal.jsonl"
+        more = f"{counted(waiting, 'row')} finished since this table was written, in {path.name}.journal.jsonl"
         table.insert(1, ("journal", f"{more} (the study still running, or killed: the same command adds them)"))
     if find:
         table.insert(1, ("search", f"--find {find}: {find}_threshold, {find}_lo, {find}_hi"))
@@ -147,7 +148,7 @@ def _commands(rows: list[dict]) -> str:
     lines = [c for c in dict.fromkeys(made) if c]
     unknown = made.count("")
     if unknown:
-        lines.append(f"{_rows(unknown)}: not recorded" if lines else "not recorded")
+        lines.append(f"{counted(unknown, 'row')}: not recorded" if lines else "not recorded")
     return "\n".join(lines)
 
 
@@ -175,10 +176,6 @@ def _journal_rows(path: Path) -> int:
         return 0
     with open(journal, errors="replace") as fh:
         return sum(1 for line in fh if line.rstrip().endswith("}"))
-
-
-def _rows(n: int) -> str:
-    return f"{n} row{'s' if n != 1 else ''}"
 
 
 def _none_yet(path: Path) -> str:

@@ -33,6 +33,7 @@ from collections.abc import Callable
 from multiprocessing import resource_tracker
 
 from masonrycli.errors import InputError
+from masonrycli.outputs.verdict import counted
 from masonrycli.study.scheduler import connect
 from masonrycli.study.task import empty_result, run_task
 
@@ -286,7 +287,7 @@ def run_on_cluster(
                         row = params | empty_result(gave_up[0], 0.0)
                     elif _scheduler_lost(client, exc):
                         raise SchedulerLost(
-                            f"lost the connection to the scheduler with {watching.runs(not_made())} pending"
+                            f"lost the connection to the scheduler with {counted(not_made(), 'run')} pending"
                         ) from None
                     elif isinstance(exc, KilledWorker) and future.key not in alone and not gave_up:
                         with lock:

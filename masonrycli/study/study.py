@@ -20,6 +20,7 @@ import numpy as np
 from rich.console import Console
 
 from masonrycli.errors import InputError
+from masonrycli.outputs.verdict import counted
 from masonrycli.study import files, store
 from masonrycli.study.axes import Axis, StudyBase, apply_point, check_axes, check_find, grid
 from masonrycli.study.drivers import FindDriver, GridDriver
@@ -183,13 +184,13 @@ def _run_study(base: StudyBase, request: StudyRequest, console: Console) -> Stud
         made = sorted({str(r["source"]) for r in other if r.get("source")})
         was = "was" if len(other) - len(unknown) == 1 else "were"
         request.warn(
-            f"{_rows(len(other) - len(unknown))} of {request.out} {was} made by another masonry (source "
+            f"{counted(len(other) - len(unknown), 'row')} of {request.out} {was} made by another masonry (source "
             f"{', '.join(made[:3])}; this one is {source}): kept, not run again — remove them (or the file) to run "
             "them with this one"
         )
     if unknown and request.warn is not None:
         request.warn(
-            f"{_rows(len(unknown))} of {request.out} {'does' if len(unknown) == 1 else 'do'} not say which masonry "
+            f"{counted(len(unknown), 'row')} of {request.out} {'does' if len(unknown) == 1 else 'do'} not say which masonry "
             "made them (written before rows named their source): kept, not run again"
         )
     for line in request.warnings if request.warn is not None else ():
@@ -275,10 +276,6 @@ def _run_study(base: StudyBase, request: StudyRequest, console: Console) -> Stud
     failed = sum(1 for r in rows if r.get("status") == "error")
     found = tuple(getattr(driver, "warnings", ()))
     return StudyResult(rows, columns, driver.skipped, ran, time.perf_counter() - start, failed, table.path, found)
-
-
-def _rows(n: int) -> str:
-    return f"{n} row" + ("" if n == 1 else "s")
 
 
 def _close(client, cluster) -> None:

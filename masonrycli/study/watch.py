@@ -10,6 +10,8 @@ import threading
 import time
 from collections.abc import Callable
 
+from masonrycli.outputs.verdict import counted
+
 NO_WORKER_WAIT = 10.0
 """s with runs pending and no worker on the scheduler before the study says it waits for one."""
 WATCH_EVERY = 1.0
@@ -98,7 +100,7 @@ class WorkerWatch:
                     quiet = True
                     self.warn(
                         f"{self.where}: the scheduler has not answered for {NO_ANSWER_WAIT:g} s (stopped, its "
-                        f"machine overloaded or cut off?), {runs(self.waiting())} waiting: the study goes on when it "
+                        f"machine overloaded or cut off?), {counted(self.waiting(), 'run')} waiting: the study goes on when it "
                         "answers (Ctrl-C stops it, every finished row written)"
                     )
                 continue
@@ -121,7 +123,8 @@ class WorkerWatch:
             if not said and time.monotonic() - since >= NO_WORKER_WAIT:
                 said = True
                 self.warn(
-                    f"{self.where}: no worker for {NO_WORKER_WAIT:g} s, {runs(self.waiting())} waiting: " + self._plan()
+                    f"{self.where}: no worker for {NO_WORKER_WAIT:g} s, {counted(self.waiting(), 'run')} waiting: "
+                    + self._plan()
                 )
             if self.give_up is not None and time.monotonic() - since >= NO_WORKER_LIMIT and self.waiting():
                 self.give_up(self.left)
@@ -168,8 +171,3 @@ class WorkerWatch:
         # ``_correct_state`` is free to change in any release); one that fails to start is closed, and replaced
         # at a later look.
         cluster.scale(len(cluster.worker_spec))
-
-
-def runs(n: int) -> str:
-    """'1 run', '8 runs' ("1 runs waiting", "with 1 runs pending" were said when one point was left)."""
-    return f"{n} run{'' if n == 1 else 's'}"
